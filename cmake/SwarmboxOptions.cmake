@@ -1,0 +1,28 @@
+# Warnings and sanitizers for every SwarmBox target, set in one place.
+# Usage: swarmbox_target_defaults(<target>) on every library and executable we own.
+# Generated code (idlc, fastddsgen) gets swarmbox_generated_defaults() instead: no warnings of ours.
+
+set(SWARMBOX_WARNINGS -Wall -Wextra -Wshadow -Wconversion -Wsign-conversion -Wnon-virtual-dtor
+    -Wold-style-cast -Woverloaded-virtual -Wnull-dereference -Wimplicit-fallthrough)
+if(SWARMBOX_WERROR)
+  list(APPEND SWARMBOX_WARNINGS -Werror)
+endif()
+
+if(SANITIZER)
+  message(STATUS "SwarmBox: building with -fsanitize=${SANITIZER}")
+  add_compile_options(-fsanitize=${SANITIZER} -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  add_link_options(-fsanitize=${SANITIZER})
+endif()
+
+function(swarmbox_target_defaults target)
+  get_target_property(type ${target} TYPE)
+  if(type STREQUAL "INTERFACE_LIBRARY")
+    return()
+  endif()
+  target_compile_options(${target} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:${SWARMBOX_WARNINGS}>)
+endfunction()
+
+function(swarmbox_generated_defaults target)
+  target_compile_options(${target} PRIVATE -w)
+  set_target_properties(${target} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+endfunction()

@@ -1,0 +1,163 @@
+#include "swarmbox/common/logfmt.hpp"
+
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+
+namespace swarmbox {
+
+namespace {
+
+bool NeedsQuoting(std::string_view v) {
+  if (v.empty()) return true;
+  for (char c : v) {
+    if (c == ' ' || c == '=' || c == '"' || c == '\\' || c == '\t' || c == '\n' || c == '\r') return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::string LogfmtValue(std::string_view value) {
+  if (!NeedsQuoting(value)) return std::string(value);
+  std::string out = "\"";
+  for (char c : value) {
+    switch (c) {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        out.push_back(c);
+    }
+  }
+  out.push_back('"');
+  return out;
+}
+
+LogEvent::LogEvent(double t_s, std::string_view node, std::string_view event) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "t=%.3f", t_s);
+  line_.reserve(128);
+  line_ += buf;
+  line_ += " node=";
+  line_ += LogfmtValue(node);
+  line_ += " event=";
+  line_ += LogfmtValue(event);
+}
+
+LogEvent& LogEvent::Add(std::string_view key, std::string_view value) {
+  line_.push_back(' ');
+  line_ += key;
+  line_.push_back('=');
+  line_ += LogfmtValue(value);
+  return *this;
+}
+
+LogEvent& LogEvent::Add(std::string_view key, double value, int decimals) {
+  char buf[64];
+  if (std::isfinite(value)) {
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  } else {
+    std::snprintf(buf, sizeof buf, "%s", std::isnan(value) ? "nan" : (value > 0 ? "inf" : "-inf"));
+  }
+  return Add(key, std::string_view(buf));
+}
+
+LogEvent& LogEvent::Add(std::string_view key, std::int64_t value) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%" PRId64, value);
+  return Add(key, std::string_view(buf));
+}
+
+LogEvent& LogEvent::Add(std::string_view key, std::uint64_t value) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%" PRIu64, value);
+  return Add(key, std::string_view(buf));
+}
+
+LogEvent& LogEvent::Add(std::string_view key, bool value) {
+  return Add(key, std::string_view(value ? "true" : "false"));
+}
+
+LogfmtFields ParseLogfmt(std::string_view line) {
+  LogfmtFields out;
+  std::size_t i = 0;
+  const std::size_t n = line.size();
+  auto is_key_char = [](char c) {
+    return c != ' ' && c != '=' && c != '"' && c != '\t' && c != '\r' && c != '\n';
+  };
+  while (i < n) {
+    while (i < n && !is_key_char(line[i])) ++i;
+    std::size_t key_start = i;
+    while (i < n && is_key_char(line[i])) ++i;
+    if (i == key_start) break;
+    std::string key(line.substr(key_start, i - key_start));
+    if (i >= n || line[i] != '=') {
+      // A bare word: only a field when the line is logfmt at all; keep it as a flag.
+      out.emplace_back(std::move(key), std::string());
+      continue;
+    }
+    ++i;  // '='
+    std::string value;
+    if (i < n && line[i] == '"') {
+      ++i;
+      while (i < n && line[i] != '"') {
+        if (line[i] == '\\' && i + 1 < n) {
+          ++i;
+          switch (line[i]) {
+            case 'n':
+              value.push_back('\n');
+              break;
+            case 'r':
+              value.push_back('\r');
+              break;
+            case 't':
+              value.push_back('\t');
+              break;
+            default:
+              value.push_back(line[i]);
+          }
+        } else {
+          value.push_back(line[i]);
+        }
+        ++i;
+      }
+      if (i < n) ++i;  // closing quote
+    } else {
+      std::size_t v_start = i;
+      while (i < n && line[i] != ' ' && line[i] != '\t' && line[i] != '\r' && line[i] != '\n') ++i;
+      value = std::string(line.substr(v_start, i - v_start));
+    }
+    out.emplace_back(std::move(key), std::move(value));
+  }
+  bool any_pair = false;
+  for (const auto& [k, v] : out) {
+    (void)v;
+    if (!k.empty()) any_pair = true;
+  }
+  // A line without a single k=v pair is not logfmt.
+  bool has_equals = line.find('=') != std::string_view::npos;
+  if (!any_pair || !has_equals) out.clear();
+  return out;
+}
+
+std::optional<std::string> FindField(const LogfmtFields& fields, std::string_view key) {
+  for (const auto& [k, v] : fields) {
+    if (k == key) return v;
+  }
+  return std::nullopt;
+}
+
+}  // namespace swarmbox
