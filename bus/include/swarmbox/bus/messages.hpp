@@ -1,0 +1,276 @@
+// SwarmBox bus messages: plain C++ value types, one per IDL type in bus/idl/swarmbox.idl.
+//
+// These structs are what publishers and subscribers exchange (see participant.hpp). They mirror
+// the IDL field for field (same names, same order, same types: `string` -> std::string,
+// `sequence<T>` -> std::vector<T>, `T x[N]` -> std::array<T, N>, `octet` -> std::uint8_t) and
+// carry no vendor types; each backend converts them to and from its generated types.
+//
+// Conventions (ARCHITECTURE.md): world frame ENU (x east, y north, z up) in metres, body frame
+// FLU (x forward, y left, z up), quaternions (w,x,y,z) rotating body to world, SI units with the
+// unit in the name. `sim_time_ns` is simulated time in nanoseconds since the start of the trial;
+// `*_wall_ns` is wall-clock time in nanoseconds since the Unix epoch (CLOCK_REALTIME).
+//
+// Which topic and QoS each type travels on: see topics.hpp.
+//
+//   SensorSample s;
+//   s.drone = "scout_1"; s.step = 42; s.imu.valid = true; s.imu.accel_m_s2 = {0, 0, 9.81};
+//   publisher->Publish(s);
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace swarmbox::bus {
+
+// ---- sim domain: physics server <-> agents ---------------------------------------------------
+
+// Simulated clock, published by the physics server once per step on topic kClockTopic.
+struct ClockTick {
+  std::uint64_t step = 0;           // control step counter, 0 at the start of the trial
+  std::int64_t sim_time_ns = 0;     // simulated time at this step
+  std::int64_t step_period_ns = 0;  // length of one control step (4'000'000 at 250 Hz)
+  double rtf = 0.0;                 // real-time factor the server paces to (0 = as fast as possible)
+  bool operator==(const ClockTick&) const = default;
+};
+
+// Inertial measurement in the body frame (FLU).
+struct ImuSample {
+  bool valid = false;
+  std::array<double, 3> accel_m_s2{};  // specific force [m/s^2], body FLU (reads +9.81 z at rest)
+  std::array<double, 3> gyro_rad_s{};  // angular rate [rad/s], body FLU
+  double temperature_c = 0.0;          // sensor temperature [degC]
+  bool operator==(const ImuSample&) const = default;
+};
+
+struct BaroSample {
+  bool valid = false;
+  double pressure_pa = 0.0;    // static pressure [Pa]
+  double altitude_m = 0.0;     // pressure altitude above the world origin [m] (ENU z)
+  double temperature_c = 0.0;  // [degC]
+  bool operator==(const BaroSample&) const = default;
+};
+
+struct MagSample {
+  bool valid = false;
+  std::array<double, 3> field_gauss{};  // magnetic field [gauss], body FLU
+  bool operator==(const MagSample&) const = default;
+};
+
+// GPS fix type, as u-blox/PX4 number them.
+enum class GpsFix : std::uint8_t { kNone = 0, k2d = 2, k3d = 3 };
+
+struct GpsSample {
+  bool valid = false;  // false during a dropout: the other fields are then meaningless
+  GpsFix fix_type = GpsFix::kNone;
+  std::uint8_t num_satellites = 0;
+  double latitude_deg = 0.0;   // WGS84
+  double longitude_deg = 0.0;  // WGS84
+  double altitude_m = 0.0;     // above mean sea level [m]
+  // The same fix in the world ENU frame (origin = the world's geodetic origin) [m]; includes the
+  // same noise/degradation as the geodetic fields.
+  std::array<double, 3> position_enu_m{};
+  std::array<double, 3> velocity_enu_m_s{};  // [m/s], world ENU
+  double h_acc_m = 0.0;                      // 1-sigma horizontal accuracy [m]
+  double v_acc_m = 0.0;                      // 1-sigma vertical accuracy [m]
+  bool operator==(const GpsSample&) const = default;
+};
+
+struct BatterySample {
+  bool valid = false;
+  double voltage_v = 0.0;
+  double current_a = 0.0;  // discharge current [A], positive when discharging
+  double remaining = 0.0;  // state of charge [0, 1]
+  bool operator==(const BatterySample&) const = default;
+};
+
+// One drone's sensors for one control step. Physics server -> agent, on
+// SensorTopic(drone) with Qos::kLockstep. The agent answers with an ActuatorCommand carrying the
+// same `step`.
+struct SensorSample {
+  std::string drone;  // drone name, e.g. "scout_1"
+  std::uint64_t step = 0;
+  std::int64_t sim_time_ns = 0;
+  ImuSample imu;
+  BaroSample baro;
+  MagSample mag;
+  GpsSample gps;
+  BatterySample battery;
+  bool operator==(const SensorSample&) const = default;
+};
+
+// Motor commands for one step. Agent -> physics server, on ActuatorTopic(drone) with
+// Qos::kLockstep.
+struct ActuatorCommand {
+  std::string drone;
+  std::uint64_t step = 0;  // the SensorSample::step this command answers
+  std::int64_t sim_time_ns = 0;
+  bool armed = false;                 // false: motors off whatever motor_throttle says
+  std::vector<double> motor_throttle;  // per motor, normalised [0, 1], in the airframe's motor order
+  bool operator==(const ActuatorCommand&) const = default;
+};
+
+// Pinhole intrinsics of a camera image [pixels]; distortion is OpenCV's (k1, k2, p1, p2, k3).
+struct CameraIntrinsics {
+  double fx_px = 0.0;
+  double fy_px = 0.0;
+  double cx_px = 0.0;
+  double cy_px = 0.0;
+  std::array<double, 5> distortion{};
+  bool operator==(const CameraIntrinsics&) const = default;
+};
+
+// A rigid pose in the world frame: position [m] ENU and the quaternion (w, x, y, z) rotating the
+// frame named by the field that holds the Pose into world ENU.
+struct Pose {
+  std::array<double, 3> position_enu_m{};
+  std::array<double, 4> orientation_wxyz{1.0, 0.0, 0.0, 0.0};
+  bool operator==(const Pose&) const = default;
+};
+
+// One camera frame. Physics server -> agent, on CameraTopic(drone) with Qos::kLockstep (5 Hz,
+// 320x240 mono8/bgr8, ~80 KB).
+struct CameraImage {
+  std::string drone;
+  std::uint64_t step = 0;  // the control step at which the image was captured
+  std::int64_t sim_time_ns = 0;
+  std::uint32_t width_px = 0;
+  std::uint32_t height_px = 0;
+  std::uint32_t row_stride_bytes = 0;  // bytes from one row to the next in `data`
+  std::string encoding;                // "mono8", "bgr8" or "rgb8" (OpenCV/ROS names)
+  CameraIntrinsics intrinsics;
+  // Pose of the camera's optical frame (OpenCV convention: x right, y down, z along the optical
+  // axis) at capture: position in world ENU and the rotation optical frame -> world.
+  Pose camera_pose;
+  std::vector<std::uint8_t> data;  // height_px * row_stride_bytes bytes, row-major, top row first
+  bool operator==(const CameraImage&) const = default;
+};
+
+// A command to the world (fault injection), to the physics server on kWorldCommandTopic with
+// Qos::kLockstep. The physics server owns the meaning of `command` and `args` and must reject
+// (log) unknown ones; the names in use are
+//   gps_dropout {duration_s}, gps_degrade {duration_s, h_acc_m, v_acc_m},
+//   imu_bias_jump {ax, ay, az [m/s^2], gx, gy, gz [rad/s]}, wind_gust {vx, vy, vz [m/s], duration_s},
+//   payload_attach {mass_kg}, payload_release {}.
+struct WorldCommand {
+  std::uint64_t seq = 0;          // per sender, increasing; lets the server drop duplicates
+  std::int64_t sim_time_ns = 0;   // when to apply it; at or before the current time = now
+  std::string target;             // drone name, or "" for the whole world (e.g. wind)
+  std::string command;            // e.g. "gps_dropout"
+  std::vector<double> args;       // numeric arguments, in the order documented for `command`
+  bool operator==(const WorldCommand&) const = default;
+};
+
+// ---- mesh domain: agent <-> agent (the radio) ----------------------------------------------
+
+// What a drone tells its neighbours about itself, on kDroneStateTopic with Qos::kState. Keyed on
+// `drone`: a subscriber keeps the latest sample per drone.
+struct DroneState {
+  std::string drone;  // the key
+  std::uint64_t seq = 0;
+  std::int64_t sim_time_ns = 0;
+  std::int64_t wall_time_ns = 0;
+  std::array<double, 3> position_enu_m{};
+  std::array<double, 3> velocity_enu_m_s{};
+  double heading_rad = 0.0;       // yaw in world ENU: 0 = facing east, counter-clockwise positive
+  double battery_fraction = 0.0;  // [0, 1]
+  std::string mode;               // the agent's flight/mission mode, e.g. "search"
+  bool operator==(const DroneState&) const = default;
+};
+
+// A Raft message, on kRaftTopic with Qos::kRadio (best effort: Raft retries; loss stays visible).
+// The bus does not look inside `payload`.
+struct RaftMessage {
+  std::string from;
+  std::string to;  // recipient drone name; subscribers drop messages not addressed to them
+  std::uint64_t term = 0;
+  std::vector<std::uint8_t> payload;
+  bool operator==(const RaftMessage&) const = default;
+};
+
+// A perception result shared on the mesh, on kDetectionTopic with Qos::kRadio.
+struct Detection {
+  std::string from;  // the drone that saw it
+  std::uint64_t seq = 0;
+  std::int64_t sim_time_ns = 0;
+  std::string label;        // e.g. "victim"
+  double confidence = 0.0;  // [0, 1]
+  std::array<double, 3> position_enu_m{};
+  double position_sigma_m = 0.0;  // 1-sigma horizontal uncertainty of position_enu_m [m]
+  bool operator==(const Detection&) const = default;
+};
+
+// Radio ping/pong for RTT and loss, on kRadioPingTopic with Qos::kRadio. A pong copies `seq`
+// and `sent_wall_ns` from its ping, swaps from/to and sets is_pong.
+struct RadioPing {
+  std::string from;
+  std::string to;
+  std::uint64_t seq = 0;
+  std::int64_t sent_wall_ns = 0;  // wall clock of the original ping's sender
+  bool is_pong = false;
+  bool operator==(const RadioPing&) const = default;
+};
+
+// ---- both domains ------------------------------------------------------------------------
+
+struct KeyValue {
+  std::string key;
+  std::string value;
+  bool operator==(const KeyValue&) const = default;
+};
+
+// A generic event (the bus form of a logfmt line: `t=.. node=.. event=.. k=v ...`), on
+// kEventTopic with Qos::kRadio.
+struct Event {
+  std::string node;
+  std::int64_t sim_time_ns = 0;
+  std::string name;  // the logfmt `event`, e.g. "leader_elected"
+  std::vector<KeyValue> fields;
+  bool operator==(const Event&) const = default;
+};
+
+// ---- type registry (used by the API to pick the backend's generated type) -----------------
+
+enum class MessageType : std::uint8_t {
+  kClockTick,
+  kSensorSample,
+  kActuatorCommand,
+  kCameraImage,
+  kWorldCommand,
+  kDroneState,
+  kRaftMessage,
+  kDetection,
+  kRadioPing,
+  kEvent,
+};
+inline constexpr int kMessageTypeCount = 10;
+
+// The DDS type name on the wire, e.g. "swarmbox::msg::SensorSample".
+std::string_view MessageTypeName(MessageType type);
+
+template <typename T>
+struct MessageTraits;  // only the top-level message types above are specialised
+
+#define SWARMBOX_BUS_MESSAGE_TRAITS(T)                             \
+  template <>                                                      \
+  struct MessageTraits<T> {                                        \
+    static constexpr MessageType kType = MessageType::k##T;        \
+  }
+SWARMBOX_BUS_MESSAGE_TRAITS(ClockTick);
+SWARMBOX_BUS_MESSAGE_TRAITS(SensorSample);
+SWARMBOX_BUS_MESSAGE_TRAITS(ActuatorCommand);
+SWARMBOX_BUS_MESSAGE_TRAITS(CameraImage);
+SWARMBOX_BUS_MESSAGE_TRAITS(WorldCommand);
+SWARMBOX_BUS_MESSAGE_TRAITS(DroneState);
+SWARMBOX_BUS_MESSAGE_TRAITS(RaftMessage);
+SWARMBOX_BUS_MESSAGE_TRAITS(Detection);
+SWARMBOX_BUS_MESSAGE_TRAITS(RadioPing);
+SWARMBOX_BUS_MESSAGE_TRAITS(Event);
+#undef SWARMBOX_BUS_MESSAGE_TRAITS
+
+template <typename T>
+concept BusMessage = requires { MessageTraits<T>::kType; };
+
+}  // namespace swarmbox::bus

@@ -1,0 +1,68 @@
+// Topic names and QoS presets of the SwarmBox bus: which message travels where.
+//
+// Per-drone traffic has a topic per drone so it does not fan out to every drone (100 agents must
+// not each receive 100 sensor streams); radio-wide traffic shares one topic per type and is
+// addressed by drone name where needed (RaftMessage::to, RadioPing::to).
+//
+//   domain  topic                      type             QoS         direction
+//   sim     sim/clock                  ClockTick        kLockstep   physics -> all
+//   sim     sim/<drone>/sensor         SensorSample     kLockstep   physics -> agent <drone>
+//   sim     sim/<drone>/actuator       ActuatorCommand  kLockstep   agent <drone> -> physics
+//   sim     sim/<drone>/camera         CameraImage      kLockstep   physics -> agent <drone>
+//   sim     sim/world_command          WorldCommand     kLockstep   orchestrator/tools -> physics
+//   mesh    mesh/state                 DroneState       kState      agent -> agents (keyed by drone)
+//   mesh    mesh/raft                  RaftMessage      kRadio      agent -> agent `to`
+//   mesh    mesh/detection             Detection        kRadio      agent -> agents
+//   mesh    mesh/ping                  RadioPing        kRadio      agent -> agent `to` (and back)
+//   both    event                      Event            kRadio      anyone -> loggers
+//
+// Topic names may hold only ASCII letters, digits, '_' and '/', and must start with a letter
+// (Cyclone DDS rejects anything else, so the rule is checked up front for both backends). Drone
+// names must therefore be [A-Za-z0-9_]+.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "swarmbox/common/result.hpp"
+
+namespace swarmbox::bus {
+
+// QoS presets. A subscriber must use the same preset as the publishers it wants to hear
+// (a best-effort subscriber would also hear a reliable publisher, but not the reverse).
+// All presets are volatile (no history for late joiners) and keep-last.
+enum class Qos {
+  // Reliable, keep-last 16 per writer. For the lossless sim network: sensor/actuator lockstep,
+  // camera, clock, world commands. A dead reader never blocks the writer for long: history is
+  // keep-last, old samples are overwritten.
+  kLockstep,
+  // Best-effort, keep-last 256. For the radio: Raft, detections, pings, events. Loss on the mesh
+  // stays visible to the application (Raft and the ping protocol do their own retries).
+  kRadio,
+  // Reliable, keep-last 1 per instance (DroneState is keyed by drone): a subscriber sees the
+  // latest state of each neighbour; a lost update is repaired only by a newer one or by the
+  // reliability protocol, never queued behind stale ones.
+  kState,
+};
+
+std::string_view QosName(Qos qos);  // "lockstep", "radio", "state"
+
+inline constexpr std::string_view kClockTopic = "sim/clock";
+inline constexpr std::string_view kWorldCommandTopic = "sim/world_command";
+inline constexpr std::string_view kDroneStateTopic = "mesh/state";
+inline constexpr std::string_view kRaftTopic = "mesh/raft";
+inline constexpr std::string_view kDetectionTopic = "mesh/detection";
+inline constexpr std::string_view kRadioPingTopic = "mesh/ping";
+inline constexpr std::string_view kEventTopic = "event";
+
+std::string SensorTopic(std::string_view drone);    // "sim/<drone>/sensor"
+std::string ActuatorTopic(std::string_view drone);  // "sim/<drone>/actuator"
+std::string CameraTopic(std::string_view drone);    // "sim/<drone>/camera"
+
+// kInvalidArgument with the offending character and the rule when `topic` is not a valid name.
+Status ValidateTopicName(std::string_view topic);
+
+// kInvalidArgument unless `drone` is a non-empty [A-Za-z0-9_]+ name.
+Status ValidateDroneName(std::string_view drone);
+
+}  // namespace swarmbox::bus
