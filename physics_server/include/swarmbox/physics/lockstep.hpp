@@ -1,0 +1,62 @@
+// Lockstep: which drones answered which control step, and who is lost. Pure logic, no clock:
+// the caller passes `now_ns` (any monotonic clock; tests use a fake one).
+//
+//   Lockstep ls(n, {.timeout_ns = 2'000'000'000});
+//   ls.BeginStep(step, now);                 // samples for `step` published
+//   ls.OnCommand(drone, step, now);          // commands arrive (late/early ones are rejected)
+//   while (!ls.StepComplete(now)) wait();    // every live drone answered, or timed out
+//   for (auto d : ls.TakeNewlyLost()) world.SetLost(d, true);
+//
+// A drone is lost when it has not answered the current step within timeout_ns of the later of
+// (the step's start, its last answer). Before a drone's first answer, join_timeout_ns applies
+// instead (agents start slower than the server). A lost drone that answers the current step
+// rejoins (TakeRejoined()).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace swarmbox::physics {
+
+struct LockstepOptions {
+  std::int64_t timeout_ns = 1'000'000'000;       // silence that marks a live drone lost
+  std::int64_t join_timeout_ns = 30'000'000'000; // before its first answer
+};
+
+class Lockstep {
+ public:
+  enum class Answer { kAccepted, kDuplicate, kWrongStep, kUnknownDrone };
+
+  Lockstep(std::size_t drone_count, LockstepOptions options);
+
+  void BeginStep(std::uint64_t step, std::int64_t now_ns);
+  Answer OnCommand(std::size_t drone, std::uint64_t step, std::int64_t now_ns);
+  // True when every live drone answered the current step; marks drones lost whose time ran out.
+  bool StepComplete(std::int64_t now_ns);
+  // The earliest time at which a waiting drone times out (for a bounded wait); INT64_MAX if none.
+  std::int64_t NextDeadlineNs() const;
+
+  std::vector<std::size_t> TakeNewlyLost();
+  std::vector<std::size_t> TakeRejoined();
+  bool lost(std::size_t drone) const { return drones_[drone].lost; }
+  bool answered(std::size_t drone) const { return drones_[drone].answered; }
+  bool joined(std::size_t drone) const { return drones_[drone].joined; }
+  std::uint64_t step() const { return step_; }
+  std::size_t live_count() const;
+
+ private:
+  struct DroneState {
+    bool joined = false;
+    bool answered = false;
+    bool lost = false;
+    std::int64_t last_heard_ns = 0;
+  };
+  LockstepOptions options_;
+  std::vector<DroneState> drones_;
+  std::uint64_t step_ = 0;
+  std::int64_t step_start_ns_ = 0;
+  std::vector<std::size_t> newly_lost_;
+  std::vector<std::size_t> rejoined_;
+};
+
+}  // namespace swarmbox::physics
