@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# SwarmBox set-up: from a fresh Debian 12 machine to one that builds, tests and runs trials.
+#
+# - installs every Debian package the project needs (build, test, run), only when one is missing;
+# - starts a Docker engine when none answers on /var/run/docker.sock (systemd when it runs the
+#   machine, else dockerd in the background with its log in /var/log/swarmbox-dockerd.log).
+# Idempotent, and quiet when everything is already there. Needs root (or sudo).
+# No registry is needed: SwarmBox builds its images FROM scratch (ARCHITECTURE.md).
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git ca-certificates curl
+  # messaging: Cyclone DDS (C API + idlc) and Fast DDS (+ fastddsgen)
+  cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
+  # physics, maths, vision, formats, HTTP, archives
+  libode-dev libeigen3-dev libopencv-dev libyaml-dev libcurl4-openssl-dev libarchive-dev zlib1g-dev
+  # command line, formatting, netfilter queue (userspace netem fallback)
+  libcli11-dev libfmt-dev libnetfilter-queue-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+  # containers, networks, hosts
+  docker.io docker-compose iptables iproute2 openssh-server openssh-client procps psmisc
+)
+
+log() { printf 'setup: %s\n' "$*"; }
+die() { printf 'setup: error: %s\n' "$*" >&2; exit 1; }
+
+SUDO=()
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null 2>&1 || die "run as root (or install sudo): packages and dockerd need it"
+  SUDO=(sudo)
+fi
+
+[ -r /etc/debian_version ] || die "this script targets Debian 12 (bookworm); /etc/debian_version not found"
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if [ "${#missing[@]}" -gt 0 ]; then
+  log "installing ${#missing[@]} package(s): ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  "${SUDO[@]}" apt-get update -qq >/dev/null || die "apt-get update failed"
+  if ! "${SUDO[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/tmp/swarmbox-apt.log 2>&1; then
+    tail -n 30 /tmp/swarmbox-apt.log >&2
+    die "apt-get install failed (full log: /tmp/swarmbox-apt.log)"
+  fi
+fi
+
+docker_answers() {
+  curl -fsS --max-time 3 --unix-socket /var/run/docker.sock http://localhost/_ping >/dev/null 2>&1
+}
+
+if ! docker_answers; then
+  if [ -d /run/systemd/system ] && command -v systemctl >/dev/null 2>&1; then
+    log "starting the Docker engine (systemctl start docker)"
+    "${SUDO[@]}" systemctl start docker || die "systemctl start docker failed"
+  else
+    log "starting the Docker engine (dockerd; log: /var/log/swarmbox-dockerd.log)"
+    # Leftover pid file from a dockerd that died with its machine session.
+    if [ -f /var/run/docker.pid ] && ! kill -0 "$(cat /var/run/docker.pid)" 2>/dev/null; then
+      "${SUDO[@]}" rm -f /var/run/docker.pid
+    fi
+    "${SUDO[@]}" setsid dockerd >>/var/log/swarmbox-dockerd.log 2>&1 < /dev/null &
+  fi
+  for _ in $(seq 1 60); do
+    docker_answers && break
+    sleep 0.5
+  done
+  docker_answers || { tail -n 20 /var/log/swarmbox-dockerd.log >&2 || true; die "the Docker engine did not answer on /var/run/docker.sock within 30 s"; }
+  log "Docker engine is up ($(docker version --format '{{.Server.Version}}' 2>/dev/null || echo unknown version))"
+fi
+
+# sshd (multi-host experiments) needs its privilege-separation directory.
+[ -d /run/sshd ] || "${SUDO[@]}" mkdir -p /run/sshd
+exit 0
