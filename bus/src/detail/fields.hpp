@@ -1,0 +1,45 @@
+// Field lists of every bus struct, in IDL order: the one place (besides the IDL and messages.hpp)
+// that names the fields. Each backend expands them into its converters
+// (C++ struct <-> generated type), so a field added to the IDL and messages.hpp but not here is
+// not carried, and the round-trip tests in tests/bus fail for it.
+//
+// SWARMBOX_BUS_STRUCTS lists every struct in dependency order (nested types first).
+#pragma once
+
+#define SWARMBOX_BUS_FIELDS_ClockTick(F) F(step) F(sim_time_ns) F(step_period_ns) F(rtf)
+#define SWARMBOX_BUS_FIELDS_ImuSample(F) F(valid) F(accel_m_s2) F(gyro_rad_s) F(temperature_c)
+#define SWARMBOX_BUS_FIELDS_BaroSample(F) F(valid) F(pressure_pa) F(altitude_m) F(temperature_c)
+#define SWARMBOX_BUS_FIELDS_MagSample(F) F(valid) F(field_gauss)
+#define SWARMBOX_BUS_FIELDS_GpsSample(F)                                                       \
+  F(valid) F(fix_type) F(num_satellites) F(latitude_deg) F(longitude_deg) F(altitude_m)        \
+  F(position_enu_m) F(velocity_enu_m_s) F(h_acc_m) F(v_acc_m)
+#define SWARMBOX_BUS_FIELDS_BatterySample(F) F(valid) F(voltage_v) F(current_a) F(remaining)
+#define SWARMBOX_BUS_FIELDS_SensorSample(F) \
+  F(drone) F(step) F(sim_time_ns) F(imu) F(baro) F(mag) F(gps) F(battery)
+#define SWARMBOX_BUS_FIELDS_ActuatorCommand(F) \
+  F(drone) F(step) F(sim_time_ns) F(armed) F(motor_throttle)
+#define SWARMBOX_BUS_FIELDS_CameraIntrinsics(F) F(fx_px) F(fy_px) F(cx_px) F(cy_px) F(distortion)
+#define SWARMBOX_BUS_FIELDS_Pose(F) F(position_enu_m) F(orientation_wxyz)
+#define SWARMBOX_BUS_FIELDS_CameraImage(F)                                                     \
+  F(drone) F(step) F(sim_time_ns) F(width_px) F(height_px) F(row_stride_bytes) F(encoding)     \
+  F(intrinsics) F(camera_pose) F(data)
+#define SWARMBOX_BUS_FIELDS_WorldCommand(F) F(seq) F(sim_time_ns) F(target) F(command) F(args)
+#define SWARMBOX_BUS_FIELDS_DroneState(F)                                                      \
+  F(drone) F(seq) F(sim_time_ns) F(wall_time_ns) F(position_enu_m) F(velocity_enu_m_s)          \
+  F(heading_rad) F(battery_fraction) F(mode)
+#define SWARMBOX_BUS_FIELDS_RaftMessage(F) F(from) F(to) F(term) F(payload)
+#define SWARMBOX_BUS_FIELDS_Detection(F)                                                       \
+  F(from) F(seq) F(sim_time_ns) F(label) F(confidence) F(position_enu_m) F(position_sigma_m)
+#define SWARMBOX_BUS_FIELDS_RadioPing(F) F(from) F(to) F(seq) F(sent_wall_ns) F(is_pong)
+#define SWARMBOX_BUS_FIELDS_KeyValue(F) F(key) F(value)
+#define SWARMBOX_BUS_FIELDS_Event(F) F(node) F(sim_time_ns) F(name) F(fields)
+
+#define SWARMBOX_BUS_STRUCTS(S)                                                               \
+  S(ClockTick) S(ImuSample) S(BaroSample) S(MagSample) S(GpsSample) S(BatterySample)          \
+  S(SensorSample) S(ActuatorCommand) S(CameraIntrinsics) S(Pose) S(CameraImage)               \
+  S(WorldCommand) S(DroneState) S(RaftMessage) S(Detection) S(RadioPing) S(KeyValue) S(Event)
+
+// The top-level message types (those with a MessageType), for dispatch.
+#define SWARMBOX_BUS_MESSAGES(M)                                                              \
+  M(ClockTick) M(SensorSample) M(ActuatorCommand) M(CameraImage) M(WorldCommand)              \
+  M(DroneState) M(RaftMessage) M(Detection) M(RadioPing) M(Event)
