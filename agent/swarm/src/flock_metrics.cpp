@@ -1,0 +1,55 @@
+#include "swarmbox/swarm/flock_metrics.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+#include "swarmbox/common/result.hpp"
+
+namespace swarmbox::swarm {
+
+FlockMetrics ComputeFlockMetrics(std::span<const Eigen::Vector3d> positions_m,
+                                 std::span<const Eigen::Vector3d> velocities_m_s,
+                                 const FlockMetricsParams& params) {
+  SWARMBOX_CHECK(positions_m.size() == velocities_m_s.size());
+  FlockMetrics m;
+  const std::size_t n = positions_m.size();
+  if (n < 2) return m;
+  std::vector<std::size_t> parent(n);
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  auto find = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
+  std::size_t pairs = 0;
+  std::size_t safe_pairs = 0;
+  double order_sum = 0.0;
+  m.min_distance_m = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const double d = (positions_m[i] - positions_m[j]).norm();
+      ++pairs;
+      if (d >= params.separation_m) ++safe_pairs;
+      m.min_distance_m = std::min(m.min_distance_m, d);
+      nearest[i] = std::min(nearest[i], d);
+      nearest[j] = std::min(nearest[j], d);
+      const Eigen::Vector2d vi = velocities_m_s[i].head<2>();
+      const Eigen::Vector2d vj = velocities_m_s[j].head<2>();
+      if (vi.norm() > 0.1 && vj.norm() > 0.1) order_sum += vi.dot(vj) / (vi.norm() * vj.norm());
+      if (d <= params.link_range_m) parent[find(i)] = find(j);
+    }
+  }
+  m.safety = static_cast<double>(safe_pairs) / static_cast<double>(pairs);
+  m.order = order_sum / static_cast<double>(pairs);
+  int components = 0;
+  for (std::size_t i = 0; i < n; ++i) components += find(i) == i ? 1 : 0;
+  m.components = components;
+  m.union_ = 1.0 - static_cast<double>(components - 1) / static_cast<double>(n - 1);
+  m.mean_nearest_m = std::accumulate(nearest.begin(), nearest.end(), 0.0) / static_cast<double>(n);
+  m.max_nearest_m = *std::max_element(nearest.begin(), nearest.end());
+  return m;
+}
+
+}  // namespace swarmbox::swarm

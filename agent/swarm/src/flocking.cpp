@@ -1,0 +1,163 @@
+// Flocking (see flocking.hpp): V18 terms plus Reynolds alignment/cohesion, no allocation per step.
+#include "swarmbox/swarm/flocking.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "swarmbox/common/result.hpp"
+
+namespace swarmbox::swarm {
+namespace {
+
+// The V18 friction rule for an imposed velocity v_other seen at clearance r: damp the part of the
+// velocity difference that exceeds what can be braked within r - r0.
+Vec2 FrictionRule(const Vec2& v_self, const Vec2& v_other, double r_m, double r0_m, double v_tol,
+                  double a, double p, double gain) {
+  const Vec2 dv = v_other - v_self;
+  const double speed = dv.norm();
+  const double v_allowed = std::max(v_tol, BrakingCurve(r_m - r0_m, a, p));
+  if (speed <= v_allowed || speed < 1e-9) return Vec2::Zero();
+  return gain * (speed - v_allowed) * dv / speed;
+}
+
+Vec2 ClampNorm(const Vec2& v, double max_norm) {
+  const double n = v.norm();
+  return n > max_norm ? Vec2(v * (max_norm / n)) : v;
+}
+
+}  // namespace
+
+double BrakingCurve(double r_m, double a_m_s2, double p_1_s) {
+  if (r_m <= 0.0) return 0.0;
+  const double linear = r_m * p_1_s;
+  if (linear < a_m_s2 / p_1_s) return linear;
+  return std::sqrt(2.0 * a_m_s2 * r_m - (a_m_s2 * a_m_s2) / (p_1_s * p_1_s));
+}
+
+Flocking::Flocking(const FlockingParams& params, const Geofence& fence,
+                   std::vector<ObstacleFootprint> obstacles)
+    : params_(params), fence_(fence), obstacles_(std::move(obstacles)) {
+  SWARMBOX_CHECK(params_.v_max_m_s > 0 && params_.a_max_m_s2 > 0 && params_.v_z_max_m_s > 0);
+  SWARMBOX_CHECK(params_.stale_timeout_s > 0 && params_.fresh_age_s >= 0 &&
+                 params_.fresh_age_s < params_.stale_timeout_s);
+  SWARMBOX_CHECK(params_.p_mig_1_s > 0 && params_.p_frict_1_s > 0 && params_.p_shill_1_s > 0);
+  SWARMBOX_CHECK(fence_.min_x_m < fence_.max_x_m && fence_.min_y_m < fence_.max_y_m);
+}
+
+Vec2 Flocking::ShillTerm(const Vec2& p, const Vec2& v) const {
+  const FlockingParams& k = params_;
+  Vec2 sum = Vec2::Zero();
+  auto add = [&](double clearance_m, const Vec2& away_normal) {
+    sum += FrictionRule(v, k.v_shill_m_s * away_normal, clearance_m, k.r0_shill_m, 0.0,
+                        k.a_shill_m_s2, k.p_shill_1_s, k.c_shill);
+  };
+  // Geofence walls: shill agents at the foot of the perpendicular, moving inward.
+  add(p.x() - fence_.min_x_m, Vec2(1, 0));
+  add(fence_.max_x_m - p.x(), Vec2(-1, 0));
+  add(p.y() - fence_.min_y_m, Vec2(0, 1));
+  add(fence_.max_y_m - p.y(), Vec2(0, -1));
+  // Obstacles: a shill agent at the nearest point of the footprint, moving away from it.
+  for (const ObstacleFootprint& o : obstacles_) {
+    const double c = std::cos(o.yaw_rad);
+    const double s = std::sin(o.yaw_rad);
+    const Vec2 d = p - o.center_m;
+    const Vec2 q(c * d.x() + s * d.y(), -s * d.x() + c * d.y());  // in the obstacle's frame
+    const Vec2 nearest(std::clamp(q.x(), -o.half_size_m.x(), o.half_size_m.x()),
+                       std::clamp(q.y(), -o.half_size_m.y(), o.half_size_m.y()));
+    Vec2 n_local;
+    double clearance = 0.0;
+    const double dist = (q - nearest).norm();
+    if (dist > 1e-9) {
+      n_local = (q - nearest) / dist;
+      clearance = dist;
+    } else {  // inside: leave through the nearest face
+      const double fx = o.half_size_m.x() - std::abs(q.x());
+      const double fy = o.half_size_m.y() - std::abs(q.y());
+      if (fx < fy) {
+        n_local = Vec2(q.x() >= 0 ? 1 : -1, 0);
+        clearance = -fx;
+      } else {
+        n_local = Vec2(0, q.y() >= 0 ? 1 : -1);
+        clearance = -fy;
+      }
+    }
+    add(clearance, Vec2(c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y()));
+  }
+  return sum;
+}
+
+FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
+  SWARMBOX_CHECK(dt_s > 0);
+  const FlockingParams& k = params_;
+  FlockingOutput out;
+  const Vec2 p = in.position_m.head<2>();
+  const Vec2 v = in.velocity_m_s.head<2>();
+
+  if (in.migrate) {
+    const Vec2 to_goal = in.goal_m.head<2>() - p;
+    const double d = to_goal.norm();
+    if (d > 1e-6) {
+      const double speed = std::min(k.v_flock_m_s, BrakingCurve(d, k.a_mig_m_s2, k.p_mig_1_s));
+      out.migration = speed * to_goal / d;
+    }
+  }
+
+  Vec2 centroid_sum = Vec2::Zero();
+  Vec2 velocity_sum = Vec2::Zero();
+  double weight_sum = 0.0;
+  std::size_t index = 0;
+  for (const NeighbourState& n : in.neighbours) {
+    ++index;
+    if (!(n.age_s <= k.stale_timeout_s)) continue;  // stale (or NaN age): dropped
+    const double age = std::max(0.0, n.age_s);
+    const Vec2 pj = n.position_m.head<2>() + age * n.velocity_m_s.head<2>();
+    const Vec2 vj = n.velocity_m_s.head<2>();
+    Vec2 diff = p - pj;
+    double r = diff.norm();
+    if (r > k.sensing_range_m) continue;
+    ++out.neighbours_used;
+    const double w =
+        age <= k.fresh_age_s ? 1.0 : (k.stale_timeout_s - age) / (k.stale_timeout_s - k.fresh_age_s);
+    if (r < 1e-6) {  // coincident: a deterministic direction per neighbour slot
+      const double angle = 2.39996322972865332 * static_cast<double>(index);  // golden angle
+      diff = Vec2(std::cos(angle), std::sin(angle));
+      r = 1e-6;
+    } else {
+      diff /= r;
+    }
+    if (r < k.r0_rep_m) out.repulsion += k.p_rep_1_s * (k.r0_rep_m - r) * diff;
+    out.friction += w * FrictionRule(v, vj, r, k.r0_frict_m, k.v_frict_m_s, k.a_frict_m_s2,
+                                     k.p_frict_1_s, k.c_frict);
+    centroid_sum += w * pj;
+    velocity_sum += w * vj;
+    weight_sum += w;
+  }
+  if (weight_sum > 1e-9) {
+    out.alignment = k.c_align * (velocity_sum / weight_sum - v);
+    const Vec2 to_centroid = centroid_sum / weight_sum - p;
+    const double d = to_centroid.norm();
+    if (d > k.r0_coh_m) {
+      out.cohesion = std::min(k.p_coh_1_s * (d - k.r0_coh_m), k.v_coh_max_m_s) * to_centroid / d;
+    }
+  }
+  out.shill = ShillTerm(p, v);
+
+  const Vec2 v_xy = ClampNorm(out.migration + out.repulsion + out.friction + out.alignment +
+                                  out.cohesion + out.shill,
+                              k.v_max_m_s);
+  const double v_z =
+      std::clamp(k.p_z_1_s * (in.goal_m.z() - in.position_m.z()), -k.v_z_max_m_s, k.v_z_max_m_s);
+  Vec3 desired(v_xy.x(), v_xy.y(), v_z);
+
+  const Vec3 previous = has_last_ ? last_command_m_s_ : in.velocity_m_s;
+  Vec3 dv = desired - previous;
+  const double dv_max = k.a_max_m_s2 * dt_s;
+  if (dv.norm() > dv_max) dv *= dv_max / dv.norm();
+  out.velocity_m_s = previous + dv;
+  last_command_m_s_ = out.velocity_m_s;
+  has_last_ = true;
+  return out;
+}
+
+}  // namespace swarmbox::swarm

@@ -1,0 +1,226 @@
+// Flocking (agent/swarm/flocking.hpp): unit behaviour of each term, then the swarm properties on
+// the kinematic model. "V18" = Vasarhelyi et al., Science Robotics 3(20), 2018.
+#include "swarmbox/swarm/flocking.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "kinematic_swarm.hpp"
+
+namespace swarmbox::swarm {
+namespace {
+
+using testing::KinematicSwarm;
+using testing::KinematicSwarmConfig;
+
+constexpr double kDt = 0.05;  // [s]
+
+// V18 eq. (S6): D(r) is p r for small r and sqrt(2 a r - a^2/p^2) beyond r = a/p^2; continuous.
+TEST(Flocking, BrakingCurveIsLinearThenSquareRootAndContinuous) {
+  EXPECT_DOUBLE_EQ(BrakingCurve(-1.0, 2.0, 1.0), 0.0);
+  EXPECT_DOUBLE_EQ(BrakingCurve(1.0, 2.0, 1.0), 1.0);                    // r p
+  EXPECT_NEAR(BrakingCurve(8.0, 2.0, 1.0), std::sqrt(32.0 - 4.0), 1e-12);  // sqrt(2 a r - a^2/p^2)
+  const double r_switch = 2.0 / (1.0 * 1.0);
+  EXPECT_NEAR(BrakingCurve(r_switch - 1e-9, 2.0, 1.0), BrakingCurve(r_switch + 1e-9, 2.0, 1.0), 1e-6);
+}
+
+// V18 eq. (1): a neighbour inside r0_rep pushes us directly away, linearly in the overlap.
+TEST(Flocking, RepulsionPushesAwayLinearlyInsideR0) {
+  FlockingParams k;
+  Flocking f(k, Geofence{});
+  const std::vector<NeighbourState> n = {{Vec3(3, 0, 10), Vec3::Zero(), 0.0}};
+  const FlockingOutput out = f.Step({Vec3(0, 0, 10), Vec3::Zero(), Vec3(0, 0, 10), n}, kDt);
+  EXPECT_NEAR(out.repulsion.x(), -k.p_rep_1_s * (k.r0_rep_m - 3.0), 1e-12);
+  EXPECT_NEAR(out.repulsion.y(), 0.0, 1e-12);
+  EXPECT_LT(out.velocity_m_s.x(), 0.0);
+  EXPECT_EQ(out.neighbours_used, 1);
+}
+
+TEST(Flocking, StaleNeighbourIsDroppedAndAgeingOneIsDeadReckoned) {
+  FlockingParams k;
+  Flocking f(k, Geofence{});
+  // Older than stale_timeout_s: ignored entirely.
+  std::vector<NeighbourState> n = {{Vec3(3, 0, 10), Vec3::Zero(), k.stale_timeout_s + 0.01}};
+  FlockingOutput out = f.Step({Vec3(0, 0, 10), Vec3::Zero(), Vec3(0, 0, 10), n}, kDt);
+  EXPECT_EQ(out.neighbours_used, 0);
+  EXPECT_TRUE(out.repulsion.isZero());
+  // 1 s old, flying +y at 2 m/s: its dead-reckoned position is (3, 2), so repulsion points to
+  // (-3, -2) / |.|.
+  n = {{Vec3(3, 0, 10), Vec3(0, 2, 0), 1.0}};
+  out = f.Step({Vec3(0, 0, 10), Vec3::Zero(), Vec3(0, 0, 10), n}, kDt);
+  EXPECT_EQ(out.neighbours_used, 1);
+  const double r = std::hypot(3.0, 2.0);
+  EXPECT_NEAR(out.repulsion.x(), -k.p_rep_1_s * (k.r0_rep_m - r) * 3.0 / r, 1e-9);
+  EXPECT_NEAR(out.repulsion.y(), -k.p_rep_1_s * (k.r0_rep_m - r) * 2.0 / r, 1e-9);
+}
+
+TEST(Flocking, FreshnessWeightScalesAlignment) {
+  FlockingParams k;
+  k.c_frict = 0.0;  // isolate the Reynolds alignment term
+  const auto alignment_at_age = [&](double age_s) {
+    Flocking f(k, Geofence{});
+    const std::vector<NeighbourState> n = {{Vec3(30, 0, 10), Vec3(2, 0, 0), age_s}};
+    return f.Step({Vec3(0, 0, 10), Vec3::Zero(), Vec3(0, 0, 10), n, false}, kDt).alignment;
+  };
+  // A single neighbour: the weighted mean is its velocity whatever the weight, so compare with a
+  // fresh second neighbour at rest: weight w gives mean = 2 w / (w + 1).
+  const auto mixed = [&](double age_s) {
+    Flocking f(k, Geofence{});
+    const std::vector<NeighbourState> n = {{Vec3(30, 0, 10), Vec3(2, 0, 0), age_s},
+                                           {Vec3(-30, 0, 10), Vec3::Zero(), 0.0}};
+    return f.Step({Vec3(0, 0, 10), Vec3::Zero(), Vec3(0, 0, 10), n, false}, kDt).alignment.x();
+  };
+  EXPECT_NEAR(alignment_at_age(0.1).x(), k.c_align * 2.0, 1e-12);
+  EXPECT_NEAR(mixed(0.1), k.c_align * 1.0, 1e-12);  // w = 1
+  const double age = (k.fresh_age_s + k.stale_timeout_s) / 2;  // w = 0.5
+  EXPECT_NEAR(mixed(age), k.c_align * (2.0 * 0.5 / 1.5), 1e-12);
+}
+
+TEST(Flocking, SpeedAndAccelerationAreLimited) {
+  FlockingParams k;
+  k.v_flock_m_s = 50.0;  // migration wants far more than v_max
+  Flocking f(k, Geofence{});
+  Vec3 v = Vec3::Zero();
+  for (int i = 0; i < 400; ++i) {
+    const Vec3 next =
+        f.Step({Vec3(0, 0, 0), v, Vec3(10000, 0, 1000), {}}, kDt).velocity_m_s;
+    EXPECT_LE((next - v).norm(), k.a_max_m_s2 * kDt + 1e-9);
+    EXPECT_LE(next.head<2>().norm(), k.v_max_m_s + 1e-9);
+    EXPECT_LE(std::abs(next.z()), k.v_z_max_m_s + 1e-9);
+    v = next;
+  }
+  EXPECT_NEAR(v.head<2>().norm(), k.v_max_m_s, 1e-6);
+}
+
+TEST(Flocking, MigrationBrakesToStopAtTheGoal) {
+  FlockingParams k;
+  Flocking f(k, Geofence{});
+  Vec3 p(0, 0, 20);
+  Vec3 v = Vec3::Zero();
+  for (int i = 0; i < 1200; ++i) {  // 60 s
+    v = f.Step({p, v, Vec3(100, 50, 20), {}}, kDt).velocity_m_s;
+    p += kDt * v;
+  }
+  EXPECT_LT((p - Vec3(100, 50, 20)).norm(), 0.2);  // [m]
+  EXPECT_LT(v.norm(), 0.1);                          // [m/s]
+}
+
+// V18 shill agents: a drone migrating toward a goal outside the geofence stops before the wall.
+TEST(Flocking, ShillAgentsKeepADroneInsideTheGeofence) {
+  FlockingParams k;
+  const Geofence fence = Geofence::Centered(100, 100);
+  Flocking f(k, fence);
+  Vec3 p(0, 0, 20);
+  Vec3 v = Vec3::Zero();
+  double max_x = -1e9;
+  for (int i = 0; i < 1200; ++i) {
+    v = f.Step({p, v, Vec3(500, 20, 20), {}}, kDt).velocity_m_s;
+    p += kDt * v;
+    max_x = std::max(max_x, p.x());
+  }
+  EXPECT_LT(max_x, fence.max_x_m);  // never crossed the wall
+  EXPECT_GT(p.x(), fence.max_x_m - 2 * k.r0_shill_m - 5.0);  // but got close to it
+}
+
+TEST(Flocking, ShillAgentsKeepADroneOutOfAnObstacle) {
+  FlockingParams k;
+  const ObstacleFootprint wall{Vec2(50, 0), Vec2(5, 20), 0.3};
+  Flocking f(k, Geofence::Centered(400, 400), {wall});
+  Vec3 p(0, 3, 20);
+  Vec3 v = Vec3::Zero();
+  double min_clearance = 1e9;
+  for (int i = 0; i < 1600; ++i) {
+    v = f.Step({p, v, Vec3(120, 0, 20), {}}, kDt).velocity_m_s;
+    p += kDt * v;
+    const Vec2 d = p.head<2>() - wall.center_m;
+    const double c = std::cos(wall.yaw_rad), s = std::sin(wall.yaw_rad);
+    const Vec2 q(c * d.x() + s * d.y(), -s * d.x() + c * d.y());
+    const double ex = std::max(std::abs(q.x()) - wall.half_size_m.x(), 0.0);
+    const double ey = std::max(std::abs(q.y()) - wall.half_size_m.y(), 0.0);
+    min_clearance = std::min(min_clearance, std::hypot(ex, ey));
+  }
+  EXPECT_GT(min_clearance, 0.5);  // [m] never touched the obstacle
+}
+
+struct RunStats {
+  double min_safety = 1.0;
+  double min_union = 1.0;
+  FlockMetrics final_metrics;
+};
+
+RunStats RunSwarm(KinematicSwarm& swarm, double duration_s, const FlockMetricsParams& mp) {
+  RunStats s;
+  const int steps = static_cast<int>(duration_s / kDt);
+  for (int i = 0; i < steps; ++i) {
+    swarm.Step();
+    const FlockMetrics m = swarm.Metrics(mp);
+    s.min_safety = std::min(s.min_safety, m.safety);
+    s.min_union = std::min(s.min_union, m.union_);
+    s.final_metrics = m;
+  }
+  return s;
+}
+
+// The acceptance: 20 agents from random starts keep every pair above the separation
+// distance (Safety = 1 at every step), reach velocity order > 0.9 (V18 phi_corr) and stay one
+// connected group (Union = 1). Seeds 1..5; separation 3 m; link range = sensing range 60 m.
+TEST(Flocking, TwentyAgentsFromRandomStartsAreSafeOrderedAndUnited) {
+  const FlockMetricsParams mp{.separation_m = 3.0, .link_range_m = 60.0};
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    KinematicSwarmConfig c;
+    c.seed = seed;
+    KinematicSwarm swarm(c);
+    const RunStats s = RunSwarm(swarm, 90.0, mp);
+    EXPECT_EQ(s.min_safety, 1.0) << "seed " << seed;
+    EXPECT_EQ(s.min_union, 1.0) << "seed " << seed;
+    EXPECT_GT(s.final_metrics.order, 0.9) << "seed " << seed;
+  }
+}
+
+// Same under a lossy radio (20% packet loss): neighbours age and are dead-reckoned.
+TEST(Flocking, LossyRadioKeepsTheFlockSafeAndUnited) {
+  const FlockMetricsParams mp{.separation_m = 3.0, .link_range_m = 60.0};
+  KinematicSwarmConfig c;
+  c.seed = 11;
+  c.loss = 0.2;
+  KinematicSwarm swarm(c);
+  const RunStats s = RunSwarm(swarm, 90.0, mp);
+  EXPECT_EQ(s.min_safety, 1.0);
+  EXPECT_EQ(s.min_union, 1.0);
+  EXPECT_GT(s.final_metrics.order, 0.9);
+}
+
+// A drone killed mid-run stops broadcasting; after stale_timeout_s the others drop it and the gap
+// it leaves closes: the mean nearest-neighbour spacing returns within 15% of its value before the
+// removal, and the flock stays one safe group.
+TEST(Flocking, RemovedDroneLeavesAGapThatTheRestReclose) {
+  const FlockMetricsParams mp{.separation_m = 3.0, .link_range_m = 60.0};
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    KinematicSwarmConfig c;
+    c.seed = seed;
+    KinematicSwarm swarm(c);
+    const RunStats before = RunSwarm(swarm, 60.0, mp);
+    // Remove the drone closest to the flock's centroid (the largest hole).
+    const std::vector<Vec3> p = swarm.AlivePositions();
+    Vec3 centroid = Vec3::Zero();
+    for (const Vec3& q : p) centroid += q / static_cast<double>(p.size());
+    int victim = 0;
+    for (int i = 1; i < c.agents; ++i)
+      if ((swarm.position(i) - centroid).norm() < (swarm.position(victim) - centroid).norm()) victim = i;
+    swarm.Remove(victim);
+    const RunStats after = RunSwarm(swarm, 40.0, mp);
+    EXPECT_EQ(swarm.alive_count(), c.agents - 1);
+    EXPECT_EQ(after.min_safety, 1.0) << "seed " << seed;
+    EXPECT_EQ(after.min_union, 1.0) << "seed " << seed;
+    EXPECT_NEAR(after.final_metrics.mean_nearest_m, before.final_metrics.mean_nearest_m,
+                0.15 * before.final_metrics.mean_nearest_m)
+        << "seed " << seed;
+    EXPECT_GT(after.final_metrics.order, 0.9) << "seed " << seed;
+  }
+}
+
+}  // namespace
+}  // namespace swarmbox::swarm
