@@ -25,7 +25,9 @@ struct CameraImage {
   int width_px = 0;
   int height_px = 0;
   CameraIntrinsics intrinsics;
-  Pose camera_pose;                 // true camera pose (world <- camera body axes) for evaluation
+  // True pose of the optical frame (x right, y down, z along the optical axis) at capture:
+  // position [m, ENU] and the rotation optical frame -> world. For evaluation and the bus message.
+  Pose camera_pose;
   std::vector<std::uint8_t> bgr;    // height_px * width_px * 3
 };
 

@@ -21,7 +21,7 @@ struct ImuSample {
 struct BaroSample {
   bool fresh = false;
   double pressure_pa = 0;     // static pressure (ISA from home_alt_m + z) [Pa]
-  double altitude_m = 0;      // AMSL altitude derived from the noisy pressure [m]
+  double altitude_m = 0;      // altitude above the world origin (ENU z) from the noisy pressure [m]
   double temperature_c = 15;  // ISA temperature at altitude [deg C]
 };
 

@@ -56,7 +56,8 @@ struct DroneSpawn {
   double initial_throttle = 0;       // rotors already spinning at u * max speed (airborne spawns)
   std::string payload;               // "" or one of airframe.payloads[].name
   // With a payload: true = hanging sling_length_m under the hook at spawn (needs the height),
-  // false = lying on the ground under the drone's start point, ready for AttachPayload().
+  // false = lying on the ground beside the drone (to its south, ENU -y, clear of its collision
+  // box), ready for AttachPayload() once the drone hovers above it.
   bool payload_attached = false;
 };
 

@@ -1,0 +1,186 @@
+#include "swarmbox/physics/airframe.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "detail/yaml_read.hpp"
+
+namespace swarmbox::physics {
+namespace {
+
+using detail::Checked;
+using detail::Nested;
+using yaml::MapReader;
+using yaml::Node;
+
+void ReadMotor(MapReader& r, const Node& n, MotorSpec* m) {
+  Checked(r, n)
+      .Positive("motor_constant", &m->motor_constant)
+      .NonNegative("moment_constant", &m->moment_constant, true)
+      .Positive("time_constant_up_s", &m->time_constant_up_s)
+      .Positive("time_constant_down_s", &m->time_constant_down_s)
+      .Positive("max_rot_velocity_rad_s", &m->max_rot_velocity_rad_s)
+      .NonNegative("rotor_drag_coefficient", &m->rotor_drag_coefficient);
+}
+
+void ReadRotors(MapReader& parent, Airframe* af) {
+  const Node* list = parent.Child("rotors", /*required=*/true);
+  if (list == nullptr) return;
+  if (!list->is_sequence() || list->items().empty()) {
+    parent.Fail(Error(ErrorCode::kInvalidArgument, "'rotors' must be a non-empty list", list->Where()));
+    return;
+  }
+  if (list->items().size() > 8) {
+    parent.Fail(Error(ErrorCode::kInvalidArgument, "at most 8 rotors are supported", list->Where()));
+    return;
+  }
+  for (const Node& item : list->items()) {
+    MapReader r(item, "rotor");
+    RotorSpec rotor;
+    std::string direction;
+    r.Required("position_m", &rotor.position_m).Required("direction", &direction);
+    if (r.ok() && direction != "ccw" && direction != "cw") {
+      r.Fail(Error(ErrorCode::kInvalidArgument,
+                   "rotor direction must be 'ccw' or 'cw' (got '" + direction + "')",
+                   item.Find("direction")->Where()));
+    }
+    rotor.ccw = direction == "ccw";
+    if (auto s = r.Finish(); !s) {
+      parent.Fail(s.error());
+      return;
+    }
+    af->rotors.push_back(rotor);
+  }
+}
+
+void ReadSensors(MapReader& parent, Airframe* af) {
+  Nested(parent, "sensors", "sensors", false, [af](MapReader& r, const Node& n) {
+    Nested(r, "imu", "imu", false, [af](MapReader& s, const Node& m) {
+      Checked(s, m)
+          .Positive("rate_hz", &af->imu.rate_hz, false)
+          .NonNegative("accel_noise_std_m_s2", &af->imu.accel_noise_std_m_s2)
+          .NonNegative("accel_bias_std_m_s2", &af->imu.accel_bias_std_m_s2)
+          .NonNegative("accel_bias_walk_std_m_s2", &af->imu.accel_bias_walk_std_m_s2)
+          .NonNegative("gyro_noise_std_rad_s", &af->imu.gyro_noise_std_rad_s)
+          .NonNegative("gyro_bias_std_rad_s", &af->imu.gyro_bias_std_rad_s)
+          .NonNegative("gyro_bias_walk_std_rad_s", &af->imu.gyro_bias_walk_std_rad_s);
+    });
+    Nested(r, "baro", "baro", false, [af](MapReader& s, const Node& m) {
+      Checked(s, m).Positive("rate_hz", &af->baro.rate_hz, false).NonNegative("noise_std_pa", &af->baro.noise_std_pa);
+    });
+    Nested(r, "mag", "mag", false, [af](MapReader& s, const Node& m) {
+      Checked(s, m)
+          .Positive("rate_hz", &af->mag.rate_hz, false)
+          .NonNegative("noise_std_gauss", &af->mag.noise_std_gauss);
+    });
+    Nested(r, "gps", "gps", false, [af](MapReader& s, const Node& m) {
+      Checked(s, m)
+          .Positive("rate_hz", &af->gps.rate_hz, false)
+          .NonNegative("horizontal_std_m", &af->gps.horizontal_std_m)
+          .NonNegative("vertical_std_m", &af->gps.vertical_std_m)
+          .NonNegative("velocity_std_m_s", &af->gps.velocity_std_m_s);
+    });
+    (void)n;
+  });
+}
+
+void ReadCamera(MapReader& parent, Airframe* af) {
+  Nested(parent, "camera", "camera", false, [af](MapReader& r, const Node& n) {
+    CameraSpec& c = af->camera;
+    r.Optional("width_px", &c.width_px).Optional("height_px", &c.height_px).Optional("offset_m", &c.offset_m);
+    Checked(r, n)
+        .Positive("hfov_rad", &c.hfov_rad, false)
+        .Positive("rate_hz", &c.rate_hz, false)
+        .NonNegative("noise_std", &c.noise_std);
+    if (r.ok() && (c.width_px < 16 || c.height_px < 16 || c.width_px > 4096 || c.height_px > 4096)) {
+      r.Fail(Error(ErrorCode::kInvalidArgument, "camera size must be within 16..4096 pixels", n.Where()));
+    }
+    if (r.ok() && c.hfov_rad >= std::numbers::pi * 0.9) {
+      r.Fail(Error(ErrorCode::kInvalidArgument, "camera hfov_rad must be below 0.9 pi", n.Find("hfov_rad")->Where()));
+    }
+  });
+}
+
+void ReadPayloads(MapReader& parent, Airframe* af) {
+  const Node* list = parent.Child("payloads", false);
+  if (list == nullptr || list->is_null()) return;
+  if (!list->is_sequence()) {
+    parent.Fail(Error(ErrorCode::kInvalidArgument, "'payloads' must be a list", list->Where()));
+    return;
+  }
+  for (const Node& item : list->items()) {
+    MapReader r(item, "payload");
+    PayloadSpec p;
+    r.Required("name", &p.name).Required("size_m", &p.size_m).Required("hook_m", &p.hook_m);
+    Checked(r, item)
+        .Positive("mass_kg", &p.mass_kg)
+        .Positive("sling_length_m", &p.sling_length_m)
+        .Positive("attach_tolerance_m", &p.attach_tolerance_m, false);
+    if (r.ok() && (p.size_m.x <= 0 || p.size_m.y <= 0 || p.size_m.z <= 0)) {
+      r.Fail(Error(ErrorCode::kInvalidArgument, "payload size_m must be positive", item.Find("size_m")->Where()));
+    }
+    if (auto s = r.Finish(); !s) {
+      parent.Fail(s.error());
+      return;
+    }
+    af->payloads.push_back(p);
+  }
+}
+
+}  // namespace
+
+double Airframe::HoverRotorSpeed(double extra_mass_kg, double gravity_m_s2) const {
+  const double n = static_cast<double>(rotors.size());
+  return std::sqrt((mass_kg + extra_mass_kg) * gravity_m_s2 / (n * motor.motor_constant));
+}
+
+Result<Airframe> ParseAirframe(const yaml::Node& root, std::string source) {
+  Airframe af;
+  af.source = std::move(source);
+  MapReader r(root, "airframe");
+  r.Required("name", &af.name).Required("inertia_kg_m2", &af.inertia_kg_m2);
+  Checked(r, root).Positive("mass_kg", &af.mass_kg).NonNegative("base_height_m", &af.base_height_m, true);
+  r.Optional("body_drag_coefficient", &af.body_drag_coefficient);
+  Nested(r, "collision", "collision", true, [&af](MapReader& c, const Node&) {
+    c.Required("box_m", &af.collision_box_m).Optional("offset_m", &af.collision_offset_m);
+  });
+  Nested(r, "impact", "impact", false, [&af](MapReader& c, const Node& n) {
+    Checked(c, n)
+        .Positive("hard_landing_speed_m_s", &af.hard_landing_speed_m_s, false)
+        .Positive("crash_speed_m_s", &af.crash_speed_m_s, false);
+  });
+  Nested(r, "motor", "motor", true, [&af](MapReader& m, const Node& n) { ReadMotor(m, n, &af.motor); });
+  if (r.ok()) ReadRotors(r, &af);
+  if (r.ok()) ReadSensors(r, &af);
+  if (r.ok()) ReadCamera(r, &af);
+  if (r.ok()) ReadPayloads(r, &af);
+  if (const Node* control = r.Child("control", false)) af.control = *control;  // flight stack's
+  if (auto s = r.Finish(); !s) return s.error().Context("airframe");
+
+  auto fail = [&](const char* key, const std::string& msg) -> Error {
+    const Node* n = root.Find(key);
+    return Error(ErrorCode::kInvalidArgument, "airframe: " + msg, (n ? *n : root).Where());
+  };
+  const Vec3& I = af.inertia_kg_m2;
+  if (I.x <= 0 || I.y <= 0 || I.z <= 0) return fail("inertia_kg_m2", "inertia must be positive");
+  if (I.x + I.y < I.z || I.y + I.z < I.x || I.x + I.z < I.y) {
+    return fail("inertia_kg_m2", "principal moments violate the triangle inequality");
+  }
+  const Vec3& b = af.collision_box_m;
+  if (b.x <= 0 || b.y <= 0 || b.z <= 0) return fail("collision", "collision box_m must be positive");
+  if (af.body_drag_coefficient.x < 0 || af.body_drag_coefficient.y < 0 || af.body_drag_coefficient.z < 0) {
+    return fail("body_drag_coefficient", "body drag coefficients must be >= 0");
+  }
+  if (af.crash_speed_m_s < af.hard_landing_speed_m_s) {
+    return fail("impact", "crash_speed_m_s must be >= hard_landing_speed_m_s");
+  }
+  return af;
+}
+
+Result<Airframe> LoadAirframe(const std::string& path) {
+  auto doc = yaml::ParseFile(path);
+  if (!doc) return doc.error();
+  return ParseAirframe(*doc, path);
+}
+
+}  // namespace swarmbox::physics

@@ -1,0 +1,45 @@
+// Helpers for reading the physics YAML schemas (airframes, worlds) with common/yaml.hpp.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/physics/types.hpp"
+
+namespace swarmbox::physics {
+
+// A Vec3 is written as a list of three numbers: [x, y, z]. Found by MapReader through ADL.
+Status Decode(const yaml::Node& node, Vec3* out);
+
+namespace detail {
+
+// Reads an optional/required number and checks `lo <= value` (strictly above lo when
+// `strict`); errors point at the value's own mark.
+class Checked {
+ public:
+  explicit Checked(yaml::MapReader& reader, const yaml::Node& map) : reader_(reader), map_(map) {}
+  // value > 0
+  Checked& Positive(std::string_view key, double* out, bool required = true);
+  // value >= 0
+  Checked& NonNegative(std::string_view key, double* out, bool required = false);
+
+ private:
+  Checked& Range(std::string_view key, double* out, bool required, bool strict);
+  yaml::MapReader& reader_;
+  const yaml::Node& map_;
+};
+
+// Runs a nested reader on `map.key` (if present) with `fn(MapReader&, const Node&)`, and folds
+// its error into `parent`.
+template <typename Fn>
+void Nested(yaml::MapReader& parent, std::string_view key, std::string what, bool required, Fn fn) {
+  const yaml::Node* child = parent.Child(key, required);
+  if (child == nullptr) return;
+  yaml::MapReader r(*child, std::move(what));
+  fn(r, *child);
+  if (auto s = r.Finish(); !s) parent.Fail(s.error());
+}
+
+}  // namespace detail
+}  // namespace swarmbox::physics
