@@ -1,0 +1,171 @@
+#include "message_samples.hpp"
+
+#include <string>
+
+namespace swarmbox::bus::testing {
+namespace {
+
+// Distinct, exactly representable doubles: seed-dependent and different per call site `k`.
+double D(std::uint64_t seed, int k) { return static_cast<double>(seed) * 1000.0 + k + 0.25; }
+std::string S(std::uint64_t seed, const char* what) {
+  return std::string(what) + "_" + std::to_string(seed) + "_padded_beyond_sso";
+}
+
+}  // namespace
+
+ClockTick FullClockTick(std::uint64_t seed) {
+  ClockTick m;
+  m.step = seed + 1;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) * 4'000'000 + 7;
+  m.step_period_ns = 4'000'000;
+  m.rtf = 0.5 + static_cast<double>(seed);
+  return m;
+}
+
+SensorSample FullSensorSample(std::uint64_t seed) {
+  SensorSample m;
+  m.drone = "drone_" + std::to_string(seed);
+  m.step = seed + 11;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 12;
+  m.imu.valid = true;
+  m.imu.accel_m_s2 = {D(seed, 1), D(seed, 2), D(seed, 3)};
+  m.imu.gyro_rad_s = {D(seed, 4), D(seed, 5), D(seed, 6)};
+  m.imu.temperature_c = D(seed, 7);
+  m.baro.valid = true;
+  m.baro.pressure_pa = D(seed, 8);
+  m.baro.altitude_m = D(seed, 9);
+  m.baro.temperature_c = D(seed, 10);
+  m.mag.valid = true;
+  m.mag.field_gauss = {D(seed, 11), D(seed, 12), D(seed, 13)};
+  m.gps.valid = true;
+  m.gps.fix_type = GpsFix::k3d;
+  m.gps.num_satellites = static_cast<std::uint8_t>(9 + seed % 7);
+  m.gps.latitude_deg = D(seed, 14);
+  m.gps.longitude_deg = D(seed, 15);
+  m.gps.altitude_m = D(seed, 16);
+  m.gps.position_enu_m = {D(seed, 17), D(seed, 18), D(seed, 19)};
+  m.gps.velocity_enu_m_s = {D(seed, 20), D(seed, 21), D(seed, 22)};
+  m.gps.h_acc_m = D(seed, 23);
+  m.gps.v_acc_m = D(seed, 24);
+  m.battery.valid = true;
+  m.battery.voltage_v = D(seed, 25);
+  m.battery.current_a = D(seed, 26);
+  m.battery.remaining = D(seed, 27);
+  return m;
+}
+
+ActuatorCommand FullActuatorCommand(std::uint64_t seed) {
+  ActuatorCommand m;
+  m.drone = "drone_" + std::to_string(seed);
+  m.step = seed + 21;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 22;
+  m.armed = true;
+  m.motor_throttle = {D(seed, 1), D(seed, 2), D(seed, 3), D(seed, 4), D(seed, 5), D(seed, 6)};
+  return m;
+}
+
+CameraImage FullCameraImage(std::uint64_t seed, std::uint32_t width_px, std::uint32_t height_px) {
+  CameraImage m;
+  m.drone = "drone_" + std::to_string(seed);
+  m.step = seed + 31;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 32;
+  m.width_px = width_px;
+  m.height_px = height_px;
+  m.row_stride_bytes = width_px;
+  m.encoding = "mono8";
+  m.intrinsics.fx_px = D(seed, 1);
+  m.intrinsics.fy_px = D(seed, 2);
+  m.intrinsics.cx_px = D(seed, 3);
+  m.intrinsics.cy_px = D(seed, 4);
+  m.intrinsics.distortion = {D(seed, 5), D(seed, 6), D(seed, 7), D(seed, 8), D(seed, 9)};
+  m.camera_pose.position_enu_m = {D(seed, 10), D(seed, 11), D(seed, 12)};
+  m.camera_pose.orientation_wxyz = {D(seed, 13), D(seed, 14), D(seed, 15), D(seed, 16)};
+  m.data.resize(static_cast<std::size_t>(width_px) * height_px);
+  for (std::size_t i = 0; i < m.data.size(); ++i) {
+    m.data[i] = static_cast<std::uint8_t>((i * 31 + seed) & 0xff);
+  }
+  return m;
+}
+
+WorldCommand FullWorldCommand(std::uint64_t seed) {
+  WorldCommand m;
+  m.seq = seed + 41;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 42;
+  m.target = "drone_" + std::to_string(seed);
+  m.command = "wind_gust";
+  m.args = {D(seed, 1), D(seed, 2), D(seed, 3), D(seed, 4)};
+  return m;
+}
+
+DroneState FullDroneState(std::uint64_t seed) {
+  DroneState m;
+  m.drone = "drone_" + std::to_string(seed);
+  m.seq = seed + 51;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 52;
+  m.wall_time_ns = static_cast<std::int64_t>(seed) + 1'700'000'000'000'000'000;
+  m.position_enu_m = {D(seed, 1), D(seed, 2), D(seed, 3)};
+  m.velocity_enu_m_s = {D(seed, 4), D(seed, 5), D(seed, 6)};
+  m.heading_rad = D(seed, 7);
+  m.battery_fraction = D(seed, 8);
+  m.mode = S(seed, "search");
+  return m;
+}
+
+RaftMessage FullRaftMessage(std::uint64_t seed, std::size_t payload_bytes) {
+  RaftMessage m;
+  m.from = S(seed, "from");
+  m.to = S(seed, "to");
+  m.term = seed + 61;
+  m.payload.resize(payload_bytes);
+  for (std::size_t i = 0; i < payload_bytes; ++i) {
+    m.payload[i] = static_cast<std::uint8_t>((i * 7 + seed + 1) & 0xff);
+  }
+  return m;
+}
+
+Detection FullDetection(std::uint64_t seed) {
+  Detection m;
+  m.from = S(seed, "from");
+  m.seq = seed + 71;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 72;
+  m.label = S(seed, "victim");
+  m.confidence = D(seed, 1);
+  m.position_enu_m = {D(seed, 2), D(seed, 3), D(seed, 4)};
+  m.position_sigma_m = D(seed, 5);
+  return m;
+}
+
+RadioPing FullRadioPing(std::uint64_t seed) {
+  RadioPing m;
+  m.from = S(seed, "from");
+  m.to = S(seed, "to");
+  m.seq = seed + 81;
+  m.sent_wall_ns = static_cast<std::int64_t>(seed) + 82;
+  m.is_pong = true;
+  return m;
+}
+
+Event FullEvent(std::uint64_t seed) {
+  Event m;
+  m.node = S(seed, "node");
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 92;
+  m.name = S(seed, "leader_elected");
+  m.fields = {{"term", std::to_string(seed)}, {S(seed, "leader_key"), S(seed, "leader_value")},
+              {"empty_value", ""}};
+  return m;
+}
+
+template <> ClockTick Full<ClockTick>(std::uint64_t seed) { return FullClockTick(seed); }
+template <> SensorSample Full<SensorSample>(std::uint64_t seed) { return FullSensorSample(seed); }
+template <> ActuatorCommand Full<ActuatorCommand>(std::uint64_t seed) {
+  return FullActuatorCommand(seed);
+}
+template <> CameraImage Full<CameraImage>(std::uint64_t seed) { return FullCameraImage(seed); }
+template <> WorldCommand Full<WorldCommand>(std::uint64_t seed) { return FullWorldCommand(seed); }
+template <> DroneState Full<DroneState>(std::uint64_t seed) { return FullDroneState(seed); }
+template <> RaftMessage Full<RaftMessage>(std::uint64_t seed) { return FullRaftMessage(seed); }
+template <> Detection Full<Detection>(std::uint64_t seed) { return FullDetection(seed); }
+template <> RadioPing Full<RadioPing>(std::uint64_t seed) { return FullRadioPing(seed); }
+template <> Event Full<Event>(std::uint64_t seed) { return FullEvent(seed); }
+
+}  // namespace swarmbox::bus::testing
