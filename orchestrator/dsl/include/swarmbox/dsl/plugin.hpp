@@ -1,0 +1,72 @@
+// Plugin: one container of a trial (a Module). Build creates it (not started), Run starts it and
+// waits for its readiness pattern, Stop stops it, collects its logs and artifacts and removes it.
+//
+//   trial.Add<Plugin>("physics", ContainerSpec::Image(img, {"swarmbox-physics", "--seed", "42"}), 1)
+//       .On(sim, "10.77.3.2")
+//       .ReadyOn("event=ready", Duration::Seconds(60))
+//       .Collect("/out/truth.csv");
+#pragma once
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "swarmbox/dsl/component.hpp"
+#include "swarmbox/dsl/duration.hpp"
+
+namespace swarmbox::dsl {
+
+struct Attachment {
+  std::string network;   // the Network component's id in the same trial ("sim", "mesh")
+  std::string ipv4;      // fixed address inside that network's subnet
+  std::vector<std::string> aliases;  // DNS names on that network
+};
+
+struct ContainerSpec {
+  std::string name;   // Docker name, unique per host: "<trial>-<run>-<component>"
+  std::string image;  // "swarmbox/agent:3f2a..."
+  std::vector<std::string> argv;  // the full command line (entrypoint + arguments); no shell
+  std::map<std::string, std::string> env;
+  std::map<std::string, std::string> labels;
+  std::vector<Attachment> networks;
+  std::string user;      // "" = the image's
+  std::string hostname;  // "" = Docker's
+  std::string ready_pattern;  // a regex on the log; "" = ready once started
+  Duration ready_timeout = Duration::Seconds(60);
+  std::vector<std::string> artifacts;  // absolute paths in the container collected on Stop
+  int stop_timeout_s = 10;             // SIGTERM, then SIGKILL after this
+
+  // ContainerSpec::Image("swarmbox/physics:1", {"swarmbox-physics", "--seed", "42"})
+  static ContainerSpec Image(std::string image, std::vector<std::string> argv = {}) {
+    ContainerSpec c;
+    c.image = std::move(image);
+    c.argv = std::move(argv);
+    return c;
+  }
+};
+
+class Plugin : public Module {
+ public:
+  Plugin(std::string id, ContainerSpec spec, int run_priority = 2);
+
+  const ContainerSpec& spec() const { return spec_; }
+  ContainerSpec& mutable_spec() { return spec_; }
+
+  // Fluent setters for the C++ DSL.
+  Plugin& On(const Network& network, std::string ipv4, std::vector<std::string> aliases = {});
+  Plugin& ReadyOn(std::string pattern, Duration timeout = Duration::Seconds(60));
+  Plugin& Collect(std::string path_in_container);
+  Plugin& Env(std::string key, std::string value);
+  Plugin& Priority(int run_priority);
+
+ protected:
+  Verdict DoBuild(Engine& engine) override;
+  Verdict DoRun(Engine& engine) override;
+  Verdict DoStop(Engine& engine) override;
+
+ private:
+  ContainerSpec spec_;
+};
+
+}  // namespace swarmbox::dsl

@@ -1,0 +1,421 @@
+#include "swarmbox/dsl/trial_loader.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "swarmbox/dsl/overrides.hpp"
+
+namespace swarmbox::dsl {
+
+namespace {
+
+using yaml::Node;
+
+constexpr std::size_t kMaxNameLength = 40;
+constexpr std::size_t kMaxDrones = 200;  // fixed addresses in a /24 mesh subnet
+
+Error At(const Node& node, std::string message) {
+  return Error(ErrorCode::kInvalidArgument, std::move(message), node.Where());
+}
+
+Error AtMark(const yaml::Mark& mark, std::string message) {
+  return Error(ErrorCode::kInvalidArgument, std::move(message), mark.ToString());
+}
+
+bool IsTrialName(std::string_view s) {
+  if (s.empty() || s.size() > kMaxNameLength) return false;
+  auto alnum = [](char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); };
+  if (!alnum(s[0])) return false;
+  for (char c : s) {
+    if (!alnum(c) && c != '-' && c != '_' && c != '.') return false;
+  }
+  return true;
+}
+
+bool IsDroneName(std::string_view s) {
+  if (s.empty() || s.size() > 32 || !(s[0] >= 'a' && s[0] <= 'z')) return false;
+  for (char c : s) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  }
+  return true;
+}
+
+// Names that are not drones but can be named where a component is expected.
+constexpr std::string_view kPhysics = "physics";
+constexpr std::string_view kRaftLeader = "raft_leader";
+
+Status DecodeMesh(const Node& node, std::string what, MeshSpec* mesh) {
+  yaml::MapReader r(node, what);
+  r.Optional("delay_ms", &mesh->delay_ms)
+      .Optional("jitter_ms", &mesh->jitter_ms)
+      .Optional("distribution", &mesh->distribution)
+      .Optional("loss", &mesh->loss)
+      .Optional("duplicate", &mesh->duplicate)
+      .Optional("corrupt", &mesh->corrupt)
+      .Optional("rate_kbit", &mesh->rate_kbit);
+  SWARMBOX_TRY(r.Finish());
+  auto non_negative = [&](std::string_view key, double v) -> Status {
+    if (v < 0) return At(*node.Find(key), "'" + std::string(key) + "' must not be negative");
+    return Ok{};
+  };
+  auto probability = [&](std::string_view key, double v) -> Status {
+    if (v < 0 || v > 1) {
+      return At(*node.Find(key), "'" + std::string(key) + "' is a probability in [0, 1]");
+    }
+    return Ok{};
+  };
+  SWARMBOX_TRY(non_negative("delay_ms", mesh->delay_ms));
+  SWARMBOX_TRY(non_negative("jitter_ms", mesh->jitter_ms));
+  SWARMBOX_TRY(non_negative("rate_kbit", mesh->rate_kbit));
+  SWARMBOX_TRY(probability("loss", mesh->loss));
+  SWARMBOX_TRY(probability("duplicate", mesh->duplicate));
+  SWARMBOX_TRY(probability("corrupt", mesh->corrupt));
+  if (!mesh->distribution.empty() && mesh->distribution != "normal" &&
+      mesh->distribution != "pareto" && mesh->distribution != "paretonormal" &&
+      mesh->distribution != "uniform") {
+    return At(*node.Find("distribution"), "unknown delay distribution '" + mesh->distribution +
+                                              "' (expected uniform, normal, pareto or paretonormal)");
+  }
+  return Ok{};
+}
+
+Status DecodeNameList(const Node& node, std::vector<std::string>* out) {
+  if (node.is_scalar()) {
+    out->push_back(node.scalar());
+    return Ok{};
+  }
+  return yaml::Decode(node, out);
+}
+
+const std::vector<FaultKind>& AllFaultKinds() {
+  static const std::vector<FaultKind> kinds = {
+      FaultKind::kKill,      FaultKind::kStop,       FaultKind::kPause,    FaultKind::kRestart,
+      FaultKind::kPartition, FaultKind::kGpsDropout, FaultKind::kWindGust, FaultKind::kNetem};
+  return kinds;
+}
+
+std::string FaultKindList() {
+  std::string s;
+  for (FaultKind k : AllFaultKinds()) s += (s.empty() ? "" : ", ") + std::string(FaultKindName(k));
+  return s;
+}
+
+Status DecodeFault(const Node& node, FaultSpec* fault) {
+  if (!node.is_mapping()) return At(node, "expected a fault to be a mapping such as {at: 30s, kill: raft_leader}");
+  fault->mark = node.mark();
+  bool have_at = false;
+  const Node* kind_key = nullptr;
+  const Node* on = nullptr;
+  const Node* for_node = nullptr;
+  for (const auto& [k, v] : node.entries()) {
+    const std::string& key = k.scalar();
+    if (key == "at") {
+      SWARMBOX_TRY(Decode(v, &fault->at));
+      have_at = true;
+      continue;
+    }
+    if (key == "for") {
+      SWARMBOX_TRY(Decode(v, &fault->duration));
+      for_node = &k;
+      continue;
+    }
+    if (key == "on") {
+      on = &k;
+      SWARMBOX_TRY(DecodeNameList(v, &fault->targets));
+      continue;
+    }
+    std::optional<FaultKind> kind;
+    for (FaultKind candidate : AllFaultKinds()) {
+      if (FaultKindName(candidate) == key) kind = candidate;
+    }
+    if (!kind) {
+      return At(k, "unknown fault kind '" + key + "' (expected one of " + FaultKindList() +
+                       ", with at, for, on)");
+    }
+    if (kind_key != nullptr) {
+      return At(k, "a fault has one kind, this one has '" + kind_key->scalar() + "' and '" + key +
+                       "'");
+    }
+    kind_key = &k;
+    fault->kind = *kind;
+    switch (*kind) {
+      case FaultKind::kKill:
+      case FaultKind::kStop:
+      case FaultKind::kPause:
+      case FaultKind::kRestart:
+      case FaultKind::kGpsDropout: {
+        std::string target;
+        if (!v.is_scalar() || v.scalar().empty()) {
+          return At(v, "'" + key + "' names one component (a drone, physics or raft_leader)");
+        }
+        fault->targets.push_back(v.scalar());
+        break;
+      }
+      case FaultKind::kPartition:
+        SWARMBOX_TRY(yaml::Decode(v, &fault->groups));
+        if (fault->groups.size() < 2) {
+          return At(v, "a partition needs at least two groups, e.g. [[scout_1], [scout_2, lifter]]");
+        }
+        break;
+      case FaultKind::kWindGust: {
+        yaml::MapReader w(v, "wind_gust");
+        w.Required("speed_mps", &fault->wind_speed_mps)
+            .Optional("direction_deg", &fault->wind_direction_deg);
+        SWARMBOX_TRY(w.Finish());
+        if (fault->wind_speed_mps < 0) return At(v, "'speed_mps' must not be negative");
+        break;
+      }
+      case FaultKind::kNetem:
+        SWARMBOX_TRY(DecodeMesh(v, "netem", &fault->netem));
+        break;
+    }
+  }
+  if (kind_key == nullptr) {
+    return At(node, "a fault needs a kind: one of " + FaultKindList());
+  }
+  if (!have_at) return At(node, "missing required key 'at' in fault");
+  if (on != nullptr && fault->kind != FaultKind::kNetem) {
+    return At(*on, "'on' applies to netem faults only");
+  }
+  if (for_node != nullptr && (fault->kind == FaultKind::kKill || fault->kind == FaultKind::kRestart)) {
+    return At(*for_node, "'for' does not apply to a " + std::string(FaultKindName(fault->kind)) +
+                             " fault");
+  }
+  return Ok{};
+}
+
+Status CheckComponent(const TrialSpec& spec, const yaml::Mark& mark, const std::string& name,
+                      bool allow_physics, bool allow_leader) {
+  if (spec.FindDrone(name) != nullptr) return Ok{};
+  if (allow_physics && name == kPhysics) return Ok{};
+  if (allow_leader && name == kRaftLeader) return Ok{};
+  std::string accepted;
+  for (const DroneSpec& d : spec.drones) accepted += (accepted.empty() ? "" : ", ") + d.name;
+  if (allow_physics) accepted += ", physics";
+  if (allow_leader) accepted += ", raft_leader";
+  return AtMark(mark, "unknown component '" + name + "' (expected one of " + accepted + ")");
+}
+
+Status CheckFaultTargets(const TrialSpec& spec, const FaultSpec& f) {
+  switch (f.kind) {
+    case FaultKind::kKill:
+    case FaultKind::kStop:
+    case FaultKind::kPause:
+    case FaultKind::kRestart:
+      return CheckComponent(spec, f.mark, f.targets.front(), true, true);
+    case FaultKind::kGpsDropout:
+      return CheckComponent(spec, f.mark, f.targets.front(), false, true);
+    case FaultKind::kNetem:
+      for (const auto& t : f.targets) SWARMBOX_TRY(CheckComponent(spec, f.mark, t, false, false));
+      return Ok{};
+    case FaultKind::kPartition: {
+      std::set<std::string> seen;
+      for (const auto& group : f.groups) {
+        if (group.empty()) return AtMark(f.mark, "a partition group is empty");
+        for (const auto& t : group) {
+          SWARMBOX_TRY(CheckComponent(spec, f.mark, t, false, false));
+          if (!seen.insert(t).second) {
+            return AtMark(f.mark, "drone '" + t + "' is in two partition groups");
+          }
+        }
+      }
+      return Ok{};
+    }
+    case FaultKind::kWindGust:
+      return Ok{};
+  }
+  return Ok{};
+}
+
+bool DefaultFileExists(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path, ec);
+}
+
+}  // namespace
+
+Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options) {
+  TrialSpec spec;
+  spec.document = doc;
+  spec.trials_dir = options.trials_dir;
+  yaml::MapReader r(doc, "trial");
+  std::string middleware = "cyclonedds";
+  r.Required("name", &spec.name)
+      .Optional("seed", &spec.seed)
+      .Optional("middleware", &middleware)
+      .Required("world", &spec.world);
+  const Node* physics = r.Child("physics");
+  const Node* drones = r.Child("drones", /*required=*/true);
+  const Node* network = r.Child("network");
+  const Node* faults = r.Child("faults");
+  const Node* end = r.Child("end");
+  const Node* timeout = r.Child("timeout", /*required=*/true);
+  SWARMBOX_TRY(r.Finish());
+
+  if (!IsTrialName(spec.name)) {
+    return At(*doc.Find("name"),
+              "trial name '" + spec.name + "' must be 1-40 characters of a-z, 0-9, '-', '_', '.', "
+              "starting with a letter or digit (it names folders and containers)");
+  }
+  if (middleware == "cyclonedds") {
+    spec.middleware = Middleware::kCycloneDds;
+  } else if (middleware == "fastdds") {
+    spec.middleware = Middleware::kFastDds;
+  } else {
+    return At(*doc.Find("middleware"),
+              "unknown middleware '" + middleware + "' (expected cyclonedds or fastdds)");
+  }
+
+  if (physics != nullptr) {
+    yaml::MapReader p(*physics, "physics");
+    p.Optional("rtf", &spec.rtf);
+    SWARMBOX_TRY(p.Finish());
+    if (spec.rtf < 0) return At(*physics->Find("rtf"), "'rtf' must be >= 0 (0 = as fast as possible)");
+  }
+
+  if (!drones->is_sequence() || drones->items().empty()) {
+    return At(*drones, "'drones' must be a non-empty list of {name, airframe, pose}");
+  }
+  if (drones->items().size() > kMaxDrones) {
+    return At(*drones, "at most " + std::to_string(kMaxDrones) + " drones per trial");
+  }
+  for (const Node& item : drones->items()) {
+    DroneSpec d;
+    d.mark = item.mark();
+    yaml::MapReader dr(item, "drone");
+    dr.Required("name", &d.name)
+        .Required("airframe", &d.airframe)
+        .Optional("pose", &d.pose)
+        .Optional("payload", &d.payload);
+    SWARMBOX_TRY(dr.Finish());
+    if (!IsDroneName(d.name) || d.name == kPhysics || d.name == kRaftLeader) {
+      return At(*item.Find("name"), "drone name '" + d.name +
+                                        "' must be 1-32 characters of a-z, 0-9, '_', starting "
+                                        "with a letter, and not physics or raft_leader");
+    }
+    if (spec.FindDrone(d.name) != nullptr) {
+      return At(*item.Find("name"), "drone name '" + d.name + "' is used twice");
+    }
+    spec.drones.push_back(std::move(d));
+  }
+
+  if (network != nullptr) {
+    yaml::MapReader nr(*network, "network");
+    const Node* mesh = nr.Child("mesh");
+    SWARMBOX_TRY(nr.Finish());
+    if (mesh != nullptr) SWARMBOX_TRY(DecodeMesh(*mesh, "network.mesh", &spec.mesh));
+  }
+
+  if (faults != nullptr && !faults->is_null()) {
+    if (!faults->is_sequence()) return At(*faults, "'faults' must be a list");
+    for (const Node& item : faults->items()) {
+      FaultSpec f;
+      SWARMBOX_TRY(DecodeFault(item, &f));
+      SWARMBOX_TRY(CheckFaultTargets(spec, f));
+      spec.faults.push_back(std::move(f));
+    }
+  }
+
+  if (end != nullptr && !end->is_null()) {
+    if (!end->is_sequence()) return At(*end, "'end' must be a list of {on, outcome, reason}");
+    for (const Node& item : end->items()) {
+      EndSpec e;
+      std::string outcome;
+      yaml::MapReader er(item, "end condition");
+      er.Required("on", &e.on)
+          .Required("outcome", &outcome)
+          .Optional("reason", &e.reason)
+          .Optional("from", &e.from);
+      SWARMBOX_TRY(er.Finish());
+      try {
+        std::regex check(e.on, std::regex::ECMAScript);
+      } catch (const std::regex_error& ex) {
+        return At(*item.Find("on"), "'on' is not a valid regular expression: " + std::string(ex.what()));
+      }
+      if (e.on.empty()) return At(*item.Find("on"), "'on' must not be empty");
+      auto o = ParseOutcome(outcome);
+      if (!o) {
+        return At(*item.Find("outcome"),
+                  "unknown outcome '" + outcome + "' (expected success, failure, timeout or error)");
+      }
+      e.outcome = *o;
+      if (!e.from.empty()) {
+        SWARMBOX_TRY(CheckComponent(spec, item.Find("from")->mark(), e.from, true, false));
+      }
+      spec.end.push_back(std::move(e));
+    }
+  }
+
+  {
+    std::string outcome = "timeout";
+    yaml::MapReader tr(*timeout, "timeout");
+    tr.Required("sim", &spec.timeout.sim)
+        .Optional("wall", &spec.timeout.wall)
+        .Optional("outcome", &outcome);
+    SWARMBOX_TRY(tr.Finish());
+    auto o = ParseOutcome(outcome);
+    if (!o) {
+      return At(*timeout->Find("outcome"),
+                "unknown outcome '" + outcome + "' (expected success, failure, timeout or error)");
+    }
+    spec.timeout.outcome = *o;
+    if (spec.timeout.sim.zero()) return At(*timeout->Find("sim"), "'sim' must be longer than 0s");
+  }
+  for (const FaultSpec& f : spec.faults) {
+    if (f.at > spec.timeout.sim) {
+      return AtMark(f.mark, "fault at " + f.at.ToString() + " is after the timeout (" +
+                                spec.timeout.sim.ToString() + ")");
+    }
+  }
+
+  if (options.check_references) {
+    if (spec.trials_dir.empty()) {
+      return AtMark(doc.mark(), "no trials directory to resolve world and airframes against");
+    }
+    auto exists = options.file_exists ? options.file_exists : DefaultFileExists;
+    const std::filesystem::path dir(spec.trials_dir);
+    if (std::filesystem::path(spec.world).is_absolute() || spec.world.find("..") != std::string::npos) {
+      return At(*doc.Find("world"), "'world' must be a path inside the trials directory, such as worlds/open_field.yaml");
+    }
+    const std::string world_path = (dir / spec.world).string();
+    if (!exists(world_path)) {
+      return At(*doc.Find("world"), "world '" + spec.world + "' not found (no file " + world_path + ")");
+    }
+    std::size_t i = 0;
+    for (const DroneSpec& d : spec.drones) {
+      const Node& item = drones->items()[i++];
+      const std::string airframe_path = (dir / "airframes" / (d.airframe + ".yaml")).string();
+      if (d.airframe.find('/') != std::string::npos || !exists(airframe_path)) {
+        return At(*item.Find("airframe"),
+                  "unknown airframe '" + d.airframe + "' (no file " + airframe_path + ")");
+      }
+    }
+  }
+  return spec;
+}
+
+Result<TrialSpec> LoadTrialText(std::string_view text, std::string_view filename,
+                                const LoadOptions& options) {
+  auto doc = yaml::Parse(text, filename);
+  if (!doc) return doc.error();
+  for (const std::string& o : options.overrides) SWARMBOX_TRY(ApplyOverride(*doc, o));
+  LoadOptions resolved = options;
+  if (resolved.trials_dir.empty()) {
+    resolved.trials_dir = std::filesystem::path(std::string(filename)).parent_path().string();
+    if (resolved.trials_dir.empty()) resolved.trials_dir = ".";
+  }
+  return DecodeTrial(*doc, resolved);
+}
+
+Result<TrialSpec> LoadTrial(const std::string& path, const LoadOptions& options) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error(ErrorCode::kNotFound, "cannot open trial file", path);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return LoadTrialText(text.str(), path, options);
+}
+
+}  // namespace swarmbox::dsl

@@ -1,0 +1,220 @@
+// Trial files -> TrialSpec. Good files decode to the model; bad ones fail with file:line:col and a
+// message that says what is wrong (cases as data).
+#include "swarmbox/dsl/trial_loader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <set>
+#include <string>
+
+namespace swarmbox::dsl {
+namespace {
+
+constexpr const char* kExample = R"(name: sar-search
+seed: 42
+middleware: cyclonedds
+world: worlds/open_field.yaml
+physics: {rtf: 1.0}
+drones:
+  - {name: scout_1, airframe: x500, pose: [0, 0, 0]}
+  - {name: scout_2, airframe: x500, pose: [3, 0, 0]}
+  - {name: lifter, airframe: x8_heavy, pose: [0, -10, 0], payload: stretcher}
+network:
+  mesh: {delay_ms: 100, jitter_ms: 20, loss: 0.05}
+faults:
+  - {at: 30s, kill: raft_leader}
+end:
+  - {on: "event=mission_complete", outcome: success}
+  - {on: "event=collision", outcome: failure, reason: collision}
+timeout: {sim: 600s, outcome: timeout}
+)";
+
+LoadOptions FakeTree() {
+  LoadOptions o;
+  o.trials_dir = "/trials";
+  o.file_exists = [](const std::string& p) {
+    static const std::set<std::string> files = {"/trials/worlds/open_field.yaml",
+                                                "/trials/airframes/x500.yaml",
+                                                "/trials/airframes/x8_heavy.yaml"};
+    return files.count(p) > 0;
+  };
+  return o;
+}
+
+TEST(LoadTrial, DecodesTheArchitectureExample) {
+  auto spec = LoadTrialText(kExample, "sar.yaml", FakeTree());
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  EXPECT_EQ(spec->name, "sar-search");
+  EXPECT_EQ(spec->seed, 42u);
+  EXPECT_EQ(spec->middleware, Middleware::kCycloneDds);
+  EXPECT_EQ(spec->world, "worlds/open_field.yaml");
+  EXPECT_DOUBLE_EQ(spec->rtf, 1.0);
+  ASSERT_EQ(spec->drones.size(), 3u);
+  EXPECT_EQ(spec->drones[2].name, "lifter");
+  EXPECT_EQ(spec->drones[2].airframe, "x8_heavy");
+  EXPECT_EQ(spec->drones[2].payload, "stretcher");
+  EXPECT_DOUBLE_EQ(spec->drones[2].pose[1], -10.0);
+  EXPECT_EQ(spec->drones[1].mark.ToString(), "sar.yaml:8:5");
+  EXPECT_DOUBLE_EQ(spec->mesh.delay_ms, 100);
+  EXPECT_DOUBLE_EQ(spec->mesh.loss, 0.05);
+  ASSERT_EQ(spec->faults.size(), 1u);
+  EXPECT_EQ(spec->faults[0].kind, FaultKind::kKill);
+  EXPECT_EQ(spec->faults[0].at.ms(), 30000);
+  EXPECT_EQ(spec->faults[0].targets, std::vector<std::string>{"raft_leader"});
+  ASSERT_EQ(spec->end.size(), 2u);
+  EXPECT_EQ(spec->end[1].on, "event=collision");
+  EXPECT_EQ(spec->end[1].outcome, Outcome::kFailure);
+  EXPECT_EQ(spec->end[1].reason, "collision");
+  EXPECT_EQ(spec->timeout.sim.ms(), 600000);
+  EXPECT_EQ(spec->timeout.outcome, Outcome::kTimeout);
+}
+
+TEST(LoadTrial, AcceptsEveryFaultShape) {
+  std::string text = std::string(kExample);
+  text.replace(text.find("faults:"), text.find("end:") - text.find("faults:"), R"(faults:
+  - {at: 30s, kill: raft_leader}
+  - {at: 40s, pause: scout_2, for: 10s}
+  - {at: 41s, stop: physics, for: 500ms}
+  - {at: 42s, restart: lifter}
+  - {at: 1m, partition: [[scout_1, scout_2], [lifter]], for: 20s}
+  - {at: 10s, gps_dropout: scout_1, for: 5s}
+  - {at: 50s, wind_gust: {speed_mps: 8, direction_deg: 90}, for: 3s}
+  - {at: 20s, netem: {delay_ms: 300, loss: 0.2}, on: [scout_1], for: 30s}
+)");
+  auto spec = LoadTrialText(text, "sar.yaml", FakeTree());
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  ASSERT_EQ(spec->faults.size(), 8u);
+  EXPECT_EQ(spec->faults[1].duration.ms(), 10000);
+  EXPECT_EQ(spec->faults[4].kind, FaultKind::kPartition);
+  EXPECT_EQ(spec->faults[4].groups.size(), 2u);
+  EXPECT_DOUBLE_EQ(spec->faults[6].wind_speed_mps, 8);
+  EXPECT_DOUBLE_EQ(spec->faults[7].netem.delay_ms, 300);
+  EXPECT_EQ(spec->faults[7].targets, std::vector<std::string>{"scout_1"});
+}
+
+struct BadCase {
+  const char* find;     // text in kExample to replace
+  const char* replace;  // with this
+  const char* where;    // expected file:line:col
+  const char* message;  // expected part of the message
+};
+
+TEST(LoadTrial, ReportsBadInputWithFileLineColumn) {
+  const BadCase cases[] = {
+      {"seed: 42", "seed: 42\ncolour: red", "sar.yaml:3:1", "unknown key 'colour' in trial"},
+      {"seed: 42", "seed: many", "sar.yaml:2:7", "'seed': expected an integer"},
+      {"world: worlds/open_field.yaml\n", "", "sar.yaml:1:1", "missing required key 'world' in trial"},
+      {"world: worlds/open_field.yaml", "world: worlds/moon.yaml", "sar.yaml:4:8",
+       "world 'worlds/moon.yaml' not found (no file /trials/worlds/moon.yaml)"},
+      {"airframe: x8_heavy", "airframe: x9", "sar.yaml:9:30",
+       "unknown airframe 'x9' (no file /trials/airframes/x9.yaml)"},
+      {"middleware: cyclonedds", "middleware: zenoh", "sar.yaml:3:13", "unknown middleware 'zenoh'"},
+      {"pose: [3, 0, 0]", "pose: [3, 0]", "sar.yaml:8:43", "expected a list of 3 values"},
+      {"name: scout_2", "name: scout_1", "sar.yaml:8:12", "drone name 'scout_1' is used twice"},
+      {"{at: 30s, kill: raft_leader}", "{at: 30s, explode: raft_leader}", "sar.yaml:13:15",
+       "unknown fault kind 'explode' (expected one of kill, stop, pause, restart, partition, "
+       "gps_dropout, wind_gust, netem"},
+      {"{at: 30s, kill: raft_leader}", "{at: 30s, kill: scout_9}", "sar.yaml:13:5",
+       "unknown component 'scout_9' (expected one of scout_1, scout_2, lifter, physics, raft_leader)"},
+      {"{at: 30s, kill: raft_leader}", "{at: 30 seconds, kill: raft_leader}", "sar.yaml:13:10",
+       "expected a duration such as 30s, 500ms or 2m, got '30 seconds'"},
+      {"{at: 30s, kill: raft_leader}", "{kill: raft_leader}", "sar.yaml:13:5",
+       "missing required key 'at' in fault"},
+      {"{at: 30s, kill: raft_leader}", "{at: 30s, kill: raft_leader, pause: scout_1}",
+       "sar.yaml:13:34", "a fault has one kind, this one has 'kill' and 'pause'"},
+      {"{at: 30s, kill: raft_leader}", "{at: 30s, kill: raft_leader, for: 3s}", "sar.yaml:13:34",
+       "'for' does not apply to a kill fault"},
+      {"outcome: failure", "outcome: disaster", "sar.yaml:16:38", "unknown outcome 'disaster'"},
+      {"\"event=collision\"", "\"event=(collision\"", "sar.yaml:16:10",
+       "'on' is not a valid regular expression"},
+      {"loss: 0.05", "loss: 5", "sar.yaml:11:46", "'loss' is a probability in [0, 1]"},
+      {"timeout: {sim: 600s, outcome: timeout}", "timeout: {outcome: timeout}", "sar.yaml:17:10",
+       "missing required key 'sim' in timeout"},
+      {"name: sar-search", "name: SAR Search", "sar.yaml:1:7", "trial name 'SAR Search' must be"},
+      {"{at: 30s, kill: raft_leader}", "{at: 601s, kill: raft_leader}", "sar.yaml:13:5",
+       "fault at 601s is after the timeout (10m)"},
+  };
+  for (const BadCase& c : cases) {
+    std::string text = kExample;
+    const auto pos = text.find(c.find);
+    ASSERT_NE(pos, std::string::npos) << c.find;
+    text.replace(pos, std::string(c.find).size(), c.replace);
+    auto spec = LoadTrialText(text, "sar.yaml", FakeTree());
+    ASSERT_FALSE(spec) << c.replace;
+    EXPECT_EQ(spec.error().where(), c.where) << c.replace << " -> " << spec.error().ToString();
+    EXPECT_NE(spec.error().message().find(c.message), std::string::npos)
+        << c.replace << " -> " << spec.error().ToString();
+  }
+}
+
+TEST(LoadTrial, OverridesApplyBeforeChecking) {
+  LoadOptions o = FakeTree();
+  o.overrides = {"network.mesh.loss=0.1", "seed=7", "drones.lifter.pose=[1, 2, 3]",
+                 "physics.rtf=0"};
+  auto spec = LoadTrialText(kExample, "sar.yaml", o);
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  EXPECT_DOUBLE_EQ(spec->mesh.loss, 0.1);
+  EXPECT_EQ(spec->seed, 7u);
+  EXPECT_DOUBLE_EQ(spec->drones[2].pose[2], 3.0);
+  EXPECT_DOUBLE_EQ(spec->rtf, 0.0);
+  // The resolved document holds the overridden values (it is written as trial.yaml).
+  EXPECT_EQ(spec->document.Find("seed")->scalar(), "7");
+}
+
+TEST(LoadTrial, BadOverridesPointAtTheSetFlag) {
+  LoadOptions o = FakeTree();
+  o.overrides = {"seed=seven"};
+  auto spec = LoadTrialText(kExample, "sar.yaml", o);
+  ASSERT_FALSE(spec);
+  EXPECT_EQ(spec.error().where(), "--set seed:1:1");
+  EXPECT_NE(spec.error().message().find("expected an integer"), std::string::npos);
+
+  o.overrides = {"network.mesh.los=0.1"};
+  spec = LoadTrialText(kExample, "sar.yaml", o);
+  ASSERT_FALSE(spec);
+  EXPECT_EQ(spec.error().where(), "--set network.mesh.los:1:1");
+  EXPECT_NE(spec.error().message().find("unknown key 'los' in network.mesh"), std::string::npos);
+}
+
+TEST(LoadTrial, MissingFileIsNotFound) {
+  auto spec = LoadTrial("/nonexistent/trial.yaml");
+  ASSERT_FALSE(spec);
+  EXPECT_EQ(spec.error().code(), ErrorCode::kNotFound);
+  EXPECT_EQ(spec.error().ToString(), "/nonexistent/trial.yaml: cannot open trial file");
+}
+
+TEST(LoadTrial, BuilderAndDocumentDescribeTheSameTrial) {
+  TrialSpec built = TrialSpec::Named("sar-search")
+                        .Seed(42)
+                        .World("worlds/open_field.yaml")
+                        .Drone("scout_1", "x500", {0, 0, 0})
+                        .Drone("lifter", "x8_heavy", {0, -10, 0}, "stretcher")
+                        .Mesh(MeshSpec::Netem(100, 20, 0.05))
+                        .Fault(FaultSpec::Kill(Duration::Seconds(30), "raft_leader"))
+                        .EndOn("event=mission_complete", Outcome::kSuccess)
+                        .EndOn("event=collision", Outcome::kFailure, "collision")
+                        .Timeout(Duration::Minutes(10));
+  const std::string text = yaml::Emit(ToDocument(built));
+  auto loaded = LoadTrialText(text, "built.yaml", FakeTree());
+  ASSERT_TRUE(loaded) << loaded.error().ToString() << "\n" << text;
+  EXPECT_EQ(loaded->name, built.name);
+  EXPECT_EQ(loaded->seed, built.seed);
+  ASSERT_EQ(loaded->drones.size(), 2u);
+  EXPECT_EQ(loaded->drones[1].payload, "stretcher");
+  EXPECT_DOUBLE_EQ(loaded->mesh.jitter_ms, 20);
+  ASSERT_EQ(loaded->faults.size(), 1u);
+  EXPECT_EQ(loaded->faults[0].targets, built.faults[0].targets);
+  ASSERT_EQ(loaded->end.size(), 2u);
+  EXPECT_EQ(loaded->end[1].reason, "collision");
+  EXPECT_EQ(loaded->timeout.sim, Duration::Minutes(10));
+}
+
+TEST(LoadTrial, ShippedTrialsLoadAgainstTheRealTrialsFolder) {
+  for (const char* file : {"sar_search.yaml", "smoke.yaml"}) {
+    auto spec = LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/" + file);
+    EXPECT_TRUE(spec) << file << ": " << spec.error().ToString();
+  }
+}
+
+}  // namespace
+}  // namespace swarmbox::dsl
