@@ -1,0 +1,141 @@
+// NodeDriver: one drone's Raft node wired to its storage, radio and mission state machine.
+//
+// The transport-facing shell around the pure RawNode (raw_node.hpp). It owns the RawNode and the
+// replicated MissionState; the caller owns the clock, the radio and the disk, behind three small
+// interfaces (real ones in the agent, fakes in tests and in the cluster simulator):
+//   Transport  Send(to_name, bytes): best effort, one datagram per message (Raft retries; the
+//              transport must not retransmit or hide loss, e.g. a best-effort DDS writer on the
+//              mesh radio topic, addressed by drone name);
+//   Storage    durable state (WalStorage in the agent);
+//   Clock      NowS(): the `t` of log events (the agent's simulated seconds).
+// Events are handed to the caller's sink as LogEvents (the logfmt contract):
+//   event=leader_elected term=3 leader=drone_2     every node, when it learns of a new leader
+//   event=mission_state state=SEARCH index=12      a committed phase change, on every node
+//   event=victim_confirmed id=1 x=41.500 y=-12.000 a committed confirmation, on every node
+//   event=victim_status id=1 status=being_rescued rescuer=lifter
+//   event=raft_stopped reason="..."                storage failed: the node is dead (exit!)
+//
+// Usage (the agent's Raft thread, or its event loop; the driver is not thread-safe):
+//
+//   DriverConfig cfg;
+//   cfg.self = "scout_1";
+//   cfg.members = {"scout_1", "scout_2", "lifter"};   // same list on every drone (order free)
+//   cfg.seed = trial_seed;                            // the trial's seed, any value per drone
+//   auto wal = WalStorage::Open(fs, "/var/lib/swarmbox/raft");
+//   auto node = NodeDriver::Open(cfg, **wal, radio, clock, [](const LogEvent& e) {
+//     std::puts(e.str().c_str());
+//   });
+//   if (!node) { print node.error(); exit(1); }
+//   every cfg.tick_ms of wall-clock time:   (*node)->Tick();
+//   on a radio sample addressed to self:    (*node)->Receive(bytes);   // errors: log, go on
+//   to change the mission:                  (*node)->Propose(StartSearch{});  // kUnavailable:
+//                                                     // no leader yet, retry later
+//   read the agreed mission:                (*node)->mission().phase() ...
+// Any call returns the storage error once the node has stopped (stopped() is true): the agent
+// must then exit non-zero, since it can no longer promise what it voted or acknowledged.
+//
+// Timing defaults (radio: 100 ms +- 20 ms one-way delay, 5% loss): tick 50 ms, heartbeat 100 ms
+// (about half the round trip), election timeout 600 ms randomised to [600, 1200) ms (6x the
+// heartbeat: a follower deposes the leader only after ~6 heartbeats in a row are lost, and with
+// PreVote/CheckQuorum a spurious timeout cannot depose a healthy leader anyway). Failover after a
+// leader crash is the election timeout plus two round trips (pre-vote, vote): ~0.8-1.7 s.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/raft/mission_command.hpp"
+#include "swarmbox/raft/mission_state.hpp"
+#include "swarmbox/raft/raw_node.hpp"
+#include "swarmbox/raft/storage.hpp"
+
+namespace swarmbox::raft {
+
+class Transport {
+ public:
+  virtual ~Transport() = default;
+  // Best effort: may drop, delay, duplicate or reorder; never blocks for long.
+  virtual void Send(const std::string& to, std::span<const std::uint8_t> bytes) = 0;
+};
+
+class Clock {
+ public:
+  virtual ~Clock() = default;
+  virtual double NowS() const = 0;  // [s], for event timestamps only
+};
+
+using EventSink = std::function<void(const LogEvent&)>;
+
+struct DriverConfig {
+  std::string self;
+  std::vector<std::string> members;  // every drone of the cluster, including self
+  int tick_ms = 50;                  // how often the caller calls Tick() [ms]
+  int heartbeat_ms = 100;            // multiple of tick_ms
+  int election_timeout_ms = 600;     // multiple of tick_ms, > heartbeat_ms
+  bool pre_vote = true;
+  bool check_quorum = true;
+  std::uint64_t seed = 1;
+  std::uint64_t snapshot_every_entries = 64;  // compact the log after this many applied entries
+  std::size_t max_entries_per_msg = 64;
+
+  // The RawNode config this gives (ids are 1 + the position in the sorted member list), or
+  // kInvalidArgument naming the problem.
+  Result<Config> ToRaftConfig() const;
+};
+
+class NodeDriver {
+ public:
+  // Loads `storage`, restores the mission from its snapshot and rejoins with the stored term,
+  // vote and log. The references must outlive the driver.
+  static Result<std::unique_ptr<NodeDriver>> Open(const DriverConfig& config, Storage& storage,
+                                                  Transport& transport, const Clock& clock,
+                                                  EventSink sink);
+
+  Status Tick();
+  // Bytes received from the radio. kProtocol for undecodable or misaddressed data (the node goes
+  // on); the stop error when stopped.
+  Status Receive(std::span<const std::uint8_t> bytes);
+  Status Propose(const MissionCommand& command);
+  Status Campaign();  // start an election now
+
+  bool stopped() const { return stop_error_.has_value(); }
+  const std::optional<Error>& stop_error() const { return stop_error_; }
+  const MissionState& mission() const { return mission_; }
+  const RawNode& raft() const { return node_; }
+  const std::string& self() const { return config_.self; }
+  std::string leader() const;  // the known leader's name, "" when none
+  bool is_leader() const { return node_.role() == Role::kLeader; }
+  const std::string& NameOf(NodeId id) const { return names_[id - 1]; }
+  NodeId IdOf(const std::string& name) const;  // kNoNode when not a member
+
+ private:
+  NodeDriver(DriverConfig config, std::vector<std::string> names, std::uint32_t tag, RawNode node,
+             MissionState mission, Storage& storage, Transport& transport, const Clock& clock,
+             EventSink sink);
+  Status Process();
+  Status Stop(Error e);
+  void Emit(const LogEvent& e) const;
+  void ApplyEntry(const Entry& e);
+
+  DriverConfig config_;
+  std::vector<std::string> names_;  // sorted; id = index + 1
+  std::uint32_t cluster_tag_;
+  RawNode node_;
+  MissionState mission_;
+  Storage& storage_;
+  Transport& transport_;
+  const Clock& clock_;
+  EventSink sink_;
+  std::optional<Error> stop_error_;
+  NodeId announced_lead_ = kNoNode;
+  std::uint64_t announced_term_ = 0;
+};
+
+}  // namespace swarmbox::raft

@@ -1,0 +1,194 @@
+// ClusterSim: a deterministic discrete-event simulator of a Raft cluster of NodeDrivers.
+//
+// Time is simulated (microseconds); one seed drives every random choice: message delay and
+// jitter, loss, duplication, reordering, partitions, crashes and restarts (storage kept, as a
+// MemoryStorage), tick phases and proposals. Messages go through the real codec and the real
+// driver, so the simulator exercises everything but files and sockets.
+//
+// After every step (a tick, a delivery, a proposal, a restart) it checks the Raft safety
+// properties (Raft §5.2 Figure 3):
+//   Election Safety      at most one leader per term; a node votes once per term
+//   Leader Append-Only   a leader's storage writes only append (never overwrite or truncate)
+//   Log Matching         two entries with the same index and term hold the same data and follow
+//                        entries of the same term (checked on every storage write)
+//   Leader Completeness  a new leader holds every entry committed before its election
+//   State Machine Safety every node's mission state after applying index i is the same, and
+//                        nodes commit the same entry at each index
+// plus monotonic terms. A violation is recorded with the seed and time; the first stops the run.
+//
+//   SimConfig cfg;                 // 5 nodes, radio-like network, no faults
+//   cfg.seed = 42;
+//   cfg.faults.crash_mean_interval_s = 5;
+//   SimReport r = RunSimulation(cfg);
+//   if (!r.ok()) std::puts(r.violations[0].c_str());   // "seed=42 t=12.340 Log Matching: ..."
+//
+// For scripted scenarios drive a ClusterSim directly: RunFor(), Crash(), Restart(),
+// Partition(), Heal(), Propose().
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <queue>
+#include <random>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "swarmbox/raft/node_driver.hpp"
+#include "swarmbox/raft/sim/memory_storage.hpp"
+
+namespace swarmbox::raft::sim {
+
+struct NetworkModel {
+  double delay_ms = 100;    // mean one-way delay
+  double jitter_ms = 20;    // uniform in [-jitter, +jitter]
+  double loss = 0.05;       // probability a message is dropped
+  double duplicate = 0;     // probability a message is delivered twice (independent delays)
+  double reorder = 0;       // probability a message gets an extra delay of up to reorder_ms
+  double reorder_ms = 300;
+};
+
+struct FaultModel {
+  double crash_mean_interval_s = 0;  // mean time between crashes of a random node (0: none)
+  double crash_leader_bias = 0.5;    // probability that a crash hits the current leader
+  double down_min_s = 0.5, down_max_s = 4;      // how long a crashed node stays down
+  double partition_mean_interval_s = 0;  // mean time between random partitions (0: none)
+  double partition_min_s = 0.5, partition_max_s = 5;
+};
+
+struct SimConfig {
+  int nodes = 5;
+  std::uint64_t seed = 1;
+  double duration_s = 20;
+  NetworkModel net;
+  FaultModel faults;
+  int tick_ms = 50;
+  int heartbeat_ms = 100;
+  int election_timeout_ms = 600;
+  bool pre_vote = true;
+  bool check_quorum = true;
+  std::uint64_t snapshot_every_entries = 32;
+  double propose_interval_s = 0.2;  // a random live node proposes a mission command this often
+  // Leader-crash schedule (the failover figure): at each time, crash the current leader (if any)
+  // and restart it leader_down_s later.
+  std::vector<double> leader_crash_at_s;
+  double leader_down_s = 3;
+  bool record_events = false;  // keep every node's logfmt events in SimReport::events
+};
+
+struct SimReport {
+  std::uint64_t seed = 0;
+  std::vector<std::string> violations;  // "seed=.. t=.. <property>: <details>"
+  std::vector<double> failover_ms;      // leader crash -> another node is leader
+  int failovers_missed = 0;             // leader crashes with no new leader before the next event
+  std::vector<double> commit_ms;        // proposal -> committed (first node to commit it)
+  int proposals = 0, proposals_dropped = 0;
+  int leader_terms = 0;                 // terms that had a leader
+  int leader_crashes = 0, crashes = 0, partitions = 0;
+  std::uint64_t messages_sent = 0, messages_delivered = 0;
+  std::uint64_t max_commit = 0;
+  std::uint64_t snapshots_sent = 0;
+  std::vector<std::string> events;  // with record_events
+
+  bool ok() const { return violations.empty(); }
+};
+
+class ClusterSim {
+ public:
+  explicit ClusterSim(const SimConfig& config);
+  ~ClusterSim();
+  ClusterSim(const ClusterSim&) = delete;
+  ClusterSim& operator=(const ClusterSim&) = delete;
+
+  // Runs events until now + seconds (or the first violation).
+  void RunFor(double seconds);
+  // Runs until some live node is leader, at most max_s; returns its index or -1.
+  int RunUntilLeader(double max_s);
+
+  void Crash(int node);
+  void Restart(int node);
+  // Nodes in different groups cannot exchange messages (also those already in flight).
+  void Partition(const std::vector<std::vector<int>>& groups);
+  void Heal();
+  Status Propose(int node, const MissionCommand& command);
+
+  double now_s() const { return static_cast<double>(now_us_) / 1e6; }
+  int size() const { return static_cast<int>(nodes_.size()); }
+  bool alive(int node) const;
+  const NodeDriver* driver(int node) const;  // nullptr while crashed
+  const MemoryStorage& storage(int node) const;
+  // The live leader with the highest term, or -1.
+  int Leader() const;
+  std::string Name(int node) const { return "n" + std::to_string(node + 1); }
+  NetworkModel& net() { return config_.net; }
+
+  const SimReport& report() const { return report_; }
+  SimReport TakeReport();
+
+ private:
+  struct Node;
+  struct Event;
+  struct EventLater {
+    bool operator()(const Event* a, const Event* b) const;
+  };
+  class NodeTransport;
+  class CheckedStorage;
+  class SimClock;
+
+  void Schedule(std::int64_t at_us, Event* e);
+  void Step();
+  void DeliverMessage(int from, int to, std::uint32_t epoch_to, Bytes bytes);
+  void SendMessage(int from, const std::string& to_name, std::span<const std::uint8_t> bytes);
+  void ScheduleTick(int node);
+  void ScheduleNextCrash();
+  void ScheduleNextPartition();
+  void ScheduleNextProposal();
+  void ProposeRandom();
+  void CrashLeaderNow();
+  void Violation(const std::string& property, const std::string& details);
+  void OnSave(int node, const std::optional<HardState>& hs, std::span<const Entry> entries,
+              const Snapshot& snapshot);
+  void CheckNode(int node);
+  double Uniform(double lo, double hi);
+  bool Chance(double p);
+
+  SimConfig config_;
+  std::mt19937_64 rng_;
+  std::int64_t now_us_ = 0;
+  std::uint64_t next_seq_ = 0;
+  std::priority_queue<Event*, std::vector<Event*>, EventLater> queue_;
+  std::vector<std::unique_ptr<Node>> nodes_;
+  std::vector<int> group_;
+  std::unique_ptr<SimClock> clock_;
+  SimReport report_;
+
+  // Safety bookkeeping.
+  struct EntryFact {
+    std::uint64_t prev_term;
+    std::uint64_t data_hash;
+  };
+  struct CommitFact {
+    std::uint64_t term;
+    std::uint64_t data_hash;
+  };
+  std::map<std::uint64_t, NodeId> leader_of_term_;
+  std::map<std::pair<std::uint64_t, std::uint64_t>, EntryFact> entries_seen_;  // (index, term)
+  std::vector<CommitFact> committed_;  // committed_[i - 1] for index i
+  std::unordered_map<std::uint64_t, std::uint64_t> state_hash_at_;  // applied index -> hash
+  // Metrics.
+  std::unordered_map<std::uint64_t, std::int64_t> proposed_at_us_;  // data hash -> time
+  std::optional<std::int64_t> leader_crash_us_;
+  std::uint64_t crashed_leader_term_ = 0;
+  std::uint64_t sighting_seq_ = 0;
+};
+
+// Builds a ClusterSim from the config, runs it for config.duration_s, returns the report.
+SimReport RunSimulation(const SimConfig& config);
+
+// FNV-1a 64 of a byte string (used for the safety bookkeeping).
+std::uint64_t HashBytes(std::span<const std::uint8_t> bytes);
+
+}  // namespace swarmbox::raft::sim

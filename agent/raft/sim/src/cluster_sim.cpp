@@ -1,0 +1,603 @@
+#include "swarmbox/raft/sim/cluster_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace swarmbox::raft::sim {
+
+std::uint64_t HashBytes(std::span<const std::uint8_t> bytes) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (std::uint8_t b : bytes) {
+    h ^= b;
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+namespace {
+
+std::uint64_t EntryHash(const Entry& e) {
+  return HashBytes(e.data) ^ (static_cast<std::uint64_t>(e.type) << 56);
+}
+
+std::int64_t Us(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e6)); }
+
+}  // namespace
+
+struct ClusterSim::Event {
+  enum class Kind { kTick, kDeliver, kAction };
+  std::int64_t at_us = 0;
+  std::uint64_t seq = 0;
+  Kind kind = Kind::kAction;
+  int node = 0;  // tick: the node; deliver: the receiver
+  int from = 0;
+  std::uint32_t epoch = 0;
+  Bytes bytes;
+  std::function<void()> action;
+};
+
+bool ClusterSim::EventLater::operator()(const Event* a, const Event* b) const {
+  if (a->at_us != b->at_us) return a->at_us > b->at_us;
+  return a->seq > b->seq;
+}
+
+class ClusterSim::SimClock final : public Clock {
+ public:
+  explicit SimClock(const ClusterSim& sim) : sim_(sim) {}
+  double NowS() const override { return sim_.now_s(); }
+
+ private:
+  const ClusterSim& sim_;
+};
+
+class ClusterSim::NodeTransport final : public Transport {
+ public:
+  NodeTransport(ClusterSim& sim, int node) : sim_(sim), node_(node) {}
+  void Send(const std::string& to, std::span<const std::uint8_t> bytes) override {
+    sim_.SendMessage(node_, to, bytes);
+  }
+
+ private:
+  ClusterSim& sim_;
+  int node_;
+};
+
+// The node's durable storage, with the Log Matching / Leader Append-Only checks on every write.
+class ClusterSim::CheckedStorage final : public MemoryStorage {
+ public:
+  CheckedStorage(ClusterSim& sim, int node) : sim_(sim), node_(node) {}
+  Status Save(const std::optional<HardState>& hard_state, std::span<const Entry> entries,
+              const Snapshot& snapshot) override {
+    sim_.OnSave(node_, hard_state, entries, snapshot);
+    return MemoryStorage::Save(hard_state, entries, snapshot);
+  }
+
+ private:
+  ClusterSim& sim_;
+  int node_;
+};
+
+struct ClusterSim::Node {
+  std::unique_ptr<CheckedStorage> storage;
+  std::unique_ptr<NodeTransport> transport;
+  std::unique_ptr<NodeDriver> driver;
+  bool alive = false;
+  std::uint32_t epoch = 0;
+  int restarts = 0;
+  std::uint64_t last_term = 0;
+  NodeId last_vote = kNoNode;
+  std::uint64_t checked_commit = 0;
+  std::uint64_t checked_applied = 0;
+  std::uint64_t led_term = 0;  // last term this node was seen leading
+};
+
+ClusterSim::ClusterSim(const SimConfig& config) : config_(config), rng_(config.seed) {
+  SWARMBOX_CHECK(config.nodes >= 1 && config.nodes <= 9);
+  report_.seed = config.seed;
+  clock_ = std::make_unique<SimClock>(*this);
+  group_.assign(static_cast<std::size_t>(config.nodes), 0);
+  for (int i = 0; i < config.nodes; ++i) {
+    auto n = std::make_unique<Node>();
+    n->storage = std::make_unique<CheckedStorage>(*this, i);
+    nodes_.push_back(std::move(n));
+  }
+  for (int i = 0; i < config.nodes; ++i) Restart(i);
+  if (config.propose_interval_s > 0) ScheduleNextProposal();
+  ScheduleNextCrash();
+  ScheduleNextPartition();
+  for (double t : config.leader_crash_at_s) {
+    auto* e = new Event;
+    e->action = [this] { CrashLeaderNow(); };
+    Schedule(Us(t), e);
+  }
+}
+
+ClusterSim::~ClusterSim() {
+  while (!queue_.empty()) {
+    delete queue_.top();
+    queue_.pop();
+  }
+}
+
+double ClusterSim::Uniform(double lo, double hi) {
+  return std::uniform_real_distribution<double>(lo, hi)(rng_);
+}
+
+bool ClusterSim::Chance(double p) { return p > 0 && Uniform(0, 1) < p; }
+
+void ClusterSim::Schedule(std::int64_t at_us, Event* e) {
+  e->at_us = std::max(at_us, now_us_);
+  e->seq = next_seq_++;
+  queue_.push(e);
+}
+
+bool ClusterSim::alive(int node) const { return nodes_[static_cast<std::size_t>(node)]->alive; }
+
+const NodeDriver* ClusterSim::driver(int node) const {
+  return nodes_[static_cast<std::size_t>(node)]->driver.get();
+}
+
+const MemoryStorage& ClusterSim::storage(int node) const {
+  return *nodes_[static_cast<std::size_t>(node)]->storage;
+}
+
+int ClusterSim::Leader() const {
+  int best = -1;
+  std::uint64_t best_term = 0;
+  for (int i = 0; i < size(); ++i) {
+    const NodeDriver* d = driver(i);
+    if (d && d->is_leader() && d->raft().term() >= best_term) {
+      best = i;
+      best_term = d->raft().term();
+    }
+  }
+  return best;
+}
+
+SimReport ClusterSim::TakeReport() { return std::move(report_); }
+
+void ClusterSim::Violation(const std::string& property, const std::string& details) {
+  std::ostringstream s;
+  s << "seed=" << config_.seed << " nodes=" << config_.nodes << " t=" << now_s() << " "
+    << property << ": " << details;
+  report_.violations.push_back(s.str());
+}
+
+// --- nodes ---------------------------------------------------------------------------------------
+
+void ClusterSim::Crash(int node) {
+  Node& n = *nodes_[static_cast<std::size_t>(node)];
+  if (!n.alive) return;
+  n.alive = false;
+  ++n.epoch;
+  n.driver.reset();
+  ++report_.crashes;
+}
+
+void ClusterSim::Restart(int node) {
+  Node& n = *nodes_[static_cast<std::size_t>(node)];
+  if (n.alive) return;
+  DriverConfig dc;
+  dc.self = Name(node);
+  for (int i = 0; i < size(); ++i) dc.members.push_back(Name(i));
+  dc.tick_ms = config_.tick_ms;
+  dc.heartbeat_ms = config_.heartbeat_ms;
+  dc.election_timeout_ms = config_.election_timeout_ms;
+  dc.pre_vote = config_.pre_vote;
+  dc.check_quorum = config_.check_quorum;
+  dc.snapshot_every_entries = config_.snapshot_every_entries;
+  dc.seed = config_.seed * std::uint64_t{1000003} +
+            static_cast<std::uint64_t>(node) * std::uint64_t{7919} +
+            static_cast<std::uint64_t>(n.restarts);
+  ++n.restarts;
+  n.transport = std::make_unique<NodeTransport>(*this, node);
+  EventSink sink;
+  if (config_.record_events) {
+    sink = [this](const LogEvent& e) { report_.events.push_back(e.str()); };
+  }
+  auto d = NodeDriver::Open(dc, *n.storage, *n.transport, *clock_, sink);
+  if (!d) {
+    Violation("Restart", Name(node) + " failed to restart: " + d.error().ToString());
+    return;
+  }
+  n.driver = std::move(*d);
+  n.alive = true;
+  ++n.epoch;
+  n.checked_commit = n.driver->raft().log().snapshot_index();
+  n.checked_applied = 0;
+  // A random phase for the node's tick clock.
+  auto* e = new Event;
+  e->kind = Event::Kind::kTick;
+  e->node = node;
+  e->epoch = n.epoch;
+  Schedule(now_us_ + static_cast<std::int64_t>(Uniform(0, config_.tick_ms * 1000.0)), e);
+  CheckNode(node);
+}
+
+void ClusterSim::ScheduleTick(int node) {
+  const Node& n = *nodes_[static_cast<std::size_t>(node)];
+  auto* e = new Event;
+  e->kind = Event::Kind::kTick;
+  e->node = node;
+  e->epoch = n.epoch;
+  Schedule(now_us_ + config_.tick_ms * 1000LL, e);
+}
+
+void ClusterSim::Partition(const std::vector<std::vector<int>>& groups) {
+  std::fill(group_.begin(), group_.end(), -1);
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    for (int node : groups[g]) group_[static_cast<std::size_t>(node)] = static_cast<int>(g);
+  }
+  // Nodes not listed are isolated, each on its own.
+  int next = static_cast<int>(groups.size());
+  for (int& g : group_) {
+    if (g < 0) g = next++;
+  }
+  ++report_.partitions;
+}
+
+void ClusterSim::Heal() { std::fill(group_.begin(), group_.end(), 0); }
+
+Status ClusterSim::Propose(int node, const MissionCommand& command) {
+  Node& n = *nodes_[static_cast<std::size_t>(node)];
+  if (!n.alive) return Error(ErrorCode::kUnavailable, Name(node) + " is down", "sim");
+  const Bytes data = EncodeCommand(command);
+  const std::uint64_t h = HashBytes(data);
+  proposed_at_us_.emplace(h, now_us_);
+  ++report_.proposals;
+  Status s = n.driver->Propose(command);
+  if (!s) {
+    ++report_.proposals_dropped;
+    proposed_at_us_.erase(h);
+  }
+  CheckNode(node);
+  return s;
+}
+
+// --- network -------------------------------------------------------------------------------------
+
+void ClusterSim::SendMessage(int from, const std::string& to_name,
+                             std::span<const std::uint8_t> bytes) {
+  ++report_.messages_sent;
+  const int to = std::stoi(to_name.substr(1)) - 1;
+  if (bytes.size() > 5 && bytes[5] == static_cast<std::uint8_t>(MessageType::kSnap)) {
+    ++report_.snapshots_sent;
+  }
+  if (group_[static_cast<std::size_t>(from)] != group_[static_cast<std::size_t>(to)]) return;
+  const NetworkModel& net = config_.net;
+  const int copies = Chance(net.duplicate) ? 2 : 1;
+  for (int c = 0; c < copies; ++c) {
+    if (Chance(net.loss)) continue;
+    double delay_ms = net.delay_ms + Uniform(-net.jitter_ms, net.jitter_ms);
+    if (Chance(net.reorder)) delay_ms += Uniform(0, net.reorder_ms);
+    auto* e = new Event;
+    e->kind = Event::Kind::kDeliver;
+    e->node = to;
+    e->from = from;
+    e->bytes.assign(bytes.begin(), bytes.end());
+    Schedule(now_us_ + static_cast<std::int64_t>(std::max(0.0, delay_ms) * 1000.0), e);
+  }
+}
+
+// --- faults and load -----------------------------------------------------------------------------
+
+void ClusterSim::ScheduleNextCrash() {
+  const FaultModel& f = config_.faults;
+  if (f.crash_mean_interval_s <= 0) return;
+  auto* e = new Event;
+  e->action = [this] {
+    const FaultModel& fm = config_.faults;
+    int victim = -1;
+    if (Chance(fm.crash_leader_bias)) victim = Leader();
+    if (victim < 0) victim = static_cast<int>(rng_() % static_cast<std::uint64_t>(size()));
+    int live = 0;
+    for (int i = 0; i < size(); ++i) live += alive(i) ? 1 : 0;
+    if (alive(victim) && live > 1) {
+      if (victim == Leader()) ++report_.leader_crashes;
+      Crash(victim);
+      auto* r = new Event;
+      r->action = [this, victim] { Restart(victim); };
+      Schedule(now_us_ + Us(Uniform(fm.down_min_s, fm.down_max_s)), r);
+    }
+    ScheduleNextCrash();
+  };
+  Schedule(now_us_ + Us(std::exponential_distribution<double>(1.0 / f.crash_mean_interval_s)(rng_)),
+           e);
+}
+
+void ClusterSim::ScheduleNextPartition() {
+  const FaultModel& f = config_.faults;
+  if (f.partition_mean_interval_s <= 0) return;
+  auto* e = new Event;
+  e->action = [this] {
+    const FaultModel& fm = config_.faults;
+    std::vector<int> order(static_cast<std::size_t>(size()));
+    for (int i = 0; i < size(); ++i) order[static_cast<std::size_t>(i)] = i;
+    std::shuffle(order.begin(), order.end(), rng_);
+    const auto cut = 1 + static_cast<std::ptrdiff_t>(rng_() % static_cast<std::uint64_t>(size() - 1));
+    Partition({std::vector<int>(order.begin(), order.begin() + cut),
+               std::vector<int>(order.begin() + cut, order.end())});
+    auto* h = new Event;
+    h->action = [this] { Heal(); };
+    Schedule(now_us_ + Us(Uniform(fm.partition_min_s, fm.partition_max_s)), h);
+    ScheduleNextPartition();
+  };
+  Schedule(now_us_ +
+               Us(std::exponential_distribution<double>(1.0 / f.partition_mean_interval_s)(rng_)),
+           e);
+}
+
+void ClusterSim::ScheduleNextProposal() {
+  auto* e = new Event;
+  e->action = [this] {
+    ProposeRandom();
+    ScheduleNextProposal();
+  };
+  Schedule(now_us_ + Us(config_.propose_interval_s * Uniform(0.5, 1.5)), e);
+}
+
+void ClusterSim::ProposeRandom() {
+  std::vector<int> live;
+  for (int i = 0; i < size(); ++i) {
+    if (alive(i)) live.push_back(i);
+  }
+  if (live.empty()) return;
+  const int node = live[rng_() % live.size()];
+  const double r = Uniform(0, 1);
+  const auto victim = static_cast<std::uint32_t>(1 + rng_() % 3);
+  MissionCommand cmd;
+  if (r < 0.05) {
+    cmd = StartSearch{};
+  } else if (r < 0.08) {
+    AssignSectors a;
+    for (int i = 0; i < size(); ++i) {
+      a.sectors.push_back(Sector{Name(i), i * 50.0, 0.0, i * 50.0 + 50.0, 100.0});
+    }
+    cmd = a;
+  } else if (r < 0.12) {
+    cmd = ConvergeOn{victim};
+  } else if (r < 0.15) {
+    cmd = BeginRescue{victim, Name(size() - 1)};
+  } else if (r < 0.18) {
+    cmd = MarkRescued{victim};
+  } else if (r < 0.20) {
+    cmd = ConfirmVictim{"ground", Uniform(-200, 200), Uniform(-200, 200)};
+  } else if (r < 0.205) {
+    cmd = ReturnHome{};
+  } else {
+    // Sightings around a few spots, so that pairs confirm victims.
+    const double cx = static_cast<double>(rng_() % 4) * 60.0;
+    cmd = ReportSighting{Name(node), ++sighting_seq_, cx + Uniform(-4, 4), Uniform(-4, 4),
+                         Uniform(0.4, 1.0)};
+  }
+  (void)Propose(node, cmd);
+}
+
+void ClusterSim::CrashLeaderNow() {
+  const int leader = Leader();
+  if (leader < 0) {
+    ++report_.failovers_missed;
+    return;
+  }
+  if (leader_crash_us_) ++report_.failovers_missed;
+  leader_crash_us_ = now_us_;
+  crashed_leader_term_ = driver(leader)->raft().term();
+  ++report_.leader_crashes;
+  Crash(leader);
+  auto* r = new Event;
+  r->action = [this, leader] { Restart(leader); };
+  Schedule(now_us_ + Us(config_.leader_down_s), r);
+}
+
+// --- the event loop ------------------------------------------------------------------------------
+
+void ClusterSim::Step() {
+  Event* e = queue_.top();
+  queue_.pop();
+  std::unique_ptr<Event> owned(e);
+  now_us_ = e->at_us;
+  switch (e->kind) {
+    case Event::Kind::kTick: {
+      Node& n = *nodes_[static_cast<std::size_t>(e->node)];
+      if (!n.alive || n.epoch != e->epoch) return;
+      (void)n.driver->Tick();
+      CheckNode(e->node);
+      ScheduleTick(e->node);
+      return;
+    }
+    case Event::Kind::kDeliver: {
+      Node& n = *nodes_[static_cast<std::size_t>(e->node)];
+      if (!n.alive) return;
+      if (group_[static_cast<std::size_t>(e->from)] != group_[static_cast<std::size_t>(e->node)]) {
+        return;
+      }
+      ++report_.messages_delivered;
+      Status s = n.driver->Receive(e->bytes);
+      if (!s && s.error().code() == ErrorCode::kProtocol) {
+        Violation("Transport", Name(e->node) + " rejected a message: " + s.error().ToString());
+      }
+      CheckNode(e->node);
+      return;
+    }
+    case Event::Kind::kAction:
+      e->action();
+      return;
+  }
+}
+
+void ClusterSim::RunFor(double seconds) {
+  const std::int64_t end = now_us_ + Us(seconds);
+  while (!queue_.empty() && queue_.top()->at_us <= end && report_.violations.empty()) Step();
+  if (report_.violations.empty()) now_us_ = end;
+}
+
+int ClusterSim::RunUntilLeader(double max_s) {
+  const std::int64_t end = now_us_ + Us(max_s);
+  while (Leader() < 0 && !queue_.empty() && queue_.top()->at_us <= end &&
+         report_.violations.empty()) {
+    Step();
+  }
+  return Leader();
+}
+
+// --- safety checks -------------------------------------------------------------------------------
+
+void ClusterSim::OnSave(int node, const std::optional<HardState>& hs,
+                        std::span<const Entry> entries, const Snapshot& snapshot) {
+  (void)hs;
+  const Node& n = *nodes_[static_cast<std::size_t>(node)];
+  const MemoryStorage& st = *n.storage;
+  const NodeDriver* d = n.driver.get();  // null while the driver is being opened
+  if (d && d->is_leader()) {
+    // Leader Append-Only (Raft §5.3): a leader never overwrites or deletes entries in its log.
+    if (!snapshot.empty()) Violation("Leader Append-Only", Name(node) + " installs a snapshot");
+    if (!entries.empty() && entries.front().index != st.last_index() + 1) {
+      Violation("Leader Append-Only",
+                Name(node) + " term " + std::to_string(d->raft().term()) + " writes entry " +
+                    std::to_string(entries.front().index) + " over a log ending at " +
+                    std::to_string(st.last_index()));
+    }
+  }
+  if (entries.empty()) return;
+  std::optional<std::uint64_t> prev;
+  const std::uint64_t first = entries.front().index;
+  if (!snapshot.empty()) {
+    if (first - 1 == snapshot.index) prev = snapshot.term;
+  } else {
+    prev = st.Term(first - 1);
+  }
+  if (!prev) {
+    Violation("Log Matching", Name(node) + " writes entry " + std::to_string(first) +
+                                  " after a gap in its log");
+    return;
+  }
+  // Log Matching (Raft §5.3): same index and term => same entry, preceded by the same term (so,
+  // by induction, identical logs up to there).
+  for (const Entry& e : entries) {
+    if (e.term < *prev) {
+      Violation("Log Matching", Name(node) + " entry " + std::to_string(e.index) + " term " +
+                                    std::to_string(e.term) + " follows term " +
+                                    std::to_string(*prev));
+    }
+    const EntryFact fact{*prev, EntryHash(e)};
+    auto [it, inserted] = entries_seen_.emplace(std::make_pair(e.index, e.term), fact);
+    if (!inserted && (it->second.prev_term != fact.prev_term ||
+                      it->second.data_hash != fact.data_hash)) {
+      Violation("Log Matching", Name(node) + " holds a different entry at index " +
+                                    std::to_string(e.index) + " term " + std::to_string(e.term));
+    }
+    prev = e.term;
+  }
+}
+
+void ClusterSim::CheckNode(int node) {
+  Node& n = *nodes_[static_cast<std::size_t>(node)];
+  if (!n.alive || !n.driver) return;
+  const NodeDriver& d = *n.driver;
+  if (d.stopped()) {
+    Violation("Storage", Name(node) + " stopped: " + d.stop_error()->ToString());
+    return;
+  }
+  const RawNode& raw = d.raft();
+  const RaftLog& log = raw.log();
+  const std::string who = Name(node);
+
+  // Terms never go back; one vote per term (Raft §5.2), across restarts too.
+  if (raw.term() < n.last_term) {
+    Violation("Election Safety", who + " term went back from " + std::to_string(n.last_term) +
+                                     " to " + std::to_string(raw.term()));
+  } else if (raw.term() > n.last_term) {
+    n.last_term = raw.term();
+    n.last_vote = raw.vote();
+  } else if (raw.vote() != n.last_vote) {
+    if (n.last_vote != kNoNode) {
+      Violation("Election Safety", who + " voted for " + std::to_string(n.last_vote) + " and " +
+                                       std::to_string(raw.vote()) + " in term " +
+                                       std::to_string(raw.term()));
+    }
+    n.last_vote = raw.vote();
+  }
+
+  // Commits: every node commits the same entry at each index.
+  const std::uint64_t commit = log.committed();
+  const std::uint64_t snap = log.snapshot_index();
+  if (snap > 0 && snap <= committed_.size() && committed_[snap - 1].term != 0 &&
+      committed_[snap - 1].term != log.snapshot_term()) {
+    Violation("State Machine Safety", who + " snapshot at " + std::to_string(snap) + " has term " +
+                                          std::to_string(log.snapshot_term()));
+  }
+  for (std::uint64_t i = std::max(n.checked_commit, snap) + 1; i <= commit; ++i) {
+    const Entry& e = log.At(i);
+    const CommitFact fact{e.term, EntryHash(e)};
+    if (committed_.size() < i) committed_.resize(i, CommitFact{0, 0});
+    CommitFact& known = committed_[i - 1];
+    if (known.term == 0) {
+      known = fact;
+      auto p = proposed_at_us_.find(fact.data_hash);
+      if (p != proposed_at_us_.end()) {
+        report_.commit_ms.push_back(static_cast<double>(now_us_ - p->second) / 1000.0);
+        proposed_at_us_.erase(p);
+      }
+    } else if (known.term != fact.term || known.data_hash != fact.data_hash) {
+      Violation("State Machine Safety",
+                who + " commits a different entry at index " + std::to_string(i) + " (term " +
+                    std::to_string(fact.term) + ", first committed in term " +
+                    std::to_string(known.term) + ")");
+    }
+  }
+  n.checked_commit = std::max(n.checked_commit, commit);
+  report_.max_commit = std::max(report_.max_commit, commit);
+
+  // Election Safety (Raft §5.2) and Leader Completeness (§5.4) when a node starts to lead.
+  if (raw.role() == Role::kLeader && n.led_term != raw.term()) {
+    n.led_term = raw.term();
+    auto [it, inserted] = leader_of_term_.emplace(raw.term(), raw.id());
+    if (!inserted && it->second != raw.id()) {
+      Violation("Election Safety", "two leaders in term " + std::to_string(raw.term()) + ": n" +
+                                       std::to_string(it->second) + " and " + who);
+    }
+    if (inserted) {
+      ++report_.leader_terms;
+      if (leader_crash_us_ && raw.term() > crashed_leader_term_) {
+        report_.failover_ms.push_back(static_cast<double>(now_us_ - *leader_crash_us_) / 1000.0);
+        leader_crash_us_.reset();
+      }
+    }
+    for (std::uint64_t i = snap + 1; i <= committed_.size(); ++i) {
+      const CommitFact& known = committed_[i - 1];
+      if (known.term == 0) continue;
+      if (i > log.last_index() || log.At(i).term != known.term ||
+          EntryHash(log.At(i)) != known.data_hash) {
+        Violation("Leader Completeness", who + " leads term " + std::to_string(raw.term()) +
+                                             " without committed entry " + std::to_string(i));
+        break;
+      }
+    }
+  }
+
+  // State Machine Safety (Raft §5.4.3): the same state after applying the same index.
+  const MissionState& m = d.mission();
+  if (m.applied_index() != log.applied()) {
+    Violation("State Machine Safety", who + " mission applied " +
+                                          std::to_string(m.applied_index()) + " but raft applied " +
+                                          std::to_string(log.applied()));
+  }
+  if (m.applied_index() != n.checked_applied) {
+    n.checked_applied = m.applied_index();
+    const std::uint64_t h = HashBytes(m.EncodeSnapshot());
+    auto [it, inserted] = state_hash_at_.emplace(m.applied_index(), h);
+    if (!inserted && it->second != h) {
+      Violation("State Machine Safety", who + " mission state after index " +
+                                            std::to_string(m.applied_index()) + " differs");
+    }
+  }
+}
+
+SimReport RunSimulation(const SimConfig& config) {
+  ClusterSim sim(config);
+  sim.RunFor(config.duration_s);
+  return sim.TakeReport();
+}
+
+}  // namespace swarmbox::raft::sim

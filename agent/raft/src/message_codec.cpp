@@ -1,0 +1,131 @@
+#include "swarmbox/raft/message_codec.hpp"
+
+#include "swarmbox/raft/detail/byte_io.hpp"
+
+namespace swarmbox::raft {
+
+std::uint32_t ClusterTag(const std::vector<std::string>& sorted_names) {
+  std::uint32_t h = 2166136261u;
+  for (const std::string& name : sorted_names) {
+    for (char c : name) {
+      h ^= static_cast<std::uint8_t>(c);
+      h *= 16777619u;
+    }
+    h *= 16777619u;  // the 0 separator byte: h ^= 0 is a no-op
+  }
+  return h;
+}
+
+Bytes EncodeMessage(const Message& m, std::uint32_t cluster_tag) {
+  SWARMBOX_CHECK(!IsLocalMessage(m.type));
+  Bytes out;
+  out.reserve(32 + m.entries.size() * 16 + m.snapshot.data.size());
+  detail::ByteWriter w(&out);
+  w.U8(kWireVersion);
+  w.Fixed32(cluster_tag);
+  w.U8(static_cast<std::uint8_t>(m.type));
+  w.Varint(m.from);
+  w.Varint(m.to);
+  w.Varint(m.term);
+  w.Varint(m.log_term);
+  w.Varint(m.index);
+  w.Varint(m.commit);
+  w.U8(m.reject ? 1 : 0);
+  w.Varint(m.reject_hint);
+  w.Varint(m.entries.size());
+  for (const Entry& e : m.entries) {
+    w.Varint(e.term);
+    w.Varint(e.index);
+    w.U8(static_cast<std::uint8_t>(e.type));
+    w.Blob(e.data);
+  }
+  if (m.type == MessageType::kSnap) {
+    w.Varint(m.snapshot.index);
+    w.Varint(m.snapshot.term);
+    w.Blob(m.snapshot.data);
+  }
+  return out;
+}
+
+namespace {
+
+Error Protocol(std::string what) {
+  return Error(ErrorCode::kProtocol, std::move(what), "raft message");
+}
+
+}  // namespace
+
+Result<Message> DecodeMessage(std::span<const std::uint8_t> bytes, std::uint32_t cluster_tag) {
+  detail::ByteReader r(bytes);
+  const std::uint8_t version = r.U8();
+  if (!r.ok()) return Protocol("empty message");
+  if (version != kWireVersion) {
+    return Protocol("unsupported wire version " + std::to_string(version) + " (expected " +
+                    std::to_string(kWireVersion) + ")");
+  }
+  const std::uint32_t tag = r.Fixed32();
+  if (r.ok() && tag != cluster_tag) {
+    return Protocol("message from another cluster (tag " + std::to_string(tag) + ", ours " +
+                    std::to_string(cluster_tag) + "): member lists differ");
+  }
+  Message m;
+  const std::uint8_t type = r.U8();
+  if (r.ok() && (type > kMaxMessageType || IsLocalMessage(static_cast<MessageType>(type)))) {
+    return Protocol("invalid message type " + std::to_string(type));
+  }
+  m.type = static_cast<MessageType>(type);
+  m.from = r.Varint();
+  m.to = r.Varint();
+  m.term = r.Varint();
+  m.log_term = r.Varint();
+  m.index = r.Varint();
+  m.commit = r.Varint();
+  const std::uint8_t flags = r.U8();
+  if (r.ok() && flags > 1) return Protocol("invalid flags " + std::to_string(flags));
+  m.reject = flags == 1;
+  m.reject_hint = r.Varint();
+  const std::uint64_t n = r.Count(4, "entry");
+  m.entries.reserve(static_cast<std::size_t>(n));
+  for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
+    Entry e;
+    e.term = r.Varint();
+    e.index = r.Varint();
+    const std::uint8_t et = r.U8();
+    if (r.ok() && et > 1) return Protocol("invalid entry type " + std::to_string(et));
+    e.type = static_cast<EntryType>(et);
+    e.data = r.Blob();
+    m.entries.push_back(std::move(e));
+  }
+  if (m.type == MessageType::kSnap) {
+    m.snapshot.index = r.Varint();
+    m.snapshot.term = r.Varint();
+    m.snapshot.data = r.Blob();
+    if (r.ok() && (m.snapshot.index == 0 || m.snapshot.term == 0)) {
+      return Protocol("snapshot message without a snapshot");
+    }
+  }
+  if (!r.ok()) return Protocol(r.error());
+  if (!r.at_end()) {
+    return Protocol(std::to_string(r.remaining()) + " trailing bytes at byte " +
+                    std::to_string(r.offset()));
+  }
+  if (m.from == kNoNode) return Protocol("message without a sender");
+  if (m.type != MessageType::kProp && m.term == 0) return Protocol("message without a term");
+  if (m.type == MessageType::kApp) {
+    // The receiver appends these as they are: they must follow `index` and not outrun `term`.
+    std::uint64_t prev_term = m.log_term;
+    for (std::size_t k = 0; k < m.entries.size(); ++k) {
+      const Entry& e = m.entries[k];
+      if (e.index != m.index + 1 + k || e.term < prev_term || e.term > m.term) {
+        return Protocol("append entries are not contiguous (entry " + std::to_string(k) + ")");
+      }
+      prev_term = e.term;
+    }
+    if (m.log_term > m.term) return Protocol("append log_term beyond the message term");
+  } else if (m.type != MessageType::kProp && !m.entries.empty()) {
+    return Protocol("entries in a " + std::string(MessageTypeName(m.type)) + " message");
+  }
+  return m;
+}
+
+}  // namespace swarmbox::raft

@@ -1,0 +1,140 @@
+#include "swarmbox/raft/mission_command.hpp"
+
+#include "swarmbox/raft/detail/byte_io.hpp"
+
+namespace swarmbox::raft {
+
+namespace {
+
+template <class... Fs>
+struct Overloaded : Fs... {
+  using Fs::operator()...;
+};
+template <class... Fs>
+Overloaded(Fs...) -> Overloaded<Fs...>;
+
+}  // namespace
+
+std::string_view CommandName(const MissionCommand& command) {
+  static constexpr std::string_view kNames[] = {
+      "start_search", "assign_sectors", "report_sighting", "confirm_victim", "converge_on",
+      "begin_rescue", "mark_rescued",   "return_home",     "complete_mission"};
+  return kNames[command.index()];
+}
+
+Bytes EncodeCommand(const MissionCommand& command) {
+  Bytes out;
+  detail::ByteWriter w(&out);
+  w.U8(kCommandVersion);
+  w.U8(static_cast<std::uint8_t>(command.index()));
+  std::visit(Overloaded{
+                 [](const StartSearch&) {},
+                 [&](const AssignSectors& c) {
+                   w.Varint(c.sectors.size());
+                   for (const Sector& s : c.sectors) {
+                     w.Str(s.drone);
+                     w.F64(s.x_min_m);
+                     w.F64(s.y_min_m);
+                     w.F64(s.x_max_m);
+                     w.F64(s.y_max_m);
+                   }
+                 },
+                 [&](const ReportSighting& c) {
+                   w.Str(c.reporter);
+                   w.Varint(c.seq);
+                   w.F64(c.x_m);
+                   w.F64(c.y_m);
+                   w.F64(c.confidence);
+                 },
+                 [&](const ConfirmVictim& c) {
+                   w.Str(c.by);
+                   w.F64(c.x_m);
+                   w.F64(c.y_m);
+                 },
+                 [&](const ConvergeOn& c) { w.Varint(c.victim_id); },
+                 [&](const BeginRescue& c) {
+                   w.Varint(c.victim_id);
+                   w.Str(c.lifter);
+                 },
+                 [&](const MarkRescued& c) { w.Varint(c.victim_id); },
+                 [](const ReturnHome&) {},
+                 [](const CompleteMission&) {},
+             },
+             command);
+  return out;
+}
+
+Result<MissionCommand> DecodeCommand(std::span<const std::uint8_t> bytes) {
+  detail::ByteReader r(bytes);
+  const std::uint8_t version = r.U8();
+  const std::uint8_t kind = r.U8();
+  if (!r.ok()) return Error(ErrorCode::kProtocol, r.error(), "mission command");
+  if (version != kCommandVersion) {
+    return Error(ErrorCode::kProtocol, "unsupported command version " + std::to_string(version),
+                 "mission command");
+  }
+  auto victim_id = [&r]() {
+    const std::uint64_t v = r.Varint();
+    if (v > UINT32_MAX) r.Fail("victim id out of range");
+    return static_cast<std::uint32_t>(v);
+  };
+  MissionCommand cmd;
+  switch (kind) {
+    case 0: cmd = StartSearch{}; break;
+    case 1: {
+      AssignSectors c;
+      const std::uint64_t n = r.Count(33, "sector");
+      for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
+        Sector s;
+        s.drone = r.Str();
+        s.x_min_m = r.F64();
+        s.y_min_m = r.F64();
+        s.x_max_m = r.F64();
+        s.y_max_m = r.F64();
+        c.sectors.push_back(std::move(s));
+      }
+      cmd = std::move(c);
+      break;
+    }
+    case 2: {
+      ReportSighting c;
+      c.reporter = r.Str();
+      c.seq = r.Varint();
+      c.x_m = r.F64();
+      c.y_m = r.F64();
+      c.confidence = r.F64();
+      cmd = std::move(c);
+      break;
+    }
+    case 3: {
+      ConfirmVictim c;
+      c.by = r.Str();
+      c.x_m = r.F64();
+      c.y_m = r.F64();
+      cmd = std::move(c);
+      break;
+    }
+    case 4: cmd = ConvergeOn{victim_id()}; break;
+    case 5: {
+      BeginRescue c;
+      c.victim_id = victim_id();
+      c.lifter = r.Str();
+      cmd = std::move(c);
+      break;
+    }
+    case 6: cmd = MarkRescued{victim_id()}; break;
+    case 7: cmd = ReturnHome{}; break;
+    case 8: cmd = CompleteMission{}; break;
+    default:
+      return Error(ErrorCode::kProtocol, "unknown command kind " + std::to_string(kind),
+                   "mission command");
+  }
+  if (!r.ok()) return Error(ErrorCode::kProtocol, r.error(), "mission command");
+  if (!r.at_end()) {
+    return Error(ErrorCode::kProtocol, std::to_string(r.remaining()) + " trailing bytes",
+                 "mission command");
+  }
+  return cmd;
+}
+
+}  // namespace swarmbox::raft

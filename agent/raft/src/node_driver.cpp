@@ -1,0 +1,230 @@
+#include "swarmbox/raft/node_driver.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include "swarmbox/raft/message_codec.hpp"
+
+namespace swarmbox::raft {
+
+Result<Config> DriverConfig::ToRaftConfig() const {
+  auto bad = [](std::string msg) {
+    return Error(ErrorCode::kInvalidArgument, std::move(msg), "raft driver config");
+  };
+  if (self.empty()) return bad("self name is empty");
+  std::vector<std::string> names = members;
+  std::sort(names.begin(), names.end());
+  if (std::adjacent_find(names.begin(), names.end()) != names.end()) {
+    return bad("member names must be distinct");
+  }
+  auto it = std::find(names.begin(), names.end(), self);
+  if (it == names.end()) return bad("self '" + self + "' is not among the members");
+  if (tick_ms <= 0) return bad("tick_ms must be > 0");
+  if (heartbeat_ms % tick_ms != 0 || election_timeout_ms % tick_ms != 0) {
+    return bad("heartbeat_ms (" + std::to_string(heartbeat_ms) + ") and election_timeout_ms (" +
+               std::to_string(election_timeout_ms) + ") must be multiples of tick_ms (" +
+               std::to_string(tick_ms) + ")");
+  }
+  if (snapshot_every_entries == 0) return bad("snapshot_every_entries must be > 0");
+  Config c;
+  c.id = static_cast<NodeId>(it - names.begin()) + 1;
+  for (std::size_t k = 0; k < names.size(); ++k) c.voters.push_back(k + 1);
+  c.heartbeat_ticks = heartbeat_ms / tick_ms;
+  c.election_ticks = election_timeout_ms / tick_ms;
+  c.pre_vote = pre_vote;
+  c.check_quorum = check_quorum;
+  c.seed = seed;
+  c.max_entries_per_msg = max_entries_per_msg;
+  if (auto s = c.Validate(); !s) return s.error();
+  return c;
+}
+
+NodeDriver::NodeDriver(DriverConfig config, std::vector<std::string> names, std::uint32_t tag,
+                       RawNode node, MissionState mission, Storage& storage, Transport& transport,
+                       const Clock& clock, EventSink sink)
+    : config_(std::move(config)),
+      names_(std::move(names)),
+      cluster_tag_(tag),
+      node_(std::move(node)),
+      mission_(std::move(mission)),
+      storage_(storage),
+      transport_(transport),
+      clock_(clock),
+      sink_(std::move(sink)) {}
+
+Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config, Storage& storage,
+                                                     Transport& transport, const Clock& clock,
+                                                     EventSink sink) {
+  auto rc = config.ToRaftConfig();
+  if (!rc) return rc.error();
+  auto state = storage.Load();
+  if (!state) return state.error().Context("loading raft state");
+  MissionState mission;
+  if (!state->snapshot.empty()) {
+    auto m = MissionState::DecodeSnapshot(state->snapshot.data);
+    if (!m) return m.error().Context("restoring the mission from the stored snapshot");
+    if (m->applied_index() != state->snapshot.index) {
+      return Error(ErrorCode::kProtocol,
+                   "stored snapshot " + std::to_string(state->snapshot.index) +
+                       " holds a mission applied to " + std::to_string(m->applied_index()),
+                   "raft storage");
+    }
+    mission = std::move(*m);
+  }
+  auto node = RawNode::Create(*rc, std::move(*state));
+  if (!node) return node.error().Context("restarting raft");
+  std::vector<std::string> names = config.members;
+  std::sort(names.begin(), names.end());
+  const std::uint32_t tag = ClusterTag(names);
+  std::unique_ptr<NodeDriver> d(new NodeDriver(config, std::move(names), tag, std::move(*node),
+                                               std::move(mission), storage, transport, clock,
+                                               std::move(sink)));
+  // Hand over what the restart produced (the term bump of a fresh node, re-applying the
+  // committed entries after the snapshot).
+  if (auto s = d->Process(); !s) return s.error();
+  return d;
+}
+
+NodeId NodeDriver::IdOf(const std::string& name) const {
+  auto it = std::lower_bound(names_.begin(), names_.end(), name);
+  if (it == names_.end() || *it != name) return kNoNode;
+  return static_cast<NodeId>(it - names_.begin()) + 1;
+}
+
+std::string NodeDriver::leader() const {
+  return node_.lead() == kNoNode ? std::string() : NameOf(node_.lead());
+}
+
+void NodeDriver::Emit(const LogEvent& e) const {
+  if (sink_) sink_(e);
+}
+
+Status NodeDriver::Stop(Error e) {
+  stop_error_ = e;
+  Emit(LogEvent(clock_.NowS(), config_.self, "raft_stopped").Add("reason", e.ToString()));
+  return e;
+}
+
+Status NodeDriver::Tick() {
+  if (stop_error_) return *stop_error_;
+  node_.Tick();
+  return Process();
+}
+
+Status NodeDriver::Campaign() {
+  if (stop_error_) return *stop_error_;
+  node_.Campaign();
+  return Process();
+}
+
+Status NodeDriver::Receive(std::span<const std::uint8_t> bytes) {
+  if (stop_error_) return *stop_error_;
+  auto m = DecodeMessage(bytes, cluster_tag_);
+  if (!m) return m.error();
+  if (m->to != node_.id()) {
+    return Error(ErrorCode::kProtocol,
+                 "message for node " + std::to_string(m->to) + " delivered to " + config_.self,
+                 "raft driver");
+  }
+  if (m->from == kNoNode || m->from > names_.size()) {
+    return Error(ErrorCode::kProtocol, "message from unknown node " + std::to_string(m->from),
+                 "raft driver");
+  }
+  Status step = node_.Step(*m);
+  Status processed = Process();
+  if (!processed) return processed;
+  return step;
+}
+
+Status NodeDriver::Propose(const MissionCommand& command) {
+  if (stop_error_) return *stop_error_;
+  Status s = node_.Propose(EncodeCommand(command));
+  Status processed = Process();
+  if (!processed) return processed;
+  return s;
+}
+
+void NodeDriver::ApplyEntry(const Entry& e) {
+  if (e.index <= mission_.applied_index()) return;  // already in the restored snapshot
+  if (e.type == EntryType::kEmpty) {
+    mission_.Skip(e.index);
+    return;
+  }
+  ApplyResult r = mission_.ApplyEncoded(e.index, e.data);
+  const double t = clock_.NowS();
+  for (const MissionEvent& ev : r.events) {
+    switch (ev.kind) {
+      case MissionEvent::Kind::kPhase:
+        Emit(LogEvent(t, config_.self, "mission_state")
+                 .Add("state", PhaseName(ev.phase))
+                 .Add("index", ev.index));
+        break;
+      case MissionEvent::Kind::kVictimConfirmed:
+        Emit(LogEvent(t, config_.self, "victim_confirmed")
+                 .Add("id", static_cast<std::uint64_t>(ev.victim.id))
+                 .Add("x", ev.victim.x_m)
+                 .Add("y", ev.victim.y_m)
+                 .Add("index", ev.index));
+        break;
+      case MissionEvent::Kind::kVictimStatus: {
+        LogEvent le(t, config_.self, "victim_status");
+        le.Add("id", static_cast<std::uint64_t>(ev.victim.id))
+            .Add("status", VictimStatusName(ev.victim.status));
+        if (!ev.victim.rescuer.empty()) le.Add("rescuer", ev.victim.rescuer);
+        Emit(le.Add("index", ev.index));
+        break;
+      }
+    }
+  }
+}
+
+Status NodeDriver::Process() {
+  while (node_.HasReady()) {
+    Ready rd = node_.GetReady();
+    // Raft §5 (Figure 2): persistent state is durable before any message that depends on it.
+    if (rd.hard_state || !rd.entries.empty() || !rd.snapshot.empty()) {
+      if (auto s = storage_.Save(rd.hard_state, rd.entries, rd.snapshot); !s) {
+        return Stop(s.error().Context("raft storage failed, node stopped"));
+      }
+    }
+    for (const Message& m : rd.messages) {
+      const Bytes bytes = EncodeMessage(m, cluster_tag_);
+      transport_.Send(NameOf(m.to), bytes);
+    }
+    if (rd.soft_state && rd.soft_state->lead != kNoNode &&
+        (rd.soft_state->lead != announced_lead_ || node_.term() != announced_term_)) {
+      announced_lead_ = rd.soft_state->lead;
+      announced_term_ = node_.term();
+      Emit(LogEvent(clock_.NowS(), config_.self, "leader_elected")
+               .Add("term", node_.term())
+               .Add("leader", NameOf(announced_lead_)));
+    }
+    if (!rd.snapshot.empty()) {
+      auto m = MissionState::DecodeSnapshot(rd.snapshot.data);
+      if (!m) return Stop(m.error().Context("leader sent an unreadable snapshot"));
+      mission_ = std::move(*m);
+      // The snapshot is the state after its index; nothing before it is applied again.
+      if (mission_.applied_index() != rd.snapshot.index) {
+        return Stop(Error(ErrorCode::kProtocol, "snapshot index mismatch", "raft driver"));
+      }
+      Emit(LogEvent(clock_.NowS(), config_.self, "mission_state")
+               .Add("state", PhaseName(mission_.phase()))
+               .Add("index", rd.snapshot.index)
+               .Add("from", "snapshot"));
+    }
+    for (const Entry& e : rd.committed_entries) ApplyEntry(e);
+    node_.Advance(rd);
+  }
+  // Raft §7: compact the log into a snapshot of the mission once enough has been applied.
+  const std::uint64_t applied = node_.log().applied();
+  if (applied >= node_.log().snapshot_index() + config_.snapshot_every_entries) {
+    Snapshot snap{applied, *node_.log().Term(applied), mission_.EncodeSnapshot()};
+    if (auto s = storage_.Compact(snap); !s) {
+      return Stop(s.error().Context("raft storage failed while compacting, node stopped"));
+    }
+    if (auto s = node_.Compact(applied, std::move(snap.data)); !s) return Stop(s.error());
+  }
+  return Ok{};
+}
+
+}  // namespace swarmbox::raft
