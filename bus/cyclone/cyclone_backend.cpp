@@ -91,9 +91,26 @@ class ParticipantHandle {
   ParticipantHandle& operator=(const ParticipantHandle&) = delete;
   dds_entity_t get() const { return participant_; }
 
+  // Cyclone DDS (with XTypes) lets one participant use a topic name with several types; the bus
+  // does not (Fast DDS cannot, and it defeats interop), so the first type a name is used with
+  // stays bound to it for the participant's life.
+  Status ClaimTopic(const std::string& name, const char* type_name) {
+    std::lock_guard lock(mu_);
+    auto [it, inserted] = topic_types_.emplace(name, type_name);
+    if (!inserted && it->second != type_name) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "topic '" + name + "' already carries " + it->second +
+                       " in this participant, not " + type_name,
+                   "cyclonedds dds_create_topic");
+    }
+    return Ok{};
+  }
+
  private:
   int domain_id_;
   dds_entity_t participant_;
+  std::mutex mu_;
+  std::map<std::string, std::string> topic_types_;
 };
 
 // QoS of a preset; the caller deletes it.
@@ -123,9 +140,11 @@ dds_qos_t* MakeQos(Qos qos, bool writer) {
 }
 
 // A topic entity owned by one writer or reader.
-Result<dds_entity_t> CreateTopic(dds_entity_t participant, const dds_topic_descriptor_t* desc,
-                                 const std::string& name) {
-  const dds_entity_t topic = dds_create_topic(participant, desc, name.c_str(), nullptr, nullptr);
+Result<dds_entity_t> CreateTopic(ParticipantHandle& participant,
+                                 const dds_topic_descriptor_t* desc, const std::string& name) {
+  SWARMBOX_TRY(participant.ClaimTopic(name, desc->m_typename));
+  const dds_entity_t topic =
+      dds_create_topic(participant.get(), desc, name.c_str(), nullptr, nullptr);
   if (topic < 0) {
     return DdsError(topic, "creating topic '" + name + "' of type " + desc->m_typename +
                                " (a topic of that name with another type exists?)",
@@ -195,7 +214,7 @@ class Reader final : public detail::ReaderBackend {
 
   Status Init(const dds_topic_descriptor_t* desc, const std::string& topic_name, Qos qos) {
     const dds_entity_t pp = participant_->get();
-    auto topic = CreateTopic(pp, desc, topic_name);
+    auto topic = CreateTopic(*participant_, desc, topic_name);
     if (!topic) return topic.error();
     topic_ = *topic;
     dds_qos_t* q = MakeQos(qos, /*writer=*/false);
@@ -310,7 +329,7 @@ class CycloneParticipant final : public detail::ParticipantBackend {
   Result<std::unique_ptr<detail::WriterBackend>> MakeWriter(const dds_topic_descriptor_t* desc,
                                                             const std::string& topic_name,
                                                             Qos qos) {
-    auto topic = CreateTopic(handle_->get(), desc, topic_name);
+    auto topic = CreateTopic(*handle_, desc, topic_name);
     if (!topic) return topic.error();
     dds_qos_t* q = MakeQos(qos, /*writer=*/true);
     const dds_entity_t writer = dds_create_writer(handle_->get(), *topic, q, nullptr);

@@ -22,7 +22,7 @@ struct Direction {
   int domain_base;  // 170 for cyclone -> fastdds, 180 for fastdds -> cyclone
 };
 
-class InteropTest : public ::testing::TestWithParam<Direction> {
+class BusInterop : public ::testing::TestWithParam<Direction> {
  protected:
   template <BusMessage T>
   void Check(int slot, const std::string& topic, Qos qos) {
@@ -36,20 +36,20 @@ class InteropTest : public ::testing::TestWithParam<Direction> {
 };
 
 // Lockstep types (sim domain, reliable).
-TEST_P(InteropTest, ClockTickCrossesVendors) { Check<ClockTick>(0, std::string(kClockTopic), Qos::kLockstep); }
-TEST_P(InteropTest, SensorSampleCrossesVendors) { Check<SensorSample>(1, SensorTopic("scout_1"), Qos::kLockstep); }
-TEST_P(InteropTest, ActuatorCommandCrossesVendors) { Check<ActuatorCommand>(2, ActuatorTopic("scout_1"), Qos::kLockstep); }
-TEST_P(InteropTest, CameraImageCrossesVendors) { Check<CameraImage>(3, CameraTopic("scout_1"), Qos::kLockstep); }
-TEST_P(InteropTest, WorldCommandCrossesVendors) { Check<WorldCommand>(4, std::string(kWorldCommandTopic), Qos::kLockstep); }
+TEST_P(BusInterop, ClockTickCrossesVendors) { Check<ClockTick>(0, std::string(kClockTopic), Qos::kLockstep); }
+TEST_P(BusInterop, SensorSampleCrossesVendors) { Check<SensorSample>(1, SensorTopic("scout_1"), Qos::kLockstep); }
+TEST_P(BusInterop, ActuatorCommandCrossesVendors) { Check<ActuatorCommand>(2, ActuatorTopic("scout_1"), Qos::kLockstep); }
+TEST_P(BusInterop, CameraImageCrossesVendors) { Check<CameraImage>(3, CameraTopic("scout_1"), Qos::kLockstep); }
+TEST_P(BusInterop, WorldCommandCrossesVendors) { Check<WorldCommand>(4, std::string(kWorldCommandTopic), Qos::kLockstep); }
 // Radio and state types (mesh domain).
-TEST_P(InteropTest, DroneStateCrossesVendors) { Check<DroneState>(5, std::string(kDroneStateTopic), Qos::kState); }
-TEST_P(InteropTest, RaftMessageCrossesVendors) { Check<RaftMessage>(6, std::string(kRaftTopic), Qos::kRadio); }
-TEST_P(InteropTest, DetectionCrossesVendors) { Check<Detection>(7, std::string(kDetectionTopic), Qos::kRadio); }
-TEST_P(InteropTest, RadioPingCrossesVendors) { Check<RadioPing>(8, std::string(kRadioPingTopic), Qos::kRadio); }
-TEST_P(InteropTest, EventCrossesVendors) { Check<Event>(9, std::string(kEventTopic), Qos::kRadio); }
+TEST_P(BusInterop, DroneStateCrossesVendors) { Check<DroneState>(5, std::string(kDroneStateTopic), Qos::kState); }
+TEST_P(BusInterop, RaftMessageCrossesVendors) { Check<RaftMessage>(6, std::string(kRaftTopic), Qos::kRadio); }
+TEST_P(BusInterop, DetectionCrossesVendors) { Check<Detection>(7, std::string(kDetectionTopic), Qos::kRadio); }
+TEST_P(BusInterop, RadioPingCrossesVendors) { Check<RadioPing>(8, std::string(kRadioPingTopic), Qos::kRadio); }
+TEST_P(BusInterop, EventCrossesVendors) { Check<Event>(9, std::string(kEventTopic), Qos::kRadio); }
 
 // A camera-sized image is fragmented by one vendor and reassembled by the other.
-TEST_P(InteropTest, CameraSizedImageCrossesVendors) {
+TEST_P(BusInterop, CameraSizedImageCrossesVendors) {
   auto pub = MakeParticipant(GetParam().from, GetParam().domain_base + 3);
   auto sub = MakeParticipant(GetParam().to, GetParam().domain_base + 3);
   ASSERT_TRUE(pub && sub);
@@ -57,7 +57,7 @@ TEST_P(InteropTest, CameraSizedImageCrossesVendors) {
                                      testing::FullCameraImage(5, 320, 240)));
 }
 
-INSTANTIATE_TEST_SUITE_P(Directions, InteropTest,
+INSTANTIATE_TEST_SUITE_P(Directions, BusInterop,
                          ::testing::Values(Direction{"cyclonedds", "fastdds", 170},
                                            Direction{"fastdds", "cyclonedds", 180}),
                          [](const auto& param_info) {

@@ -14,7 +14,7 @@ using testing::Full;
 using testing::MakeParticipant;
 using testing::RoundTrip;
 
-class RoundTripTest : public ::testing::TestWithParam<std::string> {
+class BusRoundTrip : public ::testing::TestWithParam<std::string> {
  protected:
   // Domains 150..159 for cyclonedds, 160..169 for fastdds; `slot` is per message type.
   template <BusMessage T>
@@ -27,20 +27,20 @@ class RoundTripTest : public ::testing::TestWithParam<std::string> {
   }
 };
 
-TEST_P(RoundTripTest, ClockTickArrivesIntact) { Check<ClockTick>(0, std::string(kClockTopic), Qos::kLockstep); }
-TEST_P(RoundTripTest, SensorSampleArrivesIntact) { Check<SensorSample>(1, SensorTopic("drone_7"), Qos::kLockstep); }
-TEST_P(RoundTripTest, ActuatorCommandArrivesIntact) { Check<ActuatorCommand>(2, ActuatorTopic("drone_7"), Qos::kLockstep); }
-TEST_P(RoundTripTest, CameraImageArrivesIntact) { Check<CameraImage>(3, CameraTopic("drone_7"), Qos::kLockstep); }
-TEST_P(RoundTripTest, WorldCommandArrivesIntact) { Check<WorldCommand>(4, std::string(kWorldCommandTopic), Qos::kLockstep); }
-TEST_P(RoundTripTest, DroneStateArrivesIntact) { Check<DroneState>(5, std::string(kDroneStateTopic), Qos::kState); }
-TEST_P(RoundTripTest, RaftMessageArrivesIntact) { Check<RaftMessage>(6, std::string(kRaftTopic), Qos::kRadio); }
-TEST_P(RoundTripTest, DetectionArrivesIntact) { Check<Detection>(7, std::string(kDetectionTopic), Qos::kRadio); }
-TEST_P(RoundTripTest, RadioPingArrivesIntact) { Check<RadioPing>(8, std::string(kRadioPingTopic), Qos::kRadio); }
-TEST_P(RoundTripTest, EventArrivesIntact) { Check<Event>(9, std::string(kEventTopic), Qos::kRadio); }
+TEST_P(BusRoundTrip, ClockTickArrivesIntact) { Check<ClockTick>(0, std::string(kClockTopic), Qos::kLockstep); }
+TEST_P(BusRoundTrip, SensorSampleArrivesIntact) { Check<SensorSample>(1, SensorTopic("drone_7"), Qos::kLockstep); }
+TEST_P(BusRoundTrip, ActuatorCommandArrivesIntact) { Check<ActuatorCommand>(2, ActuatorTopic("drone_7"), Qos::kLockstep); }
+TEST_P(BusRoundTrip, CameraImageArrivesIntact) { Check<CameraImage>(3, CameraTopic("drone_7"), Qos::kLockstep); }
+TEST_P(BusRoundTrip, WorldCommandArrivesIntact) { Check<WorldCommand>(4, std::string(kWorldCommandTopic), Qos::kLockstep); }
+TEST_P(BusRoundTrip, DroneStateArrivesIntact) { Check<DroneState>(5, std::string(kDroneStateTopic), Qos::kState); }
+TEST_P(BusRoundTrip, RaftMessageArrivesIntact) { Check<RaftMessage>(6, std::string(kRaftTopic), Qos::kRadio); }
+TEST_P(BusRoundTrip, DetectionArrivesIntact) { Check<Detection>(7, std::string(kDetectionTopic), Qos::kRadio); }
+TEST_P(BusRoundTrip, RadioPingArrivesIntact) { Check<RadioPing>(8, std::string(kRadioPingTopic), Qos::kRadio); }
+TEST_P(BusRoundTrip, EventArrivesIntact) { Check<Event>(9, std::string(kEventTopic), Qos::kRadio); }
 
 // A camera-sized image (320x240 mono8, 76,800 bytes of pixels) is fragmented on the wire by both
 // backends and must still arrive byte for byte.
-TEST_P(RoundTripTest, CameraSizedImageArrivesIntact) {
+TEST_P(BusRoundTrip, CameraSizedImageArrivesIntact) {
   const int domain = (GetParam() == "cyclonedds" ? 150 : 160) + 3;
   auto pub = MakeParticipant(GetParam(), domain);
   auto sub = MakeParticipant(GetParam(), domain);
@@ -49,7 +49,7 @@ TEST_P(RoundTripTest, CameraSizedImageArrivesIntact) {
                                      testing::FullCameraImage(3, 320, 240)));
 }
 
-INSTANTIATE_TEST_SUITE_P(Backends, RoundTripTest, ::testing::Values("cyclonedds", "fastdds"),
+INSTANTIATE_TEST_SUITE_P(Backends, BusRoundTrip, ::testing::Values("cyclonedds", "fastdds"),
                          [](const auto& param_info) { return param_info.param; });
 
 }  // namespace
