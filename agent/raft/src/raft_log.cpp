@@ -94,7 +94,7 @@ std::vector<Entry> RaftLog::Slice(std::uint64_t lo, std::uint64_t hi, std::size_
   SWARMBOX_CHECK(lo >= first_index() && hi <= last_index() + 1);
   std::vector<Entry> out;
   if (lo >= hi) return out;
-  hi = std::min<std::uint64_t>(hi, lo + max_count);
+  if (hi - lo > max_count) hi = lo + max_count;
   auto begin = entries_.begin() + static_cast<std::ptrdiff_t>(lo - snapshot_index_ - 1);
   out.assign(begin, begin + static_cast<std::ptrdiff_t>(hi - lo));
   return out;
