@@ -1,0 +1,42 @@
+// NetemdArgs: the command line of swarmbox-netemd, built by the radio plan and parsed by the daemon
+// (one definition, so the two cannot drift).
+//
+//   swarmbox-netemd run --queue 0 --delay-us 100000 --jitter-us 20000 --distribution normal
+//                       --correlation 0.25 --reorder 0 --reorder-correlation 0 --reorder-gap 0
+//                       --seed 42 --queue-maxlen 4096 [--pidfile /run/swarmbox-netemd-0.pid]
+//                       [--daemonize]
+//   swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid   # SIGTERM, wait until it is gone
+//   swarmbox-netemd sleep                                       # a sidecar's pid 1: reaps, waits
+//
+// `run` binds NFQUEUE `--queue`, holds each packet for its sampled delay and then accepts it. With
+// --daemonize it forks once the queue is bound and the parent exits 0 (so a `docker exec` returns
+// when the delayer is ready). On SIGTERM it accepts every held packet at once and exits 0.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/faults/delay_scheduler.hpp"
+
+namespace swarmbox::faults {
+
+struct NetemdArgs {
+  std::uint16_t queue = 0;
+  DelaySettings delay;
+  std::uint64_t seed = 0;
+  std::uint32_t queue_maxlen = 1024;  // packets the kernel may hold for us before dropping
+  std::string pidfile;                // "" = none
+  bool daemonize = false;
+  bool operator==(const NetemdArgs&) const = default;
+};
+
+// {program, "run", "--queue", ...}.
+std::vector<std::string> NetemdRunArgv(const std::string& program, const NetemdArgs& args);
+// {program, "stop", "--pidfile", pidfile}.
+std::vector<std::string> NetemdStopArgv(const std::string& program, const std::string& pidfile);
+// Parses the words after "run". Errors name the flag and what it expects.
+Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words);
+
+}  // namespace swarmbox::faults
