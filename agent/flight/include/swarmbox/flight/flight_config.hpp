@@ -1,0 +1,75 @@
+// The flight stack's configuration, read from an airframe file (trials/airframes/<name>.yaml).
+//
+// The physics engineer owns the physical part of the file; the flight stack reads from it only
+// what a real companion computer would be configured with (empty mass, rotor geometry and motor
+// constants for the mixer, sensor noise figures for the estimator, the payload's sling for swing
+// damping) and owns the top-level `control:` mapping (gains and limits), read strictly: unknown
+// keys there are errors with file:line:col. Every key of `control:` is optional; missing ones keep
+// PX4's x500 defaults below.
+//
+//   control:
+//     position: {xy_p: 0.95, z_p: 1.0, vel_xy_pid: [1.8, 0.4, 0.2], vel_z_pid: [4.0, 2.0, 0.0],
+//                vel_max_xy_mps: 5, vel_max_up_mps: 3, vel_max_down_mps: 1.5,
+//                acc_max_xy_mps2: 3, acc_max_z_mps2: 2, tilt_max_deg: 45,
+//                thrust_min: 0.1, thrust_max: 0.9}          # fractions of the total max thrust
+//     attitude: {roll_p: 6.5, pitch_p: 6.5, yaw_p: 2.8, rate_max_deg_s: [220, 220, 200]}
+//     rate: {roll_pid: [0.15, 0.2, 0.003], pitch_pid: [0.15, 0.2, 0.003], yaw_pid: [0.2, 0.1, 0.0],
+//            integrator_limit: [0.3, 0.3, 0.3]}
+//     takeoff: {speed_mps: 1.5}
+//     land: {speed_mps: 0.7, slow_speed_mps: 0.3, slow_below_m: 2.0}
+//     swing_damping: {enabled: true, gain: 1.0, shaper: true}
+//
+//   Result<FlightConfig> cfg = LoadFlightConfig("trials/airframes/x500.yaml");
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/flight/attitude_control.hpp"
+#include "swarmbox/flight/estimator.hpp"
+#include "swarmbox/flight/mixer.hpp"
+#include "swarmbox/flight/position_control.hpp"
+#include "swarmbox/flight/rate_control.hpp"
+#include "swarmbox/flight/trajectory.hpp"
+
+namespace swarmbox::flight {
+
+struct SlungPayload {
+  std::string name;
+  double mass_kg = 0.0;
+  double sling_length_m = 0.0;        // hook -> payload centre [m]
+  Vec3 hook_m = Vec3::Zero();         // hook in the body frame [m]
+};
+
+struct SwingDampingParams {
+  bool enabled = true;
+  double gain = 1.0;                  // active damping, multiplies the critical-ish gain sqrt(g L)
+  bool shaper = true;                 // ZVD input shaping of the position reference
+};
+
+struct FlightConfig {
+  std::string airframe;               // name in the file
+  std::string source;                 // file path
+  double mass_kg = 0.0;               // empty vehicle [kg]
+  std::vector<RotorGeometry> rotors;
+  PositionParams position;            // thrust_min_n/thrust_max_n filled from the mixer
+  double thrust_min_frac = 0.1;
+  double thrust_max_frac = 0.9;
+  TrajectoryLimits limits;
+  AttitudeGains attitude;
+  RateGains rate;
+  EstimatorParams estimator;
+  double takeoff_speed_mps = 1.5;
+  double land_speed_mps = 0.7;
+  double land_slow_speed_mps = 0.3;
+  double land_slow_below_m = 2.0;     // height above the take-off point where landing slows [m]
+  std::vector<SlungPayload> payloads;
+  SwingDampingParams swing;
+};
+
+Result<FlightConfig> ParseFlightConfig(const yaml::Node& airframe_root, std::string source = {});
+Result<FlightConfig> LoadFlightConfig(const std::string& path);
+
+}  // namespace swarmbox::flight

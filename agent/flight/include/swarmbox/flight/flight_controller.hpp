@@ -1,0 +1,128 @@
+// FlightController: the whole flight stack of one drone as one pure object. Sensor sample in,
+// actuator command out, on simulated time; setpoints in from the layers above, events out.
+//
+//   sample -> Estimator -> modes/setpoints -> Trajectory (limits, smoothing) [-> InputShaper]
+//          -> PositionControl (+ swing damping feed-forward) -> AttitudeControl -> RateControl
+//          -> Mixer -> u[i] in [0, 1]
+//
+// No DDS, threads, clocks or files; Step() neither allocates nor throws (STYLE.md 1, 12). The
+// agent program wraps it; the closed-loop tests run it against the physics library in process.
+//
+//   auto fc = FlightController::Create(*LoadFlightConfig("trials/airframes/x500.yaml"), {});
+//   fc->Command(Setpoint::Takeoff(5));
+//   for each lockstep sample: const ActuatorOutput& out = fc->Step(sample);  // answer with out.u
+#pragma once
+
+#include <array>
+#include <cstddef>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/flight/attitude_control.hpp"
+#include "swarmbox/flight/estimator.hpp"
+#include "swarmbox/flight/flight_config.hpp"
+#include "swarmbox/flight/mixer.hpp"
+#include "swarmbox/flight/position_control.hpp"
+#include "swarmbox/flight/rate_control.hpp"
+#include "swarmbox/flight/setpoint.hpp"
+#include "swarmbox/flight/swing_damping.hpp"
+#include "swarmbox/flight/trajectory.hpp"
+
+namespace swarmbox::flight {
+
+struct ControllerOptions {
+  double control_dt_s = 0.004;       // the lockstep period the input shaper is sized for [s]
+  // What the companion computer is told it carries at start (initial value of the mass
+  // estimate; the estimate then adapts to what the drone really lifts) [kg].
+  double payload_mass_kg = 0.0;
+  // Name of the airframe payload whose sling the swing damping is tuned for ("" = the first).
+  const char* payload_name = "";
+  bool swing_damping = true;         // AND the config's swing_damping.enabled
+  // Known start position (the take-off spot) for the estimator; see EstimatorParams.
+  bool has_start_pos = false;
+  Vec3 start_pos_m = Vec3::Zero();
+};
+
+struct ActuatorOutput {
+  bool armed = false;
+  std::size_t count = 0;
+  std::array<double, kMaxRotors> u{};  // first `count` valid, in the airframe's rotor order
+};
+
+// Internal signals, for tests, benchmarks and logs.
+struct ControllerTelemetry {
+  TrajectoryPoint reference;        // after shaping
+  PositionOutput position;
+  Vec3 rate_sp_radps = Vec3::Zero();
+  Vec3 torque_nm = Vec3::Zero();
+  double mass_estimate_kg = 0.0;
+  double swing_estimate_rad = 0.0;
+};
+
+class FlightController {
+ public:
+  static Result<FlightController> Create(const FlightConfig& config, const ControllerOptions& options);
+
+  // The setpoint interface. Rejected (and reported as an event) when the mode cannot take it:
+  // anything but Takeoff on the ground, Takeoff in the air, anything before the estimator is
+  // ready. Does not allocate.
+  bool Command(const Setpoint& sp);
+
+  // One control step on the lockstep sample. Motors off (armed = false) on the ground.
+  const ActuatorOutput& Step(const SensorSample& sample);
+
+  // Events since the last call, oldest first; false when none are left.
+  bool PopEvent(FlightEvent* out);
+
+  FlightMode mode() const { return mode_; }
+  const StateEstimate& estimate() const { return estimator_.state(); }
+  const ControllerTelemetry& telemetry() const { return telemetry_; }
+  const FlightConfig& config() const { return config_; }
+  const Mixer& mixer() const { return mixer_; }
+  bool swing_damping_active() const { return damping_on_; }
+
+ private:
+  FlightController(const FlightConfig& config, const ControllerOptions& options, Mixer mixer);
+  void SetMode(FlightMode mode, double t_s);
+  void Emit(FlightEventKind kind, double t_s);
+  void ResetControllers();
+  void StartTrajectoryHere();
+  void DisarmedOutput();
+
+  FlightConfig config_;
+  ControllerOptions options_;
+  Mixer mixer_;
+  Estimator estimator_;
+  Trajectory trajectory_;
+  InputShaper shaper_;
+  SwingObserver swing_;
+  PositionControl position_;
+  AttitudeControl attitude_;
+  RateControl rate_;
+  ActuatorOutput output_;
+  ControllerTelemetry telemetry_;
+
+  FlightMode mode_ = FlightMode::kInit;
+  double t_s_ = 0.0;
+  double last_t_s_ = -1.0;
+  double mode_since_s_ = 0.0;
+  double yaw_sp_rad_ = 0.0;
+  double home_z_m_ = 0.0;
+  Vec3 land_xy_m_ = Vec3::Zero();
+  double land_vz_mps_ = 0.0;
+  double landed_timer_s_ = 0.0;
+  bool arrived_reported_ = true;
+  bool gps_ok_ = true;
+  double mass_kg_ = 0.0;            // hover-thrust (effective mass) estimate [kg]
+  double last_thrust_n_ = 0.0;
+  Vec3 last_rate_ = Vec3::Zero();
+  Vec3 ang_accel_ = Vec3::Zero();
+  bool damping_on_ = false;
+  double airborne_s_ = 0.0;
+
+  static constexpr std::size_t kEventCapacity = 32;
+  std::array<FlightEvent, kEventCapacity> events_{};
+  std::size_t ev_head_ = 0;
+  std::size_t ev_count_ = 0;
+};
+
+}  // namespace swarmbox::flight

@@ -1,0 +1,71 @@
+// Position P -> velocity PID -> thrust vector with tilt limit -> attitude setpoint
+// (the structure of PX4 mc_pos_control/PositionControl, in ENU and SI units).
+//
+// Gains are in acceleration units ([m/s^2 per m/s], as PX4's MPC_*_VEL_*_ACC), so the loop shape
+// does not change with the vehicle's mass; the mass (from the hover-thrust estimate) only turns the
+// acceleration into newtons.
+//
+//   PositionControl pc;  pc.SetParams(params);
+//   PositionOutput out = pc.Update(state, setpoint, mass_kg, dt_s);
+//   if (out.valid) { attitude control with out.att_sp; mixer with out.thrust_n; }
+#pragma once
+
+#include "swarmbox/flight/types.hpp"
+
+namespace swarmbox::flight {
+
+struct PositionParams {
+  double xy_p = 0.95;            // [1/s]
+  double z_p = 1.0;              // [1/s]
+  Vec3 vel_p = Vec3(1.8, 1.8, 4.0);   // [(m/s^2)/(m/s)]
+  Vec3 vel_i = Vec3(0.4, 0.4, 2.0);   // [(m/s^2)/m]
+  Vec3 vel_d = Vec3(0.2, 0.2, 0.0);   // [(m/s^2)/(m/s^2)]
+  double vel_max_xy_mps = 5.0;
+  double vel_max_up_mps = 3.0;
+  double vel_max_down_mps = 1.5;
+  double tilt_max_rad = 45.0 * kPi / 180.0;
+  double thrust_min_n = 0.0;     // collective thrust bounds [N] (from the airframe)
+  double thrust_max_n = 1.0;
+  double integral_max_mps2 = 4.0;  // |velocity integral| per axis [m/s^2]
+};
+
+// What the layers above want. pos_* selects position control on that axis; otherwise the
+// velocity (plus feed-forward) is tracked directly. Feed-forwards are world ENU.
+struct PositionSetpoint {
+  bool pos_xy = true;
+  bool pos_z = true;
+  Vec3 pos_m = Vec3::Zero();
+  Vec3 vel_mps = Vec3::Zero();     // feed-forward (position mode) or setpoint (velocity mode)
+  Vec3 acc_mps2 = Vec3::Zero();    // feed-forward
+  double yaw_rad = 0.0;
+  double yawspeed_radps = 0.0;     // feed-forward
+};
+
+struct PositionOutput {
+  bool valid = false;               // false: non-finite input, nothing to fly
+  Vec3 thrust_world_n = Vec3::Zero();
+  double thrust_n = 0.0;            // collective thrust along body z [N]
+  Quat att_sp = Quat::Identity();   // body FLU -> world ENU
+  Vec3 vel_sp_mps = Vec3::Zero();   // after limits, for logs and tests
+  Vec3 acc_sp_mps2 = Vec3::Zero();  // after limits
+};
+
+class PositionControl {
+ public:
+  void SetParams(const PositionParams& params) { params_ = params; }
+  const PositionParams& params() const { return params_; }
+  PositionOutput Update(const StateEstimate& state, const PositionSetpoint& sp, double mass_kg,
+                        double dt_s);
+  void ResetIntegral() { integral_.setZero(); }
+  const Vec3& integral() const { return integral_; }
+
+ private:
+  PositionParams params_;
+  Vec3 integral_ = Vec3::Zero();  // [m/s^2]
+};
+
+// Attitude whose body z is `body_z` (world, normalised inside) and whose heading is `yaw_rad`
+// (PX4 bodyzToAttitude).
+Quat AttitudeFromThrustAndYaw(const Vec3& body_z, double yaw_rad);
+
+}  // namespace swarmbox::flight
