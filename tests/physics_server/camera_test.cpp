@@ -1,0 +1,131 @@
+// The downward camera: victims land where the pinhole model puts them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "test_util.hpp"
+
+namespace swarmbox::physics {
+namespace {
+
+using testing::CalmWorld;
+using testing::LoadShippedAirframe;
+using testing::MakeWorld;
+using testing::Spawn;
+
+struct Centroid {
+  double u = 0, v = 0;
+  int count = 0;
+};
+
+// Victim pixels: red channel high, blue low (grass and soil have R < 130); the head is the
+// brighter (G > 170) part.
+void FindVictim(const CameraImage& img, Centroid* body, Centroid* head) {
+  for (int y = 0; y < img.height_px; ++y) {
+    for (int x = 0; x < img.width_px; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width_px) + static_cast<std::size_t>(x)) * 3;
+      const int b = img.bgr[i], g = img.bgr[i + 1], r = img.bgr[i + 2];
+      if (r < 215 || b > 90) continue;
+      Centroid* c = g > 170 ? head : body;
+      c->u += x;  // OpenCV convention: pixel (x, y) is centred on coordinate (x, y)
+      c->v += y;
+      ++c->count;
+    }
+  }
+  if (body->count) body->u /= body->count, body->v /= body->count;
+  if (head->count) head->u /= head->count, head->v /= head->count;
+}
+
+// Independent pinhole model: camera at `cam` (world), yaw `yaw` of a level drone; optical frame
+// x = body right (-y_b), y = body back (-x_b), z = down.
+void Project(const Vec3& p, const Vec3& cam, double yaw, const CameraIntrinsics& k, double* u, double* v) {
+  const Vec3 d = p - cam;
+  const double xb = std::cos(yaw) * d.x + std::sin(yaw) * d.y;
+  const double yb = -std::sin(yaw) * d.x + std::cos(yaw) * d.y;
+  const double zb = d.z;
+  *u = k.fx_px * (-yb) / (-zb) + k.cx_px;
+  *v = k.fy_px * (-xb) / (-zb) + k.cy_px;
+}
+
+void CheckVictimPixel(double yaw, double victim_heading) {
+  WorldConfig config = CalmWorld();
+  config.victims.push_back({.id = "v1", .x_m = 2.0, .y_m = 1.0, .heading_rad = victim_heading});
+  auto world = MakeWorld(config, 5);
+  const Airframe af = LoadShippedAirframe("x500");
+  const auto d = Spawn(*world, testing::MakeSpawn("d", af, Vec3{0, 0, 8}, yaw));
+  world->SetPinned(d, true);
+  CameraImage img;
+  world->RenderCamera(d, &img);
+  ASSERT_EQ(img.width_px, 320);
+  ASSERT_EQ(img.height_px, 240);
+  ASSERT_EQ(img.bgr.size(), 320u * 240u * 3u);
+  EXPECT_NEAR(img.intrinsics.fx_px, 160.0 / std::tan(0.6), 1e-9);
+  EXPECT_DOUBLE_EQ(img.intrinsics.cx_px, 160.0);
+
+  const Vec3 cam = world->Truth(d).position_m + Vec3{0, 0, af.camera.offset_m.z};
+  EXPECT_NEAR(img.camera_pose.position_m.z, cam.z, 1e-9);
+  const Vec3 dir{std::cos(victim_heading), std::sin(victim_heading), 0};
+  double bu, bv, hu, hv;
+  Project(Vec3{2, 1, 0} + dir * -0.15, cam, yaw, img.intrinsics, &bu, &bv);  // body ellipse centre
+  Project(Vec3{2, 1, 0} + dir * 0.7, cam, yaw, img.intrinsics, &hu, &hv);    // head centre
+  Centroid body, head;
+  FindVictim(img, &body, &head);
+  ASSERT_GT(body.count, 200);  // 0.54 m^2 at ~8 m: ~ 460 px
+  ASSERT_GT(head.count, 15);   // 0.045 m^2: ~ 38 px
+  // Rasterised polygons of ~20 vertices and pixel noise: centroids within 0.5 px (body) and
+  // 1 px (the small head).
+  EXPECT_NEAR(body.u, bu, 0.5);
+  EXPECT_NEAR(body.v, bv, 0.5);
+  EXPECT_NEAR(head.u, hu, 1.0);
+  EXPECT_NEAR(head.v, hv, 1.0);
+}
+
+TEST(Camera, VictimAppearsWhereThePinholeModelPredicts) { CheckVictimPixel(0.0, 0.0); }
+
+TEST(Camera, ImageTurnsWithTheDrone) { CheckVictimPixel(std::numbers::pi / 2, 2.0); }
+
+TEST(Camera, RenderingIsDeterministicAndNoisy) {
+  auto world = MakeWorld(CalmWorld(), 9);
+  const auto d = Spawn(*world, testing::MakeSpawn("d", LoadShippedAirframe("x500"), Vec3{0, 0, 20}));
+  world->SetPinned(d, true);
+  CameraImage a, b;
+  world->RenderCamera(d, &a);
+  world->RenderCamera(d, &b);
+  EXPECT_EQ(a.bgr, b.bgr);  // same step, same seed
+  world->Step();
+  world->RenderCamera(d, &b);
+  EXPECT_NE(a.bgr, b.bgr);  // next step: fresh noise on the same view
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < a.bgr.size(); ++i) differing += a.bgr[i] != b.bgr[i] ? 1u : 0u;
+  EXPECT_GT(differing, a.bgr.size() / 2);  // noise std 4 levels changes most pixels
+}
+
+TEST(Camera, ObstacleTopsAreSeenFromAbove) {
+  WorldConfig config = CalmWorld();
+  config.obstacles.push_back({.id = "block", .center_m = {0, 0, 2}, .size_m = {4, 4, 4}, .yaw_rad = 0});
+  auto world = MakeWorld(config);
+  const auto d = Spawn(*world, testing::MakeSpawn("d", LoadShippedAirframe("x500"), Vec3{0, 0, 15}));
+  world->SetPinned(d, true);
+  CameraImage img;
+  world->RenderCamera(d, &img);
+  // The image centre looks straight down onto the block's top (grey ~155, noise 4).
+  const std::size_t c = (120u * 320u + 160u) * 3u;
+  EXPECT_NEAR(img.bgr[c + 2], 160, 20);
+  EXPECT_NEAR(img.bgr[c + 1], 155, 20);
+  EXPECT_NEAR(img.bgr[c], 150, 20);
+}
+
+TEST(Camera, DueAtItsRate) {
+  auto world = MakeWorld(CalmWorld());
+  const auto d = Spawn(*world, testing::MakeSpawn("d", LoadShippedAirframe("x500")));
+  int due = 0;
+  for (int k = 0; k < 250; ++k) {
+    if (world->CameraDue(d)) ++due;
+    world->Step();
+  }
+  EXPECT_EQ(due, 5);  // 5 Hz over 1 s
+}
+
+}  // namespace
+}  // namespace swarmbox::physics

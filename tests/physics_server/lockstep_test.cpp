@@ -1,0 +1,88 @@
+// Lockstep bookkeeping with a fake clock (plain integers).
+#include "swarmbox/physics/lockstep.hpp"
+
+#include <gtest/gtest.h>
+
+namespace swarmbox::physics {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+
+TEST(Lockstep, StepCompletesWhenEveryDroneAnswered) {
+  Lockstep ls(2, {.timeout_ns = 100 * kMs, .join_timeout_ns = 1000 * kMs});
+  ls.BeginStep(0, 0);
+  EXPECT_FALSE(ls.StepComplete(1 * kMs));
+  EXPECT_EQ(ls.OnCommand(0, 0, 2 * kMs), Lockstep::Answer::kAccepted);
+  EXPECT_FALSE(ls.StepComplete(2 * kMs));
+  EXPECT_EQ(ls.OnCommand(1, 0, 3 * kMs), Lockstep::Answer::kAccepted);
+  EXPECT_TRUE(ls.StepComplete(3 * kMs));
+  EXPECT_TRUE(ls.TakeNewlyLost().empty());
+}
+
+TEST(Lockstep, RejectsWrongStepDuplicatesAndUnknownDrones) {
+  Lockstep ls(1, {});
+  ls.BeginStep(5, 0);
+  EXPECT_EQ(ls.OnCommand(0, 4, 0), Lockstep::Answer::kWrongStep);
+  EXPECT_EQ(ls.OnCommand(0, 6, 0), Lockstep::Answer::kWrongStep);
+  EXPECT_EQ(ls.OnCommand(3, 5, 0), Lockstep::Answer::kUnknownDrone);
+  EXPECT_EQ(ls.OnCommand(0, 5, 0), Lockstep::Answer::kAccepted);
+  EXPECT_EQ(ls.OnCommand(0, 5, 0), Lockstep::Answer::kDuplicate);
+}
+
+TEST(Lockstep, SilentDroneIsLostAfterTheTimeoutAndTheWorldGoesOn) {
+  Lockstep ls(2, {.timeout_ns = 100 * kMs, .join_timeout_ns = 1000 * kMs});
+  // Both join at step 0.
+  ls.BeginStep(0, 0);
+  ls.OnCommand(0, 0, 1 * kMs);
+  ls.OnCommand(1, 0, 1 * kMs);
+  ASSERT_TRUE(ls.StepComplete(1 * kMs));
+  // Step 1: drone 1 goes silent.
+  ls.BeginStep(1, 10 * kMs);
+  ls.OnCommand(0, 1, 11 * kMs);
+  EXPECT_FALSE(ls.StepComplete(109 * kMs));
+  EXPECT_EQ(ls.NextDeadlineNs(), 110 * kMs);
+  EXPECT_TRUE(ls.StepComplete(110 * kMs));
+  EXPECT_EQ(ls.TakeNewlyLost(), std::vector<std::size_t>{1});
+  EXPECT_TRUE(ls.lost(1));
+  EXPECT_EQ(ls.live_count(), 1u);
+  // Later steps do not wait for the lost drone.
+  ls.BeginStep(2, 120 * kMs);
+  ls.OnCommand(0, 2, 121 * kMs);
+  EXPECT_TRUE(ls.StepComplete(121 * kMs));
+  EXPECT_TRUE(ls.TakeNewlyLost().empty());  // reported once
+}
+
+TEST(Lockstep, LostDroneThatAnswersAgainRejoins) {
+  Lockstep ls(1, {.timeout_ns = 10 * kMs, .join_timeout_ns = 10 * kMs});
+  ls.BeginStep(0, 0);
+  EXPECT_TRUE(ls.StepComplete(10 * kMs));
+  EXPECT_EQ(ls.TakeNewlyLost(), std::vector<std::size_t>{0});
+  ls.BeginStep(1, 20 * kMs);
+  EXPECT_EQ(ls.OnCommand(0, 1, 21 * kMs), Lockstep::Answer::kAccepted);
+  EXPECT_FALSE(ls.lost(0));
+  EXPECT_EQ(ls.TakeRejoined(), std::vector<std::size_t>{0});
+  EXPECT_TRUE(ls.StepComplete(21 * kMs));
+}
+
+TEST(Lockstep, DronesThatNeverJoinedGetTheLongerJoinTimeout) {
+  Lockstep ls(1, {.timeout_ns = 10 * kMs, .join_timeout_ns = 500 * kMs});
+  ls.BeginStep(0, 0);
+  EXPECT_FALSE(ls.StepComplete(100 * kMs));
+  EXPECT_FALSE(ls.joined(0));
+  EXPECT_EQ(ls.NextDeadlineNs(), 500 * kMs);
+  EXPECT_TRUE(ls.StepComplete(500 * kMs));
+  EXPECT_TRUE(ls.lost(0));
+}
+
+TEST(Lockstep, TimeoutCountsFromTheLaterOfStepStartAndLastAnswer) {
+  Lockstep ls(1, {.timeout_ns = 50 * kMs, .join_timeout_ns = 50 * kMs});
+  ls.BeginStep(0, 0);
+  ls.OnCommand(0, 0, 5 * kMs);
+  ls.BeginStep(1, 30 * kMs);
+  EXPECT_EQ(ls.NextDeadlineNs(), 80 * kMs);
+  EXPECT_FALSE(ls.StepComplete(79 * kMs));
+  EXPECT_TRUE(ls.StepComplete(80 * kMs));
+}
+
+}  // namespace
+}  // namespace swarmbox::physics

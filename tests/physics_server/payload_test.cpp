@@ -1,0 +1,118 @@
+// The x8_heavy's slung stretcher: pendulum physics, attach and release.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "test_util.hpp"
+
+namespace swarmbox::physics {
+namespace {
+
+using testing::CalmWorld;
+using testing::LoadShippedAirframe;
+using testing::MakeWorld;
+using testing::Spawn;
+
+constexpr double kG = 9.80665;
+
+TEST(Payload, SmallAngleSwingPeriodIsTwoPiSqrtLOverG) {
+  auto world = MakeWorld(CalmWorld());
+  const Airframe af = LoadShippedAirframe("x8_heavy");
+  const auto d = Spawn(*world, testing::MakeSpawn("lifter", af, Vec3{0, 0, 20}, 0.0, 0.0, "stretcher", true));
+  world->SetPinned(d, true);  // a fixed hook: the pendulum alone
+  // Excite a small swing across the stretcher (about its long axis) with a 0.5 s northerly push
+  // of wind, then calm.
+  WindConfig gust;
+  gust.mean_m_s = {0, 8, 0};
+  world->SetWind(gust);
+  for (int k = 0; k < 125; ++k) world->Step();
+  world->SetWind(WindConfig{});
+  const double hook_y = world->Truth(d).position_m.y;
+  std::vector<double> crossings;  // times the payload crosses under the hook, moving north
+  double prev = world->Truth(d).payload_position_m.y - hook_y, max_swing = 0;
+  double prev_t = world->time_s();
+  while (world->time_s() < 25.0) {
+    world->Step();
+    const double y = world->Truth(d).payload_position_m.y - hook_y;
+    max_swing = std::max(max_swing, world->Truth(d).payload_swing_rad);
+    if (prev < 0 && y >= 0) crossings.push_back(prev_t + (world->time_s() - prev_t) * (-prev) / (y - prev));
+    prev = y;
+    prev_t = world->time_s();
+  }
+  ASSERT_GE(crossings.size(), 4u);
+  const double period = (crossings.back() - crossings.front()) / static_cast<double>(crossings.size() - 1);
+  const double length = af.payloads[0].sling_length_m;
+  const double expected = 2 * std::numbers::pi * std::sqrt(length / kG);
+  // The brief's tolerance, 2%: a rigid stretcher swinging about its long axis is a physical
+  // pendulum, I = m L^2 + I_cm with I_cm / (m L^2) = 0.2%, i.e. +0.1% on the period.
+  EXPECT_NEAR(period, expected, 0.02 * expected) << "period " << period << " s, expected " << expected;
+  EXPECT_LT(max_swing, 0.1);   // small-angle regime (< 6 deg)
+  EXPECT_GT(max_swing, 0.002); // and it did swing
+}
+
+TEST(Payload, AttachNeedsTheHookAtSlingLengthAndReleaseDropsIt) {
+  CollectingEventSink events;
+  auto world = MakeWorld(CalmWorld());
+  world->SetEventSink(&events);
+  const Airframe af = LoadShippedAirframe("x8_heavy");
+  const auto d = Spawn(*world, testing::MakeSpawn("lifter", af, Vec3{0, 0, 0}, 0.0, 0.0, "stretcher"));
+  EXPECT_FALSE(world->Truth(d).payload_attached);
+  // On the ground beside the lifter: the hook is far too close to the stretcher for a 4 m sling.
+  const Status too_close = world->AttachPayload(d);
+  ASSERT_FALSE(too_close.ok());
+  EXPECT_NE(too_close.error().message().find("lifter': hook is"), std::string::npos) << too_close.error().message();
+  EXPECT_NE(too_close.error().message().find("from the stretcher, needs 4.00 +- 0.50 m"), std::string::npos)
+      << too_close.error().message();
+
+  // A lifter spawned with the stretcher hanging: release it and it falls away.
+  const auto h = Spawn(*world, testing::MakeSpawn("hauler", af, Vec3{30, 0, 15}, 0.0, 0.0, "stretcher", true));
+  EXPECT_TRUE(world->Truth(h).payload_attached);
+  ASSERT_TRUE(world->ReleasePayload(h).ok());
+  EXPECT_FALSE(world->Truth(h).payload_attached);
+  const Status again = world->ReleasePayload(h);
+  ASSERT_FALSE(again.ok());
+  EXPECT_EQ(again.error().message(), "drone 'hauler' carries no attached payload");
+  const double z0 = world->Truth(h).payload_position_m.z;
+  for (int k = 0; k < 100; ++k) world->Step();
+  // Free fall for 0.4 s: g t^2 / 2 = 0.78 m (its drag at < 4 m/s takes < 1% off).
+  EXPECT_NEAR(world->Truth(h).payload_position_m.z, z0 - 0.5 * 9.80665 * 0.16, 0.02);
+
+  ASSERT_GE(events.events.size(), 1u);
+  EXPECT_EQ(events.events[0].kind, EventKind::kPayloadReleased);
+  EXPECT_EQ(events.events[0].a, "hauler");
+  EXPECT_EQ(events.events[0].b, "stretcher");
+}
+
+TEST(Payload, AttachWithinToleranceCreatesTheSling) {
+  CollectingEventSink events;
+  auto world = MakeWorld(CalmWorld());
+  world->SetEventSink(&events);
+  const Airframe af = LoadShippedAirframe("x8_heavy");
+  const auto d = Spawn(*world, testing::MakeSpawn("lifter", af, Vec3{0, 0, 20}, 0.0, 0.0, "stretcher", true));
+  ASSERT_TRUE(world->ReleasePayload(d).ok());
+  ASSERT_TRUE(world->AttachPayload(d).ok());  // still exactly at sling length
+  EXPECT_TRUE(world->Truth(d).payload_attached);
+  ASSERT_EQ(events.events.size(), 2u);
+  EXPECT_EQ(events.events[1].kind, EventKind::kPayloadAttached);
+  EXPECT_EQ(events.events[1].ToLogEvent().str(), "t=0.000 node=physics event=payload_attached a=lifter b=stretcher");
+}
+
+TEST(Payload, SpawningAttachedTooLowIsRefused) {
+  auto world = MakeWorld(CalmWorld());
+  auto r = world->AddDrone(testing::MakeSpawn("lifter", LoadShippedAirframe("x8_heavy"), Vec3{0, 0, 1}, 0.0, 0.0, "stretcher", true));
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message().find("too low to spawn with the stretcher hanging"), std::string::npos)
+      << r.error().message();
+}
+
+TEST(Payload, UnknownPayloadIsRefused) {
+  auto world = MakeWorld(CalmWorld());
+  auto r = world->AddDrone(testing::MakeSpawn("s", LoadShippedAirframe("x500"), Vec3{}, 0.0, 0.0, "stretcher"));
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().message(), "drone 's': airframe x500 has no payload 'stretcher'");
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
