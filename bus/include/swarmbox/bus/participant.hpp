@@ -63,6 +63,9 @@ class Publisher {
   int MatchedSubscribers() const { return impl_->MatchedCount(); }
 
   // Waits (polling every 5 ms) until at least `count` subscribers are matched; kTimeout otherwise.
+  // Matching is seen per side: when this returns, a remote reader may not yet have matched this
+  // writer, and a (volatile) reader misses what was written before it matched. A protocol that
+  // needs its first sample (lockstep) resends until answered, e.g. step 0 every 100 ms.
   Status WaitForSubscribers(int count, std::chrono::milliseconds timeout) const {
     return WaitForMatch(count, timeout, "subscriber");
   }

@@ -1,0 +1,94 @@
+#include "bus_echo.hpp"
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+
+#include "swarmbox/bus/participant.hpp"
+
+namespace swarmbox::bus::testing {
+namespace {
+
+template <BusMessage In, BusMessage Out, typename Answer>
+Status Serve(Participant& p, const std::string& in_topic, const std::string& out_topic,
+             const std::atomic<bool>& stop, Answer answer) {
+  auto sub = p.CreateSubscriber<In>(in_topic, Qos::kLockstep);
+  if (!sub) return std::move(sub).error().Context("echo subscriber");
+  auto pub = p.CreatePublisher<Out>(out_topic, Qos::kLockstep);
+  if (!pub) return std::move(pub).error().Context("echo publisher");
+  std::printf("echo ready\n");
+  std::fflush(stdout);
+  In in;
+  Out out;
+  while (!stop.load()) {
+    if (!(*sub)->TakeFor(in, std::chrono::milliseconds(50))) continue;
+    const Out& reply = answer(in, out);
+    if (auto s = (*pub)->Publish(reply); !s) return s.error().Context("echo publish");
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<EchoOptions> EchoOptionsFromMap(const std::map<std::string, std::string>& options) {
+  EchoOptions o;
+  for (const auto& [key, value] : options) {
+    if (key == "backend") {
+      o.backend = value;
+    } else if (key == "domain") {
+      char* end = nullptr;
+      const long d = std::strtol(value.c_str(), &end, 10);
+      if (value.empty() || *end != '\0') {
+        return Error(ErrorCode::kInvalidArgument, "echo: --domain wants an integer, got '" + value + "'");
+      }
+      o.domain_id = static_cast<int>(d);
+    } else if (key == "interface") {
+      o.interface = value;
+    } else if (key == "kind") {
+      if (value != "lockstep" && value != "small" && value != "large") {
+        return Error(ErrorCode::kInvalidArgument,
+                     "echo: unknown --kind '" + value + "': accepted are lockstep, small, large");
+      }
+      o.kind = value;
+    } else if (key == "drone") {
+      o.drone = value;
+    } else if (key != "role") {
+      return Error(ErrorCode::kInvalidArgument,
+                   "echo: unknown option --" + key +
+                       ": accepted are --backend --domain --interface --kind --drone");
+    }
+  }
+  return o;
+}
+
+std::vector<std::string> EchoArgs(const EchoOptions& o) {
+  return {"--backend=" + o.backend, "--domain=" + std::to_string(o.domain_id),
+          "--interface=" + o.interface, "--kind=" + o.kind, "--drone=" + o.drone};
+}
+
+Status RunEcho(const EchoOptions& o, const std::atomic<bool>& stop) {
+  auto p = Participant::Create({.backend = o.backend, .domain_id = o.domain_id, .interface = o.interface});
+  if (!p) return std::move(p).error().Context("echo");
+  if (o.kind == "lockstep") {
+    return Serve<SensorSample, ActuatorCommand>(
+        **p, SensorTopic(o.drone), ActuatorTopic(o.drone), stop,
+        [](const SensorSample& s, ActuatorCommand& cmd) -> const ActuatorCommand& {
+          cmd.drone = s.drone;
+          cmd.step = s.step;
+          cmd.sim_time_ns = s.sim_time_ns;
+          cmd.armed = true;
+          cmd.motor_throttle.assign(4, 0.5);
+          return cmd;
+        });
+  }
+  const std::string ping(kBenchPingTopic);
+  const std::string pong(kBenchPongTopic);
+  if (o.kind == "small") {
+    return Serve<RaftMessage, RaftMessage>(**p, ping, pong, stop,
+                                           [](const RaftMessage& m, RaftMessage&) -> const RaftMessage& { return m; });
+  }
+  return Serve<CameraImage, CameraImage>(**p, ping, pong, stop,
+                                         [](const CameraImage& m, CameraImage&) -> const CameraImage& { return m; });
+}
+
+}  // namespace swarmbox::bus::testing
