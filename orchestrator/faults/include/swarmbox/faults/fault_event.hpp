@@ -1,0 +1,41 @@
+// Fault records for events.jsonl: one JSON object per line when a fault is applied, removed, or
+// fails, saying which mechanism carried it out (ARCHITECTURE.md "Faults": the injector records
+// which one it used).
+//
+//   {"type":"fault","phase":"applied","fault":"fault_2","kind":"radio","start":"at 30s",
+//    "t_sim_s":30.012,"wall_s":31.4,"targets":["scout_1"],"mechanism":"userspace-nfqueue",
+//    "spec":"delay_ms=100 jitter_ms=20 distribution=normal loss=0.05"}
+//
+// "error" is added for phase "failed". Mechanisms: "netem", "userspace-nfqueue" (radio), "iptables"
+// (partition), "docker" (kill/stop/pause/restart), "physics" (sensor and environment faults).
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "swarmbox/faults/fault_spec.hpp"
+
+namespace swarmbox::faults {
+
+enum class FaultPhase { kApplied, kRemoved, kFailed };
+std::string_view FaultPhaseName(FaultPhase phase);
+
+// "delay_ms=100 jitter_ms=20 ..." for a rule, "to=[a, b]" last; "" for an empty spec.
+std::string DescribeRule(const RadioRule& rule);
+// The kind's parameters in one line, e.g. "groups=[[a, b], [c]] oneway=false", "signal=SIGKILL".
+std::string DescribeFault(const Fault& fault);
+
+struct FaultEventRecord {
+  FaultPhase phase = FaultPhase::kApplied;
+  double t_sim_s = 0.0;  // simulated time when it happened
+  double wall_s = 0.0;   // wall seconds since the trial's Run
+  std::vector<std::string> targets;
+  std::string mechanism;
+  std::string error;     // kFailed only
+};
+
+// One line of events.jsonl (no trailing newline).
+std::string FaultEventJson(const Fault& fault, const FaultEventRecord& record);
+
+}  // namespace swarmbox::faults

@@ -1,0 +1,141 @@
+#include "nfqueue_delayer.hpp"
+
+#include <arpa/inet.h>
+#include <linux/netfilter.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/signalfd.h>
+#include <sys/socket.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include <libnetfilter_queue/libnetfilter_queue.h>
+}
+
+namespace swarmbox::faults {
+namespace {
+
+Error SysError(const std::string& call) {
+  return Error(ErrorCode::kIo, call + ": " + std::strerror(errno), "swarmbox-netemd");
+}
+
+}  // namespace
+
+std::int64_t MonotonicUs() {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
+}
+
+NfqueueDelayer::NfqueueDelayer(const NetemdArgs& args) : args_(args), scheduler_(args.delay, args.seed) {}
+
+NfqueueDelayer::~NfqueueDelayer() {
+  if (queue_ != nullptr) nfq_destroy_queue(queue_);
+  if (handle_ != nullptr) nfq_close(handle_);
+}
+
+Result<std::unique_ptr<NfqueueDelayer>> NfqueueDelayer::Open(const NetemdArgs& args) {
+  std::unique_ptr<NfqueueDelayer> d(new NfqueueDelayer(args));
+  d->handle_ = nfq_open();
+  if (d->handle_ == nullptr) return SysError("nfq_open (is nfnetlink_queue available, and CAP_NET_ADMIN held?)");
+  // Old kernels need the per-family binding; newer ones ignore it. Failures here are not fatal.
+  nfq_unbind_pf(d->handle_, AF_INET);
+  nfq_bind_pf(d->handle_, AF_INET);
+  d->queue_ = nfq_create_queue(d->handle_, args.queue, &NfqueueDelayer::OnPacket, d.get());
+  if (d->queue_ == nullptr) {
+    return SysError("nfq_create_queue " + std::to_string(args.queue) + " (is another daemon bound to it?)");
+  }
+  if (nfq_set_mode(d->queue_, NFQNL_COPY_META, 0) < 0) return SysError("nfq_set_mode COPY_META");
+  if (nfq_set_queue_maxlen(d->queue_, args.queue_maxlen) < 0) return SysError("nfq_set_queue_maxlen");
+  // Room for a burst of queue messages while we sleep until the next release.
+  nfnl_rcvbufsiz(nfq_nfnlh(d->handle_), 8u * 1024u * 1024u);
+  return d;
+}
+
+int NfqueueDelayer::OnPacket(nfq_q_handle* /*queue*/, ::nfgenmsg* /*msg*/, ::nfq_data* data, void* self) {
+  auto* d = static_cast<NfqueueDelayer*>(self);
+  const nfqnl_msg_packet_hdr* header = nfq_get_msg_packet_hdr(data);
+  if (header == nullptr) return 0;
+  const std::uint32_t id = ntohl(header->packet_id);
+  const std::int64_t now_us = MonotonicUs();
+  d->scheduler_.Admit(id, now_us);
+  ++d->stats_.packets;
+  return 0;
+}
+
+void NfqueueDelayer::Accept(const HeldPacket& packet, std::int64_t now_us) {
+  if (nfq_set_verdict(queue_, packet.id, NF_ACCEPT, 0, nullptr) < 0) ++stats_.verdict_errors;
+  hold_sum_ms_ += static_cast<double>(now_us - packet.admitted_us) / 1000.0;
+}
+
+void NfqueueDelayer::ReleaseDue(std::int64_t now_us) {
+  while (auto next = scheduler_.NextReleaseUs()) {
+    if (*next > now_us) break;
+    Accept(scheduler_.PopNext(), now_us);
+  }
+}
+
+Status NfqueueDelayer::Run() {
+  sigset_t mask;
+  sigemptyset(&mask);
+  sigaddset(&mask, SIGTERM);
+  sigaddset(&mask, SIGINT);
+  if (sigprocmask(SIG_BLOCK, &mask, nullptr) != 0) return SysError("sigprocmask");
+  const int sfd = signalfd(-1, &mask, SFD_CLOEXEC | SFD_NONBLOCK);
+  if (sfd < 0) return SysError("signalfd");
+  const int fd = nfq_fd(handle_);
+  std::vector<char> buf(1 << 16);
+  Status result;
+  for (bool stop = false; !stop;) {
+    std::int64_t now_us = MonotonicUs();
+    ReleaseDue(now_us);
+    timespec timeout{};
+    timespec* timeout_ptr = nullptr;
+    if (auto next = scheduler_.NextReleaseUs()) {
+      const std::int64_t wait_us = std::max<std::int64_t>(0, *next - now_us);
+      timeout.tv_sec = static_cast<time_t>(wait_us / 1000000);
+      timeout.tv_nsec = static_cast<long>((wait_us % 1000000) * 1000);
+      timeout_ptr = &timeout;
+    }
+    pollfd fds[2] = {{fd, POLLIN, 0}, {sfd, POLLIN, 0}};
+    const int n = ::ppoll(fds, 2, timeout_ptr, nullptr);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      result = SysError("ppoll");
+      break;
+    }
+    if ((fds[1].revents & POLLIN) != 0) stop = true;
+    if ((fds[0].revents & POLLIN) != 0) {
+      for (;;) {
+        const ssize_t len = ::recv(fd, buf.data(), buf.size(), MSG_DONTWAIT);
+        if (len > 0) {
+          nfq_handle_packet(handle_, buf.data(), static_cast<int>(len));
+          continue;
+        }
+        if (len < 0 && errno == ENOBUFS) {
+          ++stats_.receive_overruns;
+          continue;
+        }
+        if (len < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) break;
+        result = SysError("recv on the netfilter queue socket");
+        stop = true;
+        break;
+      }
+    }
+  }
+  // Leaving: nothing stays held.
+  const std::int64_t now_us = MonotonicUs();
+  while (!scheduler_.empty()) Accept(scheduler_.PopNext(), now_us);
+  stats_.reordered = scheduler_.reordered();
+  stats_.mean_hold_ms = stats_.packets > 0 ? hold_sum_ms_ / static_cast<double>(stats_.packets) : 0.0;
+  ::close(sfd);
+  return result;
+}
+
+}  // namespace swarmbox::faults
