@@ -23,6 +23,13 @@ struct Attachment {
   std::vector<std::string> aliases;  // DNS names on that network
 };
 
+// A host file copied into the container before it starts (Docker's archive endpoint, so it works
+// on remote engines too; `swarmbox compose` bind-mounts it instead).
+struct InputFile {
+  std::string host_path;       // absolute path on the machine running swarmbox
+  std::string container_path;  // absolute path in the container
+};
+
 struct ContainerSpec {
   std::string name;   // Docker name, unique per host: "<trial>-<run>-<component>"
   std::string image;  // "swarmbox/agent:3f2a..."
@@ -34,6 +41,8 @@ struct ContainerSpec {
   std::string hostname;  // "" = Docker's
   std::string ready_pattern;  // a regex on the log; "" = ready once started
   Duration ready_timeout = Duration::Seconds(60);
+  std::vector<InputFile> inputs;           // copied in before start
+  std::vector<std::string> scratch_dirs;  // created empty and world-writable before start (/out)
   std::vector<std::string> artifacts;  // absolute paths in the container collected on Stop
   int stop_timeout_s = 10;             // SIGTERM, then SIGKILL after this
 

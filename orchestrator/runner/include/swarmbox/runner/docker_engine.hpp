@@ -1,0 +1,89 @@
+// DockerEngine: the DSL's Engine on a DockerApi. Creates networks and containers with their
+// labels, subnets and fixed addresses, copies input files in, starts containers and follows their
+// logs into <trial dir>/logs/<component>.log (one thread per container, lines also go to the
+// LogHub), waits for readiness patterns, and on Stop: stops, collects the log's end and the
+// artifacts (Docker's archive endpoint, so remote engines work too), and removes. Containers are
+// never auto-removed, so a crashed container's logs and exit code are kept.
+//
+// Thread-safety: the dsl::Engine methods are called from the runner's thread only.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "swarmbox/docker/docker_api.hpp"
+#include "swarmbox/dsl/network.hpp"
+#include "swarmbox/dsl/plugin.hpp"
+#include "swarmbox/runner/clock.hpp"
+#include "swarmbox/runner/log_hub.hpp"
+#include "swarmbox/runner/results.hpp"
+
+namespace swarmbox::runner {
+
+struct EngineOptions {
+  std::string trial_dir;    // logs/ and artifacts go here; must exist
+  double start_wall_s = 0;  // Clock time the trial started (wall_s of log lines is relative)
+  const std::atomic<bool>* interrupted = nullptr;  // Ctrl-C: readiness waits give up
+  // Called with each lifecycle step (events.jsonl); may be empty.
+  std::function<void(const dsl::Component&, dsl::EventKind, const dsl::Verdict&)> on_trace;
+};
+
+class DockerEngine final : public dsl::Engine {
+ public:
+  DockerEngine(docker::DockerApi& api, LogHub& hub, Clock& clock, EngineOptions options);
+  ~DockerEngine() override;  // cancels and joins any follower still running
+  DockerEngine(const DockerEngine&) = delete;
+  DockerEngine& operator=(const DockerEngine&) = delete;
+
+  dsl::Verdict CreateNetwork(dsl::Network& network) override;
+  dsl::Verdict RemoveNetwork(dsl::Network& network) override;
+  dsl::Verdict CreateContainer(dsl::Plugin& plugin) override;
+  dsl::Verdict StartContainer(dsl::Plugin& plugin) override;
+  dsl::Verdict StopContainer(dsl::Plugin& plugin) override;
+  void Trace(const dsl::Component& component, dsl::EventKind event,
+             const dsl::Verdict& verdict) override;
+
+  // The container's state now (after its log stream ended, to tell a crash from a hiccup).
+  Result<docker::ContainerState> Inspect(const std::string& component);
+  // Whether a hub item comes from the component's current follower (not one before a restart).
+  bool IsCurrent(const HubItem& item) const;
+  // True when the last network creation failed because its subnet overlaps another network.
+  bool subnet_conflict() const { return subnet_conflict_; }
+  // Per container: exit code, log file, line count (filled on Stop).
+  std::vector<ComponentReport> Reports() const;
+  // Things that went wrong without changing the outcome (a missing artifact...).
+  const std::vector<std::string>& problems() const { return problems_; }
+  // Artifacts collected so far: file name -> path on the host.
+  const std::map<std::string, std::string>& artifacts() const { return artifacts_; }
+
+ private:
+  struct Follower;
+  void StartFollower(const std::string& component, const std::string& container_id);
+  void JoinFollower(const std::string& component, bool cancel);
+  Status CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id);
+  void CollectArtifacts(const dsl::Plugin& plugin, const std::string& container_id);
+
+  docker::DockerApi& api_;
+  LogHub& hub_;
+  Clock& clock_;
+  EngineOptions options_;
+  std::map<std::string, std::string> network_ids_;    // component id -> Docker id
+  std::map<std::string, std::string> container_ids_;  // component id -> Docker id
+  std::map<std::string, std::unique_ptr<Follower>> followers_;
+  std::map<std::string, ComponentReport> reports_;
+  std::vector<std::string> problems_;
+  std::map<std::string, std::string> artifacts_;
+  std::map<std::string, std::uint64_t> generations_;  // component -> current follower
+  std::uint64_t next_generation_ = 1;
+  bool subnet_conflict_ = false;
+};
+
+}  // namespace swarmbox::runner

@@ -1,0 +1,65 @@
+// Monitor: the pure core of watching a running trial. Fed log lines, container exits and the wall
+// clock; answers when the trial ends and why. No threads, no Docker, no clock of its own.
+//
+//   Monitor m = *Monitor::Create(trial);
+//   m.Started("physics");
+//   if (auto v = m.OnLine("physics", "t=601.000 node=physics event=tick")) ...   // sim timeout
+//   if (auto v = m.OnTick(wall_s)) ...                                          // wall-clock guard
+//
+// Rules, first to fire wins (later inputs return nullopt):
+//   - an end condition matches a line                      -> its outcome and reason
+//   - simulated time (max `t=` of the clock component's log) reaches timeout.sim -> timeout.outcome
+//   - a started container exits                            -> failure "<c> exited with code N"
+//   - wall time reaches timeout.wall_guard                  -> error "wall-clock guard: ..."
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+
+#include "swarmbox/dsl/trial.hpp"
+#include "swarmbox/runner/end_matcher.hpp"
+
+namespace swarmbox::runner {
+
+class Monitor {
+ public:
+  static Result<Monitor> Create(dsl::Trial& trial);
+
+  void Started(std::string_view component);
+  std::optional<dsl::Verdict> OnLine(std::string_view component, std::string_view line);
+  std::optional<dsl::Verdict> OnExit(std::string_view component, std::int64_t exit_code,
+                                     bool oom_killed);
+  std::optional<dsl::Verdict> OnTick(double wall_s);
+
+  double sim_s() const { return sim_s_; }
+  double wall_s() const { return wall_s_; }
+  bool ended() const { return ended_.has_value(); }
+  const std::optional<dsl::Verdict>& verdict() const { return ended_; }
+  // The log line that ended the trial, if a line did.
+  const std::string& ending_line() const { return ending_line_; }
+  const std::set<std::string>& live() const { return live_; }
+
+  // One status line for the terminal:
+  // "sim 12.3/600s  wall 13.0s  live 5/5  last: scout_1 leader_elected, physics tick"
+  std::string ProgressLine() const;
+
+ private:
+  Monitor(EndMatcher matcher, dsl::TimeoutPolicy timeout, std::size_t components);
+  std::optional<dsl::Verdict> End(dsl::Verdict v);
+
+  EndMatcher matcher_;
+  dsl::TimeoutPolicy timeout_;
+  std::size_t components_;
+  double sim_s_ = 0;
+  double wall_s_ = 0;
+  std::set<std::string> live_;
+  std::deque<std::string> last_events_;  // "<component> <event>", newest last
+  std::optional<dsl::Verdict> ended_;
+  std::string ending_line_;
+};
+
+}  // namespace swarmbox::runner

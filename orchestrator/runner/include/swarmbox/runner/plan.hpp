@@ -1,0 +1,57 @@
+// PlanTrial: a TrialSpec -> the component tree of networks and containers it runs as.
+//
+// THE one place that maps a trial to containers: names, labels, subnets and fixed addresses, the
+// images, and each program's command line (swarmbox-physics, swarmbox-agent). When a program's
+// flags change, change PhysicsArgv()/AgentArgv() in plan.cpp and nothing else.
+//
+// Tree (run priority in brackets):
+//   Trial <name>
+//     Network sim [0]   physics <-> agents, never impaired
+//     Network mesh [0]  agent <-> agent radio (netem applies here, fault injector's business)
+//     Plugin physics [1]  ready on `event=ready`; collects /out/truth.csv
+//     Component drones [2]
+//       Plugin <drone> [2]  one agent per drone, on sim and mesh
+// Files: the world and airframe files are copied into every container under /swarmbox/trials/
+// (same relative paths as in the trials folder).
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/dsl/trial.hpp"
+#include "swarmbox/dsl/trial_spec.hpp"
+#include "swarmbox/runner/subnets.hpp"
+
+namespace swarmbox::runner {
+
+struct Images {
+  std::string physics;  // "swarmbox/physics:<content hash>"
+  std::string agent;    // "swarmbox/agent:<content hash>"
+};
+
+struct PlanOptions {
+  std::string run_id;
+  std::string trial_id;  // "" = the trial's name
+  Images images;
+  TrialSubnets subnets;
+  std::string trials_dir;  // absolute host path the spec's references resolve against
+};
+
+inline constexpr std::string_view kPhysicsId = "physics";
+inline constexpr std::string_view kDronesGroupId = "drones";
+inline constexpr std::string_view kSimNetworkId = "sim";
+inline constexpr std::string_view kMeshNetworkId = "mesh";
+inline constexpr std::string_view kContainerTrialsDir = "/swarmbox/trials";
+inline constexpr std::string_view kContainerOutDir = "/out";
+inline constexpr std::string_view kTruthCsvPath = "/out/truth.csv";
+inline constexpr std::string_view kPhysicsReadyPattern = "event=ready";
+
+// The wall-clock guard when the trial file gives none: [s]. rtf > 0: sim/rtf * 1.5 + 120;
+// rtf == 0 (as fast as possible): sim * 3 + 120.
+dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec);
+
+Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
+                                              const PlanOptions& options);
+
+}  // namespace swarmbox::runner

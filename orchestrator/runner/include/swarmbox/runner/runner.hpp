@@ -1,0 +1,80 @@
+// The trial runner: `swarmbox run TRIAL.yaml`.
+//
+//   SteadyClock clock;
+//   RunOptions opts;  opts.out_dir = "runs"; opts.images = {...}; opts.progress = &std::cerr;
+//   auto run = RunTrialSpec(spec, api, clock, opts);
+//   if (!run) return 3;                       // nothing was started (cannot write the folder...)
+//   return ExitCodeFor(run->result.verdict);  // 0 success, 1 timeout/failure, 3 error
+//
+// One run: make <out>/<trial>-<run id>/ (trial.yaml, logs/), pick subnets (retrying on a
+// conflict), Build and Run the tree in priority order, then watch: every container's log is
+// streamed to logs/<component>.log as it comes, end conditions are matched, the simulated clock
+// (physics `t=`) and the wall-clock guard are checked, progress is printed. The first end (or
+// Ctrl-C) fires Shutdown; then Stop (reverse priority) stops, collects logs and artifacts
+// (truth.csv) and removes containers and networks. Written at the end: result.json, events.jsonl
+// (written as events arrive), trajectories.png (from truth.csv and the world).
+// A Restart raised during the run (a broken log stream) rebuilds the trial, at most
+// `max_restarts` times.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <string>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/docker/docker_api.hpp"
+#include "swarmbox/dsl/trial.hpp"
+#include "swarmbox/dsl/trial_spec.hpp"
+#include "swarmbox/runner/clock.hpp"
+#include "swarmbox/runner/plan.hpp"
+#include "swarmbox/runner/results.hpp"
+#include "swarmbox/runner/subnets.hpp"
+
+namespace swarmbox::runner {
+
+struct RunOptions {
+  std::string out_dir = "runs";
+  std::string run_id;    // "" = NewRunId()
+  std::string trial_id;  // "" = the trial's name
+  Images images;         // for RunTrialSpec
+  std::string host = "local";
+  const std::atomic<bool>* interrupted = nullptr;  // set by Ctrl-C
+  std::ostream* progress = nullptr;                // status lines; nullptr = quiet
+  std::chrono::milliseconds poll{200};             // how long the watch loop waits for lines
+  double progress_every_s = 2.0;
+  int max_restarts = 1;
+  int subnet_attempts = 5;
+};
+
+struct RunOutcome {
+  TrialResult result;
+  std::string trial_dir;
+};
+
+// What the runner needs to know about a trial besides its tree.
+struct TrialInfo {
+  std::string name;
+  std::uint64_t seed = 0;
+  std::string resolved_yaml;  // written as trial.yaml
+  std::string world_file;     // host path of the world (for trajectories.png); "" = none
+};
+
+// Builds the tree for a pair of subnets (called again with others after a subnet conflict).
+using Planner = std::function<Result<std::unique_ptr<dsl::Trial>>(const std::string& run_id,
+                                                                   const TrialSubnets& subnets)>;
+
+// Runs any tree (the C++ DSL, tests). The Result is an error only when nothing could be started
+// (the output folder cannot be made, the engine does not answer); every later problem is the
+// outcome in the result.
+Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docker::DockerApi& api,
+                            Clock& clock, const RunOptions& options);
+
+// Runs a trial description: PlanTrial + RunTrial.
+Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& api, Clock& clock,
+                                const RunOptions& options);
+
+}  // namespace swarmbox::runner

@@ -1,0 +1,143 @@
+#include "swarmbox/runner/compose_export.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::runner {
+
+namespace {
+
+using yaml::Node;
+
+Node Str(std::string_view s) { return Node::Scalar(std::string(s), {}, /*quoted=*/true); }
+
+Node StrList(const std::vector<std::string>& items) {
+  Node seq = Node::Sequence();
+  for (const auto& s : items) seq.Append(Str(s));
+  return seq;
+}
+
+Node StrMap(const std::map<std::string, std::string>& m) {
+  Node n = Node::Mapping();
+  for (const auto& [k, v] : m) n.Set(k, Str(v));
+  return n;
+}
+
+// The run priorities from the trial's child down to the component: the start order.
+std::vector<int> PriorityKey(const dsl::Component& c, const dsl::Component& root) {
+  std::vector<int> key;
+  for (const dsl::Component* p = &c; p != nullptr && p != &root; p = p->parent()) {
+    key.push_back(p->run_priority());
+  }
+  std::reverse(key.begin(), key.end());
+  return key;
+}
+
+}  // namespace
+
+std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
+  Node doc = Node::Mapping();
+  doc.Set("version", Str("2.4"));
+
+  std::vector<dsl::Plugin*> plugins = trial.Plugins();
+  std::vector<std::vector<int>> keys;
+  for (dsl::Plugin* p : plugins) keys.push_back(PriorityKey(*p, trial));
+
+  Node services = Node::Mapping();
+  Node volumes = Node::Mapping();
+  for (std::size_t i = 0; i < plugins.size(); ++i) {
+    const dsl::Plugin& p = *plugins[i];
+    const dsl::ContainerSpec& s = p.spec();
+    Node svc = Node::Mapping();
+    svc.Set("image", Str(s.image));
+    if (!s.name.empty()) svc.Set("container_name", Str(s.name));
+    if (!s.hostname.empty()) svc.Set("hostname", Str(s.hostname));
+    if (!s.user.empty()) svc.Set("user", Str(s.user));
+    if (!s.argv.empty()) {
+      svc.Set("entrypoint", StrList({s.argv.front()}));
+      svc.Set("command", StrList(std::vector<std::string>(s.argv.begin() + 1, s.argv.end())));
+    }
+    if (!s.env.empty()) svc.Set("environment", StrMap(s.env));
+    if (!s.labels.empty()) svc.Set("labels", StrMap(s.labels));
+    if (!s.networks.empty()) {
+      Node nets = Node::Mapping();
+      for (const dsl::Attachment& a : s.networks) {
+        Node n = Node::Mapping();
+        if (!a.ipv4.empty()) n.Set("ipv4_address", Str(a.ipv4));
+        if (!a.aliases.empty()) n.Set("aliases", StrList(a.aliases));
+        nets.Set(a.network, std::move(n));
+      }
+      svc.Set("networks", std::move(nets));
+    }
+    std::vector<std::string> mounts;
+    for (const dsl::InputFile& in : s.inputs) {
+      std::string host = in.host_path;
+      if (!options.host_prefix.empty() && host.rfind(options.host_prefix, 0) == 0) {
+        host = options.relative_prefix + host.substr(options.host_prefix.size());
+      }
+      mounts.push_back(host + ":" + in.container_path + ":ro");
+    }
+    for (const std::string& dir : s.scratch_dirs) {
+      std::string vol = p.id() + "-" + std::filesystem::path(dir).filename().string();
+      mounts.push_back(vol + ":" + dir);
+      Node v = Node::Mapping();
+      if (!s.labels.empty()) v.Set("labels", StrMap(s.labels));
+      volumes.Set(vol, std::move(v));
+    }
+    if (!mounts.empty()) svc.Set("volumes", StrList(mounts));
+    // Start order: depend on the services of the closest earlier priority level.
+    std::size_t previous = plugins.size();  // index of a service on that level; size() = none
+    for (std::size_t j = 0; j < plugins.size(); ++j) {
+      if (keys[j] < keys[i] && (previous == plugins.size() || keys[j] > keys[previous])) previous = j;
+    }
+    if (previous != plugins.size()) {
+      std::vector<std::string> deps;
+      for (std::size_t j = 0; j < plugins.size(); ++j) {
+        if (keys[j] == keys[previous]) deps.push_back(plugins[j]->id());
+      }
+      svc.Set("depends_on", StrList(deps));
+    }
+    svc.Set("stop_grace_period", Str(std::to_string(s.stop_timeout_s) + "s"));
+    services.Set(p.id(), std::move(svc));
+  }
+  doc.Set("services", std::move(services));
+
+  Node networks = Node::Mapping();
+  for (dsl::Network* n : trial.Networks()) {
+    const dsl::NetworkSpec& s = n->spec();
+    Node net = Node::Mapping();
+    if (!s.name.empty()) net.Set("name", Str(s.name));
+    net.Set("driver", Str("bridge"));
+    if (s.internal) net.Set("internal", Node::Scalar("true"));
+    if (!s.labels.empty()) net.Set("labels", StrMap(s.labels));
+    if (!s.subnet.empty()) {
+      Node cfg = Node::Mapping();
+      cfg.Set("subnet", Str(s.subnet));
+      if (!s.gateway.empty()) cfg.Set("gateway", Str(s.gateway));
+      Node configs = Node::Sequence();
+      configs.Append(std::move(cfg));
+      Node ipam = Node::Mapping();
+      ipam.Set("config", std::move(configs));
+      net.Set("ipam", std::move(ipam));
+    }
+    networks.Set(n->id(), std::move(net));
+  }
+  doc.Set("networks", std::move(networks));
+  if (!volumes.entries().empty()) doc.Set("volumes", std::move(volumes));
+
+  std::string header;
+  std::string_view rest = options.header_comment;
+  while (!rest.empty()) {
+    const auto nl = rest.find('\n');
+    std::string_view line = rest.substr(0, nl);
+    header += line.empty() ? "#\n" : "# " + std::string(line) + "\n";
+    if (nl == std::string_view::npos) break;
+    rest = rest.substr(nl + 1);
+  }
+  return header + yaml::Emit(doc);
+}
+
+}  // namespace swarmbox::runner

@@ -1,0 +1,313 @@
+#include "swarmbox/runner/docker_engine.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "swarmbox/docker/tar_archive.hpp"
+#include "swarmbox/runner/end_matcher.hpp"
+
+namespace swarmbox::runner {
+
+namespace fs = std::filesystem;
+using dsl::Verdict;
+
+struct DockerEngine::Follower {
+  docker::CancelToken cancel;
+  std::thread thread;
+  std::atomic<bool> done{false};
+  std::atomic<std::uint64_t> lines{0};
+};
+
+namespace {
+
+constexpr auto kStreamEndGrace = std::chrono::seconds(5);
+
+bool IsSubnetConflict(const Error& e) {
+  const std::string& m = e.message();
+  return m.find("overlap") != std::string::npos || m.find("Pool overlaps") != std::string::npos;
+}
+
+}  // namespace
+
+DockerEngine::DockerEngine(docker::DockerApi& api, LogHub& hub, Clock& clock,
+                           EngineOptions options)
+    : api_(api), hub_(hub), clock_(clock), options_(std::move(options)) {
+  std::error_code ec;
+  fs::create_directories(fs::path(options_.trial_dir) / "logs", ec);
+}
+
+DockerEngine::~DockerEngine() {
+  for (auto& [component, f] : followers_) {
+    f->cancel.Cancel();
+    if (f->thread.joinable()) f->thread.join();
+  }
+}
+
+void DockerEngine::Trace(const dsl::Component& component, dsl::EventKind event,
+                         const Verdict& verdict) {
+  if (options_.on_trace) options_.on_trace(component, event, verdict);
+}
+
+Verdict DockerEngine::CreateNetwork(dsl::Network& network) {
+  const dsl::NetworkSpec& s = network.spec();
+  docker::NetworkSpec spec;
+  spec.name = s.name;
+  spec.subnet = s.subnet;
+  spec.gateway = s.gateway;
+  spec.internal = s.internal;
+  spec.labels = s.labels;
+  subnet_conflict_ = false;
+  auto id = api_.CreateNetwork(spec);
+  if (!id) {
+    subnet_conflict_ = IsSubnetConflict(id.error());
+    return Verdict::FromError(id.error().Context("creating network " + s.name + " (" + s.subnet + ")"),
+                              network.Path());
+  }
+  network_ids_[network.id()] = *id;
+  return Verdict::Success();
+}
+
+Verdict DockerEngine::RemoveNetwork(dsl::Network& network) {
+  auto it = network_ids_.find(network.id());
+  if (it == network_ids_.end()) return Verdict::Success();
+  Status s = api_.RemoveNetwork(it->second);
+  network_ids_.erase(it);
+  if (!s && s.error().code() != ErrorCode::kNotFound) {
+    return Verdict::FromError(s.error().Context("removing network " + network.spec().name),
+                              network.Path());
+  }
+  return Verdict::Success();
+}
+
+Status DockerEngine::CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id) {
+  if (spec.inputs.empty() && spec.scratch_dirs.empty()) return Ok{};
+  docker::TarWriter tar;
+  std::set<std::string> dirs;
+  auto add_parents = [&](const std::string& path) -> Status {
+    fs::path p = fs::path(path).parent_path();
+    std::vector<std::string> chain;
+    for (; !p.empty() && p != p.root_path(); p = p.parent_path()) chain.push_back(p.string());
+    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+      if (dirs.insert(*it).second) SWARMBOX_TRY(tar.AddDirectory(*it, 0755));
+    }
+    return Ok{};
+  };
+  for (const std::string& dir : spec.scratch_dirs) {
+    SWARMBOX_TRY(add_parents(dir));
+    if (dirs.insert(dir).second) SWARMBOX_TRY(tar.AddDirectory(dir, 01777));
+  }
+  for (const dsl::InputFile& in : spec.inputs) {
+    std::ifstream f(in.host_path, std::ios::binary);
+    if (!f) return Error(ErrorCode::kNotFound, "cannot read input file", in.host_path);
+    std::ostringstream content;
+    content << f.rdbuf();
+    SWARMBOX_TRY(add_parents(in.container_path));
+    SWARMBOX_TRY(tar.AddFile(in.container_path, content.str(), 0644));
+  }
+  auto bytes = tar.Finish();
+  if (!bytes) return bytes.error();
+  return api_.PutArchive(container_id, "/", *bytes);
+}
+
+Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
+  const dsl::ContainerSpec& s = plugin.spec();
+  docker::ContainerSpec spec;
+  spec.name = s.name;
+  spec.image = s.image;
+  if (!s.argv.empty()) {
+    spec.entrypoint = {s.argv.front()};
+    spec.cmd.assign(s.argv.begin() + 1, s.argv.end());
+  }
+  spec.env = s.env;
+  spec.labels = s.labels;
+  spec.user = s.user;
+  spec.hostname = s.hostname;
+  spec.stop_timeout_s = s.stop_timeout_s;
+  spec.auto_remove = false;  // a crashed container keeps its logs until we collected them
+  for (const dsl::Attachment& a : s.networks) {
+    auto it = network_ids_.find(a.network);
+    if (it == network_ids_.end()) {
+      return Verdict::Err("network '" + a.network + "' of " + plugin.id() + " was not created",
+                          plugin.Path());
+    }
+    spec.networks.push_back({it->second, a.ipv4, a.aliases});
+  }
+  auto id = api_.CreateContainer(spec);
+  if (!id) {
+    return Verdict::FromError(id.error().Context("creating container " + s.name), plugin.Path());
+  }
+  container_ids_[plugin.id()] = *id;
+  reports_[plugin.id()] = ComponentReport{plugin.id(), std::nullopt, false,
+                                          "logs/" + plugin.id() + ".log", 0};
+  if (Status st = CopyInputs(s, *id); !st) {
+    return Verdict::FromError(st.error().Context("copying input files into " + s.name),
+                              plugin.Path());
+  }
+  return Verdict::Success();
+}
+
+void DockerEngine::StartFollower(const std::string& component, const std::string& container_id) {
+  JoinFollower(component, /*cancel=*/true);
+  auto f = std::make_unique<Follower>();
+  Follower* raw = f.get();
+  const std::uint64_t generation = next_generation_++;
+  generations_[component] = generation;
+  const std::string path = (fs::path(options_.trial_dir) / "logs" / (component + ".log")).string();
+  raw->thread = std::thread([this, raw, component, container_id, path, generation] {
+    std::FILE* out = std::fopen(path.c_str(), "ab");
+    docker::LogOptions opts;
+    opts.follow = true;
+    Status s = api_.FollowLogs(
+        container_id, opts,
+        [&](const docker::LogLine& line) {
+          if (out != nullptr) {
+            std::fwrite(line.text.data(), 1, line.text.size(), out);
+            std::fputc('\n', out);
+            std::fflush(out);
+          }
+          raw->lines.fetch_add(1);
+          hub_.Push({HubItem::Kind::kLine, component, line.text,
+                     clock_.NowS() - options_.start_wall_s, generation});
+        },
+        &raw->cancel);
+    if (out != nullptr) std::fclose(out);
+    std::string why;
+    if (!s && s.error().code() != ErrorCode::kCancelled) why = s.error().ToString();
+    if (out == nullptr) why = "cannot write " + path;
+    hub_.Push({HubItem::Kind::kStreamEnd, component, why, clock_.NowS() - options_.start_wall_s,
+               generation});
+    raw->done.store(true);
+  });
+  followers_[component] = std::move(f);
+}
+
+void DockerEngine::JoinFollower(const std::string& component, bool cancel) {
+  auto it = followers_.find(component);
+  if (it == followers_.end()) return;
+  Follower& f = *it->second;
+  if (!cancel) {
+    // The stream ends by itself once the container stopped; give it a moment to deliver the rest.
+    const auto deadline = std::chrono::steady_clock::now() + kStreamEndGrace;
+    while (!f.done.load() && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  f.cancel.Cancel();
+  if (f.thread.joinable()) f.thread.join();
+  reports_[component].log_lines += f.lines.load();
+  followers_.erase(it);
+}
+
+bool DockerEngine::IsCurrent(const HubItem& item) const {
+  auto it = generations_.find(item.component);
+  return it != generations_.end() && it->second == item.generation;
+}
+
+Verdict DockerEngine::StartContainer(dsl::Plugin& plugin) {
+  const dsl::ContainerSpec& s = plugin.spec();
+  auto it = container_ids_.find(plugin.id());
+  if (it == container_ids_.end()) return Verdict::Err("no container for " + plugin.id(), plugin.Path());
+  const std::string id = it->second;
+  if (!s.ready_pattern.empty()) {
+    auto re = CompileLogPattern(s.ready_pattern);
+    if (!re) return Verdict::FromError(re.error(), plugin.Path());
+    hub_.Expect(plugin.id(), std::move(*re));
+  }
+  if (Status st = api_.StartContainer(id); !st) {
+    return Verdict::FromError(st.error().Context("starting " + s.name), plugin.Path());
+  }
+  StartFollower(plugin.id(), id);
+  if (s.ready_pattern.empty()) return Verdict::Success();
+  switch (hub_.WaitReady(plugin.id(), std::chrono::milliseconds(s.ready_timeout.ms()),
+                         options_.interrupted)) {
+    case LogHub::Readiness::kReady:
+      return Verdict::Success();
+    case LogHub::Readiness::kInterrupted:
+      return Verdict::Err("interrupted while waiting for " + plugin.id() + " to be ready",
+                          plugin.Path());
+    case LogHub::Readiness::kTimedOut:
+      return Verdict::Failure(plugin.id() + " did not log '" + s.ready_pattern + "' within " +
+                                  s.ready_timeout.ToString(),
+                              plugin.Path());
+    case LogHub::Readiness::kStreamEnded: {
+      auto state = api_.InspectContainer(id);
+      std::string how = state ? "exited with code " + std::to_string(state->state.exit_code)
+                              : "its log stream ended";
+      return Verdict::Failure(plugin.id() + " " + how + " before it was ready", plugin.Path());
+    }
+  }
+  return Verdict::Err("unreachable", plugin.Path());
+}
+
+void DockerEngine::CollectArtifacts(const dsl::Plugin& plugin, const std::string& container_id) {
+  for (const std::string& path : plugin.spec().artifacts) {
+    auto tar = api_.GetArchive(container_id, path);
+    if (!tar) {
+      problems_.push_back(plugin.id() + ": artifact " + path + " not collected: " +
+                          tar.error().ToString());
+      continue;
+    }
+    auto entries = docker::ReadTar(*tar);
+    if (!entries) {
+      problems_.push_back(plugin.id() + ": artifact " + path + " unreadable: " +
+                          entries.error().ToString());
+      continue;
+    }
+    for (const docker::TarEntry& e : *entries) {
+      if (e.type != docker::TarEntry::Type::kFile) continue;
+      const std::string name = fs::path(e.path).filename().string();
+      const std::string dest = (fs::path(options_.trial_dir) / name).string();
+      std::ofstream out(dest, std::ios::binary | std::ios::trunc);
+      out.write(e.content.data(), static_cast<std::streamsize>(e.content.size()));
+      if (!out) {
+        problems_.push_back(plugin.id() + ": cannot write " + dest);
+        continue;
+      }
+      artifacts_[name] = dest;
+    }
+  }
+}
+
+Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
+  auto it = container_ids_.find(plugin.id());
+  if (it == container_ids_.end()) return Verdict::Success();
+  const std::string id = it->second;
+  Verdict v;
+  if (Status s = api_.StopContainer(id, plugin.spec().stop_timeout_s);
+      !s && s.error().code() != ErrorCode::kNotFound) {
+    v.KeepWorse(Verdict::FromError(s.error().Context("stopping " + plugin.spec().name), plugin.Path()));
+  }
+  JoinFollower(plugin.id(), /*cancel=*/false);
+  if (auto info = api_.InspectContainer(id)) {
+    reports_[plugin.id()].exit_code = info->state.exit_code;
+    reports_[plugin.id()].oom_killed = info->state.oom_killed;
+  }
+  CollectArtifacts(plugin, id);
+  if (Status s = api_.RemoveContainer(id, /*force=*/true, /*remove_volumes=*/true);
+      !s && s.error().code() != ErrorCode::kNotFound) {
+    v.KeepWorse(Verdict::FromError(s.error().Context("removing " + plugin.spec().name), plugin.Path()));
+  }
+  container_ids_.erase(it);
+  return v;
+}
+
+Result<docker::ContainerState> DockerEngine::Inspect(const std::string& component) {
+  auto it = container_ids_.find(component);
+  if (it == container_ids_.end()) {
+    return Error(ErrorCode::kNotFound, "no container for component " + component);
+  }
+  auto info = api_.InspectContainer(it->second);
+  if (!info) return info.error();
+  return info->state;
+}
+
+std::vector<ComponentReport> DockerEngine::Reports() const {
+  std::vector<ComponentReport> out;
+  for (const auto& [name, r] : reports_) out.push_back(r);
+  return out;
+}
+
+}  // namespace swarmbox::runner

@@ -1,0 +1,96 @@
+#include "swarmbox/runner/monitor.hpp"
+
+#include <cstdio>
+
+#include "swarmbox/common/logfmt.hpp"
+
+namespace swarmbox::runner {
+
+namespace {
+constexpr std::size_t kLastEvents = 3;
+
+std::string Seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", s);
+  return buf;
+}
+}  // namespace
+
+Result<Monitor> Monitor::Create(dsl::Trial& trial) {
+  auto matcher = EndMatcher::Compile(trial.end_conditions());
+  if (!matcher) return matcher.error();
+  return Monitor(std::move(*matcher), trial.timeout(), trial.Plugins().size());
+}
+
+Monitor::Monitor(EndMatcher matcher, dsl::TimeoutPolicy timeout, std::size_t components)
+    : matcher_(std::move(matcher)), timeout_(std::move(timeout)), components_(components) {}
+
+void Monitor::Started(std::string_view component) { live_.insert(std::string(component)); }
+
+std::optional<dsl::Verdict> Monitor::End(dsl::Verdict v) {
+  if (ended_) return std::nullopt;
+  ended_ = v;
+  return v;
+}
+
+std::optional<dsl::Verdict> Monitor::OnLine(std::string_view component, std::string_view line) {
+  if (ended_) return std::nullopt;
+  if (line.find("event=") != std::string_view::npos) {
+    if (auto ev = FindField(ParseLogfmt(line), "event")) {
+      last_events_.push_back(std::string(component) + " " + *ev);
+      if (last_events_.size() > kLastEvents) last_events_.pop_front();
+    }
+  }
+  if (timeout_.clock_component.empty() || timeout_.clock_component == component) {
+    if (auto t = SimTimeOf(line); t && *t > sim_s_) sim_s_ = *t;
+  }
+  if (auto v = matcher_.Match(component, line)) {
+    ending_line_ = std::string(line);
+    return End(std::move(*v));
+  }
+  if (!timeout_.sim.zero() && sim_s_ >= timeout_.sim.seconds()) {
+    return End(dsl::Verdict::Of(timeout_.outcome,
+                                "simulated time ran out (" + timeout_.sim.ToString() + ")",
+                                "timeout"));
+  }
+  return std::nullopt;
+}
+
+std::optional<dsl::Verdict> Monitor::OnExit(std::string_view component, std::int64_t exit_code,
+                                            bool oom_killed) {
+  live_.erase(std::string(component));
+  if (ended_) return std::nullopt;
+  std::string why = oom_killed ? std::string(component) + " was killed for lack of memory"
+                               : std::string(component) + " exited with code " +
+                                     std::to_string(exit_code) + " before the trial ended";
+  return End(dsl::Verdict::Failure(std::move(why), std::string(component)));
+}
+
+std::optional<dsl::Verdict> Monitor::OnTick(double wall_s) {
+  if (wall_s > wall_s_) wall_s_ = wall_s;
+  if (ended_) return std::nullopt;
+  if (!timeout_.wall_guard.zero() && wall_s_ >= timeout_.wall_guard.seconds()) {
+    return End(dsl::Verdict::Err("wall-clock guard: " + timeout_.wall_guard.ToString() +
+                                     " passed with simulated time at " + Seconds(sim_s_) + "s of " +
+                                     timeout_.sim.ToString(),
+                                 "wall-clock guard"));
+  }
+  return std::nullopt;
+}
+
+std::string Monitor::ProgressLine() const {
+  std::string s = "sim " + Seconds(sim_s_) + "/" + Seconds(timeout_.sim.seconds()) + "s  wall " +
+                  Seconds(wall_s_) + "s  live " + std::to_string(live_.size()) + "/" +
+                  std::to_string(components_);
+  if (!last_events_.empty()) {
+    s += "  last:";
+    bool first = true;
+    for (auto it = last_events_.rbegin(); it != last_events_.rend(); ++it) {
+      s += (first ? " " : ", ") + *it;
+      first = false;
+    }
+  }
+  return s;
+}
+
+}  // namespace swarmbox::runner

@@ -1,0 +1,170 @@
+#include "swarmbox/runner/plan.hpp"
+
+#include <charconv>
+#include <filesystem>
+#include <set>
+
+#include "swarmbox/runner/naming.hpp"
+
+namespace swarmbox::runner {
+
+namespace {
+
+std::string Num(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+std::string InContainer(std::string_view relative) {
+  return std::string(kContainerTrialsDir) + "/" + std::string(relative);
+}
+
+std::string AirframeRelative(const dsl::DroneSpec& d) { return "airframes/" + d.airframe + ".yaml"; }
+
+// --- the command lines: adjust here when the programs' flags change ------------------------------
+
+std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
+  std::vector<std::string> argv = {
+      "swarmbox-physics",
+      "--world", InContainer(spec.world),
+      "--seed", std::to_string(spec.seed),
+      "--rtf", Num(spec.rtf),
+      "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
+      "--truth", std::string(kTruthCsvPath),
+  };
+  for (const dsl::DroneSpec& d : spec.drones) {
+    // --drone name:airframe_file:x,y,z[:payload]
+    std::string drone = d.name + ":" + InContainer(AirframeRelative(d)) + ":" + Num(d.pose[0]) +
+                        "," + Num(d.pose[1]) + "," + Num(d.pose[2]);
+    if (!d.payload.empty()) drone += ":" + d.payload;
+    argv.push_back("--drone");
+    argv.push_back(std::move(drone));
+  }
+  return argv;
+}
+
+std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d,
+                                   const std::string& sim_ip, const std::string& mesh_ip,
+                                   const std::string& physics_ip) {
+  std::string peers;
+  for (const dsl::DroneSpec& other : spec.drones) {
+    if (other.name != d.name) peers += (peers.empty() ? "" : ",") + other.name;
+  }
+  std::vector<std::string> argv = {
+      "swarmbox-agent",
+      "--name", d.name,
+      "--airframe", InContainer(AirframeRelative(d)),
+      "--world", InContainer(spec.world),
+      "--seed", std::to_string(spec.seed),
+      "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
+      "--sim-ip", sim_ip,
+      "--mesh-ip", mesh_ip,
+      "--physics-ip", physics_ip,
+  };
+  if (!peers.empty()) {
+    argv.push_back("--peers");
+    argv.push_back(peers);
+  }
+  if (!d.payload.empty()) {
+    argv.push_back("--payload");
+    argv.push_back(d.payload);
+  }
+  return argv;
+}
+
+// -------------------------------------------------------------------------------------------------
+
+}  // namespace
+
+dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
+  const double sim_s = spec.timeout.sim.seconds();
+  const double guard_s = spec.rtf > 0 ? sim_s / spec.rtf * 1.5 + 120.0 : sim_s * 3.0 + 120.0;
+  return dsl::Duration::Ms(static_cast<std::int64_t>(guard_s * 1000.0));
+}
+
+Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
+                                              const PlanOptions& options) {
+  if (options.run_id.empty()) return Error(ErrorCode::kInvalidArgument, "PlanTrial: no run id");
+  if (options.images.physics.empty() || options.images.agent.empty()) {
+    return Error(ErrorCode::kInvalidArgument, "PlanTrial: images for physics and agent are needed");
+  }
+  if (spec.drones.size() + kFirstDroneHost >= 255) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "too many drones for a /24: " + std::to_string(spec.drones.size()));
+  }
+  const std::string trial_id = options.trial_id.empty() ? spec.name : options.trial_id;
+  auto name = [&](std::string_view component) {
+    return ResourceName(spec.name, options.run_id, component);
+  };
+  auto labels = [&](std::string_view component) {
+    return RunLabels(options.run_id, trial_id, component);
+  };
+  auto host_file = [&](const std::string& relative) {
+    return (std::filesystem::path(options.trials_dir) / relative).lexically_normal().string();
+  };
+  auto input = [&](const std::string& relative) {
+    return dsl::InputFile{host_file(relative), InContainer(relative)};
+  };
+
+  auto trial = std::make_unique<dsl::Trial>(spec.name, options.run_id);
+  const TrialSubnets& nets = options.subnets;
+
+  dsl::NetworkSpec sim = dsl::NetworkSpec::Subnet(name(kSimNetworkId), nets.sim.ToString(),
+                                                  nets.sim.Host(kGatewayHost));
+  sim.labels = labels(kSimNetworkId);
+  sim.internal = true;  // the wiring inside a drone: nothing leaves the host
+  dsl::NetworkSpec mesh = dsl::NetworkSpec::Subnet(name(kMeshNetworkId), nets.mesh.ToString(),
+                                                   nets.mesh.Host(kGatewayHost));
+  mesh.labels = labels(kMeshNetworkId);
+  mesh.internal = true;
+  auto& sim_net = trial->Add<dsl::Network>(std::string(kSimNetworkId), std::move(sim), 0);
+  auto& mesh_net = trial->Add<dsl::Network>(std::string(kMeshNetworkId), std::move(mesh), 0);
+
+  // The physics server: owns simulated time, writes truth.csv.
+  const std::string physics_ip = nets.sim.Host(kPhysicsHost);
+  dsl::ContainerSpec physics = dsl::ContainerSpec::Image(options.images.physics, PhysicsArgv(spec));
+  physics.name = name(kPhysicsId);
+  physics.hostname = std::string(kPhysicsId);
+  physics.labels = labels(kPhysicsId);
+  physics.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
+  physics.inputs.push_back(input(spec.world));
+  std::set<std::string> airframes;
+  for (const dsl::DroneSpec& d : spec.drones) {
+    if (airframes.insert(d.airframe).second) physics.inputs.push_back(input(AirframeRelative(d)));
+  }
+  physics.scratch_dirs = {std::string(kContainerOutDir)};
+  physics.artifacts = {std::string(kTruthCsvPath)};
+  trial->Add<dsl::Plugin>(std::string(kPhysicsId), std::move(physics), 1)
+      .On(sim_net, physics_ip, {std::string(kPhysicsId)})
+      .ReadyOn(std::string(kPhysicsReadyPattern), dsl::Duration::Seconds(60));
+
+  // One agent per drone.
+  auto& drones = trial->Add<dsl::Component>(std::string(kDronesGroupId), 2);
+  std::uint32_t host = kFirstDroneHost;
+  for (const dsl::DroneSpec& d : spec.drones) {
+    const std::string sim_ip = nets.sim.Host(host);
+    const std::string mesh_ip = nets.mesh.Host(host);
+    ++host;
+    dsl::ContainerSpec agent =
+        dsl::ContainerSpec::Image(options.images.agent, AgentArgv(spec, d, sim_ip, mesh_ip, physics_ip));
+    agent.name = name(d.name);
+    agent.hostname = d.name;
+    agent.labels = labels(d.name);
+    agent.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
+    agent.inputs = {input(spec.world), input(AirframeRelative(d))};
+    drones.Add<dsl::Plugin>(d.name, std::move(agent), 2)
+        .On(sim_net, sim_ip, {d.name})
+        .On(mesh_net, mesh_ip, {d.name});
+  }
+
+  for (const dsl::EndSpec& e : spec.end) trial->EndOn(e.on, e.outcome, e.reason, e.from);
+  dsl::TimeoutPolicy timeout = dsl::TimeoutPolicy::Sim(
+      spec.timeout.sim, spec.timeout.wall.zero() ? DefaultWallGuard(spec) : spec.timeout.wall,
+      std::string(kPhysicsId));
+  timeout.outcome = spec.timeout.outcome;
+  trial->SetTimeout(timeout);
+  return trial;
+}
+
+}  // namespace swarmbox::runner

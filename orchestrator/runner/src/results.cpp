@@ -1,0 +1,137 @@
+#include "swarmbox/runner/results.hpp"
+
+#include <charconv>
+
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::runner {
+
+namespace {
+
+using yaml::Node;
+
+std::string Num(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed, 3);
+  std::string s(buf, r.ptr);
+  while (s.size() > 1 && s.back() == '0') s.pop_back();
+  if (!s.empty() && s.back() == '.') s.pop_back();
+  return s;
+}
+
+Node Str(std::string_view s) { return Node::Scalar(std::string(s), {}, /*quoted=*/true); }
+Node Bare(std::string s) { return Node::Scalar(std::move(s)); }
+
+// A logfmt value as JSON: numbers bare, everything else a string.
+Node Value(const std::string& v) {
+  if (!v.empty() && yaml::ScalarAsDouble(v).has_value() && v.find_first_of("xXoO_") == std::string::npos &&
+      v.find("inf") == std::string::npos && v.find("nan") == std::string::npos && v[0] != '.' && v[0] != '+') {
+    return Bare(v);
+  }
+  return Str(v);
+}
+
+}  // namespace
+
+std::string ResultJson(const TrialResult& r) {
+  Node doc = Node::Mapping();
+  doc.Set("trial", Str(r.trial));
+  doc.Set("outcome", Str(dsl::OutcomeName(r.verdict.outcome)));
+  doc.Set("reason", Str(r.verdict.reason));
+  doc.Set("wall_s", Bare(Num(r.wall_s)));
+  doc.Set("sim_s", Bare(Num(r.sim_s)));
+  doc.Set("seed", Bare(std::to_string(r.seed)));
+  doc.Set("host", Str(r.host));
+  Node metrics = Node::Mapping();
+  for (const auto& [k, v] : r.metrics) metrics.Set(k, Bare(Num(v)));
+  doc.Set("metrics", std::move(metrics));
+  doc.Set("trial_id", Str(r.trial_id));
+  doc.Set("run_id", Str(r.run_id));
+  doc.Set("source", Str(r.verdict.source));
+  doc.Set("ending_line", Str(r.ending_line));
+  doc.Set("restarts", Bare(std::to_string(r.restarts)));
+  Node components = Node::Sequence();
+  for (const ComponentReport& c : r.components) {
+    Node cn = Node::Mapping();
+    cn.Set("name", Str(c.name));
+    cn.Set("exit_code", c.exit_code ? Bare(std::to_string(*c.exit_code)) : Node::Null());
+    cn.Set("oom_killed", Bare(c.oom_killed ? "true" : "false"));
+    cn.Set("log", Str(c.log_file));
+    cn.Set("log_lines", Bare(std::to_string(c.log_lines)));
+    components.Append(std::move(cn));
+  }
+  doc.Set("components", std::move(components));
+  Node problems = Node::Sequence();
+  for (const std::string& p : r.problems) problems.Append(Str(p));
+  doc.Set("problems", std::move(problems));
+  return yaml::EmitJson(doc) + "\n";
+}
+
+void Metrics::OnEvent(std::string_view /*component*/, const LogfmtFields& fields) {
+  auto event = FindField(fields, "event");
+  if (!event) return;
+  ++events_;
+  if (*event == "collision") ++collisions_;
+  if (*event == "crash") ++crashes_;
+  if (*event == "leader_elected") ++elections_;
+  if (*event == "victim_detected" || *event == "victim_confirmed") {
+    auto victim = FindField(fields, "victim");
+    const std::string id = victim ? *victim : "?";
+    (*event == "victim_detected" ? detected_ : confirmed_).insert(id);
+  }
+  if (*event == "mission_complete" && !mission_complete_t_s_) {
+    if (auto t = FindField(fields, "t")) {
+      if (auto v = yaml::ScalarAsDouble(*t)) mission_complete_t_s_ = *v;
+    }
+  }
+}
+
+std::map<std::string, double> Metrics::Values() const {
+  std::map<std::string, double> m = {
+      {"events_total", static_cast<double>(events_)},
+      {"collisions", static_cast<double>(collisions_)},
+      {"crashes", static_cast<double>(crashes_)},
+      {"leader_elections", static_cast<double>(elections_)},
+      {"victims_detected", static_cast<double>(detected_.size())},
+      {"victims_confirmed", static_cast<double>(confirmed_.size())},
+  };
+  if (mission_complete_t_s_) m["mission_complete_t_s"] = *mission_complete_t_s_;
+  return m;
+}
+
+std::optional<std::string> LogEventJson(double wall_s, std::string_view component,
+                                        const LogfmtFields& fields) {
+  if (!FindField(fields, "event")) return std::nullopt;
+  Node doc = Node::Mapping();
+  doc.Set("wall_s", Bare(Num(wall_s)));
+  doc.Set("component", Str(component));
+  for (const auto& [k, v] : fields) {
+    if (k == "wall_s" || k == "component") continue;  // ours win
+    doc.Set(k, Value(v));
+  }
+  return yaml::EmitJson(doc);
+}
+
+std::string LifecycleEventJson(double wall_s, std::string_view event, std::string_view target,
+                               const dsl::Verdict& verdict) {
+  Node doc = Node::Mapping();
+  doc.Set("wall_s", Bare(Num(wall_s)));
+  doc.Set("component", Str("orchestrator"));
+  doc.Set("event", Str(event));
+  doc.Set("target", Str(target));
+  doc.Set("outcome", Str(dsl::OutcomeName(verdict.outcome)));
+  if (!verdict.reason.empty()) doc.Set("reason", Str(verdict.reason));
+  return yaml::EmitJson(doc);
+}
+
+int ExitCodeFor(const dsl::Verdict& verdict) {
+  switch (verdict.outcome) {
+    case dsl::Outcome::kSuccess: return 0;
+    case dsl::Outcome::kTimeout:
+    case dsl::Outcome::kFailure: return 1;
+    case dsl::Outcome::kError: return 3;
+  }
+  return 3;
+}
+
+}  // namespace swarmbox::runner

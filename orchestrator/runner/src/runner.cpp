@@ -1,0 +1,290 @@
+#include "swarmbox/runner/runner.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/runner/docker_engine.hpp"
+#include "swarmbox/runner/log_hub.hpp"
+#include "swarmbox/runner/monitor.hpp"
+#include "swarmbox/runner/naming.hpp"
+#include "swarmbox/runner/trajectories.hpp"
+
+namespace swarmbox::runner {
+
+namespace fs = std::filesystem;
+using dsl::Verdict;
+
+namespace {
+
+Status WriteFile(const fs::path& path, std::string_view text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  out.close();
+  if (!out) return Error(ErrorCode::kIo, "cannot write file", path.string());
+  return Ok{};
+}
+
+std::optional<double> NumberField(const LogfmtFields& fields, std::initializer_list<const char*> keys) {
+  for (const char* k : keys) {
+    if (auto v = FindField(fields, k)) {
+      if (auto d = yaml::ScalarAsDouble(*v)) return d;
+    }
+  }
+  return std::nullopt;
+}
+
+// events.jsonl, appended line by line as events happen (also from the trace callback).
+class EventsFile {
+ public:
+  explicit EventsFile(const fs::path& path) : file_(std::fopen(path.c_str(), "wb")) {}
+  ~EventsFile() {
+    if (file_ != nullptr) std::fclose(file_);
+  }
+  EventsFile(const EventsFile&) = delete;
+  EventsFile& operator=(const EventsFile&) = delete;
+  bool ok() const { return file_ != nullptr; }
+  void Write(const std::string& line) {
+    if (file_ == nullptr) return;
+    std::fwrite(line.data(), 1, line.size(), file_);
+    std::fputc('\n', file_);
+    std::fflush(file_);
+  }
+
+ private:
+  std::FILE* file_;
+};
+
+}  // namespace
+
+Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docker::DockerApi& api,
+                            Clock& clock, const RunOptions& o) {
+  const std::string run_id = o.run_id.empty() ? NewRunId() : o.run_id;
+  const fs::path dir = fs::path(o.out_dir) / TrialDirName(info.name, run_id);
+  std::error_code ec;
+  fs::create_directories(dir / "logs", ec);
+  if (ec) return Error(ErrorCode::kIo, "cannot create the trial folder: " + ec.message(), dir.string());
+  SWARMBOX_TRY(WriteFile(dir / "trial.yaml", info.resolved_yaml));
+  EventsFile events(dir / "events.jsonl");
+  if (!events.ok()) return Error(ErrorCode::kIo, "cannot write events.jsonl", dir.string());
+  if (auto ping = api.Ping(); !ping) return ping.error().Context("reaching the Docker engine");
+
+  std::vector<std::string> taken;
+  auto refresh_taken = [&] {
+    taken.clear();
+    if (auto nets = api.ListNetworks({})) {
+      for (const auto& n : *nets) {
+        if (!n.subnet.empty()) taken.push_back(n.subnet);
+      }
+    }
+  };
+  refresh_taken();
+
+  const double t0 = clock.NowS();
+  auto wall = [&] { return clock.NowS() - t0; };
+  auto say = [&](const std::string& line) {
+    if (o.progress != nullptr) *o.progress << "[" << info.name << "] " << line << std::endl;
+  };
+  say("run " + run_id + " -> " + dir.string());
+
+  LogHub hub;  // outlives the engine, whose follower threads push into it
+  EngineOptions eo;
+  eo.trial_dir = dir.string();
+  eo.start_wall_s = t0;
+  eo.interrupted = o.interrupted;
+  eo.on_trace = [&](const dsl::Component& c, dsl::EventKind e, const Verdict& v) {
+    events.Write(LifecycleEventJson(wall(), dsl::EventName(e), c.id(), v));
+    if (!v.ok()) {
+      say(std::string(dsl::EventName(e)) + " " + c.id() + ": " + v.ToString());
+    } else if (e == dsl::EventKind::kRun && dynamic_cast<const dsl::Plugin*>(&c) != nullptr) {
+      say("started " + c.id());
+    }
+  };
+
+  std::unique_ptr<dsl::Trial> tree;
+  std::unique_ptr<DockerEngine> engine;
+  Verdict start;
+  for (int attempt = 0; attempt < std::max(1, o.subnet_attempts); ++attempt) {
+    auto subnets = PickSubnets(run_id, attempt, taken);
+    if (!subnets) {
+      start = Verdict::FromError(subnets.error(), "subnets");
+      break;
+    }
+    if (engine && tree) (void)tree->Stop(*engine);
+    engine.reset();
+    auto planned = planner(run_id, *subnets);
+    if (!planned) return planned.error().Context("planning the trial");
+    tree = std::move(*planned);
+    engine = std::make_unique<DockerEngine>(api, hub, clock, eo);
+    start = tree->Start(*engine);
+    if (start.ok() || !engine->subnet_conflict()) break;
+    say("subnet conflict (" + start.reason + "), trying another pair");
+    (void)tree->Stop(*engine);
+    engine.reset();
+    tree.reset();
+    refresh_taken();
+  }
+
+  Metrics metrics;
+  std::vector<Detection> detections;
+  std::optional<Monitor> monitor;
+  TrialResult result;
+  result.trial = info.name;
+  result.trial_id = o.trial_id.empty() ? info.name : o.trial_id;
+  result.run_id = run_id;
+  result.seed = info.seed;
+  result.host = o.host;
+
+  auto raise = [&](const std::string& component, Verdict v, bool restart) {
+    dsl::Component* c = tree->Find(component);
+    if (c == nullptr) c = tree.get();
+    if (restart) {
+      c->RaiseRestart(v.reason);
+    } else {
+      c->RaiseShutdown(std::move(v));
+    }
+  };
+  auto process = [&](const HubItem& item) {
+    if (item.kind == HubItem::Kind::kLine) {
+      const LogfmtFields fields = ParseLogfmt(item.text);
+      if (auto j = LogEventJson(item.wall_s, item.component, fields)) {
+        events.Write(*j);
+        metrics.OnEvent(item.component, fields);
+        auto ev = FindField(fields, "event");
+        if (ev && (*ev == "victim_detected" || *ev == "victim_confirmed")) {
+          auto x = NumberField(fields, {"x", "x_m"});
+          auto y = NumberField(fields, {"y", "y_m"});
+          if (x && y) {
+            detections.push_back({FindField(fields, "node").value_or(item.component), *x, *y,
+                                  *ev == "victim_confirmed"});
+          }
+        }
+      }
+      if (monitor && tree) {
+        if (auto v = monitor->OnLine(item.component, item.text)) raise(item.component, *v, false);
+      }
+      return;
+    }
+    // The end of a log stream: the container stopped, or the stream broke.
+    if (!engine || !engine->IsCurrent(item) || !monitor || !tree || tree->end_verdict()) return;
+    auto state = engine->Inspect(item.component);
+    if (state && !state->running) {
+      if (auto v = monitor->OnExit(item.component, state->exit_code, state->oom_killed)) {
+        raise(item.component, *v, false);
+      }
+      return;
+    }
+    const std::string why = item.text.empty() ? "ended while the container runs" : item.text;
+    raise(item.component, Verdict::Err("log stream of " + item.component + " broke: " + why), true);
+  };
+  auto start_monitor = [&]() -> Verdict {
+    auto m = Monitor::Create(*tree);
+    if (!m) return Verdict::FromError(m.error(), "end conditions");
+    monitor.emplace(std::move(*m));
+    for (dsl::Plugin* p : tree->Plugins()) monitor->Started(p->id());
+    return Verdict::Success();
+  };
+
+  if (start.ok()) start = start_monitor();
+  if (start.ok()) {
+    double next_progress = 0;
+    while (true) {
+      for (const HubItem& item : hub.Drain(o.poll)) process(item);
+      if (auto v = monitor->OnTick(wall())) tree->RaiseShutdown(*v);
+      if (o.interrupted != nullptr && o.interrupted->load()) {
+        tree->RaiseShutdown(Verdict::Err("interrupted (Ctrl-C)", "user"));
+      }
+      if (tree->restart_requested() && !tree->end_verdict()) {
+        if (tree->restarts() < o.max_restarts) {
+          say("restarting: " + tree->restart_reason());
+          events.Write(LifecycleEventJson(wall(), "restart", tree->id(),
+                                          Verdict::Err(tree->restart_reason())));
+          Verdict rv = tree->Restart(*engine);
+          if (rv.ok()) rv = start_monitor();
+          if (!rv.ok()) tree->RaiseShutdown(rv);
+        } else {
+          tree->RaiseShutdown(Verdict::Err("restart requested (" + tree->restart_reason() +
+                                           ") with no restarts left"));
+        }
+      }
+      if (tree->end_verdict()) break;
+      if (wall() >= next_progress) {
+        say(monitor->ProgressLine());
+        next_progress = wall() + o.progress_every_s;
+      }
+    }
+  }
+
+  Verdict verdict = start.ok() ? *tree->end_verdict() : start;
+  say("ending: " + verdict.ToString());
+  events.Write(LifecycleEventJson(wall(), "shutdown", info.name, verdict));
+  if (tree && engine) {
+    Verdict stop = tree->Stop(*engine);
+    if (!stop.ok()) {
+      result.problems.push_back("teardown: " + stop.ToString());
+      verdict.KeepWorse(stop);
+    }
+    for (const HubItem& item : hub.Drain(std::chrono::milliseconds(0))) process(item);
+    result.components = engine->Reports();
+    for (const std::string& p : engine->problems()) result.problems.push_back(p);
+    result.restarts = tree->restarts();
+  }
+  result.verdict = verdict;
+  result.wall_s = wall();
+  result.sim_s = monitor ? monitor->sim_s() : 0;
+  result.ending_line = monitor ? monitor->ending_line() : std::string();
+  result.metrics = metrics.Values();
+
+  // trajectories.png from the collected truth.csv.
+  if (engine && engine->artifacts().count("truth.csv") > 0) {
+    std::ifstream in(engine->artifacts().at("truth.csv"), std::ios::binary);
+    std::ostringstream csv;
+    csv << in.rdbuf();
+    auto tracks = ParseTruthCsv(csv.str());
+    auto world = info.world_file.empty() ? Result<WorldPicture>(WorldPicture{})
+                                         : LoadWorldPicture(info.world_file);
+    if (!tracks) {
+      result.problems.push_back("trajectories.png: " + tracks.error().ToString());
+    } else if (!world) {
+      result.problems.push_back("trajectories.png: " + world.error().ToString());
+    } else if (Status s = DrawTrajectories(*tracks, *world, detections,
+                                           (dir / "trajectories.png").string());
+               !s) {
+      result.problems.push_back("trajectories.png: " + s.error().ToString());
+    }
+  } else {
+    result.problems.push_back("trajectories.png not drawn: no truth.csv was collected");
+  }
+
+  SWARMBOX_TRY(WriteFile(dir / "result.json", ResultJson(result)));
+  say("result: " + verdict.ToString() + " (" + (dir / "result.json").string() + ")");
+  return RunOutcome{std::move(result), dir.string()};
+}
+
+Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& api, Clock& clock,
+                                const RunOptions& options) {
+  const std::string trials_dir =
+      fs::absolute(spec.trials_dir.empty() ? fs::path(".") : fs::path(spec.trials_dir))
+          .lexically_normal()
+          .string();
+  TrialInfo info;
+  info.name = spec.name;
+  info.seed = spec.seed;
+  info.resolved_yaml = yaml::Emit(spec.document.is_null() ? dsl::ToDocument(spec) : spec.document);
+  info.world_file = (fs::path(trials_dir) / spec.world).string();
+  Planner planner = [&](const std::string& run_id, const TrialSubnets& subnets) {
+    PlanOptions p;
+    p.run_id = run_id;
+    p.trial_id = options.trial_id;
+    p.images = options.images;
+    p.subnets = subnets;
+    p.trials_dir = trials_dir;
+    return PlanTrial(spec, p);
+  };
+  return RunTrial(info, planner, api, clock, options);
+}
+
+}  // namespace swarmbox::runner
