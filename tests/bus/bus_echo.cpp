@@ -16,8 +16,7 @@ Status Serve(Participant& p, const std::string& in_topic, const std::string& out
   if (!sub) return std::move(sub).error().Context("echo subscriber");
   auto pub = p.CreatePublisher<Out>(out_topic, Qos::kLockstep);
   if (!pub) return std::move(pub).error().Context("echo publisher");
-  std::printf("echo ready\n");
-  std::fflush(stdout);
+  std::fprintf(stderr, "echo ready\n");
   In in;
   Out out;
   while (!stop.load()) {

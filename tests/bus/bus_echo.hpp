@@ -37,7 +37,7 @@ Result<EchoOptions> EchoOptionsFromMap(const std::map<std::string, std::string>&
 // The options as `--key=value` arguments.
 std::vector<std::string> EchoArgs(const EchoOptions& options);
 
-// Serves until `stop` becomes true (checked every 50 ms). Prints `echo ready` on stdout once its
+// Serves until `stop` becomes true (checked every 50 ms). Prints `echo ready` on stderr once its
 // publisher and subscriber exist. Errors: participant/entity creation, or a failed publish.
 Status RunEcho(const EchoOptions& options, const std::atomic<bool>& stop);
 

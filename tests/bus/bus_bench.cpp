@@ -1,0 +1,256 @@
+// `swarmbox-bench bus`: round-trip latency (p50/p99) and throughput of the bus, per backend, for a
+// small (~100 B RaftMessage) and a large (320x240 mono8 CameraImage, ~77 KB) message, with the
+// echo in the same process (a thread with its own participant) and in a second process (this
+// binary re-executed as `swarmbox-bench bus --role=echo ...`, killed on every exit path).
+//
+// One logfmt line per scenario on stdout:
+//   suite=bus scenario=rtt_small backend=cyclonedds mode=two_process payload_bytes=68 n=5000
+//   p50_us=.. p99_us=.. max_us=.. timeouts=0 window=8 round_trips_s=.. msgs_s=.. mb_s=..
+// Latency: sequential ping-pong (publish, wait for the echo), n round trips after a handshake.
+// Throughput: `window` pings in flight; round_trips_s counts completed round trips per second,
+// msgs_s = 2 * round_trips_s (each round trip is two messages), mb_s = msgs_s * payload_bytes.
+// Options: --quick, --backend=cyclonedds|fastdds|all, --mode=same_process|two_process|all,
+//          --size=small|large|all, --domain=<first domain id, default 200>, --n=<round trips>.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "bench.hpp"
+#include "bus_echo.hpp"
+#include "child_process.hpp"
+#include "message_samples.hpp"
+#include "swarmbox/bus/participant.hpp"
+
+namespace swarmbox::bus {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using bench::Args;
+
+constexpr std::size_t kSmallPayloadBytes = 68;  // ~100 B on the wire with from/to/term and CDR
+constexpr int kWindow = 8;                      // below the kLockstep keep-last depth of 16
+
+std::atomic<bool> g_echo_stop{false};
+extern "C" void OnEchoSignal(int) { g_echo_stop.store(true); }
+
+int RunEchoRole(const Args& args) {
+  auto o = testing::EchoOptionsFromMap(args.options);
+  if (!o) {
+    std::fprintf(stderr, "bus echo: %s\n", o.error().ToString().c_str());
+    return 2;
+  }
+  std::signal(SIGTERM, OnEchoSignal);
+  std::signal(SIGINT, OnEchoSignal);
+  auto s = testing::RunEcho(*o, g_echo_stop);
+  if (!s) {
+    std::fprintf(stderr, "bus echo: %s\n", s.error().ToString().c_str());
+    return 1;
+  }
+  return 0;
+}
+
+// The sequence number a ping carries.
+std::uint64_t& Seq(RaftMessage& m) { return m.term; }
+std::uint64_t& Seq(CameraImage& m) { return m.step; }
+
+// The echo side of a scenario; stops it on destruction (thread joined / child killed).
+class Echo {
+ public:
+  static std::optional<Echo> Start(const std::string& mode, const testing::EchoOptions& o) {
+    Echo e;
+    if (mode == "same_process") {
+      e.stop_ = std::make_unique<std::atomic<bool>>(false);
+      e.thread_ = std::thread([o, stop = e.stop_.get()] {
+        if (auto s = testing::RunEcho(o, *stop); !s) {
+          std::fprintf(stderr, "bus bench: echo thread: %s\n", s.error().ToString().c_str());
+        }
+      });
+      return e;
+    }
+    std::vector<std::string> argv = {testing::SelfExecutable(), "bus", "--role=echo"};
+    for (auto& a : testing::EchoArgs(o)) argv.push_back(a);
+    auto child = testing::ChildProcess::Spawn(argv);
+    if (!child) {
+      std::fprintf(stderr, "bus bench: %s\n", child.error().ToString().c_str());
+      return std::nullopt;
+    }
+    e.child_.emplace(std::move(*child));
+    return e;
+  }
+  Echo() = default;
+  Echo(Echo&&) = default;
+  Echo& operator=(Echo&&) = delete;
+  ~Echo() {
+    if (stop_) stop_->store(true);
+    if (thread_.joinable()) thread_.join();
+    if (child_) child_->Stop(std::chrono::seconds(2));
+  }
+
+ private:
+  std::unique_ptr<std::atomic<bool>> stop_;
+  std::thread thread_;
+  std::optional<testing::ChildProcess> child_;
+};
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const auto idx = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
+  return v[std::min(idx, v.size() - 1)];
+}
+
+template <BusMessage T>
+int RunScenario(const std::string& backend, const std::string& mode, const std::string& size,
+                int domain, T ping, std::size_t payload_bytes, int n, int throughput_n) {
+  testing::EchoOptions o{.backend = backend, .domain_id = domain, .interface = "lo", .kind = size};
+  auto echo = Echo::Start(mode, o);
+  if (!echo) return 1;
+  auto p = Participant::Create({.backend = backend, .domain_id = domain, .interface = "lo"});
+  if (!p) {
+    std::fprintf(stderr, "bus bench: %s\n", p.error().ToString().c_str());
+    return 1;
+  }
+  auto pub = (*p)->CreatePublisher<T>(std::string(testing::kBenchPingTopic), Qos::kLockstep);
+  auto sub = (*p)->CreateSubscriber<T>(std::string(testing::kBenchPongTopic), Qos::kLockstep);
+  if (!pub || !sub) {
+    std::fprintf(stderr, "bus bench: cannot create publisher/subscriber\n");
+    return 1;
+  }
+  const auto match_timeout = std::chrono::milliseconds(15000);
+  if (auto s = (*pub)->WaitForSubscribers(1, match_timeout); !s) {
+    std::fprintf(stderr, "bus bench: %s\n", s.error().ToString().c_str());
+    return 1;
+  }
+  if (auto s = (*sub)->WaitForPublishers(1, match_timeout); !s) {
+    std::fprintf(stderr, "bus bench: %s\n", s.error().ToString().c_str());
+    return 1;
+  }
+  // Handshake (see Publisher::WaitForSubscribers): resend seq 0 until echoed.
+  T pong;
+  std::uint64_t seq = 0;
+  Seq(ping) = seq;
+  bool ok = false;
+  for (const auto deadline = Clock::now() + match_timeout; !ok && Clock::now() < deadline;) {
+    (void)(*pub)->Publish(ping);
+    ok = (*sub)->TakeFor(pong, std::chrono::milliseconds(100));
+  }
+  if (!ok) {
+    std::fprintf(stderr, "bus bench: %s/%s/%s: echo never answered\n", backend.c_str(),
+                 mode.c_str(), size.c_str());
+    return 1;
+  }
+  while ((*sub)->TakeFor(pong, std::chrono::milliseconds(200))) {
+  }  // drain duplicate answers to the handshake
+
+  // Latency: sequential ping-pong.
+  std::vector<double> rtt_us;
+  rtt_us.reserve(static_cast<std::size_t>(n));
+  int timeouts = 0;
+  for (int i = 0; i < n; ++i) {
+    Seq(ping) = ++seq;
+    const auto t0 = Clock::now();
+    if (!(*pub)->Publish(ping)) {
+      ++timeouts;
+      continue;
+    }
+    bool got = false;
+    while ((*sub)->TakeFor(pong, std::chrono::seconds(2))) {
+      if (Seq(pong) == seq) {
+        got = true;
+        break;
+      }
+    }
+    if (!got) {
+      ++timeouts;
+      continue;
+    }
+    rtt_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+  }
+
+  // Throughput: kWindow pings in flight.
+  const std::uint64_t first = seq + 1;
+  const std::uint64_t last = seq + static_cast<std::uint64_t>(throughput_n);
+  std::uint64_t next = first;
+  std::uint64_t done = 0;
+  const auto t0 = Clock::now();
+  for (int w = 0; w < kWindow && next <= last; ++w) {
+    Seq(ping) = next++;
+    (void)(*pub)->Publish(ping);
+  }
+  while (done < static_cast<std::uint64_t>(throughput_n)) {
+    if (!(*sub)->TakeFor(pong, std::chrono::seconds(2))) {
+      ++timeouts;
+      break;
+    }
+    if (Seq(pong) < first) continue;
+    ++done;
+    if (next <= last) {
+      Seq(ping) = next++;
+      (void)(*pub)->Publish(ping);
+    }
+  }
+  const double secs = std::chrono::duration<double>(Clock::now() - t0).count();
+  const double rts = secs > 0 ? static_cast<double>(done) / secs : 0.0;
+
+  std::printf(
+      "suite=bus scenario=rtt_%s backend=%s mode=%s payload_bytes=%zu n=%zu p50_us=%.1f "
+      "p99_us=%.1f max_us=%.1f timeouts=%d window=%d round_trips_s=%.0f msgs_s=%.0f mb_s=%.2f\n",
+      size.c_str(), backend.c_str(), mode.c_str(), payload_bytes, rtt_us.size(),
+      Percentile(rtt_us, 0.50), Percentile(rtt_us, 0.99), Percentile(rtt_us, 1.0), timeouts,
+      kWindow, rts, 2 * rts, 2 * rts * static_cast<double>(payload_bytes) / 1e6);
+  std::fflush(stdout);
+  return timeouts == 0 ? 0 : 1;
+}
+
+std::vector<std::string> Pick(const std::string& value, std::vector<std::string> all) {
+  if (value == "all") return all;
+  return {value};
+}
+
+int RunBusBench(const Args& args) {
+  if (args.Get("role", "") == "echo") return RunEchoRole(args);
+  const auto backends = Pick(args.Get("backend", "all"), {"cyclonedds", "fastdds"});
+  const auto modes = Pick(args.Get("mode", "all"), {"same_process", "two_process"});
+  const auto sizes = Pick(args.Get("size", "all"), {"small", "large"});
+  int domain = static_cast<int>(args.GetInt("domain", 200));
+  int worst = 0;
+  for (const auto& backend : backends) {
+    for (const auto& mode : modes) {
+      for (const auto& size : sizes) {
+        int rc = 0;
+        if (size == "small") {
+          const int n = static_cast<int>(args.GetInt("n", args.quick ? 200 : 5000));
+          rc = RunScenario<RaftMessage>(backend, mode, size, domain,
+                                        testing::FullRaftMessage(1, kSmallPayloadBytes),
+                                        kSmallPayloadBytes, n, args.quick ? 500 : 20000);
+        } else if (size == "large") {
+          const int n = static_cast<int>(args.GetInt("n", args.quick ? 30 : 500));
+          CameraImage img = testing::FullCameraImage(1, 320, 240);
+          const std::size_t bytes = img.data.size();
+          rc = RunScenario<CameraImage>(backend, mode, size, domain, std::move(img), bytes, n,
+                                        args.quick ? 60 : 1000);
+        } else {
+          std::fprintf(stderr, "bus bench: unknown --size '%s': accepted small, large, all\n",
+                       size.c_str());
+          return 2;
+        }
+        if (rc != 0) worst = rc;
+        ++domain;
+      }
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+}  // namespace swarmbox::bus
+
+SWARMBOX_BENCH_SUITE(bus, "DDS round-trip latency and throughput per backend (--quick)",
+                     swarmbox::bus::RunBusBench);
