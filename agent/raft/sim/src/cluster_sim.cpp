@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "swarmbox/raft/message_codec.hpp"
+
 namespace swarmbox::raft::sim {
 
 std::uint64_t HashBytes(std::span<const std::uint8_t> bytes) {
@@ -97,6 +99,9 @@ ClusterSim::ClusterSim(const SimConfig& config) : config_(config), rng_(config.s
   report_.seed = config.seed;
   clock_ = std::make_unique<SimClock>(*this);
   group_.assign(static_cast<std::size_t>(config.nodes), 0);
+  std::vector<std::string> names;
+  for (int i = 0; i < config.nodes; ++i) names.push_back(Name(i));
+  cluster_tag_ = ClusterTag(names);
   for (int i = 0; i < config.nodes; ++i) {
     auto n = std::make_unique<Node>();
     n->storage = std::make_unique<CheckedStorage>(*this, i);
@@ -178,6 +183,13 @@ void ClusterSim::Crash(int node) {
 void ClusterSim::Restart(int node) {
   Node& n = *nodes_[static_cast<std::size_t>(node)];
   if (n.alive) return;
+  if (config_.faults.wipe_storage_on_restart && n.restarts > 0) {
+    n.storage = std::make_unique<CheckedStorage>(*this, node);
+    // The per-node term/vote memory goes too, so that what the checker reports is the damage to
+    // the cluster (two leaders, lost commits), not the amnesia itself.
+    n.last_term = 0;
+    n.last_vote = kNoNode;
+  }
   DriverConfig dc;
   dc.self = Name(node);
   for (int i = 0; i < size(); ++i) dc.members.push_back(Name(i));
@@ -265,6 +277,14 @@ void ClusterSim::SendMessage(int from, const std::string& to_name,
     ++report_.snapshots_sent;
   }
   if (group_[static_cast<std::size_t>(from)] != group_[static_cast<std::size_t>(to)]) return;
+  if (drop_filter_) {
+    auto m = DecodeMessage(bytes, cluster_tag_);
+    if (!m) {
+      Violation("Transport", Name(from) + " sent an undecodable message: " + m.error().ToString());
+      return;
+    }
+    if (drop_filter_(from, to, *m)) return;
+  }
   const NetworkModel& net = config_.net;
   const int copies = Chance(net.duplicate) ? 2 : 1;
   for (int c = 0; c < copies; ++c) {

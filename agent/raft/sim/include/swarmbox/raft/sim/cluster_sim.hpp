@@ -57,6 +57,9 @@ struct FaultModel {
   double down_min_s = 0.5, down_max_s = 4;      // how long a crashed node stays down
   double partition_mean_interval_s = 0;  // mean time between random partitions (0: none)
   double partition_min_s = 0.5, partition_max_s = 5;
+  // Breaks Raft's durability assumption on purpose: a restarted node comes back with empty
+  // storage. Only for checking that the safety checker catches what follows.
+  bool wipe_storage_on_restart = false;
 };
 
 struct SimConfig {
@@ -114,6 +117,10 @@ class ClusterSim {
   void Partition(const std::vector<std::vector<int>>& groups);
   void Heal();
   Status Propose(int node, const MissionCommand& command);
+  // Drops every message for which the filter returns true (e.g. all vote responses), until
+  // cleared with nullptr. Applied at send time.
+  using DropFilter = std::function<bool(int from, int to, const Message& m)>;
+  void SetDropFilter(DropFilter filter) { drop_filter_ = std::move(filter); }
 
   double now_s() const { return static_cast<double>(now_us_) / 1e6; }
   int size() const { return static_cast<int>(nodes_.size()); }
@@ -162,6 +169,8 @@ class ClusterSim {
   std::priority_queue<Event*, std::vector<Event*>, EventLater> queue_;
   std::vector<std::unique_ptr<Node>> nodes_;
   std::vector<int> group_;
+  DropFilter drop_filter_;
+  std::uint32_t cluster_tag_ = 0;
   std::unique_ptr<SimClock> clock_;
   SimReport report_;
 
