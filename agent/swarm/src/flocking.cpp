@@ -111,20 +111,22 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
     ++index;
     if (!(n.age_s <= k.stale_timeout_s)) continue;  // stale (or NaN age): dropped
     const double age = std::max(0.0, n.age_s);
-    const Vec2 pj = n.position_m.head<2>() + age * n.velocity_m_s.head<2>();
+    const Vec3 pj3 = n.position_m + age * n.velocity_m_s;
+    const Vec2 pj = pj3.head<2>();
     const Vec2 vj = n.velocity_m_s.head<2>();
-    Vec2 diff = p - pj;
-    double r = diff.norm();
+    // Distances are 3-D (a drone far above or below is no threat), pushes horizontal.
+    double r = (in.position_m - pj3).norm();
     if (r > k.sensing_range_m) continue;
+    Vec2 diff = p - pj;
+    const double r_xy = diff.norm();
     ++out.neighbours_used;
     const double w =
         age <= k.fresh_age_s ? 1.0 : (k.stale_timeout_s - age) / (k.stale_timeout_s - k.fresh_age_s);
-    if (r < 1e-6) {  // coincident: a deterministic direction per neighbour slot
+    if (r_xy < 1e-6) {  // stacked vertically: a deterministic direction per neighbour slot
       const double angle = 2.39996322972865332 * static_cast<double>(index);  // golden angle
       diff = Vec2(std::cos(angle), std::sin(angle));
-      r = 1e-6;
     } else {
-      diff /= r;
+      diff /= r_xy;
     }
     if (r < k.r0_rep_m) out.repulsion += k.p_rep_1_s * (k.r0_rep_m - r) * diff;
     out.friction += w * FrictionRule(v, vj, r, k.r0_frict_m, k.v_frict_m_s, k.a_frict_m_s2,

@@ -16,7 +16,8 @@
 //   swarm::FlockingOutput out = flock.Step({est.pos_m, est.vel_mps, goal_m, neighbours_}, dt_s);
 //   flight.SetVelocitySetpoint(out.velocity_m_s, yaw_rad);
 //
-// Terms (all horizontal, world ENU x/y; z is a separate altitude-hold channel):
+// Terms (all horizontal, world ENU x/y; z is a separate altitude-hold channel). Distances to
+// neighbours are 3-D (a drone 15 m below is not in the way), the pushes they cause horizontal:
 //  - migration   v_flock toward the goal, slowing on the braking curve D near it (V18 eq. 4 / S6);
 //  - repulsion   p_rep (r0_rep - r) along the line from each neighbour closer than r0_rep (V18 eq. 1);
 //  - friction    velocity alignment with the V18 "smart" tolerance: only the part of the velocity

@@ -1,0 +1,108 @@
+// LifterSequence: the heavy lifter's (x8_heavy) rescue, an explicit pure state machine.
+//
+// The stretcher starts lying on the ground under the lifter's spawn point. When the committed
+// mission state puts a victim in RESCUE with this drone as its rescuer, the lifter:
+//   kTakeoffForPickup  climbs to the hook height over the stretcher        ("takeoff_for_pickup")
+//   kAttachEmpty       settles, asks payload_attach {empty mass}, waits    ("attach_empty")
+//   kClimbToTransit    climbs to transit altitude, stretcher slung below   ("climb")
+//   kTransitToVictim   flies to the drop point beside the victim           ("transit_to_victim")
+//   kDescendToRelease  lowers the stretcher onto the ground                ("descend_to_release")
+//   kRelease           settles, asks payload_release, waits                ("release")
+//   kWaitLoading       holds while the evacuee is loaded, loading_time_s   ("loading")
+//   kAttachLoaded      asks payload_attach {loaded mass = 80 kg}, waits    ("attach_loaded")
+//   kClimbWithLoad     climbs to transit altitude, swing damped            ("climb_loaded")
+//   kCarryHome         flies home, swing damped                            ("carry_home")
+//   kDescendToDrop     lowers the stretcher onto the ground at home        ("descend_to_drop")
+//   kReleaseAtHome     asks payload_release, waits; proposes MarkRescued   ("release_at_home")
+//   kMoveToLandingPoint  moves aside (land_offset_m) at low height         ("move_to_land")
+//   kLanding -> kOnGround ("landing", "on_ground"); MarkRescued is re-proposed until committed.
+// A payload request is repeated every attach_retry_s until the payload status changes (a world
+// command can be lost or refused when the hook is out of reach). Battery low: event=battery_low;
+// the lifter abandons a rescue not yet loaded and goes home (with whatever it carries).
+// Heights are above home_m.z (flat ground). Payload actions happen only once settled: within
+// position_tolerance_m / altitude_tolerance_m of the target and slower than settle_speed_m_s for
+// settle_time_s (the slung stretcher has stopped swinging).
+//
+//   LifterSequence lifter({.name = "lifter", .home_m = spawn});
+//   lifter.Step(input, &output);  // output.payload -> WorldCommand payload_attach/payload_release
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "swarmbox/swarm/mission_types.hpp"
+
+namespace swarmbox::swarm {
+
+struct LifterConfig {
+  std::string name;
+  Eigen::Vector3d home_m = Eigen::Vector3d::Zero();  // spawn point on the ground [m]
+  double base_height_m = 0.6;            // body origin above ground when landed [m]
+  double transit_altitude_m = 15.0;      // below the scouts' search altitude [m]
+  double cruise_speed_m_s = 4.0;
+  double loaded_speed_m_s = 2.5;         // with the evacuee on board [m/s]
+  // Sling geometry (airframe PayloadSpec): hook under the body origin, hook -> payload centre.
+  double hook_below_body_m = 0.4;
+  double sling_length_m = 4.0;
+  double payload_half_height_m = 0.125;
+  double release_sink_m = 0.25;          // descend this much below the attach height to set down
+  double stretcher_offset_m = 3.0;       // drop point this far from the victim, toward home [m]
+  Eigen::Vector2d land_offset_m{6.0, 0.0};  // landing point beside the stretcher at home [m]
+  double loading_time_s = 30.0;
+  double empty_stretcher_mass_kg = 15.0;  // assumption: litter alone
+  double loaded_mass_kg = 80.0;           // stretcher and evacuee (the brief)
+  double position_tolerance_m = 0.5;
+  double altitude_tolerance_m = 0.3;
+  double settle_speed_m_s = 0.3;
+  double settle_time_s = 1.5;
+  double attach_retry_s = 3.0;
+  double proposal_retry_s = 2.0;
+
+  // Body height above the ground at which the hook reaches the stretcher lying flat [m].
+  double AttachHeight() const { return payload_half_height_m + sling_length_m + hook_below_body_m; }
+};
+
+class LifterSequence {
+ public:
+  enum class Stage {
+    kOnGround, kTakeoffForPickup, kAttachEmpty, kClimbToTransit, kTransitToVictim,
+    kDescendToRelease, kRelease, kWaitLoading, kAttachLoaded, kClimbWithLoad, kCarryHome,
+    kDescendToDrop, kReleaseAtHome, kMoveToLandingPoint, kLanding,
+  };
+  static std::string_view StageName(Stage stage);
+
+  explicit LifterSequence(LifterConfig config);
+
+  void Step(const MissionInput& in, MissionOutput* out);
+
+  Stage stage() const { return stage_; }
+  std::uint32_t victim() const { return victim_; }
+  // Where the stretcher lies (or will be set down) on the ground [m, ENU].
+  const Eigen::Vector2d& stretcher_xy_m() const { return stretcher_xy_m_; }
+  const LifterConfig& config() const { return config_; }
+
+ private:
+  void Enter(Stage stage, const MissionInput& in, MissionOutput* out);
+  // True once within tolerance of `target_m` and slow for settle_time_s.
+  bool Settled(const MissionInput& in, const Eigen::Vector3d& target_m);
+  void Hold(const Eigen::Vector3d& target_m, double speed_m_s, bool damp, MissionOutput* out) const;
+  void RequestPayload(const MissionInput& in, PayloadAction action, double mass_kg,
+                      MissionOutput* out);
+  double Ground() const { return config_.home_m.z(); }
+
+  LifterConfig config_;
+  Stage stage_ = Stage::kOnGround;
+  std::uint32_t victim_ = 0;
+  Eigen::Vector2d victim_xy_m_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d drop_xy_m_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d stretcher_xy_m_ = Eigen::Vector2d::Zero();
+  double stage_start_s_ = 0.0;
+  double settled_since_s_ = -1.0;
+  double last_request_s_ = -1e9;
+  double last_proposal_s_ = -1e9;
+  std::uint32_t delivered_victim_ = 0;  // MarkRescued to (re)propose until committed
+  bool battery_low_reported_ = false;
+};
+
+}  // namespace swarmbox::swarm

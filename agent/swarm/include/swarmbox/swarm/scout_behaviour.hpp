@@ -1,0 +1,107 @@
+// ScoutBehaviour: a scout's part of the SAR mission as a pure state machine.
+//
+// Stages (mode strings in quotes, published as bus::DroneState::mode):
+//   kOnGround "on_ground" --(t >= takeoff_delay_s, mission not over)--> kTakingOff "taking_off"
+//   --(at search altitude)--> kAwaitingSector "awaiting_sector" (hold over home)
+//   --(own sector committed, phase SEARCH/CONVERGE/RESCUE)--> kSearching "searching"
+//       (lawnmower over the sector, swath from the camera footprint, flocking keeps spacing)
+//   --(last lane done)--> kSwept "swept" (loiter at the sector centre)
+//   any of the three --(phase CONVERGE/RESCUE with a target victim not rescued)--> kOrbiting
+//       "orbiting" around it; back to searching when it is rescued (or, with no lifter in the
+//       trial, after orbit_time_s on the orbit: the victim is then handled)
+//   airborne --(phase RETURN/COMPLETE, or battery low: event=battery_low)--> kReturning
+//       "returning" --(over home)--> kLanding "landing" --(touch-down)--> kLanded "landed".
+// Detections (after the latency queue) become Raft ReportSighting proposals, except near a known
+// victim or near the drone's own recent report (cooldown), and only in an active phase.
+//
+//   ScoutBehaviour scout({.name = "scout_1", .home_m = spawn});
+//   scout.Step(input, &output);   // each mission tick (e.g. 10 Hz)
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "swarmbox/swarm/mission_types.hpp"
+#include "swarmbox/swarm/search_pattern.hpp"
+
+namespace swarmbox::swarm {
+
+struct ScoutConfig {
+  std::string name;
+  Eigen::Vector3d home_m = Eigen::Vector3d::Zero();  // spawn point on the ground, world ENU [m]
+  double base_height_m = 0.23;        // body origin above the ground when landed [m]
+  double search_altitude_m = 30.0;    // above home_m.z [m]
+  double takeoff_delay_s = 0.0;
+  // Camera (airframe camera spec) and sweep.
+  double hfov_rad = 1.2;
+  int width_px = 320;
+  int height_px = 240;
+  double overlap = 0.2;               // side overlap of neighbouring swaths [-]
+  double waypoint_radius_m = 4.0;     // a lane waypoint counts as reached within this [m]
+  double cruise_speed_m_s = 5.0;
+  // Orbit around a confirmed victim.
+  double orbit_radius_m = 15.0;
+  int orbit_points = 12;
+  double orbit_lead_rad = 0.5;
+  bool lifter_present = true;         // the trial has an x8_heavy lifter
+  double orbit_time_s = 30.0;         // without a lifter: orbit this long, then resume [s]
+  // Return and landing.
+  double home_approach_m = 10.0;      // stop flocking and fly straight home within this [m]
+  double home_reached_m = 1.0;
+  // Sightings.
+  double min_report_confidence = raft::MissionState::kMinConfidence;
+  double dedupe_radius_m = raft::MissionState::kConfirmRadiusM;
+  double report_cooldown_s = 10.0;    // re-report the same place after this (a lost proposal) [s]
+  std::uint64_t first_sighting_seq = 1;  // after an agent restart: seed above any used (sim ms)
+};
+
+class ScoutBehaviour {
+ public:
+  enum class Stage {
+    kOnGround, kTakingOff, kAwaitingSector, kSearching, kSwept, kOrbiting, kReturning, kLanding,
+    kLanded,
+  };
+  static std::string_view StageName(Stage stage);
+
+  explicit ScoutBehaviour(ScoutConfig config);
+
+  // One mission tick. `out` is cleared first (its vectors keep their capacity).
+  void Step(const MissionInput& in, MissionOutput* out);
+
+  Stage stage() const { return stage_; }
+  const std::vector<Waypoint>& lanes() const { return lanes_; }
+  std::size_t lane_index() const { return lane_index_; }
+  const ScoutConfig& config() const { return config_; }
+
+ private:
+  void ReportSightings(const MissionInput& in, MissionOutput* out);
+  void PlanSector(const raft::Sector& sector, const Eigen::Vector3d& position_m);
+  const raft::Victim* OrbitTarget(const MissionInput& in) const;
+  void Enter(Stage stage, const MissionInput& in, MissionOutput* out);
+  double Altitude() const { return config_.home_m.z() + config_.search_altitude_m; }
+
+  ScoutConfig config_;
+  CameraFootprint footprint_;
+  Stage stage_ = Stage::kOnGround;
+  raft::Sector planned_sector_;
+  bool has_plan_ = false;
+  std::vector<Waypoint> lanes_;
+  std::size_t lane_index_ = 0;
+  std::uint32_t orbit_victim_ = 0;
+  double orbit_reached_s_ = -1.0;
+  std::vector<Waypoint> orbit_;
+  std::set<std::uint32_t> handled_;  // victims orbited for orbit_time_s (no lifter)
+  bool battery_low_reported_ = false;
+  std::uint64_t next_seq_ = 1;
+  struct RecentReport {
+    Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+    double t_s = -1e9;
+  };
+  std::array<RecentReport, 16> recent_{};
+  std::size_t recent_next_ = 0;
+};
+
+}  // namespace swarmbox::swarm

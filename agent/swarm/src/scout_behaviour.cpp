@@ -1,0 +1,248 @@
+#include "swarmbox/swarm/scout_behaviour.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include "swarmbox/common/result.hpp"
+
+namespace swarmbox::swarm {
+namespace {
+
+using raft::MissionPhase;
+
+bool Active(MissionPhase p) {
+  return p == MissionPhase::kSearch || p == MissionPhase::kConverge || p == MissionPhase::kRescue;
+}
+bool Over(MissionPhase p) { return p == MissionPhase::kReturn || p == MissionPhase::kComplete; }
+
+}  // namespace
+
+std::string_view RoleName(Role role) { return role == Role::kScout ? "scout" : "lifter"; }
+
+std::string_view SetpointKindName(SetpointKind kind) {
+  switch (kind) {
+    case SetpointKind::kIdle: return "idle";
+    case SetpointKind::kTakeoff: return "takeoff";
+    case SetpointKind::kPosition: return "position";
+    case SetpointKind::kFlock: return "flock";
+    case SetpointKind::kLand: return "land";
+  }
+  return "?";
+}
+
+std::string_view ScoutBehaviour::StageName(Stage stage) {
+  switch (stage) {
+    case Stage::kOnGround: return "on_ground";
+    case Stage::kTakingOff: return "taking_off";
+    case Stage::kAwaitingSector: return "awaiting_sector";
+    case Stage::kSearching: return "searching";
+    case Stage::kSwept: return "swept";
+    case Stage::kOrbiting: return "orbiting";
+    case Stage::kReturning: return "returning";
+    case Stage::kLanding: return "landing";
+    case Stage::kLanded: return "landed";
+  }
+  return "?";
+}
+
+ScoutBehaviour::ScoutBehaviour(ScoutConfig config)
+    : config_(std::move(config)),
+      footprint_(GroundFootprint(config_.search_altitude_m, config_.hfov_rad, config_.width_px,
+                                 config_.height_px)),
+      next_seq_(config_.first_sighting_seq) {
+  SWARMBOX_CHECK(!config_.name.empty());
+  SWARMBOX_CHECK(config_.first_sighting_seq > 0);
+  SWARMBOX_CHECK(config_.orbit_points >= 3 && config_.orbit_radius_m > 0);
+}
+
+void ScoutBehaviour::Enter(Stage stage, const MissionInput& in, MissionOutput* out) {
+  if (stage == stage_) return;
+  stage_ = stage;
+  LogEvent e(in.t_s, config_.name, "mission_stage");
+  e.Add("role", "scout").Add("stage", StageName(stage));
+  if (stage == Stage::kSearching && has_plan_) e.Add("lane", static_cast<std::int64_t>(lane_index_ / 2));
+  if (stage == Stage::kOrbiting) e.Add("victim", static_cast<std::int64_t>(orbit_victim_));
+  out->events.push_back(std::move(e));
+}
+
+void ScoutBehaviour::PlanSector(const raft::Sector& sector, const Eigen::Vector3d& position_m) {
+  planned_sector_ = sector;
+  has_plan_ = true;
+  lanes_ = LawnmowerWaypoints(AsRect(sector), SweepSpacing(footprint_, config_.overlap), Altitude(),
+                              footprint_, position_m.head<2>());
+  lane_index_ = 0;
+}
+
+const raft::Victim* ScoutBehaviour::OrbitTarget(const MissionInput& in) const {
+  const raft::MissionState& m = *in.mission;
+  if (m.phase() != MissionPhase::kConverge && m.phase() != MissionPhase::kRescue) return nullptr;
+  const raft::Victim* v = m.FindVictim(m.target_victim());
+  if (v == nullptr || v->status == raft::VictimStatus::kRescued) return nullptr;
+  if (handled_.count(v->id) != 0) return nullptr;
+  return v;
+}
+
+void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out) {
+  const raft::MissionState& m = *in.mission;
+  for (const GroundDetection& d : in.detections) {
+    if (d.confidence < config_.min_report_confidence) continue;
+    const Eigen::Vector2d p = d.position_m.head<2>();
+    bool known = false;
+    for (const raft::Victim& v : m.victims()) {
+      known = known || (Eigen::Vector2d(v.x_m, v.y_m) - p).norm() <= config_.dedupe_radius_m;
+    }
+    for (const RecentReport& r : recent_) {
+      known = known || ((r.position_m - p).norm() <= config_.dedupe_radius_m &&
+                        in.t_s - r.t_s < config_.report_cooldown_s);
+    }
+    if (known) continue;
+    recent_[recent_next_] = {p, in.t_s};
+    recent_next_ = (recent_next_ + 1) % recent_.size();
+    const std::uint64_t seq = next_seq_++;
+    out->proposals.push_back(raft::ReportSighting{config_.name, seq, p.x(), p.y(), d.confidence});
+    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sighting_reported")
+                                        .Add("seq", static_cast<std::uint64_t>(seq))
+                                        .Add("x", p.x(), 2)
+                                        .Add("y", p.y(), 2)
+                                        .Add("confidence", d.confidence, 3)));
+  }
+}
+
+void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
+  SWARMBOX_CHECK(in.mission != nullptr);
+  out->Clear();
+  const raft::MissionState& m = *in.mission;
+  const Eigen::Vector3d& p = in.position_m;
+  const bool airborne = stage_ != Stage::kOnGround && stage_ != Stage::kLanded;
+  const Eigen::Vector2d home_xy = config_.home_m.head<2>();
+
+  // Leaving the mission: battery low (once) or the mission is over.
+  if (airborne && stage_ != Stage::kReturning && stage_ != Stage::kLanding) {
+    if (in.battery_low && !battery_low_reported_) {
+      battery_low_reported_ = true;
+      out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "battery_low")
+                                          .Add("battery", in.battery_fraction, 3)
+                                          .Add("distance_home_m", (p.head<2>() - home_xy).norm(), 1)));
+    }
+    if (battery_low_reported_ || Over(m.phase())) Enter(Stage::kReturning, in, out);
+  }
+  if (stage_ == Stage::kOnGround && !Over(m.phase()) && in.t_s >= config_.takeoff_delay_s &&
+      !in.battery_low) {
+    Enter(Stage::kTakingOff, in, out);
+  }
+
+  // Mission stages: orbit a target, search the sector, or wait for one.
+  const bool on_mission = stage_ == Stage::kAwaitingSector || stage_ == Stage::kSearching ||
+                          stage_ == Stage::kSwept || stage_ == Stage::kOrbiting;
+  if (on_mission) {
+    const raft::Sector* sector = Active(m.phase()) ? m.SectorOf(config_.name) : nullptr;
+    if (sector != nullptr && (!has_plan_ || !(*sector == planned_sector_))) PlanSector(*sector, p);
+    const raft::Victim* target = OrbitTarget(in);
+    if (target != nullptr) {
+      if (orbit_victim_ != target->id || stage_ != Stage::kOrbiting) {
+        orbit_victim_ = target->id;
+        orbit_reached_s_ = -1.0;
+        orbit_ = OrbitWaypoints({target->x_m, target->y_m}, config_.orbit_radius_m, Altitude(),
+                                config_.orbit_points, 0.0);
+      }
+      Enter(Stage::kOrbiting, in, out);
+    } else if (sector != nullptr) {
+      Enter(lane_index_ < lanes_.size() ? Stage::kSearching : Stage::kSwept, in, out);
+    } else {
+      Enter(Stage::kAwaitingSector, in, out);
+    }
+  }
+
+  SetpointRequest& sp = out->setpoint;
+  sp = {};
+  sp.max_speed_m_s = config_.cruise_speed_m_s;
+  switch (stage_) {
+    case Stage::kOnGround:
+    case Stage::kLanded:
+      sp.kind = SetpointKind::kIdle;
+      sp.target_m = p;
+      sp.max_speed_m_s = 0;
+      break;
+    case Stage::kTakingOff:
+      sp.kind = SetpointKind::kTakeoff;
+      sp.target_m = {home_xy.x(), home_xy.y(), Altitude()};
+      sp.yaw_rad = in.yaw_rad;
+      if (p.z() >= Altitude() - 1.0) Enter(Stage::kAwaitingSector, in, out);
+      break;
+    case Stage::kAwaitingSector:
+      sp.kind = SetpointKind::kFlock;
+      sp.target_m = {home_xy.x(), home_xy.y(), Altitude()};
+      sp.yaw_rad = in.yaw_rad;
+      break;
+    case Stage::kSearching: {
+      if ((lanes_[lane_index_].position_m.head<2>() - p.head<2>()).norm() <= config_.waypoint_radius_m) {
+        ++lane_index_;
+        if (lane_index_ == lanes_.size()) {
+          out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_swept")
+                                              .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
+          Enter(Stage::kSwept, in, out);
+          sp.kind = SetpointKind::kFlock;
+          sp.target_m = lanes_.back().position_m;
+          sp.yaw_rad = in.yaw_rad;
+          break;
+        }
+      }
+      sp.kind = SetpointKind::kFlock;
+      sp.target_m = lanes_[lane_index_].position_m;
+      sp.yaw_rad = lanes_[lane_index_].yaw_rad;
+      break;
+    }
+    case Stage::kSwept: {
+      const Eigen::Vector2d c = AsRect(planned_sector_).center_m();
+      sp.kind = SetpointKind::kFlock;
+      sp.target_m = {c.x(), c.y(), Altitude()};
+      sp.yaw_rad = in.yaw_rad;
+      break;
+    }
+    case Stage::kOrbiting: {
+      const raft::Victim* v = m.FindVictim(orbit_victim_);
+      SWARMBOX_CHECK(v != nullptr);
+      const Eigen::Vector2d c(v->x_m, v->y_m);
+      const double from_centre = (p.head<2>() - c).norm();
+      if (orbit_reached_s_ < 0 && std::abs(from_centre - config_.orbit_radius_m) < 5.0) {
+        orbit_reached_s_ = in.t_s;
+      }
+      const std::size_t k =
+          NextOrbitWaypoint(orbit_, c, p.head<2>(), config_.orbit_lead_rad);
+      sp.kind = SetpointKind::kFlock;
+      sp.target_m = orbit_[k].position_m;
+      sp.yaw_rad = orbit_[k].yaw_rad;
+      if (!config_.lifter_present && orbit_reached_s_ >= 0 &&
+          in.t_s - orbit_reached_s_ >= config_.orbit_time_s) {
+        handled_.insert(orbit_victim_);
+        out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "victim_handled")
+                                            .Add("id", static_cast<std::int64_t>(orbit_victim_))
+                                            .Add("orbit_s", in.t_s - orbit_reached_s_, 1)));
+      }
+      break;
+    }
+    case Stage::kReturning: {
+      const double d = (p.head<2>() - home_xy).norm();
+      sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
+      sp.target_m = {home_xy.x(), home_xy.y(), Altitude()};
+      sp.yaw_rad = in.yaw_rad;
+      if (d <= config_.home_reached_m) Enter(Stage::kLanding, in, out);
+      break;
+    }
+    case Stage::kLanding:
+      sp.kind = SetpointKind::kLand;
+      sp.target_m = config_.home_m;
+      sp.yaw_rad = in.yaw_rad;
+      if (p.z() <= config_.home_m.z() + config_.base_height_m + 0.15 && in.velocity_m_s.norm() < 0.3) {
+        Enter(Stage::kLanded, in, out);
+      }
+      break;
+  }
+
+  const bool reporting = stage_ == Stage::kSearching || stage_ == Stage::kSwept ||
+                         stage_ == Stage::kOrbiting || stage_ == Stage::kAwaitingSector;
+  if (reporting && Active(m.phase())) ReportSightings(in, out);
+  out->mode = StageName(stage_);
+}
+
+}  // namespace swarmbox::swarm

@@ -1,0 +1,129 @@
+// The SAR mission behaviours (scout_behaviour, lifter_sequence, leader_planner) in closed loop with
+// the real raft::MissionState on the kinematic rig (mission_sim.hpp). Seeds fixed; tolerances in
+// the assertions. These check the mission contract: take off, sectors from the leader,
+// lawnmower sweeps, sightings -> confirmed victims (MissionState's confirmation rule), scouts
+// converge and orbit, the lifter's stretcher sequence, battery_low, event=mission_complete.
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "mission_sim.hpp"
+#include "swarmbox/common/logfmt.hpp"
+
+namespace swarmbox::swarm {
+namespace {
+
+using testing::MissionSim;
+using testing::MissionSimConfig;
+using testing::SimDrone;
+
+MissionSimConfig BaseConfig() {
+  MissionSimConfig c;
+  c.drones = {{"scout_1", Role::kScout, Vec3(-90, -55, 0), 0.23},
+              {"scout_2", Role::kScout, Vec3(-87, -55, 0), 0.23},
+              {"scout_3", Role::kScout, Vec3(-84, -55, 0), 0.23}};
+  c.victims_m = {Vec2(-40, 20), Vec2(60, -30)};
+  return c;
+}
+
+// The stages one drone went through, from its event=mission_stage lines.
+std::vector<std::string> Stages(const MissionSim& sim, const std::string& node) {
+  std::vector<std::string> out;
+  for (const std::string& line : sim.log()) {
+    const LogfmtFields f = ParseLogfmt(line);
+    if (FindField(f, "node") == node && FindField(f, "event") == "mission_stage") {
+      out.push_back(*FindField(f, "stage"));
+    }
+  }
+  return out;
+}
+
+bool AllDown(const MissionSim& sim, std::size_t n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    if (sim.mode(i) != "landed" && sim.mode(i) != "on_ground") return false;
+  }
+  return true;
+}
+
+TEST(MissionScenario, ScoutsAndALifterFindAndRescueEveryVictim) {
+  MissionSimConfig c = BaseConfig();
+  c.drones.push_back({"lifter", Role::kLifter, Vec3(-80, -58, 0), 0.6});
+  MissionSim sim(c);
+  const bool complete = sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 2000.0);
+  ASSERT_TRUE(complete) << "no mission_complete by t=" << sim.t_s() << ", phase "
+                        << raft::PhaseName(sim.mission().phase());
+  // Every victim confirmed once, near its true position, and rescued.
+  ASSERT_EQ(sim.mission().victims().size(), c.victims_m.size());
+  for (const raft::Victim& v : sim.mission().victims()) {
+    EXPECT_EQ(v.status, raft::VictimStatus::kRescued) << "victim " << v.id;
+    EXPECT_EQ(v.rescuer, "lifter");
+    double best = 1e9;
+    for (const Vec2& truth : c.victims_m) best = std::min(best, (truth - Vec2(v.x_m, v.y_m)).norm());
+    EXPECT_LT(best, 2.0) << "victim " << v.id;  // fake camera sigma 0.5 m per axis
+  }
+  EXPECT_EQ(sim.mission().phase(), raft::MissionPhase::kComplete);
+  EXPECT_TRUE(AllDown(sim, c.drones.size()));
+  // The stretcher is home (set down at the lifter's home), carrying the 80 kg mass last attached.
+  EXPECT_LT((sim.stretcher_m() - c.drones.back().home_m.head<2>()).norm(), 0.6);
+  EXPECT_FALSE(sim.stretcher_attached());
+  EXPECT_DOUBLE_EQ(sim.stretcher_mass_kg(), 80.0);
+  // Each scout swept its sector and orbited a victim.
+  for (const char* scout : {"scout_1", "scout_2", "scout_3"}) {
+    const std::vector<std::string> st = Stages(sim, scout);
+    EXPECT_EQ(st.front(), "taking_off") << scout;
+    EXPECT_NE(std::find(st.begin(), st.end(), "searching"), st.end()) << scout;
+    EXPECT_NE(std::find(st.begin(), st.end(), "orbiting"), st.end()) << scout;
+    EXPECT_NE(std::find(st.begin(), st.end(), "swept"), st.end()) << scout;
+    EXPECT_EQ(st.back(), "landed") << scout;
+  }
+  // The lifter's explicit rescue sequence, once per victim.
+  const std::vector<std::string> one_rescue = {
+      "takeoff_for_pickup", "attach_empty", "climb", "transit_to_victim", "descend_to_release",
+      "release", "loading", "attach_loaded", "climb_loaded", "carry_home", "descend_to_drop",
+      "release_at_home", "move_to_land", "landing", "on_ground"};
+  std::vector<std::string> expected;
+  for (std::size_t i = 0; i < c.victims_m.size(); ++i) {
+    expected.insert(expected.end(), one_rescue.begin(), one_rescue.end());
+  }
+  EXPECT_EQ(Stages(sim, "lifter"), expected);
+  // Flocking never brought two scouts closer than the 3 m they start at (homes 3 m apart; the
+  // lifter flies 15 m below them); take-offs and landings are vertical at those homes.
+  EXPECT_GT(sim.min_flocking_pair_distance_m(), 2.95);
+  EXPECT_GT(sim.min_pair_distance_m(), 2.0);
+}
+
+TEST(MissionScenario, WithoutALifterScoutsOrbitEachVictimThenComplete) {
+  MissionSim sim(BaseConfig());
+  ASSERT_TRUE(sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 2000.0));
+  EXPECT_EQ(sim.mission().victims().size(), 2u);
+  EXPECT_TRUE(sim.Logged("victim_handled"));
+  for (const raft::Victim& v : sim.mission().victims()) EXPECT_EQ(v.status, raft::VictimStatus::kConfirmed);
+  EXPECT_TRUE(AllDown(sim, 3));
+  EXPECT_GT(sim.min_flocking_pair_distance_m(), 2.95);
+  EXPECT_GT(sim.min_pair_distance_m(), 2.0);
+}
+
+TEST(MissionScenario, BatteryLowSendsEveryScoutHomeAndTheMissionEnds) {
+  MissionSimConfig c = BaseConfig();
+  c.victims_m.clear();
+  c.battery_drain_per_s = 0.8 / 60.0;  // 100% -> 20% in 60 s: low during the search
+  MissionSim sim(c);
+  ASSERT_TRUE(sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 600.0));
+  int low_events = 0;
+  for (const std::string& l : sim.log()) low_events += l.find("event=battery_low") != std::string::npos ? 1 : 0;
+  EXPECT_EQ(low_events, 3);  // once per scout
+  for (const char* scout : {"scout_1", "scout_2", "scout_3"}) {
+    const std::vector<std::string> st = Stages(sim, scout);
+    EXPECT_NE(std::find(st.begin(), st.end(), "returning"), st.end()) << scout;
+    EXPECT_EQ(st.back(), "landed") << scout;
+  }
+  // Landed at home.
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_LT((sim.position(i).head<2>() - c.drones[i].home_m.head<2>()).norm(), 1.5);
+  }
+}
+
+}  // namespace
+}  // namespace swarmbox::swarm

@@ -1,0 +1,218 @@
+#include "mission_sim.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace swarmbox::swarm::testing {
+namespace {
+
+std::string EventLine(const raft::MissionEvent& e, double t_s) {
+  using Kind = raft::MissionEvent::Kind;
+  LogEvent l(t_s, "raft", e.kind == Kind::kPhase ? "mission_state"
+                          : e.kind == Kind::kVictimConfirmed ? "victim_confirmed"
+                                                             : "victim_status");
+  if (e.kind == Kind::kPhase) {
+    l.Add("state", raft::PhaseName(e.phase));
+  } else {
+    l.Add("id", static_cast<std::int64_t>(e.victim.id)).Add("status", raft::VictimStatusName(e.victim.status));
+  }
+  return l.str();
+}
+
+}  // namespace
+
+MissionSim::MissionSim(MissionSimConfig config)
+    : config_(std::move(config)),
+      rng_(config_.seed),
+      leader_(LeaderConfig{.name = config_.drones.at(0).name, .search_area = config_.area,
+                           .retry_s = 2.0, .start_timeout_s = 60.0, .handle_time_s = 20.0}) {
+  bool lifter_present = false;
+  for (const SimDrone& d : config_.drones) lifter_present = lifter_present || d.role == Role::kLifter;
+  FlockingParams fp;
+  for (const SimDrone& d : config_.drones) {
+    pos_.push_back(d.home_m + Vec3(0, 0, d.base_height_m));
+    vel_.push_back(Vec3::Zero());
+    yaw_.push_back(0.0);
+    modes_.push_back("on_ground");
+    out_.emplace_back();
+    detections_.emplace_back();
+    flock_.emplace_back(fp, Geofence::Centered(400, 400));
+    if (d.role == Role::kScout) {
+      ScoutConfig c;
+      c.name = d.name;
+      c.home_m = d.home_m;
+      c.base_height_m = d.base_height_m;
+      c.lifter_present = lifter_present;
+      c.orbit_time_s = 15.0;
+      behaviour_of_.push_back(static_cast<int>(scouts_.size()));
+      scouts_.emplace_back(c);
+    } else {
+      LifterConfig c;
+      c.name = d.name;
+      c.home_m = d.home_m;
+      c.base_height_m = d.base_height_m;
+      c.loading_time_s = config_.loading_time_s;
+      behaviour_of_.push_back(static_cast<int>(lifters_.size()));
+      lifters_.emplace_back(c);
+      stretcher_xy_ = d.home_m.head<2>();
+    }
+  }
+}
+
+bool MissionSim::Logged(const std::string& event) const {
+  const std::string needle = "event=" + event;
+  for (const std::string& l : log_) {
+    if (l.find(needle + " ") != std::string::npos ||
+        (l.size() >= needle.size() && l.compare(l.size() - needle.size(), needle.size(), needle) == 0)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+void MissionSim::Step() {
+  const double dt = config_.dt_s;
+  t_s_ += dt;
+  // The "committed log".
+  std::stable_sort(pending_.begin(), pending_.end(),
+                   [](const Pending& a, const Pending& b) { return a.due_s < b.due_s; });
+  while (!pending_.empty() && pending_.front().due_s <= t_s_) {
+    const raft::ApplyResult r = mission_.Apply(++index_, pending_.front().command);
+    if (!r.accepted) ++rejected_;
+    for (const raft::MissionEvent& e : r.events) log_.push_back(EventLine(e, t_s_));
+    pending_.erase(pending_.begin());
+  }
+  // Fake camera at 5 Hz: victims inside 90% of a scout's footprint.
+  const bool camera = t_s_ >= next_camera_s_;
+  if (camera) next_camera_s_ += 0.2;
+  std::normal_distribution<double> noise(0.0, config_.detection_sigma_m);
+  const std::size_t n = config_.drones.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    detections_[i].clear();
+    const SimDrone& d = config_.drones[i];
+    const double height = pos_[i].z() - d.home_m.z();
+    if (!camera || d.role != Role::kScout || height < 5.0) continue;
+    const CameraFootprint fp = GroundFootprint(height, 1.2, 320, 240);
+    for (const Vec2& v : config_.victims_m) {
+      const Vec2 w = v - pos_[i].head<2>();
+      const double c = std::cos(yaw_[i]), s = std::sin(yaw_[i]);
+      const Vec2 b(c * w.x() + s * w.y(), -s * w.x() + c * w.y());  // body x forward, y left
+      if (std::abs(b.x()) > 0.45 * fp.along_m || std::abs(b.y()) > 0.45 * fp.across_m) continue;
+      GroundDetection g;
+      g.capture_time_s = t_s_;
+      g.visible_time_s = t_s_ + 0.04;
+      g.position_m = Vec3(v.x() + noise(rng_), v.y() + noise(rng_), 0.0);
+      g.sigma_m = config_.detection_sigma_m;
+      g.confidence = 0.95;
+      detections_[i].push_back(g);
+    }
+  }
+  // Behaviours.
+  const double battery = std::max(0.0, config_.battery_fraction_at_start - config_.battery_drain_per_s * t_s_);
+  for (std::size_t i = 0; i < n; ++i) {
+    const SimDrone& d = config_.drones[i];
+    MissionInput in;
+    in.t_s = t_s_;
+    in.mission = &mission_;
+    in.position_m = pos_[i];
+    in.velocity_m_s = vel_[i];
+    in.yaw_rad = yaw_[i];
+    in.battery_fraction = battery;
+    in.battery_low = battery < 0.2;
+    in.payload_attached = d.role == Role::kLifter && attached_;
+    in.detections = detections_[i];
+    MissionOutput& out = out_[i];
+    if (d.role == Role::kScout) {
+      scouts_[static_cast<std::size_t>(behaviour_of_[i])].Step(in, &out);
+    } else {
+      lifters_[static_cast<std::size_t>(behaviour_of_[i])].Step(in, &out);
+    }
+    modes_[i] = out.mode;
+    for (const LogEvent& e : out.events) log_.push_back(e.str());
+    for (const raft::MissionCommand& c : out.proposals) pending_.push_back({t_s_ + config_.commit_delay_s, c});
+    // Fake world: payload commands with the physics server's sling geometry (x8_heavy).
+    if (out.payload.action == PayloadAction::kAttach && !attached_) {
+      const double hook_to_payload = (Vec3(pos_[i].x(), pos_[i].y(), pos_[i].z() - 0.4) -
+                                      Vec3(stretcher_xy_.x(), stretcher_xy_.y(), d.home_m.z() + 0.125)).norm();
+      if (std::abs(hook_to_payload - 4.0) <= 0.5) {
+        attached_ = true;
+        payload_mass_kg_ = out.payload.mass_kg;
+        log_.push_back(LogEvent(t_s_, "world", "payload_attached").Add("mass_kg", payload_mass_kg_, 1).str());
+      }
+    } else if (out.payload.action == PayloadAction::kRelease && attached_) {
+      attached_ = false;
+      stretcher_xy_ = pos_[i].head<2>();
+      log_.push_back(LogEvent(t_s_, "world", "payload_released").str());
+    }
+  }
+  // Leader (drone 0).
+  std::vector<RosterEntry> roster;
+  for (std::size_t i = 0; i < n; ++i) {
+    roster.push_back({config_.drones[i].name, config_.drones[i].role, std::string(modes_[i])});
+  }
+  MissionOutput lead;
+  leader_.Step(t_s_, mission_, roster, &lead);
+  for (const LogEvent& e : lead.events) log_.push_back(e.str());
+  for (const raft::MissionCommand& c : lead.proposals) pending_.push_back({t_s_ + config_.commit_delay_s, c});
+
+  // Kinematics.
+  const double alpha = 1.0 - std::exp(-dt / 0.3);
+  for (std::size_t i = 0; i < n; ++i) {
+    const SimDrone& d = config_.drones[i];
+    const SetpointRequest& sp = out_[i].setpoint;
+    const double ground = d.home_m.z() + d.base_height_m;
+    Vec3 cmd = Vec3::Zero();
+    const double vmax = sp.max_speed_m_s > 0 ? sp.max_speed_m_s : 5.0;
+    switch (sp.kind) {
+      case SetpointKind::kIdle:
+        vel_[i].setZero();
+        continue;
+      case SetpointKind::kTakeoff:
+        cmd = Vec3(0, 0, std::clamp(sp.target_m.z() - pos_[i].z(), -2.0, 2.0));
+        break;
+      case SetpointKind::kPosition: {
+        Vec3 e = sp.target_m - pos_[i];
+        Vec2 h = e.head<2>();
+        if (h.norm() > vmax) h *= vmax / h.norm();
+        cmd = Vec3(h.x(), h.y(), std::clamp(e.z(), -1.5, 1.5));
+        break;
+      }
+      case SetpointKind::kFlock: {
+        scratch_.clear();
+        for (std::size_t j = 0; j < n; ++j) {
+          if (j != i && pos_[j].z() > config_.drones[j].home_m.z() + 1.0) scratch_.push_back({pos_[j], vel_[j], 0.0});
+        }
+        cmd = flock_[i].Step({pos_[i], vel_[i], sp.target_m, scratch_}, dt).velocity_m_s;
+        break;
+      }
+      case SetpointKind::kLand: {
+        Vec2 h = sp.target_m.head<2>() - pos_[i].head<2>();
+        if (h.norm() > 1.0) h = h.normalized();
+        cmd = Vec3(h.x(), h.y(), -1.0);
+        break;
+      }
+    }
+    if (sp.kind != SetpointKind::kFlock) flock_[i].Reset(vel_[i]);
+    vel_[i] += alpha * (cmd - vel_[i]);
+    pos_[i] += dt * vel_[i];
+    if (pos_[i].z() < ground) {
+      pos_[i].z() = ground;
+      vel_[i].z() = std::max(0.0, vel_[i].z());
+      if (sp.kind == SetpointKind::kLand) vel_[i].setZero();
+    }
+    if (vel_[i].head<2>().norm() > 0.5) yaw_[i] = std::atan2(vel_[i].y(), vel_[i].x());
+    if (d.role == Role::kLifter && attached_) stretcher_xy_ = pos_[i].head<2>();
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = i + 1; j < n; ++j) {
+      const double d = (pos_[i] - pos_[j]).norm();
+      if (pos_[i].z() > 2.0 && pos_[j].z() > 2.0) min_pair_m_ = std::min(min_pair_m_, d);
+      if (out_[i].setpoint.kind == SetpointKind::kFlock && out_[j].setpoint.kind == SetpointKind::kFlock) {
+        min_flock_pair_m_ = std::min(min_flock_pair_m_, d);
+      }
+    }
+  }
+}
+
+}  // namespace swarmbox::swarm::testing

@@ -1,0 +1,105 @@
+// MissionSim: a pure closed-loop test rig for the SAR mission behaviours. Kinematic drones follow
+// the behaviours' setpoint requests (kFlock through swarm::Flocking), a raft::MissionState stands
+// in for the committed log (every proposal is applied in order `commit_delay_s` after it was
+// made, which is what Raft gives when nothing fails), a fake camera turns victims inside a scout's
+// footprint into detections, and a fake world carries out payload attach/release with the
+// physics server's sling geometry (hook within sling_length +- tolerance of the stretcher).
+// Not a physics test: it checks that the behaviours, the leader planner and MissionState fit.
+#pragma once
+
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "swarmbox/swarm/flocking.hpp"
+#include "swarmbox/swarm/leader_planner.hpp"
+#include "swarmbox/swarm/lifter_sequence.hpp"
+#include "swarmbox/swarm/scout_behaviour.hpp"
+
+namespace swarmbox::swarm::testing {
+
+struct SimDrone {
+  std::string name;
+  Role role = Role::kScout;
+  Vec3 home_m = Vec3::Zero();
+  double base_height_m = 0.23;
+};
+
+struct MissionSimConfig {
+  std::uint64_t seed = 1;
+  double dt_s = 0.05;
+  double commit_delay_s = 0.3;
+  Rect area{-100, -60, 100, 60};
+  std::vector<SimDrone> drones;
+  std::vector<Vec2> victims_m;
+  double detection_sigma_m = 0.5;  // fake camera geolocation noise [m]
+  double loading_time_s = 10.0;
+  double battery_fraction_at_start = 1.0;
+  double battery_drain_per_s = 0.0;  // fraction per second (crude: tests of battery_low)
+  bool scouts_only_report_once = false;
+};
+
+class MissionSim {
+ public:
+  explicit MissionSim(MissionSimConfig config);
+
+  void Step();
+  // Runs until `until(*this)` or max_s of simulated time; returns whether `until` became true.
+  template <typename F>
+  bool RunUntil(F until, double max_s) {
+    while (t_s_ < max_s) {
+      Step();
+      if (until(*this)) return true;
+    }
+    return false;
+  }
+
+  double t_s() const { return t_s_; }
+  const raft::MissionState& mission() const { return mission_; }
+  const std::vector<std::string>& log() const { return log_; }  // every event line, in order
+  bool Logged(const std::string& event) const;                   // some line has event=<event>
+  std::string_view mode(std::size_t drone) const { return modes_[drone]; }
+  const Vec3& position(std::size_t drone) const { return pos_[drone]; }
+  const Vec2& stretcher_m() const { return stretcher_xy_; }
+  bool stretcher_attached() const { return attached_; }
+  double stretcher_mass_kg() const { return payload_mass_kg_; }
+  // Closest approach of two airborne drones (> 2 m up), and of two drones both flocking [m].
+  double min_pair_distance_m() const { return min_pair_m_; }
+  double min_flocking_pair_distance_m() const { return min_flock_pair_m_; }
+  std::size_t rejected_proposals() const { return rejected_; }
+
+ private:
+  struct Pending {
+    double due_s;
+    raft::MissionCommand command;
+  };
+
+  MissionSimConfig config_;
+  std::mt19937_64 rng_;
+  raft::MissionState mission_;
+  std::uint64_t index_ = 0;
+  std::vector<Pending> pending_;
+  std::vector<ScoutBehaviour> scouts_;         // by drone index where role == scout
+  std::vector<LifterSequence> lifters_;
+  std::vector<int> behaviour_of_;              // index into scouts_ or lifters_
+  std::vector<Flocking> flock_;
+  LeaderPlanner leader_;
+  std::vector<Vec3> pos_, vel_;
+  std::vector<double> yaw_;
+  std::vector<std::string_view> modes_;
+  std::vector<MissionOutput> out_;
+  std::vector<std::vector<GroundDetection>> detections_;
+  std::vector<NeighbourState> scratch_;
+  Vec2 stretcher_xy_ = Vec2::Zero();
+  bool attached_ = false;
+  double payload_mass_kg_ = 0.0;
+  double next_camera_s_ = 0.0;
+  double min_pair_m_ = 1e9;
+  double min_flock_pair_m_ = 1e9;
+  std::size_t rejected_ = 0;
+  std::vector<std::string> log_;
+  double t_s_ = 0.0;
+};
+
+}  // namespace swarmbox::swarm::testing
