@@ -95,6 +95,9 @@ std::vector<Vec3> Ellipse(double cx, double cy, double heading, double a, double
   return pts;
 }
 
+constexpr int kNoiseTilePx = 1024;
+constexpr double kNoiseScale = 16.0;  // tile std; frames rescale to their noise_std
+
 }  // namespace
 
 CameraIntrinsics IntrinsicsFor(const CameraSpec& spec) {
@@ -244,10 +247,27 @@ void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::
   }
 
   if (spec.noise_std > 0) {
-    noise_.create(h, w, CV_16SC3);
+    if (noise_tile_.empty()) {
+      cv::RNG tile_rng(0x6E015E);
+      noise_tile_.create(kNoiseTilePx, kNoiseTilePx, CV_16SC3);
+      tile_rng.fill(noise_tile_, cv::RNG::NORMAL, 0.0, kNoiseScale);
+    }
     cv::RNG rng(noise_seed);
-    rng.fill(noise_, cv::RNG::NORMAL, 0.0, spec.noise_std);
-    cv::add(img, noise_, img, cv::noArray(), CV_8UC3);
+    const int x0 = rng.uniform(0, kNoiseTilePx - std::min(w, kNoiseTilePx) + 1);
+    const int y0 = rng.uniform(0, kNoiseTilePx - std::min(h, kNoiseTilePx) + 1);
+    // Images larger than the tile (rare) reuse it in pieces.
+    cv::Mat scaled;
+    for (int ty = 0, ch = 0; ty < h; ty += ch) {
+      const int sy = ty == 0 ? y0 : 0;
+      ch = std::min(kNoiseTilePx - sy, h - ty);
+      for (int tx = 0, cw = 0; tx < w; tx += cw) {
+        const int sx = tx == 0 ? x0 : 0;
+        cw = std::min(kNoiseTilePx - sx, w - tx);
+        noise_tile_(cv::Rect(sx, sy, cw, ch)).convertTo(scaled, CV_16SC3, spec.noise_std / kNoiseScale);
+        cv::Mat target = img(cv::Rect(tx, ty, cw, ch));
+        cv::add(target, scaled, target, cv::noArray(), CV_8UC3);
+      }
+    }
   }
 }
 

@@ -3,6 +3,8 @@
 // order by height), victims as warm hi-vis figures (orange body ellipse + amber head) and
 // Gaussian pixel noise. Pure: no ODE, no clock; the same pose and seed give the same image.
 //
+// Pixel noise: i.i.d. Gaussian per pixel and channel, taken as a seeded random window of a large
+// pre-drawn noise tile (scaled to the camera's noise_std), so a frame costs one add.
 // Camera model: see camera_image.hpp. The ground is the plane z = 0 (mapped with one
 // homography); pixels whose rays do not hit the ground are painted sky blue.
 #pragma once
@@ -43,7 +45,7 @@ class GroundRenderer {
   double origin_x_m_ = 0;   // world x of texel column 0's left edge
   double top_y_m_ = 0;      // world y of texel row 0's top edge
   cv::Mat texture_;         // CV_8UC3
-  cv::Mat noise_;           // scratch, CV_16SC3
+  cv::Mat noise_tile_;      // CV_16SC3 i.i.d. N(0, 1) * 16, drawn once; frames use seeded windows
 };
 
 }  // namespace swarmbox::physics

@@ -89,8 +89,18 @@ struct World::Impl {
   WorldConfig config;
   WorldOptions options;
   dWorldID world = nullptr;
-  dSpaceID dynamic_space = nullptr;
-  dSpaceID static_space = nullptr;
+  // Broad phase (ours, not an ODE space: the hash space allocated and cost more than the rest of
+  // the step with 100 drones). Geoms live in no space; every sub-step sorts the moving geoms'
+  // AABBs along x (insertion sort: nearly sorted from the last sub-step) and sweeps.
+  struct Bound {
+    dReal aabb[6];  // min x, max x, min y, max y, min z, max z
+    dGeomID geom;
+    GeomTag* tag;
+  };
+  std::vector<Bound> bounds;
+  std::vector<std::uint32_t> order;
+  std::vector<dGeomID> obstacle_geoms;
+  std::vector<std::array<dReal, 6>> obstacle_aabbs;
   dGeomID ground = nullptr;
   dJointGroupID contacts = nullptr;
   std::vector<std::unique_ptr<GeomTag>> obstacle_tags;
@@ -119,8 +129,7 @@ struct World::Impl {
     }
     if (contacts) dJointGroupDestroy(contacts);
     if (ground) dGeomDestroy(ground);
-    if (static_space) dSpaceDestroy(static_space);
-    if (dynamic_space) dSpaceDestroy(dynamic_space);
+    for (dGeomID g : obstacle_geoms) dGeomDestroy(g);
     if (world) dWorldDestroy(world);
   }
 
@@ -226,13 +235,6 @@ struct World::Impl {
     if (t2 && t2->kind == GeomTag::kDrone) OnDroneContact(t2->index, p1, v1, normal);
   }
 
-  void CollideGround(dGeomID g, const GeomTag* t) {
-    dReal aabb[6];
-    dGeomGetAABB(g, aabb);
-    if (aabb[4] > kGroundCheckMarginM) return;
-    Collide(ground, g, nullptr, t);
-  }
-
   void ApplyForces(Drone& d) {
     const dReal* R = dBodyGetRotation(d.body);
     const Vec3 v_air_b = RotRT(R, V(dBodyGetLinearVel(d.body)) - wind_now);
@@ -264,6 +266,51 @@ struct World::Impl {
     }
   }
 
+  static bool Overlap(const dReal* a, const dReal* b) {
+    return a[0] <= b[1] && b[0] <= a[1] && a[2] <= b[3] && b[2] <= a[3] && a[4] <= b[5] && b[4] <= a[5];
+  }
+
+  void BroadPhase() {
+    std::size_t n = 0;
+    for (auto& d : drones) {
+      Bound& b = bounds[n++];
+      dGeomGetAABB(d->geom, b.aabb);
+      b.geom = d->geom;
+      b.tag = d->tag.get();
+      if (d->payload_geom) {
+        Bound& p = bounds[n++];
+        dGeomGetAABB(d->payload_geom, p.aabb);
+        p.geom = d->payload_geom;
+        p.tag = d->payload_tag.get();
+      }
+    }
+    // Insertion sort by min x.
+    for (std::size_t i = 1; i < order.size(); ++i) {
+      const std::uint32_t key = order[i];
+      const dReal kx = bounds[key].aabb[0];
+      std::size_t j = i;
+      while (j > 0 && bounds[order[j - 1]].aabb[0] > kx) {
+        order[j] = order[j - 1];
+        --j;
+      }
+      order[j] = key;
+    }
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      const Bound& a = bounds[order[i]];
+      for (std::size_t j = i + 1; j < order.size(); ++j) {
+        const Bound& b = bounds[order[j]];
+        if (b.aabb[0] > a.aabb[1]) break;
+        if (Overlap(a.aabb, b.aabb)) NearCallback(this, a.geom, b.geom);
+      }
+      for (std::size_t k = 0; k < obstacle_geoms.size(); ++k) {
+        if (Overlap(a.aabb, obstacle_aabbs[k].data())) {
+          Collide(a.geom, obstacle_geoms[k], a.tag, static_cast<GeomTag*>(dGeomGetData(obstacle_geoms[k])));
+        }
+      }
+      if (a.aabb[4] <= kGroundCheckMarginM) Collide(ground, a.geom, nullptr, a.tag);
+    }
+  }
+
   void SubStep() {
     for (auto& d : drones) ApplyForces(*d);
     for (auto& d : drones) {
@@ -271,14 +318,7 @@ struct World::Impl {
       d->prev_partner_count = d->partner_count;
       d->partner_count = 0;
     }
-    dSpaceCollide(dynamic_space, this, &NearCallback);
-    if (!config.obstacles.empty()) {
-      dSpaceCollide2(reinterpret_cast<dGeomID>(dynamic_space), reinterpret_cast<dGeomID>(static_space), this, &NearCallback);
-    }
-    for (auto& d : drones) {
-      CollideGround(d->geom, d->tag.get());
-      if (d->payload_geom) CollideGround(d->payload_geom, d->payload_tag.get());
-    }
+    BroadPhase();
     dWorldStep(world, dt_s);
     dJointGroupEmpty(contacts);
   }
@@ -374,20 +414,21 @@ Result<std::unique_ptr<World>> World::Create(const WorldConfig& config, const Wo
   dWorldSetCFM(w.world, 1e-7);
   dWorldSetContactSurfaceLayer(w.world, 0.001);
   dWorldSetContactMaxCorrectingVel(w.world, 0.5);
-  w.dynamic_space = dHashSpaceCreate(nullptr);
-  dHashSpaceSetLevels(w.dynamic_space, -1, 4);
-  w.static_space = dSimpleSpaceCreate(nullptr);
   w.ground = dCreatePlane(nullptr, 0, 0, 1, 0);
   w.contacts = dJointGroupCreate(0);
   for (std::size_t k = 0; k < w.config.obstacles.size(); ++k) {
     const ObstacleBox& b = w.config.obstacles[k];
-    dGeomID g = dCreateBox(w.static_space, b.size_m.x, b.size_m.y, b.size_m.z);
+    dGeomID g = dCreateBox(nullptr, b.size_m.x, b.size_m.y, b.size_m.z);
     dGeomSetPosition(g, b.center_m.x, b.center_m.y, b.center_m.z);
     dMatrix3 R;
     dRFromAxisAndAngle(R, 0, 0, 1, b.yaw_rad);
     dGeomSetRotation(g, R);
     w.obstacle_tags.push_back(std::make_unique<GeomTag>(GeomTag{GeomTag::kObstacle, k}));
     dGeomSetData(g, w.obstacle_tags.back().get());
+    w.obstacle_geoms.push_back(g);
+    std::array<dReal, 6> aabb{};
+    dGeomGetAABB(g, aabb.data());
+    w.obstacle_aabbs.push_back(aabb);
   }
   w.renderer = std::make_unique<GroundRenderer>(w.config);
   w.wind.Advance(0.0);
@@ -450,7 +491,7 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
   const dQuaternion dq = {q.w, q.x, q.y, q.z};
   dBodySetQuaternion(d->body, dq);
   dBodySetAutoDisableFlag(d->body, 0);
-  d->geom = dCreateBox(w.dynamic_space, af.collision_box_m.x, af.collision_box_m.y, af.collision_box_m.z);
+  d->geom = dCreateBox(nullptr, af.collision_box_m.x, af.collision_box_m.y, af.collision_box_m.z);
   dGeomSetBody(d->geom, d->body);
   dGeomSetOffsetPosition(d->geom, af.collision_offset_m.x, af.collision_offset_m.y, af.collision_offset_m.z);
   d->tag = std::make_unique<GeomTag>(GeomTag{GeomTag::kDrone, index});
@@ -472,7 +513,7 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
     }
     dBodySetPosition(d->payload_body, at.x, at.y, at.z);
     dBodySetQuaternion(d->payload_body, dq);
-    d->payload_geom = dCreateBox(w.dynamic_space, payload->size_m.x, payload->size_m.y, payload->size_m.z);
+    d->payload_geom = dCreateBox(nullptr, payload->size_m.x, payload->size_m.y, payload->size_m.z);
     dGeomSetBody(d->payload_geom, d->payload_body);
     d->payload_tag = std::make_unique<GeomTag>(GeomTag{GeomTag::kPayload, index});
     dGeomSetData(d->payload_geom, d->payload_tag.get());
@@ -489,6 +530,11 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
     dJointSetBallAnchor(added.sling, hook.x, hook.y, hook.z);
   }
   added.prev_velocity = V(dBodyGetLinearVel(added.body));
+  // Broad-phase slots for the new geoms (allocation happens here, not in Step()).
+  const std::size_t geoms = w.bounds.size() + (added.payload_geom ? 2 : 1);
+  w.bounds.resize(geoms);
+  w.order.clear();
+  for (std::size_t k = 0; k < geoms; ++k) w.order.push_back(static_cast<std::uint32_t>(k));
   w.SampleSensors(added);
   return index;
 }
