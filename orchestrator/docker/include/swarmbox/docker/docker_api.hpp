@@ -8,8 +8,7 @@
 //   ContainerSpec spec;
 //   spec.name = "t1-drone_1"; spec.image = tag; spec.user = "1000:1000";
 //   spec.labels = SwarmboxLabels(run_id, trial_id, "drone_1");
-//   spec.networks = {{.network = sim_id, .ipv4_address = "10.77.1.10"},
-//                    {.network = mesh_id, .ipv4_address = "10.77.2.10"}};
+//   spec.networks = {EndpointSpec{sim_id, "10.77.1.10", {}}, EndpointSpec{mesh_id, "10.77.2.10", {}}};
 //   auto id = api->CreateContainer(spec);             // all networks attached on return
 //   if (!id) return id.error().Context("creating drone_1");
 //   SWARMBOX_TRY(api->StartContainer(*id));
@@ -199,6 +198,7 @@ struct ContainerInfo {
   ContainerState state;
   Labels labels;
   std::map<std::string, std::string> network_ips;  // network name -> IPv4 address
+  bool tty = false;  // created with a TTY: its logs are raw, not multiplexed
 };
 
 struct ContainerSummary {
@@ -246,6 +246,7 @@ struct ExecState {
   bool running = false;
   std::optional<std::int64_t> exit_code;  // set once the process has ended
   int pid = 0;
+  bool tty = false;
 };
 
 // --- events ---------------------------------------------------------------------------------------

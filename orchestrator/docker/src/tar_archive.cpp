@@ -1,0 +1,178 @@
+#include "swarmbox/docker/tar_archive.hpp"
+
+#include <archive.h>
+#include <archive_entry.h>
+
+#include <utility>
+
+namespace swarmbox::docker {
+
+struct TarWriter::Impl {
+  archive* a = nullptr;
+  std::string out;
+  bool failed = false;
+  bool finished = false;
+};
+
+namespace {
+
+la_ssize_t AppendToString(archive* /*a*/, void* user, const void* buffer, size_t length) {
+  static_cast<std::string*>(user)->append(static_cast<const char*>(buffer), length);
+  return static_cast<la_ssize_t>(length);
+}
+
+std::string Normalize(std::string_view path) {
+  while (!path.empty() && path.front() == '/') path.remove_prefix(1);
+  return std::string(path);
+}
+
+Error ArchiveError(archive* a, std::string_view doing) {
+  const char* text = archive_error_string(a);
+  return Error(ErrorCode::kInternal,
+               std::string(doing) + ": " + (text != nullptr ? text : "unknown libarchive error"),
+               "libarchive");
+}
+
+}  // namespace
+
+TarWriter::TarWriter() : impl_(std::make_unique<Impl>()) {
+  impl_->a = archive_write_new();
+  SWARMBOX_CHECK(impl_->a != nullptr);
+  archive_write_set_format_pax_restricted(impl_->a);
+  archive_write_set_bytes_in_last_block(impl_->a, 1);
+  if (archive_write_open(impl_->a, &impl_->out, nullptr, &AppendToString, nullptr) != ARCHIVE_OK) {
+    impl_->failed = true;
+  }
+}
+
+TarWriter::~TarWriter() {
+  if (impl_->a != nullptr) archive_write_free(impl_->a);
+}
+
+Status TarWriter::Add(const TarEntry& entry) {
+  if (impl_->finished) return Error(ErrorCode::kInternal, "tar already finished", "libarchive");
+  if (impl_->failed) return ArchiveError(impl_->a, "tar writer failed earlier");
+  const std::string path = Normalize(entry.path);
+  if (path.empty()) return Error(ErrorCode::kInvalidArgument, "tar entry with an empty path");
+  archive_entry* e = archive_entry_new();
+  archive_entry_set_pathname(e, path.c_str());
+  archive_entry_set_uid(e, entry.uid);
+  archive_entry_set_gid(e, entry.gid);
+  archive_entry_set_mtime(e, entry.mtime_unix_s, 0);
+  switch (entry.type) {
+    case TarEntry::Type::kFile:
+      archive_entry_set_filetype(e, AE_IFREG);
+      archive_entry_set_perm(e, entry.mode);
+      archive_entry_set_size(e, static_cast<la_int64_t>(entry.content.size()));
+      break;
+    case TarEntry::Type::kDirectory:
+      archive_entry_set_filetype(e, AE_IFDIR);
+      archive_entry_set_perm(e, entry.mode);
+      archive_entry_set_size(e, 0);
+      break;
+    case TarEntry::Type::kSymlink:
+      archive_entry_set_filetype(e, AE_IFLNK);
+      archive_entry_set_perm(e, 0777);
+      archive_entry_set_symlink(e, entry.content.c_str());
+      archive_entry_set_size(e, 0);
+      break;
+  }
+  Status status = Ok{};
+  if (archive_write_header(impl_->a, e) != ARCHIVE_OK) {
+    status = ArchiveError(impl_->a, "writing tar header for " + path);
+  } else if (entry.type == TarEntry::Type::kFile && !entry.content.empty()) {
+    const la_ssize_t n = archive_write_data(impl_->a, entry.content.data(), entry.content.size());
+    if (n < 0 || static_cast<std::size_t>(n) != entry.content.size()) {
+      status = ArchiveError(impl_->a, "writing tar data for " + path);
+    }
+  }
+  archive_entry_free(e);
+  if (!status) impl_->failed = true;
+  return status;
+}
+
+Status TarWriter::AddFile(std::string_view path, std::string_view content, std::uint32_t mode) {
+  return Add(TarEntry{.type = TarEntry::Type::kFile,
+                      .path = std::string(path),
+                      .content = std::string(content),
+                      .mode = mode});
+}
+
+Status TarWriter::AddDirectory(std::string_view path, std::uint32_t mode) {
+  return Add(TarEntry{.type = TarEntry::Type::kDirectory, .path = std::string(path), .content = {}, .mode = mode});
+}
+
+Status TarWriter::AddSymlink(std::string_view path, std::string_view target) {
+  return Add(TarEntry{.type = TarEntry::Type::kSymlink,
+                      .path = std::string(path),
+                      .content = std::string(target),
+                      .mode = 0777});
+}
+
+Result<std::string> TarWriter::Finish() {
+  if (impl_->finished) return Error(ErrorCode::kInternal, "tar already finished", "libarchive");
+  impl_->finished = true;
+  if (impl_->failed) return ArchiveError(impl_->a, "tar writer failed earlier");
+  if (archive_write_close(impl_->a) != ARCHIVE_OK) return ArchiveError(impl_->a, "closing tar");
+  return std::move(impl_->out);
+}
+
+Result<std::vector<TarEntry>> ReadTar(std::string_view bytes) {
+  archive* a = archive_read_new();
+  SWARMBOX_CHECK(a != nullptr);
+  archive_read_support_format_tar(a);
+  archive_read_support_filter_all(a);
+  std::vector<TarEntry> entries;
+  if (archive_read_open_memory(a, bytes.data(), bytes.size()) != ARCHIVE_OK) {
+    Error e = ArchiveError(a, "opening tar");
+    archive_read_free(a);
+    return Error(ErrorCode::kProtocol, e.message(), e.where());
+  }
+  archive_entry* e = nullptr;
+  while (true) {
+    const int rc = archive_read_next_header(a, &e);
+    if (rc == ARCHIVE_EOF) break;
+    if (rc != ARCHIVE_OK && rc != ARCHIVE_WARN) {
+      Error err = ArchiveError(a, "reading tar header");
+      archive_read_free(a);
+      return Error(ErrorCode::kProtocol, err.message(), err.where());
+    }
+    TarEntry entry;
+    entry.path = Normalize(archive_entry_pathname(e) != nullptr ? archive_entry_pathname(e) : "");
+    entry.mode = static_cast<std::uint32_t>(archive_entry_perm(e));
+    entry.uid = static_cast<std::uint32_t>(archive_entry_uid(e));
+    entry.gid = static_cast<std::uint32_t>(archive_entry_gid(e));
+    entry.mtime_unix_s = archive_entry_mtime(e);
+    const auto type = archive_entry_filetype(e);
+    if (type == AE_IFREG && archive_entry_hardlink(e) == nullptr) {
+      entry.type = TarEntry::Type::kFile;
+      char buffer[64 * 1024];
+      while (true) {
+        const la_ssize_t n = archive_read_data(a, buffer, sizeof(buffer));
+        if (n < 0) {
+          Error err = ArchiveError(a, "reading tar data of " + entry.path);
+          archive_read_free(a);
+          return Error(ErrorCode::kProtocol, err.message(), err.where());
+        }
+        if (n == 0) break;
+        entry.content.append(buffer, static_cast<std::size_t>(n));
+      }
+    } else if (type == AE_IFDIR) {
+      entry.type = TarEntry::Type::kDirectory;
+    } else if (type == AE_IFLNK) {
+      entry.type = TarEntry::Type::kSymlink;
+      const char* target = archive_entry_symlink(e);
+      entry.content = target != nullptr ? target : "";
+    } else {
+      archive_read_free(a);
+      return Error(ErrorCode::kProtocol,
+                   "unsupported tar entry type for " + entry.path + " (hard link or special file)",
+                   "libarchive");
+    }
+    entries.push_back(std::move(entry));
+  }
+  archive_read_free(a);
+  return entries;
+}
+
+}  // namespace swarmbox::docker
