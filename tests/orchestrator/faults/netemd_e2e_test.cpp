@@ -1,0 +1,307 @@
+// End to end: the userspace radio plan (swarmbox-netemd on NFQUEUE, iptables statistic) on a real
+// veth pair between two network namespaces this test creates and always deletes. Needs root and
+// the kernel's nfnetlink_queue; without them the test FAILS with the reason (it never skips).
+//
+// One-way delay is measured directly: both UDP sockets live in this process (each created inside
+// its namespace), so send and receive times come from the same CLOCK_MONOTONIC.
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <sched.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <thread>
+#include <vector>
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+
+#include "swarmbox/faults/command_runner.hpp"
+#include "swarmbox/faults/radio_plan.hpp"
+#include "test_util.hpp"
+
+namespace swarmbox::faults {
+namespace {
+
+using testing::Yaml;
+
+std::int64_t NowUs() {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
+}
+
+struct Sample {
+  std::uint32_t sent = 0;
+  std::vector<double> delay_ms;  // per received packet
+  std::uint32_t received() const { return static_cast<std::uint32_t>(delay_ms.size()); }
+  double Mean() const {
+    double s = 0;
+    for (double d : delay_ms) s += d;
+    return s / static_cast<double>(delay_ms.size());
+  }
+  double StdDev() const {
+    const double m = Mean();
+    double s = 0;
+    for (double d : delay_ms) s += (d - m) * (d - m);
+    return std::sqrt(s / static_cast<double>(delay_ms.size() - 1));
+  }
+  double Quantile(double q) const {
+    std::vector<double> v = delay_ms;
+    std::sort(v.begin(), v.end());
+    return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
+  }
+};
+
+class NetnsPair : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_EQ(geteuid(), 0u) << "this e2e test creates network namespaces and needs root (CAP_SYS_ADMIN, "
+                                "CAP_NET_ADMIN); run it as root";
+    const std::string tag = std::to_string(getpid());
+    ns_a_ = "sbf-" + tag + "-a";
+    ns_b_ = "sbf-" + tag + "-b";
+    if_a_ = "sbfa" + tag;
+    if_b_ = "sbfb" + tag;
+    dir_ = std::filesystem::temp_directory_path() / ("swarmbox-faults-e2e-" + tag);
+    std::filesystem::create_directories(dir_ / "a");
+    std::filesystem::create_directories(dir_ / "b");
+    created_ = true;
+    Must({"ip", "netns", "add", ns_a_});
+    Must({"ip", "netns", "add", ns_b_});
+    Must({"ip", "link", "add", if_a_, "netns", ns_a_, "type", "veth", "peer", "name", if_b_, "netns", ns_b_});
+    Must({"ip", "-n", ns_a_, "addr", "add", std::string(kAddrA) + "/24", "dev", if_a_});
+    Must({"ip", "-n", ns_b_, "addr", "add", std::string(kAddrB) + "/24", "dev", if_b_});
+    Must({"ip", "-n", ns_a_, "link", "set", if_a_, "up"});
+    Must({"ip", "-n", ns_b_, "link", "set", if_b_, "up"});
+  }
+
+  void TearDown() override {
+    if (!created_) return;
+    // Stop any daemon the test left (their pidfiles), then delete the namespaces (veth and
+    // iptables rules go with them) and the scratch directory. Best effort, every path.
+    for (const char* side : {"a", "b"}) {
+      std::error_code ec;
+      for (const auto& entry : std::filesystem::directory_iterator(dir_ / side, ec)) {
+        (void)runner_.Run({SWARMBOX_NETEMD_PATH, "stop", "--pidfile", entry.path().string()});
+      }
+    }
+    (void)runner_.Run({"ip", "netns", "del", ns_a_});
+    (void)runner_.Run({"ip", "netns", "del", ns_b_});
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+    auto left = runner_.Run({"ip", "netns", "list"});
+    if (left) {
+      EXPECT_EQ(left->stdout_text.find("sbf-" + std::to_string(getpid())), std::string::npos);
+    }
+  }
+
+  void Must(const std::vector<std::string>& argv) {
+    auto out = runner_.Run(argv);
+    ASSERT_TRUE(out) << out.error().ToString();
+    ASSERT_EQ(out->exit_code, 0) << "`" << CommandText(argv) << "` failed: " << out->stderr_text;
+  }
+
+  // A UDP socket created inside namespace `ns`.
+  int SocketIn(const std::string& ns) {
+    const int self = open("/proc/self/ns/net", O_RDONLY | O_CLOEXEC);
+    const int target = open(("/run/netns/" + ns).c_str(), O_RDONLY | O_CLOEXEC);
+    EXPECT_GE(self, 0);
+    EXPECT_GE(target, 0) << "no /run/netns/" << ns;
+    EXPECT_EQ(setns(target, CLONE_NEWNET), 0) << std::strerror(errno);
+    const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    EXPECT_EQ(setns(self, CLONE_NEWNET), 0) << std::strerror(errno);
+    close(self);
+    close(target);
+    return fd;
+  }
+
+  LinkTarget Link(const std::string& node, const std::string& iface, const std::string& peer,
+                  const std::string& peer_ip) {
+    return LinkTarget{node, iface, {{peer, peer_ip}}, kAssumedLinkRateKbit};
+  }
+
+  RadioPlanOptions Options(const char* side) {
+    RadioPlanOptions o;
+    o.seed = 42;
+    o.netemd = SWARMBOX_NETEMD_PATH;
+    o.pid_dir = (dir_ / side).string();
+    return o;
+  }
+
+  // Sends `count` datagrams A -> B every `spacing_us`, returns what B received and when.
+  Sample Measure(int count, std::int64_t spacing_us) {
+    Sample sample;
+    const int tx = SocketIn(ns_a_);
+    const int rx = SocketIn(ns_b_);
+    EXPECT_GE(tx, 0);
+    EXPECT_GE(rx, 0);
+    sockaddr_in to{};
+    to.sin_family = AF_INET;
+    to.sin_port = htons(kPort);
+    inet_pton(AF_INET, kAddrB, &to.sin_addr);
+    EXPECT_EQ(bind(rx, reinterpret_cast<sockaddr*>(&to), sizeof to), 0) << std::strerror(errno);
+    timeval tv{0, 100000};
+    setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+    int big = 4 << 20;
+    setsockopt(rx, SOL_SOCKET, SO_RCVBUF, &big, sizeof big);
+    std::atomic<bool> done{false};
+    std::map<std::uint32_t, double> got;
+    std::thread receiver([&] {
+      std::int64_t quiet_since = 0;
+      for (;;) {
+        std::int64_t msg[2];
+        const ssize_t n = recv(rx, msg, sizeof msg, 0);
+        const std::int64_t now = NowUs();
+        if (n == static_cast<ssize_t>(sizeof msg)) {
+          got[static_cast<std::uint32_t>(msg[0])] = static_cast<double>(now - msg[1]) / 1000.0;
+          quiet_since = 0;
+          continue;
+        }
+        if (!done) continue;
+        if (quiet_since == 0) quiet_since = now;
+        if (now - quiet_since > 1500000) break;  // 1.5 s without packets after the last send
+      }
+    });
+    const std::int64_t start = NowUs();
+    for (int i = 0; i < count; ++i) {
+      const std::int64_t due = start + i * spacing_us;
+      while (NowUs() < due) {
+        timespec ts{0, 100000};
+        nanosleep(&ts, nullptr);
+      }
+      std::int64_t msg[2] = {i, NowUs()};
+      if (sendto(tx, msg, sizeof msg, 0, reinterpret_cast<sockaddr*>(&to), sizeof to) == sizeof msg) ++sample.sent;
+    }
+    done = true;
+    receiver.join();
+    close(tx);
+    close(rx);
+    for (const auto& [seq, d] : got) sample.delay_ms.push_back(d);
+    return sample;
+  }
+
+  std::string IptablesRules(const std::string& ns) {
+    auto out = runner_.Run({"ip", "netns", "exec", ns, "iptables", "-w", "-S"});
+    return out ? out->stdout_text : out.error().ToString();
+  }
+
+  static constexpr const char* kAddrA = "10.213.7.1";
+  static constexpr const char* kAddrB = "10.213.7.2";
+  static constexpr std::uint16_t kPort = 47001;
+
+  PosixCommandRunner runner_;
+  std::string ns_a_, ns_b_, if_a_, if_b_;
+  std::filesystem::path dir_;
+  bool created_ = false;
+};
+
+TEST_F(NetnsPair, UserspacePlanDelaysJittersAndDropsAsSpecified) {
+  // The mesh-wide block applied to both agents, as the runner does for network.mesh.
+  auto rules = ParseRadioRules(Yaml("{delay_ms: 50, jitter_ms: 10, distribution: normal, loss: 0.05}"), "radio");
+  ASSERT_TRUE(rules) << rules.error().ToString();
+  auto plan_a = PlanRadio(*rules, Link("a", if_a_, "b", kAddrB), Mechanism::kUserspace, Options("a"));
+  auto plan_b = PlanRadio(*rules, Link("b", if_b_, "a", kAddrA), Mechanism::kUserspace, Options("b"));
+  ASSERT_TRUE(plan_a && plan_b);
+  PrefixCommandRunner in_a(runner_, {"ip", "netns", "exec", ns_a_});
+  PrefixCommandRunner in_b(runner_, {"ip", "netns", "exec", ns_b_});
+  Status applied_a = RunCommands(in_a, plan_a->apply);
+  ASSERT_TRUE(applied_a) << applied_a.error().ToString();
+  Status applied_b = RunCommands(in_b, plan_b->apply);
+  ASSERT_TRUE(applied_b) << applied_b.error().ToString();
+  EXPECT_NE(IptablesRules(ns_a_).find("-A SWARMBOX-RADIO-OUT -j NFQUEUE --queue-num 0 --queue-bypass"), std::string::npos);
+
+  const Sample s = Measure(3000, 1000);  // 3,000 datagrams, 1 ms apart
+  ASSERT_EQ(s.sent, 3000u);
+  ASSERT_GT(s.received(), 2500u);
+  const double loss = 1.0 - static_cast<double>(s.received()) / s.sent;
+  std::printf("userspace plan, 50+-10 ms normal, loss 5%%: sent %u received %u loss %.2f%% mean %.2f ms "
+              "sd %.2f ms p50 %.2f ms p99 %.2f ms\n",
+              s.sent, s.received(), 100 * loss, s.Mean(), s.StdDev(), s.Quantile(0.5), s.Quantile(0.99));
+  RecordProperty("mean_delay_ms", std::to_string(s.Mean()));
+  RecordProperty("sd_delay_ms", std::to_string(s.StdDev()));
+  RecordProperty("loss", std::to_string(loss));
+  // Loss: binomial with p = 0.05 over 3,000 packets, sd = sqrt(0.05 x 0.95 / 3000) = 0.40%;
+  // allow 4 sd (1.6%).
+  EXPECT_NEAR(loss, 0.05, 0.016);
+  // Delay: the standard error of the mean of N(50, 10) over ~2,850 packets is 0.19 ms; allow
+  // 5 of them below (0.95 ms) and, above, 5 of them plus 3 ms for the daemon's and this shared
+  // machine's scheduling latency.
+  EXPECT_GT(s.Mean(), 50.0 - 0.95);
+  EXPECT_LT(s.Mean(), 50.0 + 0.95 + 3.0);
+  // Spread: the sample sd of ~2,850 normal values has a relative standard error of 1.3%; allow 15%
+  // for the same scheduling noise.
+  EXPECT_NEAR(s.StdDev(), 10.0, 1.5);
+
+  // Undo: chains, hooks and daemons gone, traffic back to a bare veth.
+  Status undone_a = RunAllCommands(in_a, plan_a->undo);
+  EXPECT_TRUE(undone_a) << undone_a.error().ToString();
+  Status undone_b = RunAllCommands(in_b, plan_b->undo);
+  EXPECT_TRUE(undone_b) << undone_b.error().ToString();
+  EXPECT_EQ(IptablesRules(ns_a_).find("SWARMBOX"), std::string::npos) << IptablesRules(ns_a_);
+  EXPECT_EQ(IptablesRules(ns_b_).find("SWARMBOX"), std::string::npos) << IptablesRules(ns_b_);
+  EXPECT_TRUE(std::filesystem::is_empty(dir_ / "a"));
+  const Sample after = Measure(300, 1000);
+  EXPECT_EQ(after.received(), after.sent);
+  EXPECT_LT(after.Mean(), 5.0);
+}
+
+TEST_F(NetnsPair, FixedDelayHasATightSpread) {
+  auto rules = ParseRadioRules(Yaml("{delay_ms: 50}"), "radio");
+  ASSERT_TRUE(rules);
+  auto plan = PlanRadio(*rules, Link("a", if_a_, "b", kAddrB), Mechanism::kUserspace, Options("a"));
+  ASSERT_TRUE(plan);
+  PrefixCommandRunner in_a(runner_, {"ip", "netns", "exec", ns_a_});
+  Status applied = RunCommands(in_a, plan->apply);
+  ASSERT_TRUE(applied) << applied.error().ToString();
+  const Sample s = Measure(1000, 2000);
+  ASSERT_EQ(s.received(), s.sent);  // no loss was asked for
+  std::printf("userspace plan, fixed 50 ms: mean %.3f ms p50 %.3f ms p99 %.3f ms max %.3f ms\n", s.Mean(),
+              s.Quantile(0.5), s.Quantile(0.99), s.Quantile(1.0));
+  // Never early; late by the daemon's wake-up latency only. On an idle machine that is +50.2 ms,
+  // p99 +51 ms (issue facts); this 2-core machine is shared with seven builds, which we measured
+  // to push p99 to ~58 ms, so the tail bound is 65 ms while the median stays within 1.5 ms.
+  EXPECT_GE(s.Quantile(0.0), 50.0);
+  EXPECT_LT(s.Quantile(0.5), 51.5);
+  EXPECT_LT(s.Quantile(0.99), 65.0);
+  EXPECT_TRUE(RunAllCommands(in_a, plan->undo));
+}
+
+TEST_F(NetnsPair, TrafficFlowsWhenTheDaemonDies) {
+  // --queue-bypass: with no daemon bound to the queue the kernel accepts the packets.
+  auto rules = ParseRadioRules(Yaml("{delay_ms: 200}"), "radio");
+  ASSERT_TRUE(rules);
+  auto plan = PlanRadio(*rules, Link("a", if_a_, "b", kAddrB), Mechanism::kUserspace, Options("a"));
+  ASSERT_TRUE(plan);
+  PrefixCommandRunner in_a(runner_, {"ip", "netns", "exec", ns_a_});
+  Status applied = RunCommands(in_a, plan->apply);
+  ASSERT_TRUE(applied) << applied.error().ToString();
+  Must({SWARMBOX_NETEMD_PATH, "stop", "--pidfile", (dir_ / "a" / "swarmbox-netemd-0.pid").string()});
+  EXPECT_NE(IptablesRules(ns_a_).find("NFQUEUE"), std::string::npos);  // the rule is still there
+  const Sample s = Measure(200, 2000);
+  EXPECT_EQ(s.received(), s.sent);
+  EXPECT_LT(s.Mean(), 5.0);
+}
+
+TEST_F(NetnsPair, DaemonReportsABusyQueue) {
+  auto first = runner_.Run({"ip", "netns", "exec", ns_a_, SWARMBOX_NETEMD_PATH, "run", "--queue", "3", "--pidfile",
+                            (dir_ / "a" / "q3.pid").string(), "--daemonize"});
+  ASSERT_TRUE(first);
+  ASSERT_EQ(first->exit_code, 0) << first->stderr_text;
+  auto second = runner_.Run({"ip", "netns", "exec", ns_a_, SWARMBOX_NETEMD_PATH, "run", "--queue", "3", "--daemonize"});
+  ASSERT_TRUE(second);
+  EXPECT_EQ(second->exit_code, 1);
+  EXPECT_NE(second->stderr_text.find("nfq_create_queue 3"), std::string::npos) << second->stderr_text;
+}
+
+}  // namespace
+}  // namespace swarmbox::faults
