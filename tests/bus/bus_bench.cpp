@@ -10,7 +10,9 @@
 // Throughput: `window` pings in flight; round_trips_s counts completed round trips per second,
 // msgs_s = 2 * round_trips_s (each round trip is two messages), mb_s = msgs_s * payload_bytes.
 // Options: --quick, --backend=cyclonedds|fastdds|all, --mode=same_process|two_process|all,
-//          --size=small|large|all, --domain=<first domain id, default 200>, --n=<round trips>.
+//          --size=small|large|all, --domain=<first domain id, default 200>, --n=<round trips>,
+//          --interface=<name, default lo>, --echo-backend=<backend of the echo; default: the same>
+//          (cross-vendor figures; the line then carries echo_backend=...).
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -106,13 +108,25 @@ double Percentile(std::vector<double> v, double q) {
   return v[std::min(idx, v.size() - 1)];
 }
 
+struct Scenario {
+  std::string backend;
+  std::string echo_backend;
+  std::string mode;
+  std::string size;
+  std::string interface;
+  int domain = 0;
+};
+
 template <BusMessage T>
-int RunScenario(const std::string& backend, const std::string& mode, const std::string& size,
-                int domain, T ping, std::size_t payload_bytes, int n, int throughput_n) {
-  testing::EchoOptions o{.backend = backend, .domain_id = domain, .interface = "lo", .kind = size};
+int RunScenario(const Scenario& sc, T ping, std::size_t payload_bytes, int n, int throughput_n) {
+  const std::string& backend = sc.backend;
+  const std::string& mode = sc.mode;
+  const std::string& size = sc.size;
+  testing::EchoOptions o{.backend = sc.echo_backend, .domain_id = sc.domain,
+                         .interface = sc.interface, .kind = size};
   auto echo = Echo::Start(mode, o);
   if (!echo) return 1;
-  auto p = Participant::Create({.backend = backend, .domain_id = domain, .interface = "lo"});
+  auto p = Participant::Create({.backend = backend, .domain_id = sc.domain, .interface = sc.interface});
   if (!p) {
     std::fprintf(stderr, "bus bench: %s\n", p.error().ToString().c_str());
     return 1;
@@ -200,9 +214,12 @@ int RunScenario(const std::string& backend, const std::string& mode, const std::
   const double rts = secs > 0 ? static_cast<double>(done) / secs : 0.0;
 
   std::printf(
-      "suite=bus scenario=rtt_%s backend=%s mode=%s payload_bytes=%zu n=%zu p50_us=%.1f "
-      "p99_us=%.1f max_us=%.1f timeouts=%d window=%d round_trips_s=%.0f msgs_s=%.0f mb_s=%.2f\n",
-      size.c_str(), backend.c_str(), mode.c_str(), payload_bytes, rtt_us.size(),
+      "suite=bus scenario=rtt_%s backend=%s%s%s mode=%s interface=%s payload_bytes=%zu n=%zu "
+      "p50_us=%.1f p99_us=%.1f max_us=%.1f timeouts=%d window=%d round_trips_s=%.0f msgs_s=%.0f "
+      "mb_s=%.2f\n",
+      size.c_str(), backend.c_str(), sc.echo_backend == backend ? "" : " echo_backend=",
+      sc.echo_backend == backend ? "" : sc.echo_backend.c_str(), mode.c_str(),
+      sc.interface.c_str(), payload_bytes, rtt_us.size(),
       Percentile(rtt_us, 0.50), Percentile(rtt_us, 0.99), Percentile(rtt_us, 1.0), timeouts,
       kWindow, rts, 2 * rts, 2 * rts * static_cast<double>(payload_bytes) / 1e6);
   std::fflush(stdout);
@@ -220,21 +237,24 @@ int RunBusBench(const Args& args) {
   const auto modes = Pick(args.Get("mode", "all"), {"same_process", "two_process"});
   const auto sizes = Pick(args.Get("size", "all"), {"small", "large"});
   int domain = static_cast<int>(args.GetInt("domain", 200));
+  const std::string interface = args.Get("interface", "lo");
+  const std::string echo_backend = args.Get("echo-backend", "");
   int worst = 0;
   for (const auto& backend : backends) {
     for (const auto& mode : modes) {
       for (const auto& size : sizes) {
         int rc = 0;
+        const Scenario sc{backend, echo_backend.empty() ? backend : echo_backend, mode, size,
+                          interface, domain};
         if (size == "small") {
           const int n = static_cast<int>(args.GetInt("n", args.quick ? 200 : 5000));
-          rc = RunScenario<RaftMessage>(backend, mode, size, domain,
-                                        testing::FullRaftMessage(1, kSmallPayloadBytes),
+          rc = RunScenario<RaftMessage>(sc, testing::FullRaftMessage(1, kSmallPayloadBytes),
                                         kSmallPayloadBytes, n, args.quick ? 500 : 20000);
         } else if (size == "large") {
           const int n = static_cast<int>(args.GetInt("n", args.quick ? 30 : 500));
           CameraImage img = testing::FullCameraImage(1, 320, 240);
           const std::size_t bytes = img.data.size();
-          rc = RunScenario<CameraImage>(backend, mode, size, domain, std::move(img), bytes, n,
+          rc = RunScenario<CameraImage>(sc, std::move(img), bytes, n,
                                         args.quick ? 60 : 1000);
         } else {
           std::fprintf(stderr, "bus bench: unknown --size '%s': accepted small, large, all\n",
