@@ -197,24 +197,26 @@ class Writer final : public detail::WriterBackend {
 template <typename Cpp, typename C>
 class Reader final : public detail::ReaderBackend {
  public:
-  Reader(std::shared_ptr<ParticipantHandle> participant, detail::SampleCallback callback)
-      : participant_(std::move(participant)), callback_(std::move(callback)) {}
+  Reader(std::shared_ptr<ParticipantHandle> participant, const dds_topic_descriptor_t* desc,
+         detail::SampleCallback callback)
+      : participant_(std::move(participant)), desc_(desc), callback_(std::move(callback)) {}
 
   ~Reader() override {
     {
-      std::lock_guard lock(callback_mu_);  // waits for a running callback
+      std::lock_guard lock(mu_);  // waits for a running callback
       alive_ = false;
     }
     if (waitset_ > 0) dds_delete(waitset_);
     if (reader_ > 0) dds_delete(reader_);
     if (topic_ > 0) dds_delete(topic_);
+    dds_sample_free(&c_sample_, desc_, DDS_FREE_CONTENTS);
   }
   Reader(const Reader&) = delete;
   Reader& operator=(const Reader&) = delete;
 
-  Status Init(const dds_topic_descriptor_t* desc, const std::string& topic_name, Qos qos) {
+  Status Init(const std::string& topic_name, Qos qos) {
     const dds_entity_t pp = participant_->get();
-    auto topic = CreateTopic(*participant_, desc, topic_name);
+    auto topic = CreateTopic(*participant_, desc_, topic_name);
     if (!topic) return topic.error();
     topic_ = *topic;
     dds_qos_t* q = MakeQos(qos, /*writer=*/false);
@@ -246,6 +248,7 @@ class Reader final : public detail::ReaderBackend {
 
   bool Take(void* out) override {
     if (callback_) return false;
+    std::lock_guard lock(mu_);
     return TakeOne(reader_, *static_cast<Cpp*>(out));
   }
 
@@ -260,36 +263,41 @@ class Reader final : public detail::ReaderBackend {
   }
 
  private:
-  // Takes one valid sample (skipping dispose/unregister notifications) into `out`.
-  static bool TakeOne(dds_entity_t reader, Cpp& out) {
+  // Takes one valid sample (skipping dispose/unregister notifications) into `out`. Cyclone
+  // deserializes into c_sample_, which keeps its string and sequence buffers between takes
+  // (Cyclone reallocates them only when a sample needs more room), so a warm reader does not
+  // allocate here. Caller holds mu_.
+  bool TakeOne(dds_entity_t reader, Cpp& out) {
     while (true) {
-      void* samples[1] = {nullptr};  // nullptr: Cyclone loans the sample
+      void* samples[1] = {&c_sample_};
       dds_sample_info_t info;
       const dds_return_t n = dds_take(reader, samples, &info, 1, 1);
       if (n <= 0) return false;
-      const bool valid = info.valid_data;
-      if (valid) FromC(*static_cast<const C*>(samples[0]), out);
-      dds_return_loan(reader, samples, n);
-      if (valid) return true;
+      if (info.valid_data) {
+        FromC(c_sample_, out);
+        return true;
+      }
     }
   }
 
   // Cyclone's listener thread (the receive thread, or the delivery thread for local writers).
   static void OnDataAvailable(dds_entity_t reader, void* arg) {
     auto* self = static_cast<Reader*>(arg);
-    std::lock_guard lock(self->callback_mu_);
+    std::lock_guard lock(self->mu_);
     if (!self->alive_) return;
-    while (TakeOne(reader, self->scratch_)) self->callback_(&self->scratch_);
+    while (self->TakeOne(reader, self->scratch_)) self->callback_(&self->scratch_);
   }
 
   std::shared_ptr<ParticipantHandle> participant_;
+  const dds_topic_descriptor_t* desc_;
   detail::SampleCallback callback_;
   dds_entity_t topic_ = 0;
   dds_entity_t reader_ = 0;
   dds_entity_t waitset_ = 0;
-  std::mutex callback_mu_;
+  std::mutex mu_;  // guards c_sample_, scratch_, alive_; held during the callback
   bool alive_ = true;
-  Cpp scratch_;  // the sample handed to the callback; reused
+  C c_sample_{};  // Cyclone deserializes into this; owns its buffers (freed in the destructor)
+  Cpp scratch_;   // the sample handed to the callback; reused
 };
 
 class CycloneParticipant final : public detail::ParticipantBackend {
@@ -346,8 +354,8 @@ class CycloneParticipant final : public detail::ParticipantBackend {
   Result<std::unique_ptr<detail::ReaderBackend>> MakeReader(const dds_topic_descriptor_t* desc,
                                                             const std::string& topic_name, Qos qos,
                                                             detail::SampleCallback callback) {
-    auto reader = std::make_unique<Reader<Cpp, C>>(handle_, std::move(callback));
-    SWARMBOX_TRY(reader->Init(desc, topic_name, qos));
+    auto reader = std::make_unique<Reader<Cpp, C>>(handle_, desc, std::move(callback));
+    SWARMBOX_TRY(reader->Init(topic_name, qos));
     return std::unique_ptr<detail::ReaderBackend>(std::move(reader));
   }
 
