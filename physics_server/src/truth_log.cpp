@@ -10,8 +10,10 @@ namespace {
 
 void AppendF(std::string* out, const char* fmt, double v) {
   char buf[48];
-  const int n = std::snprintf(buf, sizeof buf, fmt, v == 0.0 ? 0.0 : v);  // no "-0.000000"
-  out->append(buf, static_cast<std::size_t>(n));
+  const int n = std::snprintf(buf, sizeof buf, fmt, v);
+  const char* p = buf;
+  if (buf[0] == '-' && std::strspn(buf + 1, "0.") == static_cast<std::size_t>(n - 1)) ++p;  // "-0.000" -> "0.000"
+  out->append(p, static_cast<std::size_t>(n) - static_cast<std::size_t>(p - buf));
 }
 
 }  // namespace

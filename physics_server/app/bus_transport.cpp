@@ -1,0 +1,135 @@
+#include "bus_transport.hpp"
+
+#include <chrono>
+
+namespace swarmbox::physics {
+namespace {
+
+std::array<double, 3> A(const Vec3& v) { return {v.x, v.y, v.z}; }
+
+}  // namespace
+
+Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::ParticipantConfig& config,
+                                                           const std::vector<std::string>& drones,
+                                                           const std::vector<GpsSpec>& gps_specs) {
+  std::unique_ptr<BusTransport> t(new BusTransport());
+  auto participant = bus::Participant::Create(config);
+  if (!participant) return std::move(participant).error().Context("sim bus");
+  t->participant_ = std::move(*participant);
+  auto clock = t->participant_->CreatePublisher<bus::ClockTick>(bus::kClockTopic, bus::Qos::kLockstep);
+  if (!clock) return std::move(clock).error();
+  t->clock_ = std::move(*clock);
+  BusTransport* self = t.get();
+  auto wc = t->participant_->CreateSubscriber<bus::WorldCommand>(
+      bus::kWorldCommandTopic, bus::Qos::kLockstep, [self](const bus::WorldCommand& c) {
+        std::lock_guard<std::mutex> lock(self->mu_);
+        self->world_.push_back({c.target, c.command, c.args});
+      });
+  if (!wc) return std::move(wc).error();
+  t->world_commands_ = std::move(*wc);
+  for (std::size_t i = 0; i < drones.size(); ++i) {
+    const std::string& name = drones[i];
+    if (auto s = bus::ValidateDroneName(name); !s) return s.error();
+    DroneEndpoints e;
+    e.gps = gps_specs.at(i);
+    auto sensor = t->participant_->CreatePublisher<bus::SensorSample>(bus::SensorTopic(name), bus::Qos::kLockstep);
+    if (!sensor) return std::move(sensor).error();
+    e.sensor = std::move(*sensor);
+    auto camera = t->participant_->CreatePublisher<bus::CameraImage>(bus::CameraTopic(name), bus::Qos::kLockstep);
+    if (!camera) return std::move(camera).error();
+    e.camera = std::move(*camera);
+    auto act = t->participant_->CreateSubscriber<bus::ActuatorCommand>(
+        bus::ActuatorTopic(name), bus::Qos::kLockstep, [self, name](const bus::ActuatorCommand& c) {
+          {
+            std::lock_guard<std::mutex> lock(self->mu_);
+            // The topic names the drone; the message's own `drone` field is not trusted.
+            self->actuators_.push_back({name, c.step, c.armed, c.motor_throttle});
+          }
+          self->cv_.notify_one();
+        });
+    if (!act) return std::move(act).error();
+    e.actuator = std::move(*act);
+    t->drones_.push_back(std::move(e));
+  }
+  return t;
+}
+
+Status BusTransport::PublishSample(std::size_t drone, const std::string& name, const SensorSample& s) {
+  bus::SensorSample& m = sample_msg_;
+  const GpsSpec& spec = drones_.at(drone).gps;
+  m.drone = name;
+  m.step = s.step;
+  m.sim_time_ns = s.time_ns;
+  m.imu.valid = s.imu.fresh;
+  m.imu.accel_m_s2 = A(s.imu.accel_m_s2);
+  m.imu.gyro_rad_s = A(s.imu.gyro_rad_s);
+  m.imu.temperature_c = s.baro.temperature_c;
+  m.baro.valid = s.baro.fresh;
+  m.baro.pressure_pa = s.baro.pressure_pa;
+  m.baro.altitude_m = s.baro.altitude_m;
+  m.baro.temperature_c = s.baro.temperature_c;
+  m.mag.valid = s.mag.fresh;
+  m.mag.field_gauss = A(s.mag.field_gauss);
+  m.gps.valid = s.gps.fresh && s.gps.valid;
+  m.gps.fix_type = s.gps.valid ? bus::GpsFix::k3d : bus::GpsFix::kNone;
+  m.gps.num_satellites = s.gps.valid ? 12 : 0;
+  m.gps.latitude_deg = s.gps.lat_deg;
+  m.gps.longitude_deg = s.gps.lon_deg;
+  m.gps.altitude_m = s.gps.alt_m;
+  m.gps.position_enu_m = A(s.gps.position_m);
+  m.gps.velocity_enu_m_s = A(s.gps.velocity_m_s);
+  m.gps.h_acc_m = spec.horizontal_std_m;
+  m.gps.v_acc_m = spec.vertical_std_m;
+  m.battery.valid = false;  // no battery model in the physics server
+  return drones_[drone].sensor->Publish(m);
+}
+
+Status BusTransport::PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& img) {
+  bus::CameraImage& m = camera_msg_;
+  m.drone = name;
+  m.step = step;
+  m.sim_time_ns = img.time_ns;
+  m.width_px = static_cast<std::uint32_t>(img.width_px);
+  m.height_px = static_cast<std::uint32_t>(img.height_px);
+  m.row_stride_bytes = static_cast<std::uint32_t>(img.width_px * 3);
+  m.encoding = "bgr8";
+  m.intrinsics.fx_px = img.intrinsics.fx_px;
+  m.intrinsics.fy_px = img.intrinsics.fy_px;
+  m.intrinsics.cx_px = img.intrinsics.cx_px;
+  m.intrinsics.cy_px = img.intrinsics.cy_px;
+  m.intrinsics.distortion = {};
+  m.camera_pose.position_enu_m = A(img.camera_pose.position_m);
+  const Quat& q = img.camera_pose.attitude;
+  m.camera_pose.orientation_wxyz = {q.w, q.x, q.y, q.z};
+  m.data.assign(img.bgr.begin(), img.bgr.end());
+  return drones_.at(drone).camera->Publish(m);
+}
+
+Status BusTransport::PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) {
+  bus::ClockTick tick;
+  tick.step = step;
+  tick.sim_time_ns = sim_time_ns;
+  tick.step_period_ns = period_ns;
+  tick.rtf = rtf;
+  return clock_->Publish(tick);
+}
+
+void BusTransport::WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) {
+  std::unique_lock<std::mutex> lock(mu_);
+  const auto deadline = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(deadline_ns));
+  cv_.wait_until(lock, deadline, [this] { return !actuators_.empty(); });
+  while (!actuators_.empty()) {
+    out->push_back(std::move(actuators_.front()));
+    actuators_.pop_front();
+  }
+}
+
+void BusTransport::TakeWorldCommands(std::vector<WorldCommandInput>* out) {
+  std::lock_guard<std::mutex> lock(mu_);
+  while (!world_.empty()) {
+    out->push_back(std::move(world_.front()));
+    world_.pop_front();
+  }
+}
+
+}  // namespace swarmbox::physics

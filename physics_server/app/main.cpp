@@ -1,0 +1,155 @@
+// swarmbox-physics: the world of a trial on the sim bus. A thin shell: options -> World ->
+// BusTransport -> SimServer. See `swarmbox-physics --help`.
+// Exit codes: 0 done (max sim time or SIGTERM/SIGINT), 2 bad input, 3 infrastructure (bus, files).
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+
+#include "bus_transport.hpp"
+#include "server_options.hpp"
+#include "sim_server.hpp"
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/physics/world.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+
+extern "C" void OnSignal(int) { g_stop.store(true); }
+
+int Fail(int code, const std::string& message) {
+  std::fprintf(stderr, "swarmbox-physics: %s\n", message.c_str());
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using namespace swarmbox;
+  using namespace swarmbox::physics;
+  ServerOptions o;
+  std::vector<std::string> drone_args;
+  std::string drones_file;
+  CLI::App app{"swarmbox-physics: ODE world, sensors and cameras of a SwarmBox trial, in lockstep with the agents "
+               "over the sim bus"};
+  app.add_option("--world", o.world_path, "World file (trials/worlds/*.yaml)")->required();
+  app.add_option("--drone", drone_args, "A drone: name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]] (repeatable)");
+  app.add_option("--drones", drones_file, "YAML list of drones {name, airframe, pose: [x,y,z], yaw_deg, payload, payload_attached}");
+  app.add_option("--airframes-dir", o.airframes_dir, "Where airframe names are looked up (default: <world dir>/../airframes)");
+  app.add_option("--rtf", o.rtf, "Real-time factor to pace to; 0 = as fast as possible")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--seed", o.seed, "Seed of every noise source and the wind")->capture_default_str();
+  app.add_option("--truth", o.truth_path, "Ground-truth CSV to write ('' = none)")->capture_default_str();
+  app.add_option("--truth-rate-hz", o.truth_rate_hz, "truth.csv rows per simulated second per drone")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--sim-interface", o.sim_interface, "Network interface of the sim bus")->capture_default_str();
+  app.add_option("--domain", o.domain, "DDS domain id of the sim bus")->check(CLI::Range(0, 232))->capture_default_str();
+  app.add_option("--middleware", o.middleware, "DDS implementation")->check(CLI::IsMember({"cyclonedds", "fastdds"}))->capture_default_str();
+  app.add_option("--max-sim-time", o.max_sim_time_s, "Stop after this many simulated seconds; 0 = run until SIGTERM")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--step-timeout", o.step_timeout_s, "Seconds of silence after which a drone is lost (motors off)")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--join-timeout", o.join_timeout_s, "Seconds a drone may take to answer its first sample")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--physics-rate-hz", o.physics_rate_hz, "ODE sub-step rate")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--control-rate-hz", o.control_rate_hz, "Lockstep (sensor/actuator) rate")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_flag("!--no-cameras", o.cameras, "Do not render or publish camera images");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+
+  // Inputs: world, drones, airframes. Any problem: file:line:col: message, exit 2.
+  auto world_config = LoadWorld(o.world_path);
+  if (!world_config) return Fail(2, world_config.error().ToString());
+  if (o.airframes_dir.empty()) {
+    o.airframes_dir = (std::filesystem::path(o.world_path).parent_path() / ".." / "airframes").lexically_normal().string();
+  }
+  for (const std::string& a : drone_args) {
+    auto d = ParseDroneArg(a);
+    if (!d) return Fail(2, d.error().ToString());
+    o.drones.push_back(*d);
+  }
+  if (!drones_file.empty()) {
+    auto list = LoadDronesFile(drones_file);
+    if (!list) return Fail(2, list.error().ToString());
+    o.drones.insert(o.drones.end(), list->begin(), list->end());
+  }
+  if (o.drones.empty()) return Fail(2, "no drones: give --drone or --drones");
+  if (o.physics_rate_hz % o.control_rate_hz != 0) return Fail(2, "--physics-rate-hz must be a multiple of --control-rate-hz");
+
+  WorldOptions wopt;
+  wopt.seed = o.seed;
+  wopt.control_period_ns = 1'000'000'000 / o.control_rate_hz;
+  wopt.substeps = o.physics_rate_hz / o.control_rate_hz;
+  if (wopt.control_period_ns * o.control_rate_hz != 1'000'000'000 || wopt.control_period_ns % wopt.substeps != 0) {
+    return Fail(2, "--control-rate-hz must divide 1e9 ns, and its period the sub-steps");
+  }
+  auto world = World::Create(*world_config, wopt);
+  if (!world) return Fail(2, world.error().ToString());
+  std::vector<std::string> names;
+  std::vector<GpsSpec> gps;
+  for (const DroneSpec& d : o.drones) {
+    auto af = LoadAirframe(AirframePathFor(d.airframe, o.airframes_dir));
+    if (!af) return Fail(2, af.error().ToString());
+    DroneSpawn spawn;
+    spawn.name = d.name;
+    spawn.airframe = *af;
+    spawn.position_m = {d.x_m, d.y_m, d.z_m};
+    spawn.yaw_rad = d.yaw_deg * std::numbers::pi / 180.0;
+    spawn.payload = d.payload;
+    spawn.payload_attached = d.payload_attached;
+    auto idx = (*world)->AddDrone(spawn);
+    if (!idx) return Fail(2, d.where + ": " + idx.error().message());
+    names.push_back(d.name);
+    gps.push_back(af->gps);
+  }
+
+  std::optional<TruthCsvFile> truth;
+  if (!o.truth_path.empty()) {
+    auto f = TruthCsvFile::Open(o.truth_path, o.truth_rate_hz);
+    if (!f) return Fail(3, f.error().ToString());
+    truth.emplace(std::move(*f));
+  }
+
+  bus::ParticipantConfig pc;
+  pc.backend = o.middleware;
+  pc.domain_id = o.domain;
+  pc.interface = o.sim_interface;
+  auto transport = BusTransport::Create(pc, names, gps);
+  if (!transport) {
+    const ErrorCode c = transport.error().code();
+    return Fail(c == ErrorCode::kInvalidArgument || c == ErrorCode::kNotFound ? 2 : 3, transport.error().ToString());
+  }
+
+  std::signal(SIGTERM, OnSignal);
+  std::signal(SIGINT, OnSignal);
+  SimServerOptions so;
+  so.rtf = o.rtf;
+  so.max_sim_time_s = o.max_sim_time_s;
+  so.lockstep.timeout_ns = static_cast<std::int64_t>(o.step_timeout_s * 1e9);
+  so.lockstep.join_timeout_ns = static_cast<std::int64_t>(o.join_timeout_s * 1e9);
+  so.cameras = o.cameras;
+  SteadyWallClock clock;
+  SimServer server(**world, **transport, clock, truth ? &*truth : nullptr, so, stdout);
+  std::printf("%s\n", LogEvent(0.0, "physics", "ready")
+                          .Add("world", world_config->name)
+                          .Add("drones", static_cast<std::int64_t>(names.size()))
+                          .Add("middleware", o.middleware)
+                          .Add("domain", o.domain)
+                          .Add("rtf", o.rtf, 2)
+                          .Add("seed", o.seed)
+                          .str()
+                          .c_str());
+  std::fflush(stdout);
+  const Status s = server.Run(g_stop);
+  std::printf("%s\n", LogEvent((*world)->time_s(), "physics", "stopped")
+                          .Add("reason", g_stop.load() ? "signal" : "max_sim_time")
+                          .Add("steps", static_cast<std::uint64_t>((*world)->step_count()))
+                          .str()
+                          .c_str());
+  std::fflush(stdout);
+  if (!s) return Fail(3, s.error().ToString());
+  return 0;
+}

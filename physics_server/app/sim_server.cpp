@@ -1,0 +1,153 @@
+#include "sim_server.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <optional>
+#include <span>
+#include <thread>
+
+namespace swarmbox::physics {
+
+std::int64_t SteadyWallClock::NowNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+void SteadyWallClock::SleepUntilNs(std::int64_t t_ns) {
+  std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(t_ns)));
+}
+
+void SimServer::PrintingSink::OnEvent(const PhysicsEvent& event) {
+  std::fprintf(out_, "%s\n", event.ToLogEvent(node_).str().c_str());
+  std::fflush(out_);
+}
+
+SimServer::SimServer(World& world, SimTransport& transport, WallClock& clock, TruthCsvFile* truth,
+                     SimServerOptions options, std::FILE* events_out)
+    : world_(world),
+      transport_(transport),
+      clock_(clock),
+      truth_(truth),
+      options_(std::move(options)),
+      out_(events_out),
+      sink_(events_out, options_.node),
+      lockstep_(world.drone_count(), options_.lockstep),
+      zeros_(8, 0.0),
+      base_wind_(world.config().wind) {
+  world_.SetEventSink(&sink_);
+}
+
+void SimServer::Log(const LogEvent& event) {
+  std::fprintf(out_, "%s\n", event.str().c_str());
+  std::fflush(out_);
+}
+
+void SimServer::Apply(const WorldCommandInput& cmd) {
+  const double t = world_.time_s();
+  auto reject = [&](const std::string& why) {
+    Log(LogEvent(t, options_.node, "world_command_rejected").Add("command", cmd.command).Add("target", cmd.target).Add("reason", why));
+  };
+  std::optional<std::size_t> drone;
+  if (!cmd.target.empty()) {
+    drone = world_.FindDrone(cmd.target);
+    if (!drone) return reject("unknown drone");
+  }
+  const std::int64_t now = world_.time_ns();
+  auto seconds = [](double s) { return static_cast<std::int64_t>(s * 1e9); };
+  if (cmd.command == "gps_dropout") {
+    if (!drone || cmd.args.size() != 1 || !(cmd.args[0] > 0)) return reject("needs a drone and duration_s > 0");
+    world_.SetGpsDropout(*drone, true);
+    timed_.push_back({now + seconds(cmd.args[0]), *drone, Timed::kGpsBack});
+  } else if (cmd.command == "wind_gust") {
+    if (cmd.args.size() != 4 || !(cmd.args[3] > 0)) return reject("needs vx, vy, vz, duration_s > 0");
+    WindConfig gust = base_wind_;
+    gust.mean_m_s = base_wind_.mean_m_s + Vec3{cmd.args[0], cmd.args[1], cmd.args[2]};
+    world_.SetWind(gust);
+    timed_.push_back({now + seconds(cmd.args[3]), 0, Timed::kWindBack});
+  } else if (cmd.command == "payload_attach" || cmd.command == "payload_release") {
+    if (!drone) return reject("needs a drone");
+    const Status s = cmd.command == "payload_attach" ? world_.AttachPayload(*drone) : world_.ReleasePayload(*drone);
+    if (!s) return reject(s.error().message());
+  } else {
+    return reject("not supported by this physics server");
+  }
+  Log(LogEvent(t, options_.node, "world_command").Add("command", cmd.command).Add("target", cmd.target));
+}
+
+Status SimServer::RunStep(const std::atomic<bool>& stop) {
+  const std::uint64_t step = world_.step_count();
+  lockstep_.BeginStep(step, clock_.NowNs());
+  for (std::size_t i = 0; i < world_.drone_count(); ++i) {
+    if (auto s = transport_.PublishSample(i, world_.drone_name(i), world_.sensors(i)); !s) return s;
+    if (options_.cameras && world_.CameraDue(i) && !world_.Truth(i).lost) {
+      world_.RenderCamera(i, &image_);
+      if (auto s = transport_.PublishCamera(i, world_.drone_name(i), step, image_); !s) return s;
+    }
+  }
+  if (auto s = transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf); !s) {
+    return s;
+  }
+  constexpr std::int64_t kPollNs = 20'000'000;  // re-check `stop` at least this often
+  while (!stop.load()) {
+    const std::int64_t now = clock_.NowNs();
+    if (lockstep_.StepComplete(now)) break;
+    inbox_.clear();
+    transport_.WaitActuators(std::min(lockstep_.NextDeadlineNs(), now + kPollNs), &inbox_);
+    for (const ActuatorInput& cmd : inbox_) {
+      const std::optional<std::size_t> i = world_.FindDrone(cmd.drone);
+      if (!i) continue;
+      if (lockstep_.OnCommand(*i, cmd.step, clock_.NowNs()) != Lockstep::Answer::kAccepted) continue;
+      for (std::size_t r : lockstep_.TakeRejoined()) world_.SetLost(r, false);
+      const std::size_t rotors = world_.airframe(*i).rotors.size();
+      const std::span<const double> u = cmd.armed ? std::span<const double>(cmd.throttle) : std::span<const double>(zeros_.data(), rotors);
+      if (auto s = world_.SetActuators(*i, u); !s) {
+        Log(LogEvent(world_.time_s(), options_.node, "bad_command").Add("drone", cmd.drone).Add("reason", s.error().message()));
+      }
+    }
+  }
+  for (std::size_t i : lockstep_.TakeNewlyLost()) world_.SetLost(i, true);
+  if (stop.load()) return Ok{};
+
+  world_inbox_.clear();
+  transport_.TakeWorldCommands(&world_inbox_);
+  for (const WorldCommandInput& c : world_inbox_) Apply(c);
+  world_.Step();
+  for (auto it = timed_.begin(); it != timed_.end();) {
+    if (world_.time_ns() < it->until_ns) {
+      ++it;
+      continue;
+    }
+    if (it->kind == Timed::kGpsBack) world_.SetGpsDropout(it->drone, false);
+    if (it->kind == Timed::kWindBack) world_.SetWind(base_wind_);
+    it = timed_.erase(it);
+  }
+  if (truth_ != nullptr) {
+    if (auto s = truth_->MaybeWrite(world_); !s) return s;
+  }
+  if (options_.rtf > 0) {
+    const std::int64_t now = clock_.NowNs();
+    if (pace_origin_wall_ns_ < 0) {
+      pace_origin_wall_ns_ = now;
+      pace_origin_sim_ns_ = world_.time_ns();
+    }
+    const auto target = pace_origin_wall_ns_ +
+                        static_cast<std::int64_t>(static_cast<double>(world_.time_ns() - pace_origin_sim_ns_) / options_.rtf);
+    if (target > now) {
+      clock_.SleepUntilNs(target);
+    } else if (now - target > 500'000'000) {
+      pace_origin_wall_ns_ = -1;  // fell behind by > 0.5 s (agents slow): re-anchor, no catch-up burst
+    }
+  }
+  return Ok{};
+}
+
+Status SimServer::Run(const std::atomic<bool>& stop) {
+  const auto max_ns = static_cast<std::int64_t>(options_.max_sim_time_s * 1e9);
+  while (!stop.load()) {
+    if (options_.max_sim_time_s > 0 && world_.time_ns() >= max_ns) break;
+    if (auto s = RunStep(stop); !s) return s;
+  }
+  if (truth_ != nullptr) return truth_->Flush();
+  return Ok{};
+}
+
+}  // namespace swarmbox::physics

@@ -1,0 +1,127 @@
+// SimServer: the swarmbox-physics main loop, written against two small interfaces so it runs the
+// same on the DDS bus (BusTransport) and in tests (fakes):
+//   SimTransport  publishes sensor samples, camera images and the clock; delivers actuator and
+//                 world commands.
+//   WallClock     monotonic wall time and sleeping (pacing, lockstep timeouts).
+//
+// Per control step: publish every drone's sample (lost ones too, so they can rejoin) and due
+// camera frames, then wait until every live drone has answered this step (Lockstep); drones
+// silent past the timeout are marked lost (motors off, event=drone_lost) and the step goes on.
+// Then World::Step(), truth.csv, pacing to the real-time factor. Events are printed as logfmt
+// lines on `events_out`.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/physics/camera_image.hpp"
+#include "swarmbox/physics/lockstep.hpp"
+#include "swarmbox/physics/sensor_sample.hpp"
+#include "swarmbox/physics/truth_log.hpp"
+#include "swarmbox/physics/world.hpp"
+
+namespace swarmbox::physics {
+
+struct ActuatorInput {
+  std::string drone;
+  std::uint64_t step = 0;
+  bool armed = false;
+  std::vector<double> throttle;
+};
+
+// The bus contract of WorldCommand (bus/messages.hpp): gps_dropout {duration_s},
+// wind_gust {vx, vy, vz, duration_s}, payload_attach {}, payload_release {}.
+struct WorldCommandInput {
+  std::string target;
+  std::string command;
+  std::vector<double> args;
+};
+
+class SimTransport {
+ public:
+  virtual ~SimTransport() = default;
+  virtual Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample) = 0;
+  virtual Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) = 0;
+  virtual Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) = 0;
+  // Appends the actuator commands that arrived, waiting until one arrives or wall time
+  // `deadline_ns` (WallClock time) passes.
+  virtual void WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) = 0;
+  virtual void TakeWorldCommands(std::vector<WorldCommandInput>* out) = 0;
+};
+
+class WallClock {
+ public:
+  virtual ~WallClock() = default;
+  virtual std::int64_t NowNs() = 0;
+  virtual void SleepUntilNs(std::int64_t t_ns) = 0;
+};
+
+// std::chrono::steady_clock.
+class SteadyWallClock final : public WallClock {
+ public:
+  std::int64_t NowNs() override;
+  void SleepUntilNs(std::int64_t t_ns) override;
+};
+
+struct SimServerOptions {
+  double rtf = 1.0;                          // 0 = as fast as possible
+  double max_sim_time_s = 0;                 // 0 = no limit
+  LockstepOptions lockstep;
+  bool cameras = true;
+  std::string node = "physics";              // logfmt node name
+};
+
+class SimServer {
+ public:
+  // `truth` may be null. Nothing is owned except the lockstep state.
+  SimServer(World& world, SimTransport& transport, WallClock& clock, TruthCsvFile* truth, SimServerOptions options,
+            std::FILE* events_out);
+
+  // Runs until max_sim_time_s or until `stop` becomes true. Returns I/O errors (truth.csv).
+  Status Run(const std::atomic<bool>& stop);
+
+  // One control step (publish, wait for answers, step). Exposed for tests.
+  Status RunStep(const std::atomic<bool>& stop);
+
+ private:
+  class PrintingSink final : public EventSink {
+   public:
+    PrintingSink(std::FILE* out, std::string node) : out_(out), node_(std::move(node)) {}
+    void OnEvent(const PhysicsEvent& event) override;
+
+   private:
+    std::FILE* out_;
+    std::string node_;
+  };
+  struct Timed {
+    std::int64_t until_ns;
+    std::size_t drone;
+    enum Kind { kGpsBack, kWindBack } kind;
+  };
+  void Apply(const WorldCommandInput& cmd);
+  void Log(const LogEvent& event);
+
+  World& world_;
+  SimTransport& transport_;
+  WallClock& clock_;
+  TruthCsvFile* truth_;
+  SimServerOptions options_;
+  std::FILE* out_;
+  PrintingSink sink_;
+  Lockstep lockstep_;
+  std::vector<ActuatorInput> inbox_;
+  std::vector<WorldCommandInput> world_inbox_;
+  std::vector<double> zeros_;
+  std::vector<Timed> timed_;
+  WindConfig base_wind_;
+  CameraImage image_;
+  std::int64_t pace_origin_wall_ns_ = -1;
+  std::int64_t pace_origin_sim_ns_ = 0;
+};
+
+}  // namespace swarmbox::physics

@@ -1,0 +1,220 @@
+// SimServer's lockstep loop with a fake transport (a scripted agent) and a fake wall clock: no
+// DDS, deterministic.
+#include "sim_server.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include "server_options.hpp"
+#include "test_util.hpp"
+
+namespace swarmbox::physics {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;
+
+class FakeClock final : public WallClock {
+ public:
+  std::int64_t NowNs() override { return now_ns; }
+  void SleepUntilNs(std::int64_t t) override { now_ns = std::max(now_ns, t); }
+  std::int64_t now_ns = 0;
+};
+
+// Answers each published sample with a command for the same step, from the drones listed as
+// alive; waiting without an answer advances the fake clock to the deadline.
+class ScriptedAgents final : public SimTransport {
+ public:
+  explicit ScriptedAgents(FakeClock& clock) : clock_(clock) {}
+  Status PublishSample(std::size_t, const std::string& name, const SensorSample& s) override {
+    ++samples[name];
+    if (alive[name]) pending_.push_back({name, s.step, true, std::vector<double>(4, throttle)});
+    return Ok{};
+  }
+  Status PublishCamera(std::size_t, const std::string& name, std::uint64_t, const CameraImage& img) override {
+    ++frames[name];
+    EXPECT_EQ(img.bgr.size(), 320u * 240u * 3u);
+    return Ok{};
+  }
+  Status PublishClock(std::uint64_t step, std::int64_t, std::int64_t, double) override {
+    last_clock_step = step;
+    return Ok{};
+  }
+  void WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) override {
+    if (pending_.empty()) {
+      clock_.now_ns = std::max(clock_.now_ns, deadline_ns);
+      return;
+    }
+    clock_.now_ns += 1 * kMs;  // agents answer within a millisecond
+    out->insert(out->end(), pending_.begin(), pending_.end());
+    pending_.clear();
+  }
+  void TakeWorldCommands(std::vector<WorldCommandInput>* out) override {
+    out->insert(out->end(), world_commands.begin(), world_commands.end());
+    world_commands.clear();
+  }
+
+  std::map<std::string, bool> alive;
+  std::map<std::string, int> samples, frames;
+  std::vector<WorldCommandInput> world_commands;
+  double throttle = 0;
+  std::uint64_t last_clock_step = 0;
+
+ private:
+  FakeClock& clock_;
+  std::vector<ActuatorInput> pending_;
+};
+
+std::string ReadFile(std::FILE* f) {
+  std::fflush(f);
+  std::rewind(f);
+  std::string s;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, f)) s.append(buf, n);
+  return s;
+}
+
+class SimServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    world_ = testing::MakeWorld(testing::CalmWorld());
+    const Airframe af = testing::LoadShippedAirframe("x500");
+    u_ = af.HoverRotorSpeed() / af.motor.max_rot_velocity_rad_s;
+    testing::Spawn(*world_, testing::MakeSpawn("a", af, Vec3{0, 0, 10}, 0, u_));
+    testing::Spawn(*world_, testing::MakeSpawn("b", af, Vec3{5, 0, 10}, 0, u_));
+    agents_.throttle = u_;
+    agents_.alive = {{"a", true}, {"b", true}};
+    out_ = std::tmpfile();
+    ASSERT_NE(out_, nullptr);
+  }
+  void TearDown() override { std::fclose(out_); }
+
+  SimServerOptions Options(double max_sim_s) {
+    SimServerOptions o;
+    o.rtf = 1.0;
+    o.max_sim_time_s = max_sim_s;
+    o.lockstep = {.timeout_ns = 200 * kMs, .join_timeout_ns = 500 * kMs};
+    return o;
+  }
+
+  std::unique_ptr<World> world_;
+  FakeClock clock_;
+  ScriptedAgents agents_{clock_};
+  std::FILE* out_ = nullptr;
+  double u_ = 0;
+  std::atomic<bool> stop_{false};
+};
+
+TEST_F(SimServerTest, StepsInLockstepAndPacesToRealTime) {
+  SimServer server(*world_, agents_, clock_, nullptr, Options(1.0), out_);
+  ASSERT_TRUE(server.Run(stop_).ok());
+  EXPECT_EQ(world_->step_count(), 250u);
+  EXPECT_EQ(agents_.samples["a"], 250);
+  EXPECT_EQ(agents_.frames["a"], 5);  // 5 Hz
+  // Paced at rtf 1: 1 s of simulated time took at least 1 s of (fake) wall time.
+  EXPECT_GE(clock_.now_ns, 996 * kMs);
+  // Both held in hover by the agents' commands.
+  EXPECT_NEAR(world_->Truth(1).position_m.z, 10.23, 0.01);
+  EXPECT_EQ(ReadFile(out_), "");
+}
+
+TEST_F(SimServerTest, SilentDroneIsLostWithMotorsOffAndTheWorldGoesOn) {
+  SimServerOptions o = Options(2.0);
+  o.rtf = 0;
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  for (int k = 0; k < 100; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  agents_.alive["b"] = false;  // killed at t = 0.4 s
+  ASSERT_TRUE(server.Run(stop_).ok());
+  EXPECT_EQ(world_->step_count(), 500u);
+  EXPECT_TRUE(world_->Truth(1).lost);
+  EXPECT_FALSE(world_->Truth(0).lost);
+  EXPECT_LT(world_->Truth(1).rotor_speed_rad_s[0], 1.0);  // motors off, spun down
+  EXPECT_LT(world_->Truth(1).position_m.z, 5.0);           // and it fell
+  EXPECT_NEAR(world_->Truth(0).position_m.z, 10.23, 0.01); // the other kept hovering
+  const std::string log = ReadFile(out_);
+  EXPECT_EQ(log.rfind("t=0.400 node=physics event=drone_lost a=b\n", 0), 0u) << log;
+  EXPECT_NE(log.find("event=crash a=b b=ground"), std::string::npos) << log;
+}
+
+TEST_F(SimServerTest, LostDroneRejoinsWhenItAnswersAgain) {
+  SimServerOptions o = Options(0);
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  agents_.alive["b"] = false;
+  for (int k = 0; k < 3; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());  // join timeout on step 0
+  EXPECT_TRUE(world_->Truth(1).lost);
+  agents_.alive["b"] = true;
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  EXPECT_FALSE(world_->Truth(1).lost);
+  const std::string log = ReadFile(out_);
+  EXPECT_NE(log.find("event=drone_lost a=b"), std::string::npos) << log;
+  EXPECT_NE(log.find("event=drone_rejoined a=b"), std::string::npos) << log;
+}
+
+TEST_F(SimServerTest, WorldCommandsDropGpsAndRejectUnknownOnes) {
+  SimServer server(*world_, agents_, clock_, nullptr, Options(0), out_);
+  agents_.world_commands = {{"a", "gps_dropout", {0.5}}, {"a", "imu_bias_jump", {1, 0, 0, 0, 0, 0}},
+                            {"nobody", "gps_dropout", {1}}};
+  int invalid = 0;
+  for (int k = 0; k < 250; ++k) {
+    ASSERT_TRUE(server.RunStep(stop_).ok());
+    const GpsSample& g = world_->sensors(0).gps;
+    if (g.fresh && !g.valid) ++invalid;
+  }
+  EXPECT_EQ(invalid, 5);  // 0.5 s at 10 Hz, then the fix is back
+  const std::string log = ReadFile(out_);
+  EXPECT_NE(log.find("event=world_command command=gps_dropout target=a"), std::string::npos) << log;
+  EXPECT_NE(log.find("event=world_command_rejected command=imu_bias_jump target=a reason=\"not supported by this physics server\""),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("event=world_command_rejected command=gps_dropout target=nobody reason=\"unknown drone\""),
+            std::string::npos)
+      << log;
+}
+
+TEST_F(SimServerTest, StopFlagEndsTheRunAndFlushesTruth) {
+  const std::string path = ::testing::TempDir() + "sim_server_truth.csv";
+  auto truth = TruthCsvFile::Open(path, 10);
+  ASSERT_TRUE(truth.ok());
+  SimServer server(*world_, agents_, clock_, &*truth, Options(0), out_);
+  for (int k = 0; k < 50; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  stop_ = true;
+  ASSERT_TRUE(server.Run(stop_).ok());
+  std::FILE* f = std::fopen(path.c_str(), "r");
+  ASSERT_NE(f, nullptr);
+  const std::string csv = ReadFile(f);
+  std::fclose(f);
+  // 0.2 s at 10 Hz: rows at t = 0.004, 0.1, 0.2 for two drones, plus the header.
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 7);
+}
+
+TEST(ServerOptions, ParsesDroneArguments) {
+  auto d = ParseDroneArg("lifter:x8_heavy:1.5,-2,0:90:stretcher:attached");
+  ASSERT_TRUE(d.ok()) << d.error().ToString();
+  EXPECT_EQ(d->name, "lifter");
+  EXPECT_EQ(d->airframe, "x8_heavy");
+  EXPECT_DOUBLE_EQ(d->x_m, 1.5);
+  EXPECT_DOUBLE_EQ(d->y_m, -2);
+  EXPECT_DOUBLE_EQ(d->yaw_deg, 90);
+  EXPECT_EQ(d->payload, "stretcher");
+  EXPECT_TRUE(d->payload_attached);
+  auto bad = ParseDroneArg("scout:x500:1,2");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().message(),
+            "bad --drone 'scout:x500:1,2': position must be x,y,z in metres (expected "
+            "name:airframe:x,y,z[:yaw_deg[:payload[:attached]]])");
+  EXPECT_EQ(AirframePathFor("x500", "/t/airframes"), "/t/airframes/x500.yaml");
+  EXPECT_EQ(AirframePathFor("./my.yaml", "/t/airframes"), "./my.yaml");
+}
+
+TEST(ServerOptions, DronesFileErrorsPointAtTheLine) {
+  auto doc = yaml::Parse("drones:\n  - {name: a, airframe: x500, pose: [0, 0, 0]}\n  - {name: b, airframe: x500, pos: [1, 0, 0]}\n", "d.yaml");
+  ASSERT_TRUE(doc.ok());
+  auto list = ParseDronesFile(*doc);
+  ASSERT_FALSE(list.ok());
+  EXPECT_EQ(list.error().ToString(), "d.yaml:3:5: missing required key 'pose' in drone");
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
