@@ -3,7 +3,8 @@
 //
 // Domain ids: every test case uses its own domain id (ctest runs test cases in parallel
 // processes), from the bus tests' blocks:
-//   140..143 two-process, 150..169 round trips, 170..189 interop, 190..199 API behaviour;
+//   140..143 two-process, 144..146 hot path, 150..169 round trips, 170..189 interop,
+//   190..199 API behaviour;
 //   the bench uses 200..209 unless told otherwise.
 #pragma once
 
