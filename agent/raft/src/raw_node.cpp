@@ -4,6 +4,7 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <tuple>
 
 namespace swarmbox::raft {
 
@@ -183,16 +184,10 @@ void RawNode::Campaign() {
 }
 
 void RawNode::StartCampaign(bool pre_vote) {
-  MessageType type;
-  std::uint64_t term;
   if (pre_vote) {
-    BecomePreCandidate();
-    type = MessageType::kPreVote;
-    term = term_ + 1;  // the term we would use, without incrementing ours (thesis §9.6)
+    BecomePreCandidate();  // keeps its term: asks for term + 1 without taking it (thesis §9.6)
   } else {
     BecomeCandidate();
-    type = MessageType::kVote;
-    term = term_;
   }
   if (Poll(config_.id, true) == VoteResult::kWon) {
     // A single-node cluster wins at once.
@@ -203,13 +198,18 @@ void RawNode::StartCampaign(bool pre_vote) {
     }
     return;
   }
+  SendVoteRequests();
+}
+
+void RawNode::SendVoteRequests() {
+  const bool pre = role_ == Role::kPreCandidate;
   for (NodeId v : config_.voters) {
-    if (v == config_.id) continue;
+    if (v == config_.id || votes_.count(v)) continue;
     Message m;
-    m.type = type;
+    m.type = pre ? MessageType::kPreVote : MessageType::kVote;
     m.to = v;
-    m.term = term;
-    m.index = log_.last_index();   // Raft §5.4.1: the candidate's last log index and term
+    m.term = pre ? term_ + 1 : term_;  // a pre-vote asks for the term it would use
+    m.index = log_.last_index();       // Raft §5.4.1: the candidate's last log index and term
     m.log_term = log_.last_term();
     Send(std::move(m));
   }
@@ -237,6 +237,15 @@ void RawNode::Tick() {
 
 void RawNode::TickElection() {
   ++election_elapsed_;
+  // Raft §5.1: servers retry RPCs that get no timely response. The radio loses datagrams, so a
+  // (pre-)candidate asks the voters that have not answered again every two heartbeat intervals
+  // (about a round trip) instead of losing the whole election round to one lost message.
+  // Vote requests are idempotent: a voter answers a repeated request the same way.
+  if ((role_ == Role::kCandidate || role_ == Role::kPreCandidate) &&
+      election_elapsed_ % (2 * config_.heartbeat_ticks) == 0 &&
+      election_elapsed_ < randomized_election_timeout_) {
+    SendVoteRequests();
+  }
   if (election_elapsed_ >= randomized_election_timeout_) {
     election_elapsed_ = 0;
     Message m;
@@ -358,6 +367,16 @@ Status RawNode::Step(const Message& m) {
         r.reject = true;
       }
       Send(std::move(r));
+      // Pre-candidate yield (a SwarmBox addition, not in etcd-io/raft): on a slow radio
+      // (round trip ~ 200 ms) the pre-vote round lets followers whose timers fired within ~100 ms
+      // of each other all reach the real election and split the vote. A pre-candidate that hears
+      // the pre-vote of a better one (more up-to-date log, ties broken by the higher id) steps
+      // back and restarts its timer. Only timing changes: no term, vote or log does.
+      if (m.type == MessageType::kPreVote && role_ == Role::kPreCandidate && !r.reject &&
+          std::tuple(m.log_term, m.index, m.from) >
+              std::tuple(log_.last_term(), log_.last_index(), config_.id)) {
+        BecomeFollower(term_, kNoNode);
+      }
       return Ok{};
     }
     default:

@@ -232,7 +232,7 @@ TEST(NodeDriver, ConfigurationErrorsNameTheProblem) {
   d = NodeDriver::Open(c, st, radio, clock, nullptr);
   ASSERT_FALSE(d.ok());
   EXPECT_EQ(d.error().message(),
-            "heartbeat_ms (75) and election_timeout_ms (600) must be multiples of tick_ms (50)");
+            "heartbeat_ms (75) and election_timeout_ms (500) must be multiples of tick_ms (50)");
   d = NodeDriver::Open(Cfg("a", {"a", "a"}), st, radio, clock, nullptr);
   ASSERT_FALSE(d.ok());
   EXPECT_EQ(d.error().message(), "member names must be distinct");

@@ -23,6 +23,12 @@
 // PreVote (thesis §9.6), CheckQuorum and leader lease for votes (thesis §6.2, §4.2.3), proposal
 // forwarding to the leader, log compaction and InstallSnapshot (§7). Not implemented: membership
 // changes (the voter set is fixed per trial), leadership transfer, ReadIndex.
+//
+// Two liveness-only additions for a lossy, slow radio (neither changes a term, vote or log entry,
+// so safety is untouched; the simulator checks it): (pre-)candidates re-send unanswered vote
+// requests every 2 heartbeat intervals (Raft §5.1 "servers retry RPCs"; etcd relies on TCP), and
+// a pre-candidate that hears the pre-vote of a better one (more up-to-date log, then higher id)
+// steps back instead of splitting the vote (not in etcd-io/raft).
 #pragma once
 
 #include <cstdint>
@@ -130,6 +136,7 @@ class RawNode {
   void BecomeCandidate();
   void BecomeLeader();
   void StartCampaign(bool pre_vote);
+  void SendVoteRequests();  // to every voter that has not answered yet
   VoteResult Poll(NodeId from, bool granted);
   std::size_t Quorum() const { return config_.voters.size() / 2 + 1; }
 

@@ -70,7 +70,7 @@ struct SimConfig {
   FaultModel faults;
   int tick_ms = 50;
   int heartbeat_ms = 100;
-  int election_timeout_ms = 600;
+  int election_timeout_ms = 500;
   bool pre_vote = true;
   bool check_quorum = true;
   std::uint64_t snapshot_every_entries = 32;
