@@ -86,10 +86,20 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   if (auto s = transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf); !s) {
     return s;
   }
-  constexpr std::int64_t kPollNs = 20'000'000;  // re-check `stop` at least this often
+  constexpr std::int64_t kPollNs = 20'000'000;        // re-check `stop` at least this often
+  constexpr std::int64_t kRepublishNs = 200'000'000;  // unanswered samples are sent again (late
+                                                      // joiners: the lockstep QoS is volatile)
+  std::int64_t last_publish = clock_.NowNs();
   while (!stop.load()) {
     const std::int64_t now = clock_.NowNs();
     if (lockstep_.StepComplete(now)) break;
+    if (now - last_publish >= kRepublishNs) {
+      last_publish = now;
+      for (std::size_t i = 0; i < world_.drone_count(); ++i) {
+        if (lockstep_.answered(i)) continue;
+        if (auto s = transport_.PublishSample(i, world_.drone_name(i), world_.sensors(i)); !s) return s;
+      }
+    }
     inbox_.clear();
     transport_.WaitActuators(std::min(lockstep_.NextDeadlineNs(), now + kPollNs), &inbox_);
     for (const ActuatorInput& cmd : inbox_) {

@@ -7,6 +7,8 @@
 // Per control step: publish every drone's sample (lost ones too, so they can rejoin) and due
 // camera frames, then wait until every live drone has answered this step (Lockstep); drones
 // silent past the timeout are marked lost (motors off, event=drone_lost) and the step goes on.
+// While waiting, unanswered samples are published again every 200 ms (agents that join late or a
+// lost message). Duplicate and stale commands are dropped (Lockstep).
 // Then World::Step(), truth.csv, pacing to the real-time factor. Events are printed as logfmt
 // lines on `events_out`.
 #pragma once

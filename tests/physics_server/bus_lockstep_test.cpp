@@ -1,0 +1,119 @@
+// Lockstep over the real sim bus (DDS on loopback): the server loop with BusTransport against a
+// fake agent in this process that answers for drone "a" always and for drone "b" only at first.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <thread>
+
+#include "bus_transport.hpp"
+#include "sim_server.hpp"
+#include "test_util.hpp"
+
+namespace swarmbox::physics {
+namespace {
+
+std::string ReadFile(std::FILE* f) {
+  std::fflush(f);
+  std::rewind(f);
+  std::string s;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, f)) s.append(buf, n);
+  return s;
+}
+
+void RunLockstepOverBus(const std::string& backend) {
+  const int domain = 100 + static_cast<int>(::getpid() % 100);
+  auto world = testing::MakeWorld(testing::CalmWorld());
+  const Airframe af = testing::LoadShippedAirframe("x500");
+  const double u = af.HoverRotorSpeed() / af.motor.max_rot_velocity_rad_s;
+  testing::Spawn(*world, testing::MakeSpawn("a", af, Vec3{0, 0, 10}, 0, u));
+  testing::Spawn(*world, testing::MakeSpawn("b", af, Vec3{5, 0, 10}, 0, u));
+
+  bus::ParticipantConfig pc;
+  pc.backend = backend;
+  pc.domain_id = domain;
+  pc.interface = "lo";
+  // The fake agent's endpoints first, so that discovery runs while the server starts.
+  auto agent = bus::Participant::Create(pc);
+  ASSERT_TRUE(agent.ok()) << agent.error().ToString();
+  auto sub_a = (*agent)->CreateSubscriber<bus::SensorSample>(bus::SensorTopic("a"), bus::Qos::kLockstep);
+  auto sub_b = (*agent)->CreateSubscriber<bus::SensorSample>(bus::SensorTopic("b"), bus::Qos::kLockstep);
+  auto cam_a = (*agent)->CreateSubscriber<bus::CameraImage>(bus::CameraTopic("a"), bus::Qos::kLockstep);
+  auto pub_a = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic("a"), bus::Qos::kLockstep);
+  auto pub_b = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic("b"), bus::Qos::kLockstep);
+  ASSERT_TRUE(sub_a.ok() && sub_b.ok() && cam_a.ok() && pub_a.ok() && pub_b.ok());
+
+  auto transport = BusTransport::Create(pc, {"a", "b"}, {af.gps, af.gps});
+  ASSERT_TRUE(transport.ok()) << transport.error().ToString();
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  SimServerOptions so;
+  so.rtf = 0;
+  so.max_sim_time_s = 1.0;
+  so.lockstep.timeout_ns = 300'000'000;
+  so.lockstep.join_timeout_ns = 20'000'000'000;
+  SteadyWallClock clock;
+  SimServer server(*world, **transport, clock, nullptr, so, out);
+  std::atomic<bool> stop{false}, done{false};
+  Status result;
+  std::thread server_thread([&] {
+    result = server.Run(stop);
+    done = true;
+  });
+
+  constexpr std::uint64_t kBAnswersUntil = 50;  // then drone b's agent "dies"
+  bus::SensorSample s;
+  bus::ActuatorCommand cmd;
+  cmd.armed = true;
+  cmd.motor_throttle.assign(4, u);
+  std::uint64_t a_answered = 0, images = 0;
+  bool b_valid_gps = false;
+  while (!done.load()) {
+    if ((*sub_a)->TakeFor(s, std::chrono::milliseconds(5))) {
+      cmd.drone = "a";
+      cmd.step = s.step;
+      ASSERT_TRUE((*pub_a)->Publish(cmd).ok());
+      ++a_answered;
+      EXPECT_TRUE(s.imu.valid);
+      EXPECT_NEAR(s.imu.accel_m_s2[2], 9.8, 0.5);
+    }
+    while ((*sub_b)->Take(s)) {
+      b_valid_gps = b_valid_gps || s.gps.valid;
+      if (s.step >= kBAnswersUntil) continue;
+      cmd.drone = "b";
+      cmd.step = s.step;
+      ASSERT_TRUE((*pub_b)->Publish(cmd).ok());
+    }
+    bus::CameraImage img;
+    while ((*cam_a)->Take(img)) {
+      ++images;
+      EXPECT_EQ(img.width_px, 320u);
+      EXPECT_EQ(img.data.size(), 320u * 240u * 3u);
+      EXPECT_EQ(img.encoding, "bgr8");
+    }
+  }
+  server_thread.join();
+  ASSERT_TRUE(result.ok()) << result.error().ToString();
+  EXPECT_EQ(world->step_count(), 250u);
+  EXPECT_GE(a_answered, 250u);
+  EXPECT_GE(images, 4u);  // 5 frames in 1 s (the first may go before discovery completes)
+  EXPECT_TRUE(b_valid_gps);
+  EXPECT_TRUE(world->Truth(1).lost);
+  EXPECT_FALSE(world->Truth(0).lost);
+  // a kept hovering on its agent's commands; b lost its motors at t = 0.2 s and fell.
+  EXPECT_NEAR(world->Truth(0).position_m.z, 10.23, 0.01);
+  EXPECT_LT(world->Truth(1).position_m.z, 9.0);
+  const std::string log = ReadFile(out);
+  std::fclose(out);
+  EXPECT_NE(log.find("t=0.200 node=physics event=drone_lost a=b"), std::string::npos) << log;
+  EXPECT_EQ(log.find("a=a"), std::string::npos) << log;
+}
+
+TEST(BusLockstep, FakeAgentKeepsItsDroneAndASilentOneIsLostCycloneDds) { RunLockstepOverBus("cyclonedds"); }
+
+TEST(BusLockstep, FakeAgentKeepsItsDroneAndASilentOneIsLostFastDds) { RunLockstepOverBus("fastdds"); }
+
+}  // namespace
+}  // namespace swarmbox::physics
