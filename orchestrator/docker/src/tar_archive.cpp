@@ -21,8 +21,10 @@ la_ssize_t AppendToString(archive* /*a*/, void* user, const void* buffer, size_t
   return static_cast<la_ssize_t>(length);
 }
 
+// Relative, no leading or trailing '/' (libarchive writes directories as "dir/").
 std::string Normalize(std::string_view path) {
   while (!path.empty() && path.front() == '/') path.remove_prefix(1);
+  while (!path.empty() && path.back() == '/') path.remove_suffix(1);
   return std::string(path);
 }
 
@@ -59,6 +61,9 @@ Status TarWriter::Add(const TarEntry& entry) {
   archive_entry_set_uid(e, entry.uid);
   archive_entry_set_gid(e, entry.gid);
   archive_entry_set_mtime(e, entry.mtime_unix_s, 0);
+  for (const auto& [name, value] : entry.xattrs) {
+    archive_entry_xattr_add_entry(e, name.c_str(), value.data(), value.size());
+  }
   switch (entry.type) {
     case TarEntry::Type::kFile:
       archive_entry_set_filetype(e, AE_IFREG);
@@ -92,21 +97,28 @@ Status TarWriter::Add(const TarEntry& entry) {
 }
 
 Status TarWriter::AddFile(std::string_view path, std::string_view content, std::uint32_t mode) {
-  return Add(TarEntry{.type = TarEntry::Type::kFile,
-                      .path = std::string(path),
-                      .content = std::string(content),
-                      .mode = mode});
+  TarEntry entry;
+  entry.path = std::string(path);
+  entry.content = std::string(content);
+  entry.mode = mode;
+  return Add(entry);
 }
 
 Status TarWriter::AddDirectory(std::string_view path, std::uint32_t mode) {
-  return Add(TarEntry{.type = TarEntry::Type::kDirectory, .path = std::string(path), .content = {}, .mode = mode});
+  TarEntry entry;
+  entry.type = TarEntry::Type::kDirectory;
+  entry.path = std::string(path);
+  entry.mode = mode;
+  return Add(entry);
 }
 
 Status TarWriter::AddSymlink(std::string_view path, std::string_view target) {
-  return Add(TarEntry{.type = TarEntry::Type::kSymlink,
-                      .path = std::string(path),
-                      .content = std::string(target),
-                      .mode = 0777});
+  TarEntry entry;
+  entry.type = TarEntry::Type::kSymlink;
+  entry.path = std::string(path);
+  entry.content = std::string(target);
+  entry.mode = 0777;
+  return Add(entry);
 }
 
 Result<std::string> TarWriter::Finish() {
@@ -143,6 +155,14 @@ Result<std::vector<TarEntry>> ReadTar(std::string_view bytes) {
     entry.uid = static_cast<std::uint32_t>(archive_entry_uid(e));
     entry.gid = static_cast<std::uint32_t>(archive_entry_gid(e));
     entry.mtime_unix_s = archive_entry_mtime(e);
+    if (archive_entry_xattr_reset(e) > 0) {
+      const char* name = nullptr;
+      const void* value = nullptr;
+      size_t size = 0;
+      while (archive_entry_xattr_next(e, &name, &value, &size) == ARCHIVE_OK) {
+        entry.xattrs[name] = std::string(static_cast<const char*>(value), size);
+      }
+    }
     const auto type = archive_entry_filetype(e);
     if (type == AE_IFREG && archive_entry_hardlink(e) == nullptr) {
       entry.type = TarEntry::Type::kFile;

@@ -28,6 +28,23 @@ TEST(TarArchive, RoundTripsFilesDirectoriesAndSymlinks) {
   EXPECT_EQ((*entries)[3].content, "xtables-nft-multi");
 }
 
+TEST(TarArchive, CarriesExtendedAttributes) {
+  TarEntry tool;
+  tool.path = "usr/sbin/tc";
+  tool.content = "ELF";
+  tool.mode = 0755;
+  tool.xattrs["security.capability"] = std::string("\x01\x00\x00\x02\x00\x10\x00\x00", 8);
+  TarWriter w;
+  ASSERT_TRUE(w.Add(tool));
+  auto bytes = w.Finish();
+  ASSERT_TRUE(bytes) << bytes.error().ToString();
+  EXPECT_NE(bytes->find("SCHILY.xattr.security.capability"), std::string::npos);
+  auto entries = ReadTar(*bytes);
+  ASSERT_TRUE(entries) << entries.error().ToString();
+  ASSERT_EQ(entries->size(), 1u);
+  EXPECT_EQ((*entries)[0].xattrs, tool.xattrs);
+}
+
 TEST(TarArchive, EqualInputsGiveByteEqualArchives) {
   auto make = [] {
     TarWriter w;

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -31,6 +32,9 @@ struct TarEntry {
   std::uint32_t uid = 0;
   std::uint32_t gid = 0;
   std::int64_t mtime_unix_s = 0;
+  // Extended attributes written as pax SCHILY.xattr records, e.g. "security.capability" (file
+  // capabilities, which Docker's builder keeps when it copies the file into a layer).
+  std::map<std::string, std::string> xattrs;
 };
 
 class TarWriter {

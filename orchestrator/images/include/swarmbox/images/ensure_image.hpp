@@ -1,0 +1,35 @@
+// EnsureImage: make sure a host's engine has the image of a spec, building it only when missing.
+// What `swarmbox images` and the trial runner call per host.
+//
+//   auto r = EnsureImage(api, PhysicsImage(binary), [](std::string_view l) { Log(l); }, nullptr);
+//   if (!r) return r.error();          // e.g. "image build failed: COPY failed: ..."
+//   spec.image = r->tag;               // "swarmbox/physics:3f2a9c01d4e5b6a7"
+//
+// Errors: packing errors (host files), engine errors from DockerApi, build errors from the build
+// stream (errorDetail), each with the image's repository as context.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/docker/docker_api.hpp"
+#include "swarmbox/images/image_spec.hpp"
+
+namespace swarmbox::images {
+
+struct EnsuredImage {
+  std::string tag;
+  std::string image_id;
+  bool built = false;               // false: the engine already had this content hash
+  std::size_t context_bytes = 0;
+  std::int64_t image_size_bytes = 0;
+  double pack_s = 0;                // reading files, closure, tar and hash [s]
+  double build_s = 0;               // the /build call, 0 when skipped [s]
+};
+
+Result<EnsuredImage> EnsureImage(docker::DockerApi& api, const ImageSpec& spec,
+                                 const docker::BuildProgressFn& progress,
+                                 docker::CancelToken* cancel);
+
+}  // namespace swarmbox::images

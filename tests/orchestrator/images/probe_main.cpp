@@ -1,0 +1,52 @@
+// swarmbox-probe: a small C++ program of the tree that the end-to-end tests pack into a
+// registry-free image (with its libstdc++/libc closure) and run in Docker.
+//
+//   swarmbox-probe serve N    "probe ready uid=U gid=G", then N "tick i" (stdout) and "warn i"
+//                             (stderr) lines 10 ms apart; then waits for /tmp/stop to appear,
+//                             prints "stopping: <its content>" and exits 3
+//   swarmbox-probe exit K     prints "exec uid=U" and exits K
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+namespace {
+
+int Serve(int n) {
+  std::cout << "probe ready uid=" << getuid() << " gid=" << getgid() << std::endl;
+  for (int i = 0; i < n; ++i) {
+    std::cout << "tick " << i << std::endl;
+    std::cerr << "warn " << i << std::endl;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  while (true) {
+    std::ifstream stop("/tmp/stop");
+    if (stop) {
+      std::stringstream text;
+      text << stop.rdbuf();
+      std::string content = text.str();
+      while (!content.empty() && content.back() == '\n') content.pop_back();
+      std::cout << "stopping: " << content << std::endl;
+      return 3;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string mode = argc > 1 ? argv[1] : "";
+  if (mode == "serve" && argc == 3) return Serve(std::atoi(argv[2]));
+  if (mode == "exit" && argc == 3) {
+    std::cout << "exec uid=" << getuid() << std::endl;
+    return std::atoi(argv[2]);
+  }
+  std::cerr << "usage: swarmbox-probe serve N | exit K" << std::endl;
+  return 2;
+}
