@@ -79,7 +79,7 @@ int Daemonize(const std::string& pidfile, const std::function<int(const std::fun
       std::ofstream out(pidfile, std::ios::trunc);
       out << ::getpid() << "\n";
       if (!out) {
-        WriteAll(ready_fd, "cannot write pidfile " + pidfile);
+        WriteAll(ready_fd, "swarmbox-netemd: cannot write pidfile " + pidfile + "\n");
         ::_exit(1);
       }
     }
