@@ -12,7 +12,11 @@
 // Options: --quick, --backend=cyclonedds|fastdds|all, --mode=same_process|two_process|all,
 //          --size=small|large|all, --domain=<first domain id, default 200>, --n=<round trips>,
 //          --interface=<name, default lo>, --echo-backend=<backend of the echo; default: the same>
-//          (cross-vendor figures; the line then carries echo_backend=...).
+//          (cross-vendor figures; the line then carries echo_backend=...),
+//          --scenario=rtt|fleet|all, --drones=<fleet size; default 10 (quick) or 10, 50, 100>,
+//          --steps=<fleet lockstep steps; default 100 (quick) or 1000>.
+// Fleet lines: suite=bus scenario=lockstep_fleet backend=.. drones=N steps=.. step_p50_us=..
+//   step_p99_us=.. steps_s=.. msgs_s=.. (2N messages per step) max_hz_per_drone=.. timeouts=0
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -226,6 +230,116 @@ int RunScenario(const Scenario& sc, T ping, std::size_t payload_bytes, int n, in
   return timeouts == 0 ? 0 : 1;
 }
 
+// Lockstep of a fleet across two processes: this process plays the physics server (publishes
+// every drone's SensorSample for step k, then waits for every drone's ActuatorCommand of step k),
+// the child plays `drones` agents. Figures: per-step latency (first publish to last command) and
+// steps per second; at 250 Hz real time needs steps_s >= 250.
+int RunFleet(const Scenario& sc, int drones, int steps) {
+  testing::EchoOptions o{.backend = sc.echo_backend, .domain_id = sc.domain,
+                         .interface = sc.interface, .kind = "fleet", .drones = drones};
+  auto echo = Echo::Start("two_process", o);
+  if (!echo) return 1;
+  auto p = Participant::Create({.backend = sc.backend, .domain_id = sc.domain, .interface = sc.interface});
+  if (!p) {
+    std::fprintf(stderr, "bus bench: %s\n", p.error().ToString().c_str());
+    return 1;
+  }
+  std::vector<std::string> names;
+  std::vector<std::unique_ptr<Publisher<SensorSample>>> pubs;
+  std::vector<std::unique_ptr<Subscriber<ActuatorCommand>>> subs;
+  for (int i = 0; i < drones; ++i) {
+    names.push_back("drone_" + std::to_string(i));
+    auto pub = (*p)->CreatePublisher<SensorSample>(SensorTopic(names.back()), Qos::kLockstep);
+    auto sub = (*p)->CreateSubscriber<ActuatorCommand>(ActuatorTopic(names.back()), Qos::kLockstep);
+    if (!pub || !sub) {
+      std::fprintf(stderr, "bus bench: fleet: cannot create endpoints\n");
+      return 1;
+    }
+    pubs.push_back(std::move(*pub));
+    subs.push_back(std::move(*sub));
+  }
+  const auto match_deadline = Clock::now() + std::chrono::seconds(30);
+  for (int i = 0; i < drones; ++i) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(match_deadline - Clock::now());
+    if (!pubs[static_cast<std::size_t>(i)]->WaitForSubscribers(1, left) ||
+        !subs[static_cast<std::size_t>(i)]->WaitForPublishers(1, left)) {
+      std::fprintf(stderr, "bus bench: fleet: drone %d did not match within 30 s\n", i);
+      return 1;
+    }
+  }
+  SensorSample s = testing::FullSensorSample(1);
+  ActuatorCommand cmd;
+  // Handshake: resend step 0 to the drones that have not answered yet, every 100 ms.
+  std::vector<bool> answered(static_cast<std::size_t>(drones), false);
+  int missing = drones;
+  s.step = 0;
+  for (const auto deadline = Clock::now() + std::chrono::seconds(30); missing > 0 && Clock::now() < deadline;) {
+    for (std::size_t i = 0; i < answered.size(); ++i) {
+      if (answered[i]) continue;
+      s.drone = names[i];
+      (void)pubs[i]->Publish(s);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    for (std::size_t i = 0; i < answered.size(); ++i) {
+      while (!answered[i] && subs[i]->Take(cmd)) {
+        if (cmd.step == 0) {
+          answered[i] = true;
+          --missing;
+        }
+      }
+    }
+  }
+  if (missing > 0) {
+    std::fprintf(stderr, "bus bench: fleet: %d drones never answered step 0\n", missing);
+    return 1;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  for (auto& sub : subs) {
+    while (sub->Take(cmd)) {
+    }
+  }
+  std::vector<double> step_us;
+  step_us.reserve(static_cast<std::size_t>(steps));
+  int timeouts = 0;
+  const auto t_all = Clock::now();
+  for (int k = 1; k <= steps && timeouts == 0; ++k) {
+    const auto step = static_cast<std::uint64_t>(k);
+    const auto t0 = Clock::now();
+    s.step = step;
+    s.sim_time_ns = k * 4'000'000LL;
+    for (std::size_t i = 0; i < pubs.size(); ++i) {
+      s.drone = names[i];
+      (void)pubs[i]->Publish(s);
+    }
+    for (std::size_t i = 0; i < subs.size(); ++i) {
+      bool got = false;
+      while (subs[i]->TakeFor(cmd, std::chrono::seconds(2))) {
+        if (cmd.step == step) {
+          got = true;
+          break;
+        }
+      }
+      if (!got) {
+        ++timeouts;
+        break;
+      }
+    }
+    step_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+  }
+  const double secs = std::chrono::duration<double>(Clock::now() - t_all).count();
+  const double steps_s = secs > 0 ? static_cast<double>(step_us.size()) / secs : 0.0;
+  std::printf(
+      "suite=bus scenario=lockstep_fleet backend=%s%s%s mode=two_process interface=%s drones=%d "
+      "steps=%zu step_p50_us=%.1f step_p99_us=%.1f steps_s=%.0f msgs_s=%.0f "
+      "max_hz_per_drone=%.0f timeouts=%d\n",
+      sc.backend.c_str(), sc.echo_backend == sc.backend ? "" : " echo_backend=",
+      sc.echo_backend == sc.backend ? "" : sc.echo_backend.c_str(), sc.interface.c_str(), drones,
+      step_us.size(), Percentile(step_us, 0.50), Percentile(step_us, 0.99), steps_s,
+      2.0 * drones * steps_s, steps_s, timeouts);
+  std::fflush(stdout);
+  return timeouts == 0 ? 0 : 1;
+}
+
 std::vector<std::string> Pick(const std::string& value, std::vector<std::string> all) {
   if (value == "all") return all;
   return {value};
@@ -239,8 +353,26 @@ int RunBusBench(const Args& args) {
   int domain = static_cast<int>(args.GetInt("domain", 200));
   const std::string interface = args.Get("interface", "lo");
   const std::string echo_backend = args.Get("echo-backend", "");
+  const std::string scenario = args.Get("scenario", "all");
+  if (scenario != "all" && scenario != "rtt" && scenario != "fleet") {
+    std::fprintf(stderr, "bus bench: unknown --scenario '%s': accepted rtt, fleet, all\n",
+                 scenario.c_str());
+    return 2;
+  }
   int worst = 0;
   for (const auto& backend : backends) {
+    if (scenario == "rtt") break;
+    std::vector<int> fleet_sizes = args.quick ? std::vector<int>{10} : std::vector<int>{10, 50, 100};
+    if (args.options.count("drones") != 0) fleet_sizes = {static_cast<int>(args.GetInt("drones", 10))};
+    for (int drones : fleet_sizes) {
+      const Scenario sc{backend, echo_backend.empty() ? backend : echo_backend, "two_process",
+                        "fleet", interface, domain++};
+      const int steps = static_cast<int>(args.GetInt("steps", args.quick ? 100 : 1000));
+      if (const int rc = RunFleet(sc, drones, steps); rc != 0) worst = rc;
+    }
+  }
+  for (const auto& backend : backends) {
+    if (scenario == "fleet") break;
     for (const auto& mode : modes) {
       for (const auto& size : sizes) {
         int rc = 0;

@@ -6,8 +6,10 @@
 //             the same step (what an agent does for the physics server), Qos::kLockstep
 //   small     RaftMessage on kBenchPingTopic -> the same message on kBenchPongTopic, kLockstep
 //   large     CameraImage on kBenchPingTopic -> the same message on kBenchPongTopic, kLockstep
+//   fleet     `drones` agents drone_0..drone_<n-1> in this process, each answering its SensorSample
+//             with an ActuatorCommand of the same step from the subscriber callback
 // Options as key/value pairs: backend, domain, interface (default lo), kind, drone (default
-// drone_1). The swarmbox-bus-echo test helper and `swarmbox-bench bus --role=echo` both run it.
+// drone_1), drones (fleet size, default 1). The swarmbox-bus-echo test helper and `swarmbox-bench bus --role=echo` both run it.
 #pragma once
 
 #include <atomic>
@@ -29,6 +31,7 @@ struct EchoOptions {
   std::string interface = "lo";
   std::string kind = "lockstep";
   std::string drone = "drone_1";
+  int drones = 1;
 };
 
 // kInvalidArgument naming the bad key or value.
