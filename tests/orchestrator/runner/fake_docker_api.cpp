@@ -1,0 +1,306 @@
+#include "fake_docker_api.hpp"
+
+#include <chrono>
+#include <filesystem>
+
+#include "swarmbox/docker/tar_archive.hpp"
+
+namespace swarmbox::testing {
+
+Error FakeDockerApi::NotModelled(std::string_view what) {
+  return Error(ErrorCode::kInternal, std::string(what) + " is not modelled by FakeDockerApi");
+}
+
+bool FakeDockerApi::Selects(const docker::LabelSelector& selector, const docker::Labels& labels) {
+  for (const auto& [k, v] : selector.equals) {
+    auto it = labels.find(k);
+    if (it == labels.end() || (!v.empty() && it->second != v)) return false;
+  }
+  return true;
+}
+
+FakeDockerApi::Container* FakeDockerApi::Find(std::string_view id) {
+  for (auto& [cid, c] : containers_) {
+    if (cid == id || c.spec.name == id) return &c;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> FakeDockerApi::Calls() const {
+  std::lock_guard lock(mu_);
+  return calls_;
+}
+std::map<std::string, FakeDockerApi::Container> FakeDockerApi::Containers() const {
+  std::lock_guard lock(mu_);
+  return containers_;
+}
+std::map<std::string, docker::NetworkSpec> FakeDockerApi::Networks() const {
+  std::lock_guard lock(mu_);
+  return networks_;
+}
+std::map<std::string, std::string> FakeDockerApi::PutArchives() const {
+  std::lock_guard lock(mu_);
+  return put_archives_;
+}
+std::vector<std::string> FakeDockerApi::SubnetsTried() const {
+  std::lock_guard lock(mu_);
+  return subnets_tried_;
+}
+
+Result<std::string> FakeDockerApi::Ping() { return std::string("1.41"); }
+Result<docker::EngineVersion> FakeDockerApi::Version() { return NotModelled("Version"); }
+Result<docker::BuildResult> FakeDockerApi::BuildImage(const docker::BuildRequest&,
+                                                      const docker::BuildProgressFn&,
+                                                      docker::CancelToken*) {
+  return NotModelled("BuildImage");
+}
+Result<docker::ImageInfo> FakeDockerApi::InspectImage(std::string_view) { return NotModelled("InspectImage"); }
+Result<std::vector<docker::ImageInfo>> FakeDockerApi::ListImages(const docker::LabelSelector&) {
+  return NotModelled("ListImages");
+}
+Status FakeDockerApi::RemoveImage(std::string_view, bool) { return NotModelled("RemoveImage"); }
+
+Result<std::string> FakeDockerApi::CreateNetwork(const docker::NetworkSpec& spec) {
+  std::lock_guard lock(mu_);
+  calls_.push_back("create-network " + spec.name);
+  subnets_tried_.push_back(spec.subnet);
+  if (network_conflicts > 0) {
+    --network_conflicts;
+    return Error(ErrorCode::kInvalidArgument, "Pool overlaps with other one on this address space",
+                 "POST /networks/create");
+  }
+  for (const auto& [id, n] : networks_) {
+    if (n.name == spec.name) return Error(ErrorCode::kAlreadyExists, "network with name exists");
+    if (n.subnet == spec.subnet) {
+      return Error(ErrorCode::kInvalidArgument, "Pool overlaps with other one on this address space");
+    }
+  }
+  const std::string id = "net" + std::to_string(next_id_++);
+  networks_[id] = spec;
+  return id;
+}
+
+Result<docker::NetworkInfo> FakeDockerApi::InspectNetwork(std::string_view) {
+  return NotModelled("InspectNetwork");
+}
+
+Result<std::vector<docker::NetworkInfo>> FakeDockerApi::ListNetworks(
+    const docker::LabelSelector& selector) {
+  std::lock_guard lock(mu_);
+  std::vector<docker::NetworkInfo> out;
+  for (const auto& [id, n] : networks_) {
+    if (!Selects(selector, n.labels)) continue;
+    docker::NetworkInfo info;
+    info.id = id;
+    info.name = n.name;
+    info.subnet = n.subnet;
+    info.gateway = n.gateway;
+    info.internal = n.internal;
+    info.labels = n.labels;
+    out.push_back(info);
+  }
+  return out;
+}
+
+Status FakeDockerApi::ConnectNetwork(const docker::EndpointSpec&, std::string_view) {
+  return NotModelled("ConnectNetwork");
+}
+Status FakeDockerApi::DisconnectNetwork(std::string_view, std::string_view, bool) {
+  return NotModelled("DisconnectNetwork");
+}
+
+Status FakeDockerApi::RemoveNetwork(std::string_view id) {
+  std::lock_guard lock(mu_);
+  auto it = networks_.find(std::string(id));
+  if (it == networks_.end()) return Error(ErrorCode::kNotFound, "no such network");
+  calls_.push_back("remove-network " + it->second.name);
+  for (const auto& [cid, c] : containers_) {
+    for (const auto& e : c.spec.networks) {
+      if (e.network == id) {
+        return Error(ErrorCode::kInvalidArgument, "network has active endpoints");
+      }
+    }
+  }
+  networks_.erase(it);
+  return Ok{};
+}
+
+Result<std::string> FakeDockerApi::CreateContainer(const docker::ContainerSpec& spec) {
+  std::lock_guard lock(mu_);
+  calls_.push_back("create " + spec.name);
+  if (Find(spec.name) != nullptr) return Error(ErrorCode::kAlreadyExists, "name in use");
+  for (const auto& e : spec.networks) {
+    if (networks_.count(e.network) == 0) return Error(ErrorCode::kNotFound, "no such network " + e.network);
+  }
+  const std::string id = "c" + std::to_string(next_id_++);
+  Container c;
+  c.spec = spec;
+  auto label = spec.labels.find(std::string(docker::kLabelComponent));
+  c.component = label == spec.labels.end() ? spec.name : label->second;
+  c.state.status = "created";
+  containers_[id] = c;
+  return id;
+}
+
+Result<docker::ContainerInfo> FakeDockerApi::InspectContainer(std::string_view id) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  docker::ContainerInfo info;
+  info.id = std::string(id);
+  info.name = c->spec.name;
+  info.state = c->state;
+  info.labels = c->spec.labels;
+  return info;
+}
+
+Result<std::vector<docker::ContainerSummary>> FakeDockerApi::ListContainers(
+    const docker::LabelSelector& selector, bool all) {
+  std::lock_guard lock(mu_);
+  std::vector<docker::ContainerSummary> out;
+  for (const auto& [id, c] : containers_) {
+    if (!Selects(selector, c.spec.labels) || (!all && !c.state.running)) continue;
+    docker::ContainerSummary s;
+    s.id = id;
+    s.names = {c.spec.name};
+    s.state = c.state.status;
+    s.labels = c.spec.labels;
+    out.push_back(s);
+  }
+  return out;
+}
+
+Status FakeDockerApi::StartContainer(std::string_view id) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  calls_.push_back("start " + c->spec.name);
+  if (scripts[c->component].fail_start) {
+    return Error(ErrorCode::kInternal, "exec format error", "POST /containers/start");
+  }
+  c->state.status = "running";
+  c->state.running = true;
+  cv_.notify_all();
+  return Ok{};
+}
+
+Status FakeDockerApi::StopContainer(std::string_view id, int) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  calls_.push_back("stop " + c->spec.name);
+  if (c->state.running) {
+    c->state.running = false;
+    c->state.status = "exited";
+    c->state.exit_code = 0;
+  }
+  cv_.notify_all();
+  return Ok{};
+}
+
+Status FakeDockerApi::RestartContainer(std::string_view, int) { return NotModelled("RestartContainer"); }
+Status FakeDockerApi::KillContainer(std::string_view, std::string_view) { return NotModelled("KillContainer"); }
+Status FakeDockerApi::PauseContainer(std::string_view) { return NotModelled("PauseContainer"); }
+Status FakeDockerApi::UnpauseContainer(std::string_view) { return NotModelled("UnpauseContainer"); }
+Result<std::int64_t> FakeDockerApi::WaitContainer(std::string_view, docker::WaitCondition,
+                                                  docker::CancelToken*) {
+  return NotModelled("WaitContainer");
+}
+
+Status FakeDockerApi::RemoveContainer(std::string_view id, bool force, bool) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  if (c->state.running && !force) return Error(ErrorCode::kInvalidArgument, "container is running");
+  calls_.push_back("remove " + c->spec.name);
+  for (auto it = containers_.begin(); it != containers_.end(); ++it) {
+    if (&it->second == c) {
+      containers_.erase(it);
+      break;
+    }
+  }
+  cv_.notify_all();
+  return Ok{};
+}
+
+Status FakeDockerApi::FollowLogs(std::string_view id, const docker::LogOptions&,
+                                 const docker::LogLineFn& on_line, docker::CancelToken* cancel) {
+  std::vector<std::string> lines;
+  std::optional<std::int64_t> exit_code;
+  bool broken = false;
+  {
+    std::lock_guard lock(mu_);
+    Container* c = Find(id);
+    if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+    ++c->follows;
+    ContainerScript& s = scripts[c->component];
+    lines = s.lines;
+    exit_code = s.exit_code;
+    if (s.broken_streams > 0) {
+      --s.broken_streams;
+      broken = true;
+      if (lines.size() > s.broken_stream_lines) lines.resize(s.broken_stream_lines);
+    }
+  }
+  for (const std::string& l : lines) {
+    if (cancel != nullptr && cancel->cancelled()) return Error(ErrorCode::kCancelled, "cancelled");
+    on_line({docker::StreamKind::kStdout, l});
+  }
+  if (broken) return Error(ErrorCode::kIo, "connection reset by peer", "GET /containers/logs");
+  std::unique_lock lock(mu_);
+  if (exit_code) {
+    Container* c = Find(id);
+    if (c != nullptr && c->state.running) {
+      c->state.running = false;
+      c->state.status = "exited";
+      c->state.exit_code = *exit_code;
+    }
+    return Ok{};
+  }
+  while (true) {
+    Container* c = Find(id);
+    if (c == nullptr || !c->state.running) return Ok{};
+    if (cancel != nullptr && cancel->cancelled()) return Error(ErrorCode::kCancelled, "cancelled");
+    cv_.wait_for(lock, std::chrono::milliseconds(10));
+  }
+}
+
+Result<std::string> FakeDockerApi::CreateExec(std::string_view, const docker::ExecSpec&) {
+  return NotModelled("CreateExec");
+}
+Status FakeDockerApi::StartExec(std::string_view, const docker::LogLineFn&, docker::CancelToken*) {
+  return NotModelled("StartExec");
+}
+Result<docker::ExecState> FakeDockerApi::InspectExec(std::string_view) { return NotModelled("InspectExec"); }
+
+Status FakeDockerApi::PutArchive(std::string_view container_id, std::string_view dest_dir,
+                                 std::string_view tar) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(container_id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  if (dest_dir != "/") return Error(ErrorCode::kInvalidArgument, "the fake takes archives at / only");
+  c->put_archive = std::string(tar);
+  put_archives_[c->spec.name] = std::string(tar);
+  return Ok{};
+}
+
+Result<std::string> FakeDockerApi::GetArchive(std::string_view container_id, std::string_view path) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(container_id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  const auto& files = scripts[c->component].files;
+  auto it = files.find(std::string(path));
+  if (it == files.end()) return Error(ErrorCode::kNotFound, "Could not find the file " + std::string(path));
+  docker::TarWriter tar;
+  if (Status s = tar.AddFile(std::filesystem::path(std::string(path)).filename().string(), it->second); !s) {
+    return s.error();
+  }
+  return tar.Finish();
+}
+
+Status FakeDockerApi::StreamEvents(const docker::EventFilter&, const docker::EventFn&,
+                                   docker::CancelToken*) {
+  return NotModelled("StreamEvents");
+}
+
+}  // namespace swarmbox::testing

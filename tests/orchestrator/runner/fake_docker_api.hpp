@@ -1,0 +1,106 @@
+// FakeDockerApi: an in-memory Docker engine for the runner's tests. Containers follow a script
+// per component (the swarmbox.component label): lines they log once started, whether they exit by
+// themselves (and with which code), files they hold for GetArchive. Networks check subnet overlap
+// like Docker does. Thread-safe (the runner follows logs from several threads).
+//
+// Methods the runner never calls (images, exec, events, pause...) return kInternal "not modelled
+// by FakeDockerApi" so a test notices if that changes.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "swarmbox/docker/docker_api.hpp"
+
+namespace swarmbox::testing {
+
+struct ContainerScript {
+  std::vector<std::string> lines;              // logged right after start, in order
+  std::optional<std::int64_t> exit_code;       // exits by itself after the lines; nullopt = runs until stopped
+  std::map<std::string, std::string> files;    // path in the container -> content (GetArchive)
+  int broken_streams = 0;                      // the first N FollowLogs calls fail with kIo...
+  std::size_t broken_stream_lines = 0;         // ...after delivering this many lines
+  bool fail_start = false;                     // StartContainer fails
+};
+
+class FakeDockerApi : public docker::DockerApi {
+ public:
+  // Scripts by component name.
+  std::map<std::string, ContainerScript> scripts;
+  // CreateNetwork answers "Pool overlaps" this many times first (another orchestrator won a race).
+  int network_conflicts = 0;
+
+  // Inspection for tests.
+  struct Container {
+    docker::ContainerSpec spec;
+    std::string component;
+    docker::ContainerState state;
+    std::string put_archive;  // last PutArchive tar
+    int follows = 0;
+  };
+  std::vector<std::string> Calls() const;                  // "create-network <name>", ...
+  std::map<std::string, Container> Containers() const;     // id -> container
+  std::map<std::string, docker::NetworkSpec> Networks() const;  // id -> spec
+  std::vector<std::string> SubnetsTried() const;
+  std::map<std::string, std::string> PutArchives() const;  // container name -> last tar put
+
+  // docker::DockerApi
+  Result<std::string> Ping() override;
+  Result<docker::EngineVersion> Version() override;
+  std::string api_version() const override { return "1.41"; }
+  Result<docker::BuildResult> BuildImage(const docker::BuildRequest&, const docker::BuildProgressFn&,
+                                         docker::CancelToken*) override;
+  Result<docker::ImageInfo> InspectImage(std::string_view) override;
+  Result<std::vector<docker::ImageInfo>> ListImages(const docker::LabelSelector&) override;
+  Status RemoveImage(std::string_view, bool) override;
+  Result<std::string> CreateNetwork(const docker::NetworkSpec& spec) override;
+  Result<docker::NetworkInfo> InspectNetwork(std::string_view id) override;
+  Result<std::vector<docker::NetworkInfo>> ListNetworks(const docker::LabelSelector& selector) override;
+  Status ConnectNetwork(const docker::EndpointSpec&, std::string_view) override;
+  Status DisconnectNetwork(std::string_view, std::string_view, bool) override;
+  Status RemoveNetwork(std::string_view id) override;
+  Result<std::string> CreateContainer(const docker::ContainerSpec& spec) override;
+  Result<docker::ContainerInfo> InspectContainer(std::string_view id) override;
+  Result<std::vector<docker::ContainerSummary>> ListContainers(const docker::LabelSelector& selector,
+                                                               bool all) override;
+  Status StartContainer(std::string_view id) override;
+  Status StopContainer(std::string_view id, int timeout_s) override;
+  Status RestartContainer(std::string_view, int) override;
+  Status KillContainer(std::string_view, std::string_view) override;
+  Status PauseContainer(std::string_view) override;
+  Status UnpauseContainer(std::string_view) override;
+  Result<std::int64_t> WaitContainer(std::string_view, docker::WaitCondition,
+                                     docker::CancelToken*) override;
+  Status RemoveContainer(std::string_view id, bool force, bool remove_volumes) override;
+  Status FollowLogs(std::string_view id, const docker::LogOptions& options,
+                    const docker::LogLineFn& on_line, docker::CancelToken* cancel) override;
+  Result<std::string> CreateExec(std::string_view, const docker::ExecSpec&) override;
+  Status StartExec(std::string_view, const docker::LogLineFn&, docker::CancelToken*) override;
+  Result<docker::ExecState> InspectExec(std::string_view) override;
+  Status PutArchive(std::string_view container_id, std::string_view dest_dir,
+                    std::string_view tar) override;
+  Result<std::string> GetArchive(std::string_view container_id, std::string_view path) override;
+  Status StreamEvents(const docker::EventFilter&, const docker::EventFn&,
+                      docker::CancelToken*) override;
+
+ private:
+  static Error NotModelled(std::string_view what);
+  static bool Selects(const docker::LabelSelector& selector, const docker::Labels& labels);
+  Container* Find(std::string_view id);  // by id or name; mu_ held
+
+  mutable std::mutex mu_;
+  std::condition_variable cv_;
+  std::vector<std::string> calls_;
+  std::map<std::string, Container> containers_;
+  std::map<std::string, docker::NetworkSpec> networks_;
+  std::vector<std::string> subnets_tried_;
+  std::map<std::string, std::string> put_archives_;
+  int next_id_ = 1;
+};
+
+}  // namespace swarmbox::testing

@@ -1,0 +1,101 @@
+// The watch rules as scripted scenarios: inputs in order, the verdict expected (or none).
+#include "swarmbox/runner/monitor.hpp"
+
+#include <gtest/gtest.h>
+
+namespace swarmbox::runner {
+namespace {
+
+struct Step {
+  enum Kind { kLine, kExit, kTick } kind;
+  const char* component;
+  const char* text;   // line
+  double value;       // exit code or wall time
+};
+
+struct Scenario {
+  const char* name;
+  std::vector<Step> steps;
+  std::optional<dsl::Outcome> outcome;
+  const char* reason;
+  double sim_s;
+};
+
+std::unique_ptr<dsl::Trial> MakeTrial() {
+  auto t = std::make_unique<dsl::Trial>("t");
+  t->Add<dsl::Plugin>("physics", dsl::ContainerSpec(), 1);
+  t->Add<dsl::Plugin>("scout_1", dsl::ContainerSpec(), 2);
+  t->EndOn("event=mission_complete", dsl::Outcome::kSuccess);
+  t->EndOn("event=collision", dsl::Outcome::kFailure, "collision");
+  t->SetTimeout(dsl::TimeoutPolicy::Sim(dsl::Duration::Seconds(60), dsl::Duration::Seconds(120), "physics"));
+  return t;
+}
+
+TEST(Monitor, Scenarios) {
+  using S = Step;
+  const std::vector<Scenario> scenarios = {
+      {"mission completes",
+       {{S::kLine, "physics", "t=10 event=tick", 0}, {S::kLine, "scout_1", "t=11 event=mission_complete", 0}},
+       dsl::Outcome::kSuccess, "matched 'event=mission_complete'", 10},
+      {"only the clock component's t counts",
+       {{S::kLine, "scout_1", "t=70 event=tick", 0}, {S::kTick, "", "", 5}},
+       std::nullopt, "", 0},
+      {"simulated time runs out",
+       {{S::kLine, "physics", "t=59.9 event=tick", 0}, {S::kLine, "physics", "t=60 event=tick", 0}},
+       dsl::Outcome::kTimeout, "simulated time ran out (1m)", 60},
+      {"a crash ends it",
+       {{S::kLine, "physics", "t=3 event=tick", 0}, {S::kExit, "scout_1", "", 139}},
+       dsl::Outcome::kFailure, "scout_1 exited with code 139 before the trial ended", 3},
+      {"wall guard",
+       {{S::kLine, "physics", "t=3 event=tick", 0}, {S::kTick, "", "", 119}, {S::kTick, "", "", 120}},
+       dsl::Outcome::kError, "wall-clock guard: 2m passed with simulated time at 3.0s of 1m", 3},
+      {"the first end wins",
+       {{S::kLine, "scout_1", "t=3 event=collision", 0}, {S::kLine, "scout_1", "t=4 event=mission_complete", 0},
+        {S::kExit, "physics", "", 1}, {S::kTick, "", "", 500}},
+       dsl::Outcome::kFailure, "collision", 0},
+  };
+  for (const Scenario& sc : scenarios) {
+    SCOPED_TRACE(sc.name);
+    auto trial = MakeTrial();
+    auto m = Monitor::Create(*trial);
+    ASSERT_TRUE(m);
+    m->Started("physics");
+    m->Started("scout_1");
+    std::optional<dsl::Verdict> first;
+    for (const Step& s : sc.steps) {
+      std::optional<dsl::Verdict> v;
+      if (s.kind == Step::kLine) v = m->OnLine(s.component, s.text);
+      if (s.kind == Step::kExit) v = m->OnExit(s.component, static_cast<std::int64_t>(s.value), false);
+      if (s.kind == Step::kTick) v = m->OnTick(s.value);
+      if (v) {
+        EXPECT_FALSE(first.has_value()) << "a second end was reported: " << v->ToString();
+        first = v;
+      }
+    }
+    ASSERT_EQ(first.has_value(), sc.outcome.has_value());
+    if (first) {
+      EXPECT_EQ(first->outcome, *sc.outcome);
+      EXPECT_EQ(first->reason, sc.reason);
+    }
+    EXPECT_DOUBLE_EQ(m->sim_s(), sc.sim_s);
+  }
+}
+
+TEST(Monitor, ProgressLineShowsClocksLiveComponentsAndLastEvents) {
+  auto trial = MakeTrial();
+  auto m = Monitor::Create(*trial);
+  ASSERT_TRUE(m);
+  m->Started("physics");
+  m->Started("scout_1");
+  (void)m->OnLine("physics", "t=12.34 node=physics event=tick");
+  (void)m->OnLine("scout_1", "t=12.5 node=scout_1 event=leader_elected term=1");
+  (void)m->OnTick(13.04);
+  EXPECT_EQ(m->ProgressLine(),
+            "sim 12.3/60.0s  wall 13.0s  live 2/2  last: scout_1 leader_elected, physics tick");
+  (void)m->OnExit("scout_1", 0, true);
+  EXPECT_EQ(m->live().size(), 1u);
+  EXPECT_EQ(m->verdict()->reason, "scout_1 was killed for lack of memory");
+}
+
+}  // namespace
+}  // namespace swarmbox::runner

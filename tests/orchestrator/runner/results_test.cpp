@@ -1,0 +1,85 @@
+#include "swarmbox/runner/results.hpp"
+
+#include <gtest/gtest.h>
+
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::runner {
+namespace {
+
+TEST(ResultJson, HoldsTheContractFields) {
+  TrialResult r;
+  r.trial = "sar-search";
+  r.trial_id = "sar-search";
+  r.run_id = "20261121-101000-7f3a";
+  r.verdict = dsl::Verdict::Failure("collision", "scout_2");
+  r.wall_s = 312.5;
+  r.sim_s = 300.25;
+  r.seed = 42;
+  r.host = "local";
+  r.metrics = {{"collisions", 1}, {"victims_confirmed", 2}};
+  r.components = {{"physics", 0, false, "logs/physics.log", 1200}, {"scout_2", std::nullopt, false, "logs/scout_2.log", 3}};
+  r.problems = {"trajectories.png not drawn: no truth.csv was collected"};
+  auto doc = yaml::Parse(ResultJson(r), "result.json");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  for (const char* key : {"trial", "outcome", "reason", "wall_s", "sim_s", "seed", "host", "metrics"}) {
+    EXPECT_NE(doc->Find(key), nullptr) << key;
+  }
+  EXPECT_EQ(doc->Find("outcome")->scalar(), "failure");
+  EXPECT_EQ(doc->Find("reason")->scalar(), "collision");
+  EXPECT_EQ(doc->Find("wall_s")->scalar(), "312.5");
+  EXPECT_EQ(doc->Find("sim_s")->scalar(), "300.25");
+  EXPECT_EQ(doc->Find("metrics")->Find("victims_confirmed")->scalar(), "2");
+  EXPECT_TRUE(doc->Find("components")->items()[1].Find("exit_code")->is_null());
+  EXPECT_EQ(doc->Find("problems")->items().size(), 1u);
+}
+
+TEST(Metrics, CountsEventsFromTheLogs) {
+  Metrics m;
+  m.OnEvent("scout_1", ParseLogfmt("t=1 node=scout_1 event=leader_elected term=1"));
+  m.OnEvent("scout_1", ParseLogfmt("t=5 node=scout_1 event=victim_detected victim=victim_1"));
+  m.OnEvent("scout_2", ParseLogfmt("t=6 node=scout_2 event=victim_detected victim=victim_1"));
+  m.OnEvent("scout_2", ParseLogfmt("t=7 node=scout_2 event=victim_confirmed victim=victim_1"));
+  m.OnEvent("scout_2", ParseLogfmt("t=8 node=scout_2 event=collision"));
+  m.OnEvent("lifter", ParseLogfmt("t=90.5 node=lifter event=mission_complete"));
+  m.OnEvent("lifter", ParseLogfmt("no event here"));
+  auto v = m.Values();
+  EXPECT_EQ(v["events_total"], 6);
+  EXPECT_EQ(v["leader_elections"], 1);
+  EXPECT_EQ(v["victims_detected"], 1);
+  EXPECT_EQ(v["victims_confirmed"], 1);
+  EXPECT_EQ(v["collisions"], 1);
+  EXPECT_EQ(v["mission_complete_t_s"], 90.5);
+}
+
+TEST(EventsJsonl, LogEventsKeepTheirFieldsNumbersBare) {
+  auto j = LogEventJson(1.5, "scout_1", ParseLogfmt("t=12.340 node=drone_2 event=leader_elected term=3 msg=\"a b\""));
+  ASSERT_TRUE(j);
+  EXPECT_EQ(*j,
+            "{\"wall_s\":1.5,\"component\":\"scout_1\",\"t\":12.340,\"node\":\"drone_2\","
+            "\"event\":\"leader_elected\",\"term\":3,\"msg\":\"a b\"}");
+  EXPECT_FALSE(LogEventJson(1.5, "scout_1", ParseLogfmt("t=1 node=x")).has_value());
+  // Odd values stay strings (JSON has no inf/nan or hex).
+  auto odd = LogEventJson(0, "x", ParseLogfmt("event=e a=inf b=0x10 c=.5"));
+  ASSERT_TRUE(odd);
+  EXPECT_EQ(*odd, "{\"wall_s\":0,\"component\":\"x\",\"event\":\"e\",\"a\":\"inf\",\"b\":\"0x10\",\"c\":\".5\"}");
+}
+
+TEST(EventsJsonl, LifecycleEvents) {
+  EXPECT_EQ(LifecycleEventJson(0.25, "run", "physics", dsl::Verdict::Success()),
+            "{\"wall_s\":0.25,\"component\":\"orchestrator\",\"event\":\"run\",\"target\":\"physics\","
+            "\"outcome\":\"success\"}");
+  EXPECT_EQ(LifecycleEventJson(3, "build", "sim", dsl::Verdict::Err("subnet")),
+            "{\"wall_s\":3,\"component\":\"orchestrator\",\"event\":\"build\",\"target\":\"sim\","
+            "\"outcome\":\"error\",\"reason\":\"subnet\"}");
+}
+
+TEST(ExitCodeFor, FollowsTheCliContract) {
+  EXPECT_EQ(ExitCodeFor(dsl::Verdict::Success()), 0);
+  EXPECT_EQ(ExitCodeFor(dsl::Verdict::Timeout("t")), 1);
+  EXPECT_EQ(ExitCodeFor(dsl::Verdict::Failure("f")), 1);
+  EXPECT_EQ(ExitCodeFor(dsl::Verdict::Err("e")), 3);
+}
+
+}  // namespace
+}  // namespace swarmbox::runner

@@ -1,0 +1,279 @@
+// The runner end to end against FakeDockerApi and a fake clock: how trials end (log pattern, sim
+// timeout, crash, wall-clock guard, readiness, Ctrl-C), that logs and artifacts are collected and
+// that teardown leaves nothing behind on every path.
+#include "swarmbox/runner/runner.hpp"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "fake_docker_api.hpp"
+#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/docker/tar_archive.hpp"
+
+namespace swarmbox::runner {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+
+// Advances by `step` seconds on every reading; thread-safe.
+class FakeClock : public Clock {
+ public:
+  explicit FakeClock(double step) : step_(step) {}
+  double NowS() override {
+    std::lock_guard lock(mu_);
+    now_ += step_;
+    return now_;
+  }
+
+ private:
+  std::mutex mu_;
+  double now_ = 1000;
+  double step_;
+};
+
+std::string ReadFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class RunnerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    out_ = fs::temp_directory_path() /
+           ("swarmbox-runner-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(out_);
+    spec_ = dsl::TrialSpec::Named("mini")
+                .Seed(5)
+                .World("worlds/open_field.yaml")
+                .Drone("scout_1", "x500", {0, 0, 0})
+                .EndOn("event=mission_complete", dsl::Outcome::kSuccess)
+                .EndOn("event=collision", dsl::Outcome::kFailure, "collision")
+                .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout, dsl::Duration::Seconds(600));
+    spec_.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+    options_.out_dir = out_.string();
+    options_.run_id = "20261121-120000-abcd";
+    options_.images = {"swarmbox/physics:test", "swarmbox/agent:test"};
+    options_.poll = std::chrono::milliseconds(5);
+    api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready",
+                                     "t=1.000 node=physics event=tick"};
+    api_.scripts["physics"].files["/out/truth.csv"] =
+        "t_s,drone,x_m,y_m,z_m\n0.0,scout_1,0,0,0\n1.0,scout_1,1,2,3\n";
+  }
+  void TearDown() override { fs::remove_all(out_); }
+
+  RunOutcome Run(double clock_step = 0.001) {
+    FakeClock clock(clock_step);
+    auto run = RunTrialSpec(spec_, api_, clock, options_);
+    EXPECT_TRUE(run) << run.error().ToString();
+    if (!run) return {};
+    return *run;
+  }
+
+  // Nothing labelled with the run is left, and every container was removed.
+  void ExpectNothingLeft() {
+    EXPECT_TRUE(api_.Containers().empty());
+    EXPECT_TRUE(api_.Networks().empty());
+  }
+
+  fs::path out_;
+  dsl::TrialSpec spec_;
+  RunOptions options_;
+  testing::FakeDockerApi api_;
+};
+
+TEST_F(RunnerTest, EndsOnALogPatternWithItsOutcome) {
+  api_.scripts["scout_1"].lines = {"t=0.5 node=scout_1 event=takeoff",
+                                   "t=20.0 node=scout_1 event=mission_complete victims=2"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_EQ(run.result.verdict.reason, "matched 'event=mission_complete'");
+  EXPECT_EQ(run.result.verdict.source, "scout_1");
+  EXPECT_EQ(run.result.ending_line, "t=20.0 node=scout_1 event=mission_complete victims=2");
+  EXPECT_EQ(run.trial_dir, (out_ / "mini-20261121-120000-abcd").string());
+  ExpectNothingLeft();
+
+  const fs::path dir = run.trial_dir;
+  EXPECT_THAT(ReadFile(dir / "logs" / "scout_1.log"), HasSubstr("event=mission_complete victims=2\n"));
+  EXPECT_THAT(ReadFile(dir / "logs" / "physics.log"), HasSubstr("event=ready"));
+  EXPECT_THAT(ReadFile(dir / "trial.yaml"), HasSubstr("name: \"mini\""));
+  EXPECT_TRUE(fs::exists(dir / "truth.csv"));
+  EXPECT_TRUE(fs::exists(dir / "trajectories.png"));
+
+  auto result = yaml::Parse(ReadFile(dir / "result.json"), "result.json");
+  ASSERT_TRUE(result) << result.error().ToString();
+  EXPECT_EQ(result->Find("outcome")->scalar(), "success");
+  EXPECT_EQ(result->Find("trial")->scalar(), "mini");
+  EXPECT_EQ(result->Find("seed")->scalar(), "5");
+  ASSERT_NE(result->Find("metrics"), nullptr);
+  EXPECT_EQ(result->Find("metrics")->Find("mission_complete_t_s")->scalar(), "20");
+
+  const std::string events = ReadFile(dir / "events.jsonl");
+  EXPECT_THAT(events, HasSubstr("\"component\":\"scout_1\",\"t\":20.0,\"node\":\"scout_1\",\"event\":\"mission_complete\""));
+  EXPECT_THAT(events, HasSubstr("\"event\":\"run\",\"target\":\"physics\",\"outcome\":\"success\""));
+  EXPECT_THAT(events, HasSubstr("\"event\":\"shutdown\""));
+}
+
+TEST_F(RunnerTest, StartsInPriorityOrderAndStopsInReverse) {
+  api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
+  Run();
+  std::vector<std::string> order;
+  for (const std::string& c : api_.Calls()) {
+    if (c.rfind("create", 0) == 0 || c.rfind("start", 0) == 0 || c.rfind("remove", 0) == 0) {
+      order.push_back(c);
+    }
+  }
+  const std::string p = "mini-20261121-120000-abcd-";
+  EXPECT_THAT(order, ::testing::ElementsAre(
+                         "create-network " + p + "sim", "create-network " + p + "mesh",
+                         "create " + p + "physics", "create " + p + "scout_1", "start " + p + "physics",
+                         "start " + p + "scout_1", "remove " + p + "scout_1", "remove " + p + "physics",
+                         "remove-network " + p + "mesh", "remove-network " + p + "sim"));
+}
+
+TEST_F(RunnerTest, EndsWhenSimulatedTimeRunsOut) {
+  api_.scripts["physics"].lines = {"t=0 node=physics event=ready", "t=30 node=physics event=tick",
+                                   "t=60.001 node=physics event=tick"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kTimeout);
+  EXPECT_EQ(run.result.verdict.reason, "simulated time ran out (1m)");
+  EXPECT_DOUBLE_EQ(run.result.sim_s, 60.001);
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, ACrashedContainerFailsTheTrialAndItsLogsAreKept) {
+  api_.scripts["scout_1"].lines = {"t=1 node=scout_1 event=takeoff", "panic: estimator diverged"};
+  api_.scripts["scout_1"].exit_code = 134;
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kFailure);
+  EXPECT_EQ(run.result.verdict.reason, "scout_1 exited with code 134 before the trial ended");
+  EXPECT_THAT(ReadFile(fs::path(run.trial_dir) / "logs" / "scout_1.log"),
+              HasSubstr("panic: estimator diverged\n"));
+  bool reported = false;
+  for (const ComponentReport& c : run.result.components) {
+    if (c.name == "scout_1") {
+      reported = true;
+      EXPECT_EQ(c.exit_code, 134);
+      EXPECT_EQ(c.log_lines, 2u);
+    }
+  }
+  EXPECT_TRUE(reported);
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, WallClockGuardEndsAStalledTrialAsAnError) {
+  spec_.timeout.wall = dsl::Duration::Seconds(30);
+  RunOutcome run = Run(/*clock_step=*/0.5);
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run.result.verdict.reason,
+              HasSubstr("wall-clock guard: 30s passed with simulated time at 1.0s of 1m"));
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, AComponentThatNeverGetsReadyFailsAndIsTornDown) {
+  api_.scripts["physics"].lines = {"t=0 node=physics event=loading"};
+  api_.scripts["physics"].exit_code = 2;
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kFailure);
+  EXPECT_EQ(run.result.verdict.reason, "physics exited with code 2 before it was ready");
+  // The agent was created (Build) but never started.
+  for (const std::string& c : api_.Calls()) EXPECT_NE(c, "start mini-20261121-120000-abcd-scout_1");
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, AFailedStartIsAnInfrastructureError) {
+  api_.scripts["scout_1"].fail_start = true;
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("starting mini-20261121-120000-abcd-scout_1"));
+  EXPECT_EQ(ExitCodeFor(run.result.verdict), 3);
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, InterruptTearsDownCleanly) {
+  std::atomic<bool> interrupted{false};
+  options_.interrupted = &interrupted;
+  std::thread ctrl_c([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    interrupted = true;
+  });
+  RunOutcome run = Run();
+  ctrl_c.join();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_EQ(run.result.verdict.reason, "interrupted (Ctrl-C)");
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, SubnetConflictRetriesWithAnotherPair) {
+  api_.network_conflicts = 1;
+  api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto tried = api_.SubnetsTried();
+  ASSERT_GE(tried.size(), 3u);  // sim (refused), then sim + mesh of another pair
+  EXPECT_NE(tried[0], tried[1]);
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, ABrokenLogStreamRestartsTheTrial) {
+  // The first log stream of the scout breaks after one line; the restarted trial completes.
+  api_.scripts["scout_1"].lines = {"t=1 node=scout_1 event=takeoff",
+                                   "t=3 node=scout_1 event=mission_complete"};
+  api_.scripts["scout_1"].broken_streams = 1;
+  api_.scripts["scout_1"].broken_stream_lines = 1;
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.restarts, 1);
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_THAT(ReadFile(fs::path(run.trial_dir) / "events.jsonl"),
+              HasSubstr("\"event\":\"restart\",\"target\":\"mini\""));
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, MissingTruthIsAProblemNotAnOutcome) {
+  api_.scripts["physics"].files.clear();
+  api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess);
+  ASSERT_FALSE(run.result.problems.empty());
+  EXPECT_THAT(run.result.problems[0], HasSubstr("artifact /out/truth.csv not collected"));
+  EXPECT_FALSE(fs::exists(fs::path(run.trial_dir) / "trajectories.png"));
+}
+
+TEST_F(RunnerTest, InputFilesAreCopiedIntoTheContainers) {
+  api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
+  Run();
+  const auto archives = api_.PutArchives();
+  auto entries = docker::ReadTar(archives.at("mini-20261121-120000-abcd-physics"));
+  ASSERT_TRUE(entries) << entries.error().ToString();
+  std::map<std::string, std::uint32_t> modes;
+  for (const auto& e : *entries) {
+    std::string path = e.path;  // directories may come back as "out/"
+    if (!path.empty() && path.back() == '/') path.pop_back();
+    modes[path] = e.mode;
+  }
+  EXPECT_EQ(modes.count("swarmbox/trials/worlds/open_field.yaml"), 1u);
+  EXPECT_EQ(modes.count("swarmbox/trials/airframes/x500.yaml"), 1u);
+  ASSERT_EQ(modes.count("out"), 1u);
+  EXPECT_EQ(modes["out"] & 07777u, 01777u);  // writable by the container's user
+  auto agent = docker::ReadTar(archives.at("mini-20261121-120000-abcd-scout_1"));
+  ASSERT_TRUE(agent);
+  bool airframe = false;
+  for (const auto& e : *agent) {
+    if (e.path == "swarmbox/trials/airframes/x500.yaml") {
+      airframe = true;
+      EXPECT_THAT(e.content, HasSubstr("name: x500"));
+    }
+  }
+  EXPECT_TRUE(airframe);
+}
+
+}  // namespace
+}  // namespace swarmbox::runner
