@@ -216,6 +216,15 @@ Status WalStorage::Recover() {
     st.entries = std::move(rest);
   }
   st.snapshot = file_snapshot;
+  // Save() writes a Ready's entries before its hard state. A write torn between them leaves
+  // entries of a term the stored hard state has not reached: we saw that term, but cast no vote
+  // in it that anyone heard of (messages go out only after the fsync), so take the term with no
+  // vote.
+  const std::uint64_t last_term = st.entries.empty() ? st.snapshot.term : st.entries.back().term;
+  if (last_term > st.hard_state.term) {
+    st.hard_state.term = last_term;
+    st.hard_state.vote = kNoNode;
+  }
   const std::uint64_t last = st.snapshot.index + st.entries.size();
   if (st.hard_state.commit < st.snapshot.index) st.hard_state.commit = st.snapshot.index;
   if (st.hard_state.commit > last) {

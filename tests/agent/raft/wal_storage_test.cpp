@@ -165,6 +165,27 @@ TEST_F(WalStorageTest, TornLastRecordWithBadChecksumIsCutOff) {
   EXPECT_EQ(st.entries.size(), 1u);
 }
 
+// A Save torn after its entries but before its hard state: the reload takes the entries' term.
+TEST_F(WalStorageTest, TornSaveBeforeHardStateTakesTheEntriesTerm) {
+  {
+    auto w = Open(posix_);
+    std::vector<Entry> e = {Ent(1, 1)};
+    ASSERT_TRUE(w->Save(HardState{1, 2, 1}, e, {}).ok());
+    std::vector<Entry> e2 = {Ent(2, 3)};
+    ASSERT_TRUE(w->Save(HardState{3, 0, 1}, e2, {}).ok());
+  }
+  // Cut the last record (the term-3 hard state) in half.
+  fs::resize_file(dir_ + "/wal", fs::file_size(dir_ + "/wal") - 3);
+  PosixFileSystem f;
+  auto w = Open(f);
+  EXPECT_GT(w->torn_bytes_dropped(), 0u);
+  PersistentState st = *w->Load();
+  ASSERT_EQ(st.entries.size(), 2u);
+  EXPECT_EQ(st.hard_state.term, 3u);
+  EXPECT_EQ(st.hard_state.vote, kNoNode);
+  EXPECT_EQ(st.hard_state.commit, 1u);
+}
+
 TEST_F(WalStorageTest, CorruptionBeforeTheTailIsAnError) {
   {
     auto w = Open(posix_);

@@ -18,7 +18,9 @@
 // Reload: a damaged *last* record (short header, short payload or crc mismatch at the end of the
 // file) is a torn write from a crash before its fsync returned: it is cut off (truncated) and the
 // node continues with what was acknowledged. A bad record followed by more data is corruption:
-// Open fails with kProtocol and the byte offset. Any write or fsync error fails the storage for
+// Open fails with kProtocol and the byte offset. (Entries are written before the hard state in
+// each Save, so a torn Save can leave entries of a newer term than the stored term: the reload
+// then takes that term, with no vote.) Any write or fsync error fails the storage for
 // good (every later call returns that error): the node must stop.
 #pragma once
 
