@@ -47,7 +47,12 @@ void Estimator::UpdateAttitude(const SensorSample& s, double dt) {
 
   if (s.imu_fresh) {
     // Tilt: measured specific force vs the one expected from the GPS-derived acceleration.
-    const Vec3 expected_w = gps_acc_ + Vec3(0.0, 0.0, kGravity_mps2);
+    // Soft dead band on the (noisy, differentiated) GPS acceleration: in hover and cruise the
+    // reference is plain gravity; only real manoeuvres shift it.
+    const double ga = gps_acc_.norm();
+    const Vec3 a_ref = ga > params_.gps_acc_deadband_mps2 ? Vec3(gps_acc_ * (1.0 - params_.gps_acc_deadband_mps2 / ga))
+                                                          : Vec3::Zero();
+    const Vec3 expected_w = a_ref + Vec3(0.0, 0.0, kGravity_mps2);
     const double fm = s.accel_mps2.norm();
     if (fm > 1e-3 && std::abs(fm - expected_w.norm()) < params_.acc_gate_mps2) {
       const Vec3 meas = s.accel_mps2 / fm;
@@ -183,6 +188,10 @@ const StateEstimate& Estimator::Update(const SensorSample& s) {
     for (int a = 0; a < 3; ++a) Predict(&ax_[a], acc_world_[a], dt);
     if (s.baro_fresh) {
       Correct(&ax_[2], s.baro_alt_m, params_.baro_std_m * params_.baro_std_m, true, kP, 0.0, 0.0);
+    }
+    if (at_rest_ && ++rest_count_ >= 5) {  // 50 Hz zero-velocity update
+      rest_count_ = 0;
+      for (int a = 0; a < 3; ++a) Correct(&ax_[a], 0.0, 0.02 * 0.02, false, kV, 0.0, 0.0);
     }
     if (s.gps_fresh && s.gps_valid) {
       const double since = s.t_s - t_last_gps_s_;

@@ -241,6 +241,7 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
   if (!(dt > 0.0) || dt > 0.1) dt = options_.control_dt_s;
   last_t_s_ = sample.t_s;
   t_s_ = sample.t_s;
+  estimator_.SetAtRest(!Flying(mode_));
   const StateEstimate& s = estimator_.Update(sample);
 
   if (mode_ == FlightMode::kInit) {

@@ -26,18 +26,19 @@ namespace swarmbox::flight {
 
 struct EstimatorParams {
   // Attitude filter.
-  double acc_kp = 0.4;              // tilt correction gain [rad/s per unit vector error]
+  double acc_kp = 0.15;             // tilt correction gain [rad/s per unit vector error]
   double acc_ki = 0.02;             // gyro bias gain [rad/s^2 per unit error]
   double mag_kp = 0.3;              // heading correction gain [(rad/s)/rad]
   double mag_ki = 0.01;             // yaw gyro bias gain [(rad/s^2)/rad]
   double align_time_s = 1.0;        // high-gain alignment period after start [s]
   double acc_gate_mps2 = 2.5;       // skip tilt correction when |f| differs from expected by more
-  double gps_acc_tau_s = 0.3;       // low-pass of the GPS-derived acceleration [s]
+  double gps_acc_tau_s = 0.5;       // low-pass of the GPS-derived acceleration [s]
+  double gps_acc_deadband_mps2 = 0.3;  // soft dead band on it [m/s^2]
   Vec3 mag_field_world = Vec3(0.0, 0.21, -0.42);  // Earth field, ENU (only its horizontal
                                                    // direction matters) [gauss]
   // Translational Kalman filters.
-  double accel_noise_mps2 = 0.35;   // process noise on the IMU-derived acceleration [m/s^2]
-  double accel_bias_walk = 0.02;    // bias random walk [m/s^2 / sqrt(s)]
+  double accel_noise_mps2 = 0.2;   // process noise on the IMU-derived acceleration [m/s^2]
+  double accel_bias_walk = 0.01;    // bias random walk [m/s^2 / sqrt(s)]
   double baro_bias_walk = 0.003;     // barometer offset random walk [m / sqrt(s)]
   double gps_pos_h_std_m = 0.8;     // measurement noise (from the airframe's GPS spec)
   double gps_pos_v_std_m = 1.5;
@@ -58,6 +59,9 @@ class Estimator {
  public:
   explicit Estimator(const EstimatorParams& params = {});
   const StateEstimate& Update(const SensorSample& s);
+  // The vehicle is known to stand still (on the ground, motors off): zero-velocity updates let
+  // the filter learn its biases before take-off (PX4 does the same while landed).
+  void SetAtRest(bool at_rest) { at_rest_ = at_rest; }
   const StateEstimate& state() const { return state_; }
   const Vec3& gyro_bias() const { return gyro_bias_; }
   const Vec3& accel_bias_world() const { return acc_bias_; }
@@ -94,6 +98,8 @@ class Estimator {
   Axis ax_[3];
   double baro_pending_ = 0.0;
   bool baro_seen_ = false;
+  bool at_rest_ = false;
+  int rest_count_ = 0;
 };
 
 }  // namespace swarmbox::flight

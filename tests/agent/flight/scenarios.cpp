@@ -1,0 +1,159 @@
+#include "scenarios.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "sim_harness.hpp"
+
+namespace swarmbox::flight::testing {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / kPi;
+
+Result<std::unique_ptr<Rig>> HoveringRig(const RigOptions& o, double height_m) {
+  auto rig = Rig::Create(o);
+  if (!rig) return rig.error();
+  Rig& r = **rig;
+  if (!r.RunUntilMode(FlightMode::kIdle, 3.0)) {
+    return Error(ErrorCode::kInternal, "estimator did not align within 3 s");
+  }
+  r.Run(5.0);  // on the ground: zero-velocity updates teach the estimator its biases
+  if (!r.fc().Command(Setpoint::Takeoff(height_m))) {
+    return Error(ErrorCode::kInternal, "take-off rejected");
+  }
+  if (!r.RunUntilMode(FlightMode::kHold, 30.0)) {
+    return Error(ErrorCode::kInternal, "no hover within 30 s of take-off");
+  }
+  return std::move(*rig);
+}
+
+}  // namespace
+
+Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_mps, double gust_std_mps) {
+  RigOptions o;
+  o.seed = seed;
+  o.wind.mean_m_s = physics::Vec3{wind_mps, 0.0, 0.0};
+  o.wind.gust_std_m_s = gust_std_mps;
+  o.wind.gust_time_s = 2.0;
+  auto rig = HoveringRig(o, 5.0);
+  if (!rig) return rig.error();
+  Rig& r = **rig;
+  r.Run(5.0);  // settle (the wind's integrator too)
+  const Vec3 target = r.fc().telemetry().reference.pos_m;
+  double sum2 = 0.0, est2 = 0.0, max_e = 0.0;
+  long n = 0;
+  r.Run(window_s, {}, [&] {
+    const double e = (r.true_pos() - target).norm();
+    sum2 += e * e;
+    est2 += (r.fc().estimate().pos_m - r.true_pos()).squaredNorm();
+    max_e = std::max(max_e, e);
+    ++n;
+  });
+  HoverMetrics m;
+  m.rms_m = std::sqrt(sum2 / static_cast<double>(n));
+  m.est_rms_m = std::sqrt(est2 / static_cast<double>(n));
+  m.max_m = max_e;
+  m.window_s = window_s;
+  if (r.crashed()) return Error(ErrorCode::kInternal, "crashed while hovering");
+  return m;
+}
+
+Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz) {
+  RigOptions o;
+  o.seed = seed;
+  auto rig = HoveringRig(o, 5.0);
+  if (!rig) return rig.error();
+  Rig& r = **rig;
+  r.Run(3.0);
+  const Vec3 start = r.fc().telemetry().reference.pos_m;
+  const Vec3 step(dx, dy, dz);
+  const Vec3 target = start + step;
+  const Vec3 dir = step.normalized();
+  if (!r.fc().Command(Setpoint::Position(target, 0.0))) return Error(ErrorCode::kInternal, "setpoint rejected");
+  const double t0 = r.t();
+  double last_out = 0.0, max_along = 0.0, peak_v = 0.0;
+  r.Run(15.0, {}, [&] {
+    const Vec3 p = r.true_pos();
+    if ((p - target).norm() > 0.2) last_out = r.t() - t0;
+    max_along = std::max(max_along, (p - start).dot(dir));
+    const auto v = r.truth().velocity_m_s;
+    peak_v = std::max(peak_v, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+  });
+  StepMetrics m;
+  m.settle_s = last_out;
+  m.settled = last_out < 14.0;
+  m.overshoot_pct = std::max(0.0, (max_along - step.norm()) / step.norm() * 100.0);
+  m.peak_speed_mps = peak_v;
+  return m;
+}
+
+Result<DropoutMetrics> RunGpsDropout(std::uint64_t seed, double dropout_s) {
+  RigOptions o;
+  o.seed = seed;
+  auto rig = HoveringRig(o, 5.0);
+  if (!rig) return rig.error();
+  Rig& r = **rig;
+  r.Run(5.0);
+  const Vec3 target = r.fc().telemetry().reference.pos_m;
+  DropoutMetrics m;
+  r.world().SetGpsDropout(r.drone(), true);
+  r.Run(dropout_s, {}, [&] { m.max_drift_m = std::max(m.max_drift_m, (r.true_pos() - target).norm()); });
+  m.est_err_at_end_m = (r.fc().estimate().pos_m - r.true_pos()).norm();
+  r.world().SetGpsDropout(r.drone(), false);
+  r.Run(10.0, {}, [&] {
+    m.max_err_after_m = std::max(m.max_err_after_m, (r.true_pos() - target).norm());
+    const auto v = r.truth().velocity_m_s;
+    m.max_speed_after_mps = std::max(m.max_speed_after_mps, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+  });
+  m.final_err_m = (r.true_pos() - target).norm();
+  m.events_ok = r.HasEvent(FlightEventKind::kGpsLost) && r.HasEvent(FlightEventKind::kGpsRecovered);
+  m.crashed = r.crashed() || r.true_pos().z() < 1.0;
+  return m;
+}
+
+Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, bool damping) {
+  // Airborne start (a test rig, as a crane would hold it): the drone is pinned at 10 m with the
+  // stretcher hanging still while the estimator aligns, released once the motors are spinning.
+  RigOptions o;
+  o.seed = seed;
+  o.airframe = "x8_heavy";
+  o.start_m = physics::Vec3{0.0, 0.0, 10.0};
+  o.payload = "stretcher";
+  o.payload_attached = true;
+  o.swing_damping = damping;
+  o.payload_mass_hint_kg = 80.0;
+  auto created = Rig::Create(o);
+  if (!created) return created.error();
+  Rig& r = **created;
+  r.world().SetPinned(r.drone(), true);
+  if (!r.RunUntilMode(FlightMode::kIdle, 3.0)) return Error(ErrorCode::kInternal, "no alignment");
+  r.Run(3.0);
+  if (!r.fc().Command(Setpoint::Takeoff(0.5))) return Error(ErrorCode::kInternal, "take-off rejected");
+  r.Run(0.5);  // motors spin up (0.15 s lag) before the rig lets go
+  r.world().SetPinned(r.drone(), false);
+  if (!r.RunUntilMode(FlightMode::kHold, 30.0)) return Error(ErrorCode::kInternal, "no hover after release");
+  r.Run(10.0);
+  const Vec3 start = r.fc().telemetry().reference.pos_m;
+  const Vec3 target = start + Vec3(distance_m, 0.0, 0.0);
+  if (!r.fc().Command(Setpoint::Position(target, 0.0))) return Error(ErrorCode::kInternal, "setpoint rejected");
+  TransferMetrics m;
+  const double t0 = r.t();
+  double t_arrive = -1.0;
+  r.Run(60.0, [&] { return t_arrive >= 0.0 && r.t() - t_arrive >= 15.0; }, [&] {
+    const double swing = r.truth().payload_swing_rad * kRadToDeg;
+    m.max_swing_deg = std::max(m.max_swing_deg, swing);
+    if (t_arrive < 0.0 && (r.true_pos() - target).norm() < 1.0) {
+      t_arrive = r.t();
+      m.swing_at_arrival_deg = swing;
+    }
+    if (t_arrive >= 0.0 && r.t() - t_arrive >= 5.0) m.residual_swing_deg = std::max(m.residual_swing_deg, swing);
+  });
+  m.arrival_s = t_arrive >= 0.0 ? t_arrive - t0 : -1.0;
+  m.final_err_m = (r.true_pos() - target).norm();
+  m.crashed = r.crashed();
+  if (t_arrive < 0.0) return Error(ErrorCode::kInternal, "did not arrive within 60 s");
+  return m;
+}
+
+}  // namespace swarmbox::flight::testing
