@@ -139,7 +139,7 @@ class NetnsPair : public ::testing::Test {
   }
 
   // Sends `count` datagrams A -> B every `spacing_us`, returns what B received and when.
-  Sample Measure(int count, std::int64_t spacing_us) {
+  Sample Measure(int count, std::int64_t spacing_us, const char* to_addr = kAddrB) {
     Sample sample;
     const int tx = SocketIn(ns_a_);
     const int rx = SocketIn(ns_b_);
@@ -148,7 +148,7 @@ class NetnsPair : public ::testing::Test {
     sockaddr_in to{};
     to.sin_family = AF_INET;
     to.sin_port = htons(kPort);
-    inet_pton(AF_INET, kAddrB, &to.sin_addr);
+    inet_pton(AF_INET, to_addr, &to.sin_addr);
     EXPECT_EQ(bind(rx, reinterpret_cast<sockaddr*>(&to), sizeof to), 0) << std::strerror(errno);
     timeval tv{0, 100000};
     setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
@@ -197,6 +197,7 @@ class NetnsPair : public ::testing::Test {
 
   static constexpr const char* kAddrA = "10.213.7.1";
   static constexpr const char* kAddrB = "10.213.7.2";
+  static constexpr const char* kAddrC = "10.213.7.3";
   static constexpr std::uint16_t kPort = 47001;
 
   PosixCommandRunner runner_;
@@ -290,6 +291,65 @@ TEST_F(NetnsPair, TrafficFlowsWhenTheDaemonDies) {
   const Sample s = Measure(200, 2000);
   EXPECT_EQ(s.received(), s.sent);
   EXPECT_LT(s.Mean(), 5.0);
+}
+
+TEST_F(NetnsPair, PerDestinationRuleImpairsOnlyThatPeer) {
+  // A second address on B's side plays a second peer: the rule for "c" must leave "b" alone.
+  Must({"ip", "-n", ns_b_, "addr", "add", std::string(kAddrC) + "/24", "dev", if_b_});
+  auto rules = ParseRadioRules(Yaml("{to: [c], delay_ms: 80, rate_kbit: 2000}"), "radio");
+  ASSERT_TRUE(rules) << rules.error().ToString();
+  LinkTarget link{"a", if_a_, {{"b", kAddrB}, {"c", kAddrC}}, kAssumedLinkRateKbit};
+  auto plan = PlanRadio(*rules, link, Mechanism::kUserspace, Options("a"));
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  PrefixCommandRunner in_a(runner_, {"ip", "netns", "exec", ns_a_});
+  Status applied = RunCommands(in_a, plan->apply);  // htb + u32 filter for the rate, NFQUEUE -d c
+  ASSERT_TRUE(applied) << applied.error().ToString();
+  const Sample to_b = Measure(300, 2000);
+  const Sample to_c = Measure(300, 2000, kAddrC);
+  std::printf("per-destination 80 ms to c only: to b mean %.3f ms, to c mean %.3f ms p50 %.3f ms\n", to_b.Mean(),
+              to_c.Mean(), to_c.Quantile(0.5));
+  EXPECT_EQ(to_b.received(), to_b.sent);
+  EXPECT_EQ(to_c.received(), to_c.sent);
+  EXPECT_LT(to_b.Mean(), 5.0);
+  EXPECT_GE(to_c.Quantile(0.0), 80.0);
+  EXPECT_LT(to_c.Quantile(0.5), 81.5);
+  Status undone = RunAllCommands(in_a, plan->undo);
+  EXPECT_TRUE(undone) << undone.error().ToString();
+  auto qdisc = runner_.Run({"ip", "netns", "exec", ns_a_, "tc", "qdisc", "show", "dev", if_a_});
+  ASSERT_TRUE(qdisc);
+  EXPECT_EQ(qdisc->stdout_text.find("htb"), std::string::npos) << qdisc->stdout_text;
+}
+
+TEST_F(NetnsPair, KernelNetemArgvPassesTcsOwnParser) {
+  // tc parses every netem option (and reads the distribution tables) before it asks the kernel, so
+  // on a kernel without sch_netem a well-formed command fails only with "Specified qdisc kind is
+  // unknown" and a malformed one with a parse error. Where the kernel has netem, it must apply.
+  const char* specs[] = {
+      "{delay_ms: 100, jitter_ms: 20, distribution: normal, correlation: 0.25, loss: 0.05, loss_correlation: 0.1,"
+      " duplicate: 0.01, corrupt: 0.001, reorder: 0.2, reorder_correlation: 0.5, reorder_gap: 5, rate_kbit: 2000}",
+      "{delay_ms: 12.5, jitter_ms: 0.5, distribution: pareto}",
+      "{delay_ms: 40, jitter_ms: 10, distribution: paretonormal}",
+      "{gilbert_elliott: {p: 0.05, r: 0.5, loss_bad: 0.9, loss_good: 0.01}}",
+      "{rules: [{loss: 0.01}, {to: [b], delay_ms: 300, rate_kbit: 64}]}",
+  };
+  PrefixCommandRunner in_a(runner_, {"ip", "netns", "exec", ns_a_});
+  for (const char* spec : specs) {
+    auto rules = ParseRadioRules(Yaml(spec), "radio");
+    ASSERT_TRUE(rules) << rules.error().ToString();
+    auto plan = PlanRadio(*rules, Link("a", if_a_, "b", kAddrB), Mechanism::kKernelNetem);
+    ASSERT_TRUE(plan) << plan.error().ToString();
+    for (const Command& c : plan->apply) {
+      auto out = in_a.Run(c.argv);
+      ASSERT_TRUE(out) << out.error().ToString();
+      const bool netem_step = std::find(c.argv.begin(), c.argv.end(), "netem") != c.argv.end();
+      if (out->exit_code != 0) {
+        EXPECT_TRUE(netem_step) << CommandText(c.argv) << ": " << out->stderr_text;
+        EXPECT_NE(out->stderr_text.find(kNoNetemMessage), std::string::npos)
+            << CommandText(c.argv) << ": " << out->stderr_text;
+      }
+    }
+    (void)RunAllCommands(in_a, plan->undo);
+  }
 }
 
 TEST_F(NetnsPair, DaemonReportsABusyQueue) {
