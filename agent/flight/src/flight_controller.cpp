@@ -344,7 +344,7 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
     }
     if (mode_ != FlightMode::kLand || s.pos_m.z() - home_z_m_ > 2.0) {
       psp.acc_mps2 += swing_.DampingAcceleration(config_.swing.gain);
-      psp.vel_mps += swing_.DampingVelocity(config_.swing.gain);
+      // (velocity counterpart left out: it fights the position loop into a slow oscillation)
     }
     telemetry_.swing_estimate_rad = swing_.swing_angle_rad();
   }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 
 #include "sim_harness.hpp"
 
@@ -112,7 +113,8 @@ Result<DropoutMetrics> RunGpsDropout(std::uint64_t seed, double dropout_s) {
   return m;
 }
 
-Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, bool damping) {
+Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, bool damping,
+                                         std::FILE* trace) {
   // Airborne start (a test rig, as a crane would hold it): the drone is pinned at 10 m with the
   // stretcher hanging still while the estimator aligns, released once the motors are spinning.
   RigOptions o;
@@ -127,13 +129,28 @@ Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, 
   if (!created) return created.error();
   Rig& r = **created;
   r.world().SetPinned(r.drone(), true);
+  long step = 0;
+  auto tracer = [&] {
+    if (trace == nullptr || ++step % 250 != 0) return;
+    const Vec3 p = r.true_pos();
+    const Vec3 e = r.fc().estimate().pos_m;
+    const ControllerTelemetry& tm = r.fc().telemetry();
+    std::fprintf(trace,
+                 "t=%.1f mode=%s pos=(%.2f %.2f %.2f) est=(%.2f %.2f %.2f) ref=(%.2f %.2f %.2f) "
+                 "swing_deg=%.1f swing_est_deg=%.1f mass_kg=%.1f thrust_n=%.0f\n",
+                 r.t(), std::string(FlightModeName(r.fc().mode())).c_str(), p.x(), p.y(), p.z(), e.x(), e.y(),
+                 e.z(), tm.reference.pos_m.x(), tm.reference.pos_m.y(), tm.reference.pos_m.z(),
+                 r.truth().payload_swing_rad * kRadToDeg, tm.swing_estimate_rad * kRadToDeg,
+                 tm.mass_estimate_kg, tm.position.thrust_n);
+  };
   if (!r.RunUntilMode(FlightMode::kIdle, 3.0)) return Error(ErrorCode::kInternal, "no alignment");
-  r.Run(3.0);
+  r.Run(3.0, {}, tracer);
   if (!r.fc().Command(Setpoint::Takeoff(0.5))) return Error(ErrorCode::kInternal, "take-off rejected");
-  r.Run(0.5);  // motors spin up (0.15 s lag) before the rig lets go
+  r.Run(0.5, {}, tracer);  // motors spin up (0.15 s lag) before the rig lets go
   r.world().SetPinned(r.drone(), false);
-  if (!r.RunUntilMode(FlightMode::kHold, 30.0)) return Error(ErrorCode::kInternal, "no hover after release");
-  r.Run(10.0);
+  r.Run(30.0, [&] { return r.fc().mode() == FlightMode::kHold; }, tracer);
+  if (r.fc().mode() != FlightMode::kHold) return Error(ErrorCode::kInternal, "no hover after release");
+  r.Run(10.0, {}, tracer);
   const Vec3 start = r.fc().telemetry().reference.pos_m;
   const Vec3 target = start + Vec3(distance_m, 0.0, 0.0);
   if (!r.fc().Command(Setpoint::Position(target, 0.0))) return Error(ErrorCode::kInternal, "setpoint rejected");
@@ -148,6 +165,7 @@ Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, 
       m.swing_at_arrival_deg = swing;
     }
     if (t_arrive >= 0.0 && r.t() - t_arrive >= 5.0) m.residual_swing_deg = std::max(m.residual_swing_deg, swing);
+    tracer();
   });
   m.arrival_s = t_arrive >= 0.0 ? t_arrive - t0 : -1.0;
   m.final_err_m = (r.true_pos() - target).norm();

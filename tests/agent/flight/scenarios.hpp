@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 
 #include "swarmbox/common/result.hpp"
@@ -49,6 +50,8 @@ struct TransferMetrics {
   bool crashed = false;
 };
 // x8_heavy with the stretcher hanging: a `distance_m` transfer east at 10 m.
-Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, bool damping);
+// `trace` (optional): one line per second of truth, estimate and controller state.
+Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, bool damping,
+                                         std::FILE* trace = nullptr);
 
 }  // namespace swarmbox::flight::testing
