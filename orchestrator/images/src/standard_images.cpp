@@ -38,6 +38,7 @@ Result<ImageSpec> FaultToolsImage(const FaultToolPaths& paths) {
   spec.component = "faults";
   spec.executables.push_back(HostFile{paths.tc, "/usr/sbin/tc", 0755});
   spec.executables.push_back(HostFile{paths.xtables_multi, "/usr/sbin/xtables-nft-multi", 0755});
+  for (const HostFile& program : paths.extra_programs) spec.executables.push_back(program);
   for (const char* link : {"iptables", "iptables-save", "iptables-restore", "ip6tables",
                            "ip6tables-save", "ip6tables-restore"}) {
     spec.symlinks[std::string("/usr/sbin/") + link] = "xtables-nft-multi";

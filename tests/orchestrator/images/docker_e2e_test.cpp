@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <iostream>
 #include <thread>
 
@@ -236,6 +238,69 @@ TEST_F(DockerEndToEnd, CancellingALogFollowReturnsPromptly) {
   EXPECT_EQ(status.error().code(), ErrorCode::kCancelled);
   EXPECT_LT(cancel_ms, 200.0);
   std::cout << "[figures] log follow cancelled in " << cancel_ms << " ms\n";
+}
+
+TEST_F(DockerEndToEnd, TtyContainerLogsArriveRawAndEnvIsPassed) {
+  ContainerSpec spec = ProbeContainer("tty", {"env", "SWARMBOX_TRIAL_SEED"});
+  spec.tty = true;
+  spec.env = {{"SWARMBOX_TRIAL_SEED", "42 and more"}};
+  spec.resources.memory_bytes = 64 << 20;
+  spec.resources.pids_limit = 32;
+  auto id = api_->CreateContainer(spec);
+  ASSERT_TRUE(id) << id.error().ToString();
+  ASSERT_TRUE(api_->StartContainer(*id));
+  auto code = api_->WaitContainer(*id, docker::WaitCondition::kNotRunning, nullptr);
+  ASSERT_TRUE(code) << code.error().ToString();
+  EXPECT_EQ(*code, 0);
+  testing::LineLog log;
+  docker::LogOptions options;
+  options.follow = false;
+  ASSERT_TRUE(api_->FollowLogs(*id, options, log.Collector(), nullptr));
+  EXPECT_TRUE(log.Has("SWARMBOX_TRIAL_SEED=42 and more")) << log.Dump();  // no "\r" left over
+}
+
+TEST_F(DockerEndToEnd, EventsStreamReportsTheRunsContainersUntilCancelled) {
+  docker::CancelToken cancel;
+  std::mutex mu;
+  std::vector<docker::Event> events;
+  std::condition_variable cv;
+  docker::EventFilter filter;
+  filter.labels.equals = {{std::string(docker::kLabelRun), run_id_}};
+  filter.types = {"container"};
+  Status status = Ok{};
+  std::thread watcher([&] {
+    status = api_->StreamEvents(filter, [&](const docker::Event& e) {
+      std::lock_guard<std::mutex> lock(mu);
+      events.push_back(e);
+      cv.notify_all();
+    }, &cancel);
+  });
+  // The stream is open once the engine answers; give it a moment before acting.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  auto id = api_->CreateContainer(ProbeContainer("evented", {"exit", "5"}));
+  ASSERT_TRUE(id) << id.error().ToString();
+  ASSERT_TRUE(api_->StartContainer(*id));
+  {
+    std::unique_lock<std::mutex> lock(mu);
+    const bool died = cv.wait_for(lock, std::chrono::seconds(10), [&] {
+      for (const auto& e : events) {
+        if (e.action == "die") return true;
+      }
+      return false;
+    });
+    ASSERT_TRUE(died);
+    for (const auto& e : events) {
+      EXPECT_EQ(e.attributes.at("swarmbox.run"), run_id_);
+      if (e.action == "die") {
+        EXPECT_EQ(e.attributes.at("exitCode"), "5");
+      }
+    }
+    EXPECT_EQ(events.front().action, "create");
+  }
+  cancel.Cancel();
+  watcher.join();
+  ASSERT_FALSE(status);
+  EXPECT_EQ(status.error().code(), ErrorCode::kCancelled);
 }
 
 TEST_F(DockerEndToEnd, RemoveLabelledLeavesNothingLabelledBehind) {

@@ -5,6 +5,7 @@
 //                             (stderr) lines 10 ms apart; then waits for /tmp/stop to appear,
 //                             prints "stopping: <its content>" and exits 3
 //   swarmbox-probe exit K     prints "exec uid=U" and exits K
+//   swarmbox-probe env NAME   prints "NAME=<value of the environment variable>" and exits 0
 #include <unistd.h>
 
 #include <chrono>
@@ -47,6 +48,11 @@ int main(int argc, char** argv) {
     std::cout << "exec uid=" << getuid() << std::endl;
     return std::atoi(argv[2]);
   }
-  std::cerr << "usage: swarmbox-probe serve N | exit K" << std::endl;
+  if (mode == "env" && argc == 3) {
+    const char* value = std::getenv(argv[2]);
+    std::cout << argv[2] << "=" << (value != nullptr ? value : "(unset)") << std::endl;
+    return 0;
+  }
+  std::cerr << "usage: swarmbox-probe serve N | exit K | env NAME" << std::endl;
   return 2;
 }

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/images/image_spec.hpp"
@@ -37,6 +38,9 @@ struct FaultToolPaths {
   std::string tc = "/usr/sbin/tc";
   std::string xtables_multi = "/usr/sbin/xtables-nft-multi";
   std::string xtables_plugin_dir = "/usr/lib/x86_64-linux-gnu/xtables";
+  // More host programs for the sidecar (e.g. the userspace impairment daemon for kernels without
+  // sch_netem), packed with their closure.
+  std::vector<HostFile> extra_programs;
 };
 
 // tc, iptables/ip6tables(-save/-restore) as links to xtables-nft-multi, the xtables plugins (not
