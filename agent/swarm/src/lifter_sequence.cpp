@@ -87,15 +87,6 @@ void LifterSequence::Step(const MissionInput& in, MissionOutput* out) {
   const raft::MissionState& m = *in.mission;
   const Vec3& p = in.position_m;
   const Vec2 home_xy = config_.home_m.head<2>();
-  const double attach_z = Ground() + config_.AttachHeight();
-  const double release_z = attach_z - config_.release_sink_m;
-  const double transit_z = Ground() + config_.transit_altitude_m;
-  const double cruise = config_.cruise_speed_m_s;
-  const double slow = 0.5;  // vertical legs near the ground [m/s]
-  SetpointRequest& sp = out->setpoint;
-  sp = {};
-  sp.yaw_rad = in.yaw_rad;
-  sp.target_m = p;
 
   // MarkRescued until it is committed (proposals can be lost with a leader change).
   if (delivered_victim_ != 0) {
@@ -127,6 +118,28 @@ void LifterSequence::Step(const MissionInput& in, MissionOutput* out) {
     }
   }
 
+  // A transition re-runs the new stage at once, so the setpoint always belongs to out.mode.
+  for (int pass = 0; pass < 4; ++pass) {
+    const Stage before = stage_;
+    RunStage(in, out);
+    if (stage_ == before) break;
+  }
+  out->mode = StageName(stage_);
+}
+
+void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
+  const raft::MissionState& m = *in.mission;
+  const Vec3& p = in.position_m;
+  const Vec2 home_xy = config_.home_m.head<2>();
+  const double attach_z = Ground() + config_.AttachHeight();
+  const double release_z = attach_z - config_.release_sink_m;
+  const double transit_z = Ground() + config_.transit_altitude_m;
+  const double cruise = config_.cruise_speed_m_s;
+  const double slow = 0.5;  // vertical legs near the ground [m/s]
+  SetpointRequest& sp = out->setpoint;
+  sp = {};
+  sp.yaw_rad = in.yaw_rad;
+  sp.target_m = p;
   switch (stage_) {
     case Stage::kOnGround: {
       sp.kind = SetpointKind::kIdle;
@@ -262,7 +275,7 @@ void LifterSequence::Step(const MissionInput& in, MissionOutput* out) {
       break;
     }
   }
-  out->mode = StageName(stage_);
 }
+
 
 }  // namespace swarmbox::swarm

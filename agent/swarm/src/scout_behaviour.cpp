@@ -111,6 +111,20 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
 void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
   SWARMBOX_CHECK(in.mission != nullptr);
   out->Clear();
+  // A transition re-runs the new stage at once, so the setpoint always belongs to out.mode.
+  for (int pass = 0; pass < 4; ++pass) {
+    Decide(in, out);
+    const Stage before = stage_;
+    RunStage(in, out);
+    if (stage_ == before) break;
+  }
+  const bool reporting = stage_ == Stage::kSearching || stage_ == Stage::kSwept ||
+                         stage_ == Stage::kOrbiting || stage_ == Stage::kAwaitingSector;
+  if (reporting && Active(in.mission->phase())) ReportSightings(in, out);
+  out->mode = StageName(stage_);
+}
+
+void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
   const raft::MissionState& m = *in.mission;
   const Eigen::Vector3d& p = in.position_m;
   const bool airborne = stage_ != Stage::kOnGround && stage_ != Stage::kLanded;
@@ -152,7 +166,12 @@ void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
       Enter(Stage::kAwaitingSector, in, out);
     }
   }
+}
 
+void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
+  const raft::MissionState& m = *in.mission;
+  const Eigen::Vector3d& p = in.position_m;
+  const Eigen::Vector2d home_xy = config_.home_m.head<2>();
   SetpointRequest& sp = out->setpoint;
   sp = {};
   sp.max_speed_m_s = config_.cruise_speed_m_s;
@@ -181,9 +200,6 @@ void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
           out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_swept")
                                               .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
           Enter(Stage::kSwept, in, out);
-          sp.kind = SetpointKind::kFlock;
-          sp.target_m = lanes_.back().position_m;
-          sp.yaw_rad = in.yaw_rad;
           break;
         }
       }
@@ -239,10 +255,6 @@ void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
       break;
   }
 
-  const bool reporting = stage_ == Stage::kSearching || stage_ == Stage::kSwept ||
-                         stage_ == Stage::kOrbiting || stage_ == Stage::kAwaitingSector;
-  if (reporting && Active(m.phase())) ReportSightings(in, out);
-  out->mode = StageName(stage_);
 }
 
 }  // namespace swarmbox::swarm

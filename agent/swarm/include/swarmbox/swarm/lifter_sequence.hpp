@@ -83,6 +83,7 @@ class LifterSequence {
   const LifterConfig& config() const { return config_; }
 
  private:
+  void RunStage(const MissionInput& in, MissionOutput* out);
   void Enter(Stage stage, const MissionInput& in, MissionOutput* out);
   // True once within tolerance of `target_m` and slow for settle_time_s.
   bool Settled(const MissionInput& in, const Eigen::Vector3d& target_m);

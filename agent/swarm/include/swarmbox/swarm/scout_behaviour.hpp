@@ -77,6 +77,8 @@ class ScoutBehaviour {
   const ScoutConfig& config() const { return config_; }
 
  private:
+  void Decide(const MissionInput& in, MissionOutput* out);    // stage changes from the mission
+  void RunStage(const MissionInput& in, MissionOutput* out);  // the stage's setpoint
   void ReportSightings(const MissionInput& in, MissionOutput* out);
   void PlanSector(const raft::Sector& sector, const Eigen::Vector3d& position_m);
   const raft::Victim* OrbitTarget(const MissionInput& in) const;

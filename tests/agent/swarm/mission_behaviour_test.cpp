@@ -1,0 +1,407 @@
+// Scout, lifter and leader state machines (agent/swarm/{scout_behaviour,lifter_sequence,
+// leader_planner}.hpp) step by step against a raft::MissionState driven by hand.
+#include <algorithm>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "swarmbox/swarm/leader_planner.hpp"
+#include "swarmbox/swarm/lifter_sequence.hpp"
+#include "swarmbox/swarm/scout_behaviour.hpp"
+
+namespace swarmbox::swarm {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using raft::MissionPhase;
+
+class Mission {
+ public:
+  void Apply(const raft::MissionCommand& c) {
+    const raft::ApplyResult r = state.Apply(++index_, c);
+    ASSERT_TRUE(r.accepted) << raft::CommandName(c) << ": " << r.reason;
+  }
+  raft::MissionState state;
+
+ private:
+  std::uint64_t index_ = 0;
+};
+
+MissionInput Input(double t, const Mission& m, const Vector3d& p) {
+  MissionInput in;
+  in.t_s = t;
+  in.mission = &m.state;
+  in.position_m = p;
+  return in;
+}
+
+bool HasEvent(const MissionOutput& out, const std::string& name) {
+  for (const LogEvent& e : out.events) {
+    if (e.str().find("event=" + name) != std::string::npos) return true;
+  }
+  return false;
+}
+
+const raft::Sector kSector{"scout_1", 0, 0, 60, 150};
+
+// ---- scout ---------------------------------------------------------------------------------
+
+TEST(ScoutBehaviour, TakesOffToSearchAltitudeThenWaitsForItsSector) {
+  Mission m;
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0)});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  EXPECT_EQ(out.mode, "taking_off");
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kTakeoff);
+  EXPECT_DOUBLE_EQ(out.setpoint.target_m.z(), 30.0);
+  s.Step(Input(10.0, m, {0, 0, 29.5}), &out);
+  EXPECT_EQ(out.mode, "awaiting_sector");
+  s.Step(Input(10.1, m, {0, 0, 30}), &out);
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kFlock);  // holds over home, flocking
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  s.Step(Input(11.0, m, {0, 0, 30}), &out);
+  EXPECT_EQ(out.mode, "searching");
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kFlock);
+  EXPECT_EQ(out.setpoint.target_m, s.lanes().front().position_m);
+}
+
+TEST(ScoutBehaviour, SweepsItsLanesInOrderThenReportsTheSectorSwept) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0)});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);  // reaches altitude
+  s.Step(Input(1.1, m, {0, 0, 30}), &out);  // its sector is there: search
+  ASSERT_EQ(out.mode, "searching");
+  const std::vector<Waypoint> lanes = s.lanes();
+  double t = 2.0;
+  bool swept_event = false;
+  for (std::size_t i = 0; i < lanes.size(); ++i) {
+    EXPECT_EQ(out.setpoint.target_m, lanes[i].position_m) << "waypoint " << i;
+    EXPECT_DOUBLE_EQ(out.setpoint.yaw_rad, lanes[i].yaw_rad);
+    s.Step(Input(t += 1.0, m, lanes[i].position_m), &out);  // arrive
+    swept_event = swept_event || HasEvent(out, "sector_swept");
+  }
+  EXPECT_TRUE(swept_event);
+  EXPECT_EQ(out.mode, "swept");
+}
+
+TEST(ScoutBehaviour, ReportsASightingOnceAndNothingNearAKnownVictim) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .report_cooldown_s = 10.0});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  GroundDetection d;
+  d.position_m = {20, 30, 0};
+  d.confidence = 0.7;
+  std::vector<GroundDetection> dets = {d};
+  MissionInput in = Input(2.0, m, {0, 0, 30});
+  in.detections = dets;
+  s.Step(in, &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  const auto* r = std::get_if<raft::ReportSighting>(&out.proposals[0]);
+  ASSERT_NE(r, nullptr);
+  EXPECT_EQ(r->reporter, "scout_1");
+  EXPECT_EQ(r->seq, 1u);
+  EXPECT_DOUBLE_EQ(r->x_m, 20.0);
+  EXPECT_DOUBLE_EQ(r->confidence, 0.7);
+  in.t_s = 5.0;  // same place within the cooldown: silent
+  s.Step(in, &out);
+  EXPECT_TRUE(out.proposals.empty());
+  in.t_s = 13.0;  // after the cooldown (the first report may have been lost): again, next seq
+  s.Step(in, &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_EQ(std::get<raft::ReportSighting>(out.proposals[0]).seq, 2u);
+  // Once a victim is confirmed there, no more reports of it.
+  m.Apply(raft::ConfirmVictim{"operator", 21, 31});
+  in.t_s = 30.0;
+  s.Step(in, &out);
+  EXPECT_TRUE(out.proposals.empty());
+  // Below MissionState::kMinConfidence: not reported.
+  dets[0].position_m = {50, 100, 0};
+  dets[0].confidence = 0.4;
+  s.Step(in, &out);
+  EXPECT_TRUE(out.proposals.empty());
+}
+
+TEST(ScoutBehaviour, OrbitsTheTargetVictimAndResumesItsLaneAfterTheRescue) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0)});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  s.Step(Input(1.1, m, {0, 0, 30}), &out);
+  ASSERT_EQ(out.mode, "searching");
+  ASSERT_GE(s.lanes().size(), 4u);
+  s.Step(Input(2.0, m, s.lanes()[0].position_m), &out);
+  ASSERT_EQ(s.lane_index(), 1u);
+  m.Apply(raft::ConfirmVictim{"operator", 100, 100});
+  m.Apply(raft::ConvergeOn{1});
+  s.Step(Input(3.0, m, {10, 10, 30}), &out);
+  EXPECT_EQ(out.mode, "orbiting");
+  EXPECT_NEAR((out.setpoint.target_m.head<2>() - Vector2d(100, 100)).norm(), 15.0, 1e-9);  // on the orbit
+  m.Apply(raft::BeginRescue{1, "lifter"});
+  s.Step(Input(4.0, m, {85, 100, 30}), &out);
+  EXPECT_EQ(out.mode, "orbiting");  // RESCUE: keep orbiting until rescued
+  m.Apply(raft::MarkRescued{1});
+  s.Step(Input(5.0, m, {85, 100, 30}), &out);
+  EXPECT_EQ(out.mode, "searching");
+  EXPECT_EQ(s.lane_index(), 1u);  // where it left off
+  EXPECT_EQ(out.setpoint.target_m, s.lanes()[1].position_m);
+}
+
+TEST(ScoutBehaviour, BatteryLowEmitsTheEventOnceThenReturnsAndLandsAtHome) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(-5, -5, 0)});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {-5, -5, 0.23}), &out);
+  s.Step(Input(1.0, m, {-5, -5, 30}), &out);
+  MissionInput in = Input(2.0, m, {30, 60, 30});
+  in.battery_low = true;
+  in.battery_fraction = 0.18;
+  s.Step(in, &out);
+  EXPECT_TRUE(HasEvent(out, "battery_low"));
+  EXPECT_EQ(out.mode, "returning");
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kFlock);
+  in.t_s = 3.0;
+  s.Step(in, &out);
+  EXPECT_FALSE(HasEvent(out, "battery_low"));  // once
+  in.position_m = {-2, -5, 30};                  // within home_approach_m: straight home
+  s.Step(in, &out);
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kPosition);
+  in.position_m = {-5, -5.5, 30};
+  s.Step(in, &out);
+  EXPECT_EQ(out.mode, "landing");
+  s.Step(in, &out);
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kLand);
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(-5, -5, 0));
+  in.position_m = {-5, -5, 0.25};
+  s.Step(in, &out);
+  EXPECT_EQ(out.mode, "landed");
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kIdle);
+}
+
+// ---- lifter --------------------------------------------------------------------------------
+
+class LifterTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    m.Apply(raft::AssignSectors{{kSector}});
+    m.Apply(raft::StartSearch{});
+    m.Apply(raft::ConfirmVictim{"operator", 40, 0});
+    m.Apply(raft::ConvergeOn{1});
+    m.Apply(raft::BeginRescue{1, "lifter"});
+  }
+  // Steps with the drone exactly at the commanded target (an ideal flight stack).
+  void StepAt(double t, const Vector3d& p, bool attached) {
+    MissionInput in = Input(t, m, p);
+    in.payload_attached = attached;
+    lifter.Step(in, &out);
+  }
+  Mission m;
+  LifterSequence lifter{{.name = "lifter", .home_m = Vector3d(0, 0, 0), .loading_time_s = 5.0}};
+  MissionOutput out;
+};
+
+TEST_F(LifterTest, RepeatsThePayloadRequestUntilTheStatusChanges) {
+  const double attach_z = lifter.config().AttachHeight();
+  StepAt(0.0, {0, 0, 0.6}, false);
+  EXPECT_EQ(out.mode, "takeoff_for_pickup");
+  std::vector<double> request_times;
+  for (int k = 1; k <= 80; ++k) {  // 8 s, hovering at the hook height over the stretcher
+    const double t = 0.1 * k;
+    StepAt(t, {0, 0, attach_z}, false);
+    if (out.payload.action == PayloadAction::kAttach) {
+      request_times.push_back(t);
+      EXPECT_DOUBLE_EQ(out.payload.mass_kg, lifter.config().empty_stretcher_mass_kg);
+      EXPECT_EQ(out.mode, "attach_empty");
+    }
+  }
+  // First after settle_time_s (1.5 s) at the target, then every attach_retry_s (3 s).
+  ASSERT_EQ(request_times.size(), 3u);
+  EXPECT_NEAR(request_times[0], 1.6, 0.15);
+  EXPECT_NEAR(request_times[1] - request_times[0], 3.0, 0.15);
+  EXPECT_NEAR(request_times[2] - request_times[1], 3.0, 0.15);
+  StepAt(8.1, {0, 0, attach_z}, true);
+  EXPECT_EQ(out.mode, "climb");
+  EXPECT_TRUE(out.setpoint.damp_swing);
+}
+
+TEST_F(LifterTest, SetsTheStretcherDownBesideTheVictimAndReattachesItLoaded) {
+  const double attach_z = lifter.config().AttachHeight();
+  const double transit_z = lifter.config().transit_altitude_m;
+  StepAt(0.0, {0, 0, 0.6}, false);
+  for (double t = 0.1; t < 2.0; t += 0.1) StepAt(t, {0, 0, attach_z}, false);
+  StepAt(2.0, {0, 0, attach_z}, true);
+  StepAt(2.1, {0, 0, transit_z}, true);
+  ASSERT_EQ(out.mode, "transit_to_victim");
+  // The drop point: stretcher_offset_m (3 m) from the victim (40, 0) toward home (0, 0).
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(37, 0, transit_z));
+  StepAt(3.0, {37, 0, transit_z}, true);
+  ASSERT_EQ(out.mode, "descend_to_release");
+  const Vector3d release = out.setpoint.target_m;
+  EXPECT_NEAR(release.z(), attach_z - lifter.config().release_sink_m, 1e-12);
+  bool release_asked = false;
+  for (double t = 3.1; t < 5.0; t += 0.1) {
+    StepAt(t, release, true);
+    release_asked = release_asked || out.payload.action == PayloadAction::kRelease;
+  }
+  ASSERT_EQ(out.mode, "release");
+  EXPECT_TRUE(release_asked);
+  StepAt(5.1, release, false);
+  EXPECT_EQ(out.mode, "loading");
+  EXPECT_TRUE(HasEvent(out, "stretcher_released"));
+  EXPECT_EQ(lifter.stretcher_xy_m(), Vector2d(37, 0));
+  StepAt(9.0, {37, 0, attach_z}, false);
+  EXPECT_EQ(out.mode, "loading");  // loading_time_s = 5 s
+  StepAt(10.2, {37, 0, attach_z}, false);
+  ASSERT_EQ(out.mode, "attach_loaded");
+  bool asked = false;
+  for (double t = 10.3; t < 12.5 && !asked; t += 0.1) {
+    StepAt(t, {37, 0, attach_z}, false);
+    asked = out.payload.action == PayloadAction::kAttach;
+  }
+  ASSERT_TRUE(asked);
+  EXPECT_DOUBLE_EQ(out.payload.mass_kg, 80.0);
+  StepAt(13.0, {37, 0, attach_z}, true);
+  EXPECT_EQ(out.mode, "climb_loaded");
+  EXPECT_TRUE(HasEvent(out, "evacuee_loaded"));
+}
+
+TEST_F(LifterTest, MarkRescuedIsReproposedUntilCommitted) {
+  const double attach_z = lifter.config().AttachHeight();
+  // Fast-forward through the sequence with an ideal flight stack and world.
+  bool attached = false;
+  double t = 0;
+  int guard = 0;
+  while (out.mode != "move_to_land" && ++guard < 5000) {
+    t += 0.1;
+    Vector3d p = out.setpoint.kind == SetpointKind::kTakeoff ? Vector3d(0, 0, attach_z) : out.setpoint.target_m;
+    if (out.mode == "on_ground" || guard == 1) p = {0, 0, 0.6};
+    if (out.payload.action == PayloadAction::kAttach) attached = true;
+    if (out.payload.action == PayloadAction::kRelease) attached = false;
+    StepAt(t, p, attached);
+  }
+  ASSERT_EQ(out.mode, "move_to_land");
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_EQ(std::get<raft::MarkRescued>(out.proposals[0]).victim_id, 1u);
+  // Not committed: proposed again after proposal_retry_s, not before.
+  StepAt(t + 1.0, out.setpoint.target_m, false);
+  EXPECT_TRUE(out.proposals.empty());
+  StepAt(t + 2.1, out.setpoint.target_m, false);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  m.Apply(raft::MarkRescued{1});
+  StepAt(t + 5.0, out.setpoint.target_m, false);
+  EXPECT_TRUE(out.proposals.empty());
+}
+
+TEST_F(LifterTest, BatteryLowBeforeLoadingAbandonsTheRescueAndBringsTheStretcherHome) {
+  const double attach_z = lifter.config().AttachHeight();
+  StepAt(0.0, {0, 0, 0.6}, false);
+  for (double t = 0.1; t < 2.0; t += 0.1) StepAt(t, {0, 0, attach_z}, false);
+  StepAt(2.0, {0, 0, attach_z}, true);
+  StepAt(2.1, {0, 0, 15}, true);
+  ASSERT_EQ(out.mode, "transit_to_victim");
+  MissionInput in = Input(3.0, m, {20, 0, 15});
+  in.payload_attached = true;
+  in.battery_low = true;
+  lifter.Step(in, &out);
+  EXPECT_TRUE(HasEvent(out, "battery_low"));
+  EXPECT_TRUE(HasEvent(out, "rescue_abandoned"));
+  EXPECT_EQ(out.mode, "carry_home");
+  EXPECT_EQ(lifter.victim(), 0u);
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(0, 0, 15));
+}
+
+// ---- leader --------------------------------------------------------------------------------
+
+std::vector<RosterEntry> Roster(const std::string& scout_mode, const std::string& lifter_mode) {
+  return {{"scout_1", Role::kScout, scout_mode}, {"scout_2", Role::kScout, scout_mode},
+          {"lifter", Role::kLifter, lifter_mode}};
+}
+
+TEST(LeaderPlanner, AssignsSectorsAndStartsOnceTheScoutsAreAirborne) {
+  Mission m;
+  LeaderPlanner leader({.name = "scout_1", .search_area = {-50, -50, 50, 50}, .retry_s = 3.0});
+  MissionOutput out;
+  leader.Step(1.0, m.state, Roster("taking_off", "on_ground"), &out);
+  EXPECT_TRUE(out.proposals.empty());
+  leader.Step(2.0, m.state, Roster("awaiting_sector", "on_ground"), &out);
+  ASSERT_EQ(out.proposals.size(), 2u);
+  const auto& assign = std::get<raft::AssignSectors>(out.proposals[0]);
+  ASSERT_EQ(assign.sectors.size(), 2u);  // scouts only, sorted by name
+  EXPECT_EQ(assign.sectors[0].drone, "scout_1");
+  EXPECT_EQ(assign.sectors[1].drone, "scout_2");
+  EXPECT_TRUE(std::holds_alternative<raft::StartSearch>(out.proposals[1]));
+  out.Clear();
+  leader.Step(3.0, m.state, Roster("awaiting_sector", "on_ground"), &out);
+  EXPECT_TRUE(out.proposals.empty());  // within retry_s
+  leader.Step(5.5, m.state, Roster("awaiting_sector", "on_ground"), &out);
+  EXPECT_EQ(out.proposals.size(), 2u);  // not committed yet: retried
+}
+
+TEST(LeaderPlanner, ConvergesOnAConfirmedVictimThenSendsTheLifter) {
+  Mission m;
+  m.Apply(raft::StartSearch{});
+  m.Apply(raft::ConfirmVictim{"operator", 10, 10});
+  LeaderPlanner leader({.name = "scout_1", .search_area = {-50, -50, 50, 50}});
+  MissionOutput out;
+  leader.Step(1.0, m.state, Roster("searching", "on_ground"), &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_EQ(std::get<raft::ConvergeOn>(out.proposals[0]).victim_id, 1u);
+  m.Apply(out.proposals[0]);
+  out.Clear();
+  leader.Step(2.0, m.state, Roster("orbiting", "on_ground"), &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  const auto& rescue = std::get<raft::BeginRescue>(out.proposals[0]);
+  EXPECT_EQ(rescue.victim_id, 1u);
+  EXPECT_EQ(rescue.lifter, "lifter");
+}
+
+TEST(LeaderPlanner, ReturnsHomeWhenAllIsDoneThenCompletesAndReportsOnce) {
+  Mission m;
+  m.Apply(raft::StartSearch{});
+  m.Apply(raft::ConfirmVictim{"operator", 10, 10});
+  m.Apply(raft::ConvergeOn{1});
+  m.Apply(raft::BeginRescue{1, "lifter"});
+  LeaderPlanner leader({.name = "scout_1", .search_area = {-50, -50, 50, 50}});
+  MissionOutput out;
+  leader.Step(1.0, m.state, Roster("swept", "carry_home"), &out);
+  EXPECT_TRUE(out.proposals.empty());  // RESCUE: the lifter finishes it
+  m.Apply(raft::MarkRescued{1});
+  leader.Step(2.0, m.state, Roster("searching", "landing"), &out);
+  EXPECT_TRUE(out.proposals.empty());  // a scout is still searching
+  leader.Step(3.0, m.state, Roster("swept", "on_ground"), &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_TRUE(std::holds_alternative<raft::ReturnHome>(out.proposals[0]));
+  m.Apply(out.proposals[0]);
+  out.Clear();
+  leader.Step(4.0, m.state, Roster("returning", "on_ground"), &out);
+  EXPECT_TRUE(out.proposals.empty());
+  leader.Step(5.0, m.state, Roster("landed", "on_ground"), &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  m.Apply(out.proposals[0]);
+  out.Clear();
+  leader.Step(6.0, m.state, Roster("landed", "on_ground"), &out);
+  EXPECT_TRUE(HasEvent(out, "mission_complete"));
+  EXPECT_NE(out.events[0].str().find("victims=1 rescued=1"), std::string::npos) << out.events[0].str();
+  out.Clear();
+  leader.Step(7.0, m.state, Roster("landed", "on_ground"), &out);
+  EXPECT_FALSE(HasEvent(out, "mission_complete"));
+}
+
+}  // namespace
+}  // namespace swarmbox::swarm
