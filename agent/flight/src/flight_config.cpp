@@ -120,6 +120,11 @@ Result<FlightConfig> ParseFlightConfig(const yaml::Node& root, std::string sourc
   if (!mass) return mass.error();
   cfg.mass_kg = *mass;
   if (!(cfg.mass_kg > 0.0)) return Bad(root, "airframe: mass_kg must be > 0");
+  if (root.Find("base_height_m") != nullptr) {
+    auto bh = NumberAt(root, "base_height_m", "airframe");
+    if (!bh) return bh.error();
+    cfg.base_height_m = *bh;
+  }
 
   const yaml::Node* motor = root.Find("motor");
   if (motor == nullptr || !motor->is_mapping()) return Bad(root, "airframe: missing 'motor' mapping");

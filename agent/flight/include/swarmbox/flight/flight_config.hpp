@@ -53,6 +53,7 @@ struct FlightConfig {
   std::string airframe;               // name in the file
   std::string source;                 // file path
   double mass_kg = 0.0;               // empty vehicle [kg]
+  double base_height_m = 0.0;         // body origin above the ground when landed [m]
   std::vector<RotorGeometry> rotors;
   PositionParams position;            // thrust_min_n/thrust_max_n filled from the mixer
   double thrust_min_frac = 0.1;

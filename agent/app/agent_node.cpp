@@ -1,0 +1,186 @@
+#include "agent_node.hpp"
+
+#include <cmath>
+#include <utility>
+
+#include "swarmbox/common/logfmt.hpp"
+
+namespace swarmbox::agent {
+namespace {
+
+flight::Vec3 V(const std::array<double, 3>& a) { return flight::Vec3(a[0], a[1], a[2]); }
+
+std::string Seconds(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", s);
+  return buf;
+}
+
+}  // namespace
+
+flight::SensorSample FromBus(const bus::SensorSample& m) {
+  flight::SensorSample s;
+  s.t_s = static_cast<double>(m.sim_time_ns) * 1e-9;
+  s.imu_fresh = m.imu.valid;
+  s.accel_mps2 = V(m.imu.accel_m_s2);
+  s.gyro_radps = V(m.imu.gyro_rad_s);
+  s.baro_fresh = m.baro.valid;
+  s.baro_alt_m = m.baro.altitude_m;
+  s.mag_fresh = m.mag.valid;
+  s.mag_body = V(m.mag.field_gauss);
+  // The bus marks a GPS sample valid only when it is a new fix; a dropout sends no valid fixes.
+  s.gps_fresh = m.gps.valid;
+  s.gps_valid = m.gps.valid && m.gps.fix_type == bus::GpsFix::k3d;
+  s.gps_pos_m = V(m.gps.position_enu_m);
+  s.gps_vel_mps = V(m.gps.velocity_enu_m_s);
+  return s;
+}
+
+Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
+  SWARMBOX_TRY(bus::ValidateDroneName(o.name));
+  if (o.mesh && o.mesh_domain == o.sim_domain) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "the sim and mesh buses need different DDS domain ids (both are " + std::to_string(o.sim_domain) + ")");
+  }
+  auto cfg = flight::LoadFlightConfig(o.airframe_path);
+  if (!cfg) return cfg.error().Context("loading airframe");
+  auto plan = FlightPlan::Parse(o.plan);
+  if (!plan) return plan.error().Context("--plan");
+  plan->SetPreflight(o.preflight_s);
+  flight::ControllerOptions co;
+  co.control_dt_s = o.control_dt_s;
+  co.payload_mass_kg = o.payload_mass_kg;
+  co.swing_damping = o.swing_damping;
+  if (o.has_start) {
+    co.has_start_pos = true;
+    co.start_pos_m = o.start_m + flight::Vec3(0.0, 0.0, cfg->base_height_m);
+  }
+  auto fc = flight::FlightController::Create(*cfg, co);
+  if (!fc) return fc.error();
+  std::unique_ptr<AgentNode> node(new AgentNode(o, std::move(*fc), std::move(*plan)));
+
+  auto sim = bus::Participant::Create({.backend = o.middleware, .domain_id = o.sim_domain, .interface = o.sim_interface});
+  if (!sim) return sim.error().Context("joining the sim bus");
+  node->sim_ = std::move(*sim);
+  auto sub = node->sim_->CreateSubscriber<bus::SensorSample>(bus::SensorTopic(o.name), bus::Qos::kLockstep);
+  if (!sub) return sub.error().Context("subscribing to sensor samples");
+  node->sensor_sub_ = std::move(*sub);
+  auto pub = node->sim_->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic(o.name), bus::Qos::kLockstep);
+  if (!pub) return pub.error().Context("publishing actuator commands");
+  node->actuator_pub_ = std::move(*pub);
+  if (o.mesh) {
+    auto mesh = bus::Participant::Create({.backend = o.middleware, .domain_id = o.mesh_domain, .interface = o.mesh_interface});
+    if (!mesh) return mesh.error().Context("joining the mesh bus");
+    node->mesh_ = std::move(*mesh);
+    auto sp = node->mesh_->CreatePublisher<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState);
+    if (!sp) return sp.error().Context("publishing drone state");
+    node->state_pub_ = std::move(*sp);
+  }
+  return node;
+}
+
+AgentNode::AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan)
+    : options_(std::move(options)), fc_(std::move(fc)), plan_(std::move(plan)) {
+  cmd_.drone = options_.name;
+  cmd_.motor_throttle.assign(fc_.mixer().rotor_count(), 0.0);
+  state_.drone = options_.name;
+}
+
+void AgentNode::Log(const LogEvent& e) {
+  std::fprintf(options_.log, "%s\n", e.str().c_str());
+  std::fflush(options_.log);
+}
+
+void AgentNode::HandleSample(const bus::SensorSample& msg) {
+  using flight::FlightEventKind;
+  t_s_ = static_cast<double>(msg.sim_time_ns) * 1e-9;
+  const flight::ActuatorOutput& out = fc_.Step(FromBus(msg));
+  cmd_.step = msg.step;
+  cmd_.sim_time_ns = msg.sim_time_ns;
+  cmd_.armed = out.armed;
+  for (std::size_t i = 0; i < cmd_.motor_throttle.size(); ++i) cmd_.motor_throttle[i] = out.armed ? out.u[i] : 0.0;
+  if (Status s = actuator_pub_->Publish(cmd_); !s) {
+    Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "actuator").Add("reason", s.error().ToString()));
+  }
+
+  FlightStatus st;
+  st.t_s = t_s_;
+  st.mode = fc_.mode();
+  st.pos_m = fc_.estimate().pos_m;
+  flight::FlightEvent e;
+  while (fc_.PopEvent(&e)) {
+    switch (e.kind) {
+      case FlightEventKind::kArrived: st.arrived = true; break;
+      case FlightEventKind::kHover: st.hover = true; break;
+      case FlightEventKind::kLanded: st.landed = true; break;
+      case FlightEventKind::kRejected: st.rejected = true; break;
+      default: break;
+    }
+    LogEvent le(e.t_s, options_.name, flight::FlightEventName(e.kind));
+    if (e.kind == FlightEventKind::kModeChange) le.Add("mode", flight::FlightModeName(e.mode));
+    le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
+    Log(le);
+  }
+  if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
+  if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
+    plan_index_logged_ = plan_.index();
+    Log(LogEvent(t_s_, options_.name, "plan_step").Add("step", plan_.current()));
+  }
+  if (plan_.finished() && !plan_done_logged_) {
+    plan_done_logged_ = true;
+    Log(LogEvent(t_s_, options_.name, "plan_complete"));
+  }
+  // Our state for the neighbours, 5 Hz of simulated time.
+  if (state_pub_ && t_s_ >= next_state_s_) {
+    next_state_s_ = t_s_ + 0.2;
+    const flight::StateEstimate& est = fc_.estimate();
+    ++state_.seq;
+    state_.sim_time_ns = msg.sim_time_ns;
+    state_.wall_time_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                              std::chrono::system_clock::now().time_since_epoch()).count();
+    state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+    state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+    state_.heading_rad = flight::YawOf(est.att);
+    state_.mode = std::string(flight::FlightModeName(fc_.mode()));
+    (void)state_pub_->Publish(state_);
+  }
+}
+
+Status AgentNode::Run() {
+  Log(LogEvent(0.0, options_.name, "ready")
+          .Add("sim_domain", options_.sim_domain)
+          .Add("sim_interface", options_.sim_interface)
+          .Add("middleware", options_.middleware)
+          .Add("plan", options_.plan));
+  bus::SensorSample msg;
+  bool got_any = false;
+  while (true) {
+    const auto timeout = got_any ? options_.stall_timeout : options_.first_sample_timeout;
+    if (!sensor_sub_->TakeFor(msg, timeout)) {
+      const double secs = std::chrono::duration<double>(timeout).count();
+      if (!got_any) {
+        return Error(ErrorCode::kUnavailable,
+                     "no sensor sample on " + bus::SensorTopic(options_.name) + " within " + Seconds(secs) +
+                         " s: is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
+                         std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
+      }
+      Log(LogEvent(t_s_, options_.name, "samples_stopped").Add("after_s", secs, 1).Add("plan", plan_.current()));
+      if (plan_.finished()) return Ok{};
+      return Error(ErrorCode::kUnavailable,
+                   "sensor samples stopped for " + Seconds(secs) + " s before the plan was complete (at '" +
+                       std::string(plan_.current()) + "')");
+    }
+    if (have_step_ && msg.step == last_step_) {
+      (void)actuator_pub_->Publish(cmd_);  // a resent sample: answer it again, do not step twice
+      continue;
+    }
+    if (have_step_ && msg.step < last_step_) continue;  // stale
+    got_any = true;
+    have_step_ = true;
+    last_step_ = msg.step;
+    HandleSample(msg);
+    if (options_.exit_when_done && plan_.finished()) return Ok{};
+  }
+}
+
+}  // namespace swarmbox::agent

@@ -1,0 +1,81 @@
+// AgentNode: the thin node around the flight stack (STYLE.md 1). It joins the sim bus (sensor
+// samples in, actuator commands out, lockstep: every sample is answered with a command for the
+// same step) and the mesh bus (its DroneState for the neighbours), runs FlightController on the
+// samples' simulated time, lets a SetpointSource (the built-in plan now, the mission layer later)
+// drive it, and prints logfmt events (`t=12.340 node=drone_3 event=hover ...`).
+//
+//   AgentOptions o;  o.name = "drone_3";  o.airframe_path = "trials/airframes/x500.yaml";
+//   auto node = AgentNode::Create(o);           // bad airframe/plan/bus config: an error
+//   Status s = node->Run();                     // until the plan is done and samples stop
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "flight_plan.hpp"
+#include "swarmbox/bus/participant.hpp"
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/flight/flight_controller.hpp"
+
+namespace swarmbox::agent {
+
+struct AgentOptions {
+  std::string name;                     // drone name, [A-Za-z0-9_]+
+  std::string airframe_path;            // trials/airframes/<airframe>.yaml
+  std::string middleware = "cyclonedds";
+  std::string sim_interface = "lo";
+  int sim_domain = 0;
+  std::string mesh_interface = "lo";
+  int mesh_domain = 1;
+  bool mesh = true;                     // join the mesh (publish DroneState)
+  std::string plan = "takeoff:5,hover:10,land";
+  double preflight_s = 2.0;             // on the ground after the estimator is ready [sim s]
+  bool has_start = false;               // the take-off spot (ground point under the drone)
+  flight::Vec3 start_m = flight::Vec3::Zero();
+  double payload_mass_kg = 0.0;         // initial load estimate
+  bool swing_damping = true;
+  double control_dt_s = 0.004;          // the physics server's lockstep period [s]
+  std::chrono::milliseconds first_sample_timeout{10000};  // wall clock
+  std::chrono::milliseconds stall_timeout{5000};          // wall clock, after the first sample
+  bool exit_when_done = false;          // exit once the plan is complete (landed)
+  std::FILE* log = stdout;              // logfmt events
+};
+
+class AgentNode {
+ public:
+  static Result<std::unique_ptr<AgentNode>> Create(const AgentOptions& options);
+  // Serves the lockstep until the samples stop (ok if the plan was completed by then) or, with
+  // exit_when_done, until the plan is complete. kUnavailable when no sample ever arrives.
+  Status Run();
+
+ private:
+  AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan);
+  void Log(const LogEvent& e);
+  void HandleSample(const bus::SensorSample& msg);
+
+  AgentOptions options_;
+  flight::FlightController fc_;
+  FlightPlan plan_;
+  std::unique_ptr<bus::Participant> sim_;
+  std::unique_ptr<bus::Participant> mesh_;
+  std::unique_ptr<bus::Subscriber<bus::SensorSample>> sensor_sub_;
+  std::unique_ptr<bus::Publisher<bus::ActuatorCommand>> actuator_pub_;
+  std::unique_ptr<bus::Publisher<bus::DroneState>> state_pub_;
+  bus::ActuatorCommand cmd_;
+  bus::DroneState state_;
+  bool have_step_ = false;
+  std::uint64_t last_step_ = 0;
+  double t_s_ = 0.0;
+  double next_state_s_ = 0.0;
+  std::size_t plan_index_logged_ = static_cast<std::size_t>(-1);
+  bool plan_done_logged_ = false;
+};
+
+// Bus sample -> the flight stack's sample (the edge conversion).
+flight::SensorSample FromBus(const bus::SensorSample& m);
+
+}  // namespace swarmbox::agent
