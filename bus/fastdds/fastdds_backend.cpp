@@ -140,6 +140,8 @@ class ParticipantHandle {
   std::map<std::string, TopicEntry> topics_;
 };
 
+constexpr int32_t kMaxInstances = 1024;  // drones per keyed topic, with room to spare
+
 template <typename QosT>
 void ApplyPreset(Qos qos, QosT& q) {
   q.durability().kind = dds::VOLATILE_DURABILITY_QOS;
@@ -160,6 +162,11 @@ void ApplyPreset(Qos qos, QosT& q) {
       break;
   }
   q.reliability().max_blocking_time = Duration_t(0, 100'000'000);
+  // Fast DDS defaults to 10 instances; a keyed topic (DroneState) has one instance per drone.
+  // Finite on purpose: with all three unlimited, Fast DDS 2.9 writers refused every write here.
+  q.resource_limits().max_instances = kMaxInstances;
+  q.resource_limits().max_samples_per_instance = q.history().depth;
+  q.resource_limits().max_samples = kMaxInstances * q.history().depth;
 }
 
 template <typename Cpp, typename Gen>

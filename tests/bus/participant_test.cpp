@@ -181,7 +181,8 @@ TEST_P(BusApi, CallbackReceivesEverySampleInOrder) {
 }
 
 // Qos::kState keeps the latest sample per drone (DroneState is keyed by drone): after two updates
-// of each of two drones, an idle subscriber holds exactly the two latest.
+// of each of 30 drones (more than Fast DDS's default instance limit of 10), an idle subscriber
+// holds exactly the latest of each.
 TEST_P(BusApi, StateKeepsTheLatestSamplePerDrone) {
   auto pub_p = MakeParticipant(GetParam(), Domain(3));
   auto sub_p = MakeParticipant(GetParam(), Domain(3));
@@ -191,12 +192,14 @@ TEST_P(BusApi, StateKeepsTheLatestSamplePerDrone) {
   ASSERT_TRUE(sub && pub);
   ASSERT_TRUE((*pub)->WaitForSubscribers(1, testing::kMatchTimeout));
   ASSERT_TRUE((*sub)->WaitForPublishers(1, testing::kMatchTimeout));
+  constexpr int kDrones = 30;
   for (std::uint64_t seq : {1u, 2u}) {
-    for (const char* drone : {"scout_1", "scout_2"}) {
+    for (int i = 0; i < kDrones; ++i) {
       DroneState s = testing::FullDroneState(seq);
-      s.drone = drone;
+      s.drone = "scout_" + std::to_string(i);
       s.seq = seq;
-      ASSERT_TRUE((*pub)->Publish(s));
+      auto st = (*pub)->Publish(s);
+      ASSERT_TRUE(st) << s.drone << " seq " << seq << ": " << st.error().ToString();
     }
   }
   // Reliable delivery in one process completes in milliseconds; 1 s leaves ample slack.
@@ -204,8 +207,8 @@ TEST_P(BusApi, StateKeepsTheLatestSamplePerDrone) {
   std::map<std::string, std::vector<std::uint64_t>> seen;
   DroneState s;
   while ((*sub)->Take(s)) seen[s.drone].push_back(s.seq);
-  const std::map<std::string, std::vector<std::uint64_t>> expected = {{"scout_1", {2}},
-                                                                      {"scout_2", {2}}};
+  std::map<std::string, std::vector<std::uint64_t>> expected;
+  for (int i = 0; i < kDrones; ++i) expected["scout_" + std::to_string(i)] = {2};
   EXPECT_EQ(seen, expected);
 }
 
