@@ -5,7 +5,8 @@
 
 namespace swarmbox::faults {
 
-Result<PartitionPlan> PlanPartition(const PartitionFault& partition, const std::vector<MeshNode>& nodes) {
+Result<PartitionPlan> PlanPartition(const PartitionFault& partition, const std::vector<MeshNode>& nodes,
+                                    std::size_t instance) {
   PartitionPlan plan;
   std::map<std::string, const MeshNode*> by_name;
   for (const auto& n : nodes) by_name[n.name] = &n;
@@ -34,7 +35,7 @@ Result<PartitionPlan> PlanPartition(const PartitionFault& partition, const std::
                  "a partition needs at least two groups (drones in no group form one more)");
   }
 
-  const std::string chain(kPartitionChain);
+  const std::string chain = std::string(kPartitionChainPrefix) + std::to_string(instance);
   for (const auto& node : nodes) {
     const std::size_t mine = group_of.at(node.name);
     std::vector<const MeshNode*> blocked;

@@ -19,18 +19,18 @@ TEST(PartitionPlan, SymmetricSplitDropsOtherGroupsOnIngressEverywhere) {
   ASSERT_TRUE(plan) << plan.error().ToString();
   EXPECT_EQ(plan->apply.size(), 4u);
   EXPECT_THAT(Lines(plan->apply.at("a")),
-              ElementsAre("iptables -w -N SWARMBOX-PARTITION",
-                          "iptables -w -A SWARMBOX-PARTITION -s 10.77.2.12/32 -j DROP",
-                          "iptables -w -A SWARMBOX-PARTITION -s 10.77.2.13/32 -j DROP",
-                          "iptables -w -I INPUT -i eth1 -j SWARMBOX-PARTITION"));
+              ElementsAre("iptables -w -N SWARMBOX-PART-0",
+                          "iptables -w -A SWARMBOX-PART-0 -s 10.77.2.12/32 -j DROP",
+                          "iptables -w -A SWARMBOX-PART-0 -s 10.77.2.13/32 -j DROP",
+                          "iptables -w -I INPUT -i eth1 -j SWARMBOX-PART-0"));
   EXPECT_THAT(Lines(plan->apply.at("c")),
-              ElementsAre("iptables -w -N SWARMBOX-PARTITION",
-                          "iptables -w -A SWARMBOX-PARTITION -s 10.77.2.10/32 -j DROP",
-                          "iptables -w -A SWARMBOX-PARTITION -s 10.77.2.11/32 -j DROP",
-                          "iptables -w -I INPUT -i eth2 -j SWARMBOX-PARTITION"));
+              ElementsAre("iptables -w -N SWARMBOX-PART-0",
+                          "iptables -w -A SWARMBOX-PART-0 -s 10.77.2.10/32 -j DROP",
+                          "iptables -w -A SWARMBOX-PART-0 -s 10.77.2.11/32 -j DROP",
+                          "iptables -w -I INPUT -i eth2 -j SWARMBOX-PART-0"));
   EXPECT_THAT(Lines(plan->undo.at("c")),
-              ElementsAre("iptables -w -D INPUT -i eth2 -j SWARMBOX-PARTITION", "iptables -w -F SWARMBOX-PARTITION",
-                          "iptables -w -X SWARMBOX-PARTITION"));
+              ElementsAre("iptables -w -D INPUT -i eth2 -j SWARMBOX-PART-0", "iptables -w -F SWARMBOX-PART-0",
+                          "iptables -w -X SWARMBOX-PART-0"));
 }
 
 TEST(PartitionPlan, OneWayCutsOnlyTrafficFromTheFirstGroup) {
@@ -40,8 +40,8 @@ TEST(PartitionPlan, OneWayCutsOnlyTrafficFromTheFirstGroup) {
   EXPECT_EQ(plan->apply.count("a"), 0u);
   EXPECT_EQ(plan->undo.count("a"), 0u);
   EXPECT_THAT(Lines(plan->apply.at("b")),
-              ElementsAre("iptables -w -N SWARMBOX-PARTITION", "iptables -w -A SWARMBOX-PARTITION -s 10.77.2.10/32 -j DROP",
-                          "iptables -w -I INPUT -i eth1 -j SWARMBOX-PARTITION"));
+              ElementsAre("iptables -w -N SWARMBOX-PART-0", "iptables -w -A SWARMBOX-PART-0 -s 10.77.2.10/32 -j DROP",
+                          "iptables -w -I INPUT -i eth1 -j SWARMBOX-PART-0"));
   EXPECT_EQ(plan->apply.size(), 3u);
 }
 
@@ -52,6 +52,14 @@ TEST(PartitionPlan, UnlistedDronesFormTheRestGroup) {
   EXPECT_EQ(plan->groups[1], (std::vector<std::string>{"b", "c", "d"}));
   EXPECT_EQ(Lines(plan->apply.at("a")).size(), 5u);  // -N, three DROPs, the hook
   EXPECT_EQ(Lines(plan->apply.at("d")).size(), 3u);  // -N, one DROP (a), the hook
+}
+
+TEST(PartitionPlan, OverlappingPartitionsUseTheirOwnChains) {
+  auto plan = PlanPartition(PartitionFault{{{"a"}, {"b"}}, false}, kNodes, 7);
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  EXPECT_THAT(Lines(plan->undo.at("b")),
+              ElementsAre("iptables -w -D INPUT -i eth1 -j SWARMBOX-PART-7", "iptables -w -F SWARMBOX-PART-7",
+                          "iptables -w -X SWARMBOX-PART-7"));
 }
 
 TEST(PartitionPlan, RefusesUnknownAndDuplicateMembers) {

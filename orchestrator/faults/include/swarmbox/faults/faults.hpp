@@ -34,7 +34,7 @@
 //      radio      apply: changed = layers.Push(id, targets, rules); remove: changed = layers.Pop(id);
 //                 for each changed node: PlanRadioChange(before, after, ...) -> RunCommands in its
 //                 sidecar (radio_plan.hpp). Mechanism: MechanismName(*mech).
-//      partition  PlanPartition(fault, mesh_nodes): apply/undo per node in its sidecar
+//      partition  PlanPartition(fault, mesh_nodes, fault_index): apply/undo per node in its sidecar
 //                 (partition_plan.hpp). Mechanism "iptables".
 //      kill/stop/pause/restart
 //                 PlanProcessFault(fault, containers, has_duration) -> ExecuteDockerActions(api,

@@ -6,8 +6,10 @@
 // Drones in no group form one more group. Symmetric: every node drops what arrives from nodes of
 // other groups. One-way: only traffic FROM groups[0] to the others is cut (nodes outside groups[0]
 // drop what comes from groups[0]; groups[0] still hears them). Rules sit in their own chain
-// (SWARMBOX-PARTITION, hooked from INPUT -i <mesh interface>) so healing removes exactly them;
+// (SWARMBOX-PART-<instance>, hooked from INPUT -i <mesh interface>) so healing removes exactly them;
 // dropping on INPUT keeps senders free of EPERM. Nodes that block nobody get no commands.
+// Overlapping partitions each get their own chain (SWARMBOX-PART-<instance>, instance = the fault's
+// index in the schedule), so healing one leaves the other in place.
 #pragma once
 
 #include <map>
@@ -20,7 +22,7 @@
 
 namespace swarmbox::faults {
 
-inline constexpr std::string_view kPartitionChain = "SWARMBOX-PARTITION";
+inline constexpr std::string_view kPartitionChainPrefix = "SWARMBOX-PART-";
 
 struct MeshNode {
   std::string name;            // drone name
@@ -36,6 +38,7 @@ struct PartitionPlan {
 
 // kInvalidArgument for a group member missing from `nodes`, a node in two groups, fewer than two
 // groups.
-Result<PartitionPlan> PlanPartition(const PartitionFault& partition, const std::vector<MeshNode>& nodes);
+Result<PartitionPlan> PlanPartition(const PartitionFault& partition, const std::vector<MeshNode>& nodes,
+                                    std::size_t instance = 0);
 
 }  // namespace swarmbox::faults
