@@ -111,3 +111,25 @@ std::string FaultEventJson(const Fault& fault, const FaultEventRecord& record) {
 }
 
 }  // namespace swarmbox::faults
+
+namespace swarmbox::faults {
+
+std::string MeshEventJson(const std::string& node, const std::vector<RadioRule>& rules,
+                          const FaultEventRecord& record) {
+  using yaml::Node;
+  auto str = [](std::string_view s) { return Node::Scalar(std::string(s), {}, /*quoted=*/true); };
+  std::string spec;
+  for (std::size_t i = 0; i < rules.size(); ++i) spec += (i ? "; " : "") + DescribeRule(rules[i]);
+  Node root = Node::Mapping();
+  root.Set("type", str("mesh"));
+  root.Set("phase", str(FaultPhaseName(record.phase)));
+  root.Set("node", str(node));
+  root.Set("t_sim_s", Node::Scalar(detail::FormatDecimal(record.t_sim_s, 3)));
+  root.Set("wall_s", Node::Scalar(detail::FormatDecimal(record.wall_s, 3)));
+  root.Set("mechanism", str(record.mechanism));
+  root.Set("spec", str(spec));
+  if (record.phase == FaultPhase::kFailed) root.Set("error", str(record.error));
+  return yaml::EmitJson(root);
+}
+
+}  // namespace swarmbox::faults

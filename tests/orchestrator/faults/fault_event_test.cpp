@@ -48,6 +48,17 @@ TEST(FaultEvent, FailedCarriesTheError) {
   EXPECT_EQ(*back->Find("targets"), yaml::Node::Sequence());
 }
 
+TEST(FaultEvent, MeshImpairmentRecordsItsMechanism) {
+  auto mesh = ParseMeshBlock(Yaml("{delay_ms: 100, jitter_ms: 20, loss: 0.05}"));
+  ASSERT_TRUE(mesh);
+  FaultEventRecord r;
+  r.wall_s = 0.8;
+  r.mechanism = "userspace-nfqueue";
+  EXPECT_EQ(MeshEventJson("scout_1", mesh->rules, r),
+            "{\"type\":\"mesh\",\"phase\":\"applied\",\"node\":\"scout_1\",\"t_sim_s\":0,\"wall_s\":0.8,"
+            "\"mechanism\":\"userspace-nfqueue\",\"spec\":\"delay_ms=100 jitter_ms=20 loss=0.05\"}");
+}
+
 TEST(FaultEvent, DescribesEveryKind) {
   EXPECT_EQ(DescribeFault(First("- {at: 1s, duration: 30s, partition: {groups: [[a, b], [c]], oneway: true}}")),
             "groups=[[a, b], [c]] oneway=true duration=30s");

@@ -38,4 +38,10 @@ struct FaultEventRecord {
 // One line of events.jsonl (no trailing newline).
 std::string FaultEventJson(const Fault& fault, const FaultEventRecord& record);
 
+// The network.mesh impairment on one agent, applied at Run or removed at shutdown:
+//   {"type":"mesh","phase":"applied","node":"scout_1","t_sim_s":0,"wall_s":0.8,
+//    "mechanism":"userspace-nfqueue","spec":"delay_ms=100 jitter_ms=20 loss=0.05"}
+std::string MeshEventJson(const std::string& node, const std::vector<RadioRule>& rules,
+                          const FaultEventRecord& record);
+
 }  // namespace swarmbox::faults

@@ -42,7 +42,8 @@
 //      gps_dropout/imu_bias/wind_gust
 //                 data for the physics server (it applies them). Mechanism "physics".
 //    Each application, removal or failure is one events.jsonl line: FaultEventJson(fault, record)
-//    (fault_event.hpp), with the resolved targets and the mechanism used.
+//    (fault_event.hpp), with the resolved targets and the mechanism used; the mesh block on each
+//    agent is recorded with MeshEventJson(node, rules, record).
 //
 // The userspace delayer, swarmbox-netemd (netemd_args.hpp for its command line), is started and
 // stopped by the radio plans themselves; its scheduling core is DelayScheduler
