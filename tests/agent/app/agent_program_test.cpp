@@ -1,0 +1,99 @@
+// swarmbox-agent as a program: its failure without a physics server, and the integration test of
+// the issue: swarmbox-physics and three swarmbox-agent processes over the bus on loopback (a
+// private DDS domain per run), all take off, hover and land.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "process.hpp"
+#include "swarmbox/common/logfmt.hpp"
+
+namespace swarmbox::agent::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+// A domain pair per process so parallel test runs never share a bus.
+int DomainBase() { return 100 + static_cast<int>(getpid() % 60) * 2; }
+
+bool HasEvent(const std::string& log, const std::string& node, const std::string& event) {
+  std::size_t start = 0;
+  while (start < log.size()) {
+    std::size_t end = log.find('\n', start);
+    if (end == std::string::npos) end = log.size();
+    const auto fields = ParseLogfmt(std::string_view(log).substr(start, end - start));
+    if (FindField(fields, "node") == node && FindField(fields, "event") == event) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+TEST(AgentProgram, FailsClearlyWhenThePhysicsServerIsAbsent) {
+  const std::string dir = MakeTempDir("swarmbox_agent_test_");
+  ASSERT_FALSE(dir.empty());
+  const int d = DomainBase();
+  Child agent({SWARMBOX_AGENT_BIN, "--name", "drone_7", "--airframe", SWARMBOX_TRIALS_DIR "/airframes/x500.yaml",
+               "--sim-domain", std::to_string(d), "--mesh-domain", std::to_string(d + 1), "--sample-timeout", "1"},
+              dir + "/agent.log");
+  ASSERT_GT(agent.pid(), 0);
+  EXPECT_EQ(agent.Wait(20s), 3);  // infrastructure error
+  const std::string log = agent.ReadLog();
+  EXPECT_TRUE(HasEvent(log, "drone_7", "ready")) << log;
+  EXPECT_NE(log.find("no sensor sample on sim/drone_7/sensor"), std::string::npos) << log;
+  EXPECT_NE(log.find("swarmbox-physics running"), std::string::npos) << log;
+}
+
+TEST(AgentProgram, RejectsABadPlanWithUsageExitCode) {
+  const std::string dir = MakeTempDir("swarmbox_agent_test_");
+  Child agent({SWARMBOX_AGENT_BIN, "--name", "drone_7", "--airframe", SWARMBOX_TRIALS_DIR "/airframes/x500.yaml",
+               "--plan", "takeoff:5,fly_away"},
+              dir + "/agent.log");
+  EXPECT_EQ(agent.Wait(20s), 2);
+  EXPECT_NE(agent.ReadLog().find("unknown step 'fly_away'"), std::string::npos) << agent.ReadLog();
+}
+
+TEST(AgentIntegration, PhysicsAndThreeAgentsTakeOffHoverAndLand) {
+  const std::string dir = MakeTempDir("swarmbox_agent_it_");
+  ASSERT_FALSE(dir.empty());
+  const int d = DomainBase();
+  const std::vector<std::string> names = {"drone_1", "drone_2", "drone_3"};
+  const std::vector<std::string> starts = {"0,0,0", "4,0,0", "0,4,0"};
+  std::vector<std::string> phys_args = {SWARMBOX_PHYSICS_BIN, "--world", SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml",
+                                        "--rtf", "0", "--domain", std::to_string(d), "--max-sim-time", "40",
+                                        "--no-cameras", "--seed", "7", "--truth", dir + "/truth.csv"};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    phys_args.push_back("--drone");
+    phys_args.push_back(names[i] + ":x500:" + starts[i]);
+  }
+  Child physics(phys_args, dir + "/physics.log");
+  ASSERT_GT(physics.pid(), 0);
+  std::vector<std::unique_ptr<Child>> agents;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    agents.push_back(std::make_unique<Child>(
+        std::vector<std::string>{SWARMBOX_AGENT_BIN, "--name", names[i], "--airframe",
+                                 SWARMBOX_TRIALS_DIR "/airframes/x500.yaml", "--sim-domain", std::to_string(d),
+                                 "--mesh-domain", std::to_string(d + 1), "--start", starts[i], "--plan",
+                                 "takeoff:4,hover:4,land", "--stall-timeout", "3", "--sample-timeout", "30"},
+        dir + "/" + names[i] + ".log"));
+    ASSERT_GT(agents.back()->pid(), 0);
+  }
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const int code = agents[i]->Wait(150s);
+    const std::string log = agents[i]->ReadLog();
+    EXPECT_EQ(code, 0) << names[i] << ":\n" << log;
+    for (const char* ev : {"ready", "takeoff", "hover", "landed", "plan_complete"}) {
+      EXPECT_TRUE(HasEvent(log, names[i], ev)) << names[i] << " missing event=" << ev << ":\n" << log;
+    }
+  }
+  EXPECT_EQ(physics.Wait(30s), 0) << physics.ReadLog();
+  const std::string plog = physics.ReadLog();
+  EXPECT_EQ(plog.find("event=crash"), std::string::npos) << plog;
+  EXPECT_EQ(plog.find("event=drone_lost"), std::string::npos) << plog;
+}
+
+}  // namespace
+}  // namespace swarmbox::agent::testing
