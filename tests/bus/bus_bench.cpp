@@ -13,6 +13,8 @@
 //          --size=small|large|all, --domain=<first domain id, default 200>, --n=<round trips>,
 //          --interface=<name, default lo>, --echo-backend=<backend of the echo; default: the same>
 //          (cross-vendor figures; the line then carries echo_backend=...),
+//          --mode=external: no echo is started; one must already run (swarmbox-bus-echo with the
+//          same --domain/--kind, e.g. in another network namespace),
 //          --scenario=rtt|fleet|all, --drones=<fleet size; default 10 (quick) or 10, 50, 100>,
 //          --steps=<fleet lockstep steps; default 100 (quick) or 1000>.
 // Fleet lines: suite=bus scenario=lockstep_fleet backend=.. drones=N steps=.. step_p50_us=..
@@ -71,6 +73,7 @@ class Echo {
  public:
   static std::optional<Echo> Start(const std::string& mode, const testing::EchoOptions& o) {
     Echo e;
+    if (mode == "external") return e;  // an echo started by hand (e.g. in another netns)
     if (mode == "same_process") {
       e.stop_ = std::make_unique<std::atomic<bool>>(false);
       e.thread_ = std::thread([o, stop = e.stop_.get()] {
