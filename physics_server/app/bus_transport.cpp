@@ -78,8 +78,8 @@ Status BusTransport::PublishSample(std::size_t drone, const std::string& name, c
   m.gps.altitude_m = s.gps.alt_m;
   m.gps.position_enu_m = A(s.gps.position_m);
   m.gps.velocity_enu_m_s = A(s.gps.velocity_m_s);
-  m.gps.h_acc_m = spec.horizontal_std_m;
-  m.gps.v_acc_m = spec.vertical_std_m;
+  m.gps.h_acc_m = s.gps.valid ? s.gps.h_acc_m : spec.horizontal_std_m;
+  m.gps.v_acc_m = s.gps.valid ? s.gps.v_acc_m : spec.vertical_std_m;
   m.battery.valid = false;  // no battery model in the physics server
   return drones_[drone].sensor->Publish(m);
 }

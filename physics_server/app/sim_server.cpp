@@ -57,6 +57,15 @@ void SimServer::Apply(const WorldCommandInput& cmd) {
     if (!drone || cmd.args.size() != 1 || !(cmd.args[0] > 0)) return reject("needs a drone and duration_s > 0");
     world_.SetGpsDropout(*drone, true);
     timed_.push_back({now + seconds(cmd.args[0]), *drone, Timed::kGpsBack});
+  } else if (cmd.command == "gps_degrade") {
+    if (!drone || cmd.args.size() != 3 || !(cmd.args[0] > 0) || !(cmd.args[1] > 0) || !(cmd.args[2] > 0)) {
+      return reject("needs a drone, duration_s, h_acc_m, v_acc_m > 0");
+    }
+    world_.SetGpsAccuracy(*drone, cmd.args[1], cmd.args[2]);
+    timed_.push_back({now + seconds(cmd.args[0]), *drone, Timed::kGpsAccuracyBack});
+  } else if (cmd.command == "imu_bias_jump") {
+    if (!drone || cmd.args.size() != 6) return reject("needs a drone and ax, ay, az, gx, gy, gz");
+    world_.AddImuBias(*drone, {cmd.args[0], cmd.args[1], cmd.args[2]}, {cmd.args[3], cmd.args[4], cmd.args[5]});
   } else if (cmd.command == "wind_gust") {
     if (cmd.args.size() != 4 || !(cmd.args[3] > 0)) return reject("needs vx, vy, vz, duration_s > 0");
     WindConfig gust = base_wind_;
@@ -127,6 +136,7 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
       continue;
     }
     if (it->kind == Timed::kGpsBack) world_.SetGpsDropout(it->drone, false);
+    if (it->kind == Timed::kGpsAccuracyBack) world_.SetGpsAccuracy(it->drone, 0, 0);
     if (it->kind == Timed::kWindBack) world_.SetWind(base_wind_);
     it = timed_.erase(it);
   }

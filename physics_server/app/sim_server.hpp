@@ -37,7 +37,9 @@ struct ActuatorInput {
 };
 
 // The bus contract of WorldCommand (bus/messages.hpp): gps_dropout {duration_s},
-// wind_gust {vx, vy, vz, duration_s}, payload_attach {}, payload_release {}.
+// gps_degrade {duration_s, h_acc_m, v_acc_m}, imu_bias_jump {ax, ay, az, gx, gy, gz},
+// wind_gust {vx, vy, vz, duration_s}, payload_attach {[mass_kg], ignored: the airframe's payload},
+// payload_release {}. Anything else is rejected with event=world_command_rejected.
 struct WorldCommandInput {
   std::string target;
   std::string command;
@@ -103,7 +105,7 @@ class SimServer {
   struct Timed {
     std::int64_t until_ns;
     std::size_t drone;
-    enum Kind { kGpsBack, kWindBack } kind;
+    enum Kind { kGpsBack, kGpsAccuracyBack, kWindBack } kind;
   };
   void Apply(const WorldCommandInput& cmd);
   void Log(const LogEvent& event);

@@ -30,7 +30,13 @@ double IsaTemperatureC(double altitude_amsl_m) { return kT0K - kLapseK_m * altit
 std::int64_t SensorSuite::PeriodNs(double rate_hz) { return static_cast<std::int64_t>(std::llround(1e9 / rate_hz)); }
 
 SensorSuite::SensorSuite(const Airframe& airframe, const WorldConfig& world, std::uint64_t seed)
-    : imu_(airframe.imu), baro_(airframe.baro), mag_(airframe.mag), gps_(airframe.gps), world_(&world), rng_(seed) {
+    : imu_(airframe.imu),
+      baro_(airframe.baro),
+      mag_(airframe.mag),
+      gps_(airframe.gps),
+      gps_nominal_(airframe.gps),
+      world_(&world),
+      rng_(seed) {
   accel_bias_ = {Gauss(imu_.accel_bias_std_m_s2), Gauss(imu_.accel_bias_std_m_s2), Gauss(imu_.accel_bias_std_m_s2)};
   gyro_bias_ = {Gauss(imu_.gyro_bias_std_rad_s), Gauss(imu_.gyro_bias_std_rad_s), Gauss(imu_.gyro_bias_std_rad_s)};
   imu_period_ns_ = PeriodNs(imu_.rate_hz);
@@ -91,10 +97,17 @@ void SensorSuite::Sample(std::int64_t time_ns, const TrueKinematics& t, bool gps
       gps.lat_deg = world_->home_lat_deg + gps.position_m.y / kEarthRadiusM * 180.0 / std::numbers::pi;
       gps.lon_deg = world_->home_lon_deg + gps.position_m.x / (kEarthRadiusM * std::cos(lat0)) * 180.0 / std::numbers::pi;
       gps.alt_m = world_->home_alt_m + gps.position_m.z;
+      gps.h_acc_m = h;
+      gps.v_acc_m = v;
     }
     gps_next_ns_ += gps_period_ns_;
     if (gps_next_ns_ <= time_ns) gps_next_ns_ = time_ns + gps_period_ns_;
   }
+}
+
+void SensorSuite::SetGpsAccuracy(double horizontal_std_m, double vertical_std_m) {
+  gps_.horizontal_std_m = horizontal_std_m > 0 ? horizontal_std_m : gps_nominal_.horizontal_std_m;
+  gps_.vertical_std_m = vertical_std_m > 0 ? vertical_std_m : gps_nominal_.vertical_std_m;
 }
 
 WindModel::WindModel(const WindConfig& config, std::uint64_t seed) : config_(config), rng_(seed) {}

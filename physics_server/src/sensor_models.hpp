@@ -35,6 +35,12 @@ class SensorSuite {
   SensorSuite(const Airframe& airframe, const WorldConfig& world, std::uint64_t seed);
 
   void Sample(std::int64_t time_ns, const TrueKinematics& truth, bool gps_dropout, SensorSample* out);
+  // Faults: GPS noise override (<= 0: the airframe's value) and IMU bias steps.
+  void SetGpsAccuracy(double horizontal_std_m, double vertical_std_m);
+  void AddImuBias(const Vec3& accel_m_s2, const Vec3& gyro_rad_s) {
+    accel_bias_ += accel_m_s2;
+    gyro_bias_ += gyro_rad_s;
+  }
 
  private:
   double Gauss(double std) { return std * normal_(rng_); }
@@ -44,6 +50,7 @@ class SensorSuite {
   BaroSpec baro_;
   MagSpec mag_;
   GpsSpec gps_;
+  GpsSpec gps_nominal_;
   const WorldConfig* world_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};

@@ -652,6 +652,14 @@ Status World::ReleasePayload(std::size_t index) {
 
 void World::SetGpsDropout(std::size_t index, bool dropped_out) { impl_->drones.at(index)->gps_dropout = dropped_out; }
 
+void World::SetGpsAccuracy(std::size_t index, double horizontal_std_m, double vertical_std_m) {
+  impl_->drones.at(index)->sensors->SetGpsAccuracy(horizontal_std_m, vertical_std_m);
+}
+
+void World::AddImuBias(std::size_t index, const Vec3& accel_m_s2, const Vec3& gyro_rad_s) {
+  impl_->drones.at(index)->sensors->AddImuBias(accel_m_s2, gyro_rad_s);
+}
+
 void World::SetWind(const WindConfig& wind) {
   impl_->wind.Configure(wind);
   impl_->wind_now = impl_->wind.wind_m_s();

@@ -154,7 +154,7 @@ TEST_F(SimServerTest, LostDroneRejoinsWhenItAnswersAgain) {
 
 TEST_F(SimServerTest, WorldCommandsDropGpsAndRejectUnknownOnes) {
   SimServer server(*world_, agents_, clock_, nullptr, Options(0), out_);
-  agents_.world_commands = {{"a", "gps_dropout", {0.5}}, {"a", "imu_bias_jump", {1, 0, 0, 0, 0, 0}},
+  agents_.world_commands = {{"a", "gps_dropout", {0.5}}, {"a", "teleport", {1, 0, 0}},
                             {"nobody", "gps_dropout", {1}}};
   int invalid = 0;
   for (int k = 0; k < 250; ++k) {
@@ -165,7 +165,7 @@ TEST_F(SimServerTest, WorldCommandsDropGpsAndRejectUnknownOnes) {
   EXPECT_EQ(invalid, 5);  // 0.5 s at 10 Hz, then the fix is back
   const std::string log = ReadFile(out_);
   EXPECT_NE(log.find("event=world_command command=gps_dropout target=a"), std::string::npos) << log;
-  EXPECT_NE(log.find("event=world_command_rejected command=imu_bias_jump target=a reason=\"not supported by this physics server\""),
+  EXPECT_NE(log.find("event=world_command_rejected command=teleport target=a reason=\"not supported by this physics server\""),
             std::string::npos)
       << log;
   EXPECT_NE(log.find("event=world_command_rejected command=gps_dropout target=nobody reason=\"unknown drone\""),
@@ -214,6 +214,32 @@ TEST(ServerOptions, DronesFileErrorsPointAtTheLine) {
   auto list = ParseDronesFile(*doc);
   ASSERT_FALSE(list.ok());
   EXPECT_EQ(list.error().ToString(), "d.yaml:3:5: missing required key 'pose' in drone");
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
+
+namespace swarmbox::physics {
+namespace {
+
+TEST_F(SimServerTest, GpsDegradeAndImuBiasJumpChangeTheSensors) {
+  SimServer server(*world_, agents_, clock_, nullptr, Options(0), out_);
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  const double ax_before = world_->sensors(0).imu.accel_m_s2.x;
+  agents_.world_commands = {{"a", "gps_degrade", {1.0, 5.0, 8.0}}, {"a", "imu_bias_jump", {2.0, 0, 0, 0, 0, 0}}};
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  // A 2 m/s^2 step against noise of 0.02 m/s^2 and hover dynamics of < 0.1 m/s^2.
+  EXPECT_NEAR(world_->sensors(0).imu.accel_m_s2.x - ax_before, 2.0, 0.2);
+  bool degraded = false, restored = false;
+  for (int k = 0; k < 500; ++k) {
+    ASSERT_TRUE(server.RunStep(stop_).ok());
+    const GpsSample& g = world_->sensors(0).gps;
+    if (!g.fresh) continue;
+    if (world_->time_s() < 1.0) degraded = degraded || (g.h_acc_m == 5.0 && g.v_acc_m == 8.0);
+    if (world_->time_s() > 1.1) restored = g.h_acc_m == 0.8 && g.v_acc_m == 1.5;
+  }
+  EXPECT_TRUE(degraded);
+  EXPECT_TRUE(restored);  // back to the x500's GPS after duration_s
 }
 
 }  // namespace

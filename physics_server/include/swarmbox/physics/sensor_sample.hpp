@@ -39,6 +39,8 @@ struct GpsSample {
   double lat_deg = 0;   // WGS84, flat-earth around home
   double lon_deg = 0;
   double alt_m = 0;     // AMSL [m]
+  double h_acc_m = 0;   // 1-sigma horizontal noise of this fix [m] (the airframe's, or degraded)
+  double v_acc_m = 0;   // 1-sigma vertical noise [m]
 };
 
 struct SensorSample {

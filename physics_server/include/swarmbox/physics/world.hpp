@@ -102,6 +102,10 @@ class World {
 
   // Faults and lifecycle.
   void SetGpsDropout(std::size_t index, bool dropped_out);   // GPS reports no fix while set
+  // GPS noise override (1-sigma, metres); a value <= 0 restores the airframe's.
+  void SetGpsAccuracy(std::size_t index, double horizontal_std_m, double vertical_std_m);
+  // Adds a step to the IMU biases (accelerometer [m/s^2], gyro [rad/s], body FLU).
+  void AddImuBias(std::size_t index, const Vec3& accel_m_s2, const Vec3& gyro_rad_s);
   void SetWind(const WindConfig& wind);                      // e.g. a gust fault
   Vec3 wind_m_s() const;                                     // current wind (mean + gust) [m/s]
   // Lost drones (lockstep timeout) get motors off and event=drone_lost; clearing it emits
