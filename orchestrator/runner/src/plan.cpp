@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <set>
 
+#include "swarmbox/images/standard_images.hpp"
 #include "swarmbox/runner/naming.hpp"
 
 namespace swarmbox::runner {
@@ -26,7 +27,7 @@ std::string AirframeRelative(const dsl::DroneSpec& d) { return "airframes/" + d.
 
 std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
   std::vector<std::string> argv = {
-      "swarmbox-physics",
+      images::kPhysicsBinaryInImage,
       "--world", InContainer(spec.world),
       "--seed", std::to_string(spec.seed),
       "--rtf", Num(spec.rtf),
@@ -52,7 +53,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
     if (other.name != d.name) peers += (peers.empty() ? "" : ",") + other.name;
   }
   std::vector<std::string> argv = {
-      "swarmbox-agent",
+      images::kAgentBinaryInImage,
       "--name", d.name,
       "--airframe", InContainer(AirframeRelative(d)),
       "--world", InContainer(spec.world),

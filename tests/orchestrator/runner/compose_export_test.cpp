@@ -39,7 +39,7 @@ TEST(ComposeYaml, ExportsNetworksServicesAndStartOrder) {
   ASSERT_EQ(services->entries().size(), 5u);
   const yaml::Node* physics = services->Find("physics");
   EXPECT_EQ(physics->Find("image")->scalar(), "swarmbox/physics:abc");
-  EXPECT_EQ(physics->Find("entrypoint")->items()[0].scalar(), "swarmbox-physics");
+  EXPECT_EQ(physics->Find("entrypoint")->items()[0].scalar(), "/usr/local/bin/swarmbox-physics");
   EXPECT_EQ(physics->Find("networks")->Find("sim")->Find("ipv4_address")->scalar(), "10.200.8.2");
   EXPECT_EQ(physics->Find("depends_on"), nullptr);
   EXPECT_EQ(physics->Find("volumes")->items()[0].scalar(),

@@ -76,7 +76,7 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   EXPECT_EQ(lifter.labels.at("swarmbox.component"), "lifter");
   EXPECT_THAT(lifter.argv, Contains("--payload"));
   EXPECT_THAT(lifter.argv, Contains("scout_1,scout_2,scout_3"));
-  EXPECT_EQ(lifter.argv[0], "swarmbox-agent");
+  EXPECT_EQ(lifter.argv[0], "/usr/local/bin/swarmbox-agent");
 }
 
 TEST_F(PlanTest, EndConditionsAndTimeoutComeFromTheTrial) {

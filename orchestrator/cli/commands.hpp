@@ -1,0 +1,59 @@
+// The `swarmbox` subcommands (ARCHITECTURE.md "CLI", contract). Each returns the process exit
+// code: 0 success, 1 a trial ended with another outcome, 2 bad input or usage, 3 infrastructure
+// error (no Docker engine, image build failed).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace swarmbox::cli {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitOutcome = 1;
+inline constexpr int kExitUsage = 2;
+inline constexpr int kExitInfrastructure = 3;
+
+// Where the host-built programs come from (for the images).
+struct ProgramPaths {
+  std::string physics_bin;  // "" = search (see program_images.hpp)
+  std::string agent_bin;
+};
+
+struct RunArgs {
+  std::string trial;
+  std::string out = "runs";
+  std::vector<std::string> sets;
+  std::string run_id;
+  bool quiet = false;
+  ProgramPaths programs;
+};
+int RunCommand(const RunArgs& args);
+
+struct ValidateArgs {
+  std::vector<std::string> files;
+  std::vector<std::string> sets;
+};
+int ValidateCommand(const ValidateArgs& args);
+
+struct ComposeArgs {
+  std::string trial;
+  std::vector<std::string> sets;
+  std::string output;  // "" = stdout
+  std::string physics_image;  // "" = the tag the host-built binary packs to
+  std::string agent_image;
+  ProgramPaths programs;
+};
+int ComposeCommand(const ComposeArgs& args);
+
+struct ImagesArgs {
+  ProgramPaths programs;
+  bool faults = true;
+};
+int ImagesCommand(const ImagesArgs& args);
+
+struct GcArgs {
+  std::string run_id;  // "" = every run
+};
+int GcCommand(const GcArgs& args);
+
+}  // namespace swarmbox::cli

@@ -1,0 +1,88 @@
+// swarmbox compose TRIAL.yaml [-o FILE] [--set key=value ...]
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "commands.hpp"
+#include "program_images.hpp"
+#include "swarmbox/dsl/trial_loader.hpp"
+#include "swarmbox/runner/compose_export.hpp"
+#include "swarmbox/runner/plan.hpp"
+
+namespace swarmbox::cli {
+
+namespace fs = std::filesystem;
+
+// The run id of exported files: fixed, so an export is reproducible; `swarmbox gc --run compose`
+// removes what `docker-compose up` made.
+inline constexpr char kComposeRunId[] = "compose";
+
+int ComposeCommand(const ComposeArgs& args) {
+  dsl::LoadOptions load;
+  load.overrides = args.sets;
+  auto spec = dsl::LoadTrial(args.trial, load);
+  if (!spec) {
+    std::cerr << spec.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  runner::Images images{args.physics_image, args.agent_image};
+  if (images.physics.empty() || images.agent.empty()) {
+    auto tags = TrialImageTags(args.programs);
+    if (!tags) {
+      std::cerr << "swarmbox compose: " << tags.error().ToString() << "\n";
+      return kExitInfrastructure;
+    }
+    if (images.physics.empty()) images.physics = tags->physics;
+    if (images.agent.empty()) images.agent = tags->agent;
+  }
+  auto subnets = runner::PickSubnets(kComposeRunId, 0, {});
+  if (!subnets) {
+    std::cerr << "swarmbox compose: " << subnets.error().ToString() << "\n";
+    return kExitInfrastructure;
+  }
+  const std::string trials_dir = fs::absolute(spec->trials_dir).lexically_normal().string();
+  runner::PlanOptions plan;
+  plan.run_id = kComposeRunId;
+  plan.images = images;
+  plan.subnets = *subnets;
+  plan.trials_dir = trials_dir;
+  auto trial = runner::PlanTrial(*spec, plan);
+  if (!trial) {
+    std::cerr << "swarmbox compose: " << trial.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  runner::ComposeOptions compose;
+  std::string command = "swarmbox compose " + args.trial;
+  for (const auto& s : args.sets) command += " --set " + s;
+  if (!args.output.empty()) {
+    command += " -o " + args.output;
+    // Input files relative to the compose file, so the folder can move with the checkout.
+    const fs::path out_dir = fs::absolute(args.output).parent_path();
+    compose.host_prefix = trials_dir;
+    compose.relative_prefix = fs::path(trials_dir).lexically_relative(out_dir).string();
+  }
+  compose.header_comment =
+      "Exported by `" + command + "` (do not edit by hand; export again).\n"
+      "Trial '" + spec->name + "': the same images, argv, environment, labels, networks and\n"
+      "addresses as `swarmbox run`; run priority is depends_on (readiness waits are not\n"
+      "modelled: compose starts a service once the one it depends on has started).\n"
+      "Needs the images on this engine: run `swarmbox images` first.\n"
+      "  docker-compose -f <this file> up        # Ctrl-C, then:\n"
+      "  docker-compose -f <this file> down -v   # or: swarmbox gc --run compose";
+  const std::string text = runner::ComposeYaml(**trial, compose);
+  if (args.output.empty()) {
+    std::cout << text;
+    return kExitOk;
+  }
+  std::ofstream out(args.output, std::ios::binary | std::ios::trunc);
+  out << text;
+  out.close();
+  if (!out) {
+    std::cerr << "swarmbox compose: cannot write " << args.output << "\n";
+    return kExitInfrastructure;
+  }
+  std::cerr << "wrote " << args.output << "\n";
+  return kExitOk;
+}
+
+}  // namespace swarmbox::cli

@@ -1,0 +1,58 @@
+// swarmbox run TRIAL.yaml [--out DIR] [--set key=value ...]
+#include <filesystem>
+#include <iostream>
+
+#include "commands.hpp"
+#include "interrupt.hpp"
+#include "program_images.hpp"
+#include "swarmbox/docker/docker_client.hpp"
+#include "swarmbox/dsl/trial_loader.hpp"
+#include "swarmbox/runner/runner.hpp"
+
+namespace swarmbox::cli {
+
+int RunCommand(const RunArgs& args) {
+  dsl::LoadOptions load;
+  load.overrides = args.sets;
+  auto spec = dsl::LoadTrial(args.trial, load);
+  if (!spec) {
+    std::cerr << spec.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  docker::DockerClientOptions client_options;
+  client_options.socket_path = docker::DefaultSocketPath();
+  auto client = docker::DockerClient::Connect(client_options);
+  if (!client) {
+    std::cerr << "swarmbox run: " << client.error().ToString() << "\n";
+    return kExitInfrastructure;
+  }
+  auto images = EnsureTrialImages(**client, args.programs, [&](std::string_view line) {
+    if (!args.quiet) std::cerr << "  " << line << "\n";
+  });
+  if (!images) {
+    std::cerr << "swarmbox run: " << images.error().ToString() << "\n";
+    return kExitInfrastructure;
+  }
+  const std::atomic<bool>& interrupted = InstallInterruptHandlers();
+  runner::SteadyClock clock;
+  runner::RunOptions options;
+  options.out_dir = args.out;
+  options.run_id = args.run_id;
+  options.images = *images;
+  options.interrupted = &interrupted;
+  options.progress = args.quiet ? nullptr : &std::cerr;
+  auto run = runner::RunTrialSpec(*spec, **client, clock, options);
+  if (!run) {
+    std::cerr << "swarmbox run: " << run.error().ToString() << "\n";
+    return kExitInfrastructure;
+  }
+  const runner::TrialResult& r = run->result;
+  std::cout << run->trial_dir << ": " << dsl::OutcomeName(r.verdict.outcome)
+            << (r.verdict.reason.empty() ? "" : " (" + r.verdict.reason + ")") << ", sim "
+            << r.sim_s << " s, wall " << r.wall_s << " s\n";
+  for (const std::string& p : r.problems) std::cerr << "  note: " << p << "\n";
+  if (interrupted.load()) return kExitOutcome;  // the user stopped it: not an infrastructure error
+  return runner::ExitCodeFor(r.verdict);
+}
+
+}  // namespace swarmbox::cli
