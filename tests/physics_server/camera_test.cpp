@@ -101,6 +101,29 @@ TEST(Camera, RenderingIsDeterministicAndNoisy) {
   EXPECT_GT(differing, a.bgr.size() / 2);  // noise std 4 levels changes most pixels
 }
 
+TEST(Camera, PixelNoiseMatchesItsConfiguration) {
+  auto world = MakeWorld(CalmWorld(), 21);
+  const auto d = Spawn(*world, testing::MakeSpawn("d", LoadShippedAirframe("x500"), Vec3{0, 0, 20}));
+  world->SetPinned(d, true);  // the same view twice, two independent noise draws
+  CameraImage a, b;
+  world->RenderCamera(d, &a);
+  world->Step();
+  world->RenderCamera(d, &b);
+  double sum = 0, sum2 = 0;
+  for (std::size_t i = 0; i < a.bgr.size(); ++i) {
+    const double diff = static_cast<double>(a.bgr[i]) - static_cast<double>(b.bgr[i]);
+    sum += diff;
+    sum2 += diff * diff;
+  }
+  const double n = static_cast<double>(a.bgr.size());
+  const double std = std::sqrt(sum2 / n - (sum / n) * (sum / n));
+  // The difference of two independent N(0, 4^2) draws has std 4 sqrt(2) = 5.66 (rounding to whole
+  // levels adds < 1%); 230 400 samples give a 0.15% standard error: allow 5%.
+  const double expected = LoadShippedAirframe("x500").camera.noise_std * std::sqrt(2.0);
+  EXPECT_NEAR(std, expected, 0.05 * expected);
+  EXPECT_NEAR(sum / n, 0.0, 0.05);
+}
+
 TEST(Camera, ObstacleTopsAreSeenFromAbove) {
   WorldConfig config = CalmWorld();
   config.obstacles.push_back({.id = "block", .center_m = {0, 0, 2}, .size_m = {4, 4, 4}, .yaw_rad = 0});
