@@ -48,4 +48,21 @@ Result<EnsuredImage> EnsureImage(docker::DockerApi& api, const ImageSpec& spec,
   return out;
 }
 
+Result<std::vector<std::string>> RemoveStaleImages(docker::DockerApi& api,
+                                                   const std::string& repository,
+                                                   const std::string& keep_tag) {
+  docker::LabelSelector selector;
+  selector.equals = {{"swarmbox.image", repository}};
+  auto list = api.ListImages(selector);
+  if (!list) return list.error().Context("listing images of " + repository);
+  std::vector<std::string> removed;
+  for (const docker::ImageInfo& image : *list) {
+    bool keep = false;
+    for (const std::string& tag : image.repo_tags) keep = keep || tag == keep_tag;
+    if (keep) continue;
+    if (api.RemoveImage(image.id, /*force=*/false)) removed.push_back(image.id);
+  }
+  return removed;
+}
+
 }  // namespace swarmbox::images

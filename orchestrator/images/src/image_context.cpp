@@ -1,6 +1,7 @@
 #include "swarmbox/images/image_context.hpp"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <map>
@@ -9,6 +10,7 @@
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/images/content_hash.hpp"
 #include "swarmbox/images/library_closure.hpp"
+#include "swarmbox/images/process_capture.hpp"
 
 namespace swarmbox::images {
 namespace {
@@ -32,8 +34,30 @@ Result<std::uint32_t> HostMode(const std::string& path) {
   return static_cast<std::uint32_t>(st.st_mode & 07777);
 }
 
-Result<TarEntry> ReadHostFile(const HostFile& file) {
-  auto bytes = ReadFileBytes(file.host_path);
+// `objcopy --strip-debug` of a host file, through a temporary file.
+Result<std::string> StrippedCopy(const std::string& host_path) {
+  char tmp[] = "/tmp/swarmbox-strip-XXXXXX";
+  const int fd = mkstemp(tmp);
+  if (fd < 0) return Error(ErrorCode::kIo, "cannot create a temporary file for stripping", host_path);
+  close(fd);
+  auto run = RunCapture({"objcopy", "--strip-debug", host_path, tmp});
+  Result<std::string> out = Error(ErrorCode::kInternal, "not stripped", host_path);
+  if (!run) {
+    out = Error(run.error().code(),
+                "stripping debug info needs objcopy (binutils): " + run.error().message() +
+                    " (or set ImageSpec::strip_debug = false)",
+                host_path);
+  } else if (run->exit_code != 0) {
+    out = Error(ErrorCode::kInvalidArgument, "objcopy --strip-debug failed: " + run->err, host_path);
+  } else {
+    out = ReadFileBytes(tmp);
+  }
+  unlink(tmp);
+  return out;
+}
+
+Result<TarEntry> ReadHostFile(const HostFile& file, bool strip_debug = false) {
+  auto bytes = strip_debug ? StrippedCopy(file.host_path) : ReadFileBytes(file.host_path);
   if (!bytes) return bytes.error();
   std::uint32_t mode = file.mode;
   if (mode == 0) {
@@ -131,7 +155,7 @@ Result<PackedContext> PackContext(const ImageSpec& spec) {
   std::vector<std::string> elf_paths;
   for (const auto* group : {&spec.executables, &spec.plugins, &spec.files}) {
     for (const HostFile& f : *group) {
-      auto e = ReadHostFile(f);
+      auto e = ReadHostFile(f, spec.strip_debug && group == &spec.executables);
       if (!e) return e.error().Context("packing " + spec.repository);
       taken.insert(f.image_path);
       rootfs.push_back(std::move(*e));

@@ -45,7 +45,10 @@ Result<CapturedRun> RunCapture(const std::vector<std::string>& argv) {
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
   pid_t pid = 0;
-  const int rc = posix_spawn(&pid, argv.front().c_str(), &actions, nullptr, args.data(), environ);
+  // A bare name is looked up in PATH; a path is used as it is.
+  const bool search = argv.front().find('/') == std::string::npos;
+  const int rc = search ? posix_spawnp(&pid, argv.front().c_str(), &actions, nullptr, args.data(), environ)
+                        : posix_spawn(&pid, argv.front().c_str(), &actions, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (rc != 0) {
     return Error(ErrorCode::kNotFound, std::string("cannot start: ") + std::strerror(rc), what);

@@ -75,6 +75,16 @@ TEST_F(DockerEndToEnd, UnchangedImageIsNotRebuilt) {
   EXPECT_FALSE(again->built);
   EXPECT_EQ(again->tag, image_.tag);
   EXPECT_EQ(again->image_id, image_.image_id);
+  // Older content hashes of the probe (earlier builds of the tree) go; this one stays.
+  auto stale = images::RemoveStaleImages(*api_, "swarmbox/e2e-probe", image_.tag);
+  ASSERT_TRUE(stale) << stale.error().ToString();
+  auto still = api_->InspectImage(image_.tag);
+  EXPECT_TRUE(still) << still.error().ToString();
+  docker::LabelSelector probe_images;
+  probe_images.equals = {{"swarmbox.image", "swarmbox/e2e-probe"}};
+  auto left = api_->ListImages(probe_images);
+  ASSERT_TRUE(left) << left.error().ToString();
+  EXPECT_EQ(left->size(), 1u);
   std::cout << "[figures] probe image " << image_.tag << ": " << image_.image_size_bytes
             << " bytes, context " << image_.context_bytes << " bytes, pack " << image_.pack_s * 1e3
             << " ms" << (image_.built ? ", build " + std::to_string(image_.build_s * 1e3) + " ms" : "")

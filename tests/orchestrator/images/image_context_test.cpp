@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "swarmbox/images/elf_info.hpp"
 #include "swarmbox/images/standard_images.hpp"
 
 namespace swarmbox::images {
@@ -106,6 +107,32 @@ TEST(ImageContext, PacksTheProbeWithItsClosureAndTheBaseFiles) {
   auto again = PackContext(spec);
   ASSERT_TRUE(again);
   EXPECT_EQ(again->tag, ctx->tag);
+}
+
+TEST(ImageContext, StripsDebugInfoFromExecutablesOnly) {
+  auto app_size = [](bool strip) -> std::size_t {
+    ImageSpec spec = SmallSpec();
+    spec.strip_debug = strip;
+    spec.executables.push_back({SWARMBOX_PROBE_PATH, "/usr/local/bin/app", 0755});
+    auto ctx = PackContext(spec);
+    EXPECT_TRUE(ctx) << ctx.error().ToString();
+    if (!ctx) return 0;
+    auto entries = docker::ReadTar(ctx->tar);
+    EXPECT_TRUE(entries) << entries.error().ToString();
+    if (!entries) return 0;
+    for (const auto& e : *entries) {
+      if (e.path == "rootfs/usr/local/bin/app") {
+        EXPECT_TRUE(LooksLikeElf(e.content));
+        return e.content.size();
+      }
+    }
+    ADD_FAILURE() << "no app in the context";
+    return 0;
+  };
+  const std::size_t stripped = app_size(true);
+  const std::size_t full = app_size(false);
+  EXPECT_GT(stripped, 0u);
+  EXPECT_LT(stripped, full);  // the probe is built with -g (RelWithDebInfo)
 }
 
 TEST(ImageContext, MissingExecutableIsNamed) {

@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/docker/docker_api.hpp"
@@ -31,5 +32,12 @@ struct EnsuredImage {
 Result<EnsuredImage> EnsureImage(docker::DockerApi& api, const ImageSpec& spec,
                                  const docker::BuildProgressFn& progress,
                                  docker::CancelToken* cancel);
+
+// Removes the images of `repository` (label swarmbox.image=<repository>, set by the generated
+// Dockerfile) other than `keep_tag`: the older content hashes. Not forced, so an image a container
+// still uses stays (its failure is skipped). Returns the removed image ids.
+Result<std::vector<std::string>> RemoveStaleImages(docker::DockerApi& api,
+                                                   const std::string& repository,
+                                                   const std::string& keep_tag);
 
 }  // namespace swarmbox::images

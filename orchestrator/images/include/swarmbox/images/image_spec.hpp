@@ -47,6 +47,9 @@ struct ImageSpec {
   std::string user = "1000:1000";
   std::string workdir = "/tmp";
   std::map<std::string, std::string> labels;  // extra image labels
+  // Strip debug sections from `executables` (`objcopy --strip-debug`, binutils): a RelWithDebInfo
+  // swarmbox-physics drops from ~23 MB to ~1.5 MB. Libraries from the host are left as they are.
+  bool strip_debug = true;
 };
 
 // /etc/passwd and /etc/group (root, swarmbox uid/gid 1000, nobody; from docker/rootfs/etc/ in the

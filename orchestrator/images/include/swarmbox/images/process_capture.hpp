@@ -4,7 +4,7 @@
 //   auto r = RunCapture({"/lib64/ld-linux-x86-64.so.2", "--list", "/usr/sbin/tc"});
 //   if (r && r->exit_code == 0) Use(r->out);
 //
-// posix_spawn with an argv array, the caller's environment, stdin from /dev/null. Errors: kNotFound
+// posix_spawn with an argv array (argv[0] without '/' is searched in PATH), the caller's environment, stdin from /dev/null. Errors: kNotFound
 // when the program cannot be started, kIo for pipe failures; a non-zero exit is not an error
 // (it is in exit_code; a signal death gives 128 + signal). Thread-safe.
 #pragma once
