@@ -1,0 +1,128 @@
+// swarmbox-bench flight: the flight stack's acceptance scenarios as figures, one logfmt line per
+// scenario (closed loop against the in-process physics library, seeded noise), plus the cost of
+// one control step. --quick shortens the windows (CI smoke); --seed N changes the seed.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include "bench.hpp"
+#include "scenarios.hpp"
+#include "sim_harness.hpp"
+#include "swarmbox/common/logfmt.hpp"
+
+namespace {
+
+using swarmbox::LogEvent;
+namespace ft = swarmbox::flight::testing;
+
+void Print(LogEvent& e) { std::printf("%s\n", e.str().c_str()); }
+
+int Fail(const char* scenario, const swarmbox::Error& err) {
+  LogEvent e(0.0, "bench", "scenario_failed");
+  e.Add("suite", "flight").Add("scenario", scenario).Add("reason", err.ToString());
+  Print(e);
+  return 1;
+}
+
+int RunFlightBench(const swarmbox::bench::Args& args) {
+  const auto seed = static_cast<std::uint64_t>(args.GetInt("seed", 42));
+  const double window = args.quick ? 10.0 : 30.0;
+  int rc = 0;
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  if (auto m = ft::RunHover(seed, window); m) {
+    LogEvent e(0.0, "bench", "result");
+    e.Add("suite", "flight").Add("scenario", "x500_hover").Add("window_s", window, 0).Add("rms_m", m->rms_m)
+        .Add("max_m", m->max_m).Add("est_rms_m", m->est_rms_m).Add("target_rms_m", 0.1).Add("pass", m->rms_m < 0.1);
+    Print(e);
+  } else {
+    rc = Fail("x500_hover", m.error());
+  }
+  struct StepCase { const char* name; double dx, dy, dz; };
+  for (const StepCase& c : {StepCase{"x500_step_10m", 10.0, 0.0, 0.0}, StepCase{"x500_climb_5m", 0.0, 0.0, 5.0}}) {
+    if (auto m = ft::RunStep(seed, c.dx, c.dy, c.dz); m) {
+      LogEvent e(0.0, "bench", "result");
+      e.Add("suite", "flight").Add("scenario", c.name).Add("settle_s", m->settle_s, 2)
+          .Add("overshoot_pct", m->overshoot_pct, 1).Add("peak_speed_mps", m->peak_speed_mps, 2)
+          .Add("pass", m->settled && m->settle_s < 6.0 && m->overshoot_pct < 10.0);
+      Print(e);
+    } else {
+      rc = Fail(c.name, m.error());
+    }
+  }
+  if (auto m = ft::RunHover(seed, window, 5.0, 1.5); m) {
+    LogEvent e(0.0, "bench", "result");
+    e.Add("suite", "flight").Add("scenario", "x500_wind_5mps").Add("gust_std_mps", 1.5, 1).Add("rms_m", m->rms_m)
+        .Add("max_m", m->max_m).Add("pass", m->rms_m < 0.5);
+    Print(e);
+  } else {
+    rc = Fail("x500_wind_5mps", m.error());
+  }
+  if (auto m = ft::RunGpsDropout(seed, 5.0); m) {
+    LogEvent e(0.0, "bench", "result");
+    e.Add("suite", "flight").Add("scenario", "x500_gps_dropout_5s").Add("max_drift_m", m->max_drift_m)
+        .Add("est_err_end_m", m->est_err_at_end_m).Add("max_err_after_m", m->max_err_after_m)
+        .Add("final_err_m", m->final_err_m).Add("max_speed_after_mps", m->max_speed_after_mps, 2)
+        .Add("crashed", m->crashed).Add("pass", !m->crashed && m->final_err_m < 0.4);
+    Print(e);
+  } else {
+    rc = Fail("x500_gps_dropout_5s", m.error());
+  }
+  auto on = ft::RunHeavyTransfer(seed, 20.0, true);
+  auto off = ft::RunHeavyTransfer(seed, 20.0, false);
+  for (int k = 0; k < 2; ++k) {
+    auto& m = k == 0 ? on : off;
+    const char* name = k == 0 ? "x8_transfer_20m_damping_on" : "x8_transfer_20m_damping_off";
+    if (!m) {
+      rc = Fail(name, m.error());
+      continue;
+    }
+    LogEvent e(0.0, "bench", "result");
+    e.Add("suite", "flight").Add("scenario", name).Add("arrival_s", m->arrival_s, 1)
+        .Add("swing_at_arrival_deg", m->swing_at_arrival_deg, 2).Add("residual_swing_deg", m->residual_swing_deg, 2)
+        .Add("max_swing_deg", m->max_swing_deg, 2).Add("final_err_m", m->final_err_m, 2);
+    if (k == 0 && off) {
+      e.Add("reduction_x", off->residual_swing_deg / std::max(1e-6, m->residual_swing_deg), 2)
+          .Add("pass", m->residual_swing_deg < 10.0 && 2.0 * m->residual_swing_deg < off->residual_swing_deg);
+    }
+    Print(e);
+  }
+
+  // Cost of one control step (estimator + cascade + mixer), hovering x500, and the whole
+  // closed loop's speed against simulated time.
+  {
+    ft::RigOptions o;
+    o.seed = seed;
+    auto rig = ft::Rig::Create(o);
+    if (!rig) return Fail("x500_step_cost", rig.error());
+    ft::Rig& r = **rig;
+    r.RunUntilMode(swarmbox::flight::FlightMode::kIdle, 3.0);
+    (void)r.fc().Command(swarmbox::flight::Setpoint::Takeoff(5.0));
+    r.RunUntilMode(swarmbox::flight::FlightMode::kHold, 20.0);
+    const swarmbox::flight::SensorSample sample = ft::FromPhysics(r.world().sensors(r.drone()));
+    const int n = args.quick ? 20000 : 200000;
+    swarmbox::flight::SensorSample s = sample;
+    const auto t0 = std::chrono::steady_clock::now();
+    double sink = 0.0;
+    for (int i = 0; i < n; ++i) {
+      s.t_s += 0.004;
+      sink += r.fc().Step(s).u[0];
+    }
+    const double ns = std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - t0).count() / n;
+    LogEvent e(0.0, "bench", "result");
+    e.Add("suite", "flight").Add("scenario", "x500_control_step").Add("steps", n).Add("ns_per_step", ns, 0)
+        .Add("checksum", sink, 1);
+    Print(e);
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  LogEvent e(0.0, "bench", "result");
+  e.Add("suite", "flight").Add("scenario", "total").Add("wall_s", wall, 2).Add("quick", args.quick);
+  Print(e);
+  return rc;
+}
+
+}  // namespace
+
+SWARMBOX_BENCH_SUITE(flight, "Flight stack closed loop: hover, steps, wind, GPS dropout, heavy-lift swing; step cost",
+                     RunFlightBench);
