@@ -73,6 +73,7 @@ struct World::Impl {
     dJointID sling = nullptr;
     double payload_drag = 0;
     dJointID pin = nullptr;
+    Vec3 external_force;
     // state
     bool crashed = false;
     bool lost = false;
@@ -259,6 +260,9 @@ struct World::Impl {
     force += Vec3{-c.x * speed * v_air_b.x, -c.y * speed * v_air_b.y, -c.z * speed * v_air_b.z};
     dBodyAddRelForce(d.body, force.x, force.y, force.z);
     dBodyAddRelTorque(d.body, torque.x, torque.y, torque.z);
+    if (d.external_force.x != 0 || d.external_force.y != 0 || d.external_force.z != 0) {
+      dBodyAddForce(d.body, d.external_force.x, d.external_force.y, d.external_force.z);
+    }
     if (d.payload_body) {
       const Vec3 pv = V(dBodyGetLinearVel(d.payload_body)) - wind_now;
       const double s = Norm(pv);
@@ -675,6 +679,8 @@ void World::SetLost(std::size_t index, bool lost) {
   w.Emit(lost ? EventKind::kDroneLost : EventKind::kDroneRejoined, index, 0, 0.0);
   w.Dispatch();
 }
+
+void World::SetExternalForce(std::size_t index, const Vec3& force_n) { impl_->drones.at(index)->external_force = force_n; }
 
 void World::SetPinned(std::size_t index, bool pinned) {
   Impl& w = *impl_;

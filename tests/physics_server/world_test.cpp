@@ -249,6 +249,20 @@ TEST(World, GeofenceBreachIsReported) {
   EXPECT_EQ(events.events[0].kind, EventKind::kGeofence);
 }
 
+TEST(World, ExternalForceAcceleratesAsNewtonSays) {
+  auto world = MakeWorld(CalmWorld());
+  const Airframe af = DraglessX500();
+  const double u = af.HoverRotorSpeed() / af.motor.max_rot_velocity_rad_s;
+  const auto d = Spawn(*world, testing::MakeSpawn("d", af, Vec3{0, 0, 20}, 0, u));
+  world->SetExternalForce(d, {af.mass_kg * 2.0, 0, 0});  // 2 m/s^2 east
+  StepFor(*world, 1.0);
+  // Level hover, no drag: v = a t exactly up to floating point.
+  EXPECT_NEAR(world->Truth(d).velocity_m_s.x, 2.0, 1e-6);
+  world->SetExternalForce(d, {});
+  StepFor(*world, 0.5);
+  EXPECT_NEAR(world->Truth(d).velocity_m_s.x, 2.0, 1e-6);
+}
+
 TEST(World, WindPushesADroneDownwind) {
   WorldConfig config = CalmWorld();
   config.wind.mean_m_s = {5, 0, 0};

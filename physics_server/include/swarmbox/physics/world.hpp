@@ -111,6 +111,9 @@ class World {
   // Lost drones (lockstep timeout) get motors off and event=drone_lost; clearing it emits
   // event=drone_rejoined and commands count again.
   void SetLost(std::size_t index, bool lost);
+  // Test rigs and disturbances: a force [N, world ENU] applied at the drone's centre of mass on
+  // every sub-step until changed ({} clears it).
+  void SetExternalForce(std::size_t index, const Vec3& force_n);
   // Test rigs: pins the drone's body to the world where it is (a fixed joint) or frees it.
   void SetPinned(std::size_t index, bool pinned);
 
