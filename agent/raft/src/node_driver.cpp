@@ -19,13 +19,7 @@ Result<Config> DriverConfig::ToRaftConfig() const {
   }
   auto it = std::find(names.begin(), names.end(), self);
   if (it == names.end()) return bad("self '" + self + "' is not among the members");
-  if (tick_ms <= 0) return bad("tick_ms must be > 0");
-  if (heartbeat_ms % tick_ms != 0 || election_timeout_ms % tick_ms != 0) {
-    return bad("heartbeat_ms (" + std::to_string(heartbeat_ms) + ") and election_timeout_ms (" +
-               std::to_string(election_timeout_ms) + ") must be multiples of tick_ms (" +
-               std::to_string(tick_ms) + ")");
-  }
-  if (snapshot_every_entries == 0) return bad("snapshot_every_entries must be > 0");
+  if (auto s = ValidateTiming(); !s) return s.error();
   Config c;
   c.id = static_cast<NodeId>(it - names.begin()) + 1;
   for (std::size_t k = 0; k < names.size(); ++k) c.voters.push_back(k + 1);
@@ -37,6 +31,25 @@ Result<Config> DriverConfig::ToRaftConfig() const {
   c.max_entries_per_msg = max_entries_per_msg;
   if (auto s = c.Validate(); !s) return s.error();
   return c;
+}
+
+Status DriverConfig::ValidateTiming() const {
+  auto bad = [](std::string msg) {
+    return Error(ErrorCode::kInvalidArgument, std::move(msg), "raft driver config");
+  };
+  if (tick_ms <= 0) return bad("tick_ms must be > 0");
+  if (heartbeat_ms <= 0 || heartbeat_ms % tick_ms != 0 || election_timeout_ms % tick_ms != 0) {
+    return bad("heartbeat_ms (" + std::to_string(heartbeat_ms) + ") and election_timeout_ms (" +
+               std::to_string(election_timeout_ms) + ") must be multiples of tick_ms (" +
+               std::to_string(tick_ms) + ")");
+  }
+  if (election_timeout_ms <= heartbeat_ms) {
+    return bad("election_timeout_ms (" + std::to_string(election_timeout_ms) +
+               ") must be greater than heartbeat_ms (" + std::to_string(heartbeat_ms) + ")");
+  }
+  if (snapshot_every_entries == 0) return bad("snapshot_every_entries must be > 0");
+  if (max_entries_per_msg == 0) return bad("max_entries_per_msg must be > 0");
+  return Ok{};
 }
 
 NodeDriver::NodeDriver(DriverConfig config, std::vector<std::string> names, std::uint32_t tag,

@@ -21,6 +21,7 @@
 //   cfg.self = "scout_1";
 //   cfg.members = {"scout_1", "scout_2", "lifter"};   // same list on every drone (order free)
 //   cfg.seed = trial_seed;                            // the trial's seed, any value per drone
+//   ReadRaftOptions(trial_raft_mapping, &cfg);        // timings per trial (raft_options.hpp)
 //   auto wal = WalStorage::Open(fs, "/var/lib/swarmbox/raft");
 //   auto node = NodeDriver::Open(cfg, **wal, radio, clock, [](const LogEvent& e) {
 //     std::puts(e.str().c_str());
@@ -92,6 +93,8 @@ struct DriverConfig {
   // The RawNode config this gives (ids are 1 + the position in the sorted member list), or
   // kInvalidArgument naming the problem.
   Result<Config> ToRaftConfig() const;
+  // The timing and tuning fields alone (what a trial may set, see raft_options.hpp).
+  Status ValidateTiming() const;
 };
 
 class NodeDriver {
