@@ -36,6 +36,7 @@ Result<EnsuredImage> EnsureImage(docker::DockerApi& api, const ImageSpec& spec,
   docker::BuildRequest request;
   request.context_tar = std::move(ctx->tar);
   request.tags = {ctx->tag};
+  request.labels = ImageLabels(spec);
   const auto build_start = std::chrono::steady_clock::now();
   auto built = api.BuildImage(request, progress, cancel);
   if (!built) return built.error().Context(doing);

@@ -7,9 +7,10 @@
 // Layout of the context: `Dockerfile` and `rootfs/<image path>` for every file, with explicit
 // parent directories (0755), entries sorted by path, mtime 0, owner 0:0. Equal inputs give equal
 // bytes, hence equal tags, so an unchanged image is never rebuilt. The Dockerfile copies rootfs/ to
-// / and sets USER, WORKDIR, ENV, ENTRYPOINT, CMD and LABELs from the spec.
+// / and sets ENV, WORKDIR, USER, ENTRYPOINT and CMD from the spec; labels go with the build request.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,9 @@ struct PackedContext {
 
 // The generated Dockerfile (pure).
 std::string GenerateDockerfile(const ImageSpec& spec);
+// The image's labels: spec.labels plus swarmbox.component and swarmbox.image (= repository). They
+// are passed with the build request (no builder step) and named in the Dockerfile's comment.
+std::map<std::string, std::string> ImageLabels(const ImageSpec& spec);
 
 // Pure: the context from already-read rootfs entries (paths absolute in the image). Adds the parent
 // directories, sorts, tars and hashes. kInvalidArgument on two entries with the same path or a

@@ -45,7 +45,7 @@ struct ImageSpec {
   std::vector<std::string> cmd;
   std::map<std::string, std::string> env;
   std::string user = "1000:1000";
-  std::string workdir = "/tmp";
+  std::string workdir;  // "" = "/" (each Dockerfile instruction costs a builder step)
   std::map<std::string, std::string> labels;  // extra image labels
   // Strip debug sections from `executables` (`objcopy --strip-debug`, binutils): a RelWithDebInfo
   // swarmbox-physics drops from ~23 MB to ~1.5 MB. Libraries from the host are left as they are.
