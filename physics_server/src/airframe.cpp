@@ -20,7 +20,8 @@ void ReadMotor(MapReader& r, const Node& n, MotorSpec* m) {
       .Positive("time_constant_up_s", &m->time_constant_up_s)
       .Positive("time_constant_down_s", &m->time_constant_down_s)
       .Positive("max_rot_velocity_rad_s", &m->max_rot_velocity_rad_s)
-      .NonNegative("rotor_drag_coefficient", &m->rotor_drag_coefficient);
+      .NonNegative("rotor_drag_coefficient", &m->rotor_drag_coefficient)
+      .NonNegative("rolling_moment_coefficient", &m->rolling_moment_coefficient);
 }
 
 void ReadRotors(MapReader& parent, Airframe* af) {

@@ -253,6 +253,8 @@ struct World::Impl {
       const Vec3 f{drag.x, drag.y, thrust};
       force += f;
       torque += Cross(rs.position_m, f);
+      // Rolling moment (Gazebo MulticopterMotorModel): -|omega| c_r v_perp, about the in-plane axes.
+      torque += Vec3{-om * m.rolling_moment_coefficient * hub_v.x, -om * m.rolling_moment_coefficient * hub_v.y, 0.0};
       torque.z += (rs.ccw ? -1.0 : 1.0) * m.moment_constant * thrust;
     }
     const double speed = Norm(v_air_b);

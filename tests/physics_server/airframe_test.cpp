@@ -40,6 +40,7 @@ TEST(Airframe, X500MatchesPx4GazeboModel) {
   EXPECT_DOUBLE_EQ(af->motor.time_constant_down_s, 0.025);
   EXPECT_DOUBLE_EQ(af->motor.max_rot_velocity_rad_s, 1000.0);
   EXPECT_DOUBLE_EQ(af->motor.rotor_drag_coefficient, 8.06428e-05);
+  EXPECT_DOUBLE_EQ(af->motor.rolling_moment_coefficient, 1e-06);
   EXPECT_NEAR(af->mass_kg, 2.0 + 4 * 0.016076923, 1e-3);
   EXPECT_DOUBLE_EQ(af->inertia_kg_m2.z, 0.04000000000000001);
   ASSERT_EQ(af->rotors.size(), 4u);

@@ -23,6 +23,7 @@ Airframe DraglessX500() {
   Airframe af = LoadShippedAirframe("x500");
   af.body_drag_coefficient = {};
   af.motor.rotor_drag_coefficient = 0;
+  af.motor.rolling_moment_coefficient = 0;
   return af;
 }
 

@@ -37,6 +37,7 @@ struct MotorSpec {
   double time_constant_down_s = 0;    // first-order lag when slowing down [s]
   double max_rot_velocity_rad_s = 0;  // omega at u = 1 [rad/s]
   double rotor_drag_coefficient = 0;  // [N/((rad/s)(m/s))]
+  double rolling_moment_coefficient = 0;  // torque -|omega| c v_perp [N m/((rad/s)(m/s))]
 };
 
 // Noise models. Every `*_std` is one standard deviation of white Gaussian noise per axis and per
