@@ -419,6 +419,14 @@ Status DockerClient::FollowLogs(std::string_view id, const LogOptions& options,
                                 const LogLineFn& on_line, CancelToken* cancel) {
   auto info = InspectContainer(id);
   if (!info) return info.error();
+  if (options.follow && info->state.status == "created") {
+    return Error(ErrorCode::kInvalidArgument,
+                 "container " + std::string(id) +
+                     " was never started: Docker would end the log stream at once; follow its "
+                     "logs after StartContainer (no line is lost)",
+                 "GET /v" + version_.ToString() + "/containers/" + std::string(id) + "/logs (" +
+                     transport_->endpoint() + ")");
+  }
   std::string query = "?follow=" + std::string(options.follow ? "1" : "0") +
                       "&stdout=" + std::string(options.stdout ? "1" : "0") +
                       "&stderr=" + std::string(options.stderr ? "1" : "0") +

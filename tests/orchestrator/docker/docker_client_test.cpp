@@ -225,6 +225,19 @@ TEST_F(DockerClientTest, FollowLogsDemultiplexesByTheContainersTtySetting) {
   EXPECT_EQ(lines, (std::vector<std::string>{"out1", "out2", "err1"}));
 }
 
+TEST_F(DockerClientTest, RefusesToFollowANeverStartedContainer) {
+  auto c = Connect();
+  std::string created = ReadData("container_inspect.json");
+  const std::string running = "\"Status\":\"running\"";
+  ASSERT_NE(created.find(running), std::string::npos);
+  created.replace(created.find(running), running.size(), "\"Status\":\"created\"");
+  transport_->Add("GET /v1.41/containers/c1/json", 200, created);
+  Status s = c->FollowLogs("c1", {}, [](const LogLine&) {}, nullptr);
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(s.error().message().find("follow its logs after StartContainer"), std::string::npos);
+}
+
 TEST_F(DockerClientTest, ExecReportsOutputAndExitCode) {
   auto c = Connect();
   transport_->Add("POST /v1.41/containers/c1/exec", 201, ReadData("exec_create.json"));

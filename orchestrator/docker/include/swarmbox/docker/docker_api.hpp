@@ -318,7 +318,9 @@ class DockerApi {
 
   // Logs as a stream: complete lines are delivered as they arrive (multiplexed or TTY raw, as the
   // container was created). With options.follow it returns Ok when the container's output ends
-  // (it stopped), kCancelled when `cancel` fired. `cancel` may be null.
+  // (it stopped), kCancelled when `cancel` fired. `cancel` may be null. Call it after
+  // StartContainer: nothing is lost (the stream starts at the container's first line), whereas a
+  // never-started container would end the stream at once; that case is kInvalidArgument.
   virtual Status FollowLogs(std::string_view id, const LogOptions& options,
                             const LogLineFn& on_line, CancelToken* cancel) = 0;
 
