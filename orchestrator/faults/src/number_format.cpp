@@ -1,5 +1,6 @@
 #include "swarmbox/faults/detail/number_format.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -8,14 +9,14 @@ namespace swarmbox::faults::detail {
 
 std::string FormatDecimal(double value, int decimals) {
   char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
-  std::string s(buf);
-  if (s.find('.') != std::string::npos) {
-    while (!s.empty() && s.back() == '0') s.pop_back();
-    if (!s.empty() && s.back() == '.') s.pop_back();
+  const int written = std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
+  std::size_t n = written > 0 ? std::min(static_cast<std::size_t>(written), sizeof buf - 1) : 0;
+  if (std::string_view(buf, n).find('.') != std::string_view::npos) {
+    while (n > 0 && buf[n - 1] == '0') --n;
+    if (n > 0 && buf[n - 1] == '.') --n;
   }
-  if (s == "-0") s = "0";
-  return s;
+  const std::string_view text(buf, n);
+  return std::string(text == "-0" ? std::string_view("0") : text);
 }
 
 std::optional<double> ParseDecimal(std::string_view text) {
