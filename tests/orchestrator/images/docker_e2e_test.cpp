@@ -313,6 +313,49 @@ TEST_F(DockerEndToEnd, EventsStreamReportsTheRunsContainersUntilCancelled) {
   EXPECT_EQ(status.error().code(), ErrorCode::kCancelled);
 }
 
+TEST_F(DockerEndToEnd, OneClientServesConcurrentFollowersAndCalls) {
+  // The runner follows every container's logs on its own thread through one client.
+  constexpr int kContainers = 3;
+  std::vector<std::string> ids;
+  for (int i = 0; i < kContainers; ++i) {
+    auto id = api_->CreateContainer(ProbeContainer("c" + std::to_string(i), {"serve", "20"}));
+    ASSERT_TRUE(id) << id.error().ToString();
+    ids.push_back(*id);
+  }
+  std::vector<testing::LineLog> logs(kContainers);
+  std::vector<Status> results(kContainers, Status(Ok{}));
+  std::vector<std::thread> followers;
+  for (int i = 0; i < kContainers; ++i) {
+    ASSERT_TRUE(api_->StartContainer(ids[static_cast<std::size_t>(i)]));
+    followers.emplace_back([&, i] {
+      const auto k = static_cast<std::size_t>(i);
+      results[k] = api_->FollowLogs(ids[k], {}, logs[k].Collector(), nullptr);
+    });
+  }
+  docker::LabelSelector run;
+  run.equals = {{std::string(docker::kLabelRun), run_id_}};
+  for (int round = 0; round < 10; ++round) {  // ordinary calls meanwhile, on this thread
+    auto list = api_->ListContainers(run, true);
+    ASSERT_TRUE(list) << list.error().ToString();
+    EXPECT_EQ(list->size(), static_cast<std::size_t>(kContainers));
+  }
+  for (int i = 0; i < kContainers; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    ASSERT_TRUE(logs[k].WaitFor("tick 19", std::chrono::seconds(20))) << logs[k].Dump();
+    ASSERT_TRUE(logs[k].WaitFor("warn 19", std::chrono::seconds(20))) << logs[k].Dump();
+    docker::TarWriter stop;
+    ASSERT_TRUE(stop.AddFile("stop", "done\n"));
+    ASSERT_TRUE(api_->PutArchive(ids[k], "/tmp", *stop.Finish()));
+  }
+  for (auto& t : followers) t.join();
+  for (int i = 0; i < kContainers; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    EXPECT_TRUE(results[k]) << results[k].error().ToString();
+    EXPECT_TRUE(logs[k].Has("stopping: done")) << logs[k].Dump();
+    EXPECT_EQ(logs[k].lines().size(), 42u) << logs[k].Dump();  // ready + 20 + 20 + stopping
+  }
+}
+
 TEST_F(DockerEndToEnd, RemoveLabelledLeavesNothingLabelledBehind) {
   // Things of this run: two networks, a running, a created and an exited container.
   docker::NetworkSpec net;
