@@ -89,6 +89,13 @@ void Estimator::Predict(Axis* ax, double acc, double dt) const {
   Eigen::Vector4d& x = ax->x;
   x(kP) += x(kV) * dt + 0.5 * (acc - x(kBa)) * dt * dt;
   x(kV) += (acc - x(kBa)) * dt;
+  // Glide in the pending GPS corrections at bounded rates.
+  const double dp = std::clamp(ax->pending_p, -params_.max_pos_correction_mps * dt, params_.max_pos_correction_mps * dt);
+  const double dv = std::clamp(ax->pending_v, -params_.max_vel_correction_mps2 * dt, params_.max_vel_correction_mps2 * dt);
+  x(kP) += dp;
+  x(kV) += dv;
+  ax->pending_p -= dp;
+  ax->pending_v -= dv;
   Eigen::Matrix4d q = Eigen::Matrix4d::Zero();
   const double qa = params_.accel_noise_mps2 * params_.accel_noise_mps2;
   q(kP, kP) = 0.25 * dt * dt * dt * dt * qa;
@@ -103,8 +110,7 @@ void Estimator::Predict(Axis* ax, double acc, double dt) const {
   }
 }
 
-void Estimator::Correct(Axis* ax, double z, double r, bool with_baro_bias, int idx, double max_dp,
-                        double max_dv) const {
+void Estimator::Correct(Axis* ax, double z, double r, bool with_baro_bias, int idx, bool glide) const {
   Eigen::RowVector4d h = Eigen::RowVector4d::Zero();
   h(idx) = 1.0;
   if (with_baro_bias) h(kBb) = 1.0;
@@ -113,8 +119,15 @@ void Estimator::Correct(Axis* ax, double z, double r, bool with_baro_bias, int i
   if (!(s > 0.0)) return;
   const Eigen::Vector4d k = ax->p * h.transpose() / s;
   Eigen::Vector4d dx = k * innov;
-  if (max_dp > 0.0) dx(kP) = std::clamp(dx(kP), -max_dp, max_dp);
-  if (max_dv > 0.0) dx(kV) = std::clamp(dx(kV), -max_dv, max_dv);
+  if (glide) {
+    // Position and velocity corrections are not applied at once but handed to Predict(), which
+    // applies them at a bounded rate (a glide, no step for the controller); the covariance is
+    // updated now, as if applied.
+    ax->pending_p += dx(kP);
+    ax->pending_v += dx(kV);
+    dx(kP) = 0.0;
+    dx(kV) = 0.0;
+  }
   ax->x += dx;
   // Joseph form keeps P symmetric and positive.
   const Eigen::Matrix4d ikh = Eigen::Matrix4d::Identity() - k * h;
@@ -123,7 +136,10 @@ void Estimator::Correct(Axis* ax, double z, double r, bool with_baro_bias, int i
 
 const StateEstimate& Estimator::Update(const SensorSample& s) {
   if (!att_init_) {
+    // Wait for the accelerometer and the magnetometer (heading), or 0.5 s without a magnetometer.
     if (!s.imu_fresh) return state_;
+    if (first_t_s_ < 0.0) first_t_s_ = s.t_s;
+    if (!s.mag_fresh && s.t_s - first_t_s_ < 0.5) return state_;
     t_start_s_ = s.t_s;
     t_last_s_ = s.t_s;
     InitAttitude(s);
@@ -187,23 +203,17 @@ const StateEstimate& Estimator::Update(const SensorSample& s) {
   if (pos_init_) {
     for (int a = 0; a < 3; ++a) Predict(&ax_[a], acc_world_[a], dt);
     if (s.baro_fresh) {
-      Correct(&ax_[2], s.baro_alt_m, params_.baro_std_m * params_.baro_std_m, true, kP, 0.0, 0.0);
+      Correct(&ax_[2], s.baro_alt_m, params_.baro_std_m * params_.baro_std_m, true, kP, false);
     }
     if (at_rest_ && ++rest_count_ >= 5) {  // 50 Hz zero-velocity update
       rest_count_ = 0;
-      for (int a = 0; a < 3; ++a) Correct(&ax_[a], 0.0, 0.02 * 0.02, false, kV, 0.0, 0.0);
+      for (int a = 0; a < 3; ++a) Correct(&ax_[a], 0.0, 0.02 * 0.02, false, kV, false);
     }
     if (s.gps_fresh && s.gps_valid) {
-      const double since = s.t_s - t_last_gps_s_;
-      // Slew limits only bind after a gap; in steady fusion the corrections are far smaller.
-      const double gap = std::clamp(since, 0.02, 0.5);
-      const double max_dp = params_.max_pos_correction_mps * gap;
-      const double max_dv = params_.max_vel_correction_mps2 * gap;
       for (int a = 0; a < 3; ++a) {
         const double rp = a == 2 ? params_.gps_pos_v_std_m : params_.gps_pos_h_std_m;
-        Correct(&ax_[a], s.gps_vel_mps[a], params_.gps_vel_std_mps * params_.gps_vel_std_mps, false,
-                kV, max_dp, max_dv);
-        Correct(&ax_[a], s.gps_pos_m[a], rp * rp, false, kP, max_dp, max_dv);
+        Correct(&ax_[a], s.gps_vel_mps[a], params_.gps_vel_std_mps * params_.gps_vel_std_mps, false, kV, true);
+        Correct(&ax_[a], s.gps_pos_m[a], rp * rp, false, kP, true);
       }
       t_last_gps_s_ = s.t_s;
     }

@@ -49,6 +49,7 @@ void SwingObserver::Reset() {
   s_.setZero();
   s_dot_.setZero();
   s_meas_.setZero();
+  offset_.setZero();
   active_ = false;
 }
 
@@ -72,6 +73,7 @@ void SwingObserver::Update(const Vec3& f_body, const Quat& att, const Vec3& acc_
   if (!active_) {
     s_ = s_meas_;
     s_dot_.setZero();
+    offset_.setZero();
     active_ = true;
     return;
   }
@@ -80,16 +82,20 @@ void SwingObserver::Update(const Vec3& f_body, const Quat& att, const Vec3& acc_
   const double w2 = kGravity_mps2 / length_m_;
   const double l1 = 3.0 * std::sqrt(w2);
   const double l2 = 3.0 * w2;
+  // A slow offset state takes what the pendulum model cannot explain (a steady lean of the sling
+  // from wind on the payload or a steady acceleration): only the swinging part is damped.
+  const double l3 = 1.0;  // [1/s], well below the swing frequency
   for (int a = 0; a < 2; ++a) {
-    const double e = s_meas_[a] - s_[a];
+    const double e = s_meas_[a] - s_[a] - offset_[a];
     const double s_ddot = -w2 * s_[a] - acc_world[a] / length_m_ + l2 * e;
     s_[a] += dt_s * (s_dot_[a] + l1 * e);
     s_dot_[a] += dt_s * s_ddot;
+    offset_[a] += dt_s * l3 * e;
   }
 }
 
 double SwingObserver::swing_angle_rad() const {
-  return std::asin(std::min(1.0, s_.head<2>().norm()));
+  return std::asin(std::min(1.0, (s_ + offset_).head<2>().norm()));
 }
 
 Vec3 SwingObserver::DampingAcceleration(double gain) const {

@@ -12,9 +12,10 @@
 //    fusing GPS position/velocity and barometric altitude. Per-axis filters are exact for this
 //    linear model and give honest, growing uncertainty during GPS dropouts (dead reckoning on
 //    the IMU with the bias learnt before the dropout; the barometer keeps altitude).
-//  * GPS recovery: the correction that the first fixes after a dropout would apply at once is
-//    slewed (position at most `max_pos_correction_mps`, velocity at most
-//    `max_vel_correction_mps2`), so the controller sees a smooth glide back, not a jump.
+//  * GPS corrections glide in: the position/velocity change a fix asks for is applied over the
+//    following steps at most at `max_pos_correction_mps` / `max_vel_correction_mps2`. In steady
+//    fusion that is invisible (centimetres); after a dropout the estimate glides back to the GPS
+//    instead of jumping, so the controller is not kicked.
 //
 //   Estimator est(EstimatorParams{});
 //   for each sample: const StateEstimate& s = est.Update(sample);  // valid once aligned
@@ -72,20 +73,22 @@ class Estimator {
     Eigen::Vector4d x = Eigen::Vector4d::Zero();
     Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
     int n = 3;  // states in use
+    double pending_p = 0.0;  // GPS corrections still to glide in [m], [m/s]
+    double pending_v = 0.0;
   };
   void InitAttitude(const SensorSample& s);
   void UpdateAttitude(const SensorSample& s, double dt);
   void Predict(Axis* ax, double acc, double dt) const;
   // Measurement of state `idx` (plus the baro offset when `with_baro_bias`), variance r.
-  // max_step[k] bounds the applied change of state k (slew on recovery), <= 0: unbounded.
-  void Correct(Axis* ax, double z, double r, bool with_baro_bias, int idx, double max_dp,
-               double max_dv) const;
+  // glide: position/velocity corrections are applied by Predict() at bounded rates.
+  void Correct(Axis* ax, double z, double r, bool with_baro_bias, int idx, bool glide) const;
 
   EstimatorParams params_;
   StateEstimate state_;
   bool att_init_ = false;
   bool pos_init_ = false;
   double t_start_s_ = 0.0;
+  double first_t_s_ = -1.0;
   double t_last_s_ = 0.0;
   double t_last_gps_s_ = -1e9;
   Quat q_ = Quat::Identity();

@@ -58,7 +58,8 @@ class SwingObserver {
   // rests); dt_s: step [s].
   void Update(const Vec3& f_body, const Quat& att, const Vec3& acc_world, double payload_mass_kg,
               double dt_s);
-  // Horizontal payload offset over sling length (world x, y; z = 0), ~ the swing angles [rad].
+  // Swinging part of the horizontal payload offset over sling length (world x, y; z = 0),
+  // ~ the swing angles [rad]; swing_angle_rad() adds the steady lean.
   const Vec3& swing() const { return s_; }
   const Vec3& swing_rate() const { return s_dot_; }
   const Vec3& measured_swing() const { return s_meas_; }
@@ -74,6 +75,7 @@ class SwingObserver {
   Vec3 s_ = Vec3::Zero();
   Vec3 s_dot_ = Vec3::Zero();
   Vec3 s_meas_ = Vec3::Zero();
+  Vec3 offset_ = Vec3::Zero();   // steady lean (not swinging)
   bool active_ = false;
 };
 
