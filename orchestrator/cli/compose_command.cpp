@@ -41,7 +41,13 @@ int ComposeCommand(const ComposeArgs& args) {
     return kExitInfrastructure;
   }
   const std::string trials_dir = fs::absolute(spec->trials_dir).lexically_normal().string();
+  auto masses = runner::LoadPayloadMasses(*spec, trials_dir);
+  if (!masses) {
+    std::cerr << masses.error().ToString() << "\n";
+    return kExitUsage;
+  }
   runner::PlanOptions plan;
+  plan.payload_mass_kg = *masses;
   plan.run_id = kComposeRunId;
   plan.images = images;
   plan.subnets = *subnets;

@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <set>
 
+#include "swarmbox/common/yaml.hpp"
 #include "swarmbox/images/standard_images.hpp"
 #include "swarmbox/runner/naming.hpp"
 
@@ -25,51 +26,58 @@ std::string AirframeRelative(const dsl::DroneSpec& d) { return "airframes/" + d.
 
 // --- the command lines: adjust here when the programs' flags change ------------------------------
 
+// Inside the containers: sim is the first network attached (eth0), mesh the second (eth1).
+constexpr char kSimInterface[] = "eth0";
+constexpr char kMeshInterface[] = "eth1";
+constexpr int kSimDomain = 0;   // each trial has its own networks, so fixed domain ids are safe
+constexpr int kMeshDomain = 1;
+
+// swarmbox-physics (physics_server/README.md).
 std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
   std::vector<std::string> argv = {
       images::kPhysicsBinaryInImage,
       "--world", InContainer(spec.world),
+      "--airframes-dir", InContainer("airframes"),
       "--seed", std::to_string(spec.seed),
       "--rtf", Num(spec.rtf),
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
+      "--sim-interface", kSimInterface,
+      "--domain", std::to_string(kSimDomain),
       "--truth", std::string(kTruthCsvPath),
+      // Stops (event=stopped t=...) when the trial's simulated time is up; truth.csv is flushed.
+      "--max-sim-time", Num(spec.timeout.sim.seconds()),
   };
   for (const dsl::DroneSpec& d : spec.drones) {
-    // --drone name:airframe_file:x,y,z[:payload]
-    std::string drone = d.name + ":" + InContainer(AirframeRelative(d)) + ":" + Num(d.pose[0]) +
-                        "," + Num(d.pose[1]) + "," + Num(d.pose[2]);
-    if (!d.payload.empty()) drone += ":" + d.payload;
+    // name:airframe:x,y,z[:yaw_deg[:payload[:attached]]]; a payload starts attached.
+    std::string drone = d.name + ":" + d.airframe + ":" + Num(d.pose[0]) + "," + Num(d.pose[1]) +
+                        "," + Num(d.pose[2]);
+    if (!d.payload.empty()) drone += ":0:" + d.payload + ":attached";
     argv.push_back("--drone");
     argv.push_back(std::move(drone));
   }
   return argv;
 }
 
+// swarmbox-agent (agent/app/main.cpp --help).
 std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d,
-                                   const std::string& sim_ip, const std::string& mesh_ip,
-                                   const std::string& physics_ip) {
-  std::string peers;
-  for (const dsl::DroneSpec& other : spec.drones) {
-    if (other.name != d.name) peers += (peers.empty() ? "" : ",") + other.name;
-  }
+                                   const PlanOptions& options) {
   std::vector<std::string> argv = {
       images::kAgentBinaryInImage,
       "--name", d.name,
       "--airframe", InContainer(AirframeRelative(d)),
-      "--world", InContainer(spec.world),
-      "--seed", std::to_string(spec.seed),
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
-      "--sim-ip", sim_ip,
-      "--mesh-ip", mesh_ip,
-      "--physics-ip", physics_ip,
+      "--sim-interface", kSimInterface,
+      "--sim-domain", std::to_string(kSimDomain),
+      "--mesh-interface", kMeshInterface,
+      "--mesh-domain", std::to_string(kMeshDomain),
+      "--start", Num(d.pose[0]) + "," + Num(d.pose[1]) + "," + Num(d.pose[2]),
   };
-  if (!peers.empty()) {
-    argv.push_back("--peers");
-    argv.push_back(peers);
-  }
   if (!d.payload.empty()) {
-    argv.push_back("--payload");
-    argv.push_back(d.payload);
+    auto mass = options.payload_mass_kg.find(d.airframe + "/" + d.payload);
+    if (mass != options.payload_mass_kg.end()) {
+      argv.push_back("--payload-mass");
+      argv.push_back(Num(mass->second));
+    }
   }
   return argv;
 }
@@ -77,6 +85,36 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
 // -------------------------------------------------------------------------------------------------
 
 }  // namespace
+
+Result<std::map<std::string, double>> LoadPayloadMasses(const dsl::TrialSpec& spec,
+                                                        const std::string& trials_dir) {
+  std::map<std::string, double> masses;
+  for (const dsl::DroneSpec& d : spec.drones) {
+    if (d.payload.empty()) continue;
+    const std::string path = (std::filesystem::path(trials_dir) / AirframeRelative(d)).string();
+    auto doc = yaml::ParseFile(path);
+    if (!doc) return doc.error();
+    const yaml::Node* payloads = doc->Find("payloads");
+    bool found = false;
+    if (payloads != nullptr && payloads->is_sequence()) {
+      for (const yaml::Node& p : payloads->items()) {
+        const yaml::Node* name = p.Find("name");
+        const yaml::Node* mass = p.Find("mass_kg");
+        if (name == nullptr || mass == nullptr || name->scalar() != d.payload) continue;
+        auto kg = mass->AsDouble();
+        if (!kg) return kg.error();
+        masses[d.airframe + "/" + d.payload] = *kg;
+        found = true;
+      }
+    }
+    if (!found) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "drone " + d.name + ": airframe " + d.airframe + " has no payload '" + d.payload + "'",
+                   d.mark.ToString());
+    }
+  }
+  return masses;
+}
 
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
   const double sim_s = spec.timeout.sim.seconds();
@@ -148,7 +186,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     const std::string mesh_ip = nets.mesh.Host(host);
     ++host;
     dsl::ContainerSpec agent =
-        dsl::ContainerSpec::Image(options.images.agent, AgentArgv(spec, d, sim_ip, mesh_ip, physics_ip));
+        dsl::ContainerSpec::Image(options.images.agent, AgentArgv(spec, d, options));
     agent.name = name(d.name);
     agent.hostname = d.name;
     agent.labels = labels(d.name);

@@ -22,6 +22,9 @@ class PlanTest : public ::testing::Test {
     options_.images = {"swarmbox/physics:abc", "swarmbox/agent:def"};
     options_.subnets = {*Ipv4Net::Parse("10.200.8.0/24"), *Ipv4Net::Parse("10.200.9.0/24")};
     options_.trials_dir = "/src/trials";
+    auto masses = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
+    ASSERT_TRUE(masses) << masses.error().ToString();
+    options_.payload_mass_kg = *masses;
   }
   dsl::TrialSpec spec_;
   PlanOptions options_;
@@ -61,8 +64,9 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   EXPECT_EQ(physics.networks[0].ipv4, "10.200.8.2");
   EXPECT_THAT(physics.artifacts, ElementsAre("/out/truth.csv"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/worlds/open_field.yaml"));
-  EXPECT_THAT(physics.argv,
-              Contains("lifter:/swarmbox/trials/airframes/x8_heavy.yaml:0,-10,0:stretcher"));
+  EXPECT_THAT(physics.argv, Contains("lifter:x8_heavy:0,-10,0:0:stretcher:attached"));
+  EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/airframes"));
+  EXPECT_THAT(physics.argv, Contains("600"));  // --max-sim-time
   ASSERT_EQ(physics.inputs.size(), 3u);  // the world and two airframes, each once
   EXPECT_EQ(physics.inputs[0].host_path, "/src/trials/worlds/open_field.yaml");
   EXPECT_EQ(physics.inputs[0].container_path, "/swarmbox/trials/worlds/open_field.yaml");
@@ -74,8 +78,10 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   EXPECT_EQ(lifter.networks[1].network, "mesh");
   EXPECT_EQ(lifter.networks[1].ipv4, "10.200.9.13");
   EXPECT_EQ(lifter.labels.at("swarmbox.component"), "lifter");
-  EXPECT_THAT(lifter.argv, Contains("--payload"));
-  EXPECT_THAT(lifter.argv, Contains("scout_1,scout_2,scout_3"));
+  EXPECT_THAT(lifter.argv, Contains("--payload-mass"));
+  EXPECT_THAT(lifter.argv, Contains("80"));
+  EXPECT_THAT(lifter.argv, Contains("0,-10,0"));  // --start
+  EXPECT_THAT(lifter.argv, Contains("eth1"));     // --mesh-interface
   EXPECT_EQ(lifter.argv[0], "/usr/local/bin/swarmbox-agent");
 }
 
@@ -90,6 +96,15 @@ TEST_F(PlanTest, EndConditionsAndTimeoutComeFromTheTrial) {
   EXPECT_EQ((*trial)->timeout().clock_component, "physics");
   // rtf 1: 600 s * 1.5 + 120 s.
   EXPECT_EQ((*trial)->timeout().wall_guard, dsl::Duration::Seconds(1020));
+}
+
+TEST_F(PlanTest, PayloadsComeFromTheAirframe) {
+  EXPECT_EQ(options_.payload_mass_kg.at("x8_heavy/stretcher"), 80.0);
+  spec_.drones[3].payload = "piano";
+  auto masses = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
+  ASSERT_FALSE(masses);
+  EXPECT_EQ(masses.error().message(), "drone lifter: airframe x8_heavy has no payload 'piano'");
+  EXPECT_NE(masses.error().where().find("sar_search.yaml:19:5"), std::string::npos);
 }
 
 TEST_F(PlanTest, MissingImagesOrRunIdAreRefused) {

@@ -8,13 +8,15 @@
 //   Trial <name>
 //     Network sim [0]   physics <-> agents, never impaired
 //     Network mesh [0]  agent <-> agent radio (netem applies here, fault injector's business)
-//     Plugin physics [1]  ready on `event=ready`; collects /out/truth.csv
+//     Plugin physics [1]  ready on `event=ready`; collects /out/truth.csv; stops itself at the
+//                         trial's simulated timeout (--max-sim-time) with `event=stopped t=...`
 //     Component drones [2]
-//       Plugin <drone> [2]  one agent per drone, on sim and mesh
+//       Plugin <drone> [2]  one agent per drone, on sim (eth0) and mesh (eth1)
 // Files: the world and airframe files are copied into every container under /swarmbox/trials/
 // (same relative paths as in the trials folder).
 #pragma once
 
+#include <map>
 #include <memory>
 #include <string>
 
@@ -36,6 +38,8 @@ struct PlanOptions {
   Images images;
   TrialSubnets subnets;
   std::string trials_dir;  // absolute host path the spec's references resolve against
+  // "<airframe>/<payload>" -> mass [kg], told to the agent that starts with that payload.
+  std::map<std::string, double> payload_mass_kg;
 };
 
 inline constexpr std::string_view kPhysicsId = "physics";
@@ -50,6 +54,11 @@ inline constexpr std::string_view kPhysicsReadyPattern = "event=ready";
 // The wall-clock guard when the trial file gives none: [s]. rtf > 0: sim/rtf * 1.5 + 120;
 // rtf == 0 (as fast as possible): sim * 3 + 120.
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec);
+
+// Reads the payload masses the trial's drones start with from their airframe files (I/O).
+// kInvalidArgument at the drone's mark when an airframe does not list the payload.
+Result<std::map<std::string, double>> LoadPayloadMasses(const dsl::TrialSpec& spec,
+                                                        const std::string& trials_dir);
 
 Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
                                               const PlanOptions& options);
