@@ -14,8 +14,9 @@
 //   while ((*sub)->TakeFor(s, std::chrono::milliseconds(500))) { ...; (*pub)->Publish(cmd); }
 //
 // Lifetimes: publishers and subscribers share ownership of their participant's middleware objects,
-// so they may outlive the Participant object. Domains: each process may bind a given domain id to
-// one interface only (a second participant on the same domain id must name the same interface).
+// so they may outlive the Participant object. Domains: with Cyclone DDS a process binds a given
+// domain id to one interface only (a second cyclonedds participant on the same domain id must name
+// the same interface; the agent's `sim` and `mesh` domains therefore need different ids).
 // Errors are Results; nothing here throws.
 #pragma once
 
