@@ -26,6 +26,36 @@ Vec2 ClampNorm(const Vec2& v, double max_norm) {
   return n > max_norm ? Vec2(v * (max_norm / n)) : v;
 }
 
+// Clearance from p to the obstacle footprint (negative inside) and the unit normal pointing away
+// from it at the nearest point.
+double ObstacleClearance(const ObstacleFootprint& o, const Vec2& p, Vec2* away_normal) {
+  const double c = std::cos(o.yaw_rad);
+  const double s = std::sin(o.yaw_rad);
+  const Vec2 d = p - o.center_m;
+  const Vec2 q(c * d.x() + s * d.y(), -s * d.x() + c * d.y());  // in the obstacle's frame
+  const Vec2 nearest(std::clamp(q.x(), -o.half_size_m.x(), o.half_size_m.x()),
+                     std::clamp(q.y(), -o.half_size_m.y(), o.half_size_m.y()));
+  Vec2 n_local;
+  double clearance = 0.0;
+  const double dist = (q - nearest).norm();
+  if (dist > 1e-9) {
+    n_local = (q - nearest) / dist;
+    clearance = dist;
+  } else {  // inside: leave through the nearest face
+    const double fx = o.half_size_m.x() - std::abs(q.x());
+    const double fy = o.half_size_m.y() - std::abs(q.y());
+    if (fx < fy) {
+      n_local = Vec2(q.x() >= 0 ? 1 : -1, 0);
+      clearance = -fx;
+    } else {
+      n_local = Vec2(0, q.y() >= 0 ? 1 : -1);
+      clearance = -fy;
+    }
+  }
+  *away_normal = Vec2(c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y());
+  return clearance;
+}
+
 }  // namespace
 
 double BrakingCurve(double r_m, double a_m_s2, double p_1_s) {
@@ -48,8 +78,12 @@ Flocking::Flocking(const FlockingParams& params, const Geofence& fence,
 Vec2 Flocking::ShillTerm(const Vec2& p, const Vec2& v) const {
   const FlockingParams& k = params_;
   Vec2 sum = Vec2::Zero();
+  // Only the velocity component along the wall normal is compared with the shill agent's (V18
+  // compares the full velocity, which also brakes motion along the wall and can stall a drone
+  // beside an obstacle while migration pulls it past): drones slide along walls.
   auto add = [&](double clearance_m, const Vec2& away_normal) {
-    sum += FrictionRule(v, k.v_shill_m_s * away_normal, clearance_m, k.r0_shill_m, 0.0,
+    const Vec2 v_normal = v.dot(away_normal) * away_normal;
+    sum += FrictionRule(v_normal, k.v_shill_m_s * away_normal, clearance_m, k.r0_shill_m, 0.0,
                         k.a_shill_m_s2, k.p_shill_1_s, k.c_shill);
   };
   // Geofence walls: shill agents at the foot of the perpendicular, moving inward.
@@ -59,30 +93,9 @@ Vec2 Flocking::ShillTerm(const Vec2& p, const Vec2& v) const {
   add(fence_.max_y_m - p.y(), Vec2(0, -1));
   // Obstacles: a shill agent at the nearest point of the footprint, moving away from it.
   for (const ObstacleFootprint& o : obstacles_) {
-    const double c = std::cos(o.yaw_rad);
-    const double s = std::sin(o.yaw_rad);
-    const Vec2 d = p - o.center_m;
-    const Vec2 q(c * d.x() + s * d.y(), -s * d.x() + c * d.y());  // in the obstacle's frame
-    const Vec2 nearest(std::clamp(q.x(), -o.half_size_m.x(), o.half_size_m.x()),
-                       std::clamp(q.y(), -o.half_size_m.y(), o.half_size_m.y()));
-    Vec2 n_local;
-    double clearance = 0.0;
-    const double dist = (q - nearest).norm();
-    if (dist > 1e-9) {
-      n_local = (q - nearest) / dist;
-      clearance = dist;
-    } else {  // inside: leave through the nearest face
-      const double fx = o.half_size_m.x() - std::abs(q.x());
-      const double fy = o.half_size_m.y() - std::abs(q.y());
-      if (fx < fy) {
-        n_local = Vec2(q.x() >= 0 ? 1 : -1, 0);
-        clearance = -fx;
-      } else {
-        n_local = Vec2(0, q.y() >= 0 ? 1 : -1);
-        clearance = -fy;
-      }
-    }
-    add(clearance, Vec2(c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y()));
+    Vec2 n;
+    const double clearance = ObstacleClearance(o, p, &n);
+    add(clearance, n);
   }
   return sum;
 }
@@ -100,6 +113,19 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
     if (d > 1e-6) {
       const double speed = std::min(k.v_flock_m_s, BrakingCurve(d, k.a_mig_m_s2, k.p_mig_1_s));
       out.migration = speed * to_goal / d;
+    }
+    // Slide around obstacles: near one, the part of the migration that points into it turns
+    // along its face (keeping the speed; head-on, to the left), so that migration and the shill
+    // push do not cancel in front of a wall.
+    for (const ObstacleFootprint& o : obstacles_) {
+      Vec2 n;
+      const double clearance = ObstacleClearance(o, p, &n);
+      const double into = -out.migration.dot(n);
+      if (clearance > k.obstacle_slide_range_m || into <= 0.0) continue;
+      const double speed = out.migration.norm();
+      Vec2 along = out.migration + into * n;  // tangential part
+      if (along.norm() < 0.05 * speed) along = Vec2(-n.y(), n.x());
+      out.migration = speed * along.normalized();
     }
   }
 

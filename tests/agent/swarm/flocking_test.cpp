@@ -180,6 +180,49 @@ TEST(Flocking, TwentyAgentsFromRandomStartsAreSafeOrderedAndUnited) {
   }
 }
 
+// V18's obstacle case: the flock migrates through a field of obstacles (shill agents on their
+// faces) and a confining geofence; nobody enters an obstacle or leaves the fence, no pair comes
+// closer than the separation, and the flock is one group again once past the field.
+TEST(Flocking, FlockCrossesAnObstacleFieldSafelyAndRegroups) {
+  const FlockMetricsParams mp{.separation_m = 3.0, .link_range_m = 60.0};
+  for (std::uint64_t seed = 21; seed <= 25; ++seed) {
+  KinematicSwarmConfig c;
+  c.seed = seed;
+  c.fence = Geofence{-60, 400, -90, 90};
+  c.obstacles = {{Vec2(90, -30), Vec2(8, 12), 0.3}, {Vec2(110, 25), Vec2(10, 6), -0.4},
+                 {Vec2(150, -5), Vec2(6, 6), 0.0}, {Vec2(170, 45), Vec2(5, 15), 0.8}};
+  c.goal_m = Vec3(320, 0, 20);
+  KinematicSwarm swarm(c);
+  double min_safety = 1.0, min_clearance = 1e9, min_distance = 1e9;
+  bool left_fence = false;
+  for (int i = 0; i < static_cast<int>(120.0 / kDt); ++i) {
+    swarm.Step();
+    const FlockMetrics m = swarm.Metrics(mp);
+    min_safety = std::min(min_safety, m.safety);
+    min_distance = std::min(min_distance, m.min_distance_m);
+    for (int a = 0; a < c.agents; ++a) {
+      const Vec2 p = swarm.position(a).head<2>();
+      left_fence = left_fence || !c.fence.Contains(p);
+      for (const ObstacleFootprint& o : c.obstacles) {
+        const Vec2 d = p - o.center_m;
+        const double cy = std::cos(o.yaw_rad), sy = std::sin(o.yaw_rad);
+        const Vec2 q(cy * d.x() + sy * d.y(), -sy * d.x() + cy * d.y());
+        min_clearance = std::min(min_clearance, std::hypot(std::max(std::abs(q.x()) - o.half_size_m.x(), 0.0),
+                                                           std::max(std::abs(q.y()) - o.half_size_m.y(), 0.0)));
+      }
+    }
+  }
+  EXPECT_EQ(min_safety, 1.0) << "seed " << seed << " closest pair " << min_distance << " m";
+  EXPECT_FALSE(left_fence) << "seed " << seed;
+  EXPECT_GT(min_clearance, 0.5) << "seed " << seed;  // [m] outside every footprint
+  const FlockMetrics end = swarm.Metrics(mp);
+  EXPECT_EQ(end.union_, 1.0) << "seed " << seed;
+  double min_x = 1e9;
+  for (const Vec3& p : swarm.AlivePositions()) min_x = std::min(min_x, p.x());
+  EXPECT_GT(min_x, 200.0) << "seed " << seed;  // everyone got past the field (it ends at x ~ 180)
+  }
+}
+
 // Same under a lossy radio (20% packet loss): neighbours age and are dead-reckoned.
 TEST(Flocking, LossyRadioKeepsTheFlockSafeAndUnited) {
   const FlockMetricsParams mp{.separation_m = 3.0, .link_range_m = 60.0};

@@ -25,7 +25,9 @@
 //  - alignment   Reynolds' linear alignment toward the neighbours' mean velocity (gain c_align);
 //  - cohesion    Reynolds' attraction to the neighbours' centroid beyond r0_coh;
 //  - shill       V18 virtual agents on the geofence walls and on obstacle faces, moving inward /
-//                outward at v_shill; their velocity is imposed with the friction rule (V18 eq. 5);
+//                outward at v_shill; their velocity is imposed with the friction rule (V18 eq. 5)
+//                on the velocity component along the wall normal (so drones slide along walls);
+//                near an obstacle the migration term turns along its face (no head-on stall);
 //  - limits      |v_xy| <= v_max, |v_z| <= v_z_max, |dv/dt| <= a_max (across steps).
 //
 // Neighbours: the position is dead-reckoned by velocity * age. A neighbour older than
@@ -82,7 +84,7 @@ struct FlockingParams {
   double p_mig_1_s = 0.6;         // braking-curve linear gain near the goal [1/s]
   // Repulsion (V18 r0_rep, p_rep).
   double r0_rep_m = 10.0;
-  double p_rep_1_s = 0.6;
+  double p_rep_1_s = 1.2;
   // Friction alignment (V18 r0_frict, C_frict, v_frict, p_frict, a_frict).
   double r0_frict_m = 20.0;
   double c_frict = 0.1;
@@ -95,11 +97,12 @@ struct FlockingParams {
   double p_coh_1_s = 0.15;
   double v_coh_max_m_s = 2.0;     // cap on the cohesion term [m/s]
   // Shill agents (V18 r0_shill, v_shill, p_shill, a_shill) at the geofence and obstacles.
-  double r0_shill_m = 3.0;        // stand-off distance from walls and obstacle faces [m]
-  double v_shill_m_s = 4.0;
+  double r0_shill_m = 4.0;        // stand-off distance from walls and obstacle faces [m]
+  double v_shill_m_s = 6.0;
   double p_shill_1_s = 1.0;
-  double a_shill_m_s2 = 1.5;
-  double c_shill = 1.0;
+  double a_shill_m_s2 = 2.5;
+  double c_shill = 2.0;
+  double obstacle_slide_range_m = 12.0;  // migration turns along an obstacle face within this [m]
   // Neighbourhood.
   double sensing_range_m = 60.0;  // neighbours further than this are ignored [m]
   double fresh_age_s = 0.5;       // full weight up to this age [s]

@@ -15,7 +15,9 @@
 // is a partial view, its confidence is capped at partial_confidence_cap (it cannot confirm a
 // victim alone under MissionState's rule, which needs 0.9).
 //
-// Allocation: none once the scratch images have the frame's size, except growth of `out`.
+// Allocation: the scratch images are reused once they have the frame's size; OpenCV's morphology
+// and connected components still allocate a few dozen small internal buffers per frame (measured
+// in allocation_test.cpp). Frames come at 5 Hz, outside the control loop.
 #pragma once
 
 #include <vector>
