@@ -41,7 +41,7 @@ class AllocationCounter {
   long count() const { return g_allocations; }
 };
 
-TEST(Allocation, FlockingStepDoesNotAllocate) {
+TEST(SwarmAllocation, FlockingStepDoesNotAllocate) {
   Flocking f(FlockingParams{}, Geofence::Centered(200, 200), {ObstacleFootprint{Vec2(20, 0), Vec2(3, 3), 0.2}});
   std::vector<NeighbourState> n(19);
   for (std::size_t i = 0; i < n.size(); ++i) n[i] = {Vec3(5.0 * static_cast<double>(i), 3, 20), Vec3(1, 0, 0), 0.1 * static_cast<double>(i % 5)};
@@ -56,7 +56,7 @@ TEST(Allocation, FlockingStepDoesNotAllocate) {
   EXPECT_TRUE(v.allFinite());
 }
 
-TEST(Allocation, LatencyQueueDoesNotAllocateOncePopTargetHasCapacity) {
+TEST(SwarmAllocation, LatencyQueueDoesNotAllocateOncePopTargetHasCapacity) {
   LatencyQueue q(0.04, 16);
   std::vector<GroundDetection> out;
   out.reserve(16);
@@ -78,7 +78,7 @@ TEST(Allocation, LatencyQueueDoesNotAllocateOncePopTargetHasCapacity) {
 // connected components allocate small internal buffers per frame: measured (36 at 320x240 with
 // OpenCV 4.6) and bounded here, not claimed to be zero. Frames come at 5 Hz, outside the control
 // loop.
-TEST(Allocation, VictimDetectorAllocatesOnlyASmallBoundedAmountPerFrame) {
+TEST(SwarmAllocation, VictimDetectorAllocatesOnlyASmallBoundedAmountPerFrame) {
   cv::Mat img(240, 320, CV_8UC3, cv::Scalar(40, 110, 60));
   cv::ellipse(img, cv::RotatedRect({160, 120}, cv::Size2f(16, 5), 30), cv::Scalar(0, 120, 255), cv::FILLED);
   VictimDetector det;

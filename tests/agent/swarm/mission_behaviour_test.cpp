@@ -10,6 +10,7 @@
 #include "swarmbox/swarm/leader_planner.hpp"
 #include "swarmbox/swarm/lifter_sequence.hpp"
 #include "swarmbox/swarm/scout_behaviour.hpp"
+#include "swarmbox/swarm/swarm.hpp"  // the umbrella header compiles on its own
 
 namespace swarmbox::swarm {
 namespace {
