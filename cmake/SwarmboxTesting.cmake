@@ -25,12 +25,21 @@ function(swarmbox_add_test)
   if("unit" IN_LIST T_LABELS)
     add_dependencies(swarmbox_unit_tests ${T_NAME})
   endif()
-  set(props LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT})
-  if(T_RESOURCE_LOCK)
-    list(APPEND props RESOURCE_LOCK "${T_RESOURCE_LOCK}")
-  endif()
   gtest_discover_tests(${T_NAME}
     WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}
     DISCOVERY_TIMEOUT 60
-    PROPERTIES ${props})
+    PROPERTIES TIMEOUT ${T_TIMEOUT})
+  # List-valued properties lose their ';' on the way through gtest_discover_tests (only the first
+  # label would stick), so labels and locks are set by a second include file that runs after
+  # discovery, on the list of test names discovery leaves in ${T_NAME}_TESTS.
+  set(label_file ${CMAKE_CURRENT_BINARY_DIR}/${T_NAME}_labels.cmake)
+  set(lock_prop "")
+  if(T_RESOURCE_LOCK)
+    set(lock_prop " RESOURCE_LOCK \"${T_RESOURCE_LOCK}\"")
+  endif()
+  file(WRITE ${label_file}
+    "if(DEFINED ${T_NAME}_TESTS)\n"
+    "  set_tests_properties(\${${T_NAME}_TESTS} PROPERTIES LABELS \"${T_LABELS}\"${lock_prop})\n"
+    "endif()\n")
+  set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${label_file})
 endfunction()
