@@ -7,6 +7,7 @@
 #include "program_images.hpp"
 #include "swarmbox/dsl/trial_loader.hpp"
 #include "swarmbox/runner/compose_export.hpp"
+#include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/plan.hpp"
 
 namespace swarmbox::cli {
@@ -41,13 +42,11 @@ int ComposeCommand(const ComposeArgs& args) {
     return kExitInfrastructure;
   }
   const std::string trials_dir = fs::absolute(spec->trials_dir).lexically_normal().string();
-  auto masses = runner::LoadPayloadMasses(*spec, trials_dir);
-  if (!masses) {
-    std::cerr << masses.error().ToString() << "\n";
+  if (auto payloads = runner::LoadPayloadMasses(*spec, trials_dir); !payloads) {
+    std::cerr << payloads.error().ToString() << "\n";
     return kExitUsage;
   }
   runner::PlanOptions plan;
-  plan.payload_mass_kg = *masses;
   plan.run_id = kComposeRunId;
   plan.images = images;
   plan.subnets = *subnets;
@@ -73,7 +72,9 @@ int ComposeCommand(const ComposeArgs& args) {
       "addresses as `swarmbox run`; run priority is depends_on (readiness waits are not\n"
       "modelled: compose starts a service once the one it depends on has started).\n"
       "Needs the images on this engine: run `swarmbox images` first.\n"
-      "  docker-compose -f <this file> up        # Ctrl-C, then:\n"
+      "  docker-compose -f <this file> up        # Ctrl-C, then copy what you need:\n"
+      "  docker cp " + runner::ResourceName(spec->name, kComposeRunId, runner::kPhysicsId) +
+      ":/out/truth.csv .\n"
       "  docker-compose -f <this file> down -v   # or: swarmbox gc --run compose";
   const std::string text = runner::ComposeYaml(**trial, compose);
   if (args.output.empty()) {

@@ -47,7 +47,6 @@ std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
   for (dsl::Plugin* p : plugins) keys.push_back(PriorityKey(*p, trial));
 
   Node services = Node::Mapping();
-  Node volumes = Node::Mapping();
   for (std::size_t i = 0; i < plugins.size(); ++i) {
     const dsl::Plugin& p = *plugins[i];
     const dsl::ContainerSpec& s = p.spec();
@@ -80,14 +79,12 @@ std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
       }
       mounts.push_back(host + ":" + in.container_path + ":ro");
     }
-    for (const std::string& dir : s.scratch_dirs) {
-      std::string vol = p.id() + "-" + std::filesystem::path(dir).filename().string();
-      mounts.push_back(vol + ":" + dir);
-      Node v = Node::Mapping();
-      if (!s.labels.empty()) v.Set("labels", StrMap(s.labels));
-      volumes.Set(vol, std::move(v));
-    }
     if (!mounts.empty()) svc.Set("volumes", StrList(mounts));
+    // Scratch dirs: a tmpfs writable by the image's non-root user (copy results out with
+    // `docker cp <container>:/out/truth.csv .` before `down`).
+    std::vector<std::string> tmpfs;
+    for (const std::string& dir : s.scratch_dirs) tmpfs.push_back(dir + ":mode=1777");
+    if (!tmpfs.empty()) svc.Set("tmpfs", StrList(tmpfs));
     // Start order: depend on the services of the closest earlier priority level.
     std::size_t previous = plugins.size();  // index of a service on that level; size() = none
     for (std::size_t j = 0; j < plugins.size(); ++j) {
@@ -126,7 +123,6 @@ std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
     networks.Set(n->id(), std::move(net));
   }
   doc.Set("networks", std::move(networks));
-  if (!volumes.entries().empty()) doc.Set("volumes", std::move(volumes));
 
   std::string header;
   std::string_view rest = options.header_comment;

@@ -48,10 +48,11 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
       "--max-sim-time", Num(spec.timeout.sim.seconds()),
   };
   for (const dsl::DroneSpec& d : spec.drones) {
-    // name:airframe:x,y,z[:yaw_deg[:payload[:attached]]]; a payload starts attached.
+    // name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]]; a payload starts on the ground
+    // under the drone (a lifter standing on the ground cannot spawn with it hanging).
     std::string drone = d.name + ":" + d.airframe + ":" + Num(d.pose[0]) + "," + Num(d.pose[1]) +
                         "," + Num(d.pose[2]);
-    if (!d.payload.empty()) drone += ":0:" + d.payload + ":attached";
+    if (!d.payload.empty()) drone += ":0:" + d.payload + ":ground";
     argv.push_back("--drone");
     argv.push_back(std::move(drone));
   }
@@ -59,8 +60,7 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
 }
 
 // swarmbox-agent (agent/app/main.cpp --help).
-std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d,
-                                   const PlanOptions& options) {
+std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
   std::vector<std::string> argv = {
       images::kAgentBinaryInImage,
       "--name", d.name,
@@ -72,13 +72,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       "--mesh-domain", std::to_string(kMeshDomain),
       "--start", Num(d.pose[0]) + "," + Num(d.pose[1]) + "," + Num(d.pose[2]),
   };
-  if (!d.payload.empty()) {
-    auto mass = options.payload_mass_kg.find(d.airframe + "/" + d.payload);
-    if (mass != options.payload_mass_kg.end()) {
-      argv.push_back("--payload-mass");
-      argv.push_back(Num(mass->second));
-    }
-  }
+  // The agent starts unloaded (--payload-mass 0): its payload lies on the ground.
   return argv;
 }
 
@@ -186,7 +180,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     const std::string mesh_ip = nets.mesh.Host(host);
     ++host;
     dsl::ContainerSpec agent =
-        dsl::ContainerSpec::Image(options.images.agent, AgentArgv(spec, d, options));
+        dsl::ContainerSpec::Image(options.images.agent, AgentArgv(spec, d));
     agent.name = name(d.name);
     agent.hostname = d.name;
     agent.labels = labels(d.name);

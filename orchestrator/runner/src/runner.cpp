@@ -275,11 +275,11 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
   info.seed = spec.seed;
   info.resolved_yaml = yaml::Emit(spec.document.is_null() ? dsl::ToDocument(spec) : spec.document);
   info.world_file = (fs::path(trials_dir) / spec.world).string();
-  auto masses = LoadPayloadMasses(spec, trials_dir);
-  if (!masses) return masses.error().Context("reading payloads");
+  if (auto payloads = LoadPayloadMasses(spec, trials_dir); !payloads) {
+    return payloads.error().Context("checking payloads");
+  }
   Planner planner = [&](const std::string& run_id, const TrialSubnets& subnets) {
     PlanOptions p;
-    p.payload_mass_kg = *masses;
     p.run_id = run_id;
     p.trial_id = options.trial_id;
     p.images = options.images;

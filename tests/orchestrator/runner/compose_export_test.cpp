@@ -50,7 +50,7 @@ TEST(ComposeYaml, ExportsNetworksServicesAndStartOrder) {
   EXPECT_EQ(lifter->Find("depends_on")->items()[0].scalar(), "physics");
   EXPECT_EQ(lifter->Find("labels")->Find("swarmbox.component")->scalar(), "lifter");
   EXPECT_EQ(lifter->Find("networks")->Find("mesh")->Find("ipv4_address")->scalar(), "10.200.9.13");
-  EXPECT_NE(doc->Find("volumes")->Find("physics-out"), nullptr);
+  EXPECT_EQ(physics->Find("tmpfs")->items()[0].scalar(), "/out:mode=1777");
 }
 
 TEST(ComposeYaml, DependsOnTheClosestEarlierPriorityLevel) {

@@ -22,9 +22,6 @@ class PlanTest : public ::testing::Test {
     options_.images = {"swarmbox/physics:abc", "swarmbox/agent:def"};
     options_.subnets = {*Ipv4Net::Parse("10.200.8.0/24"), *Ipv4Net::Parse("10.200.9.0/24")};
     options_.trials_dir = "/src/trials";
-    auto masses = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
-    ASSERT_TRUE(masses) << masses.error().ToString();
-    options_.payload_mass_kg = *masses;
   }
   dsl::TrialSpec spec_;
   PlanOptions options_;
@@ -64,7 +61,7 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   EXPECT_EQ(physics.networks[0].ipv4, "10.200.8.2");
   EXPECT_THAT(physics.artifacts, ElementsAre("/out/truth.csv"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/worlds/open_field.yaml"));
-  EXPECT_THAT(physics.argv, Contains("lifter:x8_heavy:0,-10,0:0:stretcher:attached"));
+  EXPECT_THAT(physics.argv, Contains("lifter:x8_heavy:0,-10,0:0:stretcher:ground"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/airframes"));
   EXPECT_THAT(physics.argv, Contains("600"));  // --max-sim-time
   ASSERT_EQ(physics.inputs.size(), 3u);  // the world and two airframes, each once
@@ -78,8 +75,6 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   EXPECT_EQ(lifter.networks[1].network, "mesh");
   EXPECT_EQ(lifter.networks[1].ipv4, "10.200.9.13");
   EXPECT_EQ(lifter.labels.at("swarmbox.component"), "lifter");
-  EXPECT_THAT(lifter.argv, Contains("--payload-mass"));
-  EXPECT_THAT(lifter.argv, Contains("80"));
   EXPECT_THAT(lifter.argv, Contains("0,-10,0"));  // --start
   EXPECT_THAT(lifter.argv, Contains("eth1"));     // --mesh-interface
   EXPECT_EQ(lifter.argv[0], "/usr/local/bin/swarmbox-agent");
@@ -99,7 +94,9 @@ TEST_F(PlanTest, EndConditionsAndTimeoutComeFromTheTrial) {
 }
 
 TEST_F(PlanTest, PayloadsComeFromTheAirframe) {
-  EXPECT_EQ(options_.payload_mass_kg.at("x8_heavy/stretcher"), 80.0);
+  auto ok = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
+  ASSERT_TRUE(ok) << ok.error().ToString();
+  EXPECT_EQ(ok->at("x8_heavy/stretcher"), 80.0);
   spec_.drones[3].payload = "piano";
   auto masses = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
   ASSERT_FALSE(masses);

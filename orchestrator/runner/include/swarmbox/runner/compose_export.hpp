@@ -6,7 +6,7 @@
 //   - start order (run priority) as depends_on: each service depends on the services of the
 //     previous priority level
 //   - input files bind-mounted read-only (the runner copies them in through the API instead),
-//     scratch dirs as named volumes
+//     scratch dirs (/out) as tmpfs with mode 1777 (the images run as uid 1000)
 // Pure: the text is returned; the CLI writes it.
 #pragma once
 

@@ -38,8 +38,6 @@ struct PlanOptions {
   Images images;
   TrialSubnets subnets;
   std::string trials_dir;  // absolute host path the spec's references resolve against
-  // "<airframe>/<payload>" -> mass [kg], told to the agent that starts with that payload.
-  std::map<std::string, double> payload_mass_kg;
 };
 
 inline constexpr std::string_view kPhysicsId = "physics";
@@ -55,8 +53,9 @@ inline constexpr std::string_view kPhysicsReadyPattern = "event=ready";
 // rtf == 0 (as fast as possible): sim * 3 + 120.
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec);
 
-// Reads the payload masses the trial's drones start with from their airframe files (I/O).
-// kInvalidArgument at the drone's mark when an airframe does not list the payload.
+// Reads the masses of the trial's payloads from their airframe files (I/O), which also checks
+// that each drone's airframe has its payload: kInvalidArgument at the drone's mark otherwise.
+// Keys "<airframe>/<payload>", values [kg].
 Result<std::map<std::string, double>> LoadPayloadMasses(const dsl::TrialSpec& spec,
                                                         const std::string& trials_dir);
 
