@@ -4,6 +4,7 @@
 // endpoint, wait, removal; and RemoveLabelled (the basis of `swarmbox gc`).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
@@ -319,6 +320,34 @@ TEST_F(DockerEndToEnd, EventsStreamReportsTheRunsContainersUntilCancelled) {
   watcher.join();
   ASSERT_FALSE(status);
   EXPECT_EQ(status.error().code(), ErrorCode::kCancelled);
+}
+
+TEST_F(DockerEndToEnd, LinesArriveLiveWithinMilliseconds) {
+  // The container stamps each line with CLOCK_MONOTONIC (shared with the host: no time namespace);
+  // the callback compares with steady_clock (CLOCK_MONOTONIC too): the true write-to-callback delay.
+  auto id = api_->CreateContainer(ProbeContainer("stream", {"stream", "150"}));
+  ASSERT_TRUE(id) << id.error().ToString();
+  ASSERT_TRUE(api_->StartContainer(*id));
+  const auto follow_start = Clock::now();
+  std::vector<double> live_ms;
+  std::mutex mu;
+  Status s = api_->FollowLogs(*id, {}, [&](const docker::LogLine& line) {
+    const auto received = Clock::now();
+    const std::size_t at = line.text.find("mono_ns=");
+    if (at == std::string::npos) return;
+    const auto sent = Clock::time_point(std::chrono::nanoseconds(std::stoll(line.text.substr(at + 8))));
+    if (sent < follow_start + std::chrono::milliseconds(100)) return;  // backlog, not live
+    std::lock_guard<std::mutex> lock(mu);
+    live_ms.push_back(Ms(received - sent));
+  }, nullptr);
+  ASSERT_TRUE(s) << s.error().ToString();
+  ASSERT_GT(live_ms.size(), 50u);
+  std::sort(live_ms.begin(), live_ms.end());
+  const double p50 = live_ms[live_ms.size() / 2];
+  const double p99 = live_ms[live_ms.size() * 99 / 100];
+  EXPECT_LT(p99, 500.0);
+  std::cout << "[figures] live log line latency over " << live_ms.size() << " lines: p50 " << p50
+            << " ms, p99 " << p99 << " ms, max " << live_ms.back() << " ms\n";
 }
 
 TEST_F(DockerEndToEnd, OneClientServesConcurrentFollowersAndCalls) {

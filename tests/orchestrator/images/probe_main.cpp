@@ -5,7 +5,9 @@
 //                             (stderr) lines 10 ms apart; then waits for /tmp/stop to appear,
 //                             prints "stopping: <its content>" and exits 3
 //   swarmbox-probe exit K     prints "exec uid=U" and exits K
+//   swarmbox-probe stream N   prints N lines "line i mono_ns=<CLOCK_MONOTONIC ns>" 10 ms apart
 //   swarmbox-probe env NAME   prints "NAME=<value of the environment variable>" and exits 0
+#include <time.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -39,6 +41,17 @@ int Serve(int n) {
   }
 }
 
+int Stream(int n) {
+  for (int i = 0; i < n; ++i) {
+    timespec now{};
+    clock_gettime(CLOCK_MONOTONIC, &now);
+    const long long ns = static_cast<long long>(now.tv_sec) * 1000000000LL + now.tv_nsec;
+    std::cout << "line " << i << " mono_ns=" << ns << std::endl;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -48,11 +61,12 @@ int main(int argc, char** argv) {
     std::cout << "exec uid=" << getuid() << std::endl;
     return std::atoi(argv[2]);
   }
+  if (mode == "stream" && argc == 3) return Stream(std::atoi(argv[2]));
   if (mode == "env" && argc == 3) {
     const char* value = std::getenv(argv[2]);
     std::cout << argv[2] << "=" << (value != nullptr ? value : "(unset)") << std::endl;
     return 0;
   }
-  std::cerr << "usage: swarmbox-probe serve N | exit K | env NAME" << std::endl;
+  std::cerr << "usage: swarmbox-probe serve N | stream N | exit K | env NAME" << std::endl;
   return 2;
 }
