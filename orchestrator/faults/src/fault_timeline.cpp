@@ -19,7 +19,7 @@ bool LogLineMatches(std::string_view line, std::string_view pattern) {
 
 FaultTimeline::FaultTimeline(std::vector<Fault> faults) : faults_(std::move(faults)), state_(faults_.size()) {}
 
-void FaultTimeline::Apply(std::size_t i, double sim_s, double wall_s, std::vector<TimelineAction>* out) {
+void FaultTimeline::Apply(std::size_t i, double wall_s, std::vector<TimelineAction>* out) {
   State& s = state_[i];
   const Fault& f = faults_[i];
   s.applied = true;
@@ -35,7 +35,6 @@ void FaultTimeline::Apply(std::size_t i, double sim_s, double wall_s, std::vecto
       s.remove_wall_s = wall_s + d_s;
     }
   }
-  (void)sim_s;
   out->push_back({TimelineAction::Kind::kApply, i});
 }
 
@@ -56,7 +55,7 @@ std::vector<TimelineAction> FaultTimeline::Advance(double sim_s, double wall_s) 
     const double at_s = static_cast<double>(start.at_ms) / 1000.0;
     if ((start.clock == FaultStart::Clock::kSim && sim_s >= at_s) ||
         (start.clock == FaultStart::Clock::kWall && wall_s >= at_s)) {
-      Apply(i, sim_s, wall_s, &out);
+      Apply(i, wall_s, &out);
       // A fault whose whole window has passed (a coarse timer) is removed in the same call.
       State& s = state_[i];
       if ((s.remove_sim_s && sim_s >= *s.remove_sim_s) || (s.remove_wall_s && wall_s >= *s.remove_wall_s)) {
@@ -72,7 +71,7 @@ std::vector<TimelineAction> FaultTimeline::OnLogLine(std::string_view line, doub
   std::vector<TimelineAction> out;
   for (std::size_t i = 0; i < faults_.size(); ++i) {
     if (state_[i].applied || faults_[i].start.clock != FaultStart::Clock::kEvent) continue;
-    if (LogLineMatches(line, faults_[i].start.event_pattern)) Apply(i, 0.0, wall_s, &out);
+    if (LogLineMatches(line, faults_[i].start.event_pattern)) Apply(i, wall_s, &out);
   }
   return out;
 }

@@ -141,6 +141,7 @@ Status ValidateNetemSpec(const NetemSpec& spec, const yaml::Node& node) {
     return Invalid("'reorder_correlation' and 'reorder_gap' need reorder > 0", node,
                    spec.reorder_gap > 0 ? "reorder_gap" : "reorder_correlation");
   }
+  if (spec.reorder_gap > 1000000) return Invalid("'reorder_gap' above 1,000,000 packets", node, "reorder_gap");
   if (spec.rate_kbit && !(*spec.rate_kbit > 0.0)) {
     return Invalid("'rate_kbit' must be > 0 [kbit/s]", node, "rate_kbit");
   }

@@ -99,7 +99,7 @@ Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words) {
       SWARMBOX_TRY(ParseInt<std::int64_t>(flag, v, 0, std::numeric_limits<std::int64_t>::max(), &seed));
       a.seed = static_cast<std::uint64_t>(seed);
     } else if (flag == "--queue-maxlen") {
-      SWARMBOX_TRY(ParseInt<std::uint32_t>(flag, v, 1, 1u << 20, &a.queue_maxlen));
+      SWARMBOX_TRY(ParseInt<std::uint32_t>(flag, v, 1, kNetemdMaxQueueLen, &a.queue_maxlen));
     } else if (flag == "--pidfile") {
       if (v.empty() || v[0] != '/') return Bad(flag, "expected an absolute path, got '" + v + "'");
       a.pidfile = v;

@@ -180,7 +180,7 @@ RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanO
     args.delay.reorder_correlation = r->spec.reorder_correlation;
     args.delay.reorder_gap = r->spec.reorder_gap;
     args.seed = DaemonSeed(o.seed, link.node, queue);
-    args.queue_maxlen = NetemLimitPackets(r->spec, link.link_rate_kbit);
+    args.queue_maxlen = std::min(NetemLimitPackets(r->spec, link.link_rate_kbit), kNetemdMaxQueueLen);
     args.pidfile = o.pid_dir + "/swarmbox-netemd-" + std::to_string(queue) + ".pid";
     args.daemonize = true;
     plan.apply.push_back(Cmd(NetemdRunArgv(o.netemd, args)));

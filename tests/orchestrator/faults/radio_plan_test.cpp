@@ -1,8 +1,11 @@
 #include "swarmbox/faults/radio_plan.hpp"
 
+#include <algorithm>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "swarmbox/faults/netemd_args.hpp"
 #include "test_util.hpp"
 
 namespace swarmbox::faults {
@@ -141,6 +144,17 @@ TEST(RadioPlan, UserspaceDelayJitterLossAndRate) {
                           "iptables -w -X SWARMBOX-RADIO-OUT",
                           "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-4.pid",
                           "tc qdisc del dev eth1 root"));
+}
+
+TEST(RadioPlan, UserspaceQueueLengthIsCappedAtTheDaemonsMaximum) {
+  // 2 x 100,000 kbit/s x 60 s / 128 B = 11.7 million packets: netem's limit may be that, the
+  // daemon's queue is capped.
+  auto plan = PlanRadio(Rules("{delay_ms: 60000}"), Link(), Mechanism::kUserspace);
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  const auto& argv = plan->apply[0].argv;
+  auto it = std::find(argv.begin(), argv.end(), "--queue-maxlen");
+  ASSERT_NE(it, argv.end());
+  EXPECT_EQ(*(it + 1), std::to_string(kNetemdMaxQueueLen));
 }
 
 TEST(RadioPlan, UserspaceLossOnlyNeedsNoDaemon) {

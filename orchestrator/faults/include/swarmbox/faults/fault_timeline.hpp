@@ -52,7 +52,8 @@ class FaultTimeline {
     std::optional<double> remove_wall_s;
     std::size_t order = 0;  // application order, for RemoveAll
   };
-  void Apply(std::size_t i, double sim_s, double wall_s, std::vector<TimelineAction>* out);
+  // wall_s: now, for the end of an event-started fault's duration.
+  void Apply(std::size_t i, double wall_s, std::vector<TimelineAction>* out);
 
   std::vector<Fault> faults_;
   std::vector<State> state_;

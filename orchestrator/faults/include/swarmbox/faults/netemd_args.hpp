@@ -22,6 +22,9 @@
 
 namespace swarmbox::faults {
 
+// The longest queue the daemon asks the kernel for [packets].
+inline constexpr std::uint32_t kNetemdMaxQueueLen = 1u << 20;
+
 struct NetemdArgs {
   std::uint16_t queue = 0;
   DelaySettings delay;
