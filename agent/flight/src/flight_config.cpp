@@ -98,6 +98,7 @@ Status ReadControl(const yaml::Node& control, FlightConfig* cfg) {
     EstimatorParams& e = cfg->estimator;
     r.Optional("acc_kp", &e.acc_kp).Optional("acc_ki", &e.acc_ki).Optional("mag_kp", &e.mag_kp)
         .Optional("accel_noise_mps2", &e.accel_noise_mps2).Optional("accel_bias_walk", &e.accel_bias_walk)
+        .Optional("gps_acc_deadband_mps2", &e.gps_acc_deadband_mps2).Optional("gps_acc_tau_s", &e.gps_acc_tau_s)
         .Optional("max_pos_correction_mps", &e.max_pos_correction_mps)
         .Optional("max_vel_correction_mps2", &e.max_vel_correction_mps2);
     SWARMBOX_TRY(r.Finish());
