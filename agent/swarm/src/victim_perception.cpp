@@ -17,7 +17,7 @@ int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& 
     blobs_.clear();
     return 0;
   }
-  detector_.Detect(bgr, k.fx_px / height, &blobs_);
+  detector_.Detect(bgr, k, camera_pose, params_.ground_z_m, &blobs_);
   int queued = 0;
   for (const ImageBlob& b : blobs_) {
     if (b.confidence < params_.min_confidence) continue;

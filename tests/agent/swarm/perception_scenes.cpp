@@ -169,6 +169,84 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
   return scenes;
 }
 
+namespace {
+
+Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& config, double noise_std) {
+  Scene s;
+  s.image = std::move(image);
+  s.intrinsics = {s.image.intrinsics.fx_px, s.image.intrinsics.fy_px, s.image.intrinsics.cx_px,
+                  s.image.intrinsics.cy_px};
+  const physics::Pose& cp = s.image.camera_pose;
+  s.true_pose.position_m = {cp.position_m.x, cp.position_m.y, cp.position_m.z};
+  s.true_pose.rotation = Eigen::Quaterniond(cp.attitude.w, cp.attitude.x, cp.attitude.y, cp.attitude.z);
+  s.altitude_m = cp.position_m.z;
+  s.noise_std = noise_std;
+  const Vector3d axis = s.true_pose.rotation * Vector3d::UnitZ();  // optical axis in the world
+  s.tilt_rad = std::acos(std::clamp(-axis.z(), -1.0, 1.0));
+  for (const physics::Victim& v : config.victims) {
+    s.victims.push_back({Vector2d(v.x_m, v.y_m), Classify(v, s, config)});
+  }
+  return s;
+}
+
+}  // namespace
+
+Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double differential, double burst_s) {
+  Result<physics::Airframe> x500 = physics::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
+  if (!x500) return x500.error().Context("loading the x500 airframe for the camera");
+  std::mt19937_64 rng(p.seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<Scene> scenes;
+  int world_index = 0;
+  while (static_cast<int>(scenes.size()) < p.scenes) {
+    const physics::WorldConfig config = MakeWorld(rng, 1000 + world_index++);
+    Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = rng()});
+    if (!world) return world.error().Context("creating perception world");
+    const int count = std::min(p.scenes_per_world, p.scenes - static_cast<int>(scenes.size()));
+    const double hover_u = x500->HoverRotorSpeed() / x500->motor.max_rot_velocity_rad_s;
+    std::vector<std::size_t> drones;
+    std::vector<std::vector<double>> commands;
+    std::vector<double> noise;
+    for (int i = 0; i < count; ++i) {  // every drone is added before the first Step()
+      const double altitude = p.min_altitude_m + (p.max_altitude_m - p.min_altitude_m) * unit(rng);
+      const physics::Victim& v = config.victims[static_cast<std::size_t>(rng() % config.victims.size())];
+      const double half_w = altitude * std::tan(x500->camera.hfov_rad / 2);
+      const Vector2d centre = Vector2d(v.x_m, v.y_m) + 0.5 * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
+      physics::Airframe af = *x500;
+      af.camera.noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
+      physics::DroneSpawn spawn;
+      spawn.name = "tilt_" + std::to_string(i);
+      spawn.airframe = af;
+      spawn.position_m = {centre.x(), centre.y(), altitude - af.base_height_m};
+      spawn.yaw_rad = 2 * std::numbers::pi * unit(rng);
+      spawn.initial_throttle = hover_u;
+      Result<std::size_t> d = (*world)->AddDrone(spawn);
+      if (!d) return d.error().Context("placing camera drone");
+      const double a = differential * (2 * unit(rng) - 1), b = differential * (2 * unit(rng) - 1);
+      std::vector<double> u;
+      for (const physics::RotorSpec& r : af.rotors) {
+        u.push_back(hover_u + a * (r.position_m.x > 0 ? 1 : -1) + b * (r.position_m.y > 0 ? 1 : -1));
+      }
+      drones.push_back(*d);
+      commands.push_back(std::move(u));
+      noise.push_back(af.camera.noise_std);
+    }
+    const auto steps = static_cast<int>(std::lround(burst_s * 1e9 / static_cast<double>((*world)->options().control_period_ns)));
+    for (int k = 0; k < steps; ++k) {
+      for (std::size_t i = 0; i < drones.size(); ++i) {
+        if (Status st = (*world)->SetActuators(drones[i], commands[i]); !st) return st.error();
+      }
+      (*world)->Step();
+    }
+    for (std::size_t i = 0; i < drones.size(); ++i) {
+      physics::CameraImage img;
+      (*world)->RenderCamera(drones[i], &img);
+      scenes.push_back(SceneFromImage(std::move(img), config, noise[i]));
+    }
+  }
+  return scenes;
+}
+
 double PerceptionScore::precision() const {
   const int positives = true_positives + false_positives;
   return positives == 0 ? 1.0 : static_cast<double>(true_positives) / positives;

@@ -36,6 +36,7 @@ struct Scene {
   OpticalPose true_pose;      // the optical pose the image was rendered from
   double altitude_m = 0.0;    // camera height above the ground [m]
   double noise_std = 0.0;     // pixel noise of this scene [8-bit levels]
+  double tilt_rad = 0.0;      // angle between the optical axis and straight down
   std::vector<SceneVictim> victims;
 };
 
@@ -53,6 +54,13 @@ struct SceneSetParams {
 
 // Renders the scene set. Fails (kNotFound...) when the x500 airframe file cannot be read.
 Result<std::vector<Scene>> RenderScenes(const SceneSetParams& params);
+
+// Tilted views: the camera drones are spawned hovering (rotors at hover speed) and given a random
+// differential rotor command (+-differential on throttle, by rotor position) for burst_s of
+// simulated flight, which rolls and pitches them before the frame is rendered: the physics
+// server's own attitude and camera mounting, not a pose made up here.
+Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& params, double differential,
+                                              double burst_s);
 
 struct PerceptionScore {
   int scenes = 0;

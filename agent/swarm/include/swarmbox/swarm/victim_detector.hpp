@@ -10,7 +10,9 @@
 // 40,210,255), about 0.59 m^2 seen from above; ground is grass/soil (R <= ~125), obstacles grey,
 // sky pale blue, plus Gaussian pixel noise (std ~4 levels). The threshold keeps pixels with a
 // strong red channel well above blue and green ("R high, B low"). The blob's expected area is
-// person_area_m2 * pixels_per_m^2 (nadir view): blobs far smaller or larger are not people.
+// person_area_m2 * pixels_per_m^2 (nadir view), or, given the camera pose, the person's area seen at
+// the blob's ground point (range and incidence: tilted and oblique views): blobs far smaller or
+// larger are not people.
 // Confidence in [0, 1]: 0.5 + 0.49 * size_score * colour_score; a blob that touches the image border
 // is a partial view, its confidence is capped at partial_confidence_cap (it cannot confirm a
 // victim alone under MissionState's rule, which needs 0.9).
@@ -24,6 +26,8 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+
+#include "swarmbox/swarm/geolocation.hpp"
 
 namespace swarmbox::swarm {
 
@@ -58,11 +62,18 @@ class VictimDetector {
   // bgr: CV_8UC3. pixels_per_m: image scale on the ground at the image centre [px/m]
   // (fx_px / height above ground for a nadir camera), > 0. `out` is cleared first.
   void Detect(const cv::Mat& bgr, double pixels_per_m, std::vector<ImageBlob>* out);
+  // Same, with the expected area of each blob from the camera pose: the person's area seen at the
+  // blob's ground point, (f / range)^2 * cos(incidence) (tilted camera, oblique views).
+  void Detect(const cv::Mat& bgr, const PinholeIntrinsics& k, const OpticalPose& pose,
+              double ground_z_m, std::vector<ImageBlob>* out);
 
   const VictimDetectorParams& params() const { return params_; }
   const cv::Mat& mask() const { return mask_; }  // the last thresholded mask, for debugging
 
  private:
+  template <typename ExpectedAreaFn>
+  void DetectImpl(const cv::Mat& bgr, ExpectedAreaFn expected_area_px, std::vector<ImageBlob>* out);
+
   VictimDetectorParams params_;
   cv::Mat mask_, closed_, labels_, stats_, centroids_, kernel_;
 };
