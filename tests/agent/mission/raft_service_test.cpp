@@ -1,0 +1,249 @@
+// RaftRadio and RaftService over real DDS on loopback, in one process (integration):
+// addressing on the shared radio topic, a two-node cluster agreeing, events with the caller's
+// sim clock, and the loud stop when the storage fails.
+#include "swarmbox/mission/raft_service.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "child_process.hpp"
+#include "swarmbox/mission/raft_radio.hpp"
+
+namespace swarmbox::mission {
+namespace {
+
+using namespace std::chrono_literals;
+
+bool WaitUntil(const std::function<bool()>& pred, std::chrono::milliseconds timeout) {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (pred()) return true;
+    std::this_thread::sleep_for(10ms);
+  }
+  return pred();
+}
+
+std::unique_ptr<bus::Participant> Mesh(int domain) {
+  auto p = bus::Participant::Create({.backend = "cyclonedds", .domain_id = domain,
+                                     .interface = "lo"});
+  EXPECT_TRUE(p) << p.error().ToString();
+  return p ? std::move(*p) : nullptr;
+}
+
+class FixedClock final : public raft::Clock {
+ public:
+  double NowS() const override { return 12.5; }
+};
+
+// Thread-safe collection of the lines a service prints.
+class Lines {
+ public:
+  LineSink Sink() {
+    return [this](const std::string& l) {
+      std::lock_guard<std::mutex> lk(mu_);
+      lines_.push_back(l);
+    };
+  }
+  bool Contains(const std::string& part) const {
+    std::lock_guard<std::mutex> lk(mu_);
+    for (const std::string& l : lines_) {
+      if (l.find(part) != std::string::npos) return true;
+    }
+    return false;
+  }
+  std::string All() const {
+    std::lock_guard<std::mutex> lk(mu_);
+    std::string s;
+    for (const std::string& l : lines_) s += l + "\n";
+    return s;
+  }
+
+ private:
+  mutable std::mutex mu_;
+  std::vector<std::string> lines_;
+};
+
+// The real file system, whose appended files fail Sync() once `fail_sync` is set.
+class FlakyFileSystem final : public raft::FileSystem {
+ public:
+  std::atomic<bool> fail_sync{false};
+
+  Status CreateDirs(const std::string& p) override { return real_.CreateDirs(p); }
+  Result<raft::Bytes> ReadFile(const std::string& p) override { return real_.ReadFile(p); }
+  Result<std::unique_ptr<raft::AppendFile>> OpenAppend(const std::string& p) override {
+    auto f = real_.OpenAppend(p);
+    if (!f) return std::move(f).error();
+    return std::unique_ptr<raft::AppendFile>(new File(std::move(*f), &fail_sync));
+  }
+  Status WriteFileAtomic(const std::string& p, std::span<const std::uint8_t> b) override {
+    return real_.WriteFileAtomic(p, b);
+  }
+  Status Truncate(const std::string& p, std::uint64_t size) override {
+    return real_.Truncate(p, size);
+  }
+
+ private:
+  class File final : public raft::AppendFile {
+   public:
+    File(std::unique_ptr<raft::AppendFile> f, const std::atomic<bool>* fail)
+        : f_(std::move(f)), fail_(fail) {}
+    Status Append(std::span<const std::uint8_t> b) override { return f_->Append(b); }
+    Status Sync() override {
+      if (fail_->load()) return Error(ErrorCode::kIo, "fsync: Input/output error (injected)");
+      return f_->Sync();
+    }
+
+   private:
+    std::unique_ptr<raft::AppendFile> f_;
+    const std::atomic<bool>* fail_;
+  };
+  raft::PosixFileSystem real_;
+};
+
+RaftServiceConfig SoloConfig(const std::string& dir) {
+  RaftServiceConfig c;
+  c.driver.self = "solo";
+  c.driver.members = {"solo"};
+  c.driver.seed = 3;
+  c.data_dir = dir;
+  return c;
+}
+
+TEST(RaftRadio, DeliversOnlyPayloadsAddressedToSelfByOthers) {
+  auto mesh = Mesh(180);
+  ASSERT_NE(mesh, nullptr);
+  std::atomic<int> got_a{0}, got_b{0}, got_c{0};
+  std::mutex mu;
+  std::vector<std::uint8_t> last_b;
+  auto a = RaftRadio::Create(*mesh, "a", [&](std::span<const std::uint8_t>) { ++got_a; });
+  auto b = RaftRadio::Create(*mesh, "b", [&](std::span<const std::uint8_t> p) {
+    std::lock_guard<std::mutex> lk(mu);
+    last_b.assign(p.begin(), p.end());
+    ++got_b;
+  });
+  auto c = RaftRadio::Create(*mesh, "c", [&](std::span<const std::uint8_t>) { ++got_c; });
+  ASSERT_TRUE(a && b && c);
+  ASSERT_TRUE(WaitUntil([&] { return (*a)->matched_subscribers() >= 3; }, 10s));
+  const std::vector<std::uint8_t> payload = {1, 2, 3, 4};
+  // Best effort: resend until one arrives (loopback rarely loses, but the radio may).
+  ASSERT_TRUE(WaitUntil([&] {
+    (*a)->Send("b", payload);
+    std::this_thread::sleep_for(20ms);
+    return got_b.load() > 0;
+  }, 10s));
+  {
+    std::lock_guard<std::mutex> lk(mu);
+    EXPECT_EQ(last_b, payload);
+  }
+  EXPECT_EQ(got_a.load(), 0);  // own messages are not delivered
+  EXPECT_EQ(got_c.load(), 0);  // another drone's are not either
+  EXPECT_GE((*a)->counters().sent, 1u);
+  EXPECT_EQ((*a)->counters().send_errors, 0u);
+  EXPECT_GE((*b)->counters().delivered, 1u);
+  EXPECT_TRUE(WaitUntil([&] { return (*c)->counters().ignored >= 1; }, 5s));
+}
+
+TEST(RaftRadio, RefusesNamesThatCannotBeAddressed) {
+  auto mesh = Mesh(180);
+  ASSERT_NE(mesh, nullptr);
+  auto r = RaftRadio::Create(*mesh, "bad name", [](std::span<const std::uint8_t>) {});
+  ASSERT_FALSE(r);
+  EXPECT_EQ(r.error().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(r.error().message().find("raft radio"), std::string::npos);
+}
+
+TEST(RaftService, TwoNodesOverTheRadioElectAndCommit) {
+  auto mesh_a = Mesh(181);
+  auto mesh_b = Mesh(181);
+  ASSERT_TRUE(mesh_a && mesh_b);
+  const std::string dir = testing::MakeTempDir("swarmbox_raft_service_");
+  FixedClock clock;
+  Lines lines_a, lines_b;
+  RaftServiceConfig ca;
+  ca.driver.self = "alpha";
+  ca.driver.members = {"alpha", "bravo"};
+  ca.driver.seed = 11;
+  ca.data_dir = dir + "/alpha";
+  RaftServiceConfig cb = ca;
+  cb.driver.self = "bravo";
+  cb.data_dir = dir + "/bravo";
+  auto a = RaftService::Start(ca, *mesh_a, clock, lines_a.Sink());
+  auto b = RaftService::Start(cb, *mesh_b, clock, lines_b.Sink());
+  ASSERT_TRUE(a) << a.error().ToString();
+  ASSERT_TRUE(b) << b.error().ToString();
+  ASSERT_TRUE(WaitUntil([&] {
+    return !(*a)->leader().empty() && (*a)->leader() == (*b)->leader();
+  }, 30s)) << lines_a.All() << lines_b.All();
+  RaftService& leader = (*a)->is_leader() ? **a : **b;
+  ASSERT_TRUE(WaitUntil([&] { return leader.Propose(raft::StartSearch{}).ok(); }, 10s));
+  ASSERT_TRUE(WaitUntil([&] {
+    return (*a)->mission().phase() == raft::MissionPhase::kSearch &&
+           (*b)->mission().phase() == raft::MissionPhase::kSearch;
+  }, 20s)) << lines_a.All() << lines_b.All();
+  EXPECT_EQ((*a)->mission(), (*b)->mission());
+  EXPECT_TRUE(lines_a.Contains("t=12.500 node=alpha event=leader_elected")) << lines_a.All();
+  EXPECT_TRUE(lines_b.Contains("node=bravo event=mission_state state=SEARCH")) << lines_b.All();
+  EXPECT_TRUE((*a)->health().ok());
+  EXPECT_GE((*a)->radio_counters().delivered, 1u);
+  EXPECT_EQ((*a)->protocol_errors(), 0u);
+}
+
+TEST(RaftService, StorageFailureStopsTheNodeLoudly) {
+  auto mesh = Mesh(184);
+  ASSERT_NE(mesh, nullptr);
+  FlakyFileSystem fs;
+  RaftServiceConfig cfg = SoloConfig(testing::MakeTempDir("swarmbox_raft_flaky_"));
+  cfg.file_system = &fs;
+  FixedClock clock;
+  Lines lines;
+  auto s = RaftService::Start(cfg, *mesh, clock, lines.Sink());
+  ASSERT_TRUE(s) << s.error().ToString();
+  ASSERT_TRUE(WaitUntil([&] { return (*s)->is_leader(); }, 10s)) << lines.All();
+  EXPECT_FALSE((*s)->WaitStopped(0ms));
+  fs.fail_sync = true;
+  (void)(*s)->Propose(raft::StartSearch{});  // the WAL's fsync fails on this or the next Ready
+  ASSERT_TRUE((*s)->WaitStopped(10s)) << lines.All();
+  ASSERT_FALSE((*s)->health());
+  EXPECT_NE((*s)->health().error().ToString().find("injected"), std::string::npos);
+  EXPECT_TRUE(lines.Contains("event=raft_stopped")) << lines.All();
+  auto again = (*s)->Propose(raft::StartSearch{});
+  ASSERT_FALSE(again);
+  EXPECT_NE(again.error().ToString().find("injected"), std::string::npos);
+}
+
+TEST(RaftService, RestartReappliesTheDurableLog) {
+  auto mesh = Mesh(185);
+  ASSERT_NE(mesh, nullptr);
+  const RaftServiceConfig cfg = SoloConfig(testing::MakeTempDir("swarmbox_raft_restart_"));
+  FixedClock clock;
+  raft::MissionState before;
+  {
+    Lines lines;
+    auto s = RaftService::Start(cfg, *mesh, clock, lines.Sink());
+    ASSERT_TRUE(s) << s.error().ToString();
+    ASSERT_TRUE(WaitUntil([&] { return (*s)->is_leader(); }, 10s));
+    ASSERT_TRUE((*s)->Propose(raft::StartSearch{}));
+    ASSERT_TRUE((*s)->Propose(raft::ConfirmVictim{"op", 10.0, 20.0}));
+    ASSERT_TRUE(WaitUntil([&] { return (*s)->mission().victims().size() == 1; }, 10s));
+    before = (*s)->mission();
+  }
+  Lines lines;
+  auto s = RaftService::Start(cfg, *mesh, clock, lines.Sink());
+  ASSERT_TRUE(s) << s.error().ToString();
+  ASSERT_TRUE(WaitUntil([&] {
+    return (*s)->mission().applied_index() >= before.applied_index();
+  }, 10s)) << lines.All();
+  EXPECT_EQ((*s)->mission().victims(), before.victims());
+  EXPECT_EQ((*s)->mission().phase(), raft::MissionPhase::kSearch);
+  EXPECT_TRUE(lines.Contains("event=victim_confirmed id=1")) << lines.All();
+}
+
+}  // namespace
+}  // namespace swarmbox::mission
