@@ -7,13 +7,16 @@
 //   and catches up to the survivors' committed index with the same states.
 // One instance per middleware, on its own DDS domain.
 #include <signal.h>
+#include <stdlib.h>
 
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <map>
+#include <ostream>
 #include <memory>
 #include <optional>
 #include <set>
@@ -91,12 +94,20 @@ struct Backend {
   std::string name;
   int domain;
 };
+void PrintTo(const Backend& b, std::ostream* os) { *os << b.name << "@domain" << b.domain; }
 
 class RaftCluster : public ::testing::TestWithParam<Backend> {
  protected:
   void SetUp() override {
+    // The nodes link Debian's Fast DDS 2.9, whose DataWriter deletion trips ASan's
+    // new_delete_type_mismatch (the library's bug, see tests/bus/sanitizer_options.cpp). Only read
+    // by ASan builds; an ASAN_OPTIONS already in the environment wins.
+    setenv("ASAN_OPTIONS", "new_delete_type_mismatch=0", 0);
     root_ = testing::MakeTempDir("swarmbox_raft_cluster_");
     ASSERT_FALSE(root_.empty());
+  }
+  void TearDown() override {
+    if (!HasFailure() && !root_.empty()) std::filesystem::remove_all(root_);  // keep on failure
   }
 
   std::unique_ptr<Child> Launch(const std::string& name, const std::string& log_name) {
@@ -209,16 +220,28 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
   }, 60s)) << DumpLogs(nodes);
   const std::string restarted_log = nodes[leader]->ReadLog();
   const auto restarted = MissionStates(restarted_log);
-  // Re-applied from its own WAL (or restored from its snapshot) what it had committed before.
-  bool from_snapshot = false;
-  for (const LogfmtFields& f : Events(restarted_log, "mission_state")) {
-    if (FindField(f, "from") == std::string("snapshot") && U64(f, "index") >= before_kill) {
-      from_snapshot = true;
+  // Re-applied from its own WAL (or restored from its own snapshot) what it had committed before
+  // the kill, before it heard from any leader: the log survived the SIGKILL on disk.
+  std::optional<std::size_t> reapplied_at, first_leader_at;
+  {
+    std::istringstream in(restarted_log);
+    std::string line;
+    for (std::size_t n = 0; std::getline(in, line); ++n) {
+      const LogfmtFields f = ParseLogfmt(line);
+      const auto event = FindField(f, "event");
+      if (event == std::string("leader_elected") && !first_leader_at) first_leader_at = n;
+      if (event != std::string("mission_state") || reapplied_at) continue;
+      const bool snap = FindField(f, "from") == std::string("snapshot");
+      if ((snap && U64(f, "index") >= before_kill) ||
+          (!snap && U64(f, "index") == before_kill &&
+           FindField(f, "state") == before_states.at(before_kill))) {
+        reapplied_at = n;
+      }
     }
   }
-  if (!from_snapshot) {
-    ASSERT_TRUE(restarted.contains(before_kill)) << restarted_log;
-    EXPECT_EQ(restarted.at(before_kill), before_states.at(before_kill));
+  ASSERT_TRUE(reapplied_at.has_value()) << restarted_log;
+  if (first_leader_at) {
+    EXPECT_LT(*reapplied_at, *first_leader_at) << restarted_log;
   }
   // Same state at every index the survivors also applied (State Machine Safety, Raft §5.4.3).
   for (const std::string& n : survivors) {

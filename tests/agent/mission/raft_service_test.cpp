@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -36,6 +37,15 @@ std::unique_ptr<bus::Participant> Mesh(int domain) {
   EXPECT_TRUE(p) << p.error().ToString();
   return p ? std::move(*p) : nullptr;
 }
+
+// A fresh directory under /tmp, removed with everything in it at the end of the test.
+struct TempDir {
+  explicit TempDir(const std::string& prefix) : path(testing::MakeTempDir(prefix)) {}
+  ~TempDir() {
+    if (!path.empty()) std::filesystem::remove_all(path);
+  }
+  std::string path;
+};
 
 class FixedClock final : public raft::Clock {
  public:
@@ -163,7 +173,8 @@ TEST(RaftService, TwoNodesOverTheRadioElectAndCommit) {
   auto mesh_a = Mesh(181);
   auto mesh_b = Mesh(181);
   ASSERT_TRUE(mesh_a && mesh_b);
-  const std::string dir = testing::MakeTempDir("swarmbox_raft_service_");
+  const TempDir tmp("swarmbox_raft_service_");
+  const std::string& dir = tmp.path;
   FixedClock clock;
   Lines lines_a, lines_b;
   RaftServiceConfig ca;
@@ -199,7 +210,8 @@ TEST(RaftService, StorageFailureStopsTheNodeLoudly) {
   auto mesh = Mesh(184);
   ASSERT_NE(mesh, nullptr);
   FlakyFileSystem fs;
-  RaftServiceConfig cfg = SoloConfig(testing::MakeTempDir("swarmbox_raft_flaky_"));
+  const TempDir tmp("swarmbox_raft_flaky_");
+  RaftServiceConfig cfg = SoloConfig(tmp.path);
   cfg.file_system = &fs;
   FixedClock clock;
   Lines lines;
@@ -221,7 +233,8 @@ TEST(RaftService, StorageFailureStopsTheNodeLoudly) {
 TEST(RaftService, RestartReappliesTheDurableLog) {
   auto mesh = Mesh(185);
   ASSERT_NE(mesh, nullptr);
-  const RaftServiceConfig cfg = SoloConfig(testing::MakeTempDir("swarmbox_raft_restart_"));
+  const TempDir tmp("swarmbox_raft_restart_");
+  const RaftServiceConfig cfg = SoloConfig(tmp.path);
   FixedClock clock;
   raft::MissionState before;
   {
