@@ -230,6 +230,31 @@ TEST(RaftService, StorageFailureStopsTheNodeLoudly) {
   EXPECT_NE(again.error().ToString().find("injected"), std::string::npos);
 }
 
+TEST(RaftService, UndecodablePayloadsAreCountedNotFatal) {
+  auto mesh = Mesh(186);
+  ASSERT_NE(mesh, nullptr);
+  const TempDir tmp("swarmbox_raft_junk_");
+  FixedClock clock;
+  Lines lines;
+  auto s = RaftService::Start(SoloConfig(tmp.path), *mesh, clock, lines.Sink());
+  ASSERT_TRUE(s) << s.error().ToString();
+  ASSERT_TRUE(WaitUntil([&] { return (*s)->is_leader(); }, 10s)) << lines.All();
+  // Another "drone" (e.g. of another cluster, or a damaged datagram) talks to us.
+  auto intruder = RaftRadio::Create(*mesh, "intruder", [](std::span<const std::uint8_t>) {});
+  ASSERT_TRUE(intruder);
+  const std::vector<std::uint8_t> junk = {1, 0xde, 0xad, 0xbe, 0xef, 11, 1, 1, 1};
+  ASSERT_TRUE(WaitUntil([&] {
+    (*intruder)->Send("solo", junk);
+    std::this_thread::sleep_for(20ms);
+    return (*s)->protocol_errors() >= 1;
+  }, 10s));
+  EXPECT_TRUE((*s)->health().ok());
+  EXPECT_TRUE((*s)->is_leader());
+  EXPECT_TRUE((*s)->Propose(raft::StartSearch{}));
+  EXPECT_TRUE(WaitUntil([&] { return (*s)->mission().phase() == raft::MissionPhase::kSearch; },
+                        10s));
+}
+
 TEST(RaftService, RestartReappliesTheDurableLog) {
   auto mesh = Mesh(185);
   ASSERT_NE(mesh, nullptr);
