@@ -10,11 +10,11 @@ set -euo pipefail
 
 PACKAGES=(
   # toolchain
-  build-essential cmake ninja-build pkg-config git ca-certificates curl
+  build-essential binutils cmake ninja-build pkg-config git ca-certificates curl
   # messaging: Cyclone DDS (C API + idlc) and Fast DDS (+ fastddsgen)
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
   # physics, maths, vision, formats, HTTP, archives
-  libode-dev libeigen3-dev libopencv-dev libyaml-dev libcurl4-openssl-dev libarchive-dev zlib1g-dev
+  libode-dev libeigen3-dev libopencv-dev libyaml-dev libcurl4-openssl-dev libssl-dev libarchive-dev zlib1g-dev
   # command line, formatting, netfilter queue (userspace netem fallback)
   libcli11-dev libfmt-dev libnetfilter-queue-dev
   # tests and benchmarks
