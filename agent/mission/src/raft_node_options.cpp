@@ -106,7 +106,7 @@ Result<RaftNodeOptions> ParseRaftNodeArgs(const std::vector<std::string>& args) 
   for (const std::string& m : o.driver.members) {
     if (auto s = bus::ValidateDroneName(m); !s) return s.error().Context("--members");
   }
-  if (auto c = o.driver.ToRaftConfig(); !c) return c.error().Context("raft configuration");
+  if (auto c = o.driver.ToRaftConfig(); !c) return c.error();
   return o;
 }
 

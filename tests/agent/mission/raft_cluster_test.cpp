@@ -5,7 +5,7 @@
 //   leader_elected of another node seen in a survivor's output), the survivors commit more, and
 //   the killed node restarted on the same --data-dir re-applies its log (Raft §5.3, durable WAL)
 //   and catches up to the survivors' committed index with the same states.
-// One instance per middleware, on its own DDS domain.
+// One instance per middleware, on its own DDS domain. Waits add up to < 180 s (the TIMEOUT).
 #include <signal.h>
 #include <stdlib.h>
 
@@ -117,7 +117,10 @@ class RaftCluster : public ::testing::TestWithParam<Backend> {
                                      "--data-dir", root_ + "/" + name, "--domain",
                                      std::to_string(GetParam().domain), "--interface", "lo",
                                      "--middleware", GetParam().name, "--seed", "7",
-                                     "--propose-every-ms", "300"};
+                                     "--propose-every-ms", "300",
+                                     // Ends on its own even if ctest SIGKILLs this test at its
+                                     // TIMEOUT (no destructor would reap the nodes then).
+                                     "--duration-s", "170"};
     auto child = std::make_unique<Child>(argv, root_ + "/" + log_name);
     EXPECT_TRUE(child->running()) << "spawning " << argv[0];
     return child;
@@ -149,7 +152,7 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
     if (seen.size() != 1) return false;
     leader = seen.begin()->substr(0, seen.begin()->find('@'));
     return true;
-  }, 60s);
+  }, 40s);
   ASSERT_TRUE(elected) << DumpLogs(nodes);
   std::printf("[cluster %s] leader=%s\n", GetParam().name.c_str(), leader.c_str());
 
@@ -160,7 +163,7 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
     for (const auto& [name, c] : nodes) maps.push_back(MissionStates(c->ReadLog()));
     before_kill = HighestCommonIndex(maps);
     return before_kill > 0;
-  }, 30s)) << DumpLogs(nodes);
+  }, 20s)) << DumpLogs(nodes);
   std::printf("[cluster %s] committed on all three: index=%llu\n", GetParam().name.c_str(),
               static_cast<unsigned long long>(before_kill));
 
@@ -188,7 +191,7 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
       }
     }
     return false;
-  }, 30s);
+  }, 20s);
   const auto failover_ms =
       std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - killed_at).count();
   ASSERT_TRUE(failed_over) << DumpLogs(nodes);
@@ -205,7 +208,7 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
     for (const std::string& n : survivors) maps.push_back(MissionStates(nodes[n]->ReadLog()));
     after_failover = HighestCommonIndex(maps);
     return after_failover > before_kill;
-  }, 30s)) << DumpLogs(nodes);
+  }, 20s)) << DumpLogs(nodes);
 
   // 5. Restart the killed node on its data dir: it re-applies its durable log and catches up.
   const std::map<std::uint64_t, std::string> before_states =
@@ -217,7 +220,7 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
     if (mine.empty()) return false;
     caught_up = mine.rbegin()->first;
     return caught_up >= after_failover;
-  }, 60s)) << DumpLogs(nodes);
+  }, 40s)) << DumpLogs(nodes);
   const std::string restarted_log = nodes[leader]->ReadLog();
   const auto restarted = MissionStates(restarted_log);
   // Re-applied from its own WAL (or restored from its own snapshot) what it had committed before
@@ -258,7 +261,7 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
 
   // 6. Clean shutdown on SIGTERM.
   for (auto& [name, c] : nodes) c->Signal(SIGTERM);
-  for (auto& [name, c] : nodes) EXPECT_EQ(c->Wait(20s), 0) << name << "\n" << c->ReadLog();
+  for (auto& [name, c] : nodes) EXPECT_EQ(c->Wait(10s), 0) << name << "\n" << c->ReadLog();
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, RaftCluster,
