@@ -5,7 +5,7 @@
 //   leader_elected of another node seen in a survivor's output), the survivors commit more, and
 //   the killed node restarted on the same --data-dir re-applies its log (Raft §5.3, durable WAL)
 //   and catches up to the survivors' committed index with the same states.
-// One instance per middleware, on its own DDS domain. Waits add up to < 180 s (the TIMEOUT).
+// One instance per middleware and one mixing both, each on its own DDS domain. Waits add up to < 180 s (the TIMEOUT).
 #include <signal.h>
 #include <stdlib.h>
 
@@ -91,10 +91,16 @@ bool WaitUntil(const std::function<bool()>& pred, std::chrono::milliseconds time
 }
 
 struct Backend {
-  std::string name;
+  std::string name;  // "cyclonedds", "fastdds", or "mixed" (nodes alternate the two)
   int domain;
 };
 void PrintTo(const Backend& b, std::ostream* os) { *os << b.name << "@domain" << b.domain; }
+
+std::string MiddlewareOf(const Backend& b, const std::string& node) {
+  if (b.name != "mixed") return b.name;
+  // scout_1 and lifter on Cyclone DDS, scout_2 on Fast DDS: both speak standard RTPS.
+  return node == "scout_2" ? "fastdds" : "cyclonedds";
+}
 
 class RaftCluster : public ::testing::TestWithParam<Backend> {
  protected:
@@ -116,7 +122,7 @@ class RaftCluster : public ::testing::TestWithParam<Backend> {
     std::vector<std::string> argv = {SWARMBOX_RAFT_NODE_BIN, "--name", name, "--members", members,
                                      "--data-dir", root_ + "/" + name, "--domain",
                                      std::to_string(GetParam().domain), "--interface", "lo",
-                                     "--middleware", GetParam().name, "--seed", "7",
+                                     "--middleware", MiddlewareOf(GetParam(), name), "--seed", "7",
                                      "--propose-every-ms", "300",
                                      // Ends on its own even if ctest SIGKILLs this test at its
                                      // TIMEOUT (no destructor would reap the nodes then).
@@ -265,7 +271,8 @@ TEST_P(RaftCluster, LeaderKillFailsOverAndRestartedNodeCatchesUp) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Middleware, RaftCluster,
-                         ::testing::Values(Backend{"cyclonedds", 182}, Backend{"fastdds", 183}),
+                         ::testing::Values(Backend{"cyclonedds", 182}, Backend{"fastdds", 183},
+                                           Backend{"mixed", 188}),
                          [](const ::testing::TestParamInfo<Backend>& i) { return i.param.name; });
 
 }  // namespace
