@@ -44,7 +44,7 @@ int RunFlightBench(const swarmbox::bench::Args& args) {
   for (const StepCase& c : {StepCase{"x500_step_10m", 10.0, 0.0, 0.0}, StepCase{"x500_climb_5m", 0.0, 0.0, 5.0}}) {
     if (auto m = ft::RunStep(seed, c.dx, c.dy, c.dz); m) {
       LogEvent e(0.0, "bench", "result");
-      e.Add("suite", "flight").Add("scenario", c.name).Add("settle_s", m->settle_s, 2)
+      e.Add("suite", "flight").Add("scenario", c.name).Add("settle_s", m->settle_s, 2).Add("settle_3d_s", m->settle_3d_s, 2)
           .Add("overshoot_pct", m->overshoot_pct, 1).Add("peak_speed_mps", m->peak_speed_mps, 2)
           .Add("pass", m->settled && m->settle_s < 6.0 && m->overshoot_pct < 10.0);
       Print(e);

@@ -73,16 +73,18 @@ Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz)
   const Vec3 dir = step.normalized();
   if (!r.fc().Command(Setpoint::Position(target, 0.0))) return Error(ErrorCode::kInternal, "setpoint rejected");
   const double t0 = r.t();
-  double last_out = 0.0, max_along = 0.0, peak_v = 0.0;
+  double last_out = 0.0, last_out_3d = 0.0, max_along = 0.0, peak_v = 0.0;
   r.Run(15.0, {}, [&] {
     const Vec3 p = r.true_pos();
-    if ((p - target).norm() > 0.2) last_out = r.t() - t0;
+    if (std::abs((p - target).dot(dir)) > 0.2) last_out = r.t() - t0;
+    if ((p - target).norm() > 0.2) last_out_3d = r.t() - t0;
     max_along = std::max(max_along, (p - start).dot(dir));
     const auto v = r.truth().velocity_m_s;
     peak_v = std::max(peak_v, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
   });
   StepMetrics m;
   m.settle_s = last_out;
+  m.settle_3d_s = last_out_3d;
   m.settled = last_out < 14.0;
   m.overshoot_pct = std::max(0.0, (max_along - step.norm()) / step.norm() * 100.0);
   m.peak_speed_mps = peak_v;

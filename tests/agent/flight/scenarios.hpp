@@ -23,6 +23,9 @@ Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_m
 
 struct StepMetrics {
   double settle_s = 0;       // from the command until the truth stays within 0.2 m of the target
+                             // along the step's direction (the step response)
+  double settle_3d_s = 0;    // the same on the full 3-D error (includes the GPS-limited hover
+                             // wander across the step, see HoverMetrics)
   double overshoot_pct = 0;  // beyond the target along the step direction, % of the step
   double peak_speed_mps = 0;
   bool settled = false;
