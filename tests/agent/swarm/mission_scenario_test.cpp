@@ -54,6 +54,7 @@ TEST(MissionScenario, ScoutsAndALifterFindAndRescueEveryVictim) {
   const bool complete = sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 2000.0);
   ASSERT_TRUE(complete) << "no mission_complete by t=" << sim.t_s() << ", phase "
                         << raft::PhaseName(sim.mission().phase());
+  RecordProperty("mission_complete_sim_s", std::to_string(sim.t_s()));
   // Every victim confirmed once, near its true position, and rescued.
   ASSERT_EQ(sim.mission().victims().size(), c.victims_m.size());
   for (const raft::Victim& v : sim.mission().victims()) {
