@@ -47,146 +47,6 @@ bool IsDroneName(std::string_view s) {
 constexpr std::string_view kPhysics = "physics";
 constexpr std::string_view kRaftLeader = "raft_leader";
 
-Status DecodeMesh(const Node& node, std::string what, MeshSpec* mesh) {
-  yaml::MapReader r(node, what);
-  r.Optional("delay_ms", &mesh->delay_ms)
-      .Optional("jitter_ms", &mesh->jitter_ms)
-      .Optional("distribution", &mesh->distribution)
-      .Optional("loss", &mesh->loss)
-      .Optional("duplicate", &mesh->duplicate)
-      .Optional("corrupt", &mesh->corrupt)
-      .Optional("rate_kbit", &mesh->rate_kbit);
-  SWARMBOX_TRY(r.Finish());
-  auto non_negative = [&](std::string_view key, double v) -> Status {
-    if (v < 0) return At(*node.Find(key), "'" + std::string(key) + "' must not be negative");
-    return Ok{};
-  };
-  auto probability = [&](std::string_view key, double v) -> Status {
-    if (v < 0 || v > 1) {
-      return At(*node.Find(key), "'" + std::string(key) + "' is a probability in [0, 1]");
-    }
-    return Ok{};
-  };
-  SWARMBOX_TRY(non_negative("delay_ms", mesh->delay_ms));
-  SWARMBOX_TRY(non_negative("jitter_ms", mesh->jitter_ms));
-  SWARMBOX_TRY(non_negative("rate_kbit", mesh->rate_kbit));
-  SWARMBOX_TRY(probability("loss", mesh->loss));
-  SWARMBOX_TRY(probability("duplicate", mesh->duplicate));
-  SWARMBOX_TRY(probability("corrupt", mesh->corrupt));
-  if (!mesh->distribution.empty() && mesh->distribution != "normal" &&
-      mesh->distribution != "pareto" && mesh->distribution != "paretonormal" &&
-      mesh->distribution != "uniform") {
-    return At(*node.Find("distribution"), "unknown delay distribution '" + mesh->distribution +
-                                              "' (expected uniform, normal, pareto or paretonormal)");
-  }
-  return Ok{};
-}
-
-Status DecodeNameList(const Node& node, std::vector<std::string>* out) {
-  if (node.is_scalar()) {
-    out->push_back(node.scalar());
-    return Ok{};
-  }
-  return yaml::Decode(node, out);
-}
-
-const std::vector<FaultKind>& AllFaultKinds() {
-  static const std::vector<FaultKind> kinds = {
-      FaultKind::kKill,      FaultKind::kStop,       FaultKind::kPause,    FaultKind::kRestart,
-      FaultKind::kPartition, FaultKind::kGpsDropout, FaultKind::kWindGust, FaultKind::kNetem};
-  return kinds;
-}
-
-std::string FaultKindList() {
-  std::string s;
-  for (FaultKind k : AllFaultKinds()) s += (s.empty() ? "" : ", ") + std::string(FaultKindName(k));
-  return s;
-}
-
-Status DecodeFault(const Node& node, FaultSpec* fault) {
-  if (!node.is_mapping()) return At(node, "expected a fault to be a mapping such as {at: 30s, kill: raft_leader}");
-  fault->mark = node.mark();
-  bool have_at = false;
-  const Node* kind_key = nullptr;
-  const Node* on = nullptr;
-  const Node* for_node = nullptr;
-  for (const auto& [k, v] : node.entries()) {
-    const std::string& key = k.scalar();
-    if (key == "at") {
-      SWARMBOX_TRY(Decode(v, &fault->at));
-      have_at = true;
-      continue;
-    }
-    if (key == "for") {
-      SWARMBOX_TRY(Decode(v, &fault->duration));
-      for_node = &k;
-      continue;
-    }
-    if (key == "on") {
-      on = &k;
-      SWARMBOX_TRY(DecodeNameList(v, &fault->targets));
-      continue;
-    }
-    std::optional<FaultKind> kind;
-    for (FaultKind candidate : AllFaultKinds()) {
-      if (FaultKindName(candidate) == key) kind = candidate;
-    }
-    if (!kind) {
-      return At(k, "unknown fault kind '" + key + "' (expected one of " + FaultKindList() +
-                       ", with at, for, on)");
-    }
-    if (kind_key != nullptr) {
-      return At(k, "a fault has one kind, this one has '" + kind_key->scalar() + "' and '" + key +
-                       "'");
-    }
-    kind_key = &k;
-    fault->kind = *kind;
-    switch (*kind) {
-      case FaultKind::kKill:
-      case FaultKind::kStop:
-      case FaultKind::kPause:
-      case FaultKind::kRestart:
-      case FaultKind::kGpsDropout: {
-        std::string target;
-        if (!v.is_scalar() || v.scalar().empty()) {
-          return At(v, "'" + key + "' names one component (a drone, physics or raft_leader)");
-        }
-        fault->targets.push_back(v.scalar());
-        break;
-      }
-      case FaultKind::kPartition:
-        SWARMBOX_TRY(yaml::Decode(v, &fault->groups));
-        if (fault->groups.size() < 2) {
-          return At(v, "a partition needs at least two groups, e.g. [[scout_1], [scout_2, lifter]]");
-        }
-        break;
-      case FaultKind::kWindGust: {
-        yaml::MapReader w(v, "wind_gust");
-        w.Required("speed_mps", &fault->wind_speed_mps)
-            .Optional("direction_deg", &fault->wind_direction_deg);
-        SWARMBOX_TRY(w.Finish());
-        if (fault->wind_speed_mps < 0) return At(v, "'speed_mps' must not be negative");
-        break;
-      }
-      case FaultKind::kNetem:
-        SWARMBOX_TRY(DecodeMesh(v, "netem", &fault->netem));
-        break;
-    }
-  }
-  if (kind_key == nullptr) {
-    return At(node, "a fault needs a kind: one of " + FaultKindList());
-  }
-  if (!have_at) return At(node, "missing required key 'at' in fault");
-  if (on != nullptr && fault->kind != FaultKind::kNetem) {
-    return At(*on, "'on' applies to netem faults only");
-  }
-  if (for_node != nullptr && (fault->kind == FaultKind::kKill || fault->kind == FaultKind::kRestart)) {
-    return At(*for_node, "'for' does not apply to a " + std::string(FaultKindName(fault->kind)) +
-                             " fault");
-  }
-  return Ok{};
-}
-
 Status CheckComponent(const TrialSpec& spec, const yaml::Mark& mark, const std::string& name,
                       bool allow_physics, bool allow_leader) {
   if (spec.FindDrone(name) != nullptr) return Ok{};
@@ -199,43 +59,21 @@ Status CheckComponent(const TrialSpec& spec, const yaml::Mark& mark, const std::
   return AtMark(mark, "unknown component '" + name + "' (expected one of " + accepted + ")");
 }
 
-Status CheckFaultTargets(const TrialSpec& spec, const FaultSpec& f) {
-  switch (f.kind) {
-    case FaultKind::kKill:
-    case FaultKind::kStop:
-    case FaultKind::kPause:
-    case FaultKind::kRestart:
-      return CheckComponent(spec, f.mark, f.targets.front(), true, true);
-    case FaultKind::kGpsDropout:
-      return CheckComponent(spec, f.mark, f.targets.front(), false, true);
-    case FaultKind::kNetem:
-      for (const auto& t : f.targets) SWARMBOX_TRY(CheckComponent(spec, f.mark, t, false, false));
-      return Ok{};
-    case FaultKind::kPartition: {
-      std::set<std::string> seen;
-      for (const auto& group : f.groups) {
-        if (group.empty()) return AtMark(f.mark, "a partition group is empty");
-        for (const auto& t : group) {
-          SWARMBOX_TRY(CheckComponent(spec, f.mark, t, false, false));
-          if (!seen.insert(t).second) {
-            return AtMark(f.mark, "drone '" + t + "' is in two partition groups");
-          }
-        }
-      }
-      return Ok{};
-    }
-    case FaultKind::kWindGust:
-      return Ok{};
-  }
-  return Ok{};
-}
-
 bool DefaultFileExists(const std::string& path) {
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
 }
 
 }  // namespace
+
+std::string DefaultTrialsDir(std::string_view trial_file) {
+  const std::filesystem::path folder = std::filesystem::path(std::string(trial_file)).parent_path();
+  for (std::filesystem::path p = folder; !p.empty(); p = p.parent_path()) {
+    if (p.filename() == "trials") return p.string();
+    if (p == p.parent_path()) break;
+  }
+  return folder.empty() ? std::string(".") : folder.string();
+}
 
 Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options) {
   TrialSpec spec;
@@ -306,17 +144,26 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
     yaml::MapReader nr(*network, "network");
     const Node* mesh = nr.Child("mesh");
     SWARMBOX_TRY(nr.Finish());
-    if (mesh != nullptr) SWARMBOX_TRY(DecodeMesh(*mesh, "network.mesh", &spec.mesh));
+    if (mesh != nullptr) {
+      auto parsed = faults::ParseMeshBlock(*mesh);
+      if (!parsed) return parsed.error();
+      std::vector<std::string> names;
+      for (const DroneSpec& d : spec.drones) names.push_back(d.name);
+      SWARMBOX_TRY(faults::ValidateRadioPeers(parsed->rules, names));
+      spec.mesh = std::move(*parsed);
+      spec.mesh_node = *mesh;
+    }
   }
 
   if (faults != nullptr && !faults->is_null()) {
-    if (!faults->is_sequence()) return At(*faults, "'faults' must be a list");
-    for (const Node& item : faults->items()) {
-      FaultSpec f;
-      SWARMBOX_TRY(DecodeFault(item, &f));
-      SWARMBOX_TRY(CheckFaultTargets(spec, f));
-      spec.faults.push_back(std::move(f));
-    }
+    // The fault injector's schema (swarmbox_faults): shape, values, then names against the drones.
+    auto parsed = faults::ParseFaults(*faults);
+    if (!parsed) return parsed.error();
+    std::vector<std::string> names;
+    for (const DroneSpec& d : spec.drones) names.push_back(d.name);
+    SWARMBOX_TRY(faults::ValidateFaults(*parsed, names));
+    spec.faults = std::move(*parsed);
+    spec.faults_node = *faults;
   }
 
   if (end != nullptr && !end->is_null()) {
@@ -364,10 +211,10 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
     spec.timeout.outcome = *o;
     if (spec.timeout.sim.zero()) return At(*timeout->Find("sim"), "'sim' must be longer than 0s");
   }
-  for (const FaultSpec& f : spec.faults) {
-    if (f.at > spec.timeout.sim) {
-      return AtMark(f.mark, "fault at " + f.at.ToString() + " is after the timeout (" +
-                                spec.timeout.sim.ToString() + ")");
+  for (const faults::Fault& f : spec.faults) {
+    if (f.start.clock == faults::FaultStart::Clock::kSim && f.start.at_ms > spec.timeout.sim.ms()) {
+      return AtMark(f.mark, "fault " + f.id + " at " + Duration::Ms(f.start.at_ms).ToString() +
+                                " is after the timeout (" + spec.timeout.sim.ToString() + ")");
     }
   }
 
@@ -403,10 +250,7 @@ Result<TrialSpec> LoadTrialText(std::string_view text, std::string_view filename
   if (!doc) return doc.error();
   for (const std::string& o : options.overrides) SWARMBOX_TRY(ApplyOverride(*doc, o));
   LoadOptions resolved = options;
-  if (resolved.trials_dir.empty()) {
-    resolved.trials_dir = std::filesystem::path(std::string(filename)).parent_path().string();
-    if (resolved.trials_dir.empty()) resolved.trials_dir = ".";
-  }
+  if (resolved.trials_dir.empty()) resolved.trials_dir = DefaultTrialsDir(filename);
   return DecodeTrial(*doc, resolved);
 }
 

@@ -1,34 +1,14 @@
 #include "swarmbox/dsl/trial_spec.hpp"
 
 #include <charconv>
+#include <cstdio>
+#include <cstdlib>
 #include <utility>
 
 namespace swarmbox::dsl {
 
 std::string_view MiddlewareName(Middleware middleware) {
   return middleware == Middleware::kFastDds ? "fastdds" : "cyclonedds";
-}
-
-std::string_view FaultKindName(FaultKind kind) {
-  switch (kind) {
-    case FaultKind::kKill: return "kill";
-    case FaultKind::kStop: return "stop";
-    case FaultKind::kPause: return "pause";
-    case FaultKind::kRestart: return "restart";
-    case FaultKind::kPartition: return "partition";
-    case FaultKind::kGpsDropout: return "gps_dropout";
-    case FaultKind::kWindGust: return "wind_gust";
-    case FaultKind::kNetem: return "netem";
-  }
-  return "?";
-}
-
-FaultSpec FaultSpec::Kill(Duration at, std::string target) {
-  FaultSpec f;
-  f.at = at;
-  f.kind = FaultKind::kKill;
-  f.targets = {std::move(target)};
-  return f;
 }
 
 TrialSpec TrialSpec::Named(std::string name) {
@@ -57,13 +37,39 @@ TrialSpec& TrialSpec::Drone(std::string drone_name, std::string airframe,
   drones.push_back({std::move(drone_name), std::move(airframe), pose, std::move(payload), {}});
   return *this;
 }
-TrialSpec& TrialSpec::Mesh(MeshSpec value) {
-  mesh = std::move(value);
-  return *this;
+TrialSpec& TrialSpec::Mesh(std::string_view flow_yaml) {
+  auto node = yaml::Parse(flow_yaml, "TrialSpec::Mesh");
+  if (node) {
+    auto parsed = faults::ParseMeshBlock(*node);
+    if (parsed) {
+      mesh = std::move(*parsed);
+      mesh_node = std::move(*node);
+      return *this;
+    }
+    std::fprintf(stderr, "swarmbox: fatal: TrialSpec::Mesh: %s\n", parsed.error().ToString().c_str());
+  } else {
+    std::fprintf(stderr, "swarmbox: fatal: TrialSpec::Mesh: %s\n", node.error().ToString().c_str());
+  }
+  std::abort();
 }
-TrialSpec& TrialSpec::Fault(FaultSpec fault) {
-  faults.push_back(std::move(fault));
-  return *this;
+TrialSpec& TrialSpec::Fault(std::string_view flow_yaml) {
+  if (faults_node.is_null()) faults_node = yaml::Node::Sequence();
+  auto item = yaml::Parse(flow_yaml, "TrialSpec::Fault");
+  if (item) {
+    yaml::Node list = faults_node;
+    list.Append(*item);
+    auto parsed = faults::ParseFaults(list);
+    if (parsed) {
+      faults_node = std::move(list);
+      faults = std::move(*parsed);
+      return *this;
+    }
+    std::fprintf(stderr, "swarmbox: fatal: TrialSpec::Fault(\"%.*s\"): %s\n",
+                 static_cast<int>(flow_yaml.size()), flow_yaml.data(), parsed.error().ToString().c_str());
+  } else {
+    std::fprintf(stderr, "swarmbox: fatal: TrialSpec::Fault: %s\n", item.error().ToString().c_str());
+  }
+  std::abort();
 }
 TrialSpec& TrialSpec::EndOn(std::string pattern, Outcome outcome, std::string reason,
                             std::string from) {
@@ -95,24 +101,6 @@ std::string Number(double v) {
 Node Str(std::string_view s) { return Node::Scalar(std::string(s), {}, /*quoted=*/true); }
 Node Plain(std::string s) { return Node::Scalar(std::move(s)); }
 
-Node StringList(const std::vector<std::string>& items) {
-  Node seq = Node::Sequence();
-  for (const auto& s : items) seq.Append(Str(s));
-  return seq;
-}
-
-Node MeshNode(const MeshSpec& m) {
-  Node n = Node::Mapping();
-  if (m.delay_ms > 0) n.Set("delay_ms", Plain(Number(m.delay_ms)));
-  if (m.jitter_ms > 0) n.Set("jitter_ms", Plain(Number(m.jitter_ms)));
-  if (!m.distribution.empty()) n.Set("distribution", Str(m.distribution));
-  if (m.loss > 0) n.Set("loss", Plain(Number(m.loss)));
-  if (m.duplicate > 0) n.Set("duplicate", Plain(Number(m.duplicate)));
-  if (m.corrupt > 0) n.Set("corrupt", Plain(Number(m.corrupt)));
-  if (m.rate_kbit > 0) n.Set("rate_kbit", Plain(Number(m.rate_kbit)));
-  return n;
-}
-
 }  // namespace
 
 yaml::Node ToDocument(const TrialSpec& spec) {
@@ -136,43 +124,12 @@ yaml::Node ToDocument(const TrialSpec& spec) {
     drones.Append(std::move(dn));
   }
   doc.Set("drones", std::move(drones));
-  if (spec.mesh.impaired()) {
+  if (!spec.mesh_node.is_null()) {
     Node network = Node::Mapping();
-    network.Set("mesh", MeshNode(spec.mesh));
+    network.Set("mesh", spec.mesh_node);
     doc.Set("network", std::move(network));
   }
-  if (!spec.faults.empty()) {
-    Node faults = Node::Sequence();
-    for (const FaultSpec& f : spec.faults) {
-      Node fn = Node::Mapping();
-      fn.Set("at", Str(f.at.ToString()));
-      const std::string kind(FaultKindName(f.kind));
-      switch (f.kind) {
-        case FaultKind::kPartition: {
-          Node groups = Node::Sequence();
-          for (const auto& g : f.groups) groups.Append(StringList(g));
-          fn.Set(kind, std::move(groups));
-          break;
-        }
-        case FaultKind::kWindGust: {
-          Node w = Node::Mapping();
-          w.Set("speed_mps", Plain(Number(f.wind_speed_mps)));
-          w.Set("direction_deg", Plain(Number(f.wind_direction_deg)));
-          fn.Set(kind, std::move(w));
-          break;
-        }
-        case FaultKind::kNetem:
-          fn.Set(kind, MeshNode(f.netem));
-          if (!f.targets.empty()) fn.Set("on", StringList(f.targets));
-          break;
-        default:
-          fn.Set(kind, Str(f.targets.empty() ? std::string() : f.targets.front()));
-      }
-      if (!f.duration.zero()) fn.Set("for", Str(f.duration.ToString()));
-      faults.Append(std::move(fn));
-    }
-    doc.Set("faults", std::move(faults));
-  }
+  if (!spec.faults_node.is_null()) doc.Set("faults", spec.faults_node);
   if (!spec.end.empty()) {
     Node end = Node::Sequence();
     for (const EndSpec& e : spec.end) {

@@ -53,7 +53,7 @@ TEST(ValidateCommand, BadFilesGiveFileLineColumnAndExit2) {
   EXPECT_EQ(ValidateCommand(args), kExitUsage);
   fs::remove(bad);
   // The bad file is reported, and the good one after it is still checked.
-  EXPECT_THAT(c.err(), HasSubstr(bad.string() + ":6:14: unknown fault kind 'explode'"));
+  EXPECT_THAT(c.err(), HasSubstr(bad.string() + ":6:14: unknown key 'explode' in fault"));
   EXPECT_THAT(c.out(), HasSubstr("smoke.yaml: ok"));
 }
 

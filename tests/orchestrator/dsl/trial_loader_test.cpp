@@ -55,12 +55,13 @@ TEST(LoadTrial, DecodesTheArchitectureExample) {
   EXPECT_EQ(spec->drones[2].payload, "stretcher");
   EXPECT_DOUBLE_EQ(spec->drones[2].pose[1], -10.0);
   EXPECT_EQ(spec->drones[1].mark.ToString(), "sar.yaml:8:5");
-  EXPECT_DOUBLE_EQ(spec->mesh.delay_ms, 100);
-  EXPECT_DOUBLE_EQ(spec->mesh.loss, 0.05);
+  ASSERT_EQ(spec->mesh.rules.size(), 1u);
+  EXPECT_DOUBLE_EQ(spec->mesh.rules[0].spec.delay_ms, 100);
+  EXPECT_DOUBLE_EQ(spec->mesh.rules[0].spec.loss, 0.05);
   ASSERT_EQ(spec->faults.size(), 1u);
-  EXPECT_EQ(spec->faults[0].kind, FaultKind::kKill);
-  EXPECT_EQ(spec->faults[0].at.ms(), 30000);
-  EXPECT_EQ(spec->faults[0].targets, std::vector<std::string>{"raft_leader"});
+  EXPECT_EQ(spec->faults[0].kind(), "kill");
+  EXPECT_EQ(spec->faults[0].start.at_ms, 30000);
+  EXPECT_EQ(spec->faults[0].target()->ToString(), "raft_leader");
   ASSERT_EQ(spec->end.size(), 2u);
   EXPECT_EQ(spec->end[1].on, "event=collision");
   EXPECT_EQ(spec->end[1].outcome, Outcome::kFailure);
@@ -69,27 +70,23 @@ TEST(LoadTrial, DecodesTheArchitectureExample) {
   EXPECT_EQ(spec->timeout.outcome, Outcome::kTimeout);
 }
 
-TEST(LoadTrial, AcceptsEveryFaultShape) {
+TEST(LoadTrial, FaultsUseTheFaultInjectorsSchema) {
   std::string text = std::string(kExample);
   text.replace(text.find("faults:"), text.find("end:") - text.find("faults:"), R"(faults:
   - {at: 30s, kill: raft_leader}
-  - {at: 40s, pause: scout_2, for: 10s}
-  - {at: 41s, stop: physics, for: 500ms}
-  - {at: 42s, restart: lifter}
-  - {at: 1m, partition: [[scout_1, scout_2], [lifter]], for: 20s}
-  - {at: 10s, gps_dropout: scout_1, for: 5s}
-  - {at: 50s, wind_gust: {speed_mps: 8, direction_deg: 90}, for: 3s}
-  - {at: 20s, netem: {delay_ms: 300, loss: 0.2}, on: [scout_1], for: 30s}
+  - {at: 40s, duration: 10s, pause: scout_2}
+  - {at: 1m, duration: 20s, partition: {groups: [[scout_1, scout_2], [lifter]]}}
+  - {at: 10s, duration: 5s, gps_dropout: scout_1}
+  - {at: 50s, duration: 3s, wind_gust: {speed_mps: 8, direction_deg: 90}}
 )");
   auto spec = LoadTrialText(text, "sar.yaml", FakeTree());
   ASSERT_TRUE(spec) << spec.error().ToString();
-  ASSERT_EQ(spec->faults.size(), 8u);
-  EXPECT_EQ(spec->faults[1].duration.ms(), 10000);
-  EXPECT_EQ(spec->faults[4].kind, FaultKind::kPartition);
-  EXPECT_EQ(spec->faults[4].groups.size(), 2u);
-  EXPECT_DOUBLE_EQ(spec->faults[6].wind_speed_mps, 8);
-  EXPECT_DOUBLE_EQ(spec->faults[7].netem.delay_ms, 300);
-  EXPECT_EQ(spec->faults[7].targets, std::vector<std::string>{"scout_1"});
+  ASSERT_EQ(spec->faults.size(), 5u);
+  EXPECT_EQ(spec->faults[0].kind(), "kill");
+  EXPECT_EQ(spec->faults[0].start.at_ms, 30000);
+  EXPECT_EQ(spec->faults[2].kind(), "partition");
+  EXPECT_EQ(spec->faults[1].duration_ms, 10000);
+  EXPECT_TRUE(spec->faults_node.is_sequence());
 }
 
 struct BadCase {
@@ -112,18 +109,17 @@ TEST(LoadTrial, ReportsBadInputWithFileLineColumn) {
       {"pose: [3, 0, 0]", "pose: [3, 0]", "sar.yaml:8:43", "expected a list of 3 values"},
       {"name: scout_2", "name: scout_1", "sar.yaml:8:12", "drone name 'scout_1' is used twice"},
       {"{at: 30s, kill: raft_leader}", "{at: 30s, explode: raft_leader}", "sar.yaml:13:15",
-       "unknown fault kind 'explode' (expected one of kill, stop, pause, restart, partition, "
-       "gps_dropout, wind_gust, netem"},
+       "unknown key 'explode' in fault"},
       {"{at: 30s, kill: raft_leader}", "{at: 30s, kill: scout_9}", "sar.yaml:13:5",
-       "unknown component 'scout_9' (expected one of scout_1, scout_2, lifter, physics, raft_leader)"},
+       "unknown drone 'scout_9' (drones: scout_1, scout_2, lifter)"},
       {"{at: 30s, kill: raft_leader}", "{at: 30 seconds, kill: raft_leader}", "sar.yaml:13:10",
-       "expected a duration such as 30s, 500ms or 2m, got '30 seconds'"},
+       "30 seconds"},
       {"{at: 30s, kill: raft_leader}", "{kill: raft_leader}", "sar.yaml:13:5",
-       "missing required key 'at' in fault"},
+       "a fault needs exactly one start: at (simulated time), at_wall (wall time) or on"},
       {"{at: 30s, kill: raft_leader}", "{at: 30s, kill: raft_leader, pause: scout_1}",
-       "sar.yaml:13:34", "a fault has one kind, this one has 'kill' and 'pause'"},
+       "sar.yaml:13:5", "a fault has exactly one kind; got both 'kill' and 'pause'"},
       {"{at: 30s, kill: raft_leader}", "{at: 30s, kill: raft_leader, for: 3s}", "sar.yaml:13:34",
-       "'for' does not apply to a kill fault"},
+       "unknown key 'for' in fault"},
       {"outcome: failure", "outcome: disaster", "sar.yaml:16:38", "unknown outcome 'disaster'"},
       {"\"event=collision\"", "\"event=(collision\"", "sar.yaml:16:10",
        "'on' is not a valid regular expression"},
@@ -132,7 +128,7 @@ TEST(LoadTrial, ReportsBadInputWithFileLineColumn) {
        "missing required key 'sim' in timeout"},
       {"name: sar-search", "name: SAR Search", "sar.yaml:1:7", "trial name 'SAR Search' must be"},
       {"{at: 30s, kill: raft_leader}", "{at: 601s, kill: raft_leader}", "sar.yaml:13:5",
-       "fault at 601s is after the timeout (10m)"},
+       "fault fault_0 at 601s is after the timeout (10m)"},
   };
   for (const BadCase& c : cases) {
     std::string text = kExample;
@@ -153,7 +149,7 @@ TEST(LoadTrial, OverridesApplyBeforeChecking) {
                  "physics.rtf=0"};
   auto spec = LoadTrialText(kExample, "sar.yaml", o);
   ASSERT_TRUE(spec) << spec.error().ToString();
-  EXPECT_DOUBLE_EQ(spec->mesh.loss, 0.1);
+  EXPECT_DOUBLE_EQ(spec->mesh.rules[0].spec.loss, 0.1);
   EXPECT_EQ(spec->seed, 7u);
   EXPECT_DOUBLE_EQ(spec->drones[2].pose[2], 3.0);
   EXPECT_DOUBLE_EQ(spec->rtf, 0.0);
@@ -189,8 +185,8 @@ TEST(LoadTrial, BuilderAndDocumentDescribeTheSameTrial) {
                         .World("worlds/open_field.yaml")
                         .Drone("scout_1", "x500", {0, 0, 0})
                         .Drone("lifter", "x8_heavy", {0, -10, 0}, "stretcher")
-                        .Mesh(MeshSpec::Netem(100, 20, 0.05))
-                        .Fault(FaultSpec::Kill(Duration::Seconds(30), "raft_leader"))
+                        .Mesh("{delay_ms: 100, jitter_ms: 20, loss: 0.05}")
+                        .Fault("{at: 30s, kill: raft_leader}")
                         .EndOn("event=mission_complete", Outcome::kSuccess)
                         .EndOn("event=collision", Outcome::kFailure, "collision")
                         .Timeout(Duration::Minutes(10));
@@ -201,12 +197,20 @@ TEST(LoadTrial, BuilderAndDocumentDescribeTheSameTrial) {
   EXPECT_EQ(loaded->seed, built.seed);
   ASSERT_EQ(loaded->drones.size(), 2u);
   EXPECT_EQ(loaded->drones[1].payload, "stretcher");
-  EXPECT_DOUBLE_EQ(loaded->mesh.jitter_ms, 20);
+  EXPECT_DOUBLE_EQ(loaded->mesh.rules[0].spec.jitter_ms, 20);
   ASSERT_EQ(loaded->faults.size(), 1u);
-  EXPECT_EQ(loaded->faults[0].targets, built.faults[0].targets);
+  EXPECT_EQ(loaded->faults[0].kind(), "kill");
+  EXPECT_EQ(loaded->faults[0].target()->ToString(), "raft_leader");
   ASSERT_EQ(loaded->end.size(), 2u);
   EXPECT_EQ(loaded->end[1].reason, "collision");
   EXPECT_EQ(loaded->timeout.sim, Duration::Minutes(10));
+}
+
+TEST(LoadTrial, TrialsDirIsTheNearestTrialsFolder) {
+  EXPECT_EQ(DefaultTrialsDir("/src/trials/faults/partition.yaml"), "/src/trials");
+  EXPECT_EQ(DefaultTrialsDir("/src/trials/sar_search.yaml"), "/src/trials");
+  EXPECT_EQ(DefaultTrialsDir("/elsewhere/mine.yaml"), "/elsewhere");
+  EXPECT_EQ(DefaultTrialsDir("mine.yaml"), ".");
 }
 
 TEST(LoadTrial, ShippedTrialsLoadAgainstTheRealTrialsFolder) {

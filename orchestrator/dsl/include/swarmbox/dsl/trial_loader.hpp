@@ -9,7 +9,8 @@
 //
 // References resolve against the trials directory: `world: worlds/open_field.yaml` is
 // <trials_dir>/worlds/open_field.yaml, `airframe: x500` is <trials_dir>/airframes/x500.yaml.
-// trials_dir defaults to the folder of the trial file.
+// trials_dir defaults to the nearest folder named `trials` that holds the trial file (so
+// trials/faults/partition.yaml resolves against trials/), else the trial file's folder.
 #pragma once
 
 #include <functional>
@@ -25,11 +26,14 @@ namespace swarmbox::dsl {
 
 struct LoadOptions {
   std::vector<std::string> overrides;  // "key.path=value", applied in order
-  std::string trials_dir;              // "" = the trial file's folder
+  std::string trials_dir;              // "" = DefaultTrialsDir(the trial file)
   // Whether a referenced file exists; default: std::filesystem. Tests pass a fake.
   std::function<bool(const std::string& path)> file_exists;
   bool check_references = true;
 };
+
+// The default trials directory of a trial file (see above).
+std::string DefaultTrialsDir(std::string_view trial_file);
 
 // Reads the file, applies overrides, decodes and checks it.
 Result<TrialSpec> LoadTrial(const std::string& path, const LoadOptions& options = {});

@@ -8,13 +8,15 @@
 //                     .World("worlds/open_field.yaml")
 //                     .Drone("scout_1", "x500", {0, 0, 0})
 //                     .Drone("lifter", "x8_heavy", {0, -10, 0}, "stretcher")
-//                     .Mesh(MeshSpec::Netem(100, 20, 0.05))
-//                     .Fault(FaultSpec::Kill(Duration::Seconds(30), "raft_leader"))
+//                     .Mesh("{delay_ms: 100, jitter_ms: 20, loss: 0.05}")
+//                     .Fault("{at: 30s, kill: raft_leader}")
 //                     .EndOn("event=mission_complete", Outcome::kSuccess)
 //                     .EndOn("event=collision", Outcome::kFailure, "collision")
 //                     .Timeout(Duration::Minutes(10));
 //
-// Faults are parsed and validated now and carried out by the fault injector (a later issue).
+// Faults: the `faults:` list is parsed and checked by swarmbox_faults (faults::ParseFaults, the
+// fault injector's own schema: at/at_wall/on, duration, kill/stop/pause/restart/radio/partition/
+// gps_dropout/imu_bias/wind_gust, targets) and carried out by the fault injector.
 #pragma once
 
 #include <array>
@@ -26,6 +28,8 @@
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/dsl/duration.hpp"
 #include "swarmbox/dsl/outcome.hpp"
+#include "swarmbox/faults/fault_spec.hpp"
+#include "swarmbox/faults/netem_spec.hpp"
 
 namespace swarmbox::dsl {
 
@@ -38,55 +42,6 @@ struct DroneSpec {
   std::array<double, 3> pose{};     // start position [m], world frame (x east, y north, z up)
   std::string payload;              // "" = none
   yaml::Mark mark;                  // where the drone was declared
-};
-
-// tc netem semantics for the radio link of every agent (network.mesh).
-struct MeshSpec {
-  double delay_ms = 0;
-  double jitter_ms = 0;
-  std::string distribution;  // "" = netem default; normal, pareto, paretonormal
-  double loss = 0;           // probability [0, 1]
-  double duplicate = 0;      // probability [0, 1]
-  double corrupt = 0;        // probability [0, 1]
-  double rate_kbit = 0;      // 0 = unlimited
-  // delay [ms], jitter [ms], loss probability.
-  static MeshSpec Netem(double delay_ms, double jitter_ms = 0, double loss = 0) {
-    MeshSpec m;
-    m.delay_ms = delay_ms;
-    m.jitter_ms = jitter_ms;
-    m.loss = loss;
-    return m;
-  }
-  bool impaired() const {
-    return delay_ms > 0 || jitter_ms > 0 || loss > 0 || duplicate > 0 || corrupt > 0 ||
-           rate_kbit > 0;
-  }
-};
-
-enum class FaultKind { kKill, kStop, kPause, kRestart, kPartition, kGpsDropout, kWindGust, kNetem };
-// The YAML key of each kind: "kill", "stop", "pause", "restart", "partition", "gps_dropout",
-// "wind_gust", "netem".
-std::string_view FaultKindName(FaultKind kind);
-
-// One scheduled fault, `at` simulated time after the start. Shapes (YAML):
-//   {at: 30s, kill: raft_leader}               kill|stop|pause|restart: a drone, physics or raft_leader
-//   {at: 40s, pause: scout_2, for: 10s}        stop/pause may last `for`
-//   {at: 40s, partition: [[scout_1, scout_2], [scout_3, lifter]], for: 20s}
-//   {at: 10s, gps_dropout: scout_1, for: 5s}
-//   {at: 50s, wind_gust: {speed_mps: 8, direction_deg: 90}, for: 3s}
-//   {at: 20s, netem: {delay_ms: 300, loss: 0.2}, on: [scout_1], for: 30s}   on: default every drone
-struct FaultSpec {
-  Duration at;
-  FaultKind kind = FaultKind::kKill;
-  std::vector<std::string> targets;              // kill..restart, gps_dropout, netem `on`
-  std::vector<std::vector<std::string>> groups;  // partition
-  Duration duration;                             // `for`; zero = until the end
-  MeshSpec netem;
-  double wind_speed_mps = 0;
-  double wind_direction_deg = 0;  // where the wind blows to, clockwise from north
-  yaml::Mark mark;
-
-  static FaultSpec Kill(Duration at, std::string target);
 };
 
 struct EndSpec {
@@ -109,8 +64,10 @@ struct TrialSpec {
   std::string world;  // relative to the trials directory
   double rtf = 1.0;   // real-time factor, 0 = as fast as possible
   std::vector<DroneSpec> drones;
-  MeshSpec mesh;
-  std::vector<FaultSpec> faults;
+  faults::MeshImpairment mesh;  // network.mesh, parsed by swarmbox_faults (tc netem semantics)
+  yaml::Node mesh_node;         // network.mesh as written (null = an unimpaired radio)
+  std::vector<faults::Fault> faults;
+  yaml::Node faults_node;  // the `faults:` list as written (null = none)
   std::vector<EndSpec> end;
   TimeoutSpec timeout;
 
@@ -125,8 +82,12 @@ struct TrialSpec {
   TrialSpec& Rtf(double rtf);
   TrialSpec& Drone(std::string name, std::string airframe, std::array<double, 3> pose,
                    std::string payload = {});
-  TrialSpec& Mesh(MeshSpec mesh);
-  TrialSpec& Fault(FaultSpec fault);
+  // network.mesh in flow syntax, e.g. "{delay_ms: 100, jitter_ms: 20, loss: 0.05}". Aborts with
+  // the parser's message on a malformed literal (a bug in the calling code).
+  TrialSpec& Mesh(std::string_view flow_yaml);
+  // One fault in the trial file's flow syntax, e.g. "{at: 30s, kill: raft_leader}". Aborts with
+  // the parser's message on a malformed literal (a bug in the calling code).
+  TrialSpec& Fault(std::string_view flow_yaml);
   TrialSpec& EndOn(std::string pattern, Outcome outcome, std::string reason = {},
                    std::string from = {});
   TrialSpec& Timeout(Duration sim, Outcome outcome = Outcome::kTimeout, Duration wall = {});
