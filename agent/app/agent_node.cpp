@@ -1,5 +1,6 @@
 #include "agent_node.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -76,6 +77,14 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!sp) return sp.error().Context("publishing drone state");
     node->state_pub_ = std::move(*sp);
   }
+  if (!o.raft.members.empty()) {
+    if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--members (Raft) needs the mesh bus (drop --no-mesh)");
+    RaftHostOptions ro = o.raft;
+    ro.self = o.name;
+    auto raft = RaftHost::Start(ro, *node->mesh_, o.log);
+    if (!raft) return raft.error();
+    node->raft_ = std::move(*raft);
+  }
   return node;
 }
 
@@ -94,6 +103,7 @@ void AgentNode::Log(const LogEvent& e) {
 void AgentNode::HandleSample(const bus::SensorSample& msg) {
   using flight::FlightEventKind;
   t_s_ = static_cast<double>(msg.sim_time_ns) * 1e-9;
+  if (raft_) raft_->SetSimTime(t_s_);
   const flight::ActuatorOutput& out = fc_.Step(FromBus(msg));
   cmd_.step = msg.step;
   cmd_.sim_time_ns = msg.sim_time_ns;
@@ -151,12 +161,28 @@ Status AgentNode::Run() {
           .Add("sim_domain", options_.sim_domain)
           .Add("sim_interface", options_.sim_interface)
           .Add("middleware", options_.middleware)
-          .Add("plan", options_.plan));
+          .Add("plan", options_.plan)
+          .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
   bus::SensorSample msg;
   bool got_any = false;
   while (true) {
     const auto timeout = got_any ? options_.stall_timeout : options_.first_sample_timeout;
-    if (!sensor_sub_->TakeFor(msg, timeout)) {
+    // Wait in slices so the Raft host is polled (storage failure, proposals) while no sample comes.
+    const auto wait_until = std::chrono::steady_clock::now() + timeout;
+    bool took = false;
+    while (true) {
+      if (raft_) {
+        if (Status s = raft_->Poll(); !s) return s.error().Context("raft stopped");
+      }
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(wait_until - std::chrono::steady_clock::now());
+      if (left <= std::chrono::milliseconds(0)) break;
+      const auto slice = raft_ ? std::min(left, std::chrono::milliseconds(50)) : left;
+      if (sensor_sub_->TakeFor(msg, slice)) {
+        took = true;
+        break;
+      }
+    }
+    if (!took) {
       const double secs = std::chrono::duration<double>(timeout).count();
       if (!got_any) {
         return Error(ErrorCode::kUnavailable,

@@ -1,6 +1,7 @@
 // AgentNode: the thin node around the flight stack (STYLE.md 1). It joins the sim bus (sensor
 // samples in, actuator commands out, lockstep: every sample is answered with a command for the
-// same step) and the mesh bus (its DroneState for the neighbours), runs FlightController on the
+// same step) and the mesh bus (its DroneState for the neighbours; with raft.members, the drone's
+// Raft node on the mission state, raft_host.hpp), runs FlightController on the
 // samples' simulated time, lets a SetpointSource (the built-in plan now, the mission layer later)
 // drive it, and prints logfmt events (`t=12.340 node=drone_3 event=hover ...`).
 //
@@ -16,6 +17,7 @@
 #include <string>
 
 #include "flight_plan.hpp"
+#include "raft_host.hpp"
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
@@ -43,6 +45,9 @@ struct AgentOptions {
   std::chrono::milliseconds stall_timeout{5000};          // wall clock, after the first sample
   bool exit_when_done = false;          // exit once the plan is complete (landed)
   std::FILE* log = stdout;              // logfmt events
+  // Raft on the mesh (raft_host.hpp): on when raft.members is not empty (needs `mesh`).
+  // raft.self is set from `name`.
+  RaftHostOptions raft;
 };
 
 class AgentNode {
@@ -50,7 +55,10 @@ class AgentNode {
   static Result<std::unique_ptr<AgentNode>> Create(const AgentOptions& options);
   // Serves the lockstep until the samples stop (ok if the plan was completed by then) or, with
   // exit_when_done, until the plan is complete. kUnavailable when no sample ever arrives.
+  // With Raft: also ends (the service's error) when the Raft storage failed (raft_failed()).
   Status Run();
+  // True once the Raft service stopped because its storage failed: the agent must exit 1.
+  bool raft_failed() const { return raft_ && raft_->stopped(); }
 
  private:
   AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan);
@@ -65,6 +73,7 @@ class AgentNode {
   std::unique_ptr<bus::Subscriber<bus::SensorSample>> sensor_sub_;
   std::unique_ptr<bus::Publisher<bus::ActuatorCommand>> actuator_pub_;
   std::unique_ptr<bus::Publisher<bus::DroneState>> state_pub_;
+  std::unique_ptr<RaftHost> raft_;  // after mesh_: destroyed before the participant
   bus::ActuatorCommand cmd_;
   bus::DroneState state_;
   bool have_step_ = false;

@@ -1,6 +1,18 @@
 // swarmbox-agent: one drone's companion computer. Thin: parses the command line, builds the
-// AgentNode (agent_node.hpp) and runs it. Exit codes: 0 done, 2 bad usage/config, 3 the bus or
-// the physics server is not there.
+// AgentNode (agent_node.hpp) and runs it. Exit codes: 0 done, 1 the Raft storage failed
+// (event=raft_stopped), 2 bad usage/config, 3 the bus or the physics server is not there.
+//
+// Raft on the mesh (raft_host.hpp) is on when --members lists the trial's drones (same list on
+// every drone, including this one); off when absent:
+//   swarmbox-agent --name drone_1 --airframe trials/airframes/x500.yaml --sim-domain 10
+//       --mesh-domain 11 --members drone_1,drone_2,drone_3 --seed 7
+//       [--raft-dir DIR]            WAL + snapshot; default /tmp/swarmbox-raft/<name>; reuse it
+//                                   on restart so the node rejoins with its durable log
+//       [--raft-tick-ms 50] [--raft-heartbeat-ms 100] [--raft-election-timeout-ms 500]
+//       [--propose-every-ms N]      diagnostic: the leader proposes the next demo mission command
+//                                   every N wall ms (0 = never), until the mission layer does
+// Raft events (event=leader_elected, mission_state, victim_confirmed, raft_stopped) are printed
+// on stdout with the agent's simulated time `t`. The mesh domain must differ from the sim one.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -30,6 +42,14 @@ int main(int argc, char** argv) {
   app.add_option("--sample-timeout", first_timeout_s, "Wall seconds to wait for the first sensor sample")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--stall-timeout", stall_timeout_s, "Wall seconds without samples after which the run ends")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--exit-when-done", o.exit_when_done, "Exit as soon as the plan is complete");
+  std::string members;
+  app.add_option("--members", members, "Raft: every drone of the trial, comma-separated (incl. this one); Raft is off when absent");
+  app.add_option("--raft-dir", o.raft.raft_dir, "Raft: WAL directory (default /tmp/swarmbox-raft/<name>)");
+  app.add_option("--seed", o.raft.seed, "Raft: the trial's seed (election timeouts)")->capture_default_str();
+  app.add_option("--raft-tick-ms", o.raft.tick_ms, "Raft: wall-clock tick [ms]")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--raft-heartbeat-ms", o.raft.heartbeat_ms, "Raft: heartbeat, a multiple of the tick [ms]")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--raft-election-timeout-ms", o.raft.election_timeout_ms, "Raft: election timeout, a multiple of the tick, > heartbeat [ms]")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--propose-every-ms", o.raft.propose_every_ms, "Raft diagnostic: the leader proposes a demo mission command every N ms (0 = never)")->check(CLI::NonNegativeNumber)->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   o.mesh = !no_mesh;
@@ -46,6 +66,15 @@ int main(int argc, char** argv) {
     o.has_start = true;
     o.start_m = swarmbox::flight::Vec3(x, y, z);
   }
+  if (!members.empty()) {
+    auto list = swarmbox::agent::ParseMembers(members, o.name);
+    if (!list) {
+      std::fprintf(stderr, "swarmbox-agent: %s\n", list.error().ToString().c_str());
+      return 2;
+    }
+    o.raft.members = std::move(*list);
+    if (o.raft.raft_dir.empty()) o.raft.raft_dir = swarmbox::agent::DefaultRaftDir(o.name);
+  }
   auto node = swarmbox::agent::AgentNode::Create(o);
   if (!node) {
     std::fprintf(stderr, "swarmbox-agent: %s\n", node.error().ToString().c_str());
@@ -58,7 +87,7 @@ int main(int argc, char** argv) {
   if (!s) {
     std::printf("%s\n", swarmbox::LogEvent(0.0, o.name, "error").Add("reason", s.error().ToString()).str().c_str());
     std::fprintf(stderr, "swarmbox-agent: %s\n", s.error().ToString().c_str());
-    return 3;
+    return (*node)->raft_failed() ? 1 : 3;
   }
   return 0;
 }

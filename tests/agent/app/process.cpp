@@ -53,8 +53,10 @@ int Child::Wait(std::chrono::milliseconds timeout) {
   }
 }
 
-void Child::Terminate() {
-  if (pid_ > 0 && !reaped_) kill(pid_, SIGTERM);
+void Child::Terminate() { Signal(SIGTERM); }
+
+void Child::Signal(int sig) {
+  if (pid_ > 0 && !reaped_) kill(pid_, sig);
 }
 
 std::string Child::ReadLog() const {

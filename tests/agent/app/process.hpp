@@ -22,7 +22,10 @@ class Child {
   // Waits for the exit; the exit code, or -1 on timeout (still running), or 128+signal.
   int Wait(std::chrono::milliseconds timeout);
   void Terminate();  // SIGTERM
+  void Signal(int sig);  // no-op once reaped
+  bool running() const { return pid_ > 0 && !reaped_; }
   std::string ReadLog() const;
+  const std::string& log_path() const { return log_path_; }
 
  private:
   pid_t pid_ = -1;
