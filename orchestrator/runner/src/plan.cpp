@@ -143,14 +143,20 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   auto trial = std::make_unique<dsl::Trial>(spec.name, options.run_id);
   const TrialSubnets& nets = options.subnets;
 
-  dsl::NetworkSpec sim = dsl::NetworkSpec::Subnet(name(kSimNetworkId), nets.sim.ToString(),
+  // Docker names a container's interfaces in the order of its networks' names (libnetwork sorts
+  // the endpoints), not in the order they were attached: "net1-sim" < "net2-mesh" makes sim eth0
+  // and mesh eth1 in every agent, as kSimInterface/kMeshInterface say (measured on 20.10).
+  dsl::NetworkSpec sim = dsl::NetworkSpec::Subnet(name("net1-sim"), nets.sim.ToString(),
                                                   nets.sim.Host(kGatewayHost));
   sim.labels = labels(kSimNetworkId);
-  sim.internal = true;  // the wiring inside a drone: nothing leaves the host
-  dsl::NetworkSpec mesh = dsl::NetworkSpec::Subnet(name(kMeshNetworkId), nets.mesh.ToString(),
+  // Not `internal`: Docker's isolation rules for internal networks drop every packet whose
+  // destination is outside the subnet, DDS discovery multicast (239.255.0.1) included, once
+  // bridged traffic goes through iptables (br_netfilter; measured on this host).
+  sim.internal = false;
+  dsl::NetworkSpec mesh = dsl::NetworkSpec::Subnet(name("net2-mesh"), nets.mesh.ToString(),
                                                    nets.mesh.Host(kGatewayHost));
   mesh.labels = labels(kMeshNetworkId);
-  mesh.internal = true;
+  mesh.internal = false;
   auto& sim_net = trial->Add<dsl::Network>(std::string(kSimNetworkId), std::move(sim), 0);
   auto& mesh_net = trial->Add<dsl::Network>(std::string(kMeshNetworkId), std::move(mesh), 0);
 

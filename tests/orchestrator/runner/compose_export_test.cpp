@@ -31,7 +31,7 @@ TEST(ComposeYaml, ExportsNetworksServicesAndStartOrder) {
   EXPECT_EQ(doc->Find("version")->scalar(), "2.4");
   const yaml::Node* sim = doc->Find("networks")->Find("sim");
   ASSERT_NE(sim, nullptr);
-  EXPECT_EQ(sim->Find("name")->scalar(), "sar-search-compose-sim");
+  EXPECT_EQ(sim->Find("name")->scalar(), "sar-search-compose-net1-sim");
   EXPECT_EQ(sim->Find("ipam")->Find("config")->items()[0].Find("subnet")->scalar(), "10.200.8.0/24");
   EXPECT_EQ(sim->Find("labels")->Find("swarmbox.run")->scalar(), "compose");
 

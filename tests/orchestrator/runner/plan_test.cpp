@@ -33,7 +33,7 @@ TEST_F(PlanTest, MakesTwoNetworksWithTheirSubnetsNamesAndLabels) {
   auto nets = (*trial)->Networks();
   ASSERT_EQ(nets.size(), 2u);
   EXPECT_EQ(nets[0]->id(), "sim");
-  EXPECT_EQ(nets[0]->spec().name, "sar-search-20261121-101000-7f3a-sim");
+  EXPECT_EQ(nets[0]->spec().name, "sar-search-20261121-101000-7f3a-net1-sim");
   EXPECT_EQ(nets[0]->spec().subnet, "10.200.8.0/24");
   EXPECT_EQ(nets[0]->spec().gateway, "10.200.8.1");
   EXPECT_EQ(nets[1]->spec().subnet, "10.200.9.0/24");

@@ -133,10 +133,10 @@ TEST_F(RunnerTest, StartsInPriorityOrderAndStopsInReverse) {
   }
   const std::string p = "mini-20261121-120000-abcd-";
   EXPECT_THAT(order, ::testing::ElementsAre(
-                         "create-network " + p + "sim", "create-network " + p + "mesh",
+                         "create-network " + p + "net1-sim", "create-network " + p + "net2-mesh",
                          "create " + p + "physics", "create " + p + "scout_1", "start " + p + "physics",
                          "start " + p + "scout_1", "remove " + p + "scout_1", "remove " + p + "physics",
-                         "remove-network " + p + "mesh", "remove-network " + p + "sim"));
+                         "remove-network " + p + "net2-mesh", "remove-network " + p + "net1-sim"));
 }
 
 TEST_F(RunnerTest, EndsWhenSimulatedTimeRunsOut) {
