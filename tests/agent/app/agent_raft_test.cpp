@@ -39,8 +39,10 @@ using SteadyClock = std::chrono::steady_clock;
 const std::vector<std::string> kNames = {"drone_1", "drone_2", "drone_3"};
 const std::vector<std::string> kStarts = {"0,0,0", "4,0,0", "0,4,0"};
 
-// Sim and mesh domains of this run: 200-215, a pair per process id so parallel runs differ.
-int SimDomain() { return 200 + static_cast<int>(getpid() % 8) * 2; }
+// Sim and mesh domains of a run: 200-215, a pair chosen by process id (parallel runs differ) and
+// moved on at every run of the fixture (--gtest_repeat: no stale endpoints of the last run).
+int g_run = 0;
+int SimDomain() { return 200 + static_cast<int>((getpid() + g_run) % 8) * 2; }
 
 // The events `event` in an agent's output, in order (flight and Raft events share stdout).
 std::vector<LogfmtFields> Events(const std::string& log, std::string_view event) {
@@ -96,6 +98,7 @@ bool WaitUntil(const std::function<bool()>& pred, std::chrono::milliseconds time
 class AgentRaft : public ::testing::Test {
  protected:
   void SetUp() override {
+    ++g_run;
     root_ = MakeTempDir("swarmbox_agent_raft_");
     ASSERT_FALSE(root_.empty());
   }
@@ -144,6 +147,15 @@ TEST_F(AgentRaft, LeaderAgentKillFailsOverAndRestartedAgentCatchesUpFromItsWal) 
   std::unique_ptr<Child> physics = StartPhysics();
   std::map<std::string, std::unique_ptr<Child>> agents;
   for (std::size_t i = 0; i < kNames.size(); ++i) agents[kNames[i]] = StartAgent(i, kNames[i] + ".log");
+
+  // 0. All three are in lockstep with the physics server (each has taken off): only then is
+  // the drone of the agent killed below known to the server, which then marks it lost.
+  ASSERT_TRUE(WaitUntil([&] {
+    for (const auto& [name, c] : agents) {
+      if (Events(c->ReadLog(), "takeoff").empty()) return false;
+    }
+    return true;
+  }, 60s)) << DumpLogs(agents, *physics);
 
   // 1. A leader all three agree on (each one's latest leader_elected).
   std::string leader;
