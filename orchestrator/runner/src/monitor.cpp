@@ -41,8 +41,11 @@ std::optional<dsl::Verdict> Monitor::OnLine(std::string_view component, std::str
       if (last_events_.size() > kLastEvents) last_events_.pop_front();
     }
   }
-  if (timeout_.clock_component.empty() || timeout_.clock_component == component) {
-    if (auto t = SimTimeOf(line); t && *t > sim_s_) sim_s_ = *t;
+  if (auto t = SimTimeOf(line)) {
+    if (*t > any_sim_s_) any_sim_s_ = *t;
+    if ((timeout_.clock_component.empty() || timeout_.clock_component == component) && *t > sim_s_) {
+      sim_s_ = *t;
+    }
   }
   if (auto v = matcher_.Match(component, line)) {
     ending_line_ = std::string(line);
@@ -71,7 +74,7 @@ std::optional<dsl::Verdict> Monitor::OnTick(double wall_s) {
   if (ended_) return std::nullopt;
   if (!timeout_.wall_guard.zero() && wall_s_ >= timeout_.wall_guard.seconds()) {
     return End(dsl::Verdict::Err("wall-clock guard: " + timeout_.wall_guard.ToString() +
-                                     " passed with simulated time at " + Seconds(sim_s_) + "s of " +
+                                     " passed with simulated time at " + Seconds(sim_s()) + "s of " +
                                      timeout_.sim.ToString(),
                                  "wall-clock guard"));
   }
@@ -79,7 +82,7 @@ std::optional<dsl::Verdict> Monitor::OnTick(double wall_s) {
 }
 
 std::string Monitor::ProgressLine() const {
-  std::string s = "sim " + Seconds(sim_s_) + "/" + Seconds(timeout_.sim.seconds()) + "s  wall " +
+  std::string s = "sim " + Seconds(sim_s()) + "/" + Seconds(timeout_.sim.seconds()) + "s  wall " +
                   Seconds(wall_s_) + "s  live " + std::to_string(live_.size()) + "/" +
                   std::to_string(components_);
   if (!last_events_.empty()) {

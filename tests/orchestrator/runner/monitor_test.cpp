@@ -36,10 +36,10 @@ TEST(Monitor, Scenarios) {
   const std::vector<Scenario> scenarios = {
       {"mission completes",
        {{S::kLine, "physics", "t=10 event=tick", 0}, {S::kLine, "scout_1", "t=11 event=mission_complete", 0}},
-       dsl::Outcome::kSuccess, "matched 'event=mission_complete'", 10},
-      {"only the clock component's t counts",
+       dsl::Outcome::kSuccess, "matched 'event=mission_complete'", 11},
+      {"only the clock component's t ends the trial; others' t is shown",
        {{S::kLine, "scout_1", "t=70 event=tick", 0}, {S::kTick, "", "", 5}},
-       std::nullopt, "", 0},
+       std::nullopt, "", 70},
       {"simulated time runs out",
        {{S::kLine, "physics", "t=59.9 event=tick", 0}, {S::kLine, "physics", "t=60 event=tick", 0}},
        dsl::Outcome::kTimeout, "simulated time ran out (1m)", 60},
@@ -52,7 +52,7 @@ TEST(Monitor, Scenarios) {
       {"the first end wins",
        {{S::kLine, "scout_1", "t=3 event=collision", 0}, {S::kLine, "scout_1", "t=4 event=mission_complete", 0},
         {S::kExit, "physics", "", 1}, {S::kTick, "", "", 500}},
-       dsl::Outcome::kFailure, "collision", 0},
+       dsl::Outcome::kFailure, "collision", 3},
   };
   for (const Scenario& sc : scenarios) {
     SCOPED_TRACE(sc.name);
@@ -91,7 +91,7 @@ TEST(Monitor, ProgressLineShowsClocksLiveComponentsAndLastEvents) {
   (void)m->OnLine("scout_1", "t=12.5 node=scout_1 event=leader_elected term=1");
   (void)m->OnTick(13.04);
   EXPECT_EQ(m->ProgressLine(),
-            "sim 12.3/60.0s  wall 13.0s  live 2/2  last: scout_1 leader_elected, physics tick");
+            "sim 12.5/60.0s  wall 13.0s  live 2/2  last: scout_1 leader_elected, physics tick");
   (void)m->OnExit("scout_1", 0, true);
   EXPECT_EQ(m->live().size(), 1u);
   EXPECT_EQ(m->verdict()->reason, "scout_1 was killed for lack of memory");

@@ -35,7 +35,9 @@ class Monitor {
                                      bool oom_killed);
   std::optional<dsl::Verdict> OnTick(double wall_s);
 
-  double sim_s() const { return sim_s_; }
+  // Simulated time [s]: the clock component's, or when it is behind (the physics server logs
+  // only on events) the latest `t=` of any component. Timeouts use the clock component's only.
+  double sim_s() const { return sim_s_ > any_sim_s_ ? sim_s_ : any_sim_s_; }
   double wall_s() const { return wall_s_; }
   bool ended() const { return ended_.has_value(); }
   const std::optional<dsl::Verdict>& verdict() const { return ended_; }
@@ -54,7 +56,8 @@ class Monitor {
   EndMatcher matcher_;
   dsl::TimeoutPolicy timeout_;
   std::size_t components_;
-  double sim_s_ = 0;
+  double sim_s_ = 0;      // the clock component's
+  double any_sim_s_ = 0;  // any component's
   double wall_s_ = 0;
   std::set<std::string> live_;
   std::deque<std::string> last_events_;  // "<component> <event>", newest last
