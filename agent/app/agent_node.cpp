@@ -167,16 +167,22 @@ Status AgentNode::Run() {
   bool got_any = false;
   while (true) {
     const auto timeout = got_any ? options_.stall_timeout : options_.first_sample_timeout;
-    // Wait in slices so the Raft host is polled (storage failure, proposals) while no sample comes.
+    // Wait in slices so the Raft host is polled (storage failure, proposals) and a stop request
+    // seen while no sample comes.
     const auto wait_until = std::chrono::steady_clock::now() + timeout;
     bool took = false;
     while (true) {
+      if (options_.stop != nullptr && *options_.stop != 0) {
+        Log(LogEvent(t_s_, options_.name, "stopped").Add("reason", "signal"));
+        return Ok{};
+      }
       if (raft_) {
         if (Status s = raft_->Poll(); !s) return s.error().Context("raft stopped");
       }
       const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(wait_until - std::chrono::steady_clock::now());
       if (left <= std::chrono::milliseconds(0)) break;
-      const auto slice = raft_ ? std::min(left, std::chrono::milliseconds(50)) : left;
+      const bool poll = raft_ || options_.stop != nullptr;
+      const auto slice = poll ? std::min(left, std::chrono::milliseconds(50)) : left;
       if (sensor_sub_->TakeFor(msg, slice)) {
         took = true;
         break;

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
@@ -45,6 +46,9 @@ struct AgentOptions {
   std::chrono::milliseconds stall_timeout{5000};          // wall clock, after the first sample
   bool exit_when_done = false;          // exit once the plan is complete (landed)
   std::FILE* log = stdout;              // logfmt events
+  // Set (e.g. by a SIGTERM handler) to end Run() cleanly (Ok, event=stopped reason=signal) within
+  // ~50 ms; nullptr: never. Must outlive the node.
+  const volatile std::sig_atomic_t* stop = nullptr;
   // Raft on the mesh (raft_host.hpp): on when raft.members is not empty (needs `mesh`).
   // raft.self is set from `name`.
   RaftHostOptions raft;
@@ -55,7 +59,7 @@ class AgentNode {
   static Result<std::unique_ptr<AgentNode>> Create(const AgentOptions& options);
   // Serves the lockstep until the samples stop (ok if the plan was completed by then) or, with
   // exit_when_done, until the plan is complete. kUnavailable when no sample ever arrives.
-  // With Raft: also ends (the service's error) when the Raft storage failed (raft_failed()).
+  // Also ends (Ok) when *options.stop is set. With Raft: also ends (the service's error) when the Raft storage failed (raft_failed()).
   Status Run();
   // True once the Raft service stopped because its storage failed: the agent must exit 1.
   bool raft_failed() const { return raft_ && raft_->stopped(); }

@@ -1,5 +1,6 @@
 // swarmbox-agent: one drone's companion computer. Thin: parses the command line, builds the
-// AgentNode (agent_node.hpp) and runs it. Exit codes: 0 done, 1 the Raft storage failed
+// AgentNode (agent_node.hpp) and runs it. Exit codes: 0 done or SIGTERM/SIGINT (the Raft
+// service is stopped before the mesh participant is closed), 1 the Raft storage failed
 // (event=raft_stopped), 2 bad usage/config, 3 the bus or the physics server is not there.
 //
 // Raft on the mesh (raft_host.hpp) is on when --members lists the trial's drones (same list on
@@ -15,10 +16,16 @@
 // on stdout with the agent's simulated time `t`. The mesh domain must differ from the sim one.
 #include <CLI/CLI.hpp>
 
+#include <csignal>
 #include <cstdio>
 #include <string>
 
 #include "agent_node.hpp"
+
+namespace {
+volatile std::sig_atomic_t g_stop = 0;
+void OnSignal(int) { g_stop = 1; }
+}  // namespace
 
 int main(int argc, char** argv) {
   swarmbox::agent::AgentOptions o;
@@ -75,6 +82,9 @@ int main(int argc, char** argv) {
     o.raft.members = std::move(*list);
     if (o.raft.raft_dir.empty()) o.raft.raft_dir = swarmbox::agent::DefaultRaftDir(o.name);
   }
+  o.stop = &g_stop;
+  std::signal(SIGTERM, OnSignal);
+  std::signal(SIGINT, OnSignal);
   auto node = swarmbox::agent::AgentNode::Create(o);
   if (!node) {
     std::fprintf(stderr, "swarmbox-agent: %s\n", node.error().ToString().c_str());

@@ -291,9 +291,14 @@ TEST_F(AgentRaft, LeaderAgentKillFailsOverAndRestartedAgentCatchesUpFromItsWal) 
     EXPECT_TRUE(c->running()) << name << "\n" << c->ReadLog();
     EXPECT_TRUE(Events(c->ReadLog(), "raft_stopped").empty()) << name;
   }
+  // 7. Clean shutdown: SIGTERM ends each agent with 0 (Raft service stopped before the mesh).
+  for (auto& [name, c] : agents) c->Signal(SIGTERM);
+  for (auto& [name, c] : agents) {
+    EXPECT_EQ(c->Wait(10s), 0) << name << "\n" << c->ReadLog();
+    EXPECT_FALSE(Events(c->ReadLog(), "stopped").empty()) << name;
+  }
   physics->Signal(SIGTERM);
   EXPECT_EQ(physics->Wait(20s), 0) << physics->ReadLog();
-  // The Child destructors SIGKILL and reap the agents (samples stopped before the endless hover).
 }
 
 }  // namespace
