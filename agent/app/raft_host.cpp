@@ -45,6 +45,7 @@ Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options
   rc.driver.heartbeat_ms = options.heartbeat_ms;
   rc.driver.election_timeout_ms = options.election_timeout_ms;
   rc.data_dir = options.raft_dir;
+  rc.file_system = options.file_system;
   // One fprintf per line: stdio's lock keeps it whole next to the control loop's events.
   auto service = mission::RaftService::Start(rc, mesh, host->clock_, [log](const std::string& line) {
     std::fprintf(log, "%s\n", line.c_str());
@@ -59,10 +60,11 @@ Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options
 
 Status RaftHost::Poll() {
   using namespace std::chrono;
+  if (stopped_) return service_->health();
   const auto now = steady_clock::now();
   if (now < next_poll_) return Ok{};
   next_poll_ = now + milliseconds(20);
-  if (stopped_ || service_->WaitStopped(milliseconds(0))) {
+  if (service_->WaitStopped(milliseconds(0))) {
     stopped_ = true;
     return service_->health();
   }

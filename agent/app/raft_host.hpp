@@ -31,6 +31,7 @@
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/mission/raft_service.hpp"
+#include "swarmbox/raft/file_system.hpp"
 #include "swarmbox/raft/node_driver.hpp"
 
 namespace swarmbox::agent {
@@ -44,6 +45,7 @@ struct RaftHostOptions {
   int heartbeat_ms = 100;            // multiple of tick_ms [ms]
   int election_timeout_ms = 500;     // multiple of tick_ms, > heartbeat_ms [ms]
   int propose_every_ms = 0;          // 0: never; N: the leader proposes a demo command every N ms
+  raft::FileSystem* file_system = nullptr;  // the WAL's; nullptr = the real one (tests inject)
 };
 
 // "a,b,c" -> {"a","b","c"}; kInvalidArgument for an empty item, a bad drone name, a duplicate, or
@@ -74,8 +76,8 @@ class RaftHost {
   ~RaftHost() = default;  // stops the service (thread, radio, storage)
 
   void SetSimTime(double t_s) { clock_.Set(t_s); }
-  // Cheap when called often (acts at most every 20 ms of wall-clock time). Ok while running; the
-  // service's stop error (storage failed) once it stopped.
+  // Cheap when called often (looks at the service at most every 20 ms of wall-clock time). Ok
+  // while running; the service's stop error (storage failed) once it stopped, on every later call.
   Status Poll();
   bool stopped() const { return stopped_; }
   mission::RaftService& service() { return *service_; }
