@@ -17,8 +17,9 @@ namespace {
 
 using namespace std::chrono_literals;
 
-// A domain pair per process so parallel test runs never share a bus.
-int DomainBase() { return 100 + static_cast<int>(getpid() % 60) * 2; }
+// A domain pair per process so parallel test runs never share a bus (100-199: 200-215 are
+// agent_raft_test's).
+int DomainBase() { return 100 + static_cast<int>(getpid() % 50) * 2; }
 
 bool HasEvent(const std::string& log, const std::string& node, const std::string& event) {
   std::size_t start = 0;
