@@ -26,6 +26,8 @@ int RunCommand(const RunArgs& args) {
     std::cerr << "swarmbox run: " << client.error().ToString() << "\n";
     return kExitInfrastructure;
   }
+  // Before the (possibly long) image step, so a Ctrl-C there is not lost: the run then ends at once.
+  const std::atomic<bool>& interrupted = InstallInterruptHandlers();
   auto images = EnsureTrialImages(**client, args.programs, [&](std::string_view line) {
     if (!args.quiet) std::cerr << "  " << line << "\n";
   });
@@ -33,7 +35,6 @@ int RunCommand(const RunArgs& args) {
     std::cerr << "swarmbox run: " << images.error().ToString() << "\n";
     return kExitInfrastructure;
   }
-  const std::atomic<bool>& interrupted = InstallInterruptHandlers();
   runner::SteadyClock clock;
   runner::RunOptions options;
   options.out_dir = args.out;
