@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# SwarmBox quick start: set up the machine, build, build the registry-free images and run the
+# main demo trial in containers. The README's first command.
+#   bash scripts/quickstart.sh                 # trials/demo_flight.yaml, outputs in runs/
+#   bash scripts/quickstart.sh TRIAL.yaml      # another trial
+# The SAR trial (trials/sar_search.yaml) becomes the default once the agents run the mission.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+bash scripts/setup.sh
+
+BUILD_DIR=${BUILD_DIR:-build}
+TRIAL=${1:-trials/demo_flight.yaml}
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build "$BUILD_DIR" -j "$(nproc)" --target swarmbox swarmbox-physics swarmbox-agent
+
+swarmbox="$BUILD_DIR/orchestrator/cli/swarmbox"
+"$swarmbox" images
+exec "$swarmbox" run "$TRIAL" --out runs
