@@ -54,23 +54,33 @@ docker_answers() {
   curl -fsS --max-time 3 --unix-socket /var/run/docker.sock http://localhost/_ping >/dev/null 2>&1
 }
 
+wait_for() {  # wait_for SECONDS CONDITION...: polls every 0.5 s
+  local tries=$(( $1 * 2 )); shift
+  for _ in $(seq 1 "$tries"); do "$@" && return 0; sleep 0.5; done
+  "$@"
+}
+pidfile_alive() { [ -f /var/run/docker.pid ] && kill -0 "$(cat /var/run/docker.pid)" 2>/dev/null; }
+answers_or_gone() { docker_answers || ! pidfile_alive; }
+
 if ! docker_answers; then
   if [ -d /run/systemd/system ] && command -v systemctl >/dev/null 2>&1; then
     log "starting the Docker engine (systemctl start docker)"
     "${SUDO[@]}" systemctl start docker || die "systemctl start docker failed"
   else
-    log "starting the Docker engine (dockerd; log: /var/log/swarmbox-dockerd.log)"
-    # Leftover pid file from a dockerd that died with its machine session.
-    if [ -f /var/run/docker.pid ] && ! kill -0 "$(cat /var/run/docker.pid)" 2>/dev/null; then
-      "${SUDO[@]}" rm -f /var/run/docker.pid
+    # A dockerd that is still starting (or still shutting down) owns the pid file: let it finish.
+    if pidfile_alive; then
+      log "waiting for the running dockerd (pid $(cat /var/run/docker.pid))"
+      wait_for 60 answers_or_gone ||
+        die "dockerd (pid $(cat /var/run/docker.pid)) neither answers nor exits; stop it and retry"
     fi
-    "${SUDO[@]}" setsid dockerd >>/var/log/swarmbox-dockerd.log 2>&1 < /dev/null &
+    if ! docker_answers; then
+      log "starting the Docker engine (dockerd; log: /var/log/swarmbox-dockerd.log)"
+      # A pid file left by a dockerd that died with its machine session.
+      "${SUDO[@]}" rm -f /var/run/docker.pid
+      "${SUDO[@]}" setsid dockerd >>/var/log/swarmbox-dockerd.log 2>&1 < /dev/null &
+    fi
   fi
-  for _ in $(seq 1 60); do
-    docker_answers && break
-    sleep 0.5
-  done
-  docker_answers || { tail -n 20 /var/log/swarmbox-dockerd.log >&2 || true; die "the Docker engine did not answer on /var/run/docker.sock within 30 s"; }
+  wait_for 30 docker_answers || { tail -n 20 /var/log/swarmbox-dockerd.log >&2 || true; die "the Docker engine did not answer on /var/run/docker.sock within 30 s"; }
   log "Docker engine is up ($(docker version --format '{{.Server.Version}}' 2>/dev/null || echo unknown version))"
 fi
 
