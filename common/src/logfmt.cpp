@@ -142,14 +142,8 @@ LogfmtFields ParseLogfmt(std::string_view line) {
     }
     out.emplace_back(std::move(key), std::move(value));
   }
-  bool any_pair = false;
-  for (const auto& [k, v] : out) {
-    (void)v;
-    if (!k.empty()) any_pair = true;
-  }
-  // A line without a single k=v pair is not logfmt.
-  bool has_equals = line.find('=') != std::string_view::npos;
-  if (!any_pair || !has_equals) out.clear();
+  // A line without a single k=v pair is not logfmt (bare words alone are prose).
+  if (line.find('=') == std::string_view::npos) out.clear();
   return out;
 }
 
