@@ -1,19 +1,11 @@
 #include "swarmbox/raft/mission_command.hpp"
 
 #include "swarmbox/raft/detail/byte_io.hpp"
+#include "swarmbox/raft/detail/overloaded.hpp"
 
 namespace swarmbox::raft {
 
-namespace {
-
-template <class... Fs>
-struct Overloaded : Fs... {
-  using Fs::operator()...;
-};
-template <class... Fs>
-Overloaded(Fs...) -> Overloaded<Fs...>;
-
-}  // namespace
+using detail::Overloaded;
 
 std::string_view CommandName(const MissionCommand& command) {
   static constexpr std::string_view kNames[] = {

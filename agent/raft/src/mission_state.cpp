@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "swarmbox/raft/detail/byte_io.hpp"
+#include "swarmbox/raft/detail/overloaded.hpp"
 
 namespace swarmbox::raft {
 
@@ -29,12 +30,7 @@ std::string_view VictimStatusName(VictimStatus status) {
 
 namespace {
 
-template <class... Fs>
-struct Overloaded : Fs... {
-  using Fs::operator()...;
-};
-template <class... Fs>
-Overloaded(Fs...) -> Overloaded<Fs...>;
+using detail::Overloaded;
 
 bool Finite(double v) { return std::isfinite(v); }
 
