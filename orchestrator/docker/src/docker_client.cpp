@@ -50,6 +50,18 @@ std::string_view WaitConditionName(WaitCondition condition) {
 
 }  // namespace
 
+// Sends `call` and parses its body with `parse`; a parse error names the request and the engine.
+template <typename Parse>
+auto DockerClient::DoParsed(const Call& call, Parse parse) -> decltype(parse(std::string())) {
+  auto r = Do(call);
+  if (!r) return r.error();
+  auto parsed = parse(r->body);
+  if (!parsed) {
+    return At(parsed.error(), call.method + " " + call.path + " (" + transport_->endpoint() + ")");
+  }
+  return parsed;
+}
+
 std::string DefaultSocketPath() {
   const char* host = std::getenv("DOCKER_HOST");
   if (host != nullptr) {
@@ -127,11 +139,7 @@ Result<std::string> DockerClient::Ping() {
 Result<EngineVersion> DockerClient::Version() {
   Call call("GET", "/version");
   call.versioned = false;
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto v = ParseVersion(r->body);
-  if (!v) return At(v.error(), "GET /version (" + transport_->endpoint() + ")");
-  return v;
+  return DoParsed(call, [](const std::string& text) { return ParseVersion(text); });
 }
 
 // --- images ---------------------------------------------------------------------------------------
@@ -203,21 +211,13 @@ Result<BuildResult> DockerClient::BuildImage(const BuildRequest& request,
 
 Result<ImageInfo> DockerClient::InspectImage(std::string_view reference) {
   Call call("GET", "/images/" + std::string(reference) + "/json");
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto info = ParseImageInspect(r->body);
-  if (!info) return At(info.error(), "GET " + call.path + " (" + transport_->endpoint() + ")");
-  return info;
+  return DoParsed(call, [](const std::string& text) { return ParseImageInspect(text); });
 }
 
 Result<std::vector<ImageInfo>> DockerClient::ListImages(const LabelSelector& selector) {
   Call call("GET", "/images/json");
   call.query = "?filters=" + UrlEncode(FiltersJson(selector));
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto list = ParseImageList(r->body);
-  if (!list) return At(list.error(), "GET /images/json (" + transport_->endpoint() + ")");
-  return list;
+  return DoParsed(call, [](const std::string& text) { return ParseImageList(text); });
 }
 
 Status DockerClient::RemoveImage(std::string_view reference, bool force) {
@@ -234,30 +234,18 @@ Result<std::string> DockerClient::CreateNetwork(const NetworkSpec& spec) {
   call.content_type = "application/json";
   call.body = body;
   call.creating = true;
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto id = ParseIdResponse(r->body);
-  if (!id) return At(id.error(), "POST /networks/create (" + transport_->endpoint() + ")");
-  return id;
+  return DoParsed(call, [](const std::string& text) { return ParseIdResponse(text); });
 }
 
 Result<NetworkInfo> DockerClient::InspectNetwork(std::string_view id) {
   Call call("GET", "/networks/" + std::string(id));
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto info = ParseNetwork(r->body);
-  if (!info) return At(info.error(), "GET " + call.path + " (" + transport_->endpoint() + ")");
-  return info;
+  return DoParsed(call, [](const std::string& text) { return ParseNetwork(text); });
 }
 
 Result<std::vector<NetworkInfo>> DockerClient::ListNetworks(const LabelSelector& selector) {
   Call call("GET", "/networks");
   call.query = "?filters=" + UrlEncode(FiltersJson(selector));
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto list = ParseNetworkList(r->body);
-  if (!list) return At(list.error(), "GET /networks (" + transport_->endpoint() + ")");
-  return list;
+  return DoParsed(call, [](const std::string& text) { return ParseNetworkList(text); });
 }
 
 Status DockerClient::ConnectNetwork(const EndpointSpec& endpoint, std::string_view container_id) {
@@ -318,22 +306,14 @@ Result<std::string> DockerClient::CreateContainer(const ContainerSpec& spec) {
 
 Result<ContainerInfo> DockerClient::InspectContainer(std::string_view id) {
   Call call("GET", "/containers/" + std::string(id) + "/json");
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto info = ParseContainerInspect(r->body);
-  if (!info) return At(info.error(), "GET " + call.path + " (" + transport_->endpoint() + ")");
-  return info;
+  return DoParsed(call, [](const std::string& text) { return ParseContainerInspect(text); });
 }
 
 Result<std::vector<ContainerSummary>> DockerClient::ListContainers(const LabelSelector& selector,
                                                                    bool all) {
   Call call("GET", "/containers/json");
   call.query = std::string(all ? "?all=1&" : "?") + "filters=" + UrlEncode(FiltersJson(selector));
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto list = ParseContainerList(r->body);
-  if (!list) return At(list.error(), "GET /containers/json (" + transport_->endpoint() + ")");
-  return list;
+  return DoParsed(call, [](const std::string& text) { return ParseContainerList(text); });
 }
 
 Status DockerClient::StartContainer(std::string_view id) {
@@ -379,11 +359,7 @@ Result<std::int64_t> DockerClient::WaitContainer(std::string_view id, WaitCondit
   call.query = "?condition=" + std::string(WaitConditionName(condition));
   call.stream = true;
   call.cancel = cancel;
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto code = ParseWaitResponse(r->body);
-  if (!code) return At(code.error(), "POST " + call.path + " (" + transport_->endpoint() + ")");
-  return code;
+  return DoParsed(call, [](const std::string& text) { return ParseWaitResponse(text); });
 }
 
 Status DockerClient::RemoveContainer(std::string_view id, bool force, bool remove_volumes) {
@@ -448,11 +424,7 @@ Result<std::string> DockerClient::CreateExec(std::string_view container_id, cons
   Call call("POST", "/containers/" + std::string(container_id) + "/exec");
   call.content_type = "application/json";
   call.body = body;
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto id = ParseIdResponse(r->body);
-  if (!id) return At(id.error(), "POST " + call.path + " (" + transport_->endpoint() + ")");
-  return id;
+  return DoParsed(call, [](const std::string& text) { return ParseIdResponse(text); });
 }
 
 Status DockerClient::StartExec(std::string_view exec_id, const LogLineFn& on_line,
@@ -469,11 +441,7 @@ Status DockerClient::StartExec(std::string_view exec_id, const LogLineFn& on_lin
 
 Result<ExecState> DockerClient::InspectExec(std::string_view exec_id) {
   Call call("GET", "/exec/" + std::string(exec_id) + "/json");
-  auto r = Do(call);
-  if (!r) return r.error();
-  auto state = ParseExecInspect(r->body);
-  if (!state) return At(state.error(), "GET " + call.path + " (" + transport_->endpoint() + ")");
-  return state;
+  return DoParsed(call, [](const std::string& text) { return ParseExecInspect(text); });
 }
 
 // --- archive --------------------------------------------------------------------------------------

@@ -104,6 +104,9 @@ class DockerClient final : public DockerApi {
   Status Negotiate();
   Result<HttpResponse> Do(const Call& call);
   Status DoStatus(const Call& call);
+  // Do(), then `parse` (body -> Result<T>) with parse errors located at the request.
+  template <typename Parse>
+  auto DoParsed(const Call& call, Parse parse) -> decltype(parse(std::string()));
   // Streams a log-like body (logs, exec output) through a LogDemuxer.
   Status StreamLines(Call call, bool tty, const LogLineFn& on_line);
 
