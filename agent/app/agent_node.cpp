@@ -45,6 +45,20 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   }
   auto cfg = flight::LoadFlightConfig(o.airframe_path);
   if (!cfg) return cfg.error().Context("loading airframe");
+  if (o.mission.kind == MissionKind::kSar) {
+    if (o.raft.members.empty()) return Error(ErrorCode::kInvalidArgument, "--mission sar needs --members");
+    auto world = LoadWorldView(o.mission.world_path);
+    if (!world) return world.error();
+    if (!o.mission.payload.empty() &&
+        std::none_of(cfg->payloads.begin(), cfg->payloads.end(),
+                     [&](const flight::SlungPayload& p) { return p.name == o.mission.payload; })) {
+      std::string known;
+      for (const flight::SlungPayload& p : cfg->payloads) known += (known.empty() ? "" : ", ") + p.name;
+      return Error(ErrorCode::kInvalidArgument, "--payload '" + o.mission.payload + "': airframe " + cfg->airframe +
+                                                    " has " + (known.empty() ? std::string("no payloads") : "payloads " + known));
+    }
+    return Error(ErrorCode::kInvalidArgument, "--mission sar: the SAR mission is not hosted by this build yet");
+  }
   auto plan = FlightPlan::Parse(o.plan);
   if (!plan) return plan.error().Context("--plan");
   plan->SetPreflight(o.preflight_s);

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "flight_plan.hpp"
+#include "mission_options.hpp"
 #include "raft_host.hpp"
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/logfmt.hpp"
@@ -52,6 +53,8 @@ struct AgentOptions {
   // Raft on the mesh (raft_host.hpp): on when raft.members is not empty (needs `mesh`).
   // raft.self is set from `name`.
   RaftHostOptions raft;
+  // What to fly (mission_options.hpp): the plan above, or the SAR mission (needs raft.members).
+  MissionOptions mission;
 };
 
 class AgentNode {

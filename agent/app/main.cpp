@@ -14,6 +14,12 @@
 //                                   every N wall ms (0 = never), until the mission layer does
 // Raft events (event=leader_elected, mission_state, victim_confirmed, raft_stopped) are printed
 // on stdout with the agent's simulated time `t`. The mesh domain must differ from the sim one.
+//
+// What it flies (mission_options.hpp): --mission plan (default) flies --plan; --mission sar flies
+// the SAR mission (mission_host.hpp) and needs --members and --world:
+//       --mission sar --world trials/worlds/open_field.yaml [--payload stretcher]
+//       [--inference-latency-ms 40]
+// Usage errors (unknown flag, bad value, a bad combination) exit 2, as the rest of bad input.
 #include <CLI/CLI.hpp>
 
 #include <csignal>
@@ -21,6 +27,7 @@
 #include <string>
 
 #include "agent_node.hpp"
+#include "mission_options.hpp"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
@@ -57,7 +64,21 @@ int main(int argc, char** argv) {
   app.add_option("--raft-heartbeat-ms", o.raft.heartbeat_ms, "Raft: heartbeat, a multiple of the tick [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--raft-election-timeout-ms", o.raft.election_timeout_ms, "Raft: election timeout, a multiple of the tick, > heartbeat [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--propose-every-ms", o.raft.propose_every_ms, "Raft diagnostic: the leader proposes a demo mission command every N ms (0 = never)")->check(CLI::NonNegativeNumber)->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  std::string mission_kind = "plan";
+  app.add_option("--mission", mission_kind, "What to fly: plan (the built-in --plan) or sar (the SAR mission; needs --members and --world)")->capture_default_str();
+  app.add_option("--world", o.mission.world_path, "SAR: the world file (only its geofence and home are read)");
+  app.add_option("--payload", o.mission.payload, "SAR: this drone's airframe payload NAME lies on the ground under it (the lifter)");
+  app.add_option("--inference-latency-ms", o.mission.inference_latency_ms, "SAR: simulated perception latency [ms]")->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    (void)app.exit(e);  // prints the message and the usage hint
+    return 2;           // bad usage (ARCHITECTURE.md exit codes), not CLI11's own codes
+  }
 
   o.mesh = !no_mesh;
   o.swing_damping = !no_damping;
@@ -81,6 +102,16 @@ int main(int argc, char** argv) {
     }
     o.raft.members = std::move(*list);
     if (o.raft.raft_dir.empty()) o.raft.raft_dir = swarmbox::agent::DefaultRaftDir(o.name);
+  }
+  if (auto kind = swarmbox::agent::ParseMissionKind(mission_kind)) {
+    o.mission.kind = *kind;
+  } else {
+    std::fprintf(stderr, "swarmbox-agent: %s\n", kind.error().ToString().c_str());
+    return 2;
+  }
+  if (swarmbox::Status s = swarmbox::agent::ValidateMissionOptions(o.mission, !o.raft.members.empty(), app.count("--plan") > 0); !s) {
+    std::fprintf(stderr, "swarmbox-agent: %s\n", s.error().ToString().c_str());
+    return 2;
   }
   o.stop = &g_stop;
   std::signal(SIGTERM, OnSignal);
