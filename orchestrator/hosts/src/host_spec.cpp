@@ -1,0 +1,191 @@
+#include "swarmbox/hosts/host_spec.hpp"
+
+#include <charconv>
+
+namespace swarmbox::hosts {
+
+namespace {
+
+constexpr std::string_view kForms =
+    "expected local[?slots=N] or ssh://[user@]host[:port][?slots=N&socket=PATH&identity=KEY&"
+    "known_hosts=FILE]";
+
+Error Bad(std::string_view text, const std::string& why) {
+  return Error(ErrorCode::kInvalidArgument,
+               "host '" + std::string(text) + "': " + why + " (" + std::string(kForms) + ")",
+               "--hosts");
+}
+
+bool ParseInt(std::string_view s, int* out) {
+  const char* end = s.data() + s.size();
+  auto [p, ec] = std::from_chars(s.data(), end, *out);
+  return ec == std::errc() && p == end;
+}
+
+bool Contains(std::string_view hay, std::string_view needle) {
+  return hay.find(needle) != std::string_view::npos;
+}
+
+}  // namespace
+
+std::string HostSpec::name() const {
+  if (kind == Kind::kLocal) return "local";
+  std::string n = user.empty() ? host : user + "@" + host;
+  if (port != 22) n += ":" + std::to_string(port);
+  return n;
+}
+
+Result<HostSpec> ParseHostSpec(std::string_view text) {
+  HostSpec spec;
+  spec.text = std::string(text);
+  std::string_view main = text;
+  std::string_view query;
+  if (auto q = text.find('?'); q != std::string_view::npos) {
+    main = text.substr(0, q);
+    query = text.substr(q + 1);
+  }
+  if (main == "local") {
+    spec.kind = HostSpec::Kind::kLocal;
+  } else if (main.substr(0, 6) == "ssh://") {
+    spec.kind = HostSpec::Kind::kSsh;
+    spec.socket = std::string(kDefaultRemoteSocket);
+    std::string_view rest = main.substr(6);
+    if (auto at = rest.find('@'); at != std::string_view::npos) {
+      spec.user = std::string(rest.substr(0, at));
+      rest = rest.substr(at + 1);
+      if (spec.user.empty()) return Bad(text, "empty user name");
+    }
+    if (auto colon = rest.rfind(':'); colon != std::string_view::npos && rest.front() != '[') {
+      if (!ParseInt(rest.substr(colon + 1), &spec.port) || spec.port < 1 || spec.port > 65535) {
+        return Bad(text, "bad port '" + std::string(rest.substr(colon + 1)) + "'");
+      }
+      rest = rest.substr(0, colon);
+    }
+    if (rest.empty() || rest.find('/') != std::string_view::npos) {
+      return Bad(text, "missing or bad host name");
+    }
+    spec.host = std::string(rest);
+  } else {
+    return Bad(text, "unknown kind of host");
+  }
+  while (!query.empty()) {
+    const auto amp = query.find('&');
+    std::string_view kv = query.substr(0, amp);
+    query = amp == std::string_view::npos ? std::string_view() : query.substr(amp + 1);
+    const auto eq = kv.find('=');
+    if (eq == std::string_view::npos) return Bad(text, "option '" + std::string(kv) + "' needs =value");
+    const std::string_view key = kv.substr(0, eq);
+    const std::string value(kv.substr(eq + 1));
+    if (key == "slots") {
+      if (!ParseInt(value, &spec.slots) || spec.slots < 1 || spec.slots > 64) {
+        return Bad(text, "slots must be 1..64, got '" + value + "'");
+      }
+    } else if (key == "socket") {
+      if (value.empty() || value.front() != '/') return Bad(text, "socket must be an absolute path");
+      spec.socket = value;
+    } else if (key == "identity" && spec.kind == HostSpec::Kind::kSsh) {
+      spec.identity = value;
+    } else if (key == "known_hosts" && spec.kind == HostSpec::Kind::kSsh) {
+      spec.known_hosts = value;
+    } else {
+      return Bad(text, "unknown option '" + std::string(key) + "'");
+    }
+  }
+  return spec;
+}
+
+Result<std::vector<HostSpec>> ParseHostSpecs(const std::vector<std::string>& texts) {
+  std::vector<HostSpec> out;
+  for (const std::string& arg : texts) {
+    std::string_view rest = arg;
+    while (!rest.empty()) {
+      const auto comma = rest.find(',');
+      std::string_view one = rest.substr(0, comma);
+      rest = comma == std::string_view::npos ? std::string_view() : rest.substr(comma + 1);
+      if (one.empty()) continue;
+      auto spec = ParseHostSpec(one);
+      if (!spec) return spec.error();
+      for (const HostSpec& other : out) {
+        if (other.name() == spec->name() && other.socket == spec->socket) {
+          return Bad(one, "given twice (use ?slots=N for parallel trials on one host)");
+        }
+      }
+      out.push_back(std::move(*spec));
+    }
+  }
+  if (out.empty()) return Bad("", "no hosts given");
+  return out;
+}
+
+std::vector<std::string> SshTunnelArgv(const HostSpec& spec, const std::string& local_socket,
+                                       const std::string& control_dir) {
+  std::vector<std::string> argv = {"ssh", "-N", "-o", "BatchMode=yes", "-o",
+                                   "StrictHostKeyChecking=yes"};
+  if (!spec.known_hosts.empty()) {
+    argv.insert(argv.end(), {"-o", "UserKnownHostsFile=" + spec.known_hosts});
+  }
+  if (!spec.identity.empty()) {
+    argv.insert(argv.end(), {"-i", spec.identity, "-o", "IdentitiesOnly=yes"});
+  }
+  argv.insert(argv.end(), {"-o", "ExitOnForwardFailure=yes", "-o", "StreamLocalBindUnlink=yes",
+                           "-o", "ControlMaster=auto", "-o", "ControlPath=" + control_dir + "/cm-%C",
+                           "-o", "ControlPersist=no", "-o", "ServerAliveInterval=5", "-o",
+                           "ServerAliveCountMax=3", "-o", "ConnectTimeout=10", "-p",
+                           std::to_string(spec.port), "-L", local_socket + ":" + spec.socket,
+                           spec.user.empty() ? spec.host : spec.user + "@" + spec.host});
+  return argv;
+}
+
+Error ClassifySshFailure(const HostSpec& spec, std::string_view err, int exit_code) {
+  const std::string who = spec.name();
+  const std::string tail = err.empty() ? std::string() : " [ssh: " + std::string(err.substr(0, 400)) + "]";
+  if (Contains(err, "REMOTE HOST IDENTIFICATION HAS CHANGED")) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "the host key of " + who + " changed: check the host, then fix known_hosts" + tail,
+                 "ssh");
+  }
+  if (Contains(err, "Host key verification failed") || Contains(err, "No ED25519 host key") ||
+      Contains(err, "host key for") ) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "the host key of " + who + " is not in " +
+                     (spec.known_hosts.empty() ? std::string("~/.ssh/known_hosts")
+                                               : spec.known_hosts) +
+                     " (host keys are always checked: add it, e.g. ssh-keyscan -p " +
+                     std::to_string(spec.port) + " " + spec.host + " after checking it)" + tail,
+                 "ssh");
+  }
+  if (Contains(err, "Permission denied (") || Contains(err, "Too many authentication failures")) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "ssh authentication to " + who + " was refused (key-only, BatchMode: is the key " +
+                     (spec.identity.empty() ? std::string("in ~/.ssh or the agent")
+                                            : spec.identity) +
+                     " authorised for this user?)" + tail,
+                 "ssh");
+  }
+  if (Contains(err, "open failed") || Contains(err, "connect failed")) {
+    const bool perm = Contains(err, "Permission denied") || Contains(err, "prohibited");
+    return Error(ErrorCode::kInvalidArgument,
+                 perm ? "the remote Docker socket " + spec.socket + " on " + who +
+                            " cannot be opened by this user (permission denied: add the user to "
+                            "the docker group, or allow stream-local forwarding in sshd)" + tail
+                      : "the remote Docker socket " + spec.socket + " on " + who +
+                            " does not answer (is dockerd running there?)" + tail,
+                 "ssh");
+  }
+  if (Contains(err, "Could not resolve hostname") || Contains(err, "No route to host") ||
+      Contains(err, "Connection refused") || Contains(err, "timed out") ||
+      Contains(err, "Network is unreachable") || Contains(err, "Connection closed") ||
+      Contains(err, "Broken pipe") || Contains(err, "Connection reset")) {
+    return Error(ErrorCode::kUnavailable, "cannot reach " + who + " over ssh" + tail, "ssh");
+  }
+  if (exit_code == 127) {
+    return Error(ErrorCode::kNotFound, "the ssh client is not installed (openssh-client)", "ssh");
+  }
+  return Error(ErrorCode::kUnavailable,
+               "ssh to " + who + " failed" +
+                   (exit_code >= 0 ? " (exit " + std::to_string(exit_code) + ")" : std::string()) +
+                   tail,
+               "ssh");
+}
+
+}  // namespace swarmbox::hosts

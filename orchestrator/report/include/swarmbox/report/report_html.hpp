@@ -1,0 +1,38 @@
+// report.html: a self-contained page (inline CSS and SVG, no scripts, no external files except
+// each trial's own trajectories.png, linked relative to the experiment folder). Pure.
+//
+//   1. totals: trials per outcome;
+//   2. per factor, outcome counts per level;
+//   3. per metric with at least one value, per factor, a box plot per level (Tukey: box = quartiles,
+//      whiskers to the furthest points within 1.5 IQR, points beyond drawn as outliers; n under
+//      each box);
+//   4. a table of every trial (levels, seed, host, outcome, reason, times) linking its folder,
+//      logs and trajectories.png.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "swarmbox/report/trial_record.hpp"
+
+namespace swarmbox::report {
+
+struct BoxStats {
+  std::size_t n = 0;
+  double min = 0, q1 = 0, median = 0, q3 = 0, max = 0;
+  double whisker_low = 0, whisker_high = 0;  // furthest points within 1.5 IQR of the box
+  std::vector<double> outliers;
+};
+
+// Quartiles by linear interpolation between order statistics (type 7, as R and numpy default).
+// n == 0 gives all zeros.
+BoxStats ComputeBoxStats(std::vector<double> values);
+
+// HTML escaping of text and attribute values.
+std::string HtmlEscape(std::string_view text);
+
+std::string ReportHtml(std::string_view title, const std::vector<std::string>& factors,
+                       const std::vector<TrialRecord>& records);
+
+}  // namespace swarmbox::report

@@ -1,0 +1,81 @@
+// Per-trial metrics for results.csv and report.html, computed from what a trial left in its
+// folder (pure: feed events and truth rows, read Values()).
+//
+// Every metric is optional: a trial whose logs have no event a metric needs gets an empty cell,
+// never an invented value.
+//   mission_time_s        t of the first event=mission_complete
+//   first_detection_s     t of the first victim_detected / victim_confirmed / sighting_reported
+//   detections            distinct victims detected or confirmed (`victim` field; events without
+//                         one count one each); empty when the trial logged no perception event
+//                         and no mission_state
+//   victims_confirmed     distinct victims in victim_confirmed events (same rule)
+//   min_separation_m      smallest 3-D distance between two drones at the same truth.csv time
+//                         (needs >= 2 drones)
+//   collisions            event=collision count (0 when the physics log is there)
+//   leader_changes        times the elected leader differed from the previous term's leader
+//                         (distinct (term, leader) pairs of event=leader_elected, in term order)
+//   failover_s            longest time from losing the leader (the leader's node logging
+//                         raft_stopped/stopped/crash, or a fault event targeting it) to the next
+//                         leader_elected
+//   radio_rtt_ms          mean of rtt_ms_mean over event=link lines
+//   radio_loss            mean of loss over event=link lines
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "swarmbox/common/logfmt.hpp"
+
+namespace swarmbox::report {
+
+// The metric columns, in results.csv order.
+const std::vector<std::string>& MetricNames();
+
+using MetricValues = std::map<std::string, std::optional<double>>;
+
+class TrialMetrics {
+ public:
+  // One logfmt line of `component`'s log (lines without `event` are ignored).
+  void OnLogEvent(std::string_view component, const LogfmtFields& fields);
+  // One orchestrator record from events.jsonl (component "orchestrator" or a fault injector):
+  // `event`, `target`, and the wall/sim time it happened at (`t_s`, simulated when known).
+  void OnOrchestratorEvent(std::string_view event, std::string_view target, std::optional<double> t_s);
+  // One truth.csv sample.
+  void OnTruth(double t_s, std::string_view drone, double x_m, double y_m, double z_m);
+  // Says that the physics server's log was read (collisions are then 0, not unknown).
+  void SawPhysicsLog() { physics_log_ = true; }
+
+  MetricValues Values();
+
+ private:
+  void FlushTruthTime();
+
+  std::optional<double> mission_time_s_;
+  std::optional<double> first_detection_s_;
+  bool perception_seen_ = false;
+  std::set<std::string> detected_;
+  std::set<std::string> confirmed_;
+  std::uint64_t anonymous_detections_ = 0;
+  std::uint64_t anonymous_confirmed_ = 0;
+  bool physics_log_ = false;
+  std::uint64_t collisions_ = 0;
+  // leader_elected: term -> (t, leader)
+  std::map<std::int64_t, std::pair<double, std::string>> terms_;
+  std::vector<std::pair<double, std::string>> leader_losses_;  // (t, node that stopped)
+  double link_rtt_sum_ = 0;
+  std::uint64_t link_rtt_n_ = 0;
+  double link_loss_sum_ = 0;
+  std::uint64_t link_loss_n_ = 0;
+  // truth: samples of the current time step
+  std::optional<double> truth_t_;
+  std::vector<std::array<double, 3>> truth_points_;
+  std::optional<double> min_sep_;
+};
+
+}  // namespace swarmbox::report

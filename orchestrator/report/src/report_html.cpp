@@ -1,0 +1,248 @@
+#include "swarmbox/report/report_html.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "swarmbox/report/results_csv.hpp"
+
+namespace swarmbox::report {
+
+namespace {
+
+const std::vector<std::string>& Outcomes() {
+  static const std::vector<std::string> k = {"success", "failure", "timeout", "error"};
+  return k;
+}
+
+std::string Fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
+double Quantile(const std::vector<double>& sorted, double q) {
+  if (sorted.empty()) return 0;
+  const double pos = q * static_cast<double>(sorted.size() - 1);
+  const auto lo = static_cast<std::size_t>(std::floor(pos));
+  const auto hi = std::min(lo + 1, sorted.size() - 1);
+  const double frac = pos - static_cast<double>(lo);
+  return sorted[lo] + (sorted[hi] - sorted[lo]) * frac;
+}
+
+// Levels of factor i in the order first seen in code order.
+std::vector<std::pair<char, std::string>> LevelsOf(const std::vector<TrialRecord>& records,
+                                                   std::size_t i) {
+  std::map<char, std::string> by_code;
+  for (const TrialRecord& r : records) {
+    if (i < r.meta.code.size() && i < r.meta.levels.size()) by_code[r.meta.code[i]] = r.meta.levels[i];
+  }
+  return {by_code.begin(), by_code.end()};
+}
+
+std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxes) {
+  constexpr double kW = 110, kH = 220, kTop = 14, kBottom = 40, kLeft = 56;
+  double lo = 0, hi = 0;
+  bool any = false;
+  for (const auto& [label, b] : boxes) {
+    if (b.n == 0) continue;
+    lo = any ? std::min(lo, b.min) : b.min;
+    hi = any ? std::max(hi, b.max) : b.max;
+    any = true;
+  }
+  if (hi - lo < 1e-12) {
+    hi += 0.5 + std::abs(hi) * 0.05;
+    lo -= 0.5 + std::abs(lo) * 0.05;
+  }
+  const double pad = (hi - lo) * 0.05;
+  lo -= pad;
+  hi += pad;
+  const double width = kLeft + kW * static_cast<double>(boxes.size()) + 10;
+  const double plot_h = kH - kTop - kBottom;
+  auto y = [&](double v) { return kTop + (hi - v) / (hi - lo) * plot_h; };
+  std::string s = "<svg xmlns='http://www.w3.org/2000/svg' width='" + Fmt(width) + "' height='" +
+                  Fmt(kH) + "' class='box'>";
+  for (int k = 0; k <= 4; ++k) {
+    const double v = lo + (hi - lo) * k / 4.0;
+    s += "<line x1='" + Fmt(kLeft - 4) + "' x2='" + Fmt(width - 10) + "' y1='" + Fmt(y(v)) +
+         "' y2='" + Fmt(y(v)) + "' class='grid'/><text x='" + Fmt(kLeft - 6) + "' y='" +
+         Fmt(y(v) + 4) + "' text-anchor='end'>" + Fmt(v) + "</text>";
+  }
+  for (std::size_t i = 0; i < boxes.size(); ++i) {
+    const auto& [label, b] = boxes[i];
+    const double cx = kLeft + kW * (static_cast<double>(i) + 0.5);
+    s += "<text x='" + Fmt(cx) + "' y='" + Fmt(kH - kBottom + 16) + "' text-anchor='middle'>" +
+         HtmlEscape(label) + "</text><text x='" + Fmt(cx) + "' y='" + Fmt(kH - kBottom + 32) +
+         "' text-anchor='middle' class='n'>n=" + std::to_string(b.n) + "</text>";
+    if (b.n == 0) continue;
+    const double bw = 36;
+    s += "<line x1='" + Fmt(cx) + "' x2='" + Fmt(cx) + "' y1='" + Fmt(y(b.whisker_low)) +
+         "' y2='" + Fmt(y(b.whisker_high)) + "' class='whisker'/>";
+    for (double w : {b.whisker_low, b.whisker_high}) {
+      s += "<line x1='" + Fmt(cx - bw / 4) + "' x2='" + Fmt(cx + bw / 4) + "' y1='" + Fmt(y(w)) +
+           "' y2='" + Fmt(y(w)) + "' class='whisker'/>";
+    }
+    s += "<rect x='" + Fmt(cx - bw / 2) + "' y='" + Fmt(y(b.q3)) + "' width='" + Fmt(bw) +
+         "' height='" + Fmt(std::max(1.0, y(b.q1) - y(b.q3))) + "' class='iqr'><title>" +
+         HtmlEscape(label) + ": n=" + std::to_string(b.n) + " min " + Fmt(b.min) + " q1 " +
+         Fmt(b.q1) + " median " + Fmt(b.median) + " q3 " + Fmt(b.q3) + " max " + Fmt(b.max) +
+         "</title></rect>";
+    s += "<line x1='" + Fmt(cx - bw / 2) + "' x2='" + Fmt(cx + bw / 2) + "' y1='" +
+         Fmt(y(b.median)) + "' y2='" + Fmt(y(b.median)) + "' class='median'/>";
+    for (double o : b.outliers) {
+      s += "<circle cx='" + Fmt(cx) + "' cy='" + Fmt(y(o)) + "' r='3' class='outlier'/>";
+    }
+  }
+  return s + "</svg>";
+}
+
+}  // namespace
+
+BoxStats ComputeBoxStats(std::vector<double> values) {
+  BoxStats b;
+  values.erase(std::remove_if(values.begin(), values.end(),
+                              [](double v) { return !std::isfinite(v); }),
+               values.end());
+  b.n = values.size();
+  if (values.empty()) return b;
+  std::sort(values.begin(), values.end());
+  b.min = values.front();
+  b.max = values.back();
+  b.q1 = Quantile(values, 0.25);
+  b.median = Quantile(values, 0.5);
+  b.q3 = Quantile(values, 0.75);
+  const double iqr = b.q3 - b.q1;
+  const double low_fence = b.q1 - 1.5 * iqr;
+  const double high_fence = b.q3 + 1.5 * iqr;
+  b.whisker_low = b.q1;
+  b.whisker_high = b.q3;
+  for (double v : values) {
+    if (v < low_fence || v > high_fence) {
+      b.outliers.push_back(v);
+    } else {
+      b.whisker_low = std::min(b.whisker_low, v);
+      b.whisker_high = std::max(b.whisker_high, v);
+    }
+  }
+  return b;
+}
+
+std::string HtmlEscape(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+std::string ReportHtml(std::string_view title, const std::vector<std::string>& factors,
+                       const std::vector<TrialRecord>& records) {
+  std::string h =
+      "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" + HtmlEscape(title) +
+      "</title>\n<style>body{font-family:sans-serif;margin:2em;color:#222}"
+      "table{border-collapse:collapse;margin:.5em 0 1.5em}td,th{border:1px solid #ccc;"
+      "padding:3px 8px;text-align:left;font-size:13px}th{background:#f3f3f3}"
+      ".success{color:#1a7f37}.failure{color:#b42318}.timeout{color:#b54708}.error{color:#6941c6}"
+      "svg.box text{font-size:11px;fill:#333}svg.box .n{fill:#777}.grid{stroke:#eee}"
+      ".whisker{stroke:#555}.iqr{fill:#cfe2ff;stroke:#1f4e9c}.median{stroke:#1f4e9c;"
+      "stroke-width:2}.outlier{fill:none;stroke:#b42318}.plots{display:flex;flex-wrap:wrap;"
+      "gap:1.5em}.plots figure{margin:0}figcaption{font-size:13px;color:#555}"
+      "img.thumb{width:90px;height:90px;object-fit:contain;border:1px solid #ddd}</style>"
+      "</head><body>\n<h1>" + HtmlEscape(title) + "</h1>\n";
+
+  std::map<std::string, int> totals;
+  for (const TrialRecord& r : records) totals[r.outcome] += 1;
+  h += "<p>" + std::to_string(records.size()) + " trials:";
+  for (const std::string& o : Outcomes()) {
+    h += " <span class='" + o + "'>" + o + " " + std::to_string(totals[o]) + "</span>";
+  }
+  h += "</p>\n<h2>Outcomes per factor level</h2>\n";
+  for (std::size_t i = 0; i < factors.size(); ++i) {
+    h += "<table><tr><th>" + HtmlEscape(factors[i]) + "</th>";
+    for (const std::string& o : Outcomes()) h += "<th class='" + o + "'>" + o + "</th>";
+    h += "</tr>";
+    for (const auto& [code, label] : LevelsOf(records, i)) {
+      std::map<std::string, int> counts;
+      for (const TrialRecord& r : records) {
+        if (i < r.meta.code.size() && r.meta.code[i] == code) counts[r.outcome] += 1;
+      }
+      h += "<tr><td>" + std::string(1, code) + ": " + HtmlEscape(label) + "</td>";
+      for (const std::string& o : Outcomes()) h += "<td>" + std::to_string(counts[o]) + "</td>";
+      h += "</tr>";
+    }
+    h += "</table>\n";
+  }
+
+  h += "<h2>Metrics per factor level</h2>\n";
+  bool any_metric = false;
+  std::vector<std::string> metrics = {"wall_s", "sim_s"};
+  metrics.insert(metrics.end(), MetricNames().begin(), MetricNames().end());
+  for (const std::string& m : metrics) {
+    auto value = [&](const TrialRecord& r) -> std::optional<double> {
+      if (m == "wall_s") return r.wall_s;
+      if (m == "sim_s") return r.sim_s;
+      auto it = r.metrics.find(m);
+      return it == r.metrics.end() ? std::nullopt : it->second;
+    };
+    if (std::none_of(records.begin(), records.end(),
+                     [&](const TrialRecord& r) { return value(r).has_value(); })) {
+      continue;
+    }
+    any_metric = true;
+    h += "<h3>" + HtmlEscape(m) + "</h3><div class='plots'>";
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      std::vector<std::pair<std::string, BoxStats>> boxes;
+      for (const auto& [code, label] : LevelsOf(records, i)) {
+        std::vector<double> values;
+        for (const TrialRecord& r : records) {
+          if (i < r.meta.code.size() && r.meta.code[i] == code) {
+            if (auto v = value(r)) values.push_back(*v);
+          }
+        }
+        boxes.emplace_back(label, ComputeBoxStats(std::move(values)));
+      }
+      h += "<figure>" + BoxPlotSvg(boxes) + "<figcaption>" + HtmlEscape(m) + " by " +
+           HtmlEscape(factors[i]) + "</figcaption></figure>";
+    }
+    h += "</div>\n";
+  }
+  if (!any_metric) h += "<p>No trial reported a metric.</p>\n";
+
+  h += "<h2>Trials</h2>\n<table><tr><th>trial</th><th>code</th>";
+  for (const std::string& f : factors) h += "<th>" + HtmlEscape(f) + "</th>";
+  h += "<th>rep</th><th>seed</th><th>host</th><th>outcome</th><th>reason</th><th>wall s</th>"
+       "<th>sim s</th><th>trajectories</th></tr>\n";
+  for (const TrialRecord& r : records) {
+    const std::string folder = HtmlEscape(r.folder);
+    h += "<tr><td><a href='" + folder + "/'>" + HtmlEscape(r.meta.id) + "</a> (<a href='" +
+         folder + "/logs/'>logs</a>, <a href='" + folder + "/result.json'>result</a>)</td><td>" +
+         HtmlEscape(r.meta.code) + "</td>";
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      h += "<td>" + (i < r.meta.levels.size() ? HtmlEscape(r.meta.levels[i]) : "") + "</td>";
+    }
+    h += "<td>" + std::to_string(r.meta.repetition) + "</td><td>" + std::to_string(r.meta.seed) +
+         "</td><td>" + HtmlEscape(r.host) + "</td><td class='" + HtmlEscape(r.outcome) + "'>" +
+         HtmlEscape(r.outcome) + "</td><td>" + HtmlEscape(r.reason) + "</td><td>" +
+         (r.wall_s ? CsvNumber(*r.wall_s) : "") + "</td><td>" +
+         (r.sim_s ? CsvNumber(*r.sim_s) : "") + "</td><td>";
+    if (r.has_trajectories) {
+      h += "<a href='" + folder + "/trajectories.png'><img class='thumb' loading='lazy' src='" +
+           folder + "/trajectories.png' alt='trajectories of " + HtmlEscape(r.meta.id) + "'></a>";
+    } else {
+      h += "none";
+    }
+    h += "</td></tr>\n";
+  }
+  h += "</table>\n</body></html>\n";
+  return h;
+}
+
+}  // namespace swarmbox::report

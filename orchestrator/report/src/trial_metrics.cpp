@@ -1,0 +1,153 @@
+#include "swarmbox/report/trial_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::report {
+
+namespace {
+
+std::optional<double> Number(const LogfmtFields& fields, std::string_view key) {
+  if (auto v = FindField(fields, key)) return yaml::ScalarAsDouble(*v);
+  return std::nullopt;
+}
+
+void KeepMin(std::optional<double>& slot, double v) {
+  if (!slot || v < *slot) slot = v;
+}
+
+}  // namespace
+
+const std::vector<std::string>& MetricNames() {
+  static const std::vector<std::string> kNames = {
+      "mission_time_s", "first_detection_s", "detections",   "victims_confirmed",
+      "min_separation_m", "collisions",       "leader_changes", "failover_s",
+      "radio_rtt_ms",   "radio_loss"};
+  return kNames;
+}
+
+void TrialMetrics::OnLogEvent(std::string_view component, const LogfmtFields& fields) {
+  const auto event = FindField(fields, "event");
+  if (!event) return;
+  const std::optional<double> t = Number(fields, "t");
+  const std::string node = FindField(fields, "node").value_or(std::string(component));
+  const std::string& e = *event;
+  if (e == "mission_complete") {
+    if (t) KeepMin(mission_time_s_, *t);
+  } else if (e == "victim_detected" || e == "victim_confirmed" || e == "sighting_reported") {
+    perception_seen_ = true;
+    if (t) KeepMin(first_detection_s_, *t);
+    const auto victim = FindField(fields, "victim");
+    if (victim) {
+      detected_.insert(*victim);
+      if (e == "victim_confirmed") confirmed_.insert(*victim);
+    } else {
+      ++anonymous_detections_;
+      if (e == "victim_confirmed") ++anonymous_confirmed_;
+    }
+  } else if (e == "mission_state") {
+    perception_seen_ = true;  // the mission runs: zero detections is then a real zero
+  } else if (e == "collision") {
+    ++collisions_;
+  } else if (e == "leader_elected") {
+    const auto term = Number(fields, "term");
+    const auto leader = FindField(fields, "leader");
+    if (term && leader && t) {
+      const auto key = static_cast<std::int64_t>(*term);
+      auto it = terms_.find(key);
+      if (it == terms_.end() || *t < it->second.first) terms_[key] = {*t, *leader};
+    }
+  } else if (e == "raft_stopped" || e == "stopped" || e == "crash") {
+    if (t) leader_losses_.emplace_back(*t, node);
+  } else if (e == "link") {
+    if (auto rtt = Number(fields, "rtt_ms_mean"); rtt && std::isfinite(*rtt)) {
+      link_rtt_sum_ += *rtt;
+      ++link_rtt_n_;
+    }
+    if (auto loss = Number(fields, "loss"); loss && std::isfinite(*loss)) {
+      link_loss_sum_ += *loss;
+      ++link_loss_n_;
+    }
+  }
+}
+
+void TrialMetrics::OnOrchestratorEvent(std::string_view event, std::string_view target,
+                                       std::optional<double> t_s) {
+  if (!t_s) return;
+  const bool fault = event.find("fault") != std::string_view::npos || event == "kill" ||
+                     event == "stop" || event == "pause";
+  if (fault && !target.empty()) leader_losses_.emplace_back(*t_s, std::string(target));
+}
+
+void TrialMetrics::OnTruth(double t_s, std::string_view /*drone*/, double x_m, double y_m,
+                           double z_m) {
+  if (truth_t_ && *truth_t_ != t_s) FlushTruthTime();
+  truth_t_ = t_s;
+  truth_points_.push_back({x_m, y_m, z_m});
+}
+
+void TrialMetrics::FlushTruthTime() {
+  for (std::size_t i = 0; i < truth_points_.size(); ++i) {
+    for (std::size_t j = i + 1; j < truth_points_.size(); ++j) {
+      const double dx = truth_points_[i][0] - truth_points_[j][0];
+      const double dy = truth_points_[i][1] - truth_points_[j][1];
+      const double dz = truth_points_[i][2] - truth_points_[j][2];
+      KeepMin(min_sep_, std::sqrt(dx * dx + dy * dy + dz * dz));
+    }
+  }
+  truth_points_.clear();
+}
+
+MetricValues TrialMetrics::Values() {
+  FlushTruthTime();
+  MetricValues v;
+  for (const std::string& name : MetricNames()) v[name] = std::nullopt;
+  v["mission_time_s"] = mission_time_s_;
+  v["first_detection_s"] = first_detection_s_;
+  if (perception_seen_) {
+    v["detections"] = static_cast<double>(detected_.size() + anonymous_detections_);
+    v["victims_confirmed"] = static_cast<double>(confirmed_.size() + anonymous_confirmed_);
+  }
+  v["min_separation_m"] = min_sep_;
+  if (physics_log_ || collisions_ > 0) v["collisions"] = static_cast<double>(collisions_);
+  if (!terms_.empty()) {
+    int changes = 0;
+    const std::string* previous = nullptr;
+    for (const auto& [term, tl] : terms_) {
+      if (previous != nullptr && *previous != tl.second) ++changes;
+      previous = &tl.second;
+    }
+    v["leader_changes"] = changes;
+
+    // Failover: from a loss of the then-current leader to the next election after it.
+    std::sort(leader_losses_.begin(), leader_losses_.end());
+    std::optional<double> longest;
+    for (const auto& [t_loss, node] : leader_losses_) {
+      const std::string* leader = nullptr;
+      double elected_at = -1;
+      for (const auto& [term, tl] : terms_) {
+        if (tl.first <= t_loss && tl.first >= elected_at) {
+          leader = &tl.second;
+          elected_at = tl.first;
+        }
+      }
+      if (leader == nullptr || (*leader != node && node != "raft_leader")) continue;
+      std::optional<double> next;
+      for (const auto& [term, tl] : terms_) {
+        if (tl.first > t_loss && tl.second != node) KeepMin(next, tl.first);
+      }
+      if (next) {
+        const double d = *next - t_loss;
+        if (!longest || d > *longest) longest = d;
+      }
+    }
+    v["failover_s"] = longest;
+  }
+  if (link_rtt_n_ > 0) v["radio_rtt_ms"] = link_rtt_sum_ / static_cast<double>(link_rtt_n_);
+  if (link_loss_n_ > 0) v["radio_loss"] = link_loss_sum_ / static_cast<double>(link_loss_n_);
+  return v;
+}
+
+}  // namespace swarmbox::report

@@ -1,0 +1,214 @@
+#include "swarmbox/report/trial_record.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::report {
+
+namespace fs = std::filesystem;
+using yaml::Node;
+
+namespace {
+
+Node Str(std::string_view s) { return Node::Scalar(std::string(s), {}, /*quoted=*/true); }
+Node Bare(std::string s) { return Node::Scalar(std::move(s)); }
+
+Node StrList(const std::vector<std::string>& items) {
+  Node n = Node::Sequence();
+  for (const std::string& s : items) n.Append(Str(s));
+  return n;
+}
+
+Result<std::string> ReadText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error(ErrorCode::kNotFound, "cannot read", path.string());
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::optional<double> NumberAt(const Node& doc, std::string_view key) {
+  const Node* n = doc.Find(key);
+  if (n == nullptr || !n->is_scalar()) return std::nullopt;
+  return yaml::ScalarAsDouble(n->scalar());
+}
+
+std::string StringAt(const Node& doc, std::string_view key) {
+  const Node* n = doc.Find(key);
+  return n != nullptr && n->is_scalar() ? n->scalar() : std::string();
+}
+
+std::vector<std::string> StringsAt(const Node& doc, std::string_view key) {
+  std::vector<std::string> out;
+  if (const Node* n = doc.Find(key); n != nullptr && n->is_sequence()) {
+    for (const Node& item : n->items()) out.push_back(item.scalar());
+  }
+  return out;
+}
+
+// Feeds truth.csv (t_s, drone, x_m, y_m, z_m columns by header) into the metrics.
+void ReadTruth(const fs::path& path, TrialMetrics& metrics) {
+  std::ifstream in(path);
+  if (!in) return;
+  std::string line;
+  if (!std::getline(in, line)) return;
+  std::vector<std::string> header;
+  {
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) header.push_back(cell);
+  }
+  auto col = [&](std::string_view name) -> int {
+    auto it = std::find(header.begin(), header.end(), name);
+    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+  };
+  const int ct = col("t_s"), cd = col("drone"), cx = col("x_m"), cy = col("y_m"), cz = col("z_m");
+  if (ct < 0 || cd < 0 || cx < 0 || cy < 0 || cz < 0) return;
+  std::vector<std::string> cells;
+  while (std::getline(in, line)) {
+    cells.clear();
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    const auto need = static_cast<std::size_t>(std::max({ct, cd, cx, cy, cz}));
+    if (cells.size() <= need) continue;
+    auto t = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(ct)]);
+    auto x = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(cx)]);
+    auto y = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(cy)]);
+    auto z = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(cz)]);
+    if (t && x && y && z) metrics.OnTruth(*t, cells[static_cast<std::size_t>(cd)], *x, *y, *z);
+  }
+}
+
+}  // namespace
+
+std::string TrialMetaJson(const TrialMeta& m) {
+  Node doc = Node::Mapping();
+  doc.Set("id", Str(m.id));
+  doc.Set("code", Str(m.code));
+  doc.Set("factors", StrList(m.factors));
+  doc.Set("levels", StrList(m.levels));
+  doc.Set("repetition", Bare(std::to_string(m.repetition)));
+  doc.Set("seed", Bare(std::to_string(m.seed)));
+  doc.Set("attempts", Bare(std::to_string(m.attempts)));
+  doc.Set("hosts", StrList(m.hosts));
+  return yaml::EmitJson(doc) + "\n";
+}
+
+Result<TrialMeta> ParseTrialMetaJson(std::string_view text, std::string_view where) {
+  auto doc = yaml::Parse(text, where);
+  if (!doc) return doc.error();
+  if (!doc->is_mapping()) return Error(ErrorCode::kProtocol, "expected a JSON object", std::string(where));
+  TrialMeta m;
+  m.id = StringAt(*doc, "id");
+  m.code = StringAt(*doc, "code");
+  m.factors = StringsAt(*doc, "factors");
+  m.levels = StringsAt(*doc, "levels");
+  m.repetition = static_cast<int>(NumberAt(*doc, "repetition").value_or(1));
+  m.seed = static_cast<std::uint64_t>(NumberAt(*doc, "seed").value_or(0));
+  m.attempts = static_cast<int>(NumberAt(*doc, "attempts").value_or(1));
+  m.hosts = StringsAt(*doc, "hosts");
+  if (m.id.empty()) return Error(ErrorCode::kProtocol, "no \"id\"", std::string(where));
+  return m;
+}
+
+Result<TrialRecord> ReadTrialFolder(const std::string& dir_text) {
+  const fs::path dir(dir_text);
+  TrialRecord rec;
+  rec.folder = dir.filename().string();
+  auto result_text = ReadText(dir / "result.json");
+  if (!result_text) return Error(ErrorCode::kNotFound, "no result.json", dir.string());
+  auto result = yaml::Parse(*result_text, (dir / "result.json").string());
+  if (!result) return result.error();
+  if (!result->is_mapping()) {
+    return Error(ErrorCode::kProtocol, "result.json is not an object", dir.string());
+  }
+  rec.outcome = StringAt(*result, "outcome");
+  rec.reason = StringAt(*result, "reason");
+  rec.host = StringAt(*result, "host");
+  rec.wall_s = NumberAt(*result, "wall_s");
+  rec.sim_s = NumberAt(*result, "sim_s");
+  if (auto meta_text = ReadText(dir / "trial_meta.json")) {
+    auto meta = ParseTrialMetaJson(*meta_text, (dir / "trial_meta.json").string());
+    if (!meta) return meta.error();
+    rec.meta = std::move(*meta);
+  } else {
+    // A plain `swarmbox run` folder: what result.json says.
+    rec.meta.id = StringAt(*result, "trial_id").empty() ? rec.folder : StringAt(*result, "trial_id");
+    rec.meta.seed = static_cast<std::uint64_t>(NumberAt(*result, "seed").value_or(0));
+  }
+
+  TrialMetrics metrics;
+  std::error_code ec;
+  std::vector<fs::path> logs;
+  for (const auto& e : fs::directory_iterator(dir / "logs", ec)) {
+    if (e.path().extension() == ".log") logs.push_back(e.path());
+  }
+  std::sort(logs.begin(), logs.end());
+  for (const fs::path& log : logs) {
+    const std::string component = log.stem().string();
+    if (component == "physics") metrics.SawPhysicsLog();
+    std::ifstream in(log);
+    std::string line;
+    while (std::getline(in, line)) metrics.OnLogEvent(component, ParseLogfmt(line));
+  }
+  {
+    std::ifstream in(dir / "events.jsonl");
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.find("\"orchestrator\"") == std::string::npos &&
+          line.find("fault") == std::string::npos) {
+        continue;  // agent/physics events are read from logs/
+      }
+      auto j = yaml::Parse(line, "events.jsonl");
+      if (!j || !j->is_mapping()) continue;
+      const std::string component = StringAt(*j, "component");
+      if (component != "orchestrator" && component.find("fault") == std::string::npos) continue;
+      std::optional<double> t = NumberAt(*j, "t");
+      if (!t) t = NumberAt(*j, "sim_s");
+      metrics.OnOrchestratorEvent(StringAt(*j, "event"), StringAt(*j, "target"), t);
+    }
+  }
+  ReadTruth(dir / "truth.csv", metrics);
+  rec.metrics = metrics.Values();
+  rec.has_trajectories = fs::exists(dir / "trajectories.png", ec);
+  return rec;
+}
+
+std::vector<TrialRecord> ReadExperimentFolder(const std::string& dir,
+                                              std::vector<std::string>* problems) {
+  std::vector<TrialRecord> out;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (!e.is_directory() || e.path().filename().string().front() == '.') continue;
+    if (!fs::exists(e.path() / "result.json")) continue;
+    auto rec = ReadTrialFolder(e.path().string());
+    if (rec) {
+      out.push_back(std::move(*rec));
+    } else if (problems != nullptr) {
+      problems->push_back(rec.error().ToString());
+    }
+  }
+  std::sort(out.begin(), out.end(),
+            [](const TrialRecord& a, const TrialRecord& b) { return a.meta.id < b.meta.id; });
+  return out;
+}
+
+std::vector<std::string> FactorNames(const std::string& dir, const std::vector<TrialRecord>& records) {
+  if (auto text = ReadText(fs::path(dir) / "experiment.json")) {
+    if (auto doc = yaml::Parse(*text, "experiment.json"); doc && doc->is_mapping()) {
+      return StringsAt(*doc, "factors");
+    }
+  }
+  for (const TrialRecord& r : records) {
+    if (!r.meta.factors.empty()) return r.meta.factors;
+  }
+  return {};
+}
+
+}  // namespace swarmbox::report
