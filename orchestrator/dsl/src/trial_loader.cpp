@@ -59,6 +59,70 @@ Status CheckComponent(const TrialSpec& spec, const yaml::Mark& mark, const std::
   return AtMark(mark, "unknown component '" + name + "' (expected one of " + accepted + ")");
 }
 
+// `mission: {kind: sar|plan, plan: "takeoff:5,hover:10,land", inference_latency_ms: 40}`.
+Status DecodeMission(const Node& node, MissionSpec* out) {
+  std::string kind(MissionKindName(out->kind));
+  yaml::MapReader r(node, "mission");
+  r.Optional("kind", &kind).Optional("plan", &out->plan).Optional("inference_latency_ms",
+                                                                   &out->inference_latency_ms);
+  SWARMBOX_TRY(r.Finish());
+  if (kind == "sar") {
+    out->kind = MissionKind::kSar;
+  } else if (kind == "plan") {
+    out->kind = MissionKind::kPlan;
+  } else {
+    return At(*node.Find("kind"), "unknown mission kind '" + kind + "' (expected sar or plan)");
+  }
+  if (const Node* plan = node.Find("plan")) {
+    if (out->kind != MissionKind::kPlan) {
+      return At(*plan, "'plan' belongs to mission kind plan (this mission is kind sar)");
+    }
+    if (out->plan.empty()) return At(*plan, "'plan' must not be empty (e.g. \"takeoff:5,hover:10,land\")");
+    // The agent parses the plan; here only what would break its command line.
+    for (char c : out->plan) {
+      if (c == ' ' || c == '\t' || c == '\n') {
+        return At(*plan, "'plan' is a comma-separated list without spaces, e.g. \"takeoff:5,hover:10,land\"");
+      }
+    }
+  }
+  if (out->inference_latency_ms < 0 || out->inference_latency_ms > 10000) {
+    return At(*node.Find("inference_latency_ms"), "'inference_latency_ms' must be in [0, 10000] [ms]");
+  }
+  return Ok{};
+}
+
+// `raft: {tick_ms, heartbeat_ms, election_timeout_ms}`: what the agent's Raft service accepts
+// (positive, both timings multiples of the tick, heartbeat < election timeout).
+Status DecodeRaft(const Node& node, RaftSpec* out) {
+  yaml::MapReader r(node, "raft");
+  r.Optional("tick_ms", &out->tick_ms)
+      .Optional("heartbeat_ms", &out->heartbeat_ms)
+      .Optional("election_timeout_ms", &out->election_timeout_ms);
+  SWARMBOX_TRY(r.Finish());
+  auto where = [&](const char* key) -> const Node& {
+    const Node* n = node.Find(key);
+    return n != nullptr ? *n : node;
+  };
+  for (const auto& [key, value] : {std::pair{"tick_ms", out->tick_ms}, std::pair{"heartbeat_ms", out->heartbeat_ms},
+                                   std::pair{"election_timeout_ms", out->election_timeout_ms}}) {
+    if (value <= 0) return At(where(key), "'" + std::string(key) + "' must be > 0 [ms]");
+  }
+  if (out->heartbeat_ms % out->tick_ms != 0) {
+    return At(where("heartbeat_ms"), "'heartbeat_ms' (" + std::to_string(out->heartbeat_ms) +
+                                         ") must be a multiple of tick_ms (" + std::to_string(out->tick_ms) + ")");
+  }
+  if (out->election_timeout_ms % out->tick_ms != 0) {
+    return At(where("election_timeout_ms"), "'election_timeout_ms' (" + std::to_string(out->election_timeout_ms) +
+                                                ") must be a multiple of tick_ms (" + std::to_string(out->tick_ms) + ")");
+  }
+  if (out->election_timeout_ms <= out->heartbeat_ms) {
+    return At(where("election_timeout_ms"), "'election_timeout_ms' (" + std::to_string(out->election_timeout_ms) +
+                                                ") must be longer than heartbeat_ms (" +
+                                                std::to_string(out->heartbeat_ms) + ")");
+  }
+  return Ok{};
+}
+
 bool DefaultFileExists(const std::string& path) {
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
@@ -87,6 +151,9 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
       .Required("world", &spec.world);
   const Node* physics = r.Child("physics");
   const Node* drones = r.Child("drones", /*required=*/true);
+  const Node* mission = r.Child("mission");
+  const Node* raft = r.Child("raft");
+  const Node* radio = r.Child("radio");
   const Node* network = r.Child("network");
   const Node* faults = r.Child("faults");
   const Node* end = r.Child("end");
@@ -138,6 +205,17 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
       return At(*item.Find("name"), "drone name '" + d.name + "' is used twice");
     }
     spec.drones.push_back(std::move(d));
+  }
+
+  if (mission != nullptr && !mission->is_null()) SWARMBOX_TRY(DecodeMission(*mission, &spec.mission));
+  if (raft != nullptr && !raft->is_null()) SWARMBOX_TRY(DecodeRaft(*raft, &spec.raft));
+  if (radio != nullptr && !radio->is_null()) {
+    yaml::MapReader rr(*radio, "radio");
+    rr.Optional("ping_every_ms", &spec.radio.ping_every_ms);
+    SWARMBOX_TRY(rr.Finish());
+    if (spec.radio.ping_every_ms < 0) {
+      return At(*radio->Find("ping_every_ms"), "'ping_every_ms' must be >= 0 (0 = no link pings)");
+    }
   }
 
   if (network != nullptr) {

@@ -11,6 +11,10 @@ std::string_view MiddlewareName(Middleware middleware) {
   return middleware == Middleware::kFastDds ? "fastdds" : "cyclonedds";
 }
 
+std::string_view MissionKindName(MissionKind kind) {
+  return kind == MissionKind::kPlan ? "plan" : "sar";
+}
+
 TrialSpec TrialSpec::Named(std::string name) {
   TrialSpec t;
   t.name = std::move(name);
@@ -76,6 +80,18 @@ TrialSpec& TrialSpec::EndOn(std::string pattern, Outcome outcome, std::string re
   end.push_back({std::move(pattern), outcome, std::move(reason), std::move(from)});
   return *this;
 }
+TrialSpec& TrialSpec::Mission(MissionSpec value) {
+  mission = std::move(value);
+  return *this;
+}
+TrialSpec& TrialSpec::Raft(RaftSpec value) {
+  raft = value;
+  return *this;
+}
+TrialSpec& TrialSpec::Radio(RadioLinkSpec value) {
+  radio = value;
+  return *this;
+}
 TrialSpec& TrialSpec::Timeout(Duration sim, Outcome outcome, Duration wall) {
   timeout = {sim, wall, outcome};
   return *this;
@@ -124,6 +140,19 @@ yaml::Node ToDocument(const TrialSpec& spec) {
     drones.Append(std::move(dn));
   }
   doc.Set("drones", std::move(drones));
+  Node mission = Node::Mapping();
+  mission.Set("kind", Str(MissionKindName(spec.mission.kind)));
+  if (spec.mission.kind == MissionKind::kPlan) mission.Set("plan", Str(spec.mission.plan));
+  mission.Set("inference_latency_ms", Plain(std::to_string(spec.mission.inference_latency_ms)));
+  doc.Set("mission", std::move(mission));
+  Node raft = Node::Mapping();
+  raft.Set("tick_ms", Plain(std::to_string(spec.raft.tick_ms)));
+  raft.Set("heartbeat_ms", Plain(std::to_string(spec.raft.heartbeat_ms)));
+  raft.Set("election_timeout_ms", Plain(std::to_string(spec.raft.election_timeout_ms)));
+  doc.Set("raft", std::move(raft));
+  Node radio = Node::Mapping();
+  radio.Set("ping_every_ms", Plain(std::to_string(spec.radio.ping_every_ms)));
+  doc.Set("radio", std::move(radio));
   if (!spec.mesh_node.is_null()) {
     Node network = Node::Mapping();
     network.Set("mesh", spec.mesh_node);

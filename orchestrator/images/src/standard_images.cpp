@@ -55,4 +55,13 @@ Result<ImageSpec> FaultToolsImage(const FaultToolPaths& paths) {
   return spec;
 }
 
+Result<ImageSpec> FaultSidecarImage(const std::string& netemd_binary, FaultToolPaths paths) {
+  if (access(netemd_binary.c_str(), X_OK) != 0) {
+    return Error(ErrorCode::kNotFound, "swarmbox-netemd is not an executable file (build it: target swarmbox-netemd)",
+                 netemd_binary);
+  }
+  paths.extra_programs.push_back(HostFile{netemd_binary, kNetemdInImage, 0755});
+  return FaultToolsImage(paths);
+}
+
 }  // namespace swarmbox::images

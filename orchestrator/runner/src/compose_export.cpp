@@ -61,6 +61,9 @@ std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
     }
     if (!s.env.empty()) svc.Set("environment", StrMap(s.env));
     if (!s.labels.empty()) svc.Set("labels", StrMap(s.labels));
+    if (!s.network_of.empty()) svc.Set("network_mode", Str("service:" + s.network_of));
+    if (!s.cap_add.empty()) svc.Set("cap_add", StrList(s.cap_add));
+    if (!s.cap_drop.empty()) svc.Set("cap_drop", StrList(s.cap_drop));
     if (!s.networks.empty()) {
       Node nets = Node::Mapping();
       for (const dsl::Attachment& a : s.networks) {

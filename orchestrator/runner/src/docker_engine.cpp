@@ -127,6 +127,22 @@ Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
   spec.hostname = s.hostname;
   spec.stop_timeout_s = s.stop_timeout_s;
   spec.auto_remove = false;  // a crashed container keeps its logs until we collected them
+  spec.cap_add = s.cap_add;
+  spec.cap_drop = s.cap_drop;
+  if (!s.network_of.empty()) {
+    auto owner = container_ids_.find(s.network_of);
+    if (owner == container_ids_.end()) {
+      return Verdict::Err("the network namespace of " + plugin.id() + " belongs to '" + s.network_of +
+                              "', which was not created",
+                          plugin.Path());
+    }
+    if (!s.networks.empty() || !s.hostname.empty()) {
+      return Verdict::Err(plugin.id() + " shares the network of " + s.network_of +
+                              ": it can have no networks or hostname of its own",
+                          plugin.Path());
+    }
+    spec.network_mode = "container:" + owner->second;
+  }
   for (const dsl::Attachment& a : s.networks) {
     auto it = network_ids_.find(a.network);
     if (it == network_ids_.end()) {
@@ -149,20 +165,26 @@ Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
   return Verdict::Success();
 }
 
-void DockerEngine::StartFollower(const std::string& component, const std::string& container_id) {
+void DockerEngine::StartFollower(const std::string& component, const std::string& container_id,
+                                 std::uint64_t skip_lines) {
   JoinFollower(component, /*cancel=*/true);
   auto f = std::make_unique<Follower>();
   Follower* raw = f.get();
   const std::uint64_t generation = next_generation_++;
   generations_[component] = generation;
   const std::string path = (fs::path(options_.trial_dir) / "logs" / (component + ".log")).string();
-  raw->thread = std::thread([this, raw, component, container_id, path, generation] {
+  raw->thread = std::thread([this, raw, component, container_id, path, generation, skip_lines] {
+    std::uint64_t to_skip = skip_lines;
     std::FILE* out = std::fopen(path.c_str(), "ab");
     docker::LogOptions opts;
     opts.follow = true;
     Status s = api_.FollowLogs(
         container_id, opts,
         [&](const docker::LogLine& line) {
+          if (to_skip > 0) {  // delivered by an earlier follower (the container ran before)
+            --to_skip;
+            return;
+          }
           if (out != nullptr) {
             std::fwrite(line.text.data(), 1, line.text.size(), out);
             std::fputc('\n', out);
@@ -199,6 +221,17 @@ void DockerEngine::JoinFollower(const std::string& component, bool cancel) {
   if (f.thread.joinable()) f.thread.join();
   reports_[component].log_lines += f.lines.load();
   followers_.erase(it);
+}
+
+Status DockerEngine::ResumeLogs(const std::string& component) {
+  auto it = container_ids_.find(component);
+  if (it == container_ids_.end()) {
+    return Error(ErrorCode::kNotFound, "no container for component " + component);
+  }
+  JoinFollower(component, /*cancel=*/true);  // counts its lines into the report
+  // Lines the cancelled stream had not delivered yet come again with the new one.
+  StartFollower(component, it->second, reports_[component].log_lines);
+  return Ok{};
 }
 
 bool DockerEngine::IsCurrent(const HubItem& item) const {

@@ -3,8 +3,10 @@
 #include <charconv>
 #include <filesystem>
 #include <set>
+#include <variant>
 
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/dsl/step.hpp"
 #include "swarmbox/images/standard_images.hpp"
 #include "swarmbox/runner/naming.hpp"
 
@@ -27,8 +29,8 @@ std::string AirframeRelative(const dsl::DroneSpec& d) { return "airframes/" + d.
 // --- the command lines: adjust here when the programs' flags change ------------------------------
 
 // Inside the containers: sim is the first network attached (eth0), mesh the second (eth1).
-constexpr char kSimInterface[] = "eth0";
-constexpr char kMeshInterface[] = "eth1";
+constexpr std::string_view kSimInterface = kSimInterfaceName;
+constexpr std::string_view kMeshInterface = kMeshInterfaceName;
 constexpr int kSimDomain = 0;   // each trial has its own networks, so fixed domain ids are safe
 constexpr int kMeshDomain = 1;
 
@@ -41,7 +43,7 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
       "--seed", std::to_string(spec.seed),
       "--rtf", Num(spec.rtf),
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
-      "--sim-interface", kSimInterface,
+      "--sim-interface", std::string(kSimInterface),
       "--domain", std::to_string(kSimDomain),
       "--truth", std::string(kTruthCsvPath),
       // Stops (event=stopped t=...) when the trial's simulated time is up; truth.csv is flushed.
@@ -59,22 +61,56 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
   return argv;
 }
 
-// swarmbox-agent (agent/app/main.cpp --help).
+// swarmbox-agent (agent/app/main.cpp --help). Flags the agent does not know make it exit 2, so a
+// flag is passed only once agent/app/main.cpp has it (these switches say which ones it has).
+constexpr bool kAgentHasMissionFlags = false;  // --mission, --world, --payload, --inference-latency-ms
+constexpr bool kAgentHasPingFlag = false;      // --ping-every-ms
+
+std::string Members(const dsl::TrialSpec& spec) {
+  std::string out;
+  for (const dsl::DroneSpec& d : spec.drones) out += (out.empty() ? "" : ",") + d.name;
+  return out;
+}
+
 std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
   std::vector<std::string> argv = {
       images::kAgentBinaryInImage,
       "--name", d.name,
       "--airframe", InContainer(AirframeRelative(d)),
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
-      "--sim-interface", kSimInterface,
+      "--sim-interface", std::string(kSimInterface),
       "--sim-domain", std::to_string(kSimDomain),
-      "--mesh-interface", kMeshInterface,
+      "--mesh-interface", std::string(kMeshInterface),
       "--mesh-domain", std::to_string(kMeshDomain),
       "--start", Num(d.pose[0]) + "," + Num(d.pose[1]) + "," + Num(d.pose[2]),
+      // Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`.
+      "--members", Members(spec),
+      "--seed", std::to_string(spec.seed),
+      "--raft-tick-ms", std::to_string(spec.raft.tick_ms),
+      "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
+      "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
   };
+  if (kAgentHasPingFlag) {
+    argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
+  }
+  if (spec.mission.kind == dsl::MissionKind::kPlan) {
+    if (kAgentHasMissionFlags) argv.insert(argv.end(), {"--mission", "plan"});
+    argv.insert(argv.end(), {"--plan", spec.mission.plan});
+  } else if (kAgentHasMissionFlags) {
+    argv.insert(argv.end(), {"--mission", "sar", "--world", InContainer(spec.world),
+                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
+    // The lifter starts with its payload on the ground under it (as the physics server places it).
+    if (!d.payload.empty()) argv.insert(argv.end(), {"--payload", d.payload});
+  }
   // The agent starts unloaded (--payload-mass 0): its payload lies on the ground.
   return argv;
 }
+
+// The fault sidecar of a drone: holds the drone's network namespace (sim and mesh attachments,
+// fixed addresses) so the mesh impairment is in place before the agent's first packet and survives
+// the agent being killed or restarted; the agent joins it (network_of). It alone has NET_ADMIN
+// (CapDrop ALL); its pid 1 is swarmbox-netemd's `sleep` (reaps the daemons started by exec).
+std::vector<std::string> SidecarArgv() { return {images::kNetemdInImage, "sleep"}; }
 
 // -------------------------------------------------------------------------------------------------
 
@@ -110,6 +146,19 @@ Result<std::map<std::string, double>> LoadPayloadMasses(const dsl::TrialSpec& sp
   return masses;
 }
 
+bool NeedsFaultSidecars(const dsl::TrialSpec& spec) {
+  if (!spec.mesh.empty()) return true;
+  for (const faults::Fault& f : spec.faults) {
+    if (std::holds_alternative<faults::RadioFault>(f.action) ||
+        std::holds_alternative<faults::PartitionFault>(f.action)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string SidecarId(std::string_view drone) { return std::string(drone) + "-faults"; }
+
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
   const double sim_s = spec.timeout.sim.seconds();
   const double guard_s = spec.rtf > 0 ? sim_s / spec.rtf * 1.5 + 120.0 : sim_s * 3.0 + 120.0;
@@ -122,6 +171,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   if (options.images.physics.empty() || options.images.agent.empty()) {
     return Error(ErrorCode::kInvalidArgument, "PlanTrial: images for physics and agent are needed");
   }
+  const bool sidecars = NeedsFaultSidecars(spec) && !options.faults_image.empty();
   if (spec.drones.size() + kFirstDroneHost >= 255) {
     return Error(ErrorCode::kInvalidArgument,
                  "too many drones for a /24: " + std::to_string(spec.drones.size()));
@@ -178,8 +228,30 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
       .On(sim_net, physics_ip, {std::string(kPhysicsId)})
       .ReadyOn(std::string(kPhysicsReadyPattern), dsl::Duration::Seconds(60));
 
-  // One agent per drone.
-  auto& drones = trial->Add<dsl::Component>(std::string(kDronesGroupId), 2);
+  // One agent per drone; with network faults, each agent lives in its fault sidecar's network
+  // namespace (sidecars [2], the injector's set-up step [3], agents [4]).
+  if (sidecars) {
+    auto& radios = trial->Add<dsl::Component>(std::string(kSidecarsGroupId), 2);
+    std::uint32_t host = kFirstDroneHost;
+    for (const dsl::DroneSpec& d : spec.drones) {
+      const std::string id = SidecarId(d.name);
+      dsl::ContainerSpec sc = dsl::ContainerSpec::Image(options.faults_image, SidecarArgv());
+      sc.name = name(id);
+      sc.hostname = d.name;
+      sc.labels = labels(id);
+      sc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
+      sc.cap_drop = {"ALL"};
+      sc.cap_add = {"NET_ADMIN"};
+      sc.user = "0:0";  // NET_ADMIN reaches no non-root user on Docker 20.10 (standard_images.hpp)
+      sc.stop_timeout_s = 2;
+      radios.Add<dsl::Plugin>(id, std::move(sc), 2)
+          .On(sim_net, nets.sim.Host(host), {d.name})
+          .On(mesh_net, nets.mesh.Host(host), {d.name});
+      ++host;
+    }
+    trial->Add<dsl::Step>(std::string(kFaultsStepId), 3);
+  }
+  auto& drones = trial->Add<dsl::Component>(std::string(kDronesGroupId), sidecars ? 4 : 2);
   std::uint32_t host = kFirstDroneHost;
   for (const dsl::DroneSpec& d : spec.drones) {
     const std::string sim_ip = nets.sim.Host(host);
@@ -188,13 +260,18 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     dsl::ContainerSpec agent =
         dsl::ContainerSpec::Image(options.images.agent, AgentArgv(spec, d));
     agent.name = name(d.name);
-    agent.hostname = d.name;
     agent.labels = labels(d.name);
     agent.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
     agent.inputs = {input(spec.world), input(AirframeRelative(d))};
-    drones.Add<dsl::Plugin>(d.name, std::move(agent), 2)
-        .On(sim_net, sim_ip, {d.name})
-        .On(mesh_net, mesh_ip, {d.name});
+    if (sidecars) {
+      agent.network_of = SidecarId(d.name);  // Docker refuses a hostname here
+      drones.Add<dsl::Plugin>(d.name, std::move(agent), 2);
+    } else {
+      agent.hostname = d.name;
+      drones.Add<dsl::Plugin>(d.name, std::move(agent), 2)
+          .On(sim_net, sim_ip, {d.name})
+          .On(mesh_net, mesh_ip, {d.name});
+    }
   }
 
   for (const dsl::EndSpec& e : spec.end) trial->EndOn(e.on, e.outcome, e.reason, e.from);

@@ -7,7 +7,10 @@
 
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/dsl/step.hpp"
 #include "swarmbox/runner/docker_engine.hpp"
+#include "swarmbox/runner/fault_image.hpp"
+#include "swarmbox/runner/fault_injector.hpp"
 #include "swarmbox/runner/log_hub.hpp"
 #include "swarmbox/runner/monitor.hpp"
 #include "swarmbox/runner/naming.hpp"
@@ -106,6 +109,51 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
 
   std::unique_ptr<dsl::Trial> tree;
   std::unique_ptr<DockerEngine> engine;
+  std::optional<Monitor> monitor;
+
+  // Faults: one injector per built tree (a restart or another subnet pair makes a new one).
+  const bool has_faults = !info.mesh.empty() || !info.faults.empty();
+  std::unique_ptr<FaultInjector> injector;
+  auto make_injector = [&]() -> std::unique_ptr<FaultInjector> {
+    InjectorConfig c;
+    c.drones = info.drones;
+    c.mesh = info.mesh;
+    c.faults = info.faults;
+    c.seed = info.seed;
+    c.host = o.host;
+    for (const std::string& d : info.drones) {
+      if (dsl::Plugin* agent = tree->FindPlugin(d)) c.agents[d] = agent->spec().name;
+      if (dsl::Plugin* sidecar = tree->FindPlugin(SidecarId(d))) {
+        c.sidecars[d] = sidecar->spec().name;
+        for (const dsl::Attachment& a : sidecar->spec().networks) {
+          if (a.network == kMeshNetworkId) c.mesh_ipv4[d] = a.ipv4;
+        }
+      }
+    }
+    c.mesh_interface = std::string(kMeshInterfaceName);
+    return std::make_unique<FaultInjector>(
+        api, std::move(c), [&](const std::string& line) { events.Write(line); },
+        [&] { return monitor ? monitor->sim_s() : 0.0; }, [&] { return wall(); });
+  };
+  // With sidecars the tree's `faults` Step runs the set-up between the sidecars and the agents;
+  // without (process faults only) it runs once the tree has started.
+  auto bind_faults = [&]() {
+    if (!has_faults || !tree) return;
+    if (auto* step = dynamic_cast<dsl::Step*>(tree->Find(kFaultsStepId))) {
+      step->Bind(
+          [&]() {
+            injector = make_injector();
+            return injector->Setup();
+          },
+          [&]() { return injector ? injector->Teardown() : Verdict::Success(); });
+    }
+  };
+  auto start_faults = [&]() -> Verdict {
+    if (!has_faults) return Verdict::Success();
+    if (dynamic_cast<dsl::Step*>(tree->Find(kFaultsStepId)) != nullptr) return Verdict::Success();
+    injector = make_injector();
+    return injector->Setup();
+  };
   Verdict start;
   for (int attempt = 0; attempt < std::max(1, o.subnet_attempts); ++attempt) {
     auto subnets = PickSubnets(run_id, attempt, taken);
@@ -119,6 +167,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     if (!planned) return planned.error().Context("planning the trial");
     tree = std::move(*planned);
     engine = std::make_unique<DockerEngine>(api, hub, clock, eo);
+    bind_faults();
     start = tree->Start(*engine);
     if (start.ok() || !engine->subnet_conflict()) break;
     say("subnet conflict (" + start.reason + "), trying another pair");
@@ -130,7 +179,6 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
 
   Metrics metrics;
   std::vector<Detection> detections;
-  std::optional<Monitor> monitor;
   TrialResult result;
   result.trial = info.name;
   result.trial_id = o.trial_id.empty() ? info.name : o.trial_id;
@@ -145,6 +193,17 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       c->RaiseRestart(v.reason);
     } else {
       c->RaiseShutdown(std::move(v));
+    }
+  };
+  // Containers a fault brought back (start after kill/stop, restart): follow their logs again.
+  auto resume_logs = [&]() {
+    if (!injector || !engine) return;
+    for (const std::string& c : injector->TakeResumed()) {
+      if (Status s = engine->ResumeLogs(c); !s) {
+        tree->RaiseShutdown(Verdict::FromError(s.error().Context("following " + c + " again"), c));
+      } else if (monitor) {
+        monitor->Started(c);
+      }
     }
   };
   auto process = [&](const HubItem& item) {
@@ -166,10 +225,16 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       if (monitor && tree) {
         if (auto v = monitor->OnLine(item.component, item.text)) raise(item.component, *v, false);
       }
+      if (injector && tree && !tree->end_verdict()) {
+        if (auto v = injector->OnLogLine(item.component, item.text)) tree->RaiseShutdown(*v);
+        resume_logs();
+      }
       return;
     }
     // The end of a log stream: the container stopped, or the stream broke.
     if (!engine || !engine->IsCurrent(item) || !monitor || !tree || tree->end_verdict()) return;
+    // A container a fault took down (kill, stop, restart) did not crash.
+    if (injector && injector->Disrupted(item.component)) return;
     auto state = engine->Inspect(item.component);
     if (state && !state->running) {
       if (auto v = monitor->OnExit(item.component, state->exit_code, state->oom_killed)) {
@@ -189,11 +254,16 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   };
 
   if (start.ok()) start = start_monitor();
+  if (start.ok()) start = start_faults();
   if (start.ok()) {
     double next_progress = 0;
     while (true) {
       for (const HubItem& item : hub.Drain(o.poll)) process(item);
       if (auto v = monitor->OnTick(wall())) tree->RaiseShutdown(*v);
+      if (injector && !tree->end_verdict()) {
+        if (auto v = injector->Advance()) tree->RaiseShutdown(*v);
+        resume_logs();
+      }
       if (o.interrupted != nullptr && o.interrupted->load()) {
         tree->RaiseShutdown(Verdict::Err("interrupted (Ctrl-C)", "user"));
       }
@@ -202,8 +272,11 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
           say("restarting: " + tree->restart_reason());
           events.Write(LifecycleEventJson(wall(), "restart", tree->id(),
                                           Verdict::Err(tree->restart_reason())));
+          if (injector) (void)injector->RemoveActive();
+          bind_faults();
           Verdict rv = tree->Restart(*engine);
           if (rv.ok()) rv = start_monitor();
+          if (rv.ok()) rv = start_faults();
           if (!rv.ok()) tree->RaiseShutdown(rv);
         } else {
           tree->RaiseShutdown(Verdict::Err("restart requested (" + tree->restart_reason() +
@@ -222,12 +295,21 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   say("ending: " + verdict.ToString());
   events.Write(LifecycleEventJson(wall(), "shutdown", info.name, verdict));
   if (tree && engine) {
+    // Faults first (unpause, restart what a fault stopped, heal partitions, restore radios), while
+    // the sidecars still run; the tree's Step then undoes network.mesh before they are removed.
+    if (injector) {
+      (void)injector->RemoveActive();
+      if (dynamic_cast<dsl::Step*>(tree->Find(kFaultsStepId)) == nullptr) (void)injector->Teardown();
+    }
     Verdict stop = tree->Stop(*engine);
     if (!stop.ok()) {
       result.problems.push_back("teardown: " + stop.ToString());
       verdict.KeepWorse(stop);
     }
     for (const HubItem& item : hub.Drain(std::chrono::milliseconds(0))) process(item);
+    if (injector) {
+      for (const std::string& p : injector->problems()) result.problems.push_back("faults: " + p);
+    }
     result.components = engine->Reports();
     for (const std::string& p : engine->problems()) result.problems.push_back(p);
     result.restarts = tree->restarts();
@@ -278,11 +360,25 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
   if (auto payloads = LoadPayloadMasses(spec, trials_dir); !payloads) {
     return payloads.error().Context("checking payloads");
   }
-  Planner planner = [&](const std::string& run_id, const TrialSubnets& subnets) {
+  for (const dsl::DroneSpec& d : spec.drones) info.drones.push_back(d.name);
+  info.mesh = spec.mesh;
+  info.faults = spec.faults;
+  std::string faults_image = options.faults_image;
+  if (NeedsFaultSidecars(spec) && faults_image.empty()) {
+    auto netemd = FindNetemd(options.netemd_bin);
+    if (!netemd) return netemd.error().Context("the fault sidecar image");
+    auto tag = EnsureFaultsImage(api, *netemd, [&](std::string_view line) {
+      if (options.progress != nullptr) *options.progress << "  " << line << std::endl;
+    });
+    if (!tag) return tag.error();
+    faults_image = *tag;
+  }
+  Planner planner = [&, faults_image](const std::string& run_id, const TrialSubnets& subnets) {
     PlanOptions p;
     p.run_id = run_id;
     p.trial_id = options.trial_id;
     p.images = options.images;
+    p.faults_image = faults_image;
     p.subnets = subnets;
     p.trials_dir = trials_dir;
     return PlanTrial(spec, p);

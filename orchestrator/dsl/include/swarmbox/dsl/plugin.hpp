@@ -37,6 +37,12 @@ struct ContainerSpec {
   std::map<std::string, std::string> env;
   std::map<std::string, std::string> labels;
   std::vector<Attachment> networks;
+  // Share another plugin's network namespace: that plugin's id in the same trial ("" = own
+  // namespace on `networks`). Then `networks` and `hostname` must be empty (Docker refuses them);
+  // the other plugin must be running first (lower run priority).
+  std::string network_of;
+  std::vector<std::string> cap_add;   // e.g. "NET_ADMIN" (the fault sidecar only)
+  std::vector<std::string> cap_drop;  // e.g. "ALL"
   std::string user;      // "" = the image's
   std::string hostname;  // "" = Docker's
   std::string ready_pattern;  // a regex on the log; "" = ready once started

@@ -8,6 +8,7 @@
 //                     .World("worlds/open_field.yaml")
 //                     .Drone("scout_1", "x500", {0, 0, 0})
 //                     .Drone("lifter", "x8_heavy", {0, -10, 0}, "stretcher")
+//                     .Mission({.kind = MissionKind::kSar})
 //                     .Mesh("{delay_ms: 100, jitter_ms: 20, loss: 0.05}")
 //                     .Fault("{at: 30s, kill: raft_leader}")
 //                     .EndOn("event=mission_complete", Outcome::kSuccess)
@@ -51,6 +52,40 @@ struct EndSpec {
   std::string from;                    // a component ("physics", a drone); "" = any
 };
 
+// What the agents fly (`mission:`). kSar: the SAR mission (agents need the world file and their
+// peers); kPlan: every agent flies the built-in flight plan `plan` (the demo, smoke tests).
+enum class MissionKind { kSar, kPlan };
+std::string_view MissionKindName(MissionKind kind);  // "sar", "plan"
+
+inline constexpr std::string_view kDefaultFlightPlan = "takeoff:5,hover:10,land";
+
+struct MissionSpec {
+  MissionKind kind = MissionKind::kSar;
+  std::string plan = std::string(kDefaultFlightPlan);  // kind plan only
+  int inference_latency_ms = 40;                       // simulated perception latency [ms], >= 0
+};
+
+// Raft timings of every agent (`raft:`), on wall-clock time. The defaults are chosen to stay stable
+// on the sar_search radio (100 ms +- 20 ms one-way, 5% loss), following etcd's guidance (heartbeat
+// about the round-trip time, election timeout several heartbeats):
+//   heartbeat 200 ms   = the round trip (2 x 100 ms), so followers hear the leader every RTT;
+//   election  1500 ms  = 7.5 heartbeats: a follower campaigns only after ~7 heartbeats in a row were
+//                        lost or late (0.05^7 ~ 8e-10 per window at 5% loss; the worst one-way delay,
+//                        ~160 ms at 3 sigma, is far below it), while failover stays ~1.5-3 s
+//                        (timeouts randomised in [T, 2T)).
+//   tick 50 ms         the service's resolution; both timings must be multiples of it.
+struct RaftSpec {
+  int tick_ms = 50;
+  int heartbeat_ms = 200;
+  int election_timeout_ms = 1500;
+};
+
+// The agents' radio link measurement (`radio:`): each agent pings every peer every ping_every_ms
+// on the mesh (0 = off) and logs event=link lines.
+struct RadioLinkSpec {
+  int ping_every_ms = 200;
+};
+
 struct TimeoutSpec {
   Duration sim;                         // simulated time; zero = none
   Duration wall;                        // wall-clock guard; zero = derived from sim and rtf
@@ -64,6 +99,9 @@ struct TrialSpec {
   std::string world;  // relative to the trials directory
   double rtf = 1.0;   // real-time factor, 0 = as fast as possible
   std::vector<DroneSpec> drones;
+  MissionSpec mission;
+  RaftSpec raft;
+  RadioLinkSpec radio;
   faults::MeshImpairment mesh;  // network.mesh, parsed by swarmbox_faults (tc netem semantics)
   yaml::Node mesh_node;         // network.mesh as written (null = an unimpaired radio)
   std::vector<faults::Fault> faults;
@@ -90,6 +128,9 @@ struct TrialSpec {
   TrialSpec& Fault(std::string_view flow_yaml);
   TrialSpec& EndOn(std::string pattern, Outcome outcome, std::string reason = {},
                    std::string from = {});
+  TrialSpec& Mission(MissionSpec value);
+  TrialSpec& Raft(RaftSpec value);
+  TrialSpec& Radio(RadioLinkSpec value);
   TrialSpec& Timeout(Duration sim, Outcome outcome = Outcome::kTimeout, Duration wall = {});
 
   const DroneSpec* FindDrone(std::string_view drone_name) const;

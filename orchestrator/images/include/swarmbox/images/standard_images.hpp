@@ -48,4 +48,12 @@ struct FaultToolPaths {
 // when a tool or the plugin directory is missing on this host.
 Result<ImageSpec> FaultToolsImage(const FaultToolPaths& paths = {});
 
+// Where the fault sidecar finds the userspace delayer (the runner's radio plans call it there).
+inline constexpr char kNetemdInImage[] = "/usr/bin/swarmbox-netemd";
+
+// The image of the runner's fault sidecars: FaultToolsImage plus the host-built swarmbox-netemd at
+// kNetemdInImage (the userspace mechanism for kernels without sch_netem; also the sidecar's pid 1,
+// `swarmbox-netemd sleep`). kNotFound when `netemd_binary` is not an executable file.
+Result<ImageSpec> FaultSidecarImage(const std::string& netemd_binary, FaultToolPaths paths = {});
+
 }  // namespace swarmbox::images

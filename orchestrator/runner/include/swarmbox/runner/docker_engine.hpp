@@ -53,6 +53,10 @@ class DockerEngine final : public dsl::Engine {
 
   // The container's state now (after its log stream ended, to tell a crash from a hiccup).
   Result<docker::ContainerState> Inspect(const std::string& component);
+  // After a fault restarted the component's container (docker start/restart): follow its log
+  // again from the first line not delivered yet (Docker keeps the earlier runs' lines); items of the
+  // previous follower are no longer current. kNotFound for an unknown component.
+  Status ResumeLogs(const std::string& component);
   // Whether a hub item comes from the component's current follower (not one before a restart).
   bool IsCurrent(const HubItem& item) const;
   // True when the last network creation failed because its subnet overlaps another network.
@@ -66,7 +70,8 @@ class DockerEngine final : public dsl::Engine {
 
  private:
   struct Follower;
-  void StartFollower(const std::string& component, const std::string& container_id);
+  void StartFollower(const std::string& component, const std::string& container_id,
+                     std::uint64_t skip_lines = 0);
   void JoinFollower(const std::string& component, bool cancel);
   Status CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id);
   void CollectArtifacts(const dsl::Plugin& plugin, const std::string& container_id);

@@ -12,6 +12,15 @@
 //                         trial's simulated timeout (--max-sim-time) with `event=stopped t=...`
 //     Component drones [2]
 //       Plugin <drone> [2]  one agent per drone, on sim (eth0) and mesh (eth1)
+// With network faults (network.mesh, radio or partition faults: NeedsFaultSidecars), instead:
+//     Component sidecars [2]
+//       Plugin <drone>-faults [2]  the fault sidecar (fault-tools image + swarmbox-netemd, CapDrop
+//                                  ALL, CapAdd NET_ADMIN): owns the drone's network namespace
+//                                  (sim eth0 + mesh eth1, the drone's fixed addresses)
+//     Step faults [3]      bound by the runner to the FaultInjector: mechanism, network.mesh
+//     Component drones [4]
+//       Plugin <drone> [2]  the agent, in its sidecar's namespace (network_of), unprivileged
+// Agent flags: the shared contract (mission, --members in trial order, --seed, --raft-*, radio).
 // Files: the world and airframe files are copied into every container under /swarmbox/trials/
 // (same relative paths as in the trials folder).
 #pragma once
@@ -36,6 +45,10 @@ struct PlanOptions {
   std::string run_id;
   std::string trial_id;  // "" = the trial's name
   Images images;
+  // The fault sidecar image ("swarmbox/faults:<content hash>", with swarmbox-netemd: fault_image.hpp).
+  // "" plans no sidecars even when the trial impairs the mesh (what `swarmbox compose` exports:
+  // compose carries out no faults); the runner always passes it for such trials.
+  std::string faults_image;
   TrialSubnets subnets;
   std::string trials_dir;  // absolute host path the spec's references resolve against
 };
@@ -48,6 +61,17 @@ inline constexpr std::string_view kContainerTrialsDir = "/swarmbox/trials";
 inline constexpr std::string_view kContainerOutDir = "/out";
 inline constexpr std::string_view kTruthCsvPath = "/out/truth.csv";
 inline constexpr std::string_view kPhysicsReadyPattern = "event=ready";
+inline constexpr std::string_view kSidecarsGroupId = "sidecars";
+inline constexpr std::string_view kFaultsStepId = "faults";
+// The agents' interfaces in their (or their sidecar's) namespace.
+inline constexpr std::string_view kSimInterfaceName = "eth0";
+inline constexpr std::string_view kMeshInterfaceName = "eth1";
+
+// Whether the trial impairs the mesh (network.mesh, radio or partition faults), so every agent
+// gets a fault sidecar.
+bool NeedsFaultSidecars(const dsl::TrialSpec& spec);
+// The sidecar's component id: "<drone>-faults".
+std::string SidecarId(std::string_view drone);
 
 // The wall-clock guard when the trial file gives none: [s]. rtf > 0: sim/rtf * 1.5 + 120;
 // rtf == 0 (as fast as possible): sim * 3 + 120.

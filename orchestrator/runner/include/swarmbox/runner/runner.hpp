@@ -10,7 +10,9 @@
 // conflict), Build and Run the tree in priority order, then watch: every container's log is
 // streamed to logs/<component>.log as it comes, end conditions are matched, the simulated clock
 // (physics `t=`) and the wall-clock guard are checked, progress is printed. The first end (or
-// Ctrl-C) fires Shutdown; then Stop (reverse priority) stops, collects logs and artifacts
+// Ctrl-C) fires Shutdown; faults (TrialInfo::mesh/faults) are applied by a FaultInjector: the
+// mesh block before the agents start, the schedule while watching, everything undone before Stop.
+// Then Stop (reverse priority) stops, collects logs and artifacts
 // (truth.csv) and removes containers and networks. Written at the end: result.json, events.jsonl
 // (written as events arrive), trajectories.png (from truth.csv and the world).
 // A Restart raised during the run (a broken log stream) rebuilds the trial, at most
@@ -41,6 +43,9 @@ struct RunOptions {
   std::string run_id;    // "" = NewRunId()
   std::string trial_id;  // "" = the trial's name
   Images images;         // for RunTrialSpec
+  // The fault sidecar image for trials that impair the mesh; "" = RunTrialSpec builds it from
+  // swarmbox-netemd (netemd_bin, or FindNetemd's search).
+  std::string faults_image;
   std::string host = "local";
   const std::atomic<bool>* interrupted = nullptr;  // set by Ctrl-C
   std::ostream* progress = nullptr;                // status lines; nullptr = quiet
@@ -48,6 +53,9 @@ struct RunOptions {
   double progress_every_s = 2.0;
   int max_restarts = 1;
   int subnet_attempts = 5;
+  // swarmbox-netemd for the fault sidecar image, when faults_image is "" and the trial impairs
+  // the mesh ("" = FindNetemd's search, fault_image.hpp).
+  std::string netemd_bin;
 };
 
 struct RunOutcome {
@@ -61,6 +69,12 @@ struct TrialInfo {
   std::uint64_t seed = 0;
   std::string resolved_yaml;  // written as trial.yaml
   std::string world_file;     // host path of the world (for trajectories.png); "" = none
+  // Faults (fault_injector.hpp): carried out when either is non-empty. Drone names in trial
+  // order; each drone is a Plugin of that id in the tree, and with network faults its sidecar
+  // SidecarId(drone) is a Plugin on the "mesh" network and the tree has the Step kFaultsStepId.
+  std::vector<std::string> drones;
+  faults::MeshImpairment mesh;
+  std::vector<faults::Fault> faults;
 };
 
 // Builds the tree for a pair of subnets (called again with others after a subnet conflict).

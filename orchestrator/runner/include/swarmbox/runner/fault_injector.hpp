@@ -1,0 +1,122 @@
+// FaultInjector: the runner's I/O shell around swarmbox_faults (faults.hpp says what each piece
+// does). It carries out a trial's network.mesh block and its `faults:` schedule on a Docker engine:
+//
+//   - Setup() (the tree's `faults` Step, after the sidecars started and before the agents start):
+//     detects the mechanism once per host through the first sidecar (kernel netem, else the
+//     userspace path), refuses rules the mechanism cannot honour (the trial ends with error and the
+//     reason before any agent starts), then applies network.mesh on every drone's mesh interface
+//     (eth1) from its sidecar. The sim link (eth0) is never touched.
+//   - OnLogLine() / Advance(): feed the timeline (sim time, wall time, `on:` log events) and the
+//     Raft leader tracker; each due action is carried out at once: radio (RadioLayers +
+//     PlanRadioChange in the target's sidecar), partition (iptables chains in every agent's
+//     sidecar), kill/stop/pause/restart (Docker API on the agent's container). A fault that cannot
+//     be carried out (no leader elected yet, tc/iptables failing...) returns an error verdict.
+//   - RemoveActive() (before the tree stops) and Teardown() (the Step's Stop): undo every active
+//     fault (newest first), then the mesh block on every sidecar. Removing the sidecars afterwards
+//     takes their namespaces' leftovers with them.
+// Every apply/remove/failure is one events.jsonl line (FaultEventJson / MeshEventJson, with the
+// mechanism); the detection is one line {"type":"mechanism",...}.
+//
+// Process faults and the log watch: a container a fault stopped, killed or restarts is Disrupted()
+// (the runner does not call its exit a crash); once a fault brings it back (start, restart) it is
+// listed by TakeResumed() so the runner follows its log again.
+//
+// Thread-safety: none; the runner's thread drives it (the Step runs on that thread too).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <random>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "swarmbox/docker/docker_api.hpp"
+#include "swarmbox/dsl/outcome.hpp"
+#include "swarmbox/faults/faults.hpp"
+
+namespace swarmbox::runner {
+
+struct InjectorConfig {
+  std::vector<std::string> drones;                 // trial order
+  std::map<std::string, std::string> agents;       // drone -> agent container (Docker name or id)
+  std::map<std::string, std::string> sidecars;     // drone -> fault sidecar container; empty when
+                                                   // the trial has no network faults
+  std::map<std::string, std::string> mesh_ipv4;    // drone -> its mesh address
+  std::string mesh_interface = "eth1";
+  faults::MeshImpairment mesh;
+  std::vector<faults::Fault> faults;
+  std::uint64_t seed = 0;        // the trial's: random targets and the delay daemons' draws
+  std::string host = "local";    // the mechanism is detected once per host
+  std::string netemd = "/usr/bin/swarmbox-netemd";  // in the sidecar image
+};
+
+// The mechanism detected per host, shared by every trial of this process.
+faults::MechanismCache& HostMechanisms();
+
+class FaultInjector {
+ public:
+  using EventSink = std::function<void(const std::string& json_line)>;
+  // Clocks: simulated seconds (the monitor's) and wall seconds since the trial's Run.
+  using ClockFn = std::function<double()>;
+
+  FaultInjector(docker::DockerApi& api, InjectorConfig config, EventSink events, ClockFn sim_s,
+                ClockFn wall_s, faults::MechanismCache* mechanisms = &HostMechanisms());
+
+  // Mechanism + network.mesh on every sidecar. An error verdict says what went wrong (the runner
+  // then tears down); sensor and environment faults are refused here too (the physics server does
+  // not take fault commands yet).
+  dsl::Verdict Setup();
+  // Every log line of every container (leader tracking, `on:` triggers).
+  std::optional<dsl::Verdict> OnLogLine(const std::string& component, const std::string& line);
+  // Often (every watch-loop turn): `at`/`at_wall` starts and the ends of durations.
+  std::optional<dsl::Verdict> Advance();
+  // Undoes every active fault, newest first (best effort; failures are recorded and returned).
+  dsl::Verdict RemoveActive();
+  // RemoveActive, then the mesh block on every sidecar. Idempotent.
+  dsl::Verdict Teardown();
+
+  bool Disrupted(const std::string& component) const { return disrupted_.count(component) != 0; }
+  std::vector<std::string> TakeResumed();
+  // The mechanism in use (after Setup with sidecars).
+  const std::optional<faults::Mechanism>& mechanism() const { return mechanism_; }
+  // What went wrong without ending the trial (teardown leftovers).
+  const std::vector<std::string>& problems() const { return problems_; }
+
+ private:
+  std::optional<dsl::Verdict> Carry(const std::vector<faults::TimelineAction>& actions);
+  Status Apply(std::size_t index, faults::FaultEventRecord* record);
+  Status Remove(std::size_t index, faults::FaultEventRecord* record);
+  Status ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,
+                     const std::vector<std::string>& changed);
+  faults::LinkTarget LinkOf(const std::string& drone) const;
+  faults::RadioPlanOptions PlanOptions() const;
+  faults::CommandRunner& Sidecar(const std::string& drone);
+  faults::FaultEventRecord Record(faults::FaultPhase phase) const;
+
+  docker::DockerApi& api_;
+  InjectorConfig config_;
+  EventSink events_;
+  ClockFn sim_s_;
+  ClockFn wall_s_;
+  faults::MechanismCache* mechanisms_;
+  std::optional<faults::Mechanism> mechanism_;
+  faults::FaultTimeline timeline_;
+  faults::LeaderTracker leaders_;
+  faults::RadioLayers layers_;
+  std::mt19937_64 rng_;
+  std::map<std::string, std::unique_ptr<faults::DockerExecCommandRunner>> runners_;
+  std::map<std::size_t, std::vector<std::string>> targets_;          // fault -> resolved drones
+  std::map<std::size_t, faults::PartitionPlan> partitions_;          // active partitions
+  std::map<std::size_t, faults::ProcessPlan> processes_;             // active process faults
+  std::map<std::string, std::vector<faults::RadioRule>> installed_;  // drone -> rules in place
+  std::set<std::string> disrupted_;  // agent components a process fault took down
+  std::vector<std::string> resumed_;
+  std::vector<std::string> problems_;
+  bool set_up_ = false;
+  bool torn_down_ = false;
+};
+
+}  // namespace swarmbox::runner

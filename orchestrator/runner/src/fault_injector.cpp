@@ -1,0 +1,361 @@
+#include "swarmbox/runner/fault_injector.hpp"
+
+#include <cstdio>
+#include <utility>
+#include <variant>
+
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::runner {
+
+using dsl::Verdict;
+using faults::FaultPhase;
+using faults::TimelineAction;
+
+namespace {
+
+bool IsWorldFault(const faults::Fault& f) {
+  return std::holds_alternative<faults::GpsDropout>(f.action) ||
+         std::holds_alternative<faults::ImuBias>(f.action) ||
+         std::holds_alternative<faults::WindGust>(f.action);
+}
+
+std::string MechanismEventJson(const std::string& host, faults::Mechanism mechanism, bool cached,
+                               double wall_s) {
+  using yaml::Node;
+  auto str = [](std::string_view s) { return Node::Scalar(std::string(s), {}, /*quoted=*/true); };
+  Node root = Node::Mapping();
+  root.Set("type", str("mechanism"));
+  root.Set("host", str(host));
+  root.Set("mechanism", str(faults::MechanismName(mechanism)));
+  root.Set("detected", Node::Scalar(cached ? "false" : "true"));
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", wall_s);
+  root.Set("wall_s", Node::Scalar(buf));
+  return yaml::EmitJson(root);
+}
+
+}  // namespace
+
+faults::MechanismCache& HostMechanisms() {
+  static faults::MechanismCache cache;
+  return cache;
+}
+
+FaultInjector::FaultInjector(docker::DockerApi& api, InjectorConfig config, EventSink events,
+                             ClockFn sim_s, ClockFn wall_s, faults::MechanismCache* mechanisms)
+    : api_(api),
+      config_(std::move(config)),
+      events_(std::move(events)),
+      sim_s_(std::move(sim_s)),
+      wall_s_(std::move(wall_s)),
+      mechanisms_(mechanisms != nullptr ? mechanisms : &HostMechanisms()),
+      timeline_(config_.faults),
+      layers_(config_.mesh.rules, config_.drones),
+      rng_(config_.seed) {}
+
+faults::FaultEventRecord FaultInjector::Record(FaultPhase phase) const {
+  faults::FaultEventRecord r;
+  r.phase = phase;
+  r.t_sim_s = sim_s_ ? sim_s_() : 0.0;
+  r.wall_s = wall_s_ ? wall_s_() : 0.0;
+  return r;
+}
+
+faults::CommandRunner& FaultInjector::Sidecar(const std::string& drone) {
+  auto it = runners_.find(drone);
+  if (it == runners_.end()) {
+    auto container = config_.sidecars.find(drone);
+    const std::string name = container == config_.sidecars.end() ? drone + "-faults" : container->second;
+    it = runners_.emplace(drone, std::make_unique<faults::DockerExecCommandRunner>(api_, name)).first;
+  }
+  return *it->second;
+}
+
+faults::LinkTarget FaultInjector::LinkOf(const std::string& drone) const {
+  faults::LinkTarget link;
+  link.node = drone;
+  link.mesh_interface = config_.mesh_interface;
+  for (const auto& [peer, ip] : config_.mesh_ipv4) {
+    if (peer != drone) link.peer_ipv4[peer] = ip;
+  }
+  return link;
+}
+
+faults::RadioPlanOptions FaultInjector::PlanOptions() const {
+  faults::RadioPlanOptions o;
+  o.seed = config_.seed;
+  o.netemd = config_.netemd;
+  return o;
+}
+
+Verdict FaultInjector::Setup() {
+  if (set_up_) return Verdict::Success();
+  set_up_ = true;
+  for (const faults::Fault& f : config_.faults) {
+    if (IsWorldFault(f)) {
+      return Verdict::Err("fault " + f.id + " (" + std::string(f.kind()) + ", " + f.mark.ToString() +
+                              ") cannot be carried out: the physics server takes no sensor or "
+                              "environment fault commands yet",
+                          "faults");
+    }
+  }
+  bool network_faults = !config_.mesh.empty();
+  for (const faults::Fault& f : config_.faults) {
+    network_faults = network_faults || std::holds_alternative<faults::RadioFault>(f.action) ||
+                     std::holds_alternative<faults::PartitionFault>(f.action);
+  }
+  if (config_.sidecars.empty()) {
+    if (!network_faults) return Verdict::Success();
+    return Verdict::Err("this trial impairs the mesh but its agents have no fault sidecars (planned "
+                        "without a fault sidecar image)",
+                        "faults");
+  }
+  for (const std::string& d : config_.drones) {
+    if (config_.sidecars.count(d) == 0 || config_.mesh_ipv4.count(d) == 0) {
+      return Verdict::Err("drone " + d + " has no fault sidecar on the mesh network", "faults");
+    }
+  }
+
+  const std::string& probe_drone = config_.drones.front();
+  bool detected_now = false;
+  auto mech = mechanisms_->Get(config_.host, [&]() {
+    detected_now = true;
+    return faults::DetectMechanism(Sidecar(probe_drone));
+  });
+  if (!mech) {
+    return Verdict::FromError(mech.error().Context("detecting the netem mechanism in the sidecar of " +
+                                                   probe_drone),
+                              "faults");
+  }
+  mechanism_ = *mech;
+  if (events_) events_(MechanismEventJson(config_.host, *mech, !detected_now, wall_s_ ? wall_s_() : 0.0));
+
+  // Refuse, before any agent starts, what this host's mechanism cannot honour.
+  if (Status s = faults::CheckMechanismSupports(config_.mesh.rules, *mech); !s) {
+    return Verdict::FromError(s.error().Context("network.mesh"), "faults");
+  }
+  for (const faults::Fault& f : config_.faults) {
+    if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) {
+      if (Status s = faults::CheckMechanismSupports(radio->rules, *mech); !s) {
+        return Verdict::FromError(s.error().Context("fault " + f.id), "faults");
+      }
+    }
+  }
+
+  if (config_.mesh.empty()) return Verdict::Success();
+  for (const std::string& drone : config_.drones) {
+    const auto rules = layers_.Effective(drone);
+    faults::FaultEventRecord record = Record(FaultPhase::kApplied);
+    record.mechanism = std::string(faults::MechanismName(*mech));
+    Status s = [&]() -> Status {
+      auto plan = faults::PlanRadio(rules, LinkOf(drone), *mech, PlanOptions());
+      if (!plan) return plan.error();
+      installed_[drone] = rules;  // partly applied counts: teardown undoes it (undo may fail)
+      return faults::RunCommands(Sidecar(drone), plan->apply);
+    }();
+    if (!s) {
+      record.phase = FaultPhase::kFailed;
+      record.error = s.error().ToString();
+    }
+    if (events_) events_(faults::MeshEventJson(drone, rules, record));
+    if (!s) {
+      return Verdict::FromError(s.error().Context("applying network.mesh on " + drone), "faults");
+    }
+  }
+  return Verdict::Success();
+}
+
+Status FaultInjector::ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,
+                                  const std::vector<std::string>& changed) {
+  if (!mechanism_) {
+    return Error(ErrorCode::kInternal, "radio fault before the mechanism was detected (no sidecars?)");
+  }
+  for (const std::string& drone : changed) {
+    auto it = before.find(drone);
+    const std::vector<faults::RadioRule> from =
+        it == before.end() ? std::vector<faults::RadioRule>{} : it->second;
+    const auto to = layers_.Effective(drone);
+    auto plan = faults::PlanRadioChange(from, to, LinkOf(drone), *mechanism_, PlanOptions());
+    if (!plan) return plan.error().Context(drone);
+    installed_[drone] = to;
+    SWARMBOX_TRY(faults::RunCommands(Sidecar(drone), plan->apply));
+  }
+  return Ok{};
+}
+
+Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record) {
+  const faults::Fault& f = timeline_.faults()[index];
+  auto mesh_nodes = [&] {
+    std::vector<faults::MeshNode> nodes;
+    for (const std::string& d : config_.drones) {
+      auto ip = config_.mesh_ipv4.find(d);
+      nodes.push_back({d, config_.mesh_interface, ip == config_.mesh_ipv4.end() ? "" : ip->second});
+    }
+    return nodes;
+  };
+  if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) {
+    if (mechanism_) record->mechanism = std::string(faults::MechanismName(*mechanism_));
+    auto targets = faults::ResolveTarget(radio->target, config_.drones, leaders_, rng_);
+    if (!targets) return targets.error();
+    record->targets = *targets;
+    targets_[index] = *targets;
+    const auto before = installed_;
+    const auto changed = layers_.Push(f.id, *targets, radio->rules);
+    return ChangeRadio(before, changed);
+  }
+  if (const auto* partition = std::get_if<faults::PartitionFault>(&f.action)) {
+    record->mechanism = "iptables";
+    auto plan = faults::PlanPartition(*partition, mesh_nodes(), index);
+    if (!plan) return plan.error();
+    for (const auto& group : plan->groups) record->targets.insert(record->targets.end(), group.begin(), group.end());
+    targets_[index] = record->targets;
+    partitions_[index] = *plan;  // stored first: a half-applied partition is healed too
+    for (const auto& [node, commands] : plan->apply) SWARMBOX_TRY(faults::RunCommands(Sidecar(node), commands));
+    return Ok{};
+  }
+  if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
+    record->mechanism = "docker";
+    auto targets = faults::ResolveTarget(process->target, config_.drones, leaders_, rng_);
+    if (!targets) return targets.error();
+    record->targets = *targets;
+    targets_[index] = *targets;
+    std::vector<std::string> containers;
+    for (const std::string& d : *targets) {
+      auto c = config_.agents.find(d);
+      if (c == config_.agents.end()) return Error(ErrorCode::kInternal, "no container for drone " + d);
+      containers.push_back(c->second);
+    }
+    faults::ProcessPlan plan = faults::PlanProcessFault(*process, containers, f.duration_ms.has_value());
+    const bool takes_down = process->action != faults::ProcessAction::kPause;
+    if (takes_down) disrupted_.insert(targets->begin(), targets->end());
+    processes_[index] = plan;
+    Status s = faults::ExecuteDockerActions(api_, plan.apply);
+    if (process->action == faults::ProcessAction::kRestart) {
+      for (const std::string& d : *targets) {
+        disrupted_.erase(d);
+        resumed_.push_back(d);
+      }
+    }
+    return s;
+  }
+  return Error(ErrorCode::kInvalidArgument,
+               "fault " + f.id + " (" + std::string(f.kind()) + ") cannot be carried out by the runner",
+               f.mark.ToString());
+}
+
+Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record) {
+  const faults::Fault& f = timeline_.faults()[index];
+  if (auto t = targets_.find(index); t != targets_.end()) record->targets = t->second;
+  if (std::holds_alternative<faults::RadioFault>(f.action)) {
+    if (mechanism_) record->mechanism = std::string(faults::MechanismName(*mechanism_));
+    const auto before = installed_;
+    const auto changed = layers_.Pop(f.id);
+    return ChangeRadio(before, changed);
+  }
+  if (std::holds_alternative<faults::PartitionFault>(f.action)) {
+    record->mechanism = "iptables";
+    auto it = partitions_.find(index);
+    if (it == partitions_.end()) return Ok{};
+    Status first = Ok{};
+    for (const auto& [node, commands] : it->second.undo) {
+      Status s = faults::RunAllCommands(Sidecar(node), commands);
+      if (!s && first) first = s;
+    }
+    partitions_.erase(it);
+    return first;
+  }
+  if (std::holds_alternative<faults::ProcessFault>(f.action)) {
+    record->mechanism = "docker";
+    auto it = processes_.find(index);
+    if (it == processes_.end()) return Ok{};
+    Status s = faults::ExecuteDockerActions(api_, it->second.undo);
+    bool started = false;
+    for (const auto& a : it->second.undo) started = started || a.kind == faults::DockerAction::Kind::kStart;
+    if (started && s) {
+      for (const std::string& d : record->targets) {
+        disrupted_.erase(d);
+        resumed_.push_back(d);
+      }
+    }
+    processes_.erase(it);
+    return s;
+  }
+  return Ok{};
+}
+
+std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& actions) {
+  std::optional<Verdict> failure;
+  for (const TimelineAction& action : actions) {
+    const faults::Fault& f = timeline_.faults()[action.fault];
+    const bool apply = action.kind == TimelineAction::Kind::kApply;
+    faults::FaultEventRecord record = Record(apply ? FaultPhase::kApplied : FaultPhase::kRemoved);
+    Status s = apply ? Apply(action.fault, &record) : Remove(action.fault, &record);
+    if (!s) {
+      record.phase = FaultPhase::kFailed;
+      record.error = s.error().ToString();
+      if (!failure) {
+        failure = Verdict::Err("fault " + f.id + " (" + std::string(f.kind()) + ") could not be " +
+                                   (apply ? "applied" : "removed") + ": " + s.error().ToString(),
+                               "faults");
+      }
+    }
+    if (events_) events_(faults::FaultEventJson(f, record));
+  }
+  return failure;
+}
+
+std::optional<Verdict> FaultInjector::OnLogLine(const std::string& /*component*/, const std::string& line) {
+  if (torn_down_) return std::nullopt;
+  leaders_.Feed(line);
+  return Carry(timeline_.OnLogLine(line, wall_s_ ? wall_s_() : 0.0));
+}
+
+std::optional<Verdict> FaultInjector::Advance() {
+  if (torn_down_) return std::nullopt;
+  return Carry(timeline_.Advance(sim_s_ ? sim_s_() : 0.0, wall_s_ ? wall_s_() : 0.0));
+}
+
+Verdict FaultInjector::RemoveActive() {
+  auto failure = Carry(timeline_.RemoveAll());
+  if (failure) {
+    problems_.push_back(failure->reason);
+    return *failure;
+  }
+  return Verdict::Success();
+}
+
+Verdict FaultInjector::Teardown() {
+  if (torn_down_) return Verdict::Success();
+  Verdict v = RemoveActive();
+  torn_down_ = true;
+  if (!mechanism_) return v;
+  for (const std::string& drone : config_.drones) {
+    auto it = installed_.find(drone);
+    if (it == installed_.end() || it->second.empty()) continue;
+    faults::FaultEventRecord record = Record(FaultPhase::kRemoved);
+    record.mechanism = std::string(faults::MechanismName(*mechanism_));
+    Status s = [&]() -> Status {
+      auto plan = faults::PlanRadio(it->second, LinkOf(drone), *mechanism_, PlanOptions());
+      if (!plan) return plan.error();
+      return faults::RunAllCommands(Sidecar(drone), plan->undo);
+    }();
+    if (!s) {
+      record.phase = FaultPhase::kFailed;
+      record.error = s.error().ToString();
+      problems_.push_back("undoing the radio rules on " + drone + ": " + s.error().ToString());
+      v.KeepWorse(Verdict::FromError(s.error().Context("undoing the radio rules on " + drone), "faults"));
+    }
+    if (events_) events_(faults::MeshEventJson(drone, it->second, record));
+    installed_.erase(it);
+  }
+  return v;
+}
+
+std::vector<std::string> FaultInjector::TakeResumed() {
+  std::vector<std::string> out;
+  out.swap(resumed_);
+  return out;
+}
+
+}  // namespace swarmbox::runner
