@@ -51,6 +51,24 @@ struct ImagesArgs {
 };
 int ImagesCommand(const ImagesArgs& args);
 
+struct ExperimentArgs {
+  std::string experiment;
+  std::string out;                  // "" = runs/<name>-<run id>
+  std::vector<std::string> hosts;   // "" = the file's hosts:, else local
+  bool resume = false;
+  std::vector<std::string> filter;  // replaces the file's filter
+  int max_attempts = 3;
+  std::string run_id;
+  bool quiet = false;
+  ProgramPaths programs;
+};
+int ExperimentCommand(const ExperimentArgs& args);
+
+struct ReportArgs {
+  std::string dir;
+};
+int ReportCommand(const ReportArgs& args);
+
 struct GcArgs {
   std::string run_id;  // "" = every run
 };

@@ -47,6 +47,31 @@ int main(int argc, char** argv) {
   images_cmd->add_option("--agent-bin", images.programs.agent_bin, "Host-built swarmbox-agent");
   images_cmd->add_flag("--no-faults", no_faults, "Skip the fault-injection sidecar image");
 
+  ExperimentArgs exp;
+  auto* exp_cmd = app.add_subcommand(
+      "experiment", "Run an experiment's trials over a pool of hosts into <out>/ (resumable)");
+  exp_cmd->add_option("experiment", exp.experiment, "Experiment description (YAML)")->required();
+  exp_cmd->add_option("--out", exp.out, "Output folder (default: runs/<name>-<run id>)");
+  exp_cmd->add_option("--hosts", exp.hosts,
+                      "Hosts: local[?slots=N], ssh://user@host[:port][?slots=N&socket=PATH&"
+                      "identity=KEY&known_hosts=FILE] (default: the file's hosts, else local)")
+      ->allow_extra_args(false);
+  exp_cmd->add_flag("--resume", exp.resume, "Run only the trials of --out without result.json");
+  exp_cmd->add_option("--filter", exp.filter, "Run only codes matching a pattern (? = any level)")
+      ->allow_extra_args(false);
+  exp_cmd->add_option("--max-attempts", exp.max_attempts,
+                      "Attempts per trial when hosts fail under it (default 3)")
+      ->check(CLI::Range(1, 20));
+  exp_cmd->add_option("--run-id", exp.run_id, "Run id (default: UTC time + random)");
+  exp_cmd->add_flag("--quiet", exp.quiet, "No progress on the terminal");
+  exp_cmd->add_option("--physics-bin", exp.programs.physics_bin, "Host-built swarmbox-physics");
+  exp_cmd->add_option("--agent-bin", exp.programs.agent_bin, "Host-built swarmbox-agent");
+
+  ReportArgs report;
+  auto* report_cmd =
+      app.add_subcommand("report", "Regenerate results.csv and report.html of an experiment folder");
+  report_cmd->add_option("dir", report.dir, "Experiment folder")->required();
+
   GcArgs gc;
   auto* gc_cmd = app.add_subcommand("gc", "Remove containers and networks left by killed runs");
   gc_cmd->add_option("--run", gc.run_id, "Only this run id (default: every run)");
@@ -64,6 +89,8 @@ int main(int argc, char** argv) {
     images.faults = !no_faults;
     return ImagesCommand(images);
   }
+  if (*exp_cmd) return ExperimentCommand(exp);
+  if (*report_cmd) return ReportCommand(report);
   if (*gc_cmd) return GcCommand(gc);
   return kExitUsage;
 }

@@ -1,0 +1,145 @@
+// swarmbox experiment EXPERIMENT.yaml [--out DIR] [--hosts SPEC ...] [--resume]
+//
+// Loads and checks the experiment and every trial it expands to (exit 2 on bad input), connects
+// the hosts (ssh tunnels for ssh:// hosts), builds the images on each host that lacks them, then
+// runs the trials over every slot (experiment_runner.hpp) with a live board on stderr. Exit 0 when
+// every trial of the experiment has an outcome (result.json), 3 when some could not be run (no host
+// left, image builds failed: --resume runs them later), 1 when stopped with Ctrl-C, 2 bad input.
+#include <unistd.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <thread>
+
+#include "commands.hpp"
+#include "interrupt.hpp"
+#include "program_images.hpp"
+#include "swarmbox/experiment/experiment_runner.hpp"
+#include "swarmbox/experiment/experiment_spec.hpp"
+#include "swarmbox/hosts/host.hpp"
+#include "swarmbox/runner/naming.hpp"
+
+namespace swarmbox::cli {
+
+namespace fs = std::filesystem;
+
+int ExperimentCommand(const ExperimentArgs& args) {
+  auto spec = experiment::LoadExperiment(args.experiment);
+  if (!spec) {
+    std::cerr << spec.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  if (!args.filter.empty()) spec->filter = args.filter;
+  auto plan = experiment::PlanExperiment(*spec);
+  if (!plan) {
+    std::cerr << plan.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  if (args.resume && args.out.empty()) {
+    std::cerr << "swarmbox experiment: --resume needs --out DIR (the folder of the run to resume)\n";
+    return kExitUsage;
+  }
+  const std::vector<std::string> host_texts =
+      !args.hosts.empty() ? args.hosts
+                          : (!spec->hosts.empty() ? spec->hosts : std::vector<std::string>{"local"});
+  auto host_specs = hosts::ParseHostSpecs(host_texts);
+  if (!host_specs) {
+    std::cerr << host_specs.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
+  const std::string out = args.out.empty() ? "runs/" + spec->name + "-" + run_id : args.out;
+  const std::atomic<bool>& interrupted = InstallInterruptHandlers();
+  auto say = [&](const std::string& line) {
+    if (!args.quiet) std::cerr << line << "\n";
+  };
+  say("swarmbox experiment " + spec->name + ": " + std::to_string(plan->trials.size()) +
+      " trials, run " + run_id + " -> " + out);
+
+  // Hosts: connect and build the images, each host on its own thread (a remote build is slow).
+  // Forwarded sockets live in a short private folder (unix socket paths are limited to 108 bytes).
+  const std::string workdir = "/tmp/swarmbox-" + run_id;
+  std::vector<std::unique_ptr<hosts::Host>> connected(host_specs->size());
+  std::vector<runner::Images> images(host_specs->size());
+  std::mutex say_mu;
+  std::vector<std::thread> threads;
+  for (std::size_t i = 0; i < host_specs->size(); ++i) {
+    threads.emplace_back([&, i] {
+      const hosts::HostSpec& hs = (*host_specs)[i];
+      auto host = hosts::ConnectHost(hs, workdir);
+      if (!host) {
+        std::lock_guard lock(say_mu);
+        std::cerr << "swarmbox experiment: host " << hs.name() << " left out: "
+                  << host.error().ToString() << "\n";
+        return;
+      }
+      auto built = EnsureTrialImages((*host)->api(), args.programs, [&](std::string_view line) {
+        if (args.quiet) return;
+        std::lock_guard lock(say_mu);
+        std::cerr << "  [" << hs.name() << "] " << line << "\n";
+      });
+      if (!built) {
+        std::lock_guard lock(say_mu);
+        std::cerr << "swarmbox experiment: host " << hs.name()
+                  << " left out: images: " << built.error().ToString() << "\n";
+        return;
+      }
+      images[i] = *built;
+      connected[i] = std::move(*host);
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  std::vector<experiment::PoolHost> pool;
+  for (std::size_t i = 0; i < connected.size(); ++i) {
+    if (!connected[i]) continue;
+    hosts::Host* h = connected[i].get();
+    pool.push_back({h->name(), h->slots(), &h->api(), [h] { return h->Check(); }, images[i]});
+  }
+  if (pool.empty()) {
+    std::cerr << "swarmbox experiment: no host is usable (see above)\n";
+    std::error_code ec;
+    fs::remove_all(workdir, ec);
+    return kExitInfrastructure;
+  }
+  if (interrupted.load()) {
+    std::cerr << "swarmbox experiment: interrupted (Ctrl-C) before any trial started\n";
+    return kExitOutcome;
+  }
+
+  experiment::ExperimentOptions options;
+  options.out_dir = out;
+  options.run_id = run_id;
+  options.resume = args.resume;
+  options.max_attempts = args.max_attempts;
+  options.interrupted = &interrupted;
+  options.progress = args.quiet ? nullptr : &std::cerr;
+  options.progress_tty = !args.quiet && ::isatty(STDERR_FILENO) == 1;
+  auto summary = experiment::RunExperiment(*plan, pool, options);
+  connected.clear();  // closes the tunnels
+  std::error_code ec;
+  fs::remove_all(workdir, ec);
+  if (!summary) {
+    std::cerr << "swarmbox experiment: " << summary.error().ToString() << "\n";
+    return summary.error().code() == ErrorCode::kInvalidArgument ? kExitUsage : kExitInfrastructure;
+  }
+  for (const std::string& p : summary->problems) std::cerr << "  note: " << p << "\n";
+  std::cout << out << ": " << summary->committed << "/" << summary->total << " trials";
+  std::string sep = " (";
+  for (const auto& [outcome, n] : summary->outcomes) {
+    std::cout << sep << outcome << " " << n;
+    sep = ", ";
+  }
+  std::cout << (summary->outcomes.empty() ? "" : ")") << "; " << out << "/results.csv, " << out
+            << "/report.html\n";
+  if (interrupted.load()) return kExitOutcome;
+  if (summary->committed < summary->total) {
+    std::cerr << "swarmbox experiment: " << (summary->total - summary->committed)
+              << " trials have no result: run again with --resume --out " << out << "\n";
+    return kExitInfrastructure;
+  }
+  return kExitOk;
+}
+
+}  // namespace swarmbox::cli

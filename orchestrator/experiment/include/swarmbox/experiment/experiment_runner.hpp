@@ -1,0 +1,86 @@
+// Running an experiment: every planned trial on a pool of hosts, into one folder, resumable.
+//
+//   auto spec = LoadExperiment("trials/experiments/radio.yaml");
+//   auto plan = PlanExperiment(*spec);                       // every trial loaded and checked
+//   std::vector<PoolHost> pool = {{"local", 2, &local_api, check, images}};
+//   ExperimentOptions o;  o.out_dir = "runs/radio";  o.run_id = runner::NewRunId();
+//   auto summary = RunExperiment(*plan, pool, o);
+//
+// Per attempt (TrialExecutor): a fresh staging folder, runner::RunTrialSpec with run id = the
+// experiment's run id, trial id = name = the planned id (so parallel trials never collide and
+// `swarmbox gc --run <run id>` finds all of an experiment on a host), host = the host's name.
+// When the trial ends with outcome `error` and the host no longer answers, the attempt is the
+// host's failure: its folder goes to .failed/, the trial back to the queue (scheduler.hpp).
+// Otherwise trial_meta.json is added and the folder committed (trial_store.hpp). A trial that
+// runs out of attempts is committed with outcome `error` and the reasons.
+// At the end: every host still reachable is checked for anything left with the run's label (and
+// cleaned), then results.csv and report.html are written from the trial folders.
+#pragma once
+
+#include <atomic>
+#include <functional>
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/docker/docker_api.hpp"
+#include "swarmbox/dsl/trial_spec.hpp"
+#include "swarmbox/experiment/experiment_spec.hpp"
+#include "swarmbox/experiment/scheduler.hpp"
+#include "swarmbox/runner/runner.hpp"
+
+namespace swarmbox::experiment {
+
+struct ExperimentPlan {
+  ExperimentSpec spec;
+  std::vector<PlannedTrial> trials;
+  std::map<std::string, dsl::TrialSpec> specs;  // by trial id
+};
+
+// Loads every trial (the base file with its overrides) through dsl::LoadTrial, so a bad level
+// value stops the experiment before anything runs (kInvalidArgument naming the trial and the
+// override).
+Result<ExperimentPlan> PlanExperiment(const ExperimentSpec& spec);
+
+struct PoolHost {
+  std::string name;
+  int slots = 1;
+  docker::DockerApi* api = nullptr;
+  std::function<Status()> check;  // does the engine answer now (with the host-level reason)
+  runner::Images images;          // the images built on this host
+};
+
+struct ExperimentOptions {
+  std::string out_dir;
+  std::string run_id;
+  bool resume = false;
+  int max_attempts = 3;
+  const std::atomic<bool>* interrupted = nullptr;
+  std::ostream* progress = nullptr;  // the live board; nullptr = quiet
+  bool progress_tty = false;         // redraw in place (ANSI) rather than print blocks
+  double progress_every_s = 2.0;
+  runner::RunOptions trial_options;  // the template for every trial (out_dir, run_id, trial_id,
+                                     // host, images and interrupted are set per attempt)
+};
+
+struct ExperimentSummary {
+  std::vector<TrialReport> reports;  // one per trial run in this session
+  std::size_t total = 0;             // trials in the plan
+  std::size_t done_before = 0;       // committed by an earlier run (--resume)
+  std::size_t committed = 0;         // trials with a result.json now
+  std::map<std::string, std::size_t> outcomes;  // over every committed trial
+  std::vector<std::string> problems;  // cleanup and report issues, hosts that left
+};
+
+// kInvalidArgument: the folder already holds this experiment's trials and resume is false, or it
+// holds another experiment. kUnavailable: another run holds the folder. kIo: folder not writable.
+Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
+                                        const ExperimentOptions& options);
+
+// results.csv and report.html of an experiment folder, from its trial folders (also
+// `swarmbox report DIR`). Returns the number of trials found.
+Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::string>* problems);
+
+}  // namespace swarmbox::experiment

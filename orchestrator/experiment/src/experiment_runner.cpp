@@ -1,0 +1,400 @@
+#include "swarmbox/experiment/experiment_runner.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/docker/remove_labelled.hpp"
+#include "swarmbox/dsl/trial_loader.hpp"
+#include "swarmbox/experiment/progress.hpp"
+#include "swarmbox/experiment/trial_store.hpp"
+#include "swarmbox/report/report_html.hpp"
+#include "swarmbox/report/results_csv.hpp"
+#include "swarmbox/report/trial_record.hpp"
+
+namespace swarmbox::experiment {
+
+namespace fs = std::filesystem;
+using yaml::Node;
+
+namespace {
+
+Node Str(std::string_view s) { return Node::Scalar(std::string(s), {}, /*quoted=*/true); }
+
+std::vector<std::string> FactorNamesOf(const ExperimentSpec& spec) {
+  std::vector<std::string> names;
+  for (const Factor& f : spec.factors) names.push_back(f.name);
+  return names;
+}
+
+report::TrialMeta MetaOf(const ExperimentSpec& spec, const PlannedTrial& t, int attempts,
+                         std::vector<std::string> hosts) {
+  report::TrialMeta m;
+  m.id = t.id;
+  m.code = t.code;
+  m.factors = FactorNamesOf(spec);
+  m.levels = t.levels;
+  m.repetition = t.repetition;
+  m.seed = t.seed;
+  m.attempts = attempts;
+  m.hosts = std::move(hosts);
+  return m;
+}
+
+// Shared state of one RunExperiment: the attempt history and the one monotonic clock.
+struct Session {
+  const ExperimentPlan* plan = nullptr;
+  const ExperimentOptions* options = nullptr;
+  TrialStore* store = nullptr;
+  std::mutex mu;
+  std::map<std::string, std::vector<std::string>> hosts_of;  // trial -> host per attempt
+  runner::SteadyClock clock;
+
+  void AttemptOn(const std::string& trial, const std::string& host) {
+    std::lock_guard lock(mu);
+    hosts_of[trial].push_back(host);
+  }
+  std::vector<std::string> HostsOf(const std::string& trial) {
+    std::lock_guard lock(mu);
+    return hosts_of[trial];
+  }
+};
+
+// Writes a result.json of outcome error for a trial that never produced one, and commits it.
+Status CommitError(Session& s, const PlannedTrial& t, int attempts, const std::string& host,
+                   const std::string& reason) {
+  auto staging = s.store->Staging(t.id, 0);
+  if (!staging) return staging.error();
+  runner::TrialResult r;
+  r.trial = t.id;
+  r.trial_id = t.id;
+  r.run_id = s.options->run_id;
+  r.verdict = dsl::Verdict::Err(reason, "experiment");
+  r.seed = t.seed;
+  r.host = host;
+  const fs::path dir(*staging);
+  const dsl::TrialSpec& spec = s.plan->specs.at(t.id);
+  SWARMBOX_TRY(WriteFileAtomic((dir / "trial.yaml").string(),
+                               yaml::Emit(spec.document.is_null() ? dsl::ToDocument(spec)
+                                                                  : spec.document)));
+  SWARMBOX_TRY(WriteFileAtomic(
+      (dir / "trial_meta.json").string(),
+      report::TrialMetaJson(MetaOf(s.plan->spec, t, attempts, s.HostsOf(t.id)))));
+  SWARMBOX_TRY(WriteFileAtomic((dir / "result.json").string(), runner::ResultJson(r)));
+  return s.store->Commit(t.id, *staging);
+}
+
+class TrialExecutor final : public HostWorker {
+ public:
+  TrialExecutor(Session& session, const PoolHost& host) : s_(session), host_(host) {}
+  std::string name() const override { return host_.name; }
+  int slots() const override { return host_.slots; }
+
+  AttemptResult Run(const PlannedTrial& t, int attempt) override {
+    s_.AttemptOn(t.id, host_.name);
+    auto staging = s_.store->Staging(t.id, attempt);
+    if (!staging) return Lost("cannot make the staging folder: " + staging.error().ToString());
+    const ExperimentOptions& eo = *s_.options;
+    runner::RunOptions o = eo.trial_options;
+    o.out_dir = *staging;
+    o.run_id = eo.run_id;
+    o.trial_id = t.id;
+    o.host = host_.name;
+    o.images = host_.images;
+    o.interrupted = eo.interrupted;
+    std::ofstream log(fs::path(*staging) / "orchestrator.log");
+    o.progress = &log;
+    auto run = runner::RunTrialSpec(s_.plan->specs.at(t.id), *host_.api, s_.clock, o);
+    log.close();
+    const bool interrupted = eo.interrupted != nullptr && eo.interrupted->load();
+    if (interrupted) {
+      return {AttemptResult::Kind::kCancelled, "", "interrupted (Ctrl-C)"};
+    }
+    if (!run) {
+      if (Status h = host_.check(); !h) return Lost(h.error().message(), *staging, t.id, attempt);
+      // The host answers but the trial could not start (not the host's fault): an outcome.
+      const std::string reason = "could not start: " + run.error().ToString();
+      if (Status c = CommitError(s_, t, attempt, host_.name, reason); !c) {
+        return Lost("cannot record the trial: " + c.error().ToString());
+      }
+      return {AttemptResult::Kind::kCompleted, "error", reason};
+    }
+    const runner::TrialResult& r = run->result;
+    if (r.verdict.outcome == dsl::Outcome::kError) {
+      if (Status h = host_.check(); !h) {
+        return Lost(h.error().message() + " (trial: " + r.verdict.reason + ")", run->trial_dir,
+                    t.id, attempt);
+      }
+    }
+    std::error_code ec;
+    fs::rename(fs::path(*staging) / "orchestrator.log",
+               fs::path(run->trial_dir) / "orchestrator.log", ec);
+    Status meta = WriteFileAtomic(
+        (fs::path(run->trial_dir) / "trial_meta.json").string(),
+        report::TrialMetaJson(MetaOf(s_.plan->spec, t, attempt, s_.HostsOf(t.id))));
+    if (!meta) return Lost("cannot write trial_meta.json: " + meta.error().ToString());
+    if (Status c = s_.store->Commit(t.id, run->trial_dir); !c) {
+      return Lost("cannot commit the trial: " + c.error().ToString());
+    }
+    fs::remove_all(*staging, ec);
+    return {AttemptResult::Kind::kCompleted, std::string(dsl::OutcomeName(r.verdict.outcome)),
+            r.verdict.reason};
+  }
+
+ private:
+  AttemptResult Lost(std::string reason, const std::string& dir = {}, const std::string& id = {},
+                     int attempt = 0) {
+    if (!dir.empty()) (void)s_.store->Discard(id, attempt, dir);
+    return {AttemptResult::Kind::kHostFailed, "", std::move(reason)};
+  }
+
+  Session& s_;
+  const PoolHost& host_;
+};
+
+// Updates the board and prints it; records exhausted trials.
+class Observer final : public ScheduleObserver {
+ public:
+  Observer(Session& s, ProgressBoard& board, std::mutex& board_mu, std::vector<std::string>& problems)
+      : s_(s), board_(board), board_mu_(board_mu), problems_(problems) {}
+
+  void OnStart(const std::string& host, const PlannedTrial& t, int /*attempt*/) override {
+    std::lock_guard lock(board_mu_);
+    board_.Started(host, t.id, s_.clock.NowS());
+  }
+  void OnFinish(const std::string& host, const PlannedTrial& t, const AttemptResult& r) override {
+    std::lock_guard lock(board_mu_);
+    board_.Finished(host, t.id, r.kind == AttemptResult::Kind::kCompleted ? r.outcome : "",
+                    s_.clock.NowS());
+  }
+  void OnHostDown(const std::string& host, const std::string& reason) override {
+    {
+      std::lock_guard lock(board_mu_);
+      board_.HostDown(host, reason);
+    }
+    problems_.push_back("host " + host + " left the pool: " + reason);
+    if (s_.options->progress != nullptr) {
+      *s_.options->progress << "swarmbox experiment: host " << host << " left the pool: " << reason
+                            << "\n";
+    }
+  }
+  void OnExhausted(const PlannedTrial& t, const std::string& reason) override {
+    const auto hosts = s_.HostsOf(t.id);
+    if (Status c = CommitError(s_, t, static_cast<int>(hosts.size()),
+                               hosts.empty() ? "" : hosts.back(), reason);
+        !c) {
+      problems_.push_back("cannot record " + t.id + ": " + c.error().ToString());
+    }
+    std::lock_guard lock(board_mu_);
+    board_.Exhausted(t.id);
+  }
+
+ private:
+  Session& s_;
+  ProgressBoard& board_;
+  std::mutex& board_mu_;
+  std::vector<std::string>& problems_;
+};
+
+std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::string>& run_ids) {
+  Node doc = Node::Mapping();
+  doc.Set("name", Str(plan.spec.name));
+  doc.Set("file", Str(plan.spec.file));
+  doc.Set("base", Str(plan.spec.base_trial));
+  Node factors = Node::Sequence();
+  for (const Factor& f : plan.spec.factors) factors.Append(Str(f.name));
+  doc.Set("factors", std::move(factors));
+  doc.Set("trials", Node::Scalar(std::to_string(plan.trials.size())));
+  Node ids = Node::Sequence();
+  for (const std::string& id : run_ids) ids.Append(Str(id));
+  doc.Set("run_ids", std::move(ids));
+  return yaml::EmitJson(doc) + "\n";
+}
+
+}  // namespace
+
+Result<ExperimentPlan> PlanExperiment(const ExperimentSpec& spec) {
+  ExperimentPlan plan;
+  plan.spec = spec;
+  auto trials = ExpandTrials(spec);
+  if (!trials) return trials.error();
+  plan.trials = std::move(*trials);
+  for (const PlannedTrial& t : plan.trials) {
+    dsl::LoadOptions load;
+    load.overrides = t.overrides;
+    auto trial = dsl::LoadTrial(spec.base_trial, load);
+    if (!trial) return trial.error().Context("trial " + t.id + " (code " + t.code + ")");
+    plan.specs.emplace(t.id, std::move(*trial));
+  }
+  return plan;
+}
+
+Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::string>* problems) {
+  auto records = report::ReadExperimentFolder(out_dir, problems);
+  const auto factors = report::FactorNames(out_dir, records);
+  SWARMBOX_TRY(WriteFileAtomic((fs::path(out_dir) / "results.csv").string(),
+                               report::ResultsCsv(factors, records)));
+  std::string title = fs::path(out_dir).lexically_normal().filename().string();
+  if (title.empty()) title = out_dir;
+  SWARMBOX_TRY(WriteFileAtomic((fs::path(out_dir) / "report.html").string(),
+                               report::ReportHtml("SwarmBox experiment " + title, factors, records)));
+  return records.size();
+}
+
+Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
+                                        const ExperimentOptions& options) {
+  auto dir_lock = DirLock::Acquire(options.out_dir);
+  if (!dir_lock) return dir_lock.error();
+  TrialStore store(options.out_dir);
+  const fs::path meta_path = fs::path(options.out_dir) / "experiment.json";
+  std::vector<std::string> run_ids;
+  std::error_code ec;
+  if (fs::exists(meta_path, ec)) {
+    auto doc = yaml::ParseFile(meta_path.string());
+    if (!doc || !doc->is_mapping()) {
+      return Error(ErrorCode::kInvalidArgument, "cannot read experiment.json", meta_path.string());
+    }
+    const Node* name = doc->Find("name");
+    if (name == nullptr || name->scalar() != plan.spec.name) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "the folder holds another experiment ('" +
+                       (name == nullptr ? std::string("?") : name->scalar()) +
+                       "'): choose another --out",
+                   options.out_dir);
+    }
+    if (const Node* ids = doc->Find("run_ids"); ids != nullptr && ids->is_sequence()) {
+      for (const Node& id : ids->items()) run_ids.push_back(id.scalar());
+    }
+    const bool any_done = std::any_of(plan.trials.begin(), plan.trials.end(),
+                                      [&](const PlannedTrial& t) { return store.Done(t.id); });
+    if (any_done && !options.resume) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "the folder already holds trials of this experiment: add --resume to run the "
+                   "ones without result.json, or choose another --out",
+                   options.out_dir);
+    }
+  }
+  ExperimentSummary summary;
+  // What a killed earlier run of this folder left on the hosts (its run ids).
+  for (const std::string& old : run_ids) {
+    docker::LabelSelector sel;
+    sel.equals[std::string(docker::kLabelRun)] = old;
+    for (const PoolHost& h : pool) {
+      if (auto removed = docker::RemoveLabelled(*h.api, sel, false);
+          removed && !removed->containers.empty()) {
+        summary.problems.push_back("removed " + std::to_string(removed->containers.size()) +
+                                   " containers of the earlier run " + old + " on " + h.name);
+      }
+    }
+  }
+  SWARMBOX_TRY(store.ClearStaging());
+  run_ids.push_back(options.run_id);
+  SWARMBOX_TRY(WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids)));
+
+  const std::vector<PlannedTrial> pending = store.Pending(plan.trials);
+  summary.total = plan.trials.size();
+  summary.done_before = plan.trials.size() - pending.size();
+
+  Session session;
+  session.plan = &plan;
+  session.options = &options;
+  session.store = &store;
+  std::vector<std::pair<std::string, int>> host_rows;
+  for (const PoolHost& h : pool) host_rows.emplace_back(h.name, h.slots);
+  ProgressBoard board(host_rows, plan.trials.size(), summary.done_before);
+  std::mutex board_mu;
+  std::vector<std::string> problems;
+  Observer observer(session, board, board_mu, problems);
+
+  // The printer: redraws in place on a terminal, else prints the board every progress_every_s.
+  std::mutex stop_mu;
+  std::condition_variable stop_cv;
+  bool stop = false;
+  std::thread printer;
+  std::size_t drawn = 0;
+  auto draw = [&] {
+    if (options.progress == nullptr) return;
+    std::vector<std::string> lines;
+    {
+      std::lock_guard lock(board_mu);
+      lines = board.Render(session.clock.NowS());
+    }
+    std::string out;
+    if (options.progress_tty && drawn > 0) out += "\x1b[" + std::to_string(drawn) + "A";
+    for (const std::string& l : lines) out += (options.progress_tty ? "\x1b[2K" : "") + l + "\n";
+    *options.progress << out << std::flush;
+    drawn = lines.size();
+  };
+  if (options.progress != nullptr) {
+    printer = std::thread([&] {
+      const auto every = std::chrono::milliseconds(
+          static_cast<long>((options.progress_tty ? 1.0 : options.progress_every_s) * 1000));
+      std::unique_lock lock(stop_mu);
+      while (!stop) {
+        lock.unlock();
+        draw();
+        lock.lock();
+        stop_cv.wait_for(lock, every, [&] { return stop; });
+      }
+    });
+  }
+
+  std::vector<std::unique_ptr<TrialExecutor>> executors;
+  std::vector<HostWorker*> workers;
+  for (const PoolHost& h : pool) {
+    executors.push_back(std::make_unique<TrialExecutor>(session, h));
+    workers.push_back(executors.back().get());
+  }
+  ScheduleOptions so;
+  so.max_attempts = options.max_attempts;
+  so.interrupted = options.interrupted;
+  summary.reports = RunSchedule(pending, workers, so, observer);
+
+  if (printer.joinable()) {
+    {
+      std::lock_guard lock(stop_mu);
+      stop = true;
+    }
+    stop_cv.notify_all();
+    printer.join();
+    draw();
+  }
+
+  // Nothing of this run may stay on any host it can still reach.
+  docker::LabelSelector sel;
+  sel.equals[std::string(docker::kLabelRun)] = options.run_id;
+  for (const PoolHost& h : pool) {
+    if (Status up = h.check(); !up) {
+      problems.push_back("could not check " + h.name + " for leftovers (" + up.error().message() +
+                         "): when it is back, run `swarmbox gc --run " + options.run_id +
+                         "` against it");
+      continue;
+    }
+    auto removed = docker::RemoveLabelled(*h.api, sel, false);
+    if (!removed) {
+      problems.push_back("listing leftovers on " + h.name + ": " + removed.error().ToString());
+    } else if (!removed->containers.empty() || !removed->networks.empty()) {
+      problems.push_back("removed leftovers on " + h.name + ": " +
+                         std::to_string(removed->containers.size()) + " containers, " +
+                         std::to_string(removed->networks.size()) + " networks");
+    }
+  }
+  summary.problems.insert(summary.problems.end(), problems.begin(), problems.end());
+  if (auto n = WriteReports(options.out_dir, &summary.problems); !n) {
+    summary.problems.push_back("writing results.csv/report.html: " + n.error().ToString());
+  }
+  for (const PlannedTrial& t : plan.trials) {
+    if (!store.Done(t.id)) continue;
+    ++summary.committed;
+    if (auto rec = report::ReadTrialFolder(store.TrialDir(t.id))) summary.outcomes[rec->outcome] += 1;
+  }
+  return summary;
+}
+
+}  // namespace swarmbox::experiment
