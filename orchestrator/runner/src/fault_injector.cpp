@@ -269,9 +269,18 @@ Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record
     record->mechanism = "docker";
     auto it = processes_.find(index);
     if (it == processes_.end()) return Ok{};
-    Status s = faults::ExecuteDockerActions(api_, it->second.undo);
+    std::vector<faults::DockerAction> undo = it->second.undo;
+    // A pause without a duration lasts until the end: unpaused here, so teardown can stop it.
+    if (undo.empty()) {
+      for (const auto& a : it->second.apply) {
+        if (a.kind == faults::DockerAction::Kind::kPause) {
+          undo.push_back({faults::DockerAction::Kind::kUnpause, a.container, "", 0});
+        }
+      }
+    }
+    Status s = faults::ExecuteDockerActions(api_, undo);
     bool started = false;
-    for (const auto& a : it->second.undo) started = started || a.kind == faults::DockerAction::Kind::kStart;
+    for (const auto& a : undo) started = started || a.kind == faults::DockerAction::Kind::kStart;
     if (started && s) {
       for (const std::string& d : record->targets) {
         disrupted_.erase(d);

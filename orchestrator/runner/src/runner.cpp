@@ -226,7 +226,9 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
         if (auto v = monitor->OnLine(item.component, item.text)) raise(item.component, *v, false);
       }
       if (injector && tree && !tree->end_verdict()) {
+        // The line may move simulated time on: `at:` faults fire at the line that crosses.
         if (auto v = injector->OnLogLine(item.component, item.text)) tree->RaiseShutdown(*v);
+        if (auto v = injector->Advance(); v && !tree->end_verdict()) tree->RaiseShutdown(*v);
         resume_logs();
       }
       return;

@@ -30,6 +30,10 @@ std::vector<std::string> FakeDockerApi::Calls() const {
   std::lock_guard lock(mu_);
   return calls_;
 }
+std::vector<docker::ContainerSpec> FakeDockerApi::Created() const {
+  std::lock_guard lock(mu_);
+  return created_;
+}
 std::map<std::string, FakeDockerApi::Container> FakeDockerApi::Containers() const {
   std::lock_guard lock(mu_);
   return containers_;
@@ -132,7 +136,16 @@ Result<std::string> FakeDockerApi::CreateContainer(const docker::ContainerSpec& 
   for (const auto& e : spec.networks) {
     if (networks_.count(e.network) == 0) return Error(ErrorCode::kNotFound, "no such network " + e.network);
   }
+  if (spec.network_mode.rfind("container:", 0) == 0) {
+    if (Find(spec.network_mode.substr(10)) == nullptr) {
+      return Error(ErrorCode::kNotFound, "No such container: " + spec.network_mode.substr(10));
+    }
+    if (!spec.networks.empty() || !spec.hostname.empty()) {
+      return Error(ErrorCode::kInvalidArgument, "conflicting options: networks/hostname and the network mode");
+    }
+  }
   const std::string id = "c" + std::to_string(next_id_++);
+  created_.push_back(spec);
   Container c;
   c.spec = spec;
   auto label = spec.labels.find(std::string(docker::kLabelComponent));
@@ -178,10 +191,25 @@ Status FakeDockerApi::StartContainer(std::string_view id) {
   if (scripts[c->component].fail_start) {
     return Error(ErrorCode::kInternal, "exec format error", "POST /containers/start");
   }
-  c->state.status = "running";
-  c->state.running = true;
+  if (c->spec.network_mode.rfind("container:", 0) == 0) {
+    Container* owner = Find(c->spec.network_mode.substr(10));
+    if (owner == nullptr || !owner->state.running) {
+      return Error(ErrorCode::kInvalidArgument, "cannot join network of a non running container");
+    }
+  }
+  if (!c->state.running) StartLocked(*c);
   cv_.notify_all();
   return Ok{};
+}
+
+void FakeDockerApi::StartLocked(Container& c) {
+  const ContainerScript& s = scripts[c.component];
+  const auto& lines = c.starts == 0 ? s.lines : s.restart_lines;
+  c.history.insert(c.history.end(), lines.begin(), lines.end());
+  ++c.starts;
+  c.state.status = "running";
+  c.state.running = true;
+  c.state.paused = false;
 }
 
 Status FakeDockerApi::StopContainer(std::string_view id, int) {
@@ -198,10 +226,53 @@ Status FakeDockerApi::StopContainer(std::string_view id, int) {
   return Ok{};
 }
 
-Status FakeDockerApi::RestartContainer(std::string_view, int) { return NotModelled("RestartContainer"); }
-Status FakeDockerApi::KillContainer(std::string_view, std::string_view) { return NotModelled("KillContainer"); }
-Status FakeDockerApi::PauseContainer(std::string_view) { return NotModelled("PauseContainer"); }
-Status FakeDockerApi::UnpauseContainer(std::string_view) { return NotModelled("UnpauseContainer"); }
+Status FakeDockerApi::RestartContainer(std::string_view id, int timeout_s) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  calls_.push_back("restart " + c->spec.name + " " + std::to_string(timeout_s));
+  StartLocked(*c);  // a new run: a follower of the old one sees `starts` change and ends
+  cv_.notify_all();
+  return Ok{};
+}
+
+Status FakeDockerApi::KillContainer(std::string_view id, std::string_view signal) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  calls_.push_back("kill " + c->spec.name + " " + std::string(signal));
+  if (!c->state.running) {
+    return Error(ErrorCode::kInvalidArgument, "Container " + std::string(id) + " is not running");
+  }
+  c->state.running = false;
+  c->state.paused = false;
+  c->state.status = "exited";
+  c->state.exit_code = signal == "SIGTERM" ? 143 : 137;
+  cv_.notify_all();
+  return Ok{};
+}
+
+Status FakeDockerApi::PauseContainer(std::string_view id) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  calls_.push_back("pause " + c->spec.name);
+  if (!c->state.running) return Error(ErrorCode::kInvalidArgument, "container is not running");
+  c->state.paused = true;
+  c->state.status = "paused";
+  return Ok{};
+}
+
+Status FakeDockerApi::UnpauseContainer(std::string_view id) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  calls_.push_back("unpause " + c->spec.name);
+  if (!c->state.paused) return Error(ErrorCode::kInvalidArgument, "container is not paused");
+  c->state.paused = false;
+  c->state.status = "running";
+  return Ok{};
+}
 Result<std::int64_t> FakeDockerApi::WaitContainer(std::string_view, docker::WaitCondition,
                                                   docker::CancelToken*) {
   return NotModelled("WaitContainer");
@@ -228,13 +299,15 @@ Status FakeDockerApi::FollowLogs(std::string_view id, const docker::LogOptions&,
   std::vector<std::string> lines;
   std::optional<std::int64_t> exit_code;
   bool broken = false;
+  int starts = 0;
   {
     std::lock_guard lock(mu_);
     Container* c = Find(id);
     if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
     ++c->follows;
     ContainerScript& s = scripts[c->component];
-    lines = s.lines;
+    lines = c->history;
+    starts = c->starts;
     exit_code = s.exit_code;
     if (s.broken_streams > 0) {
       --s.broken_streams;
@@ -259,19 +332,51 @@ Status FakeDockerApi::FollowLogs(std::string_view id, const docker::LogOptions&,
   }
   while (true) {
     Container* c = Find(id);
-    if (c == nullptr || !c->state.running) return Ok{};
+    if (c == nullptr || !c->state.running || c->starts != starts) return Ok{};
     if (cancel != nullptr && cancel->cancelled()) return Error(ErrorCode::kCancelled, "cancelled");
     cv_.wait_for(lock, std::chrono::milliseconds(10));
   }
 }
 
-Result<std::string> FakeDockerApi::CreateExec(std::string_view, const docker::ExecSpec&) {
-  return NotModelled("CreateExec");
+Result<std::string> FakeDockerApi::CreateExec(std::string_view container_id, const docker::ExecSpec& spec) {
+  std::lock_guard lock(mu_);
+  Container* c = Find(container_id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "No such container: " + std::string(container_id));
+  if (!c->state.running) {
+    return Error(ErrorCode::kInvalidArgument, "Container " + std::string(container_id) + " is not running");
+  }
+  const std::string id = "e" + std::to_string(next_id_++);
+  execs_[id] = Exec{c->spec.name, spec.cmd, std::nullopt};
+  return id;
 }
-Status FakeDockerApi::StartExec(std::string_view, const docker::LogLineFn&, docker::CancelToken*) {
-  return NotModelled("StartExec");
+
+Status FakeDockerApi::StartExec(std::string_view exec_id, const docker::LogLineFn& on_line, docker::CancelToken*) {
+  ExecAnswer answer;
+  {
+    std::lock_guard lock(mu_);
+    auto it = execs_.find(std::string(exec_id));
+    if (it == execs_.end()) return Error(ErrorCode::kNotFound, "no such exec");
+    std::string text;
+    for (const auto& a : it->second.cmd) text += (text.empty() ? "" : " ") + a;
+    calls_.push_back("exec " + it->second.container + " " + text);
+    if (auto a = exec_answers.find(text); a != exec_answers.end()) answer = a->second;
+    it->second.exit_code = answer.exit_code;
+  }
+  if (on_line) {
+    for (const auto& l : answer.stdout_lines) on_line({docker::StreamKind::kStdout, l});
+    for (const auto& l : answer.stderr_lines) on_line({docker::StreamKind::kStderr, l});
+  }
+  return Ok{};
 }
-Result<docker::ExecState> FakeDockerApi::InspectExec(std::string_view) { return NotModelled("InspectExec"); }
+
+Result<docker::ExecState> FakeDockerApi::InspectExec(std::string_view exec_id) {
+  std::lock_guard lock(mu_);
+  auto it = execs_.find(std::string(exec_id));
+  if (it == execs_.end()) return Error(ErrorCode::kNotFound, "no such exec");
+  docker::ExecState st;
+  st.exit_code = it->second.exit_code;
+  return st;
+}
 
 Status FakeDockerApi::PutArchive(std::string_view container_id, std::string_view dest_dir,
                                  std::string_view tar) {

@@ -3,8 +3,12 @@
 // themselves (and with which code), files they hold for GetArchive. Networks check subnet overlap
 // like Docker does. Thread-safe (the runner follows logs from several threads).
 //
-// Methods the runner never calls (images, exec, events, pause...) return kInternal "not modelled
-// by FakeDockerApi" so a test notices if that changes.
+// Fault injection is modelled too: exec in a running container answers from `exec_answers` (by the
+// command's text; unlisted commands exit 0) and is recorded as "exec <container name> <argv>";
+// kill/pause/unpause/restart change the state ("kill <name> <signal>", ...); a container created
+// with network_mode "container:<id>" needs that container to exist, and to run when it starts.
+// Methods the runner never calls (images, events, wait...) return kInternal "not modelled by
+// FakeDockerApi" so a test notices if that changes.
 #pragma once
 
 #include <atomic>
@@ -26,6 +30,13 @@ struct ContainerScript {
   int broken_streams = 0;                      // the first N FollowLogs calls fail with kIo...
   std::size_t broken_stream_lines = 0;         // ...after delivering this many lines
   bool fail_start = false;                     // StartContainer fails
+  std::vector<std::string> restart_lines;      // logged on each start after the first (restart)
+};
+
+struct ExecAnswer {
+  std::vector<std::string> stdout_lines;
+  std::vector<std::string> stderr_lines;
+  std::int64_t exit_code = 0;
 };
 
 class FakeDockerApi : public docker::DockerApi {
@@ -34,6 +45,8 @@ class FakeDockerApi : public docker::DockerApi {
   std::map<std::string, ContainerScript> scripts;
   // CreateNetwork answers "Pool overlaps" this many times first (another orchestrator won a race).
   int network_conflicts = 0;
+  // Exec answers by command text (argv joined with spaces); others exit 0 with no output.
+  std::map<std::string, ExecAnswer> exec_answers;
 
   // Inspection for tests.
   struct Container {
@@ -42,8 +55,11 @@ class FakeDockerApi : public docker::DockerApi {
     docker::ContainerState state;
     std::string put_archive;  // last PutArchive tar
     int follows = 0;
+    int starts = 0;                 // StartContainer/RestartContainer calls that started it
+    std::vector<std::string> history;  // every line logged so far (as Docker keeps them)
   };
   std::vector<std::string> Calls() const;                  // "create-network <name>", ...
+  std::vector<docker::ContainerSpec> Created() const;      // every CreateContainer spec, in order
   std::map<std::string, Container> Containers() const;     // id -> container
   std::map<std::string, docker::NetworkSpec> Networks() const;  // id -> spec
   std::vector<std::string> SubnetsTried() const;
@@ -93,9 +109,17 @@ class FakeDockerApi : public docker::DockerApi {
   static bool Selects(const docker::LabelSelector& selector, const docker::Labels& labels);
   Container* Find(std::string_view id);  // by id or name; mu_ held
 
+  void StartLocked(Container& c);  // mu_ held
+  struct Exec {
+    std::string container;
+    std::vector<std::string> cmd;
+    std::optional<std::int64_t> exit_code;
+  };
+  std::map<std::string, Exec> execs_;
   mutable std::mutex mu_;
   std::condition_variable cv_;
   std::vector<std::string> calls_;
+  std::vector<docker::ContainerSpec> created_;
   std::map<std::string, Container> containers_;
   std::map<std::string, docker::NetworkSpec> networks_;
   std::vector<std::string> subnets_tried_;

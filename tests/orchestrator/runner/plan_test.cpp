@@ -4,7 +4,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "swarmbox/dsl/trial_loader.hpp"
+#include "swarmbox/runner/compose_export.hpp"
 
 namespace swarmbox::runner {
 namespace {
@@ -101,7 +104,7 @@ TEST_F(PlanTest, PayloadsComeFromTheAirframe) {
   auto masses = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
   ASSERT_FALSE(masses);
   EXPECT_EQ(masses.error().message(), "drone lifter: airframe x8_heavy has no payload 'piano'");
-  EXPECT_NE(masses.error().where().find("sar_search.yaml:19:5"), std::string::npos);
+  EXPECT_NE(masses.error().where().find("sar_search.yaml:30:5"), std::string::npos);
 }
 
 TEST_F(PlanTest, MissingImagesOrRunIdAreRefused) {
@@ -109,6 +112,85 @@ TEST_F(PlanTest, MissingImagesOrRunIdAreRefused) {
   auto trial = PlanTrial(spec_, options_);
   ASSERT_FALSE(trial);
   EXPECT_EQ(trial.error().message(), "PlanTrial: images for physics and agent are needed");
+}
+
+// The shared contract's agent flags: Raft on the mesh for every drone (members in trial order, the
+// trial's seed, the raft: timings); mission kind plan flies the trial's plan.
+TEST_F(PlanTest, AgentsGetTheRaftMembersSeedTimingsAndTheirMission) {
+  spec_.raft = {25, 150, 900};
+  spec_.mission = {dsl::MissionKind::kPlan, "takeoff:4,hover:3,land", 40};
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  const std::vector<std::string>& argv = (*trial)->FindPlugin("scout_2")->spec().argv;
+  auto value_of = [&](const std::string& flag) -> std::string {
+    auto it = std::find(argv.begin(), argv.end(), flag);
+    return it == argv.end() || it + 1 == argv.end() ? "<absent>" : *(it + 1);
+  };
+  EXPECT_EQ(value_of("--name"), "scout_2");
+  EXPECT_EQ(value_of("--members"), "scout_1,scout_2,scout_3,lifter");
+  EXPECT_EQ(value_of("--seed"), "42");
+  EXPECT_EQ(value_of("--raft-tick-ms"), "25");
+  EXPECT_EQ(value_of("--raft-heartbeat-ms"), "150");
+  EXPECT_EQ(value_of("--raft-election-timeout-ms"), "900");
+  EXPECT_EQ(value_of("--plan"), "takeoff:4,hover:3,land");
+  EXPECT_EQ(value_of("--sim-interface"), "eth0");
+  EXPECT_EQ(value_of("--mesh-interface"), "eth1");
+}
+
+// With a fault sidecar image, a trial that impairs the mesh gets one sidecar per drone owning the
+// drone's addresses; the agents join their sidecar's namespace; the faults Step sits between.
+TEST_F(PlanTest, NetworkFaultsGiveEachAgentASidecarThatOwnsItsNamespace) {
+  options_.faults_image = "swarmbox/faults:f00";
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  std::vector<std::string> ids;
+  for (auto* p : (*trial)->Plugins()) ids.push_back(p->id());
+  EXPECT_THAT(ids, ElementsAre("physics", "scout_1-faults", "scout_2-faults", "scout_3-faults", "lifter-faults",
+                               "scout_1", "scout_2", "scout_3", "lifter"));
+  dsl::Component* step = (*trial)->Find("faults");
+  ASSERT_NE(step, nullptr);
+  EXPECT_EQ(step->run_priority(), 3);
+  EXPECT_EQ((*trial)->Find("sidecars")->run_priority(), 2);
+  EXPECT_EQ((*trial)->Find("drones")->run_priority(), 4);
+
+  const dsl::ContainerSpec& sidecar = (*trial)->FindPlugin("lifter-faults")->spec();
+  EXPECT_EQ(sidecar.image, "swarmbox/faults:f00");
+  EXPECT_EQ(sidecar.name, "sar-search-20261121-101000-7f3a-lifter-faults");
+  EXPECT_EQ(sidecar.labels.at("swarmbox.component"), "lifter-faults");
+  EXPECT_THAT(sidecar.argv, ElementsAre("/usr/bin/swarmbox-netemd", "sleep"));
+  EXPECT_THAT(sidecar.cap_add, ElementsAre("NET_ADMIN"));
+  EXPECT_THAT(sidecar.cap_drop, ElementsAre("ALL"));
+  ASSERT_EQ(sidecar.networks.size(), 2u);
+  EXPECT_EQ(sidecar.networks[0].ipv4, "10.200.8.13");
+  EXPECT_EQ(sidecar.networks[1].ipv4, "10.200.9.13");
+
+  const dsl::ContainerSpec& lifter = (*trial)->FindPlugin("lifter")->spec();
+  EXPECT_EQ(lifter.network_of, "lifter-faults");
+  EXPECT_TRUE(lifter.networks.empty());
+  EXPECT_TRUE(lifter.hostname.empty());
+  EXPECT_TRUE(lifter.cap_add.empty());
+  EXPECT_TRUE((*trial)->FindPlugin("physics")->spec().cap_add.empty());
+
+  // compose: the agent shares its sidecar's network (compose carries out no faults itself).
+  const std::string compose = ComposeYaml(**trial, {});
+  EXPECT_NE(compose.find("network_mode: \"service:lifter-faults\""), std::string::npos) << compose;
+  EXPECT_NE(compose.find("- \"NET_ADMIN\""), std::string::npos);
+}
+
+TEST_F(PlanTest, WithoutAFaultsImageOrNetworkFaultsThereAreNoSidecars) {
+  auto trial = PlanTrial(spec_, options_);  // mesh block, but no faults image (swarmbox compose)
+  ASSERT_TRUE(trial);
+  EXPECT_EQ((*trial)->Find("faults"), nullptr);
+  EXPECT_EQ((*trial)->FindPlugin("scout_1-faults"), nullptr);
+  spec_.mesh = {};
+  options_.faults_image = "swarmbox/faults:f00";
+  EXPECT_FALSE(NeedsFaultSidecars(spec_));
+  trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  EXPECT_EQ((*trial)->FindPlugin("scout_1-faults"), nullptr);
+  EXPECT_EQ((*trial)->FindPlugin("scout_1")->spec().networks.size(), 2u);
+  spec_.Fault("{at: 10s, duration: 5s, partition: {groups: [[scout_1], [scout_2]]}}");
+  EXPECT_TRUE(NeedsFaultSidecars(spec_));
 }
 
 }  // namespace

@@ -1,0 +1,370 @@
+// Faults carried out by the runner, against FakeDockerApi (exec answered from a script, kill/pause/
+// restart modelled): the fault sidecars (one per agent, owning its network namespace, the only
+// container with NET_ADMIN), the mechanism detected through a sidecar, network.mesh applied before
+// the agents start and undone at teardown, timeline triggers (sim time, log events), partitions,
+// process faults on the Raft leader, refusals and failures, and that nothing is left on any path.
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+
+#include "fake_docker_api.hpp"
+#include "swarmbox/runner/runner.hpp"
+
+namespace swarmbox::runner {
+namespace {
+
+namespace fs = std::filesystem;
+using ::testing::HasSubstr;
+using ::testing::Not;
+
+class StepClock : public Clock {
+ public:
+  explicit StepClock(double step) : step_(step) {}
+  double NowS() override {
+    std::lock_guard lock(mu_);
+    now_ += step_;
+    return now_;
+  }
+
+ private:
+  std::mutex mu_;
+  double now_ = 1000;
+  double step_;
+};
+
+std::string ReadFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+constexpr char kRun[] = "20261121-160000-f00d";
+constexpr char kProbe[] = "tc qdisc replace dev lo root netem delay 0ms";
+
+std::string Name(const std::string& component) { return std::string("mini-") + kRun + "-" + component; }
+
+// Index of the first call starting with `prefix`; calls.size() when none.
+std::size_t IndexOf(const std::vector<std::string>& calls, const std::string& prefix) {
+  for (std::size_t i = 0; i < calls.size(); ++i) {
+    if (calls[i].rfind(prefix, 0) == 0) return i;
+  }
+  return calls.size();
+}
+// Index of the call that is exactly `call`; calls.size() when none.
+std::size_t IndexOfExact(const std::vector<std::string>& calls, const std::string& call) {
+  for (std::size_t i = 0; i < calls.size(); ++i) {
+    if (calls[i] == call) return i;
+  }
+  return calls.size();
+}
+std::size_t LastIndexOfExact(const std::vector<std::string>& calls, const std::string& call) {
+  for (std::size_t i = calls.size(); i-- > 0;) {
+    if (calls[i] == call) return i;
+  }
+  return calls.size();
+}
+std::size_t LastIndexOf(const std::vector<std::string>& calls, const std::string& prefix) {
+  for (std::size_t i = calls.size(); i-- > 0;) {
+    if (calls[i].rfind(prefix, 0) == 0) return i;
+  }
+  return calls.size();
+}
+std::vector<std::string> Matching(const std::vector<std::string>& calls, const std::string& needle) {
+  std::vector<std::string> out;
+  for (const auto& c : calls) {
+    if (c.find(needle) != std::string::npos) out.push_back(c);
+  }
+  return out;
+}
+
+class FaultRunnerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    out_ = fs::temp_directory_path() /
+           ("swarmbox-fault-runner-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(out_);
+    spec_ = dsl::TrialSpec::Named("mini")
+                .Seed(9)
+                .World("worlds/open_field.yaml")
+                .Drone("scout_1", "x500", {0, 0, 0})
+                .Drone("scout_2", "x500", {3, 0, 0})
+                .Mission({dsl::MissionKind::kPlan, "takeoff:5,hover:10,land", 40})
+                .EndOn("event=done", dsl::Outcome::kSuccess)
+                .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout, dsl::Duration::Seconds(600));
+    spec_.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+    options_.out_dir = out_.string();
+    options_.run_id = kRun;
+    options_.images = {"swarmbox/physics:test", "swarmbox/agent:test"};
+    options_.faults_image = "swarmbox/faults:test";
+    // A host of its own per test run: the mechanism is cached per host for the whole process.
+    static int runs = 0;
+    options_.host = "fake-host-" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+                    "-" + std::to_string(++runs);
+    options_.poll = std::chrono::milliseconds(5);
+    // This "kernel" has no sch_netem: the userspace mechanism.
+    api_.exec_answers[kProbe] = {{}, {"Error: Specified qdisc kind is unknown."}, 2};
+    api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready"};
+  }
+  void TearDown() override { fs::remove_all(out_); }
+
+  RunOutcome Run(double clock_step = 0.001) {
+    StepClock clock(clock_step);
+    auto run = RunTrialSpec(spec_, api_, clock, options_);
+    EXPECT_TRUE(run) << run.error().ToString();
+    if (!run) return {};
+    return *run;
+  }
+  void ExpectNothingLeft() {
+    EXPECT_TRUE(api_.Containers().empty());
+    EXPECT_TRUE(api_.Networks().empty());
+  }
+  std::string Events(const RunOutcome& run) { return ReadFile(fs::path(run.trial_dir) / "events.jsonl"); }
+
+  fs::path out_;
+  dsl::TrialSpec spec_;
+  RunOptions options_;
+  testing::FakeDockerApi api_;
+};
+
+TEST_F(FaultRunnerTest, MeshImpairmentIsAppliedFromSidecarsBeforeTheAgentsStartAndUndoneAtTeardown) {
+  spec_.Mesh("{delay_ms: 100, jitter_ms: 20, loss: 0.05}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=3.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  ExpectNothingLeft();
+
+  // One sidecar per agent: the faults image, the drone's addresses, NET_ADMIN alone; the agent
+  // joins its namespace and stays unprivileged.
+  std::map<std::string, docker::ContainerSpec> created;
+  for (const auto& c : api_.Created()) created[c.name] = c;
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    ASSERT_EQ(created.count(Name(d + "-faults")), 1u) << d;
+    const docker::ContainerSpec& sc = created[Name(d + "-faults")];
+    EXPECT_EQ(sc.image, "swarmbox/faults:test");
+    EXPECT_EQ(sc.cap_add, std::vector<std::string>{"NET_ADMIN"});
+    EXPECT_EQ(sc.cap_drop, std::vector<std::string>{"ALL"});
+    EXPECT_EQ(sc.networks.size(), 2u);
+    EXPECT_EQ(sc.labels.at("swarmbox.run"), kRun);
+    EXPECT_EQ(sc.labels.at("swarmbox.component"), d + "-faults");
+    EXPECT_EQ(sc.entrypoint, std::vector<std::string>{"/usr/bin/swarmbox-netemd"});
+    EXPECT_EQ(sc.cmd, std::vector<std::string>{"sleep"});
+    const docker::ContainerSpec& agent = created[Name(d)];
+    EXPECT_THAT(agent.network_mode, ::testing::StartsWith("container:"));
+    EXPECT_TRUE(agent.networks.empty());
+    EXPECT_TRUE(agent.cap_add.empty());
+  }
+  EXPECT_TRUE(created[Name("physics")].cap_add.empty());
+
+  const std::vector<std::string> calls = api_.Calls();
+  // Order: sidecars start, the probe (once, in the first sidecar), the mesh rules in every
+  // sidecar, then the agents start.
+  const std::size_t probe = IndexOf(calls, "exec " + Name("scout_1-faults") + " " + kProbe);
+  ASSERT_LT(probe, calls.size());
+  EXPECT_EQ(Matching(calls, kProbe).size(), 1u);
+  EXPECT_LT(IndexOfExact(calls, "start " + Name("scout_2-faults")), probe);
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    const std::string in = "exec " + Name(d + "-faults") + " ";
+    const std::size_t hook = IndexOf(calls, in + "iptables -w -I INPUT -i eth1 -j SWARMBOX-RADIO-IN");
+    ASSERT_LT(hook, calls.size()) << d;
+    EXPECT_LT(probe, hook);
+    EXPECT_LT(hook, IndexOfExact(calls, "start " + Name("scout_1")));
+    EXPECT_LT(IndexOf(calls, in + "/usr/bin/swarmbox-netemd run --queue 0 --delay-us 100000 --jitter-us 20000"),
+              IndexOfExact(calls, "start " + Name(d)));
+    EXPECT_LT(IndexOf(calls, in + "iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.05 -j DROP"),
+              calls.size());
+    // Teardown: the undo runs after the agent stopped and before its sidecar is removed.
+    const std::size_t undo = IndexOf(calls, in + "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid");
+    ASSERT_LT(undo, calls.size()) << d;
+    EXPECT_LT(IndexOfExact(calls, "stop " + Name(d)), undo);
+    EXPECT_LT(undo, IndexOfExact(calls, "remove " + Name(d + "-faults")));
+    EXPECT_LT(IndexOf(calls, in + "iptables -w -D INPUT -i eth1 -j SWARMBOX-RADIO-IN"), calls.size());
+  }
+  // The sim link (eth0) is never touched.
+  EXPECT_THAT(Matching(calls, "eth0"), ::testing::IsEmpty());
+
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("{\"type\":\"mechanism\",\"host\":\"" + options_.host +
+                                "\",\"mechanism\":\"userspace-nfqueue\",\"detected\":true"));
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    EXPECT_THAT(events, HasSubstr("{\"type\":\"mesh\",\"phase\":\"applied\",\"node\":\"" + d + "\""));
+    EXPECT_THAT(events, HasSubstr("{\"type\":\"mesh\",\"phase\":\"removed\",\"node\":\"" + d + "\""));
+  }
+  EXPECT_THAT(events, HasSubstr("\"mechanism\":\"userspace-nfqueue\",\"spec\":\"delay_ms=100 jitter_ms=20 loss=0.05\""));
+}
+
+TEST_F(FaultRunnerTest, MechanismIsDetectedOncePerHost) {
+  spec_.Mesh("{loss: 0.1}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.000 node=physics event=done"};
+  RunOutcome first = Run();
+  EXPECT_EQ(first.result.verdict.outcome, dsl::Outcome::kSuccess) << first.result.verdict.ToString();
+  options_.run_id = "20261121-160001-f00e";
+  RunOutcome second = Run();
+  EXPECT_EQ(second.result.verdict.outcome, dsl::Outcome::kSuccess) << second.result.verdict.ToString();
+  EXPECT_EQ(Matching(api_.Calls(), kProbe).size(), 1u);
+  EXPECT_THAT(Events(second), HasSubstr("\"mechanism\":\"userspace-nfqueue\",\"detected\":false"));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, SpecTheMechanismCannotHonourIsRefusedBeforeAnyAgentStarts) {
+  spec_.Mesh("{delay_ms: 20, duplicate: 0.01}");
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("'duplicate' cannot be honoured on this host"));
+  const auto calls = api_.Calls();
+  EXPECT_EQ(IndexOfExact(calls, "start " + Name("scout_1")), calls.size());
+  EXPECT_EQ(IndexOfExact(calls, "start " + Name("scout_2")), calls.size());
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, PartitionAtSimTimeIsAppliedInEverySidecarAndHealed) {
+  spec_.Fault("{name: split, at: 2s, duration: 1s, partition: {groups: [[scout_1], [scout_2]]}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.000 node=physics event=tick",
+                                   "t=2.500 node=physics event=tick", "t=4.000 node=physics event=tick",
+                                   "t=5.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  ExpectNothingLeft();
+  const auto calls = api_.Calls();
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    const std::string in = "exec " + Name(d + "-faults") + " iptables -w ";
+    const std::size_t hook = IndexOf(calls, in + "-I INPUT -i eth1 -j SWARMBOX-PART-0");
+    const std::size_t heal = IndexOf(calls, in + "-D INPUT -i eth1 -j SWARMBOX-PART-0");
+    ASSERT_LT(hook, calls.size()) << d;
+    ASSERT_LT(heal, calls.size()) << d;
+    EXPECT_LT(hook, heal);
+    EXPECT_LT(heal, IndexOfExact(calls, "stop " + Name(d)));  // healed at 3 s, not at teardown
+  }
+  // scout_1 drops what comes from scout_2's mesh address and the other way round.
+  EXPECT_EQ(Matching(calls, "SWARMBOX-PART-0 -s ").size(), 2u);
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"split\",\"kind\":\"partition\",\"start\":\"at 2s\",\"t_sim_s\":2.5,"));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"split\",\"kind\":\"partition\",\"start\":\"at 2s\",\"t_sim_s\":4,"));
+  EXPECT_THAT(events, HasSubstr("\"mechanism\":\"iptables\""));
+}
+
+TEST_F(FaultRunnerTest, KillingTheRaftLeaderOnAnEventIsNotACrashAndIsUndoneAfterItsDuration) {
+  // No network faults: no sidecars, the agents keep their own namespaces.
+  spec_.Fault("{name: kill_leader, on: \"event=leader_elected\", duration: 200ms, kill: raft_leader}");
+  api_.scripts["scout_1"].lines = {"t=1.0 node=scout_1 event=leader_elected term=2 leader=scout_2"};
+  api_.scripts["scout_2"].lines = {"t=1.0 node=scout_2 event=leader_elected term=2 leader=scout_2"};
+  api_.scripts["scout_2"].restart_lines = {"t=4.0 node=scout_2 event=rejoined", "t=4.1 node=scout_2 event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_EQ(run.result.verdict.source, "scout_2");
+  ExpectNothingLeft();
+  const auto calls = api_.Calls();
+  EXPECT_EQ(IndexOfExact(calls, "create " + Name("scout_1-faults")), calls.size());
+  const std::size_t kill = IndexOf(calls, "kill " + Name("scout_2") + " SIGKILL");
+  ASSERT_LT(kill, calls.size());
+  EXPECT_LT(kill, LastIndexOfExact(calls, "start " + Name("scout_2")));
+  EXPECT_EQ(Matching(calls, "kill ").size(), 1u);  // fired once, on the first election line
+  // The log was followed again from the first new line: nothing twice.
+  const std::string log = ReadFile(fs::path(run.trial_dir) / "logs" / "scout_2.log");
+  EXPECT_EQ(log, "t=1.0 node=scout_2 event=leader_elected term=2 leader=scout_2\n"
+                 "t=4.0 node=scout_2 event=rejoined\nt=4.1 node=scout_2 event=done\n");
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"kill_leader\",\"kind\":\"kill\",\"start\":\"on event=leader_elected\""));
+  EXPECT_THAT(events, HasSubstr("\"targets\":[\"scout_2\"],\"mechanism\":\"docker\",\"spec\":\"signal=SIGKILL duration=200ms\"}"));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"kill_leader\""));
+}
+
+TEST_F(FaultRunnerTest, RestartFollowsTheNewRunsLog) {
+  spec_.Fault("{name: reboot, at: 2s, restart: scout_1}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=2.500 node=physics event=tick"};
+  api_.scripts["scout_1"].lines = {"t=0.5 node=scout_1 event=takeoff"};
+  api_.scripts["scout_1"].restart_lines = {"t=3.0 node=scout_1 event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_LT(IndexOf(api_.Calls(), "restart " + Name("scout_1") + " 10"), api_.Calls().size());
+  EXPECT_EQ(ReadFile(fs::path(run.trial_dir) / "logs" / "scout_1.log"),
+            "t=0.5 node=scout_1 event=takeoff\nt=3.0 node=scout_1 event=done\n");
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, AFaultStillActiveAtTheEndIsUndoneBeforeTheContainersStop) {
+  spec_.Fault("{name: freeze, at: 1s, pause: scout_2}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=tick",
+                                   "t=2.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto calls = api_.Calls();
+  const std::size_t pause = IndexOfExact(calls, "pause " + Name("scout_2"));
+  const std::size_t unpause = IndexOfExact(calls, "unpause " + Name("scout_2"));
+  ASSERT_LT(pause, calls.size());
+  ASSERT_LT(unpause, calls.size());
+  EXPECT_LT(pause, unpause);
+  EXPECT_LT(unpause, IndexOfExact(calls, "stop " + Name("scout_2")));
+  EXPECT_THAT(Events(run), HasSubstr("\"phase\":\"removed\",\"fault\":\"freeze\""));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, AFaultThatCannotBeCarriedOutEndsTheTrialWithErrorAndTearsDown) {
+  spec_.Mesh("{loss: 0.02}");
+  spec_.Fault("{name: kill_leader, at: 1s, kill: raft_leader}");  // nobody was elected
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=tick",
+                                   "t=9.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("fault kill_leader (kill) could not be applied"));
+  EXPECT_THAT(Events(run), HasSubstr("\"phase\":\"failed\",\"fault\":\"kill_leader\""));
+  EXPECT_THAT(Events(run), HasSubstr("{\"type\":\"mesh\",\"phase\":\"removed\",\"node\":\"scout_1\""));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, InterruptedRunStillUndoesEverything) {
+  spec_.Mesh("{delay_ms: 50}");
+  spec_.Fault("{name: fade, at: 1s, radio: {target: scout_1, loss: 0.3}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=tick"};
+  std::atomic<bool> interrupted{false};
+  options_.interrupted = &interrupted;
+  // Ctrl-C once the radio fault is in place (the exec of its loss rule).
+  api_.exec_answers["iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.3 -j DROP"] = {};
+  StepClock clock(0.001);
+  std::thread stopper([&] {
+    for (int i = 0; i < 2000 && !interrupted.load(); ++i) {
+      if (!Matching(api_.Calls(), "--probability 0.3").empty()) interrupted.store(true);
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+  });
+  auto run = RunTrialSpec(spec_, api_, clock, options_);
+  stopper.join();
+  ASSERT_TRUE(run) << run.error().ToString();
+  EXPECT_EQ(run->result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run->result.verdict.reason, HasSubstr("interrupted"));
+  const auto calls = api_.Calls();
+  // The fault's rules were replaced by the mesh rules again, then the mesh rules removed.
+  const std::string in = "exec " + Name("scout_1-faults") + " ";
+  EXPECT_LT(IndexOf(calls, in + "iptables -w -D INPUT -i eth1 -j SWARMBOX-RADIO-IN"), calls.size());
+  EXPECT_LT(LastIndexOf(calls, in + "/usr/bin/swarmbox-netemd stop"), IndexOfExact(calls, "remove " + Name("scout_1-faults")));
+  const std::string events = Events(*run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"fade\""));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"fade\""));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, SensorFaultsAreRefusedWithTheReason) {
+  spec_.Fault("{name: gps_loss, at: 1s, duration: 1s, gps_dropout: scout_1}");
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("physics server takes no sensor or environment fault commands"));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, WithoutFaultsNoSidecarIsCreated) {
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_THAT(api_.Calls(), Not(::testing::Contains(HasSubstr("-faults"))));
+  EXPECT_THAT(api_.Calls(), Not(::testing::Contains(HasSubstr("exec "))));
+  ExpectNothingLeft();
+}
+
+}  // namespace
+}  // namespace swarmbox::runner
