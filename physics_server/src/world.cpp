@@ -622,11 +622,14 @@ DroneTruth World::Truth(std::size_t index) const {
   return t;
 }
 
-Status World::AttachPayload(std::size_t index) {
+Status World::AttachPayload(std::size_t index, double mass_kg) {
   Impl& w = *impl_;
   if (index >= w.drones.size()) return Error(ErrorCode::kNotFound, "no drone with index " + std::to_string(index));
   Impl::Drone& d = *w.drones[index];
   if (d.payload == nullptr) return Error(ErrorCode::kInvalidArgument, "drone '" + d.name + "' has no payload");
+  if (!(mass_kg >= 0.0) || !std::isfinite(mass_kg)) {
+    return Error(ErrorCode::kInvalidArgument, "drone '" + d.name + "': payload mass must be >= 0 kg (0 keeps it)");
+  }
   if (d.sling) return Error(ErrorCode::kAlreadyExists, "drone '" + d.name + "': " + d.payload->name + " already attached");
   const Vec3 hook = V(dBodyGetPosition(d.body)) + RotR(dBodyGetRotation(d.body), d.payload->hook_m);
   const double dist = Norm(V(dBodyGetPosition(d.payload_body)) - hook);
@@ -635,6 +638,11 @@ Status World::AttachPayload(std::size_t index) {
     std::snprintf(buf, sizeof buf, "hook is %.2f m from the %s, needs %.2f +- %.2f m", dist, d.payload->name.c_str(),
                   d.payload->sling_length_m, d.payload->attach_tolerance_m);
     return Error(ErrorCode::kInvalidArgument, "drone '" + d.name + "': " + buf);
+  }
+  if (mass_kg > 0.0) {  // what was loaded onto it: same box, new mass
+    dMass pm;
+    dMassSetBoxTotal(&pm, mass_kg, d.payload->size_m.x, d.payload->size_m.y, d.payload->size_m.z);
+    dBodySetMass(d.payload_body, &pm);
   }
   d.sling = dJointCreateBall(w.world, nullptr);
   dJointAttach(d.sling, d.body, d.payload_body);

@@ -99,6 +99,51 @@ TEST(Payload, AttachWithinToleranceCreatesTheSling) {
   EXPECT_EQ(events.events[1].ToLogEvent().str(), "t=0.000 node=physics event=payload_attached a=lifter b=stretcher");
 }
 
+// Vertical speed [m/s] of the x8_heavy after 1 s of free flight with its rotors at the speed that
+// hovers the airframe plus `hover_for_kg`, its stretcher re-attached with AttachPayload(attach_kg).
+double VerticalSpeedAfterOneSecond(double attach_kg, double hover_for_kg) {
+  auto world = MakeWorld(CalmWorld());
+  const Airframe af = LoadShippedAirframe("x8_heavy");
+  const double u = af.HoverRotorSpeed(hover_for_kg) / af.motor.max_rot_velocity_rad_s;
+  const auto d = Spawn(*world, testing::MakeSpawn("lifter", af, Vec3{0, 0, 20}, 0.0, u, "stretcher", true));
+  world->SetPinned(d, true);
+  EXPECT_TRUE(world->ReleasePayload(d).ok());
+  EXPECT_TRUE(world->AttachPayload(d, attach_kg).ok());  // still at sling length: no fall yet
+  const std::vector<double> throttle(af.rotors.size(), u);
+  EXPECT_TRUE(world->SetActuators(d, throttle).ok());
+  for (int k = 0; k < 250; ++k) world->Step();  // 1 s pinned: rotors at speed, stretcher at rest
+  world->SetPinned(d, false);
+  for (int k = 0; k < 250; ++k) world->Step();
+  return world->Truth(d).velocity_m_s.z;
+}
+
+TEST(Payload, AttachWithAMassSetsWhatTheLifterCarries) {
+  // Given rotors sized to hover the lifter with 15 kg below, when the stretcher is attached as
+  // 15 kg, then the lifter holds its height; attached as 80 kg it sinks at
+  // a = 65 kg g / 215 kg ~ 3 m/s^2.
+  const double with_15 = VerticalSpeedAfterOneSecond(15.0, 15.0);
+  const double with_80 = VerticalSpeedAfterOneSecond(80.0, 15.0);
+  EXPECT_NEAR(with_15, 0.0, 0.3) << "15 kg attached, thrust for 15 kg";
+  EXPECT_LT(with_80, -2.0) << "80 kg attached, thrust for 15 kg";
+  EXPECT_GT(with_80, -4.0);
+  // mass 0 keeps the airframe's 80 kg: hovers on the thrust for 80 kg.
+  EXPECT_NEAR(VerticalSpeedAfterOneSecond(0.0, 80.0), 0.0, 0.3) << "mass kept";
+}
+
+TEST(Payload, AttachRefusesANegativeOrNanMass) {
+  auto world = MakeWorld(CalmWorld());
+  const auto d = Spawn(*world, testing::MakeSpawn("lifter", LoadShippedAirframe("x8_heavy"), Vec3{0, 0, 20}, 0.0, 0.0,
+                                                  "stretcher", true));
+  ASSERT_TRUE(world->ReleasePayload(d).ok());
+  for (double bad : {-1.0, std::nan("")}) {
+    const Status s = world->AttachPayload(d, bad);
+    ASSERT_FALSE(s.ok());
+    EXPECT_EQ(s.error().code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(s.error().message().find("payload mass must be >= 0 kg"), std::string::npos) << s.error().message();
+    EXPECT_FALSE(world->Truth(d).payload_attached);
+  }
+}
+
 TEST(Payload, SpawningAttachedTooLowIsRefused) {
   auto world = MakeWorld(CalmWorld());
   auto r = world->AddDrone(testing::MakeSpawn("lifter", LoadShippedAirframe("x8_heavy"), Vec3{0, 0, 1}, 0.0, 0.0, "stretcher", true));

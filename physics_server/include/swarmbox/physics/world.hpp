@@ -97,7 +97,10 @@ class World {
 
   // Payloads. Attach: the drone's hook must be within sling_length_m +- attach_tolerance_m of the
   // payload's centre; the sling keeps the distance it has then. Errors say why not.
-  Status AttachPayload(std::size_t index);
+  // mass_kg > 0: the payload's mass from now on (what was loaded onto it, e.g. the 80 kg of
+  // stretcher and evacuee), a uniform box of the payload's size; 0 keeps its current mass (the
+  // airframe's at spawn). Negative or NaN: kInvalidArgument, nothing changes.
+  Status AttachPayload(std::size_t index, double mass_kg = 0.0);
   Status ReleasePayload(std::size_t index);
 
   // Faults and lifecycle.
