@@ -53,6 +53,7 @@ int main(int argc, char** argv) {
   app.add_option("--physics-rate-hz", o.physics_rate_hz, "ODE sub-step rate")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--control-rate-hz", o.control_rate_hz, "Lockstep (sensor/actuator) rate")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("!--no-cameras", o.cameras, "Do not render or publish camera images");
+  app.add_option("--clock-every", o.clock_every_s, "Simulated seconds between event=clock progress lines; 0 = none")->check(CLI::NonNegativeNumber)->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -131,6 +132,7 @@ int main(int argc, char** argv) {
   so.lockstep.timeout_ns = static_cast<std::int64_t>(o.step_timeout_s * 1e9);
   so.lockstep.join_timeout_ns = static_cast<std::int64_t>(o.join_timeout_s * 1e9);
   so.cameras = o.cameras;
+  so.clock_every_s = o.clock_every_s;
   SteadyWallClock clock;
   SimServer server(**world, **transport, clock, truth ? &*truth : nullptr, so, stdout);
   std::printf("%s\n", LogEvent(0.0, "physics", "ready")

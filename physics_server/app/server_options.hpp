@@ -43,6 +43,7 @@ struct ServerOptions {
   int physics_rate_hz = 1000;
   int control_rate_hz = 250;
   bool cameras = true;
+  double clock_every_s = 10.0;          // simulated s between event=clock lines; 0 = none
 };
 
 // "name:airframe:x,y,z[:yaw_deg[:payload[:attached]]]".

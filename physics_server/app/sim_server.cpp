@@ -16,6 +16,29 @@ void SteadyWallClock::SleepUntilNs(std::int64_t t_ns) {
   std::this_thread::sleep_until(std::chrono::steady_clock::time_point(std::chrono::nanoseconds(t_ns)));
 }
 
+bool ClockProgress::OnStep(std::int64_t sim_ns, std::int64_t wall_ns, bool late) {
+  if (origin_wall_ns_ < 0) {  // the first step anchors the first interval
+    origin_sim_ns_ = sim_ns;
+    origin_wall_ns_ = wall_ns;
+  }
+  sim_ns_ = sim_ns;
+  wall_ns_ = wall_ns;
+  if (late) ++late_;
+  return sim_ns >= next_ns_;
+}
+
+ClockProgress::Line ClockProgress::Take() {
+  Line line;
+  const std::int64_t wall = wall_ns_ - origin_wall_ns_;
+  if (wall > 0) line.rtf = static_cast<double>(sim_ns_ - origin_sim_ns_) / static_cast<double>(wall);
+  line.late = late_;
+  while (next_ns_ <= sim_ns_) next_ns_ += every_ns_;
+  origin_sim_ns_ = sim_ns_;
+  origin_wall_ns_ = wall_ns_;
+  late_ = 0;
+  return line;
+}
+
 void SimServer::PrintingSink::OnEvent(const PhysicsEvent& event) {
   std::fprintf(out_, "%s\n", event.ToLogEvent(node_).str().c_str());
   std::fflush(out_);
@@ -34,6 +57,9 @@ SimServer::SimServer(World& world, SimTransport& transport, WallClock& clock, Tr
       zeros_(8, 0.0),
       base_wind_(world.config().wind) {
   world_.SetEventSink(&sink_);
+  if (options_.clock_every_s > 0) {
+    progress_.emplace(static_cast<std::int64_t>(options_.clock_every_s * 1e9));
+  }
 }
 
 void SimServer::Log(const LogEvent& event) {
@@ -143,8 +169,9 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   if (truth_ != nullptr) {
     if (auto s = truth_->MaybeWrite(world_); !s) return s;
   }
+  bool late = false;
+  std::int64_t now = clock_.NowNs();
   if (options_.rtf > 0) {
-    const std::int64_t now = clock_.NowNs();
     if (pace_origin_wall_ns_ < 0) {
       pace_origin_wall_ns_ = now;
       pace_origin_sim_ns_ = world_.time_ns();
@@ -153,9 +180,20 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
                         static_cast<std::int64_t>(static_cast<double>(world_.time_ns() - pace_origin_sim_ns_) / options_.rtf);
     if (target > now) {
       clock_.SleepUntilNs(target);
-    } else if (now - target > 500'000'000) {
-      pace_origin_wall_ns_ = -1;  // fell behind by > 0.5 s (agents slow): re-anchor, no catch-up burst
+      now = target;  // what the wall clock says after the sleep, without reading it again
+    } else {
+      late = target < now;
+      if (now - target > 500'000'000) pace_origin_wall_ns_ = -1;  // fell behind by > 0.5 s (agents
+                                                                   // slow): re-anchor, no catch-up burst
     }
+  }
+  if (progress_ && progress_->OnStep(world_.time_ns(), now, late)) {
+    const ClockProgress::Line line = progress_->Take();
+    Log(LogEvent(world_.time_s(), options_.node, "clock")
+            .Add("rtf", line.rtf, 2)
+            .Add("steps", static_cast<std::uint64_t>(world_.step_count()))
+            .Add("late", line.late)
+            .Add("lost", static_cast<std::uint64_t>(world_.drone_count() - lockstep_.live_count())));
   }
   return Ok{};
 }

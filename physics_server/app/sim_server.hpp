@@ -10,13 +10,16 @@
 // While waiting, unanswered samples are published again every 200 ms (agents that join late or a
 // lost message). Duplicate and stale commands are dropped (Lockstep).
 // Then World::Step(), truth.csv, pacing to the real-time factor. Events are printed as logfmt
-// lines on `events_out`.
+// lines on `events_out`, and every `clock_every_s` simulated seconds a progress line
+//   t=10.000 node=physics event=clock rtf=0.98 steps=2500 late=3 lost=0
+// (ClockProgress below), so simulated time is seen to advance between events.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,9 +75,38 @@ class SteadyWallClock final : public WallClock {
   void SleepUntilNs(std::int64_t t_ns) override;
 };
 
+// The figures of one `event=clock` line, over the interval since the previous one. Pure: fed the
+// wall time and the pacing verdict of each step; no clock or I/O of its own.
+class ClockProgress {
+ public:
+  // `every_ns`: simulated interval between lines (> 0).
+  explicit ClockProgress(std::int64_t every_ns) : every_ns_(every_ns), next_ns_(every_ns) {}
+
+  // After a step that ended at simulated `sim_ns` (the world's time) and wall `wall_ns`; `late`:
+  // the step ended behind its paced wall time (rtf > 0 only). True when a line is due: then
+  // Take() gives its figures and starts the next interval.
+  bool OnStep(std::int64_t sim_ns, std::int64_t wall_ns, bool late);
+
+  struct Line {
+    double rtf = 0;        // simulated / wall seconds over the interval (0 if no wall time passed)
+    std::uint64_t late = 0;  // steps of the interval that ended behind the requested pace
+  };
+  Line Take();
+
+ private:
+  std::int64_t every_ns_;
+  std::int64_t next_ns_;
+  std::int64_t origin_sim_ns_ = 0;
+  std::int64_t origin_wall_ns_ = -1;  // -1: not yet anchored (at the end of the first step)
+  std::int64_t sim_ns_ = 0;
+  std::int64_t wall_ns_ = 0;
+  std::uint64_t late_ = 0;
+};
+
 struct SimServerOptions {
   double rtf = 1.0;                          // 0 = as fast as possible
   double max_sim_time_s = 0;                 // 0 = no limit
+  double clock_every_s = 10.0;               // event=clock every this many simulated s; 0 = never
   LockstepOptions lockstep;
   bool cameras = true;
   std::string node = "physics";              // logfmt node name
@@ -126,6 +158,7 @@ class SimServer {
   CameraImage image_;
   std::int64_t pace_origin_wall_ns_ = -1;
   std::int64_t pace_origin_sim_ns_ = 0;
+  std::optional<ClockProgress> progress_;  // empty: clock_every_s = 0
 };
 
 }  // namespace swarmbox::physics

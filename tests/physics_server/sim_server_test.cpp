@@ -244,3 +244,72 @@ TEST_F(SimServerTest, GpsDegradeAndImuBiasJumpChangeTheSensors) {
 
 }  // namespace
 }  // namespace swarmbox::physics
+
+namespace swarmbox::physics {
+namespace {
+
+// event=clock: the progress line every clock_every_s simulated seconds.
+TEST(ClockProgress, MeasuresRtfAndLateStepsPerInterval) {
+  ClockProgress p(1'000 * kMs);
+  // Given steps of 4 ms simulated that take 2 ms of wall time, every other one behind the pace,
+  EXPECT_FALSE(p.OnStep(4 * kMs, 100 * kMs, false));  // anchors the interval
+  bool due = false;
+  int steps = 1;
+  for (std::int64_t k = 2; !due; ++k, ++steps) due = p.OnStep(4 * kMs * k, 100 * kMs + 2 * kMs * (k - 1), k % 2 == 0);
+  // then a line is due at 1 s simulated, at rtf 2 with 125 late steps out of 249 after the anchor.
+  EXPECT_EQ(steps, 250);
+  const ClockProgress::Line line = p.Take();
+  EXPECT_DOUBLE_EQ(line.rtf, 2.0);
+  EXPECT_EQ(line.late, 125u);
+  // The next interval starts where this one ended.
+  EXPECT_FALSE(p.OnStep(1'004 * kMs, 600 * kMs, false));
+  EXPECT_TRUE(p.OnStep(2'000 * kMs, 1'096 * kMs, true));
+  const ClockProgress::Line next = p.Take();
+  EXPECT_DOUBLE_EQ(next.rtf, 1000.0 / 498.0);
+  EXPECT_EQ(next.late, 1u);
+}
+
+TEST(ClockProgress, NoWallTimeGivesRtfZeroAndSkippedIntervalsAreNotRepeated) {
+  ClockProgress p(1'000 * kMs);
+  EXPECT_FALSE(p.OnStep(4 * kMs, 0, false));
+  EXPECT_TRUE(p.OnStep(3'500 * kMs, 0, false));  // a jump over three intervals: one line
+  EXPECT_EQ(p.Take().rtf, 0.0);
+  EXPECT_FALSE(p.OnStep(3'900 * kMs, 0, false));
+  EXPECT_TRUE(p.OnStep(4'000 * kMs, 0, false));
+}
+
+TEST_F(SimServerTest, PrintsTheClockLineEverySimulatedInterval) {
+  SimServerOptions o = Options(2.0);
+  o.clock_every_s = 1.0;
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  ASSERT_TRUE(server.Run(stop_).ok());
+  // Paced at rtf 1 by the fake clock; agents answer within 1 ms, so no step is late.
+  EXPECT_EQ(ReadFile(out_),
+            "t=1.000 node=physics event=clock rtf=1.00 steps=250 late=0 lost=0\n"
+            "t=2.000 node=physics event=clock rtf=1.00 steps=500 late=0 lost=0\n");
+}
+
+TEST_F(SimServerTest, ClockLineCountsLateStepsAndLostDrones) {
+  // rtf 8 asks 0.5 ms of wall time per 4 ms step, the agents take 1 ms: every step after the
+  // first is late and the measured rtf is 4.
+  SimServerOptions o = Options(1.0);
+  o.rtf = 8;
+  o.clock_every_s = 1.0;
+  agents_.alive["b"] = false;  // never answers: lost after the join timeout on step 0
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  ASSERT_TRUE(server.Run(stop_).ok());
+  const std::string log = ReadFile(out_);
+  EXPECT_NE(log.find("t=1.000 node=physics event=clock rtf=4.00 steps=250 late=249 lost=1\n"), std::string::npos) << log;
+}
+
+TEST_F(SimServerTest, ClockEveryZeroPrintsNoClockLine) {
+  SimServerOptions o = Options(12.0);
+  o.rtf = 0;
+  o.clock_every_s = 0;
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  ASSERT_TRUE(server.Run(stop_).ok());
+  EXPECT_EQ(ReadFile(out_).find("event=clock"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
