@@ -61,7 +61,7 @@ std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxe
   const double width = kLeft + kW * static_cast<double>(boxes.size()) + 10;
   const double plot_h = kH - kTop - kBottom;
   auto y = [&](double v) { return kTop + (hi - v) / (hi - lo) * plot_h; };
-  std::string s = "<svg xmlns='http://www.w3.org/2000/svg' width='" + Fmt(width) + "' height='" +
+  std::string s = "<svg width='" + Fmt(width) + "' height='" +
                   Fmt(kH) + "' class='box'>";
   for (int k = 0; k <= 4; ++k) {
     const double v = lo + (hi - lo) * k / 4.0;

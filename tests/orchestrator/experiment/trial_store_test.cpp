@@ -1,0 +1,185 @@
+// The experiment folder: atomic commits, resume that never loses or repeats a trial, the folder
+// lock, and the progress board.
+#include "swarmbox/experiment/trial_store.hpp"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <sstream>
+
+#include "swarmbox/experiment/progress.hpp"
+#include "swarmbox/experiment/scheduler.hpp"
+
+namespace swarmbox::experiment {
+namespace {
+
+namespace fs = std::filesystem;
+
+class TrialStoreTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("swarmbox-store-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  static std::string Read(const fs::path& p) {
+    std::ifstream in(p);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  fs::path dir_;
+};
+
+TEST_F(TrialStoreTest, CommitMovesTheWholeFolderOnceAndOnlyWithAResult) {
+  TrialStore store(dir_.string());
+  auto staging = store.Staging("exp-a-r1", 1);
+  ASSERT_TRUE(staging);
+  const fs::path run = fs::path(*staging) / "exp-a-r1-run";
+  fs::create_directories(run / "logs");
+  std::ofstream(run / "logs" / "physics.log") << "t=1.000 node=physics event=ready\n";
+  Status without = store.Commit("exp-a-r1", run.string());
+  ASSERT_FALSE(without);
+  EXPECT_EQ(without.error().message(), "refusing to commit a trial without result.json");
+  EXPECT_FALSE(store.Done("exp-a-r1"));
+
+  ASSERT_TRUE(WriteFileAtomic((run / "result.json").string(), "{\"outcome\":\"success\"}"));
+  ASSERT_TRUE(store.Commit("exp-a-r1", run.string()));
+  EXPECT_TRUE(store.Done("exp-a-r1"));
+  EXPECT_EQ(Read(dir_ / "exp-a-r1" / "logs" / "physics.log"), "t=1.000 node=physics event=ready\n");
+  EXPECT_FALSE(fs::exists(run));
+
+  // A second commit of the same trial is refused: it is never recorded twice.
+  auto again = store.Staging("exp-a-r1", 2);
+  ASSERT_TRUE(again);
+  ASSERT_TRUE(WriteFileAtomic((fs::path(*again) / "result.json").string(), "{}"));
+  Status twice = store.Commit("exp-a-r1", *again);
+  ASSERT_FALSE(twice);
+  EXPECT_EQ(twice.error().code(), ErrorCode::kAlreadyExists);
+  EXPECT_EQ(Read(dir_ / "exp-a-r1" / "result.json"), "{\"outcome\":\"success\"}");
+}
+
+TEST_F(TrialStoreTest, WriteFileAtomicReplacesAndLeavesNoTemporary) {
+  const fs::path f = dir_ / "result.json";
+  ASSERT_TRUE(WriteFileAtomic(f.string(), "first"));
+  ASSERT_TRUE(WriteFileAtomic(f.string(), "second"));
+  EXPECT_EQ(Read(f), "second");
+  int files = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir_)) ++files;
+  EXPECT_EQ(files, 1);
+}
+
+TEST_F(TrialStoreTest, TheFolderLockIsExclusive) {
+  auto first = DirLock::Acquire(dir_.string());
+  ASSERT_TRUE(first);
+  auto second = DirLock::Acquire(dir_.string());
+  ASSERT_FALSE(second);
+  EXPECT_EQ(second.error().code(), ErrorCode::kUnavailable);
+}
+
+// A host that commits each trial through the store like the real executor, counts runs per trial,
+// and "crashes" the orchestrator (sets the interrupt) after `crash_after` commits; the attempt in
+// flight at that moment is left in staging, as a killed process would leave it.
+class StoreHost final : public HostWorker {
+ public:
+  StoreHost(TrialStore& store, std::atomic<bool>& crash, int crash_after)
+      : store_(store), crash_(crash), crash_after_(crash_after) {}
+  std::string name() const override { return "local"; }
+  int slots() const override { return 2; }
+  AttemptResult Run(const PlannedTrial& t, int attempt) override {
+    {
+      std::lock_guard lock(mu_);
+      runs_[t.id] += 1;
+    }
+    auto staging = store_.Staging(t.id, attempt);
+    if (!staging) return {AttemptResult::Kind::kHostFailed, "", staging.error().ToString()};
+    const fs::path run = fs::path(*staging) / (t.id + "-run");
+    fs::create_directories(run);
+    if (crash_.load()) return {AttemptResult::Kind::kCancelled, "", "crashed"};
+    (void)WriteFileAtomic((run / "result.json").string(), "{\"trial\":\"" + t.id + "\"}");
+    if (!store_.Commit(t.id, run.string())) {
+      return {AttemptResult::Kind::kHostFailed, "", "commit failed"};
+    }
+    if (++commits_ >= crash_after_) crash_.store(true);
+    return {AttemptResult::Kind::kCompleted, "success", ""};
+  }
+  std::map<std::string, int> runs() {
+    std::lock_guard lock(mu_);
+    return runs_;
+  }
+
+ private:
+  TrialStore& store_;
+  std::atomic<bool>& crash_;
+  int crash_after_;
+  std::atomic<int> commits_{0};
+  std::mutex mu_;
+  std::map<std::string, int> runs_;
+};
+
+TEST_F(TrialStoreTest, ResumeRunsOnlyWhatHasNoResultAndNeverATrialTwice) {
+  std::vector<PlannedTrial> all;
+  for (int i = 0; i < 9; ++i) {
+    PlannedTrial t;
+    t.id = "exp-" + std::string(1, static_cast<char>('a' + i)) + "-r1";
+    all.push_back(t);
+  }
+  TrialStore store(dir_.string());
+  ScheduleObserver quiet;
+
+  // First run: crashes after 4 commits.
+  std::atomic<bool> crash{false};
+  StoreHost first(store, crash, 4);
+  RunSchedule(store.Pending(all), {&first}, {.max_attempts = 3, .interrupted = &crash}, quiet);
+  const auto pending = store.Pending(all);
+  const std::size_t committed_first = all.size() - pending.size();
+  EXPECT_GE(committed_first, 4u);
+  EXPECT_LT(committed_first, all.size());
+
+  // Resume: staging is cleared, only the rest runs.
+  ASSERT_TRUE(store.ClearStaging());
+  EXPECT_FALSE(fs::exists(dir_ / ".staging"));
+  std::atomic<bool> never{false};
+  StoreHost second(store, never, 1000);
+  auto reports = RunSchedule(pending, {&second}, {.max_attempts = 3, .interrupted = &never}, quiet);
+  for (const TrialReport& r : reports) EXPECT_EQ(r.status, TrialStatus::kCompleted);
+
+  for (const PlannedTrial& t : all) {
+    EXPECT_TRUE(store.Done(t.id)) << t.id;
+    EXPECT_EQ(Read(dir_ / t.id / "result.json"), "{\"trial\":\"" + t.id + "\"}");
+    const int committed_runs = (first.runs().count(t.id) > 0 && second.runs().count(t.id) > 0) ? 2 : 1;
+    // A trial committed by the first run is never handed to the second.
+    EXPECT_EQ(committed_runs, 1) << t.id << " ran in both sessions";
+  }
+  EXPECT_TRUE(store.Pending(all).empty());
+}
+
+TEST(ProgressBoard, LinesPerHostAndAnOverallBarWithEta) {
+  ProgressBoard board({{"local", 2}, {"root@10.250.0.2", 1}}, 8, 2);
+  board.Started("local", "e-aa-r1", 0);
+  board.Started("root@10.250.0.2", "e-ab-r1", 0);
+  board.Finished("local", "e-aa-r1", "success", 30);
+  board.Started("local", "e-ba-r1", 30);
+  board.Finished("root@10.250.0.2", "e-ab-r1", "", 35);  // lost with its host
+  board.HostDown("root@10.250.0.2", "dockerd gone");
+  auto lines = board.Render(40);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines[0], "local            2 slots  up    done 1  running e-ba-r1 10s");
+  EXPECT_EQ(lines[1], "root@10.250.0.2  1 slot   DOWN  done 0  (dockerd gone)");
+  // 3 of 8 done, 5 left on 2 slots up at 30 s a trial: 3 waves = 1m30s.
+  EXPECT_EQ(lines[2],
+            "[#######.............] 3/8  success 1 failure 0 timeout 0 error 0 | running 1 | "
+            "requeued 1 | ETA 1m30s");
+  EXPECT_EQ(FormatDuration(3725), "1h02m");
+}
+
+}  // namespace
+}  // namespace swarmbox::experiment

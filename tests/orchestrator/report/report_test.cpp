@@ -1,0 +1,214 @@
+// Per-trial metrics from events and truth samples, results.csv, report.html and box-plot
+// statistics (pure), and reading a trial folder written here (temp dir).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "swarmbox/report/report_html.hpp"
+#include "swarmbox/report/results_csv.hpp"
+#include "swarmbox/report/trial_metrics.hpp"
+#include "swarmbox/report/trial_record.hpp"
+
+namespace swarmbox::report {
+namespace {
+
+void Feed(TrialMetrics& m, std::string_view component, std::string_view line) {
+  m.OnLogEvent(component, ParseLogfmt(line));
+}
+
+TEST(TrialMetrics, EmptyLogsGiveEmptyCellsNotZeros) {
+  TrialMetrics m;
+  MetricValues v = m.Values();
+  ASSERT_EQ(v.size(), MetricNames().size());
+  for (const auto& [name, value] : v) EXPECT_FALSE(value.has_value()) << name;
+  TrialMetrics with_physics;
+  with_physics.SawPhysicsLog();
+  EXPECT_EQ(with_physics.Values()["collisions"], 0.0);
+}
+
+TEST(TrialMetrics, MissionDetectionsCollisionsAndRadio) {
+  TrialMetrics m;
+  m.SawPhysicsLog();
+  Feed(m, "scout_1", "t=5.000 node=scout_1 event=mission_state phase=search");
+  Feed(m, "scout_1", "t=41.200 node=scout_1 event=victim_detected victim=v1 x=10 y=20");
+  Feed(m, "scout_2", "t=38.900 node=scout_2 event=victim_detected victim=v2 x=1 y=2");
+  Feed(m, "scout_2", "t=44.000 node=scout_2 event=victim_confirmed victim=v2");
+  Feed(m, "scout_1", "t=45.000 node=scout_1 event=victim_detected victim=v2");
+  Feed(m, "physics", "t=50.000 node=physics event=collision a=scout_1 b=scout_2");
+  Feed(m, "lifter", "t=300.500 node=lifter event=mission_complete");
+  Feed(m, "scout_1", "t=10 node=scout_1 event=link peer=scout_2 loss=0.10 rtt_ms_mean=210.0");
+  Feed(m, "scout_2", "t=10 node=scout_2 event=link peer=scout_1 loss=0.00 rtt_ms_mean=190.0");
+  Feed(m, "scout_2", "not an event line");
+  MetricValues v = m.Values();
+  EXPECT_EQ(v["mission_time_s"], 300.5);
+  EXPECT_EQ(v["first_detection_s"], 38.9);
+  EXPECT_EQ(v["detections"], 2.0);
+  EXPECT_EQ(v["victims_confirmed"], 1.0);
+  EXPECT_EQ(v["collisions"], 1.0);
+  EXPECT_DOUBLE_EQ(*v["radio_rtt_ms"], 200.0);
+  EXPECT_DOUBLE_EQ(*v["radio_loss"], 0.05);
+  EXPECT_FALSE(v["leader_changes"].has_value());
+  EXPECT_FALSE(v["min_separation_m"].has_value());
+}
+
+TEST(TrialMetrics, LeaderChangesAndFailoverFromTheLeadersStop) {
+  TrialMetrics m;
+  // Every node logs the same election; term 2 re-elects scout_1 (no change), term 3 after its stop.
+  for (const char* node : {"scout_1", "scout_2", "scout_3"}) {
+    Feed(m, node, std::string("t=2.000 node=") + node + " event=leader_elected term=1 leader=scout_1");
+  }
+  Feed(m, "scout_2", "t=9.000 node=scout_2 event=leader_elected term=2 leader=scout_1");
+  Feed(m, "scout_1", "t=30.000 node=scout_1 event=raft_stopped");
+  Feed(m, "scout_3", "t=32.400 node=scout_3 event=leader_elected term=3 leader=scout_3");
+  Feed(m, "scout_2", "t=32.500 node=scout_2 event=leader_elected term=3 leader=scout_3");
+  MetricValues v = m.Values();
+  EXPECT_EQ(v["leader_changes"], 1.0);
+  ASSERT_TRUE(v["failover_s"].has_value());
+  EXPECT_NEAR(*v["failover_s"], 2.4, 1e-9);
+}
+
+TEST(TrialMetrics, FailoverFromAFaultOnTheLeaderAndNoneWhenAFollowerStops) {
+  TrialMetrics m;
+  Feed(m, "a", "t=1 node=a event=leader_elected term=1 leader=a");
+  Feed(m, "b", "t=20 node=b event=stopped");  // a follower: no failover
+  m.OnOrchestratorEvent("fault", "raft_leader", 40.0);
+  Feed(m, "b", "t=41.5 node=b event=leader_elected term=2 leader=b");
+  MetricValues v = m.Values();
+  EXPECT_NEAR(*v["failover_s"], 1.5, 1e-9);
+}
+
+TEST(TrialMetrics, MinSeparationComparesDronesAtTheSameTime) {
+  TrialMetrics m;
+  m.OnTruth(0.0, "a", 0, 0, 0);
+  m.OnTruth(0.0, "b", 3, 4, 0);   // 5 m
+  m.OnTruth(0.1, "a", 0, 0, 1);
+  m.OnTruth(0.1, "b", 0, 2, 1);   // 2 m
+  m.OnTruth(0.2, "a", 0, 0, 0);   // alone at t=0.2
+  EXPECT_DOUBLE_EQ(*m.Values()["min_separation_m"], 2.0);
+}
+
+TrialRecord Record(std::string id, std::string code, std::vector<std::string> levels,
+                   std::string outcome, double wall) {
+  TrialRecord r;
+  r.folder = id;
+  r.meta.id = std::move(id);
+  r.meta.code = std::move(code);
+  r.meta.levels = std::move(levels);
+  r.meta.repetition = 1;
+  r.meta.seed = 7;
+  r.host = "local";
+  r.outcome = std::move(outcome);
+  r.wall_s = wall;
+  r.sim_s = 60;
+  for (const std::string& m : MetricNames()) r.metrics[m] = std::nullopt;
+  return r;
+}
+
+TEST(ResultsCsv, ContractColumnsQuotingAndEmptyCells) {
+  TrialRecord r = Record("e-ab-r1", "ab", {"0.05", "three, spread"}, "timeout", 12.25);
+  r.reason = "sim time \"60 s\" reached";
+  r.metrics["collisions"] = 0;
+  r.metrics["radio_rtt_ms"] = 201.5;
+  const std::string csv = ResultsCsv({"loss", "swarm"}, {r});
+  const std::string header =
+      "trial_id,code,loss,swarm,repetition,seed,host,outcome,reason,wall_s,sim_s,mission_time_s,"
+      "first_detection_s,detections,victims_confirmed,min_separation_m,collisions,leader_changes,"
+      "failover_s,radio_rtt_ms,radio_loss\n";
+  ASSERT_EQ(csv.substr(0, header.size()), header);
+  EXPECT_EQ(csv.substr(header.size()),
+            "e-ab-r1,ab,0.05,\"three, spread\",1,7,local,timeout,\"sim time \"\"60 s\"\" reached\","
+            "12.25,60,,,,,,0,,,201.5,\n");
+  EXPECT_EQ(CsvNumber(0.1 + 0.2), "0.3");
+  EXPECT_EQ(CsvNumber(3), "3");
+}
+
+TEST(BoxStats, TukeyQuartilesWhiskersAndOutliers) {
+  BoxStats b = ComputeBoxStats({1, 2, 3, 4, 5, 6, 7, 8, 100});
+  EXPECT_EQ(b.n, 9u);
+  EXPECT_DOUBLE_EQ(b.q1, 3);
+  EXPECT_DOUBLE_EQ(b.median, 5);
+  EXPECT_DOUBLE_EQ(b.q3, 7);
+  EXPECT_DOUBLE_EQ(b.whisker_low, 1);
+  EXPECT_DOUBLE_EQ(b.whisker_high, 8);
+  ASSERT_EQ(b.outliers.size(), 1u);
+  EXPECT_DOUBLE_EQ(b.outliers[0], 100);
+  BoxStats two = ComputeBoxStats({1, 2});
+  EXPECT_DOUBLE_EQ(two.median, 1.5);
+  EXPECT_DOUBLE_EQ(two.q1, 1.25);
+  EXPECT_EQ(ComputeBoxStats({}).n, 0u);
+}
+
+TEST(ReportHtml, CountsPerLevelPlotsPerMetricAndLinksEveryTrial) {
+  std::vector<TrialRecord> records = {
+      Record("e-aa-r1", "aa", {"0", "3"}, "success", 10),
+      Record("e-ab-r1", "ab", {"0", "<5>"}, "failure", 20),
+      Record("e-ba-r1", "ba", {"0.2", "3"}, "success", 30),
+  };
+  records[0].has_trajectories = true;
+  records[2].metrics["mission_time_s"] = 55;
+  const std::string html = ReportHtml("exp <1>", {"loss", "swarm"}, records);
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_NE(html.find("<title>exp &lt;1&gt;</title>"), std::string::npos);
+  EXPECT_NE(html.find("3 trials: <span class='success'>success 2</span>"), std::string::npos);
+  EXPECT_NE(html.find("<td>b: &lt;5&gt;</td><td>0</td><td>1</td>"), std::string::npos);
+  EXPECT_NE(html.find("<h3>wall_s</h3>"), std::string::npos);
+  EXPECT_NE(html.find("<h3>mission_time_s</h3>"), std::string::npos);
+  EXPECT_EQ(html.find("<h3>radio_rtt_ms</h3>"), std::string::npos);  // no trial has it
+  EXPECT_NE(html.find("wall_s by loss"), std::string::npos);
+  EXPECT_NE(html.find("<a href='e-aa-r1/trajectories.png'><img"), std::string::npos);
+  EXPECT_NE(html.find("<a href='e-ab-r1/logs/'>logs</a>"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("http://"), std::string::npos) << "self-contained: no external resource";
+}
+
+TEST(TrialRecordTest, ReadsResultMetaLogsAndTruthFromAFolder) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("swarmbox-record-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const fs::path trial = dir / "e-ab-r2";
+  fs::create_directories(trial / "logs");
+  TrialMeta meta;
+  meta.id = "e-ab-r2";
+  meta.code = "ab";
+  meta.factors = {"loss", "size"};
+  meta.levels = {"0", "3"};
+  meta.repetition = 2;
+  meta.seed = 99;
+  meta.attempts = 2;
+  meta.hosts = {"root@10.250.0.2", "local"};
+  std::ofstream(trial / "trial_meta.json") << TrialMetaJson(meta);
+  std::ofstream(trial / "result.json")
+      << R"({"trial":"e-ab-r2","outcome":"success","reason":"","wall_s":21.5,"sim_s":60.0,)"
+      << R"("seed":99,"host":"local","metrics":{}})";
+  std::ofstream(trial / "logs" / "physics.log") << "t=0.000 node=physics event=ready\n";
+  std::ofstream(trial / "logs" / "scout_1.log")
+      << "t=3.000 node=scout_1 event=leader_elected term=1 leader=scout_1\nplain text\n";
+  std::ofstream(trial / "truth.csv") << "t_s,drone,x_m,y_m,z_m,vx_m_s\n0,a,0,0,0,0\n0,b,0,6,8,0\n";
+  fs::create_directories(dir / ".staging" / "e-aa-r1.1");
+  fs::create_directories(dir / "e-ba-r1");  // no result.json: not a trial yet
+
+  auto rec = ReadTrialFolder(trial.string());
+  ASSERT_TRUE(rec) << rec.error().ToString();
+  EXPECT_EQ(rec->meta.id, "e-ab-r2");
+  EXPECT_EQ(rec->meta.hosts, meta.hosts);
+  EXPECT_EQ(rec->meta.attempts, 2);
+  EXPECT_EQ(rec->outcome, "success");
+  EXPECT_EQ(rec->host, "local");
+  EXPECT_EQ(rec->wall_s, 21.5);
+  EXPECT_EQ(rec->metrics["collisions"], 0.0);
+  EXPECT_EQ(rec->metrics["leader_changes"], 0.0);
+  EXPECT_DOUBLE_EQ(*rec->metrics["min_separation_m"], 10.0);
+  EXPECT_FALSE(rec->has_trajectories);
+
+  std::vector<std::string> problems;
+  auto all = ReadExperimentFolder(dir.string(), &problems);
+  ASSERT_EQ(all.size(), 1u);
+  EXPECT_TRUE(problems.empty());
+  EXPECT_EQ(FactorNames(dir.string(), all), (std::vector<std::string>{"loss", "size"}));
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace swarmbox::report
