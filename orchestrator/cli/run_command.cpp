@@ -35,6 +35,10 @@ int RunCommand(const RunArgs& args) {
     std::cerr << "swarmbox run: " << images.error().ToString() << "\n";
     return kExitInfrastructure;
   }
+  if (interrupted.load()) {  // Ctrl-C during the image step: nothing of the trial exists yet
+    std::cerr << "swarmbox run: interrupted (Ctrl-C) before the trial started; nothing was created\n";
+    return kExitOutcome;
+  }
   runner::SteadyClock clock;
   runner::RunOptions options;
   options.out_dir = args.out;
