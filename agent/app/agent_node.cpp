@@ -4,6 +4,8 @@
 #include <cmath>
 #include <utility>
 
+#include <opencv2/imgproc.hpp>
+
 #include "swarmbox/common/logfmt.hpp"
 
 namespace swarmbox::agent {
@@ -45,21 +47,44 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   }
   auto cfg = flight::LoadFlightConfig(o.airframe_path);
   if (!cfg) return cfg.error().Context("loading airframe");
+  MissionHostConfig mc;
   if (o.mission.kind == MissionKind::kSar) {
     if (o.raft.members.empty()) return Error(ErrorCode::kInvalidArgument, "--mission sar needs --members");
+    if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--mission sar needs the mesh bus (drop --no-mesh)");
     auto world = LoadWorldView(o.mission.world_path);
     if (!world) return world.error();
-    if (!o.mission.payload.empty() &&
-        std::none_of(cfg->payloads.begin(), cfg->payloads.end(),
-                     [&](const flight::SlungPayload& p) { return p.name == o.mission.payload; })) {
-      std::string known;
-      for (const flight::SlungPayload& p : cfg->payloads) known += (known.empty() ? "" : ", ") + p.name;
-      return Error(ErrorCode::kInvalidArgument, "--payload '" + o.mission.payload + "': airframe " + cfg->airframe +
-                                                    " has " + (known.empty() ? std::string("no payloads") : "payloads " + known));
+    auto camera = LoadCameraSpec(o.airframe_path);
+    if (!camera) return camera.error().Context("loading the airframe's camera");
+    mc.name = o.name;
+    mc.members = o.raft.members;
+    mc.airframe = cfg->airframe;
+    mc.payload = o.mission.payload;
+    mc.base_height_m = cfg->base_height_m;
+    mc.vehicle_mass_kg = cfg->mass_kg;
+    mc.has_home = o.has_start;
+    mc.home_m = o.start_m;
+    mc.geofence_size_x_m = world->size_x_m;
+    mc.geofence_size_y_m = world->size_y_m;
+    mc.camera = *camera;
+    mc.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
+    if (!o.mission.payload.empty()) {
+      auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
+                             [&](const flight::SlungPayload& p) { return p.name == o.mission.payload; });
+      if (it == cfg->payloads.end()) {
+        std::string known;
+        for (const flight::SlungPayload& p : cfg->payloads) known += (known.empty() ? "" : ", ") + p.name;
+        return Error(ErrorCode::kInvalidArgument, "--payload '" + o.mission.payload + "': airframe " + cfg->airframe +
+                                                      " has " + (known.empty() ? std::string("no payloads") : "payloads " + known));
+      }
+      mc.payload_sling_length_m = it->sling_length_m;
+      mc.payload_hook_m = it->hook_m;
+      auto ground = LoadGroundPayload(o.airframe_path, o.mission.payload);
+      if (!ground) return ground.error().Context("--payload");
+      mc.payload_offset_m = ground->offset_m;
+      mc.payload_half_height_m = ground->half_height_m;
     }
-    return Error(ErrorCode::kInvalidArgument, "--mission sar: the SAR mission is not hosted by this build yet");
   }
-  auto plan = FlightPlan::Parse(o.plan);
+  auto plan = FlightPlan::Parse(o.plan);  // --mission sar: parsed (the default) but not flown
   if (!plan) return plan.error().Context("--plan");
   plan->SetPreflight(o.preflight_s);
   flight::ControllerOptions co;
@@ -98,6 +123,25 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     auto raft = RaftHost::Start(ro, *node->mesh_, o.log);
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
+  }
+  if (o.mission.kind == MissionKind::kSar) {
+    auto host = MissionHost::Create(mc);
+    if (!host) return host.error();
+    node->mission_ = std::move(*host);
+    if (node->mission_->role() == swarm::Role::kScout) {
+      auto cam = node->sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(o.name), bus::Qos::kLockstep);
+      if (!cam) return cam.error().Context("subscribing to the camera");
+      node->camera_sub_ = std::move(*cam);
+    }
+    auto wc = node->sim_->CreatePublisher<bus::WorldCommand>(bus::kWorldCommandTopic, bus::Qos::kLockstep);
+    if (!wc) return wc.error().Context("publishing world commands");
+    node->world_pub_ = std::move(*wc);
+    auto det = node->mesh_->CreatePublisher<bus::Detection>(bus::kDetectionTopic, bus::Qos::kRadio);
+    if (!det) return det.error().Context("publishing detections");
+    node->detection_pub_ = std::move(*det);
+    auto peers = node->mesh_->CreateSubscriber<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState);
+    if (!peers) return peers.error().Context("subscribing to drone states");
+    node->peers_sub_ = std::move(*peers);
   }
   return node;
 }
@@ -145,14 +189,18 @@ void AgentNode::HandleSample(const bus::SensorSample& msg) {
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
     Log(le);
   }
-  if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
-  if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
-    plan_index_logged_ = plan_.index();
-    Log(LogEvent(t_s_, options_.name, "plan_step").Add("step", plan_.current()));
-  }
-  if (plan_.finished() && !plan_done_logged_) {
-    plan_done_logged_ = true;
-    Log(LogEvent(t_s_, options_.name, "plan_complete"));
+  if (mission_) {
+    StepMission(msg, st.hover);
+  } else {
+    if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
+    if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
+      plan_index_logged_ = plan_.index();
+      Log(LogEvent(t_s_, options_.name, "plan_step").Add("step", plan_.current()));
+    }
+    if (plan_.finished() && !plan_done_logged_) {
+      plan_done_logged_ = true;
+      Log(LogEvent(t_s_, options_.name, "plan_complete"));
+    }
   }
   // Our state for the neighbours, 5 Hz of simulated time.
   if (state_pub_ && t_s_ >= next_state_s_) {
@@ -165,9 +213,89 @@ void AgentNode::HandleSample(const bus::SensorSample& msg) {
     state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
     state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
     state_.heading_rad = flight::YawOf(est.att);
-    state_.mode = std::string(flight::FlightModeName(fc_.mode()));
+    if (mission_) {
+      state_.mode = mission_->mode();
+      state_.battery_fraction = mission_->battery_fraction();
+    } else {
+      state_.mode = std::string(flight::FlightModeName(fc_.mode()));
+    }
     (void)state_pub_->Publish(state_);
   }
+}
+
+void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
+  const flight::StateEstimate& est = fc_.estimate();
+  mission_->RecordEstimate(t_s_, est);
+  while (peers_sub_->Take(peer_)) {
+    PeerState p;
+    p.name = peer_.drone;
+    p.mode = peer_.mode;
+    p.position_m = V(peer_.position_enu_m);
+    p.velocity_m_s = V(peer_.velocity_enu_m_s);
+    p.sim_time_s = static_cast<double>(peer_.sim_time_ns) * 1e-9;
+    mission_->OnPeerState(p);
+  }
+  if (camera_sub_) {
+    while (camera_sub_->Take(image_)) {
+      if (image_.encoding != "bgr8" && image_.encoding != "rgb8") continue;  // the detector needs colour
+      if (image_.data.size() < static_cast<std::size_t>(image_.height_px) * image_.row_stride_bytes) continue;
+      cv::Mat bgr(static_cast<int>(image_.height_px), static_cast<int>(image_.width_px), CV_8UC3, image_.data.data(),
+                  image_.row_stride_bytes);
+      if (image_.encoding == "rgb8") cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
+      const bus::CameraIntrinsics& k = image_.intrinsics;
+      mission_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image_.sim_time_ns) * 1e-9);
+    }
+  }
+  if (t_s_ >= next_committed_s_) {  // a copy of the committed state, 10 Hz of simulated time
+    next_committed_s_ = t_s_ + 0.1;
+    committed_ = raft_->service().mission();
+    leader_ = raft_->service().is_leader();
+  }
+  MissionHostInput in;
+  in.t_s = t_s_;
+  in.dt_s = options_.control_dt_s;
+  in.flight_mode = fc_.mode();
+  in.estimate = &est;
+  in.mission = &committed_;
+  in.is_leader = leader_;
+  in.hover_event = hover_event;
+  in.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
+  const MissionHostOutput& out = mission_->Step(in);
+  for (const LogEvent& e : out.events) Log(e);
+  if (out.command) (void)fc_.Command(*out.command);
+  for (const raft::MissionCommand& c : out.proposals) {
+    (void)raft_->service().Propose(c);  // kUnavailable (no leader yet): the behaviours re-propose
+  }
+  if (out.payload.action != swarm::PayloadAction::kNone) {
+    ++world_cmd_.seq;
+    world_cmd_.sim_time_ns = msg.sim_time_ns;
+    world_cmd_.target = options_.name;
+    world_cmd_.args.clear();
+    if (out.payload.action == swarm::PayloadAction::kAttach) {
+      world_cmd_.command = "payload_attach";
+      world_cmd_.args.push_back(out.payload.mass_kg);
+    } else {
+      world_cmd_.command = "payload_release";
+    }
+    if (Status s = world_pub_->Publish(world_cmd_); !s) {
+      Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "world_command").Add("reason", s.error().ToString()));
+    }
+  }
+  for (const swarm::GroundDetection& d : out.detections) {
+    ++detection_.seq;
+    detection_.from = options_.name;
+    detection_.sim_time_ns = static_cast<std::int64_t>(d.capture_time_s * 1e9);
+    detection_.label = "victim";
+    detection_.confidence = d.confidence;
+    detection_.position_enu_m = {d.position_m.x(), d.position_m.y(), d.position_m.z()};
+    detection_.position_sigma_m = d.sigma_m;
+    (void)detection_pub_->Publish(detection_);  // best effort, as the radio
+  }
+}
+
+bool AgentNode::Done() const {
+  if (!mission_) return plan_.finished();
+  return mission_->complete() && (fc_.mode() == flight::FlightMode::kLanded || fc_.mode() == flight::FlightMode::kIdle);
 }
 
 Status AgentNode::Run() {
@@ -175,7 +303,8 @@ Status AgentNode::Run() {
           .Add("sim_domain", options_.sim_domain)
           .Add("sim_interface", options_.sim_interface)
           .Add("middleware", options_.middleware)
-          .Add("plan", options_.plan)
+          .Add("mission", MissionKindName(options_.mission.kind))
+          .Add("plan", mission_ ? std::string("-") : options_.plan)
           .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
   bus::SensorSample msg;
   bool got_any = false;
@@ -210,8 +339,12 @@ Status AgentNode::Run() {
                          " s: is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
                          std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
       }
-      Log(LogEvent(t_s_, options_.name, "samples_stopped").Add("after_s", secs, 1).Add("plan", plan_.current()));
-      if (plan_.finished()) return Ok{};
+      Log(LogEvent(t_s_, options_.name, "samples_stopped").Add("after_s", secs, 1).Add("plan", mission_ ? std::string_view("sar") : plan_.current()));
+      if (Done() || (mission_ && mission_->complete())) return Ok{};
+      if (mission_) {
+        return Error(ErrorCode::kUnavailable, "sensor samples stopped for " + Seconds(secs) +
+                                                  " s before the SAR mission was complete (" + mission_->mode() + ")");
+      }
       return Error(ErrorCode::kUnavailable,
                    "sensor samples stopped for " + Seconds(secs) + " s before the plan was complete (at '" +
                        std::string(plan_.current()) + "')");
@@ -225,7 +358,7 @@ Status AgentNode::Run() {
     have_step_ = true;
     last_step_ = msg.step;
     HandleSample(msg);
-    if (options_.exit_when_done && plan_.finished()) return Ok{};
+    if (options_.exit_when_done && Done()) return Ok{};
   }
 }
 

@@ -18,6 +18,7 @@
 #include <string>
 
 #include "flight_plan.hpp"
+#include "mission_host.hpp"
 #include "mission_options.hpp"
 #include "raft_host.hpp"
 #include "swarmbox/bus/participant.hpp"
@@ -71,6 +72,10 @@ class AgentNode {
   AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan);
   void Log(const LogEvent& e);
   void HandleSample(const bus::SensorSample& msg);
+  // --mission sar: feeds the mission host (camera, peers, committed state) and carries out what
+  // it asks (setpoint, payload world command, proposals, detections, events).
+  void StepMission(const bus::SensorSample& msg, bool hover_event);
+  bool Done() const;  // the plan is complete, or the SAR mission is (and this drone is down)
 
   AgentOptions options_;
   flight::FlightController fc_;
@@ -81,6 +86,19 @@ class AgentNode {
   std::unique_ptr<bus::Publisher<bus::ActuatorCommand>> actuator_pub_;
   std::unique_ptr<bus::Publisher<bus::DroneState>> state_pub_;
   std::unique_ptr<RaftHost> raft_;  // after mesh_: destroyed before the participant
+  // --mission sar only.
+  std::unique_ptr<MissionHost> mission_;
+  std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;
+  std::unique_ptr<bus::Publisher<bus::WorldCommand>> world_pub_;
+  std::unique_ptr<bus::Publisher<bus::Detection>> detection_pub_;
+  std::unique_ptr<bus::Subscriber<bus::DroneState>> peers_sub_;
+  bus::CameraImage image_;
+  bus::DroneState peer_;
+  bus::WorldCommand world_cmd_;
+  bus::Detection detection_;
+  raft::MissionState committed_;   // refreshed from the Raft service at each mission tick
+  bool leader_ = false;
+  double next_committed_s_ = 0.0;
   bus::ActuatorCommand cmd_;
   bus::DroneState state_;
   bool have_step_ = false;

@@ -77,7 +77,7 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
       if (m.phase() == MissionPhase::kConverge && tv != nullptr &&
           tv->status == VictimStatus::kConfirmed && handled_.count(target) == 0) {
         if (lifter != nullptr) {
-          if (lifter->mode == "on_ground" && Due("rescue:" + std::to_string(target), t_s)) {
+          if (IsOneOf(lifter->mode, {"on_ground", "standby"}) && Due("rescue:" + std::to_string(target), t_s)) {
             out->proposals.push_back(raft::BeginRescue{target, lifter->name});
           }
           break;

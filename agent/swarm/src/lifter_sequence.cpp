@@ -28,15 +28,18 @@ std::string_view LifterSequence::StageName(Stage stage) {
     case Stage::kReleaseAtHome: return "release_at_home";
     case Stage::kMoveToLandingPoint: return "move_to_land";
     case Stage::kLanding: return "landing";
+    case Stage::kStandby: return "standby";
   }
   return "?";
 }
 
 LifterSequence::LifterSequence(LifterConfig config)
-    : config_(std::move(config)), stretcher_xy_m_(config_.home_m.head<2>()) {
+    : config_(std::move(config)),
+      stretcher_xy_m_(config_.home_m.head<2>() + config_.stretcher_start_offset_m) {
   SWARMBOX_CHECK(!config_.name.empty());
   SWARMBOX_CHECK(config_.sling_length_m > 0 && config_.transit_altitude_m > config_.AttachHeight());
-  SWARMBOX_CHECK(config_.release_sink_m >= 0 && config_.release_sink_m < config_.AttachHeight());
+  SWARMBOX_CHECK(config_.release_sink_m < config_.AttachHeight() &&
+                 config_.transit_altitude_m > config_.AttachHeight() - config_.release_sink_m);
 }
 
 void LifterSequence::Enter(Stage stage, const MissionInput& in, MissionOutput* out) {
@@ -51,10 +54,12 @@ void LifterSequence::Enter(Stage stage, const MissionInput& in, MissionOutput* o
   out->events.push_back(std::move(e));
 }
 
-bool LifterSequence::Settled(const MissionInput& in, const Vec3& target_m) {
-  const bool close = (in.position_m.head<2>() - target_m.head<2>()).norm() <= config_.position_tolerance_m &&
-                     std::abs(in.position_m.z() - target_m.z()) <= config_.altitude_tolerance_m &&
-                     in.velocity_m_s.norm() <= config_.settle_speed_m_s;
+bool LifterSequence::Settled(const MissionInput& in, const Vec3& target_m, bool release) {
+  const double xy_tol = release ? config_.release_tolerance_m : config_.position_tolerance_m;
+  const double z_tol = release ? 2 * config_.altitude_tolerance_m : config_.altitude_tolerance_m;
+  const double speed = release ? config_.release_speed_m_s : config_.settle_speed_m_s;
+  const bool close = (in.position_m.head<2>() - target_m.head<2>()).norm() <= xy_tol &&
+                     std::abs(in.position_m.z() - target_m.z()) <= z_tol && in.velocity_m_s.norm() <= speed;
   if (!close) {
     settled_since_s_ = -1.0;
     return false;
@@ -127,6 +132,22 @@ void LifterSequence::Step(const MissionInput& in, MissionOutput* out) {
   out->mode = StageName(stage_);
 }
 
+bool LifterSequence::TakeRescue(const MissionInput& in) {
+  const raft::MissionState& m = *in.mission;
+  const raft::Victim* v = m.FindVictim(m.target_victim());
+  if (m.phase() != MissionPhase::kRescue || v == nullptr || v->status != raft::VictimStatus::kBeingRescued ||
+      v->rescuer != config_.name || v->id == delivered_victim_ || in.battery_low) {
+    return false;
+  }
+  victim_ = v->id;
+  victim_xy_m_ = {v->x_m, v->y_m};
+  const Vec2 home_xy = config_.home_m.head<2>();
+  Vec2 toward_home = home_xy - victim_xy_m_;
+  toward_home = toward_home.norm() > 1e-6 ? Vec2(toward_home.normalized()) : Vec2(1, 0);
+  drop_xy_m_ = victim_xy_m_ + config_.stretcher_offset_m * toward_home;
+  return true;
+}
+
 void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
   const raft::MissionState& m = *in.mission;
   const Vec3& p = in.position_m;
@@ -141,19 +162,20 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
   sp.yaw_rad = in.yaw_rad;
   sp.target_m = p;
   switch (stage_) {
-    case Stage::kOnGround: {
+    case Stage::kOnGround:
       sp.kind = SetpointKind::kIdle;
-      const raft::Victim* v = m.FindVictim(m.target_victim());
-      if (m.phase() == MissionPhase::kRescue && v != nullptr &&
-          v->status == raft::VictimStatus::kBeingRescued && v->rescuer == config_.name &&
-          v->id != delivered_victim_ && !in.battery_low) {
-        victim_ = v->id;
-        victim_xy_m_ = {v->x_m, v->y_m};
-        Vec2 toward_home = home_xy - victim_xy_m_;
-        toward_home = toward_home.norm() > 1e-6 ? Vec2(toward_home.normalized()) : Vec2(1, 0);
-        drop_xy_m_ = victim_xy_m_ + config_.stretcher_offset_m * toward_home;
+      if (TakeRescue(in)) Enter(Stage::kTakeoffForPickup, in, out);
+      break;
+    case Stage::kStandby: {
+      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z}, slow, false, out);
+      if (TakeRescue(in)) {  // over the stretcher already: settle, then hook it
         Enter(Stage::kTakeoffForPickup, in, out);
+        break;
       }
+      bool waiting = false;  // a confirmed victim nobody rescues yet
+      for (const raft::Victim& v : m.victims()) waiting = waiting || v.status == raft::VictimStatus::kConfirmed;
+      const bool over = m.phase() == MissionPhase::kReturn || m.phase() == MissionPhase::kComplete;
+      if (!waiting || over || in.battery_low) Enter(Stage::kMoveToLandingPoint, in, out);
       break;
     }
     case Stage::kTakeoffForPickup: {
@@ -176,11 +198,19 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
       }
       break;
     case Stage::kClimbToTransit: {
+      if (!in.payload_attached) {  // the load check found the hook empty: go back for it
+        Enter(Stage::kTakeoffForPickup, in, out);
+        break;
+      }
       Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), transit_z}, cruise, true, out);
       if (std::abs(p.z() - transit_z) <= 1.0) Enter(Stage::kTransitToVictim, in, out);
       break;
     }
     case Stage::kTransitToVictim:
+      if (!in.payload_attached) {
+        Enter(Stage::kTakeoffForPickup, in, out);
+        break;
+      }
       Hold({drop_xy_m_.x(), drop_xy_m_.y(), transit_z}, cruise, true, out);
       if ((p.head<2>() - drop_xy_m_).norm() <= 1.0 && in.velocity_m_s.norm() < 0.5) {
         Enter(Stage::kDescendToRelease, in, out);
@@ -189,13 +219,13 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
     case Stage::kDescendToRelease: {
       const Vec3 target(drop_xy_m_.x(), drop_xy_m_.y(), release_z);
       Hold(target, slow, true, out);
-      if (Settled(in, target)) Enter(Stage::kRelease, in, out);
+      if (Settled(in, target, /*release=*/true)) Enter(Stage::kRelease, in, out);
       break;
     }
     case Stage::kRelease:
       Hold({drop_xy_m_.x(), drop_xy_m_.y(), release_z}, slow, true, out);
       if (!in.payload_attached) {
-        stretcher_xy_m_ = drop_xy_m_;
+        stretcher_xy_m_ = p.head<2>();  // it hung under us (release tolerance: not exactly at the drop point)
         out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "stretcher_released")
                                             .Add("victim", static_cast<std::int64_t>(victim_))
                                             .Add("x", drop_xy_m_.x(), 2)
@@ -206,11 +236,11 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
       }
       break;
     case Stage::kWaitLoading:
-      Hold({drop_xy_m_.x(), drop_xy_m_.y(), attach_z}, slow, false, out);
+      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z}, slow, false, out);
       if (in.t_s - stage_start_s_ >= config_.loading_time_s) Enter(Stage::kAttachLoaded, in, out);
       break;
     case Stage::kAttachLoaded: {
-      const Vec3 target(drop_xy_m_.x(), drop_xy_m_.y(), attach_z);
+      const Vec3 target(stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z);
       Hold(target, slow, false, out);
       if (in.payload_attached) {
         out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "evacuee_loaded")
@@ -223,10 +253,18 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
       break;
     }
     case Stage::kClimbWithLoad:
-      Hold({drop_xy_m_.x(), drop_xy_m_.y(), transit_z}, slow, true, out);
+      if (!in.payload_attached) {  // the evacuee's stretcher stayed on the ground
+        Enter(Stage::kAttachLoaded, in, out);
+        break;
+      }
+      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), transit_z}, slow, true, out);
       if (std::abs(p.z() - transit_z) <= 1.0) Enter(Stage::kCarryHome, in, out);
       break;
     case Stage::kCarryHome:
+      if (!in.payload_attached && victim_ != 0) {
+        Enter(Stage::kAttachLoaded, in, out);
+        break;
+      }
       Hold({home_xy.x(), home_xy.y(), transit_z}, victim_ != 0 ? config_.loaded_speed_m_s : cruise,
            in.payload_attached, out);
       if ((p.head<2>() - home_xy).norm() <= 1.0 && in.velocity_m_s.norm() < 0.5) {
@@ -236,13 +274,13 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
     case Stage::kDescendToDrop: {
       const Vec3 target(home_xy.x(), home_xy.y(), release_z);
       Hold(target, slow, true, out);
-      if (Settled(in, target)) Enter(Stage::kReleaseAtHome, in, out);
+      if (Settled(in, target, /*release=*/true)) Enter(Stage::kReleaseAtHome, in, out);
       break;
     }
     case Stage::kReleaseAtHome:
       Hold({home_xy.x(), home_xy.y(), release_z}, slow, true, out);
       if (!in.payload_attached) {
-        stretcher_xy_m_ = home_xy;
+        stretcher_xy_m_ = p.head<2>();
         if (victim_ != 0) {
           delivered_victim_ = victim_;
           last_proposal_s_ = in.t_s;
@@ -251,7 +289,7 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
                                               .Add("victim", static_cast<std::int64_t>(victim_))));
           victim_ = 0;
         }
-        Enter(Stage::kMoveToLandingPoint, in, out);
+        Enter(config_.standby_after_delivery && !in.battery_low ? Stage::kStandby : Stage::kMoveToLandingPoint, in, out);
       } else {
         RequestPayload(in, PayloadAction::kRelease, 0.0, out);
       }

@@ -91,12 +91,14 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
     for (const raft::Victim& v : m.victims()) {
       known = known || (Eigen::Vector2d(v.x_m, v.y_m) - p).norm() <= config_.dedupe_radius_m;
     }
+    const double high = raft::MissionState::kHighConfidence;
     for (const RecentReport& r : recent_) {
+      const bool better = d.confidence >= high && r.confidence < high;
       known = known || ((r.position_m - p).norm() <= config_.dedupe_radius_m &&
-                        in.t_s - r.t_s < config_.report_cooldown_s);
+                        in.t_s - r.t_s < config_.report_cooldown_s && !better);
     }
     if (known) continue;
-    recent_[recent_next_] = {p, in.t_s};
+    recent_[recent_next_] = {p, in.t_s, d.confidence};
     recent_next_ = (recent_next_ + 1) % recent_.size();
     const std::uint64_t seq = next_seq_++;
     out->proposals.push_back(raft::ReportSighting{config_.name, seq, p.x(), p.y(), d.confidence});
@@ -152,6 +154,8 @@ void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
     const raft::Sector* sector = Active(m.phase()) ? m.SectorOf(config_.name) : nullptr;
     if (sector != nullptr && (!has_plan_ || !(*sector == planned_sector_))) PlanSector(*sector, p);
     const raft::Victim* target = OrbitTarget(in);
+    const bool still_sweeping = sector != nullptr && lane_index_ < lanes_.size();
+    if (config_.keep_searching_during_rescue && still_sweeping && stage_ != Stage::kOrbiting) target = nullptr;
     if (target != nullptr) {
       if (orbit_victim_ != target->id || stage_ != Stage::kOrbiting) {
         orbit_victim_ = target->id;
@@ -161,7 +165,9 @@ void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
       }
       Enter(Stage::kOrbiting, in, out);
     } else if (sector != nullptr) {
-      Enter(lane_index_ < lanes_.size() ? Stage::kSearching : Stage::kSwept, in, out);
+      Enter(lane_index_ < lanes_.size() ? Stage::kSearching
+                                        : (config_.return_when_swept ? Stage::kReturning : Stage::kSwept),
+            in, out);
     } else {
       Enter(Stage::kAwaitingSector, in, out);
     }
@@ -228,7 +234,7 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
       sp.kind = SetpointKind::kFlock;
       sp.target_m = orbit_[k].position_m;
       sp.yaw_rad = orbit_[k].yaw_rad;
-      if (!config_.lifter_present && orbit_reached_s_ >= 0 &&
+      if ((!config_.lifter_present || config_.return_when_swept) && orbit_reached_s_ >= 0 &&
           in.t_s - orbit_reached_s_ >= config_.orbit_time_s) {
         handled_.insert(orbit_victim_);
         out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "victim_handled")
@@ -240,9 +246,10 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
     case Stage::kReturning: {
       const double d = (p.head<2>() - home_xy).norm();
       sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
-      sp.target_m = {home_xy.x(), home_xy.y(), Altitude()};
+      const double approach_z = config_.approach_height_m > 0 ? config_.home_m.z() + config_.approach_height_m : Altitude();
+      sp.target_m = {home_xy.x(), home_xy.y(), d > config_.home_approach_m ? Altitude() : approach_z};
       sp.yaw_rad = in.yaw_rad;
-      if (d <= config_.home_reached_m) Enter(Stage::kLanding, in, out);
+      if (d <= config_.home_reached_m && p.z() <= approach_z + 1.0) Enter(Stage::kLanding, in, out);
       break;
     }
     case Stage::kLanding:

@@ -5,7 +5,7 @@
 //
 //   IDLE      all scouts airborne (or start_timeout_s)  -> AssignSectors(partition), StartSearch
 //   SEARCH    a confirmed victim                         -> ConvergeOn(lowest id)
-//   CONVERGE  a lifter on the ground                     -> BeginRescue(target, lifter)
+//   CONVERGE  a lifter on the ground or in "standby"      -> BeginRescue(target, lifter)
 //             no lifter in the roster: after handle_time_s the victim counts as handled (scouts
 //             orbited it) and the next confirmed victim is converged on
 //   SEARCH/CONVERGE  every scout done ("swept"/returning/landed) and every victim rescued or

@@ -16,6 +16,10 @@
 //   kReleaseAtHome     asks payload_release, waits; proposes MarkRescued   ("release_at_home")
 //   kMoveToLandingPoint  moves aside (land_offset_m) at low height         ("move_to_land")
 //   kLanding -> kOnGround ("landing", "on_ground"); MarkRescued is re-proposed until committed.
+// With standby_after_delivery, after the release at home the lifter first holds at hook height
+// over the stretcher it just set down ("standby") while a confirmed victim still waits for a
+// rescue: a BeginRescue for it then goes straight to kAttachEmpty (no landing and take-off in
+// between); with no victim waiting (or battery low) it moves aside and lands as above.
 // A payload request is repeated every attach_retry_s until the payload status changes (a world
 // command can be lost or refused when the hook is out of reach). Battery low: event=battery_low;
 // the lifter abandons a rescue not yet loaded and goes home (with whatever it carries).
@@ -46,9 +50,16 @@ struct LifterConfig {
   double hook_below_body_m = 0.4;
   double sling_length_m = 4.0;
   double payload_half_height_m = 0.125;
-  double release_sink_m = 0.25;          // descend this much below the attach height to set down
+  // Descend this much below the attach height to set down; negative: release the stretcher this
+  // far above the ground (a rigid sling on a stretcher lying on the ground drags it by friction
+  // and upsets the swing damping) [m].
+  double release_sink_m = 0.25;
   double stretcher_offset_m = 3.0;       // drop point this far from the victim, toward home [m]
   Eigen::Vector2d land_offset_m{6.0, 0.0};  // landing point beside the stretcher at home [m]
+  // Where the stretcher lies at start, relative to home_m (the physics server lays a ground
+  // payload beside the drone, not under it) [m].
+  Eigen::Vector2d stretcher_start_offset_m{0.0, 0.0};
+  bool standby_after_delivery = false;    // hover over the stretcher while victims wait
   double loading_time_s = 30.0;
   double empty_stretcher_mass_kg = 15.0;  // assumption: litter alone
   double loaded_mass_kg = 80.0;           // stretcher and evacuee (the brief)
@@ -56,6 +67,10 @@ struct LifterConfig {
   double altitude_tolerance_m = 0.3;
   double settle_speed_m_s = 0.3;
   double settle_time_s = 1.5;
+  // Setting the stretcher down needs less than hooking it: within release_tolerance_m and slower
+  // than release_speed_m_s for settle_time_s (a slung load keeps the lifter moving a little).
+  double release_tolerance_m = 2.0;
+  double release_speed_m_s = 2.5;
   double attach_retry_s = 3.0;
   double proposal_retry_s = 2.0;
 
@@ -68,7 +83,7 @@ class LifterSequence {
   enum class Stage {
     kOnGround, kTakeoffForPickup, kAttachEmpty, kClimbToTransit, kTransitToVictim,
     kDescendToRelease, kRelease, kWaitLoading, kAttachLoaded, kClimbWithLoad, kCarryHome,
-    kDescendToDrop, kReleaseAtHome, kMoveToLandingPoint, kLanding,
+    kDescendToDrop, kReleaseAtHome, kMoveToLandingPoint, kLanding, kStandby,
   };
   static std::string_view StageName(Stage stage);
 
@@ -84,9 +99,13 @@ class LifterSequence {
 
  private:
   void RunStage(const MissionInput& in, MissionOutput* out);
+  // A rescue committed for this drone (phase RESCUE, its victim being rescued by it): takes it
+  // (victim, drop point) and returns true.
+  bool TakeRescue(const MissionInput& in);
   void Enter(Stage stage, const MissionInput& in, MissionOutput* out);
-  // True once within tolerance of `target_m` and slow for settle_time_s.
-  bool Settled(const MissionInput& in, const Eigen::Vector3d& target_m);
+  // True once within tolerance of `target_m` and slow for settle_time_s (the attach tolerances,
+  // or with `release` the looser release ones).
+  bool Settled(const MissionInput& in, const Eigen::Vector3d& target_m, bool release = false);
   void Hold(const Eigen::Vector3d& target_m, double speed_m_s, bool damp, MissionOutput* out) const;
   void RequestPayload(const MissionInput& in, PayloadAction action, double mass_kg,
                       MissionOutput* out);

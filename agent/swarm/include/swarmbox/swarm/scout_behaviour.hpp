@@ -9,10 +9,15 @@
 //   any of the three --(phase CONVERGE/RESCUE with a target victim not rescued)--> kOrbiting
 //       "orbiting" around it; back to searching when it is rescued (or, with no lifter in the
 //       trial, after orbit_time_s on the orbit: the victim is then handled)
+//   (keep_searching_during_rescue: only a scout with its sector swept orbits; return_when_swept:
+//    "swept" with no victim to orbit goes straight to "returning")
 //   airborne --(phase RETURN/COMPLETE, or battery low: event=battery_low)--> kReturning
 //       "returning" --(over home)--> kLanding "landing" --(touch-down)--> kLanded "landed".
 // Detections (after the latency queue) become Raft ReportSighting proposals, except near a known
-// victim or near the drone's own recent report (cooldown), and only in an active phase.
+// victim or near the drone's own recent report (cooldown), and only in an active phase. A better
+// view within the cooldown is still reported when it reaches MissionState::kHighConfidence and
+// the recent report did not (a victim first seen partly at the image edge is capped below it; the
+// full view a moment later confirms it on its own).
 //
 //   ScoutBehaviour scout({.name = "scout_1", .home_m = spawn});
 //   scout.Step(input, &output);   // each mission tick (e.g. 10 Hz)
@@ -48,9 +53,19 @@ struct ScoutConfig {
   double orbit_lead_rad = 0.5;
   bool lifter_present = true;         // the trial has an x8_heavy lifter
   double orbit_time_s = 30.0;         // without a lifter: orbit this long, then resume [s]
+  // With keep_searching_during_rescue, only a scout whose sector is swept (or that has none)
+  // converges on and orbits the target; the others finish their sweep first (faster search).
+  bool keep_searching_during_rescue = false;
+  // With return_when_swept, a scout with its sector swept and no victim to orbit flies home and
+  // lands at once instead of loitering over its sector until RETURN.
+  // It also leaves an orbit after orbit_time_s (the victim is marked, the lifter is on its way).
+  bool return_when_swept = false;
   // Return and landing.
   double home_approach_m = 10.0;      // stop flocking and fly straight home within this [m]
   double home_reached_m = 1.0;
+  // > 0: descend to this height above home (position mode, faster than the landing descent)
+  // before landing; 0: land from the search altitude [m].
+  double approach_height_m = 0.0;
   // Sightings.
   double min_report_confidence = raft::MissionState::kMinConfidence;
   double dedupe_radius_m = raft::MissionState::kConfirmRadiusM;
@@ -101,6 +116,7 @@ class ScoutBehaviour {
   struct RecentReport {
     Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
     double t_s = -1e9;
+    double confidence = 0.0;
   };
   std::array<RecentReport, 16> recent_{};
   std::size_t recent_next_ = 0;
