@@ -18,6 +18,7 @@
 #include "program_images.hpp"
 #include "swarmbox/experiment/experiment_runner.hpp"
 #include "swarmbox/experiment/experiment_spec.hpp"
+#include "swarmbox/experiment/trial_store.hpp"
 #include "swarmbox/hosts/host.hpp"
 #include "swarmbox/runner/naming.hpp"
 
@@ -51,6 +52,18 @@ int ExperimentCommand(const ExperimentArgs& args) {
   }
   const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
   const std::string out = args.out.empty() ? "runs/" + spec->name + "-" + run_id : args.out;
+  if (auto checked = experiment::CheckOutFolder(*plan, out, args.resume); !checked) {
+    std::cerr << "swarmbox experiment: " << checked.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  if (args.resume && experiment::TrialStore(out).Pending(plan->trials).empty()) {
+    std::vector<std::string> problems;
+    (void)experiment::WriteReports(out, &problems);
+    std::cout << out << ": " << plan->trials.size() << "/" << plan->trials.size()
+              << " trials already have a result; " << out << "/results.csv, " << out
+              << "/report.html\n";
+    return kExitOk;
+  }
   const std::atomic<bool>& interrupted = InstallInterruptHandlers();
   auto say = [&](const std::string& line) {
     if (!args.quiet) std::cerr << line << "\n";

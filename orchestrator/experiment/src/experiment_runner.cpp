@@ -247,39 +247,48 @@ Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::st
   return records.size();
 }
 
+Result<std::vector<std::string>> CheckOutFolder(const ExperimentPlan& plan, const std::string& out_dir,
+                                               bool resume) {
+  const fs::path meta_path = fs::path(out_dir) / "experiment.json";
+  std::vector<std::string> run_ids;
+  std::error_code ec;
+  if (!fs::exists(meta_path, ec)) return run_ids;
+  auto doc = yaml::ParseFile(meta_path.string());
+  if (!doc || !doc->is_mapping()) {
+    return Error(ErrorCode::kInvalidArgument, "cannot read experiment.json", meta_path.string());
+  }
+  const Node* name = doc->Find("name");
+  if (name == nullptr || name->scalar() != plan.spec.name) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "the folder holds another experiment ('" +
+                     (name == nullptr ? std::string("?") : name->scalar()) +
+                     "'): choose another --out",
+                 out_dir);
+  }
+  if (const Node* ids = doc->Find("run_ids"); ids != nullptr && ids->is_sequence()) {
+    for (const Node& id : ids->items()) run_ids.push_back(id.scalar());
+  }
+  TrialStore store(out_dir);
+  const bool any_done = std::any_of(plan.trials.begin(), plan.trials.end(),
+                                    [&](const PlannedTrial& t) { return store.Done(t.id); });
+  if (any_done && !resume) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "the folder already holds trials of this experiment: add --resume to run the "
+                 "ones without result.json, or choose another --out",
+                 out_dir);
+  }
+  return run_ids;
+}
+
 Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
                                         const ExperimentOptions& options) {
   auto dir_lock = DirLock::Acquire(options.out_dir);
   if (!dir_lock) return dir_lock.error();
   TrialStore store(options.out_dir);
   const fs::path meta_path = fs::path(options.out_dir) / "experiment.json";
-  std::vector<std::string> run_ids;
-  std::error_code ec;
-  if (fs::exists(meta_path, ec)) {
-    auto doc = yaml::ParseFile(meta_path.string());
-    if (!doc || !doc->is_mapping()) {
-      return Error(ErrorCode::kInvalidArgument, "cannot read experiment.json", meta_path.string());
-    }
-    const Node* name = doc->Find("name");
-    if (name == nullptr || name->scalar() != plan.spec.name) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "the folder holds another experiment ('" +
-                       (name == nullptr ? std::string("?") : name->scalar()) +
-                       "'): choose another --out",
-                   options.out_dir);
-    }
-    if (const Node* ids = doc->Find("run_ids"); ids != nullptr && ids->is_sequence()) {
-      for (const Node& id : ids->items()) run_ids.push_back(id.scalar());
-    }
-    const bool any_done = std::any_of(plan.trials.begin(), plan.trials.end(),
-                                      [&](const PlannedTrial& t) { return store.Done(t.id); });
-    if (any_done && !options.resume) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "the folder already holds trials of this experiment: add --resume to run the "
-                   "ones without result.json, or choose another --out",
-                   options.out_dir);
-    }
-  }
+  auto previous = CheckOutFolder(plan, options.out_dir, options.resume);
+  if (!previous) return previous.error();
+  std::vector<std::string> run_ids = std::move(*previous);
   ExperimentSummary summary;
   // What a killed earlier run of this folder left on the hosts (its run ids).
   for (const std::string& old : run_ids) {

@@ -1,5 +1,6 @@
 #include "swarmbox/hosts/host_spec.hpp"
 
+#include <algorithm>
 #include <charconv>
 
 namespace swarmbox::hosts {
@@ -24,6 +25,29 @@ bool ParseInt(std::string_view s, int* out) {
 
 bool Contains(std::string_view hay, std::string_view needle) {
   return hay.find(needle) != std::string_view::npos;
+}
+
+// What ssh printed, for a message: its distinct lines (a long-lived tunnel repeats "channel N: open
+// failed" once per refused connection), the first two and the last, at most 300 characters.
+std::string QuoteSsh(std::string_view err) {
+  std::vector<std::string> lines;
+  while (!err.empty()) {
+    const auto nl = err.find('\n');
+    std::string line(err.substr(0, nl));
+    err = nl == std::string_view::npos ? std::string_view() : err.substr(nl + 1);
+    while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
+    // "channel 7: open failed..." and "channel 2: open failed..." are the same news.
+    if (line.rfind("channel ", 0) == 0) {
+      if (auto colon = line.find(':'); colon != std::string::npos) line = "channel" + line.substr(colon);
+    }
+    if (line.empty() || std::find(lines.begin(), lines.end(), line) != lines.end()) continue;
+    lines.push_back(std::move(line));
+  }
+  if (lines.size() > 3) lines.erase(lines.begin() + 2, lines.end() - 1);
+  std::string out;
+  for (const std::string& l : lines) out += (out.empty() ? "" : " / ") + l;
+  if (out.size() > 300) out = out.substr(0, 297) + "...";
+  return out;
 }
 
 }  // namespace
@@ -138,7 +162,8 @@ std::vector<std::string> SshTunnelArgv(const HostSpec& spec, const std::string& 
 
 Error ClassifySshFailure(const HostSpec& spec, std::string_view err, int exit_code) {
   const std::string who = spec.name();
-  const std::string tail = err.empty() ? std::string() : " [ssh: " + std::string(err.substr(0, 400)) + "]";
+  const std::string quoted = QuoteSsh(err);
+  const std::string tail = quoted.empty() ? std::string() : " [ssh: " + quoted + "]";
   if (Contains(err, "REMOTE HOST IDENTIFICATION HAS CHANGED")) {
     return Error(ErrorCode::kInvalidArgument,
                  "the host key of " + who + " changed: check the host, then fix known_hosts" + tail,

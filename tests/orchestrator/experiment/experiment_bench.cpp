@@ -11,8 +11,10 @@
 //   teardown  shutdown -> the trial's end (stop, logs and truth.csv collected, removal, outputs)
 // and between = experiment wall x slots - the sum of the trials' wall times (scheduling, commits,
 // report). orchestration_share = (launch + teardown + between) / (wall x slots).
-// Options: --slots=N (default 1), --repetitions=N (default: the file's 2), --quick (1 repetition,
-// codes a? only: 2 trials). Fails (exit 1) when no engine answers or a trial has no result.
+// Options: --slots=N (default 1), --repetitions=N (default: the file's), --experiment=FILE (another
+// experiment, e.g. trials/experiments/radio.yaml), --filter=PATTERN, --quick (1 repetition, codes
+// with the first factor at level a: 2 trials of hover_grid). Fails (exit 1) when no engine answers
+// or a trial has no result.
 #include <unistd.h>
 
 #include <chrono>
@@ -68,14 +70,16 @@ Phases ReadPhases(const fs::path& trial_dir, double wall_s) {
 
 int RunExperimentBench(const bench::Args& args) {
   const int slots = static_cast<int>(args.GetInt("slots", 1));
-  auto spec = experiment::LoadExperiment(std::string(SWARMBOX_EXP_SOURCE_DIR) +
-                                         "/trials/experiments/hover_grid.yaml");
+  const std::string file = args.Get(
+      "experiment", std::string(SWARMBOX_EXP_SOURCE_DIR) + "/trials/experiments/hover_grid.yaml");
+  auto spec = experiment::LoadExperiment(file);
   if (!spec) {
     std::cerr << spec.error().ToString() << "\n";
     return 1;
   }
   spec->repetitions = static_cast<int>(args.GetInt("repetitions", args.quick ? 1 : spec->repetitions));
-  if (args.quick) spec->filter = {"a?"};
+  if (args.quick) spec->filter = {std::string("a") + std::string(spec->factors.size() - 1, '?')};
+  if (const std::string f = args.Get("filter", ""); !f.empty()) spec->filter = {f};
   auto plan = experiment::PlanExperiment(*spec);
   if (!plan) {
     std::cerr << plan.error().ToString() << "\n";
@@ -139,10 +143,10 @@ int RunExperimentBench(const bench::Args& args) {
   const double between = std::max(0.0, capacity - trial_wall);
   const double dn = static_cast<double>(n);
   std::printf(
-      "suite=experiment scenario=hover_grid slots=%d trials=%zu success=%d wall_s=%.1f "
+      "suite=experiment scenario=%s slots=%d trials=%zu success=%d wall_s=%.1f "
       "trials_per_hour=%.0f launch_s_mean=%.2f sim_s_mean=%.2f teardown_s_mean=%.2f "
       "between_s_mean=%.2f orchestration_share=%.3f\n",
-      slots, records.size(), outcomes["success"], wall, static_cast<double>(records.size()) / wall * 3600.0,
+      spec->name.c_str(), slots, records.size(), outcomes["success"], wall, static_cast<double>(records.size()) / wall * 3600.0,
       launch / dn, sim / dn, teardown / dn, between / dn, (launch + teardown + between) / capacity);
   return 0;
 }

@@ -98,6 +98,11 @@ TEST(ClassifySshFailure, NamesTheCauseAndWhatToDo) {
   Error refused = ClassifySshFailure(spec, "ssh: connect to host 10.250.0.2 port 22: Connection refused", 255);
   EXPECT_EQ(refused.code(), ErrorCode::kUnavailable);
   EXPECT_TRUE(refused.retryable());
+  Error repeated = ClassifySshFailure(
+      spec, "channel 2: open failed: connect failed: open failed\nchannel 3: open failed: connect "
+            "failed: open failed\nchannel 4: open failed: connect failed: open failed\n", -1);
+  EXPECT_EQ(repeated.message().substr(repeated.message().find(" [ssh:")),
+            " [ssh: channel: open failed: connect failed: open failed]");
   Error changed = ClassifySshFailure(spec, "@ WARNING: REMOTE HOST IDENTIFICATION HAS CHANGED! @", 255);
   EXPECT_NE(changed.message().find("host key of root@10.250.0.2 changed"), std::string::npos);
 }

@@ -74,6 +74,11 @@ struct ExperimentSummary {
   std::vector<std::string> problems;  // cleanup and report issues, hosts that left
 };
 
+// Whether `out_dir` can take this run: kInvalidArgument when it holds another experiment, or trials
+// of this one and `resume` is false. Returns the run ids of earlier runs in the folder.
+Result<std::vector<std::string>> CheckOutFolder(const ExperimentPlan& plan, const std::string& out_dir,
+                                               bool resume);
+
 // kInvalidArgument: the folder already holds this experiment's trials and resume is false, or it
 // holds another experiment. kUnavailable: another run holds the folder. kIo: folder not writable.
 Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
