@@ -63,7 +63,7 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
 
 // swarmbox-agent (agent/app/main.cpp --help). Flags the agent does not know make it exit 2, so a
 // flag is passed only once agent/app/main.cpp has it (these switches say which ones it has).
-constexpr bool kAgentHasMissionFlags = false;  // --mission, --world, --payload, --inference-latency-ms
+constexpr bool kAgentHasMissionFlags = true;   // --mission, --world, --payload, --inference-latency-ms
 constexpr bool kAgentHasPingFlag = false;      // --ping-every-ms
 
 std::string Members(const dsl::TrialSpec& spec) {

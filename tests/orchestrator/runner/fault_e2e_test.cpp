@@ -125,7 +125,11 @@ TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemov
         EXPECT_THAT(rules, HasSubstr("-A OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT")) << rules;
         EXPECT_THAT(rules, HasSubstr("-A SWARMBOX-RADIO-OUT -j NFQUEUE --queue-num 0 --queue-bypass")) << rules;
         EXPECT_THAT(rules, HasSubstr("-A INPUT -i eth1 -j SWARMBOX-RADIO-IN")) << rules;
-        EXPECT_THAT(rules, HasSubstr("-m statistic --mode random --probability 0.05")) << rules;
+        // iptables prints the kernel's 32-bit fixed-point probability (0.04999999981 for 0.05).
+        const auto at = rules.find("-A SWARMBOX-RADIO-IN -m statistic --mode random --probability ");
+        ASSERT_NE(at, std::string::npos) << rules;
+        const double p = std::stod(rules.substr(at + std::string("-A SWARMBOX-RADIO-IN -m statistic --mode random --probability ").size()));
+        EXPECT_NEAR(p, 0.05, 1e-6) << rules;
         // The delayer runs in the sidecar (its pidfile is there).
         auto pidfile = api.GetArchive(sidecar, "/run/swarmbox-netemd-0.pid");
         EXPECT_TRUE(pidfile) << sidecar << ": " << (pidfile ? "" : pidfile.error().ToString());

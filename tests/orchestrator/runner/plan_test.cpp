@@ -132,9 +132,33 @@ TEST_F(PlanTest, AgentsGetTheRaftMembersSeedTimingsAndTheirMission) {
   EXPECT_EQ(value_of("--raft-tick-ms"), "25");
   EXPECT_EQ(value_of("--raft-heartbeat-ms"), "150");
   EXPECT_EQ(value_of("--raft-election-timeout-ms"), "900");
+  EXPECT_EQ(value_of("--mission"), "plan");
   EXPECT_EQ(value_of("--plan"), "takeoff:4,hover:3,land");
+  EXPECT_EQ(value_of("--world"), "<absent>");  // the agent refuses --world/--payload with plan
+  EXPECT_EQ(value_of("--payload"), "<absent>");
   EXPECT_EQ(value_of("--sim-interface"), "eth0");
   EXPECT_EQ(value_of("--mesh-interface"), "eth1");
+}
+
+// Mission kind sar: the world file in the container, the perception latency, and the lifter's
+// payload (it lies on the ground under the lifter, as the physics server places it); no --plan.
+TEST_F(PlanTest, SarAgentsGetTheWorldLatencyAndTheLifterItsPayload) {
+  spec_.mission.inference_latency_ms = 55;
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  auto argv_of = [&](const char* drone) { return (*trial)->FindPlugin(drone)->spec().argv; };
+  auto value_of = [](const std::vector<std::string>& argv, const std::string& flag) -> std::string {
+    auto it = std::find(argv.begin(), argv.end(), flag);
+    return it == argv.end() || it + 1 == argv.end() ? "<absent>" : *(it + 1);
+  };
+  const auto lifter = argv_of("lifter");
+  EXPECT_EQ(value_of(lifter, "--mission"), "sar");
+  EXPECT_EQ(value_of(lifter, "--world"), "/swarmbox/trials/worlds/open_field.yaml");
+  EXPECT_EQ(value_of(lifter, "--inference-latency-ms"), "55");
+  EXPECT_EQ(value_of(lifter, "--payload"), "stretcher");
+  EXPECT_EQ(value_of(lifter, "--plan"), "<absent>");
+  EXPECT_EQ(value_of(argv_of("scout_1"), "--payload"), "<absent>");
+  EXPECT_EQ(value_of(argv_of("scout_1"), "--mission"), "sar");
 }
 
 // With a fault sidecar image, a trial that impairs the mesh gets one sidecar per drone owning the
