@@ -364,6 +364,7 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
   so.max_attempts = options.max_attempts;
   so.interrupted = options.interrupted;
   summary.reports = RunSchedule(pending, workers, so, observer);
+  (void)store.ClearStaging();  // every attempt has ended: committed, discarded or cancelled
 
   if (printer.joinable()) {
     {
