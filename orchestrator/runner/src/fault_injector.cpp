@@ -1,6 +1,7 @@
 #include "swarmbox/runner/fault_injector.hpp"
 
 #include <cstdio>
+#include <future>
 #include <utility>
 #include <variant>
 
@@ -144,26 +145,39 @@ Verdict FaultInjector::Setup() {
   }
 
   if (config_.mesh.empty()) return Verdict::Success();
+  // Every sidecar at once (each is a few docker exec round trips); results recorded in trial order.
+  const std::string mechanism_name(faults::MechanismName(*mech));
+  std::vector<std::pair<std::string, std::future<Status>>> jobs;
   for (const std::string& drone : config_.drones) {
     const auto rules = layers_.Effective(drone);
+    installed_[drone] = rules;  // partly applied counts: teardown undoes it (undo may fail)
+    faults::CommandRunner& sidecar = Sidecar(drone);
+    auto plan = faults::PlanRadio(rules, LinkOf(drone), *mech, PlanOptions());
+    if (!plan) {
+      std::promise<Status> failed;
+      failed.set_value(plan.error());
+      jobs.emplace_back(drone, failed.get_future());
+      continue;
+    }
+    jobs.emplace_back(drone, std::async(std::launch::async, [&sidecar, commands = plan->apply] {
+                        return faults::RunCommands(sidecar, commands);
+                      }));
+  }
+  std::optional<Verdict> failure;
+  for (auto& [drone, job] : jobs) {
+    const Status s = job.get();
     faults::FaultEventRecord record = Record(FaultPhase::kApplied);
-    record.mechanism = std::string(faults::MechanismName(*mech));
-    Status s = [&]() -> Status {
-      auto plan = faults::PlanRadio(rules, LinkOf(drone), *mech, PlanOptions());
-      if (!plan) return plan.error();
-      installed_[drone] = rules;  // partly applied counts: teardown undoes it (undo may fail)
-      return faults::RunCommands(Sidecar(drone), plan->apply);
-    }();
+    record.mechanism = mechanism_name;
     if (!s) {
       record.phase = FaultPhase::kFailed;
       record.error = s.error().ToString();
+      if (!failure) {
+        failure = Verdict::FromError(s.error().Context("applying network.mesh on " + drone), "faults");
+      }
     }
-    if (events_) events_(faults::MeshEventJson(drone, rules, record));
-    if (!s) {
-      return Verdict::FromError(s.error().Context("applying network.mesh on " + drone), "faults");
-    }
+    if (events_) events_(faults::MeshEventJson(drone, installed_[drone], record));
   }
-  return Verdict::Success();
+  return failure ? *failure : Verdict::Success();
 }
 
 Status FaultInjector::ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,

@@ -35,6 +35,7 @@ constexpr int kSimDomain = 0;   // each trial has its own networks, so fixed dom
 constexpr int kMeshDomain = 1;
 
 // swarmbox-physics (physics_server/README.md).
+constexpr double kFaultClockEveryS = 0.5;  // [simulated s]
 std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
   std::vector<std::string> argv = {
       images::kPhysicsBinaryInImage,
@@ -49,6 +50,14 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
       // Stops (event=stopped t=...) when the trial's simulated time is up; truth.csv is flushed.
       "--max-sim-time", Num(spec.timeout.sim.seconds()),
   };
+  // Faults at simulated times fire at the log line that crosses their time: with such faults the
+  // physics server reports its clock every 0.5 s (default 10 s), so they fire at most 0.5 s late.
+  for (const faults::Fault& f : spec.faults) {
+    if (f.start.clock == faults::FaultStart::Clock::kSim) {
+      argv.insert(argv.end(), {"--clock-every", Num(kFaultClockEveryS)});
+      break;
+    }
+  }
   for (const dsl::DroneSpec& d : spec.drones) {
     // name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]]; a payload starts on the ground
     // under the drone (a lifter standing on the ground cannot spawn with it hanging).

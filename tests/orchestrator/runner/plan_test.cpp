@@ -67,6 +67,7 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   EXPECT_THAT(physics.argv, Contains("lifter:x8_heavy:0,-10,0:0:stretcher:ground"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/airframes"));
   EXPECT_THAT(physics.argv, Contains("600"));  // --max-sim-time
+  EXPECT_THAT(physics.argv, ::testing::Not(Contains("--clock-every")));  // no sim-time faults
   ASSERT_EQ(physics.inputs.size(), 3u);  // the world and two airframes, each once
   EXPECT_EQ(physics.inputs[0].host_path, "/src/trials/worlds/open_field.yaml");
   EXPECT_EQ(physics.inputs[0].container_path, "/swarmbox/trials/worlds/open_field.yaml");
@@ -199,6 +200,16 @@ TEST_F(PlanTest, NetworkFaultsGiveEachAgentASidecarThatOwnsItsNamespace) {
   const std::string compose = ComposeYaml(**trial, {});
   EXPECT_NE(compose.find("network_mode: \"service:lifter-faults\""), std::string::npos) << compose;
   EXPECT_NE(compose.find("- \"NET_ADMIN\""), std::string::npos);
+}
+
+TEST_F(PlanTest, SimTimeFaultsMakeThePhysicsClockFiner) {
+  spec_.Fault("{at: 30s, kill: raft_leader}");
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  const auto& argv = (*trial)->FindPlugin("physics")->spec().argv;
+  auto it = std::find(argv.begin(), argv.end(), "--clock-every");
+  ASSERT_NE(it, argv.end());
+  EXPECT_EQ(*(it + 1), "0.5");
 }
 
 TEST_F(PlanTest, WithoutAFaultsImageOrNetworkFaultsThereAreNoSidecars) {
