@@ -1,0 +1,387 @@
+// swarmbox-bench launch: how fast a trial comes up and goes down, `swarmbox run` against the
+// docker-compose file `swarmbox compose` exports for the same trial, in the same run.
+//
+//   swarmbox-bench launch [--quick] [--drones=3,10,20] [--keep=1]
+//
+// Per fleet size N (default 3, 10 and 20 drones; --quick: 3): the fleet of trials/demo_flight.yaml
+// replaced by N x500 scouts on a 4 m grid, ending on the physics server's first progress line
+// (`event=clock`, 10 s simulated), paced at rtf 1.
+//   1. `swarmbox run` (images built beforehand, untimed): from starting the program to the last
+//      agent's `event=ready` line (run_ready_s), and from the ending line to the last container
+//      stopped (end_to_stopped_s) and to swarmbox's exit (end_to_exit_s).
+//   2. `swarmbox compose` (untimed), then `docker-compose up -d`: from starting docker-compose to
+//      the last agent's `event=ready` (compose_ready_s), and the time `up -d` itself took; then
+//      `docker-compose down` (compose_down_s, for reference).
+// Every time comes from the engine (log line timestamps and `die` events, both on this host's real
+// time clock), watched by the bench itself, so both paths are measured the same way.
+// Aims (issue 6): ratio = run_ready_s / compose_ready_s <= 0.5; end_to_stopped_s < 1.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "bench.hpp"
+#include "child_process.hpp"
+#include "launch_timing.hpp"
+#include "swarmbox/docker/docker_client.hpp"
+#include "swarmbox/docker/remove_labelled.hpp"
+#include "swarmbox/runner/naming.hpp"
+
+namespace swarmbox {
+namespace {
+
+namespace fs = std::filesystem;
+using cli::testing::ChildProcess;
+using cli::testing::LaunchTimes;
+using cli::testing::ReadWholeFile;
+
+constexpr char kSwarmbox[] = SWARMBOX_LAUNCH_SWARMBOX_EXE;
+constexpr char kTrial[] = SWARMBOX_LAUNCH_TRIAL;
+constexpr char kComposeRunId[] = "compose";  // what `swarmbox compose` labels its export with
+constexpr char kEndPattern[] = "event=clock";
+constexpr char kEndComponent[] = "physics";
+
+std::int64_t NowUnixNs() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Watches the engine for one run id: container start/die events, and each started container's
+// log (followed with Docker's timestamps) for its first `event=ready` and the ending line.
+class EngineWatch {
+ public:
+  EngineWatch(docker::DockerApi& api, std::string run_id) : api_(api), run_id_(std::move(run_id)) {
+    docker::EventFilter filter;
+    filter.labels.equals[std::string(docker::kLabelRun)] = run_id_;
+    filter.types = {"container"};
+    filter.actions = {"start", "die"};
+    // Replays from a second ago: nothing is lost while the stream connects.
+    filter.since_unix_s = NowUnixNs() / 1'000'000'000 - 1;
+    since_ns_ = (filter.since_unix_s) * 1'000'000'000;
+    events_ = std::thread([this, filter] {
+      Status s = api_.StreamEvents(filter, [this](const docker::Event& e) { OnEvent(e); }, &cancel_);
+      if (!s && s.error().code() != ErrorCode::kCancelled) {
+        std::lock_guard<std::mutex> lock(mu_);
+        errors_.push_back("events: " + s.error().ToString());
+      }
+    });
+  }
+  ~EngineWatch() {
+    cancel_.Cancel();
+    events_.join();
+    std::vector<std::thread> followers;
+    {
+      std::lock_guard<std::mutex> lock(mu_);
+      followers.swap(followers_);
+    }
+    for (std::thread& t : followers) t.join();
+  }
+  EngineWatch(const EngineWatch&) = delete;
+  EngineWatch& operator=(const EngineWatch&) = delete;
+
+  // Until every one of `agents` logged event=ready, or the deadline.
+  bool WaitReady(const std::vector<std::string>& agents, std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock<std::mutex> lock(mu_);
+    return cv_.wait_until(lock, deadline, [&] {
+      return std::all_of(agents.begin(), agents.end(),
+                         [&](const std::string& a) { return times_.ready_ns.count(a) > 0; });
+    });
+  }
+  // Until every container that started has died, or the deadline.
+  bool WaitAllDied(std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock<std::mutex> lock(mu_);
+    return cv_.wait_until(lock, deadline, [&] { return !started_.empty() && died_.size() >= started_.size(); });
+  }
+  LaunchTimes Times() {
+    std::lock_guard<std::mutex> lock(mu_);
+    LaunchTimes t = times_;
+    t.died_ns.clear();
+    for (const auto& [id, ns] : died_) t.died_ns.push_back(ns);
+    return t;
+  }
+  std::vector<std::string> Errors() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return errors_;
+  }
+  std::size_t started() {
+    std::lock_guard<std::mutex> lock(mu_);
+    return started_.size();
+  }
+
+ private:
+  void OnEvent(const docker::Event& e) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (e.time_unix_ns < since_ns_) return;
+    if (e.action == "die") {
+      died_[e.actor_id] = e.time_unix_ns;
+      cv_.notify_all();
+      return;
+    }
+    if (e.action != "start" || !started_.insert(e.actor_id).second) return;
+    auto c = e.attributes.find(std::string(docker::kLabelComponent));
+    const std::string component = c == e.attributes.end() ? e.actor_id : c->second;
+    followers_.emplace_back([this, id = e.actor_id, component] { Follow(id, component); });
+  }
+
+  void Follow(const std::string& id, const std::string& component) {
+    docker::LogOptions o;
+    o.follow = true;
+    o.timestamps = true;
+    Status s = api_.FollowLogs(id, o, [&](const docker::LogLine& line) {
+      auto stamped = cli::testing::SplitStampedLine(line.text);
+      if (!stamped) return;
+      std::lock_guard<std::mutex> lock(mu_);
+      if (stamped->text.find("event=ready") != std::string_view::npos &&
+          times_.ready_ns.count(component) == 0) {
+        times_.ready_ns[component] = stamped->time_ns;
+        cv_.notify_all();
+      }
+      if (component == kEndComponent && !times_.end_line_ns &&
+          stamped->text.find(kEndPattern) != std::string_view::npos) {
+        times_.end_line_ns = stamped->time_ns;
+      }
+    }, &cancel_);
+    // A container removed right after it stopped can end the stream with "no such container".
+    if (!s && s.error().code() != ErrorCode::kCancelled && s.error().code() != ErrorCode::kNotFound) {
+      std::lock_guard<std::mutex> lock(mu_);
+      errors_.push_back("logs of " + component + ": " + s.error().ToString());
+    }
+  }
+
+  docker::DockerApi& api_;
+  std::string run_id_;
+  std::int64_t since_ns_ = 0;
+  docker::CancelToken cancel_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  LaunchTimes times_;
+  std::set<std::string> started_;
+  std::map<std::string, std::int64_t> died_;
+  std::vector<std::thread> followers_;
+  std::vector<std::string> errors_;
+  std::thread events_;
+};
+
+std::string FindOnPath(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  std::stringstream dirs(path != nullptr ? path : "/usr/local/bin:/usr/bin:/bin");
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    const fs::path p = fs::path(dir) / program;
+    if (::access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return "";
+}
+
+// --set arguments: N x500 scouts on a 4 m grid, the end on the physics server's first clock line.
+std::vector<std::string> TrialSets(int drones) {
+  std::string list = "[";
+  for (int i = 0; i < drones; ++i) {
+    if (i > 0) list += ", ";
+    list += "{name: scout_" + std::to_string(i + 1) + ", airframe: x500, pose: [" +
+            std::to_string((i % 5) * 4) + ", " + std::to_string((i / 5) * 4) + ", 0]}";
+  }
+  list += "]";
+  return {"--set", "name=launch" + std::to_string(drones),
+          "--set", "drones=" + list,
+          "--set", std::string("end=[{on: \"") + kEndPattern + "\", from: " + kEndComponent +
+                       ", outcome: success}]",
+          "--set", "physics.rtf=1",
+          "--set", "timeout.sim=60s",
+          "--set", "timeout.wall=10m"};
+}
+
+std::vector<std::string> AgentNames(int drones) {
+  std::vector<std::string> names;
+  for (int i = 0; i < drones; ++i) names.push_back("scout_" + std::to_string(i + 1));
+  return names;
+}
+
+std::string Fmt(std::optional<double> v) {
+  if (!v) return "nan";
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", *v);
+  return buf;
+}
+
+double SecondsSince(std::int64_t from_ns) { return static_cast<double>(NowUnixNs() - from_ns) / 1e9; }
+
+void RemoveRun(docker::DockerApi& api, const std::string& run_id, std::size_t* left) {
+  docker::LabelSelector run;
+  run.equals[std::string(docker::kLabelRun)] = run_id;
+  auto removed = docker::RemoveLabelled(api, run, /*include_images=*/false);
+  if (removed) *left = removed->containers.size() + removed->networks.size();
+}
+
+struct ScenarioResult {
+  bool ok = true;
+  std::string line;
+};
+
+ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& scratch,
+                           const std::string& compose_exe) {
+  using std::chrono::minutes;
+  using std::chrono::steady_clock;
+  const std::vector<std::string> agents = AgentNames(drones);
+  const std::vector<std::string> sets = TrialSets(drones);
+  std::ostringstream line;
+  line << "suite=launch scenario=drones_" << drones << " drones=" << drones;
+  auto fail = [&](const std::string& why) {
+    line << " error=\"" << why << "\"";
+    return ScenarioResult{false, line.str()};
+  };
+
+  // 1. swarmbox run.
+  const std::string run_id = runner::NewRunId();
+  std::vector<std::string> argv = {kSwarmbox, "run", kTrial, "--quiet", "--out", scratch.string(),
+                                   "--run-id", run_id};
+  argv.insert(argv.end(), sets.begin(), sets.end());
+  std::optional<double> run_ready_s, end_to_stopped_s, end_to_exit_s;
+  std::size_t run_left = 0;
+  {
+    EngineWatch watch(api, run_id);
+    const std::int64_t spawn_ns = NowUnixNs();
+    const std::string err = (scratch / ("run-" + std::to_string(drones) + ".err")).string();
+    auto child = ChildProcess::Spawn(argv, "", err);
+    if (!child) return fail(child.error().ToString());
+    const bool ready = watch.WaitReady(agents, steady_clock::now() + minutes(5));
+    const std::optional<int> code = child->Wait(minutes(10));
+    const std::int64_t exited_ns = NowUnixNs();
+    (void)watch.WaitAllDied(steady_clock::now() + std::chrono::seconds(10));
+    LaunchTimes times = watch.Times();
+    times.spawn_ns = spawn_ns;
+    if (code) times.exited_ns = exited_ns;
+    const auto figures = cli::testing::ComputeLaunchFigures(times, agents);
+    run_ready_s = figures.ready_s;
+    end_to_stopped_s = figures.end_to_stopped_s;
+    end_to_exit_s = figures.end_to_exit_s;
+    if (!code) {
+      child->Signal(SIGINT);
+      (void)child->Wait(minutes(1));
+    }
+    RemoveRun(api, run_id, &run_left);
+    for (const std::string& e : watch.Errors()) std::fprintf(stderr, "launch: %s\n", e.c_str());
+    if (!ready || !code || *code != 0) {
+      line << " run_exit=" << (code ? std::to_string(*code) : "hung") << " run_ready_s=" << Fmt(run_ready_s);
+      if (!figures.not_ready.empty()) line << " not_ready=" << figures.not_ready.size();
+      std::fprintf(stderr, "launch: swarmbox run (%d drones) said:\n%s\n", drones, ReadWholeFile(err).c_str());
+      return fail("swarmbox run did not launch and end as expected");
+    }
+  }
+
+  // 2. The exported compose file, brought up by docker-compose.
+  const fs::path compose_file = scratch / ("launch" + std::to_string(drones) + ".compose.yaml");
+  std::vector<std::string> export_argv = {kSwarmbox, "compose", kTrial, "-o", compose_file.string()};
+  export_argv.insert(export_argv.end(), sets.begin(), sets.end());
+  auto exported = cli::testing::RunToEnd(export_argv, minutes(2), scratch.string());
+  if (!exported || exported->code != 0) {
+    return fail("swarmbox compose: " + (exported ? exported->err : exported.error().ToString()));
+  }
+  const std::string project = "swarmbox-bench-launch";
+  std::optional<double> compose_ready_s, compose_up_s, compose_down_s;
+  std::size_t compose_left = 0;
+  bool compose_ok = true;
+  std::string compose_error;
+  {
+    EngineWatch watch(api, kComposeRunId);
+    const std::int64_t spawn_ns = NowUnixNs();
+    const std::string err = (scratch / ("compose-" + std::to_string(drones) + ".err")).string();
+    auto up = ChildProcess::Spawn({compose_exe, "-f", compose_file.string(), "-p", project, "up", "-d"}, "", err);
+    if (!up) return fail(up.error().ToString());
+    const bool ready = watch.WaitReady(agents, steady_clock::now() + minutes(5));
+    const std::optional<int> code = up->Wait(minutes(5));
+    if (code) compose_up_s = SecondsSince(spawn_ns);  // up -d returns before the agents are ready
+    LaunchTimes times = watch.Times();
+    times.spawn_ns = spawn_ns;
+    compose_ready_s = cli::testing::ComputeLaunchFigures(times, agents).ready_s;
+    if (!ready || !code || *code != 0) {
+      compose_ok = false;
+      compose_error = "docker-compose up did not bring every agent up: " + ReadWholeFile(err);
+    }
+    const std::int64_t down_ns = NowUnixNs();
+    auto down = cli::testing::RunToEnd({compose_exe, "-f", compose_file.string(), "-p", project, "down", "-v"},
+                                       minutes(5), scratch.string());
+    if (down && down->code == 0) compose_down_s = SecondsSince(down_ns);
+    RemoveRun(api, kComposeRunId, &compose_left);
+  }
+
+  line << " run_ready_s=" << Fmt(run_ready_s) << " compose_ready_s=" << Fmt(compose_ready_s);
+  std::optional<double> ratio;
+  if (run_ready_s && compose_ready_s && *compose_ready_s > 0) ratio = *run_ready_s / *compose_ready_s;
+  line << " ratio=" << Fmt(ratio) << " end_to_stopped_s=" << Fmt(end_to_stopped_s)
+       << " end_to_exit_s=" << Fmt(end_to_exit_s) << " compose_up_returned_s=" << Fmt(compose_up_s)
+       << " compose_down_s=" << Fmt(compose_down_s)
+       << " aim_ratio_met=" << (ratio && *ratio <= 0.5 ? "yes" : "no")
+       << " aim_stop_met=" << (end_to_stopped_s && *end_to_stopped_s < 1.0 ? "yes" : "no")
+       << " left=" << run_left + compose_left;
+  if (!compose_ok) {
+    std::fprintf(stderr, "launch: %s\n", compose_error.c_str());
+    return fail("docker-compose launch failed");
+  }
+  return ScenarioResult{true, line.str()};
+}
+
+int RunLaunchBench(const bench::Args& args) {
+  std::vector<int> sizes = {3, 10, 20};
+  if (args.quick) sizes = {3};
+  if (auto list = args.Get("drones", ""); !list.empty()) {
+    sizes.clear();
+    std::stringstream s(list);
+    std::string item;
+    while (std::getline(s, item, ',')) sizes.push_back(std::atoi(item.c_str()));
+  }
+  for (int n : sizes) {
+    if (n < 1 || n > 200) {
+      std::printf("suite=launch error=\"--drones: %d is not a fleet size in 1..200\"\n", n);
+      return 2;
+    }
+  }
+  const std::string compose_exe = FindOnPath("docker-compose");
+  if (compose_exe.empty()) {
+    std::printf("suite=launch error=\"docker-compose is not on PATH (scripts/setup.sh installs it)\"\n");
+    return 1;
+  }
+  auto api = docker::DockerClient::Connect({.socket_path = docker::DefaultSocketPath(),
+                                            .connect_timeout = std::chrono::seconds(5),
+                                            .request_timeout = std::chrono::seconds(120)});
+  if (!api) {
+    std::printf("suite=launch error=\"%s\"\n", api.error().ToString().c_str());
+    return 1;
+  }
+  const fs::path scratch = fs::temp_directory_path() / ("swarmbox-bench-launch-" + std::to_string(::getpid()));
+  fs::create_directories(scratch);
+  // The images first (untimed): both paths then start from images that exist.
+  auto images = cli::testing::RunToEnd({kSwarmbox, "images", "--no-faults"}, std::chrono::minutes(10),
+                                       scratch.string());
+  if (!images || images->code != 0) {
+    std::printf("suite=launch error=\"swarmbox images failed: %s\"\n",
+                images ? images->err.c_str() : images.error().ToString().c_str());
+    fs::remove_all(scratch);
+    return 1;
+  }
+  int failures = 0;
+  for (int n : sizes) {
+    ScenarioResult r = RunScenario(**api, n, scratch, compose_exe);
+    std::printf("%s\n", r.line.c_str());
+    std::fflush(stdout);
+    if (!r.ok) ++failures;
+  }
+  if (args.Get("keep", "0") == "0") fs::remove_all(scratch);  // else: the logs and compose files
+  return failures == 0 ? 0 : 1;
+}
+
+}  // namespace
+}  // namespace swarmbox
+
+SWARMBOX_BENCH_SUITE(launch, "swarmbox run vs the exported docker-compose file: launch to ready, end to stopped",
+                     swarmbox::RunLaunchBench);
