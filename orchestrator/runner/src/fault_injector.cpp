@@ -353,24 +353,35 @@ Verdict FaultInjector::Teardown() {
   Verdict v = RemoveActive();
   torn_down_ = true;
   if (!mechanism_) return v;
+  // Every sidecar at once, recorded in trial order.
+  std::vector<std::pair<std::string, std::future<Status>>> jobs;
   for (const std::string& drone : config_.drones) {
     auto it = installed_.find(drone);
     if (it == installed_.end() || it->second.empty()) continue;
+    faults::CommandRunner& sidecar = Sidecar(drone);
+    auto plan = faults::PlanRadio(it->second, LinkOf(drone), *mechanism_, PlanOptions());
+    if (!plan) {
+      std::promise<Status> failed;
+      failed.set_value(plan.error());
+      jobs.emplace_back(drone, failed.get_future());
+      continue;
+    }
+    jobs.emplace_back(drone, std::async(std::launch::async, [&sidecar, commands = plan->undo] {
+                        return faults::RunAllCommands(sidecar, commands);
+                      }));
+  }
+  for (auto& [drone, job] : jobs) {
+    const Status s = job.get();
     faults::FaultEventRecord record = Record(FaultPhase::kRemoved);
     record.mechanism = std::string(faults::MechanismName(*mechanism_));
-    Status s = [&]() -> Status {
-      auto plan = faults::PlanRadio(it->second, LinkOf(drone), *mechanism_, PlanOptions());
-      if (!plan) return plan.error();
-      return faults::RunAllCommands(Sidecar(drone), plan->undo);
-    }();
     if (!s) {
       record.phase = FaultPhase::kFailed;
       record.error = s.error().ToString();
       problems_.push_back("undoing the radio rules on " + drone + ": " + s.error().ToString());
       v.KeepWorse(Verdict::FromError(s.error().Context("undoing the radio rules on " + drone), "faults"));
     }
-    if (events_) events_(faults::MeshEventJson(drone, it->second, record));
-    installed_.erase(it);
+    if (events_) events_(faults::MeshEventJson(drone, installed_[drone], record));
+    installed_.erase(drone);
   }
   return v;
 }
