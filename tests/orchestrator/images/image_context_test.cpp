@@ -164,5 +164,23 @@ TEST(StandardImages, MissingToolsAreReported) {
             "/nonexistent/tc: fault tool missing on this host (install iproute2 and iptables)");
 }
 
+// The runner's sidecar image: the fault tools plus swarmbox-netemd where the radio plans call it.
+TEST(StandardImages, FaultSidecarCarriesTheDelayerWithItsLibraries) {
+  auto spec = FaultSidecarImage(SWARMBOX_PROBE_PATH);  // any host-built program stands in for it
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  EXPECT_TRUE(std::any_of(spec->executables.begin(), spec->executables.end(), [](const HostFile& f) {
+    return f.image_path == kNetemdInImage && f.host_path == SWARMBOX_PROBE_PATH && f.mode == 0755;
+  }));
+  EXPECT_EQ(std::string(kNetemdInImage), "/usr/bin/swarmbox-netemd");
+  EXPECT_EQ(spec->symlinks.at("/usr/sbin/iptables"), "xtables-nft-multi");
+  auto ctx = PackContext(*spec);
+  ASSERT_TRUE(ctx) << ctx.error().ToString();
+
+  auto missing = FaultSidecarImage("/nonexistent/swarmbox-netemd");
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().code(), ErrorCode::kNotFound);
+  EXPECT_EQ(missing.error().where(), "/nonexistent/swarmbox-netemd");
+}
+
 }  // namespace
 }  // namespace swarmbox::images
