@@ -12,6 +12,7 @@
 #include <mutex>
 #include <sstream>
 
+#include "swarmbox/experiment/experiment_runner.hpp"
 #include "swarmbox/experiment/progress.hpp"
 #include "swarmbox/experiment/scheduler.hpp"
 
@@ -179,6 +180,40 @@ TEST(ProgressBoard, LinesPerHostAndAnOverallBarWithEta) {
             "[#######.............] 3/8  success 1 failure 0 timeout 0 error 0 | running 1 | "
             "requeued 1 | ETA 1m30s");
   EXPECT_EQ(FormatDuration(3725), "1h02m");
+}
+
+}  // namespace
+}  // namespace swarmbox::experiment
+
+namespace swarmbox::experiment {
+namespace {
+
+TEST_F(TrialStoreTest, TheOutputFolderTakesOnlyItsOwnExperimentAndResumesOnlyWhenAsked) {
+  ExperimentPlan plan;
+  plan.spec.name = "hover";
+  PlannedTrial t;
+  t.id = "hover-a-r1";
+  plan.trials = {t};
+  // A new folder: no earlier runs.
+  auto fresh = CheckOutFolder(plan, dir_.string(), /*resume=*/false);
+  ASSERT_TRUE(fresh) << fresh.error().ToString();
+  EXPECT_TRUE(fresh->empty());
+
+  ASSERT_TRUE(WriteFileAtomic((dir_ / "experiment.json").string(),
+                              R"({"name":"hover","run_ids":["r1","r2"]})"));
+  fs::create_directories(dir_ / "hover-a-r1");
+  ASSERT_TRUE(WriteFileAtomic((dir_ / "hover-a-r1" / "result.json").string(), "{}"));
+  auto again = CheckOutFolder(plan, dir_.string(), /*resume=*/false);
+  ASSERT_FALSE(again);
+  EXPECT_NE(again.error().message().find("add --resume"), std::string::npos);
+  auto resumed = CheckOutFolder(plan, dir_.string(), /*resume=*/true);
+  ASSERT_TRUE(resumed);
+  EXPECT_EQ(*resumed, (std::vector<std::string>{"r1", "r2"}));
+
+  plan.spec.name = "radio";
+  auto other = CheckOutFolder(plan, dir_.string(), /*resume=*/true);
+  ASSERT_FALSE(other);
+  EXPECT_NE(other.error().message().find("holds another experiment ('hover')"), std::string::npos);
 }
 
 }  // namespace
