@@ -122,8 +122,12 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
     return s;
   }
   constexpr std::int64_t kPollNs = 20'000'000;        // re-check `stop` at least this often
-  constexpr std::int64_t kRepublishNs = 200'000'000;  // unanswered samples are sent again (late
-                                                      // joiners: the lockstep QoS is volatile)
+  // While a step waits, every drone's sample is sent again at this period: unanswered ones for
+  // late joiners and lost messages (the lockstep QoS is volatile), answered ones as a keepalive,
+  // so an agent that did answer does not take a long wait (a fleet still starting, a silent
+  // drone's timeout) for a stalled server (its --stall-timeout). It answers again; Lockstep drops
+  // the duplicate.
+  constexpr std::int64_t kRepublishNs = 200'000'000;
   std::int64_t last_publish = clock_.NowNs();
   while (!stop.load()) {
     const std::int64_t now = clock_.NowNs();
@@ -131,7 +135,6 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
     if (now - last_publish >= kRepublishNs) {
       last_publish = now;
       for (std::size_t i = 0; i < world_.drone_count(); ++i) {
-        if (lockstep_.answered(i)) continue;
         if (auto s = transport_.PublishSample(i, world_.drone_name(i), world_.sensors(i)); !s) return s;
       }
     }

@@ -7,8 +7,9 @@
 // Per control step: publish every drone's sample (lost ones too, so they can rejoin) and due
 // camera frames, then wait until every live drone has answered this step (Lockstep); drones
 // silent past the timeout are marked lost (motors off, event=drone_lost) and the step goes on.
-// While waiting, unanswered samples are published again every 200 ms (agents that join late or a
-// lost message). Duplicate and stale commands are dropped (Lockstep).
+// While waiting, every drone's sample is published again every 200 ms (agents that join late, a
+// lost message, and a keepalive for the drones that answered, so a long wait does not look like a
+// stalled server to them). Duplicate and stale commands are dropped (Lockstep).
 // Then World::Step(), truth.csv, pacing to the real-time factor. Events are printed as logfmt
 // lines on `events_out`, and every `clock_every_s` simulated seconds a progress line
 //   t=10.000 node=physics event=clock rtf=0.98 steps=2500 late=3 lost=0

@@ -313,3 +313,23 @@ TEST_F(SimServerTest, ClockEveryZeroPrintsNoClockLine) {
 
 }  // namespace
 }  // namespace swarmbox::physics
+
+namespace swarmbox::physics {
+namespace {
+
+TEST_F(SimServerTest, AWaitingStepResendsEverySampleAsAKeepalive) {
+  // Given drone b that has not joined yet (it answers nothing until its join timeout, 500 ms),
+  agents_.alive["b"] = false;
+  SimServer server(*world_, agents_, clock_, nullptr, Options(0), out_);
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  // then during the wait both drones got step 0 again at 200 and 400 ms: b to join late, a (which
+  // answered at once) so that it sees a live server; a's repeated answers were dropped.
+  EXPECT_EQ(agents_.samples["b"], 3);
+  EXPECT_EQ(agents_.samples["a"], 3);
+  EXPECT_EQ(world_->step_count(), 1u);
+  EXPECT_TRUE(world_->Truth(1).lost);
+  EXPECT_FALSE(world_->Truth(0).lost);
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
