@@ -1,0 +1,117 @@
+// The events.jsonl readers the fault-trial tests judge by: link pooling (discovery windows
+// skipped, pooled mean and sd), failovers, commits and their agreement, on hand-written lines.
+#include "trial_events.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace swarmbox::fault_trials {
+namespace {
+
+std::vector<TrialEvent> Parse(std::string_view text) {
+  auto e = ParseEvents(text);
+  EXPECT_TRUE(e) << e.error().ToString();
+  return e ? *e : std::vector<TrialEvent>{};
+}
+
+TEST(ParseEvents, ReadsScalarsTargetsAndRefusesNonObjects) {
+  auto events = Parse(
+      R"({"wall_s":1.5,"component":"scout_1","t":"1.200","node":"scout_1","event":"hover"})"
+      "\n\n"
+      R"({"type":"fault","phase":"applied","fault":"k","kind":"kill","wall_s":3.25,"targets":["scout_2"]})"
+      "\n");
+  ASSERT_EQ(events.size(), 2u);
+  EXPECT_DOUBLE_EQ(events[0].wall_s, 1.5);
+  EXPECT_EQ(events[0].component, "scout_1");
+  EXPECT_EQ(events[0].Get("event"), "hover");
+  EXPECT_EQ(events[0].Number("t"), 1.2);
+  EXPECT_EQ(events[1].targets, std::vector<std::string>{"scout_2"});
+  ASSERT_TRUE(FindFaultRecord(events, "k", "applied"));
+  EXPECT_FALSE(FindFaultRecord(events, "k", "removed"));
+  auto bad = ParseEvents("{\"a\":1}\n[1, 2]\n");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().where(), "events.jsonl:2");
+}
+
+TEST(SummariseLinks, SkipsDiscoveryWindowsAndPoolsMoments) {
+  // scout_1 -> scout_2: a discovery window (nothing back), then two windows of 2 and 4 pongs.
+  auto events = Parse(
+      R"({"wall_s":1,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"0","loss":"1"})"
+      "\n"
+      R"({"wall_s":3,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"2","loss":"0.6","rtt_ms_mean":"10","rtt_ms_sd":"0","rtt_ms_p50":"10"})"
+      "\n"
+      R"({"wall_s":5,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"4","loss":"0.2","rtt_ms_mean":"20","rtt_ms_sd":"2","rtt_ms_p50":"20"})"
+      "\n"
+      R"({"wall_s":7,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"5","loss":"0","rtt_ms_mean":"99","rtt_ms_sd":"0","rtt_ms_p50":"99"})"
+      "\n");
+  // The first window with a pong straddles discovery too: [0, 6) holds only the 5 s window.
+  LinkSummary s = SummariseLinks(events, 0.0, 6.0);
+  EXPECT_EQ(s.windows, 1u);
+  EXPECT_EQ(s.sent, 5u);
+  EXPECT_EQ(s.received, 4u);
+  EXPECT_DOUBLE_EQ(s.loss, 0.2);
+  EXPECT_DOUBLE_EQ(s.rtt_mean_ms, 20.0);
+  EXPECT_NEAR(s.rtt_sd_ms, 2.0, 1e-9);
+  // Two windows pooled: 4 x N(20, 2) and 5 x 99: mean (80 + 495) / 9.
+  LinkSummary all = SummariseLinks(events, 0.0, 100.0);
+  EXPECT_EQ(all.windows, 2u);
+  EXPECT_DOUBLE_EQ(all.rtt_mean_ms, 575.0 / 9.0);
+  const double mean = 575.0 / 9.0;
+  const double ss = 3 * 4.0 + 4 * 400.0 + 5 * 99.0 * 99.0 - 9 * mean * mean;
+  EXPECT_NEAR(all.rtt_sd_ms, std::sqrt(ss / 8.0), 1e-9);
+}
+
+TEST(Failovers, FromTheKilledLeaderToTheNextLeaderOfAHigherTerm) {
+  auto events = Parse(
+      R"({"wall_s":2,"event":"leader_elected","node":"a","term":"2","leader":"b"})"
+      "\n"
+      R"({"type":"fault","phase":"applied","fault":"k1","kind":"kill","wall_s":10,"targets":["b"]})"
+      "\n"
+      R"({"wall_s":10.5,"event":"leader_elected","node":"c","term":"2","leader":"b"})"
+      "\n"
+      R"({"wall_s":11.75,"event":"leader_elected","node":"c","term":"4","leader":"c"})"
+      "\n"
+      R"({"type":"fault","phase":"applied","fault":"k2","kind":"kill","wall_s":20,"targets":["a"]})"
+      "\n");
+  const std::vector<Failover> f = Failovers(events);
+  ASSERT_EQ(f.size(), 1u);  // k2 killed a follower
+  EXPECT_EQ(f[0].fault, "k1");
+  EXPECT_EQ(f[0].old_leader, "b");
+  EXPECT_EQ(f[0].new_leader, "c");
+  EXPECT_EQ(f[0].new_term, 4u);
+  EXPECT_DOUBLE_EQ(f[0].failover_ms, 1750.0);
+}
+
+TEST(Commits, IndexAtAndDisagreements) {
+  auto events = Parse(
+      R"({"wall_s":1,"event":"mission_state","node":"a","state":"SEARCH","index":"3"})"
+      "\n"
+      R"({"wall_s":2,"event":"victim_confirmed","node":"a","id":"1","index":"4"})"
+      "\n"
+      R"({"wall_s":2.5,"event":"mission_state","node":"b","state":"SEARCH","index":"3"})"
+      "\n"
+      R"({"wall_s":3,"event":"mission_state","node":"b","state":"CONVERGE","index":"4"})"
+      "\n"
+      R"({"wall_s":4,"event":"mission_state","node":"c","state":"SEARCH","index":"9","from":"snapshot"})"
+      "\n");
+  const auto commits = CommitsByDrone(events);
+  EXPECT_EQ(IndexAt(commits.at("a"), 1.5), 3u);
+  EXPECT_EQ(IndexAt(commits.at("a"), 0.5), 0u);
+  EXPECT_EQ(commits.count("c"), 0u);  // snapshot installs are not commits of their own
+  const auto d = Disagreements(commits);
+  ASSERT_EQ(d.size(), 1u);
+  EXPECT_EQ(d[0], "index 4: a 'victim_confirmed id=1' vs b 'mission_state state=CONVERGE'");
+  EXPECT_EQ(LeaderSeenBy(Parse(R"({"wall_s":1,"event":"leader_elected","node":"x","leader":"y"})"),
+                         {"x"}, 2.0),
+            "y");
+}
+
+TEST(Percentile, NearestRank) {
+  EXPECT_EQ(Percentile({}, 0.5), -1.0);
+  EXPECT_EQ(Percentile({5, 1, 3}, 0.5), 3.0);
+  EXPECT_EQ(Percentile({5, 1, 3}, 0.99), 5.0);
+}
+
+}  // namespace
+}  // namespace swarmbox::fault_trials
