@@ -19,7 +19,7 @@
 // PartitionOneVsThree (partition_minority.yaml + the agents' demo proposer): scout_1 alone vs
 //   three for 20 s. The majority has a leader and commits; scout_1 commits nothing while cut off;
 //   after healing it catches up and every index holds the same entry on every drone.
-// LeaderKill (leader_kill.yaml): five scouts on 100 +- 20 ms / 5 % loss, the leader killed three
+// LeaderKill (leader_kill_failover.yaml): five scouts on 100 +- 20 ms / 5 % loss, the leader killed three
 //   times: each time another drone is elected, within the bound Raft gives (2 x the election
 //   timeout plus a pre-vote and a vote round trip on this radio, with slack: 10 s).
 #include <gtest/gtest.h>
@@ -209,7 +209,7 @@ TEST_F(FaultTrial, PartitionOneVsThree) {
 }
 
 TEST_F(FaultTrial, LeaderKill) {
-  auto run = Run("leader_kill.yaml");
+  auto run = Run("leader_kill_failover.yaml");
   ASSERT_TRUE(run) << run.error().ToString();
   ASSERT_TRUE(RanToTheEnd(*run));
   const std::vector<Failover> failovers = Failovers(run->events);

@@ -3,7 +3,7 @@
 //
 //   swarmbox-bench faults [--quick] [--trials N] [--seeds N] [--out DIR]
 //
-// scenario=leader_kill_trials: trials/faults/leader_kill.yaml (five scouts, 100 ms +- 20 ms one
+// scenario=leader_kill_trials: trials/faults/leader_kill_failover.yaml (five scouts, 100 ms +- 20 ms one
 //   way, 5 % loss, the leader SIGKILLed three times and restarted 10 s later) run N times through
 //   the trial runner on the local Docker engine, with seeds 1..N (--set seed=i). Failover = the
 //   runner's wall time from the kill's `applied` record to the first event=leader_elected naming
@@ -35,7 +35,7 @@ int RunFaultsBench(const bench::Args& args) {
   const long seeds = args.GetInt("seeds", args.quick ? 200 : 2000);
   const std::string out =
       args.Get("out", (std::filesystem::temp_directory_path() / "swarmbox-bench-faults").string());
-  auto base = LoadFaultTrial("leader_kill.yaml");
+  auto base = LoadFaultTrial("leader_kill_failover.yaml");
   if (!base) {
     std::fprintf(stderr, "faults bench: %s\n", base.error().ToString().c_str());
     return 1;
@@ -49,7 +49,7 @@ int RunFaultsBench(const bench::Args& args) {
     down_s = static_cast<double>(f.duration_ms.value_or(0)) / 1000.0;
   }
   if (kill_at_s.empty() || base->mesh.rules.size() != 1 || !base->mesh.rules[0].to.empty()) {
-    std::fprintf(stderr, "faults bench: leader_kill.yaml needs kill faults at simulated times and "
+    std::fprintf(stderr, "faults bench: leader_kill_failover.yaml needs kill faults at simulated times and "
                          "one all-traffic network.mesh rule\n");
     return 1;
   }
@@ -97,7 +97,7 @@ int RunFaultsBench(const bench::Args& args) {
   std::vector<double> failover;
   int missed = 0, kills = 0, failed_runs = 0;
   for (long i = 0; i < trials; ++i) {
-    auto spec = LoadFaultTrial("leader_kill.yaml", {"seed=" + std::to_string(1 + i)});
+    auto spec = LoadFaultTrial("leader_kill_failover.yaml", {"seed=" + std::to_string(1 + i)});
     if (!spec) {
       std::fprintf(stderr, "faults bench: %s\n", spec.error().ToString().c_str());
       return 1;
