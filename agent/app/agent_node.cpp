@@ -124,6 +124,14 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
   }
+  if (o.ping_every_ms < 0) return Error(ErrorCode::kInvalidArgument, "--ping-every-ms must be >= 0");
+  if (o.mesh && o.ping_every_ms > 0 && o.raft.members.size() > 1) {
+    radio::RadioLinkOptions ro;
+    ro.ping_every = std::chrono::milliseconds(o.ping_every_ms);
+    auto link = radio::RadioLink::Create(*node->mesh_, o.name, o.raft.members, ro);
+    if (!link) return link.error().Context("starting the radio link");
+    node->radio_ = std::move(*link);
+  }
   if (o.mission.kind == MissionKind::kSar) {
     auto host = MissionHost::Create(mc);
     if (!host) return host.error();
@@ -188,6 +196,9 @@ void AgentNode::HandleSample(const bus::SensorSample& msg) {
     if (e.kind == FlightEventKind::kModeChange) le.Add("mode", flight::FlightModeName(e.mode));
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
     Log(le);
+  }
+  if (radio_) {
+    for (const LogEvent& line : radio_->Poll(std::chrono::steady_clock::now(), t_s_)) Log(line);
   }
   if (mission_) {
     StepMission(msg, st.hover);

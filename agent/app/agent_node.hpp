@@ -25,6 +25,7 @@
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/flight/flight_controller.hpp"
+#include "swarmbox/radio/radio_link.hpp"
 
 namespace swarmbox::agent {
 
@@ -56,6 +57,9 @@ struct AgentOptions {
   RaftHostOptions raft;
   // What to fly (mission_options.hpp): the plan above, or the SAR mission (needs raft.members).
   MissionOptions mission;
+  // Radio link measurement (agent/radio RadioLink): with the mesh and raft.members, ping every
+  // other member every ping_every_ms of wall-clock time and log event=link per peer; 0 = off.
+  int ping_every_ms = 200;
 };
 
 class AgentNode {
@@ -86,6 +90,7 @@ class AgentNode {
   std::unique_ptr<bus::Publisher<bus::ActuatorCommand>> actuator_pub_;
   std::unique_ptr<bus::Publisher<bus::DroneState>> state_pub_;
   std::unique_ptr<RaftHost> raft_;  // after mesh_: destroyed before the participant
+  std::unique_ptr<radio::RadioLink> radio_;  // likewise
   // --mission sar only.
   std::unique_ptr<MissionHost> mission_;
   std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;

@@ -134,6 +134,77 @@ TEST(ScoutBehaviour, ReportsASightingOnceAndNothingNearAKnownVictim) {
   EXPECT_TRUE(out.proposals.empty());
 }
 
+TEST(ScoutBehaviour, ReportsAHighConfidenceViewWithinTheCooldownOfAPartialOne) {
+  // A victim entering the image at its edge is a partial view (confidence capped below
+  // kHighConfidence); the full view a moment later must still go out: it confirms on its own.
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .report_cooldown_s = 10.0});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  GroundDetection d;
+  d.position_m = {20, 30, 0};
+  d.confidence = 0.75;
+  std::vector<GroundDetection> dets = {d};
+  MissionInput in = Input(2.0, m, {0, 0, 30});
+  in.detections = dets;
+  s.Step(in, &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  dets[0].confidence = 0.8;  // still partial: silent within the cooldown
+  in.t_s = 2.2;
+  s.Step(in, &out);
+  EXPECT_TRUE(out.proposals.empty());
+  dets[0].confidence = 0.97;  // the full view
+  dets[0].position_m = {20.5, 30.2, 0};
+  in.t_s = 2.4;
+  s.Step(in, &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_DOUBLE_EQ(std::get<raft::ReportSighting>(out.proposals[0]).confidence, 0.97);
+  in.t_s = 2.6;  // once a high-confidence report went out: silent again
+  s.Step(in, &out);
+  EXPECT_TRUE(out.proposals.empty());
+}
+
+TEST(ScoutBehaviour, KeepSearchingDuringRescueOrbitsOnlyOnceSweptThenLeavesTheOrbit) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .orbit_time_s = 20.0,
+                    .keep_searching_during_rescue = true, .return_when_swept = true,
+                    .approach_height_m = 5.0});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  s.Step(Input(1.1, m, {0, 0, 30}), &out);
+  ASSERT_EQ(out.mode, "searching");
+  m.Apply(raft::ConfirmVictim{"operator", 100, 100});
+  m.Apply(raft::ConvergeOn{1});
+  m.Apply(raft::BeginRescue{1, "lifter"});
+  s.Step(Input(2.0, m, {0, 0, 30}), &out);
+  EXPECT_EQ(out.mode, "searching");  // its lanes first
+  double t = 2.0;
+  for (std::size_t k = 0; k < s.lanes().size(); ++k) s.Step(Input(t += 0.1, m, s.lanes()[k].position_m), &out);
+  EXPECT_EQ(out.mode, "orbiting");  // swept: now it orbits the victim being rescued
+  const Vector3d on_orbit(88, 100, 30);
+  s.Step(Input(t += 0.1, m, on_orbit), &out);
+  s.Step(Input(t += 10.0, m, on_orbit), &out);
+  EXPECT_EQ(out.mode, "orbiting");
+  s.Step(Input(t += 10.5, m, on_orbit), &out);  // orbit_time_s on the orbit: done with it
+  EXPECT_TRUE(HasEvent(out, "victim_handled"));
+  s.Step(Input(t += 0.1, m, on_orbit), &out);  // nothing left: home
+  EXPECT_EQ(out.mode, "returning");
+  // Near home it descends in position mode to the approach height, then lands.
+  s.Step(Input(t += 30, m, {3, 3, 30}), &out);
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kPosition);
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(0, 0, 5));
+  s.Step(Input(t += 1, m, {0.2, 0.1, 29}), &out);
+  EXPECT_EQ(out.mode, "returning");  // over home but still high
+  s.Step(Input(t += 10, m, {0.2, 0.1, 5.4}), &out);
+  EXPECT_EQ(out.mode, "landing");
+}
+
 TEST(ScoutBehaviour, OrbitsTheTargetVictimAndResumesItsLaneAfterTheRescue) {
   Mission m;
   m.Apply(raft::AssignSectors{{kSector}});
@@ -280,6 +351,91 @@ TEST_F(LifterTest, SetsTheStretcherDownBesideTheVictimAndReattachesItLoaded) {
   StepAt(13.0, {37, 0, attach_z}, true);
   EXPECT_EQ(out.mode, "climb_loaded");
   EXPECT_TRUE(HasEvent(out, "evacuee_loaded"));
+}
+
+TEST_F(LifterTest, ReleasesWithinTheLooserToleranceWhileTheLoadStillSwings) {
+  const double attach_z = lifter.config().AttachHeight();
+  const double transit_z = lifter.config().transit_altitude_m;
+  StepAt(0.0, {0, 0, 0.6}, false);
+  for (double t = 0.1; t < 2.0; t += 0.1) StepAt(t, {0, 0, attach_z}, false);
+  StepAt(2.0, {0, 0, attach_z}, true);
+  StepAt(2.1, {0, 0, transit_z}, true);
+  StepAt(3.0, {37, 0, transit_z}, true);
+  ASSERT_EQ(out.mode, "descend_to_release");
+  const Vector3d release = out.setpoint.target_m;
+  // 1.2 m off and moving at 0.8 m/s (a swinging stretcher): too loose to hook, fine to set down.
+  bool asked = false;
+  for (double t = 3.1; t < 6.0 && !asked; t += 0.1) {
+    MissionInput in = Input(t, m, release + Vector3d(1.2, 0, 0));
+    in.velocity_m_s = {0.8, 0, 0};
+    in.payload_attached = true;
+    lifter.Step(in, &out);
+    asked = out.payload.action == PayloadAction::kRelease;
+  }
+  EXPECT_TRUE(asked);
+  StepAt(6.1, release + Vector3d(1.2, 0, 0), false);
+  EXPECT_EQ(out.mode, "loading");
+  EXPECT_EQ(lifter.stretcher_xy_m(), Vector2d(38.2, 0));  // where it really came down
+}
+
+TEST_F(LifterTest, GoesBackForTheStretcherWhenTheHookTurnsOutEmpty) {
+  const double attach_z = lifter.config().AttachHeight();
+  StepAt(0.0, {0, 0, 0.6}, false);
+  for (double t = 0.1; t < 2.0; t += 0.1) StepAt(t, {0, 0, attach_z}, false);
+  StepAt(2.0, {0, 0, attach_z}, true);
+  ASSERT_EQ(out.mode, "climb");
+  StepAt(3.0, {0, 0, attach_z + 3}, false);  // the load check found no load
+  EXPECT_EQ(out.mode, "takeoff_for_pickup");
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(0, 0, attach_z));
+}
+
+class StandbyLifterTest : public LifterTest {
+ protected:
+  StandbyLifterTest() {
+    lifter = LifterSequence({.name = "lifter", .home_m = Vector3d(0, 0, 0),
+                             .stretcher_start_offset_m = Vector2d(0, -3), .standby_after_delivery = true,
+                             .loading_time_s = 5.0});
+  }
+  // Runs the rescue of victim 1 with an ideal flight stack and world until `mode`.
+  double RunUntil(const std::string& mode, double t) {
+    const double attach_z = lifter.config().AttachHeight();
+    bool attached = false;
+    for (int guard = 0; out.mode != mode && guard < 5000; ++guard) {
+      t += 0.1;
+      Vector3d p = out.setpoint.kind == SetpointKind::kTakeoff ? Vector3d(0, -3, attach_z) : out.setpoint.target_m;
+      if (out.mode == "on_ground" || guard == 0) p = {0, 0, 0.6};
+      if (out.payload.action == PayloadAction::kAttach) attached = true;
+      if (out.payload.action == PayloadAction::kRelease) attached = false;
+      StepAt(t, p, attached);
+    }
+    return t;
+  }
+};
+
+TEST_F(StandbyLifterTest, PicksUpTheStretcherBesideItsSpawnThenStandsByForTheNextVictim) {
+  StepAt(0.0, {0, 0, 0.6}, false);
+  EXPECT_EQ(out.mode, "takeoff_for_pickup");
+  EXPECT_EQ(lifter.stretcher_xy_m(), Vector2d(0, -3));  // beside the spawn, as the world lays it
+  m.Apply(raft::ConfirmVictim{"operator", -30, 40});  // a second victim waits meanwhile
+  double t = RunUntil("standby", 0.0);
+  ASSERT_EQ(out.mode, "standby");
+  ASSERT_EQ(out.proposals.size(), 1u);  // MarkRescued{1}
+  m.Apply(raft::MarkRescued{1});
+  m.Apply(raft::ConvergeOn{2});
+  StepAt(t + 1.0, out.setpoint.target_m, false);
+  EXPECT_EQ(out.mode, "standby");  // hovers over the stretcher, no landing
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kPosition);
+  m.Apply(raft::BeginRescue{2, "lifter"});
+  StepAt(t + 2.0, out.setpoint.target_m, false);
+  EXPECT_EQ(out.mode, "takeoff_for_pickup");
+  EXPECT_EQ(lifter.victim(), 2u);
+}
+
+TEST_F(StandbyLifterTest, LandsAfterDeliveryWhenNoVictimWaits) {
+  StepAt(0.0, {0, 0, 0.6}, false);
+  const double t = RunUntil("move_to_land", 0.0);
+  EXPECT_EQ(out.mode, "move_to_land");
+  EXPECT_LT(t, 400.0);
 }
 
 TEST_F(LifterTest, MarkRescuedIsReproposedUntilCommitted) {
