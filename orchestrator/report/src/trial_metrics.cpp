@@ -39,13 +39,18 @@ void TrialMetrics::OnLogEvent(std::string_view component, const LogfmtFields& fi
   } else if (e == "victim_detected" || e == "victim_confirmed" || e == "sighting_reported") {
     perception_seen_ = true;
     if (t) KeepMin(first_detection_s_, *t);
-    const auto victim = FindField(fields, "victim");
-    if (victim) {
+    // Victims are told apart by `id` (the mission's) or `victim`; a sighting names none and only
+    // counts for the time of the first detection.
+    auto victim = FindField(fields, "id");
+    if (!victim) victim = FindField(fields, "victim");
+    if (victim && e != "sighting_reported") {
       detected_.insert(*victim);
       if (e == "victim_confirmed") confirmed_.insert(*victim);
-    } else {
+    } else if (e == "victim_detected") {
       ++anonymous_detections_;
-      if (e == "victim_confirmed") ++anonymous_confirmed_;
+    } else if (e == "victim_confirmed") {
+      ++anonymous_detections_;
+      ++anonymous_confirmed_;
     }
   } else if (e == "mission_state") {
     perception_seen_ = true;  // the mission runs: zero detections is then a real zero
@@ -62,13 +67,20 @@ void TrialMetrics::OnLogEvent(std::string_view component, const LogfmtFields& fi
   } else if (e == "raft_stopped" || e == "stopped" || e == "crash") {
     if (t) leader_losses_.emplace_back(*t, node);
   } else if (e == "link") {
+    // Weighted by the pings of each window when the line says how many (sent, received).
+    const auto sent = Number(fields, "sent");
+    const auto received = Number(fields, "received");
     if (auto rtt = Number(fields, "rtt_ms_mean"); rtt && std::isfinite(*rtt)) {
-      link_rtt_sum_ += *rtt;
-      ++link_rtt_n_;
+      const double w = received && *received > 0 ? *received : (received ? 0.0 : 1.0);
+      link_rtt_sum_ += *rtt * w;
+      link_rtt_w_ += w;
     }
-    if (auto loss = Number(fields, "loss"); loss && std::isfinite(*loss)) {
-      link_loss_sum_ += *loss;
-      ++link_loss_n_;
+    if (sent && received && *sent > 0) {
+      link_sent_ += *sent;
+      link_lost_ += std::max(0.0, *sent - *received);
+    } else if (auto loss = Number(fields, "loss"); loss && std::isfinite(*loss)) {
+      link_sent_ += 1;
+      link_lost_ += *loss;
     }
   }
 }
@@ -145,8 +157,8 @@ MetricValues TrialMetrics::Values() {
     }
     v["failover_s"] = longest;
   }
-  if (link_rtt_n_ > 0) v["radio_rtt_ms"] = link_rtt_sum_ / static_cast<double>(link_rtt_n_);
-  if (link_loss_n_ > 0) v["radio_loss"] = link_loss_sum_ / static_cast<double>(link_loss_n_);
+  if (link_rtt_w_ > 0) v["radio_rtt_ms"] = link_rtt_sum_ / link_rtt_w_;
+  if (link_sent_ > 0) v["radio_loss"] = link_lost_ / link_sent_;
   return v;
 }
 

@@ -40,6 +40,7 @@ TEST(TrialMetrics, MissionDetectionsCollisionsAndRadio) {
   Feed(m, "lifter", "t=300.500 node=lifter event=mission_complete");
   Feed(m, "scout_1", "t=10 node=scout_1 event=link peer=scout_2 loss=0.10 rtt_ms_mean=210.0");
   Feed(m, "scout_2", "t=10 node=scout_2 event=link peer=scout_1 loss=0.00 rtt_ms_mean=190.0");
+  Feed(m, "scout_2", "t=50 node=scout_2 event=sighting_reported seq=7 x=1 y=2 confidence=0.9");
   Feed(m, "scout_2", "not an event line");
   MetricValues v = m.Values();
   EXPECT_EQ(v["mission_time_s"], 300.5);
@@ -51,6 +52,24 @@ TEST(TrialMetrics, MissionDetectionsCollisionsAndRadio) {
   EXPECT_DOUBLE_EQ(*v["radio_loss"], 0.05);
   EXPECT_FALSE(v["leader_changes"].has_value());
   EXPECT_FALSE(v["min_separation_m"].has_value());
+}
+
+TEST(TrialMetrics, RadioFiguresAreWeightedByPingsAndVictimsKnownById) {
+  TrialMetrics m;
+  // The agents' format: counts per window; a window with nothing answered has no RTT.
+  Feed(m, "a", "t=12 node=a event=link peer=b sent=6 received=0 loss=1.0000 late=0 dup=0");
+  Feed(m, "a", "t=13 node=a event=link peer=b sent=10 received=9 loss=0.1 rtt_ms_mean=200 rtt_ms_p50=199");
+  Feed(m, "b", "t=13 node=b event=link peer=a sent=4 received=3 loss=0.25 rtt_ms_mean=100");
+  Feed(m, "lifter", "t=77 node=lifter event=victim_confirmed id=1 x=35.6 y=19.6 index=12");
+  Feed(m, "scout_1", "t=75 node=scout_1 event=victim_confirmed id=1 x=35.6 y=19.6 index=12");
+  Feed(m, "scout_1", "t=72.5 node=scout_1 event=sighting_reported seq=4405 x=-42.9 y=54.6");
+  Feed(m, "scout_1", "t=86 node=scout_1 event=victim_confirmed id=2 x=-42.7 y=54.7 index=20");
+  MetricValues v = m.Values();
+  EXPECT_DOUBLE_EQ(*v["radio_loss"], 8.0 / 20.0);
+  EXPECT_DOUBLE_EQ(*v["radio_rtt_ms"], (200.0 * 9 + 100.0 * 3) / 12.0);
+  EXPECT_EQ(v["detections"], 2.0);
+  EXPECT_EQ(v["victims_confirmed"], 2.0);
+  EXPECT_EQ(v["first_detection_s"], 72.5);
 }
 
 TEST(TrialMetrics, LeaderChangesAndFailoverFromTheLeadersStop) {

@@ -5,8 +5,9 @@
 // never an invented value.
 //   mission_time_s        t of the first event=mission_complete
 //   first_detection_s     t of the first victim_detected / victim_confirmed / sighting_reported
-//   detections            distinct victims detected or confirmed (`victim` field; events without
-//                         one count one each); empty when the trial logged no perception event
+//   detections            distinct victims detected or confirmed (their `id`, or `victim`, field;
+//                         such events without one count one each; sighting_reported only sets
+//                         first_detection_s); empty when the trial logged no perception event
 //                         and no mission_state
 //   victims_confirmed     distinct victims in victim_confirmed events (same rule)
 //   min_separation_m      smallest 3-D distance between two drones at the same truth.csv time
@@ -17,8 +18,9 @@
 //   failover_s            longest time from losing the leader (the leader's node logging
 //                         raft_stopped/stopped/crash, or a fault event targeting it) to the next
 //                         leader_elected
-//   radio_rtt_ms          mean of rtt_ms_mean over event=link lines
-//   radio_loss            mean of loss over event=link lines
+//   radio_rtt_ms          mean RTT over event=link lines: rtt_ms_mean weighted by `received`
+//   radio_loss            1 - sum(received) / sum(sent) over event=link lines (the mean of `loss`
+//                         for lines without counts)
 #pragma once
 
 #include <array>
@@ -68,10 +70,10 @@ class TrialMetrics {
   // leader_elected: term -> (t, leader)
   std::map<std::int64_t, std::pair<double, std::string>> terms_;
   std::vector<std::pair<double, std::string>> leader_losses_;  // (t, node that stopped)
-  double link_rtt_sum_ = 0;
-  std::uint64_t link_rtt_n_ = 0;
-  double link_loss_sum_ = 0;
-  std::uint64_t link_loss_n_ = 0;
+  double link_rtt_sum_ = 0;  // sum of rtt_ms_mean x pings answered
+  double link_rtt_w_ = 0;
+  double link_sent_ = 0;     // pings sent (a line without counts weighs 1)
+  double link_lost_ = 0;
   // truth: samples of the current time step
   std::optional<double> truth_t_;
   std::vector<std::array<double, 3>> truth_points_;
