@@ -108,12 +108,15 @@ TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
   // Until some agent logs mission_complete (or everything stopped, or the wall deadline).
   std::optional<Line> complete;
   const auto deadline = wall_start + 780s;
-  while (std::chrono::steady_clock::now() < deadline && physics.running()) {
+  while (std::chrono::steady_clock::now() < deadline && physics.Wait(0ms) == -1) {
     for (auto& a : agents) {
       const auto c = Events(a->ReadLog(), "mission_complete");
       if (!c.empty() && (!complete || c.front().t_s < complete->t_s)) complete = c.front();
     }
     if (complete) break;
+    bool all_running = true;  // an agent that died (bad config, crash) ends the wait
+    for (auto& a : agents) all_running = all_running && a->Wait(0ms) == -1;
+    if (!all_running) break;
     std::this_thread::sleep_for(1s);
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
