@@ -1,5 +1,6 @@
 #include "sensor_models.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -27,6 +28,54 @@ double IsaAltitudeM(double pressure_pa) {
 }
 double IsaTemperatureC(double altitude_amsl_m) { return kT0K - kLapseK_m * altitude_amsl_m - 273.15; }
 
+GpsErrorModel::Split GpsErrorModel::SplitFor(double total_h_m, double total_v_m) {
+  Split s{};
+  const auto axis = [](double total, double wander, double white, double* slow, double* w_out, double* n_out) {
+    const double fast2 = wander * wander + white * white;
+    if (total * total >= fast2) {
+      *slow = std::sqrt(total * total - fast2);
+      *w_out = wander;
+      *n_out = white;
+    } else {  // a receiver better than the wander and noise alone: scale those down
+      const double k = fast2 > 0.0 ? total / std::sqrt(fast2) : 0.0;
+      *slow = 0.0;
+      *w_out = k * wander;
+      *n_out = k * white;
+    }
+  };
+  axis(total_h_m, kWanderHStdM, kWhiteHStdM, &s.slow_h, &s.wander_h, &s.white_h);
+  axis(total_v_m, kWanderVStdM, kWhiteVStdM, &s.slow_v, &s.wander_v, &s.white_v);
+  return s;
+}
+
+GpsErrorModel::Split GpsErrorModel::Scaled(const Split& s, double ratio_h, double ratio_v) {
+  return {s.slow_h * ratio_h, s.slow_v * ratio_v, s.wander_h * ratio_h,
+          s.wander_v * ratio_v, s.white_h * ratio_h, s.white_v * ratio_v};
+}
+
+GpsErrorModel::GpsErrorModel(std::uint64_t seed) : rng_(seed) {
+  // Stationary start: each unit state is N(0, 1).
+  slow_unit_ = {Gauss(), Gauss(), Gauss()};
+  wander_unit_ = {Gauss(), Gauss(), Gauss()};
+}
+
+Vec3 GpsErrorModel::Next(double dt_s, const Split& s) {
+  // Exact discretisation of a unit-variance first-order Gauss-Markov process.
+  const auto advance = [this](Vec3* x, double dt, double tau) {
+    const double a = std::exp(-dt / tau);
+    const double q = std::sqrt(1.0 - a * a);
+    *x = Vec3{a * x->x + q * Gauss(), a * x->y + q * Gauss(), a * x->z + q * Gauss()};
+  };
+  if (dt_s > 0.0) {
+    advance(&slow_unit_, dt_s, kSlowTimeS);
+    advance(&wander_unit_, dt_s, kWanderTimeS);
+  }
+  correlated_ = Vec3{s.slow_h * slow_unit_.x + s.wander_h * wander_unit_.x,
+                     s.slow_h * slow_unit_.y + s.wander_h * wander_unit_.y,
+                     s.slow_v * slow_unit_.z + s.wander_v * wander_unit_.z};
+  return correlated_ + Vec3{s.white_h * Gauss(), s.white_h * Gauss(), s.white_v * Gauss()};
+}
+
 std::int64_t SensorSuite::PeriodNs(double rate_hz) { return static_cast<std::int64_t>(std::llround(1e9 / rate_hz)); }
 
 SensorSuite::SensorSuite(const Airframe& airframe, const WorldConfig& world, std::uint64_t seed)
@@ -36,7 +85,9 @@ SensorSuite::SensorSuite(const Airframe& airframe, const WorldConfig& world, std
       gps_(airframe.gps),
       gps_nominal_(airframe.gps),
       world_(&world),
-      rng_(seed) {
+      rng_(seed),
+      gps_error_(MixSeed(seed, 0x6A5)),
+      gps_split_(GpsErrorModel::SplitFor(airframe.gps.horizontal_std_m, airframe.gps.vertical_std_m)) {
   accel_bias_ = {Gauss(imu_.accel_bias_std_m_s2), Gauss(imu_.accel_bias_std_m_s2), Gauss(imu_.accel_bias_std_m_s2)};
   gyro_bias_ = {Gauss(imu_.gyro_bias_std_rad_s), Gauss(imu_.gyro_bias_std_rad_s), Gauss(imu_.gyro_bias_std_rad_s)};
   imu_period_ns_ = PeriodNs(imu_.rate_hz);
@@ -45,8 +96,24 @@ SensorSuite::SensorSuite(const Airframe& airframe, const WorldConfig& world, std
   gps_period_ns_ = PeriodNs(gps_.rate_hz);
 }
 
+const SensorSuite::PastState& SensorSuite::Delayed(std::int64_t time_ns) const {
+  const auto latency_ns = static_cast<std::int64_t>(std::llround(kGpsLatencyS * 1e9));
+  // Newest first: the first state at or before time_ns - latency.
+  std::size_t idx = (history_head_ + kHistory - 1) % kHistory;
+  for (std::size_t k = 0; k + 1 < history_count_; ++k) {
+    if (history_[idx].time_ns <= time_ns - latency_ns) return history_[idx];
+    idx = (idx + kHistory - 1) % kHistory;
+  }
+  return history_[idx];  // the oldest kept
+}
+
 void SensorSuite::Sample(std::int64_t time_ns, const TrueKinematics& t, bool gps_dropout, SensorSample* out) {
   out->time_ns = time_ns;
+  if (history_count_ == 0 || history_[(history_head_ + kHistory - 1) % kHistory].time_ns != time_ns) {
+    history_[history_head_] = PastState{time_ns, t.position_m, t.velocity_m_s};
+    history_head_ = (history_head_ + 1) % kHistory;
+    history_count_ = std::min(history_count_ + 1, kHistory);
+  }
   out->imu.fresh = out->baro.fresh = out->mag.fresh = out->gps.fresh = false;
   const double g = world_->gravity_m_s2;
 
@@ -89,10 +156,13 @@ void SensorSuite::Sample(std::int64_t time_ns, const TrueKinematics& t, bool gps
       gps.fix_type = 0;
     } else {
       const double h = gps_.horizontal_std_m, v = gps_.vertical_std_m, s = gps_.velocity_std_m_s;
+      const double dt_s = last_fix_ns_ < 0 ? 0.0 : static_cast<double>(time_ns - last_fix_ns_) * 1e-9;
+      last_fix_ns_ = time_ns;
+      const PastState& past = Delayed(time_ns);
       gps.valid = true;
       gps.fix_type = 3;
-      gps.position_m = t.position_m + Vec3{Gauss(h), Gauss(h), Gauss(v)};
-      gps.velocity_m_s = t.velocity_m_s + Vec3{Gauss(s), Gauss(s), Gauss(s)};
+      gps.position_m = past.position_m + gps_error_.Next(dt_s, gps_split_);
+      gps.velocity_m_s = past.velocity_m_s + Vec3{Gauss(s), Gauss(s), Gauss(s)};
       const double lat0 = world_->home_lat_deg * std::numbers::pi / 180.0;
       gps.lat_deg = world_->home_lat_deg + gps.position_m.y / kEarthRadiusM * 180.0 / std::numbers::pi;
       gps.lon_deg = world_->home_lon_deg + gps.position_m.x / (kEarthRadiusM * std::cos(lat0)) * 180.0 / std::numbers::pi;
@@ -108,6 +178,14 @@ void SensorSuite::Sample(std::int64_t time_ns, const TrueKinematics& t, bool gps
 void SensorSuite::SetGpsAccuracy(double horizontal_std_m, double vertical_std_m) {
   gps_.horizontal_std_m = horizontal_std_m > 0 ? horizontal_std_m : gps_nominal_.horizontal_std_m;
   gps_.vertical_std_m = vertical_std_m > 0 ? vertical_std_m : gps_nominal_.vertical_std_m;
+  // Degraded: the airframe's split scaled (an airframe without GPS noise: split afresh).
+  const double nh = gps_nominal_.horizontal_std_m, nv = gps_nominal_.vertical_std_m;
+  if (nh > 0 && nv > 0) {
+    gps_split_ = GpsErrorModel::Scaled(GpsErrorModel::SplitFor(nh, nv), gps_.horizontal_std_m / nh,
+                                       gps_.vertical_std_m / nv);
+  } else {
+    gps_split_ = GpsErrorModel::SplitFor(gps_.horizontal_std_m, gps_.vertical_std_m);
+  }
 }
 
 WindModel::WindModel(const WindConfig& config, std::uint64_t seed) : config_(config), rng_(seed) {}

@@ -2,6 +2,7 @@
 // generator (no ODE). Units and frames: see sensor_sample.hpp.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <random>
 
@@ -28,6 +29,57 @@ struct TrueKinematics {
   Vec3 body_rates_rad_s;  // body FLU
 };
 
+// GPS receiver position error, per axis (ENU), as the sum of three processes:
+//  * a slow offset (ionosphere, troposphere, orbit and clock residuals): first-order Gauss-Markov,
+//    correlation time kSlowTimeS = 1800 s (Joerger and Pervan's troposphere error bounds,
+//    900-2700 s; the ionospheric residual of a single-frequency receiver varies as slowly);
+//  * multipath and receiver wander: first-order Gauss-Markov, kWanderTimeS = 60 s (the
+//    correlation time of PX4's SITL Gazebo GPS plugin, kGpsCorrelationTime; the bend of the error
+//    autocorrelation of stationary receivers near one minute), std 0.5 m per pseudorange (code
+//    multipath at zenith, Joerger and Pervan) times HDOP 0.7 / sqrt(2) per horizontal axis
+//    = 0.25 m, times VDOP 1.1 vertically = 0.55 m (DOPs of PX4's simulated receiver);
+//  * white noise per fix: 0.2 m horizontal, 0.5 m vertical (PX4's SensorGpsSim).
+// The airframe's horizontal_std_m / vertical_std_m are the *total* 1-sigma per-axis error of a
+// fix (a u-blox M8/M9-class receiver: 1.5-2.5 m CEP, CEP = 1.18 sigma); the slow offset takes what
+// the other two leave (a spec tighter than those two scales them down, with no slow offset). A
+// degraded accuracy (SetGpsAccuracy) scales the airframe's split by new / nominal. The states
+// start in their stationary distribution, from their own generator. Advance once per fix; no
+// allocation.
+class GpsErrorModel {
+ public:
+  static constexpr double kSlowTimeS = 1800.0;
+  static constexpr double kWanderTimeS = 60.0;
+  static constexpr double kWanderHStdM = 0.25;
+  static constexpr double kWanderVStdM = 0.55;
+  static constexpr double kWhiteHStdM = 0.2;
+  static constexpr double kWhiteVStdM = 0.5;
+
+  struct Split {  // per-axis 1-sigma of each component for a total (h, v) accuracy [m]
+    double slow_h, slow_v, wander_h, wander_v, white_h, white_v;
+  };
+  // The split of an airframe's total per-axis accuracy (h, v) [m].
+  static Split SplitFor(double total_h_m, double total_v_m);
+  static Split Scaled(const Split& s, double ratio_h, double ratio_v);
+
+  explicit GpsErrorModel(std::uint64_t seed);
+  // Advances the correlated states by dt_s [s] and returns this fix's error [m] (ENU).
+  Vec3 Next(double dt_s, const Split& split);
+  // The correlated part (slow + wander) of the last fix [m]; the white part is not included.
+  const Vec3& correlated_m() const { return correlated_; }
+
+ private:
+  double Gauss() { return normal_(rng_); }
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  Vec3 slow_unit_, wander_unit_;  // unit-variance Gauss-Markov states
+  Vec3 correlated_;
+};
+
+// Latency of a GPS fix: the position and velocity it reports are those of kGpsLatencyS earlier
+// (PX4's SITL Gazebo GPS plugin delays fixes by 0.12 s; PX4's EKF2_GPS_DELAY default is 110 ms;
+// u-blox M8/M9 solutions come out ~0.1 s after their epoch).
+inline constexpr double kGpsLatencyS = 0.12;
+
 // One drone's sensor suite: rates, biases and noise. Sample() fills `out` with the sensors due at
 // time_ns (fresh = true) and keeps the others as they were (fresh = false).
 class SensorSuite {
@@ -45,6 +97,12 @@ class SensorSuite {
  private:
   double Gauss(double std) { return std * normal_(rng_); }
   static std::int64_t PeriodNs(double rate_hz);
+  struct PastState {
+    std::int64_t time_ns = 0;
+    Vec3 position_m, velocity_m_s;
+  };
+  // Truth as it was kGpsLatencyS before time_ns (the oldest kept if the history is shorter).
+  const PastState& Delayed(std::int64_t time_ns) const;
 
   ImuSpec imu_;
   BaroSpec baro_;
@@ -58,6 +116,13 @@ class SensorSuite {
   Vec3 gyro_bias_;
   std::int64_t imu_period_ns_, baro_period_ns_, mag_period_ns_, gps_period_ns_;
   std::int64_t imu_next_ns_ = 0, baro_next_ns_ = 0, mag_next_ns_ = 0, gps_next_ns_ = 0;
+  GpsErrorModel gps_error_;
+  GpsErrorModel::Split gps_split_;
+  std::int64_t last_fix_ns_ = -1;
+  static constexpr std::size_t kHistory = 256;  // >= latency / control period (0.12 s / 1 ms)
+  std::array<PastState, kHistory> history_{};
+  std::size_t history_head_ = 0;   // next slot to write
+  std::size_t history_count_ = 0;
 };
 
 // Mean wind plus first-order Gauss-Markov gusts per axis, advanced in fixed steps.

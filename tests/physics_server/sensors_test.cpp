@@ -1,4 +1,5 @@
-// Sensor noise statistics against their configuration, and GPS dropout.
+// Sensor noise statistics against their configuration, the GPS error model (correlated, delayed)
+// and GPS dropout.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -100,13 +101,127 @@ TEST_F(SensorNoise, StatisticsMatchTheirConfiguration) {
   EXPECT_NEAR(bias_x.std(), af_.imu.accel_bias_std_m_s2, 0.25 * af_.imu.accel_bias_std_m_s2);
   EXPECT_NEAR(bias_x.mean(), 0.0, 0.4 * af_.imu.accel_bias_std_m_s2);
   EXPECT_NEAR(bias_gz.std(), af_.imu.gyro_bias_std_rad_s, 0.25 * af_.imu.gyro_bias_std_rad_s);
-  // 50 000 baro, 10 000 GPS, 100 000 mag samples: std errors below 0.7%; allow 3%.
+  // 50 000 baro, 100 000 mag samples: std errors below 0.7%; allow 3%.
   EXPECT_NEAR(baro.std(), af_.baro.noise_std_pa, 0.03 * af_.baro.noise_std_pa);
   EXPECT_NEAR(baro.mean(), 0.0, 0.05);
-  EXPECT_NEAR(gps_x.std(), af_.gps.horizontal_std_m, 0.03 * af_.gps.horizontal_std_m);
-  EXPECT_NEAR(gps_z.std(), af_.gps.vertical_std_m, 0.03 * af_.gps.vertical_std_m);
-  EXPECT_NEAR(gps_x.mean(), 0.0, 0.05);
+  // GPS: the error is mostly a slow offset, one draw per drone over 10 s: 100 drones give the
+  // total std to ~7% (1 sigma) and its mean to sigma / 10; allow 25% and 3.5 standard errors.
+  EXPECT_NEAR(gps_x.std(), af_.gps.horizontal_std_m, 0.25 * af_.gps.horizontal_std_m);
+  EXPECT_NEAR(gps_z.std(), af_.gps.vertical_std_m, 0.25 * af_.gps.vertical_std_m);
+  EXPECT_NEAR(gps_x.mean(), 0.0, 0.35 * af_.gps.horizontal_std_m);
   EXPECT_NEAR(mag.std(), af_.mag.noise_std_gauss, 0.03 * af_.mag.noise_std_gauss);
+}
+
+// The GPS error model alone: 400 independent receivers at 10 Hz for 120 s.
+class GpsError : public ::testing::Test {
+ protected:
+  static constexpr int kReceivers = 400;
+  static constexpr int kFixes = 1200;
+  static constexpr double kDt = 0.1;
+  // e[r][k]: east error of receiver r at fix k; u: its up error.
+  void Run(const GpsErrorModel::Split& split) {
+    e_.assign(kReceivers, std::vector<double>(kFixes));
+    u_.assign(kReceivers, std::vector<double>(kFixes));
+    for (int r = 0; r < kReceivers; ++r) {
+      GpsErrorModel m(MixSeed(77, static_cast<std::uint64_t>(r)));
+      for (int k = 0; k < kFixes; ++k) {
+        const Vec3 err = m.Next(k == 0 ? 0.0 : kDt, split);
+        e_[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)] = err.x;
+        u_[static_cast<std::size_t>(r)][static_cast<std::size_t>(k)] = err.z;
+      }
+    }
+  }
+  // Std of x[k + lag] - x[k] over all receivers and k.
+  static double LagStd(const std::vector<std::vector<double>>& x, int lag) {
+    Stats s;
+    for (const auto& series : x) {
+      for (std::size_t k = 0; k + static_cast<std::size_t>(lag) < series.size(); k += 10) {
+        s.Add(series[k + static_cast<std::size_t>(lag)] - series[k]);
+      }
+    }
+    return s.std();
+  }
+  static double TotalStd(const std::vector<std::vector<double>>& x) {
+    Stats s;
+    for (const auto& series : x) {
+      for (std::size_t k = 0; k < series.size(); k += 50) s.Add(series[k]);
+    }
+    return s.std();
+  }
+  std::vector<std::vector<double>> e_, u_;
+};
+
+TEST_F(GpsError, SplitKeepsTheAirframesTotalAccuracy) {
+  const auto s = GpsErrorModel::SplitFor(0.8, 1.5);
+  EXPECT_NEAR(std::hypot(s.slow_h, s.wander_h, s.white_h), 0.8, 1e-12);
+  EXPECT_NEAR(std::hypot(s.slow_v, s.wander_v, s.white_v), 1.5, 1e-12);
+  EXPECT_DOUBLE_EQ(s.white_h, GpsErrorModel::kWhiteHStdM);
+  EXPECT_DOUBLE_EQ(s.wander_v, GpsErrorModel::kWanderVStdM);
+  // A receiver tighter than the wander and noise alone: those scale down, no slow offset.
+  const auto fine = GpsErrorModel::SplitFor(0.1, 0.2);
+  EXPECT_EQ(fine.slow_h, 0.0);
+  EXPECT_NEAR(std::hypot(fine.wander_h, fine.white_h), 0.1, 1e-12);
+  EXPECT_NEAR(fine.white_h / fine.wander_h, GpsErrorModel::kWhiteHStdM / GpsErrorModel::kWanderHStdM, 1e-12);
+}
+
+TEST_F(GpsError, IsCorrelatedLikeARealReceiverNotWhite) {
+  const auto split = GpsErrorModel::SplitFor(0.8, 1.5);
+  Run(split);
+  // Stationary from the first fix: the total std is the airframe's (400 slow-offset draws: the
+  // std is known to ~4%; allow 12%).
+  EXPECT_NEAR(TotalStd(e_), 0.8, 0.12 * 0.8);
+  EXPECT_NEAR(TotalStd(u_), 1.5, 0.12 * 1.5);
+  // Fix to fix, only the white part changes (the correlated part moves by < 1 cm in 0.1 s).
+  const auto expected_lag = [&](double lag_s, double slow, double wander, double white) {
+    return std::sqrt(2.0 * (white * white + wander * wander * (1.0 - std::exp(-lag_s / GpsErrorModel::kWanderTimeS)) +
+                            slow * slow * (1.0 - std::exp(-lag_s / GpsErrorModel::kSlowTimeS))));
+  };
+  EXPECT_NEAR(LagStd(e_, 1), expected_lag(0.1, split.slow_h, split.wander_h, split.white_h), 0.05 * std::sqrt(2.0) * split.white_h);
+  // Over 60 s the wander decorrelates (1 - 1/e) and the slow offset hardly moves: the
+  // correlation times show in the growth of the difference (some 100 000 pairs: ~1% errors).
+  EXPECT_NEAR(LagStd(e_, 600), expected_lag(60.0, split.slow_h, split.wander_h, split.white_h),
+              0.05 * expected_lag(60.0, split.slow_h, split.wander_h, split.white_h));
+  EXPECT_NEAR(LagStd(u_, 600), expected_lag(60.0, split.slow_v, split.wander_v, split.white_v),
+              0.05 * expected_lag(60.0, split.slow_v, split.wander_v, split.white_v));
+  // White noise would give sqrt(2) * 0.8 = 1.13 m for any lag; this receiver moves ~0.4 m a minute.
+  EXPECT_LT(LagStd(e_, 600), 0.5);
+}
+
+TEST_F(GpsError, DegradedAccuracyScalesEveryComponent) {
+  const auto nominal = GpsErrorModel::SplitFor(0.8, 1.5);
+  const auto degraded = GpsErrorModel::Scaled(nominal, 5.0, 2.0);
+  EXPECT_DOUBLE_EQ(degraded.white_h, 5.0 * nominal.white_h);
+  EXPECT_DOUBLE_EQ(degraded.wander_v, 2.0 * nominal.wander_v);
+  Run(degraded);
+  EXPECT_NEAR(TotalStd(e_), 4.0, 0.12 * 4.0);
+  EXPECT_NEAR(TotalStd(u_), 3.0, 0.12 * 3.0);
+}
+
+TEST(Sensors, GpsFixesReportWhereTheDroneWasOneLatencyAgo) {
+  // Noise-free GPS on a drone flying east at 5 m/s: each fix is the truth of kGpsLatencyS ago,
+  // position and velocity (the velocity steps from 0 to 5 m/s at t = 1 s).
+  Airframe af = LoadShippedAirframe("x500");
+  af.gps.horizontal_std_m = 0;
+  af.gps.vertical_std_m = 0;
+  af.gps.velocity_std_m_s = 0;
+  const WorldConfig world = CalmWorld();
+  SensorSuite suite(af, world, 5);
+  SensorSample out;
+  int fixes = 0;
+  for (int k = 0; k < 750; ++k) {  // 3 s at 250 Hz
+    const std::int64_t t_ns = k * 4'000'000LL;
+    const double t = static_cast<double>(t_ns) * 1e-9;
+    TrueKinematics truth;
+    truth.position_m = Vec3{t < 1.0 ? 0.0 : 5.0 * (t - 1.0), 2.0, 10.0};
+    truth.velocity_m_s = Vec3{t < 1.0 ? 0.0 : 5.0, 0.0, 0.0};
+    suite.Sample(t_ns, truth, false, &out);
+    if (!out.gps.fresh || t < 1.5) continue;
+    ++fixes;
+    EXPECT_NEAR(out.gps.position_m.x, 5.0 * (t - kGpsLatencyS - 1.0), 1e-9) << "t=" << t;
+    EXPECT_NEAR(out.gps.position_m.y, 2.0, 1e-12);
+    EXPECT_NEAR(out.gps.velocity_m_s.x, 5.0, 1e-12);
+  }
+  EXPECT_EQ(fixes, 15);
 }
 
 TEST(Sensors, GpsDropoutProducesInvalidSamples) {
