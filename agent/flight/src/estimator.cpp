@@ -9,7 +9,8 @@ namespace {
 constexpr int kP = 0;  // state indices of an axis filter
 constexpr int kV = 1;
 constexpr int kBa = 2;
-constexpr int kBb = 3;
+constexpr int kBg = 3;
+constexpr int kBb = 4;
 
 Quat ExpMap(const Vec3& w_dt) {
   const double a = w_dt.norm();
@@ -21,7 +22,7 @@ Quat ExpMap(const Vec3& w_dt) {
 }  // namespace
 
 Estimator::Estimator(const EstimatorParams& params) : params_(params) {
-  for (int a = 0; a < 3; ++a) ax_[a].n = (a == 2) ? 4 : 3;
+  for (int a = 0; a < 3; ++a) ax_[a].n = (a == 2) ? 5 : 4;
 }
 
 void Estimator::InitAttitude(const SensorSample& s) {
@@ -41,17 +42,35 @@ void Estimator::InitAttitude(const SensorSample& s) {
 
 void Estimator::UpdateAttitude(const SensorSample& s, double dt) {
   const bool aligning = (s.t_s - t_start_s_) < params_.align_time_s;
-  const double gain_boost = aligning ? 10.0 : 1.0;
+  // Aligning, or standing still on the ground: the accelerometer is a clean gravity reference,
+  // so correct tilt ten times faster and learn the gyro biases fifty times faster: PI poles
+  // at ~1 rad/s (time constant kp / ki ~1.5 s) instead of ~0.14 rad/s in flight, where the
+  // accelerometer also sees manoeuvres.
+  const bool still = aligning || at_rest_;
+  const double gain_boost = still ? 10.0 : 1.0;
+  const double bias_boost = still ? 50.0 : 1.0;
   Vec3 corr = Vec3::Zero();     // rad/s, body
   Vec3 bias_rate = Vec3::Zero();
 
   if (s.imu_fresh) {
-    // Tilt: measured specific force vs the one expected from the GPS-derived acceleration.
-    // Soft dead band on the (noisy, differentiated) GPS acceleration: in hover and cruise the
-    // reference is plain gravity; only real manoeuvres shift it.
-    const double ga = gps_acc_.norm();
-    const Vec3 a_ref = ga > params_.gps_acc_deadband_mps2 ? Vec3(gps_acc_ * (1.0 - params_.gps_acc_deadband_mps2 / ga))
-                                                          : Vec3::Zero();
+    // Tilt: measured specific force vs the one expected from the vehicle's acceleration. At
+    // rest the reference is plain gravity. In flight, either
+    //  * the translational filter's acceleration (IMU minus the world-frame bias that GPS
+    //    velocity reveals): a tilt error shows there as a horizontal bias of g times the error,
+    //    so this closes the tilt-from-GPS-velocity loop of a full INS filter, without lag; or
+    //  * differentiated GPS velocity, low-passed, with a soft dead band (hover and cruise: plain
+    //    gravity): lagged, but blind to what a swinging slung load does to the filter's bias.
+    Vec3 a_ref = Vec3::Zero();
+    // Without GPS (lost for longer than gps_timeout_s) nothing observes that bias: hover
+    // assumption, plain gravity, as the GPS-derived reference decays to.
+    const bool gps_recent = s.t_s - t_last_gps_s_ < params_.gps_timeout_s;
+    if (!at_rest_ && pos_init_) {
+      if (params_.tilt_ref_from_filter && gps_recent) {
+        a_ref = state_.accel_mps2;
+      } else if (const double ga = gps_acc_.norm(); ga > params_.gps_acc_deadband_mps2) {
+        a_ref = gps_acc_ * (1.0 - params_.gps_acc_deadband_mps2 / ga);
+      }
+    }
     const Vec3 expected_w = a_ref + Vec3(0.0, 0.0, kGravity_mps2);
     const double fm = s.accel_mps2.norm();
     if (fm > 1e-3 && std::abs(fm - expected_w.norm()) < params_.acc_gate_mps2) {
@@ -59,7 +78,7 @@ void Estimator::UpdateAttitude(const SensorSample& s, double dt) {
       const Vec3 expect = q_.inverse() * expected_w.normalized();
       const Vec3 e = meas.cross(expect);
       corr += gain_boost * params_.acc_kp * e;
-      bias_rate -= params_.acc_ki * e;
+      bias_rate -= bias_boost * params_.acc_ki * e;
     }
   }
   if (s.mag_fresh && s.mag_body.norm() > 1e-9) {
@@ -71,7 +90,7 @@ void Estimator::UpdateAttitude(const SensorSample& s, double dt) {
       // The estimate's yaw is short by err: turn it about world z, expressed in the body.
       const Vec3 e_b = q_.inverse() * Vec3(0.0, 0.0, err);
       corr += gain_boost * params_.mag_kp * e_b;
-      bias_rate -= params_.mag_ki * e_b;
+      bias_rate -= bias_boost * params_.mag_ki * e_b;
     }
   }
   if (!aligning) gyro_bias_ += bias_rate * dt;
@@ -81,57 +100,60 @@ void Estimator::UpdateAttitude(const SensorSample& s, double dt) {
   state_.rate_radps = s.gyro_radps - gyro_bias_;
 }
 
-void Estimator::Predict(Axis* ax, double acc, double dt) const {
-  Eigen::Matrix4d f = Eigen::Matrix4d::Identity();
+void Estimator::Predict(Axis* ax, int axis, double acc, double dt) const {
+  Mat5 f = Mat5::Identity();
   f(kP, kV) = dt;
   f(kP, kBa) = -0.5 * dt * dt;
   f(kV, kBa) = -dt;
-  Eigen::Vector4d& x = ax->x;
+  Vec5& x = ax->x;
   x(kP) += x(kV) * dt + 0.5 * (acc - x(kBa)) * dt * dt;
   x(kV) += (acc - x(kBa)) * dt;
-  // Glide in the pending GPS corrections at bounded rates.
-  const double dp = std::clamp(ax->pending_p, -params_.max_pos_correction_mps * dt, params_.max_pos_correction_mps * dt);
-  const double dv = std::clamp(ax->pending_v, -params_.max_vel_correction_mps2 * dt, params_.max_vel_correction_mps2 * dt);
-  x(kP) += dp;
-  x(kV) += dv;
-  ax->pending_p -= dp;
-  ax->pending_v -= dv;
-  Eigen::Matrix4d q = Eigen::Matrix4d::Zero();
+  Mat5 q = Mat5::Zero();
   const double qa = params_.accel_noise_mps2 * params_.accel_noise_mps2;
   q(kP, kP) = 0.25 * dt * dt * dt * dt * qa;
+  // In flight the horizontal position lives in the receiver's (wandering) frame; standing on the
+  // ground the drone is known not to move, and the GPS error state takes the wander instead.
+  if (axis != 2) {
+    const double w = at_rest_ ? params_.gps_frame_walk_h : 0.0;
+    q(kP, kP) += params_.gps_frame_walk_h * params_.gps_frame_walk_h * dt - w * w * dt;
+    q(kBg, kBg) += w * w * dt;
+  }
   q(kP, kV) = q(kV, kP) = 0.5 * dt * dt * dt * qa;
   q(kV, kV) = dt * dt * qa;
   q(kBa, kBa) = params_.accel_bias_walk * params_.accel_bias_walk * dt;
+  const double gw = axis == 2 ? params_.gps_bias_walk_v : params_.gps_bias_walk_h;
+  q(kBg, kBg) = gw * gw * dt;
   q(kBb, kBb) = params_.baro_bias_walk * params_.baro_bias_walk * dt;
   ax->p = f * ax->p * f.transpose() + q;
-  if (ax->n < 4) {
+  if (ax->n < 5) {
     ax->p.row(kBb).setZero();
     ax->p.col(kBb).setZero();
   }
+  // The output glides after the corrections at bounded rates.
+  ax->out_dp -= std::clamp(ax->out_dp, -params_.max_pos_correction_mps * dt, params_.max_pos_correction_mps * dt);
+  ax->out_dv -= std::clamp(ax->out_dv, -params_.max_vel_correction_mps2 * dt, params_.max_vel_correction_mps2 * dt);
 }
 
-void Estimator::Correct(Axis* ax, double z, double r, bool with_baro_bias, int idx, bool glide) const {
-  Eigen::RowVector4d h = Eigen::RowVector4d::Zero();
-  h(idx) = 1.0;
-  if (with_baro_bias) h(kBb) = 1.0;
-  const double innov = z - h.dot(ax->x);
-  const double s = h * ax->p * h.transpose() + r;
-  if (!(s > 0.0)) return;
-  const Eigen::Vector4d k = ax->p * h.transpose() / s;
-  Eigen::Vector4d dx = k * innov;
-  if (glide) {
-    // Position and velocity corrections are not applied at once but handed to Predict(), which
-    // applies them at a bounded rate (a glide, no step for the controller); the covariance is
-    // updated now, as if applied.
-    ax->pending_p += dx(kP);
-    ax->pending_v += dx(kV);
-    dx(kP) = 0.0;
-    dx(kV) = 0.0;
-  }
+void Estimator::Correct(Axis* ax, const Row5& h, double y, double r) const {
+  const double s = (h * ax->p * h.transpose())(0, 0) + r;
+  if (!(s > 0.0) || !std::isfinite(y)) return;
+  const Vec5 k = ax->p * h.transpose() / s;
+  const Vec5 dx = k * y;
   ax->x += dx;
   // Joseph form keeps P symmetric and positive.
-  const Eigen::Matrix4d ikh = Eigen::Matrix4d::Identity() - k * h;
+  const Mat5 ikh = Mat5::Identity() - k * h;
   ax->p = ikh * ax->p * ikh.transpose() + k * r * k.transpose();
+  // The history moves with the correction, mapped back through the motion model.
+  const double t_now = hist_t_[HistIndex(0)];
+  for (std::size_t age = 0; age < hist_count_; ++age) {
+    const std::size_t i = HistIndex(age);
+    const double d = t_now - hist_t_[i];
+    ax->hist_p[i] += dx(kP) - dx(kV) * d - 0.5 * dx(kBa) * d * d;
+    ax->hist_v[i] += dx(kV) + dx(kBa) * d;
+  }
+  // The output does not jump: it catches up in Predict().
+  ax->out_dp += dx(kP);
+  ax->out_dv += dx(kV);
 }
 
 const StateEstimate& Estimator::Update(const SensorSample& s) {
@@ -169,22 +191,27 @@ const StateEstimate& Estimator::Update(const SensorSample& s) {
     const bool have_gps = s.gps_fresh && s.gps_valid;
     if (params_.has_initial_pos || have_gps) {
       const Vec3 p0 = params_.has_initial_pos ? params_.initial_pos_m : s.gps_pos_m;
-      const double std_h = params_.has_initial_pos ? params_.initial_pos_std_m : params_.gps_pos_h_std_m;
-      const double std_v = params_.has_initial_pos ? params_.initial_pos_std_m : params_.gps_pos_v_std_m;
       for (int a = 0; a < 3; ++a) {
         Axis& ax = ax_[a];
         ax.x.setZero();
         ax.p.setZero();
         ax.x(kP) = p0[a];
         ax.x(kV) = have_gps ? s.gps_vel_mps[a] : 0.0;
-        const double sp = a == 2 ? std_v : std_h;
+        const double total = a == 2 ? params_.gps_pos_v_std_m : params_.gps_pos_h_std_m;
+        // Known start: the position is sure, the GPS error is what the receiver's spec says.
+        // Else the first fix is all there is: position and GPS error share its uncertainty.
+        const double sp = params_.has_initial_pos ? params_.initial_pos_std_m : total;
         ax.p(kP, kP) = sp * sp;
         ax.p(kV, kV) = 0.5 * 0.5;
         ax.p(kBa, kBa) = 0.2 * 0.2;
+        ax.p(kBg, kBg) = total * total;
+        // Started on a fix: p + b_gps is what was measured, so their errors cancel in the sum.
+        if (!params_.has_initial_pos) ax.p(kP, kBg) = ax.p(kBg, kP) = -0.99 * total * total;
+        ax.out_dp = ax.out_dv = 0.0;
       }
       // Barometer offset: anchored at the start altitude (its own uncertainty).
       ax_[2].x(kBb) = baro_seen_ ? baro_pending_ - p0.z() : 0.0;
-      ax_[2].p(kBb, kBb) = baro_seen_ ? std_v * std_v : 100.0;
+      ax_[2].p(kBb, kBb) = baro_seen_ ? params_.gps_pos_v_std_m * params_.gps_pos_v_std_m : 100.0;
       pos_init_ = true;
       if (have_gps) t_last_gps_s_ = s.t_s;
     }
@@ -194,34 +221,63 @@ const StateEstimate& Estimator::Update(const SensorSample& s) {
       baro_seen_ = true;
       if (pos_init_) {
         ax_[2].x(kBb) = s.baro_alt_m - ax_[2].x(kP);
-        ax_[2].p(kBb, kBb) = ax_[2].p(kP, kP);
+        ax_[2].p(kBb, kBb) = ax_[2].p(kP, kP) + params_.baro_std_m * params_.baro_std_m;
       }
     }
     baro_pending_ = s.baro_alt_m;
   }
 
   if (pos_init_) {
-    for (int a = 0; a < 3; ++a) Predict(&ax_[a], acc_world_[a], dt);
+    for (int a = 0; a < 3; ++a) Predict(&ax_[a], a, acc_world_[a], dt);
+    // History: this step's position and velocity.
+    hist_head_ = (hist_head_ + 1) % kHistory;
+    hist_count_ = std::min(hist_count_ + 1, kHistory);
+    hist_t_[HistIndex(0)] = s.t_s;
+    for (Axis& ax : ax_) {
+      ax.hist_p[HistIndex(0)] = ax.x(kP);
+      ax.hist_v[HistIndex(0)] = ax.x(kV);
+    }
     if (s.baro_fresh) {
-      Correct(&ax_[2], s.baro_alt_m, params_.baro_std_m * params_.baro_std_m, true, kP, false);
+      Row5 h = Row5::Zero();
+      h(kP) = 1.0;
+      h(kBb) = 1.0;
+      Correct(&ax_[2], h, s.baro_alt_m - ax_[2].x(kP) - ax_[2].x(kBb), params_.baro_std_m * params_.baro_std_m);
     }
     if (at_rest_ && ++rest_count_ >= 5) {  // 50 Hz zero-velocity update
       rest_count_ = 0;
-      for (int a = 0; a < 3; ++a) Correct(&ax_[a], 0.0, 0.02 * 0.02, false, kV, false);
+      Row5 h = Row5::Zero();
+      h(kV) = 1.0;
+      for (Axis& ax : ax_) Correct(&ax, h, -ax.x(kV), 0.02 * 0.02);
     }
     if (s.gps_fresh && s.gps_valid) {
+      // The state of the fix's epoch: the newest history slot at least gps_delay_s old.
+      std::size_t age = 0;
+      while (age + 1 < hist_count_ && s.t_s - hist_t_[HistIndex(age)] < params_.gps_delay_s - 1e-6) ++age;
+      const std::size_t i = HistIndex(age);
+      const double d = s.t_s - hist_t_[i];
       for (int a = 0; a < 3; ++a) {
-        const double rp = a == 2 ? params_.gps_pos_v_std_m : params_.gps_pos_h_std_m;
-        Correct(&ax_[a], s.gps_vel_mps[a], params_.gps_vel_std_mps * params_.gps_vel_std_mps, false, kV, true);
-        Correct(&ax_[a], s.gps_pos_m[a], rp * rp, false, kP, true);
+        Axis& ax = ax_[a];
+        // Velocity: v(t - d) = v + d b_acc (+ known inputs, in the history).
+        Row5 hv = Row5::Zero();
+        hv(kV) = 1.0;
+        hv(kBa) = d;
+        Correct(&ax, hv, s.gps_vel_mps[a] - ax.hist_v[i], params_.gps_vel_std_mps * params_.gps_vel_std_mps);
+        // Position: p(t - d) + b_gps, p(t - d) = p - d v - d^2/2 b_acc (+ known inputs).
+        Row5 hp = Row5::Zero();
+        hp(kP) = 1.0;
+        hp(kV) = -d;
+        hp(kBa) = -0.5 * d * d;
+        hp(kBg) = 1.0;
+        const double rn = a == 2 ? params_.gps_noise_v_m : params_.gps_noise_h_m;
+        Correct(&ax, hp, s.gps_pos_m[a] - ax.hist_p[i] - ax.x(kBg), rn * rn);
       }
       t_last_gps_s_ = s.t_s;
     }
   }
 
   for (int a = 0; a < 3; ++a) {
-    state_.pos_m[a] = ax_[a].x(kP);
-    state_.vel_mps[a] = ax_[a].x(kV);
+    state_.pos_m[a] = ax_[a].x(kP) - ax_[a].out_dp;
+    state_.vel_mps[a] = ax_[a].x(kV) - ax_[a].out_dv;
     acc_bias_[a] = ax_[a].x(kBa);
     state_.accel_mps2[a] = acc_world_[a] - ax_[a].x(kBa);
     state_.pos_std_m[a] = std::sqrt(std::max(0.0, ax_[a].p(kP, kP)));

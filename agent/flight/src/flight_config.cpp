@@ -100,7 +100,11 @@ Status ReadControl(const yaml::Node& control, FlightConfig* cfg) {
         .Optional("accel_noise_mps2", &e.accel_noise_mps2).Optional("accel_bias_walk", &e.accel_bias_walk)
         .Optional("gps_acc_deadband_mps2", &e.gps_acc_deadband_mps2).Optional("gps_acc_tau_s", &e.gps_acc_tau_s)
         .Optional("max_pos_correction_mps", &e.max_pos_correction_mps)
-        .Optional("max_vel_correction_mps2", &e.max_vel_correction_mps2);
+        .Optional("max_vel_correction_mps2", &e.max_vel_correction_mps2)
+        .Optional("gps_noise_h_m", &e.gps_noise_h_m).Optional("gps_noise_v_m", &e.gps_noise_v_m)
+        .Optional("gps_delay_s", &e.gps_delay_s).Optional("gps_frame_walk_h", &e.gps_frame_walk_h)
+        .Optional("gps_bias_walk_h", &e.gps_bias_walk_h).Optional("gps_bias_walk_v", &e.gps_bias_walk_v)
+        .Optional("baro_std_m", &e.baro_std_m).Optional("tilt_ref_from_filter", &e.tilt_ref_from_filter);
     SWARMBOX_TRY(r.Finish());
   }
   return top.Finish();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "sim_harness.hpp"
 
@@ -20,6 +21,7 @@ Result<std::unique_ptr<Rig>> HoveringRig(const RigOptions& o, double height_m) {
     return Error(ErrorCode::kInternal, "estimator did not align within 3 s");
   }
   r.Run(5.0);  // on the ground: zero-velocity updates teach the estimator its biases
+  r.MarkGpsReference();
   if (!r.fc().Command(Setpoint::Takeoff(height_m))) {
     return Error(ErrorCode::kInternal, "take-off rejected");
   }
@@ -27,6 +29,11 @@ Result<std::unique_ptr<Rig>> HoveringRig(const RigOptions& o, double height_m) {
     return Error(ErrorCode::kInternal, "no hover within 30 s of take-off");
   }
   return std::move(*rig);
+}
+
+Status TwinOk(const Rig& r) {
+  if (!r.gps_twin_ok()) return Error(ErrorCode::kInternal, "GPS error twin out of step with the World (see stderr)");
+  return {};
 }
 
 }  // namespace
@@ -42,21 +49,35 @@ Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_m
   Rig& r = **rig;
   r.Run(5.0);  // settle (the wind's integrator too)
   const Vec3 target = r.fc().telemetry().reference.pos_m;
-  double sum2 = 0.0, est2 = 0.0, max_e = 0.0;
-  long n = 0;
+  const Vec3 gps0 = r.gps_error();
+  std::vector<Vec3> nav;
+  nav.reserve(static_cast<std::size_t>(window_s * 250.0) + 2);
+  double truth2 = 0.0, target2 = 0.0, wander2 = 0.0, est2 = 0.0;
   r.Run(window_s, {}, [&] {
-    const double e = (r.true_pos() - target).norm();
-    sum2 += e * e;
-    est2 += (r.fc().estimate().pos_m - r.true_pos()).squaredNorm();
-    max_e = std::max(max_e, e);
-    ++n;
+    nav.push_back(r.nav_pos());
+    target2 += (r.nav_pos() - target).squaredNorm();
+    truth2 += (r.true_pos() - target).squaredNorm();
+    wander2 += (r.gps_error() - gps0).head<2>().squaredNorm();
+    est2 += (r.fc().estimate().pos_m - r.nav_pos()).squaredNorm();
   });
+  const double dn = static_cast<double>(nav.size());
+  Vec3 mean = Vec3::Zero();
+  for (const Vec3& p : nav) mean += p / dn;
+  double sum2 = 0.0, max_e = 0.0;
+  for (const Vec3& p : nav) {
+    sum2 += (p - mean).squaredNorm();
+    max_e = std::max(max_e, (p - mean).norm());
+  }
   HoverMetrics m;
-  m.rms_m = std::sqrt(sum2 / static_cast<double>(n));
-  m.est_rms_m = std::sqrt(est2 / static_cast<double>(n));
+  m.rms_m = std::sqrt(sum2 / dn);
+  m.target_rms_m = std::sqrt(target2 / dn);
+  m.truth_rms_m = std::sqrt(truth2 / dn);
+  m.gps_wander_rms_m = std::sqrt(wander2 / dn);
+  m.est_rms_m = std::sqrt(est2 / dn);
   m.max_m = max_e;
   m.window_s = window_s;
   if (r.crashed()) return Error(ErrorCode::kInternal, "crashed while hovering");
+  SWARMBOX_TRY(TwinOk(r));
   return m;
 }
 
@@ -71,23 +92,28 @@ Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz)
   const Vec3 step(dx, dy, dz);
   const Vec3 target = start + step;
   const Vec3 dir = step.normalized();
+  const Vec3 nav0 = r.nav_pos();     // where the drone is at the command: the step starts there
+  const Vec3 truth0 = r.true_pos();
   if (!r.fc().Command(Setpoint::Position(target, 0.0))) return Error(ErrorCode::kInternal, "setpoint rejected");
   const double t0 = r.t();
-  double last_out = 0.0, last_out_3d = 0.0, max_along = 0.0, peak_v = 0.0;
+  double last_out = 0.0, last_out_3d = 0.0, last_out_truth = 0.0, max_along = 0.0, peak_v = 0.0;
   r.Run(15.0, {}, [&] {
-    const Vec3 p = r.true_pos();
-    if (std::abs((p - target).dot(dir)) > 0.2) last_out = r.t() - t0;
-    if ((p - target).norm() > 0.2) last_out_3d = r.t() - t0;
-    max_along = std::max(max_along, (p - start).dot(dir));
+    const Vec3 moved = r.nav_pos() - nav0;
+    if (std::abs((moved - step).dot(dir)) > 0.2) last_out = r.t() - t0;
+    if ((moved - step).norm() > 0.2) last_out_3d = r.t() - t0;
+    if (std::abs((r.true_pos() - truth0 - step).dot(dir)) > 0.2) last_out_truth = r.t() - t0;
+    max_along = std::max(max_along, moved.dot(dir));
     const auto v = r.truth().velocity_m_s;
     peak_v = std::max(peak_v, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
   });
   StepMetrics m;
   m.settle_s = last_out;
   m.settle_3d_s = last_out_3d;
+  m.settle_truth_s = last_out_truth;
   m.settled = last_out < 14.0;
   m.overshoot_pct = std::max(0.0, (max_along - step.norm()) / step.norm() * 100.0);
   m.peak_speed_mps = peak_v;
+  SWARMBOX_TRY(TwinOk(r));
   return m;
 }
 
@@ -101,15 +127,16 @@ Result<DropoutMetrics> RunGpsDropout(std::uint64_t seed, double dropout_s) {
   const Vec3 target = r.fc().telemetry().reference.pos_m;
   DropoutMetrics m;
   r.world().SetGpsDropout(r.drone(), true);
-  r.Run(dropout_s, {}, [&] { m.max_drift_m = std::max(m.max_drift_m, (r.true_pos() - target).norm()); });
-  m.est_err_at_end_m = (r.fc().estimate().pos_m - r.true_pos()).norm();
+  r.Run(dropout_s, {}, [&] { m.max_drift_m = std::max(m.max_drift_m, (r.nav_pos() - target).norm()); });
+  m.est_err_at_end_m = (r.fc().estimate().pos_m - r.nav_pos()).norm();
   r.world().SetGpsDropout(r.drone(), false);
   r.Run(10.0, {}, [&] {
-    m.max_err_after_m = std::max(m.max_err_after_m, (r.true_pos() - target).norm());
+    m.max_err_after_m = std::max(m.max_err_after_m, (r.nav_pos() - target).norm());
     const auto v = r.truth().velocity_m_s;
     m.max_speed_after_mps = std::max(m.max_speed_after_mps, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
   });
-  m.final_err_m = (r.true_pos() - target).norm();
+  m.final_err_m = (r.nav_pos() - target).norm();
+  SWARMBOX_TRY(TwinOk(r));
   m.events_ok = r.HasEvent(FlightEventKind::kGpsLost) && r.HasEvent(FlightEventKind::kGpsRecovered);
   m.crashed = r.crashed() || r.true_pos().z() < 1.0;
   return m;
@@ -147,6 +174,7 @@ Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, 
   };
   if (!r.RunUntilMode(FlightMode::kIdle, 3.0)) return Error(ErrorCode::kInternal, "no alignment");
   r.Run(3.0, {}, tracer);
+  r.MarkGpsReference();
   if (!r.fc().Command(Setpoint::Takeoff(0.5))) return Error(ErrorCode::kInternal, "take-off rejected");
   r.Run(0.5, {}, tracer);  // motors spin up (0.15 s lag) before the rig lets go
   r.world().SetPinned(r.drone(), false);
@@ -162,7 +190,7 @@ Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, 
   r.Run(60.0, [&] { return t_arrive >= 0.0 && r.t() - t_arrive >= 15.0; }, [&] {
     const double swing = r.truth().payload_swing_rad * kRadToDeg;
     m.max_swing_deg = std::max(m.max_swing_deg, swing);
-    if (t_arrive < 0.0 && (r.true_pos() - target).norm() < 1.0) {
+    if (t_arrive < 0.0 && (r.nav_pos() - target).norm() < 1.0) {
       t_arrive = r.t();
       m.swing_at_arrival_deg = swing;
     }
@@ -170,8 +198,9 @@ Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, 
     tracer();
   });
   m.arrival_s = t_arrive >= 0.0 ? t_arrive - t0 : -1.0;
-  m.final_err_m = (r.true_pos() - target).norm();
+  m.final_err_m = (r.nav_pos() - target).norm();
   m.crashed = r.crashed();
+  SWARMBOX_TRY(TwinOk(r));
   if (t_arrive < 0.0) return Error(ErrorCode::kInternal, "did not arrive within 60 s");
   return m;
 }

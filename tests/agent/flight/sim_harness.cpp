@@ -1,5 +1,7 @@
 #include "sim_harness.hpp"
 
+#include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace swarmbox::flight::testing {
@@ -64,7 +66,50 @@ Result<std::unique_ptr<Rig>> Rig::Create(const RigOptions& options) {
   if (!fc) return fc.error();
   rig->fc_ = std::make_unique<FlightController>(std::move(*fc));
   rig->u_.assign(rig->fc_->mixer().rotor_count(), 0.0);
+  // The twin of the World's receiver error: SensorSuite seed MixSeed(world seed, 0x5E0000 +
+  // drone index) (world.cpp), GpsErrorModel seed MixSeed(that, 0x6A5) (sensor_models.cpp).
+  rig->twin_ = std::make_unique<physics::GpsErrorModel>(
+      physics::MixSeed(physics::MixSeed(options.seed, 0x5E0000 + rig->drone_), 0x6A5));
+  rig->split_ = physics::GpsErrorModel::SplitFor(af->gps.horizontal_std_m, af->gps.vertical_std_m);
+  rig->RecordTruthAndCheckGps();
   return rig;
+}
+
+void Rig::RecordTruthAndCheckGps() {
+  const std::int64_t now = world_->time_ns();
+  hist_t_[hist_n_ % kHist] = now;
+  hist_p_[hist_n_ % kHist] = world_->Truth(drone_).position_m;
+  ++hist_n_;
+  const physics::GpsSample& g = world_->sensors(drone_).gps;
+  if (!g.fresh || !g.valid) return;
+  const double dt = last_fix_ns_ < 0 ? 0.0 : static_cast<double>(now - last_fix_ns_) * 1e-9;
+  last_fix_ns_ = now;
+  const physics::Vec3 err = twin_->Next(dt, split_);
+  // The truth the fix describes: the newest at least the latency old (as SensorSuite::Delayed).
+  const auto latency_ns = static_cast<std::int64_t>(std::llround(physics::kGpsLatencyS * 1e9));
+  std::size_t k = hist_n_ - 1;
+  while (k > 0 && hist_n_ - k < kHist && hist_t_[k % kHist] > now - latency_ns) --k;
+  const physics::Vec3 expected = hist_p_[k % kHist] + err;
+  const physics::Vec3 d = g.position_m - expected;
+  if (std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z) > 1e-9) {
+    if (twin_ok_) {
+      std::fprintf(stderr, "sim_harness: GPS fix at t=%.3f differs from the twin error model by (%g %g %g) m\n",
+                   world_->time_s(), d.x, d.y, d.z);
+    }
+    twin_ok_ = false;
+  }
+}
+
+Vec3 Rig::gps_error() const {
+  const physics::Vec3& c = twin_->correlated_m();
+  return Vec3(c.x, c.y, c.z);
+}
+
+Vec3 Rig::nav_pos() const {
+  // Horizontal only: height is the barometer's (the GPS's vertical wander is estimated away).
+  Vec3 shift = gps_error() - gps_ref_;
+  shift.z() = 0.0;
+  return true_pos() + shift;
 }
 
 Vec3 Rig::true_pos() const { return E(world_->Truth(drone_).position_m); }
@@ -76,6 +121,7 @@ double Rig::Run(double max_s, const std::function<bool()>& done, const std::func
     for (std::size_t i = 0; i < u_.size(); ++i) u_[i] = out.armed ? out.u[i] : 0.0;
     (void)world_->SetActuators(drone_, u_);
     world_->Step();
+    RecordTruthAndCheckGps();
     FlightEvent e;
     while (fc_->PopEvent(&e)) events_.push_back(e);
     for (const auto& pe : sink_.events) {

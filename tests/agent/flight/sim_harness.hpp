@@ -1,8 +1,18 @@
 // Closed-loop test rig: a FlightController flying a drone of the in-process physics World
 // (ODE, seeded sensor noise), lockstep as the server does it: read the sample, answer it, step.
 // Used by closed_loop_test.cpp and by the `flight` benchmark suite.
+//
+// The receiver's frame. A real GPS receiver's error wanders (metres over minutes, ~0.25 m a
+// minute from multipath; physics_server/src/sensor_models.hpp), and over seconds no GPS-based
+// navigation can tell that wander from motion. The rig therefore also measures positions in the
+// receiver's frame: nav_pos() = truth + (the receiver's horizontal correlated error now - at the
+// reference mark, the take-off), i.e. where the drone is as its GPS sees it, which is what the
+// flight stack can be held to. Heights stay absolute: they come from the barometer. The error comes from a twin of the drone's GpsErrorModel (same seed
+// derivation as the World's, advanced on the same fixes); every fix is checked against the
+// World's to 1e-9 m, so a change in the World's seeding fails loudly instead of measuring wrong.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
@@ -11,6 +21,7 @@
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/flight/flight_controller.hpp"
 #include "swarmbox/physics/world.hpp"
+#include "sensor_models.hpp"  // physics_server/src: GpsErrorModel
 
 namespace swarmbox::flight::testing {
 
@@ -49,6 +60,13 @@ class Rig {
   std::size_t drone() const { return drone_; }
   double t() const { return world_->time_s(); }
   Vec3 true_pos() const;
+  // Truth shifted by the receiver's correlated error since MarkGpsReference() (see above).
+  Vec3 nav_pos() const;
+  // The receiver's correlated (slow + wander) error at the last fix, world ENU [m].
+  Vec3 gps_error() const;
+  void MarkGpsReference() { gps_ref_ = gps_error(); }
+  // False once a fix disagreed with the twin error model (the metrics would be wrong).
+  bool gps_twin_ok() const { return twin_ok_; }
   std::vector<FlightEvent>& events() { return events_; }
   bool HasEvent(FlightEventKind kind) const;
   bool crashed() const { return crashed_; }
@@ -61,6 +79,17 @@ class Rig {
   std::vector<FlightEvent> events_;
   physics::CollectingEventSink sink_;
   bool crashed_ = false;
+  // GPS error twin and the truth history it needs for the fix latency.
+  void RecordTruthAndCheckGps();
+  std::unique_ptr<physics::GpsErrorModel> twin_;
+  physics::GpsErrorModel::Split split_{};
+  std::int64_t last_fix_ns_ = -1;
+  static constexpr std::size_t kHist = 256;
+  std::array<std::int64_t, kHist> hist_t_{};
+  std::array<physics::Vec3, kHist> hist_p_{};
+  std::size_t hist_n_ = 0;
+  Vec3 gps_ref_ = Vec3::Zero();
+  bool twin_ok_ = true;
 };
 
 }  // namespace swarmbox::flight::testing

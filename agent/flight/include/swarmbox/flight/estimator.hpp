@@ -4,22 +4,39 @@
 // each part small, allocation-free and easy to tune and test:
 //  * Attitude: a Mahony complementary filter on SO(3) with gyro-bias integration. Gyros propagate;
 //    the accelerometer corrects tilt against the *expected* specific force q^-1 (a_world + g z),
-//    where a_world comes from differentiated GPS velocity (so tilt is not pulled towards level
-//    while the drone accelerates, the classic complementary-filter failure on multirotors);
+//    where a_world is the translational filter's acceleration (IMU minus the bias GPS velocity
+//    reveals, so GPS velocity corrects tilt as in a full INS filter) or differentiated GPS
+//    velocity (per airframe), so tilt is not pulled towards level while the drone accelerates,
+//    the classic complementary-filter failure on multirotors;
 //    the magnetometer corrects heading only (its horizontal projection), never tilt.
 //  * Translation: one linear Kalman filter per world axis, driven by the IMU's world-frame
-//    acceleration, states [position, velocity, acceleration bias] (+ barometer offset on z),
-//    fusing GPS position/velocity and barometric altitude. Per-axis filters are exact for this
-//    linear model and give honest, growing uncertainty during GPS dropouts (dead reckoning on
-//    the IMU with the bias learnt before the dropout; the barometer keeps altitude).
-//  * GPS corrections glide in: the position/velocity change a fix asks for is applied over the
-//    following steps at most at `max_pos_correction_mps` / `max_vel_correction_mps2`. In steady
-//    fusion that is invisible (centimetres); after a dropout the estimate glides back to the GPS
-//    instead of jumping, so the controller is not kicked.
+//    acceleration, states [position, velocity, accelerometer bias, GPS position error] (+ the
+//    barometer offset on z), fusing GPS position and velocity, barometric altitude and, on the
+//    ground, zero-velocity updates. Per-axis filters are exact for this linear model and give
+//    honest, growing uncertainty during GPS dropouts (dead reckoning on the IMU with the bias
+//    learnt before; the barometer keeps altitude).
+//  * The GPS error is a state because a real receiver's error is not white: it is dominated by
+//    offsets that wander over minutes (atmosphere, multipath). Horizontally the state holds the
+//    offset between the receiver's frame and a known start point (a surveyed take-off spot, as
+//    PX4's home), learnt on the ground; in flight the position follows the receiver (over
+//    seconds its wander cannot be told from motion). Vertically it is a random walk as fast as
+//    the receiver's wander, so height follows the barometer and GPS only anchors it.
+//  * GPS delay: fixes describe the vehicle `gps_delay_s` ago (PX4's EKF2_GPS_DELAY). A short
+//    history of the state is kept; a fix is compared with the state of its epoch, and the
+//    correction maps to the present through the motion model (H * Phi(-delay)), as PX4's EKF2
+//    fuses delayed measurements on a delayed horizon and predicts forward.
+//  * Output smoothing: every correction is applied to the filter at once (it stays consistent);
+//    what the controllers see glides after it at most at `max_pos_correction_mps` /
+//    `max_vel_correction_mps2`. In steady fusion that is invisible (millimetres per fix); after
+//    a dropout the estimate glides back to the GPS instead of jumping, so the controller is not
+//    kicked.
 //
 //   Estimator est(EstimatorParams{});
 //   for each sample: const StateEstimate& s = est.Update(sample);  // valid once aligned
 #pragma once
+
+#include <array>
+#include <cstddef>
 
 #include "swarmbox/flight/types.hpp"
 
@@ -33,17 +50,32 @@ struct EstimatorParams {
   double mag_ki = 0.01;             // yaw gyro bias gain [(rad/s^2)/rad]
   double align_time_s = 1.0;        // high-gain alignment period after start [s]
   double acc_gate_mps2 = 2.5;       // skip tilt correction when |f| differs from expected by more
+  bool tilt_ref_from_filter = true;  // tilt reference in flight: the filter's acceleration, or
+                                    // (false) differentiated GPS velocity; see UpdateAttitude
   double gps_acc_tau_s = 0.5;       // low-pass of the GPS-derived acceleration [s]
   double gps_acc_deadband_mps2 = 0.3;  // soft dead band on it [m/s^2]
   Vec3 mag_field_world = Vec3(0.0, 0.21, -0.42);  // Earth field, ENU (only its horizontal
                                                    // direction matters) [gauss]
   // Translational Kalman filters.
   double accel_noise_mps2 = 0.2;   // process noise on the IMU-derived acceleration [m/s^2]
-  double accel_bias_walk = 0.01;    // bias random walk [m/s^2 / sqrt(s)]
+                                   // (EKF2_ACC_NOISE; covers attitude errors too)
+  double accel_bias_walk = 0.01;    // bias random walk [m/s^2 / sqrt(s)] (EKF2_ACC_B_NOISE)
   double baro_bias_walk = 0.003;     // barometer offset random walk [m / sqrt(s)]
-  double gps_pos_h_std_m = 0.8;     // measurement noise (from the airframe's GPS spec)
-  double gps_pos_v_std_m = 1.5;
-  double gps_vel_std_mps = 0.1;
+  double gps_pos_h_std_m = 0.8;     // total GPS accuracy, 1 sigma per axis (the airframe's GPS
+  double gps_pos_v_std_m = 1.5;     // spec): the prior of the GPS error state [m]
+  double gps_noise_h_m = 0.2;       // fix-to-fix (white) GPS noise (EKF2_GPS_P_NOISE) [m]
+  double gps_noise_v_m = 0.5;
+  double gps_bias_walk_h = 0.002;   // GPS error random walk [m / sqrt(s)]. Horizontally ~0: the
+                                    // state holds the offset learnt at a known start, and the
+                                    // position follows the receiver's wander (seconds cannot
+                                    // tell it from motion; PX4's EKF2 follows GPS the same way).
+  double gps_frame_walk_h = 0.046;  // the receiver frame's horizontal wander (multipath), as a
+                                    // random walk of the position itself, sqrt(2 0.25^2 / 60 s)
+                                    // [m / sqrt(s)]: what lets the position follow it
+  double gps_bias_walk_v = 0.11;    // Vertically the wander's, sqrt(2 0.55^2 / 60 s): height
+                                    // follows the barometer, GPS only anchors it.
+  double gps_delay_s = 0.12;        // age of a fix when it arrives (EKF2_GPS_DELAY) [s]
+  double gps_vel_std_mps = 0.1;     // GPS velocity noise (EKF2_GPS_V_NOISE) [m/s]
   double baro_std_m = 0.15;
   double gps_timeout_s = 0.5;       // no fix for this long: GPS lost
   double max_pos_correction_mps = 1.0;    // slew limit of the position correction [m/s]
@@ -66,22 +98,32 @@ class Estimator {
   const StateEstimate& state() const { return state_; }
   const Vec3& gyro_bias() const { return gyro_bias_; }
   const Vec3& accel_bias_world() const { return acc_bias_; }
+  // The estimated GPS position error (fix minus true position), world ENU [m].
+  Vec3 gps_error_estimate() const { return Vec3(ax_[0].x(3), ax_[1].x(3), ax_[2].x(3)); }
 
  private:
-  // Per-axis Kalman filter, states [p, v, b_acc, b_baro], the last used on z only.
+  using Vec5 = Eigen::Matrix<double, 5, 1>;
+  using Mat5 = Eigen::Matrix<double, 5, 5>;
+  using Row5 = Eigen::Matrix<double, 1, 5>;
+  static constexpr std::size_t kHistory = 128;  // >= gps_delay_s / control period (0.5 s at 4 ms)
+  // Per-axis Kalman filter, states [p, v, b_acc, b_gps, b_baro], the last used on z only, and
+  // the history of its position and velocity for delayed measurements.
   struct Axis {
-    Eigen::Vector4d x = Eigen::Vector4d::Zero();
-    Eigen::Matrix4d p = Eigen::Matrix4d::Zero();
-    int n = 3;  // states in use
-    double pending_p = 0.0;  // GPS corrections still to glide in [m], [m/s]
-    double pending_v = 0.0;
+    Vec5 x = Vec5::Zero();
+    Mat5 p = Mat5::Zero();
+    int n = 4;  // states in use
+    double out_dp = 0.0;  // corrections not yet passed to the output [m], [m/s]
+    double out_dv = 0.0;
+    std::array<double, kHistory> hist_p{}, hist_v{};
   };
   void InitAttitude(const SensorSample& s);
   void UpdateAttitude(const SensorSample& s, double dt);
-  void Predict(Axis* ax, double acc, double dt) const;
-  // Measurement of state `idx` (plus the baro offset when `with_baro_bias`), variance r.
-  // glide: position/velocity corrections are applied by Predict() at bounded rates.
-  void Correct(Axis* ax, double z, double r, bool with_baro_bias, int idx, bool glide) const;
+  void Predict(Axis* ax, int axis, double acc, double dt) const;
+  // Scalar measurement with row h, innovation y, variance r; the correction is also carried into
+  // the history (mapped back through the motion model) and into the output glide.
+  void Correct(Axis* ax, const Row5& h, double y, double r) const;
+  // History slot `age` steps back (0 = now) and its age [s].
+  std::size_t HistIndex(std::size_t age) const { return (hist_head_ + kHistory - 1 - age) % kHistory; }
 
   EstimatorParams params_;
   StateEstimate state_;
@@ -99,6 +141,9 @@ class Estimator {
   double last_gps_vel_t_s_ = -1.0;
   Vec3 acc_world_ = Vec3::Zero();    // last IMU acceleration in the world, gravity removed
   Axis ax_[3];
+  std::array<double, kHistory> hist_t_{};  // times of the history slots [s]
+  std::size_t hist_head_ = 0;
+  std::size_t hist_count_ = 0;
   double baro_pending_ = 0.0;
   bool baro_seen_ = false;
   bool at_rest_ = false;

@@ -75,6 +75,7 @@ class FlightController {
 
   FlightMode mode() const { return mode_; }
   const StateEstimate& estimate() const { return estimator_.state(); }
+  const Estimator& estimator() const { return estimator_; }
   const ControllerTelemetry& telemetry() const { return telemetry_; }
   const FlightConfig& config() const { return config_; }
   const Mixer& mixer() const { return mixer_; }
