@@ -212,7 +212,8 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
         break;
       }
       Hold({drop_xy_m_.x(), drop_xy_m_.y(), transit_z}, cruise, true, out);
-      if ((p.head<2>() - drop_xy_m_).norm() <= 1.0 && in.velocity_m_s.norm() < 0.5) {
+      if ((p.head<2>() - drop_xy_m_).norm() <= config_.arrive_tolerance_m &&
+          in.velocity_m_s.norm() < config_.arrive_speed_m_s) {
         Enter(Stage::kDescendToRelease, in, out);
       }
       break;
@@ -267,7 +268,8 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
       }
       Hold({home_xy.x(), home_xy.y(), transit_z}, victim_ != 0 ? config_.loaded_speed_m_s : cruise,
            in.payload_attached, out);
-      if ((p.head<2>() - home_xy).norm() <= 1.0 && in.velocity_m_s.norm() < 0.5) {
+      if ((p.head<2>() - home_xy).norm() <= config_.arrive_tolerance_m &&
+          in.velocity_m_s.norm() < config_.arrive_speed_m_s) {
         Enter(in.payload_attached ? Stage::kDescendToDrop : Stage::kMoveToLandingPoint, in, out);
       }
       break;

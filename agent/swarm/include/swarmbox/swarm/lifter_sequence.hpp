@@ -71,6 +71,11 @@ struct LifterConfig {
   // than release_speed_m_s for settle_time_s (a slung load keeps the lifter moving a little).
   double release_tolerance_m = 2.0;
   double release_speed_m_s = 2.5;
+  // Arrival over the drop point or home at transit altitude (then the descent starts): within
+  // arrive_tolerance_m and slower than arrive_speed_m_s (a heavy swinging load keeps the lifter
+  // circling slowly around its target; the descent is a position hold on the same point).
+  double arrive_tolerance_m = 1.5;
+  double arrive_speed_m_s = 1.0;
   double attach_retry_s = 3.0;
   double proposal_retry_s = 2.0;
 
