@@ -70,17 +70,14 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
   return argv;
 }
 
-// swarmbox-agent (agent/app/main.cpp --help). Flags the agent does not know make it exit 2, so a
-// flag is passed only once agent/app/main.cpp has it (these switches say which ones it has).
-constexpr bool kAgentHasMissionFlags = true;   // --mission, --world, --payload, --inference-latency-ms
-constexpr bool kAgentHasPingFlag = false;      // --ping-every-ms
-
 std::string Members(const dsl::TrialSpec& spec) {
   std::string out;
   for (const dsl::DroneSpec& d : spec.drones) out += (out.empty() ? "" : ",") + d.name;
   return out;
 }
 
+// swarmbox-agent (agent/app/main.cpp --help): the shared contract's flags. An agent given a flag it
+// does not know exits 2, so a new flag goes here only once agent/app/main.cpp has it.
 std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
   std::vector<std::string> argv = {
       images::kAgentBinaryInImage,
@@ -99,13 +96,11 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
       "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
   };
-  if (kAgentHasPingFlag) {
-    argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
-  }
+  // The radio link measurement (event=link per peer).
+  argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
   if (spec.mission.kind == dsl::MissionKind::kPlan) {
-    if (kAgentHasMissionFlags) argv.insert(argv.end(), {"--mission", "plan"});
-    argv.insert(argv.end(), {"--plan", spec.mission.plan});
-  } else if (kAgentHasMissionFlags) {
+    argv.insert(argv.end(), {"--mission", "plan", "--plan", spec.mission.plan});
+  } else {
     argv.insert(argv.end(), {"--mission", "sar", "--world", InContainer(spec.world),
                              "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
     // The lifter starts with its payload on the ground under it (as the physics server places it).
