@@ -76,6 +76,7 @@ int ExperimentCommand(const ExperimentArgs& args) {
   const std::string workdir = "/tmp/swarmbox-" + run_id;
   std::vector<std::unique_ptr<hosts::Host>> connected(host_specs->size());
   std::vector<runner::Images> images(host_specs->size());
+  std::vector<std::string> faults_images(host_specs->size());
   std::mutex say_mu;
   std::vector<std::thread> threads;
   for (std::size_t i = 0; i < host_specs->size(); ++i) {
@@ -99,7 +100,19 @@ int ExperimentCommand(const ExperimentArgs& args) {
                   << " left out: images: " << built.error().ToString() << "\n";
         return;
       }
+      auto faults = experiment::EnsurePlanFaultsImage(*plan, (*host)->api(), [&](std::string_view line) {
+        if (args.quiet) return;
+        std::lock_guard lock(say_mu);
+        std::cerr << "  [" << hs.name() << "] " << line << "\n";
+      });
+      if (!faults) {
+        std::lock_guard lock(say_mu);
+        std::cerr << "swarmbox experiment: host " << hs.name()
+                  << " left out: images: " << faults.error().ToString() << "\n";
+        return;
+      }
       images[i] = *built;
+      faults_images[i] = *faults;
       connected[i] = std::move(*host);
     });
   }
@@ -108,7 +121,8 @@ int ExperimentCommand(const ExperimentArgs& args) {
   for (std::size_t i = 0; i < connected.size(); ++i) {
     if (!connected[i]) continue;
     hosts::Host* h = connected[i].get();
-    pool.push_back({h->name(), h->slots(), &h->api(), [h] { return h->Check(); }, images[i]});
+    pool.push_back({h->name(), h->slots(), &h->api(), [h] { return h->Check(); }, images[i],
+                    faults_images[i]});
   }
   if (pool.empty()) {
     std::cerr << "swarmbox experiment: no host is usable (see above)\n";

@@ -17,6 +17,8 @@
 #include "swarmbox/report/report_html.hpp"
 #include "swarmbox/report/results_csv.hpp"
 #include "swarmbox/report/trial_record.hpp"
+#include "swarmbox/runner/fault_image.hpp"
+#include "swarmbox/runner/plan.hpp"
 
 namespace swarmbox::experiment {
 
@@ -107,6 +109,7 @@ class TrialExecutor final : public HostWorker {
     o.trial_id = t.id;
     o.host = host_.name;
     o.images = host_.images;
+    if (!host_.faults_image.empty()) o.faults_image = host_.faults_image;
     o.interrupted = eo.interrupted;
     std::ofstream log(fs::path(*staging) / "orchestrator.log");
     o.progress = &log;
@@ -233,6 +236,17 @@ Result<ExperimentPlan> PlanExperiment(const ExperimentSpec& spec) {
     plan.specs.emplace(t.id, std::move(*trial));
   }
   return plan;
+}
+
+Result<std::string> EnsurePlanFaultsImage(const ExperimentPlan& plan, docker::DockerApi& api,
+                                          const std::function<void(std::string_view)>& progress) {
+  const bool needed = std::any_of(plan.specs.begin(), plan.specs.end(), [](const auto& kv) {
+    return runner::NeedsFaultSidecars(kv.second);
+  });
+  if (!needed) return std::string();
+  auto netemd = runner::FindNetemd("");
+  if (!netemd) return netemd.error().Context("the fault sidecar image");
+  return runner::EnsureFaultsImage(api, *netemd, progress);
 }
 
 Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::string>* problems) {

@@ -12,7 +12,8 @@
 // and between = experiment wall x slots - the sum of the trials' wall times (scheduling, commits,
 // report). orchestration_share = (launch + teardown + between) / (wall x slots).
 // Options: --slots=N (default 1), --repetitions=N (default: the file's), --experiment=FILE (another
-// experiment, e.g. trials/experiments/radio.yaml), --filter=PATTERN, --quick (1 repetition, codes
+// experiment, e.g. trials/experiments/radio.yaml), --filter=PATTERN, --rtf=X (physics.rtf of every
+// trial), --quick (1 repetition, codes
 // with the first factor at level a: 2 trials of hover_grid). Fails (exit 1) when no engine answers
 // or a trial has no result.
 #include <unistd.h>
@@ -80,6 +81,7 @@ int RunExperimentBench(const bench::Args& args) {
   spec->repetitions = static_cast<int>(args.GetInt("repetitions", args.quick ? 1 : spec->repetitions));
   if (args.quick) spec->filter = {std::string("a") + std::string(spec->factors.size() - 1, '?')};
   if (const std::string f = args.Get("filter", ""); !f.empty()) spec->filter = {f};
+  if (const std::string rtf = args.Get("rtf", ""); !rtf.empty()) spec->set.push_back("physics.rtf=" + rtf);
   auto plan = experiment::PlanExperiment(*spec);
   if (!plan) {
     std::cerr << plan.error().ToString() << "\n";
@@ -103,9 +105,14 @@ int RunExperimentBench(const bench::Args& args) {
     std::cerr << "experiment bench: " << images.error().ToString() << "\n";
     return 1;
   }
+  auto faults = experiment::EnsurePlanFaultsImage(*plan, (*host)->api(), [](std::string_view) {});
+  if (!faults) {
+    std::cerr << "experiment bench: " << faults.error().ToString() << "\n";
+    return 1;
+  }
   hosts::Host* h = host->get();
   std::vector<experiment::PoolHost> pool = {
-      {h->name(), h->slots(), &h->api(), [h] { return h->Check(); }, *images}};
+      {h->name(), h->slots(), &h->api(), [h] { return h->Check(); }, *images, *faults}};
   experiment::ExperimentOptions o;
   o.out_dir = (out / "exp").string();
   o.run_id = run_id;

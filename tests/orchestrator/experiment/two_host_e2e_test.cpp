@@ -103,7 +103,7 @@ class TwoHostExperiment : public ::testing::Test {
       auto images = cli::EnsureTrialImages((*h)->api(), programs, [](std::string_view) {});
       ASSERT_TRUE(images) << s.name() << ": " << images.error().ToString();
       hosts::Host* raw = h->get();
-      p->pool.push_back({raw->name(), raw->slots(), &raw->api(), [raw] { return raw->Check(); }, *images});
+      p->pool.push_back({raw->name(), raw->slots(), &raw->api(), [raw] { return raw->Check(); }, *images, ""});
       p->hosts.push_back(std::move(*h));
     }
   }

@@ -50,7 +50,14 @@ struct PoolHost {
   docker::DockerApi* api = nullptr;
   std::function<Status()> check;  // does the engine answer now (with the host-level reason)
   runner::Images images;          // the images built on this host
+  std::string faults_image;       // the fault sidecar image on this host ("" = none needed, or
+                                  // let the runner build it per trial)
 };
+
+// The fault sidecar image on `api` when some trial of the plan impairs the mesh (built once per
+// host instead of once per trial); "" when no trial needs it.
+Result<std::string> EnsurePlanFaultsImage(const ExperimentPlan& plan, docker::DockerApi& api,
+                                          const std::function<void(std::string_view)>& progress);
 
 struct ExperimentOptions {
   std::string out_dir;
