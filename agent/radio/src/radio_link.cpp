@@ -28,7 +28,9 @@ RadioLink::~RadioLink() {
   wake_.notify_all();
   if (sender_.joinable()) sender_.join();
   subscriber_.reset();  // waits for a running callback; none after this
-  publisher_.reset();
+  ping_writers_.clear();
+  pong_writers_.clear();
+  other_pong_writer_.reset();
 }
 
 Result<std::unique_ptr<RadioLink>> RadioLink::Create(bus::Participant& mesh, std::string self,
@@ -54,9 +56,22 @@ Result<std::unique_ptr<RadioLink>> RadioLink::Create(bus::Participant& mesh, std
                  "radio link: no peer to ping besides '" + self + "'");
   }
   std::unique_ptr<RadioLink> link(new RadioLink(std::move(self), std::move(unique), options));
-  auto pub = mesh.CreatePublisher<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio);
-  if (!pub) return std::move(pub).error().Context("radio link: creating the writer");
-  link->publisher_ = std::move(*pub);
+  // One writer per peer and direction (see the header: a best-effort reader drops what arrives
+  // out of order within one writer's stream).
+  auto writer = [&mesh]() {
+    return mesh.CreatePublisher<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio);
+  };
+  for (std::size_t i = 0; i < link->monitor_.peers().size(); ++i) {
+    auto ping = writer();
+    if (!ping) return std::move(ping).error().Context("radio link: creating a ping writer");
+    link->ping_writers_.push_back(std::move(*ping));
+    auto pong = writer();
+    if (!pong) return std::move(pong).error().Context("radio link: creating a pong writer");
+    link->pong_writers_.push_back(std::move(*pong));
+  }
+  auto other = writer();
+  if (!other) return std::move(other).error().Context("radio link: creating the writer");
+  link->other_pong_writer_ = std::move(*other);
   RadioLink* raw = link.get();
   auto sub = mesh.CreateSubscriber<bus::RadioPing>(
       bus::kRadioPingTopic, bus::Qos::kRadio, [raw](const bus::RadioPing& m) { raw->OnSample(m); });
@@ -106,7 +121,7 @@ void RadioLink::SenderLoop() {
       msg.to = p.to;
       msg.seq = p.seq;
       msg.sent_wall_ns = p.sent_wall_ns;
-      Publish(msg);
+      Publish(PongWriter(p.to), msg);
       pings_answered_.fetch_add(1, std::memory_order_relaxed);
     }
     pongs.clear();
@@ -115,17 +130,25 @@ void RadioLink::SenderLoop() {
       msg.to = monitor_.peers()[p.peer];  // peers() never changes after construction
       msg.seq = p.seq;
       msg.sent_wall_ns = SteadyNs(now);
-      Publish(msg);
+      Publish(*ping_writers_[p.peer], msg);
       pings_sent_.fetch_add(1, std::memory_order_relaxed);
     }
     lk.lock();
   }
 }
 
-void RadioLink::Publish(const bus::RadioPing& m) {
+void RadioLink::Publish(bus::Publisher<bus::RadioPing>& writer, const bus::RadioPing& m) {
   // Best effort like the radio: a failed publish is not retried; the monitor then sees the ping
   // (or the peer's ping, for a pong) as lost.
-  if (!publisher_->Publish(m)) send_errors_.fetch_add(1, std::memory_order_relaxed);
+  if (!writer.Publish(m)) send_errors_.fetch_add(1, std::memory_order_relaxed);
+}
+
+bus::Publisher<bus::RadioPing>& RadioLink::PongWriter(const std::string& to) {
+  const std::vector<std::string>& peers = monitor_.peers();  // never changes after construction
+  for (std::size_t i = 0; i < peers.size(); ++i) {
+    if (peers[i] == to) return *pong_writers_[i];
+  }
+  return *other_pong_writer_;
 }
 
 void RadioLink::OnSample(const bus::RadioPing& m) {
