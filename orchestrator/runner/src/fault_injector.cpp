@@ -180,11 +180,34 @@ Verdict FaultInjector::Setup() {
   return failure ? *failure : Verdict::Success();
 }
 
+Status FaultInjector::RunOnSidecars(const std::map<std::string, std::vector<faults::Command>>& per_drone,
+                                    bool run_all) {
+  // Every sidecar at once, so a fault on several drones starts (and ends) on all of them together;
+  // the first failure in trial order is returned.
+  std::vector<std::pair<std::string, std::future<Status>>> jobs;
+  for (const std::string& drone : config_.drones) {
+    auto it = per_drone.find(drone);
+    if (it == per_drone.end()) continue;
+    faults::CommandRunner& sidecar = Sidecar(drone);
+    jobs.emplace_back(drone, std::async(std::launch::async, [&sidecar, commands = it->second, run_all] {
+                        return run_all ? faults::RunAllCommands(sidecar, commands)
+                                       : faults::RunCommands(sidecar, commands);
+                      }));
+  }
+  Status first = Ok{};
+  for (auto& [drone, job] : jobs) {
+    Status s = job.get();
+    if (!s && first) first = s.error().Context(drone);
+  }
+  return first;
+}
+
 Status FaultInjector::ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,
                                   const std::vector<std::string>& changed) {
   if (!mechanism_) {
     return Error(ErrorCode::kInternal, "radio fault before the mechanism was detected (no sidecars?)");
   }
+  std::map<std::string, std::vector<faults::Command>> commands;
   for (const std::string& drone : changed) {
     auto it = before.find(drone);
     const std::vector<faults::RadioRule> from =
@@ -192,10 +215,10 @@ Status FaultInjector::ChangeRadio(const std::map<std::string, std::vector<faults
     const auto to = layers_.Effective(drone);
     auto plan = faults::PlanRadioChange(from, to, LinkOf(drone), *mechanism_, PlanOptions());
     if (!plan) return plan.error().Context(drone);
-    installed_[drone] = to;
-    SWARMBOX_TRY(faults::RunCommands(Sidecar(drone), plan->apply));
+    commands[drone] = plan->apply;
   }
-  return Ok{};
+  for (const std::string& drone : changed) installed_[drone] = layers_.Effective(drone);
+  return RunOnSidecars(commands, /*run_all=*/false);
 }
 
 Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record) {
@@ -225,8 +248,7 @@ Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record)
     for (const auto& group : plan->groups) record->targets.insert(record->targets.end(), group.begin(), group.end());
     targets_[index] = record->targets;
     partitions_[index] = *plan;  // stored first: a half-applied partition is healed too
-    for (const auto& [node, commands] : plan->apply) SWARMBOX_TRY(faults::RunCommands(Sidecar(node), commands));
-    return Ok{};
+    return RunOnSidecars(plan->apply, /*run_all=*/false);
   }
   if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
     record->mechanism = "docker";
@@ -271,11 +293,7 @@ Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record
     record->mechanism = "iptables";
     auto it = partitions_.find(index);
     if (it == partitions_.end()) return Ok{};
-    Status first = Ok{};
-    for (const auto& [node, commands] : it->second.undo) {
-      Status s = faults::RunAllCommands(Sidecar(node), commands);
-      if (!s && first) first = s;
-    }
+    Status first = RunOnSidecars(it->second.undo, /*run_all=*/true);
     partitions_.erase(it);
     return first;
   }

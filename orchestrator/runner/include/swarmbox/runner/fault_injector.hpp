@@ -91,6 +91,9 @@ class FaultInjector {
   Status Remove(std::size_t index, faults::FaultEventRecord* record);
   Status ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,
                      const std::vector<std::string>& changed);
+  // Runs each drone's commands in its sidecar, all sidecars concurrently (RunCommands, or
+  // RunAllCommands for undo paths); the first failure in trial order.
+  Status RunOnSidecars(const std::map<std::string, std::vector<faults::Command>>& per_drone, bool run_all);
   faults::LinkTarget LinkOf(const std::string& drone) const;
   faults::RadioPlanOptions PlanOptions() const;
   faults::CommandRunner& Sidecar(const std::string& drone);
