@@ -13,7 +13,8 @@
 //      the last agent's `event=ready` (compose_ready_s), and the time `up -d` itself took; then
 //      `docker-compose down` (compose_down_s, for reference).
 // Every time comes from the engine (log line timestamps and `die` events, both on this host's real
-// time clock), watched by the bench itself, so both paths are measured the same way.
+// time clock), watched by the bench itself, so both paths are measured the same way. The exported
+// file's fixed subnets move to a free pair when another network on the engine holds them.
 // Aims (issue 6): ratio = run_ready_s / compose_ready_s <= 0.5; end_to_stopped_s < 1.
 #include <unistd.h>
 
@@ -24,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <set>
 #include <sstream>
@@ -35,6 +37,7 @@
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/runner/naming.hpp"
+#include "swarmbox/runner/subnets.hpp"
 
 namespace swarmbox {
 namespace {
@@ -183,6 +186,8 @@ std::string FindOnPath(const std::string& program) {
   return "";
 }
 
+std::string TrialName(int drones) { return "launch" + std::to_string(drones) + "-" + std::to_string(::getpid()); }
+
 // --set arguments: N x500 scouts on a 4 m grid, the end on the physics server's first clock line.
 std::vector<std::string> TrialSets(int drones) {
   std::string list = "[";
@@ -192,7 +197,9 @@ std::vector<std::string> TrialSets(int drones) {
             std::to_string((i % 5) * 4) + ", " + std::to_string((i / 5) * 4) + ", 0]}";
   }
   list += "]";
-  return {"--set", "name=launch" + std::to_string(drones),
+  // The name is per bench process: a network Docker failed to release in an earlier run ("has
+  // active endpoints" until the engine restarts) cannot be picked up by name.
+  return {"--set", "name=" + TrialName(drones),
           "--set", "drones=" + list,
           "--set", std::string("end=[{on: \"") + kEndPattern + "\", from: " + kEndComponent +
                        ", outcome: success}]",
@@ -216,11 +223,59 @@ std::string Fmt(std::optional<double> v) {
 
 double SecondsSince(std::int64_t from_ns) { return static_cast<double>(NowUnixNs() - from_ns) / 1e9; }
 
-void RemoveRun(docker::DockerApi& api, const std::string& run_id, std::size_t* left) {
+// Removes everything labelled with the run; networks whose endpoints Docker is still releasing
+// ("has active endpoints") are retried for a few seconds. `left`: what is still there afterwards.
+void RemoveRun(docker::DockerApi& api, const std::string& run_id, const std::string& trial,
+               std::size_t* left) {
   docker::LabelSelector run;
   run.equals[std::string(docker::kLabelRun)] = run_id;
-  auto removed = docker::RemoveLabelled(api, run, /*include_images=*/false);
-  if (removed) *left = removed->containers.size() + removed->networks.size();
+  run.equals[std::string(docker::kLabelTrial)] = trial;
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    auto removed = docker::RemoveLabelled(api, run, /*include_images=*/false);
+    if (removed && removed->failures.empty()) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  }
+  auto containers = api.ListContainers(run, /*all=*/true);
+  auto networks = api.ListNetworks(run);
+  *left = (containers ? containers->size() : 0) + (networks ? networks->size() : 0);
+}
+
+// The exported file's subnets are fixed (run id "compose"); when another network on this engine
+// holds one of them, both /24s move to a pair that is free (addresses keep their host part).
+// Timing does not depend on the addresses.
+Status MoveComposeSubnetsIfTaken(docker::DockerApi& api, const fs::path& file) {
+  std::string text = ReadWholeFile(file.string());
+  auto nets = api.ListNetworks({});
+  if (!nets) return nets.error();
+  std::vector<std::string> taken;
+  for (const auto& n : *nets) {
+    if (!n.subnet.empty()) taken.push_back(n.subnet);
+  }
+  auto exported = runner::PickSubnets(kComposeRunId, 0, {});
+  if (!exported) return exported.error();
+  const std::string sim = exported->sim.ToString(), mesh = exported->mesh.ToString();
+  if (std::find(taken.begin(), taken.end(), sim) == taken.end() &&
+      std::find(taken.begin(), taken.end(), mesh) == taken.end()) {
+    return Ok{};
+  }
+  auto free = runner::PickSubnets("launch-bench-" + std::to_string(::getpid()), 0, taken);
+  if (!free) return free.error();
+  auto prefix = [](const std::string& cidr) {  // "10.201.230.0/24" -> "10.201.230."
+    return cidr.substr(0, cidr.rfind('.') + 1);
+  };
+  auto replace_all = [&](const std::string& from, const std::string& to) {
+    for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size())) {
+      text.replace(at, from.size(), to);
+    }
+  };
+  replace_all("\"" + prefix(sim), "\"" + prefix(free->sim.ToString()));
+  replace_all("\"" + prefix(mesh), "\"" + prefix(free->mesh.ToString()));
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out << text;
+  if (!out) return Error(ErrorCode::kIo, "cannot rewrite", file.string());
+  std::fprintf(stderr, "launch: exported subnets %s and %s are taken on this engine; using %s and %s\n",
+               sim.c_str(), mesh.c_str(), free->sim.ToString().c_str(), free->mesh.ToString().c_str());
+  return Ok{};
 }
 
 struct ScenarioResult {
@@ -234,6 +289,7 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
   using std::chrono::steady_clock;
   const std::vector<std::string> agents = AgentNames(drones);
   const std::vector<std::string> sets = TrialSets(drones);
+  const std::string trial = TrialName(drones);
   std::ostringstream line;
   line << "suite=launch scenario=drones_" << drones << " drones=" << drones;
   auto fail = [&](const std::string& why) {
@@ -269,7 +325,7 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
       child->Signal(SIGINT);
       (void)child->Wait(minutes(1));
     }
-    RemoveRun(api, run_id, &run_left);
+    RemoveRun(api, run_id, trial, &run_left);
     for (const std::string& e : watch.Errors()) std::fprintf(stderr, "launch: %s\n", e.c_str());
     if (!ready || !code || *code != 0) {
       line << " run_exit=" << (code ? std::to_string(*code) : "hung") << " run_ready_s=" << Fmt(run_ready_s);
@@ -280,12 +336,15 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
   }
 
   // 2. The exported compose file, brought up by docker-compose.
-  const fs::path compose_file = scratch / ("launch" + std::to_string(drones) + ".compose.yaml");
+  const fs::path compose_file = scratch / ("launch" + std::to_string(drones) + ".compose.yaml");  // -o
   std::vector<std::string> export_argv = {kSwarmbox, "compose", kTrial, "-o", compose_file.string()};
   export_argv.insert(export_argv.end(), sets.begin(), sets.end());
   auto exported = cli::testing::RunToEnd(export_argv, minutes(2), scratch.string());
   if (!exported || exported->code != 0) {
     return fail("swarmbox compose: " + (exported ? exported->err : exported.error().ToString()));
+  }
+  if (Status moved = MoveComposeSubnetsIfTaken(api, compose_file); !moved) {
+    return fail("compose subnets: " + moved.error().ToString());
   }
   const std::string project = "swarmbox-bench-launch";
   std::optional<double> compose_ready_s, compose_up_s, compose_down_s;
@@ -298,9 +357,18 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
     const std::string err = (scratch / ("compose-" + std::to_string(drones) + ".err")).string();
     auto up = ChildProcess::Spawn({compose_exe, "-f", compose_file.string(), "-p", project, "up", "-d"}, "", err);
     if (!up) return fail(up.error().ToString());
-    const bool ready = watch.WaitReady(agents, steady_clock::now() + minutes(5));
-    const std::optional<int> code = up->Wait(minutes(5));
-    if (code) compose_up_s = SecondsSince(spawn_ns);  // up -d returns before the agents are ready
+    // Until every agent is ready; `up -d` returns before that (its time is noted), or fails.
+    const auto deadline = steady_clock::now() + minutes(5);
+    std::optional<int> code;
+    bool ready = false;
+    while (!ready && steady_clock::now() < deadline) {
+      if (!code && (code = up->Wait(std::chrono::milliseconds(0)))) {
+        compose_up_s = SecondsSince(spawn_ns);
+        if (*code != 0) break;
+      }
+      ready = watch.WaitReady(agents, steady_clock::now() + std::chrono::milliseconds(5));
+    }
+    if (!code && (code = up->Wait(minutes(2)))) compose_up_s = SecondsSince(spawn_ns);
     LaunchTimes times = watch.Times();
     times.spawn_ns = spawn_ns;
     compose_ready_s = cli::testing::ComputeLaunchFigures(times, agents).ready_s;
@@ -311,8 +379,13 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
     const std::int64_t down_ns = NowUnixNs();
     auto down = cli::testing::RunToEnd({compose_exe, "-f", compose_file.string(), "-p", project, "down", "-v"},
                                        minutes(5), scratch.string());
-    if (down && down->code == 0) compose_down_s = SecondsSince(down_ns);
-    RemoveRun(api, kComposeRunId, &compose_left);
+    if (down && down->code == 0) {
+      compose_down_s = SecondsSince(down_ns);
+    } else {
+      std::fprintf(stderr, "launch: docker-compose down (%d drones) failed: %s\n", drones,
+                   down ? down->err.c_str() : down.error().ToString().c_str());
+    }
+    RemoveRun(api, kComposeRunId, trial, &compose_left);
   }
 
   line << " run_ready_s=" << Fmt(run_ready_s) << " compose_ready_s=" << Fmt(compose_ready_s);
