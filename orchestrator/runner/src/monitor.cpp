@@ -51,10 +51,10 @@ std::optional<dsl::Verdict> Monitor::OnLine(std::string_view component, std::str
     ending_line_ = std::string(line);
     return End(std::move(*v));
   }
-  if (!timeout_.sim.zero() && sim_s_ >= timeout_.sim.seconds()) {
-    return End(dsl::Verdict::Of(timeout_.outcome,
-                                "simulated time ran out (" + timeout_.sim.ToString() + ")",
-                                "timeout"));
+  if (!timeout_pending_ && !timeout_.sim.zero() && sim_s_ >= timeout_.sim.seconds()) {
+    timeout_pending_ = dsl::Verdict::Of(
+        timeout_.outcome, "simulated time ran out (" + timeout_.sim.ToString() + ")", "timeout");
+    timeout_seen_wall_s_ = wall_s_;
   }
   return std::nullopt;
 }
@@ -63,6 +63,7 @@ std::optional<dsl::Verdict> Monitor::OnExit(std::string_view component, std::int
                                             bool oom_killed) {
   live_.erase(std::string(component));
   if (ended_) return std::nullopt;
+  if (timeout_pending_) return End(*timeout_pending_);
   std::string why = oom_killed ? std::string(component) + " was killed for lack of memory"
                                : std::string(component) + " exited with code " +
                                      std::to_string(exit_code) + " before the trial ended";
@@ -72,6 +73,9 @@ std::optional<dsl::Verdict> Monitor::OnExit(std::string_view component, std::int
 std::optional<dsl::Verdict> Monitor::OnTick(double wall_s) {
   if (wall_s > wall_s_) wall_s_ = wall_s;
   if (ended_) return std::nullopt;
+  if (timeout_pending_ && wall_s_ - timeout_seen_wall_s_ >= kTimeoutDrainS) {
+    return End(*timeout_pending_);
+  }
   if (!timeout_.wall_guard.zero() && wall_s_ >= timeout_.wall_guard.seconds()) {
     return End(dsl::Verdict::Err("wall-clock guard: " + timeout_.wall_guard.ToString() +
                                      " passed with simulated time at " + Seconds(sim_s()) + "s of " +

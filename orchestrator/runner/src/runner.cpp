@@ -156,7 +156,10 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   };
   Verdict start;
   for (int attempt = 0; attempt < std::max(1, o.subnet_attempts); ++attempt) {
-    auto subnets = PickSubnets(run_id, attempt, taken);
+    // Keyed by run and trial: an experiment's parallel trials share the run id and would all
+    // start from the same pair, racing for it.
+    auto subnets = PickSubnets(run_id + "/" + (o.trial_id.empty() ? info.name : o.trial_id),
+                               attempt, taken);
     if (!subnets) {
       start = Verdict::FromError(subnets.error(), "subnets");
       break;

@@ -68,7 +68,7 @@ bool Ipv4Net::Overlaps(const Ipv4Net& other) const {
   return (base & m) == (other.base & m);
 }
 
-Result<TrialSubnets> PickSubnets(std::string_view run_id, int attempt,
+Result<TrialSubnets> PickSubnets(std::string_view key, int attempt,
                                  const std::vector<std::string>& taken) {
   std::vector<Ipv4Net> used;
   for (const std::string& t : taken) {
@@ -80,7 +80,7 @@ Result<TrialSubnets> PickSubnets(std::string_view run_id, int attempt,
     }
     return true;
   };
-  const std::uint32_t start = Fnv1a(run_id) % kPoolPairs;
+  const std::uint32_t start = Fnv1a(key) % kPoolPairs;
   int skip = attempt;  // a retry moves past the pairs that lost a race before
   for (std::uint32_t i = 0; i < kPoolPairs; ++i) {
     const std::uint32_t pair = (start + i) % kPoolPairs;

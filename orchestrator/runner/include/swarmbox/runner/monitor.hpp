@@ -8,7 +8,12 @@
 //
 // Rules, first to fire wins (later inputs return nullopt):
 //   - an end condition matches a line                      -> its outcome and reason
-//   - simulated time (max `t=` of the clock component's log) reaches timeout.sim -> timeout.outcome
+//   - simulated time (max `t=` of the clock component's log) reaches timeout.sim -> timeout.outcome,
+//     after a drain window of kTimeoutDrainS wall seconds: the containers' logs are separate
+//     streams, so an agent's ending line stamped before the timeout can reach us after the clock
+//     component's line that crossed it (seen at rtf 0, where simulated time races ahead). Lines
+//     that match an end condition during the window still win; a container exiting during it
+//     (the physics server stops at the timeout) confirms the timeout.
 //   - a started container exits                            -> failure "<c> exited with code N"
 //   - wall time reaches timeout.wall_guard                  -> error "wall-clock guard: ..."
 #pragma once
@@ -27,6 +32,8 @@ namespace swarmbox::runner {
 
 class Monitor {
  public:
+  static constexpr double kTimeoutDrainS = 1.0;
+
   static Result<Monitor> Create(dsl::Trial& trial);
 
   void Started(std::string_view component);
@@ -62,6 +69,8 @@ class Monitor {
   std::set<std::string> live_;
   std::deque<std::string> last_events_;  // "<component> <event>", newest last
   std::optional<dsl::Verdict> ended_;
+  std::optional<dsl::Verdict> timeout_pending_;  // simulated time ran out; draining the streams
+  double timeout_seen_wall_s_ = 0;
   std::string ending_line_;
 };
 

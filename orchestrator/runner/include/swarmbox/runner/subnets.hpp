@@ -40,9 +40,10 @@ inline constexpr std::uint32_t kPhysicsHost = 2;
 inline constexpr std::uint32_t kGroundHost = 3;
 inline constexpr std::uint32_t kFirstDroneHost = 10;
 
+// `key` picks the first candidate pair (the runner passes "<run id>/<trial id>").
 // `taken`: CIDRs of networks already on the host (unparseable entries are ignored). Fails with
 // kUnavailable when the whole pool is taken.
-Result<TrialSubnets> PickSubnets(std::string_view run_id, int attempt,
+Result<TrialSubnets> PickSubnets(std::string_view key, int attempt,
                                  const std::vector<std::string>& taken);
 
 }  // namespace swarmbox::runner
