@@ -6,6 +6,7 @@
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/images/ensure_image.hpp"
 #include "swarmbox/images/standard_images.hpp"
+#include "swarmbox/runner/fault_image.hpp"
 
 namespace swarmbox::cli {
 
@@ -29,7 +30,12 @@ int ImagesCommand(const ImagesArgs& args) {
   auto agent = FindProgram("swarmbox-agent", args.programs.agent_bin);
   wanted.push_back({"agent", agent ? Result<images::ImageSpec>(images::AgentImage(*agent))
                                    : Result<images::ImageSpec>(agent.error())});
-  if (args.faults) wanted.push_back({"faults", images::FaultToolsImage()});
+  if (args.faults) {
+    // The image the runner's fault sidecars use: tc, iptables and swarmbox-netemd.
+    auto netemd = runner::FindNetemd("");
+    wanted.push_back({"faults", netemd ? images::FaultSidecarImage(*netemd)
+                                       : Result<images::ImageSpec>(netemd.error())});
+  }
   int failures = 0;
   for (Wanted& w : wanted) {
     if (!w.spec) {
