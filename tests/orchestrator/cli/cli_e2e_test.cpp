@@ -223,8 +223,14 @@ TEST_F(CliE2eTest, GcRemovesWhatKilledRunsLeft) {
   EXPECT_EQ(Left(b).networks, 2u);
 
   // and `swarmbox gc` removes every run's leftovers (B's, and any other run's on this engine).
+  // (Exit 3 is right when the engine refuses to remove some other run's network: Docker 20.10 can
+  // keep a stale endpoint on a network until it restarts, "has active endpoints". Nothing of A or
+  // B may be among the failures.)
   testing::Finished gc_all = Swarmbox({"gc"});
-  EXPECT_EQ(gc_all.code, 0) << gc_all.err;
+  EXPECT_TRUE(gc_all.code == 0 || (gc_all.code == 3 && gc_all.err.find("has active endpoints") != std::string::npos))
+      << gc_all.code << ": " << gc_all.err;
+  EXPECT_EQ(gc_all.err.find(a), std::string::npos) << gc_all.err;
+  EXPECT_EQ(gc_all.err.find(b), std::string::npos) << gc_all.err;
   EXPECT_THAT(gc_all.out, HasSubstr("removed "));
   EXPECT_EQ(Left(b).containers, 0u);
   EXPECT_EQ(Left(b).networks, 0u);
