@@ -1,6 +1,8 @@
 // swarmbox-physics: the world of a trial on the sim bus. A thin shell: options -> World ->
 // BusTransport -> SimServer. See `swarmbox-physics --help`.
 // Exit codes: 0 done (max sim time or SIGTERM/SIGINT), 2 bad input, 3 infrastructure (bus, files).
+// `--send-command <target> <command> [args...]` instead: one world command to a running server
+// (send_command_main.hpp; how the orchestrator's sensor and environment faults reach it).
 #include <CLI/CLI.hpp>
 
 #include <atomic>
@@ -10,6 +12,7 @@
 #include <numbers>
 
 #include "bus_transport.hpp"
+#include "send_command_main.hpp"
 #include "server_options.hpp"
 #include "sim_server.hpp"
 #include "swarmbox/common/logfmt.hpp"
@@ -31,6 +34,7 @@ int Fail(int code, const std::string& message) {
 int main(int argc, char** argv) {
   using namespace swarmbox;
   using namespace swarmbox::physics;
+  if (IsSendCommand(argc, argv)) return RunSendCommand(argc, argv);
   ServerOptions o;
   std::vector<std::string> drone_args;
   std::string drones_file;

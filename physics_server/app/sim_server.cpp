@@ -6,6 +6,8 @@
 #include <span>
 #include <thread>
 
+#include "world_commands.hpp"
+
 namespace swarmbox::physics {
 
 std::int64_t SteadyWallClock::NowNs() {
@@ -79,31 +81,25 @@ void SimServer::Apply(const WorldCommandInput& cmd) {
   }
   const std::int64_t now = world_.time_ns();
   auto seconds = [](double s) { return static_cast<std::int64_t>(s * 1e9); };
+  if (Status ok = CheckWorldCommand(cmd.command, drone.has_value(), cmd.args); !ok) {
+    return reject(ok.error().message());
+  }
   if (cmd.command == "gps_dropout") {
-    if (!drone || cmd.args.size() != 1 || !(cmd.args[0] > 0)) return reject("needs a drone and duration_s > 0");
     world_.SetGpsDropout(*drone, true);
     timed_.push_back({now + seconds(cmd.args[0]), *drone, Timed::kGpsBack});
   } else if (cmd.command == "gps_degrade") {
-    if (!drone || cmd.args.size() != 3 || !(cmd.args[0] > 0) || !(cmd.args[1] > 0) || !(cmd.args[2] > 0)) {
-      return reject("needs a drone, duration_s, h_acc_m, v_acc_m > 0");
-    }
     world_.SetGpsAccuracy(*drone, cmd.args[1], cmd.args[2]);
     timed_.push_back({now + seconds(cmd.args[0]), *drone, Timed::kGpsAccuracyBack});
   } else if (cmd.command == "imu_bias_jump") {
-    if (!drone || cmd.args.size() != 6) return reject("needs a drone and ax, ay, az, gx, gy, gz");
     world_.AddImuBias(*drone, {cmd.args[0], cmd.args[1], cmd.args[2]}, {cmd.args[3], cmd.args[4], cmd.args[5]});
   } else if (cmd.command == "wind_gust") {
-    if (cmd.args.size() != 4 || !(cmd.args[3] > 0)) return reject("needs vx, vy, vz, duration_s > 0");
     WindConfig gust = base_wind_;
     gust.mean_m_s = base_wind_.mean_m_s + Vec3{cmd.args[0], cmd.args[1], cmd.args[2]};
     world_.SetWind(gust);
     timed_.push_back({now + seconds(cmd.args[3]), 0, Timed::kWindBack});
-  } else if (cmd.command == "payload_attach" || cmd.command == "payload_release") {
-    if (!drone) return reject("needs a drone");
+  } else {  // payload_attach / payload_release (the table knows no other name)
     const Status s = cmd.command == "payload_attach" ? world_.AttachPayload(*drone) : world_.ReleasePayload(*drone);
     if (!s) return reject(s.error().message());
-  } else {
-    return reject("not supported by this physics server");
   }
   Log(LogEvent(t, options_.node, "world_command").Add("command", cmd.command).Add("target", cmd.target));
 }

@@ -1,0 +1,13 @@
+// The `--send-command` mode of swarmbox-physics (send_command_main.cpp): main() hands the whole
+// command line over when it sees that flag.
+#pragma once
+
+namespace swarmbox::physics {
+
+// Whether argv asks for the one-shot sender.
+bool IsSendCommand(int argc, char** argv);
+// `--send-command <target> <command> [args...] [--sim-interface I] [--domain D] [--middleware M]
+// [--match-timeout S]`; returns the exit code (0 sent, 2 bad input, 3 no server / bus failure).
+int RunSendCommand(int argc, char** argv);
+
+}  // namespace swarmbox::physics
