@@ -15,11 +15,7 @@ using faults::TimelineAction;
 
 namespace {
 
-bool IsWorldFault(const faults::Fault& f) {
-  return std::holds_alternative<faults::GpsDropout>(f.action) ||
-         std::holds_alternative<faults::ImuBias>(f.action) ||
-         std::holds_alternative<faults::WindGust>(f.action);
-}
+constexpr std::string_view kPhysicsMechanism = "physics-command";
 
 std::string MechanismEventJson(const std::string& host, faults::Mechanism mechanism, bool cached,
                                double wall_s) {
@@ -73,6 +69,26 @@ faults::CommandRunner& FaultInjector::Sidecar(const std::string& drone) {
   return *it->second;
 }
 
+Status FaultInjector::SendToPhysics(const std::vector<faults::WorldCommandCall>& calls) {
+  if (!physics_runner_) {
+    physics_runner_ = std::make_unique<faults::DockerExecCommandRunner>(api_, config_.physics_container);
+  }
+  // One exec per call, all at once (each waits up to ~1 s for the bus): a fault on several drones
+  // starts on all of them together. The first failure in call order.
+  std::vector<std::future<Status>> jobs;
+  for (const faults::WorldCommandCall& call : calls) {
+    jobs.push_back(std::async(std::launch::async, [this, argv = config_.physics_command_argv(call)] {
+      return faults::RunCommands(*physics_runner_, {faults::Command{argv, false}});
+    }));
+  }
+  Status first = Ok{};
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    Status s = jobs[i].get();
+    if (!s && first) first = s.error().Context("sending " + faults::WorldCommandText(calls[i]) + " to the physics server");
+  }
+  return first;
+}
+
 faults::LinkTarget FaultInjector::LinkOf(const std::string& drone) const {
   faults::LinkTarget link;
   link.node = drone;
@@ -94,10 +110,9 @@ Verdict FaultInjector::Setup() {
   if (set_up_) return Verdict::Success();
   set_up_ = true;
   for (const faults::Fault& f : config_.faults) {
-    if (IsWorldFault(f)) {
+    if (faults::IsPhysicsFault(f) && (config_.physics_container.empty() || !config_.physics_command_argv)) {
       return Verdict::Err("fault " + f.id + " (" + std::string(f.kind()) + ", " + f.mark.ToString() +
-                              ") cannot be carried out: the physics server takes no sensor or "
-                              "environment fault commands yet",
+                              ") cannot be carried out: no physics server container to send it to",
                           "faults");
     }
   }
@@ -275,6 +290,20 @@ Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record)
     }
     return s;
   }
+  if (faults::IsPhysicsFault(f)) {
+    record->mechanism = std::string(kPhysicsMechanism);
+    std::vector<std::string> targets;
+    if (const faults::FaultTarget* target = f.target()) {
+      auto resolved = faults::ResolveTarget(*target, config_.drones, leaders_, rng_);
+      if (!resolved) return resolved.error();
+      targets = *resolved;
+    }
+    record->targets = targets;
+    targets_[index] = targets;
+    faults::PhysicsPlan plan = faults::PlanPhysicsFault(f, targets);
+    physics_[index] = plan;  // stored first: a half-applied bias jump is taken back too
+    return SendToPhysics(plan.apply);
+  }
   return Error(ErrorCode::kInvalidArgument,
                "fault " + f.id + " (" + std::string(f.kind()) + ") cannot be carried out by the runner",
                f.mark.ToString());
@@ -321,6 +350,16 @@ Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record
     }
     processes_.erase(it);
     return s;
+  }
+  if (faults::IsPhysicsFault(f)) {
+    // gps_dropout and wind_gust end in the physics server itself (their duration travelled with
+    // the command); an imu_bias with a duration is taken back by the negated jump.
+    record->mechanism = std::string(kPhysicsMechanism);
+    auto it = physics_.find(index);
+    if (it == physics_.end()) return Ok{};
+    const std::vector<faults::WorldCommandCall> undo = it->second.undo;
+    physics_.erase(it);
+    return SendToPhysics(undo);
   }
   return Ok{};
 }

@@ -70,6 +70,22 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
   return argv;
 }
 
+}  // namespace
+
+std::vector<std::string> PhysicsCommandArgv(dsl::Middleware middleware, const faults::WorldCommandCall& call) {
+  std::vector<std::string> argv = {
+      images::kPhysicsBinaryInImage,
+      "--sim-interface", std::string(kSimInterface),
+      "--domain", std::to_string(kSimDomain),
+      "--middleware", std::string(dsl::MiddlewareName(middleware)),
+      "--send-command", call.target.empty() ? "-" : call.target, call.command,
+  };
+  for (double a : call.args) argv.push_back(Num(a));
+  return argv;
+}
+
+namespace {
+
 std::string Members(const dsl::TrialSpec& spec) {
   std::string out;
   for (const dsl::DroneSpec& d : spec.drones) out += (out.empty() ? "" : ",") + d.name;

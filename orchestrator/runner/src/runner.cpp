@@ -131,6 +131,10 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       }
     }
     c.mesh_interface = std::string(kMeshInterfaceName);
+    if (dsl::Plugin* physics = tree->FindPlugin(kPhysicsId)) c.physics_container = physics->spec().name;
+    c.physics_command_argv = [middleware = info.middleware](const faults::WorldCommandCall& call) {
+      return PhysicsCommandArgv(middleware, call);
+    };
     return std::make_unique<FaultInjector>(
         api, std::move(c), [&](const std::string& line) { events.Write(line); },
         [&] { return monitor ? monitor->sim_s() : 0.0; }, [&] { return wall(); });
@@ -368,6 +372,7 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
   for (const dsl::DroneSpec& d : spec.drones) info.drones.push_back(d.name);
   info.mesh = spec.mesh;
   info.faults = spec.faults;
+  info.middleware = spec.middleware;
   std::string faults_image = options.faults_image;
   if (NeedsFaultSidecars(spec) && faults_image.empty()) {
     auto netemd = FindNetemd(options.netemd_bin);

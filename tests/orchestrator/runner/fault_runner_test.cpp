@@ -349,11 +349,71 @@ TEST_F(FaultRunnerTest, InterruptedRunStillUndoesEverything) {
   ExpectNothingLeft();
 }
 
-TEST_F(FaultRunnerTest, SensorFaultsAreRefusedWithTheReason) {
-  spec_.Fault("{name: gps_loss, at: 1s, duration: 1s, gps_dropout: scout_1}");
+// Sensor and environment faults: `swarmbox-physics --send-command` exec'd in the physics
+// container (no sidecars: they touch no network), exit code checked, mechanism physics-command.
+constexpr char kSend[] =
+    "/usr/local/bin/swarmbox-physics --sim-interface eth0 --domain 0 --middleware cyclonedds --send-command ";
+
+TEST_F(FaultRunnerTest, GpsDropoutIsSentToThePhysicsServerWithItsDuration) {
+  spec_.Fault("{name: gps_loss, at: 1s, duration: 1500ms, gps_dropout: scout_1}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=clock",
+                                   "t=3.000 node=physics event=clock", "t=3.500 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto calls = api_.Calls();
+  const std::string exec = "exec " + Name("physics") + " " + kSend + "scout_1 gps_dropout 1.5";
+  EXPECT_LT(IndexOfExact(calls, exec), calls.size()) << ::testing::PrintToString(calls);
+  // Once: the server restores the fix itself after 1.5 simulated s, nothing is sent at removal.
+  EXPECT_EQ(Matching(calls, "--send-command").size(), 1u);
+  EXPECT_THAT(calls, Not(::testing::Contains(HasSubstr("-faults"))));
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"gps_loss\",\"kind\":\"gps_dropout\",\"start\":\"at 1s\""));
+  EXPECT_THAT(events, HasSubstr("\"targets\":[\"scout_1\"],\"mechanism\":\"physics-command\""));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"gps_loss\""));
+  EXPECT_THAT(events, Not(HasSubstr("\"phase\":\"failed\"")));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, ImuBiasIsTakenBackByTheNegatedJumpAndAGustCarriesItsVector) {
+  spec_.Fault("{name: bias, at: 1s, duration: 1s, imu_bias: {target: all, accel_mps2: [0.3, 0, 0], gyro_rad_s: [0, 0, 0.02]}}");
+  spec_.Fault("{name: gust, at: 1s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270, vertical_mps: -1.5}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=clock",
+                                   "t=2.500 node=physics event=clock", "t=3.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto calls = api_.Calls();
+  const std::string in = "exec " + Name("physics") + " " + kSend;
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    const std::size_t jump = IndexOfExact(calls, in + d + " imu_bias_jump 0.3 0 0 0 0 0.02");
+    const std::size_t back = IndexOfExact(calls, in + d + " imu_bias_jump -0.3 0 0 0 0 -0.02");
+    ASSERT_LT(jump, calls.size()) << ::testing::PrintToString(calls);
+    ASSERT_LT(back, calls.size()) << ::testing::PrintToString(calls);
+    EXPECT_LT(jump, back);
+  }
+  // From the west (270 deg) blows towards +x (east), ENU; the world as target is "-". Still
+  // active at the end: the server drops it with the run, nothing is sent.
+  EXPECT_LT(IndexOfExact(calls, in + "- wind_gust 12 0 -1.5 5"), calls.size()) << ::testing::PrintToString(calls);
+  EXPECT_EQ(Matching(calls, "wind_gust").size(), 1u);
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"bias\""));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"gust\",\"kind\":\"wind_gust\""));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"gust\""));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, APhysicsCommandThatFailsEndsTheTrialWithItsMessage) {
+  spec_.Fault("{name: gps_loss, at: 1s, duration: 1s, gps_dropout: scout_2}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=clock",
+                                   "t=9.000 node=physics event=done"};
+  api_.exec_answers[std::string(kSend) + "scout_2 gps_dropout 1"] = {
+      {}, {"swarmbox-physics: no physics server matched on sim/world_command"}, 3};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
-  EXPECT_THAT(run.result.verdict.reason, HasSubstr("physics server takes no sensor or environment fault commands"));
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("fault gps_loss (gps_dropout) could not be applied"));
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("no physics server matched"));
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"failed\",\"fault\":\"gps_loss\""));
+  EXPECT_THAT(events, HasSubstr("\"mechanism\":\"physics-command\""));
   ExpectNothingLeft();
 }
 

@@ -229,5 +229,16 @@ TEST_F(PlanTest, WithoutAFaultsImageOrNetworkFaultsThereAreNoSidecars) {
   EXPECT_TRUE(NeedsFaultSidecars(spec_));
 }
 
+// A sensor or environment fault's exec in the physics container: the same sim bus as PhysicsArgv.
+TEST(PhysicsCommandArgvTest, SendsOnThePhysicsServersBusWithTheWorldAsDash) {
+  EXPECT_THAT(PhysicsCommandArgv(dsl::Middleware::kFastDds, {"scout_1", "gps_dropout", {3.0}}),
+              ElementsAre("/usr/local/bin/swarmbox-physics", "--sim-interface", "eth0", "--domain", "0",
+                          "--middleware", "fastdds", "--send-command", "scout_1", "gps_dropout", "3"));
+  EXPECT_THAT(PhysicsCommandArgv(dsl::Middleware::kCycloneDds, {"", "wind_gust", {12.0, 0.0, -1.5, 1e6}}),
+              ElementsAre("/usr/local/bin/swarmbox-physics", "--sim-interface", "eth0", "--domain", "0",
+                          "--middleware", "cyclonedds", "--send-command", "-", "wind_gust", "12", "0", "-1.5",
+                          "1e+06"));
+}
+
 }  // namespace
 }  // namespace swarmbox::runner

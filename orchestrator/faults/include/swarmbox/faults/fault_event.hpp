@@ -7,7 +7,7 @@
 //    "spec":"delay_ms=100 jitter_ms=20 distribution=normal loss=0.05"}
 //
 // "error" is added for phase "failed". Mechanisms: "netem", "userspace-nfqueue" (radio), "iptables"
-// (partition), "docker" (kill/stop/pause/restart), "physics" (sensor and environment faults).
+// (partition), "docker" (kill/stop/pause/restart), "physics-command" (sensor and environment faults).
 #pragma once
 
 #include <string>

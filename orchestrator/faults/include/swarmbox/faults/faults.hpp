@@ -40,7 +40,9 @@
 //                 PlanProcessFault(fault, containers, has_duration) -> ExecuteDockerActions(api,
 //                 plan.apply / plan.undo) (process_plan.hpp). Mechanism "docker".
 //      gps_dropout/imu_bias/wind_gust
-//                 data for the physics server (it applies them). Mechanism "physics".
+//                 PlanPhysicsFault(fault, targets) -> world commands for the physics server,
+//                 each sent by `swarmbox-physics --send-command` exec'd in the physics container
+//                 (physics_plan.hpp). Mechanism "physics-command".
 //    Each application, removal or failure is one events.jsonl line: FaultEventJson(fault, record)
 //    (fault_event.hpp), with the resolved targets and the mechanism used; the mesh block on each
 //    agent is recorded with MeshEventJson(node, rules, record).
@@ -63,6 +65,7 @@
 #include "swarmbox/faults/netem_spec.hpp"
 #include "swarmbox/faults/netemd_args.hpp"
 #include "swarmbox/faults/partition_plan.hpp"
+#include "swarmbox/faults/physics_plan.hpp"
 #include "swarmbox/faults/process_plan.hpp"
 #include "swarmbox/faults/radio_layers.hpp"
 #include "swarmbox/faults/radio_plan.hpp"

@@ -9,8 +9,11 @@
 //   - OnLogLine() / Advance(): feed the timeline (sim time, wall time, `on:` log events) and the
 //     Raft leader tracker; each due action is carried out at once: radio (RadioLayers +
 //     PlanRadioChange in the target's sidecar), partition (iptables chains in every agent's
-//     sidecar), kill/stop/pause/restart (Docker API on the agent's container). A fault that cannot
-//     be carried out (no leader elected yet, tc/iptables failing...) returns an error verdict.
+//     sidecar), kill/stop/pause/restart (Docker API on the agent's container), gps_dropout /
+//     imu_bias / wind_gust (world commands: `swarmbox-physics --send-command ...` exec'd in the
+//     physics container, one per target at once, exit code checked; physics_plan.hpp). A fault
+//     that cannot be carried out (no leader elected yet, tc/iptables failing, no physics server
+//     matched...) returns an error verdict.
 //   - RemoveActive() (before the tree stops) and Teardown() (the Step's Stop): undo every active
 //     fault (newest first), then the mesh block on every sidecar. Removing the sidecars afterwards
 //     takes their namespaces' leftovers with them.
@@ -51,6 +54,11 @@ struct InjectorConfig {
   std::uint64_t seed = 0;        // the trial's: random targets and the delay daemons' draws
   std::string host = "local";    // the mechanism is detected once per host
   std::string netemd = "/usr/bin/swarmbox-netemd";  // in the sidecar image
+  // Sensor and environment faults: the physics server's container (Docker name or id) and the
+  // argv of one world command in it (plan.hpp PhysicsCommandArgv). Needed only when the trial
+  // has such faults (Setup refuses them otherwise).
+  std::string physics_container;
+  std::function<std::vector<std::string>(const faults::WorldCommandCall&)> physics_command_argv;
 };
 
 // The mechanism detected per host, shared by every trial of this process.
@@ -66,8 +74,8 @@ class FaultInjector {
                 ClockFn wall_s, faults::MechanismCache* mechanisms = &HostMechanisms());
 
   // Mechanism + network.mesh on every sidecar. An error verdict says what went wrong (the runner
-  // then tears down); sensor and environment faults are refused here too (the physics server does
-  // not take fault commands yet).
+  // then tears down); sensor and environment faults are refused here when there is no physics
+  // container to send them to.
   dsl::Verdict Setup();
   // Every log line of every container (leader tracking, `on:` triggers).
   std::optional<dsl::Verdict> OnLogLine(const std::string& component, const std::string& line);
@@ -97,6 +105,8 @@ class FaultInjector {
   faults::LinkTarget LinkOf(const std::string& drone) const;
   faults::RadioPlanOptions PlanOptions() const;
   faults::CommandRunner& Sidecar(const std::string& drone);
+  // Sends the world commands through the physics container, all at once; the first failure.
+  Status SendToPhysics(const std::vector<faults::WorldCommandCall>& calls);
   faults::FaultEventRecord Record(faults::FaultPhase phase) const;
 
   docker::DockerApi& api_;
@@ -114,6 +124,8 @@ class FaultInjector {
   std::map<std::size_t, std::vector<std::string>> targets_;          // fault -> resolved drones
   std::map<std::size_t, faults::PartitionPlan> partitions_;          // active partitions
   std::map<std::size_t, faults::ProcessPlan> processes_;             // active process faults
+  std::map<std::size_t, faults::PhysicsPlan> physics_;               // active sensor/world faults
+  std::unique_ptr<faults::DockerExecCommandRunner> physics_runner_;
   std::map<std::string, std::vector<faults::RadioRule>> installed_;  // drone -> rules in place
   std::set<std::string> disrupted_;  // agent components a process fault took down
   std::vector<std::string> resumed_;

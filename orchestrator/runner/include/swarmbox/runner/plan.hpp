@@ -28,10 +28,12 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/dsl/trial.hpp"
 #include "swarmbox/dsl/trial_spec.hpp"
+#include "swarmbox/faults/physics_plan.hpp"
 #include "swarmbox/runner/subnets.hpp"
 
 namespace swarmbox::runner {
@@ -66,6 +68,11 @@ inline constexpr std::string_view kFaultsStepId = "faults";
 // The agents' interfaces in their (or their sidecar's) namespace.
 inline constexpr std::string_view kSimInterfaceName = "eth0";
 inline constexpr std::string_view kMeshInterfaceName = "eth1";
+
+// The argv a sensor or environment fault execs in the physics container (the orchestrator links
+// no DDS): swarmbox-physics --send-command <target|-> <command> <args...> on the sim bus the
+// physics server runs on (PhysicsArgv's interface, domain and middleware).
+std::vector<std::string> PhysicsCommandArgv(dsl::Middleware middleware, const faults::WorldCommandCall& call);
 
 // Whether the trial impairs the mesh (network.mesh, radio or partition faults), so every agent
 // gets a fault sidecar.

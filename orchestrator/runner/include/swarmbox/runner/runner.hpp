@@ -75,6 +75,9 @@ struct TrialInfo {
   std::vector<std::string> drones;
   faults::MeshImpairment mesh;
   std::vector<faults::Fault> faults;
+  // The sim bus's middleware: sensor and environment faults are sent to the tree's Plugin
+  // kPhysicsId with PhysicsCommandArgv (plan.hpp).
+  dsl::Middleware middleware = dsl::Middleware::kCycloneDds;
 };
 
 // Builds the tree for a pair of subnets (called again with others after a subnet conflict).
