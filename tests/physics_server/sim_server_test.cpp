@@ -333,3 +333,43 @@ TEST_F(SimServerTest, AWaitingStepResendsEverySampleAsAKeepalive) {
 
 }  // namespace
 }  // namespace swarmbox::physics
+
+namespace swarmbox::physics {
+namespace {
+
+// payload_attach carries the payload's new mass (the agent's stretcher: 15 kg empty, 80 kg with
+// the evacuee) on to World::AttachPayload (whose effect on the flight is tested in payload_test).
+TEST(SimServerPayload, AttachPassesTheMassOnAndRejectsExtraArguments) {
+  auto world = testing::MakeWorld(testing::CalmWorld());
+  const Airframe af = testing::LoadShippedAirframe("x8_heavy");
+  testing::Spawn(*world, testing::MakeSpawn("lifter", af, Vec3{0, 0, 20}, 0.0, 0.0, "stretcher", true));
+  FakeClock clock;
+  ScriptedAgents agents{clock};
+  agents.alive = {{"lifter", true}};
+  agents.throttle = af.HoverRotorSpeed(15.0) / af.motor.max_rot_velocity_rad_s;
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  SimServerOptions o;
+  o.rtf = 0;
+  o.lockstep = {.timeout_ns = 200 * kMs, .join_timeout_ns = 500 * kMs};
+  std::atomic<bool> stop{false};
+  SimServer server(*world, agents, clock, nullptr, o, out);
+  agents.world_commands = {{"lifter", "payload_release", {}}};
+  ASSERT_TRUE(server.RunStep(stop).ok());
+  agents.world_commands = {{"lifter", "payload_attach", {80.0, 1.0}}, {"lifter", "payload_attach", {-1.0}},
+                           {"lifter", "payload_attach", {80.0}}};
+  ASSERT_TRUE(server.RunStep(stop).ok());
+  EXPECT_TRUE(world->Truth(0).payload_attached);
+  const std::string log = ReadFile(out);
+  std::fclose(out);
+  EXPECT_NE(log.find("event=world_command_rejected command=payload_attach target=lifter "
+                     "reason=\"payload_attach takes at most one argument, mass_kg >= 0\""),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("event=world_command command=payload_attach target=lifter mass_kg=80.000"),
+            std::string::npos)
+      << log;
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
