@@ -76,6 +76,9 @@ std::string DescribeFault(const Fault& fault) {
       return "timeout_s=" + std::to_string(p.timeout_s);
     }
     std::string operator()(const GpsDropout&) const { return ""; }
+    std::string operator()(const GpsDegrade& g) const {
+      return "h_acc_m=" + Num(g.h_acc_m) + " v_acc_m=" + Num(g.v_acc_m);
+    }
     std::string operator()(const ImuBias& b) const {
       auto v = [](const std::array<double, 3>& a) { return "[" + Num(a[0]) + ", " + Num(a[1]) + ", " + Num(a[2]) + "]"; };
       return "accel_mps2=" + v(b.accel_mps2) + " gyro_rad_s=" + v(b.gyro_rad_s);

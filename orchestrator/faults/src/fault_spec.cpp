@@ -6,6 +6,7 @@
 #include <set>
 #include <string>
 
+#include "swarmbox/faults/detail/number_format.hpp"
 #include "swarmbox/faults/duration_ms.hpp"
 
 namespace swarmbox::faults {
@@ -25,8 +26,8 @@ bool IsName(std::string_view text) {
   });
 }
 
-constexpr std::string_view kKinds[] = {"radio", "partition", "kill", "stop", "pause", "restart",
-                                       "gps_dropout", "imu_bias", "wind_gust"};
+constexpr std::string_view kKinds[] = {"radio",       "partition",   "kill",     "stop",     "pause", "restart",
+                                       "gps_dropout", "gps_degrade", "imu_bias", "wind_gust"};
 
 std::string KindList() {
   std::string out;
@@ -141,6 +142,30 @@ Result<FaultAction> ParseAction(std::string_view kind, const yaml::Node& value) 
       SWARMBOX_TRY(r.Finish());
     }
     return FaultAction(GpsDropout{std::move(*target)});
+  }
+  if (kind == "gps_degrade") {
+    GpsDegrade out;
+    if (!value.is_mapping()) {
+      return Invalid("expected gps_degrade to be a mapping such as {target: scout_1, h_acc_m: 5, v_acc_m: 8}",
+                     value.Where());
+    }
+    yaml::MapReader r(value, "gps_degrade");
+    const yaml::Node* t = r.Child("target", /*required=*/true);
+    r.Required("h_acc_m", &out.h_acc_m).Required("v_acc_m", &out.v_acc_m);
+    SWARMBOX_TRY(r.Finish());
+    auto target = ParseTarget(*t);
+    if (!target) return target.error();
+    out.target = std::move(*target);
+    for (const char* key : {"h_acc_m", "v_acc_m"}) {
+      const double v = std::string_view(key) == "h_acc_m" ? out.h_acc_m : out.v_acc_m;
+      if (!(v > 0.0 && v <= kMaxGpsAccuracyM)) {
+        return Invalid("'" + std::string(key) + "' is the degraded 1-sigma accuracy in metres, in (0, " +
+                           detail::FormatDecimal(kMaxGpsAccuracyM) + "]; got " + detail::FormatDecimal(v) +
+                           " (for no fix at all use gps_dropout)",
+                       value.Find(key)->Where());
+      }
+    }
+    return FaultAction(std::move(out));
   }
   if (kind == "imu_bias") {
     ImuBias out;
@@ -298,6 +323,7 @@ std::string_view Fault::kind() const {
     std::string_view operator()(const PartitionFault&) const { return "partition"; }
     std::string_view operator()(const ProcessFault& p) const { return ProcessActionName(p.action); }
     std::string_view operator()(const GpsDropout&) const { return "gps_dropout"; }
+    std::string_view operator()(const GpsDegrade&) const { return "gps_degrade"; }
     std::string_view operator()(const ImuBias&) const { return "imu_bias"; }
     std::string_view operator()(const WindGust&) const { return "wind_gust"; }
   };
@@ -308,6 +334,7 @@ const FaultTarget* Fault::target() const {
   if (auto* r = std::get_if<RadioFault>(&action)) return &r->target;
   if (auto* p = std::get_if<ProcessFault>(&action)) return &p->target;
   if (auto* g = std::get_if<GpsDropout>(&action)) return &g->target;
+  if (auto* g = std::get_if<GpsDegrade>(&action)) return &g->target;
   if (auto* i = std::get_if<ImuBias>(&action)) return &i->target;
   return nullptr;
 }

@@ -9,8 +9,8 @@
 namespace swarmbox::faults {
 
 bool IsPhysicsFault(const Fault& fault) {
-  return std::holds_alternative<GpsDropout>(fault.action) || std::holds_alternative<ImuBias>(fault.action) ||
-         std::holds_alternative<WindGust>(fault.action);
+  return std::holds_alternative<GpsDropout>(fault.action) || std::holds_alternative<GpsDegrade>(fault.action) ||
+         std::holds_alternative<ImuBias>(fault.action) || std::holds_alternative<WindGust>(fault.action);
 }
 
 std::array<double, 3> GustVelocityEnu(const WindGust& gust) {
@@ -26,6 +26,10 @@ PhysicsPlan PlanPhysicsFault(const Fault& fault, const std::vector<std::string>&
       fault.duration_ms ? static_cast<double>(*fault.duration_ms) / 1000.0 : kUntilEndS;
   if (std::holds_alternative<GpsDropout>(fault.action)) {
     for (const std::string& t : targets) plan.apply.push_back({t, "gps_dropout", {duration_s}});
+  } else if (const auto* degrade = std::get_if<GpsDegrade>(&fault.action)) {
+    for (const std::string& t : targets) {
+      plan.apply.push_back({t, "gps_degrade", {duration_s, degrade->h_acc_m, degrade->v_acc_m}});
+    }
   } else if (const auto* bias = std::get_if<ImuBias>(&fault.action)) {
     const auto& a = bias->accel_mps2;
     const auto& g = bias->gyro_rad_s;

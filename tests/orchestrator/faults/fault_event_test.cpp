@@ -64,6 +64,8 @@ TEST(FaultEvent, DescribesEveryKind) {
             "groups=[[a, b], [c]] oneway=true duration=30s");
   EXPECT_EQ(DescribeFault(First("- {at: 1s, stop: {target: a, timeout: 3s}}")), "timeout_s=3");
   EXPECT_EQ(DescribeFault(First("- {at: 1s, duration: 2s, gps_dropout: a}")), "duration=2s");
+  EXPECT_EQ(DescribeFault(First("- {at: 1s, duration: 4s, gps_degrade: {target: a, h_acc_m: 5, v_acc_m: 8.5}}")),
+            "h_acc_m=5 v_acc_m=8.5 duration=4s");
   EXPECT_EQ(DescribeFault(First("- {at: 1s, wind_gust: {speed_mps: 12, direction_deg: 270}}")),
             "speed_mps=12 direction_deg=270 vertical_mps=0");
   EXPECT_EQ(DescribeFault(First("- {at: 1s, radio: {rules: [{to: [b], delay_ms: 5}, {rate_kbit: 64}]}}")),

@@ -66,6 +66,27 @@ TEST(FaultSpec, RadioDefaultsToAllAgents) {
   EXPECT_EQ(radio.rules[0].spec.loss, 0.2);
 }
 
+TEST(FaultSpec, ParsesAGpsDegradationWithItsAccuracies) {
+  auto faults = Parse("- {at: 30s, duration: 20s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8.5}}\n"
+                      "- {on: \"event=leader_elected\", gps_degrade: {target: raft_leader, h_acc_m: 1000, v_acc_m: 0.5}}\n");
+  ASSERT_TRUE(faults) << faults.error().ToString();
+  EXPECT_EQ((*faults)[0].kind(), "gps_degrade");
+  const auto& degrade = std::get<GpsDegrade>((*faults)[0].action);
+  EXPECT_EQ(degrade.h_acc_m, 5.0);
+  EXPECT_EQ(degrade.v_acc_m, 8.5);
+  EXPECT_EQ((*faults)[0].target()->names, std::vector<std::string>{"scout_1"});
+  EXPECT_EQ((*faults)[1].target()->kind, FaultTarget::Kind::kRaftLeader);
+  EXPECT_TRUE(ValidateFaults(*faults, kDrones));
+}
+
+TEST(FaultSpec, ValidationNamesAGpsDegradationsUnknownDrone) {
+  auto faults = Parse("- {at: 3s, gps_degrade: {target: scout_9, h_acc_m: 5, v_acc_m: 8}}");
+  ASSERT_TRUE(faults) << faults.error().ToString();
+  Status s = ValidateFaults(*faults, kDrones);
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message().find("unknown drone 'scout_9'"), std::string::npos) << s.error().message();
+}
+
 TEST(FaultSpec, ParsesPartitionsAndSensorFaults) {
   auto faults = Parse(
       "- {at: 60s, duration: 30s, partition: {groups: [[scout_1, scout_2], [lifter]], oneway: true}}\n"
@@ -123,6 +144,18 @@ INSTANTIATE_TEST_SUITE_P(
         BadFault{"- {at: 3s, partition: {groups: [[a], []]}}", "trial.yaml:1:38", "group 1 is empty"},
         BadFault{"- {at: 3s, wind_gust: {speed_mps: 500}}", "trial.yaml:1:35", "'speed_mps' must be in [0, 100]"},
         BadFault{"- {at: 3s, imu_bias: {target: a}}", "trial.yaml:1:22", "imu_bias changes nothing"},
+        BadFault{"- {at: 3s, gps_degrade: a}", "trial.yaml:1:25", "expected gps_degrade to be a mapping"},
+        BadFault{"- {at: 3s, gps_degrade: {h_acc_m: 5, v_acc_m: 8}}", "trial.yaml:1:25",
+                 "missing required key 'target' in gps_degrade"},
+        BadFault{"- {at: 3s, gps_degrade: {target: a, h_acc_m: 5}}", "trial.yaml:1:25",
+                 "missing required key 'v_acc_m' in gps_degrade"},
+        BadFault{"- {at: 3s, gps_degrade: {target: a, h_acc_m: 0, v_acc_m: 8}}", "trial.yaml:1:46",
+                 "'h_acc_m' is the degraded 1-sigma accuracy in metres, in (0, 1000]; got 0 (for no fix at all use "
+                 "gps_dropout)"},
+        BadFault{"- {at: 3s, gps_degrade: {target: a, h_acc_m: 5, v_acc_m: 1e4}}", "trial.yaml:1:58",
+                 "'v_acc_m' is the degraded 1-sigma accuracy in metres, in (0, 1000]; got 10000"},
+        BadFault{"- {at: 3s, gps_degrade: {target: a, h_acc_m: 5, v_acc_m: 8, hdop: 3}}", "trial.yaml:1:61",
+                 "unknown key 'hdop' in gps_degrade"},
         BadFault{"- {at: 3s, radio: {target: a, loss: 2}}", "trial.yaml:1:37", "'loss' is a probability"},
         BadFault{"- {at: 1s, name: x, kill: a}\n- {at: 2s, name: x, kill: b}", "trial.yaml:2:3",
                  "two faults are named 'x'"}));

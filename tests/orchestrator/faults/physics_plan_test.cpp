@@ -25,6 +25,21 @@ TEST(PhysicsPlan, WithoutDurationADropoutLastsUntilTheEnd) {
   EXPECT_EQ(plan.apply, (std::vector<WorldCommandCall>{{"a", "gps_dropout", {kUntilEndS}}}));
 }
 
+TEST(PhysicsPlan, GpsDegradeSendsDurationAndBothAccuraciesPerTargetAndNeedsNoUndo) {
+  GpsDegrade degrade;
+  degrade.h_acc_m = 5;
+  degrade.v_acc_m = 8.5;
+  const PhysicsPlan plan = PlanPhysicsFault(Make(degrade, 4000), {"scout_1", "scout_2"});
+  // The physics server's order: duration_s, h_acc_m, v_acc_m; it restores the accuracy itself.
+  EXPECT_EQ(plan.apply, (std::vector<WorldCommandCall>{{"scout_1", "gps_degrade", {4.0, 5.0, 8.5}},
+                                                       {"scout_2", "gps_degrade", {4.0, 5.0, 8.5}}}));
+  EXPECT_TRUE(plan.undo.empty());
+  EXPECT_EQ(WorldCommandText(plan.apply[0]), "gps_degrade scout_1 4 5 8.5");
+  EXPECT_TRUE(IsPhysicsFault(Make(degrade, 4000)));
+  EXPECT_EQ(PlanPhysicsFault(Make(degrade, std::nullopt), {"a"}).apply,
+            (std::vector<WorldCommandCall>{{"a", "gps_degrade", {kUntilEndS, 5.0, 8.5}}}));
+}
+
 TEST(PhysicsPlan, ImuBiasWithDurationIsTakenBackByTheNegatedJump) {
   ImuBias bias;
   bias.accel_mps2 = {0.3, 0, 0};

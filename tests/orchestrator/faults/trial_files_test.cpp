@@ -11,6 +11,7 @@
 #include "swarmbox/faults/leader_tracker.hpp"
 #include "swarmbox/faults/mechanism.hpp"
 #include "swarmbox/faults/partition_plan.hpp"
+#include "swarmbox/faults/physics_plan.hpp"
 #include "swarmbox/faults/process_plan.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
 #include "swarmbox/faults/target_resolver.hpp"
@@ -107,7 +108,7 @@ TEST(FaultTrialFiles, TogetherTheyCoverEveryFaultKindAndStart) {
       if (const FaultTarget* target = f.target()) targets.insert(target->kind);
     }
   }
-  EXPECT_EQ(kinds, (std::set<std::string>{"gps_dropout", "imu_bias", "kill", "partition", "pause", "radio", "restart",
+  EXPECT_EQ(kinds, (std::set<std::string>{"gps_degrade", "gps_dropout", "imu_bias", "kill", "partition", "pause", "radio", "restart",
                                           "stop", "wind_gust"}));
   EXPECT_EQ(clocks.size(), 3u);   // at, at_wall, on
   EXPECT_EQ(targets.size(), 5u);  // names, pattern, all, raft_leader, random
@@ -152,6 +153,17 @@ TEST(FaultTrialFiles, EveryFaultPlansOnTheMechanismsItClaims) {
         ASSERT_TRUE(names) << names.error().ToString();
         const ProcessPlan plan = PlanProcessFault(*process, *names, f.duration_ms.has_value());
         EXPECT_EQ(plan.apply.size(), names->size());
+      } else if (IsPhysicsFault(f)) {
+        std::vector<std::string> names;
+        if (const FaultTarget* target = f.target()) {
+          auto resolved = ResolveTarget(*target, t->drones, leaders, rng);
+          ASSERT_TRUE(resolved) << resolved.error().ToString();
+          names = *resolved;
+        }
+        const PhysicsPlan plan = PlanPhysicsFault(f, names);
+        EXPECT_EQ(plan.apply.size(), f.target() != nullptr ? names.size() : 1u);
+      } else {
+        ADD_FAILURE() << "no plan check for fault kind " << f.kind();
       }
     }
     // The mesh block itself runs on this project's machines.

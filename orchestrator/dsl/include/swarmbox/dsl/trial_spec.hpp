@@ -17,7 +17,7 @@
 //
 // Faults: the `faults:` list is parsed and checked by swarmbox_faults (faults::ParseFaults, the
 // fault injector's own schema: at/at_wall/on, duration, kill/stop/pause/restart/radio/partition/
-// gps_dropout/imu_bias/wind_gust, targets) and carried out by the fault injector.
+// gps_dropout/gps_degrade/imu_bias/wind_gust, targets) and carried out by the fault injector.
 #pragma once
 
 #include <array>

@@ -11,14 +11,15 @@
 //                                        distribution: normal, loss: 0.1}}
 //     - {at: 60s, duration: 30s, partition: {groups: [[scout_1, scout_2], [lifter]], oneway: false}}
 //     - {at: 20s, duration: 10s, gps_dropout: scout_2}
+//     - {at: 30s, duration: 20s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}
 //     - {at: 25s, duration: 10s, imu_bias: {target: lifter, accel_mps2: [0.2, 0, 0]}}
 //     - {at: 50s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270}}
 //
 // Targets: a drone name, a list of names, a glob pattern ("scout_*"), `all`, `raft_leader` (the
 // leader of the latest `event=leader_elected` seen in the logs when the fault fires) or `random`
 // (one drone, drawn from the trial's seed). Kinds kill/stop/pause/restart/gps_dropout take the
-// target as their value or as `target:` in a mapping; radio and imu_bias as `target:` (radio
-// defaults to all). Partitions name their groups; drones listed in no group form one more group.
+// target as their value or as `target:` in a mapping; radio, imu_bias and gps_degrade as `target:`
+// (radio defaults to all). Partitions name their groups; drones listed in no group form one more group.
 // wind_gust acts on the world and has no target.
 //
 // ParseFaults() checks shape and values (file:line:col); ValidateFaults() checks names against the
@@ -79,6 +80,15 @@ struct ProcessFault {
 struct GpsDropout {
   FaultTarget target;
 };
+// Worse GPS fixes: the 1-sigma noise of each fix becomes h_acc_m / v_acc_m (the receiver reports
+// them as its accuracy) for the fault's duration, then the airframe's own accuracy is back.
+struct GpsDegrade {
+  FaultTarget target;
+  double h_acc_m = 0.0;  // horizontal 1-sigma [m], (0, kMaxGpsAccuracyM]
+  double v_acc_m = 0.0;  // vertical 1-sigma [m], (0, kMaxGpsAccuracyM]
+};
+// The worst accuracy a gps_degrade may ask for [m] (beyond it, ask for a gps_dropout).
+inline constexpr double kMaxGpsAccuracyM = 1000.0;
 struct ImuBias {
   FaultTarget target;
   std::array<double, 3> accel_mps2{};  // added to the accelerometer [m/s^2], body frame FRD
@@ -90,7 +100,8 @@ struct WindGust {
   double vertical_mps = 0.0;   // up positive [m/s]
 };
 
-using FaultAction = std::variant<RadioFault, PartitionFault, ProcessFault, GpsDropout, ImuBias, WindGust>;
+using FaultAction =
+    std::variant<RadioFault, PartitionFault, ProcessFault, GpsDropout, GpsDegrade, ImuBias, WindGust>;
 
 struct Fault {
   std::string id;  // `name:` when given, else "fault_<index>"
@@ -98,7 +109,8 @@ struct Fault {
   std::optional<std::int64_t> duration_ms;  // absent: never undone
   FaultAction action;
   yaml::Mark mark;
-  // "radio", "partition", "kill", "stop", "pause", "restart", "gps_dropout", "imu_bias", "wind_gust".
+  // "radio", "partition", "kill", "stop", "pause", "restart", "gps_dropout", "gps_degrade",
+  // "imu_bias", "wind_gust".
   std::string_view kind() const;
   // The target when the kind has one (partitions and wind gusts have none).
   const FaultTarget* target() const;

@@ -39,7 +39,7 @@
 //      kill/stop/pause/restart
 //                 PlanProcessFault(fault, containers, has_duration) -> ExecuteDockerActions(api,
 //                 plan.apply / plan.undo) (process_plan.hpp). Mechanism "docker".
-//      gps_dropout/imu_bias/wind_gust
+//      gps_dropout/gps_degrade/imu_bias/wind_gust
 //                 PlanPhysicsFault(fault, targets) -> world commands for the physics server,
 //                 each sent by `swarmbox-physics --send-command` exec'd in the physics container
 //                 (physics_plan.hpp). Mechanism "physics-command".

@@ -1,4 +1,4 @@
-// Sensor and environment faults (gps_dropout, imu_bias, wind_gust) as the world commands the
+// Sensor and environment faults (gps_dropout, gps_degrade, imu_bias, wind_gust) as the world commands the
 // physics server takes on the sim bus (physics_server/app/world_commands.hpp), planned purely. The
 // runner carries each one out as `swarmbox-physics --send-command <target> <command> <args...>`
 // exec'd in the physics container (the orchestrator links no DDS); mechanism "physics-command".
@@ -6,8 +6,10 @@
 //   PhysicsPlan plan = PlanPhysicsFault(fault, {"scout_1"});
 //   // fault {at: 8s, duration: 3s, gps_dropout: scout_1}:
 //   //   apply {scout_1, gps_dropout, [3]}, undo {}: the server restores the fix after 3 s itself
+//   // fault {at: 9s, duration: 4s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}:
+//   //   apply {scout_1, gps_degrade, [4, 5, 8]} (duration_s, h_acc_m, v_acc_m), undo {}
 //
-// Undo: gps_dropout and wind_gust carry their duration (the server ends them on its own, in
+// Undo: gps_dropout, gps_degrade and wind_gust carry their duration (the server ends them on its own, in
 // simulated time; no duration = kUntilEndS); imu_bias with a duration is undone by the negated
 // jump, without one it stays.
 #pragma once
