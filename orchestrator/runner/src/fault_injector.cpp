@@ -352,8 +352,8 @@ Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record
     return s;
   }
   if (faults::IsPhysicsFault(f)) {
-    // gps_dropout and wind_gust end in the physics server itself (their duration travelled with
-    // the command); an imu_bias with a duration is taken back by the negated jump.
+    // gps_dropout, gps_degrade and wind_gust end in the physics server itself (their duration
+    // travelled with the command); an imu_bias with a duration is taken back by the negated jump.
     record->mechanism = std::string(kPhysicsMechanism);
     auto it = physics_.find(index);
     if (it == physics_.end()) return Ok{};

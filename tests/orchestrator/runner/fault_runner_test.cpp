@@ -374,6 +374,27 @@ TEST_F(FaultRunnerTest, GpsDropoutIsSentToThePhysicsServerWithItsDuration) {
   ExpectNothingLeft();
 }
 
+TEST_F(FaultRunnerTest, GpsDegradeIsSentWithItsDurationAndAccuraciesToEveryTarget) {
+  spec_.Fault("{name: bad_fix, at: 1s, duration: 4s, gps_degrade: {target: all, h_acc_m: 5, v_acc_m: 8.5}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=clock",
+                                   "t=5.500 node=physics event=clock", "t=6.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto calls = api_.Calls();
+  const std::string in = "exec " + Name("physics") + " " + kSend;
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    EXPECT_LT(IndexOfExact(calls, in + d + " gps_degrade 4 5 8.5"), calls.size()) << ::testing::PrintToString(calls);
+  }
+  // Once per drone: the server restores the airframe's accuracy itself after 4 simulated s.
+  EXPECT_EQ(Matching(calls, "--send-command").size(), 2u);
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"bad_fix\",\"kind\":\"gps_degrade\""));
+  EXPECT_THAT(events, HasSubstr("\"mechanism\":\"physics-command\",\"spec\":\"h_acc_m=5 v_acc_m=8.5 duration=4s\""));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"bad_fix\""));
+  EXPECT_THAT(events, Not(HasSubstr("\"phase\":\"failed\"")));
+  ExpectNothingLeft();
+}
+
 TEST_F(FaultRunnerTest, ImuBiasIsTakenBackByTheNegatedJumpAndAGustCarriesItsVector) {
   spec_.Fault("{name: bias, at: 1s, duration: 1s, imu_bias: {target: all, accel_mps2: [0.3, 0, 0], gyro_rad_s: [0, 0, 0.02]}}");
   spec_.Fault("{name: gust, at: 1s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270, vertical_mps: -1.5}}");

@@ -238,6 +238,11 @@ TEST(PhysicsCommandArgvTest, SendsOnThePhysicsServersBusWithTheWorldAsDash) {
               ElementsAre("/usr/local/bin/swarmbox-physics", "--sim-interface", "eth0", "--domain", "0",
                           "--middleware", "cyclonedds", "--send-command", "-", "wind_gust", "12", "0", "-1.5",
                           "1e+06"));
+  // gps_degrade: duration_s, then the horizontal and vertical 1-sigma accuracy [m].
+  EXPECT_THAT(PhysicsCommandArgv(dsl::Middleware::kCycloneDds, {"scout_1", "gps_degrade", {4.0, 5.0, 8.5}}),
+              ElementsAre("/usr/local/bin/swarmbox-physics", "--sim-interface", "eth0", "--domain", "0",
+                          "--middleware", "cyclonedds", "--send-command", "scout_1", "gps_degrade", "4", "5",
+                          "8.5"));
 }
 
 }  // namespace

@@ -10,10 +10,10 @@
 //     Raft leader tracker; each due action is carried out at once: radio (RadioLayers +
 //     PlanRadioChange in the target's sidecar), partition (iptables chains in every agent's
 //     sidecar), kill/stop/pause/restart (Docker API on the agent's container), gps_dropout /
-//     imu_bias / wind_gust (world commands: `swarmbox-physics --send-command ...` exec'd in the
-//     physics container, one per target at once, exit code checked; physics_plan.hpp). A fault
-//     that cannot be carried out (no leader elected yet, tc/iptables failing, no physics server
-//     matched...) returns an error verdict.
+//     gps_degrade / imu_bias / wind_gust (world commands: `swarmbox-physics --send-command ...`
+//     exec'd in the physics container, one per target at once, exit code checked;
+//     physics_plan.hpp). A fault that cannot be carried out (no leader elected yet, tc/iptables
+//     failing, no physics server matched...) returns an error verdict.
 //   - RemoveActive() (before the tree stops) and Teardown() (the Step's Stop): undo every active
 //     fault (newest first), then the mesh block on every sidecar. Removing the sidecars afterwards
 //     takes their namespaces' leftovers with them.
