@@ -72,22 +72,51 @@ std::vector<Component*> Component::RunOrder() const {
   return order;
 }
 
+namespace {
+
+// Consecutive runs of equal priority in a run order.
+std::vector<std::vector<Component*>> Levels(const std::vector<Component*>& order) {
+  std::vector<std::vector<Component*>> levels;
+  for (Component* c : order) {
+    if (levels.empty() || levels.back().front()->run_priority() != c->run_priority()) {
+      levels.emplace_back();
+    }
+    levels.back().push_back(c);
+  }
+  return levels;
+}
+
+}  // namespace
+
+Verdict Component::DispatchLevel(const std::vector<Component*>& level, EventKind event,
+                                 Engine& engine) {
+  if (level.size() == 1) return level.front()->Dispatch(event, engine);
+  std::vector<std::function<Verdict()>> steps;
+  steps.reserve(level.size());
+  for (Component* c : level) {
+    steps.emplace_back([c, event, &engine] { return c->Dispatch(event, engine); });
+  }
+  return engine.RunSiblings(steps, /*stop_on_failure=*/event != EventKind::kStop);
+}
+
 Verdict Component::Dispatch(EventKind event, Engine& engine) {
   SWARMBOX_CHECK(event == EventKind::kBuild || event == EventKind::kRun ||
                  event == EventKind::kStop);
+  const std::vector<std::vector<Component*>> levels = Levels(RunOrder());
   if (event == EventKind::kStop) {
     Verdict v;
-    std::vector<Component*> order = RunOrder();
-    for (auto it = order.rbegin(); it != order.rend(); ++it) {
-      v.KeepWorse((*it)->Dispatch(event, engine));
+    for (auto level = levels.rbegin(); level != levels.rend(); ++level) {
+      // Within a level too, the last added stops first (when the engine goes one by one).
+      v.KeepWorse(DispatchLevel(std::vector<Component*>(level->rbegin(), level->rend()), event,
+                                engine));
     }
     v.KeepWorse(Handle(event, engine));
     return v;
   }
   Verdict v = Handle(event, engine);
   if (!v.ok()) return v;
-  for (Component* c : RunOrder()) {
-    v.KeepWorse(c->Dispatch(event, engine));
+  for (const std::vector<Component*>& level : levels) {
+    v.KeepWorse(DispatchLevel(level, event, engine));
     if (!v.ok()) break;
   }
   return v;
@@ -153,5 +182,15 @@ Verdict Module::Handle(EventKind event, Engine& engine) {
 
 void Engine::Trace(const Component& /*component*/, EventKind /*event*/,
                    const Verdict& /*verdict*/) {}
+
+Verdict Engine::RunSiblings(const std::vector<std::function<Verdict()>>& steps,
+                            bool stop_on_failure) {
+  Verdict v;
+  for (const auto& step : steps) {
+    v.KeepWorse(step());
+    if (stop_on_failure && !v.ok()) break;
+  }
+  return v;
+}
 
 }  // namespace swarmbox::dsl

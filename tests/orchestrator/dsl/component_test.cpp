@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -234,6 +235,55 @@ TEST(Trial, RestartRequestFiresAndRebuildsTheTree) {
                           "create-network mesh", "create physics", "create scout_1",
                           "create scout_2", "create recorder", "start physics", "start scout_1",
                           "start scout_2", "start recorder"));
+}
+
+// An engine that runs each level's steps in an order of its own (last first, as a concurrent
+// engine may) and records which steps it was handed together.
+class LevelEngine : public FakeEngine {
+ public:
+  std::vector<std::size_t> level_sizes;
+  Verdict RunSiblings(const std::vector<std::function<Verdict()>>& steps, bool) override {
+    level_sizes.push_back(steps.size());
+    Verdict v;
+    for (auto it = steps.rbegin(); it != steps.rend(); ++it) v.KeepWorse((*it)());
+    return v;
+  }
+};
+
+TEST(Component, SiblingsOfEqualPriorityGoToTheEngineTogether) {
+  auto trial = MakeTrial();
+  LevelEngine engine;
+  ASSERT_TRUE(trial->Start(engine).ok());
+  // Build: {sim, mesh}, {scout_1, scout_2}; Run: the same (physics and recorder are alone).
+  EXPECT_THAT(engine.level_sizes, ElementsAre(2u, 2u, 2u, 2u));
+  // Levels stay in priority order whatever the engine does inside one.
+  EXPECT_THAT(engine.log, ElementsAre("create-network mesh", "create-network sim", "create physics",
+                                      "create scout_2", "create scout_1", "create recorder",
+                                      "start physics", "start scout_2", "start scout_1",
+                                      "start recorder"));
+  engine.log.clear();
+  engine.level_sizes.clear();
+  ASSERT_TRUE(trial->Stop(engine).ok());
+  // Stop hands each level over in reverse insertion order (this engine reverses it back).
+  EXPECT_THAT(engine.level_sizes, ElementsAre(2u, 2u));
+  EXPECT_THAT(engine.log, ElementsAre("stop recorder", "stop scout_1", "stop scout_2",
+                                      "stop physics", "remove-network sim", "remove-network mesh"));
+}
+
+TEST(Component, AFailureInALevelStopsTheWalkAfterThatLevel) {
+  auto trial = MakeTrial();
+  LevelEngine engine;  // runs every step of a level, as a concurrent engine does
+  engine.fail["create scout_2"] = Verdict::Err("image missing");
+  Verdict v = trial->Start(engine);
+  EXPECT_EQ(v.ToString(), "error: image missing (t/scout_2)");
+  // scout_1 (same level) was created too; the recorder's level never came, nothing started.
+  EXPECT_THAT(engine.log, ElementsAre("create-network mesh", "create-network sim", "create physics",
+                                      "create scout_2", "create scout_1"));
+  engine.log.clear();
+  (void)trial->Stop(engine);
+  // scout_2 was never built: only scout_1 has something to undo.
+  EXPECT_THAT(engine.log, ElementsAre("stop scout_1", "stop physics", "remove-network sim",
+                                      "remove-network mesh"));
 }
 
 TEST(Trial, EndConditionsAndTimeoutAreKept) {

@@ -8,6 +8,10 @@
 //               at the first result that is not success (nothing is built on a broken base).
 //   Stop        propagates DOWN in reverse run order (5 first, the component itself last) and is
 //               best-effort: every module that was built is stopped even when others fail.
+// Siblings of equal run priority form a level; a level is handed to Engine::RunSiblings, which
+// may run its steps at once (the Docker engine does): a level then starts only once the level
+// before it has finished (a container with a readiness pattern is ready), and a failure stops the
+// walk after its level (its siblings of the same level may have run too; Stop undoes them).
 //   Shutdown,   propagate UP from the component that raised them, through each ancestor's
 //   Restart     OnShutdown()/OnRestart() until one consumes it (a Trial does).
 // Every walk returns the worst Verdict of its steps (outcome.hpp).
@@ -17,9 +21,11 @@
 //   trial.Add<Plugin>("physics", ContainerSpec::Image("swarmbox/physics:1"), 1).On(sim, "10.77.3.2");
 //   Verdict v = trial.Start(engine);   // creates sim, creates and starts physics
 //
-// Thread-safety: none; the runner drives a tree from one thread.
+// Thread-safety: a tree is driven from one thread; during a walk, the steps of one level may run on
+// several threads at once (Engine::RunSiblings), each on its own subtree.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -107,6 +113,9 @@ class Component {
 
  private:
   void Adopt(std::unique_ptr<Component> child);
+  // One level (siblings of equal priority, in the order to go through them) through RunSiblings.
+  static Verdict DispatchLevel(const std::vector<Component*>& level, EventKind event,
+                               Engine& engine);
 
   std::string id_;
   int run_priority_;
@@ -150,6 +159,13 @@ class Engine {
   virtual Verdict StopContainer(Plugin& plugin) = 0;
   // Called after each Module handled a downward event, with its result (for events.jsonl).
   virtual void Trace(const Component& component, EventKind event, const Verdict& verdict);
+  // Runs the steps of one level (siblings of equal run priority, independent of each other) and
+  // returns the worst verdict. The default runs them one after another on the calling thread and,
+  // with `stop_on_failure` (Build, Run), stops after the first that is not success. An engine may
+  // run them at once instead (then every step runs); it must then accept concurrent calls of its
+  // methods (and of Trace) for different components.
+  virtual Verdict RunSiblings(const std::vector<std::function<Verdict()>>& steps,
+                              bool stop_on_failure);
 };
 
 }  // namespace swarmbox::dsl
