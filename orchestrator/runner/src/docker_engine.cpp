@@ -1,5 +1,6 @@
 #include "swarmbox/runner/docker_engine.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -32,6 +33,30 @@ bool IsSubnetConflict(const Error& e) {
 
 }  // namespace
 
+Verdict RunConcurrently(const std::vector<std::function<Verdict()>>& steps, int max_threads) {
+  std::vector<Verdict> verdicts(steps.size());
+  const std::size_t threads =
+      std::min(steps.size(), static_cast<std::size_t>(std::max(1, max_threads)));
+  if (threads <= 1) {
+    for (std::size_t i = 0; i < steps.size(); ++i) verdicts[i] = steps[i]();
+  } else {
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+      for (std::size_t i = next.fetch_add(1); i < steps.size(); i = next.fetch_add(1)) {
+        verdicts[i] = steps[i]();
+      }
+    };
+    std::vector<std::thread> pool;
+    pool.reserve(threads - 1);
+    for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();  // the calling thread is one of the workers
+    for (std::thread& t : pool) t.join();
+  }
+  Verdict v;
+  for (const Verdict& one : verdicts) v.KeepWorse(one);  // in step order: ties keep the first
+  return v;
+}
+
 DockerEngine::DockerEngine(docker::DockerApi& api, LogHub& hub, Clock& clock,
                            EngineOptions options)
     : api_(api), hub_(hub), clock_(clock), options_(std::move(options)) {
@@ -40,15 +65,33 @@ DockerEngine::DockerEngine(docker::DockerApi& api, LogHub& hub, Clock& clock,
 }
 
 DockerEngine::~DockerEngine() {
+  for (auto& [component, f] : followers_) f->cancel.Cancel();
   for (auto& [component, f] : followers_) {
-    f->cancel.Cancel();
     if (f->thread.joinable()) f->thread.join();
   }
 }
 
 void DockerEngine::Trace(const dsl::Component& component, dsl::EventKind event,
                          const Verdict& verdict) {
+  std::lock_guard lock(trace_mu_);
   if (options_.on_trace) options_.on_trace(component, event, verdict);
+}
+
+Verdict DockerEngine::RunSiblings(const std::vector<std::function<Verdict()>>& steps,
+                                  bool /*stop_on_failure*/) {
+  return RunConcurrently(steps, options_.max_parallel);
+}
+
+void DockerEngine::AddProblem(std::string problem) {
+  std::lock_guard lock(mu_);
+  problems_.push_back(std::move(problem));
+}
+
+std::optional<std::string> DockerEngine::ContainerId(const std::string& component) const {
+  std::lock_guard lock(mu_);
+  auto it = container_ids_.find(component);
+  if (it == container_ids_.end()) return std::nullopt;
+  return it->second;
 }
 
 Verdict DockerEngine::CreateNetwork(dsl::Network& network) {
@@ -59,22 +102,27 @@ Verdict DockerEngine::CreateNetwork(dsl::Network& network) {
   spec.gateway = s.gateway;
   spec.internal = s.internal;
   spec.labels = s.labels;
-  subnet_conflict_ = false;
   auto id = api_.CreateNetwork(spec);
   if (!id) {
-    subnet_conflict_ = IsSubnetConflict(id.error());
+    if (IsSubnetConflict(id.error())) subnet_conflict_.store(true);
     return Verdict::FromError(id.error().Context("creating network " + s.name + " (" + s.subnet + ")"),
                               network.Path());
   }
+  std::lock_guard lock(mu_);
   network_ids_[network.id()] = *id;
   return Verdict::Success();
 }
 
 Verdict DockerEngine::RemoveNetwork(dsl::Network& network) {
-  auto it = network_ids_.find(network.id());
-  if (it == network_ids_.end()) return Verdict::Success();
-  Status s = api_.RemoveNetwork(it->second);
-  network_ids_.erase(it);
+  std::string id;
+  {
+    std::lock_guard lock(mu_);
+    auto it = network_ids_.find(network.id());
+    if (it == network_ids_.end()) return Verdict::Success();
+    id = it->second;
+    network_ids_.erase(it);
+  }
+  Status s = api_.RemoveNetwork(id);
   if (!s && s.error().code() != ErrorCode::kNotFound) {
     return Verdict::FromError(s.error().Context("removing network " + network.spec().name),
                               network.Path());
@@ -129,6 +177,7 @@ Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
   spec.auto_remove = false;  // a crashed container keeps its logs until we collected them
   spec.cap_add = s.cap_add;
   spec.cap_drop = s.cap_drop;
+  std::unique_lock lock(mu_);
   if (!s.network_of.empty()) {
     auto owner = container_ids_.find(s.network_of);
     if (owner == container_ids_.end()) {
@@ -151,13 +200,16 @@ Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
     }
     spec.networks.push_back({it->second, a.ipv4, a.aliases});
   }
+  lock.unlock();
   auto id = api_.CreateContainer(spec);
   if (!id) {
     return Verdict::FromError(id.error().Context("creating container " + s.name), plugin.Path());
   }
+  lock.lock();
   container_ids_[plugin.id()] = *id;
   reports_[plugin.id()] = ComponentReport{plugin.id(), std::nullopt, false,
                                           "logs/" + plugin.id() + ".log", 0};
+  lock.unlock();
   if (Status st = CopyInputs(s, *id); !st) {
     return Verdict::FromError(st.error().Context("copying input files into " + s.name),
                               plugin.Path());
@@ -170,8 +222,12 @@ void DockerEngine::StartFollower(const std::string& component, const std::string
   JoinFollower(component, /*cancel=*/true);
   auto f = std::make_unique<Follower>();
   Follower* raw = f.get();
-  const std::uint64_t generation = next_generation_++;
-  generations_[component] = generation;
+  std::uint64_t generation = 0;
+  {
+    std::lock_guard lock(mu_);
+    generation = next_generation_++;
+    generations_[component] = generation;
+  }
   const std::string path = (fs::path(options_.trial_dir) / "logs" / (component + ".log")).string();
   raw->thread = std::thread([this, raw, component, container_id, path, generation, skip_lines] {
     std::uint64_t to_skip = skip_lines;
@@ -203,13 +259,20 @@ void DockerEngine::StartFollower(const std::string& component, const std::string
                generation});
     raw->done.store(true);
   });
+  std::lock_guard lock(mu_);
   followers_[component] = std::move(f);
 }
 
 void DockerEngine::JoinFollower(const std::string& component, bool cancel) {
-  auto it = followers_.find(component);
-  if (it == followers_.end()) return;
-  Follower& f = *it->second;
+  std::unique_ptr<Follower> follower;
+  {
+    std::lock_guard lock(mu_);
+    auto it = followers_.find(component);
+    if (it == followers_.end()) return;
+    follower = std::move(it->second);
+    followers_.erase(it);
+  }
+  Follower& f = *follower;
   if (!cancel) {
     // The stream ends by itself once the container stopped; give it a moment to deliver the rest.
     const auto deadline = std::chrono::steady_clock::now() + kStreamEndGrace;
@@ -219,31 +282,35 @@ void DockerEngine::JoinFollower(const std::string& component, bool cancel) {
   }
   f.cancel.Cancel();
   if (f.thread.joinable()) f.thread.join();
+  std::lock_guard lock(mu_);
   reports_[component].log_lines += f.lines.load();
-  followers_.erase(it);
 }
 
 Status DockerEngine::ResumeLogs(const std::string& component) {
-  auto it = container_ids_.find(component);
-  if (it == container_ids_.end()) {
-    return Error(ErrorCode::kNotFound, "no container for component " + component);
-  }
+  auto id = ContainerId(component);
+  if (!id) return Error(ErrorCode::kNotFound, "no container for component " + component);
   JoinFollower(component, /*cancel=*/true);  // counts its lines into the report
+  std::uint64_t delivered = 0;
+  {
+    std::lock_guard lock(mu_);
+    delivered = reports_[component].log_lines;
+  }
   // Lines the cancelled stream had not delivered yet come again with the new one.
-  StartFollower(component, it->second, reports_[component].log_lines);
+  StartFollower(component, *id, delivered);
   return Ok{};
 }
 
 bool DockerEngine::IsCurrent(const HubItem& item) const {
+  std::lock_guard lock(mu_);
   auto it = generations_.find(item.component);
   return it != generations_.end() && it->second == item.generation;
 }
 
 Verdict DockerEngine::StartContainer(dsl::Plugin& plugin) {
   const dsl::ContainerSpec& s = plugin.spec();
-  auto it = container_ids_.find(plugin.id());
-  if (it == container_ids_.end()) return Verdict::Err("no container for " + plugin.id(), plugin.Path());
-  const std::string id = it->second;
+  const auto found = ContainerId(plugin.id());
+  if (!found) return Verdict::Err("no container for " + plugin.id(), plugin.Path());
+  const std::string id = *found;
   if (!s.ready_pattern.empty()) {
     auto re = CompileLogPattern(s.ready_pattern);
     if (!re) return Verdict::FromError(re.error(), plugin.Path());
@@ -279,14 +346,12 @@ void DockerEngine::CollectArtifacts(const dsl::Plugin& plugin, const std::string
   for (const std::string& path : plugin.spec().artifacts) {
     auto tar = api_.GetArchive(container_id, path);
     if (!tar) {
-      problems_.push_back(plugin.id() + ": artifact " + path + " not collected: " +
-                          tar.error().ToString());
+      AddProblem(plugin.id() + ": artifact " + path + " not collected: " + tar.error().ToString());
       continue;
     }
     auto entries = docker::ReadTar(*tar);
     if (!entries) {
-      problems_.push_back(plugin.id() + ": artifact " + path + " unreadable: " +
-                          entries.error().ToString());
+      AddProblem(plugin.id() + ": artifact " + path + " unreadable: " + entries.error().ToString());
       continue;
     }
     for (const docker::TarEntry& e : *entries) {
@@ -296,18 +361,19 @@ void DockerEngine::CollectArtifacts(const dsl::Plugin& plugin, const std::string
       std::ofstream out(dest, std::ios::binary | std::ios::trunc);
       out.write(e.content.data(), static_cast<std::streamsize>(e.content.size()));
       if (!out) {
-        problems_.push_back(plugin.id() + ": cannot write " + dest);
+        AddProblem(plugin.id() + ": cannot write " + dest);
         continue;
       }
+      std::lock_guard lock(mu_);
       artifacts_[name] = dest;
     }
   }
 }
 
 Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
-  auto it = container_ids_.find(plugin.id());
-  if (it == container_ids_.end()) return Verdict::Success();
-  const std::string id = it->second;
+  const auto found = ContainerId(plugin.id());
+  if (!found) return Verdict::Success();
+  const std::string id = *found;
   Verdict v;
   if (Status s = api_.StopContainer(id, plugin.spec().stop_timeout_s);
       !s && s.error().code() != ErrorCode::kNotFound) {
@@ -315,6 +381,7 @@ Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
   }
   JoinFollower(plugin.id(), /*cancel=*/false);
   if (auto info = api_.InspectContainer(id)) {
+    std::lock_guard lock(mu_);
     reports_[plugin.id()].exit_code = info->state.exit_code;
     reports_[plugin.id()].oom_killed = info->state.oom_killed;
   }
@@ -323,21 +390,21 @@ Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
       !s && s.error().code() != ErrorCode::kNotFound) {
     v.KeepWorse(Verdict::FromError(s.error().Context("removing " + plugin.spec().name), plugin.Path()));
   }
-  container_ids_.erase(it);
+  std::lock_guard lock(mu_);
+  container_ids_.erase(plugin.id());
   return v;
 }
 
 Result<docker::ContainerState> DockerEngine::Inspect(const std::string& component) {
-  auto it = container_ids_.find(component);
-  if (it == container_ids_.end()) {
-    return Error(ErrorCode::kNotFound, "no container for component " + component);
-  }
-  auto info = api_.InspectContainer(it->second);
+  const auto id = ContainerId(component);
+  if (!id) return Error(ErrorCode::kNotFound, "no container for component " + component);
+  auto info = api_.InspectContainer(*id);
   if (!info) return info.error();
   return info->state;
 }
 
 std::vector<ComponentReport> DockerEngine::Reports() const {
+  std::lock_guard lock(mu_);
   std::vector<ComponentReport> out;
   for (const auto& [name, r] : reports_) out.push_back(r);
   return out;

@@ -183,9 +183,29 @@ Result<std::vector<docker::ContainerSummary>> FakeDockerApi::ListContainers(
   return out;
 }
 
+bool FakeDockerApi::Rendezvous(std::unique_lock<std::mutex>& lock,
+                               const std::set<std::string>& group, std::set<std::string>& arrived,
+                               const std::string& component) {
+  if (group.count(component) == 0) return true;
+  arrived.insert(component);
+  cv_.notify_all();
+  return cv_.wait_for(lock, std::chrono::seconds(10), [&] {
+    for (const std::string& g : group) {
+      if (arrived.count(g) == 0) return false;
+    }
+    return true;
+  });
+}
+
 Status FakeDockerApi::StartContainer(std::string_view id) {
-  std::lock_guard lock(mu_);
+  std::unique_lock lock(mu_);
   Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  const std::string component = c->component;
+  if (!Rendezvous(lock, start_together, started_together_, component)) {
+    return Error(ErrorCode::kTimeout, component + " started alone", "POST /containers/start");
+  }
+  c = Find(id);  // the map may have changed while we waited
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
   calls_.push_back("start " + c->spec.name);
   if (scripts[c->component].fail_start) {
@@ -213,8 +233,14 @@ void FakeDockerApi::StartLocked(Container& c) {
 }
 
 Status FakeDockerApi::StopContainer(std::string_view id, int) {
-  std::lock_guard lock(mu_);
+  std::unique_lock lock(mu_);
   Container* c = Find(id);
+  if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
+  const std::string component = c->component;
+  if (!Rendezvous(lock, stop_together, stopped_together_, component)) {
+    return Error(ErrorCode::kTimeout, component + " stopped alone", "POST /containers/stop");
+  }
+  c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
   calls_.push_back("stop " + c->spec.name);
   if (c->state.running) {

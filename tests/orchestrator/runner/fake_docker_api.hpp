@@ -16,6 +16,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,12 @@ class FakeDockerApi : public docker::DockerApi {
   int network_conflicts = 0;
   // Exec answers by command text (argv joined with spaces); others exit 0 with no output.
   std::map<std::string, ExecAnswer> exec_answers;
+  // Rendezvous, to show that calls overlap: StartContainer (StopContainer) of a component named
+  // here blocks until every component named here is inside StartContainer (StopContainer) too.
+  // A call that waited 10 s in vain fails ("... alone"), so a one-by-one runner fails the test
+  // instead of hanging it.
+  std::set<std::string> start_together;
+  std::set<std::string> stop_together;
 
   // Inspection for tests.
   struct Container {
@@ -110,6 +117,11 @@ class FakeDockerApi : public docker::DockerApi {
   Container* Find(std::string_view id);  // by id or name; mu_ held
 
   void StartLocked(Container& c);  // mu_ held
+  // Waits for the other members of `group` (mu_ held through `lock`); false after 10 s in vain.
+  bool Rendezvous(std::unique_lock<std::mutex>& lock, const std::set<std::string>& group,
+                  std::set<std::string>& arrived, const std::string& component);
+  std::set<std::string> started_together_;
+  std::set<std::string> stopped_together_;
   struct Exec {
     std::string container;
     std::vector<std::string> cmd;

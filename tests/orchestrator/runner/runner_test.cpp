@@ -6,7 +6,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <condition_variable>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -15,6 +18,7 @@
 #include "fake_docker_api.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/tar_archive.hpp"
+#include "swarmbox/runner/docker_engine.hpp"
 
 namespace swarmbox::runner {
 namespace {
@@ -273,6 +277,104 @@ TEST_F(RunnerTest, InputFilesAreCopiedIntoTheContainers) {
     }
   }
   EXPECT_TRUE(airframe);
+}
+
+TEST_F(RunnerTest, TheAgentsOfALevelStartAndStopAtOnceAfterThePhysicsServerIsReady) {
+  spec_.drones.clear();
+  spec_.Drone("scout_1", "x500", {0, 0, 0})
+      .Drone("scout_2", "x500", {3, 0, 0})
+      .Drone("scout_3", "x500", {6, 0, 0});
+  api_.scripts["scout_3"].lines = {"t=2 node=scout_3 event=mission_complete"};
+  // Each scout's start (stop) waits inside the engine until the other two are there as well: a
+  // runner going one by one would fail these calls instead.
+  api_.start_together = {"scout_1", "scout_2", "scout_3"};
+  api_.stop_together = {"scout_1", "scout_2", "scout_3"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  for (const std::string& problem : run.result.problems) {
+    EXPECT_THAT(problem, ::testing::Not(HasSubstr("alone")));
+  }
+  // Levels keep their order: the physics server starts (and is ready) before any scout starts,
+  // and is stopped only after every scout was removed; networks go last.
+  std::vector<std::string> calls;
+  for (const std::string& c : api_.Calls()) {
+    if (c.rfind("start", 0) == 0 || c.rfind("stop", 0) == 0 || c.rfind("remove", 0) == 0) {
+      calls.push_back(c);
+    }
+  }
+  const std::string p = "mini-20261121-120000-abcd-";
+  auto at = [&](const std::string& call) {
+    return std::find(calls.begin(), calls.end(), call) - calls.begin();
+  };
+  ASSERT_EQ(calls.size(), 14u) << ::testing::PrintToString(calls);
+  EXPECT_EQ(calls[0], "start " + p + "physics");
+  for (const char* s : {"scout_1", "scout_2", "scout_3"}) {
+    EXPECT_LT(at("start " + p + s), at("stop " + p + s));
+    EXPECT_LT(at("remove " + p + s), at("stop " + p + "physics"));
+  }
+  EXPECT_THAT(std::vector<std::string>(calls.end() - 4, calls.end()),
+              ::testing::ElementsAre("stop " + p + "physics", "remove " + p + "physics",
+                                     "remove-network " + p + "net2-mesh",
+                                     "remove-network " + p + "net1-sim"));
+  EXPECT_EQ(run.result.components.size(), 4u);
+  for (const ComponentReport& c : run.result.components) EXPECT_EQ(c.exit_code, 0) << c.name;
+  ExpectNothingLeft();
+}
+
+TEST(RunConcurrently, RunsTheStepsAtOnceAndKeepsTheWorstVerdict) {
+  // Four steps that each wait for all four: only a run with four at once gets through.
+  std::mutex mu;
+  std::condition_variable cv;
+  int arrived = 0;
+  auto step = [&](dsl::Verdict v) {
+    return [&, v] {
+      std::unique_lock lock(mu);
+      ++arrived;
+      cv.notify_all();
+      const bool all = cv.wait_for(lock, std::chrono::seconds(10), [&] { return arrived == 4; });
+      return all ? v : dsl::Verdict::Err("ran alone");
+    };
+  };
+  std::vector<std::function<dsl::Verdict()>> steps = {
+      step(dsl::Verdict::Success()), step(dsl::Verdict::Fail("first failure")),
+      step(dsl::Verdict::Fail("second failure")), step(dsl::Verdict::Success())};
+  dsl::Verdict v = RunConcurrently(steps, 4);
+  EXPECT_EQ(v.ToString(), "failure: first failure");
+  EXPECT_EQ(arrived, 4);
+}
+
+TEST(RunConcurrently, NeverRunsMoreThanTheLimitAndRunsEveryStep) {
+  std::mutex mu;
+  int running = 0;
+  int peak = 0;
+  std::vector<int> ran(10, 0);
+  std::vector<std::function<dsl::Verdict()>> steps;
+  for (int i = 0; i < 10; ++i) {
+    steps.emplace_back([&, i] {
+      {
+        std::lock_guard lock(mu);
+        peak = std::max(peak, ++running);
+        ++ran[static_cast<std::size_t>(i)];
+      }
+      std::lock_guard lock(mu);
+      --running;
+      return dsl::Verdict::Success();
+    });
+  }
+  EXPECT_TRUE(RunConcurrently(steps, 3).ok());
+  EXPECT_LE(peak, 3);
+  EXPECT_THAT(ran, ::testing::Each(1));
+  // One thread: in order, on the calling thread.
+  std::vector<std::string> order;
+  std::vector<std::function<dsl::Verdict()>> in_order;
+  for (const char* name : {"a", "b", "c"}) {
+    in_order.emplace_back([&order, name, caller = std::this_thread::get_id()] {
+      order.push_back(std::this_thread::get_id() == caller ? name : "elsewhere");
+      return dsl::Verdict::Success();
+    });
+  }
+  EXPECT_TRUE(RunConcurrently(in_order, 1).ok());
+  EXPECT_THAT(order, ::testing::ElementsAre("a", "b", "c"));
 }
 
 }  // namespace

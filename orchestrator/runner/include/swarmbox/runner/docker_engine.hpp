@@ -5,7 +5,14 @@
 // artifacts (Docker's archive endpoint, so remote engines work too), and removes. Containers are
 // never auto-removed, so a crashed container's logs and exit code are kept.
 //
-// Thread-safety: the dsl::Engine methods are called from the runner's thread only.
+// The containers of one run-priority level are handled at once (RunSiblings: up to
+// EngineOptions::max_parallel threads, each making its own calls on the thread-safe DockerApi):
+// created and filled together, started together (each waiting for its own readiness), stopped,
+// drained and removed together. Levels stay in order (the tree walks them one after another).
+//
+// Thread-safety: the tree (runner's thread) calls the dsl::Engine methods, concurrently for the
+// components of one level; Trace calls are serialised. Inspect, ResumeLogs and IsCurrent may be
+// called from the runner's thread at any time; problems() and artifacts() once no walk runs.
 #pragma once
 
 #include <atomic>
@@ -34,7 +41,15 @@ struct EngineOptions {
   const std::atomic<bool>* interrupted = nullptr;  // Ctrl-C: readiness waits give up
   // Called with each lifecycle step (events.jsonl); may be empty.
   std::function<void(const dsl::Component&, dsl::EventKind, const dsl::Verdict&)> on_trace;
+  // How many containers of one level are created, started or stopped at once (1 = one by one).
+  int max_parallel = 8;
 };
+
+// Runs every step, at most `max_threads` at once (the calling thread works too; one thread or one
+// step runs on the calling thread alone), waits for all and returns the worst verdict (ties: the
+// earliest step's). Steps must not throw.
+dsl::Verdict RunConcurrently(const std::vector<std::function<dsl::Verdict()>>& steps,
+                             int max_threads);
 
 class DockerEngine final : public dsl::Engine {
  public:
@@ -50,6 +65,8 @@ class DockerEngine final : public dsl::Engine {
   dsl::Verdict StopContainer(dsl::Plugin& plugin) override;
   void Trace(const dsl::Component& component, dsl::EventKind event,
              const dsl::Verdict& verdict) override;
+  dsl::Verdict RunSiblings(const std::vector<std::function<dsl::Verdict()>>& steps,
+                           bool stop_on_failure) override;
 
   // The container's state now (after its log stream ended, to tell a crash from a hiccup).
   Result<docker::ContainerState> Inspect(const std::string& component);
@@ -60,7 +77,7 @@ class DockerEngine final : public dsl::Engine {
   // Whether a hub item comes from the component's current follower (not one before a restart).
   bool IsCurrent(const HubItem& item) const;
   // True when the last network creation failed because its subnet overlaps another network.
-  bool subnet_conflict() const { return subnet_conflict_; }
+  bool subnet_conflict() const { return subnet_conflict_.load(); }
   // Per container: exit code, log file, line count (filled on Stop).
   std::vector<ComponentReport> Reports() const;
   // Things that went wrong without changing the outcome (a missing artifact...).
@@ -75,11 +92,15 @@ class DockerEngine final : public dsl::Engine {
   void JoinFollower(const std::string& component, bool cancel);
   Status CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id);
   void CollectArtifacts(const dsl::Plugin& plugin, const std::string& container_id);
+  void AddProblem(std::string problem);
+  std::optional<std::string> ContainerId(const std::string& component) const;
 
   docker::DockerApi& api_;
   LogHub& hub_;
   Clock& clock_;
   EngineOptions options_;
+  std::mutex trace_mu_;    // one Trace at a time
+  mutable std::mutex mu_;  // guards the maps and lists below (never held across a Docker call)
   std::map<std::string, std::string> network_ids_;    // component id -> Docker id
   std::map<std::string, std::string> container_ids_;  // component id -> Docker id
   std::map<std::string, std::unique_ptr<Follower>> followers_;
@@ -88,7 +109,7 @@ class DockerEngine final : public dsl::Engine {
   std::map<std::string, std::string> artifacts_;
   std::map<std::string, std::uint64_t> generations_;  // component -> current follower
   std::uint64_t next_generation_ = 1;
-  bool subnet_conflict_ = false;
+  std::atomic<bool> subnet_conflict_{false};
 };
 
 }  // namespace swarmbox::runner
