@@ -9,6 +9,7 @@
 #include "swarmbox/images/ensure_image.hpp"
 #include "swarmbox/images/image_context.hpp"
 #include "swarmbox/images/standard_images.hpp"
+#include "swarmbox/images/tag_cache.hpp"
 
 namespace swarmbox::cli {
 
@@ -73,10 +74,13 @@ Result<runner::Images> EnsureTrialImages(docker::DockerApi& api, const ProgramPa
   auto agent_bin = FindProgram("swarmbox-agent", programs.agent_bin);
   if (!agent_bin) return agent_bin.error();
   runner::Images out;
-  auto physics = images::EnsureImage(api, images::PhysicsImage(*physics_bin), progress, nullptr);
+  // Unchanged programs are not packed again (their tags are remembered in the user's cache).
+  const images::TagCache cache(images::DefaultTagCacheDir());
+  auto physics =
+      images::EnsureImage(api, images::PhysicsImage(*physics_bin), progress, nullptr, &cache);
   if (!physics) return physics.error().Context("image swarmbox/physics");
   out.physics = physics->tag;
-  auto agent = images::EnsureImage(api, images::AgentImage(*agent_bin), progress, nullptr);
+  auto agent = images::EnsureImage(api, images::AgentImage(*agent_bin), progress, nullptr, &cache);
   if (!agent) return agent.error().Context("image swarmbox/agent");
   out.agent = agent->tag;
   return out;

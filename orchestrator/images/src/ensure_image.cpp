@@ -15,15 +15,49 @@ double SecondsSince(std::chrono::steady_clock::time_point start) {
 
 Result<EnsuredImage> EnsureImage(docker::DockerApi& api, const ImageSpec& spec,
                                  const docker::BuildProgressFn& progress,
-                                 docker::CancelToken* cancel) {
+                                 docker::CancelToken* cancel, const TagCache* cache) {
   const std::string doing = "ensuring image " + spec.repository;
   EnsuredImage out;
   const auto pack_start = std::chrono::steady_clock::now();
+  if (cache != nullptr) {
+    if (auto tag = cache->Lookup(spec)) {
+      auto existing = api.InspectImage(*tag);
+      if (existing) {
+        out.tag = *tag;
+        out.from_cache = true;
+        out.image_id = existing->id;
+        out.image_size_bytes = existing->size_bytes;
+        out.pack_s = SecondsSince(pack_start);
+        return out;
+      }
+      if (existing.error().code() != ErrorCode::kNotFound) return existing.error().Context(doing);
+      // Not on this engine: pack and build as usual.
+    }
+  }
+  // The spec's own files before packing: a file rewritten while we read it is not remembered.
+  std::vector<Result<FileStamp>> before;
+  if (cache != nullptr) {
+    for (const auto* group : {&spec.executables, &spec.plugins, &spec.files}) {
+      for (const HostFile& f : *group) before.push_back(StampFile(f.host_path));
+    }
+  }
   auto ctx = PackContext(spec);
   if (!ctx) return ctx.error();
   out.pack_s = SecondsSince(pack_start);
   out.tag = ctx->tag;
   out.context_bytes = ctx->tar.size();
+  if (cache != nullptr) {
+    bool unchanged = true;
+    std::size_t i = 0;
+    for (const auto* group : {&spec.executables, &spec.plugins, &spec.files}) {
+      for (const HostFile& f : *group) {
+        auto now = StampFile(f.host_path);
+        unchanged = unchanged && before[i] && now && *before[i] == *now;
+        ++i;
+      }
+    }
+    if (unchanged) (void)cache->Remember(spec, *ctx);  // a failure only costs the next run a pack
+  }
 
   auto existing = api.InspectImage(ctx->tag);
   if (existing) {

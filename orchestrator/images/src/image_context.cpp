@@ -165,6 +165,7 @@ Result<PackedContext> PackContext(const ImageSpec& spec) {
   std::vector<TarEntry> rootfs;
   std::set<std::string> taken;
   std::vector<std::string> elf_paths;
+  std::vector<std::string> closure_paths;
   for (const auto* group : {&spec.executables, &spec.plugins, &spec.files}) {
     for (const HostFile& f : *group) {
       auto e = ReadHostFile(f, spec.strip_debug && group == &spec.executables);
@@ -179,6 +180,7 @@ Result<PackedContext> PackContext(const ImageSpec& spec) {
     if (!closure) return closure.error().Context("packing " + spec.repository);
     for (const std::string& lib : *closure) {
       if (taken.count(lib) != 0) continue;  // the spec placed it already
+      closure_paths.push_back(lib);
       auto e = ReadHostFile(HostFile{lib, lib, 0});
       if (!e) return e.error().Context("packing " + spec.repository);
       taken.insert(lib);
@@ -207,7 +209,14 @@ Result<PackedContext> PackContext(const ImageSpec& spec) {
     e.mode = mode;
     rootfs.push_back(std::move(e));
   }
-  return AssembleContext(spec, std::move(rootfs));
+  std::vector<std::string> host_files;
+  for (const auto* group : {&spec.executables, &spec.plugins, &spec.files}) {
+    for (const HostFile& f : *group) host_files.push_back(f.host_path);
+  }
+  for (const std::string& lib : closure_paths) host_files.push_back(lib);
+  auto ctx = AssembleContext(spec, std::move(rootfs));
+  if (ctx) ctx->host_files = std::move(host_files);
+  return ctx;
 }
 
 }  // namespace swarmbox::images

@@ -8,6 +8,7 @@
 
 #include "swarmbox/images/ensure_image.hpp"
 #include "swarmbox/images/standard_images.hpp"
+#include "swarmbox/images/tag_cache.hpp"
 
 namespace swarmbox::runner {
 
@@ -66,7 +67,8 @@ Result<std::string> EnsureFaultsImage(docker::DockerApi& api, const std::string&
                                       const std::function<void(std::string_view)>& progress) {
   auto spec = images::FaultSidecarImage(netemd_binary);
   if (!spec) return spec.error().Context("fault sidecar image");
-  auto built = images::EnsureImage(api, *spec, progress, nullptr);
+  const images::TagCache cache(images::DefaultTagCacheDir());
+  auto built = images::EnsureImage(api, *spec, progress, nullptr, &cache);
   if (!built) return built.error().Context("image swarmbox/faults");
   return built->tag;
 }

@@ -16,6 +16,7 @@
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/docker/docker_api.hpp"
 #include "swarmbox/images/image_spec.hpp"
+#include "swarmbox/images/tag_cache.hpp"
 
 namespace swarmbox::images {
 
@@ -27,11 +28,16 @@ struct EnsuredImage {
   std::int64_t image_size_bytes = 0;
   double pack_s = 0;                // reading files, closure, tar and hash [s]
   double build_s = 0;               // the /build call, 0 when skipped [s]
+  bool from_cache = false;          // the tag came from the TagCache (nothing packed; no context)
 };
 
+// With a `cache` (tag_cache.hpp), a spec whose input files are unchanged since it was last packed
+// is not packed again: its remembered tag is checked on the engine (one inspect) and, when the
+// engine has it, that is all; otherwise (or on a miss) it is packed, built if missing, and
+// remembered.
 Result<EnsuredImage> EnsureImage(docker::DockerApi& api, const ImageSpec& spec,
                                  const docker::BuildProgressFn& progress,
-                                 docker::CancelToken* cancel);
+                                 docker::CancelToken* cancel, const TagCache* cache = nullptr);
 
 // Removes the images of `repository` (label swarmbox.image=<repository>, set by the generated
 // Dockerfile) other than `keep_tag`: the older content hashes. Not forced, so an image a container

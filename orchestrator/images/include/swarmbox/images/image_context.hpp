@@ -28,6 +28,8 @@ struct PackedContext {
   std::string content_hash;  // full SHA-256 of `tar`, hex
   std::vector<std::string> image_paths;  // every file, directory and link put in the image
   std::size_t payload_bytes = 0;         // sum of the file sizes
+  // Every host file read (the spec's files and the library closure; PackContext only).
+  std::vector<std::string> host_files;
 };
 
 // The generated Dockerfile (pure).
