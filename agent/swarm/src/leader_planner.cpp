@@ -1,6 +1,7 @@
 #include "swarmbox/swarm/leader_planner.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,11 +18,25 @@ bool IsOneOf(const std::string& mode, std::initializer_list<std::string_view> mo
   return std::find(modes.begin(), modes.end(), mode) != modes.end();
 }
 
+// A scout that has nothing left to sweep (or has left the search: battery, mission over).
+bool ScoutDone(const std::string& mode) {
+  return IsOneOf(mode, {"swept", "returning", "landing", "landed", "on_ground"});
+}
+
+// How soon a scout could take over a sector: 0 idle in the air, 1 busy (or climbing), 2 on its
+// way down or on the ground (it must take off again).
+int Availability(const std::string& mode) {
+  if (IsOneOf(mode, {"swept", "awaiting_sector", "returning"})) return 0;
+  if (IsOneOf(mode, {"landing", "landed", "on_ground"})) return 2;
+  return 1;
+}
+
 }  // namespace
 
 LeaderPlanner::LeaderPlanner(LeaderConfig config) : config_(std::move(config)) {
   SWARMBOX_CHECK(config_.search_area.width_m() > 0 && config_.search_area.height_m() > 0);
   SWARMBOX_CHECK(config_.retry_s > 0);
+  SWARMBOX_CHECK(config_.member_timeout_s > 0 && config_.assignment_settle_s >= 0);
 }
 
 bool LeaderPlanner::Due(const std::string& key, double t_s) {
@@ -31,14 +46,110 @@ bool LeaderPlanner::Due(const std::string& key, double t_s) {
   return true;
 }
 
+void LeaderPlanner::Track(double t_s, const raft::MissionState& m) {
+  const bool first = !tracking_;
+  if (first) {
+    tracking_ = true;
+    first_s_ = t_s;
+  }
+  if (first || !(m.sectors() == sectors_)) {
+    sectors_ = m.sectors();
+    sectors_changed_s_ = t_s;
+  }
+}
+
+bool LeaderPlanner::GoneOwner(double t_s, const std::string& drone,
+                              std::span<const RosterEntry> roster) const {
+  for (const RosterEntry& r : roster) {
+    if (r.name == drone) return !Alive(r);
+  }
+  // Never heard (or not a mission agent): gone once everyone had time to be heard.
+  return t_s - first_s_ >= config_.member_timeout_s;
+}
+
+void LeaderPlanner::ReportMembers(double t_s, std::span<const RosterEntry> roster, MissionOutput* out) {
+  for (const RosterEntry& r : roster) {
+    const bool alive = Alive(r);
+    if (!alive && lost_.insert(r.name).second) {
+      out->events.push_back(std::move(LogEvent(t_s, config_.name, "member_lost")
+                                          .Add("drone", r.name)
+                                          .Add("role", RoleName(r.role))
+                                          .Add("silent_s", r.age_s, 1)
+                                          .Add("last_mode", r.mode)));
+    } else if (alive && lost_.erase(r.name) != 0) {
+      out->events.push_back(std::move(LogEvent(t_s, config_.name, "member_back")
+                                          .Add("drone", r.name)
+                                          .Add("mode", r.mode)));
+    }
+  }
+}
+
+std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raft::MissionState& m,
+                                                           std::span<const RosterEntry> roster,
+                                                           MissionOutput* out) const {
+  std::vector<raft::Sector> keep, orphans;
+  for (const raft::Sector& s : m.sectors()) (GoneOwner(t_s, s.drone, roster) ? orphans : keep).push_back(s);
+  if (orphans.empty()) return std::nullopt;
+  struct Candidate {
+    const RosterEntry* entry;
+    int rank;
+  };
+  std::vector<Candidate> cands;
+  for (const RosterEntry& r : roster) {
+    if (r.role == Role::kScout && Alive(r)) cands.push_back({&r, Availability(r.mode)});
+  }
+  if (cands.empty()) return std::nullopt;
+  // Lane progress is not replicated (a dead scout's last lane is in no committed state a new
+  // leader could read), so the whole sector is handed over. It is cut across its longer side into
+  // at most as many near-square pieces as fit (about as long as the sector is wide, so lanes stay
+  // long and no swath is wasted), one per scout: the re-sweep costs a fraction of a sector.
+  raft::AssignSectors a;
+  a.sectors = std::move(keep);
+  for (const raft::Sector& o : orphans) {
+    const Rect rect = AsRect(o);
+    const double long_m = std::max(rect.width_m(), rect.height_m());
+    const double short_m = std::min(rect.width_m(), rect.height_m());
+    const std::size_t fit = static_cast<std::size_t>(std::max(1.0, std::round(long_m / short_m)));
+    const std::size_t k = std::min(cands.size(), fit);
+    const Eigen::Vector2d c = rect.center_m();
+    std::sort(cands.begin(), cands.end(), [&](const Candidate& x, const Candidate& y) {
+      if (x.rank != y.rank) return x.rank < y.rank;
+      const double dx = (x.entry->position_m - c).norm(), dy = (y.entry->position_m - c).norm();
+      if (dx != dy) return dx < dy;
+      return x.entry->name < y.entry->name;
+    });
+    std::vector<std::string> to;
+    for (std::size_t i = 0; i < k; ++i) {
+      to.push_back(cands[i].entry->name);
+      cands[i].rank = std::max(cands[i].rank, 1) + 1;  // has work now: others first next time
+    }
+    std::sort(to.begin(), to.end());  // pieces in name order: the same plan whoever computes it
+    std::string list;
+    for (raft::Sector& piece : PartitionArea(rect, to)) {
+      list += (list.empty() ? "" : ",") + piece.drone;
+      a.sectors.push_back(std::move(piece));
+    }
+    out->events.push_back(std::move(LogEvent(t_s, config_.name, "sector_reassigned")
+                                        .Add("from", o.drone)
+                                        .Add("to", list)
+                                        .Add("x_min", o.x_min_m, 1)
+                                        .Add("y_min", o.y_min_m, 1)
+                                        .Add("x_max", o.x_max_m, 1)
+                                        .Add("y_max", o.y_max_m, 1)));
+  }
+  return a;
+}
+
 void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
                          std::span<const RosterEntry> roster, MissionOutput* out) {
-  std::vector<std::string> scouts;
+  Track(t_s, m);
+  ReportMembers(t_s, roster, out);
+  std::vector<std::string> scouts;  // live ones
   const RosterEntry* lifter = nullptr;
   bool scouts_airborne = true;
-  bool scouts_done = true;
   bool all_down = true;
   for (const RosterEntry& r : roster) {
+    if (!Alive(r)) continue;  // a dead drone's last mode says nothing any more
     all_down = all_down && IsOneOf(r.mode, {"landed", "on_ground"});
     if (r.role == Role::kLifter) {
       if (lifter == nullptr) lifter = &r;
@@ -46,10 +157,34 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
     }
     scouts.push_back(r.name);
     scouts_airborne = scouts_airborne && !IsOneOf(r.mode, {"on_ground", "taking_off"});
-    scouts_done = scouts_done &&
-                  IsOneOf(r.mode, {"swept", "returning", "landing", "landed", "on_ground"});
   }
   std::sort(scouts.begin(), scouts.end());
+
+  // Sectors of gone members go to live scouts first (any phase with sectors still to search).
+  bool orphans = false;
+  const bool searching = m.phase() == MissionPhase::kIdle || m.phase() == MissionPhase::kSearch ||
+                         m.phase() == MissionPhase::kConverge || m.phase() == MissionPhase::kRescue;
+  if (searching && !m.sectors().empty()) {
+    MissionOutput scratch;
+    if (auto a = Reassign(t_s, m, roster, &scratch)) {
+      orphans = true;
+      if (Due("reassign", t_s)) {
+        out->proposals.push_back(std::move(*a));
+        for (LogEvent& e : scratch.events) out->events.push_back(std::move(e));
+      }
+    } else {
+      for (const raft::Sector& s : m.sectors()) orphans = orphans || GoneOwner(t_s, s.drone, roster);
+    }
+  }
+  // The search is finished when every sector has a live owner that swept it (or left), every
+  // live scout without a sector idles, and no hand-over is younger than the settle time.
+  bool scouts_done = !orphans && t_s - sectors_changed_s_ >= config_.assignment_settle_s;
+  for (const RosterEntry& r : roster) {
+    if (!scouts_done) break;
+    if (r.role != Role::kScout || !Alive(r)) continue;
+    const bool owns = m.SectorOf(r.name) != nullptr;
+    scouts_done = ScoutDone(r.mode) || (!owns && r.mode == "awaiting_sector");
+  }
 
   const raft::Victim* candidate = nullptr;  // confirmed, not yet rescued or handled
   bool rescue_running = false;

@@ -1,5 +1,6 @@
 #include "swarmbox/swarm/scout_behaviour.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -71,6 +72,13 @@ void ScoutBehaviour::PlanSector(const raft::Sector& sector, const Eigen::Vector3
   lanes_ = LawnmowerWaypoints(AsRect(sector), SweepSpacing(footprint_, config_.overlap), Altitude(),
                               footprint_, position_m.head<2>());
   lane_index_ = 0;
+}
+
+const raft::Sector* ScoutBehaviour::NextSector(const raft::MissionState& m) const {
+  for (const raft::Sector& s : m.sectors()) {
+    if (s.drone == config_.name && std::find(swept_.begin(), swept_.end(), s) == swept_.end()) return &s;
+  }
+  return nullptr;
 }
 
 const raft::Victim* ScoutBehaviour::OrbitTarget(const MissionInput& in) const {
@@ -147,14 +155,29 @@ void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
     Enter(Stage::kTakingOff, in, out);
   }
 
+  // Back to work: a sector handed over after this scout had finished (not with a low battery).
+  if (Active(m.phase()) && !battery_low_reported_ && !in.battery_low && NextSector(m) != nullptr) {
+    if (stage_ == Stage::kReturning) Enter(Stage::kAwaitingSector, in, out);
+    if (stage_ == Stage::kLanded) Enter(Stage::kTakingOff, in, out);
+  }
+
   // Mission stages: orbit a target, search the sector, or wait for one.
   const bool on_mission = stage_ == Stage::kAwaitingSector || stage_ == Stage::kSearching ||
                           stage_ == Stage::kSwept || stage_ == Stage::kOrbiting;
   if (on_mission) {
-    const raft::Sector* sector = Active(m.phase()) ? m.SectorOf(config_.name) : nullptr;
-    if (sector != nullptr && (!has_plan_ || !(*sector == planned_sector_))) PlanSector(*sector, p);
+    const raft::Sector* sector = Active(m.phase()) ? NextSector(m) : nullptr;
+    const bool owns = Active(m.phase()) && m.SectorOf(config_.name) != nullptr;
+    if (sector != nullptr && (!has_plan_ || !(*sector == planned_sector_))) {
+      PlanSector(*sector, p);
+      out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_started")
+                                          .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))
+                                          .Add("x_min", sector->x_min_m, 1)
+                                          .Add("y_min", sector->y_min_m, 1)
+                                          .Add("x_max", sector->x_max_m, 1)
+                                          .Add("y_max", sector->y_max_m, 1)));
+    }
     const raft::Victim* target = OrbitTarget(in);
-    const bool still_sweeping = sector != nullptr && lane_index_ < lanes_.size();
+    const bool still_sweeping = sector != nullptr;
     if (config_.keep_searching_during_rescue && still_sweeping && stage_ != Stage::kOrbiting) target = nullptr;
     if (target != nullptr) {
       if (orbit_victim_ != target->id || stage_ != Stage::kOrbiting) {
@@ -165,9 +188,9 @@ void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
       }
       Enter(Stage::kOrbiting, in, out);
     } else if (sector != nullptr) {
-      Enter(lane_index_ < lanes_.size() ? Stage::kSearching
-                                        : (config_.return_when_swept ? Stage::kReturning : Stage::kSwept),
-            in, out);
+      Enter(Stage::kSearching, in, out);
+    } else if (owns) {
+      Enter(config_.return_when_swept ? Stage::kReturning : Stage::kSwept, in, out);
     } else {
       Enter(Stage::kAwaitingSector, in, out);
     }
@@ -203,10 +226,16 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
       if ((lanes_[lane_index_].position_m.head<2>() - p.head<2>()).norm() <= config_.waypoint_radius_m) {
         ++lane_index_;
         if (lane_index_ == lanes_.size()) {
+          swept_.push_back(planned_sector_);
           out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_swept")
                                               .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
           Enter(Stage::kSwept, in, out);
           break;
+        }
+        if (lane_index_ % 2 == 0) {  // the end of a lane
+          out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_progress")
+                                              .Add("lanes_done", static_cast<std::int64_t>(lane_index_ / 2))
+                                              .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
         }
       }
       sp.kind = SetpointKind::kFlock;

@@ -535,6 +535,7 @@ TEST(LeaderPlanner, ReturnsHomeWhenAllIsDoneThenCompletesAndReportsOnce) {
   m.Apply(raft::ConvergeOn{1});
   m.Apply(raft::BeginRescue{1, "lifter"});
   LeaderPlanner leader({.name = "scout_1", .search_area = {-50, -50, 50, 50}});
+  leader.Track(-20.0, m.state);  // followed the committed state for a while (sectors settled)
   MissionOutput out;
   leader.Step(1.0, m.state, Roster("swept", "carry_home"), &out);
   EXPECT_TRUE(out.proposals.empty());  // RESCUE: the lifter finishes it

@@ -4,6 +4,7 @@
 // lawnmower sweeps, sightings -> confirmed victims (MissionState's confirmation rule), scouts
 // converge and orbit, the lifter's stretcher sequence, battery_low, event=mission_complete.
 #include <algorithm>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -124,6 +125,68 @@ TEST(MissionScenario, BatteryLowSendsEveryScoutHomeAndTheMissionEnds) {
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_LT((sim.position(i).head<2>() - c.drones[i].home_m.head<2>()).norm(), 1.5);
   }
+}
+
+
+// ---- losing a drone (issue #8) -------------------------------------------------------------
+
+// The lifter's config for the failure scenarios: victims in every strip of the area.
+MissionSimConfig FailureConfig() {
+  MissionSimConfig c = BaseConfig();
+  c.drones.push_back({"lifter", Role::kLifter, Vec3(-80, -58, 0), 0.6});
+  c.victims_m = {Vec2(-40, 20), Vec2(60, -30)};  // scout_3's strip is x in [33, 100]
+  return c;
+}
+
+// Runs to the first event=sector_progress of `drone`, then kills it (or silences it until
+// `back_s` after that); runs on to mission_complete and checks the ending.
+void RunWithOutage(MissionSim& sim, const std::string& drone, bool killed, double back_after_s) {
+  ASSERT_TRUE(sim.RunUntil([&](const MissionSim& s) { return s.FirstTime("sector_progress", "node=" + drone) >= 0; },
+                           600.0));
+  const double at = sim.t_s();
+  sim.AddOutage({drone, at, at + back_after_s, killed});
+  const bool complete = sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 3000.0);
+  ASSERT_TRUE(complete) << "no mission_complete by t=" << sim.t_s() << ", phase "
+                        << raft::PhaseName(sim.mission().phase());
+  // Every victim found and rescued, nobody owns a sector it did not sweep.
+  ASSERT_EQ(sim.mission().victims().size(), 2u);
+  for (const raft::Victim& v : sim.mission().victims()) EXPECT_EQ(v.status, raft::VictimStatus::kRescued);
+  const double lost = sim.FirstTime("member_lost", "drone=" + drone);
+  const double handed = sim.FirstTime("sector_reassigned", "from=" + drone);
+  EXPECT_GE(lost, at + 6.0 - 0.3);  // member_timeout_s after its last state (heard 0.2 s late)
+  EXPECT_GE(handed, lost);
+  for (const raft::Sector& s : sim.mission().sectors()) EXPECT_NE(s.drone, drone);
+  std::printf("%s lost at %.1f s: member_lost %.1f s, sector_reassigned %.1f s, mission_complete %.1f s\n",
+              drone.c_str(), at, lost, handed, sim.FirstTime("mission_complete"));
+}
+
+TEST(MissionFailure, AScoutKilledMidSweepHasItsSectorSweptByTheOthers) {
+  MissionSim sim(FailureConfig());
+  RunWithOutage(sim, "scout_3", true, 0.0);
+  // The strip scout_3 never finished went to the two live scouts, who swept it.
+  const std::string handed = sim.FirstLine("sector_reassigned", "from=scout_3");
+  EXPECT_NE(handed.find("to=scout_1,scout_2"), std::string::npos) << handed;
+  int swept = 0;
+  for (const std::string& l : sim.log()) {
+    swept += l.find("event=sector_swept") != std::string::npos && l.find("node=scout_3") == std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(swept, 4);  // two own strips, two pieces of scout_3's
+  EXPECT_TRUE(AllDown(sim, 2));
+}
+
+TEST(MissionFailure, TheLeaderKilledMidSweepANewLeaderFinishesTheMission) {
+  MissionSim sim(FailureConfig());
+  RunWithOutage(sim, "scout_1", true, 0.0);
+  EXPECT_EQ(sim.leader(), 1u);  // scout_2 leads now
+  const std::string handed = sim.FirstLine("sector_reassigned", "from=scout_1");
+  EXPECT_NE(handed.find("node=scout_2"), std::string::npos) << handed;  // the new leader did it
+}
+
+TEST(MissionFailure, AScoutSilentPastTheTimeoutComesBackAndTheMissionCompletes) {
+  MissionSim sim(FailureConfig());
+  RunWithOutage(sim, "scout_3", false, 20.0);
+  EXPECT_TRUE(sim.Logged("member_back"));
+  EXPECT_TRUE(AllDown(sim, 4));  // scout_3 too: it idled without a sector, then went home
 }
 
 }  // namespace

@@ -23,10 +23,14 @@ std::string EventLine(const raft::MissionEvent& e, double t_s) {
 }  // namespace
 
 MissionSim::MissionSim(MissionSimConfig config)
-    : config_(std::move(config)),
-      rng_(config_.seed),
-      leader_(LeaderConfig{.name = config_.drones.at(0).name, .search_area = config_.area,
-                           .retry_s = 2.0, .start_timeout_s = 60.0, .handle_time_s = 20.0}) {
+    : config_(std::move(config)), rng_(config_.seed) {
+  for (const SimDrone& d : config_.drones) {
+    planners_.emplace_back(LeaderConfig{.name = d.name, .search_area = config_.area, .retry_s = 2.0,
+                                        .start_timeout_s = 60.0, .handle_time_s = 20.0});
+    heard_s_.push_back(0.0);
+    heard_mode_.push_back("on_ground");
+    heard_pos_.push_back(d.home_m.head<2>());
+  }
   bool lifter_present = false;
   for (const SimDrone& d : config_.drones) lifter_present = lifter_present || d.role == Role::kLifter;
   FlockingParams fp;
@@ -58,6 +62,39 @@ MissionSim::MissionSim(MissionSimConfig config)
       stretcher_xy_ = d.home_m.head<2>();
     }
   }
+}
+
+bool MissionSim::Killed(std::size_t drone) const {
+  for (const MissionSimConfig::Outage& o : config_.outages) {
+    if (o.killed && o.drone == config_.drones[drone].name && t_s_ >= o.from_s) return true;
+  }
+  return false;
+}
+
+bool MissionSim::Silent(std::size_t drone) const {
+  for (const MissionSimConfig::Outage& o : config_.outages) {
+    if (!o.killed && o.drone == config_.drones[drone].name && t_s_ >= o.from_s && t_s_ < o.until_s) return true;
+  }
+  return false;
+}
+
+std::string MissionSim::FirstLine(const std::string& event, const std::string& also) const {
+  const std::string needle = "event=" + event;
+  for (const std::string& l : log_) {
+    const std::size_t at = l.find(needle);
+    if (at == std::string::npos) continue;
+    const std::size_t end = at + needle.size();
+    if (end != l.size() && l[end] != ' ') continue;
+    if (!also.empty() && l.find(also) == std::string::npos) continue;
+    return l;
+  }
+  return "";
+}
+
+double MissionSim::FirstTime(const std::string& event, const std::string& also) const {
+  const std::string l = FirstLine(event, also);
+  if (l.rfind("t=", 0) != 0) return -1.0;
+  return std::stod(l.substr(2));
 }
 
 bool MissionSim::Logged(const std::string& event) const {
@@ -112,6 +149,13 @@ void MissionSim::Step() {
   const double battery = std::max(0.0, config_.battery_fraction_at_start - config_.battery_drain_per_s * t_s_);
   for (std::size_t i = 0; i < n; ++i) {
     const SimDrone& d = config_.drones[i];
+    if (Killed(i)) {  // companion computer gone: motors off, it drops, nothing more from it
+      out_[i].setpoint = {};
+      out_[i].setpoint.kind = SetpointKind::kIdle;
+      pos_[i].z() = d.home_m.z() + d.base_height_m;
+      continue;
+    }
+    if (!Silent(i)) heard_s_[i] = t_s_;
     MissionInput in;
     in.t_s = t_s_;
     in.mission = &mission_;
@@ -129,8 +173,14 @@ void MissionSim::Step() {
       lifters_[static_cast<std::size_t>(behaviour_of_[i])].Step(in, &out);
     }
     modes_[i] = out.mode;
+    if (!Silent(i)) {
+      heard_mode_[i] = std::string(out.mode);
+      heard_pos_[i] = pos_[i].head<2>();
+    }
     for (const LogEvent& e : out.events) log_.push_back(e.str());
-    for (const raft::MissionCommand& c : out.proposals) pending_.push_back({t_s_ + config_.commit_delay_s, c});
+    if (!Silent(i)) {
+      for (const raft::MissionCommand& c : out.proposals) pending_.push_back({t_s_ + config_.commit_delay_s, c});
+    }
     // Fake world: payload commands with the physics server's sling geometry (x8_heavy).
     if (out.payload.action == PayloadAction::kAttach && !attached_) {
       const double hook_to_payload = (Vec3(pos_[i].x(), pos_[i].y(), pos_[i].z() - 0.4) -
@@ -146,15 +196,34 @@ void MissionSim::Step() {
       log_.push_back(LogEvent(t_s_, "world", "payload_released").str());
     }
   }
-  // Leader (drone 0).
-  std::vector<RosterEntry> roster;
-  for (std::size_t i = 0; i < n; ++i) {
-    roster.push_back({config_.drones[i].name, config_.drones[i].role, std::string(modes_[i])});
+  // Leader: the first drone alive and heard (Raft would elect one of those).
+  std::size_t lead_i = n;
+  for (std::size_t i = 0; i < n && lead_i == n; ++i) {
+    if (!Killed(i) && !Silent(i)) lead_i = i;
   }
-  MissionOutput lead;
-  leader_.Step(t_s_, mission_, roster, &lead);
-  for (const LogEvent& e : lead.events) log_.push_back(e.str());
-  for (const raft::MissionCommand& c : lead.proposals) pending_.push_back({t_s_ + config_.commit_delay_s, c});
+  if (lead_i != leader_index_ && lead_i < n) {
+    leader_index_ = lead_i;
+    log_.push_back(LogEvent(t_s_, config_.drones[lead_i].name, "leader_elected").Add("leader", config_.drones[lead_i].name).str());
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!Killed(i)) planners_[i].Track(t_s_, mission_);
+  }
+  if (lead_i < n) {
+    std::vector<RosterEntry> roster;
+    for (std::size_t i = 0; i < n; ++i) {
+      RosterEntry r;
+      r.name = config_.drones[i].name;
+      r.role = config_.drones[i].role;
+      r.mode = heard_mode_[i];
+      r.age_s = i == lead_i ? 0.0 : t_s_ - heard_s_[i] + config_.state_age_s;
+      r.position_m = heard_pos_[i];
+      roster.push_back(std::move(r));
+    }
+    MissionOutput lead;
+    planners_[lead_i].Step(t_s_, mission_, roster, &lead);
+    for (const LogEvent& e : lead.events) log_.push_back(e.str());
+    for (const raft::MissionCommand& c : lead.proposals) pending_.push_back({t_s_ + config_.commit_delay_s, c});
+  }
 
   // Kinematics.
   const double alpha = 1.0 - std::exp(-dt / 0.3);

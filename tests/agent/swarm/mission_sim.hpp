@@ -5,6 +5,12 @@
 // footprint into detections, and a fake world carries out payload attach/release with the
 // physics server's sling geometry (hook within sling_length +- tolerance of the stretcher).
 // Not a physics test: it checks that the behaviours, the leader planner and MissionState fit.
+//
+// Failures: a drone can be killed (its behaviour stops, it drops to the ground, it is never heard
+// again) or fall silent for a while (it flies on, but nobody hears its state and its proposals
+// are lost: a radio cut). Every drone runs a LeaderPlanner (Track on each step); the leader is
+// the first drone in the list that is alive and heard, so killing it hands the lead to the next.
+// Each drone's state is heard by the others state_age_s after it was taken.
 #pragma once
 
 #include <cstdint>
@@ -38,6 +44,14 @@ struct MissionSimConfig {
   double battery_fraction_at_start = 1.0;
   double battery_drain_per_s = 0.0;  // fraction per second (crude: tests of battery_low)
   bool scouts_only_report_once = false;
+  double state_age_s = 0.2;  // how old a heard state is (5 Hz, radio delay) [s]
+  struct Outage {
+    std::string drone;
+    double from_s = 0;
+    double until_s = 1e9;  // killed: never back (ignored); silent: heard again from here
+    bool killed = true;
+  };
+  std::vector<Outage> outages;
 };
 
 class MissionSim {
@@ -68,6 +82,13 @@ class MissionSim {
   double min_pair_distance_m() const { return min_pair_m_; }
   double min_flocking_pair_distance_m() const { return min_flock_pair_m_; }
   std::size_t rejected_proposals() const { return rejected_; }
+  std::size_t leader() const { return leader_index_; }
+  // A failure from now on (e.g. once a drone logged its first sector progress).
+  void AddOutage(MissionSimConfig::Outage outage) { config_.outages.push_back(std::move(outage)); }
+  // The first logged line with event=<event> (and `also` in it), or "".
+  std::string FirstLine(const std::string& event, const std::string& also = "") const;
+  // Its t= value, or -1.
+  double FirstTime(const std::string& event, const std::string& also = "") const;
 
  private:
   struct Pending {
@@ -84,7 +105,13 @@ class MissionSim {
   std::vector<LifterSequence> lifters_;
   std::vector<int> behaviour_of_;              // index into scouts_ or lifters_
   std::vector<Flocking> flock_;
-  LeaderPlanner leader_;
+  bool Killed(std::size_t drone) const;
+  bool Silent(std::size_t drone) const;
+  std::vector<LeaderPlanner> planners_;        // one per drone (whoever leads uses its own)
+  std::size_t leader_index_ = 0;
+  std::vector<double> heard_s_;                // when each drone's latest state was taken
+  std::vector<std::string> heard_mode_;        // and its mode and position then
+  std::vector<Vec2> heard_pos_;
   std::vector<Vec3> pos_, vel_;
   std::vector<double> yaw_;
   std::vector<std::string_view> modes_;

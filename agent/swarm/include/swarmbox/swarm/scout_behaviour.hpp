@@ -4,8 +4,13 @@
 //   kOnGround "on_ground" --(t >= takeoff_delay_s, mission not over)--> kTakingOff "taking_off"
 //   --(at search altitude)--> kAwaitingSector "awaiting_sector" (hold over home)
 //   --(own sector committed, phase SEARCH/CONVERGE/RESCUE)--> kSearching "searching"
-//       (lawnmower over the sector, swath from the camera footprint, flocking keeps spacing)
+//       (lawnmower over the sector, swath from the camera footprint, flocking keeps spacing;
+//       event=sector_started, event=sector_progress after each lane)
 //   --(last lane done)--> kSwept "swept" (loiter at the sector centre)
+//   A drone may own several sectors (the leader hands a lost drone's sector to live scouts): they
+//   are swept one after the other in committed order, and "swept" means all of them. A sector
+//   handed over after this scout finished sends it back to work: from "swept", from "returning"
+//   (not for a low battery) and from "landed" (it takes off again).
 //   any of the three --(phase CONVERGE/RESCUE with a target victim not rescued)--> kOrbiting
 //       "orbiting" around it; back to searching when it is rescued (or, with no lifter in the
 //       trial, after orbit_time_s on the orbit: the victim is then handled)
@@ -96,6 +101,8 @@ class ScoutBehaviour {
   void RunStage(const MissionInput& in, MissionOutput* out);  // the stage's setpoint
   void ReportSightings(const MissionInput& in, MissionOutput* out);
   void PlanSector(const raft::Sector& sector, const Eigen::Vector3d& position_m);
+  // This drone's first committed sector it has not swept yet, or nullptr.
+  const raft::Sector* NextSector(const raft::MissionState& m) const;
   const raft::Victim* OrbitTarget(const MissionInput& in) const;
   void Enter(Stage stage, const MissionInput& in, MissionOutput* out);
   double Altitude() const { return config_.home_m.z() + config_.search_altitude_m; }
@@ -105,6 +112,7 @@ class ScoutBehaviour {
   Stage stage_ = Stage::kOnGround;
   raft::Sector planned_sector_;
   bool has_plan_ = false;
+  std::vector<raft::Sector> swept_;  // sectors this drone finished (a repeated hand-over is a no-op)
   std::vector<Waypoint> lanes_;
   std::size_t lane_index_ = 0;
   std::uint32_t orbit_victim_ = 0;
