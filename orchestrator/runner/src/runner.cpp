@@ -1,6 +1,7 @@
 #include "swarmbox/runner/runner.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -61,6 +62,14 @@ class EventsFile {
   std::FILE* file_;
 };
 
+// $SWARMBOX_PARALLEL (a positive number), else `fallback`.
+int ParallelFromEnvironment(int fallback) {
+  const char* v = std::getenv("SWARMBOX_PARALLEL");
+  if (v == nullptr) return fallback;
+  const int n = std::atoi(v);
+  return n > 0 ? n : fallback;
+}
+
 }  // namespace
 
 Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docker::DockerApi& api,
@@ -98,6 +107,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   eo.trial_dir = dir.string();
   eo.start_wall_s = t0;
   eo.interrupted = o.interrupted;
+  eo.max_parallel = o.max_parallel > 0 ? o.max_parallel : ParallelFromEnvironment(eo.max_parallel);
   eo.on_trace = [&](const dsl::Component& c, dsl::EventKind e, const Verdict& v) {
     events.Write(LifecycleEventJson(wall(), dsl::EventName(e), c.id(), v));
     if (!v.ok()) {
