@@ -187,14 +187,18 @@ void MissionHost::OnPeerState(const PeerState& peer) {
   if (p.name.empty() || peer.sim_time_s >= p.sim_time_s) p = peer;
 }
 
-void MissionHost::Roster(std::vector<swarm::RosterEntry>* out) const {
+void MissionHost::Roster(double t_s, const flight::Vec3& own_position_m, std::vector<swarm::RosterEntry>* out) const {
   out->clear();
-  std::string own;
-  Role own_role = role_;
-  if (DecodeMissionMode(mode_, &own_role, &own)) out->push_back({config_.name, own_role, own});
+  swarm::RosterEntry own;
+  own.name = config_.name;
+  own.position_m = own_position_m.head<2>();
+  if (DecodeMissionMode(mode_, &own.role, &own.mode)) out->push_back(std::move(own));
   for (const auto& [name, p] : peers_) {
     swarm::RosterEntry e;
     e.name = name;
+    // Age on the shared simulated clock (lockstep): see leader_planner.hpp for the timeout.
+    e.age_s = std::max(0.0, t_s - p.sim_time_s);
+    e.position_m = p.position_m.head<2>();
     if (DecodeMissionMode(p.mode, &e.role, &e.mode)) out->push_back(std::move(e));
   }
 }
@@ -263,6 +267,8 @@ void MissionHost::Start(const MissionHostInput& in) {
                     config_.geofence_size_x_m / 2 - m, config_.geofence_size_y_m / 2 - m};
   lc.retry_s = 2.0;
   lc.start_timeout_s = t.leader_start_timeout_s;
+  lc.member_timeout_s = t.member_timeout_s;
+  lc.assignment_settle_s = t.assignment_settle_s;
   leader_.emplace(std::move(lc));
   out_.events.push_back(std::move(LogEvent(in.t_s, config_.name, "mission_start")
                                       .Add("role", swarm::RoleName(role_))
@@ -322,9 +328,10 @@ void MissionHost::RunBehaviour(const MissionHostInput& in) {
   if (behaviour_out_.payload.action != swarm::PayloadAction::kNone) Apply(behaviour_out_.payload);
   Drive(in, behaviour_out_.setpoint);
 
+  leader_->Track(in.t_s, *in.mission);  // every drone: a new leader knows when sectors changed
   if (in.is_leader) {
     std::vector<swarm::RosterEntry> roster;
-    Roster(&roster);
+    Roster(in.t_s, est.pos_m, &roster);
     const bool everyone = roster.size() == config_.members.size();
     if (everyone || in.mission->phase() != raft::MissionPhase::kIdle || in.t_s >= config_.tuning.leader_start_timeout_s) {
       swarm::MissionOutput lead;

@@ -9,7 +9,9 @@
 //   - peers' DroneState: neighbours for flocking and the leader's roster (role and mode travel in
 //     DroneState::mode as "<role>/<mode>", e.g. "scout/searching", "lifter/on_ground");
 //   - the committed raft::MissionState and whether this node leads: ScoutBehaviour or
-//     LifterSequence every mission tick (10 Hz of simulated time), LeaderPlanner on the leader;
+//     LifterSequence every mission tick (10 Hz of simulated time), LeaderPlanner on the leader
+//     (its roster carries each peer's age on the simulated clock: a killed drone falls silent
+//     and its sectors are handed over; LeaderPlanner::Track runs on every drone);
 //   - a per-airframe BatteryModel (battery_low -> return home, in the behaviours).
 // And returns what the node must do: a flight setpoint (only when it changes, or each tick for a
 // flocking velocity), a payload world command, Raft proposals, logfmt events and the mode string.
@@ -88,6 +90,11 @@ struct MissionTuning {
   double lifter_transit_altitude_m = 10.0;
   double lifter_loading_time_s = 10.0;  // evacuee loaded onto the stretcher [s]
   double leader_start_timeout_s = 45.0; // start the search even if a member is still unheard
+  // A member silent this long (simulated time) is gone; its sectors go to live scouts. The
+  // search counts as finished only with the sector list unchanged this long (leader_planner.hpp
+  // has the reasoning for 100 +- 20 ms radio delay and 5% loss) [s].
+  double member_timeout_s = 6.0;
+  double assignment_settle_s = 10.0;
   double sighting_dedupe_m = 10.0;      // a sighting this close to a known victim is that victim
   double max_tilt_for_perception_rad = 0.2;   // frames taken more tilted are not used
   double max_rate_for_perception_rad_s = 0.5; // nor while turning faster
@@ -166,7 +173,7 @@ class MissionHost {
   void RunBehaviour(const MissionHostInput& in);
   void Drive(const MissionHostInput& in, const swarm::SetpointRequest& sp);
   void Apply(const swarm::PayloadRequest& p);
-  void Roster(std::vector<swarm::RosterEntry>* out) const;
+  void Roster(double t_s, const flight::Vec3& own_position_m, std::vector<swarm::RosterEntry>* out) const;
 
   MissionHostConfig config_;
   swarm::Role role_ = swarm::Role::kScout;
