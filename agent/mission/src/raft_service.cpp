@@ -35,7 +35,8 @@ Result<std::unique_ptr<RaftService>> RaftService::Start(const RaftServiceConfig&
   s->wal_ = std::move(*wal);
 
   RaftService* raw = s.get();
-  auto radio = RaftRadio::Create(mesh, s->config_.driver.self,
+  // A writer per member (RaftRadio: reordering on the radio must not become extra loss).
+  auto radio = RaftRadio::Create(mesh, s->config_.driver.self, s->config_.driver.members,
                                  [raw](std::span<const std::uint8_t> b) { raw->OnPayload(b); });
   if (!radio) return std::move(radio).error().Context("raft service");
   s->radio_ = std::move(*radio);
