@@ -616,7 +616,12 @@ DroneTruth World::Truth(std::size_t index) const {
   for (std::size_t r = 0; r < d.rotor_count; ++r) t.rotor_speed_rad_s[r] = d.omega[r];
   t.payload_attached = d.sling != nullptr;
   t.payload_swing_rad = impl_->SwingAngle(d);
-  if (d.payload_body) t.payload_position_m = V(dBodyGetPosition(d.payload_body));
+  if (d.payload_body) {
+    t.payload_position_m = V(dBodyGetPosition(d.payload_body));
+    dMass pm;
+    dBodyGetMass(d.payload_body, &pm);
+    t.payload_mass_kg = pm.mass;
+  }
   t.crashed = d.crashed;
   t.lost = d.lost;
   return t;

@@ -36,7 +36,7 @@ TEST(StepAllocation, SteppingAWarmWorldDoesNotAllocate) {
   }
   const Airframe x8 = testing::LoadShippedAirframe("x8_heavy");
   testing::Spawn(*world, testing::MakeSpawn("lifter", x8, Vec3{40, 40, 10}, 0,
-                                            x8.HoverRotorSpeed(80) / x8.motor.max_rot_velocity_rad_s, "stretcher", true));
+                                            x8.HoverRotorSpeed(x8.payloads[0].mass_kg) / x8.motor.max_rot_velocity_rad_s, "stretcher", true));
   const std::vector<double> cmd(4, u);
   for (int k = 0; k < 50; ++k) world->Step();  // warm-up: ODE arenas, first contacts
   const long before = g_allocations.load();

@@ -33,7 +33,7 @@ std::string RunScenario(std::uint64_t seed, const std::string& path) {
   for (int i = 0; i < 3; ++i) {
     testing::Spawn(*world, testing::MakeSpawn("scout_" + std::to_string(i), x500, Vec3{-5.0 + 3 * i, 26.0, 3}, 0.0, u));
   }
-  const double u8 = x8.HoverRotorSpeed(80) / x8.motor.max_rot_velocity_rad_s;
+  const double u8 = x8.HoverRotorSpeed(x8.payloads[0].mass_kg) / x8.motor.max_rot_velocity_rad_s;
   testing::Spawn(*world, testing::MakeSpawn("lifter", x8, Vec3{40, -40, 10}, 0.0, u8, "stretcher", true));
   CollectingEventSink events;
   world->SetEventSink(&events);

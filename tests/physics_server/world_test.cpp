@@ -90,7 +90,7 @@ TEST(World, AnalyticHoverSpeedHoldsAltitude) {
 TEST(World, HeavyLifterHoversWithItsStretcherAtTheCombinedHoverSpeed) {
   auto world = MakeWorld(CalmWorld());
   const Airframe af = LoadShippedAirframe("x8_heavy");
-  const double u = af.HoverRotorSpeed(80.0, kG) / af.motor.max_rot_velocity_rad_s;
+  const double u = af.HoverRotorSpeed(af.payloads[0].mass_kg, kG) / af.motor.max_rot_velocity_rad_s;
   const auto d = Spawn(*world, testing::MakeSpawn("lifter", af, Vec3{0, 0, 20}, 0.0, u, "stretcher", true));
   EXPECT_LT(u, 0.8);  // sized to hover loaded at ~70% throttle
   const double z0 = world->Truth(d).position_m.z;

@@ -90,8 +90,22 @@ Status ReadControl(const yaml::Node& control, FlightConfig* cfg) {
   if (const yaml::Node* n = top.Child("swing_damping")) {
     yaml::MapReader r(*n, "control.swing_damping");
     r.Optional("enabled", &cfg->swing.enabled).Optional("gain", &cfg->swing.gain)
-        .Optional("shaper", &cfg->swing.shaper);
+        .Optional("shaper", &cfg->swing.shaper)
+        .Optional("full_gain_load_ratio", &cfg->swing.full_gain_load_ratio);
     SWARMBOX_TRY(r.Finish());
+    if (!(cfg->swing.full_gain_load_ratio >= 0.0)) {
+      return Bad(*n, "control.swing_damping.full_gain_load_ratio must be >= 0");
+    }
+  }
+  if (const yaml::Node* n = top.Child("hover_thrust")) {
+    yaml::MapReader r(*n, "control.hover_thrust");
+    HoverThrustParams& h = cfg->hover_thrust;
+    r.Optional("process_noise", &h.process_noise).Optional("init_std", &h.init_std)
+        .Optional("gate_sd", &h.gate_sd).Optional("thrust_lag_s", &cfg->hover_thrust_lag_s);
+    SWARMBOX_TRY(r.Finish());
+    if (!(h.process_noise > 0.0 && h.init_std > 0.0 && h.gate_sd > 0.0 && cfg->hover_thrust_lag_s >= 0.0)) {
+      return Bad(*n, "control.hover_thrust: process_noise, init_std, gate_sd must be > 0, thrust_lag_s >= 0");
+    }
   }
   if (const yaml::Node* n = top.Child("estimator")) {
     yaml::MapReader r(*n, "control.estimator");

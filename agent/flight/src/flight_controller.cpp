@@ -11,7 +11,6 @@ namespace {
 constexpr double kArriveTol_m = 0.3;
 constexpr double kArriveSpeed_mps = 0.3;
 constexpr double kYawRateLimit_radps = 1.5;
-constexpr double kMassTau_s = 2.0;
 constexpr double kAngAccelCutoff_hz = 30.0;
 
 bool Flying(FlightMode m) {
@@ -87,7 +86,13 @@ FlightController::FlightController(const FlightConfig& config, const ControllerO
   attitude_.SetGains(config_.attitude);
   rate_.SetGains(config_.rate);
   trajectory_.SetLimits(config_.limits);
-  mass_kg_ = config_.mass_kg + options_.payload_mass_kg;
+  // Hover thrust estimate: between half the empty vehicle and the most the position loop may ask.
+  HoverThrustParams hp = config_.hover_thrust;
+  hp.min_hover = 0.5 * config_.mass_kg * kGravity_mps2 / mixer_.max_thrust_n();
+  hp.max_hover = config_.thrust_max_frac;
+  hte_.SetParams(hp);
+  hte_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
+  mass_kg_ = MassFor(hte_.hover_thrust());
   output_.count = mixer_.rotor_count();
 
   // Swing damping: needs a slung payload in the airframe and both switches on.
@@ -108,6 +113,23 @@ FlightController::FlightController(const FlightConfig& config, const ControllerO
       shaper_.Configure(period, 0.0, options_.control_dt_s);
     }
   }
+}
+
+double FlightController::HoverThrustFor(double mass_kg) const {
+  return mass_kg * kGravity_mps2 / mixer_.max_thrust_n();
+}
+
+double FlightController::MassFor(double hover_thrust) const {
+  return hover_thrust * mixer_.max_thrust_n() / kGravity_mps2;
+}
+
+void FlightController::SetPayloadMass(double payload_mass_kg) {
+  if (!(payload_mass_kg >= 0.0) || !std::isfinite(payload_mass_kg)) return;
+  options_.payload_mass_kg = payload_mass_kg;
+  // A prior as uncertain as a fresh start: the estimator corrects it within seconds when the
+  // announced load is not what the drone lifts (a refused hook, a heavier evacuee).
+  hte_.SetPrior(HoverThrustFor(config_.mass_kg + payload_mass_kg), config_.hover_thrust.init_std);
+  mass_kg_ = MassFor(hte_.hover_thrust());
 }
 
 void FlightController::Emit(FlightEventKind kind, double t_s) {
@@ -170,7 +192,10 @@ bool FlightController::Command(const Setpoint& sp) {
       home_z_m_ = s.pos_m.z();
       yaw_sp_rad_ = YawOf(s.att);
       ResetControllers();
-      mass_kg_ = config_.mass_kg + options_.payload_mass_kg;
+      hte_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
+      mass_kg_ = MassFor(hte_.hover_thrust());
+      thrust_lagged_n_ = 0.0;
+      hte_in_air_ = false;
       airborne_s_ = 0.0;
       trajectory_.Reset(s.pos_m, Vec3::Zero());
       if (shaper_.configured()) shaper_.Reset(trajectory_.reference());
@@ -234,6 +259,7 @@ void FlightController::DisarmedOutput() {
   output_.armed = false;
   output_.u.fill(0.0);
   last_thrust_n_ = 0.0;
+  thrust_lagged_n_ = 0.0;
 }
 
 const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
@@ -265,17 +291,23 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
   }
   airborne_s_ += dt;
 
-  // Effective-mass (hover thrust) estimate: what the thrust achieves vertically.
+  // Hover thrust (effective mass) estimate, PX4's mc_hover_thrust_estimator: the vertical
+  // acceleration against the vertical thrust that produced it, once clear of the ground. The
+  // thrust goes through the rotors' lag first (what the rotors deliver, not what was asked).
   const Vec3 body_z = s.att * Vec3::UnitZ();
-  if (airborne_s_ > 1.0 && s.pos_m.z() - home_z_m_ > 0.5 && last_thrust_n_ > 0.0) {
-    const double az = s.accel_mps2.z() + kGravity_mps2;
-    if (az > 0.5 * kGravity_mps2 && az < 1.5 * kGravity_mps2) {
-      const double m_meas = last_thrust_n_ * body_z.z() / az;
-      mass_kg_ += std::min(1.0, dt / kMassTau_s) * (m_meas - mass_kg_);
-      double m_max = config_.mass_kg;
-      for (const SlungPayload& p : config_.payloads) m_max = std::max(m_max, config_.mass_kg + 1.5 * p.mass_kg);
-      mass_kg_ = std::clamp(mass_kg_, 0.5 * config_.mass_kg, std::max(1.5 * config_.mass_kg, m_max));
-    }
+  const double lag_s = config_.hover_thrust_lag_s;
+  thrust_lagged_n_ += (lag_s > 0.0 ? std::min(1.0, dt / lag_s) : 1.0) * (last_thrust_n_ - thrust_lagged_n_);
+  // In the air (latched until the next take-off): 0.5 m above the take-off point, or sinking
+  // (an airborne start whose first thrust was too low for its load).
+  if (airborne_s_ > 1.0 && (s.pos_m.z() - home_z_m_ > 0.5 || s.vel_mps.z() < -0.3)) hte_in_air_ = true;
+  if (hte_in_air_ && thrust_lagged_n_ > 0.0) {
+    hte_.Predict(dt);
+    const double thrust_z = thrust_lagged_n_ * body_z.z() / mixer_.max_thrust_n();
+    // De-weight fast vertical (drag, prop wash) and horizontal flight, as PX4 (HTE_VZ_THR 2 m/s,
+    // HTE_VXY_THR 10 m/s).
+    const double scale = std::max({1.0, std::abs(s.vel_mps.z()) - 2.0 + 1.0, s.vel_mps.head<2>().norm() - 10.0 + 1.0});
+    hte_.Fuse(s.accel_mps2.z(), thrust_z, dt, scale);
+    mass_kg_ = MassFor(hte_.hover_thrust());
   }
 
   // Yaw setpoint slews to the wanted heading.
@@ -343,7 +375,9 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
       swing_.Update(sample.accel_mps2, s.att, s.accel_mps2, mass_kg_ - config_.mass_kg, dt);
     }
     if (mode_ != FlightMode::kLand || s.pos_m.z() - home_z_m_ > 2.0) {
-      psp.acc_mps2 += swing_.DampingAcceleration(config_.swing.gain);
+      const double gain = LoadScaledDampingGain(config_.swing.gain, mass_kg_ - config_.mass_kg, config_.mass_kg,
+                                                config_.swing.full_gain_load_ratio);
+      psp.acc_mps2 += swing_.DampingAcceleration(gain);
       // (velocity counterpart left out: it fights the position loop into a slow oscillation)
     }
     telemetry_.swing_estimate_rad = swing_.swing_angle_rad();
@@ -352,6 +386,8 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
   const PositionOutput po = position_.Update(s, psp, mass_kg_, dt);
   telemetry_.position = po;
   telemetry_.mass_estimate_kg = mass_kg_;
+  telemetry_.hover_thrust = hte_.hover_thrust();
+  telemetry_.hover_thrust_std = std::sqrt(hte_.variance());
   if (!po.valid) {
     // Non-finite estimate or setpoint: nothing sane to fly. Keep the last output, report once.
     return output_;

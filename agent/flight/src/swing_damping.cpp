@@ -5,6 +5,12 @@
 
 namespace swarmbox::flight {
 
+double LoadScaledDampingGain(double gain, double payload_mass_kg, double drone_mass_kg, double full_ratio) {
+  if (!(full_ratio > 0.0)) return gain;
+  if (!(drone_mass_kg > 0.0) || !(payload_mass_kg > 0.0)) return 0.0;
+  return gain * std::min(1.0, payload_mass_kg / (full_ratio * drone_mass_kg));
+}
+
 void InputShaper::Configure(double period_s, double damping_ratio, double dt_s) {
   buffer_.clear();
   if (!(period_s > 0.0) || !(dt_s > 0.0)) return;

@@ -17,7 +17,8 @@
 //            integrator_limit: [0.3, 0.3, 0.3]}
 //     takeoff: {speed_mps: 1.5}
 //     land: {speed_mps: 0.7, slow_speed_mps: 0.3, slow_below_m: 2.0}
-//     swing_damping: {enabled: true, gain: 1.0, shaper: true}
+//     swing_damping: {enabled: true, gain: 1.0, shaper: true, full_gain_load_ratio: 0.0}
+//     hover_thrust: {process_noise: 0.0036, init_std: 0.1, gate_sd: 3.0, thrust_lag_s: 0.0}
 //
 //   Result<FlightConfig> cfg = LoadFlightConfig("trials/airframes/x500.yaml");
 #pragma once
@@ -29,6 +30,7 @@
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/flight/attitude_control.hpp"
 #include "swarmbox/flight/estimator.hpp"
+#include "swarmbox/flight/hover_thrust_estimator.hpp"
 #include "swarmbox/flight/mixer.hpp"
 #include "swarmbox/flight/position_control.hpp"
 #include "swarmbox/flight/rate_control.hpp"
@@ -47,6 +49,9 @@ struct SwingDampingParams {
   bool enabled = true;
   double gain = 1.0;                  // active damping, multiplies the critical-ish gain sqrt(g L)
   bool shaper = true;                 // ZVD input shaping of the position reference
+  // Payload/drone mass ratio (estimated load) from which `gain` applies in full; below it the
+  // gain shrinks in proportion (LoadScaledDampingGain). 0: always the full gain.
+  double full_gain_load_ratio = 0.0;
 };
 
 struct FlightConfig {
@@ -68,6 +73,10 @@ struct FlightConfig {
   double land_slow_below_m = 2.0;     // height above the take-off point where landing slows [m]
   std::vector<SlungPayload> payloads;
   SwingDampingParams swing;
+  // Hover thrust estimator (PX4 HTE_HT_NOISE, HTE_HT_ERR_INIT, HTE_ACC_GATE); its bounds are
+  // set by the controller from the airframe.
+  HoverThrustParams hover_thrust;
+  double hover_thrust_lag_s = 0.0;    // rotor lag applied to the thrust it is fed [s]
 };
 
 Result<FlightConfig> ParseFlightConfig(const yaml::Node& airframe_root, std::string source = {});

@@ -20,6 +20,7 @@
 #include "swarmbox/flight/attitude_control.hpp"
 #include "swarmbox/flight/estimator.hpp"
 #include "swarmbox/flight/flight_config.hpp"
+#include "swarmbox/flight/hover_thrust_estimator.hpp"
 #include "swarmbox/flight/mixer.hpp"
 #include "swarmbox/flight/position_control.hpp"
 #include "swarmbox/flight/rate_control.hpp"
@@ -31,8 +32,8 @@ namespace swarmbox::flight {
 
 struct ControllerOptions {
   double control_dt_s = 0.004;       // the lockstep period the input shaper is sized for [s]
-  // What the companion computer is told it carries at start (initial value of the mass
-  // estimate; the estimate then adapts to what the drone really lifts) [kg].
+  // What the companion computer is told it carries at start: the prior of the hover thrust
+  // estimate, which then learns what the drone really lifts (SetPayloadMass changes it) [kg].
   double payload_mass_kg = 0.0;
   // Name of the airframe payload whose sling the swing damping is tuned for ("" = the first).
   const char* payload_name = "";
@@ -54,7 +55,9 @@ struct ControllerTelemetry {
   PositionOutput position;
   Vec3 rate_sp_radps = Vec3::Zero();
   Vec3 torque_nm = Vec3::Zero();
-  double mass_estimate_kg = 0.0;
+  double mass_estimate_kg = 0.0;   // vehicle + load from the hover thrust estimate [kg]
+  double hover_thrust = 0.0;       // learnt hover thrust, fraction of the maximum thrust
+  double hover_thrust_std = 0.0;   // its 1-sigma uncertainty
   double swing_estimate_rad = 0.0;
 };
 
@@ -69,6 +72,12 @@ class FlightController {
 
   // One control step on the lockstep sample. Motors off (armed = false) on the ground.
   const ActuatorOutput& Step(const SensorSample& sample);
+
+  // The load the drone was just told it carries (a payload attach: the stretcher's announced
+  // mass; a release: 0) [kg]. A prior for the hover thrust estimate (as uncertain as at take-off),
+  // which goes on correcting it from the vertical acceleration; also the prior of the next
+  // take-off. Ignored if negative or not finite. Does not allocate.
+  void SetPayloadMass(double payload_mass_kg);
 
   // Events since the last call, oldest first; false when none are left.
   bool PopEvent(FlightEvent* out);
@@ -88,6 +97,8 @@ class FlightController {
   void ResetControllers();
   void StartTrajectoryHere();
   void DisarmedOutput();
+  double HoverThrustFor(double mass_kg) const;   // normalised hover thrust of a total mass
+  double MassFor(double hover_thrust) const;
 
   FlightConfig config_;
   ControllerOptions options_;
@@ -96,6 +107,7 @@ class FlightController {
   Trajectory trajectory_;
   InputShaper shaper_;
   SwingObserver swing_;
+  HoverThrustEstimator hte_;
   PositionControl position_;
   AttitudeControl attitude_;
   RateControl rate_;
@@ -115,6 +127,8 @@ class FlightController {
   bool gps_ok_ = true;
   double mass_kg_ = 0.0;            // hover-thrust (effective mass) estimate [kg]
   double last_thrust_n_ = 0.0;
+  double thrust_lagged_n_ = 0.0;    // last_thrust_n_ through the rotors' lag [N]
+  bool hte_in_air_ = false;         // the hover thrust estimator may learn (cleared at take-off)
   Vec3 last_rate_ = Vec3::Zero();
   Vec3 ang_accel_ = Vec3::Zero();
   bool damping_on_ = false;

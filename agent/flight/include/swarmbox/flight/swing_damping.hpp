@@ -13,6 +13,9 @@
 //     gives the swing rate. Moving the hook with the swing (a = k s', k = gain * sqrt(g L),
 //     like a crane operator) adds damping ratio ~ gain/2 to the pendulum.
 // No cable sensor: only IMU, attitude and the estimated acceleration and mass are used.
+// The load is the flight controller's estimate (hover thrust estimate minus the empty vehicle):
+// it sizes the cable tension in the observer and, through LoadScaledDampingGain, the active
+// damping, so a light load (the empty stretcher) is not driven by its own noisy swing estimate.
 //
 //   SwingObserver obs;  obs.Configure(sling_length_m, drone_mass_kg);
 //   obs.Update(imu_specific_force_body, attitude, accel_world, payload_mass_kg, dt_s);
@@ -26,6 +29,14 @@
 #include "swarmbox/flight/types.hpp"
 
 namespace swarmbox::flight {
+
+// Active damping gain for the estimated load [kg] under a drone of drone_mass_kg: `gain` from a
+// payload/drone mass ratio of `full_ratio` up, proportionally less below it (0 for no load;
+// full_ratio <= 0: always `gain`). The swing rate is observed through the cable's pull on the
+// drone, so its error grows as drone mass / payload mass (x8_heavy: 1.5x with the 80 kg loaded
+// stretcher, 8x with the 15 kg empty one); at full gain the empty stretcher's noisy estimate
+// drives the hook into a 20 deg swing that the ZVD shaper alone keeps under 4 deg.
+double LoadScaledDampingGain(double gain, double payload_mass_kg, double drone_mass_kg, double full_ratio);
 
 class InputShaper {
  public:
