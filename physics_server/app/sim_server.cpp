@@ -98,10 +98,19 @@ void SimServer::Apply(const WorldCommandInput& cmd) {
     world_.SetWind(gust);
     timed_.push_back({now + seconds(cmd.args[3]), 0, Timed::kWindBack});
   } else {  // payload_attach / payload_release (the table knows no other name)
-    const Status s = cmd.command == "payload_attach" ? world_.AttachPayload(*drone) : world_.ReleasePayload(*drone);
+    // payload_attach [mass_kg]: the payload's mass from now on (the lifter's stretcher is 15 kg
+    // empty, 80 kg with the evacuee); absent or 0 keeps its current mass.
+    if (cmd.command == "payload_attach" && (cmd.args.size() > 1 || (!cmd.args.empty() && !(cmd.args[0] >= 0)))) {
+      return reject("payload_attach takes at most one argument, mass_kg >= 0");
+    }
+    const double mass_kg = cmd.args.empty() ? 0.0 : cmd.args[0];
+    const Status s = cmd.command == "payload_attach" ? world_.AttachPayload(*drone, mass_kg) : world_.ReleasePayload(*drone);
     if (!s) return reject(s.error().message());
   }
-  Log(LogEvent(t, options_.node, "world_command").Add("command", cmd.command).Add("target", cmd.target));
+  LogEvent done(t, options_.node, "world_command");
+  done.Add("command", cmd.command).Add("target", cmd.target);
+  if (cmd.command == "payload_attach" && !cmd.args.empty()) done.Add("mass_kg", cmd.args[0]);
+  Log(done);
 }
 
 Status SimServer::RunStep(const std::atomic<bool>& stop) {

@@ -11,7 +11,7 @@ constexpr std::array<WorldCommandSpec, 6> kSpecs{{
     {"gps_degrade", true, 3, 0b111, "needs a drone, duration_s, h_acc_m, v_acc_m > 0"},
     {"imu_bias_jump", true, 6, 0, "needs a drone and ax, ay, az, gx, gy, gz"},
     {"wind_gust", false, 4, 0b1000, "needs vx, vy, vz, duration_s > 0"},
-    {"payload_attach", true, -1, 0, "needs a drone"},
+    {"payload_attach", true, -1, 0, "needs a drone (and at most mass_kg)"},
     {"payload_release", true, -1, 0, "needs a drone"},
 }};
 

@@ -333,3 +333,62 @@ TEST_F(SimServerTest, AWaitingStepResendsEverySampleAsAKeepalive) {
 
 }  // namespace
 }  // namespace swarmbox::physics
+
+namespace swarmbox::physics {
+namespace {
+
+// payload_attach [mass_kg] reaches World::AttachPayload: the simulated payload body takes the
+// announced mass (the lifter's stretcher: 15 kg empty, 80 kg with the evacuee), no argument keeps
+// it, and a malformed mass is refused by name with nothing changed. (What the mass does to the
+// flight is tested in payload_test and in the flight stack's closed-loop payload tests.)
+TEST(SimServerPayload, AttachWithAMassChangesTheSimulatedMass) {
+  auto world = testing::MakeWorld(testing::CalmWorld());
+  const Airframe af = testing::LoadShippedAirframe("x8_heavy");
+  testing::Spawn(*world, testing::MakeSpawn("lifter", af, Vec3{0, 0, 20}, 0.0, 0.0, "stretcher", true));
+  const double spawn_kg = af.payloads[0].mass_kg;
+  EXPECT_NEAR(world->Truth(0).payload_mass_kg, spawn_kg, 1e-9);
+  FakeClock clock;
+  ScriptedAgents agents{clock};
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  SimServerOptions o;
+  o.rtf = 0;
+  o.lockstep = {.timeout_ns = 200 * kMs, .join_timeout_ns = 500 * kMs};
+  std::atomic<bool> stop{false};
+  SimServer server(*world, agents, clock, nullptr, o, out);
+  auto step = [&](std::vector<WorldCommandInput> cmds) {
+    agents.world_commands = std::move(cmds);
+    ASSERT_TRUE(server.RunStep(stop).ok());
+  };
+
+  step({{"lifter", "payload_release", {}}});
+  EXPECT_FALSE(world->Truth(0).payload_attached);
+  // Loaded: the evacuee is on.
+  step({{"lifter", "payload_attach", {80.0, 1.0}}, {"lifter", "payload_attach", {-1.0}},
+        {"lifter", "payload_attach", {80.0}}});
+  EXPECT_TRUE(world->Truth(0).payload_attached);
+  EXPECT_NEAR(world->Truth(0).payload_mass_kg, 80.0, 1e-9);
+  // No mass: keeps the 80 kg.
+  step({{"lifter", "payload_release", {}}});
+  step({{"lifter", "payload_attach", {}}});
+  EXPECT_NEAR(world->Truth(0).payload_mass_kg, 80.0, 1e-9);
+  // Set down empty again and picked up: 15 kg.
+  step({{"lifter", "payload_release", {}}});
+  step({{"lifter", "payload_attach", {15.0}}});
+  EXPECT_TRUE(world->Truth(0).payload_attached);
+  EXPECT_NEAR(world->Truth(0).payload_mass_kg, 15.0, 1e-9);
+
+  const std::string log = ReadFile(out);
+  std::fclose(out);
+  EXPECT_NE(log.find("event=world_command_rejected command=payload_attach target=lifter "
+                     "reason=\"payload_attach takes at most one argument, mass_kg >= 0\""),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("event=world_command command=payload_attach target=lifter mass_kg=80.000"), std::string::npos)
+      << log;
+  EXPECT_NE(log.find("event=world_command command=payload_attach target=lifter mass_kg=15.000"), std::string::npos)
+      << log;
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
