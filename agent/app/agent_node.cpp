@@ -288,6 +288,8 @@ void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
     } else {
       world_cmd_.command = "payload_release";
     }
+    // The announced load as the hover thrust estimator's prior (it corrects a refused hook).
+    fc_.SetPayloadMass(out.payload.action == swarm::PayloadAction::kAttach ? out.payload.mass_kg : 0.0);
     if (Status s = world_pub_->Publish(world_cmd_); !s) {
       Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "world_command").Add("reason", s.error().ToString()));
     }
