@@ -32,8 +32,8 @@
 
 #include "bench.hpp"
 #include "bus_echo.hpp"
-#include "child_process.hpp"
 #include "message_samples.hpp"
+#include "support/child_process.hpp"
 #include "swarmbox/bus/participant.hpp"
 
 namespace swarmbox::bus {
@@ -83,9 +83,9 @@ class Echo {
       });
       return e;
     }
-    std::vector<std::string> argv = {testing::SelfExecutable(), "bus", "--role=echo"};
+    std::vector<std::string> argv = {swarmbox::testing::SelfExecutable(), "bus", "--role=echo"};
     for (auto& a : testing::EchoArgs(o)) argv.push_back(a);
-    auto child = testing::ChildProcess::Spawn(argv);
+    auto child = swarmbox::testing::ChildProcess::Spawn(argv);
     if (!child) {
       std::fprintf(stderr, "bus bench: %s\n", child.error().ToString().c_str());
       return std::nullopt;
@@ -105,7 +105,7 @@ class Echo {
  private:
   std::unique_ptr<std::atomic<bool>> stop_;
   std::thread thread_;
-  std::optional<testing::ChildProcess> child_;
+  std::optional<swarmbox::testing::ChildProcess> child_;
 };
 
 double Percentile(std::vector<double> v, double q) {

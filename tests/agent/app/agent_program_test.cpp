@@ -9,13 +9,16 @@
 #include <string>
 #include <vector>
 
-#include "process.hpp"
+#include "support/files.hpp"
+#include "support/logged_child.hpp"
 #include "swarmbox/common/logfmt.hpp"
 
 namespace swarmbox::agent::testing {
 namespace {
 
 using namespace std::chrono_literals;
+using swarmbox::testing::LoggedChild;
+using swarmbox::testing::MakeTempDir;
 
 // A domain pair per process so parallel test runs never share a bus (100-199: 200-215 are
 // agent_raft_test's).
@@ -37,9 +40,10 @@ TEST(AgentProgram, FailsClearlyWhenThePhysicsServerIsAbsent) {
   const std::string dir = MakeTempDir("swarmbox_agent_test_");
   ASSERT_FALSE(dir.empty());
   const int d = DomainBase();
-  Child agent({SWARMBOX_AGENT_BIN, "--name", "drone_7", "--airframe", SWARMBOX_TRIALS_DIR "/airframes/x500.yaml",
-               "--sim-domain", std::to_string(d), "--mesh-domain", std::to_string(d + 1), "--sample-timeout", "1"},
-              dir + "/agent.log");
+  LoggedChild agent(
+      {SWARMBOX_AGENT_BIN, "--name", "drone_7", "--airframe", SWARMBOX_TRIALS_DIR "/airframes/x500.yaml",
+       "--sim-domain", std::to_string(d), "--mesh-domain", std::to_string(d + 1), "--sample-timeout", "1"},
+      dir + "/agent.log");
   ASSERT_GT(agent.pid(), 0);
   EXPECT_EQ(agent.Wait(20s), 3);  // infrastructure error
   const std::string log = agent.ReadLog();
@@ -50,9 +54,9 @@ TEST(AgentProgram, FailsClearlyWhenThePhysicsServerIsAbsent) {
 
 TEST(AgentProgram, RejectsABadPlanWithUsageExitCode) {
   const std::string dir = MakeTempDir("swarmbox_agent_test_");
-  Child agent({SWARMBOX_AGENT_BIN, "--name", "drone_7", "--airframe", SWARMBOX_TRIALS_DIR "/airframes/x500.yaml",
-               "--plan", "takeoff:5,fly_away"},
-              dir + "/agent.log");
+  LoggedChild agent({SWARMBOX_AGENT_BIN, "--name", "drone_7", "--airframe",
+                     SWARMBOX_TRIALS_DIR "/airframes/x500.yaml", "--plan", "takeoff:5,fly_away"},
+                    dir + "/agent.log");
   EXPECT_EQ(agent.Wait(20s), 2);
   EXPECT_NE(agent.ReadLog().find("unknown step 'fly_away'"), std::string::npos) << agent.ReadLog();
 }
@@ -70,11 +74,11 @@ TEST(AgentIntegration, PhysicsAndThreeAgentsTakeOffHoverAndLand) {
     phys_args.push_back("--drone");
     phys_args.push_back(names[i] + ":x500:" + starts[i]);
   }
-  Child physics(phys_args, dir + "/physics.log");
+  LoggedChild physics(phys_args, dir + "/physics.log");
   ASSERT_GT(physics.pid(), 0);
-  std::vector<std::unique_ptr<Child>> agents;
+  std::vector<std::unique_ptr<LoggedChild>> agents;
   for (std::size_t i = 0; i < names.size(); ++i) {
-    agents.push_back(std::make_unique<Child>(
+    agents.push_back(std::make_unique<LoggedChild>(
         std::vector<std::string>{SWARMBOX_AGENT_BIN, "--name", names[i], "--airframe",
                                  SWARMBOX_TRIALS_DIR "/airframes/x500.yaml", "--sim-domain", std::to_string(d),
                                  "--mesh-domain", std::to_string(d + 1), "--start", starts[i], "--plan",

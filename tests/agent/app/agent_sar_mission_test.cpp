@@ -18,13 +18,16 @@
 #include <thread>
 #include <vector>
 
-#include "process.hpp"
+#include "support/files.hpp"
+#include "support/logged_child.hpp"
 #include "swarmbox/common/logfmt.hpp"
 
 namespace swarmbox::agent::testing {
 namespace {
 
 using namespace std::chrono_literals;
+using Child = swarmbox::testing::LoggedChild;
+using swarmbox::testing::MakeTempDir;
 
 constexpr double kMaxMissionSimS = 400.0;  // the bound (sar_search's timeout is 600 s)
 

@@ -10,52 +10,18 @@
 #include <string>
 #include <thread>
 
-#include "process.hpp"
 #include "raft_host.hpp"
-#include "swarmbox/raft/file_system.hpp"
+#include "support/files.hpp"
+#include "support/flaky_file_system.hpp"
 
 namespace swarmbox::agent {
 namespace {
 
 using namespace std::chrono_literals;
-
-// The real file system, whose appended files fail Sync() once `fail_sync` is set (minimal copy
-// of tests/agent/mission/raft_service_test.cpp's FlakyFileSystem, which is not a shared helper).
-class FlakyFileSystem final : public raft::FileSystem {
- public:
-  std::atomic<bool> fail_sync{false};
-
-  Status CreateDirs(const std::string& p) override { return real_.CreateDirs(p); }
-  Result<raft::Bytes> ReadFile(const std::string& p) override { return real_.ReadFile(p); }
-  Result<std::unique_ptr<raft::AppendFile>> OpenAppend(const std::string& p) override {
-    auto f = real_.OpenAppend(p);
-    if (!f) return std::move(f).error();
-    return std::unique_ptr<raft::AppendFile>(new File(std::move(*f), &fail_sync));
-  }
-  Status WriteFileAtomic(const std::string& p, std::span<const std::uint8_t> b) override {
-    return real_.WriteFileAtomic(p, b);
-  }
-  Status Truncate(const std::string& p, std::uint64_t size) override { return real_.Truncate(p, size); }
-
- private:
-  class File final : public raft::AppendFile {
-   public:
-    File(std::unique_ptr<raft::AppendFile> f, const std::atomic<bool>* fail) : f_(std::move(f)), fail_(fail) {}
-    Status Append(std::span<const std::uint8_t> b) override { return f_->Append(b); }
-    Status Sync() override {
-      if (fail_->load()) return Error(ErrorCode::kIo, "fsync: Input/output error (injected)");
-      return f_->Sync();
-    }
-
-   private:
-    std::unique_ptr<raft::AppendFile> f_;
-    const std::atomic<bool>* fail_;
-  };
-  raft::PosixFileSystem real_;
-};
+using swarmbox::testing::FlakyFileSystem;
 
 TEST(RaftHostService, ProposesWhenLeaderAndReportsAStorageFailure) {
-  const std::string dir = testing::MakeTempDir("swarmbox_agent_raft_host_");
+  const std::string dir = swarmbox::testing::MakeTempDir("swarmbox_agent_raft_host_");
   ASSERT_FALSE(dir.empty());
   auto mesh = bus::Participant::Create({.backend = "cyclonedds", .domain_id = 215, .interface = "lo"});
   ASSERT_TRUE(mesh) << mesh.error().ToString();

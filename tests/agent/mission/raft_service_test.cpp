@@ -8,28 +8,22 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
-#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "child_process.hpp"
+#include "support/files.hpp"
+#include "support/flaky_file_system.hpp"
+#include "support/wait_until.hpp"
 #include "swarmbox/mission/raft_radio.hpp"
 
 namespace swarmbox::mission {
 namespace {
 
 using namespace std::chrono_literals;
-
-bool WaitUntil(const std::function<bool()>& pred, std::chrono::milliseconds timeout) {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (pred()) return true;
-    std::this_thread::sleep_for(10ms);
-  }
-  return pred();
-}
+using swarmbox::testing::FlakyFileSystem;
+using swarmbox::testing::WaitUntil;
 
 std::unique_ptr<bus::Participant> Mesh(int domain) {
   auto p = bus::Participant::Create({.backend = "cyclonedds", .domain_id = domain,
@@ -40,7 +34,7 @@ std::unique_ptr<bus::Participant> Mesh(int domain) {
 
 // A fresh directory under /tmp, removed with everything in it at the end of the test.
 struct TempDir {
-  explicit TempDir(const std::string& prefix) : path(testing::MakeTempDir(prefix)) {}
+  explicit TempDir(const std::string& prefix) : path(swarmbox::testing::MakeTempDir(prefix)) {}
   ~TempDir() {
     if (!path.empty()) std::filesystem::remove_all(path);
   }
@@ -78,43 +72,6 @@ class Lines {
  private:
   mutable std::mutex mu_;
   std::vector<std::string> lines_;
-};
-
-// The real file system, whose appended files fail Sync() once `fail_sync` is set.
-class FlakyFileSystem final : public raft::FileSystem {
- public:
-  std::atomic<bool> fail_sync{false};
-
-  Status CreateDirs(const std::string& p) override { return real_.CreateDirs(p); }
-  Result<raft::Bytes> ReadFile(const std::string& p) override { return real_.ReadFile(p); }
-  Result<std::unique_ptr<raft::AppendFile>> OpenAppend(const std::string& p) override {
-    auto f = real_.OpenAppend(p);
-    if (!f) return std::move(f).error();
-    return std::unique_ptr<raft::AppendFile>(new File(std::move(*f), &fail_sync));
-  }
-  Status WriteFileAtomic(const std::string& p, std::span<const std::uint8_t> b) override {
-    return real_.WriteFileAtomic(p, b);
-  }
-  Status Truncate(const std::string& p, std::uint64_t size) override {
-    return real_.Truncate(p, size);
-  }
-
- private:
-  class File final : public raft::AppendFile {
-   public:
-    File(std::unique_ptr<raft::AppendFile> f, const std::atomic<bool>* fail)
-        : f_(std::move(f)), fail_(fail) {}
-    Status Append(std::span<const std::uint8_t> b) override { return f_->Append(b); }
-    Status Sync() override {
-      if (fail_->load()) return Error(ErrorCode::kIo, "fsync: Input/output error (injected)");
-      return f_->Sync();
-    }
-
-   private:
-    std::unique_ptr<raft::AppendFile> f_;
-    const std::atomic<bool>* fail_;
-  };
-  raft::PosixFileSystem real_;
 };
 
 RaftServiceConfig SoloConfig(const std::string& dir) {

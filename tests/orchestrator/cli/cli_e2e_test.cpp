@@ -21,7 +21,8 @@
 #include <iostream>
 #include <thread>
 
-#include "child_process.hpp"
+#include "support/child_process.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
@@ -32,9 +33,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-using testing::ChildProcess;
-using testing::ReadWholeFile;
-using testing::RunToEnd;
+using swarmbox::testing::ChildProcess;
+using swarmbox::testing::ReadWholeFile;
+using swarmbox::testing::RunToEnd;
 
 constexpr char kSwarmbox[] = SWARMBOX_CLI_EXE;
 const std::string kSmokeTrial = std::string(SWARMBOX_SOURCE_DIR) + "/trials/smoke.yaml";

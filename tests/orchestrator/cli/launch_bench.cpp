@@ -32,8 +32,9 @@
 #include <thread>
 
 #include "bench.hpp"
-#include "child_process.hpp"
 #include "launch_timing.hpp"
+#include "support/child_process.hpp"
+#include "support/files.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/runner/naming.hpp"
@@ -43,9 +44,10 @@ namespace swarmbox {
 namespace {
 
 namespace fs = std::filesystem;
-using cli::testing::ChildProcess;
 using cli::testing::LaunchTimes;
-using cli::testing::ReadWholeFile;
+using swarmbox::testing::ChildProcess;
+using swarmbox::testing::ReadWholeFile;
+using swarmbox::testing::RunToEnd;
 
 constexpr char kSwarmbox[] = SWARMBOX_LAUNCH_SWARMBOX_EXE;
 constexpr char kTrial[] = SWARMBOX_LAUNCH_TRIAL;
@@ -339,7 +341,7 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
   const fs::path compose_file = scratch / ("launch" + std::to_string(drones) + ".compose.yaml");  // -o
   std::vector<std::string> export_argv = {kSwarmbox, "compose", kTrial, "-o", compose_file.string()};
   export_argv.insert(export_argv.end(), sets.begin(), sets.end());
-  auto exported = cli::testing::RunToEnd(export_argv, minutes(2), scratch.string());
+  auto exported = RunToEnd(export_argv, minutes(2), scratch.string());
   if (!exported || exported->code != 0) {
     return fail("swarmbox compose: " + (exported ? exported->err : exported.error().ToString()));
   }
@@ -377,8 +379,8 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
       compose_error = "docker-compose up did not bring every agent up: " + ReadWholeFile(err);
     }
     const std::int64_t down_ns = NowUnixNs();
-    auto down = cli::testing::RunToEnd({compose_exe, "-f", compose_file.string(), "-p", project, "down", "-v"},
-                                       minutes(5), scratch.string());
+    auto down = RunToEnd({compose_exe, "-f", compose_file.string(), "-p", project, "down", "-v"}, minutes(5),
+                         scratch.string());
     if (down && down->code == 0) {
       compose_down_s = SecondsSince(down_ns);
     } else {
@@ -434,8 +436,7 @@ int RunLaunchBench(const bench::Args& args) {
   const fs::path scratch = fs::temp_directory_path() / ("swarmbox-bench-launch-" + std::to_string(::getpid()));
   fs::create_directories(scratch);
   // The images first (untimed): both paths then start from images that exist.
-  auto images = cli::testing::RunToEnd({kSwarmbox, "images", "--no-faults"}, std::chrono::minutes(10),
-                                       scratch.string());
+  auto images = RunToEnd({kSwarmbox, "images", "--no-faults"}, std::chrono::minutes(10), scratch.string());
   if (!images || images->code != 0) {
     std::printf("suite=launch error=\"swarmbox images failed: %s\"\n",
                 images ? images->err.c_str() : images.error().ToString().c_str());

@@ -15,7 +15,8 @@
 #include <set>
 #include <sstream>
 
-#include "child_process.hpp"
+#include "support/child_process.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/docker_client.hpp"
@@ -27,8 +28,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
-using testing::ReadWholeFile;
-using testing::RunToEnd;
+using swarmbox::testing::ReadWholeFile;
+using swarmbox::testing::RunToEnd;
 
 constexpr char kSwarmbox[] = SWARMBOX_CLI_EXE;
 const std::string kTrial = std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml";
