@@ -3,11 +3,10 @@
 // drone's sensor samples (no GPS fix during a dropout), the server logs it, and the error paths
 // (unknown command, wrong arguments, no server) exit with their codes and messages.
 #include <gtest/gtest.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -16,10 +15,9 @@
 #include "bus_transport.hpp"
 #include "command_sender.hpp"
 #include "sim_server.hpp"
+#include "support/logged_child.hpp"
 #include "test_util.hpp"
 #include "world_commands.hpp"
-
-extern char** environ;
 
 namespace swarmbox::physics {
 namespace {
@@ -31,30 +29,19 @@ struct ProcessResult {
   std::string output;  // stdout + stderr
 };
 
-// Runs the program (argv, no shell) to completion.
+// Runs the program (argv, no shell) to completion (a hang guard of 60 s: then exit_code -1).
 ProcessResult RunProgram(const std::vector<std::string>& args) {
-  int fds[2];
-  EXPECT_EQ(::pipe(fds), 0);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_adddup2(&fa, fds[1], 1);
-  posix_spawn_file_actions_adddup2(&fa, fds[1], 2);
-  posix_spawn_file_actions_addclose(&fa, fds[0]);
-  std::vector<char*> argv;
-  for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  pid_t pid = -1;
-  EXPECT_EQ(posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ), 0);
-  posix_spawn_file_actions_destroy(&fa);
-  ::close(fds[1]);
+  static std::atomic<int> runs{0};
+  const std::string log = ::testing::TempDir() + "send_command_" + std::to_string(::getpid()) + "_" +
+                          std::to_string(runs.fetch_add(1)) + ".log";
   ProcessResult r;
-  char buf[4096];
-  ssize_t n = 0;
-  while ((n = ::read(fds[0], buf, sizeof buf)) > 0) r.output.append(buf, static_cast<std::size_t>(n));
-  ::close(fds[0]);
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  {
+    swarmbox::testing::LoggedChild child(args, log);
+    EXPECT_GT(child.pid(), 0) << child.spawn_error();
+    r.exit_code = child.Wait(std::chrono::seconds(60));
+    r.output = child.ReadLog();
+  }
+  ::unlink(log.c_str());
   return r;
 }
 
