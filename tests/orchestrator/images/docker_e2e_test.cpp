@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "e2e_support.hpp"
+#include "probe_image.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/docker/tar_archive.hpp"
 #include "swarmbox/images/ensure_image.hpp"
@@ -26,23 +27,13 @@ using Clock = std::chrono::steady_clock;
 
 double Ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
-images::ImageSpec ProbeImage() {
-  images::ImageSpec spec;
-  spec.repository = "swarmbox/e2e-probe";
-  spec.component = "e2e-probe";
-  spec.executables.push_back({SWARMBOX_PROBE_PATH, "/usr/local/bin/swarmbox-probe", 0755});
-  spec.entrypoint = {"/usr/local/bin/swarmbox-probe"};
-  images::AddSwarmboxBaseFiles(&spec);
-  return spec;
-}
-
 class DockerEndToEnd : public ::testing::Test {
  protected:
   void SetUp() override {
     api_ = testing::ConnectOrFail();
     ASSERT_NE(api_, nullptr);
     run_id_ = testing::UniqueRunId("e2e");
-    auto image = images::EnsureImage(*api_, ProbeImage(), nullptr, nullptr);
+    auto image = images::EnsureImage(*api_, testing::ProbeImageSpec(), nullptr, nullptr);
     ASSERT_TRUE(image) << image.error().ToString();
     image_ = *image;
   }
@@ -71,7 +62,7 @@ class DockerEndToEnd : public ::testing::Test {
 };
 
 TEST_F(DockerEndToEnd, UnchangedImageIsNotRebuilt) {
-  auto again = images::EnsureImage(*api_, ProbeImage(), nullptr, nullptr);
+  auto again = images::EnsureImage(*api_, testing::ProbeImageSpec(), nullptr, nullptr);
   ASSERT_TRUE(again) << again.error().ToString();
   EXPECT_FALSE(again->built);
   EXPECT_EQ(again->tag, image_.tag);

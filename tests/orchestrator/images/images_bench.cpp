@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "bench.hpp"
+#include "probe_image.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/images/ensure_image.hpp"
@@ -29,18 +30,8 @@ double MsSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-images::ImageSpec ProbeSpec() {
-  images::ImageSpec spec;
-  spec.repository = "swarmbox/e2e-probe";
-  spec.component = "e2e-probe";
-  spec.executables.push_back({SWARMBOX_PROBE_PATH, "/usr/local/bin/swarmbox-probe", 0755});
-  spec.entrypoint = {"/usr/local/bin/swarmbox-probe"};
-  images::AddSwarmboxBaseFiles(&spec);
-  return spec;
-}
-
 int RunImagesBench(const bench::Args& args) {
-  std::vector<images::ImageSpec> specs = {ProbeSpec()};
+  std::vector<images::ImageSpec> specs = {testing::ProbeImageSpec()};
   if (auto faults = images::FaultToolsImage(); faults) {
     specs.push_back(*faults);
   } else {
