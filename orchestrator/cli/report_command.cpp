@@ -1,5 +1,6 @@
-// swarmbox report DIR: regenerates DIR/results.csv and DIR/report.html from the trial folders
-// (experiment_runner.hpp WriteReports). Exit 2 when DIR is not a folder or holds no trial.
+// swarmbox report DIR: regenerates DIR/results.csv, DIR/report.html and DIR/plots/ from the
+// trial folders (experiment_runner.hpp WriteReports). Exit 2 when DIR is not a folder or holds
+// no trial.
 #include <filesystem>
 #include <iostream>
 
@@ -25,7 +26,8 @@ int ReportCommand(const ReportArgs& args) {
     std::cerr << "swarmbox report: no trial folder (with result.json) in " << args.dir << "\n";
     return kExitUsage;
   }
-  std::cout << args.dir << "/results.csv, " << args.dir << "/report.html: " << *n << " trials\n";
+  std::cout << args.dir << "/results.csv, " << args.dir << "/report.html, " << args.dir
+            << "/plots/: " << *n << " trials\n";
   return kExitOk;
 }
 

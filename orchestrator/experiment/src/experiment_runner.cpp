@@ -258,6 +258,15 @@ Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::st
   if (title.empty()) title = out_dir;
   SWARMBOX_TRY(WriteFileAtomic((fs::path(out_dir) / "report.html").string(),
                                report::ReportHtml("SwarmBox experiment " + title, factors, records)));
+  // The page's box plots again as files, for documents that cannot hold inline SVG (a README).
+  const fs::path plots_dir = fs::path(out_dir) / "plots";
+  std::error_code ec;
+  fs::create_directories(plots_dir, ec);
+  if (ec) return Error(ErrorCode::kIo, "cannot create " + plots_dir.string() + ": " + ec.message());
+  for (const report::ReportPlot& plot : report::ReportPlots(factors, records)) {
+    SWARMBOX_TRY(WriteFileAtomic((plots_dir / report::PlotFileName(plot)).string(),
+                                 report::StandalonePlotSvg(plot)));
+  }
   return records.size();
 }
 

@@ -97,6 +97,11 @@ std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxe
   return s + "</svg>";
 }
 
+constexpr char kPlotCss[] =
+    "svg.box text{font-family:sans-serif;font-size:11px;fill:#333}svg.box .n{fill:#777}"
+    ".grid{stroke:#eee}.whisker{stroke:#555}.iqr{fill:#cfe2ff;stroke:#1f4e9c}"
+    ".median{stroke:#1f4e9c;stroke-width:2}.outlier{fill:none;stroke:#b42318}";
+
 }  // namespace
 
 BoxStats ComputeBoxStats(std::vector<double> values) {
@@ -143,6 +148,60 @@ std::string HtmlEscape(std::string_view text) {
   return out;
 }
 
+std::vector<ReportPlot> ReportPlots(const std::vector<std::string>& factors,
+                                    const std::vector<TrialRecord>& records) {
+  std::vector<ReportPlot> plots;
+  std::vector<std::string> metrics = {"wall_s", "sim_s"};
+  metrics.insert(metrics.end(), MetricNames().begin(), MetricNames().end());
+  for (const std::string& m : metrics) {
+    auto value = [&](const TrialRecord& r) -> std::optional<double> {
+      if (m == "wall_s") return r.wall_s;
+      if (m == "sim_s") return r.sim_s;
+      auto it = r.metrics.find(m);
+      return it == r.metrics.end() ? std::nullopt : it->second;
+    };
+    if (std::none_of(records.begin(), records.end(),
+                     [&](const TrialRecord& r) { return value(r).has_value(); })) {
+      continue;
+    }
+    for (std::size_t i = 0; i < factors.size(); ++i) {
+      std::vector<std::pair<std::string, BoxStats>> boxes;
+      for (const auto& [code, label] : LevelsOf(records, i)) {
+        std::vector<double> values;
+        for (const TrialRecord& r : records) {
+          if (i < r.meta.code.size() && r.meta.code[i] == code) {
+            if (auto v = value(r)) values.push_back(*v);
+          }
+        }
+        boxes.emplace_back(label, ComputeBoxStats(std::move(values)));
+      }
+      plots.push_back({m, factors[i], BoxPlotSvg(boxes)});
+    }
+  }
+  return plots;
+}
+
+std::string PlotFileName(const ReportPlot& plot) {
+  std::string name = plot.metric + "_by_" + plot.factor;
+  for (char& c : name) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '_' || c == '-';
+    if (!keep) c = '_';
+  }
+  return name + ".svg";
+}
+
+std::string StandalonePlotSvg(const ReportPlot& plot) {
+  // The inline <svg> of the page (HTML needs no namespace; a file does), with its style and a
+  // title, as a file of its own.
+  const std::string& svg = plot.svg;
+  const std::size_t open_end = svg.find('>');
+  return "<?xml version='1.0' encoding='utf-8'?>\n<svg xmlns='http://www.w3.org/2000/svg'" +
+         svg.substr(4, open_end + 1 - 4) + "<style>" + kPlotCss + "</style><title>" +
+         HtmlEscape(plot.metric) + " by " + HtmlEscape(plot.factor) + "</title>" +
+         svg.substr(open_end + 1) + "\n";
+}
+
 std::string ReportHtml(std::string_view title, const std::vector<std::string>& factors,
                        const std::vector<TrialRecord>& records) {
   std::string h =
@@ -182,38 +241,20 @@ std::string ReportHtml(std::string_view title, const std::vector<std::string>& f
   }
 
   h += "<h2>Metrics per factor level</h2>\n";
-  bool any_metric = false;
-  std::vector<std::string> metrics = {"wall_s", "sim_s"};
-  metrics.insert(metrics.end(), MetricNames().begin(), MetricNames().end());
-  for (const std::string& m : metrics) {
-    auto value = [&](const TrialRecord& r) -> std::optional<double> {
-      if (m == "wall_s") return r.wall_s;
-      if (m == "sim_s") return r.sim_s;
-      auto it = r.metrics.find(m);
-      return it == r.metrics.end() ? std::nullopt : it->second;
-    };
-    if (std::none_of(records.begin(), records.end(),
-                     [&](const TrialRecord& r) { return value(r).has_value(); })) {
-      continue;
+  const std::vector<ReportPlot> plots = ReportPlots(factors, records);
+  for (std::size_t k = 0; k < plots.size(); ++k) {
+    if (k == 0 || plots[k].metric != plots[k - 1].metric) {
+      if (k != 0) h += "</div>\n";
+      h += "<h3>" + HtmlEscape(plots[k].metric) + "</h3><div class='plots'>";
     }
-    any_metric = true;
-    h += "<h3>" + HtmlEscape(m) + "</h3><div class='plots'>";
-    for (std::size_t i = 0; i < factors.size(); ++i) {
-      std::vector<std::pair<std::string, BoxStats>> boxes;
-      for (const auto& [code, label] : LevelsOf(records, i)) {
-        std::vector<double> values;
-        for (const TrialRecord& r : records) {
-          if (i < r.meta.code.size() && r.meta.code[i] == code) {
-            if (auto v = value(r)) values.push_back(*v);
-          }
-        }
-        boxes.emplace_back(label, ComputeBoxStats(std::move(values)));
-      }
-      h += "<figure>" + BoxPlotSvg(boxes) + "<figcaption>" + HtmlEscape(m) + " by " +
-           HtmlEscape(factors[i]) + "</figcaption></figure>";
-    }
-    h += "</div>\n";
+    h += "<figure>" + plots[k].svg + "<figcaption>" + HtmlEscape(plots[k].metric) + " by " +
+         HtmlEscape(plots[k].factor) + "</figcaption></figure>";
   }
+  if (!plots.empty()) h += "</div>\n";
+  const bool any_metric = std::any_of(records.begin(), records.end(), [](const TrialRecord& r) {
+    return r.wall_s || r.sim_s ||
+           std::any_of(r.metrics.begin(), r.metrics.end(), [](const auto& kv) { return kv.second.has_value(); });
+  });
   if (!any_metric) h += "<p>No trial reported a metric.</p>\n";
 
   h += "<h2>Trials</h2>\n<table><tr><th>trial</th><th>code</th>";

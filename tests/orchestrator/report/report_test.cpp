@@ -182,6 +182,32 @@ TEST(ReportHtml, CountsPerLevelPlotsPerMetricAndLinksEveryTrial) {
   EXPECT_EQ(html.find("http://"), std::string::npos) << "self-contained: no external resource";
 }
 
+TEST(ReportHtml, PlotsAreThePagesBoxPlotsAndStandAloneAsFiles) {
+  std::vector<TrialRecord> records = {
+      Record("e-aa-r1", "aa", {"0", "3"}, "success", 10),
+      Record("e-ba-r1", "ba", {"0.2", "3"}, "success", 30),
+  };
+  records[1].metrics["mission_time_s"] = 55;
+  const std::vector<ReportPlot> plots = ReportPlots({"loss", "swarm size"}, records);
+  // wall_s, sim_s and mission_time_s (reported by one trial), each by both factors, page order.
+  ASSERT_EQ(plots.size(), 6u);
+  EXPECT_EQ(plots[0].metric, "wall_s");
+  EXPECT_EQ(plots[0].factor, "loss");
+  EXPECT_EQ(plots[1].factor, "swarm size");
+  EXPECT_EQ(plots[4].metric, "mission_time_s");
+  EXPECT_EQ(PlotFileName(plots[1]), "wall_s_by_swarm_size.svg");
+  const std::string html = ReportHtml("e", {"loss", "swarm size"}, records);
+  for (const ReportPlot& p : plots) EXPECT_NE(html.find(p.svg), std::string::npos) << p.metric;
+  const std::string file = StandalonePlotSvg(plots[4]);
+  EXPECT_EQ(file.rfind("<?xml", 0), 0u);
+  EXPECT_NE(file.find("<svg xmlns='http://www.w3.org/2000/svg' width="), std::string::npos);
+  EXPECT_NE(file.find("<style>"), std::string::npos);
+  EXPECT_NE(file.find("<title>mission_time_s by loss</title>"), std::string::npos);
+  EXPECT_NE(file.find("n=1"), std::string::npos);
+  EXPECT_EQ(file.find("<svg", file.find("<svg") + 1), std::string::npos);  // one root element
+  EXPECT_NE(file.rfind("</svg>"), std::string::npos);
+}
+
 TEST(TrialRecordTest, ReadsResultMetaLogsAndTruthFromAFolder) {
   namespace fs = std::filesystem;
   const fs::path dir = fs::temp_directory_path() / ("swarmbox-record-" + std::to_string(::getpid()));

@@ -91,8 +91,8 @@ Result<std::vector<std::string>> CheckOutFolder(const ExperimentPlan& plan, cons
 Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
                                         const ExperimentOptions& options);
 
-// results.csv and report.html of an experiment folder, from its trial folders (also
-// `swarmbox report DIR`). Returns the number of trials found.
+// results.csv, report.html and plots/*.svg (the page's box plots as files) of an experiment
+// folder, from its trial folders (also `swarmbox report DIR`). Returns the number of trials found.
 Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::string>* problems);
 
 }  // namespace swarmbox::experiment

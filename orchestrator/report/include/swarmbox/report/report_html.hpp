@@ -32,6 +32,25 @@ BoxStats ComputeBoxStats(std::vector<double> values);
 // HTML escaping of text and attribute values.
 std::string HtmlEscape(std::string_view text);
 
+// One box plot of the page: a metric's distribution per level of one factor, as inline SVG.
+struct ReportPlot {
+  std::string metric;
+  std::string factor;
+  std::string svg;
+};
+
+// Every plot of the page, in page order (metric by metric, factors in order); metrics no trial
+// reported are left out.
+std::vector<ReportPlot> ReportPlots(const std::vector<std::string>& factors,
+                                    const std::vector<TrialRecord>& records);
+
+// `<metric>_by_<factor>.svg`, characters outside [A-Za-z0-9_-] replaced by '_'.
+std::string PlotFileName(const ReportPlot& plot);
+
+// The plot as a standalone SVG file (its own style and title), as written to plots/ next to
+// report.html so that other documents (a README) can show it.
+std::string StandalonePlotSvg(const ReportPlot& plot);
+
 std::string ReportHtml(std::string_view title, const std::vector<std::string>& factors,
                        const std::vector<TrialRecord>& records);
 
