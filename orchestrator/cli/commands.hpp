@@ -57,6 +57,7 @@ struct ExperimentArgs {
   std::vector<std::string> hosts;   // "" = the file's hosts:, else local
   bool resume = false;
   std::vector<std::string> filter;  // replaces the file's filter
+  std::vector<std::string> sets;    // appended to the file's set: (factor levels still win)
   int max_attempts = 3;
   std::string run_id;
   bool quiet = false;

@@ -1,4 +1,5 @@
-// swarmbox experiment EXPERIMENT.yaml [--out DIR] [--hosts SPEC ...] [--resume]
+// swarmbox experiment EXPERIMENT.yaml [--out DIR] [--hosts SPEC ...] [--resume] [--filter P]
+//                                    [--set key=value ...]
 //
 // Loads and checks the experiment and every trial it expands to (exit 2 on bad input), connects
 // the hosts (ssh tunnels for ssh:// hosts), builds the images on each host that lacks them, then
@@ -33,6 +34,7 @@ int ExperimentCommand(const ExperimentArgs& args) {
     return kExitUsage;
   }
   if (!args.filter.empty()) spec->filter = args.filter;
+  spec->set.insert(spec->set.end(), args.sets.begin(), args.sets.end());
   auto plan = experiment::PlanExperiment(*spec);
   if (!plan) {
     std::cerr << plan.error().ToString() << "\n";

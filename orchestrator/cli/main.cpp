@@ -59,6 +59,10 @@ int main(int argc, char** argv) {
   exp_cmd->add_flag("--resume", exp.resume, "Run only the trials of --out without result.json");
   exp_cmd->add_option("--filter", exp.filter, "Run only codes matching a pattern (? = any level)")
       ->allow_extra_args(false);
+  exp_cmd->add_option("--set", exp.sets,
+                      "Override a key of every trial: key.path=value (after the file's set:, "
+                      "before the factor levels)")
+      ->allow_extra_args(false);
   exp_cmd->add_option("--max-attempts", exp.max_attempts,
                       "Attempts per trial when hosts fail under it (default 3)")
       ->check(CLI::Range(1, 20));

@@ -117,5 +117,18 @@ TEST(RunCommand, MissingProgramIsAnInfrastructureError) {
   EXPECT_FALSE(c.err().empty());
 }
 
+TEST(ExperimentCommand, SetOverridesEveryTrialAndIsCheckedBeforeTouchingDocker) {
+  Capture c;
+  ExperimentArgs args;
+  args.experiment = kTrials + "/experiments/radio.yaml";
+  args.filter = {"a?a"};
+  args.sets = {"physics.rtf=-1"};
+  args.quiet = true;
+  EXPECT_EQ(ExperimentCommand(args), kExitUsage);
+  // Reported for the first trial the filter keeps: the override reached it.
+  EXPECT_THAT(c.err(), HasSubstr("trial radio-aaa-r1 (code aaa)"));
+  EXPECT_THAT(c.err(), HasSubstr("'rtf' must be >= 0"));
+}
+
 }  // namespace
 }  // namespace swarmbox::cli
