@@ -5,12 +5,21 @@
 // event=mission_complete inside a bounded simulated time, with no collision or crash.
 // Prints the figures: time to first detection, to each confirmation, mission time (sim and wall).
 // DDS domains 216-223 (a pair per process id).
+//
+// AgentSarMission.AScoutKilledMidSearchHasItsSectorSweptByTheOthers (issue #8): the same swarm,
+// one scout (not the leader) SIGKILLed after its first event=sector_progress; the leader must
+// notice it (event=member_lost), hand its sector to live scouts through Raft
+// (event=sector_reassigned), they sweep it, and the mission still ends with
+// event=mission_complete victims=2 rescued=2 within a bounded simulated time. Prints the kill,
+// loss, reassignment and completion times. DDS domains 227-232.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -30,6 +39,8 @@ using Child = swarmbox::testing::LoggedChild;
 using swarmbox::testing::MakeTempDir;
 
 constexpr double kMaxMissionSimS = 400.0;  // the bound (sar_search's timeout is 600 s)
+// With a scout lost mid-search its sector is swept again by others (leader_kill's timeout is 600 s).
+constexpr double kMaxFailoverMissionSimS = 500.0;
 
 int DomainBase() { return 216 + static_cast<int>(getpid() % 4) * 2; }
 
@@ -59,82 +70,139 @@ double Field(const Line& l, const char* key) {
   return v ? std::stod(*v) : std::nan("");
 }
 
+struct Drone {
+  const char* name;
+  const char* airframe;
+  const char* start;
+  const char* payload;
+};
+
+// The open field's SAR swarm: three x500 scouts and the x8_heavy lifter with the stretcher.
+const std::vector<Drone> kDrones = {{"scout_1", "x500", "0,0,0", ""},
+                                    {"scout_2", "x500", "3,0,0", ""},
+                                    {"scout_3", "x500", "6,0,0", ""},
+                                    {"lifter", "x8_heavy", "0,-10,0", "stretcher"}};
+
+// swarmbox-physics (open field, rtf 0, seed 42) and one swarmbox-agent --mission sar per drone,
+// on DDS domains `domain` (sim) and `domain` + 1 (mesh).
+class SarSwarm {
+ public:
+  SarSwarm(std::vector<Drone> drones, int domain, const std::string& dir) : drones_(std::move(drones)), dir_(dir) {
+    const std::string world = SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml";
+    std::vector<std::string> phys = {SWARMBOX_PHYSICS_BIN, "--world", world, "--rtf", "0", "--domain",
+                                     std::to_string(domain), "--max-sim-time", "600", "--seed", "42",
+                                     "--truth", dir + "/truth.csv"};
+    std::string members;
+    for (const Drone& dr : drones_) {
+      phys.push_back("--drone");
+      std::string spec = std::string(dr.name) + ":" + dr.airframe + ":" + dr.start;
+      if (*dr.payload != '\0') spec += std::string(":0:") + dr.payload + ":ground";
+      phys.push_back(spec);
+      members += (members.empty() ? "" : ",") + std::string(dr.name);
+    }
+    wall_start_ = std::chrono::steady_clock::now();
+    physics_ = std::make_unique<Child>(phys, dir + "/physics.log");
+    for (const Drone& dr : drones_) {
+      std::vector<std::string> argv = {SWARMBOX_AGENT_BIN, "--name", dr.name, "--airframe",
+                                       std::string(SWARMBOX_TRIALS_DIR "/airframes/") + dr.airframe + ".yaml",
+                                       "--sim-domain", std::to_string(domain), "--mesh-domain",
+                                       std::to_string(domain + 1), "--start", dr.start, "--members", members,
+                                       "--seed", "42", "--raft-dir", dir + "/raft_" + dr.name, "--mission", "sar",
+                                       "--world", world, "--inference-latency-ms", "40", "--sample-timeout", "60",
+                                       "--stall-timeout", "20"};
+      if (*dr.payload != '\0') {
+        argv.push_back("--payload");
+        argv.push_back(dr.payload);
+      }
+      agents_.push_back(std::make_unique<Child>(argv, dir + "/" + dr.name + ".log"));
+    }
+  }
+
+  bool started() const {
+    bool ok = physics_->pid() > 0;
+    for (const auto& a : agents_) ok = ok && a->pid() > 0;
+    return ok;
+  }
+
+  // Polls every `poll` (wall) until some agent logs mission_complete, or an agent not killed
+  // here or the physics server has exited, or `wall_limit`; `each_poll` runs at every poll (it
+  // may Kill() an agent). Then stops every process. The earliest mission_complete, if any.
+  std::optional<Line> Run(std::chrono::milliseconds poll, std::chrono::seconds wall_limit,
+                          const std::function<void()>& each_poll) {
+    std::optional<Line> complete;
+    const auto deadline = wall_start_ + wall_limit;
+    while (std::chrono::steady_clock::now() < deadline && physics_->Wait(0ms) == -1) {
+      for (auto& a : agents_) {
+        const auto c = Events(a->ReadLog(), "mission_complete");
+        if (!c.empty() && (!complete || c.front().t_s < complete->t_s)) complete = c.front();
+      }
+      if (complete) break;
+      bool all_running = true;  // an agent that died (bad config, crash) ends the wait
+      for (std::size_t i = 0; i < agents_.size(); ++i) {
+        all_running = all_running && (i == killed_ || agents_[i]->Wait(0ms) == -1);
+      }
+      if (!all_running) break;
+      if (each_poll) each_poll();
+      std::this_thread::sleep_for(poll);
+    }
+    wall_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start_).count();
+    for (std::size_t i = 0; i < agents_.size(); ++i) {
+      if (i != killed_) agents_[i]->Terminate();
+    }
+    physics_->Terminate();
+    for (std::size_t i = 0; i < agents_.size(); ++i) {
+      if (i != killed_) {
+        EXPECT_EQ(agents_[i]->Wait(30s), 0) << drones_[i].name;
+      }
+    }
+    physics_->Wait(30s);
+    return complete;
+  }
+
+  // SIGKILL to agent `i` (at most one per run).
+  void Kill(std::size_t i) {
+    killed_ = i;
+    agents_[i]->Signal(SIGKILL);
+    EXPECT_EQ(agents_[i]->Wait(10s), 128 + SIGKILL) << drones_[i].name;
+  }
+
+  std::size_t size() const { return agents_.size(); }
+  const Drone& drone(std::size_t i) const { return drones_[i]; }
+  std::string Log(std::size_t i) const { return agents_[i]->ReadLog(); }
+  std::string PhysicsLog() const { return physics_->ReadLog(); }
+  std::string AllLogs() const {
+    std::string s = "---- physics\n" + physics_->ReadLog();
+    for (std::size_t i = 0; i < agents_.size(); ++i) s += std::string("---- ") + drones_[i].name + "\n" + agents_[i]->ReadLog();
+    return s;
+  }
+  double wall_s() const { return wall_s_; }
+  const std::string& dir() const { return dir_; }
+
+ private:
+  std::vector<Drone> drones_;
+  std::string dir_;
+  std::unique_ptr<Child> physics_;
+  std::vector<std::unique_ptr<Child>> agents_;
+  std::chrono::steady_clock::time_point wall_start_;
+  std::size_t killed_ = static_cast<std::size_t>(-1);
+  double wall_s_ = 0;
+};
+
 TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
   const std::string dir = MakeTempDir("swarmbox_sar_it_");
   ASSERT_FALSE(dir.empty());
-  const int d = DomainBase();
-  const std::string world = SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml";
-  struct Drone {
-    const char* name;
-    const char* airframe;
-    const char* start;
-    const char* payload;
-  };
-  const std::vector<Drone> drones = {{"scout_1", "x500", "0,0,0", ""},
-                                     {"scout_2", "x500", "3,0,0", ""},
-                                     {"scout_3", "x500", "6,0,0", ""},
-                                     {"lifter", "x8_heavy", "0,-10,0", "stretcher"}};
-  std::vector<std::string> phys = {SWARMBOX_PHYSICS_BIN, "--world", world, "--rtf", "0", "--domain", std::to_string(d),
-                                   "--max-sim-time", "600", "--seed", "42", "--truth", dir + "/truth.csv"};
-  std::string members;
-  for (const Drone& dr : drones) {
-    phys.push_back("--drone");
-    std::string spec = std::string(dr.name) + ":" + dr.airframe + ":" + dr.start;
-    if (*dr.payload != '\0') spec += std::string(":0:") + dr.payload + ":ground";
-    phys.push_back(spec);
-    members += (members.empty() ? "" : ",") + std::string(dr.name);
-  }
-  const auto wall_start = std::chrono::steady_clock::now();
-  Child physics(phys, dir + "/physics.log");
-  ASSERT_GT(physics.pid(), 0);
-  std::vector<std::unique_ptr<Child>> agents;
-  for (const Drone& dr : drones) {
-    std::vector<std::string> argv = {SWARMBOX_AGENT_BIN, "--name", dr.name, "--airframe",
-                                     std::string(SWARMBOX_TRIALS_DIR "/airframes/") + dr.airframe + ".yaml",
-                                     "--sim-domain", std::to_string(d), "--mesh-domain", std::to_string(d + 1),
-                                     "--start", dr.start, "--members", members, "--seed", "42",
-                                     "--raft-dir", dir + "/raft_" + dr.name, "--mission", "sar", "--world", world,
-                                     "--inference-latency-ms", "40", "--sample-timeout", "60", "--stall-timeout", "20"};
-    if (*dr.payload != '\0') {
-      argv.push_back("--payload");
-      argv.push_back(dr.payload);
-    }
-    agents.push_back(std::make_unique<Child>(argv, dir + "/" + dr.name + ".log"));
-    ASSERT_GT(agents.back()->pid(), 0);
-  }
-  auto all_logs = [&] {
-    std::string s = "---- physics\n" + physics.ReadLog();
-    for (std::size_t i = 0; i < agents.size(); ++i) s += std::string("---- ") + drones[i].name + "\n" + agents[i]->ReadLog();
-    return s;
-  };
-
-  // Until some agent logs mission_complete (or everything stopped, or the wall deadline).
-  std::optional<Line> complete;
-  const auto deadline = wall_start + 780s;
-  while (std::chrono::steady_clock::now() < deadline && physics.Wait(0ms) == -1) {
-    for (auto& a : agents) {
-      const auto c = Events(a->ReadLog(), "mission_complete");
-      if (!c.empty() && (!complete || c.front().t_s < complete->t_s)) complete = c.front();
-    }
-    if (complete) break;
-    bool all_running = true;  // an agent that died (bad config, crash) ends the wait
-    for (auto& a : agents) all_running = all_running && a->Wait(0ms) == -1;
-    if (!all_running) break;
-    std::this_thread::sleep_for(1s);
-  }
-  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  for (auto& a : agents) a->Terminate();
-  physics.Terminate();
-  for (std::size_t i = 0; i < agents.size(); ++i) EXPECT_EQ(agents[i]->Wait(30s), 0) << drones[i].name;
-  physics.Wait(30s);
-  const std::string logs = all_logs();
+  SarSwarm swarm(kDrones, DomainBase(), dir);
+  ASSERT_TRUE(swarm.started());
+  const std::optional<Line> complete = swarm.Run(1s, 780s, nullptr);
+  const double wall_s = swarm.wall_s();
+  const std::string logs = swarm.AllLogs();
   ASSERT_TRUE(complete.has_value()) << "no event=mission_complete after " << wall_s << " s wall:\n" << logs;
   EXPECT_LT(complete->t_s, kMaxMissionSimS) << logs;
   EXPECT_EQ(FindField(complete->fields, "victims"), "2");
   EXPECT_EQ(FindField(complete->fields, "rescued"), "2");
 
   // Both victims confirmed through Raft near where they lie (the agents never read them).
-  const std::string scout_log = agents[0]->ReadLog();
+  const std::string scout_log = swarm.Log(0);
   const auto confirmed = Events(scout_log, "victim_confirmed", "scout_1");
   ASSERT_EQ(confirmed.size(), 2u) << scout_log;
   const double truth[2][2] = {{35.0, 20.0}, {-42.0, 55.0}};
@@ -144,11 +212,11 @@ TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
     EXPECT_LT(best, 3.0) << "victim at " << v[0] << "," << v[1] << " confirmed " << best << " m away";
   }
   // The lifter hooked, set down, reloaded and delivered each victim; its load was felt.
-  const std::string lifter_log = agents[3]->ReadLog();
+  const std::string lifter_log = swarm.Log(3);
   EXPECT_EQ(Events(lifter_log, "victim_delivered").size(), 2u) << lifter_log;
   EXPECT_EQ(Events(lifter_log, "evacuee_loaded").size(), 2u) << lifter_log;
   EXPECT_TRUE(Events(lifter_log, "payload_missing").empty()) << lifter_log;
-  const std::string plog = physics.ReadLog();
+  const std::string plog = swarm.PhysicsLog();
   EXPECT_GE(Events(plog, "payload_attached").size(), 4u) << plog;
   EXPECT_TRUE(Events(plog, "collision").empty()) << plog;
   EXPECT_TRUE(Events(plog, "crash").empty()) << plog;
@@ -157,7 +225,7 @@ TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
   // The figures.
   double first_detection = 1e9;
   for (std::size_t i = 0; i < 3; ++i) {
-    const auto s = Events(agents[i]->ReadLog(), "sighting_reported");
+    const auto s = Events(swarm.Log(i), "sighting_reported");
     if (!s.empty()) first_detection = std::min(first_detection, s.front().t_s);
   }
   std::printf("sar_mission first_detection_s=%.1f", first_detection);
@@ -165,6 +233,78 @@ TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
     std::printf(" confirm_%s_s=%.1f", FindField(c.fields, "id").value_or("?").c_str(), c.t_s);
   }
   std::printf(" mission_s=%.1f wall_s=%.1f\n", complete->t_s, wall_s);
+  std::fflush(stdout);
+  if (HasFailure()) std::fprintf(stderr, "logs in %s\n", dir.c_str());
+}
+
+
+// The agents' Raft leader: the latest event=leader_elected in `log` ("" before any).
+std::string LeaderIn(const std::string& log) {
+  const auto e = Events(log, "leader_elected");
+  return e.empty() ? "" : FindField(e.back().fields, "leader").value_or("");
+}
+
+TEST(AgentSarMission, AScoutKilledMidSearchHasItsSectorSweptByTheOthers) {
+  const std::string dir = MakeTempDir("swarmbox_sar_failover_it_");
+  ASSERT_FALSE(dir.empty());
+  SarSwarm swarm(kDrones, 227 + static_cast<int>(getpid() % 3) * 2, dir);
+  ASSERT_TRUE(swarm.started());
+  // The first scout other than the leader to finish a lane is killed at once (polls every 0.1 s
+  // of wall time: about half a second of simulated time at rtf 0 here).
+  std::size_t victim = swarm.size();
+  double progress_s = -1;
+  const auto kill_after_progress = [&] {
+    if (victim != swarm.size()) return;
+    const std::string leader = LeaderIn(swarm.Log(3));
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto p = Events(swarm.Log(i), "sector_progress");
+      if (p.empty() || leader.empty() || leader == swarm.drone(i).name) continue;
+      victim = i;
+      progress_s = p.front().t_s;
+      swarm.Kill(i);
+      return;
+    }
+  };
+  const std::optional<Line> complete = swarm.Run(100ms, 780s, kill_after_progress);
+  const std::string logs = swarm.AllLogs();
+  ASSERT_LT(victim, swarm.size()) << "no scout was killed:\n" << logs;
+  const std::string killed = swarm.drone(victim).name;
+  ASSERT_TRUE(complete.has_value()) << "no event=mission_complete after " << swarm.wall_s() << " s wall:\n" << logs;
+  EXPECT_LT(complete->t_s, kMaxFailoverMissionSimS) << logs;
+  EXPECT_EQ(FindField(complete->fields, "victims"), "2");
+  EXPECT_EQ(FindField(complete->fields, "rescued"), "2");
+
+  // The leader noticed the loss and handed the sector over; the pieces were taken and swept.
+  std::optional<Line> lost, handed;
+  for (std::size_t i = 0; i < swarm.size(); ++i) {
+    for (const Line& l : Events(swarm.Log(i), "member_lost")) {
+      if (FindField(l.fields, "drone") == killed && (!lost || l.t_s < lost->t_s)) lost = l;
+    }
+    for (const Line& l : Events(swarm.Log(i), "sector_reassigned")) {
+      if (FindField(l.fields, "from") == killed && (!handed || l.t_s < handed->t_s)) handed = l;
+    }
+  }
+  ASSERT_TRUE(lost.has_value()) << logs;
+  ASSERT_TRUE(handed.has_value()) << logs;
+  EXPECT_GE(handed->t_s, lost->t_s);
+  const std::string to = FindField(handed->fields, "to").value_or("");
+  EXPECT_EQ(to.find(killed), std::string::npos) << to;
+  double taken_s = 1e9, swept_s = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (i == victim || to.find(swarm.drone(i).name) == std::string::npos) continue;
+    const auto started = Events(swarm.Log(i), "sector_started");
+    const auto swept = Events(swarm.Log(i), "sector_swept");
+    ASSERT_GE(started.size(), 2u) << swarm.drone(i).name << " never started its piece:\n" << swarm.Log(i);
+    EXPECT_EQ(swept.size(), started.size()) << swarm.Log(i);  // its own sector and the piece(s)
+    taken_s = std::min(taken_s, started[1].t_s);
+    if (!swept.empty()) swept_s = std::max(swept_s, swept.back().t_s);
+  }
+  const std::string plog = swarm.PhysicsLog();
+  EXPECT_TRUE(Events(plog, "collision").empty()) << plog;
+  std::printf("sar_failover killed=%s progress_s=%.1f lost_s=%.1f silent_s=%s reassigned_s=%.1f to=%s "
+              "first_piece_started_s=%.1f last_swept_s=%.1f mission_s=%.1f wall_s=%.1f\n",
+              killed.c_str(), progress_s, lost->t_s, FindField(lost->fields, "silent_s").value_or("?").c_str(),
+              handed->t_s, to.c_str(), taken_s, swept_s, complete->t_s, swarm.wall_s());
   std::fflush(stdout);
   if (HasFailure()) std::fprintf(stderr, "logs in %s\n", dir.c_str());
 }
