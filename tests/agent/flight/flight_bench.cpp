@@ -38,7 +38,8 @@ int RunSeed(std::uint64_t seed) {
     e.Add("suite", "flight").Add("scenario", "x500_hover").Add("seed", seed_l).Add("window_s", window, 0)
         .Add("rms_m", m->rms_m).Add("max_m", m->max_m).Add("target_rms_m", m->target_rms_m)
         .Add("truth_rms_m", m->truth_rms_m).Add("gps_wander_rms_m", m->gps_wander_rms_m)
-        .Add("est_rms_m", m->est_rms_m).Add("issue_target_rms_m", 0.1).Add("pass", m->rms_m < 0.1);
+        .Add("est_rms_m", m->est_rms_m).Add("track_rms_m", m->track_rms_m).Add("issue_target_rms_m", 0.1)
+        .Add("pass", m->rms_m < 0.1);
     Print(e);
   } else {
     rc = Fail("x500_hover", m.error());

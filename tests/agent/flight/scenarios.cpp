@@ -52,13 +52,14 @@ Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_m
   const Vec3 gps0 = r.gps_error();
   std::vector<Vec3> nav;
   nav.reserve(static_cast<std::size_t>(window_s * 250.0) + 2);
-  double truth2 = 0.0, target2 = 0.0, wander2 = 0.0, est2 = 0.0;
+  double truth2 = 0.0, target2 = 0.0, wander2 = 0.0, est2 = 0.0, track2 = 0.0;
   r.Run(window_s, {}, [&] {
     nav.push_back(r.nav_pos());
     target2 += (r.nav_pos() - target).squaredNorm();
     truth2 += (r.true_pos() - target).squaredNorm();
     wander2 += (r.gps_error() - gps0).head<2>().squaredNorm();
     est2 += (r.fc().estimate().pos_m - r.nav_pos()).squaredNorm();
+    track2 += (r.fc().estimate().pos_m - target).squaredNorm();
   });
   const double dn = static_cast<double>(nav.size());
   Vec3 mean = Vec3::Zero();
@@ -74,6 +75,7 @@ Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_m
   m.truth_rms_m = std::sqrt(truth2 / dn);
   m.gps_wander_rms_m = std::sqrt(wander2 / dn);
   m.est_rms_m = std::sqrt(est2 / dn);
+  m.track_rms_m = std::sqrt(track2 / dn);
   m.max_m = max_e;
   m.window_s = window_s;
   if (r.crashed()) return Error(ErrorCode::kInternal, "crashed while hovering");

@@ -24,6 +24,9 @@ struct HoverMetrics {
   double truth_rms_m = 0;    // the same on absolute truth
   double gps_wander_rms_m = 0;  // RMS of the receiver's horizontal error change over the window
   double est_rms_m = 0;      // estimator error (estimate - nav position), 3-D RMS
+  double track_rms_m = 0;    // control tracking: the estimate to the hold point, 3-D RMS (what the
+                             // controller sees; includes the estimate's per-fix steps it does not
+                             // follow)
   double window_s = 0;
 };
 // Takes off to 5 m, settles, then holds for window_s; optional mean wind with gusts.
