@@ -33,7 +33,9 @@ std::int64_t MonotonicUs() {
   return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
 }
 
-NfqueueDelayer::NfqueueDelayer(const NetemdArgs& args) : args_(args), scheduler_(args.delay, args.seed) {}
+NfqueueDelayer::NfqueueDelayer(const NetemdArgs& args) : args_(args), scheduler_(args.delay, args.seed) {
+  if (args.gilbert_elliott) loss_.emplace(*args.gilbert_elliott, args.seed);
+}
 
 NfqueueDelayer::~NfqueueDelayer() {
   if (queue_ != nullptr) nfq_destroy_queue(queue_);
@@ -63,9 +65,14 @@ int NfqueueDelayer::OnPacket(nfq_q_handle* /*queue*/, ::nfgenmsg* /*msg*/, ::nfq
   const nfqnl_msg_packet_hdr* header = nfq_get_msg_packet_hdr(data);
   if (header == nullptr) return 0;
   const std::uint32_t id = ntohl(header->packet_id);
+  ++d->stats_.packets;
+  if (d->loss_ && d->loss_->Lose()) {
+    if (nfq_set_verdict(d->queue_, id, NF_DROP, 0, nullptr) < 0) ++d->stats_.verdict_errors;
+    ++d->stats_.dropped;
+    return 0;
+  }
   const std::int64_t now_us = MonotonicUs();
   d->scheduler_.Admit(id, now_us);
-  ++d->stats_.packets;
   return 0;
 }
 
@@ -133,7 +140,8 @@ Status NfqueueDelayer::Run() {
   const std::int64_t now_us = MonotonicUs();
   while (!scheduler_.empty()) Accept(scheduler_.PopNext(), now_us);
   stats_.reordered = scheduler_.reordered();
-  stats_.mean_hold_ms = stats_.packets > 0 ? hold_sum_ms_ / static_cast<double>(stats_.packets) : 0.0;
+  const std::uint64_t held = stats_.packets - stats_.dropped;
+  stats_.mean_hold_ms = held > 0 ? hold_sum_ms_ / static_cast<double>(held) : 0.0;
   ::close(sfd);
   return result;
 }

@@ -1,15 +1,18 @@
 // NfqueueDelayer: swarmbox-netemd's I/O shell around DelayScheduler. Binds one NFQUEUE, admits each
 // queued packet into the scheduler with the monotonic clock and accepts it when its release time
 // comes (ppoll with microsecond timeouts). Metadata only is copied from the kernel; packets are
-// never modified or dropped here (loss is iptables `statistic`'s job).
+// never modified. Random loss is iptables `statistic`'s job (on ingress); a Gilbert-Elliott model
+// (bursty loss, --ge-*) is drawn here and its losses get NF_DROP at once.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/faults/delay_scheduler.hpp"
+#include "swarmbox/faults/gilbert_elliott_loss.hpp"
 #include "swarmbox/faults/netemd_args.hpp"
 
 struct nfq_handle;
@@ -22,6 +25,7 @@ namespace swarmbox::faults {
 struct DelayerStats {
   std::uint64_t packets = 0;
   std::uint64_t reordered = 0;        // sent at once (reorder fraction)
+  std::uint64_t dropped = 0;          // lost by the Gilbert-Elliott model (NF_DROP)
   std::uint64_t verdict_errors = 0;
   std::uint64_t receive_overruns = 0;  // ENOBUFS: the kernel dropped queue messages for us
   double mean_hold_ms = 0.0;          // actual hold time, admission to verdict
@@ -45,6 +49,7 @@ class NfqueueDelayer {
 
   NetemdArgs args_;
   DelayScheduler scheduler_;
+  std::optional<GilbertElliottLoss> loss_;
   nfq_handle* handle_ = nullptr;
   nfq_q_handle* queue_ = nullptr;
   DelayerStats stats_;

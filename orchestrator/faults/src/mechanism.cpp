@@ -48,10 +48,6 @@ Status CheckMechanismSupports(const std::vector<RadioRule>& rules, Mechanism mec
                    "sch_netem and the userspace mechanism " + std::string(why),
                    rule.mark.ToString());
     };
-    if (s.gilbert_elliott) {
-      return refuse("gilbert_elliott", "draws losses with iptables statistic, which has no state "
-                                       "(use loss)");
-    }
     if (s.loss_correlation > 0.0) {
       return refuse("loss_correlation", "draws each loss independently with iptables statistic");
     }

@@ -56,6 +56,12 @@ std::vector<std::string> NetemdRunArgv(const std::string& program, const NetemdA
     argv.push_back(a.pidfile);
   }
   if (a.daemonize) argv.push_back("--daemonize");
+  if (a.gilbert_elliott) {
+    const GilbertElliott& g = *a.gilbert_elliott;
+    argv.insert(argv.end(), {"--ge-p", detail::FormatDecimal(g.p), "--ge-r", detail::FormatDecimal(g.r),
+                             "--ge-loss-bad", detail::FormatDecimal(g.loss_bad), "--ge-loss-good",
+                             detail::FormatDecimal(g.loss_good)});
+  }
   return argv;
 }
 
@@ -66,6 +72,8 @@ std::vector<std::string> NetemdStopArgv(const std::string& program, const std::s
 Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words) {
   NetemdArgs a;
   bool have_queue = false;
+  GilbertElliott ge;
+  int ge_flags = 0;
   for (std::size_t i = 0; i < words.size(); ++i) {
     const std::string& flag = words[i];
     if (flag == "--daemonize") {
@@ -100,6 +108,18 @@ Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words) {
       a.seed = static_cast<std::uint64_t>(seed);
     } else if (flag == "--queue-maxlen") {
       SWARMBOX_TRY(ParseInt<std::uint32_t>(flag, v, 1, kNetemdMaxQueueLen, &a.queue_maxlen));
+    } else if (flag == "--ge-p") {
+      SWARMBOX_TRY(ParseFraction(flag, v, &ge.p));
+      ge_flags |= 1;
+    } else if (flag == "--ge-r") {
+      SWARMBOX_TRY(ParseFraction(flag, v, &ge.r));
+      ge_flags |= 2;
+    } else if (flag == "--ge-loss-bad") {
+      SWARMBOX_TRY(ParseFraction(flag, v, &ge.loss_bad));
+      ge_flags |= 4;
+    } else if (flag == "--ge-loss-good") {
+      SWARMBOX_TRY(ParseFraction(flag, v, &ge.loss_good));
+      ge_flags |= 8;
     } else if (flag == "--pidfile") {
       if (v.empty() || v[0] != '/') return Bad(flag, "expected an absolute path, got '" + v + "'");
       a.pidfile = v;
@@ -108,6 +128,10 @@ Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words) {
     }
   }
   if (!have_queue) return Bad("--queue", "required");
+  if (ge_flags != 0 && ge_flags != 0b1111) {
+    return Bad("--ge-p", "a Gilbert-Elliott model needs all of --ge-p, --ge-r, --ge-loss-bad and --ge-loss-good");
+  }
+  if (ge_flags != 0) a.gilbert_elliott = ge;
   return a;
 }
 

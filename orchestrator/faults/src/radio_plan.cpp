@@ -134,7 +134,11 @@ RadioPlan PlanKernel(const Split& s, const LinkTarget& link) {
   return plan;
 }
 
-bool Delays(const RadioRule* r) { return r != nullptr && (r->spec.has_delay() || r->spec.reorder > 0.0); }
+// Rules whose packets go through swarmbox-netemd: delay, reorder, or Gilbert-Elliott loss (drawn
+// there; random loss stays with iptables statistic on ingress).
+bool Delays(const RadioRule* r) {
+  return r != nullptr && (r->spec.has_delay() || r->spec.reorder > 0.0 || r->spec.gilbert_elliott.has_value());
+}
 bool Drops(const RadioRule* r) { return r != nullptr && r->spec.loss > 0.0; }
 
 RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanOptions& o) {
@@ -179,6 +183,7 @@ RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanO
     args.delay.reorder = r->spec.reorder;
     args.delay.reorder_correlation = r->spec.reorder_correlation;
     args.delay.reorder_gap = r->spec.reorder_gap;
+    args.gilbert_elliott = r->spec.gilbert_elliott;
     args.seed = DaemonSeed(o.seed, link.node, queue);
     args.queue_maxlen = std::min(NetemLimitPackets(r->spec, link.link_rate_kbit), kNetemdMaxQueueLen);
     args.pidfile = o.pid_dir + "/swarmbox-netemd-" + std::to_string(queue) + ".pid";

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 namespace swarmbox::faults {
 namespace {
 
@@ -24,6 +26,24 @@ TEST(NetemdArgs, RunArgvRoundTrips) {
   EXPECT_EQ(*parsed, a);
 }
 
+TEST(NetemdArgs, GilbertElliottFlagsRoundTrip) {
+  NetemdArgs a;
+  a.queue = 1;
+  a.gilbert_elliott = GilbertElliott{0.02, 0.25, 0.9, 0.01};
+  const auto argv = NetemdRunArgv("netemd", a);
+  const std::vector<std::string> tail(argv.end() - 8, argv.end());
+  EXPECT_EQ(tail, (std::vector<std::string>{"--ge-p", "0.02", "--ge-r", "0.25", "--ge-loss-bad", "0.9",
+                                            "--ge-loss-good", "0.01"}));
+  auto parsed = ParseNetemdRunArgs(std::vector<std::string>(argv.begin() + 2, argv.end()));
+  ASSERT_TRUE(parsed) << parsed.error().ToString();
+  EXPECT_EQ(*parsed, a);
+  // Without the model no --ge-* flag is written, and none parsed means no loss.
+  a.gilbert_elliott.reset();
+  const auto plain = NetemdRunArgv("netemd", a);
+  EXPECT_EQ(std::find(plain.begin(), plain.end(), "--ge-p"), plain.end());
+  EXPECT_FALSE(ParseNetemdRunArgs({"--queue", "1"})->gilbert_elliott.has_value());
+}
+
 TEST(NetemdArgs, StopArgv) {
   EXPECT_EQ(NetemdStopArgv("/usr/bin/swarmbox-netemd", "/run/x.pid"),
             (std::vector<std::string>{"/usr/bin/swarmbox-netemd", "stop", "--pidfile", "/run/x.pid"}));
@@ -42,6 +62,9 @@ TEST(NetemdArgs, RejectsBadFlagsWithTheReason) {
       {{"--queue", "1", "--pidfile", "rel.pid"}, "--pidfile: expected an absolute path"},
       {{"--queue", "1", "--speed", "3"}, "--speed: unknown flag"},
       {{"--queue"}, "--queue: missing value"},
+      {{"--queue", "1", "--ge-p", "0.1", "--ge-r", "0.2"},
+       "--ge-p: a Gilbert-Elliott model needs all of --ge-p, --ge-r, --ge-loss-bad and --ge-loss-good"},
+      {{"--queue", "1", "--ge-loss-bad", "2"}, "--ge-loss-bad: expected a fraction in [0, 1], got '2'"},
   };
   for (const Case& c : cases) {
     auto parsed = ParseNetemdRunArgs(c.words);

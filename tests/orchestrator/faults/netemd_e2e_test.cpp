@@ -55,6 +55,7 @@ std::int64_t RealtimeUs() {
 struct Sample {
   std::uint32_t sent = 0;
   std::vector<double> delay_ms;  // per received packet
+  std::vector<std::uint32_t> seqs;  // the received packets' numbers, ascending
   std::uint32_t received() const { return static_cast<std::uint32_t>(delay_ms.size()); }
   double Mean() const {
     double s = 0;
@@ -217,7 +218,10 @@ class NetnsPair : public ::testing::Test {
     receiver.join();
     close(tx);
     close(rx);
-    for (const auto& [seq, d] : got) sample.delay_ms.push_back(d);
+    for (const auto& [seq, d] : got) {
+      sample.delay_ms.push_back(d);
+      sample.seqs.push_back(seq);
+    }
     return sample;
   }
 
@@ -301,6 +305,43 @@ TEST_F(NetnsPair, UserspacePlanDelaysJittersAndDropsAsSpecified) {
   const Sample after = Measure(300, 1000);
   EXPECT_EQ(after.received(), after.sent);
   EXPECT_LT(after.Mean(), 5.0);
+}
+
+TEST_F(NetnsPair, GilbertElliottLossComesInBurstsAndTheSenderSeesNoError) {
+  // netem "loss gemodel 2% 25% 100% 0%": bad spells of 4 packets on average, all lost; 7.4 % in the
+  // long run. Drawn and dropped by the daemon on egress (NF_DROP after the packet was queued).
+  auto rules = ParseRadioRules(Yaml("{delay_ms: 5, gilbert_elliott: {p: 0.02, r: 0.25, loss_bad: 1.0, loss_good: 0.0}}"),
+                               "radio");
+  ASSERT_TRUE(rules) << rules.error().ToString();
+  auto plan = PlanRadio(*rules, Link("a", if_a_, "b", kAddrB), Mechanism::kUserspace, Options("a"));
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  PrefixCommandRunner in_a(runner_, {"ip", "netns", "exec", ns_a_});
+  Status applied = RunCommands(in_a, plan->apply);
+  ASSERT_TRUE(applied) << applied.error().ToString();
+  const Sample s = Measure(3000, 1000);
+  ASSERT_EQ(s.sent, 3000u);  // every sendto() succeeded: the drop happens after the queue took it
+  const double loss = 1.0 - static_cast<double>(s.received()) / s.sent;
+  // Runs of consecutive lost numbers (the receiver keeps each packet's number).
+  int bursts = 0;
+  std::uint32_t expected = 0;
+  for (std::uint32_t seq : s.seqs) {
+    if (seq != expected) ++bursts;
+    expected = seq + 1;
+  }
+  if (expected != s.sent) ++bursts;
+  const double mean_burst = bursts > 0 ? static_cast<double>(s.sent - s.received()) / bursts : 0.0;
+  std::printf("userspace Gilbert-Elliott p 2%% r 25%% loss_bad 100%%: sent %u received %u loss %.2f%% "
+              "(stationary 7.41%%), %d bursts, mean burst %.2f packets (model 4)\n",
+              s.sent, s.received(), 100 * loss, bursts, mean_burst);
+  RecordProperty("ge_loss", std::to_string(loss));
+  RecordProperty("ge_mean_burst", std::to_string(mean_burst));
+  // The state is a Markov chain: over 3,000 packets the loss estimate's sd is
+  // sqrt(pi (1 - pi) (2 - p - r) / ((p + r) n)) = 1.2 %; 4 sd either side.
+  EXPECT_NEAR(loss, 0.0741, 0.048);
+  // Geometric bursts of mean 4 over ~55 bursts: sd of the mean about 0.47; independent 7.4 % loss
+  // would give 1.08. Allow 4.0 +- 2.
+  EXPECT_NEAR(mean_burst, 4.0, 2.0);
+  EXPECT_TRUE(RunAllCommands(in_a, plan->undo));
 }
 
 TEST_F(NetnsPair, FixedDelayHasATightSpread) {

@@ -169,6 +169,25 @@ TEST(RadioPlan, UserspaceLossOnlyNeedsNoDaemon) {
                           "iptables -w -X SWARMBOX-RADIO-IN"));
 }
 
+TEST(RadioPlan, UserspaceGilbertElliottLossIsDrawnByTheDaemonOnEgress) {
+  // Bursty loss has state, which iptables statistic has not: the daemon drops, so the rule's packets
+  // go through its queue even without delay, and no ingress chain is made.
+  auto plan = PlanRadio(Rules("{gilbert_elliott: {p: 0.02, r: 0.25, loss_bad: 0.9, loss_good: 0.01}}"), Link(),
+                        Mechanism::kUserspace);
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  EXPECT_THAT(Lines(plan->apply),
+              ElementsAre(::testing::AllOf(::testing::StartsWith("/usr/bin/swarmbox-netemd run --queue 0 --delay-us 0 "),
+                                           ::testing::EndsWith("--daemonize --ge-p 0.02 --ge-r 0.25 --ge-loss-bad 0.9 "
+                                                               "--ge-loss-good 0.01")),
+                          "iptables -w -N SWARMBOX-RADIO-OUT",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -j NFQUEUE --queue-num 0 --queue-bypass",
+                          "iptables -w -I OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT"));
+  EXPECT_THAT(Lines(plan->undo),
+              ElementsAre("iptables -w -D OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT", "iptables -w -F SWARMBOX-RADIO-OUT",
+                          "iptables -w -X SWARMBOX-RADIO-OUT",
+                          "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid"));
+}
+
 TEST(RadioPlan, UserspacePerDestinationRulesComeBeforeTheAllTrafficRule) {
   RadioPlanOptions options;
   options.seed = 7;

@@ -4,16 +4,20 @@
 //   swarmbox-netemd run --queue 0 --delay-us 100000 --jitter-us 20000 --distribution normal
 //                       --correlation 0.25 --reorder 0 --reorder-correlation 0 --reorder-gap 0
 //                       --seed 42 --queue-maxlen 4096 [--pidfile /run/swarmbox-netemd-0.pid]
-//                       [--daemonize]
+//                       [--daemonize] [--ge-p 0.02 --ge-r 0.25 --ge-loss-bad 0.9 --ge-loss-good 0]
 //   swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid   # SIGTERM, wait until it is gone
 //   swarmbox-netemd sleep                                       # a sidecar's pid 1: reaps, waits
 //
 // `run` binds NFQUEUE `--queue`, holds each packet for its sampled delay and then accepts it. With
 // --daemonize it forks once the queue is bound and the parent exits 0 (so a `docker exec` returns
-// when the delayer is ready). On SIGTERM it accepts every held packet at once and exits 0.
+// when the delayer is ready). On SIGTERM it accepts every held packet at once and exits 0. With the
+// --ge-* flags (all four, netem's gemodel p, r, 1-h, 1-k) it drops each packet a Gilbert-Elliott
+// model (gilbert_elliott_loss.hpp) says is lost, before delaying the rest: on egress, yet the
+// sender sees no error (its send() returned when the packet was queued).
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +33,7 @@ struct NetemdArgs {
   std::uint16_t queue = 0;
   DelaySettings delay;
   std::uint64_t seed = 0;
+  std::optional<GilbertElliott> gilbert_elliott;  // bursty loss, drawn per packet; none = no loss
   std::uint32_t queue_maxlen = 1024;  // packets the kernel may hold for us before dropping
   std::string pidfile;                // "" = none
   bool daemonize = false;
