@@ -108,14 +108,49 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
     if (known) continue;
     recent_[recent_next_] = {p, in.t_s, d.confidence};
     recent_next_ = (recent_next_ + 1) % recent_.size();
-    const std::uint64_t seq = next_seq_++;
-    out->proposals.push_back(raft::ReportSighting{config_.name, seq, p.x(), p.y(), d.confidence});
-    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sighting_reported")
-                                        .Add("seq", static_cast<std::uint64_t>(seq))
-                                        .Add("x", p.x(), 2)
-                                        .Add("y", p.y(), 2)
-                                        .Add("confidence", d.confidence, 3)));
+    // A new report of a place supersedes an outstanding one there.
+    std::erase_if(outstanding_, [&](const Outstanding& o) {
+      return (o.position_m - p).norm() <= config_.dedupe_radius_m;
+    });
+    if (outstanding_.size() >= recent_.size()) outstanding_.erase(outstanding_.begin());
+    Propose(in, p, d.confidence, 1, out);
   }
+}
+
+void ScoutBehaviour::Propose(const MissionInput& in, const Eigen::Vector2d& p, double confidence,
+                             int tries, MissionOutput* out) {
+  const std::uint64_t seq = next_seq_++;
+  out->proposals.push_back(raft::ReportSighting{config_.name, seq, p.x(), p.y(), confidence});
+  LogEvent e(in.t_s, config_.name, "sighting_reported");
+  e.Add("seq", static_cast<std::uint64_t>(seq)).Add("x", p.x(), 2).Add("y", p.y(), 2).Add("confidence", confidence, 3);
+  if (tries > 1) e.Add("retry", tries - 1);
+  out->events.push_back(std::move(e));
+  outstanding_.push_back({seq, p, confidence, in.t_s, tries});
+}
+
+void ScoutBehaviour::RetrySightings(const MissionInput& in, MissionOutput* out) {
+  const raft::MissionState& m = *in.mission;
+  const std::size_t n = outstanding_.size();  // Propose() appends the retries behind these
+  std::vector<Outstanding> keep;
+  for (std::size_t i = 0; i < n; ++i) {
+    const Outstanding o = outstanding_[i];
+    bool committed = false;
+    for (const raft::Sighting& s : m.pending_sightings()) {
+      committed = committed || (s.reporter == config_.name && s.seq == o.seq);
+    }
+    for (const raft::Victim& v : m.victims()) {
+      committed = committed || (Eigen::Vector2d(v.x_m, v.y_m) - o.position_m).norm() <= config_.dedupe_radius_m;
+    }
+    if (committed) continue;
+    if (in.t_s - o.sent_s < config_.report_retry_s) {
+      keep.push_back(o);
+    } else if (o.tries < config_.report_tries) {
+      Propose(in, o.position_m, o.confidence, o.tries + 1, out);
+      keep.push_back(outstanding_.back());
+      outstanding_.pop_back();
+    }
+  }
+  outstanding_ = std::move(keep);
 }
 
 void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
@@ -130,7 +165,10 @@ void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
   }
   const bool reporting = stage_ == Stage::kSearching || stage_ == Stage::kSwept ||
                          stage_ == Stage::kOrbiting || stage_ == Stage::kAwaitingSector;
-  if (reporting && Active(in.mission->phase())) ReportSightings(in, out);
+  if (reporting && Active(in.mission->phase())) {
+    ReportSightings(in, out);
+    RetrySightings(in, out);
+  }
   out->mode = StageName(stage_);
 }
 

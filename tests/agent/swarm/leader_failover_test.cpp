@@ -13,6 +13,7 @@
 
 #include "swarmbox/swarm/leader_planner.hpp"
 #include "swarmbox/swarm/scout_behaviour.hpp"
+#include "swarmbox/swarm/detection.hpp"
 
 namespace swarmbox::swarm {
 namespace {
@@ -387,6 +388,49 @@ TEST(ScoutHandOver, GoesBackToWorkWhenHandedASectorAfterItLanded) {
   low.battery_low = true;
   s.Step(low, &out);
   EXPECT_EQ(out.mode, "returning");
+}
+
+
+// A report lost on the radio or in a dead leader's log is proposed again until committed.
+TEST(ScoutReports, ReproposesAReportUntilTheCommittedStateShowsIt) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .report_retry_s = 5.0, .report_tries = 3});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  GroundDetection d;
+  d.position_m = {20, 30, 0};
+  d.confidence = 0.7;
+  std::vector<GroundDetection> dets = {d};
+  MissionInput in = Input(2.0, m, {0, 0, 30});
+  in.detections = dets;
+  s.Step(in, &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_EQ(Get<raft::ReportSighting>(out).seq, 1u);
+  s.Step(Input(6.9, m, {10, 10, 30}), &out);
+  EXPECT_TRUE(out.proposals.empty());
+  s.Step(Input(7.0, m, {10, 10, 30}), &out);  // lost: again, next seq
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_EQ(Get<raft::ReportSighting>(out).seq, 2u);
+  EXPECT_DOUBLE_EQ(Get<raft::ReportSighting>(out).x_m, 20.0);
+  EXPECT_TRUE(HasEvent(out, "sighting_reported", "retry=1"));
+  m.Apply(Get<raft::ReportSighting>(out));  // committed (pending: one drone, below 0.9)
+  s.Step(Input(20.0, m, {10, 10, 30}), &out);
+  EXPECT_TRUE(out.proposals.empty());
+  // Never committed: report_tries proposals in all, then it is given up.
+  d.position_m = {40, 100, 0};
+  dets = {d};
+  in = Input(30.0, m, {40, 100, 30});
+  in.detections = dets;
+  s.Step(in, &out);
+  int proposals = static_cast<int>(out.proposals.size());
+  for (double t = 30.5; t < 80.0; t += 0.5) {
+    s.Step(Input(t, m, {40, 60, 30}), &out);
+    proposals += static_cast<int>(out.proposals.size());
+  }
+  EXPECT_EQ(proposals, 3);
 }
 
 }  // namespace

@@ -23,6 +23,10 @@
 // view within the cooldown is still reported when it reaches MissionState::kHighConfidence and
 // the recent report did not (a victim first seen partly at the image edge is capped below it; the
 // full view a moment later confirms it on its own).
+// A report is re-proposed (next seq) every report_retry_s until the committed state shows it (a
+// pending sighting with its seq, or a victim there), at most report_tries times: a proposal
+// forwarded over the lossy radio, or caught in the leader's log when the leader died, is lost
+// without a word, and nobody else may pass over that spot again.
 //
 //   ScoutBehaviour scout({.name = "scout_1", .home_m = spawn});
 //   scout.Step(input, &output);   // each mission tick (e.g. 10 Hz)
@@ -75,6 +79,8 @@ struct ScoutConfig {
   double min_report_confidence = raft::MissionState::kMinConfidence;
   double dedupe_radius_m = raft::MissionState::kConfirmRadiusM;
   double report_cooldown_s = 10.0;    // re-report the same place after this (a lost proposal) [s]
+  double report_retry_s = 5.0;        // re-propose a report not yet in the committed state [s]
+  int report_tries = 4;               // proposals of one report at most
   std::uint64_t first_sighting_seq = 1;  // after an agent restart: seed above any used (sim ms)
 };
 
@@ -100,6 +106,9 @@ class ScoutBehaviour {
   void Decide(const MissionInput& in, MissionOutput* out);    // stage changes from the mission
   void RunStage(const MissionInput& in, MissionOutput* out);  // the stage's setpoint
   void ReportSightings(const MissionInput& in, MissionOutput* out);
+  void RetrySightings(const MissionInput& in, MissionOutput* out);
+  void Propose(const MissionInput& in, const Eigen::Vector2d& p, double confidence, int tries,
+               MissionOutput* out);
   void PlanSector(const raft::Sector& sector, const Eigen::Vector3d& position_m);
   // This drone's first committed sector it has not swept yet, or nullptr.
   const raft::Sector* NextSector(const raft::MissionState& m) const;
@@ -128,6 +137,14 @@ class ScoutBehaviour {
   };
   std::array<RecentReport, 16> recent_{};
   std::size_t recent_next_ = 0;
+  struct Outstanding {  // a report not seen in the committed state yet
+    std::uint64_t seq = 0;
+    Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+    double confidence = 0.0;
+    double sent_s = 0.0;
+    int tries = 0;
+  };
+  std::vector<Outstanding> outstanding_;  // at most recent_.size()
 };
 
 }  // namespace swarmbox::swarm
