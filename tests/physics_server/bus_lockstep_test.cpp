@@ -8,20 +8,12 @@
 #include <thread>
 
 #include "bus_transport.hpp"
+#include "server_thread.hpp"
 #include "sim_server.hpp"
 #include "test_util.hpp"
 
 namespace swarmbox::physics {
 namespace {
-
-std::string ReadFile(std::FILE* f) {
-  std::fflush(f);
-  std::rewind(f);
-  std::string s;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, f)) s.append(buf, n);
-  return s;
-}
 
 void RunLockstepOverBus(const std::string& backend) {
   const int domain = 100 + static_cast<int>(::getpid() % 100);
@@ -54,14 +46,7 @@ void RunLockstepOverBus(const std::string& backend) {
   so.max_sim_time_s = 1.0;
   so.lockstep.timeout_ns = 300'000'000;
   so.lockstep.join_timeout_ns = 20'000'000'000;
-  SteadyWallClock clock;
-  SimServer server(*world, **transport, clock, nullptr, so, out);
-  std::atomic<bool> stop{false}, done{false};
-  Status result;
-  std::thread server_thread([&] {
-    result = server.Run(stop);
-    done = true;
-  });
+  testing::ServerThread server(*world, **transport, so, out);
 
   constexpr std::uint64_t kBAnswersUntil = 50;  // then drone b's agent "dies"
   bus::SensorSample s;
@@ -70,7 +55,7 @@ void RunLockstepOverBus(const std::string& backend) {
   cmd.motor_throttle.assign(4, u);
   std::uint64_t a_answered = 0, images = 0;
   bool b_valid_gps = false;
-  while (!done.load()) {
+  while (!server.done()) {
     if ((*sub_a)->TakeFor(s, std::chrono::milliseconds(5))) {
       cmd.drone = "a";
       cmd.step = s.step;
@@ -94,7 +79,7 @@ void RunLockstepOverBus(const std::string& backend) {
       EXPECT_EQ(img.encoding, "bgr8");
     }
   }
-  server_thread.join();
+  const Status result = server.Join();
   ASSERT_TRUE(result.ok()) << result.error().ToString();
   EXPECT_EQ(world->step_count(), 250u);
   EXPECT_GE(a_answered, 250u);
@@ -105,7 +90,7 @@ void RunLockstepOverBus(const std::string& backend) {
   // a kept hovering on its agent's commands; b lost its motors at t = 0.2 s and fell.
   EXPECT_NEAR(world->Truth(0).position_m.z, 10.23, 0.01);
   EXPECT_LT(world->Truth(1).position_m.z, 9.0);
-  const std::string log = ReadFile(out);
+  const std::string log = testing::ReadAll(out);
   std::fclose(out);
   EXPECT_NE(log.find("t=0.200 node=physics event=drone_lost a=b"), std::string::npos) << log;
   EXPECT_EQ(log.find("a=a"), std::string::npos) << log;

@@ -14,6 +14,7 @@
 
 #include "bus_transport.hpp"
 #include "command_sender.hpp"
+#include "server_thread.hpp"
 #include "sim_server.hpp"
 #include "support/logged_child.hpp"
 #include "test_util.hpp"
@@ -53,15 +54,6 @@ std::vector<std::string> SendArgs(int domain, std::vector<std::string> words) {
   a.push_back("--match-timeout");
   a.push_back("1");
   return a;
-}
-
-std::string ReadFile(std::FILE* f) {
-  std::fflush(f);
-  std::rewind(f);
-  std::string s;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, f)) s.append(buf, n);
-  return s;
 }
 
 TEST(WorldCommandTable, ChecksNamesArgumentCountsAndSigns) {
@@ -135,14 +127,7 @@ TEST(SendCommandProgram, GpsDropoutReachesTheServerAndTheDroneLosesItsFix) {
   so.cameras = false;
   so.lockstep.timeout_ns = 2'000'000'000;
   so.lockstep.join_timeout_ns = 20'000'000'000;
-  SteadyWallClock clock;
-  SimServer server(*world, **transport, clock, nullptr, so, out);
-  std::atomic<bool> stop{false}, done{false};
-  Status result;
-  std::thread server_thread([&] {
-    result = server.Run(stop);
-    done = true;
-  });
+  testing::ServerThread server(*world, **transport, so, out);
   ProcessResult sent, gust;
   std::thread sender([&] {
     sent = RunProgram(SendArgs(domain, {"a", "gps_dropout", "1.0"}));
@@ -155,7 +140,7 @@ TEST(SendCommandProgram, GpsDropoutReachesTheServerAndTheDroneLosesItsFix) {
   cmd.armed = true;
   cmd.motor_throttle.assign(4, u);
   bool fix_before = false, lost_fix = false, fix_after = false;
-  while (!done.load()) {
+  while (!server.done()) {
     if (!(*sensors)->TakeFor(s, std::chrono::milliseconds(5))) continue;
     cmd.step = s.step;
     ASSERT_TRUE((*actuators)->Publish(cmd).ok());
@@ -169,7 +154,7 @@ TEST(SendCommandProgram, GpsDropoutReachesTheServerAndTheDroneLosesItsFix) {
       fix_after = fix_after || (fix && s.gps.valid);
     }
   }
-  server_thread.join();
+  const Status result = server.Join();
   sender.join();
   ASSERT_TRUE(result.ok()) << result.error().ToString();
   EXPECT_EQ(sent.exit_code, 0) << sent.output;
@@ -177,7 +162,7 @@ TEST(SendCommandProgram, GpsDropoutReachesTheServerAndTheDroneLosesItsFix) {
   EXPECT_TRUE(fix_before);
   EXPECT_TRUE(lost_fix);   // the dropout reached the drone
   EXPECT_TRUE(fix_after);  // and ended after its 1 s
-  const std::string log = ReadFile(out);
+  const std::string log = testing::ReadAll(out);
   std::fclose(out);
   EXPECT_NE(log.find("event=world_command command=gps_dropout target=a"), std::string::npos) << log;
   EXPECT_NE(log.find("event=world_command command=wind_gust target="), std::string::npos) << log;
