@@ -1,8 +1,10 @@
-// A sensor fault with the real programs on the real engine: a short kind plan trial (physics server
-// + one agent: take-off, hover, land) with `{at: 8s, duration: 3s, gps_dropout: scout_1}`. The
-// runner execs `swarmbox-physics --send-command scout_1 gps_dropout 3` in the physics container;
-// events.jsonl records the apply and the removal with mechanism physics-command, the physics log
-// shows the server took the command, and nothing labelled remains.
+// Sensor faults with the real programs on the real engine: a short kind plan trial (physics server
+// + one agent: take-off, hover, land) with `{at: 8s, duration: 3s, gps_dropout: scout_1}` and then
+// `{at: 12s, duration: 2s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}`. The runner
+// execs `swarmbox-physics --send-command scout_1 gps_dropout 3` (and `... gps_degrade 2 5 8`) in
+// the physics container; events.jsonl records each apply and removal with mechanism
+// physics-command, the physics log shows the server took both commands, and nothing labelled
+// remains.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -31,7 +33,7 @@ std::string ReadFile(const fs::path& p) {
   return s.str();
 }
 
-TEST(SensorFaultE2e, GpsDropoutIsSentToThePhysicsServerAndRecorded) {
+TEST(SensorFaultE2e, GpsDropoutAndDegradationAreSentToThePhysicsServerAndRecorded) {
   auto client = docker::DockerClient::Connect(docker::DockerClientOptions{});
   ASSERT_TRUE(client) << "this test needs a Docker engine: " << client.error().ToString();
   docker::DockerApi& api = **client;
@@ -50,6 +52,7 @@ TEST(SensorFaultE2e, GpsDropoutIsSentToThePhysicsServerAndRecorded) {
                             .EndOn("event=crash", dsl::Outcome::kFailure, "crash")
                             .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout, dsl::Duration::Seconds(240));
   spec.Fault("{name: gps_loss, at: 8s, duration: 3s, gps_dropout: scout_1}");
+  spec.Fault("{name: bad_fix, at: 12s, duration: 2s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}");
   spec.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
 
   const fs::path out = fs::temp_directory_path() / "swarmbox-sensor-fault-e2e";
@@ -78,9 +81,12 @@ TEST(SensorFaultE2e, GpsDropoutIsSentToThePhysicsServerAndRecorded) {
   EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"gps_loss\",\"kind\":\"gps_dropout\""));
   EXPECT_THAT(events, HasSubstr("\"targets\":[\"scout_1\"],\"mechanism\":\"physics-command\""));
   EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"gps_loss\""));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"bad_fix\",\"kind\":\"gps_degrade\""));
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"bad_fix\""));
   EXPECT_THAT(events, Not(HasSubstr("\"phase\":\"failed\"")));
   const std::string physics_log = ReadFile(fs::path(run->trial_dir) / "logs" / "physics.log");
   EXPECT_THAT(physics_log, HasSubstr("event=world_command command=gps_dropout target=scout_1")) << physics_log;
+  EXPECT_THAT(physics_log, HasSubstr("event=world_command command=gps_degrade target=scout_1")) << physics_log;
 
   auto containers = api.ListContainers(mine, /*all=*/true);
   ASSERT_TRUE(containers);
