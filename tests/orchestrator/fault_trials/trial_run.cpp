@@ -1,11 +1,9 @@
 #include "trial_run.hpp"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -14,6 +12,7 @@
 #include <sstream>
 
 #include "program_images.hpp"
+#include "support/child_process.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/dsl/plugin.hpp"
@@ -22,8 +21,6 @@
 #include "swarmbox/runner/fault_image.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/plan.hpp"
-
-extern char** environ;
 
 namespace swarmbox::fault_trials {
 namespace {
@@ -137,27 +134,8 @@ Result<TrialRun> RunFaultTrial(docker::DockerApi& api, const dsl::TrialSpec& spe
 }
 
 bool AgentHasFlag(const std::string& flag) {
-  char path[] = "/tmp/swarmbox-agent-help-XXXXXX";
-  const int fd = ::mkstemp(path);
-  if (fd < 0) return false;
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, fd, STDOUT_FILENO);
-  posix_spawn_file_actions_addopen(&actions, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
-  std::string bin = SWARMBOX_AGENT_BIN;
-  std::string help = "--help";
-  char* argv[] = {bin.data(), help.data(), nullptr};
-  pid_t pid = 0;
-  const int rc = ::posix_spawn(&pid, bin.c_str(), &actions, nullptr, argv, environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ::close(fd);
-  int status = 0;
-  if (rc == 0) ::waitpid(pid, &status, 0);
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  ::unlink(path);
-  return rc == 0 && ss.str().find(flag) != std::string::npos;
+  auto help = swarmbox::testing::RunToEnd({SWARMBOX_AGENT_BIN, "--help"}, std::chrono::seconds(60), "/tmp");
+  return help && help->out.find(flag) != std::string::npos;
 }
 
 }  // namespace swarmbox::fault_trials
