@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <set>
 #include <sstream>
 
@@ -19,7 +20,18 @@ struct DockerEngine::Follower {
   docker::CancelToken cancel;
   std::thread thread;
   std::atomic<bool> done{false};
+  std::atomic<bool> clean_end{false};  // the stream ended by itself: the container's output closed
   std::atomic<std::uint64_t> lines{0};
+};
+
+// The second half of a container's stop, finished while the tree goes on: Docker's stop call
+// returns only after the engine has torn down the container's network (~0.1-0.4 s each, one at a
+// time inside the engine), then the exit code, artifacts and removal.
+struct DockerEngine::PendingStop {
+  std::thread thread;
+  bool stop_returned = false;  // guarded by DockerEngine::done_mu_
+  std::promise<void> logs_joined;
+  Verdict verdict;  // written by `thread`, read after joining it
 };
 
 namespace {
@@ -65,6 +77,7 @@ DockerEngine::DockerEngine(docker::DockerApi& api, LogHub& hub, Clock& clock,
 }
 
 DockerEngine::~DockerEngine() {
+  JoinStops();
   for (auto& [component, f] : followers_) f->cancel.Cancel();
   for (auto& [component, f] : followers_) {
     if (f->thread.joinable()) f->thread.join();
@@ -95,6 +108,7 @@ std::optional<std::string> DockerEngine::ContainerId(const std::string& componen
 }
 
 Verdict DockerEngine::CreateNetwork(dsl::Network& network) {
+  JoinStops();  // a rebuild: the containers of the last build are gone first
   const dsl::NetworkSpec& s = network.spec();
   docker::NetworkSpec spec;
   spec.name = s.name;
@@ -114,6 +128,7 @@ Verdict DockerEngine::CreateNetwork(dsl::Network& network) {
 }
 
 Verdict DockerEngine::RemoveNetwork(dsl::Network& network) {
+  JoinStops();  // its containers are removed first
   std::string id;
   {
     std::lock_guard lock(mu_);
@@ -257,7 +272,12 @@ void DockerEngine::StartFollower(const std::string& component, const std::string
     if (out == nullptr) why = "cannot write " + path;
     hub_.Push({HubItem::Kind::kStreamEnd, component, why, clock_.NowS() - options_.start_wall_s,
                generation});
-    raw->done.store(true);
+    raw->clean_end.store(s.ok());
+    {
+      std::lock_guard lock(done_mu_);
+      raw->done.store(true);
+    }
+    done_cv_.notify_all();
   });
   std::lock_guard lock(mu_);
   followers_[component] = std::move(f);
@@ -342,16 +362,18 @@ Verdict DockerEngine::StartContainer(dsl::Plugin& plugin) {
   return Verdict::Err("unreachable", plugin.Path());
 }
 
-void DockerEngine::CollectArtifacts(const dsl::Plugin& plugin, const std::string& container_id) {
-  for (const std::string& path : plugin.spec().artifacts) {
+void DockerEngine::CollectArtifacts(const std::string& component,
+                                    const std::vector<std::string>& artifacts,
+                                    const std::string& container_id) {
+  for (const std::string& path : artifacts) {
     auto tar = api_.GetArchive(container_id, path);
     if (!tar) {
-      AddProblem(plugin.id() + ": artifact " + path + " not collected: " + tar.error().ToString());
+      AddProblem(component + ": artifact " + path + " not collected: " + tar.error().ToString());
       continue;
     }
     auto entries = docker::ReadTar(*tar);
     if (!entries) {
-      AddProblem(plugin.id() + ": artifact " + path + " unreadable: " + entries.error().ToString());
+      AddProblem(component + ": artifact " + path + " unreadable: " + entries.error().ToString());
       continue;
     }
     for (const docker::TarEntry& e : *entries) {
@@ -361,7 +383,7 @@ void DockerEngine::CollectArtifacts(const dsl::Plugin& plugin, const std::string
       std::ofstream out(dest, std::ios::binary | std::ios::trunc);
       out.write(e.content.data(), static_cast<std::streamsize>(e.content.size()));
       if (!out) {
-        AddProblem(plugin.id() + ": cannot write " + dest);
+        AddProblem(component + ": cannot write " + dest);
         continue;
       }
       std::lock_guard lock(mu_);
@@ -371,27 +393,85 @@ void DockerEngine::CollectArtifacts(const dsl::Plugin& plugin, const std::string
 }
 
 Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
-  const auto found = ContainerId(plugin.id());
-  if (!found) return Verdict::Success();
-  const std::string id = *found;
-  Verdict v;
-  if (Status s = api_.StopContainer(id, plugin.spec().stop_timeout_s);
-      !s && s.error().code() != ErrorCode::kNotFound) {
-    v.KeepWorse(Verdict::FromError(s.error().Context("stopping " + plugin.spec().name), plugin.Path()));
-  }
-  JoinFollower(plugin.id(), /*cancel=*/false);
-  if (auto info = api_.InspectContainer(id)) {
+  const std::string component = plugin.id();
+  std::string id;
+  {
     std::lock_guard lock(mu_);
-    reports_[plugin.id()].exit_code = info->state.exit_code;
-    reports_[plugin.id()].oom_killed = info->state.oom_killed;
+    auto it = container_ids_.find(component);
+    if (it == container_ids_.end()) return Verdict::Success();
+    id = it->second;
+    container_ids_.erase(it);  // a rebuild may create the component again while this one goes
   }
-  CollectArtifacts(plugin, id);
-  if (Status s = api_.RemoveContainer(id, /*force=*/true, /*remove_volumes=*/true);
-      !s && s.error().code() != ErrorCode::kNotFound) {
-    v.KeepWorse(Verdict::FromError(s.error().Context("removing " + plugin.spec().name), plugin.Path()));
+  auto pending = std::make_unique<PendingStop>();
+  PendingStop* raw = pending.get();
+  std::shared_future<void> logs_joined = raw->logs_joined.get_future().share();
+  raw->thread = std::thread([this, raw, logs_joined, id, component, name = plugin.spec().name,
+                             path = plugin.Path(), grace_s = plugin.spec().stop_timeout_s,
+                             artifacts = plugin.spec().artifacts] {
+    // SIGTERM, SIGKILL after the grace; returns once the engine has cleaned the container up.
+    Status s = api_.StopContainer(id, grace_s);
+    if (!s && s.error().code() != ErrorCode::kNotFound) {
+      raw->verdict.KeepWorse(Verdict::FromError(s.error().Context("stopping " + name), path));
+    }
+    {
+      std::lock_guard lock(done_mu_);
+      raw->stop_returned = true;
+    }
+    done_cv_.notify_all();
+    logs_joined.wait();  // the log is complete: the container may go
+    if (auto info = api_.InspectContainer(id)) {
+      std::lock_guard lock(mu_);
+      reports_[component].exit_code = info->state.exit_code;
+      reports_[component].oom_killed = info->state.oom_killed;
+    }
+    CollectArtifacts(component, artifacts, id);
+    if (Status r = api_.RemoveContainer(id, /*force=*/true, /*remove_volumes=*/true);
+        !r && r.error().code() != ErrorCode::kNotFound) {
+      raw->verdict.KeepWorse(Verdict::FromError(r.error().Context("removing " + name), path));
+    }
+  });
+  // The container counts as stopped once its program has exited: its log stream ends by itself
+  // (its output closed). A stream that broke, or a container without one, waits for Docker's stop.
+  {
+    std::unique_lock lock(done_mu_);
+    done_cv_.wait(lock, [&] { return raw->stop_returned || LogEndedByItself(component); });
+  }
+  JoinFollower(component, /*cancel=*/false);
+  raw->logs_joined.set_value();
+  std::lock_guard lock(mu_);
+  pending_stops_.push_back(std::move(pending));
+  return Verdict::Success();
+}
+
+bool DockerEngine::LogEndedByItself(const std::string& component) const {
+  std::lock_guard lock(mu_);
+  auto it = followers_.find(component);
+  return it != followers_.end() && it->second->done.load() && it->second->clean_end.load();
+}
+
+void DockerEngine::JoinStops() {
+  // One joiner at a time: a second caller (the other network of the level) returns only once the
+  // first has joined everything.
+  std::lock_guard joining(join_mu_);
+  std::vector<std::unique_ptr<PendingStop>> pending;
+  {
+    std::lock_guard lock(mu_);
+    pending.swap(pending_stops_);
+  }
+  Verdict v;
+  for (auto& p : pending) {
+    if (p->thread.joinable()) p->thread.join();
+    v.KeepWorse(p->verdict);
   }
   std::lock_guard lock(mu_);
-  container_ids_.erase(plugin.id());
+  stops_verdict_.KeepWorse(v);
+}
+
+Verdict DockerEngine::FinishStops() {
+  JoinStops();
+  std::lock_guard lock(mu_);
+  Verdict v = stops_verdict_;
+  stops_verdict_ = Verdict::Success();
   return v;
 }
 

@@ -321,6 +321,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       if (dynamic_cast<dsl::Step*>(tree->Find(kFaultsStepId)) == nullptr) (void)injector->Teardown();
     }
     Verdict stop = tree->Stop(*engine);
+    stop.KeepWorse(engine->FinishStops());  // exit codes, artifacts, removals still under way
     if (!stop.ok()) {
       result.problems.push_back("teardown: " + stop.ToString());
       verdict.KeepWorse(stop);

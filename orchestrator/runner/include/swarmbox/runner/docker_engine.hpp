@@ -5,6 +5,11 @@
 // artifacts (Docker's archive endpoint, so remote engines work too), and removes. Containers are
 // never auto-removed, so a crashed container's logs and exit code are kept.
 //
+// Stop returns as soon as the container's program has exited (SIGTERM, SIGKILL after the grace;
+// its log stream ended and was read to the end), so the next level is stopped without waiting for
+// the engine's clean-up; Docker's stop call, the exit code, artifacts and removal finish in the
+// background. RemoveNetwork, a rebuild, FinishStops() and the destructor wait for them.
+//
 // The containers of one run-priority level are handled at once (RunSiblings: up to
 // EngineOptions::max_parallel threads, each making its own calls on the thread-safe DockerApi):
 // created and filled together, started together (each waiting for its own readiness), stopped,
@@ -16,6 +21,7 @@
 #pragma once
 
 #include <atomic>
+#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -42,7 +48,7 @@ struct EngineOptions {
   // Called with each lifecycle step (events.jsonl); may be empty.
   std::function<void(const dsl::Component&, dsl::EventKind, const dsl::Verdict&)> on_trace;
   // How many containers of one level are created, started or stopped at once (1 = one by one).
-  int max_parallel = 8;
+  int max_parallel = 32;
 };
 
 // Runs every step, at most `max_threads` at once (the calling thread works too; one thread or one
@@ -78,6 +84,10 @@ class DockerEngine final : public dsl::Engine {
   bool IsCurrent(const HubItem& item) const;
   // True when the last network creation failed because its subnet overlaps another network.
   bool subnet_conflict() const { return subnet_conflict_.load(); }
+  // Waits for the stops still finishing (exit codes, artifacts, removal) and returns their worst
+  // verdict since the last call (a failed stop or removal). Call after the tree's Stop, before
+  // Reports(), problems() and artifacts(). The destructor and RemoveNetwork wait for them too.
+  dsl::Verdict FinishStops();
   // Per container: exit code, log file, line count (filled on Stop).
   std::vector<ComponentReport> Reports() const;
   // Things that went wrong without changing the outcome (a missing artifact...).
@@ -91,7 +101,11 @@ class DockerEngine final : public dsl::Engine {
                      std::uint64_t skip_lines = 0);
   void JoinFollower(const std::string& component, bool cancel);
   Status CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id);
-  void CollectArtifacts(const dsl::Plugin& plugin, const std::string& container_id);
+  void CollectArtifacts(const std::string& component, const std::vector<std::string>& artifacts,
+                        const std::string& container_id);
+  struct PendingStop;
+  bool LogEndedByItself(const std::string& component) const;
+  void JoinStops();
   void AddProblem(std::string problem);
   std::optional<std::string> ContainerId(const std::string& component) const;
 
@@ -110,6 +124,12 @@ class DockerEngine final : public dsl::Engine {
   std::map<std::string, std::uint64_t> generations_;  // component -> current follower
   std::uint64_t next_generation_ = 1;
   std::atomic<bool> subnet_conflict_{false};
+  std::vector<std::unique_ptr<PendingStop>> pending_stops_;  // guarded by mu_
+  std::mutex join_mu_;  // held while JoinStops joins
+  dsl::Verdict stops_verdict_;                               // guarded by mu_
+  // Signalled when a follower ends or a Docker stop returns (StopContainer waits on either).
+  std::mutex done_mu_;
+  std::condition_variable done_cv_;
 };
 
 }  // namespace swarmbox::runner
