@@ -29,7 +29,9 @@
 //   in = {now, &driver.mission(), est.pos_m, est.vel_mps, yaw, battery.fraction(),
 //         battery.IsLow(dist_home, height, payload_kg), payload_attached, detections};
 //   scout.Step(in, &out);                                // or lifter.Step(in, &out)
+//   leader.Track(now, driver.mission());                 // every drone: sector list changes
 //   if (driver.is_leader()) leader.Step(now, driver.mission(), roster_from_drone_states, &out);
+//   // (roster: name, role, mode and age of each drone's latest DroneState: a silent one is gone)
 //   for (auto& c : out.proposals) driver.Propose(c);
 //   for (auto& e : out.events) std::puts(e.str().c_str());
 //   if (out.payload.action != PayloadAction::kNone) publish bus::WorldCommand payload_attach/release
