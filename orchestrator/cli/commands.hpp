@@ -3,6 +3,8 @@
 // error (no Docker engine, image build failed).
 #pragma once
 
+#include <functional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -71,8 +73,16 @@ struct ReportArgs {
 int ReportCommand(const ReportArgs& args);
 
 struct GcArgs {
-  std::string run_id;  // "" = every run
+  std::string run_id;  // "" = every run not alive on this machine
 };
 int GcCommand(const GcArgs& args);
+
+// Which runs `swarmbox gc` removes: only_run when given, else every labelled run that is not alive.
+struct GcPlan {
+  std::vector<std::string> remove;
+  std::vector<std::string> skip_live;
+};
+GcPlan PlanGc(const std::set<std::string>& labelled_runs, const std::string& only_run,
+              const std::function<bool(const std::string&)>& is_live);
 
 }  // namespace swarmbox::cli

@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "program_images.hpp"
+#include "run_lock.hpp"
 #include "swarmbox/experiment/experiment_runner.hpp"
 #include "swarmbox/experiment/experiment_spec.hpp"
 #include "swarmbox/experiment/trial_store.hpp"
@@ -53,6 +54,12 @@ int ExperimentCommand(const ExperimentArgs& args) {
     return kExitUsage;
   }
   const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
+  // Held until this process ends, however it ends: `swarmbox gc` leaves a live experiment alone.
+  auto lock = RunLock::Acquire(run_id);
+  if (!lock) {
+    std::cerr << "swarmbox experiment: " << lock.error().ToString() << "\n";
+    return lock.error().code() == ErrorCode::kUnavailable ? kExitUsage : kExitInfrastructure;
+  }
   const std::string out = args.out.empty() ? "runs/" + spec->name + "-" + run_id : args.out;
   if (auto checked = experiment::CheckOutFolder(*plan, out, args.resume); !checked) {
     std::cerr << "swarmbox experiment: " << checked.error().ToString() << "\n";

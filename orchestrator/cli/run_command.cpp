@@ -5,8 +5,10 @@
 #include "commands.hpp"
 #include "interrupt.hpp"
 #include "program_images.hpp"
+#include "run_lock.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/dsl/trial_loader.hpp"
+#include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
 
 namespace swarmbox::cli {
@@ -39,10 +41,17 @@ int RunCommand(const RunArgs& args) {
     std::cerr << "swarmbox run: interrupted (Ctrl-C) before the trial started; nothing was created\n";
     return kExitOutcome;
   }
+  // Held until this process ends, however it ends: `swarmbox gc` leaves a live run alone.
+  const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
+  auto lock = RunLock::Acquire(run_id);
+  if (!lock) {
+    std::cerr << "swarmbox run: " << lock.error().ToString() << "\n";
+    return lock.error().code() == ErrorCode::kUnavailable ? kExitUsage : kExitInfrastructure;
+  }
   runner::SteadyClock clock;
   runner::RunOptions options;
   options.out_dir = args.out;
-  options.run_id = args.run_id;
+  options.run_id = run_id;
   options.images = *images;
   options.interrupted = &interrupted;
   options.progress = args.quiet ? nullptr : &std::cerr;

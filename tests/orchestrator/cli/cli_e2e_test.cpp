@@ -6,7 +6,7 @@
 //   SIGINT  -> exit 1, result.json outcome "error" ("interrupted (Ctrl-C)"), every log collected,
 //              nothing labelled with the run id left (ARCHITECTURE.md "CLI", "Labels").
 //   SIGKILL -> the containers and networks stay; `swarmbox gc --run ID` removes exactly that run's,
-//              `swarmbox gc` every run's.
+//              `swarmbox gc` every dead run's, and leaves a live run's alone.
 //
 // Plain `swarmbox gc` removes whatever any run left on this engine, so these tests hold the
 // ctest resource lock "docker" like every other end-to-end test.
@@ -21,6 +21,7 @@
 #include <iostream>
 #include <thread>
 
+#include "run_lock.hpp"
 #include "support/child_process.hpp"
 #include "support/files.hpp"
 #include "swarmbox/common/yaml.hpp"
@@ -223,7 +224,18 @@ TEST_F(CliE2eTest, GcRemovesWhatKilledRunsLeft) {
   EXPECT_EQ(Left(b).containers, 2u);
   EXPECT_EQ(Left(b).networks, 2u);
 
-  // and `swarmbox gc` removes every run's leftovers (B's, and any other run's on this engine).
+  // A run still alive on this machine (its swarmbox holds the run lock; here, this test holds it
+  // for a network labelled with its id)
+  const std::string live = NewRun();
+  auto live_lock = RunLock::Acquire(live);
+  ASSERT_TRUE(live_lock) << live_lock.error().ToString();
+  docker::NetworkSpec live_net;
+  live_net.name = "swarmbox-cli-e2e-live-" + live;
+  live_net.labels[std::string(docker::kLabelRun)] = live;
+  ASSERT_TRUE(api_->CreateNetwork(live_net));
+
+  // and `swarmbox gc` removes every dead run's leftovers (B's, and any other dead run's on this
+  // engine) but not the live run's.
   // (Exit 3 is right when the engine refuses to remove some other run's network: Docker 20.10 can
   // keep a stale endpoint on a network until it restarts, "has active endpoints". Nothing of A or
   // B may be among the failures.)
@@ -235,6 +247,12 @@ TEST_F(CliE2eTest, GcRemovesWhatKilledRunsLeft) {
   EXPECT_THAT(gc_all.out, HasSubstr("removed "));
   EXPECT_EQ(Left(b).containers, 0u);
   EXPECT_EQ(Left(b).networks, 0u);
+  EXPECT_THAT(gc_all.out, HasSubstr("left run " + live + ": it is still running here"));
+  EXPECT_EQ(Left(live).networks, 1u);
+  // Named, it goes anyway.
+  testing::Finished gc_live = Swarmbox({"gc", "--run", live});
+  EXPECT_EQ(gc_live.code, 0) << gc_live.err;
+  EXPECT_EQ(Left(live).networks, 0u);
 }
 
 }  // namespace
