@@ -37,13 +37,15 @@ int ImagesCommand(const ImagesArgs& args) {
                                        : Result<images::ImageSpec>(netemd.error())});
   }
   int failures = 0;
+  // Remembers the tags, so the next `swarmbox run` does not pack the same programs again.
+  const images::TagCache cache(images::DefaultTagCacheDir());
   for (Wanted& w : wanted) {
     if (!w.spec) {
       std::cerr << w.what << ": " << w.spec.error().ToString() << "\n";
       ++failures;
       continue;
     }
-    auto r = images::EnsureImage(**client, *w.spec, progress, nullptr);
+    auto r = images::EnsureImage(**client, *w.spec, progress, nullptr, &cache);
     if (!r) {
       std::cerr << w.what << ": " << r.error().ToString() << "\n";
       ++failures;
