@@ -18,8 +18,9 @@
 // any other destination. A best-effort DDS reader drops a sample that arrives after a later sample
 // of the same writer (RTPS sequence numbers), so a radio with jitter (netem and the NFQUEUE delayer
 // both reorder packets) would turn reordering into extra loss on one shared writer: a heartbeat
-// broadcast is four samples at once, and the reader of each peer sees all four (measured on the
-// ping topic: 43.5 % apparent loss for 5 % configured). With a writer of its own per destination
+// broadcast is four samples at once, and the reader of each peer sees all four (measured in
+// mission_raft_radio_reorder_test at 50 +- 20 ms / 5 %: 52.7 % of a leader's messages to one
+// follower lost with one writer, 4.0 % with these lanes). With a writer of its own per destination
 // a reader only loses what its own stream reorders, and with two lanes per peer two messages sent
 // to one peer back to back (an append and a heartbeat, a response pair) are on different writers
 // too: only two messages to one peer whose send times differ by less than the jitter and with a
