@@ -185,6 +185,41 @@ TEST(MissionHostScout, WaitsForEveryMemberBeforeStartingAndReadsTheirRoles) {
   EXPECT_NE(out.events.front().str().find("lifter_present=true"), std::string::npos) << out.events.front().str();
 }
 
+// The leader's roster ages each peer on the simulated clock: a scout whose DroneState stops is
+// gone after member_timeout_s (6 s) and its committed sector is handed over through Raft.
+TEST(MissionHostScout, LeadingItHandsASilentPeersSectorOverAfterTheMemberTimeout) {
+  HostRig rig(Scout("scout_1", {"scout_1", "scout_2"}));
+  rig.mission().Apply(1, raft::AssignSectors{{{"scout_1", -92, -92, 0, 92}, {"scout_2", 0, -92, 92, 92}}});
+  rig.mission().Apply(2, raft::StartSearch{});
+  rig.estimate().pos_m = Vec3(0, 0, 30);
+  PeerState peer;
+  peer.name = "scout_2";
+  peer.mode = "scout/searching";
+  peer.position_m = Vec3(50, 0, 30);
+  const auto handed_over = [&] {
+    for (const raft::MissionCommand& c : rig.proposals()) {
+      if (std::holds_alternative<raft::AssignSectors>(c)) return true;
+    }
+    return false;
+  };
+  for (double t = 0.0; t < 10.0; t += 0.5) {  // heard at 5 Hz (every other half second here)
+    peer.sim_time_s = t;
+    rig.host().OnPeerState(peer);
+    rig.Run(0.5, FlightMode::kVelocity, /*leader=*/true);
+  }
+  EXPECT_FALSE(handed_over());
+  rig.Run(5.0, FlightMode::kVelocity, true);  // last state taken at 9.5 s: 5.5 s of silence
+  EXPECT_FALSE(handed_over());
+  rig.Run(1.5, FlightMode::kVelocity, true);
+  ASSERT_TRUE(handed_over());
+  for (const raft::MissionCommand& c : rig.proposals()) {
+    const auto* a = std::get_if<raft::AssignSectors>(&c);
+    if (a == nullptr) continue;
+    for (const raft::Sector& sector : a->sectors) EXPECT_EQ(sector.drone, "scout_1");
+    EXPECT_EQ(a->sectors.size(), 2u);
+  }
+}
+
 TEST(MissionHostLifter, TheLoadCheckDropsAnAttachTheWorldDidNotCarryOut) {
   MissionHostConfig c;
   c.name = "lifter";
