@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "detail/backslash_escape.hpp"
+
 namespace swarmbox {
 
 namespace {
@@ -22,24 +24,10 @@ std::string LogfmtValue(std::string_view value) {
   if (!NeedsQuoting(value)) return std::string(value);
   std::string out = "\"";
   for (char c : value) {
-    switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
-      default:
-        out.push_back(c);
+    if (const std::string_view escape = detail::BackslashEscape(c); !escape.empty()) {
+      out += escape;
+    } else {
+      out.push_back(c);
     }
   }
   out.push_back('"');

@@ -12,6 +12,8 @@
 #include <limits>
 #include <sstream>
 
+#include "detail/backslash_escape.hpp"
+
 namespace swarmbox::yaml {
 
 std::string Mark::ToString() const {
@@ -356,23 +358,12 @@ std::string JsonQuote(std::string_view text) {
   out.reserve(text.size() + 2);
   out.push_back('"');
   for (char ch : text) {
+    if (const std::string_view escape = detail::BackslashEscape(ch); !escape.empty()) {
+      out += escape;
+      continue;
+    }
     const auto c = static_cast<unsigned char>(ch);
     switch (c) {
-      case '"':
-        out += "\\\"";
-        break;
-      case '\\':
-        out += "\\\\";
-        break;
-      case '\n':
-        out += "\\n";
-        break;
-      case '\r':
-        out += "\\r";
-        break;
-      case '\t':
-        out += "\\t";
-        break;
       case '\b':
         out += "\\b";
         break;
