@@ -4,8 +4,8 @@
 #include <iostream>
 
 #include "commands.hpp"
+#include "load_trial.hpp"
 #include "program_images.hpp"
-#include "swarmbox/dsl/trial_loader.hpp"
 #include "swarmbox/runner/compose_export.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/plan.hpp"
@@ -19,13 +19,8 @@ namespace fs = std::filesystem;
 inline constexpr char kComposeRunId[] = "compose";
 
 int ComposeCommand(const ComposeArgs& args) {
-  dsl::LoadOptions load;
-  load.overrides = args.sets;
-  auto spec = dsl::LoadTrial(args.trial, load);
-  if (!spec) {
-    std::cerr << spec.error().ToString() << "\n";
-    return kExitUsage;
-  }
+  auto spec = LoadTrialOrPrintError(args.trial, args.sets);
+  if (!spec) return kExitUsage;
   runner::Images images{args.physics_image, args.agent_image};
   if (images.physics.empty() || images.agent.empty()) {
     auto tags = TrialImageTags(args.programs);

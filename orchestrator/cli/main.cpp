@@ -4,6 +4,31 @@
 
 #include "commands.hpp"
 
+namespace {
+
+using swarmbox::cli::ProgramPaths;
+
+// --physics-bin and --agent-bin: where the host-built programs for the images come from.
+void AddProgramOptions(CLI::App* cmd, ProgramPaths& programs) {
+  cmd->add_option("--physics-bin", programs.physics_bin, "Host-built swarmbox-physics");
+  cmd->add_option("--agent-bin", programs.agent_bin, "Host-built swarmbox-agent");
+}
+
+// --set key.path=value, repeatable; one value per --set, so a positional argument after it is not
+// taken as another override.
+void AddSetOption(CLI::App* cmd, std::vector<std::string>& sets, const std::string& help) {
+  cmd->add_option("--set", sets, help)->allow_extra_args(false);
+}
+
+// What `run` and `experiment` share after their own options: --run-id, --quiet and the programs.
+void AddLaunchOptions(CLI::App* cmd, std::string& run_id, bool& quiet, ProgramPaths& programs) {
+  cmd->add_option("--run-id", run_id, "Run id (default: UTC time + random)");
+  cmd->add_flag("--quiet", quiet, "No progress on the terminal");
+  AddProgramOptions(cmd, programs);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace swarmbox::cli;
   CLI::App app{"SwarmBox: a containerised SITL fleet for a search-and-rescue drone swarm.\n"
@@ -16,35 +41,27 @@ int main(int argc, char** argv) {
   auto* run_cmd = app.add_subcommand("run", "Run one trial and write <out>/<trial>-<run id>/");
   run_cmd->add_option("trial", run.trial, "Trial description (YAML)")->required();
   run_cmd->add_option("--out", run.out, "Output folder (default: runs)");
-  run_cmd->add_option("--set", run.sets, "Override a key of the trial: key.path=value")
-      ->allow_extra_args(false);
-  run_cmd->add_option("--run-id", run.run_id, "Run id (default: UTC time + random)");
-  run_cmd->add_flag("--quiet", run.quiet, "No progress on the terminal");
-  run_cmd->add_option("--physics-bin", run.programs.physics_bin, "Host-built swarmbox-physics");
-  run_cmd->add_option("--agent-bin", run.programs.agent_bin, "Host-built swarmbox-agent");
+  AddSetOption(run_cmd, run.sets, "Override a key of the trial: key.path=value");
+  AddLaunchOptions(run_cmd, run.run_id, run.quiet, run.programs);
 
   ValidateArgs validate;
   auto* validate_cmd = app.add_subcommand("validate", "Check trial files (file:line:col: message)");
   validate_cmd->add_option("files", validate.files, "Trial descriptions")->required();
-  validate_cmd->add_option("--set", validate.sets, "Override a key: key.path=value")
-      ->allow_extra_args(false);
+  AddSetOption(validate_cmd, validate.sets, "Override a key: key.path=value");
 
   ComposeArgs compose;
   auto* compose_cmd = app.add_subcommand("compose", "Export a trial as a docker-compose file");
   compose_cmd->add_option("trial", compose.trial, "Trial description (YAML)")->required();
   compose_cmd->add_option("-o,--output", compose.output, "Write here (default: stdout)");
-  compose_cmd->add_option("--set", compose.sets, "Override a key: key.path=value")
-      ->allow_extra_args(false);
+  AddSetOption(compose_cmd, compose.sets, "Override a key: key.path=value");
   compose_cmd->add_option("--physics-image", compose.physics_image, "Image tag (default: packed)");
   compose_cmd->add_option("--agent-image", compose.agent_image, "Image tag (default: packed)");
-  compose_cmd->add_option("--physics-bin", compose.programs.physics_bin, "Host-built swarmbox-physics");
-  compose_cmd->add_option("--agent-bin", compose.programs.agent_bin, "Host-built swarmbox-agent");
+  AddProgramOptions(compose_cmd, compose.programs);
 
   ImagesArgs images;
   bool no_faults = false;
   auto* images_cmd = app.add_subcommand("images", "Build the registry-free images (only what is missing)");
-  images_cmd->add_option("--physics-bin", images.programs.physics_bin, "Host-built swarmbox-physics");
-  images_cmd->add_option("--agent-bin", images.programs.agent_bin, "Host-built swarmbox-agent");
+  AddProgramOptions(images_cmd, images.programs);
   images_cmd->add_flag("--no-faults", no_faults, "Skip the fault-injection sidecar image");
 
   ExperimentArgs exp;
@@ -59,17 +76,13 @@ int main(int argc, char** argv) {
   exp_cmd->add_flag("--resume", exp.resume, "Run only the trials of --out without result.json");
   exp_cmd->add_option("--filter", exp.filter, "Run only codes matching a pattern (? = any level)")
       ->allow_extra_args(false);
-  exp_cmd->add_option("--set", exp.sets,
-                      "Override a key of every trial: key.path=value (after the file's set:, "
-                      "before the factor levels)")
-      ->allow_extra_args(false);
+  AddSetOption(exp_cmd, exp.sets,
+               "Override a key of every trial: key.path=value (after the file's set:, "
+               "before the factor levels)");
   exp_cmd->add_option("--max-attempts", exp.max_attempts,
                       "Attempts per trial when hosts fail under it (default 3)")
       ->check(CLI::Range(1, 20));
-  exp_cmd->add_option("--run-id", exp.run_id, "Run id (default: UTC time + random)");
-  exp_cmd->add_flag("--quiet", exp.quiet, "No progress on the terminal");
-  exp_cmd->add_option("--physics-bin", exp.programs.physics_bin, "Host-built swarmbox-physics");
-  exp_cmd->add_option("--agent-bin", exp.programs.agent_bin, "Host-built swarmbox-agent");
+  AddLaunchOptions(exp_cmd, exp.run_id, exp.quiet, exp.programs);
 
   ReportArgs report;
   auto* report_cmd =

@@ -4,23 +4,18 @@
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "load_trial.hpp"
 #include "program_images.hpp"
 #include "run_lock.hpp"
 #include "swarmbox/docker/docker_client.hpp"
-#include "swarmbox/dsl/trial_loader.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
 
 namespace swarmbox::cli {
 
 int RunCommand(const RunArgs& args) {
-  dsl::LoadOptions load;
-  load.overrides = args.sets;
-  auto spec = dsl::LoadTrial(args.trial, load);
-  if (!spec) {
-    std::cerr << spec.error().ToString() << "\n";
-    return kExitUsage;
-  }
+  auto spec = LoadTrialOrPrintError(args.trial, args.sets);
+  if (!spec) return kExitUsage;
   docker::DockerClientOptions client_options;
   client_options.socket_path = docker::DefaultSocketPath();
   auto client = docker::DockerClient::Connect(client_options);

@@ -2,18 +2,15 @@
 #include <iostream>
 
 #include "commands.hpp"
-#include "swarmbox/dsl/trial_loader.hpp"
+#include "load_trial.hpp"
 
 namespace swarmbox::cli {
 
 int ValidateCommand(const ValidateArgs& args) {
   int bad = 0;
   for (const std::string& file : args.files) {
-    dsl::LoadOptions load;
-    load.overrides = args.sets;
-    auto spec = dsl::LoadTrial(file, load);
+    auto spec = LoadTrialOrPrintError(file, args.sets);
     if (!spec) {
-      std::cerr << spec.error().ToString() << "\n";
       ++bad;
       continue;
     }
