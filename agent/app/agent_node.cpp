@@ -120,6 +120,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--members (Raft) needs the mesh bus (drop --no-mesh)");
     RaftHostOptions ro = o.raft;
     ro.self = o.name;
+    ro.election_timeout_ms = ElectionTimeoutMsFor(o.mission, o.raft.election_timeout_ms);
     auto raft = RaftHost::Start(ro, *node->mesh_, o.log);
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);

@@ -76,4 +76,9 @@ Result<WorldView> LoadWorldView(const std::string& path) {
   return w;
 }
 
+int ElectionTimeoutMsFor(const MissionOptions& options, int configured_ms) {
+  const bool lifter = options.kind == MissionKind::kSar && !options.payload.empty();
+  return lifter ? 2 * configured_ms : configured_ms;
+}
+
 }  // namespace swarmbox::agent

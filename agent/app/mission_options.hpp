@@ -36,6 +36,14 @@ inline constexpr int kMaxInferenceLatencyMs = 10000;
 // latency lies in [0, kMaxInferenceLatencyMs].
 Status ValidateMissionOptions(const MissionOptions& options, bool has_members, bool plan_given);
 
+// The Raft election timeout this drone uses [ms]. The SAR lifter (sar with a payload) waits
+// twice the configured one: Raft has no leader priority, and the lifter is the one drone the
+// rescue cannot do without, so a fault on "the leader" (or the leader's own failure) should not
+// also take the rescue away. Timeouts are drawn from [T, 2T): with 2T the lifter stands for
+// election only when no scout has within its own timeout (all scouts gone or cut off), and then
+// still can. Every other drone: the configured timeout.
+int ElectionTimeoutMsFor(const MissionOptions& options, int configured_ms);
+
 // The agent's view of a world file (trials/worlds/*.yaml): the geofence (the world spans
 // |x| <= size_x_m/2, |y| <= size_y_m/2 around the origin, ENU [m]) and the WGS84 home of the
 // origin. Other keys are not looked at (victims stay unknown to the agent).

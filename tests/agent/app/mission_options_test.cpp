@@ -103,5 +103,18 @@ TEST(WorldView, MissingFileIsNotFound) {
   EXPECT_EQ(w.error().code(), ErrorCode::kNotFound);
 }
 
+TEST(ElectionTimeout, TheSarLifterWaitsTwiceAsLongEveryoneElseAsConfigured) {
+  MissionOptions scout;
+  scout.kind = MissionKind::kSar;
+  EXPECT_EQ(ElectionTimeoutMsFor(scout, 1500), 1500);
+  MissionOptions lifter = scout;
+  lifter.payload = "stretcher";
+  EXPECT_EQ(ElectionTimeoutMsFor(lifter, 1500), 3000);
+  // Raft's timeouts are drawn from [T, 2T): the lifter's earliest is every scout's latest.
+  EXPECT_GE(ElectionTimeoutMsFor(lifter, 500), 2 * ElectionTimeoutMsFor(scout, 500));
+  MissionOptions plan;  // the built-in plan has no rescue to protect
+  EXPECT_EQ(ElectionTimeoutMsFor(plan, 500), 500);
+}
+
 }  // namespace
 }  // namespace swarmbox::agent
