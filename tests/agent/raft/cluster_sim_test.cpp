@@ -8,36 +8,16 @@
 
 #include <algorithm>
 
+#include "hostile_sim_config.hpp"
+
 namespace swarmbox::raft::sim {
 namespace {
-
-SimConfig Hostile(int nodes, std::uint64_t seed) {
-  SimConfig c;
-  c.nodes = nodes;
-  c.seed = seed;
-  c.duration_s = 12;
-  c.net.delay_ms = 30;
-  c.net.jitter_ms = 25;
-  c.net.loss = 0.1;
-  c.net.duplicate = 0.05;
-  c.net.reorder = 0.1;
-  c.net.reorder_ms = 200;
-  c.faults.crash_mean_interval_s = 2;
-  c.faults.down_min_s = 0.2;
-  c.faults.down_max_s = 3;
-  c.faults.partition_mean_interval_s = 3;
-  c.faults.partition_min_s = 0.3;
-  c.faults.partition_max_s = 3;
-  c.snapshot_every_entries = 8;
-  c.propose_interval_s = 0.05;
-  return c;
-}
 
 void RunSeeds(int nodes, std::uint64_t first_seed, int count) {
   int leader_terms = 0;
   std::uint64_t commits = 0, snapshots = 0;
   for (int k = 0; k < count; ++k) {
-    const SimReport r = RunSimulation(Hostile(nodes, first_seed + static_cast<std::uint64_t>(k)));
+    const SimReport r = RunSimulation(HostileSimConfig(nodes, first_seed + static_cast<std::uint64_t>(k)));
     ASSERT_TRUE(r.ok()) << r.violations.front();
     leader_terms += r.leader_terms;
     commits += r.max_commit;
@@ -57,7 +37,7 @@ TEST(ClusterSim, SevenNodesStaySafeUnderFaults) { RunSeeds(7, 30000, 1000); }
 // Without PreVote and CheckQuorum (plain Raft §5) the cluster is just as safe.
 TEST(ClusterSim, PlainRaftWithoutPreVoteOrCheckQuorumStaysSafe) {
   for (std::uint64_t seed = 40000; seed < 40300; ++seed) {
-    SimConfig c = Hostile(5, seed);
+    SimConfig c = HostileSimConfig(5, seed);
     c.pre_vote = false;
     c.check_quorum = false;
     const SimReport r = RunSimulation(c);
@@ -67,7 +47,7 @@ TEST(ClusterSim, PlainRaftWithoutPreVoteOrCheckQuorumStaysSafe) {
 
 // A seed replays exactly: what a failure report prints is enough to reproduce it.
 TEST(ClusterSim, SameSeedSameRun) {
-  SimConfig c = Hostile(5, 77);
+  SimConfig c = HostileSimConfig(5, 77);
   c.record_events = true;
   const SimReport a = RunSimulation(c);
   const SimReport b = RunSimulation(c);

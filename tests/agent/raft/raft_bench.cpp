@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "bench.hpp"
+#include "hostile_sim_config.hpp"
 #include "swarmbox/raft/sim/cluster_sim.hpp"
 
 namespace {
@@ -105,20 +106,7 @@ int RunRaftBench(const swarmbox::bench::Args& args) {
     const auto start = std::chrono::steady_clock::now();
     Totals t;
     for (long s = 0; s < hostile_seeds; ++s) {
-      SimConfig c;
-      c.nodes = nodes;
-      c.seed = static_cast<std::uint64_t>(100000 * nodes + s);
-      c.duration_s = 12;
-      c.net = NetworkModel{30, 25, 0.1, 0.05, 0.1, 200};
-      c.faults.crash_mean_interval_s = 2;
-      c.faults.down_min_s = 0.2;
-      c.faults.down_max_s = 3;
-      c.faults.partition_mean_interval_s = 3;
-      c.faults.partition_min_s = 0.3;
-      c.faults.partition_max_s = 3;
-      c.snapshot_every_entries = 8;
-      c.propose_interval_s = 0.05;
-      t.Add(RunSimulation(c), 0);
+      t.Add(RunSimulation(HostileSimConfig(nodes, static_cast<std::uint64_t>(100000 * nodes + s))), 0);
     }
     const std::string scenario = "hostile_n" + std::to_string(nodes);
     std::printf("suite=raft scenario=%s nodes=%d violations=%d seeds=%d commit_p50_ms=%.0f wall_s=%.1f\n",
