@@ -1,6 +1,7 @@
 #include "swarmbox/raft/mission_command.hpp"
 
 #include "swarmbox/raft/detail/byte_io.hpp"
+#include "swarmbox/raft/detail/mission_io.hpp"
 #include "swarmbox/raft/detail/overloaded.hpp"
 
 namespace swarmbox::raft {
@@ -21,23 +22,8 @@ Bytes EncodeCommand(const MissionCommand& command) {
   w.U8(static_cast<std::uint8_t>(command.index()));
   std::visit(Overloaded{
                  [](const StartSearch&) {},
-                 [&](const AssignSectors& c) {
-                   w.Varint(c.sectors.size());
-                   for (const Sector& s : c.sectors) {
-                     w.Str(s.drone);
-                     w.F64(s.x_min_m);
-                     w.F64(s.y_min_m);
-                     w.F64(s.x_max_m);
-                     w.F64(s.y_max_m);
-                   }
-                 },
-                 [&](const ReportSighting& c) {
-                   w.Str(c.reporter);
-                   w.Varint(c.seq);
-                   w.F64(c.x_m);
-                   w.F64(c.y_m);
-                   w.F64(c.confidence);
-                 },
+                 [&](const AssignSectors& c) { detail::WriteSectors(w, c.sectors); },
+                 [&](const ReportSighting& c) { detail::WriteSighting(w, c); },
                  [&](const ConfirmVictim& c) {
                    w.Str(c.by);
                    w.F64(c.x_m);
@@ -73,31 +59,8 @@ Result<MissionCommand> DecodeCommand(std::span<const std::uint8_t> bytes) {
   MissionCommand cmd;
   switch (kind) {
     case 0: cmd = StartSearch{}; break;
-    case 1: {
-      AssignSectors c;
-      const std::uint64_t n = r.Count(33, "sector");
-      for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-        Sector s;
-        s.drone = r.Str();
-        s.x_min_m = r.F64();
-        s.y_min_m = r.F64();
-        s.x_max_m = r.F64();
-        s.y_max_m = r.F64();
-        c.sectors.push_back(std::move(s));
-      }
-      cmd = std::move(c);
-      break;
-    }
-    case 2: {
-      ReportSighting c;
-      c.reporter = r.Str();
-      c.seq = r.Varint();
-      c.x_m = r.F64();
-      c.y_m = r.F64();
-      c.confidence = r.F64();
-      cmd = std::move(c);
-      break;
-    }
+    case 1: cmd = AssignSectors{detail::ReadSectors(r)}; break;
+    case 2: cmd = detail::ReadSighting<ReportSighting>(r); break;
     case 3: {
       ConfirmVictim c;
       c.by = r.Str();

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "swarmbox/raft/detail/byte_io.hpp"
+#include "swarmbox/raft/detail/mission_io.hpp"
 #include "swarmbox/raft/detail/overloaded.hpp"
 
 namespace swarmbox::raft {
@@ -35,6 +36,17 @@ using detail::Overloaded;
 bool Finite(double v) { return std::isfinite(v); }
 
 double Distance(double ax, double ay, double bx, double by) { return std::hypot(ax - bx, ay - by); }
+
+// A kVictimConfirmed / kVictimStatus event at `phase` and log `index`: `v` after the change.
+MissionEvent VictimEvent(MissionEvent::Kind kind, MissionPhase phase, std::uint64_t index,
+                         const Victim& v) {
+  MissionEvent e;
+  e.kind = kind;
+  e.phase = phase;
+  e.index = index;
+  e.victim = v;
+  return e;
+}
 
 }  // namespace
 
@@ -90,12 +102,8 @@ Victim& MissionState::AddVictim(double x_m, double y_m, std::vector<std::string>
   v.y_m = y_m;
   v.confirmed_by = std::move(by);
   victims_.push_back(std::move(v));
-  MissionEvent e;
-  e.kind = MissionEvent::Kind::kVictimConfirmed;
-  e.phase = phase_;
-  e.index = applied_index_;
-  e.victim = victims_.back();
-  r->events.push_back(e);
+  r->events.push_back(
+      VictimEvent(MissionEvent::Kind::kVictimConfirmed, phase_, applied_index_, victims_.back()));
   return victims_.back();
 }
 
@@ -182,12 +190,8 @@ ApplyResult MissionState::Apply(std::uint64_t index, const MissionCommand& comma
             v->status = VictimStatus::kBeingRescued;
             v->rescuer = c.lifter;
             SetPhase(MissionPhase::kRescue, &r);
-            MissionEvent e;
-            e.kind = MissionEvent::Kind::kVictimStatus;
-            e.phase = phase_;
-            e.index = applied_index_;
-            e.victim = *v;
-            r.events.push_back(e);
+            r.events.push_back(
+                VictimEvent(MissionEvent::Kind::kVictimStatus, phase_, applied_index_, *v));
             return r;
           },
           [&](const MarkRescued& c) -> ApplyResult {
@@ -202,12 +206,8 @@ ApplyResult MissionState::Apply(std::uint64_t index, const MissionCommand& comma
             SWARMBOX_CHECK(v != nullptr);
             v->status = VictimStatus::kRescued;
             target_victim_ = 0;
-            MissionEvent e;
-            e.kind = MissionEvent::Kind::kVictimStatus;
-            e.phase = phase_;
-            e.index = applied_index_;
-            e.victim = *v;
-            r.events.push_back(e);
+            r.events.push_back(
+                VictimEvent(MissionEvent::Kind::kVictimStatus, phase_, applied_index_, *v));
             SetPhase(MissionPhase::kSearch, &r);
             return r;
           },
@@ -284,27 +284,14 @@ Bytes MissionState::EncodeSnapshot() const {
   w.U8(static_cast<std::uint8_t>(phase_));
   w.Varint(target_victim_);
   w.Varint(next_victim_id_);
-  w.Varint(sectors_.size());
-  for (const Sector& s : sectors_) {
-    w.Str(s.drone);
-    w.F64(s.x_min_m);
-    w.F64(s.y_min_m);
-    w.F64(s.x_max_m);
-    w.F64(s.y_max_m);
-  }
+  detail::WriteSectors(w, sectors_);
   w.Varint(last_seq_.size());
   for (const auto& [reporter, seq] : last_seq_) {
     w.Str(reporter);
     w.Varint(seq);
   }
   w.Varint(pending_.size());
-  for (const Sighting& s : pending_) {
-    w.Str(s.reporter);
-    w.Varint(s.seq);
-    w.F64(s.x_m);
-    w.F64(s.y_m);
-    w.F64(s.confidence);
-  }
+  for (const Sighting& s : pending_) detail::WriteSighting(w, s);
   w.Varint(victims_.size());
   for (const Victim& v : victims_) {
     w.Varint(v.id);
@@ -342,30 +329,15 @@ Result<MissionState> MissionState::DecodeSnapshot(std::span<const std::uint8_t> 
   m.phase_ = static_cast<MissionPhase>(phase);
   m.target_victim_ = u32("target victim");
   m.next_victim_id_ = u32("next victim id");
-  std::uint64_t n = r.Count(33, "sector");
-  for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-    Sector s;
-    s.drone = r.Str();
-    s.x_min_m = r.F64();
-    s.y_min_m = r.F64();
-    s.x_max_m = r.F64();
-    s.y_max_m = r.F64();
-    m.sectors_.push_back(std::move(s));
-  }
-  n = r.Count(2, "reporter");
+  m.sectors_ = detail::ReadSectors(r);
+  std::uint64_t n = r.Count(2, "reporter");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
     std::string reporter = r.Str();
     m.last_seq_[reporter] = r.Varint();
   }
   n = r.Count(26, "sighting");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-    Sighting s;
-    s.reporter = r.Str();
-    s.seq = r.Varint();
-    s.x_m = r.F64();
-    s.y_m = r.F64();
-    s.confidence = r.F64();
-    m.pending_.push_back(std::move(s));
+    m.pending_.push_back(detail::ReadSighting<Sighting>(r));
   }
   n = r.Count(20, "victim");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
