@@ -118,6 +118,21 @@ TEST_P(ClosedLoop, X8HeavyTransferDampsStretcherSwing) {
   EXPECT_LT(2.0 * on->residual_swing_deg, off->residual_swing_deg);  // at least 2x less than off
 }
 
+// The same with the stretcher loaded (80 kg of stretcher and evacuee: the case).
+TEST_P(ClosedLoop, X8HeavyTransferDampsLoadedStretcherSwing) {
+  auto on = RunHeavyTransfer(GetParam(), 20.0, true, nullptr, 80.0);
+  ASSERT_TRUE(on.ok()) << on.error().ToString();
+  auto off = RunHeavyTransfer(GetParam(), 20.0, false, nullptr, 80.0);
+  ASSERT_TRUE(off.ok()) << off.error().ToString();
+  std::printf("seed=%llu x8_transfer_80kg damping=on: arrival_s=%.1f residual_deg=%.2f max_deg=%.1f\n",
+              static_cast<unsigned long long>(GetParam()), on->arrival_s, on->residual_swing_deg, on->max_swing_deg);
+  std::printf("seed=%llu x8_transfer_80kg damping=off: arrival_s=%.1f residual_deg=%.2f max_deg=%.1f\n",
+              static_cast<unsigned long long>(GetParam()), off->arrival_s, off->residual_swing_deg, off->max_swing_deg);
+  EXPECT_FALSE(on->crashed);
+  EXPECT_LT(on->residual_swing_deg, 10.0);
+  EXPECT_LT(2.0 * on->residual_swing_deg, off->residual_swing_deg);
+}
+
 INSTANTIATE_TEST_SUITE_P(Seeds, ClosedLoop, ::testing::Values(1u, 3u, 7u, 42u),
                          [](const ::testing::TestParamInfo<std::uint64_t>& i) {
                            return "seed" + std::to_string(i.param);

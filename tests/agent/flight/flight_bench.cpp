@@ -76,24 +76,28 @@ int RunSeed(std::uint64_t seed) {
   } else {
     rc = Fail("x500_gps_dropout_5s", m.error());
   }
-  auto on = ft::RunHeavyTransfer(seed, 20.0, true);
-  auto off = ft::RunHeavyTransfer(seed, 20.0, false);
-  for (int k = 0; k < 2; ++k) {
-    auto& m = k == 0 ? on : off;
-    const char* name = k == 0 ? "x8_transfer_20m_damping_on" : "x8_transfer_20m_damping_off";
-    if (!m) {
-      rc = Fail(name, m.error());
-      continue;
+  for (const double loaded_kg : {0.0, 80.0}) {
+    auto on = ft::RunHeavyTransfer(seed, 20.0, true, nullptr, loaded_kg);
+    auto off = ft::RunHeavyTransfer(seed, 20.0, false, nullptr, loaded_kg);
+    for (int k = 0; k < 2; ++k) {
+      auto& m = k == 0 ? on : off;
+      const char* name = loaded_kg > 0.0
+                             ? (k == 0 ? "x8_transfer_20m_80kg_damping_on" : "x8_transfer_20m_80kg_damping_off")
+                             : (k == 0 ? "x8_transfer_20m_damping_on" : "x8_transfer_20m_damping_off");
+      if (!m) {
+        rc = Fail(name, m.error());
+        continue;
+      }
+      LogEvent e(0.0, "bench", "result");
+      e.Add("suite", "flight").Add("scenario", name).Add("seed", seed_l).Add("arrival_s", m->arrival_s, 1)
+          .Add("swing_at_arrival_deg", m->swing_at_arrival_deg, 2).Add("residual_swing_deg", m->residual_swing_deg, 2)
+          .Add("max_swing_deg", m->max_swing_deg, 2).Add("final_err_m", m->final_err_m, 2);
+      if (k == 0 && off) {
+        e.Add("reduction_x", off->residual_swing_deg / std::max(1e-6, m->residual_swing_deg), 2)
+            .Add("pass", m->residual_swing_deg < 10.0 && 2.0 * m->residual_swing_deg < off->residual_swing_deg);
+      }
+      Print(e);
     }
-    LogEvent e(0.0, "bench", "result");
-    e.Add("suite", "flight").Add("scenario", name).Add("seed", seed_l).Add("arrival_s", m->arrival_s, 1)
-        .Add("swing_at_arrival_deg", m->swing_at_arrival_deg, 2).Add("residual_swing_deg", m->residual_swing_deg, 2)
-        .Add("max_swing_deg", m->max_swing_deg, 2).Add("final_err_m", m->final_err_m, 2);
-    if (k == 0 && off) {
-      e.Add("reduction_x", off->residual_swing_deg / std::max(1e-6, m->residual_swing_deg), 2)
-          .Add("pass", m->residual_swing_deg < 10.0 && 2.0 * m->residual_swing_deg < off->residual_swing_deg);
-    }
-    Print(e);
   }
   return rc;
 }

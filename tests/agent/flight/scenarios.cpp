@@ -145,7 +145,7 @@ Result<DropoutMetrics> RunGpsDropout(std::uint64_t seed, double dropout_s) {
 }
 
 Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, bool damping,
-                                         std::FILE* trace) {
+                                         std::FILE* trace, double loaded_mass_kg) {
   // Airborne start (a test rig, as a crane would hold it): the drone is pinned at 10 m with the
   // stretcher hanging still while the estimator aligns, released once the motors are spinning.
   RigOptions o;
@@ -160,6 +160,10 @@ Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, 
   if (!created) return created.error();
   Rig& r = **created;
   r.world().SetPinned(r.drone(), true);
+  if (loaded_mass_kg > 0.0) {  // loaded where it hangs: same sling length, new mass
+    SWARMBOX_TRY(r.world().ReleasePayload(r.drone()));
+    SWARMBOX_TRY(r.world().AttachPayload(r.drone(), loaded_mass_kg));
+  }
   long step = 0;
   auto tracer = [&] {
     if (trace == nullptr || ++step % 250 != 0) return;

@@ -65,9 +65,12 @@ struct TransferMetrics {
   double final_err_m = 0;
   bool crashed = false;
 };
-// x8_heavy with the stretcher hanging: a `distance_m` transfer east at 10 m.
+// x8_heavy with the stretcher hanging: a `distance_m` transfer east at 10 m. `loaded_mass_kg`
+// > 0: the stretcher is re-hooked with that mass before the rig lets go (80: stretcher and
+// evacuee); 0: the airframe's empty stretcher. The controller is told 80 kg either way (its
+// hover-thrust estimator learns the real load).
 // `trace` (optional): one line per second of truth, estimate and controller state.
 Result<TransferMetrics> RunHeavyTransfer(std::uint64_t seed, double distance_m, bool damping,
-                                         std::FILE* trace = nullptr);
+                                         std::FILE* trace = nullptr, double loaded_mass_kg = 0.0);
 
 }  // namespace swarmbox::flight::testing
