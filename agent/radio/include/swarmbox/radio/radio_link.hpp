@@ -24,8 +24,8 @@
 // turn reordering between pings and pongs to different peers into loss (measured: 43.5 % "loss"
 // with one writer at 100 +- 20 ms / 5 % loss, and RTTs biased low, as the overtaken samples are the
 // slow ones). Each writer's stream is then one sample per ping period, which 20 ms of jitter does
-// not reorder, and the figures are those of the radio. The same effect hits every other
-// best-effort stream with several samples per jitter interval (Raft's mesh/raft).
+// not reorder, and the figures are those of the radio. The same effect hit Raft's mesh/raft, whose
+// RaftRadio (agent/mission) now also spreads its messages over several writers per member.
 //
 // Pings and pongs share one topic (like Raft's); a sample is for us when `to == self`. A ping from
 // anyone (a peer, a ground station) is answered; a pong is counted only from a peer we pinged.
