@@ -16,7 +16,7 @@ constexpr const char* kUsage =
     "uniform|normal|pareto|paretonormal]\n"
     "                           [--correlation F] [--reorder F] [--reorder-correlation F] [--reorder-gap N]\n"
     "                           [--seed S] [--queue-maxlen N] [--pidfile /run/x.pid] [--daemonize]\n"
-    "                           [--ge-p F --ge-r F --ge-loss-bad F --ge-loss-good F]\n"
+    "                           [--ge-p F --ge-r F --ge-loss-bad F --ge-loss-good F] [--corrupt F]\n"
     "       swarmbox-netemd stop --pidfile /run/x.pid\n"
     "       swarmbox-netemd sleep\n";
 
@@ -30,10 +30,10 @@ int Serve(const swarmbox::faults::NetemdArgs& args, const std::function<void()>&
   const auto status = (*delayer)->Run();
   const auto& s = (*delayer)->stats();
   std::fprintf(stderr,
-               "swarmbox-netemd: queue=%u packets=%llu reordered=%llu dropped=%llu mean_hold_ms=%.3f overruns=%llu "
+               "swarmbox-netemd: queue=%u packets=%llu reordered=%llu dropped=%llu corrupted=%llu mean_hold_ms=%.3f overruns=%llu "
                "verdict_errors=%llu\n",
                args.queue, static_cast<unsigned long long>(s.packets), static_cast<unsigned long long>(s.reordered),
-               static_cast<unsigned long long>(s.dropped),
+               static_cast<unsigned long long>(s.dropped), static_cast<unsigned long long>(s.corrupted),
                s.mean_hold_ms, static_cast<unsigned long long>(s.receive_overruns),
                static_cast<unsigned long long>(s.verdict_errors));
   if (!status) {

@@ -35,6 +35,7 @@ std::int64_t MonotonicUs() {
 
 NfqueueDelayer::NfqueueDelayer(const NetemdArgs& args) : args_(args), scheduler_(args.delay, args.seed) {
   if (args.gilbert_elliott) loss_.emplace(*args.gilbert_elliott, args.seed);
+  if (args.corrupt > 0.0) corruptor_.emplace(args.corrupt, args.seed);
 }
 
 NfqueueDelayer::~NfqueueDelayer() {
@@ -53,7 +54,12 @@ Result<std::unique_ptr<NfqueueDelayer>> NfqueueDelayer::Open(const NetemdArgs& a
   if (d->queue_ == nullptr) {
     return SysError("nfq_create_queue " + std::to_string(args.queue) + " (is another daemon bound to it?)");
   }
-  if (nfq_set_mode(d->queue_, NFQNL_COPY_META, 0) < 0) return SysError("nfq_set_mode COPY_META");
+  // Corruption needs the packet's bytes; otherwise metadata (the id) is all we need.
+  if (args.corrupt > 0.0) {
+    if (nfq_set_mode(d->queue_, NFQNL_COPY_PACKET, 0xffff) < 0) return SysError("nfq_set_mode COPY_PACKET");
+  } else if (nfq_set_mode(d->queue_, NFQNL_COPY_META, 0) < 0) {
+    return SysError("nfq_set_mode COPY_META");
+  }
   if (nfq_set_queue_maxlen(d->queue_, args.queue_maxlen) < 0) return SysError("nfq_set_queue_maxlen");
   // Room for a burst of queue messages while we sleep until the next release.
   nfnl_rcvbufsiz(nfq_nfnlh(d->handle_), 8u * 1024u * 1024u);
@@ -71,13 +77,33 @@ int NfqueueDelayer::OnPacket(nfq_q_handle* /*queue*/, ::nfgenmsg* /*msg*/, ::nfq
     ++d->stats_.dropped;
     return 0;
   }
+  if (d->corruptor_) {
+    unsigned char* payload = nullptr;
+    const int length = nfq_get_payload(data, &payload);
+    if (length > 0) {
+      if (auto bit = d->corruptor_->Choose(static_cast<std::size_t>(length))) {
+        std::vector<std::uint8_t> bytes(payload, payload + length);
+        FlipBit(bytes, *bit);
+        d->corrupted_[id] = std::move(bytes);
+        ++d->stats_.corrupted;
+      }
+    }
+  }
   const std::int64_t now_us = MonotonicUs();
   d->scheduler_.Admit(id, now_us);
   return 0;
 }
 
 void NfqueueDelayer::Accept(const HeldPacket& packet, std::int64_t now_us) {
-  if (nfq_set_verdict(queue_, packet.id, NF_ACCEPT, 0, nullptr) < 0) ++stats_.verdict_errors;
+  int sent = 0;
+  if (auto it = corrupted_.find(packet.id); it != corrupted_.end()) {
+    sent = nfq_set_verdict(queue_, packet.id, NF_ACCEPT, static_cast<std::uint32_t>(it->second.size()),
+                           it->second.data());
+    corrupted_.erase(it);
+  } else {
+    sent = nfq_set_verdict(queue_, packet.id, NF_ACCEPT, 0, nullptr);
+  }
+  if (sent < 0) ++stats_.verdict_errors;
   hold_sum_ms_ += static_cast<double>(now_us - packet.admitted_us) / 1000.0;
 }
 

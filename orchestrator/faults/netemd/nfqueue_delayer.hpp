@@ -1,19 +1,25 @@
 // NfqueueDelayer: swarmbox-netemd's I/O shell around DelayScheduler. Binds one NFQUEUE, admits each
 // queued packet into the scheduler with the monotonic clock and accepts it when its release time
 // comes (ppoll with microsecond timeouts). Metadata only is copied from the kernel; packets are
-// never modified. Random loss is iptables `statistic`'s job (on ingress); a Gilbert-Elliott model
-// (bursty loss, --ge-*) is drawn here and its losses get NF_DROP at once.
+// modified only by --corrupt: then whole packets are copied from the kernel, and a packet the
+// PacketCorruptor chooses has one bit flipped and keeps its modified bytes until its verdict
+// (NF_ACCEPT with the new payload; checksums are not fixed, as netem does not). Random loss is
+// iptables `statistic`'s job (on ingress); a Gilbert-Elliott model (bursty loss, --ge-*) is drawn
+// here and its losses get NF_DROP at once.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <unordered_map>
+#include <vector>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/faults/delay_scheduler.hpp"
 #include "swarmbox/faults/gilbert_elliott_loss.hpp"
 #include "swarmbox/faults/netemd_args.hpp"
+#include "swarmbox/faults/packet_corruptor.hpp"
 
 struct nfq_handle;
 struct nfq_q_handle;
@@ -26,6 +32,7 @@ struct DelayerStats {
   std::uint64_t packets = 0;
   std::uint64_t reordered = 0;        // sent at once (reorder fraction)
   std::uint64_t dropped = 0;          // lost by the Gilbert-Elliott model (NF_DROP)
+  std::uint64_t corrupted = 0;        // one bit flipped (--corrupt)
   std::uint64_t verdict_errors = 0;
   std::uint64_t receive_overruns = 0;  // ENOBUFS: the kernel dropped queue messages for us
   double mean_hold_ms = 0.0;          // actual hold time, admission to verdict
@@ -50,6 +57,8 @@ class NfqueueDelayer {
   NetemdArgs args_;
   DelayScheduler scheduler_;
   std::optional<GilbertElliottLoss> loss_;
+  std::optional<PacketCorruptor> corruptor_;
+  std::unordered_map<std::uint32_t, std::vector<std::uint8_t>> corrupted_;  // packet id -> its new bytes
   nfq_handle* handle_ = nullptr;
   nfq_q_handle* queue_ = nullptr;
   DelayerStats stats_;

@@ -62,6 +62,7 @@ std::vector<std::string> NetemdRunArgv(const std::string& program, const NetemdA
                              "--ge-loss-bad", detail::FormatDecimal(g.loss_bad), "--ge-loss-good",
                              detail::FormatDecimal(g.loss_good)});
   }
+  if (a.corrupt > 0.0) argv.insert(argv.end(), {"--corrupt", detail::FormatDecimal(a.corrupt)});
   return argv;
 }
 
@@ -120,6 +121,8 @@ Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words) {
     } else if (flag == "--ge-loss-good") {
       SWARMBOX_TRY(ParseFraction(flag, v, &ge.loss_good));
       ge_flags |= 8;
+    } else if (flag == "--corrupt") {
+      SWARMBOX_TRY(ParseFraction(flag, v, &a.corrupt));
     } else if (flag == "--pidfile") {
       if (v.empty() || v[0] != '/') return Bad(flag, "expected an absolute path, got '" + v + "'");
       a.pidfile = v;

@@ -134,10 +134,11 @@ RadioPlan PlanKernel(const Split& s, const LinkTarget& link) {
   return plan;
 }
 
-// Rules whose packets go through swarmbox-netemd: delay, reorder, or Gilbert-Elliott loss (drawn
-// there; random loss stays with iptables statistic on ingress).
+// Rules whose packets go through swarmbox-netemd: delay, reorder, Gilbert-Elliott loss (drawn
+// there; random loss stays with iptables statistic on ingress) or corruption (a bit flipped there).
 bool Delays(const RadioRule* r) {
-  return r != nullptr && (r->spec.has_delay() || r->spec.reorder > 0.0 || r->spec.gilbert_elliott.has_value());
+  return r != nullptr && (r->spec.has_delay() || r->spec.reorder > 0.0 || r->spec.gilbert_elliott.has_value() ||
+                          r->spec.corrupt > 0.0);
 }
 bool Drops(const RadioRule* r) { return r != nullptr && r->spec.loss > 0.0; }
 
@@ -184,6 +185,7 @@ RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanO
     args.delay.reorder_correlation = r->spec.reorder_correlation;
     args.delay.reorder_gap = r->spec.reorder_gap;
     args.gilbert_elliott = r->spec.gilbert_elliott;
+    args.corrupt = r->spec.corrupt;
     args.seed = DaemonSeed(o.seed, link.node, queue);
     args.queue_maxlen = std::min(NetemLimitPackets(r->spec, link.link_rate_kbit), kNetemdMaxQueueLen);
     args.pidfile = o.pid_dir + "/swarmbox-netemd-" + std::to_string(queue) + ".pid";

@@ -59,6 +59,17 @@ TEST(FaultEvent, MeshImpairmentRecordsItsMechanism) {
             "\"mechanism\":\"userspace-nfqueue\",\"spec\":\"delay_ms=100 jitter_ms=20 loss=0.05\"}");
 }
 
+TEST(FaultEvent, UserspaceCorruptionIsRecordedWithItsMechanism) {
+  auto mesh = ParseMeshBlock(Yaml("{corrupt: 0.1}"));
+  ASSERT_TRUE(mesh);
+  FaultEventRecord r;
+  r.wall_s = 0.8;
+  r.mechanism = "userspace-nfqueue";  // swarmbox-netemd flips the bits
+  EXPECT_EQ(MeshEventJson("scout_1", mesh->rules, r),
+            "{\"type\":\"mesh\",\"phase\":\"applied\",\"node\":\"scout_1\",\"t_sim_s\":0,\"wall_s\":0.8,"
+            "\"mechanism\":\"userspace-nfqueue\",\"spec\":\"corrupt=0.1\"}");
+}
+
 TEST(FaultEvent, DescribesEveryKind) {
   EXPECT_EQ(DescribeFault(First("- {at: 1s, duration: 30s, partition: {groups: [[a, b], [c]], oneway: true}}")),
             "groups=[[a, b], [c]] oneway=true duration=30s");

@@ -87,7 +87,7 @@ TEST(Mechanism, UserspaceSupportTable) {
       {"{loss: 0.1, loss_correlation: 0.2}", "'loss_correlation'"},
       {"{gilbert_elliott: {p: 0.1, r: 0.2}}", ""},  // drawn by swarmbox-netemd
       {"{duplicate: 0.1}", "'duplicate'"},
-      {"{corrupt: 0.1}", "'corrupt'"},
+      {"{corrupt: 0.1}", ""},  // a bit flipped by swarmbox-netemd
   };
   for (const Case& c : cases) {
     auto rules = ParseRadioRules(Yaml(c.yaml), "radio");

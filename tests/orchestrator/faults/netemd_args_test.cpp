@@ -44,6 +44,21 @@ TEST(NetemdArgs, GilbertElliottFlagsRoundTrip) {
   EXPECT_FALSE(ParseNetemdRunArgs({"--queue", "1"})->gilbert_elliott.has_value());
 }
 
+TEST(NetemdArgs, CorruptFlagRoundTripsAndIsOnlyWrittenWhenSet) {
+  NetemdArgs a;
+  a.queue = 2;
+  a.corrupt = 0.1;
+  const auto argv = NetemdRunArgv("netemd", a);
+  EXPECT_EQ(std::vector<std::string>(argv.end() - 2, argv.end()), (std::vector<std::string>{"--corrupt", "0.1"}));
+  auto parsed = ParseNetemdRunArgs(std::vector<std::string>(argv.begin() + 2, argv.end()));
+  ASSERT_TRUE(parsed) << parsed.error().ToString();
+  EXPECT_EQ(*parsed, a);
+  a.corrupt = 0.0;
+  const auto plain = NetemdRunArgv("netemd", a);
+  EXPECT_EQ(std::find(plain.begin(), plain.end(), "--corrupt"), plain.end());
+  EXPECT_EQ(ParseNetemdRunArgs({"--queue", "1"})->corrupt, 0.0);
+}
+
 TEST(NetemdArgs, StopArgv) {
   EXPECT_EQ(NetemdStopArgv("/usr/bin/swarmbox-netemd", "/run/x.pid"),
             (std::vector<std::string>{"/usr/bin/swarmbox-netemd", "stop", "--pidfile", "/run/x.pid"}));
@@ -65,6 +80,7 @@ TEST(NetemdArgs, RejectsBadFlagsWithTheReason) {
       {{"--queue", "1", "--ge-p", "0.1", "--ge-r", "0.2"},
        "--ge-p: a Gilbert-Elliott model needs all of --ge-p, --ge-r, --ge-loss-bad and --ge-loss-good"},
       {{"--queue", "1", "--ge-loss-bad", "2"}, "--ge-loss-bad: expected a fraction in [0, 1], got '2'"},
+      {{"--queue", "1", "--corrupt", "-0.1"}, "--corrupt: expected a fraction in [0, 1], got '-0.1'"},
   };
   for (const Case& c : cases) {
     auto parsed = ParseNetemdRunArgs(c.words);

@@ -188,6 +188,27 @@ TEST(RadioPlan, UserspaceGilbertElliottLossIsDrawnByTheDaemonOnEgress) {
                           "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid"));
 }
 
+TEST(RadioPlan, UserspaceCorruptionIsDoneByTheDaemonOnEgress) {
+  // netem "corrupt 10%": the daemon flips one bit of the chosen packets, so the rule's packets go
+  // through its queue even without delay; random loss still goes to the ingress chain.
+  auto plan = PlanRadio(Rules("{corrupt: 0.1, loss: 0.05}"), Link(), Mechanism::kUserspace);
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  EXPECT_THAT(Lines(plan->apply),
+              ElementsAre(::testing::AllOf(::testing::StartsWith("/usr/bin/swarmbox-netemd run --queue 0 --delay-us 0 "),
+                                           ::testing::EndsWith("--daemonize --corrupt 0.1")),
+                          "iptables -w -N SWARMBOX-RADIO-OUT",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -j NFQUEUE --queue-num 0 --queue-bypass",
+                          "iptables -w -I OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT",
+                          "iptables -w -N SWARMBOX-RADIO-IN",
+                          "iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.05 -j DROP",
+                          "iptables -w -I INPUT -i eth1 -j SWARMBOX-RADIO-IN"));
+  EXPECT_THAT(Lines(plan->undo),
+              ElementsAre("iptables -w -D INPUT -i eth1 -j SWARMBOX-RADIO-IN", "iptables -w -F SWARMBOX-RADIO-IN",
+                          "iptables -w -X SWARMBOX-RADIO-IN", "iptables -w -D OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT",
+                          "iptables -w -F SWARMBOX-RADIO-OUT", "iptables -w -X SWARMBOX-RADIO-OUT",
+                          "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid"));
+}
+
 TEST(RadioPlan, UserspacePerDestinationRulesComeBeforeTheAllTrafficRule) {
   RadioPlanOptions options;
   options.seed = 7;
@@ -250,7 +271,8 @@ TEST(RadioPlan, UserspaceRefusesWhatOnlyNetemCanDoWithTheReason) {
   EXPECT_EQ(plan.error().where(), "trial.yaml:1:1");
   EXPECT_EQ(plan.error().message(),
             "'duplicate' cannot be honoured on this host: the kernel has no sch_netem and the userspace "
-            "mechanism cannot duplicate packets");
+            "mechanism cannot duplicate packets (an NFQUEUE verdict passes a packet once; a copy would have "
+            "to be re-injected)");
   EXPECT_TRUE(PlanRadio(rules, Link(), Mechanism::kKernelNetem));
 }
 

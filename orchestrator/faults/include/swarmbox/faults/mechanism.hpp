@@ -3,10 +3,10 @@
 //   kKernelNetem  tc qdisc replace ... netem (and htb + u32 filters for per-destination rules)
 //   kUserspace    where the kernel has no sch_netem ("Specified qdisc kind is unknown"; WSL2,
 //                 minikube, some cloud kernels, this project's machines): swarmbox-netemd on an
-//                 iptables NFQUEUE (delay, jitter, distribution, correlation, reordering, and
-//                 Gilbert-Elliott loss drawn per packet), iptables `statistic` on INPUT for random
-//                 loss, tbf (or htb classes per destination) for rate. Refused here (it cannot):
-//                 duplicate, corrupt, loss_correlation.
+//                 iptables NFQUEUE (delay, jitter, distribution, correlation, reordering,
+//                 Gilbert-Elliott loss drawn per packet, corruption: one bit flipped), iptables
+//                 `statistic` on INPUT for random loss, tbf (or htb classes per destination) for
+//                 rate. Refused here (it cannot): duplicate, loss_correlation.
 //
 //   MechanismCache cache;
 //   auto m = cache.Get(host, [&] { return DetectMechanism(sidecar_runner); });

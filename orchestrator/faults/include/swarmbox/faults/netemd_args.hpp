@@ -5,6 +5,7 @@
 //                       --correlation 0.25 --reorder 0 --reorder-correlation 0 --reorder-gap 0
 //                       --seed 42 --queue-maxlen 4096 [--pidfile /run/swarmbox-netemd-0.pid]
 //                       [--daemonize] [--ge-p 0.02 --ge-r 0.25 --ge-loss-bad 0.9 --ge-loss-good 0]
+//                       [--corrupt 0.1]
 //   swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid   # SIGTERM, wait until it is gone
 //   swarmbox-netemd sleep                                       # a sidecar's pid 1: reaps, waits
 //
@@ -13,7 +14,8 @@
 // when the delayer is ready). On SIGTERM it accepts every held packet at once and exits 0. With the
 // --ge-* flags (all four, netem's gemodel p, r, 1-h, 1-k) it drops each packet a Gilbert-Elliott
 // model (gilbert_elliott_loss.hpp) says is lost, before delaying the rest: on egress, yet the
-// sender sees no error (its send() returned when the packet was queued).
+// sender sees no error (its send() returned when the packet was queued). With --corrupt P it flips
+// one random bit in a fraction P of the packets (packet_corruptor.hpp), checksums left as they are.
 #pragma once
 
 #include <cstdint>
@@ -34,6 +36,7 @@ struct NetemdArgs {
   DelaySettings delay;
   std::uint64_t seed = 0;
   std::optional<GilbertElliott> gilbert_elliott;  // bursty loss, drawn per packet; none = no loss
+  double corrupt = 0.0;               // fraction of packets with one bit flipped; 0 = none
   std::uint32_t queue_maxlen = 1024;  // packets the kernel may hold for us before dropping
   std::string pidfile;                // "" = none
   bool daemonize = false;

@@ -17,7 +17,8 @@
 //                  filters on `ip dst` per peer.
 //   undo:          tc qdisc del dev IF root
 // Userspace (no sch_netem):
-//   delay/jitter/reorder (and Gilbert-Elliott loss, dropped by the daemon) on egress:
+//   delay/jitter/reorder (and Gilbert-Elliott loss, dropped by the daemon, and corruption, a bit
+//                  flipped by the daemon) on egress:
 //                  swarmbox-netemd per rule (NFQUEUE number first_queue + i,
 //                  started first), then chain SWARMBOX-RADIO-OUT (-d PEER for per-destination
 //                  rules, RETURN for peers whose rule has no delay) hooked from OUTPUT -o IF with
