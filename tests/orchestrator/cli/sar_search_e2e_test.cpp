@@ -5,6 +5,11 @@
 // SAR mission under the trial's 100 ms +- 20 ms / 5% loss radio (fault sidecars, the userspace
 // mechanism on kernels without sch_netem). Issue #6: "on a fresh machine ends with outcome:
 // success"; issue #7: both victims confirmed, no collision.
+//
+// And trials/faults/leader_kill.yaml the same way (issue #8: "a leader-kill trial under 100 ms
+// +- 20 ms / 5% loss with five scouts: a new leader is elected and the mission completes"): the
+// Raft leader is SIGKILLed 30 s into the mission and stays down; another drone is elected, the
+// new leader hands the dead drone's sector to live scouts, and both victims are rescued.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -32,53 +37,94 @@ using swarmbox::testing::ReadWholeFile;
 using swarmbox::testing::RunToEnd;
 
 constexpr char kSwarmbox[] = SWARMBOX_CLI_EXE;
-const std::string kTrial = std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml";
+const std::string kTrials = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
 
-TEST(SarSearchE2e, EndsWithMissionCompleteInContainers) {
-  auto client = docker::DockerClient::Connect(docker::DockerClientOptions{});
-  ASSERT_TRUE(client) << "this test needs a Docker engine: " << client.error().ToString();
-  const fs::path dir = fs::temp_directory_path() / ("swarmbox-sar-e2e-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  const std::string run_id = runner::NewRunId();
-  struct Cleanup {
-    docker::DockerApi& api;
-    std::string run_id;
-    fs::path dir;
-    ~Cleanup() {
+// `swarmbox run TRIAL --set physics.rtf=0` into a fresh folder with its own run id; removes what
+// is labelled with the run and the folder when it goes.
+class TrialRun : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto client = docker::DockerClient::Connect(docker::DockerClientOptions{});
+    ASSERT_TRUE(client) << "this test needs a Docker engine: " << client.error().ToString();
+    api_ = std::move(*client);
+    dir_ = fs::temp_directory_path() / ("swarmbox-trial-e2e-" + std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    run_id_ = runner::NewRunId();
+  }
+  void TearDown() override {
+    if (api_ != nullptr) {
       docker::LabelSelector run;
-      run.equals[std::string(docker::kLabelRun)] = run_id;
-      (void)docker::RemoveLabelled(api, run, /*include_images=*/false);
-      fs::remove_all(dir);
+      run.equals[std::string(docker::kLabelRun)] = run_id_;
+      (void)docker::RemoveLabelled(*api_, run, /*include_images=*/false);
     }
-  } cleanup{**client, run_id, dir};
+    fs::remove_all(dir_);
+  }
 
-  // A hang guard only: the run takes ~40 s of wall time on an idle 2-core machine.
-  auto done = RunToEnd({kSwarmbox, "run", kTrial, "--out", dir.string(), "--run-id", run_id,
-                        "--set", "physics.rtf=0", "--quiet"},
-                       std::chrono::minutes(15), dir.string());
-  ASSERT_TRUE(done) << done.error().ToString();
-  const fs::path trial_dir = dir / runner::TrialDirName("sar-search", run_id);
-  std::cout << done->out << done->err;
-  EXPECT_EQ(done->code, 0) << done->err;
+  // Runs the trial to its end (a hang guard only) and checks the CLI contract: exit 0, outcome
+  // success. Returns the trial folder.
+  fs::path RunToSuccess(const std::string& trial, const std::string& trial_name) {
+    auto done = RunToEnd({kSwarmbox, "run", trial, "--out", dir_.string(), "--run-id", run_id_,
+                          "--set", "physics.rtf=0", "--quiet"},
+                         std::chrono::minutes(15), dir_.string());
+    EXPECT_TRUE(done) << done.error().ToString();
+    const fs::path trial_dir = dir_ / runner::TrialDirName(trial_name, run_id_);
+    if (!done) return trial_dir;
+    std::cout << done->out << done->err;
+    EXPECT_EQ(done->code, 0) << done->err;
+    auto result = yaml::Parse(ReadWholeFile((trial_dir / "result.json").string()), "result.json");
+    EXPECT_TRUE(result) << result.error().ToString();
+    if (result && result->Find("outcome") != nullptr) {
+      EXPECT_EQ(result->Find("outcome")->scalar(), "success")
+          << ReadWholeFile((trial_dir / "result.json").string());
+    } else {
+      ADD_FAILURE() << "no outcome in result.json";
+    }
+    return trial_dir;
+  }
 
-  auto result = yaml::Parse(ReadWholeFile((trial_dir / "result.json").string()), "result.json");
-  ASSERT_TRUE(result) << result.error().ToString();
-  ASSERT_NE(result->Find("outcome"), nullptr);
-  EXPECT_EQ(result->Find("outcome")->scalar(), "success")
-      << ReadWholeFile((trial_dir / "result.json").string());
+  // Nothing labelled with the run is left.
+  void ExpectNothingLeft() {
+    docker::LabelSelector run;
+    run.equals[std::string(docker::kLabelRun)] = run_id_;
+    auto containers = api_->ListContainers(run, /*all=*/true);
+    ASSERT_TRUE(containers) << containers.error().ToString();
+    EXPECT_TRUE(containers->empty());
+    auto networks = api_->ListNetworks(run);
+    ASSERT_TRUE(networks) << networks.error().ToString();
+    EXPECT_TRUE(networks->empty());
+  }
+
+  std::unique_ptr<docker::DockerClient> api_;
+  fs::path dir_;
+  std::string run_id_;
+};
+
+// Every logfmt line of a trial's component log with its fields.
+std::vector<LogfmtFields> Events(const fs::path& trial_dir, const std::string& component) {
+  std::vector<LogfmtFields> out;
+  std::istringstream log(ReadWholeFile((trial_dir / "logs" / (component + ".log")).string()));
+  std::string line;
+  while (std::getline(log, line)) {
+    auto fields = ParseLogfmt(line);
+    if (FindField(fields, "event")) out.push_back(std::move(fields));
+  }
+  return out;
+}
+
+using SarSearchE2e = TrialRun;
+
+TEST_F(SarSearchE2e, EndsWithMissionCompleteInContainers) {
+  // ~40 s of wall time on an idle 2-core machine.
+  const fs::path trial_dir = RunToSuccess(kTrials + "/sar_search.yaml", "sar-search");
 
   // Every drone applied the same committed mission: two victims confirmed (by id), complete.
   std::set<std::string> confirmed;
   std::size_t collisions = 0;
   for (const char* drone : {"scout_1", "scout_2", "scout_3", "lifter"}) {
-    std::istringstream log(ReadWholeFile((trial_dir / "logs" / (std::string(drone) + ".log")).string()));
-    std::string line;
     bool saw_link = false;
-    while (std::getline(log, line)) {
-      const auto fields = ParseLogfmt(line);
+    for (const auto& fields : Events(trial_dir, drone)) {
       const auto event = FindField(fields, "event");
-      if (!event) continue;
       if (*event == "victim_confirmed") {
         if (auto id = FindField(fields, "id")) confirmed.insert(std::string(*id));
       }
@@ -95,15 +141,65 @@ TEST(SarSearchE2e, EndsWithMissionCompleteInContainers) {
   EXPECT_TRUE(fs::exists(trial_dir / "truth.csv"));
   EXPECT_TRUE(fs::exists(trial_dir / "trajectories.png"));
 
-  // Nothing labelled with the run is left.
-  docker::LabelSelector run;
-  run.equals[std::string(docker::kLabelRun)] = run_id;
-  auto containers = (*client)->ListContainers(run, /*all=*/true);
-  ASSERT_TRUE(containers) << containers.error().ToString();
-  EXPECT_TRUE(containers->empty());
-  auto networks = (*client)->ListNetworks(run);
-  ASSERT_TRUE(networks) << networks.error().ToString();
-  EXPECT_TRUE(networks->empty());
+  ExpectNothingLeft();
+}
+
+using LeaderKillE2e = TrialRun;
+
+TEST_F(LeaderKillE2e, ANewLeaderTakesOverAndTheMissionCompletes) {
+  // ~1-2.5 minutes of wall time (five scouts and the lifter).
+  const fs::path trial_dir = RunToSuccess(kTrials + "/faults/leader_kill.yaml", "faults-leader-kill");
+
+  // The kill: applied by docker to the leader of the latest leader_elected.
+  const std::string events = ReadWholeFile((trial_dir / "events.jsonl").string());
+  std::string killed;
+  std::istringstream lines(events);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("\"kind\":\"kill\"") == std::string::npos || line.find("\"applied\"") == std::string::npos) continue;
+    auto doc = yaml::Parse(line, "events.jsonl");
+    ASSERT_TRUE(doc) << doc.error().ToString();
+    const auto* targets = doc->Find("targets");
+    ASSERT_TRUE(targets != nullptr && targets->is_sequence() && targets->items().size() == 1u) << line;
+    killed = targets->items()[0].scalar();
+  }
+  ASSERT_FALSE(killed.empty()) << "no kill applied: " << events;
+  EXPECT_NE(killed, "lifter") << "a scout leads (the lifter's election timeout is doubled)";
+
+  // Every survivor saw another drone elected after the kill, the new leader noticed the dead drone
+  // and handed its sector over, and mission_complete came with all victims rescued.
+  std::set<std::string> leaders_after, lost, handed_over_from;
+  std::size_t completed = 0;
+  for (const char* drone : {"scout_1", "scout_2", "scout_3", "scout_4", "scout_5", "lifter"}) {
+    if (drone == killed) continue;
+    bool seen_other_leader = false;
+    for (const auto& fields : Events(trial_dir, drone)) {
+      const std::string event(*FindField(fields, "event"));
+      if (event == "leader_elected") {
+        if (auto leader = FindField(fields, "leader"); leader && *leader != killed) {
+          seen_other_leader = true;
+          leaders_after.insert(std::string(*leader));
+        }
+      } else if (event == "member_lost") {
+        if (auto d = FindField(fields, "drone")) lost.insert(std::string(*d));
+      } else if (event == "sector_reassigned") {
+        if (auto from = FindField(fields, "from")) handed_over_from.insert(std::string(*from));
+      } else if (event == "mission_complete") {
+        const auto victims = FindField(fields, "victims");
+        const auto rescued = FindField(fields, "rescued");
+        ASSERT_TRUE(victims && rescued);
+        EXPECT_EQ(*victims, *rescued) << drone;
+        EXPECT_EQ(*victims, "2") << drone;
+        ++completed;
+      }
+    }
+    EXPECT_TRUE(seen_other_leader) << drone << " never saw a leader other than " << killed;
+  }
+  EXPECT_FALSE(leaders_after.empty());
+  EXPECT_TRUE(lost.count(killed)) << "the new leader never reported " << killed << " lost";
+  EXPECT_TRUE(handed_over_from.count(killed)) << "no sector_reassigned from=" << killed;
+  // The first mission_complete line ends the trial: the others may not have logged theirs yet.
+  EXPECT_GE(completed, 1u);
+  ExpectNothingLeft();
 }
 
 }  // namespace
