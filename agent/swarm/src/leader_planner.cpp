@@ -37,6 +37,7 @@ LeaderPlanner::LeaderPlanner(LeaderConfig config) : config_(std::move(config)) {
   SWARMBOX_CHECK(config_.search_area.width_m() > 0 && config_.search_area.height_m() > 0);
   SWARMBOX_CHECK(config_.retry_s > 0);
   SWARMBOX_CHECK(config_.member_timeout_s > 0 && config_.assignment_settle_s >= 0);
+  SWARMBOX_CHECK(config_.member_min_wall_s >= 0);
 }
 
 bool LeaderPlanner::Due(const std::string& key, double t_s) {
@@ -46,12 +47,14 @@ bool LeaderPlanner::Due(const std::string& key, double t_s) {
   return true;
 }
 
-void LeaderPlanner::Track(double t_s, const raft::MissionState& m) {
+void LeaderPlanner::Track(double t_s, const raft::MissionState& m, double wall_s) {
   const bool first = !tracking_;
   if (first) {
     tracking_ = true;
     first_s_ = t_s;
+    first_wall_s_ = wall_s;
   }
+  wall_s_ = wall_s;
   if (first || !(m.sectors() == sectors_)) {
     sectors_ = m.sectors();
     sectors_changed_s_ = t_s;
@@ -63,19 +66,19 @@ bool LeaderPlanner::GoneOwner(double t_s, const std::string& drone,
   for (const RosterEntry& r : roster) {
     if (r.name == drone) return !Alive(r);
   }
-  // Never heard (or not a mission agent): gone once everyone had time to be heard.
-  return t_s - first_s_ >= config_.member_timeout_s;
+  // Never heard (or not a mission agent): gone once everyone had time to be heard, on both clocks
+  // (NaN wall times: no wall clock, the comparison below is false).
+  return t_s - first_s_ >= config_.member_timeout_s && !(wall_s_ - first_wall_s_ < config_.member_min_wall_s);
 }
 
 void LeaderPlanner::ReportMembers(double t_s, std::span<const RosterEntry> roster, MissionOutput* out) {
   for (const RosterEntry& r : roster) {
     const bool alive = Alive(r);
     if (!alive && lost_.insert(r.name).second) {
-      out->events.push_back(std::move(LogEvent(t_s, config_.name, "member_lost")
-                                          .Add("drone", r.name)
-                                          .Add("role", RoleName(r.role))
-                                          .Add("silent_s", r.age_s, 1)
-                                          .Add("last_mode", r.mode)));
+      LogEvent e(t_s, config_.name, "member_lost");
+      e.Add("drone", r.name).Add("role", RoleName(r.role)).Add("silent_s", r.age_s, 1);
+      if (std::isfinite(r.wall_age_s)) e.Add("silent_wall_s", r.wall_age_s, 1);
+      out->events.push_back(std::move(e.Add("last_mode", r.mode)));
     } else if (alive && lost_.erase(r.name) != 0) {
       out->events.push_back(std::move(LogEvent(t_s, config_.name, "member_back")
                                           .Add("drone", r.name)
@@ -141,8 +144,8 @@ std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raf
 }
 
 void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
-                         std::span<const RosterEntry> roster, MissionOutput* out) {
-  Track(t_s, m);
+                         std::span<const RosterEntry> roster, MissionOutput* out, double wall_s) {
+  Track(t_s, m, wall_s);
   ReportMembers(t_s, roster, out);
   std::vector<std::string> scouts;  // live ones
   const RosterEntry* lifter = nullptr;

@@ -287,6 +287,95 @@ TEST_F(FailoverTest, ADroneNeverHeardIsLostOnlyAfterTheTimeoutFromTheStart) {
   ASSERT_NE(Find<raft::AssignSectors>(out), nullptr);
 }
 
+// ---- both clocks (rtf 0: the radio delivers in wall time, the world runs many times faster) --
+
+// The roster of Roster() with scout_3 silent `sim_s` simulated and `wall_s` wall seconds, the
+// others heard 0.2 s ago on both clocks.
+std::vector<RosterEntry> Aged(double sim_s, double wall_s) {
+  std::vector<RosterEntry> r = {Entry("scout_1", "searching", 0.0, Role::kScout, {-60, 0}),
+                                Entry("scout_2", "searching", 0.2, Role::kScout, {0, 0}),
+                                Entry("scout_3", "searching", sim_s, Role::kScout, {60, 0}),
+                                Entry("lifter", "on_ground", 0.2, Role::kLifter)};
+  for (RosterEntry& e : r) e.wall_age_s = e.name == "scout_3" ? wall_s : std::min(e.age_s, 0.2);
+  return r;
+}
+
+// At rtf 0 a sample held back 0.8 s of wall time (a starved thread, DDS repairing a loss) is
+// 6.5 s old on the simulated clock: a live member, not a lost one.
+TEST_F(FailoverTest, SilentSixSimulatedSecondsButUnderASecondOfWallTimeIsNotLost) {
+  LeaderPlanner leader = Planner("scout_1");
+  MissionOutput out;
+  leader.Step(20.0, m.state, Aged(6.5, 0.8), &out, 1000.0);
+  EXPECT_FALSE(HasEvent(out, "member_lost"));
+  EXPECT_FALSE(HasEvent(out, "sector_reassigned"));
+  EXPECT_TRUE(out.proposals.empty());
+  EXPECT_TRUE(leader.Alive(Aged(6.5, 0.8)[2]));
+  // Even 60 simulated seconds within 2.9 s of wall time (a 20x speed-up) is not silence.
+  leader.Step(80.0, m.state, Aged(60.0, 2.9), &out, 1002.9);
+  EXPECT_FALSE(HasEvent(out, "member_lost"));
+  EXPECT_TRUE(out.proposals.empty());
+}
+
+// Silent past both floors: lost, and its sector handed over as with the simulated clock alone.
+TEST_F(FailoverTest, SilentSixSimulatedAndThreeWallSecondsIsLost) {
+  LeaderPlanner leader = Planner("scout_1");
+  MissionOutput out;
+  leader.Step(20.0, m.state, Aged(6.5, 3.0), &out, 1000.0);
+  EXPECT_TRUE(HasEvent(out, "member_lost", "drone=scout_3 role=scout silent_s=6.5 silent_wall_s=3.0"));
+  EXPECT_TRUE(HasEvent(out, "sector_reassigned", "from=scout_3 to=scout_1,scout_2"));
+  ASSERT_NE(Find<raft::AssignSectors>(out), nullptr);
+  // Long on the wall clock but under 6 s simulated (a slow world, rtf < 0.5): still alive.
+  LeaderPlanner slow = Planner("scout_1");
+  out.Clear();
+  slow.Step(20.0, m.state, Aged(5.9, 30.0), &out, 1000.0);
+  EXPECT_FALSE(HasEvent(out, "member_lost"));
+  EXPECT_TRUE(out.proposals.empty());
+}
+
+// At rtf 1 both ages are the same: the 6 s simulated timeout decides, exactly as without a wall
+// clock (5.9 s alive, 6.1 s lost), and a member heard again is back.
+TEST_F(FailoverTest, AtRealTimeTheSimulatedTimeoutDecidesAsWithoutAWallClock) {
+  for (const bool wall : {true, false}) {
+    SCOPED_TRACE(wall ? "ages on both clocks" : "no wall clock");
+    LeaderPlanner leader = Planner("scout_1");
+    const auto roster = [&](double age3) {
+      return wall ? Aged(age3, age3) : Roster("searching", "searching", "searching", age3);
+    };
+    const auto step = [&](double t, double age3, MissionOutput* out) {
+      if (wall) {
+        leader.Step(t, m.state, roster(age3), out, 500.0 + t);  // rtf 1: wall = sim + offset
+      } else {
+        leader.Step(t, m.state, roster(age3), out);
+      }
+    };
+    MissionOutput out;
+    step(20.0, 5.9, &out);
+    EXPECT_FALSE(HasEvent(out, "member_lost"));
+    EXPECT_TRUE(out.proposals.empty());
+    step(20.2, 6.1, &out);
+    EXPECT_TRUE(HasEvent(out, "member_lost", "drone=scout_3"));
+    ASSERT_NE(Find<raft::AssignSectors>(out), nullptr);
+    out.Clear();
+    step(21.0, 0.2, &out);
+    EXPECT_TRUE(HasEvent(out, "member_back", "drone=scout_3"));
+  }
+}
+
+// Never heard (a restarted leader): lost after 6 s of simulated time from the start only once
+// 3 s of wall time passed too; without a wall clock (NaN) the simulated time alone decides.
+TEST_F(FailoverTest, ADroneNeverHeardIsLostOnlyAfterBothTimeoutsFromTheStart) {
+  LeaderPlanner leader = Planner("scout_1");
+  std::vector<RosterEntry> r = {Entry("scout_1", "searching", 0.0), Entry("scout_2", "searching", 0.2),
+                                Entry("lifter", "on_ground", 0.2, Role::kLifter)};
+  for (RosterEntry& e : r) e.wall_age_s = 0.1;
+  MissionOutput out;
+  leader.Step(100.0, m.state, r, &out, 7.0);
+  leader.Step(110.0, m.state, r, &out, 8.0);  // 10 s simulated, 1 s wall: not yet
+  EXPECT_EQ(Find<raft::AssignSectors>(out), nullptr);
+  leader.Step(110.1, m.state, r, &out, 10.0);
+  ASSERT_NE(Find<raft::AssignSectors>(out), nullptr);
+}
+
 // ---- scout ---------------------------------------------------------------------------------
 
 MissionInput Input(double t, const Mission& m, const Vector3d& p) {

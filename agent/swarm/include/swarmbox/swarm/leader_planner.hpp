@@ -19,26 +19,40 @@
 //   COMPLETE  once: event=mission_complete victims=<n> rescued=<n>
 //
 // A member is *gone* when its latest DroneState was taken more than member_timeout_s of
-// simulated time ago (RosterEntry::age_s), or, never heard, member_timeout_s after this planner
-// first ran. Simulated time is the right clock for it: the agents run in lockstep with the physics
-// server, so a stalled (busy, swapped out) agent stops the clock for everyone and never looks
-// silent, while a killed one stops publishing and ages at the rate of the world. Only the radio
-// adds age to a live member, in wall time: at rtf 1 a state sample (5 Hz, reliable, keep-last 1)
-// over 100 +- 20 ms delay with 5% loss is rarely more than 0.3 s old, and 6 s of silence means 30
-// lost samples in a row (0.05^30); at rtf 0 the age is that wall delay times the speed-up, still
-// far below 6 s while the world runs under ~10x real time. A member wrongly taken for gone only
-// costs a repeated sweep (its sector goes to others; when it is heard again it is a live scout
-// without a sector, done and free for the next hand-over), never a wrong ending.
+// simulated time ago (RosterEntry::age_s) AND was received at least member_min_wall_s of wall
+// time ago (RosterEntry::wall_age_s), or, never heard, both that long after this planner first
+// ran. Simulated time is the clock of the rule: the agents run in lockstep with the physics
+// server, so a stalled (busy, swapped out) agent stops the clock for everyone, while a killed one
+// stops publishing and ages at the rate of the world. But the radio (DDS on the mesh, 100 +- 20
+// ms of netem delay in containers) delivers in wall time, and at rtf 0 the world runs many times
+// faster than the wall clock: a state sample held back ~1 s of wall time (a starved receive or
+// publish thread, DDS repairing a loss) is then 6+ simulated seconds old on arrival. At load ~42
+// on two cores a leader at rtf 0 declared every member lost at once (member_lost silent_s=6.1)
+// and the mission took 390 s instead of ~225 s. Hence the wall-clock floor: 3 s is ten times the
+// worst radio delay of a live member at rtf 1 (a 5 Hz sample over 100 +- 20 ms with 5% loss is
+// rarely 0.3 s old) and leaves ~2 s for starvation and DDS repair. At rtf 1 (and whenever the
+// world runs no faster than 2x real time) 6 s of simulated silence is already >= 3 s of wall
+// time, so the simulated rule decides alone, as before; at rtf 0 a killed member is noticed after
+// max(6 s simulated, 3 s wall), i.e. ~25 s simulated at the ~8x of the loopback test. 6 s of
+// simulated silence at rtf 1 means 30 lost samples in a row (0.05^30). Without a wall clock
+// (wall_age_s infinite, wall_s NaN: the default) the simulated rule decides alone. A member
+// wrongly taken for gone only costs a repeated sweep (its sector goes to others; when it is heard
+// again it is a live scout without a sector, done and free for the next hand-over), never a wrong
+// ending.
 //
 // The planner keeps no state a new leader could not rebuild: sectors and their owners live in the
 // committed MissionState; what it tracks (when the sector list last changed, who it reported
 // lost) is re-learned from the committed state and the roster. Track() runs on every drone each
 // mission tick so that a follower that becomes leader already knows when the list last changed.
 //
-//   planner.Track(t_s, driver.mission());                       // every drone, every tick
-//   planner.Step(t_s, driver.mission(), roster, &out);          // the leader: appends proposals
+//   planner.Track(t_s, driver.mission(), wall_s);               // every drone, every tick
+//   planner.Step(t_s, driver.mission(), roster, &out, wall_s);  // the leader: appends proposals
+//
+// wall_s is any monotonic wall clock [s] (steady_clock), read by the caller: the planner reads
+// no clock.
 #pragma once
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -56,6 +70,9 @@ struct RosterEntry {
   Role role = Role::kScout;
   std::string mode;  // bus::DroneState::mode, as the behaviours publish it
   double age_s = 0;  // simulated time since the latest DroneState was taken (0: this drone) [s]
+  // Wall time since the latest DroneState was received (0: this drone; infinite: no wall clock,
+  // the simulated age alone decides) [s].
+  double wall_age_s = std::numeric_limits<double>::infinity();
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();  // its latest position, world ENU [m]
 };
 
@@ -67,6 +84,9 @@ struct LeaderConfig {
   double handle_time_s = 45.0;    // no lifter: converge this long, then the victim is handled
   // A member silent this long (simulated time) is gone: see the banner for why 6 s [s].
   double member_timeout_s = 6.0;
+  // ... and silent at least this long on the wall clock (rtf 0: the radio's wall-time delays are
+  // many simulated seconds): see the banner for why 3 s [s].
+  double member_min_wall_s = 3.0;
   // The sector list must be unchanged this long before the search counts as finished: an owner
   // that was just handed a sector may still publish the "swept" of before it applied the commit.
   // A follower applies a commit within a heartbeat or two of the leader (200 ms + 100 ms radio
@@ -80,15 +100,19 @@ class LeaderPlanner {
   explicit LeaderPlanner(LeaderConfig config);
 
   // Follows the committed sector list (when it last changed). Step() calls it too.
-  void Track(double t_s, const raft::MissionState& mission);
+  // wall_s: a monotonic wall clock [s]; NaN: none (the simulated clock alone decides).
+  void Track(double t_s, const raft::MissionState& mission,
+             double wall_s = std::numeric_limits<double>::quiet_NaN());
 
   // Appends proposals and events to `out` (does not clear it or touch the setpoint).
   void Step(double t_s, const raft::MissionState& mission, std::span<const RosterEntry> roster,
-            MissionOutput* out);
+            MissionOutput* out, double wall_s = std::numeric_limits<double>::quiet_NaN());
 
   bool handled(std::uint32_t victim_id) const { return handled_.count(victim_id) != 0; }
   // Whether `entry` is alive at `t_s` by the rule in the banner.
-  bool Alive(const RosterEntry& entry) const { return entry.age_s <= config_.member_timeout_s; }
+  bool Alive(const RosterEntry& entry) const {
+    return entry.age_s <= config_.member_timeout_s || entry.wall_age_s < config_.member_min_wall_s;
+  }
 
  private:
   bool Due(const std::string& key, double t_s);
@@ -107,6 +131,8 @@ class LeaderPlanner {
   bool complete_reported_ = false;
   bool tracking_ = false;                 // Track() ran before
   double first_s_ = 0.0;                  // first Track() [s]
+  double first_wall_s_ = 0.0;             // its wall clock (NaN: none) [s]
+  double wall_s_ = 0.0;                   // the wall clock of the latest Track() (NaN: none) [s]
   std::vector<raft::Sector> sectors_;     // the committed list as last seen
   double sectors_changed_s_ = 0.0;        // when it last changed (or was first seen) [s]
   std::set<std::string> lost_;            // members reported lost (event=member_lost)
