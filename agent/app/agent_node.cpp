@@ -238,6 +238,10 @@ void AgentNode::HandleSample(const bus::SensorSample& msg) {
 void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
   const flight::StateEstimate& est = fc_.estimate();
   mission_->RecordEstimate(t_s_, est);
+  // Wall times for the leader's lost-member rule (at rtf 0 a radio delay is many simulated s).
+  const auto wall_s = [] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  };
   while (peers_sub_->Take(peer_)) {
     PeerState p;
     p.name = peer_.drone;
@@ -245,6 +249,7 @@ void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
     p.position_m = V(peer_.position_enu_m);
     p.velocity_m_s = V(peer_.velocity_enu_m_s);
     p.sim_time_s = static_cast<double>(peer_.sim_time_ns) * 1e-9;
+    p.received_wall_s = wall_s();
     mission_->OnPeerState(p);
   }
   if (camera_sub_) {
@@ -265,6 +270,7 @@ void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
   }
   MissionHostInput in;
   in.t_s = t_s_;
+  in.wall_s = wall_s();
   in.dt_s = options_.control_dt_s;
   in.flight_mode = fc_.mode();
   in.estimate = &est;

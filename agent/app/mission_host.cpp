@@ -187,17 +187,23 @@ void MissionHost::OnPeerState(const PeerState& peer) {
   if (p.name.empty() || peer.sim_time_s >= p.sim_time_s) p = peer;
 }
 
-void MissionHost::Roster(double t_s, const flight::Vec3& own_position_m, std::vector<swarm::RosterEntry>* out) const {
+void MissionHost::Roster(double t_s, double wall_s, const flight::Vec3& own_position_m,
+                         std::vector<swarm::RosterEntry>* out) const {
   out->clear();
   swarm::RosterEntry own;
   own.name = config_.name;
   own.position_m = own_position_m.head<2>();
+  own.wall_age_s = 0.0;
   if (DecodeMissionMode(mode_, &own.role, &own.mode)) out->push_back(std::move(own));
   for (const auto& [name, p] : peers_) {
     swarm::RosterEntry e;
     e.name = name;
     // Age on the shared simulated clock (lockstep): see leader_planner.hpp for the timeout.
     e.age_s = std::max(0.0, t_s - p.sim_time_s);
+    // And on the wall clock since it was received (infinite without wall times: the simulated
+    // age alone decides), so that a radio delay at rtf 0 is not taken for silence.
+    const double wall_age_s = wall_s - p.received_wall_s;
+    if (std::isfinite(wall_age_s)) e.wall_age_s = std::max(0.0, wall_age_s);
     e.position_m = p.position_m.head<2>();
     if (DecodeMissionMode(p.mode, &e.role, &e.mode)) out->push_back(std::move(e));
   }
@@ -268,6 +274,7 @@ void MissionHost::Start(const MissionHostInput& in) {
   lc.retry_s = 2.0;
   lc.start_timeout_s = t.leader_start_timeout_s;
   lc.member_timeout_s = t.member_timeout_s;
+  lc.member_min_wall_s = t.member_min_wall_s;
   lc.assignment_settle_s = t.assignment_settle_s;
   leader_.emplace(std::move(lc));
   out_.events.push_back(std::move(LogEvent(in.t_s, config_.name, "mission_start")
@@ -328,14 +335,14 @@ void MissionHost::RunBehaviour(const MissionHostInput& in) {
   if (behaviour_out_.payload.action != swarm::PayloadAction::kNone) Apply(behaviour_out_.payload);
   Drive(in, behaviour_out_.setpoint);
 
-  leader_->Track(in.t_s, *in.mission);  // every drone: a new leader knows when sectors changed
+  leader_->Track(in.t_s, *in.mission, in.wall_s);  // every drone: a new leader knows when sectors changed
   if (in.is_leader) {
     std::vector<swarm::RosterEntry> roster;
-    Roster(in.t_s, est.pos_m, &roster);
+    Roster(in.t_s, in.wall_s, est.pos_m, &roster);
     const bool everyone = roster.size() == config_.members.size();
     if (everyone || in.mission->phase() != raft::MissionPhase::kIdle || in.t_s >= config_.tuning.leader_start_timeout_s) {
       swarm::MissionOutput lead;
-      leader_->Step(in.t_s, *in.mission, roster, &lead);
+      leader_->Step(in.t_s, *in.mission, roster, &lead, in.wall_s);
       for (raft::MissionCommand& c : lead.proposals) out_.proposals.push_back(std::move(c));
       for (LogEvent& e : lead.events) {
         // Every drone logs mission_complete itself when it applies COMPLETE (Step()).

@@ -10,8 +10,9 @@
 //     DroneState::mode as "<role>/<mode>", e.g. "scout/searching", "lifter/on_ground");
 //   - the committed raft::MissionState and whether this node leads: ScoutBehaviour or
 //     LifterSequence every mission tick (10 Hz of simulated time), LeaderPlanner on the leader
-//     (its roster carries each peer's age on the simulated clock: a killed drone falls silent
-//     and its sectors are handed over; LeaderPlanner::Track runs on every drone);
+//     (its roster carries each peer's age on the simulated clock and, when the node passes wall
+//     times, on the wall clock: a killed drone falls silent and its sectors are handed over, a
+//     live one held back by the radio at rtf 0 does not; LeaderPlanner::Track runs on every drone);
 //   - a per-airframe BatteryModel (battery_low -> return home, in the behaviours).
 // And returns what the node must do: a flight setpoint (only when it changes, or each tick for a
 // flocking velocity), a payload world command, Raft proposals, logfmt events and the mode string.
@@ -22,9 +23,12 @@
 //   host->OnPeerState(peer);                          // each DroneState of another drone
 //   const MissionHostOutput& out = host->Step(in);    // every control step
 //
-// Time is simulated seconds. Frames: world ENU [m]. Not thread-safe (the control loop owns it).
+// Time is simulated seconds, except the wall times (PeerState::received_wall_s,
+// MissionHostInput::wall_s: a monotonic clock the node reads; NaN: none, the simulated clock alone
+// decides who is lost). Frames: world ENU [m]. Not thread-safe (the control loop owns it).
 #pragma once
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -75,6 +79,8 @@ struct PeerState {
   flight::Vec3 position_m = flight::Vec3::Zero();
   flight::Vec3 velocity_m_s = flight::Vec3::Zero();
   double sim_time_s = 0.0;           // the sample's simulated time [s]
+  // When this node took it off the bus, monotonic wall clock [s]; NaN: unknown.
+  double received_wall_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Tuning of the mission, chosen so sar_search completes well inside its 600 s timeout (see
@@ -94,6 +100,9 @@ struct MissionTuning {
   // search counts as finished only with the sector list unchanged this long (leader_planner.hpp
   // has the reasoning for 100 +- 20 ms radio delay and 5% loss) [s].
   double member_timeout_s = 6.0;
+  // ... and silent this long on the wall clock too: at rtf 0 a radio or starvation delay of ~1 s
+  // wall is many simulated seconds (leader_planner.hpp has the reasoning for 3 s) [s].
+  double member_min_wall_s = 3.0;
   double assignment_settle_s = 10.0;
   double sighting_dedupe_m = 10.0;      // a sighting this close to a known victim is that victim
   double max_tilt_for_perception_rad = 0.2;   // frames taken more tilted are not used
@@ -128,6 +137,7 @@ struct MissionHostConfig {
 
 struct MissionHostInput {
   double t_s = 0.0;
+  double wall_s = std::numeric_limits<double>::quiet_NaN();  // monotonic wall clock now [s]; NaN: none
   double dt_s = 0.004;                           // since the previous Step [s]
   flight::FlightMode flight_mode = flight::FlightMode::kInit;
   const flight::StateEstimate* estimate = nullptr;  // never null
@@ -173,7 +183,8 @@ class MissionHost {
   void RunBehaviour(const MissionHostInput& in);
   void Drive(const MissionHostInput& in, const swarm::SetpointRequest& sp);
   void Apply(const swarm::PayloadRequest& p);
-  void Roster(double t_s, const flight::Vec3& own_position_m, std::vector<swarm::RosterEntry>* out) const;
+  void Roster(double t_s, double wall_s, const flight::Vec3& own_position_m,
+              std::vector<swarm::RosterEntry>* out) const;
 
   MissionHostConfig config_;
   swarm::Role role_ = swarm::Role::kScout;

@@ -86,10 +86,12 @@ class HostRig {
   explicit HostRig(const MissionHostConfig& c) : host_(*MissionHost::Create(c)) { est_.valid = true; }
   const MissionHostOutput& Step(FlightMode mode, bool leader = false, bool hover = false, double mass_kg = 0) {
     t_ += 0.004;
+    wall_ += 0.004 / speed_up_;
     est_.t_s = t_;
     host_->RecordEstimate(t_, est_);
     MissionHostInput in;
     in.t_s = t_;
+    if (speed_up_ > 0) in.wall_s = wall_;
     in.flight_mode = mode;
     in.estimate = &est_;
     in.mission = &mission_;
@@ -108,6 +110,10 @@ class HostRig {
     }
     return sent;
   }
+  // Passes wall times from now on: the world runs `speed_up` times faster than the wall clock
+  // (1: rtf 1; ~8 at rtf 0 on loopback). Without it the host gets no wall clock (NaN).
+  void PassWallTime(double speed_up) { speed_up_ = speed_up; }
+  double wall_s() const { return wall_; }
   MissionHost& host() { return *host_; }
   flight::StateEstimate& estimate() { return est_; }
   raft::MissionState& mission() { return mission_; }
@@ -119,6 +125,8 @@ class HostRig {
   raft::MissionState mission_;
   std::vector<raft::MissionCommand> proposals_;
   double t_ = 0.0;
+  double wall_ = 100.0;  // any monotonic origin
+  double speed_up_ = -1.0;  // <= 0: no wall clock
 };
 
 TEST(MissionHostScout, TakesOffShortThenClimbsInPositionModeAndPublishesItsMode) {
@@ -217,6 +225,49 @@ TEST(MissionHostScout, LeadingItHandsASilentPeersSectorOverAfterTheMemberTimeout
     if (a == nullptr) continue;
     for (const raft::Sector& sector : a->sectors) EXPECT_EQ(sector.drone, "scout_1");
     EXPECT_EQ(a->sectors.size(), 2u);
+  }
+}
+
+// With wall times (the node stamps each DroneState when it takes it off the bus): at rtf 0 the
+// world runs ~10x faster than the radio delivers, so 6 s of simulated silence is 0.6 s of wall
+// time, a delayed sample, not a lost drone; the sector goes over once the peer is also 3 s silent
+// on the wall clock. At rtf 1 the 6 s simulated timeout decides, as without wall times.
+TEST(MissionHostScout, AtRtf0APeerIsLostOnlyWhenAlsoSilentOnTheWallClock) {
+  for (const double speed_up : {10.0, 1.0}) {
+    SCOPED_TRACE("speed-up " + std::to_string(speed_up));
+    HostRig rig(Scout("scout_1", {"scout_1", "scout_2"}));
+    rig.PassWallTime(speed_up);
+    rig.mission().Apply(1, raft::AssignSectors{{{"scout_1", -92, -92, 0, 92}, {"scout_2", 0, -92, 92, 92}}});
+    rig.mission().Apply(2, raft::StartSearch{});
+    rig.estimate().pos_m = Vec3(0, 0, 30);
+    PeerState peer;
+    peer.name = "scout_2";
+    peer.mode = "scout/searching";
+    peer.position_m = Vec3(50, 0, 30);
+    const auto handed_over = [&] {
+      for (const raft::MissionCommand& c : rig.proposals()) {
+        if (std::holds_alternative<raft::AssignSectors>(c)) return true;
+      }
+      return false;
+    };
+    for (double t = 0.0; t < 10.0; t += 0.5) {
+      peer.sim_time_s = t;
+      peer.received_wall_s = rig.wall_s();
+      rig.host().OnPeerState(peer);
+      rig.Run(0.5, FlightMode::kVelocity, /*leader=*/true);
+    }
+    rig.Run(5.0, FlightMode::kVelocity, true);  // last state taken at 9.5 s: 5.5 s of silence
+    EXPECT_FALSE(handed_over());
+    rig.Run(1.5, FlightMode::kVelocity, true);  // 7 s simulated: 7 s wall at rtf 1, 0.7 s at 10x
+    if (speed_up == 1.0) {
+      EXPECT_TRUE(handed_over());
+      continue;
+    }
+    EXPECT_FALSE(handed_over());
+    rig.Run(21.0, FlightMode::kVelocity, true);  // 28 s simulated, 2.8 s wall
+    EXPECT_FALSE(handed_over());
+    rig.Run(3.0, FlightMode::kVelocity, true);   // 31 s simulated, 3.1 s wall
+    EXPECT_TRUE(handed_over());
   }
 }
 
