@@ -118,6 +118,11 @@ Status FakeDockerApi::RemoveNetwork(std::string_view id) {
   auto it = networks_.find(std::string(id));
   if (it == networks_.end()) return Error(ErrorCode::kNotFound, "no such network");
   calls_.push_back("remove-network " + it->second.name);
+  if (stale_endpoints > 0) {
+    --stale_endpoints;
+    return Error(ErrorCode::kUnavailable,
+                 "error while removing network: network " + it->second.name + " has active endpoints");
+  }
   for (const auto& [cid, c] : containers_) {
     for (const auto& e : c.spec.networks) {
       if (e.network == id) {

@@ -46,6 +46,9 @@ class FakeDockerApi : public docker::DockerApi {
   std::map<std::string, ContainerScript> scripts;
   // CreateNetwork answers "Pool overlaps" this many times first (another orchestrator won a race).
   int network_conflicts = 0;
+  // RemoveNetwork answers "has active endpoints" this many times first, though nothing is
+  // attached (Docker 20.10's stale endpoints, moby#43286).
+  int stale_endpoints = 0;
   // Exec answers by command text (argv joined with spaces); others exit 0 with no output.
   std::map<std::string, ExecAnswer> exec_answers;
   // Rendezvous, to show that calls overlap: StartContainer (StopContainer) of a component named

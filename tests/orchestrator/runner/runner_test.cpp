@@ -238,6 +238,27 @@ TEST_F(RunnerTest, SubnetConflictRetriesWithAnotherPair) {
   ExpectNothingLeft();
 }
 
+TEST_F(RunnerTest, AStaleEndpointIsWaitedOutAndOneThatStaysIsNamed) {
+  // Docker 20.10 refuses twice, then lets the network go: nothing is left.
+  api_.stale_endpoints = 2;
+  api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  ExpectNothingLeft();
+
+  // A stale endpoint that stays: the trial's outcome stands, the problem says what to do.
+  fs::remove_all(out_);
+  options_.run_id = "20261121-120000-abce";
+  api_.stale_endpoints = 1000;
+  RunOutcome stuck = Run();
+  EXPECT_EQ(stuck.result.verdict.outcome, dsl::Outcome::kSuccess) << stuck.result.verdict.ToString();
+  std::string problems;
+  for (const std::string& p : stuck.result.problems) problems += p + "\n";
+  EXPECT_THAT(problems, HasSubstr("moby#43286")) << problems;
+  EXPECT_THAT(problems, HasSubstr("swarmbox gc")) << problems;
+  EXPECT_TRUE(api_.Containers().empty());
+}
+
 TEST_F(RunnerTest, ABrokenLogStreamRestartsTheTrial) {
   // The first log stream of the scout breaks after one line; the restarted trial completes.
   api_.scripts["scout_1"].lines = {"t=1 node=scout_1 event=takeoff",
