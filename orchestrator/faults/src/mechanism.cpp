@@ -51,10 +51,6 @@ Status CheckMechanismSupports(const std::vector<RadioRule>& rules, Mechanism mec
     if (s.loss_correlation > 0.0) {
       return refuse("loss_correlation", "draws each loss independently with iptables statistic");
     }
-    if (s.duplicate > 0.0) {
-      return refuse("duplicate", "cannot duplicate packets (an NFQUEUE verdict passes a packet once; "
-                                 "a copy would have to be re-injected)");
-    }
   }
   return Ok{};
 }

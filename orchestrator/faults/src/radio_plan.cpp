@@ -141,6 +141,16 @@ bool Delays(const RadioRule* r) {
                           r->spec.corrupt > 0.0);
 }
 bool Drops(const RadioRule* r) { return r != nullptr && r->spec.loss > 0.0; }
+bool Duplicates(const RadioRule* r) { return r != nullptr && r->spec.duplicate > 0.0; }
+
+// netem "duplicate P" for packets to `peer`: iptables TEE clones a fraction P (statistic) and sends
+// the clone to the peer itself. The clone goes through OUTPUT again, where TEE leaves it alone
+// (nf_dup_ipv4 does not duplicate a duplicate) and the rule's NFQUEUE gives it its own delay, as
+// netem re-enqueues its clone.
+Argv Tee(const std::string& chain, const LinkTarget& link, const std::string& peer, double p) {
+  return Iptables({"-A", chain, "-d", PeerCidr(link, peer), "-m", "statistic", "--mode", "random", "--probability",
+                   detail::FormatDecimal(p, 6), "-j", "TEE", "--gateway", link.peer_ipv4.at(peer)});
+}
 
 RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanOptions& o) {
   RadioPlan plan;
@@ -194,14 +204,21 @@ RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanO
     undo_daemons.push_back(Cmd(NetemdStopArgv(o.netemd, args.pidfile)));
   }
 
-  // Egress chain: per-destination rules first (they win), the all-traffic rule last.
-  if (!queue_of.empty()) {
+  // Egress chain: per-destination rules first (they win), the all-traffic rule last; a rule's
+  // duplication (TEE) before its NFQUEUE, since an accepted packet leaves the chain.
+  const bool any_duplicate = Duplicates(s.all) || std::any_of(s.per.begin(), s.per.end(), Duplicates);
+  if (!queue_of.empty() || any_duplicate) {
     plan.apply.push_back(Cmd(Iptables({"-N", out_chain})));
     for (const RadioRule* r : s.per) {
       for (const auto& peer : r->to) {
+        if (Duplicates(r)) plan.apply.push_back(Cmd(Tee(out_chain, link, peer, r->spec.duplicate)));
         Argv rule = Iptables({"-A", out_chain, "-d", PeerCidr(link, peer)});
         plan.apply.push_back(Cmd(Delays(r) ? Concat(rule, Nfqueue(queue_of.at(r))) : Concat(rule, {"-j", "RETURN"})));
       }
+    }
+    if (Duplicates(s.all)) {
+      // Unicast to each known peer (TEE needs a gateway); multicast and broadcast are not duplicated.
+      for (const auto& [peer, ip] : link.peer_ipv4) plan.apply.push_back(Cmd(Tee(out_chain, link, peer, s.all->spec.duplicate)));
     }
     if (Delays(s.all)) plan.apply.push_back(Cmd(Concat(Iptables({"-A", out_chain}), Nfqueue(queue_of.at(s.all)))));
     plan.apply.push_back(Cmd(Iptables({"-I", "OUTPUT", "-o", dev, "-j", out_chain})));

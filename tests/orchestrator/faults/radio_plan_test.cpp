@@ -209,6 +209,45 @@ TEST(RadioPlan, UserspaceCorruptionIsDoneByTheDaemonOnEgress) {
                           "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid"));
 }
 
+TEST(RadioPlan, UserspaceDuplicationTeesToEachPeerBeforeTheQueue) {
+  // netem "duplicate 10%" for all traffic: one TEE per known peer (the clone is routed to the peer
+  // itself), before the NFQUEUE so the clone comes back through it for its own delay.
+  auto plan = PlanRadio(Rules("{delay_ms: 5, duplicate: 0.1}"), Link(), Mechanism::kUserspace);
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  const std::vector<std::string> lines = Lines(plan->apply);
+  ASSERT_EQ(lines.size(), 7u);
+  EXPECT_THAT(lines[0], ::testing::StartsWith("/usr/bin/swarmbox-netemd run --queue 0 --delay-us 5000 "));
+  EXPECT_THAT(std::vector<std::string>(lines.begin() + 1, lines.end()),
+              ElementsAre("iptables -w -N SWARMBOX-RADIO-OUT",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -d 10.77.2.12/32 -m statistic --mode random --probability 0.1 "
+                          "-j TEE --gateway 10.77.2.12",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -d 10.77.2.11/32 -m statistic --mode random --probability 0.1 "
+                          "-j TEE --gateway 10.77.2.11",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -d 10.77.2.13/32 -m statistic --mode random --probability 0.1 "
+                          "-j TEE --gateway 10.77.2.13",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -j NFQUEUE --queue-num 0 --queue-bypass",
+                          "iptables -w -I OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT"));
+  EXPECT_THAT(Lines(plan->undo),
+              ElementsAre("iptables -w -D OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT", "iptables -w -F SWARMBOX-RADIO-OUT",
+                          "iptables -w -X SWARMBOX-RADIO-OUT",
+                          "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid"));
+}
+
+TEST(RadioPlan, UserspaceDuplicationAloneNeedsNoDaemon) {
+  // Per destination, without delay: TEE then RETURN, no queue and no daemon.
+  auto plan = PlanRadio(Rules("rules:\n  - {to: [scout_2], duplicate: 0.05}\n"), Link(), Mechanism::kUserspace);
+  ASSERT_TRUE(plan) << plan.error().ToString();
+  EXPECT_THAT(Lines(plan->apply),
+              ElementsAre("iptables -w -N SWARMBOX-RADIO-OUT",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -d 10.77.2.11/32 -m statistic --mode random --probability 0.05 "
+                          "-j TEE --gateway 10.77.2.11",
+                          "iptables -w -A SWARMBOX-RADIO-OUT -d 10.77.2.11/32 -j RETURN",
+                          "iptables -w -I OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT"));
+  EXPECT_THAT(Lines(plan->undo),
+              ElementsAre("iptables -w -D OUTPUT -o eth1 -j SWARMBOX-RADIO-OUT", "iptables -w -F SWARMBOX-RADIO-OUT",
+                          "iptables -w -X SWARMBOX-RADIO-OUT"));
+}
+
 TEST(RadioPlan, UserspacePerDestinationRulesComeBeforeTheAllTrafficRule) {
   RadioPlanOptions options;
   options.seed = 7;
@@ -264,15 +303,14 @@ TEST(RadioPlan, UserspaceDaemonSeedsAreDerivedFromTheTrialSeed) {
 }
 
 TEST(RadioPlan, UserspaceRefusesWhatOnlyNetemCanDoWithTheReason) {
-  const auto rules = Rules("{delay_ms: 10, duplicate: 0.01}");
+  const auto rules = Rules("{delay_ms: 10, loss: 0.1, loss_correlation: 0.5}");
   auto plan = PlanRadio(rules, Link(), Mechanism::kUserspace);
   ASSERT_FALSE(plan);
   EXPECT_EQ(plan.error().code(), ErrorCode::kInvalidArgument);
   EXPECT_EQ(plan.error().where(), "trial.yaml:1:1");
   EXPECT_EQ(plan.error().message(),
-            "'duplicate' cannot be honoured on this host: the kernel has no sch_netem and the userspace "
-            "mechanism cannot duplicate packets (an NFQUEUE verdict passes a packet once; a copy would have "
-            "to be re-injected)");
+            "'loss_correlation' cannot be honoured on this host: the kernel has no sch_netem and the userspace "
+            "mechanism draws each loss independently with iptables statistic");
   EXPECT_TRUE(PlanRadio(rules, Link(), Mechanism::kKernelNetem));
 }
 

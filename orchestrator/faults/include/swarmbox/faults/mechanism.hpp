@@ -5,8 +5,9 @@
 //                 minikube, some cloud kernels, this project's machines): swarmbox-netemd on an
 //                 iptables NFQUEUE (delay, jitter, distribution, correlation, reordering,
 //                 Gilbert-Elliott loss drawn per packet, corruption: one bit flipped), iptables
-//                 `statistic` on INPUT for random loss, tbf (or htb classes per destination) for
-//                 rate. Refused here (it cannot): duplicate, loss_correlation.
+//                 `statistic` on INPUT for random loss, `statistic` + TEE on OUTPUT for
+//                 duplication (unicast to known peers), tbf (or htb classes per destination) for
+//                 rate. Refused here (it cannot): loss_correlation.
 //
 //   MechanismCache cache;
 //   auto m = cache.Get(host, [&] { return DetectMechanism(sidecar_runner); });

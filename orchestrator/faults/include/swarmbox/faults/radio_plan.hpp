@@ -23,6 +23,10 @@
 //                  started first), then chain SWARMBOX-RADIO-OUT (-d PEER for per-destination
 //                  rules, RETURN for peers whose rule has no delay) hooked from OUTPUT -o IF with
 //                  NFQUEUE --queue-bypass (traffic flows undelayed if the daemon dies);
+//   duplicate:     in SWARMBOX-RADIO-OUT before the rule's NFQUEUE, -d PEER -m statistic --mode
+//                  random --probability P -j TEE --gateway PEER (every known peer for the
+//                  all-traffic rule; multicast is not duplicated): the clone passes OUTPUT again,
+//                  is not cloned again, and gets its own delay from the daemon, as netem's does.
 //   loss on ingress: chain SWARMBOX-RADIO-IN hooked from INPUT -i IF, -m statistic --mode random
 //                  --probability P -j DROP (-s PEER per destination): on ingress the sender never sees
 //                  EPERM. So for one target, delay acts on what it sends and loss on what it
