@@ -213,10 +213,10 @@ TEST_F(FaultRunnerTest, MechanismIsDetectedOncePerHost) {
 }
 
 TEST_F(FaultRunnerTest, SpecTheMechanismCannotHonourIsRefusedBeforeAnyAgentStarts) {
-  spec_.Mesh("{delay_ms: 20, duplicate: 0.01}");
+  spec_.Mesh("{delay_ms: 20, loss: 0.1, loss_correlation: 0.5}");
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
-  EXPECT_THAT(run.result.verdict.reason, HasSubstr("'duplicate' cannot be honoured on this host"));
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("'loss_correlation' cannot be honoured on this host"));
   const auto calls = api_.Calls();
   EXPECT_EQ(IndexOfExact(calls, "start " + Name("scout_1")), calls.size());
   EXPECT_EQ(IndexOfExact(calls, "start " + Name("scout_2")), calls.size());
