@@ -55,10 +55,10 @@ int ExperimentCommand(const ExperimentArgs& args) {
   }
   const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
   // Held until this process ends, however it ends: `swarmbox gc` leaves a live experiment alone.
-  auto lock = RunLock::Acquire(run_id);
-  if (!lock) {
-    std::cerr << "swarmbox experiment: " << lock.error().ToString() << "\n";
-    return lock.error().code() == ErrorCode::kUnavailable ? kExitUsage : kExitInfrastructure;
+  auto run_lock = RunLock::Acquire(run_id);
+  if (!run_lock) {
+    std::cerr << "swarmbox experiment: " << run_lock.error().ToString() << "\n";
+    return run_lock.error().code() == ErrorCode::kUnavailable ? kExitUsage : kExitInfrastructure;
   }
   const std::string out = args.out.empty() ? "runs/" + spec->name + "-" + run_id : args.out;
   if (auto checked = experiment::CheckOutFolder(*plan, out, args.resume); !checked) {

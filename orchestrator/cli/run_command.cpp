@@ -38,10 +38,10 @@ int RunCommand(const RunArgs& args) {
   }
   // Held until this process ends, however it ends: `swarmbox gc` leaves a live run alone.
   const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
-  auto lock = RunLock::Acquire(run_id);
-  if (!lock) {
-    std::cerr << "swarmbox run: " << lock.error().ToString() << "\n";
-    return lock.error().code() == ErrorCode::kUnavailable ? kExitUsage : kExitInfrastructure;
+  auto run_lock = RunLock::Acquire(run_id);
+  if (!run_lock) {
+    std::cerr << "swarmbox run: " << run_lock.error().ToString() << "\n";
+    return run_lock.error().code() == ErrorCode::kUnavailable ? kExitUsage : kExitInfrastructure;
   }
   runner::SteadyClock clock;
   runner::RunOptions options;
