@@ -100,7 +100,7 @@ TEST_F(PlanTest, EndConditionsAndTimeoutComeFromTheTrial) {
 TEST_F(PlanTest, PayloadsComeFromTheAirframe) {
   auto ok = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
   ASSERT_TRUE(ok) << ok.error().ToString();
-  EXPECT_EQ(ok->at("x8_heavy/stretcher"), 80.0);
+  EXPECT_EQ(ok->at("x8_heavy/stretcher"), 15.0);  // empty; loaded, payload_attach makes it 80 kg
   spec_.drones[3].payload = "piano";
   auto masses = LoadPayloadMasses(spec_, std::string(SWARMBOX_SOURCE_DIR) + "/trials");
   ASSERT_FALSE(masses);
