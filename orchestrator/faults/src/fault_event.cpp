@@ -110,6 +110,7 @@ std::string FaultEventJson(const Fault& fault, const FaultEventRecord& record) {
   root.Set("mechanism", str(record.mechanism));
   root.Set("spec", str(DescribeFault(fault)));
   if (record.phase == FaultPhase::kFailed) root.Set("error", str(record.error));
+  if (!record.note.empty()) root.Set("note", str(record.note));
   return yaml::EmitJson(root);
 }
 
@@ -132,6 +133,7 @@ std::string MeshEventJson(const std::string& node, const std::vector<RadioRule>&
   root.Set("mechanism", str(record.mechanism));
   root.Set("spec", str(spec));
   if (record.phase == FaultPhase::kFailed) root.Set("error", str(record.error));
+  if (!record.note.empty()) root.Set("note", str(record.note));
   return yaml::EmitJson(root);
 }
 

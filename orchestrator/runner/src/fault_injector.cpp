@@ -16,6 +16,10 @@ using faults::TimelineAction;
 namespace {
 
 constexpr std::string_view kPhysicsMechanism = "physics-command";
+// events.jsonl notes for what the end of a trial leaves to the containers' removal (Remove,
+// Teardown).
+constexpr std::string_view kWithNamespace = "with the sidecar's network namespace";
+constexpr std::string_view kWithPhysics = "with the physics server";
 
 std::string MechanismEventJson(const std::string& host, faults::Mechanism mechanism, bool cached,
                                double wall_s) {
@@ -309,19 +313,31 @@ Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record)
                f.mark.ToString());
 }
 
-Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record) {
+Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record, bool trial_end) {
   const faults::Fault& f = timeline_.faults()[index];
   if (auto t = targets_.find(index); t != targets_.end()) record->targets = t->second;
   if (std::holds_alternative<faults::RadioFault>(f.action)) {
     if (mechanism_) record->mechanism = std::string(faults::MechanismName(*mechanism_));
     const auto before = installed_;
     const auto changed = layers_.Pop(f.id);
+    if (trial_end) {
+      // Its qdiscs, iptables chains and delay daemons live in the sidecars' network namespaces
+      // (the daemons are processes of the sidecars): they go when the sidecars stop, right after.
+      for (const std::string& drone : changed) installed_[drone] = layers_.Effective(drone);
+      record->note = std::string(kWithNamespace);
+      return Ok{};
+    }
     return ChangeRadio(before, changed);
   }
   if (std::holds_alternative<faults::PartitionFault>(f.action)) {
     record->mechanism = "iptables";
     auto it = partitions_.find(index);
     if (it == partitions_.end()) return Ok{};
+    if (trial_end) {  // iptables chains in the sidecars' namespaces, as above
+      partitions_.erase(it);
+      record->note = std::string(kWithNamespace);
+      return Ok{};
+    }
     Status first = RunOnSidecars(it->second.undo, /*run_all=*/true);
     partitions_.erase(it);
     return first;
@@ -359,18 +375,22 @@ Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record
     if (it == physics_.end()) return Ok{};
     const std::vector<faults::WorldCommandCall> undo = it->second.undo;
     physics_.erase(it);
+    if (trial_end) {  // the physics server stops with the trial: its world state goes with it
+      if (!undo.empty()) record->note = std::string(kWithPhysics);
+      return Ok{};
+    }
     return SendToPhysics(undo);
   }
   return Ok{};
 }
 
-std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& actions) {
+std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& actions, bool trial_end) {
   std::optional<Verdict> failure;
   for (const TimelineAction& action : actions) {
     const faults::Fault& f = timeline_.faults()[action.fault];
     const bool apply = action.kind == TimelineAction::Kind::kApply;
     faults::FaultEventRecord record = Record(apply ? FaultPhase::kApplied : FaultPhase::kRemoved);
-    Status s = apply ? Apply(action.fault, &record) : Remove(action.fault, &record);
+    Status s = apply ? Apply(action.fault, &record) : Remove(action.fault, &record, trial_end);
     if (!s) {
       record.phase = FaultPhase::kFailed;
       record.error = s.error().ToString();
@@ -388,16 +408,17 @@ std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& a
 std::optional<Verdict> FaultInjector::OnLogLine(const std::string& /*component*/, const std::string& line) {
   if (torn_down_) return std::nullopt;
   leaders_.Feed(line);
-  return Carry(timeline_.OnLogLine(line, wall_s_ ? wall_s_() : 0.0));
+  return Carry(timeline_.OnLogLine(line, wall_s_ ? wall_s_() : 0.0), /*trial_end=*/false);
 }
 
 std::optional<Verdict> FaultInjector::Advance() {
   if (torn_down_) return std::nullopt;
-  return Carry(timeline_.Advance(sim_s_ ? sim_s_() : 0.0, wall_s_ ? wall_s_() : 0.0));
+  return Carry(timeline_.Advance(sim_s_ ? sim_s_() : 0.0, wall_s_ ? wall_s_() : 0.0),
+               /*trial_end=*/false);
 }
 
 Verdict FaultInjector::RemoveActive() {
-  auto failure = Carry(timeline_.RemoveAll());
+  auto failure = Carry(timeline_.RemoveAll(), /*trial_end=*/true);
   if (failure) {
     problems_.push_back(failure->reason);
     return *failure;
@@ -410,35 +431,21 @@ Verdict FaultInjector::Teardown() {
   Verdict v = RemoveActive();
   torn_down_ = true;
   if (!mechanism_) return v;
-  // Every sidecar at once, recorded in trial order.
-  std::vector<std::pair<std::string, std::future<Status>>> jobs;
+  // network.mesh is not undone command by command (it was ~1.3 s of a SAR trial's teardown under
+  // load, every sidecar running its iptables -D/-F/-X, tc and `swarmbox-netemd stop` one after
+  // another): every rule sits in the sidecar's network namespace (eth1's qdiscs, the iptables
+  // chains and NFQUEUE rules) and the delay daemons are processes of the sidecar, so all of it
+  // goes when the sidecar stops, which the tree does right after this Step (the agent, which
+  // shares the namespace, has stopped before it). Nothing of it is on the host: a crash before
+  // this point leaves only labelled containers, which `swarmbox gc` removes with their namespaces.
   for (const std::string& drone : config_.drones) {
     auto it = installed_.find(drone);
     if (it == installed_.end() || it->second.empty()) continue;
-    faults::CommandRunner& sidecar = Sidecar(drone);
-    auto plan = faults::PlanRadio(it->second, LinkOf(drone), *mechanism_, PlanOptions());
-    if (!plan) {
-      std::promise<Status> failed;
-      failed.set_value(plan.error());
-      jobs.emplace_back(drone, failed.get_future());
-      continue;
-    }
-    jobs.emplace_back(drone, std::async(std::launch::async, [&sidecar, commands = plan->undo] {
-                        return faults::RunAllCommands(sidecar, commands);
-                      }));
-  }
-  for (auto& [drone, job] : jobs) {
-    const Status s = job.get();
     faults::FaultEventRecord record = Record(FaultPhase::kRemoved);
     record.mechanism = std::string(faults::MechanismName(*mechanism_));
-    if (!s) {
-      record.phase = FaultPhase::kFailed;
-      record.error = s.error().ToString();
-      problems_.push_back("undoing the radio rules on " + drone + ": " + s.error().ToString());
-      v.KeepWorse(Verdict::FromError(s.error().Context("undoing the radio rules on " + drone), "faults"));
-    }
-    if (events_) events_(faults::MeshEventJson(drone, installed_[drone], record));
-    installed_.erase(drone);
+    record.note = std::string(kWithNamespace);
+    if (events_) events_(faults::MeshEventJson(drone, it->second, record));
+    installed_.erase(it);
   }
   return v;
 }

@@ -1,7 +1,8 @@
 // Faults carried out by the runner, against FakeDockerApi (exec answered from a script, kill/pause/
 // restart modelled): the fault sidecars (one per agent, owning its network namespace, the only
 // container with NET_ADMIN), the mechanism detected through a sidecar, network.mesh applied before
-// the agents start and undone at teardown, timeline triggers (sim time, log events), partitions,
+// the agents start and left to the sidecars' namespaces at teardown (no undo command: the rules
+// die with the namespace), fault windows ending mid-trial undone explicitly, timeline triggers (sim time, log events), partitions,
 // process faults on the Raft leader, refusals and failures, and that nothing is left on any path.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -133,7 +134,7 @@ class FaultRunnerTest : public ::testing::Test {
   testing::FakeDockerApi api_;
 };
 
-TEST_F(FaultRunnerTest, MeshImpairmentIsAppliedFromSidecarsBeforeTheAgentsStartAndUndoneAtTeardown) {
+TEST_F(FaultRunnerTest, MeshImpairmentIsAppliedFromSidecarsBeforeTheAgentsStartAndGoesWithTheirNamespaces) {
   spec_.Mesh("{delay_ms: 100, jitter_ms: 20, loss: 0.05}");
   api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=3.000 node=physics event=done"};
   RunOutcome run = Run();
@@ -179,12 +180,16 @@ TEST_F(FaultRunnerTest, MeshImpairmentIsAppliedFromSidecarsBeforeTheAgentsStartA
               IndexOfExact(calls, "start " + Name(d)));
     EXPECT_LT(IndexOf(calls, in + "iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.05 -j DROP"),
               calls.size());
-    // Teardown: the undo runs after the agent stopped and before its sidecar is removed.
-    const std::size_t undo = IndexOf(calls, in + "/usr/bin/swarmbox-netemd stop --pidfile /run/swarmbox-netemd-0.pid");
-    ASSERT_LT(undo, calls.size()) << d;
-    EXPECT_LT(IndexOfExact(calls, "stop " + Name(d)), undo);
-    EXPECT_LT(undo, IndexOfExact(calls, "remove " + Name(d + "-faults")));
-    EXPECT_LT(IndexOf(calls, in + "iptables -w -D INPUT -i eth1 -j SWARMBOX-RADIO-IN"), calls.size());
+    // Teardown: nothing is exec'd in the sidecar once its agent stopped (no iptables -D, no
+    // `swarmbox-netemd stop`): the rules and the daemons go when the sidecar stops, after the agent.
+    const std::size_t agent_stop = IndexOfExact(calls, "stop " + Name(d));
+    const std::size_t sidecar_stop = IndexOfExact(calls, "stop " + Name(d + "-faults"));
+    ASSERT_LT(agent_stop, calls.size()) << d;
+    ASSERT_LT(sidecar_stop, calls.size()) << d;
+    EXPECT_LT(agent_stop, sidecar_stop);
+    EXPECT_LT(LastIndexOf(calls, in), agent_stop) << ::testing::PrintToString(calls);
+    EXPECT_THAT(Matching(calls, in + "/usr/bin/swarmbox-netemd stop"), ::testing::IsEmpty());
+    EXPECT_THAT(Matching(calls, in + "iptables -w -D "), ::testing::IsEmpty());
   }
   // The sim link (eth0) is never touched.
   EXPECT_THAT(Matching(calls, "eth0"), ::testing::IsEmpty());
@@ -197,6 +202,7 @@ TEST_F(FaultRunnerTest, MeshImpairmentIsAppliedFromSidecarsBeforeTheAgentsStartA
     EXPECT_THAT(events, HasSubstr("{\"type\":\"mesh\",\"phase\":\"removed\",\"node\":\"" + d + "\""));
   }
   EXPECT_THAT(events, HasSubstr("\"mechanism\":\"userspace-nfqueue\",\"spec\":\"delay_ms=100 jitter_ms=20 loss=0.05\""));
+  EXPECT_THAT(events, HasSubstr("\"spec\":\"delay_ms=100 jitter_ms=20 loss=0.05\",\"note\":\"with the sidecar's network namespace\"}"));
 }
 
 TEST_F(FaultRunnerTest, MechanismIsDetectedOncePerHost) {
@@ -318,7 +324,7 @@ TEST_F(FaultRunnerTest, AFaultThatCannotBeCarriedOutEndsTheTrialWithErrorAndTear
   ExpectNothingLeft();
 }
 
-TEST_F(FaultRunnerTest, InterruptedRunStillUndoesEverything) {
+TEST_F(FaultRunnerTest, InterruptedRunLeavesNothingAndExecsNoUndoInTheSidecars) {
   spec_.Mesh("{delay_ms: 50}");
   spec_.Fault("{name: fade, at: 1s, radio: {target: scout_1, loss: 0.3}}");
   api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=tick"};
@@ -339,13 +345,76 @@ TEST_F(FaultRunnerTest, InterruptedRunStillUndoesEverything) {
   EXPECT_EQ(run->result.verdict.outcome, dsl::Outcome::kError);
   EXPECT_THAT(run->result.verdict.reason, HasSubstr("interrupted"));
   const auto calls = api_.Calls();
-  // The fault's rules were replaced by the mesh rules again, then the mesh rules removed.
-  const std::string in = "exec " + Name("scout_1-faults") + " ";
-  EXPECT_LT(IndexOf(calls, in + "iptables -w -D INPUT -i eth1 -j SWARMBOX-RADIO-IN"), calls.size());
-  EXPECT_LT(LastIndexOf(calls, in + "/usr/bin/swarmbox-netemd stop"), IndexOfExact(calls, "remove " + Name("scout_1-faults")));
+  // Neither the fault nor the mesh rules were undone command by command: nothing was exec'd in
+  // a sidecar once the agents stopped (scout_1's -D and `netemd stop` calls are the fault's
+  // apply, which swaps the mesh rules for the fault's), and the sidecars (with them their
+  // namespaces) were stopped and removed.
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    const std::string in = "exec " + Name(d + "-faults") + " ";
+    const std::size_t agent_stop = IndexOfExact(calls, "stop " + Name(d));
+    ASSERT_LT(agent_stop, calls.size()) << d;
+    EXPECT_LT(LastIndexOf(calls, in), agent_stop) << d << ": " << ::testing::PrintToString(calls);
+    EXPECT_LT(IndexOfExact(calls, "remove " + Name(d + "-faults")), calls.size()) << d;
+  }
+  EXPECT_THAT(Matching(calls, "exec " + Name("scout_2-faults") + " iptables -w -D "), ::testing::IsEmpty());
   const std::string events = Events(*run);
   EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"fade\""));
   EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"fade\""));
+  EXPECT_THAT(events, HasSubstr("\"spec\":\"loss=0.3\",\"note\":\"with the sidecar's network namespace\"}"));
+  EXPECT_THAT(events, HasSubstr("{\"type\":\"mesh\",\"phase\":\"removed\",\"node\":\"scout_1\""));
+  EXPECT_THAT(events, Not(HasSubstr("\"phase\":\"failed\"")));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, ARadioFaultWindowEndingMidTrialIsUndoneInTheSidecarWhileTheTrialGoesOn) {
+  spec_.Mesh("{delay_ms: 50}");
+  spec_.Fault("{name: fade, at: 1s, duration: 1s, radio: {target: scout_1, loss: 0.3}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=tick",
+                                   "t=3.000 node=physics event=tick", "t=4.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto calls = api_.Calls();
+  const std::string in = "exec " + Name("scout_1-faults") + " ";
+  const std::size_t fade = IndexOf(calls, in + "iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.3");
+  ASSERT_LT(fade, calls.size()) << ::testing::PrintToString(calls);
+  // At 3 s the fault's rules are replaced by the mesh rules again (its chain unhooked, its
+  // daemon stopped, the mesh's started), all before the agent stops.
+  const std::size_t agent_stop = IndexOfExact(calls, "stop " + Name("scout_1"));
+  const std::size_t unhook = IndexOf(calls, in + "iptables -w -D INPUT -i eth1 -j SWARMBOX-RADIO-IN");
+  const std::size_t daemon_stop = IndexOf(calls, in + "/usr/bin/swarmbox-netemd stop");
+  ASSERT_LT(unhook, calls.size()) << ::testing::PrintToString(calls);
+  ASSERT_LT(daemon_stop, calls.size()) << ::testing::PrintToString(calls);
+  EXPECT_LT(fade, unhook);
+  EXPECT_LT(unhook, agent_stop);
+  EXPECT_LT(daemon_stop, agent_stop);
+  EXPECT_LT(LastIndexOf(calls, in + "/usr/bin/swarmbox-netemd run"), agent_stop);
+  // The other drone's radio was never touched after the set-up.
+  EXPECT_THAT(Matching(calls, "exec " + Name("scout_2-faults") + " iptables -w -D "), ::testing::IsEmpty());
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"fade\",\"kind\":\"radio\",\"start\":\"at 1s\",\"t_sim_s\":3,"));
+  // Removed in the sidecar, not with the namespace: no note on the fault's record.
+  EXPECT_THAT(events, HasSubstr("\"spec\":\"loss=0.3 duration=1s\"}"));
+  EXPECT_THAT(events, Not(HasSubstr("\"phase\":\"failed\"")));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, APartitionStillActiveAtTheEndGoesWithTheSidecarsNamespaces) {
+  spec_.Fault("{name: split, at: 2s, partition: {groups: [[scout_1], [scout_2]]}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=2.500 node=physics event=tick",
+                                   "t=3.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto calls = api_.Calls();
+  for (const std::string d : {"scout_1", "scout_2"}) {
+    const std::string in = "exec " + Name(d + "-faults") + " iptables -w ";
+    EXPECT_LT(IndexOf(calls, in + "-I INPUT -i eth1 -j SWARMBOX-PART-0"), calls.size()) << d;
+    EXPECT_THAT(Matching(calls, in + "-D "), ::testing::IsEmpty()) << d;
+    EXPECT_THAT(Matching(calls, in + "-X "), ::testing::IsEmpty()) << d;
+    EXPECT_LT(IndexOfExact(calls, "stop " + Name(d)), IndexOfExact(calls, "stop " + Name(d + "-faults"))) << d;
+  }
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"split\""));
+  EXPECT_THAT(events, HasSubstr("\"mechanism\":\"iptables\",\"spec\":\"groups=[[scout_1], [scout_2]] oneway=false\",\"note\":\"with the sidecar's network namespace\"}"));
   ExpectNothingLeft();
 }
 
@@ -444,6 +513,22 @@ TEST_F(FaultRunnerTest, WithoutFaultsNoSidecarIsCreated) {
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
   EXPECT_THAT(api_.Calls(), Not(::testing::Contains(HasSubstr("-faults"))));
   EXPECT_THAT(api_.Calls(), Not(::testing::Contains(HasSubstr("exec "))));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, AnImuBiasStillActiveAtTheEndIsNotTakenBack) {
+  spec_.Fault("{name: bias, at: 1s, duration: 60s, imu_bias: {target: scout_1, accel_mps2: [0.3, 0, 0]}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=clock",
+                                   "t=3.000 node=physics event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const auto calls = api_.Calls();
+  // The jump, and no negated one: the physics server stops with the trial.
+  EXPECT_EQ(Matching(calls, "--send-command").size(), 1u) << ::testing::PrintToString(calls);
+  EXPECT_LT(IndexOf(calls, "exec " + Name("physics") + " " + kSend + "scout_1 imu_bias_jump 0.3 0 0"), calls.size());
+  const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"bias\""));
+  EXPECT_THAT(events, HasSubstr("\"note\":\"with the physics server\"}"));
   ExpectNothingLeft();
 }
 

@@ -6,7 +6,9 @@
 //    "t_sim_s":30.012,"wall_s":31.4,"targets":["scout_1"],"mechanism":"userspace-nfqueue",
 //    "spec":"delay_ms=100 jitter_ms=20 distribution=normal loss=0.05"}
 //
-// "error" is added for phase "failed". Mechanisms: "netem", "userspace-nfqueue" (radio), "iptables"
+// "error" is added for phase "failed"; "note" when the record says how something was done, e.g. a
+// removal at the end of the trial left to the sidecar's removal (the rules die with its network
+// namespace; fault_injector.hpp). Mechanisms: "netem", "userspace-nfqueue" (radio), "iptables"
 // (partition), "docker" (kill/stop/pause/restart), "physics-command" (sensor and environment faults).
 #pragma once
 
@@ -33,6 +35,8 @@ struct FaultEventRecord {
   std::vector<std::string> targets;
   std::string mechanism;
   std::string error;     // kFailed only
+  std::string note;      // optional, any phase: how it was done when that is not the mechanism's
+                         // usual way (e.g. "with the sidecar's network namespace")
 };
 
 // One line of events.jsonl (no trailing newline).

@@ -14,9 +14,17 @@
 //     exec'd in the physics container, one per target at once, exit code checked;
 //     physics_plan.hpp). A fault that cannot be carried out (no leader elected yet, tc/iptables
 //     failing, no physics server matched...) returns an error verdict.
-//   - RemoveActive() (before the tree stops) and Teardown() (the Step's Stop): undo every active
-//     fault (newest first), then the mesh block on every sidecar. Removing the sidecars afterwards
-//     takes their namespaces' leftovers with them.
+//   - RemoveActive() (before the tree stops) and Teardown() (the Step's Stop): end every active
+//     fault (newest first), then the mesh block on every sidecar. Both run only when the whole
+//     tree stops (the trial's end, or a restart, which stops and removes every container), so
+//     what lives in a sidecar's network namespace (network.mesh, radio faults, partitions: tc
+//     qdiscs, iptables chains, NFQUEUE rules and the swarmbox-netemd daemons, processes of the
+//     sidecar) is not undone command by command: it goes with the namespace when the sidecar
+//     stops right after, and is recorded "removed" with a note saying so. Sensor and
+//     environment faults end with the physics server the same way. Process faults are still
+//     undone (a paused agent is unpaused so it can stop; a killed one started again). A fault
+//     whose window ends mid-trial (Advance, OnLogLine) is always undone explicitly: the trial
+//     goes on.
 // Every apply/remove/failure is one events.jsonl line (FaultEventJson / MeshEventJson, with the
 // mechanism); the detection is one line {"type":"mechanism",...}.
 //
@@ -81,9 +89,12 @@ class FaultInjector {
   std::optional<dsl::Verdict> OnLogLine(const std::string& component, const std::string& line);
   // Often (every watch-loop turn): `at`/`at_wall` starts and the ends of durations.
   std::optional<dsl::Verdict> Advance();
-  // Undoes every active fault, newest first (best effort; failures are recorded and returned).
+  // At the end of the tree (trial end or restart; see the banner): ends every active fault,
+  // newest first, leaving what dies with the sidecars' namespaces and the physics server to them
+  // (best effort; failures are recorded and returned).
   dsl::Verdict RemoveActive();
-  // RemoveActive, then the mesh block on every sidecar. Idempotent.
+  // RemoveActive, then records network.mesh removed with the namespaces. Idempotent. Call it only
+  // when the sidecars are stopped right after (the tree's Step does).
   dsl::Verdict Teardown();
 
   bool Disrupted(const std::string& component) const { return disrupted_.count(component) != 0; }
@@ -94,9 +105,10 @@ class FaultInjector {
   const std::vector<std::string>& problems() const { return problems_; }
 
  private:
-  std::optional<dsl::Verdict> Carry(const std::vector<faults::TimelineAction>& actions);
+  // trial_end: the removals come from RemoveActive (see the banner).
+  std::optional<dsl::Verdict> Carry(const std::vector<faults::TimelineAction>& actions, bool trial_end);
   Status Apply(std::size_t index, faults::FaultEventRecord* record);
-  Status Remove(std::size_t index, faults::FaultEventRecord* record);
+  Status Remove(std::size_t index, faults::FaultEventRecord* record, bool trial_end);
   Status ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,
                      const std::vector<std::string>& changed);
   // Runs each drone's commands in its sidecar, all sidecars concurrently (RunCommands, or
