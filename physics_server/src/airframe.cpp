@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "detail/yaml_read.hpp"
+#include "sensor_models.hpp"
 
 namespace swarmbox::physics {
 namespace {
@@ -75,11 +76,48 @@ void ReadSensors(MapReader& parent, Airframe* af) {
           .NonNegative("noise_std_gauss", &af->mag.noise_std_gauss);
     });
     Nested(r, "gps", "gps", false, [af](MapReader& s, const Node& m) {
+      std::string fix = "standalone";
+      s.Optional("fix", &fix);
+      if (s.ok() && fix != "standalone" && fix != "rtk") {
+        s.Fail(Error(ErrorCode::kInvalidArgument,
+                     "gps fix must be 'standalone' or 'rtk' (got '" + fix + "')", m.Find("fix")->Where()));
+        return;
+      }
       Checked(s, m)
           .Positive("rate_hz", &af->gps.rate_hz, false)
-          .NonNegative("horizontal_std_m", &af->gps.horizontal_std_m)
-          .NonNegative("vertical_std_m", &af->gps.vertical_std_m)
           .NonNegative("velocity_std_m_s", &af->gps.velocity_std_m_s);
+      if (fix == "standalone") {
+        Checked(s, m)
+            .NonNegative("horizontal_std_m", &af->gps.horizontal_std_m)
+            .NonNegative("vertical_std_m", &af->gps.vertical_std_m);
+        if (s.ok() && m.Find("rtk_baseline_km") != nullptr) {
+          s.Fail(Error(ErrorCode::kInvalidArgument, "gps rtk_baseline_km needs fix: rtk",
+                       m.Find("rtk_baseline_km")->Where()));
+        }
+        return;
+      }
+      // RTK: the accuracy is the receiver's datasheet figure for the baseline, not a free number.
+      for (const char* key : {"horizontal_std_m", "vertical_std_m"}) {
+        if (s.ok() && m.Find(key) != nullptr) {
+          s.Fail(Error(ErrorCode::kInvalidArgument,
+                       std::string("gps ") + key + " is set by the RTK receiver model with fix: rtk "
+                           "(0.01 m + 1 ppm of rtk_baseline_km); leave it out",
+                       m.Find(key)->Where()));
+        }
+      }
+      double baseline_km = af->gps.rtk_baseline_km;
+      Checked(s, m).NonNegative("rtk_baseline_km", &baseline_km);
+      if (s.ok() && baseline_km > 100.0) {
+        s.Fail(Error(ErrorCode::kInvalidArgument,
+                     "gps rtk_baseline_km must be at most 100 (RTK needs a base within tens of km)",
+                     m.Find("rtk_baseline_km")->Where()));
+      }
+      if (s.ok() && af->gps.rate_hz > kRtkMaxRateHz) {
+        s.Fail(Error(ErrorCode::kInvalidArgument,
+                     "gps rate_hz must be at most 20 with fix: rtk (the ZED-F9P's RTK navigation rate)",
+                     m.Find("rate_hz")->Where()));
+      }
+      SetRtkFix(&af->gps, baseline_km);
     });
     (void)n;
   });
@@ -176,6 +214,14 @@ Result<Airframe> ParseAirframe(const yaml::Node& root, std::string source) {
     return fail("impact", "crash_speed_m_s must be >= hard_landing_speed_m_s");
   }
   return af;
+}
+
+void SetRtkFix(GpsSpec* gps, double baseline_km) {
+  const GpsErrorModel::Accuracy a = GpsErrorModel::RtkAccuracy(baseline_km);
+  gps->fix = GpsFix::kRtk;
+  gps->rtk_baseline_km = baseline_km;
+  gps->horizontal_std_m = a.h;
+  gps->vertical_std_m = a.v;
 }
 
 Result<Airframe> LoadAirframe(const std::string& path) {

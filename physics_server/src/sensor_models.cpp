@@ -48,6 +48,29 @@ GpsErrorModel::Split GpsErrorModel::SplitFor(double total_h_m, double total_v_m)
   return s;
 }
 
+GpsErrorModel::Accuracy GpsErrorModel::RtkAccuracy(double baseline_km) {
+  const double err = kRtkConstantM + kRtkPpm * std::max(0.0, baseline_km) * 1000.0;
+  return {err / kCepPerSigma, err / kR50PerSigma};
+}
+
+GpsErrorModel::Split GpsErrorModel::RtkSplit(double baseline_km) {
+  const Accuracy total = RtkAccuracy(baseline_km);
+  const Accuracy constant = RtkAccuracy(0.0);
+  Split s{};
+  s.white_h = kRtkWhiteHStdM;
+  s.white_v = kRtkWhiteVStdM;
+  s.wander_h = std::sqrt(constant.h * constant.h - s.white_h * s.white_h);
+  s.wander_v = std::sqrt(constant.v * constant.v - s.white_v * s.white_v);
+  s.slow_h = std::sqrt(std::max(0.0, total.h * total.h - constant.h * constant.h));
+  s.slow_v = std::sqrt(std::max(0.0, total.v * total.v - constant.v * constant.v));
+  return s;
+}
+
+GpsErrorModel::Split GpsErrorModel::SplitForSpec(const GpsSpec& spec) {
+  return spec.fix == GpsFix::kRtk ? RtkSplit(spec.rtk_baseline_km)
+                                  : SplitFor(spec.horizontal_std_m, spec.vertical_std_m);
+}
+
 GpsErrorModel::Split GpsErrorModel::Scaled(const Split& s, double ratio_h, double ratio_v) {
   return {s.slow_h * ratio_h, s.slow_v * ratio_v, s.wander_h * ratio_h,
           s.wander_v * ratio_v, s.white_h * ratio_h, s.white_v * ratio_v};
@@ -87,7 +110,7 @@ SensorSuite::SensorSuite(const Airframe& airframe, const WorldConfig& world, std
       world_(&world),
       rng_(seed),
       gps_error_(MixSeed(seed, 0x6A5)),
-      gps_split_(GpsErrorModel::SplitFor(airframe.gps.horizontal_std_m, airframe.gps.vertical_std_m)) {
+      gps_split_(GpsErrorModel::SplitForSpec(airframe.gps)) {
   accel_bias_ = {Gauss(imu_.accel_bias_std_m_s2), Gauss(imu_.accel_bias_std_m_s2), Gauss(imu_.accel_bias_std_m_s2)};
   gyro_bias_ = {Gauss(imu_.gyro_bias_std_rad_s), Gauss(imu_.gyro_bias_std_rad_s), Gauss(imu_.gyro_bias_std_rad_s)};
   imu_period_ns_ = PeriodNs(imu_.rate_hz);
@@ -181,7 +204,7 @@ void SensorSuite::SetGpsAccuracy(double horizontal_std_m, double vertical_std_m)
   // Degraded: the airframe's split scaled (an airframe without GPS noise: split afresh).
   const double nh = gps_nominal_.horizontal_std_m, nv = gps_nominal_.vertical_std_m;
   if (nh > 0 && nv > 0) {
-    gps_split_ = GpsErrorModel::Scaled(GpsErrorModel::SplitFor(nh, nv), gps_.horizontal_std_m / nh,
+    gps_split_ = GpsErrorModel::Scaled(GpsErrorModel::SplitForSpec(gps_nominal_), gps_.horizontal_std_m / nh,
                                        gps_.vertical_std_m / nv);
   } else {
     gps_split_ = GpsErrorModel::SplitFor(gps_.horizontal_std_m, gps_.vertical_std_m);

@@ -45,6 +45,27 @@ struct TrueKinematics {
 // degraded accuracy (SetGpsAccuracy) scales the airframe's split by new / nominal. The states
 // start in their stationary distribution, from their own generator. Advance once per fix; no
 // allocation.
+//
+// RTK fixed (GpsFix::kRtk, `fix: rtk`): a u-blox ZED-F9P, the receiver of Holybro's H-RTK F9P for
+// the X500, with corrections from a base station rtk_baseline_km away. Datasheet (u-blox ZED-F9P
+// Data sheet, UBX-17051259, "Performance"; ZED-F9P Integration manual UBX-18010802 R13, section
+// 1 / RTK performance): RTK horizontal accuracy 0.01 m + 1 ppm CEP, vertical 0.01 m + 1 ppm R50,
+// navigation update rate up to 20 Hz (kRtkMaxRateHz), velocity 0.05 m/s. Per axis: a circular
+// Gaussian's CEP is sqrt(2 ln 2) sigma = 1.1774 sigma, a 1-D R50 0.6745 sigma, so at 1 km
+// (0.011 m) sigma_h = 0.0093 m and sigma_v = 0.0163 m (RtkAccuracy). The same three processes
+// carry it, split as real RTK error is:
+//  * white per fix: the carrier-phase noise of a fixed solution, ~1% of the ~0.19 m L1
+//    wavelength per satellite (~2 mm) times the DOPs: kRtkWhiteHStdM = 0.004 m, kRtkWhiteVStdM
+//    = 0.007 m;
+//  * wander (60 s, as above): carrier-phase multipath and antenna phase-centre residuals, the
+//    rest of the baseline-independent 0.01 m (0.0075 m per horizontal axis, 0.013 m vertically);
+//  * slow (1800 s): the baseline term, 1 ppm of differential ionosphere/troposphere/orbit
+//    residuals between base and rover, which decorrelate as slowly as the atmosphere itself;
+//    it takes what the other two leave of the datasheet total (0.0039 m per axis at 1 km).
+// Corrections: RTCM3 at 1 Hz over the telemetry link, so their age is ~1-2 s, within what the
+// datasheet's figures assume (the F9P keeps RTK fixed with corrections up to its
+// CFG-NAVSPG-CONSTR_DGNSSTO, 60 s by default); no separate age term. Latency: as the standalone
+// receiver's (kGpsLatencyS: PX4 flies the F9P with the same EKF2_GPS_DELAY default).
 class GpsErrorModel {
  public:
   static constexpr double kSlowTimeS = 1800.0;
@@ -54,11 +75,27 @@ class GpsErrorModel {
   static constexpr double kWhiteHStdM = 0.2;
   static constexpr double kWhiteVStdM = 0.5;
 
+  // RTK fixed (ZED-F9P datasheet): 0.01 m + 1 ppm, CEP horizontally, R50 vertically.
+  static constexpr double kRtkConstantM = 0.01;
+  static constexpr double kRtkPpm = 1e-6;
+  static constexpr double kCepPerSigma = 1.1774;  // sqrt(2 ln 2): CEP of a circular Gaussian
+  static constexpr double kR50PerSigma = 0.6745;  // median |x| of a 1-D Gaussian
+  static constexpr double kRtkWhiteHStdM = 0.004;
+  static constexpr double kRtkWhiteVStdM = 0.007;
+
   struct Split {  // per-axis 1-sigma of each component for a total (h, v) accuracy [m]
     double slow_h, slow_v, wander_h, wander_v, white_h, white_v;
   };
-  // The split of an airframe's total per-axis accuracy (h, v) [m].
+  struct Accuracy {  // total 1-sigma per axis [m]
+    double h, v;
+  };
+  // The split of an airframe's total per-axis accuracy (h, v) [m] (standalone receiver).
   static Split SplitFor(double total_h_m, double total_v_m);
+  // An RTK-fixed ZED-F9P's accuracy and its split, `baseline_km` from its base.
+  static Accuracy RtkAccuracy(double baseline_km);
+  static Split RtkSplit(double baseline_km);
+  // The split of a receiver as the airframe describes it (standalone or rtk).
+  static Split SplitForSpec(const GpsSpec& spec);
   static Split Scaled(const Split& s, double ratio_h, double ratio_v);
 
   explicit GpsErrorModel(std::uint64_t seed);

@@ -103,6 +103,52 @@ TEST(Airframe, BadRotorDirectionIsRejected) {
   EXPECT_EQ(af.error().where(), "af.yaml:11:44");
 }
 
+TEST(Airframe, GpsFixDefaultsToStandalone) {
+  auto af = ParseText(kMinimal);
+  ASSERT_TRUE(af.ok()) << af.error().ToString();
+  EXPECT_EQ(af->gps.fix, GpsFix::kStandalone);
+  auto x500 = LoadAirframe(AirframePath("x500"));
+  ASSERT_TRUE(x500.ok()) << x500.error().ToString();
+  EXPECT_EQ(x500->gps.fix, GpsFix::kStandalone);
+  EXPECT_EQ(x500->gps.horizontal_std_m, 0.8);
+}
+
+TEST(Airframe, RtkGpsTakesItsAccuracyFromTheReceiverModel) {
+  auto af =
+      ParseText(std::string(kMinimal) + "sensors:\n  gps: {rate_hz: 20, fix: rtk, rtk_baseline_km: 5}\n");
+  ASSERT_TRUE(af.ok()) << af.error().ToString();
+  EXPECT_EQ(af->gps.fix, GpsFix::kRtk);
+  EXPECT_EQ(af->gps.rtk_baseline_km, 5.0);
+  EXPECT_EQ(af->gps.rate_hz, 20.0);
+  EXPECT_NEAR(af->gps.horizontal_std_m, 0.015 / 1.1774, 1e-9);  // 0.01 m + 5 ppm of 5 km, CEP
+  EXPECT_NEAR(af->gps.vertical_std_m, 0.015 / 0.6745, 1e-9);    // R50
+  auto dflt = ParseText(std::string(kMinimal) + "sensors:\n  gps: {fix: rtk}\n");
+  ASSERT_TRUE(dflt.ok()) << dflt.error().ToString();
+  EXPECT_EQ(dflt->gps.rtk_baseline_km, 1.0);
+  EXPECT_NEAR(dflt->gps.horizontal_std_m, 0.011 / 1.1774, 1e-9);
+}
+
+TEST(Airframe, BadGpsFixSettingsAreRejectedClearly) {
+  struct Case {
+    const char* gps;
+    const char* message;
+  };
+  for (const Case& c : {
+           Case{"{fix: dgps}", "gps fix must be 'standalone' or 'rtk' (got 'dgps')"},
+           Case{"{fix: rtk, horizontal_std_m: 0.5}", "gps horizontal_std_m is set by the RTK receiver model"},
+           Case{"{fix: rtk, rate_hz: 25}", "gps rate_hz must be at most 20 with fix: rtk"},
+           Case{"{fix: rtk, rtk_baseline_km: 500}", "gps rtk_baseline_km must be at most 100"},
+           Case{"{fix: rtk, rtk_baseline_km: -1}", "'rtk_baseline_km' must be >= 0"},
+           Case{"{rtk_baseline_km: 2}", "gps rtk_baseline_km needs fix: rtk"},
+       }) {
+    auto af = ParseText(std::string(kMinimal) + "sensors:\n  gps: " + c.gps + "\n");
+    ASSERT_FALSE(af.ok()) << c.gps;
+    EXPECT_NE(af.error().message().find(c.message), std::string::npos)
+        << c.gps << ": " << af.error().message();
+    EXPECT_EQ(af.error().where().rfind("af.yaml:14:", 0), 0u) << c.gps << ": " << af.error().where();
+  }
+}
+
 TEST(Airframe, MissingFileIsNotFound) {
   auto af = LoadAirframe("/nonexistent/x.yaml");
   ASSERT_FALSE(af.ok());

@@ -2,6 +2,7 @@
 // and GPS dropout.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -195,6 +196,112 @@ TEST_F(GpsError, DegradedAccuracyScalesEveryComponent) {
   Run(degraded);
   EXPECT_NEAR(TotalStd(e_), 4.0, 0.12 * 4.0);
   EXPECT_NEAR(TotalStd(u_), 3.0, 0.12 * 3.0);
+}
+
+TEST_F(GpsError, StandaloneSpecKeepsItsSplit) {
+  // `fix: standalone` (the default) is the model above, unchanged: the split of the airframe's
+  // total, and the same draws from the same seed.
+  GpsSpec spec;
+  spec.horizontal_std_m = 0.8;
+  spec.vertical_std_m = 1.5;
+  const auto a = GpsErrorModel::SplitForSpec(spec);
+  const auto b = GpsErrorModel::SplitFor(0.8, 1.5);
+  EXPECT_EQ(a.slow_h, b.slow_h);
+  EXPECT_EQ(a.wander_h, b.wander_h);
+  EXPECT_EQ(a.white_h, b.white_h);
+  EXPECT_EQ(a.slow_v, b.slow_v);
+  EXPECT_EQ(a.wander_v, b.wander_v);
+  EXPECT_EQ(a.white_v, b.white_v);
+  GpsErrorModel m1(99), m2(99);
+  for (int k = 0; k < 50; ++k) {
+    const Vec3 e1 = m1.Next(0.1, a), e2 = m2.Next(0.1, b);
+    EXPECT_EQ(e1.x, e2.x);
+    EXPECT_EQ(e1.z, e2.z);
+  }
+}
+
+TEST_F(GpsError, RtkSplitIsTheF9pDatasheetAccuracy) {
+  // ZED-F9P: 0.01 m + 1 ppm CEP horizontally, R50 vertically. At 1 km: 0.011 m.
+  const auto acc = GpsErrorModel::RtkAccuracy(1.0);
+  EXPECT_NEAR(acc.h, 0.011 / 1.1774, 1e-9);  // 0.0093 m per axis
+  EXPECT_NEAR(acc.v, 0.011 / 0.6745, 1e-9);  // 0.0163 m
+  const auto s = GpsErrorModel::RtkSplit(1.0);
+  EXPECT_NEAR(std::hypot(s.slow_h, s.wander_h, s.white_h), acc.h, 1e-12);
+  EXPECT_NEAR(std::hypot(s.slow_v, s.wander_v, s.white_v), acc.v, 1e-12);
+  // White small, the baseline term slow: at 1 km the ppm part is 0.0039 m per axis, at 10 km
+  // (0.02 m CEP) most of the error.
+  EXPECT_LT(s.white_h, 0.5 * acc.h);
+  EXPECT_NEAR(s.slow_h, std::sqrt(acc.h * acc.h - 0.01 / 1.1774 * 0.01 / 1.1774), 1e-12);
+  const auto far = GpsErrorModel::RtkSplit(10.0);
+  EXPECT_NEAR(std::hypot(far.slow_h, far.wander_h, far.white_h), 0.02 / 1.1774, 1e-12);
+  EXPECT_GT(far.slow_h, far.wander_h);
+  EXPECT_EQ(far.white_h, s.white_h);
+  // The spec the airframe parser builds for `fix: rtk` reports that accuracy and uses that split.
+  GpsSpec spec;
+  SetRtkFix(&spec, 1.0);
+  EXPECT_EQ(spec.fix, GpsFix::kRtk);
+  EXPECT_NEAR(spec.horizontal_std_m, acc.h, 1e-12);
+  EXPECT_NEAR(spec.vertical_std_m, acc.v, 1e-12);
+  EXPECT_EQ(GpsErrorModel::SplitForSpec(spec).slow_h, s.slow_h);
+}
+
+TEST_F(GpsError, RtkFixedStatisticsMatchTheDatasheet) {
+  const auto split = GpsErrorModel::RtkSplit(1.0);
+  const auto acc = GpsErrorModel::RtkAccuracy(1.0);
+  Run(split);
+  // Per-axis std over 400 receivers x 120 s: the datasheet's 0.0093 m / 0.0163 m (12%: the slow
+  // part is 400 draws).
+  EXPECT_NEAR(TotalStd(e_), acc.h, 0.12 * acc.h);
+  EXPECT_NEAR(TotalStd(u_), acc.v, 0.12 * acc.v);
+  // Vertical R50 (median |error|) as the datasheet states it: 0.011 m.
+  std::vector<double> abs_u;
+  for (const auto& series : u_) {
+    for (std::size_t k = 0; k < series.size(); k += 50) abs_u.push_back(std::abs(series[k]));
+  }
+  std::nth_element(abs_u.begin(), abs_u.begin() + static_cast<std::ptrdiff_t>(abs_u.size() / 2), abs_u.end());
+  EXPECT_NEAR(abs_u[abs_u.size() / 2], 0.011, 0.15 * 0.011);
+  // Time-correlated as real RTK error: fix to fix only the 4 mm white part changes, so the
+  // difference is far below the sqrt(2) * 9.3 mm of white noise.
+  EXPECT_NEAR(LagStd(e_, 1), std::sqrt(2.0) * split.white_h, 0.05 * std::sqrt(2.0) * split.white_h);
+  EXPECT_LT(LagStd(e_, 1), 0.5 * std::sqrt(2.0) * acc.h);
+  // Over 60 s the multipath wander decorrelates, the baseline term hardly moves.
+  const double wander_part = 1.0 - std::exp(-60.0 / GpsErrorModel::kWanderTimeS);
+  const double slow_part = 1.0 - std::exp(-60.0 / GpsErrorModel::kSlowTimeS);
+  const double lag60 = std::sqrt(2.0 * (split.white_h * split.white_h +
+                                        split.wander_h * split.wander_h * wander_part +
+                                        split.slow_h * split.slow_h * slow_part));
+  EXPECT_NEAR(LagStd(e_, 600), lag60, 0.05 * lag60);
+}
+
+TEST(Sensors, RtkReceiverReportsItsAccuracyAndStaysWithinCentimetres) {
+  // A pinned x500 whose GPS is an RTK-fixed F9P 1 km from its base: every fix reports the
+  // datasheet accuracy (eph/epv) and lies within 5 sigma of the truth of its epoch.
+  Airframe af = LoadShippedAirframe("x500");
+  SetRtkFix(&af.gps, 1.0);
+  auto world = MakeWorld(CalmWorld(), 5);
+  const auto d = Spawn(*world, testing::MakeSpawn("rtk", af, Vec3{0, 0, 10}));
+  world->SetPinned(d, true);
+  const auto acc = GpsErrorModel::RtkAccuracy(1.0);
+  Stats ex, ez;
+  int fixes = 0;
+  for (int i = 0; i < 250 * 60; ++i) {
+    world->Step();
+    const GpsSample& g = world->sensors(d).gps;
+    if (!g.fresh || !g.valid) continue;
+    ++fixes;
+    EXPECT_NEAR(g.h_acc_m, acc.h, 1e-12);
+    EXPECT_NEAR(g.v_acc_m, acc.v, 1e-12);
+    const Vec3 p = world->Truth(d).position_m;
+    ex.Add(g.position_m.x - p.x);
+    ez.Add(g.position_m.z - p.z);
+    EXPECT_LT(std::abs(g.position_m.x - p.x), 5.0 * acc.h);
+    EXPECT_LT(std::abs(g.position_m.z - p.z), 5.0 * acc.v);
+  }
+  EXPECT_NEAR(fixes, 600, 2);  // 10 Hz for 60 s
+  // One receiver over a minute sees its slow part as an offset: the spread about it is the white
+  // and wander parts only, below the total.
+  EXPECT_LT(ex.std(), acc.h);
+  EXPECT_LT(ez.std(), acc.v);
 }
 
 TEST(Sensors, GpsFixesReportWhereTheDroneWasOneLatencyAgo) {

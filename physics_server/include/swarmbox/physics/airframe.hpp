@@ -60,12 +60,25 @@ struct MagSpec {
   double rate_hz = 100;
   double noise_std_gauss = 0.005;
 };
+// What kind of solution the receiver delivers (sensors.gps.fix in the airframe YAML).
+enum class GpsFix {
+  kStandalone,  // a single-frequency standalone receiver (u-blox M8/M9 class)
+  kRtk,         // RTK fixed with a base station's corrections (u-blox ZED-F9P)
+};
 struct GpsSpec {
   double rate_hz = 10;
-  double horizontal_std_m = 0.8;   // white noise per fix, per horizontal axis
+  double horizontal_std_m = 0.8;   // total 1-sigma error of a fix, per horizontal axis
   double vertical_std_m = 1.5;
   double velocity_std_m_s = 0.1;   // per axis
+  GpsFix fix = GpsFix::kStandalone;
+  double rtk_baseline_km = 1.0;    // rtk: distance to the base station (the datasheet's ppm term)
 };
+// Makes `gps` an RTK-fixed ZED-F9P receiver `baseline_km` from its base: fix, baseline and the
+// accuracy the datasheet gives for it (horizontal/vertical_std_m; see sensor_models.hpp
+// RtkAccuracy). What the airframe parser does for `fix: rtk`.
+void SetRtkFix(GpsSpec* gps, double baseline_km);
+// The ZED-F9P's highest navigation rate in RTK mode [Hz] (datasheet UBX-17051259).
+inline constexpr double kRtkMaxRateHz = 20.0;
 // Downward camera: pinhole looking along body -z; image "up" is body +x (forward), image right is
 // body -y (right). Rendered on demand (World::RenderCamera) at rate_hz by the caller.
 struct CameraSpec {

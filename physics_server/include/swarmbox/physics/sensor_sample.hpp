@@ -39,8 +39,10 @@ struct GpsSample {
   double lat_deg = 0;   // WGS84, flat-earth around home
   double lon_deg = 0;
   double alt_m = 0;     // AMSL [m]
-  double h_acc_m = 0;   // 1-sigma horizontal noise of this fix [m] (the airframe's, or degraded)
-  double v_acc_m = 0;   // 1-sigma vertical noise [m]
+  double h_acc_m = 0;   // the receiver's reported accuracy (u-blox hAcc, PX4's eph): total
+                        // 1-sigma error per horizontal axis of this fix [m] (the airframe's,
+                        // the RTK model's for `fix: rtk`, or degraded)
+  double v_acc_m = 0;   // the same vertically (vAcc, epv) [m]
 };
 
 struct SensorSample {
