@@ -36,6 +36,8 @@ flight::SensorSample FromBus(const bus::SensorSample& m) {
   s.gps_valid = m.gps.valid && m.gps.fix_type == bus::GpsFix::k3d;
   s.gps_pos_m = V(m.gps.position_enu_m);
   s.gps_vel_mps = V(m.gps.velocity_enu_m_s);
+  s.gps_eph_m = m.gps.h_acc_m;  // the receiver's reported accuracy: how much the estimator trusts it
+  s.gps_epv_m = m.gps.v_acc_m;
   return s;
 }
 

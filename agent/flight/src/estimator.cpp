@@ -113,15 +113,17 @@ void Estimator::Predict(Axis* ax, int axis, double acc, double dt) const {
   q(kP, kP) = 0.25 * dt * dt * dt * dt * qa;
   // In flight the horizontal position lives in the receiver's (wandering) frame; standing on the
   // ground the drone is known not to move, and the GPS error state takes the wander instead.
+  const double fw = params_.gps_frame_walk_h * gps_scale_h_;
   if (axis != 2) {
-    const double w = at_rest_ ? params_.gps_frame_walk_h : 0.0;
-    q(kP, kP) += params_.gps_frame_walk_h * params_.gps_frame_walk_h * dt - w * w * dt;
+    const double w = at_rest_ ? fw : 0.0;
+    q(kP, kP) += fw * fw * dt - w * w * dt;
     q(kBg, kBg) += w * w * dt;
   }
   q(kP, kV) = q(kV, kP) = 0.5 * dt * dt * dt * qa;
   q(kV, kV) = dt * dt * qa;
   q(kBa, kBa) = params_.accel_bias_walk * params_.accel_bias_walk * dt;
-  const double gw = axis == 2 ? params_.gps_bias_walk_v : params_.gps_bias_walk_h;
+  const double gw =
+      axis == 2 ? params_.gps_bias_walk_v * gps_scale_v_ : params_.gps_bias_walk_h * gps_scale_h_;
   q(kBg, kBg) = gw * gw * dt;
   q(kBb, kBb) = params_.baro_bias_walk * params_.baro_bias_walk * dt;
   ax->p = f * ax->p * f.transpose() + q;
@@ -154,6 +156,32 @@ void Estimator::Correct(Axis* ax, const Row5& h, double y, double r) const {
   // The output does not jump: it catches up in Predict().
   ax->out_dp += dx(kP);
   ax->out_dv += dx(kV);
+}
+
+void Estimator::TakeGpsAccuracy(const SensorSample& s) {
+  const auto noise = [](double reported, double white, double floor) {
+    return reported > 0.0 ? std::max(floor, std::min(white, reported)) : white;
+  };
+  const auto scale = [](double reported, double nominal) {
+    return reported > 0.0 && nominal > 0.0 ? std::min(1.0, reported / nominal) : 1.0;
+  };
+  gps_r_h_m_ = noise(s.gps_eph_m, params_.gps_noise_h_m, params_.gps_noise_floor_h_m);
+  gps_r_v_m_ = noise(s.gps_epv_m, params_.gps_noise_v_m, params_.gps_noise_floor_v_m);
+  gps_scale_h_ = scale(s.gps_eph_m, params_.gps_pos_h_std_m);
+  gps_scale_v_ = scale(s.gps_epv_m, params_.gps_pos_v_std_m);
+  if (gps_prior_taken_) return;
+  gps_prior_taken_ = true;
+  // The error state's prior was the airframe's accuracy; a receiver reporting better (RTK) narrows
+  // it before its first fix is fused. P -> D P D with D = 1 but c on the error state keeps P
+  // positive (semi-)definite; with a report of the airframe's figure c = 1 and nothing changes.
+  for (int a = 0; a < 3; ++a) {
+    const double reported = a == 2 ? s.gps_epv_m : s.gps_eph_m;
+    const double var = ax_[a].p(kBg, kBg);
+    if (!(reported > 0.0) || !(reported * reported < 0.99 * var)) continue;
+    const double c = reported / std::sqrt(var);
+    ax_[a].p.row(kBg) *= c;
+    ax_[a].p.col(kBg) *= c;
+  }
 }
 
 const StateEstimate& Estimator::Update(const SensorSample& s) {
@@ -250,6 +278,7 @@ const StateEstimate& Estimator::Update(const SensorSample& s) {
       for (Axis& ax : ax_) Correct(&ax, h, -ax.x(kV), 0.02 * 0.02);
     }
     if (s.gps_fresh && s.gps_valid) {
+      TakeGpsAccuracy(s);
       // The state of the fix's epoch: the newest history slot at least gps_delay_s old.
       std::size_t age = 0;
       while (age + 1 < hist_count_ && s.t_s - hist_t_[HistIndex(age)] < params_.gps_delay_s - 1e-6) ++age;
@@ -268,7 +297,7 @@ const StateEstimate& Estimator::Update(const SensorSample& s) {
         hp(kV) = -d;
         hp(kBa) = -0.5 * d * d;
         hp(kBg) = 1.0;
-        const double rn = a == 2 ? params_.gps_noise_v_m : params_.gps_noise_h_m;
+        const double rn = a == 2 ? gps_r_v_m_ : gps_r_h_m_;
         Correct(&ax, hp, s.gps_pos_m[a] - ax.hist_p[i] - ax.x(kBg), rn * rn);
       }
       t_last_gps_s_ = s.t_s;

@@ -116,6 +116,8 @@ Status ReadControl(const yaml::Node& control, FlightConfig* cfg) {
         .Optional("max_pos_correction_mps", &e.max_pos_correction_mps)
         .Optional("max_vel_correction_mps2", &e.max_vel_correction_mps2)
         .Optional("gps_noise_h_m", &e.gps_noise_h_m).Optional("gps_noise_v_m", &e.gps_noise_v_m)
+        .Optional("gps_noise_floor_h_m", &e.gps_noise_floor_h_m)
+        .Optional("gps_noise_floor_v_m", &e.gps_noise_floor_v_m)
         .Optional("gps_delay_s", &e.gps_delay_s).Optional("gps_frame_walk_h", &e.gps_frame_walk_h)
         .Optional("gps_bias_walk_h", &e.gps_bias_walk_h).Optional("gps_bias_walk_v", &e.gps_bias_walk_v)
         .Optional("baro_std_m", &e.baro_std_m).Optional("tilt_ref_from_filter", &e.tilt_ref_from_filter);

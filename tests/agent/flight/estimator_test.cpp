@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 namespace swarmbox::flight {
@@ -27,6 +28,8 @@ class FakeVehicle {
   Vec3 rate = Vec3::Zero();     // body [rad/s]
   bool gps_on = true;
   double gps_noise = 0.2;                      // white, per fix [m]
+  double gps_noise_v = 0.5;
+  double eph = 0.0, epv = 0.0;                 // reported accuracy (0: none)
   Vec3 gps_offset = Vec3(0.6, -0.4, 1.0);      // the receiver's slowly varying error [m]
   static constexpr int kDelaySteps = 30;       // 0.12 s at 250 Hz
   int k = 0;
@@ -50,7 +53,9 @@ class FakeVehicle {
     const std::size_t then = static_cast<std::size_t>(std::max(1, k - kDelaySteps)) % past_pos_.size();
     s.gps_fresh = k % 25 == 0;
     s.gps_valid = gps_on;
-    s.gps_pos_m = past_pos_[then] + gps_offset + Vec3(N(gps_noise), N(gps_noise), N(0.5));
+    s.gps_pos_m = past_pos_[then] + gps_offset + Vec3(N(gps_noise), N(gps_noise), N(gps_noise_v));
+    s.gps_eph_m = eph;
+    s.gps_epv_m = epv;
     s.gps_vel_mps = past_vel_[then] + Noise(0.1);
     return s;
   }
@@ -146,6 +151,62 @@ TEST(Estimator, BarometerOffsetIsAnchoredAtTheKnownStart) {
   Estimator est(KnownStart(v.pos));
   for (int i = 0; i < 2500; ++i) est.Update(v.Step(0.004));
   EXPECT_NEAR(est.state().pos_m.z(), v.pos.z(), 0.1);  // baro reads 488 m AMSL, estimate is ENU
+}
+
+// A standalone receiver reporting the accuracy the estimator was configured with (the
+// airframe's) is fused exactly as one that reports nothing.
+TEST(Estimator, ReportingTheAirframesAccuracyChangesNothing) {
+  FakeVehicle quiet(5), reporting(5);
+  reporting.eph = 0.8;  // EstimatorParams' gps_pos_h_std_m / gps_pos_v_std_m
+  reporting.epv = 1.5;
+  Estimator a(KnownStart(quiet.pos)), b(KnownStart(reporting.pos));
+  for (int i = 0; i < 5000; ++i) {
+    const double t = i * 0.004;
+    quiet.acc = reporting.acc = Vec3(std::sin(0.5 * t), std::cos(0.3 * t), 0.2 * std::sin(t));
+    a.Update(quiet.Step(0.004));
+    b.Update(reporting.Step(0.004));
+  }
+  EXPECT_EQ(a.state().pos_m, b.state().pos_m);
+  EXPECT_EQ(a.state().vel_mps, b.state().vel_mps);
+  EXPECT_EQ(a.state().pos_std_m, b.state().pos_std_m);
+}
+
+// An RTK-fixed receiver (5 mm per fix, reporting 1 cm) is trusted to its reported accuracy: with
+// the report the estimate follows it to the centimetre; without it (the 0.2 m fix-to-fix noise a
+// standalone receiver has) several times worse on the same samples.
+TEST(Estimator, TrustsAnRtkFixToItsReportedAccuracy) {
+  const auto rms_error = [](double eph, double epv, Vec3* pos_std) {
+    FakeVehicle v(6);
+    v.gps_noise = 0.005;
+    v.gps_noise_v = 0.008;
+    v.gps_offset = Vec3(0.004, -0.003, 0.006);
+    v.eph = eph;
+    v.epv = epv;
+    Estimator est(KnownStart(v.pos));
+    est.SetAtRest(true);
+    for (int i = 0; i < 1250; ++i) est.Update(v.Step(0.004));
+    est.SetAtRest(false);
+    double sum2 = 0.0;
+    int n = 0;
+    for (int i = 0; i < 7500; ++i) {  // 30 s of manoeuvres
+      const double t = i * 0.004;
+      v.acc = Vec3(1.5 * std::sin(0.7 * t), 1.0 * std::cos(0.4 * t), 0.5 * std::sin(0.9 * t));
+      est.Update(v.Step(0.004));
+      if (i >= 1250) {
+        sum2 += (est.state().pos_m - v.pos).squaredNorm();
+        ++n;
+      }
+    }
+    *pos_std = est.state().pos_std_m;
+    return std::sqrt(sum2 / n);
+  };
+  Vec3 std_rtk, std_plain;
+  const double rtk = rms_error(0.0093, 0.0163, &std_rtk);
+  const double plain = rms_error(0.0, 0.0, &std_plain);
+  std::printf("rtk fix: reported rms_m=%.4f, unreported rms_m=%.4f\n", rtk, plain);
+  EXPECT_LT(rtk, 0.03);
+  EXPECT_LT(3.0 * rtk, plain);
+  EXPECT_LT(std_rtk.x(), 0.5 * std_plain.x());  // and it knows it
 }
 
 }  // namespace

@@ -27,6 +27,8 @@ SensorSample FromPhysics(const physics::SensorSample& s) {
   out.gps_valid = s.gps.valid;
   out.gps_pos_m = E(s.gps.position_m);
   out.gps_vel_mps = E(s.gps.velocity_m_s);
+  out.gps_eph_m = s.gps.h_acc_m;
+  out.gps_epv_m = s.gps.v_acc_m;
   return out;
 }
 
@@ -42,6 +44,7 @@ Result<std::unique_ptr<Rig>> Rig::Create(const RigOptions& options) {
   const std::string path = TrialsDir() + "/airframes/" + options.airframe + ".yaml";
   auto af = physics::LoadAirframe(path);
   if (!af) return af.error();
+  if (options.gps_fix == physics::GpsFix::kRtk) physics::SetRtkFix(&af->gps, options.rtk_baseline_km);
   physics::DroneSpawn spawn;
   spawn.name = "drone_1";
   spawn.airframe = *af;
@@ -70,7 +73,7 @@ Result<std::unique_ptr<Rig>> Rig::Create(const RigOptions& options) {
   // drone index) (world.cpp), GpsErrorModel seed MixSeed(that, 0x6A5) (sensor_models.cpp).
   rig->twin_ = std::make_unique<physics::GpsErrorModel>(
       physics::MixSeed(physics::MixSeed(options.seed, 0x5E0000 + rig->drone_), 0x6A5));
-  rig->split_ = physics::GpsErrorModel::SplitFor(af->gps.horizontal_std_m, af->gps.vertical_std_m);
+  rig->split_ = physics::GpsErrorModel::SplitForSpec(af->gps);
   rig->RecordTruthAndCheckGps();
   return rig;
 }

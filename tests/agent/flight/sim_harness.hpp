@@ -41,6 +41,10 @@ struct RigOptions {
   double initial_throttle = 0.0;
   bool swing_damping = true;
   double payload_mass_hint_kg = 0.0; // what the controller is told it carries
+  // The airframe's GPS receiver as its YAML says (standalone for all of trials/airframes), or
+  // switched to an RTK-fixed ZED-F9P this far from its base (physics::SetRtkFix).
+  physics::GpsFix gps_fix = physics::GpsFix::kStandalone;
+  double rtk_baseline_km = 1.0;
 };
 
 class Rig {

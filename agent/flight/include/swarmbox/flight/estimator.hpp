@@ -21,6 +21,14 @@
 //    PX4's home), learnt on the ground; in flight the position follows the receiver (over
 //    seconds its wander cannot be told from motion). Vertically it is a random walk as fast as
 //    the receiver's wander, so height follows the barometer and GPS only anchors it.
+//  * The receiver's reported accuracy (eph/epv) sets how much a fix is trusted, as in PX4's
+//    EKF2 (position noise max(EKF2_GPS_P_NOISE, eph)): per fix, the measurement noise is
+//    max(gps_noise_floor, min(gps_noise, eph)) (a standalone receiver's 0.8 m report is mostly
+//    its slow error, which the error state carries; its fix-to-fix part is gps_noise, 0.2 m), and
+//    the receiver-error processes (gps_frame_walk_h, gps_bias_walk_*) and the error state's prior
+//    scale with eph / gps_pos_std (at most 1). A standalone fix reporting the airframe's accuracy
+//    is fused exactly as without the report; an RTK-fixed one (eph ~0.01 m) is followed to the
+//    centimetre, with no hand-set gain.
 //  * GPS delay: fixes describe the vehicle `gps_delay_s` ago (PX4's EKF2_GPS_DELAY). A short
 //    history of the state is kept; a fix is compared with the state of its epoch, and the
 //    correction maps to the present through the motion model (H * Phi(-delay)), as PX4's EKF2
@@ -65,6 +73,9 @@ struct EstimatorParams {
   double gps_pos_v_std_m = 1.5;     // spec): the prior of the GPS error state [m]
   double gps_noise_h_m = 0.2;       // fix-to-fix (white) GPS noise (EKF2_GPS_P_NOISE) [m]
   double gps_noise_v_m = 0.5;
+  double gps_noise_floor_h_m = 0.01;   // the least GPS noise assumed whatever the receiver reports
+  double gps_noise_floor_v_m = 0.015;  // (EKF2_GPS_P_NOISE's lower bound 0.01; vertically 1.5x, as
+                                       // EKF2 fuses GPS height) [m]
   double gps_bias_walk_h = 0.002;   // GPS error random walk [m / sqrt(s)]. Horizontally ~0: the
                                     // state holds the offset learnt at a known start, and the
                                     // position follows the receiver's wander (seconds cannot
@@ -122,6 +133,8 @@ class Estimator {
   // Scalar measurement with row h, innovation y, variance r; the correction is also carried into
   // the history (mapped back through the motion model) and into the output glide.
   void Correct(Axis* ax, const Row5& h, double y, double r) const;
+  // Takes the receiver's reported accuracy of a fix (see the header comment).
+  void TakeGpsAccuracy(const SensorSample& s);
   // History slot `age` steps back (0 = now) and its age [s].
   std::size_t HistIndex(std::size_t age) const { return (hist_head_ + kHistory - 1 - age) % kHistory; }
 
@@ -148,6 +161,11 @@ class Estimator {
   bool baro_seen_ = false;
   bool at_rest_ = false;
   int rest_count_ = 0;
+  // From the last fix's reported accuracy: the receiver-error processes' scale (<= 1) and the
+  // measurement noise [m], horizontal and vertical.
+  double gps_scale_h_ = 1.0, gps_scale_v_ = 1.0;
+  double gps_r_h_m_ = 0.0, gps_r_v_m_ = 0.0;
+  bool gps_prior_taken_ = false;  // the error state's prior has met the first report
 };
 
 }  // namespace swarmbox::flight

@@ -37,6 +37,9 @@ struct SensorSample {
   bool gps_valid = false;             // the report has a fix (false during a dropout)
   Vec3 gps_pos_m = Vec3::Zero();      // position, world ENU [m]
   Vec3 gps_vel_mps = Vec3::Zero();    // velocity, world ENU [m/s]
+  double gps_eph_m = 0.0;             // the receiver's reported accuracy (u-blox hAcc, PX4's
+  double gps_epv_m = 0.0;             // eph/epv): 1-sigma per horizontal axis / vertically [m];
+                                      // 0: not reported
 };
 
 // The estimator's output, the controllers' input.
