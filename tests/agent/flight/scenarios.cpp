@@ -38,9 +38,13 @@ Status TwinOk(const Rig& r) {
 
 }  // namespace
 
-Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_mps, double gust_std_mps) {
+const char* ReceiverName(Receiver receiver) { return receiver == Receiver::kRtk ? "rtk" : "standalone"; }
+
+Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_mps, double gust_std_mps,
+                              Receiver receiver) {
   RigOptions o;
   o.seed = seed;
+  o.gps_fix = receiver;
   o.wind.mean_m_s = physics::Vec3{wind_mps, 0.0, 0.0};
   o.wind.gust_std_m_s = gust_std_mps;
   o.wind.gust_time_s = 2.0;
@@ -83,9 +87,10 @@ Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_m
   return m;
 }
 
-Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz) {
+Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz, Receiver receiver) {
   RigOptions o;
   o.seed = seed;
+  o.gps_fix = receiver;
   auto rig = HoveringRig(o, 5.0);
   if (!rig) return rig.error();
   Rig& r = **rig;
@@ -98,13 +103,16 @@ Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz)
   const Vec3 truth0 = r.true_pos();
   if (!r.fc().Command(Setpoint::Position(target, 0.0))) return Error(ErrorCode::kInternal, "setpoint rejected");
   const double t0 = r.t();
-  double last_out = 0.0, last_out_3d = 0.0, last_out_truth = 0.0, max_along = 0.0, peak_v = 0.0;
+  double last_out = 0.0, last_out_3d = 0.0, last_out_truth = 0.0, last_out_target = 0.0;
+  double max_along = 0.0, max_truth = 0.0, peak_v = 0.0;
   r.Run(15.0, {}, [&] {
     const Vec3 moved = r.nav_pos() - nav0;
     if (std::abs((moved - step).dot(dir)) > 0.2) last_out = r.t() - t0;
     if ((moved - step).norm() > 0.2) last_out_3d = r.t() - t0;
     if (std::abs((r.true_pos() - truth0 - step).dot(dir)) > 0.2) last_out_truth = r.t() - t0;
+    if (std::abs((r.true_pos() - target).dot(dir)) > 0.2) last_out_target = r.t() - t0;
     max_along = std::max(max_along, moved.dot(dir));
+    max_truth = std::max(max_truth, (r.true_pos() - truth0).dot(dir));
     const auto v = r.truth().velocity_m_s;
     peak_v = std::max(peak_v, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
   });
@@ -112,8 +120,10 @@ Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz)
   m.settle_s = last_out;
   m.settle_3d_s = last_out_3d;
   m.settle_truth_s = last_out_truth;
+  m.settle_target_s = last_out_target;
   m.settled = last_out < 14.0;
   m.overshoot_pct = std::max(0.0, (max_along - step.norm()) / step.norm() * 100.0);
+  m.overshoot_truth_pct = std::max(0.0, (max_truth - step.norm()) / step.norm() * 100.0);
   m.peak_speed_mps = peak_v;
   SWARMBOX_TRY(TwinOk(r));
   return m;

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "swarmbox/common/result.hpp"
+#include "swarmbox/physics/airframe.hpp"  // GpsFix
 
 namespace swarmbox::flight::testing {
 
@@ -29,22 +30,32 @@ struct HoverMetrics {
                              // follow)
   double window_s = 0;
 };
+// The x500's GPS receiver in a scenario: the airframe's standalone one (x500.yaml), or an
+// RTK-fixed ZED-F9P 1 km from its base (sim_harness.hpp RigOptions::gps_fix).
+using Receiver = physics::GpsFix;
+const char* ReceiverName(Receiver receiver);  // "standalone" | "rtk"
+
 // Takes off to 5 m, settles, then holds for window_s; optional mean wind with gusts.
 Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_mps = 0.0,
-                              double gust_std_mps = 0.0);
+                              double gust_std_mps = 0.0, Receiver receiver = Receiver::kStandalone);
 
 struct StepMetrics {         // the step response: displacement from where the drone was at the
                              // command, receiver's frame
   double settle_s = 0;       // from the command until the displacement along the step stays
                              // within 0.2 m of the step
   double settle_3d_s = 0;    // the same on the full 3-D displacement error
-  double settle_truth_s = 0; // settle_s on absolute truth
+  double settle_truth_s = 0; // settle_s on absolute truth (the true displacement)
+  double settle_target_s = 0; // until the true position stays within 0.2 m of the commanded
+                              // target along the step (absolute: adds the hold offset at the
+                              // command and the estimate's error)
   double overshoot_pct = 0;  // beyond the step along its direction, % of the step
+  double overshoot_truth_pct = 0;  // the same on absolute truth
   double peak_speed_mps = 0;
   bool settled = false;
 };
 // From a 5 m hover, a step of `step_m` (world ENU) to the position setpoint.
-Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz);
+Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz,
+                            Receiver receiver = Receiver::kStandalone);
 
 struct DropoutMetrics {              // receiver's frame throughout
   double max_drift_m = 0;        // position to hold point during the dropout
