@@ -314,8 +314,9 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   say("ending: " + verdict.ToString());
   events.Write(LifecycleEventJson(wall(), "shutdown", info.name, verdict));
   if (tree && engine) {
-    // Faults first (unpause, restart what a fault stopped, heal partitions, restore radios), while
-    // the sidecars still run; the tree's Step then undoes network.mesh before they are removed.
+    // Faults first (unpause, restart what a fault stopped); radio rules, partitions and
+    // network.mesh are not undone: they go with the sidecars' namespaces when the tree stops them
+    // (fault_injector.hpp).
     if (injector) {
       (void)injector->RemoveActive();
       if (dynamic_cast<dsl::Step*>(tree->Find(kFaultsStepId)) == nullptr) (void)injector->Teardown();
