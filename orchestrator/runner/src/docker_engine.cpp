@@ -80,6 +80,7 @@ DockerEngine::DockerEngine(docker::DockerApi& api, LogHub& hub, Clock& clock,
 }
 
 DockerEngine::~DockerEngine() {
+  CloseQueue();
   JoinStops();
   for (auto& [component, f] : followers_) f->cancel.Cancel();
   for (auto& [component, f] : followers_) {
@@ -89,13 +90,84 @@ DockerEngine::~DockerEngine() {
 
 void DockerEngine::Trace(const dsl::Component& component, dsl::EventKind event,
                          const Verdict& verdict) {
+  if (event == dsl::EventKind::kBuild) {
+    // A container's creation running ahead traces its build itself, once it has finished.
+    std::lock_guard lock(mu_);
+    if (build_traced_by_create_.erase(component.id()) > 0) return;
+  }
   std::lock_guard lock(trace_mu_);
   if (options_.on_trace) options_.on_trace(component, event, verdict);
 }
 
 Verdict DockerEngine::RunSiblings(const std::vector<std::function<Verdict()>>& steps,
-                                  bool /*stop_on_failure*/) {
-  return RunConcurrently(steps, options_.max_parallel);
+                                  bool stop_on_failure) {
+  // Stops (the only walk that goes on after a failure) mostly wait for programs to exit: all of
+  // a level's at once, so every container gets its SIGTERM right away.
+  const bool stopping = !stop_on_failure;
+  const int threads = stopping && options_.max_parallel > 1
+                          ? std::max(options_.max_parallel, static_cast<int>(steps.size()))
+                          : options_.max_parallel;
+  return RunConcurrently(steps, threads);
+}
+
+void DockerEngine::Enqueue(std::function<void(bool)> job) {
+  std::unique_lock lock(queue_mu_);
+  if (closing_) {
+    lock.unlock();
+    job(true);
+    return;
+  }
+  jobs_.push_back(std::move(job));
+  if (idle_workers_ == 0 && static_cast<int>(workers_.size()) < options_.max_parallel) {
+    workers_.emplace_back([this] {
+      std::unique_lock worker_lock(queue_mu_);
+      while (true) {
+        ++idle_workers_;
+        queue_cv_.wait(worker_lock, [this] { return closing_ || !jobs_.empty(); });
+        --idle_workers_;
+        if (jobs_.empty()) return;  // closing
+        std::function<void(bool)> next = std::move(jobs_.front());
+        jobs_.pop_front();
+        const bool cancelled = closing_;
+        worker_lock.unlock();
+        next(cancelled);
+        worker_lock.lock();
+      }
+    });
+  } else {
+    queue_cv_.notify_one();
+  }
+}
+
+void DockerEngine::CloseQueue() {
+  std::vector<std::thread> workers;
+  {
+    std::lock_guard lock(queue_mu_);
+    closing_ = true;
+    workers.swap(workers_);
+  }
+  queue_cv_.notify_all();
+  for (std::thread& t : workers) t.join();
+}
+
+std::optional<Verdict> DockerEngine::WaitCreated(const std::string& component) {
+  std::shared_future<Verdict> created;
+  {
+    std::lock_guard lock(mu_);
+    auto it = creates_.find(component);
+    if (it == creates_.end()) return std::nullopt;
+    created = it->second;
+  }
+  return created.get();
+}
+
+void DockerEngine::FinishCreates() {
+  std::vector<std::shared_future<Verdict>> all;
+  {
+    std::lock_guard lock(mu_);
+    for (const auto& [component, created] : creates_) all.push_back(created);
+  }
+  for (const auto& created : all) created.wait();
 }
 
 void DockerEngine::AddProblem(std::string problem) {
@@ -196,6 +268,70 @@ Status DockerEngine::CopyInputs(const dsl::ContainerSpec& spec, const std::strin
 }
 
 Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
+  if (options_.max_parallel <= 1) return CreateNow(plugin);
+  const std::string component = plugin.id();
+  // What can be checked now is checked now: the tree's Build walk fails where it did before.
+  const dsl::ContainerSpec& s = plugin.spec();
+  std::optional<std::shared_future<Verdict>> owner;
+  {
+    std::lock_guard lock(mu_);
+    for (const dsl::Attachment& a : s.networks) {
+      if (network_ids_.count(a.network) == 0) {
+        return Verdict::Err("network '" + a.network + "' of " + component + " was not created",
+                            plugin.Path());
+      }
+    }
+    if (!s.network_of.empty()) {
+      auto it = creates_.find(s.network_of);
+      if (it != creates_.end()) owner = it->second;
+    }
+  }
+  auto promise = std::make_shared<std::promise<Verdict>>();
+  const int priority = plugin.run_priority();
+  {
+    std::lock_guard lock(mu_);
+    creates_[component] = promise->get_future().share();
+    build_traced_by_create_.insert(component);
+    ++unfinished_creates_[priority];
+  }
+  // What a creation waits for (the earlier levels' creations, the owner of a shared network
+  // namespace) was queued before it: workers take jobs in order, so it is running or done and
+  // the wait cannot starve the queue.
+  Enqueue([this, &plugin, promise, owner, priority](bool cancelled) {
+    if (!cancelled) {
+      std::unique_lock lock(mu_);
+      create_cv_.wait(lock, [&] {
+        for (const auto& [p, n] : unfinished_creates_) {
+          if (p < priority && n > 0) return false;
+        }
+        return true;
+      });
+    }
+    Verdict v;
+    if (cancelled) {
+      v = Verdict::Err("not created: the run was torn down first", plugin.Path());
+    } else if (owner && !owner->get().ok()) {
+      v = Verdict::Err("the network namespace of " + plugin.id() + " belongs to '" +
+                           plugin.spec().network_of + "', which was not created",
+                       plugin.Path());
+    } else {
+      v = CreateNow(plugin);
+    }
+    {
+      std::lock_guard lock(trace_mu_);
+      if (options_.on_trace) options_.on_trace(plugin, dsl::EventKind::kBuild, v);
+    }
+    {
+      std::lock_guard lock(mu_);
+      --unfinished_creates_[priority];
+    }
+    create_cv_.notify_all();
+    promise->set_value(v);
+  });
+  return Verdict::Success();
+}
+
+Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
   const dsl::ContainerSpec& s = plugin.spec();
   docker::ContainerSpec spec;
   spec.name = s.name;
@@ -348,6 +484,7 @@ bool DockerEngine::IsCurrent(const HubItem& item) const {
 
 Verdict DockerEngine::StartContainer(dsl::Plugin& plugin) {
   const dsl::ContainerSpec& s = plugin.spec();
+  if (auto created = WaitCreated(plugin.id()); created && !created->ok()) return *created;
   const auto found = ContainerId(plugin.id());
   if (!found) return Verdict::Err("no container for " + plugin.id(), plugin.Path());
   const std::string id = *found;
@@ -414,9 +551,11 @@ void DockerEngine::CollectArtifacts(const std::string& component,
 
 Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
   const std::string component = plugin.id();
+  (void)WaitCreated(component);  // a creation still under way finishes first, then goes
   std::string id;
   {
     std::lock_guard lock(mu_);
+    creates_.erase(component);
     auto it = container_ids_.find(component);
     if (it == container_ids_.end()) return Verdict::Success();
     id = it->second;

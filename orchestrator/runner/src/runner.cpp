@@ -193,6 +193,9 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     tree.reset();
     refresh_taken();
   }
+  // After a failed start, creations queued ahead may still trace their build: let them finish
+  // before the runner writes to events.jsonl itself.
+  if (engine) engine->FinishCreates();
 
   Metrics metrics;
   std::vector<Detection> detections;

@@ -1,5 +1,6 @@
 #include "fake_docker_api.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 
@@ -135,9 +136,27 @@ Status FakeDockerApi::RemoveNetwork(std::string_view id) {
 }
 
 Result<std::string> FakeDockerApi::CreateContainer(const docker::ContainerSpec& spec) {
-  std::lock_guard lock(mu_);
+  std::unique_lock lock(mu_);
+  if (auto label = spec.labels.find(std::string(docker::kLabelComponent)); label != spec.labels.end()) {
+    const std::set<std::string> awaited = scripts[label->second].create_after_started;
+    auto all_started = [&] {
+      return std::all_of(awaited.begin(), awaited.end(), [&](const std::string& a) {
+        return std::any_of(containers_.begin(), containers_.end(), [&](const auto& entry) {
+          return entry.second.component == a && entry.second.starts > 0;
+        });
+      });
+    };
+    if (!cv_.wait_for(lock, std::chrono::seconds(10), all_started)) {
+      return Error(ErrorCode::kTimeout, "create_after_started: created before the others started",
+                   "POST /containers/create");
+    }
+  }
   calls_.push_back("create " + spec.name);
   if (Find(spec.name) != nullptr) return Error(ErrorCode::kAlreadyExists, "name in use");
+  if (auto label = spec.labels.find(std::string(docker::kLabelComponent));
+      label != spec.labels.end() && scripts[label->second].fail_create) {
+    return Error(ErrorCode::kInternal, "create refused (fail_create)", "POST /containers/create");
+  }
   for (const auto& e : spec.networks) {
     if (networks_.count(e.network) == 0) return Error(ErrorCode::kNotFound, "no such network " + e.network);
   }
@@ -157,6 +176,7 @@ Result<std::string> FakeDockerApi::CreateContainer(const docker::ContainerSpec& 
   c.component = label == spec.labels.end() ? spec.name : label->second;
   c.state.status = "created";
   containers_[id] = c;
+  cv_.notify_all();  // a log stream may be waiting for this container (log_after_created)
   return id;
 }
 
@@ -332,7 +352,19 @@ Status FakeDockerApi::FollowLogs(std::string_view id, const docker::LogOptions&,
   bool broken = false;
   int starts = 0;
   {
-    std::lock_guard lock(mu_);
+    std::unique_lock lock(mu_);
+    std::string component;
+    if (Container* c = Find(id)) component = c->component;
+    const std::set<std::string> awaited = scripts[component].log_after_created;
+    auto all_created = [&] {
+      return std::all_of(awaited.begin(), awaited.end(), [&](const std::string& a) {
+        return std::any_of(containers_.begin(), containers_.end(),
+                           [&](const auto& entry) { return entry.second.component == a; });
+      });
+    };
+    if (!cv_.wait_for(lock, std::chrono::seconds(10), all_created)) {
+      return Error(ErrorCode::kIo, "log_after_created: the awaited containers were never created");
+    }
     Container* c = Find(id);
     if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
     ++c->follows;

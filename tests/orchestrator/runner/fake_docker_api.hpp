@@ -32,6 +32,13 @@ struct ContainerScript {
   std::size_t broken_stream_lines = 0;         // ...after delivering this many lines
   bool fail_start = false;                     // StartContainer fails
   std::vector<std::string> restart_lines;      // logged on each start after the first (restart)
+  bool fail_create = false;                    // CreateContainer fails
+  // Its log stream delivers nothing until the containers of these components have been created
+  // (to show that later levels are created while this one starts); after 10 s in vain it fails.
+  std::set<std::string> log_after_created;
+  // Its creation waits until the containers of these components have started (to show that it
+  // is created while an earlier level starts); after 10 s in vain it fails.
+  std::set<std::string> create_after_started;
 };
 
 struct ExecAnswer {

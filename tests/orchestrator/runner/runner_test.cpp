@@ -129,17 +129,24 @@ TEST_F(RunnerTest, EndsOnALogPatternWithItsOutcome) {
 TEST_F(RunnerTest, StartsInPriorityOrderAndStopsInReverse) {
   api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
   Run();
-  // The two networks form one level (made and removed at once, in any order); containers are
-  // removed while the next level stops (in any order), all before the networks.
+  // The two networks form one level (made and removed at once, in any order); the containers
+  // are created ahead, in any order (a creation starts nothing), each before its start; starts
+  // keep the priority order; containers are removed while the next level stops (in any order),
+  // all before the networks.
   const std::string p = "mini-20261121-120000-abcd-";
   std::vector<std::string> order;
+  std::vector<std::string> created;
   std::vector<std::string> removed;
   for (const std::string& c : api_.Calls()) {
     if (c.rfind("create-network", 0) == 0) {
       order.push_back("create-network");
     } else if (c.rfind("remove-network", 0) == 0) {
       order.push_back("remove-network");
-    } else if (c.rfind("create", 0) == 0 || c.rfind("start", 0) == 0 || c.rfind("stop", 0) == 0) {
+    } else if (c.rfind("create", 0) == 0) {
+      EXPECT_EQ(std::count(order.begin(), order.end(), "create-network"), 2) << c;
+      EXPECT_EQ(std::count(order.begin(), order.end(), "start " + c.substr(7)), 0) << c;
+      created.push_back(c);
+    } else if (c.rfind("start", 0) == 0 || c.rfind("stop", 0) == 0) {
       order.push_back(c);
     } else if (c.rfind("remove", 0) == 0) {
       EXPECT_EQ(std::count(order.begin(), order.end(), "remove-network"), 0) << c;
@@ -147,10 +154,10 @@ TEST_F(RunnerTest, StartsInPriorityOrderAndStopsInReverse) {
     }
   }
   EXPECT_THAT(order, ::testing::ElementsAre(
-                         "create-network", "create-network", "create " + p + "physics",
-                         "create " + p + "scout_1", "start " + p + "physics", "start " + p + "scout_1",
-                         "stop " + p + "scout_1", "stop " + p + "physics", "remove-network",
-                         "remove-network"));
+                         "create-network", "create-network", "start " + p + "physics",
+                         "start " + p + "scout_1", "stop " + p + "scout_1", "stop " + p + "physics",
+                         "remove-network", "remove-network"));
+  EXPECT_THAT(created, ::testing::UnorderedElementsAre("create " + p + "scout_1", "create " + p + "physics"));
   EXPECT_THAT(removed, ::testing::UnorderedElementsAre("remove " + p + "scout_1", "remove " + p + "physics"));
 }
 
@@ -351,6 +358,102 @@ TEST_F(RunnerTest, TheAgentsOfALevelStartAndStopAtOnceAfterThePhysicsServerIsRea
                                               "remove-network " + p + "net1-sim"));
   EXPECT_EQ(run.result.components.size(), 4u);
   for (const ComponentReport& c : run.result.components) EXPECT_EQ(c.exit_code, 0) << c.name;
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, LaterLevelsAreCreatedWhileTheFirstStartsButStartOnlyOnceItIsReady) {
+  spec_.drones.clear();
+  spec_.Drone("scout_1", "x500", {0, 0, 0}).Drone("scout_2", "x500", {3, 0, 0});
+  // The scouts' creation waits inside the engine until the physics server has started: a runner
+  // creating every container before the first start (or one level after another) fails these.
+  api_.scripts["scout_1"].create_after_started = {"physics"};
+  api_.scripts["scout_2"].create_after_started = {"physics"};
+  api_.scripts["scout_2"].lines = {"t=2 node=scout_2 event=mission_complete"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  const std::string p = "mini-20261121-120000-abcd-";
+  const std::vector<std::string> calls = api_.Calls();
+  auto at = [&](const std::string& call) {
+    return std::find(calls.begin(), calls.end(), call) - calls.begin();
+  };
+  for (const char* s : {"scout_1", "scout_2"}) {
+    EXPECT_LT(at("start " + p + "physics"), at("start " + p + s)) << s;
+    EXPECT_LT(at("create " + p + s), at("start " + p + s)) << s;
+  }
+  // Each build is traced once, when its creation has finished.
+  const std::string events = ReadFile(fs::path(run.trial_dir) / "events.jsonl");
+  for (const char* s : {"physics", "scout_1", "scout_2"}) {
+    const std::string build = std::string("\"event\":\"build\",\"target\":\"") + s + "\",\"outcome\":\"success\"";
+    const auto first = events.find(build);
+    ASSERT_NE(first, std::string::npos) << s;
+    EXPECT_EQ(events.find(build, first + 1), std::string::npos) << s;
+  }
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, ContainersCreatedAheadAreRemovedWhenAnEarlierLevelFails) {
+  // The scouts are created while the physics server starts; it exits before it is ready: they
+  // are never started, and removed.
+  spec_.drones.clear();
+  spec_.Drone("scout_1", "x500", {0, 0, 0}).Drone("scout_2", "x500", {3, 0, 0});
+  api_.scripts["physics"].log_after_created = {"scout_1", "scout_2"};
+  api_.scripts["physics"].lines = {"t=0 node=physics event=loading"};
+  api_.scripts["physics"].exit_code = 2;
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kFailure);
+  EXPECT_EQ(run.result.verdict.reason, "physics exited with code 2 before it was ready");
+  const std::string p = "mini-20261121-120000-abcd-";
+  const std::vector<std::string> calls = api_.Calls();
+  for (const char* s : {"scout_1", "scout_2"}) {
+    EXPECT_EQ(std::count(calls.begin(), calls.end(), "create " + p + s), 1) << s;
+    EXPECT_EQ(std::count(calls.begin(), calls.end(), "start " + p + s), 0) << s;
+    EXPECT_EQ(std::count(calls.begin(), calls.end(), "remove " + p + s), 1) << s;
+  }
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, ContainersCreatedAheadAreRemovedAfterCtrlCDuringAReadinessWait) {
+  spec_.drones.clear();
+  spec_.Drone("scout_1", "x500", {0, 0, 0}).Drone("scout_2", "x500", {3, 0, 0});
+  api_.scripts["physics"].lines = {"t=0 node=physics event=loading"};  // never ready
+  std::atomic<bool> interrupted{false};
+  options_.interrupted = &interrupted;
+  std::thread ctrl_c([&] {
+    // Once both scouts exist (created ahead), while the runner waits for the physics server.
+    for (int i = 0; i < 1000; ++i) {
+      const auto created = api_.Created();
+      if (created.size() == 3u) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    interrupted = true;
+  });
+  RunOutcome run = Run();
+  ctrl_c.join();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("interrupted"));
+  EXPECT_EQ(api_.Created().size(), 3u);
+  const std::string p = "mini-20261121-120000-abcd-";
+  const std::vector<std::string> calls = api_.Calls();
+  for (const char* s : {"scout_1", "scout_2"}) {
+    EXPECT_EQ(std::count(calls.begin(), calls.end(), "start " + p + s), 0) << s;
+  }
+  ExpectNothingLeft();
+}
+
+TEST_F(RunnerTest, AFailedCreationOfALaterLevelEndsTheRunBeforeThatLevelStarts) {
+  spec_.drones.clear();
+  spec_.Drone("scout_1", "x500", {0, 0, 0}).Drone("scout_2", "x500", {3, 0, 0});
+  api_.scripts["scout_2"].fail_create = true;
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  EXPECT_THAT(run.result.verdict.reason, HasSubstr("creating container mini-20261121-120000-abcd-scout_2"));
+  EXPECT_EQ(ExitCodeFor(run.result.verdict), 3);
+  const std::string p = "mini-20261121-120000-abcd-";
+  const std::vector<std::string> calls = api_.Calls();
+  EXPECT_EQ(std::count(calls.begin(), calls.end(), "start " + p + "scout_2"), 0);
+  // The failed build is in events.jsonl with Docker's message.
+  const std::string events = ReadFile(fs::path(run.trial_dir) / "events.jsonl");
+  EXPECT_THAT(events, HasSubstr("\"event\":\"build\",\"target\":\"scout_2\",\"outcome\":\"error\""));
   ExpectNothingLeft();
 }
 

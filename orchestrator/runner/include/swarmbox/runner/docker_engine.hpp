@@ -12,8 +12,19 @@
 //
 // The containers of one run-priority level are handled at once (RunSiblings: up to
 // EngineOptions::max_parallel threads, each making its own calls on the thread-safe DockerApi):
-// created and filled together, started together (each waiting for its own readiness), stopped,
-// drained and removed together. Levels stay in order (the tree walks them one after another).
+// started together (each waiting for its own readiness), stopped, drained and removed together
+// (a level's stops all at once: they wait, the engine does not work for them). Levels stay in
+// order (the tree walks them one after another).
+//
+// Creates run ahead: CreateContainer queues the creation (create, the second network, the input
+// files) on up to max_parallel workers and returns at once, so the tree's Build walk ends right
+// after the networks and every level's containers are created while the earlier levels start and
+// wait for their readiness (a level's creations begin once the earlier levels' have finished, so
+// they do not slow those down). Creating starts nothing: StartContainer waits for its own container's
+// creation (and fails with its verdict), so starts keep the priority order. The build event of a
+// container is traced when its creation has finished, with its real verdict. StopContainer waits
+// for the creation too, so a container created but never started is removed like any other.
+// With max_parallel 1 everything goes one at a time on the caller's thread, as before.
 //
 // Thread-safety: the tree (runner's thread) calls the dsl::Engine methods, concurrently for the
 // components of one level; Trace calls are serialised. Inspect, ResumeLogs and IsCurrent may be
@@ -23,11 +34,14 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -47,7 +61,8 @@ struct EngineOptions {
   const std::atomic<bool>* interrupted = nullptr;  // Ctrl-C: readiness waits give up
   // Called with each lifecycle step (events.jsonl); may be empty.
   std::function<void(const dsl::Component&, dsl::EventKind, const dsl::Verdict&)> on_trace;
-  // How many containers of one level are created, started or stopped at once (1 = one by one).
+  // How many containers are created (ahead) or started at once (1 = one by one, no creating
+  // ahead). A level's stops all go at once unless this is 1.
   int max_parallel = 32;
 };
 
@@ -82,6 +97,9 @@ class DockerEngine final : public dsl::Engine {
   Status ResumeLogs(const std::string& component);
   // Whether a hub item comes from the component's current follower (not one before a restart).
   bool IsCurrent(const HubItem& item) const;
+  // Waits until every creation queued so far has finished (the tree's Stop does too, container by
+  // container); after a failed Start, before writing anything, no build trace is still to come.
+  void FinishCreates();
   // True when the last network creation failed because its subnet overlaps another network.
   bool subnet_conflict() const { return subnet_conflict_.load(); }
   // Waits for the stops still finishing (exit codes, artifacts, removal) and returns their worst
@@ -97,6 +115,12 @@ class DockerEngine final : public dsl::Engine {
 
  private:
   struct Follower;
+  dsl::Verdict CreateNow(dsl::Plugin& plugin);
+  // The creation of the component's container queued by CreateContainer, if any; waits for it.
+  std::optional<dsl::Verdict> WaitCreated(const std::string& component);
+  // Runs job(false) on a create worker; job(true) when the engine closes before it ran.
+  void Enqueue(std::function<void(bool cancelled)> job);
+  void CloseQueue();
   void StartFollower(const std::string& component, const std::string& container_id,
                      std::uint64_t skip_lines = 0);
   void JoinFollower(const std::string& component, bool cancel);
@@ -127,6 +151,22 @@ class DockerEngine final : public dsl::Engine {
   std::vector<std::unique_ptr<PendingStop>> pending_stops_;  // guarded by mu_
   std::mutex join_mu_;  // held while JoinStops joins
   dsl::Verdict stops_verdict_;                               // guarded by mu_
+  // Creates running ahead (guarded by mu_): component -> its verdict once created; the ids
+  // whose build trace (from the tree, before the creation finished) is left to the creation.
+  std::map<std::string, std::shared_future<dsl::Verdict>> creates_;
+  std::set<std::string> build_traced_by_create_;
+  // Creations queued and not finished, by run priority: a level's creation waits for the earlier
+  // levels' (so the physics server is not created among twenty agents), then overlaps their
+  // starts and readiness waits. Guarded by mu_; create_cv_ is signalled when one finishes.
+  std::map<int, int> unfinished_creates_;
+  std::condition_variable create_cv_;
+  // The create workers (up to max_parallel, started when needed; they live until the destructor).
+  std::mutex queue_mu_;
+  std::condition_variable queue_cv_;
+  std::deque<std::function<void(bool)>> jobs_;  // guarded by queue_mu_
+  std::vector<std::thread> workers_;        // guarded by queue_mu_
+  int idle_workers_ = 0;                    // guarded by queue_mu_
+  bool closing_ = false;                    // guarded by queue_mu_
   // Signalled when a follower ends or a Docker stop returns (StopContainer waits on either).
   std::mutex done_mu_;
   std::condition_variable done_cv_;
