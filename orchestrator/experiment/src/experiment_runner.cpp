@@ -6,12 +6,14 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <thread>
 
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/dsl/trial_loader.hpp"
+#include "swarmbox/experiment/background_removal.hpp"
 #include "swarmbox/experiment/progress.hpp"
 #include "swarmbox/experiment/trial_store.hpp"
 #include "swarmbox/report/report_html.hpp"
@@ -94,7 +96,9 @@ Status CommitError(Session& s, const PlannedTrial& t, int attempts, const std::s
 
 class TrialExecutor final : public HostWorker {
  public:
-  TrialExecutor(Session& session, const PoolHost& host) : s_(session), host_(host) {}
+  // remover: the host's background remover, or nullptr to remove inside each trial.
+  TrialExecutor(Session& session, const PoolHost& host, BackgroundRemover* remover)
+      : s_(session), host_(host), remover_(remover) {}
   std::string name() const override { return host_.name; }
   int slots() const override { return host_.slots; }
 
@@ -113,7 +117,12 @@ class TrialExecutor final : public HostWorker {
     o.interrupted = eo.interrupted;
     std::ofstream log(fs::path(*staging) / "orchestrator.log");
     o.progress = &log;
-    auto run = runner::RunTrialSpec(s_.plan->specs.at(t.id), *host_.api, s_.clock, o);
+    // With a remover, the trial's containers and networks are removed while this slot goes on
+    // (background_removal.hpp): the attempt ends once result.json, the logs and truth.csv are in.
+    std::optional<DeferredRemovalApi> deferred;
+    if (remover_ != nullptr) deferred.emplace(*host_.api, *remover_);
+    docker::DockerApi& api = deferred ? static_cast<docker::DockerApi&>(*deferred) : *host_.api;
+    auto run = runner::RunTrialSpec(s_.plan->specs.at(t.id), api, s_.clock, o);
     log.close();
     const bool interrupted = eo.interrupted != nullptr && eo.interrupted->load();
     if (interrupted) {
@@ -159,6 +168,7 @@ class TrialExecutor final : public HostWorker {
 
   Session& s_;
   const PoolHost& host_;
+  BackgroundRemover* remover_;
 };
 
 // Updates the board and prints it; records exhausted trials.
@@ -377,10 +387,17 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
     });
   }
 
+  // Declared before the executors, so they outlive them; each drains its queue when destroyed.
+  std::vector<std::unique_ptr<BackgroundRemover>> removers;
   std::vector<std::unique_ptr<TrialExecutor>> executors;
   std::vector<HostWorker*> workers;
   for (const PoolHost& h : pool) {
-    executors.push_back(std::make_unique<TrialExecutor>(session, h));
+    BackgroundRemover* remover = nullptr;
+    if (options.remove_in_background) {
+      removers.push_back(std::make_unique<BackgroundRemover>(*h.api, h.name));
+      remover = removers.back().get();
+    }
+    executors.push_back(std::make_unique<TrialExecutor>(session, h, remover));
     workers.push_back(executors.back().get());
   }
   ScheduleOptions so;
@@ -388,6 +405,11 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
   so.interrupted = options.interrupted;
   summary.reports = RunSchedule(pending, workers, so, observer);
   (void)store.ClearStaging();  // every attempt has ended: committed, discarded or cancelled
+  // Every removal still queued is carried out before the leftover sweep (and on Ctrl-C too).
+  for (const auto& remover : removers) {
+    remover->Drain();
+    for (std::string& p : remover->TakeProblems()) problems.push_back("clean-up: " + std::move(p));
+  }
 
   if (printer.joinable()) {
     {

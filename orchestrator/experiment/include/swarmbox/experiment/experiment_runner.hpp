@@ -13,8 +13,12 @@
 // host's failure: its folder goes to .failed/, the trial back to the queue (scheduler.hpp).
 // Otherwise trial_meta.json is added and the folder committed (trial_store.hpp). A trial that
 // runs out of attempts is committed with outcome `error` and the reasons.
-// At the end: every host still reachable is checked for anything left with the run's label (and
-// cleaned), then results.csv and report.html are written from the trial folders.
+// By default a trial's containers and networks are removed in the background, one queue per host
+// (background_removal.hpp): a slot starts its next trial once result.json is written; a failed
+// removal is a problem of the summary.
+// At the end: every background removal is waited for, every host still reachable is checked for
+// anything left with the run's label (and cleaned), then results.csv and report.html are written
+// from the trial folders.
 #pragma once
 
 #include <atomic>
@@ -68,6 +72,9 @@ struct ExperimentOptions {
   std::ostream* progress = nullptr;  // the live board; nullptr = quiet
   bool progress_tty = false;         // redraw in place (ANSI) rather than print blocks
   double progress_every_s = 2.0;
+  // Remove each trial's containers and networks on a per-host thread while the slot launches its
+  // next trial (false: inside the trial, before its result.json is written).
+  bool remove_in_background = true;
   runner::RunOptions trial_options;  // the template for every trial (out_dir, run_id, trial_id,
                                      // host, images and interrupted are set per attempt)
 };
