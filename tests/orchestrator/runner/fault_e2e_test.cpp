@@ -5,11 +5,14 @@
 // (here: no sch_netem, so the userspace path: NFQUEUE + swarmbox-netemd for delay/jitter, iptables
 // statistic on ingress for loss), that nothing touches the sim interface, and that the agents are
 // unprivileged. Afterwards: the trial succeeded (the lockstep over the untouched sim link worked),
-// events.jsonl records the mechanism and each mesh apply/remove, and nothing labelled remains.
+// events.jsonl records the mechanism and each mesh apply/remove (the removal left to the sidecars'
+// namespaces: afterwards no SWARMBOX chain or NFQUEUE rule is in the host's iptables and the
+// sidecars' swarmbox-netemd processes are gone), and nothing labelled remains.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -47,6 +50,33 @@ std::string ExecOut(docker::DockerApi& api, const std::string& container, const 
   if (!out) return {};
   EXPECT_EQ(out->exit_code, 0) << faults::CommandText(argv) << ": " << out->stderr_text;
   return out->stdout_text;
+}
+
+// Host pids of the processes named `comm` in the container `container_id` (its id in their
+// cgroup paths, as Docker names them).
+std::vector<std::string> HostProcessesOf(const std::string& container_id, const std::string& comm) {
+  std::vector<std::string> pids;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator("/proc", ec)) {
+    const std::string pid = entry.path().filename().string();
+    if (pid.empty() || pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::string name = ReadFile(entry.path() / "comm");
+    if (!name.empty() && name.back() == '\n') name.pop_back();
+    if (name != comm) continue;
+    if (ReadFile(entry.path() / "cgroup").find(container_id) != std::string::npos) pids.push_back(pid);
+  }
+  return pids;
+}
+
+// The host's own iptables rules (its network namespace), every table.
+std::string HostIptables() {
+  std::string out;
+  if (std::FILE* p = ::popen("iptables-save 2>/dev/null", "r")) {
+    char buf[4096];
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+    ::pclose(p);
+  }
+  return out;
 }
 
 TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemoved) {
@@ -104,6 +134,7 @@ TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemov
   const std::string sidecar_2 = ResourceName(spec.name, options.run_id, "scout_2-faults");
   const std::string agent_2 = ResourceName(spec.name, options.run_id, "scout_2");
   bool inspected = false;
+  std::vector<std::string> daemons;  // host pids of the sidecars' swarmbox-netemd processes
   for (int i = 0; i < 600 && !done.load() && !inspected; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     auto state = api.InspectContainer(agent_2);
@@ -130,9 +161,14 @@ TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemov
         ASSERT_NE(at, std::string::npos) << rules;
         const double p = std::stod(rules.substr(at + std::string("-A SWARMBOX-RADIO-IN -m statistic --mode random --probability ").size()));
         EXPECT_NEAR(p, 0.05, 1e-6) << rules;
-        // The delayer runs in the sidecar (its pidfile is there).
+        // The delayer runs in the sidecar (its pidfile is there), as a process of the sidecar.
         auto pidfile = api.GetArchive(sidecar, "/run/swarmbox-netemd-0.pid");
         EXPECT_TRUE(pidfile) << sidecar << ": " << (pidfile ? "" : pidfile.error().ToString());
+        auto info = api.InspectContainer(sidecar);
+        ASSERT_TRUE(info) << info.error().ToString();
+        const auto pids = HostProcessesOf(info->id, "swarmbox-netemd");
+        EXPECT_GE(pids.size(), 2u) << sidecar << ": the sleeping init and the delayer";
+        daemons.insert(daemons.end(), pids.begin(), pids.end());
       } else {
         EXPECT_THAT(qdisc_mesh, HasSubstr("netem")) << qdisc_mesh;
         EXPECT_THAT(qdisc_mesh, HasSubstr("delay 40ms")) << qdisc_mesh;
@@ -153,6 +189,18 @@ TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemov
   EXPECT_THAT(events, Not(HasSubstr("\"phase\":\"failed\"")));
   // Raft ran over the impaired mesh.
   EXPECT_THAT(events, HasSubstr("\"event\":\"leader_elected\""));
+
+  // The mesh rules were not undone command by command: they went with the sidecars' network
+  // namespaces, and the delay daemons with the sidecars. Nothing of them is on the host: no
+  // SWARMBOX chain or NFQUEUE rule in its own iptables, no daemon left running.
+  EXPECT_THAT(events, HasSubstr("\"note\":\"with the sidecar's network namespace\""));
+  const std::string host_rules = HostIptables();
+  EXPECT_THAT(host_rules, Not(HasSubstr("SWARMBOX-"))) << host_rules;
+  EXPECT_THAT(host_rules, Not(HasSubstr("NFQUEUE"))) << host_rules;
+  for (const std::string& pid : daemons) {
+    std::string comm = ReadFile(fs::path("/proc") / pid / "comm");
+    EXPECT_THAT(comm, Not(HasSubstr("swarmbox-netemd"))) << "pid " << pid << " still runs";
+  }
 
   // Nothing labelled with the run is left.
   auto containers = api.ListContainers(mine, /*all=*/true);
