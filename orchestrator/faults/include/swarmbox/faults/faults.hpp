@@ -28,7 +28,10 @@
 //      FaultTimeline timeline(*faults);  LeaderTracker leaders;                  // fault_timeline.hpp
 //      every log line:  leaders.Feed(line); Carry(timeline.OnLogLine(line, wall_s));
 //      every ~50 ms:    Carry(timeline.Advance(sim_s, wall_s));
-//      shutdown:        Carry(timeline.RemoveAll());   then undo the mesh plans.
+//      shutdown:        Carry(timeline.RemoveAll());   the mesh plans need no undo when the
+//                       sidecars are removed next: their rules and daemons go with the sidecars'
+//                       network namespaces (the runner's FaultInjector records them removed so);
+//                       a fault window ending mid-trial is undone with its plan's undo.
 //    Carrying one action, by kind (targets from ResolveTarget(target, drones, leaders, rng) with
 //    rng seeded from the trial's seed: target_resolver.hpp):
 //      radio      apply: changed = layers.Push(id, targets, rules); remove: changed = layers.Pop(id);
