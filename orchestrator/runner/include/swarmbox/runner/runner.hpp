@@ -53,8 +53,8 @@ struct RunOptions {
   double progress_every_s = 2.0;
   int max_restarts = 1;
   int subnet_attempts = 5;
-  // Containers of one priority level created, started and stopped at once (EngineOptions::
-  // max_parallel); 0 = $SWARMBOX_PARALLEL when set (1 = one at a time), else 8.
+  // Containers created (ahead) and started at once (EngineOptions::max_parallel); 0 =
+  // $SWARMBOX_PARALLEL when set (1 = one at a time, nothing created ahead), else 32.
   int max_parallel = 0;
   // swarmbox-netemd for the fault sidecar image, when faults_image is "" and the trial impairs
   // the mesh ("" = FindNetemd's search, fault_image.hpp).
