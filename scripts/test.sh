@@ -6,7 +6,8 @@
 #   bash scripts/test.sh -L unit         # extra arguments go to the first ctest
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores), SANITIZE (default
 # address,undefined: the -DSANITIZER value of the sanitizer stage; "off" skips the stage),
-# ASAN_BUILD_DIR (default build-asan).
+# ASAN_BUILD_DIR (default build-asan), TSAN (default on; "off" skips the ThreadSanitizer stage),
+# TSAN_BUILD_DIR (default build-tsan).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -53,4 +54,22 @@ dsl_trial_loader_test runner_pure_test cli_launch_timing_test}"
     ctest --test-dir "$ASAN_BUILD_DIR" --output-on-failure -j "$JOBS" -L unit \
       -E '[Bb]ench|^ShippedTrialsValidate$'
   echo "test.sh: sanitizer stage took $(( $(date +%s) - stage_start )) s"
+fi
+
+# ThreadSanitizer stage: the orchestrator's concurrent code, against the fake Docker API (the
+# runner creates, starts and stops a level's containers from a pool of threads, creates later
+# levels ahead while earlier ones start, and the experiment runner removes finished trials in the
+# background while its slots launch the next ones). scripts/tsan.supp names the one report from
+# outside the project (a lock-order report inside libgdal, which OpenCV's image codecs load).
+if [ "${TSAN:-on}" != "off" ]; then
+  TSAN_BUILD_DIR=${TSAN_BUILD_DIR:-build-tsan}
+  stage_start=$(date +%s)
+  echo "test.sh: ThreadSanitizer stage in $TSAN_BUILD_DIR: runner_fake_docker_test experiment_test"
+  cmake -S . -B "$TSAN_BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSWARMBOX_WERROR=OFF \
+    -DSANITIZER=thread >/dev/null
+  cmake --build "$TSAN_BUILD_DIR" -j "$JOBS" --target runner_fake_docker_test experiment_test
+  TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp} \
+    ctest --test-dir "$TSAN_BUILD_DIR" --output-on-failure -j "$JOBS" -L unit \
+      -E '[Bb]ench|^ShippedTrialsValidate$'
+  echo "test.sh: ThreadSanitizer stage took $(( $(date +%s) - stage_start )) s"
 fi
