@@ -101,7 +101,13 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   if (!fc) return fc.error();
   std::unique_ptr<AgentNode> node(new AgentNode(o, std::move(*fc), std::move(*plan)));
 
-  auto sim = bus::Participant::Create({.backend = o.middleware, .domain_id = o.sim_domain, .interface = o.sim_interface});
+  // No writer lingers at exit (Cyclone's default keeps an unacknowledged one up to 1 s, ~0.2 s per
+  // agent on a stop): what it sent last (the last actuator command, Raft messages the protocol
+  // resends, state, detections) is of no use once the agent goes, and the orchestrator stops the
+  // next priority level (the physics server) only when every agent has exited.
+  constexpr int kNoLinger = 0;
+  auto sim = bus::Participant::Create(
+      {.backend = o.middleware, .domain_id = o.sim_domain, .interface = o.sim_interface, .writer_linger_ms = kNoLinger});
   if (!sim) return sim.error().Context("joining the sim bus");
   node->sim_ = std::move(*sim);
   auto sub = node->sim_->CreateSubscriber<bus::SensorSample>(bus::SensorTopic(o.name), bus::Qos::kLockstep);
@@ -111,7 +117,10 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   if (!pub) return pub.error().Context("publishing actuator commands");
   node->actuator_pub_ = std::move(*pub);
   if (o.mesh) {
-    auto mesh = bus::Participant::Create({.backend = o.middleware, .domain_id = o.mesh_domain, .interface = o.mesh_interface});
+    auto mesh = bus::Participant::Create({.backend = o.middleware,
+                                          .domain_id = o.mesh_domain,
+                                          .interface = o.mesh_interface,
+                                          .writer_linger_ms = kNoLinger});
     if (!mesh) return mesh.error().Context("joining the mesh bus");
     node->mesh_ = std::move(*mesh);
     auto sp = node->mesh_->CreatePublisher<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState);

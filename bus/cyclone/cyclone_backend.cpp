@@ -29,7 +29,7 @@ class DomainRegistry {
     return registry;
   }
 
-  Status Acquire(int domain_id, const std::string& interface) {
+  Status Acquire(int domain_id, const std::string& interface, int writer_linger_ms) {
     std::lock_guard lock(mu_);
     auto it = domains_.find(domain_id);
     if (it != domains_.end()) {
@@ -46,7 +46,10 @@ class DomainRegistry {
     const std::string xml =
         "<CycloneDDS><Domain Id=\"any\"><General><Interfaces>"
         "<NetworkInterface name=\"" + interface + "\" multicast=\"true\"/>"
-        "</Interfaces><AllowMulticast>true</AllowMulticast></General>"
+        "</Interfaces><AllowMulticast>true</AllowMulticast></General>" +
+        (writer_linger_ms >= 0
+             ? "<Internal><WriterLingerDuration>" + std::to_string(writer_linger_ms) + " ms</WriterLingerDuration></Internal>"
+             : std::string()) +
         "<Tracing><Verbosity>severe</Verbosity><OutputFile>stderr</OutputFile></Tracing>"
         "</Domain></CycloneDDS>";
     const dds_entity_t domain = dds_create_domain(static_cast<dds_domainid_t>(domain_id), xml.c_str());
@@ -371,7 +374,7 @@ Result<std::unique_ptr<ParticipantBackend>> CreateCycloneBackend(const Participa
                                                                  const std::string& ipv4) {
   (void)ipv4;  // Cyclone binds by interface name (the XML config); the address is for Fast DDS
   using cyclone_detail::DomainRegistry;
-  SWARMBOX_TRY(DomainRegistry::Instance().Acquire(config.domain_id, config.interface));
+  SWARMBOX_TRY(DomainRegistry::Instance().Acquire(config.domain_id, config.interface, config.writer_linger_ms));
   const dds_entity_t pp =
       dds_create_participant(static_cast<dds_domainid_t>(config.domain_id), nullptr, nullptr);
   if (pp < 0) {

@@ -44,6 +44,11 @@ struct ParticipantConfig {
   std::string backend = std::string(kDefaultBackend);  // "cyclonedds" or "fastdds"
   int domain_id = 0;                                    // [0, kMaxDomainId]
   std::string interface = "lo";                         // network interface name, must have IPv4
+  // Cyclone DDS: how long a deleted writer waits for its unacknowledged samples to be acknowledged
+  // (its reliable protocol's heartbeats, ~0.2 s on an idle link) before it goes; -1 = Cyclone's
+  // default (1 s). A process that must leave at once on a stop request and needs nothing it sent
+  // last sets it low. Set by the first participant of a domain id in the process. Fast DDS: unused.
+  int writer_linger_ms = -1;
 };
 
 // The backend names Participant::Create accepts, in order: {"cyclonedds", "fastdds"}.
