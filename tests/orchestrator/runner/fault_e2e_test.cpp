@@ -12,10 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <thread>
 
 #include "swarmbox/docker/docker_client.hpp"
@@ -23,10 +20,12 @@
 #include "swarmbox/faults/docker_exec_runner.hpp"
 #include "swarmbox/faults/mechanism.hpp"
 #include "swarmbox/images/ensure_image.hpp"
+#include "swarmbox/images/process_capture.hpp"
 #include "swarmbox/images/standard_images.hpp"
 #include "swarmbox/runner/fault_image.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
+#include "support/files.hpp"
 
 namespace swarmbox::runner {
 namespace {
@@ -35,12 +34,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 // What `argv` prints in `container` (exit code must be 0).
 std::string ExecOut(docker::DockerApi& api, const std::string& container, const std::vector<std::string>& argv) {
@@ -68,15 +62,13 @@ std::vector<std::string> HostProcessesOf(const std::string& container_id, const 
   return pids;
 }
 
-// The host's own iptables rules (its network namespace), every table.
+// The host's own iptables rules (its network namespace), every table; the run must succeed.
 std::string HostIptables() {
-  std::string out;
-  if (std::FILE* p = ::popen("iptables-save 2>/dev/null", "r")) {
-    char buf[4096];
-    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
-    ::pclose(p);
-  }
-  return out;
+  auto run = images::RunCapture({"iptables-save"});
+  EXPECT_TRUE(run) << run.error().ToString();
+  if (!run) return {};
+  EXPECT_EQ(run->exit_code, 0) << run->err;
+  return run->out;
 }
 
 TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemoved) {
