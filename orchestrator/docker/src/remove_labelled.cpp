@@ -1,6 +1,22 @@
 #include "swarmbox/docker/remove_labelled.hpp"
 
+#include <chrono>
+#include <thread>
+
 namespace swarmbox::docker {
+
+bool IsStaleEndpointRefusal(const Status& s) {
+  return !s && s.error().message().find("active endpoints") != std::string::npos;
+}
+
+Status RemoveNetworkPatiently(DockerApi& api, std::string_view id) {
+  Status s = api.RemoveNetwork(id);
+  for (int wait_ms = 100; IsStaleEndpointRefusal(s) && wait_ms <= 1600; wait_ms *= 2) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
+    s = api.RemoveNetwork(id);
+  }
+  return s;
+}
 
 Result<RemovalReport> RemoveLabelled(DockerApi& api, const LabelSelector& selector,
                                      bool include_images) {
@@ -26,7 +42,7 @@ Result<RemovalReport> RemoveLabelled(DockerApi& api, const LabelSelector& select
   auto networks = api.ListNetworks(selector);
   if (!networks) return networks.error().Context("listing labelled networks");
   for (const NetworkInfo& n : *networks) {
-    keep(api.RemoveNetwork(n.id), &report.networks, n.id);
+    keep(RemoveNetworkPatiently(api, n.id), &report.networks, n.id);
   }
 
   if (include_images) {

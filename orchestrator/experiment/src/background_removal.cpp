@@ -1,7 +1,8 @@
 #include "swarmbox/experiment/background_removal.hpp"
 
-#include <chrono>
 #include <utility>
+
+#include "swarmbox/docker/remove_labelled.hpp"
 
 namespace swarmbox::experiment {
 
@@ -88,20 +89,10 @@ void BackgroundRemover::Remove(const Item& item) {
       problem = host_ + ": removing container " + item.id + ": " + s.error().ToString();
     }
   } else {
-    // Docker 20.10 can refuse with "has active endpoints" though nothing is attached any more
-    // (moby#43286); the endpoint is sometimes released a moment later (as DockerEngine does).
-    auto stale = [](const Status& st) {
-      return !st && st.error().message().find("active endpoints") != std::string::npos;
-    };
-    Status s = api_.RemoveNetwork(item.id);
-    for (int wait_ms = 100; stale(s) && wait_ms <= 1600; wait_ms *= 2) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
-      s = api_.RemoveNetwork(item.id);
-    }
-    if (stale(s)) {
+    const Status s = docker::RemoveNetworkPatiently(api_, item.id);
+    if (docker::IsStaleEndpointRefusal(s)) {
       problem = host_ + ": network " + item.id + " left on the engine: " + s.error().message() +
-                " (no container of the trial is attached: Docker 20.10 keeps a stale endpoint, "
-                "moby#43286, until dockerd restarts; `swarmbox gc` removes the network then)";
+                " (" + docker::kStaleEndpointAdvice + ")";
     } else if (!s && s.error().code() != ErrorCode::kNotFound) {
       problem = host_ + ": removing network " + item.id + ": " + s.error().ToString();
     }

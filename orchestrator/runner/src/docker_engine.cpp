@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/docker/tar_archive.hpp"
 #include "swarmbox/runner/end_matcher.hpp"
 
@@ -212,22 +213,11 @@ Verdict DockerEngine::RemoveNetwork(dsl::Network& network) {
     id = it->second;
     network_ids_.erase(it);
   }
-  // Docker 20.10 can refuse with "has active endpoints" though no container is attached any
-  // more, when several of its containers exited at once (moby#43286; docker-compose down hits it
-  // too). Sometimes the endpoint is released a moment later: retry for ~3 s. When it stays, only
-  // a daemon restart frees the network; say so.
-  Status s = api_.RemoveNetwork(id);
-  for (int wait_ms = 100; !s && wait_ms <= 1600 &&
-                          s.error().message().find("active endpoints") != std::string::npos;
-       wait_ms *= 2) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(wait_ms));
-    s = api_.RemoveNetwork(id);
-  }
-  if (!s && s.error().message().find("active endpoints") != std::string::npos) {
+  const Status s = docker::RemoveNetworkPatiently(api_, id);
+  if (docker::IsStaleEndpointRefusal(s)) {
     // An engine fault after the trial, not the trial's: its outcome stands, the problem is kept.
     AddProblem("network " + network.spec().name + " left on the engine: " + s.error().message() +
-               " (no container of the trial is attached: Docker 20.10 keeps a stale endpoint, "
-               "moby#43286, until dockerd restarts; `swarmbox gc` removes the network then)");
+               " (" + docker::kStaleEndpointAdvice + ")");
     return Verdict::Success();
   }
   if (!s && s.error().code() != ErrorCode::kNotFound) {

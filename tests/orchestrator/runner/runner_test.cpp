@@ -17,6 +17,7 @@
 
 #include "fake_docker_api.hpp"
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/docker/tar_archive.hpp"
 #include "swarmbox/runner/docker_engine.hpp"
 
@@ -264,6 +265,33 @@ TEST_F(RunnerTest, AStaleEndpointIsWaitedOutAndOneThatStaysIsNamed) {
   EXPECT_THAT(problems, HasSubstr("moby#43286")) << problems;
   EXPECT_THAT(problems, HasSubstr("swarmbox gc")) << problems;
   EXPECT_TRUE(api_.Containers().empty());
+}
+
+TEST(RemoveLabelled, GcRidesOutAStaleEndpointAndReportsOneThatStays) {
+  // `swarmbox gc` removes networks with the same patience as a run's teardown.
+  testing::FakeDockerApi api;
+  docker::NetworkSpec net;
+  net.name = "gc-net";
+  net.subnet = "10.79.0.0/24";
+  net.labels = {{"swarmbox.run", "gc-test"}};
+  ASSERT_TRUE(api.CreateNetwork(net));
+  docker::LabelSelector run;
+  run.equals = {{"swarmbox.run", "gc-test"}};
+  api.stale_endpoints = 2;  // released after two refusals
+  auto report = docker::RemoveLabelled(api, run, /*include_images=*/false);
+  ASSERT_TRUE(report) << report.error().ToString();
+  EXPECT_EQ(report->networks.size(), 1u);
+  EXPECT_TRUE(report->failures.empty());
+  EXPECT_TRUE(api.Networks().empty());
+
+  net.name = "gc-net-2";
+  ASSERT_TRUE(api.CreateNetwork(net));
+  api.stale_endpoints = 1000;  // never released
+  report = docker::RemoveLabelled(api, run, /*include_images=*/false);
+  ASSERT_TRUE(report) << report.error().ToString();
+  ASSERT_EQ(report->failures.size(), 1u);
+  EXPECT_TRUE(docker::IsStaleEndpointRefusal(Status(report->failures[0])));
+  EXPECT_EQ(api.Networks().size(), 1u);
 }
 
 TEST_F(RunnerTest, ABrokenLogStreamRestartsTheTrial) {
