@@ -148,7 +148,8 @@ TEST_F(AgentRaft, LeaderAgentKillFailsOverAndRestartedAgentCatchesUpFromItsWal) 
     EXPECT_TRUE(c->running()) << name << "\n" << c->ReadLog();
     EXPECT_TRUE(Events(c->ReadLog(), "raft_stopped").empty()) << name;
   }
-  // 7. Clean shutdown: SIGTERM ends each agent with 0 (Raft service stopped before the mesh).
+  // 7. Shutdown: SIGTERM ends each agent with 0 after event=stopped (it leaves without the DDS
+  // goodbye, main.cpp LeaveNow).
   for (auto& [name, c] : agents) c->Signal(SIGTERM);
   for (auto& [name, c] : agents) {
     EXPECT_EQ(c->Wait(10s), 0) << name << "\n" << c->ReadLog();
