@@ -12,10 +12,19 @@
 //   2. `swarmbox compose` (untimed), then `docker-compose up -d`: from starting docker-compose to
 //      the last agent's `event=ready` (compose_ready_s), and the time `up -d` itself took; then
 //      `docker-compose down` (compose_down_s, for reference).
-// Every time comes from the engine (log line timestamps and `die` events, both on this host's real
-// time clock), watched by the bench itself, so both paths are measured the same way. The exported
-// file's fixed subnets move to a free pair when another network on the engine holds them.
-// Aims (issue 6): ratio = run_ready_s / compose_ready_s <= 0.5; end_to_stopped_s < 1.
+//   3. The engine's floor: N containers of the agent image (argv `--help`: they print and exit),
+//      created beforehand on two fresh networks as the trial's agents are (untimed), then started
+//      all at once, one request each: from the first start request to the last `start` event
+//      (engine_start_floor_s). No launcher, swarmbox or docker-compose, starts the trial's agents
+//      faster than this on this engine; floor_over_compose = engine_start_floor_s / compose_ready_s.
+// Every time comes from the engine (log line timestamps and `start`/`die` events, both on this
+// host's real time clock), watched by the bench itself, so every path is measured the same way.
+// The exported file's fixed subnets move to a free pair when another network on the engine holds
+// them.
+// Aims (issue 6): ratio = run_ready_s / compose_ready_s <= 0.5; end_to_stopped_s < 1. The ratio
+// aim is out of reach on an engine whose floor alone is over half of compose's time
+// (floor_rules_out_ratio_aim=yes: floor_over_compose > 0.5); "no" only means that the floor
+// alone does not rule it out (the trial's physics server still starts and gets ready first).
 #include <unistd.h>
 
 #include <algorithm>
@@ -65,7 +74,9 @@ std::int64_t NowUnixNs() {
 // log (followed with Docker's timestamps) for its first `event=ready` and the ending line.
 class EngineWatch {
  public:
-  EngineWatch(docker::DockerApi& api, std::string run_id) : api_(api), run_id_(std::move(run_id)) {
+  // follow_logs: follow each started container's log (ready and ending lines).
+  EngineWatch(docker::DockerApi& api, std::string run_id, bool follow_logs = true)
+      : api_(api), run_id_(std::move(run_id)), follow_logs_(follow_logs) {
     docker::EventFilter filter;
     filter.labels.equals[std::string(docker::kLabelRun)] = run_id_;
     filter.types = {"container"};
@@ -122,6 +133,12 @@ class EngineWatch {
     std::lock_guard<std::mutex> lock(mu_);
     return started_.size();
   }
+  // Until `n` containers have started, or the deadline; then the last start's engine time.
+  std::optional<std::int64_t> WaitStarted(std::size_t n, std::chrono::steady_clock::time_point deadline) {
+    std::unique_lock<std::mutex> lock(mu_);
+    if (!cv_.wait_until(lock, deadline, [&] { return started_.size() >= n; })) return std::nullopt;
+    return last_start_ns_;
+  }
 
  private:
   void OnEvent(const docker::Event& e) {
@@ -133,6 +150,9 @@ class EngineWatch {
       return;
     }
     if (e.action != "start" || !started_.insert(e.actor_id).second) return;
+    last_start_ns_ = std::max(last_start_ns_, e.time_unix_ns);
+    cv_.notify_all();
+    if (!follow_logs_) return;
     auto c = e.attributes.find(std::string(docker::kLabelComponent));
     const std::string component = c == e.attributes.end() ? e.actor_id : c->second;
     followers_.emplace_back([this, id = e.actor_id, component] { Follow(id, component); });
@@ -165,7 +185,9 @@ class EngineWatch {
 
   docker::DockerApi& api_;
   std::string run_id_;
+  bool follow_logs_ = true;
   std::int64_t since_ns_ = 0;
+  std::int64_t last_start_ns_ = 0;
   docker::CancelToken cancel_;
   std::mutex mu_;
   std::condition_variable cv_;
@@ -280,13 +302,95 @@ Status MoveComposeSubnetsIfTaken(docker::DockerApi& api, const fs::path& file) {
   return Ok{};
 }
 
+// The agent image `swarmbox images` printed ("swarmbox/agent:<hash>  present  46 MiB"), or "".
+std::string AgentImage(const std::string& images_out) {
+  std::istringstream in(images_out);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("swarmbox/agent:", 0) == 0) return line.substr(0, line.find_first_of(" \t"));
+  }
+  return "";
+}
+
+// Step 3 (see the top): N agent-image containers on two fresh networks, started all at once.
+Result<double> EngineStartFloor(docker::DockerApi& api, int drones, const std::string& image) {
+  const std::string run_id = "floor-" + std::to_string(::getpid());
+  const std::string trial = TrialName(drones);
+  const docker::Labels labels = {{std::string(docker::kLabelRun), run_id},
+                                 {std::string(docker::kLabelTrial), trial}};
+  std::size_t left = 0;
+  auto clean = [&] { RemoveRun(api, run_id, trial, &left); };
+  auto nets = api.ListNetworks({});
+  if (!nets) return nets.error();
+  std::vector<std::string> taken;
+  for (const auto& n : *nets) {
+    if (!n.subnet.empty()) taken.push_back(n.subnet);
+  }
+  auto subnets = runner::PickSubnets(run_id + "/" + trial, 0, taken);
+  if (!subnets) return subnets.error();
+  std::vector<std::string> network_ids;
+  const std::vector<std::pair<std::string, runner::Ipv4Net>> wanted = {{"sim", subnets->sim},
+                                                                         {"mesh", subnets->mesh}};
+  for (const auto& [suffix, cidr] : wanted) {
+    docker::NetworkSpec spec;
+    spec.name = trial + "-floor-" + suffix;
+    spec.subnet = cidr.ToString();
+    spec.labels = labels;
+    auto id = api.CreateNetwork(spec);
+    if (!id) {
+      clean();
+      return id.error();
+    }
+    network_ids.push_back(*id);
+  }
+  std::vector<std::string> ids;
+  for (int i = 0; i < drones; ++i) {
+    docker::ContainerSpec spec;
+    spec.name = trial + "-floor-" + std::to_string(i + 1);
+    spec.image = image;
+    spec.cmd = {"--help"};
+    spec.labels = labels;
+    // Fixed addresses, as the trial's containers have.
+    const auto host = static_cast<std::uint32_t>(10 + i);
+    spec.networks = {{.network = network_ids[0], .ipv4_address = subnets->sim.Host(host), .aliases = {}},
+                     {.network = network_ids[1], .ipv4_address = subnets->mesh.Host(host), .aliases = {}}};
+    auto id = api.CreateContainer(spec);
+    if (!id) {
+      clean();
+      return id.error();
+    }
+    ids.push_back(*id);
+  }
+  Result<double> floor = Error(ErrorCode::kTimeout, "not every container started within 2 minutes");
+  {
+    EngineWatch watch(api, run_id, /*follow_logs=*/false);
+    std::vector<Status> started(ids.size(), Ok{});
+    const std::int64_t first_ns = NowUnixNs();
+    std::vector<std::thread> starters;
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+      starters.emplace_back([&, i] { started[i] = api.StartContainer(ids[i]); });
+    }
+    for (std::thread& t : starters) t.join();
+    for (const Status& st : started) {
+      if (!st) floor = st.error();
+    }
+    if (floor || floor.error().code() == ErrorCode::kTimeout) {
+      if (auto last = watch.WaitStarted(ids.size(), std::chrono::steady_clock::now() + std::chrono::minutes(2))) {
+        floor = static_cast<double>(*last - first_ns) / 1e9;
+      }
+    }
+  }
+  clean();
+  return floor;
+}
+
 struct ScenarioResult {
   bool ok = true;
   std::string line;
 };
 
 ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& scratch,
-                           const std::string& compose_exe) {
+                           const std::string& compose_exe, const std::string& agent_image) {
   using std::chrono::minutes;
   using std::chrono::steady_clock;
   const std::vector<std::string> agents = AgentNames(drones);
@@ -390,13 +494,24 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
     RemoveRun(api, kComposeRunId, trial, &compose_left);
   }
 
+  // 3. The engine's floor.
+  std::optional<double> floor_s;
+  if (auto f = EngineStartFloor(api, drones, agent_image)) {
+    floor_s = *f;
+  } else {
+    std::fprintf(stderr, "launch: the engine's floor (%d containers): %s\n", drones, f.error().ToString().c_str());
+  }
+
   line << " run_ready_s=" << Fmt(run_ready_s) << " compose_ready_s=" << Fmt(compose_ready_s);
-  std::optional<double> ratio;
+  std::optional<double> ratio, floor_over_compose;
   if (run_ready_s && compose_ready_s && *compose_ready_s > 0) ratio = *run_ready_s / *compose_ready_s;
+  if (floor_s && compose_ready_s && *compose_ready_s > 0) floor_over_compose = *floor_s / *compose_ready_s;
   line << " ratio=" << Fmt(ratio) << " end_to_stopped_s=" << Fmt(end_to_stopped_s)
        << " end_to_exit_s=" << Fmt(end_to_exit_s) << " compose_up_returned_s=" << Fmt(compose_up_s)
        << " compose_down_s=" << Fmt(compose_down_s)
+       << " engine_start_floor_s=" << Fmt(floor_s) << " floor_over_compose=" << Fmt(floor_over_compose)
        << " aim_ratio_met=" << (ratio && *ratio <= 0.5 ? "yes" : "no")
+       << " floor_rules_out_ratio_aim=" << (!floor_over_compose ? "unknown" : *floor_over_compose > 0.5 ? "yes" : "no")
        << " aim_stop_met=" << (end_to_stopped_s && *end_to_stopped_s < 1.0 ? "yes" : "no")
        << " left=" << run_left + compose_left;
   if (!compose_ok) {
@@ -443,9 +558,15 @@ int RunLaunchBench(const bench::Args& args) {
     fs::remove_all(scratch);
     return 1;
   }
+  const std::string agent_image = AgentImage(images->out);
+  if (agent_image.empty()) {
+    std::printf("suite=launch error=\"swarmbox images printed no swarmbox/agent image: %s\"\n", images->out.c_str());
+    fs::remove_all(scratch);
+    return 1;
+  }
   int failures = 0;
   for (int n : sizes) {
-    ScenarioResult r = RunScenario(**api, n, scratch, compose_exe);
+    ScenarioResult r = RunScenario(**api, n, scratch, compose_exe, agent_image);
     std::printf("%s\n", r.line.c_str());
     std::fflush(stdout);
     if (!r.ok) ++failures;
