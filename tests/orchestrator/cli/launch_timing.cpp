@@ -88,4 +88,11 @@ LaunchFigures ComputeLaunchFigures(const LaunchTimes& times, const std::vector<s
   return f;
 }
 
+std::optional<double> StartToReady(const LaunchTimes& times, const std::string& component) {
+  auto start = times.start_ns.find(component);
+  auto ready = times.ready_ns.find(component);
+  if (start == times.start_ns.end() || ready == times.ready_ns.end()) return std::nullopt;
+  return Seconds(ready->second - start->second);
+}
+
 }  // namespace swarmbox::cli::testing

@@ -35,6 +35,7 @@ std::optional<StampedLine> SplitStampedLine(std::string_view line);
 struct LaunchTimes {
   std::int64_t spawn_ns = 0;
   std::map<std::string, std::int64_t> ready_ns;  // component -> its first event=ready line
+  std::map<std::string, std::int64_t> start_ns;  // component -> its container's `start` event
   std::optional<std::int64_t> end_line_ns;        // the ending line (runs with a watcher only)
   std::vector<std::int64_t> died_ns;               // one per container that stopped
   std::optional<std::int64_t> exited_ns;           // when the launching program exited
@@ -48,5 +49,8 @@ struct LaunchFigures {
 };
 
 LaunchFigures ComputeLaunchFigures(const LaunchTimes& times, const std::vector<std::string>& agents);
+
+// From a component's container `start` event to its event=ready line; nullopt without both.
+std::optional<double> StartToReady(const LaunchTimes& times, const std::string& component);
 
 }  // namespace swarmbox::cli::testing

@@ -63,5 +63,15 @@ TEST(LaunchFigures, AnAgentThatNeverGotReadyLeavesNoLaunchTime) {
   EXPECT_FALSE(f.end_to_exit_s);
 }
 
+TEST(LaunchFigures, StartToReadyOfOneComponent) {
+  LaunchTimes t;
+  t.start_ns = {{"physics", 100 * kS + kS / 4}, {"scout_1", 101 * kS}};
+  t.ready_ns = {{"physics", 100 * kS + kS}, {"scout_2", 102 * kS}};
+  ASSERT_TRUE(StartToReady(t, "physics"));
+  EXPECT_DOUBLE_EQ(*StartToReady(t, "physics"), 0.75);
+  EXPECT_FALSE(StartToReady(t, "scout_1"));  // never ready
+  EXPECT_FALSE(StartToReady(t, "scout_2"));  // no start event seen
+}
+
 }  // namespace
 }  // namespace swarmbox::cli::testing
