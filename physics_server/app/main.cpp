@@ -8,6 +8,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <numbers>
 
@@ -161,5 +162,15 @@ int main(int argc, char** argv) {
                           .c_str());
   std::fflush(stdout);
   if (!s) return Fail(3, s.error().ToString());
+  if (g_stop.load()) {
+    // Stopped by a signal (a trial's end): truth.csv and event=stopped are out, so leave without
+    // DDS's orderly goodbye, as the agents do (agent/app/main.cpp): announcing the removal of the
+    // server's 3 endpoints per drone to agents that are gone or going is of no use to anyone.
+    if (truth) {
+      if (Status f = truth->Flush(); !f) return Fail(3, f.error().ToString());
+    }
+    std::fflush(stderr);
+    std::_Exit(0);
+  }
   return 0;
 }
