@@ -19,7 +19,9 @@
 //      request each, from the first start request to the last `start` event; plus
 //      physics_start_to_ready_s, the physics server's own start (its container's `start` event
 //      to its event=ready line) in the run of step 1. in_order_floor_s is their sum, and
-//      floor_over_compose = in_order_floor_s / compose_ready_s.
+//      floor_over_compose = in_order_floor_s / compose_ready_s. The same containers are then
+//      stopped all at once: the first stop request to the last `die` event (engine_stop_floor_s,
+//      the engine's part of one level's stop, to set end_to_stopped_s against).
 // Every time comes from the engine (log line timestamps and `start`/`die` events, both on this
 // host's real time clock), watched by the bench itself, so every path is measured the same way.
 // The exported file's fixed subnets move to a free pair when another network on the engine holds
@@ -323,8 +325,13 @@ Result<std::string> FloorImage(docker::DockerApi& api) {
   return image->tag;
 }
 
-// Step 3 (see the top): N idle containers on two fresh networks, started all at once.
-Result<double> EngineStartFloor(docker::DockerApi& api, int drones, const std::string& image) {
+// Step 3 (see the top): N idle containers on two fresh networks, started all at once, then
+// stopped all at once.
+struct EngineFloor {
+  double start_s = 0;            // the first start request to the last `start` event
+  std::optional<double> stop_s;  // the first stop request to the last `die` event
+};
+Result<EngineFloor> EngineStartFloor(docker::DockerApi& api, int drones, const std::string& image) {
   const std::string run_id = "floor-" + std::to_string(::getpid());
   const std::string trial = TrialName(drones);
   const docker::Labels labels = {{std::string(docker::kLabelRun), run_id},
@@ -372,7 +379,7 @@ Result<double> EngineStartFloor(docker::DockerApi& api, int drones, const std::s
     }
     ids.push_back(*id);
   }
-  Result<double> floor = Error(ErrorCode::kTimeout, "not every container started within 2 minutes");
+  Result<EngineFloor> floor = Error(ErrorCode::kTimeout, "not every container started within 2 minutes");
   {
     EngineWatch watch(api, run_id, /*follow_logs=*/false);
     std::vector<Status> started(ids.size(), Ok{});
@@ -382,13 +389,25 @@ Result<double> EngineStartFloor(docker::DockerApi& api, int drones, const std::s
       starters.emplace_back([&, i] { started[i] = api.StartContainer(ids[i]); });
     }
     for (std::thread& t : starters) t.join();
+    Status failed = Ok{};
     for (const Status& st : started) {
-      if (!st) floor = st.error();
+      if (!st) failed = st;
     }
-    if (floor || floor.error().code() == ErrorCode::kTimeout) {
-      if (auto last = watch.WaitStarted(ids.size(), std::chrono::steady_clock::now() + std::chrono::minutes(2))) {
-        floor = static_cast<double>(*last - first_ns) / 1e9;
+    if (!failed) {
+      floor = failed.error();
+    } else if (auto last = watch.WaitStarted(ids.size(), std::chrono::steady_clock::now() + std::chrono::minutes(2))) {
+      EngineFloor f;
+      f.start_s = static_cast<double>(*last - first_ns) / 1e9;
+      // Then stopped all at once, as a trial's level is: the first stop request to the last `die`.
+      const std::int64_t stop_ns = NowUnixNs();
+      std::vector<std::thread> stoppers;
+      for (const std::string& id : ids) stoppers.emplace_back([&api, &id] { (void)api.StopContainer(id, 10); });
+      for (std::thread& t : stoppers) t.join();
+      if (watch.WaitAllDied(std::chrono::steady_clock::now() + std::chrono::minutes(1))) {
+        const LaunchTimes t = watch.Times();
+        f.stop_s = static_cast<double>(*std::max_element(t.died_ns.begin(), t.died_ns.end()) - stop_ns) / 1e9;
       }
+      floor = f;
     }
   }
   clean();
@@ -507,9 +526,10 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
   }
 
   // 3. The engine's floor.
-  std::optional<double> floor_s;
+  std::optional<double> floor_s, stop_floor_s;
   if (auto f = EngineStartFloor(api, drones, floor_image)) {
-    floor_s = *f;
+    floor_s = f->start_s;
+    stop_floor_s = f->stop_s;
   } else {
     std::fprintf(stderr, "launch: the engine's floor (%d containers): %s\n", drones, f.error().ToString().c_str());
   }
@@ -526,6 +546,7 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
        << " compose_down_s=" << Fmt(compose_down_s)
        << " physics_start_to_ready_s=" << Fmt(physics_start_to_ready_s) << " engine_start_floor_s=" << Fmt(floor_s)
        << " in_order_floor_s=" << Fmt(in_order_floor_s) << " floor_over_compose=" << Fmt(floor_over_compose)
+       << " engine_stop_floor_s=" << Fmt(stop_floor_s)
        << " aim_ratio_met=" << (ratio && *ratio <= 0.5 ? "yes" : "no")
        << " floor_rules_out_ratio_aim=" << (!floor_over_compose ? "unknown" : *floor_over_compose > 0.5 ? "yes" : "no")
        << " aim_stop_met=" << (end_to_stopped_s && *end_to_stopped_s < 1.0 ? "yes" : "no")
