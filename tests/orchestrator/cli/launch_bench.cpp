@@ -331,13 +331,14 @@ struct EngineFloor {
   double start_s = 0;            // the first start request to the last `start` event
   std::optional<double> stop_s;  // the first stop request to the last `die` event
 };
-Result<EngineFloor> EngineStartFloor(docker::DockerApi& api, int drones, const std::string& image) {
+// `left`: what is still there after the clean-up (a stale network), as for the runs.
+Result<EngineFloor> MeasureEngineFloor(docker::DockerApi& api, int drones, const std::string& image,
+                                       std::size_t* left) {
   const std::string run_id = "floor-" + std::to_string(::getpid());
   const std::string trial = TrialName(drones);
   const docker::Labels labels = {{std::string(docker::kLabelRun), run_id},
                                  {std::string(docker::kLabelTrial), trial}};
-  std::size_t left = 0;
-  auto clean = [&] { RemoveRun(api, run_id, trial, &left); };
+  auto clean = [&] { RemoveRun(api, run_id, trial, left); };
   auto nets = api.ListNetworks({});
   if (!nets) return nets.error();
   std::vector<std::string> taken;
@@ -527,7 +528,8 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
 
   // 3. The engine's floor.
   std::optional<double> floor_s, stop_floor_s;
-  if (auto f = EngineStartFloor(api, drones, floor_image)) {
+  std::size_t floor_left = 0;
+  if (auto f = MeasureEngineFloor(api, drones, floor_image, &floor_left)) {
     floor_s = f->start_s;
     stop_floor_s = f->stop_s;
   } else {
@@ -550,7 +552,7 @@ ScenarioResult RunScenario(docker::DockerApi& api, int drones, const fs::path& s
        << " aim_ratio_met=" << (ratio && *ratio <= 0.5 ? "yes" : "no")
        << " floor_rules_out_ratio_aim=" << (!floor_over_compose ? "unknown" : *floor_over_compose > 0.5 ? "yes" : "no")
        << " aim_stop_met=" << (end_to_stopped_s && *end_to_stopped_s < 1.0 ? "yes" : "no")
-       << " left=" << run_left + compose_left;
+       << " left=" << run_left + compose_left + floor_left;
   if (!compose_ok) {
     std::fprintf(stderr, "launch: %s\n", compose_error.c_str());
     return fail("docker-compose launch failed");
