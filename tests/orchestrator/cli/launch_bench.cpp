@@ -47,12 +47,11 @@
 
 #include "bench.hpp"
 #include "launch_timing.hpp"
+#include "orchestrator/runner/e2e_node_image.hpp"
 #include "support/child_process.hpp"
 #include "support/files.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
-#include "swarmbox/images/ensure_image.hpp"
-#include "swarmbox/images/image_spec.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/subnets.hpp"
 
@@ -308,21 +307,6 @@ Status MoveComposeSubnetsIfTaken(docker::DockerApi& api, const fs::path& file) {
   std::fprintf(stderr, "launch: exported subnets %s and %s are taken on this engine; using %s and %s\n",
                sim.c_str(), mesh.c_str(), free->sim.ToString().c_str(), free->mesh.ToString().c_str());
   return Ok{};
-}
-
-// The image of the floor's containers: swarmbox-e2e-node packed as `swarmbox images` packs the
-// programs (content-hash tag: built once).
-Result<std::string> FloorImage(docker::DockerApi& api) {
-  constexpr char kInImage[] = "/usr/local/bin/swarmbox-e2e-node";
-  images::ImageSpec spec;
-  spec.repository = "swarmbox/e2e-node";
-  spec.component = "e2e-node";
-  spec.executables = {{SWARMBOX_LAUNCH_E2E_NODE, kInImage, 0}};
-  spec.entrypoint = {kInImage};
-  images::AddSwarmboxBaseFiles(&spec);
-  auto image = images::EnsureImage(api, spec, {}, nullptr);
-  if (!image) return image.error();
-  return image->tag;
 }
 
 // Step 3 (see the top): N idle containers on two fresh networks, started all at once, then
@@ -597,7 +581,7 @@ int RunLaunchBench(const bench::Args& args) {
     fs::remove_all(scratch);
     return 1;
   }
-  auto floor_image = FloorImage(**api);
+  auto floor_image = swarmbox::testing::EnsureE2eNodeImage(**api, SWARMBOX_LAUNCH_E2E_NODE);
   if (!floor_image) {
     std::printf("suite=launch error=\"the floor's image: %s\"\n", floor_image.error().ToString().c_str());
     fs::remove_all(scratch);

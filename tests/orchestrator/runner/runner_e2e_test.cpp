@@ -8,9 +8,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "e2e_node_image.hpp"
 #include "swarmbox/docker/docker_client.hpp"
-#include "swarmbox/images/ensure_image.hpp"
-#include "swarmbox/images/image_spec.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
 
@@ -20,7 +19,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-constexpr char kNodeInImage[] = "/usr/local/bin/swarmbox-e2e-node";
+using swarmbox::testing::kE2eNodeInImage;
 
 std::string ReadFile(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -35,15 +34,9 @@ class RunnerE2eTest : public ::testing::Test {
     auto client = docker::DockerClient::Connect(docker::DockerClientOptions{});
     ASSERT_TRUE(client) << "these tests need a Docker engine: " << client.error().ToString();
     api_ = std::move(*client).release();
-    images::ImageSpec spec;
-    spec.repository = "swarmbox/e2e-node";
-    spec.component = "e2e-node";
-    spec.executables = {{SWARMBOX_E2E_NODE, kNodeInImage, 0}};
-    spec.entrypoint = {kNodeInImage};
-    images::AddSwarmboxBaseFiles(&spec);
-    auto image = images::EnsureImage(*api_, spec, {}, nullptr);
+    auto image = swarmbox::testing::EnsureE2eNodeImage(*api_, SWARMBOX_E2E_NODE);
     ASSERT_TRUE(image) << image.error().ToString();
-    image_ = new std::string(image->tag);
+    image_ = new std::string(*image);
   }
   static void TearDownTestSuite() {
     delete api_;
@@ -85,7 +78,7 @@ class RunnerE2eTest : public ::testing::Test {
       auto& sim = trial->Add<dsl::Network>("sim", net("sim", nets.sim));
       auto& mesh = trial->Add<dsl::Network>("mesh", net("mesh", nets.mesh));
       auto physics = dsl::ContainerSpec::Image(
-          *image_, {kNodeInImage, "--name", "physics", "--ready", "--truth", "/out/truth.csv"});
+          *image_, {kE2eNodeInImage, "--name", "physics", "--ready", "--truth", "/out/truth.csv"});
       physics.name = name("physics");
       physics.labels = RunLabels(run_id, "e2e", "physics");
       physics.scratch_dirs = {"/out"};
@@ -94,7 +87,7 @@ class RunnerE2eTest : public ::testing::Test {
           .On(sim, nets.sim.Host(kPhysicsHost))
           .ReadyOn("event=ready", dsl::Duration::Seconds(30))
           .Collect("/out/truth.csv");
-      std::vector<std::string> argv = {kNodeInImage, "--name", "scout_1", "--quiet-ticks"};
+      std::vector<std::string> argv = {kE2eNodeInImage, "--name", "scout_1", "--quiet-ticks"};
       argv.insert(argv.end(), scout_args.begin(), scout_args.end());
       auto scout = dsl::ContainerSpec::Image(*image_, argv);
       scout.name = name("scout_1");
