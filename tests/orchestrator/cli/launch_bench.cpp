@@ -52,6 +52,7 @@
 #include "support/files.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
+#include "swarmbox/images/find_program.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/subnets.hpp"
 
@@ -205,17 +206,6 @@ class EngineWatch {
   std::vector<std::string> errors_;
   std::thread events_;
 };
-
-std::string FindOnPath(const std::string& program) {
-  const char* path = std::getenv("PATH");
-  std::stringstream dirs(path != nullptr ? path : "/usr/local/bin:/usr/bin:/bin");
-  std::string dir;
-  while (std::getline(dirs, dir, ':')) {
-    const fs::path p = fs::path(dir) / program;
-    if (::access(p.c_str(), X_OK) == 0) return p.string();
-  }
-  return "";
-}
 
 std::string TrialName(int drones) { return "launch" + std::to_string(drones) + "-" + std::to_string(::getpid()); }
 
@@ -559,11 +549,12 @@ int RunLaunchBench(const bench::Args& args) {
       return 2;
     }
   }
-  const std::string compose_exe = FindOnPath("docker-compose");
-  if (compose_exe.empty()) {
-    std::printf("suite=launch error=\"docker-compose is not on PATH (scripts/setup.sh installs it)\"\n");
+  auto compose = images::FindProgram("docker-compose", "", {}, "scripts/setup.sh installs it");
+  if (!compose) {
+    std::printf("suite=launch error=\"%s\"\n", compose.error().ToString().c_str());
     return 1;
   }
+  const std::string compose_exe = *compose;
   auto api = docker::DockerClient::Connect({.socket_path = docker::DefaultSocketPath(),
                                             .connect_timeout = std::chrono::seconds(5),
                                             .request_timeout = std::chrono::seconds(120)});
