@@ -102,9 +102,10 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   std::unique_ptr<AgentNode> node(new AgentNode(o, std::move(*fc), std::move(*plan)));
 
   // No writer lingers at exit (Cyclone's default keeps an unacknowledged one up to 1 s, ~0.2 s per
-  // agent on a stop): what it sent last (the last actuator command, Raft messages the protocol
-  // resends, state, detections) is of no use once the agent goes, and the orchestrator stops the
-  // next priority level (the physics server) only when every agent has exited.
+  // agent): what it sent last (the last actuator command, Raft messages the protocol resends,
+  // state, detections) is of no use once the agent goes. This is for the exits that delete the
+  // participants (plan complete, samples stopped, errors); a SIGTERM stop skips the deletion
+  // altogether (main.cpp, LeaveNow).
   constexpr int kNoLinger = 0;
   auto sim = bus::Participant::Create(
       {.backend = o.middleware, .domain_id = o.sim_domain, .interface = o.sim_interface, .writer_linger_ms = kNoLinger});
