@@ -34,6 +34,8 @@ Result<std::string> FindProgram(std::string_view name, const std::string& explic
     candidates.push_back(fs::path(dir) / name);
   }
   candidates.insert(candidates.end(), preferred.begin(), preferred.end());
+  // Installed programs sit side by side in <prefix>/bin (cmake --install).
+  if (const fs::path self = SelfDir(); !self.empty()) candidates.push_back(self / name);
   if (const char* path = std::getenv("PATH"); path != nullptr) {
     std::string_view rest = path;
     while (!rest.empty()) {

@@ -1,5 +1,6 @@
-// images::FindProgram: an explicit path, then $SWARMBOX_BIN_DIR, the caller's preferred places and
-// $PATH, in that order; a miss names every place looked in and the caller's hint.
+// images::FindProgram: an explicit path, then $SWARMBOX_BIN_DIR, the caller's preferred places, the
+// running program's own folder (an installed <prefix>/bin) and $PATH, in that order; a miss names
+// every place looked in and the caller's hint.
 #include "swarmbox/images/find_program.hpp"
 
 #include <gmock/gmock.h>
@@ -62,6 +63,25 @@ TEST_F(FindProgramTest, BinDirThenPreferredThenPath) {
   EXPECT_EQ(*found, (root_ / "path" / "swarmbox-x").string());
 }
 
+// An installed swarmbox finds swarmbox-physics beside it in <prefix>/bin: the test program's own
+// folder plays <prefix>/bin here, holding a companion that is also on $PATH.
+TEST_F(FindProgramTest, NextToTheRunningProgramAfterPreferredBeforePath) {
+  const std::string name = "swarmbox-find-program-companion-" + std::to_string(::getpid());
+  const fs::path beside = SelfDir() / name;
+  ASSERT_FALSE(SelfDir().empty());
+  { std::ofstream(beside) << "#!/bin/sh\n"; }
+  ::chmod(beside.c_str(), 0755);
+  { std::ofstream(root_ / "path" / name) << "#!/bin/sh\n"; }
+  ::chmod((root_ / "path" / name).c_str(), 0755);
+  auto found = FindProgram(name, "", {root_ / "preferred" / name}, "build it");
+  fs::remove(beside);
+  ASSERT_TRUE(found) << found.error().ToString();
+  EXPECT_EQ(*found, beside.lexically_normal().string());
+  found = FindProgram(name, "", {root_ / "preferred" / name}, "build it");
+  ASSERT_TRUE(found) << found.error().ToString();
+  EXPECT_EQ(*found, (root_ / "path" / name).string());
+}
+
 TEST_F(FindProgramTest, ANonExecutableFileIsNotAProgram) {
   ::chmod((root_ / "bin" / "swarmbox-x").c_str(), 0644);
   auto found = Find();
@@ -77,6 +97,7 @@ TEST_F(FindProgramTest, MissEverywhereNamesEachPlaceAndTheHint) {
   for (const char* d : {"bin", "preferred", "path"}) {
     EXPECT_THAT(missing.error().message(), HasSubstr((root_ / d / "swarmbox-x").string()));
   }
+  EXPECT_THAT(missing.error().message(), HasSubstr((SelfDir() / "swarmbox-x").string()));
   EXPECT_THAT(missing.error().message(), HasSubstr("cannot find swarmbox-x"));
   EXPECT_THAT(missing.error().message(), HasSubstr("; build it"));
 }

@@ -16,8 +16,9 @@ std::filesystem::path SelfDir();
 
 // `explicit_path` when it is given (kNotFound if it is not an executable file). Otherwise the first
 // executable among $SWARMBOX_BIN_DIR/<name>, then `preferred` (e.g. places in the build tree next
-// to the running executable), then every $PATH entry. kNotFound lists every place looked in and
-// ends with `hint` (how to build or name the program).
+// to the running executable), then SelfDir()/<name> (an installed swarmbox finds its companions in
+// its own <prefix>/bin), then every $PATH entry. kNotFound lists every place looked in and ends
+// with `hint` (how to build or name the program).
 Result<std::string> FindProgram(std::string_view name, const std::string& explicit_path,
                                 const std::vector<std::filesystem::path>& preferred,
                                 std::string_view hint);
