@@ -1,6 +1,18 @@
-# Warnings and sanitizers for every SwarmBox target, set in one place.
+# Warnings, sanitizers and the compiler launcher for every SwarmBox target, set in one place.
 # Usage: swarmbox_target_defaults(<target>) on every library and executable we own.
 # Generated code (idlc, fastddsgen) gets swarmbox_generated_defaults() instead: no warnings of ours.
+
+# ccache, when installed, as the compiler launcher (objects are reused across build folders and
+# worktrees). A launcher given on the command line or in a preset wins; SWARMBOX_CCACHE=OFF opts out.
+option(SWARMBOX_CCACHE "Use ccache as the compiler launcher when it is installed" ON)
+find_program(CCACHE ccache)
+if(SWARMBOX_CCACHE AND CCACHE)
+  foreach(lang C CXX)
+    if(NOT CMAKE_${lang}_COMPILER_LAUNCHER)
+      set(CMAKE_${lang}_COMPILER_LAUNCHER ${CCACHE})
+    endif()
+  endforeach()
+endif()
 
 set(SWARMBOX_WARNINGS -Wall -Wextra -Wshadow -Wconversion -Wsign-conversion -Wnon-virtual-dtor
     -Wold-style-cast -Woverloaded-virtual -Wnull-dereference -Wimplicit-fallthrough)

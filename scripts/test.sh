@@ -2,8 +2,10 @@
 # SwarmBox test suite: set up the machine, build everything, run every test under ctest, then the
 # sanitizer stage: the unit tests again, built with AddressSanitizer and UndefinedBehaviorSanitizer.
 # This is the README's test command, and all that .ci/run calls.
-#   bash scripts/test.sh                 # the whole suite (unit, integration, Docker end-to-end)
+#   bash scripts/test.sh                 # the whole suite (unit, integration, Docker end-to-end, bench)
 #   bash scripts/test.sh -L unit         # extra arguments go to the first ctest
+# The configurations are CMakePresets.json's: `default` (or `ci` when CI=true: warnings are errors),
+# `asan` and `tsan`; the stages below configure with `cmake --preset NAME` and may move the folder.
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores), SANITIZE (default
 # address,undefined: the -DSANITIZER value of the sanitizer stage; "off" skips the stage),
 # ASAN_BUILD_DIR (default build-asan), TSAN (default on; "off" skips the ThreadSanitizer stage),
@@ -15,10 +17,10 @@ bash scripts/setup.sh
 
 BUILD_DIR=${BUILD_DIR:-build}
 JOBS=${JOBS:-$(nproc)}
-werror=OFF
-[ "${CI:-}" = "true" ] && werror=ON   # warnings are errors in CI
+preset=default
+[ "${CI:-}" = "true" ] && preset=ci   # warnings are errors in CI
 
-cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSWARMBOX_WERROR="$werror" >/dev/null
+cmake --preset "$preset" -B "$BUILD_DIR" >/dev/null
 cmake --build "$BUILD_DIR" -j "$JOBS"
 ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" "$@"
 
@@ -31,9 +33,9 @@ ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" "$@"
 # ASan (the agent's Eigen-heavy flight/swarm code, the physics server, the DDS bus types) would
 # roughly double the CI time. SANITIZER_TARGETS widens the set (e.g. "swarmbox_unit_tests", the
 # aggregate of every unit test). Only unit-labelled tests of the built targets run: tests of
-# targets not built show up unlabelled (<target>_NOT_BUILT) and are not selected; the few plain
-# add_test()s labelled unit that run other programs (swarmbox-bench --quick, swarmbox validate)
-# are excluded by name.
+# targets not built show up unlabelled (<target>_NOT_BUILT) and are not selected; the benchmark
+# smoke runs (swarmbox-bench --quick, label bench) and the plain add_test() that runs swarmbox
+# validate are excluded (they run programs this stage does not build).
 SANITIZE=${SANITIZE:-address,undefined}
 if [ "$SANITIZE" != "off" ]; then
   ASAN_BUILD_DIR=${ASAN_BUILD_DIR:-build-asan}
@@ -45,14 +47,13 @@ dsl_trial_loader_test runner_pure_test cli_launch_timing_test}"
   # Warnings are not errors here: the first build already holds the code to -Werror, and GCC 12
   # with -fsanitize=address reports false -Wmaybe-uninitialized inside libstdc++'s <regex>
   # (std::function in the regex compiler, seen in orchestrator/dsl/src/trial_loader.cpp).
-  cmake -S . -B "$ASAN_BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSWARMBOX_WERROR=OFF \
-    -DSANITIZER="$SANITIZE" >/dev/null
+  cmake --preset asan -B "$ASAN_BUILD_DIR" -DSANITIZER="$SANITIZE" >/dev/null
   cmake --build "$ASAN_BUILD_DIR" -j "$JOBS" --target "${sanitizer_targets[@]}"
   # halt_on_error: the first report fails the test; detect_leaks: LeakSanitizer at exit.
   ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:strict_string_checks=1} \
   UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1} \
     ctest --test-dir "$ASAN_BUILD_DIR" --output-on-failure -j "$JOBS" -L unit \
-      -E '[Bb]ench|^ShippedTrialsValidate$'
+      -LE bench -E '^ShippedTrialsValidate$'
   echo "test.sh: sanitizer stage took $(( $(date +%s) - stage_start )) s"
 fi
 
@@ -65,11 +66,10 @@ if [ "${TSAN:-on}" != "off" ]; then
   TSAN_BUILD_DIR=${TSAN_BUILD_DIR:-build-tsan}
   stage_start=$(date +%s)
   echo "test.sh: ThreadSanitizer stage in $TSAN_BUILD_DIR: runner_fake_docker_test experiment_test"
-  cmake -S . -B "$TSAN_BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSWARMBOX_WERROR=OFF \
-    -DSANITIZER=thread >/dev/null
+  cmake --preset tsan -B "$TSAN_BUILD_DIR" >/dev/null
   cmake --build "$TSAN_BUILD_DIR" -j "$JOBS" --target runner_fake_docker_test experiment_test
   TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp} \
     ctest --test-dir "$TSAN_BUILD_DIR" --output-on-failure -j "$JOBS" -L unit \
-      -E '[Bb]ench|^ShippedTrialsValidate$'
+      -LE bench -E '^ShippedTrialsValidate$'
   echo "test.sh: ThreadSanitizer stage took $(( $(date +%s) - stage_start )) s"
 fi
