@@ -9,18 +9,18 @@
 set -euo pipefail
 
 PACKAGES=(
-  # toolchain
-  build-essential binutils cmake ninja-build pkg-config git ca-certificates curl
+  # toolchain (binutils: objcopy strips the images' binaries; ccache: CMake uses it when present)
+  build-essential binutils cmake ninja-build pkg-config git ca-certificates curl ccache
   # messaging: Cyclone DDS (C API + idlc) and Fast DDS (+ fastddsgen)
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
   # physics, maths, vision, formats, HTTP, archives
   libode-dev libeigen3-dev libopencv-dev libyaml-dev libcurl4-openssl-dev libssl-dev libarchive-dev zlib1g-dev
-  # command line, formatting, netfilter queue (userspace netem fallback)
-  libcli11-dev libfmt-dev libnetfilter-queue-dev
-  # tests and benchmarks
+  # command line, netfilter queue (userspace netem fallback)
+  libcli11-dev libnetfilter-queue-dev
+  # tests and micro-benchmarks (swarmbox-microbench)
   libgtest-dev libgmock-dev libbenchmark-dev
-  # containers, networks, hosts
-  docker.io docker-compose iptables iproute2 openssh-server openssh-client procps psmisc
+  # containers, networks, hosts (procps: pgrep in netns_host.sh)
+  docker.io docker-compose iptables iproute2 openssh-server openssh-client procps
 )
 
 log() { printf 'setup: %s\n' "$*"; }
