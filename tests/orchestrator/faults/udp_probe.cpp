@@ -108,9 +108,15 @@ Result<ProbeSample> MeasureOneWay(const ProbeOptions& o) {
   }
   timeval tv{0, 100000};
   setsockopt(rx.get(), SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  // 4 MB each way, past net.core.[rw]mem_max where this process may (root: the FORCE options), so a
+  // burst after a stall of the receiver is queued rather than dropped by the socket.
   int big = 4 << 20;
-  setsockopt(rx.get(), SOL_SOCKET, SO_RCVBUF, &big, sizeof big);
-  setsockopt(tx.get(), SOL_SOCKET, SO_SNDBUF, &big, sizeof big);
+  if (setsockopt(rx.get(), SOL_SOCKET, SO_RCVBUFFORCE, &big, sizeof big) != 0) {
+    setsockopt(rx.get(), SOL_SOCKET, SO_RCVBUF, &big, sizeof big);
+  }
+  if (setsockopt(tx.get(), SOL_SOCKET, SO_SNDBUFFORCE, &big, sizeof big) != 0) {
+    setsockopt(tx.get(), SOL_SOCKET, SO_SNDBUF, &big, sizeof big);
+  }
   int on = 1;
   if (setsockopt(rx.get(), SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on) != 0) {
     return Error(ErrorCode::kIo, Errno("SO_TIMESTAMPNS"));
@@ -160,10 +166,11 @@ Result<ProbeSample> MeasureOneWay(const ProbeOptions& o) {
   const std::int64_t start = ClockUs(CLOCK_MONOTONIC);
   for (int i = 0; i < o.count; ++i) {
     const std::int64_t due = start + i * o.spacing_us;
-    while (ClockUs(CLOCK_MONOTONIC) < due) {
-      timespec ts{0, 100000};
-      nanosleep(&ts, nullptr);
+    // One sleep to the due time (not a poll: in a user-mode Linux guest each system call is costly).
+    const timespec until{static_cast<time_t>(due / 1000000), static_cast<long>(due % 1000000) * 1000};
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &until, nullptr) == EINTR) {
     }
+    sample.max_send_late_us = std::max(sample.max_send_late_us, ClockUs(CLOCK_MONOTONIC) - due);
     const std::int64_t head[2] = {i, ClockUs(CLOCK_REALTIME)};
     std::memcpy(msg.data(), head, sizeof head);
     if (sendto(tx.get(), msg.data(), msg.size(), 0, reinterpret_cast<sockaddr*>(&to), sizeof to) ==

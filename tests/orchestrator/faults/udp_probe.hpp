@@ -41,6 +41,9 @@ struct ProbeSample {
   std::vector<double> delay_ms;      // their one-way delays [ms] (a duplicated number: its last copy)
   std::uint32_t datagrams = 0;       // every datagram received, duplicates included
   std::vector<ProbeArrival> arrivals;  // every datagram received, in arrival order
+  // The sender's worst lateness against its schedule [us]: how long this process (or, in a guest,
+  // the guest) was not run; a stall delays the datagrams in flight by as much.
+  std::int64_t max_send_late_us = 0;
 
   std::uint32_t received() const { return static_cast<std::uint32_t>(delay_ms.size()); }
   double Mean() const;
