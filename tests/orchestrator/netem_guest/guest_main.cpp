@@ -9,6 +9,7 @@
 // module tree (and points `iptables` at its legacy build, see kGuestBinDir), runs each scenario (guest_scenarios.hpp) on fresh network namespaces, prints its
 // records on the console (guest_console.hpp) and powers the guest off. It refuses to run anywhere
 // but as PID 1 of a user-mode Linux kernel (it mounts over /tmp and /run and powers off).
+#include <sys/mman.h>
 #include <sys/mount.h>
 #include <sys/reboot.h>
 #include <sys/stat.h>
@@ -111,6 +112,11 @@ int Main(int argc, char** argv) {
                  "swarmbox-netem-guest: this is the init of the netem guest; it runs only as PID 1 of a user-mode Linux "
                  "kernel (tests/orchestrator/netem_guest/README.md)\n");
     return 2;
+  }
+  // Every page of this program and its libraries in memory now: a page fault during a probe would
+  // be a read through hostfs, which blocks the whole (single-threaded) guest kernel.
+  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0) {
+    std::fprintf(stderr, "swarmbox-netem-guest: mlockall: %s\n", std::strerror(errno));
   }
   ConsoleReporter report;
   std::string modules_root = "/usr/lib/uml/modules";

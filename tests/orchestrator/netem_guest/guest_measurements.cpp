@@ -21,7 +21,8 @@ Fields SampleFields(const faults::testing::ProbeSample& s) {
   Fields f = {{"sent", std::to_string(s.sent)},
               {"received", std::to_string(s.received())},
               {"datagrams", std::to_string(s.datagrams)},
-              {"loss", Fixed(loss, 5)}};
+              {"loss", Fixed(loss, 5)},
+              {"send_late_max_ms", Fixed(static_cast<double>(s.max_send_late_us) / 1000.0, 3)}};
   if (s.received() > 1) {
     f.insert(f.end(), {{"mean_ms", Fixed(s.Mean(), 3)},
                        {"sd_ms", Fixed(s.StdDev(), 3)},

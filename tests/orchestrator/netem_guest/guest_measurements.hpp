@@ -20,8 +20,9 @@ namespace swarmbox::netem_guest {
 
 using Fields = std::vector<std::pair<std::string, std::string>>;
 
-// sent, received, datagrams, loss (1 - received / sent), mean_ms, sd_ms, min_ms, p50_ms, p99_ms,
-// max_ms (delays with 3 decimals; loss with 5).
+// sent, received, datagrams, loss (1 - received / sent), send_late_max_ms (the sender's worst
+// lateness: how long the guest went unscheduled), mean_ms, sd_ms, min_ms, p50_ms, p99_ms, max_ms
+// (times with 3 decimals; loss with 5).
 Fields SampleFields(const faults::testing::ProbeSample& sample);
 
 struct LossBursts {

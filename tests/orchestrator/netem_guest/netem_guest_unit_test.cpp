@@ -132,7 +132,8 @@ TEST(SampleFields, ReportsCountsLossAndTheDelayDistribution) {
   EXPECT_EQ(field("p50_ms"), "20.000");
   EXPECT_EQ(field("max_ms"), "31.000");
   // Nothing received: counts only.
-  EXPECT_EQ(SampleFields(Sample(3, {})).size(), 4u);
+  EXPECT_EQ(field("send_late_max_ms"), "0.000");
+  EXPECT_EQ(SampleFields(Sample(3, {})).size(), 5u);
 }
 
 TEST(CountLossBursts, CountsRunsOfConsecutiveLostNumbers) {
