@@ -1,5 +1,7 @@
 #include "guest_console.hpp"
 
+#include <cstdlib>
+
 namespace swarmbox::netem_guest {
 
 std::string GuestRecord::Field(std::string_view key) const { return FindField(fields, key).value_or(""); }
@@ -34,6 +36,18 @@ const GuestRecord* GuestConsole::Find(std::string_view event,
     if (all) return &r;
   }
   return nullptr;
+}
+
+std::pair<double, std::string> GuestConsole::LongestStall() const {
+  std::pair<double, std::string> worst{0.0, ""};
+  for (const GuestRecord& r : records) {
+    if (r.event != kEventMeasured) continue;
+    const std::string late = r.Field("send_late_max_ms");
+    if (late.empty()) continue;
+    const double ms = std::strtod(late.c_str(), nullptr);
+    if (ms > worst.first) worst = {ms, r.Field("probe")};
+  }
+  return worst;
 }
 
 GuestConsole ParseGuestConsole(std::string_view console) {

@@ -45,6 +45,9 @@ struct GuestConsole {
   // "mesh"}, {"probe", "impaired"}}), or nullptr.
   const GuestRecord* Find(std::string_view event,
                           const std::vector<std::pair<std::string_view, std::string_view>>& match) const;
+  // The longest the guest went unscheduled while a probe was sending (the largest
+  // send_late_max_ms of the measured records) [ms], and that probe's name; {0, ""} without any.
+  std::pair<double, std::string> LongestStall() const;
 };
 
 // The node=netem_guest lines of the console text, in order.

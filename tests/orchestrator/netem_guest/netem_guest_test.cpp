@@ -33,15 +33,43 @@ class NetemGuest : public ::testing::Test {
     if (dir_.empty()) return;
     std::error_code ec;
     std::filesystem::remove_all(dir_, ec);
+    dir_.clear();
   }
 
   // Boots the guest with `scenario` and reads its console; fatal failures say why it could not.
+  //
+  // A sample taken while the host did not run the guest at all is not a sample of netem: on this
+  // 2-core machine at a load of 10-15 the guest was seen unscheduled for up to 1.1 s (its sender's
+  // lateness shows it), which by itself moves the 3,000-datagram mean by ~5 ms. An attempt whose
+  // probes saw the guest stopped for more than kStarvedMs is therefore void and the guest is booted
+  // again, up to kAttempts times; the tolerances apply unchanged to the attempt that counts, and if
+  // every attempt was starved the test fails saying so.
   void Boot(const std::string& scenario) {
+    constexpr double kStarvedMs = 250.0;  // where a stall alone eats the mean's 3 ms allowance
+    constexpr int kAttempts = 3;
+    std::string starved;
+    for (int attempt = 1; attempt <= kAttempts; ++attempt) {
+      ASSERT_NO_FATAL_FAILURE(BootOnce(scenario));
+      const auto [stall_ms, probe] = console_.LongestStall();
+      if (stall_ms <= kStarvedMs) return;
+      char line[200];
+      std::snprintf(line, sizeof line, "attempt %d: the guest went unscheduled for %.0f ms during probe %s\n", attempt,
+                    stall_ms, probe.c_str());
+      starved += line;
+      std::printf("guest: %s", line);
+    }
+    FAIL() << "the host starved the guest (> " << kStarvedMs << " ms without running it) in all " << kAttempts
+           << " attempts; no valid sample of netem:\n"
+           << starved;
+  }
+
+  void BootOnce(const std::string& scenario) {
     auto kernel = images::FindProgram("linux.uml", "", {},
                                       "install Debian's user-mode-linux package (bash scripts/setup.sh does)");
     ASSERT_TRUE(kernel) << kernel.error().ToString();
     ASSERT_TRUE(std::filesystem::is_directory(kUmlModulesDir))
         << kUmlModulesDir << " is missing: the UML kernel's modules (sch_netem among them) come with user-mode-linux";
+    TearDown();
     dir_ = testing::MakeTempDir("swarmbox-netem-guest-");
     ASSERT_FALSE(dir_.empty());
     GuestBoot boot;

@@ -92,6 +92,15 @@ TEST(GuestConsole, KeepsOnlyTheGuestsRecordsAndRoundTripsText) {
   EXPECT_EQ(c.Errors(), "rate: `tc` exited 2\n");
 }
 
+TEST(GuestConsole, LongestStallIsTheLatestSenderOfAnyProbe) {
+  const GuestConsole c = ParseGuestConsole(
+      GuestLine(1.0, kEventMeasured, {{"probe", "to_b"}, {"send_late_max_ms", "3.5"}}) + "\n" +
+      GuestLine(2.0, kEventMeasured, {{"probe", "to_c"}, {"send_late_max_ms", "341.2"}}) + "\n" +
+      GuestLine(3.0, kEventTree, {{"stage", "applied"}, {"send_late_max_ms", "999"}}) + "\n");
+  EXPECT_EQ(c.LongestStall(), (std::pair<double, std::string>{341.2, "to_c"}));
+  EXPECT_EQ(ParseGuestConsole("").LongestStall(), (std::pair<double, std::string>{0.0, ""}));
+}
+
 TEST(GuestConsole, IsNotDoneWithoutTheDoneRecord) {
   const GuestConsole c = ParseGuestConsole(GuestLine(1.0, kEventReady, {}) + "\nKernel panic - not syncing\n");
   EXPECT_FALSE(c.done());
