@@ -61,7 +61,8 @@ Result<int> SocketIn(const std::string& ns) {
     std::fprintf(stderr, "udp_probe: setns back from %s failed: %s\n", path.c_str(), std::strerror(errno));
     std::abort();
   }
-  if (fd < 0) return Error(ErrorCode::kIo, std::string("socket in ") + ns + ": " + std::strerror(socket_errno));
+  if (fd < 0)
+    return Error(ErrorCode::kIo, std::string("socket in ") + ns + ": " + std::strerror(socket_errno));
   return fd;
 }
 

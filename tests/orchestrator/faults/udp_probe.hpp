@@ -36,10 +36,10 @@ struct ProbeArrival {
 };
 
 struct ProbeSample {
-  std::uint32_t sent = 0;            // datagrams sendto() took
-  std::vector<std::uint32_t> seqs;   // the distinct numbers received, ascending
-  std::vector<double> delay_ms;      // their one-way delays [ms] (a duplicated number: its last copy)
-  std::uint32_t datagrams = 0;       // every datagram received, duplicates included
+  std::uint32_t sent = 0;              // datagrams sendto() took
+  std::vector<std::uint32_t> seqs;     // the distinct numbers received, ascending
+  std::vector<double> delay_ms;        // their one-way delays [ms] (a duplicated number: its last copy)
+  std::uint32_t datagrams = 0;         // every datagram received, duplicates included
   std::vector<ProbeArrival> arrivals;  // every datagram received, in arrival order
   // The sender's worst lateness against its schedule [us]: how long this process (or, in a guest,
   // the guest) was not run; a stall delays the datagrams in flight by as much.
@@ -47,19 +47,20 @@ struct ProbeSample {
 
   std::uint32_t received() const { return static_cast<std::uint32_t>(delay_ms.size()); }
   double Mean() const;
-  double StdDev() const;        // the sample standard deviation (n - 1)
+  double StdDev() const;            // the sample standard deviation (n - 1)
   double Quantile(double q) const;  // the value at floor(q x (n - 1)) of the sorted delays
 };
 
 struct ProbeOptions {
   std::string from_netns;  // names under /run/netns (ip netns add)
   std::string to_netns;
-  std::string to_addr;     // the receiver binds this IPv4 address
+  std::string to_addr;  // the receiver binds this IPv4 address
   std::uint16_t port = 47001;
   int count = 0;
   std::int64_t spacing_us = 1000;  // between sends [us]; 0 = back to back
   std::size_t payload_bytes = 16;  // UDP payload [bytes], >= 16 (number + send time)
-  std::int64_t quiet_us = 1500000;  // the receiver stops after this long without a datagram after the last send
+  std::int64_t quiet_us =
+      1500000;  // the receiver stops after this long without a datagram after the last send
 };
 
 // kInvalidArgument for payload_bytes < 16 or count < 0; kIo when a namespace, socket or bind fails.

@@ -21,8 +21,8 @@ std::string GuestConsole::Errors() const {
   return out;
 }
 
-const GuestRecord* GuestConsole::Find(std::string_view event,
-                                      const std::vector<std::pair<std::string_view, std::string_view>>& match) const {
+const GuestRecord* GuestConsole::Find(
+    std::string_view event, const std::vector<std::pair<std::string_view, std::string_view>>& match) const {
   for (const GuestRecord& r : records) {
     if (r.event != event) continue;
     bool all = true;

@@ -3,8 +3,8 @@
 //
 //   t=3.412 node=netem_guest event=ready kernel=6.1.176 modules=12
 //   t=9.870 node=netem_guest event=measured scenario=mesh probe=impaired sent=3000 received=2851 ...
-//   t=9.990 node=netem_guest event=qdisc_tree scenario=mesh drone=a stage=pristine text="qdisc noqueue 0: ..."
-//   t=10.200 node=netem_guest event=error scenario=mesh message="`tc qdisc replace ...` exited 2: ..."
+//   t=9.990 node=netem_guest event=qdisc_tree scenario=mesh drone=a stage=pristine text="qdisc noqueue 0:
+//   ..." t=10.200 node=netem_guest event=error scenario=mesh message="`tc qdisc replace ...` exited 2: ..."
 //   t=10.300 node=netem_guest event=done scenarios=1 errors=0
 //
 // The console also carries the kernel's own lines (and, with UML, carriage returns); the reader
@@ -22,8 +22,9 @@ namespace swarmbox::netem_guest {
 
 inline constexpr std::string_view kGuestNode = "netem_guest";
 
-inline constexpr std::string_view kEventReady = "ready";        // kernel=, modules= (count loaded)
-inline constexpr std::string_view kEventApplied = "applied";    // scenario=, drone=, argv=, exit= (one per command)
+inline constexpr std::string_view kEventReady = "ready";  // kernel=, modules= (count loaded)
+inline constexpr std::string_view kEventApplied =
+    "applied";  // scenario=, drone=, argv=, exit= (one per command)
 inline constexpr std::string_view kEventMeasured = "measured";  // scenario=, probe=, the figures
 inline constexpr std::string_view kEventTree = "qdisc_tree";    // scenario=, drone=, stage=, text= (tc show)
 inline constexpr std::string_view kEventError = "error";        // scenario= (or "guest"), message=
@@ -31,7 +32,7 @@ inline constexpr std::string_view kEventDone = "done";          // scenarios=, e
 
 struct GuestRecord {
   std::string event;
-  LogfmtFields fields;  // every field of the line, t/node/event included
+  LogfmtFields fields;                            // every field of the line, t/node/event included
   std::string Field(std::string_view key) const;  // "" when absent
 };
 

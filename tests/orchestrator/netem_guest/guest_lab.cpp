@@ -25,8 +25,10 @@ Result<faults::CommandOutput> ReportingRunner::Run(const std::vector<std::string
 
 GuestLab::GuestLab(faults::CommandRunner& runner, Reporter& reporter, std::string scenario)
     : runner_(runner), reporter_(reporter), scenario_(std::move(scenario)) {
-  in_a_ = std::make_unique<faults::PrefixCommandRunner>(runner_, std::vector<std::string>{"ip", "netns", "exec", Namespace("a")});
-  in_b_ = std::make_unique<faults::PrefixCommandRunner>(runner_, std::vector<std::string>{"ip", "netns", "exec", Namespace("b")});
+  in_a_ = std::make_unique<faults::PrefixCommandRunner>(
+      runner_, std::vector<std::string>{"ip", "netns", "exec", Namespace("a")});
+  in_b_ = std::make_unique<faults::PrefixCommandRunner>(
+      runner_, std::vector<std::string>{"ip", "netns", "exec", Namespace("b")});
   report_a_ = std::make_unique<ReportingRunner>(*in_a_, reporter_, scenario_, "a");
   report_b_ = std::make_unique<ReportingRunner>(*in_b_, reporter_, scenario_, "b");
 }
@@ -41,8 +43,8 @@ Status GuestLab::Must(const std::vector<std::string>& argv) {
   auto out = runner_.Run(argv);
   if (!out) return out.error();
   if (out->exit_code != 0) {
-    return Error(ErrorCode::kInternal, "`" + faults::CommandText(argv) + "` exited " + std::to_string(out->exit_code) +
-                                           ": " + out->stderr_text);
+    return Error(ErrorCode::kInternal, "`" + faults::CommandText(argv) + "` exited " +
+                                           std::to_string(out->exit_code) + ": " + out->stderr_text);
   }
   return Ok{};
 }
@@ -53,8 +55,8 @@ Status GuestLab::Create() {
   SWARMBOX_TRY(Must({"ip", "netns", "add", a}));
   created_ = true;
   SWARMBOX_TRY(Must({"ip", "netns", "add", b}));
-  SWARMBOX_TRY(Must({"ip", "link", "add", if_a, "address", kMacA, "netns", a, "type", "veth", "peer", "name", if_b,
-                     "address", kMacB, "netns", b}));
+  SWARMBOX_TRY(Must({"ip", "link", "add", if_a, "address", kMacA, "netns", a, "type", "veth", "peer", "name",
+                     if_b, "address", kMacB, "netns", b}));
   SWARMBOX_TRY(Must({"ip", "-n", a, "addr", "add", std::string(kAddrA) + "/24", "dev", if_a}));
   SWARMBOX_TRY(Must({"ip", "-n", b, "addr", "add", std::string(kAddrB) + "/24", "dev", if_b}));
   SWARMBOX_TRY(Must({"ip", "-n", b, "addr", "add", std::string(kAddrC) + "/24", "dev", if_b}));
@@ -62,16 +64,21 @@ Status GuestLab::Create() {
     SWARMBOX_TRY(Must({"ip", "-n", ns, "link", "set", "lo", "up"}));
     SWARMBOX_TRY(Must({"ip", "-n", ns, "link", "set", dev, "up"}));
   }
-  SWARMBOX_TRY(Must({"ip", "-n", a, "neigh", "replace", kAddrB, "lladdr", kMacB, "nud", "permanent", "dev", if_a}));
-  SWARMBOX_TRY(Must({"ip", "-n", a, "neigh", "replace", kAddrC, "lladdr", kMacB, "nud", "permanent", "dev", if_a}));
-  SWARMBOX_TRY(Must({"ip", "-n", b, "neigh", "replace", kAddrA, "lladdr", kMacA, "nud", "permanent", "dev", if_b}));
+  SWARMBOX_TRY(
+      Must({"ip", "-n", a, "neigh", "replace", kAddrB, "lladdr", kMacB, "nud", "permanent", "dev", if_a}));
+  SWARMBOX_TRY(
+      Must({"ip", "-n", a, "neigh", "replace", kAddrC, "lladdr", kMacB, "nud", "permanent", "dev", if_a}));
+  SWARMBOX_TRY(
+      Must({"ip", "-n", b, "neigh", "replace", kAddrA, "lladdr", kMacA, "nud", "permanent", "dev", if_b}));
   return Ok{};
 }
 
 faults::CommandRunner& GuestLab::In(const std::string& node) { return node == "a" ? *report_a_ : *report_b_; }
 
 faults::LinkTarget GuestLab::Link(const std::string& node) const {
-  if (node == "a") return faults::LinkTarget{"a", Interface("a"), {{"b", kAddrB}, {"c", kAddrC}}, faults::kAssumedLinkRateKbit};
+  if (node == "a")
+    return faults::LinkTarget{
+        "a", Interface("a"), {{"b", kAddrB}, {"c", kAddrC}}, faults::kAssumedLinkRateKbit};
   return faults::LinkTarget{"b", Interface("b"), {{"a", kAddrA}}, faults::kAssumedLinkRateKbit};
 }
 
@@ -82,11 +89,12 @@ std::vector<faults::MeshNode> GuestLab::MeshNodes() const {
 Result<std::string> GuestLab::Tree(const std::string& node) {
   std::string text;
   for (const char* what : {"qdisc", "class", "filter"}) {
-    const std::vector<std::string> argv = {"ip", "netns", "exec", Namespace(node), "tc", what, "show", "dev",
-                                           Interface(node)};
+    const std::vector<std::string> argv = {"ip", "netns", "exec", Namespace(node), "tc",
+                                           what, "show",  "dev",  Interface(node)};
     auto out = runner_.Run(argv);
     if (!out) return out.error();
-    if (out->exit_code != 0) return Error(ErrorCode::kInternal, "`" + faults::CommandText(argv) + "`: " + out->stderr_text);
+    if (out->exit_code != 0)
+      return Error(ErrorCode::kInternal, "`" + faults::CommandText(argv) + "`: " + out->stderr_text);
     text += out->stdout_text;
   }
   return text;
@@ -96,7 +104,8 @@ Result<std::string> GuestLab::IptablesRules(const std::string& node) {
   const std::vector<std::string> argv = {"ip", "netns", "exec", Namespace(node), "iptables", "-w", "-S"};
   auto out = runner_.Run(argv);
   if (!out) return out.error();
-  if (out->exit_code != 0) return Error(ErrorCode::kInternal, "`" + faults::CommandText(argv) + "`: " + out->stderr_text);
+  if (out->exit_code != 0)
+    return Error(ErrorCode::kInternal, "`" + faults::CommandText(argv) + "`: " + out->stderr_text);
   return out->stdout_text;
 }
 
@@ -104,8 +113,8 @@ Result<std::int64_t> GuestLab::ReceiveErrors(const std::string& node) {
   return faults::testing::ReceiveErrors(runner_, Namespace(node));
 }
 
-Result<faults::testing::ProbeSample> GuestLab::Measure(const std::string& peer, int count, std::int64_t spacing_us,
-                                                       std::size_t payload_bytes) {
+Result<faults::testing::ProbeSample> GuestLab::Measure(const std::string& peer, int count,
+                                                       std::int64_t spacing_us, std::size_t payload_bytes) {
   faults::testing::ProbeOptions o;
   o.from_netns = Namespace("a");
   o.to_netns = Namespace("b");

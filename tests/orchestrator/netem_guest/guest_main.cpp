@@ -5,10 +5,11 @@
 //       --scenario mesh [--scenario rate ...]       (one command line: uml_guest.hpp builds it)
 //
 // It mounts the guest's own /proc, /sys, /tmp and /run (the root is the host's file system, seen
-// read-only through hostfs), loads veth, sch_netem, htb, u32 and the iptables filter table from the UML kernel's
-// module tree (and points `iptables` at its legacy build, see kGuestBinDir), runs each scenario (guest_scenarios.hpp) on fresh network namespaces, prints its
-// records on the console (guest_console.hpp) and powers the guest off. It refuses to run anywhere
-// but as PID 1 of a user-mode Linux kernel (it mounts over /tmp and /run and powers off).
+// read-only through hostfs), loads veth, sch_netem, htb, u32 and the iptables filter table from the UML
+// kernel's module tree (and points `iptables` at its legacy build, see kGuestBinDir), runs each scenario
+// (guest_scenarios.hpp) on fresh network namespaces, prints its records on the console (guest_console.hpp)
+// and powers the guest off. It refuses to run anywhere but as PID 1 of a user-mode Linux kernel (it mounts
+// over /tmp and /run and powers off).
 #include <sys/mman.h>
 #include <sys/mount.h>
 #include <sys/reboot.h>
@@ -67,7 +68,8 @@ class ConsoleReporter : public Reporter {
 
 Status MountFs(const char* type, const char* target, const char* options) {
   if (mount(type, target, type, MS_NOSUID | MS_NODEV, options) != 0) {
-    return Error(ErrorCode::kIo, std::string("mount ") + type + " on " + target + ": " + std::strerror(errno));
+    return Error(ErrorCode::kIo,
+                 std::string("mount ") + type + " on " + target + ": " + std::strerror(errno));
   }
   return Ok{};
 }
@@ -78,7 +80,8 @@ Status PrepareGuest(const std::string& modules_root, ConsoleReporter& report) {
   SWARMBOX_TRY(MountFs("tmpfs", "/run", "mode=0755"));
   if (mkdir(kGuestBinDir, 0755) != 0 ||
       symlink(kLegacyIptables, (std::string(kGuestBinDir) + "/iptables").c_str()) != 0) {
-    return Error(ErrorCode::kIo, std::string("the guest's iptables link: ") + std::strerror(errno), kGuestBinDir);
+    return Error(ErrorCode::kIo, std::string("the guest's iptables link: ") + std::strerror(errno),
+                 kGuestBinDir);
   }
   // The kernel starts init with HOME and TERM only; tc, ip and iptables live in /usr/sbin.
   setenv("PATH", (std::string(kGuestBinDir) + ":/usr/sbin:/usr/bin:/sbin:/bin").c_str(), 1);
@@ -86,7 +89,8 @@ Status PrepareGuest(const std::string& modules_root, ConsoleReporter& report) {
   uname(&uts);
   const std::string dir = modules_root + "/" + uts.release;
   const std::string dep = testing::ReadWholeFile(dir + "/modules.dep");
-  if (dep.empty()) return Error(ErrorCode::kNotFound, "no modules.dep for kernel " + std::string(uts.release), dir);
+  if (dep.empty())
+    return Error(ErrorCode::kNotFound, "no modules.dep for kernel " + std::string(uts.release), dir);
   auto order = ModuleLoadOrder(dep, kModules);
   if (!order) return order.error().Context(dir);
   SWARMBOX_TRY(LoadModules(dir, *order));
@@ -109,7 +113,8 @@ bool RunningInUml() {
 int Main(int argc, char** argv) {
   if (getpid() != 1 || !RunningInUml()) {
     std::fprintf(stderr,
-                 "swarmbox-netem-guest: this is the init of the netem guest; it runs only as PID 1 of a user-mode Linux "
+                 "swarmbox-netem-guest: this is the init of the netem guest; it runs only as PID 1 of a "
+                 "user-mode Linux "
                  "kernel (tests/orchestrator/netem_guest/README.md)\n");
     return 2;
   }
@@ -153,7 +158,8 @@ int Main(int argc, char** argv) {
       report.Record("scenario_end", {{"scenario", name}, {"took_s", took}});
     }
   }
-  report.Record(kEventDone, {{"scenarios", std::to_string(names.size())}, {"errors", std::to_string(report.errors())}});
+  report.Record(kEventDone,
+                {{"scenarios", std::to_string(names.size())}, {"errors", std::to_string(report.errors())}});
   PowerOff();
 }
 
@@ -164,8 +170,8 @@ int main(int argc, char** argv) {
   try {
     return swarmbox::netem_guest::Main(argc, argv);
   } catch (const std::exception& e) {
-    const std::string line = swarmbox::netem_guest::GuestLine(
-        0.0, swarmbox::netem_guest::kEventError, {{"scenario", "guest"}, {"message", e.what()}});
+    const std::string line = swarmbox::netem_guest::GuestLine(0.0, swarmbox::netem_guest::kEventError,
+                                                              {{"scenario", "guest"}, {"message", e.what()}});
     std::printf("%s\n", line.c_str());
     std::fflush(stdout);
     if (getpid() == 1) swarmbox::netem_guest::PowerOff();

@@ -49,7 +49,8 @@ LossBursts CountLossBursts(const faults::testing::ProbeSample& s) {
 
 double EarlyFraction(const faults::testing::ProbeSample& s, double threshold_ms) {
   if (s.delay_ms.empty()) return 0.0;
-  const auto early = std::count_if(s.delay_ms.begin(), s.delay_ms.end(), [&](double d) { return d < threshold_ms; });
+  const auto early =
+      std::count_if(s.delay_ms.begin(), s.delay_ms.end(), [&](double d) { return d < threshold_ms; });
   return static_cast<double>(early) / static_cast<double>(s.delay_ms.size());
 }
 

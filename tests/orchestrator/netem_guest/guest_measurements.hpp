@@ -26,8 +26,8 @@ using Fields = std::vector<std::pair<std::string, std::string>>;
 Fields SampleFields(const faults::testing::ProbeSample& sample);
 
 struct LossBursts {
-  int bursts = 0;           // runs of consecutive numbers never received
-  double mean_length = 0.0; // lost / bursts (0 without loss)
+  int bursts = 0;            // runs of consecutive numbers never received
+  double mean_length = 0.0;  // lost / bursts (0 without loss)
 };
 LossBursts CountLossBursts(const faults::testing::ProbeSample& sample);
 

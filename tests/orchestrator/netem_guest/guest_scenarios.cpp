@@ -38,7 +38,8 @@ Result<std::vector<RadioRule>> Mesh(std::string_view yaml_text) {
   return mesh->rules;
 }
 
-Result<std::vector<faults::Fault>> Faults(std::string_view yaml_text, const std::vector<std::string>& drones) {
+Result<std::vector<faults::Fault>> Faults(std::string_view yaml_text,
+                                          const std::vector<std::string>& drones) {
   auto node = yaml::Parse(yaml_text, "faults");
   if (!node) return node.error();
   auto list = faults::ParseFaults(*node);
@@ -52,7 +53,8 @@ Result<std::vector<faults::Fault>> Faults(std::string_view yaml_text, const std:
 // RadioLayers, each change planned with PlanRadioChange from the rules installed before.
 class RadioInjector {
  public:
-  RadioInjector(GuestLab& lab, std::vector<RadioRule> mesh) : lab_(lab), layers_(std::move(mesh), lab.RadioNodes()) {}
+  RadioInjector(GuestLab& lab, std::vector<RadioRule> mesh)
+      : lab_(lab), layers_(std::move(mesh), lab.RadioNodes()) {}
 
   Status ApplyMesh() {
     for (const std::string& node : lab_.RadioNodes()) {
@@ -67,7 +69,8 @@ class RadioInjector {
 
   Status Apply(const faults::Fault& fault) {
     const auto* radio = std::get_if<faults::RadioFault>(&fault.action);
-    if (radio == nullptr) return Error(ErrorCode::kInvalidArgument, "fault " + fault.id + " is not a radio fault");
+    if (radio == nullptr)
+      return Error(ErrorCode::kInvalidArgument, "fault " + fault.id + " is not a radio fault");
     auto targets = faults::ResolveTarget(radio->target, lab_.RadioNodes(), leaders_, rng_);
     if (!targets) return targets.error();
     const auto before = installed_;
@@ -100,7 +103,8 @@ class RadioInjector {
   }
 
  private:
-  Status Change(const std::map<std::string, std::vector<RadioRule>>& before, const std::vector<std::string>& changed) {
+  Status Change(const std::map<std::string, std::vector<RadioRule>>& before,
+                const std::vector<std::string>& changed) {
     for (const std::string& node : changed) {
       auto it = before.find(node);
       const std::vector<RadioRule> from = it == before.end() ? std::vector<RadioRule>{} : it->second;
@@ -120,7 +124,8 @@ class RadioInjector {
   std::mt19937_64 rng_{42};
 };
 
-void ReportSample(GuestLab& lab, const std::string& probe, const ProbeSample& sample, const Fields& extra = {}) {
+void ReportSample(GuestLab& lab, const std::string& probe, const ProbeSample& sample,
+                  const Fields& extra = {}) {
   Fields f = {{"scenario", lab.scenario()}, {"probe", probe}};
   for (auto& kv : SampleFields(sample)) f.push_back(std::move(kv));
   f.insert(f.end(), extra.begin(), extra.end());
@@ -139,7 +144,8 @@ Result<ProbeSample> Probe(GuestLab& lab, const std::string& probe, const std::st
 Status ReportTree(GuestLab& lab, const std::string& node, const std::string& stage) {
   auto tree = lab.Tree(node);
   if (!tree) return tree.error();
-  lab.reporter().Record(kEventTree, {{"scenario", lab.scenario()}, {"drone", node}, {"stage", stage}, {"text", *tree}});
+  lab.reporter().Record(kEventTree,
+                        {{"scenario", lab.scenario()}, {"drone", node}, {"stage", stage}, {"text", *tree}});
   return Ok{};
 }
 
@@ -167,7 +173,8 @@ Status RunMesh(GuestLab& lab) {
 Status RunFixed(GuestLab& lab) { return MeshScenario(lab, "{delay_ms: 50}", 1000, 2000); }
 
 Status RunPerDestination(GuestLab& lab) {
-  auto faults = Faults("[{at: 1s, name: to_c, radio: {target: a, to: [c], delay_ms: 80, rate_kbit: 2000}}]", lab.Drones());
+  auto faults = Faults("[{at: 1s, name: to_c, radio: {target: a, to: [c], delay_ms: 80, rate_kbit: 2000}}]",
+                       lab.Drones());
   if (!faults) return faults.error();
   RadioInjector injector(lab, {});
   SWARMBOX_TRY(ReportTree(lab, "a", "pristine"));
@@ -204,7 +211,8 @@ Status RunRate(GuestLab& lab) {
 }
 
 Status RunReorder(GuestLab& lab) {
-  auto faults = Faults("[{at: 1s, name: shuffle, radio: {target: a, delay_ms: 10, reorder: 0.25}}]", lab.Drones());
+  auto faults =
+      Faults("[{at: 1s, name: shuffle, radio: {target: a, delay_ms: 10, reorder: 0.25}}]", lab.Drones());
   if (!faults) return faults.error();
   RadioInjector injector(lab, {});
   SWARMBOX_TRY(injector.Apply(faults->front()));
@@ -212,8 +220,9 @@ Status RunReorder(GuestLab& lab) {
   auto s = lab.Measure("b", 3000, 1000);
   if (!s) return s.error();
   // Sent at once: no 10 ms delay (under 5 ms); overtaken: arrived after a higher number.
-  ReportSample(lab, "impaired", *s,
-               {{"early", Fixed(EarlyFraction(*s, 5.0), 5)}, {"out_of_order", Fixed(OutOfOrderFraction(*s), 5)}});
+  ReportSample(
+      lab, "impaired", *s,
+      {{"early", Fixed(EarlyFraction(*s, 5.0), 5)}, {"out_of_order", Fixed(OutOfOrderFraction(*s), 5)}});
   return injector.Remove("shuffle");
 }
 
@@ -249,7 +258,8 @@ Status RunCorrupt(GuestLab& lab) {
 
 Status RunGilbertElliott(GuestLab& lab) {
   auto faults = Faults(
-      "[{at: 1s, name: fade, radio: {target: a, delay_ms: 5, gilbert_elliott: {p: 0.02, r: 0.25, loss_bad: 1.0, "
+      "[{at: 1s, name: fade, radio: {target: a, delay_ms: 5, gilbert_elliott: {p: 0.02, r: 0.25, loss_bad: "
+      "1.0, "
       "loss_good: 0.0}}}]",
       lab.Drones());
   if (!faults) return faults.error();
@@ -273,12 +283,16 @@ Status RunPartition(GuestLab& lab) {
   SWARMBOX_TRY(faults::RunCommands(lab.In("b"), plan->apply.at("b")));
   auto rules = lab.IptablesRules("b");
   if (!rules) return rules.error();
-  lab.reporter().Record(kEventTree, {{"scenario", lab.scenario()}, {"drone", "b"}, {"stage", "iptables_cut"}, {"text", *rules}});
+  lab.reporter().Record(
+      kEventTree,
+      {{"scenario", lab.scenario()}, {"drone", "b"}, {"stage", "iptables_cut"}, {"text", *rules}});
   if (auto s = Probe(lab, "cut", "b", 100, 1000); !s) return s.error();
   SWARMBOX_TRY(faults::RunAllCommands(lab.In("b"), plan->undo.at("b")));
   rules = lab.IptablesRules("b");
   if (!rules) return rules.error();
-  lab.reporter().Record(kEventTree, {{"scenario", lab.scenario()}, {"drone", "b"}, {"stage", "iptables_healed"}, {"text", *rules}});
+  lab.reporter().Record(
+      kEventTree,
+      {{"scenario", lab.scenario()}, {"drone", "b"}, {"stage", "iptables_healed"}, {"text", *rules}});
   if (auto s = Probe(lab, "healed", "b", 100, 1000); !s) return s.error();
   return Ok{};
 }
@@ -299,7 +313,8 @@ Status RunReplace(GuestLab& lab) {
   SWARMBOX_TRY(ReportTree(lab, "a", "mesh_again"));
   if (auto s = Probe(lab, "mesh_to_b", "b", 200, 2000); !s) return s.error();
 
-  SWARMBOX_TRY(injector.Apply((*faults)[0]));  // per destination: htb + u32 to c, the mesh's 20 ms for the rest
+  SWARMBOX_TRY(
+      injector.Apply((*faults)[0]));  // per destination: htb + u32 to c, the mesh's 20 ms for the rest
   SWARMBOX_TRY(ReportTree(lab, "a", "fade_c"));
   if (auto s = Probe(lab, "fade_c_to_b", "b", 200, 2000); !s) return s.error();
   if (auto s = Probe(lab, "fade_c_to_c", "c", 200, 2000); !s) return s.error();
@@ -323,12 +338,16 @@ Status RunReplace(GuestLab& lab) {
 
 const std::vector<Scenario>& AllScenarios() {
   static const std::vector<Scenario> kAll = {
-      {"mesh", RunMesh},          {"fixed", RunFixed},
+      {"mesh", RunMesh},
+      {"fixed", RunFixed},
       {"per_destination", RunPerDestination},
-      {"rate", RunRate},          {"reorder", RunReorder},
-      {"duplicate", RunDuplicate}, {"corrupt", RunCorrupt},
+      {"rate", RunRate},
+      {"reorder", RunReorder},
+      {"duplicate", RunDuplicate},
+      {"corrupt", RunCorrupt},
       {"gilbert_elliott", RunGilbertElliott},
-      {"partition", RunPartition}, {"replace", RunReplace},
+      {"partition", RunPartition},
+      {"replace", RunReplace},
   };
   return kAll;
 }

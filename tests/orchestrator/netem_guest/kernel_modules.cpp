@@ -25,7 +25,8 @@ std::string ModuleName(std::string_view path) {
   return name;
 }
 
-Result<std::vector<std::string>> ModuleLoadOrder(std::string_view modules_dep, const std::vector<std::string>& wanted) {
+Result<std::vector<std::string>> ModuleLoadOrder(std::string_view modules_dep,
+                                                 const std::vector<std::string>& wanted) {
   // name -> (path, the paths it needs)
   std::map<std::string, std::pair<std::string, std::vector<std::string>>> modules;
   std::istringstream lines{std::string(modules_dep)};
@@ -35,7 +36,8 @@ Result<std::vector<std::string>> ModuleLoadOrder(std::string_view modules_dep, c
     if (line.empty()) continue;
     const std::size_t colon = line.find(':');
     if (colon == std::string::npos) {
-      return Error(ErrorCode::kInvalidArgument, "modules.dep line " + std::to_string(line_no) + " has no ':'");
+      return Error(ErrorCode::kInvalidArgument,
+                   "modules.dep line " + std::to_string(line_no) + " has no ':'");
     }
     const std::string path = line.substr(0, colon);
     std::istringstream deps(line.substr(colon + 1));
@@ -57,7 +59,8 @@ Result<std::vector<std::string>> ModuleLoadOrder(std::string_view modules_dep, c
                                              (needed_by.empty() ? "" : " (needed by " + needed_by + ")") +
                                              " is not in modules.dep");
     }
-    if (depth > 64) return Error(ErrorCode::kInvalidArgument, "modules.dep: dependency cycle through " + name);
+    if (depth > 64)
+      return Error(ErrorCode::kInvalidArgument, "modules.dep: dependency cycle through " + name);
     for (const std::string& dep : it->second.second) SWARMBOX_TRY(place(ModuleName(dep), name, depth + 1));
     placed.insert(name);
     order.push_back(it->second.first);
@@ -71,7 +74,8 @@ Status LoadModules(const std::string& dir, const std::vector<std::string>& paths
   for (const std::string& rel : paths) {
     const std::string path = dir + "/" + rel;
     if (path.size() < 3 || path.compare(path.size() - 3, 3, ".ko") != 0) {
-      return Error(ErrorCode::kInvalidArgument, "compressed module " + path + ": the guest loads plain .ko files only");
+      return Error(ErrorCode::kInvalidArgument,
+                   "compressed module " + path + ": the guest loads plain .ko files only");
     }
     const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return Error(ErrorCode::kIo, std::string("open: ") + std::strerror(errno), path);

@@ -24,7 +24,8 @@ std::string ModuleName(std::string_view path);
 // Paths (relative to the module tree, as modules.dep writes them) of `wanted` and their
 // dependencies, each once, dependencies before the modules that need them. kNotFound names a
 // wanted or needed module that modules.dep does not list; kInvalidArgument a line without ':'.
-Result<std::vector<std::string>> ModuleLoadOrder(std::string_view modules_dep, const std::vector<std::string>& wanted);
+Result<std::vector<std::string>> ModuleLoadOrder(std::string_view modules_dep,
+                                                 const std::vector<std::string>& wanted);
 
 // finit_module(2) of each `dir`/path in order; a module already loaded (EEXIST) is fine. kIo with
 // the path and the kernel's reason otherwise. Uncompressed modules only (the guest has no

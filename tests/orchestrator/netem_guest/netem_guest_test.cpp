@@ -11,12 +11,12 @@
 // host's timers delivered to the UML process, so the guest is late exactly when the host does not
 // schedule that process: the same kind of lateness the userspace daemon sees, which is what the
 // userspace tolerances were set for (BENCHMARKS.md has both sets of figures).
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "guest_console.hpp"
 #include "guest_measurements.hpp"
@@ -53,8 +53,8 @@ class NetemGuest : public ::testing::Test {
       const auto [stall_ms, probe] = console_.LongestStall();
       if (stall_ms <= kStarvedMs) return;
       char line[200];
-      std::snprintf(line, sizeof line, "attempt %d: the guest went unscheduled for %.0f ms during probe %s\n", attempt,
-                    stall_ms, probe.c_str());
+      std::snprintf(line, sizeof line, "attempt %d: the guest went unscheduled for %.0f ms during probe %s\n",
+                    attempt, stall_ms, probe.c_str());
       starved += line;
       std::printf("guest: %s", line);
     }
@@ -64,11 +64,12 @@ class NetemGuest : public ::testing::Test {
   }
 
   void BootOnce(const std::string& scenario) {
-    auto kernel = images::FindProgram("linux.uml", "", {},
-                                      "install Debian's user-mode-linux package (bash scripts/setup.sh does)");
+    auto kernel = images::FindProgram(
+        "linux.uml", "", {}, "install Debian's user-mode-linux package (bash scripts/setup.sh does)");
     ASSERT_TRUE(kernel) << kernel.error().ToString();
     ASSERT_TRUE(std::filesystem::is_directory(kUmlModulesDir))
-        << kUmlModulesDir << " is missing: the UML kernel's modules (sch_netem among them) come with user-mode-linux";
+        << kUmlModulesDir
+        << " is missing: the UML kernel's modules (sch_netem among them) come with user-mode-linux";
     TearDown();
     dir_ = testing::MakeTempDir("swarmbox-netem-guest-");
     ASSERT_FALSE(dir_.empty());
@@ -82,7 +83,8 @@ class NetemGuest : public ::testing::Test {
     raw_ = run->console;
     console_ = ParseGuestConsole(raw_);
     scenario_ = scenario;
-    ASSERT_TRUE(console_.done()) << "the guest did not finish (exit " << run->exit_code << "); its console:\n" << raw_;
+    ASSERT_TRUE(console_.done()) << "the guest did not finish (exit " << run->exit_code << "); its console:\n"
+                                 << raw_;
     ASSERT_EQ(console_.Errors(), "") << "its console:\n" << raw_;
     ASSERT_EQ(run->exit_code, 0) << raw_;
     std::printf("guest: scenario %s booted, ran and powered off in %.1f s\n", scenario.c_str(), run->wall_s);
@@ -104,18 +106,21 @@ class NetemGuest : public ::testing::Test {
 
   // The normalized tc listing of node a's veth at `stage`.
   std::string Tree(const std::string& stage, const std::string& node = "a") {
-    const GuestRecord* r = console_.Find(kEventTree, {{"scenario", scenario_}, {"drone", node}, {"stage", stage}});
+    const GuestRecord* r =
+        console_.Find(kEventTree, {{"scenario", scenario_}, {"drone", node}, {"stage", stage}});
     EXPECT_NE(r, nullptr) << "no " << stage << " listing in the console:\n" << raw_;
     return r == nullptr ? "<missing " + stage + ">" : NormalizeTcListing(r->Field("text"));
   }
 
   static void Print(const char* what, const GuestRecord& r) {
-    std::printf("kernel netem (guest), %s: sent %s received %s (%s datagrams) loss %.2f%% mean %s ms sd %s ms p50 %s ms "
-                "p99 %s ms min %s max %s; sender at most %s ms late\n",
-                what, r.Field("sent").c_str(), r.Field("received").c_str(), r.Field("datagrams").c_str(),
-                100 * Num(r, "loss"), r.Field("mean_ms").c_str(), r.Field("sd_ms").c_str(), r.Field("p50_ms").c_str(),
-                r.Field("p99_ms").c_str(), r.Field("min_ms").c_str(), r.Field("max_ms").c_str(),
-                r.Field("send_late_max_ms").c_str());
+    std::printf(
+        "kernel netem (guest), %s: sent %s received %s (%s datagrams) loss %.2f%% mean %s ms sd %s ms p50 %s "
+        "ms "
+        "p99 %s ms min %s max %s; sender at most %s ms late\n",
+        what, r.Field("sent").c_str(), r.Field("received").c_str(), r.Field("datagrams").c_str(),
+        100 * Num(r, "loss"), r.Field("mean_ms").c_str(), r.Field("sd_ms").c_str(), r.Field("p50_ms").c_str(),
+        r.Field("p99_ms").c_str(), r.Field("min_ms").c_str(), r.Field("max_ms").c_str(),
+        r.Field("send_late_max_ms").c_str());
   }
 
   // For timing failures: how long the guest went unscheduled during the probe (the host's load).
@@ -194,8 +199,9 @@ TEST_F(NetemGuest, PerDestinationRuleDelaysAndLimitsOnlyThatPeer) {
   // them by that exactly; 2 % covers the guest's late wake-ups (the slope is fitted over 300).
   const GuestRecord* rate = Probe("rate_to_c");
   ASSERT_NE(rate, nullptr);
-  std::printf("kernel netem (guest), per-destination rate 2000 kbit/s: %s kbit/s on the wire (%s of %s arrived)\n",
-              rate->Field("wire_kbit").c_str(), rate->Field("received").c_str(), rate->Field("sent").c_str());
+  std::printf(
+      "kernel netem (guest), per-destination rate 2000 kbit/s: %s kbit/s on the wire (%s of %s arrived)\n",
+      rate->Field("wire_kbit").c_str(), rate->Field("received").c_str(), rate->Field("sent").c_str());
   EXPECT_EQ(rate->Field("received"), rate->Field("sent"));
   EXPECT_NEAR(Num(*rate, "wire_kbit"), 2000.0, 40.0) << Late(*rate);
   // The fault's removal leaves the veth as it was.
@@ -211,9 +217,10 @@ TEST_F(NetemGuest, RateLimitsEveryPacketOnTheLink) {
   ASSERT_NO_FATAL_FAILURE(Boot("rate"));
   const GuestRecord* rate = Probe("rate");
   ASSERT_NE(rate, nullptr);
-  std::printf("kernel netem (guest), rate 2000 kbit/s: %s kbit/s on the wire (%s of %s arrived, last after %s ms)\n",
-              rate->Field("wire_kbit").c_str(), rate->Field("received").c_str(), rate->Field("sent").c_str(),
-              rate->Field("max_ms").c_str());
+  std::printf(
+      "kernel netem (guest), rate 2000 kbit/s: %s kbit/s on the wire (%s of %s arrived, last after %s ms)\n",
+      rate->Field("wire_kbit").c_str(), rate->Field("received").c_str(), rate->Field("sent").c_str(),
+      rate->Field("max_ms").c_str());
   EXPECT_EQ(rate->Field("received"), rate->Field("sent"));
   EXPECT_NEAR(Num(*rate, "wire_kbit"), 2000.0, 40.0);
 }
@@ -243,9 +250,10 @@ TEST_F(NetemGuest, DuplicationSendsASecondCopy) {
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
   const double ratio = Num(*s, "datagrams") / Num(*s, "sent");
-  std::printf("kernel netem (guest), duplicate 10%% (delay 5 ms): sent %s, b received %s datagrams (%.2f%%) of %s "
-              "distinct numbers\n",
-              s->Field("sent").c_str(), s->Field("datagrams").c_str(), 100 * ratio, s->Field("received").c_str());
+  std::printf(
+      "kernel netem (guest), duplicate 10%% (delay 5 ms): sent %s, b received %s datagrams (%.2f%%) of %s "
+      "distinct numbers\n",
+      s->Field("sent").c_str(), s->Field("datagrams").c_str(), 100 * ratio, s->Field("received").c_str());
   EXPECT_EQ(s->Field("received"), s->Field("sent"));  // nothing lost
   // Binomial with p = 0.1 over 3,000: sd of the extra fraction 0.55 %; allow 4 sd (as userspace).
   EXPECT_NEAR(ratio, 1.1, 0.022);
@@ -275,9 +283,11 @@ TEST_F(NetemGuest, CorruptionFlipsABitThatTheReceiversChecksumsCatch) {
   const double delivered = Num(*s, "received") / sent;
   const double missing = sent - Num(*s, "received");
   const double refused = Num(*s, "receive_errors");
-  std::printf("kernel netem (guest), corrupt 10%%: sent %.0f received %s (%.2f%%, model 91.06%%); of the %.0f missing "
-              "%.1f%% refused by b's stack (model 84.8%%)\n",
-              sent, s->Field("received").c_str(), 100 * delivered, missing, 100 * refused / missing);
+  std::printf(
+      "kernel netem (guest), corrupt 10%%: sent %.0f received %s (%.2f%%, model 91.06%%); of the %.0f "
+      "missing "
+      "%.1f%% refused by b's stack (model 84.8%%)\n",
+      sent, s->Field("received").c_str(), 100 * delivered, missing, 100 * refused / missing);
   // Binomial over 3,000 with p = 0.0894: sd 0.52 %; allow 4 sd (the userspace test's 2.2 %).
   EXPECT_NEAR(delivered, 1.0 - 0.1 * 415.0 / 464.0, 0.022);
   // Binomial over ~270 missing: sd 2.2 %; allow 4 sd.
@@ -294,10 +304,11 @@ TEST_F(NetemGuest, GilbertElliottLossComesInBursts) {
   ASSERT_NO_FATAL_FAILURE(Boot("gilbert_elliott"));
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
-  std::printf("kernel netem (guest), Gilbert-Elliott p 2%% r 25%% loss_bad 100%%: sent %s received %s loss %.2f%% "
-              "(stationary 7.41%%), %s bursts, mean burst %s packets (model 4)\n",
-              s->Field("sent").c_str(), s->Field("received").c_str(), 100 * Num(*s, "loss"), s->Field("bursts").c_str(),
-              s->Field("mean_burst").c_str());
+  std::printf(
+      "kernel netem (guest), Gilbert-Elliott p 2%% r 25%% loss_bad 100%%: sent %s received %s loss %.2f%% "
+      "(stationary 7.41%%), %s bursts, mean burst %s packets (model 4)\n",
+      s->Field("sent").c_str(), s->Field("received").c_str(), 100 * Num(*s, "loss"),
+      s->Field("bursts").c_str(), s->Field("mean_burst").c_str());
   // The userspace test's tolerances: the Markov chain's loss estimate has sd 1.2 % over 3,000
   // packets (4 sd); the mean of ~55 geometric bursts of mean 4 has sd ~0.47 (4.0 +- 2).
   EXPECT_NEAR(Num(*s, "loss"), 0.0741, 0.048);

@@ -1,12 +1,12 @@
 // The netem guest's pure parts: modules.dep load order, the console records, the measurements the
 // guest reports, the tc listing normalization, the UML command line, and the probe's /proc/net/snmp
 // reader.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "guest_console.hpp"
 #include "guest_measurements.hpp"
@@ -27,7 +27,8 @@ constexpr const char* kModulesDep =
     "kernel/net/netfilter/x_tables.ko\n"
     "kernel/net/ipv4/netfilter/ip_tables.ko: kernel/net/netfilter/x_tables.ko\n"
     "kernel/net/netfilter/x_tables.ko:\n"
-    "kernel/net/netfilter/xt_TEE.ko: kernel/net/ipv4/netfilter/nf-dup-ipv4.ko kernel/net/netfilter/x_tables.ko\n";
+    "kernel/net/netfilter/xt_TEE.ko: kernel/net/ipv4/netfilter/nf-dup-ipv4.ko "
+    "kernel/net/netfilter/x_tables.ko\n";
 
 TEST(ModuleName, IsTheFileNameWithoutKoAndWithUnderscores) {
   EXPECT_EQ(ModuleName("kernel/net/sched/sch_netem.ko"), "sch_netem");
@@ -39,10 +40,10 @@ TEST(ModuleName, IsTheFileNameWithoutKoAndWithUnderscores) {
 TEST(ModuleLoadOrder, PutsDependenciesFirstAndEachModuleOnce) {
   auto order = ModuleLoadOrder(kModulesDep, {"veth", "iptable_filter", "ip_tables", "sch_netem"});
   ASSERT_TRUE(order) << order.error().ToString();
-  EXPECT_EQ(*order, (std::vector<std::string>{"kernel/drivers/net/veth.ko", "kernel/net/netfilter/x_tables.ko",
-                                              "kernel/net/ipv4/netfilter/ip_tables.ko",
-                                              "kernel/net/ipv4/netfilter/iptable_filter.ko",
-                                              "kernel/net/sched/sch_netem.ko"}));
+  EXPECT_EQ(*order, (std::vector<std::string>{
+                        "kernel/drivers/net/veth.ko", "kernel/net/netfilter/x_tables.ko",
+                        "kernel/net/ipv4/netfilter/ip_tables.ko",
+                        "kernel/net/ipv4/netfilter/iptable_filter.ko", "kernel/net/sched/sch_netem.ko"}));
 }
 
 TEST(ModuleLoadOrder, NamesAModuleTheTreeDoesNotHave) {
@@ -70,11 +71,12 @@ TEST(LoadModules, RefusesACompressedModule) {
 TEST(GuestConsole, KeepsOnlyTheGuestsRecordsAndRoundTripsText) {
   const std::string tree = "qdisc netem 8001: root refcnt 2 limit 1000 delay 50ms\nqdisc \"x\" y=z\n";
   const std::string console =
-      "Linux version 6.1.176\r\n" + GuestLine(1.5, kEventReady, {{"kernel", "6.1.176"}, {"modules", "7"}}) + "\r\n" +
-      "netem: version 1.3 " + GuestLine(2.0, kEventTree, {{"scenario", "mesh"}, {"stage", "applied"}, {"text", tree}}) +
-      "\n" + "t=3.000 node=physics event=ready\n" +
-      GuestLine(4.0, kEventMeasured, {{"scenario", "mesh"}, {"probe", "impaired"}, {"mean_ms", "50.4"}}) + "\n" +
-      GuestLine(5.0, kEventError, {{"scenario", "rate"}, {"message", "`tc` exited 2"}}) + "\n" +
+      "Linux version 6.1.176\r\n" + GuestLine(1.5, kEventReady, {{"kernel", "6.1.176"}, {"modules", "7"}}) +
+      "\r\n" + "netem: version 1.3 " +
+      GuestLine(2.0, kEventTree, {{"scenario", "mesh"}, {"stage", "applied"}, {"text", tree}}) + "\n" +
+      "t=3.000 node=physics event=ready\n" +
+      GuestLine(4.0, kEventMeasured, {{"scenario", "mesh"}, {"probe", "impaired"}, {"mean_ms", "50.4"}}) +
+      "\n" + GuestLine(5.0, kEventError, {{"scenario", "rate"}, {"message", "`tc` exited 2"}}) + "\n" +
       GuestLine(6.0, kEventDone, {{"scenarios", "2"}, {"errors", "1"}});
   const GuestConsole c = ParseGuestConsole(console);
   ASSERT_EQ(c.records.size(), 5u);
@@ -102,7 +104,8 @@ TEST(GuestConsole, LongestStallIsTheLatestSenderOfAnyProbe) {
 }
 
 TEST(GuestConsole, IsNotDoneWithoutTheDoneRecord) {
-  const GuestConsole c = ParseGuestConsole(GuestLine(1.0, kEventReady, {}) + "\nKernel panic - not syncing\n");
+  const GuestConsole c =
+      ParseGuestConsole(GuestLine(1.0, kEventReady, {}) + "\nKernel panic - not syncing\n");
   EXPECT_FALSE(c.done());
   EXPECT_EQ(c.Errors(), "");
 }
@@ -188,7 +191,8 @@ TEST(NormalizeTcListing, MasksTheKernelsOwnHandlesAndCounters) {
   EXPECT_EQ(NormalizeTcListing("qdisc netem 110: parent 1:10 limit 1000 delay 80ms\n"),
             "qdisc netem 110: parent 1:10 limit 1000 delay 80ms\n");
   EXPECT_EQ(NormalizeTcListing("qdisc noqueue 0: root refcnt 2 \n"), "qdisc noqueue 0: root refcnt 2 \n");
-  EXPECT_EQ(NormalizeTcListing("qdisc htb 1: root refcnt 2 r2q 10 default 0x1 direct_packets_stat 7 direct_qlen 1000"),
+  EXPECT_EQ(NormalizeTcListing(
+                "qdisc htb 1: root refcnt 2 r2q 10 default 0x1 direct_packets_stat 7 direct_qlen 1000"),
             "qdisc htb 1: root refcnt 2 r2q 10 default 0x1 direct_qlen 1000");
 }
 
@@ -202,15 +206,17 @@ TEST(UmlArgv, BootsTheHostRootReadOnlyWithTheGuestAsInit) {
   ASSERT_FALSE(argv.empty());
   EXPECT_EQ(argv[0], "/usr/bin/linux.uml");
   auto has = [&](const std::string& a) { return std::find(argv.begin(), argv.end(), a) != argv.end(); };
-  for (const char* a : {"mem=256M", "rootfstype=hostfs", "rootflags=/", "ro", "init=/build/swarmbox-netem-guest",
-                        "uml_dir=/tmp/g", "con0=null,fd:1", "con=null", "ssl=null"}) {
+  for (const char* a :
+       {"mem=256M", "rootfstype=hostfs", "rootflags=/", "ro", "init=/build/swarmbox-netem-guest",
+        "uml_dir=/tmp/g", "con0=null,fd:1", "con=null", "ssl=null"}) {
     EXPECT_TRUE(has(a)) << a;
   }
   // The init's own arguments come after "--", the scenarios last, in order.
   const auto dashes = std::find(argv.begin(), argv.end(), "--");
   ASSERT_NE(dashes, argv.end());
   EXPECT_EQ(std::vector<std::string>(dashes + 1, argv.end()),
-            (std::vector<std::string>{"--modules", "/usr/lib/uml/modules", "--scenario", "mesh", "--scenario", "rate"}));
+            (std::vector<std::string>{"--modules", "/usr/lib/uml/modules", "--scenario", "mesh", "--scenario",
+                                      "rate"}));
 }
 
 TEST(SnmpReceiveErrors, AddsIpHeaderErrorsAndUdpErrors) {

@@ -25,8 +25,8 @@ namespace swarmbox::netem_guest {
 inline constexpr const char* kUmlModulesDir = "/usr/lib/uml/modules";  // Debian's user-mode-linux
 
 struct GuestBoot {
-  std::string kernel;       // linux.uml
-  std::string init;         // swarmbox-netem-guest, an absolute path on the host (= in the guest)
+  std::string kernel;  // linux.uml
+  std::string init;    // swarmbox-netem-guest, an absolute path on the host (= in the guest)
   std::string modules_dir = kUmlModulesDir;
   std::string scratch_dir;  // exists; UML's umid directory and the console file go here
   int mem_mb = 256;
@@ -38,9 +38,9 @@ struct GuestBoot {
 std::vector<std::string> UmlArgv(const GuestBoot& boot);
 
 struct GuestRun {
-  int exit_code = 0;     // linux.uml's: 0 after the guest powered off
-  std::string console;   // everything the guest printed (kernel lines and the records)
-  double wall_s = 0.0;   // boot to power-off on the host [s]
+  int exit_code = 0;    // linux.uml's: 0 after the guest powered off
+  std::string console;  // everything the guest printed (kernel lines and the records)
+  double wall_s = 0.0;  // boot to power-off on the host [s]
 };
 
 // Runs the guest to its power-off. kTimeout (the console so far in the message) when it has not
