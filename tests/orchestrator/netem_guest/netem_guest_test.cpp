@@ -38,20 +38,22 @@ class NetemGuest : public ::testing::Test {
 
   // Boots the guest with `scenario` and reads its console; fatal failures say why it could not.
   //
-  // A sample taken while the host did not run the guest at all is not a sample of netem: on this
-  // 2-core machine at a load of 10-15 the guest was seen unscheduled for up to 1.1 s (its sender's
-  // lateness shows it), which by itself moves the 3,000-datagram mean by ~5 ms. An attempt whose
-  // probes saw the guest stopped for more than kStarvedMs is therefore void and the guest is booted
-  // again, up to kAttempts times; the tolerances apply unchanged to the attempt that counts, and if
-  // every attempt was starved the test fails saying so.
-  void Boot(const std::string& scenario) {
+  // A sample taken while the host did not run the guest at all is not a sample of netem's timing:
+  // on this 2-core machine at a load of 10-15 the guest was seen unscheduled for up to 1.4 s (its
+  // sender's lateness shows it), which by itself moves the 3,000-datagram mean by ~5 ms. For the
+  // scenarios judged on delays (`timing`), an attempt whose probes saw the guest stopped for more
+  // than kStarvedMs is therefore void and the guest is booted again, up to kAttempts times; the
+  // tolerances apply unchanged to the attempt that counts, and if every attempt was starved the
+  // test fails saying so. Counts (loss, duplicates, corruption, bursts, a partition) are not moved
+  // by a stall (the probe's 4 MB socket buffer holds the burst after one): no retry there.
+  void Boot(const std::string& scenario, bool timing) {
     constexpr double kStarvedMs = 250.0;  // where a stall alone eats the mean's 3 ms allowance
     constexpr int kAttempts = 3;
     std::string starved;
     for (int attempt = 1; attempt <= kAttempts; ++attempt) {
       ASSERT_NO_FATAL_FAILURE(BootOnce(scenario));
       const auto [stall_ms, probe] = console_.LongestStall();
-      if (stall_ms <= kStarvedMs) return;
+      if (!timing || stall_ms <= kStarvedMs) return;
       char line[200];
       std::snprintf(line, sizeof line, "attempt %d: the guest went unscheduled for %.0f ms during probe %s\n",
                     attempt, stall_ms, probe.c_str());
@@ -144,7 +146,7 @@ class NetemGuest : public ::testing::Test {
 TEST_F(NetemGuest, MeshDelayJitterAndLossAsTheUserspacePath) {
   // network.mesh {delay_ms: 50, jitter_ms: 10, distribution: normal, loss: 0.05} on both agents,
   // 3,000 datagrams a -> b 1 ms apart: netem on a's egress delays and drops.
-  ASSERT_NO_FATAL_FAILURE(Boot("mesh"));
+  ASSERT_NO_FATAL_FAILURE(Boot("mesh", /*timing=*/true));
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
   Print("50+-10 ms normal, loss 5%", *s);
@@ -166,7 +168,7 @@ TEST_F(NetemGuest, MeshDelayJitterAndLossAsTheUserspacePath) {
 }
 
 TEST_F(NetemGuest, FixedDelayHasATightSpread) {
-  ASSERT_NO_FATAL_FAILURE(Boot("fixed"));
+  ASSERT_NO_FATAL_FAILURE(Boot("fixed", /*timing=*/true));
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
   Print("fixed 50 ms", *s);
@@ -181,7 +183,7 @@ TEST_F(NetemGuest, FixedDelayHasATightSpread) {
 TEST_F(NetemGuest, PerDestinationRuleDelaysAndLimitsOnlyThatPeer) {
   // A radio fault on a: {to: [c], delay_ms: 80, rate_kbit: 2000}: htb root, a class with netem for
   // c (u32 filter on c's address), the default class for the rest.
-  ASSERT_NO_FATAL_FAILURE(Boot("per_destination"));
+  ASSERT_NO_FATAL_FAILURE(Boot("per_destination", /*timing=*/true));
   const std::string applied = Tree("applied");
   EXPECT_NE(applied.find("qdisc htb 1:"), std::string::npos) << applied;
   EXPECT_NE(applied.find("delay 80ms rate 2Mbit"), std::string::npos) << applied;
@@ -214,7 +216,7 @@ TEST_F(NetemGuest, PerDestinationRuleDelaysAndLimitsOnlyThatPeer) {
 TEST_F(NetemGuest, RateLimitsEveryPacketOnTheLink) {
   // network.mesh {rate_kbit: 2000}: netem's own rate on the root qdisc, 400 datagrams of 1042
   // bytes on the wire offered at 8.3 Mbit/s; the default queue (1,000 packets) holds the backlog.
-  ASSERT_NO_FATAL_FAILURE(Boot("rate"));
+  ASSERT_NO_FATAL_FAILURE(Boot("rate", /*timing=*/false));
   const GuestRecord* rate = Probe("rate");
   ASSERT_NE(rate, nullptr);
   std::printf(
@@ -228,7 +230,7 @@ TEST_F(NetemGuest, RateLimitsEveryPacketOnTheLink) {
 TEST_F(NetemGuest, ReorderSendsAFractionAtOnce) {
   // A radio fault {delay_ms: 10, reorder: 0.25}: netem sends 25 % at once (tc sets gap 1) and
   // delays the rest 10 ms, so the ones sent at once overtake those of the last 10 ms.
-  ASSERT_NO_FATAL_FAILURE(Boot("reorder"));
+  ASSERT_NO_FATAL_FAILURE(Boot("reorder", /*timing=*/false));
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
   Print("10 ms, reorder 25%", *s);
@@ -246,7 +248,7 @@ TEST_F(NetemGuest, ReorderSendsAFractionAtOnce) {
 
 TEST_F(NetemGuest, DuplicationSendsASecondCopy) {
   // network.mesh {delay_ms: 5, duplicate: 0.1}.
-  ASSERT_NO_FATAL_FAILURE(Boot("duplicate"));
+  ASSERT_NO_FATAL_FAILURE(Boot("duplicate", /*timing=*/false));
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
   const double ratio = Num(*s, "datagrams") / Num(*s, "sent");
@@ -276,7 +278,7 @@ TEST_F(NetemGuest, CorruptionFlipsABitThatTheReceiversChecksumsCatch) {
   // So 10 % x 415/464 = 8.94 % go missing (delivered 91.06 %) and 352/415 = 84.8 % of the missing
   // show in b's error counters. (The userspace daemon flips a bit of the 44-byte IP packet before
   // routing: 90 % delivered and 90.9 % of the missing counted; netemd_e2e_test.cpp.)
-  ASSERT_NO_FATAL_FAILURE(Boot("corrupt"));
+  ASSERT_NO_FATAL_FAILURE(Boot("corrupt", /*timing=*/false));
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
   const double sent = Num(*s, "sent");
@@ -301,7 +303,7 @@ TEST_F(NetemGuest, CorruptionFlipsABitThatTheReceiversChecksumsCatch) {
 TEST_F(NetemGuest, GilbertElliottLossComesInBursts) {
   // A radio fault {delay_ms: 5, gilbert_elliott: {p: 0.02, r: 0.25, loss_bad: 1.0, loss_good: 0}}:
   // netem "loss gemodel 2% 25% 100% 0%", bad spells of 1/r = 4 packets, 7.41 % in the long run.
-  ASSERT_NO_FATAL_FAILURE(Boot("gilbert_elliott"));
+  ASSERT_NO_FATAL_FAILURE(Boot("gilbert_elliott", /*timing=*/false));
   const GuestRecord* s = Probe("impaired");
   ASSERT_NE(s, nullptr);
   std::printf(
@@ -318,7 +320,7 @@ TEST_F(NetemGuest, GilbertElliottLossComesInBursts) {
 TEST_F(NetemGuest, PartitionCutsOneWayAndHeals) {
   // partition {groups: [[a], [b]], oneway: true}: b drops what comes from a (PlanPartition's
   // iptables chain on b's INPUT); healing removes exactly that chain.
-  ASSERT_NO_FATAL_FAILURE(Boot("partition"));
+  ASSERT_NO_FATAL_FAILURE(Boot("partition", /*timing=*/false));
   const std::string cut = Tree("iptables_cut", "b");
   EXPECT_NE(cut.find("-A SWARMBOX-PART-3 -s 10.213.7.1/32 -j DROP"), std::string::npos) << cut;
   const GuestRecord* during = Probe("cut");
@@ -334,7 +336,7 @@ TEST_F(NetemGuest, ReplaceAndRemovalLeaveTheQdiscTreeAsItWas) {
   // network.mesh {delay_ms: 20}; a radio fault for c only {to: [c], delay_ms: 80} pushed and popped;
   // then an all-traffic fault {delay_ms: 30} pushed and popped; the injector's PlanRadioChange each
   // time. The mesh plan is also applied twice (tc qdisc replace over itself).
-  ASSERT_NO_FATAL_FAILURE(Boot("replace"));
+  ASSERT_NO_FATAL_FAILURE(Boot("replace", /*timing=*/true));
   const std::string mesh = Tree("mesh");
   EXPECT_NE(mesh.find("delay 20ms"), std::string::npos) << mesh;
   EXPECT_EQ(Tree("mesh_again"), mesh);
