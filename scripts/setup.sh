@@ -21,6 +21,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # containers, networks, hosts (procps: pgrep in netns_host.sh)
   docker.io docker-compose iptables iproute2 openssh-server openssh-client procps
+  # a Linux kernel with sch_netem run as a process (user-mode Linux): the kernel netem path's guest test
+  user-mode-linux
 )
 
 log() { printf 'setup: %s\n' "$*"; }

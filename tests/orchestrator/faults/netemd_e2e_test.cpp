@@ -2,79 +2,34 @@
 // veth pair between two network namespaces this test creates and always deletes. Needs root and
 // the kernel's nfnetlink_queue; without them the test FAILS with the reason (it never skips).
 //
-// One-way delay is measured directly: both UDP sockets live in this process (each created inside
-// its namespace), so send and receive times come from the same CLOCK_MONOTONIC.
-#include <fcntl.h>
-#include <sys/uio.h>
-#include <netinet/in.h>
-#include <sched.h>
-#include <sys/socket.h>
-#include <sys/stat.h>
-#include <time.h>
+// One-way delay is measured with udp_probe.hpp (the same probe measures kernel netem in the
+// user-mode Linux guest, tests/orchestrator/netem_guest): both UDP sockets live in this process
+// (each created inside its namespace), so send and arrival times come from one clock.
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
-#include <cmath>
-#include <cstring>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <sstream>
-#include <map>
-#include <thread>
 #include <vector>
 
-#include <arpa/inet.h>
 #include <gtest/gtest.h>
 
 #include "swarmbox/faults/command_runner.hpp"
 #include "swarmbox/faults/partition_plan.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
 #include "test_util.hpp"
+#include "udp_probe.hpp"
 
 namespace swarmbox::faults {
 namespace {
 
+using testing::MeasureOneWay;
+using testing::ProbeOptions;
+using Sample = testing::ProbeSample;
 using testing::Yaml;
-
-std::int64_t NowUs() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
-}
-
-// Send and arrival times share CLOCK_REALTIME (SO_TIMESTAMPNS reports it); one host, one clock.
-std::int64_t RealtimeUs() {
-  timespec ts{};
-  clock_gettime(CLOCK_REALTIME, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
-}
-
-struct Sample {
-  std::uint32_t sent = 0;
-  std::vector<double> delay_ms;  // per received packet
-  std::vector<std::uint32_t> seqs;  // the received packets' numbers, ascending
-  std::uint32_t datagrams = 0;      // every datagram received, duplicates included
-  std::uint32_t received() const { return static_cast<std::uint32_t>(delay_ms.size()); }
-  double Mean() const {
-    double s = 0;
-    for (double d : delay_ms) s += d;
-    return s / static_cast<double>(delay_ms.size());
-  }
-  double StdDev() const {
-    const double m = Mean();
-    double s = 0;
-    for (double d : delay_ms) s += (d - m) * (d - m);
-    return std::sqrt(s / static_cast<double>(delay_ms.size() - 1));
-  }
-  double Quantile(double q) const {
-    std::vector<double> v = delay_ms;
-    std::sort(v.begin(), v.end());
-    return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
-  }
-};
 
 class NetnsPair : public ::testing::Test {
  protected:
@@ -125,20 +80,6 @@ class NetnsPair : public ::testing::Test {
     ASSERT_EQ(out->exit_code, 0) << "`" << CommandText(argv) << "` failed: " << out->stderr_text;
   }
 
-  // A UDP socket created inside namespace `ns`.
-  int SocketIn(const std::string& ns) {
-    const int self = open("/proc/self/ns/net", O_RDONLY | O_CLOEXEC);
-    const int target = open(("/run/netns/" + ns).c_str(), O_RDONLY | O_CLOEXEC);
-    EXPECT_GE(self, 0);
-    EXPECT_GE(target, 0) << "no /run/netns/" << ns;
-    EXPECT_EQ(setns(target, CLONE_NEWNET), 0) << std::strerror(errno);
-    const int fd = socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    EXPECT_EQ(setns(self, CLONE_NEWNET), 0) << std::strerror(errno);
-    close(self);
-    close(target);
-    return fd;
-  }
-
   LinkTarget Link(const std::string& node, const std::string& iface, const std::string& peer,
                   const std::string& peer_ip) {
     return LinkTarget{node, iface, {{peer, peer_ip}}, kAssumedLinkRateKbit};
@@ -154,77 +95,19 @@ class NetnsPair : public ::testing::Test {
 
   // Sends `count` datagrams A -> B every `spacing_us`, returns what B received and when.
   Sample Measure(int count, std::int64_t spacing_us, const char* to_addr = kAddrB) {
-    Sample sample;
-    const int tx = SocketIn(ns_a_);
-    const int rx = SocketIn(ns_b_);
-    EXPECT_GE(tx, 0);
-    EXPECT_GE(rx, 0);
-    sockaddr_in to{};
-    to.sin_family = AF_INET;
-    to.sin_port = htons(kPort);
-    inet_pton(AF_INET, to_addr, &to.sin_addr);
-    EXPECT_EQ(bind(rx, reinterpret_cast<sockaddr*>(&to), sizeof to), 0) << std::strerror(errno);
-    timeval tv{0, 100000};
-    setsockopt(rx, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
-    int big = 4 << 20;
-    setsockopt(rx, SOL_SOCKET, SO_RCVBUF, &big, sizeof big);
-    int on = 1;
-    EXPECT_EQ(setsockopt(rx, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on), 0) << std::strerror(errno);
-    std::atomic<bool> done{false};
-    std::map<std::uint32_t, double> got;
-    std::thread receiver([&] {
-      std::int64_t quiet_since = 0;
-      for (;;) {
-        std::int64_t msg[2];
-        iovec iov{msg, sizeof msg};
-        alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
-        msghdr hdr{};
-        hdr.msg_iov = &iov;
-        hdr.msg_iovlen = 1;
-        hdr.msg_control = control;
-        hdr.msg_controllen = sizeof control;
-        const ssize_t n = recvmsg(rx, &hdr, 0);
-        const std::int64_t now = RealtimeUs();
-        if (n == static_cast<ssize_t>(sizeof msg)) {
-          // The kernel's arrival time (SO_TIMESTAMPNS), so this thread's own wake-up latency does
-          // not count as added delay.
-          std::int64_t arrived = now;
-          for (cmsghdr* c = CMSG_FIRSTHDR(&hdr); c != nullptr; c = CMSG_NXTHDR(&hdr, c)) {
-            if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SO_TIMESTAMPNS) {
-              timespec ts{};
-              std::memcpy(&ts, CMSG_DATA(c), sizeof ts);
-              arrived = static_cast<std::int64_t>(ts.tv_sec) * 1000000 + ts.tv_nsec / 1000;
-            }
-          }
-          got[static_cast<std::uint32_t>(msg[0])] = static_cast<double>(arrived - msg[1]) / 1000.0;
-          ++sample.datagrams;
-          quiet_since = 0;
-          continue;
-        }
-        if (!done) continue;
-        if (quiet_since == 0) quiet_since = now;
-        if (now - quiet_since > 1500000) break;  // 1.5 s without packets after the last send
-      }
-    });
-    const std::int64_t start = NowUs();
-    for (int i = 0; i < count; ++i) {
-      const std::int64_t due = start + i * spacing_us;
-      while (NowUs() < due) {
-        timespec ts{0, 100000};
-        nanosleep(&ts, nullptr);
-      }
-      std::int64_t msg[2] = {i, RealtimeUs()};
-      if (sendto(tx, msg, sizeof msg, 0, reinterpret_cast<sockaddr*>(&to), sizeof to) == sizeof msg) ++sample.sent;
+    ProbeOptions o;
+    o.from_netns = ns_a_;
+    o.to_netns = ns_b_;
+    o.to_addr = to_addr;
+    o.port = kPort;
+    o.count = count;
+    o.spacing_us = spacing_us;
+    auto sample = MeasureOneWay(o);
+    if (!sample) {
+      ADD_FAILURE() << sample.error().ToString();
+      return Sample{};
     }
-    done = true;
-    receiver.join();
-    close(tx);
-    close(rx);
-    for (const auto& [seq, d] : got) {
-      sample.delay_ms.push_back(d);
-      sample.seqs.push_back(seq);
-    }
-    return sample;
+    return *sample;
   }
 
   // user + system CPU of the daemon whose pidfile is side/swarmbox-netemd-0.pid [s].
@@ -243,27 +126,11 @@ class NetnsPair : public ::testing::Test {
     return static_cast<double>(std::stoll(f[11]) + std::stoll(f[12])) / static_cast<double>(sysconf(_SC_CLK_TCK));
   }
 
-  // Packets namespace `ns`'s stack refused as malformed: Ip InHdrErrors (bad IP header checksum,
-  // version or length) plus Udp InErrors (bad UDP checksum or length).
+  // Packets namespace `ns`'s stack refused as malformed (Ip InHdrErrors + Udp InErrors).
   std::int64_t ReceiveErrors(const std::string& ns) {
-    auto out = runner_.Run({"ip", "netns", "exec", ns, "cat", "/proc/net/snmp"});
-    EXPECT_TRUE(out) << out.error().ToString();
-    if (!out) return -1;
-    // Each group is a header line ("Udp: InDatagrams NoPorts InErrors ...") then a value line.
-    std::int64_t total = 0;
-    std::istringstream lines(out->stdout_text);
-    std::string names, values;
-    while (std::getline(lines, names) && std::getline(lines, values)) {
-      const std::string group = names.substr(0, names.find(':'));
-      const char* counter = group == "Ip" ? "InHdrErrors" : group == "Udp" ? "InErrors" : nullptr;
-      if (counter == nullptr) continue;
-      std::istringstream n(names), v(values);
-      std::string name, value;
-      while (n >> name && v >> value) {
-        if (name == counter) total += std::stoll(value);
-      }
-    }
-    return total;
+    auto errors = testing::ReceiveErrors(runner_, ns);
+    EXPECT_TRUE(errors) << errors.error().ToString();
+    return errors ? *errors : -1;
   }
 
   std::string IptablesRules(const std::string& ns) {
