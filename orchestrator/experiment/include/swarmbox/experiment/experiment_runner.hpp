@@ -88,6 +88,16 @@ struct ExperimentSummary {
   std::vector<std::string> problems;  // cleanup and report issues, hosts that left
 };
 
+// experiment.json: {"name","file","base","factors":[...],"trials","run_ids":[...],
+//   "provenance":{"swarmbox_version","swarmbox_commit","build_type","host_name","rtf_requested",
+//                 "hosts":[{"name","images":[...],"docker_version","docker_api_version","kernel"}]}}
+// (the provenance every trial shares: this build and machine, each host's images and engine, asked
+// with GET /version now; rtf_requested null when the trials differ in it). A trial's own (the
+// engine it ran on, the fault mechanism, the rtf achieved) is in its result.json and results.csv
+// row (report/provenance.hpp).
+std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::string>& run_ids,
+                           const std::vector<PoolHost>& pool);
+
 // Whether `out_dir` can take this run: kInvalidArgument when it holds another experiment, or trials
 // of this one and `resume` is false. Returns the run ids of earlier runs in the folder.
 Result<std::vector<std::string>> CheckOutFolder(const ExperimentPlan& plan, const std::string& out_dir,
