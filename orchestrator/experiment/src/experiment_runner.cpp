@@ -219,7 +219,8 @@ class Observer final : public ScheduleObserver {
 }  // namespace
 
 std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::string>& run_ids,
-                           const std::vector<PoolHost>& pool) {
+                           const std::vector<PoolHost>& pool,
+                           const std::vector<report::Provenance>& trials) {
   Node doc = Node::Mapping();
   doc.Set("name", Str(plan.spec.name));
   doc.Set("file", Str(plan.spec.file));
@@ -262,6 +263,24 @@ std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::st
     hosts.Append(std::move(host));
   }
   prov.Set("hosts", std::move(hosts));
+  // From the trials run so far (their result.json): the fault mechanisms used, the rtf achieved.
+  std::set<std::string> mechanisms;
+  std::optional<double> rtf_min, rtf_max;
+  for (const report::Provenance& t : trials) {
+    if (!t.fault_mechanism.empty()) mechanisms.insert(t.fault_mechanism);
+    if (t.rtf_achieved) {
+      rtf_min = rtf_min ? std::min(*rtf_min, *t.rtf_achieved) : *t.rtf_achieved;
+      rtf_max = rtf_max ? std::max(*rtf_max, *t.rtf_achieved) : *t.rtf_achieved;
+    }
+  }
+  Node used = Node::Sequence();
+  for (const std::string& m : mechanisms) used.Append(Str(m));
+  prov.Set("fault_mechanisms", std::move(used));
+  auto number = [](const std::optional<double>& v) {
+    return v ? Node::Scalar(report::CsvNumber(*v)) : Node::Null();
+  };
+  prov.Set("rtf_achieved_min", number(rtf_min));
+  prov.Set("rtf_achieved_max", number(rtf_max));
   doc.Set("provenance", std::move(prov));
   return yaml::EmitJson(doc) + "\n";
 }
@@ -476,10 +495,18 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
   if (auto n = WriteReports(options.out_dir, &summary.problems); !n) {
     summary.problems.push_back("writing results.csv/report.html: " + n.error().ToString());
   }
+  std::vector<report::Provenance> trials;
   for (const PlannedTrial& t : plan.trials) {
     if (!store.Done(t.id)) continue;
     ++summary.committed;
-    if (auto rec = report::ReadTrialFolder(store.TrialDir(t.id))) summary.outcomes[rec->outcome] += 1;
+    if (auto rec = report::ReadTrialFolder(store.TrialDir(t.id))) {
+      summary.outcomes[rec->outcome] += 1;
+      trials.push_back(rec->provenance);
+    }
+  }
+  // experiment.json again, with what the trials' result.json say about their fault mechanism and pace.
+  if (Status s = WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids, pool, trials)); !s) {
+    summary.problems.push_back("writing experiment.json: " + s.error().ToString());
   }
   return summary;
 }

@@ -46,6 +46,25 @@ TEST(ExperimentJson, NamesTheExperimentAndCarriesItsProvenancePerHost) {
   EXPECT_EQ(h.Find("images")->items()[0].scalar(), "swarmbox/agent:aa11");
   EXPECT_EQ(h.Find("images")->items()[2].scalar(), "swarmbox/faults:cc33");
 
+  EXPECT_TRUE(p->Find("fault_mechanisms")->items().empty());  // before any trial ran
+  EXPECT_TRUE(p->Find("rtf_achieved_min")->is_null());
+
+  // At the end: what the trials' result.json said.
+  report::Provenance t1, t2, t3;
+  t1.fault_mechanism = "netem";
+  t1.rtf_achieved = 3.5;
+  t2.fault_mechanism = "none";
+  t2.rtf_achieved = 2.25;
+  t3.fault_mechanism = "netem";
+  auto after = yaml::Parse(ExperimentJson(plan, {"20261121-195623-5238"}, {local}, {t1, t2, t3}), "experiment.json");
+  ASSERT_TRUE(after);
+  const yaml::Node* ap = after->Find("provenance");
+  ASSERT_EQ(ap->Find("fault_mechanisms")->items().size(), 2u);
+  EXPECT_EQ(ap->Find("fault_mechanisms")->items()[0].scalar(), "netem");
+  EXPECT_EQ(ap->Find("fault_mechanisms")->items()[1].scalar(), "none");
+  EXPECT_EQ(ap->Find("rtf_achieved_min")->scalar(), "2.25");
+  EXPECT_EQ(ap->Find("rtf_achieved_max")->scalar(), "3.5");
+
   // Trials that differ in their pace: no one rtf for the experiment (each result.json has its own).
   plan.specs["radio-b-r1"].rtf = 1;
   auto mixed = yaml::Parse(ExperimentJson(plan, {}, {local}), "experiment.json");
