@@ -3,7 +3,10 @@
 // (report::ReadExperimentFolder + ResultsCsv, as `swarmbox report` writes it) and in its ending
 // line (`event=mission_complete victims=N rescued=M`).
 //
-// The logs are lines in the formats the agents write them (agent/raft/src/node_driver.cpp:
+// SarRunMetrics.ARealRunsFolderAgrees: the logs of a real `swarmbox run trials/sar_search.yaml`
+// (data/sar_search, its README says how it was written), also against the result.json its runner
+// wrote. SarRunMetrics.ResultJsonResultsCsvAndTheEndingLineAgree: the same on a small folder whose
+// lines are in the formats the agents write them (agent/raft/src/node_driver.cpp:
 // victim_confirmed/victim_status by `id`, logged by every node as it applies the entry;
 // agent/swarm/src/scout_behaviour.cpp: sighting_reported without an id; agent/app/mission_host.cpp:
 // mission_complete victims= rescued=), with the ending line of the example report's trial
@@ -82,14 +85,11 @@ std::vector<std::string> Split(const std::string& line) {
   return out;
 }
 
-TEST(SarRunMetrics, ResultJsonResultsCsvAndTheEndingLineAgree) {
-  const fs::path exp = fs::temp_directory_path() / ("swarmbox-sar-metrics-" + std::to_string(::getpid()));
-  fs::remove_all(exp);
-  const fs::path trial = exp / "sar-search-run";
-  WriteSarTrialFolder(trial);
-  const std::string ending_line = kEndingLine;
+// Writes result.json into `trial` (inside the experiment folder `exp`) as the runner does, reads
+// the folder back as `swarmbox report` does, and checks that result.json's metrics, the
+// results.csv row and the ending line agree. Returns result.json's metrics.
+yaml::Node ExpectAgreement(const fs::path& exp, const fs::path& trial, const std::string& ending_line) {
   const auto ending = ParseLogfmt(ending_line);
-
   // result.json as the runner writes it.
   TrialResult r;
   r.trial = "sar-search";
@@ -97,18 +97,23 @@ TEST(SarRunMetrics, ResultJsonResultsCsvAndTheEndingLineAgree) {
   r.verdict = dsl::Verdict::Of(dsl::Outcome::kSuccess, "matched 'event=mission_complete'");
   r.ending_line = ending_line;
   auto metrics = report::ReadTrialMetrics(trial.string());
-  ASSERT_TRUE(metrics);
+  if (!metrics) {
+    ADD_FAILURE() << "no logs in " << trial;
+    return yaml::Node::Null();
+  }
   r.metrics = *metrics;
   { std::ofstream(trial / "result.json") << ResultJson(r); }
   auto result = yaml::Parse(ReadFile(trial / "result.json"), "result.json");
-  ASSERT_TRUE(result) << result.error().ToString();
-  const yaml::Node* m = result->Find("metrics");
-  ASSERT_NE(m, nullptr);
+  const yaml::Node* m = result ? result->Find("metrics") : nullptr;
+  if (m == nullptr) {
+    ADD_FAILURE() << "no metrics";
+    return yaml::Node::Null();
+  }
 
   // results.csv as `swarmbox report` writes it.
   std::vector<std::string> problems;
   const auto records = report::ReadExperimentFolder(exp.string(), &problems);
-  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records.size(), 1u);
   EXPECT_TRUE(problems.empty());
   std::istringstream csv(report::ResultsCsv({}, records));
   std::string header_line, row_line;
@@ -126,16 +131,36 @@ TEST(SarRunMetrics, ResultJsonResultsCsvAndTheEndingLineAgree) {
 
   for (const std::string& name : report::MetricNames()) {
     const yaml::Node* v = m->Find(name);
-    ASSERT_NE(v, nullptr) << name;
+    if (v == nullptr) {
+      ADD_FAILURE() << "result.json has no metric " << name;
+      continue;
+    }
     EXPECT_EQ(cell(name), v->is_null() ? "" : v->scalar()) << name;
   }
   const auto victims = FindField(ending, "victims");
   const auto rescued = FindField(ending, "rescued");
-  ASSERT_TRUE(victims && rescued) << ending_line;
+  if (!victims || !rescued) {
+    ADD_FAILURE() << "no victims=/rescued= in " << ending_line;
+    return *m;
+  }
   EXPECT_EQ(m->Find("victims_confirmed")->scalar(), *victims);
   EXPECT_EQ(m->Find("victims_rescued")->scalar(), *rescued);
   EXPECT_EQ(cell("victims_confirmed"), *victims);
   EXPECT_EQ(cell("victims_rescued"), *rescued);
+  return *m;
+}
+
+TEST(SarRunMetrics, ResultJsonResultsCsvAndTheEndingLineAgree) {
+  const fs::path exp = fs::temp_directory_path() / ("swarmbox-sar-metrics-" + std::to_string(::getpid()));
+  fs::remove_all(exp);
+  const fs::path trial = exp / "sar-search-run";
+  WriteSarTrialFolder(trial);
+  const std::string ending_line = kEndingLine;
+  const auto ending = ParseLogfmt(ending_line);
+
+  const yaml::Node metrics = ExpectAgreement(exp, trial, ending_line);
+  ASSERT_TRUE(metrics.is_mapping());
+  const yaml::Node* m = &metrics;
   // mission_time_s is the first mission_complete of any log: at or before the ending line's (the
   // runner ends on the first such line to arrive, not always the earliest in simulated time).
   const double mission_s = *yaml::ScalarAsDouble(m->Find("mission_time_s")->scalar());
@@ -146,6 +171,37 @@ TEST(SarRunMetrics, ResultJsonResultsCsvAndTheEndingLineAgree) {
   EXPECT_EQ(m->Find("collisions")->scalar(), "0");
   EXPECT_EQ(m->Find("leader_changes")->scalar(), "0");
   EXPECT_TRUE(m->Find("min_separation_m")->is_null());  // no truth.csv here
+  fs::remove_all(exp);
+}
+
+TEST(SarRunMetrics, ARealRunsFolderAgrees) {
+  const fs::path data = fs::path(SWARMBOX_SOURCE_DIR) / "tests/orchestrator/runner/data/sar_search";
+  ASSERT_TRUE(fs::exists(data / "logs" / "scout_1.log")) << data;
+  const fs::path exp = fs::temp_directory_path() / ("swarmbox-sar-real-" + std::to_string(::getpid()));
+  fs::remove_all(exp);
+  const fs::path trial = exp / "sar-search-real";
+  fs::create_directories(trial);
+  fs::copy(data / "logs", trial / "logs", fs::copy_options::recursive);
+  fs::copy_file(data / "events.jsonl", trial / "events.jsonl");
+  auto written = yaml::Parse(ReadFile(data / "result.json"), "result.json");
+  ASSERT_TRUE(written) << written.error().ToString();
+  const std::string ending_line = written->Find("ending_line")->scalar();
+  EXPECT_EQ(ending_line, "t=255.512 node=scout_2 event=mission_complete victims=2 rescued=2");
+
+  const yaml::Node m = ExpectAgreement(exp, trial, ending_line);
+  ASSERT_TRUE(m.is_mapping());
+  EXPECT_EQ(m.Find("victims_confirmed")->scalar(), "2");
+  EXPECT_EQ(m.Find("victims_rescued")->scalar(), "2");
+  // The runner of that run wrote the same values (min_separation_m needs truth.csv, not kept).
+  const yaml::Node* runner_metrics = written->Find("metrics");
+  ASSERT_NE(runner_metrics, nullptr);
+  for (const std::string& name : report::MetricNames()) {
+    if (name == "min_separation_m") continue;
+    const yaml::Node* a = m.Find(name);
+    const yaml::Node* b = runner_metrics->Find(name);
+    ASSERT_TRUE(a != nullptr && b != nullptr) << name;
+    EXPECT_EQ(a->is_null() ? "" : a->scalar(), b->is_null() ? "" : b->scalar()) << name;
+  }
   fs::remove_all(exp);
 }
 
