@@ -7,6 +7,7 @@
 #include <fstream>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -215,7 +216,11 @@ class Observer final : public ScheduleObserver {
   std::vector<std::string>& problems_;
 };
 
-std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::string>& run_ids) {
+}  // namespace
+
+std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::string>& run_ids,
+                           const std::vector<PoolHost>& pool,
+                           const std::vector<report::Provenance>& trials) {
   Node doc = Node::Mapping();
   doc.Set("name", Str(plan.spec.name));
   doc.Set("file", Str(plan.spec.file));
@@ -227,10 +232,58 @@ std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::st
   Node ids = Node::Sequence();
   for (const std::string& id : run_ids) ids.Append(Str(id));
   doc.Set("run_ids", std::move(ids));
+
+  // What every trial shares; each trial's result.json (and results.csv row) has its own engine,
+  // fault mechanism and rtf achieved.
+  const report::Provenance local = report::LocalProvenance();
+  Node prov = Node::Mapping();
+  prov.Set("swarmbox_version", Str(local.swarmbox_version));
+  prov.Set("swarmbox_commit", Str(local.swarmbox_commit));
+  prov.Set("build_type", Str(local.build_type));
+  prov.Set("host_name", Str(local.host_name));
+  std::set<double> rtfs;
+  for (const auto& [id, spec] : plan.specs) rtfs.insert(spec.rtf);
+  prov.Set("rtf_requested", rtfs.size() == 1 ? Node::Scalar(report::CsvNumber(*rtfs.begin())) : Node::Null());
+  Node hosts = Node::Sequence();
+  for (const PoolHost& h : pool) {
+    Node host = Node::Mapping();
+    host.Set("name", Str(h.name));
+    Node images = Node::Sequence();
+    for (const std::string& image : {h.images.agent, h.images.physics, h.faults_image}) {
+      if (!image.empty()) images.Append(Str(image));
+    }
+    host.Set("images", std::move(images));
+    docker::EngineVersion engine;
+    if (h.api != nullptr) {
+      if (auto v = h.api->Version()) engine = *v;
+    }
+    host.Set("docker_version", Str(engine.version));
+    host.Set("docker_api_version", Str(engine.api_version));
+    host.Set("kernel", Str(engine.kernel_version));
+    hosts.Append(std::move(host));
+  }
+  prov.Set("hosts", std::move(hosts));
+  // From the trials run so far (their result.json): the fault mechanisms used, the rtf achieved.
+  std::set<std::string> mechanisms;
+  std::optional<double> rtf_min, rtf_max;
+  for (const report::Provenance& t : trials) {
+    if (!t.fault_mechanism.empty()) mechanisms.insert(t.fault_mechanism);
+    if (t.rtf_achieved) {
+      rtf_min = rtf_min ? std::min(*rtf_min, *t.rtf_achieved) : *t.rtf_achieved;
+      rtf_max = rtf_max ? std::max(*rtf_max, *t.rtf_achieved) : *t.rtf_achieved;
+    }
+  }
+  Node used = Node::Sequence();
+  for (const std::string& m : mechanisms) used.Append(Str(m));
+  prov.Set("fault_mechanisms", std::move(used));
+  auto number = [](const std::optional<double>& v) {
+    return v ? Node::Scalar(report::CsvNumber(*v)) : Node::Null();
+  };
+  prov.Set("rtf_achieved_min", number(rtf_min));
+  prov.Set("rtf_achieved_max", number(rtf_max));
+  doc.Set("provenance", std::move(prov));
   return yaml::EmitJson(doc) + "\n";
 }
-
-}  // namespace
 
 Result<ExperimentPlan> PlanExperiment(const ExperimentSpec& spec) {
   ExperimentPlan plan;
@@ -264,10 +317,8 @@ Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::st
   const auto factors = report::FactorNames(out_dir, records);
   SWARMBOX_TRY(WriteFileAtomic((fs::path(out_dir) / "results.csv").string(),
                                report::ResultsCsv(factors, records)));
-  std::string title = fs::path(out_dir).lexically_normal().filename().string();
-  if (title.empty()) title = out_dir;
   SWARMBOX_TRY(WriteFileAtomic((fs::path(out_dir) / "report.html").string(),
-                               report::ReportHtml("SwarmBox experiment " + title, factors, records)));
+                               report::ReportHtml("SwarmBox experiment " + report::ExperimentTitle(out_dir), factors, records)));
   // The page's box plots again as files, for documents that cannot hold inline SVG (a README).
   const fs::path plots_dir = fs::path(out_dir) / "plots";
   std::error_code ec;
@@ -337,7 +388,7 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
   }
   SWARMBOX_TRY(store.ClearStaging());
   run_ids.push_back(options.run_id);
-  SWARMBOX_TRY(WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids)));
+  SWARMBOX_TRY(WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids, pool)));
 
   const std::vector<PlannedTrial> pending = store.Pending(plan.trials);
   summary.total = plan.trials.size();
@@ -444,10 +495,18 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
   if (auto n = WriteReports(options.out_dir, &summary.problems); !n) {
     summary.problems.push_back("writing results.csv/report.html: " + n.error().ToString());
   }
+  std::vector<report::Provenance> trials;
   for (const PlannedTrial& t : plan.trials) {
     if (!store.Done(t.id)) continue;
     ++summary.committed;
-    if (auto rec = report::ReadTrialFolder(store.TrialDir(t.id))) summary.outcomes[rec->outcome] += 1;
+    if (auto rec = report::ReadTrialFolder(store.TrialDir(t.id))) {
+      summary.outcomes[rec->outcome] += 1;
+      trials.push_back(rec->provenance);
+    }
+  }
+  // experiment.json again, with what the trials' result.json say about their fault mechanism and pace.
+  if (Status s = WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids, pool, trials)); !s) {
+    summary.problems.push_back("writing experiment.json: " + s.error().ToString());
   }
   return summary;
 }

@@ -24,7 +24,9 @@ std::string Num(double v) { return detail::FormatDecimal(v, 6); }
 
 std::string_view FaultPhaseName(FaultPhase phase) {
   switch (phase) {
+    case FaultPhase::kRequested: return "requested";
     case FaultPhase::kApplied: return "applied";
+    case FaultPhase::kRemoveRequested: return "remove_requested";
     case FaultPhase::kRemoved: return "removed";
     case FaultPhase::kFailed: return "failed";
   }
@@ -111,6 +113,12 @@ std::string FaultEventJson(const Fault& fault, const FaultEventRecord& record) {
   root.Set("spec", str(DescribeFault(fault)));
   if (record.phase == FaultPhase::kFailed) root.Set("error", str(record.error));
   if (!record.note.empty()) root.Set("note", str(record.note));
+  if (record.requested_t_sim_s) {
+    root.Set("requested_t_sim_s", Node::Scalar(detail::FormatDecimal(*record.requested_t_sim_s, 3)));
+  }
+  if (record.requested_wall_s) {
+    root.Set("requested_wall_s", Node::Scalar(detail::FormatDecimal(*record.requested_wall_s, 3)));
+  }
   return yaml::EmitJson(root);
 }
 

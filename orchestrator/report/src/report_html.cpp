@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <map>
 
+#include "swarmbox/report/plot_axis.hpp"
 #include "swarmbox/report/results_csv.hpp"
 
 namespace swarmbox::report {
@@ -41,33 +42,28 @@ std::vector<std::pair<char, std::string>> LevelsOf(const std::vector<TrialRecord
   return {by_code.begin(), by_code.end()};
 }
 
-std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxes) {
+std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxes,
+                       const AxisKind& kind) {
   constexpr double kW = 110, kH = 220, kTop = 14, kBottom = 40, kLeft = 56;
-  double lo = 0, hi = 0;
+  double data_lo = 0, data_hi = 0;
   bool any = false;
   for (const auto& [label, b] : boxes) {
     if (b.n == 0) continue;
-    lo = any ? std::min(lo, b.min) : b.min;
-    hi = any ? std::max(hi, b.max) : b.max;
+    data_lo = any ? std::min(data_lo, b.min) : b.min;
+    data_hi = any ? std::max(data_hi, b.max) : b.max;
     any = true;
   }
-  if (hi - lo < 1e-12) {
-    hi += 0.5 + std::abs(hi) * 0.05;
-    lo -= 0.5 + std::abs(lo) * 0.05;
-  }
-  const double pad = (hi - lo) * 0.05;
-  lo -= pad;
-  hi += pad;
+  const PlotAxis axis = ChooseAxis(data_lo, data_hi, kind);
+  const double lo = axis.lo, hi = axis.hi;
   const double width = kLeft + kW * static_cast<double>(boxes.size()) + 10;
   const double plot_h = kH - kTop - kBottom;
   auto y = [&](double v) { return kTop + (hi - v) / (hi - lo) * plot_h; };
   std::string s = "<svg width='" + Fmt(width) + "' height='" +
                   Fmt(kH) + "' class='box'>";
-  for (int k = 0; k <= 4; ++k) {
-    const double v = lo + (hi - lo) * k / 4.0;
+  for (double v : axis.Ticks()) {
     s += "<line x1='" + Fmt(kLeft - 4) + "' x2='" + Fmt(width - 10) + "' y1='" + Fmt(y(v)) +
          "' y2='" + Fmt(y(v)) + "' class='grid'/><text x='" + Fmt(kLeft - 6) + "' y='" +
-         Fmt(y(v) + 4) + "' text-anchor='end'>" + Fmt(v) + "</text>";
+         Fmt(y(v) + 4) + "' text-anchor='end'>" + CsvNumber(v) + "</text>";
   }
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const auto& [label, b] = boxes[i];
@@ -175,7 +171,7 @@ std::vector<ReportPlot> ReportPlots(const std::vector<std::string>& factors,
         }
         boxes.emplace_back(label, ComputeBoxStats(std::move(values)));
       }
-      plots.push_back({m, factors[i], BoxPlotSvg(boxes)});
+      plots.push_back({m, factors[i], BoxPlotSvg(boxes, AxisKindOf(m))});
     }
   }
   return plots;

@@ -32,6 +32,7 @@ std::string ResultsCsv(const std::vector<std::string>& factors,
   for (const std::string& f : factors) out += "," + CsvField(f);
   out += ",repetition,seed,host,outcome,reason,wall_s,sim_s";
   for (const std::string& m : MetricNames()) out += "," + m;
+  for (const std::string& c : ProvenanceColumns()) out += "," + c;
   out += "\n";
   for (const TrialRecord& r : records) {
     out += CsvField(r.meta.id) + "," + CsvField(r.meta.code);
@@ -46,6 +47,7 @@ std::string ResultsCsv(const std::vector<std::string>& factors,
       out += ",";
       if (it != r.metrics.end() && it->second) out += CsvNumber(*it->second);
     }
+    for (const std::string& cell : ProvenanceCells(r.provenance)) out += "," + CsvField(cell);
     out += "\n";
   }
   return out;

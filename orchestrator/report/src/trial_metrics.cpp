@@ -24,7 +24,7 @@ const std::vector<std::string>& MetricNames() {
   static const std::vector<std::string> kNames = {
       "mission_time_s", "first_detection_s", "detections",   "victims_confirmed",
       "min_separation_m", "collisions",       "leader_changes", "failover_s",
-      "radio_rtt_ms",   "radio_loss"};
+      "radio_rtt_ms",   "radio_loss",        "victims_rescued"};
   return kNames;
 }
 
@@ -51,6 +51,14 @@ void TrialMetrics::OnLogEvent(std::string_view component, const LogfmtFields& fi
     } else if (e == "victim_confirmed") {
       ++anonymous_detections_;
       ++anonymous_confirmed_;
+    }
+  } else if (e == "victim_status") {
+    // Every node logs the status as it applies the entry: distinct ids, as mission_complete's
+    // `rescued` counts the mission's victims whose status is rescued.
+    perception_seen_ = true;
+    const auto victim = FindField(fields, "id");
+    if (victim && FindField(fields, "status") == std::optional<std::string>("rescued")) {
+      rescued_.insert(*victim);
     }
   } else if (e == "mission_state") {
     perception_seen_ = true;  // the mission runs: zero detections is then a real zero
@@ -121,6 +129,7 @@ MetricValues TrialMetrics::Values() {
   if (perception_seen_) {
     v["detections"] = static_cast<double>(detected_.size() + anonymous_detections_);
     v["victims_confirmed"] = static_cast<double>(confirmed_.size() + anonymous_confirmed_);
+    v["victims_rescued"] = static_cast<double>(rescued_.size());
   }
   v["min_separation_m"] = min_sep_;
   if (physics_log_ || collisions_ > 0) v["collisions"] = static_cast<double>(collisions_);

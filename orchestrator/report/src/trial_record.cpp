@@ -117,6 +117,55 @@ Result<TrialMeta> ParseTrialMetaJson(std::string_view text, std::string_view whe
   return m;
 }
 
+std::optional<MetricValues> ReadTrialMetrics(const std::string& dir_text) {
+  const fs::path dir(dir_text);
+  TrialMetrics metrics;
+  std::error_code ec;
+  std::vector<fs::path> logs;
+  for (const auto& e : fs::directory_iterator(dir / "logs", ec)) {
+    if (e.path().extension() == ".log") logs.push_back(e.path());
+  }
+  if (logs.empty()) return std::nullopt;
+  std::sort(logs.begin(), logs.end());
+  for (const fs::path& log : logs) {
+    const std::string component = log.stem().string();
+    if (component == "physics") metrics.SawPhysicsLog();
+    std::ifstream in(log);
+    std::string line;
+    while (std::getline(in, line)) metrics.OnLogEvent(component, ParseLogfmt(line));
+  }
+  {
+    std::ifstream in(dir / "events.jsonl");
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.find("\"orchestrator\"") == std::string::npos &&
+          line.find("fault") == std::string::npos) {
+        continue;  // agent/physics events are read from logs/
+      }
+      auto j = yaml::Parse(line, "events.jsonl");
+      if (!j || !j->is_mapping()) continue;
+      if (StringAt(*j, "type") == "fault") {
+        // A process fault's record (faults/fault_event.hpp): its targets are lost from the time
+        // it was applied.
+        const std::string kind = StringAt(*j, "kind");
+        const bool process = kind == "kill" || kind == "stop" || kind == "pause" || kind == "restart";
+        if (StringAt(*j, "phase") != "applied" || !process) continue;
+        for (const std::string& target : StringsAt(*j, "targets")) {
+          metrics.OnOrchestratorEvent(kind + "_fault", target, NumberAt(*j, "t_sim_s"));
+        }
+        continue;
+      }
+      const std::string component = StringAt(*j, "component");
+      if (component != "orchestrator" && component.find("fault") == std::string::npos) continue;
+      std::optional<double> t = NumberAt(*j, "t");
+      if (!t) t = NumberAt(*j, "sim_s");
+      metrics.OnOrchestratorEvent(StringAt(*j, "event"), StringAt(*j, "target"), t);
+    }
+  }
+  ReadTruth(dir / "truth.csv", metrics);
+  return metrics.Values();
+}
+
 Result<TrialRecord> ReadTrialFolder(const std::string& dir_text) {
   const fs::path dir(dir_text);
   TrialRecord rec;
@@ -143,39 +192,17 @@ Result<TrialRecord> ReadTrialFolder(const std::string& dir_text) {
     rec.meta.seed = static_cast<std::uint64_t>(NumberAt(*result, "seed").value_or(0));
   }
 
-  TrialMetrics metrics;
-  std::error_code ec;
-  std::vector<fs::path> logs;
-  for (const auto& e : fs::directory_iterator(dir / "logs", ec)) {
-    if (e.path().extension() == ".log") logs.push_back(e.path());
-  }
-  std::sort(logs.begin(), logs.end());
-  for (const fs::path& log : logs) {
-    const std::string component = log.stem().string();
-    if (component == "physics") metrics.SawPhysicsLog();
-    std::ifstream in(log);
-    std::string line;
-    while (std::getline(in, line)) metrics.OnLogEvent(component, ParseLogfmt(line));
-  }
-  {
-    std::ifstream in(dir / "events.jsonl");
-    std::string line;
-    while (std::getline(in, line)) {
-      if (line.find("\"orchestrator\"") == std::string::npos &&
-          line.find("fault") == std::string::npos) {
-        continue;  // agent/physics events are read from logs/
-      }
-      auto j = yaml::Parse(line, "events.jsonl");
-      if (!j || !j->is_mapping()) continue;
-      const std::string component = StringAt(*j, "component");
-      if (component != "orchestrator" && component.find("fault") == std::string::npos) continue;
-      std::optional<double> t = NumberAt(*j, "t");
-      if (!t) t = NumberAt(*j, "sim_s");
-      metrics.OnOrchestratorEvent(StringAt(*j, "event"), StringAt(*j, "target"), t);
+  if (auto metrics = ReadTrialMetrics(dir.string())) {
+    rec.metrics = std::move(*metrics);
+  } else {
+    // logs/ pruned: what the runner computed with the same definitions when it wrote result.json.
+    for (const std::string& name : MetricNames()) rec.metrics[name] = std::nullopt;
+    if (const Node* stored = result->Find("metrics"); stored != nullptr && stored->is_mapping()) {
+      for (const std::string& name : MetricNames()) rec.metrics[name] = NumberAt(*stored, name);
     }
   }
-  ReadTruth(dir / "truth.csv", metrics);
-  rec.metrics = metrics.Values();
+  if (const Node* p = result->Find("provenance"); p != nullptr) rec.provenance = ParseProvenance(*p);
+  std::error_code ec;
   rec.has_trajectories = fs::exists(dir / "trajectories.png", ec);
   return rec;
 }
@@ -197,6 +224,17 @@ std::vector<TrialRecord> ReadExperimentFolder(const std::string& dir,
   std::sort(out.begin(), out.end(),
             [](const TrialRecord& a, const TrialRecord& b) { return a.meta.id < b.meta.id; });
   return out;
+}
+
+std::string ExperimentTitle(const std::string& dir) {
+  if (auto text = ReadText(fs::path(dir) / "experiment.json")) {
+    if (auto doc = yaml::Parse(*text, "experiment.json"); doc && doc->is_mapping()) {
+      if (std::string name = StringAt(*doc, "name"); !name.empty()) return name;
+    }
+  }
+  std::string title = fs::path(dir).lexically_normal().filename().string();
+  if (title.empty() || title == ".") title = fs::path(dir).lexically_normal().parent_path().filename().string();
+  return title.empty() ? dir : title;
 }
 
 std::vector<std::string> FactorNames(const std::string& dir, const std::vector<TrialRecord>& records) {

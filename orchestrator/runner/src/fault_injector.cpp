@@ -240,54 +240,73 @@ Status FaultInjector::ChangeRadio(const std::map<std::string, std::vector<faults
   return RunOnSidecars(commands, /*run_all=*/false);
 }
 
-Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record) {
+std::vector<faults::MeshNode> FaultInjector::MeshNodes() const {
+  std::vector<faults::MeshNode> nodes;
+  for (const std::string& d : config_.drones) {
+    auto ip = config_.mesh_ipv4.find(d);
+    nodes.push_back({d, config_.mesh_interface, ip == config_.mesh_ipv4.end() ? "" : ip->second});
+  }
+  return nodes;
+}
+
+Status FaultInjector::Resolve(std::size_t index, faults::FaultEventRecord* record) {
   const faults::Fault& f = timeline_.faults()[index];
-  auto mesh_nodes = [&] {
-    std::vector<faults::MeshNode> nodes;
-    for (const std::string& d : config_.drones) {
-      auto ip = config_.mesh_ipv4.find(d);
-      nodes.push_back({d, config_.mesh_interface, ip == config_.mesh_ipv4.end() ? "" : ip->second});
-    }
-    return nodes;
-  };
   if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) {
     if (mechanism_) record->mechanism = std::string(faults::MechanismName(*mechanism_));
     auto targets = faults::ResolveTarget(radio->target, config_.drones, leaders_, rng_);
     if (!targets) return targets.error();
     record->targets = *targets;
-    targets_[index] = *targets;
-    const auto before = installed_;
-    const auto changed = layers_.Push(f.id, *targets, radio->rules);
-    return ChangeRadio(before, changed);
-  }
-  if (const auto* partition = std::get_if<faults::PartitionFault>(&f.action)) {
+  } else if (const auto* partition = std::get_if<faults::PartitionFault>(&f.action)) {
     record->mechanism = "iptables";
-    auto plan = faults::PlanPartition(*partition, mesh_nodes(), index);
+    auto plan = faults::PlanPartition(*partition, MeshNodes(), index);  // pure: Apply plans again
     if (!plan) return plan.error();
     for (const auto& group : plan->groups) record->targets.insert(record->targets.end(), group.begin(), group.end());
-    targets_[index] = record->targets;
-    partitions_[index] = *plan;  // stored first: a half-applied partition is healed too
-    return RunOnSidecars(plan->apply, /*run_all=*/false);
-  }
-  if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
+  } else if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
     record->mechanism = "docker";
     auto targets = faults::ResolveTarget(process->target, config_.drones, leaders_, rng_);
     if (!targets) return targets.error();
     record->targets = *targets;
-    targets_[index] = *targets;
+  } else if (faults::IsPhysicsFault(f)) {
+    record->mechanism = std::string(kPhysicsMechanism);
+    if (const faults::FaultTarget* target = f.target()) {
+      auto resolved = faults::ResolveTarget(*target, config_.drones, leaders_, rng_);
+      if (!resolved) return resolved.error();
+      record->targets = *resolved;
+    }
+  }
+  targets_[index] = record->targets;
+  return Ok{};
+}
+
+Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record) {
+  const faults::Fault& f = timeline_.faults()[index];
+  // Targets and mechanism: Resolve (before the `requested` record).
+  const std::vector<std::string> targets = record->targets;
+  if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) {
+    const auto before = installed_;
+    const auto changed = layers_.Push(f.id, targets, radio->rules);
+    return ChangeRadio(before, changed);
+  }
+  if (const auto* partition = std::get_if<faults::PartitionFault>(&f.action)) {
+    auto plan = faults::PlanPartition(*partition, MeshNodes(), index);
+    if (!plan) return plan.error();
+    partitions_[index] = *plan;  // stored first: a half-applied partition is healed too
+    return RunOnSidecars(plan->apply, /*run_all=*/false);
+  }
+  if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
     std::vector<std::string> containers;
-    for (const std::string& d : *targets) {
+    for (const std::string& d : targets) {
       auto c = config_.agents.find(d);
       if (c == config_.agents.end()) return Error(ErrorCode::kInternal, "no container for drone " + d);
       containers.push_back(c->second);
     }
     faults::ProcessPlan plan = faults::PlanProcessFault(*process, containers, f.duration_ms.has_value());
     const bool takes_down = process->action != faults::ProcessAction::kPause;
-    if (takes_down) disrupted_.insert(targets->begin(), targets->end());
+    if (takes_down) disrupted_.insert(targets.begin(), targets.end());
     processes_[index] = plan;
     Status s = faults::ExecuteDockerActions(api_, plan.apply);
     if (process->action == faults::ProcessAction::kRestart) {
-      for (const std::string& d : *targets) {
+      for (const std::string& d : targets) {
         disrupted_.erase(d);
         resumed_.push_back(d);
       }
@@ -295,15 +314,6 @@ Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record)
     return s;
   }
   if (faults::IsPhysicsFault(f)) {
-    record->mechanism = std::string(kPhysicsMechanism);
-    std::vector<std::string> targets;
-    if (const faults::FaultTarget* target = f.target()) {
-      auto resolved = faults::ResolveTarget(*target, config_.drones, leaders_, rng_);
-      if (!resolved) return resolved.error();
-      targets = *resolved;
-    }
-    record->targets = targets;
-    targets_[index] = targets;
     faults::PhysicsPlan plan = faults::PlanPhysicsFault(f, targets);
     physics_[index] = plan;  // stored first: a half-applied bias jump is taken back too
     return SendToPhysics(plan.apply);
@@ -389,8 +399,29 @@ std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& a
   for (const TimelineAction& action : actions) {
     const faults::Fault& f = timeline_.faults()[action.fault];
     const bool apply = action.kind == TimelineAction::Kind::kApply;
-    faults::FaultEventRecord record = Record(apply ? FaultPhase::kApplied : FaultPhase::kRemoved);
-    Status s = apply ? Apply(action.fault, &record) : Remove(action.fault, &record, trial_end);
+    // `requested` (or `remove_requested`) when the timeline asks, with the targets it resolved;
+    // `applied` (`removed`) with the time every target's mechanism confirmed it: tc/iptables/
+    // swarmbox-netemd exited 0 in every sidecar (the delay daemon only once bound to its queue),
+    // the Docker API answered for every container, every world command's exec exited 0.
+    faults::FaultEventRecord record = Record(apply ? FaultPhase::kRequested : FaultPhase::kRemoveRequested);
+    Status s = Ok{};
+    if (apply) {
+      s = Resolve(action.fault, &record);
+    } else if (auto t = targets_.find(action.fault); t != targets_.end()) {
+      record.targets = t->second;
+    }
+    if (events_) events_(faults::FaultEventJson(f, record));
+    if (s) {
+      const double requested_wall_s = record.wall_s;
+      const double requested_sim_s = record.t_sim_s;
+      s = apply ? Apply(action.fault, &record) : Remove(action.fault, &record, trial_end);
+      const faults::FaultEventRecord done = Record(apply ? FaultPhase::kApplied : FaultPhase::kRemoved);
+      record.phase = done.phase;
+      record.t_sim_s = done.t_sim_s;
+      record.wall_s = done.wall_s;
+      record.requested_t_sim_s = requested_sim_s;
+      record.requested_wall_s = requested_wall_s;
+    }
     if (!s) {
       record.phase = FaultPhase::kFailed;
       record.error = s.error().ToString();

@@ -3,6 +3,7 @@
 #include <charconv>
 
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/report/results_csv.hpp"
 
 namespace swarmbox::runner {
 
@@ -43,7 +44,11 @@ std::string ResultJson(const TrialResult& r) {
   doc.Set("seed", Bare(std::to_string(r.seed)));
   doc.Set("host", Str(r.host));
   Node metrics = Node::Mapping();
-  for (const auto& [k, v] : r.metrics) metrics.Set(k, Bare(Num(v)));
+  for (const std::string& name : report::MetricNames()) {
+    auto it = r.metrics.find(name);
+    metrics.Set(name, it != r.metrics.end() && it->second ? Bare(report::CsvNumber(*it->second))
+                                                           : Node::Null());
+  }
   doc.Set("metrics", std::move(metrics));
   doc.Set("trial_id", Str(r.trial_id));
   doc.Set("run_id", Str(r.run_id));
@@ -64,39 +69,21 @@ std::string ResultJson(const TrialResult& r) {
   Node problems = Node::Sequence();
   for (const std::string& p : r.problems) problems.Append(Str(p));
   doc.Set("problems", std::move(problems));
+  doc.Set("provenance", report::ProvenanceNode(r.provenance));
   return yaml::EmitJson(doc) + "\n";
 }
 
-void Metrics::OnEvent(std::string_view /*component*/, const LogfmtFields& fields) {
-  auto event = FindField(fields, "event");
-  if (!event) return;
-  ++events_;
-  if (*event == "collision") ++collisions_;
-  if (*event == "crash") ++crashes_;
-  if (*event == "leader_elected") ++elections_;
-  if (*event == "victim_detected" || *event == "victim_confirmed") {
-    auto victim = FindField(fields, "victim");
-    const std::string id = victim ? *victim : "?";
-    (*event == "victim_detected" ? detected_ : confirmed_).insert(id);
-  }
-  if (*event == "mission_complete" && !mission_complete_t_s_) {
-    if (auto t = FindField(fields, "t")) {
-      if (auto v = yaml::ScalarAsDouble(*t)) mission_complete_t_s_ = *v;
-    }
-  }
+void RtfMeter::Observe(double wall_s, double sim_s) {
+  if (!first_ && sim_s > 0) first_ = {wall_s, sim_s};
+  last_ = {wall_s, sim_s};
 }
 
-std::map<std::string, double> Metrics::Values() const {
-  std::map<std::string, double> m = {
-      {"events_total", static_cast<double>(events_)},
-      {"collisions", static_cast<double>(collisions_)},
-      {"crashes", static_cast<double>(crashes_)},
-      {"leader_elections", static_cast<double>(elections_)},
-      {"victims_detected", static_cast<double>(detected_.size())},
-      {"victims_confirmed", static_cast<double>(confirmed_.size())},
-  };
-  if (mission_complete_t_s_) m["mission_complete_t_s"] = *mission_complete_t_s_;
-  return m;
+std::optional<double> RtfMeter::Achieved() const {
+  if (!first_) return std::nullopt;
+  const double wall = last_.first - first_->first;
+  const double sim = last_.second - first_->second;
+  if (wall <= 0 || sim <= 0) return std::nullopt;
+  return sim / wall;
 }
 
 std::optional<std::string> LogEventJson(double wall_s, std::string_view component,

@@ -4,11 +4,13 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/dsl/step.hpp"
+#include "swarmbox/report/trial_record.hpp"
 #include "swarmbox/runner/docker_engine.hpp"
 #include "swarmbox/runner/fault_image.hpp"
 #include "swarmbox/runner/fault_injector.hpp"
@@ -68,6 +70,30 @@ int ParallelFromEnvironment(int fallback) {
   if (v == nullptr) return fallback;
   const int n = std::atoi(v);
   return n > 0 ? n : fallback;
+}
+
+// result.json's provenance (report/provenance.hpp): this build and machine, the engine's
+// GET /version, the tree's images, the fault mechanism the injector used.
+report::Provenance TrialProvenance(docker::DockerApi& api, dsl::Trial* tree,
+                                   const FaultInjector* injector, std::optional<double> rtf_requested,
+                                   std::optional<double> rtf_achieved) {
+  report::Provenance p = report::LocalProvenance();
+  if (auto v = api.Version()) {
+    p.engine.docker_version = v->version;
+    p.engine.docker_api_version = v->api_version;
+    p.engine.kernel = v->kernel_version;
+  }
+  if (tree != nullptr) {
+    std::set<std::string> images;
+    for (dsl::Plugin* plugin : tree->Plugins()) images.insert(plugin->spec().image);
+    p.images.assign(images.begin(), images.end());
+  }
+  p.fault_mechanism = injector != nullptr && injector->mechanism()
+                          ? std::string(faults::MechanismName(*injector->mechanism()))
+                          : "none";
+  p.rtf_requested = rtf_requested;
+  p.rtf_achieved = rtf_achieved;
+  return p;
 }
 
 }  // namespace
@@ -197,7 +223,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   // before the runner writes to events.jsonl itself.
   if (engine) engine->FinishCreates();
 
-  Metrics metrics;
+  RtfMeter rtf;
   std::vector<Detection> detections;
   TrialResult result;
   result.trial = info.name;
@@ -231,7 +257,6 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       const LogfmtFields fields = ParseLogfmt(item.text);
       if (auto j = LogEventJson(item.wall_s, item.component, fields)) {
         events.Write(*j);
-        metrics.OnEvent(item.component, fields);
         auto ev = FindField(fields, "event");
         if (ev && (*ev == "victim_detected" || *ev == "victim_confirmed")) {
           auto x = NumberField(fields, {"x", "x_m"});
@@ -281,6 +306,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     double next_progress = 0;
     while (true) {
       for (const HubItem& item : hub.Drain(o.poll)) process(item);
+      rtf.Observe(wall(), monitor->sim_s());
       if (auto v = monitor->OnTick(wall())) tree->RaiseShutdown(*v);
       if (injector && !tree->end_verdict()) {
         if (auto v = injector->Advance()) tree->RaiseShutdown(*v);
@@ -342,7 +368,9 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   result.wall_s = wall();
   result.sim_s = monitor ? monitor->sim_s() : 0;
   result.ending_line = monitor ? monitor->ending_line() : std::string();
-  result.metrics = metrics.Values();
+  // The metrics as results.csv and report.html compute them, from the files just written.
+  result.metrics = report::ReadTrialMetrics(dir.string()).value_or(report::MetricValues{});
+  result.provenance = TrialProvenance(api, tree.get(), injector.get(), info.rtf, rtf.Achieved());
 
   // trajectories.png from the collected truth.csv.
   if (engine && engine->artifacts().count("truth.csv") > 0) {
@@ -379,6 +407,7 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
   TrialInfo info;
   info.name = spec.name;
   info.seed = spec.seed;
+  info.rtf = spec.rtf;
   info.resolved_yaml = yaml::Emit(spec.document.is_null() ? dsl::ToDocument(spec) : spec.document);
   info.world_file = (fs::path(trials_dir) / spec.world).string();
   if (auto payloads = LoadPayloadMasses(spec, trials_dir); !payloads) {

@@ -100,6 +100,86 @@ class TrialRun : public ::testing::Test {
   std::string run_id_;
 };
 
+// One RFC 4180 line's cells (quoted cells unquoted).
+std::vector<std::string> CsvCells(const std::string& line) {
+  std::vector<std::string> cells(1);
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+      cells.back() += '"';
+      ++i;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      cells.emplace_back();
+    } else {
+      cells.back() += c;
+    }
+  }
+  return cells;
+}
+
+// result.json, results.csv (`swarmbox report` over the run's folder) and the ending line of one
+// trial say the same: every metric cell is result.json's value as written, the victims the
+// ending line counts are victims_confirmed and victims_rescued, and the provenance is there
+// (issue #16). Returns result.json.
+yaml::Node ExpectOneDefinitionOfEachMetric(const fs::path& out_dir, const fs::path& trial_dir) {
+  auto result = yaml::Parse(ReadWholeFile((trial_dir / "result.json").string()), "result.json");
+  EXPECT_TRUE(result) << result.error().ToString();
+  if (!result) return yaml::Node::Null();
+  auto report = RunToEnd({kSwarmbox, "report", out_dir.string()}, std::chrono::minutes(2), out_dir.string());
+  EXPECT_TRUE(report && report->code == 0) << (report ? report->err : report.error().ToString());
+  std::istringstream csv(ReadWholeFile((out_dir / "results.csv").string()));
+  std::string header_line, row_line;
+  std::getline(csv, header_line);
+  std::getline(csv, row_line);
+  const auto header = CsvCells(header_line);
+  const auto row = CsvCells(row_line);
+  EXPECT_EQ(header.size(), row.size()) << header_line << "\n" << row_line;
+  auto cell = [&](const std::string& column) -> std::string {
+    for (std::size_t i = 0; i < header.size() && i < row.size(); ++i) {
+      if (header[i] == column) return row[i];
+    }
+    ADD_FAILURE() << "results.csv has no column " << column;
+    return "?";
+  };
+  const yaml::Node* metrics = result->Find("metrics");
+  EXPECT_TRUE(metrics != nullptr && metrics->is_mapping());
+  if (metrics == nullptr) return *result;
+  EXPECT_EQ(metrics->entries().size(), 11u);
+  for (const auto& [key, value] : metrics->entries()) {
+    EXPECT_EQ(cell(key.scalar()), value.is_null() ? "" : value.scalar()) << key.scalar();
+  }
+  // The ending line's counts are the metrics.
+  const auto ending = ParseLogfmt(result->Find("ending_line")->scalar());
+  const auto victims = FindField(ending, "victims");
+  const auto rescued = FindField(ending, "rescued");
+  EXPECT_TRUE(victims && rescued) << result->Find("ending_line")->scalar();
+  if (victims && rescued) {
+    EXPECT_EQ(metrics->Find("victims_confirmed")->scalar(), *victims);
+    EXPECT_EQ(metrics->Find("victims_rescued")->scalar(), *rescued);
+    EXPECT_EQ(cell("victims_confirmed"), *victims);
+    EXPECT_EQ(cell("victims_rescued"), *rescued);
+  }
+  // Provenance: present and non-empty in result.json and in the row.
+  const yaml::Node* p = result->Find("provenance");
+  EXPECT_NE(p, nullptr);
+  if (p == nullptr) return *result;
+  for (const char* key : {"swarmbox_version", "swarmbox_commit", "build_type", "docker_version",
+                          "docker_api_version", "kernel", "fault_mechanism", "rtf_requested",
+                          "rtf_achieved", "host_name"}) {
+    EXPECT_TRUE(p->Find(key) != nullptr && !p->Find(key)->is_null() && !p->Find(key)->scalar().empty()) << key;
+    EXPECT_FALSE(cell(key).empty()) << key;
+  }
+  EXPECT_EQ(p->Find("rtf_requested")->scalar(), "0");
+  EXPECT_TRUE(p->Find("images") != nullptr && p->Find("images")->items().size() >= 2u);
+  EXPECT_THAT(cell("images"), HasSubstr("swarmbox/agent:"));
+  EXPECT_THAT(cell("images"), HasSubstr("swarmbox/physics:"));
+  EXPECT_EQ(cell("swarmbox_commit"), p->Find("swarmbox_commit")->scalar());
+  return *result;
+}
+
 // Every logfmt line of a trial's component log with its fields.
 std::vector<LogfmtFields> Events(const fs::path& trial_dir, const std::string& component) {
   std::vector<LogfmtFields> out;
@@ -140,6 +220,15 @@ TEST_F(SarSearchE2e, EndsWithMissionCompleteInContainers) {
   EXPECT_THAT(ReadWholeFile((trial_dir / "events.jsonl").string()), HasSubstr("\"mechanism\""));
   EXPECT_TRUE(fs::exists(trial_dir / "truth.csv"));
   EXPECT_TRUE(fs::exists(trial_dir / "trajectories.png"));
+
+  // result.json, results.csv and the ending line agree: two victims confirmed, two rescued.
+  const yaml::Node result = ExpectOneDefinitionOfEachMetric(dir_, trial_dir);
+  if (result.is_mapping()) {
+    EXPECT_EQ(result.Find("metrics")->Find("victims_confirmed")->scalar(), "2");
+    EXPECT_EQ(result.Find("metrics")->Find("collisions")->scalar(), "0");
+    const std::string mechanism = result.Find("provenance")->Find("fault_mechanism")->scalar();
+    EXPECT_TRUE(mechanism == "netem" || mechanism == "userspace-nfqueue") << mechanism;
+  }
 
   ExpectNothingLeft();
 }

@@ -95,23 +95,30 @@ TEST_F(FaultTrial, RadioImpairment) {
   auto run = Run("radio_link_check.yaml", {{"--ping-every-ms", "200"}});
   ASSERT_TRUE(run) << run.error().ToString();
   ASSERT_TRUE(RanToTheEnd(*run));
+  const auto requested = FindFaultRecord(run->events, "radio_100ms_5pct", "requested");
   const auto applied = FindFaultRecord(run->events, "radio_100ms_5pct", "applied");
+  const auto remove_requested = FindFaultRecord(run->events, "radio_100ms_5pct", "remove_requested");
   const auto removed = FindFaultRecord(run->events, "radio_100ms_5pct", "removed");
-  ASSERT_TRUE(applied && removed) << "the radio fault was not applied and removed";
+  ASSERT_TRUE(requested && applied && remove_requested && removed)
+      << "the radio fault was not requested, applied, asked to end and removed";
   // A link line closes a 2 s window whose pings were sent up to 1 s (the timeout) earlier: lines
-  // within 3.5 s after a change still hold pings from before it. And the runner carries a radio
-  // fault out sidecar by sidecar (starting a delayer daemon and iptables in each); measured here,
-  // the last of three drones was impaired ~8 s after the `applied` record and every drone was
-  // back ~3 s after `removed`. So: during = from 12 s after applied, after = from 9.5 s after
-  // removed.
+  // within 3.5 s after a change still hold pings from before it. The runner records `requested`
+  // before it starts (a delayer daemon and iptables in each sidecar) and `applied` once every
+  // sidecar confirmed it (the daemon answers once bound to its queue), `removed` likewise: so
+  // before = until requested, during = from applied (+ the window) to remove_requested, after =
+  // from removed (+ the window). (When `applied` was written at the request, the last of three
+  // drones was impaired ~8 s after it.) kConfirmSlack: a packet already queued in the delayer.
   constexpr double kWindowMargin = 3.5;
-  constexpr double kApplySpread = 8.5;
-  constexpr double kRemoveSpread = 6.0;
-  const LinkSummary before = SummariseLinks(run->events, 0.0, applied->wall_s);
+  constexpr double kConfirmSlack = 1.0;
+  EXPECT_GE(applied->wall_s, requested->wall_s);
+  EXPECT_GE(removed->wall_s, remove_requested->wall_s);
+  const LinkSummary before = SummariseLinks(run->events, 0.0, requested->wall_s);
   const LinkSummary during = SummariseLinks(
-      run->events, applied->wall_s + kApplySpread + kWindowMargin, removed->wall_s);
+      run->events, applied->wall_s + kConfirmSlack + kWindowMargin, remove_requested->wall_s);
   const LinkSummary after =
-      SummariseLinks(run->events, removed->wall_s + kRemoveSpread + kWindowMargin, 1e9);
+      SummariseLinks(run->events, removed->wall_s + kConfirmSlack + kWindowMargin, 1e9);
+  std::printf("fault_trial=radio_confirm apply_s=%.3f remove_s=%.3f\n",
+              applied->wall_s - requested->wall_s, removed->wall_s - remove_requested->wall_s);
   std::printf(
       "fault_trial=radio mechanism=%s before_sent=%llu before_loss=%.4f before_rtt_ms=%.2f "
       "before_sd_ms=%.2f during_sent=%llu during_loss=%.4f during_rtt_ms=%.2f during_sd_ms=%.2f "
@@ -174,14 +181,16 @@ TEST_F(FaultTrial, PartitionOneVsThree) {
   ASSERT_TRUE(run) << run.error().ToString();
   ASSERT_TRUE(RanToTheEnd(*run));
   const auto applied = FindFaultRecord(run->events, "isolate_scout_1", "applied");
+  const auto heal_requested = FindFaultRecord(run->events, "isolate_scout_1", "remove_requested");
   const auto removed = FindFaultRecord(run->events, "isolate_scout_1", "removed");
-  ASSERT_TRUE(applied && removed) << "the partition was not applied and healed";
+  ASSERT_TRUE(applied && heal_requested && removed) << "the partition was not applied and healed";
   const std::string isolated = "scout_1";
   const std::vector<std::string> majority = {"scout_2", "scout_3", "scout_4"};
-  // The runner installs (and removes) the rules sidecar by sidecar: judge the partition from 2 s
-  // after it was applied to 2 s before it was healed, when every rule was surely in place.
+  // `applied` is written once every sidecar's rules are in, `remove_requested` before any is
+  // taken out: judge the partition from 2 s after it was applied (Raft's heartbeats notice) to
+  // the heal's request.
   const double from = applied->wall_s + 2.0;
-  const double to = removed->wall_s - 2.0;
+  const double to = heal_requested->wall_s;
   ASSERT_GT(to - from, 10.0);
   const auto commits = CommitsByDrone(run->events);
   ASSERT_TRUE(commits.count(isolated) != 0) << "scout_1 never committed anything";

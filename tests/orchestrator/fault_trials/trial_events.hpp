@@ -37,7 +37,8 @@ struct TrialEvent {
 Result<std::vector<TrialEvent>> ParseEvents(std::string_view jsonl);
 Result<std::vector<TrialEvent>> ReadEvents(const std::string& path);
 
-// A fault record (type "fault") with the given fault id and phase ("applied", "removed",
+// A fault record (type "fault") with the given fault id and phase ("requested", "applied",
+// "remove_requested", "removed",
 // "failed"); nullopt when there is none.
 std::optional<TrialEvent> FindFaultRecord(const std::vector<TrialEvent>& events,
                                           std::string_view fault_id, std::string_view phase);

@@ -6,6 +6,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include <cmath>
+
+#include "swarmbox/common/version.hpp"
+#include "swarmbox/report/plot_axis.hpp"
+#include "swarmbox/report/provenance.hpp"
 #include "swarmbox/report/report_html.hpp"
 #include "swarmbox/report/results_csv.hpp"
 #include "swarmbox/report/trial_metrics.hpp"
@@ -52,6 +57,27 @@ TEST(TrialMetrics, MissionDetectionsCollisionsAndRadio) {
   EXPECT_DOUBLE_EQ(*v["radio_loss"], 0.05);
   EXPECT_FALSE(v["leader_changes"].has_value());
   EXPECT_FALSE(v["min_separation_m"].has_value());
+}
+
+TEST(TrialMetrics, VictimsAsTheAgentsLogThemMatchTheEndingLine) {
+  // agent/raft node_driver.cpp: every node logs what it applies, the victim by `id`.
+  TrialMetrics m;
+  for (const char* node : {"scout_1", "lifter"}) {
+    const std::string n(node);
+    Feed(m, n, "t=30.1 node=" + n + " event=victim_confirmed id=1 x=40.0 y=12.0 index=17");
+    Feed(m, n, "t=52.7 node=" + n + " event=victim_confirmed id=2 x=-35.0 y=60.0 index=31");
+    Feed(m, n, "t=90.0 node=" + n + " event=victim_status id=1 status=being_rescued rescuer=lifter index=40");
+    Feed(m, n, "t=140.0 node=" + n + " event=victim_status id=1 status=rescued index=55");
+    Feed(m, n, "t=210.0 node=" + n + " event=victim_status id=2 status=rescued index=80");
+  }
+  Feed(m, "scout_3", "t=25.0 node=scout_3 event=sighting_reported seq=1 x=40.1 y=11.8 confidence=0.9");
+  Feed(m, "scout_3", "t=257.3 node=scout_3 event=mission_complete victims=2 rescued=2");
+  MetricValues v = m.Values();
+  EXPECT_EQ(v["victims_confirmed"], 2.0);
+  EXPECT_EQ(v["victims_rescued"], 2.0);
+  EXPECT_EQ(v["detections"], 2.0);
+  EXPECT_EQ(v["first_detection_s"], 25.0);
+  EXPECT_EQ(v["mission_time_s"], 257.3);
 }
 
 TEST(TrialMetrics, RadioFiguresAreWeightedByPingsAndVictimsKnownById) {
@@ -134,13 +160,117 @@ TEST(ResultsCsv, ContractColumnsQuotingAndEmptyCells) {
   const std::string header =
       "trial_id,code,loss,swarm,repetition,seed,host,outcome,reason,wall_s,sim_s,mission_time_s,"
       "first_detection_s,detections,victims_confirmed,min_separation_m,collisions,leader_changes,"
-      "failover_s,radio_rtt_ms,radio_loss\n";
+      "failover_s,radio_rtt_ms,radio_loss,victims_rescued,swarmbox_version,swarmbox_commit,"
+      "build_type,images,docker_version,docker_api_version,kernel,fault_mechanism,rtf_requested,"
+      "rtf_achieved,host_name\n";
   ASSERT_EQ(csv.substr(0, header.size()), header);
   EXPECT_EQ(csv.substr(header.size()),
             "e-ab-r1,ab,0.05,\"three, spread\",1,7,local,timeout,\"sim time \"\"60 s\"\" reached\","
-            "12.25,60,,,,,,0,,,201.5,\n");
+            "12.25,60,,,,,,0,,,201.5,,,,,,,,,,,,,\n");
   EXPECT_EQ(CsvNumber(0.1 + 0.2), "0.3");
   EXPECT_EQ(CsvNumber(3), "3");
+}
+
+TEST(ResultsCsv, ProvenanceColumnsFollowTheMetrics) {
+  TrialRecord r = Record("e-a-r1", "a", {"0"}, "success", 10);
+  r.provenance.swarmbox_version = "0.1.0";
+  r.provenance.swarmbox_commit = "1a2b3c4d5e6f-dirty";
+  r.provenance.build_type = "RelWithDebInfo";
+  r.provenance.images = {"swarmbox/agent:aa11", "swarmbox/physics:bb22"};
+  r.provenance.engine = {"20.10.24+dfsg1", "1.41", "6.1.0-18-amd64"};
+  r.provenance.fault_mechanism = "userspace-nfqueue";
+  r.provenance.rtf_requested = 0;
+  r.provenance.rtf_achieved = 2.5;
+  r.provenance.host_name = "lab-3";
+  const std::string csv = ResultsCsv({"loss"}, {r});
+  const std::string row = csv.substr(csv.find('\n') + 1);
+  EXPECT_NE(row.find(",0.1.0,1a2b3c4d5e6f-dirty,RelWithDebInfo,swarmbox/agent:aa11 swarmbox/physics:bb22,"
+                     "20.10.24+dfsg1,1.41,6.1.0-18-amd64,userspace-nfqueue,0,2.5,lab-3\n"),
+            std::string::npos)
+      << row;
+  // Round trip through result.json's object.
+  const Provenance back = ParseProvenance(ProvenanceNode(r.provenance));
+  EXPECT_EQ(ProvenanceCells(back), ProvenanceCells(r.provenance));
+  EXPECT_EQ(ProvenanceCells(ParseProvenance(yaml::Node::Mapping())).size(), ProvenanceColumns().size());
+}
+
+TEST(Provenance, LocalIsThisBuildAndMachine) {
+  const Provenance p = LocalProvenance();
+  EXPECT_EQ(p.swarmbox_version, std::string(Build().version));
+  EXPECT_EQ(p.swarmbox_commit, std::string(Build().commit));
+  EXPECT_FALSE(p.swarmbox_version.empty());
+  EXPECT_FALSE(p.host_name.empty());
+}
+
+TEST(PlotAxis, NiceStepsFollowTheOneTwoFiveSeries) {
+  EXPECT_DOUBLE_EQ(NiceStep(0.0238), 0.05);
+  EXPECT_DOUBLE_EQ(NiceStep(0.02), 0.02);
+  EXPECT_DOUBLE_EQ(NiceStep(0.2), 0.2);
+  EXPECT_DOUBLE_EQ(NiceStep(3), 5);
+  EXPECT_DOUBLE_EQ(NiceStep(7), 10);
+  EXPECT_DOUBLE_EQ(NiceStep(1), 1);
+  EXPECT_DOUBLE_EQ(NiceStep(140), 200);
+}
+
+TEST(PlotAxis, RatesAndCountsStartAtZeroWithRoundTicks) {
+  // The example report's loss: 0.0078..0.1169 (drew -0.0119 .. 0.13 before).
+  const PlotAxis loss = ChooseAxis(0.007763, 0.11691, AxisKindOf("radio_loss"));
+  EXPECT_DOUBLE_EQ(loss.lo, 0);
+  EXPECT_DOUBLE_EQ(loss.step, 0.05);
+  EXPECT_DOUBLE_EQ(loss.hi, 0.15);
+  EXPECT_EQ(loss.Ticks(), (std::vector<double>{0, 0.05, 0.1, 0.15}));
+  // Every collisions value 0 (drew -0.55 .. 0.55 before).
+  const PlotAxis none = ChooseAxis(0, 0, AxisKindOf("collisions"));
+  EXPECT_EQ(none.Ticks(), (std::vector<double>{0, 1}));
+  // Counts step by whole numbers.
+  const PlotAxis detections = ChooseAxis(2, 2, AxisKindOf("detections"));
+  EXPECT_DOUBLE_EQ(detections.lo, 0);
+  for (double t : detections.Ticks()) EXPECT_EQ(t, std::round(t));
+  EXPECT_GE(detections.hi, 2);
+  const PlotAxis changes = ChooseAxis(0, 3, AxisKindOf("leader_changes"));
+  EXPECT_EQ(changes.Ticks(), (std::vector<double>{0, 1, 2, 3}));
+  // A rate never passes 1.
+  EXPECT_DOUBLE_EQ(ChooseAxis(0.2, 0.97, AxisKindOf("radio_loss")).hi, 1.0);
+}
+
+TEST(PlotAxis, TimesKeepTheirRangeOnRoundTicksAndNeverGoBelowZero) {
+  const PlotAxis mission = ChooseAxis(239.112, 261.848, AxisKindOf("mission_time_s"));
+  EXPECT_DOUBLE_EQ(mission.step, 10);  // 5 would take 7 ticks
+  EXPECT_DOUBLE_EQ(mission.lo, 230);
+  EXPECT_DOUBLE_EQ(mission.hi, 270);
+  EXPECT_EQ(mission.Ticks(), (std::vector<double>{230, 240, 250, 260, 270}));
+  const PlotAxis near_zero = ChooseAxis(0.4, 9.7, AxisKindOf("failover_s"));
+  EXPECT_DOUBLE_EQ(near_zero.lo, 0);
+  const PlotAxis one = ChooseAxis(210.9, 210.9, AxisKindOf("radio_rtt_ms"));
+  EXPECT_LE(one.lo, 210.9);
+  EXPECT_GE(one.hi, 210.9);
+  EXPECT_GE(one.lo, 0);
+  for (double t : one.Ticks()) EXPECT_NEAR(t / one.step, std::round(t / one.step), 1e-9);
+}
+
+TEST(ReportHtml, BoxPlotTicksAreRoundAndNeverBelowZero) {
+  std::vector<TrialRecord> records = {
+      Record("e-a-r1", "a", {"0"}, "success", 10),
+      Record("e-a-r2", "a", {"0"}, "success", 11),
+      Record("e-b-r1", "b", {"0.05"}, "success", 12),
+  };
+  records[0].metrics["collisions"] = 0;
+  records[1].metrics["collisions"] = 0;
+  records[2].metrics["collisions"] = 0;
+  records[0].metrics["radio_loss"] = 0.007763;
+  records[1].metrics["radio_loss"] = 0.011596;
+  records[2].metrics["radio_loss"] = 0.11691;
+  for (const ReportPlot& p : ReportPlots({"loss"}, records)) {
+    EXPECT_EQ(p.svg.find(">-"), std::string::npos) << p.metric << ": a negative tick\n" << p.svg;
+    if (p.metric == "collisions") {
+      EXPECT_NE(p.svg.find("text-anchor='end'>0</text>"), std::string::npos) << p.svg;
+      EXPECT_NE(p.svg.find("text-anchor='end'>1</text>"), std::string::npos) << p.svg;
+      EXPECT_EQ(p.svg.find("text-anchor='end'>0.5</text>"), std::string::npos) << p.svg;
+    }
+    if (p.metric == "radio_loss") {
+      EXPECT_NE(p.svg.find("text-anchor='end'>0.05</text>"), std::string::npos) << p.svg;
+    }
+  }
 }
 
 TEST(BoxStats, TukeyQuartilesWhiskersAndOutliers) {
@@ -252,6 +382,54 @@ TEST(TrialRecordTest, ReadsResultMetaLogsAndTruthFromAFolder) {
   ASSERT_EQ(all.size(), 1u);
   EXPECT_TRUE(problems.empty());
   EXPECT_EQ(FactorNames(dir.string(), all), (std::vector<std::string>{"loss", "size"}));
+  // The title: the folder's name until experiment.json names the experiment.
+  EXPECT_EQ(ExperimentTitle(dir.string()), dir.filename().string());
+  std::ofstream(dir / "experiment.json") << R"({"name":"radio","factors":["loss","size"]})";
+  EXPECT_EQ(ExperimentTitle(dir.string()), "radio");
+  EXPECT_EQ(ExperimentTitle(dir.string() + "/"), "radio");
+  fs::remove_all(dir);
+}
+
+TEST(TrialRecordTest, AFolderWithoutLogsKeepsTheMetricsItsResultStored) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("swarmbox-pruned-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "result.json")
+      << R"({"trial":"t","outcome":"success","reason":"","wall_s":2,"sim_s":3,"seed":1,)"
+      << R"("host":"local","metrics":{"victims_confirmed":2,"victims_rescued":2,"failover_s":null},)"
+      << R"("provenance":{"swarmbox_version":"0.1.0","kernel":"6.1.0","rtf_requested":0}})";
+  EXPECT_FALSE(ReadTrialMetrics(dir.string()).has_value());
+  auto rec = ReadTrialFolder(dir.string());
+  ASSERT_TRUE(rec) << rec.error().ToString();
+  EXPECT_EQ(rec->metrics["victims_confirmed"], 2.0);
+  EXPECT_EQ(rec->metrics["victims_rescued"], 2.0);
+  EXPECT_FALSE(rec->metrics["failover_s"].has_value());
+  EXPECT_EQ(rec->metrics.size(), MetricNames().size());
+  EXPECT_EQ(rec->provenance.swarmbox_version, "0.1.0");
+  EXPECT_EQ(rec->provenance.engine.kernel, "6.1.0");
+  EXPECT_EQ(rec->provenance.rtf_requested, 0.0);
+  fs::remove_all(dir);
+}
+
+TEST(TrialRecordTest, ProcessFaultRecordsCountForFailoverFromTheirApplication) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("swarmbox-failover-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "logs");
+  std::ofstream(dir / "result.json") << R"({"trial":"t","outcome":"success","seed":1})";
+  std::ofstream(dir / "logs" / "scout_2.log")
+      << "t=3.000 node=scout_2 event=leader_elected term=1 leader=scout_1\n"
+      << "t=34.500 node=scout_2 event=leader_elected term=2 leader=scout_2\n";
+  std::ofstream(dir / "events.jsonl")
+      << R"({"type":"fault","phase":"requested","fault":"fault_1","kind":"kill","t_sim_s":30.0,"wall_s":9.0,"targets":["scout_1"]})"
+      << "\n"
+      << R"({"type":"fault","phase":"applied","fault":"fault_1","kind":"kill","t_sim_s":31.0,"wall_s":9.4,"targets":["scout_1"]})"
+      << "\n";
+  auto metrics = ReadTrialMetrics(dir.string());
+  ASSERT_TRUE(metrics);
+  ASSERT_TRUE((*metrics)["failover_s"].has_value());
+  EXPECT_DOUBLE_EQ(*(*metrics)["failover_s"], 3.5);
   fs::remove_all(dir);
 }
 

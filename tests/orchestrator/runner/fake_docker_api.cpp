@@ -53,7 +53,10 @@ std::vector<std::string> FakeDockerApi::SubnetsTried() const {
 }
 
 Result<std::string> FakeDockerApi::Ping() { return std::string("1.41"); }
-Result<docker::EngineVersion> FakeDockerApi::Version() { return NotModelled("Version"); }
+Result<docker::EngineVersion> FakeDockerApi::Version() {
+  // A fixed engine, as GET /version of Debian 12's docker.io answers (for provenance).
+  return docker::EngineVersion{"20.10.24+dfsg1", "1.41", "1.12", "linux", "amd64", "6.1.0-fake-amd64"};
+}
 Result<docker::BuildResult> FakeDockerApi::BuildImage(const docker::BuildRequest&,
                                                       const docker::BuildProgressFn&,
                                                       docker::CancelToken*) {
@@ -415,16 +418,19 @@ Result<std::string> FakeDockerApi::CreateExec(std::string_view container_id, con
 
 Status FakeDockerApi::StartExec(std::string_view exec_id, const docker::LogLineFn& on_line, docker::CancelToken*) {
   ExecAnswer answer;
+  std::string call;
   {
     std::lock_guard lock(mu_);
     auto it = execs_.find(std::string(exec_id));
     if (it == execs_.end()) return Error(ErrorCode::kNotFound, "no such exec");
     std::string text;
     for (const auto& a : it->second.cmd) text += (text.empty() ? "" : " ") + a;
-    calls_.push_back("exec " + it->second.container + " " + text);
+    call = "exec " + it->second.container + " " + text;
+    calls_.push_back(call);
     if (auto a = exec_answers.find(text); a != exec_answers.end()) answer = a->second;
     it->second.exit_code = answer.exit_code;
   }
+  if (on_exec) on_exec(call);  // outside the lock: a test may look at the fake
   if (on_line) {
     for (const auto& l : answer.stdout_lines) on_line({docker::StreamKind::kStdout, l});
     for (const auto& l : answer.stderr_lines) on_line({docker::StreamKind::kStderr, l});

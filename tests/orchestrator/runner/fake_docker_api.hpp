@@ -13,6 +13,7 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -58,6 +59,9 @@ class FakeDockerApi : public docker::DockerApi {
   int stale_endpoints = 0;
   // Exec answers by command text (argv joined with spaces); others exit 0 with no output.
   std::map<std::string, ExecAnswer> exec_answers;
+  // Called with "exec <container name> <argv>" as each exec runs, before it answers (e.g. to let
+  // a test's clock jump: a slow sidecar). Called from the runner's exec threads.
+  std::function<void(const std::string& call)> on_exec;
   // Rendezvous, to show that calls overlap: StartContainer (StopContainer) of a component named
   // here blocks until every component named here is inside StartContainer (StopContainer) too.
   // A call that waited 10 s in vain fails ("... alone"), so a one-by-one runner fails the test

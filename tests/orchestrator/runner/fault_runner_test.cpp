@@ -15,6 +15,7 @@
 #include <sstream>
 
 #include "fake_docker_api.hpp"
+#include "swarmbox/common/yaml.hpp"
 #include "swarmbox/runner/runner.hpp"
 
 namespace swarmbox::runner {
@@ -37,6 +38,24 @@ class StepClock : public Clock {
   std::mutex mu_;
   double now_ = 1000;
   double step_;
+};
+
+// A StepClock that also jumps on request (a slow exec in a sidecar).
+class JumpClock : public Clock {
+ public:
+  double NowS() override {
+    std::lock_guard lock(mu_);
+    now_ += 0.001;
+    return now_;
+  }
+  void Jump(double s) {
+    std::lock_guard lock(mu_);
+    now_ += s;
+  }
+
+ private:
+  std::mutex mu_;
+  double now_ = 1000;
 };
 
 std::string ReadFile(const fs::path& p) {
@@ -255,6 +274,81 @@ TEST_F(FaultRunnerTest, PartitionAtSimTimeIsAppliedInEverySidecarAndHealed) {
   EXPECT_THAT(events, HasSubstr("\"mechanism\":\"iptables\""));
 }
 
+// The fault records of events.jsonl, parsed, in file order.
+std::vector<yaml::Node> FaultRecords(const std::string& events, const std::string& fault) {
+  std::vector<yaml::Node> out;
+  std::istringstream lines(events);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.find("\"type\":\"fault\"") == std::string::npos) continue;
+    auto doc = yaml::Parse(line, "events.jsonl");
+    if (doc && doc->Find("fault") != nullptr && doc->Find("fault")->scalar() == fault) out.push_back(*doc);
+  }
+  return out;
+}
+
+double NumberOf(const yaml::Node& doc, std::string_view key) {
+  const yaml::Node* n = doc.Find(key);
+  return n != nullptr ? yaml::ScalarAsDouble(n->scalar()).value_or(-1) : -1;
+}
+
+TEST_F(FaultRunnerTest, AFaultIsRecordedRequestedThenAppliedOnceEveryTargetConfirmedIt) {
+  // scout_2's sidecar takes 7 s to install the partition's hook (a busy engine): `applied` comes
+  // after it, with the time of the last confirmation; `requested` before anything was run.
+  spec_.Fault("{name: split, at: 2s, duration: 1s, partition: {groups: [[scout_1], [scout_2]]}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.000 node=physics event=tick",
+                                   "t=2.500 node=physics event=tick", "t=4.000 node=physics event=tick",
+                                   "t=5.000 node=physics event=done"};
+  JumpClock clock;
+  const std::string slow = "exec " + Name("scout_2-faults") + " iptables -w -I INPUT -i eth1 -j SWARMBOX-PART-0";
+  std::atomic<bool> slow_done{false};
+  api_.on_exec = [&](const std::string& call) {
+    if (call == slow) {
+      clock.Jump(7.0);
+      slow_done = true;
+    }
+  };
+  auto run = RunTrialSpec(spec_, api_, clock, options_);
+  ASSERT_TRUE(run) << run.error().ToString();
+  EXPECT_EQ(run->result.verdict.outcome, dsl::Outcome::kSuccess) << run->result.verdict.ToString();
+  EXPECT_TRUE(slow_done);
+  const auto records = FaultRecords(ReadFile(fs::path(run->trial_dir) / "events.jsonl"), "split");
+  std::vector<std::string> phases;
+  for (const yaml::Node& r : records) phases.push_back(r.Find("phase")->scalar());
+  ASSERT_EQ(phases, (std::vector<std::string>{"requested", "applied", "remove_requested", "removed"}));
+  const yaml::Node& requested = records[0];
+  const yaml::Node& applied = records[1];
+  // Both name the targets and the mechanism, each has its own sim and wall time.
+  for (const yaml::Node* r : {&requested, &applied}) {
+    EXPECT_EQ(r->Find("targets")->items().size(), 2u);
+    EXPECT_EQ(r->Find("mechanism")->scalar(), "iptables");
+    EXPECT_GE(NumberOf(*r, "t_sim_s"), 2.5);
+  }
+  EXPECT_GE(NumberOf(applied, "wall_s"), NumberOf(requested, "wall_s") + 7.0);
+  EXPECT_EQ(NumberOf(applied, "requested_wall_s"), NumberOf(requested, "wall_s"));
+  EXPECT_EQ(NumberOf(applied, "requested_t_sim_s"), NumberOf(requested, "t_sim_s"));
+  EXPECT_EQ(requested.Find("requested_wall_s"), nullptr);
+  // The removal likewise: asked for at 4 s of simulated time, done after.
+  EXPECT_GE(NumberOf(records[3], "wall_s"), NumberOf(records[2], "wall_s"));
+  EXPECT_EQ(NumberOf(records[3], "requested_wall_s"), NumberOf(records[2], "wall_s"));
+  ExpectNothingLeft();
+}
+
+TEST_F(FaultRunnerTest, AFaultThatFailsIsRecordedRequestedThenFailed) {
+  spec_.Fault("{name: split, at: 2s, duration: 1s, partition: {groups: [[scout_1], [scout_2]]}}");
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=2.500 node=physics event=tick",
+                                   "t=5.000 node=physics event=done"};
+  api_.exec_answers["iptables -w -I INPUT -i eth1 -j SWARMBOX-PART-0"] = {{}, {"iptables: No chain"}, 1};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
+  const auto records = FaultRecords(Events(run), "split");
+  ASSERT_GE(records.size(), 2u);
+  EXPECT_EQ(records[0].Find("phase")->scalar(), "requested");
+  EXPECT_EQ(records[1].Find("phase")->scalar(), "failed");
+  EXPECT_THAT(records[1].Find("error")->scalar(), HasSubstr("No chain"));
+  for (const yaml::Node& r : records) EXPECT_NE(r.Find("phase")->scalar(), "applied");
+  ExpectNothingLeft();
+}
+
 TEST_F(FaultRunnerTest, KillingTheRaftLeaderOnAnEventIsNotACrashAndIsUndoneAfterItsDuration) {
   // No network faults: no sidecars, the agents keep their own namespaces.
   spec_.Fault("{name: kill_leader, on: \"event=leader_elected\", duration: 200ms, kill: raft_leader}");
@@ -276,8 +370,10 @@ TEST_F(FaultRunnerTest, KillingTheRaftLeaderOnAnEventIsNotACrashAndIsUndoneAfter
   EXPECT_EQ(log, "t=1.0 node=scout_2 event=leader_elected term=2 leader=scout_2\n"
                  "t=4.0 node=scout_2 event=rejoined\nt=4.1 node=scout_2 event=done\n");
   const std::string events = Events(run);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"requested\",\"fault\":\"kill_leader\",\"kind\":\"kill\",\"start\":\"on event=leader_elected\""));
   EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"kill_leader\",\"kind\":\"kill\",\"start\":\"on event=leader_elected\""));
   EXPECT_THAT(events, HasSubstr("\"targets\":[\"scout_2\"],\"mechanism\":\"docker\",\"spec\":\"signal=SIGKILL duration=200ms\"}"));
+  EXPECT_THAT(events, HasSubstr("\"targets\":[\"scout_2\"],\"mechanism\":\"docker\",\"spec\":\"signal=SIGKILL duration=200ms\",\"requested_t_sim_s\":"));
   EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"kill_leader\""));
 }
 
@@ -360,7 +456,7 @@ TEST_F(FaultRunnerTest, InterruptedRunLeavesNothingAndExecsNoUndoInTheSidecars) 
   const std::string events = Events(*run);
   EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"fade\""));
   EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"fade\""));
-  EXPECT_THAT(events, HasSubstr("\"spec\":\"loss=0.3\",\"note\":\"with the sidecar's network namespace\"}"));
+  EXPECT_THAT(events, HasSubstr("\"spec\":\"loss=0.3\",\"note\":\"with the sidecar's network namespace\",\"requested_t_sim_s\":"));
   EXPECT_THAT(events, HasSubstr("{\"type\":\"mesh\",\"phase\":\"removed\",\"node\":\"scout_1\""));
   EXPECT_THAT(events, Not(HasSubstr("\"phase\":\"failed\"")));
   ExpectNothingLeft();
@@ -414,7 +510,7 @@ TEST_F(FaultRunnerTest, APartitionStillActiveAtTheEndGoesWithTheSidecarsNamespac
   }
   const std::string events = Events(run);
   EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"split\""));
-  EXPECT_THAT(events, HasSubstr("\"mechanism\":\"iptables\",\"spec\":\"groups=[[scout_1], [scout_2]] oneway=false\",\"note\":\"with the sidecar's network namespace\"}"));
+  EXPECT_THAT(events, HasSubstr("\"mechanism\":\"iptables\",\"spec\":\"groups=[[scout_1], [scout_2]] oneway=false\",\"note\":\"with the sidecar's network namespace\",\"requested_t_sim_s\":"));
   ExpectNothingLeft();
 }
 
@@ -528,7 +624,7 @@ TEST_F(FaultRunnerTest, AnImuBiasStillActiveAtTheEndIsNotTakenBack) {
   EXPECT_LT(IndexOf(calls, "exec " + Name("physics") + " " + kSend + "scout_1 imu_bias_jump 0.3 0 0"), calls.size());
   const std::string events = Events(run);
   EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"bias\""));
-  EXPECT_THAT(events, HasSubstr("\"note\":\"with the physics server\"}"));
+  EXPECT_THAT(events, HasSubstr("\"note\":\"with the physics server\",\"requested_t_sim_s\":"));
   ExpectNothingLeft();
 }
 

@@ -34,22 +34,49 @@ TEST(ResultJson, HoldsTheContractFields) {
   EXPECT_EQ(doc->Find("problems")->items().size(), 1u);
 }
 
-TEST(Metrics, CountsEventsFromTheLogs) {
-  Metrics m;
-  m.OnEvent("scout_1", ParseLogfmt("t=1 node=scout_1 event=leader_elected term=1"));
-  m.OnEvent("scout_1", ParseLogfmt("t=5 node=scout_1 event=victim_detected victim=victim_1"));
-  m.OnEvent("scout_2", ParseLogfmt("t=6 node=scout_2 event=victim_detected victim=victim_1"));
-  m.OnEvent("scout_2", ParseLogfmt("t=7 node=scout_2 event=victim_confirmed victim=victim_1"));
-  m.OnEvent("scout_2", ParseLogfmt("t=8 node=scout_2 event=collision"));
-  m.OnEvent("lifter", ParseLogfmt("t=90.5 node=lifter event=mission_complete"));
-  m.OnEvent("lifter", ParseLogfmt("no event here"));
-  auto v = m.Values();
-  EXPECT_EQ(v["events_total"], 6);
-  EXPECT_EQ(v["leader_elections"], 1);
-  EXPECT_EQ(v["victims_detected"], 1);
-  EXPECT_EQ(v["victims_confirmed"], 1);
-  EXPECT_EQ(v["collisions"], 1);
-  EXPECT_EQ(v["mission_complete_t_s"], 90.5);
+TEST(ResultJson, MetricsAreResultsCsvsColumnsNullWhenUnknownAndProvenanceIsOneObject) {
+  TrialResult r;
+  r.metrics = {{"victims_confirmed", 2.0}, {"radio_loss", 0.0079412}, {"failover_s", std::nullopt}};
+  r.provenance.swarmbox_version = "0.1.0";
+  r.provenance.swarmbox_commit = "1a2b3c4d5e6f";
+  r.provenance.images = {"swarmbox/agent:aa", "swarmbox/physics:bb"};
+  r.provenance.engine = {"20.10.24+dfsg1", "1.41", "6.1.0-18-amd64"};
+  r.provenance.fault_mechanism = "netem";
+  r.provenance.rtf_requested = 0;
+  r.provenance.rtf_achieved = 3.25;
+  r.provenance.host_name = "lab-3";
+  auto doc = yaml::Parse(ResultJson(r), "result.json");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  const yaml::Node* metrics = doc->Find("metrics");
+  ASSERT_NE(metrics, nullptr);
+  for (const std::string& name : report::MetricNames()) EXPECT_NE(metrics->Find(name), nullptr) << name;
+  EXPECT_EQ(metrics->Find("victims_confirmed")->scalar(), "2");
+  EXPECT_EQ(metrics->Find("radio_loss")->scalar(), "0.007941");  // as results.csv writes it
+  EXPECT_TRUE(metrics->Find("failover_s")->is_null());
+  EXPECT_TRUE(metrics->Find("victims_rescued")->is_null());
+  const yaml::Node* p = doc->Find("provenance");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->Find("swarmbox_commit")->scalar(), "1a2b3c4d5e6f");
+  EXPECT_EQ(p->Find("images")->items().size(), 2u);
+  EXPECT_EQ(p->Find("docker_api_version")->scalar(), "1.41");
+  EXPECT_EQ(p->Find("kernel")->scalar(), "6.1.0-18-amd64");
+  EXPECT_EQ(p->Find("fault_mechanism")->scalar(), "netem");
+  EXPECT_EQ(p->Find("rtf_requested")->scalar(), "0");
+  EXPECT_EQ(p->Find("rtf_achieved")->scalar(), "3.25");
+  EXPECT_EQ(p->Find("host_name")->scalar(), "lab-3");
+}
+
+TEST(RtfMeter, SimulatedOverWallSecondsFromTheFirstMoveOfSimulatedTime) {
+  RtfMeter m;
+  EXPECT_FALSE(m.Achieved());
+  m.Observe(0.5, 0.0);  // containers starting: no simulated time yet
+  m.Observe(2.0, 0.0);
+  EXPECT_FALSE(m.Achieved());
+  m.Observe(3.0, 0.1);
+  EXPECT_FALSE(m.Achieved());  // one observation: no span yet
+  m.Observe(13.0, 40.1);
+  ASSERT_TRUE(m.Achieved());
+  EXPECT_DOUBLE_EQ(*m.Achieved(), 4.0);
 }
 
 TEST(EventsJsonl, LogEventsKeepTheirFieldsNumbersBare) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "e2e_node_image.hpp"
+#include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
@@ -108,6 +109,7 @@ class RunnerE2eTest : public ::testing::Test {
     TrialInfo info;
     info.name = "e2e";
     info.resolved_yaml = "name: e2e\n";
+    info.rtf = 1.0;
     auto run = RunTrial(info, planner, *api_, clock, options_);
     EXPECT_TRUE(run) << run.error().ToString();
     return run ? *run : RunOutcome{};
@@ -135,6 +137,26 @@ TEST_F(RunnerE2eTest, EndsOnALogPattern) {
   EXPECT_TRUE(fs::exists(dir / "trajectories.png"));
   EXPECT_THAT(ReadFile(dir / "result.json"), HasSubstr("\"outcome\":\"success\""));
   EXPECT_THAT(ReadFile(dir / "events.jsonl"), HasSubstr("\"event\":\"mission_complete\""));
+
+  // What produced it (issue #16): every provenance field present and non-empty, from this engine.
+  auto result = yaml::Parse(ReadFile(dir / "result.json"), "result.json");
+  ASSERT_TRUE(result) << result.error().ToString();
+  const yaml::Node* p = result->Find("provenance");
+  ASSERT_NE(p, nullptr);
+  for (const char* key : {"swarmbox_version", "swarmbox_commit", "build_type", "docker_version",
+                          "docker_api_version", "kernel", "fault_mechanism", "rtf_requested",
+                          "rtf_achieved", "host_name"}) {
+    const yaml::Node* v = p->Find(key);
+    EXPECT_TRUE(v != nullptr && !v->is_null() && !v->scalar().empty()) << key << ": " << ReadFile(dir / "result.json");
+  }
+  auto engine = api_->Version();
+  ASSERT_TRUE(engine) << engine.error().ToString();
+  EXPECT_EQ(p->Find("docker_version")->scalar(), engine->version);
+  EXPECT_EQ(p->Find("kernel")->scalar(), engine->kernel_version);
+  EXPECT_EQ(p->Find("fault_mechanism")->scalar(), "none");
+  ASSERT_EQ(p->Find("images")->items().size(), 1u);
+  EXPECT_EQ(p->Find("images")->items()[0].scalar(), *image_);
+  EXPECT_GT(*yaml::ScalarAsDouble(p->Find("rtf_achieved")->scalar()), 0.0);
 }
 
 TEST_F(RunnerE2eTest, EndsOnSimulatedTimeout) {

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "fake_docker_api.hpp"
+#include "swarmbox/common/version.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/docker/tar_archive.hpp"
@@ -119,7 +120,18 @@ TEST_F(RunnerTest, EndsOnALogPatternWithItsOutcome) {
   EXPECT_EQ(result->Find("trial")->scalar(), "mini");
   EXPECT_EQ(result->Find("seed")->scalar(), "5");
   ASSERT_NE(result->Find("metrics"), nullptr);
-  EXPECT_EQ(result->Find("metrics")->Find("mission_complete_t_s")->scalar(), "20");
+  EXPECT_EQ(result->Find("metrics")->Find("mission_time_s")->scalar(), "20");
+  // What produced it: this build, the engine's GET /version, the tree's images, no fault.
+  const yaml::Node* p = result->Find("provenance");
+  ASSERT_NE(p, nullptr);
+  EXPECT_EQ(p->Find("swarmbox_version")->scalar(), std::string(swarmbox::Build().version));
+  EXPECT_EQ(p->Find("swarmbox_commit")->scalar(), std::string(swarmbox::Build().commit));
+  EXPECT_EQ(p->Find("docker_version")->scalar(), "20.10.24+dfsg1");
+  EXPECT_EQ(p->Find("docker_api_version")->scalar(), "1.41");
+  EXPECT_EQ(p->Find("kernel")->scalar(), "6.1.0-fake-amd64");
+  EXPECT_EQ(p->Find("fault_mechanism")->scalar(), "none");
+  EXPECT_FALSE(p->Find("images")->items().empty());
+  EXPECT_FALSE(p->Find("host_name")->scalar().empty());
 
   const std::string events = ReadFile(dir / "events.jsonl");
   EXPECT_THAT(events, HasSubstr("\"component\":\"scout_1\",\"t\":20.0,\"node\":\"scout_1\",\"event\":\"mission_complete\""));

@@ -78,7 +78,14 @@ TEST(SensorFaultE2e, GpsDropoutAndDegradationAreSentToThePhysicsServerAndRecorde
   EXPECT_EQ(run->result.verdict.outcome, dsl::Outcome::kSuccess) << run->result.verdict.ToString();
 
   const std::string events = ReadFile(fs::path(run->trial_dir) / "events.jsonl");
-  EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"gps_loss\",\"kind\":\"gps_dropout\""));
+  // Requested when due, applied once the world command's exec exited 0, with the request's times.
+  const std::size_t requested = events.find("\"phase\":\"requested\",\"fault\":\"gps_loss\",\"kind\":\"gps_dropout\"");
+  const std::size_t applied = events.find("\"phase\":\"applied\",\"fault\":\"gps_loss\",\"kind\":\"gps_dropout\"");
+  ASSERT_NE(requested, std::string::npos) << events;
+  ASSERT_NE(applied, std::string::npos) << events;
+  EXPECT_LT(requested, applied);
+  EXPECT_NE(events.find("\"requested_wall_s\":", applied), std::string::npos);
+  EXPECT_THAT(events, HasSubstr("\"phase\":\"remove_requested\",\"fault\":\"gps_loss\""));
   EXPECT_THAT(events, HasSubstr("\"targets\":[\"scout_1\"],\"mechanism\":\"physics-command\""));
   EXPECT_THAT(events, HasSubstr("\"phase\":\"removed\",\"fault\":\"gps_loss\""));
   EXPECT_THAT(events, HasSubstr("\"phase\":\"applied\",\"fault\":\"bad_fix\",\"kind\":\"gps_degrade\""));

@@ -33,6 +33,7 @@
 #include "swarmbox/dsl/trial_spec.hpp"
 #include "swarmbox/experiment/experiment_spec.hpp"
 #include "swarmbox/experiment/scheduler.hpp"
+#include "swarmbox/report/provenance.hpp"
 #include "swarmbox/runner/runner.hpp"
 
 namespace swarmbox::experiment {
@@ -87,6 +88,19 @@ struct ExperimentSummary {
   std::map<std::string, std::size_t> outcomes;  // over every committed trial
   std::vector<std::string> problems;  // cleanup and report issues, hosts that left
 };
+
+// experiment.json: {"name","file","base","factors":[...],"trials","run_ids":[...],
+//   "provenance":{"swarmbox_version","swarmbox_commit","build_type","host_name","rtf_requested",
+//                 "hosts":[{"name","images":[...],"docker_version","docker_api_version","kernel"}],
+//                 "fault_mechanisms":[...],"rtf_achieved_min","rtf_achieved_max"}}
+// (this build and machine, each host's images and engine, asked with GET /version now;
+// rtf_requested null when the trials differ in it; the mechanisms and the rtf range from the
+// `trials`' result.json provenance: RunExperiment writes the file before the trials with none and
+// again at the end). Each trial's own is in its result.json and results.csv row
+// (report/provenance.hpp).
+std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::string>& run_ids,
+                           const std::vector<PoolHost>& pool,
+                           const std::vector<report::Provenance>& trials = {});
 
 // Whether `out_dir` can take this run: kInvalidArgument when it holds another experiment, or trials
 // of this one and `resume` is false. Returns the run ids of earlier runs in the folder.

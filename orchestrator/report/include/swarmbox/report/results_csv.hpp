@@ -1,5 +1,7 @@
 // results.csv (ARCHITECTURE.md "Per-trial output", contract): one row per trial,
-//   trial_id,code,<factors...>,repetition,seed,host,outcome,reason,wall_s,sim_s,<metrics...>
+//   trial_id,code,<factors...>,repetition,seed,host,outcome,reason,wall_s,sim_s,<metrics...>,
+//   <provenance...>
+// (metrics: MetricNames(), trial_metrics.hpp; provenance: ProvenanceColumns(), provenance.hpp)
 // RFC 4180 quoting (fields with a comma, quote or newline are quoted, quotes doubled); a metric a
 // trial does not have is an empty cell. Pure.
 #pragma once

@@ -1,5 +1,6 @@
-// Per-trial metrics for results.csv and report.html, computed from what a trial left in its
-// folder (pure: feed events and truth rows, read Values()).
+// Per-trial metrics: the one definition of each metric, used by the runner for result.json's
+// "metrics", by results.csv and by report.html (pure: feed events and truth rows, read Values();
+// ReadTrialMetrics in trial_record.hpp feeds it a trial folder).
 //
 // Every metric is optional: a trial whose logs have no event a metric needs gets an empty cell,
 // never an invented value.
@@ -9,7 +10,9 @@
 //                         such events without one count one each; sighting_reported only sets
 //                         first_detection_s); empty when the trial logged no perception event
 //                         and no mission_state
-//   victims_confirmed     distinct victims in victim_confirmed events (same rule)
+//   victims_confirmed     distinct victims in victim_confirmed events (same rule): the ending
+//                         line's `victims=` (mission_complete counts the mission's victims, which
+//                         are the confirmed ones)
 //   min_separation_m      smallest 3-D distance between two drones at the same truth.csv time
 //                         (needs >= 2 drones)
 //   collisions            event=collision count (0 when the physics log is there)
@@ -21,6 +24,10 @@
 //   radio_rtt_ms          mean RTT over event=link lines: rtt_ms_mean weighted by `received`
 //   radio_loss            1 - sum(received) / sum(sent) over event=link lines (the mean of `loss`
 //                         for lines without counts)
+//   victims_rescued       distinct victims (`id`) in event=victim_status status=rescued: the ending
+//                         line's `rescued=`; empty like detections
+// The agents log victim_confirmed/victim_status with `id=` (agent/raft node_driver.cpp) and
+// sighting_reported without one (agent/swarm scout_behaviour.cpp); `victim=` is also accepted.
 #pragma once
 
 #include <array>
@@ -63,6 +70,7 @@ class TrialMetrics {
   bool perception_seen_ = false;
   std::set<std::string> detected_;
   std::set<std::string> confirmed_;
+  std::set<std::string> rescued_;
   std::uint64_t anonymous_detections_ = 0;
   std::uint64_t anonymous_confirmed_ = 0;
   bool physics_log_ = false;

@@ -4,11 +4,14 @@
 // Files read in <experiment>/<trial>/:
 //   trial_meta.json  written by `swarmbox experiment`: {"id","code","levels":[...],
 //                    "factors":[...],"repetition","seed","attempts","hosts":[...]}
-//   result.json      the runner's (outcome, reason, wall_s, sim_s, seed, host)
+//   result.json      the runner's (outcome, reason, wall_s, sim_s, seed, host, provenance)
 //   logs/*.log       logfmt events per component (the file stem is the component)
 //   events.jsonl     orchestrator records (fault events for failover)
 //   truth.csv        ground truth (min separation)
 // and at the experiment level <experiment>/experiment.json: {"name","run_id","factors":[...]}.
+// The metrics are computed from logs/, events.jsonl and truth.csv (ReadTrialMetrics, the same
+// function the runner uses for result.json's "metrics"); a folder whose logs/ holds no log (pruned,
+// as in docs/example-report) keeps the metrics its result.json stored.
 #pragma once
 
 #include <cstdint>
@@ -18,6 +21,7 @@
 #include <vector>
 
 #include "swarmbox/common/result.hpp"
+#include "swarmbox/report/provenance.hpp"
 #include "swarmbox/report/trial_metrics.hpp"
 
 namespace swarmbox::report {
@@ -45,8 +49,13 @@ struct TrialRecord {
   std::optional<double> wall_s;
   std::optional<double> sim_s;
   MetricValues metrics;
+  Provenance provenance;  // result.json's (empty for folders written before it existed)
   bool has_trajectories = false;  // trajectories.png exists
 };
+
+// The metrics of a trial folder from its logs/*.log, events.jsonl and truth.csv (TrialMetrics fed
+// in that order, logs sorted by name). nullopt when logs/ holds no .log file.
+std::optional<MetricValues> ReadTrialMetrics(const std::string& dir);
 
 // Reads one trial folder (kNotFound when it has no result.json).
 Result<TrialRecord> ReadTrialFolder(const std::string& dir);
@@ -55,6 +64,9 @@ Result<TrialRecord> ReadTrialFolder(const std::string& dir);
 // unreadable folders are reported in `problems`.
 std::vector<TrialRecord> ReadExperimentFolder(const std::string& dir,
                                               std::vector<std::string>* problems);
+
+// The report's title: experiment.json's "name", else the folder's name.
+std::string ExperimentTitle(const std::string& dir);
 
 // Factor names of an experiment folder: experiment.json, else the first trial's meta.
 std::vector<std::string> FactorNames(const std::string& dir, const std::vector<TrialRecord>& records);

@@ -25,8 +25,14 @@
 //     undone (a paused agent is unpaused so it can stop; a killed one started again). A fault
 //     whose window ends mid-trial (Advance, OnLogLine) is always undone explicitly: the trial
 //     goes on.
-// Every apply/remove/failure is one events.jsonl line (FaultEventJson / MeshEventJson, with the
-// mechanism); the detection is one line {"type":"mechanism",...}.
+// Every fault action is two events.jsonl lines (FaultEventJson, with the mechanism): `requested`
+// when the timeline asks for it (the targets resolved then), and `applied` once the mechanism has
+// confirmed it on every target (every sidecar's commands exited 0, the Docker API answered for
+// every container, every world command was acknowledged), or `failed`; a removal likewise
+// `remove_requested`, then `removed`. Each line has its simulated and wall time, `applied` and
+// `removed` also the request's (requested_t_sim_s, requested_wall_s). network.mesh is one
+// MeshEventJson line per drone once its sidecar confirmed it; the detection is one line
+// {"type":"mechanism",...}.
 //
 // Process faults and the log watch: a container a fault stopped, killed or restarts is Disrupted()
 // (the runner does not call its exit a crash); once a fault brings it back (start, restart) it is
@@ -107,6 +113,9 @@ class FaultInjector {
  private:
   // trial_end: the removals come from RemoveActive (see the banner).
   std::optional<dsl::Verdict> Carry(const std::vector<faults::TimelineAction>& actions, bool trial_end);
+  // The fault's targets (and mechanism) into `record` and targets_ (pure: the leader tracker, the
+  // random draw); Apply then carries it out on them.
+  Status Resolve(std::size_t index, faults::FaultEventRecord* record);
   Status Apply(std::size_t index, faults::FaultEventRecord* record);
   Status Remove(std::size_t index, faults::FaultEventRecord* record, bool trial_end);
   Status ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,
@@ -115,6 +124,7 @@ class FaultInjector {
   // RunAllCommands for undo paths); the first failure in trial order.
   Status RunOnSidecars(const std::map<std::string, std::vector<faults::Command>>& per_drone, bool run_all);
   faults::LinkTarget LinkOf(const std::string& drone) const;
+  std::vector<faults::MeshNode> MeshNodes() const;
   faults::RadioPlanOptions PlanOptions() const;
   faults::CommandRunner& Sidecar(const std::string& drone);
   // Sends the world commands through the physics container, all at once; the first failure.

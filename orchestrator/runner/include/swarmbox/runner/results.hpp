@@ -5,7 +5,11 @@
 //   {"trial":"sar-search","outcome":"success","reason":"...","wall_s":312.5,"sim_s":300.2,
 //    "seed":42,"host":"local","metrics":{...},"run_id":"...","trial_id":"...","source":"...",
 //    "ending_line":"...","restarts":0,"components":[{"name":"physics","exit_code":0,...}],
-//    "problems":[...]}
+//    "problems":[...],"provenance":{...}}
+// "metrics" are results.csv's metric columns (report/trial_metrics.hpp, the one definition of
+// each; computed by report::ReadTrialMetrics from the trial folder), every one present, null when
+// the trial has no value for it, written as results.csv writes them (report::CsvNumber).
+// "provenance": report/provenance.hpp.
 // events.jsonl: one JSON object per line, in arrival order:
 //   log events   {"wall_s":1.234,"component":"scout_1","t":12.34,"node":"scout_1","event":"...",...}
 //   lifecycle    {"wall_s":0.5,"component":"orchestrator","event":"run","target":"physics",
@@ -15,13 +19,14 @@
 #include <cstdint>
 #include <map>
 #include <optional>
-#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/dsl/outcome.hpp"
+#include "swarmbox/report/provenance.hpp"
+#include "swarmbox/report/trial_metrics.hpp"
 
 namespace swarmbox::runner {
 
@@ -42,7 +47,8 @@ struct TrialResult {
   double sim_s = 0;
   std::uint64_t seed = 0;
   std::string host;
-  std::map<std::string, double> metrics;
+  report::MetricValues metrics;  // by report::MetricNames()
+  report::Provenance provenance;
   std::vector<ComponentReport> components;
   int restarts = 0;
   std::string ending_line;
@@ -51,22 +57,17 @@ struct TrialResult {
 
 std::string ResultJson(const TrialResult& result);
 
-// Counts what happened, from the events of every log (pure).
-class Metrics {
+// The achieved real-time factor: simulated seconds over wall seconds between the first and the last
+// simulated time observed (pure; fed by the runner's watch loop).
+class RtfMeter {
  public:
-  void OnEvent(std::string_view component, const LogfmtFields& fields);
-  // events_total, victims_detected, victims_confirmed (distinct `victim`), collisions, crashes,
-  // leader_elections, and mission_complete_t_s when the mission completed.
-  std::map<std::string, double> Values() const;
+  void Observe(double wall_s, double sim_s);
+  // nullopt until simulated time has moved on over some wall time.
+  std::optional<double> Achieved() const;
 
  private:
-  std::uint64_t events_ = 0;
-  std::uint64_t collisions_ = 0;
-  std::uint64_t crashes_ = 0;
-  std::uint64_t elections_ = 0;
-  std::set<std::string> detected_;
-  std::set<std::string> confirmed_;
-  std::optional<double> mission_complete_t_s_;
+  std::optional<std::pair<double, double>> first_;  // (wall, sim) when sim first moved past 0
+  std::pair<double, double> last_{0, 0};
 };
 
 // One events.jsonl line (no trailing newline) for a logfmt line that has an `event` field;

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -70,6 +71,7 @@ struct RunOutcome {
 struct TrialInfo {
   std::string name;
   std::uint64_t seed = 0;
+  std::optional<double> rtf;  // physics.rtf as asked (provenance); nullopt = not known
   std::string resolved_yaml;  // written as trial.yaml
   std::string world_file;     // host path of the world (for trajectories.png); "" = none
   // Faults (fault_injector.hpp): carried out when either is non-empty. Drone names in trial
