@@ -15,9 +15,7 @@ EngineConnection ConnectEngineOrPrintError(std::string_view command) {
     c.exit_code = kExitUsage;
     return c;
   }
-  docker::DockerClientOptions options;
-  options.engine = *engine;
-  auto client = docker::DockerClient::Connect(options);
+  auto client = docker::DockerClient::Connect(*engine, docker::DockerClientOptions{});
   if (!client) {
     std::cerr << "swarmbox " << command << ": " << client.error().ToString() << "\n";
     c.exit_code = kExitInfrastructure;

@@ -10,7 +10,7 @@ namespace swarmbox::docker {
 namespace {
 
 Error Bad(const std::string& value, const std::string& why) {
-  return Error(ErrorCode::kInvalidArgument, "DOCKER_HOST=" + value + ": " + why, "DOCKER_HOST");
+  return Error(ErrorCode::kInvalidArgument, why, "DOCKER_HOST=" + value);
 }
 
 // "host:port", "host", "[::1]:port", "[::1]" -> host, port (0 = none given).

@@ -30,7 +30,9 @@ class DockerHostE2eTest : public ::testing::Test {
  protected:
   void SetUp() override {
     socket_ = docker::DefaultSocketPath();
-    auto client = docker::DockerClient::Connect({.socket_path = socket_});
+    docker::DockerClientOptions options;
+    options.socket_path = socket_;
+    auto client = docker::DockerClient::Connect(options);
     ASSERT_TRUE(client) << "this test needs a Docker engine: " << client.error().ToString();
     api_ = std::move(*client);
     auto fwd = TcpUnixForwarder::Start(socket_);
@@ -74,11 +76,9 @@ class DockerHostE2eTest : public ::testing::Test {
 };
 
 TEST_F(DockerHostE2eTest, TheClientSpeaksTheEngineApiOverTcp) {
-  docker::DockerClientOptions options;
   auto engine = docker::ParseEngineEndpoint({TcpHost(), "", "", "", ""});
   ASSERT_TRUE(engine) << engine.error().ToString();
-  options.engine = *engine;
-  auto tcp = docker::DockerClient::Connect(options);
+  auto tcp = docker::DockerClient::Connect(*engine, docker::DockerClientOptions{});
   ASSERT_TRUE(tcp) << tcp.error().ToString();
   EXPECT_EQ((*tcp)->transport().endpoint(), TcpHost());
   auto over_tcp = (*tcp)->Version();

@@ -128,8 +128,7 @@ TEST(ParseEngineEndpoint, EverythingElseIsAnErrorThatSaysWhy) {
     auto e = ParseEngineEndpoint(Env(c.value));
     ASSERT_FALSE(e) << c.value << " parsed as " << e->ToString();
     EXPECT_EQ(e.error().code(), ErrorCode::kInvalidArgument) << c.value;
-    EXPECT_EQ(e.error().where(), "DOCKER_HOST");
-    EXPECT_THAT(e.error().message(), HasSubstr(std::string("DOCKER_HOST=") + c.value)) << c.value;
+    EXPECT_EQ(e.error().where(), std::string("DOCKER_HOST=") + c.value);
     EXPECT_THAT(e.error().message(), HasSubstr(c.says)) << c.value;
   }
 }

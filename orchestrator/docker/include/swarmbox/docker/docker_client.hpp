@@ -16,7 +16,6 @@
 
 #include <chrono>
 #include <memory>
-#include <optional>
 #include <string>
 #include <string_view>
 
@@ -32,9 +31,6 @@ namespace swarmbox::docker {
 std::string DefaultSocketPath();
 
 struct DockerClientOptions {
-  // The engine (engine_endpoint.hpp): set it from EngineEndpointFromEnvironment() to honour
-  // $DOCKER_HOST. Unset: the unix socket below.
-  std::optional<EngineEndpoint> engine;
   std::string socket_path = "/var/run/docker.sock";
   std::chrono::milliseconds connect_timeout{5000};
   // Limit for ordinary calls (not for streams, wait, build, exec start). Stop/restart add their
@@ -47,8 +43,12 @@ class DockerClient final : public DockerApi {
   static constexpr ApiVersion kMinApiVersion{1, 40};
   static constexpr ApiVersion kMaxApiVersion{1, 44};
 
-  // Connects to options.engine (else the unix socket) and negotiates the API version.
+  // Connects over the unix socket options.socket_path and negotiates the API version.
   static Result<std::unique_ptr<DockerClient>> Connect(const DockerClientOptions& options);
+  // The same to any engine endpoint (engine_endpoint.hpp: EngineEndpointFromEnvironment() honours
+  // $DOCKER_HOST); options.socket_path is not used.
+  static Result<std::unique_ptr<DockerClient>> Connect(const EngineEndpoint& engine,
+                                                       const DockerClientOptions& options);
   // Same over any transport (recorded exchanges in tests).
   static Result<std::unique_ptr<DockerClient>> Connect(std::unique_ptr<HttpTransport> transport,
                                                        std::chrono::milliseconds request_timeout);

@@ -15,8 +15,8 @@
 //                                    the local socket
 //
 //   auto engine = EngineEndpointFromEnvironment();
-//   if (!engine) return engine.error();   // "DOCKER_HOST=...: ..." (bad input: exit 2)
-//   DockerClientOptions o; o.engine = *engine;
+//   if (!engine) return engine.error();   // "DOCKER_HOST=ftp://x: unknown scheme..." (exit 2)
+//   auto client = DockerClient::Connect(*engine, DockerClientOptions{});
 //
 // ParseEngineEndpoint is pure (the environment passed in); EngineEndpointFromEnvironment reads
 // the process environment and checks that the certificate files named exist.
@@ -59,7 +59,7 @@ struct DockerEnvironment {
   std::string home;        // HOME
 };
 
-// Errors: kInvalidArgument with where = "DOCKER_HOST" and the value in the message.
+// Errors: kInvalidArgument with where = "DOCKER_HOST=<value>" and the message saying why.
 Result<EngineEndpoint> ParseEngineEndpoint(const DockerEnvironment& env);
 
 DockerEnvironment DockerEnvironmentFromProcess();
