@@ -1,6 +1,7 @@
-// TrialProgress: the live progress line as a fold over a SAR trial's log lines. The lines are in
-// the exact form the agents and the physics server print them (common/logfmt LogEvent; the
-// events of agent/app/README.md), in the order the runner's log streams deliver them.
+// TrialProgress: the live progress line as a fold over a SAR trial's log lines: the first ones
+// copied from a real run's logs, the later ones (victims, a leader change) in the exact form the
+// agents print them (common/logfmt LogEvent; agent/app/README.md), in an order the runner's log
+// streams can deliver them.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -15,16 +16,19 @@ namespace {
 // A trials/sar_search.yaml run: three scouts and a lifter; every agent applies the same Raft log,
 // so each committed event arrives once per drone.
 const std::vector<std::pair<std::string, std::string>> kSarLines = {
+    // Copied from a `swarmbox run trials/sar_search.yaml --set physics.rtf=1` run's logs/.
     {"physics", "t=0.000 node=physics event=ready drones=4"},
-    {"scout_1", "t=0.000 node=scout_1 event=ready"},
-    {"scout_1", "t=1.850 node=scout_1 event=leader_elected term=1 leader=scout_2"},
-    {"scout_2", "t=1.850 node=scout_2 event=leader_elected term=1 leader=scout_2"},
-    {"scout_2", "t=2.000 node=scout_2 event=mission_start role=scout"},
-    {"scout_2", "t=2.100 node=scout_2 event=mission_state state=SEARCH index=3"},
-    {"scout_1", "t=2.100 node=scout_1 event=mission_state state=SEARCH index=3"},
-    {"scout_1", "t=4.000 node=scout_1 event=mission_stage role=scout stage=searching lane=0"},
-    {"scout_1", "t=10.000 node=scout_1 event=link peer=scout_2 sent=10 received=10 loss=0.0000 late=0 dup=0 rtt_ms_mean=1.2"},
-    {"physics", "t=20.000 node=physics event=clock rtf=0.98 steps=5000 late=0 lost=0"},
+    {"scout_1", "t=1.608 node=scout_1 event=link peer=scout_2 sent=9 received=6 loss=0.3333 late=0 dup=0 rtt_ms_mean=199.49 rtt_ms_sd=22.55 rtt_ms_p50=185.06 rtt_ms_p99=227.71 rtt_ms_max=227.71"},
+    {"scout_2", "t=1.792 node=scout_2 event=leader_elected term=2 leader=scout_2"},
+    {"scout_1", "t=1.808 node=scout_1 event=leader_elected term=2 leader=scout_2"},
+    {"scout_1", "t=3.020 node=scout_1 event=mission_stage role=scout stage=taking_off"},
+    {"physics", "t=10.000 node=physics event=clock rtf=1.00 steps=2500 late=379 lost=0"},
+    {"scout_2", "t=16.236 node=scout_2 event=mission_state state=SEARCH index=3"},
+    {"scout_1", "t=16.352 node=scout_1 event=mission_state state=SEARCH index=3"},
+    {"scout_1", "t=16.432 node=scout_1 event=mission_stage role=scout stage=searching lane=0"},
+    {"physics", "t=20.000 node=physics event=clock rtf=1.00 steps=5000 late=663 lost=0"},
+    // Later events in the form the agents print them (node_driver.cpp, scout_behaviour.cpp,
+    // lifter_sequence.cpp, mission_host.cpp).
     {"scout_3", "t=41.200 node=scout_3 event=sighting_reported seq=1 x=35.6 y=19.6 confidence=0.91"},
     {"scout_3", "t=46.200 node=scout_3 event=sighting_reported seq=1 x=35.6 y=19.6 confidence=0.91 retry=1"},
     {"scout_2", "t=46.500 node=scout_2 event=victim_confirmed id=1 x=35.600 y=19.600 index=12"},
@@ -42,10 +46,10 @@ const std::vector<std::pair<std::string, std::string>> kSarLines = {
     {"scout_2", "t=95.200 node=scout_2 event=victim_status id=1 status=rescued rescuer=lifter index=31"},
     {"scout_1", "t=95.200 node=scout_1 event=victim_status id=1 status=rescued rescuer=lifter index=31"},
     {"scout_2", "t=96.000 node=scout_2 event=victim_status id=2 status=being_rescued rescuer=lifter index=32"},
-    // scout_2 is killed; scout_3 wins term 2 (each voter logs it).
-    {"scout_3", "t=101.400 node=scout_3 event=leader_elected term=2 leader=scout_3"},
-    {"scout_1", "t=101.400 node=scout_1 event=leader_elected term=2 leader=scout_3"},
-    {"scout_2", "t=101.000 node=scout_2 event=leader_elected term=1 leader=scout_2"},  // stale
+    // scout_2 is killed; scout_3 wins term 3 (each voter logs it).
+    {"scout_3", "t=101.400 node=scout_3 event=leader_elected term=3 leader=scout_3"},
+    {"scout_1", "t=101.400 node=scout_1 event=leader_elected term=3 leader=scout_3"},
+    {"scout_2", "t=101.000 node=scout_2 event=leader_elected term=2 leader=scout_2"},  // stale
 };
 
 TrialProgress Fold(std::size_t n) {
@@ -56,7 +60,8 @@ TrialProgress Fold(std::size_t n) {
 
 TEST(TrialProgress, BeforeAnyMissionEventShowsClocksAndContainersOnly) {
   const TrialProgress p = Fold(2);
-  EXPECT_EQ(RenderProgress(p, {600, 3.0, 5, 5}), "sim 0.0/600.0s  wall 3.0s  live 5/5");
+  // (a link line only moves the clock)
+  EXPECT_EQ(RenderProgress(p, {600, 3.0, 5, 5}), "sim 1.6/600.0s  wall 3.0s  live 5/5");
 }
 
 TEST(TrialProgress, LeaderAndStageComeFromTheCommittedEvents) {
@@ -64,11 +69,11 @@ TEST(TrialProgress, LeaderAndStageComeFromTheCommittedEvents) {
   EXPECT_EQ(p.leader, "scout_2");
   EXPECT_EQ(p.stage, "SEARCH");
   ASSERT_TRUE(p.rtf.has_value());
-  EXPECT_DOUBLE_EQ(*p.rtf, 0.98);
+  EXPECT_DOUBLE_EQ(*p.rtf, 1.0);
   // A link line moves nothing but the clock.
   EXPECT_DOUBLE_EQ(p.sim_s, 20.0);
   EXPECT_EQ(RenderProgress(p, {600, 21.0, 5, 5}),
-            "sim 20.0/600.0s  rtf 0.98  wall 21.0s  stage SEARCH  leader scout_2  live 5/5");
+            "sim 20.0/600.0s  rtf 1.00  wall 21.0s  stage SEARCH  leader scout_2  live 5/5");
 }
 
 TEST(TrialProgress, VictimsAreCountedOnceWhateverTheNumberOfDronesLoggingThem) {
@@ -77,7 +82,7 @@ TEST(TrialProgress, VictimsAreCountedOnceWhateverTheNumberOfDronesLoggingThem) {
   EXPECT_EQ(p.confirmed.size(), 2u);
   EXPECT_EQ(p.rescued.size(), 1u);  // victim 2 is only being rescued
   EXPECT_EQ(p.stage, "RESCUE");     // the late SEARCH (index 3) does not win over index 13
-  EXPECT_EQ(p.leader, "scout_3");   // term 2; the stale term-1 line does not take it back
+  EXPECT_EQ(p.leader, "scout_3");   // term 3; the stale term-2 line does not take it back
   EXPECT_DOUBLE_EQ(p.sim_s, 101.4);
   EXPECT_EQ(RenderProgress(p, {600, 104.0, 4, 5}),
             "sim 101.4/600.0s  rtf 1.02  wall 104.0s  stage RESCUE  leader scout_3  victims "
