@@ -72,7 +72,12 @@ std::string DefaultSocketPath() {
 }
 
 Result<std::unique_ptr<DockerClient>> DockerClient::Connect(const DockerClientOptions& options) {
-  return Connect(std::make_unique<UnixSocketTransport>(options.socket_path, options.connect_timeout),
+  return Connect(UnixEngine(options.socket_path), options);
+}
+
+Result<std::unique_ptr<DockerClient>> DockerClient::Connect(const EngineEndpoint& engine,
+                                                            const DockerClientOptions& options) {
+  return Connect(std::make_unique<CurlTransport>(engine, options.connect_timeout),
                  options.request_timeout);
 }
 

@@ -156,14 +156,23 @@ Result<std::unique_ptr<Host>> ConnectHost(const HostSpec& spec, const std::strin
   host->spec_ = spec;
   docker::DockerClientOptions options;
   if (spec.kind == HostSpec::Kind::kLocal) {
-    options.socket_path = spec.socket.empty() ? docker::DefaultSocketPath() : spec.socket;
+    options.socket_path = spec.socket;
   } else {
     auto tunnel = SshTunnel::Open(spec, workdir, std::chrono::seconds(20));
     if (!tunnel) return tunnel.error();
     host->tunnel_ = std::move(*tunnel);
     options.socket_path = host->tunnel_->local_socket();
   }
-  auto client = docker::DockerClient::Connect(options);
+  // The local engine without a socket given: $DOCKER_HOST (unix:// or tcp://), as the docker CLI
+  // reads it.
+  auto client = [&]() -> Result<std::unique_ptr<docker::DockerClient>> {
+    if (spec.kind != HostSpec::Kind::kLocal || !spec.socket.empty()) {
+      return docker::DockerClient::Connect(options);
+    }
+    auto engine = docker::EngineEndpointFromEnvironment();
+    if (!engine) return engine.error();
+    return docker::DockerClient::Connect(*engine, options);
+  }();
   if (!client) {
     if (host->tunnel_) {
       // Give ssh a moment to print why the channel was refused.

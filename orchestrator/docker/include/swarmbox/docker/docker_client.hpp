@@ -21,11 +21,13 @@
 
 #include "swarmbox/docker/api_json.hpp"
 #include "swarmbox/docker/docker_api.hpp"
+#include "swarmbox/docker/engine_endpoint.hpp"
 #include "swarmbox/docker/http_transport.hpp"
 
 namespace swarmbox::docker {
 
-// $DOCKER_HOST when it is unix://PATH, else /var/run/docker.sock.
+// $DOCKER_HOST when it is unix://PATH, else /var/run/docker.sock. Only for callers that need a
+// socket path; the engine a user means is EngineEndpointFromEnvironment() (tcp:// too).
 std::string DefaultSocketPath();
 
 struct DockerClientOptions {
@@ -41,8 +43,12 @@ class DockerClient final : public DockerApi {
   static constexpr ApiVersion kMinApiVersion{1, 40};
   static constexpr ApiVersion kMaxApiVersion{1, 44};
 
-  // Connects over a unix socket and negotiates the API version.
+  // Connects over the unix socket options.socket_path and negotiates the API version.
   static Result<std::unique_ptr<DockerClient>> Connect(const DockerClientOptions& options);
+  // The same to any engine endpoint (engine_endpoint.hpp: EngineEndpointFromEnvironment() honours
+  // $DOCKER_HOST); options.socket_path is not used.
+  static Result<std::unique_ptr<DockerClient>> Connect(const EngineEndpoint& engine,
+                                                       const DockerClientOptions& options);
   // Same over any transport (recorded exchanges in tests).
   static Result<std::unique_ptr<DockerClient>> Connect(std::unique_ptr<HttpTransport> transport,
                                                        std::chrono::milliseconds request_timeout);
