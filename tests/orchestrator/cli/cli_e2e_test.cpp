@@ -1,7 +1,8 @@
 // `swarmbox run` and `swarmbox gc` as a user runs them: the built `swarmbox` program as a child
 // process against the real Docker engine, running trials/smoke.yaml (the real physics server and
-// one real agent, packed from this build tree by swarmbox itself) at rtf 1 with a long simulated
-// timeout, so the trial is still running when the test interrupts or kills swarmbox.
+// one real agent, packed from this build tree by swarmbox itself) at rtf 1 with its hover stretched
+// to 600 s and a long simulated timeout, so the trial is still running when the test interrupts or
+// kills swarmbox (as shipped, the smoke trial lands and succeeds within seconds).
 //
 //   SIGINT  -> exit 1, result.json outcome "error" ("interrupted (Ctrl-C)"), every log collected,
 //              nothing labelled with the run id left (ARCHITECTURE.md "CLI", "Labels").
@@ -87,11 +88,12 @@ class CliE2eTest : public ::testing::Test {
   std::string Out(const std::string& run_id) const { return (dir_ / (run_id + ".out")).string(); }
   std::string Err(const std::string& run_id) const { return (dir_ / (run_id + ".err")).string(); }
 
-  // `swarmbox run trials/smoke.yaml` paced at real time, far from its end.
+  // `swarmbox run trials/smoke.yaml` paced at real time, hovering far from its end.
   ChildProcess& StartRun(const std::string& run_id) {
     const std::vector<std::string> argv = {
         kSwarmbox, "run", kSmokeTrial, "--out", dir_.string(), "--run-id", run_id,
-        "--set", "physics.rtf=1", "--set", "timeout.sim=600s", "--set", "timeout.wall=20m"};
+        "--set", "physics.rtf=1", "--set", "mission.plan=takeoff:3,hover:600,land",
+        "--set", "timeout.sim=700s", "--set", "timeout.wall=20m"};
     auto child = ChildProcess::Spawn(argv, Out(run_id), Err(run_id));
     EXPECT_TRUE(child) << child.error().ToString();
     if (!child) std::abort();
