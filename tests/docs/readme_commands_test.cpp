@@ -89,7 +89,7 @@ std::vector<Rule> Rules() {
        .timeout = 420s},
       {.line = cli + " experiment trials/experiments/radio.yaml --out runs/radio --hosts local?slots=2 "
                      "--hosts ssh://lab@lab2?slots=4&known_hosts=/etc/swarmbox/known_hosts",
-       .excluded = "needs a second host reached by ssh (the two-host test, TwoHostE2e, runs an experiment "
+       .excluded = "needs a second host reached by ssh (TwoHostExperiment, tests/orchestrator/experiment, runs an experiment "
                    "over a second dockerd in a network namespace)"},
       {.line = cli + " experiment trials/experiments/radio.yaml --out runs/radio --resume",
        .append = {"--filter", "aab", "--set", "physics.rtf=0", "--set", kShort},
