@@ -31,6 +31,7 @@
 
 #include "agent_node.hpp"
 #include "mission_options.hpp"
+#include "swarmbox/common/version.hpp"
 
 namespace {
 volatile std::sig_atomic_t g_stop = 0;
@@ -58,6 +59,8 @@ int main(int argc, char** argv) {
   std::string start;
   double first_timeout_s = 10.0, stall_timeout_s = 5.0;
   bool no_mesh = false, no_damping = false;
+  app.set_version_flag("--version", swarmbox::VersionLine("swarmbox-agent"),
+                       "Print the version, git commit and build type, and exit");
   app.add_option("--name", o.name, "Drone name (as the physics server knows it)")->required();
   app.add_option("--airframe", o.airframe_path, "Airframe file (trials/airframes/*.yaml)")->required()->check(CLI::ExistingFile);
   app.add_option("--middleware", o.middleware, "DDS implementation")->check(CLI::IsMember({"cyclonedds", "fastdds"}))->capture_default_str();
@@ -93,6 +96,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     (void)app.exit(e);  // prints the message and the usage hint

@@ -1,6 +1,10 @@
 // The `swarmbox` subcommands (ARCHITECTURE.md "CLI", contract). Each returns the process exit
 // code: 0 success, 1 a trial ended with another outcome, 2 bad input or usage, 3 infrastructure
-// error (no Docker engine, image build failed).
+// error (no Docker engine, image build failed), 130 / 143 `run` or `experiment` stopped by SIGINT
+// (Ctrl-C) / SIGTERM, after the clean-up (interrupt.hpp).
+//
+// `json`: the command's summary is one JSON object on stdout (json_out.hpp) instead of its lines;
+// progress and diagnostics stay on stderr.
 #pragma once
 
 #include <functional>
@@ -14,6 +18,8 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitOutcome = 1;
 inline constexpr int kExitUsage = 2;
 inline constexpr int kExitInfrastructure = 3;
+inline constexpr int kExitSigint = 130;   // 128 + SIGINT
+inline constexpr int kExitSigterm = 143;  // 128 + SIGTERM
 
 // Where the host-built programs come from (for the images).
 struct ProgramPaths {
@@ -27,13 +33,17 @@ struct RunArgs {
   std::vector<std::string> sets;
   std::string run_id;
   bool quiet = false;
+  bool json = false;
   ProgramPaths programs;
 };
 int RunCommand(const RunArgs& args);
 
+// Each file is a trial or an experiment (one with `factors:` or `base:`); an experiment is
+// checked with every trial it expands to.
 struct ValidateArgs {
   std::vector<std::string> files;
   std::vector<std::string> sets;
+  bool json = false;
 };
 int ValidateCommand(const ValidateArgs& args);
 
@@ -50,6 +60,8 @@ int ComposeCommand(const ComposeArgs& args);
 struct ImagesArgs {
   ProgramPaths programs;
   bool faults = true;
+  bool quiet = false;
+  bool json = false;
 };
 int ImagesCommand(const ImagesArgs& args);
 
@@ -63,6 +75,7 @@ struct ExperimentArgs {
   int max_attempts = 3;
   std::string run_id;
   bool quiet = false;
+  bool json = false;
   ProgramPaths programs;
 };
 int ExperimentCommand(const ExperimentArgs& args);
@@ -74,6 +87,8 @@ int ReportCommand(const ReportArgs& args);
 
 struct GcArgs {
   std::string run_id;  // "" = every run not alive on this machine
+  bool dry_run = false;  // list what would be removed, remove nothing
+  bool json = false;
 };
 int GcCommand(const GcArgs& args);
 

@@ -1,21 +1,24 @@
-// swarmbox experiment EXPERIMENT.yaml [--out DIR] [--hosts SPEC ...] [--resume] [--filter P]
-//                                    [--set key=value ...]
+// swarmbox experiment EXPERIMENT.yaml [-o DIR] [--hosts SPEC ...] [--resume] [--filter P]
+//                                    [--set key=value ...] [-q] [--json]
 //
 // Loads and checks the experiment and every trial it expands to (exit 2 on bad input), connects
 // the hosts (ssh tunnels for ssh:// hosts), builds the images on each host that lacks them, then
 // runs the trials over every slot (experiment_runner.hpp) with a live board on stderr. Exit 0 when
 // every trial of the experiment has an outcome (result.json), 3 when some could not be run (no host
-// left, image builds failed: --resume runs them later), 1 when stopped with Ctrl-C, 2 bad input.
+// left, image builds failed: --resume runs them later), 130 / 143 when stopped with Ctrl-C /
+// SIGTERM (after the clean-up), 2 bad input. --json: the summary as one JSON object on stdout.
 #include <unistd.h>
 
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <thread>
 
 #include "commands.hpp"
 #include "interrupt.hpp"
+#include "json_out.hpp"
 #include "program_images.hpp"
 #include "run_lock.hpp"
 #include "swarmbox/experiment/experiment_runner.hpp"
@@ -27,6 +30,31 @@
 namespace swarmbox::cli {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+// The --json summary.
+void PrintJsonSummary(const std::string& name, const std::string& run_id, const std::string& out,
+                      std::size_t total, std::size_t committed,
+                      const std::map<std::string, int>& outcomes,
+                      const std::vector<std::string>& problems, int exit_code) {
+  yaml::Node o = yaml::Node::Mapping();
+  o.Set("experiment", json::Str(name));
+  o.Set("run_id", json::Str(run_id));
+  o.Set("out", json::Str(out));
+  o.Set("total", json::Int(static_cast<std::int64_t>(total)));
+  o.Set("committed", json::Int(static_cast<std::int64_t>(committed)));
+  yaml::Node by_outcome = yaml::Node::Mapping();
+  for (const auto& [outcome, n] : outcomes) by_outcome.Set(outcome, json::Int(n));
+  o.Set("outcomes", std::move(by_outcome));
+  o.Set("results_csv", json::Str(out + "/results.csv"));
+  o.Set("report_html", json::Str(out + "/report.html"));
+  o.Set("problems", json::Strs(problems));
+  o.Set("exit_code", json::Int(exit_code));
+  json::Print(o);
+}
+
+}  // namespace
 
 int ExperimentCommand(const ExperimentArgs& args) {
   auto spec = experiment::LoadExperiment(args.experiment);
@@ -68,6 +96,11 @@ int ExperimentCommand(const ExperimentArgs& args) {
   if (args.resume && experiment::TrialStore(out).Pending(plan->trials).empty()) {
     std::vector<std::string> problems;
     (void)experiment::WriteReports(out, &problems);
+    if (args.json) {
+      PrintJsonSummary(spec->name, run_id, out, plan->trials.size(), plan->trials.size(), {},
+                       problems, kExitOk);
+      return kExitOk;
+    }
     std::cout << out << ": " << plan->trials.size() << "/" << plan->trials.size()
               << " trials already have a result; " << out << "/results.csv, " << out
               << "/report.html\n";
@@ -140,8 +173,8 @@ int ExperimentCommand(const ExperimentArgs& args) {
     return kExitInfrastructure;
   }
   if (interrupted.load()) {
-    std::cerr << "swarmbox experiment: interrupted (Ctrl-C) before any trial started\n";
-    return kExitOutcome;
+    std::cerr << "swarmbox experiment: " << InterruptName() << " before any trial started\n";
+    return InterruptExitCode();
   }
 
   experiment::ExperimentOptions options;
@@ -161,6 +194,21 @@ int ExperimentCommand(const ExperimentArgs& args) {
     return summary.error().code() == ErrorCode::kInvalidArgument ? kExitUsage : kExitInfrastructure;
   }
   for (const std::string& p : summary->problems) std::cerr << "  note: " << p << "\n";
+  int code = kExitOk;
+  if (interrupted.load()) {
+    code = InterruptExitCode();
+  } else if (summary->committed < summary->total) {
+    std::cerr << "swarmbox experiment: " << (summary->total - summary->committed)
+              << " trials have no result: run again with --resume --out " << out << "\n";
+    code = kExitInfrastructure;
+  }
+  if (args.json) {
+    std::map<std::string, int> outcomes;
+    for (const auto& [outcome, n] : summary->outcomes) outcomes[outcome] = static_cast<int>(n);
+    PrintJsonSummary(spec->name, run_id, out, summary->total, summary->committed, outcomes,
+                     summary->problems, code);
+    return code;
+  }
   std::cout << out << ": " << summary->committed << "/" << summary->total << " trials";
   std::string sep = " (";
   for (const auto& [outcome, n] : summary->outcomes) {
@@ -169,13 +217,7 @@ int ExperimentCommand(const ExperimentArgs& args) {
   }
   std::cout << (summary->outcomes.empty() ? "" : ")") << "; " << out << "/results.csv, " << out
             << "/report.html\n";
-  if (interrupted.load()) return kExitOutcome;
-  if (summary->committed < summary->total) {
-    std::cerr << "swarmbox experiment: " << (summary->total - summary->committed)
-              << " trials have no result: run again with --resume --out " << out << "\n";
-    return kExitInfrastructure;
-  }
-  return kExitOk;
+  return code;
 }
 
 }  // namespace swarmbox::cli

@@ -1,4 +1,5 @@
-// swarmbox gc [--run ID]: remove what killed runs left behind, by label.
+// swarmbox gc [--run ID] [--dry-run] [--json]: remove what killed runs left behind, by label.
+// --dry-run lists the containers and networks it would remove and removes nothing.
 //
 // Without --run: every run id labelled on the engine's containers and networks, except the runs
 // still alive on this machine (run_lock.hpp: their swarmbox holds the run's lock), which are
@@ -8,8 +9,9 @@
 #include <set>
 
 #include "commands.hpp"
+#include "connect_engine.hpp"
+#include "json_out.hpp"
 #include "run_lock.hpp"
-#include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
 
 namespace swarmbox::cli {
@@ -50,17 +52,39 @@ GcPlan PlanGc(const std::set<std::string>& labelled_runs, const std::string& onl
   return plan;
 }
 
-int GcCommand(const GcArgs& args) {
-  docker::DockerClientOptions client_options;
-  client_options.socket_path = docker::DefaultSocketPath();
-  auto client = docker::DockerClient::Connect(client_options);
-  if (!client) {
-    std::cerr << "swarmbox gc: " << client.error().ToString() << "\n";
-    return kExitInfrastructure;
+namespace {
+
+// What a run has on the engine now, by name.
+struct RunLeftovers {
+  std::string run;
+  std::vector<std::string> containers;
+  std::vector<std::string> networks;
+};
+
+Result<RunLeftovers> ListRun(docker::DockerApi& api, const std::string& run) {
+  docker::LabelSelector selector;
+  selector.equals[std::string(docker::kLabelRun)] = run;
+  RunLeftovers left{run, {}, {}};
+  auto containers = api.ListContainers(selector, /*all=*/true);
+  if (!containers) return containers.error().Context("listing the containers of run " + run);
+  for (const docker::ContainerSummary& c : *containers) {
+    left.containers.push_back(c.names.empty() ? c.id : c.names.front());
   }
+  auto networks = api.ListNetworks(selector);
+  if (!networks) return networks.error().Context("listing the networks of run " + run);
+  for (const docker::NetworkInfo& n : *networks) left.networks.push_back(n.name);
+  return left;
+}
+
+}  // namespace
+
+int GcCommand(const GcArgs& args) {
+  EngineConnection engine = ConnectEngineOrPrintError("gc");
+  if (!engine.client) return engine.exit_code;
+  docker::DockerClient& client = *engine.client;
   std::set<std::string> runs;
   if (args.run_id.empty()) {
-    auto found = LabelledRuns(**client);
+    auto found = LabelledRuns(client);
     if (!found) {
       std::cerr << "swarmbox gc: " << found.error().ToString() << "\n";
       return kExitInfrastructure;
@@ -70,10 +94,22 @@ int GcCommand(const GcArgs& args) {
   const GcPlan plan = PlanGc(runs, args.run_id, IsRunLive);
   std::size_t containers = 0, networks = 0;
   std::vector<Error> failures;
+  std::vector<RunLeftovers> listed;
   for (const std::string& run : plan.remove) {
+    auto left = ListRun(client, run);
+    if (!left) {
+      std::cerr << "swarmbox gc: " << left.error().ToString() << "\n";
+      return kExitInfrastructure;
+    }
+    listed.push_back(*left);
+    if (args.dry_run) {
+      containers += left->containers.size();
+      networks += left->networks.size();
+      continue;
+    }
     docker::LabelSelector selector;
     selector.equals[std::string(docker::kLabelRun)] = run;
-    auto report = docker::RemoveLabelled(**client, selector, /*include_images=*/false);
+    auto report = docker::RemoveLabelled(client, selector, /*include_images=*/false);
     if (!report) {
       std::cerr << "swarmbox gc: " << report.error().ToString() << "\n";
       return kExitInfrastructure;
@@ -82,15 +118,50 @@ int GcCommand(const GcArgs& args) {
     networks += report->networks.size();
     failures.insert(failures.end(), report->failures.begin(), report->failures.end());
   }
-  std::cout << "removed " << containers << " containers and " << networks << " networks"
-            << (args.run_id.empty() ? "" : " of run " + args.run_id) << "\n";
+  for (const Error& e : failures) std::cerr << "  failed: " << e.ToString() << "\n";
+  const int code = failures.empty() ? kExitOk : kExitInfrastructure;
+  if (args.json) {
+    yaml::Node o = yaml::Node::Mapping();
+    o.Set("dry_run", json::Bool(args.dry_run));
+    yaml::Node list = yaml::Node::Sequence();
+    for (const RunLeftovers& r : listed) {
+      yaml::Node item = yaml::Node::Mapping();
+      item.Set("run", json::Str(r.run));
+      item.Set("containers", json::Strs(r.containers));
+      item.Set("networks", json::Strs(r.networks));
+      list.Append(std::move(item));
+    }
+    o.Set("runs", std::move(list));
+    o.Set(args.dry_run ? "would_remove_containers" : "removed_containers",
+          json::Int(static_cast<std::int64_t>(containers)));
+    o.Set(args.dry_run ? "would_remove_networks" : "removed_networks",
+          json::Int(static_cast<std::int64_t>(networks)));
+    o.Set("left_live", json::Strs(plan.skip_live));
+    std::vector<std::string> failed;
+    for (const Error& e : failures) failed.push_back(e.ToString());
+    o.Set("failures", json::Strs(failed));
+    o.Set("exit_code", json::Int(code));
+    json::Print(o);
+    return code;
+  }
+  const std::string of_run = args.run_id.empty() ? "" : " of run " + args.run_id;
+  if (args.dry_run) {
+    std::cout << "would remove " << containers << " containers and " << networks << " networks"
+              << of_run << " (dry run: nothing removed)\n";
+    for (const RunLeftovers& r : listed) {
+      for (const std::string& c : r.containers) std::cout << "  container " << c << "  run " << r.run << "\n";
+      for (const std::string& n : r.networks) std::cout << "  network " << n << "  run " << r.run << "\n";
+    }
+  } else {
+    std::cout << "removed " << containers << " containers and " << networks << " networks" << of_run
+              << "\n";
+  }
   for (const std::string& run : plan.skip_live) {
     std::cout << "left run " << run << ": it is still running here (its swarmbox holds "
               << RunLockDir() << "/" << run << ".lock; `swarmbox gc --run " << run
               << "` removes it anyway)\n";
   }
-  for (const Error& e : failures) std::cerr << "  failed: " << e.ToString() << "\n";
-  return failures.empty() ? kExitOk : kExitInfrastructure;
+  return code;
 }
 
 }  // namespace swarmbox::cli

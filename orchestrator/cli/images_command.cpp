@@ -1,9 +1,11 @@
-// swarmbox images: build (only what is missing) the registry-free images on the local engine.
+// swarmbox images [--no-faults] [-q] [--json]: build (only what is missing) the registry-free
+// images on the engine ($DOCKER_HOST).
 #include <iostream>
 
 #include "commands.hpp"
+#include "connect_engine.hpp"
+#include "json_out.hpp"
 #include "program_images.hpp"
-#include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/images/ensure_image.hpp"
 #include "swarmbox/images/standard_images.hpp"
 #include "swarmbox/runner/fault_image.hpp"
@@ -11,14 +13,12 @@
 namespace swarmbox::cli {
 
 int ImagesCommand(const ImagesArgs& args) {
-  docker::DockerClientOptions client_options;
-  client_options.socket_path = docker::DefaultSocketPath();
-  auto client = docker::DockerClient::Connect(client_options);
-  if (!client) {
-    std::cerr << "swarmbox images: " << client.error().ToString() << "\n";
-    return kExitInfrastructure;
-  }
-  auto progress = [](std::string_view line) { std::cerr << "  " << line << "\n"; };
+  EngineConnection engine = ConnectEngineOrPrintError("images");
+  if (!engine.client) return engine.exit_code;
+  docker::DockerClient& client = *engine.client;
+  auto progress = [&](std::string_view line) {
+    if (!args.quiet) std::cerr << "  " << line << "\n";
+  };
   struct Wanted {
     const char* what;
     Result<images::ImageSpec> spec;
@@ -37,24 +37,48 @@ int ImagesCommand(const ImagesArgs& args) {
                                        : Result<images::ImageSpec>(netemd.error())});
   }
   int failures = 0;
+  yaml::Node listed = yaml::Node::Sequence();  // --json
+  auto failed = [&](const char* what, const Error& e) {
+    std::cerr << what << ": " << e.ToString() << "\n";
+    ++failures;
+    yaml::Node item = yaml::Node::Mapping();
+    item.Set("image", json::Str(what));
+    item.Set("error", json::Str(e.ToString()));
+    listed.Append(std::move(item));
+  };
   // Remembers the tags, so the next `swarmbox run` does not pack the same programs again.
   const images::TagCache cache(images::DefaultTagCacheDir());
   for (Wanted& w : wanted) {
     if (!w.spec) {
-      std::cerr << w.what << ": " << w.spec.error().ToString() << "\n";
-      ++failures;
+      failed(w.what, w.spec.error());
       continue;
     }
-    auto r = images::EnsureImage(**client, *w.spec, progress, nullptr, &cache);
+    auto r = images::EnsureImage(client, *w.spec, progress, nullptr, &cache);
     if (!r) {
-      std::cerr << w.what << ": " << r.error().ToString() << "\n";
-      ++failures;
+      failed(w.what, r.error());
       continue;
     }
-    std::cout << r->tag << (r->built ? "  built" : "  present") << "  "
-              << r->image_size_bytes / (1024 * 1024) << " MiB\n";
+    if (args.json) {
+      yaml::Node item = yaml::Node::Mapping();
+      item.Set("image", json::Str(w.what));
+      item.Set("tag", json::Str(r->tag));
+      item.Set("built", json::Bool(r->built));
+      item.Set("size_bytes", json::Int(static_cast<std::int64_t>(r->image_size_bytes)));
+      listed.Append(std::move(item));
+    } else {
+      std::cout << r->tag << (r->built ? "  built" : "  present") << "  "
+                << r->image_size_bytes / (1024 * 1024) << " MiB\n";
+    }
   }
-  return failures == 0 ? kExitOk : kExitInfrastructure;
+  const int code = failures == 0 ? kExitOk : kExitInfrastructure;
+  if (args.json) {
+    yaml::Node o = yaml::Node::Mapping();
+    o.Set("engine", json::Str(client.transport().endpoint()));
+    o.Set("images", std::move(listed));
+    o.Set("exit_code", json::Int(code));
+    json::Print(o);
+  }
+  return code;
 }
 
 }  // namespace swarmbox::cli

@@ -2,7 +2,11 @@
 // subcommand lives in its own file.
 #include <CLI/CLI.hpp>
 
+#include <iostream>
+
 #include "commands.hpp"
+#include "json_out.hpp"
+#include "swarmbox/common/version.hpp"
 
 namespace {
 
@@ -20,39 +24,71 @@ void AddSetOption(CLI::App* cmd, std::vector<std::string>& sets, const std::stri
   cmd->add_option("--set", sets, help)->allow_extra_args(false);
 }
 
-// What `run` and `experiment` share after their own options: --run-id, --quiet and the programs.
-void AddLaunchOptions(CLI::App* cmd, std::string& run_id, bool& quiet, ProgramPaths& programs) {
+// -o,--out: the one spelling of "where the output goes" on every subcommand.
+void AddOutOption(CLI::App* cmd, std::string& out, const std::string& help) {
+  cmd->add_option("-o,--out", out, help);
+}
+
+// -q,--quiet: no progress on stderr (results and errors still print).
+void AddQuietFlag(CLI::App* cmd, bool& quiet) {
+  cmd->add_flag("-q,--quiet", quiet, "No progress on the terminal (errors still print)");
+}
+
+// --json: the summary as one JSON object on stdout; progress stays on stderr.
+void AddJsonFlag(CLI::App* cmd, bool& json) {
+  cmd->add_flag("--json", json, "Print the summary as one JSON object on stdout (progress on stderr)");
+}
+
+// What `run` and `experiment` share after their own options: --run-id, --quiet, --json and the
+// programs.
+void AddLaunchOptions(CLI::App* cmd, std::string& run_id, bool& quiet, bool& json,
+                      ProgramPaths& programs) {
   cmd->add_option("--run-id", run_id, "Run id (default: UTC time + random)");
-  cmd->add_flag("--quiet", quiet, "No progress on the terminal");
+  AddQuietFlag(cmd, quiet);
+  AddJsonFlag(cmd, json);
   AddProgramOptions(cmd, programs);
 }
+
+constexpr char kExitCodes[] =
+    "Exit codes: 0 success, 1 another trial outcome, 2 bad input or usage, 3 infrastructure error "
+    "(no Docker engine, image build failed), 130 run/experiment interrupted by Ctrl-C (SIGINT), "
+    "143 run/experiment stopped by SIGTERM (both after the clean-up: nothing labelled with the run "
+    "is left).\n"
+    "Engine: $DOCKER_HOST (unix://PATH, tcp://HOST:PORT with $DOCKER_TLS_VERIFY and "
+    "$DOCKER_CERT_PATH as the docker CLI reads them; default unix:///var/run/docker.sock).";
 
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace swarmbox::cli;
-  CLI::App app{"SwarmBox: a containerised SITL fleet for a search-and-rescue drone swarm.\n"
-               "Exit codes: 0 success, 1 another trial outcome, 2 bad input or usage, "
-               "3 infrastructure error.",
+  CLI::App app{"SwarmBox: a containerised SITL fleet for a search-and-rescue drone swarm.\n" +
+                   swarmbox::VersionLine("swarmbox"),
                "swarmbox"};
+  app.footer(kExitCodes);
+  app.set_version_flag("--version", swarmbox::VersionLine("swarmbox"),
+                       "Print the version, git commit and build type, and exit");
   app.require_subcommand(1);
 
   RunArgs run;
   auto* run_cmd = app.add_subcommand("run", "Run one trial and write <out>/<trial>-<run id>/");
   run_cmd->add_option("trial", run.trial, "Trial description (YAML)")->required();
-  run_cmd->add_option("--out", run.out, "Output folder (default: runs)");
+  AddOutOption(run_cmd, run.out, "Output folder (default: runs)");
   AddSetOption(run_cmd, run.sets, "Override a key of the trial: key.path=value");
-  AddLaunchOptions(run_cmd, run.run_id, run.quiet, run.programs);
+  AddLaunchOptions(run_cmd, run.run_id, run.quiet, run.json, run.programs);
 
   ValidateArgs validate;
-  auto* validate_cmd = app.add_subcommand("validate", "Check trial files (file:line:col: message)");
-  validate_cmd->add_option("files", validate.files, "Trial descriptions")->required();
-  AddSetOption(validate_cmd, validate.sets, "Override a key: key.path=value");
+  auto* validate_cmd = app.add_subcommand(
+      "validate", "Check trial and experiment files (file:line:col: message); an experiment with "
+                  "every trial it expands to");
+  validate_cmd->add_option("files", validate.files, "Trial or experiment descriptions")->required();
+  AddSetOption(validate_cmd, validate.sets, "Override a key (of every trial): key.path=value");
+  AddJsonFlag(validate_cmd, validate.json);
 
   ComposeArgs compose;
   auto* compose_cmd = app.add_subcommand("compose", "Export a trial as a docker-compose file");
   compose_cmd->add_option("trial", compose.trial, "Trial description (YAML)")->required();
-  compose_cmd->add_option("-o,--output", compose.output, "Write here (default: stdout)");
+  AddOutOption(compose_cmd, compose.output, "Write here (default: stdout)");
+  compose_cmd->add_option("--output", compose.output, "Old spelling of --out")->group("");
   AddSetOption(compose_cmd, compose.sets, "Override a key: key.path=value");
   compose_cmd->add_option("--physics-image", compose.physics_image, "Image tag (default: packed)");
   compose_cmd->add_option("--agent-image", compose.agent_image, "Image tag (default: packed)");
@@ -63,12 +99,14 @@ int main(int argc, char** argv) {
   auto* images_cmd = app.add_subcommand("images", "Build the registry-free images (only what is missing)");
   AddProgramOptions(images_cmd, images.programs);
   images_cmd->add_flag("--no-faults", no_faults, "Skip the fault-injection sidecar image");
+  AddQuietFlag(images_cmd, images.quiet);
+  AddJsonFlag(images_cmd, images.json);
 
   ExperimentArgs exp;
   auto* exp_cmd = app.add_subcommand(
       "experiment", "Run an experiment's trials over a pool of hosts into <out>/ (resumable)");
   exp_cmd->add_option("experiment", exp.experiment, "Experiment description (YAML)")->required();
-  exp_cmd->add_option("--out", exp.out, "Output folder (default: runs/<name>-<run id>)");
+  AddOutOption(exp_cmd, exp.out, "Output folder (default: runs/<name>-<run id>)");
   exp_cmd->add_option("--hosts", exp.hosts,
                       "Hosts: local[?slots=N], ssh://user@host[:port][?slots=N&socket=PATH&"
                       "identity=KEY&known_hosts=FILE] (default: the file's hosts, else local)")
@@ -82,7 +120,7 @@ int main(int argc, char** argv) {
   exp_cmd->add_option("--max-attempts", exp.max_attempts,
                       "Attempts per trial when hosts fail under it (default 3)")
       ->check(CLI::Range(1, 20));
-  AddLaunchOptions(exp_cmd, exp.run_id, exp.quiet, exp.programs);
+  AddLaunchOptions(exp_cmd, exp.run_id, exp.quiet, exp.json, exp.programs);
 
   ReportArgs report;
   auto* report_cmd =
@@ -91,7 +129,13 @@ int main(int argc, char** argv) {
 
   GcArgs gc;
   auto* gc_cmd = app.add_subcommand("gc", "Remove containers and networks left by killed runs");
-  gc_cmd->add_option("--run", gc.run_id, "Only this run id (default: every run)");
+  gc_cmd->add_option("--run", gc.run_id, "Only this run id (default: every run not alive here)");
+  gc_cmd->add_flag("--dry-run", gc.dry_run, "List what would be removed; remove nothing");
+  AddJsonFlag(gc_cmd, gc.json);
+
+  bool version_json = false;
+  auto* version_cmd = app.add_subcommand("version", "Print the version, git commit and build type");
+  AddJsonFlag(version_cmd, version_json);
 
   try {
     app.parse(argc, argv);
@@ -109,5 +153,18 @@ int main(int argc, char** argv) {
   if (*exp_cmd) return ExperimentCommand(exp);
   if (*report_cmd) return ReportCommand(report);
   if (*gc_cmd) return GcCommand(gc);
+  if (*version_cmd) {
+    if (!version_json) {
+      std::cout << swarmbox::VersionLine("swarmbox") << "\n";
+      return kExitOk;
+    }
+    const swarmbox::BuildInfo& b = swarmbox::Build();
+    swarmbox::yaml::Node o = swarmbox::yaml::Node::Mapping();
+    o.Set("version", json::Str(b.version));
+    o.Set("commit", json::Str(b.commit));
+    o.Set("build_type", json::Str(b.build_type));
+    json::Print(o);
+    return kExitOk;
+  }
   return kExitUsage;
 }

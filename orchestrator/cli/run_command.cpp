@@ -1,40 +1,58 @@
-// swarmbox run TRIAL.yaml [--out DIR] [--set key=value ...]
+// swarmbox run TRIAL.yaml [-o DIR] [--set key=value ...] [-q] [--json]
 #include <filesystem>
 #include <iostream>
 
 #include "commands.hpp"
+#include "connect_engine.hpp"
 #include "interrupt.hpp"
+#include "json_out.hpp"
 #include "load_trial.hpp"
 #include "program_images.hpp"
 #include "run_lock.hpp"
-#include "swarmbox/docker/docker_client.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
 
 namespace swarmbox::cli {
 
+namespace {
+
+// The --json summary of a finished trial.
+void PrintJsonSummary(const runner::RunOutcome& run, const std::string& run_id, int exit_code) {
+  const runner::TrialResult& r = run.result;
+  yaml::Node o = yaml::Node::Mapping();
+  o.Set("trial_dir", json::Str(run.trial_dir));
+  o.Set("run_id", json::Str(run_id));
+  o.Set("outcome", json::Str(dsl::OutcomeName(r.verdict.outcome)));
+  o.Set("reason", json::Str(r.verdict.reason));
+  o.Set("sim_s", json::Num(r.sim_s));
+  o.Set("wall_s", json::Num(r.wall_s));
+  o.Set("result_json", json::Str((std::filesystem::path(run.trial_dir) / "result.json").string()));
+  o.Set("problems", json::Strs(r.problems));
+  o.Set("exit_code", json::Int(exit_code));
+  json::Print(o);
+}
+
+}  // namespace
+
 int RunCommand(const RunArgs& args) {
   auto spec = LoadTrialOrPrintError(args.trial, args.sets);
   if (!spec) return kExitUsage;
-  docker::DockerClientOptions client_options;
-  client_options.socket_path = docker::DefaultSocketPath();
-  auto client = docker::DockerClient::Connect(client_options);
-  if (!client) {
-    std::cerr << "swarmbox run: " << client.error().ToString() << "\n";
-    return kExitInfrastructure;
-  }
+  EngineConnection engine = ConnectEngineOrPrintError("run");
+  if (!engine.client) return engine.exit_code;
+  docker::DockerClient& client = *engine.client;
   // Before the (possibly long) image step, so a Ctrl-C there is not lost: the run then ends at once.
   const std::atomic<bool>& interrupted = InstallInterruptHandlers();
-  auto images = EnsureTrialImages(**client, args.programs, [&](std::string_view line) {
+  auto images = EnsureTrialImages(client, args.programs, [&](std::string_view line) {
     if (!args.quiet) std::cerr << "  " << line << "\n";
   });
   if (!images) {
     std::cerr << "swarmbox run: " << images.error().ToString() << "\n";
     return kExitInfrastructure;
   }
-  if (interrupted.load()) {  // Ctrl-C during the image step: nothing of the trial exists yet
-    std::cerr << "swarmbox run: interrupted (Ctrl-C) before the trial started; nothing was created\n";
-    return kExitOutcome;
+  if (interrupted.load()) {  // a signal during the image step: nothing of the trial exists yet
+    std::cerr << "swarmbox run: " << InterruptName()
+              << " before the trial started; nothing was created\n";
+    return InterruptExitCode();
   }
   // Held until this process ends, however it ends: `swarmbox gc` leaves a live run alone.
   const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
@@ -50,18 +68,23 @@ int RunCommand(const RunArgs& args) {
   options.images = *images;
   options.interrupted = &interrupted;
   options.progress = args.quiet ? nullptr : &std::cerr;
-  auto run = runner::RunTrialSpec(*spec, **client, clock, options);
+  auto run = runner::RunTrialSpec(*spec, client, clock, options);
   if (!run) {
     std::cerr << "swarmbox run: " << run.error().ToString() << "\n";
-    return kExitInfrastructure;
+    return interrupted.load() ? InterruptExitCode() : kExitInfrastructure;
   }
   const runner::TrialResult& r = run->result;
-  std::cout << run->trial_dir << ": " << dsl::OutcomeName(r.verdict.outcome)
-            << (r.verdict.reason.empty() ? "" : " (" + r.verdict.reason + ")") << ", sim "
-            << r.sim_s << " s, wall " << r.wall_s << " s\n";
+  // The user stopped it (130 / 143): neither an infrastructure error nor the trial's own outcome.
+  const int code = interrupted.load() ? InterruptExitCode() : runner::ExitCodeFor(r.verdict);
   for (const std::string& p : r.problems) std::cerr << "  note: " << p << "\n";
-  if (interrupted.load()) return kExitOutcome;  // the user stopped it: not an infrastructure error
-  return runner::ExitCodeFor(r.verdict);
+  if (args.json) {
+    PrintJsonSummary(*run, run_id, code);
+  } else {
+    std::cout << run->trial_dir << ": " << dsl::OutcomeName(r.verdict.outcome)
+              << (r.verdict.reason.empty() ? "" : " (" + r.verdict.reason + ")") << ", sim "
+              << r.sim_s << " s, wall " << r.wall_s << " s\n";
+  }
+  return code;
 }
 
 }  // namespace swarmbox::cli

@@ -1,22 +1,127 @@
-// swarmbox validate FILE... [--set key=value ...]
+// swarmbox validate FILE... [--set key=value ...] [--json]
+//
+// Each FILE is a trial or an experiment (experiment_check.hpp tells them apart). An experiment is
+// checked as `swarmbox experiment` would load it, then every trial it expands to is loaded with
+// its overrides (and the --set ones after the experiment's `set:`); an error from an override is
+// reported at the experiment's line, one that is in the base trial at the base trial's line, each
+// once however many trials share it. Errors go to stderr as file:line:col: message (also into the
+// --json summary); exit 2 when any file is bad, after checking them all.
 #include <iostream>
+#include <map>
 
 #include "commands.hpp"
+#include "experiment_check.hpp"
+#include "json_out.hpp"
 #include "load_trial.hpp"
+#include "swarmbox/dsl/trial_loader.hpp"
 
 namespace swarmbox::cli {
 
+namespace {
+
+struct FileReport {
+  std::string file;
+  std::string kind;     // "trial" or "experiment"
+  std::string name;     // the trial's or experiment's name ("" when it did not load)
+  std::string summary;  // the "ok (...)" text
+  std::size_t trials = 0;  // experiment: trials checked
+  std::vector<std::string> errors;
+};
+
+FileReport ValidateTrial(const std::string& file, const std::vector<std::string>& sets) {
+  FileReport r{file, "trial", "", "", 1, {}};
+  auto spec = LoadTrialOrPrintError(file, sets);
+  if (!spec) {
+    r.errors.push_back(spec.error().ToString());
+    return r;
+  }
+  r.name = spec->name;
+  r.summary = "trial " + spec->name + ", " + std::to_string(spec->drones.size()) + " drones, " +
+              std::to_string(spec->end.size()) + " end conditions, timeout " +
+              spec->timeout.sim.ToString();
+  return r;
+}
+
+FileReport ValidateExperiment(const std::string& file, const yaml::Node& document,
+                              const std::vector<std::string>& sets) {
+  FileReport r{file, "experiment", "", "", 0, {}};
+  auto fail = [&](const Error& e) {
+    std::cerr << e.ToString() << "\n";
+    r.errors.push_back(e.ToString());
+  };
+  auto spec = experiment::LoadExperiment(file);
+  if (!spec) {
+    fail(spec.error());
+    return r;
+  }
+  r.name = spec->name;
+  spec->set.insert(spec->set.end(), sets.begin(), sets.end());
+  auto trials = experiment::ExpandTrials(*spec);
+  if (!trials) {
+    fail(trials.error());
+    return r;
+  }
+  // One line per distinct error (the first trial that has it named), with how many trials have it.
+  std::vector<std::pair<std::string, Error>> order;  // the error as LoadTrial gave it, located
+  std::map<std::string, int> count;
+  for (const experiment::PlannedTrial& t : *trials) {
+    dsl::LoadOptions load;
+    load.overrides = t.overrides;
+    auto trial = dsl::LoadTrial(spec->base_trial, load);
+    ++r.trials;
+    if (trial) continue;
+    const std::string key = trial.error().ToString();
+    if (count[key]++ == 0) order.emplace_back(key, LocateInExperiment(trial.error(), document, t));
+  }
+  for (const auto& [key, located] : order) {
+    const int others = count[key] - 1;
+    fail(others == 0 ? located
+                     : Error(located.code(),
+                             located.message() + " (and " + std::to_string(others) +
+                                 (others == 1 ? " more trial)" : " more trials)"),
+                             located.where()));
+  }
+  if (r.errors.empty()) {
+    r.summary = "experiment " + spec->name + ", " + std::to_string(trials->size()) + " trials of " +
+                spec->base_trial + ", " + std::to_string(spec->factors.size()) + " factors";
+  }
+  return r;
+}
+
+}  // namespace
+
 int ValidateCommand(const ValidateArgs& args) {
-  int bad = 0;
+  std::vector<FileReport> reports;
   for (const std::string& file : args.files) {
-    auto spec = LoadTrialOrPrintError(file, args.sets);
-    if (!spec) {
-      ++bad;
-      continue;
+    auto document = yaml::ParseFile(file);
+    if (document && LooksLikeExperiment(*document)) {
+      reports.push_back(ValidateExperiment(file, *document, args.sets));
+    } else {
+      reports.push_back(ValidateTrial(file, args.sets));  // reports an unreadable file too
     }
-    std::cout << file << ": ok (trial " << spec->name << ", " << spec->drones.size()
-              << " drones, " << spec->end.size() << " end conditions, timeout "
-              << spec->timeout.sim.ToString() << ")\n";
+  }
+  std::size_t bad = 0;
+  for (const FileReport& r : reports) bad += r.errors.empty() ? 0u : 1u;
+  if (args.json) {
+    yaml::Node o = yaml::Node::Mapping();
+    o.Set("ok", json::Bool(bad == 0));
+    yaml::Node files = yaml::Node::Sequence();
+    for (const FileReport& r : reports) {
+      yaml::Node f = yaml::Node::Mapping();
+      f.Set("file", json::Str(r.file));
+      f.Set("kind", json::Str(r.kind));
+      f.Set("name", json::Str(r.name));
+      f.Set("ok", json::Bool(r.errors.empty()));
+      if (r.kind == "experiment") f.Set("trials", json::Int(static_cast<std::int64_t>(r.trials)));
+      f.Set("errors", json::Strs(r.errors));
+      files.Append(std::move(f));
+    }
+    o.Set("files", std::move(files));
+    json::Print(o);
+  } else {
+    for (const FileReport& r : reports) {
+      if (r.errors.empty()) std::cout << r.file << ": ok (" << r.summary << ")\n";
+    }
   }
   return bad == 0 ? kExitOk : kExitUsage;
 }

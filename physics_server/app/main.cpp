@@ -17,6 +17,7 @@
 #include "server_options.hpp"
 #include "sim_server.hpp"
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/version.hpp"
 #include "swarmbox/physics/world.hpp"
 
 namespace {
@@ -41,6 +42,8 @@ int main(int argc, char** argv) {
   std::string drones_file;
   CLI::App app{"swarmbox-physics: ODE world, sensors and cameras of a SwarmBox trial, in lockstep with the agents "
                "over the sim bus"};
+  app.set_version_flag("--version", VersionLine("swarmbox-physics"),
+                       "Print the version, git commit and build type, and exit");
   app.add_option("--world", o.world_path, "World file (trials/worlds/*.yaml)")->required();
   app.add_option("--drone", drone_args, "A drone: name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]] (repeatable)");
   app.add_option("--drones", drones_file, "YAML list of drones {name, airframe, pose: [x,y,z], yaw_deg, payload, payload_attached}");

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "bench.hpp"
+#include "swarmbox/common/version.hpp"
 
 namespace swarmbox::bench {
 
@@ -41,7 +42,8 @@ namespace {
 void PrintUsage(std::FILE* out) {
   std::fprintf(out,
                "usage: swarmbox-bench SUITE [--quick] [--key=value ...]\n"
-               "       swarmbox-bench all [--quick]\n\n"
+               "       swarmbox-bench all [--quick]\n"
+               "       swarmbox-bench --version\n\n"
                "Each suite prints one logfmt line of figures per scenario.\nsuites:\n");
   for (const auto& s : swarmbox::bench::Suites()) {
     std::fprintf(out, "  %-12s %s\n", s.name.c_str(), s.description.c_str());
@@ -55,6 +57,10 @@ int main(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
     PrintUsage(argc < 2 ? stderr : stdout);
     return argc < 2 ? 2 : 0;
+  }
+  if (std::string(argv[1]) == "--version") {
+    std::printf("%s\n", swarmbox::VersionLine("swarmbox-bench").c_str());
+    return 0;
   }
   const std::string suite_name = argv[1];
   Args args;

@@ -72,7 +72,8 @@ std::string DefaultSocketPath() {
 }
 
 Result<std::unique_ptr<DockerClient>> DockerClient::Connect(const DockerClientOptions& options) {
-  return Connect(std::make_unique<UnixSocketTransport>(options.socket_path, options.connect_timeout),
+  EngineEndpoint engine = options.engine ? *options.engine : UnixEngine(options.socket_path);
+  return Connect(std::make_unique<CurlTransport>(std::move(engine), options.connect_timeout),
                  options.request_timeout);
 }
 

@@ -104,13 +104,12 @@ std::string HttpResponse::Header(std::string_view name) const {
   return it == headers.end() ? std::string() : it->second;
 }
 
-UnixSocketTransport::UnixSocketTransport(std::string socket_path,
-                                         std::chrono::milliseconds connect_timeout)
-    : socket_path_(std::move(socket_path)), connect_timeout_(connect_timeout) {
+CurlTransport::CurlTransport(EngineEndpoint engine, std::chrono::milliseconds connect_timeout)
+    : engine_(std::move(engine)), base_url_(engine_.BaseUrl()), connect_timeout_(connect_timeout) {
   GlobalInitOnce();
 }
 
-Result<HttpResponse> UnixSocketTransport::Send(const HttpRequest& request,
+Result<HttpResponse> CurlTransport::Send(const HttpRequest& request,
                                                const BodyChunkFn& on_chunk, CancelToken* cancel) {
   const std::string where = request.method + " " + request.target + " (" + endpoint() + ")";
   if (cancel != nullptr && cancel->cancelled()) {
@@ -128,7 +127,7 @@ Result<HttpResponse> UnixSocketTransport::Send(const HttpRequest& request,
     return Error(ErrorCode::kInternal, "libcurl could not allocate a handle", where);
   }
 
-  const std::string url = "http://docker" + request.target;
+  const std::string url = base_url_ + request.target;
   char error_buffer[CURL_ERROR_SIZE] = {0};
   curl_slist* headers = nullptr;
   // An empty Expect: stops libcurl from waiting a second for "100 Continue" on large bodies.
@@ -141,7 +140,19 @@ Result<HttpResponse> UnixSocketTransport::Send(const HttpRequest& request,
   }
 
   CURL* e = ex.easy;
-  curl_easy_setopt(e, CURLOPT_UNIX_SOCKET_PATH, socket_path_.c_str());
+  if (engine_.kind == EngineEndpoint::Kind::kUnix) {
+    curl_easy_setopt(e, CURLOPT_UNIX_SOCKET_PATH, engine_.socket_path.c_str());
+  } else if (engine_.tls) {
+    // As the docker CLI: the engine's certificate against ca.pem (or the system's CAs), the
+    // client's own certificate when there is one; DOCKER_TLS alone checks nothing.
+    if (!engine_.ca_file.empty()) curl_easy_setopt(e, CURLOPT_CAINFO, engine_.ca_file.c_str());
+    if (!engine_.cert_file.empty()) {
+      curl_easy_setopt(e, CURLOPT_SSLCERT, engine_.cert_file.c_str());
+      curl_easy_setopt(e, CURLOPT_SSLKEY, engine_.key_file.c_str());
+    }
+    curl_easy_setopt(e, CURLOPT_SSL_VERIFYPEER, engine_.tls_verify ? 1L : 0L);
+    curl_easy_setopt(e, CURLOPT_SSL_VERIFYHOST, engine_.tls_verify ? 2L : 0L);
+  }
   curl_easy_setopt(e, CURLOPT_URL, url.c_str());
   curl_easy_setopt(e, CURLOPT_HTTPHEADER, headers);
   curl_easy_setopt(e, CURLOPT_ERRORBUFFER, error_buffer);
@@ -228,7 +239,9 @@ Result<HttpResponse> UnixSocketTransport::Send(const HttpRequest& request,
   if (result != CURLE_OK) {
     std::string detail = error_buffer[0] != '\0' ? error_buffer : curl_easy_strerror(result);
     if (result == CURLE_COULDNT_CONNECT) {
-      detail = "no Docker engine answers at " + socket_path_ + " (" + detail + ")";
+      const std::string at =
+          engine_.kind == EngineEndpoint::Kind::kUnix ? engine_.socket_path : endpoint();
+      detail = "no Docker engine answers at " + at + " (" + detail + ")";
     }
     return Error(MapCurlCode(result), detail, where);
   }

@@ -7,6 +7,7 @@
 
 #include "nfqueue_delayer.hpp"
 #include "process_control.hpp"
+#include "swarmbox/common/version.hpp"
 #include "swarmbox/faults/netemd_args.hpp"
 
 namespace {
@@ -18,7 +19,8 @@ constexpr const char* kUsage =
     "                           [--seed S] [--queue-maxlen N] [--pidfile /run/x.pid] [--daemonize]\n"
     "                           [--ge-p F --ge-r F --ge-loss-bad F --ge-loss-good F] [--corrupt F]\n"
     "       swarmbox-netemd stop --pidfile /run/x.pid\n"
-    "       swarmbox-netemd sleep\n";
+    "       swarmbox-netemd sleep\n"
+    "       swarmbox-netemd --version\n";
 
 int Serve(const swarmbox::faults::NetemdArgs& args, const std::function<void()>& ready) {
   auto delayer = swarmbox::faults::NfqueueDelayer::Open(args);
@@ -50,6 +52,10 @@ int main(int argc, char** argv) {
   if (words.empty() || words[0] == "--help" || words[0] == "-h") {
     std::fputs(kUsage, words.empty() ? stderr : stdout);
     return words.empty() ? 2 : 0;
+  }
+  if (words[0] == "--version") {
+    std::printf("%s\n", swarmbox::VersionLine("swarmbox-netemd").c_str());
+    return 0;
   }
   const std::string command = words[0];
   words.erase(words.begin());

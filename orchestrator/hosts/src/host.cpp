@@ -156,7 +156,13 @@ Result<std::unique_ptr<Host>> ConnectHost(const HostSpec& spec, const std::strin
   host->spec_ = spec;
   docker::DockerClientOptions options;
   if (spec.kind == HostSpec::Kind::kLocal) {
-    options.socket_path = spec.socket.empty() ? docker::DefaultSocketPath() : spec.socket;
+    if (spec.socket.empty()) {  // $DOCKER_HOST (unix:// or tcp://), as the docker CLI reads it
+      auto engine = docker::EngineEndpointFromEnvironment();
+      if (!engine) return engine.error();
+      options.engine = *engine;
+    } else {
+      options.socket_path = spec.socket;
+    }
   } else {
     auto tunnel = SshTunnel::Open(spec, workdir, std::chrono::seconds(20));
     if (!tunnel) return tunnel.error();

@@ -2,12 +2,10 @@
 
 #include <cstdio>
 
-#include "swarmbox/common/logfmt.hpp"
 
 namespace swarmbox::runner {
 
 namespace {
-constexpr std::size_t kLastEvents = 3;
 
 std::string Seconds(double s) {
   char buf[32];
@@ -35,12 +33,7 @@ std::optional<dsl::Verdict> Monitor::End(dsl::Verdict v) {
 
 std::optional<dsl::Verdict> Monitor::OnLine(std::string_view component, std::string_view line) {
   if (ended_) return std::nullopt;
-  if (line.find("event=") != std::string_view::npos) {
-    if (auto ev = FindField(ParseLogfmt(line), "event")) {
-      last_events_.push_back(std::string(component) + " " + *ev);
-      if (last_events_.size() > kLastEvents) last_events_.pop_front();
-    }
-  }
+  progress_.OnLine(component, line);
   if (auto t = SimTimeOf(line)) {
     if (*t > any_sim_s_) any_sim_s_ = *t;
     if ((timeout_.clock_component.empty() || timeout_.clock_component == component) && *t > sim_s_) {
@@ -86,18 +79,7 @@ std::optional<dsl::Verdict> Monitor::OnTick(double wall_s) {
 }
 
 std::string Monitor::ProgressLine() const {
-  std::string s = "sim " + Seconds(sim_s()) + "/" + Seconds(timeout_.sim.seconds()) + "s  wall " +
-                  Seconds(wall_s_) + "s  live " + std::to_string(live_.size()) + "/" +
-                  std::to_string(components_);
-  if (!last_events_.empty()) {
-    s += "  last:";
-    bool first = true;
-    for (auto it = last_events_.rbegin(); it != last_events_.rend(); ++it) {
-      s += (first ? " " : ", ") + *it;
-      first = false;
-    }
-  }
-  return s;
+  return RenderProgress(progress_, {timeout_.sim.seconds(), wall_s_, live_.size(), components_});
 }
 
 }  // namespace swarmbox::runner

@@ -2,12 +2,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
 #include "commands.hpp"
+#include "experiment_check.hpp"
 #include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::cli {
@@ -61,6 +64,118 @@ TEST(ValidateCommand, OverridesAreCheckedToo) {
   Capture c;
   EXPECT_EQ(ValidateCommand({{kTrials + "/smoke.yaml"}, {"physics.rtf=-1"}}), kExitUsage);
   EXPECT_THAT(c.err(), HasSubstr("'rtf' must be >= 0"));
+}
+
+// Writes `text` to a temporary file and removes it when the test ends.
+class TempFile {
+ public:
+  TempFile(const std::string& name, const std::string& text)
+      : path_(fs::temp_directory_path() / ("swarmbox-cli-" + std::to_string(::getpid()) + "-" + name)) {
+    std::ofstream(path_) << text;
+  }
+  ~TempFile() { fs::remove(path_); }
+  std::string path() const { return path_.string(); }
+
+ private:
+  fs::path path_;
+};
+
+TEST(ValidateCommand, ExperimentsAreCheckedWithEveryTrialTheyExpandTo) {
+  Capture c;
+  ValidateArgs args{{kTrials + "/smoke.yaml", kTrials + "/experiments/hover_grid.yaml",
+                     kTrials + "/experiments/radio.yaml"},
+                    {}};
+  EXPECT_EQ(ValidateCommand(args), kExitOk) << c.err();
+  EXPECT_THAT(c.out(), HasSubstr("hover_grid.yaml: ok (experiment hover, 8 trials of "));
+  EXPECT_THAT(c.out(), HasSubstr("radio.yaml: ok (experiment radio, "));
+  EXPECT_EQ(c.err(), "");
+}
+
+TEST(ValidateCommand, ALevelErrorPointsAtTheExperimentsLine) {
+  // Level b of the factor sets a value the trial schema refuses, in 2 of the 4 trials.
+  const TempFile exp("bad-level.yaml",
+                     "name: bad\n"
+                     "base: " + kTrials + "/smoke.yaml\n"
+                     "set:\n"
+                     "  timeout.sim: 5s\n"
+                     "factors:\n"
+                     "  - name: rate\n"
+                     "    key: physics.rtf\n"
+                     "    levels: {a: 0, b: -1}\n"
+                     "repetitions: 2\n");
+  Capture c;
+  EXPECT_EQ(ValidateCommand({{exp.path()}, {}}), kExitUsage);
+  EXPECT_EQ(c.err(), exp.path() + ":8:23: 'rtf' must be >= 0 (0 = as fast as possible) (trial bad-b-r1, key physics.rtf) "
+                                  "(and 1 more trial)\n");
+  EXPECT_EQ(c.out(), "");
+}
+
+TEST(ValidateCommand, ASetErrorPointsAtTheSetEntryAndABaseErrorAtTheBaseTrial) {
+  // A base trial with a mistake of its own, in a trials/ folder that sees the shipped worlds and
+  // airframes.
+  const fs::path trials = fs::temp_directory_path() / ("swarmbox-cli-" + std::to_string(::getpid())) / "trials";
+  fs::create_directories(trials);
+  fs::create_symlink(kTrials + "/worlds", trials / "worlds");
+  fs::create_symlink(kTrials + "/airframes", trials / "airframes");
+  const std::string base = (trials / "base.yaml").string();
+  std::ofstream(base) << "name: base\nworld: worlds/open_field.yaml\n"
+                         "drones:\n  - {name: scout_1, airframe: x500, pose: [0, 0, 0]}\n"
+                         "timeout: {sim: 10s}\n"
+                         "wind: strong\n";
+  const TempFile exp("bad-set.yaml",
+                     "name: bad\n"
+                     "base: " + kTrials + "/smoke.yaml\n"
+                     "set: {timeout.sim: forever}\n"
+                     "factors:\n"
+                     "  - {name: rate, key: physics.rtf, levels: {a: 0, b: 1}}\n");
+  const TempFile on_bad_base("on-bad-base.yaml",
+                             "name: bad\nbase: " + base + "\n"
+                             "factors:\n  - {name: rate, key: physics.rtf, levels: {a: 0}}\n");
+  Capture c;
+  EXPECT_EQ(ValidateCommand({{exp.path(), on_bad_base.path()}, {}}), kExitUsage);
+  EXPECT_THAT(c.err(), HasSubstr(exp.path() + ":3:20: 'sim': expected a duration"));
+  EXPECT_THAT(c.err(), HasSubstr("(trial bad-a-r1, key timeout.sim) (and 1 more trial)"));
+  EXPECT_THAT(c.err(), HasSubstr(base + ":6:1: unknown key 'wind'"));
+  fs::remove_all(trials.parent_path());
+}
+
+TEST(ExperimentCheck, TellsExperimentsFromTrials) {
+  auto experiment = yaml::Parse("name: x\nbase: a.yaml\nfactors: []\n");
+  auto trial = yaml::Parse("name: x\nworld: w.yaml\ndrones: []\n");
+  ASSERT_TRUE(experiment && trial);
+  EXPECT_TRUE(LooksLikeExperiment(*experiment));
+  EXPECT_FALSE(LooksLikeExperiment(*trial));
+  EXPECT_FALSE(LooksLikeExperiment(yaml::Node::Scalar("x")));
+}
+
+TEST(ExperimentCheck, FindsTheOverrideKeyOfAnError) {
+  EXPECT_EQ(OverrideKeyOf(Error(ErrorCode::kInvalidArgument, "m", "--set physics.rtf:1:1")),
+            std::optional<std::string>("physics.rtf"));
+  EXPECT_EQ(OverrideKeyOf(Error(ErrorCode::kInvalidArgument, "m", "--set drones.x.pose=[1]")),
+            std::optional<std::string>("drones.x.pose"));
+  EXPECT_FALSE(OverrideKeyOf(Error(ErrorCode::kInvalidArgument, "m", "trials/smoke.yaml:3:1")).has_value());
+}
+
+TEST(ExperimentCheck, LocatesKeylessLevelsAndLaterFactorsFirst) {
+  auto doc = yaml::Parse(
+      "name: x\n"
+      "set: {physics.rtf: 0}\n"
+      "factors:\n"
+      "  - {name: f1, key: physics.rtf, levels: {a: 1, b: 2}}\n"
+      "  - name: f2\n"
+      "    levels:\n"
+      "      a: {physics.rtf: 3, seed: 4}\n"
+      "      b: {timeout.sim: 5s}\n",
+      "x.yaml");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  experiment::PlannedTrial ab;
+  ab.code = "ab";
+  experiment::PlannedTrial aa;
+  aa.code = "aa";
+  EXPECT_EQ(LocateOverride(*doc, ab, "physics.rtf").value_or(yaml::Mark{}).ToString(), "x.yaml:4:46");  // f1 level a
+  EXPECT_EQ(LocateOverride(*doc, aa, "physics.rtf").value_or(yaml::Mark{}).ToString(), "x.yaml:7:24");  // f2 wins
+  EXPECT_EQ(LocateOverride(*doc, ab, "timeout.sim").value_or(yaml::Mark{}).ToString(), "x.yaml:8:24");
+  EXPECT_FALSE(LocateOverride(*doc, ab, "drones").has_value());
 }
 
 TEST(ComposeCommand, WritesAComposeFileWithTheGivenImages) {

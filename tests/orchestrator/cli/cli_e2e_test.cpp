@@ -1,11 +1,11 @@
 // `swarmbox run` and `swarmbox gc` as a user runs them: the built `swarmbox` program as a child
 // process against the real Docker engine, running trials/smoke.yaml (the real physics server and
-// one real agent, packed from this build tree by swarmbox itself) at rtf 1 with its hover stretched
-// to 600 s and a long simulated timeout, so the trial is still running when the test interrupts or
-// kills swarmbox (as shipped, the smoke trial lands and succeeds within seconds).
+// one real agent, packed from this build tree by swarmbox itself) at rtf 1 with a long simulated
+// timeout, so the trial is still running when the test interrupts or kills swarmbox.
 //
-//   SIGINT  -> exit 1, result.json outcome "error" ("interrupted (Ctrl-C)"), every log collected,
+//   SIGINT  -> exit 130, result.json outcome "error" ("interrupted (Ctrl-C)"), every log collected,
 //              nothing labelled with the run id left (ARCHITECTURE.md "CLI", "Labels").
+//   SIGTERM -> the same clean-up, exit 143 (`--json`: the summary on stdout says so too).
 //   SIGKILL -> the containers and networks stay; `swarmbox gc --run ID` removes exactly that run's,
 //              `swarmbox gc` every dead run's, and leaves a live run's alone.
 //
@@ -88,12 +88,14 @@ class CliE2eTest : public ::testing::Test {
   std::string Out(const std::string& run_id) const { return (dir_ / (run_id + ".out")).string(); }
   std::string Err(const std::string& run_id) const { return (dir_ / (run_id + ".err")).string(); }
 
-  // `swarmbox run trials/smoke.yaml` paced at real time, hovering far from its end.
-  ChildProcess& StartRun(const std::string& run_id) {
-    const std::vector<std::string> argv = {
+  // `swarmbox run trials/smoke.yaml` paced at real time, far from its end (a plan that hovers
+  // for 10 minutes, whatever the smoke trial itself flies).
+  ChildProcess& StartRun(const std::string& run_id, std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv = {
         kSwarmbox, "run", kSmokeTrial, "--out", dir_.string(), "--run-id", run_id,
-        "--set", "physics.rtf=1", "--set", "mission.plan=takeoff:3,hover:600,land",
-        "--set", "timeout.sim=700s", "--set", "timeout.wall=20m"};
+        "--set", "physics.rtf=1", "--set", "timeout.sim=600s", "--set", "timeout.wall=20m",
+        "--set", "mission={kind: plan, plan: \"takeoff:2,hover:600,land\"}"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
     auto child = ChildProcess::Spawn(argv, Out(run_id), Err(run_id));
     EXPECT_TRUE(child) << child.error().ToString();
     if (!child) std::abort();
@@ -163,10 +165,10 @@ TEST_F(CliE2eTest, SigintEndsTheRunCleanlyWithItsLogs) {
   std::cout << "suite=cli_e2e scenario=sigint sigint_to_exit_s=" << exit_s << "\n";
   RecordProperty("sigint_to_exit_ms", static_cast<int>(exit_s * 1000));
 
-  // then swarmbox exits 1 ("another outcome"), having written the outcome the runner gives an
-  // interrupted trial,
+  // then swarmbox exits 130 (128 + SIGINT, as a shell reports Ctrl-C: not a trial's outcome),
+  // having written the outcome the runner gives an interrupted trial,
   const std::string err = ReadWholeFile(Err(id));
-  EXPECT_EQ(*code, 1) << err;
+  EXPECT_EQ(*code, 130) << err;
   const fs::path dir = TrialDir(id);
   EXPECT_THAT(ReadWholeFile(Out(id)), HasSubstr(dir.string() + ": error (interrupted (Ctrl-C))"));
   auto result = yaml::Parse(ReadWholeFile((dir / "result.json").string()), "result.json");
@@ -187,6 +189,39 @@ TEST_F(CliE2eTest, SigintEndsTheRunCleanlyWithItsLogs) {
   EXPECT_THAT(ReadWholeFile((dir / "events.jsonl").string()), HasSubstr("\"shutdown\""));
   EXPECT_TRUE(fs::exists(dir / "trial.yaml"));
   // and left nothing labelled with its run id.
+  const Leftovers left = Left(id);
+  EXPECT_EQ(left.containers, 0u);
+  EXPECT_EQ(left.networks, 0u);
+}
+
+TEST_F(CliE2eTest, SigtermEndsTheRunCleanlyWithExit143) {
+  const std::string id = NewRun();
+  ChildProcess& run = StartRun(id, {"--json", "-q"});
+  ASSERT_TRUE(WaitRunning(run, id));
+  ASSERT_EQ(Left(id).containers, 2u);
+
+  // When a script (or systemd, or `timeout`) sends SIGTERM,
+  ASSERT_TRUE(run.Signal(SIGTERM));
+  const std::optional<int> code = run.Wait(std::chrono::minutes(2));  // a hang guard
+  ASSERT_TRUE(code) << "swarmbox run still runs 2 minutes after SIGTERM:\n" << ReadWholeFile(Err(id));
+
+  // swarmbox tears the trial down as for Ctrl-C and exits 143 (128 + SIGTERM),
+  EXPECT_EQ(*code, 143) << ReadWholeFile(Err(id));
+  // its --json summary is the only thing on stdout and says the same,
+  auto summary = yaml::Parse(ReadWholeFile(Out(id)), "stdout");
+  ASSERT_TRUE(summary) << summary.error().ToString() << "\n" << ReadWholeFile(Out(id));
+  ASSERT_NE(summary->Find("exit_code"), nullptr);
+  EXPECT_EQ(summary->Find("exit_code")->scalar(), "143");
+  EXPECT_EQ(summary->Find("outcome")->scalar(), "error");
+  EXPECT_EQ(summary->Find("run_id")->scalar(), id);
+  const fs::path dir = TrialDir(id);
+  EXPECT_EQ(summary->Find("trial_dir")->scalar(), dir.string());
+  auto result = yaml::Parse(ReadWholeFile((dir / "result.json").string()), "result.json");
+  ASSERT_TRUE(result) << result.error().ToString();
+  EXPECT_EQ(result->Find("outcome")->scalar(), "error");
+  EXPECT_THAT(result->Find("reason")->scalar(), HasSubstr("interrupted"));
+  EXPECT_THAT(ReadWholeFile((dir / "logs" / "physics.log").string()), HasSubstr("event=stopped"));
+  // and nothing labelled with its run id is left.
   const Leftovers left = Left(id);
   EXPECT_EQ(left.containers, 0u);
   EXPECT_EQ(left.networks, 0u);

@@ -90,17 +90,18 @@ TEST(Monitor, Scenarios) {
   }
 }
 
-TEST(Monitor, ProgressLineShowsClocksLiveComponentsAndLastEvents) {
+TEST(Monitor, ProgressLineShowsClocksMissionStateAndLiveComponents) {
   auto trial = MakeTrial();
   auto m = Monitor::Create(*trial);
   ASSERT_TRUE(m);
   m->Started("physics");
   m->Started("scout_1");
-  (void)m->OnLine("physics", "t=12.34 node=physics event=tick");
-  (void)m->OnLine("scout_1", "t=12.5 node=scout_1 event=leader_elected term=1");
+  (void)m->OnLine("physics", "t=10.000 node=physics event=clock rtf=0.97 steps=2500 late=0 lost=0");
+  (void)m->OnLine("scout_1", "t=12.500 node=scout_1 event=leader_elected term=1 leader=scout_1");
+  (void)m->OnLine("scout_1", "t=12.500 node=scout_1 event=link peer=scout_2 sent=10 received=10 loss=0.0000");
   (void)m->OnTick(13.04);
-  EXPECT_EQ(m->ProgressLine(),
-            "sim 12.5/60.0s  wall 13.0s  live 2/2  last: scout_1 leader_elected, physics tick");
+  // The folded state (trial_progress.hpp), not the last events (mostly `link`).
+  EXPECT_EQ(m->ProgressLine(), "sim 12.5/60.0s  rtf 0.97  wall 13.0s  leader scout_1  live 2/2");
   (void)m->OnExit("scout_1", 0, true);
   EXPECT_EQ(m->live().size(), 1u);
   EXPECT_EQ(m->verdict()->reason, "scout_1 was killed for lack of memory");

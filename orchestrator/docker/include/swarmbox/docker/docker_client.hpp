@@ -16,19 +16,25 @@
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
 #include "swarmbox/docker/api_json.hpp"
 #include "swarmbox/docker/docker_api.hpp"
+#include "swarmbox/docker/engine_endpoint.hpp"
 #include "swarmbox/docker/http_transport.hpp"
 
 namespace swarmbox::docker {
 
-// $DOCKER_HOST when it is unix://PATH, else /var/run/docker.sock.
+// $DOCKER_HOST when it is unix://PATH, else /var/run/docker.sock. Only for callers that need a
+// socket path; the engine a user means is EngineEndpointFromEnvironment() (tcp:// too).
 std::string DefaultSocketPath();
 
 struct DockerClientOptions {
+  // The engine (engine_endpoint.hpp): set it from EngineEndpointFromEnvironment() to honour
+  // $DOCKER_HOST. Unset: the unix socket below.
+  std::optional<EngineEndpoint> engine;
   std::string socket_path = "/var/run/docker.sock";
   std::chrono::milliseconds connect_timeout{5000};
   // Limit for ordinary calls (not for streams, wait, build, exec start). Stop/restart add their
@@ -41,7 +47,7 @@ class DockerClient final : public DockerApi {
   static constexpr ApiVersion kMinApiVersion{1, 40};
   static constexpr ApiVersion kMaxApiVersion{1, 44};
 
-  // Connects over a unix socket and negotiates the API version.
+  // Connects to options.engine (else the unix socket) and negotiates the API version.
   static Result<std::unique_ptr<DockerClient>> Connect(const DockerClientOptions& options);
   // Same over any transport (recorded exchanges in tests).
   static Result<std::unique_ptr<DockerClient>> Connect(std::unique_ptr<HttpTransport> transport,

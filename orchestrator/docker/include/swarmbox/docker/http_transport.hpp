@@ -1,8 +1,10 @@
 // HttpTransport: one HTTP/1.1 exchange with a Docker engine, whole or streamed.
 //
 // The seam between DockerClient (which knows the Engine API) and the wire. The real one is
-// UnixSocketTransport: libcurl with CURLOPT_UNIX_SOCKET_PATH, any socket path (the local engine, or
-// an ssh-forwarded remote daemon's socket). Tests replace it with recorded exchanges.
+// CurlTransport: libcurl to an EngineEndpoint (engine_endpoint.hpp), a unix socket
+// (CURLOPT_UNIX_SOCKET_PATH: the local engine, or an ssh-forwarded remote daemon's socket) or TCP,
+// plain or TLS ($DOCKER_HOST=tcp://...). UnixSocketTransport is the unix-socket one by path.
+// Tests replace it with recorded exchanges.
 //
 //   UnixSocketTransport t("/var/run/docker.sock");
 //   HttpRequest req{.method = "GET", .target = "/_ping"};
@@ -29,6 +31,7 @@
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/docker/cancel_token.hpp"
+#include "swarmbox/docker/engine_endpoint.hpp"
 
 namespace swarmbox::docker {
 
@@ -68,21 +71,32 @@ class HttpTransport {
   virtual std::string endpoint() const = 0;
 };
 
-// libcurl over a unix socket. Large bodies are sent with an empty `Expect:` header (libcurl would
-// otherwise wait a second for "100 Continue"). Cancellation wakes the transfer immediately
+// libcurl to an engine: a unix socket, or TCP with TLS (CURLOPT_CAINFO / SSLCERT / SSLKEY from
+// the endpoint's files) or without. Large bodies are sent with an empty `Expect:` header (libcurl
+// would otherwise wait a second for "100 Continue"). Cancellation wakes the transfer immediately
 // (curl_multi_wakeup), not at the next progress tick.
-class UnixSocketTransport final : public HttpTransport {
+class CurlTransport : public HttpTransport {
  public:
-  explicit UnixSocketTransport(std::string socket_path,
-                               std::chrono::milliseconds connect_timeout = std::chrono::seconds(5));
+  explicit CurlTransport(EngineEndpoint engine,
+                         std::chrono::milliseconds connect_timeout = std::chrono::seconds(5));
   Result<HttpResponse> Send(const HttpRequest& request, const BodyChunkFn& on_chunk,
                             CancelToken* cancel) override;
-  std::string endpoint() const override { return "unix://" + socket_path_; }
-  const std::string& socket_path() const { return socket_path_; }
+  std::string endpoint() const override { return engine_.ToString(); }
+  const EngineEndpoint& engine() const { return engine_; }
 
  private:
-  std::string socket_path_;
+  EngineEndpoint engine_;
+  std::string base_url_;
   std::chrono::milliseconds connect_timeout_;
+};
+
+// CurlTransport on a unix socket.
+class UnixSocketTransport final : public CurlTransport {
+ public:
+  explicit UnixSocketTransport(std::string socket_path,
+                               std::chrono::milliseconds connect_timeout = std::chrono::seconds(5))
+      : CurlTransport(UnixEngine(std::move(socket_path)), connect_timeout) {}
+  const std::string& socket_path() const { return engine().socket_path; }
 };
 
 }  // namespace swarmbox::docker

@@ -19,7 +19,6 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <set>
 #include <string>
@@ -27,6 +26,7 @@
 
 #include "swarmbox/dsl/trial.hpp"
 #include "swarmbox/runner/end_matcher.hpp"
+#include "swarmbox/runner/trial_progress.hpp"
 
 namespace swarmbox::runner {
 
@@ -52,8 +52,11 @@ class Monitor {
   const std::string& ending_line() const { return ending_line_; }
   const std::set<std::string>& live() const { return live_; }
 
-  // One status line for the terminal:
-  // "sim 12.3/600s  wall 13.0s  live 5/5  last: scout_1 leader_elected, physics tick"
+  // What the log lines said so far (trial_progress.hpp).
+  const TrialProgress& progress() const { return progress_; }
+  // One status line for the terminal (RenderProgress):
+  // "sim 41.2/600.0s  rtf 0.98  wall 43.0s  stage SEARCH  leader scout_2  victims sighted 3
+  //  confirmed 2 rescued 1  live 5/5"
   std::string ProgressLine() const;
 
  private:
@@ -67,7 +70,7 @@ class Monitor {
   double any_sim_s_ = 0;  // any component's
   double wall_s_ = 0;
   std::set<std::string> live_;
-  std::deque<std::string> last_events_;  // "<component> <event>", newest last
+  TrialProgress progress_;
   std::optional<dsl::Verdict> ended_;
   std::optional<dsl::Verdict> timeout_pending_;  // simulated time ran out; draining the streams
   double timeout_seen_wall_s_ = 0;

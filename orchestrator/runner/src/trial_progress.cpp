@@ -1,0 +1,101 @@
+#include "swarmbox/runner/trial_progress.hpp"
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/runner/end_matcher.hpp"
+
+namespace swarmbox::runner {
+
+namespace {
+
+std::string Fixed(double v, int digits) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+std::optional<std::int64_t> IntField(const LogfmtFields& fields, std::string_view key) {
+  auto v = FindField(fields, key);
+  if (!v) return std::nullopt;
+  std::int64_t out = 0;
+  try {
+    std::size_t used = 0;
+    out = std::stoll(std::string(*v), &used);
+    if (used != v->size()) return std::nullopt;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return out;
+}
+
+std::optional<double> DoubleField(const LogfmtFields& fields, std::string_view key) {
+  auto v = FindField(fields, key);
+  if (!v) return std::nullopt;
+  try {
+    std::size_t used = 0;
+    const double out = std::stod(std::string(*v), &used);
+    if (used != v->size()) return std::nullopt;
+    return out;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+void TrialProgress::OnLine(std::string_view component, std::string_view line) {
+  (void)component;
+  if (line.find("event=") == std::string_view::npos) {
+    if (auto t = SimTimeOf(line); t && *t > sim_s) sim_s = *t;
+    return;
+  }
+  const LogfmtFields fields = ParseLogfmt(line);
+  if (auto t = DoubleField(fields, "t"); t && *t > sim_s) sim_s = *t;
+  const auto event = FindField(fields, "event");
+  if (!event) return;
+  if (*event == "clock") {
+    if (auto r = DoubleField(fields, "rtf")) rtf = *r;
+  } else if (*event == "leader_elected") {
+    const auto term = IntField(fields, "term");
+    const auto elected = FindField(fields, "leader");
+    if (term && elected && *term > leader_term) {
+      leader_term = *term;
+      leader = *elected;
+    }
+  } else if (*event == "mission_state") {
+    const auto index = IntField(fields, "index");
+    const auto state = FindField(fields, "state");
+    if (index && state && *index > stage_index && stage != "COMPLETE") {
+      stage_index = *index;
+      stage = std::string(*state);
+    }
+  } else if (*event == "mission_complete") {
+    stage = "COMPLETE";
+  } else if (*event == "sighting_reported") {
+    if (!FindField(fields, "retry")) ++sightings;
+  } else if (*event == "victim_confirmed") {
+    if (auto id = IntField(fields, "id")) confirmed.insert(*id);
+  } else if (*event == "victim_status") {
+    const auto id = IntField(fields, "id");
+    const auto status = FindField(fields, "status");
+    if (id && status && *status == "rescued") rescued.insert(*id);
+  }
+}
+
+std::string RenderProgress(const TrialProgress& p, const ProgressFrame& frame) {
+  std::string s = "sim " + Fixed(p.sim_s, 1) + "/" + Fixed(frame.timeout_sim_s, 1) + "s";
+  if (p.rtf) s += "  rtf " + Fixed(*p.rtf, 2);
+  s += "  wall " + Fixed(frame.wall_s, 1) + "s";
+  if (!p.stage.empty()) s += "  stage " + p.stage;
+  if (!p.leader.empty()) s += "  leader " + p.leader;
+  if (p.sightings > 0 || !p.confirmed.empty() || !p.rescued.empty()) {
+    s += "  victims sighted " + std::to_string(p.sightings) + " confirmed " +
+         std::to_string(p.confirmed.size()) + " rescued " + std::to_string(p.rescued.size());
+  }
+  s += "  live " + std::to_string(frame.live) + "/" + std::to_string(frame.components);
+  return s;
+}
+
+}  // namespace swarmbox::runner
