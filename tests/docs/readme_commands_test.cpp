@@ -79,6 +79,7 @@ std::vector<Rule> Rules() {
        .why = "a plain gc removes every dead run's leftovers on the engine, other tests' and users' "
               "included; here it removes only a run of its own (none)",
        .timeout = 60s},
+      {.line = cli + " --version", .timeout = 30s, .stdout_has = "swarmbox "},
       {.line = "bash scripts/setup.sh", .excluded = "installs Debian packages as root; this test runs after it"},
       {.line = "cmake -S . -B build -G Ninja && cmake --build build -j$(nproc)",
        .excluded = "builds the project: this test is part of that build"},
