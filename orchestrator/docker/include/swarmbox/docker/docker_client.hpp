@@ -34,7 +34,7 @@ std::string DefaultSocketPath();
 struct DockerClientOptions {
   // The engine (engine_endpoint.hpp): set it from EngineEndpointFromEnvironment() to honour
   // $DOCKER_HOST. Unset: the unix socket below.
-  std::optional<EngineEndpoint> engine;
+  std::optional<EngineEndpoint> engine = {};  // (initialised: designated initialisers may leave it out)
   std::string socket_path = "/var/run/docker.sock";
   std::chrono::milliseconds connect_timeout{5000};
   // Limit for ordinary calls (not for streams, wait, build, exec start). Stop/restart add their
