@@ -74,6 +74,7 @@ std::vector<Rule> Rules() {
                    "with --set physics.rtf=0 and checks the failover and the rescue"},
       {.line = cli + " validate trials/*.yaml trials/faults/*.yaml trials/experiments/*.yaml", .timeout = 60s},
       {.line = cli + " compose trials/sar_search.yaml", .timeout = 60s, .stdout_has = "services:"},
+      {.line = cli + " gc --dry-run", .timeout = 60s},  // removes nothing: says what gc would remove
       {.line = cli + " gc",
        .append = {"--run", "readme-commands-none"},
        .why = "a plain gc removes every dead run's leftovers on the engine, other tests' and users' "
