@@ -46,7 +46,7 @@ int Redirect(int fd, const char* path, int flags) {
 // The forked child: its own process group, killed with the spawning thread, default signal
 // handling, the redirections, then exec. On failure it writes errno to `report_fd` and exits 127.
 [[noreturn]] void ExecChild(char* const* argv, const char* out, const char* err, bool err_to_out,
-                            pid_t parent, int report_fd) {
+                            const char* dir, pid_t parent, int report_fd) {
   ::setpgid(0, 0);
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != parent) ::_exit(126);  // the parent died before prctl took effect
@@ -63,6 +63,7 @@ int Redirect(int fd, const char* path, int flags) {
   if (e == 0 && out != nullptr) e = Redirect(STDOUT_FILENO, out, O_WRONLY | O_CREAT | O_TRUNC);
   if (e == 0 && err_to_out && ::dup2(STDOUT_FILENO, STDERR_FILENO) < 0) e = errno;
   if (e == 0 && !err_to_out && err != nullptr) e = Redirect(STDERR_FILENO, err, O_WRONLY | O_CREAT | O_TRUNC);
+  if (e == 0 && dir != nullptr && ::chdir(dir) != 0) e = errno;
   if (e == 0) {
     ::execv(argv[0], argv);
     e = errno;
@@ -84,6 +85,7 @@ Result<ChildProcess> ChildProcess::Spawn(const std::vector<std::string>& argv, c
   const char* out = options.stdout_path.empty() ? nullptr : options.stdout_path.c_str();
   const char* err = options.stderr_path.empty() ? nullptr : options.stderr_path.c_str();
   const bool err_to_out = out != nullptr && err != nullptr && options.stdout_path == options.stderr_path;
+  const char* dir = options.working_dir.empty() ? nullptr : options.working_dir.c_str();
 
   // The exec failure channel: closed on a successful exec (O_CLOEXEC), errno written otherwise.
   int report[2];
@@ -100,7 +102,7 @@ Result<ChildProcess> ChildProcess::Spawn(const std::vector<std::string>& argv, c
   }
   if (pid == 0) {
     ::close(report[0]);
-    ExecChild(args.data(), out, err, err_to_out, parent, report[1]);
+    ExecChild(args.data(), out, err, err_to_out, dir, parent, report[1]);
   }
   ::close(report[1]);
   ::setpgid(pid, pid);  // the child does it too: whichever comes first (a kill of the group works at once)

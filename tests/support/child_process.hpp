@@ -33,6 +33,9 @@ struct SpawnOptions {
   // process's own stream. The same path for both: one file with both streams (2>&1).
   std::string stdout_path;
   std::string stderr_path;
+  // The child's working directory (the redirections above are opened first, relative to this
+  // process's). Empty: this process's own.
+  std::string working_dir = {};  // (initialised: designated initialisers may leave it out)
 };
 
 class ChildProcess {

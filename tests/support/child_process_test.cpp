@@ -47,6 +47,20 @@ TEST_F(ChildProcessTest, ArgumentsAreNotInterpretedByAShell) {
   EXPECT_EQ(done->out, "$HOME; `id` a  b\n");
 }
 
+TEST_F(ChildProcessTest, RunsInTheGivenWorkingDirectory) {
+  fs::create_directories(dir_ / "work");
+  SpawnOptions options;
+  options.stdout_path = (dir_ / "out.txt").string();  // opened before the child changes directory
+  options.working_dir = (dir_ / "work").string();
+  auto child = ChildProcess::Spawn({"/bin/pwd", "-P"}, options);
+  ASSERT_TRUE(child) << child.error().ToString();
+  EXPECT_EQ(child->Wait(10s), std::optional<int>(0));
+  EXPECT_EQ(ReadWholeFile((dir_ / "out.txt").string()), fs::canonical(dir_ / "work").string() + "\n");
+
+  options.working_dir = (dir_ / "missing").string();  // a directory that is not there: the spawn fails
+  EXPECT_FALSE(ChildProcess::Spawn({"/bin/pwd"}, options));
+}
+
 TEST_F(ChildProcessTest, ASignalEndsItWith128PlusTheSignal) {
   auto child = ChildProcess::Spawn({"/bin/sleep", "30"}, "", "");
   ASSERT_TRUE(child) << child.error().ToString();
