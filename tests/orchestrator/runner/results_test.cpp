@@ -34,6 +34,24 @@ TEST(ResultJson, HoldsTheContractFields) {
   EXPECT_EQ(doc->Find("problems")->items().size(), 1u);
 }
 
+TEST(ResultJson, ListsTheContainersKilledForLackOfMemory) {
+  TrialResult r;
+  r.verdict = dsl::Verdict::Failure("scout_2 was killed for lack of memory", "scout_2");
+  r.components = {{"physics", 0, false, "logs/physics.log", 10},
+                  {"scout_2", 137, true, "logs/scout_2.log", 3}};
+  auto doc = yaml::Parse(ResultJson(r), "result.json");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  const yaml::Node* oom = doc->Find("oom_killed");
+  ASSERT_NE(oom, nullptr);
+  ASSERT_EQ(oom->items().size(), 1u);
+  EXPECT_EQ(oom->items()[0].scalar(), "scout_2");
+  EXPECT_EQ(doc->Find("components")->items()[1].Find("oom_killed")->scalar(), "true");
+  r.components[1].oom_killed = false;
+  doc = yaml::Parse(ResultJson(r), "result.json");
+  ASSERT_TRUE(doc);
+  EXPECT_TRUE(doc->Find("oom_killed")->items().empty());  // always there, empty when none
+}
+
 TEST(Metrics, CountsEventsFromTheLogs) {
   Metrics m;
   m.OnEvent("scout_1", ParseLogfmt("t=1 node=scout_1 event=leader_elected term=1"));
