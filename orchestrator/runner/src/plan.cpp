@@ -114,6 +114,8 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   };
   // The radio link measurement (event=link per peer).
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
+  // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
+  argv.insert(argv.end(), {"--raft-dir", std::string(kAgentStateDir) + "/raft"});
   if (spec.mission.kind == dsl::MissionKind::kPlan) {
     argv.insert(argv.end(), {"--mission", "plan", "--plan", spec.mission.plan});
   } else {

@@ -179,8 +179,8 @@ TEST(LoadTrial, BadLimitsPointAtTheirKey) {
       {"limits: {memory_mib: 300", "limits: {memory_mib: 5", "limited.yaml:4:22",
        "'memory_mib' must be >= 6 [MiB] (Docker's minimum)"},
       {"pids: 128}", "pids: 8}", "limited.yaml:4:33", "'pids' must be >= 16"},
-      {"pids: 128}", "pids: 128, cpus: 2}", "limited.yaml:4:44", "unknown key 'cpus' in limits"},
-      {"limits: {memory_mib: 16}", "limits: {memory_mib: lots}", "limited.yaml:7:59",
+      {"pids: 128}", "pids: 128, cpus: 2}", "limited.yaml:4:38", "unknown key 'cpus' in limits"},
+      {"limits: {memory_mib: 16}", "limits: {memory_mib: lots}", "limited.yaml:7:58",
        "'memory_mib': expected an integer"},
       {"limits: {pids: 64}", "limits: {pids: 0}", "limited.yaml:3:34", "'pids' must be >= 16"},
   };

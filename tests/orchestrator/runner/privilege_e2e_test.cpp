@@ -174,7 +174,9 @@ TEST_F(PrivilegeE2e, ADroneOverItsMemoryLimitIsReportedAsOomKilled) {
   ASSERT_EQ(oom->items().size(), 1u);
   EXPECT_EQ(oom->items()[0].scalar(), "scout_1");
   for (const yaml::Node& c : doc->Find("components")->items()) {
-    if (c.Find("name")->scalar() == "scout_1") EXPECT_EQ(c.Find("exit_code")->scalar(), "137");
+    if (c.Find("name")->scalar() == "scout_1") {
+      EXPECT_EQ(c.Find("exit_code")->scalar(), "137");
+    }
   }
   fs::remove_all(out);
 }
