@@ -33,8 +33,9 @@ using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::IsEmpty;
 
-// An agent peaks at 10-11 MiB (9-10 MiB anonymous) on sar_search; Docker's minimum, 6 MiB, lets
-// its container start (measured: `--help` exits normally in it) but not its DDS and flight loop.
+// A SAR agent peaks at 10-11 MiB (9-10 MiB anonymous) on sar_search; Docker's minimum, 6 MiB, lets
+// its container start (measured: a bad-flag run exits 2 normally in it) but not the SAR mission
+// (a plan flight does fit: measured, the trial succeeded).
 constexpr int kOomDroneMemoryMib = 6;
 
 class PrivilegeE2e : public ::testing::Test {
@@ -158,6 +159,8 @@ TEST_F(PrivilegeE2e, AgentsPhysicsAndSidecarsRunWithLeastPrivilegeAndTheTrialSuc
 
 TEST_F(PrivilegeE2e, ADroneOverItsMemoryLimitIsReportedAsOomKilled) {
   dsl::TrialSpec spec = Flight("oom-e2e");
+  // The SAR mission (its agents hold 9-10 MiB anonymous memory; a plan flight lives in 6 MiB).
+  spec.mission = dsl::MissionSpec{};
   spec.drones[0].limits = {kOomDroneMemoryMib, 0};  // scout_1 cannot live in this
   const fs::path out = fs::temp_directory_path() / "swarmbox-oom-e2e";
   fs::remove_all(out);
