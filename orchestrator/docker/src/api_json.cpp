@@ -1,5 +1,6 @@
 #include "swarmbox/docker/api_json.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <ctime>
@@ -268,9 +269,10 @@ std::string CreateContainerBody(const ContainerSpec& spec, bool all_networks) {
       if (m.type != Mount::Type::kTmpfs) mount.Set("Source", Str(m.source));
       mount.Set("Target", Str(m.target));
       mount.Set("ReadOnly", Bool(m.read_only));
-      if (m.type == Mount::Type::kTmpfs && m.tmpfs_size_bytes > 0) {
+      if (m.type == Mount::Type::kTmpfs && (m.tmpfs_size_bytes > 0 || m.tmpfs_mode > 0)) {
         Node tmpfs = Node::Mapping();
-        tmpfs.Set("SizeBytes", Int(m.tmpfs_size_bytes));
+        if (m.tmpfs_size_bytes > 0) tmpfs.Set("SizeBytes", Int(m.tmpfs_size_bytes));
+        if (m.tmpfs_mode > 0) tmpfs.Set("Mode", Int(m.tmpfs_mode));
         mount.Set("TmpfsOptions", std::move(tmpfs));
       }
       mounts.Append(std::move(mount));
@@ -282,7 +284,12 @@ std::string CreateContainerBody(const ContainerSpec& spec, bool all_networks) {
   if (!network_mode.empty()) host.Set("NetworkMode", Str(network_mode));
   if (!spec.cap_add.empty()) host.Set("CapAdd", StrList(spec.cap_add));
   if (!spec.cap_drop.empty()) host.Set("CapDrop", StrList(spec.cap_drop));
-  if (spec.resources.memory_bytes > 0) host.Set("Memory", Int(spec.resources.memory_bytes));
+  if (!spec.security_opt.empty()) host.Set("SecurityOpt", StrList(spec.security_opt));
+  if (spec.resources.memory_bytes > 0) {
+    host.Set("Memory", Int(spec.resources.memory_bytes));
+    // A hard limit: no swap on top of it (Docker's default allows as much swap again).
+    host.Set("MemorySwap", Int(spec.resources.memory_bytes));
+  }
   if (spec.resources.nano_cpus > 0) host.Set("NanoCpus", Int(spec.resources.nano_cpus));
   if (spec.resources.pids_limit > 0) host.Set("PidsLimit", Int(spec.resources.pids_limit));
   if (!spec.resources.cpuset_cpus.empty()) host.Set("CpusetCpus", Str(spec.resources.cpuset_cpus));
@@ -435,6 +442,33 @@ Result<ContainerInfo> ParseContainerInspect(std::string_view body) {
   if (const Node* config = Child(*doc, "Config")) {
     info.labels = GetStrMap(*config, "Labels");
     info.tty = GetBool(*config, "Tty");
+  }
+  if (const Node* host = Child(*doc, "HostConfig")) {
+    ContainerHostConfig& hc = info.host_config;
+    hc.cap_add = GetStrList(*host, "CapAdd");
+    hc.cap_drop = GetStrList(*host, "CapDrop");
+    hc.security_opt = GetStrList(*host, "SecurityOpt");
+    hc.read_only_rootfs = GetBool(*host, "ReadonlyRootfs");
+    hc.memory_bytes = GetInt(*host, "Memory");
+    hc.pids_limit = std::max<std::int64_t>(0, GetInt(*host, "PidsLimit"));
+    hc.network_mode = GetStr(*host, "NetworkMode");
+    if (const Node* mounts = Child(*host, "Mounts"); mounts != nullptr && mounts->is_sequence()) {
+      for (const Node& m : mounts->items()) {
+        Mount mount;
+        const std::string type = GetStr(m, "Type");
+        mount.type = type == "volume"  ? Mount::Type::kVolume
+                     : type == "tmpfs" ? Mount::Type::kTmpfs
+                                       : Mount::Type::kBind;
+        mount.source = GetStr(m, "Source");
+        mount.target = GetStr(m, "Target");
+        mount.read_only = GetBool(m, "ReadOnly");
+        if (const Node* tmpfs = Child(m, "TmpfsOptions")) {
+          mount.tmpfs_size_bytes = GetInt(*tmpfs, "SizeBytes");
+          mount.tmpfs_mode = static_cast<int>(GetInt(*tmpfs, "Mode"));
+        }
+        hc.mounts.push_back(std::move(mount));
+      }
+    }
   }
   if (const Node* settings = Child(*doc, "NetworkSettings")) {
     if (const Node* networks = Child(*settings, "Networks"); networks != nullptr &&

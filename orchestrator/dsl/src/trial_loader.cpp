@@ -123,6 +123,21 @@ Status DecodeRaft(const Node& node, RaftSpec* out) {
   return Ok{};
 }
 
+// `limits: {memory_mib, pids}` (the trial's, a drone's or physics'); a key left out keeps *out's
+// value (the default, or 0 = the trial's in an override).
+Status DecodeLimits(const Node& node, ContainerLimits* out) {
+  yaml::MapReader r(node, "limits");
+  r.Optional("memory_mib", &out->memory_mib).Optional("pids", &out->pids);
+  SWARMBOX_TRY(r.Finish());
+  if (const Node* m = node.Find("memory_mib"); m != nullptr && out->memory_mib < 6) {
+    return At(*m, "'memory_mib' must be >= 6 [MiB] (Docker's minimum)");
+  }
+  if (const Node* p = node.Find("pids"); p != nullptr && out->pids < 16) {
+    return At(*p, "'pids' must be >= 16 (it counts threads: DDS alone starts several)");
+  }
+  return Ok{};
+}
+
 bool DefaultFileExists(const std::string& path) {
   std::error_code ec;
   return std::filesystem::is_regular_file(path, ec);
@@ -158,7 +173,9 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   const Node* faults = r.Child("faults");
   const Node* end = r.Child("end");
   const Node* timeout = r.Child("timeout", /*required=*/true);
+  const Node* limits = r.Child("limits");
   SWARMBOX_TRY(r.Finish());
+  if (limits != nullptr && !limits->is_null()) SWARMBOX_TRY(DecodeLimits(*limits, &spec.limits));
 
   if (!IsTrialName(spec.name)) {
     return At(*doc.Find("name"),
@@ -177,7 +194,11 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   if (physics != nullptr) {
     yaml::MapReader p(*physics, "physics");
     p.Optional("rtf", &spec.rtf);
+    const Node* physics_limits = p.Child("limits");
     SWARMBOX_TRY(p.Finish());
+    if (physics_limits != nullptr && !physics_limits->is_null()) {
+      SWARMBOX_TRY(DecodeLimits(*physics_limits, &spec.physics_limits));
+    }
     if (spec.rtf < 0) return At(*physics->Find("rtf"), "'rtf' must be >= 0 (0 = as fast as possible)");
   }
 
@@ -195,7 +216,11 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
         .Required("airframe", &d.airframe)
         .Optional("pose", &d.pose)
         .Optional("payload", &d.payload);
+    const Node* drone_limits = dr.Child("limits");
     SWARMBOX_TRY(dr.Finish());
+    if (drone_limits != nullptr && !drone_limits->is_null()) {
+      SWARMBOX_TRY(DecodeLimits(*drone_limits, &d.limits));
+    }
     if (!IsDroneName(d.name) || d.name == kPhysics || d.name == kRaftLeader) {
       return At(*item.Find("name"), "drone name '" + d.name +
                                         "' must be 1-32 characters of a-z, 0-9, '_', starting "

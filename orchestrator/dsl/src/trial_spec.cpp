@@ -38,7 +38,7 @@ TrialSpec& TrialSpec::Rtf(double value) {
 }
 TrialSpec& TrialSpec::Drone(std::string drone_name, std::string airframe,
                             std::array<double, 3> pose, std::string payload) {
-  drones.push_back({std::move(drone_name), std::move(airframe), pose, std::move(payload), {}});
+  drones.push_back({std::move(drone_name), std::move(airframe), pose, std::move(payload), {}, {}});
   return *this;
 }
 TrialSpec& TrialSpec::Mesh(std::string_view flow_yaml) {
@@ -97,6 +97,17 @@ TrialSpec& TrialSpec::Timeout(Duration sim, Outcome outcome, Duration wall) {
   return *this;
 }
 
+TrialSpec& TrialSpec::Limits(ContainerLimits value) {
+  limits = value;
+  return *this;
+}
+
+ContainerLimits TrialSpec::LimitsOf(const DroneSpec* drone) const {
+  const ContainerLimits& own = drone != nullptr ? drone->limits : physics_limits;
+  return {own.memory_mib > 0 ? own.memory_mib : limits.memory_mib,
+          own.pids > 0 ? own.pids : limits.pids};
+}
+
 const DroneSpec* TrialSpec::FindDrone(std::string_view drone_name) const {
   for (const DroneSpec& d : drones) {
     if (d.name == drone_name) return &d;
@@ -125,9 +136,19 @@ yaml::Node ToDocument(const TrialSpec& spec) {
   doc.Set("seed", Plain(std::to_string(spec.seed)));
   doc.Set("middleware", Str(MiddlewareName(spec.middleware)));
   doc.Set("world", Str(spec.world));
+  auto limits_node = [](const ContainerLimits& l) {
+    Node n = Node::Mapping();
+    if (l.memory_mib > 0) n.Set("memory_mib", Plain(std::to_string(l.memory_mib)));
+    if (l.pids > 0) n.Set("pids", Plain(std::to_string(l.pids)));
+    return n;
+  };
   Node physics = Node::Mapping();
   physics.Set("rtf", Plain(Number(spec.rtf)));
+  if (spec.physics_limits.memory_mib > 0 || spec.physics_limits.pids > 0) {
+    physics.Set("limits", limits_node(spec.physics_limits));
+  }
   doc.Set("physics", std::move(physics));
+  doc.Set("limits", limits_node(spec.limits));
   Node drones = Node::Sequence();
   for (const DroneSpec& d : spec.drones) {
     Node dn = Node::Mapping();
@@ -137,6 +158,7 @@ yaml::Node ToDocument(const TrialSpec& spec) {
     for (double v : d.pose) pose.Append(Plain(Number(v)));
     dn.Set("pose", std::move(pose));
     if (!d.payload.empty()) dn.Set("payload", Str(d.payload));
+    if (d.limits.memory_mib > 0 || d.limits.pids > 0) dn.Set("limits", limits_node(d.limits));
     drones.Append(std::move(dn));
   }
   doc.Set("drones", std::move(drones));

@@ -64,6 +64,13 @@ std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
     if (!s.network_of.empty()) svc.Set("network_mode", Str("service:" + s.network_of));
     if (!s.cap_add.empty()) svc.Set("cap_add", StrList(s.cap_add));
     if (!s.cap_drop.empty()) svc.Set("cap_drop", StrList(s.cap_drop));
+    if (s.no_new_privileges) svc.Set("security_opt", StrList({"no-new-privileges:true"}));
+    if (s.read_only_rootfs) svc.Set("read_only", Node::Scalar("true"));
+    if (s.memory_mib > 0) {
+      svc.Set("mem_limit", Str(std::to_string(s.memory_mib) + "m"));
+      svc.Set("memswap_limit", Str(std::to_string(s.memory_mib) + "m"));  // no swap on top
+    }
+    if (s.pids_limit > 0) svc.Set("pids_limit", Node::Scalar(std::to_string(s.pids_limit)));
     if (!s.networks.empty()) {
       Node nets = Node::Mapping();
       for (const dsl::Attachment& a : s.networks) {
@@ -84,9 +91,15 @@ std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
     }
     if (!mounts.empty()) svc.Set("volumes", StrList(mounts));
     // Scratch dirs: a tmpfs writable by the image's non-root user (copy results out with
-    // `docker cp <container>:/out/truth.csv .` before `down`).
+    // `docker cp <container>:/swarmbox/out/truth.csv .` before `down`). The runner's volumes
+    // (where it copies the inputs in) are not needed: compose bind-mounts the inputs, and the
+    // scratch dirs under them are tmpfs here.
     std::vector<std::string> tmpfs;
     for (const std::string& dir : s.scratch_dirs) tmpfs.push_back(dir + ":mode=1777");
+    for (const dsl::TmpfsMount& t : s.tmpfs) {
+      const std::string size = t.size_mib > 0 ? ",size=" + std::to_string(t.size_mib) + "m" : "";
+      tmpfs.push_back(t.path + ":mode=1777" + size);
+    }
     if (!tmpfs.empty()) svc.Set("tmpfs", StrList(tmpfs));
     // Start order: depend on the services of the closest earlier priority level.
     std::size_t previous = plugins.size();  // index of a service on that level; size() = none

@@ -227,34 +227,75 @@ Verdict DockerEngine::RemoveNetwork(dsl::Network& network) {
   return Verdict::Success();
 }
 
+namespace {
+
+// The volume a path lies under ("" = none): Docker's archive endpoint writes into a read-only
+// container only there ("container rootfs is marked read-only" elsewhere; a tmpfs is not mounted
+// before the start, so what is put there is hidden once it runs).
+std::string VolumeOf(const dsl::ContainerSpec& spec, const std::string& path) {
+  for (const std::string& v : spec.volumes) {
+    const std::string prefix = !v.empty() && v.back() == '/' ? v : v + "/";
+    if (path.rfind(prefix, 0) == 0) return v;
+  }
+  return {};
+}
+
+}  // namespace
+
 Status DockerEngine::CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id) {
   if (spec.inputs.empty() && spec.scratch_dirs.empty()) return Ok{};
-  docker::TarWriter tar;
-  std::set<std::string> dirs;
-  auto add_parents = [&](const std::string& path) -> Status {
-    fs::path p = fs::path(path).parent_path();
+  // One archive per destination: "/" for a writable root filesystem, else each volume.
+  struct Archive {
+    docker::TarWriter tar;
+    std::set<std::string> dirs;
+  };
+  std::map<std::string, Archive> archives;
+  auto archive_for = [&](const std::string& path, std::string* relative) -> Result<Archive*> {
+    std::string dest = "/";
+    if (spec.read_only_rootfs) {
+      dest = VolumeOf(spec, path);
+      if (dest.empty()) {
+        return Error(ErrorCode::kInvalidArgument,
+                     "the root filesystem is read-only and " + path + " lies in none of its volumes");
+      }
+    }
+    *relative = fs::path(path).lexically_relative(dest).string();
+    return &archives[dest];
+  };
+  auto add_parents = [](Archive& a, const std::string& relative) -> Status {
     std::vector<std::string> chain;
-    for (; !p.empty() && p != p.root_path(); p = p.parent_path()) chain.push_back(p.string());
+    for (fs::path p = fs::path(relative).parent_path(); !p.empty(); p = p.parent_path()) {
+      chain.push_back(p.string());
+    }
     for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
-      if (dirs.insert(*it).second) SWARMBOX_TRY(tar.AddDirectory(*it, 0755));
+      if (a.dirs.insert(*it).second) SWARMBOX_TRY(a.tar.AddDirectory(*it, 0755));
     }
     return Ok{};
   };
   for (const std::string& dir : spec.scratch_dirs) {
-    SWARMBOX_TRY(add_parents(dir));
-    if (dirs.insert(dir).second) SWARMBOX_TRY(tar.AddDirectory(dir, 01777));
+    std::string relative;
+    auto a = archive_for(dir, &relative);
+    if (!a) return a.error();
+    SWARMBOX_TRY(add_parents(**a, relative));
+    if ((*a)->dirs.insert(relative).second) SWARMBOX_TRY((*a)->tar.AddDirectory(relative, 01777));
   }
   for (const dsl::InputFile& in : spec.inputs) {
     std::ifstream f(in.host_path, std::ios::binary);
     if (!f) return Error(ErrorCode::kNotFound, "cannot read input file", in.host_path);
     std::ostringstream content;
     content << f.rdbuf();
-    SWARMBOX_TRY(add_parents(in.container_path));
-    SWARMBOX_TRY(tar.AddFile(in.container_path, content.str(), 0644));
+    std::string relative;
+    auto a = archive_for(in.container_path, &relative);
+    if (!a) return a.error();
+    SWARMBOX_TRY(add_parents(**a, relative));
+    SWARMBOX_TRY((*a)->tar.AddFile(relative, content.str(), 0644));
   }
-  auto bytes = tar.Finish();
-  if (!bytes) return bytes.error();
-  return api_.PutArchive(container_id, "/", *bytes);
+  for (auto& [dest, a] : archives) {
+    auto bytes = a.tar.Finish();
+    if (!bytes) return bytes.error();
+    SWARMBOX_TRY(api_.PutArchive(container_id, dest, *bytes));
+  }
+  return Ok{};
 }
 
 Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
@@ -338,6 +379,16 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
   spec.auto_remove = false;  // a crashed container keeps its logs until we collected them
   spec.cap_add = s.cap_add;
   spec.cap_drop = s.cap_drop;
+  if (s.no_new_privileges) spec.security_opt.push_back("no-new-privileges");
+  spec.read_only_rootfs = s.read_only_rootfs;
+  for (const std::string& v : s.volumes) {
+    spec.mounts.push_back({docker::Mount::Type::kVolume, "", v, false, 0, 0});  // anonymous
+  }
+  for (const dsl::TmpfsMount& t : s.tmpfs) {
+    spec.mounts.push_back({docker::Mount::Type::kTmpfs, "", t.path, false, t.size_mib << 20, 01777});
+  }
+  spec.resources.memory_bytes = s.memory_mib << 20;
+  spec.resources.pids_limit = s.pids_limit;
   std::unique_lock lock(mu_);
   if (!s.network_of.empty()) {
     auto owner = container_ids_.find(s.network_of);

@@ -114,6 +114,8 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   };
   // The radio link measurement (event=link per peer).
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
+  // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
+  argv.insert(argv.end(), {"--raft-dir", std::string(kAgentStateDir) + "/raft"});
   if (spec.mission.kind == dsl::MissionKind::kPlan) {
     argv.insert(argv.end(), {"--mission", "plan", "--plan", spec.mission.plan});
   } else {
@@ -131,6 +133,18 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
 // the agent being killed or restarted; the agent joins it (network_of). It alone has NET_ADMIN
 // (CapDrop ALL); its pid 1 is swarmbox-netemd's `sleep` (reaps the daemons started by exec).
 std::vector<std::string> SidecarArgv() { return {images::kNetemdInImage, "sleep"}; }
+
+// Every agent and the physics server: no capabilities, no privilege gained by exec, nothing
+// written outside the volume and the scratch tmpfs, bounded memory and processes.
+void Confine(const dsl::ContainerLimits& limits, dsl::ContainerSpec* c) {
+  c->cap_drop = {"ALL"};
+  c->no_new_privileges = true;
+  c->read_only_rootfs = true;
+  c->volumes = {std::string(kContainerVolumeDir)};
+  c->tmpfs = {{std::string(kScratchTmpfsDir), kScratchTmpfsMib}};
+  c->memory_mib = limits.memory_mib;
+  c->pids_limit = limits.pids;
+}
 
 // -------------------------------------------------------------------------------------------------
 
@@ -244,6 +258,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   }
   physics.scratch_dirs = {std::string(kContainerOutDir)};
   physics.artifacts = {std::string(kTruthCsvPath)};
+  Confine(spec.LimitsOf(nullptr), &physics);
   trial->Add<dsl::Plugin>(std::string(kPhysicsId), std::move(physics), 1)
       .On(sim_net, physics_ip, {std::string(kPhysicsId)})
       .ReadyOn(std::string(kPhysicsReadyPattern), dsl::Duration::Seconds(60));
@@ -260,8 +275,11 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
       sc.hostname = d.name;
       sc.labels = labels(id);
       sc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
+      // tc and iptables-nft talk netlink: NET_ADMIN alone (no NET_RAW: the fault e2e test runs
+      // both with just this); no-new-privileges holds, as root keeps its set across exec.
       sc.cap_drop = {"ALL"};
       sc.cap_add = {"NET_ADMIN"};
+      sc.no_new_privileges = true;
       sc.user = "0:0";  // NET_ADMIN reaches no non-root user on Docker 20.10 (standard_images.hpp)
       sc.stop_timeout_s = 2;
       radios.Add<dsl::Plugin>(id, std::move(sc), 2)
@@ -283,6 +301,8 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     agent.labels = labels(d.name);
     agent.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
     agent.inputs = {input(spec.world), input(AirframeRelative(d))};
+    agent.scratch_dirs = {std::string(kAgentStateDir)};
+    Confine(spec.LimitsOf(&d), &agent);
     if (sidecars) {
       agent.network_of = SidecarId(d.name);  // Docker refuses a hostname here
       drones.Add<dsl::Plugin>(d.name, std::move(agent), 2);

@@ -66,6 +66,12 @@ std::string ResultJson(const TrialResult& r) {
     components.Append(std::move(cn));
   }
   doc.Set("components", std::move(components));
+  // The containers killed for going over their memory limit (`limits:`), at a glance.
+  Node oom_killed = Node::Sequence();
+  for (const ComponentReport& c : r.components) {
+    if (c.oom_killed) oom_killed.Append(Str(c.name));
+  }
+  doc.Set("oom_killed", std::move(oom_killed));
   Node problems = Node::Sequence();
   for (const std::string& p : r.problems) problems.Append(Str(p));
   doc.Set("problems", std::move(problems));

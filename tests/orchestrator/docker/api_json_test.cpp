@@ -67,6 +67,39 @@ TEST(ApiJson, ParsesRecordedContainerInspect) {
   EXPECT_FALSE(c->tty);
   EXPECT_EQ(c->labels.at("swarmbox.component"), "probe");
   EXPECT_EQ(c->network_ips.at("swarmbox-rec-net"), "10.213.77.10");
+  // Docker's nulls read as "not set".
+  EXPECT_TRUE(c->host_config.cap_drop.empty());
+  EXPECT_TRUE(c->host_config.security_opt.empty());
+  EXPECT_FALSE(c->host_config.read_only_rootfs);
+  EXPECT_EQ(c->host_config.pids_limit, 0);
+  EXPECT_EQ(c->host_config.memory_bytes, 0);
+  EXPECT_EQ(c->host_config.network_mode, "swarmbox-rec-net");
+}
+
+TEST(ApiJson, ParsesTheHostConfigOfAHardenedContainer) {
+  // The fields as Docker 20.10 answers them for an agent created by the runner.
+  auto c = ParseContainerInspect(
+      R"({"Id":"abc","Name":"/t1-drone_1","State":{"Status":"exited","OOMKilled":true,"ExitCode":137},)"
+      R"("HostConfig":{"NetworkMode":"t1-sim","CapAdd":null,"CapDrop":["ALL"],)"
+      R"("SecurityOpt":["no-new-privileges"],"ReadonlyRootfs":true,"Memory":268435456,)"
+      R"("PidsLimit":256,"Mounts":[{"Type":"volume","Target":"/swarmbox"},)"
+      R"({"Type":"tmpfs","Target":"/tmp","TmpfsOptions":{"SizeBytes":16777216,"Mode":1023}}]}})");
+  ASSERT_TRUE(c) << c.error().ToString();
+  EXPECT_TRUE(c->state.oom_killed);
+  EXPECT_EQ(c->state.exit_code, 137);
+  const ContainerHostConfig& h = c->host_config;
+  EXPECT_TRUE(h.cap_add.empty());
+  EXPECT_EQ(h.cap_drop, std::vector<std::string>{"ALL"});
+  EXPECT_EQ(h.security_opt, std::vector<std::string>{"no-new-privileges"});
+  EXPECT_TRUE(h.read_only_rootfs);
+  EXPECT_EQ(h.memory_bytes, 268435456);
+  EXPECT_EQ(h.pids_limit, 256);
+  ASSERT_EQ(h.mounts.size(), 2u);
+  EXPECT_EQ(h.mounts[0].type, Mount::Type::kVolume);
+  EXPECT_EQ(h.mounts[0].target, "/swarmbox");
+  EXPECT_EQ(h.mounts[1].type, Mount::Type::kTmpfs);
+  EXPECT_EQ(h.mounts[1].tmpfs_size_bytes, 16777216);
+  EXPECT_EQ(h.mounts[1].tmpfs_mode, 01777);
 }
 
 TEST(ApiJson, ParsesRecordedContainerList) {
@@ -249,7 +282,10 @@ ContainerSpec AgentSpec() {
   spec.user = "1000:1000";
   spec.labels = SwarmboxLabels("r1", "t1", "drone_1");
   spec.mounts = {{Mount::Type::kBind, "/host/out", "/out", false, 0},
-                 {Mount::Type::kTmpfs, "", "/scratch", false, 1 << 20}};
+                 {Mount::Type::kTmpfs, "", "/scratch", false, 1 << 20, 01777},
+                 {Mount::Type::kVolume, "", "/swarmbox", false, 0, 0}};
+  spec.security_opt = {"no-new-privileges"};
+  spec.read_only_rootfs = true;
   EndpointSpec sim;
   sim.network = "t1-sim";
   sim.ipv4_address = "10.77.1.11";
@@ -279,12 +315,20 @@ TEST(ApiJson, ContainerBodyPutsOnlyTheFirstNetworkAtCreateBelowApi144) {
   ASSERT_NE(host, nullptr);
   EXPECT_EQ(host->Find("NetworkMode")->scalar(), "t1-sim");
   EXPECT_EQ(host->Find("Memory")->scalar(), std::to_string(256 << 20));
+  EXPECT_EQ(host->Find("MemorySwap")->scalar(), std::to_string(256 << 20));
   EXPECT_EQ(host->Find("NanoCpus")->scalar(), "500000000");
   EXPECT_EQ(host->Find("PidsLimit")->scalar(), "64");
   EXPECT_EQ(host->Find("CapDrop")->items()[0].scalar(), "ALL");
   EXPECT_EQ(host->Find("Mounts")->items()[0].Find("Type")->scalar(), "bind");
   EXPECT_EQ(host->Find("Mounts")->items()[1].Find("TmpfsOptions")->Find("SizeBytes")->scalar(),
             "1048576");
+  EXPECT_EQ(host->Find("Mounts")->items()[1].Find("TmpfsOptions")->Find("Mode")->scalar(), "1023");
+  // An anonymous volume: no Source, so Docker creates one (removed with the container's v=1).
+  EXPECT_EQ(host->Find("Mounts")->items()[2].Find("Type")->scalar(), "volume");
+  EXPECT_EQ(host->Find("Mounts")->items()[2].Find("Source")->scalar(), "");
+  EXPECT_EQ(host->Find("SecurityOpt")->items().size(), 1u);
+  EXPECT_EQ(host->Find("SecurityOpt")->items()[0].scalar(), "no-new-privileges");
+  EXPECT_EQ(host->Find("ReadonlyRootfs")->scalar(), "true");
   const yaml::Node* endpoints = n.Find("NetworkingConfig")->Find("EndpointsConfig");
   ASSERT_EQ(endpoints->entries().size(), 1u);
   EXPECT_EQ(endpoints->Find("t1-sim")->Find("IPAMConfig")->Find("IPv4Address")->scalar(),

@@ -143,6 +143,60 @@ TEST(LoadTrial, ReportsBadInputWithFileLineColumn) {
   }
 }
 
+constexpr const char* kLimited = R"(name: limited
+world: worlds/open_field.yaml
+physics: {rtf: 0, limits: {pids: 64}}
+limits: {memory_mib: 300, pids: 128}
+drones:
+  - {name: scout_1, airframe: x500}
+  - {name: scout_2, airframe: x500, limits: {memory_mib: 16}}
+timeout: {sim: 60s}
+)";
+
+TEST(LoadTrial, LimitsApplyToEveryContainerWithDroneAndPhysicsOverrides) {
+  auto spec = LoadTrialText(kLimited, "limited.yaml", FakeTree());
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  EXPECT_EQ(spec->LimitsOf(&spec->drones[0]).memory_mib, 300);
+  EXPECT_EQ(spec->LimitsOf(&spec->drones[0]).pids, 128);
+  EXPECT_EQ(spec->LimitsOf(&spec->drones[1]).memory_mib, 16);
+  EXPECT_EQ(spec->LimitsOf(&spec->drones[1]).pids, 128);  // not overridden: the trial's
+  EXPECT_EQ(spec->LimitsOf(nullptr).memory_mib, 300);
+  EXPECT_EQ(spec->LimitsOf(nullptr).pids, 64);
+  // Without `limits:` the defaults hold; the resolved document says which were used.
+  auto plain = LoadTrialText(kExample, "sar.yaml", FakeTree());
+  ASSERT_TRUE(plain);
+  EXPECT_EQ(plain->LimitsOf(&plain->drones[0]).memory_mib, kDefaultLimits.memory_mib);
+  EXPECT_EQ(plain->LimitsOf(nullptr).pids, kDefaultLimits.pids);
+  auto again = LoadTrialText(yaml::Emit(ToDocument(*spec)), "again.yaml", FakeTree());
+  ASSERT_TRUE(again) << again.error().ToString();
+  EXPECT_EQ(again->LimitsOf(&again->drones[1]).memory_mib, 16);
+  EXPECT_EQ(again->LimitsOf(nullptr).pids, 64);
+  EXPECT_EQ(again->limits.memory_mib, 300);
+}
+
+TEST(LoadTrial, BadLimitsPointAtTheirKey) {
+  const BadCase cases[] = {
+      {"limits: {memory_mib: 300", "limits: {memory_mib: 5", "limited.yaml:4:22",
+       "'memory_mib' must be >= 6 [MiB] (Docker's minimum)"},
+      {"pids: 128}", "pids: 8}", "limited.yaml:4:33", "'pids' must be >= 16"},
+      {"pids: 128}", "pids: 128, cpus: 2}", "limited.yaml:4:38", "unknown key 'cpus' in limits"},
+      {"limits: {memory_mib: 16}", "limits: {memory_mib: lots}", "limited.yaml:7:58",
+       "'memory_mib': expected an integer"},
+      {"limits: {pids: 64}", "limits: {pids: 0}", "limited.yaml:3:34", "'pids' must be >= 16"},
+  };
+  for (const BadCase& c : cases) {
+    std::string text = kLimited;
+    const auto pos = text.find(c.find);
+    ASSERT_NE(pos, std::string::npos) << c.find;
+    text.replace(pos, std::string(c.find).size(), c.replace);
+    auto spec = LoadTrialText(text, "limited.yaml", FakeTree());
+    ASSERT_FALSE(spec) << c.replace;
+    EXPECT_EQ(spec.error().where(), c.where) << c.replace << " -> " << spec.error().ToString();
+    EXPECT_NE(spec.error().message().find(c.message), std::string::npos)
+        << c.replace << " -> " << spec.error().ToString();
+  }
+}
+
 TEST(LoadTrial, OverridesApplyBeforeChecking) {
   LoadOptions o = FakeTree();
   o.overrides = {"network.mesh.loss=0.1", "seed=7", "drones.lifter.pose=[1, 2, 3]",

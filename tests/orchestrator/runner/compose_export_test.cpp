@@ -50,7 +50,24 @@ TEST(ComposeYaml, ExportsNetworksServicesAndStartOrder) {
   EXPECT_EQ(lifter->Find("depends_on")->items()[0].scalar(), "physics");
   EXPECT_EQ(lifter->Find("labels")->Find("swarmbox.component")->scalar(), "lifter");
   EXPECT_EQ(lifter->Find("networks")->Find("mesh")->Find("ipv4_address")->scalar(), "10.200.9.13");
-  EXPECT_EQ(physics->Find("tmpfs")->items()[0].scalar(), "/out:mode=1777");
+  EXPECT_EQ(physics->Find("tmpfs")->items()[0].scalar(), "/swarmbox/out:mode=1777");
+  // The runner's confinement, as compose spells it.
+  for (const char* service : {"physics", "lifter"}) {
+    SCOPED_TRACE(service);
+    const yaml::Node* s = services->Find(service);
+    ASSERT_EQ(s->Find("cap_drop")->items().size(), 1u);
+    EXPECT_EQ(s->Find("cap_drop")->items()[0].scalar(), "ALL");
+    EXPECT_EQ(s->Find("cap_add"), nullptr);
+    EXPECT_EQ(s->Find("security_opt")->items()[0].scalar(), "no-new-privileges:true");
+    EXPECT_EQ(s->Find("read_only")->scalar(), "true");
+    EXPECT_EQ(s->Find("mem_limit")->scalar(), std::to_string(dsl::kDefaultLimits.memory_mib) + "m");
+    EXPECT_EQ(s->Find("memswap_limit")->scalar(), std::to_string(dsl::kDefaultLimits.memory_mib) + "m");
+    EXPECT_EQ(s->Find("pids_limit")->scalar(), std::to_string(dsl::kDefaultLimits.pids));
+  }
+  const yaml::Node* lifter_tmpfs = lifter->Find("tmpfs");
+  ASSERT_EQ(lifter_tmpfs->items().size(), 2u);
+  EXPECT_EQ(lifter_tmpfs->items()[0].scalar(), "/swarmbox/state:mode=1777");  // the Raft WAL
+  EXPECT_EQ(lifter_tmpfs->items()[1].scalar(), "/tmp:mode=1777,size=16m");
 }
 
 TEST(ComposeYaml, DependsOnTheClosestEarlierPriorityLevel) {

@@ -47,6 +47,10 @@ std::map<std::string, std::string> FakeDockerApi::PutArchives() const {
   std::lock_guard lock(mu_);
   return put_archives_;
 }
+std::map<std::string, std::string> FakeDockerApi::PutArchiveDirs() const {
+  std::lock_guard lock(mu_);
+  return put_archive_dirs_;
+}
 std::vector<std::string> FakeDockerApi::SubnetsTried() const {
   std::lock_guard lock(mu_);
   return subnets_tried_;
@@ -452,9 +456,21 @@ Status FakeDockerApi::PutArchive(std::string_view container_id, std::string_view
   std::lock_guard lock(mu_);
   Container* c = Find(container_id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
-  if (dest_dir != "/") return Error(ErrorCode::kInvalidArgument, "the fake takes archives at / only");
+  // Docker's rule for a read-only root filesystem: archives go into a volume only.
+  bool to_volume = false;
+  for (const docker::Mount& m : c->spec.mounts) {
+    const std::string prefix = m.target + "/";
+    if (m.type == docker::Mount::Type::kVolume &&
+        (dest_dir == m.target || std::string(dest_dir).rfind(prefix, 0) == 0)) {
+      to_volume = true;
+    }
+  }
+  if (c->spec.read_only_rootfs && !to_volume) {
+    return Error(ErrorCode::kInvalidArgument, "container rootfs is marked read-only");
+  }
   c->put_archive = std::string(tar);
   put_archives_[c->spec.name] = std::string(tar);
+  put_archive_dirs_[c->spec.name] = std::string(dest_dir);
   return Ok{};
 }
 

@@ -85,6 +85,7 @@ class FakeDockerApi : public docker::DockerApi {
   std::map<std::string, docker::NetworkSpec> Networks() const;  // id -> spec
   std::vector<std::string> SubnetsTried() const;
   std::map<std::string, std::string> PutArchives() const;  // container name -> last tar put
+  std::map<std::string, std::string> PutArchiveDirs() const;  // container name -> its dest dir
 
   // docker::DockerApi
   Result<std::string> Ping() override;
@@ -150,6 +151,7 @@ class FakeDockerApi : public docker::DockerApi {
   std::map<std::string, docker::NetworkSpec> networks_;
   std::vector<std::string> subnets_tried_;
   std::map<std::string, std::string> put_archives_;
+  std::map<std::string, std::string> put_archive_dirs_;
   int next_id_ = 1;
 };
 

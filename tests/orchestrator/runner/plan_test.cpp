@@ -62,7 +62,7 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   ASSERT_EQ(physics.networks.size(), 1u);
   EXPECT_EQ(physics.networks[0].network, "sim");
   EXPECT_EQ(physics.networks[0].ipv4, "10.200.8.2");
-  EXPECT_THAT(physics.artifacts, ElementsAre("/out/truth.csv"));
+  EXPECT_THAT(physics.artifacts, ElementsAre("/swarmbox/out/truth.csv"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/worlds/open_field.yaml"));
   EXPECT_THAT(physics.argv, Contains("lifter:x8_heavy:0,-10,0:0:stretcher:ground"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/airframes"));
@@ -186,6 +186,7 @@ TEST_F(PlanTest, NetworkFaultsGiveEachAgentASidecarThatOwnsItsNamespace) {
   EXPECT_THAT(sidecar.argv, ElementsAre("/usr/bin/swarmbox-netemd", "sleep"));
   EXPECT_THAT(sidecar.cap_add, ElementsAre("NET_ADMIN"));
   EXPECT_THAT(sidecar.cap_drop, ElementsAre("ALL"));
+  EXPECT_TRUE(sidecar.no_new_privileges);
   ASSERT_EQ(sidecar.networks.size(), 2u);
   EXPECT_EQ(sidecar.networks[0].ipv4, "10.200.8.13");
   EXPECT_EQ(sidecar.networks[1].ipv4, "10.200.9.13");
@@ -201,6 +202,52 @@ TEST_F(PlanTest, NetworkFaultsGiveEachAgentASidecarThatOwnsItsNamespace) {
   const std::string compose = ComposeYaml(**trial, {});
   EXPECT_NE(compose.find("network_mode: \"service:lifter-faults\""), std::string::npos) << compose;
   EXPECT_NE(compose.find("- \"NET_ADMIN\""), std::string::npos);
+}
+
+// Least privilege: what every agent and the physics server are created with.
+TEST_F(PlanTest, AgentsAndPhysicsRunConfinedWithTheDefaultLimits) {
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  for (dsl::Plugin* p : (*trial)->Plugins()) {
+    const dsl::ContainerSpec& c = p->spec();
+    SCOPED_TRACE(p->id());
+    EXPECT_THAT(c.cap_drop, ElementsAre("ALL"));
+    EXPECT_TRUE(c.cap_add.empty());
+    EXPECT_TRUE(c.no_new_privileges);
+    EXPECT_TRUE(c.read_only_rootfs);
+    EXPECT_THAT(c.volumes, ElementsAre("/swarmbox"));
+    ASSERT_EQ(c.tmpfs.size(), 1u);
+    EXPECT_EQ(c.tmpfs[0].path, "/tmp");
+    EXPECT_EQ(c.tmpfs[0].size_mib, kScratchTmpfsMib);
+    EXPECT_EQ(c.memory_mib, dsl::kDefaultLimits.memory_mib);
+    EXPECT_EQ(c.pids_limit, dsl::kDefaultLimits.pids);
+    // Everything copied in before the start lies in the volume (the root filesystem refuses it).
+    for (const dsl::InputFile& in : c.inputs) EXPECT_EQ(in.container_path.rfind("/swarmbox/", 0), 0u);
+    for (const std::string& d : c.scratch_dirs) EXPECT_EQ(d.rfind("/swarmbox/", 0), 0u);
+  }
+  // The WAL in the volume: it survives a restart fault, which a tmpfs would not.
+  const auto& argv = (*trial)->FindPlugin("scout_1")->spec().argv;
+  auto it = std::find(argv.begin(), argv.end(), "--raft-dir");
+  ASSERT_NE(it, argv.end());
+  EXPECT_EQ(*(it + 1), "/swarmbox/state/raft");
+  EXPECT_THAT((*trial)->FindPlugin("scout_1")->spec().scratch_dirs, ElementsAre("/swarmbox/state"));
+}
+
+TEST_F(PlanTest, LimitsComeFromTheTrialWithDroneAndPhysicsOverrides) {
+  spec_.Limits({300, 128});
+  spec_.drones[1].limits = {64, 0};  // scout_2: memory only, pids from the trial
+  spec_.physics_limits = {0, 64};
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  const dsl::ContainerSpec& scout_1 = (*trial)->FindPlugin("scout_1")->spec();
+  EXPECT_EQ(scout_1.memory_mib, 300);
+  EXPECT_EQ(scout_1.pids_limit, 128);
+  const dsl::ContainerSpec& scout_2 = (*trial)->FindPlugin("scout_2")->spec();
+  EXPECT_EQ(scout_2.memory_mib, 64);
+  EXPECT_EQ(scout_2.pids_limit, 128);
+  const dsl::ContainerSpec& physics = (*trial)->FindPlugin("physics")->spec();
+  EXPECT_EQ(physics.memory_mib, 300);
+  EXPECT_EQ(physics.pids_limit, 64);
 }
 
 TEST_F(PlanTest, SimTimeFaultsMakeThePhysicsClockFiner) {

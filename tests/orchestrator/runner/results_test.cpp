@@ -79,6 +79,42 @@ TEST(RtfMeter, SimulatedOverWallSecondsFromTheFirstMoveOfSimulatedTime) {
   EXPECT_DOUBLE_EQ(*m.Achieved(), 4.0);
 }
 
+TEST(ResultJson, ListsTheContainersKilledForLackOfMemory) {
+  TrialResult r;
+  r.verdict = dsl::Verdict::Failure("scout_2 was killed for lack of memory", "scout_2");
+  r.components = {{"physics", 0, false, "logs/physics.log", 10},
+                  {"scout_2", 137, true, "logs/scout_2.log", 3}};
+  auto doc = yaml::Parse(ResultJson(r), "result.json");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  const yaml::Node* oom = doc->Find("oom_killed");
+  ASSERT_NE(oom, nullptr);
+  ASSERT_EQ(oom->items().size(), 1u);
+  EXPECT_EQ(oom->items()[0].scalar(), "scout_2");
+  EXPECT_EQ(doc->Find("components")->items()[1].Find("oom_killed")->scalar(), "true");
+  r.components[1].oom_killed = false;
+  doc = yaml::Parse(ResultJson(r), "result.json");
+  ASSERT_TRUE(doc);
+  EXPECT_TRUE(doc->Find("oom_killed")->items().empty());  // always there, empty when none
+}
+
+TEST(Metrics, CountsEventsFromTheLogs) {
+  Metrics m;
+  m.OnEvent("scout_1", ParseLogfmt("t=1 node=scout_1 event=leader_elected term=1"));
+  m.OnEvent("scout_1", ParseLogfmt("t=5 node=scout_1 event=victim_detected victim=victim_1"));
+  m.OnEvent("scout_2", ParseLogfmt("t=6 node=scout_2 event=victim_detected victim=victim_1"));
+  m.OnEvent("scout_2", ParseLogfmt("t=7 node=scout_2 event=victim_confirmed victim=victim_1"));
+  m.OnEvent("scout_2", ParseLogfmt("t=8 node=scout_2 event=collision"));
+  m.OnEvent("lifter", ParseLogfmt("t=90.5 node=lifter event=mission_complete"));
+  m.OnEvent("lifter", ParseLogfmt("no event here"));
+  auto v = m.Values();
+  EXPECT_EQ(v["events_total"], 6);
+  EXPECT_EQ(v["leader_elections"], 1);
+  EXPECT_EQ(v["victims_detected"], 1);
+  EXPECT_EQ(v["victims_confirmed"], 1);
+  EXPECT_EQ(v["collisions"], 1);
+  EXPECT_EQ(v["mission_complete_t_s"], 90.5);
+}
+
 TEST(EventsJsonl, LogEventsKeepTheirFieldsNumbersBare) {
   auto j = LogEventJson(1.5, "scout_1", ParseLogfmt("t=12.340 node=drone_2 event=leader_elected term=3 msg=\"a b\""));
   ASSERT_TRUE(j);

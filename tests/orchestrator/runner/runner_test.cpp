@@ -71,7 +71,7 @@ class RunnerTest : public ::testing::Test {
     options_.poll = std::chrono::milliseconds(5);
     api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready",
                                      "t=1.000 node=physics event=tick"};
-    api_.scripts["physics"].files["/out/truth.csv"] =
+    api_.scripts["physics"].files["/swarmbox/out/truth.csv"] =
         "t_s,drone,x_m,y_m,z_m\n0.0,scout_1,0,0,0\n1.0,scout_1,1,2,3\n";
   }
   void TearDown() override { fs::remove_all(out_); }
@@ -326,7 +326,7 @@ TEST_F(RunnerTest, MissingTruthIsAProblemNotAnOutcome) {
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess);
   ASSERT_FALSE(run.result.problems.empty());
-  EXPECT_THAT(run.result.problems[0], HasSubstr("artifact /out/truth.csv not collected"));
+  EXPECT_THAT(run.result.problems[0], HasSubstr("artifact /swarmbox/out/truth.csv not collected"));
   EXPECT_FALSE(fs::exists(fs::path(run.trial_dir) / "trajectories.png"));
 }
 
@@ -334,6 +334,8 @@ TEST_F(RunnerTest, InputFilesAreCopiedIntoTheContainers) {
   api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
   Run();
   const auto archives = api_.PutArchives();
+  // The root filesystem is read-only: the files go into the container's volume at /swarmbox.
+  EXPECT_EQ(api_.PutArchiveDirs().at("mini-20261121-120000-abcd-physics"), "/swarmbox");
   auto entries = docker::ReadTar(archives.at("mini-20261121-120000-abcd-physics"));
   ASSERT_TRUE(entries) << entries.error().ToString();
   std::map<std::string, std::uint32_t> modes;
@@ -342,15 +344,15 @@ TEST_F(RunnerTest, InputFilesAreCopiedIntoTheContainers) {
     if (!path.empty() && path.back() == '/') path.pop_back();
     modes[path] = e.mode;
   }
-  EXPECT_EQ(modes.count("swarmbox/trials/worlds/open_field.yaml"), 1u);
-  EXPECT_EQ(modes.count("swarmbox/trials/airframes/x500.yaml"), 1u);
+  EXPECT_EQ(modes.count("trials/worlds/open_field.yaml"), 1u);
+  EXPECT_EQ(modes.count("trials/airframes/x500.yaml"), 1u);
   ASSERT_EQ(modes.count("out"), 1u);
   EXPECT_EQ(modes["out"] & 07777u, 01777u);  // writable by the container's user
   auto agent = docker::ReadTar(archives.at("mini-20261121-120000-abcd-scout_1"));
   ASSERT_TRUE(agent);
   bool airframe = false;
   for (const auto& e : *agent) {
-    if (e.path == "swarmbox/trials/airframes/x500.yaml") {
+    if (e.path == "trials/airframes/x500.yaml") {
       airframe = true;
       EXPECT_THAT(e.content, HasSubstr("name: x500"));
     }

@@ -137,10 +137,13 @@ struct Mount {
   std::string target;  // path in the container
   bool read_only = false;
   std::int64_t tmpfs_size_bytes = 0;  // tmpfs only; 0 = engine default
+  // tmpfs only: its mode (e.g. 01777); 0 = the engine's. Docker 20.10 copies the mode of a
+  // directory the image already has at `target` over it (tmpcopyup), whatever this says.
+  int tmpfs_mode = 0;
 };
 
 struct ResourceLimits {
-  std::int64_t memory_bytes = 0;  // 0 = unlimited
+  std::int64_t memory_bytes = 0;  // 0 = unlimited; also MemorySwap: no swap beyond it
   std::int64_t nano_cpus = 0;     // 1e9 = one CPU; 0 = unlimited
   std::int64_t pids_limit = 0;    // 0 = unlimited
   std::string cpuset_cpus;        // "0-1"; "" = any
@@ -167,6 +170,7 @@ struct ContainerSpec {
   std::string network_mode;
   std::vector<std::string> cap_add;      // e.g. "NET_ADMIN"
   std::vector<std::string> cap_drop;     // e.g. "ALL"
+  std::vector<std::string> security_opt; // HostConfig.SecurityOpt, e.g. "no-new-privileges"
   ResourceLimits resources;
   std::map<std::string, std::string> sysctls;
   std::vector<std::string> extra_hosts;  // "name:ip"
@@ -191,6 +195,18 @@ struct ContainerState {
   std::string finished_at;
 };
 
+// What a container was created with (inspect's HostConfig), as far as the orchestrator sets it.
+struct ContainerHostConfig {
+  std::vector<std::string> cap_add;
+  std::vector<std::string> cap_drop;
+  std::vector<std::string> security_opt;
+  bool read_only_rootfs = false;
+  std::int64_t memory_bytes = 0;  // 0 = unlimited
+  std::int64_t pids_limit = 0;    // 0 (or Docker's -1/null) = unlimited
+  std::vector<Mount> mounts;      // HostConfig.Mounts (type, target, read-only, tmpfs size/mode)
+  std::string network_mode;
+};
+
 struct ContainerInfo {
   std::string id;
   std::string name;   // without Docker's leading '/'
@@ -199,6 +215,7 @@ struct ContainerInfo {
   Labels labels;
   std::map<std::string, std::string> network_ips;  // network name -> IPv4 address
   bool tty = false;  // created with a TTY: its logs are raw, not multiplexed
+  ContainerHostConfig host_config;
 };
 
 struct ContainerSummary {

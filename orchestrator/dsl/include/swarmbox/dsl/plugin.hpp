@@ -7,6 +7,7 @@
 //       .Collect("/out/truth.csv");
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <utility>
@@ -21,6 +22,12 @@ struct Attachment {
   std::string network;   // the Network component's id in the same trial ("sim", "mesh")
   std::string ipv4;      // fixed address inside that network's subnet
   std::vector<std::string> aliases;  // DNS names on that network
+};
+
+// A tmpfs: writable, in memory (counted in the container's memory limit), empty at every start.
+struct TmpfsMount {
+  std::string path;         // absolute path in the container
+  std::int64_t size_mib = 0;  // 0 = the engine's default (half the host's memory)
 };
 
 // A host file copied into the container before it starts (Docker's archive endpoint, so it works
@@ -43,6 +50,17 @@ struct ContainerSpec {
   std::string network_of;
   std::vector<std::string> cap_add;   // e.g. "NET_ADMIN" (the fault sidecar only)
   std::vector<std::string> cap_drop;  // e.g. "ALL"
+  // Least privilege: SecurityOpt no-new-privileges; a read-only root filesystem, where the
+  // container writes only into `volumes` and `tmpfs`; memory and pids limits (0 = unlimited).
+  bool no_new_privileges = false;
+  bool read_only_rootfs = false;
+  // Anonymous volumes (absolute paths): kept across a restart of the container, readable after
+  // it stopped (artifacts), removed with it. With read_only_rootfs, `inputs` and `scratch_dirs`
+  // must lie under one of them (they are copied in before the start).
+  std::vector<std::string> volumes;
+  std::vector<TmpfsMount> tmpfs;
+  std::int64_t memory_mib = 0;
+  std::int64_t pids_limit = 0;
   std::string user;      // "" = the image's
   std::string hostname;  // "" = Docker's
   std::string ready_pattern;  // a regex on the log; "" = ready once started

@@ -8,7 +8,7 @@
 //   Trial <name>
 //     Network sim [0]   physics <-> agents, never impaired
 //     Network mesh [0]  agent <-> agent radio (netem applies here, fault injector's business)
-//     Plugin physics [1]  ready on `event=ready`; collects /out/truth.csv; stops itself at the
+//     Plugin physics [1]  ready on `event=ready`; collects truth.csv; stops itself at the
 //                         trial's simulated timeout (--max-sim-time) with `event=stopped t=...`
 //     Component drones [2]
 //       Plugin <drone> [2]  one agent per drone, on sim (eth0) and mesh (eth1)
@@ -20,11 +20,14 @@
 //     Step faults [3]      bound by the runner to the FaultInjector: mechanism, network.mesh
 //     Component drones [4]
 //       Plugin <drone> [2]  the agent, in its sidecar's namespace (network_of), unprivileged
+// Agents and physics: CapDrop ALL, no-new-privileges, read-only root filesystem (a volume at
+// /swarmbox, a tmpfs at /tmp), memory and pids limits from the trial's `limits:` (LimitsOf).
 // Agent flags: the shared contract (mission, --members in trial order, --seed, --raft-*, radio).
 // Files: the world and airframe files are copied into every container under /swarmbox/trials/
 // (same relative paths as in the trials folder).
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -59,9 +62,16 @@ inline constexpr std::string_view kPhysicsId = "physics";
 inline constexpr std::string_view kDronesGroupId = "drones";
 inline constexpr std::string_view kSimNetworkId = "sim";
 inline constexpr std::string_view kMeshNetworkId = "mesh";
+// Agents and the physics server run with a read-only root filesystem: all they write goes to an
+// anonymous volume at /swarmbox (the input files, truth.csv, the Raft WAL: it survives a restart
+// fault and is readable after the stop, unlike a tmpfs) or to a small tmpfs at /tmp (scratch).
+inline constexpr std::string_view kContainerVolumeDir = "/swarmbox";
 inline constexpr std::string_view kContainerTrialsDir = "/swarmbox/trials";
-inline constexpr std::string_view kContainerOutDir = "/out";
-inline constexpr std::string_view kTruthCsvPath = "/out/truth.csv";
+inline constexpr std::string_view kContainerOutDir = "/swarmbox/out";
+inline constexpr std::string_view kTruthCsvPath = "/swarmbox/out/truth.csv";
+inline constexpr std::string_view kAgentStateDir = "/swarmbox/state";  // --raft-dir <it>/raft
+inline constexpr std::string_view kScratchTmpfsDir = "/tmp";
+inline constexpr std::int64_t kScratchTmpfsMib = 16;
 inline constexpr std::string_view kPhysicsReadyPattern = "event=ready";
 inline constexpr std::string_view kSidecarsGroupId = "sidecars";
 inline constexpr std::string_view kFaultsStepId = "faults";
