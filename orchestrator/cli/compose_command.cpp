@@ -69,7 +69,7 @@ int ComposeCommand(const ComposeArgs& args) {
       "Needs the images on this engine: run `swarmbox images` first.\n"
       "  docker-compose -f <this file> up        # Ctrl-C, then copy what you need:\n"
       "  docker cp " + runner::ResourceName(spec->name, kComposeRunId, runner::kPhysicsId) +
-      ":/out/truth.csv .\n"
+      ":" + std::string(runner::kTruthCsvPath) + " .\n"
       "  docker-compose -f <this file> down -v   # or: swarmbox gc --run compose";
   const std::string text = runner::ComposeYaml(**trial, compose);
   if (args.output.empty()) {

@@ -4,7 +4,8 @@
 //   2. $SWARMBOX_BIN_DIR/<program>;
 //   3. the build tree this swarmbox was built in: <build>/physics_server/[app/]swarmbox-physics,
 //      <build>/agent/[app/]swarmbox-agent (swarmbox itself is <build>/orchestrator/cli/swarmbox);
-//   4. $PATH.
+//   4. beside the running swarmbox (an installed prefix: <prefix>/bin/swarmbox-physics);
+//   5. $PATH.
 #pragma once
 
 #include <functional>

@@ -67,6 +67,7 @@ int RunCommand(const RunArgs& args) {
   options.run_id = run_id;
   options.images = *images;
   options.interrupted = &interrupted;
+  options.interrupt_reason = [] { return std::string(InterruptName()); };
   options.progress = args.quiet ? nullptr : &std::cerr;
   auto run = runner::RunTrialSpec(*spec, client, clock, options);
   if (!run) {

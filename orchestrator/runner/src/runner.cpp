@@ -313,7 +313,8 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
         resume_logs();
       }
       if (o.interrupted != nullptr && o.interrupted->load()) {
-        tree->RaiseShutdown(Verdict::Err("interrupted (Ctrl-C)", "user"));
+        tree->RaiseShutdown(Verdict::Err(
+            o.interrupt_reason ? o.interrupt_reason() : std::string("interrupted (Ctrl-C)"), "user"));
       }
       if (tree->restart_requested() && !tree->end_verdict()) {
         if (tree->restarts() < o.max_restarts) {

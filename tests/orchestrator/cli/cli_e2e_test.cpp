@@ -219,7 +219,7 @@ TEST_F(CliE2eTest, SigtermEndsTheRunCleanlyWithExit143) {
   auto result = yaml::Parse(ReadWholeFile((dir / "result.json").string()), "result.json");
   ASSERT_TRUE(result) << result.error().ToString();
   EXPECT_EQ(result->Find("outcome")->scalar(), "error");
-  EXPECT_THAT(result->Find("reason")->scalar(), HasSubstr("interrupted"));
+  EXPECT_EQ(result->Find("reason")->scalar(), "interrupted (SIGTERM)");
   EXPECT_THAT(ReadWholeFile((dir / "logs" / "physics.log").string()), HasSubstr("event=stopped"));
   // and nothing labelled with its run id is left.
   const Leftovers left = Left(id);

@@ -48,7 +48,10 @@ struct RunOptions {
   // swarmbox-netemd (netemd_bin, or FindNetemd's search).
   std::string faults_image;
   std::string host = "local";
-  const std::atomic<bool>* interrupted = nullptr;  // set by Ctrl-C
+  const std::atomic<bool>* interrupted = nullptr;  // set by Ctrl-C or SIGTERM
+  // The trial's reason once `interrupted` is set, e.g. "interrupted (SIGTERM)"; empty: the
+  // reason is "interrupted (Ctrl-C)".
+  std::function<std::string()> interrupt_reason;
   std::ostream* progress = nullptr;                // status lines; nullptr = quiet
   std::chrono::milliseconds poll{200};             // how long the watch loop waits for lines
   double progress_every_s = 2.0;
