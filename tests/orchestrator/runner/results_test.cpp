@@ -97,24 +97,6 @@ TEST(ResultJson, ListsTheContainersKilledForLackOfMemory) {
   EXPECT_TRUE(doc->Find("oom_killed")->items().empty());  // always there, empty when none
 }
 
-TEST(Metrics, CountsEventsFromTheLogs) {
-  Metrics m;
-  m.OnEvent("scout_1", ParseLogfmt("t=1 node=scout_1 event=leader_elected term=1"));
-  m.OnEvent("scout_1", ParseLogfmt("t=5 node=scout_1 event=victim_detected victim=victim_1"));
-  m.OnEvent("scout_2", ParseLogfmt("t=6 node=scout_2 event=victim_detected victim=victim_1"));
-  m.OnEvent("scout_2", ParseLogfmt("t=7 node=scout_2 event=victim_confirmed victim=victim_1"));
-  m.OnEvent("scout_2", ParseLogfmt("t=8 node=scout_2 event=collision"));
-  m.OnEvent("lifter", ParseLogfmt("t=90.5 node=lifter event=mission_complete"));
-  m.OnEvent("lifter", ParseLogfmt("no event here"));
-  auto v = m.Values();
-  EXPECT_EQ(v["events_total"], 6);
-  EXPECT_EQ(v["leader_elections"], 1);
-  EXPECT_EQ(v["victims_detected"], 1);
-  EXPECT_EQ(v["victims_confirmed"], 1);
-  EXPECT_EQ(v["collisions"], 1);
-  EXPECT_EQ(v["mission_complete_t_s"], 90.5);
-}
-
 TEST(EventsJsonl, LogEventsKeepTheirFieldsNumbersBare) {
   auto j = LogEventJson(1.5, "scout_1", ParseLogfmt("t=12.340 node=drone_2 event=leader_elected term=3 msg=\"a b\""));
   ASSERT_TRUE(j);
