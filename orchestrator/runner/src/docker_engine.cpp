@@ -679,6 +679,16 @@ Result<docker::ContainerState> DockerEngine::Inspect(const std::string& componen
   const auto id = ContainerId(component);
   if (!id) return Error(ErrorCode::kNotFound, "no container for component " + component);
   auto info = api_.InspectContainer(*id);
+  // A container the kernel's OOM killer took exits 137 (SIGKILL), and Docker marks OOMKilled when
+  // its OOM event arrives, which can be just after the exit is already visible (seen on 20.10 with
+  // a 6 MiB agent: the first inspect said 137 and OOMKilled false). So a 137 without the mark is
+  // asked again for up to ~1 s before it is taken as a plain SIGKILL.
+  for (int retry = 0; retry < 10 && info && !info->state.running && info->state.exit_code == 137 &&
+                      !info->state.oom_killed;
+       ++retry) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    info = api_.InspectContainer(*id);
+  }
   if (!info) return info.error();
   return info->state;
 }
