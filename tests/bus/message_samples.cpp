@@ -51,6 +51,8 @@ SensorSample FullSensorSample(std::uint64_t seed) {
   m.battery.voltage_v = D(seed, 25);
   m.battery.current_a = D(seed, 26);
   m.battery.remaining = D(seed, 27);
+  m.camera_frame = true;
+  m.radio_in = {FullRadioFrame(seed, 0), FullRadioFrame(seed + 1, 1), FullRadioFrame(seed + 2, 2), FullRadioFrame(seed + 3, 3)};
   return m;
 }
 
@@ -61,6 +63,9 @@ ActuatorCommand FullActuatorCommand(std::uint64_t seed) {
   m.sim_time_ns = static_cast<std::int64_t>(seed) + 22;
   m.armed = true;
   m.motor_throttle = {D(seed, 1), D(seed, 2), D(seed, 3), D(seed, 4), D(seed, 5), D(seed, 6)};
+  m.raft_leader = true;
+  m.world = {FullWorldCommand(seed), FullWorldCommand(seed + 1)};
+  m.radio_out = {FullRadioFrame(seed, 2), FullRadioFrame(seed + 5, 0)};
   return m;
 }
 
@@ -140,8 +145,25 @@ RadioPing FullRadioPing(std::uint64_t seed) {
   m.from = S(seed, "from");
   m.to = S(seed, "to");
   m.seq = seed + 81;
-  m.sent_wall_ns = static_cast<std::int64_t>(seed) + 82;
+  m.sent_ns = static_cast<std::int64_t>(seed) + 82;
   m.is_pong = true;
+  return m;
+}
+
+RadioFrame FullRadioFrame(std::uint64_t seed, int which) {
+  RadioFrame m;
+  m.from = S(seed, "from");
+  m.to = which == 1 ? std::string() : S(seed, "to");  // "" = broadcast
+  m.seq = seed + 85;
+  m.sent_ns = static_cast<std::int64_t>(seed) + 86;
+  m.delivered_ns = static_cast<std::int64_t>(seed) + 87;
+  m.size_bytes = static_cast<std::uint32_t>(seed + 88);
+  switch (which) {
+    case 0: m.state_msg = {FullDroneState(seed)}; break;
+    case 1: m.detection_msg = {FullDetection(seed)}; break;
+    case 2: m.raft_msg = {FullRaftMessage(seed, 40)}; break;
+    default: m.ping_msg = {FullRadioPing(seed)}; break;
+  }
   return m;
 }
 

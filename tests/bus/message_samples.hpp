@@ -21,6 +21,8 @@ DroneState FullDroneState(std::uint64_t seed);
 RaftMessage FullRaftMessage(std::uint64_t seed, std::size_t payload_bytes = 48);
 Detection FullDetection(std::uint64_t seed);
 RadioPing FullRadioPing(std::uint64_t seed);
+// `which`: 0 state, 1 detection (broadcast), 2 raft, 3 ping.
+RadioFrame FullRadioFrame(std::uint64_t seed, int which);
 Event FullEvent(std::uint64_t seed);
 
 // Overload set for generic tests: Full<T>(seed).

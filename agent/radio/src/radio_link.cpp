@@ -120,7 +120,7 @@ void RadioLink::SenderLoop() {
     for (const PongRequest& p : pongs) {
       msg.to = p.to;
       msg.seq = p.seq;
-      msg.sent_wall_ns = p.sent_wall_ns;
+      msg.sent_ns = p.sent_wall_ns;
       Publish(PongWriter(p.to), msg);
       pings_answered_.fetch_add(1, std::memory_order_relaxed);
     }
@@ -129,7 +129,7 @@ void RadioLink::SenderLoop() {
     for (const PingToSend& p : due) {
       msg.to = monitor_.peers()[p.peer];  // peers() never changes after construction
       msg.seq = p.seq;
-      msg.sent_wall_ns = SteadyNs(now);
+      msg.sent_ns = SteadyNs(now);
       Publish(*ping_writers_[p.peer], msg);
       pings_sent_.fetch_add(1, std::memory_order_relaxed);
     }
@@ -160,7 +160,7 @@ void RadioLink::OnSample(const bus::RadioPing& m) {
   if (!m.is_pong) {
     {
       std::lock_guard<std::mutex> lk(mu_);
-      pong_queue_.push_back(PongRequest{m.from, m.seq, m.sent_wall_ns});
+      pong_queue_.push_back(PongRequest{m.from, m.seq, m.sent_ns});
     }
     wake_.notify_one();
     return;

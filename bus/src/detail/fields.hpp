@@ -15,9 +15,9 @@
   F(position_enu_m) F(velocity_enu_m_s) F(h_acc_m) F(v_acc_m)
 #define SWARMBOX_BUS_FIELDS_BatterySample(F) F(valid) F(voltage_v) F(current_a) F(remaining)
 #define SWARMBOX_BUS_FIELDS_SensorSample(F) \
-  F(drone) F(step) F(sim_time_ns) F(imu) F(baro) F(mag) F(gps) F(battery)
+  F(drone) F(step) F(sim_time_ns) F(imu) F(baro) F(mag) F(gps) F(battery) F(camera_frame) F(radio_in)
 #define SWARMBOX_BUS_FIELDS_ActuatorCommand(F) \
-  F(drone) F(step) F(sim_time_ns) F(armed) F(motor_throttle)
+  F(drone) F(step) F(sim_time_ns) F(armed) F(motor_throttle) F(raft_leader) F(world) F(radio_out)
 #define SWARMBOX_BUS_FIELDS_CameraIntrinsics(F) F(fx_px) F(fy_px) F(cx_px) F(cy_px) F(distortion)
 #define SWARMBOX_BUS_FIELDS_Pose(F) F(position_enu_m) F(orientation_wxyz)
 #define SWARMBOX_BUS_FIELDS_CameraImage(F)                                                     \
@@ -30,14 +30,17 @@
 #define SWARMBOX_BUS_FIELDS_RaftMessage(F) F(from) F(to) F(term) F(payload)
 #define SWARMBOX_BUS_FIELDS_Detection(F)                                                       \
   F(from) F(seq) F(sim_time_ns) F(label) F(confidence) F(position_enu_m) F(position_sigma_m)
-#define SWARMBOX_BUS_FIELDS_RadioPing(F) F(from) F(to) F(seq) F(sent_wall_ns) F(is_pong)
+#define SWARMBOX_BUS_FIELDS_RadioPing(F) F(from) F(to) F(seq) F(sent_ns) F(is_pong)
+#define SWARMBOX_BUS_FIELDS_RadioFrame(F) \
+  F(from) F(to) F(seq) F(sent_ns) F(delivered_ns) F(size_bytes) F(state_msg) F(detection_msg) F(raft_msg) F(ping_msg)
 #define SWARMBOX_BUS_FIELDS_KeyValue(F) F(key) F(value)
 #define SWARMBOX_BUS_FIELDS_Event(F) F(node) F(sim_time_ns) F(name) F(fields)
 
 #define SWARMBOX_BUS_STRUCTS(S)                                                               \
+  S(DroneState) S(RaftMessage) S(Detection) S(RadioPing) S(RadioFrame) S(WorldCommand)        \
   S(ClockTick) S(ImuSample) S(BaroSample) S(MagSample) S(GpsSample) S(BatterySample)          \
   S(SensorSample) S(ActuatorCommand) S(CameraIntrinsics) S(Pose) S(CameraImage)               \
-  S(WorldCommand) S(DroneState) S(RaftMessage) S(Detection) S(RadioPing) S(KeyValue) S(Event)
+  S(KeyValue) S(Event)
 
 // The top-level message types (those with a MessageType), for dispatch.
 #define SWARMBOX_BUS_MESSAGES(M)                                                              \

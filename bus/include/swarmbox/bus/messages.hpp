@@ -25,7 +25,94 @@
 
 namespace swarmbox::bus {
 
+// ---- mesh domain: agent <-> agent (the radio; first: the sim domain carries them) -------------
+
+// What a drone tells its neighbours about itself, on kDroneStateTopic with Qos::kState. Keyed on
+// `drone`: a subscriber keeps the latest sample per drone.
+struct DroneState {
+  std::string drone;  // the key
+  std::uint64_t seq = 0;
+  std::int64_t sim_time_ns = 0;
+  std::int64_t wall_time_ns = 0;
+  std::array<double, 3> position_enu_m{};
+  std::array<double, 3> velocity_enu_m_s{};
+  double heading_rad = 0.0;       // yaw in world ENU: 0 = facing east, counter-clockwise positive
+  double battery_fraction = 0.0;  // [0, 1]
+  std::string mode;               // the agent's flight/mission mode, e.g. "search"
+  bool operator==(const DroneState&) const = default;
+};
+
+// A Raft message, on kRaftTopic with Qos::kRadio (best effort: Raft retries; loss stays visible).
+// The bus does not look inside `payload`.
+struct RaftMessage {
+  std::string from;
+  std::string to;  // recipient drone name; subscribers drop messages not addressed to them
+  std::uint64_t term = 0;
+  std::vector<std::uint8_t> payload;
+  bool operator==(const RaftMessage&) const = default;
+};
+
+// A perception result shared on the mesh, on kDetectionTopic with Qos::kRadio.
+struct Detection {
+  std::string from;  // the drone that saw it
+  std::uint64_t seq = 0;
+  std::int64_t sim_time_ns = 0;
+  std::string label;        // e.g. "victim"
+  double confidence = 0.0;  // [0, 1]
+  std::array<double, 3> position_enu_m{};
+  double position_sigma_m = 0.0;  // 1-sigma horizontal uncertainty of position_enu_m [m]
+  bool operator==(const Detection&) const = default;
+};
+
+// Radio ping/pong for RTT and loss, on kRadioPingTopic with Qos::kRadio. A pong copies `seq`
+// and `sent_ns` from its ping, swaps from/to and sets is_pong.
+struct RadioPing {
+  std::string from;
+  std::string to;
+  std::uint64_t seq = 0;
+  // When the original ping was sent, on the radio's clock: simulated ns with radio.model channel,
+  // the sender's steady clock with netem.
+  std::int64_t sent_ns = 0;
+  bool is_pong = false;
+  bool operator==(const RadioPing&) const = default;
+};
+
+// One frame on the simulated radio channel (radio.model: channel). An agent hands its frames to the
+// physics server in its ActuatorCommand (radio_out, delivered_ns 0); the channel decides whether and
+// when each arrives and hands it to each receiver in a SensorSample (radio_in, delivered_ns set), in
+// the order (delivered_ns, from, seq). Exactly one of state_msg, detection_msg, raft_msg, ping_msg holds
+// one element (the IDL is case-insensitive: `detection` would clash with the type Detection).
+struct RadioFrame {
+  std::string from;               // the sending drone
+  std::string to;                 // the receiving drone; "" = broadcast to every drone in range
+  std::uint64_t seq = 0;          // per sender, from 1, increasing
+  std::int64_t sent_ns = 0;       // simulated time the sender handed it to the radio
+  std::int64_t delivered_ns = 0;  // simulated time the channel delivered it (0 on the way out)
+  std::uint32_t size_bytes = 0;   // bytes on the air (the channel charges airtime for them)
+  std::vector<DroneState> state_msg;
+  std::vector<Detection> detection_msg;
+  std::vector<RaftMessage> raft_msg;
+  std::vector<RadioPing> ping_msg;
+  bool operator==(const RadioFrame&) const = default;
+};
+
 // ---- sim domain: physics server <-> agents ---------------------------------------------------
+
+// A command to the world (fault injection), to the physics server on kWorldCommandTopic with
+// Qos::kLockstep. The physics server owns the meaning of `command` and `args` and must reject
+// (log) unknown ones; the names in use are
+//   gps_dropout {duration_s}, gps_degrade {duration_s, h_acc_m, v_acc_m},
+//   imu_bias_jump {ax, ay, az [m/s^2], gx, gy, gz [rad/s]}, wind_gust {vx, vy, vz [m/s], duration_s},
+//   payload_attach {mass_kg}, payload_release {}.
+struct WorldCommand {
+  std::uint64_t seq = 0;          // per sender, increasing; lets the server drop duplicates
+  std::int64_t sim_time_ns = 0;   // when to apply it; at or before the current time = now
+  std::string target;             // drone name, or "" for the whole world (e.g. wind)
+  std::string command;            // e.g. "gps_dropout"
+  std::vector<double> args;       // numeric arguments, in the order documented for `command`
+  bool operator==(const WorldCommand&) const = default;
+};
+
 
 // Simulated clock, published by the physics server once per step on topic kClockTopic.
 struct ClockTick {
@@ -98,6 +185,12 @@ struct SensorSample {
   MagSample mag;
   GpsSample gps;
   BatterySample battery;
+  // A CameraImage of this step was published before this sample (the agent takes it before it
+  // steps, so perception sees the same frames at any speed).
+  bool camera_frame = false;
+  // radio.model channel: the frames the channel delivered to this drone in (previous step, this
+  // step], in delivery order. Empty with radio.model netem.
+  std::vector<RadioFrame> radio_in;
   bool operator==(const SensorSample&) const = default;
 };
 
@@ -109,6 +202,13 @@ struct ActuatorCommand {
   std::int64_t sim_time_ns = 0;
   bool armed = false;                 // false: motors off whatever motor_throttle says
   std::vector<double> motor_throttle;  // per motor, normalised [0, 1], in the airframe's motor order
+  // This agent's Raft node leads (the physics server resolves a `raft_leader` fault target at its
+  // simulated time from these: the drone that became leader last).
+  bool raft_leader = false;
+  // World commands of this step (payload attach/release), applied before the world steps.
+  std::vector<WorldCommand> world;
+  // radio.model channel: the frames this agent sends at this step (to the channel).
+  std::vector<RadioFrame> radio_out;
   bool operator==(const ActuatorCommand&) const = default;
 };
 
@@ -148,70 +248,6 @@ struct CameraImage {
   bool operator==(const CameraImage&) const = default;
 };
 
-// A command to the world (fault injection), to the physics server on kWorldCommandTopic with
-// Qos::kLockstep. The physics server owns the meaning of `command` and `args` and must reject
-// (log) unknown ones; the names in use are
-//   gps_dropout {duration_s}, gps_degrade {duration_s, h_acc_m, v_acc_m},
-//   imu_bias_jump {ax, ay, az [m/s^2], gx, gy, gz [rad/s]}, wind_gust {vx, vy, vz [m/s], duration_s},
-//   payload_attach {mass_kg}, payload_release {}.
-struct WorldCommand {
-  std::uint64_t seq = 0;          // per sender, increasing; lets the server drop duplicates
-  std::int64_t sim_time_ns = 0;   // when to apply it; at or before the current time = now
-  std::string target;             // drone name, or "" for the whole world (e.g. wind)
-  std::string command;            // e.g. "gps_dropout"
-  std::vector<double> args;       // numeric arguments, in the order documented for `command`
-  bool operator==(const WorldCommand&) const = default;
-};
-
-// ---- mesh domain: agent <-> agent (the radio) ----------------------------------------------
-
-// What a drone tells its neighbours about itself, on kDroneStateTopic with Qos::kState. Keyed on
-// `drone`: a subscriber keeps the latest sample per drone.
-struct DroneState {
-  std::string drone;  // the key
-  std::uint64_t seq = 0;
-  std::int64_t sim_time_ns = 0;
-  std::int64_t wall_time_ns = 0;
-  std::array<double, 3> position_enu_m{};
-  std::array<double, 3> velocity_enu_m_s{};
-  double heading_rad = 0.0;       // yaw in world ENU: 0 = facing east, counter-clockwise positive
-  double battery_fraction = 0.0;  // [0, 1]
-  std::string mode;               // the agent's flight/mission mode, e.g. "search"
-  bool operator==(const DroneState&) const = default;
-};
-
-// A Raft message, on kRaftTopic with Qos::kRadio (best effort: Raft retries; loss stays visible).
-// The bus does not look inside `payload`.
-struct RaftMessage {
-  std::string from;
-  std::string to;  // recipient drone name; subscribers drop messages not addressed to them
-  std::uint64_t term = 0;
-  std::vector<std::uint8_t> payload;
-  bool operator==(const RaftMessage&) const = default;
-};
-
-// A perception result shared on the mesh, on kDetectionTopic with Qos::kRadio.
-struct Detection {
-  std::string from;  // the drone that saw it
-  std::uint64_t seq = 0;
-  std::int64_t sim_time_ns = 0;
-  std::string label;        // e.g. "victim"
-  double confidence = 0.0;  // [0, 1]
-  std::array<double, 3> position_enu_m{};
-  double position_sigma_m = 0.0;  // 1-sigma horizontal uncertainty of position_enu_m [m]
-  bool operator==(const Detection&) const = default;
-};
-
-// Radio ping/pong for RTT and loss, on kRadioPingTopic with Qos::kRadio. A pong copies `seq`
-// and `sent_wall_ns` from its ping, swaps from/to and sets is_pong.
-struct RadioPing {
-  std::string from;
-  std::string to;
-  std::uint64_t seq = 0;
-  std::int64_t sent_wall_ns = 0;  // wall clock of the original ping's sender
-  bool is_pong = false;
-  bool operator==(const RadioPing&) const = default;
-};
 
 // ---- both domains ------------------------------------------------------------------------
 
