@@ -140,6 +140,8 @@ class Channel {
   const ChannelStats& stats() const { return stats_; }
   const RadioProfile& profile() const { return profile_; }
   std::size_t drone_count() const { return drones_; }
+  // The largest until_ns given to TakeDeliveries so far (the earliest time Send accepts).
+  std::int64_t taken_until_ns() const { return watermark_ns_; }
   // The link from -> to at the current positions (no random draw beyond the seeded shadowing).
   LinkState Link(std::size_t from, std::size_t to) const;
   // Airtime of a frame of `size_bytes` [ns] (size*8/data_rate + overhead, at least 1 ns).
