@@ -78,18 +78,44 @@ bool SegmentCrossesBox(const Vec3d& a_in, const Vec3d& b_in, const Box& box) {
   return true;
 }
 
-Status ValidateImpairment(const Impairment& m) {
-  auto bad = [](std::string message) { return Error(ErrorCode::kInvalidArgument, std::move(message)); };
+namespace {
+
+// The first problem of an impairment: (key, message), or nullopt.
+std::optional<std::pair<const char*, std::string>> ImpairmentProblem(const Impairment& m) {
   if (m.distribution != "normal" && m.distribution != "uniform") {
-    return bad("the simulated channel does not support jitter distribution '" + m.distribution +
-               "' (supported: normal, uniform)");
+    return std::make_pair("distribution", "the simulated channel does not support jitter distribution '" +
+                                              m.distribution + "' (supported: normal, uniform)");
   }
-  if (!(m.delay_ms >= 0) || !std::isfinite(m.delay_ms)) return bad("delay_ms must be at least 0");
-  if (!(m.jitter_ms >= 0) || !std::isfinite(m.jitter_ms)) return bad("jitter_ms must be at least 0");
-  if (!(m.loss >= 0 && m.loss <= 1)) return bad("loss must be in [0, 1]");
-  if (!(m.duplicate >= 0 && m.duplicate <= 1)) return bad("duplicate must be in [0, 1]");
-  if (!(m.rate_kbit >= 0) || !std::isfinite(m.rate_kbit)) return bad("rate_kbit must be at least 0");
+  if (!(m.delay_ms >= 0) || !std::isfinite(m.delay_ms)) return std::make_pair("delay_ms", std::string("delay_ms must be at least 0"));
+  if (!(m.jitter_ms >= 0) || !std::isfinite(m.jitter_ms)) return std::make_pair("jitter_ms", std::string("jitter_ms must be at least 0"));
+  if (!(m.loss >= 0 && m.loss <= 1)) return std::make_pair("loss", std::string("loss must be in [0, 1]"));
+  if (!(m.duplicate >= 0 && m.duplicate <= 1)) return std::make_pair("duplicate", std::string("duplicate must be in [0, 1]"));
+  if (!(m.rate_kbit >= 0) || !std::isfinite(m.rate_kbit)) return std::make_pair("rate_kbit", std::string("rate_kbit must be at least 0"));
+  return std::nullopt;
+}
+
+}  // namespace
+
+Status ValidateImpairment(const Impairment& m) {
+  if (auto p = ImpairmentProblem(m)) return Error(ErrorCode::kInvalidArgument, std::move(p->second));
   return Ok{};
+}
+
+Result<Impairment> ParseImpairment(const yaml::Node& node) {
+  Impairment m;
+  yaml::MapReader r(node, "impairment");
+  r.Optional("delay_ms", &m.delay_ms)
+      .Optional("jitter_ms", &m.jitter_ms)
+      .Optional("distribution", &m.distribution)
+      .Optional("loss", &m.loss)
+      .Optional("rate_kbit", &m.rate_kbit)
+      .Optional("duplicate", &m.duplicate);
+  if (auto s = r.Finish(); !s) return s.error();
+  if (auto p = ImpairmentProblem(m)) {
+    const yaml::Node* at = node.Find(p->first);
+    return Error(ErrorCode::kInvalidArgument, std::move(p->second), at != nullptr ? at->Where() : node.Where());
+  }
+  return m;
 }
 
 Channel::Channel(RadioProfile profile, std::size_t drone_count, std::uint64_t seed, std::vector<Box> obstacles)

@@ -166,3 +166,48 @@ TEST(ChannelImpairment, RefusesValuesOutOfRange) {
 
 }  // namespace
 }  // namespace swarmbox::channel
+
+namespace swarmbox::channel {
+namespace {
+
+TEST(ChannelImpairment, ParsesTheRadioPlansNetemSpec) {
+  auto doc = yaml::Parse(
+      R"({"delay_ms": 100, "jitter_ms": 20, "distribution": "uniform", "loss": 0.05, "rate_kbit": 0, "duplicate": 0.01})",
+      "plan.json");
+  ASSERT_TRUE(doc.ok());
+  auto m = ParseImpairment(*doc);
+  ASSERT_TRUE(m.ok()) << m.error().ToString();
+  EXPECT_EQ(m->delay_ms, 100);
+  EXPECT_EQ(m->jitter_ms, 20);
+  EXPECT_EQ(m->distribution, "uniform");
+  EXPECT_EQ(m->loss, 0.05);
+  EXPECT_EQ(m->duplicate, 0.01);
+
+  doc = yaml::Parse(R"({"delay_ms": 300, "loss": 0.2})", "plan.json");
+  m = ParseImpairment(*doc);
+  ASSERT_TRUE(m.ok());
+  EXPECT_EQ(m->distribution, "normal");
+  EXPECT_EQ(m->jitter_ms, 0);
+}
+
+TEST(ChannelImpairment, ParseErrorsPointAtTheKey) {
+  auto doc = yaml::Parse("{\"delay_ms\": 100,\n \"distribution\": \"pareto\"}", "plan.json");
+  ASSERT_TRUE(doc.ok());
+  auto m = ParseImpairment(*doc);
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.error().where(), "plan.json:2:18");  // the value
+  EXPECT_NE(m.error().message().find("supported: normal, uniform"), std::string::npos);
+
+  doc = yaml::Parse("{\"delay_ms\": 100, \"reorder_gap\": 5}", "plan.json");
+  m = ParseImpairment(*doc);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.error().message().find("unknown key 'reorder_gap'"), std::string::npos) << m.error().message();
+
+  doc = yaml::Parse("{\"loss\": 2}", "plan.json");
+  m = ParseImpairment(*doc);
+  ASSERT_FALSE(m.ok());
+  EXPECT_EQ(m.error().where(), "plan.json:1:10");
+}
+
+}  // namespace
+}  // namespace swarmbox::channel

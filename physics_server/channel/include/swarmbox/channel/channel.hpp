@@ -43,6 +43,7 @@
 
 #include "swarmbox/channel/radio_profile.hpp"
 #include "swarmbox/common/result.hpp"
+#include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::channel {
 
@@ -72,6 +73,10 @@ struct Impairment {
 // Ok, or why the channel cannot carry the impairment out (an unsupported distribution names the
 // supported ones).
 Status ValidateImpairment(const Impairment& impairment);
+// Reads a netem spec mapping ({delay_ms, jitter_ms, distribution, loss, rate_kbit, duplicate}, all
+// optional: the radio plan's `mesh` and `impairment` objects) and validates it. Errors carry
+// file:line:col of the offending key; unknown keys (reorder_gap, corrupt...) are errors.
+Result<Impairment> ParseImpairment(const yaml::Node& node);
 
 struct Packet {
   std::size_t from = 0;                  // drone index
