@@ -211,3 +211,60 @@ TEST(ChannelImpairment, ParseErrorsPointAtTheKey) {
 
 }  // namespace
 }  // namespace swarmbox::channel
+
+namespace swarmbox::channel {
+namespace {
+
+// The figure: network.mesh delay 150 jitter 10 loss 0.10 on every sender gives a ping
+// round trip of ~300 simulated ms and ~19 % loss (1 - 0.9^2), with B answering at the lockstep step
+// in which the ping reached it.
+TEST(ChannelImpairment, PingRoundTripIsTwiceTheDelayAndLossCompoundsBothWays) {
+  Channel ch(testing::CleanProfile(), 2, 42, {});
+  ch.SetPositions(testing::LineUp(2, 10));
+  Impairment imp;
+  imp.delay_ms = 150;
+  imp.jitter_ms = 10;
+  imp.loss = 0.10;
+  ch.SetImpairment(std::nullopt, imp);
+  constexpr int kPings = 5000;
+  constexpr std::int64_t kStep = 4'000'000, kPeriod = 500'000'000;
+  std::vector<double> rtt_ms;
+  std::vector<Delivery> got;
+  std::uint64_t pong_seq = 0;
+  const std::int64_t end = kPings * kPeriod + 1'000'000'000;
+  for (std::int64_t t = 0; t <= end; t += kStep) {
+    got.clear();
+    ch.TakeDeliveries(t, &got);
+    for (const Delivery& d : got) {
+      if (d.to == 1) {  // a ping at B: answer now, carrying the ping's send time
+        Packet pong;
+        pong.from = 1;
+        pong.to = 0;
+        pong.seq = pong_seq++;
+        pong.size_bytes = 100;
+        pong.sent_ns = t;
+        pong.token = static_cast<std::uint64_t>(d.packet.sent_ns);
+        ch.Send(t, pong);
+      } else {
+        rtt_ms.push_back(static_cast<double>(d.at_ns - static_cast<std::int64_t>(d.packet.token)) * 1e-6);
+      }
+    }
+    if (t % kPeriod == 0 && t / kPeriod < kPings) {
+      Packet ping;
+      ping.from = 0;
+      ping.to = 1;
+      ping.seq = static_cast<std::uint64_t>(t / kPeriod);
+      ping.size_bytes = 100;
+      ping.sent_ns = t;
+      ch.Send(t, ping);
+    }
+  }
+  const double loss = 1.0 - static_cast<double>(rtt_ms.size()) / kPings;
+  EXPECT_NEAR(loss, 0.19, 0.015);  // binomial sd 0.0055
+  std::sort(rtt_ms.begin(), rtt_ms.end());
+  // 2 x 150 ms, plus 2 airtimes (0.9 ms) and B's wait for its step (2 ms on average).
+  EXPECT_NEAR(rtt_ms[rtt_ms.size() / 2], 300.0 + 1.8 + 2.0, 1.5);
+}
+
+}  // namespace
+}  // namespace swarmbox::channel
