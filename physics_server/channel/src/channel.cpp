@@ -37,8 +37,8 @@ bool EgressAfter(std::int64_t at_a, const Packet& a, std::uint32_t copy_a, std::
   return std::tie(at_a, a.from, a.seq, copy_a) > std::tie(at_b, b.from, b.seq, copy_b);
 }
 
-bool DeliveryAfter(const Delivery& a, const Delivery& b) {
-  return std::tie(a.at_ns, a.packet.from, a.packet.seq, a.to) > std::tie(b.at_ns, b.packet.from, b.packet.seq, b.to);
+bool DeliveryBefore(const Delivery& a, const Delivery& b) {
+  return std::tie(a.at_ns, a.packet.from, a.packet.seq, a.to) < std::tie(b.at_ns, b.packet.from, b.packet.seq, b.to);
 }
 
 std::int64_t NsFromSeconds(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
@@ -124,6 +124,8 @@ Channel::Channel(RadioProfile profile, std::size_t drone_count, std::uint64_t se
       seed_(seed),
       obstacles_(std::move(obstacles)),
       positions_(drone_count),
+      cells_(drone_count),
+      shadow_memo_(drone_count * (drone_count > 0 ? drone_count - 1 : 0) / 2),
       senders_(drone_count),
       blocked_(drone_count * drone_count, false) {
   if (auto s = ValidateRadioProfile(profile_); !s) {
@@ -131,6 +133,7 @@ Channel::Channel(RadioProfile profile, std::size_t drone_count, std::uint64_t se
   }
   SWARMBOX_CHECK(ValidateRadioProfile(profile_).ok());
   for (SenderState& s : senders_) s.ring.resize(profile_.queue_frames);
+  std::fill(cells_.begin(), cells_.end(), CellHash(Vec3d{}, profile_.path_loss.decorrelation_m));
   pending_.reserve(drone_count * 4);
   deliveries_.reserve(drone_count * drone_count);
 }
@@ -138,6 +141,7 @@ Channel::Channel(RadioProfile profile, std::size_t drone_count, std::uint64_t se
 void Channel::SetPositions(std::span<const Vec3d> positions_m) {
   SWARMBOX_CHECK(positions_m.size() == drones_);
   std::copy(positions_m.begin(), positions_m.end(), positions_.begin());
+  for (std::size_t i = 0; i < drones_; ++i) cells_[i] = CellHash(positions_[i], profile_.path_loss.decorrelation_m);
 }
 
 void Channel::SetImpairment(std::optional<std::size_t> sender, const Impairment& impairment) {
@@ -329,26 +333,32 @@ void Channel::Receive(std::int64_t end_ns, const Egress& e, std::size_t to) {
   }
   ++stats_.delivered;
   deliveries_.push_back(Delivery{to, end_ns + NsFromSeconds(d / kSpeedOfLightM_S), e.packet});
-  std::push_heap(deliveries_.begin(), deliveries_.end(), DeliveryAfter);
 }
 
 void Channel::TakeDeliveries(std::int64_t until_ns, std::vector<Delivery>* out) {
   AdvanceMedium(until_ns);
   watermark_ns_ = std::max(watermark_ns_, until_ns);
-  while (!deliveries_.empty() && deliveries_.front().at_ns <= until_ns) {
-    std::pop_heap(deliveries_.begin(), deliveries_.end(), DeliveryAfter);
-    out->push_back(deliveries_.back());
-    deliveries_.pop_back();
-  }
+  // The in-flight deliveries are few (those of the last airtime or so): partition, then sort the
+  // due ones. Deliveries equal in the sort key are equal in content (a duplicate's twin).
+  const auto due_end = std::partition(deliveries_.begin(), deliveries_.end(),
+                                      [until_ns](const Delivery& d) { return d.at_ns <= until_ns; });
+  const auto first = static_cast<std::ptrdiff_t>(out->size());
+  out->insert(out->end(), deliveries_.begin(), due_end);
+  deliveries_.erase(deliveries_.begin(), due_end);
+  std::sort(out->begin() + first, out->end(), DeliveryBefore);
 }
 
 double Channel::ShadowingDb(std::size_t a, std::size_t b) const {
   const PathLossModel& m = profile_.path_loss;
-  if (m.shadowing_sigma_db <= 0) return 0.0;
+  if (m.shadowing_sigma_db <= 0 || a == b) return 0.0;
   const std::size_t lo = std::min(a, b), hi = std::max(a, b);
-  const std::uint64_t h = DrawHash(seed_, PurposeCode(Purpose::kShadowing), lo, CellHash(positions_[lo], m.decorrelation_m),
-                                   static_cast<std::int64_t>(CellHash(positions_[hi], m.decorrelation_m)), hi);
-  return m.shadowing_sigma_db * detail::StandardNormal(h);
+  // A pure function of (seed, pair, cells); the memo only saves recomputing it.
+  ShadowMemo& memo = shadow_memo_[hi * (hi - 1) / 2 + lo];
+  if (memo.valid && memo.cell_lo == cells_[lo] && memo.cell_hi == cells_[hi]) return memo.db;
+  const std::uint64_t h = DrawHash(seed_, PurposeCode(Purpose::kShadowing), lo, cells_[lo],
+                                   static_cast<std::int64_t>(cells_[hi]), hi);
+  memo = ShadowMemo{cells_[lo], cells_[hi], m.shadowing_sigma_db * detail::StandardNormal(h), true};
+  return memo.db;
 }
 
 int Channel::ObstaclesBetween(const Vec3d& a, const Vec3d& b) const {

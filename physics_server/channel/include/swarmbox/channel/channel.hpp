@@ -175,16 +175,25 @@ class Channel {
   double ShadowingDb(std::size_t a, std::size_t b) const;
   int ObstaclesBetween(const Vec3d& a, const Vec3d& b) const;
 
+  // The shadowing of an unordered pair for the cells it was drawn in (a memo of ShadowingDb).
+  struct ShadowMemo {
+    std::uint64_t cell_lo = 0, cell_hi = 0;
+    double db = 0;
+    bool valid = false;
+  };
+
   RadioProfile profile_;
   std::size_t drones_;
   std::uint64_t seed_;
   std::vector<Box> obstacles_;
   std::vector<Vec3d> positions_;
+  std::vector<std::uint64_t> cells_;      // hash of each drone's shadowing cell
+  mutable std::vector<ShadowMemo> shadow_memo_;  // [hi * (hi - 1) / 2 + lo], lo < hi
   std::vector<SenderState> senders_;
   std::vector<bool> blocked_;            // drones_ x drones_, [from * drones_ + to]
   std::optional<Impairment> default_impairment_;
   std::vector<Egress> pending_;          // min-heap on (egress_ns, from, seq, copy)
-  std::vector<Delivery> deliveries_;     // min-heap on (at_ns, from, seq, to)
+  std::vector<Delivery> deliveries_;     // made, not yet taken (unordered)
   std::int64_t medium_free_ns_ = 0;
   std::size_t next_sender_ = 0;          // round-robin cursor
   std::size_t queued_ = 0;               // frames in all sender queues
