@@ -93,9 +93,10 @@ struct Delivery {
   Packet packet;
 };
 
-// Counters since construction. A frame counts once in `sent`; each lost_* and `delivered` counts
-// per (frame copy, receiver) except lost_impairment, lost_queue and lost_out (sender side), which
-// count per frame copy.
+// Counters since construction. `sent` counts Send calls; lost_impairment counts frames,
+// lost_queue frame copies; delivered, lost_range, lost_per and lost_partition count (frame copy,
+// receiver) pairs; lost_out counts frames or copies of an out sender and (copy, receiver) pairs of
+// an out receiver.
 struct ChannelStats {
   std::uint64_t sent = 0;            // Send calls
   std::uint64_t delivered = 0;       // deliveries made
