@@ -1,8 +1,9 @@
 // The passive RaftService without DDS or wall clock (unit): services in one thread on a
 // ManualClock, wired through SimRadio (sim_radio.hpp). The tick grid and its cap after a clock
-// jump; the loud stop when storage fails; junk survived; a restart re-applying the log; three
-// nodes electing and committing, byte for byte the same event lines for the same inputs; and the
-// failover time after a leader stops, with the trial's timings over a 100 +- 20 ms / 5% link.
+// jump, and a paused follower rejoining; the loud stop when storage fails; junk survived; a
+// restart re-applying the log; three nodes electing and committing, byte for byte the same event
+// lines for the same inputs; and the failover time after a leader stops, with the trial's
+// timings over a 100 +- 20 ms / 5% link.
 #include "swarmbox/mission/raft_service.hpp"
 
 #include <gtest/gtest.h>
@@ -277,7 +278,9 @@ class SimCluster {
     }
     return true;
   }
+  // Out of the loop: no ticks, and what is sent to it is lost (a stopped, paused or out drone).
   void Stop(std::size_t i) { up_[i] = false; }
+  void Resume(std::size_t i) { up_[i] = true; }
 
   RaftService& node(std::size_t i) { return *nodes_[i]; }
   bool up(std::size_t i) const { return up_[i]; }
@@ -349,6 +352,42 @@ TEST(RaftServiceSim, ThreeNodesElectAndCommitTheSameWayEveryTime) {
   // Another seed (election timeouts and the link's draws) gives another run.
   const std::vector<std::string> other = ElectAndCommit(8, tmp.path + "/c");
   EXPECT_NE(Joined(first), Joined(other));
+}
+
+// A follower paused for 10 s (docker pause, or out of the lockstep) comes back with its clock
+// 10 s later: Tick() runs the capped catch-up and drops the rest, the node rejoins on the
+// leader's next heartbeat and catches up, and nobody's term moves (no election, Raft §5.2; PreVote
+// and CheckQuorum would also refuse one while the leader is healthy).
+TEST(RaftServiceSim, APausedFollowerRejoinsWithoutAnElection) {
+  const TempDir tmp("swarmbox_raft_pause_");
+  SimCluster c(kTrio, TrialTimings(5), FailoverLink(5), tmp.path);
+  ASSERT_TRUE(c.ok());
+  ASSERT_TRUE(c.RunUntil([&] { return c.Leader().has_value(); }, 20.0)) << Joined(c.lines());
+  const std::size_t l = *c.Leader();
+  ASSERT_TRUE(c.RunUntil([&] { return c.node(l).Propose(raft::StartSearch{}).ok(); }, 25.0));
+  ASSERT_TRUE(c.RunUntil([&] { return c.AllUpIn(raft::MissionPhase::kSearch); }, 30.0));
+  const std::size_t f = (l + 1) % c.size();
+  const std::uint64_t term = c.node(l).term();
+  const std::uint64_t ticks_before = c.node(f).ticks();
+  const double paused_at = c.clock().NowS();
+  c.Stop(f);
+  // The others go on and commit without it (two of three are a quorum).
+  ASSERT_TRUE(c.node(l).Propose(raft::ReturnHome{}));
+  c.RunUntil([] { return false; }, paused_at + 10.0);
+  ASSERT_EQ(c.node(l).mission().phase(), raft::MissionPhase::kReturn);
+  c.Resume(f);
+  ASSERT_TRUE(c.RunUntil([&] { return c.node(f).mission().phase() == raft::MissionPhase::kReturn; },
+                         paused_at + 15.0))
+      << Joined(c.lines());
+  c.RunUntil([] { return false; }, paused_at + 20.0);
+  // 10 s owed 200 ticks: 4 ran at once (heartbeat_ms / tick_ms), 196 were dropped.
+  EXPECT_EQ(c.node(f).dropped_ticks(), 196u);
+  EXPECT_EQ(c.node(f).ticks() - ticks_before, 400u - 196u);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    EXPECT_EQ(c.node(i).term(), term) << c.name(i) << "\n" << Joined(c.lines());
+    EXPECT_EQ(c.node(i).leader(), c.name(l)) << c.name(i);
+    EXPECT_EQ(c.node(i).mission(), c.node(l).mission()) << c.name(i);
+  }
 }
 
 struct Failover {
