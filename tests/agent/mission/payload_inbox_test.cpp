@@ -58,8 +58,10 @@ TEST(PayloadInbox, WaitUntilReturnsOnArrivalOrDeadline) {
 TEST(PayloadInbox, ManyProducersOneConsumerLoseNothing) {
   constexpr int kThreads = 4;
   constexpr int kEach = 2000;
-  PayloadInbox inbox(kThreads * kEach);
+  constexpr std::size_t kTotal = std::size_t{kThreads} * kEach;
+  PayloadInbox inbox(kTotal);
   std::vector<std::thread> producers;
+  producers.reserve(kThreads);
   for (int t = 0; t < kThreads; ++t) {
     producers.emplace_back([&inbox, t] {
       for (int i = 0; i < kEach; ++i) {
@@ -68,13 +70,13 @@ TEST(PayloadInbox, ManyProducersOneConsumerLoseNothing) {
     });
   }
   std::vector<raft::Bytes> got;
-  while (got.size() < static_cast<std::size_t>(kThreads * kEach)) {
+  while (got.size() < kTotal) {
     inbox.WaitUntil(std::chrono::steady_clock::now() + 100ms);
     inbox.Drain(&got);
   }
   for (std::thread& p : producers) p.join();
   inbox.Drain(&got);
-  EXPECT_EQ(got.size(), static_cast<std::size_t>(kThreads * kEach));
+  EXPECT_EQ(got.size(), kTotal);
   EXPECT_EQ(inbox.drops(), 0u);
   // Each producer's payloads arrive in its own order (i % 256 counts up per thread).
   std::vector<int> next(kThreads, 0);

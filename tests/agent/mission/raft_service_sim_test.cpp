@@ -224,7 +224,7 @@ TEST(RaftServiceSim, RestartReappliesTheDurableLog) {
 // every 4 ms, node by node in order, the deliveries due (in delivery order), then Tick().
 class SimCluster {
  public:
-  SimCluster(std::vector<std::string> names, const raft::DriverConfig& timings, SimLink link,
+  SimCluster(const std::vector<std::string>& names, const raft::DriverConfig& timings, SimLink link,
              const std::string& dir)
       : names_(names), radio_(names, link, clock_), up_(names.size(), true) {
     for (std::size_t i = 0; i < names_.size(); ++i) {
@@ -295,8 +295,8 @@ class SimCluster {
   ManualClock clock_;
   SimRadio radio_;
   std::vector<bool> up_;
-  std::vector<std::unique_ptr<RaftService>> nodes_;
   std::vector<std::string> lines_;  // every node's events, in the order they were printed
+  std::vector<std::unique_ptr<RaftService>> nodes_;  // last: destroyed first
   std::vector<raft::Bytes> batch_;
 };
 
