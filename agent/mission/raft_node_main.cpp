@@ -1,40 +1,33 @@
 // swarmbox-raft-node: one drone's Raft node (RaftService) on the mesh radio, as a program.
-// The stand-in until swarmbox-agent hosts RaftService; used by the integration tests
-// (tests/agent/mission/) and for trying consensus over a real (netem) radio by hand:
+// Used by the integration tests (tests/agent/mission/) and for trying consensus over a real
+// (netem) radio by hand:
 //
 //   swarmbox-raft-node --name scout_1 --members scout_1,scout_2,lifter --data-dir /tmp/r1
 //       --domain 180 --interface lo --middleware cyclonedds --seed 42 --propose-every-ms 500
 //
 // Prints the contract events (event=leader_elected, mission_state, victim_confirmed, ...) on
-// stdout, `t` = seconds since the program started (no physics here: wall clock stands in for
-// simulated time). Runs until SIGTERM/SIGINT (exit 0) or --duration-s; exits 1 when the storage
-// fails (event=raft_stopped), 2 on bad usage, 3 when the bus or the storage cannot be opened.
+// stdout, `t` = seconds since the program started (no physics here: the monotonic clock stands in
+// for simulated time, as in the agent's netem radio model). Runs until SIGTERM/SIGINT (exit 0) or
+// --duration-s; exits 1 when the storage fails (event=raft_stopped), 2 on bad usage, 3 when the
+// bus or the storage cannot be opened.
 //
-// HOSTING RaftService IN swarmbox-agent (a few lines; agent/app/ is the flight engineer's):
-//   1. agent/app/CMakeLists.txt: target_link_libraries(swarmbox-agent PRIVATE swarmbox::mission)
-//   2. after the agent has its mesh bus::Participant (`mesh`) and a raft::Clock returning the
-//      agent's simulated seconds (`sim_clock`, must outlive the service):
-//        #include "swarmbox/mission/raft_service.hpp"
-//        mission::RaftServiceConfig rc;
-//        rc.driver.self = drone_name;  rc.driver.members = all_drone_names;  // same on all drones
-//        rc.driver.seed = trial_seed;  rc.data_dir = raft_data_dir;          // e.g. a volume
-//        // optional: raft::ReadRaftOptions(trial_raft_mapping, &rc.driver);
-//        auto raft = mission::RaftService::Start(rc, *mesh, sim_clock);   // events -> stdout
-//        if (!raft) { fprintf(stderr, "%s\n", raft.error().ToString().c_str()); return 3; }
-//   3. in the agent's main loop: `if ((*raft)->WaitStopped(0ms)) return 1;` (storage failed);
-//      propose with (*raft)->Propose(cmd) from any thread, read (*raft)->mission() for the plan.
-//   4. destroy the service before the mesh participant.
+// The loop is what a host of the passive RaftService does on the wall clock: RaftRadio's
+// middleware callback pushes payloads into a PayloadInbox; the loop sleeps until the next tick,
+// the next proposal or the first arrival (whichever is first), feeds what arrived in arrival
+// order, then calls Tick(). A payload is thus handled within microseconds of its arrival, as
+// with the former service thread.
+#include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <string>
 #include <vector>
 
-#include <chrono>
-#include <thread>
-
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/mission/demo_mission.hpp"
+#include "swarmbox/mission/payload_inbox.hpp"
 #include "swarmbox/mission/raft_node_options.hpp"
+#include "swarmbox/mission/raft_radio.hpp"
 #include "swarmbox/mission/raft_service.hpp"
 
 namespace {
@@ -47,6 +40,11 @@ class SinceStartClock final : public swarmbox::raft::Clock {
  public:
   double NowS() const override {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  // The steady-clock instant of clock time `t_s`.
+  std::chrono::steady_clock::time_point At(double t_s) const {
+    return start_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double>(t_s));
   }
 
  private:
@@ -79,10 +77,18 @@ int main(int argc, char** argv) {
     return 3;
   }
   SinceStartClock clock;
+  mission::PayloadInbox inbox;  // before the radio: its callback pushes here until it is gone
+  // A writer per member (RaftRadio: reordering on the radio must not become extra loss).
+  auto radio = mission::RaftRadio::Create(**mesh, opts->driver.self, opts->driver.members,
+                                          [&inbox](std::span<const std::uint8_t> b) { inbox.Push(b); });
+  if (!radio) {
+    std::fprintf(stderr, "swarmbox-raft-node: %s\n", radio.error().ToString().c_str());
+    return 3;
+  }
   mission::RaftServiceConfig cfg;
   cfg.driver = opts->driver;
   cfg.data_dir = opts->data_dir;
-  auto service = mission::RaftService::Start(cfg, **mesh, clock);
+  auto service = mission::RaftService::Start(cfg, **radio, clock);
   if (!service) {
     std::fprintf(stderr, "swarmbox-raft-node: %s\n", service.error().ToString().c_str());
     return 3;
@@ -92,17 +98,20 @@ int main(int argc, char** argv) {
   const auto start = steady_clock::now();
   const auto propose_every = milliseconds(opts->propose_every_ms);
   auto next_propose = start + propose_every;
+  std::vector<raft::Bytes> batch;
   int code = 0;
   while (g_signal == 0) {
-    if (raft.WaitStopped(milliseconds(20))) {
-      std::fprintf(stderr, "swarmbox-raft-node: stopped: %s\n",
-                   raft.health().error().ToString().c_str());
-      code = 1;
-      break;
-    }
+    // Wake for the next tick, the next proposal, the first arrival, or at least every 20 ms (a
+    // signal or the duration ending).
+    auto wake = std::min(clock.At(raft.next_tick_s()), steady_clock::now() + milliseconds(20));
+    if (opts->propose_every_ms > 0) wake = std::min(wake, next_propose);
+    inbox.WaitUntil(wake);
+    batch.clear();
+    inbox.Drain(&batch);
+    for (const raft::Bytes& b : batch) raft.OnPayload(b);
+    (void)raft.Tick();
     const auto now = steady_clock::now();
-    if (opts->duration_s > 0 && now - start >= duration<double>(opts->duration_s)) break;
-    if (opts->propose_every_ms > 0 && now >= next_propose) {
+    if (opts->propose_every_ms > 0 && now >= next_propose && !raft.stopped()) {
       next_propose = now + propose_every;
       if (raft.is_leader()) {
         if (auto cmd = mission::NextDemoCommand(raft.mission(), raft.self())) {
@@ -110,7 +119,14 @@ int main(int argc, char** argv) {
         }
       }
     }
+    if (Status h = raft.health(); !h) {
+      std::fprintf(stderr, "swarmbox-raft-node: stopped: %s\n", h.error().ToString().c_str());
+      code = 1;
+      break;
+    }
+    if (opts->duration_s > 0 && now - start >= duration<double>(opts->duration_s)) break;
   }
   service->reset();
+  radio->reset();  // no callback into the inbox after this
   return code;
 }

@@ -1,9 +1,11 @@
-// RaftService: one drone's Raft node running on wall-clock time over the mesh radio.
+// RaftService: one drone's Raft node, driven by its caller's loop on the caller's clock.
 //
-// Owns a raft::NodeDriver (node_driver.hpp), its WalStorage in `data_dir`, and a RaftRadio
-// (raft_radio.hpp) on the caller's mesh bus::Participant. One thread of its own calls Tick()
-// every tick_ms of wall-clock time and feeds the bytes the radio received into the driver; the
-// driver is not thread-safe, so that thread and the public calls share one lock.
+// Owns a raft::NodeDriver (node_driver.hpp) and its WalStorage in `data_dir`. It has no thread
+// and no bus: the caller hands it the received Raft payloads (OnPayload) and calls Tick() on its
+// loop; the node's messages go out through the caller's raft::Transport, synchronously inside
+// these calls. Time is the caller's raft::Clock: the agent's simulated seconds (radio model
+// `channel`), or a monotonic clock (radio model `netem`, swarmbox-raft-node). The same sequence
+// of calls with the same clock readings gives the same messages and the same event lines.
 //
 //   RaftServiceConfig cfg;
 //   cfg.driver.self = "scout_1";
@@ -11,42 +13,52 @@
 //   cfg.driver.seed = trial_seed;
 //   ReadRaftOptions(trial_raft_mapping, &cfg.driver);       // per-trial timings (optional)
 //   cfg.data_dir = "/var/lib/swarmbox/raft";
-//   auto raft = RaftService::Start(cfg, *mesh, sim_clock);   // prints events on stdout
+//   auto raft = RaftService::Start(cfg, transport, sim_clock);   // prints events on stdout
 //   if (!raft) { print raft.error(); exit(1); }
-//   (*raft)->Propose(raft::StartSearch{});   // any thread; kUnavailable: no leader yet, retry
-//   raft::MissionState m = (*raft)->mission();   // a copy of the committed mission
-//   if ((*raft)->WaitStopped(100ms)) exit(1);    // storage failed: the node must die loudly
+//   every control step, at simulated time t_k (the clock reads t_k):
+//     for (payload : raft payloads delivered this step, in delivery order) (*raft)->OnPayload(payload);
+//     if (Status s = (*raft)->Tick(); !s) exit(1);   // storage failed: the node must die loudly
+//     (*raft)->Propose(raft::StartSearch{});         // kUnavailable: no leader known, retry later
+//     raft::MissionState m = (*raft)->mission();     // a copy of the committed mission
+//
+// Ticks: Tick() runs the driver's ticks due by clock.NowS() on a fixed grid, start + n * tick_ms,
+// where `start` is the clock at Start() (read in whole microseconds, so float noise in the clock
+// cannot move a tick across a step). Calling Tick() more often than every tick_ms is free (it
+// runs none); a call late by up to max_catch_up_ticks() ticks runs every tick it owes. A longer
+// gap (the process was paused or stopped, the drone was out of the lockstep, the machine stalled)
+// runs max_catch_up_ticks() ticks and drops the rest (dropped_ticks()), then goes on on the same
+// grid: the node heard nothing during the gap, and replaying all of its ticks at once, without
+// the messages that would have come between them, would fire every timer together and send a
+// burst of stale (pre-)votes. Dropping missed ticks is what a Go time.Ticker does to a slow etcd
+// node, and what the threaded service did before. max_catch_up_ticks() = heartbeat_ms / tick_ms
+// (4 with a 50 ms tick and a 200 ms heartbeat): a loop late by less than a heartbeat loses no
+// Raft time at all.
 //
 // Events: the driver's contract events (event=leader_elected, mission_state, victim_confirmed,
-// victim_status, raft_stopped) go to `out` as logfmt lines, `t` from the caller's `sim_clock`.
-// The default `out` writes each line to stdout and flushes (log watchers match them live).
-// Received bytes the driver cannot decode are counted (protocol_errors()), not fatal.
+// victim_status, raft_stopped) go to `out` as logfmt lines, `t` from the clock given, during
+// the call that caused them. Received bytes the driver cannot decode are counted
+// (protocol_errors()), not fatal.
 //
 // Failure: when the driver stops (a storage write or fsync failed: it can no longer promise what
-// it voted or acknowledged) the thread prints event=raft_stopped (the driver does), ends, and
-// health() / WaitStopped() report the error; every later Propose returns it. The caller must
+// it voted or acknowledged) it prints event=raft_stopped; from then on health(), Tick(),
+// Propose() and Campaign() return that error and OnPayload() drops its bytes. The caller must
 // then exit non-zero.
 //
-// Thread-safety: every public member is thread-safe. `out` is called with the service's lock
-// held (from the service thread or from a Propose caller): it must not call back into the
-// service. Ownership: `mesh` and `sim_clock` must outlive the service; the destructor stops the
-// thread, then the radio (no callback after it returns), then closes the storage.
+// Thread-safety: none. One thread (the control loop) calls everything, `out` and the
+// transport's Send included (they run inside the calls). Payloads received on other threads
+// (RaftRadio's middleware callback) go through a PayloadInbox (payload_inbox.hpp) and are fed at
+// the next step. Ownership: `transport` and `clock` must outlive the service; the destructor
+// closes the storage.
 #pragma once
 
-#include <chrono>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <optional>
+#include <span>
 #include <string>
-#include <thread>
 
-#include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/result.hpp"
-#include "swarmbox/mission/raft_radio.hpp"
 #include "swarmbox/raft/file_system.hpp"
 #include "swarmbox/raft/mission_state.hpp"
 #include "swarmbox/raft/node_driver.hpp"
@@ -55,11 +67,8 @@
 namespace swarmbox::mission {
 
 struct RaftServiceConfig {
-  raft::DriverConfig driver;  // self, members, seed, timings (tick_ms drives the service thread)
+  raft::DriverConfig driver;  // self, members, seed, timings (tick_ms: the Tick() grid)
   std::string data_dir;       // WAL and snapshot directory, created when missing
-  // Received samples waiting for the service thread beyond this are dropped, oldest first (as
-  // the radio would): a stalled node must not buffer without bound.
-  std::size_t max_inbox = 1024;
   // The file system of the WAL; nullptr = the real one (PosixFileSystem). Tests inject failures.
   // Must outlive the service.
   raft::FileSystem* file_system = nullptr;
@@ -72,67 +81,63 @@ void PrintLineToStdout(const std::string& line);
 
 class RaftService {
  public:
-  // Opens the storage (replaying the WAL), the radio and the driver, then starts the thread.
-  // Errors: a bad DriverConfig (kInvalidArgument), storage that cannot be read (kIo/kProtocol),
-  // the radio's bus errors.
+  // Opens the storage (replaying the WAL: re-applied entries print their events now) and the
+  // driver; reads `clock` once to anchor the tick grid. Errors: a bad DriverConfig or no data
+  // directory (kInvalidArgument), storage that cannot be read (kIo/kProtocol).
   static Result<std::unique_ptr<RaftService>> Start(const RaftServiceConfig& config,
-                                                    bus::Participant& mesh,
-                                                    const raft::Clock& sim_clock,
+                                                    raft::Transport& transport,
+                                                    const raft::Clock& clock,
                                                     LineSink out = PrintLineToStdout);
   ~RaftService();
   RaftService(const RaftService&) = delete;
   RaftService& operator=(const RaftService&) = delete;
 
+  // A delivered Raft payload (RaftMessage.payload addressed to self), in delivery order. Bytes
+  // the driver refuses are counted in protocol_errors(); dropped once stopped.
+  void OnPayload(std::span<const std::uint8_t> bytes);
+  // Runs the ticks due by clock.NowS() (see the banner). Ok while running; the stop error once
+  // the node stopped.
+  Status Tick();
   // Proposes a mission command (encoded by the driver). kUnavailable when this node knows no
   // leader to forward to; the stop error once stopped.
   Status Propose(const raft::MissionCommand& command);
   // Starts an election now (tests, the "kill the leader" fault's bookkeeping).
   Status Campaign();
 
-  raft::MissionState mission() const;  // a copy of the committed (applied) mission state
-  std::string leader() const;          // "" when none known
-  bool is_leader() const;
-  std::uint64_t term() const;
-  std::uint64_t commit_index() const;
+  const raft::MissionState& mission() const { return driver_->mission(); }  // committed state
+  std::string leader() const { return driver_->leader(); }  // "" when none known
+  bool is_leader() const { return driver_->is_leader(); }
+  std::uint64_t term() const { return driver_->raft().term(); }
+  std::uint64_t commit_index() const { return driver_->raft().log().committed(); }
 
-  // Ok while running; the driver's stop error once it stopped.
+  // Ok while running; the driver's stop error once it stopped (storage failed: exit non-zero).
   Status health() const;
-  // Waits up to `timeout` for the driver to stop; true when it has (then exit non-zero).
-  bool WaitStopped(std::chrono::milliseconds timeout) const;
+  bool stopped() const { return driver_->stopped(); }
 
-  RaftRadio::Counters radio_counters() const { return radio_->counters(); }
-  std::uint64_t protocol_errors() const;  // undecodable/misaddressed payloads dropped
-  std::uint64_t inbox_drops() const;      // samples dropped because the inbox was full
+  std::uint64_t protocol_errors() const { return protocol_errors_; }  // undecodable payloads
+  std::uint64_t ticks() const { return ticks_; }                 // driver ticks run
+  std::uint64_t dropped_ticks() const { return dropped_ticks_; }  // ticks skipped after a gap
+  int max_catch_up_ticks() const { return max_catch_up_ticks_; }
+  // The clock time [s] at which the next tick is due (a loop may sleep until then).
+  double next_tick_s() const;
   const std::string& self() const { return config_.driver.self; }
 
  private:
-  explicit RaftService(RaftServiceConfig config, LineSink out);
-  void OnPayload(std::span<const std::uint8_t> bytes);  // middleware thread
-  void Run();                                           // the service thread
-  void MarkStopped();                                   // with mu_ held
+  RaftService(RaftServiceConfig config, const raft::Clock& clock, LineSink out);
 
   RaftServiceConfig config_;
+  const raft::Clock& clock_;
   LineSink out_;
   std::unique_ptr<raft::FileSystem> own_fs_;  // when config_.file_system is null
   std::unique_ptr<raft::WalStorage> wal_;
+  std::unique_ptr<raft::NodeDriver> driver_;  // after wal_: destroyed before it
 
-  // Received payloads, handed from the radio's middleware thread to the service thread.
-  mutable std::mutex inbox_mu_;
-  std::condition_variable inbox_cv_;
-  std::deque<raft::Bytes> inbox_;
-  bool quit_ = false;
-  std::uint64_t inbox_drops_ = 0;
-
-  std::unique_ptr<RaftRadio> radio_;  // after the inbox: destroyed before it
-
-  // The driver and what is guarded with it.
-  mutable std::mutex mu_;
-  mutable std::condition_variable stopped_cv_;
-  std::unique_ptr<raft::NodeDriver> driver_;  // after radio_ and wal_: destroyed before them
-  std::optional<Error> stop_error_;
+  std::int64_t tick_us_ = 0;       // config_.driver.tick_ms in [us]
+  std::int64_t next_tick_us_ = 0;  // clock time of the next tick on the grid [us]
+  int max_catch_up_ticks_ = 1;
+  std::uint64_t ticks_ = 0;
+  std::uint64_t dropped_ticks_ = 0;
   std::uint64_t protocol_errors_ = 0;
-
-  std::thread thread_;
 };
 
 }  // namespace swarmbox::mission
