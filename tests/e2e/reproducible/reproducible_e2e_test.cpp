@@ -9,8 +9,9 @@
 // engine, with the trial's default radio model (`radio.model: channel` once it is the default; the
 // real-stack `netem` radio is on the wall clock and is not expected to pass). Each run is cut
 // short by a simulated timeout (`timeout.sim`: 60 s for the SAR search, 45 s for the leader kill,
-// 15 s past the kill) so the whole test takes ~6 minutes on an idle 2-core machine (the rtf 1 runs
-// are 105 s of it).
+// 15 s past the kill) so the whole test takes ~7 minutes (measured on a loaded 2-core machine with
+// today's netem model: 195 s for the SAR search, 227 s for the leader kill; each rtf 0 run 26-41 s,
+// each rtf 1 run 67-75 s).
 #include <gtest/gtest.h>
 
 #include <unistd.h>
