@@ -85,6 +85,15 @@ struct ReportArgs {
 };
 int ReportCommand(const ReportArgs& args);
 
+// The first divergence between two trial folders (report/run_diff.hpp): exit 0 identical, 1 they
+// differ, 2 a folder that is not a trial folder or a file that cannot be parsed.
+struct DiffArgs {
+  std::string run_a;
+  std::string run_b;
+  bool json = false;
+};
+int DiffCommand(const DiffArgs& args);
+
 struct GcArgs {
   std::string run_id;  // "" = every run not alive on this machine
   bool dry_run = false;  // list what would be removed, remove nothing

@@ -57,6 +57,18 @@ constexpr char kExitCodes[] =
     "Engine: $DOCKER_HOST (unix://PATH, tcp://HOST:PORT with $DOCKER_TLS_VERIFY and "
     "$DOCKER_CERT_PATH as the docker CLI reads them; default unix:///var/run/docker.sock).";
 
+constexpr char kDiffHelp[] =
+    "Compared: truth.csv row by row (the first row that differs: simulated time, drone, each "
+    "differing column with both values, or which file ended first); events.jsonl per stream (a "
+    "container's log events; the orchestrator's records by target, fault, mesh node), the earliest "
+    "divergence by simulated time; result.json's outcome and reason.\n"
+    "Not compared (wall-clock by nature): events.jsonl fields with 'wall' as a word of their name "
+    "(wall_s, requested_wall_s, ...), rtf, late of event=clock, detected and host of the mechanism "
+    "record; the run id inside values (container names, paths). A trial that ended on a log line "
+    "is compared up to that line's simulated time.\n"
+    "Exit codes: 0 identical, 1 they differ, 2 not a trial folder, or a file that cannot be read "
+    "or parsed.";
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -127,6 +139,15 @@ int main(int argc, char** argv) {
       app.add_subcommand("report", "Regenerate results.csv and report.html of an experiment folder");
   report_cmd->add_option("dir", report.dir, "Experiment folder")->required();
 
+  DiffArgs diff;
+  auto* diff_cmd = app.add_subcommand(
+      "diff", "The first divergence between two trial folders; exit 0 identical, 1 they differ, 2 "
+              "not a trial folder or a file that cannot be parsed");
+  diff_cmd->add_option("run_a", diff.run_a, "Trial folder A (<out>/<trial>-<run id>)")->required();
+  diff_cmd->add_option("run_b", diff.run_b, "Trial folder B")->required();
+  AddJsonFlag(diff_cmd, diff.json);
+  diff_cmd->footer(kDiffHelp);
+
   GcArgs gc;
   auto* gc_cmd = app.add_subcommand("gc", "Remove containers and networks left by killed runs");
   gc_cmd->add_option("--run", gc.run_id, "Only this run id (default: every run not alive here)");
@@ -152,6 +173,7 @@ int main(int argc, char** argv) {
   }
   if (*exp_cmd) return ExperimentCommand(exp);
   if (*report_cmd) return ReportCommand(report);
+  if (*diff_cmd) return DiffCommand(diff);
   if (*gc_cmd) return GcCommand(gc);
   if (*version_cmd) {
     if (!version_json) {

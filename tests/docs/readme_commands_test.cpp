@@ -74,6 +74,9 @@ std::vector<Rule> Rules() {
                    "with --set physics.rtf=0 and checks the failover and the rescue"},
       {.line = cli + " validate trials/*.yaml trials/faults/*.yaml trials/experiments/*.yaml", .timeout = 60s},
       {.line = cli + " compose trials/sar_search.yaml", .timeout = 60s, .stdout_has = "services:"},
+      {.line = cli + " diff runs/RUN_A runs/RUN_B",
+       .excluded = "RUN_A and RUN_B stand for two trial folders; cli_diff_command_test runs diff on folders "
+                   "it writes, ReproducibleE2e (tests/e2e/reproducible) on real runs"},
       {.line = cli + " gc --dry-run", .timeout = 60s},  // removes nothing: says what gc would remove
       {.line = cli + " gc",
        .append = {"--run", "readme-commands-none"},

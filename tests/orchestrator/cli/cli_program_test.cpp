@@ -98,7 +98,7 @@ TEST_F(CliProgramTest, HelpShowsTheVersionAndEveryExitCode) {
   for (const char* sub : {"run", "experiment", "images"}) {
     EXPECT_THAT(Run({SWARMBOX_CLI_EXE, sub, "--help"}).out, HasSubstr("-q,--quiet")) << sub;
   }
-  for (const char* sub : {"run", "experiment", "images", "validate", "gc"}) {
+  for (const char* sub : {"run", "experiment", "images", "validate", "gc", "diff"}) {
     EXPECT_THAT(Run({SWARMBOX_CLI_EXE, sub, "--help"}).out, HasSubstr("--json")) << sub;
   }
   EXPECT_THAT(Run({SWARMBOX_CLI_EXE, "gc", "--help"}).out, HasSubstr("--dry-run"));

@@ -1,0 +1,526 @@
+#include "swarmbox/report/run_diff.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+#include <tuple>
+
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::report {
+
+const std::vector<std::string_view> kIgnoredEventFields = {"rtf", "clock.late", "mechanism.detected",
+                                                           "mechanism.host"};
+
+namespace {
+
+constexpr std::string_view kRunPlaceholder = "<run>";
+
+std::string_view SideName(Side s) { return s == Side::kA ? "A" : "B"; }
+
+std::string Seconds(double t) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.3f", t);
+  return buf;
+}
+
+// Lines without their '\n' (and a '\r' before it); a last empty line is not a line.
+std::vector<std::string_view> Lines(std::string_view text) {
+  std::vector<std::string_view> lines;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    lines.push_back(line);
+    pos = end + 1;
+  }
+  return lines;
+}
+
+std::vector<std::string_view> SplitCsv(std::string_view line) {
+  std::vector<std::string_view> cells;
+  std::size_t pos = 0;
+  while (true) {
+    const std::size_t comma = line.find(',', pos);
+    if (comma == std::string_view::npos) {
+      cells.push_back(line.substr(pos));
+      return cells;
+    }
+    cells.push_back(line.substr(pos, comma - pos));
+    pos = comma + 1;
+  }
+}
+
+std::optional<double> Number(std::string_view text) {
+  if (text.empty()) return std::nullopt;
+  return yaml::ScalarAsDouble(text);
+}
+
+std::string ReplaceAll(std::string text, std::string_view what, std::string_view with) {
+  if (what.empty()) return text;
+  for (std::size_t pos = text.find(what); pos != std::string::npos;
+       pos = text.find(what, pos + with.size())) {
+    text.replace(pos, what.size(), with);
+  }
+  return text;
+}
+
+// ---- result.json ----------------------------------------------------------------------------
+
+struct ResultFacts {
+  std::string outcome, reason, run_id, seed, trial;
+  std::optional<double> end_t_s;  // the ending line's t
+  std::string ending_line;
+};
+
+std::string StringAt(const yaml::Node& doc, std::string_view key) {
+  const yaml::Node* n = doc.Find(key);
+  return n != nullptr && n->is_scalar() ? n->scalar() : std::string();
+}
+
+Result<ResultFacts> ParseResult(std::string_view text, Side side) {
+  const std::string where = "result.json of run " + std::string(SideName(side));
+  auto doc = yaml::Parse(text, where);
+  if (!doc) return Error(ErrorCode::kInvalidArgument, doc.error().message(), where);
+  if (!doc->is_mapping()) return Error(ErrorCode::kInvalidArgument, "not a JSON object", where);
+  ResultFacts r;
+  r.outcome = StringAt(*doc, "outcome");
+  r.reason = StringAt(*doc, "reason");
+  r.run_id = StringAt(*doc, "run_id");
+  r.seed = StringAt(*doc, "seed");
+  r.trial = StringAt(*doc, "trial");
+  r.ending_line = StringAt(*doc, "ending_line");
+  if (!r.ending_line.empty()) {
+    if (auto t = FindField(ParseLogfmt(r.ending_line), "t")) r.end_t_s = Number(*t);
+  }
+  return r;
+}
+
+// ---- truth.csv ------------------------------------------------------------------------------
+
+struct TruthTable {
+  std::vector<std::string_view> lines;  // header first
+  std::vector<std::string_view> header;
+  std::size_t t_col = 0, drone_col = 0;
+  std::size_t rows = 0;                 // data rows within the horizon
+};
+
+Result<TruthTable> ParseTruth(std::string_view text, Side side, std::optional<double> horizon_s) {
+  const std::string where = "truth.csv of run " + std::string(SideName(side));
+  TruthTable t;
+  t.lines = Lines(text);
+  if (t.lines.empty()) return t;  // nothing written: compared as a file with no header and no row
+  t.header = SplitCsv(t.lines[0]);
+  auto col = [&](std::string_view name) -> std::optional<std::size_t> {
+    auto it = std::find(t.header.begin(), t.header.end(), name);
+    if (it == t.header.end()) return std::nullopt;
+    return static_cast<std::size_t>(it - t.header.begin());
+  };
+  auto tc = col("t_s");
+  auto dc = col("drone");
+  if (!tc || !dc) {
+    return Error(ErrorCode::kInvalidArgument, "the header has no t_s or drone column", where + ":1");
+  }
+  t.t_col = *tc;
+  t.drone_col = *dc;
+  t.rows = t.lines.size() - 1;
+  if (horizon_s) {
+    for (std::size_t i = 1; i < t.lines.size(); ++i) {
+      const auto cells = SplitCsv(t.lines[i]);
+      const auto ts = cells.size() > t.t_col ? Number(cells[t.t_col]) : std::nullopt;
+      if (ts && *ts > *horizon_s) {
+        t.rows = i - 1;
+        break;
+      }
+    }
+  }
+  return t;
+}
+
+std::optional<TruthDivergence> CompareTruth(const TruthTable& a, const TruthTable& b,
+                                            std::size_t* rows_alike) {
+  const bool a_empty = a.lines.empty();
+  const bool b_empty = b.lines.empty();
+  if (a_empty || b_empty) {
+    if (a_empty && b_empty) return std::nullopt;
+    TruthDivergence d;
+    d.line = 1;
+    d.ended = a_empty ? Side::kA : Side::kB;
+    return d;
+  }
+  if (a.header != b.header) {
+    TruthDivergence d;
+    d.line = 1;
+    const std::size_t n = std::max(a.header.size(), b.header.size());
+    for (std::size_t c = 0; c < n; ++c) {
+      FieldDiff f{"column " + std::to_string(c + 1), std::nullopt, std::nullopt};
+      if (c < a.header.size()) f.a = std::string(a.header[c]);
+      if (c < b.header.size()) f.b = std::string(b.header[c]);
+      if (f.a != f.b) d.fields.push_back(std::move(f));
+    }
+    return d;
+  }
+  for (std::size_t row = 0;; ++row) {
+    const bool end_a = row >= a.rows;
+    const bool end_b = row >= b.rows;
+    if (end_a && end_b) return std::nullopt;
+    TruthDivergence d;
+    d.line = row + 2;
+    if (end_a || end_b) {
+      d.ended = end_a ? Side::kA : Side::kB;
+      const auto cells = SplitCsv((end_a ? b : a).lines[row + 1]);
+      if (cells.size() > a.t_col) d.t_s = Number(cells[a.t_col]);
+      if (cells.size() > a.drone_col) d.drone = std::string(cells[a.drone_col]);
+      return d;
+    }
+    const std::string_view la = a.lines[row + 1];
+    const std::string_view lb = b.lines[row + 1];
+    if (la == lb) {
+      *rows_alike = row + 1;
+      continue;
+    }
+    const auto ca = SplitCsv(la);
+    const auto cb = SplitCsv(lb);
+    if (ca.size() > a.t_col) d.t_s = Number(ca[a.t_col]);
+    if (ca.size() > a.drone_col) d.drone = std::string(ca[a.drone_col]);
+    const std::size_t n = std::max(ca.size(), cb.size());
+    for (std::size_t c = 0; c < n; ++c) {
+      FieldDiff f{c < a.header.size() ? std::string(a.header[c]) : "column " + std::to_string(c + 1),
+                  std::nullopt, std::nullopt};
+      if (c < ca.size()) f.a = std::string(ca[c]);
+      if (c < cb.size()) f.b = std::string(cb[c]);
+      if (f.a != f.b) d.fields.push_back(std::move(f));
+    }
+    return d;
+  }
+}
+
+// ---- events.jsonl ---------------------------------------------------------------------------
+
+struct Event {
+  std::size_t line = 0;
+  std::string stream;
+  std::optional<double> t_s;
+  std::string json;                                        // as compared
+  std::vector<std::pair<std::string, std::string>> fields;  // as compared, in order
+};
+
+bool HasWallWord(std::string_view name) {
+  std::size_t pos = 0;
+  while (pos <= name.size()) {
+    std::size_t end = name.find('_', pos);
+    if (end == std::string_view::npos) end = name.size();
+    if (name.substr(pos, end - pos) == "wall") return true;
+    pos = end + 1;
+  }
+  return false;
+}
+
+yaml::Node WithoutRun(const yaml::Node& node, const std::string& run_id) {
+  if (node.is_scalar()) {
+    if (run_id.empty() || node.scalar().find(run_id) == std::string::npos) return node;
+    return yaml::Node::Scalar(ReplaceAll(node.scalar(), run_id, kRunPlaceholder), {}, /*quoted=*/true);
+  }
+  yaml::Node out = node;
+  if (node.is_sequence()) {
+    for (yaml::Node& item : out.items()) item = WithoutRun(item, run_id);
+  } else if (node.is_mapping()) {
+    for (auto& [key, value] : out.entries()) value = WithoutRun(value, run_id);
+  }
+  return out;
+}
+
+std::string ValueText(const yaml::Node& node) {
+  return node.is_scalar() ? node.scalar() : yaml::EmitJson(node);
+}
+
+std::string StreamOf(const yaml::Node& doc) {
+  const std::string component = StringAt(doc, "component");
+  const std::string type = StringAt(doc, "type");
+  if (!component.empty() && component != "orchestrator") return component;
+  if (type == "fault") return "fault:" + StringAt(doc, "fault");
+  if (!type.empty()) {
+    const std::string node = StringAt(doc, "node");
+    return node.empty() ? type : type + ":" + node;
+  }
+  if (component == "orchestrator") return "orchestrator:" + StringAt(doc, "target");
+  return "-";
+}
+
+Result<std::vector<Event>> ParseEvents(std::string_view text, Side side, const std::string& run_id,
+                                       std::optional<double> horizon_s) {
+  const std::string where = "events.jsonl of run " + std::string(SideName(side));
+  std::vector<Event> events;
+  const auto lines = Lines(text);
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    if (lines[i].find_first_not_of(" \t") == std::string_view::npos) continue;
+    const std::string at = where + ":" + std::to_string(i + 1);
+    auto doc = yaml::Parse(lines[i], at);
+    if (!doc || !doc->is_mapping()) {
+      return Error(ErrorCode::kInvalidArgument,
+                   doc ? std::string("not a JSON object") : doc.error().message(), at);
+    }
+    std::string kind = StringAt(*doc, "event");
+    if (kind.empty()) kind = StringAt(*doc, "type");
+    Event e;
+    e.line = i + 1;
+    e.stream = StreamOf(*doc);
+    const yaml::Node* t = doc->Find("t");
+    if (t == nullptr) t = doc->Find("t_sim_s");
+    if (t != nullptr && t->is_scalar()) e.t_s = Number(t->scalar());
+    if (horizon_s && e.t_s && *e.t_s > *horizon_s) continue;
+    yaml::Node kept = yaml::Node::Mapping();
+    for (const auto& [key, value] : doc->entries()) {
+      const std::string& name = key.scalar();
+      if (IgnoredEventField(kind, name)) continue;
+      yaml::Node v = WithoutRun(value, run_id);
+      e.fields.emplace_back(name, ValueText(v));
+      kept.Set(name, std::move(v));
+    }
+    e.json = yaml::EmitJson(kept);
+    events.push_back(std::move(e));
+  }
+  return events;
+}
+
+using Streams = std::map<std::string, std::vector<const Event*>>;
+
+Streams ByStream(const std::vector<Event>& events) {
+  Streams s;
+  for (const Event& e : events) s[e.stream].push_back(&e);
+  return s;
+}
+
+std::vector<FieldDiff> EventFields(const Event& a, const Event& b) {
+  std::vector<FieldDiff> out;
+  auto find = [](const Event& e, const std::string& name) -> std::optional<std::string> {
+    for (const auto& [n, v] : e.fields) {
+      if (n == name) return v;
+    }
+    return std::nullopt;
+  };
+  for (const auto& [name, value] : a.fields) {
+    auto other = find(b, name);
+    if (other != value) out.push_back({name, value, other});
+  }
+  for (const auto& [name, value] : b.fields) {
+    if (!find(a, name)) out.push_back({name, std::nullopt, value});
+  }
+  return out;
+}
+
+std::optional<EventDivergence> CompareEvents(const std::vector<Event>& a, const std::vector<Event>& b,
+                                             std::size_t* streams) {
+  const Streams sa = ByStream(a);
+  const Streams sb = ByStream(b);
+  std::vector<std::string> keys;
+  for (const auto& [k, _] : sa) keys.push_back(k);
+  for (const auto& [k, _] : sb) {
+    if (sa.count(k) == 0) keys.push_back(k);
+  }
+  *streams = keys.size();
+  static const std::vector<const Event*> kNone;
+  std::optional<EventDivergence> best;
+  auto rank = [](const EventDivergence& d) {
+    const std::size_t line = d.line_a != 0 ? d.line_a : d.line_b;
+    return std::make_tuple(d.t_s ? 0 : 1, d.t_s.value_or(0.0), line);
+  };
+  for (const std::string& key : keys) {
+    auto ia = sa.find(key);
+    auto ib = sb.find(key);
+    const auto& ea = ia != sa.end() ? ia->second : kNone;
+    const auto& eb = ib != sb.end() ? ib->second : kNone;
+    std::optional<double> last_t;
+    for (std::size_t i = 0; i < std::max(ea.size(), eb.size()); ++i) {
+      const Event* x = i < ea.size() ? ea[i] : nullptr;
+      const Event* y = i < eb.size() ? eb[i] : nullptr;
+      if (x != nullptr && y != nullptr && x->json == y->json) {
+        if (x->t_s) last_t = x->t_s;
+        continue;
+      }
+      EventDivergence d;
+      d.stream = key;
+      d.index = i;
+      std::optional<double> t;
+      for (const Event* e : {x, y}) {
+        if (e != nullptr && e->t_s && (!t || *e->t_s < *t)) t = e->t_s;
+      }
+      d.t_s = t ? t : last_t;
+      if (x != nullptr) {
+        d.line_a = x->line;
+        d.event_a = x->json;
+      }
+      if (y != nullptr) {
+        d.line_b = y->line;
+        d.event_b = y->json;
+      }
+      if (x != nullptr && y != nullptr) d.fields = EventFields(*x, *y);
+      if (!best || rank(d) < rank(*best)) best = std::move(d);
+      break;
+    }
+  }
+  return best;
+}
+
+std::string Quoted(const std::optional<std::string>& v) { return v ? *v : std::string("(none)"); }
+
+void AppendFields(std::string* out, const std::vector<FieldDiff>& fields) {
+  std::size_t width = 0;
+  for (const FieldDiff& f : fields) width = std::max(width, f.field.size());
+  for (const FieldDiff& f : fields) {
+    *out += "  " + f.field + ":" + std::string(width - f.field.size() + 1, ' ') + Quoted(f.a) +
+            " (A)  vs  " + Quoted(f.b) + " (B)\n";
+  }
+}
+
+}  // namespace
+
+bool IgnoredEventField(std::string_view kind, std::string_view name) {
+  if (HasWallWord(name)) return true;
+  for (std::string_view ignored : kIgnoredEventFields) {
+    const std::size_t dot = ignored.find('.');
+    if (dot == std::string_view::npos) {
+      if (ignored == name) return true;
+    } else if (ignored.substr(0, dot) == kind && ignored.substr(dot + 1) == name) {
+      return true;
+    }
+  }
+  return false;
+}
+
+std::optional<std::string> RunDiff::first_file() const {
+  if (identical()) return std::nullopt;
+  if (truth && truth->t_s && (!events || !events->t_s || *truth->t_s <= *events->t_s)) return "truth.csv";
+  if (events && events->t_s) return "events.jsonl";
+  if (truth) return "truth.csv";
+  if (events) return "events.jsonl";
+  if (!missing.empty()) return missing.front().file;
+  return "result.json";
+}
+
+std::optional<double> RunDiff::first_t_s() const {
+  const auto file = first_file();
+  if (file == "truth.csv") return truth ? truth->t_s : std::nullopt;
+  if (file == "events.jsonl") return events ? events->t_s : std::nullopt;
+  return std::nullopt;
+}
+
+Result<RunDiff> DiffRuns(const RunFiles& a, const RunFiles& b) {
+  RunDiff diff;
+  auto note_missing = [&](const std::string& file, bool in_a, bool in_b) {
+    if (in_a && in_b) {
+      diff.compared.push_back(file);
+    } else if (in_a != in_b) {
+      diff.missing.push_back({file, in_a ? Side::kB : Side::kA});
+    }
+    return in_a && in_b;
+  };
+
+  std::optional<ResultFacts> ra, rb;
+  if (a.result_json) {
+    auto r = ParseResult(*a.result_json, Side::kA);
+    if (!r) return r.error();
+    ra = std::move(*r);
+  }
+  if (b.result_json) {
+    auto r = ParseResult(*b.result_json, Side::kB);
+    if (!r) return r.error();
+    rb = std::move(*r);
+  }
+  for (const auto& [r, side] : {std::pair{&ra, Side::kA}, std::pair{&rb, Side::kB}}) {
+    if (*r && (*r)->end_t_s && (!diff.horizon_s || *(*r)->end_t_s < *diff.horizon_s)) {
+      diff.horizon_s = (*r)->end_t_s;
+      diff.horizon_reason = "the trial ended on '" + (*r)->ending_line + "' (run " +
+                            std::string(SideName(side)) + ")";
+    }
+  }
+
+  if (note_missing("truth.csv", a.truth_csv.has_value(), b.truth_csv.has_value())) {
+    auto ta = ParseTruth(*a.truth_csv, Side::kA, diff.horizon_s);
+    if (!ta) return ta.error();
+    auto tb = ParseTruth(*b.truth_csv, Side::kB, diff.horizon_s);
+    if (!tb) return tb.error();
+    diff.truth = CompareTruth(*ta, *tb, &diff.truth_rows);
+  }
+  if (note_missing("events.jsonl", a.events_jsonl.has_value(), b.events_jsonl.has_value())) {
+    auto ea = ParseEvents(*a.events_jsonl, Side::kA, ra ? ra->run_id : "", diff.horizon_s);
+    if (!ea) return ea.error();
+    auto eb = ParseEvents(*b.events_jsonl, Side::kB, rb ? rb->run_id : "", diff.horizon_s);
+    if (!eb) return eb.error();
+    diff.events = CompareEvents(*ea, *eb, &diff.streams);
+    diff.event_count = ea->size();
+  }
+  if (note_missing("result.json", ra.has_value(), rb.has_value())) {
+    ResultDivergence r;
+    if (ra->outcome != rb->outcome) r.fields.push_back({"outcome", ra->outcome, rb->outcome});
+    const std::string reason_a = ReplaceAll(ra->reason, ra->run_id, kRunPlaceholder);
+    const std::string reason_b = ReplaceAll(rb->reason, rb->run_id, kRunPlaceholder);
+    if (reason_a != reason_b) r.fields.push_back({"reason", reason_a, reason_b});
+    if (!r.fields.empty()) diff.result = std::move(r);
+    if (ra->seed != rb->seed) diff.notes.push_back("the seeds differ: " + ra->seed + " (A), " + rb->seed + " (B)");
+    if (ra->trial != rb->trial) diff.notes.push_back("the trials differ: " + ra->trial + " (A), " + rb->trial + " (B)");
+  }
+  return diff;
+}
+
+std::string FormatRunDiff(const RunDiff& d, std::string_view name_a, std::string_view name_b) {
+  std::string out;
+  const std::string a(name_a), b(name_b);
+  if (d.identical()) {
+    out += "identical: A " + a + ", B " + b + "\n";
+  } else {
+    out += "differ: A " + a + ", B " + b + "; first divergence in " + *d.first_file();
+    if (auto t = d.first_t_s()) out += " at t=" + Seconds(*t) + " s";
+    out += "\n";
+  }
+  std::string compared = "compared:";
+  for (const std::string& f : d.compared) {
+    compared += " " + f;
+    if (f == "truth.csv") compared += " (" + std::to_string(d.truth_rows) + " rows alike)";
+    if (f == "events.jsonl") {
+      compared += " (" + std::to_string(d.event_count) + " events in " + std::to_string(d.streams) + " streams)";
+    }
+  }
+  if (d.compared.empty()) compared += " nothing (no file is in both runs)";
+  out += compared + "\n";
+  if (d.horizon_s) out += "up to t=" + Seconds(*d.horizon_s) + " s: " + d.horizon_reason + "\n";
+  for (const std::string& n : d.notes) out += "note: " + n + "\n";
+  for (const MissingFile& m : d.missing) {
+    out += m.file + ": not in run " + std::string(SideName(m.missing_in)) + "\n";
+  }
+  if (d.truth) {
+    const TruthDivergence& t = *d.truth;
+    out += "truth.csv line " + std::to_string(t.line);
+    if (t.t_s) out += ", t=" + Seconds(*t.t_s) + " s";
+    if (!t.drone.empty()) out += ", drone " + t.drone;
+    if (t.ended) {
+      const Side other = *t.ended == Side::kA ? Side::kB : Side::kA;
+      out += ": run " + std::string(SideName(*t.ended)) + "'s file ended first" +
+             (t.line > 1 ? " (run " + std::string(SideName(other)) + " goes on with this row)" : "") + "\n";
+    } else {
+      out += (t.line == 1 ? ": the headers differ\n" : ":\n");
+      AppendFields(&out, t.fields);
+    }
+  }
+  if (d.events) {
+    const EventDivergence& e = *d.events;
+    out += "events.jsonl stream " + e.stream + ", event " + std::to_string(e.index + 1);
+    if (e.t_s) out += ", t=" + Seconds(*e.t_s) + " s";
+    out += " (line " + (e.line_a ? std::to_string(e.line_a) : std::string("-")) + " of A, line " +
+           (e.line_b ? std::to_string(e.line_b) : std::string("-")) + " of B):\n";
+    out += "  A: " + (e.event_a.empty() ? std::string("(the stream ended)") : e.event_a) + "\n";
+    out += "  B: " + (e.event_b.empty() ? std::string("(the stream ended)") : e.event_b) + "\n";
+    AppendFields(&out, e.fields);
+  }
+  if (d.result) {
+    out += "result.json:\n";
+    AppendFields(&out, d.result->fields);
+  }
+  return out;
+}
+
+}  // namespace swarmbox::report
