@@ -18,7 +18,10 @@ using ::testing::ElementsAre;
 class PlanTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml");
+    // The netem model's tree (mesh network, fault sidecars); PlanChannelTest plans the channel's.
+    dsl::LoadOptions load;
+    load.overrides = {"radio.model=netem"};
+    auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml", load);
     ASSERT_TRUE(spec) << spec.error().ToString();
     spec_ = *spec;
     options_.run_id = "20261121-101000-7f3a";
