@@ -440,7 +440,9 @@ std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& a
 std::optional<Verdict> FaultInjector::OnPlannedEvent(const std::string& line) {
   const LogfmtFields fields = ParseLogfmt(line);
   const std::string event = FindField(fields, "event").value_or("");
-  if (event != "drone_out" && event != "drone_back" && event != "radio_fault") return std::nullopt;
+  if (event != "drone_out" && event != "drone_back" && event != "radio_fault" && event != "fault_skipped") {
+    return std::nullopt;
+  }
   const std::string name = FindField(fields, "fault").value_or("");
   const faults::Fault* fault = nullptr;
   for (const faults::Fault& f : config_.planned) {
@@ -454,8 +456,16 @@ std::optional<Verdict> FaultInjector::OnPlannedEvent(const std::string& line) {
   const auto t = yaml::ScalarAsDouble(FindField(fields, "t").value_or(""));
   const double t_sim_s = t ? *t : (sim_s_ ? sim_s_() : 0.0);
   const std::string drone = FindField(fields, "drone").value_or("");
-  if (event == "drone_out") return DroneOut(*fault, drone, FindField(fields, "mode").value_or(""), t_sim_s);
+  if (event == "drone_out") return DroneOut(*fault, drone, t_sim_s);
   if (event == "drone_back") return DroneBack(drone, t_sim_s, /*trial_end=*/false);
+  if (event == "fault_skipped") {  // e.g. no drone led the Raft group at its time
+    faults::FaultEventRecord record = Record(FaultPhase::kFailed);
+    record.t_sim_s = t_sim_s;
+    record.mechanism = "physics";
+    record.error = "skipped by the physics server: " + FindField(fields, "reason").value_or("no reason given");
+    if (events_) events_(faults::FaultEventJson(*fault, record));
+    return std::nullopt;
+  }
   // radio_fault: the channel carried it out in the physics server; recorded as it happened.
   const std::string state = FindField(fields, "state").value_or("");
   if (state != "on" && state != "off") {
@@ -471,7 +481,7 @@ std::optional<Verdict> FaultInjector::OnPlannedEvent(const std::string& line) {
 }
 
 std::optional<Verdict> FaultInjector::DroneOut(const faults::Fault& fault, const std::string& drone,
-                                               const std::string& mode, double t_sim_s) {
+                                               double t_sim_s) {
   const auto* process = std::get_if<faults::ProcessFault>(&fault.action);
   auto container = config_.agents.find(drone);
   faults::FaultEventRecord record = Record(FaultPhase::kRequested);
@@ -485,11 +495,9 @@ std::optional<Verdict> FaultInjector::DroneOut(const faults::Fault& fault, const
   } else if (container == config_.agents.end()) {
     error = "the physics server took out '" + drone + "', which is not a drone of this trial";
   }
-  faults::ProcessAction action = process != nullptr ? process->action : faults::ProcessAction::kKill;
-  for (auto a : {faults::ProcessAction::kKill, faults::ProcessAction::kStop, faults::ProcessAction::kPause,
-                 faults::ProcessAction::kRestart}) {
-    if (mode == faults::ProcessActionName(a)) action = a;  // the server's word; else the fault's kind
-  }
+  // The fault's own action: the server's mode says how it keeps the drone out (a kill with a
+  // duration is its `restart`), the fault what happens to the container.
+  const faults::ProcessAction action = process != nullptr ? process->action : faults::ProcessAction::kKill;
   Status s = Ok{};
   if (error.empty()) {
     if (events_) events_(faults::FaultEventJson(fault, record));

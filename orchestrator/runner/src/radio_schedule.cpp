@@ -19,6 +19,7 @@ namespace {
 using yaml::Node;
 
 constexpr std::string_view kRaftLeader = "raft_leader";
+constexpr double kRestartOutS = 0.004;  // one lockstep step [simulated s]
 
 double Seconds(std::int64_t ms) { return static_cast<double>(ms) / 1000.0; }
 
@@ -106,6 +107,16 @@ Result<RadioSchedule> PlanRadioSchedule(const dsl::TrialSpec& spec) {
       e.kind = ScheduleEntry::Kind::kDroneOut;
       e.mode = process->action;
       e.targets = std::move(*targets);
+      // The physics server's modes (physics_server/app/radio_plan.hpp): a kill stays out (0); a
+      // kill that ends is out for its duration and back as a new process, its `restart`; stop and
+      // pause need an end (none: the rest of the trial); a restart is out for one lockstep step.
+      if (process->action == faults::ProcessAction::kKill && f.duration_ms) {
+        e.mode = faults::ProcessAction::kRestart;
+      } else if (process->action == faults::ProcessAction::kRestart) {
+        e.duration_s = kRestartOutS;
+      } else if (process->action != faults::ProcessAction::kKill && !f.duration_ms) {
+        e.duration_s = faults::kUntilEndS;
+      }
       plan.schedule.push_back(std::move(e));
     } else if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) {
       auto targets = Targets(radio->target, drones, rng);

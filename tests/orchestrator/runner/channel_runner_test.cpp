@@ -265,6 +265,37 @@ TEST_F(ChannelRunnerTest, PausesKillsWithTheFaultsSignalAndRecordsTheChannelsRad
   EXPECT_EQ(starts, 1u);
 }
 
+// A kill that ends (leader_kill_failover.yaml's): the server keeps the drone out as its `restart`
+// for the duration; the container is killed with the fault's signal and started when it is back.
+// A raft_leader the server could not resolve is recorded failed.
+TEST_F(ChannelRunnerTest, AKillWithADurationKillsThenStartsAndASkippedFaultIsRecordedFailed) {
+  spec_.Fault("{name: kill_leader_1, at: 15s, duration: 10s, kill: raft_leader}");
+  spec_.Fault("{name: kill_leader_2, at: 30s, kill: raft_leader}");
+  api_.scripts["physics"].lines = {
+      "t=0.000 node=physics event=ready",
+      "t=15.000 node=physics event=raft_leader_resolved fault=kill_leader_1 drone=scout_1",
+      "t=15.000 node=physics event=drone_out drone=scout_1 fault=kill_leader_1 mode=restart",
+      "t=25.000 node=physics event=drone_back drone=scout_1 fault=kill_leader_1",
+      "t=30.000 node=physics event=fault_skipped fault=kill_leader_2 reason=\"no drone leads the Raft group\""};
+  api_.scripts["scout_1"].restart_lines = {"t=25.5 node=scout_1 event=done"};
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_EQ(run.result.verdict.source, "scout_1");
+  const auto calls = api_.Calls();
+  const std::size_t kill = IndexOfExact(calls, "kill " + Name("scout_1") + " SIGKILL");
+  ASSERT_LT(kill, calls.size());
+  bool started_after = false;
+  for (std::size_t i = kill; i < calls.size(); ++i) started_after = started_after || calls[i] == "start " + Name("scout_1");
+  EXPECT_TRUE(started_after);
+  EXPECT_EQ(IndexOfExact(calls, "stop " + Name("scout_1")) < kill, false);
+  const auto skipped = FaultRecords(Events(run), "kill_leader_2");
+  ASSERT_EQ(skipped.size(), 1u) << Events(run);
+  EXPECT_EQ(skipped[0].Find("phase")->scalar(), "failed");
+  EXPECT_EQ(skipped[0].Find("t_sim_s")->scalar(), "30");
+  EXPECT_THAT(skipped[0].Find("error")->scalar(), HasSubstr("no drone leads the Raft group"));
+  ExpectNothingLeft();
+}
+
 // A drone the server pauses and never brings back is unpaused at the end, so it can stop.
 TEST_F(ChannelRunnerTest, ADroneStillPausedAtTheEndIsUnpausedBeforeTheContainersStop) {
   spec_.Fault("{name: freeze, at: 1s, pause: scout_2}");

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/faults/physics_plan.hpp"
 
 namespace swarmbox::runner {
 namespace {
@@ -97,10 +98,15 @@ TEST(RadioSchedule, FaultsAtSimulatedTimesBecomeThePhysicsServersEntries) {
   EXPECT_EQ(plan->schedule[4].mode, faults::ProcessAction::kPause);
   EXPECT_THAT(plan->schedule[4].targets, ElementsAre("scout_1", "scout_2", "scout_3"));
   EXPECT_EQ(plan->schedule[4].duration_s, 3.0);
-  EXPECT_EQ(plan->schedule[5].mode, faults::ProcessAction::kKill);
+  // In the physics server's modes: a kill that ends is out for its duration and back as a new
+  // process (restart); a restart is out for one lockstep step; a stop without an end lasts the
+  // rest of the trial.
+  EXPECT_EQ(plan->schedule[5].mode, faults::ProcessAction::kRestart);
   EXPECT_EQ(plan->schedule[5].duration_s, 20.0);
   EXPECT_EQ(plan->schedule[6].mode, faults::ProcessAction::kRestart);
+  EXPECT_EQ(plan->schedule[6].duration_s, 0.004);
   EXPECT_EQ(plan->schedule[7].mode, faults::ProcessAction::kStop);
+  EXPECT_EQ(plan->schedule[7].duration_s, faults::kUntilEndS);
 
   const std::string json = RadioScheduleJson(*plan);
   auto doc = yaml::Parse(json, "radio_plan.json");
@@ -115,7 +121,7 @@ TEST(RadioSchedule, FaultsAtSimulatedTimesBecomeThePhysicsServersEntries) {
   EXPECT_THAT(json, HasSubstr(R"({"at_s":5,"name":"gps","kind":"world_command","target":"scout_1",)"
                               R"("command":"gps_dropout","args":[10]})"));
   EXPECT_THAT(json, HasSubstr(R"("name":"reboot","kind":"drone_out","mode":"restart","targets":["lifter"],)"
-                              R"("duration_s":0})"));
+                              R"("duration_s":0.004})"));
 }
 
 // `random` draws from the trial's seed (std::mt19937_64, rng() % drones, in firing order: the

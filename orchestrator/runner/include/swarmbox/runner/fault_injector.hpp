@@ -36,14 +36,16 @@
 //
 // Faults the physics server schedules (radio.model channel: `planned`, the radio plan's entries,
 // runner/radio_schedule.hpp). The injector does not fire them; on the physics server's lines:
-//   `event=drone_out drone=X fault=F mode=M`: the container action on X's agent (kill: the fault's
-//       signal, default SIGKILL; stop and restart: docker stop with the fault's timeout; pause),
+//   `event=drone_out drone=X fault=F mode=M`: the fault's container action on X's agent (kill: the
+//       fault's signal, default SIGKILL; stop and restart: docker stop with the fault's timeout;
+//       pause; the server's mode is how it keeps the drone out: radio_schedule.hpp),
 //       recorded `requested` then `applied` (or `failed`), both with t_sim_s = the line's `t`, the
 //       simulated time the drone left the lockstep (mechanism "docker");
 //   `event=drone_back drone=X fault=F`: the reverse (start; unpause), `remove_requested` then
 //       `removed` at the line's `t`; a started agent is followed again (TakeResumed);
 //   `event=radio_fault fault=F kind=impair|partition state=on|off`: recorded `applied` / `removed`
-//       at the line's `t` (mechanism "channel": the physics server carried it out).
+//       at the line's `t` (mechanism "channel": the physics server carried it out);
+//   `event=fault_skipped fault=F reason=R` (e.g. no Raft leader at its time): recorded `failed`.
 // At the end of the trial a drone still paused is unpaused (so it can stop); killed and stopped
 // ones stay down and are recorded removed with the trial's end.
 //
@@ -150,8 +152,7 @@ class FaultInjector {
   // A physics server line reporting a planned fault (drone_out, drone_back, radio_fault); nullopt
   // verdict when carried out (or not such a line).
   std::optional<dsl::Verdict> OnPlannedEvent(const std::string& line);
-  std::optional<dsl::Verdict> DroneOut(const faults::Fault& fault, const std::string& drone,
-                                       const std::string& mode, double t_sim_s);
+  std::optional<dsl::Verdict> DroneOut(const faults::Fault& fault, const std::string& drone, double t_sim_s);
   std::optional<dsl::Verdict> DroneBack(const std::string& drone, double t_sim_s, bool trial_end);
 
   docker::DockerApi& api_;

@@ -20,9 +20,14 @@
 //   - `mesh`: network.mesh, the impairment of every sender's egress (absent: none);
 //   - `schedule`: every fault whose trigger is a simulated time (`at:`), sorted by (at_s, the
 //     fault's place in `faults:`):
-//       kill/stop/pause/restart  `drone_out`, mode = the kind, duration_s = the fault's duration
-//                                (0 = none: the drone stays out); the runner carries out the
-//                                container action when the server reports it (fault_injector.hpp);
+//       kill/stop/pause/restart  `drone_out` in the physics server's modes: kill without a
+//                                duration: mode kill, duration_s 0 (stays out); kill with one: mode
+//                                restart for its duration (out, then back as a new process); stop
+//                                and pause: their mode and duration (none: faults::kUntilEndS, the
+//                                rest of the trial); restart: out for one lockstep step (0.004 s).
+//                                The runner carries out the fault's own container action (kill with
+//                                its signal, stop, pause) when the server reports the drone out,
+//                                and the reverse when it reports it back (fault_injector.hpp);
 //       radio                    `radio`, the fault's one all-traffic rule as `impairment`;
 //       partition                `partition`, groups as written plus the drones in no group as one
 //                                more group, `oneway`;
