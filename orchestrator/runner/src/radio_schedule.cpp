@@ -24,9 +24,10 @@ constexpr double kRestartOutS = 0.004;  // one lockstep step [simulated s]
 double Seconds(std::int64_t ms) { return static_cast<double>(ms) / 1000.0; }
 
 // Names, globs and `all` resolved against the drones; `random` drawn from rng; raft_leader kept.
-Result<std::vector<std::string>> Targets(const faults::FaultTarget& target, const std::vector<std::string>& drones,
-                                         std::mt19937_64& rng) {
-  if (target.kind == faults::FaultTarget::Kind::kRaftLeader) return std::vector<std::string>{std::string(kRaftLeader)};
+Result<std::vector<std::string>> Targets(const faults::FaultTarget& target,
+                                         const std::vector<std::string>& drones, std::mt19937_64& rng) {
+  if (target.kind == faults::FaultTarget::Kind::kRaftLeader)
+    return std::vector<std::string>{std::string(kRaftLeader)};
   const faults::LeaderTracker no_leader;  // never asked: raft_leader is handled above
   return faults::ResolveTarget(target, drones, no_leader, rng);
 }
@@ -57,23 +58,30 @@ Node Impairment(const faults::NetemSpec& s) {
 
 std::string_view KindName(ScheduleEntry::Kind kind) {
   switch (kind) {
-    case ScheduleEntry::Kind::kDroneOut: return "drone_out";
-    case ScheduleEntry::Kind::kRadio: return "radio";
-    case ScheduleEntry::Kind::kPartition: return "partition";
-    case ScheduleEntry::Kind::kWorldCommand: return "world_command";
+    case ScheduleEntry::Kind::kDroneOut:
+      return "drone_out";
+    case ScheduleEntry::Kind::kRadio:
+      return "radio";
+    case ScheduleEntry::Kind::kPartition:
+      return "partition";
+    case ScheduleEntry::Kind::kWorldCommand:
+      return "world_command";
   }
   return "drone_out";
 }
 
 }  // namespace
 
-bool InRadioSchedule(const faults::Fault& fault) { return fault.start.clock == faults::FaultStart::Clock::kSim; }
+bool InRadioSchedule(const faults::Fault& fault) {
+  return fault.start.clock == faults::FaultStart::Clock::kSim;
+}
 
 Result<RadioSchedule> PlanRadioSchedule(const dsl::TrialSpec& spec) {
   if (spec.radio.model != dsl::RadioModel::kChannel) {
     return Error(ErrorCode::kInvalidArgument,
-                 "trial " + spec.name + " runs radio.model netem: its faults are carried out by the runner, "
-                 "it has no radio plan");
+                 "trial " + spec.name +
+                     " runs radio.model netem: its faults are carried out by the runner, "
+                     "it has no radio plan");
   }
   SWARMBOX_TRY(faults::CheckChannelSupports(spec.mesh.rules, "network.mesh"));
   SWARMBOX_TRY(faults::CheckChannelFaults(spec.faults));

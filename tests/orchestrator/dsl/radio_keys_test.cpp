@@ -40,8 +40,9 @@ std::string With(std::string_view find, std::string_view replace) {
 }
 
 TEST(RadioKeys, DefaultIsTheChannelWithTheWifiMeshProfile) {
-  auto spec = LoadTrialText(With("radio: {model: channel, profile: telemetry_900mhz, ping_every_ms: 250}\n", ""),
-                            "bare.yaml", Opts());
+  auto spec =
+      LoadTrialText(With("radio: {model: channel, profile: telemetry_900mhz, ping_every_ms: 250}\n", ""),
+                    "bare.yaml", Opts());
   ASSERT_TRUE(spec) << spec.error().ToString();
   EXPECT_EQ(spec->radio.model, RadioModel::kChannel);
   EXPECT_EQ(spec->radio.profile, "wifi_5ghz_mesh");
@@ -68,7 +69,8 @@ TEST(RadioKeys, SetNetemKeepsTheRealStack) {
   EXPECT_EQ(spec->radio.model, RadioModel::kNetem);
   EXPECT_EQ(RadioModelName(spec->radio.model), "netem");
   // netem needs no profile: one that does not exist is not looked for.
-  auto missing = LoadTrialText(With("telemetry_900mhz", "no_such_radio"), "radio.yaml", Opts({"radio.model=netem"}));
+  auto missing =
+      LoadTrialText(With("telemetry_900mhz", "no_such_radio"), "radio.yaml", Opts({"radio.model=netem"}));
   EXPECT_TRUE(missing) << missing.error().ToString();
 }
 
@@ -82,7 +84,8 @@ TEST(RadioKeys, BadValuesFailAtFileLineColumnWithTheReason) {
        "radio profile 'no_such_radio' not found (no file /trials/radios/no_such_radio.yaml)"},
       {"profile: telemetry_900mhz", "profile: /etc/radio.yaml", "radio.yaml:7:34",
        "'profile' must be a radio profile name"},
-      {"profile: telemetry_900mhz", "profile: ../radio.yaml", "radio.yaml:7:34", "inside the trials directory"},
+      {"profile: telemetry_900mhz", "profile: ../radio.yaml", "radio.yaml:7:34",
+       "inside the trials directory"},
       {"ping_every_ms: 250", "ping_every: 250", "radio.yaml:7:52", "unknown key 'ping_every' in radio"},
   };
   for (const Case& c : cases) {
@@ -106,11 +109,14 @@ TEST(RadioKeys, TheChannelRefusesWhatItDoesNotCarryOutAndNetemTakesIt) {
       {"network:\n  mesh: {gilbert_elliott: {p: 0.02, r: 0.25}}\n", "radio.yaml:10:9", "'gilbert_elliott'"},
       {"network:\n  mesh: {loss: 0.1, loss_correlation: 0.5}\n", "radio.yaml:10:9", "'loss_correlation'"},
       {"faults:\n  - {name: bits, at: 5s, radio: {target: scout_1, corrupt: 0.01}}\n", "radio.yaml:10:33",
-       "fault bits: 'corrupt' is not carried out by the simulated radio channel (radio.model channel): a frame "
+       "fault bits: 'corrupt' is not carried out by the simulated radio channel (radio.model channel): a "
+       "frame "
        "arrives whole or not at all; radio.model: netem (the real network stack) does"},
-      {"faults:\n  - {name: late, at: 5s, radio: {delay_ms: 50, reorder: 0.2}}\n", "radio.yaml:10:33", "'reorder'"},
+      {"faults:\n  - {name: late, at: 5s, radio: {delay_ms: 50, reorder: 0.2}}\n", "radio.yaml:10:33",
+       "'reorder'"},
       {"faults:\n  - {name: storm, at_wall: 5s, radio: {loss: 0.5}}\n", "radio.yaml:10:5",
-       "fault storm (radio, at_wall 5s): the simulated radio channel (radio.model channel) takes radio faults and "
+       "fault storm (radio, at_wall 5s): the simulated radio channel (radio.model channel) takes radio "
+       "faults and "
        "partitions at simulated times only (at:)"},
       {"faults:\n  - {on: \"event=leader_elected\", partition: {groups: [[scout_1]]}}\n", "radio.yaml:10:5",
        "takes radio faults and partitions at simulated times only"},
@@ -129,15 +135,16 @@ TEST(RadioKeys, TheChannelRefusesWhatItDoesNotCarryOutAndNetemTakesIt) {
 // What the channel does carry out loads: the mesh impairment, radio faults and partitions at
 // simulated times, process faults with any trigger.
 TEST(RadioKeys, TheChannelTakesTheMeshAndFaultsAtSimulatedTimes) {
-  const std::string text = std::string(kTrial) +
-                           "network:\n  mesh: {delay_ms: 100, jitter_ms: 20, distribution: normal, loss: 0.05, "
-                           "rate_kbit: 500, duplicate: 0.01}\n"
-                           "faults:\n"
-                           "  - {at: 20s, duration: 10s, radio: {target: scout_1, delay_ms: 300, loss: 0.2}}\n"
-                           "  - {at: 40s, duration: 20s, partition: {groups: [[scout_1], [scout_2]]}}\n"
-                           "  - {at: 30s, kill: raft_leader}\n"
-                           "  - {on: \"event=leader_elected\", restart: raft_leader}\n"
-                           "  - {at_wall: 5s, duration: 2s, pause: scout_2}\n";
+  const std::string text =
+      std::string(kTrial) +
+      "network:\n  mesh: {delay_ms: 100, jitter_ms: 20, distribution: normal, loss: 0.05, "
+      "rate_kbit: 500, duplicate: 0.01}\n"
+      "faults:\n"
+      "  - {at: 20s, duration: 10s, radio: {target: scout_1, delay_ms: 300, loss: 0.2}}\n"
+      "  - {at: 40s, duration: 20s, partition: {groups: [[scout_1], [scout_2]]}}\n"
+      "  - {at: 30s, kill: raft_leader}\n"
+      "  - {on: \"event=leader_elected\", restart: raft_leader}\n"
+      "  - {at_wall: 5s, duration: 2s, pause: scout_2}\n";
   auto spec = LoadTrialText(text, "radio.yaml", Opts());
   ASSERT_TRUE(spec) << spec.error().ToString();
   EXPECT_EQ(spec->faults.size(), 5u);
@@ -153,7 +160,8 @@ TEST(RadioKeys, TheResolvedDocumentKeepsTheModelAndAProfileThatIsNotTheDefault) 
   EXPECT_EQ(again->radio.profile, "telemetry_900mhz");
   EXPECT_EQ(again->radio.ping_every_ms, 250);
 
-  TrialSpec built = TrialSpec::Named("built").World("worlds/open_field.yaml").Drone("scout_1", "x500", {0, 0, 0});
+  TrialSpec built =
+      TrialSpec::Named("built").World("worlds/open_field.yaml").Drone("scout_1", "x500", {0, 0, 0});
   built.Timeout(Duration::Seconds(30));
   const std::string text = yaml::Emit(ToDocument(built));
   EXPECT_NE(text.find("model: \"channel\""), std::string::npos) << text;

@@ -62,7 +62,8 @@ std::vector<yaml::Node> FaultRecords(const std::string& events, const std::strin
     if (!j) continue;
     const yaml::Node* type = j->Find("type");
     const yaml::Node* name = j->Find("fault");
-    if (type != nullptr && type->scalar() == "fault" && name != nullptr && name->scalar() == fault) out.push_back(*j);
+    if (type != nullptr && type->scalar() == "fault" && name != nullptr && name->scalar() == fault)
+      out.push_back(*j);
   }
   return out;
 }
@@ -126,10 +127,11 @@ class ChannelRunnerTest : public ::testing::Test {
 TEST_F(ChannelRunnerTest, KillsTheContainerTheServerTookOutAtItsSimulatedTime) {
   spec_.Mesh("{delay_ms: 100, jitter_ms: 20, distribution: normal, loss: 0.05}");
   spec_.Fault("{name: kill_leader, at: 30s, kill: raft_leader}");
-  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready",
-                                   "t=30.000 node=physics event=raft_leader_resolved fault=kill_leader drone=scout_2",
-                                   "t=30.000 node=physics event=drone_out drone=scout_2 fault=kill_leader mode=kill",
-                                   "t=31.000 node=physics event=tick"};
+  api_.scripts["physics"].lines = {
+      "t=0.000 node=physics event=ready",
+      "t=30.000 node=physics event=raft_leader_resolved fault=kill_leader drone=scout_2",
+      "t=30.000 node=physics event=drone_out drone=scout_2 fault=kill_leader mode=kill",
+      "t=31.000 node=physics event=tick"};
   api_.scripts["scout_1"].lines = {"t=35.0 node=scout_1 event=done"};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
@@ -149,11 +151,12 @@ TEST_F(ChannelRunnerTest, KillsTheContainerTheServerTookOutAtItsSimulatedTime) {
 
   // The plan in the trial folder, and in the physics container's volume.
   const std::string plan = ReadFile(fs::path(run.trial_dir) / "radio_plan.json");
-  EXPECT_EQ(plan,
-            R"({"seed":11,"mesh":{"delay_ms":100,"jitter_ms":20,"distribution":"normal","loss":0.05,"rate_kbit":0,)"
-            R"("duplicate":0},"schedule":[{"at_s":30,"name":"kill_leader","kind":"drone_out","mode":"kill",)"
-            R"("targets":["raft_leader"],"duration_s":0}]})"
-            "\n");
+  EXPECT_EQ(
+      plan,
+      R"({"seed":11,"mesh":{"delay_ms":100,"jitter_ms":20,"distribution":"normal","loss":0.05,"rate_kbit":0,)"
+      R"("duplicate":0},"schedule":[{"at_s":30,"name":"kill_leader","kind":"drone_out","mode":"kill",)"
+      R"("targets":["raft_leader"],"duration_s":0}]})"
+      "\n");
   const std::string tar = api_.PutArchives().at(Name("physics"));
   EXPECT_THAT(tar, HasSubstr("radio_plan.json"));
   EXPECT_THAT(tar, HasSubstr(plan));
@@ -165,8 +168,9 @@ TEST_F(ChannelRunnerTest, KillsTheContainerTheServerTookOutAtItsSimulatedTime) {
       physics_argv.insert(physics_argv.end(), c.cmd.begin(), c.cmd.end());
     }
   }
-  EXPECT_THAT(physics_argv, ::testing::IsSupersetOf({std::string("--radio-plan"), std::string("/swarmbox/radio_plan.json"),
-                                                      std::string("/swarmbox/trials/radios/bench_radio.yaml")}));
+  EXPECT_THAT(physics_argv,
+              ::testing::IsSupersetOf({std::string("--radio-plan"), std::string("/swarmbox/radio_plan.json"),
+                                       std::string("/swarmbox/trials/radios/bench_radio.yaml")}));
 
   // events.jsonl: requested and applied at the simulated time it landed, on the resolved drone.
   const auto records = FaultRecords(Events(run), "kill_leader");
@@ -276,7 +280,8 @@ TEST_F(ChannelRunnerTest, AKillWithADurationKillsThenStartsAndASkippedFaultIsRec
       "t=15.000 node=physics event=raft_leader_resolved fault=kill_leader_1 drone=scout_1",
       "t=15.000 node=physics event=drone_out drone=scout_1 fault=kill_leader_1 mode=restart",
       "t=25.000 node=physics event=drone_back drone=scout_1 fault=kill_leader_1",
-      "t=30.000 node=physics event=fault_skipped fault=kill_leader_2 reason=\"no drone leads the Raft group\""};
+      "t=30.000 node=physics event=fault_skipped fault=kill_leader_2 reason=\"no drone leads the Raft "
+      "group\""};
   api_.scripts["scout_1"].restart_lines = {"t=25.5 node=scout_1 event=done"};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
@@ -285,7 +290,8 @@ TEST_F(ChannelRunnerTest, AKillWithADurationKillsThenStartsAndASkippedFaultIsRec
   const std::size_t kill = IndexOfExact(calls, "kill " + Name("scout_1") + " SIGKILL");
   ASSERT_LT(kill, calls.size());
   bool started_after = false;
-  for (std::size_t i = kill; i < calls.size(); ++i) started_after = started_after || calls[i] == "start " + Name("scout_1");
+  for (std::size_t i = kill; i < calls.size(); ++i)
+    started_after = started_after || calls[i] == "start " + Name("scout_1");
   EXPECT_TRUE(started_after);
   EXPECT_EQ(IndexOfExact(calls, "stop " + Name("scout_1")) < kill, false);
   const auto skipped = FaultRecords(Events(run), "kill_leader_2");
@@ -299,9 +305,10 @@ TEST_F(ChannelRunnerTest, AKillWithADurationKillsThenStartsAndASkippedFaultIsRec
 // A drone the server pauses and never brings back is unpaused at the end, so it can stop.
 TEST_F(ChannelRunnerTest, ADroneStillPausedAtTheEndIsUnpausedBeforeTheContainersStop) {
   spec_.Fault("{name: freeze, at: 1s, pause: scout_2}");
-  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready",
-                                   "t=1.000 node=physics event=drone_out drone=scout_2 fault=freeze mode=pause",
-                                   "t=2.000 node=physics event=done"};
+  api_.scripts["physics"].lines = {
+      "t=0.000 node=physics event=ready",
+      "t=1.000 node=physics event=drone_out drone=scout_2 fault=freeze mode=pause",
+      "t=2.000 node=physics event=done"};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
   const auto calls = api_.Calls();
@@ -315,9 +322,10 @@ TEST_F(ChannelRunnerTest, ADroneStillPausedAtTheEndIsUnpausedBeforeTheContainers
 // A report that matches no entry of the plan means the two disagree: the trial ends with error.
 TEST_F(ChannelRunnerTest, AReportOfAFaultNotInThePlanEndsTheTrialWithError) {
   spec_.Fault("{name: kill_leader, at: 30s, kill: raft_leader}");
-  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready",
-                                   "t=30.000 node=physics event=drone_out drone=scout_1 fault=other mode=kill",
-                                   "t=31.000 node=physics event=done"};
+  api_.scripts["physics"].lines = {
+      "t=0.000 node=physics event=ready",
+      "t=30.000 node=physics event=drone_out drone=scout_1 fault=other mode=kill",
+      "t=31.000 node=physics event=done"};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kError);
   EXPECT_THAT(run.result.verdict.reason, HasSubstr("fault 'other', which is not in the radio plan"));
@@ -345,8 +353,10 @@ TEST_F(ChannelRunnerTest, NetemAtAnotherRtfThanOneIsWarnedAbout) {
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
   const std::string events = Events(run);
-  EXPECT_THAT(events, HasSubstr("\"component\":\"orchestrator\",\"event\":\"warning\",\"reason\":\"radio.model netem runs "
-                                "the radio on the wall clock: at rtf 0"));
+  EXPECT_THAT(
+      events,
+      HasSubstr("\"component\":\"orchestrator\",\"event\":\"warning\",\"reason\":\"radio.model netem runs "
+                "the radio on the wall clock: at rtf 0"));
   EXPECT_FALSE(fs::exists(fs::path(run.trial_dir) / "radio_plan.json"));
   auto result = yaml::Parse(ReadFile(fs::path(run.trial_dir) / "result.json"), "result.json");
   ASSERT_TRUE(result);

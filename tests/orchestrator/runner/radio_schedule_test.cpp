@@ -51,15 +51,16 @@ TEST(RadioSchedule, TheMeshImpairmentIsEverySendersEgress) {
 
 // Every kind at a simulated time, in time order; the design's example entries.
 TEST(RadioSchedule, FaultsAtSimulatedTimesBecomeThePhysicsServersEntries) {
-  dsl::TrialSpec spec = Trial()
-                            .Fault("{name: split, at: 40s, duration: 20s, partition: {groups: [[scout_1]], oneway: false}}")
-                            .Fault("{name: kill_leader, at: 30s, kill: raft_leader}")
-                            .Fault("{name: deg, at: 20s, duration: 10s, radio: {target: scout_1, delay_ms: 300, loss: 0.2}}")
-                            .Fault("{name: gps, at: 5s, duration: 10s, gps_dropout: scout_1}")
-                            .Fault("{name: nap, at: 50s, duration: 3s, pause: \"scout_*\"}")
-                            .Fault("{name: term, at: 60s, duration: 20s, kill: {target: scout_3, signal: SIGTERM}}")
-                            .Fault("{name: reboot, at: 70s, restart: lifter}")
-                            .Fault("{name: halt, at: 80s, stop: {target: scout_2, timeout: 5s}}");
+  dsl::TrialSpec spec =
+      Trial()
+          .Fault("{name: split, at: 40s, duration: 20s, partition: {groups: [[scout_1]], oneway: false}}")
+          .Fault("{name: kill_leader, at: 30s, kill: raft_leader}")
+          .Fault("{name: deg, at: 20s, duration: 10s, radio: {target: scout_1, delay_ms: 300, loss: 0.2}}")
+          .Fault("{name: gps, at: 5s, duration: 10s, gps_dropout: scout_1}")
+          .Fault("{name: nap, at: 50s, duration: 3s, pause: \"scout_*\"}")
+          .Fault("{name: term, at: 60s, duration: 20s, kill: {target: scout_3, signal: SIGTERM}}")
+          .Fault("{name: reboot, at: 70s, restart: lifter}")
+          .Fault("{name: halt, at: 80s, stop: {target: scout_2, timeout: 5s}}");
   auto plan = PlanRadioSchedule(spec);
   ASSERT_TRUE(plan) << plan.error().ToString();
   std::vector<std::string> names;
@@ -113,11 +114,14 @@ TEST(RadioSchedule, FaultsAtSimulatedTimesBecomeThePhysicsServersEntries) {
   ASSERT_TRUE(doc) << doc.error().ToString();
   EXPECT_THAT(json, HasSubstr(R"({"at_s":30,"name":"kill_leader","kind":"drone_out","mode":"kill",)"
                               R"("targets":["raft_leader"],"duration_s":0})"));
-  EXPECT_THAT(json, HasSubstr(R"({"at_s":20,"name":"deg","kind":"radio","targets":["scout_1"],)"
-                              R"("impairment":{"delay_ms":300,"jitter_ms":0,"distribution":"uniform","loss":0.2,)"
-                              R"("rate_kbit":0,"duplicate":0},"duration_s":10})"));
-  EXPECT_THAT(json, HasSubstr(R"({"at_s":40,"name":"split","kind":"partition",)"
-                              R"("groups":[["scout_1"],["scout_2","scout_3","lifter"]],"oneway":false,"duration_s":20})"));
+  EXPECT_THAT(json,
+              HasSubstr(R"({"at_s":20,"name":"deg","kind":"radio","targets":["scout_1"],)"
+                        R"("impairment":{"delay_ms":300,"jitter_ms":0,"distribution":"uniform","loss":0.2,)"
+                        R"("rate_kbit":0,"duplicate":0},"duration_s":10})"));
+  EXPECT_THAT(
+      json,
+      HasSubstr(R"({"at_s":40,"name":"split","kind":"partition",)"
+                R"("groups":[["scout_1"],["scout_2","scout_3","lifter"]],"oneway":false,"duration_s":20})"));
   EXPECT_THAT(json, HasSubstr(R"({"at_s":5,"name":"gps","kind":"world_command","target":"scout_1",)"
                               R"("command":"gps_dropout","args":[10]})"));
   EXPECT_THAT(json, HasSubstr(R"("name":"reboot","kind":"drone_out","mode":"restart","targets":["lifter"],)"
@@ -154,7 +158,8 @@ TEST(RadioSchedule, SensorAndWorldFaultsAreWorldCommandsWithTheirUndoAtTheEnd) {
       Trial()
           .Fault("{name: bias, at: 40s, duration: 30s, imu_bias: {target: lifter, accel_mps2: [0.3, 0, 0]}}")
           .Fault("{name: gust, at: 60s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270}}")
-          .Fault("{name: fix, at: 50s, duration: 20s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}");
+          .Fault(
+              "{name: fix, at: 50s, duration: 20s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}");
   auto plan = PlanRadioSchedule(spec);
   ASSERT_TRUE(plan) << plan.error().ToString();
   ASSERT_EQ(plan->schedule.size(), 4u);
@@ -197,12 +202,13 @@ TEST(RadioSchedule, RefusesANetemTrialAndWhatTheChannelDoesNotCarryOut) {
   EXPECT_EQ(corrupt.error().code(), ErrorCode::kInvalidArgument);
   EXPECT_THAT(corrupt.error().message(), HasSubstr("network.mesh: 'corrupt' is not carried out"));
 
-  auto per_destination = PlanRadioSchedule(
-      Trial().Fault("{name: link, at: 5s, radio: {target: scout_1, rules: [{to: [lifter], delay_ms: 400}]}}"));
+  auto per_destination = PlanRadioSchedule(Trial().Fault(
+      "{name: link, at: 5s, radio: {target: scout_1, rules: [{to: [lifter], delay_ms: 400}]}}"));
   ASSERT_FALSE(per_destination);
   EXPECT_THAT(per_destination.error().message(), HasSubstr("fault link: 'to' is not carried out"));
 
-  auto wall = PlanRadioSchedule(Trial().Fault("{name: storm, at_wall: 5s, partition: {groups: [[scout_1]]}}"));
+  auto wall =
+      PlanRadioSchedule(Trial().Fault("{name: storm, at_wall: 5s, partition: {groups: [[scout_1]]}}"));
   ASSERT_FALSE(wall);
   EXPECT_THAT(wall.error().message(), HasSubstr("at simulated times only"));
 }

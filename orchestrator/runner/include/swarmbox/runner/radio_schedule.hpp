@@ -60,17 +60,17 @@ namespace swarmbox::runner {
 struct ScheduleEntry {
   enum class Kind { kDroneOut, kRadio, kPartition, kWorldCommand };
   Kind kind = Kind::kDroneOut;
-  double at_s = 0.0;                         // simulated time [s]
-  std::string name;                          // the fault's id (`name:` or fault_<index>)
-  double duration_s = 0.0;                   // drone_out, radio, partition; 0 = until the end
-  std::vector<std::string> targets;          // drone_out, radio: drone names or "raft_leader"
+  double at_s = 0.0;                 // simulated time [s]
+  std::string name;                  // the fault's id (`name:` or fault_<index>)
+  double duration_s = 0.0;           // drone_out, radio, partition; 0 = until the end
+  std::vector<std::string> targets;  // drone_out, radio: drone names or "raft_leader"
   faults::ProcessAction mode = faults::ProcessAction::kKill;  // drone_out
-  faults::NetemSpec impairment;              // radio
-  std::vector<std::vector<std::string>> groups;  // partition
-  bool oneway = false;                       // partition
-  std::string target;                        // world_command: a drone, "raft_leader", "" = world
-  std::string command;                       // world_command
-  std::vector<double> args;                  // world_command
+  faults::NetemSpec impairment;                               // radio
+  std::vector<std::vector<std::string>> groups;               // partition
+  bool oneway = false;                                        // partition
+  std::string target;        // world_command: a drone, "raft_leader", "" = world
+  std::string command;       // world_command
+  std::vector<double> args;  // world_command
 };
 
 struct RadioSchedule {
