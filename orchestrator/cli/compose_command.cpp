@@ -9,6 +9,7 @@
 #include "swarmbox/runner/compose_export.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/plan.hpp"
+#include "swarmbox/runner/radio_schedule.hpp"
 
 namespace swarmbox::cli {
 
@@ -41,11 +42,36 @@ int ComposeCommand(const ComposeArgs& args) {
     std::cerr << payloads.error().ToString() << "\n";
     return kExitUsage;
   }
+  if (Status s = runner::CheckRadioProfile(*spec, trials_dir); !s) {
+    std::cerr << "swarmbox compose: " << s.error().ToString() << "\n";
+    return kExitUsage;
+  }
   runner::PlanOptions plan;
   plan.run_id = kComposeRunId;
   plan.images = images;
   plan.subnets = *subnets;
   plan.trials_dir = trials_dir;
+  // radio.model channel: the radio plan (network.mesh, the faults at simulated times) is written
+  // next to the compose file and bind-mounted by a path relative to it; printed to stdout there is
+  // no place for it, and the channel runs unimpaired (compose carries out no faults either).
+  std::string radio_plan_text;
+  fs::path radio_plan_file;
+  if (spec->radio.model == dsl::RadioModel::kChannel) {
+    auto schedule = runner::PlanRadioSchedule(*spec);
+    if (!schedule) {
+      std::cerr << "swarmbox compose: " << schedule.error().ToString() << "\n";
+      return kExitUsage;
+    }
+    if (args.output.empty()) {
+      std::cerr << "swarmbox compose: note: the radio plan (network.mesh, faults at simulated times) is exported "
+                   "only with -o FILE, next to it\n";
+    } else {
+      radio_plan_text = runner::RadioScheduleJson(*schedule) + "\n";
+      radio_plan_file = fs::path(args.output).parent_path() /
+                        (fs::path(args.output).stem().string() + "." + std::string(runner::kRadioPlanFile));
+      plan.radio_plan_path = "./" + radio_plan_file.filename().string();
+    }
+  }
   auto trial = runner::PlanTrial(*spec, plan);
   if (!trial) {
     std::cerr << "swarmbox compose: " << trial.error().ToString() << "\n";
@@ -75,6 +101,16 @@ int ComposeCommand(const ComposeArgs& args) {
   if (args.output.empty()) {
     std::cout << text;
     return kExitOk;
+  }
+  if (!radio_plan_text.empty()) {
+    std::ofstream plan_out(radio_plan_file, std::ios::binary | std::ios::trunc);
+    plan_out << radio_plan_text;
+    plan_out.close();
+    if (!plan_out) {
+      std::cerr << "swarmbox compose: cannot write " << radio_plan_file.string() << "\n";
+      return kExitInfrastructure;
+    }
+    std::cerr << "wrote " << radio_plan_file.string() << "\n";
   }
   std::ofstream out(args.output, std::ios::binary | std::ios::trunc);
   out << text;

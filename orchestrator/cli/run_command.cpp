@@ -37,6 +37,15 @@ void PrintJsonSummary(const runner::RunOutcome& run, const std::string& run_id, 
 int RunCommand(const RunArgs& args) {
   auto spec = LoadTrialOrPrintError(args.trial, args.sets);
   if (!spec) return kExitUsage;
+  // The radio profile (the default one is not checked by the loader), before anything starts.
+  const std::string trials_dir = std::filesystem::absolute(spec->trials_dir).lexically_normal().string();
+  if (Status s = runner::CheckRadioProfile(*spec, trials_dir); !s) {
+    std::cerr << "swarmbox run: " << s.error().ToString() << "\n";
+    return kExitUsage;
+  }
+  if (auto warning = runner::RadioRtfWarning(dsl::RadioModelName(spec->radio.model), spec->rtf)) {
+    std::cerr << "swarmbox run: warning: " << *warning << "\n";  // events.jsonl has it too
+  }
   EngineConnection engine = ConnectEngineOrPrintError("run");
   if (!engine.client) return engine.exit_code;
   docker::DockerClient& client = *engine.client;

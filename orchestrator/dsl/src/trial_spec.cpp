@@ -15,6 +15,17 @@ std::string_view MissionKindName(MissionKind kind) {
   return kind == MissionKind::kPlan ? "plan" : "sar";
 }
 
+std::string_view RadioModelName(RadioModel model) {
+  return model == RadioModel::kNetem ? "netem" : "channel";
+}
+
+std::string RadioProfileFile(const RadioLinkSpec& radio) {
+  const std::string& p = radio.profile;
+  const bool is_path = p.find('/') != std::string::npos ||
+                       (p.size() > 5 && p.compare(p.size() - 5, 5, ".yaml") == 0);
+  return is_path ? p : "radios/" + p + ".yaml";
+}
+
 TrialSpec TrialSpec::Named(std::string name) {
   TrialSpec t;
   t.name = std::move(name);
@@ -173,6 +184,9 @@ yaml::Node ToDocument(const TrialSpec& spec) {
   raft.Set("election_timeout_ms", Plain(std::to_string(spec.raft.election_timeout_ms)));
   doc.Set("raft", std::move(raft));
   Node radio = Node::Mapping();
+  radio.Set("model", Str(RadioModelName(spec.radio.model)));
+  // The default profile is left implied (a profile written out is checked where it is written).
+  if (spec.radio.profile != kDefaultRadioProfile) radio.Set("profile", Str(spec.radio.profile));
   radio.Set("ping_every_ms", Plain(std::to_string(spec.radio.ping_every_ms)));
   doc.Set("radio", std::move(radio));
   if (!spec.mesh_node.is_null()) {

@@ -5,6 +5,7 @@
 #include <utility>
 #include <variant>
 
+#include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::runner {
@@ -436,8 +437,154 @@ std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& a
   return failure;
 }
 
-std::optional<Verdict> FaultInjector::OnLogLine(const std::string& /*component*/, const std::string& line) {
+std::optional<Verdict> FaultInjector::OnPlannedEvent(const std::string& line) {
+  const LogfmtFields fields = ParseLogfmt(line);
+  const std::string event = FindField(fields, "event").value_or("");
+  if (event != "drone_out" && event != "drone_back" && event != "radio_fault" && event != "fault_skipped") {
+    return std::nullopt;
+  }
+  const std::string name = FindField(fields, "fault").value_or("");
+  const faults::Fault* fault = nullptr;
+  for (const faults::Fault& f : config_.planned) {
+    if (f.id == name) fault = &f;
+  }
+  if (fault == nullptr) {
+    return Verdict::Err("the physics server reported fault '" + name + "', which is not in the radio plan: " + line,
+                        "faults");
+  }
+  // The simulated time it landed: the line's own (the monitor's clock may lag a line behind).
+  const auto t = yaml::ScalarAsDouble(FindField(fields, "t").value_or(""));
+  const double t_sim_s = t ? *t : (sim_s_ ? sim_s_() : 0.0);
+  const std::string drone = FindField(fields, "drone").value_or("");
+  if (event == "drone_out") return DroneOut(*fault, drone, t_sim_s);
+  if (event == "drone_back") return DroneBack(drone, t_sim_s, /*trial_end=*/false);
+  if (event == "fault_skipped") {  // e.g. no drone led the Raft group at its time
+    faults::FaultEventRecord record = Record(FaultPhase::kFailed);
+    record.t_sim_s = t_sim_s;
+    record.mechanism = "physics";
+    record.error = "skipped by the physics server: " + FindField(fields, "reason").value_or("no reason given");
+    if (events_) events_(faults::FaultEventJson(*fault, record));
+    return std::nullopt;
+  }
+  // radio_fault: the channel carried it out in the physics server; recorded as it happened.
+  const std::string state = FindField(fields, "state").value_or("");
+  if (state != "on" && state != "off") {
+    return Verdict::Err("the physics server reported a radio fault with state '" + state + "': " + line, "faults");
+  }
+  faults::FaultEventRecord record = Record(state == "on" ? FaultPhase::kApplied : FaultPhase::kRemoved);
+  record.t_sim_s = t_sim_s;
+  record.requested_t_sim_s = t_sim_s;
+  record.requested_wall_s = record.wall_s;
+  record.mechanism = "channel";
+  if (events_) events_(faults::FaultEventJson(*fault, record));
+  return std::nullopt;
+}
+
+std::optional<Verdict> FaultInjector::DroneOut(const faults::Fault& fault, const std::string& drone,
+                                               double t_sim_s) {
+  const auto* process = std::get_if<faults::ProcessFault>(&fault.action);
+  auto container = config_.agents.find(drone);
+  faults::FaultEventRecord record = Record(FaultPhase::kRequested);
+  record.t_sim_s = t_sim_s;
+  record.targets = {drone};
+  record.mechanism = "docker";
+  std::string error;
+  if (process == nullptr) {
+    error = "the physics server took " + drone + " out for fault " + fault.id + ", which is a " +
+            std::string(fault.kind()) + " fault, not a process fault";
+  } else if (container == config_.agents.end()) {
+    error = "the physics server took out '" + drone + "', which is not a drone of this trial";
+  }
+  // The fault's own action: the server's mode says how it keeps the drone out (a kill with a
+  // duration is its `restart`), the fault what happens to the container.
+  const faults::ProcessAction action = process != nullptr ? process->action : faults::ProcessAction::kKill;
+  Status s = Ok{};
+  if (error.empty()) {
+    if (events_) events_(faults::FaultEventJson(fault, record));
+    using Kind = faults::DockerAction::Kind;
+    const std::string& c = container->second;
+    Out out{&fault, {}};
+    std::vector<faults::DockerAction> apply;
+    switch (action) {
+      case faults::ProcessAction::kKill: apply = {{Kind::kKill, c, process->signal, 0}}; break;
+      case faults::ProcessAction::kStop:
+      case faults::ProcessAction::kRestart: apply = {{Kind::kStop, c, "", process->timeout_s}}; break;
+      case faults::ProcessAction::kPause: apply = {{Kind::kPause, c, "", 0}}; break;
+    }
+    out.undo = {{action == faults::ProcessAction::kPause ? Kind::kUnpause : Kind::kStart, c, "", 0}};
+    if (action != faults::ProcessAction::kPause) disrupted_.insert(drone);
+    out_[drone] = out;  // stored first: a half-done action is undone too
+    s = faults::ExecuteDockerActions(api_, apply);
+    const double requested_wall_s = record.wall_s;
+    record = Record(FaultPhase::kApplied);
+    record.t_sim_s = t_sim_s;  // out of the lockstep at exactly this time; the container followed
+    record.targets = {drone};
+    record.mechanism = "docker";
+    record.requested_t_sim_s = t_sim_s;
+    record.requested_wall_s = requested_wall_s;
+  } else {
+    s = Error(ErrorCode::kInvalidArgument, error);
+  }
+  if (!s) {
+    record.phase = FaultPhase::kFailed;
+    record.error = s.error().ToString();
+  }
+  if (events_) events_(faults::FaultEventJson(fault, record));
+  if (!s) {
+    return Verdict::Err("fault " + fault.id + " (" + std::string(fault.kind()) + ") could not be applied: " +
+                            s.error().ToString(),
+                        "faults");
+  }
+  return std::nullopt;
+}
+
+std::optional<Verdict> FaultInjector::DroneBack(const std::string& drone, double t_sim_s, bool trial_end) {
+  auto it = out_.find(drone);
+  if (it == out_.end()) {
+    return Verdict::Err("the physics server brought back '" + drone + "', which no fault took out", "faults");
+  }
+  const Out out = it->second;
+  out_.erase(it);
+  const faults::Fault& fault = *out.fault;
+  faults::FaultEventRecord record = Record(FaultPhase::kRemoveRequested);
+  record.t_sim_s = t_sim_s;
+  record.targets = {drone};
+  record.mechanism = "docker";
+  if (events_) events_(faults::FaultEventJson(fault, record));
+  const bool paused = !out.undo.empty() && out.undo.front().kind == faults::DockerAction::Kind::kUnpause;
+  Status s = Ok{};
+  // At the trial's end only a paused agent is brought back (so it can stop); the others stay down.
+  if (!trial_end || paused) s = faults::ExecuteDockerActions(api_, out.undo);
+  const double requested_wall_s = record.wall_s;
+  record = Record(FaultPhase::kRemoved);
+  if (!trial_end) record.t_sim_s = t_sim_s;
+  record.targets = {drone};
+  record.mechanism = "docker";
+  record.requested_t_sim_s = t_sim_s;
+  record.requested_wall_s = requested_wall_s;
+  if (trial_end && !paused) record.note = "left down: the trial's end stops every container";
+  if (s && !trial_end && !paused) {
+    disrupted_.erase(drone);
+    resumed_.push_back(drone);
+  }
+  if (!s) {
+    record.phase = FaultPhase::kFailed;
+    record.error = s.error().ToString();
+  }
+  if (events_) events_(faults::FaultEventJson(fault, record));
+  if (!s) {
+    return Verdict::Err("fault " + fault.id + " (" + std::string(fault.kind()) + ") could not be removed: " +
+                            s.error().ToString(),
+                        "faults");
+  }
+  return std::nullopt;
+}
+
+std::optional<Verdict> FaultInjector::OnLogLine(const std::string& component, const std::string& line) {
   if (torn_down_) return std::nullopt;
+  if (!config_.planned.empty() && component == config_.physics_component) {
+    if (auto v = OnPlannedEvent(line)) return v;
+  }
   leaders_.Feed(line);
   return Carry(timeline_.OnLogLine(line, wall_s_ ? wall_s_() : 0.0), /*trial_end=*/false);
 }
@@ -449,7 +596,15 @@ std::optional<Verdict> FaultInjector::Advance() {
 }
 
 Verdict FaultInjector::RemoveActive() {
+  // The drones the physics server took out and has not brought back, newest fault last: as the
+  // trial ends (a paused one is unpaused so it can stop).
+  std::optional<Verdict> out_failure;
+  while (!out_.empty()) {
+    auto v = DroneBack(out_.begin()->first, sim_s_ ? sim_s_() : 0.0, /*trial_end=*/true);
+    if (v && !out_failure) out_failure = v;
+  }
   auto failure = Carry(timeline_.RemoveAll(), /*trial_end=*/true);
+  if (!failure) failure = out_failure;
   if (failure) {
     problems_.push_back(failure->reason);
     return *failure;

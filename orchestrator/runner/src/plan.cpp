@@ -36,7 +36,7 @@ constexpr int kMeshDomain = 1;
 
 // swarmbox-physics (physics_server/README.md).
 constexpr double kFaultClockEveryS = 0.5;  // [simulated s]
-std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
+std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan) {
   std::vector<std::string> argv = {
       images::kPhysicsBinaryInImage,
       "--world", InContainer(spec.world),
@@ -50,10 +50,18 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec) {
       // Stops (event=stopped t=...) when the trial's simulated time is up; truth.csv is flushed.
       "--max-sim-time", Num(spec.timeout.sim.seconds()),
   };
-  // Faults at simulated times fire at the log line that crosses their time: with such faults the
-  // physics server reports its clock every 0.5 s (default 10 s), so they fire at most 0.5 s late.
+  // The simulated radio: the channel with its profile, and the plan of what happens at simulated
+  // times (network.mesh, the faults with `at:`; radio_schedule.hpp).
+  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
+  if (channel) {
+    argv.insert(argv.end(), {"--radio-model", "channel", "--radio-profile", InContainer(dsl::RadioProfileFile(spec.radio))});
+    if (radio_plan) argv.insert(argv.end(), {"--radio-plan", std::string(kRadioPlanPath)});
+  }
+  // netem: faults at simulated times fire at the log line that crosses their time (the fault
+  // injector's timeline): with such faults the physics server reports its clock every 0.5 s
+  // (default 10 s), so they fire at most 0.5 s late. With the channel they are in the plan.
   for (const faults::Fault& f : spec.faults) {
-    if (f.start.clock == faults::FaultStart::Clock::kSim) {
+    if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {
       argv.insert(argv.end(), {"--clock-every", Num(kFaultClockEveryS)});
       break;
     }
@@ -102,8 +110,15 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
       "--sim-interface", std::string(kSimInterface),
       "--sim-domain", std::to_string(kSimDomain),
-      "--mesh-interface", std::string(kMeshInterface),
-      "--mesh-domain", std::to_string(kMeshDomain),
+  };
+  if (spec.radio.model == dsl::RadioModel::kChannel) {
+    // The radio is the physics server's channel, over the sim bus: no mesh network, no mesh domain.
+    argv.insert(argv.end(), {"--radio-model", "channel"});
+  } else {
+    argv.insert(argv.end(), {"--mesh-interface", std::string(kMeshInterface),
+                             "--mesh-domain", std::to_string(kMeshDomain)});
+  }
+  argv.insert(argv.end(), {
       "--start", Num(d.pose[0]) + "," + Num(d.pose[1]) + "," + Num(d.pose[2]),
       // Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`.
       "--members", Members(spec),
@@ -111,7 +126,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       "--raft-tick-ms", std::to_string(spec.raft.tick_ms),
       "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
       "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
-  };
+  });
   // The radio link measurement (event=link per peer).
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
   // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
@@ -180,7 +195,20 @@ Result<std::map<std::string, double>> LoadPayloadMasses(const dsl::TrialSpec& sp
   return masses;
 }
 
+Status CheckRadioProfile(const dsl::TrialSpec& spec, const std::string& trials_dir) {
+  if (spec.radio.model != dsl::RadioModel::kChannel) return Ok{};
+  const std::string relative = dsl::RadioProfileFile(spec.radio);
+  const std::string path = (std::filesystem::path(trials_dir) / relative).lexically_normal().string();
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec)) return Ok{};
+  return Error(ErrorCode::kInvalidArgument,
+               "radio profile '" + spec.radio.profile + "' not found (no file " + path +
+                   "): radio.model channel needs one (set radio.profile, or radio.model: netem for the real "
+                   "network stack)");
+}
+
 bool NeedsFaultSidecars(const dsl::TrialSpec& spec) {
+  if (spec.radio.model == dsl::RadioModel::kChannel) return false;  // the channel impairs in the plan
   if (!spec.mesh.empty()) return true;
   for (const faults::Fault& f : spec.faults) {
     if (std::holds_alternative<faults::RadioFault>(f.action) ||
@@ -237,16 +265,23 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   // destination is outside the subnet, DDS discovery multicast (239.255.0.1) included, once
   // bridged traffic goes through iptables (br_netfilter; measured on this host).
   sim.internal = false;
-  dsl::NetworkSpec mesh = dsl::NetworkSpec::Subnet(name("net2-mesh"), nets.mesh.ToString(),
-                                                   nets.mesh.Host(kGatewayHost));
-  mesh.labels = labels(kMeshNetworkId);
-  mesh.internal = false;
   auto& sim_net = trial->Add<dsl::Network>(std::string(kSimNetworkId), std::move(sim), 0);
-  auto& mesh_net = trial->Add<dsl::Network>(std::string(kMeshNetworkId), std::move(mesh), 0);
+  // The mesh network carries the netem model's radio; the channel's radio is simulated.
+  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
+  dsl::Network* mesh_net = nullptr;
+  if (!channel) {
+    dsl::NetworkSpec mesh = dsl::NetworkSpec::Subnet(name("net2-mesh"), nets.mesh.ToString(),
+                                                     nets.mesh.Host(kGatewayHost));
+    mesh.labels = labels(kMeshNetworkId);
+    mesh.internal = false;
+    mesh_net = &trial->Add<dsl::Network>(std::string(kMeshNetworkId), std::move(mesh), 0);
+  }
 
   // The physics server: owns simulated time, writes truth.csv.
   const std::string physics_ip = nets.sim.Host(kPhysicsHost);
-  dsl::ContainerSpec physics = dsl::ContainerSpec::Image(options.images.physics, PhysicsArgv(spec));
+  const bool radio_plan = channel && !options.radio_plan_path.empty();
+  dsl::ContainerSpec physics =
+      dsl::ContainerSpec::Image(options.images.physics, PhysicsArgv(spec, radio_plan));
   physics.name = name(kPhysicsId);
   physics.hostname = std::string(kPhysicsId);
   physics.labels = labels(kPhysicsId);
@@ -255,6 +290,10 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   std::set<std::string> airframes;
   for (const dsl::DroneSpec& d : spec.drones) {
     if (airframes.insert(d.airframe).second) physics.inputs.push_back(input(AirframeRelative(d)));
+  }
+  if (channel) {
+    physics.inputs.push_back(input(dsl::RadioProfileFile(spec.radio)));
+    if (radio_plan) physics.inputs.push_back({options.radio_plan_path, std::string(kRadioPlanPath)});
   }
   physics.scratch_dirs = {std::string(kContainerOutDir)};
   physics.artifacts = {std::string(kTruthCsvPath)};
@@ -284,7 +323,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
       sc.stop_timeout_s = 2;
       radios.Add<dsl::Plugin>(id, std::move(sc), 2)
           .On(sim_net, nets.sim.Host(host), {d.name})
-          .On(mesh_net, nets.mesh.Host(host), {d.name});
+          .On(*mesh_net, nets.mesh.Host(host), {d.name});
       ++host;
     }
     trial->Add<dsl::Step>(std::string(kFaultsStepId), 3);
@@ -308,9 +347,8 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
       drones.Add<dsl::Plugin>(d.name, std::move(agent), 2);
     } else {
       agent.hostname = d.name;
-      drones.Add<dsl::Plugin>(d.name, std::move(agent), 2)
-          .On(sim_net, sim_ip, {d.name})
-          .On(mesh_net, mesh_ip, {d.name});
+      auto& plugin = drones.Add<dsl::Plugin>(d.name, std::move(agent), 2).On(sim_net, sim_ip, {d.name});
+      if (mesh_net != nullptr) plugin.On(*mesh_net, mesh_ip, {d.name});
     }
   }
 

@@ -43,6 +43,12 @@ std::string ResultJson(const TrialResult& r) {
   doc.Set("sim_s", Bare(Num(r.sim_s)));
   doc.Set("seed", Bare(std::to_string(r.seed)));
   doc.Set("host", Str(r.host));
+  if (!r.radio_model.empty()) {
+    Node radio = Node::Mapping();
+    radio.Set("model", Str(r.radio_model));
+    radio.Set("profile", r.radio_profile.empty() ? Node::Null() : Str(r.radio_profile));
+    doc.Set("radio", std::move(radio));
+  }
   Node metrics = Node::Mapping();
   for (const std::string& name : report::MetricNames()) {
     auto it = r.metrics.find(name);

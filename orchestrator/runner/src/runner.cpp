@@ -17,6 +17,7 @@
 #include "swarmbox/runner/log_hub.hpp"
 #include "swarmbox/runner/monitor.hpp"
 #include "swarmbox/runner/naming.hpp"
+#include "swarmbox/runner/radio_schedule.hpp"
 #include "swarmbox/runner/trajectories.hpp"
 
 namespace swarmbox::runner {
@@ -64,6 +65,18 @@ class EventsFile {
   std::FILE* file_;
 };
 
+// {"wall_s":0.000,"component":"orchestrator","event":"warning","reason":"..."}
+std::string WarningEventJson(double wall_s, const std::string& reason) {
+  yaml::Node root = yaml::Node::Mapping();
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", wall_s);
+  root.Set("wall_s", yaml::Node::Scalar(buf));
+  root.Set("component", yaml::Node::Scalar("orchestrator", {}, /*quoted=*/true));
+  root.Set("event", yaml::Node::Scalar("warning", {}, /*quoted=*/true));
+  root.Set("reason", yaml::Node::Scalar(reason, {}, /*quoted=*/true));
+  return yaml::EmitJson(root);
+}
+
 // $SWARMBOX_PARALLEL (a positive number), else `fallback`.
 int ParallelFromEnvironment(int fallback) {
   const char* v = std::getenv("SWARMBOX_PARALLEL");
@@ -98,6 +111,15 @@ report::Provenance TrialProvenance(docker::DockerApi& api, dsl::Trial* tree,
 
 }  // namespace
 
+std::optional<std::string> RadioRtfWarning(std::string_view radio_model, std::optional<double> rtf_asked) {
+  if (radio_model != "netem" || !rtf_asked || *rtf_asked == 1.0) return std::nullopt;
+  char rtf[32];
+  std::snprintf(rtf, sizeof rtf, "%g", *rtf_asked);
+  return "radio.model netem runs the radio on the wall clock: at rtf " + std::string(rtf) +
+         " its delays, timeouts and link figures are distorted against simulated time (radio.model channel "
+         "keeps them on simulated time at any rtf)";
+}
+
 Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docker::DockerApi& api,
                             Clock& clock, const RunOptions& o) {
   const std::string run_id = o.run_id.empty() ? NewRunId() : o.run_id;
@@ -106,8 +128,10 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   fs::create_directories(dir / "logs", ec);
   if (ec) return Error(ErrorCode::kIo, "cannot create the trial folder: " + ec.message(), dir.string());
   SWARMBOX_TRY(WriteFile(dir / "trial.yaml", info.resolved_yaml));
+  for (const auto& [file, text] : info.files) SWARMBOX_TRY(WriteFile(dir / file, text));
   EventsFile events(dir / "events.jsonl");
   if (!events.ok()) return Error(ErrorCode::kIo, "cannot write events.jsonl", dir.string());
+  if (auto warning = RadioRtfWarning(info.radio_model, info.rtf)) events.Write(WarningEventJson(0.0, *warning));
   if (auto ping = api.Ping(); !ping) return ping.error().Context("reaching the Docker engine");
 
   std::vector<std::string> taken;
@@ -148,13 +172,15 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   std::optional<Monitor> monitor;
 
   // Faults: one injector per built tree (a restart or another subnet pair makes a new one).
-  const bool has_faults = !info.mesh.empty() || !info.faults.empty();
+  const bool has_faults = !info.mesh.empty() || !info.faults.empty() || !info.planned_faults.empty();
   std::unique_ptr<FaultInjector> injector;
   auto make_injector = [&]() -> std::unique_ptr<FaultInjector> {
     InjectorConfig c;
     c.drones = info.drones;
     c.mesh = info.mesh;
     c.faults = info.faults;
+    c.planned = info.planned_faults;
+    c.physics_component = std::string(kPhysicsId);
     c.seed = info.seed;
     c.host = o.host;
     for (const std::string& d : info.drones) {
@@ -231,6 +257,8 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   result.run_id = run_id;
   result.seed = info.seed;
   result.host = o.host;
+  result.radio_model = info.radio_model;
+  result.radio_profile = info.radio_profile;
 
   auto raise = [&](const std::string& component, Verdict v, bool restart) {
     dsl::Component* c = tree->Find(component);
@@ -415,9 +443,22 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
     return payloads.error().Context("checking payloads");
   }
   for (const dsl::DroneSpec& d : spec.drones) info.drones.push_back(d.name);
-  info.mesh = spec.mesh;
-  info.faults = spec.faults;
   info.middleware = spec.middleware;
+  info.radio_model = std::string(dsl::RadioModelName(spec.radio.model));
+  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
+  if (channel) {
+    // The simulated radio: network.mesh and the faults at simulated times go to the physics
+    // server in the radio plan; the rest (on:, at_wall:) stay with the fault injector.
+    info.radio_profile = spec.radio.profile;
+    SWARMBOX_TRY(CheckRadioProfile(spec, trials_dir));
+    auto plan = PlanRadioSchedule(spec);
+    if (!plan) return plan.error().Context("the radio plan");
+    info.files[std::string(kRadioPlanFile)] = RadioScheduleJson(*plan) + "\n";
+    for (const faults::Fault& f : spec.faults) (InRadioSchedule(f) ? info.planned_faults : info.faults).push_back(f);
+  } else {
+    info.mesh = spec.mesh;
+    info.faults = spec.faults;
+  }
   std::string faults_image = options.faults_image;
   if (NeedsFaultSidecars(spec) && faults_image.empty()) {
     auto netemd = FindNetemd(options.netemd_bin);
@@ -428,8 +469,12 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
     if (!tag) return tag.error();
     faults_image = *tag;
   }
-  Planner planner = [&, faults_image](const std::string& run_id, const TrialSubnets& subnets) {
+  Planner planner = [&, faults_image, channel](const std::string& run_id, const TrialSubnets& subnets) {
     PlanOptions p;
+    if (channel) {  // RunTrial wrote it (info.files) into the trial folder
+      p.radio_plan_path =
+          (fs::absolute(options.out_dir) / TrialDirName(spec.name, run_id) / kRadioPlanFile).lexically_normal().string();
+    }
     p.run_id = run_id;
     p.trial_id = options.trial_id;
     p.images = options.images;

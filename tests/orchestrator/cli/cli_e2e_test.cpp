@@ -94,7 +94,7 @@ class CliE2eTest : public ::testing::Test {
     std::vector<std::string> argv = {
         kSwarmbox, "run", kSmokeTrial, "--out", dir_.string(), "--run-id", run_id,
         "--set", "physics.rtf=1", "--set", "timeout.sim=600s", "--set", "timeout.wall=20m",
-        "--set", "mission={kind: plan, plan: \"takeoff:2,hover:600,land\"}"};
+        "--set", "mission={kind: plan, plan: \"takeoff:2,hover:600,land\"}", "--set", "radio.model=netem"};
     argv.insert(argv.end(), extra.begin(), extra.end());
     auto child = ChildProcess::Spawn(argv, Out(run_id), Err(run_id));
     EXPECT_TRUE(child) << child.error().ToString();

@@ -65,7 +65,7 @@ class TrialRun : public ::testing::Test {
   // success. Returns the trial folder.
   fs::path RunToSuccess(const std::string& trial, const std::string& trial_name) {
     auto done = RunToEnd({kSwarmbox, "run", trial, "--out", dir_.string(), "--run-id", run_id_,
-                          "--set", "physics.rtf=0", "--quiet"},
+                          "--set", "physics.rtf=0", "--set", "radio.model=netem", "--quiet"},
                          std::chrono::minutes(15), dir_.string());
     EXPECT_TRUE(done) << done.error().ToString();
     const fs::path trial_dir = dir_ / runner::TrialDirName(trial_name, run_id_);

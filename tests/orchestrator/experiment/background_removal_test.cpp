@@ -86,6 +86,7 @@ dsl::TrialSpec MiniTrial(const std::string& name) {
                             .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout,
                                      dsl::Duration::Seconds(600));
   spec.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+  spec.radio.model = dsl::RadioModel::kNetem;  // the two networks these removals are about
   return spec;
 }
 

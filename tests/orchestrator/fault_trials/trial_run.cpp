@@ -104,7 +104,9 @@ Result<std::unique_ptr<docker::DockerApi>> ConnectDocker() {
 
 Result<dsl::TrialSpec> LoadFaultTrial(const std::string& name, const std::vector<std::string>& sets) {
   dsl::LoadOptions opts;
-  opts.overrides = sets;
+  // These trials are judged on the netem model's figures through its sidecars (RunWithExtraArgs).
+  opts.overrides = {"radio.model=netem"};
+  opts.overrides.insert(opts.overrides.end(), sets.begin(), sets.end());
   return dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/faults/" + name, opts);
 }
 

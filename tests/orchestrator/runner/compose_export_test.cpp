@@ -10,7 +10,9 @@ namespace swarmbox::runner {
 namespace {
 
 TEST(ComposeYaml, ExportsNetworksServicesAndStartOrder) {
-  auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml");
+  dsl::LoadOptions load;
+  load.overrides = {"radio.model=netem"};  // both networks (ChannelExportHasNoMeshNetwork: the channel's)
+  auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml", load);
   ASSERT_TRUE(spec) << spec.error().ToString();
   PlanOptions o;
   o.run_id = "compose";

@@ -95,6 +95,7 @@ TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemov
                             .EndOn("event=crash", dsl::Outcome::kFailure, "crash")
                             .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout, dsl::Duration::Seconds(240));
   spec.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+  spec.radio.model = dsl::RadioModel::kNetem;  // the sidecars' impairment is what is inspected
 
   const fs::path out = fs::temp_directory_path() / "swarmbox-fault-e2e";
   fs::remove_all(out);

@@ -119,6 +119,9 @@ class FaultRunnerTest : public ::testing::Test {
                 .EndOn("event=done", dsl::Outcome::kSuccess)
                 .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout, dsl::Duration::Seconds(600));
     spec_.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+    // Faults carried out by the runner itself: the netem model (channel_runner_test.cpp has the
+    // channel's, where the physics server schedules them).
+    spec_.radio.model = dsl::RadioModel::kNetem;
     options_.out_dir = out_.string();
     options_.run_id = kRun;
     options_.images = {"swarmbox/physics:test", "swarmbox/agent:test"};

@@ -18,7 +18,10 @@ using ::testing::ElementsAre;
 class PlanTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml");
+    // The netem model's tree (mesh network, fault sidecars); PlanChannelTest plans the channel's.
+    dsl::LoadOptions load;
+    load.overrides = {"radio.model=netem"};
+    auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml", load);
     ASSERT_TRUE(spec) << spec.error().ToString();
     spec_ = *spec;
     options_.run_id = "20261121-101000-7f3a";
@@ -290,6 +293,154 @@ TEST(PhysicsCommandArgvTest, SendsOnThePhysicsServersBusWithTheWorldAsDash) {
               ElementsAre("/usr/local/bin/swarmbox-physics", "--sim-interface", "eth0", "--domain", "0",
                           "--middleware", "cyclonedds", "--send-command", "scout_1", "gps_degrade", "4", "5",
                           "8.5"));
+}
+
+// radio.model channel (the default): one network, no sidecars, the channel's flags and files.
+class PlanChannelTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_search.yaml");
+    ASSERT_TRUE(spec) << spec.error().ToString();
+    spec_ = *spec;
+    ASSERT_EQ(spec_.radio.model, dsl::RadioModel::kChannel);
+    options_.run_id = "20261121-101000-7f3a";
+    options_.images = {"swarmbox/physics:abc", "swarmbox/agent:def"};
+    options_.subnets = {*Ipv4Net::Parse("10.200.8.0/24"), *Ipv4Net::Parse("10.200.9.0/24")};
+    options_.trials_dir = "/src/trials";
+    options_.faults_image = "swarmbox/faults:f00";  // sar_search impairs the mesh: no sidecar anyway
+    options_.radio_plan_path = "/runs/sar-search-20261121-101000-7f3a/radio_plan.json";
+  }
+  static std::string ValueOf(const std::vector<std::string>& argv, const std::string& flag) {
+    auto it = std::find(argv.begin(), argv.end(), flag);
+    return it == argv.end() || it + 1 == argv.end() ? "<absent>" : *(it + 1);
+  }
+  dsl::TrialSpec spec_;
+  PlanOptions options_;
+};
+
+TEST_F(PlanChannelTest, NoMeshNetworkAndNoSidecars) {
+  EXPECT_FALSE(NeedsFaultSidecars(spec_));
+  spec_.Fault("{at: 10s, duration: 5s, partition: {groups: [[scout_1], [scout_2]]}}");
+  EXPECT_FALSE(NeedsFaultSidecars(spec_));
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  auto nets = (*trial)->Networks();
+  ASSERT_EQ(nets.size(), 1u);
+  EXPECT_EQ(nets[0]->id(), "sim");
+  std::vector<std::string> ids;
+  for (auto* p : (*trial)->Plugins()) ids.push_back(p->id());
+  EXPECT_THAT(ids, ElementsAre("physics", "scout_1", "scout_2", "scout_3", "lifter"));
+  EXPECT_EQ((*trial)->Find("faults"), nullptr);
+  EXPECT_EQ((*trial)->Find("drones")->run_priority(), 2);
+  const dsl::ContainerSpec& lifter = (*trial)->FindPlugin("lifter")->spec();
+  ASSERT_EQ(lifter.networks.size(), 1u);
+  EXPECT_EQ(lifter.networks[0].network, "sim");
+  EXPECT_EQ(lifter.networks[0].ipv4, "10.200.8.13");
+  EXPECT_EQ(lifter.hostname, "lifter");
+  EXPECT_TRUE(lifter.network_of.empty());
+}
+
+TEST_F(PlanChannelTest, AgentsRunTheChannelRadioWithoutMeshFlags) {
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  for (const std::string d : {"scout_1", "lifter"}) {
+    const auto& argv = (*trial)->FindPlugin(d)->spec().argv;
+    EXPECT_EQ(ValueOf(argv, "--radio-model"), "channel") << d;
+    EXPECT_EQ(ValueOf(argv, "--mesh-interface"), "<absent>") << d;
+    EXPECT_EQ(ValueOf(argv, "--mesh-domain"), "<absent>") << d;
+    EXPECT_EQ(ValueOf(argv, "--sim-interface"), "eth0") << d;
+    EXPECT_EQ(ValueOf(argv, "--members"), "scout_1,scout_2,scout_3,lifter") << d;
+    EXPECT_EQ(ValueOf(argv, "--ping-every-ms"), "200") << d;
+  }
+}
+
+TEST_F(PlanChannelTest, ThePhysicsServerGetsTheProfileAndThePlanCopiedIn) {
+  spec_.Fault("{at: 30s, kill: raft_leader}");
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  const dsl::ContainerSpec& physics = (*trial)->FindPlugin("physics")->spec();
+  EXPECT_EQ(ValueOf(physics.argv, "--radio-model"), "channel");
+  EXPECT_EQ(ValueOf(physics.argv, "--radio-profile"), "/swarmbox/trials/radios/wifi_5ghz_mesh.yaml");
+  EXPECT_EQ(ValueOf(physics.argv, "--radio-plan"), "/swarmbox/radio_plan.json");
+  // Faults at simulated times are the physics server's: no finer clock for the runner's timeline.
+  EXPECT_EQ(ValueOf(physics.argv, "--clock-every"), "<absent>");
+  bool profile = false;
+  bool plan = false;
+  for (const dsl::InputFile& in : physics.inputs) {
+    if (in.container_path == "/swarmbox/trials/radios/wifi_5ghz_mesh.yaml") {
+      profile = true;
+      EXPECT_EQ(in.host_path, "/src/trials/radios/wifi_5ghz_mesh.yaml");
+    }
+    if (in.container_path == "/swarmbox/radio_plan.json") {
+      plan = true;
+      EXPECT_EQ(in.host_path, options_.radio_plan_path);
+    }
+  }
+  EXPECT_TRUE(profile);
+  EXPECT_TRUE(plan);
+  // The agents need neither.
+  for (const dsl::InputFile& in : (*trial)->FindPlugin("scout_1")->spec().inputs) {
+    EXPECT_EQ(in.container_path.find("radio"), std::string::npos) << in.container_path;
+  }
+
+  // A profile by path; no plan file: no --radio-plan.
+  spec_.radio.profile = "radios/lab/bench.yaml";
+  options_.radio_plan_path.clear();
+  trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  const auto& argv = (*trial)->FindPlugin("physics")->spec().argv;
+  EXPECT_EQ(ValueOf(argv, "--radio-profile"), "/swarmbox/trials/radios/lab/bench.yaml");
+  EXPECT_EQ(ValueOf(argv, "--radio-plan"), "<absent>");
+}
+
+TEST_F(PlanChannelTest, NetemKeepsTheFlagsOfBefore) {
+  spec_.radio.model = dsl::RadioModel::kNetem;
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  EXPECT_EQ(ValueOf((*trial)->FindPlugin("physics")->spec().argv, "--radio-model"), "<absent>");
+  EXPECT_EQ(ValueOf((*trial)->FindPlugin("physics")->spec().argv, "--radio-plan"), "<absent>");
+  EXPECT_EQ(ValueOf((*trial)->FindPlugin("scout_1")->spec().argv, "--radio-model"), "<absent>");
+  EXPECT_EQ(ValueOf((*trial)->FindPlugin("scout_1")->spec().argv, "--mesh-interface"), "eth1");
+  EXPECT_NE((*trial)->FindPlugin("scout_1-faults"), nullptr);
+}
+
+TEST_F(PlanChannelTest, TheRadioProfileMustExistOnTheHost) {
+  const std::string trials = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+  spec_.radio.profile = "no_such_radio";
+  Status s = CheckRadioProfile(spec_, trials);
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(s.error().message().find("radio profile 'no_such_radio' not found (no file " + trials +
+                                     "/radios/no_such_radio.yaml)"),
+            std::string::npos)
+      << s.error().ToString();
+  spec_.radio.profile = "worlds/open_field.yaml";  // any file there: only existence is checked here
+  EXPECT_TRUE(CheckRadioProfile(spec_, trials));
+  spec_.radio.model = dsl::RadioModel::kNetem;
+  spec_.radio.profile = "no_such_radio";
+  EXPECT_TRUE(CheckRadioProfile(spec_, trials));
+}
+
+// compose exports the channel: one network, the flags, the plan bind-mounted from next to the file.
+TEST_F(PlanChannelTest, ComposeExportsTheChannel) {
+  options_.run_id = "compose";
+  options_.radio_plan_path = "./sar_search.compose.radio_plan.json";
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial);
+  ComposeOptions co;
+  co.host_prefix = "/src/trials";
+  co.relative_prefix = "../trials";
+  const std::string text = ComposeYaml(**trial, co);
+  auto doc = yaml::Parse(text, "compose.yaml");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  EXPECT_EQ(doc->Find("networks")->Find("mesh"), nullptr) << text;
+  EXPECT_NE(doc->Find("networks")->Find("sim"), nullptr);
+  EXPECT_NE(text.find("- \"../trials/radios/wifi_5ghz_mesh.yaml:/swarmbox/trials/radios/wifi_5ghz_mesh.yaml:ro\""),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("- \"./sar_search.compose.radio_plan.json:/swarmbox/radio_plan.json:ro\""), std::string::npos);
+  EXPECT_NE(text.find("- \"--radio-model\"\n      - \"channel\""), std::string::npos);
+  EXPECT_EQ(text.find("NET_ADMIN"), std::string::npos);
 }
 
 }  // namespace

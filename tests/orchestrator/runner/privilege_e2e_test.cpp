@@ -71,6 +71,7 @@ class PrivilegeE2e : public ::testing::Test {
                               .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout,
                                        dsl::Duration::Seconds(240));
     spec.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+    spec.radio.model = dsl::RadioModel::kNetem;  // fault sidecars with NET_ADMIN are inspected too
     return spec;
   }
 

@@ -65,6 +65,9 @@ class RunnerTest : public ::testing::Test {
                 .EndOn("event=collision", dsl::Outcome::kFailure, "collision")
                 .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout, dsl::Duration::Seconds(600));
     spec_.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+    // The netem model's tree (mesh network, sidecars), as these tests were written for; the
+    // channel's runs are in channel_runner_test.cpp.
+    spec_.radio.model = dsl::RadioModel::kNetem;
     options_.out_dir = out_.string();
     options_.run_id = "20261121-120000-abcd";
     options_.images = {"swarmbox/physics:test", "swarmbox/agent:test"};

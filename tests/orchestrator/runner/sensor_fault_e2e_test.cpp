@@ -54,6 +54,7 @@ TEST(SensorFaultE2e, GpsDropoutAndDegradationAreSentToThePhysicsServerAndRecorde
   spec.Fault("{name: gps_loss, at: 8s, duration: 3s, gps_dropout: scout_1}");
   spec.Fault("{name: bad_fix, at: 12s, duration: 2s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}");
   spec.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
+  spec.radio.model = dsl::RadioModel::kNetem;  // sent by `--send-command` (the channel's plan has them)
 
   const fs::path out = fs::temp_directory_path() / "swarmbox-sensor-fault-e2e";
   fs::remove_all(out);

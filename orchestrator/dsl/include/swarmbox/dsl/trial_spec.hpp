@@ -95,11 +95,28 @@ struct RaftSpec {
   int election_timeout_ms = 1500;
 };
 
-// The agents' radio link measurement (`radio:`): each agent pings every peer every ping_every_ms
-// on the mesh (0 = off) and logs event=link lines.
+// The radio between drones (`radio:`, ARCHITECTURE.md "Two networks per trial, two radio models"):
+//   model channel  the simulated channel next to the physics world, on simulated time (default):
+//                  no mesh network and no fault sidecars; network.mesh, radio faults and
+//                  partitions at simulated times go to the physics server in the radio plan
+//                  (runner/radio_schedule.hpp);
+//   model netem    the real stack over the `mesh` Docker network, impaired from fault sidecars,
+//                  on the wall clock (meaningful at rtf 1 only).
+// `profile`: the channel's radio profile, a name (trials/radios/<NAME>.yaml) or a path relative to
+// the trials directory ending in .yaml (RadioProfileFile). Each agent pings every peer every
+// ping_every_ms (0 = off; simulated ms with channel, wall ms with netem) and logs event=link lines.
+enum class RadioModel { kChannel, kNetem };
+std::string_view RadioModelName(RadioModel model);  // "channel", "netem"
+inline constexpr std::string_view kDefaultRadioProfile = "wifi_5ghz_mesh";
+
 struct RadioLinkSpec {
   int ping_every_ms = 200;
+  RadioModel model = RadioModel::kChannel;
+  std::string profile = std::string(kDefaultRadioProfile);
 };
+// The profile's file relative to the trials directory: "radios/<name>.yaml" for a name, the path
+// itself for a path (it has a '/' or ends in ".yaml").
+std::string RadioProfileFile(const RadioLinkSpec& radio);
 
 struct TimeoutSpec {
   Duration sim;                         // simulated time; zero = none

@@ -55,6 +55,7 @@
 // (delay_scheduler.hpp), with netem's random numbers in netem_random.hpp.
 #pragma once
 
+#include "swarmbox/faults/channel_support.hpp"
 #include "swarmbox/faults/command_runner.hpp"
 #include "swarmbox/faults/delay_scheduler.hpp"
 #include "swarmbox/faults/docker_exec_runner.hpp"

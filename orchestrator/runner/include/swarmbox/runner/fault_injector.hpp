@@ -34,6 +34,21 @@
 // MeshEventJson line per drone once its sidecar confirmed it; the detection is one line
 // {"type":"mechanism",...}.
 //
+// Faults the physics server schedules (radio.model channel: `planned`, the radio plan's entries,
+// runner/radio_schedule.hpp). The injector does not fire them; on the physics server's lines:
+//   `event=drone_out drone=X fault=F mode=M`: the fault's container action on X's agent (kill: the
+//       fault's signal, default SIGKILL; stop and restart: docker stop with the fault's timeout;
+//       pause; the server's mode is how it keeps the drone out: radio_schedule.hpp),
+//       recorded `requested` then `applied` (or `failed`), both with t_sim_s = the line's `t`, the
+//       simulated time the drone left the lockstep (mechanism "docker");
+//   `event=drone_back drone=X fault=F`: the reverse (start; unpause), `remove_requested` then
+//       `removed` at the line's `t`; a started agent is followed again (TakeResumed);
+//   `event=radio_fault fault=F kind=impair|partition state=on|off`: recorded `applied` / `removed`
+//       at the line's `t` (mechanism "channel": the physics server carried it out);
+//   `event=fault_skipped fault=F reason=R` (e.g. no Raft leader at its time): recorded `failed`.
+// At the end of the trial a drone still paused is unpaused (so it can stop); killed and stopped
+// ones stay down and are recorded removed with the trial's end.
+//
 // Process faults and the log watch: a container a fault stopped, killed or restarts is Disrupted()
 // (the runner does not call its exit a crash); once a fault brings it back (start, restart) it is
 // listed by TakeResumed() so the runner follows its log again.
@@ -73,6 +88,10 @@ struct InjectorConfig {
   // has such faults (Setup refuses them otherwise).
   std::string physics_container;
   std::function<std::vector<std::string>(const faults::WorldCommandCall&)> physics_command_argv;
+  // radio.model channel: the faults the physics server schedules (not in `faults`) and the
+  // component whose log lines report them.
+  std::vector<faults::Fault> planned;
+  std::string physics_component = "physics";
 };
 
 // The mechanism detected per host, shared by every trial of this process.
@@ -130,6 +149,11 @@ class FaultInjector {
   // Sends the world commands through the physics container, all at once; the first failure.
   Status SendToPhysics(const std::vector<faults::WorldCommandCall>& calls);
   faults::FaultEventRecord Record(faults::FaultPhase phase) const;
+  // A physics server line reporting a planned fault (drone_out, drone_back, radio_fault); nullopt
+  // verdict when carried out (or not such a line).
+  std::optional<dsl::Verdict> OnPlannedEvent(const std::string& line);
+  std::optional<dsl::Verdict> DroneOut(const faults::Fault& fault, const std::string& drone, double t_sim_s);
+  std::optional<dsl::Verdict> DroneBack(const std::string& drone, double t_sim_s, bool trial_end);
 
   docker::DockerApi& api_;
   InjectorConfig config_;
@@ -149,6 +173,12 @@ class FaultInjector {
   std::map<std::size_t, faults::PhysicsPlan> physics_;               // active sensor/world faults
   std::unique_ptr<faults::DockerExecCommandRunner> physics_runner_;
   std::map<std::string, std::vector<faults::RadioRule>> installed_;  // drone -> rules in place
+  // drone -> the planned fault that took it out, and what brings it back
+  struct Out {
+    const faults::Fault* fault = nullptr;
+    std::vector<faults::DockerAction> undo;
+  };
+  std::map<std::string, Out> out_;
   std::set<std::string> disrupted_;  // agent components a process fault took down
   std::vector<std::string> resumed_;
   std::vector<std::string> problems_;

@@ -4,7 +4,14 @@
 // images, and each program's command line (swarmbox-physics, swarmbox-agent). When a program's
 // flags change, change PhysicsArgv()/AgentArgv() in plan.cpp and nothing else.
 //
-// Tree (run priority in brackets):
+// Tree (run priority in brackets), radio.model channel (the default):
+//   Trial <name>
+//     Network sim [0]   physics <-> agents, never impaired; the channel's radio frames ride it
+//     Plugin physics [1]  + --radio-model channel --radio-profile /swarmbox/trials/radios/<p>.yaml
+//                         --radio-plan /swarmbox/radio_plan.json (both copied in as inputs)
+//     Component drones [2]
+//       Plugin <drone> [2]  one agent per drone, on sim (eth0) only, --radio-model channel
+// radio.model netem (the real stack, as before the channel):
 //   Trial <name>
 //     Network sim [0]   physics <-> agents, never impaired
 //     Network mesh [0]  agent <-> agent radio (netem applies here, fault injector's business)
@@ -56,6 +63,10 @@ struct PlanOptions {
   std::string faults_image;
   TrialSubnets subnets;
   std::string trials_dir;  // absolute host path the spec's references resolve against
+  // radio.model channel: the radio plan JSON on the host (radio_schedule.hpp; the runner writes it
+  // into the trial folder), copied to kRadioPlanPath and passed as --radio-plan. "" = none (the
+  // physics server then runs the channel with no mesh impairment and no scheduled faults).
+  std::string radio_plan_path;
 };
 
 inline constexpr std::string_view kPhysicsId = "physics";
@@ -70,6 +81,8 @@ inline constexpr std::string_view kContainerTrialsDir = "/swarmbox/trials";
 inline constexpr std::string_view kContainerOutDir = "/swarmbox/out";
 inline constexpr std::string_view kTruthCsvPath = "/swarmbox/out/truth.csv";
 inline constexpr std::string_view kAgentStateDir = "/swarmbox/state";  // --raft-dir <it>/raft
+inline constexpr std::string_view kRadioPlanPath = "/swarmbox/radio_plan.json";  // in physics
+inline constexpr std::string_view kRadioPlanFile = "radio_plan.json";            // trial folder
 inline constexpr std::string_view kScratchTmpfsDir = "/tmp";
 inline constexpr std::int64_t kScratchTmpfsMib = 16;
 inline constexpr std::string_view kPhysicsReadyPattern = "event=ready";
@@ -84,8 +97,8 @@ inline constexpr std::string_view kMeshInterfaceName = "eth1";
 // physics server runs on (PhysicsArgv's interface, domain and middleware).
 std::vector<std::string> PhysicsCommandArgv(dsl::Middleware middleware, const faults::WorldCommandCall& call);
 
-// Whether the trial impairs the mesh (network.mesh, radio or partition faults), so every agent
-// gets a fault sidecar.
+// Whether the trial impairs the mesh (network.mesh, radio or partition faults) with radio.model
+// netem, so every agent gets a fault sidecar (the channel impairs in the physics server: never).
 bool NeedsFaultSidecars(const dsl::TrialSpec& spec);
 // The sidecar's component id: "<drone>-faults".
 std::string SidecarId(std::string_view drone);
@@ -99,6 +112,11 @@ dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec);
 // Keys "<airframe>/<payload>", values [kg].
 Result<std::map<std::string, double>> LoadPayloadMasses(const dsl::TrialSpec& spec,
                                                         const std::string& trials_dir);
+
+// radio.model channel: that the radio profile file exists under trials_dir (I/O; the loader checks
+// a profile the trial file names at its key, this also the default one). kInvalidArgument with
+// the path otherwise. netem: Ok.
+Status CheckRadioProfile(const dsl::TrialSpec& spec, const std::string& trials_dir);
 
 Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
                                               const PlanOptions& options);

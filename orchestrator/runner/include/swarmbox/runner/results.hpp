@@ -3,7 +3,7 @@
 //
 // result.json (one JSON object):
 //   {"trial":"sar-search","outcome":"success","reason":"...","wall_s":312.5,"sim_s":300.2,
-//    "seed":42,"host":"local","metrics":{...},"run_id":"...","trial_id":"...","source":"...",
+//    "seed":42,"host":"local","radio":{"model":"channel","profile":"wifi_5ghz_mesh"},"metrics":{...},"run_id":"...","trial_id":"...","source":"...",
 //    "ending_line":"...","restarts":0,"components":[{"name":"physics","exit_code":0,...}],
 //    "problems":[...],"provenance":{...}}
 // "metrics" are results.csv's metric columns (report/trial_metrics.hpp, the one definition of
@@ -47,6 +47,9 @@ struct TrialResult {
   double sim_s = 0;
   std::uint64_t seed = 0;
   std::string host;
+  // "radio": {"model": ..., "profile": ...} (profile null for netem); both "" = not written.
+  std::string radio_model;
+  std::string radio_profile;
   report::MetricValues metrics;  // by report::MetricNames()
   report::Provenance provenance;
   std::vector<ComponentReport> components;

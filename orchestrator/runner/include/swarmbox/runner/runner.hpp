@@ -11,7 +11,9 @@
 // streamed to logs/<component>.log as it comes, end conditions are matched, the simulated clock
 // (physics `t=`) and the wall-clock guard are checked, progress is printed. The first end (or
 // Ctrl-C) fires Shutdown; faults (TrialInfo::mesh/faults) are applied by a FaultInjector: the
-// mesh block before the agents start, the schedule while watching, everything undone before Stop.
+// mesh block before the agents start, the schedule while watching, everything undone before Stop;
+// with the simulated radio (TrialInfo::planned_faults) the physics server schedules process
+// faults and the injector carries out the container action it reports.
 // Then Stop (reverse priority) stops, collects logs and artifacts
 // (truth.csv) and removes containers and networks. Written at the end: result.json, events.jsonl
 // (written as events arrive), trajectories.png (from truth.csv and the world).
@@ -23,10 +25,12 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
+#include <string_view>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/docker/docker_api.hpp"
@@ -86,7 +90,23 @@ struct TrialInfo {
   // The sim bus's middleware: sensor and environment faults are sent to the tree's Plugin
   // kPhysicsId with PhysicsCommandArgv (plan.hpp).
   dsl::Middleware middleware = dsl::Middleware::kCycloneDds;
+  // The radio model ("channel", "netem"; "" = not said, e.g. a C++ DSL tree) and the channel's
+  // profile, for result.json's "radio". netem with rtf != 1 is warned about (events.jsonl).
+  std::string radio_model;
+  std::string radio_profile;
+  // Faults the physics server carries out at simulated times (the radio plan's, radio.model
+  // channel): the runner does the container action when the server reports `event=drone_out` /
+  // `event=drone_back` and records `event=radio_fault` (fault_injector.hpp). Not in `faults`.
+  std::vector<faults::Fault> planned_faults;
+  // Files written into the trial folder before the tree is planned (name -> content), e.g. the
+  // radio plan (plan.hpp kRadioPlanFile) the planner copies into the physics container.
+  std::map<std::string, std::string> files;
 };
+
+// The warning for a netem trial at an rtf other than 1 (its radio runs on the wall clock);
+// nullopt otherwise. RunTrial writes it to events.jsonl ({"event":"warning",...}); `swarmbox run`
+// prints it too.
+std::optional<std::string> RadioRtfWarning(std::string_view radio_model, std::optional<double> rtf);
 
 // Builds the tree for a pair of subnets (called again with others after a subnet conflict).
 using Planner = std::function<Result<std::unique_ptr<dsl::Trial>>(const std::string& run_id,
