@@ -124,6 +124,39 @@ TEST(SimServerChannel, DeliveriesArriveAtExactSimulatedTimes) {
   EXPECT_EQ(got.frame.state_msg[0].drone, "a");
 }
 
+// The plan's mesh impairment is every sender's egress delay (netem's meaning) in simulated time,
+// and the stats come with each clock line.
+TEST(SimServerChannel, MeshDelayOfThePlanDelaysEveryFrameInSimulatedTime) {
+  ChannelServer s(50, PlanOf(R"({"mesh": {"delay_ms": 100}})"));
+  s.Step({"a"});
+  for (int k = 1; k < 40; ++k) s.Step({});
+  ASSERT_EQ(s.agents.heard["b"].size(), 1u);
+  const auto& got = s.agents.heard["b"][0];
+  const std::int64_t delay = got.frame.delivered_ns - got.frame.sent_ns;
+  EXPECT_GE(delay, 100 * kMs);
+  EXPECT_LT(delay, 101 * kMs);  // plus airtime (~0.4 ms) and propagation
+  EXPECT_EQ(got.step, 26u);     // t_25 = 100 ms < delivery <= t_26
+}
+
+TEST(SimServerChannel, ChannelStatsComeWithEveryClockLine) {
+  ChannelServer s(50);
+  SimServerOptions o;
+  o.rtf = 0;
+  o.clock_every_s = 0.1;
+  o.cameras = false;
+  o.radio_profile = WifiProfile();
+  SimServer server(*s.world, s.agents, s.clock, nullptr, o, s.out);
+  for (int k = 0; k < 25; ++k) {
+    s.agents.answer_radio["a"] = {StateFrame("a", static_cast<std::uint64_t>(k) + 1)};
+    ASSERT_TRUE(server.RunStep(s.stop).ok());
+  }
+  const std::string log = ReadFile(s.out);
+  EXPECT_NE(log.find("t=0.100 node=physics event=channel sent=25 delivered=24 lost_range=0 lost_per=0 lost_impairment=0 "
+                     "lost_queue=0 lost_partition=0 lost_out=0 duplicated=0 medium_busy_s=0.0"),
+            std::string::npos)
+      << log;
+}
+
 // Many frames in one step from both drones: each receiver gets them in (delivered_ns, from, seq)
 // order, unicast frames only at their addressee.
 TEST(SimServerChannel, RadioInIsInDeliveryOrderAndUnicastReachesOnlyItsAddressee) {
