@@ -304,7 +304,7 @@ void SimServer::Accept(std::size_t i, ActuatorInput& cmd) {
   Slot& slot = slots_[i];
   slot.answer_leader = cmd.raft_leader;
   slot.world = std::move(cmd.world);
-  slot.radio_out = std::move(cmd.radio_out);
+  if (channel_) slot.radio_out = std::move(cmd.radio_out);  // netem: the mesh network carries the radio
 }
 
 void SimServer::ApplyAnswers() {
