@@ -62,6 +62,15 @@ int main(int argc, char** argv) {
   app.add_option("--control-rate-hz", o.control_rate_hz, "Lockstep (sensor/actuator) rate")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("!--no-cameras", o.cameras, "Do not render or publish camera images");
   app.add_option("--clock-every", o.clock_every_s, "Simulated seconds between event=clock progress lines; 0 = none")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--radio-plan", o.radio_plan_path,
+                 "Radio plan JSON: simulated-time faults (drone_out, world_command; radio and partition with "
+                 "--radio-model channel) and the mesh impairment");
+  app.add_option("--radio-model", o.radio_model,
+                 "channel: host the simulated radio channel (radio_out -> channel -> radio_in, simulated time); "
+                 "netem: none (the agents' mesh network carries the radio)")
+      ->check(CLI::IsMember({"channel", "netem"}))
+      ->capture_default_str();
+  app.add_option("--radio-profile", o.radio_profile_path, "Radio profile YAML (trials/radios/*.yaml); required with --radio-model channel");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -115,6 +124,26 @@ int main(int argc, char** argv) {
     gps.push_back(af->gps);
   }
 
+  RadioPlan plan;
+  if (!o.radio_plan_path.empty()) {
+    auto p = LoadRadioPlan(o.radio_plan_path);
+    if (!p) return Fail(2, p.error().ToString());
+    if (Status c = CheckRadioPlan(*p, names); !c) return Fail(2, c.error().ToString());
+    plan = std::move(*p);
+  }
+  std::optional<channel::RadioProfile> radio_profile;
+  if (o.radio_model == "channel") {
+    if (o.radio_profile_path.empty()) return Fail(2, "--radio-model channel needs --radio-profile PATH");
+    auto profile = channel::LoadRadioProfile(o.radio_profile_path);
+    if (!profile) return Fail(2, profile.error().ToString());
+    radio_profile = std::move(*profile);
+    if (Status c = CheckChannelPlan(plan); !c) {
+      return Fail(2, (c.error().where().empty() ? o.radio_plan_path + ": " : std::string()) + c.error().ToString());
+    }
+  } else if (!o.radio_profile_path.empty()) {
+    return Fail(2, "--radio-profile needs --radio-model channel");
+  }
+
   std::optional<TruthCsvFile> truth;
   if (!o.truth_path.empty()) {
     auto f = TruthCsvFile::Open(o.truth_path, o.truth_rate_hz);
@@ -145,6 +174,10 @@ int main(int argc, char** argv) {
   so.lockstep.join_timeout_ns = static_cast<std::int64_t>(o.join_timeout_s * 1e9);
   so.cameras = o.cameras;
   so.clock_every_s = o.clock_every_s;
+  so.plan = std::move(plan);
+  so.radio_profile = std::move(radio_profile);
+  // The plan's seed when it has one (the trial's, written by the orchestrator), else --seed.
+  so.radio_seed = so.plan.seed.value_or(o.seed);
   SteadyWallClock clock;
   SimServer server(**world, **transport, clock, truth ? &*truth : nullptr, so, stdout);
   std::printf("%s\n", LogEvent(0.0, "physics", "ready")
@@ -154,6 +187,7 @@ int main(int argc, char** argv) {
                           .Add("domain", o.domain)
                           .Add("rtf", o.rtf, 2)
                           .Add("seed", o.seed)
+                          .Add("radio_model", o.radio_model)
                           .str()
                           .c_str());
   std::fflush(stdout);
