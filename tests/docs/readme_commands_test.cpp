@@ -77,6 +77,13 @@ std::vector<Rule> Rules() {
       {.line = cli + " diff runs/RUN_A runs/RUN_B",
        .excluded = "RUN_A and RUN_B stand for two trial folders; cli_diff_command_test runs diff on folders "
                    "it writes, ReproducibleE2e (tests/e2e/reproducible) on real runs"},
+      {.line = cli + " run trials/sar_search.yaml --set seed=7 --set physics.rtf=0 --out runs/a",
+       .excluded = "ReproducibleE2e (tests/e2e/reproducible) runs this line with a 30 s simulated timeout "
+                   "and diffs it against the rtf 1 and loaded runs"},
+      {.line = cli + " run trials/sar_search.yaml --set seed=7 --set physics.rtf=1 --out runs/b",
+       .excluded = "4-5 minutes at real time; ReproducibleE2e runs it cut short by a simulated timeout"},
+      {.line = cli + " diff runs/a/sar-search-* runs/b/sar-search-*",
+       .excluded = "needs the two runs above; ReproducibleE2e diffs its runs with this command"},
       {.line = cli + " gc --dry-run", .timeout = 60s},  // removes nothing: says what gc would remove
       {.line = cli + " gc",
        .append = {"--run", "readme-commands-none"},
