@@ -23,7 +23,7 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
   auto wc = t->participant_->CreateSubscriber<bus::WorldCommand>(
       bus::kWorldCommandTopic, bus::Qos::kLockstep, [self](const bus::WorldCommand& c) {
         std::lock_guard<std::mutex> lock(self->mu_);
-        self->world_.push_back({c.target, c.command, c.args});
+        self->world_.push_back({c.target, c.command, c.args, c.seq});
       });
   if (!wc) return std::move(wc).error();
   t->world_commands_ = std::move(*wc);
@@ -43,7 +43,10 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
           {
             std::lock_guard<std::mutex> lock(self->mu_);
             // The topic names the drone; the message's own `drone` field is not trusted.
-            self->actuators_.push_back({name, c.step, c.armed, c.motor_throttle});
+            ActuatorInput in{name, c.step, c.armed, c.motor_throttle, c.raft_leader, {}, c.radio_out};
+            in.world.reserve(c.world.size());
+            for (const bus::WorldCommand& w : c.world) in.world.push_back({w.target, w.command, w.args, w.seq});
+            self->actuators_.push_back(std::move(in));
           }
           self->cv_.notify_one();
         });
@@ -54,7 +57,8 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
   return t;
 }
 
-Status BusTransport::PublishSample(std::size_t drone, const std::string& name, const SensorSample& s) {
+Status BusTransport::PublishSample(std::size_t drone, const std::string& name, const SensorSample& s,
+                                   const SampleExtras& extras) {
   bus::SensorSample& m = sample_msg_;
   const GpsSpec& spec = drones_.at(drone).gps;
   m.drone = name;
@@ -81,6 +85,8 @@ Status BusTransport::PublishSample(std::size_t drone, const std::string& name, c
   m.gps.h_acc_m = s.gps.valid ? s.gps.h_acc_m : spec.horizontal_std_m;
   m.gps.v_acc_m = s.gps.valid ? s.gps.v_acc_m : spec.vertical_std_m;
   m.battery.valid = false;  // no battery model in the physics server
+  m.camera_frame = extras.camera_frame;
+  m.radio_in.assign(extras.radio_in.begin(), extras.radio_in.end());
   return drones_[drone].sensor->Publish(m);
 }
 

@@ -6,6 +6,9 @@
 // measurement at this step" (the physics `fresh` flag; stale values are repeated but invalid).
 // GPS: valid = a new fix; fix_type = kNone in a dropout (reports keep coming at the GPS rate with
 // valid = false), k3d otherwise. Baro altitude is relative to the world origin (ENU z).
+// camera_frame and radio_in come from SampleExtras. An ActuatorCommand's world commands keep
+// their seq (SimServer orders them); the `drone` fields of the message are not trusted (the topic
+// names the drone).
 #pragma once
 
 #include <condition_variable>
@@ -29,7 +32,8 @@ class BusTransport final : public SimTransport {
                                                       const std::vector<std::string>& drones,
                                                       const std::vector<GpsSpec>& gps_specs);
 
-  Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample) override;
+  Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample,
+                       const SampleExtras& extras) override;
   Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) override;
   Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) override;
   void WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) override;

@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
   app.add_option("--control-rate-hz", o.control_rate_hz, "Lockstep (sensor/actuator) rate")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("!--no-cameras", o.cameras, "Do not render or publish camera images");
   app.add_option("--clock-every", o.clock_every_s, "Simulated seconds between event=clock progress lines; 0 = none")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--radio-plan", o.radio_plan_path,
+                 "Radio plan JSON: simulated-time faults (drone_out, world_command; radio and partition with "
+                 "--radio-model channel) and the mesh impairment");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -115,6 +118,14 @@ int main(int argc, char** argv) {
     gps.push_back(af->gps);
   }
 
+  RadioPlan plan;
+  if (!o.radio_plan_path.empty()) {
+    auto p = LoadRadioPlan(o.radio_plan_path);
+    if (!p) return Fail(2, p.error().ToString());
+    if (Status c = CheckRadioPlan(*p, names); !c) return Fail(2, c.error().ToString());
+    plan = std::move(*p);
+  }
+
   std::optional<TruthCsvFile> truth;
   if (!o.truth_path.empty()) {
     auto f = TruthCsvFile::Open(o.truth_path, o.truth_rate_hz);
@@ -145,6 +156,7 @@ int main(int argc, char** argv) {
   so.lockstep.join_timeout_ns = static_cast<std::int64_t>(o.join_timeout_s * 1e9);
   so.cameras = o.cameras;
   so.clock_every_s = o.clock_every_s;
+  so.plan = std::move(plan);
   SteadyWallClock clock;
   SimServer server(**world, **transport, clock, truth ? &*truth : nullptr, so, stdout);
   std::printf("%s\n", LogEvent(0.0, "physics", "ready")

@@ -44,6 +44,7 @@ struct ServerOptions {
   int control_rate_hz = 250;
   bool cameras = true;
   double clock_every_s = 10.0;          // simulated s between event=clock lines; 0 = none
+  std::string radio_plan_path;          // --radio-plan: radio_plan.hpp JSON; "" = none
 };
 
 // "name:airframe:x,y,z[:yaw_deg[:payload[:attached]]]".

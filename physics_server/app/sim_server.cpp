@@ -57,7 +57,8 @@ SimServer::SimServer(World& world, SimTransport& transport, WallClock& clock, Tr
       sink_(events_out, options_.node),
       lockstep_(world.drone_count(), options_.lockstep),
       zeros_(8, 0.0),
-      base_wind_(world.config().wind) {
+      base_wind_(world.config().wind),
+      slots_(world.drone_count()) {
   world_.SetEventSink(&sink_);
   if (options_.clock_every_s > 0) {
     progress_.emplace(static_cast<std::int64_t>(options_.clock_every_s * 1e9));
@@ -113,25 +114,138 @@ void SimServer::Apply(const WorldCommandInput& cmd) {
   Log(done);
 }
 
+Status SimServer::PublishDrone(std::size_t i, bool with_camera) {
+  Slot& slot = slots_[i];
+  const std::string& name = world_.drone_name(i);
+  if (with_camera && slot.camera_frame) {
+    if (auto s = transport_.PublishCamera(i, name, world_.step_count(), slot.image); !s) return s;
+  }
+  return transport_.PublishSample(i, name, world_.sensors(i), SampleExtras{slot.camera_frame, slot.radio_in});
+}
+
+void SimServer::Accept(std::size_t i, ActuatorInput& cmd) {
+  for (std::size_t r : lockstep_.TakeRejoined()) world_.SetLost(r, false);
+  const std::size_t rotors = world_.airframe(i).rotors.size();
+  const std::span<const double> u = cmd.armed ? std::span<const double>(cmd.throttle) : std::span<const double>(zeros_.data(), rotors);
+  if (auto s = world_.SetActuators(i, u); !s) {
+    Log(LogEvent(world_.time_s(), options_.node, "bad_command").Add("drone", cmd.drone).Add("reason", s.error().message()));
+  }
+  Slot& slot = slots_[i];
+  slot.answer_leader = cmd.raft_leader;
+  slot.world = std::move(cmd.world);
+  slot.radio_out = std::move(cmd.radio_out);
+}
+
+void SimServer::ApplyAnswers() {
+  const std::uint64_t step = world_.step_count();
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    Slot& slot = slots_[i];
+    if (!lockstep_.answered(i)) continue;
+    std::stable_sort(slot.world.begin(), slot.world.end(),
+                     [](const WorldCommandInput& a, const WorldCommandInput& b) { return a.seq < b.seq; });
+    for (const WorldCommandInput& c : slot.world) Apply(c);
+    slot.world.clear();
+    if (slot.answer_leader && !slot.leader) slot.leader_since = step + 1;
+    slot.leader = slot.answer_leader;
+  }
+}
+
+std::optional<std::size_t> SimServer::RaftLeader() const {
+  std::optional<std::size_t> best;
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    const Slot& slot = slots_[i];
+    if (!slot.leader || lockstep_.out(i) || lockstep_.lost(i)) continue;
+    if (!best || slot.leader_since > slots_[*best].leader_since) best = i;  // ties: drone order
+  }
+  return best;
+}
+
+void SimServer::TakeOut(std::size_t i, const PlanEntry& e) {
+  Slot& slot = slots_[i];
+  if (lockstep_.out(i)) {
+    Log(LogEvent(world_.time_s(), options_.node, "fault_skipped").Add("fault", e.name).Add("drone", world_.drone_name(i))
+            .Add("reason", "already out"));
+    return;
+  }
+  lockstep_.SetOut(i, true);
+  world_.SetOut(i, true);
+  slot.leader = false;
+  slot.camera_frame = false;
+  slot.radio_in.clear();
+  slot.radio_out.clear();
+  slot.back_ns = e.duration_ns > 0 ? world_.time_ns() + e.duration_ns : -1;
+  slot.out_fault = e.name;
+  Log(LogEvent(world_.time_s(), options_.node, "drone_out").Add("drone", world_.drone_name(i)).Add("fault", e.name)
+          .Add("mode", ModeName(e.mode)));
+}
+
+void SimServer::CarryOut(const PlanEntry& e) {
+  const double t = world_.time_s();
+  switch (e.kind) {
+    case PlanEntry::Kind::kDroneOut: {
+      std::vector<std::size_t> drones;
+      for (const std::string& target : e.targets) {
+        if (target == kRaftLeaderTarget) {
+          const std::optional<std::size_t> leader = RaftLeader();
+          if (!leader) {
+            Log(LogEvent(t, options_.node, "fault_skipped").Add("fault", e.name).Add("reason", "no drone leads the Raft group"));
+            continue;
+          }
+          Log(LogEvent(t, options_.node, "raft_leader_resolved").Add("fault", e.name).Add("drone", world_.drone_name(*leader)));
+          drones.push_back(*leader);
+        } else if (const auto i = world_.FindDrone(target)) {
+          drones.push_back(*i);
+        }
+      }
+      for (std::size_t i : drones) TakeOut(i, e);
+      break;
+    }
+    case PlanEntry::Kind::kWorldCommand:
+      Apply({e.target, e.command, e.args, 0});
+      break;
+    case PlanEntry::Kind::kRadio:
+    case PlanEntry::Kind::kPartition:
+      Log(LogEvent(t, options_.node, "radio_fault_ignored").Add("fault", e.name)
+              .Add("kind", e.kind == PlanEntry::Kind::kRadio ? "impair" : "partition")
+              .Add("reason", "radio.model netem: the fault sidecars carry radio faults"));
+      break;
+  }
+}
+
+void SimServer::RunSchedule(std::int64_t now_ns) {
+  // Drones whose time out ends now come back first: they re-enter the lockstep as joining drones
+  // at the next step.
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    Slot& slot = slots_[i];
+    if (!lockstep_.out(i) || slot.back_ns < 0 || slot.back_ns > now_ns) continue;
+    lockstep_.SetOut(i, false);
+    world_.SetOut(i, false);
+    slot.back_ns = -1;
+    Log(LogEvent(world_.time_s(), options_.node, "drone_back").Add("drone", world_.drone_name(i)).Add("fault", slot.out_fault));
+  }
+  const std::vector<PlanEntry>& schedule = options_.plan.schedule;
+  while (next_entry_ < schedule.size() && schedule[next_entry_].at_ns <= now_ns) CarryOut(schedule[next_entry_++]);
+}
+
 Status SimServer::RunStep(const std::atomic<bool>& stop) {
   const std::uint64_t step = world_.step_count();
   lockstep_.BeginStep(step, clock_.NowNs());
   for (std::size_t i = 0; i < world_.drone_count(); ++i) {
-    if (auto s = transport_.PublishSample(i, world_.drone_name(i), world_.sensors(i)); !s) return s;
-    if (options_.cameras && world_.CameraDue(i) && !world_.Truth(i).lost) {
-      world_.RenderCamera(i, &image_);
-      if (auto s = transport_.PublishCamera(i, world_.drone_name(i), step, image_); !s) return s;
-    }
+    if (lockstep_.out(i)) continue;
+    Slot& slot = slots_[i];
+    slot.camera_frame = options_.cameras && world_.CameraDue(i) && !world_.Truth(i).lost;
+    if (slot.camera_frame) world_.RenderCamera(i, &slot.image);
+    if (auto s = PublishDrone(i, /*with_camera=*/true); !s) return s;
   }
   if (auto s = transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf); !s) {
     return s;
   }
   constexpr std::int64_t kPollNs = 20'000'000;        // re-check `stop` at least this often
   // While a step waits, every drone's sample is sent again at this period: unanswered ones for
-  // late joiners and lost messages (the lockstep QoS is volatile), answered ones as a keepalive,
-  // so an agent that did answer does not take a long wait (a fleet still starting, a silent
-  // drone's timeout) for a stalled server (its --stall-timeout). It answers again; Lockstep drops
-  // the duplicate.
+  // late joiners and lost messages (the lockstep QoS is volatile; an unanswered drone gets its
+  // camera frame again first), answered ones as a keepalive, so an agent that did answer does not
+  // take a long wait (a fleet still starting, a silent drone's timeout) for a stalled server (its
+  // --stall-timeout). It answers again; Lockstep drops the duplicate.
   constexpr std::int64_t kRepublishNs = 200'000'000;
   std::int64_t last_publish = clock_.NowNs();
   while (!stop.load()) {
@@ -140,29 +254,27 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
     if (now - last_publish >= kRepublishNs) {
       last_publish = now;
       for (std::size_t i = 0; i < world_.drone_count(); ++i) {
-        if (auto s = transport_.PublishSample(i, world_.drone_name(i), world_.sensors(i)); !s) return s;
+        if (lockstep_.out(i)) continue;
+        if (auto s = PublishDrone(i, /*with_camera=*/!lockstep_.answered(i)); !s) return s;
       }
     }
     inbox_.clear();
     transport_.WaitActuators(std::min(lockstep_.NextDeadlineNs(), now + kPollNs), &inbox_);
-    for (const ActuatorInput& cmd : inbox_) {
+    for (ActuatorInput& cmd : inbox_) {
       const std::optional<std::size_t> i = world_.FindDrone(cmd.drone);
       if (!i) continue;
       if (lockstep_.OnCommand(*i, cmd.step, clock_.NowNs()) != Lockstep::Answer::kAccepted) continue;
-      for (std::size_t r : lockstep_.TakeRejoined()) world_.SetLost(r, false);
-      const std::size_t rotors = world_.airframe(*i).rotors.size();
-      const std::span<const double> u = cmd.armed ? std::span<const double>(cmd.throttle) : std::span<const double>(zeros_.data(), rotors);
-      if (auto s = world_.SetActuators(*i, u); !s) {
-        Log(LogEvent(world_.time_s(), options_.node, "bad_command").Add("drone", cmd.drone).Add("reason", s.error().message()));
-      }
+      Accept(*i, cmd);
     }
   }
   for (std::size_t i : lockstep_.TakeNewlyLost()) world_.SetLost(i, true);
   if (stop.load()) return Ok{};
 
+  ApplyAnswers();
   world_inbox_.clear();
   transport_.TakeWorldCommands(&world_inbox_);
   for (const WorldCommandInput& c : world_inbox_) Apply(c);
+  RunSchedule(world_.time_ns());
   world_.Step();
   for (auto it = timed_.begin(); it != timed_.end();) {
     if (world_.time_ns() < it->until_ns) {
@@ -201,7 +313,7 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
             .Add("rtf", line.rtf, 2)
             .Add("steps", static_cast<std::uint64_t>(world_.step_count()))
             .Add("late", line.late)
-            .Add("lost", static_cast<std::uint64_t>(world_.drone_count() - lockstep_.live_count())));
+            .Add("lost", static_cast<std::uint64_t>(lockstep_.lost_count())));
   }
   return Ok{};
 }

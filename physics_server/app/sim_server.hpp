@@ -4,9 +4,17 @@
 //                 world commands.
 //   WallClock     monotonic wall time and sleeping (pacing, lockstep timeouts).
 //
-// Per control step: publish every drone's sample (lost ones too, so they can rejoin) and due
-// camera frames, then wait until every live drone has answered this step (Lockstep); drones
-// silent past the timeout are marked lost (motors off, event=drone_lost) and the step goes on.
+// Per control step k (t_k = k * control period), the simulated time line of everything an agent
+// hears:
+//   1. for each drone in order: its camera frame if due, FIRST, then its sample k with
+//      camera_frame = true when a frame went out (lost drones get samples too, so they can
+//      rejoin; drones out of the trial by a plan's drone_out get nothing);
+//   2. wait until every live drone has answered step k (Lockstep); drones silent past the
+//      timeout are marked lost (motors off, event=drone_lost) and the step goes on;
+//   3. apply the answers' `world` commands (drone order, then seq), then those of the
+//      sim/world_command topic (arrival order), track each drone's raft_leader flag, then carry out
+//      the radio plan's entries due at t_k (drone_out/back, world commands, raft_leader targets);
+//   4. World::Step() to t_{k+1}.
 // While waiting, every drone's sample is published again every 200 ms (agents that join late, a
 // lost message, and a keepalive for the drones that answered, so a long wait does not look like a
 // stalled server to them). Duplicate and stale commands are dropped (Lockstep).
@@ -21,9 +29,12 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
+#include "radio_plan.hpp"
+#include "swarmbox/bus/messages.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/physics/camera_image.hpp"
 #include "swarmbox/physics/lockstep.hpp"
@@ -33,13 +44,6 @@
 
 namespace swarmbox::physics {
 
-struct ActuatorInput {
-  std::string drone;
-  std::uint64_t step = 0;
-  bool armed = false;
-  std::vector<double> throttle;
-};
-
 // The bus contract of WorldCommand (bus/messages.hpp): gps_dropout {duration_s},
 // gps_degrade {duration_s, h_acc_m, v_acc_m}, imu_bias_jump {ax, ay, az, gx, gy, gz},
 // wind_gust {vx, vy, vz, duration_s}, payload_attach {[mass_kg], ignored: the airframe's payload},
@@ -48,12 +52,31 @@ struct WorldCommandInput {
   std::string target;
   std::string command;
   std::vector<double> args;
+  std::uint64_t seq = 0;   // per sender; orders one answer's commands
+};
+
+// One agent's answer to a sample (bus ActuatorCommand).
+struct ActuatorInput {
+  std::string drone;
+  std::uint64_t step = 0;
+  bool armed = false;
+  std::vector<double> throttle;
+  bool raft_leader = false;                  // this agent's Raft node leads
+  std::vector<WorldCommandInput> world;      // applied once every live drone answered the step
+  std::vector<bus::RadioFrame> radio_out;    // radio.model channel: sent at this step's time
+};
+
+// What a sensor sample carries beside the sensors.
+struct SampleExtras {
+  bool camera_frame = false;                 // this step's camera frame was published before it
+  std::span<const bus::RadioFrame> radio_in; // deliveries in (t_{k-1}, t_k], in delivery order
 };
 
 class SimTransport {
  public:
   virtual ~SimTransport() = default;
-  virtual Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample) = 0;
+  virtual Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample,
+                               const SampleExtras& extras) = 0;
   virtual Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) = 0;
   virtual Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) = 0;
   // Appends the actuator commands that arrived, waiting until one arrives or wall time
@@ -111,6 +134,7 @@ struct SimServerOptions {
   LockstepOptions lockstep;
   bool cameras = true;
   std::string node = "physics";              // logfmt node name
+  RadioPlan plan;                            // simulated-time faults (--radio-plan); empty: none
 };
 
 class SimServer {
@@ -140,6 +164,26 @@ class SimServer {
     std::size_t drone;
     enum Kind { kGpsBack, kGpsAccuracyBack, kWindBack } kind;
   };
+  // Per drone: what this step published and what its answer carried.
+  struct Slot {
+    bool camera_frame = false;
+    CameraImage image;                         // this step's frame, re-sent with a re-sent sample
+    std::vector<bus::RadioFrame> radio_in;
+    std::vector<WorldCommandInput> world;      // the accepted answer's
+    std::vector<bus::RadioFrame> radio_out;    // the accepted answer's
+    bool answer_leader = false;                // the accepted answer's raft_leader
+    bool leader = false;                       // the flag as last answered
+    std::uint64_t leader_since = 0;            // step + 1 at which it turned true
+    std::int64_t back_ns = -1;                 // out: when it comes back; -1 = never (or not out)
+    std::string out_fault;                     // out: the plan entry's name
+  };
+  Status PublishDrone(std::size_t i, bool with_camera);
+  void Accept(std::size_t i, ActuatorInput& cmd);
+  void ApplyAnswers();
+  void RunSchedule(std::int64_t now_ns);
+  void CarryOut(const PlanEntry& e);
+  void TakeOut(std::size_t i, const PlanEntry& e);
+  std::optional<std::size_t> RaftLeader() const;
   void Apply(const WorldCommandInput& cmd);
   void Log(const LogEvent& event);
 
@@ -156,7 +200,8 @@ class SimServer {
   std::vector<double> zeros_;
   std::vector<Timed> timed_;
   WindConfig base_wind_;
-  CameraImage image_;
+  std::vector<Slot> slots_;
+  std::size_t next_entry_ = 0;               // options_.plan.schedule[next_entry_] is due next
   std::int64_t pace_origin_wall_ns_ = -1;
   std::int64_t pace_origin_sim_ns_ = 0;
   std::optional<ClockProgress> progress_;  // empty: clock_every_s = 0

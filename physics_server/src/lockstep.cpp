@@ -18,6 +18,7 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
   if (drone >= drones_.size()) return Answer::kUnknownDrone;
   if (step != step_) return Answer::kWrongStep;
   DroneState& d = drones_[drone];
+  if (d.out) return Answer::kOut;
   if (d.answered) return Answer::kDuplicate;
   d.answered = true;
   d.joined = true;
@@ -32,7 +33,7 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
 std::int64_t Lockstep::NextDeadlineNs() const {
   std::int64_t next = std::numeric_limits<std::int64_t>::max();
   for (const DroneState& d : drones_) {
-    if (d.lost || d.answered) continue;
+    if (d.lost || d.answered || d.out) continue;
     const std::int64_t deadline = d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
                                            : step_start_ns_ + options_.join_timeout_ns;
     next = std::min(next, deadline);
@@ -44,7 +45,7 @@ bool Lockstep::StepComplete(std::int64_t now_ns) {
   bool complete = true;
   for (std::size_t i = 0; i < drones_.size(); ++i) {
     DroneState& d = drones_[i];
-    if (d.lost || d.answered) continue;
+    if (d.lost || d.answered || d.out) continue;
     const std::int64_t deadline = d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
                                            : step_start_ns_ + options_.join_timeout_ns;
     if (now_ns >= deadline) {
@@ -57,11 +58,21 @@ bool Lockstep::StepComplete(std::int64_t now_ns) {
   return complete;
 }
 
+void Lockstep::SetOut(std::size_t drone, bool out) {
+  DroneState& d = drones_.at(drone);
+  d.out = out;
+  if (!out) d = DroneState{};
+}
+
 std::vector<std::size_t> Lockstep::TakeNewlyLost() { return std::exchange(newly_lost_, {}); }
 std::vector<std::size_t> Lockstep::TakeRejoined() { return std::exchange(rejoined_, {}); }
 
 std::size_t Lockstep::live_count() const {
-  return static_cast<std::size_t>(std::count_if(drones_.begin(), drones_.end(), [](const DroneState& d) { return !d.lost; }));
+  return static_cast<std::size_t>(std::count_if(drones_.begin(), drones_.end(), [](const DroneState& d) { return !d.lost && !d.out; }));
+}
+
+std::size_t Lockstep::lost_count() const {
+  return static_cast<std::size_t>(std::count_if(drones_.begin(), drones_.end(), [](const DroneState& d) { return d.lost; }));
 }
 
 }  // namespace swarmbox::physics

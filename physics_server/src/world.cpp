@@ -695,6 +695,12 @@ void World::SetLost(std::size_t index, bool lost) {
   w.Dispatch();
 }
 
+void World::SetOut(std::size_t index, bool out) {
+  Impl::Drone& d = *impl_->drones.at(index);
+  d.lost = out;
+  if (out) d.u.fill(0.0);
+}
+
 void World::SetExternalForce(std::size_t index, const Vec3& force_n) { impl_->drones.at(index)->external_force = force_n; }
 
 void World::SetPinned(std::size_t index, bool pinned) {

@@ -84,5 +84,39 @@ TEST(Lockstep, TimeoutCountsFromTheLaterOfStepStartAndLastAnswer) {
   EXPECT_TRUE(ls.StepComplete(80 * kMs));
 }
 
+// A drone taken out by a process fault is not waited for and not heard; back, it joins again
+// with the join timeout.
+TEST(Lockstep, OutDroneIsNeitherWaitedForNorHeardAndComesBackJoining) {
+  Lockstep ls(2, {.timeout_ns = 100 * kMs, .join_timeout_ns = 1000 * kMs});
+  ls.BeginStep(0, 0);
+  ls.OnCommand(0, 0, 1 * kMs);
+  ls.OnCommand(1, 0, 1 * kMs);
+  ASSERT_TRUE(ls.StepComplete(1 * kMs));
+  ls.SetOut(1, true);
+  ls.BeginStep(1, 10 * kMs);
+  EXPECT_EQ(ls.OnCommand(1, 1, 11 * kMs), Lockstep::Answer::kOut);
+  EXPECT_FALSE(ls.StepComplete(11 * kMs));
+  ls.OnCommand(0, 1, 12 * kMs);
+  EXPECT_TRUE(ls.StepComplete(12 * kMs));
+  EXPECT_EQ(ls.live_count(), 1u);
+  EXPECT_EQ(ls.lost_count(), 0u);
+  // Out for far longer than the step timeout: still not lost.
+  ls.BeginStep(2, 5000 * kMs);
+  ls.OnCommand(0, 2, 5001 * kMs);
+  EXPECT_TRUE(ls.StepComplete(5001 * kMs));
+  EXPECT_TRUE(ls.TakeNewlyLost().empty());
+  // Back: a joining drone, waited for up to the join timeout (not the step timeout).
+  ls.SetOut(1, false);
+  EXPECT_FALSE(ls.joined(1));
+  ls.BeginStep(3, 6000 * kMs);
+  ls.OnCommand(0, 3, 6001 * kMs);
+  EXPECT_FALSE(ls.StepComplete(6500 * kMs));
+  EXPECT_EQ(ls.NextDeadlineNs(), 7000 * kMs);
+  EXPECT_EQ(ls.OnCommand(1, 3, 6600 * kMs), Lockstep::Answer::kAccepted);
+  EXPECT_TRUE(ls.StepComplete(6600 * kMs));
+  EXPECT_TRUE(ls.joined(1));
+  EXPECT_EQ(ls.live_count(), 2u);
+}
+
 }  // namespace
 }  // namespace swarmbox::physics

@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <map>
+#include <utility>
 #include <string>
 
 #include "server_options.hpp"
@@ -28,13 +29,20 @@ class FakeClock final : public WallClock {
 class ScriptedAgents final : public SimTransport {
  public:
   explicit ScriptedAgents(FakeClock& clock) : clock_(clock) {}
-  Status PublishSample(std::size_t, const std::string& name, const SensorSample& s) override {
+  Status PublishSample(std::size_t, const std::string& name, const SensorSample& s, const SampleExtras& extras) override {
     ++samples[name];
-    if (alive[name]) pending_.push_back({name, s.step, true, std::vector<double>(4, throttle)});
+    last_step[name] = s.step;
+    published.push_back("sample " + name + " " + std::to_string(s.step) + (extras.camera_frame ? " camera_frame" : ""));
+    if (alive[name]) {
+      ActuatorInput in{name, s.step, true, std::vector<double>(4, throttle), leader[name], {}, {}};
+      in.world = std::exchange(answer_world[name], {});
+      pending_.push_back(std::move(in));
+    }
     return Ok{};
   }
-  Status PublishCamera(std::size_t, const std::string& name, std::uint64_t, const CameraImage& img) override {
+  Status PublishCamera(std::size_t, const std::string& name, std::uint64_t step, const CameraImage& img) override {
     ++frames[name];
+    published.push_back("camera " + name + " " + std::to_string(step));
     EXPECT_EQ(img.bgr.size(), 320u * 240u * 3u);
     return Ok{};
   }
@@ -57,7 +65,11 @@ class ScriptedAgents final : public SimTransport {
   }
 
   std::map<std::string, bool> alive;
+  std::map<std::string, bool> leader;                                 // raft_leader in answers
+  std::map<std::string, std::vector<WorldCommandInput>> answer_world;  // in the next answer
   std::map<std::string, int> samples, frames;
+  std::map<std::string, std::uint64_t> last_step;
+  std::vector<std::string> published;  // "camera a 25", "sample a 25 camera_frame", in order
   std::vector<WorldCommandInput> world_commands;
   double throttle = 0;
   std::uint64_t last_clock_step = 0;
@@ -388,6 +400,168 @@ TEST(SimServerPayload, AttachWithAMassChangesTheSimulatedMass) {
       << log;
   EXPECT_NE(log.find("event=world_command command=payload_attach target=lifter mass_kg=15.000"), std::string::npos)
       << log;
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
+
+namespace swarmbox::physics {
+namespace {
+
+// Camera determinism: a due frame goes out before the sample of its step, which says so.
+TEST_F(SimServerTest, CameraFrameGoesOutBeforeItsSampleWhichSaysSo) {
+  SimServerOptions o = Options(0);
+  o.rtf = 0;
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  for (int k = 0; k < 51; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  // 5 Hz at 250 Hz: frames at steps 0 and 50 (the first one due at once).
+  std::vector<std::string> framed;
+  for (std::size_t n = 0; n < agents_.published.size(); ++n) {
+    const std::string& line = agents_.published[n];
+    if (line.rfind("camera ", 0) != 0) continue;
+    framed.push_back(line);
+    ASSERT_LT(n + 1, agents_.published.size());
+    EXPECT_EQ(agents_.published[n + 1], "sample " + line.substr(7) + " camera_frame");
+  }
+  EXPECT_EQ(framed, (std::vector<std::string>{"camera a 0", "camera b 0", "camera a 50", "camera b 50"}));
+  EXPECT_EQ(std::count_if(agents_.published.begin(), agents_.published.end(),
+                          [](const std::string& l) { return l.find("camera_frame") != std::string::npos; }),
+            4);
+}
+
+// World commands inside the answers: applied once every drone answered, before the world steps,
+// in drone order then seq; the topic's come after them.
+TEST_F(SimServerTest, AnswerWorldCommandsApplyInDroneOrderThenSeqBeforeTheStep) {
+  SimServerOptions o = Options(0);
+  o.rtf = 0;
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  const double ax_before = world_->sensors(0).imu.accel_m_s2.x;
+  agents_.answer_world["b"] = {{"a", "imu_bias_jump", {2.0, 0, 0, 0, 0, 0}, 7}, {"b", "gps_degrade", {1.0, 5.0, 8.0}, 3}};
+  agents_.answer_world["a"] = {{"b", "gps_dropout", {1.0}, 9}};
+  agents_.world_commands = {{"", "wind_gust", {1, 0, 0, 0.5}, 1}};
+  // The answers to step 1 carry them (the samples of step 1 are answered with them).
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  EXPECT_NEAR(world_->sensors(0).imu.accel_m_s2.x - ax_before, 2.0, 0.2);  // before World::Step()
+  const std::string log = ReadFile(out_);
+  EXPECT_EQ(log,
+            "t=0.004 node=physics event=world_command command=gps_dropout target=b\n"
+            "t=0.004 node=physics event=world_command command=gps_degrade target=b\n"
+            "t=0.004 node=physics event=world_command command=imu_bias_jump target=a\n"
+            "t=0.004 node=physics event=world_command command=wind_gust target=\"\"\n");
+}
+
+RadioPlan PlanOf(const std::string& json) {
+  auto doc = yaml::Parse(json, "plan.json");
+  EXPECT_TRUE(doc.ok()) << doc.error().ToString();
+  auto plan = ParseRadioPlan(*doc);
+  EXPECT_TRUE(plan.ok()) << plan.error().ToString();
+  return *plan;
+}
+
+// drone_out kill: out at exactly at_s (no sample after, motors off, no drone_lost), the rest
+// goes on without waiting for it.
+TEST_F(SimServerTest, KillLandsAtExactlyItsSimulatedTime) {
+  SimServerOptions o = Options(1.0);
+  o.rtf = 0;
+  o.plan = PlanOf(R"({"schedule": [{"at_s": 0.4, "name": "k", "kind": "drone_out", "mode": "kill",
+                                     "targets": ["b"], "duration_s": 0}]})");
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  ASSERT_TRUE(server.Run(stop_).ok());
+  EXPECT_EQ(world_->step_count(), 250u);
+  EXPECT_EQ(agents_.last_step["b"], 100u);  // t_100 = 0.4 s: its last sample
+  EXPECT_EQ(agents_.samples["b"], 101);
+  EXPECT_EQ(agents_.last_step["a"], 249u);
+  EXPECT_TRUE(world_->Truth(1).lost);
+  EXPECT_LT(world_->Truth(1).rotor_speed_rad_s[0], world_->Truth(0).rotor_speed_rad_s[0] / 2);
+  const std::string log = ReadFile(out_);
+  EXPECT_EQ(log.rfind("t=0.400 node=physics event=drone_out drone=b fault=k mode=kill\n", 0), 0u) << log;
+  EXPECT_EQ(log.find("drone_lost"), std::string::npos) << log;
+  // The world never waited for b: the fake wall clock moved 1 ms per answered step only.
+  EXPECT_LT(clock_.now_ns, 300 * kMs);
+}
+
+// stop with a duration: back after it as a joining drone, answered at once here.
+TEST_F(SimServerTest, StoppedDroneComesBackAfterItsDurationAndRejoins) {
+  SimServerOptions o = Options(1.0);
+  o.rtf = 0;
+  o.plan = PlanOf(R"({"schedule": [{"at_s": 0.2, "name": "s", "kind": "drone_out", "mode": "stop",
+                                     "targets": ["b"], "duration_s": 0.3}]})");
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  ASSERT_TRUE(server.Run(stop_).ok());
+  // Samples for steps 0..50, then from 126 (t_125 = 0.5 s: back, published from the next step).
+  EXPECT_EQ(agents_.samples["b"], 51 + 124);
+  EXPECT_FALSE(world_->Truth(1).lost);
+  EXPECT_EQ(ReadFile(out_),
+            "t=0.200 node=physics event=drone_out drone=b fault=s mode=stop\n"
+            "t=0.500 node=physics event=drone_back drone=b fault=s\n");
+}
+
+// Back but silent: the lockstep waits for its first answer up to the join timeout, then it is lost.
+TEST_F(SimServerTest, DroneBackButSilentIsWaitedForUpToTheJoinTimeout) {
+  SimServerOptions o = Options(0);
+  o.rtf = 0;
+  o.plan = PlanOf(R"({"schedule": [{"at_s": 0.1, "name": "p", "kind": "drone_out", "mode": "pause",
+                                     "targets": ["b"], "duration_s": 0.1}]})");
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  for (int k = 0; k <= 25; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  agents_.alive["b"] = false;
+  const std::int64_t wall_before = clock_.now_ns;
+  for (int k = 26; k <= 50; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());  // back at t_50
+  EXPECT_LT(clock_.now_ns - wall_before, 100 * kMs);                        // nobody waited yet
+  ASSERT_TRUE(server.RunStep(stop_).ok());                                   // step 51 waits for b
+  EXPECT_GE(clock_.now_ns - wall_before, 500 * kMs);                         // its join timeout
+  EXPECT_TRUE(world_->Truth(1).lost);
+  const std::string log = ReadFile(out_);
+  EXPECT_NE(log.find("t=0.200 node=physics event=drone_back drone=b fault=p\nt=0.204 node=physics event=drone_lost a=b\n"),
+            std::string::npos)
+      << log;
+}
+
+// raft_leader targets: the drone whose flag turned true most recently; ties by drone order.
+TEST_F(SimServerTest, RaftLeaderTargetIsTheDroneThatBecameLeaderLast) {
+  SimServerOptions o = Options(0);
+  o.rtf = 0;
+  o.plan = PlanOf(R"({"schedule": [{"at_s": 0.2, "name": "kl", "kind": "drone_out", "mode": "kill",
+                                     "targets": ["raft_leader"]}]})");
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  agents_.leader["a"] = true;
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  agents_.leader["b"] = true;  // b too, later (a stale flag on a: a partitioned old leader)
+  for (int k = 10; k <= 50; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  EXPECT_TRUE(world_->Truth(1).lost);
+  EXPECT_FALSE(world_->Truth(0).lost);
+  EXPECT_EQ(ReadFile(out_),
+            "t=0.200 node=physics event=raft_leader_resolved fault=kl drone=b\n"
+            "t=0.200 node=physics event=drone_out drone=b fault=kl mode=kill\n");
+}
+
+TEST_F(SimServerTest, RaftLeaderTieGoesToDroneOrderAndNoLeaderSkipsTheFault) {
+  SimServerOptions o = Options(0);
+  o.rtf = 0;
+  o.plan = PlanOf(R"({"schedule": [
+      {"at_s": 0.02, "name": "none", "kind": "drone_out", "mode": "kill", "targets": ["raft_leader"]},
+      {"at_s": 0.1, "name": "tie", "kind": "drone_out", "mode": "kill", "targets": ["raft_leader"]}]})");
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  agents_.leader["a"] = true;
+  agents_.leader["b"] = true;  // both in the same step
+  for (int k = 10; k <= 25; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  EXPECT_EQ(ReadFile(out_),
+            "t=0.020 node=physics event=fault_skipped fault=none reason=\"no drone leads the Raft group\"\n"
+            "t=0.100 node=physics event=raft_leader_resolved fault=tie drone=a\n"
+            "t=0.100 node=physics event=drone_out drone=a fault=tie mode=kill\n");
+}
+
+// world_command entries land at their simulated time.
+TEST_F(SimServerTest, PlanWorldCommandAppliesAtItsTime) {
+  SimServerOptions o = Options(0);
+  o.rtf = 0;
+  o.plan = PlanOf(R"({"schedule": [{"at_s": 0.05, "name": "g", "kind": "world_command", "target": "a",
+                                     "command": "gps_dropout", "args": [1.0]}]})");
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  for (int k = 0; k < 20; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  EXPECT_EQ(ReadFile(out_), "t=0.052 node=physics event=world_command command=gps_dropout target=a\n");
 }
 
 }  // namespace

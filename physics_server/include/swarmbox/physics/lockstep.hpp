@@ -11,6 +11,10 @@
 // (the step's start, its last answer). Before a drone's first answer, join_timeout_ns applies
 // instead (agents start slower than the server). A lost drone that answers the current step
 // rejoins (TakeRejoined()).
+//
+// A drone taken out of the trial (SetOut: a process fault of the radio plan) is neither waited for
+// nor heard (its commands are kOut) until SetOut(false), when it re-enters as a joining drone:
+// join_timeout_ns applies to its first answer again.
 #pragma once
 
 #include <cstdint>
@@ -25,7 +29,7 @@ struct LockstepOptions {
 
 class Lockstep {
  public:
-  enum class Answer { kAccepted, kDuplicate, kWrongStep, kUnknownDrone };
+  enum class Answer { kAccepted, kDuplicate, kWrongStep, kUnknownDrone, kOut };
 
   Lockstep(std::size_t drone_count, LockstepOptions options);
 
@@ -36,19 +40,25 @@ class Lockstep {
   // The earliest time at which a waiting drone times out (for a bounded wait); INT64_MAX if none.
   std::int64_t NextDeadlineNs() const;
 
+  // Out of the trial (true) or back as a joining drone (false; clears lost, answered and joined).
+  void SetOut(std::size_t drone, bool out);
+
   std::vector<std::size_t> TakeNewlyLost();
   std::vector<std::size_t> TakeRejoined();
   bool lost(std::size_t drone) const { return drones_[drone].lost; }
   bool answered(std::size_t drone) const { return drones_[drone].answered; }
   bool joined(std::size_t drone) const { return drones_[drone].joined; }
+  bool out(std::size_t drone) const { return drones_[drone].out; }
   std::uint64_t step() const { return step_; }
-  std::size_t live_count() const;
+  std::size_t live_count() const;   // neither lost nor out
+  std::size_t lost_count() const;
 
  private:
   struct DroneState {
     bool joined = false;
     bool answered = false;
     bool lost = false;
+    bool out = false;
     std::int64_t last_heard_ns = 0;
   };
   LockstepOptions options_;

@@ -114,6 +114,10 @@ class World {
   // Lost drones (lockstep timeout) get motors off and event=drone_lost; clearing it emits
   // event=drone_rejoined and commands count again.
   void SetLost(std::size_t index, bool lost);
+  // A drone taken out of the trial by a process fault (the server's radio plan: kill, stop,
+  // pause, restart): motors off from now as when lost (Truth().lost is true), but no event (the
+  // server logs event=drone_out / drone_back). Clearing it lets commands count again.
+  void SetOut(std::size_t index, bool out);
   // Test rigs and disturbances: a force [N, world ENU] applied at the drone's centre of mass on
   // every sub-step until changed ({} clears it).
   void SetExternalForce(std::size_t index, const Vec3& force_n);
