@@ -268,6 +268,21 @@ void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::Radi
   // broadcast detections are for recorders and a ground station.
 }
 
+Status AgentNode::ServeRadioBetweenSteps() {
+  frames_.clear();
+  radio_->TakeReceived(bus::SensorSample{}, &frames_);  // netem: the sample is not looked at
+  DispatchFrames(frames_, options_.name, *this, &dispatched_);
+  if (raft_) {
+    if (Status s = raft_->Step(); !s) return s.error().Context("raft stopped");
+  }
+  if (probe_) {
+    lines_.clear();
+    probe_->Step(radio::RadioTime(radio_->now_ns()), t_s_, *radio_, &lines_);
+    for (const LogEvent& line : lines_) Log(line);
+  }
+  return Ok{};
+}
+
 Status AgentNode::HandleSample(const bus::SensorSample& msg) {
   using flight::FlightEventKind;
   t_s_ = static_cast<double>(msg.sim_time_ns) * 1e-9;
@@ -462,12 +477,17 @@ Status AgentNode::Run() {
         took = sensor_sub_->Take(msg);
         break;
       }
-      const bool poll = options_.stop != nullptr;
-      const auto slice = poll ? std::min(left, std::chrono::milliseconds(50)) : left;
+      // netem: the mesh lives on the wall clock whether or not the lockstep moves (a drone the
+      // physics server is waiting for, a stalled server): Raft and the probe go on between
+      // samples, every 10 ms without one.
+      const bool idle_radio = options_.radio_model == RadioModel::kNetem && radio_ && (raft_ || probe_);
+      const bool poll = options_.stop != nullptr || idle_radio;
+      const auto slice = poll ? std::min(left, std::chrono::milliseconds(idle_radio ? 10 : 50)) : left;
       if (sensor_sub_->TakeFor(msg, slice)) {
         took = true;
         break;
       }
+      if (idle_radio) SWARMBOX_TRY(ServeRadioBetweenSteps());
     }
     if (!took) {
       const double secs = std::chrono::duration<double>(timeout).count();

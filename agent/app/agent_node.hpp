@@ -21,8 +21,10 @@
 //   d. radio.Flush into the ActuatorCommand, cmd.world = this step's world commands (payload
 //      attach/release), cmd.raft_leader; publish.
 // Clocks: with RadioModel::kChannel every decision runs on the samples' simulated time (the
-// radio's clock is the lockstep's); with kNetem the radio, Raft and the probe run on the steady
-// clock, and the SAR leader's lost-member rule also wants a wall-clock silence (mission_host.hpp).
+// radio's clock is the lockstep's; nothing happens between samples); with kNetem the radio, Raft
+// and the probe run on the steady clock, also between samples (every 10 ms while waiting: the
+// mesh does not wait for the lockstep), and the SAR leader's lost-member rule also wants a
+// wall-clock silence (mission_host.hpp).
 // Wall clocks otherwise only bound liveness: the first sample, a stall, a missing camera frame.
 #pragma once
 
@@ -114,6 +116,9 @@ class AgentNode final : private FrameHandler {
   // of this step. false: stop requested while waiting.
   bool TakeCamera(const bus::SensorSample& msg);
   Status HandleSample(const bus::SensorSample& msg);
+  // netem only, while waiting for a sample: the radio's deliveries dispatched, Raft's ticks and
+  // the probe on the wall clock (as the mesh does not wait for the lockstep). Raft's error.
+  Status ServeRadioBetweenSteps();
   // --mission sar: feeds the mission host (camera, committed state) and carries out what it
   // asks (setpoint, payload world command, proposals, detections, events).
   void StepMission(const bus::SensorSample& msg, bool hover_event);
