@@ -21,6 +21,23 @@ std::string Seconds(double s) {
   return buf;
 }
 
+// A wall-clock wait of `total`, spent in slices: each slice counts at most its own length, so a
+// process stopped or starved in the middle of one (SIGSTOP, docker pause) resumes with the rest
+// of its budget instead of a deadline long gone.
+class WaitBudget {
+ public:
+  explicit WaitBudget(std::chrono::milliseconds total) : left_(total) {}
+  bool spent() const { return left_ <= std::chrono::milliseconds(0); }
+  std::chrono::milliseconds Slice(std::chrono::milliseconds max) const { return std::min(left_, max); }
+  void Spend(std::chrono::steady_clock::duration elapsed, std::chrono::milliseconds slice) {
+    left_ -= std::min(std::chrono::duration_cast<std::chrono::milliseconds>(elapsed), slice);
+    if (elapsed < std::chrono::milliseconds(1)) left_ -= std::chrono::milliseconds(1);  // always progress
+  }
+
+ private:
+  std::chrono::milliseconds left_;
+};
+
 double SteadyS() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
@@ -221,12 +238,11 @@ bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
   // The physics server publishes a step's frame before its sample; DDS may still hand the sample
   // over first (two readers). Wait for it: what the camera saw at t_k is part of step k.
   if (!msg.camera_frame || have_step) return true;
-  const auto deadline = std::chrono::steady_clock::now() + options_.camera_timeout;
+  WaitBudget budget(options_.camera_timeout);  // waiting time, as Run()'s
   while (!have_step) {
     if (options_.stop != nullptr && *options_.stop != 0) return false;
-    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
-    if (left <= std::chrono::milliseconds(0)) {
-      // Past the wall-clock bound (or the process was stopped and resumed): look once more.
+    if (budget.spent()) {
+      // Past the liveness bound: look once more, then go on without it.
       while (!have_step && take(false, {})) {
       }
       if (!have_step) {
@@ -236,7 +252,10 @@ bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
       }
       return true;
     }
-    (void)take(true, std::min(left, std::chrono::milliseconds(50)));
+    const auto slice = budget.Slice(std::chrono::milliseconds(50));
+    const auto start = std::chrono::steady_clock::now();
+    (void)take(true, slice);
+    budget.Spend(std::chrono::steady_clock::now() - start, slice);
   }
   return true;
 }
@@ -462,18 +481,18 @@ Status AgentNode::Run() {
   bool got_any = false;
   while (true) {
     const auto timeout = got_any ? options_.stall_timeout : options_.first_sample_timeout;
-    // Wait in slices so a stop request is seen while no sample comes.
-    const auto wait_until = std::chrono::steady_clock::now() + timeout;
+    // Wait in slices so a stop request is seen while no sample comes. The timeout counts the time
+    // spent waiting, each slice at most its own length: a process stopped (SIGSTOP, docker pause)
+    // or starved in the middle of a slice does not find its deadline gone when it resumes.
+    WaitBudget budget(timeout);
     bool took = false;
     while (true) {
       if (options_.stop != nullptr && *options_.stop != 0) {
         Log(LogEvent(t_s_, options_.name, "stopped").Add("reason", "signal"));
         return Ok{};
       }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(wait_until - std::chrono::steady_clock::now());
-      if (left <= std::chrono::milliseconds(0)) {
-        // The wall-clock deadline passed. After a SIGSTOP/SIGCONT (or a starved process) it can
-        // pass while samples sit in the reader: look at the topic once more before giving up.
+      if (budget.spent()) {
+        // Look at the topic once more before giving up (a sample may have come in the last slice).
         took = sensor_sub_->Take(msg);
         break;
       }
@@ -481,12 +500,13 @@ Status AgentNode::Run() {
       // physics server is waiting for, a stalled server): Raft and the probe go on between
       // samples, every 10 ms without one.
       const bool idle_radio = options_.radio_model == RadioModel::kNetem && radio_ && (raft_ || probe_);
-      const bool poll = options_.stop != nullptr || idle_radio;
-      const auto slice = poll ? std::min(left, std::chrono::milliseconds(idle_radio ? 10 : 50)) : left;
+      const auto slice = budget.Slice(idle_radio ? std::chrono::milliseconds(10) : std::chrono::milliseconds(50));
+      const auto start = std::chrono::steady_clock::now();
       if (sensor_sub_->TakeFor(msg, slice)) {
         took = true;
         break;
       }
+      budget.Spend(std::chrono::steady_clock::now() - start, slice);
       if (idle_radio) SWARMBOX_TRY(ServeRadioBetweenSteps());
     }
     if (!took) {
