@@ -17,7 +17,8 @@ void DispatchFrames(std::span<const bus::RadioFrame> frames, std::string_view se
     }
     const int kinds = (f.state_msg.empty() ? 0 : 1) + (f.detection_msg.empty() ? 0 : 1) +
                       (f.raft_msg.empty() ? 0 : 1) + (f.ping_msg.empty() ? 0 : 1);
-    const std::size_t items = f.state_msg.size() + f.detection_msg.size() + f.raft_msg.size() + f.ping_msg.size();
+    const std::size_t items =
+        f.state_msg.size() + f.detection_msg.size() + f.raft_msg.size() + f.ping_msg.size();
     if (kinds != 1 || items != 1) {
       ++counts->malformed;
       continue;
@@ -29,9 +30,15 @@ void DispatchFrames(std::span<const bus::RadioFrame> frames, std::string_view se
           ++counts->raft;
           handler.OnRaftPayload(m.payload);
           break;
-        case mission::RaftDelivery::kOwn: ++counts->own; break;
-        case mission::RaftDelivery::kNotForUs: ++counts->not_for_us; break;
-        case mission::RaftDelivery::kEmpty: ++counts->malformed; break;
+        case mission::RaftDelivery::kOwn:
+          ++counts->own;
+          break;
+        case mission::RaftDelivery::kNotForUs:
+          ++counts->not_for_us;
+          break;
+        case mission::RaftDelivery::kEmpty:
+          ++counts->malformed;
+          break;
       }
     } else if (!f.ping_msg.empty()) {
       ++counts->ping;

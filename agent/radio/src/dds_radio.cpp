@@ -10,7 +10,8 @@ namespace swarmbox::radio {
 namespace {
 
 std::int64_t SteadyNs() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
       .count();
 }
 
@@ -28,7 +29,8 @@ DdsRadio::~DdsRadio() {
   raft_.reset();
 }
 
-Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::string self, DdsRadioOptions options) {
+Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::string self,
+                                                   DdsRadioOptions options) {
   if (auto s = bus::ValidateDroneName(self); !s) return s.error().Context("dds radio");
   std::vector<std::string> peers;
   for (const std::string& m : options.members) {
@@ -36,7 +38,8 @@ Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::
     if (m != self && std::find(peers.begin(), peers.end(), m) == peers.end()) peers.push_back(m);
   }
   if ((options.raft || options.pings) && peers.empty()) {
-    return Error(ErrorCode::kInvalidArgument, "dds radio: Raft and pings need another member besides '" + self + "'");
+    return Error(ErrorCode::kInvalidArgument,
+                 "dds radio: Raft and pings need another member besides '" + self + "'");
   }
   std::unique_ptr<DdsRadio> radio(new DdsRadio(std::move(self), std::move(peers)));
   DdsRadio* raw = radio.get();
@@ -47,7 +50,9 @@ Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::
   if (!dp) return dp.error().Context("dds radio: publishing detections");
   radio->detection_pub_ = std::move(*dp);
   if (options.pings) {
-    auto writer = [&mesh]() { return mesh.CreatePublisher<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio); };
+    auto writer = [&mesh]() {
+      return mesh.CreatePublisher<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio);
+    };
     for (std::size_t i = 0; i < radio->peers_.size(); ++i) {
       auto ping = writer();
       if (!ping) return ping.error().Context("dds radio: creating a ping writer");
@@ -72,16 +77,17 @@ Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::
     radio->ping_sub_ = std::move(*sub);
   }
   if (options.raft) {
-    auto rr = mission::RaftRadio::Create(mesh, radio->self_, radio->peers_, [raw](std::span<const std::uint8_t> bytes) {
-      bus::RadioFrame f;
-      f.to = raw->self_;
-      bus::RaftMessage m;
-      m.to = raw->self_;
-      m.term = mission::PeekRaftTerm(bytes);
-      m.payload.assign(bytes.begin(), bytes.end());
-      f.raft_msg.push_back(std::move(m));
-      raw->Push(std::move(f));
-    });
+    auto rr = mission::RaftRadio::Create(mesh, radio->self_, radio->peers_,
+                                         [raw](std::span<const std::uint8_t> bytes) {
+                                           bus::RadioFrame f;
+                                           f.to = raw->self_;
+                                           bus::RaftMessage m;
+                                           m.to = raw->self_;
+                                           m.term = mission::PeekRaftTerm(bytes);
+                                           m.payload.assign(bytes.begin(), bytes.end());
+                                           f.raft_msg.push_back(std::move(m));
+                                           raw->Push(std::move(f));
+                                         });
     if (!rr) return rr.error().Context("dds radio: raft");
     radio->raft_ = std::move(*rr);
   }
@@ -121,7 +127,8 @@ DdsRadio::PingWriter& DdsRadio::PingWriterFor(const bus::RadioPing& m) {
 
 bool DdsRadio::Publish(const bus::RadioFrame& frame) {
   if (!frame.state_msg.empty()) return static_cast<bool>(state_pub_->Publish(frame.state_msg.front()));
-  if (!frame.detection_msg.empty()) return static_cast<bool>(detection_pub_->Publish(frame.detection_msg.front()));
+  if (!frame.detection_msg.empty())
+    return static_cast<bool>(detection_pub_->Publish(frame.detection_msg.front()));
   if (!frame.raft_msg.empty()) {
     if (!raft_) return false;
     const bus::RaftMessage& m = frame.raft_msg.front();
@@ -130,7 +137,8 @@ bool DdsRadio::Publish(const bus::RadioFrame& frame) {
   }
   if (!frame.ping_msg.empty()) {
     const bus::RadioPing& m = frame.ping_msg.front();
-    if (!other_pong_writer_ || (!m.is_pong && std::find(peers_.begin(), peers_.end(), m.to) == peers_.end())) {
+    if (!other_pong_writer_ ||
+        (!m.is_pong && std::find(peers_.begin(), peers_.end(), m.to) == peers_.end())) {
       return false;  // no ping writers, or a ping to a drone that is not a member
     }
     return static_cast<bool>(PingWriterFor(m).Publish(m));

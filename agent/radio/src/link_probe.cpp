@@ -14,8 +14,9 @@ Result<std::unique_ptr<LinkProbe>> LinkProbe::Create(std::string self, std::vect
   if (options.ping_every.count() <= 0 || options.timeout.count() <= 0 || options.report_every.count() <= 0) {
     return Error(ErrorCode::kInvalidArgument,
                  "link probe: ping_every, timeout and report_every must be positive (got " +
-                     std::to_string(options.ping_every.count()) + " ms, " + std::to_string(options.timeout.count()) +
-                     " ms, " + std::to_string(options.report_every.count()) + " ms)");
+                     std::to_string(options.ping_every.count()) + " ms, " +
+                     std::to_string(options.timeout.count()) + " ms, " +
+                     std::to_string(options.report_every.count()) + " ms)");
   }
   std::vector<std::string> unique;
   for (std::string& p : peers) {
@@ -23,14 +24,17 @@ Result<std::unique_ptr<LinkProbe>> LinkProbe::Create(std::string self, std::vect
     if (p == self || std::find(unique.begin(), unique.end(), p) != unique.end()) continue;
     unique.push_back(std::move(p));
   }
-  if (unique.empty()) return Error(ErrorCode::kInvalidArgument, "link probe: no peer to ping besides '" + self + "'");
+  if (unique.empty())
+    return Error(ErrorCode::kInvalidArgument, "link probe: no peer to ping besides '" + self + "'");
   return std::unique_ptr<LinkProbe>(new LinkProbe(std::move(self), std::move(unique), options, start));
 }
 
-LinkProbe::LinkProbe(std::string self, std::vector<std::string> peers, LinkProbeOptions options, TimePoint start)
+LinkProbe::LinkProbe(std::string self, std::vector<std::string> peers, LinkProbeOptions options,
+                     TimePoint start)
     : self_(std::move(self)),
       monitor_(std::move(peers),
-               LinkMonitorOptions{.ping_every = options.ping_every, .timeout = options.timeout,
+               LinkMonitorOptions{.ping_every = options.ping_every,
+                                  .timeout = options.timeout,
                                   .report_every = options.report_every},
                start) {
   due_.reserve(monitor_.peers().size());

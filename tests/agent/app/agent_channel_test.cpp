@@ -60,10 +60,23 @@ struct TrialRun {
 TrialRun RunTrial(const std::string& root) {
   ++g_run;
   TrialRun run;
-  std::vector<std::string> argv = {SWARMBOX_PHYSICS_BIN, "--world", SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml",
-                                   "--rtf", "0", "--domain", std::to_string(SimDomain()), "--max-sim-time",
-                                   std::to_string(kSimS), "--no-cameras", "--seed", "7", "--truth", "",
-                                   "--radio-model", "channel", "--radio-profile",
+  std::vector<std::string> argv = {SWARMBOX_PHYSICS_BIN,
+                                   "--world",
+                                   SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml",
+                                   "--rtf",
+                                   "0",
+                                   "--domain",
+                                   std::to_string(SimDomain()),
+                                   "--max-sim-time",
+                                   std::to_string(kSimS),
+                                   "--no-cameras",
+                                   "--seed",
+                                   "7",
+                                   "--truth",
+                                   "",
+                                   "--radio-model",
+                                   "channel",
+                                   "--radio-profile",
                                    SWARMBOX_TRIALS_DIR "/radios/wifi_5ghz_mesh.yaml"};
   for (std::size_t i = 0; i < kNames.size(); ++i) {
     argv.push_back("--drone");
@@ -74,13 +87,33 @@ TrialRun RunTrial(const std::string& root) {
   std::vector<std::unique_ptr<LoggedChild>> agents;
   for (std::size_t i = 0; i < kNames.size(); ++i) {
     agents.push_back(std::make_unique<LoggedChild>(
-        std::vector<std::string>{SWARMBOX_AGENT_BIN, "--name", kNames[i], "--airframe",
-                                 SWARMBOX_TRIALS_DIR "/airframes/x500.yaml", "--sim-domain",
-                                 std::to_string(SimDomain()), "--radio-model", "channel", "--start", kStarts[i],
-                                 "--plan", "takeoff:3,hover:1000", "--members", members, "--raft-dir",
-                                 root + "/run" + std::to_string(g_run) + "_" + kNames[i], "--seed", "7",
-                                 "--propose-every-ms", "300", "--ping-every-ms", "200", "--sample-timeout", "60",
-                                 "--stall-timeout", "3"},
+        std::vector<std::string>{SWARMBOX_AGENT_BIN,
+                                 "--name",
+                                 kNames[i],
+                                 "--airframe",
+                                 SWARMBOX_TRIALS_DIR "/airframes/x500.yaml",
+                                 "--sim-domain",
+                                 std::to_string(SimDomain()),
+                                 "--radio-model",
+                                 "channel",
+                                 "--start",
+                                 kStarts[i],
+                                 "--plan",
+                                 "takeoff:3,hover:1000",
+                                 "--members",
+                                 members,
+                                 "--raft-dir",
+                                 root + "/run" + std::to_string(g_run) + "_" + kNames[i],
+                                 "--seed",
+                                 "7",
+                                 "--propose-every-ms",
+                                 "300",
+                                 "--ping-every-ms",
+                                 "200",
+                                 "--sample-timeout",
+                                 "60",
+                                 "--stall-timeout",
+                                 "3"},
         root + "/run" + std::to_string(g_run) + "_" + kNames[i] + ".log"));
     EXPECT_TRUE(agents.back()->running()) << agents.back()->spawn_error();
   }
@@ -144,7 +177,8 @@ TEST(AgentChannel, RaftAndLinksOnTheSimulatedChannelAreReproducible) {
   // The same trial again: every agent's simulated-time lines are the same, byte for byte.
   const TrialRun b = RunTrial(root);
   for (const std::string& name : kNames) {
-    EXPECT_EQ(SimulatedLines(a.logs.at(name), kSimS - 1.0), SimulatedLines(b.logs.at(name), kSimS - 1.0)) << name;
+    EXPECT_EQ(SimulatedLines(a.logs.at(name), kSimS - 1.0), SimulatedLines(b.logs.at(name), kSimS - 1.0))
+        << name;
   }
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(root);
 }

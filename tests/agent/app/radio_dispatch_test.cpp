@@ -21,7 +21,9 @@ class Recorder final : public FrameHandler {
   void OnState(const bus::DroneState& s, const bus::RadioFrame& f) override {
     calls.push_back("state:" + s.drone + "@" + std::to_string(f.delivered_ns));
   }
-  void OnDetection(const bus::Detection& d, const bus::RadioFrame&) override { calls.push_back("detection:" + d.from); }
+  void OnDetection(const bus::Detection& d, const bus::RadioFrame&) override {
+    calls.push_back("detection:" + d.from);
+  }
   std::vector<std::string> calls;
 };
 
@@ -64,8 +66,8 @@ TEST(RadioDispatch, HandsEachFrameToItsConsumerInDeliveryOrder) {
   Recorder r;
   DispatchCounts c;
   DispatchFrames(frames, "scout_1", r, &c);
-  EXPECT_EQ(r.calls, (std::vector<std::string>{"state:scout_2@5", "raft:12", "ping:scout_2", "detection:scout_3",
-                                               "state:lifter@6"}));
+  EXPECT_EQ(r.calls, (std::vector<std::string>{"state:scout_2@5", "raft:12", "ping:scout_2",
+                                               "detection:scout_3", "state:lifter@6"}));
   EXPECT_EQ(c, (DispatchCounts{.raft = 1, .ping = 1, .state = 2, .detection = 1}));
 }
 
@@ -79,11 +81,14 @@ TEST(RadioDispatch, DropsOwnForeignAndMalformedFrames) {
   bus::RadioFrame own_state = State("scout_2");
   own_state.state_msg[0].drone = "scout_1";  // relayed, but ours
   const std::vector<bus::RadioFrame> frames = {
-      State("scout_1"),                 // our own broadcast
-      Raft("scout_2", "scout_3", 4),    // addressed to another drone
-      Ping("scout_2", "lifter"),        // likewise
-      Raft("scout_2", "scout_1", 0),    // a Raft envelope without payload
-      two_kinds, two_states, empty, own_state};
+      State("scout_1"),               // our own broadcast
+      Raft("scout_2", "scout_3", 4),  // addressed to another drone
+      Ping("scout_2", "lifter"),      // likewise
+      Raft("scout_2", "scout_1", 0),  // a Raft envelope without payload
+      two_kinds,
+      two_states,
+      empty,
+      own_state};
   Recorder r;
   DispatchCounts c;
   DispatchFrames(frames, "scout_1", r, &c);

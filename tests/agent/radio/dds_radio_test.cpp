@@ -27,7 +27,9 @@ std::unique_ptr<bus::Participant> Mesh(int domain) {
   return p ? std::move(*p) : nullptr;
 }
 
-LinkProbeOptions Fast() { return LinkProbeOptions{.ping_every = 50ms, .timeout = 500ms, .report_every = 1000ms}; }
+LinkProbeOptions Fast() {
+  return LinkProbeOptions{.ping_every = 50ms, .timeout = 500ms, .report_every = 1000ms};
+}
 
 struct Drone {
   std::string name;
@@ -42,7 +44,8 @@ struct Drone {
   Drone(int domain, std::string n, std::vector<std::string> members, std::vector<std::string> ping)
       : name(std::move(n)), mesh(Mesh(domain)) {
     if (!mesh) return;
-    auto r = DdsRadio::Create(*mesh, name, {.members = members, .raft = true, .pings = true, .hear_states = true});
+    auto r =
+        DdsRadio::Create(*mesh, name, {.members = members, .raft = true, .pings = true, .hear_states = true});
     EXPECT_TRUE(r) << r.error().ToString();
     if (r) radio = std::move(*r);
     auto p = LinkProbe::Create(name, ping, Fast(), RadioTime(radio ? radio->now_ns() : 0));

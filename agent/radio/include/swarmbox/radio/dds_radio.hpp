@@ -63,7 +63,8 @@ class DdsRadio final : public MeshRadio {
 
   // kInvalidArgument for a bad drone name, or raft/pings without another member; the bus errors
   // of creating a writer or reader otherwise.
-  static Result<std::unique_ptr<DdsRadio>> Create(bus::Participant& mesh, std::string self, DdsRadioOptions options);
+  static Result<std::unique_ptr<DdsRadio>> Create(bus::Participant& mesh, std::string self,
+                                                  DdsRadioOptions options);
   ~DdsRadio() override;
   DdsRadio(const DdsRadio&) = delete;
   DdsRadio& operator=(const DdsRadio&) = delete;
