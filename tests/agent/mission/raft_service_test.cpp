@@ -1,28 +1,32 @@
-// RaftRadio and RaftService over real DDS on loopback, in one process (integration):
-// addressing on the shared radio topic, a two-node cluster agreeing, events with the caller's
-// sim clock, and the loud stop when the storage fails.
+// RaftRadio and RaftService over real DDS on loopback, in one process (integration): addressing
+// on the shared radio topic, and a two-node cluster agreeing over the radio, each passive service
+// driven by the test's loop (PayloadInbox from the middleware threads, Tick on the test's clock),
+// its events carrying that clock. The service's behaviour without DDS (storage failure, junk,
+// restart, the tick grid, determinism) is in raft_service_sim_test.cpp.
 #include "swarmbox/mission/raft_service.hpp"
 
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "support/files.hpp"
-#include "support/flaky_file_system.hpp"
 #include "support/wait_until.hpp"
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/mission/payload_inbox.hpp"
 #include "swarmbox/mission/raft_radio.hpp"
 
 namespace swarmbox::mission {
 namespace {
 
 using namespace std::chrono_literals;
-using swarmbox::testing::FlakyFileSystem;
 using swarmbox::testing::WaitUntil;
 
 std::unique_ptr<bus::Participant> Mesh(int domain) {
@@ -41,9 +45,15 @@ struct TempDir {
   std::string path;
 };
 
-class FixedClock final : public raft::Clock {
+// The test loop's clock: starts at 12.5 s (events must carry the caller's clock, not the time
+// since the start), advanced by the loop.
+class LoopClock final : public raft::Clock {
  public:
-  double NowS() const override { return 12.5; }
+  double NowS() const override { return static_cast<double>(t_us_) * 1e-6; }
+  void Advance(std::chrono::microseconds dt) { t_us_ += dt.count(); }
+
+ private:
+  std::int64_t t_us_ = 12'500'000;
 };
 
 // Thread-safe collection of the lines a service prints.
@@ -62,6 +72,13 @@ class Lines {
     }
     return false;
   }
+  std::string First(const std::string& part) const {
+    std::lock_guard<std::mutex> lk(mu_);
+    for (const std::string& l : lines_) {
+      if (l.find(part) != std::string::npos) return l;
+    }
+    return "";
+  }
   std::string All() const {
     std::lock_guard<std::mutex> lk(mu_);
     std::string s;
@@ -73,15 +90,6 @@ class Lines {
   mutable std::mutex mu_;
   std::vector<std::string> lines_;
 };
-
-RaftServiceConfig SoloConfig(const std::string& dir) {
-  RaftServiceConfig c;
-  c.driver.self = "solo";
-  c.driver.members = {"solo"};
-  c.driver.seed = 3;
-  c.data_dir = dir;
-  return c;
-}
 
 TEST(RaftRadio, DeliversOnlyPayloadsAddressedToSelfByOthers) {
   auto mesh = Mesh(180);
@@ -126,13 +134,45 @@ TEST(RaftRadio, RefusesNamesThatCannotBeAddressed) {
   EXPECT_NE(r.error().message().find("raft radio"), std::string::npos);
 }
 
+// One passive service on its radio, as a host drives it: the radio's middleware callback pushes
+// into the inbox; the loop feeds the inbox to the service and ticks it.
+struct RadioNode {
+  PayloadInbox inbox;
+  std::unique_ptr<RaftRadio> radio;      // after the inbox: destroyed before it
+  std::unique_ptr<RaftService> service;  // after the radio: destroyed first
+  std::vector<raft::Bytes> batch;
+
+  void Step() {
+    batch.clear();
+    inbox.Drain(&batch);
+    for (const raft::Bytes& b : batch) service->OnPayload(b);
+    EXPECT_TRUE(service->Tick().ok());
+  }
+};
+
+std::unique_ptr<RadioNode> StartNode(bus::Participant& mesh, const RaftServiceConfig& cfg,
+                                     const raft::Clock& clock, LineSink sink) {
+  auto n = std::make_unique<RadioNode>();
+  RadioNode* raw = n.get();
+  auto radio = RaftRadio::Create(mesh, cfg.driver.self, cfg.driver.members,
+                                 [raw](std::span<const std::uint8_t> b) { raw->inbox.Push(b); });
+  EXPECT_TRUE(radio) << radio.error().ToString();
+  if (!radio) return nullptr;
+  n->radio = std::move(*radio);
+  auto service = RaftService::Start(cfg, *n->radio, clock, std::move(sink));
+  EXPECT_TRUE(service) << service.error().ToString();
+  if (!service) return nullptr;
+  n->service = std::move(*service);
+  return n;
+}
+
 TEST(RaftService, TwoNodesOverTheRadioElectAndCommit) {
   auto mesh_a = Mesh(181);
   auto mesh_b = Mesh(181);
   ASSERT_TRUE(mesh_a && mesh_b);
   const TempDir tmp("swarmbox_raft_service_");
   const std::string& dir = tmp.path;
-  FixedClock clock;
+  LoopClock clock;
   Lines lines_a, lines_b;
   RaftServiceConfig ca;
   ca.driver.self = "alpha";
@@ -142,102 +182,40 @@ TEST(RaftService, TwoNodesOverTheRadioElectAndCommit) {
   RaftServiceConfig cb = ca;
   cb.driver.self = "bravo";
   cb.data_dir = dir + "/bravo";
-  auto a = RaftService::Start(ca, *mesh_a, clock, lines_a.Sink());
-  auto b = RaftService::Start(cb, *mesh_b, clock, lines_b.Sink());
-  ASSERT_TRUE(a) << a.error().ToString();
-  ASSERT_TRUE(b) << b.error().ToString();
-  ASSERT_TRUE(WaitUntil([&] {
-    return !(*a)->leader().empty() && (*a)->leader() == (*b)->leader();
+  auto a = StartNode(*mesh_a, ca, clock, lines_a.Sink());
+  auto b = StartNode(*mesh_b, cb, clock, lines_b.Sink());
+  ASSERT_TRUE(a && b);
+  // The loop: 5 ms of wall clock, 5 ms of the test's clock, one step of each node.
+  auto step_until = [&](const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+    return WaitUntil([&] {
+      clock.Advance(5ms);
+      a->Step();
+      b->Step();
+      return done();
+    }, timeout, 5ms);
+  };
+  ASSERT_TRUE(step_until([&] {
+    return !a->service->leader().empty() && a->service->leader() == b->service->leader();
   }, 30s)) << lines_a.All() << lines_b.All();
-  RaftService& leader = (*a)->is_leader() ? **a : **b;
-  ASSERT_TRUE(WaitUntil([&] { return leader.Propose(raft::StartSearch{}).ok(); }, 10s));
-  ASSERT_TRUE(WaitUntil([&] {
-    return (*a)->mission().phase() == raft::MissionPhase::kSearch &&
-           (*b)->mission().phase() == raft::MissionPhase::kSearch;
+  RaftService& leader = a->service->is_leader() ? *a->service : *b->service;
+  ASSERT_TRUE(step_until([&] { return leader.Propose(raft::StartSearch{}).ok(); }, 10s));
+  ASSERT_TRUE(step_until([&] {
+    return a->service->mission().phase() == raft::MissionPhase::kSearch &&
+           b->service->mission().phase() == raft::MissionPhase::kSearch;
   }, 20s)) << lines_a.All() << lines_b.All();
-  EXPECT_EQ((*a)->mission(), (*b)->mission());
-  EXPECT_TRUE(lines_a.Contains("t=12.500 node=alpha event=leader_elected")) << lines_a.All();
+  EXPECT_EQ(a->service->mission(), b->service->mission());
+  EXPECT_TRUE(lines_a.Contains("node=alpha event=leader_elected")) << lines_a.All();
   EXPECT_TRUE(lines_b.Contains("node=bravo event=mission_state state=SEARCH")) << lines_b.All();
-  EXPECT_TRUE((*a)->health().ok());
-  EXPECT_GE((*a)->radio_counters().delivered, 1u);
-  EXPECT_EQ((*a)->protocol_errors(), 0u);
-}
-
-TEST(RaftService, StorageFailureStopsTheNodeLoudly) {
-  auto mesh = Mesh(184);
-  ASSERT_NE(mesh, nullptr);
-  FlakyFileSystem fs;
-  const TempDir tmp("swarmbox_raft_flaky_");
-  RaftServiceConfig cfg = SoloConfig(tmp.path);
-  cfg.file_system = &fs;
-  FixedClock clock;
-  Lines lines;
-  auto s = RaftService::Start(cfg, *mesh, clock, lines.Sink());
-  ASSERT_TRUE(s) << s.error().ToString();
-  ASSERT_TRUE(WaitUntil([&] { return (*s)->is_leader(); }, 10s)) << lines.All();
-  EXPECT_FALSE((*s)->WaitStopped(0ms));
-  fs.fail_sync = true;
-  (void)(*s)->Propose(raft::StartSearch{});  // the WAL's fsync fails on this or the next Ready
-  ASSERT_TRUE((*s)->WaitStopped(10s)) << lines.All();
-  ASSERT_FALSE((*s)->health());
-  EXPECT_NE((*s)->health().error().ToString().find("injected"), std::string::npos);
-  EXPECT_TRUE(lines.Contains("event=raft_stopped")) << lines.All();
-  auto again = (*s)->Propose(raft::StartSearch{});
-  ASSERT_FALSE(again);
-  EXPECT_NE(again.error().ToString().find("injected"), std::string::npos);
-}
-
-TEST(RaftService, UndecodablePayloadsAreCountedNotFatal) {
-  auto mesh = Mesh(186);
-  ASSERT_NE(mesh, nullptr);
-  const TempDir tmp("swarmbox_raft_junk_");
-  FixedClock clock;
-  Lines lines;
-  auto s = RaftService::Start(SoloConfig(tmp.path), *mesh, clock, lines.Sink());
-  ASSERT_TRUE(s) << s.error().ToString();
-  ASSERT_TRUE(WaitUntil([&] { return (*s)->is_leader(); }, 10s)) << lines.All();
-  // Another "drone" (e.g. of another cluster, or a damaged datagram) talks to us.
-  auto intruder = RaftRadio::Create(*mesh, "intruder", [](std::span<const std::uint8_t>) {});
-  ASSERT_TRUE(intruder);
-  const std::vector<std::uint8_t> junk = {1, 0xde, 0xad, 0xbe, 0xef, 11, 1, 1, 1};
-  ASSERT_TRUE(WaitUntil([&] {
-    (*intruder)->Send("solo", junk);
-    std::this_thread::sleep_for(20ms);
-    return (*s)->protocol_errors() >= 1;
-  }, 10s));
-  EXPECT_TRUE((*s)->health().ok());
-  EXPECT_TRUE((*s)->is_leader());
-  EXPECT_TRUE((*s)->Propose(raft::StartSearch{}));
-  EXPECT_TRUE(WaitUntil([&] { return (*s)->mission().phase() == raft::MissionPhase::kSearch; },
-                        10s));
-}
-
-TEST(RaftService, RestartReappliesTheDurableLog) {
-  auto mesh = Mesh(185);
-  ASSERT_NE(mesh, nullptr);
-  const TempDir tmp("swarmbox_raft_restart_");
-  const RaftServiceConfig cfg = SoloConfig(tmp.path);
-  FixedClock clock;
-  raft::MissionState before;
-  {
-    Lines lines;
-    auto s = RaftService::Start(cfg, *mesh, clock, lines.Sink());
-    ASSERT_TRUE(s) << s.error().ToString();
-    ASSERT_TRUE(WaitUntil([&] { return (*s)->is_leader(); }, 10s));
-    ASSERT_TRUE((*s)->Propose(raft::StartSearch{}));
-    ASSERT_TRUE((*s)->Propose(raft::ConfirmVictim{"op", 10.0, 20.0}));
-    ASSERT_TRUE(WaitUntil([&] { return (*s)->mission().victims().size() == 1; }, 10s));
-    before = (*s)->mission();
-  }
-  Lines lines;
-  auto s = RaftService::Start(cfg, *mesh, clock, lines.Sink());
-  ASSERT_TRUE(s) << s.error().ToString();
-  ASSERT_TRUE(WaitUntil([&] {
-    return (*s)->mission().applied_index() >= before.applied_index();
-  }, 10s)) << lines.All();
-  EXPECT_EQ((*s)->mission().victims(), before.victims());
-  EXPECT_EQ((*s)->mission().phase(), raft::MissionPhase::kSearch);
-  EXPECT_TRUE(lines.Contains("event=victim_confirmed id=1")) << lines.All();
+  // `t` is the loop's clock: from 12.5 s on, never the time since the start.
+  const std::string first = lines_a.First("event=leader_elected");
+  const auto t = FindField(ParseLogfmt(first), "t");
+  ASSERT_TRUE(t) << first;
+  EXPECT_GE(std::stod(*t), 12.5) << first;
+  EXPECT_LE(std::stod(*t), clock.NowS()) << first;
+  EXPECT_TRUE(a->service->health().ok());
+  EXPECT_GE(a->radio->counters().delivered, 1u);
+  EXPECT_EQ(a->service->protocol_errors(), 0u);
+  EXPECT_EQ(a->inbox.drops(), 0u);
 }
 
 }  // namespace
