@@ -65,6 +65,12 @@ int main(int argc, char** argv) {
   app.add_option("--radio-plan", o.radio_plan_path,
                  "Radio plan JSON: simulated-time faults (drone_out, world_command; radio and partition with "
                  "--radio-model channel) and the mesh impairment");
+  app.add_option("--radio-model", o.radio_model,
+                 "channel: host the simulated radio channel (radio_out -> channel -> radio_in, simulated time); "
+                 "netem: none (the agents' mesh network carries the radio)")
+      ->check(CLI::IsMember({"channel", "netem"}))
+      ->capture_default_str();
+  app.add_option("--radio-profile", o.radio_profile_path, "Radio profile YAML (trials/radios/*.yaml); required with --radio-model channel");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -125,6 +131,18 @@ int main(int argc, char** argv) {
     if (Status c = CheckRadioPlan(*p, names); !c) return Fail(2, c.error().ToString());
     plan = std::move(*p);
   }
+  std::optional<channel::RadioProfile> radio_profile;
+  if (o.radio_model == "channel") {
+    if (o.radio_profile_path.empty()) return Fail(2, "--radio-model channel needs --radio-profile PATH");
+    auto profile = channel::LoadRadioProfile(o.radio_profile_path);
+    if (!profile) return Fail(2, profile.error().ToString());
+    radio_profile = std::move(*profile);
+    if (Status c = CheckChannelPlan(plan); !c) {
+      return Fail(2, (c.error().where().empty() ? o.radio_plan_path + ": " : std::string()) + c.error().ToString());
+    }
+  } else if (!o.radio_profile_path.empty()) {
+    return Fail(2, "--radio-profile needs --radio-model channel");
+  }
 
   std::optional<TruthCsvFile> truth;
   if (!o.truth_path.empty()) {
@@ -157,6 +175,9 @@ int main(int argc, char** argv) {
   so.cameras = o.cameras;
   so.clock_every_s = o.clock_every_s;
   so.plan = std::move(plan);
+  so.radio_profile = std::move(radio_profile);
+  // The plan's seed when it has one (the trial's, written by the orchestrator), else --seed.
+  so.radio_seed = so.plan.seed.value_or(o.seed);
   SteadyWallClock clock;
   SimServer server(**world, **transport, clock, truth ? &*truth : nullptr, so, stdout);
   std::printf("%s\n", LogEvent(0.0, "physics", "ready")
@@ -166,6 +187,7 @@ int main(int argc, char** argv) {
                           .Add("domain", o.domain)
                           .Add("rtf", o.rtf, 2)
                           .Add("seed", o.seed)
+                          .Add("radio_model", o.radio_model)
                           .str()
                           .c_str());
   std::fflush(stdout);

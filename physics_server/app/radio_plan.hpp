@@ -71,7 +71,7 @@ struct PlanEntry {
 };
 
 struct RadioPlan {
-  std::uint64_t seed = 0;
+  std::optional<std::uint64_t> seed;  // the channel's seed (the trial's); absent: --seed
   std::optional<PlanImpairment> mesh;  // absent: no impairment
   std::vector<PlanEntry> schedule;     // sorted by at_ns, file order among equal times
 };

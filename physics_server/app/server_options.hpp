@@ -45,6 +45,8 @@ struct ServerOptions {
   bool cameras = true;
   double clock_every_s = 10.0;          // simulated s between event=clock lines; 0 = none
   std::string radio_plan_path;          // --radio-plan: radio_plan.hpp JSON; "" = none
+  std::string radio_model = "netem";    // --radio-model channel|netem
+  std::string radio_profile_path;       // --radio-profile (required with channel)
 };
 
 // "name:airframe:x,y,z[:yaw_deg[:payload[:attached]]]".

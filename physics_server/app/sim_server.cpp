@@ -60,6 +60,14 @@ SimServer::SimServer(World& world, SimTransport& transport, WallClock& clock, Tr
       base_wind_(world.config().wind),
       slots_(world.drone_count()) {
   world_.SetEventSink(&sink_);
+  if (options_.radio_profile) {
+    const std::size_t n = world.drone_count();
+    channel_.emplace(*options_.radio_profile, n, options_.radio_seed, ChannelObstacles(world.config()));
+    if (options_.plan.mesh) channel_->SetImpairment(std::nullopt, ToChannelImpairment(*options_.plan.mesh));
+    positions_.resize(n);
+    impairments_.resize(n);
+    blocked_.assign(n * n, 0);
+  }
   if (options_.clock_every_s > 0) {
     progress_.emplace(static_cast<std::int64_t>(options_.clock_every_s * 1e9));
   }
@@ -112,6 +120,169 @@ void SimServer::Apply(const WorldCommandInput& cmd) {
   done.Add("command", cmd.command).Add("target", cmd.target);
   if (cmd.command == "payload_attach" && !cmd.args.empty()) done.Add("mass_kg", cmd.args[0]);
   Log(done);
+}
+
+namespace {
+
+// How long a sent frame's payload is kept for its deliveries [simulated ns]: far beyond any delay
+// the channel gives (impairment delay and jitter, a full queue on a busy medium). A delivery of an
+// older frame is counted as `expired` in event=channel and dropped.
+constexpr std::int64_t kFrameKeepNs = 120'000'000'000;
+
+}  // namespace
+
+channel::Impairment ToChannelImpairment(const PlanImpairment& m) {
+  channel::Impairment c;
+  c.delay_ms = m.delay_ms;
+  c.jitter_ms = m.jitter_ms;
+  c.distribution = m.distribution;
+  c.loss = m.loss;
+  c.rate_kbit = m.rate_kbit;
+  c.duplicate = m.duplicate;
+  return c;
+}
+
+Status CheckChannelPlan(const RadioPlan& plan) {
+  if (plan.mesh) {
+    if (Status s = channel::ValidateImpairment(ToChannelImpairment(*plan.mesh)); !s) {
+      return Error(ErrorCode::kInvalidArgument, "mesh: " + s.error().message());
+    }
+  }
+  for (const PlanEntry& e : plan.schedule) {
+    if (e.kind != PlanEntry::Kind::kRadio) continue;
+    if (Status s = channel::ValidateImpairment(ToChannelImpairment(e.impairment)); !s) {
+      return Error(ErrorCode::kInvalidArgument, "entry '" + e.name + "': " + s.error().message(), e.where);
+    }
+  }
+  return Ok{};
+}
+
+std::vector<channel::Box> ChannelObstacles(const WorldConfig& world) {
+  std::vector<channel::Box> boxes;
+  for (const ObstacleBox& o : world.obstacles) {
+    const Vec3 h = o.size_m * 0.5;
+    boxes.push_back({{o.center_m.x - h.x, o.center_m.y - h.y, o.center_m.z - h.z},
+                     {o.center_m.x + h.x, o.center_m.y + h.y, o.center_m.z + h.z},
+                     o.yaw_rad});
+  }
+  return boxes;
+}
+
+void SimServer::TakeDeliveries(std::int64_t until_ns) {
+  for (Slot& slot : slots_) slot.radio_in.clear();
+  deliveries_.clear();
+  channel_->TakeDeliveries(until_ns, &deliveries_);
+  for (const channel::Delivery& d : deliveries_) {
+    if (d.packet.token < first_token_ || d.packet.token - first_token_ >= frames_.size()) {
+      ++frames_expired_;
+      continue;
+    }
+    bus::RadioFrame& f = slots_[d.to].radio_in.emplace_back(frames_[d.packet.token - first_token_].frame);
+    f.delivered_ns = d.at_ns;
+  }
+  // Frames old enough that no delivery can be due any more.
+  while (!frames_.empty() && frames_.front().sent_ns < until_ns - kFrameKeepNs) {
+    frames_.pop_front();
+    ++first_token_;
+  }
+  for (std::size_t i = 0; i < positions_.size(); ++i) {
+    const Vec3 p = world_.Truth(i).position_m;
+    positions_[i] = {p.x, p.y, p.z};
+  }
+  channel_->SetPositions(positions_);
+}
+
+void SimServer::SendRadio(std::int64_t now_ns) {
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    Slot& slot = slots_[i];
+    if (!lockstep_.answered(i)) {
+      slot.radio_out.clear();
+      continue;
+    }
+    std::stable_sort(slot.radio_out.begin(), slot.radio_out.end(),
+                     [](const bus::RadioFrame& a, const bus::RadioFrame& b) { return a.seq < b.seq; });
+    for (bus::RadioFrame& f : slot.radio_out) {
+      channel::Packet p;
+      p.from = i;
+      if (!f.to.empty()) {
+        p.to = world_.FindDrone(f.to);
+        if (!p.to) {
+          Log(LogEvent(world_.time_s(), options_.node, "radio_frame_rejected").Add("drone", world_.drone_name(i))
+                  .Add("to", f.to).Add("reason", "unknown drone"));
+          continue;
+        }
+      }
+      p.seq = f.seq;
+      p.size_bytes = f.size_bytes;
+      p.sent_ns = now_ns;
+      p.token = first_token_ + frames_.size();
+      f.from = world_.drone_name(i);  // the answer's topic names the sender, not the frame
+      f.sent_ns = now_ns;
+      f.delivered_ns = 0;
+      frames_.push_back({now_ns, std::move(f)});
+      channel_->Send(now_ns, p);
+    }
+    slot.radio_out.clear();
+  }
+}
+
+void SimServer::SetImpairmentOf(std::size_t drone) {
+  const std::vector<std::size_t>& active = impairments_[drone];
+  if (active.empty()) {
+    channel_->ClearImpairment(drone);
+  } else {
+    channel_->SetImpairment(drone, ToChannelImpairment(options_.plan.schedule[active.back()].impairment));
+  }
+}
+
+void SimServer::RadioFault(std::size_t entry, bool on) {
+  const PlanEntry& e = options_.plan.schedule[entry];
+  if (e.kind == PlanEntry::Kind::kRadio) {
+    for (const std::string& t : e.targets) {
+      const std::size_t i = *world_.FindDrone(t);  // CheckRadioPlan
+      std::vector<std::size_t>& active = impairments_[i];
+      if (on) {
+        active.push_back(entry);
+      } else {
+        active.erase(std::remove(active.begin(), active.end(), entry), active.end());
+      }
+      SetImpairmentOf(i);
+    }
+  } else {
+    const std::size_t n = slots_.size();
+    for (std::size_t a = 0; a < e.groups.size(); ++a) {
+      for (std::size_t b = 0; b < e.groups.size(); ++b) {
+        if (a == b || (e.oneway && a != 0)) continue;
+        for (const std::string& from : e.groups[a]) {
+          for (const std::string& to : e.groups[b]) {
+            const std::size_t f = *world_.FindDrone(from), t = *world_.FindDrone(to);
+            int& count = blocked_[f * n + t];
+            count += on ? 1 : -1;
+            channel_->SetBlocked(f, t, count > 0);
+          }
+        }
+      }
+    }
+  }
+  Log(LogEvent(world_.time_s(), options_.node, "radio_fault").Add("fault", e.name)
+          .Add("kind", e.kind == PlanEntry::Kind::kRadio ? "impair" : "partition").Add("state", on ? "on" : "off"));
+  if (on && e.duration_ns > 0) radio_ends_.push_back({world_.time_ns() + e.duration_ns, entry});
+}
+
+void SimServer::LogChannel() {
+  const channel::ChannelStats& c = channel_->stats();
+  Log(LogEvent(world_.time_s(), options_.node, "channel")
+          .Add("sent", c.sent)
+          .Add("delivered", c.delivered)
+          .Add("lost_range", c.lost_range)
+          .Add("lost_per", c.lost_per)
+          .Add("lost_impairment", c.lost_impairment)
+          .Add("lost_queue", c.lost_queue)
+          .Add("lost_partition", c.lost_partition)
+          .Add("lost_out", c.lost_out)
+          .Add("duplicated", c.duplicated)
+          .Add("medium_busy_s", static_cast<double>(c.medium_busy_ns) * 1e-9, 3)
+          .Add("expired", frames_expired_));
 }
 
 Status SimServer::PublishDrone(std::size_t i, bool with_camera) {
@@ -169,6 +340,7 @@ void SimServer::TakeOut(std::size_t i, const PlanEntry& e) {
   }
   lockstep_.SetOut(i, true);
   world_.SetOut(i, true);
+  if (channel_) channel_->SetOut(i, true);
   slot.leader = false;
   slot.camera_frame = false;
   slot.radio_in.clear();
@@ -205,6 +377,10 @@ void SimServer::CarryOut(const PlanEntry& e) {
       break;
     case PlanEntry::Kind::kRadio:
     case PlanEntry::Kind::kPartition:
+      if (channel_) {
+        RadioFault(static_cast<std::size_t>(&e - options_.plan.schedule.data()), true);
+        break;
+      }
       Log(LogEvent(t, options_.node, "radio_fault_ignored").Add("fault", e.name)
               .Add("kind", e.kind == PlanEntry::Kind::kRadio ? "impair" : "partition")
               .Add("reason", "radio.model netem: the fault sidecars carry radio faults"));
@@ -220,8 +396,18 @@ void SimServer::RunSchedule(std::int64_t now_ns) {
     if (!lockstep_.out(i) || slot.back_ns < 0 || slot.back_ns > now_ns) continue;
     lockstep_.SetOut(i, false);
     world_.SetOut(i, false);
+    if (channel_) channel_->SetOut(i, false);
     slot.back_ns = -1;
     Log(LogEvent(world_.time_s(), options_.node, "drone_back").Add("drone", world_.drone_name(i)).Add("fault", slot.out_fault));
+  }
+  for (std::size_t n = 0; n < radio_ends_.size();) {
+    if (radio_ends_[n].at_ns > now_ns) {
+      ++n;
+      continue;
+    }
+    const std::size_t entry = radio_ends_[n].entry;
+    radio_ends_.erase(radio_ends_.begin() + static_cast<std::ptrdiff_t>(n));
+    RadioFault(entry, false);
   }
   const std::vector<PlanEntry>& schedule = options_.plan.schedule;
   while (next_entry_ < schedule.size() && schedule[next_entry_].at_ns <= now_ns) CarryOut(schedule[next_entry_++]);
@@ -230,6 +416,7 @@ void SimServer::RunSchedule(std::int64_t now_ns) {
 Status SimServer::RunStep(const std::atomic<bool>& stop) {
   const std::uint64_t step = world_.step_count();
   lockstep_.BeginStep(step, clock_.NowNs());
+  if (channel_) TakeDeliveries(world_.time_ns());
   for (std::size_t i = 0; i < world_.drone_count(); ++i) {
     if (lockstep_.out(i)) continue;
     Slot& slot = slots_[i];
@@ -274,6 +461,7 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   world_inbox_.clear();
   transport_.TakeWorldCommands(&world_inbox_);
   for (const WorldCommandInput& c : world_inbox_) Apply(c);
+  if (channel_) SendRadio(world_.time_ns());
   RunSchedule(world_.time_ns());
   world_.Step();
   for (auto it = timed_.begin(); it != timed_.end();) {
@@ -314,6 +502,7 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
             .Add("steps", static_cast<std::uint64_t>(world_.step_count()))
             .Add("late", line.late)
             .Add("lost", static_cast<std::uint64_t>(lockstep_.lost_count())));
+    if (channel_) LogChannel();
   }
   return Ok{};
 }

@@ -15,6 +15,11 @@
 //      sim/world_command topic (arrival order), track each drone's raft_leader flag, then carry out
 //      the radio plan's entries due at t_k (drone_out/back, world commands, raft_leader targets);
 //   4. World::Step() to t_{k+1}.
+// With a radio profile (--radio-model channel) the server hosts the simulated radio channel
+// (swarmbox::channel::Channel): at the start of step k it takes the channel's deliveries up to
+// t_k into each drone's sample (radio_in, in delivery order), then gives it the drones' true
+// positions at t_k; after the answers' world commands it hands each answer's radio_out frames to
+// the channel with send time t_k (drone order, then seq), before the plan's entries of t_k.
 // While waiting, every drone's sample is published again every 200 ms (agents that join late, a
 // lost message, and a keepalive for the drones that answered, so a long wait does not look like a
 // stalled server to them). Duplicate and stale commands are dropped (Lockstep).
@@ -27,6 +32,7 @@
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <span>
@@ -34,6 +40,7 @@
 #include <vector>
 
 #include "radio_plan.hpp"
+#include "swarmbox/channel/channel.hpp"
 #include "swarmbox/bus/messages.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/physics/camera_image.hpp"
@@ -135,7 +142,19 @@ struct SimServerOptions {
   bool cameras = true;
   std::string node = "physics";              // logfmt node name
   RadioPlan plan;                            // simulated-time faults (--radio-plan); empty: none
+  // radio.model channel: the radio profile (ValidateRadioProfile passed) and the channel's seed;
+  // nullopt = netem (radio_out ignored, radio_in empty). The plan's impairments must pass
+  // channel::ValidateImpairment (CheckChannelPlan).
+  std::optional<channel::RadioProfile> radio_profile;
+  std::uint64_t radio_seed = 1;
 };
+
+// The plan's impairments against what the channel carries out (its distributions): the first one
+// it cannot, at its entry.
+Status CheckChannelPlan(const RadioPlan& plan);
+channel::Impairment ToChannelImpairment(const PlanImpairment& impairment);
+// The world's obstacle boxes as the channel's (same centre, size and yaw).
+std::vector<channel::Box> ChannelObstacles(const WorldConfig& world);
 
 class SimServer {
  public:
@@ -148,6 +167,9 @@ class SimServer {
 
   // One control step (publish, wait for answers, step). Exposed for tests.
   Status RunStep(const std::atomic<bool>& stop);
+
+  // radio.model channel: the channel's counters; nullptr with netem.
+  const channel::ChannelStats* channel_stats() const { return channel_ ? &channel_->stats() : nullptr; }
 
  private:
   class PrintingSink final : public EventSink {
@@ -184,6 +206,11 @@ class SimServer {
   void CarryOut(const PlanEntry& e);
   void TakeOut(std::size_t i, const PlanEntry& e);
   std::optional<std::size_t> RaftLeader() const;
+  void TakeDeliveries(std::int64_t until_ns);
+  void SendRadio(std::int64_t now_ns);
+  void RadioFault(std::size_t entry, bool on);
+  void SetImpairmentOf(std::size_t drone);
+  void LogChannel();
   void Apply(const WorldCommandInput& cmd);
   void Log(const LogEvent& event);
 
@@ -202,6 +229,25 @@ class SimServer {
   WindConfig base_wind_;
   std::vector<Slot> slots_;
   std::size_t next_entry_ = 0;               // options_.plan.schedule[next_entry_] is due next
+
+  // radio.model channel.
+  struct RadioEnd {
+    std::int64_t at_ns;
+    std::size_t entry;                       // a radio or partition entry of the plan
+  };
+  struct StoredFrame {
+    std::int64_t sent_ns = 0;
+    bus::RadioFrame frame;
+  };
+  std::optional<channel::Channel> channel_;
+  std::vector<channel::Vec3d> positions_;
+  std::vector<channel::Delivery> deliveries_;
+  std::deque<StoredFrame> frames_;           // by token: frames_[token - first_token_]
+  std::uint64_t first_token_ = 0;
+  std::uint64_t frames_expired_ = 0;         // deliveries whose frame was dropped (see kFrameKeepNs)
+  std::vector<RadioEnd> radio_ends_;
+  std::vector<std::vector<std::size_t>> impairments_;  // per drone: its active radio entries
+  std::vector<int> blocked_;                 // per (from, to): active partitions blocking it
   std::int64_t pace_origin_wall_ns_ = -1;
   std::int64_t pace_origin_sim_ns_ = 0;
   std::optional<ClockProgress> progress_;  // empty: clock_every_s = 0

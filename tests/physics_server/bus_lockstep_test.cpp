@@ -1,5 +1,7 @@
 // Lockstep over the real sim bus (DDS on loopback): the server loop with BusTransport against a
 // fake agent in this process that answers for drone "a" always and for drone "b" only at first.
+// radio.model channel: a's answers carry a broadcast frame, a world command and raft_leader; b
+// hears the frames in its samples' radio_in.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -8,6 +10,7 @@
 #include <thread>
 
 #include "bus_transport.hpp"
+#include "swarmbox/channel/radio_profile.hpp"
 #include "server_thread.hpp"
 #include "sim_server.hpp"
 #include "test_util.hpp"
@@ -46,6 +49,9 @@ void RunLockstepOverBus(const std::string& backend) {
   so.max_sim_time_s = 1.0;
   so.lockstep.timeout_ns = 300'000'000;
   so.lockstep.join_timeout_ns = 20'000'000'000;
+  auto profile = channel::LoadRadioProfile(testing::TrialsDir() + "/radios/wifi_5ghz_mesh.yaml");
+  ASSERT_TRUE(profile.ok()) << profile.error().ToString();
+  so.radio_profile = *profile;
   testing::ServerThread server(*world, **transport, so, out);
 
   constexpr std::uint64_t kBAnswersUntil = 50;  // then drone b's agent "dies"
@@ -53,19 +59,40 @@ void RunLockstepOverBus(const std::string& backend) {
   bus::ActuatorCommand cmd;
   cmd.armed = true;
   cmd.motor_throttle.assign(4, u);
-  std::uint64_t a_answered = 0, images = 0;
+  std::uint64_t a_answered = 0, images = 0, a_camera_flags = 0, b_heard = 0;
   bool b_valid_gps = false;
+  bus::RadioFrame frame;
+  frame.from = "a";
+  frame.size_bytes = 120;
+  frame.state_msg.resize(1);
+  frame.state_msg[0].drone = "a";
   while (!server.done()) {
     if ((*sub_a)->TakeFor(s, std::chrono::milliseconds(5))) {
       cmd.drone = "a";
       cmd.step = s.step;
+      cmd.raft_leader = true;
+      frame.seq = s.step + 1;
+      cmd.radio_out = {frame};
+      cmd.world.clear();
+      if (s.step == 10) cmd.world.push_back({1, 0, "a", "gps_dropout", {0.1}});
       ASSERT_TRUE((*pub_a)->Publish(cmd).ok());
+      cmd.radio_out.clear();
+      cmd.world.clear();
+      cmd.raft_leader = false;
+      if (s.camera_frame) ++a_camera_flags;
       ++a_answered;
       EXPECT_TRUE(s.imu.valid);
       EXPECT_NEAR(s.imu.accel_m_s2[2], 9.8, 0.5);
     }
     while ((*sub_b)->Take(s)) {
       b_valid_gps = b_valid_gps || s.gps.valid;
+      for (const bus::RadioFrame& f : s.radio_in) {
+        ++b_heard;
+        EXPECT_EQ(f.from, "a");
+        EXPECT_GT(f.delivered_ns, f.sent_ns);
+        EXPECT_LE(f.delivered_ns, s.sim_time_ns);
+        EXPECT_GT(f.delivered_ns, s.sim_time_ns - 4'000'000);
+      }
       if (s.step >= kBAnswersUntil) continue;
       cmd.drone = "b";
       cmd.step = s.step;
@@ -85,6 +112,8 @@ void RunLockstepOverBus(const std::string& backend) {
   EXPECT_GE(a_answered, 250u);
   EXPECT_GE(images, 4u);  // 5 frames in 1 s (the first may go before discovery completes)
   EXPECT_TRUE(b_valid_gps);
+  EXPECT_GE(a_camera_flags, 5u);  // 5 frames in 1 s, each announced by its step's sample
+  EXPECT_GE(b_heard, 40u);        // a's frames of steps 0..49 (b answers, and hears, until 50)
   EXPECT_TRUE(world->Truth(1).lost);
   EXPECT_FALSE(world->Truth(0).lost);
   // a kept hovering on its agent's commands; b lost its motors at t = 0.2 s and fell.
@@ -94,6 +123,7 @@ void RunLockstepOverBus(const std::string& backend) {
   std::fclose(out);
   EXPECT_NE(log.find("t=0.200 node=physics event=drone_lost a=b"), std::string::npos) << log;
   EXPECT_EQ(log.find("a=a"), std::string::npos) << log;
+  EXPECT_NE(log.find("t=0.040 node=physics event=world_command command=gps_dropout target=a"), std::string::npos) << log;
 }
 
 TEST(BusLockstep, FakeAgentKeepsItsDroneAndASilentOneIsLostCycloneDds) { RunLockstepOverBus("cyclonedds"); }

@@ -31,7 +31,7 @@ TEST(RadioPlan, ParsesTheContractExampleSortedByTime) {
   ]
 })");
   ASSERT_TRUE(plan.ok()) << plan.error().ToString();
-  EXPECT_EQ(plan->seed, 42u);
+  EXPECT_EQ(plan->seed, std::optional<std::uint64_t>(42));
   ASSERT_TRUE(plan->mesh.has_value());
   EXPECT_EQ(*plan->mesh, (PlanImpairment{100, 20, "normal", 0.05, 0, 0}));
   ASSERT_EQ(plan->schedule.size(), 4u);
@@ -61,6 +61,7 @@ TEST(RadioPlan, ParsesTheContractExampleSortedByTime) {
 TEST(RadioPlan, AnEmptyPlanHasNoMeshAndNoSchedule) {
   auto plan = Parse("{}");
   ASSERT_TRUE(plan.ok()) << plan.error().ToString();
+  EXPECT_FALSE(plan->seed.has_value());
   EXPECT_FALSE(plan->mesh.has_value());
   EXPECT_TRUE(plan->schedule.empty());
 }

@@ -42,6 +42,32 @@ TEST(ServerProcess, BadWorldFileIsReportedWithPositionAndExitTwo) {
   EXPECT_EQ(out, "swarmbox-physics: " + world + ":2:18: world: 'mean_m_s': expected a list of 3 values\n");
 }
 
+// The radio plan and the radio model: bad input is refused before the bus is touched.
+TEST(ServerProcess, BadRadioPlanOrRadioModelExitsTwoWithTheReason) {
+  const std::vector<std::string> base = {SWARMBOX_PHYSICS_EXE, "--world", testing::WorldPath("open_field"), "--drone",
+                                         "a:x500:0,0,0"};
+  auto run = [&](std::vector<std::string> extra, const std::string& name) {
+    std::vector<std::string> argv = base;
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    LoggedChild c(argv, LogPath(name));
+    EXPECT_EQ(c.Wait(60s), 2) << name;
+    return c.ReadLog();
+  };
+  const std::string plan = WriteTemp("bad_plan.json", "{\"schedule\": [\n  {\"at_s\": 1, \"name\": \"k\", \"kind\": "
+                                                     "\"drone_out\", \"mode\": \"kill\", \"targets\": [\"b\"]}]}\n");
+  EXPECT_EQ(run({"--radio-plan", plan}, "plan_unknown_drone"),
+            "swarmbox-physics: " + plan + ":2:3: entry 'k': unknown drone 'b'\n");
+  EXPECT_EQ(run({"--radio-model", "channel"}, "channel_without_profile"),
+            "swarmbox-physics: --radio-model channel needs --radio-profile PATH\n");
+  const std::string pareto = WriteTemp("pareto_plan.json", "{\"mesh\": {\"delay_ms\": 10, \"jitter_ms\": 5, "
+                                                         "\"distribution\": \"pareto\"}}\n");
+  const std::string out = run({"--radio-model", "channel", "--radio-profile", testing::TrialsDir() + "/radios/wifi_5ghz_mesh.yaml",
+                               "--radio-plan", pareto},
+                              "channel_pareto");
+  EXPECT_EQ(out.rfind("swarmbox-physics: " + pareto + ": mesh: ", 0), 0u) << out;
+  EXPECT_NE(out.find("pareto"), std::string::npos) << out;
+}
+
 TEST(ServerProcess, BadAirframeFileIsReportedWithPositionAndExitTwo) {
   // The shipped x500 with one bad value.
   std::ifstream shipped(testing::AirframePath("x500"));
