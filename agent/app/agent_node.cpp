@@ -7,6 +7,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/radio/channel_radio.hpp"
+#include "swarmbox/radio/dds_radio.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -19,7 +21,36 @@ std::string Seconds(double s) {
   return buf;
 }
 
+// A wall-clock wait of `total`, spent in slices: each slice counts at most its own length, so a
+// process stopped or starved in the middle of one (SIGSTOP, docker pause) resumes with the rest
+// of its budget instead of a deadline long gone.
+class WaitBudget {
+ public:
+  explicit WaitBudget(std::chrono::milliseconds total) : left_(total) {}
+  bool spent() const { return left_ <= std::chrono::milliseconds(0); }
+  std::chrono::milliseconds Slice(std::chrono::milliseconds max) const { return std::min(left_, max); }
+  void Spend(std::chrono::steady_clock::duration elapsed, std::chrono::milliseconds slice) {
+    left_ -= std::min(std::chrono::duration_cast<std::chrono::milliseconds>(elapsed), slice);
+    if (elapsed < std::chrono::milliseconds(1)) left_ -= std::chrono::milliseconds(1);  // always progress
+  }
+
+ private:
+  std::chrono::milliseconds left_;
+};
+
+double SteadyS() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
 }  // namespace
+
+Result<RadioModel> ParseRadioModel(std::string_view text) {
+  if (text == "netem") return RadioModel::kNetem;
+  if (text == "channel") return RadioModel::kChannel;
+  return Error(ErrorCode::kInvalidArgument, "--radio-model '" + std::string(text) + "': expected channel or netem");
+}
+
+std::string_view RadioModelName(RadioModel model) { return model == RadioModel::kChannel ? "channel" : "netem"; }
 
 flight::SensorSample FromBus(const bus::SensorSample& m) {
   flight::SensorSample s;
@@ -43,7 +74,8 @@ flight::SensorSample FromBus(const bus::SensorSample& m) {
 
 Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   SWARMBOX_TRY(bus::ValidateDroneName(o.name));
-  if (o.mesh && o.mesh_domain == o.sim_domain) {
+  const bool channel = o.radio_model == RadioModel::kChannel;
+  if (o.mesh && !channel && o.mesh_domain == o.sim_domain) {
     return Error(ErrorCode::kInvalidArgument,
                  "the sim and mesh buses need different DDS domain ids (both are " + std::to_string(o.sim_domain) + ")");
   }
@@ -117,33 +149,45 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   auto pub = node->sim_->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic(o.name), bus::Qos::kLockstep);
   if (!pub) return pub.error().Context("publishing actuator commands");
   node->actuator_pub_ = std::move(*pub);
-  if (o.mesh) {
+  const bool sar = o.mission.kind == MissionKind::kSar;
+  if (o.mesh && channel) {
+    // No mesh domain at all: every frame rides the lockstep to the physics server's channel.
+    node->radio_ = std::make_unique<radio::ChannelRadio>(o.name);
+  } else if (o.mesh) {
     auto mesh = bus::Participant::Create({.backend = o.middleware,
                                           .domain_id = o.mesh_domain,
                                           .interface = o.mesh_interface,
                                           .writer_linger_ms = kNoLinger});
     if (!mesh) return mesh.error().Context("joining the mesh bus");
     node->mesh_ = std::move(*mesh);
-    auto sp = node->mesh_->CreatePublisher<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState);
-    if (!sp) return sp.error().Context("publishing drone state");
-    node->state_pub_ = std::move(*sp);
+    radio::DdsRadioOptions ro;
+    ro.members = o.raft.members;
+    ro.raft = o.raft.members.size() > 1;
+    ro.pings = o.ping_every_ms > 0 && o.raft.members.size() > 1;
+    ro.hear_states = sar;
+    auto dds = radio::DdsRadio::Create(*node->mesh_, o.name, ro);
+    if (!dds) return dds.error().Context("starting the mesh radio");
+    node->radio_ = std::move(*dds);
   }
   if (!o.raft.members.empty()) {
     if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--members (Raft) needs the mesh bus (drop --no-mesh)");
     RaftHostOptions ro = o.raft;
     ro.self = o.name;
     ro.election_timeout_ms = ElectionTimeoutMsFor(o.mission, o.raft.election_timeout_ms);
-    auto raft = RaftHost::Start(ro, *node->mesh_, o.log);
+    // Raft's clock: simulated seconds (channel: the radio's clock is the lockstep's, from 0), or
+    // wall seconds since now (netem: the steady clock). Its lines carry the simulated time.
+    node->raft_clock_ = std::make_unique<RadioClock>(*node->radio_, channel ? 0 : node->radio_->now_ns());
+    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_);
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
   }
   if (o.ping_every_ms < 0) return Error(ErrorCode::kInvalidArgument, "--ping-every-ms must be >= 0");
-  if (o.mesh && o.ping_every_ms > 0 && o.raft.members.size() > 1) {
-    radio::RadioLinkOptions ro;
-    ro.ping_every = std::chrono::milliseconds(o.ping_every_ms);
-    auto link = radio::RadioLink::Create(*node->mesh_, o.name, o.raft.members, ro);
-    if (!link) return link.error().Context("starting the radio link");
-    node->radio_ = std::move(*link);
+  if (node->radio_ && o.ping_every_ms > 0 && o.raft.members.size() > 1) {
+    radio::LinkProbeOptions po;
+    po.ping_every = std::chrono::milliseconds(o.ping_every_ms);
+    auto probe = radio::LinkProbe::Create(o.name, o.raft.members, po, radio::RadioTime(node->radio_->now_ns()));
+    if (!probe) return probe.error().Context("starting the link probe");
+    node->probe_ = std::move(*probe);
   }
   if (o.mission.kind == MissionKind::kSar) {
     auto host = MissionHost::Create(mc);
@@ -154,15 +198,6 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
       if (!cam) return cam.error().Context("subscribing to the camera");
       node->camera_sub_ = std::move(*cam);
     }
-    auto wc = node->sim_->CreatePublisher<bus::WorldCommand>(bus::kWorldCommandTopic, bus::Qos::kLockstep);
-    if (!wc) return wc.error().Context("publishing world commands");
-    node->world_pub_ = std::move(*wc);
-    auto det = node->mesh_->CreatePublisher<bus::Detection>(bus::kDetectionTopic, bus::Qos::kRadio);
-    if (!det) return det.error().Context("publishing detections");
-    node->detection_pub_ = std::move(*det);
-    auto peers = node->mesh_->CreateSubscriber<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState);
-    if (!peers) return peers.error().Context("subscribing to drone states");
-    node->peers_sub_ = std::move(*peers);
   }
   return node;
 }
@@ -172,25 +207,120 @@ AgentNode::AgentNode(AgentOptions options, flight::FlightController fc, FlightPl
   cmd_.drone = options_.name;
   cmd_.motor_throttle.assign(fc_.mixer().rotor_count(), 0.0);
   state_.drone = options_.name;
+  frames_.reserve(64);
+  lines_.reserve(8);
 }
+
+// Members are destroyed in reverse order of declaration: the Raft host and the probe before the
+// radio, the radio before the mesh participant.
+AgentNode::~AgentNode() = default;
 
 void AgentNode::Log(const LogEvent& e) {
   std::fprintf(options_.log, "%s\n", e.str().c_str());
   std::fflush(options_.log);
 }
 
-void AgentNode::HandleSample(const bus::SensorSample& msg) {
+bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
+  image_count_ = 0;
+  if (!camera_sub_) return true;
+  bool have_step = false;
+  auto take = [&](bool wait, std::chrono::milliseconds slice) {
+    if (image_count_ == images_.size()) images_.emplace_back();
+    bus::CameraImage& img = images_[image_count_];
+    const bool took = wait ? camera_sub_->TakeFor(img, slice) : camera_sub_->Take(img);
+    if (!took) return false;
+    ++image_count_;
+    have_step = have_step || img.sim_time_ns == msg.sim_time_ns;
+    return true;
+  };
+  while (take(false, {})) {
+  }
+  // The physics server publishes a step's frame before its sample; DDS may still hand the sample
+  // over first (two readers). Wait for it: what the camera saw at t_k is part of step k.
+  if (!msg.camera_frame || have_step) return true;
+  WaitBudget budget(options_.camera_timeout);  // waiting time, as Run()'s
+  while (!have_step) {
+    if (options_.stop != nullptr && *options_.stop != 0) return false;
+    if (budget.spent()) {
+      // Past the liveness bound: look once more, then go on without it.
+      while (!have_step && take(false, {})) {
+      }
+      if (!have_step) {
+        Log(LogEvent(t_s_, options_.name, "camera_missing")
+                .Add("step", static_cast<std::int64_t>(msg.step))
+                .Add("after_wall_s", std::chrono::duration<double>(options_.camera_timeout).count(), 1));
+      }
+      return true;
+    }
+    const auto slice = budget.Slice(std::chrono::milliseconds(50));
+    const auto start = std::chrono::steady_clock::now();
+    (void)take(true, slice);
+    budget.Spend(std::chrono::steady_clock::now() - start, slice);
+  }
+  return true;
+}
+
+void AgentNode::OnRaftPayload(std::span<const std::uint8_t> bytes) {
+  if (raft_) raft_->OnPayload(bytes);
+}
+
+void AgentNode::OnPing(const bus::RadioFrame& frame) {
+  if (probe_) probe_->OnFrame(frame, *radio_);
+}
+
+void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& frame) {
+  if (!mission_) return;
+  PeerState p;
+  p.name = state.drone;
+  p.mode = state.mode;
+  p.position_m = V(state.position_enu_m);
+  p.velocity_m_s = V(state.velocity_enu_m_s);
+  p.sim_time_s = static_cast<double>(state.sim_time_ns) * 1e-9;
+  // netem: when it arrived on the steady clock, for the lost-member rule's wall-clock silence.
+  // channel: none (NaN): the simulated clock alone decides.
+  if (options_.radio_model == RadioModel::kNetem) p.received_wall_s = static_cast<double>(frame.delivered_ns) * 1e-9;
+  mission_->OnPeerState(p);
+}
+
+void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::RadioFrame& /*frame*/) {
+  // Heard and counted (dispatched_.detection): sightings reach the swarm through Raft; the
+  // broadcast detections are for recorders and a ground station.
+}
+
+Status AgentNode::ServeRadioBetweenSteps() {
+  frames_.clear();
+  radio_->TakeReceived(bus::SensorSample{}, &frames_);  // netem: the sample is not looked at
+  DispatchFrames(frames_, options_.name, *this, &dispatched_);
+  if (raft_) {
+    if (Status s = raft_->Step(); !s) return s.error().Context("raft stopped");
+  }
+  if (probe_) {
+    lines_.clear();
+    probe_->Step(radio::RadioTime(radio_->now_ns()), t_s_, *radio_, &lines_);
+    for (const LogEvent& line : lines_) Log(line);
+  }
+  return Ok{};
+}
+
+Status AgentNode::HandleSample(const bus::SensorSample& msg) {
   using flight::FlightEventKind;
   t_s_ = static_cast<double>(msg.sim_time_ns) * 1e-9;
-  if (raft_) raft_->SetSimTime(t_s_);
+  sim_clock_.Set(t_s_);
+  // a. The camera frame of this step.
+  if (!TakeCamera(msg)) return Ok{};  // stop requested: Run() logs it
+  cmd_.world.clear();
+  // b. What the radio delivered for this step, in delivery order.
+  frames_.clear();
+  if (radio_) {
+    radio_->TakeReceived(msg, &frames_);
+    DispatchFrames(frames_, options_.name, *this, &dispatched_);
+  }
+  // c. Flight, Raft, the link probe, the mission or plan, the state broadcast.
   const flight::ActuatorOutput& out = fc_.Step(FromBus(msg));
   cmd_.step = msg.step;
   cmd_.sim_time_ns = msg.sim_time_ns;
   cmd_.armed = out.armed;
   for (std::size_t i = 0; i < cmd_.motor_throttle.size(); ++i) cmd_.motor_throttle[i] = out.armed ? out.u[i] : 0.0;
-  if (Status s = actuator_pub_->Publish(cmd_); !s) {
-    Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "actuator").Add("reason", s.error().ToString()));
-  }
 
   FlightStatus st;
   st.t_s = t_s_;
@@ -210,8 +340,13 @@ void AgentNode::HandleSample(const bus::SensorSample& msg) {
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
     Log(le);
   }
-  if (radio_) {
-    for (const LogEvent& line : radio_->Poll(std::chrono::steady_clock::now(), t_s_)) Log(line);
+  if (raft_) {
+    if (Status s = raft_->Step(); !s) return s.error().Context("raft stopped");
+  }
+  if (probe_) {
+    lines_.clear();
+    probe_->Step(radio::RadioTime(radio_->now_ns()), t_s_, *radio_, &lines_);
+    for (const LogEvent& line : lines_) Log(line);
   }
   if (mission_) {
     StepMission(msg, st.hover);
@@ -226,68 +361,71 @@ void AgentNode::HandleSample(const bus::SensorSample& msg) {
       Log(LogEvent(t_s_, options_.name, "plan_complete"));
     }
   }
-  // Our state for the neighbours, 5 Hz of simulated time.
-  if (state_pub_ && t_s_ >= next_state_s_) {
-    next_state_s_ = t_s_ + 0.2;
-    const flight::StateEstimate& est = fc_.estimate();
-    ++state_.seq;
-    state_.sim_time_ns = msg.sim_time_ns;
-    state_.wall_time_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                              std::chrono::system_clock::now().time_since_epoch()).count();
-    state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
-    state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
-    state_.heading_rad = flight::YawOf(est.att);
-    if (mission_) {
-      state_.mode = mission_->mode();
-      state_.battery_fraction = mission_->battery_fraction();
-    } else {
-      state_.mode = std::string(flight::FlightModeName(fc_.mode()));
-    }
-    (void)state_pub_->Publish(state_);
+  BroadcastState(msg);
+  // d. The step's answer: motors, world commands, Raft leadership, the radio's frames.
+  if (radio_) {
+    radio_->Flush(&cmd_);
+  } else {
+    cmd_.radio_out.clear();
   }
+  cmd_.raft_leader = raft_ && raft_->service().is_leader();
+  if (Status s = actuator_pub_->Publish(cmd_); !s) {
+    Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "actuator").Add("reason", s.error().ToString()));
+  }
+  return Ok{};
+}
+
+void AgentNode::BroadcastState(const bus::SensorSample& msg) {
+  // Our state for the neighbours, 5 Hz of simulated time.
+  if (!radio_ || t_s_ < next_state_s_) return;
+  next_state_s_ = t_s_ + 0.2;
+  const flight::StateEstimate& est = fc_.estimate();
+  ++state_.seq;
+  state_.sim_time_ns = msg.sim_time_ns;
+  // Informational only (recorders); never read on the channel, where it stays 0 so a frame's
+  // bytes do not depend on the wall clock.
+  state_.wall_time_ns = options_.radio_model == RadioModel::kNetem
+                            ? std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                  std::chrono::system_clock::now().time_since_epoch())
+                                  .count()
+                            : 0;
+  state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+  state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  state_.heading_rad = flight::YawOf(est.att);
+  if (mission_) {
+    state_.mode = mission_->mode();
+    state_.battery_fraction = mission_->battery_fraction();
+  } else {
+    state_.mode = std::string(flight::FlightModeName(fc_.mode()));
+  }
+  out_frame_ = bus::RadioFrame{};
+  out_frame_.state_msg.push_back(state_);
+  radio_->Send(std::move(out_frame_));
 }
 
 void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
   const flight::StateEstimate& est = fc_.estimate();
   mission_->RecordEstimate(t_s_, est);
-  // Wall times for the leader's lost-member rule (at rtf 0 a radio delay is many simulated s).
-  const auto wall_s = [] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-  };
-  while (peers_sub_->Take(peer_)) {
-    PeerState p;
-    p.name = peer_.drone;
-    p.mode = peer_.mode;
-    p.position_m = V(peer_.position_enu_m);
-    p.velocity_m_s = V(peer_.velocity_enu_m_s);
-    p.sim_time_s = static_cast<double>(peer_.sim_time_ns) * 1e-9;
-    p.received_wall_s = wall_s();
-    mission_->OnPeerState(p);
-  }
-  if (camera_sub_) {
-    while (camera_sub_->Take(image_)) {
-      if (image_.encoding != "bgr8" && image_.encoding != "rgb8") continue;  // the detector needs colour
-      if (image_.data.size() < static_cast<std::size_t>(image_.height_px) * image_.row_stride_bytes) continue;
-      cv::Mat bgr(static_cast<int>(image_.height_px), static_cast<int>(image_.width_px), CV_8UC3, image_.data.data(),
-                  image_.row_stride_bytes);
-      if (image_.encoding == "rgb8") cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
-      const bus::CameraIntrinsics& k = image_.intrinsics;
-      mission_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image_.sim_time_ns) * 1e-9);
-    }
-  }
-  if (t_s_ >= next_committed_s_) {  // a copy of the committed state, 10 Hz of simulated time
-    next_committed_s_ = t_s_ + 0.1;
-    committed_ = raft_->service().mission();
-    leader_ = raft_->service().is_leader();
+  for (std::size_t i = 0; i < image_count_; ++i) {
+    bus::CameraImage& image = images_[i];
+    if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
+    if (image.data.size() < static_cast<std::size_t>(image.height_px) * image.row_stride_bytes) continue;
+    cv::Mat bgr(static_cast<int>(image.height_px), static_cast<int>(image.width_px), CV_8UC3, image.data.data(),
+                image.row_stride_bytes);
+    if (image.encoding == "rgb8") cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
+    const bus::CameraIntrinsics& k = image.intrinsics;
+    mission_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image.sim_time_ns) * 1e-9);
   }
   MissionHostInput in;
   in.t_s = t_s_;
-  in.wall_s = wall_s();
+  // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
+  // time and nothing of the wall clock may feed a decision (NaN: the simulated rule alone).
+  if (options_.radio_model == RadioModel::kNetem) in.wall_s = SteadyS();
   in.dt_s = options_.control_dt_s;
   in.flight_mode = fc_.mode();
   in.estimate = &est;
-  in.mission = &committed_;
-  in.is_leader = leader_;
+  in.mission = &raft_->service().mission();  // the committed state as of this step's Raft calls
+  in.is_leader = raft_->service().is_leader();
   in.hover_event = hover_event;
   in.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
   const MissionHostOutput& out = mission_->Step(in);
@@ -309,19 +447,19 @@ void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
     }
     // The announced load as the hover thrust estimator's prior (it corrects a refused hook).
     fc_.SetPayloadMass(out.payload.action == swarm::PayloadAction::kAttach ? out.payload.mass_kg : 0.0);
-    if (Status s = world_pub_->Publish(world_cmd_); !s) {
-      Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "world_command").Add("reason", s.error().ToString()));
-    }
+    cmd_.world.push_back(world_cmd_);  // applied by the physics server before it steps the world
   }
   for (const swarm::GroundDetection& d : out.detections) {
-    ++detection_.seq;
-    detection_.from = options_.name;
-    detection_.sim_time_ns = static_cast<std::int64_t>(d.capture_time_s * 1e9);
-    detection_.label = "victim";
-    detection_.confidence = d.confidence;
-    detection_.position_enu_m = {d.position_m.x(), d.position_m.y(), d.position_m.z()};
-    detection_.position_sigma_m = d.sigma_m;
-    (void)detection_pub_->Publish(detection_);  // best effort, as the radio
+    bus::Detection det;
+    det.from = options_.name;
+    det.sim_time_ns = static_cast<std::int64_t>(d.capture_time_s * 1e9);
+    det.label = "victim";
+    det.confidence = d.confidence;
+    det.position_enu_m = {d.position_m.x(), d.position_m.y(), d.position_m.z()};
+    det.position_sigma_m = d.sigma_m;
+    out_frame_ = bus::RadioFrame{};
+    out_frame_.detection_msg.push_back(std::move(det));
+    radio_->Send(std::move(out_frame_));  // best effort, as the radio
   }
 }
 
@@ -335,6 +473,7 @@ Status AgentNode::Run() {
           .Add("sim_domain", options_.sim_domain)
           .Add("sim_interface", options_.sim_interface)
           .Add("middleware", options_.middleware)
+          .Add("radio_model", RadioModelName(options_.radio_model))
           .Add("mission", MissionKindName(options_.mission.kind))
           .Add("plan", mission_ ? std::string("-") : options_.plan)
           .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
@@ -342,26 +481,33 @@ Status AgentNode::Run() {
   bool got_any = false;
   while (true) {
     const auto timeout = got_any ? options_.stall_timeout : options_.first_sample_timeout;
-    // Wait in slices so the Raft host is polled (storage failure, proposals) and a stop request
-    // seen while no sample comes.
-    const auto wait_until = std::chrono::steady_clock::now() + timeout;
+    // Wait in slices so a stop request is seen while no sample comes. The timeout counts the time
+    // spent waiting, each slice at most its own length: a process stopped (SIGSTOP, docker pause)
+    // or starved in the middle of a slice does not find its deadline gone when it resumes.
+    WaitBudget budget(timeout);
     bool took = false;
     while (true) {
       if (options_.stop != nullptr && *options_.stop != 0) {
         Log(LogEvent(t_s_, options_.name, "stopped").Add("reason", "signal"));
         return Ok{};
       }
-      if (raft_) {
-        if (Status s = raft_->Poll(); !s) return s.error().Context("raft stopped");
+      if (budget.spent()) {
+        // Look at the topic once more before giving up (a sample may have come in the last slice).
+        took = sensor_sub_->Take(msg);
+        break;
       }
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(wait_until - std::chrono::steady_clock::now());
-      if (left <= std::chrono::milliseconds(0)) break;
-      const bool poll = raft_ || options_.stop != nullptr;
-      const auto slice = poll ? std::min(left, std::chrono::milliseconds(50)) : left;
+      // netem: the mesh lives on the wall clock whether or not the lockstep moves (a drone the
+      // physics server is waiting for, a stalled server): Raft and the probe go on between
+      // samples, every 10 ms without one.
+      const bool idle_radio = options_.radio_model == RadioModel::kNetem && radio_ && (raft_ || probe_);
+      const auto slice = budget.Slice(idle_radio ? std::chrono::milliseconds(10) : std::chrono::milliseconds(50));
+      const auto start = std::chrono::steady_clock::now();
       if (sensor_sub_->TakeFor(msg, slice)) {
         took = true;
         break;
       }
+      budget.Spend(std::chrono::steady_clock::now() - start, slice);
+      if (idle_radio) SWARMBOX_TRY(ServeRadioBetweenSteps());
     }
     if (!took) {
       const double secs = std::chrono::duration<double>(timeout).count();
@@ -389,7 +535,7 @@ Status AgentNode::Run() {
     got_any = true;
     have_step_ = true;
     last_step_ = msg.step;
-    HandleSample(msg);
+    SWARMBOX_TRY(HandleSample(msg));
     if (options_.exit_when_done && Done()) return Ok{};
   }
 }

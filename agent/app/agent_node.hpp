@@ -1,13 +1,31 @@
 // AgentNode: the thin node around the flight stack (STYLE.md 1). It joins the sim bus (sensor
 // samples in, actuator commands out, lockstep: every sample is answered with a command for the
-// same step) and the mesh bus (its DroneState for the neighbours; with raft.members, the drone's
-// Raft node on the mission state, raft_host.hpp), runs FlightController on the
-// samples' simulated time, lets a SetpointSource (the built-in plan now, the mission layer later)
-// drive it, and prints logfmt events (`t=12.340 node=drone_3 event=hover ...`).
+// same step), talks to the other drones through a radio::MeshRadio (its DroneState for the
+// neighbours; with raft.members, the drone's Raft node on the mission state, raft_host.hpp, and
+// the link probe), runs FlightController on the samples' simulated time, lets a SetpointSource
+// (the built-in plan, or the SAR mission) drive it, and prints logfmt events
+// (`t=12.340 node=drone_3 event=hover ...`).
 //
 //   AgentOptions o;  o.name = "drone_3";  o.airframe_path = "trials/airframes/x500.yaml";
+//   o.radio_model = RadioModel::kChannel;       // the physics server's simulated channel
 //   auto node = AgentNode::Create(o);           // bad airframe/plan/bus config: an error
 //   Status s = node->Run();                     // until the plan is done and samples stop
+//
+// One lockstep step k (sample k at t_k; design17 "The time line of one lockstep step"):
+//   a. with sample.camera_frame, the CameraImage of step k is taken first (waited for; a wall
+//      clock liveness bound of camera_timeout, event=camera_missing when it fires);
+//   b. radio.TakeReceived -> DispatchFrames (radio_dispatch.hpp): Raft payloads to the Raft
+//      service, pings/pongs to the link probe, DroneStates to the mission's peers;
+//   c. flight step, Raft ticks and the link probe on the radio's clock, the mission (or plan)
+//      step, the DroneState broadcast (5 Hz of simulated time), detections;
+//   d. radio.Flush into the ActuatorCommand, cmd.world = this step's world commands (payload
+//      attach/release), cmd.raft_leader; publish.
+// Clocks: with RadioModel::kChannel every decision runs on the samples' simulated time (the
+// radio's clock is the lockstep's; nothing happens between samples); with kNetem the radio, Raft
+// and the probe run on the steady clock, also between samples (every 10 ms while waiting: the
+// mesh does not wait for the lockstep), and the SAR leader's lost-member rule also wants a
+// wall-clock silence (mission_host.hpp).
+// Wall clocks otherwise only bound liveness: the first sample, a stall, a missing camera frame.
 #pragma once
 
 #include <chrono>
@@ -15,19 +33,33 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <span>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "flight_plan.hpp"
 #include "mission_host.hpp"
 #include "mission_options.hpp"
+#include "radio_dispatch.hpp"
 #include "raft_host.hpp"
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/flight/flight_controller.hpp"
-#include "swarmbox/radio/radio_link.hpp"
+#include "swarmbox/radio/link_probe.hpp"
+#include "swarmbox/radio/mesh_radio.hpp"
 
 namespace swarmbox::agent {
+
+// --radio-model: how the agent reaches the other drones.
+enum class RadioModel {
+  kNetem,    // the mesh DDS domain (radio::DdsRadio), impaired by netem on the wall clock
+  kChannel,  // no mesh domain: frames ride the lockstep to the physics server's simulated channel
+};
+// "netem" | "channel" (kInvalidArgument otherwise), and back.
+Result<RadioModel> ParseRadioModel(std::string_view text);
+std::string_view RadioModelName(RadioModel model);
 
 struct AgentOptions {
   std::string name;                     // drone name, [A-Za-z0-9_]+
@@ -37,7 +69,8 @@ struct AgentOptions {
   int sim_domain = 0;
   std::string mesh_interface = "lo";
   int mesh_domain = 1;
-  bool mesh = true;                     // join the mesh (publish DroneState)
+  bool mesh = true;                     // have a radio (publish DroneState); false: --no-mesh
+  RadioModel radio_model = RadioModel::kNetem;  // channel: mesh_interface/mesh_domain unused
   std::string plan = "takeoff:5,hover:10,land";
   double preflight_s = 2.0;             // on the ground after the estimator is ready [sim s]
   bool has_start = false;               // the take-off spot (ground point under the drone)
@@ -47,27 +80,31 @@ struct AgentOptions {
   double control_dt_s = 0.004;          // the physics server's lockstep period [s]
   std::chrono::milliseconds first_sample_timeout{10000};  // wall clock
   std::chrono::milliseconds stall_timeout{5000};          // wall clock, after the first sample
+  std::chrono::milliseconds camera_timeout{5000};         // wall clock, a flagged camera frame
   bool exit_when_done = false;          // exit once the plan is complete (landed)
   std::FILE* log = stdout;              // logfmt events
   // Set (e.g. by a SIGTERM handler) to end Run() cleanly (Ok, event=stopped reason=signal) within
   // ~50 ms; nullptr: never. Must outlive the node.
   const volatile std::sig_atomic_t* stop = nullptr;
-  // Raft on the mesh (raft_host.hpp): on when raft.members is not empty (needs `mesh`).
+  // Raft over the radio (raft_host.hpp): on when raft.members is not empty (needs `mesh`); its
+  // timings on the radio's clock (simulated ms with channel, wall ms with netem).
   // raft.self is set from `name`.
   RaftHostOptions raft;
   // What to fly (mission_options.hpp): the plan above, or the SAR mission (needs raft.members).
   MissionOptions mission;
-  // Radio link measurement (agent/radio RadioLink): with the mesh and raft.members, ping every
-  // other member every ping_every_ms of wall-clock time and log event=link per peer; 0 = off.
+  // Radio link measurement (agent/radio LinkProbe): with a radio and raft.members, ping every
+  // other member every ping_every_ms of the radio's clock and log event=link per peer; 0 = off.
   int ping_every_ms = 200;
 };
 
-class AgentNode {
+class AgentNode final : private FrameHandler {
  public:
   static Result<std::unique_ptr<AgentNode>> Create(const AgentOptions& options);
+  ~AgentNode() override;
   // Serves the lockstep until the samples stop (ok if the plan was completed by then) or, with
   // exit_when_done, until the plan is complete. kUnavailable when no sample ever arrives.
-  // Also ends (Ok) when *options.stop is set. With Raft: also ends (the service's error) when the Raft storage failed (raft_failed()).
+  // Also ends (Ok) when *options.stop is set. With Raft: also ends (the service's error) when
+  // the Raft storage failed (raft_failed()).
   Status Run();
   // True once the Raft service stopped because its storage failed: the agent must exit 1.
   bool raft_failed() const { return raft_ && raft_->stopped(); }
@@ -75,35 +112,46 @@ class AgentNode {
  private:
   AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan);
   void Log(const LogEvent& e);
-  void HandleSample(const bus::SensorSample& msg);
-  // --mission sar: feeds the mission host (camera, peers, committed state) and carries out what
-  // it asks (setpoint, payload world command, proposals, detections, events).
+  // Takes the camera frames waiting; with msg.camera_frame, waits (camera_timeout) for the one
+  // of this step. false: stop requested while waiting.
+  bool TakeCamera(const bus::SensorSample& msg);
+  Status HandleSample(const bus::SensorSample& msg);
+  // netem only, while waiting for a sample: the radio's deliveries dispatched, Raft's ticks and
+  // the probe on the wall clock (as the mesh does not wait for the lockstep). Raft's error.
+  Status ServeRadioBetweenSteps();
+  // --mission sar: feeds the mission host (camera, committed state) and carries out what it
+  // asks (setpoint, payload world command, proposals, detections, events).
   void StepMission(const bus::SensorSample& msg, bool hover_event);
+  void BroadcastState(const bus::SensorSample& msg);
   bool Done() const;  // the plan is complete, or the SAR mission is (and this drone is down)
+  // FrameHandler (radio_dispatch.hpp).
+  void OnRaftPayload(std::span<const std::uint8_t> bytes) override;
+  void OnPing(const bus::RadioFrame& frame) override;
+  void OnState(const bus::DroneState& state, const bus::RadioFrame& frame) override;
+  void OnDetection(const bus::Detection& detection, const bus::RadioFrame& frame) override;
 
   AgentOptions options_;
   flight::FlightController fc_;
   FlightPlan plan_;
   std::unique_ptr<bus::Participant> sim_;
-  std::unique_ptr<bus::Participant> mesh_;
+  std::unique_ptr<bus::Participant> mesh_;  // netem only
   std::unique_ptr<bus::Subscriber<bus::SensorSample>> sensor_sub_;
   std::unique_ptr<bus::Publisher<bus::ActuatorCommand>> actuator_pub_;
-  std::unique_ptr<bus::Publisher<bus::DroneState>> state_pub_;
-  std::unique_ptr<RaftHost> raft_;  // after mesh_: destroyed before the participant
-  std::unique_ptr<radio::RadioLink> radio_;  // likewise
+  std::unique_ptr<radio::MeshRadio> radio_;   // after mesh_: destroyed before the participant
+  SimClock sim_clock_;                        // the agent's simulated seconds (event lines)
+  std::unique_ptr<RadioClock> raft_clock_;    // the radio's clock for Raft
+  std::unique_ptr<RaftHost> raft_;            // after radio_ and the clocks: destroyed first
+  std::unique_ptr<radio::LinkProbe> probe_;
+  std::vector<bus::RadioFrame> frames_;       // this step's deliveries
+  DispatchCounts dispatched_;
+  std::vector<LogEvent> lines_;
   // --mission sar only.
   std::unique_ptr<MissionHost> mission_;
   std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;
-  std::unique_ptr<bus::Publisher<bus::WorldCommand>> world_pub_;
-  std::unique_ptr<bus::Publisher<bus::Detection>> detection_pub_;
-  std::unique_ptr<bus::Subscriber<bus::DroneState>> peers_sub_;
-  bus::CameraImage image_;
-  bus::DroneState peer_;
+  std::vector<bus::CameraImage> images_;      // taken this step (buffers reused)
+  std::size_t image_count_ = 0;
   bus::WorldCommand world_cmd_;
-  bus::Detection detection_;
-  raft::MissionState committed_;   // refreshed from the Raft service at each mission tick
-  bool leader_ = false;
-  double next_committed_s_ = 0.0;
+  bus::RadioFrame out_frame_;
   bus::ActuatorCommand cmd_;
   bus::DroneState state_;
   bool have_step_ = false;

@@ -11,7 +11,10 @@
 //                                   on restart so the node rejoins with its durable log
 //       [--raft-tick-ms 50] [--raft-heartbeat-ms 100] [--raft-election-timeout-ms 500]
 //       [--propose-every-ms N]      diagnostic: the leader proposes the next demo mission command
-//                                   every N wall ms (0 = never), until the mission layer does
+//                                   every N ms (0 = never), until the mission layer does
+// Every *-ms timing is on the radio's clock: simulated ms with --radio-model channel (the physics
+// server's simulated channel carries the mesh traffic through the lockstep; no mesh DDS domain),
+// wall ms with --radio-model netem (default: the mesh DDS domain, --mesh-domain/--mesh-interface).
 // Raft events (event=leader_elected, mission_state, victim_confirmed, raft_stopped) are printed
 // on stdout with the agent's simulated time `t`. The mesh domain must differ from the sim one.
 //
@@ -21,7 +24,7 @@
 //       [--inference-latency-ms 40]
 // Usage errors (unknown flag, bad value, a bad combination) exit 2, as the rest of bad input.
 // With --members, the radio link is measured (agent/radio): each agent pings every other member
-// every --ping-every-ms (default 200, 0 = off) and logs event=link per peer every 2 s.
+// every --ping-every-ms (default 200, 0 = off) and logs event=link per peer every 2 s (radio clock).
 #include <CLI/CLI.hpp>
 
 #include <csignal>
@@ -68,7 +71,9 @@ int main(int argc, char** argv) {
   app.add_option("--sim-domain", o.sim_domain, "DDS domain id of the sim bus")->check(CLI::Range(0, 232))->capture_default_str();
   app.add_option("--mesh-interface", o.mesh_interface, "Network interface of the mesh (radio) bus")->capture_default_str();
   app.add_option("--mesh-domain", o.mesh_domain, "DDS domain id of the mesh bus")->check(CLI::Range(0, 232))->capture_default_str();
-  app.add_flag("--no-mesh", no_mesh, "Do not join the mesh bus");
+  app.add_flag("--no-mesh", no_mesh, "No radio: do not join the mesh bus (netem) nor send on the channel");
+  std::string radio_model = "netem";
+  app.add_option("--radio-model", radio_model, "How the drones talk: netem (the mesh DDS domain, wall clock) or channel (the physics server's simulated channel through the lockstep; no mesh domain, --mesh-* ignored)")->capture_default_str();
   app.add_option("--plan", o.plan, "Built-in flight plan: takeoff:H, hover:S, goto:X:Y:Z[:YAW_DEG], velocity:VX:VY:VZ:S, land")->capture_default_str();
   app.add_option("--preflight", o.preflight_s, "Simulated seconds on the ground before take-off")->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--start", start, "Take-off spot x,y,z [m, ENU] (the trial's pose); default: first GPS fix");
@@ -81,11 +86,11 @@ int main(int argc, char** argv) {
   app.add_option("--members", members, "Raft: every drone of the trial, comma-separated (incl. this one); Raft is off when absent");
   app.add_option("--raft-dir", o.raft.raft_dir, "Raft: WAL directory (default /tmp/swarmbox-raft/<name>)");
   app.add_option("--seed", o.raft.seed, "Raft: the trial's seed (election timeouts)")->capture_default_str();
-  app.add_option("--raft-tick-ms", o.raft.tick_ms, "Raft: wall-clock tick [ms]")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--raft-tick-ms", o.raft.tick_ms, "Raft: tick on the radio's clock (simulated ms with channel, wall ms with netem) [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--raft-heartbeat-ms", o.raft.heartbeat_ms, "Raft: heartbeat, a multiple of the tick [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--raft-election-timeout-ms", o.raft.election_timeout_ms, "Raft: election timeout, a multiple of the tick, > heartbeat [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--propose-every-ms", o.raft.propose_every_ms, "Raft diagnostic: the leader proposes a demo mission command every N ms (0 = never)")->check(CLI::NonNegativeNumber)->capture_default_str();
-  app.add_option("--ping-every-ms", o.ping_every_ms, "Radio: ping each other member every N wall ms and log event=link per peer (needs --members; 0 = off)")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--ping-every-ms", o.ping_every_ms, "Radio: ping each other member every N ms of the radio's clock (simulated with channel, wall with netem) and log event=link per peer (needs --members; 0 = off)")->check(CLI::NonNegativeNumber)->capture_default_str();
   std::string mission_kind = "plan";
   app.add_option("--mission", mission_kind, "What to fly: plan (the built-in --plan) or sar (the SAR mission; needs --members and --world)")->capture_default_str();
   app.add_option("--world", o.mission.world_path, "SAR: the world file (only its geofence and home are read)");
@@ -126,6 +131,12 @@ int main(int argc, char** argv) {
     }
     o.raft.members = std::move(*list);
     if (o.raft.raft_dir.empty()) o.raft.raft_dir = swarmbox::agent::DefaultRaftDir(o.name);
+  }
+  if (auto model = swarmbox::agent::ParseRadioModel(radio_model)) {
+    o.radio_model = *model;
+  } else {
+    std::fprintf(stderr, "swarmbox-agent: %s\n", model.error().ToString().c_str());
+    return 2;
   }
   if (auto kind = swarmbox::agent::ParseMissionKind(mission_kind)) {
     o.mission.kind = *kind;

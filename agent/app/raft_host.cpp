@@ -5,6 +5,7 @@
 
 #include "swarmbox/bus/topics.hpp"
 #include "swarmbox/mission/demo_mission.hpp"
+#include "swarmbox/mission/raft_envelope.hpp"
 
 namespace swarmbox::agent {
 
@@ -32,11 +33,27 @@ Result<std::vector<std::string>> ParseMembers(std::string_view text, std::string
 
 std::string DefaultRaftDir(std::string_view name) { return "/tmp/swarmbox-raft/" + std::string(name); }
 
-Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options, bus::Participant& mesh,
-                                                  std::FILE* log) {
+std::string RestampLine(std::string_view line, double t_s) {
+  if (line.substr(0, 2) != "t=") return std::string(line);
+  const std::size_t end = line.find(' ');
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "t=%.3f", t_s);
+  return std::string(buf) + std::string(end == std::string_view::npos ? std::string_view() : line.substr(end));
+}
+
+void RadioTransport::Send(const std::string& to, std::span<const std::uint8_t> bytes) {
+  bus::RadioFrame f;
+  f.to = to;
+  f.raft_msg.push_back(mission::WrapRaftPayload(self_, to, bytes));
+  radio_.Send(std::move(f));
+}
+
+Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options, radio::MeshRadio& radio,
+                                                  const raft::Clock& clock, std::FILE* log,
+                                                  const raft::Clock* event_clock) {
   if (options.propose_every_ms < 0) return Error(ErrorCode::kInvalidArgument, "--propose-every-ms must be >= 0");
   if (options.raft_dir.empty()) return Error(ErrorCode::kInvalidArgument, "--raft-dir must not be empty");
-  std::unique_ptr<RaftHost> host(new RaftHost(options));
+  std::unique_ptr<RaftHost> host(new RaftHost(options, radio, clock));
   mission::RaftServiceConfig rc;
   rc.driver.self = options.self;
   rc.driver.members = options.members;
@@ -46,37 +63,31 @@ Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options
   rc.driver.election_timeout_ms = options.election_timeout_ms;
   rc.data_dir = options.raft_dir;
   rc.file_system = options.file_system;
-  // One fprintf per line: stdio's lock keeps it whole next to the control loop's events.
-  auto service = mission::RaftService::Start(rc, mesh, host->clock_, [log](const std::string& line) {
-    std::fprintf(log, "%s\n", line.c_str());
+  auto service = mission::RaftService::Start(rc, host->transport_, clock, [log, event_clock](const std::string& line) {
+    const std::string out = event_clock != nullptr ? RestampLine(line, event_clock->NowS()) : line;
+    std::fprintf(log, "%s\n", out.c_str());
     std::fflush(log);
   });
   if (!service) return service.error().Context("starting raft");
   host->service_ = std::move(*service);
-  const auto now = std::chrono::steady_clock::now();
-  host->next_propose_ = now + std::chrono::milliseconds(options.propose_every_ms);
+  host->next_propose_s_ = clock.NowS() + options.propose_every_ms * 1e-3;
   return host;
 }
 
-Status RaftHost::Poll() {
-  using namespace std::chrono;
-  if (stopped_) return service_->health();
-  const auto now = steady_clock::now();
-  if (now < next_poll_) return Ok{};
-  next_poll_ = now + milliseconds(20);
-  if (service_->WaitStopped(milliseconds(0))) {
-    stopped_ = true;
-    return service_->health();
-  }
-  if (options_.propose_every_ms > 0 && now >= next_propose_) {
-    next_propose_ = now + milliseconds(options_.propose_every_ms);
-    if (service_->is_leader()) {
-      if (auto cmd = mission::NextDemoCommand(service_->mission(), service_->self())) {
-        (void)service_->Propose(*cmd);  // kUnavailable (leadership just lost): the next round retries
+Status RaftHost::Step() {
+  SWARMBOX_TRY(service_->Tick());
+  if (options_.propose_every_ms > 0) {
+    const double now = clock_.NowS();
+    if (now >= next_propose_s_) {
+      next_propose_s_ = now + options_.propose_every_ms * 1e-3;
+      if (service_->is_leader()) {
+        if (auto cmd = mission::NextDemoCommand(service_->mission(), service_->self())) {
+          (void)service_->Propose(*cmd);  // kUnavailable (leadership just lost): the next round retries
+        }
       }
     }
   }
-  return Ok{};
+  return service_->health();
 }
 
 }  // namespace swarmbox::agent

@@ -1,36 +1,40 @@
-// RaftHost: the agent's Raft node on the mesh radio (agent/mission RaftService), with the
-// agent's simulated time as the event clock and a diagnostic proposal loop.
+// RaftHost: the agent's Raft node (agent/mission's passive RaftService) driven by the control
+// loop on the radio's clock, its messages carried by the agent's MeshRadio, plus the storage
+// failure check and a diagnostic proposal loop.
 //
-// The swarm agrees on its mission through Raft (agent/raft); RaftService runs the node on its own
-// thread over the agent's mesh bus::Participant. RaftHost adds what the agent needs around it:
-//   - SimClock: the agent's simulated seconds (set by the control loop, read by the service
-//     thread), so raft events carry the same `t` as the flight events;
-//   - Poll(): called from the control loop; reports a stopped service (storage failed: the agent
-//     must exit 1) and, with propose_every_ms > 0, proposes the next demo mission command
-//     (mission/demo_mission.hpp) when this node leads, until the SAR mission layer replaces it.
+// The swarm agrees on its mission through Raft (agent/raft). The service has no thread and no
+// bus: every lockstep step the node hands it the Raft payloads the radio delivered (OnPayload,
+// in delivery order), then calls Step(), which runs the ticks due by the Raft clock and, with
+// propose_every_ms > 0, proposes the next demo mission command (mission/demo_mission.hpp) when
+// this node leads. Its messages go out as RadioFrames (raft_msg: one RaftMessage {from, to, term,
+// payload}) through radio.Send, inside those calls.
 //
-//   RaftHostOptions r;  r.self = "drone_1";  r.members = {"drone_1", "drone_2", "drone_3"};
-//   r.raft_dir = DefaultRaftDir("drone_1");  r.seed = 7;  r.propose_every_ms = 300;
-//   auto host = RaftHost::Start(r, *mesh, stdout);   // kInvalidArgument: bad members/timings
-//   host->SetSimTime(t_s);                           // control loop, every sample
-//   if (Status s = host->Poll(); !s) exit(1);        // storage failed
+//   RadioClock clock(*radio, 0);                       // channel: simulated seconds
+//   RadioClock clock(*radio, radio->now_ns());         // netem: wall seconds since start
+//   auto host = RaftHost::Start(options, *radio, clock, stdout, &sim_clock);
+//   for (payload delivered this step) host->OnPayload(payload);
+//   if (Status s = host->Step(); !s) exit(1);           // storage failed
 //
-// Thread-safety: SetSimTime/Poll from one thread (the control loop); the clock is atomic.
-// Ownership: `mesh` and `log` must outlive the host; destroy the host before the participant.
+// Clocks: `clock` times Raft (ticks, heartbeats, election timeouts, the proposal loop):
+// RadioClock over the radio's now_ns, i.e. the lockstep's simulated time with radio.model channel
+// and the steady clock with netem. The event lines (event=leader_elected, ...) carry `t` from
+// `event_clock` when given (the agent's simulated seconds, so that every line of an agent is on one
+// axis in both models), else from `clock`.
+// Thread-safety: none; the control loop calls everything. Ownership: `radio`, `clock`,
+// `event_clock` and `log` must outlive the host.
 #pragma once
 
-#include <atomic>
-#include <chrono>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/mission/raft_service.hpp"
+#include "swarmbox/radio/mesh_radio.hpp"
 #include "swarmbox/raft/file_system.hpp"
 #include "swarmbox/raft/node_driver.hpp"
 
@@ -41,7 +45,7 @@ struct RaftHostOptions {
   std::vector<std::string> members;  // every drone of the trial, including self, same on all
   std::string raft_dir;              // WAL and snapshot directory (created when missing)
   std::uint64_t seed = 1;            // the trial's seed
-  int tick_ms = 50;                  // wall-clock tick of the service thread [ms]
+  int tick_ms = 50;                  // Raft tick on the radio's clock [ms]
   int heartbeat_ms = 100;            // multiple of tick_ms [ms]
   int election_timeout_ms = 500;     // multiple of tick_ms, > heartbeat_ms [ms]
   int propose_every_ms = 0;          // 0: never; N: the leader proposes a demo command every N ms
@@ -56,41 +60,67 @@ Result<std::vector<std::string>> ParseMembers(std::string_view text, std::string
 // the same machine or container; give --raft-dir a volume to survive the container).
 std::string DefaultRaftDir(std::string_view name);
 
-// The agent's simulated seconds as a raft::Clock (written by the control loop, read by the
-// service thread).
+// The agent's simulated seconds as a raft::Clock (set by the control loop).
 class SimClock final : public raft::Clock {
  public:
-  double NowS() const override { return t_s_.load(std::memory_order_relaxed); }
-  void Set(double t_s) { t_s_.store(t_s, std::memory_order_relaxed); }
+  double NowS() const override { return t_s_; }
+  void Set(double t_s) { t_s_ = t_s; }
 
  private:
-  std::atomic<double> t_s_{0.0};
+  double t_s_ = 0.0;
+};
+
+// A MeshRadio's clock (now_ns) as a raft::Clock, in seconds since `origin_ns` on that clock.
+class RadioClock final : public raft::Clock {
+ public:
+  RadioClock(const radio::MeshRadio& radio, std::int64_t origin_ns) : radio_(radio), origin_ns_(origin_ns) {}
+  double NowS() const override { return static_cast<double>(radio_.now_ns() - origin_ns_) * 1e-9; }
+
+ private:
+  const radio::MeshRadio& radio_;
+  std::int64_t origin_ns_;
+};
+
+// raft::Transport onto a MeshRadio: Send(to, bytes) is one frame to `to` carrying one
+// RaftMessage {from = self, to, term (peeked from the bytes), payload}.
+class RadioTransport final : public raft::Transport {
+ public:
+  RadioTransport(radio::MeshRadio& radio, std::string self) : radio_(radio), self_(std::move(self)) {}
+  void Send(const std::string& to, std::span<const std::uint8_t> bytes) override;
+
+ private:
+  radio::MeshRadio& radio_;
+  std::string self_;
 };
 
 class RaftHost {
  public:
-  // Opens the WAL (replaying it) and starts the service on `mesh`; events are logfmt lines on
-  // `log`. Errors: kInvalidArgument for bad members/timings, the storage's or the bus's errors.
-  static Result<std::unique_ptr<RaftHost>> Start(const RaftHostOptions& options, bus::Participant& mesh,
-                                                 std::FILE* log);
-  ~RaftHost() = default;  // stops the service (thread, radio, storage)
+  // Opens the WAL (replaying it) and starts the service; events are logfmt lines on `log`.
+  // Errors: kInvalidArgument for bad members/timings, the storage's errors.
+  static Result<std::unique_ptr<RaftHost>> Start(const RaftHostOptions& options, radio::MeshRadio& radio,
+                                                 const raft::Clock& clock, std::FILE* log,
+                                                 const raft::Clock* event_clock = nullptr);
 
-  void SetSimTime(double t_s) { clock_.Set(t_s); }
-  // Cheap when called often (looks at the service at most every 20 ms of wall-clock time). Ok
-  // while running; the service's stop error (storage failed) once it stopped, on every later call.
-  Status Poll();
-  bool stopped() const { return stopped_; }
+  // A delivered RaftMessage payload addressed to this drone, in delivery order.
+  void OnPayload(std::span<const std::uint8_t> bytes) { service_->OnPayload(bytes); }
+  // The ticks due by the clock, then the proposal loop. Ok while running; the service's stop
+  // error (storage failed) once it stopped, on every later call.
+  Status Step();
+  bool stopped() const { return service_->stopped(); }
   mission::RaftService& service() { return *service_; }
 
  private:
-  explicit RaftHost(RaftHostOptions options) : options_(std::move(options)) {}
+  RaftHost(RaftHostOptions options, radio::MeshRadio& radio, const raft::Clock& clock)
+      : options_(std::move(options)), transport_(radio, options_.self), clock_(clock) {}
 
   RaftHostOptions options_;
-  SimClock clock_;                                 // before service_: outlives it
-  std::unique_ptr<mission::RaftService> service_;  // destroyed first
-  std::chrono::steady_clock::time_point next_poll_{};
-  std::chrono::steady_clock::time_point next_propose_{};
-  bool stopped_ = false;
+  RadioTransport transport_;  // before service_: outlives it
+  const raft::Clock& clock_;
+  std::unique_ptr<mission::RaftService> service_;
+  double next_propose_s_ = 0.0;
 };
+
+// `line` with its leading "t=<number>" replaced by `t_s` (3 decimals); unchanged without one.
+std::string RestampLine(std::string_view line, double t_s);
 
 }  // namespace swarmbox::agent

@@ -2,11 +2,13 @@
 // the issue: swarmbox-physics and three swarmbox-agent processes over the bus on loopback (a
 // private DDS domain per run), all take off, hover and land.
 #include <gtest/gtest.h>
+#include <signal.h>
 
 #include <unistd.h>
 
 #include <chrono>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "support/files.hpp"
@@ -98,6 +100,37 @@ TEST(AgentIntegration, PhysicsAndThreeAgentsTakeOffHoverAndLand) {
   const std::string plog = physics.ReadLog();
   EXPECT_EQ(plog.find("event=crash"), std::string::npos) << plog;
   EXPECT_EQ(plog.find("event=drone_lost"), std::string::npos) << plog;
+}
+
+// SIGSTOP for longer than the stall timeout, then SIGCONT: the agent resumes the lockstep (its
+// stall timeout counts time spent waiting, and it looks at the topic once more) and completes
+// its plan. The physics server waits for it (--step-timeout 60).
+TEST(AgentIntegration, SurvivesASigstopLongerThanItsStallTimeout) {
+  const std::string dir = MakeTempDir("swarmbox_agent_it_");
+  ASSERT_FALSE(dir.empty());
+  const int d = DomainBase();
+  LoggedChild physics({SWARMBOX_PHYSICS_BIN, "--world", SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml", "--rtf", "1",
+                       "--domain", std::to_string(d), "--max-sim-time", "40", "--no-cameras", "--seed", "7",
+                       "--truth", "", "--step-timeout", "60", "--drone", "drone_1:x500:0,0,0"},
+                      dir + "/physics.log");
+  ASSERT_GT(physics.pid(), 0);
+  LoggedChild agent({SWARMBOX_AGENT_BIN, "--name", "drone_1", "--airframe", SWARMBOX_TRIALS_DIR "/airframes/x500.yaml",
+                     "--sim-domain", std::to_string(d), "--mesh-domain", std::to_string(d + 1), "--start", "0,0,0",
+                     "--plan", "takeoff:3,hover:2,land", "--stall-timeout", "2", "--sample-timeout", "30",
+                     "--exit-when-done"},
+                    dir + "/agent.log");
+  ASSERT_GT(agent.pid(), 0);
+  ASSERT_TRUE(agent.WaitForLog("event=takeoff", 60s)) << agent.ReadLog();
+  ASSERT_TRUE(agent.Signal(SIGSTOP));
+  std::this_thread::sleep_for(4s);  // twice the stall timeout
+  ASSERT_TRUE(agent.Signal(SIGCONT));
+  EXPECT_EQ(agent.Wait(120s), 0) << agent.ReadLog();
+  const std::string log = agent.ReadLog();
+  EXPECT_TRUE(HasEvent(log, "drone_1", "plan_complete")) << log;
+  EXPECT_FALSE(HasEvent(log, "drone_1", "samples_stopped")) << log;
+  physics.Terminate();
+  (void)physics.Wait(20s);
+  EXPECT_EQ(physics.ReadLog().find("event=drone_lost"), std::string::npos) << physics.ReadLog();
 }
 
 }  // namespace

@@ -4,7 +4,8 @@
 // both victims through its cameras, agree on them through Raft, carry both home and end with
 // event=mission_complete inside a bounded simulated time, with no collision or crash.
 // Prints the figures: time to first detection, to each confirmation, mission time (sim and wall).
-// DDS domains 216-223 (a pair per process id).
+// DDS domains 216-223 (a pair per process id). AgentSarMission.OnTheSimulatedChannelFourAgents...
+// flies the same mission with --radio-model channel (the sim domain only: the pair's second).
 //
 // AgentSarMission.AScoutKilledMidSearchHasItsSectorSweptByTheOthers (issue #8): the same swarm,
 // one scout (not the leader) SIGKILLed after its first event=sector_progress; the leader must
@@ -84,14 +85,21 @@ const std::vector<Drone> kDrones = {{"scout_1", "x500", "0,0,0", ""},
                                     {"lifter", "x8_heavy", "0,-10,0", "stretcher"}};
 
 // swarmbox-physics (open field, rtf 0, seed 42) and one swarmbox-agent --mission sar per drone,
-// on DDS domains `domain` (sim) and `domain` + 1 (mesh).
+// on DDS domains `domain` (sim) and `domain` + 1 (mesh); with `channel`, the physics server hosts
+// the simulated radio channel (wifi_5ghz_mesh) and there is no mesh domain.
 class SarSwarm {
  public:
-  SarSwarm(std::vector<Drone> drones, int domain, const std::string& dir) : drones_(std::move(drones)), dir_(dir) {
+  SarSwarm(std::vector<Drone> drones, int domain, const std::string& dir, bool channel = false)
+      : drones_(std::move(drones)), dir_(dir) {
     const std::string world = SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml";
     std::vector<std::string> phys = {SWARMBOX_PHYSICS_BIN, "--world", world, "--rtf", "0", "--domain",
                                      std::to_string(domain), "--max-sim-time", "600", "--seed", "42",
                                      "--truth", dir + "/truth.csv"};
+    if (channel) {
+      for (const char* a : {"--radio-model", "channel", "--radio-profile", SWARMBOX_TRIALS_DIR "/radios/wifi_5ghz_mesh.yaml"}) {
+        phys.push_back(a);
+      }
+    }
     std::string members;
     for (const Drone& dr : drones_) {
       phys.push_back("--drone");
@@ -113,6 +121,10 @@ class SarSwarm {
       if (*dr.payload != '\0') {
         argv.push_back("--payload");
         argv.push_back(dr.payload);
+      }
+      if (channel) {
+        argv.push_back("--radio-model");
+        argv.push_back("channel");
       }
       agents_.push_back(std::make_unique<Child>(argv, dir + "/" + dr.name + ".log"));
     }
@@ -188,10 +200,10 @@ class SarSwarm {
   double wall_s_ = 0;
 };
 
-TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
+void ExpectBothVictimsRescued(const char* label, int domain, bool channel) {
   const std::string dir = MakeTempDir("swarmbox_sar_it_");
   ASSERT_FALSE(dir.empty());
-  SarSwarm swarm(kDrones, DomainBase(), dir);
+  SarSwarm swarm(kDrones, domain, dir, channel);
   ASSERT_TRUE(swarm.started());
   const std::optional<Line> complete = swarm.Run(1s, 780s, nullptr);
   const double wall_s = swarm.wall_s();
@@ -228,13 +240,24 @@ TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
     const auto s = Events(swarm.Log(i), "sighting_reported");
     if (!s.empty()) first_detection = std::min(first_detection, s.front().t_s);
   }
-  std::printf("sar_mission first_detection_s=%.1f", first_detection);
+  std::printf("%s first_detection_s=%.1f", label, first_detection);
   for (const Line& c : confirmed) {
     std::printf(" confirm_%s_s=%.1f", FindField(c.fields, "id").value_or("?").c_str(), c.t_s);
   }
   std::printf(" mission_s=%.1f wall_s=%.1f\n", complete->t_s, wall_s);
   std::fflush(stdout);
-  if (HasFailure()) std::fprintf(stderr, "logs in %s\n", dir.c_str());
+  if (::testing::Test::HasFailure()) std::fprintf(stderr, "logs in %s\n", dir.c_str());
+}
+
+TEST(AgentSarMission, FourAgentsFindAndRescueBothVictimsThenComplete) {
+  ExpectBothVictimsRescued("sar_mission", DomainBase(), false);
+}
+
+// The same mission with --radio-model channel: every mesh frame through the physics server's
+// simulated channel, every decision on simulated time (the sim domain only: the first case's
+// mesh domain, whose mesh/* topics never meet sim/* ones).
+TEST(AgentSarMission, OnTheSimulatedChannelFourAgentsRescueBothVictims) {
+  ExpectBothVictimsRescued("sar_mission_channel", DomainBase() + 1, true);
 }
 
 

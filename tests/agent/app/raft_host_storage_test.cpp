@@ -1,30 +1,27 @@
-// The agent's Raft host over a real mesh participant (Cyclone DDS on lo, domain 215): a one-drone
-// cluster elects itself, the diagnostic loop proposes and commits, then an injected fsync failure
-// stops the service and Poll() reports it (swarmbox-agent then exits 1).
+// The agent's Raft host driven as the control loop drives it, on a ChannelRadio and simulated
+// time (no DDS, no wall clock): a one-drone cluster elects itself, the diagnostic loop proposes
+// and commits, the event lines carry the simulated time, then an injected fsync failure stops
+// the service and Step() reports it (swarmbox-agent then exits 1).
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <thread>
+#include <vector>
 
 #include "raft_host.hpp"
 #include "support/files.hpp"
 #include "support/flaky_file_system.hpp"
+#include "swarmbox/radio/channel_radio.hpp"
 
 namespace swarmbox::agent {
 namespace {
 
-using namespace std::chrono_literals;
 using swarmbox::testing::FlakyFileSystem;
 
 TEST(RaftHostService, ProposesWhenLeaderAndReportsAStorageFailure) {
   const std::string dir = swarmbox::testing::MakeTempDir("swarmbox_agent_raft_host_");
   ASSERT_FALSE(dir.empty());
-  auto mesh = bus::Participant::Create({.backend = "cyclonedds", .domain_id = 215, .interface = "lo"});
-  ASSERT_TRUE(mesh) << mesh.error().ToString();
   std::FILE* log = std::tmpfile();
   ASSERT_NE(log, nullptr);
   FlakyFileSystem fs;
@@ -35,33 +32,39 @@ TEST(RaftHostService, ProposesWhenLeaderAndReportsAStorageFailure) {
   o.seed = 3;
   o.propose_every_ms = 50;
   o.file_system = &fs;
-  auto host = RaftHost::Start(o, **mesh, log);
+  radio::ChannelRadio radio("drone_1");
+  RadioClock clock(radio, 0);
+  SimClock events;
+  auto host = RaftHost::Start(o, radio, clock, log, &events);
   ASSERT_TRUE(host) << host.error().ToString();
-  (*host)->SetSimTime(4.25);
 
-  // Given a running node, Poll() drives the proposal loop: the demo mission commits.
-  const auto deadline = std::chrono::steady_clock::now() + 10s;
-  while ((*host)->service().commit_index() < 2 && std::chrono::steady_clock::now() < deadline) {
-    ASSERT_TRUE((*host)->Poll());
-    std::this_thread::sleep_for(5ms);
-  }
+  // Given a running node stepped every 4 ms of simulated time, the demo mission commits.
+  std::vector<bus::RadioFrame> frames;
+  bus::SensorSample sample;
+  std::int64_t t_ns = 0;
+  auto step = [&] {
+    t_ns += 4'000'000;
+    sample.sim_time_ns = t_ns;
+    frames.clear();
+    radio.TakeReceived(sample, &frames);
+    events.Set(static_cast<double>(t_ns) * 1e-9);
+    return (*host)->Step();
+  };
+  while ((*host)->service().commit_index() < 2 && t_ns < 20'000'000'000) ASSERT_TRUE(step());
   ASSERT_GE((*host)->service().commit_index(), 2u);
   EXPECT_FALSE((*host)->stopped());
+  const double elected_by_s = static_cast<double>(t_ns) * 1e-9;
+  EXPECT_LT(elected_by_s, 5.0);  // a 500..1000 ms election timeout, then two 50 ms proposals
 
-  // When the WAL's fsync fails, then Poll() returns the injected error and the host is stopped.
+  // When the WAL's fsync fails, then Step() returns the injected error and the host is stopped.
   fs.fail_sync = true;
-  Status polled;
-  const auto deadline2 = std::chrono::steady_clock::now() + 10s;
-  while (polled && std::chrono::steady_clock::now() < deadline2) {
-    polled = (*host)->Poll();
-    std::this_thread::sleep_for(5ms);
-  }
-  ASSERT_FALSE(polled);
-  EXPECT_NE(polled.error().ToString().find("injected"), std::string::npos) << polled.error().ToString();
+  Status stepped;
+  while (stepped && t_ns < 40'000'000'000) stepped = step();
+  ASSERT_FALSE(stepped);
+  EXPECT_NE(stepped.error().ToString().find("injected"), std::string::npos) << stepped.error().ToString();
   EXPECT_TRUE((*host)->stopped());
-  EXPECT_FALSE((*host)->Poll());  // stays stopped
+  EXPECT_FALSE(step());  // stays stopped
 
-  // The events went to the agent's log with its simulated time.
   host->reset();
   std::fflush(log);
   std::rewind(log);
@@ -69,8 +72,10 @@ TEST(RaftHostService, ProposesWhenLeaderAndReportsAStorageFailure) {
   char buf[512];
   while (std::fgets(buf, sizeof buf, log) != nullptr) text += buf;
   std::fclose(log);
-  EXPECT_NE(text.find("t=4.250 node=drone_1 event=leader_elected"), std::string::npos) << text;
+  EXPECT_NE(text.find("node=drone_1 event=leader_elected"), std::string::npos) << text;
   EXPECT_NE(text.find("event=raft_stopped"), std::string::npos) << text;
+  // A single-member cluster sends nothing on the radio.
+  EXPECT_EQ(radio.sent(), 0u);
   std::filesystem::remove_all(dir);
 }
 

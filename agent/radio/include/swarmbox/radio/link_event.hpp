@@ -1,13 +1,13 @@
 // The `event=link` log line (ARCHITECTURE.md "Log events"): one line per peer per report window,
-// written by every agent that pings its peers (RadioLink), read back by tests and benchmarks.
+// written by every agent that pings its peers (LinkProbe), read back by tests and benchmarks.
 //
 //   t=12.340 node=scout_1 event=link peer=scout_2 sent=10 received=9 loss=0.1000 late=0 dup=0
 //       rtt_ms_mean=201.7 rtt_ms_sd=27.9 rtt_ms_p50=199.8 rtt_ms_p99=251.2 rtt_ms_max=251.2
 //
 // sent/received/loss follow LinkMonitor's settling rule (link_monitor.hpp): pings settled in the
 // window, the answered ones, 1 - received/sent. The rtt_ms_* fields are present only when
-// received > 0 (there is no RTT of nothing); t is the agent's simulated time, the RTTs are wall
-// clock [ms].
+// received > 0 (there is no RTT of nothing); t is the agent's simulated time, the RTTs are on the radio's
+// clock [ms] (simulated with radio.model channel, wall with netem).
 #pragma once
 
 #include <cstdint>

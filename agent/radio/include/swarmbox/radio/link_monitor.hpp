@@ -19,8 +19,9 @@
 // still remembered (about 4 x timeout) count as late. A pong for a seq never sent, or from a name
 // that is not a peer, is refused (kUnknownSeq, kUnknownPeer) and counted in `refused()`.
 //
-// Times are std::chrono::steady_clock time points given by the caller (wall clock in the agent,
-// synthetic in tests). Not thread-safe: the caller serialises (RadioLink holds a mutex).
+// Times are std::chrono::steady_clock time points given by the caller (the radio's clock in the
+// agent: simulated or steady, link_probe.hpp; synthetic in tests). Not thread-safe: the caller
+// serialises (LinkProbe runs on the control loop).
 // Allocation: DuePings and OnPong do not allocate once warm (DuePings appends to the caller's
 // vector); TakeReport allocates the report.
 #pragma once

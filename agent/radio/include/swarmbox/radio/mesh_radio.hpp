@@ -16,8 +16,8 @@
 //   radio->TakeReceived(sample, &frames);             // every step, before the agent decides
 //   radio->Flush(&command);                           // every step, before the command goes out
 //
-// Send() fills `from`, `seq` (per sender, from 1), `sent_ns` (the step's simulated time, set by
-// the last TakeReceived) and `size_bytes` (FrameBytes below); the caller sets `to` ("" =
+// Send() fills `from`, `seq` (per sender, from 1), `sent_ns` (the radio's clock, now_ns(): the
+// step's simulated time with channel, set by the last TakeReceived) and `size_bytes` (FrameBytes below); the caller sets `to` ("" =
 // broadcast) and exactly one of state_msg / detection_msg / raft_msg / ping_msg.
 //
 // Thread-safety: one thread (the agent's control loop) calls every member. An implementation may
@@ -39,11 +39,14 @@ class MeshRadio {
   virtual void Send(bus::RadioFrame frame) = 0;
   // Appends to `out` the frames received for the step of `sample` (the channel's radio_in, or
   // what the mesh delivered since the previous call), in delivery order; sets the radio's clock
-  // to the sample's simulated time.
+  // (now_ns()). Each frame's delivered_ns is on that clock.
   virtual void TakeReceived(const bus::SensorSample& sample, std::vector<bus::RadioFrame>* out) = 0;
   // Channel: moves the frames sent since the last Flush into `command->radio_out` (replacing its
   // contents). Netem: clears `command->radio_out` (the frames went out on the mesh already).
   virtual void Flush(bus::ActuatorCommand* command) = 0;
+  // The radio's clock as set by the last TakeReceived [ns]: the sample's simulated time (channel),
+  // the steady clock when it was called (netem). Raft ticks and the link probe run on it.
+  virtual std::int64_t now_ns() const = 0;
 };
 
 // The bytes a frame occupies on the air, the figure the channel charges airtime for: the payload's
