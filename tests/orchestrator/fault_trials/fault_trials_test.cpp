@@ -91,7 +91,7 @@ double Mean(const std::vector<double>& v) {
 TEST_F(FaultTrial, RadioImpairment) {
   ASSERT_TRUE(AgentHasFlag("--ping-every-ms"))
       << "swarmbox-agent has no --ping-every-ms: the agent does not host the radio link "
-         "(agent/radio RadioLink) yet, so there is no event=link to judge";
+         "(agent/radio LinkProbe) yet, so there is no event=link to judge";
   auto run = Run("radio_link_check.yaml", {{"--ping-every-ms", "200"}});
   ASSERT_TRUE(run) << run.error().ToString();
   ASSERT_TRUE(RanToTheEnd(*run));
