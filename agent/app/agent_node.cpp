@@ -38,6 +38,8 @@ class WaitBudget {
   std::chrono::milliseconds left_;
 };
 
+// The wall clock of radio.model netem only (the wall part of its lost-member rule, as the radio
+// itself runs on it); never read with the channel.
 double SteadyS() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
