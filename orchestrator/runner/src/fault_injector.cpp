@@ -538,7 +538,7 @@ std::optional<Verdict> FaultInjector::DroneOut(const faults::Fault& fault, const
   return std::nullopt;
 }
 
-std::optional<Verdict> FaultInjector::DroneBack(const std::string& drone, double t_sim_s, bool trial_end) {
+std::optional<Verdict> FaultInjector::DroneBack(std::string drone, double t_sim_s, bool trial_end) {
   auto it = out_.find(drone);
   if (it == out_.end()) {
     return Verdict::Err("the physics server brought back '" + drone + "', which no fault took out", "faults");

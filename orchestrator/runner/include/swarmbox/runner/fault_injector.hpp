@@ -153,7 +153,8 @@ class FaultInjector {
   // verdict when carried out (or not such a line).
   std::optional<dsl::Verdict> OnPlannedEvent(const std::string& line);
   std::optional<dsl::Verdict> DroneOut(const faults::Fault& fault, const std::string& drone, double t_sim_s);
-  std::optional<dsl::Verdict> DroneBack(const std::string& drone, double t_sim_s, bool trial_end);
+  // `drone` by value: RemoveActive passes a key of out_, which this erases before it is done.
+  std::optional<dsl::Verdict> DroneBack(std::string drone, double t_sim_s, bool trial_end);
 
   docker::DockerApi& api_;
   InjectorConfig config_;
