@@ -11,6 +11,7 @@
 
 #include "commands.hpp"
 #include "experiment_check.hpp"
+#include "support/capture_streams.hpp"
 #include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::cli {
@@ -19,22 +20,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-// Captures std::cout and std::cerr while alive.
-class Capture {
- public:
-  Capture() : out_old_(std::cout.rdbuf(out_.rdbuf())), err_old_(std::cerr.rdbuf(err_.rdbuf())) {}
-  ~Capture() {
-    std::cout.rdbuf(out_old_);
-    std::cerr.rdbuf(err_old_);
-  }
-  std::string out() const { return out_.str(); }
-  std::string err() const { return err_.str(); }
-
- private:
-  std::ostringstream out_, err_;
-  std::streambuf* out_old_;
-  std::streambuf* err_old_;
-};
+using Capture = swarmbox::testing::CaptureStreams;
 
 const std::string kTrials = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
 

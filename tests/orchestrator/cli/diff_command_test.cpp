@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "commands.hpp"
+#include "support/capture_streams.hpp"
 #include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::cli {
@@ -20,21 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-class Capture {
- public:
-  Capture() : out_old_(std::cout.rdbuf(out_.rdbuf())), err_old_(std::cerr.rdbuf(err_.rdbuf())) {}
-  ~Capture() {
-    std::cout.rdbuf(out_old_);
-    std::cerr.rdbuf(err_old_);
-  }
-  std::string out() const { return out_.str(); }
-  std::string err() const { return err_.str(); }
-
- private:
-  std::ostringstream out_, err_;
-  std::streambuf* out_old_;
-  std::streambuf* err_old_;
-};
+using Capture = swarmbox::testing::CaptureStreams;
 
 constexpr char kTruth[] =
     "t_s,drone,x_m,y_m,z_m\n"
