@@ -13,7 +13,10 @@ std::string_view MessageTypeName(MessageType type) {
     case MessageType::kRaftMessage: return "swarmbox::msg::RaftMessage";
     case MessageType::kDetection: return "swarmbox::msg::Detection";
     case MessageType::kRadioPing: return "swarmbox::msg::RadioPing";
+    case MessageType::kBrainMessage: return "swarmbox::msg::BrainMessage";
     case MessageType::kEvent: return "swarmbox::msg::Event";
+    case MessageType::kBrainInput: return "swarmbox::msg::BrainInput";
+    case MessageType::kBrainOutput: return "swarmbox::msg::BrainOutput";
   }
   return "swarmbox::msg::<unknown>";
 }

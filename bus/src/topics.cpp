@@ -29,6 +29,12 @@ std::string ActuatorTopic(std::string_view drone) {
   return "sim/" + std::string(drone) + "/actuator";
 }
 std::string CameraTopic(std::string_view drone) { return "sim/" + std::string(drone) + "/camera"; }
+std::string OffboardInputTopic(std::string_view drone) {
+  return "offboard/" + std::string(drone) + "/input";
+}
+std::string OffboardOutputTopic(std::string_view drone) {
+  return "offboard/" + std::string(drone) + "/output";
+}
 
 Status ValidateTopicName(std::string_view topic) {
   static constexpr std::string_view kRule =

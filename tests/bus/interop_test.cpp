@@ -47,6 +47,10 @@ TEST_P(BusInterop, RaftMessageCrossesVendors) { Check<RaftMessage>(6, std::strin
 TEST_P(BusInterop, DetectionCrossesVendors) { Check<Detection>(7, std::string(kDetectionTopic), Qos::kRadio); }
 TEST_P(BusInterop, RadioPingCrossesVendors) { Check<RadioPing>(8, std::string(kRadioPingTopic), Qos::kRadio); }
 TEST_P(BusInterop, EventCrossesVendors) { Check<Event>(9, std::string(kEventTopic), Qos::kRadio); }
+// The brain's types share slots (domains) with others, on topics of their own.
+TEST_P(BusInterop, BrainMessageCrossesVendors) { Check<BrainMessage>(8, std::string(kBrainMessageTopic), Qos::kRadio); }
+TEST_P(BusInterop, BrainInputCrossesVendors) { Check<BrainInput>(1, OffboardInputTopic("scout_1"), Qos::kLockstep); }
+TEST_P(BusInterop, BrainOutputCrossesVendors) { Check<BrainOutput>(2, OffboardOutputTopic("scout_1"), Qos::kLockstep); }
 
 // A camera-sized image is fragmented by one vendor and reassembled by the other.
 TEST_P(BusInterop, CameraSizedImageCrossesVendors) {

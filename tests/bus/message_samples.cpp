@@ -52,7 +52,8 @@ SensorSample FullSensorSample(std::uint64_t seed) {
   m.battery.current_a = D(seed, 26);
   m.battery.remaining = D(seed, 27);
   m.camera_frame = true;
-  m.radio_in = {FullRadioFrame(seed, 0), FullRadioFrame(seed + 1, 1), FullRadioFrame(seed + 2, 2), FullRadioFrame(seed + 3, 3)};
+  m.radio_in = {FullRadioFrame(seed, 0), FullRadioFrame(seed + 1, 1), FullRadioFrame(seed + 2, 2),
+                FullRadioFrame(seed + 3, 3), FullRadioFrame(seed + 4, 4)};
   return m;
 }
 
@@ -150,6 +151,15 @@ RadioPing FullRadioPing(std::uint64_t seed) {
   return m;
 }
 
+BrainMessage FullBrainMessage(std::uint64_t seed) {
+  BrainMessage m;
+  m.from = S(seed, "from");
+  m.to = S(seed, "to");
+  m.topic = S(seed, "rendezvous/vote");
+  m.payload = {static_cast<std::uint8_t>(seed & 0xff), 0, 255, 17, 42};
+  return m;
+}
+
 RadioFrame FullRadioFrame(std::uint64_t seed, int which) {
   RadioFrame m;
   m.from = S(seed, "from");
@@ -162,7 +172,8 @@ RadioFrame FullRadioFrame(std::uint64_t seed, int which) {
     case 0: m.state_msg = {FullDroneState(seed)}; break;
     case 1: m.detection_msg = {FullDetection(seed)}; break;
     case 2: m.raft_msg = {FullRaftMessage(seed, 40)}; break;
-    default: m.ping_msg = {FullRadioPing(seed)}; break;
+    case 3: m.ping_msg = {FullRadioPing(seed)}; break;
+    default: m.brain_msg = {FullBrainMessage(seed)}; break;
   }
   return m;
 }
@@ -177,6 +188,54 @@ Event FullEvent(std::uint64_t seed) {
   return m;
 }
 
+BrainInput FullBrainInput(std::uint64_t seed) {
+  BrainInput m;
+  m.drone = S(seed, "drone");
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 101;
+  VehicleState& v = m.vehicle;
+  v.drone = m.drone;
+  v.step = seed + 102;
+  v.sim_time_ns = m.sim_time_ns;
+  v.position_enu_m = {D(seed, 11), D(seed, 12), D(seed, 13)};
+  v.velocity_enu_m_s = {D(seed, 14), D(seed, 15), D(seed, 16)};
+  v.attitude_wxyz = {D(seed, 17), D(seed, 18), D(seed, 19), D(seed, 20)};
+  v.angular_rate_flu_rad_s = {D(seed, 21), D(seed, 22), D(seed, 23)};
+  v.battery_fraction = D(seed, 24);
+  v.battery_voltage_v = D(seed, 25);
+  v.flight_mode = S(seed, "trajectory");
+  v.armed = true;
+  v.landed = false;
+  v.payload_mass_kg = D(seed, 26);
+  v.mass_estimate_kg = D(seed, 27);
+  m.flight_events = {FullEvent(seed), FullEvent(seed + 1)};
+  m.is_leader = true;
+  m.leader = S(seed, "leader");
+  m.neighbours = {FullDroneState(seed), FullDroneState(seed + 1)};
+  m.messages = {FullBrainMessage(seed), FullBrainMessage(seed + 2)};
+  m.committed = {{seed + 103, {1, 2, 3}}, {seed + 104, {}}};
+  m.detections = {FullDetection(seed)};
+  return m;
+}
+
+BrainOutput FullBrainOutput(std::uint64_t seed) {
+  BrainOutput m;
+  m.drone = S(seed, "drone");
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 111;
+  TrajectorySetpoint sp;
+  sp.position_enu_m = {D(seed, 31), D(seed, 32), D(seed, 33)};
+  sp.velocity_enu_m_s = {D(seed, 34), D(seed, 35), D(seed, 36)};
+  sp.acceleration_enu_m_s2 = {D(seed, 37), D(seed, 38), D(seed, 39)};
+  sp.yaw_rad = D(seed, 40);
+  sp.yawspeed_rad_s = D(seed, 41);
+  m.setpoint = {sp};
+  m.commands = {{S(seed, "takeoff"), D(seed, 42)}, {S(seed, "payload_attach"), D(seed, 43)}};
+  m.messages = {FullBrainMessage(seed + 3)};
+  m.proposals = {{{9, 8, 7, 6}}, {{}}};
+  m.status = S(seed, "rendezvous/flying");
+  m.events = {FullEvent(seed + 4)};
+  return m;
+}
+
 template <> ClockTick Full<ClockTick>(std::uint64_t seed) { return FullClockTick(seed); }
 template <> SensorSample Full<SensorSample>(std::uint64_t seed) { return FullSensorSample(seed); }
 template <> ActuatorCommand Full<ActuatorCommand>(std::uint64_t seed) {
@@ -188,6 +247,9 @@ template <> DroneState Full<DroneState>(std::uint64_t seed) { return FullDroneSt
 template <> RaftMessage Full<RaftMessage>(std::uint64_t seed) { return FullRaftMessage(seed); }
 template <> Detection Full<Detection>(std::uint64_t seed) { return FullDetection(seed); }
 template <> RadioPing Full<RadioPing>(std::uint64_t seed) { return FullRadioPing(seed); }
+template <> BrainMessage Full<BrainMessage>(std::uint64_t seed) { return FullBrainMessage(seed); }
 template <> Event Full<Event>(std::uint64_t seed) { return FullEvent(seed); }
+template <> BrainInput Full<BrainInput>(std::uint64_t seed) { return FullBrainInput(seed); }
+template <> BrainOutput Full<BrainOutput>(std::uint64_t seed) { return FullBrainOutput(seed); }
 
 }  // namespace swarmbox::bus::testing

@@ -21,9 +21,12 @@ DroneState FullDroneState(std::uint64_t seed);
 RaftMessage FullRaftMessage(std::uint64_t seed, std::size_t payload_bytes = 48);
 Detection FullDetection(std::uint64_t seed);
 RadioPing FullRadioPing(std::uint64_t seed);
-// `which`: 0 state, 1 detection (broadcast), 2 raft, 3 ping.
+BrainMessage FullBrainMessage(std::uint64_t seed);
+// `which`: 0 state, 1 detection (broadcast), 2 raft, 3 ping, 4 brain.
 RadioFrame FullRadioFrame(std::uint64_t seed, int which);
 Event FullEvent(std::uint64_t seed);
+BrainInput FullBrainInput(std::uint64_t seed);
+BrainOutput FullBrainOutput(std::uint64_t seed);
 
 // Overload set for generic tests: Full<T>(seed).
 template <typename T>
@@ -37,6 +40,9 @@ template <> DroneState Full<DroneState>(std::uint64_t seed);
 template <> RaftMessage Full<RaftMessage>(std::uint64_t seed);
 template <> Detection Full<Detection>(std::uint64_t seed);
 template <> RadioPing Full<RadioPing>(std::uint64_t seed);
+template <> BrainMessage Full<BrainMessage>(std::uint64_t seed);
 template <> Event Full<Event>(std::uint64_t seed);
+template <> BrainInput Full<BrainInput>(std::uint64_t seed);
+template <> BrainOutput Full<BrainOutput>(std::uint64_t seed);
 
 }  // namespace swarmbox::bus::testing

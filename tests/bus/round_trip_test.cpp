@@ -37,6 +37,10 @@ TEST_P(BusRoundTrip, RaftMessageArrivesIntact) { Check<RaftMessage>(6, std::stri
 TEST_P(BusRoundTrip, DetectionArrivesIntact) { Check<Detection>(7, std::string(kDetectionTopic), Qos::kRadio); }
 TEST_P(BusRoundTrip, RadioPingArrivesIntact) { Check<RadioPing>(8, std::string(kRadioPingTopic), Qos::kRadio); }
 TEST_P(BusRoundTrip, EventArrivesIntact) { Check<Event>(9, std::string(kEventTopic), Qos::kRadio); }
+// The brain's types share slots (domains) with others, on topics of their own.
+TEST_P(BusRoundTrip, BrainMessageArrivesIntact) { Check<BrainMessage>(8, std::string(kBrainMessageTopic), Qos::kRadio); }
+TEST_P(BusRoundTrip, BrainInputArrivesIntact) { Check<BrainInput>(1, OffboardInputTopic("drone_7"), Qos::kLockstep); }
+TEST_P(BusRoundTrip, BrainOutputArrivesIntact) { Check<BrainOutput>(2, OffboardOutputTopic("drone_7"), Qos::kLockstep); }
 
 // A camera-sized image (320x240 mono8, 76,800 bytes of pixels) is fragmented on the wire by both
 // backends and must still arrive byte for byte.

@@ -32,17 +32,35 @@
   F(from) F(seq) F(sim_time_ns) F(label) F(confidence) F(position_enu_m) F(position_sigma_m)
 #define SWARMBOX_BUS_FIELDS_RadioPing(F) F(from) F(to) F(seq) F(sent_ns) F(is_pong)
 #define SWARMBOX_BUS_FIELDS_RadioFrame(F) \
-  F(from) F(to) F(seq) F(sent_ns) F(delivered_ns) F(size_bytes) F(state_msg) F(detection_msg) F(raft_msg) F(ping_msg)
+  F(from) F(to) F(seq) F(sent_ns) F(delivered_ns) F(size_bytes) F(state_msg) F(detection_msg) F(raft_msg) F(ping_msg) \
+  F(brain_msg)
+#define SWARMBOX_BUS_FIELDS_BrainMessage(F) F(from) F(to) F(topic) F(payload)
+#define SWARMBOX_BUS_FIELDS_VehicleState(F)                                                    \
+  F(drone) F(step) F(sim_time_ns) F(position_enu_m) F(velocity_enu_m_s) F(attitude_wxyz)        \
+  F(angular_rate_flu_rad_s) F(battery_fraction) F(battery_voltage_v) F(flight_mode) F(armed)    \
+  F(landed) F(payload_mass_kg) F(mass_estimate_kg)
+#define SWARMBOX_BUS_FIELDS_CommittedEntry(F) F(index) F(data)
+#define SWARMBOX_BUS_FIELDS_BrainInput(F)                                                      \
+  F(drone) F(sim_time_ns) F(vehicle) F(flight_events) F(is_leader) F(leader) F(neighbours)      \
+  F(messages) F(committed) F(detections)
+#define SWARMBOX_BUS_FIELDS_TrajectorySetpoint(F)                                              \
+  F(position_enu_m) F(velocity_enu_m_s) F(acceleration_enu_m_s2) F(yaw_rad) F(yawspeed_rad_s)
+#define SWARMBOX_BUS_FIELDS_VehicleCommand(F) F(command) F(param)
+#define SWARMBOX_BUS_FIELDS_Proposal(F) F(data)
+#define SWARMBOX_BUS_FIELDS_BrainOutput(F)                                                     \
+  F(drone) F(sim_time_ns) F(setpoint) F(commands) F(messages) F(proposals) F(status) F(events)
 #define SWARMBOX_BUS_FIELDS_KeyValue(F) F(key) F(value)
 #define SWARMBOX_BUS_FIELDS_Event(F) F(node) F(sim_time_ns) F(name) F(fields)
 
 #define SWARMBOX_BUS_STRUCTS(S)                                                               \
-  S(DroneState) S(RaftMessage) S(Detection) S(RadioPing) S(RadioFrame) S(WorldCommand)        \
-  S(ClockTick) S(ImuSample) S(BaroSample) S(MagSample) S(GpsSample) S(BatterySample)          \
-  S(SensorSample) S(ActuatorCommand) S(CameraIntrinsics) S(Pose) S(CameraImage)               \
-  S(KeyValue) S(Event)
+  S(DroneState) S(RaftMessage) S(Detection) S(RadioPing) S(BrainMessage) S(RadioFrame)        \
+  S(WorldCommand) S(ClockTick) S(ImuSample) S(BaroSample) S(MagSample) S(GpsSample)           \
+  S(BatterySample) S(SensorSample) S(ActuatorCommand) S(CameraIntrinsics) S(Pose)             \
+  S(CameraImage) S(KeyValue) S(Event) S(VehicleState) S(CommittedEntry) S(BrainInput)         \
+  S(TrajectorySetpoint) S(VehicleCommand) S(Proposal) S(BrainOutput)
 
 // The top-level message types (those with a MessageType), for dispatch.
 #define SWARMBOX_BUS_MESSAGES(M)                                                              \
   M(ClockTick) M(SensorSample) M(ActuatorCommand) M(CameraImage) M(WorldCommand)              \
-  M(DroneState) M(RaftMessage) M(Detection) M(RadioPing) M(Event)
+  M(DroneState) M(RaftMessage) M(Detection) M(RadioPing) M(BrainMessage) M(Event)            \
+  M(BrainInput) M(BrainOutput)

@@ -77,11 +77,22 @@ struct RadioPing {
   bool operator==(const RadioPing&) const = default;
 };
 
+// A brain's own radio message (agent/brain: the brain SDK and the offboard interface): bytes under
+// a topic the brain names. With radio.model netem on kBrainMessageTopic with Qos::kRadio; with
+// channel inside a RadioFrame. The bus does not look inside `payload`.
+struct BrainMessage {
+  std::string from;
+  std::string to;     // the receiving drone; "" = every drone in range
+  std::string topic;  // the brain's name for the kind of message, e.g. "rendezvous/vote"
+  std::vector<std::uint8_t> payload;
+  bool operator==(const BrainMessage&) const = default;
+};
+
 // One frame on the simulated radio channel (radio.model: channel). An agent hands its frames to the
 // physics server in its ActuatorCommand (radio_out, delivered_ns 0); the channel decides whether and
 // when each arrives and hands it to each receiver in a SensorSample (radio_in, delivered_ns set), in
-// the order (delivered_ns, from, seq). Exactly one of state_msg, detection_msg, raft_msg, ping_msg holds
-// one element (the IDL is case-insensitive: `detection` would clash with the type Detection).
+// the order (delivered_ns, from, seq). Exactly one of state_msg, detection_msg, raft_msg, ping_msg,
+// brain_msg holds one element (the IDL is case-insensitive: `detection` would clash with the type Detection).
 struct RadioFrame {
   std::string from;               // the sending drone
   std::string to;                 // the receiving drone; "" = broadcast to every drone in range
@@ -93,6 +104,7 @@ struct RadioFrame {
   std::vector<Detection> detection_msg;
   std::vector<RaftMessage> raft_msg;
   std::vector<RadioPing> ping_msg;
+  std::vector<BrainMessage> brain_msg;
   bool operator==(const RadioFrame&) const = default;
 };
 
@@ -267,6 +279,99 @@ struct Event {
   bool operator==(const Event&) const = default;
 };
 
+// ---- sim domain, offboard: an agent's flight stack <-> a brain in its own process ------------
+//
+// brain: program. OffboardInputTopic(drone) carries BrainInput (agent -> brain) and
+// OffboardOutputTopic(drone) BrainOutput (brain -> agent), both Qos::kLockstep. Every brain period
+// the agent publishes one BrainInput stamped with the step's simulated time and waits for the
+// BrainOutput with the same sim_time_ns before it answers the lockstep: a brain that keeps up gives
+// the same run at any speed. The contract (timeouts, the failsafe, determinism):
+// agent/brain/README.md; the same data as C++ values: swarmbox/brain/brain.hpp.
+
+// The flight stack's estimate of its own drone (PX4 VehicleOdometry + VehicleStatus +
+// BatteryStatus in one sample): estimated, not true, state.
+struct VehicleState {
+  std::string drone;
+  std::uint64_t step = 0;
+  std::int64_t sim_time_ns = 0;
+  std::array<double, 3> position_enu_m{};
+  std::array<double, 3> velocity_enu_m_s{};
+  std::array<double, 4> attitude_wxyz{1.0, 0.0, 0.0, 0.0};  // body FLU -> world ENU
+  std::array<double, 3> angular_rate_flu_rad_s{};
+  double battery_fraction = 0.0;  // [0, 1]
+  double battery_voltage_v = 0.0;
+  // The flight stack's mode: init, idle, takeoff, hold, position, velocity, trajectory, land,
+  // landed (flight::FlightModeName).
+  std::string flight_mode;
+  bool armed = false;
+  bool landed = true;
+  double payload_mass_kg = 0.0;   // what the brain last attached (0: none)
+  double mass_estimate_kg = 0.0;  // the hover-thrust estimator's total mass [kg]
+  bool operator==(const VehicleState&) const = default;
+};
+
+// One committed entry of the swarm's consensus log (Raft), in index order.
+struct CommittedEntry {
+  std::uint64_t index = 0;
+  std::vector<std::uint8_t> data;
+  bool operator==(const CommittedEntry&) const = default;
+};
+
+// Agent -> brain, once per brain period: everything that happened since the previous input.
+struct BrainInput {
+  std::string drone;
+  std::int64_t sim_time_ns = 0;       // the step's simulated time: the brain's only clock
+  VehicleState vehicle;
+  std::vector<Event> flight_events;   // the flight stack's events (takeoff, hover, arrived, landed...)
+  bool is_leader = false;             // this drone leads the consensus
+  std::string leader;                 // who leads, as far as this drone knows ("" = nobody)
+  std::vector<DroneState> neighbours; // the latest state heard from each other drone
+  std::vector<BrainMessage> messages; // brain messages the radio delivered, in delivery order
+  std::vector<CommittedEntry> committed;  // newly committed consensus entries, in index order
+  std::vector<Detection> detections;  // this drone's perception results (geolocated)
+  bool operator==(const BrainInput&) const = default;
+};
+
+// PX4 TrajectorySetpoint semantics in world ENU; NaN = unset. Per axis: a position controls it
+// (velocity and acceleration then feed forward); else a velocity; else an acceleration. yaw, else
+// yawspeed; both NaN keep the heading.
+struct TrajectorySetpoint {
+  std::array<double, 3> position_enu_m{};
+  std::array<double, 3> velocity_enu_m_s{};
+  std::array<double, 3> acceleration_enu_m_s2{};
+  double yaw_rad = 0.0;
+  double yawspeed_rad_s = 0.0;
+  bool operator==(const TrajectorySetpoint&) const = default;
+};
+
+// A command to the flight stack: "arm", "disarm", "takeoff" (param: height above the start [m]),
+// "land", "hold", "payload_attach" (param: mass [kg]), "payload_release".
+struct VehicleCommand {
+  std::string command;
+  double param = 0.0;
+  bool operator==(const VehicleCommand&) const = default;
+};
+
+// A proposal to the swarm's consensus log (committed entries come back in BrainInput::committed).
+struct Proposal {
+  std::vector<std::uint8_t> data;
+  bool operator==(const Proposal&) const = default;
+};
+
+// Brain -> agent: the answer to the BrainInput with the same sim_time_ns. Also the offboard
+// heartbeat: no answer for the offboard timeout and the drone fails safe.
+struct BrainOutput {
+  std::string drone;
+  std::int64_t sim_time_ns = 0;                // the BrainInput it answers
+  std::vector<TrajectorySetpoint> setpoint;    // none: keep the last one; at most one
+  std::vector<VehicleCommand> commands;        // applied in order, before the setpoint
+  std::vector<BrainMessage> messages;          // onto the radio
+  std::vector<Proposal> proposals;             // to the consensus log
+  std::string status;                          // broadcast in DroneState::mode
+  std::vector<Event> events;                   // logged by the agent as logfmt lines
+  bool operator==(const BrainOutput&) const = default;
+};
+
 // ---- type registry (used by the API to pick the backend's generated type) -----------------
 
 enum class MessageType : std::uint8_t {
@@ -279,9 +384,12 @@ enum class MessageType : std::uint8_t {
   kRaftMessage,
   kDetection,
   kRadioPing,
+  kBrainMessage,
   kEvent,
+  kBrainInput,
+  kBrainOutput,
 };
-inline constexpr int kMessageTypeCount = 10;
+inline constexpr int kMessageTypeCount = 13;
 
 // The DDS type name on the wire, e.g. "swarmbox::msg::SensorSample".
 std::string_view MessageTypeName(MessageType type);
@@ -303,7 +411,10 @@ SWARMBOX_BUS_MESSAGE_TRAITS(DroneState);
 SWARMBOX_BUS_MESSAGE_TRAITS(RaftMessage);
 SWARMBOX_BUS_MESSAGE_TRAITS(Detection);
 SWARMBOX_BUS_MESSAGE_TRAITS(RadioPing);
+SWARMBOX_BUS_MESSAGE_TRAITS(BrainMessage);
 SWARMBOX_BUS_MESSAGE_TRAITS(Event);
+SWARMBOX_BUS_MESSAGE_TRAITS(BrainInput);
+SWARMBOX_BUS_MESSAGE_TRAITS(BrainOutput);
 #undef SWARMBOX_BUS_MESSAGE_TRAITS
 
 template <typename T>

@@ -14,6 +14,9 @@
 //   mesh    mesh/raft                  RaftMessage      kRadio      agent -> agent `to`
 //   mesh    mesh/detection             Detection        kRadio      agent -> agents
 //   mesh    mesh/ping                  RadioPing        kRadio      agent -> agent `to` (and back)
+//   mesh    mesh/brain                 BrainMessage     kRadio      brain -> brains (`to` or all)
+//   sim     offboard/<drone>/input     BrainInput       kLockstep   agent <drone> -> its brain
+//   sim     offboard/<drone>/output    BrainOutput      kLockstep   brain -> agent <drone>
 //   both    event                      Event            kRadio      anyone -> loggers
 //
 // Topic names may hold only ASCII letters, digits, '_' and '/', and must start with a letter
@@ -53,11 +56,14 @@ inline constexpr std::string_view kDroneStateTopic = "mesh/state";
 inline constexpr std::string_view kRaftTopic = "mesh/raft";
 inline constexpr std::string_view kDetectionTopic = "mesh/detection";
 inline constexpr std::string_view kRadioPingTopic = "mesh/ping";
+inline constexpr std::string_view kBrainMessageTopic = "mesh/brain";
 inline constexpr std::string_view kEventTopic = "event";
 
 std::string SensorTopic(std::string_view drone);    // "sim/<drone>/sensor"
 std::string ActuatorTopic(std::string_view drone);  // "sim/<drone>/actuator"
 std::string CameraTopic(std::string_view drone);    // "sim/<drone>/camera"
+std::string OffboardInputTopic(std::string_view drone);   // "offboard/<drone>/input"
+std::string OffboardOutputTopic(std::string_view drone);  // "offboard/<drone>/output"
 
 // kInvalidArgument with the offending character and the rule when `topic` is not a valid name.
 Status ValidateTopicName(std::string_view topic);
