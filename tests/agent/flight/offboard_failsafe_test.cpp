@@ -76,7 +76,7 @@ TEST(OffboardFailsafe, HoldSecondsMoreSilenceLands) {
   EXPECT_EQ(ev[1].silent_s, 6.125);
   EXPECT_EQ(ev[1].action, Action::kLand);
   EXPECT_EQ(OffboardFailsafe::ToLogEvent(ev[1], "scout_1").str(),
-            "t=8.125 node=scout_1 event=offboard_failsafe silent_s=6.125 action=land");
+            "t=8.125 node=scout_1 event=offboard_failsafe action=land silent_s=6.125");
 }
 
 TEST(OffboardFailsafe, AnAnswerDuringHoldRegainsTheBrain) {
