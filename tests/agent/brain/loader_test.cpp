@@ -166,6 +166,16 @@ TEST(BrainLoader, ExampleRendezvousBrainAsksForTakeoffFirst) {
   EXPECT_EQ(out.status, "rendezvous/takeoff");
 }
 
+TEST(BrainLoader, TwoBrainsFromOneLibraryKeepTheirOwnState) {
+  auto first = LoadBrain(SWARMBOX_EXAMPLE_RENDEZVOUS_BRAIN, "rendezvous", MakeContext());
+  auto second = LoadBrain(SWARMBOX_EXAMPLE_RENDEZVOUS_BRAIN, "rendezvous", MakeContext());
+  ASSERT_TRUE(first && second);
+  EXPECT_EQ(StepOnce(**first).commands.size(), 1u);   // asks for take-off ...
+  EXPECT_EQ(StepOnce(**first).commands.size(), 0u);   // ... once
+  first->reset();                                     // the library stays loaded for the other
+  EXPECT_EQ(StepOnce(**second).commands.size(), 1u);  // its own first take-off
+}
+
 TEST(BrainLoader, ExampleRendezvousBrainRefusesADroneOutsideTheMembers) {
   Context ctx = MakeContext();
   ctx.self = "lifter_1";
