@@ -52,7 +52,14 @@ struct OpenLibrary {
 Result<OpenLibrary> Open(const std::string& path) {
   dlerror();  // clear a stale error
   void* raw = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (raw == nullptr) return LoadError(path, "cannot load the brain library: " + DlErrorText());
+  if (raw == nullptr) {
+    std::string message = "cannot load the brain library: " + DlErrorText();
+    if (path.find('/') == std::string::npos) {
+      message += " (a name without '/' is searched on the library path, not in the current folder: ./" +
+                 path + " for that)";
+    }
+    return LoadError(path, message);
+  }
   OpenLibrary lib;
   lib.handle = std::shared_ptr<void>(raw, [](void* h) { dlclose(h); });
 

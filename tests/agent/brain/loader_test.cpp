@@ -120,6 +120,14 @@ TEST(BrainLoader, MissingFileGivesDlerror) {
   EXPECT_THAT(loaded.error().message(), HasSubstr("No such file or directory"));
 }
 
+TEST(BrainLoader, BareNameIsSearchedAsDlopenDoesAndTheErrorSaysSo) {
+  auto loaded = LoadBrain("libswarmbox_no_such_brain.so", "alpha", MakeContext());
+  ASSERT_FALSE(loaded);
+  EXPECT_THAT(loaded.error().message(),
+              HasSubstr("(a name without '/' is searched on the library path, not in the current "
+                        "folder: ./libswarmbox_no_such_brain.so for that)"));
+}
+
 TEST(BrainLoader, LibraryWithoutTheEntryPointsIsNoBrainLibrary) {
   auto loaded = LoadBrain(SWARMBOX_TEST_NOT_A_BRAIN, "alpha", MakeContext());
   ASSERT_FALSE(loaded);
