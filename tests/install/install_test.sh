@@ -9,7 +9,7 @@
 #     engine needed): found beside swarmbox (the tags equal those of --physics-bin/--agent-bin
 #     P/bin/...), and a missing companion is reported with the place looked in;
 #   - the brain SDK: examples/brains/rendezvous builds against P alone (find_package(swarmbox),
-#     swarmbox_add_brain), its library exports exactly the two entry points, and a program on the
+#     swarmbox_add_brain), its library exports exactly the three entry points, and a program on the
 #     installed loader (brain_loader_check/) loads it and steps it once (take-off first).
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR CXX_COMPILER
 set -euo pipefail
@@ -69,8 +69,8 @@ done
 brain_lib=$work/build-rendezvous/librendezvous_brain.so
 [ -f "$brain_lib" ] || fail "no $brain_lib"
 exports=$(nm -D --defined-only "$brain_lib" | awk '{print $3}' | sort | tr '\n' ' ')
-[ "$exports" = "swarmbox_brain_abi_version swarmbox_brain_registry " ] ||
-  fail "librendezvous_brain.so exports more or less than the two entry points: $exports"
+[ "$exports" = "swarmbox_brain_abi_version swarmbox_brain_cxx_library swarmbox_brain_registry " ] ||
+  fail "librendezvous_brain.so exports more or less than the three entry points: $exports"
 answer=$("$work/build-brain_loader_check/brain_loader_check" "$brain_lib" rendezvous) ||
   fail "the installed loader did not load $brain_lib"
 [ "$answer" = "takeoff(10) rendezvous/takeoff" ] || fail "the rendezvous brain's first answer: $answer"

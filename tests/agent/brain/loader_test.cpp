@@ -97,6 +97,15 @@ TEST(BrainLoader, WrongAbiVersionNamesBothNumbers) {
                         ", this agent speaks ABI " + std::to_string(kAbiVersion)));
 }
 
+TEST(BrainLoader, OtherCxxStandardLibraryNamesBoth) {
+  auto loaded = LoadBrain(SWARMBOX_TEST_BRAIN_OTHER_CXX, "alpha", MakeContext());
+  ASSERT_FALSE(loaded);
+  EXPECT_EQ(loaded.error().message(),
+            std::string("built against the C++ standard library libc++, this agent uses ") + CxxLibrary() +
+                ": rebuild it with the agent's compiler and standard library");
+  EXPECT_STREQ(CxxLibrary(), "libstdc++/cxx11");  // this build's (GCC, the default ABI)
+}
+
 TEST(BrainLoader, UnknownNameListsTheLibrarysBrains) {
   auto loaded = LoadBrain(SWARMBOX_TEST_BRAIN_A, "gamma", MakeContext());
   ASSERT_FALSE(loaded);

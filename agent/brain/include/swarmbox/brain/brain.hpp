@@ -267,7 +267,7 @@ struct Registration {
 // One table per shared object: swarmbox::brain is a static library that every brain library (and
 // the agent) links its own copy of, and this function has hidden visibility, so a brain library's
 // SWARMBOX_BRAIN always fills that library's table, never the agent's or another library's (even
-// when the agent exports its symbols, or another library was loaded RTLD_GLOBAL). The two
+// when the agent exports its symbols, or another library was loaded RTLD_GLOBAL). The three
 // extern "C" functions below are the only symbols a brain library must export.
 #if defined(__GNUC__)
 #define SWARMBOX_BRAIN_LOCAL __attribute__((visibility("hidden")))
@@ -278,11 +278,27 @@ struct Registration {
 #endif
 SWARMBOX_BRAIN_LOCAL std::vector<Registration>& LibraryRegistry();
 
+// The C++ standard library this translation unit is compiled against: "libstdc++/cxx11",
+// "libstdc++/cow" (_GLIBCXX_USE_CXX11_ABI=0), "libc++" or "unknown". std::string, std::vector and
+// std::function cross the boundary, so the loader refuses a library built against another one.
+inline const char* CxxLibrary() {
+#if defined(_LIBCPP_VERSION)
+  return "libc++";
+#elif defined(__GLIBCXX__) && defined(_GLIBCXX_USE_CXX11_ABI) && _GLIBCXX_USE_CXX11_ABI
+  return "libstdc++/cxx11";
+#elif defined(__GLIBCXX__)
+  return "libstdc++/cow";
+#else
+  return "unknown";
+#endif
+}
+
 }  // namespace swarmbox::brain
 
 // What the loader finds in a library with dlsym: the ABI version (kAbiVersion of the SwarmBox the
-// library was built against), and the table.
+// library was built against), the C++ standard library it was built with (CxxLibrary), and the table.
 extern "C" SWARMBOX_BRAIN_EXPORT int swarmbox_brain_abi_version();
+extern "C" SWARMBOX_BRAIN_EXPORT const char* swarmbox_brain_cxx_library();
 extern "C" SWARMBOX_BRAIN_EXPORT const std::vector<swarmbox::brain::Registration>*
 swarmbox_brain_registry();
 
