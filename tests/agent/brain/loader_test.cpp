@@ -113,6 +113,13 @@ TEST(BrainLoader, UnknownNameListsTheLibrarysBrains) {
             "no brain named \"gamma\" in the library; it has: alpha, stateful, thrower");
 }
 
+TEST(BrainLoader, NameRegisteredTwiceIsRefused) {
+  auto loaded = LoadBrain(SWARMBOX_TEST_BRAIN_DUPLICATE, "twin", MakeContext());
+  ASSERT_FALSE(loaded);
+  EXPECT_EQ(loaded.error().message(),
+            "the library registers brain \"twin\" twice (two SWARMBOX_BRAIN lines with one name)");
+}
+
 TEST(BrainLoader, ThrowingConstructorGivesItsMessage) {
   auto loaded = LoadBrain(SWARMBOX_TEST_BRAIN_A, "thrower", MakeContext({{"speed_m_s", "fast"}}));
   ASSERT_FALSE(loaded);
