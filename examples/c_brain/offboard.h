@@ -6,12 +6,16 @@
  *   writer       offboard/<drone>/output  swarmbox::msg::BrainOutput   (brain -> agent)
  *   QoS (both)   reliable, volatile, keep-last 16: the bus's kLockstep preset; the writer
  *                writes plain CDR (XCDR1), which every SwarmBox agent reads
- *   rule         every BrainInput is answered by exactly one BrainOutput with its sim_time_ns
+ *   rule         every BrainInput is answered by exactly one BrainOutput with its sim_time_ns;
+ *                an input repeating the previous one's sim_time_ns (the agent resends its first
+ *                input until it hears an answer) gets the same answer again, the brain is not
+ *                stepped twice
  */
 #ifndef SWARMBOX_C_BRAIN_OFFBOARD_H
 #define SWARMBOX_C_BRAIN_OFFBOARD_H
 
 #include <signal.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -26,6 +30,9 @@ typedef struct offboard {
   dds_entity_t writer;
   dds_entity_t waitset;
   uint64_t answered; /* BrainInputs answered */
+  bool has_last;     /* last: the previous answer, for a repeated input */
+  int64_t last_t_ns;
+  rv_output last;
 } offboard;
 
 /* 0, or -1 with what failed (and Cyclone's reason) in `error`; offboard_close either way. */

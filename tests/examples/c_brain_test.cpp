@@ -65,9 +65,9 @@ class CBrain : public ::testing::Test {
     if (!dir_.empty()) std::filesystem::remove_all(dir_);
   }
 
-  // Starts the brain (members deliberately unsorted) and shakes hands: the first input is resent
-  // until answered (matching is seen per side: the child's reader may not know our writer yet and
-  // would miss it), then late duplicate answers to it are drained.
+  // Starts the brain (members deliberately unsorted) and shakes hands as the agent does: the first
+  // input is resent until answered (matching is seen per side: the child's reader may not know our
+  // writer yet and would miss it), then the answers to the copies are drained (each the same).
   void StartBrain(const bus::BrainInput& first) {
     ::setenv("CYCLONEDDS_URI", kCycloneUri, 1);
     brain_.emplace(std::vector<std::string>{SWARMBOX_C_BRAIN_BIN, "--drone", "scout_2", "--domain",
@@ -89,6 +89,7 @@ class CBrain : public ::testing::Test {
     first_ = out;
     while (output_->TakeFor(out, 300ms)) {
       ASSERT_EQ(out.sim_time_ns, first.sim_time_ns) << "an answer to an input never sent";
+      ASSERT_EQ(out, first_) << "a resent input answered differently";
     }
   }
 
@@ -282,9 +283,14 @@ TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
       << brain_->ReadLog();
 }
 
-TEST_F(CBrain, SigintEndsItWithExitZero) {
-  ASSERT_NO_FATAL_FAILURE(StartBrain(Input(0, "idle", 0.0, 0.0, 0.0)));
+TEST_F(CBrain, AnswersARepeatedInputTheSameAndSigintEndsItWithExitZero) {
+  const auto first = Input(0, "idle", 0.0, 0.0, 0.0);
+  ASSERT_NO_FATAL_FAILURE(StartBrain(first));
   EXPECT_EQ(Commands(first_), std::vector<std::string>{"takeoff"});
+  // The agent resends its first input until it hears an answer: every copy gets the same answer
+  // (the takeoff is not lost to whichever copy the agent keeps), the brain steps once.
+  for (int copy = 0; copy < 2; ++copy) EXPECT_EQ(Exchange(first), first_);
+  EXPECT_TRUE(Exchange(Input(kPeriodNs, "takeoff", 0.0, 0.0, 1.0)).commands.empty());
   ASSERT_TRUE(brain_->Signal(SIGINT));
   EXPECT_EQ(brain_->Wait(10s), 0) << brain_->ReadLog();
 }
