@@ -90,6 +90,7 @@ static void read_input(rv_state *brain, const swarmbox_msg_BrainInput *in, rv_in
     if (event == NULL) continue;
     if (strcmp(event, "hover") == 0) out->hover_event = true;
     if (strcmp(event, "setpoint_rejected") == 0) out->rejected_event = true;
+    if (strcmp(event, "landed") == 0) out->landed_event = true;
   }
 }
 

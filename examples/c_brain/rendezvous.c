@@ -39,16 +39,17 @@ void rv_apply_entry(rv_state *s, const uint8_t *data, size_t length) {
   text[length] = '\0';
   if (strlen(text) != length) return; /* holds a NUL: not text */
 
-  /* Split on single spaces: "pos <member> <x> <y>" or "arrived <member>". */
+  /* Words separated by runs of spaces: "pos <member> <x> <y>" or "arrived <member>". */
   char *words[4];
   size_t n = 0;
-  for (char *p = text;;) {
+  for (char *p = text; *p != '\0';) {
+    if (*p == ' ') {
+      *p++ = '\0';
+      continue;
+    }
     if (n == 4) return; /* a fifth word: not ours */
     words[n++] = p;
-    char *space = strchr(p, ' ');
-    if (space == NULL) break;
-    *space = '\0';
-    p = space + 1;
+    while (*p != '\0' && *p != ' ') ++p;
   }
   if (n < 2) return;
   const size_t who = member_index(&s->config, words[1], strlen(words[1]));
@@ -146,7 +147,7 @@ void rv_step(rv_state *s, const rv_input *in, rv_output *out) {
     return;
   }
   if (s->land_commanded) {
-    if (in->landed) {
+    if (in->landed || in->landed_event) {
       s->done = true;
       char members[32];
       snprintf(members, sizeof members, "%zu", c->n_members);
@@ -171,11 +172,12 @@ void rv_step(rv_state *s, const rv_input *in, rv_output *out) {
 
   /* 2. vote on the positions */
   if (s->n_pos < c->n_members) {
-    if (!s->have_pos[c->self] && due(s->pos_proposed, s->pos_proposed_ns, in->t_ns)) {
-      char entry[RV_ENTRY_MAX];
-      snprintf(entry, sizeof entry, "pos %s %.3f %.3f", self, in->position_enu_m[0],
+    if (s->pos_entry[0] == '\0') { /* where it hovers first: the same entry every time */
+      snprintf(s->pos_entry, sizeof s->pos_entry, "pos %s %.3f %.3f", self, in->position_enu_m[0],
                in->position_enu_m[1]);
-      add_proposal(out, entry);
+    }
+    if (!s->have_pos[c->self] && due(s->pos_proposed, s->pos_proposed_ns, in->t_ns)) {
+      add_proposal(out, s->pos_entry);
       s->pos_proposed = true;
       s->pos_proposed_ns = in->t_ns;
     }

@@ -12,7 +12,8 @@
  * Pure: no DDS, no clock, no allocation. The only time is rv_input.t_ns (the BrainInput's
  * sim_time_ns), so the same inputs always give the same outputs.
  *
- * Entries (ASCII text, in Proposal.data / CommittedEntry.data, no terminating NUL):
+ * Entries (ASCII text, in Proposal.data / CommittedEntry.data, no terminating NUL; words separated
+ * by spaces):
  *   "pos <member> <x> <y>"   its estimated position [m, world ENU] when it started hovering, %.3f
  *   "arrived <member>"       it is within 1 m of its slot
  * The first entry of each kind per member counts; entries of unknown members or of another shape
@@ -22,7 +23,8 @@
  *   rendezvous/takeoff  landed, flight stack ready (mode not "init"): command takeoff(altitude_m)
  *                       once (again after a setpoint_rejected flight event before hovering)
  *   rendezvous/voting   hovering (flight event "hover", or mode "hold" above altitude_m - 1 m):
- *                       propose "pos"; again every 2 s until its own "pos" is committed
+ *                       propose "pos" (where it is at that first step); the same entry again
+ *                       every 2 s until its own "pos" is committed
  *   rendezvous/flying   a "pos" of every member committed: P = their mean (summed in sorted member
  *                       order); slot i (index in sorted members) = P + radius_m (cos a, sin a),
  *                       a = 2 pi i / N; a position setpoint (slot, altitude_m) every step, yaw unset;
@@ -31,7 +33,8 @@
  *                       until committed; the setpoint stays
  *   rendezvous/landing  "arrived" of every member committed: hold_s more on the slot, then the
  *                       land command (once), no setpoint after it
- *   rendezvous/done     landed after the land command: event rendezvous_complete members=N once
+ *   rendezvous/done     landed (vehicle.landed or a flight event "landed") after the land command:
+ *                       event rendezvous_complete members=N once
  */
 #ifndef SWARMBOX_C_BRAIN_RENDEZVOUS_H
 #define SWARMBOX_C_BRAIN_RENDEZVOUS_H
@@ -67,6 +70,7 @@ typedef struct rv_input {
   bool landed;                /* vehicle.landed */
   bool hover_event;           /* a flight event "hover" in this input */
   bool rejected_event;        /* a flight event "setpoint_rejected" in this input */
+  bool landed_event;          /* a flight event "landed" in this input */
 } rv_input;
 
 typedef struct rv_command {
@@ -102,6 +106,7 @@ typedef struct rv_state {
   rv_config config;
   bool takeoff_asked;
   bool airborne;
+  char pos_entry[RV_ENTRY_MAX]; /* "pos <self> <x> <y>" where it first hovered */
   bool pos_proposed;
   int64_t pos_proposed_ns;
   size_t n_pos;

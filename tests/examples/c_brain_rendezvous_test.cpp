@@ -120,7 +120,8 @@ std::vector<Drone> Fleet(const std::vector<std::string>& members, const std::vec
                         .flight_mode = d.mode.c_str(),
                         .landed = d.landed,
                         .hover_event = d.hover_event,
-                        .rejected_event = false};
+                        .rejected_event = false,
+                        .landed_event = false};
       rv_output out;
       rv_step(&d.brain, &in, &out);
       for (std::size_t p = 0; p < out.n_proposals; ++p) pending.emplace_back(out.proposals[p]);
@@ -173,17 +174,18 @@ TEST(CBrainRendezvous, TheSameInputsGiveTheSameRun) {
   }
 }
 
+// Words are separated by runs of spaces (as the C++ example brain reads them).
 TEST(CBrainRendezvous, IgnoresEntriesItDoesNotKnowAndCountsTheFirstPerMember) {
   const rv_config c = Config({"a", "b"}, 0);
   rv_state s;
   rv_init(&s, &c);
   for (const std::string& e : std::vector<std::string>{"pos c 1 2", "pos a 1", "pos a 1 2 3", "pos a x 2", "pos a nan 2", "arrived",
-                              "arrived a b", "posa 1 2", std::string("pos a 1\0 2", 9), "pos a  1 2"}) {
+                              "arrived a b", "posa 1 2", std::string("pos a 1\0 2", 9), "pos a 1e999 2"}) {
     rv_apply_entry(&s, reinterpret_cast<const std::uint8_t*>(e.data()), e.size());
   }
   EXPECT_EQ(s.n_pos, 0u);
   EXPECT_EQ(s.n_arrived, 0u);
-  for (const std::string& e : std::vector<std::string>{"pos b -1.5 2.25", "pos b 9 9", "arrived b", "arrived b"}) {
+  for (const std::string& e : std::vector<std::string>{"pos  b -1.5   2.25", "pos b 9 9", " arrived b ", "arrived b"}) {
     rv_apply_entry(&s, reinterpret_cast<const std::uint8_t*>(e.data()), e.size());
   }
   EXPECT_EQ(s.n_pos, 1u);
@@ -198,7 +200,7 @@ TEST(CBrainRendezvous, AsksForTakeoffAgainWhenTheFlightStackRefusedIt) {
   rv_init(&s, &c);
   rv_output out;
   rv_input in{.t_ns = 0, .position_enu_m = {0, 0, 0}, .flight_mode = "init", .landed = true,
-              .hover_event = false, .rejected_event = false};
+              .hover_event = false, .rejected_event = false, .landed_event = false};
   rv_step(&s, &in, &out);
   EXPECT_EQ(out.n_commands, 0u) << "takeoff in init (the flight stack refuses it)";
   in.flight_mode = "idle";

@@ -172,7 +172,8 @@ TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
   EXPECT_TRUE(out.commands.empty());
   EXPECT_EQ(out.status, "rendezvous/takeoff");
 
-  // 2. Hovering: propose its position, again 2 s (simulated) later until committed.
+  // 2. Hovering: propose its position there, the same entry again 2 s (simulated) later until
+  // committed.
   auto hover = Input(t += kPeriodNs, "hold", 1.2344, -2.5, 10.0);
   FlightEvent(hover, "hover");
   const std::int64_t proposed_ns = t;
@@ -186,7 +187,7 @@ TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
   out = Exchange(Input(t, "hold", 1.3, -2.5, 10.0));
   EXPECT_TRUE(out.proposals.empty()) << "re-proposed before 2 s";
   out = Exchange(Input(t += kPeriodNs, "hold", 1.3, -2.5, 10.0));
-  EXPECT_EQ(Proposals(out), std::vector<std::string>{"pos scout_2 1.300 -2.500"});
+  EXPECT_EQ(Proposals(out), std::vector<std::string>{"pos scout_2 1.234 -2.500"}) << "not the same entry";
   EXPECT_EQ(out.status, "rendezvous/voting");
 
   // 3. A `pos` of every member committed (the first per member counts; other entries ignored):
@@ -259,8 +260,9 @@ TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
   EXPECT_TRUE(out.events.empty());
   EXPECT_EQ(out.status, "rendezvous/landing");
 
-  // Landed: rendezvous_complete once, then done.
-  auto landed = Input(t += kPeriodNs, "landed", sx, sy, 0.0);
+  // Landed (the flight event comes first; vehicle.landed may follow a step later):
+  // rendezvous_complete once, then done.
+  auto landed = Input(t += kPeriodNs, "land", sx, sy, 0.0);
   FlightEvent(landed, "landed");
   out = Exchange(landed);
   ASSERT_EQ(out.events.size(), 1u);
