@@ -1,7 +1,7 @@
 // examples/c_brain (swarmbox_c_brain) as an agent meets it: this process plays the agent over the
 // bus library (publishes BrainInputs of a scripted flight on offboard/scout_2/input, reads the
 // BrainOutputs on offboard/scout_2/output, both kLockstep), the C program runs as a child on a DDS
-// domain of its own (64..71, by process id) with CYCLONEDDS_URI binding it to lo. Checked: every
+// domain of its own (64..71) with CYCLONEDDS_URI binding it to lo. Checked: every
 // input is answered by exactly one output with its sim_time_ns, and the rendezvous protocol
 // (design of issue #24): takeoff first, a `pos` proposal once hovering (again after 2 s of
 // simulated time), the slot setpoint once every member's `pos` is committed, `arrived` near the
@@ -32,7 +32,9 @@ using namespace std::chrono_literals;
 constexpr std::int64_t kPeriodNs = 20'000'000;  // an external brain's default period (50 Hz)
 constexpr auto kAnswerTimeout = 10s;            // a hang guard, never a speed assertion
 
-int Domain() { return 64 + static_cast<int>(::getpid() % 8); }
+// DDS domains 64..71: even for the flight, odd for the other case (ctest runs them side by side),
+// spread by process id over concurrent runs.
+int Domain(int slot) { return 64 + slot + 2 * static_cast<int>(::getpid() % 4); }
 
 // Cyclone DDS of the child: lo, multicast on (as the bus binds its own participants).
 constexpr const char* kCycloneUri =
@@ -45,10 +47,12 @@ std::string Text(const std::vector<std::uint8_t>& bytes) { return {bytes.begin()
 
 class CBrain : public ::testing::Test {
  protected:
-  void SetUp() override {
+  // Joins domain Domain(slot) as the agent of scout_2.
+  void Join(int slot) {
+    domain_ = Domain(slot);
     dir_ = testing::MakeTempDir("swarmbox-c-brain-");
     ASSERT_FALSE(dir_.empty());
-    auto p = bus::Participant::Create({.backend = "cyclonedds", .domain_id = Domain(), .interface = "lo"});
+    auto p = bus::Participant::Create({.backend = "cyclonedds", .domain_id = domain_, .interface = "lo"});
     ASSERT_TRUE(p) << p.error().ToString();
     participant_ = std::move(*p);
     auto in = participant_->CreatePublisher<bus::BrainInput>(bus::OffboardInputTopic("scout_2"),
@@ -71,7 +75,7 @@ class CBrain : public ::testing::Test {
   void StartBrain(const bus::BrainInput& first) {
     ::setenv("CYCLONEDDS_URI", kCycloneUri, 1);
     brain_.emplace(std::vector<std::string>{SWARMBOX_C_BRAIN_BIN, "--drone", "scout_2", "--domain",
-                                            std::to_string(Domain()), "--members",
+                                            std::to_string(domain_), "--members",
                                             "scout_3,scout_1,scout_2", "--hold-s", "3"},
                    dir_ + "/brain.log");
     ASSERT_TRUE(brain_->running()) << brain_->spawn_error();
@@ -107,6 +111,7 @@ class CBrain : public ::testing::Test {
     return out;
   }
 
+  int domain_ = 0;
   std::string dir_;
   std::unique_ptr<bus::Participant> participant_;
   std::unique_ptr<bus::Publisher<bus::BrainInput>> input_;
@@ -153,6 +158,7 @@ std::vector<std::string> Commands(const bus::BrainOutput& out) {
 }
 
 TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
+  ASSERT_NO_FATAL_FAILURE(Join(0));
   std::int64_t t = 0;
   // Landed, the estimator not ready ("init": the flight stack would refuse a takeoff): wait.
   ASSERT_NO_FATAL_FAILURE(StartBrain(Input(t, "init", 0.0, 0.0, 0.0)));
@@ -286,6 +292,7 @@ TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
 }
 
 TEST_F(CBrain, AnswersARepeatedInputTheSameAndSigintEndsItWithExitZero) {
+  ASSERT_NO_FATAL_FAILURE(Join(1));
   const auto first = Input(0, "idle", 0.0, 0.0, 0.0);
   ASSERT_NO_FATAL_FAILURE(StartBrain(first));
   EXPECT_EQ(Commands(first_), std::vector<std::string>{"takeoff"});
