@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/raft/mission_command.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
 
@@ -42,6 +43,13 @@ class WaitBudget {
 // itself runs on it); never read with the channel.
 double SteadyS() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// A brain's event as the agent's logfmt line.
+LogEvent FromBrainEvent(double t_s, const std::string& node, const brain::Event& e) {
+  LogEvent line(t_s, node, e.name);
+  for (const auto& [key, value] : e.fields) line.Add(key, value);
+  return line;
 }
 
 }  // namespace
@@ -83,42 +91,32 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   }
   auto cfg = flight::LoadFlightConfig(o.airframe_path);
   if (!cfg) return cfg.error().Context("loading airframe");
-  MissionHostConfig mc;
+  // --mission sar: SarBrain's Context (what any brain is told) and the agent's perception,
+  // checked before anything joins the bus.
+  brain::Context sar_ctx;
+  std::optional<SarBrainConfig> sar_config;
+  PerceptionConfig perception;
   if (o.mission.kind == MissionKind::kSar) {
     if (o.raft.members.empty()) return Error(ErrorCode::kInvalidArgument, "--mission sar needs --members");
     if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--mission sar needs the mesh bus (drop --no-mesh)");
-    auto world = LoadWorldView(o.mission.world_path);
-    if (!world) return world.error();
-    auto camera = LoadCameraSpec(o.airframe_path);
-    if (!camera) return camera.error().Context("loading the airframe's camera");
-    mc.name = o.name;
-    mc.members = o.raft.members;
-    mc.airframe = cfg->airframe;
-    mc.payload = o.mission.payload;
-    mc.base_height_m = cfg->base_height_m;
-    mc.vehicle_mass_kg = cfg->mass_kg;
-    mc.has_home = o.has_start;
-    mc.home_m = o.start_m;
-    mc.geofence_size_x_m = world->size_x_m;
-    mc.geofence_size_y_m = world->size_y_m;
-    mc.camera = *camera;
-    mc.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
-    if (!o.mission.payload.empty()) {
-      auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
-                             [&](const flight::SlungPayload& p) { return p.name == o.mission.payload; });
-      if (it == cfg->payloads.end()) {
-        std::string known;
-        for (const flight::SlungPayload& p : cfg->payloads) known += (known.empty() ? "" : ", ") + p.name;
-        return Error(ErrorCode::kInvalidArgument, "--payload '" + o.mission.payload + "': airframe " + cfg->airframe +
-                                                      " has " + (known.empty() ? std::string("no payloads") : "payloads " + known));
-      }
-      mc.payload_sling_length_m = it->sling_length_m;
-      mc.payload_hook_m = it->hook_m;
-      auto ground = LoadGroundPayload(o.airframe_path, o.mission.payload);
-      if (!ground) return ground.error().Context("--payload");
-      mc.payload_offset_m = ground->offset_m;
-      mc.payload_half_height_m = ground->half_height_m;
+    sar_ctx.self = o.name;
+    sar_ctx.members = o.raft.members;
+    sar_ctx.seed = o.raft.seed;
+    sar_ctx.period_ns = static_cast<std::int64_t>(std::llround(o.control_dt_s * 1e9));
+    sar_ctx.airframe = cfg->airframe;
+    sar_ctx.airframe_path = o.airframe_path;
+    sar_ctx.world_path = o.mission.world_path;
+    sar_ctx.payload = o.mission.payload;
+    if (o.has_start) {
+      char start[96];
+      std::snprintf(start, sizeof start, "%.17g,%.17g,%.17g", o.start_m.x(), o.start_m.y(), o.start_m.z());
+      sar_ctx.args["start"] = start;
     }
+    auto c = SarBrainConfigFrom(sar_ctx);
+    if (!c) return c.error();
+    sar_config = std::move(*c);
+    perception.camera = sar_config->camera;
+    perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
   }
   auto plan = FlightPlan::Parse(o.plan);  // --mission sar: parsed (the default) but not flown
   if (!plan) return plan.error().Context("--plan");
@@ -191,11 +189,17 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!probe) return probe.error().Context("starting the link probe");
     node->probe_ = std::move(*probe);
   }
-  if (o.mission.kind == MissionKind::kSar) {
-    auto host = MissionHost::Create(mc);
-    if (!host) return host.error();
-    node->mission_ = std::move(*host);
+  if (sar_config) {
+    AgentNode* n = node.get();
+    auto log = [n](const brain::Event& e) { n->Log(FromBrainEvent(n->t_s_, n->options_.name, e)); };
+    auto made = SarBrain::Create(*sar_config, log, channel ? nullptr : &node->netem_wall_);
+    if (!made) return made.error();
+    node->mission_ = std::move(*made);
+    node->mission_state_ = node->mission_->MakeReplicatedState();
     if (node->mission_->role() == swarm::Role::kScout) {
+      auto p = PerceptionHost::Create(perception);
+      if (!p) return p.error();
+      node->perception_ = std::move(*p);
       auto cam = node->sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(o.name), bus::Qos::kLockstep);
       if (!cam) return cam.error().Context("subscribing to the camera");
       node->camera_sub_ = std::move(*cam);
@@ -272,16 +276,21 @@ void AgentNode::OnPing(const bus::RadioFrame& frame) {
 
 void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& frame) {
   if (!mission_) return;
-  PeerState p;
-  p.name = state.drone;
-  p.mode = state.mode;
-  p.position_m = V(state.position_enu_m);
-  p.velocity_m_s = V(state.velocity_enu_m_s);
-  p.sim_time_s = static_cast<double>(state.sim_time_ns) * 1e-9;
-  // netem: when it arrived on the steady clock, for the lost-member rule's wall-clock silence.
-  // channel: none (NaN): the simulated clock alone decides.
-  if (options_.radio_model == RadioModel::kNetem) p.received_wall_s = static_cast<double>(frame.delivered_ns) * 1e-9;
-  mission_->OnPeerState(p);
+  brain::Neighbour n;
+  n.name = state.drone;
+  n.t_ns = state.sim_time_ns;
+  n.position_m = {state.position_enu_m[0], state.position_enu_m[1], state.position_enu_m[2]};
+  n.velocity_m_s = {state.velocity_enu_m_s[0], state.velocity_enu_m_s[1], state.velocity_enu_m_s[2]};
+  n.heading_rad = state.heading_rad;
+  n.battery_fraction = state.battery_fraction;
+  n.status = state.mode;
+  // netem: when it arrived on the steady clock, for the lost-member rule's wall-clock silence
+  // (SarBrain's side channel). channel: none, the simulated clock alone decides.
+  if (options_.radio_model == RadioModel::kNetem) {
+    netem_wall_.OnState(n.name, n.t_ns, static_cast<double>(frame.delivered_ns) * 1e-9);
+  }
+  auto [it, fresh] = neighbours_.try_emplace(n.name, n);
+  if (!fresh && n.t_ns >= it->second.t_ns) it->second = std::move(n);  // the latest state heard
 }
 
 void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::RadioFrame& /*frame*/) {
@@ -407,57 +416,101 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
 
 void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
   const flight::StateEstimate& est = fc_.estimate();
-  mission_->RecordEstimate(t_s_, est);
-  for (std::size_t i = 0; i < image_count_; ++i) {
-    bus::CameraImage& image = images_[i];
-    if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
-    if (image.data.size() < static_cast<std::size_t>(image.height_px) * image.row_stride_bytes) continue;
-    cv::Mat bgr(static_cast<int>(image.height_px), static_cast<int>(image.width_px), CV_8UC3, image.data.data(),
-                image.row_stride_bytes);
-    if (image.encoding == "rgb8") cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
-    const bus::CameraIntrinsics& k = image.intrinsics;
-    mission_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image.sim_time_ns) * 1e-9);
-  }
-  MissionHostInput in;
-  in.t_s = t_s_;
-  // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
-  // time and nothing of the wall clock may feed a decision (NaN: the simulated rule alone).
-  if (options_.radio_model == RadioModel::kNetem) in.wall_s = SteadyS();
-  in.dt_s = options_.control_dt_s;
-  in.flight_mode = fc_.mode();
-  in.estimate = &est;
-  in.mission = &raft_->service().mission();  // the committed state as of this step's Raft calls
-  in.is_leader = raft_->service().is_leader();
-  in.hover_event = hover_event;
-  in.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
-  const MissionHostOutput& out = mission_->Step(in);
-  for (const LogEvent& e : out.events) Log(e);
-  if (out.command) (void)fc_.Command(*out.command);
-  for (const raft::MissionCommand& c : out.proposals) {
-    (void)raft_->service().Propose(c);  // kUnavailable (no leader yet): the behaviours re-propose
-  }
-  if (out.payload.action != swarm::PayloadAction::kNone) {
-    ++world_cmd_.seq;
-    world_cmd_.sim_time_ns = msg.sim_time_ns;
-    world_cmd_.target = options_.name;
-    world_cmd_.args.clear();
-    if (out.payload.action == swarm::PayloadAction::kAttach) {
-      world_cmd_.command = "payload_attach";
-      world_cmd_.args.push_back(out.payload.mass_kg);
-    } else {
-      world_cmd_.command = "payload_release";
+  // Perception (scouts): this step's frames geolocated with the estimate of their capture step.
+  detections_.clear();
+  if (perception_) {
+    perception_->RecordEstimate(t_s_, est);
+    for (std::size_t i = 0; i < image_count_; ++i) {
+      bus::CameraImage& image = images_[i];
+      if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
+      if (image.data.size() < static_cast<std::size_t>(image.height_px) * image.row_stride_bytes) continue;
+      cv::Mat bgr(static_cast<int>(image.height_px), static_cast<int>(image.width_px), CV_8UC3, image.data.data(),
+                  image.row_stride_bytes);
+      if (image.encoding == "rgb8") cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
+      const bus::CameraIntrinsics& k = image.intrinsics;
+      perception_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image.sim_time_ns) * 1e-9);
     }
-    // The announced load as the hover thrust estimator's prior (it corrects a refused hook).
-    fc_.SetPayloadMass(out.payload.action == swarm::PayloadAction::kAttach ? out.payload.mass_kg : 0.0);
-    cmd_.world.push_back(world_cmd_);  // applied by the physics server before it steps the world
+    perception_->PopVisible(t_s_, &detections_);
   }
-  for (const swarm::GroundDetection& d : out.detections) {
+  // The committed mission as of this step's Raft calls.
+  dynamic_cast<SarMissionState&>(*mission_state_).Mirror(raft_->service().mission());
+  // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
+  // time and nothing of the wall clock may feed a decision (the brain has no side channel then).
+  if (options_.radio_model == RadioModel::kNetem) netem_wall_.now_s = SteadyS();
+  brain::Input in;
+  in.t_ns = msg.sim_time_ns;
+  in.self.name = options_.name;
+  in.self.step = msg.step;
+  in.self.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+  in.self.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  in.self.attitude_wxyz[0] = est.att.w();
+  in.self.attitude_wxyz[1] = est.att.x();
+  in.self.attitude_wxyz[2] = est.att.y();
+  in.self.attitude_wxyz[3] = est.att.z();
+  in.self.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
+  in.self.heading_rad = flight::YawOf(est.att);
+  in.self.flight_mode = std::string(flight::FlightModeName(fc_.mode()));
+  in.self.landed = fc_.mode() == flight::FlightMode::kIdle || fc_.mode() == flight::FlightMode::kLanded;
+  in.self.armed = !in.self.landed && fc_.mode() != flight::FlightMode::kInit;
+  in.self.payload_mass_kg = mission_->payload_mass_kg();
+  in.self.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
+  flight_events_.clear();
+  if (hover_event) flight_events_.push_back({"hover", msg.sim_time_ns, {}});
+  in.flight_events = flight_events_;
+  in.is_leader = raft_->service().is_leader();
+  neighbour_table_.clear();
+  for (const auto& [name, n] : neighbours_) neighbour_table_.push_back(n);
+  in.neighbours = neighbour_table_;
+  in.detections = detections_;
+  in.state = mission_state_.get();
+  brain_out_ = brain::Output{};
+  mission_->Step(in, brain_out_);
+  for (const brain::Event& e : brain_out_.events) Log(FromBrainEvent(t_s_, options_.name, e));
+  for (const brain::Command& c : brain_out_.commands) {
+    switch (c.kind) {
+      case brain::Command::Kind::kTakeoff: (void)fc_.Command(flight::Setpoint::Takeoff(c.param)); break;
+      case brain::Command::Kind::kLand: (void)fc_.Command(flight::Setpoint::Land()); break;
+      case brain::Command::Kind::kHold: (void)fc_.Command(flight::Setpoint::Hold()); break;
+      case brain::Command::Kind::kPayloadAttach:
+      case brain::Command::Kind::kPayloadRelease: {
+        const bool attach = c.kind == brain::Command::Kind::kPayloadAttach;
+        ++world_cmd_.seq;
+        world_cmd_.sim_time_ns = msg.sim_time_ns;
+        world_cmd_.target = options_.name;
+        world_cmd_.args.clear();
+        world_cmd_.command = attach ? "payload_attach" : "payload_release";
+        if (attach) world_cmd_.args.push_back(c.param);
+        // The announced load as the hover thrust estimator's prior (it corrects a refused hook).
+        fc_.SetPayloadMass(attach ? c.param : 0.0);
+        cmd_.world.push_back(world_cmd_);  // applied by the physics server before it steps the world
+        break;
+      }
+      case brain::Command::Kind::kArm:
+      case brain::Command::Kind::kDisarm:
+        break;  // the flight stack arms on take-off and disarms on landing by itself
+    }
+  }
+  for (const brain::Setpoint& sp : brain_out_.setpoint) {
+    // SarBrain answers position only or velocity only (TrajectorySetpoint form).
+    if (std::isfinite(sp.position_m.x)) {
+      (void)fc_.Command(flight::Setpoint::Position(flight::Vec3(sp.position_m.x, sp.position_m.y, sp.position_m.z), sp.yaw_rad));
+    } else {
+      (void)fc_.Command(
+          flight::Setpoint::Velocity(flight::Vec3(sp.velocity_m_s.x, sp.velocity_m_s.y, sp.velocity_m_s.z), sp.yaw_rad));
+    }
+  }
+  for (const std::vector<std::uint8_t>& bytes : brain_out_.proposals) {
+    auto c = raft::DecodeCommand(bytes);
+    if (!c) continue;  // SarBrain's own encoding: always decodes
+    (void)raft_->service().Propose(*c);  // kUnavailable (no leader yet): the behaviours re-propose
+  }
+  for (const brain::Detection& d : detections_) {
     bus::Detection det;
     det.from = options_.name;
-    det.sim_time_ns = static_cast<std::int64_t>(d.capture_time_s * 1e9);
-    det.label = "victim";
+    det.sim_time_ns = d.t_ns;
+    det.label = d.label;
     det.confidence = d.confidence;
-    det.position_enu_m = {d.position_m.x(), d.position_m.y(), d.position_m.z()};
+    det.position_enu_m = {d.position_m.x, d.position_m.y, d.position_m.z};
     det.position_sigma_m = d.sigma_m;
     out_frame_ = bus::RadioFrame{};
     out_frame_.detection_msg.push_back(std::move(det));

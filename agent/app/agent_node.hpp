@@ -24,7 +24,7 @@
 // radio's clock is the lockstep's; nothing happens between samples); with kNetem the radio, Raft
 // and the probe run on the steady clock, also between samples (every 10 ms while waiting: the
 // mesh does not wait for the lockstep), and the SAR leader's lost-member rule also wants a
-// wall-clock silence (mission_host.hpp).
+// wall-clock silence (sar_brain.hpp: NetemWallClock, its one side channel).
 // Wall clocks otherwise only bound liveness: the first sample, a stall, a missing camera frame.
 #pragma once
 
@@ -32,6 +32,7 @@
 #include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -39,10 +40,11 @@
 #include <vector>
 
 #include "flight_plan.hpp"
-#include "mission_host.hpp"
+#include "perception_host.hpp"
 #include "mission_options.hpp"
 #include "radio_dispatch.hpp"
 #include "raft_host.hpp"
+#include "sar_brain.hpp"
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
@@ -119,8 +121,9 @@ class AgentNode final : private FrameHandler {
   // netem only, while waiting for a sample: the radio's deliveries dispatched, Raft's ticks and
   // the probe on the wall clock (as the mesh does not wait for the lockstep). Raft's error.
   Status ServeRadioBetweenSteps();
-  // --mission sar: feeds the mission host (camera, committed state) and carries out what it
-  // asks (setpoint, payload world command, proposals, detections, events).
+  // --mission sar: perception (camera frames -> detections, also broadcast), then SarBrain
+  // stepped through the brain SDK, and what it answers carried out (commands, setpoint, payload
+  // world commands, proposals, status, events).
   void StepMission(const bus::SensorSample& msg, bool hover_event);
   void BroadcastState(const bus::SensorSample& msg);
   bool Done() const;  // the plan is complete, or the SAR mission is (and this drone is down)
@@ -146,7 +149,15 @@ class AgentNode final : private FrameHandler {
   DispatchCounts dispatched_;
   std::vector<LogEvent> lines_;
   // --mission sar only.
-  std::unique_ptr<MissionHost> mission_;
+  std::unique_ptr<SarBrain> mission_;
+  std::unique_ptr<brain::ReplicatedState> mission_state_;  // the brain's: the committed mission
+  std::unique_ptr<PerceptionHost> perception_;             // scouts
+  NetemWallClock netem_wall_;                              // netem only: the brain's side channel
+  std::map<std::string, brain::Neighbour> neighbours_;     // latest state heard from each drone
+  std::vector<brain::Neighbour> neighbour_table_;          // sorted by name, for the Input
+  std::vector<brain::Detection> detections_;               // this step's
+  std::vector<brain::FlightEvent> flight_events_;          // this step's
+  brain::Output brain_out_;
   std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;
   std::vector<bus::CameraImage> images_;      // taken this step (buffers reused)
   std::size_t image_count_ = 0;

@@ -19,7 +19,7 @@
 // on stdout with the agent's simulated time `t`. The mesh domain must differ from the sim one.
 //
 // What it flies (mission_options.hpp): --mission plan (default) flies --plan; --mission sar flies
-// the SAR mission (mission_host.hpp) and needs --members and --world:
+// the SAR mission (SarBrain, sar_brain.hpp, on the brain SDK) and needs --members and --world:
 //       --mission sar --world trials/worlds/open_field.yaml [--payload stretcher]
 //       [--inference-latency-ms 40]
 // Usage errors (unknown flag, bad value, a bad combination) exit 2, as the rest of bad input.
