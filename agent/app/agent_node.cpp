@@ -10,6 +10,7 @@
 #include "swarmbox/raft/mission_command.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
+#include "wait_budget.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -21,23 +22,6 @@ std::string Seconds(double s) {
   std::snprintf(buf, sizeof buf, "%.1f", s);
   return buf;
 }
-
-// A wall-clock wait of `total`, spent in slices: each slice counts at most its own length, so a
-// process stopped or starved in the middle of one (SIGSTOP, docker pause) resumes with the rest
-// of its budget instead of a deadline long gone.
-class WaitBudget {
- public:
-  explicit WaitBudget(std::chrono::milliseconds total) : left_(total) {}
-  bool spent() const { return left_ <= std::chrono::milliseconds(0); }
-  std::chrono::milliseconds Slice(std::chrono::milliseconds max) const { return std::min(left_, max); }
-  void Spend(std::chrono::steady_clock::duration elapsed, std::chrono::milliseconds slice) {
-    left_ -= std::min(std::chrono::duration_cast<std::chrono::milliseconds>(elapsed), slice);
-    if (elapsed < std::chrono::milliseconds(1)) left_ -= std::chrono::milliseconds(1);  // always progress
-  }
-
- private:
-  std::chrono::milliseconds left_;
-};
 
 // The wall clock of radio.model netem only (the wall part of its lost-member rule, as the radio
 // itself runs on it); never read with the channel.
@@ -296,6 +280,10 @@ void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& fra
 void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::RadioFrame& /*frame*/) {
   // Heard and counted (dispatched_.detection): sightings reach the swarm through Raft; the
   // broadcast detections are for recorders and a ground station.
+}
+
+void AgentNode::OnBrainMessage(const bus::BrainMessage& /*message*/, const bus::RadioFrame& /*frame*/) {
+  // Heard and counted (dispatched_.brain): the built-in missions have no brain inbox.
 }
 
 Status AgentNode::ServeRadioBetweenSteps() {

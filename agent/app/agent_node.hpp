@@ -132,6 +132,7 @@ class AgentNode final : private FrameHandler {
   void OnPing(const bus::RadioFrame& frame) override;
   void OnState(const bus::DroneState& state, const bus::RadioFrame& frame) override;
   void OnDetection(const bus::Detection& detection, const bus::RadioFrame& frame) override;
+  void OnBrainMessage(const bus::BrainMessage& message, const bus::RadioFrame& frame) override;
 
   AgentOptions options_;
   flight::FlightController fc_;
