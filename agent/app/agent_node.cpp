@@ -6,8 +6,8 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "brain_convert.hpp"
 #include "swarmbox/common/logfmt.hpp"
-#include "swarmbox/raft/mission_command.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
 #include "wait_budget.hpp"
@@ -153,6 +153,16 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!dds) return dds.error().Context("starting the mesh radio");
     node->radio_ = std::move(*dds);
   }
+  // --mission sar: the builtin brain and its replicated state, which Raft applies (before Raft).
+  std::unique_ptr<SarBrain> sar_brain;
+  if (sar_config) {
+    AgentNode* n = node.get();
+    auto log = [n](const brain::Event& e) { n->Log(FromBrainEvent(n->t_s_, n->options_.name, e)); };
+    auto made = SarBrain::Create(*sar_config, log, channel ? nullptr : &node->netem_wall_);
+    if (!made) return made.error();
+    sar_brain = std::move(*made);
+    node->mission_state_ = sar_brain->MakeMissionState();
+  }
   if (!o.raft.members.empty()) {
     if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--members (Raft) needs the mesh bus (drop --no-mesh)");
     RaftHostOptions ro = o.raft;
@@ -161,7 +171,8 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     // Raft's clock: simulated seconds (channel: the radio's clock is the lockstep's, from 0), or
     // wall seconds since now (netem: the steady clock). Its lines carry the simulated time.
     node->raft_clock_ = std::make_unique<RadioClock>(*node->radio_, channel ? 0 : node->radio_->now_ns());
-    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_);
+    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_,
+                                node->mission_state_ ? node->mission_state_->RaftMachine() : nullptr);
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
   }
@@ -173,13 +184,17 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!probe) return probe.error().Context("starting the link probe");
     node->probe_ = std::move(*probe);
   }
-  if (sar_config) {
-    AgentNode* n = node.get();
-    auto log = [n](const brain::Event& e) { n->Log(FromBrainEvent(n->t_s_, n->options_.name, e)); };
-    auto made = SarBrain::Create(*sar_config, log, channel ? nullptr : &node->netem_wall_);
-    if (!made) return made.error();
-    node->mission_ = std::move(*made);
-    node->mission_state_ = node->mission_->MakeReplicatedState();
+  if (sar_brain) {
+    // SarBrain through BrainHost, as any brain: every lockstep step (the control period).
+    node->mission_ = sar_brain.get();
+    node->flight_port_ = std::make_unique<ControllerPort>(node->fc_);
+    node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
+    BrainHostOptions bo;
+    bo.self = o.name;
+    bo.period_steps = 1;
+    bo.state = node->mission_state_.get();
+    node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(sar_brain), *node->flight_port_, node->radio_.get(),
+                                                    node->consensus_.get(), o.log);
     if (node->mission_->role() == swarm::Role::kScout) {
       auto p = PerceptionHost::Create(perception);
       if (!p) return p.error();
@@ -259,22 +274,13 @@ void AgentNode::OnPing(const bus::RadioFrame& frame) {
 }
 
 void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& frame) {
-  if (!mission_) return;
-  brain::Neighbour n;
-  n.name = state.drone;
-  n.t_ns = state.sim_time_ns;
-  n.position_m = {state.position_enu_m[0], state.position_enu_m[1], state.position_enu_m[2]};
-  n.velocity_m_s = {state.velocity_enu_m_s[0], state.velocity_enu_m_s[1], state.velocity_enu_m_s[2]};
-  n.heading_rad = state.heading_rad;
-  n.battery_fraction = state.battery_fraction;
-  n.status = state.mode;
+  if (!brain_host_) return;
   // netem: when it arrived on the steady clock, for the lost-member rule's wall-clock silence
   // (SarBrain's side channel). channel: none, the simulated clock alone decides.
-  if (options_.radio_model == RadioModel::kNetem) {
-    netem_wall_.OnState(n.name, n.t_ns, static_cast<double>(frame.delivered_ns) * 1e-9);
+  if (options_.radio_model == RadioModel::kNetem && state.drone != options_.name) {
+    netem_wall_.OnState(state.drone, state.sim_time_ns, static_cast<double>(frame.delivered_ns) * 1e-9);
   }
-  auto [it, fresh] = neighbours_.try_emplace(n.name, n);
-  if (!fresh && n.t_ns >= it->second.t_ns) it->second = std::move(n);  // the latest state heard
+  brain_host_->OnState(state);
 }
 
 void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::RadioFrame& /*frame*/) {
@@ -334,6 +340,7 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
       case FlightEventKind::kRejected: st.rejected = true; break;
       default: break;
     }
+    if (brain_host_) brain_host_->OnFlightEvent(e);
     LogEvent le(e.t_s, options_.name, flight::FlightEventName(e.kind));
     if (e.kind == FlightEventKind::kModeChange) le.Add("mode", flight::FlightModeName(e.mode));
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
@@ -348,7 +355,7 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
     for (const LogEvent& line : lines_) Log(line);
   }
   if (mission_) {
-    StepMission(msg, st.hover);
+    StepMission(msg);
   } else {
     if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
     if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
@@ -391,8 +398,8 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
   state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
   state_.heading_rad = flight::YawOf(est.att);
-  if (mission_) {
-    state_.mode = mission_->mode();
+  if (brain_host_) {
+    state_.mode = brain_host_->status();
     state_.battery_fraction = mission_->battery_fraction();
   } else {
     state_.mode = std::string(flight::FlightModeName(fc_.mode()));
@@ -402,9 +409,19 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   radio_->Send(std::move(out_frame_));
 }
 
-void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
+void RaftConsensus::TakeCommitted(std::vector<brain::Entry>* out) {
+  raft_.TakeCommitted(&taken_);
+  for (raft::Committed& c : taken_) out->push_back({c.index, std::move(c.data)});
+}
+
+bool RaftConsensus::Propose(std::span<const std::uint8_t> data) {
+  return raft_.ProposeBytes(raft::Bytes(data.begin(), data.end())).ok();
+}
+
+void AgentNode::StepMission(const bus::SensorSample& msg) {
   const flight::StateEstimate& est = fc_.estimate();
-  // Perception (scouts): this step's frames geolocated with the estimate of their capture step.
+  // Perception (scouts): this step's frames geolocated with the estimate of their capture step,
+  // to the brain once the inference latency has passed, and on the radio (best effort).
   detections_.clear();
   if (perception_) {
     perception_->RecordEstimate(t_s_, est);
@@ -419,89 +436,33 @@ void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
       perception_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image.sim_time_ns) * 1e-9);
     }
     perception_->PopVisible(t_s_, &detections_);
+    for (const brain::Detection& d : detections_) brain_host_->OnDetection(d);
   }
-  // The committed mission as of this step's Raft calls.
-  dynamic_cast<SarMissionState&>(*mission_state_).Mirror(raft_->service().mission());
   // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
   // time and nothing of the wall clock may feed a decision (the brain has no side channel then).
   if (options_.radio_model == RadioModel::kNetem) netem_wall_.now_s = SteadyS();
-  brain::Input in;
-  in.t_ns = msg.sim_time_ns;
-  in.self.name = options_.name;
-  in.self.step = msg.step;
-  in.self.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
-  in.self.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
-  in.self.attitude_wxyz[0] = est.att.w();
-  in.self.attitude_wxyz[1] = est.att.x();
-  in.self.attitude_wxyz[2] = est.att.y();
-  in.self.attitude_wxyz[3] = est.att.z();
-  in.self.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
-  in.self.heading_rad = flight::YawOf(est.att);
-  in.self.flight_mode = std::string(flight::FlightModeName(fc_.mode()));
-  in.self.landed = fc_.mode() == flight::FlightMode::kIdle || fc_.mode() == flight::FlightMode::kLanded;
-  in.self.armed = !in.self.landed && fc_.mode() != flight::FlightMode::kInit;
-  in.self.payload_mass_kg = mission_->payload_mass_kg();
-  in.self.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
-  flight_events_.clear();
-  if (hover_event) flight_events_.push_back({"hover", msg.sim_time_ns, {}});
-  in.flight_events = flight_events_;
-  in.is_leader = raft_->service().is_leader();
-  neighbour_table_.clear();
-  for (const auto& [name, n] : neighbours_) neighbour_table_.push_back(n);
-  in.neighbours = neighbour_table_;
-  in.detections = detections_;
-  in.state = mission_state_.get();
-  brain_out_ = brain::Output{};
-  mission_->Step(in, brain_out_);
-  for (const brain::Event& e : brain_out_.events) Log(FromBrainEvent(t_s_, options_.name, e));
-  for (const brain::Command& c : brain_out_.commands) {
-    switch (c.kind) {
-      case brain::Command::Kind::kTakeoff: (void)fc_.Command(flight::Setpoint::Takeoff(c.param)); break;
-      case brain::Command::Kind::kLand: (void)fc_.Command(flight::Setpoint::Land()); break;
-      case brain::Command::Kind::kHold: (void)fc_.Command(flight::Setpoint::Hold()); break;
-      case brain::Command::Kind::kPayloadAttach:
-      case brain::Command::Kind::kPayloadRelease: {
-        const bool attach = c.kind == brain::Command::Kind::kPayloadAttach;
-        ++world_cmd_.seq;
-        world_cmd_.sim_time_ns = msg.sim_time_ns;
-        world_cmd_.target = options_.name;
-        world_cmd_.args.clear();
-        world_cmd_.command = attach ? "payload_attach" : "payload_release";
-        if (attach) world_cmd_.args.push_back(c.param);
-        // The announced load as the hover thrust estimator's prior (it corrects a refused hook).
-        fc_.SetPayloadMass(attach ? c.param : 0.0);
-        cmd_.world.push_back(world_cmd_);  // applied by the physics server before it steps the world
-        break;
-      }
-      case brain::Command::Kind::kArm:
-      case brain::Command::Kind::kDisarm:
-        break;  // the flight stack arms on take-off and disarms on landing by itself
-    }
-  }
-  for (const brain::Setpoint& sp : brain_out_.setpoint) {
-    // SarBrain answers position only or velocity only (TrajectorySetpoint form).
-    if (std::isfinite(sp.position_m.x)) {
-      (void)fc_.Command(flight::Setpoint::Position(flight::Vec3(sp.position_m.x, sp.position_m.y, sp.position_m.z), sp.yaw_rad));
-    } else {
-      (void)fc_.Command(
-          flight::Setpoint::Velocity(flight::Vec3(sp.velocity_m_s.x, sp.velocity_m_s.y, sp.velocity_m_s.z), sp.yaw_rad));
-    }
-  }
-  for (const std::vector<std::uint8_t>& bytes : brain_out_.proposals) {
-    auto c = raft::DecodeCommand(bytes);
-    if (!c) continue;  // SarBrain's own encoding: always decodes
-    (void)raft_->service().Propose(*c);  // kUnavailable (no leader yet): the behaviours re-propose
-  }
+  // The flight stack's estimate as the brain's Vehicle.
+  brain::Vehicle& v = vehicle_;
+  v.step = msg.step;
+  v.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+  v.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  v.attitude_wxyz[0] = est.att.w();
+  v.attitude_wxyz[1] = est.att.x();
+  v.attitude_wxyz[2] = est.att.y();
+  v.attitude_wxyz[3] = est.att.z();
+  v.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
+  v.heading_rad = flight::YawOf(est.att);
+  v.battery_fraction = mission_->battery_fraction();  // the SAR battery model (the flight stack has none)
+  v.flight_mode = std::string(flight::FlightModeName(fc_.mode()));
+  v.landed = LandedMode(fc_.mode());
+  v.armed = !v.landed;
+  v.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
+  world_.clear();
+  brain_host_->Step(msg.step, msg.sim_time_ns, v, &world_);
+  for (bus::WorldCommand& w : world_) cmd_.world.push_back(std::move(w));  // applied before the world steps
   for (const brain::Detection& d : detections_) {
-    bus::Detection det;
-    det.from = options_.name;
-    det.sim_time_ns = d.t_ns;
-    det.label = d.label;
-    det.confidence = d.confidence;
-    det.position_enu_m = {d.position_m.x, d.position_m.y, d.position_m.z};
-    det.position_sigma_m = d.sigma_m;
     out_frame_ = bus::RadioFrame{};
-    out_frame_.detection_msg.push_back(std::move(det));
+    out_frame_.detection_msg.push_back(DetectionToBus(d, options_.name));
     radio_->Send(std::move(out_frame_));  // best effort, as the radio
   }
 }

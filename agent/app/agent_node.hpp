@@ -39,6 +39,7 @@
 #include <string_view>
 #include <vector>
 
+#include "brain_host.hpp"
 #include "flight_plan.hpp"
 #include "perception_host.hpp"
 #include "mission_options.hpp"
@@ -99,6 +100,31 @@ struct AgentOptions {
   int ping_every_ms = 200;
 };
 
+// The flight controller as BrainHost's FlightPort.
+class ControllerPort final : public FlightPort {
+ public:
+  explicit ControllerPort(flight::FlightController& fc) : fc_(fc) {}
+  bool Command(const flight::Setpoint& setpoint) override { return fc_.Command(setpoint); }
+  void SetPayloadMass(double payload_mass_kg) override { fc_.SetPayloadMass(payload_mass_kg); }
+
+ private:
+  flight::FlightController& fc_;
+};
+
+// The Raft host as BrainHost's ConsensusPort.
+class RaftConsensus final : public ConsensusPort {
+ public:
+  explicit RaftConsensus(RaftHost& raft) : raft_(raft) {}
+  bool is_leader() const override { return raft_.is_leader(); }
+  std::string leader() const override { return raft_.leader(); }
+  void TakeCommitted(std::vector<brain::Entry>* out) override;
+  bool Propose(std::span<const std::uint8_t> data) override;
+
+ private:
+  RaftHost& raft_;
+  std::vector<raft::Committed> taken_;
+};
+
 class AgentNode final : private FrameHandler {
  public:
   static Result<std::unique_ptr<AgentNode>> Create(const AgentOptions& options);
@@ -121,10 +147,9 @@ class AgentNode final : private FrameHandler {
   // netem only, while waiting for a sample: the radio's deliveries dispatched, Raft's ticks and
   // the probe on the wall clock (as the mesh does not wait for the lockstep). Raft's error.
   Status ServeRadioBetweenSteps();
-  // --mission sar: perception (camera frames -> detections, also broadcast), then SarBrain
-  // stepped through the brain SDK, and what it answers carried out (commands, setpoint, payload
-  // world commands, proposals, status, events).
-  void StepMission(const bus::SensorSample& msg, bool hover_event);
+  // --mission sar: perception (camera frames -> detections to the brain, also broadcast), then
+  // BrainHost steps SarBrain and carries out its Output (brain_host.hpp).
+  void StepMission(const bus::SensorSample& msg);
   void BroadcastState(const bus::SensorSample& msg);
   bool Done() const;  // the plan is complete, or the SAR mission is (and this drone is down)
   // FrameHandler (radio_dispatch.hpp).
@@ -144,25 +169,26 @@ class AgentNode final : private FrameHandler {
   std::unique_ptr<radio::MeshRadio> radio_;   // after mesh_: destroyed before the participant
   SimClock sim_clock_;                        // the agent's simulated seconds (event lines)
   std::unique_ptr<RadioClock> raft_clock_;    // the radio's clock for Raft
+  // --mission sar: the brain's replicated state, Raft's machine (MachineRef): outlives raft_.
+  std::unique_ptr<SarMissionState> mission_state_;
   std::unique_ptr<RaftHost> raft_;            // after radio_ and the clocks: destroyed first
   std::unique_ptr<radio::LinkProbe> probe_;
   std::vector<bus::RadioFrame> frames_;       // this step's deliveries
   DispatchCounts dispatched_;
   std::vector<LogEvent> lines_;
-  // --mission sar only.
-  std::unique_ptr<SarBrain> mission_;
-  std::unique_ptr<brain::ReplicatedState> mission_state_;  // the brain's: the committed mission
+  // --mission sar only: SarBrain driven by BrainHost (after raft_ and radio_: destroyed first).
+  std::unique_ptr<ControllerPort> flight_port_;
+  std::unique_ptr<RaftConsensus> consensus_;
+  std::unique_ptr<BrainHost> brain_host_;
+  SarBrain* mission_ = nullptr;                             // the brain brain_host_ owns
   std::unique_ptr<PerceptionHost> perception_;             // scouts
   NetemWallClock netem_wall_;                              // netem only: the brain's side channel
-  std::map<std::string, brain::Neighbour> neighbours_;     // latest state heard from each drone
-  std::vector<brain::Neighbour> neighbour_table_;          // sorted by name, for the Input
   std::vector<brain::Detection> detections_;               // this step's
-  std::vector<brain::FlightEvent> flight_events_;          // this step's
-  brain::Output brain_out_;
+  std::vector<bus::WorldCommand> world_;                   // this step's, from the brain
+  brain::Vehicle vehicle_;
   std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;
   std::vector<bus::CameraImage> images_;      // taken this step (buffers reused)
   std::size_t image_count_ = 0;
-  bus::WorldCommand world_cmd_;
   bus::RadioFrame out_frame_;
   bus::ActuatorCommand cmd_;
   bus::DroneState state_;

@@ -12,6 +12,7 @@
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/flight/flight_config.hpp"
 #include "swarmbox/raft/mission_command.hpp"
+#include "swarmbox/raft/mission_state_machine.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -180,35 +181,52 @@ void NetemWallClock::OnState(const std::string& drone, std::int64_t t_ns, double
 // ---- the replicated mission ----------------------------------------------------------------------
 
 struct SarMissionState::Impl {
-  std::function<void(const brain::Event&)> log;
-  raft::MissionState mission;
+  raft::MissionStateMachine machine;
+  raft::EventSink sink;  // the machine's lines -> the Context's log
 };
 
+namespace {
+
+// Forwards every call to a machine owned elsewhere (the brain's SarMissionState).
+class MachineRef final : public raft::StateMachine {
+ public:
+  explicit MachineRef(raft::StateMachine& target) : target_(target) {}
+  void Apply(std::uint64_t index, std::span<const std::uint8_t> data, const raft::EventOut& events) override {
+    target_.Apply(index, data, events);
+  }
+  raft::Bytes Snapshot() const override { return target_.Snapshot(); }
+  Status Restore(std::span<const std::uint8_t> snapshot) override { return target_.Restore(snapshot); }
+  void OnSnapshotInstalled(std::uint64_t index, const raft::EventOut& events) override {
+    target_.OnSnapshotInstalled(index, events);
+  }
+  void ReplayRestored(std::uint64_t after, std::vector<raft::Committed>* out) const override {
+    target_.ReplayRestored(after, out);
+  }
+
+ private:
+  raft::StateMachine& target_;
+};
+
+}  // namespace
+
 SarMissionState::SarMissionState(std::function<void(const brain::Event&)> log) : impl_(std::make_unique<Impl>()) {
-  impl_->log = std::move(log);
+  if (log) impl_->sink = [log = std::move(log)](const LogEvent& e) { log(ToBrainEvent(e)); };
 }
 SarMissionState::~SarMissionState() = default;
 
 void SarMissionState::Apply(std::uint64_t index, std::span<const std::uint8_t> entry) {
-  // Undecodable bytes and rejected commands change nothing (MissionState::ApplyEncoded), the
-  // same way on every drone.
-  (void)impl_->mission.ApplyEncoded(index, entry);
+  // Undecodable bytes and rejected commands change nothing (MissionStateMachine), the same way
+  // on every drone. The line's t and node are the host's to stamp (Context::log).
+  impl_->machine.Apply(index, entry, raft::EventOut(0.0, "", impl_->sink));
 }
 
-std::vector<std::uint8_t> SarMissionState::Snapshot() const { return impl_->mission.EncodeSnapshot(); }
+std::vector<std::uint8_t> SarMissionState::Snapshot() const { return impl_->machine.Snapshot(); }
 
-bool SarMissionState::Restore(std::span<const std::uint8_t> snapshot) {
-  auto m = raft::MissionState::DecodeSnapshot(snapshot);
-  if (!m) return false;
-  impl_->mission = std::move(*m);
-  return true;
-}
+bool SarMissionState::Restore(std::span<const std::uint8_t> snapshot) { return impl_->machine.Restore(snapshot).ok(); }
 
-const raft::MissionState& SarMissionState::mission() const { return impl_->mission; }
+const raft::MissionState& SarMissionState::mission() const { return impl_->machine.mission(); }
 
-void SarMissionState::Mirror(const raft::MissionState& committed) {
-  if (committed.applied_index() != impl_->mission.applied_index()) impl_->mission = committed;
-}
+std::unique_ptr<raft::StateMachine> SarMissionState::RaftMachine() { return std::make_unique<MachineRef>(impl_->machine); }
 
 // ---- the brain -----------------------------------------------------------------------------------
 
@@ -256,7 +274,7 @@ SarBrain::SarBrain(const SarBrainConfig& config, swarm::BatteryModel battery,
   neighbours_.reserve(config_.members.size());
 }
 
-std::unique_ptr<brain::ReplicatedState> SarBrain::MakeReplicatedState() {
+std::unique_ptr<SarMissionState> SarBrain::MakeMissionState() {
   return std::make_unique<SarMissionState>(log_);
 }
 

@@ -3,6 +3,9 @@
 // user's brain: the proof that the SDK suffices (tests/agent/app/sar_brain_test.cpp steps it by
 // hand on simulated time, without any bus).
 //
+// The agent runs it through BrainHost (brain_host.hpp) every lockstep step, exactly as a library
+// brain; only the side channel below and the typed accessors (mode, complete) are SAR's own.
+//
 // What it does with the Input:
 //   - its ReplicatedState is the committed mission (SarMissionState: raft::MissionState behind
 //     raft::MissionStateMachine; entries are encoded raft::MissionCommands, its proposals too);
@@ -52,6 +55,7 @@
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/raft/mission_state.hpp"
+#include "swarmbox/raft/state_machine.hpp"
 #include "swarmbox/swarm/swarm.hpp"
 
 namespace swarmbox::agent {
@@ -139,8 +143,10 @@ struct NetemWallClock {
 };
 
 // SarBrain's ReplicatedState: the committed raft::MissionState. Apply/Snapshot/Restore are
-// raft::MissionStateMachine's; its event lines (mission_state, victim_confirmed, victim_status)
-// go to the Context's log.
+// raft::MissionStateMachine's; through this interface its event lines (mission_state,
+// victim_confirmed, victim_status) go to the Context's log. The agent hands Raft the same machine
+// directly (RaftMachine), so that Raft applies it with its own event lines, byte for byte as
+// before the SDK (also the snapshot-installed line, which brain::ReplicatedState has no call for).
 class SarMissionState final : public brain::ReplicatedState {
  public:
   explicit SarMissionState(std::function<void(const brain::Event&)> log);
@@ -149,9 +155,9 @@ class SarMissionState final : public brain::ReplicatedState {
   std::vector<std::uint8_t> Snapshot() const override;
   bool Restore(std::span<const std::uint8_t> snapshot) override;
   const raft::MissionState& mission() const;
-  // Takes a committed state applied elsewhere as it is (the node whose Raft service applies the
-  // mission itself); a no-op while its applied index is the one held.
-  void Mirror(const raft::MissionState& committed);
+  // This state as Raft's state machine: a reference to its MissionStateMachine (this object must
+  // outlive the Raft node that holds it).
+  std::unique_ptr<raft::StateMachine> RaftMachine();
 
  private:
   struct Impl;
@@ -166,7 +172,9 @@ class SarBrain final : public brain::Brain {
                                                   std::function<void(const brain::Event&)> log = {},
                                                   const NetemWallClock* wall = nullptr);
 
-  std::unique_ptr<brain::ReplicatedState> MakeReplicatedState() override;
+  std::unique_ptr<brain::ReplicatedState> MakeReplicatedState() override { return MakeMissionState(); }
+  // The same, typed (the agent hands Raft its machine: SarMissionState::RaftMachine).
+  std::unique_ptr<SarMissionState> MakeMissionState();
   // in.state must be this brain's SarMissionState (aborts otherwise: a wiring bug).
   void Step(const brain::Input& in, brain::Output& out) override;
 
