@@ -17,17 +17,6 @@ std::string Fixed(double v, int decimals) {
 
 double Seconds(std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 
-// Output::Clear without the SDK library (agent/app compiles against the header alone until the
-// loader joins).
-void ClearOutput(brain::Output* out) {
-  out->setpoint.clear();
-  out->commands.clear();
-  out->messages.clear();
-  out->proposals.clear();
-  out->status.clear();
-  out->events.clear();
-}
-
 }  // namespace
 
 bool LandedMode(flight::FlightMode mode) {
@@ -202,7 +191,7 @@ void BrainHost::Step(std::uint64_t step, std::int64_t t_ns, const brain::Vehicle
   bool answered = false;
   if (step % static_cast<std::uint64_t>(options_.period_steps) == 0) {
     BuildInput(t_ns, vehicle);
-    ClearOutput(&out_);
+    out_.Clear();
     brain_->Step(in_, out_);
     ++brain_steps_;
     answered = remote_ == nullptr || remote_->answered();
