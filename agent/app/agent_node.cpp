@@ -7,6 +7,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "brain_convert.hpp"
+#include "external_brain.hpp"
+#include "swarmbox/bus/topics.hpp"
+#include "swarmbox/brain/args.hpp"
+#include "swarmbox/brain/loader.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
@@ -29,14 +33,17 @@ double SteadyS() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// A brain's event as the agent's logfmt line.
-LogEvent FromBrainEvent(double t_s, const std::string& node, const brain::Event& e) {
-  LogEvent line(t_s, node, e.name);
-  for (const auto& [key, value] : e.fields) line.Add(key, value);
-  return line;
-}
-
 }  // namespace
+
+class AgentNode::FlightAdapter final : public FlightPort {
+ public:
+  explicit FlightAdapter(flight::FlightController& fc) : fc_(fc) {}
+  bool Command(const flight::Setpoint& setpoint) override { return fc_.Command(setpoint); }
+  void SetPayloadMass(double payload_mass_kg) override { fc_.SetPayloadMass(payload_mass_kg); }
+
+ private:
+  flight::FlightController& fc_;
+};
 
 Result<RadioModel> ParseRadioModel(std::string_view text) {
   if (text == "netem") return RadioModel::kNetem;
@@ -77,32 +84,42 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   if (!cfg) return cfg.error().Context("loading airframe");
   // --mission sar: SarBrain's Context (what any brain is told) and the agent's perception,
   // checked before anything joins the bus.
-  brain::Context sar_ctx;
   std::optional<SarBrainConfig> sar_config;
   PerceptionConfig perception;
   if (o.mission.kind == MissionKind::kSar) {
     if (o.raft.members.empty()) return Error(ErrorCode::kInvalidArgument, "--mission sar needs --members");
     if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--mission sar needs the mesh bus (drop --no-mesh)");
-    sar_ctx.self = o.name;
-    sar_ctx.members = o.raft.members;
-    sar_ctx.seed = o.raft.seed;
-    sar_ctx.period_ns = static_cast<std::int64_t>(std::llround(o.control_dt_s * 1e9));
-    sar_ctx.airframe = cfg->airframe;
-    sar_ctx.airframe_path = o.airframe_path;
-    sar_ctx.world_path = o.mission.world_path;
-    sar_ctx.payload = o.mission.payload;
+    brain::Context ctx;
+    ctx.self = o.name;
+    ctx.members = o.raft.members;
+    ctx.seed = o.raft.seed;
+    ctx.period_ns = std::llround(o.control_dt_s * 1e9);
+    ctx.airframe = cfg->airframe;
+    ctx.airframe_path = o.airframe_path;
+    ctx.world_path = o.mission.world_path;
+    ctx.payload = o.mission.payload;
     if (o.has_start) {
       char start[96];
       std::snprintf(start, sizeof start, "%.17g,%.17g,%.17g", o.start_m.x(), o.start_m.y(), o.start_m.z());
-      sar_ctx.args["start"] = start;
+      ctx.args["start"] = start;
     }
-    auto c = SarBrainConfigFrom(sar_ctx);
+    auto c = SarBrainConfigFrom(ctx);
     if (!c) return c.error();
     sar_config = std::move(*c);
     perception.camera = sar_config->camera;
     perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
   }
-  auto plan = FlightPlan::Parse(o.plan);  // --mission sar: parsed (the default) but not flown
+  const bool brain = o.brain.kind != BrainKind::kBuiltin;
+  int period_steps = 1;
+  if (brain) {
+    auto steps = BrainPeriodSteps(o.brain, o.control_dt_s);
+    if (!steps) return steps.error();
+    period_steps = *steps;
+    if (o.mission.kind != MissionKind::kPlan) {
+      return Error(ErrorCode::kInvalidArgument, "--mission is for --brain builtin (the brain decides what to fly)");
+    }
+  }
+  auto plan = FlightPlan::Parse(o.plan);  // --mission sar, a brain: parsed (the default) but not flown
   if (!plan) return plan.error().Context("--plan");
   plan->SetPreflight(o.preflight_s);
   flight::ControllerOptions co;
@@ -134,6 +151,29 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   if (!pub) return pub.error().Context("publishing actuator commands");
   node->actuator_pub_ = std::move(*pub);
   const bool sar = o.mission.kind == MissionKind::kSar;
+  std::unique_ptr<brain::Brain> the_brain;
+  if (brain) {
+    auto made = node->MakeBrain(*cfg, period_steps);
+    if (!made) return made.error();
+    the_brain = std::move(*made);
+    // Its own replicated state, made once before Raft starts (Raft replays its WAL into it).
+    node->brain_state_ = the_brain->MakeReplicatedState();
+  } else if (sar_config) {
+    // The builtin SAR brain, through BrainHost as any brain; its replicated state is the mission.
+    AgentNode* n = node.get();
+    auto log = [n](const brain::Event& e) {
+      LogEvent line(n->t_s_, n->options_.name, e.name);
+      for (const auto& [k, v] : e.fields) line.Add(k, v);
+      n->Log(line);
+    };
+    auto made = SarBrain::Create(*sar_config, log, channel ? nullptr : &node->netem_wall_);
+    if (!made) return made.error();
+    node->sar_ = made->get();
+    auto state = node->sar_->MakeMissionState();
+    node->sar_state_ = state.get();
+    node->brain_state_ = std::move(state);
+    the_brain = std::move(*made);
+  }
   if (o.mesh && channel) {
     // No mesh domain at all: every frame rides the lockstep to the physics server's channel.
     node->radio_ = std::make_unique<radio::ChannelRadio>(o.name);
@@ -148,20 +188,11 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     ro.members = o.raft.members;
     ro.raft = o.raft.members.size() > 1;
     ro.pings = o.ping_every_ms > 0 && o.raft.members.size() > 1;
-    ro.hear_states = sar;
+    ro.hear_states = sar || brain;
+    ro.brains = brain;
     auto dds = radio::DdsRadio::Create(*node->mesh_, o.name, ro);
     if (!dds) return dds.error().Context("starting the mesh radio");
     node->radio_ = std::move(*dds);
-  }
-  // --mission sar: the builtin brain and its replicated state, which Raft applies (before Raft).
-  std::unique_ptr<SarBrain> sar_brain;
-  if (sar_config) {
-    AgentNode* n = node.get();
-    auto log = [n](const brain::Event& e) { n->Log(FromBrainEvent(n->t_s_, n->options_.name, e)); };
-    auto made = SarBrain::Create(*sar_config, log, channel ? nullptr : &node->netem_wall_);
-    if (!made) return made.error();
-    sar_brain = std::move(*made);
-    node->mission_state_ = sar_brain->MakeMissionState();
   }
   if (!o.raft.members.empty()) {
     if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--members (Raft) needs the mesh bus (drop --no-mesh)");
@@ -171,8 +202,16 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     // Raft's clock: simulated seconds (channel: the radio's clock is the lockstep's, from 0), or
     // wall seconds since now (netem: the steady clock). Its lines carry the simulated time.
     node->raft_clock_ = std::make_unique<RadioClock>(*node->radio_, channel ? 0 : node->radio_->now_ns());
-    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_,
-                                node->mission_state_ ? node->mission_state_->RaftMachine() : nullptr);
+    std::unique_ptr<raft::StateMachine> machine;  // null: the SAR mission's
+    if (node->sar_state_ != nullptr) {
+      // SarBrain's state is raft's MissionStateMachine: Raft applies it with its own event lines.
+      machine = node->sar_state_->RaftMachine();
+    } else if (brain && node->brain_state_) {
+      machine = std::make_unique<ReplicatedStateMachine>(node->brain_state_.get());
+    } else if (brain) {
+      machine = std::make_unique<raft::EntryLogMachine>();
+    }
+    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_, std::move(machine));
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
   }
@@ -184,25 +223,26 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!probe) return probe.error().Context("starting the link probe");
     node->probe_ = std::move(*probe);
   }
-  if (sar_brain) {
-    // SarBrain through BrainHost, as any brain: every lockstep step (the control period).
-    node->mission_ = sar_brain.get();
-    node->flight_port_ = std::make_unique<ControllerPort>(node->fc_);
-    node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
+  if (brain || node->sar_ != nullptr) {
     BrainHostOptions bo;
     bo.self = o.name;
-    bo.period_steps = 1;
-    bo.state = node->mission_state_.get();
-    node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(sar_brain), *node->flight_port_, node->radio_.get(),
+    bo.period_steps = period_steps;
+    bo.offboard_timeout_s = o.brain.offboard_timeout_ms * 1e-3;
+    bo.offboard_hold_s = o.brain.offboard_hold_ms * 1e-3;
+    bo.state = node->brain_state_.get();
+    node->flight_port_ = std::make_unique<FlightAdapter>(node->fc_);
+    if (node->raft_) node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
+    node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(the_brain), *node->flight_port_, node->radio_.get(),
                                                     node->consensus_.get(), o.log);
-    if (node->mission_->role() == swarm::Role::kScout) {
-      auto p = PerceptionHost::Create(perception);
-      if (!p) return p.error();
-      node->perception_ = std::move(*p);
-      auto cam = node->sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(o.name), bus::Qos::kLockstep);
-      if (!cam) return cam.error().Context("subscribing to the camera");
-      node->camera_sub_ = std::move(*cam);
-    }
+    if (auto spec = swarm::BatterySpecFor(cfg->airframe)) node->battery_.emplace(*spec);
+  }
+  if (node->sar_ != nullptr && node->sar_->role() == swarm::Role::kScout) {
+    auto p = PerceptionHost::Create(perception);
+    if (!p) return p.error();
+    node->perception_ = std::move(*p);
+    auto cam = node->sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(o.name), bus::Qos::kLockstep);
+    if (!cam) return cam.error().Context("subscribing to the camera");
+    node->camera_sub_ = std::move(*cam);
   }
   return node;
 }
@@ -223,6 +263,52 @@ AgentNode::~AgentNode() = default;
 void AgentNode::Log(const LogEvent& e) {
   std::fprintf(options_.log, "%s\n", e.str().c_str());
   std::fflush(options_.log);
+}
+
+Result<std::unique_ptr<brain::Brain>> AgentNode::MakeBrain(const flight::FlightConfig& config, int period_steps) {
+  const BrainOptions& b = options_.brain;
+  brain::Context ctx;
+  ctx.self = options_.name;
+  ctx.members = options_.raft.members.empty() ? std::vector<std::string>{options_.name} : options_.raft.members;
+  ctx.seed = options_.raft.seed;
+  ctx.period_ns = static_cast<std::int64_t>(std::llround(period_steps * options_.control_dt_s * 1e9));
+  ctx.airframe = config.airframe;
+  ctx.airframe_path = options_.airframe_path;
+  ctx.world_path = options_.mission.world_path;
+  ctx.payload = options_.mission.payload;
+  auto args = brain::ParseBrainArgs(b.args_json);
+  if (!args) return args.error();
+  ctx.args = std::move(*args);
+  ctx.log = [this](const brain::Event& e) {
+    LogEvent line(t_s_, options_.name, e.name);
+    for (const auto& [k, v] : e.fields) line.Add(k, v);
+    Log(line);
+  };
+  LogEvent loaded(0.0, options_.name, "brain_loaded");
+  loaded.Add("kind", BrainKindName(b.kind));
+  std::unique_ptr<brain::Brain> made;
+  if (b.kind == BrainKind::kLibrary) {
+    auto lib = brain::LoadBrain(b.library_path, b.name, ctx);
+    if (!lib) return lib.error().Context("--brain library");
+    loaded.Add("name", b.name).Add("library", b.library_path);
+    made = std::move(*lib);
+  } else {
+    ExternalBrainOptions eo;
+    eo.drone = options_.name;
+    eo.wait = std::chrono::milliseconds(b.wait_ms);
+    eo.start = std::chrono::milliseconds(b.start_ms);
+    eo.stop = options_.stop;
+    eo.log = options_.log;
+    auto ext = ExternalBrain::Create(*sim_, eo);
+    if (!ext) return ext.error().Context("--brain external");
+    loaded.Add("name", bus::OffboardInputTopic(options_.name));
+    made = std::move(*ext);
+  }
+  loaded.Add("period_ms", static_cast<double>(ctx.period_ns) * 1e-6, 1)
+      .Add("offboard_timeout_ms", b.offboard_timeout_ms)
+      .Add("offboard_hold_ms", b.offboard_hold_ms);
+  Log(loaded);
+  return made;
 }
 
 bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
@@ -274,13 +360,12 @@ void AgentNode::OnPing(const bus::RadioFrame& frame) {
 }
 
 void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& frame) {
-  if (!brain_host_) return;
-  // netem: when it arrived on the steady clock, for the lost-member rule's wall-clock silence
-  // (SarBrain's side channel). channel: none, the simulated clock alone decides.
-  if (options_.radio_model == RadioModel::kNetem && state.drone != options_.name) {
+  // netem, SarBrain only: when it arrived on the steady clock, for the lost-member rule's
+  // wall-clock silence (its side channel). channel: none, the simulated clock alone decides.
+  if (sar_ != nullptr && options_.radio_model == RadioModel::kNetem && state.drone != options_.name) {
     netem_wall_.OnState(state.drone, state.sim_time_ns, static_cast<double>(frame.delivered_ns) * 1e-9);
   }
-  brain_host_->OnState(state);
+  if (brain_host_) brain_host_->OnState(state);
 }
 
 void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::RadioFrame& /*frame*/) {
@@ -288,8 +373,9 @@ void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::Radi
   // broadcast detections are for recorders and a ground station.
 }
 
-void AgentNode::OnBrainMessage(const bus::BrainMessage& /*message*/, const bus::RadioFrame& /*frame*/) {
-  // Heard and counted (dispatched_.brain): the built-in missions have no brain inbox.
+void AgentNode::OnBrainMessage(const bus::BrainMessage& message, const bus::RadioFrame& /*frame*/) {
+  // Counted (dispatched_.brain); the built-in missions have no brain inbox.
+  if (brain_host_) brain_host_->OnMessage(message);
 }
 
 Status AgentNode::ServeRadioBetweenSteps() {
@@ -354,8 +440,10 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
     probe_->Step(radio::RadioTime(radio_->now_ns()), t_s_, *radio_, &lines_);
     for (const LogEvent& line : lines_) Log(line);
   }
-  if (mission_) {
+  if (sar_ != nullptr) {
     StepMission(msg);
+  } else if (brain_host_) {
+    StepBrain(msg);
   } else {
     if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
     if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
@@ -399,8 +487,10 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
   state_.heading_rad = flight::YawOf(est.att);
   if (brain_host_) {
-    state_.mode = brain_host_->status();
-    state_.battery_fraction = mission_->battery_fraction();
+    // The brain's status (Neighbour::status on the other drones); the flight mode until it says.
+    state_.mode = brain_host_->status().empty() ? std::string(flight::FlightModeName(fc_.mode())) : brain_host_->status();
+    // SarBrain: its own battery model (the one behind its battery_low), as before the SDK.
+    state_.battery_fraction = sar_ != nullptr ? sar_->battery_fraction() : vehicle_.battery_fraction;
   } else {
     state_.mode = std::string(flight::FlightModeName(fc_.mode()));
   }
@@ -409,22 +499,36 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   radio_->Send(std::move(out_frame_));
 }
 
-void RaftConsensus::TakeCommitted(std::vector<brain::Entry>* out) {
-  raft_.TakeCommitted(&taken_);
-  for (raft::Committed& c : taken_) out->push_back({c.index, std::move(c.data)});
-}
-
-bool RaftConsensus::Propose(std::span<const std::uint8_t> data) {
-  return raft_.ProposeBytes(raft::Bytes(data.begin(), data.end())).ok();
+void AgentNode::StepBrain(const bus::SensorSample& msg) {
+  const flight::StateEstimate& est = fc_.estimate();
+  const flight::FlightMode mode = fc_.mode();
+  if (battery_) battery_->Step(options_.control_dt_s, est.vel_mps, brain_host_->payload_mass_kg(), !LandedMode(mode));
+  brain::Vehicle& v = vehicle_;
+  v.name = options_.name;
+  v.step = msg.step;
+  v.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+  v.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  v.attitude_wxyz[0] = est.att.w();
+  v.attitude_wxyz[1] = est.att.x();
+  v.attitude_wxyz[2] = est.att.y();
+  v.attitude_wxyz[3] = est.att.z();
+  v.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
+  v.heading_rad = flight::YawOf(est.att);
+  v.battery_fraction = battery_ ? battery_->fraction() : 1.0;
+  v.battery_voltage_v = 0.0;  // not modelled: the battery model counts energy
+  v.flight_mode = std::string(flight::FlightModeName(mode));
+  v.armed = cmd_.armed;
+  v.landed = LandedMode(mode);
+  v.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
+  brain_host_->Step(msg.step, msg.sim_time_ns, v, &cmd_.world);
 }
 
 void AgentNode::StepMission(const bus::SensorSample& msg) {
-  const flight::StateEstimate& est = fc_.estimate();
   // Perception (scouts): this step's frames geolocated with the estimate of their capture step,
-  // to the brain once the inference latency has passed, and on the radio (best effort).
+  // to the brain once the inference latency has passed.
   detections_.clear();
   if (perception_) {
-    perception_->RecordEstimate(t_s_, est);
+    perception_->RecordEstimate(t_s_, fc_.estimate());
     for (std::size_t i = 0; i < image_count_; ++i) {
       bus::CameraImage& image = images_[i];
       if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
@@ -441,35 +545,21 @@ void AgentNode::StepMission(const bus::SensorSample& msg) {
   // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
   // time and nothing of the wall clock may feed a decision (the brain has no side channel then).
   if (options_.radio_model == RadioModel::kNetem) netem_wall_.now_s = SteadyS();
-  // The flight stack's estimate as the brain's Vehicle.
-  brain::Vehicle& v = vehicle_;
-  v.step = msg.step;
-  v.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
-  v.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
-  v.attitude_wxyz[0] = est.att.w();
-  v.attitude_wxyz[1] = est.att.x();
-  v.attitude_wxyz[2] = est.att.y();
-  v.attitude_wxyz[3] = est.att.z();
-  v.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
-  v.heading_rad = flight::YawOf(est.att);
-  v.battery_fraction = mission_->battery_fraction();  // the SAR battery model (the flight stack has none)
-  v.flight_mode = std::string(flight::FlightModeName(fc_.mode()));
-  v.landed = LandedMode(fc_.mode());
-  v.armed = !v.landed;
-  v.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
-  world_.clear();
-  brain_host_->Step(msg.step, msg.sim_time_ns, v, &world_);
-  for (bus::WorldCommand& w : world_) cmd_.world.push_back(std::move(w));  // applied before the world steps
+  StepBrain(msg);
+  // The detections on the radio too (for recorders and a ground station), best effort.
   for (const brain::Detection& d : detections_) {
     out_frame_ = bus::RadioFrame{};
     out_frame_.detection_msg.push_back(DetectionToBus(d, options_.name));
-    radio_->Send(std::move(out_frame_));  // best effort, as the radio
+    radio_->Send(std::move(out_frame_));
   }
 }
 
 bool AgentNode::Done() const {
-  if (!mission_) return plan_.finished();
-  return mission_->complete() && (fc_.mode() == flight::FlightMode::kLanded || fc_.mode() == flight::FlightMode::kIdle);
+  if (sar_ != nullptr) {
+    return sar_->complete() && (fc_.mode() == flight::FlightMode::kLanded || fc_.mode() == flight::FlightMode::kIdle);
+  }
+  if (brain_host_) return false;  // a brain flies until the trial ends (the samples stop)
+  return plan_.finished();
 }
 
 Status AgentNode::Run() {
@@ -478,8 +568,9 @@ Status AgentNode::Run() {
           .Add("sim_interface", options_.sim_interface)
           .Add("middleware", options_.middleware)
           .Add("radio_model", RadioModelName(options_.radio_model))
-          .Add("mission", MissionKindName(options_.mission.kind))
-          .Add("plan", mission_ ? std::string("-") : options_.plan)
+          .Add("brain", BrainKindName(options_.brain.kind))
+          .Add("mission", brain_host_ && sar_ == nullptr ? std::string_view("-") : MissionKindName(options_.mission.kind))
+          .Add("plan", brain_host_ ? std::string("-") : options_.plan)
           .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
   bus::SensorSample msg;
   bool got_any = false;
@@ -521,11 +612,14 @@ Status AgentNode::Run() {
                          " s: is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
                          std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
       }
-      Log(LogEvent(t_s_, options_.name, "samples_stopped").Add("after_s", secs, 1).Add("plan", mission_ ? std::string_view("sar") : plan_.current()));
-      if (Done() || (mission_ && mission_->complete())) return Ok{};
-      if (mission_) {
+      Log(LogEvent(t_s_, options_.name, "samples_stopped")
+              .Add("after_s", secs, 1)
+              .Add("plan", sar_ != nullptr ? std::string_view("sar") : brain_host_ ? std::string_view("brain") : plan_.current()));
+      // A brain has no end of its own: the trial's end stops the samples.
+      if ((brain_host_ && sar_ == nullptr) || Done() || (sar_ != nullptr && sar_->complete())) return Ok{};
+      if (sar_ != nullptr) {
         return Error(ErrorCode::kUnavailable, "sensor samples stopped for " + Seconds(secs) +
-                                                  " s before the SAR mission was complete (" + mission_->mode() + ")");
+                                                  " s before the SAR mission was complete (" + sar_->mode() + ")");
       }
       return Error(ErrorCode::kUnavailable,
                    "sensor samples stopped for " + Seconds(secs) + " s before the plan was complete (at '" +

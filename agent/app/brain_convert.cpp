@@ -8,15 +8,11 @@
 namespace swarmbox::agent {
 namespace {
 
-constexpr std::array<std::pair<brain::Command::Kind, std::string_view>, 7> kCommands = {{
-    {brain::Command::Kind::kArm, "arm"},
-    {brain::Command::Kind::kDisarm, "disarm"},
-    {brain::Command::Kind::kTakeoff, "takeoff"},
-    {brain::Command::Kind::kLand, "land"},
-    {brain::Command::Kind::kHold, "hold"},
-    {brain::Command::Kind::kPayloadAttach, "payload_attach"},
-    {brain::Command::Kind::kPayloadRelease, "payload_release"},
-}};
+constexpr std::array<brain::Command::Kind, 7> kCommandKinds = {
+    brain::Command::Kind::kArm,  brain::Command::Kind::kDisarm,        brain::Command::Kind::kTakeoff,
+    brain::Command::Kind::kLand, brain::Command::Kind::kHold,          brain::Command::Kind::kPayloadAttach,
+    brain::Command::Kind::kPayloadRelease,
+};
 
 std::array<double, 3> A(const brain::Vec3& v) { return {v.x, v.y, v.z}; }
 brain::Vec3 V(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
@@ -35,18 +31,12 @@ bus::Event EventToBus(const std::string& node, std::int64_t t_ns, const std::str
 
 Result<brain::Command::Kind> ParseCommandName(std::string_view name) {
   std::string known;
-  for (const auto& [kind, text] : kCommands) {
+  for (brain::Command::Kind kind : kCommandKinds) {
+    const std::string_view text = brain::CommandName(kind);
     if (text == name) return kind;
     known += (known.empty() ? "" : ", ") + std::string(text);
   }
   return Error(ErrorCode::kInvalidArgument, "unknown command '" + std::string(name) + "' (known: " + known + ")");
-}
-
-std::string_view CommandKindName(brain::Command::Kind kind) {
-  for (const auto& [k, text] : kCommands) {
-    if (k == kind) return text;
-  }
-  return "unknown";
 }
 
 brain::Neighbour NeighbourFromBus(const bus::DroneState& s) {
@@ -219,7 +209,7 @@ void ToBus(const brain::Output& out, const std::string& drone, std::int64_t t_ns
   wire->setpoint.clear();
   for (const brain::Setpoint& sp : out.setpoint) wire->setpoint.push_back(SetpointToBus(sp));
   wire->commands.clear();
-  for (const brain::Command& c : out.commands) wire->commands.push_back({std::string(CommandKindName(c.kind)), c.param});
+  for (const brain::Command& c : out.commands) wire->commands.push_back({brain::CommandName(c.kind), c.param});
   wire->messages.clear();
   for (const brain::Message& m : out.messages) wire->messages.push_back(MessageToBus(m));
   wire->proposals.clear();

@@ -25,8 +25,6 @@ namespace swarmbox::agent {
 
 // The inverse of brain::CommandName: "takeoff" -> kTakeoff; kInvalidArgument listing the names.
 Result<brain::Command::Kind> ParseCommandName(std::string_view name);
-// brain::CommandName's names, spelled here too so that this file needs no SDK library.
-std::string_view CommandKindName(brain::Command::Kind kind);
 
 brain::Neighbour NeighbourFromBus(const bus::DroneState& state);
 brain::Message MessageFromBus(const bus::BrainMessage& message);

@@ -17,18 +17,16 @@ std::string Fixed(double v, int decimals) {
 
 double Seconds(std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 
-// Output::Clear without the SDK library (agent/app compiles against the header alone until the
-// loader joins).
-void ClearOutput(brain::Output* out) {
-  out->setpoint.clear();
-  out->commands.clear();
-  out->messages.clear();
-  out->proposals.clear();
-  out->status.clear();
-  out->events.clear();
-}
+bool Same(double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); }
+bool Same(const brain::Vec3& a, const brain::Vec3& b) { return Same(a.x, b.x) && Same(a.y, b.y) && Same(a.z, b.z); }
 
 }  // namespace
+
+bool SameSetpoint(const brain::Setpoint& a, const brain::Setpoint& b) {
+  return Same(a.position_m, b.position_m) && Same(a.velocity_m_s, b.velocity_m_s) &&
+         Same(a.acceleration_m_s2, b.acceleration_m_s2) && Same(a.yaw_rad, b.yaw_rad) &&
+         Same(a.yawspeed_rad_s, b.yawspeed_rad_s);
+}
 
 bool LandedMode(flight::FlightMode mode) {
   return mode == flight::FlightMode::kInit || mode == flight::FlightMode::kIdle ||
@@ -158,9 +156,16 @@ void BrainHost::Apply(std::int64_t t_ns, std::vector<bus::WorldCommand>* world, 
   const double t_s = Seconds(t_ns);
   if (fly) {
     for (const brain::Command& c : out_.commands) ApplyCommand(c, t_ns, world);
+    if (!out_.commands.empty()) has_flown_ = false;  // a command replaced what was flying
     if (!out_.setpoint.empty()) {
       if (out_.setpoint.size() > 1) Reject(t_s, "setpoint", "more than one setpoint; the first is flown");
-      (void)flight_.Command(FlightSetpointOf(out_.setpoint.front()));
+      const brain::Setpoint& sp = out_.setpoint.front();
+      // The same setpoint streamed again (PX4 offboard style) keeps flying the one commanded:
+      // commanding it anew would restart the position trajectory at every period.
+      if (!has_flown_ || !SameSetpoint(sp, flown_)) {
+        has_flown_ = flight_.Command(FlightSetpointOf(sp));
+        flown_ = sp;
+      }
     }
   }
   for (const brain::Message& m : out_.messages) {
@@ -202,7 +207,7 @@ void BrainHost::Step(std::uint64_t step, std::int64_t t_ns, const brain::Vehicle
   bool answered = false;
   if (step % static_cast<std::uint64_t>(options_.period_steps) == 0) {
     BuildInput(t_ns, vehicle);
-    ClearOutput(&out_);
+    out_.Clear();
     brain_->Step(in_, out_);
     ++brain_steps_;
     answered = remote_ == nullptr || remote_->answered();
@@ -223,6 +228,7 @@ void BrainHost::Step(std::uint64_t step, std::int64_t t_ns, const brain::Vehicle
     fe.fields["action"] = std::string(flight::OffboardFailsafe::ActionName(e.action));
     flight_events_.push_back(std::move(fe));
   }
+  if (action != before) has_flown_ = false;  // the failsafe took over (or gave back)
   if (action != before && !vehicle.landed) {  // on the ground there is nothing to hold or land
     if (action == Action::kHold) (void)flight_.Command(flight::Setpoint::Hold());
     if (action == Action::kLand) (void)flight_.Command(flight::Setpoint::Land());

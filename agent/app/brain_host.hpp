@@ -21,7 +21,9 @@
 //   Output, in this order: commands (takeoff/land/hold to the flight stack; payload_attach/
 //           payload_release as this step's WorldCommands plus the load estimate, as the SAR lifter
 //           did; arm is part of takeoff, disarm of landing: both logged as event=brain_rejected),
-//           then the setpoint (PX4 TrajectorySetpoint semantics: flight::Setpoint::FromTrajectory),
+//           then the setpoint (PX4 TrajectorySetpoint semantics: flight::Setpoint::FromTrajectory;
+//           the same setpoint again, NaN for NaN, is not commanded anew after the flight stack
+//           accepted it and no command or failsafe action came between: a brain may stream it),
 //           messages onto the radio as RadioFrames with brain_msg (from = self), proposals to the
 //           consensus (dropped without one: event=brain_rejected what=proposal once), status for
 //           the DroneState broadcast, events as logfmt lines `t=.. node=<self> event=<name> k=v`.
@@ -147,6 +149,8 @@ class BrainHost {
   std::uint64_t world_seq_ = 0;
   std::uint64_t brain_steps_ = 0;
   std::uint64_t answers_ = 0;
+  brain::Setpoint flown_;  // the setpoint last commanded (has_flown_: and accepted since)
+  bool has_flown_ = false;
   bool warned_radio_ = false;
   bool warned_consensus_ = false;
 };
@@ -159,6 +163,9 @@ bool LandedMode(flight::FlightMode mode);
 // flight::FlightEvent -> brain::FlightEvent: name flight::FlightEventName, t_ns, fields x, y, z
 // (2 decimals), and mode for mode_change.
 brain::FlightEvent FlightEventOf(const flight::FlightEvent& e);
+
+// Field for field, NaN equal to NaN.
+bool SameSetpoint(const brain::Setpoint& a, const brain::Setpoint& b);
 
 // brain::Setpoint -> the flight stack's (Setpoint::FromTrajectory of the same target).
 flight::Setpoint FlightSetpointOf(const brain::Setpoint& sp);

@@ -312,11 +312,8 @@ TEST(BrainHost, HoldsThenLandsWhenTheBrainFallsSilent) {
   EXPECT_NE(lines[0].find("action=hold"), std::string::npos) << lines[0];
   EXPECT_NE(lines[1].find("t=5.0"), std::string::npos) << lines[1];
   EXPECT_NE(lines[1].find("action=land"), std::string::npos) << lines[1];
-  // 101 answers (t = 0 .. 2 s every 20 ms) flew a velocity each; then hold, then land.
-  ASSERT_EQ(rig.flight.commands.size(), 103u);
-  EXPECT_EQ(rig.flight.commands[100], "velocity");
-  EXPECT_EQ(rig.flight.commands[101], "hold");
-  EXPECT_EQ(rig.flight.commands[102], "land");
+  // The streamed velocity was commanded once (the same one again keeps flying); then hold, land.
+  EXPECT_EQ(rig.flight.commands, (std::vector<std::string>{"velocity", "hold", "land"}));
   EXPECT_EQ(rig.host->failsafe(), flight::OffboardFailsafe::Action::kLand);
 }
 
@@ -335,7 +332,22 @@ TEST(BrainHost, FliesAgainWhenTheBrainAnswersDuringTheHold) {
   std::vector<std::string> brain_events;
   for (const Seen& s : seen) brain_events.insert(brain_events.end(), s.events.begin(), s.events.end());
   EXPECT_EQ(brain_events, (std::vector<std::string>{"offboard_regained"}));
-  EXPECT_EQ(rig.flight.commands.back(), "velocity");
+  // Flown again after the failsafe's hold: the same velocity is commanded anew.
+  EXPECT_EQ(rig.flight.commands, (std::vector<std::string>{"velocity", "hold", "velocity"}));
+}
+
+TEST(BrainHost, CommandsAStreamedSetpointOnceUntilItChangesOrACommandComes) {
+  Rig rig;
+  rig.Make(std::make_unique<ScriptBrain>(&rig.seen, [](const brain::Input& in, brain::Output& out) {
+    const std::int64_t k = in.t_ns / kStepNs;
+    if (k == 3) out.commands.push_back(brain::Command::Hold());
+    brain::Setpoint sp = brain::Setpoint::Position({k < 5 ? 1.0 : 2.0, 0, brain::kUnset});
+    out.setpoint.push_back(sp);
+  }));
+  for (std::uint64_t k = 0; k < 8; ++k) rig.Step(k);
+  EXPECT_EQ(rig.flight.commands, (std::vector<std::string>{"trajectory", "hold", "trajectory", "trajectory"}));
+  EXPECT_TRUE(SameSetpoint(brain::Setpoint{}, brain::Setpoint{}));
+  EXPECT_FALSE(SameSetpoint(brain::Setpoint{}, brain::Setpoint::Velocity({0, 0, 0})));
 }
 
 TEST(BrainHost, OnTheGroundTheFailsafeCommandsNothing) {
