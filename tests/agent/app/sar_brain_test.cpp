@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include "brain_host.hpp"
+
 #include <cmath>
 #include <map>
 #include <string>
@@ -460,6 +462,81 @@ TEST(SarMissionState, SnapshotRestoresTheCommittedMissionAndRefusesGarbage) {
   // Entries that do not decode change nothing, the same way everywhere.
   copy->Apply(1, garbage);
   EXPECT_EQ(dynamic_cast<const SarMissionState&>(*copy).mission().phase(), raft::MissionPhase::kIdle);
+}
+
+// The agent's wiring in small: SarBrain inside BrainHost with a fake flight stack and consensus,
+// its state applied as Raft would. The take-off is a flight-stack take-off, the climb a Position
+// kind, the lane a Velocity kind (FromTrajectory keeps the smoothed kinds for position-only and
+// velocity-only setpoints); the leader's proposals reach the consensus as MissionCommands.
+class RecordingFlight final : public FlightPort {
+ public:
+  bool Command(const flight::Setpoint& sp) override {
+    kinds.push_back(sp.kind);
+    values.push_back(sp.value);
+    return true;
+  }
+  void SetPayloadMass(double /*kg*/) override {}
+  std::vector<flight::Setpoint::Kind> kinds;
+  std::vector<Vec3> values;
+};
+
+class LeadingConsensus final : public ConsensusPort {
+ public:
+  bool is_leader() const override { return true; }
+  std::string leader() const override { return "scout_1"; }
+  void TakeCommitted(std::vector<brain::Entry>* /*out*/) override {}
+  bool Propose(std::span<const std::uint8_t> data) override {
+    auto c = raft::DecodeCommand(data);
+    EXPECT_TRUE(c.ok());
+    if (c.ok()) proposals.push_back(*c);
+    return true;
+  }
+  std::vector<raft::MissionCommand> proposals;
+};
+
+TEST(SarBrainOnBrainHost, TakesOffClimbsAndSearchesThroughTheHostAlone) {
+  auto made = SarBrain::Create(Scout("scout_1", {"scout_1"}));
+  ASSERT_TRUE(made.ok());
+  SarBrain* sar = made->get();
+  std::unique_ptr<SarMissionState> state = sar->MakeMissionState();
+  RecordingFlight flight;
+  LeadingConsensus consensus;
+  BrainHostOptions bo;
+  bo.self = "scout_1";
+  bo.state = state.get();
+  BrainHost host(bo, std::move(*made), flight, nullptr, &consensus, nullptr);
+  brain::Vehicle v;
+  std::uint64_t step = 0;
+  std::vector<bus::WorldCommand> world;
+  const auto run = [&](double seconds, const std::string& mode, double z) {
+    v.flight_mode = mode;
+    v.landed = mode == "idle";
+    v.position_m = {0, 0, z};
+    for (const std::uint64_t end = step + static_cast<std::uint64_t>(seconds / 0.004); step < end;) {
+      ++step;
+      host.Step(step, static_cast<std::int64_t>(step) * 4'000'000, v, &world);
+    }
+  };
+  run(2.5, "idle", 0.23);
+  ASSERT_FALSE(flight.kinds.empty());
+  EXPECT_EQ(flight.kinds.front(), flight::Setpoint::Kind::kTakeoff);
+  EXPECT_DOUBLE_EQ(flight.values.front().z(), 3.0);
+  EXPECT_EQ(host.status(), "scout/taking_off");
+  flight.kinds.clear();
+  flight.values.clear();
+  run(0.5, "hold", 3.2);
+  ASSERT_EQ(flight.kinds.size(), 1u);
+  EXPECT_EQ(flight.kinds[0], flight::Setpoint::Kind::kPosition);
+  EXPECT_EQ(flight.values[0], Vec3(0, 0, 30));
+  run(0.5, "position", 29.5);
+  ASSERT_EQ(consensus.proposals.size(), 2u);
+  std::uint64_t index = 0;
+  for (const raft::MissionCommand& c : consensus.proposals) state->Apply(++index, raft::EncodeCommand(c));  // as Raft
+  EXPECT_EQ(state->mission().phase(), raft::MissionPhase::kSearch);
+  run(1.0, "velocity", 30.0);
+  EXPECT_EQ(flight.kinds.back(), flight::Setpoint::Kind::kVelocity);
+  EXPECT_EQ(host.status(), "scout/searching");
+  EXPECT_TRUE(world.empty());  // a scout has no payload
 }
 
 }  // namespace
