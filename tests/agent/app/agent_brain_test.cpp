@@ -70,6 +70,42 @@ std::vector<std::string> Physics(int domain, double sim_s, const std::vector<std
   return argv;
 }
 
+// A bad --brain combination or library: exit 2 with the reason, before any sample is waited for.
+TEST(AgentBrain, RefusesBadBrainsWithUsageExitCode) {
+  const std::string dir = MakeTempDir("swarmbox_agent_brain_");
+  ASSERT_FALSE(dir.empty());
+  const std::vector<std::string> base = {SWARMBOX_AGENT_BIN, "--name", "scout_1", "--airframe",
+                                         SWARMBOX_TRIALS_DIR "/airframes/x500.yaml", "--sim-domain",
+                                         std::to_string(DomainBase()), "--no-mesh", "--sample-timeout", "1"};
+  struct Case {
+    std::vector<std::string> args;
+    std::string reason;
+  };
+  const std::vector<Case> cases = {
+      {{"--brain", "library", "--brain-library", SWARMBOX_RENDEZVOUS_LIB}, "--brain library needs --brain-name NAME"},
+      {{"--brain", "library", "--brain-library", dir + "/nothing.so", "--brain-name", "rendezvous"}, "nothing.so"},
+      {{"--brain", "library", "--brain-library", SWARMBOX_RENDEZVOUS_LIB, "--brain-name", "flocking"}, "rendezvous"},
+      {{"--brain", "library", "--brain-library", SWARMBOX_RENDEZVOUS_LIB, "--brain-name", "rendezvous", "--brain-args",
+        R"({"altitude_m": "high"})"},
+       "altitude_m"},
+      {{"--brain", "library", "--brain-library", SWARMBOX_RENDEZVOUS_LIB, "--brain-name", "rendezvous", "--brain-args",
+        "[1, 2]"},
+       "--brain-args"},
+      {{"--brain", "external", "--mission", "sar"}, "--mission is for --brain builtin"},
+      {{"--brain", "external", "--brain-rate-hz", "60"}, "--brain-rate-hz 60"},
+      {{"--brain", "python"}, "expected builtin, library or external"},
+  };
+  int i = 0;
+  for (const Case& c : cases) {
+    std::vector<std::string> argv = base;
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    LoggedChild agent(argv, dir + "/case" + std::to_string(i++) + ".log");
+    EXPECT_EQ(agent.Wait(30s), 2) << c.reason << "\n" << agent.ReadLog();
+    EXPECT_NE(agent.ReadLog().find(c.reason), std::string::npos) << agent.ReadLog();
+  }
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
 TEST(AgentBrain, LibraryBrainsMeetThroughConsensusAndLand) {
   const std::string dir = MakeTempDir("swarmbox_agent_brain_");
   ASSERT_FALSE(dir.empty());
