@@ -10,9 +10,9 @@
 # What it sets, and why (agent/brain/README.md, "ABI"):
 #   - C++20 and position-independent code, as the agent is built;
 #   - hidden visibility for the brain's own code (-fvisibility=hidden, inlines too): the library
-#     exports only swarmbox_brain_abi_version and swarmbox_brain_registry (from swarmbox::brain),
+#     exports only swarmbox_brain_abi_version, _cxx_library and _registry (from swarmbox::brain),
 #     so nothing of it can clash with the agent or another brain library loaded next to it;
-#   - a version script exporting those two and nothing else (the C++ standard library's template
+#   - a version script exporting those three and nothing else (the C++ standard library's template
 #     instantiations keep default visibility under -fvisibility=hidden: they go local too);
 #   - -Wl,-Bsymbolic: what it does export binds to its own definitions, never to a same-named
 #     symbol of the agent or of a library loaded before it;
@@ -34,9 +34,9 @@ function(swarmbox_add_brain name)
     POSITION_INDEPENDENT_CODE ON
     CXX_VISIBILITY_PRESET hidden C_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON)
   set(map ${CMAKE_CURRENT_BINARY_DIR}/swarmbox_brain_exports.map)
-  if(NOT EXISTS ${map})
-    file(WRITE ${map} "{\n  global: swarmbox_brain_abi_version; swarmbox_brain_registry;\n  local: *;\n};\n")
-  endif()
+  # file(CONFIGURE) writes only when the text changes: no relink at every configure.
+  file(CONFIGURE OUTPUT ${map} CONTENT
+    "{\n  global: swarmbox_brain_abi_version; swarmbox_brain_cxx_library; swarmbox_brain_registry;\n  local: *;\n};\n")
   target_link_options(${name} PRIVATE -Wl,-Bsymbolic "-Wl,--version-script=${map}")
   set_property(TARGET ${name} APPEND PROPERTY LINK_DEPENDS ${map})
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" OR (CMAKE_CXX_COMPILER_ID MATCHES "Clang" AND NOT SANITIZER))

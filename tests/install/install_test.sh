@@ -7,7 +7,10 @@
 #     and no SWARMBOX_BIN_DIR: --help, `validate` on P/share/swarmbox/trials/sar_search.yaml, and
 #     `compose`, which packs the images of P/bin/swarmbox-physics and P/bin/swarmbox-agent (no
 #     engine needed): found beside swarmbox (the tags equal those of --physics-bin/--agent-bin
-#     P/bin/...), and a missing companion is reported with the place looked in.
+#     P/bin/...), and a missing companion is reported with the place looked in;
+#   - the brain SDK: examples/brains/rendezvous builds against P alone (find_package(swarmbox),
+#     swarmbox_add_brain), its library exports exactly the three entry points, and a program on the
+#     installed loader (brain_loader_check/) loads it and steps it once (take-off first).
 # Usage: install_test.sh BUILD_DIR SOURCE_DIR CXX_COMPILER
 set -euo pipefail
 build=$1 src=$2 cxx=$3
@@ -27,10 +30,12 @@ for f in bin/swarmbox bin/swarmbox-physics bin/swarmbox-agent bin/swarmbox-netem
          lib/cmake/swarmbox/swarmboxTargets.cmake \
          include/swarmbox/common/result.hpp include/swarmbox/dsl/trial_loader.hpp \
          include/swarmbox/experiment/experiment_runner.hpp include/swarmbox/hosts/host.hpp \
+         include/swarmbox/brain/brain.hpp include/swarmbox/brain/loader.hpp \
+         include/swarmbox/brain/args.hpp lib/cmake/swarmbox/SwarmboxBrain.cmake \
          share/doc/swarmbox/README.md share/doc/swarmbox/examples/CMakeLists.txt; do
   [ -e "$prefix/$f" ] || fail "missing $prefix/$f"
 done
-for lib in common docker images dsl faults runner hosts report experiment; do
+for lib in common docker images dsl faults runner hosts report experiment brain brain_loader; do
   [ -f "$prefix/lib/libswarmbox_$lib.a" ] || fail "missing $prefix/lib/libswarmbox_$lib.a"
 done
 # Every shipped trial, airframe, world, fault trial and experiment.
@@ -49,6 +54,31 @@ done < <(find "$src/trials" -name '*.yaml' -print0)
 } >"$work/all_headers.cpp"
 "$cxx" -std=c++20 -fsyntax-only -I "$prefix/include" "$work/all_headers.cpp" 2>"$work/headers.log" ||
   { cat "$work/headers.log" >&2; fail "the installed headers do not compile from $prefix/include alone"; }
+
+# The brain SDK: the example brain and a loader program, built against P alone.
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+for project in "$src/examples/brains/rendezvous" "$src/tests/install/brain_loader_check"; do
+  out=$work/build-$(basename "$project")
+  cmake -S "$project" -B "$out" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_COMPILER="$cxx" \
+    "${launcher[@]}" >"$work/brain-configure.log" 2>&1 ||
+    { cat "$work/brain-configure.log" >&2; fail "$project does not configure against $prefix"; }
+  cmake --build "$out" >"$work/brain-build.log" 2>&1 ||
+    { tail -n 40 "$work/brain-build.log" >&2; fail "$project does not build against $prefix"; }
+done
+brain_lib=$work/build-rendezvous/librendezvous_brain.so
+[ -f "$brain_lib" ] || fail "no $brain_lib"
+exports=$(nm -D --defined-only "$brain_lib" | awk '{print $3}' | sort | tr '\n' ' ')
+[ "$exports" = "swarmbox_brain_abi_version swarmbox_brain_cxx_library swarmbox_brain_registry " ] ||
+  fail "librendezvous_brain.so exports more or less than the three entry points: $exports"
+answer=$("$work/build-brain_loader_check/brain_loader_check" "$brain_lib" rendezvous) ||
+  fail "the installed loader did not load $brain_lib"
+[ "$answer" = "takeoff(10) rendezvous/takeoff" ] || fail "the rendezvous brain's first answer: $answer"
+if "$work/build-brain_loader_check/brain_loader_check" "$brain_lib" nothing 2>"$work/brain-unknown.err"; then
+  fail "loading brain 'nothing' succeeded"
+fi
+grep -qF 'no brain named "nothing" in the library; it has: rendezvous' "$work/brain-unknown.err" ||
+  { cat "$work/brain-unknown.err" >&2; fail "the unknown brain's error does not list the library's brains"; }
 
 # The installed programs, away from the build tree.
 mkdir "$work/cwd"

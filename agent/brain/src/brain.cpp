@@ -63,6 +63,8 @@ std::vector<Registration>& LibraryRegistry() {
 
 extern "C" int swarmbox_brain_abi_version() { return swarmbox::brain::kAbiVersion; }
 
+extern "C" const char* swarmbox_brain_cxx_library() { return swarmbox::brain::CxxLibrary(); }
+
 extern "C" const std::vector<swarmbox::brain::Registration>* swarmbox_brain_registry() {
   return &swarmbox::brain::LibraryRegistry();
 }

@@ -9,6 +9,7 @@ namespace swarmbox::brain {
 namespace {
 
 using AbiVersionFn = int (*)();
+using CxxLibraryFn = const char* (*)();
 using RegistryFn = const std::vector<Registration>* (*)();
 
 Error LoadError(const std::string& path, std::string message) {
@@ -52,24 +53,43 @@ struct OpenLibrary {
 Result<OpenLibrary> Open(const std::string& path) {
   dlerror();  // clear a stale error
   void* raw = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (raw == nullptr) return LoadError(path, "cannot load the brain library: " + DlErrorText());
+  if (raw == nullptr) {
+    std::string message = "cannot load the brain library: " + DlErrorText();
+    if (path.find('/') == std::string::npos) {
+      message += " (a name without '/' is searched on the library path, not in the current folder: ./" +
+                 path + " for that)";
+    }
+    return LoadError(path, message);
+  }
   OpenLibrary lib;
   lib.handle = std::shared_ptr<void>(raw, [](void* h) { dlclose(h); });
 
   // dlsym on the handle searches this library (and its dependencies) only, never the agent.
   void* abi_sym = dlsym(raw, "swarmbox_brain_abi_version");
-  void* registry_sym = dlsym(raw, "swarmbox_brain_registry");
-  if (abi_sym == nullptr || registry_sym == nullptr) {
+  if (abi_sym == nullptr) {
     return LoadError(path,
-                     "not a SwarmBox brain library: it exports no swarmbox_brain_abi_version/"
-                     "swarmbox_brain_registry (link it with swarmbox::brain, register its brain "
-                     "with SWARMBOX_BRAIN, build it with swarmbox_add_brain)");
+                     "not a SwarmBox brain library: it exports no swarmbox_brain_abi_version (link "
+                     "it with swarmbox::brain, register its brain with SWARMBOX_BRAIN, build it "
+                     "with swarmbox_add_brain)");
   }
   const int abi = reinterpret_cast<AbiVersionFn>(abi_sym)();
   if (abi != kAbiVersion) {
     return LoadError(path, "built against brain ABI " + std::to_string(abi) + ", this agent speaks ABI " +
                                std::to_string(kAbiVersion) +
                                ": rebuild the library against this SwarmBox's package");
+  }
+  void* cxx_sym = dlsym(raw, "swarmbox_brain_cxx_library");
+  void* registry_sym = dlsym(raw, "swarmbox_brain_registry");
+  if (cxx_sym == nullptr || registry_sym == nullptr) {
+    return LoadError(path, "not a SwarmBox brain library: it exports swarmbox_brain_abi_version but no " +
+                               std::string(cxx_sym == nullptr ? "swarmbox_brain_cxx_library"
+                                                              : "swarmbox_brain_registry"));
+  }
+  const char* cxx = reinterpret_cast<CxxLibraryFn>(cxx_sym)();
+  if (cxx == nullptr || std::string(cxx) != CxxLibrary()) {
+    return LoadError(path, std::string("built against the C++ standard library ") +
+                               (cxx != nullptr ? cxx : "(none)") + ", this agent uses " + CxxLibrary() +
+                               ": rebuild it with the agent's compiler and standard library");
   }
   const std::vector<Registration>* registry = reinterpret_cast<RegistryFn>(registry_sym)();
   if (registry != nullptr) lib.registry = *registry;

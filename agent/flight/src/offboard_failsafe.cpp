@@ -86,9 +86,14 @@ std::string_view OffboardFailsafe::ActionName(Action action) {
 }
 
 LogEvent OffboardFailsafe::ToLogEvent(const Event& e, std::string_view node) {
+  // Field order as the design's lines (docs and tests match on them): offboard_lost silent_s=..
+  // action=hold; offboard_failsafe action=land silent_s=..; offboard_regained silent_s=..
   LogEvent line(e.t_s, node, EventName(e.kind));
-  line.Add("silent_s", e.silent_s);
-  if (e.kind != EventKind::kRegained) line.Add("action", ActionName(e.action));
+  switch (e.kind) {
+    case EventKind::kLost: line.Add("silent_s", e.silent_s).Add("action", ActionName(e.action)); break;
+    case EventKind::kFailsafe: line.Add("action", ActionName(e.action)).Add("silent_s", e.silent_s); break;
+    case EventKind::kRegained: line.Add("silent_s", e.silent_s); break;
+  }
   return line;
 }
 

@@ -92,6 +92,13 @@ Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config,
                                std::to_string(state->snapshot.index));
     }
     applied = state->snapshot.index;
+    const auto* m = dynamic_cast<const MissionStateMachine*>(machine.get());
+    if (m != nullptr && m->mission().applied_index() != applied) {
+      return Error(ErrorCode::kProtocol,
+                   "stored snapshot " + std::to_string(applied) + " holds a mission applied to " +
+                       std::to_string(m->mission().applied_index()),
+                   "raft storage");
+    }
     machine->ReplayRestored(0, &tap);
   }
   auto node = RawNode::Create(*rc, std::move(*state));
@@ -228,6 +235,9 @@ Status NodeDriver::Process() {
       }
       const std::uint64_t before = applied_;
       applied_ = rd.snapshot.index;
+      if (mission_machine_ != nullptr && mission_machine_->mission().applied_index() != applied_) {
+        return Stop(Error(ErrorCode::kProtocol, "snapshot index mismatch", "raft driver"));
+      }
       machine_->OnSnapshotInstalled(rd.snapshot.index,
                                     EventOut(clock_.NowS(), config_.self, sink_));
       machine_->ReplayRestored(before, &tap_);

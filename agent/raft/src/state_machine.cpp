@@ -15,6 +15,7 @@ void EntryLogMachine::Apply(std::uint64_t index, std::span<const std::uint8_t> d
 
 Bytes EntryLogMachine::Snapshot() const {
   Bytes out;
+  out.assign(kSnapshotMagic.begin(), kSnapshotMagic.end());
   detail::ByteWriter w(&out);
   w.U8(kSnapshotVersion);
   w.Varint(entries_.size());
@@ -29,7 +30,12 @@ Status EntryLogMachine::Restore(std::span<const std::uint8_t> snapshot) {
   auto bad = [](std::string what) {
     return Error(ErrorCode::kProtocol, std::move(what), "entry log snapshot");
   };
+  if (snapshot.size() < kSnapshotMagic.size() ||
+      !std::equal(kSnapshotMagic.begin(), kSnapshotMagic.end(), snapshot.begin())) {
+    return bad("not an entry log snapshot (no \"sbel\" magic)");
+  }
   detail::ByteReader r(snapshot);
+  for (std::size_t k = 0; k < kSnapshotMagic.size(); ++k) (void)r.U8();  // checked above
   const std::uint8_t version = r.U8();
   if (r.ok() && version != kSnapshotVersion) {
     return bad("unsupported version " + std::to_string(version) + " (this build reads " +

@@ -1,6 +1,7 @@
 // The agent's Raft host, pure parts: the --members list, the default WAL directory, the clocks,
 // the transport onto a MeshRadio, the event restamp; three hosts over ChannelRadios and a
-// scripted channel elect one leader at the same simulated time on every run.
+// scripted channel elect one leader at the same simulated time on every run, and replicate a
+// brain's bytes through the entry log (ProposeBytes, TakeCommitted, leader()).
 #include "raft_host.hpp"
 
 #include <gtest/gtest.h>
@@ -93,9 +94,16 @@ TEST(RaftHostEvents, RestampReplacesOnlyTheLeadingTime) {
   EXPECT_EQ(RestampLine("node=a t=1", 2.0), "node=a t=1");
 }
 
+struct ThreeRun {
+  std::map<std::string, std::string> logs;                   // each drone's event lines
+  std::map<std::string, std::vector<raft::Committed>> taps;  // each drone's TakeCommitted, joined
+  std::map<std::string, std::string> leaders;                // each drone's leader() at the end
+};
+
 // Three drones on a lossless channel with a 10 ms delay, stepped every 4 ms of simulated time.
-// Returns each drone's log.
-std::map<std::string, std::string> RunThree(std::uint64_t seed, double seconds) {
+// With `entry_log` each runs an EntryLogMachine and, from t = 1 s, proposes "hello <name>" until
+// a proposal is accepted.
+ThreeRun RunThree(std::uint64_t seed, double seconds, bool entry_log = false) {
   const std::vector<std::string> members = {"drone_1", "drone_2", "drone_3"};
   const std::string dir = swarmbox::testing::MakeTempDir("swarmbox_agent_raft_three_");
   struct Drone {
@@ -103,6 +111,7 @@ std::map<std::string, std::string> RunThree(std::uint64_t seed, double seconds) 
     std::unique_ptr<RadioClock> clock;
     std::FILE* log = nullptr;
     std::unique_ptr<RaftHost> host;
+    bool proposed = false;
   };
   std::vector<Drone> drones(members.size());
   for (std::size_t i = 0; i < members.size(); ++i) {
@@ -115,11 +124,14 @@ std::map<std::string, std::string> RunThree(std::uint64_t seed, double seconds) 
     o.members = members;
     o.raft_dir = dir + "/" + members[i];
     o.seed = seed;
-    auto h = RaftHost::Start(o, *d.radio, *d.clock, d.log);
+    std::unique_ptr<raft::StateMachine> machine;
+    if (entry_log) machine = std::make_unique<raft::EntryLogMachine>();
+    auto h = RaftHost::Start(o, *d.radio, *d.clock, d.log, nullptr, std::move(machine));
     EXPECT_TRUE(h) << h.error().ToString();
     if (!h) return {};
     d.host = std::move(*h);
   }
+  ThreeRun run;
   std::multimap<std::int64_t, bus::RadioFrame> air;
   for (std::int64_t t = 4'000'000; t <= static_cast<std::int64_t>(seconds * 1e9); t += 4'000'000) {
     for (std::size_t i = 0; i < drones.size(); ++i) {
@@ -142,6 +154,14 @@ std::map<std::string, std::string> RunThree(std::uint64_t seed, double seconds) 
         }
       }
       EXPECT_TRUE(d.host->Step());
+      if (entry_log && t >= 1'000'000'000 && !d.proposed) {
+        const std::string text = "hello " + members[i];
+        d.proposed = d.host->ProposeBytes(raft::Bytes(text.begin(), text.end())).ok();
+      }
+      std::vector<raft::Committed> got;
+      d.host->TakeCommitted(&got);
+      auto& tap = run.taps[members[i]];
+      tap.insert(tap.end(), got.begin(), got.end());
       bus::ActuatorCommand cmd;
       d.radio->Flush(&cmd);
       for (bus::RadioFrame& f : cmd.radio_out) {
@@ -150,23 +170,23 @@ std::map<std::string, std::string> RunThree(std::uint64_t seed, double seconds) 
       }
     }
   }
-  std::map<std::string, std::string> logs;
   for (std::size_t i = 0; i < drones.size(); ++i) {
+    run.leaders[members[i]] = drones[i].host->leader();
     drones[i].host.reset();
     std::FILE* log = drones[i].log;
     std::fflush(log);
     std::rewind(log);
     char buf[512];
-    while (std::fgets(buf, sizeof buf, log) != nullptr) logs[members[i]] += buf;
+    while (std::fgets(buf, sizeof buf, log) != nullptr) run.logs[members[i]] += buf;
     std::fclose(log);
   }
   std::filesystem::remove_all(dir);
-  return logs;
+  return run;
 }
 
 TEST(RaftHostOnTheChannel, ElectsOneLeaderAtTheSameSimulatedTimeOnEveryRun) {
-  const auto a = RunThree(7, 3.0);
-  const auto b = RunThree(7, 3.0);
+  const auto a = RunThree(7, 3.0).logs;
+  const auto b = RunThree(7, 3.0).logs;
   ASSERT_EQ(a.size(), 3u);
   EXPECT_EQ(a, b);  // same seed, same deliveries: the same lines, byte for byte
   std::set<std::string> leaders;
@@ -178,6 +198,62 @@ TEST(RaftHostOnTheChannel, ElectsOneLeaderAtTheSameSimulatedTimeOnEveryRun) {
     leaders.insert(log.substr(l + 7, log.find_first_of(" \n", l) - l - 7));
   }
   EXPECT_EQ(leaders.size(), 1u) << "every drone agrees on one leader";
+}
+
+// A brain's entries through the host: every drone's tap yields the same three entries, in the
+// same index order, and every drone names the same leader.
+TEST(RaftHostOnTheChannel, ReplicatesBytesThroughTheEntryLog) {
+  const ThreeRun run = RunThree(7, 3.0, /*entry_log=*/true);
+  ASSERT_EQ(run.taps.size(), 3u);
+  const std::vector<raft::Committed>& first = run.taps.begin()->second;
+  ASSERT_EQ(first.size(), 3u);
+  std::set<std::string> texts;
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    texts.insert(std::string(first[k].data.begin(), first[k].data.end()));
+    if (k > 0) {
+      EXPECT_LT(first[k - 1].index, first[k].index);
+    }
+  }
+  EXPECT_EQ(texts, (std::set<std::string>{"hello drone_1", "hello drone_2", "hello drone_3"}));
+  for (const auto& [name, tap] : run.taps) EXPECT_EQ(tap, first) << name;
+  std::set<std::string> leaders;
+  for (const auto& [name, leader] : run.leaders) leaders.insert(leader);
+  ASSERT_EQ(leaders.size(), 1u);
+  EXPECT_FALSE(leaders.begin()->empty());
+  for (const auto& [name, log] : run.logs) {
+    EXPECT_EQ(log.find("event=mission_state"), std::string::npos) << name << ": no mission here";
+  }
+}
+
+TEST(RaftHostMachine, MissionByDefaultAndTheDemoLoopOnlyWithIt) {
+  const std::string dir = swarmbox::testing::MakeTempDir("swarmbox_agent_raft_machine_");
+  radio::ChannelRadio radio("drone_1");
+  RadioClock clock(radio, 0);
+  std::FILE* log = std::tmpfile();
+  RaftHostOptions o;
+  o.self = "drone_1";
+  o.members = {"drone_1"};
+  o.raft_dir = dir + "/mission";
+  auto mission = RaftHost::Start(o, radio, clock, log);
+  ASSERT_TRUE(mission) << mission.error().ToString();
+  ASSERT_NE((*mission)->FindMission(), nullptr);
+  EXPECT_EQ((*mission)->mission().phase(), raft::MissionPhase::kIdle);
+  o.raft_dir = dir + "/log";
+  o.propose_every_ms = 500;
+  auto bad = RaftHost::Start(o, radio, clock, log, nullptr, std::make_unique<raft::EntryLogMachine>());
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(bad.error().ToString().find("--propose-every-ms proposes mission commands"), std::string::npos)
+      << bad.error().ToString();
+  o.propose_every_ms = 0;
+  auto log_host = RaftHost::Start(o, radio, clock, log, nullptr, std::make_unique<raft::EntryLogMachine>());
+  ASSERT_TRUE(log_host) << log_host.error().ToString();
+  EXPECT_EQ((*log_host)->FindMission(), nullptr);
+  Status empty = (*log_host)->ProposeBytes({});
+  ASSERT_FALSE(empty.ok());
+  EXPECT_EQ(empty.error().code(), ErrorCode::kInvalidArgument);
+  std::fclose(log);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -97,11 +97,27 @@ TEST(BrainLoader, WrongAbiVersionNamesBothNumbers) {
                         ", this agent speaks ABI " + std::to_string(kAbiVersion)));
 }
 
+TEST(BrainLoader, OtherCxxStandardLibraryNamesBoth) {
+  auto loaded = LoadBrain(SWARMBOX_TEST_BRAIN_OTHER_CXX, "alpha", MakeContext());
+  ASSERT_FALSE(loaded);
+  EXPECT_EQ(loaded.error().message(),
+            std::string("built against the C++ standard library libc++, this agent uses ") + CxxLibrary() +
+                ": rebuild it with the agent's compiler and standard library");
+  EXPECT_STREQ(CxxLibrary(), "libstdc++/cxx11");  // this build's (GCC, the default ABI)
+}
+
 TEST(BrainLoader, UnknownNameListsTheLibrarysBrains) {
   auto loaded = LoadBrain(SWARMBOX_TEST_BRAIN_A, "gamma", MakeContext());
   ASSERT_FALSE(loaded);
   EXPECT_EQ(loaded.error().message(),
             "no brain named \"gamma\" in the library; it has: alpha, stateful, thrower");
+}
+
+TEST(BrainLoader, NameRegisteredTwiceIsRefused) {
+  auto loaded = LoadBrain(SWARMBOX_TEST_BRAIN_DUPLICATE, "twin", MakeContext());
+  ASSERT_FALSE(loaded);
+  EXPECT_EQ(loaded.error().message(),
+            "the library registers brain \"twin\" twice (two SWARMBOX_BRAIN lines with one name)");
 }
 
 TEST(BrainLoader, ThrowingConstructorGivesItsMessage) {
@@ -118,6 +134,14 @@ TEST(BrainLoader, MissingFileGivesDlerror) {
   EXPECT_EQ(loaded.error().where(), "/nonexistent/libnothing.so");
   EXPECT_THAT(loaded.error().message(), HasSubstr("cannot load the brain library: "));
   EXPECT_THAT(loaded.error().message(), HasSubstr("No such file or directory"));
+}
+
+TEST(BrainLoader, BareNameIsSearchedAsDlopenDoesAndTheErrorSaysSo) {
+  auto loaded = LoadBrain("libswarmbox_no_such_brain.so", "alpha", MakeContext());
+  ASSERT_FALSE(loaded);
+  EXPECT_THAT(loaded.error().message(),
+              HasSubstr("(a name without '/' is searched on the library path, not in the current "
+                        "folder: ./libswarmbox_no_such_brain.so for that)"));
 }
 
 TEST(BrainLoader, LibraryWithoutTheEntryPointsIsNoBrainLibrary) {
@@ -164,6 +188,16 @@ TEST(BrainLoader, ExampleRendezvousBrainAsksForTakeoffFirst) {
   EXPECT_EQ(out.commands[0].kind, Command::Kind::kTakeoff);
   EXPECT_EQ(out.commands[0].param, 12.0);
   EXPECT_EQ(out.status, "rendezvous/takeoff");
+}
+
+TEST(BrainLoader, TwoBrainsFromOneLibraryKeepTheirOwnState) {
+  auto first = LoadBrain(SWARMBOX_EXAMPLE_RENDEZVOUS_BRAIN, "rendezvous", MakeContext());
+  auto second = LoadBrain(SWARMBOX_EXAMPLE_RENDEZVOUS_BRAIN, "rendezvous", MakeContext());
+  ASSERT_TRUE(first && second);
+  EXPECT_EQ(StepOnce(**first).commands.size(), 1u);   // asks for take-off ...
+  EXPECT_EQ(StepOnce(**first).commands.size(), 0u);   // ... once
+  first->reset();                                     // the library stays loaded for the other
+  EXPECT_EQ(StepOnce(**second).commands.size(), 1u);  // its own first take-off
 }
 
 TEST(BrainLoader, ExampleRendezvousBrainRefusesADroneOutsideTheMembers) {

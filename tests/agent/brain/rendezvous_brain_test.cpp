@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -97,6 +98,8 @@ struct Drone {
   std::string status;
   std::vector<sb::Event> events;
   std::vector<std::string> proposals;  // every proposal it made, as text
+  std::int64_t landing_status_ns = 0;  // first Step with status rendezvous/landing
+  std::int64_t land_command_ns = 0;    // the Step that commanded land
 };
 
 struct Outcome {
@@ -162,6 +165,10 @@ Outcome RunSwarm(std::size_t n, bool lose_first = false, double limit_s = 200.0)
 
       d.flight.Apply(out, t_ns);
       d.status = out.status;
+      if (d.landing_status_ns == 0 && out.status == "rendezvous/landing") d.landing_status_ns = t_ns;
+      for (const sb::Command& c : out.commands) {
+        if (c.kind == sb::Command::Kind::kLand) d.land_command_ns = t_ns;
+      }
       for (const auto& p : out.proposals) {
         d.proposals.emplace_back(p.begin(), p.end());
         if (lose_first && !lost[i]) {
@@ -222,6 +229,9 @@ void ExpectRendezvous(const Outcome& o) {
     ASSERT_FALSE(d.proposals.empty());
     EXPECT_EQ(d.proposals.front().rfind("pos " + d.name + " ", 0), 0u) << d.proposals.front();
     EXPECT_EQ(d.proposals.back(), "arrived " + d.name);
+    // Every arrival committed: hold_s (2 s) at the slot, then land.
+    EXPECT_GT(d.landing_status_ns, 0);
+    EXPECT_EQ(d.land_command_ns - d.landing_status_ns, 2'000'000'000);
   }
   // Every drone landed on its slot: P + r (cos a, sin a), a = 2 pi i / N, from the logged P.
   const double px = std::stod(first_point->fields[0].second);
@@ -239,6 +249,8 @@ class RendezvousSwarm : public ::testing::TestWithParam<std::size_t> {};
 TEST_P(RendezvousSwarm, EveryDroneReachesItsSlotAndCompletes) {
   const Outcome o = RunSwarm(GetParam());
   ExpectRendezvous(o);
+  std::cout << GetParam() << " drones: rendezvous_complete on every drone at "
+            << static_cast<double>(o.end_ns) * 1e-9 << " s simulated\n";
   // The point is the mean of the starts (straight take-offs), summed in sorted member order.
   double sx = 0.0, sy = 0.0;
   for (std::size_t i = 0; i < GetParam(); ++i) {

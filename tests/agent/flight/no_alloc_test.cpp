@@ -11,6 +11,7 @@
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/flight/flight_config.hpp"
 #include "swarmbox/flight/flight_controller.hpp"
+#include "swarmbox/flight/offboard_failsafe.hpp"
 
 namespace {
 std::atomic<long> g_news{0};
@@ -69,6 +70,55 @@ TEST(NoAllocation, ControlStepsAndSetpointsDoNotAllocate) {
   const long during = g_news.load() - before;
   EXPECT_EQ(during, 0) << "operator new called " << during << " times in 2500 control steps";
   EXPECT_EQ(accepted, 3);  // the steps really flew: take-off, position, land accepted
+  EXPECT_TRUE(std::isfinite(sink));
+}
+
+// The trajectory kind streamed every 5th step (a brain at 50 Hz), with every axis rule and a yaw
+// rate, and the offboard failsafe stepped alongside: neither allocates.
+TEST(NoAllocation, TrajectoryStreamAndOffboardFailsafeDoNotAllocate) {
+  auto doc = yaml::Parse(kQuad, "quad.yaml");
+  ASSERT_TRUE(doc.ok());
+  auto cfg = ParseFlightConfig(*doc, "quad.yaml");
+  ASSERT_TRUE(cfg.ok()) << cfg.error().ToString();
+  auto fc = FlightController::Create(*cfg, {});
+  ASSERT_TRUE(fc.ok()) << fc.error().ToString();
+  OffboardFailsafe failsafe(1.0, 5.0);
+  SensorSample s;
+  s.accel_mps2 = Vec3(0.0, 0.0, kGravity_mps2);
+  s.mag_fresh = true;
+  s.mag_body = Vec3(0.0, 0.21, -0.42);
+  s.baro_fresh = true;
+  s.gps_fresh = s.gps_valid = true;
+  const double nan = std::nan("");
+  TrajectoryTarget t;
+  t.pos_m = Vec3(2.0, nan, nan);
+  t.vel_mps = Vec3(0.5, 1.0, nan);
+  t.acc_mps2 = Vec3(nan, nan, 0.2);
+  t.yawspeed_radps = 0.3;
+  FlightEvent e;
+  OffboardFailsafe::Event fe;
+  const long before = g_news.load();
+  double sink = 0.0;
+  int accepted = 0;
+  for (int i = 0; i < 2500; ++i) {
+    s.t_s = i * 0.004;
+    s.gps_fresh = i % 25 == 0;
+    sink += fc->Step(s).u[0];
+    if (i == 500) accepted += fc->Command(Setpoint::Takeoff(5.0)) ? 1 : 0;
+    if (i > 600 && i % 5 == 0) {
+      if (i == 1500) t = TrajectoryTarget{};  // all unset: hold
+      accepted += fc->Command(Setpoint::Trajectory(t)) ? 1 : 0;
+    }
+    const bool answered = i < 2000;
+    sink += static_cast<double>(failsafe.Update(s.t_s, answered));
+    while (fc->PopEvent(&e)) sink += e.t_s;
+    while (failsafe.PopEvent(&fe)) sink += fe.silent_s;
+  }
+  const long during = g_news.load() - before;
+  EXPECT_EQ(during, 0) << "operator new called " << during << " times in 2500 control steps";
+  EXPECT_EQ(accepted, 1 + 379);  // take-off and every trajectory setpoint (steps 605..2495)
+  EXPECT_EQ(fc->mode(), FlightMode::kTrajectory);
+  EXPECT_EQ(failsafe.action(), OffboardFailsafe::Action::kHold);  // silent since 8 s: lost at 9 s
   EXPECT_TRUE(std::isfinite(sink));
 }
 

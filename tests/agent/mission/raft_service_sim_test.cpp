@@ -1,7 +1,7 @@
 // The passive RaftService without DDS or wall clock (unit): services in one thread on a
 // ManualClock, wired through SimRadio (sim_radio.hpp). The tick grid and its cap after a clock
 // jump, and a paused follower rejoining; the loud stop when storage fails; junk survived; a
-// restart re-applying the log; three nodes electing and committing, byte for byte the same event
+// restart re-applying the log (the mission's, and the entry log's replay to the tap); three nodes electing and committing, byte for byte the same event
 // lines for the same inputs; and the failover time after a leader stops, with the trial's
 // timings over a 100 +- 20 ms / 5% link.
 #include "swarmbox/mission/raft_service.hpp"
@@ -216,6 +216,46 @@ TEST(RaftServiceSim, RestartReappliesTheDurableLog) {
   EXPECT_EQ((*s)->mission().victims(), before.victims());
   EXPECT_EQ((*s)->mission().phase(), raft::MissionPhase::kSearch);
   EXPECT_TRUE(Contains(lines, "event=victim_confirmed id=1")) << Joined(lines);
+}
+
+// Any state machine through the service: a brain's bytes in the entry log, and after a restart
+// on the same WAL the tap replays every one of them, in index order, before anything new.
+TEST(RaftServiceSim, EntryLogTapReplaysTheWholeLogAfterARestart) {
+  const TempDir tmp("swarmbox_raft_entry_log_");
+  RaftServiceConfig cfg = SoloConfig(tmp.path);
+  cfg.driver.snapshot_every_entries = 5;  // part of the log lives in a snapshot
+  ManualClock clock;
+  NoRadio radio;
+  std::vector<raft::Committed> before;
+  auto text = [](int k) {
+    const std::string t = "pos solo " + std::to_string(k) + ".000 0.000";
+    return raft::Bytes(t.begin(), t.end());
+  };
+  {
+    auto s = RaftService::Start(cfg, radio, clock, nullptr, std::make_unique<raft::EntryLogMachine>());
+    ASSERT_TRUE(s) << s.error().ToString();
+    ASSERT_TRUE(StepUntil(clock, **s, [&] { return (*s)->is_leader(); }, 5.0));
+    EXPECT_EQ((*s)->leader(), "solo");
+    EXPECT_EQ((*s)->FindMission(), nullptr);
+    for (int k = 1; k <= 12; ++k) ASSERT_TRUE((*s)->ProposeBytes(text(k)));
+    (*s)->TakeCommitted(&before);
+  }
+  ASSERT_EQ(before.size(), 12u);
+  for (int k = 1; k <= 12; ++k) EXPECT_EQ(before[static_cast<std::size_t>(k - 1)].data, text(k));
+  std::vector<std::string> lines;
+  auto s = RaftService::Start(cfg, radio, clock, [&](const std::string& l) { lines.push_back(l); },
+                              std::make_unique<raft::EntryLogMachine>());
+  ASSERT_TRUE(s) << s.error().ToString();
+  std::vector<raft::Committed> replay;
+  (*s)->TakeCommitted(&replay);
+  EXPECT_EQ(replay, before);
+  ASSERT_TRUE(StepUntil(clock, **s, [&] { return (*s)->is_leader(); }, 5.0));
+  ASSERT_TRUE((*s)->ProposeBytes(text(13)));
+  (*s)->TakeCommitted(&replay);
+  ASSERT_EQ(replay.size(), 1u);
+  EXPECT_EQ(replay[0].data, text(13));
+  EXPECT_GT(replay[0].index, before.back().index);
+  EXPECT_FALSE(Contains(lines, "event=mission_state")) << Joined(lines);
 }
 
 // ---- clusters on the simulated radio -------------------------------------------------------

@@ -1,5 +1,6 @@
 // NodeDriver: persistence before sending, contract events, restart, stop-loudly on storage
-// failure, misaddressed and garbage input, configuration errors.
+// failure, misaddressed and garbage input, configuration errors; any state machine (the entry
+// log) and the committed-entries tap with its replay after a restart or a snapshot.
 #include "swarmbox/raft/node_driver.hpp"
 
 #include <gtest/gtest.h>
@@ -8,6 +9,7 @@
 #include <deque>
 #include <filesystem>
 #include <map>
+#include <set>
 
 #include "swarmbox/raft/sim/memory_storage.hpp"
 #include "swarmbox/raft/wal_storage.hpp"
@@ -61,8 +63,11 @@ class DriverCluster : public ::testing::Test {
   }
   void Start(const std::string& name) {
     radios_[name] = std::make_unique<FakeRadio>(name, &air_);
+    std::unique_ptr<StateMachine> machine;
+    if (entry_log_) machine = std::make_unique<EntryLogMachine>();
     auto d = NodeDriver::Open(Cfg(name, names_), storage_[name], *radios_[name], clock_,
-                              [this](const LogEvent& e) { events_.push_back(e.str()); });
+                              [this](const LogEvent& e) { events_.push_back(e.str()); },
+                              std::move(machine));
     ASSERT_TRUE(d.ok()) << d.error().ToString();
     drivers_[name] = std::move(*d);
   }
@@ -70,6 +75,7 @@ class DriverCluster : public ::testing::Test {
     while (!air_.empty()) {
       Packet p = air_.front();
       air_.pop_front();
+      if (cut_.count(p.from) != 0 || cut_.count(p.to) != 0) continue;  // off the radio
       auto it = drivers_.find(p.to);
       if (it == drivers_.end() || !it->second) continue;
       (void)it->second->Receive(p.bytes);
@@ -99,6 +105,18 @@ class DriverCluster : public ::testing::Test {
     return out;
   }
 
+  std::vector<Committed> Take(const std::string& name) {
+    std::vector<Committed> out;
+    drivers_[name]->TakeCommitted(&out);
+    return out;
+  }
+  std::string AFollower() {
+    const std::string leader = Leader();
+    return names_[0] == leader ? names_[1] : names_[0];
+  }
+
+  bool entry_log_ = false;     // the drones' machine: EntryLogMachine, else the default mission
+  std::set<std::string> cut_;  // drones whose packets are lost
   FakeClock clock_;
   std::deque<Packet> air_;
   std::map<std::string, MemoryStorage> storage_;
@@ -219,6 +237,120 @@ TEST_F(DriverCluster, GarbageAndMisaddressedBytesAreReportedAndIgnored) {
   EXPECT_FALSE(Leader().empty());
 }
 
+// A mission follower cut off while the leader compacts gets the leader's snapshot: it prints
+// the mission_state line for it, and its tap yields nothing for what the snapshot covers.
+TEST_F(DriverCluster, InstalledMissionSnapshotIsAnnouncedAndTapsOnlyLaterEntries) {
+  TickAll(40);
+  const std::string leader = Leader();
+  ASSERT_FALSE(leader.empty());
+  const std::string follower = AFollower();
+  TickAll(1);
+  (void)Take(follower);
+  cut_.insert(follower);
+  ASSERT_TRUE(drivers_[leader]->Propose(StartSearch{}).ok());
+  for (std::uint64_t s = 1; s <= 9; ++s) {
+    ASSERT_TRUE(drivers_[leader]->Propose(ReportSighting{"scout_2", s, 10.0 * static_cast<double>(s), 0, 0.6}).ok());
+    Pump();
+  }
+  TickAll(2);
+  EXPECT_EQ(Take(follower).size(), 0u);  // heard nothing
+  cut_.clear();
+  events_.clear();
+  TickAll(4);
+  EXPECT_EQ(drivers_[follower]->mission(), drivers_[leader]->mission());
+  const std::uint64_t snap = storage_[follower].state().snapshot.index;
+  ASSERT_GT(snap, 0u);
+  std::vector<std::string> from_snapshot;
+  for (const auto& line : events_) {
+    if (line.find("from=snapshot") != std::string::npos) from_snapshot.push_back(line);
+  }
+  ASSERT_EQ(from_snapshot.size(), 1u);
+  EXPECT_NE(from_snapshot[0].find("node=" + follower + " event=mission_state state=SEARCH index=" +
+                                  std::to_string(snap) + " from=snapshot"),
+            std::string::npos)
+      << from_snapshot[0];
+  for (const Committed& c : Take(follower)) EXPECT_GT(c.index, snap);
+}
+
+// The entry log through the driver: every drone's tap yields the same entries in index order,
+// once each; empty proposals are refused.
+TEST_F(DriverCluster, EntryLogCommitsBytesAndEveryTapYieldsThemInOrder) {
+  entry_log_ = true;
+  drivers_.clear();
+  for (const auto& n : names_) Start(n);
+  TickAll(40);
+  const std::string leader = Leader();
+  ASSERT_FALSE(leader.empty());
+  const std::string follower = AFollower();
+  for (const auto& n : names_) EXPECT_EQ(drivers_[n]->leader(), leader) << n;
+  EXPECT_EQ(drivers_[leader]->FindMission(), nullptr);
+  Status empty = drivers_[follower]->Propose(Bytes{});
+  ASSERT_FALSE(empty.ok());
+  EXPECT_EQ(empty.error().code(), ErrorCode::kInvalidArgument);
+  ASSERT_TRUE(drivers_[follower]->Propose(Bytes{'p', 'o', 's'}).ok());  // forwarded
+  Pump();
+  ASSERT_TRUE(drivers_[leader]->Propose(Bytes{'a', 'r', 'r'}).ok());
+  Pump();
+  TickAll(2);
+  const std::vector<Committed> want = Take(leader);
+  ASSERT_EQ(want.size(), 2u);
+  EXPECT_EQ(want[0].data, (Bytes{'p', 'o', 's'}));
+  EXPECT_EQ(want[1].data, (Bytes{'a', 'r', 'r'}));
+  EXPECT_LT(want[0].index, want[1].index);
+  for (const auto& n : names_) {
+    if (n != leader) {
+      EXPECT_EQ(Take(n), want) << n;
+    }
+    EXPECT_TRUE(Take(n).empty()) << n;  // taken: nothing new since
+  }
+  EXPECT_EQ(events_.size(), 3u) << "leader_elected only: the entry log prints nothing";
+}
+
+// A restarted drone replays the whole log to its tap (snapshot first, then the WAL's entries);
+// one cut off while the leader compacted gets a snapshot and taps exactly what it missed.
+TEST_F(DriverCluster, EntryLogTapReplaysTheWholeLogAfterRestartAndSnapshot) {
+  entry_log_ = true;
+  drivers_.clear();
+  for (const auto& n : names_) Start(n);
+  TickAll(40);
+  const std::string leader = Leader();
+  ASSERT_FALSE(leader.empty());
+  const std::string follower = AFollower();
+  const std::string other = names_[2] == leader ? names_[1] == follower ? names_[0] : names_[1] : names_[2];
+  auto propose = [&](int from, int to) {
+    for (int k = from; k <= to; ++k) {
+      ASSERT_TRUE(drivers_[leader]->Propose(Bytes{'e', static_cast<std::uint8_t>(k)}).ok());
+      Pump();
+    }
+    TickAll(2);
+  };
+  propose(1, 5);
+  const std::vector<Committed> first = Take(follower);
+  ASSERT_EQ(first.size(), 5u);
+  (void)Take(other);
+
+  // Restart: the tap replays everything, in order, though the log was compacted (every 4).
+  drivers_[follower].reset();
+  Start(follower);
+  EXPECT_GT(storage_[follower].state().snapshot.index, 0u);
+  EXPECT_EQ(Take(follower), first);
+
+  // Cut off while 10 more entries commit and the leader compacts past them: a snapshot.
+  cut_.insert(other);
+  propose(6, 15);
+  // The leader no longer holds the entries after `other`'s last one: only a snapshot helps.
+  ASSERT_GT(drivers_[leader]->raft().log().snapshot_index(), first.back().index);
+  cut_.clear();
+  TickAll(4);
+  std::vector<Committed> all = Take(leader);
+  ASSERT_EQ(all.size(), 15u);
+  const std::vector<Committed> missed(all.begin() + 5, all.end());
+  EXPECT_EQ(Take(other), missed);
+  EXPECT_GT(storage_[other].state().snapshot.index, first.back().index);
+  EXPECT_EQ(drivers_[other]->applied_index(), drivers_[leader]->applied_index());
+  EXPECT_EQ(drivers_[other]->machine().Snapshot(), drivers_[leader]->machine().Snapshot());
+}
+
 TEST(NodeDriver, ConfigurationErrorsNameTheProblem) {
   MemoryStorage st;
   std::deque<Packet> air;
@@ -268,6 +400,56 @@ TEST(NodeDriver, SingleDroneRestartsFromWalOnDisk) {
     auto d = NodeDriver::Open(Cfg("solo", {"solo"}), **wal, radio, clock, nullptr);
     ASSERT_TRUE(d.ok()) << d.error().ToString();
     EXPECT_EQ((*d)->mission(), before);
+  }
+  std::filesystem::remove_all(tmpl);
+}
+
+// The entry log on real files: after a restart the tap yields every entry again, in index
+// order, from the snapshot and the WAL; storage of another machine's snapshot does not open.
+TEST(NodeDriver, EntryLogReplaysTheWalToTheTapAfterARestart) {
+  std::string tmpl = (std::filesystem::temp_directory_path() / "swarmbox-drv-XXXXXX").string();
+  ASSERT_NE(mkdtemp(tmpl.data()), nullptr);
+  PosixFileSystem fs;
+  std::deque<Packet> air;
+  FakeRadio radio("solo", &air);
+  FakeClock clock;
+  std::vector<Committed> before;
+  {
+    auto wal = WalStorage::Open(fs, tmpl);
+    ASSERT_TRUE(wal.ok());
+    auto d = NodeDriver::Open(Cfg("solo", {"solo"}), **wal, radio, clock, nullptr,
+                              std::make_unique<EntryLogMachine>());
+    ASSERT_TRUE(d.ok());
+    for (int i = 0; i < 30 && !(*d)->is_leader(); ++i) ASSERT_TRUE((*d)->Tick().ok());
+    ASSERT_TRUE((*d)->is_leader());
+    EXPECT_EQ((*d)->leader(), "solo");
+    for (int k = 0; k < 11; ++k) {
+      const std::string text = "entry " + std::to_string(k);
+      ASSERT_TRUE((*d)->Propose(Bytes(text.begin(), text.end())).ok());
+    }
+    (*d)->TakeCommitted(&before);
+    ASSERT_EQ(before.size(), 11u);
+    for (std::size_t k = 1; k < before.size(); ++k) EXPECT_LT(before[k - 1].index, before[k].index);
+  }
+  {
+    auto wal = WalStorage::Open(fs, tmpl);
+    ASSERT_TRUE(wal.ok());
+    EXPECT_GT((*wal)->Load()->snapshot.index, 0u);  // part comes from the snapshot
+    auto d = NodeDriver::Open(Cfg("solo", {"solo"}), **wal, radio, clock, nullptr,
+                              std::make_unique<EntryLogMachine>());
+    ASSERT_TRUE(d.ok()) << d.error().ToString();
+    std::vector<Committed> replay;
+    (*d)->TakeCommitted(&replay);
+    EXPECT_EQ(replay, before);
+  }
+  {
+    auto wal = WalStorage::Open(fs, tmpl);
+    ASSERT_TRUE(wal.ok());
+    auto d = NodeDriver::Open(Cfg("solo", {"solo"}), **wal, radio, clock, nullptr);  // mission
+    ASSERT_FALSE(d.ok());
+    EXPECT_NE(d.error().ToString().find("restoring the state machine from the stored snapshot"),
+              std::string::npos)
+        << d.error().ToString();
   }
   std::filesystem::remove_all(tmpl);
 }

@@ -8,12 +8,19 @@
 //    public:
 //     explicit Hover(const swarmbox::brain::Context& ctx) : height_m_(ctx.ArgDouble("height_m", 10)) {}
 //     void Step(const swarmbox::brain::Input& in, swarmbox::brain::Output& out) override {
-//       if (in.self.landed && !asked_) { out.commands.push_back(Command::Takeoff(height_m_)); asked_ = true; }
+//       if (in.self.landed && in.self.flight_mode != "init" && !asked_) {  // "init": estimator not ready
+//         out.commands.push_back(swarmbox::brain::Command::Takeoff(height_m_));
+//         asked_ = true;
+//       }
 //     }
 //    private:
 //     double height_m_; bool asked_ = false;
 //   };
 //   SWARMBOX_BRAIN("hover", Hover)          // once per brain, in one .cpp of the library
+//
+//   # CMakeLists.txt: find_package(swarmbox 0.1 REQUIRED COMPONENTS brain)
+//   #                 swarmbox_add_brain(hover SOURCES hover.cpp)        -> libhover.so
+// (agent/brain/README.md: the whole contract; loader.hpp: how the agent loads it.)
 //
 // Contract (every brain, in-process or not):
 //   - Time. Input::t_ns is the lockstep's simulated time, the brain's only clock. A brain that
@@ -21,7 +28,9 @@
 //     deterministic: the same trial and seed would no longer give the same run at any speed.
 //   - Calls. Make (the factory) once, then Step every Context::period_ns of simulated time (the
 //     trial's brain.rate_hz; default every lockstep step, 4 ms), from one thread, never
-//     concurrently. Step must return promptly: the whole swarm's lockstep waits for it.
+//     concurrently, with `out` cleared. Step must return promptly: the whole swarm's lockstep
+//     waits for it; it must not throw. The constructor may throw (a bad argument): the agent exits
+//     with its message. The Context is valid during construction only: copy what you keep.
 //   - Frames and units. World ENU (x east, y north, z up) [m], body FLU, quaternions (w,x,y,z)
 //     rotating body to world, SI units with the unit in the name, simulated time in ns.
 //   - Setpoints have PX4 TrajectorySetpoint semantics (Setpoint below). Output::setpoint empty
@@ -84,8 +93,10 @@ struct Vehicle {
   double mass_estimate_kg = 0.0;          // the hover-thrust estimator's total mass [kg]
 };
 
-// Something the flight stack reported since the previous Step: takeoff, hover, arrived, landing,
-// landed, gps_lost, gps_recovered, rejected, and the offboard failsafe's offboard_lost.
+// Something the flight stack reported since the previous Step, by flight::FlightEventName:
+// flight_ready, takeoff, hover, arrived, landing, landed, mode, gps_lost, gps_recovered,
+// setpoint_rejected (a command or setpoint the mode could not take), and the offboard failsafe's
+// offboard_lost.
 struct FlightEvent {
   std::string name;
   std::int64_t t_ns = 0;
@@ -256,7 +267,7 @@ struct Registration {
 // One table per shared object: swarmbox::brain is a static library that every brain library (and
 // the agent) links its own copy of, and this function has hidden visibility, so a brain library's
 // SWARMBOX_BRAIN always fills that library's table, never the agent's or another library's (even
-// when the agent exports its symbols, or another library was loaded RTLD_GLOBAL). The two
+// when the agent exports its symbols, or another library was loaded RTLD_GLOBAL). The three
 // extern "C" functions below are the only symbols a brain library must export.
 #if defined(__GNUC__)
 #define SWARMBOX_BRAIN_LOCAL __attribute__((visibility("hidden")))
@@ -267,11 +278,27 @@ struct Registration {
 #endif
 SWARMBOX_BRAIN_LOCAL std::vector<Registration>& LibraryRegistry();
 
+// The C++ standard library this translation unit is compiled against: "libstdc++/cxx11",
+// "libstdc++/cow" (_GLIBCXX_USE_CXX11_ABI=0), "libc++" or "unknown". std::string, std::vector and
+// std::function cross the boundary, so the loader refuses a library built against another one.
+inline const char* CxxLibrary() {
+#if defined(_LIBCPP_VERSION)
+  return "libc++";
+#elif defined(__GLIBCXX__) && defined(_GLIBCXX_USE_CXX11_ABI) && _GLIBCXX_USE_CXX11_ABI
+  return "libstdc++/cxx11";
+#elif defined(__GLIBCXX__)
+  return "libstdc++/cow";
+#else
+  return "unknown";
+#endif
+}
+
 }  // namespace swarmbox::brain
 
 // What the loader finds in a library with dlsym: the ABI version (kAbiVersion of the SwarmBox the
-// library was built against), and the table.
+// library was built against), the C++ standard library it was built with (CxxLibrary), and the table.
 extern "C" SWARMBOX_BRAIN_EXPORT int swarmbox_brain_abi_version();
+extern "C" SWARMBOX_BRAIN_EXPORT const char* swarmbox_brain_cxx_library();
 extern "C" SWARMBOX_BRAIN_EXPORT const std::vector<swarmbox::brain::Registration>*
 swarmbox_brain_registry();
 

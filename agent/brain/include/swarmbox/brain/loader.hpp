@@ -9,8 +9,9 @@
 // Errors (all ErrorCode::kInvalidArgument, where = the library's path):
 //   - the library does not load: dlerror()'s text (no such file, not an ELF object, an undefined
 //     symbol: RTLD_NOW resolves everything at load time, not at the first call);
-//   - it is not a brain library (no swarmbox_brain_abi_version/swarmbox_brain_registry exported);
-//   - it was built against another brain ABI: both numbers;
+//   - it is not a brain library (no swarmbox_brain_abi_version, _cxx_library or _registry exported);
+//   - it was built against another brain ABI: both numbers; another C++ standard library
+//     (libc++, or libstdc++ with _GLIBCXX_USE_CXX11_ABI=0): both names;
 //   - no brain of that name: the names the library has;
 //   - the constructor threw: the brain's name and the exception's message.
 //

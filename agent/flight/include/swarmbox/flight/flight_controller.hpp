@@ -4,6 +4,10 @@
 //   sample -> Estimator -> modes/setpoints -> Trajectory (limits, smoothing) [-> InputShaper]
 //          -> PositionControl (+ swing damping feed-forward) -> AttitudeControl -> RateControl
 //          -> Mixer -> u[i] in [0, 1]
+// The trajectory kind (a brain's PX4 TrajectorySetpoint stream, setpoint.hpp) skips the
+// smoothing: its targets go to PositionControl per axis, within the same velocity and tilt limits.
+// When a brain's stream stops, OffboardFailsafe (offboard_failsafe.hpp) tells the caller to send
+// Hold, then Land.
 //
 // No DDS, threads, clocks or files; Step() neither allocates nor throws (STYLE.md 1, 12). The
 // agent program wraps it; the closed-loop tests run it against the physics library in process.

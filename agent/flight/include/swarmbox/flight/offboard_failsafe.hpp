@@ -1,5 +1,6 @@
-// OffboardFailsafe: what the flight stack does when the setpoint stream of an offboard brain stops
-// (PX4's offboard loss failsafe: COM_OF_LOSS_T, default 1.0 s, then the COM_OBL_RC_ACT action).
+// OffboardFailsafe: what the flight stack does when the setpoint stream of an offboard brain stops.
+// PX4's offboard loss failsafe: after COM_OF_LOSS_T (default 1.0 s) without the stream, the
+// action of COM_OBL_RC_ACT (hold, land, return...). Here: hold for hold_s, then land.
 // Pure, on simulated time only: the caller says every step whether the brain answered this
 // period; no clock is read here, so a run is the same at any speed.
 //
@@ -18,7 +19,7 @@
 //   kNone, silent_s >  timeout_s          -> kHold; event offboard_lost silent_s=.. action=hold
 //   kHold, an answer                      -> kNone; event offboard_regained silent_s=.. (the
 //                                            silence that ended); the brain flies again
-//   kHold, silent_s >  timeout_s + hold_s -> kLand; event offboard_failsafe silent_s=.. action=land
+//   kHold, silent_s >  timeout_s + hold_s -> kLand; event offboard_failsafe action=land silent_s=..
 //   kLand                                 -> kLand for good: answers are ignored (PX4 needs a new
 //                                            mode switch to leave the failsafe; here, a new trial)
 // An answer at a step resets the silence before the step is judged. A jump in t_s past both
@@ -73,7 +74,7 @@ class OffboardFailsafe {
   // "none", "hold", "land".
   static std::string_view ActionName(Action action);
   // The event's log line: `t=.. node=<node> event=offboard_lost silent_s=1.004 action=hold`,
-  // `event=offboard_failsafe silent_s=6.004 action=land`, `event=offboard_regained silent_s=1.5`.
+  // `event=offboard_failsafe action=land silent_s=6.004`, `event=offboard_regained silent_s=1.500`.
   static LogEvent ToLogEvent(const Event& e, std::string_view node);
 
  private:

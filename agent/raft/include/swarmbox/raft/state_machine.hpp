@@ -91,11 +91,13 @@ class StateMachine {
 // Keeps every committed (non-empty) entry; its snapshot is all of them. The machine for
 // applications whose meaning lives elsewhere (a brain without a ReplicatedState reads the log
 // from the tap), and a replay of the whole log after a restart. Memory grows with the log.
-// Snapshot encoding: version (1 byte, kSnapshotVersion), the entry count (LEB128 varint), then
+// Snapshot encoding: the magic "sbel", version (1 byte, kSnapshotVersion), the entry count
+// (LEB128 varint), then
 // per entry its index (varint, strictly increasing) and its data (varint length, bytes).
 // Apply ignores the leader's no-ops (empty data): entries() holds application entries only.
 class EntryLogMachine final : public StateMachine {
  public:
+  static constexpr std::string_view kSnapshotMagic = "sbel";
   static constexpr std::uint8_t kSnapshotVersion = 1;
 
   void Apply(std::uint64_t index, std::span<const std::uint8_t> data,

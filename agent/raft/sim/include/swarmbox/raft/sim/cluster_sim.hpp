@@ -198,6 +198,7 @@ class ClusterSim {
   std::map<std::pair<std::uint64_t, std::uint64_t>, EntryFact> entries_seen_;  // (index, term)
   std::vector<CommitFact> committed_;  // committed_[i - 1] for index i (term 0: not seen yet)
   std::unordered_map<std::uint64_t, std::uint64_t> state_hash_at_;  // applied index -> hash
+  std::unordered_map<std::uint64_t, std::uint64_t> tapped_hash_at_;  // tapped index -> data hash
   // Metrics.
   std::unordered_map<std::uint64_t, std::int64_t> proposed_at_us_;  // data hash -> time
   std::optional<std::int64_t> leader_crash_us_;
