@@ -6,9 +6,15 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "brain_convert.hpp"
+#include "external_brain.hpp"
+#include "swarmbox/bus/topics.hpp"
+#include "swarmbox/brain/args.hpp"
+#include "swarmbox/brain/loader.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
+#include "wait_budget.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -21,23 +27,6 @@ std::string Seconds(double s) {
   return buf;
 }
 
-// A wall-clock wait of `total`, spent in slices: each slice counts at most its own length, so a
-// process stopped or starved in the middle of one (SIGSTOP, docker pause) resumes with the rest
-// of its budget instead of a deadline long gone.
-class WaitBudget {
- public:
-  explicit WaitBudget(std::chrono::milliseconds total) : left_(total) {}
-  bool spent() const { return left_ <= std::chrono::milliseconds(0); }
-  std::chrono::milliseconds Slice(std::chrono::milliseconds max) const { return std::min(left_, max); }
-  void Spend(std::chrono::steady_clock::duration elapsed, std::chrono::milliseconds slice) {
-    left_ -= std::min(std::chrono::duration_cast<std::chrono::milliseconds>(elapsed), slice);
-    if (elapsed < std::chrono::milliseconds(1)) left_ -= std::chrono::milliseconds(1);  // always progress
-  }
-
- private:
-  std::chrono::milliseconds left_;
-};
-
 // The wall clock of radio.model netem only (the wall part of its lost-member rule, as the radio
 // itself runs on it); never read with the channel.
 double SteadyS() {
@@ -45,6 +34,16 @@ double SteadyS() {
 }
 
 }  // namespace
+
+class AgentNode::FlightAdapter final : public FlightPort {
+ public:
+  explicit FlightAdapter(flight::FlightController& fc) : fc_(fc) {}
+  bool Command(const flight::Setpoint& setpoint) override { return fc_.Command(setpoint); }
+  void SetPayloadMass(double payload_mass_kg) override { fc_.SetPayloadMass(payload_mass_kg); }
+
+ private:
+  flight::FlightController& fc_;
+};
 
 Result<RadioModel> ParseRadioModel(std::string_view text) {
   if (text == "netem") return RadioModel::kNetem;
@@ -83,44 +82,44 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   }
   auto cfg = flight::LoadFlightConfig(o.airframe_path);
   if (!cfg) return cfg.error().Context("loading airframe");
-  MissionHostConfig mc;
+  // --mission sar: SarBrain's Context (what any brain is told) and the agent's perception,
+  // checked before anything joins the bus.
+  std::optional<SarBrainConfig> sar_config;
+  PerceptionConfig perception;
   if (o.mission.kind == MissionKind::kSar) {
     if (o.raft.members.empty()) return Error(ErrorCode::kInvalidArgument, "--mission sar needs --members");
     if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--mission sar needs the mesh bus (drop --no-mesh)");
-    auto world = LoadWorldView(o.mission.world_path);
-    if (!world) return world.error();
-    auto camera = LoadCameraSpec(o.airframe_path);
-    if (!camera) return camera.error().Context("loading the airframe's camera");
-    mc.name = o.name;
-    mc.members = o.raft.members;
-    mc.airframe = cfg->airframe;
-    mc.payload = o.mission.payload;
-    mc.base_height_m = cfg->base_height_m;
-    mc.vehicle_mass_kg = cfg->mass_kg;
-    mc.has_home = o.has_start;
-    mc.home_m = o.start_m;
-    mc.geofence_size_x_m = world->size_x_m;
-    mc.geofence_size_y_m = world->size_y_m;
-    mc.camera = *camera;
-    mc.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
-    if (!o.mission.payload.empty()) {
-      auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
-                             [&](const flight::SlungPayload& p) { return p.name == o.mission.payload; });
-      if (it == cfg->payloads.end()) {
-        std::string known;
-        for (const flight::SlungPayload& p : cfg->payloads) known += (known.empty() ? "" : ", ") + p.name;
-        return Error(ErrorCode::kInvalidArgument, "--payload '" + o.mission.payload + "': airframe " + cfg->airframe +
-                                                      " has " + (known.empty() ? std::string("no payloads") : "payloads " + known));
-      }
-      mc.payload_sling_length_m = it->sling_length_m;
-      mc.payload_hook_m = it->hook_m;
-      auto ground = LoadGroundPayload(o.airframe_path, o.mission.payload);
-      if (!ground) return ground.error().Context("--payload");
-      mc.payload_offset_m = ground->offset_m;
-      mc.payload_half_height_m = ground->half_height_m;
+    brain::Context ctx;
+    ctx.self = o.name;
+    ctx.members = o.raft.members;
+    ctx.seed = o.raft.seed;
+    ctx.period_ns = std::llround(o.control_dt_s * 1e9);
+    ctx.airframe = cfg->airframe;
+    ctx.airframe_path = o.airframe_path;
+    ctx.world_path = o.mission.world_path;
+    ctx.payload = o.mission.payload;
+    if (o.has_start) {
+      char start[96];
+      std::snprintf(start, sizeof start, "%.17g,%.17g,%.17g", o.start_m.x(), o.start_m.y(), o.start_m.z());
+      ctx.args["start"] = start;
+    }
+    auto c = SarBrainConfigFrom(ctx);
+    if (!c) return c.error();
+    sar_config = std::move(*c);
+    perception.camera = sar_config->camera;
+    perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
+  }
+  const bool brain = o.brain.kind != BrainKind::kBuiltin;
+  int period_steps = 1;
+  if (brain) {
+    auto steps = BrainPeriodSteps(o.brain, o.control_dt_s);
+    if (!steps) return steps.error();
+    period_steps = *steps;
+    if (o.mission.kind != MissionKind::kPlan) {
+      return Error(ErrorCode::kInvalidArgument, "--mission is for --brain builtin (the brain decides what to fly)");
     }
   }
-  auto plan = FlightPlan::Parse(o.plan);  // --mission sar: parsed (the default) but not flown
+  auto plan = FlightPlan::Parse(o.plan);  // --mission sar, a brain: parsed (the default) but not flown
   if (!plan) return plan.error().Context("--plan");
   plan->SetPreflight(o.preflight_s);
   flight::ControllerOptions co;
@@ -152,6 +151,29 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   if (!pub) return pub.error().Context("publishing actuator commands");
   node->actuator_pub_ = std::move(*pub);
   const bool sar = o.mission.kind == MissionKind::kSar;
+  std::unique_ptr<brain::Brain> the_brain;
+  if (brain) {
+    auto made = node->MakeBrain(*cfg, period_steps);
+    if (!made) return made.error();
+    the_brain = std::move(*made);
+    // Its own replicated state, made once before Raft starts (Raft replays its WAL into it).
+    node->brain_state_ = the_brain->MakeReplicatedState();
+  } else if (sar_config) {
+    // The builtin SAR brain, through BrainHost as any brain; its replicated state is the mission.
+    AgentNode* n = node.get();
+    auto log = [n](const brain::Event& e) {
+      LogEvent line(n->t_s_, n->options_.name, e.name);
+      for (const auto& [k, v] : e.fields) line.Add(k, v);
+      n->Log(line);
+    };
+    auto made = SarBrain::Create(*sar_config, log, channel ? nullptr : &node->netem_wall_);
+    if (!made) return made.error();
+    node->sar_ = made->get();
+    auto state = node->sar_->MakeMissionState();
+    node->sar_state_ = state.get();
+    node->brain_state_ = std::move(state);
+    the_brain = std::move(*made);
+  }
   if (o.mesh && channel) {
     // No mesh domain at all: every frame rides the lockstep to the physics server's channel.
     node->radio_ = std::make_unique<radio::ChannelRadio>(o.name);
@@ -166,7 +188,8 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     ro.members = o.raft.members;
     ro.raft = o.raft.members.size() > 1;
     ro.pings = o.ping_every_ms > 0 && o.raft.members.size() > 1;
-    ro.hear_states = sar;
+    ro.hear_states = sar || brain;
+    ro.brains = brain;
     auto dds = radio::DdsRadio::Create(*node->mesh_, o.name, ro);
     if (!dds) return dds.error().Context("starting the mesh radio");
     node->radio_ = std::move(*dds);
@@ -179,7 +202,16 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     // Raft's clock: simulated seconds (channel: the radio's clock is the lockstep's, from 0), or
     // wall seconds since now (netem: the steady clock). Its lines carry the simulated time.
     node->raft_clock_ = std::make_unique<RadioClock>(*node->radio_, channel ? 0 : node->radio_->now_ns());
-    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_);
+    std::unique_ptr<raft::StateMachine> machine;  // null: the SAR mission's
+    if (node->sar_state_ != nullptr) {
+      // SarBrain's state is raft's MissionStateMachine: Raft applies it with its own event lines.
+      machine = node->sar_state_->RaftMachine();
+    } else if (brain && node->brain_state_) {
+      machine = std::make_unique<ReplicatedStateMachine>(node->brain_state_.get());
+    } else if (brain) {
+      machine = std::make_unique<raft::EntryLogMachine>();
+    }
+    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_, std::move(machine));
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
   }
@@ -191,15 +223,26 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     if (!probe) return probe.error().Context("starting the link probe");
     node->probe_ = std::move(*probe);
   }
-  if (o.mission.kind == MissionKind::kSar) {
-    auto host = MissionHost::Create(mc);
-    if (!host) return host.error();
-    node->mission_ = std::move(*host);
-    if (node->mission_->role() == swarm::Role::kScout) {
-      auto cam = node->sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(o.name), bus::Qos::kLockstep);
-      if (!cam) return cam.error().Context("subscribing to the camera");
-      node->camera_sub_ = std::move(*cam);
-    }
+  if (brain || node->sar_ != nullptr) {
+    BrainHostOptions bo;
+    bo.self = o.name;
+    bo.period_steps = period_steps;
+    bo.offboard_timeout_s = o.brain.offboard_timeout_ms * 1e-3;
+    bo.offboard_hold_s = o.brain.offboard_hold_ms * 1e-3;
+    bo.state = node->brain_state_.get();
+    node->flight_port_ = std::make_unique<FlightAdapter>(node->fc_);
+    if (node->raft_) node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
+    node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(the_brain), *node->flight_port_, node->radio_.get(),
+                                                    node->consensus_.get(), o.log);
+    if (auto spec = swarm::BatterySpecFor(cfg->airframe)) node->battery_.emplace(*spec);
+  }
+  if (node->sar_ != nullptr && node->sar_->role() == swarm::Role::kScout) {
+    auto p = PerceptionHost::Create(perception);
+    if (!p) return p.error();
+    node->perception_ = std::move(*p);
+    auto cam = node->sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(o.name), bus::Qos::kLockstep);
+    if (!cam) return cam.error().Context("subscribing to the camera");
+    node->camera_sub_ = std::move(*cam);
   }
   return node;
 }
@@ -220,6 +263,52 @@ AgentNode::~AgentNode() = default;
 void AgentNode::Log(const LogEvent& e) {
   std::fprintf(options_.log, "%s\n", e.str().c_str());
   std::fflush(options_.log);
+}
+
+Result<std::unique_ptr<brain::Brain>> AgentNode::MakeBrain(const flight::FlightConfig& config, int period_steps) {
+  const BrainOptions& b = options_.brain;
+  brain::Context ctx;
+  ctx.self = options_.name;
+  ctx.members = options_.raft.members.empty() ? std::vector<std::string>{options_.name} : options_.raft.members;
+  ctx.seed = options_.raft.seed;
+  ctx.period_ns = static_cast<std::int64_t>(std::llround(period_steps * options_.control_dt_s * 1e9));
+  ctx.airframe = config.airframe;
+  ctx.airframe_path = options_.airframe_path;
+  ctx.world_path = options_.mission.world_path;
+  ctx.payload = options_.mission.payload;
+  auto args = brain::ParseBrainArgs(b.args_json);
+  if (!args) return args.error();
+  ctx.args = std::move(*args);
+  ctx.log = [this](const brain::Event& e) {
+    LogEvent line(t_s_, options_.name, e.name);
+    for (const auto& [k, v] : e.fields) line.Add(k, v);
+    Log(line);
+  };
+  LogEvent loaded(0.0, options_.name, "brain_loaded");
+  loaded.Add("kind", BrainKindName(b.kind));
+  std::unique_ptr<brain::Brain> made;
+  if (b.kind == BrainKind::kLibrary) {
+    auto lib = brain::LoadBrain(b.library_path, b.name, ctx);
+    if (!lib) return lib.error().Context("--brain library");
+    loaded.Add("name", b.name).Add("library", b.library_path);
+    made = std::move(*lib);
+  } else {
+    ExternalBrainOptions eo;
+    eo.drone = options_.name;
+    eo.wait = std::chrono::milliseconds(b.wait_ms);
+    eo.start = std::chrono::milliseconds(b.start_ms);
+    eo.stop = options_.stop;
+    eo.log = options_.log;
+    auto ext = ExternalBrain::Create(*sim_, eo);
+    if (!ext) return ext.error().Context("--brain external");
+    loaded.Add("name", bus::OffboardInputTopic(options_.name));
+    made = std::move(*ext);
+  }
+  loaded.Add("period_ms", static_cast<double>(ctx.period_ns) * 1e-6, 1)
+      .Add("offboard_timeout_ms", b.offboard_timeout_ms)
+      .Add("offboard_hold_ms", b.offboard_hold_ms);
+  Log(loaded);
+  return made;
 }
 
 bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
@@ -271,22 +360,22 @@ void AgentNode::OnPing(const bus::RadioFrame& frame) {
 }
 
 void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& frame) {
-  if (!mission_) return;
-  PeerState p;
-  p.name = state.drone;
-  p.mode = state.mode;
-  p.position_m = V(state.position_enu_m);
-  p.velocity_m_s = V(state.velocity_enu_m_s);
-  p.sim_time_s = static_cast<double>(state.sim_time_ns) * 1e-9;
-  // netem: when it arrived on the steady clock, for the lost-member rule's wall-clock silence.
-  // channel: none (NaN): the simulated clock alone decides.
-  if (options_.radio_model == RadioModel::kNetem) p.received_wall_s = static_cast<double>(frame.delivered_ns) * 1e-9;
-  mission_->OnPeerState(p);
+  // netem, SarBrain only: when it arrived on the steady clock, for the lost-member rule's
+  // wall-clock silence (its side channel). channel: none, the simulated clock alone decides.
+  if (sar_ != nullptr && options_.radio_model == RadioModel::kNetem && state.drone != options_.name) {
+    netem_wall_.OnState(state.drone, state.sim_time_ns, static_cast<double>(frame.delivered_ns) * 1e-9);
+  }
+  if (brain_host_) brain_host_->OnState(state);
 }
 
 void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::RadioFrame& /*frame*/) {
   // Heard and counted (dispatched_.detection): sightings reach the swarm through Raft; the
   // broadcast detections are for recorders and a ground station.
+}
+
+void AgentNode::OnBrainMessage(const bus::BrainMessage& message, const bus::RadioFrame& /*frame*/) {
+  // Counted (dispatched_.brain); the built-in missions have no brain inbox.
+  if (brain_host_) brain_host_->OnMessage(message);
 }
 
 Status AgentNode::ServeRadioBetweenSteps() {
@@ -337,6 +426,7 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
       case FlightEventKind::kRejected: st.rejected = true; break;
       default: break;
     }
+    if (brain_host_) brain_host_->OnFlightEvent(e);
     LogEvent le(e.t_s, options_.name, flight::FlightEventName(e.kind));
     if (e.kind == FlightEventKind::kModeChange) le.Add("mode", flight::FlightModeName(e.mode));
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
@@ -350,8 +440,10 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
     probe_->Step(radio::RadioTime(radio_->now_ns()), t_s_, *radio_, &lines_);
     for (const LogEvent& line : lines_) Log(line);
   }
-  if (mission_) {
-    StepMission(msg, st.hover);
+  if (sar_ != nullptr) {
+    StepMission(msg);
+  } else if (brain_host_) {
+    StepBrain(msg);
   } else {
     if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
     if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
@@ -394,9 +486,11 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
   state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
   state_.heading_rad = flight::YawOf(est.att);
-  if (mission_) {
-    state_.mode = mission_->mode();
-    state_.battery_fraction = mission_->battery_fraction();
+  if (brain_host_) {
+    // The brain's status (Neighbour::status on the other drones); the flight mode until it says.
+    state_.mode = brain_host_->status().empty() ? std::string(flight::FlightModeName(fc_.mode())) : brain_host_->status();
+    // SarBrain: its own battery model (the one behind its battery_low), as before the SDK.
+    state_.battery_fraction = sar_ != nullptr ? sar_->battery_fraction() : vehicle_.battery_fraction;
   } else {
     state_.mode = std::string(flight::FlightModeName(fc_.mode()));
   }
@@ -405,69 +499,67 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   radio_->Send(std::move(out_frame_));
 }
 
-void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
+void AgentNode::StepBrain(const bus::SensorSample& msg) {
   const flight::StateEstimate& est = fc_.estimate();
-  mission_->RecordEstimate(t_s_, est);
-  for (std::size_t i = 0; i < image_count_; ++i) {
-    bus::CameraImage& image = images_[i];
-    if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
-    if (image.data.size() < static_cast<std::size_t>(image.height_px) * image.row_stride_bytes) continue;
-    cv::Mat bgr(static_cast<int>(image.height_px), static_cast<int>(image.width_px), CV_8UC3, image.data.data(),
-                image.row_stride_bytes);
-    if (image.encoding == "rgb8") cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
-    const bus::CameraIntrinsics& k = image.intrinsics;
-    mission_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image.sim_time_ns) * 1e-9);
-  }
-  MissionHostInput in;
-  in.t_s = t_s_;
-  // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
-  // time and nothing of the wall clock may feed a decision (NaN: the simulated rule alone).
-  if (options_.radio_model == RadioModel::kNetem) in.wall_s = SteadyS();
-  in.dt_s = options_.control_dt_s;
-  in.flight_mode = fc_.mode();
-  in.estimate = &est;
-  in.mission = &raft_->service().mission();  // the committed state as of this step's Raft calls
-  in.is_leader = raft_->service().is_leader();
-  in.hover_event = hover_event;
-  in.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
-  const MissionHostOutput& out = mission_->Step(in);
-  for (const LogEvent& e : out.events) Log(e);
-  if (out.command) (void)fc_.Command(*out.command);
-  for (const raft::MissionCommand& c : out.proposals) {
-    (void)raft_->service().Propose(c);  // kUnavailable (no leader yet): the behaviours re-propose
-  }
-  if (out.payload.action != swarm::PayloadAction::kNone) {
-    ++world_cmd_.seq;
-    world_cmd_.sim_time_ns = msg.sim_time_ns;
-    world_cmd_.target = options_.name;
-    world_cmd_.args.clear();
-    if (out.payload.action == swarm::PayloadAction::kAttach) {
-      world_cmd_.command = "payload_attach";
-      world_cmd_.args.push_back(out.payload.mass_kg);
-    } else {
-      world_cmd_.command = "payload_release";
+  const flight::FlightMode mode = fc_.mode();
+  if (battery_) battery_->Step(options_.control_dt_s, est.vel_mps, brain_host_->payload_mass_kg(), !LandedMode(mode));
+  brain::Vehicle& v = vehicle_;
+  v.name = options_.name;
+  v.step = msg.step;
+  v.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+  v.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  v.attitude_wxyz[0] = est.att.w();
+  v.attitude_wxyz[1] = est.att.x();
+  v.attitude_wxyz[2] = est.att.y();
+  v.attitude_wxyz[3] = est.att.z();
+  v.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
+  v.heading_rad = flight::YawOf(est.att);
+  v.battery_fraction = battery_ ? battery_->fraction() : 1.0;
+  v.battery_voltage_v = 0.0;  // not modelled: the battery model counts energy
+  v.flight_mode = std::string(flight::FlightModeName(mode));
+  v.armed = cmd_.armed;
+  v.landed = LandedMode(mode);
+  v.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
+  brain_host_->Step(msg.step, msg.sim_time_ns, v, &cmd_.world);
+}
+
+void AgentNode::StepMission(const bus::SensorSample& msg) {
+  // Perception (scouts): this step's frames geolocated with the estimate of their capture step,
+  // to the brain once the inference latency has passed.
+  detections_.clear();
+  if (perception_) {
+    perception_->RecordEstimate(t_s_, fc_.estimate());
+    for (std::size_t i = 0; i < image_count_; ++i) {
+      bus::CameraImage& image = images_[i];
+      if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
+      if (image.data.size() < static_cast<std::size_t>(image.height_px) * image.row_stride_bytes) continue;
+      cv::Mat bgr(static_cast<int>(image.height_px), static_cast<int>(image.width_px), CV_8UC3, image.data.data(),
+                  image.row_stride_bytes);
+      if (image.encoding == "rgb8") cv::cvtColor(bgr, bgr, cv::COLOR_RGB2BGR);
+      const bus::CameraIntrinsics& k = image.intrinsics;
+      perception_->OnCameraFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, static_cast<double>(image.sim_time_ns) * 1e-9);
     }
-    // The announced load as the hover thrust estimator's prior (it corrects a refused hook).
-    fc_.SetPayloadMass(out.payload.action == swarm::PayloadAction::kAttach ? out.payload.mass_kg : 0.0);
-    cmd_.world.push_back(world_cmd_);  // applied by the physics server before it steps the world
+    perception_->PopVisible(t_s_, &detections_);
+    for (const brain::Detection& d : detections_) brain_host_->OnDetection(d);
   }
-  for (const swarm::GroundDetection& d : out.detections) {
-    bus::Detection det;
-    det.from = options_.name;
-    det.sim_time_ns = static_cast<std::int64_t>(d.capture_time_s * 1e9);
-    det.label = "victim";
-    det.confidence = d.confidence;
-    det.position_enu_m = {d.position_m.x(), d.position_m.y(), d.position_m.z()};
-    det.position_sigma_m = d.sigma_m;
+  // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
+  // time and nothing of the wall clock may feed a decision (the brain has no side channel then).
+  if (options_.radio_model == RadioModel::kNetem) netem_wall_.now_s = SteadyS();
+  StepBrain(msg);
+  // The detections on the radio too (for recorders and a ground station), best effort.
+  for (const brain::Detection& d : detections_) {
     out_frame_ = bus::RadioFrame{};
-    out_frame_.detection_msg.push_back(std::move(det));
-    radio_->Send(std::move(out_frame_));  // best effort, as the radio
+    out_frame_.detection_msg.push_back(DetectionToBus(d, options_.name));
+    radio_->Send(std::move(out_frame_));
   }
 }
 
 bool AgentNode::Done() const {
-  if (!mission_) return plan_.finished();
-  return mission_->complete() && (fc_.mode() == flight::FlightMode::kLanded || fc_.mode() == flight::FlightMode::kIdle);
+  if (sar_ != nullptr) {
+    return sar_->complete() && (fc_.mode() == flight::FlightMode::kLanded || fc_.mode() == flight::FlightMode::kIdle);
+  }
+  if (brain_host_) return false;  // a brain flies until the trial ends (the samples stop)
+  return plan_.finished();
 }
 
 Status AgentNode::Run() {
@@ -476,8 +568,9 @@ Status AgentNode::Run() {
           .Add("sim_interface", options_.sim_interface)
           .Add("middleware", options_.middleware)
           .Add("radio_model", RadioModelName(options_.radio_model))
-          .Add("mission", MissionKindName(options_.mission.kind))
-          .Add("plan", mission_ ? std::string("-") : options_.plan)
+          .Add("brain", BrainKindName(options_.brain.kind))
+          .Add("mission", brain_host_ && sar_ == nullptr ? std::string_view("-") : MissionKindName(options_.mission.kind))
+          .Add("plan", brain_host_ ? std::string("-") : options_.plan)
           .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
   bus::SensorSample msg;
   bool got_any = false;
@@ -519,11 +612,14 @@ Status AgentNode::Run() {
                          " s: is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
                          std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
       }
-      Log(LogEvent(t_s_, options_.name, "samples_stopped").Add("after_s", secs, 1).Add("plan", mission_ ? std::string_view("sar") : plan_.current()));
-      if (Done() || (mission_ && mission_->complete())) return Ok{};
-      if (mission_) {
+      Log(LogEvent(t_s_, options_.name, "samples_stopped")
+              .Add("after_s", secs, 1)
+              .Add("plan", sar_ != nullptr ? std::string_view("sar") : brain_host_ ? std::string_view("brain") : plan_.current()));
+      // A brain has no end of its own: the trial's end stops the samples.
+      if ((brain_host_ && sar_ == nullptr) || Done() || (sar_ != nullptr && sar_->complete())) return Ok{};
+      if (sar_ != nullptr) {
         return Error(ErrorCode::kUnavailable, "sensor samples stopped for " + Seconds(secs) +
-                                                  " s before the SAR mission was complete (" + mission_->mode() + ")");
+                                                  " s before the SAR mission was complete (" + sar_->mode() + ")");
       }
       return Error(ErrorCode::kUnavailable,
                    "sensor samples stopped for " + Seconds(secs) + " s before the plan was complete (at '" +

@@ -21,7 +21,7 @@
 // `event_clock` when given (the agent's simulated seconds, so that every line of an agent is on one
 // axis in both models), else from `clock`.
 // The replicated state machine is the caller's (`machine` at Start; null: a MissionStateMachine,
-// the SAR mission, which agent_node and MissionHost read through mission()). A brain reads the
+// the SAR mission, read through mission(); --mission sar hands it SarBrain's own). A brain reads the
 // committed log through TakeCommitted (every entry applied since the previous call, in index
 // order; after a restart first the replay of the WAL, see raft/node_driver.hpp) and proposes
 // bytes with ProposeBytes.

@@ -1,0 +1,571 @@
+#include "sar_brain.hpp"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <utility>
+
+#include "mission_options.hpp"
+#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/flight/flight_config.hpp"
+#include "swarmbox/raft/mission_command.hpp"
+#include "swarmbox/raft/mission_state_machine.hpp"
+
+namespace swarmbox::agent {
+namespace {
+
+using flight::Vec3;
+using swarm::Role;
+using swarm::SetpointKind;
+
+// On the ground for the behaviours: the flight stack's init, idle and landed (flight::FlightModeName).
+bool OnGround(std::string_view mode) { return mode == "init" || mode == "idle" || mode == "landed"; }
+
+Vec3 V(const brain::Vec3& v) { return Vec3(v.x, v.y, v.z); }
+brain::Vec3 B(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
+
+double YawOf(const double q[4]) { return flight::YawOf(flight::Quat(q[0], q[1], q[2], q[3])); }
+
+// args[key] as a number; absent: unchanged. kInvalidArgument naming the key otherwise.
+Status ArgNumber(const brain::Context& ctx, const std::string& key, double* out) {
+  const auto it = ctx.args.find(key);
+  if (it == ctx.args.end()) return Ok{};
+  const std::string& text = it->second;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v)) {
+    return Error(ErrorCode::kInvalidArgument, "sar brain: arg " + key + " '" + text + "': expected a number");
+  }
+  *out = v;
+  return Ok{};
+}
+
+}  // namespace
+
+Result<GroundPayload> LoadGroundPayload(const std::string& airframe_path, const std::string& payload) {
+  auto doc = yaml::ParseFile(airframe_path);
+  if (!doc) return doc.error();
+  if (!doc->is_mapping()) return Error(ErrorCode::kInvalidArgument, "airframe: expected a mapping", doc->Where());
+  const yaml::Node* collision = doc->Find("collision");
+  const yaml::Node* box = collision != nullptr && collision->is_mapping() ? collision->Find("box_m") : nullptr;
+  if (box == nullptr) return Error(ErrorCode::kInvalidArgument, "airframe has no collision.box_m", doc->Where());
+  std::array<double, 3> box_m{};
+  SWARMBOX_TRY(yaml::Decode(*box, &box_m));
+  const yaml::Node* list = doc->Find("payloads");
+  if (list != nullptr && list->is_sequence()) {
+    for (const yaml::Node& p : list->items()) {
+      const yaml::Node* name = p.is_mapping() ? p.Find("name") : nullptr;
+      if (name == nullptr || name->scalar() != payload) continue;
+      const yaml::Node* size = p.Find("size_m");
+      if (size == nullptr) return Error(ErrorCode::kInvalidArgument, "payload " + payload + " has no size_m", p.Where());
+      std::array<double, 3> size_m{};
+      SWARMBOX_TRY(yaml::Decode(*size, &size_m));
+      GroundPayload g;
+      g.offset_m = Eigen::Vector2d(0.0, -(box_m[1] / 2 + size_m[1] / 2 + 0.5));
+      g.half_height_m = size_m[2] / 2;
+      return g;
+    }
+  }
+  return Error(ErrorCode::kInvalidArgument, "airframe has no payload '" + payload + "'", doc->Where());
+}
+
+std::string EncodeMissionMode(Role role, std::string_view mode) {
+  return std::string(swarm::RoleName(role)) + "/" + std::string(mode);
+}
+
+bool DecodeMissionMode(std::string_view text, Role* role, std::string* mode) {
+  const std::size_t slash = text.find('/');
+  if (slash == std::string_view::npos || slash + 1 >= text.size()) return false;
+  const std::string_view r = text.substr(0, slash);
+  if (r == "scout") {
+    *role = Role::kScout;
+  } else if (r == "lifter") {
+    *role = Role::kLifter;
+  } else {
+    return false;
+  }
+  *mode = std::string(text.substr(slash + 1));
+  return true;
+}
+
+
+brain::Event ToBrainEvent(const LogEvent& e) {
+  brain::Event b;
+  for (auto& [key, value] : ParseLogfmt(e.str())) {
+    if (key == "t" || key == "node") continue;
+    if (key == "event" && b.name.empty()) {
+      b.name = std::move(value);
+      continue;
+    }
+    b.fields.emplace_back(std::move(key), std::move(value));
+  }
+  return b;
+}
+
+Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
+  auto cfg = flight::LoadFlightConfig(ctx.airframe_path);
+  if (!cfg) return cfg.error().Context("sar brain: loading the airframe");
+  auto world = LoadWorldView(ctx.world_path);
+  if (!world) return world.error();
+  auto camera = LoadCameraSpec(ctx.airframe_path);
+  if (!camera) return camera.error().Context("loading the airframe's camera");
+  SarBrainConfig c;
+  c.name = ctx.self;
+  c.members = ctx.members;
+  c.airframe = cfg->airframe;
+  c.payload = ctx.payload;
+  c.base_height_m = cfg->base_height_m;
+  c.vehicle_mass_kg = cfg->mass_kg;
+  c.geofence_size_x_m = world->size_x_m;
+  c.geofence_size_y_m = world->size_y_m;
+  c.camera = *camera;
+  c.period_s = static_cast<double>(ctx.period_ns) * 1e-9;
+  if (const auto it = ctx.args.find("start"); it != ctx.args.end()) {
+    double x = 0, y = 0, z = 0;
+    char tail = 0;
+    if (std::sscanf(it->second.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &tail) != 3) {
+      return Error(ErrorCode::kInvalidArgument, "sar brain: arg start '" + it->second + "': expected x,y,z in metres");
+    }
+    c.has_home = true;
+    c.home_m = Vec3(x, y, z);
+  }
+  MissionTuning& t = c.tuning;
+  const std::pair<const char*, double*> tuning[] = {
+      {"mission_dt_s", &t.mission_dt_s},
+      {"search_margin_m", &t.search_margin_m},
+      {"scout_altitude_m", &t.scout_altitude_m},
+      {"scout_cruise_m_s", &t.scout_cruise_m_s},
+      {"scout_takeoff_step_m", &t.scout_takeoff_step_m},
+      {"scout_orbit_radius_m", &t.scout_orbit_radius_m},
+      {"scout_orbit_time_s", &t.scout_orbit_time_s},
+      {"lifter_transit_altitude_m", &t.lifter_transit_altitude_m},
+      {"lifter_loading_time_s", &t.lifter_loading_time_s},
+      {"leader_start_timeout_s", &t.leader_start_timeout_s},
+      {"member_timeout_s", &t.member_timeout_s},
+      {"member_min_wall_s", &t.member_min_wall_s},
+      {"assignment_settle_s", &t.assignment_settle_s},
+      {"sighting_dedupe_m", &t.sighting_dedupe_m},
+      {"load_check_climb_m", &t.load_check_climb_m},
+      {"load_check_delay_s", &t.load_check_delay_s},
+      {"load_check_fraction", &t.load_check_fraction},
+  };
+  for (const auto& [key, value] : tuning) SWARMBOX_TRY(ArgNumber(ctx, key, value));
+  if (!(t.mission_dt_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg mission_dt_s must be > 0");
+  if (!c.payload.empty()) {
+    auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
+                           [&](const flight::SlungPayload& p) { return p.name == c.payload; });
+    if (it == cfg->payloads.end()) {
+      std::string known;
+      for (const flight::SlungPayload& p : cfg->payloads) known += (known.empty() ? "" : ", ") + p.name;
+      return Error(ErrorCode::kInvalidArgument, "--payload '" + c.payload + "': airframe " + cfg->airframe + " has " +
+                                                    (known.empty() ? std::string("no payloads") : "payloads " + known));
+    }
+    c.payload_sling_length_m = it->sling_length_m;
+    c.payload_hook_m = it->hook_m;
+    auto ground = LoadGroundPayload(ctx.airframe_path, c.payload);
+    if (!ground) return ground.error().Context("--payload");
+    c.payload_offset_m = ground->offset_m;
+    c.payload_half_height_m = ground->half_height_m;
+  }
+  return c;
+}
+
+void NetemWallClock::OnState(const std::string& drone, std::int64_t t_ns, double wall_s) {
+  auto [it, fresh] = heard.try_emplace(drone, Heard{t_ns, wall_s});
+  if (!fresh && t_ns >= it->second.t_ns) it->second = {t_ns, wall_s};
+}
+
+// ---- the replicated mission ----------------------------------------------------------------------
+
+struct SarMissionState::Impl {
+  raft::MissionStateMachine machine;
+  raft::EventSink sink;  // the machine's lines -> the Context's log
+};
+
+namespace {
+
+// Forwards every call to a machine owned elsewhere (the brain's SarMissionState).
+class MachineRef final : public raft::StateMachine {
+ public:
+  explicit MachineRef(raft::StateMachine& target) : target_(target) {}
+  void Apply(std::uint64_t index, std::span<const std::uint8_t> data, const raft::EventOut& events) override {
+    target_.Apply(index, data, events);
+  }
+  raft::Bytes Snapshot() const override { return target_.Snapshot(); }
+  Status Restore(std::span<const std::uint8_t> snapshot) override { return target_.Restore(snapshot); }
+  void OnSnapshotInstalled(std::uint64_t index, const raft::EventOut& events) override {
+    target_.OnSnapshotInstalled(index, events);
+  }
+  void ReplayRestored(std::uint64_t after, std::vector<raft::Committed>* out) const override {
+    target_.ReplayRestored(after, out);
+  }
+
+ private:
+  raft::StateMachine& target_;
+};
+
+}  // namespace
+
+SarMissionState::SarMissionState(std::function<void(const brain::Event&)> log) : impl_(std::make_unique<Impl>()) {
+  if (log) impl_->sink = [log = std::move(log)](const LogEvent& e) { log(ToBrainEvent(e)); };
+}
+SarMissionState::~SarMissionState() = default;
+
+void SarMissionState::Apply(std::uint64_t index, std::span<const std::uint8_t> entry) {
+  // Undecodable bytes and rejected commands change nothing (MissionStateMachine), the same way
+  // on every drone. The line's t and node are the host's to stamp (Context::log).
+  impl_->machine.Apply(index, entry, raft::EventOut(0.0, "", impl_->sink));
+}
+
+std::vector<std::uint8_t> SarMissionState::Snapshot() const { return impl_->machine.Snapshot(); }
+
+bool SarMissionState::Restore(std::span<const std::uint8_t> snapshot) { return impl_->machine.Restore(snapshot).ok(); }
+
+const raft::MissionState& SarMissionState::mission() const { return impl_->machine.mission(); }
+
+std::unique_ptr<raft::StateMachine> SarMissionState::RaftMachine() { return std::make_unique<MachineRef>(impl_->machine); }
+
+// ---- the brain -----------------------------------------------------------------------------------
+
+Result<std::unique_ptr<SarBrain>> SarBrain::Create(const brain::Context& ctx, const NetemWallClock* wall) {
+  auto config = SarBrainConfigFrom(ctx);
+  if (!config) return config.error();
+  return Create(*config, ctx.log, wall);
+}
+
+Result<std::unique_ptr<SarBrain>> SarBrain::Create(const SarBrainConfig& c, std::function<void(const brain::Event&)> log,
+                                                   const NetemWallClock* wall) {
+  if (c.name.empty()) return Error(ErrorCode::kInvalidArgument, "mission: no drone name");
+  if (std::find(c.members.begin(), c.members.end(), c.name) == c.members.end()) {
+    return Error(ErrorCode::kInvalidArgument, "mission: --members does not include '" + c.name + "'");
+  }
+  if (!(c.period_s > 0)) return Error(ErrorCode::kInvalidArgument, "mission: the brain period must be > 0");
+  if (!(c.geofence_size_x_m > 2 * c.tuning.search_margin_m) || !(c.geofence_size_y_m > 2 * c.tuning.search_margin_m)) {
+    return Error(ErrorCode::kInvalidArgument, "mission: the world's geofence is too small to search");
+  }
+  auto spec = swarm::BatterySpecFor(c.airframe);
+  if (!spec) return spec.error().Context("mission battery model");
+  return std::unique_ptr<SarBrain>(new SarBrain(c, swarm::BatteryModel(*spec), std::move(log), wall));
+}
+
+namespace {
+
+swarm::FlockingParams FlockParams(const MissionTuning& t) {
+  swarm::FlockingParams p;
+  p.v_flock_m_s = t.scout_cruise_m_s;
+  p.v_max_m_s = t.scout_cruise_m_s;
+  return p;
+}
+
+}  // namespace
+
+SarBrain::SarBrain(const SarBrainConfig& config, swarm::BatteryModel battery,
+                   std::function<void(const brain::Event&)> log, const NetemWallClock* wall)
+    : config_(config),
+      log_(std::move(log)),
+      wall_(wall),
+      role_(config.payload.empty() ? Role::kScout : Role::kLifter),
+      battery_(std::move(battery)),
+      flock_(FlockParams(config.tuning), swarm::Geofence::Centered(config.geofence_size_x_m, config.geofence_size_y_m)),
+      mode_(EncodeMissionMode(role_, "on_ground")) {
+  neighbours_.reserve(config_.members.size());
+}
+
+std::unique_ptr<SarMissionState> SarBrain::MakeMissionState() {
+  return std::make_unique<SarMissionState>(log_);
+}
+
+void SarBrain::OnNeighbour(const brain::Neighbour& n) {
+  if (n.name == config_.name) return;
+  if (std::find(config_.members.begin(), config_.members.end(), n.name) == config_.members.end()) return;
+  auto [it, fresh] = peers_.try_emplace(n.name);
+  Peer& p = it->second;
+  if (!fresh && n.t_ns < p.t_ns) return;  // an older state than the one held
+  p.mode = n.status;
+  p.position_m = V(n.position_m);
+  p.velocity_m_s = V(n.velocity_m_s);
+  p.t_ns = n.t_ns;
+  p.sim_time_s = static_cast<double>(n.t_ns) * 1e-9;
+  p.received_wall_s = std::numeric_limits<double>::quiet_NaN();
+  if (wall_ != nullptr) {
+    // netem: when this very state was taken off the radio (the side channel keeps the newest).
+    const auto h = wall_->heard.find(n.name);
+    if (h != wall_->heard.end() && h->second.t_ns == n.t_ns) p.received_wall_s = h->second.wall_s;
+  }
+}
+
+void SarBrain::Roster(const Now& now, std::vector<swarm::RosterEntry>* out) const {
+  out->clear();
+  swarm::RosterEntry own;
+  own.name = config_.name;
+  own.position_m = now.pos_m.head<2>();
+  own.wall_age_s = 0.0;
+  if (DecodeMissionMode(mode_, &own.role, &own.mode)) out->push_back(std::move(own));
+  for (const auto& [name, p] : peers_) {
+    swarm::RosterEntry e;
+    e.name = name;
+    // Age on the shared simulated clock (lockstep): see leader_planner.hpp for the timeout.
+    e.age_s = std::max(0.0, now.t_s - p.sim_time_s);
+    // And, netem only, on the wall clock since it was received (infinite without: the simulated
+    // age alone decides), so that a radio delay at rtf 0 is not taken for silence.
+    const double wall_age_s = now.wall_s - p.received_wall_s;
+    if (std::isfinite(wall_age_s)) e.wall_age_s = std::max(0.0, wall_age_s);
+    e.position_m = p.position_m.head<2>();
+    if (DecodeMissionMode(p.mode, &e.role, &e.mode)) out->push_back(std::move(e));
+  }
+}
+
+void SarBrain::Start(const Now& now, brain::Output& out) {
+  if (now.flight_mode == "init" || now.flight_mode.empty()) return;  // the estimator is not ready
+  // Wait (up to 10 s) until every member was heard, so roles are known (lifter present or not).
+  std::size_t heard = 0;
+  bool lifter_present = role_ == Role::kLifter;
+  for (const auto& [name, p] : peers_) {
+    Role r;
+    std::string m;
+    if (DecodeMissionMode(p.mode, &r, &m)) {
+      ++heard;
+      lifter_present = lifter_present || r == Role::kLifter;
+    }
+  }
+  if (heard + 1 < config_.members.size() && now.t_s < 10.0) return;
+  home_m_ = config_.has_home ? config_.home_m : Vec3(now.pos_m - Vec3(0, 0, config_.base_height_m));
+  const MissionTuning& t = config_.tuning;
+  if (role_ == Role::kScout) {
+    swarm::ScoutConfig s;
+    s.name = config_.name;
+    s.home_m = home_m_;
+    s.base_height_m = config_.base_height_m;
+    s.search_altitude_m = t.scout_altitude_m;
+    s.takeoff_delay_s = now.t_s + 2.0;  // the estimator settles on the ground (as the plan's preflight)
+    s.hfov_rad = config_.camera.hfov_rad;
+    s.width_px = config_.camera.width_px;
+    s.height_px = config_.camera.height_px;
+    s.cruise_speed_m_s = t.scout_cruise_m_s;
+    s.orbit_radius_m = t.scout_orbit_radius_m;
+    s.lifter_present = lifter_present;
+    s.dedupe_radius_m = t.sighting_dedupe_m;
+    s.keep_searching_during_rescue = true;  // the lifter does the rescue; scouts finish the search
+    s.return_when_swept = true;             // nothing left to see: land, do not loiter
+    s.approach_height_m = 5.0;              // descend at vel_max_down, land the last 5 m
+    s.orbit_time_s = t.scout_orbit_time_s;
+    // After a restart, sighting sequence numbers continue above any used before (sim ms).
+    s.first_sighting_seq = static_cast<std::uint64_t>(now.t_s * 1000.0) + 1;
+    scout_.emplace(std::move(s));
+  } else {
+    swarm::LifterConfig l;
+    l.name = config_.name;
+    l.home_m = home_m_;
+    l.base_height_m = config_.base_height_m;
+    l.transit_altitude_m = t.lifter_transit_altitude_m;
+    l.hook_below_body_m = -config_.payload_hook_m.z();
+    l.sling_length_m = config_.payload_sling_length_m;
+    l.payload_half_height_m = config_.payload_half_height_m;
+    l.loading_time_s = t.lifter_loading_time_s;
+    l.stretcher_start_offset_m = config_.payload_offset_m;
+    l.standby_after_delivery = true;
+    l.release_sink_m = -0.3;  // let go 0.3 m above the ground: no drag on a grounded stretcher
+    // Hooking needs the hook within 4 +- 0.5 m of the stretcher's centre: 1 m sideways at 4 m
+    // below changes that distance by 0.12 m, so the horizontal tolerance can be 1 m.
+    l.position_tolerance_m = 1.0;
+    l.settle_speed_m_s = 0.5;
+    lifter_.emplace(std::move(l));
+  }
+  swarm::LeaderConfig lc;
+  lc.name = config_.name;
+  const double m = t.search_margin_m;
+  lc.search_area = {-config_.geofence_size_x_m / 2 + m, -config_.geofence_size_y_m / 2 + m,
+                    config_.geofence_size_x_m / 2 - m, config_.geofence_size_y_m / 2 - m};
+  lc.retry_s = 2.0;
+  lc.start_timeout_s = t.leader_start_timeout_s;
+  lc.member_timeout_s = t.member_timeout_s;
+  lc.member_min_wall_s = t.member_min_wall_s;
+  lc.assignment_settle_s = t.assignment_settle_s;
+  leader_.emplace(std::move(lc));
+  out.events.push_back(ToBrainEvent(LogEvent(now.t_s, config_.name, "mission_start")
+                                        .Add("role", swarm::RoleName(role_))
+                                        .Add("home_x", home_m_.x(), 2)
+                                        .Add("home_y", home_m_.y(), 2)
+                                        .Add("lifter_present", lifter_present)));
+}
+
+void SarBrain::Step(const brain::Input& in, brain::Output& out) {
+  const auto* state = dynamic_cast<const SarMissionState*>(in.state);
+  if (state == nullptr) {
+    std::fprintf(stderr, "SarBrain::Step: Input::state is not the brain's SarMissionState (a wiring bug)\n");
+    std::abort();
+  }
+  Now now;
+  now.t_s = static_cast<double>(in.t_ns) * 1e-9;
+  if (wall_ != nullptr) now.wall_s = wall_->now_s;
+  now.flight_mode = in.self.flight_mode;
+  now.on_ground = OnGround(in.self.flight_mode);
+  now.pos_m = V(in.self.position_m);
+  now.vel_mps = V(in.self.velocity_m_s);
+  now.yaw_rad = YawOf(in.self.attitude_wxyz);
+  now.mission = &state->mission();
+  now.is_leader = in.is_leader;
+  for (const brain::FlightEvent& e : in.flight_events) now.hover_event = now.hover_event || e.name == "hover";
+  now.mass_estimate_kg = in.self.mass_estimate_kg;
+  for (const brain::Neighbour& n : in.neighbours) OnNeighbour(n);
+  if (role_ == Role::kScout) {
+    for (const brain::Detection& d : in.detections) {
+      swarm::GroundDetection g;
+      g.capture_time_s = static_cast<double>(d.t_ns) * 1e-9;
+      g.position_m = V(d.position_m);
+      g.sigma_m = d.sigma_m;
+      g.confidence = d.confidence;
+      visible_.push_back(g);
+    }
+  }
+
+  battery_.Step(config_.period_s, now.vel_mps, payload_mass_kg(), !now.on_ground);
+  if (!scout_ && !lifter_) Start(now, out);
+  if (scout_ || lifter_) {
+    if (now.t_s >= next_tick_s_) {
+      next_tick_s_ = now.t_s + config_.tuning.mission_dt_s;
+      if (role_ == Role::kLifter) CheckLoad(now, out);
+      RunBehaviour(now, out);
+    }
+    const raft::MissionState& mission = *now.mission;
+    if (mission.phase() == raft::MissionPhase::kComplete && !complete_logged_) {
+      complete_logged_ = true;
+      std::int64_t rescued = 0;
+      for (const raft::Victim& v : mission.victims()) rescued += v.status == raft::VictimStatus::kRescued ? 1 : 0;
+      out.events.push_back(ToBrainEvent(LogEvent(now.t_s, config_.name, "mission_complete")
+                                            .Add("victims", static_cast<std::int64_t>(mission.victims().size()))
+                                            .Add("rescued", rescued)));
+    }
+  }
+  out.status = mode_;
+}
+
+void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
+  swarm::MissionInput mi;
+  mi.t_s = now.t_s;
+  mi.mission = now.mission;
+  mi.position_m = now.pos_m;
+  mi.velocity_m_s = now.vel_mps;
+  mi.yaw_rad = now.yaw_rad;
+  mi.battery_fraction = battery_.fraction();
+  const double to_home = (now.pos_m.head<2>() - home_m_.head<2>()).norm();
+  mi.battery_low = battery_.IsLow(to_home, std::max(0.0, now.pos_m.z() - home_m_.z()), payload_mass_kg());
+  mi.payload_attached = payload_attached_;
+  mi.detections = visible_;
+  if (scout_) {
+    scout_->Step(mi, &behaviour_out_);
+  } else {
+    lifter_->Step(mi, &behaviour_out_);
+  }
+  visible_.clear();
+  mode_ = EncodeMissionMode(role_, behaviour_out_.mode);
+  for (const raft::MissionCommand& c : behaviour_out_.proposals) out.proposals.push_back(raft::EncodeCommand(c));
+  for (const LogEvent& e : behaviour_out_.events) out.events.push_back(ToBrainEvent(e));
+  if (behaviour_out_.payload.action != swarm::PayloadAction::kNone) Apply(behaviour_out_.payload, out);
+  Drive(now, behaviour_out_.setpoint, out);
+
+  leader_->Track(now.t_s, *now.mission, now.wall_s);  // every drone: a new leader knows when sectors changed
+  if (now.is_leader) {
+    std::vector<swarm::RosterEntry> roster;
+    Roster(now, &roster);
+    const bool everyone = roster.size() == config_.members.size();
+    if (everyone || now.mission->phase() != raft::MissionPhase::kIdle || now.t_s >= config_.tuning.leader_start_timeout_s) {
+      swarm::MissionOutput lead;
+      leader_->Step(now.t_s, *now.mission, roster, &lead, now.wall_s);
+      for (const raft::MissionCommand& c : lead.proposals) out.proposals.push_back(raft::EncodeCommand(c));
+      for (const LogEvent& e : lead.events) {
+        // Every drone logs mission_complete itself when it applies COMPLETE (Step()).
+        if (e.str().find(" event=mission_complete") == std::string::npos) out.events.push_back(ToBrainEvent(e));
+      }
+    }
+  }
+}
+
+void SarBrain::Apply(const swarm::PayloadRequest& p, brain::Output& out) {
+  // The command drives the simulated hook (a world command of the agent): the brain takes the
+  // hook's state to be the last command it sent (a refused command shows as
+  // event=world_command_rejected in the physics log; the lifter only asks once settled within
+  // the hook's reach, and the load check below catches an empty hook).
+  if (p.action == swarm::PayloadAction::kAttach) {
+    out.commands.push_back(brain::Command::PayloadAttach(p.mass_kg));
+    payload_attached_ = true;
+    payload_mass_kg_ = p.mass_kg;
+    attach_t_s_ = next_tick_s_ - config_.tuning.mission_dt_s;
+  } else if (p.action == swarm::PayloadAction::kRelease) {
+    out.commands.push_back(brain::Command::PayloadRelease());
+    payload_attached_ = false;
+    attach_t_s_ = -1.0;
+  }
+}
+
+void SarBrain::CheckLoad(const Now& now, brain::Output& out) {
+  if (attach_t_s_ < 0 || !payload_attached_) return;
+  const MissionTuning& t = config_.tuning;
+  const double hook_height = -config_.payload_hook_m.z() + config_.payload_sling_length_m + config_.payload_half_height_m;
+  const double height = now.pos_m.z() - home_m_.z();
+  if (now.t_s - attach_t_s_ < t.load_check_delay_s || height < hook_height + t.load_check_climb_m) return;
+  const double load = now.mass_estimate_kg - config_.vehicle_mass_kg;
+  const bool ok = load >= t.load_check_fraction * payload_mass_kg_;
+  out.events.push_back(ToBrainEvent(LogEvent(now.t_s, config_.name, ok ? "payload_confirmed" : "payload_missing")
+                                        .Add("expected_kg", payload_mass_kg_, 1)
+                                        .Add("estimated_kg", load, 1)));
+  attach_t_s_ = -1.0;
+  if (!ok) payload_attached_ = false;  // the world refused the hook: the lifter goes back for it
+}
+
+void SarBrain::Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Output& out) {
+  const bool changed = sp.kind != sent_kind_;
+  switch (sp.kind) {
+    case SetpointKind::kIdle:
+      break;
+    case SetpointKind::kTakeoff: {
+      // A short flight-stack take-off, then the climb in position mode (faster: vel_max_up).
+      const double height = sp.target_m.z() - now.pos_m.z();
+      if (now.on_ground) {
+        if (changed || now.flight_mode != "takeoff") {
+          out.commands.push_back(brain::Command::Takeoff(std::clamp(height, 0.5, config_.tuning.scout_takeoff_step_m)));
+          climb_sent_ = false;
+        }
+      } else if (!climb_sent_ && (now.hover_event || now.flight_mode == "hold")) {
+        out.setpoint.assign(1, brain::Setpoint::Position(B(sp.target_m)));
+        climb_sent_ = true;
+      }
+      break;
+    }
+    case SetpointKind::kPosition:
+      if (now.on_ground) break;
+      if (changed || (sp.target_m - sent_target_m_).norm() > 0.05) {
+        out.setpoint.assign(1, brain::Setpoint::Position(B(sp.target_m), sp.yaw_rad));
+        sent_target_m_ = sp.target_m;
+      }
+      break;
+    case SetpointKind::kFlock: {
+      if (now.on_ground) break;
+      neighbours_.clear();
+      for (const auto& [name, p] : peers_) {
+        const double age = std::max(0.0, now.t_s - p.sim_time_s);
+        if (p.position_m.z() < home_m_.z() + 1.5) continue;  // on the ground: not in the way
+        neighbours_.push_back({p.position_m, p.velocity_m_s, age});
+      }
+      if (changed) flock_.Reset(now.vel_mps);
+      swarm::FlockingInput fi;
+      fi.position_m = now.pos_m;
+      fi.velocity_m_s = now.vel_mps;
+      fi.goal_m = sp.target_m;
+      fi.neighbours = neighbours_;
+      const swarm::FlockingOutput f = flock_.Step(fi, config_.tuning.mission_dt_s);
+      out.setpoint.assign(1, brain::Setpoint::Velocity(B(f.velocity_m_s), sp.yaw_rad));
+      break;
+    }
+    case SetpointKind::kLand:
+      if (!now.on_ground && (changed || now.flight_mode != "land")) out.commands.push_back(brain::Command::Land());
+      break;
+  }
+  if (sp.kind != SetpointKind::kPosition) sent_target_m_ = Vec3::Constant(1e9);
+  sent_kind_ = sp.kind;
+}
+
+}  // namespace swarmbox::agent

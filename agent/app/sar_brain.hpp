@@ -1,0 +1,256 @@
+// SarBrain: SwarmBox's own search-and-rescue logic as a brain (agent/brain's SDK), the builtin
+// brain of `--mission sar`. It sees only brain::Input and answers only brain::Output, like any
+// user's brain: the proof that the SDK suffices (tests/agent/app/sar_brain_test.cpp steps it by
+// hand on simulated time, without any bus).
+//
+// The agent runs it through BrainHost (brain_host.hpp) every lockstep step, exactly as a library
+// brain; only the side channel below and the typed accessors (mode, complete) are SAR's own.
+//
+// What it does with the Input:
+//   - its ReplicatedState is the committed mission (SarMissionState: raft::MissionState behind
+//     raft::MissionStateMachine; entries are encoded raft::MissionCommands, its proposals too);
+//   - neighbours: flocking, and the leader's roster from each one's status "<role>/<mode>"
+//     (e.g. "scout/searching", "lifter/on_ground"; its own Output::status likewise);
+//   - is_leader: LeaderPlanner on the leader (Track on every drone);
+//   - detections (the agent's PerceptionHost): sightings to report, scouts only;
+//   - flight events (`hover`) and the flight mode: take-off, climb, landing;
+//   - a per-airframe BatteryModel (battery_low -> return home, in the behaviours);
+//   ScoutBehaviour or LifterSequence every mission tick (10 Hz of simulated time).
+// And answers: take-off, land, payload_attach/payload_release commands; position setpoints
+// (position only, only when the target changes) or flocking velocities (velocity only, every
+// tick), PX4 TrajectorySetpoint form; proposals; the status; events (mission_start,
+// sector_progress, payload_confirmed, mission_complete, ... as before the SDK).
+//
+//   auto brain = SarBrain::Create(ctx);               // kInvalidArgument: bad airframe/world/args
+//   auto state = brain->MakeReplicatedState();         // Raft applies the committed entries to it
+//   brain->Step(in, out);                              // every period (in.state == state.get())
+//
+// Context: self, members, airframe_path (battery model, camera, base height, mass, payloads),
+// payload (non-empty: this drone is the lifter with that payload), world_path (the geofence),
+// period_ns (the battery integrates over it), log (the mission state's event lines) and args:
+// `start` "x,y,z" (the take-off spot, ground point [m, ENU]; absent: the first estimate minus the
+// base height) and any MissionTuning field by name (e.g. member_timeout_s), as numbers.
+//
+// The one wall clock (netem only): the leader's lost-member rule also wants a wall-clock silence
+// when the radio runs on the wall clock (leader_planner.hpp has why). brain::Input carries no wall
+// clock, so the agent hands it through a SAR-private side channel, NetemWallClock, that only the
+// node with --radio-model netem creates; with the channel (and in every test without it) the
+// brain reads no wall clock at all and the simulated rule decides alone.
+// Frames: world ENU [m]; time: Input::t_ns. Not thread-safe (the control loop owns it).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "perception_host.hpp"
+#include "swarmbox/brain/brain.hpp"
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/raft/mission_state.hpp"
+#include "swarmbox/raft/state_machine.hpp"
+#include "swarmbox/swarm/swarm.hpp"
+
+namespace swarmbox::agent {
+
+// Where a payload that starts on the ground lies relative to the drone's spawn point, and its
+// half height, from the airframe file: the physics server (World::AddDrone) lays it flat beside
+// the drone, on the world -y side, (collision box y + payload y) / 2 + 0.5 m from the spawn.
+struct GroundPayload {
+  Eigen::Vector2d offset_m = Eigen::Vector2d::Zero();  // from the spawn point, world ENU [m]
+  double half_height_m = 0.0;
+};
+Result<GroundPayload> LoadGroundPayload(const std::string& airframe_path, const std::string& payload);
+
+// "<role>/<mode>" for Output::status (DroneState::mode), and back. Decode is false for anything
+// else (the flight modes a --mission plan agent publishes, another brain's status, garbage).
+std::string EncodeMissionMode(swarm::Role role, std::string_view mode);
+bool DecodeMissionMode(std::string_view text, swarm::Role* role, std::string* mode);
+
+// Tuning of the mission, chosen so sar_search completes well inside its 600 s timeout (see
+// agent/app/README.md for the figures); every value has a reason next to it in sar_brain.cpp.
+struct MissionTuning {
+  double mission_dt_s = 0.1;            // behaviour tick [s]
+  double search_margin_m = 8.0;         // search area = geofence shrunk by this [m]
+  double scout_altitude_m = 30.0;       // above home [m]
+  double scout_cruise_m_s = 7.0;
+  double scout_takeoff_step_m = 3.0;    // flight-stack take-off height; then climb in position mode
+  double scout_orbit_radius_m = 12.0;
+  double scout_orbit_time_s = 20.0;     // a swept scout orbits a victim this long, then lands
+  double lifter_transit_altitude_m = 10.0;
+  double lifter_loading_time_s = 10.0;  // evacuee loaded onto the stretcher [s]
+  double leader_start_timeout_s = 45.0; // start the search even if a member is still unheard
+  // A member silent this long (simulated time) is gone; its sectors go to live scouts. The
+  // search counts as finished only with the sector list unchanged this long (leader_planner.hpp
+  // has the reasoning for 100 +- 20 ms radio delay and 5% loss) [s].
+  double member_timeout_s = 6.0;
+  // ... and silent this long on the wall clock too, netem only: at rtf 0 a radio or starvation
+  // delay of ~1 s wall is many simulated seconds (leader_planner.hpp has the reasoning for 3 s) [s].
+  double member_min_wall_s = 3.0;
+  double assignment_settle_s = 10.0;
+  double sighting_dedupe_m = 10.0;      // a sighting this close to a known victim is that victim
+  // Load check (lifter): once lifted (attach height + load_check_climb_m) and load_check_delay_s
+  // after an attach, the flight stack's mass estimate must show at least load_check_fraction of
+  // the attached mass, or the hook is taken to be empty (event=payload_missing).
+  double load_check_climb_m = 3.0;
+  double load_check_delay_s = 4.0;
+  double load_check_fraction = 0.5;
+};
+
+struct SarBrainConfig {
+  std::string name;
+  std::vector<std::string> members;   // every drone of the trial (same list on each)
+  std::string airframe;               // airframe name ("x500", "x8_heavy"): battery model
+  std::string payload;                // non-empty: this drone is the lifter with that payload
+  double payload_sling_length_m = 4.0;
+  flight::Vec3 payload_hook_m{0.0, 0.0, -0.4};
+  double payload_half_height_m = 0.125;
+  Eigen::Vector2d payload_offset_m = Eigen::Vector2d::Zero();  // where it lies, from home [m]
+  double base_height_m = 0.23;
+  double vehicle_mass_kg = 0.0;       // empty airframe (the load check compares the estimate)
+  bool has_home = false;              // the take-off spot is known (args start); else first estimate
+  flight::Vec3 home_m = flight::Vec3::Zero();  // ground point under the drone at start [m]
+  double geofence_size_x_m = 200.0;
+  double geofence_size_y_m = 200.0;
+  CameraSpec camera;                  // the sweep's footprint (scouts)
+  double period_s = 0.004;            // between Steps (Context::period_ns) [s]
+  MissionTuning tuning;
+};
+
+// The config from a brain::Context (the files it names and its args); kInvalidArgument naming
+// the file, the flag or the arg otherwise.
+Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx);
+
+// The SAR-private side channel of the wall clock, netem only (banner). The node owns it, sets
+// now_s before each Step and records, per drone, when its latest state (by simulated time) was
+// taken off the radio; the brain only reads it.
+struct NetemWallClock {
+  struct Heard {
+    std::int64_t t_ns = 0;   // the state's simulated time (Neighbour::t_ns)
+    double wall_s = 0.0;     // when it was received, monotonic wall clock [s]
+  };
+  double now_s = std::numeric_limits<double>::quiet_NaN();  // monotonic wall clock now [s]
+  std::map<std::string, Heard> heard;
+  // A state of `drone` sent at t_ns received at wall_s: kept when no older than the one held.
+  void OnState(const std::string& drone, std::int64_t t_ns, double wall_s);
+};
+
+// SarBrain's ReplicatedState: the committed raft::MissionState. Apply/Snapshot/Restore are
+// raft::MissionStateMachine's; through this interface its event lines (mission_state,
+// victim_confirmed, victim_status) go to the Context's log. The agent hands Raft the same machine
+// directly (RaftMachine), so that Raft applies it with its own event lines, byte for byte as
+// before the SDK (also the snapshot-installed line, which brain::ReplicatedState has no call for).
+class SarMissionState final : public brain::ReplicatedState {
+ public:
+  explicit SarMissionState(std::function<void(const brain::Event&)> log);
+  ~SarMissionState() override;
+  void Apply(std::uint64_t index, std::span<const std::uint8_t> entry) override;
+  std::vector<std::uint8_t> Snapshot() const override;
+  bool Restore(std::span<const std::uint8_t> snapshot) override;
+  const raft::MissionState& mission() const;
+  // This state as Raft's state machine: a reference to its MissionStateMachine (this object must
+  // outlive the Raft node that holds it).
+  std::unique_ptr<raft::StateMachine> RaftMachine();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+class SarBrain final : public brain::Brain {
+ public:
+  // `wall`: netem's side channel (outlives the brain); nullptr: none.
+  static Result<std::unique_ptr<SarBrain>> Create(const brain::Context& ctx, const NetemWallClock* wall = nullptr);
+  static Result<std::unique_ptr<SarBrain>> Create(const SarBrainConfig& config,
+                                                  std::function<void(const brain::Event&)> log = {},
+                                                  const NetemWallClock* wall = nullptr);
+
+  std::unique_ptr<brain::ReplicatedState> MakeReplicatedState() override { return MakeMissionState(); }
+  // The same, typed (the agent hands Raft its machine: SarMissionState::RaftMachine).
+  std::unique_ptr<SarMissionState> MakeMissionState();
+  // in.state must be this brain's SarMissionState (aborts otherwise: a wiring bug).
+  void Step(const brain::Input& in, brain::Output& out) override;
+
+  swarm::Role role() const { return role_; }
+  // "<role>/<mode>", also Output::status.
+  const std::string& mode() const { return mode_; }
+  double battery_fraction() const { return battery_.fraction(); }
+  bool payload_attached() const { return payload_attached_; }
+  double payload_mass_kg() const { return payload_attached_ ? payload_mass_kg_ : 0.0; }
+  // The committed mission is complete (event=mission_complete logged).
+  bool complete() const { return complete_logged_; }
+
+ private:
+  struct Peer {
+    std::string mode;
+    flight::Vec3 position_m = flight::Vec3::Zero();
+    flight::Vec3 velocity_m_s = flight::Vec3::Zero();
+    double sim_time_s = 0.0;
+    std::int64_t t_ns = 0;
+    double received_wall_s = std::numeric_limits<double>::quiet_NaN();
+  };
+  // What one Step knows, in the behaviours' types.
+  struct Now {
+    double t_s = 0.0;
+    double wall_s = std::numeric_limits<double>::quiet_NaN();
+    std::string_view flight_mode;
+    bool on_ground = true;
+    flight::Vec3 pos_m = flight::Vec3::Zero();
+    flight::Vec3 vel_mps = flight::Vec3::Zero();
+    double yaw_rad = 0.0;
+    const raft::MissionState* mission = nullptr;
+    bool is_leader = false;
+    bool hover_event = false;
+    double mass_estimate_kg = 0.0;
+  };
+
+  SarBrain(const SarBrainConfig& config, swarm::BatteryModel battery, std::function<void(const brain::Event&)> log,
+           const NetemWallClock* wall);
+  void OnNeighbour(const brain::Neighbour& n);
+  void Start(const Now& now, brain::Output& out);  // builds the behaviour once the estimator is ready
+  void RunBehaviour(const Now& now, brain::Output& out);
+  void Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Output& out);
+  void Apply(const swarm::PayloadRequest& p, brain::Output& out);
+  void CheckLoad(const Now& now, brain::Output& out);
+  void Roster(const Now& now, std::vector<swarm::RosterEntry>* out) const;
+
+  SarBrainConfig config_;
+  std::function<void(const brain::Event&)> log_;
+  const NetemWallClock* wall_;
+  swarm::Role role_ = swarm::Role::kScout;
+  swarm::BatteryModel battery_;
+  std::optional<swarm::ScoutBehaviour> scout_;
+  std::optional<swarm::LifterSequence> lifter_;
+  std::optional<swarm::LeaderPlanner> leader_;
+  swarm::Flocking flock_;
+  flight::Vec3 home_m_ = flight::Vec3::Zero();
+  std::string mode_;
+
+  std::map<std::string, Peer> peers_;
+  std::vector<swarm::NeighbourState> neighbours_;
+  std::vector<swarm::GroundDetection> visible_;
+
+  swarm::MissionOutput behaviour_out_;
+  double next_tick_s_ = 0.0;
+  bool payload_attached_ = false;
+  double payload_mass_kg_ = 0.0;
+  double attach_t_s_ = -1.0;  // >= 0: an attach waits for its load check
+  // What was last sent to the flight stack (to send position/land/takeoff only on change).
+  swarm::SetpointKind sent_kind_ = swarm::SetpointKind::kIdle;
+  flight::Vec3 sent_target_m_ = flight::Vec3::Constant(1e9);
+  bool climb_sent_ = false;
+  bool complete_logged_ = false;
+};
+
+// One LogEvent line (t, node, event, fields) as a brain::Event (event and fields; the host
+// stamps t and node again when it prints it).
+brain::Event ToBrainEvent(const LogEvent& e);
+
+}  // namespace swarmbox::agent

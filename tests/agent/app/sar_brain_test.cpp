@@ -1,0 +1,543 @@
+// SarBrain (agent/app/sar_brain.hpp) through the brain SDK only, without any bus: the mode
+// strings on DroneState, what the brain reads from the airframe and its Context, and how it turns
+// the behaviours into commands and TrajectorySetpoint-form setpoints, leader proposals (encoded
+// MissionCommands) and the lifter's load check, stepped by hand on simulated time with its own
+// ReplicatedState as the committed mission.
+#include "sar_brain.hpp"
+
+#include <gtest/gtest.h>
+
+#include "brain_host.hpp"
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "swarmbox/raft/mission_command.hpp"
+
+namespace swarmbox::agent {
+namespace {
+
+using flight::Vec3;
+
+bool HasEvent(const brain::Output& out, const std::string& name) {
+  for (const brain::Event& e : out.events) {
+    if (e.name == name) return true;
+  }
+  return false;
+}
+
+std::string Field(const brain::Event& e, const std::string& key) {
+  for (const auto& [k, v] : e.fields) {
+    if (k == key) return v;
+  }
+  return "";
+}
+
+TEST(MissionMode, RoundTripsRoleAndModeAndRejectsOthers) {
+  EXPECT_EQ(EncodeMissionMode(swarm::Role::kScout, "searching"), "scout/searching");
+  swarm::Role role = swarm::Role::kScout;
+  std::string mode;
+  ASSERT_TRUE(DecodeMissionMode("lifter/standby", &role, &mode));
+  EXPECT_EQ(role, swarm::Role::kLifter);
+  EXPECT_EQ(mode, "standby");
+  for (const char* bad : {"hold", "pilot/x", "scout/", "/x", ""}) {
+    EXPECT_FALSE(DecodeMissionMode(bad, &role, &mode)) << bad;
+  }
+}
+
+TEST(AirframeExtras, ReadsTheCameraAndWhereTheStretcherLies) {
+  auto cam = LoadCameraSpec(SWARMBOX_TRIALS_DIR "/airframes/x500.yaml");
+  ASSERT_TRUE(cam.ok()) << cam.error().ToString();
+  EXPECT_EQ(cam->width_px, 320);
+  EXPECT_EQ(cam->height_px, 240);
+  EXPECT_DOUBLE_EQ(cam->hfov_rad, 1.2);
+  EXPECT_EQ(cam->offset_m, Vec3(0, 0, -0.05));
+  // x8_heavy: collision box 4.4 m wide, stretcher 0.6 m wide -> 2.2 + 0.3 + 0.5 = 3 m to the south.
+  auto g = LoadGroundPayload(SWARMBOX_TRIALS_DIR "/airframes/x8_heavy.yaml", "stretcher");
+  ASSERT_TRUE(g.ok()) << g.error().ToString();
+  EXPECT_NEAR(g->offset_m.x(), 0.0, 1e-12);
+  EXPECT_NEAR(g->offset_m.y(), -3.0, 1e-12);
+  EXPECT_NEAR(g->half_height_m, 0.125, 1e-12);
+  auto none = LoadGroundPayload(SWARMBOX_TRIALS_DIR "/airframes/x500.yaml", "stretcher");
+  ASSERT_FALSE(none.ok());
+  EXPECT_NE(none.error().ToString().find("no payload 'stretcher'"), std::string::npos) << none.error().ToString();
+}
+
+// What the agent hands the builtin brain: the files, the payload, args start and tuning.
+brain::Context LifterContext() {
+  brain::Context ctx;
+  ctx.self = "lifter";
+  ctx.members = {"scout_1", "lifter"};
+  ctx.airframe = "x8_heavy";
+  ctx.airframe_path = SWARMBOX_TRIALS_DIR "/airframes/x8_heavy.yaml";
+  ctx.world_path = SWARMBOX_TRIALS_DIR "/worlds/open_field.yaml";
+  ctx.payload = "stretcher";
+  ctx.args = {{"start", "0,-10,0"}, {"member_timeout_s", "8"}};
+  return ctx;
+}
+
+TEST(SarBrainConfigFrom, ReadsTheAirframeWorldPayloadStartAndTuningFromTheContext) {
+  auto c = SarBrainConfigFrom(LifterContext());
+  ASSERT_TRUE(c.ok()) << c.error().ToString();
+  EXPECT_EQ(c->name, "lifter");
+  EXPECT_EQ(c->airframe, "x8_heavy");
+  EXPECT_EQ(c->payload, "stretcher");
+  EXPECT_TRUE(c->has_home);
+  EXPECT_EQ(c->home_m, Vec3(0, -10, 0));
+  EXPECT_NEAR(c->payload_offset_m.y(), -3.0, 1e-12);
+  EXPECT_NEAR(c->payload_half_height_m, 0.125, 1e-12);
+  EXPECT_GT(c->payload_sling_length_m, 0.0);
+  EXPECT_GT(c->vehicle_mass_kg, 0.0);
+  EXPECT_DOUBLE_EQ(c->tuning.member_timeout_s, 8.0);
+  EXPECT_DOUBLE_EQ(c->tuning.member_min_wall_s, 3.0);  // untouched
+  EXPECT_DOUBLE_EQ(c->period_s, 0.004);
+}
+
+TEST(SarBrainConfigFrom, NamesTheBadArgOrPayload) {
+  brain::Context ctx = LifterContext();
+  ctx.args["member_timeout_s"] = "six";
+  auto c = SarBrainConfigFrom(ctx);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().ToString().find("member_timeout_s 'six'"), std::string::npos) << c.error().ToString();
+  ctx = LifterContext();
+  ctx.args["start"] = "0,-10";
+  c = SarBrainConfigFrom(ctx);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().ToString().find("start '0,-10'"), std::string::npos) << c.error().ToString();
+  ctx = LifterContext();
+  ctx.payload = "piano";
+  c = SarBrainConfigFrom(ctx);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().ToString().find("--payload 'piano'"), std::string::npos) << c.error().ToString();
+}
+
+SarBrainConfig Scout(const std::string& name, std::vector<std::string> members) {
+  SarBrainConfig c;
+  c.name = name;
+  c.members = std::move(members);
+  c.airframe = "x500";
+  c.has_home = true;
+  c.home_m = Vec3(0, 0, 0);
+  return c;
+}
+
+TEST(SarBrainCreate, RejectsBadConfigurations) {
+  SarBrainConfig c = Scout("scout_9", {"scout_1"});
+  auto r = SarBrain::Create(c);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().ToString().find("does not include 'scout_9'"), std::string::npos);
+  c = Scout("scout_1", {"scout_1"});
+  c.airframe = "glider";
+  r = SarBrain::Create(c);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().ToString().find("battery"), std::string::npos) << r.error().ToString();
+  c = Scout("scout_1", {"scout_1"});
+  c.geofence_size_x_m = 10.0;
+  r = SarBrain::Create(c);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().ToString().find("too small"), std::string::npos);
+}
+
+// What the brain asked the flight stack for, in one shape: a command (takeoff, land) or a
+// setpoint (position only, or velocity only with the position unset).
+struct Sent {
+  std::string kind;  // "takeoff", "land", "position", "velocity"
+  Vec3 value = Vec3::Zero();
+};
+
+// A brain stepped at the lockstep rate as BrainHost does: the estimate the test moves by hand,
+// the neighbour table (latest state heard from each drone, sorted by name), the committed
+// mission in the brain's own ReplicatedState, and, when asked for, netem's wall-clock side channel.
+class BrainRig {
+ public:
+  explicit BrainRig(const SarBrainConfig& c, bool netem_wall = false)
+      : brain_(*SarBrain::Create(c, {}, netem_wall ? &wall_ : nullptr)), state_(brain_->MakeReplicatedState()) {}
+  const brain::Output& Step(std::string_view mode, bool leader = false, bool hover = false, double mass_kg = 0) {
+    t_ns_ += 4'000'000;
+    wall_.now_s += 0.004 / speed_up_;
+    out_ = brain::Output{};
+    brain::Input in;
+    in.t_ns = t_ns_;
+    in.self.name = "self";
+    in.self.position_m = {pos_.x(), pos_.y(), pos_.z()};
+    in.self.flight_mode = std::string(mode);
+    in.self.landed = mode == "idle" || mode == "landed";
+    in.self.mass_estimate_kg = mass_kg;
+    events_.clear();
+    if (hover) events_.push_back({"hover", t_ns_, {}});
+    in.flight_events = events_;
+    in.is_leader = leader;
+    table_.clear();
+    for (const auto& [name, n] : heard_) table_.push_back(n);
+    in.neighbours = table_;
+    in.state = state_.get();
+    brain_->Step(in, out_);
+    EXPECT_EQ(out_.status, brain_->mode());
+    return out_;
+  }
+  // Steps `seconds` and returns everything asked of the flight stack meanwhile.
+  std::vector<Sent> Run(double seconds, std::string_view mode, bool leader = false) {
+    std::vector<Sent> sent;
+    for (const std::int64_t end = t_ns_ + static_cast<std::int64_t>(seconds * 1e9); t_ns_ < end;) {
+      const brain::Output& out = Step(mode, leader);
+      for (const brain::Command& c : out.commands) {
+        if (c.kind == brain::Command::Kind::kTakeoff) sent.push_back({"takeoff", Vec3(0, 0, c.param)});
+        if (c.kind == brain::Command::Kind::kLand) sent.push_back({"land", Vec3::Zero()});
+      }
+      for (const brain::Setpoint& sp : out.setpoint) {
+        const bool position = std::isfinite(sp.position_m.x);
+        EXPECT_NE(position, std::isfinite(sp.velocity_m_s.x)) << "position only, or velocity only";
+        EXPECT_TRUE(std::isnan(sp.acceleration_m_s2.x));
+        const brain::Vec3& v = position ? sp.position_m : sp.velocity_m_s;
+        sent.push_back({position ? "position" : "velocity", Vec3(v.x, v.y, v.z)});
+      }
+      for (const std::vector<std::uint8_t>& bytes : out.proposals) {
+        auto c = raft::DecodeCommand(bytes);
+        EXPECT_TRUE(c.ok());
+        if (c.ok()) proposals_.push_back(*c);
+      }
+    }
+    return sent;
+  }
+  // A DroneState of `name` heard now (netem: received now on the wall clock as well).
+  void Hear(const std::string& name, const std::string& status, const Vec3& pos, double sent_s) {
+    brain::Neighbour n;
+    n.name = name;
+    n.status = status;
+    n.position_m = {pos.x(), pos.y(), pos.z()};
+    n.t_ns = static_cast<std::int64_t>(std::llround(sent_s * 1e9));
+    heard_[name] = n;
+    wall_.OnState(name, n.t_ns, wall_.now_s);
+  }
+  void Commit(const raft::MissionCommand& c) { state_->Apply(++index_, raft::EncodeCommand(c)); }
+  // The world runs `speed_up` times faster than the wall clock (1: rtf 1; ~8 at rtf 0 on
+  // loopback); only read by a brain made with netem_wall.
+  void SetSpeedUp(double speed_up) { speed_up_ = speed_up; }
+  SarBrain& brain() { return *brain_; }
+  Vec3& position() { return pos_; }
+  const raft::MissionState& mission() const { return dynamic_cast<const SarMissionState&>(*state_).mission(); }
+  std::vector<raft::MissionCommand>& proposals() { return proposals_; }
+
+ private:
+  NetemWallClock wall_{.now_s = 100.0, .heard = {}};  // any monotonic origin
+  std::unique_ptr<SarBrain> brain_;
+  std::unique_ptr<brain::ReplicatedState> state_;
+  brain::Output out_;
+  std::vector<brain::FlightEvent> events_;
+  std::map<std::string, brain::Neighbour> heard_;
+  std::vector<brain::Neighbour> table_;
+  std::vector<raft::MissionCommand> proposals_;
+  Vec3 pos_ = Vec3::Zero();
+  std::int64_t t_ns_ = 0;
+  std::uint64_t index_ = 0;
+  double speed_up_ = 1.0;
+};
+
+TEST(SarBrainScout, TakesOffShortThenClimbsInPositionModeAndPublishesItsMode) {
+  BrainRig rig(Scout("scout_1", {"scout_1"}));
+  rig.position() = Vec3(0, 0, 0.23);
+  const brain::Output& first = rig.Step("idle");
+  EXPECT_TRUE(HasEvent(first, "mission_start"));
+  EXPECT_EQ(first.status, "scout/on_ground");
+  std::vector<Sent> sent = rig.Run(1.5, "idle");
+  EXPECT_TRUE(sent.empty());  // 2 s on the ground first (the estimator settles)
+  sent = rig.Run(1.0, "idle");  // (re-sent each tick while the drone stays idle)
+  ASSERT_FALSE(sent.empty());
+  for (const Sent& sp : sent) {
+    EXPECT_EQ(sp.kind, "takeoff");
+    EXPECT_DOUBLE_EQ(sp.value.z(), 3.0);  // the short flight-stack take-off
+  }
+  EXPECT_EQ(rig.brain().mode(), "scout/taking_off");
+  rig.position() = Vec3(0, 0, 3.2);
+  sent = rig.Run(1.0, "takeoff");
+  EXPECT_TRUE(sent.empty());
+  sent = rig.Run(0.5, "hold");  // take-off height reached: the flight stack holds
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].kind, "position");
+  EXPECT_EQ(sent[0].value, Vec3(0, 0, 30));  // then the climb to the search altitude
+}
+
+TEST(SarBrainScout, TheHoverEventAloneStartsTheClimb) {
+  BrainRig rig(Scout("scout_1", {"scout_1"}));
+  rig.position() = Vec3(0, 0, 0.23);
+  rig.Run(2.5, "idle");
+  rig.position() = Vec3(0, 0, 3.2);
+  EXPECT_TRUE(rig.Run(0.2, "takeoff").empty());
+  bool climb = false;
+  // The flight event `hover` while the mode still reads takeoff (the behaviours look at it on
+  // their 10 Hz tick: one tick's worth of steps reporting it): the climb follows.
+  for (int k = 0; k < 25 && !climb; ++k) climb = !rig.Step("takeoff", false, /*hover=*/true).setpoint.empty();
+  EXPECT_TRUE(climb);
+}
+
+TEST(SarBrainScout, AloneAndLeadingItAssignsItselfTheWholeSearchAreaAndStarts) {
+  BrainRig rig(Scout("scout_1", {"scout_1"}));
+  rig.position() = Vec3(0, 0, 0.23);
+  rig.Run(2.5, "idle", /*leader=*/true);
+  EXPECT_TRUE(rig.proposals().empty());  // on the ground: no search yet
+  rig.position() = Vec3(0, 0, 29.5);
+  rig.Run(0.5, "position", true);
+  ASSERT_EQ(rig.proposals().size(), 2u);
+  const auto* assign = std::get_if<raft::AssignSectors>(&rig.proposals()[0]);
+  ASSERT_NE(assign, nullptr);
+  ASSERT_EQ(assign->sectors.size(), 1u);
+  // The 200 x 200 m geofence shrunk by the search margin (8 m).
+  EXPECT_DOUBLE_EQ(assign->sectors[0].x_min_m, -92.0);
+  EXPECT_DOUBLE_EQ(assign->sectors[0].y_max_m, 92.0);
+  EXPECT_TRUE(std::holds_alternative<raft::StartSearch>(rig.proposals()[1]));
+  // Committed: it flocks along its first lane (a velocity setpoint every mission tick).
+  rig.Commit(rig.proposals()[0]);
+  rig.Commit(rig.proposals()[1]);
+  EXPECT_EQ(rig.mission().phase(), raft::MissionPhase::kSearch);
+  rig.position() = Vec3(0, 0, 30);
+  const std::vector<Sent> sent = rig.Run(1.0, "velocity", true);
+  ASSERT_GE(sent.size(), 9u);
+  EXPECT_EQ(sent.back().kind, "velocity");
+  EXPECT_EQ(rig.brain().mode(), "scout/searching");
+}
+
+TEST(SarBrainScout, WaitsForEveryMemberBeforeStartingAndReadsTheirRoles) {
+  BrainRig rig(Scout("scout_1", {"scout_1", "lifter"}));
+  rig.position() = Vec3(0, 0, 0.23);
+  rig.Run(3.0, "idle");
+  EXPECT_EQ(rig.brain().mode(), "scout/on_ground");  // not started: the lifter is unheard
+  rig.Hear("lifter", "lifter/on_ground", Vec3(0, -10, 0.6), 3.0);
+  rig.Hear("ground_station", "scout/on_ground", Vec3::Zero(), 3.0);  // not a member: ignored
+  const brain::Output& out = rig.Step("idle");
+  ASSERT_TRUE(HasEvent(out, "mission_start"));
+  EXPECT_EQ(out.events.front().name, "mission_start");
+  EXPECT_EQ(Field(out.events.front(), "lifter_present"), "true");
+}
+
+// The leader's roster ages each peer on the simulated clock: a scout whose DroneState stops is
+// gone after member_timeout_s (6 s) and its committed sector is handed over through Raft.
+TEST(SarBrainScout, LeadingItHandsASilentPeersSectorOverAfterTheMemberTimeout) {
+  BrainRig rig(Scout("scout_1", {"scout_1", "scout_2"}));
+  rig.Commit(raft::AssignSectors{{{"scout_1", -92, -92, 0, 92}, {"scout_2", 0, -92, 92, 92}}});
+  rig.Commit(raft::StartSearch{});
+  rig.position() = Vec3(0, 0, 30);
+  const auto handed_over = [&] {
+    for (const raft::MissionCommand& c : rig.proposals()) {
+      if (std::holds_alternative<raft::AssignSectors>(c)) return true;
+    }
+    return false;
+  };
+  for (double t = 0.0; t < 10.0; t += 0.5) {  // heard at 5 Hz (every other half second here)
+    rig.Hear("scout_2", "scout/searching", Vec3(50, 0, 30), t);
+    rig.Run(0.5, "velocity", /*leader=*/true);
+  }
+  EXPECT_FALSE(handed_over());
+  rig.Run(5.0, "velocity", true);  // last state taken at 9.5 s: 5.5 s of silence
+  EXPECT_FALSE(handed_over());
+  rig.Run(1.5, "velocity", true);
+  ASSERT_TRUE(handed_over());
+  for (const raft::MissionCommand& c : rig.proposals()) {
+    const auto* a = std::get_if<raft::AssignSectors>(&c);
+    if (a == nullptr) continue;
+    for (const raft::Sector& sector : a->sectors) EXPECT_EQ(sector.drone, "scout_1");
+    EXPECT_EQ(a->sectors.size(), 2u);
+  }
+}
+
+// netem's side channel (the node stamps each DroneState when it takes it off the radio): at rtf
+// 0 the world runs ~10x faster than the radio delivers, so 6 s of simulated silence is 0.6 s of
+// wall time, a delayed sample, not a lost drone; the sector goes over once the peer is also 3 s
+// silent on the wall clock. At rtf 1 the 6 s simulated timeout decides, as without wall times.
+TEST(SarBrainScout, AtRtf0APeerIsLostOnlyWhenAlsoSilentOnTheWallClock) {
+  for (const double speed_up : {10.0, 1.0}) {
+    SCOPED_TRACE("speed-up " + std::to_string(speed_up));
+    BrainRig rig(Scout("scout_1", {"scout_1", "scout_2"}), /*netem_wall=*/true);
+    rig.SetSpeedUp(speed_up);
+    rig.Commit(raft::AssignSectors{{{"scout_1", -92, -92, 0, 92}, {"scout_2", 0, -92, 92, 92}}});
+    rig.Commit(raft::StartSearch{});
+    rig.position() = Vec3(0, 0, 30);
+    const auto handed_over = [&] {
+      for (const raft::MissionCommand& c : rig.proposals()) {
+        if (std::holds_alternative<raft::AssignSectors>(c)) return true;
+      }
+      return false;
+    };
+    for (double t = 0.0; t < 10.0; t += 0.5) {
+      rig.Hear("scout_2", "scout/searching", Vec3(50, 0, 30), t);
+      rig.Run(0.5, "velocity", /*leader=*/true);
+    }
+    rig.Run(5.0, "velocity", true);  // last state taken at 9.5 s: 5.5 s of silence
+    EXPECT_FALSE(handed_over());
+    rig.Run(1.5, "velocity", true);  // 7 s simulated: 7 s wall at rtf 1, 0.7 s at 10x
+    if (speed_up == 1.0) {
+      EXPECT_TRUE(handed_over());
+      continue;
+    }
+    EXPECT_FALSE(handed_over());
+    rig.Run(21.0, "velocity", true);  // 28 s simulated, 2.8 s wall
+    EXPECT_FALSE(handed_over());
+    rig.Run(3.0, "velocity", true);   // 31 s simulated, 3.1 s wall
+    EXPECT_TRUE(handed_over());
+  }
+}
+
+// Without the side channel (the simulated channel, any library host) the same speed-up does not
+// matter: the simulated rule alone decides, after 6 s.
+TEST(SarBrainScout, WithoutTheSideChannelTheSimulatedRuleDecidesAlone) {
+  BrainRig rig(Scout("scout_1", {"scout_1", "scout_2"}));
+  rig.SetSpeedUp(10.0);
+  rig.Commit(raft::AssignSectors{{{"scout_1", -92, -92, 0, 92}, {"scout_2", 0, -92, 92, 92}}});
+  rig.Commit(raft::StartSearch{});
+  rig.position() = Vec3(0, 0, 30);
+  for (double t = 0.0; t < 10.0; t += 0.5) {
+    rig.Hear("scout_2", "scout/searching", Vec3(50, 0, 30), t);
+    rig.Run(0.5, "velocity", /*leader=*/true);
+  }
+  rig.Run(7.0, "velocity", true);
+  bool handed_over = false;
+  for (const raft::MissionCommand& c : rig.proposals()) handed_over = handed_over || std::holds_alternative<raft::AssignSectors>(c);
+  EXPECT_TRUE(handed_over);
+}
+
+TEST(SarBrainLifter, TheLoadCheckDropsAnAttachTheWorldDidNotCarryOut) {
+  SarBrainConfig c;
+  c.name = "lifter";
+  c.members = {"lifter"};
+  c.airframe = "x8_heavy";
+  c.payload = "stretcher";
+  c.base_height_m = 0.6;
+  c.vehicle_mass_kg = 120.0;
+  c.has_home = true;
+  c.payload_offset_m = Eigen::Vector2d(0, -3);
+  BrainRig rig(c);
+  // A rescue for this lifter is committed.
+  rig.Commit(raft::AssignSectors{{{"scout_1", -50, -50, 50, 50}}});
+  rig.Commit(raft::StartSearch{});
+  rig.Commit(raft::ConfirmVictim{"operator", 40, 0});
+  rig.Commit(raft::ConvergeOn{1});
+  rig.Commit(raft::BeginRescue{1, "lifter"});
+  ASSERT_EQ(rig.mission().phase(), raft::MissionPhase::kRescue);
+  rig.position() = Vec3(0, 0, 0.6);
+  rig.Run(0.2, "idle");
+  EXPECT_EQ(rig.brain().mode(), "lifter/takeoff_for_pickup");
+  // Hover settled over the stretcher at the hook height: the attach goes out as a command.
+  rig.position() = Vec3(0, -3, 4.525);
+  bool attach = false;
+  for (int k = 0; k < 1000 && !attach; ++k) {
+    const brain::Output& out = rig.Step("position");
+    for (const brain::Command& cmd : out.commands) {
+      if (cmd.kind != brain::Command::Kind::kPayloadAttach) continue;
+      attach = true;
+      EXPECT_DOUBLE_EQ(cmd.param, 15.0);
+    }
+  }
+  ASSERT_TRUE(attach);
+  EXPECT_TRUE(rig.brain().payload_attached());
+  // Climbing 4 m higher, 5 s later, the flight stack still feels only the empty airframe.
+  rig.position() = Vec3(0, -3, 8.6);
+  bool missing = false;
+  for (int k = 0; k < 2000 && !missing; ++k) missing = HasEvent(rig.Step("position", false, false, 120.5), "payload_missing");
+  ASSERT_TRUE(missing);
+  EXPECT_FALSE(rig.brain().payload_attached());
+  rig.Run(0.3, "position");
+  EXPECT_EQ(rig.brain().mode(), "lifter/takeoff_for_pickup");  // back over the stretcher
+}
+
+// The ReplicatedState is the mission: its snapshot restores an equal state on another brain,
+// and bytes that are not a snapshot are refused.
+TEST(SarMissionState, SnapshotRestoresTheCommittedMissionAndRefusesGarbage) {
+  BrainRig rig(Scout("scout_1", {"scout_1"}));
+  rig.Commit(raft::AssignSectors{{{"scout_1", -92, -92, 92, 92}}});
+  rig.Commit(raft::StartSearch{});
+  rig.Commit(raft::ConfirmVictim{"operator", 40, 0});
+  auto other = (*SarBrain::Create(Scout("scout_1", {"scout_1"})))->MakeReplicatedState();
+  std::unique_ptr<brain::ReplicatedState> copy = rig.brain().MakeReplicatedState();
+  // The rig's own state holds the three entries; a fresh state of another brain takes its snapshot.
+  const auto& held = rig.mission();
+  ASSERT_EQ(held.victims().size(), 1u);
+  SarMissionState restored({});
+  ASSERT_TRUE(restored.Restore(held.EncodeSnapshot()));
+  EXPECT_EQ(restored.mission(), held);
+  EXPECT_EQ(restored.Snapshot(), held.EncodeSnapshot());
+  const std::vector<std::uint8_t> garbage = {0xff, 0x00, 0x13};
+  EXPECT_FALSE(other->Restore(garbage));
+  // Entries that do not decode change nothing, the same way everywhere.
+  copy->Apply(1, garbage);
+  EXPECT_EQ(dynamic_cast<const SarMissionState&>(*copy).mission().phase(), raft::MissionPhase::kIdle);
+}
+
+// The agent's wiring in small: SarBrain inside BrainHost with a fake flight stack and consensus,
+// its state applied as Raft would. The take-off is a flight-stack take-off, the climb a Position
+// kind, the lane a Velocity kind (FromTrajectory keeps the smoothed kinds for position-only and
+// velocity-only setpoints); the leader's proposals reach the consensus as MissionCommands.
+class RecordingFlight final : public FlightPort {
+ public:
+  bool Command(const flight::Setpoint& sp) override {
+    kinds.push_back(sp.kind);
+    values.push_back(sp.value);
+    return true;
+  }
+  void SetPayloadMass(double /*kg*/) override {}
+  std::vector<flight::Setpoint::Kind> kinds;
+  std::vector<Vec3> values;
+};
+
+class LeadingConsensus final : public ConsensusPort {
+ public:
+  bool is_leader() const override { return true; }
+  std::string leader() const override { return "scout_1"; }
+  void TakeCommitted(std::vector<brain::Entry>* /*out*/) override {}
+  bool Propose(std::span<const std::uint8_t> data) override {
+    auto c = raft::DecodeCommand(data);
+    EXPECT_TRUE(c.ok());
+    if (c.ok()) proposals.push_back(*c);
+    return true;
+  }
+  std::vector<raft::MissionCommand> proposals;
+};
+
+TEST(SarBrainOnBrainHost, TakesOffClimbsAndSearchesThroughTheHostAlone) {
+  auto made = SarBrain::Create(Scout("scout_1", {"scout_1"}));
+  ASSERT_TRUE(made.ok());
+  SarBrain* sar = made->get();
+  std::unique_ptr<SarMissionState> state = sar->MakeMissionState();
+  RecordingFlight flight;
+  LeadingConsensus consensus;
+  BrainHostOptions bo;
+  bo.self = "scout_1";
+  bo.state = state.get();
+  BrainHost host(bo, std::move(*made), flight, nullptr, &consensus, nullptr);
+  brain::Vehicle v;
+  std::uint64_t step = 0;
+  std::vector<bus::WorldCommand> world;
+  const auto run = [&](double seconds, const std::string& mode, double z) {
+    v.flight_mode = mode;
+    v.landed = mode == "idle";
+    v.position_m = {0, 0, z};
+    for (const std::uint64_t end = step + static_cast<std::uint64_t>(seconds / 0.004); step < end;) {
+      ++step;
+      host.Step(step, static_cast<std::int64_t>(step) * 4'000'000, v, &world);
+    }
+  };
+  run(2.5, "idle", 0.23);
+  ASSERT_FALSE(flight.kinds.empty());
+  EXPECT_EQ(flight.kinds.front(), flight::Setpoint::Kind::kTakeoff);
+  EXPECT_DOUBLE_EQ(flight.values.front().z(), 3.0);
+  EXPECT_EQ(host.status(), "scout/taking_off");
+  flight.kinds.clear();
+  flight.values.clear();
+  run(0.5, "hold", 3.2);
+  ASSERT_EQ(flight.kinds.size(), 1u);
+  EXPECT_EQ(flight.kinds[0], flight::Setpoint::Kind::kPosition);
+  EXPECT_EQ(flight.values[0], Vec3(0, 0, 30));
+  run(0.5, "position", 29.5);
+  ASSERT_EQ(consensus.proposals.size(), 2u);
+  std::uint64_t index = 0;
+  for (const raft::MissionCommand& c : consensus.proposals) state->Apply(++index, raft::EncodeCommand(c));  // as Raft
+  EXPECT_EQ(state->mission().phase(), raft::MissionPhase::kSearch);
+  run(1.0, "velocity", 30.0);
+  EXPECT_EQ(flight.kinds.back(), flight::Setpoint::Kind::kVelocity);
+  EXPECT_EQ(host.status(), "scout/searching");
+  EXPECT_TRUE(world.empty());  // a scout has no payload
+}
+
+}  // namespace
+}  // namespace swarmbox::agent
