@@ -155,9 +155,7 @@ class BrainHost {
   bool warned_consensus_ = false;
 };
 
-// The brain's view of this drone: the flight stack's `estimate`-derived fields the node fills
-// (see agent_node.cpp) in one place, for the tests as well: mode names as flight::FlightModeName,
-// landed for init/idle/landed.
+// brain::Vehicle::landed of a flight mode: init, idle and landed (on the ground, motors off).
 bool LandedMode(flight::FlightMode mode);
 
 // flight::FlightEvent -> brain::FlightEvent: name flight::FlightEventName, t_ns, fields x, y, z
