@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <utility>
 
 #include "brain_convert.hpp"
@@ -208,9 +209,21 @@ void BrainHost::Step(std::uint64_t step, std::int64_t t_ns, const brain::Vehicle
   if (step % static_cast<std::uint64_t>(options_.period_steps) == 0) {
     BuildInput(t_ns, vehicle);
     out_.Clear();
-    brain_->Step(in_, out_);
-    ++brain_steps_;
-    answered = remote_ == nullptr || remote_->answered();
+    if (!failed_) {
+      try {
+        brain_->Step(in_, out_);
+        ++brain_steps_;
+        answered = remote_ == nullptr || remote_->answered();
+      } catch (const std::exception& e) {
+        // A broken contract (Step must not throw): the brain is not called again, its state is
+        // unknown; the offboard failsafe brings the drone down.
+        failed_ = true;
+        Log(LogEvent(t_s, options_.self, "brain_failed").Add("reason", e.what()));
+      } catch (...) {
+        failed_ = true;
+        Log(LogEvent(t_s, options_.self, "brain_failed").Add("reason", "a non-standard exception"));
+      }
+    }
     flight_events_.clear();
     messages_.clear();
     detections_.clear();

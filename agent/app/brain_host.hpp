@@ -32,6 +32,8 @@
 // timeout -> hold, then land; while it holds or lands the brain's commands and setpoints are not
 // flown (its messages, proposals, status and events still are). Its events are logged and also
 // handed to the brain as flight events (offboard_lost, offboard_regained, offboard_failsafe).
+// A brain whose Step throws (it must not) is logged (`event=brain_failed reason=..`) and never
+// called again: it no longer answers, so the failsafe holds, then lands.
 // Time: only the step's simulated time; nothing here reads a clock. Not thread-safe (the control
 // loop owns it). Ownership: `flight`, `radio`, `consensus` and `log` outlive the host.
 #pragma once
@@ -113,7 +115,8 @@ class BrainHost {
   const std::string& status() const { return status_; }  // the brain's last Output::status
   double payload_mass_kg() const { return payload_mass_kg_; }
   flight::OffboardFailsafe::Action failsafe() const { return failsafe_.action(); }
-  std::uint64_t brain_steps() const { return brain_steps_; }  // Step calls of the brain
+  std::uint64_t brain_steps() const { return brain_steps_; }  // Step calls of the brain that returned
+  bool failed() const { return failed_; }
   std::uint64_t answers() const { return answers_; }          // ... that answered
   brain::Brain& brain() { return *brain_; }
 
@@ -151,13 +154,12 @@ class BrainHost {
   std::uint64_t answers_ = 0;
   brain::Setpoint flown_;  // the setpoint last commanded (has_flown_: and accepted since)
   bool has_flown_ = false;
+  bool failed_ = false;  // the brain threw: never called again
   bool warned_radio_ = false;
   bool warned_consensus_ = false;
 };
 
-// The brain's view of this drone: the flight stack's `estimate`-derived fields the node fills
-// (see agent_node.cpp) in one place, for the tests as well: mode names as flight::FlightModeName,
-// landed for init/idle/landed.
+// brain::Vehicle::landed of a flight mode: init, idle and landed (on the ground, motors off).
 bool LandedMode(flight::FlightMode mode);
 
 // flight::FlightEvent -> brain::FlightEvent: name flight::FlightEventName, t_ns, fields x, y, z

@@ -63,6 +63,13 @@ Result<int> BrainPeriodSteps(const BrainOptions& o, double control_dt_s) {
                                                   ": the brain runs every whole number of lockstep steps (" +
                                                   std::to_string(n) + " per second): e.g. " + ok);
   }
+  const double period_ms = whole * control_dt_s * 1e3;
+  if (period_ms >= o.offboard_timeout_ms) {
+    char what[96];
+    std::snprintf(what, sizeof what, "the brain period (%g ms) must be shorter than --offboard-timeout-ms (%d)", period_ms,
+                  o.offboard_timeout_ms);
+    return Error(ErrorCode::kInvalidArgument, std::string(what) + ": a brain answering at every period would be lost between two");
+  }
   return static_cast<int>(whole);
 }
 

@@ -44,7 +44,8 @@ inline constexpr double kExternalDefaultRateHz = 50.0;
 Status ValidateBrainOptions(const BrainOptions& options, bool mission_given, bool plan_given);
 
 // The brain period in lockstep steps of `control_dt_s`: round(1 / (rate_hz * dt)), which must be
-// a whole number >= 1 (kInvalidArgument naming the rates that are: 250, 125, 50, ... at 4 ms).
+// a whole number >= 1 (kInvalidArgument naming the rates that are: 250, 125, 50, ... at 4 ms),
+// and shorter than the offboard timeout (else the failsafe would fire between two periods).
 Result<int> BrainPeriodSteps(const BrainOptions& options, double control_dt_s);
 
 }  // namespace swarmbox::agent

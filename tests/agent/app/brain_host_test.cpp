@@ -9,6 +9,7 @@
 
 #include <cstdio>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -348,6 +349,22 @@ TEST(BrainHost, CommandsAStreamedSetpointOnceUntilItChangesOrACommandComes) {
   EXPECT_EQ(rig.flight.commands, (std::vector<std::string>{"trajectory", "hold", "trajectory", "trajectory"}));
   EXPECT_TRUE(SameSetpoint(brain::Setpoint{}, brain::Setpoint{}));
   EXPECT_FALSE(SameSetpoint(brain::Setpoint{}, brain::Setpoint::Velocity({0, 0, 0})));
+}
+
+TEST(BrainHost, ABrainThatThrowsIsNotCalledAgainAndTheFailsafeLands) {
+  Rig rig;
+  int calls = 0;
+  rig.Make(std::make_unique<ScriptBrain>(&rig.seen, [&calls](const brain::Input& in, brain::Output& out) {
+    ++calls;
+    if (in.t_ns >= 1'000'000'000) throw std::runtime_error("division by zero in the flocking law");
+    out.setpoint.push_back(brain::Setpoint::Velocity({1, 0, 0}));
+  }), 5, 1.0, 1.0);
+  for (std::uint64_t k = 0; k <= 1000; ++k) rig.Step(k);  // 4 s
+  EXPECT_EQ(calls, 51);  // t = 0 .. 1 s every 20 ms; never after the throw
+  EXPECT_TRUE(rig.host->failed());
+  EXPECT_EQ(rig.lines.Events(), (std::vector<std::string>{"brain_failed", "offboard_lost", "offboard_failsafe"}));
+  EXPECT_NE(rig.lines.Read()[0].find("reason=\"division by zero in the flocking law\""), std::string::npos);
+  EXPECT_EQ(rig.flight.commands, (std::vector<std::string>{"velocity", "hold", "land"}));
 }
 
 TEST(BrainHost, OnTheGroundTheFailsafeCommandsNothing) {

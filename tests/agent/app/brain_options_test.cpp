@@ -69,6 +69,14 @@ TEST(BrainOptions, ThePeriodIsAWholeNumberOfLockstepSteps) {
   EXPECT_EQ(*BrainPeriodSteps(o, 0.004), 4);
   o.rate_hz = 500;  // faster than the lockstep
   EXPECT_FALSE(BrainPeriodSteps(o, 0.004));
+  o.rate_hz = 1;  // a period of 1000 ms: as long as the offboard timeout
+  auto slow = BrainPeriodSteps(o, 0.004);
+  ASSERT_FALSE(slow);
+  EXPECT_NE(slow.error().ToString().find("the brain period (1000 ms) must be shorter than --offboard-timeout-ms (1000)"),
+            std::string::npos)
+      << slow.error().ToString();
+  o.offboard_timeout_ms = 1500;
+  EXPECT_EQ(*BrainPeriodSteps(o, 0.004), 250);
 }
 
 }  // namespace
