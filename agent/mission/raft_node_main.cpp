@@ -87,6 +87,7 @@ int main(int argc, char** argv) {
   }
   mission::RaftServiceConfig cfg;
   cfg.driver = opts->driver;
+  cfg.driver.tap_committed = false;  // the demo reads the mission's state, never the entries
   cfg.data_dir = opts->data_dir;
   auto service = mission::RaftService::Start(cfg, **radio, clock);
   if (!service) {

@@ -99,7 +99,7 @@ Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config,
                        std::to_string(m->mission().applied_index()),
                    "raft storage");
     }
-    machine->ReplayRestored(0, &tap);
+    if (config.tap_committed) machine->ReplayRestored(0, &tap);
   }
   auto node = RawNode::Create(*rc, std::move(*state));
   if (!node) return node.error().Context("restarting raft");
@@ -198,7 +198,7 @@ void NodeDriver::ApplyEntry(const Entry& e) {
   const bool noop = e.type == EntryType::kEmpty || e.data.empty();
   const std::span<const std::uint8_t> data = noop ? std::span<const std::uint8_t>() : e.data;
   machine_->Apply(e.index, data, EventOut(clock_.NowS(), config_.self, sink_));
-  if (!noop) tap_.push_back(Committed{e.index, e.data});
+  if (!noop && config_.tap_committed) tap_.push_back(Committed{e.index, e.data});
 }
 
 Status NodeDriver::Process() {
@@ -240,7 +240,7 @@ Status NodeDriver::Process() {
       }
       machine_->OnSnapshotInstalled(rd.snapshot.index,
                                     EventOut(clock_.NowS(), config_.self, sink_));
-      machine_->ReplayRestored(before, &tap_);
+      if (config_.tap_committed) machine_->ReplayRestored(before, &tap_);
     }
     for (const Entry& e : rd.committed_entries) ApplyEntry(e);
     node_.Advance(rd);

@@ -351,6 +351,24 @@ TEST_F(DriverCluster, EntryLogTapReplaysTheWholeLogAfterRestartAndSnapshot) {
   EXPECT_EQ(drivers_[other]->machine().Snapshot(), drivers_[leader]->machine().Snapshot());
 }
 
+// A node whose application reads only the state keeps no tap.
+TEST(NodeDriver, TapOffKeepsNothing) {
+  MemoryStorage st;
+  std::deque<Packet> air;
+  FakeRadio radio("solo", &air);
+  FakeClock clock;
+  DriverConfig c = Cfg("solo", {"solo"});
+  c.tap_committed = false;
+  auto d = NodeDriver::Open(c, st, radio, clock, nullptr);
+  ASSERT_TRUE(d.ok());
+  for (int i = 0; i < 30 && !(*d)->is_leader(); ++i) ASSERT_TRUE((*d)->Tick().ok());
+  ASSERT_TRUE((*d)->Propose(StartSearch{}).ok());
+  EXPECT_EQ((*d)->mission().phase(), MissionPhase::kSearch);
+  std::vector<Committed> got = {Committed{99, Bytes{1}}};
+  (*d)->TakeCommitted(&got);
+  EXPECT_TRUE(got.empty());
+}
+
 TEST(NodeDriver, ConfigurationErrorsNameTheProblem) {
   MemoryStorage st;
   std::deque<Packet> air;

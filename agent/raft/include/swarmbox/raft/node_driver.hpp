@@ -25,7 +25,8 @@
 //     stands for those entries);
 //   - then the committed entries after the snapshot, re-applied from the log, one by one.
 // Within one driver the tap never yields an index twice nor goes back. The tap keeps everything
-// until taken (callers that never read it keep the log a second time in memory).
+// until taken; a node whose application reads only the machine's state sets
+// DriverConfig::tap_committed = false (TakeCommitted then yields nothing, nothing is kept).
 //
 // Usage (the agent's Raft thread, or its event loop; the driver is not thread-safe):
 //
@@ -104,6 +105,7 @@ struct DriverConfig {
   std::uint64_t seed = 1;
   std::uint64_t snapshot_every_entries = 64;  // compact the log after this many applied entries
   std::size_t max_entries_per_msg = 64;
+  bool tap_committed = true;  // keep applied entries for TakeCommitted (see the banner)
 
   // The RawNode config this gives (ids are 1 + the position in the sorted member list), or
   // kInvalidArgument naming the problem.
