@@ -157,8 +157,8 @@ TEST(CBrainRendezvous, ThreeDronesMeetOnTheRingAndLand) {
   // -3pi/4, scout_c atan2(-10, 20), scout_b atan2(20, -10). So scout_a ranks first and keeps its
   // bearing, scout_c is 2pi/3 further round, scout_b 4pi/3.
   double min_gap_m = 1e9;
-  const auto drones = Fleet({"scout_c", "scout_a", "scout_b"}, {{{30.0, 0.0}}, {{0.0, 0.0}}, {{0.0, 30.0}}}, 120.0,
-                            &end_ns, &min_gap_m);
+  const auto drones = Fleet({"scout_c", "scout_a", "scout_b"}, {{{30.0, 0.0}}, {{0.0, 0.0}}, {{0.0, 30.0}}},
+                            120.0, &end_ns, &min_gap_m);
   const double a0 = std::atan2(-10.0, -10.0);
   const double rank[3] = {1.0, 0.0, 2.0};  // scout_c, scout_a, scout_b
   const std::vector<std::string> phases = {"rendezvous/takeoff", "rendezvous/voting", "rendezvous/flying",

@@ -45,9 +45,7 @@ std::string Fixed3(double v) {
 }
 
 // Member i's name: "m00", "m01", ... (sorted order = index order).
-std::string Name(std::size_t i) {
-  return (i < 10 ? "m0" : "m") + std::to_string(i);
-}
+std::string Name(std::size_t i) { return (i < 10 ? "m0" : "m") + std::to_string(i); }
 
 std::vector<std::string> PosEntries(const Layout& l) {
   std::vector<std::string> entries;
@@ -100,7 +98,9 @@ std::vector<Layout> Random(std::size_t count) {
     Layout l{"random " + std::to_string(k), {}, {}};
     for (std::size_t i = 0; i < n; ++i) {
       const auto mm = [&](std::uint64_t span) {
-        return static_cast<double>(static_cast<std::int64_t>(rng() % (2 * span + 1)) - static_cast<std::int64_t>(span)) / 1000.0;
+        const auto mm_from_zero =
+            static_cast<std::int64_t>(rng() % (2 * span + 1)) - static_cast<std::int64_t>(span);
+        return static_cast<double>(mm_from_zero) / 1000.0;
       };
       if (kind == 2 && i > 0 && rng() % 3 == 0) {
         const std::size_t twin = static_cast<std::size_t>(rng() % i);
@@ -137,12 +137,22 @@ Answer CBrain(const std::vector<std::string>& entries, std::size_t n, std::size_
   for (const std::string& e : entries) {
     rv_apply_entry(&s, reinterpret_cast<const std::uint8_t*>(e.data()), e.size());
   }
-  rv_input in{.t_ns = 0, .position_enu_m = {0.0, 0.0, 0.0}, .flight_mode = "idle", .landed = true,
-              .hover_event = false, .rejected_event = false, .landed_event = false};
+  rv_input in{.t_ns = 0,
+              .position_enu_m = {0.0, 0.0, 0.0},
+              .flight_mode = "idle",
+              .landed = true,
+              .hover_event = false,
+              .rejected_event = false,
+              .landed_event = false};
   rv_output out;
   rv_step(&s, &in, &out);  // takeoff
-  in = {.t_ns = 20'000'000, .position_enu_m = {0.0, 0.0, 10.0}, .flight_mode = "hold", .landed = false,
-        .hover_event = true, .rejected_event = false, .landed_event = false};
+  in = {.t_ns = 20'000'000,
+        .position_enu_m = {0.0, 0.0, 10.0},
+        .flight_mode = "hold",
+        .landed = false,
+        .hover_event = true,
+        .rejected_event = false,
+        .landed_event = false};
   rv_step(&s, &in, &out);
   EXPECT_TRUE(out.has_setpoint);
   EXPECT_EQ(out.n_events, 1u);

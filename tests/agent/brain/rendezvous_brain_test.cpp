@@ -208,7 +208,9 @@ Outcome RunSwarmFrom(const std::vector<sb::Vec3>& starts, bool lose_first = fals
       for (std::size_t j = i + 1; j < n; ++j) {
         const sb::Vec3& a = o.drones[i].flight.position;
         const sb::Vec3& b = o.drones[j].flight.position;
-        if (a.z > 0.0 && b.z > 0.0) o.min_gap_m = std::min(o.min_gap_m, std::hypot(a.x - b.x, a.y - b.y));
+        if (a.z > 0.0 && b.z > 0.0) {
+          o.min_gap_m = std::min(o.min_gap_m, std::hypot(a.x - b.x, a.y - b.y));
+        }
       }
     }
     o.trace += "\n";
@@ -217,7 +219,9 @@ Outcome RunSwarmFrom(const std::vector<sb::Vec3>& starts, bool lose_first = fals
   return o;
 }
 
-Outcome RunSwarm(std::size_t n, bool lose_first = false) { return RunSwarmFrom(ScatteredStarts(n), lose_first); }
+Outcome RunSwarm(std::size_t n, bool lose_first = false) {
+  return RunSwarmFrom(ScatteredStarts(n), lose_first);
+}
 
 const sb::Event* FindEvent(const Drone& d, const std::string& name) {
   for (const sb::Event& e : d.events) {
