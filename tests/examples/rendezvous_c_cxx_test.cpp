@@ -173,6 +173,7 @@ Answer CxxBrain(const std::vector<std::string>& entries, std::size_t n, std::siz
   sb::Output out;
   brain.Step(in, out);  // takeoff
   std::vector<sb::Entry> committed;
+  committed.reserve(entries.size());
   std::uint64_t index = 0;
   for (const std::string& e : entries) committed.push_back({++index, {e.begin(), e.end()}});
   const std::vector<sb::FlightEvent> hover = {{"hover", 0, {}}};
