@@ -100,21 +100,62 @@ static bool due(bool proposed, int64_t proposed_ns, int64_t t_ns) {
   return !proposed || t_ns - proposed_ns >= RV_REPROPOSE_NS;
 }
 
+/* Whether member j comes before member i on the ring (rendezvous.h, rv_place_ring). */
+static bool ranks_before(size_t j, size_t i, const bool centred[], const double bearing_rad[]) {
+  if (centred[j] != centred[i]) return centred[i]; /* the centred ones after all the others */
+  if (!centred[i] && bearing_rad[j] != bearing_rad[i]) return bearing_rad[j] < bearing_rad[i];
+  return j < i; /* the same bearing (exactly), or both centred: by name */
+}
+
+void rv_place_ring(size_t n, const double x_m[], const double y_m[], double radius_m,
+                   double point_m[2], double slot_x_m[], double slot_y_m[]) {
+  double sum_x = 0.0;
+  double sum_y = 0.0;
+  for (size_t i = 0; i < n; ++i) { /* sorted member order: the same sum everywhere */
+    sum_x += x_m[i];
+    sum_y += y_m[i];
+  }
+  const double count = (double)n;
+  point_m[0] = sum_x / count;
+  point_m[1] = sum_y / count;
+
+  bool centred[RV_MAX_MEMBERS];
+  double bearing_rad[RV_MAX_MEMBERS];
+  for (size_t i = 0; i < n; ++i) {
+    const double dx = x_m[i] - point_m[0];
+    const double dy = y_m[i] - point_m[1];
+    centred[i] = dx * dx + dy * dy < RV_CENTRED_M2;
+    double b = 0.0;
+    if (!centred[i]) {
+      b = atan2(dy, dx);
+      if (b <= -kPi) b = kPi; /* (-pi, pi]: atan2(-0.0, -1) is -pi */
+    }
+    bearing_rad[i] = b;
+  }
+  size_t rank[RV_MAX_MEMBERS];
+  double a0 = 0.0; /* the first one's bearing; 0 when every member is centred */
+  for (size_t i = 0; i < n; ++i) {
+    rank[i] = 0;
+    for (size_t j = 0; j < n; ++j) {
+      if (j != i && ranks_before(j, i, centred, bearing_rad)) ++rank[i];
+    }
+    if (rank[i] == 0 && !centred[i]) a0 = bearing_rad[i];
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const double a = a0 + 2.0 * kPi * (double)rank[i] / count;
+    slot_x_m[i] = point_m[0] + radius_m * cos(a);
+    slot_y_m[i] = point_m[1] + radius_m * sin(a);
+  }
+}
+
 /* P and this drone's slot, once every member's "pos" is committed. */
 static void place_slot(rv_state *s, rv_output *out) {
   const rv_config *c = &s->config;
-  double sum_x = 0.0;
-  double sum_y = 0.0;
-  for (size_t i = 0; i < c->n_members; ++i) { /* sorted member order: the same sum everywhere */
-    sum_x += s->pos_x_m[i];
-    sum_y += s->pos_y_m[i];
-  }
-  const double n = (double)c->n_members;
-  s->point_m[0] = sum_x / n;
-  s->point_m[1] = sum_y / n;
-  const double a = 2.0 * kPi * (double)c->self / n;
-  s->slot_m[0] = s->point_m[0] + c->radius_m * cos(a);
-  s->slot_m[1] = s->point_m[1] + c->radius_m * sin(a);
+  double slot_x_m[RV_MAX_MEMBERS];
+  double slot_y_m[RV_MAX_MEMBERS];
+  rv_place_ring(c->n_members, s->pos_x_m, s->pos_y_m, c->radius_m, s->point_m, slot_x_m, slot_y_m);
+  s->slot_m[0] = slot_x_m[c->self];
+  s->slot_m[1] = slot_y_m[c->self];
   s->point_known = true;
 
   char value[32];

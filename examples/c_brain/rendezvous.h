@@ -25,10 +25,9 @@
  *   rendezvous/voting   hovering (flight event "hover", or mode "hold" above altitude_m - 1 m):
  *                       propose "pos" (where it is at that first step); the same entry again
  *                       every 2 s until its own "pos" is committed
- *   rendezvous/flying   a "pos" of every member committed: P = their mean (summed in sorted member
- *                       order); slot i (index in sorted members) = P + radius_m (cos a, sin a),
- *                       a = 2 pi i / N; a position setpoint (slot, altitude_m) every step, yaw unset;
- *                       event rendezvous_point x=.. y=.. once
+ *   rendezvous/flying   a "pos" of every member committed: P and its slot (rv_place_ring: the
+ *                       members keep their angular order around P); a position setpoint (slot,
+ *                       altitude_m) every step, yaw unset; event rendezvous_point x=.. y=.. once
  *   rendezvous/arrived  within 1.0 m of the slot horizontally: propose "arrived"; again every 2 s
  *                       until committed; the setpoint stays
  *   rendezvous/landing  "arrived" of every member committed: hold_s more on the slot, then the
@@ -52,6 +51,7 @@ extern "C" {
 #define RV_ENTRY_MAX 160 /* an entry's text + NUL */
 #define RV_REPROPOSE_NS INT64_C(2000000000)
 #define RV_ARRIVED_RADIUS_M 1.0
+#define RV_CENTRED_M2 1e-4 /* [m^2] a member this close to P (squared: 0.01 m) has no bearing */
 
 typedef struct rv_config {
   double altitude_m; /* [m] above the start, also the ring's height */
@@ -128,6 +128,22 @@ typedef struct rv_state {
 } rv_state;
 
 void rv_init(rv_state *s, const rv_config *config);
+
+/* The ring (the C++ example brain computes it with the same operations in the same order, so the
+ * two agree bit for bit; compile without FMA contraction, -ffp-contract=off). Members 0..n-1 in
+ * sorted member order (n <= RV_MAX_MEMBERS), at (x_m[i], y_m[i]) as read from their "pos" entries:
+ *   P = (sum of x_m in index order / n, sum of y_m / n);
+ *   dx = x_m[i] - P.x, dy = y_m[i] - P.y; member i is centred when dx*dx + dy*dy < 1e-4 (0.01 m),
+ *   else its bearing is b_i = atan2(dy, dx), with -pi taken as +pi (so b_i is in (-pi, pi]);
+ *   rank: the members that are not centred by increasing b_i (equal doubles: by index, i.e. name),
+ *   then the centred ones by index;
+ *   a0 = the bearing of rank 0 (0.0 when every member is centred);
+ *   slot of rank r: a = a0 + 2.0 * pi * r / n (left to right, in doubles),
+ *   (P.x + radius_m * cos(a), P.y + radius_m * sin(a)).
+ * Each drone thus keeps its angular order around P: the first one flies straight out (or in) along
+ * its bearing and the others follow round the ring, so two drones never swap sides. */
+void rv_place_ring(size_t n, const double x_m[], const double y_m[], double radius_m,
+                   double point_m[2], double slot_x_m[], double slot_y_m[]);
 
 /* Applies one committed entry (any bytes; what is not a rendezvous entry is ignored). */
 void rv_apply_entry(rv_state *s, const uint8_t *data, size_t length);

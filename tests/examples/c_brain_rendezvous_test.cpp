@@ -1,8 +1,9 @@
 // The C brain's rendezvous protocol alone (examples/c_brain/rendezvous.h), no DDS: brains stepped
 // on simulated time with a perfect consensus log (every proposal committed to every drone the next
 // period, in proposal order) and an ideal flight stack (takeoff climbs, a position setpoint is
-// flown at 5 m/s, land descends). Every drone reaches its slot on the ring and logs
-// rendezvous_complete; all agree on the rendezvous point; the same inputs give the same run.
+// flown at 5 m/s, land descends). Every drone reaches its slot on the ring (in the angular order it
+// started in around the point: no two drones swap sides) and logs rendezvous_complete; all agree
+// on the rendezvous point; the same inputs give the same run. rv_place_ring on hand-worked layouts.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -93,8 +94,9 @@ void Fly(Drone& d, const rv_output& out) {
 }
 
 // Runs `drones` (started at `starts`) until every one is done or `max_s` of simulated time.
+// `min_gap_m` (optional): the least horizontal distance between two airborne drones.
 std::vector<Drone> Fleet(const std::vector<std::string>& members, const std::vector<std::array<double, 2>>& starts,
-                       double max_s, std::int64_t* end_ns) {
+                       double max_s, std::int64_t* end_ns, double* min_gap_m = nullptr) {
   std::vector<std::string> sorted = members;
   std::sort(sorted.begin(), sorted.end());
   std::vector<Drone> drones(members.size());
@@ -136,6 +138,13 @@ std::vector<Drone> Fleet(const std::vector<std::string>& members, const std::vec
       Fly(d, out);
       all_done = all_done && d.brain.done;
     }
+    for (std::size_t i = 0; min_gap_m != nullptr && i < drones.size(); ++i) {
+      for (std::size_t j = i + 1; j < drones.size(); ++j) {
+        if (drones[i].pos[2] <= 0.0 || drones[j].pos[2] <= 0.0) continue;
+        *min_gap_m = std::min(*min_gap_m, std::hypot(drones[i].pos[0] - drones[j].pos[0],
+                                                     drones[i].pos[1] - drones[j].pos[1]));
+      }
+    }
     if (all_done) break;
   }
   *end_ns = t;
@@ -144,21 +153,93 @@ std::vector<Drone> Fleet(const std::vector<std::string>& members, const std::vec
 
 TEST(CBrainRendezvous, ThreeDronesMeetOnTheRingAndLand) {
   std::int64_t end_ns = 0;
-  // Not in sorted order: slots follow the sorted order (scout_a index 0, scout_b 1, scout_c 2).
-  const auto drones = Fleet({"scout_c", "scout_a", "scout_b"}, {{{30.0, 0.0}}, {{0.0, 0.0}}, {{0.0, 30.0}}}, 120.0, &end_ns);
+  // Not in sorted order (scout_c, scout_a, scout_b). P = (10, 10); bearings around it: scout_a
+  // -3pi/4, scout_c atan2(-10, 20), scout_b atan2(20, -10). So scout_a ranks first and keeps its
+  // bearing, scout_c is 2pi/3 further round, scout_b 4pi/3.
+  double min_gap_m = 1e9;
+  const auto drones = Fleet({"scout_c", "scout_a", "scout_b"}, {{{30.0, 0.0}}, {{0.0, 0.0}}, {{0.0, 30.0}}},
+                            120.0, &end_ns, &min_gap_m);
+  const double a0 = std::atan2(-10.0, -10.0);
+  const double rank[3] = {1.0, 0.0, 2.0};  // scout_c, scout_a, scout_b
   const std::vector<std::string> phases = {"rendezvous/takeoff", "rendezvous/voting", "rendezvous/flying",
                                            "rendezvous/arrived", "rendezvous/landing", "rendezvous/done"};
-  for (const auto& d : drones) {
+  for (std::size_t i = 0; i < drones.size(); ++i) {
+    const Drone& d = drones[i];
     EXPECT_TRUE(d.brain.done) << "not done at " << static_cast<double>(end_ns) / 1e9 << " s";
     EXPECT_EQ(d.statuses, phases);
     // P = the mean of the positions proposed when hovering: (10, 10).
     EXPECT_EQ(d.events, (std::vector<std::string>{"rendezvous_point x=10.000 y=10.000", "rendezvous_complete members=3"}));
     EXPECT_EQ(d.mode, "landed");
-    const double angle = 2.0 * std::numbers::pi * static_cast<double>(d.brain.config.self) / 3.0;
-    EXPECT_NEAR(d.pos[0], 10.0 + 6.0 * std::cos(angle), 1.0);
-    EXPECT_NEAR(d.pos[1], 10.0 + 6.0 * std::sin(angle), 1.0);
+    const double angle = a0 + 2.0 * std::numbers::pi * rank[i] / 3.0;
+    EXPECT_NEAR(d.pos[0], 10.0 + 6.0 * std::cos(angle), 1e-9) << d.brain.config.members[d.brain.config.self];
+    EXPECT_NEAR(d.pos[1], 10.0 + 6.0 * std::sin(angle), 1e-9) << d.brain.config.members[d.brain.config.self];
   }
   EXPECT_LT(end_ns, 60'000'000'000) << "the rendezvous took longer than a minute of simulated time";
+  EXPECT_GT(min_gap_m, 10.0) << "two drones came close on the way";
+}
+
+// The layout that collided when slots followed the sorted names (scout_1 sent east through scout_2,
+// scout_2 west through scout_1, at the same altitude): each now flies outward on its own side.
+TEST(CBrainRendezvous, TwoDronesOnALineFlyOutwardWithoutSwapping) {
+  std::int64_t end_ns = 0;
+  double min_gap_m = 1e9;
+  const auto drones = Fleet({"scout_1", "scout_2"}, {{{0.0, 0.0}}, {{8.0, 0.0}}}, 120.0, &end_ns, &min_gap_m);
+  ASSERT_TRUE(drones[0].brain.done && drones[1].brain.done);
+  EXPECT_EQ(drones[0].pos[0], -2.0);  // P = (4, 0), radius 6
+  EXPECT_NEAR(drones[0].pos[1], 0.0, 1e-12);
+  EXPECT_EQ(drones[1].pos[0], 10.0);
+  EXPECT_EQ(drones[1].pos[1], 0.0);
+  EXPECT_EQ(min_gap_m, 8.0) << "they only move apart";
+}
+
+TEST(CBrainRendezvous, RingKeepsTheAngularOrderAroundThePoint) {
+  double point[2];
+  double sx[3];
+  double sy[3];
+  // Two on a line: the one at (8, 0) (bearing 0) first, straight out; the other at 0 + pi.
+  const double line_x[2] = {0.0, 8.0};
+  const double line_y[2] = {0.0, 0.0};
+  rv_place_ring(2, line_x, line_y, 6.0, point, sx, sy);
+  EXPECT_EQ(point[0], 4.0);
+  EXPECT_EQ(point[1], 0.0);
+  EXPECT_EQ(sx[1], 10.0);
+  EXPECT_EQ(sy[1], 0.0);
+  EXPECT_EQ(sx[0], -2.0);
+  EXPECT_NEAR(sy[0], 0.0, 1e-12);
+  // "-0.000" read back: atan2(-0.0, -4) = -pi counts as +pi, the same ring bit for bit.
+  const double line_y_negative_zero[2] = {-0.0, 0.0};
+  double nx[2];
+  double ny[2];
+  rv_place_ring(2, line_x, line_y_negative_zero, 6.0, point, nx, ny);
+  EXPECT_EQ(std::memcmp(nx, sx, sizeof nx), 0);
+  EXPECT_EQ(std::memcmp(ny, sy, sizeof ny), 0);
+
+  // A drone on P (closer than 0.01 m) ranks last; the others keep their bearings from member 2's 0.
+  const double pi = std::numbers::pi;
+  const double centre_x[3] = {0.0, 5.0, 10.0};
+  const double centre_y[3] = {0.0, 0.0, 0.0};
+  rv_place_ring(3, centre_x, centre_y, 6.0, point, sx, sy);
+  const double centre_angle[3] = {2.0 * pi / 3.0, 4.0 * pi / 3.0, 0.0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(sx[i], 5.0 + 6.0 * std::cos(centre_angle[i]), 1e-12) << i;
+    EXPECT_NEAR(sy[i], 6.0 * std::sin(centre_angle[i]), 1e-12) << i;
+  }
+
+  // Equal bearings (members 0 and 1 on one ray from P = (0, 0)) rank by name, after member 2.
+  const double ray_x[3] = {1.0, 2.0, -3.0};
+  rv_place_ring(3, ray_x, ray_x, 6.0, point, sx, sy);
+  const double a0 = std::atan2(-3.0, -3.0);
+  const double ray_angle[3] = {a0 + 2.0 * pi / 3.0, a0 + 4.0 * pi / 3.0, a0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(sx[i], 6.0 * std::cos(ray_angle[i]), 1e-12) << i;
+    EXPECT_NEAR(sy[i], 6.0 * std::sin(ray_angle[i]), 1e-12) << i;
+  }
+
+  // Everyone on one spot: a0 = 0, by name.
+  const double spot[2] = {1.0, 1.0};
+  rv_place_ring(2, spot, spot, 6.0, point, sx, sy);
+  EXPECT_EQ(sx[0], 7.0);
+  EXPECT_EQ(sx[1], -5.0);
 }
 
 TEST(CBrainRendezvous, TheSameInputsGiveTheSameRun) {

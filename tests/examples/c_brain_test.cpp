@@ -197,7 +197,9 @@ TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
   EXPECT_EQ(out.status, "rendezvous/voting");
 
   // 3. A `pos` of every member committed (the first per member counts; other entries ignored):
-  // P = mean in sorted member order; scout_2 is index 1 of 3: slot = P + 6 (cos 2pi/3, sin 2pi/3).
+  // P = mean in sorted member order; bearings around P: scout_1 about -2.45 rad, scout_2 -1.62,
+  // scout_3 1.25, so scout_1 ranks first (a0 = its bearing) and scout_2 is 2pi/3 further round:
+  // slot = P + 6 (cos a, sin a), a = a0 + 2pi/3.
   auto all_pos = Input(t += kPeriodNs, "hold", 1.3, -2.5, 10.0);
   Commit(all_pos, 5, "pos scout_1 0.000 0.000");
   Commit(all_pos, 6, "pos scout_2 1.234 -2.500");
@@ -207,7 +209,10 @@ TEST_F(CBrain, FliesTheRendezvousAnsweringEveryInputOnce) {
   out = Exchange(all_pos);
   const double px = ((0.0 + 1.234) + 3.0) / 3.0;
   const double py = ((0.0 + -2.5) + 6.0) / 3.0;
-  const double a = 2.0 * std::numbers::pi * 1.0 / 3.0;
+  const double a0 = std::atan2(0.0 - py, 0.0 - px);
+  ASSERT_LT(a0, std::atan2(-2.5 - py, 1.234 - px));
+  ASSERT_LT(std::atan2(-2.5 - py, 1.234 - px), std::atan2(6.0 - py, 3.0 - px));
+  const double a = a0 + 2.0 * std::numbers::pi * 1.0 / 3.0;
   const double sx = px + 6.0 * std::cos(a);
   const double sy = py + 6.0 * std::sin(a);
   ASSERT_EQ(out.setpoint.size(), 1u);

@@ -63,11 +63,54 @@ std::vector<std::uint8_t> PosEntry(const std::string& name, double x, double y) 
 
 std::vector<std::uint8_t> ArrivedEntry(const std::string& name) { return Bytes("arrived " + name); }
 
-sb::Vec3 Slot(double px, double py, double radius_m, double altitude_m, std::size_t index,
-              std::size_t count) {
-  // Written as the C brain computes it: 2.0 * pi * i / N, left to right, in doubles.
-  const double a = 2.0 * std::numbers::pi * static_cast<double>(index) / static_cast<double>(count);
-  return {px + radius_m * std::cos(a), py + radius_m * std::sin(a), altitude_m};
+Ring PlaceRing(const std::vector<double>& x, const std::vector<double>& y, double radius_m,
+               double altitude_m) {
+  constexpr double kPi = std::numbers::pi;
+  const std::size_t n = x.size();
+  Ring ring;
+  double sx = 0.0;
+  double sy = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {  // sorted member order: the same sum on every drone
+    sx += x[i];
+    sy += y[i];
+  }
+  const double count = static_cast<double>(n);
+  ring.px = sx / count;
+  ring.py = sy / count;
+
+  std::vector<bool> centred(n);
+  std::vector<double> bearing(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = x[i] - ring.px;
+    const double dy = y[i] - ring.py;
+    centred[i] = dx * dx + dy * dy < kCentredM2;
+    double b = 0.0;
+    if (!centred[i]) {
+      b = std::atan2(dy, dx);
+      if (b <= -kPi) b = kPi;  // (-pi, pi]: atan2(-0.0, -1) is -pi
+    }
+    bearing[i] = b;
+  }
+  // Whether member j comes before member i on the ring.
+  const auto before = [&](std::size_t j, std::size_t i) {
+    if (centred[j] != centred[i]) return static_cast<bool>(centred[i]);  // the centred ones last
+    if (!centred[i] && bearing[j] != bearing[i]) return bearing[j] < bearing[i];
+    return j < i;  // the same bearing (exactly), or both centred: by name
+  };
+  std::vector<std::size_t> rank(n, 0);
+  double a0 = 0.0;  // the first one's bearing; 0 when every member is centred
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j != i && before(j, i)) ++rank[i];
+    }
+    if (rank[i] == 0 && !centred[i]) a0 = bearing[i];
+  }
+  ring.slots.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = a0 + 2.0 * kPi * static_cast<double>(rank[i]) / count;
+    ring.slots.push_back({ring.px + radius_m * std::cos(a), ring.py + radius_m * std::sin(a), altitude_m});
+  }
+  return ring;
 }
 
 RendezvousBrain::RendezvousBrain(const sb::Context& ctx)
@@ -141,17 +184,15 @@ void RendezvousBrain::Step(const sb::Input& in, sb::Output& out) {
   if (phase_ == Phase::kVoting) {
     ProposeUntil(positions_.count(self_) > 0, pos_entry_, in.t_ns, out);
     if (positions_.size() == members_.size()) {
-      double sx = 0.0;
-      double sy = 0.0;
-      for (const std::string& m : members_) {  // sorted order: the same sum on every drone
-        sx += positions_.at(m).x;
-        sy += positions_.at(m).y;
+      std::vector<double> x;
+      std::vector<double> y;
+      for (const std::string& m : members_) {  // sorted order: the same ring on every drone
+        x.push_back(positions_.at(m).x);
+        y.push_back(positions_.at(m).y);
       }
-      const double n = static_cast<double>(members_.size());
-      const double px = sx / n;
-      const double py = sy / n;
-      slot_ = Slot(px, py, radius_m_, altitude_m_, index_, members_.size());
-      out.events.push_back({"rendezvous_point", {{"x", Fixed3(px)}, {"y", Fixed3(py)}}});
+      const Ring ring = PlaceRing(x, y, radius_m_, altitude_m_);
+      slot_ = ring.slots[index_];
+      out.events.push_back({"rendezvous_point", {{"x", Fixed3(ring.px)}, {"y", Fixed3(ring.py)}}});
       phase_ = Phase::kFlying;
     }
   }

@@ -38,9 +38,27 @@ std::optional<Entry> ParseEntry(const std::vector<std::uint8_t>& data);
 std::vector<std::uint8_t> PosEntry(const std::string& name, double x, double y);  // "%.3f"
 std::vector<std::uint8_t> ArrivedEntry(const std::string& name);
 
-// Slot `index` of `count` on the ring of `radius_m` around (px, py): angle 2*pi*index/count.
-swarmbox::brain::Vec3 Slot(double px, double py, double radius_m, double altitude_m,
-                           std::size_t index, std::size_t count);
+// The ring: P and every member's slot, computed with the same operations in the same order as
+// the C brain's rv_place_ring (examples/c_brain/rendezvous.h), so the two agree bit for bit
+// (compiled without FMA contraction, -ffp-contract=off). Members in sorted name order, at (x[i],
+// y[i]) as read from their `pos` entries:
+//   P = (sum of x in index order / N, sum of y / N);
+//   dx = x[i] - P.x, dy = y[i] - P.y; member i is centred when dx*dx + dy*dy < kCentredM2 (0.01 m),
+//   else its bearing is b_i = atan2(dy, dx), with -pi taken as +pi (so b_i is in (-pi, pi]);
+//   rank: the members that are not centred by increasing b_i (equal doubles: by index, i.e. name),
+//   then the centred ones by index;
+//   a0 = the bearing of rank 0 (0.0 when every member is centred);
+//   slot of rank r: a = a0 + 2.0 * pi * r / N (left to right, in doubles),
+//   (P.x + radius_m * cos(a), P.y + radius_m * sin(a), altitude_m).
+// Each drone keeps its angular order around P, so two drones never swap sides of the ring.
+struct Ring {
+  double px = 0.0;
+  double py = 0.0;
+  std::vector<swarmbox::brain::Vec3> slots;  // per member, in the order of x and y
+};
+inline constexpr double kCentredM2 = 1e-4;  // [m^2]
+Ring PlaceRing(const std::vector<double>& x, const std::vector<double>& y, double radius_m,
+               double altitude_m);
 
 class RendezvousBrain final : public swarmbox::brain::Brain {
  public:

@@ -3,7 +3,9 @@
 // committed in drone order, delivered to every drone at the next step) and an ideal point-mass
 // flight (take-off and position targets approached at 5 m/s, `hover` on reaching the take-off
 // height, `landed` on the ground after `land`). Checks the protocol end to end: everyone reaches
-// its slot on the ring, logs rendezvous_complete once, and two runs are bit-identical.
+// its slot on the ring, in the angular order it started in around the point (no two drones swap
+// sides), logs rendezvous_complete once, and two runs are bit-identical. PlaceRing's rule on
+// hand-worked layouts (two drones on a line, a drone at the point, equal bearings).
 #include "rendezvous_brain.hpp"
 
 #include <gtest/gtest.h>
@@ -104,8 +106,10 @@ struct Drone {
 
 struct Outcome {
   std::vector<Drone> drones;
+  std::vector<sb::Vec3> starts;
   std::string trace;         // every step's outputs and positions, floats in hex: bit-exact
   std::int64_t end_ns = 0;   // when the last drone logged rendezvous_complete (0: never)
+  double min_gap_m = 1e9;    // the least horizontal distance between two airborne drones
 };
 
 std::string Hex(double v) {
@@ -114,10 +118,22 @@ std::string Hex(double v) {
   return buf;
 }
 
-// N drones scout_1..scout_N at fixed, scattered starts. `lose_first`: the first proposal of every
-// drone is lost (as on a leader change), so only re-proposals can commit.
-Outcome RunSwarm(std::size_t n, bool lose_first = false, double limit_s = 200.0) {
+// N drones scout_1..scout_N at fixed, scattered starts.
+std::vector<sb::Vec3> ScatteredStarts(std::size_t n) {
+  std::vector<sb::Vec3> starts;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double fi = static_cast<double>(i);
+    starts.push_back({-20.0 + 13.7 * fi, 4.0 * std::sin(fi) + 3.1 * fi, 0.0});
+  }
+  return starts;
+}
+
+// Drones scout_1..scout_N at `starts`. `lose_first`: the first proposal of every drone is lost (as
+// on a leader change), so only re-proposals can commit.
+Outcome RunSwarmFrom(const std::vector<sb::Vec3>& starts, bool lose_first = false, double limit_s = 200.0) {
+  const std::size_t n = starts.size();
   Outcome o;
+  o.starts = starts;
   std::vector<std::string> members;
   for (std::size_t i = n; i >= 1; --i) members.push_back("scout_" + std::to_string(i));  // unsorted
   for (std::size_t i = 0; i < n; ++i) {
@@ -129,8 +145,7 @@ Outcome RunSwarm(std::size_t n, bool lose_first = false, double limit_s = 200.0)
     ctx.period_ns = kPeriodNs;
     ctx.args = {{"altitude_m", "8"}, {"radius_m", "5"}, {"hold_s", "2"}};
     d.brain = std::make_unique<RendezvousBrain>(ctx);
-    const double fi = static_cast<double>(i);
-    d.flight.position = {-20.0 + 13.7 * fi, 4.0 * std::sin(fi) + 3.1 * fi, 0.0};
+    d.flight.position = starts[i];
     o.drones.push_back(std::move(d));
   }
 
@@ -189,10 +204,23 @@ Outcome RunSwarm(std::size_t n, bool lose_first = false, double limit_s = 200.0)
       d.flight.Move(static_cast<double>(kPeriodNs) * 1e-9, t_ns);
       o.trace += " " + Hex(d.flight.position.x) + "," + Hex(d.flight.position.y) + "," + Hex(d.flight.position.z);
     }
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = i + 1; j < n; ++j) {
+        const sb::Vec3& a = o.drones[i].flight.position;
+        const sb::Vec3& b = o.drones[j].flight.position;
+        if (a.z > 0.0 && b.z > 0.0) {
+          o.min_gap_m = std::min(o.min_gap_m, std::hypot(a.x - b.x, a.y - b.y));
+        }
+      }
+    }
     o.trace += "\n";
     if (completed == n) o.end_ns = t_ns;
   }
   return o;
+}
+
+Outcome RunSwarm(std::size_t n, bool lose_first = false) {
+  return RunSwarmFrom(ScatteredStarts(n), lose_first);
 }
 
 const sb::Event* FindEvent(const Drone& d, const std::string& name) {
@@ -233,14 +261,25 @@ void ExpectRendezvous(const Outcome& o) {
     EXPECT_GT(d.landing_status_ns, 0);
     EXPECT_EQ(d.land_command_ns - d.landing_status_ns, 2'000'000'000);
   }
-  // Every drone landed on its slot: P + r (cos a, sin a), a = 2 pi i / N, from the logged P.
+  // Every drone landed on the ring (radius 5 around the logged P), the slots 2 pi / N apart, in the
+  // angular order of the starts around P: the first by bearing (from -pi) landed straight out along
+  // its own bearing, each next one 2 pi / N further round.
   const double px = std::stod(first_point->fields[0].second);
   const double py = std::stod(first_point->fields[1].second);
-  for (std::size_t i = 0; i < n; ++i) {
-    SCOPED_TRACE(o.drones[i].name);
-    const double a = 2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(n);
-    EXPECT_NEAR(o.drones[i].flight.position.x, px + 5.0 * std::cos(a), 1.0);
-    EXPECT_NEAR(o.drones[i].flight.position.y, py + 5.0 * std::sin(a), 1.0);
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  const auto bearing = [&](const sb::Vec3& p) { return std::atan2(p.y - py, p.x - px); };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return bearing(o.starts[a]) < bearing(o.starts[b]);
+  });
+  const double a0 = bearing(o.starts[order[0]]);
+  for (std::size_t r = 0; r < n; ++r) {
+    const Drone& d = o.drones[order[r]];
+    SCOPED_TRACE(d.name + " rank " + std::to_string(r));
+    EXPECT_NEAR(std::hypot(d.flight.position.x - px, d.flight.position.y - py), 5.0, 0.01);
+    const double a = a0 + 2.0 * std::numbers::pi * static_cast<double>(r) / static_cast<double>(n);
+    EXPECT_NEAR(d.flight.position.x, px + 5.0 * std::cos(a), 0.01);
+    EXPECT_NEAR(d.flight.position.y, py + 5.0 * std::sin(a), 0.01);
   }
 }
 
@@ -292,7 +331,93 @@ TEST_P(RendezvousSwarm, LostProposalsAreProposedAgainAfterTwoSeconds) {
   EXPECT_GT(o.end_ns, RunSwarm(GetParam()).end_ns + 2'000'000'000 - kPeriodNs);
 }
 
+TEST_P(RendezvousSwarm, NoTwoDronesMeetOnTheWay) {
+  const Outcome o = RunSwarm(GetParam());
+  ASSERT_GT(o.end_ns, 0);
+  std::cout << GetParam() << " drones: least horizontal gap in flight " << o.min_gap_m << " m\n";
+  EXPECT_GT(o.min_gap_m, 3.0);
+}
+
 INSTANTIATE_TEST_SUITE_P(ThreeToFiveDrones, RendezvousSwarm, ::testing::Values(3u, 4u, 5u));
+
+// The layout that collided when slots followed the sorted names (scout_1 sent east through scout_2,
+// scout_2 west through scout_1, at the same altitude): each now flies outward on its own side.
+TEST(RendezvousSwarmLayouts, TwoDronesOnALineFlyOutwardWithoutSwapping) {
+  const Outcome o = RunSwarmFrom({{0.0, 0.0, 0.0}, {8.0, 0.0, 0.0}});
+  ExpectRendezvous(o);
+  EXPECT_NEAR(o.drones[0].flight.position.x, -1.0, 1e-9);  // P = (4, 0), radius 5
+  EXPECT_NEAR(o.drones[0].flight.position.y, 0.0, 1e-9);
+  EXPECT_EQ(o.drones[1].flight.position.x, 9.0);
+  EXPECT_EQ(o.drones[1].flight.position.y, 0.0);
+  std::cout << "two drones at (0,0) and (8,0): least horizontal gap in flight " << o.min_gap_m << " m\n";
+  EXPECT_EQ(o.min_gap_m, 8.0);  // they only move apart
+}
+
+TEST(RendezvousRing, TwoDronesOnALineKeepTheirSides) {
+  const Ring ring = PlaceRing({0.0, 8.0}, {0.0, 0.0}, 6.0, 10.0);
+  EXPECT_EQ(ring.px, 4.0);
+  EXPECT_EQ(ring.py, 0.0);
+  ASSERT_EQ(ring.slots.size(), 2u);
+  // The one at (8, 0) has bearing 0 and ranks first: straight out east; the other at 0 + pi.
+  EXPECT_EQ(ring.slots[1].x, 10.0);
+  EXPECT_EQ(ring.slots[1].y, 0.0);
+  EXPECT_EQ(ring.slots[1].z, 10.0);
+  EXPECT_EQ(ring.slots[0].x, -2.0);
+  EXPECT_NEAR(ring.slots[0].y, 0.0, 1e-12);
+  // "-0.000" read back (an estimate a hair below zero): bearing -pi counts as +pi, the same ring.
+  const Ring negative_zero = PlaceRing({0.0, 8.0}, {-0.0, 0.0}, 6.0, 10.0);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(Hex(negative_zero.slots[i].x), Hex(ring.slots[i].x)) << i;
+    EXPECT_EQ(Hex(negative_zero.slots[i].y), Hex(ring.slots[i].y)) << i;
+  }
+  // Along y: the southern one (bearing -pi/2) ranks first and keeps its bearing.
+  const Ring north_south = PlaceRing({0.0, 0.0}, {8.0, 0.0}, 6.0, 10.0);
+  EXPECT_NEAR(north_south.slots[1].x, 0.0, 1e-12);
+  EXPECT_EQ(north_south.slots[1].y, -2.0);
+  EXPECT_NEAR(north_south.slots[0].x, 0.0, 1e-12);
+  EXPECT_EQ(north_south.slots[0].y, 10.0);
+}
+
+TEST(RendezvousRing, ADroneAtThePointRanksLastAndTheOthersKeepTheirBearings) {
+  // P = (5, 0); member 1 is on it (no bearing). Member 2 (bearing 0) first: east; member 0
+  // (bearing pi) 2 pi / 3 further; member 1 last, at 4 pi / 3.
+  const Ring ring = PlaceRing({0.0, 5.0, 10.0}, {0.0, 0.0, 0.0}, 6.0, 10.0);
+  const double pi = std::numbers::pi;
+  const double expected_angle[3] = {2.0 * pi / 3.0, 4.0 * pi / 3.0, 0.0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_NEAR(ring.slots[i].x, 5.0 + 6.0 * std::cos(expected_angle[i]), 1e-12);
+    EXPECT_NEAR(ring.slots[i].y, 6.0 * std::sin(expected_angle[i]), 1e-12);
+  }
+  // 0.03 m from P: not centred. Member 1 (bearing pi/2) then ranks second, after member 2 (bearing
+  // a hair below 0) and before member 0 (a hair below pi).
+  const Ring off = PlaceRing({0.0, 5.0, 10.0}, {0.01, 0.03, -0.04}, 6.0, 10.0);
+  const double a0 = std::atan2(-0.04, 5.0);
+  EXPECT_NEAR(off.slots[2].x, 5.0 + 6.0 * std::cos(a0), 1e-12);
+  EXPECT_NEAR(off.slots[1].x, 5.0 + 6.0 * std::cos(a0 + 2.0 * pi / 3.0), 1e-12);
+  EXPECT_NEAR(off.slots[1].y, 6.0 * std::sin(a0 + 2.0 * pi / 3.0), 1e-12);
+  EXPECT_NEAR(off.slots[0].x, 5.0 + 6.0 * std::cos(a0 + 4.0 * pi / 3.0), 1e-12);
+  // Everyone on the point (one drone, or all at one place): a0 = 0, by name.
+  const Ring alone = PlaceRing({3.0}, {4.0}, 6.0, 10.0);
+  EXPECT_EQ(alone.slots[0].x, 9.0);
+  EXPECT_EQ(alone.slots[0].y, 4.0);
+  const Ring together = PlaceRing({1.0, 1.0}, {1.0, 1.0}, 6.0, 10.0);
+  EXPECT_EQ(together.slots[0].x, 7.0);
+  EXPECT_EQ(together.slots[1].x, -5.0);
+}
+
+TEST(RendezvousRing, EqualBearingsRankByName) {
+  // P = (0, 0); members 0 and 1 on the same ray (bearing pi/4, equal doubles), member 2 at -3pi/4.
+  const Ring ring = PlaceRing({1.0, 2.0, -3.0}, {1.0, 2.0, -3.0}, 6.0, 10.0);
+  const double pi = std::numbers::pi;
+  const double a0 = std::atan2(-3.0, -3.0);
+  const double expected_angle[3] = {a0 + 2.0 * pi / 3.0, a0 + 4.0 * pi / 3.0, a0};
+  for (std::size_t i = 0; i < 3; ++i) {
+    SCOPED_TRACE(i);
+    EXPECT_NEAR(ring.slots[i].x, 6.0 * std::cos(expected_angle[i]), 1e-12);
+    EXPECT_NEAR(ring.slots[i].y, 6.0 * std::sin(expected_angle[i]), 1e-12);
+  }
+}
 
 TEST(RendezvousEntries, ParseWhatTheProtocolWritesAndNothingElse) {
   const std::vector<std::uint8_t> text = PosEntry("scout_2", -1.23456, 20.0);
