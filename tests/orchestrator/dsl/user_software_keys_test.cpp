@@ -209,7 +209,9 @@ TEST(UserSoftwareKeys, ComponentErrorsPointAtTheKey) {
     EXPECT_THAT(err, HasSubstr("byo.yaml:9:")) << c.component;
     EXPECT_THAT(err, HasSubstr(c.message)) << c.component;
   }
-  EXPECT_THAT(ErrorOf(With("components:", "components: {a: 1}\nx:")), HasSubstr("'components' must be a list"));
+  const std::string trial = kTrial;
+  const std::string not_a_list = trial.substr(0, trial.find("components:")) + "components: {a: 1}\ntimeout: {sim: 60s}\n";
+  EXPECT_THAT(ErrorOf(not_a_list), HasSubstr("byo.yaml:7:13: 'components' must be a list"));
 }
 
 TEST(UserSoftwareKeys, ANetemTrialLetsComponentsJoinTheMesh) {

@@ -83,7 +83,7 @@ TEST_F(UserSoftwarePlanTest, StartOrderFollowsThePriorities) {
   for (dsl::Plugin* p : trial->Plugins()) ids.push_back(p->id());
   // ground (10) before physics; the brain before the agents; gcs (100) with the drones; recorder
   // (200) last.
-  EXPECT_THAT(ids, ElementsAre("ground", "physics", "scout_2-brain", "scout_1", "scout_2", "scout_3", "gcs",
+  EXPECT_THAT(ids, ElementsAre("ground", "physics", "scout_2-brain", "gcs", "scout_1", "scout_2", "scout_3",
                                "recorder"));
   auto level = [&](std::string_view id) {
     int p = 0;
