@@ -7,9 +7,11 @@
 # Layout (GNUInstallDirs):
 #   P/bin/swarmbox, swarmbox-physics, swarmbox-agent, swarmbox-netemd   side by side: an installed
 #                                  swarmbox finds its companions next to itself (images::FindProgram)
-#   P/lib/libswarmbox_*.a          common, docker, images, dsl, faults, runner, hosts, report, experiment
+#   P/lib/libswarmbox_*.a          common, docker, images, dsl, faults, runner, hosts, report, experiment;
+#                                  brain (what a brain library links, PIC) and brain_loader
 #   P/include/swarmbox/<component>/...   their public headers
-#   P/lib/cmake/swarmbox/          swarmboxConfig.cmake, swarmboxConfigVersion.cmake, swarmboxTargets.cmake
+#   P/lib/cmake/swarmbox/          swarmboxConfig.cmake, swarmboxConfigVersion.cmake, swarmboxTargets.cmake,
+#                                  SwarmboxBrain.cmake (swarmbox_add_brain)
 #   P/share/swarmbox/trials/       the shipped trials, airframes/, worlds/, faults/, experiments/
 #   P/share/doc/swarmbox/          README.md and the other top-level documents, docs/
 # The DDS side (bus, physics, agent libraries) is not installed as libraries: they are the
@@ -56,6 +58,11 @@ endfunction()
 foreach(lib common docker images dsl faults runner hosts report experiment)
   swarmbox_install_library(swarmbox_${lib} ${lib})
 endforeach()
+# The brain SDK (agent/brain): what a brain library links, the loader, and swarmbox_add_brain().
+swarmbox_install_library(swarmbox_brain brain)
+swarmbox_install_library(swarmbox_brain_loader brain_loader)
+install(FILES ${PROJECT_SOURCE_DIR}/cmake/SwarmboxBrain.cmake DESTINATION ${SWARMBOX_INSTALL_CMAKEDIR}
+        COMPONENT development)
 foreach(program swarmbox swarmbox-physics swarmbox-agent swarmbox-netemd)
   swarmbox_install_program(${program})
 endforeach()

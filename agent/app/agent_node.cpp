@@ -6,9 +6,14 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "external_brain.hpp"
+#include "swarmbox/bus/topics.hpp"
+#include "swarmbox/brain/args.hpp"
+#include "swarmbox/brain/loader.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
+#include "wait_budget.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -21,23 +26,6 @@ std::string Seconds(double s) {
   return buf;
 }
 
-// A wall-clock wait of `total`, spent in slices: each slice counts at most its own length, so a
-// process stopped or starved in the middle of one (SIGSTOP, docker pause) resumes with the rest
-// of its budget instead of a deadline long gone.
-class WaitBudget {
- public:
-  explicit WaitBudget(std::chrono::milliseconds total) : left_(total) {}
-  bool spent() const { return left_ <= std::chrono::milliseconds(0); }
-  std::chrono::milliseconds Slice(std::chrono::milliseconds max) const { return std::min(left_, max); }
-  void Spend(std::chrono::steady_clock::duration elapsed, std::chrono::milliseconds slice) {
-    left_ -= std::min(std::chrono::duration_cast<std::chrono::milliseconds>(elapsed), slice);
-    if (elapsed < std::chrono::milliseconds(1)) left_ -= std::chrono::milliseconds(1);  // always progress
-  }
-
- private:
-  std::chrono::milliseconds left_;
-};
-
 // The wall clock of radio.model netem only (the wall part of its lost-member rule, as the radio
 // itself runs on it); never read with the channel.
 double SteadyS() {
@@ -45,6 +33,16 @@ double SteadyS() {
 }
 
 }  // namespace
+
+class AgentNode::FlightAdapter final : public FlightPort {
+ public:
+  explicit FlightAdapter(flight::FlightController& fc) : fc_(fc) {}
+  bool Command(const flight::Setpoint& setpoint) override { return fc_.Command(setpoint); }
+  void SetPayloadMass(double payload_mass_kg) override { fc_.SetPayloadMass(payload_mass_kg); }
+
+ private:
+  flight::FlightController& fc_;
+};
 
 Result<RadioModel> ParseRadioModel(std::string_view text) {
   if (text == "netem") return RadioModel::kNetem;
@@ -120,7 +118,17 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
       mc.payload_half_height_m = ground->half_height_m;
     }
   }
-  auto plan = FlightPlan::Parse(o.plan);  // --mission sar: parsed (the default) but not flown
+  const bool brain = o.brain.kind != BrainKind::kBuiltin;
+  int period_steps = 1;
+  if (brain) {
+    auto steps = BrainPeriodSteps(o.brain, o.control_dt_s);
+    if (!steps) return steps.error();
+    period_steps = *steps;
+    if (o.mission.kind != MissionKind::kPlan) {
+      return Error(ErrorCode::kInvalidArgument, "--mission is for --brain builtin (the brain decides what to fly)");
+    }
+  }
+  auto plan = FlightPlan::Parse(o.plan);  // --mission sar, a brain: parsed (the default) but not flown
   if (!plan) return plan.error().Context("--plan");
   plan->SetPreflight(o.preflight_s);
   flight::ControllerOptions co;
@@ -152,6 +160,14 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   if (!pub) return pub.error().Context("publishing actuator commands");
   node->actuator_pub_ = std::move(*pub);
   const bool sar = o.mission.kind == MissionKind::kSar;
+  std::unique_ptr<brain::Brain> the_brain;
+  if (brain) {
+    auto made = node->MakeBrain(*cfg, period_steps);
+    if (!made) return made.error();
+    the_brain = std::move(*made);
+    // Its own replicated state, made once before Raft starts (Raft replays its WAL into it).
+    node->brain_state_ = the_brain->MakeReplicatedState();
+  }
   if (o.mesh && channel) {
     // No mesh domain at all: every frame rides the lockstep to the physics server's channel.
     node->radio_ = std::make_unique<radio::ChannelRadio>(o.name);
@@ -166,7 +182,8 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     ro.members = o.raft.members;
     ro.raft = o.raft.members.size() > 1;
     ro.pings = o.ping_every_ms > 0 && o.raft.members.size() > 1;
-    ro.hear_states = sar;
+    ro.hear_states = sar || brain;
+    ro.brains = brain;
     auto dds = radio::DdsRadio::Create(*node->mesh_, o.name, ro);
     if (!dds) return dds.error().Context("starting the mesh radio");
     node->radio_ = std::move(*dds);
@@ -179,7 +196,13 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     // Raft's clock: simulated seconds (channel: the radio's clock is the lockstep's, from 0), or
     // wall seconds since now (netem: the steady clock). Its lines carry the simulated time.
     node->raft_clock_ = std::make_unique<RadioClock>(*node->radio_, channel ? 0 : node->radio_->now_ns());
-    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_);
+    std::unique_ptr<raft::StateMachine> machine;  // null: the SAR mission's
+    if (brain && node->brain_state_) {
+      machine = std::make_unique<ReplicatedStateMachine>(node->brain_state_.get());
+    } else if (brain) {
+      machine = std::make_unique<raft::EntryLogMachine>();
+    }
+    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_, std::move(machine));
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
   }
@@ -190,6 +213,19 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     auto probe = radio::LinkProbe::Create(o.name, o.raft.members, po, radio::RadioTime(node->radio_->now_ns()));
     if (!probe) return probe.error().Context("starting the link probe");
     node->probe_ = std::move(*probe);
+  }
+  if (brain) {
+    BrainHostOptions bo;
+    bo.self = o.name;
+    bo.period_steps = period_steps;
+    bo.offboard_timeout_s = o.brain.offboard_timeout_ms * 1e-3;
+    bo.offboard_hold_s = o.brain.offboard_hold_ms * 1e-3;
+    bo.state = node->brain_state_.get();
+    node->flight_port_ = std::make_unique<FlightAdapter>(node->fc_);
+    if (node->raft_) node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
+    node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(the_brain), *node->flight_port_, node->radio_.get(),
+                                                    node->consensus_.get(), o.log);
+    if (auto spec = swarm::BatterySpecFor(cfg->airframe)) node->battery_.emplace(*spec);
   }
   if (o.mission.kind == MissionKind::kSar) {
     auto host = MissionHost::Create(mc);
@@ -220,6 +256,52 @@ AgentNode::~AgentNode() = default;
 void AgentNode::Log(const LogEvent& e) {
   std::fprintf(options_.log, "%s\n", e.str().c_str());
   std::fflush(options_.log);
+}
+
+Result<std::unique_ptr<brain::Brain>> AgentNode::MakeBrain(const flight::FlightConfig& config, int period_steps) {
+  const BrainOptions& b = options_.brain;
+  brain::Context ctx;
+  ctx.self = options_.name;
+  ctx.members = options_.raft.members.empty() ? std::vector<std::string>{options_.name} : options_.raft.members;
+  ctx.seed = options_.raft.seed;
+  ctx.period_ns = static_cast<std::int64_t>(std::llround(period_steps * options_.control_dt_s * 1e9));
+  ctx.airframe = config.airframe;
+  ctx.airframe_path = options_.airframe_path;
+  ctx.world_path = options_.mission.world_path;
+  ctx.payload = options_.mission.payload;
+  auto args = brain::ParseBrainArgs(b.args_json);
+  if (!args) return args.error();
+  ctx.args = std::move(*args);
+  ctx.log = [this](const brain::Event& e) {
+    LogEvent line(t_s_, options_.name, e.name);
+    for (const auto& [k, v] : e.fields) line.Add(k, v);
+    Log(line);
+  };
+  LogEvent loaded(0.0, options_.name, "brain_loaded");
+  loaded.Add("kind", BrainKindName(b.kind));
+  std::unique_ptr<brain::Brain> made;
+  if (b.kind == BrainKind::kLibrary) {
+    auto lib = brain::LoadBrain(b.library_path, b.name, ctx);
+    if (!lib) return lib.error().Context("--brain library");
+    loaded.Add("name", b.name).Add("library", b.library_path);
+    made = std::move(*lib);
+  } else {
+    ExternalBrainOptions eo;
+    eo.drone = options_.name;
+    eo.wait = std::chrono::milliseconds(b.wait_ms);
+    eo.start = std::chrono::milliseconds(b.start_ms);
+    eo.stop = options_.stop;
+    eo.log = options_.log;
+    auto ext = ExternalBrain::Create(*sim_, eo);
+    if (!ext) return ext.error().Context("--brain external");
+    loaded.Add("name", bus::OffboardInputTopic(options_.name));
+    made = std::move(*ext);
+  }
+  loaded.Add("period_ms", static_cast<double>(ctx.period_ns) * 1e-6, 1)
+      .Add("offboard_timeout_ms", b.offboard_timeout_ms)
+      .Add("offboard_hold_ms", b.offboard_hold_ms);
+  Log(loaded);
+  return made;
 }
 
 bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
@@ -271,6 +353,7 @@ void AgentNode::OnPing(const bus::RadioFrame& frame) {
 }
 
 void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& frame) {
+  if (brain_host_) brain_host_->OnState(state);
   if (!mission_) return;
   PeerState p;
   p.name = state.drone;
@@ -287,6 +370,11 @@ void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& fra
 void AgentNode::OnDetection(const bus::Detection& /*detection*/, const bus::RadioFrame& /*frame*/) {
   // Heard and counted (dispatched_.detection): sightings reach the swarm through Raft; the
   // broadcast detections are for recorders and a ground station.
+}
+
+void AgentNode::OnBrainMessage(const bus::BrainMessage& message, const bus::RadioFrame& /*frame*/) {
+  // Counted (dispatched_.brain); the built-in missions have no brain inbox.
+  if (brain_host_) brain_host_->OnMessage(message);
 }
 
 Status AgentNode::ServeRadioBetweenSteps() {
@@ -337,6 +425,7 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
       case FlightEventKind::kRejected: st.rejected = true; break;
       default: break;
     }
+    if (brain_host_) brain_host_->OnFlightEvent(e);
     LogEvent le(e.t_s, options_.name, flight::FlightEventName(e.kind));
     if (e.kind == FlightEventKind::kModeChange) le.Add("mode", flight::FlightModeName(e.mode));
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
@@ -350,7 +439,9 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
     probe_->Step(radio::RadioTime(radio_->now_ns()), t_s_, *radio_, &lines_);
     for (const LogEvent& line : lines_) Log(line);
   }
-  if (mission_) {
+  if (brain_host_) {
+    StepBrain(msg);
+  } else if (mission_) {
     StepMission(msg, st.hover);
   } else {
     if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
@@ -394,7 +485,11 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
   state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
   state_.heading_rad = flight::YawOf(est.att);
-  if (mission_) {
+  if (brain_host_) {
+    // The brain's status (Neighbour::status on the other drones); the flight mode until it says.
+    state_.mode = brain_host_->status().empty() ? std::string(flight::FlightModeName(fc_.mode())) : brain_host_->status();
+    state_.battery_fraction = vehicle_.battery_fraction;
+  } else if (mission_) {
     state_.mode = mission_->mode();
     state_.battery_fraction = mission_->battery_fraction();
   } else {
@@ -403,6 +498,30 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
   out_frame_ = bus::RadioFrame{};
   out_frame_.state_msg.push_back(state_);
   radio_->Send(std::move(out_frame_));
+}
+
+void AgentNode::StepBrain(const bus::SensorSample& msg) {
+  const flight::StateEstimate& est = fc_.estimate();
+  const flight::FlightMode mode = fc_.mode();
+  if (battery_) battery_->Step(options_.control_dt_s, est.vel_mps, brain_host_->payload_mass_kg(), !LandedMode(mode));
+  brain::Vehicle& v = vehicle_;
+  v.name = options_.name;
+  v.step = msg.step;
+  v.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+  v.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  v.attitude_wxyz[0] = est.att.w();
+  v.attitude_wxyz[1] = est.att.x();
+  v.attitude_wxyz[2] = est.att.y();
+  v.attitude_wxyz[3] = est.att.z();
+  v.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
+  v.heading_rad = flight::YawOf(est.att);
+  v.battery_fraction = battery_ ? battery_->fraction() : 1.0;
+  v.battery_voltage_v = 0.0;  // not modelled: the battery model counts energy
+  v.flight_mode = std::string(flight::FlightModeName(mode));
+  v.armed = cmd_.armed;
+  v.landed = LandedMode(mode);
+  v.mass_estimate_kg = fc_.telemetry().mass_estimate_kg;
+  brain_host_->Step(msg.step, msg.sim_time_ns, v, &cmd_.world);
 }
 
 void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
@@ -466,6 +585,7 @@ void AgentNode::StepMission(const bus::SensorSample& msg, bool hover_event) {
 }
 
 bool AgentNode::Done() const {
+  if (brain_host_) return false;  // a brain flies until the trial ends (the samples stop)
   if (!mission_) return plan_.finished();
   return mission_->complete() && (fc_.mode() == flight::FlightMode::kLanded || fc_.mode() == flight::FlightMode::kIdle);
 }
@@ -476,8 +596,9 @@ Status AgentNode::Run() {
           .Add("sim_interface", options_.sim_interface)
           .Add("middleware", options_.middleware)
           .Add("radio_model", RadioModelName(options_.radio_model))
-          .Add("mission", MissionKindName(options_.mission.kind))
-          .Add("plan", mission_ ? std::string("-") : options_.plan)
+          .Add("brain", BrainKindName(options_.brain.kind))
+          .Add("mission", brain_host_ ? std::string_view("-") : MissionKindName(options_.mission.kind))
+          .Add("plan", mission_ || brain_host_ ? std::string("-") : options_.plan)
           .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
   bus::SensorSample msg;
   bool got_any = false;
@@ -519,8 +640,11 @@ Status AgentNode::Run() {
                          " s: is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
                          std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
       }
-      Log(LogEvent(t_s_, options_.name, "samples_stopped").Add("after_s", secs, 1).Add("plan", mission_ ? std::string_view("sar") : plan_.current()));
-      if (Done() || (mission_ && mission_->complete())) return Ok{};
+      Log(LogEvent(t_s_, options_.name, "samples_stopped")
+              .Add("after_s", secs, 1)
+              .Add("plan", brain_host_ ? std::string_view("brain") : mission_ ? std::string_view("sar") : plan_.current()));
+      // A brain has no end of its own: the trial's end stops the samples.
+      if (brain_host_ || Done() || (mission_ && mission_->complete())) return Ok{};
       if (mission_) {
         return Error(ErrorCode::kUnavailable, "sensor samples stopped for " + Seconds(secs) +
                                                   " s before the SAR mission was complete (" + mission_->mode() + ")");

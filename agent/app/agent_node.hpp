@@ -3,7 +3,8 @@
 // same step), talks to the other drones through a radio::MeshRadio (its DroneState for the
 // neighbours; with raft.members, the drone's Raft node on the mission state, raft_host.hpp, and
 // the link probe), runs FlightController on the samples' simulated time, lets a SetpointSource
-// (the built-in plan, or the SAR mission) drive it, and prints logfmt events
+// (the built-in plan, or the SAR mission) or a brain (brain_host.hpp: --brain library|external)
+// drive it, and prints logfmt events
 // (`t=12.340 node=drone_3 event=hover ...`).
 //
 //   AgentOptions o;  o.name = "drone_3";  o.airframe_path = "trials/airframes/x500.yaml";
@@ -16,8 +17,9 @@
 //      clock liveness bound of camera_timeout, event=camera_missing when it fires);
 //   b. radio.TakeReceived -> DispatchFrames (radio_dispatch.hpp): Raft payloads to the Raft
 //      service, pings/pongs to the link probe, DroneStates to the mission's peers;
-//   c. flight step, Raft ticks and the link probe on the radio's clock, the mission (or plan)
-//      step, the DroneState broadcast (5 Hz of simulated time), detections;
+//   c. flight step, Raft ticks and the link probe on the radio's clock, the mission (or plan, or
+//      brain: every brain period, BrainHost) step, the DroneState broadcast (5 Hz of simulated
+//      time; a brain's status as its mode), detections;
 //   d. radio.Flush into the ActuatorCommand, cmd.world = this step's world commands (payload
 //      attach/release), cmd.raft_leader; publish.
 // Clocks: with RadioModel::kChannel every decision runs on the samples' simulated time (the
@@ -25,7 +27,8 @@
 // and the probe run on the steady clock, also between samples (every 10 ms while waiting: the
 // mesh does not wait for the lockstep), and the SAR leader's lost-member rule also wants a
 // wall-clock silence (mission_host.hpp).
-// Wall clocks otherwise only bound liveness: the first sample, a stall, a missing camera frame.
+// Wall clocks otherwise only bound liveness: the first sample, a stall, a missing camera frame,
+// an external brain's answer (external_brain.hpp).
 #pragma once
 
 #include <chrono>
@@ -33,11 +36,15 @@
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "brain_consensus.hpp"
+#include "brain_host.hpp"
+#include "brain_options.hpp"
 #include "flight_plan.hpp"
 #include "mission_host.hpp"
 #include "mission_options.hpp"
@@ -49,6 +56,7 @@
 #include "swarmbox/flight/flight_controller.hpp"
 #include "swarmbox/radio/link_probe.hpp"
 #include "swarmbox/radio/mesh_radio.hpp"
+#include "swarmbox/swarm/battery_model.hpp"
 
 namespace swarmbox::agent {
 
@@ -92,6 +100,10 @@ struct AgentOptions {
   RaftHostOptions raft;
   // What to fly (mission_options.hpp): the plan above, or the SAR mission (needs raft.members).
   MissionOptions mission;
+  // Which brain flies (brain_options.hpp): builtin = `mission` above; library or external: a
+  // brain::Brain through BrainHost (Context from name, raft.members, raft.seed, the airframe,
+  // mission.world_path and mission.payload; Raft on its own state or the entry log).
+  BrainOptions brain;
   // Radio link measurement (agent/radio LinkProbe): with a radio and raft.members, ping every
   // other member every ping_every_ms of the radio's clock and log event=link per peer; 0 = off.
   int ping_every_ms = 200;
@@ -122,6 +134,8 @@ class AgentNode final : private FrameHandler {
   // --mission sar: feeds the mission host (camera, committed state) and carries out what it
   // asks (setpoint, payload world command, proposals, detections, events).
   void StepMission(const bus::SensorSample& msg, bool hover_event);
+  // --brain library|external: the vehicle as the brain sees it, then the BrainHost step.
+  void StepBrain(const bus::SensorSample& msg);
   void BroadcastState(const bus::SensorSample& msg);
   bool Done() const;  // the plan is complete, or the SAR mission is (and this drone is down)
   // FrameHandler (radio_dispatch.hpp).
@@ -129,6 +143,12 @@ class AgentNode final : private FrameHandler {
   void OnPing(const bus::RadioFrame& frame) override;
   void OnState(const bus::DroneState& state, const bus::RadioFrame& frame) override;
   void OnDetection(const bus::Detection& detection, const bus::RadioFrame& frame) override;
+  void OnBrainMessage(const bus::BrainMessage& message, const bus::RadioFrame& frame) override;
+  // Creates the brain of options_.brain (library or external) with its Context; kInvalidArgument
+  // for what the user must fix (exit 2), bus errors otherwise.
+  Result<std::unique_ptr<brain::Brain>> MakeBrain(const flight::FlightConfig& config, int period_steps);
+
+  class FlightAdapter;  // FlightPort over fc_
 
   AgentOptions options_;
   flight::FlightController fc_;
@@ -140,11 +160,19 @@ class AgentNode final : private FrameHandler {
   std::unique_ptr<radio::MeshRadio> radio_;   // after mesh_: destroyed before the participant
   SimClock sim_clock_;                        // the agent's simulated seconds (event lines)
   std::unique_ptr<RadioClock> raft_clock_;    // the radio's clock for Raft
+  // --brain library|external: the brain's own replicated state (Raft's machine refers to it).
+  std::unique_ptr<brain::ReplicatedState> brain_state_;
   std::unique_ptr<RaftHost> raft_;            // after radio_ and the clocks: destroyed first
   std::unique_ptr<radio::LinkProbe> probe_;
   std::vector<bus::RadioFrame> frames_;       // this step's deliveries
   DispatchCounts dispatched_;
   std::vector<LogEvent> lines_;
+  // --brain library|external only (after sim_, radio_ and raft_: destroyed before them).
+  std::unique_ptr<FlightPort> flight_port_;
+  std::unique_ptr<RaftConsensus> consensus_;
+  std::unique_ptr<BrainHost> brain_host_;
+  std::optional<swarm::BatteryModel> battery_;  // the airframe's (x500, x8_heavy); none: 1.0
+  brain::Vehicle vehicle_;
   // --mission sar only.
   std::unique_ptr<MissionHost> mission_;
   std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;

@@ -22,6 +22,17 @@
 // the SAR mission (mission_host.hpp) and needs --members and --world:
 //       --mission sar --world trials/worlds/open_field.yaml [--payload stretcher]
 //       [--inference-latency-ms 40]
+// Which brain flies (brain_options.hpp, agent/brain/README.md): --brain builtin (default: the
+// --mission above), library or external:
+//       --brain library --brain-library librendezvous.so --brain-name rendezvous
+//       [--brain-args '{"altitude_m": 12}']   a JSON object: Context::args
+//       --brain external                      a brain process on offboard/<name>/input|output
+//       [--brain-rate-hz HZ]                  default: every step (250 Hz); external 50 Hz
+//       [--offboard-timeout-ms 1000] [--offboard-hold-ms 5000]   simulated: hold, then land
+//       [--brain-wait-ms 3000] [--brain-start-ms 30000]          external: wall-clock bounds
+// --name, --members, --seed, --airframe, --world and --payload go into every brain's Context.
+// A library that does not load, has another ABI, lacks the name (the names it has are listed) or
+// whose constructor throws exits 2 with the reason.
 // Usage errors (unknown flag, bad value, a bad combination) exit 2, as the rest of bad input.
 // With --members, the radio link is measured (agent/radio): each agent pings every other member
 // every --ping-every-ms (default 200, 0 = off) and logs event=link per peer every 2 s (radio clock).
@@ -30,6 +41,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "agent_node.hpp"
@@ -96,6 +108,16 @@ int main(int argc, char** argv) {
   app.add_option("--world", o.mission.world_path, "SAR: the world file (only its geofence and home are read)");
   app.add_option("--payload", o.mission.payload, "SAR: this drone's airframe payload NAME lies on the ground under it (the lifter)");
   app.add_option("--inference-latency-ms", o.mission.inference_latency_ms, "SAR: simulated perception latency [ms]")->capture_default_str();
+  std::string brain_kind = "builtin";
+  app.add_option("--brain", brain_kind, "Who flies: builtin (--mission), library (--brain-library/--brain-name) or external (a brain process on the offboard topics)")->capture_default_str();
+  app.add_option("--brain-library", o.brain.library_path, "library: the brain's shared library (.so)");
+  app.add_option("--brain-name", o.brain.name, "library: the SWARMBOX_BRAIN name in it");
+  app.add_option("--brain-args", o.brain.args_json, "The brain's arguments: a JSON object (Context::args)")->capture_default_str();
+  app.add_option("--brain-rate-hz", o.brain.rate_hz, "Brain steps per simulated second; a whole number of lockstep steps (default: every step; external: 50)")->check(CLI::PositiveNumber);
+  app.add_option("--offboard-timeout-ms", o.brain.offboard_timeout_ms, "Offboard failsafe: simulated ms without an answer before the drone holds")->capture_default_str();
+  app.add_option("--offboard-hold-ms", o.brain.offboard_hold_ms, "Offboard failsafe: simulated ms of holding before it lands")->capture_default_str();
+  app.add_option("--brain-wait-ms", o.brain.wait_ms, "external: wall-clock ms to wait for an answer before event=brain_unresponsive")->capture_default_str();
+  app.add_option("--brain-start-ms", o.brain.start_ms, "external: wall-clock ms to wait for the first answer")->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -144,8 +166,24 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "swarmbox-agent: %s\n", kind.error().ToString().c_str());
     return 2;
   }
-  if (swarmbox::Status s = swarmbox::agent::ValidateMissionOptions(o.mission, !o.raft.members.empty(), app.count("--plan") > 0); !s) {
+  if (auto kind = swarmbox::agent::ParseBrainKind(brain_kind)) {
+    o.brain.kind = *kind;
+  } else {
+    std::fprintf(stderr, "swarmbox-agent: %s\n", kind.error().ToString().c_str());
+    return 2;
+  }
+  if (swarmbox::Status s = swarmbox::agent::ValidateBrainOptions(o.brain, app.count("--mission") > 0, app.count("--plan") > 0); !s) {
     std::fprintf(stderr, "swarmbox-agent: %s\n", s.error().ToString().c_str());
+    return 2;
+  }
+  // --world and --payload are the SAR mission's with the builtin brain, any brain's Context otherwise.
+  if (o.brain.kind == swarmbox::agent::BrainKind::kBuiltin) {
+    if (swarmbox::Status s = swarmbox::agent::ValidateMissionOptions(o.mission, !o.raft.members.empty(), app.count("--plan") > 0); !s) {
+      std::fprintf(stderr, "swarmbox-agent: %s\n", s.error().ToString().c_str());
+      return 2;
+    }
+  } else if (!o.mission.world_path.empty() && !std::filesystem::is_regular_file(o.mission.world_path)) {
+    std::fprintf(stderr, "swarmbox-agent: --world '%s': no such file\n", o.mission.world_path.c_str());
     return 2;
   }
   o.stop = &g_stop;

@@ -16,9 +16,9 @@ void DispatchFrames(std::span<const bus::RadioFrame> frames, std::string_view se
       continue;
     }
     const int kinds = (f.state_msg.empty() ? 0 : 1) + (f.detection_msg.empty() ? 0 : 1) +
-                      (f.raft_msg.empty() ? 0 : 1) + (f.ping_msg.empty() ? 0 : 1);
-    const std::size_t items =
-        f.state_msg.size() + f.detection_msg.size() + f.raft_msg.size() + f.ping_msg.size();
+                      (f.raft_msg.empty() ? 0 : 1) + (f.ping_msg.empty() ? 0 : 1) + (f.brain_msg.empty() ? 0 : 1);
+    const std::size_t items = f.state_msg.size() + f.detection_msg.size() + f.raft_msg.size() +
+                              f.ping_msg.size() + f.brain_msg.size();
     if (kinds != 1 || items != 1) {
       ++counts->malformed;
       continue;
@@ -50,6 +50,18 @@ void DispatchFrames(std::span<const bus::RadioFrame> frames, std::string_view se
       }
       ++counts->state;
       handler.OnState(f.state_msg.front(), f);
+    } else if (!f.brain_msg.empty()) {
+      const bus::BrainMessage& m = f.brain_msg.front();
+      if (m.from == self) {
+        ++counts->own;
+        continue;
+      }
+      if (!m.to.empty() && m.to != self) {
+        ++counts->not_for_us;
+        continue;
+      }
+      ++counts->brain;
+      handler.OnBrainMessage(m, f);
     } else {
       if (f.detection_msg.front().from == self) {
         ++counts->own;

@@ -7,10 +7,11 @@
 //     ping_msg                                   -> handler.OnPing(frame)           (LinkProbe)
 //     state_msg of another drone                 -> handler.OnState(state, frame)   (mission peers)
 //     detection_msg of another drone             -> handler.OnDetection(det, frame)
+//     brain_msg of another drone                 -> handler.OnBrainMessage(msg, frame) (the brain's inbox)
 //
 // Dropped and counted: our own frames (from == self, or a state of ours), frames addressed to
 // another drone (to neither "" nor self; a Raft envelope to another drone), and malformed frames
-// (not exactly one of the four sequences holding exactly one element, a Raft envelope without a
+// (not exactly one of the five sequences holding exactly one element, a Raft envelope without a
 // payload). The handler's calls come in the frames' order; nothing is reordered here.
 #pragma once
 
@@ -29,6 +30,7 @@ class FrameHandler {
   virtual void OnPing(const bus::RadioFrame& frame) = 0;
   virtual void OnState(const bus::DroneState& state, const bus::RadioFrame& frame) = 0;
   virtual void OnDetection(const bus::Detection& detection, const bus::RadioFrame& frame) = 0;
+  virtual void OnBrainMessage(const bus::BrainMessage& message, const bus::RadioFrame& frame) = 0;
 };
 
 struct DispatchCounts {
@@ -36,6 +38,7 @@ struct DispatchCounts {
   std::uint64_t ping = 0;
   std::uint64_t state = 0;
   std::uint64_t detection = 0;
+  std::uint64_t brain = 0;
   std::uint64_t own = 0;
   std::uint64_t not_for_us = 0;
   std::uint64_t malformed = 0;

@@ -50,8 +50,14 @@ void RadioTransport::Send(const std::string& to, std::span<const std::uint8_t> b
 
 Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options, radio::MeshRadio& radio,
                                                   const raft::Clock& clock, std::FILE* log,
-                                                  const raft::Clock* event_clock) {
+                                                  const raft::Clock* event_clock,
+                                                  std::unique_ptr<raft::StateMachine> machine) {
   if (options.propose_every_ms < 0) return Error(ErrorCode::kInvalidArgument, "--propose-every-ms must be >= 0");
+  if (options.propose_every_ms > 0 && machine != nullptr &&
+      dynamic_cast<const raft::MissionStateMachine*>(machine.get()) == nullptr) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "--propose-every-ms proposes mission commands: it needs the mission state machine");
+  }
   if (options.raft_dir.empty()) return Error(ErrorCode::kInvalidArgument, "--raft-dir must not be empty");
   std::unique_ptr<RaftHost> host(new RaftHost(options, radio, clock));
   mission::RaftServiceConfig rc;
@@ -67,7 +73,7 @@ Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options
     const std::string out = event_clock != nullptr ? RestampLine(line, event_clock->NowS()) : line;
     std::fprintf(log, "%s\n", out.c_str());
     std::fflush(log);
-  });
+  }, std::move(machine));
   if (!service) return service.error().Context("starting raft");
   host->service_ = std::move(*service);
   host->next_propose_s_ = clock.NowS() + options.propose_every_ms * 1e-3;
@@ -80,8 +86,9 @@ Status RaftHost::Step() {
     const double now = clock_.NowS();
     if (now >= next_propose_s_) {
       next_propose_s_ = now + options_.propose_every_ms * 1e-3;
-      if (service_->is_leader()) {
-        if (auto cmd = mission::NextDemoCommand(service_->mission(), service_->self())) {
+      const raft::MissionState* mission = service_->FindMission();
+      if (service_->is_leader() && mission != nullptr) {
+        if (auto cmd = mission::NextDemoCommand(*mission, service_->self())) {
           (void)service_->Propose(*cmd);  // kUnavailable (leadership just lost): the next round retries
         }
       }

@@ -20,6 +20,12 @@
 // and the steady clock with netem. The event lines (event=leader_elected, ...) carry `t` from
 // `event_clock` when given (the agent's simulated seconds, so that every line of an agent is on one
 // axis in both models), else from `clock`.
+// The replicated state machine is the caller's (`machine` at Start; null: a MissionStateMachine,
+// the SAR mission, which agent_node and MissionHost read through mission()). A brain reads the
+// committed log through TakeCommitted (every entry applied since the previous call, in index
+// order; after a restart first the replay of the WAL, see raft/node_driver.hpp) and proposes
+// bytes with ProposeBytes.
+//
 // Thread-safety: none; the control loop calls everything. Ownership: `radio`, `clock`,
 // `event_clock` and `log` must outlive the host.
 #pragma once
@@ -37,6 +43,7 @@
 #include "swarmbox/radio/mesh_radio.hpp"
 #include "swarmbox/raft/file_system.hpp"
 #include "swarmbox/raft/node_driver.hpp"
+#include "swarmbox/raft/state_machine.hpp"
 
 namespace swarmbox::agent {
 
@@ -95,11 +102,13 @@ class RadioTransport final : public raft::Transport {
 
 class RaftHost {
  public:
-  // Opens the WAL (replaying it) and starts the service; events are logfmt lines on `log`.
-  // Errors: kInvalidArgument for bad members/timings, the storage's errors.
+  // Opens the WAL (replaying it into `machine`, null: a MissionStateMachine) and starts the
+  // service; events are logfmt lines on `log`. Errors: kInvalidArgument for bad members/timings
+  // or propose_every_ms > 0 with a machine other than the mission, the storage's errors.
   static Result<std::unique_ptr<RaftHost>> Start(const RaftHostOptions& options, radio::MeshRadio& radio,
                                                  const raft::Clock& clock, std::FILE* log,
-                                                 const raft::Clock* event_clock = nullptr);
+                                                 const raft::Clock* event_clock = nullptr,
+                                                 std::unique_ptr<raft::StateMachine> machine = nullptr);
 
   // A delivered RaftMessage payload addressed to this drone, in delivery order.
   void OnPayload(std::span<const std::uint8_t> bytes) { service_->OnPayload(bytes); }
@@ -108,6 +117,18 @@ class RaftHost {
   Status Step();
   bool stopped() const { return service_->stopped(); }
   mission::RaftService& service() { return *service_; }
+
+  // The committed-entries tap: replaces *out with the entries applied since the previous call.
+  void TakeCommitted(std::vector<raft::Committed>* out) { service_->TakeCommitted(out); }
+  // Proposes an entry (kUnavailable: no leader known; kInvalidArgument: empty; the stop error).
+  Status ProposeBytes(raft::Bytes data) { return service_->ProposeBytes(std::move(data)); }
+  std::string leader() const { return service_->leader(); }  // "" when none known
+  bool is_leader() const { return service_->is_leader(); }
+  const raft::StateMachine& machine() const { return service_->machine(); }
+  // The committed SAR mission (a MissionStateMachine only; aborts otherwise). FindMission():
+  // nullptr for another machine.
+  const raft::MissionState& mission() const { return service_->mission(); }
+  const raft::MissionState* FindMission() const { return service_->FindMission(); }
 
  private:
   RaftHost(RaftHostOptions options, radio::MeshRadio& radio, const raft::Clock& clock)

@@ -15,8 +15,13 @@ constexpr double kAngAccelCutoff_hz = 30.0;
 
 bool Flying(FlightMode m) {
   return m == FlightMode::kTakeoff || m == FlightMode::kHold || m == FlightMode::kPosition ||
-         m == FlightMode::kVelocity || m == FlightMode::kLand;
+         m == FlightMode::kVelocity || m == FlightMode::kTrajectory || m == FlightMode::kLand;
 }
+
+bool NoInfinity(const Vec3& v) { return !std::isinf(v.x()) && !std::isinf(v.y()) && !std::isinf(v.z()); }
+
+bool ExactlyAllSet(const Vec3& v) { return v.allFinite(); }
+bool AllUnset(const Vec3& v) { return std::isnan(v.x()) && std::isnan(v.y()) && std::isnan(v.z()); }
 
 }  // namespace
 
@@ -28,6 +33,7 @@ std::string_view FlightModeName(FlightMode mode) {
     case FlightMode::kHold: return "hold";
     case FlightMode::kPosition: return "position";
     case FlightMode::kVelocity: return "velocity";
+    case FlightMode::kTrajectory: return "trajectory";
     case FlightMode::kLand: return "land";
     case FlightMode::kLanded: return "landed";
   }
@@ -48,6 +54,18 @@ std::string_view FlightEventName(FlightEventKind kind) {
     case FlightEventKind::kRejected: return "setpoint_rejected";
   }
   return "unknown";
+}
+
+Setpoint Setpoint::FromTrajectory(const TrajectoryTarget& t) {
+  const bool no_yawspeed = std::isnan(t.yawspeed_radps);
+  const bool yaw_ok = !std::isinf(t.yaw_rad);
+  if (ExactlyAllSet(t.pos_m) && AllUnset(t.vel_mps) && AllUnset(t.acc_mps2) && no_yawspeed && yaw_ok) {
+    return Position(t.pos_m, t.yaw_rad);
+  }
+  if (AllUnset(t.pos_m) && ExactlyAllSet(t.vel_mps) && AllUnset(t.acc_mps2) && no_yawspeed && yaw_ok) {
+    return Velocity(t.vel_mps, t.yaw_rad);
+  }
+  return Trajectory(t);
 }
 
 Result<FlightController> FlightController::Create(const FlightConfig& config,
@@ -211,14 +229,17 @@ bool FlightController::Command(const Setpoint& sp) {
     case Setpoint::Kind::kVelocity:
     case Setpoint::Kind::kHold:
     case Setpoint::Kind::kLand:
+    case Setpoint::Kind::kTrajectory:
       break;
   }
   if (on_ground) {
     Emit(FlightEventKind::kRejected, t);
     return false;
   }
+  if (sp.kind == Setpoint::Kind::kTrajectory) return CommandTrajectory(sp.trajectory, t);
   trajectory_.SetLimits(config_.limits);
-  if (mode_ == FlightMode::kLand) StartTrajectoryHere();
+  // The reference generator did not run in Land and Trajectory: restart it where the drone is.
+  if (mode_ == FlightMode::kLand || mode_ == FlightMode::kTrajectory) StartTrajectoryHere();
   switch (sp.kind) {
     case Setpoint::Kind::kPosition:
       trajectory_.SetPositionTarget(sp.value);
@@ -249,10 +270,80 @@ bool FlightController::Command(const Setpoint& sp) {
       return true;
     }
     case Setpoint::Kind::kTakeoff:
+    case Setpoint::Kind::kTrajectory:
       break;
   }
   Emit(FlightEventKind::kRejected, t);
   return false;
+}
+
+bool FlightController::CommandTrajectory(const TrajectoryTarget& target, double t_s) {
+  if (!NoInfinity(target.pos_m) || !NoInfinity(target.vel_mps) || !NoInfinity(target.acc_mps2) ||
+      std::isinf(target.yaw_rad) || std::isinf(target.yawspeed_radps)) {
+    Emit(FlightEventKind::kRejected, t_s);
+    return false;
+  }
+  const StateEstimate& s = estimator_.state();
+  const bool continuing = mode_ == FlightMode::kTrajectory;
+  for (int a = 0; a < 3; ++a) {
+    const auto i = static_cast<std::size_t>(a);
+    const bool unset = std::isnan(target.pos_m[a]) && std::isnan(target.vel_mps[a]) && std::isnan(target.acc_mps2[a]);
+    if (unset && !(continuing && traj_held_[i])) {
+      // Hold where braking at the acceleration limit from the estimated velocity ends (as Hold).
+      const double acc_max = std::max(0.1, a < 2 ? config_.limits.acc_max_xy_mps2 : config_.limits.acc_max_z_mps2);
+      const double v = s.vel_mps[a];
+      traj_hold_m_[a] = s.pos_m[a] + v * std::abs(v) / (2.0 * acc_max);
+    }
+    traj_held_[i] = unset;
+  }
+  if (!std::isnan(target.yaw_rad)) yaw_sp_rad_ = WrapPi(target.yaw_rad);
+  traj_ = target;
+  if (mode_ == FlightMode::kLand) StartTrajectoryHere();  // for a later Position/Hold, as they do
+  SetMode(FlightMode::kTrajectory, t_s);
+  return true;
+}
+
+PositionSetpoint FlightController::TrajectoryStep(const StateEstimate& s, double dt_s, double* yawspeed_ff_radps) {
+  PositionSetpoint psp;
+  const auto or0 = [](double v) { return std::isnan(v) ? 0.0 : v; };
+  // The target's velocities (setpoints and feed-forwards) within the airframe's limits, as the
+  // reference of the other kinds: horizontal by norm, vertical up/down.
+  Vec3 vel(or0(traj_.vel_mps.x()), or0(traj_.vel_mps.y()), or0(traj_.vel_mps.z()));
+  const TrajectoryLimits& lim = config_.limits;
+  const double vxy = vel.head<2>().norm();
+  if (vxy > lim.vel_max_xy_mps) vel.head<2>() *= lim.vel_max_xy_mps / vxy;
+  vel.z() = std::clamp(vel.z(), -lim.vel_max_down_mps, lim.vel_max_up_mps);
+  for (int a = 0; a < 3; ++a) {
+    const auto i = static_cast<std::size_t>(a);
+    psp.vel_mps[a] = vel[a];
+    psp.acc_mps2[a] = or0(traj_.acc_mps2[a]);
+    psp.pos_m[a] = s.pos_m[a];  // unused unless the axis is position-controlled
+    if (traj_held_[i]) {
+      psp.axes[i] = AxisControl::kPosition;
+      psp.pos_m[a] = traj_hold_m_[a];
+    } else if (!std::isnan(traj_.pos_m[a])) {
+      psp.axes[i] = AxisControl::kPosition;
+      psp.pos_m[a] = traj_.pos_m[a];
+    } else if (!std::isnan(traj_.vel_mps[a])) {
+      psp.axes[i] = AxisControl::kVelocity;
+    } else {
+      psp.axes[i] = AxisControl::kAcceleration;
+      psp.vel_mps[a] = 0.0;
+    }
+  }
+  psp.vel_cap_xy_mps = lim.vel_max_xy_mps;
+  psp.vel_cap_up_mps = lim.vel_max_up_mps;
+  psp.vel_cap_down_mps = lim.vel_max_down_mps;
+  // Heading: yaw (set at the command), else turn at yawspeed, else keep.
+  *yawspeed_ff_radps = 0.0;
+  if (std::isnan(traj_.yaw_rad) && !std::isnan(traj_.yawspeed_radps)) {
+    const double rate = std::clamp(traj_.yawspeed_radps, -kYawRateLimit_radps, kYawRateLimit_radps);
+    yaw_sp_rad_ = WrapPi(yaw_sp_rad_ + rate * dt_s);
+    *yawspeed_ff_radps = rate;
+  }
+  psp.yaw_rad = yaw_sp_rad_;
+  psp.yawspeed_radps = *yawspeed_ff_radps;
+  return psp;
 }
 
 void FlightController::DisarmedOutput() {
@@ -317,13 +408,18 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
   // Reference for this step.
   PositionSetpoint psp;
   psp.yaw_rad = yaw_sp_rad_;
-  if (mode_ == FlightMode::kLand) {
+  double yawspeed_ff_radps = 0.0;
+  if (mode_ == FlightMode::kTrajectory) {
+    psp = TrajectoryStep(s, dt, &yawspeed_ff_radps);
+    telemetry_.reference.pos_m = psp.pos_m;
+    telemetry_.reference.vel_mps = psp.vel_mps;
+    telemetry_.reference.acc_mps2 = psp.acc_mps2;
+  } else if (mode_ == FlightMode::kLand) {
     const double height = s.pos_m.z() - home_z_m_;
     const double v_target = height < config_.land_slow_below_m ? config_.land_slow_speed_mps : config_.land_speed_mps;
     const double dv = config_.limits.acc_max_z_mps2 * 0.5 * dt;
     land_vz_mps_ = std::clamp(-v_target, land_vz_mps_ - dv, land_vz_mps_ + dv);
-    psp.pos_xy = true;
-    psp.pos_z = false;
+    psp.axes = {AxisControl::kPosition, AxisControl::kPosition, AxisControl::kVelocity};
     psp.pos_m = land_xy_m_;
     psp.vel_mps = Vec3(0.0, 0.0, land_vz_mps_);
     telemetry_.reference.pos_m = land_xy_m_;
@@ -350,8 +446,7 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
     }
     telemetry_.reference = ref;
     if (mode_ == FlightMode::kVelocity) {
-      psp.pos_xy = false;
-      psp.pos_z = false;
+      psp.axes = {AxisControl::kVelocity, AxisControl::kVelocity, AxisControl::kVelocity};
     }
     psp.pos_m = ref.pos_m;
     psp.vel_mps = ref.vel_mps;
@@ -392,7 +487,7 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
     // Non-finite estimate or setpoint: nothing sane to fly. Keep the last output, report once.
     return output_;
   }
-  const Vec3 rate_sp = attitude_.Update(s.att, po.att_sp, 0.0);
+  const Vec3 rate_sp = attitude_.Update(s.att, po.att_sp, yawspeed_ff_radps);
 
   // Angular acceleration for the D term: differentiated, low-passed rate.
   const double alpha = dt / (dt + 1.0 / (2.0 * kPi * kAngAccelCutoff_hz));

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <limits>
 
 namespace swarmbox::flight {
 namespace {
@@ -36,18 +38,34 @@ PositionOutput PositionControl::Update(const StateEstimate& state, const Positio
   }
   const PositionParams& p = params_;
 
-  // Position P -> velocity setpoint, with the velocity limits.
+  // Position P -> velocity setpoint, with the velocity limits. Acceleration-only axes have none.
+  const auto is = [&sp](int a, AxisControl c) { return sp.axes[static_cast<std::size_t>(a)] == c; };
   Vec3 vel_sp = sp.vel_mps;
-  if (sp.pos_xy) vel_sp.head<2>() += p.xy_p * (sp.pos_m - state.pos_m).head<2>();
-  if (sp.pos_z) vel_sp.z() += p.z_p * (sp.pos_m.z() - state.pos_m.z());
+  for (int a = 0; a < 3; ++a) {
+    if (is(a, AxisControl::kPosition)) {
+      vel_sp[a] += (a < 2 ? p.xy_p : p.z_p) * (sp.pos_m[a] - state.pos_m[a]);
+    } else if (is(a, AxisControl::kAcceleration)) {
+      vel_sp[a] = 0.0;
+    }
+  }
+  const double vel_max_xy = std::min(p.vel_max_xy_mps, sp.vel_cap_xy_mps);
   const double vxy = vel_sp.head<2>().norm();
-  if (vxy > p.vel_max_xy_mps) vel_sp.head<2>() *= p.vel_max_xy_mps / vxy;
-  vel_sp.z() = std::clamp(vel_sp.z(), -p.vel_max_down_mps, p.vel_max_up_mps);
+  if (vxy > vel_max_xy) vel_sp.head<2>() *= vel_max_xy / vxy;
+  vel_sp.z() = std::clamp(vel_sp.z(), -std::min(p.vel_max_down_mps, sp.vel_cap_down_mps),
+                          std::min(p.vel_max_up_mps, sp.vel_cap_up_mps));
 
-  // Velocity PID -> acceleration setpoint (D on the measured acceleration).
-  const Vec3 vel_err = vel_sp - state.vel_mps;
+  // Velocity PID -> acceleration setpoint (D on the measured acceleration); acceleration-only
+  // axes take the feed-forward alone (PX4: a NaN velocity setpoint leaves the axis to it).
+  Vec3 vel_err = vel_sp - state.vel_mps;
   Vec3 acc_sp = p.vel_p.cwiseProduct(vel_err) + integral_ - p.vel_d.cwiseProduct(state.accel_mps2) +
                 sp.acc_mps2;
+  for (int a = 0; a < 3; ++a) {
+    if (is(a, AxisControl::kAcceleration)) {
+      vel_err[a] = 0.0;
+      vel_sp[a] = std::numeric_limits<double>::quiet_NaN();
+      acc_sp[a] = sp.acc_mps2[a];
+    }
+  }
 
   // Thrust: vertical first (altitude has priority), then horizontal within the tilt and the
   // remaining thrust margin.
@@ -68,10 +86,11 @@ PositionOutput PositionControl::Update(const StateEstimate& state, const Positio
     const double ez = vel_err.z();
     const bool sat_hi = fz_raw >= f_max && ez > 0.0;
     const bool sat_lo = fz_raw <= f_min && ez < 0.0;
-    if (!sat_hi && !sat_lo) integral_.z() += p.vel_i.z() * ez * dt_s;
+    if (!sat_hi && !sat_lo && !is(2, AxisControl::kAcceleration)) integral_.z() += p.vel_i.z() * ez * dt_s;
     const Vec3 acc_xy_lim = f_xy / mass_kg;
     const Vec3 acc_xy_raw = f_xy_raw / mass_kg;
     for (int a = 0; a < 2; ++a) {
+      if (is(a, AxisControl::kAcceleration)) continue;  // frozen
       const double arw_gain = p.vel_p[a] > 0.0 ? 2.0 / p.vel_p[a] : 0.0;
       const double e = vel_err[a] - arw_gain * (acc_xy_raw[a] - acc_xy_lim[a]);
       integral_[a] += p.vel_i[a] * e * dt_s;

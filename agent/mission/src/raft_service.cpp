@@ -27,7 +27,8 @@ RaftService::~RaftService() { driver_.reset(); }
 
 Result<std::unique_ptr<RaftService>> RaftService::Start(const RaftServiceConfig& config,
                                                         raft::Transport& transport,
-                                                        const raft::Clock& clock, LineSink out) {
+                                                        const raft::Clock& clock, LineSink out,
+                                                        std::unique_ptr<raft::StateMachine> machine) {
   if (auto c = config.driver.ToRaftConfig(); !c) return c.error().Context("raft service");
   if (config.data_dir.empty()) {
     return Error(ErrorCode::kInvalidArgument, "raft service: no data directory");
@@ -45,7 +46,8 @@ Result<std::unique_ptr<RaftService>> RaftService::Start(const RaftServiceConfig&
 
   RaftService* raw = s.get();
   auto driver = raft::NodeDriver::Open(s->config_.driver, *s->wal_, transport, clock,
-                                       [raw](const LogEvent& e) { raw->out_(e.str()); });
+                                       [raw](const LogEvent& e) { raw->out_(e.str()); },
+                                       std::move(machine));
   if (!driver) return std::move(driver).error().Context("raft service: opening the node");
   s->driver_ = std::move(*driver);
 
@@ -82,6 +84,8 @@ Status RaftService::Tick() {
 Status RaftService::Propose(const raft::MissionCommand& command) {
   return driver_->Propose(command);
 }
+
+Status RaftService::ProposeBytes(raft::Bytes data) { return driver_->Propose(std::move(data)); }
 
 Status RaftService::Campaign() { return driver_->Campaign(); }
 

@@ -24,6 +24,7 @@ DdsRadio::DdsRadio(std::string self, std::vector<std::string> peers)
 
 DdsRadio::~DdsRadio() {
   // Readers first: no callback runs after these return.
+  brain_sub_.reset();
   state_sub_.reset();
   ping_sub_.reset();
   raft_.reset();
@@ -103,6 +104,23 @@ Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::
     if (!sub) return sub.error().Context("dds radio: hearing drone states");
     radio->state_sub_ = std::move(*sub);
   }
+  if (options.brains) {
+    auto bp = mesh.CreatePublisher<bus::BrainMessage>(bus::kBrainMessageTopic, bus::Qos::kRadio);
+    if (!bp) return bp.error().Context("dds radio: publishing brain messages");
+    radio->brain_pub_ = std::move(*bp);
+    auto sub = mesh.CreateSubscriber<bus::BrainMessage>(bus::kBrainMessageTopic, bus::Qos::kRadio,
+                                                        [raw](const bus::BrainMessage& m) {
+                                                          if (m.from == raw->self_) return;
+                                                          if (!m.to.empty() && m.to != raw->self_) return;
+                                                          bus::RadioFrame f;
+                                                          f.from = m.from;
+                                                          f.to = m.to;
+                                                          f.brain_msg.push_back(m);
+                                                          raw->Push(std::move(f));
+                                                        });
+    if (!sub) return sub.error().Context("dds radio: hearing brain messages");
+    radio->brain_sub_ = std::move(*sub);
+  }
   return radio;
 }
 
@@ -142,6 +160,13 @@ bool DdsRadio::Publish(const bus::RadioFrame& frame) {
       return false;  // no ping writers, or a ping to a drone that is not a member
     }
     return static_cast<bool>(PingWriterFor(m).Publish(m));
+  }
+  if (!frame.brain_msg.empty()) {
+    if (!brain_pub_) return false;
+    bus::BrainMessage m = frame.brain_msg.front();
+    m.from = self_;
+    if (m.to.empty()) m.to = frame.to;
+    return static_cast<bool>(brain_pub_->Publish(m));
   }
   return false;
 }

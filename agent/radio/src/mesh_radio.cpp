@@ -18,6 +18,7 @@ std::size_t Payload(const bus::RadioFrame& f) {
   for (const bus::Detection& d : f.detection_msg) n += Str(d.from) + 8 + 8 + Str(d.label) + 8 + 3 * 8 + 8;
   for (const bus::RaftMessage& r : f.raft_msg) n += Str(r.from) + Str(r.to) + 8 + 4 + r.payload.size();
   for (const bus::RadioPing& p : f.ping_msg) n += Str(p.from) + Str(p.to) + 8 + 8 + 1;
+  for (const bus::BrainMessage& b : f.brain_msg) n += Str(b.from) + Str(b.to) + Str(b.topic) + 4 + b.payload.size();
   return n;
 }
 

@@ -53,13 +53,17 @@ Status DriverConfig::ValidateTiming() const {
 }
 
 NodeDriver::NodeDriver(DriverConfig config, std::vector<std::string> names, std::uint32_t tag,
-                       RawNode node, MissionState mission, Storage& storage, Transport& transport,
+                       RawNode node, std::unique_ptr<StateMachine> machine, std::uint64_t applied,
+                       std::vector<Committed> tap, Storage& storage, Transport& transport,
                        const Clock& clock, EventSink sink)
     : config_(std::move(config)),
       names_(std::move(names)),
       cluster_tag_(tag),
       node_(std::move(node)),
-      mission_(std::move(mission)),
+      machine_(std::move(machine)),
+      mission_machine_(dynamic_cast<const MissionStateMachine*>(machine_.get())),
+      applied_(applied),
+      tap_(std::move(tap)),
       storage_(storage),
       transport_(transport),
       clock_(clock),
@@ -68,21 +72,27 @@ NodeDriver::NodeDriver(DriverConfig config, std::vector<std::string> names, std:
 Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config, Storage& storage,
                                                      Transport& transport, const Clock& clock,
                                                      EventSink sink) {
+  return Open(config, storage, transport, clock, std::move(sink), nullptr);
+}
+
+Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config, Storage& storage,
+                                                     Transport& transport, const Clock& clock,
+                                                     EventSink sink,
+                                                     std::unique_ptr<StateMachine> machine) {
   auto rc = config.ToRaftConfig();
   if (!rc) return rc.error();
+  if (!machine) machine = std::make_unique<MissionStateMachine>();
   auto state = storage.Load();
   if (!state) return state.error().Context("loading raft state");
-  MissionState mission;
+  std::uint64_t applied = 0;
+  std::vector<Committed> tap;
   if (!state->snapshot.empty()) {
-    auto m = MissionState::DecodeSnapshot(state->snapshot.data);
-    if (!m) return m.error().Context("restoring the mission from the stored snapshot");
-    if (m->applied_index() != state->snapshot.index) {
-      return Error(ErrorCode::kProtocol,
-                   "stored snapshot " + std::to_string(state->snapshot.index) +
-                       " holds a mission applied to " + std::to_string(m->applied_index()),
-                   "raft storage");
+    if (auto s = machine->Restore(state->snapshot.data); !s) {
+      return s.error().Context("restoring the state machine from the stored snapshot " +
+                               std::to_string(state->snapshot.index));
     }
-    mission = std::move(*m);
+    applied = state->snapshot.index;
+    machine->ReplayRestored(0, &tap);
   }
   auto node = RawNode::Create(*rc, std::move(*state));
   if (!node) return node.error().Context("restarting raft");
@@ -90,8 +100,8 @@ Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config,
   std::sort(names.begin(), names.end());
   const std::uint32_t tag = ClusterTag(names);
   std::unique_ptr<NodeDriver> d(new NodeDriver(config, std::move(names), tag, std::move(*node),
-                                               std::move(mission), storage, transport, clock,
-                                               std::move(sink)));
+                                               std::move(machine), applied, std::move(tap),
+                                               storage, transport, clock, std::move(sink)));
   // Hand over what the restart produced (the term bump of a fresh node, re-applying the
   // committed entries after the snapshot).
   if (auto s = d->Process(); !s) return s.error();
@@ -102,6 +112,16 @@ NodeId NodeDriver::IdOf(const std::string& name) const {
   auto it = std::lower_bound(names_.begin(), names_.end(), name);
   if (it == names_.end() || *it != name) return kNoNode;
   return static_cast<NodeId>(it - names_.begin()) + 1;
+}
+
+const MissionState& NodeDriver::mission() const {
+  SWARMBOX_CHECK(mission_machine_ != nullptr);  // mission() of a driver without a mission
+  return mission_machine_->mission();
+}
+
+void NodeDriver::TakeCommitted(std::vector<Committed>* out) {
+  out->clear();
+  out->swap(tap_);
 }
 
 std::string NodeDriver::leader() const {
@@ -149,46 +169,29 @@ Status NodeDriver::Receive(std::span<const std::uint8_t> bytes) {
   return step;
 }
 
-Status NodeDriver::Propose(const MissionCommand& command) {
+Status NodeDriver::Propose(Bytes data) {
   if (stop_error_) return *stop_error_;
-  Status s = node_.Propose(EncodeCommand(command));
+  if (data.empty()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "an empty entry cannot be proposed (empty entries are the leader's no-ops)",
+                 "raft driver");
+  }
+  Status s = node_.Propose(std::move(data));
   Status processed = Process();
   if (!processed) return processed;
   return s;
 }
 
+Status NodeDriver::Propose(const MissionCommand& command) { return Propose(EncodeCommand(command)); }
+
 void NodeDriver::ApplyEntry(const Entry& e) {
-  if (e.index <= mission_.applied_index()) return;  // already in the restored snapshot
-  if (e.type == EntryType::kEmpty) {
-    mission_.Skip(e.index);
-    return;
-  }
-  ApplyResult r = mission_.ApplyEncoded(e.index, e.data);
-  const double t = clock_.NowS();
-  for (const MissionEvent& ev : r.events) {
-    switch (ev.kind) {
-      case MissionEvent::Kind::kPhase:
-        Emit(LogEvent(t, config_.self, "mission_state")
-                 .Add("state", PhaseName(ev.phase))
-                 .Add("index", ev.index));
-        break;
-      case MissionEvent::Kind::kVictimConfirmed:
-        Emit(LogEvent(t, config_.self, "victim_confirmed")
-                 .Add("id", static_cast<std::uint64_t>(ev.victim.id))
-                 .Add("x", ev.victim.x_m)
-                 .Add("y", ev.victim.y_m)
-                 .Add("index", ev.index));
-        break;
-      case MissionEvent::Kind::kVictimStatus: {
-        LogEvent le(t, config_.self, "victim_status");
-        le.Add("id", static_cast<std::uint64_t>(ev.victim.id))
-            .Add("status", VictimStatusName(ev.victim.status));
-        if (!ev.victim.rescuer.empty()) le.Add("rescuer", ev.victim.rescuer);
-        Emit(le.Add("index", ev.index));
-        break;
-      }
-    }
-  }
+  if (e.index <= applied_) return;  // already in the restored snapshot
+  applied_ = e.index;
+  // A kNormal entry is never empty (Propose refuses that); treat one like the no-op it carries.
+  const bool noop = e.type == EntryType::kEmpty || e.data.empty();
+  const std::span<const std::uint8_t> data = noop ? std::span<const std::uint8_t>() : e.data;
+  machine_->Apply(e.index, data, EventOut(clock_.NowS(), config_.self, sink_));
+  if (!noop) tap_.push_back(Committed{e.index, e.data});
 }
 
 Status NodeDriver::Process() {
@@ -213,25 +216,29 @@ Status NodeDriver::Process() {
                .Add("leader", NameOf(announced_lead_)));
     }
     if (!rd.snapshot.empty()) {
-      auto m = MissionState::DecodeSnapshot(rd.snapshot.data);
-      if (!m) return Stop(m.error().Context("leader sent an unreadable snapshot"));
-      mission_ = std::move(*m);
       // The snapshot is the state after its index; nothing before it is applied again.
-      if (mission_.applied_index() != rd.snapshot.index) {
-        return Stop(Error(ErrorCode::kProtocol, "snapshot index mismatch", "raft driver"));
+      if (rd.snapshot.index < applied_) {
+        return Stop(Error(ErrorCode::kProtocol,
+                          "snapshot at " + std::to_string(rd.snapshot.index) +
+                              " is behind the applied index " + std::to_string(applied_),
+                          "raft driver"));
       }
-      Emit(LogEvent(clock_.NowS(), config_.self, "mission_state")
-               .Add("state", PhaseName(mission_.phase()))
-               .Add("index", rd.snapshot.index)
-               .Add("from", "snapshot"));
+      if (auto s = machine_->Restore(rd.snapshot.data); !s) {
+        return Stop(s.error().Context("leader sent an unreadable snapshot"));
+      }
+      const std::uint64_t before = applied_;
+      applied_ = rd.snapshot.index;
+      machine_->OnSnapshotInstalled(rd.snapshot.index,
+                                    EventOut(clock_.NowS(), config_.self, sink_));
+      machine_->ReplayRestored(before, &tap_);
     }
     for (const Entry& e : rd.committed_entries) ApplyEntry(e);
     node_.Advance(rd);
   }
-  // Raft §7: compact the log into a snapshot of the mission once enough has been applied.
+  // Raft §7: compact the log into a snapshot of the state machine once enough has been applied.
   const std::uint64_t applied = node_.log().applied();
   if (applied >= node_.log().snapshot_index() + config_.snapshot_every_entries) {
-    Snapshot snap{applied, *node_.log().Term(applied), mission_.EncodeSnapshot()};
+    Snapshot snap{applied, *node_.log().Term(applied), machine_->Snapshot()};
     if (auto s = storage_.Compact(snap); !s) {
       return Stop(s.error().Context("raft storage failed while compacting, node stopped"));
     }

@@ -24,6 +24,9 @@ class Recorder final : public FrameHandler {
   void OnDetection(const bus::Detection& d, const bus::RadioFrame&) override {
     calls.push_back("detection:" + d.from);
   }
+  void OnBrainMessage(const bus::BrainMessage& m, const bus::RadioFrame&) override {
+    calls.push_back("brain:" + m.from + ">" + m.to + ":" + m.topic);
+  }
   std::vector<std::string> calls;
 };
 
@@ -56,19 +59,33 @@ bus::RadioFrame Ping(const std::string& from, const std::string& to) {
   return f;
 }
 
+bus::RadioFrame Brain(const std::string& from, const std::string& to, const std::string& topic) {
+  bus::RadioFrame f;
+  f.from = from;
+  f.to = to;
+  bus::BrainMessage m;
+  m.from = from;
+  m.to = to;
+  m.topic = topic;
+  m.payload = {1, 2, 3};
+  f.brain_msg.push_back(m);
+  return f;
+}
+
 TEST(RadioDispatch, HandsEachFrameToItsConsumerInDeliveryOrder) {
   bus::RadioFrame det;
   det.from = "scout_3";
   det.detection_msg.emplace_back();
   det.detection_msg[0].from = "scout_3";
   const std::vector<bus::RadioFrame> frames = {State("scout_2", 5), Raft("scout_3", "scout_1", 12),
-                                               Ping("scout_2", "scout_1"), det, State("lifter", 6)};
+                                               Brain("scout_3", "", "rv/vote"), Ping("scout_2", "scout_1"),
+                                               det, Brain("lifter", "scout_1", "rv/ack"), State("lifter", 6)};
   Recorder r;
   DispatchCounts c;
   DispatchFrames(frames, "scout_1", r, &c);
-  EXPECT_EQ(r.calls, (std::vector<std::string>{"state:scout_2@5", "raft:12", "ping:scout_2",
-                                               "detection:scout_3", "state:lifter@6"}));
-  EXPECT_EQ(c, (DispatchCounts{.raft = 1, .ping = 1, .state = 2, .detection = 1}));
+  EXPECT_EQ(r.calls, (std::vector<std::string>{"state:scout_2@5", "raft:12", "brain:scout_3>:rv/vote", "ping:scout_2",
+                                               "detection:scout_3", "brain:lifter>scout_1:rv/ack", "state:lifter@6"}));
+  EXPECT_EQ(c, (DispatchCounts{.raft = 1, .ping = 1, .state = 2, .detection = 1, .brain = 2}));
 }
 
 TEST(RadioDispatch, DropsOwnForeignAndMalformedFrames) {
@@ -80,6 +97,10 @@ TEST(RadioDispatch, DropsOwnForeignAndMalformedFrames) {
   empty.from = "scout_2";
   bus::RadioFrame own_state = State("scout_2");
   own_state.state_msg[0].drone = "scout_1";  // relayed, but ours
+  bus::RadioFrame own_brain = Brain("scout_2", "", "rv");
+  own_brain.brain_msg[0].from = "scout_1";  // relayed, but ours
+  bus::RadioFrame brain_for_other = Brain("scout_2", "", "rv");
+  brain_for_other.brain_msg[0].to = "lifter";  // a broadcast frame holding a message for another drone
   const std::vector<bus::RadioFrame> frames = {
       State("scout_1"),               // our own broadcast
       Raft("scout_2", "scout_3", 4),  // addressed to another drone
@@ -88,12 +109,16 @@ TEST(RadioDispatch, DropsOwnForeignAndMalformedFrames) {
       two_kinds,
       two_states,
       empty,
-      own_state};
+      own_state,
+      Brain("scout_1", "", "rv"),       // our own brain's broadcast
+      Brain("scout_2", "lifter", "rv"),  // addressed to another drone
+      own_brain,
+      brain_for_other};
   Recorder r;
   DispatchCounts c;
   DispatchFrames(frames, "scout_1", r, &c);
   EXPECT_TRUE(r.calls.empty());
-  EXPECT_EQ(c, (DispatchCounts{.own = 2, .not_for_us = 2, .malformed = 4}));
+  EXPECT_EQ(c, (DispatchCounts{.own = 4, .not_for_us = 4, .malformed = 4}));
 }
 
 TEST(RadioDispatch, DeliversRaftEnvelopesWhoseFrameHasNoSender) {

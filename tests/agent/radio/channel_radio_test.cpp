@@ -52,6 +52,33 @@ TEST(ChannelRadio, SendStampsTheFrameWithTheStepsSimulatedTime) {
   EXPECT_EQ(radio.sent(), 2u);
 }
 
+TEST(ChannelRadio, CarriesBrainMessagesAndChargesTheirBytes) {
+  ChannelRadio radio("scout_1");
+  std::vector<bus::RadioFrame> in;
+  bus::SensorSample sample = SampleAt(8'000'000);
+  bus::RadioFrame heard;
+  heard.from = "scout_2";
+  heard.delivered_ns = 8'000'000;
+  heard.brain_msg.push_back({"scout_2", "", "rendezvous/vote", {1, 2, 3}});
+  sample.radio_in.push_back(heard);
+  radio.TakeReceived(sample, &in);
+  ASSERT_EQ(in.size(), 1u);
+  EXPECT_EQ(in[0], heard);
+  bus::RadioFrame f;
+  f.brain_msg.push_back({"scout_1", "", "rendezvous/vote", std::vector<std::uint8_t>(100, 7)});
+  radio.Send(f);
+  f.brain_msg[0].payload.resize(300);
+  radio.Send(f);
+  bus::ActuatorCommand cmd;
+  radio.Flush(&cmd);
+  ASSERT_EQ(cmd.radio_out.size(), 2u);
+  EXPECT_EQ(cmd.radio_out[0].brain_msg[0].topic, "rendezvous/vote");
+  EXPECT_EQ(cmd.radio_out[0].sent_ns, 8'000'000);
+  // The payload is on the air: 200 more bytes cost 200 more bytes of airtime.
+  EXPECT_EQ(cmd.radio_out[1].size_bytes - cmd.radio_out[0].size_bytes, 200u);
+  EXPECT_GT(cmd.radio_out[0].size_bytes, 106u + 100u);
+}
+
 TEST(ChannelRadio, FlushReplacesRadioOutAndEmptiesTheQueue) {
   ChannelRadio radio("scout_1");
   bus::ActuatorCommand cmd;

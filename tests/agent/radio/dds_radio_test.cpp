@@ -2,11 +2,12 @@
 // control loop drives it (TakeReceived, the LinkProbe, Send; every 5 ms of wall time): two drones
 // see a clean fast link, hear each other's DroneStates and Raft payloads addressed to them, a
 // third drone's traffic is not counted, a missing peer is reported lost, bad arguments fail with
-// the reason. DDS domains 224-226.
+// the reason, brain messages reach their addressees. DDS domains 224-226.
 #include "swarmbox/radio/dds_radio.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <map>
 #include <string>
@@ -179,6 +180,65 @@ TEST(DdsRadio, RefusesBadNamesAndPingsWithoutPeers) {
   ASSERT_TRUE(plain) << plain.error().ToString();
   bus::RadioFrame f;
   f.raft_msg.emplace_back();
+  (*plain)->Send(f);
+  EXPECT_EQ((*plain)->counters().send_errors, 1u);
+}
+
+TEST(DdsRadio, CarriesBrainMessagesToTheirAddresseesOnly) {
+  // Three radios with brains on one mesh: a broadcast reaches the two others, an addressed
+  // message only its addressee; nobody hears itself.
+  std::vector<std::unique_ptr<bus::Participant>> meshes;
+  std::vector<std::unique_ptr<DdsRadio>> radios;
+  const std::vector<std::string> names = {"a", "b", "c"};
+  for (const std::string& n : names) {
+    meshes.push_back(Mesh(226));
+    ASSERT_TRUE(meshes.back());
+    auto r = DdsRadio::Create(*meshes.back(), n, {.members = {}, .raft = false, .pings = false, .hear_states = false, .brains = true});
+    ASSERT_TRUE(r) << r.error().ToString();
+    radios.push_back(std::move(*r));
+  }
+  std::map<std::string, std::vector<std::string>> heard;  // receiver -> "from>to:topic:payload size"
+  const auto end = std::chrono::steady_clock::now() + 8s;
+  std::vector<bus::RadioFrame> frames;
+  while (std::chrono::steady_clock::now() < end) {
+    bus::RadioFrame f;
+    bus::BrainMessage m;
+    m.topic = "rv/vote";
+    m.payload = {1, 2, 3};
+    f.brain_msg.push_back(m);
+    radios[0]->Send(f);  // broadcast
+    f.to = "c";
+    f.brain_msg[0].topic = "rv/ack";
+    f.brain_msg[0].to = "c";
+    radios[0]->Send(f);
+    for (std::size_t i = 0; i < radios.size(); ++i) {
+      frames.clear();
+      radios[i]->TakeReceived(bus::SensorSample{}, &frames);
+      for (const bus::RadioFrame& r : frames) {
+        ASSERT_EQ(r.brain_msg.size(), 1u);
+        const bus::BrainMessage& b = r.brain_msg[0];
+        EXPECT_EQ(r.from, b.from);
+        EXPECT_GT(r.size_bytes, 106u);
+        heard[names[i]].push_back(b.from + ">" + b.to + ":" + b.topic + ":" + std::to_string(b.payload.size()));
+      }
+    }
+    const auto has = [&](const std::string& who, const std::string& what) {
+      return std::find(heard[who].begin(), heard[who].end(), what) != heard[who].end();
+    };
+    if (has("b", "a>:rv/vote:3") && has("c", "a>:rv/vote:3") && has("c", "a>c:rv/ack:3")) break;
+    std::this_thread::sleep_for(20ms);
+  }
+  EXPECT_TRUE(heard["a"].empty());
+  ASSERT_FALSE(heard["b"].empty());
+  for (const std::string& h : heard["b"]) EXPECT_EQ(h, "a>:rv/vote:3");
+  EXPECT_NE(std::find(heard["c"].begin(), heard["c"].end(), "a>c:rv/ack:3"), heard["c"].end());
+  EXPECT_NE(std::find(heard["c"].begin(), heard["c"].end(), "a>:rv/vote:3"), heard["c"].end());
+  EXPECT_EQ(radios[0]->counters().send_errors, 0u);
+  // Without brains, a brain frame is a send error.
+  auto plain = DdsRadio::Create(*meshes[1], "d", {});
+  ASSERT_TRUE(plain) << plain.error().ToString();
+  bus::RadioFrame f;
+  f.brain_msg.emplace_back();
   (*plain)->Send(f);
   EXPECT_EQ((*plain)->counters().send_errors, 1u);
 }

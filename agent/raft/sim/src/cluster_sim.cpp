@@ -23,6 +23,20 @@ std::uint64_t EntryHash(const Entry& e) {
   return HashBytes(e.data) ^ (static_cast<std::uint64_t>(e.type) << 56);
 }
 
+// The hash a committed no-op has (EntryType::kEmpty, no data).
+std::uint64_t NoopHash() { return EntryHash(Entry{0, 0, EntryType::kEmpty, {}}); }
+
+std::unique_ptr<StateMachine> MakeMachine(SimMachine kind) {
+  switch (kind) {
+    case SimMachine::kMission:
+      return std::make_unique<MissionStateMachine>();
+    case SimMachine::kEntryLog:
+      return std::make_unique<EntryLogMachine>();
+  }
+  SWARMBOX_CHECK(false);  // unknown SimMachine
+  return nullptr;
+}
+
 std::int64_t Us(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e6)); }
 
 }  // namespace
@@ -91,6 +105,8 @@ struct ClusterSim::Node {
   NodeId last_vote = kNoNode;
   std::uint64_t checked_commit = 0;
   std::uint64_t checked_applied = 0;
+  std::uint64_t tapped_last = 0;  // the last index the tap yielded in this life
+  std::vector<Committed> tapped;  // scratch for TakeCommitted
   std::uint64_t led_term = 0;  // last term this node was seen leading
 };
 
@@ -208,7 +224,8 @@ void ClusterSim::Restart(int node) {
   if (config_.record_events) {
     sink = [this](const LogEvent& e) { report_.events.push_back(e.str()); };
   }
-  auto d = NodeDriver::Open(dc, *n.storage, *n.transport, *clock_, sink);
+  auto d = NodeDriver::Open(dc, *n.storage, *n.transport, *clock_, sink,
+                            MakeMachine(config_.machine));
   if (!d) {
     Violation("Restart", Name(node) + " failed to restart: " + d.error().ToString());
     return;
@@ -218,6 +235,7 @@ void ClusterSim::Restart(int node) {
   ++n.epoch;
   n.checked_commit = n.driver->raft().log().snapshot_index();
   n.checked_applied = 0;
+  n.tapped_last = 0;
   // A random phase for the node's tick clock.
   auto* e = new Event;
   e->kind = Event::Kind::kTick;
@@ -252,13 +270,16 @@ void ClusterSim::Partition(const std::vector<std::vector<int>>& groups) {
 void ClusterSim::Heal() { std::fill(group_.begin(), group_.end(), 0); }
 
 Status ClusterSim::Propose(int node, const MissionCommand& command) {
+  return Propose(node, EncodeCommand(command));
+}
+
+Status ClusterSim::Propose(int node, Bytes data) {
   Node& n = *nodes_[static_cast<std::size_t>(node)];
   if (!n.alive) return Error(ErrorCode::kUnavailable, Name(node) + " is down", "sim");
-  const Bytes data = EncodeCommand(command);
   const std::uint64_t h = HashBytes(data);
   proposed_at_us_.emplace(h, now_us_);
   ++report_.proposals;
-  Status s = n.driver->Propose(command);
+  Status s = n.driver->Propose(std::move(data));
   if (!s) {
     ++report_.proposals_dropped;
     proposed_at_us_.erase(h);
@@ -597,20 +618,63 @@ void ClusterSim::CheckNode(int node) {
   }
 
   // State Machine Safety (Raft §5.4.3): the same state after applying the same index.
-  const MissionState& m = d.mission();
-  if (m.applied_index() != log.applied()) {
+  if (d.applied_index() != log.applied()) {
+    Violation("State Machine Safety", who + " state machine applied " +
+                                          std::to_string(d.applied_index()) +
+                                          " but raft applied " + std::to_string(log.applied()));
+  }
+  if (const MissionState* m = d.FindMission(); m != nullptr && m->applied_index() != log.applied()) {
     Violation("State Machine Safety", who + " mission applied " +
-                                          std::to_string(m.applied_index()) + " but raft applied " +
+                                          std::to_string(m->applied_index()) + " but raft applied " +
                                           std::to_string(log.applied()));
   }
-  if (m.applied_index() != n.checked_applied) {
-    n.checked_applied = m.applied_index();
-    const std::uint64_t h = HashBytes(m.EncodeSnapshot());
-    auto [it, inserted] = state_hash_at_.emplace(m.applied_index(), h);
+  if (d.applied_index() != n.checked_applied) {
+    n.checked_applied = d.applied_index();
+    const std::uint64_t h = HashBytes(d.machine().Snapshot());
+    auto [it, inserted] = state_hash_at_.emplace(d.applied_index(), h);
     if (!inserted && it->second != h) {
-      Violation("State Machine Safety", who + " mission state after index " +
-                                            std::to_string(m.applied_index()) + " differs");
+      Violation("State Machine Safety", who + " state after index " +
+                                            std::to_string(d.applied_index()) + " differs");
     }
+  }
+  CheckTap(node);
+}
+
+void ClusterSim::CheckTap(int node) {
+  Node& n = *nodes_[static_cast<std::size_t>(node)];
+  const std::string who = Name(node);
+  n.driver->TakeCommitted(&n.tapped);
+  report_.entries_tapped += n.tapped.size();
+  const bool complete = config_.machine == SimMachine::kEntryLog;
+  for (const Committed& c : n.tapped) {
+    if (c.index <= n.tapped_last || c.index > n.driver->applied_index()) {
+      Violation("Committed Tap", who + " tapped index " + std::to_string(c.index) + " after " +
+                                     std::to_string(n.tapped_last) + " with " +
+                                     std::to_string(n.driver->applied_index()) + " applied");
+      return;
+    }
+    const CommitFact* known = c.index <= committed_.size() ? &committed_[c.index - 1] : nullptr;
+    if (known == nullptr || known->term == 0) {
+      Violation("Committed Tap", who + " tapped index " + std::to_string(c.index) +
+                                     " that no node was seen committing");
+      return;
+    }
+    if (known->data_hash != HashBytes(c.data)) {
+      Violation("Committed Tap", who + " tapped other data than was committed at index " +
+                                     std::to_string(c.index));
+      return;
+    }
+    // The entry log replays the whole log: nothing but no-ops between two tapped entries.
+    for (std::uint64_t i = n.tapped_last + 1; complete && i < c.index; ++i) {
+      const CommitFact& gap = committed_[i - 1];
+      if (gap.term != 0 && gap.data_hash != NoopHash()) {
+        Violation("Committed Tap", who + " skipped committed entry " + std::to_string(i) +
+                                       " (tapped " + std::to_string(c.index) + " after " +
+                                       std::to_string(n.tapped_last) + ")");
+        return;
+      }
+    }
+    n.tapped_last = c.index;
   }
 }
 

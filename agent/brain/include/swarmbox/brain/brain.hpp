@@ -252,13 +252,28 @@ struct Registration {
 };
 
 // The library's table: every SWARMBOX_BRAIN of the library, in registration order.
-std::vector<Registration>& LibraryRegistry();
+//
+// One table per shared object: swarmbox::brain is a static library that every brain library (and
+// the agent) links its own copy of, and this function has hidden visibility, so a brain library's
+// SWARMBOX_BRAIN always fills that library's table, never the agent's or another library's (even
+// when the agent exports its symbols, or another library was loaded RTLD_GLOBAL). The two
+// extern "C" functions below are the only symbols a brain library must export.
+#if defined(__GNUC__)
+#define SWARMBOX_BRAIN_LOCAL __attribute__((visibility("hidden")))
+#define SWARMBOX_BRAIN_EXPORT __attribute__((visibility("default")))
+#else
+#define SWARMBOX_BRAIN_LOCAL
+#define SWARMBOX_BRAIN_EXPORT
+#endif
+SWARMBOX_BRAIN_LOCAL std::vector<Registration>& LibraryRegistry();
 
 }  // namespace swarmbox::brain
 
-// What the loader finds in a library with dlsym: the ABI version, and the table.
-extern "C" int swarmbox_brain_abi_version();
-extern "C" const std::vector<swarmbox::brain::Registration>* swarmbox_brain_registry();
+// What the loader finds in a library with dlsym: the ABI version (kAbiVersion of the SwarmBox the
+// library was built against), and the table.
+extern "C" SWARMBOX_BRAIN_EXPORT int swarmbox_brain_abi_version();
+extern "C" SWARMBOX_BRAIN_EXPORT const std::vector<swarmbox::brain::Registration>*
+swarmbox_brain_registry();
 
 #define SWARMBOX_BRAIN_CONCAT_(a, b) a##b
 #define SWARMBOX_BRAIN_CONCAT(a, b) SWARMBOX_BRAIN_CONCAT_(a, b)

@@ -67,7 +67,9 @@ class FlightController {
 
   // The setpoint interface. Rejected (and reported as an event) when the mode cannot take it:
   // anything but Takeoff on the ground, Takeoff in the air, anything before the estimator is
-  // ready. Does not allocate.
+  // ready; or when it has infinite values (non-finite for the kinds other than Trajectory, whose
+  // NaN means unset). Does not allocate. Trajectory: see setpoint.hpp; a stream of them is one
+  // mode (kTrajectory), each replacing the last.
   bool Command(const Setpoint& sp);
 
   // One control step on the lockstep sample. Motors off (armed = false) on the ground.
@@ -97,6 +99,9 @@ class FlightController {
   void ResetControllers();
   void StartTrajectoryHere();
   void DisarmedOutput();
+  bool CommandTrajectory(const TrajectoryTarget& target, double t_s);
+  // The trajectory kind's setpoint for this step (per-axis control, heading), from target_.
+  PositionSetpoint TrajectoryStep(const StateEstimate& s, double dt_s, double* yawspeed_ff_radps);
   double HoverThrustFor(double mass_kg) const;   // normalised hover thrust of a total mass
   double MassFor(double hover_thrust) const;
 
@@ -133,6 +138,11 @@ class FlightController {
   Vec3 ang_accel_ = Vec3::Zero();
   bool damping_on_ = false;
   double airborne_s_ = 0.0;
+  // Trajectory kind: the target in force, and per axis whether it is held (all three unset) at
+  // traj_hold_m_ (latched when the axis became unset).
+  TrajectoryTarget traj_{};
+  std::array<bool, 3> traj_held_{};
+  Vec3 traj_hold_m_ = Vec3::Zero();
 
   static constexpr std::size_t kEventCapacity = 32;
   std::array<FlightEvent, kEventCapacity> events_{};

@@ -5,10 +5,17 @@
 // does not change with the vehicle's mass; the mass (from the hover-thrust estimate) only turns the
 // acceleration into newtons.
 //
+// Per axis as PX4's PositionControl with NaN setpoints: position P + velocity feed-forward,
+// velocity PID + acceleration feed-forward, or acceleration alone (PositionSetpoint::axes).
+//
 //   PositionControl pc;  pc.SetParams(params);
 //   PositionOutput out = pc.Update(state, setpoint, mass_kg, dt_s);
 //   if (out.valid) { attitude control with out.att_sp; mixer with out.thrust_n; }
 #pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
 
 #include "swarmbox/flight/types.hpp"
 
@@ -29,16 +36,26 @@ struct PositionParams {
   double integral_max_mps2 = 4.0;  // |velocity integral| per axis [m/s^2]
 };
 
-// What the layers above want. pos_* selects position control on that axis; otherwise the
-// velocity (plus feed-forward) is tracked directly. Feed-forwards are world ENU.
+// How one world axis is controlled (PX4 PositionControl with NaN setpoints).
+enum class AxisControl : std::uint8_t {
+  kPosition,      // position P; vel_mps and acc_mps2 feed forward
+  kVelocity,      // vel_mps tracked by the velocity PID; acc_mps2 feeds forward
+  kAcceleration,  // acc_mps2 alone: no velocity loop on this axis, its integral frozen
+};
+
+// What the layers above want, per world axis (x, y, z). Feed-forwards are world ENU.
 struct PositionSetpoint {
-  bool pos_xy = true;
-  bool pos_z = true;
-  Vec3 pos_m = Vec3::Zero();
-  Vec3 vel_mps = Vec3::Zero();     // feed-forward (position mode) or setpoint (velocity mode)
-  Vec3 acc_mps2 = Vec3::Zero();    // feed-forward
+  std::array<AxisControl, 3> axes{AxisControl::kPosition, AxisControl::kPosition, AxisControl::kPosition};
+  Vec3 pos_m = Vec3::Zero();       // used on kPosition axes
+  Vec3 vel_mps = Vec3::Zero();     // feed-forward (kPosition) or setpoint (kVelocity)
+  Vec3 acc_mps2 = Vec3::Zero();    // feed-forward, or the setpoint (kAcceleration)
   double yaw_rad = 0.0;
   double yawspeed_radps = 0.0;     // feed-forward
+  // Velocity limits of this setpoint when tighter than the params' (the trajectory kind flies at
+  // the airframe's limits, with no reference to chase) [m/s]; infinity: the params' alone.
+  double vel_cap_xy_mps = std::numeric_limits<double>::infinity();
+  double vel_cap_up_mps = std::numeric_limits<double>::infinity();
+  double vel_cap_down_mps = std::numeric_limits<double>::infinity();
 };
 
 struct PositionOutput {
@@ -46,7 +63,7 @@ struct PositionOutput {
   Vec3 thrust_world_n = Vec3::Zero();
   double thrust_n = 0.0;            // collective thrust along body z [N]
   Quat att_sp = Quat::Identity();   // body FLU -> world ENU
-  Vec3 vel_sp_mps = Vec3::Zero();   // after limits, for logs and tests
+  Vec3 vel_sp_mps = Vec3::Zero();   // after limits, for logs and tests; NaN on kAcceleration axes
   Vec3 acc_sp_mps2 = Vec3::Zero();  // after limits
 };
 

@@ -21,6 +21,13 @@
 //     (*raft)->Propose(raft::StartSearch{});         // kUnavailable: no leader known, retry later
 //     raft::MissionState m = (*raft)->mission();     // a copy of the committed mission
 //
+// Any other replicated state: hand Start() the machine (raft/state_machine.hpp), propose bytes and
+// read the committed entries from the tap:
+//   auto raft = RaftService::Start(cfg, transport, sim_clock, sink,
+//                                  std::make_unique<raft::EntryLogMachine>());
+//   (*raft)->ProposeBytes(bytes);
+//   (*raft)->TakeCommitted(&entries);   // since the previous call, in index order, replay first
+//
 // Ticks: Tick() runs the driver's ticks due by clock.NowS() on a fixed grid, start + n * tick_ms,
 // where `start` is the clock at Start() (read in whole microseconds, so float noise in the clock
 // cannot move a tick across a step). Calling Tick() more often than every tick_ms is free (it
@@ -34,8 +41,8 @@
 // (4 with a 50 ms tick and a 200 ms heartbeat): a loop late by less than a heartbeat loses no
 // Raft time at all.
 //
-// Events: the driver's contract events (event=leader_elected, mission_state, victim_confirmed,
-// victim_status, raft_stopped) go to `out` as logfmt lines, `t` from the clock given, during
+// Events: the driver's contract events (event=leader_elected, raft_stopped) and the machine's
+// (MissionStateMachine: mission_state, victim_confirmed, victim_status) go to `out` as logfmt lines, `t` from the clock given, during
 // the call that caused them. Received bytes the driver cannot decode are counted
 // (protocol_errors()), not fatal.
 //
@@ -57,11 +64,13 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/raft/file_system.hpp"
 #include "swarmbox/raft/mission_state.hpp"
 #include "swarmbox/raft/node_driver.hpp"
+#include "swarmbox/raft/state_machine.hpp"
 #include "swarmbox/raft/wal_storage.hpp"
 
 namespace swarmbox::mission {
@@ -81,13 +90,15 @@ void PrintLineToStdout(const std::string& line);
 
 class RaftService {
  public:
-  // Opens the storage (replaying the WAL: re-applied entries print their events now) and the
-  // driver; reads `clock` once to anchor the tick grid. Errors: a bad DriverConfig or no data
-  // directory (kInvalidArgument), storage that cannot be read (kIo/kProtocol).
+  // Opens the storage (replaying the WAL: re-applied entries print their events now and fill the
+  // committed-entries tap) and the driver with `machine` (null: a MissionStateMachine); reads
+  // `clock` once to anchor the tick grid. Errors: a bad DriverConfig or no data directory
+  // (kInvalidArgument), storage that cannot be read or restored (kIo/kProtocol).
   static Result<std::unique_ptr<RaftService>> Start(const RaftServiceConfig& config,
                                                     raft::Transport& transport,
                                                     const raft::Clock& clock,
-                                                    LineSink out = PrintLineToStdout);
+                                                    LineSink out = PrintLineToStdout,
+                                                    std::unique_ptr<raft::StateMachine> machine = nullptr);
   ~RaftService();
   RaftService(const RaftService&) = delete;
   RaftService& operator=(const RaftService&) = delete;
@@ -101,10 +112,20 @@ class RaftService {
   // Proposes a mission command (encoded by the driver). kUnavailable when this node knows no
   // leader to forward to; the stop error once stopped.
   Status Propose(const raft::MissionCommand& command);
+  // Proposes an entry for the machine (NodeDriver::Propose(Bytes)): kUnavailable when no leader
+  // is known, kInvalidArgument for empty bytes, the stop error once stopped.
+  Status ProposeBytes(raft::Bytes data);
   // Starts an election now (tests, the "kill the leader" fault's bookkeeping).
   Status Campaign();
+  // Replaces *out with the entries applied since the previous call (NodeDriver::TakeCommitted).
+  void TakeCommitted(std::vector<raft::Committed>* out) { driver_->TakeCommitted(out); }
 
-  const raft::MissionState& mission() const { return driver_->mission(); }  // committed state
+  const raft::StateMachine& machine() const { return driver_->machine(); }
+  // The committed mission of a MissionStateMachine (aborts for another machine); FindMission():
+  // nullptr then.
+  const raft::MissionState& mission() const { return driver_->mission(); }
+  const raft::MissionState* FindMission() const { return driver_->FindMission(); }
+  std::uint64_t applied_index() const { return driver_->applied_index(); }
   std::string leader() const { return driver_->leader(); }  // "" when none known
   bool is_leader() const { return driver_->is_leader(); }
   std::uint64_t term() const { return driver_->raft().term(); }

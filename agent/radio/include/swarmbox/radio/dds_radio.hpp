@@ -7,13 +7,15 @@
 //   ping_msg       bus::RadioPing on kRadioPingTopic (Qos::kRadio), one writer per peer for pings
 //                  and one per peer for pongs (a best-effort reader drops what one writer's stream
 //                  reorders: radio_link history in agent/radio/README.md), one for anyone else
+//   brain_msg      bus::BrainMessage on kBrainMessageTopic (Qos::kRadio), with options.brains:
+//                  heard when addressed to us or to everyone ("") and not our own
 //
 //   DdsRadioOptions o;  o.members = {"scout_1", "scout_2"};  o.raft = o.pings = o.hear_states = true;
 //   auto radio = DdsRadio::Create(*mesh, "scout_1", o);   // bad name or a bus error: an error
 //   radio->TakeReceived(sample, &frames);                // what arrived since the last call
 //
 // Receiving: the middleware callbacks (DroneStates of others, pings/pongs addressed to us, Raft
-// payloads RaftRadio delivers to us) push a frame into a mutex-guarded inbox, stamped
+// payloads RaftRadio delivers to us, brain messages for us) push a frame into a mutex-guarded inbox, stamped
 // delivered_ns = the steady clock at arrival; TakeReceived drains it in arrival order. The inbox
 // keeps at most kMaxInbox frames (oldest dropped, counted: a stalled control loop must not buffer
 // without bound). Detections are sent, not heard (no agent consumes them; recorders listen).
@@ -48,6 +50,7 @@ struct DdsRadioOptions {
   bool raft = false;                 // carry raft_msg (mission::RaftRadio); needs members
   bool pings = false;                // ping/pong writers per member, hear mesh/ping; needs members
   bool hear_states = false;          // hear the others' DroneStates (the SAR mission's peers)
+  bool brains = false;               // carry brain_msg (send and hear mesh/brain)
 };
 
 class DdsRadio final : public MeshRadio {
@@ -98,6 +101,7 @@ class DdsRadio final : public MeshRadio {
 
   std::unique_ptr<bus::Publisher<bus::DroneState>> state_pub_;
   std::unique_ptr<bus::Publisher<bus::Detection>> detection_pub_;
+  std::unique_ptr<bus::Publisher<bus::BrainMessage>> brain_pub_;
   std::vector<std::unique_ptr<PingWriter>> ping_writers_;  // per peer
   std::vector<std::unique_ptr<PingWriter>> pong_writers_;  // per peer
   std::unique_ptr<PingWriter> other_pong_writer_;
@@ -105,6 +109,7 @@ class DdsRadio final : public MeshRadio {
   std::unique_ptr<mission::RaftRadio> raft_;
   std::unique_ptr<bus::Subscriber<bus::RadioPing>> ping_sub_;
   std::unique_ptr<bus::Subscriber<bus::DroneState>> state_sub_;
+  std::unique_ptr<bus::Subscriber<bus::BrainMessage>> brain_sub_;
 };
 
 }  // namespace swarmbox::radio

@@ -1,6 +1,6 @@
 // MeshRadio: how an agent talks to the other drones, whichever radio model the trial runs
 // (ARCHITECTURE.md, "Time" and "Two networks per trial"). Everything an agent says to its peers
-// (its DroneState, detections, Raft messages, link pings) is a bus::RadioFrame handed to Send();
+// (its DroneState, detections, Raft messages, link pings, its brain's messages) is a bus::RadioFrame handed to Send();
 // everything it hears comes out of TakeReceived(), once per lockstep step, in delivery order.
 //
 //   radio.model channel (ChannelRadio): no mesh network at all. Send() queues the frame; Flush()
@@ -18,7 +18,7 @@
 //
 // Send() fills `from`, `seq` (per sender, from 1), `sent_ns` (the radio's clock, now_ns(): the
 // step's simulated time with channel, set by the last TakeReceived) and `size_bytes` (FrameBytes below); the caller sets `to` ("" =
-// broadcast) and exactly one of state_msg / detection_msg / raft_msg / ping_msg.
+// broadcast) and exactly one of state_msg / detection_msg / raft_msg / ping_msg / brain_msg.
 //
 // Thread-safety: one thread (the agent's control loop) calls every member. An implementation may
 // receive on middleware threads internally. Ownership: the radio outlives nothing it is given.

@@ -1,7 +1,8 @@
-// NodeDriver: one drone's Raft node wired to its storage, radio and mission state machine.
+// NodeDriver: one drone's Raft node wired to its storage, radio and replicated state machine.
 //
 // The transport-facing shell around the pure RawNode (raw_node.hpp). It owns the RawNode and the
-// replicated MissionState; the caller owns the clock, the radio and the disk, behind three small
+// StateMachine it replicates (state_machine.hpp: MissionStateMachine by default, EntryLogMachine,
+// or the caller's); the caller owns the clock, the radio and the disk, behind three small
 // interfaces (real ones in the agent, fakes in tests and in the cluster simulator):
 //   Transport  Send(to_name, bytes): best effort, one datagram per message (Raft retries; the
 //              transport must not retransmit or hide loss, e.g. a best-effort DDS writer on the
@@ -10,10 +11,21 @@
 //   Clock      NowS(): the `t` of log events (the agent's simulated seconds).
 // Events are handed to the caller's sink as LogEvents (the logfmt contract):
 //   event=leader_elected term=3 leader=drone_2     every node, when it learns of a new leader
-//   event=mission_state state=SEARCH index=12      a committed phase change, on every node
-//   event=victim_confirmed id=1 x=41.500 y=-12.000 a committed confirmation, on every node
-//   event=victim_status id=1 status=being_rescued rescuer=lifter
 //   event=raft_stopped reason="..."                storage failed: the node is dead (exit!)
+// plus the state machine's own lines, written while it applies an entry (MissionStateMachine:
+// event=mission_state, victim_confirmed, victim_status; mission_state_machine.hpp).
+//
+// The committed-entries tap: TakeCommitted(&v) replaces v with every application entry (no-ops
+// left out) applied since the previous call, {index, data} in index order, on every node (the
+// proposer's own included). Open() fills it with the replay of what the node already holds, so a
+// new reader (a brain object or process started with the node) sees the whole log again:
+//   - a restored snapshot (storage at Open, or one the leader sent) yields what the machine's
+//     ReplayRestored() gives for it: EntryLogMachine every entry it holds above what was applied
+//     before; MissionStateMachine and machines without a replay nothing (the restored state
+//     stands for those entries);
+//   - then the committed entries after the snapshot, re-applied from the log, one by one.
+// Within one driver the tap never yields an index twice nor goes back. The tap keeps everything
+// until taken (callers that never read it keep the log a second time in memory).
 //
 // Usage (the agent's Raft thread, or its event loop; the driver is not thread-safe):
 //
@@ -32,6 +44,9 @@
 //   to change the mission:                  (*node)->Propose(StartSearch{});  // kUnavailable:
 //                                                     // no leader yet, retry later
 //   read the agreed mission:                (*node)->mission().phase() ...
+//   any other machine:   NodeDriver::Open(cfg, wal, radio, clock, sink,
+//                                         std::make_unique<EntryLogMachine>());
+//                        (*node)->Propose(Bytes{...});   (*node)->TakeCommitted(&entries);
 // Any call returns the storage error once the node has stopped (stopped() is true): the agent
 // must then exit non-zero, since it can no longer promise what it voted or acknowledged.
 //
@@ -58,7 +73,9 @@
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/raft/mission_command.hpp"
 #include "swarmbox/raft/mission_state.hpp"
+#include "swarmbox/raft/mission_state_machine.hpp"
 #include "swarmbox/raft/raw_node.hpp"
+#include "swarmbox/raft/state_machine.hpp"
 #include "swarmbox/raft/storage.hpp"
 
 namespace swarmbox::raft {
@@ -75,8 +92,6 @@ class Clock {
   virtual ~Clock() = default;
   virtual double NowS() const = 0;  // [s], for event timestamps only
 };
-
-using EventSink = std::function<void(const LogEvent&)>;
 
 struct DriverConfig {
   std::string self;
@@ -99,8 +114,15 @@ struct DriverConfig {
 
 class NodeDriver {
  public:
-  // Loads `storage`, restores the mission from its snapshot and rejoins with the stored term,
-  // vote and log. The references must outlive the driver.
+  // Loads `storage`, restores the state machine from its snapshot and rejoins with the stored
+  // term, vote and log (re-applying the committed entries after the snapshot, events included).
+  // `machine` null: a MissionStateMachine. The references must outlive the driver. Errors: a bad
+  // config (kInvalidArgument), unreadable storage, a snapshot the machine cannot restore.
+  static Result<std::unique_ptr<NodeDriver>> Open(const DriverConfig& config, Storage& storage,
+                                                  Transport& transport, const Clock& clock,
+                                                  EventSink sink,
+                                                  std::unique_ptr<StateMachine> machine);
+  // The same with a MissionStateMachine.
   static Result<std::unique_ptr<NodeDriver>> Open(const DriverConfig& config, Storage& storage,
                                                   Transport& transport, const Clock& clock,
                                                   EventSink sink);
@@ -109,12 +131,28 @@ class NodeDriver {
   // Bytes received from the radio. kProtocol for undecodable or misaddressed data (the node goes
   // on); the stop error when stopped.
   Status Receive(std::span<const std::uint8_t> bytes);
+  // Proposes an entry for the state machine (forwarded to the leader when a follower). Accepted
+  // is not committed: a leader change can lose it; watch the tap (or the state) and re-propose.
+  // kUnavailable: no leader known (retry later); kInvalidArgument: empty `data` (empty entries
+  // are the leader's no-ops); the stop error once stopped.
+  Status Propose(Bytes data);
+  // The same for an encoded MissionCommand (for a MissionStateMachine).
   Status Propose(const MissionCommand& command);
   Status Campaign();  // start an election now
 
+  // Replaces *out with the application entries applied since the previous call (see the banner).
+  void TakeCommitted(std::vector<Committed>* out);
+
   bool stopped() const { return stop_error_.has_value(); }
   const std::optional<Error>& stop_error() const { return stop_error_; }
-  const MissionState& mission() const { return mission_; }
+  const StateMachine& machine() const { return *machine_; }
+  // The MissionStateMachine's mission; nullptr when the machine is another kind.
+  const MissionState* FindMission() const {
+    return mission_machine_ != nullptr ? &mission_machine_->mission() : nullptr;
+  }
+  // The mission of a MissionStateMachine (aborts for another machine: a programming error).
+  const MissionState& mission() const;
+  std::uint64_t applied_index() const { return applied_; }  // the machine's last index
   const RawNode& raft() const { return node_; }
   const std::string& self() const { return config_.self; }
   std::string leader() const;  // the known leader's name, "" when none
@@ -124,8 +162,9 @@ class NodeDriver {
 
  private:
   NodeDriver(DriverConfig config, std::vector<std::string> names, std::uint32_t tag, RawNode node,
-             MissionState mission, Storage& storage, Transport& transport, const Clock& clock,
-             EventSink sink);
+             std::unique_ptr<StateMachine> machine, std::uint64_t applied,
+             std::vector<Committed> tap, Storage& storage, Transport& transport,
+             const Clock& clock, EventSink sink);
   Status Process();
   Status Stop(Error e);
   void Emit(const LogEvent& e) const;
@@ -135,7 +174,10 @@ class NodeDriver {
   std::vector<std::string> names_;  // sorted; id = index + 1
   std::uint32_t cluster_tag_;
   RawNode node_;
-  MissionState mission_;
+  std::unique_ptr<StateMachine> machine_;
+  const MissionStateMachine* mission_machine_;  // machine_ when it is one, else nullptr
+  std::uint64_t applied_;                       // last index applied to (or restored into) machine_
+  std::vector<Committed> tap_;                  // applied since the last TakeCommitted
   Storage& storage_;
   Transport& transport_;
   const Clock& clock_;

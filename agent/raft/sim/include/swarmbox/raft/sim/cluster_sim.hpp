@@ -12,9 +12,14 @@
 //   Log Matching         two entries with the same index and term hold the same data and follow
 //                        entries of the same term (checked on every storage write)
 //   Leader Completeness  a new leader holds every entry committed before its election
-//   State Machine Safety every node's mission state after applying index i is the same, and
-//                        nodes commit the same entry at each index
-// plus monotonic terms. A violation is recorded with the seed and time; the first stops the run.
+//   State Machine Safety every node's state machine after applying index i is the same (its
+//                        Snapshot() bytes), and nodes commit the same entry at each index
+// plus monotonic terms, and the committed-entries tap (NodeDriver::TakeCommitted, drained after
+// every step): per node life it yields committed entries only, with the committed data, in
+// strictly increasing index order; with the EntryLogMachine also every one of them from index 1
+// on (after a restart and a snapshot from the leader too: the replay). The machine is
+// SimConfig::machine: the mission (MissionStateMachine, the proposals are mission commands) or the
+// entry log (EntryLogMachine, the same proposals as opaque bytes). A violation is recorded with the seed and time; the first stops the run.
 //
 //   SimConfig cfg;                 // 5 nodes, radio-like network, no faults
 //   cfg.seed = 42;
@@ -62,8 +67,11 @@ struct FaultModel {
   bool wipe_storage_on_restart = false;
 };
 
+enum class SimMachine : std::uint8_t { kMission, kEntryLog };
+
 struct SimConfig {
   int nodes = 5;
+  SimMachine machine = SimMachine::kMission;  // every node's replicated state machine
   std::uint64_t seed = 1;
   double duration_s = 20;
   NetworkModel net;
@@ -95,6 +103,7 @@ struct SimReport {
   std::uint64_t max_commit = 0;
   std::uint64_t snapshots_sent = 0;
   std::vector<std::string> events;  // with record_events
+  std::uint64_t entries_tapped = 0;  // entries every node's tap yielded (replays included)
 
   bool ok() const { return violations.empty(); }
 };
@@ -116,7 +125,8 @@ class ClusterSim {
   // Nodes in different groups cannot exchange messages (also those already in flight).
   void Partition(const std::vector<std::vector<int>>& groups);
   void Heal();
-  Status Propose(int node, const MissionCommand& command);
+  Status Propose(int node, const MissionCommand& command);  // encoded
+  Status Propose(int node, Bytes data);
   // Drops every message for which the filter returns true (e.g. all vote responses), until
   // cleared with nullptr. Applied at send time.
   using DropFilter = std::function<bool(int from, int to, const Message& m)>;
@@ -159,6 +169,7 @@ class ClusterSim {
   void OnSave(int node, const std::optional<HardState>& hs, std::span<const Entry> entries,
               const Snapshot& snapshot);
   void CheckNode(int node);
+  void CheckTap(int node);
   double Uniform(double lo, double hi);
   bool Chance(double p);
 
@@ -185,7 +196,7 @@ class ClusterSim {
   };
   std::map<std::uint64_t, NodeId> leader_of_term_;
   std::map<std::pair<std::uint64_t, std::uint64_t>, EntryFact> entries_seen_;  // (index, term)
-  std::vector<CommitFact> committed_;  // committed_[i - 1] for index i
+  std::vector<CommitFact> committed_;  // committed_[i - 1] for index i (term 0: not seen yet)
   std::unordered_map<std::uint64_t, std::uint64_t> state_hash_at_;  // applied index -> hash
   // Metrics.
   std::unordered_map<std::uint64_t, std::int64_t> proposed_at_us_;  // data hash -> time
