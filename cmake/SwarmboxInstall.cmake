@@ -13,6 +13,7 @@
 #   P/lib/cmake/swarmbox/          swarmboxConfig.cmake, swarmboxConfigVersion.cmake, swarmboxTargets.cmake,
 #                                  SwarmboxBrain.cmake (swarmbox_add_brain)
 #   P/share/swarmbox/trials/       the shipped trials, airframes/, worlds/, faults/, experiments/
+#   P/share/swarmbox/idl/          swarmbox.idl, the bus's message types (other languages generate from it)
 #   P/share/doc/swarmbox/          README.md and the other top-level documents, docs/
 # The DDS side (bus, physics, agent libraries) is not installed as libraries: they are the
 # programs inside the images, not an API (ARCHITECTURE.md: the orchestrator never links DDS).
@@ -74,6 +75,12 @@ install(FILES ${swarmbox_top_docs} DESTINATION ${CMAKE_INSTALL_DOCDIR} COMPONENT
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/docs
         COMPONENT runtime)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/examples/ DESTINATION ${CMAKE_INSTALL_DOCDIR}/examples
+        COMPONENT development)
+
+# The IDL of every bus message: a program in another language generates its types from it and flies
+# a drone over the offboard topics (examples/c_brain: idlc -l c). SWARMBOX_IDL_DIR in the package.
+set(SWARMBOX_INSTALL_IDLDIR ${CMAKE_INSTALL_DATADIR}/swarmbox/idl)
+install(FILES ${PROJECT_SOURCE_DIR}/bus/idl/swarmbox.idl DESTINATION ${SWARMBOX_INSTALL_IDLDIR}
         COMPONENT development)
 
 install(EXPORT swarmboxTargets NAMESPACE swarmbox:: DESTINATION ${SWARMBOX_INSTALL_CMAKEDIR}
