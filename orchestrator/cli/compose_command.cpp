@@ -129,7 +129,8 @@ int ComposeCommand(const ComposeArgs& args) {
       "Trial '" + spec->name + "': the same images, argv, environment, labels, networks and\n"
       "addresses as `swarmbox run`; run priority is depends_on (readiness waits are not\n"
       "modelled: compose starts a service once the one it depends on has started).\n"
-      "Needs the images on this engine: run `swarmbox images` first.\n"
+      "Needs the images on this engine: run `swarmbox images` first (a trial's brain and\n"
+      "component images: `swarmbox run` it once; a Dockerfile's image compose builds).\n"
       "  docker-compose -f <this file> up        # Ctrl-C, then copy what you need:\n"
       "  docker cp " + runner::ResourceName(spec->name, kComposeRunId, runner::kPhysicsId) +
       ":" + std::string(runner::kTruthCsvPath) + " .\n"

@@ -330,6 +330,9 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     return Error(ErrorCode::kInvalidArgument,
                  "too many drones, brains and components for a /24: " + std::to_string(std::max(sim_hosts, mesh_hosts)));
   }
+  // A group's plugins carry the group's level as their own priority: the engine orders creations
+  // by plugin priority across the whole tree (a level's creations wait for the lower ones'), so
+  // the numbers must be comparable between groups.
   // Run levels: networks 0; components below the drones' priority, each priority its own level;
   // physics; external brains; sidecars and their set-up step; the drones (with the components of
   // priority kDronesPriority); the components above it.
@@ -437,7 +440,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
                 {"CYCLONEDDS_URI", CycloneUriFor(kSimInterface)}};
       ConfineUser(spec.LimitsOf(&d), &bc);
       bc.stop_timeout_s = 5;
-      brains.Add<dsl::Plugin>(id, std::move(bc), 0).On(sim_net, nets.sim.Host(next_sim_host++), {id});
+      brains.Add<dsl::Plugin>(id, std::move(bc), brains_level).On(sim_net, nets.sim.Host(next_sim_host++), {id});
     }
   }
 
@@ -495,7 +498,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
       sc.no_new_privileges = true;
       sc.user = "0:0";  // NET_ADMIN reaches no non-root user on Docker 20.10 (standard_images.hpp)
       sc.stop_timeout_s = 2;
-      radios.Add<dsl::Plugin>(id, std::move(sc), 2)
+      radios.Add<dsl::Plugin>(id, std::move(sc), sidecars_level)
           .On(sim_net, nets.sim.Host(host), {d.name})
           .On(*mesh_net, nets.mesh.Host(host), {d.name});
       ++host;
@@ -519,10 +522,10 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     Confine(spec.LimitsOf(&d), &agent);
     if (sidecars) {
       agent.network_of = SidecarId(d.name);  // Docker refuses a hostname here
-      drones.Add<dsl::Plugin>(d.name, std::move(agent), 2);
+      drones.Add<dsl::Plugin>(d.name, std::move(agent), drones_level);
     } else {
       agent.hostname = d.name;
-      auto& plugin = drones.Add<dsl::Plugin>(d.name, std::move(agent), 2).On(sim_net, sim_ip, {d.name});
+      auto& plugin = drones.Add<dsl::Plugin>(d.name, std::move(agent), drones_level).On(sim_net, sim_ip, {d.name});
       if (mesh_net != nullptr) plugin.On(*mesh_net, mesh_ip, {d.name});
     }
   }

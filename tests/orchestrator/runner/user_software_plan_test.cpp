@@ -97,6 +97,15 @@ TEST_F(UserSoftwarePlanTest, StartOrderFollowsThePriorities) {
   EXPECT_LT(level("scout_2-brain"), level("scout_1"));
   EXPECT_EQ(level("gcs"), level("scout_1"));  // one level: started together
   EXPECT_LT(level("scout_1"), level("recorder"));
+  // Each plugin's own priority is its level too: the engine orders creations by plugin priority
+  // across groups (a creation waits for the lower ones'), so they must agree with the start order
+  // (with the brain at 0 inside its group, physics' creation waited for it: a deadlock).
+  int previous = 0;
+  for (dsl::Plugin* p : trial->Plugins()) {
+    EXPECT_EQ(p->run_priority(), level(p->id())) << p->id();
+    EXPECT_GE(p->run_priority(), previous) << p->id();
+    previous = p->run_priority();
+  }
 }
 
 TEST_F(UserSoftwarePlanTest, ALibraryBrainRunsInItsAgentWithTheContractsFlags) {

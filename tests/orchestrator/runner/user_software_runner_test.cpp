@@ -100,7 +100,13 @@ TEST_F(UserSoftwareRunnerTest, AComponentStartsFirstAndItsFileComesBack) {
   api_.scripts["scout_1"].lines = {"t=40 node=scout_1 event=rendezvous_complete members=2"};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
-  EXPECT_THAT(Starts(), ::testing::ElementsAre("ground", "physics", "scout_2-brain", "scout_1", "scout_2"));
+  // Level by level; the two agents form one level (started at once, in any order).
+  const std::vector<std::string> starts = Starts();
+  ASSERT_EQ(starts.size(), 5u);
+  EXPECT_THAT(std::vector<std::string>(starts.begin(), starts.begin() + 3),
+              ::testing::ElementsAre("ground", "physics", "scout_2-brain"));
+  EXPECT_THAT(std::vector<std::string>(starts.begin() + 3, starts.end()),
+              ::testing::UnorderedElementsAre("scout_1", "scout_2"));
   const fs::path dir = run.trial_dir;
   EXPECT_EQ(ReadFile(dir / "components" / "ground" / "ground.csv"), "t,x\n0,1\n");
   EXPECT_THAT(ReadFile(dir / "logs" / "ground.log"), HasSubstr("event=ground_ready"));
@@ -130,10 +136,11 @@ TEST_F(UserSoftwareRunnerTest, AnExternalBrainThatGoesDoesNotEndTheTrial) {
   api_.scripts["scout_2-brain"].lines = {"brain: up"};
   api_.scripts["scout_2-brain"].exit_code = 137;
   api_.scripts["scout_2"].lines = {"t=5 node=scout_2 event=offboard_lost silent_s=1.0 action=hold"};
-  api_.scripts["scout_1"].log_after_created = {"scout_2"};
+  api_.scripts["scout_1"].log_after_exit_seen = {"scout_2-brain"};  // the runner saw the exit first
   api_.scripts["scout_1"].lines = {"t=9 node=scout_1 event=tick", "t=40 node=scout_1 event=rendezvous_complete members=2"};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_EQ(run.result.verdict.reason, "matched 'event=rendezvous_complete'");
   const std::string events = ReadFile(fs::path(run.trial_dir) / "events.jsonl");
   EXPECT_THAT(events, HasSubstr("\"component\":\"scout_2-brain\",\"event\":\"exited\",\"exit_code\":137"));
   EXPECT_THAT(events, HasSubstr("\"event\":\"offboard_lost\""));
@@ -153,10 +160,13 @@ TEST_F(UserSoftwareRunnerTest, ACrashingComponentFailsTheTrialAndItsFileStillCom
 
 TEST_F(UserSoftwareRunnerTest, AComponentThatFinishesItsJobDoesNotEndTheTrial) {
   api_.scripts["ground"].exit_code = 0;
-  api_.scripts["scout_1"].log_after_created = {"scout_2"};
+  api_.scripts["scout_1"].log_after_exit_seen = {"ground"};
   api_.scripts["scout_1"].lines = {"t=3 node=scout_1 event=tick", "t=40 node=scout_1 event=rendezvous_complete members=2"};
   RunOutcome run = Run();
   EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_EQ(run.result.verdict.reason, "matched 'event=rendezvous_complete'");
+  EXPECT_THAT(ReadFile(fs::path(run.trial_dir) / "events.jsonl"),
+              HasSubstr("\"component\":\"ground\",\"event\":\"exited\",\"exit_code\":0"));
   EXPECT_EQ(ReadFile(fs::path(run.trial_dir) / "components" / "ground" / "ground.csv"), "t,x\n0,1\n");
 }
 
