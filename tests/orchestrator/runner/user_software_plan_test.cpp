@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+#include "swarmbox/docker/tar_archive.hpp"
 
 #include "swarmbox/runner/compose_export.hpp"
 #include "swarmbox/runner/plan.hpp"
@@ -255,6 +259,36 @@ TEST(UserImages, ImageSpecsOfTheUsersSoftware) {
   EXPECT_EQ(prog.directories.at("/out"), 01777u);  // writable for uid 1000
   EXPECT_EQ(prog.directories.at("/tmp"), 01777u);
   EXPECT_EQ(prog.directories.count("/"), 0u);
+}
+
+TEST(UserImages, ADockerfilesFolderPacksToTheSameContextEveryTime) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "swarmbox-dockerfile-context-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "conf");
+  std::ofstream(dir / "Dockerfile.brain") << "FROM swarmbox/brain:base\nCOPY conf/ /etc/brain/\n";
+  std::ofstream(dir / "conf" / "gains.yaml") << "kp: 2\n";
+  auto a = PackDockerfileContext((dir / "Dockerfile.brain").string(), "scout_2-brain");
+  ASSERT_TRUE(a) << a.error().ToString();
+  EXPECT_EQ(a->dockerfile, "Dockerfile.brain");
+  EXPECT_EQ(a->tag.rfind("swarmbox/user-scout_2-brain:", 0), 0u) << a->tag;
+  auto entries = docker::ReadTar(a->tar);
+  ASSERT_TRUE(entries) << entries.error().ToString();
+  std::vector<std::string> paths;
+  for (const docker::TarEntry& e : *entries) paths.push_back(e.path);
+  EXPECT_THAT(paths, ::testing::IsSupersetOf({"Dockerfile.brain", "conf/gains.yaml"}));
+  // Deterministic: the same folder, the same tag; a changed file, another.
+  auto b = PackDockerfileContext((dir / "Dockerfile.brain").string(), "scout_2-brain");
+  ASSERT_TRUE(b);
+  EXPECT_EQ(a->tag, b->tag);
+  std::ofstream(dir / "conf" / "gains.yaml") << "kp: 3\n";
+  auto c = PackDockerfileContext((dir / "Dockerfile.brain").string(), "scout_2-brain");
+  ASSERT_TRUE(c);
+  EXPECT_NE(a->tag, c->tag);
+  auto missing = PackDockerfileContext((dir / "nope").string(), "x");
+  ASSERT_FALSE(missing);
+  EXPECT_EQ(missing.error().code(), ErrorCode::kNotFound);
+  fs::remove_all(dir);
 }
 
 }  // namespace
