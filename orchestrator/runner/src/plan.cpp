@@ -459,7 +459,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     const bool on_sim = std::find(c.networks.begin(), c.networks.end(), kSimNetworkId) != c.networks.end();
     if (on_sim) cc.env["CYCLONEDDS_URI"] = CycloneUriFor(kSimInterface);  // sim sorts first: eth0
     for (const auto& [k, v] : c.env) cc.env[k] = v;  // the trial's env wins
-    ConfineUser(spec.LimitsOf(nullptr), &cc);
+    ConfineUser(spec.limits, &cc);  // the trial's (physics: {limits} is the server's own)
     cc.artifacts = c.collect;
     cc.artifacts_dir = std::string(kComponentsDir) + "/" + c.name;
     if (c.networks.empty()) {
