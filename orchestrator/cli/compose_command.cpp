@@ -10,6 +10,7 @@
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/plan.hpp"
 #include "swarmbox/runner/radio_schedule.hpp"
+#include "swarmbox/runner/user_images.hpp"
 
 namespace swarmbox::cli {
 
@@ -22,7 +23,9 @@ inline constexpr char kComposeRunId[] = "compose";
 int ComposeCommand(const ComposeArgs& args) {
   auto spec = LoadTrialOrPrintError(args.trial, args.sets);
   if (!spec) return kExitUsage;
-  runner::Images images{args.physics_image, args.agent_image};
+  runner::Images images;
+  images.physics = args.physics_image;
+  images.agent = args.agent_image;
   if (images.physics.empty() || images.agent.empty()) {
     auto tags = TrialImageTags(args.programs);
     if (!tags) {
@@ -31,6 +34,26 @@ int ComposeCommand(const ComposeArgs& args) {
     }
     if (images.physics.empty()) images.physics = tags->physics;
     if (images.agent.empty()) images.agent = tags->agent;
+  }
+  // The trial's own software: packed programs by their content tags, Dockerfiles built by compose.
+  {
+    std::string agent_bin;
+    for (const dsl::DroneSpec& d : spec->drones) {
+      if (d.brain.kind != dsl::BrainKind::kLibrary) continue;
+      auto found = FindProgram("swarmbox-agent", args.programs.agent_bin);
+      if (!found) {
+        std::cerr << "swarmbox compose: " << found.error().ToString() << "\n";
+        return kExitInfrastructure;
+      }
+      agent_bin = *found;
+      break;
+    }
+    auto tags = runner::UserImageTags(*spec, agent_bin, images);
+    if (!tags) {
+      std::cerr << "swarmbox compose: " << tags.error().ToString() << "\n";
+      return kExitInfrastructure;
+    }
+    images = std::move(*tags);
   }
   auto subnets = runner::PickSubnets(kComposeRunId, 0, {});
   if (!subnets) {
@@ -78,6 +101,20 @@ int ComposeCommand(const ComposeArgs& args) {
     return kExitUsage;
   }
   runner::ComposeOptions compose;
+  auto build_of = [&](const std::string& service, const std::string& dockerfile) {
+    const fs::path file = fs::absolute(dockerfile).lexically_normal();
+    std::string context = file.parent_path().string();
+    if (!args.output.empty()) {
+      context = file.parent_path().lexically_relative(fs::absolute(args.output).parent_path()).string();
+    }
+    compose.builds[service] = {context, file.filename().string()};
+  };
+  for (const dsl::DroneSpec& d : spec->drones) {
+    if (d.brain.kind == dsl::BrainKind::kDockerfile) build_of(runner::BrainId(d.name), d.brain.host_path);
+  }
+  for (const dsl::UserComponentSpec& c : spec->components) {
+    if (c.source == dsl::ComponentSource::kDockerfile) build_of(c.name, c.host_path);
+  }
   std::string command = "swarmbox compose " + args.trial;
   for (const auto& s : args.sets) command += " --set " + s;
   if (!args.output.empty()) {
@@ -92,7 +129,8 @@ int ComposeCommand(const ComposeArgs& args) {
       "Trial '" + spec->name + "': the same images, argv, environment, labels, networks and\n"
       "addresses as `swarmbox run`; run priority is depends_on (readiness waits are not\n"
       "modelled: compose starts a service once the one it depends on has started).\n"
-      "Needs the images on this engine: run `swarmbox images` first.\n"
+      "Needs the images on this engine: run `swarmbox images` first (a trial's brain and\n"
+      "component images: `swarmbox run` it once; a Dockerfile's image compose builds).\n"
       "  docker-compose -f <this file> up        # Ctrl-C, then copy what you need:\n"
       "  docker cp " + runner::ResourceName(spec->name, kComposeRunId, runner::kPhysicsId) +
       ":" + std::string(runner::kTruthCsvPath) + " .\n"

@@ -181,6 +181,10 @@ int ExperimentCommand(const ExperimentArgs& args) {
   options.out_dir = out;
   options.run_id = run_id;
   options.resume = args.resume;
+  // Library brains: their agent images are packed from this swarmbox-agent on each host.
+  if (auto agent_bin = FindProgram("swarmbox-agent", args.programs.agent_bin)) {
+    options.trial_options.agent_binary = *agent_bin;
+  }
   options.max_attempts = args.max_attempts;
   options.interrupted = &interrupted;
   options.progress = args.quiet ? nullptr : &std::cerr;

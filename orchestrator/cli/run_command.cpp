@@ -75,6 +75,8 @@ int RunCommand(const RunArgs& args) {
   options.out_dir = args.out;
   options.run_id = run_id;
   options.images = *images;
+  // A library brain's agent image is packed from the same swarmbox-agent (user_images.hpp).
+  if (auto agent_bin = FindProgram("swarmbox-agent", args.programs.agent_bin)) options.agent_binary = *agent_bin;
   options.interrupted = &interrupted;
   options.interrupt_reason = [] { return std::string(InterruptName()); };
   options.progress = args.quiet ? nullptr : &std::cerr;

@@ -39,6 +39,19 @@ FileReport ValidateTrial(const std::string& file, const std::vector<std::string>
   r.summary = "trial " + spec->name + ", " + std::to_string(spec->drones.size()) + " drones, " +
               std::to_string(spec->end.size()) + " end conditions, timeout " +
               spec->timeout.sim.ToString();
+  // The user's software, when there is some: "brains scout_1 library, scout_2 program; components
+  // probe (program)".
+  std::string brains;
+  for (const dsl::DroneSpec& d : spec->drones) {
+    if (d.brain.kind == dsl::BrainKind::kBuiltin) continue;
+    brains += (brains.empty() ? "" : ", ") + d.name + " " + std::string(dsl::BrainKindName(d.brain.kind));
+  }
+  if (!brains.empty()) r.summary += ", brains " + brains;
+  std::string components;
+  for (const dsl::UserComponentSpec& c : spec->components) {
+    components += (components.empty() ? "" : ", ") + c.name + " (" + std::string(dsl::ComponentSourceName(c.source)) + ")";
+  }
+  if (!components.empty()) r.summary += ", components " + components;
   return r;
 }
 

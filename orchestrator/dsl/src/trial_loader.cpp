@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "detail/user_software_keys.hpp"
 #include "swarmbox/dsl/overrides.hpp"
 #include "swarmbox/faults/channel_support.hpp"
 
@@ -52,10 +53,14 @@ Status CheckComponent(const TrialSpec& spec, const yaml::Mark& mark, const std::
                       bool allow_physics, bool allow_leader) {
   if (spec.FindDrone(name) != nullptr) return Ok{};
   if (allow_physics && name == kPhysics) return Ok{};
+  if (allow_physics && spec.FindComponent(name) != nullptr) return Ok{};  // `from:` a component
   if (allow_leader && name == kRaftLeader) return Ok{};
   std::string accepted;
   for (const DroneSpec& d : spec.drones) accepted += (accepted.empty() ? "" : ", ") + d.name;
   if (allow_physics) accepted += ", physics";
+  if (allow_physics) {
+    for (const UserComponentSpec& c : spec.components) accepted += ", " + c.name;
+  }
   if (allow_leader) accepted += ", raft_leader";
   return AtMark(mark, "unknown component '" + name + "' (expected one of " + accepted + ")");
 }
@@ -204,7 +209,12 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   const Node* end = r.Child("end");
   const Node* timeout = r.Child("timeout", /*required=*/true);
   const Node* limits = r.Child("limits");
+  const Node* components = r.Child("components");
   SWARMBOX_TRY(r.Finish());
+  detail::SoftwareContext software;
+  software.base_dir = options.base_dir;
+  software.check_files = options.check_references;
+  software.file_kind = options.file_kind;
   if (limits != nullptr && !limits->is_null()) SWARMBOX_TRY(DecodeLimits(*limits, &spec.limits));
 
   if (!IsTrialName(spec.name)) {
@@ -247,7 +257,13 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
         .Optional("pose", &d.pose)
         .Optional("payload", &d.payload);
     const Node* drone_limits = dr.Child("limits");
+    const Node* brain = dr.Child("brain");
     SWARMBOX_TRY(dr.Finish());
+    if (brain != nullptr) {
+      auto decoded = detail::DecodeBrain(*brain, software);
+      if (!decoded) return decoded.error();
+      d.brain = std::move(*decoded);
+    }
     if (drone_limits != nullptr && !drone_limits->is_null()) {
       SWARMBOX_TRY(DecodeLimits(*drone_limits, &d.limits));
     }
@@ -266,6 +282,12 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   if (raft != nullptr && !raft->is_null()) SWARMBOX_TRY(DecodeRaft(*raft, &spec.raft));
   if (radio != nullptr && !radio->is_null()) {
     SWARMBOX_TRY(DecodeRadio(*radio, &spec.radio));
+  }
+
+  if (components != nullptr) {
+    auto decoded = detail::DecodeComponents(*components, spec, software);
+    if (!decoded) return decoded.error();
+    spec.components = std::move(*decoded);
   }
 
   if (network != nullptr) {
@@ -395,6 +417,10 @@ Result<TrialSpec> LoadTrialText(std::string_view text, std::string_view filename
   for (const std::string& o : options.overrides) SWARMBOX_TRY(ApplyOverride(*doc, o));
   LoadOptions resolved = options;
   if (resolved.trials_dir.empty()) resolved.trials_dir = DefaultTrialsDir(filename);
+  if (resolved.base_dir.empty()) {
+    const std::filesystem::path folder = std::filesystem::path(std::string(filename)).parent_path();
+    resolved.base_dir = folder.empty() ? std::string(".") : folder.string();
+  }
   return DecodeTrial(*doc, resolved);
 }
 

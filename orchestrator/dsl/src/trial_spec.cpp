@@ -49,7 +49,7 @@ TrialSpec& TrialSpec::Rtf(double value) {
 }
 TrialSpec& TrialSpec::Drone(std::string drone_name, std::string airframe,
                             std::array<double, 3> pose, std::string payload) {
-  drones.push_back({std::move(drone_name), std::move(airframe), pose, std::move(payload), {}, {}});
+  drones.push_back({std::move(drone_name), std::move(airframe), pose, std::move(payload), {}, {}, {}});
   return *this;
 }
 TrialSpec& TrialSpec::Mesh(std::string_view flow_yaml) {
@@ -113,6 +113,37 @@ TrialSpec& TrialSpec::Limits(ContainerLimits value) {
   return *this;
 }
 
+TrialSpec& TrialSpec::Brain(std::string_view drone_name, BrainSpec brain) {
+  for (DroneSpec& d : drones) {
+    if (d.name == drone_name) {
+      d.brain = std::move(brain);
+      return *this;
+    }
+  }
+  std::fprintf(stderr, "swarmbox: fatal: TrialSpec::Brain: no drone '%.*s' (add it with Drone() first)\n",
+               static_cast<int>(drone_name.size()), drone_name.data());
+  std::abort();
+}
+
+TrialSpec& TrialSpec::Component(UserComponentSpec component) {
+  components.push_back(std::move(component));
+  return *this;
+}
+
+const UserComponentSpec* TrialSpec::FindComponent(std::string_view component_name) const {
+  for (const UserComponentSpec& c : components) {
+    if (c.name == component_name) return &c;
+  }
+  return nullptr;
+}
+
+bool TrialSpec::HasExternalBrain() const {
+  for (const DroneSpec& d : drones) {
+    if (d.brain.external()) return true;
+  }
+  return false;
+}
+
 ContainerLimits TrialSpec::LimitsOf(const DroneSpec* drone) const {
   const ContainerLimits& own = drone != nullptr ? drone->limits : physics_limits;
   return {own.memory_mib > 0 ? own.memory_mib : limits.memory_mib,
@@ -170,6 +201,7 @@ yaml::Node ToDocument(const TrialSpec& spec) {
     dn.Set("pose", std::move(pose));
     if (!d.payload.empty()) dn.Set("payload", Str(d.payload));
     if (d.limits.memory_mib > 0 || d.limits.pids > 0) dn.Set("limits", limits_node(d.limits));
+    if (d.brain.kind != BrainKind::kBuiltin) dn.Set("brain", BrainToNode(d.brain));
     drones.Append(std::move(dn));
   }
   doc.Set("drones", std::move(drones));
@@ -195,6 +227,11 @@ yaml::Node ToDocument(const TrialSpec& spec) {
     doc.Set("network", std::move(network));
   }
   if (!spec.faults_node.is_null()) doc.Set("faults", spec.faults_node);
+  if (!spec.components.empty()) {
+    Node components = Node::Sequence();
+    for (const UserComponentSpec& c : spec.components) components.Append(ComponentToNode(c));
+    doc.Set("components", std::move(components));
+  }
   if (!spec.end.empty()) {
     Node end = Node::Sequence();
     for (const EndSpec& e : spec.end) {

@@ -55,13 +55,22 @@ std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options) {
     if (!s.name.empty()) svc.Set("container_name", Str(s.name));
     if (!s.hostname.empty()) svc.Set("hostname", Str(s.hostname));
     if (!s.user.empty()) svc.Set("user", Str(s.user));
-    if (!s.argv.empty()) {
+    if (auto b = options.builds.find(p.id()); b != options.builds.end()) {
+      Node build = Node::Mapping();  // compose builds it, tagged as `image`
+      build.Set("context", Str(b->second.context));
+      build.Set("dockerfile", Str(b->second.dockerfile));
+      svc.Set("build", std::move(build));
+    }
+    if (s.argv_is_cmd) {
+      if (!s.argv.empty()) svc.Set("command", StrList(s.argv));  // the image's ENTRYPOINT stays
+    } else if (!s.argv.empty()) {
       svc.Set("entrypoint", StrList({s.argv.front()}));
       svc.Set("command", StrList(std::vector<std::string>(s.argv.begin() + 1, s.argv.end())));
     }
     if (!s.env.empty()) svc.Set("environment", StrMap(s.env));
     if (!s.labels.empty()) svc.Set("labels", StrMap(s.labels));
     if (!s.network_of.empty()) svc.Set("network_mode", Str("service:" + s.network_of));
+    if (s.no_network) svc.Set("network_mode", Str("none"));
     if (!s.cap_add.empty()) svc.Set("cap_add", StrList(s.cap_add));
     if (!s.cap_drop.empty()) svc.Set("cap_drop", StrList(s.cap_drop));
     if (s.no_new_privileges) svc.Set("security_opt", StrList({"no-new-privileges:true"}));

@@ -367,7 +367,9 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
   docker::ContainerSpec spec;
   spec.name = s.name;
   spec.image = s.image;
-  if (!s.argv.empty()) {
+  if (s.argv_is_cmd) {
+    spec.cmd = s.argv;  // the image's ENTRYPOINT stays (a user's image)
+  } else if (!s.argv.empty()) {
     spec.entrypoint = {s.argv.front()};
     spec.cmd.assign(s.argv.begin() + 1, s.argv.end());
   }
@@ -403,6 +405,12 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
                           plugin.Path());
     }
     spec.network_mode = "container:" + owner->second;
+  }
+  if (s.no_network) {
+    if (!s.networks.empty() || !s.network_of.empty()) {
+      return Verdict::Err(plugin.id() + " has no network: it can join none", plugin.Path());
+    }
+    spec.network_mode = "none";
   }
   for (const dsl::Attachment& a : s.networks) {
     auto it = network_ids_.find(a.network);
@@ -562,7 +570,17 @@ Verdict DockerEngine::StartContainer(dsl::Plugin& plugin) {
 
 void DockerEngine::CollectArtifacts(const std::string& component,
                                     const std::vector<std::string>& artifacts,
+                                    const std::string& artifacts_dir,
                                     const std::string& container_id) {
+  const fs::path dest_dir = fs::path(options_.trial_dir) / artifacts_dir;
+  if (!artifacts_dir.empty() && !artifacts.empty()) {
+    std::error_code ec;
+    fs::create_directories(dest_dir, ec);
+    if (ec) {
+      AddProblem(component + ": cannot create " + dest_dir.string() + ": " + ec.message());
+      return;
+    }
+  }
   for (const std::string& path : artifacts) {
     auto tar = api_.GetArchive(container_id, path);
     if (!tar) {
@@ -576,8 +594,17 @@ void DockerEngine::CollectArtifacts(const std::string& component,
     }
     for (const docker::TarEntry& e : *entries) {
       if (e.type != docker::TarEntry::Type::kFile) continue;
-      const std::string name = fs::path(e.path).filename().string();
-      const std::string dest = (fs::path(options_.trial_dir) / name).string();
+      // The trial folder keeps file names (truth.csv); an artifacts_dir keeps a folder's layout.
+      const fs::path relative = fs::path(e.path).lexically_normal();
+      if (relative.empty() || relative.is_absolute() || *relative.begin() == "..") continue;
+      const std::string name = artifacts_dir.empty() ? relative.filename().string()
+                                                     : (fs::path(artifacts_dir) / relative).string();
+      if (!artifacts_dir.empty() && relative.has_parent_path()) {
+        std::error_code ec;
+        fs::create_directories(dest_dir / relative.parent_path(), ec);
+      }
+      const std::string dest = artifacts_dir.empty() ? (fs::path(options_.trial_dir) / name).string()
+                                                     : (dest_dir / relative).string();
       std::ofstream out(dest, std::ios::binary | std::ios::trunc);
       out.write(e.content.data(), static_cast<std::streamsize>(e.content.size()));
       if (!out) {
@@ -607,7 +634,8 @@ Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
   std::shared_future<void> logs_joined = raw->logs_joined.get_future().share();
   raw->thread = std::thread([this, raw, logs_joined, id, component, name = plugin.spec().name,
                              path = plugin.Path(), grace_s = plugin.spec().stop_timeout_s,
-                             artifacts = plugin.spec().artifacts] {
+                             artifacts = plugin.spec().artifacts,
+                             artifacts_dir = plugin.spec().artifacts_dir] {
     // SIGTERM, SIGKILL after the grace; returns once the engine has cleaned the container up.
     Status s = api_.StopContainer(id, grace_s);
     if (!s && s.error().code() != ErrorCode::kNotFound) {
@@ -624,7 +652,7 @@ Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
       reports_[component].exit_code = info->state.exit_code;
       reports_[component].oom_killed = info->state.oom_killed;
     }
-    CollectArtifacts(component, artifacts, id);
+    CollectArtifacts(component, artifacts, artifacts_dir, id);
     if (Status r = api_.RemoveContainer(id, /*force=*/true, /*remove_volumes=*/true);
         !r && r.error().code() != ErrorCode::kNotFound) {
       raw->verdict.KeepWorse(Verdict::FromError(r.error().Context("removing " + name), path));

@@ -52,11 +52,19 @@ std::optional<dsl::Verdict> Monitor::OnLine(std::string_view component, std::str
   return std::nullopt;
 }
 
+void Monitor::SetExitRule(std::string_view component, ExitRule rule) {
+  exit_rules_[std::string(component)] = rule;
+}
+
 std::optional<dsl::Verdict> Monitor::OnExit(std::string_view component, std::int64_t exit_code,
                                             bool oom_killed) {
   live_.erase(std::string(component));
   if (ended_) return std::nullopt;
   if (timeout_pending_) return End(*timeout_pending_);
+  if (auto rule = exit_rules_.find(component); rule != exit_rules_.end() && !oom_killed) {
+    if (rule->second == ExitRule::kAnyExitAllowed) return std::nullopt;
+    if (rule->second == ExitRule::kCleanExitAllowed && exit_code == 0) return std::nullopt;
+  }
   std::string why = oom_killed ? std::string(component) + " was killed for lack of memory"
                                : std::string(component) + " exited with code " +
                                      std::to_string(exit_code) + " before the trial ended";

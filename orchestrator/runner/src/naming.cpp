@@ -40,4 +40,11 @@ std::map<std::string, std::string> RunLabels(std::string_view run_id, std::strin
   return docker::SwarmboxLabels(run_id, trial_id, component);
 }
 
+std::map<std::string, std::string> RoleLabels(std::string_view run_id, std::string_view trial_id,
+                                              std::string_view component, std::string_view role) {
+  auto labels = RunLabels(run_id, trial_id, component);
+  labels[std::string(kLabelRole)] = std::string(role);
+  return labels;
+}
+
 }  // namespace swarmbox::runner

@@ -1,5 +1,6 @@
 #include "swarmbox/runner/plan.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <filesystem>
 #include <set>
@@ -60,6 +61,12 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
   // netem: faults at simulated times fire at the log line that crosses their time (the fault
   // injector's timeline): with such faults the physics server reports its clock every 0.5 s
   // (default 10 s), so they fire at most 0.5 s late. With the channel they are in the plan.
+  // An agent with an external brain waits up to the brain's wall-clock bounds for its answer:
+  // the server must wait longer before it calls that drone lost.
+  if (spec.HasExternalBrain()) {
+    argv.insert(argv.end(), {"--step-timeout", Num(kExternalBrainStepTimeoutS),
+                             "--join-timeout", Num(kExternalBrainJoinTimeoutS)});
+  }
   for (const faults::Fault& f : spec.faults) {
     if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {
       argv.insert(argv.end(), {"--clock-every", Num(kFaultClockEveryS)});
@@ -100,6 +107,12 @@ std::string Members(const dsl::TrialSpec& spec) {
   return out;
 }
 
+std::string BasenameOf(const std::string& path) { return std::filesystem::path(path).filename().string(); }
+
+std::string BrainLibraryInImage(const dsl::BrainSpec& brain) {
+  return std::string(kBrainsDir) + "/" + BasenameOf(brain.host_path.empty() ? brain.path : brain.host_path);
+}
+
 // swarmbox-agent (agent/app/main.cpp --help): the shared contract's flags. An agent given a flag it
 // does not know exits 2, so a new flag goes here only once agent/app/main.cpp has it.
 std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
@@ -131,7 +144,29 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
   // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
   argv.insert(argv.end(), {"--raft-dir", std::string(kAgentStateDir) + "/raft"});
-  if (spec.mission.kind == dsl::MissionKind::kPlan) {
+  const dsl::BrainSpec& brain = d.brain;
+  if (brain.kind != dsl::BrainKind::kBuiltin) {
+    // The user's brain (design24 "Agent flags"): its context gets the world and the payload; the
+    // mission keys are the builtin brain's.
+    argv.insert(argv.end(), {"--world", InContainer(spec.world),
+                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
+    if (!d.payload.empty()) argv.insert(argv.end(), {"--payload", d.payload});
+    if (brain.kind == dsl::BrainKind::kLibrary) {
+      argv.insert(argv.end(), {"--brain", "library",
+                               "--brain-library", BrainLibraryInImage(brain),
+                               "--brain-name", brain.name,
+                               "--brain-args", brain.ArgsJson()});
+    } else {
+      argv.insert(argv.end(), {"--brain", "external"});
+    }
+    if (brain.rate_hz > 0) argv.insert(argv.end(), {"--brain-rate-hz", Num(brain.rate_hz)});
+    if (brain.offboard.timeout_ms) {
+      argv.insert(argv.end(), {"--offboard-timeout-ms", std::to_string(*brain.offboard.timeout_ms)});
+    }
+    if (brain.offboard.hold_ms) {
+      argv.insert(argv.end(), {"--offboard-hold-ms", std::to_string(*brain.offboard.hold_ms)});
+    }
+  } else if (spec.mission.kind == dsl::MissionKind::kPlan) {
     argv.insert(argv.end(), {"--mission", "plan", "--plan", spec.mission.plan});
   } else {
     argv.insert(argv.end(), {"--mission", "sar", "--world", InContainer(spec.world),
@@ -143,6 +178,19 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   return argv;
 }
 
+// An external brain (design24 "The C brain"): --drone, --domain (the sim bus), --members (trial
+// order) first, then the trial's args. A packed program is its image's entrypoint and comes first;
+// an image or a Dockerfile's image keeps its ENTRYPOINT and gets these as its command.
+std::vector<std::string> BrainArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
+  std::vector<std::string> argv;
+  if (d.brain.kind == dsl::BrainKind::kProgram) {
+    argv.push_back(std::string(kProgramDirInImage) + "/" + BasenameOf(d.brain.host_path.empty() ? d.brain.path : d.brain.host_path));
+  }
+  argv.insert(argv.end(), {"--drone", d.name, "--domain", std::to_string(kSimDomain), "--members", Members(spec)});
+  for (std::string& a : d.brain.ArgList()) argv.push_back(std::move(a));
+  return argv;
+}
+
 // The fault sidecar of a drone: holds the drone's network namespace (sim and mesh attachments,
 // fixed addresses) so the mesh impairment is in place before the agent's first packet and survives
 // the agent being killed or restarted; the agent joins it (network_of). It alone has NET_ADMIN
@@ -151,6 +199,15 @@ std::vector<std::string> SidecarArgv() { return {images::kNetemdInImage, "sleep"
 
 // Every agent and the physics server: no capabilities, no privilege gained by exec, nothing
 // written outside the volume and the scratch tmpfs, bounded memory and processes.
+// The user's containers (brains, components): no capabilities, no privilege gained by exec,
+// bounded memory and processes; their root filesystem stays writable (their files are theirs).
+void ConfineUser(const dsl::ContainerLimits& limits, dsl::ContainerSpec* c) {
+  c->cap_drop = {"ALL"};
+  c->no_new_privileges = true;
+  c->memory_mib = limits.memory_mib;
+  c->pids_limit = limits.pids;
+}
+
 void Confine(const dsl::ContainerLimits& limits, dsl::ContainerSpec* c) {
   c->cap_drop = {"ALL"};
   c->no_new_privileges = true;
@@ -220,6 +277,19 @@ bool NeedsFaultSidecars(const dsl::TrialSpec& spec) {
 }
 
 std::string SidecarId(std::string_view drone) { return std::string(drone) + "-faults"; }
+std::string BrainId(std::string_view drone) { return std::string(drone) + "-brain"; }
+
+std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone) {
+  return AgentArgv(spec, drone);
+}
+std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone) {
+  return BrainArgv(spec, drone);
+}
+
+std::string CycloneUriFor(std::string_view interface) {
+  return "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"" + std::string(interface) +
+         "\" multicast=\"true\"/></Interfaces><AllowMulticast>true</AllowMulticast></General></Domain></CycloneDDS>";
+}
 
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
   const double sim_s = spec.timeout.sim.seconds();
@@ -234,9 +304,57 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     return Error(ErrorCode::kInvalidArgument, "PlanTrial: images for physics and agent are needed");
   }
   const bool sidecars = NeedsFaultSidecars(spec) && !options.faults_image.empty();
-  if (spec.drones.size() + kFirstDroneHost >= 255) {
+  // Fixed addresses: drones from kFirstDroneHost, then the external brains and the components on
+  // sim (and on mesh) right after them.
+  std::size_t sim_hosts = spec.drones.size();
+  std::size_t mesh_hosts = spec.drones.size();
+  for (const dsl::DroneSpec& d : spec.drones) {
+    if (d.brain.external()) ++sim_hosts;
+    if (d.brain.kind == dsl::BrainKind::kLibrary && options.images.drone_agents.count(d.name) == 0) {
+      return Error(ErrorCode::kInvalidArgument, "PlanTrial: no agent image with the brain library of " + d.name);
+    }
+    if (d.brain.external() && options.images.brains.count(d.name) == 0) {
+      return Error(ErrorCode::kInvalidArgument, "PlanTrial: no image for the brain of " + d.name);
+    }
+  }
+  for (const dsl::UserComponentSpec& c : spec.components) {
+    for (const std::string& n : c.networks) ++(n == kMeshNetworkId ? mesh_hosts : sim_hosts);
+    if (options.images.components.count(c.name) == 0) {
+      return Error(ErrorCode::kInvalidArgument, "PlanTrial: no image for component " + c.name);
+    }
+    if (c.name == kPhysicsId || spec.FindDrone(c.name) != nullptr) {
+      return Error(ErrorCode::kInvalidArgument, "component name '" + c.name + "' is taken by the trial", c.mark.ToString());
+    }
+  }
+  if (std::max(sim_hosts, mesh_hosts) + kFirstDroneHost >= 255) {
     return Error(ErrorCode::kInvalidArgument,
-                 "too many drones for a /24: " + std::to_string(spec.drones.size()));
+                 "too many drones, brains and components for a /24: " + std::to_string(std::max(sim_hosts, mesh_hosts)));
+  }
+  // A group's plugins carry the group's level as their own priority: the engine orders creations
+  // by plugin priority across the whole tree (a level's creations wait for the lower ones'), so
+  // the numbers must be comparable between groups.
+  // Run levels: networks 0; components below the drones' priority, each priority its own level;
+  // physics; external brains; sidecars and their set-up step; the drones (with the components of
+  // priority kDronesPriority); the components above it.
+  std::set<int> before;
+  std::set<int> after;
+  for (const dsl::UserComponentSpec& c : spec.components) {
+    if (c.priority < dsl::kDronesPriority) before.insert(c.priority);
+    if (c.priority > dsl::kDronesPriority) after.insert(c.priority);
+  }
+  std::map<int, int> level_of;  // component priority -> tree run priority
+  int next_level = 1;
+  for (int p : before) level_of[p] = next_level++;
+  const int physics_level = next_level++;
+  const bool external_brains = spec.HasExternalBrain();
+  const int brains_level = external_brains ? next_level++ : 0;
+  const int sidecars_level = sidecars ? next_level++ : 0;
+  const int faults_level = sidecars ? next_level++ : 0;
+  const int drones_level = next_level++;
+  level_of[dsl::kDronesPriority] = drones_level;
+  for (int p : after) level_of[p] = next_level++;
+  if (next_level - 1 > dsl::kMaxRunPriority) {
+    return Error(ErrorCode::kInvalidArgument, "too many component priorities: " + std::to_string(before.size() + after.size()));
   }
   const std::string trial_id = options.trial_id.empty() ? spec.name : options.trial_id;
   auto name = [&](std::string_view component) {
@@ -298,14 +416,73 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   physics.scratch_dirs = {std::string(kContainerOutDir)};
   physics.artifacts = {std::string(kTruthCsvPath)};
   Confine(spec.LimitsOf(nullptr), &physics);
-  trial->Add<dsl::Plugin>(std::string(kPhysicsId), std::move(physics), 1)
+  trial->Add<dsl::Plugin>(std::string(kPhysicsId), std::move(physics), physics_level)
       .On(sim_net, physics_ip, {std::string(kPhysicsId)})
       .ReadyOn(std::string(kPhysicsReadyPattern), dsl::Duration::Seconds(60));
 
   // One agent per drone; with network faults, each agent lives in its fault sidecar's network
   // namespace (sidecars [2], the injector's set-up step [3], agents [4]).
+  std::uint32_t next_sim_host = kFirstDroneHost + static_cast<std::uint32_t>(spec.drones.size());
+  std::uint32_t next_mesh_host = next_sim_host;
+
+  // External brains: their own containers on sim, started before the agents that wait for them.
+  if (external_brains) {
+    auto& brains = trial->Add<dsl::Component>(std::string(kBrainsGroupId), brains_level);
+    for (const dsl::DroneSpec& d : spec.drones) {
+      if (!d.brain.external()) continue;
+      const std::string id = BrainId(d.name);
+      dsl::ContainerSpec bc = dsl::ContainerSpec::Image(options.images.brains.at(d.name), BrainArgv(spec, d));
+      bc.argv_is_cmd = d.brain.kind != dsl::BrainKind::kProgram;
+      bc.name = name(id);
+      bc.hostname = id;
+      bc.labels = RoleLabels(options.run_id, trial_id, id, kRoleBrain);
+      bc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id},
+                {"CYCLONEDDS_URI", CycloneUriFor(kSimInterface)}};
+      ConfineUser(spec.LimitsOf(&d), &bc);
+      bc.stop_timeout_s = 5;
+      brains.Add<dsl::Plugin>(id, std::move(bc), brains_level).On(sim_net, nets.sim.Host(next_sim_host++), {id});
+    }
+  }
+
+  // The trial's components, each at the level of its priority.
+  for (const dsl::UserComponentSpec& c : spec.components) {
+    std::vector<std::string> argv;
+    if (c.source == dsl::ComponentSource::kProgram) {
+      argv.push_back(std::string(kProgramDirInImage) + "/" + BasenameOf(c.host_path.empty() ? c.ref : c.host_path));
+    }
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    dsl::ContainerSpec cc = dsl::ContainerSpec::Image(options.images.components.at(c.name), std::move(argv));
+    cc.argv_is_cmd = c.source != dsl::ComponentSource::kProgram;
+    cc.name = name(c.name);
+    cc.labels = RoleLabels(options.run_id, trial_id, c.name, kRoleComponent);
+    cc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
+    const bool on_sim = std::find(c.networks.begin(), c.networks.end(), kSimNetworkId) != c.networks.end();
+    if (on_sim) cc.env["CYCLONEDDS_URI"] = CycloneUriFor(kSimInterface);  // sim sorts first: eth0
+    for (const auto& [k, v] : c.env) cc.env[k] = v;  // the trial's env wins
+    ConfineUser(spec.limits, &cc);  // the trial's (physics: {limits} is the server's own)
+    cc.artifacts = c.collect;
+    cc.artifacts_dir = std::string(kComponentsDir) + "/" + c.name;
+    if (c.networks.empty()) {
+      cc.no_network = true;
+    } else {
+      cc.hostname = c.name;
+    }
+    auto& plugin = trial->Add<dsl::Plugin>(c.name, std::move(cc), level_of.at(c.priority));
+    for (const std::string& n : c.networks) {
+      if (n == kSimNetworkId) {
+        plugin.On(sim_net, nets.sim.Host(next_sim_host++), {c.name});
+      } else if (mesh_net != nullptr) {
+        plugin.On(*mesh_net, nets.mesh.Host(next_mesh_host++), {c.name});
+      } else {
+        return Error(ErrorCode::kInvalidArgument,
+                     "component " + c.name + " joins mesh, which only a radio.model netem trial has", c.mark.ToString());
+      }
+    }
+    if (!c.ready.empty()) plugin.ReadyOn(c.ready, dsl::Duration::Seconds(kComponentReadySeconds));
+  }
+
   if (sidecars) {
-    auto& radios = trial->Add<dsl::Component>(std::string(kSidecarsGroupId), 2);
+    auto& radios = trial->Add<dsl::Component>(std::string(kSidecarsGroupId), sidecars_level);
     std::uint32_t host = kFirstDroneHost;
     for (const dsl::DroneSpec& d : spec.drones) {
       const std::string id = SidecarId(d.name);
@@ -321,21 +498,22 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
       sc.no_new_privileges = true;
       sc.user = "0:0";  // NET_ADMIN reaches no non-root user on Docker 20.10 (standard_images.hpp)
       sc.stop_timeout_s = 2;
-      radios.Add<dsl::Plugin>(id, std::move(sc), 2)
+      radios.Add<dsl::Plugin>(id, std::move(sc), sidecars_level)
           .On(sim_net, nets.sim.Host(host), {d.name})
           .On(*mesh_net, nets.mesh.Host(host), {d.name});
       ++host;
     }
-    trial->Add<dsl::Step>(std::string(kFaultsStepId), 3);
+    trial->Add<dsl::Step>(std::string(kFaultsStepId), faults_level);
   }
-  auto& drones = trial->Add<dsl::Component>(std::string(kDronesGroupId), sidecars ? 4 : 2);
+  auto& drones = trial->Add<dsl::Component>(std::string(kDronesGroupId), drones_level);
   std::uint32_t host = kFirstDroneHost;
   for (const dsl::DroneSpec& d : spec.drones) {
     const std::string sim_ip = nets.sim.Host(host);
     const std::string mesh_ip = nets.mesh.Host(host);
     ++host;
-    dsl::ContainerSpec agent =
-        dsl::ContainerSpec::Image(options.images.agent, AgentArgv(spec, d));
+    const auto own_agent = options.images.drone_agents.find(d.name);
+    dsl::ContainerSpec agent = dsl::ContainerSpec::Image(
+        own_agent != options.images.drone_agents.end() ? own_agent->second : options.images.agent, AgentArgv(spec, d));
     agent.name = name(d.name);
     agent.labels = labels(d.name);
     agent.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
@@ -344,10 +522,10 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     Confine(spec.LimitsOf(&d), &agent);
     if (sidecars) {
       agent.network_of = SidecarId(d.name);  // Docker refuses a hostname here
-      drones.Add<dsl::Plugin>(d.name, std::move(agent), 2);
+      drones.Add<dsl::Plugin>(d.name, std::move(agent), drones_level);
     } else {
       agent.hostname = d.name;
-      auto& plugin = drones.Add<dsl::Plugin>(d.name, std::move(agent), 2).On(sim_net, sim_ip, {d.name});
+      auto& plugin = drones.Add<dsl::Plugin>(d.name, std::move(agent), drones_level).On(sim_net, sim_ip, {d.name});
       if (mesh_net != nullptr) plugin.On(*mesh_net, mesh_ip, {d.name});
     }
   }

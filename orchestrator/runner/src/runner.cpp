@@ -19,6 +19,7 @@
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/radio_schedule.hpp"
 #include "swarmbox/runner/trajectories.hpp"
+#include "swarmbox/runner/user_images.hpp"
 
 namespace swarmbox::runner {
 
@@ -74,6 +75,19 @@ std::string WarningEventJson(double wall_s, const std::string& reason) {
   root.Set("component", yaml::Node::Scalar("orchestrator", {}, /*quoted=*/true));
   root.Set("event", yaml::Node::Scalar("warning", {}, /*quoted=*/true));
   root.Set("reason", yaml::Node::Scalar(reason, {}, /*quoted=*/true));
+  return yaml::EmitJson(root);
+}
+
+// {"wall_s":1.234,"component":"scout_2-brain","event":"exited","exit_code":137}: a container
+// that may leave without ending the trial (Monitor::ExitRule) did.
+std::string ExitedEventJson(double wall_s, const std::string& component, std::int64_t exit_code) {
+  yaml::Node root = yaml::Node::Mapping();
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3f", wall_s);
+  root.Set("wall_s", yaml::Node::Scalar(buf));
+  root.Set("component", yaml::Node::Scalar(component, {}, /*quoted=*/true));
+  root.Set("event", yaml::Node::Scalar("exited", {}, /*quoted=*/true));
+  root.Set("exit_code", yaml::Node::Scalar(std::to_string(exit_code)));
   return yaml::EmitJson(root);
 }
 
@@ -314,6 +328,9 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     if (state && !state->running) {
       if (auto v = monitor->OnExit(item.component, state->exit_code, state->oom_killed)) {
         raise(item.component, *v, false);
+      } else {
+        events.Write(ExitedEventJson(wall(), item.component, state->exit_code));
+        say(item.component + " exited with code " + std::to_string(state->exit_code) + " (the trial goes on)");
       }
       return;
     }
@@ -324,7 +341,15 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     auto m = Monitor::Create(*tree);
     if (!m) return Verdict::FromError(m.error(), "end conditions");
     monitor.emplace(std::move(*m));
-    for (dsl::Plugin* p : tree->Plugins()) monitor->Started(p->id());
+    for (dsl::Plugin* p : tree->Plugins()) {
+      monitor->Started(p->id());
+      // A brain may go (its drone's offboard failsafe answers, in the agent's events); a user's
+      // component may finish its job (exit 0). Anything else leaving is a crash.
+      const auto role = p->spec().labels.find(std::string(kLabelRole));
+      if (role == p->spec().labels.end()) continue;
+      if (role->second == kRoleBrain) monitor->SetExitRule(p->id(), Monitor::ExitRule::kAnyExitAllowed);
+      if (role->second == kRoleComponent) monitor->SetExitRule(p->id(), Monitor::ExitRule::kCleanExitAllowed);
+    }
     return Verdict::Success();
   };
 
@@ -469,7 +494,23 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
     if (!tag) return tag.error();
     faults_image = *tag;
   }
-  Planner planner = [&, faults_image, channel](const std::string& run_id, const TrialSubnets& subnets) {
+  // The images of the trial's own software that the caller did not bring.
+  Images images = options.images;
+  bool missing = false;
+  for (const dsl::DroneSpec& d : spec.drones) {
+    missing = missing || (d.brain.kind == dsl::BrainKind::kLibrary && images.drone_agents.count(d.name) == 0) ||
+              (d.brain.external() && images.brains.count(d.name) == 0);
+  }
+  for (const dsl::UserComponentSpec& c : spec.components) missing = missing || images.components.count(c.name) == 0;
+  if (missing) {
+    const images::TagCache cache(images::DefaultTagCacheDir());
+    auto made = EnsureUserImages(api, spec, options.agent_binary, images, [&](std::string_view line) {
+      if (options.progress != nullptr) *options.progress << "  " << line << std::endl;
+    }, &cache);
+    if (!made) return made.error();
+    images = std::move(*made);
+  }
+  Planner planner = [&, faults_image, channel, images](const std::string& run_id, const TrialSubnets& subnets) {
     PlanOptions p;
     if (channel) {  // RunTrial wrote it (info.files) into the trial folder
       p.radio_plan_path =
@@ -477,7 +518,7 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
     }
     p.run_id = run_id;
     p.trial_id = options.trial_id;
-    p.images = options.images;
+    p.images = images;
     p.faults_image = faults_image;
     p.subnets = subnets;
     p.trials_dir = trials_dir;

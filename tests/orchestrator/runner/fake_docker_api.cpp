@@ -196,6 +196,10 @@ Result<docker::ContainerInfo> FakeDockerApi::InspectContainer(std::string_view i
   info.name = c->spec.name;
   info.state = c->state;
   info.labels = c->spec.labels;
+  if (!c->state.running && c->state.status == "exited" && !c->exit_inspected) {
+    c->exit_inspected = true;
+    cv_.notify_all();  // a log stream may be waiting for this (log_after_exit_seen)
+  }
   return info;
 }
 
@@ -371,6 +375,17 @@ Status FakeDockerApi::FollowLogs(std::string_view id, const docker::LogOptions&,
     };
     if (!cv_.wait_for(lock, std::chrono::seconds(10), all_created)) {
       return Error(ErrorCode::kIo, "log_after_created: the awaited containers were never created");
+    }
+    const std::set<std::string> exits = scripts[component].log_after_exit_seen;
+    auto all_exits_seen = [&] {
+      return std::all_of(exits.begin(), exits.end(), [&](const std::string& a) {
+        return std::any_of(containers_.begin(), containers_.end(), [&](const auto& entry) {
+          return entry.second.component == a && entry.second.exit_inspected;
+        });
+      });
+    };
+    if (!cv_.wait_for(lock, std::chrono::seconds(10), all_exits_seen)) {
+      return Error(ErrorCode::kIo, "log_after_exit_seen: the awaited containers' exits were never inspected");
     }
     Container* c = Find(id);
     if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");

@@ -37,6 +37,10 @@ struct ContainerScript {
   // Its log stream delivers nothing until the containers of these components have been created
   // (to show that later levels are created while this one starts); after 10 s in vain it fails.
   std::set<std::string> log_after_created;
+  // Its log stream delivers nothing until the containers of these components have exited and
+  // been inspected since (the runner inspects a container whose stream ended: so the runner has
+  // handled their exit before this stream's lines); after 10 s in vain it fails.
+  std::set<std::string> log_after_exit_seen;
   // Its creation waits until the containers of these components have started (to show that it
   // is created while an earlier level starts); after 10 s in vain it fails.
   std::set<std::string> create_after_started;
@@ -78,6 +82,7 @@ class FakeDockerApi : public docker::DockerApi {
     int follows = 0;
     int starts = 0;                 // StartContainer/RestartContainer calls that started it
     std::vector<std::string> history;  // every line logged so far (as Docker keeps them)
+    bool exit_inspected = false;       // inspected after it exited (log_after_exit_seen)
   };
   std::vector<std::string> Calls() const;                  // "create-network <name>", ...
   std::vector<docker::ContainerSpec> Created() const;      // every CreateContainer spec, in order

@@ -109,3 +109,40 @@ TEST(Monitor, ProgressLineShowsClocksMissionStateAndLiveComponents) {
 
 }  // namespace
 }  // namespace swarmbox::runner
+
+namespace swarmbox::runner {
+namespace {
+
+// Exit rules (issue #24): a brain may leave at any time (its drone's offboard failsafe answers), a
+// user component may finish with 0; anything else leaving, or an OOM kill, still ends the trial.
+TEST(Monitor, ExitRulesLetBrainsGoAndComponentsFinish) {
+  auto trial = MakeTrial();
+  auto m = Monitor::Create(*trial);
+  ASSERT_TRUE(m);
+  for (const char* c : {"physics", "scout_1", "scout_1-brain", "ground", "recorder"}) m->Started(c);
+  m->SetExitRule("scout_1-brain", Monitor::ExitRule::kAnyExitAllowed);
+  m->SetExitRule("ground", Monitor::ExitRule::kCleanExitAllowed);
+  m->SetExitRule("recorder", Monitor::ExitRule::kCleanExitAllowed);
+  EXPECT_FALSE(m->OnExit("scout_1-brain", 137, false).has_value());
+  EXPECT_FALSE(m->OnExit("ground", 0, false).has_value());
+  EXPECT_EQ(m->live().count("scout_1-brain"), 0u);  // no longer live, the trial goes on
+  EXPECT_FALSE(m->ended());
+  auto v = m->OnExit("recorder", 2, false);
+  ASSERT_TRUE(v.has_value());
+  EXPECT_EQ(v->outcome, dsl::Outcome::kFailure);
+  EXPECT_EQ(v->reason, "recorder exited with code 2 before the trial ended");
+}
+
+TEST(Monitor, AnOomKillEndsTheTrialWhateverTheRule) {
+  auto trial = MakeTrial();
+  auto m = Monitor::Create(*trial);
+  ASSERT_TRUE(m);
+  m->Started("scout_1-brain");
+  m->SetExitRule("scout_1-brain", Monitor::ExitRule::kAnyExitAllowed);
+  auto v = m->OnExit("scout_1-brain", 137, true);
+  ASSERT_TRUE(v.has_value());
+  EXPECT_EQ(v->reason, "scout_1-brain was killed for lack of memory");
+}
+
+}  // namespace
+}  // namespace swarmbox::runner

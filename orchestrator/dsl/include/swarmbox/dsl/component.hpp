@@ -4,9 +4,9 @@
 //
 // Lifecycle events (pure: every side effect goes through the Engine interface):
 //   Build, Run  propagate DOWN: the component handles the event, then its children in run order
-//               (run priority 0 first, 5 last; ties in the order they were added). The walk stops
+//               (run priority 0 first, 63 last; ties in the order they were added). The walk stops
 //               at the first result that is not success (nothing is built on a broken base).
-//   Stop        propagates DOWN in reverse run order (5 first, the component itself last) and is
+//   Stop        propagates DOWN in reverse run order (highest first, the component itself last) and is
 //               best-effort: every module that was built is stopped even when others fail.
 // Siblings of equal run priority form a level; a level is handed to Engine::RunSiblings, which
 // may run its steps at once (the Docker engine does): a level then starts only once the level
@@ -42,7 +42,9 @@ enum class EventKind { kBuild, kRun, kStop, kShutdown, kRestart };
 std::string_view EventName(EventKind event);
 
 inline constexpr int kMinRunPriority = 0;
-inline constexpr int kMaxRunPriority = 5;
+// Enough levels for a trial's own (networks, physics, sidecars, faults, drones) and one per
+// distinct `components:` priority (at most 32 components).
+inline constexpr int kMaxRunPriority = 63;
 
 class Engine;
 class Network;
@@ -50,7 +52,7 @@ class Plugin;
 
 class Component {
  public:
-  // Aborts (SWARMBOX_CHECK) on an empty id or a priority outside [0, 5].
+  // Aborts (SWARMBOX_CHECK) on an empty id or a priority outside [0, kMaxRunPriority].
   explicit Component(std::string id, int run_priority = 0);
   virtual ~Component();
   Component(const Component&) = delete;

@@ -41,6 +41,9 @@ struct ContainerSpec {
   std::string name;   // Docker name, unique per host: "<trial>-<run>-<component>"
   std::string image;  // "swarmbox/agent:3f2a..."
   std::vector<std::string> argv;  // the full command line (entrypoint + arguments); no shell
+  // argv replaces only the image's CMD and keeps its ENTRYPOINT (a user's image, whose program
+  // SwarmBox does not know); empty argv then keeps the image's CMD too.
+  bool argv_is_cmd = false;
   std::map<std::string, std::string> env;
   std::map<std::string, std::string> labels;
   std::vector<Attachment> networks;
@@ -48,6 +51,8 @@ struct ContainerSpec {
   // namespace on `networks`). Then `networks` and `hostname` must be empty (Docker refuses them);
   // the other plugin must be running first (lower run priority).
   std::string network_of;
+  // No network at all (Docker's NetworkMode "none"); `networks` must then be empty.
+  bool no_network = false;
   std::vector<std::string> cap_add;   // e.g. "NET_ADMIN" (the fault sidecar only)
   std::vector<std::string> cap_drop;  // e.g. "ALL"
   // Least privilege: SecurityOpt no-new-privileges; a read-only root filesystem, where the
@@ -68,6 +73,9 @@ struct ContainerSpec {
   std::vector<InputFile> inputs;           // copied in before start
   std::vector<std::string> scratch_dirs;  // created empty and world-writable before start (/out)
   std::vector<std::string> artifacts;  // absolute paths in the container collected on Stop
+  // Where the artifacts go, relative to the trial folder ("" = the trial folder itself), e.g.
+  // "components/recorder". Files keep their names; a folder's files keep their relative paths.
+  std::string artifacts_dir;
   int stop_timeout_s = 10;             // SIGTERM, then SIGKILL after this
 
   // ContainerSpec::Image("swarmbox/physics:1", {"swarmbox-physics", "--seed", "42"})

@@ -11,6 +11,8 @@
 // <trials_dir>/worlds/open_field.yaml, `airframe: x500` is <trials_dir>/airframes/x500.yaml.
 // trials_dir defaults to the nearest folder named `trials` that holds the trial file (so
 // trials/faults/partition.yaml resolves against trials/), else the trial file's folder.
+// Brain and component paths (`drones[].brain`, `components:`) resolve against the trial file's own
+// folder and are checked (existence and kind: user_software.hpp) with check_references.
 #pragma once
 
 #include <functional>
@@ -30,6 +32,10 @@ struct LoadOptions {
   // Whether a referenced file exists; default: std::filesystem. Tests pass a fake.
   std::function<bool(const std::string& path)> file_exists;
   bool check_references = true;
+  // What a brain's or component's file is (user_software.hpp); default: ProbeFileKind.
+  std::function<FileKind(const std::string& path)> file_kind;
+  // Where brain and component paths resolve; "" = the trial file's folder (LoadTrialText sets it).
+  std::string base_dir;
 };
 
 // The default trials directory of a trial file (see above).

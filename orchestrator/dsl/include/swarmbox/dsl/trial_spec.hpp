@@ -14,6 +14,8 @@
 //                     .EndOn("event=mission_complete", Outcome::kSuccess)
 //                     .EndOn("event=collision", Outcome::kFailure, "collision")
 //                     .Timeout(Duration::Minutes(10));
+//   t.Brain("scout_1", BrainSpec::Library("/abs/librendezvous.so", "rendezvous"))
+//    .Component(UserComponentSpec::Program("ground", "/abs/ground_station"));
 //
 // Faults: the `faults:` list is parsed and checked by swarmbox_faults (faults::ParseFaults, the
 // fault injector's own schema: at/at_wall/on, duration, kill/stop/pause/restart/radio/partition/
@@ -31,6 +33,7 @@
 #include "swarmbox/dsl/outcome.hpp"
 #include "swarmbox/faults/fault_spec.hpp"
 #include "swarmbox/faults/netem_spec.hpp"
+#include "swarmbox/dsl/user_software.hpp"
 
 namespace swarmbox::dsl {
 
@@ -58,6 +61,7 @@ struct DroneSpec {
   std::string payload;              // "" = none
   ContainerLimits limits;           // overrides of the trial's `limits:` (0 = the trial's)
   yaml::Mark mark;                  // where the drone was declared
+  BrainSpec brain;                  // what flies it (`brain:`; builtin = `mission:`)
 };
 
 struct EndSpec {
@@ -142,6 +146,7 @@ struct TrialSpec {
   TimeoutSpec timeout;
   ContainerLimits limits = kDefaultLimits;  // every agent and the physics server
   ContainerLimits physics_limits;           // physics.limits: overrides (0 = the trial's)
+  std::vector<UserComponentSpec> components;  // `components:` (user_software.hpp)
 
   std::string trials_dir;  // where world and airframe references resolve ("" = not checked)
   yaml::Node document;     // the resolved description (after --set), written as trial.yaml
@@ -168,8 +173,15 @@ struct TrialSpec {
   TrialSpec& Timeout(Duration sim, Outcome outcome = Outcome::kTimeout, Duration wall = {});
 
   TrialSpec& Limits(ContainerLimits value);
+  // The brain of a drone added before (aborts naming the drone when there is none: a bug in the
+  // calling code). Paths are taken as given (relative ones against the working directory).
+  TrialSpec& Brain(std::string_view drone_name, BrainSpec brain);
+  // One more `components:` entry (checked when the trial is planned or validated).
+  TrialSpec& Component(UserComponentSpec component);
 
   const DroneSpec* FindDrone(std::string_view drone_name) const;
+  const UserComponentSpec* FindComponent(std::string_view component_name) const;
+  bool HasExternalBrain() const;
   // The limits a container runs with: the drone's (nullptr = the physics server's) overrides over
   // the trial's.
   ContainerLimits LimitsOf(const DroneSpec* drone) const;

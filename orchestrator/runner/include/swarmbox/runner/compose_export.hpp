@@ -5,11 +5,13 @@
 //     hostname, fixed addresses and aliases on each network
 //   - start order (run priority) as depends_on: each service depends on the services of the
 //     previous priority level
+//   - a user's image keeps its entrypoint (`command` only); a Dockerfile's image is `build:`
 //   - input files bind-mounted read-only (the runner copies them in through the API instead),
 //     scratch dirs (/out) as tmpfs with mode 1777 (the images run as uid 1000)
 // Pure: the text is returned; the CLI writes it.
 #pragma once
 
+#include <map>
 #include <string>
 
 #include "swarmbox/dsl/trial.hpp"
@@ -22,6 +24,13 @@ struct ComposeOptions {
   std::string host_prefix;
   std::string relative_prefix;
   std::string header_comment;  // first lines of the file, each prefixed with "# "
+  // Services whose image compose builds (a brain's or component's Dockerfile): service id ->
+  // the context folder and the Dockerfile in it.
+  struct Build {
+    std::string context;
+    std::string dockerfile;
+  };
+  std::map<std::string, Build> builds;
 };
 
 std::string ComposeYaml(dsl::Trial& trial, const ComposeOptions& options);

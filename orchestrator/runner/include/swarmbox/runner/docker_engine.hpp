@@ -110,7 +110,8 @@ class DockerEngine final : public dsl::Engine {
   std::vector<ComponentReport> Reports() const;
   // Things that went wrong without changing the outcome (a missing artifact...).
   const std::vector<std::string>& problems() const { return problems_; }
-  // Artifacts collected so far: file name -> path on the host.
+  // Artifacts collected so far: file name (relative to the trial folder: "truth.csv",
+  // "components/recorder/out.csv") -> path on the host.
   const std::map<std::string, std::string>& artifacts() const { return artifacts_; }
 
  private:
@@ -126,7 +127,7 @@ class DockerEngine final : public dsl::Engine {
   void JoinFollower(const std::string& component, bool cancel);
   Status CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id);
   void CollectArtifacts(const std::string& component, const std::vector<std::string>& artifacts,
-                        const std::string& container_id);
+                        const std::string& artifacts_dir, const std::string& container_id);
   struct PendingStop;
   bool LogEndedByItself(const std::string& component) const;
   void JoinStops();

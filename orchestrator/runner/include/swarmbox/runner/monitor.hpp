@@ -15,10 +15,13 @@
 //     that match an end condition during the window still win; a container exiting during it
 //     (the physics server stops at the timeout) confirms the timeout.
 //   - a started container exits                            -> failure "<c> exited with code N"
+//     unless its ExitRule allows it: a brain may go at any time (its drone's offboard failsafe is
+//     the answer, recorded by the agent), a user component may finish with code 0 (a job done)
 //   - wall time reaches timeout.wall_guard                  -> error "wall-clock guard: ..."
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -35,6 +38,10 @@ class Monitor {
   static constexpr double kTimeoutDrainS = 1.0;
 
   static Result<Monitor> Create(dsl::Trial& trial);
+
+  // How a container leaving is judged (default kCrashEnds).
+  enum class ExitRule { kCrashEnds, kAnyExitAllowed, kCleanExitAllowed };
+  void SetExitRule(std::string_view component, ExitRule rule);
 
   void Started(std::string_view component);
   std::optional<dsl::Verdict> OnLine(std::string_view component, std::string_view line);
@@ -70,6 +77,7 @@ class Monitor {
   double any_sim_s_ = 0;  // any component's
   double wall_s_ = 0;
   std::set<std::string> live_;
+  std::map<std::string, ExitRule, std::less<>> exit_rules_;
   TrialProgress progress_;
   std::optional<dsl::Verdict> ended_;
   std::optional<dsl::Verdict> timeout_pending_;  // simulated time ran out; draining the streams

@@ -5,6 +5,8 @@
 //   Docker names      <trial>-<run id>-<component> sar-search-20261121-131210-7f3a-scout_1
 //   output folder     <out>/<trial>-<run id>/      runs/sar-search-20261121-131210-7f3a/
 //   labels            swarmbox.run=<run id> swarmbox.trial=<trial id> swarmbox.component=<name>
+//                     + swarmbox.role=brain|component on a drone's external brain and a user's
+//                     component (the trial's `components:`), so tools can tell them apart
 #pragma once
 
 #include <cstdint>
@@ -25,5 +27,12 @@ std::string TrialDirName(std::string_view trial, std::string_view run_id);
 
 std::map<std::string, std::string> RunLabels(std::string_view run_id, std::string_view trial_id,
                                              std::string_view component);
+
+inline constexpr std::string_view kLabelRole = "swarmbox.role";
+inline constexpr std::string_view kRoleBrain = "brain";
+inline constexpr std::string_view kRoleComponent = "component";
+// RunLabels plus swarmbox.role=<role>.
+std::map<std::string, std::string> RoleLabels(std::string_view run_id, std::string_view trial_id,
+                                              std::string_view component, std::string_view role);
 
 }  // namespace swarmbox::runner

@@ -19,6 +19,14 @@
 //                         trial's simulated timeout (--max-sim-time) with `event=stopped t=...`
 //     Component drones [2]
 //       Plugin <drone> [2]  one agent per drone, on sim (eth0) and mesh (eth1)
+// Drones with an external brain (drones[].brain program/dockerfile/image) get its container first:
+//     Component brains [after physics, before the drones]
+//       Plugin <drone>-brain   on sim, role=brain, argv --drone --domain --members + the brain's
+//                              args, CYCLONEDDS_URI bound to eth0 (the agents' sim domain)
+// and the agent runs --brain external; a library brain runs in the agent (--brain library, the
+// library at /swarmbox/brains/<basename> in an agent image packed with it). The trial's
+// `components:` are Plugins <name> (role=component) at levels by their priority: below
+// kDronesPriority before the physics server, equal with the drones, above after them.
 // With network faults (network.mesh, radio or partition faults: NeedsFaultSidecars), instead:
 //     Component sidecars [2]
 //       Plugin <drone>-faults [2]  the fault sidecar (fault-tools image + swarmbox-netemd, CapDrop
@@ -49,8 +57,17 @@
 namespace swarmbox::runner {
 
 struct Images {
+  // Images{physics, agent}: the two every trial runs (the rest are filled by their makers).
+  Images(std::string physics_image = {}, std::string agent_image = {})  // NOLINT(google-explicit-constructor)
+      : physics(std::move(physics_image)), agent(std::move(agent_image)) {}
   std::string physics;  // "swarmbox/physics:<content hash>"
   std::string agent;    // "swarmbox/agent:<content hash>"
+  // The trial's own software (user_images.hpp makes them): per drone with a library brain, the
+  // agent image with that library at kBrainsDir/<basename>; per drone with an external brain, the
+  // brain's image; per component, its image. PlanTrial fails naming what is missing.
+  std::map<std::string, std::string> drone_agents;
+  std::map<std::string, std::string> brains;
+  std::map<std::string, std::string> components;
 };
 
 struct PlanOptions {
@@ -87,6 +104,30 @@ inline constexpr std::string_view kScratchTmpfsDir = "/tmp";
 inline constexpr std::int64_t kScratchTmpfsMib = 16;
 inline constexpr std::string_view kPhysicsReadyPattern = "event=ready";
 inline constexpr std::string_view kSidecarsGroupId = "sidecars";
+inline constexpr std::string_view kBrainsGroupId = "brains";
+// Where a library brain lies in the agent's image (and so in its container).
+inline constexpr std::string_view kBrainsDir = "/swarmbox/brains";
+// Where a packed program (external brain, component) lies in its image.
+inline constexpr std::string_view kProgramDirInImage = "/usr/local/bin";
+// A component's collected files: <trial folder>/components/<name>/<basename>.
+inline constexpr std::string_view kComponentsDir = "components";
+inline constexpr int kComponentReadySeconds = 60;  // as the physics server's readiness
+// The agent's wall-clock bounds on an external brain (the contract's --brain-wait-ms and
+// --brain-start-ms defaults): with an external brain the physics server waits longer than these
+// for a step's answer (--step-timeout) and a first answer (--join-timeout), so the agent's own
+// liveness rule decides, not the server's lost-drone rule.
+inline constexpr int kAgentBrainWaitMs = 3000;
+inline constexpr int kAgentBrainStartMs = 30000;
+inline constexpr double kExternalBrainStepTimeoutS = kAgentBrainWaitMs / 1000.0 + 2.0;
+inline constexpr double kExternalBrainJoinTimeoutS = kAgentBrainStartMs / 1000.0 + 15.0;
+// The external brain's container id: "<drone>-brain".
+std::string BrainId(std::string_view drone);
+// The agent's argv (swarmbox-agent) and an external brain's (for tests and `swarmbox compose`).
+std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
+std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
+// The CYCLONEDDS_URI an external brain or a component on sim gets: Cyclone on `interface` with
+// multicast (what the agents' bus configures for itself from --sim-interface).
+std::string CycloneUriFor(std::string_view interface);
 inline constexpr std::string_view kFaultsStepId = "faults";
 // The agents' interfaces in their (or their sidecar's) namespace.
 inline constexpr std::string_view kSimInterfaceName = "eth0";

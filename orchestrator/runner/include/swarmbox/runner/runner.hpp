@@ -67,6 +67,10 @@ struct RunOptions {
   // swarmbox-netemd for the fault sidecar image, when faults_image is "" and the trial impairs
   // the mesh ("" = FindNetemd's search, fault_image.hpp).
   std::string netemd_bin;
+  // The host swarmbox-agent: RunTrialSpec packs the agent image of a drone with a library brain
+  // from it when `images.drone_agents` lacks that drone (user_images.hpp; brains' and components'
+  // images missing from `images` are made the same way).
+  std::string agent_binary;
 };
 
 struct RunOutcome {
