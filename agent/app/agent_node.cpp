@@ -12,6 +12,7 @@
 #include "swarmbox/brain/args.hpp"
 #include "swarmbox/brain/loader.hpp"
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/yaml.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
 #include "wait_budget.hpp"
@@ -236,7 +237,22 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
                                                     node->consensus_.get(), o.log);
     if (auto spec = swarm::BatterySpecFor(cfg->airframe)) node->battery_.emplace(*spec);
   }
-  if (node->sar_ != nullptr && node->sar_->role() == swarm::Role::kScout) {
+  // Perception runs beside the brain on a scout of the SAR mission and, for any other brain, on
+  // an airframe with a camera: its detections are Input::detections. (The physics server renders
+  // frames only when the trial asks for cameras; without frames nothing is detected.)
+  bool perceive = node->sar_ != nullptr && node->sar_->role() == swarm::Role::kScout;
+  if (brain) {
+    auto airframe = yaml::ParseFile(o.airframe_path);
+    if (!airframe) return airframe.error().Context("loading airframe");
+    if (airframe->is_mapping() && airframe->Find("camera") != nullptr) {
+      auto camera = LoadCameraSpec(o.airframe_path);
+      if (!camera) return camera.error().Context("the airframe's camera");
+      perception.camera = *camera;
+      perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
+      perceive = true;
+    }
+  }
+  if (perceive) {
     auto p = PerceptionHost::Create(perception);
     if (!p) return p.error();
     node->perception_ = std::move(*p);
