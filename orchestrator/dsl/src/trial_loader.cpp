@@ -279,6 +279,24 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   }
 
   if (mission != nullptr && !mission->is_null()) SWARMBOX_TRY(DecodeMission(*mission, &spec.mission));
+  // Every drone is a member of the swarm's one Raft log. The SAR mission's planner runs on the Raft
+  // leader only, so a SAR drone next to drones on other brains could wait forever under a leader
+  // that never plans (and the brains would ignore each other's entries): refused up front.
+  if (spec.mission.kind == MissionKind::kSar) {
+    const DroneSpec* builtin = nullptr;
+    const DroneSpec* other = nullptr;
+    for (const DroneSpec& d : spec.drones) {
+      const DroneSpec*& first = d.brain.kind == BrainKind::kBuiltin ? builtin : other;
+      if (first == nullptr) first = &d;
+    }
+    if (builtin != nullptr && other != nullptr) {
+      return AtMark(other->mark,
+                   "drone '" + other->name + "' flies its own brain while '" + builtin->name +
+                       "' flies the sar mission: they would share one consensus log (Raft) whose leader "
+                       "plans the search only if it flies sar; give every drone a brain, or none "
+                       "(mission: {kind: plan} for builtin drones beside brains)");
+    }
+  }
   if (raft != nullptr && !raft->is_null()) SWARMBOX_TRY(DecodeRaft(*raft, &spec.raft));
   if (radio != nullptr && !radio->is_null()) {
     SWARMBOX_TRY(DecodeRadio(*radio, &spec.radio));

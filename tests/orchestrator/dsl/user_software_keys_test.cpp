@@ -17,6 +17,7 @@ using ::testing::HasSubstr;
 
 constexpr const char* kTrial = R"(name: byo
 world: worlds/open_field.yaml
+mission: {kind: plan, plan: "takeoff:5,hover:2,land"}
 drones:
   - {name: scout_1, airframe: x500, brain: {library: brains/librendezvous.so, name: rendezvous, args: {radius_m: 6, label: ring}}}
   - {name: scout_2, airframe: x500, brain: {program: bin/c_brain, args: [--radius-m, 6], rate_hz: 50, offboard: {timeout_ms: 800, hold_ms: 0}}}
@@ -90,6 +91,23 @@ TEST(UserSoftwareKeys, BrainsOfEveryKindResolveAgainstTheTrialFilesFolder) {
 
   EXPECT_EQ(spec->drones[2].brain.kind, BrainKind::kBuiltin);
   EXPECT_TRUE(spec->HasExternalBrain());
+}
+
+// Every drone is a member of the one Raft log, and the SAR planner runs on its leader only: a sar
+// mission beside other brains is refused at the first drone on another brain.
+TEST(UserSoftwareKeys, ASarMissionBesideOtherBrainsIsRefused) {
+  const std::string text = With("mission: {kind: plan, plan: \"takeoff:5,hover:2,land\"}\n", "");
+  const std::string error = ErrorOf(text);
+  EXPECT_THAT(error, HasSubstr("byo.yaml:4:"));  // scout_1's entry
+  EXPECT_THAT(error, HasSubstr("drone 'scout_1' flies its own brain while 'scout_3' flies the sar mission"));
+  // Every drone on a brain of its own (no builtin drone): the mission key does not matter.
+  std::string brains_only = text;
+  const std::string scout_3 = "  - {name: scout_3, airframe: x500}\n";
+  brains_only.erase(brains_only.find(scout_3), scout_3.size());
+  auto spec = Load(brains_only);
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  EXPECT_EQ(spec->mission.kind, MissionKind::kSar);
+  EXPECT_EQ(spec->drones.size(), 2u);
 }
 
 TEST(UserSoftwareKeys, BuiltinAndDockerfileAndImageBrains) {
