@@ -279,6 +279,17 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   }
 
   if (mission != nullptr && !mission->is_null()) SWARMBOX_TRY(DecodeMission(*mission, &spec.mission));
+  if (raft != nullptr && !raft->is_null()) SWARMBOX_TRY(DecodeRaft(*raft, &spec.raft));
+  if (radio != nullptr && !radio->is_null()) {
+    SWARMBOX_TRY(DecodeRadio(*radio, &spec.radio));
+  }
+
+  if (components != nullptr) {
+    auto decoded = detail::DecodeComponents(*components, spec, software);
+    if (!decoded) return decoded.error();
+    spec.components = std::move(*decoded);
+  }
+
   // Every drone is a member of the swarm's one Raft log. The SAR mission's planner runs on the Raft
   // leader only, so a SAR drone next to drones on other brains could wait forever under a leader
   // that never plans (and the brains would ignore each other's entries): refused up front.
@@ -296,16 +307,6 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
                        "plans the search only if it flies sar; give every drone a brain, or none "
                        "(mission: {kind: plan} for builtin drones beside brains)");
     }
-  }
-  if (raft != nullptr && !raft->is_null()) SWARMBOX_TRY(DecodeRaft(*raft, &spec.raft));
-  if (radio != nullptr && !radio->is_null()) {
-    SWARMBOX_TRY(DecodeRadio(*radio, &spec.radio));
-  }
-
-  if (components != nullptr) {
-    auto decoded = detail::DecodeComponents(*components, spec, software);
-    if (!decoded) return decoded.error();
-    spec.components = std::move(*decoded);
   }
 
   if (network != nullptr) {

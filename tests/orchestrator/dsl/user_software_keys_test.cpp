@@ -17,7 +17,6 @@ using ::testing::HasSubstr;
 
 constexpr const char* kTrial = R"(name: byo
 world: worlds/open_field.yaml
-mission: {kind: plan, plan: "takeoff:5,hover:2,land"}
 drones:
   - {name: scout_1, airframe: x500, brain: {library: brains/librendezvous.so, name: rendezvous, args: {radius_m: 6, label: ring}}}
   - {name: scout_2, airframe: x500, brain: {program: bin/c_brain, args: [--radius-m, 6], rate_hz: 50, offboard: {timeout_ms: 800, hold_ms: 0}}}
@@ -25,6 +24,7 @@ drones:
 components:
   - {name: ground, program: bin/ground, args: [--out, /tmp/ground.csv], env: {LEVEL: debug, N: 3}, networks: [sim], priority: 10, ready: "event=ready", collect: [/tmp/ground.csv, /out/log]}
   - {name: recorder, image: "recorder:local"}
+mission: {kind: plan, plan: "takeoff:5,hover:2,land"}
 timeout: {sim: 60s}
 )";
 
