@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 
 #include "support/child_process.hpp"
@@ -29,6 +30,12 @@ using swarmbox::testing::ReadWholeFile;
 using swarmbox::testing::RunToEnd;
 
 constexpr char kSwarmbox[] = SWARMBOX_CLI_EXE;
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  ASSERT_TRUE(out.good()) << "cannot write " << path;
+}
 const std::string kTrial = std::string(SWARMBOX_SOURCE_DIR) + "/trials/components/probe.yaml";
 
 TEST(ComponentE2e, AUserComponentRunsAndItsCollectedFileComesBack) {
@@ -105,6 +112,68 @@ TEST(ComponentE2e, AUserComponentRunsAndItsCollectedFileComesBack) {
   auto networks = api.ListNetworks(mine);
   ASSERT_TRUE(networks) << networks.error().ToString();
   EXPECT_TRUE(networks->empty());
+}
+
+
+// A component whose image the engine builds from the trial's Dockerfile (its folder is the build
+// context). Nothing can be pulled here, so the Dockerfile starts FROM scratch and copies the probe
+// linked statically; the trial lives in a scratch `trials/` folder whose worlds and airframes are
+// the shipped ones (and its radio profiles).
+TEST(ComponentE2e, AComponentBuiltFromADockerfileRunsAndItsFileComesBack) {
+  auto client = docker::DockerClient::Connect(docker::DockerClientOptions{});
+  ASSERT_TRUE(client) << "this test needs a Docker engine: " << client.error().ToString();
+  docker::DockerApi& api = **client;
+  const fs::path dir = fs::temp_directory_path() / ("swarmbox-dockerfile-e2e-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const fs::path trials = dir / "trials";
+  fs::create_directories(trials / "components" / "built");
+  for (const char* shared : {"worlds", "airframes", "radios"}) {
+    fs::create_directory_symlink(fs::path(SWARMBOX_SOURCE_DIR) / "trials" / shared, trials / shared);
+  }
+  fs::copy_file(SWARMBOX_STATIC_PROBE_EXE, trials / "components" / "built" / "probe");
+  WriteText((trials / "components" / "built" / "Dockerfile").string(),
+                                    "FROM scratch\nCOPY probe /probe\nENTRYPOINT [\"/probe\"]\n");
+  const fs::path trial = trials / "components" / "built.yaml";
+  WriteText(trial.string(), R"(name: built
+seed: 1
+world: worlds/open_field.yaml
+physics: {rtf: 0}
+drones:
+  - {name: scout_1, airframe: x500, pose: [0, 0, 0]}
+mission: {kind: plan, plan: "takeoff:3,hover:2,land"}
+components:
+  - {name: built, dockerfile: built/Dockerfile, args: [--out, /hello.txt], priority: 0,
+     ready: "event=probe_ready", collect: [/hello.txt]}
+end:
+  - {on: "event=plan_complete", outcome: success}
+timeout: {sim: 60s, wall: 5m, outcome: timeout}
+)");
+  const std::string run_id = runner::NewRunId();
+  docker::LabelSelector mine;
+  mine.equals[std::string(docker::kLabelRun)] = run_id;
+  struct Cleanup {
+    docker::DockerApi& api;
+    docker::LabelSelector selector;
+    fs::path dir;
+    ~Cleanup() {
+      (void)docker::RemoveLabelled(api, selector, /*include_images=*/false);
+      fs::remove_all(dir);
+    }
+  } cleanup{api, mine, dir};
+
+  auto done = RunToEnd({kSwarmbox, "run", trial.string(), "--out", (dir / "runs").string(), "--run-id", run_id},
+                       std::chrono::minutes(8), dir.string());
+  ASSERT_TRUE(done) << done.error().ToString();
+  std::cout << done->out << done->err;
+  EXPECT_EQ(done->code, 0) << done->err;
+  const fs::path trial_dir = dir / "runs" / runner::TrialDirName("built", run_id);
+  const std::string hello = ReadWholeFile((trial_dir / "components" / "built" / "hello.txt").string());
+  EXPECT_THAT(hello, HasSubstr("started trial="));
+  EXPECT_THAT(hello, HasSubstr("stopped signal=15\n"));
+  EXPECT_THAT(ReadWholeFile((trial_dir / "logs" / "built.log").string()), HasSubstr("event=probe_ready out=/hello.txt"));
+  auto containers = api.ListContainers(mine, /*all=*/true);
+  ASSERT_TRUE(containers) << containers.error().ToString();
+  EXPECT_TRUE(containers->empty());
 }
 
 }  // namespace
