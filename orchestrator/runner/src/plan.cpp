@@ -64,8 +64,10 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
   // An agent with an external brain waits up to the brain's wall-clock bounds for its answer:
   // the server must wait longer before it calls that drone lost.
   if (spec.HasExternalBrain()) {
-    argv.insert(argv.end(), {"--step-timeout", Num(kExternalBrainStepTimeoutS),
+    argv.insert(argv.end(), {"--step-timeout", Num(std::max(kExternalBrainStepTimeoutS, channel ? kChannelStepTimeoutS : 0.0)),
                              "--join-timeout", Num(kExternalBrainJoinTimeoutS)});
+  } else if (channel) {
+    argv.insert(argv.end(), {"--step-timeout", Num(kChannelStepTimeoutS)});
   }
   for (const faults::Fault& f : spec.faults) {
     if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {

@@ -179,12 +179,19 @@ TEST_F(UserSoftwarePlanTest, ThePhysicsServerOutwaitsTheAgentsBrainBounds) {
   const double join = std::stod(FlagValue(argv, "--join-timeout"));
   EXPECT_GT(step * 1000, kAgentBrainWaitMs);
   EXPECT_GT(join * 1000, kAgentBrainStartMs);
-  // No external brain: the server's defaults stay.
+  // No external brain: the server's join default stays; on the channel its step timeout is the
+  // channel's liveness net (kChannelStepTimeoutS), with netem the server's default.
   spec_.drones[1].brain = {};
   auto plain = PlanTrial(spec_, options_);
   ASSERT_TRUE(plain);
-  EXPECT_THAT((*plain)->FindPlugin("physics")->spec().argv, Not(Contains("--step-timeout")));
+  const auto& plain_argv = (*plain)->FindPlugin("physics")->spec().argv;
+  EXPECT_EQ(std::stod(FlagValue(plain_argv, "--step-timeout")), kChannelStepTimeoutS);
+  EXPECT_THAT(plain_argv, Not(Contains("--join-timeout")));
   EXPECT_EQ((*plain)->FindPlugin("scout_2-brain"), nullptr);
+  spec_.radio.model = dsl::RadioModel::kNetem;
+  auto netem = PlanTrial(spec_, options_);
+  ASSERT_TRUE(netem);
+  EXPECT_THAT((*netem)->FindPlugin("physics")->spec().argv, Not(Contains("--step-timeout")));
 }
 
 TEST_F(UserSoftwarePlanTest, ComponentsAreLabelledNetworkedReadyAndCollected) {

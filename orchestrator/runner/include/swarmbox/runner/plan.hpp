@@ -120,6 +120,12 @@ inline constexpr int kAgentBrainWaitMs = 3000;
 inline constexpr int kAgentBrainStartMs = 30000;
 inline constexpr double kExternalBrainStepTimeoutS = kAgentBrainWaitMs / 1000.0 + 2.0;
 inline constexpr double kExternalBrainJoinTimeoutS = kAgentBrainStartMs / 1000.0 + 15.0;
+// With radio.model channel the physics server's lost-drone rule is only a liveness net: drones the
+// trial takes out leave the lockstep at their simulated time (the radio plan), so a wall-clock
+// stall of an agent on a loaded host (both cores busy, ReproducibleE2e) must not drop it: the
+// server waits this long (its own default, 1 s, stays for netem trials, whose failover tests
+// time the loss).
+inline constexpr double kChannelStepTimeoutS = 5.0;
 // The external brain's container id: "<drone>-brain".
 std::string BrainId(std::string_view drone);
 // The agent's argv (swarmbox-agent) and an external brain's (for tests and `swarmbox compose`).
