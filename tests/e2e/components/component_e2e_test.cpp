@@ -31,6 +31,17 @@ using swarmbox::testing::RunToEnd;
 
 constexpr char kSwarmbox[] = SWARMBOX_CLI_EXE;
 
+// Removes what the run labelled and the scratch folder, however the test ends.
+struct RunCleanup {
+  docker::DockerApi& api;
+  docker::LabelSelector selector;
+  fs::path dir;
+  ~RunCleanup() {
+    (void)docker::RemoveLabelled(api, selector, /*include_images=*/false);
+    fs::remove_all(dir);
+  }
+};
+
 void WriteText(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
@@ -48,15 +59,7 @@ TEST(ComponentE2e, AUserComponentRunsAndItsCollectedFileComesBack) {
   const std::string run_id = runner::NewRunId();
   docker::LabelSelector mine;
   mine.equals[std::string(docker::kLabelRun)] = run_id;
-  struct Cleanup {
-    docker::DockerApi& api;
-    docker::LabelSelector selector;
-    fs::path dir;
-    ~Cleanup() {
-      (void)docker::RemoveLabelled(api, selector, /*include_images=*/false);
-      fs::remove_all(dir);
-    }
-  } cleanup{api, mine, dir};
+  const RunCleanup cleanup{api, mine, dir};
 
   const std::string set_program = std::string("components.probe.program=") + SWARMBOX_PROBE_EXE;
   // The file validates with this build's program.
@@ -151,15 +154,7 @@ timeout: {sim: 60s, wall: 5m, outcome: timeout}
   const std::string run_id = runner::NewRunId();
   docker::LabelSelector mine;
   mine.equals[std::string(docker::kLabelRun)] = run_id;
-  struct Cleanup {
-    docker::DockerApi& api;
-    docker::LabelSelector selector;
-    fs::path dir;
-    ~Cleanup() {
-      (void)docker::RemoveLabelled(api, selector, /*include_images=*/false);
-      fs::remove_all(dir);
-    }
-  } cleanup{api, mine, dir};
+  const RunCleanup cleanup{api, mine, dir};
 
   auto done = RunToEnd({kSwarmbox, "run", trial.string(), "--out", (dir / "runs").string(), "--run-id", run_id},
                        std::chrono::minutes(8), dir.string());
