@@ -36,7 +36,13 @@ FileReport ValidateTrial(const std::string& file, const std::vector<std::string>
     return r;
   }
   r.name = spec->name;
-  r.summary = "trial " + spec->name + ", " + std::to_string(spec->drones.size()) + " drones, " +
+  // Groups are counted expanded: "101 drones (scout x100)".
+  std::string groups;
+  for (const dsl::DroneGroup& g : spec->groups) {
+    groups += (groups.empty() ? " (" : ", ") + g.name + " x" + std::to_string(g.count);
+  }
+  if (!groups.empty()) groups += ")";
+  r.summary = "trial " + spec->name + ", " + std::to_string(spec->drones.size()) + " drones" + groups + ", " +
               std::to_string(spec->end.size()) + " end conditions, timeout " +
               spec->timeout.sim.ToString();
   // The user's software, when there is some: "brains scout_1 library, scout_2 program; components

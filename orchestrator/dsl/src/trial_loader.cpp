@@ -1,5 +1,6 @@
 #include "swarmbox/dsl/trial_loader.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -7,6 +8,7 @@
 #include <sstream>
 
 #include "detail/user_software_keys.hpp"
+#include "swarmbox/dsl/drone_groups.hpp"
 #include "swarmbox/dsl/overrides.hpp"
 #include "swarmbox/faults/channel_support.hpp"
 
@@ -189,7 +191,38 @@ std::string DefaultTrialsDir(std::string_view trial_file) {
   return folder.empty() ? std::string(".") : folder.string();
 }
 
-Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options) {
+namespace {
+
+// The groups (`count:` items) of a document's drones list, as written.
+std::vector<DroneGroup> GroupsOf(const yaml::Node& doc) {
+  std::vector<DroneGroup> groups;
+  const Node* drones = doc.is_mapping() ? doc.Find("drones") : nullptr;
+  if (drones == nullptr || !drones->is_sequence()) return groups;
+  for (const Node& item : drones->items()) {
+    const Node* count = item.is_mapping() ? item.Find("count") : nullptr;
+    const Node* name = count != nullptr ? item.Find("name") : nullptr;
+    auto n = count != nullptr ? count->AsInt() : Result<std::int64_t>(0);
+    if (name != nullptr && name->is_scalar() && n && *n > 0) groups.push_back({name->scalar(), static_cast<int>(*n)});
+  }
+  return groups;
+}
+
+Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& options);
+
+}  // namespace
+
+Result<TrialSpec> DecodeTrial(const yaml::Node& document, const LoadOptions& options) {
+  std::vector<DroneGroup> groups = GroupsOf(document);
+  yaml::Node doc = document;
+  SWARMBOX_TRY(ExpandDroneGroups(doc));
+  auto spec = DecodeExpanded(doc, options);
+  if (spec) spec->groups = std::move(groups);
+  return spec;
+}
+
+namespace {
+
+Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& options) {
   TrialSpec spec;
   spec.document = doc;
   spec.trials_dir = options.trials_dir;
@@ -199,6 +232,7 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
       .Optional("seed", &spec.seed)
       .Optional("middleware", &middleware)
       .Required("world", &spec.world);
+  const Node* world_size = r.Child("world_size_m");
   const Node* physics = r.Child("physics");
   const Node* drones = r.Child("drones", /*required=*/true);
   const Node* mission = r.Child("mission");
@@ -216,6 +250,16 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   software.check_files = options.check_references;
   software.file_kind = options.file_kind;
   if (limits != nullptr && !limits->is_null()) SWARMBOX_TRY(DecodeLimits(*limits, &spec.limits));
+
+  if (world_size != nullptr && !world_size->is_null()) {
+    const std::string what = "'world_size_m' must be [X, Y], the geofence's size in metres (both > 0)";
+    if (!world_size->is_sequence() || world_size->items().size() != 2) return At(*world_size, what);
+    for (std::size_t i = 0; i < 2; ++i) {
+      auto v = world_size->items()[i].AsDouble();
+      if (!v || !(*v > 0) || !std::isfinite(*v)) return At(world_size->items()[i], what);
+      spec.world_size_m[i] = *v;
+    }
+  }
 
   if (!IsTrialName(spec.name)) {
     return At(*doc.Find("name"),
@@ -429,18 +473,30 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& doc, const LoadOptions& options)
   return spec;
 }
 
+}  // namespace
+
 Result<TrialSpec> LoadTrialText(std::string_view text, std::string_view filename,
                                 const LoadOptions& options) {
   auto doc = yaml::Parse(text, filename);
   if (!doc) return doc.error();
-  for (const std::string& o : options.overrides) SWARMBOX_TRY(ApplyOverride(*doc, o));
+  std::vector<DroneGroup> groups;  // groups expanded by an override naming one of their drones
+  for (const std::string& o : options.overrides) {
+    if (AddressesGroupMember(*doc, o)) {
+      std::vector<DroneGroup> now = GroupsOf(*doc);
+      groups.insert(groups.end(), now.begin(), now.end());
+      SWARMBOX_TRY(ExpandDroneGroups(*doc));
+    }
+    SWARMBOX_TRY(ApplyOverride(*doc, o));
+  }
   LoadOptions resolved = options;
   if (resolved.trials_dir.empty()) resolved.trials_dir = DefaultTrialsDir(filename);
   if (resolved.base_dir.empty()) {
     const std::filesystem::path folder = std::filesystem::path(std::string(filename)).parent_path();
     resolved.base_dir = folder.empty() ? std::string(".") : folder.string();
   }
-  return DecodeTrial(*doc, resolved);
+  auto spec = DecodeTrial(*doc, resolved);
+  if (spec && !groups.empty()) spec->groups.insert(spec->groups.begin(), groups.begin(), groups.end());
+  return spec;
 }
 
 Result<TrialSpec> LoadTrial(const std::string& path, const LoadOptions& options) {

@@ -43,6 +43,10 @@ TrialSpec& TrialSpec::World(std::string value) {
   world = std::move(value);
   return *this;
 }
+TrialSpec& TrialSpec::WorldSize(double x_m, double y_m) {
+  world_size_m = {x_m, y_m};
+  return *this;
+}
 TrialSpec& TrialSpec::Rtf(double value) {
   rtf = value;
   return *this;
@@ -178,6 +182,11 @@ yaml::Node ToDocument(const TrialSpec& spec) {
   doc.Set("seed", Plain(std::to_string(spec.seed)));
   doc.Set("middleware", Str(MiddlewareName(spec.middleware)));
   doc.Set("world", Str(spec.world));
+  if (spec.HasWorldSize()) {
+    Node size = Node::Sequence();
+    for (double v : spec.world_size_m) size.Append(Plain(Number(v)));
+    doc.Set("world_size_m", std::move(size));
+  }
   auto limits_node = [](const ContainerLimits& l) {
     Node n = Node::Mapping();
     if (l.memory_mib > 0) n.Set("memory_mib", Plain(std::to_string(l.memory_mib)));

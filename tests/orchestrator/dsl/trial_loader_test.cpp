@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <set>
 #include <string>
 
@@ -268,10 +269,24 @@ TEST(LoadTrial, TrialsDirIsTheNearestTrialsFolder) {
 }
 
 TEST(LoadTrial, ShippedTrialsLoadAgainstTheRealTrialsFolder) {
-  for (const char* file : {"sar_search.yaml", "smoke.yaml"}) {
-    auto spec = LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/" + file);
-    EXPECT_TRUE(spec) << file << ": " << spec.error().ToString();
+  // Every trial at the top of trials/ (the folders below have their own tests).
+  int found = 0;
+  for (const auto& e : std::filesystem::directory_iterator(std::string(SWARMBOX_SOURCE_DIR) + "/trials")) {
+    if (e.path().extension() != ".yaml") continue;
+    auto spec = LoadTrial(e.path().string());
+    EXPECT_TRUE(spec) << e.path() << ": " << spec.error().ToString();
+    ++found;
   }
+  EXPECT_GE(found, 4);
+  // The 100-drone trial: 100 scouts on a 10 x 10 grid 4 m apart, the lifter last, the area scaled.
+  auto swarm = LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/swarm_100.yaml");
+  ASSERT_TRUE(swarm) << swarm.error().ToString();
+  ASSERT_EQ(swarm->drones.size(), 101u);
+  EXPECT_EQ(swarm->drones[99].name, "scout_100");
+  EXPECT_EQ(swarm->drones[99].pose, (std::array<double, 3>{36, 36, 0}));
+  EXPECT_EQ(swarm->drones[100].name, "lifter");
+  EXPECT_EQ(swarm->world_size_m, (std::array<double, 2>{600, 600}));
+  EXPECT_DOUBLE_EQ(swarm->rtf, 0);
 }
 
 }  // namespace

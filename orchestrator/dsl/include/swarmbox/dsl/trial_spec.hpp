@@ -128,13 +128,25 @@ struct TimeoutSpec {
   Outcome outcome = Outcome::kTimeout;  // what running out of simulated time means
 };
 
+// A `drones:` item with `count:` (drone_groups.hpp), as written: its drones are in
+// TrialSpec::drones already (<name>_1 .. <name>_<count>).
+struct DroneGroup {
+  std::string name;
+  int count = 0;
+};
+
 struct TrialSpec {
   std::string name;  // [a-z0-9][a-z0-9_.-]*, at most 40 characters; used in folder/Docker names
   std::uint64_t seed = 0;
   Middleware middleware = Middleware::kCycloneDds;
   std::string world;  // relative to the trials directory
+  // `world_size_m: [X, Y]`: the world's geofence set to X x Y m (the SAR search area); {0, 0} = the
+  // world file's own. The runner writes the derived world into the trial folder and every container
+  // reads that one (runner/derived_world.hpp).
+  std::array<double, 2> world_size_m{};
   double rtf = 1.0;   // real-time factor, 0 = as fast as possible
-  std::vector<DroneSpec> drones;
+  std::vector<DroneSpec> drones;  // groups expanded, in file order
+  std::vector<DroneGroup> groups;  // the groups they came from (for summaries)
   MissionSpec mission;
   RaftSpec raft;
   RadioLinkSpec radio;
@@ -156,6 +168,7 @@ struct TrialSpec {
   TrialSpec& Seed(std::uint64_t seed);
   TrialSpec& Using(Middleware middleware);
   TrialSpec& World(std::string world);
+  TrialSpec& WorldSize(double x_m, double y_m);
   TrialSpec& Rtf(double rtf);
   TrialSpec& Drone(std::string name, std::string airframe, std::array<double, 3> pose,
                    std::string payload = {});
@@ -182,6 +195,7 @@ struct TrialSpec {
   const DroneSpec* FindDrone(std::string_view drone_name) const;
   const UserComponentSpec* FindComponent(std::string_view component_name) const;
   bool HasExternalBrain() const;
+  bool HasWorldSize() const { return world_size_m[0] > 0 && world_size_m[1] > 0; }
   // The limits a container runs with: the drone's (nullptr = the physics server's) overrides over
   // the trial's.
   ContainerLimits LimitsOf(const DroneSpec* drone) const;
