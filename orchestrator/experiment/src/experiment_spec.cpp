@@ -45,12 +45,21 @@ Result<std::vector<std::string>> OverridesOf(const Node& mapping, std::string_vi
 
 Result<Factor> ParseFactor(const Node& node) {
   Factor f;
-  if (!node.is_mapping()) return At(node, "a factor is a mapping {name, key, levels, labels}");
+  if (!node.is_mapping()) return At(node, "a factor is a mapping {name, key or keys, levels, labels}");
   yaml::MapReader r(node, "factor");
-  r.Required("name", &f.name).Optional("key", &f.key);
+  r.Required("name", &f.name).Optional("key", &f.key).Optional("keys", &f.keys);
   const Node* levels = r.Child("levels", /*required=*/true);
   const Node* labels = r.Child("labels");
   SWARMBOX_TRY(r.Finish());
+  if (const Node* keys = node.Find("keys")) {
+    if (node.Find("key") != nullptr) {
+      return At(*keys, "give 'key' (one trial key per level) or 'keys' (several), not both");
+    }
+    if (f.keys.empty()) return At(*keys, "'keys' must list at least one trial key");
+    for (std::size_t i = 0; i < f.keys.size(); ++i) {
+      if (f.keys[i].empty()) return At(keys->items()[i], "expected a trial key (a.b.c)");
+    }
+  }
   if (!IsName(f.name) || f.name.find('.') != std::string::npos) {
     return At(*node.Find("name"), "factor name '" + f.name +
                                       "' must be a-z, 0-9, '-', '_', starting with a letter or digit");
@@ -70,6 +79,14 @@ Result<Factor> ParseFactor(const Node& node) {
     if (!f.key.empty()) {
       level.overrides.push_back(Assignment(f.key, v));
       level.label = v.is_scalar() ? v.scalar() : std::string(1, level.code);
+    } else if (!f.keys.empty()) {
+      if (!v.is_sequence() || v.items().size() != f.keys.size()) {
+        return At(v, "level '" + k.scalar() + "' must be a list of " + std::to_string(f.keys.size()) +
+                         " values, one per key of 'keys' in that order");
+      }
+      for (std::size_t i = 0; i < f.keys.size(); ++i) level.overrides.push_back(Assignment(f.keys[i], v.items()[i]));
+      const Node& first = v.items().front();
+      level.label = first.is_scalar() ? first.scalar() : std::string(1, level.code);
     } else {
       auto o = OverridesOf(v, "a level of a factor without 'key'");
       if (!o) return o.error();

@@ -26,8 +26,14 @@ const std::string kTrials = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
 
 TEST(ValidateCommand, ShippedTrialsAreValid) {
   Capture c;
-  EXPECT_EQ(ValidateCommand({{kTrials + "/sar_search.yaml", kTrials + "/smoke.yaml"}, {}}), kExitOk);
+  EXPECT_EQ(ValidateCommand({{kTrials + "/sar_search.yaml", kTrials + "/smoke.yaml", kTrials + "/swarm_100.yaml",
+                               kTrials + "/experiments/swarm_size.yaml"},
+                              {}}),
+            kExitOk);
   EXPECT_THAT(c.out(), HasSubstr("sar_search.yaml: ok (trial sar-search, 4 drones"));
+  // A group is counted expanded.
+  EXPECT_THAT(c.out(), HasSubstr("swarm_100.yaml: ok (trial swarm-100, 101 drones (scout x100), 3 end conditions"));
+  EXPECT_THAT(c.out(), HasSubstr("swarm_size.yaml: ok (experiment swarm_size, 5 trials"));
 }
 
 TEST(ValidateCommand, BadFilesGiveFileLineColumnAndExit2) {

@@ -136,6 +136,35 @@ TEST(ExperimentSpec, ErrorsSayWhereAndWhat) {
             std::string::npos);
 }
 
+TEST(ExperimentSpec, AFactorWithSeveralKeysSetsThemAllPerLevel) {
+  const ExperimentSpec spec = Parse(R"(name: swarm
+base: t.yaml
+factors:
+  - name: scouts
+    keys: [drones.scout.count, world_size_m]
+    levels: {a: [5, [150, 150]], b: [100, [600, 600]]}
+)");
+  ASSERT_EQ(spec.factors.size(), 1u);
+  EXPECT_EQ(spec.factors[0].keys, (std::vector<std::string>{"drones.scout.count", "world_size_m"}));
+  auto trials = ExpandTrials(spec);
+  ASSERT_TRUE(trials) << trials.error().ToString();
+  ASSERT_EQ(trials->size(), 2u);
+  EXPECT_EQ((*trials)[1].levels, std::vector<std::string>{"100"});  // labelled by the first value
+  EXPECT_EQ((*trials)[1].overrides[0], "drones.scout.count=100");
+  EXPECT_EQ((*trials)[1].overrides[1], "world_size_m=[600,600]");
+}
+
+TEST(ExperimentSpec, SeveralKeysErrorsSayWhereAndWhat) {
+  EXPECT_EQ(ParseError("name: x\nbase: t.yaml\nfactors:\n  - {name: f, keys: [seed, name], levels: {a: [1]}}\n"),
+            "exp.yaml:4:47: level 'a' must be a list of 2 values, one per key of 'keys' in that order");
+  EXPECT_EQ(ParseError("name: x\nbase: t.yaml\nfactors:\n  - {name: f, keys: [seed], levels: {a: 1}}\n"),
+            "exp.yaml:4:41: level 'a' must be a list of 1 values, one per key of 'keys' in that order");
+  EXPECT_EQ(ParseError("name: x\nbase: t.yaml\nfactors:\n  - {name: f, key: seed, keys: [seed], levels: {a: [1]}}\n"),
+            "exp.yaml:4:32: give 'key' (one trial key per level) or 'keys' (several), not both");
+  EXPECT_EQ(ParseError("name: x\nbase: t.yaml\nfactors:\n  - {name: f, keys: [], levels: {a: [1]}}\n"),
+            "exp.yaml:4:21: 'keys' must list at least one trial key");
+}
+
 // The shipped smoke trial as the base: every trial loads through the real loader, and a level
 // value the trial schema refuses stops the plan with the trial's id.
 class PlanExperimentTest : public ::testing::Test {
@@ -203,6 +232,22 @@ TEST(ShippedExperiments, LoadAndPlan) {
   auto trials = ExpandTrials(*radio);
   ASSERT_TRUE(trials);
   EXPECT_EQ(trials->size(), 81u);
+  // The swarm-size experiment: 5 sizes of trials/swarm_100.yaml, each on its own area.
+  auto swarm = LoadExperiment((dir / "swarm_size.yaml").string());
+  ASSERT_TRUE(swarm) << swarm.error().ToString();
+  auto swarm_plan = PlanExperiment(*swarm);
+  ASSERT_TRUE(swarm_plan) << swarm_plan.error().ToString();
+  const std::vector<std::pair<std::string, std::size_t>> sizes = {
+      {"swarm_size-a-r1", 6}, {"swarm_size-b-r1", 11}, {"swarm_size-c-r1", 26}, {"swarm_size-d-r1", 51}, {"swarm_size-e-r1", 101}};
+  for (const auto& [id, drones] : sizes) {
+    ASSERT_EQ(swarm_plan->specs.count(id), 1u) << id;
+    const dsl::TrialSpec& t = swarm_plan->specs.at(id);
+    EXPECT_EQ(t.drones.size(), drones) << id;
+    EXPECT_EQ(t.drones.back().name, "lifter") << id;
+    EXPECT_TRUE(t.HasWorldSize()) << id;
+  }
+  EXPECT_EQ(swarm_plan->specs.at("swarm_size-a-r1").world_size_m, (std::array<double, 2>{150, 150}));
+  EXPECT_EQ(swarm_plan->specs.at("swarm_size-e-r1").world_size_m, (std::array<double, 2>{600, 600}));
 }
 
 }  // namespace

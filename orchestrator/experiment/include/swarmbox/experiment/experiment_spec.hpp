@@ -8,6 +8,9 @@
 //     - name: loss                     # a results.csv column
 //       key: network.mesh.loss         # the trial key each level sets
 //       levels: {a: 0, b: 0.05, c: 0.2}
+//     - name: scouts                   # several keys: each level is a list, one value per key
+//       keys: [drones.scout.count, world_size_m]
+//       levels: {a: [5, [150, 150]], b: [100, [600, 600]]}   # label: the first value (5, 100)
 //     - name: swarm                    # no key: each level is a mapping of overrides
 //       levels:
 //         a: {drones: [{name: scout_1, airframe: x500, pose: [0, 0, 0]}]}
@@ -45,7 +48,8 @@ struct Level {
 
 struct Factor {
   std::string name;
-  std::string key;  // "" when each level is a mapping of overrides
+  std::string key;  // "" when each level is a mapping of overrides, or with `keys`
+  std::vector<std::string> keys;  // `keys:` (each level a list of as many values); empty = `key`
   std::vector<Level> levels;  // sorted by code
   const Level* FindLevel(char code) const;
 };
