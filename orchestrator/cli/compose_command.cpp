@@ -2,11 +2,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include "commands.hpp"
 #include "load_trial.hpp"
 #include "program_images.hpp"
 #include "swarmbox/runner/compose_export.hpp"
+#include "swarmbox/runner/derived_world.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/plan.hpp"
 #include "swarmbox/runner/radio_schedule.hpp"
@@ -95,6 +97,30 @@ int ComposeCommand(const ComposeArgs& args) {
       plan.radio_plan_path = "./" + radio_plan_file.filename().string();
     }
   }
+  // world_size_m: the derived world (derived_world.hpp) next to the compose file, like the radio
+  // plan; printed to stdout the services would read the trial's world with its own geofence.
+  std::string world_text;
+  fs::path world_file;
+  if (spec->HasWorldSize()) {
+    const std::string source = (fs::path(trials_dir) / spec->world).string();
+    std::ifstream in(source, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    auto derived = runner::DeriveWorld(text.str(), source, spec->world_size_m);
+    if (!in || !derived) {
+      std::cerr << "swarmbox compose: world_size_m: "
+                << (derived ? "cannot read " + source : derived.error().ToString()) << "\n";
+      return kExitUsage;
+    }
+    if (args.output.empty()) {
+      std::cerr << "swarmbox compose: error: world_size_m needs -o FILE (the derived world is written next to it)\n";
+      return kExitUsage;
+    }
+    world_text = std::move(*derived);
+    world_file = fs::path(args.output).parent_path() /
+                 (fs::path(args.output).stem().string() + "." + std::string(runner::kDerivedWorldFile));
+    plan.world_path = "./" + world_file.filename().string();
+  }
   auto trial = runner::PlanTrial(*spec, plan);
   if (!trial) {
     std::cerr << "swarmbox compose: " << trial.error().ToString() << "\n";
@@ -149,6 +175,16 @@ int ComposeCommand(const ComposeArgs& args) {
       return kExitInfrastructure;
     }
     std::cerr << "wrote " << radio_plan_file.string() << "\n";
+  }
+  if (!world_text.empty()) {
+    std::ofstream world_out(world_file, std::ios::binary | std::ios::trunc);
+    world_out << world_text;
+    world_out.close();
+    if (!world_out) {
+      std::cerr << "swarmbox compose: cannot write " << world_file.string() << "\n";
+      return kExitInfrastructure;
+    }
+    std::cerr << "wrote " << world_file.string() << "\n";
   }
   std::ofstream out(args.output, std::ios::binary | std::ios::trunc);
   out << text;

@@ -371,6 +371,10 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   auto input = [&](const std::string& relative) {
     return dsl::InputFile{host_file(relative), InContainer(relative)};
   };
+  // The world every container reads: the trial's, or the one derived from it (world_size_m).
+  const dsl::InputFile world_input = options.world_path.empty()
+                                         ? input(spec.world)
+                                         : dsl::InputFile{options.world_path, InContainer(spec.world)};
 
   auto trial = std::make_unique<dsl::Trial>(spec.name, options.run_id);
   const TrialSubnets& nets = options.subnets;
@@ -406,7 +410,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   physics.hostname = std::string(kPhysicsId);
   physics.labels = labels(kPhysicsId);
   physics.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
-  physics.inputs.push_back(input(spec.world));
+  physics.inputs.push_back(world_input);
   std::set<std::string> airframes;
   for (const dsl::DroneSpec& d : spec.drones) {
     if (airframes.insert(d.airframe).second) physics.inputs.push_back(input(AirframeRelative(d)));
@@ -519,7 +523,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     agent.name = name(d.name);
     agent.labels = labels(d.name);
     agent.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
-    agent.inputs = {input(spec.world), input(AirframeRelative(d))};
+    agent.inputs = {world_input, input(AirframeRelative(d))};
     agent.scratch_dirs = {std::string(kAgentStateDir)};
     Confine(spec.LimitsOf(&d), &agent);
     if (sidecars) {

@@ -11,6 +11,7 @@
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/dsl/step.hpp"
 #include "swarmbox/report/trial_record.hpp"
+#include "swarmbox/runner/derived_world.hpp"
 #include "swarmbox/runner/docker_engine.hpp"
 #include "swarmbox/runner/fault_image.hpp"
 #include "swarmbox/runner/fault_injector.hpp"
@@ -432,8 +433,9 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     std::ostringstream csv;
     csv << in.rdbuf();
     auto tracks = ParseTruthCsv(csv.str());
-    auto world = info.world_file.empty() ? Result<WorldPicture>(WorldPicture{})
-                                         : LoadWorldPicture(info.world_file);
+    const bool derived = info.files.count(std::string(kDerivedWorldFile)) > 0;  // world_size_m
+    const std::string world_file = derived ? (dir / kDerivedWorldFile).string() : info.world_file;
+    auto world = world_file.empty() ? Result<WorldPicture>(WorldPicture{}) : LoadWorldPicture(world_file);
     if (!tracks) {
       result.problems.push_back("trajectories.png: " + tracks.error().ToString());
     } else if (!world) {
@@ -464,6 +466,15 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
   info.rtf = spec.rtf;
   info.resolved_yaml = yaml::Emit(spec.document.is_null() ? dsl::ToDocument(spec) : spec.document);
   info.world_file = (fs::path(trials_dir) / spec.world).string();
+  if (spec.HasWorldSize()) {  // the world every container reads, written into the trial folder
+    std::ifstream in(info.world_file, std::ios::binary);
+    if (!in) return Error(ErrorCode::kNotFound, "cannot read the world file", info.world_file);
+    std::ostringstream text;
+    text << in.rdbuf();
+    auto derived = DeriveWorld(text.str(), info.world_file, spec.world_size_m);
+    if (!derived) return derived.error().Context("world_size_m");
+    info.files[std::string(kDerivedWorldFile)] = std::move(*derived);
+  }
   if (auto payloads = LoadPayloadMasses(spec, trials_dir); !payloads) {
     return payloads.error().Context("checking payloads");
   }
@@ -515,6 +526,10 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
     if (channel) {  // RunTrial wrote it (info.files) into the trial folder
       p.radio_plan_path =
           (fs::absolute(options.out_dir) / TrialDirName(spec.name, run_id) / kRadioPlanFile).lexically_normal().string();
+    }
+    if (spec.HasWorldSize()) {  // RunTrial wrote it (info.files) into the trial folder
+      p.world_path =
+          (fs::absolute(options.out_dir) / TrialDirName(spec.name, run_id) / kDerivedWorldFile).lexically_normal().string();
     }
     p.run_id = run_id;
     p.trial_id = options.trial_id;

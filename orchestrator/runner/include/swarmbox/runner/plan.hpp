@@ -39,7 +39,8 @@
 // /swarmbox, a tmpfs at /tmp), memory and pids limits from the trial's `limits:` (LimitsOf).
 // Agent flags: the shared contract (mission, --members in trial order, --seed, --raft-*, radio).
 // Files: the world and airframe files are copied into every container under /swarmbox/trials/
-// (same relative paths as in the trials folder).
+// (same relative paths as in the trials folder); with world_size_m the world copied is the derived
+// one (PlanOptions::world_path) at the world's path.
 #pragma once
 
 #include <cstdint>
@@ -84,6 +85,10 @@ struct PlanOptions {
   // into the trial folder), copied to kRadioPlanPath and passed as --radio-plan. "" = none (the
   // physics server then runs the channel with no mesh impairment and no scheduled faults).
   std::string radio_plan_path;
+  // world_size_m: the derived world on the host (derived_world.hpp; the runner writes it into the
+  // trial folder), copied in where the trial's world would be, so every container reads it.
+  // "" = the trial's world file from trials_dir.
+  std::string world_path;
 };
 
 inline constexpr std::string_view kPhysicsId = "physics";
