@@ -1,0 +1,74 @@
+// A real swarm in the suite (issue #18): trials/swarm_100.yaml with 50 scouts and the lifter, rtf 0,
+// 25 simulated seconds, through the trial runner on the real engine. Every drone joins (simulated
+// time moves: the lockstep has all 51), a Raft leader is elected and every drone hears of it, no
+// drone is lost to the infrastructure, and nothing of the run stays on the engine. The figures
+// line (swarm_figures.hpp) and the wall time go to the log.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "swarm_run.hpp"
+#include "swarmbox/common/yaml.hpp"
+
+namespace swarmbox::swarm {
+namespace {
+
+constexpr int kScouts = 50;
+constexpr double kSimS = 25.0;
+
+TEST(SwarmE2e, FiftyDronesJoinElectALeaderLoseNoneAndCleanUp) {
+  auto api = ConnectDocker();
+  ASSERT_TRUE(api) << api.error().ToString();
+  auto spec = LoadSwarmTrial(kScouts, kSimS);
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  ASSERT_EQ(spec->drones.size(), static_cast<std::size_t>(kScouts + 1));
+  SwarmRunConfig cfg;
+  cfg.out_dir = (std::filesystem::temp_directory_path() / "swarmbox-swarm-e2e").string();
+  const auto started = std::chrono::steady_clock::now();
+  auto run = RunSwarmTrial(**api, *spec, cfg);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ASSERT_TRUE(run) << run.error().ToString();
+  const SwarmFigures& f = run->figures;
+  std::printf("SwarmE2e: %s test_wall_s=%.1f dir=%s\n", FormatSwarmLine(f, kScouts).c_str(), wall_s,
+              run->outcome.trial_dir.c_str());
+  const dsl::Verdict& verdict = run->outcome.result.verdict;
+  // A short SAR mission ends on its simulated timeout (or, sooner, complete): never a failure.
+  EXPECT_TRUE(verdict.outcome == dsl::Outcome::kTimeout || verdict.outcome == dsl::Outcome::kSuccess)
+      << verdict.ToString() << " (" << run->outcome.trial_dir << ")";
+  EXPECT_EQ(f.joined, kScouts + 1) << "agents that logged event=ready";
+  ASSERT_TRUE(f.start_s) << "simulated time never moved: not every drone joined the lockstep";
+  EXPECT_GE(f.sim_s, kSimS - 0.5);
+  EXPECT_EQ(f.lost, 0);
+
+  // A leader, and every drone hears of it (event=leader_elected names it on each drone).
+  std::map<std::string, std::string> leader_of;  // drone -> the last leader it logged
+  for (const std::string& line : run->events) {
+    if (line.find("\"leader_elected\"") == std::string::npos) continue;
+    auto doc = yaml::Parse(line, "events.jsonl");
+    ASSERT_TRUE(doc) << line;
+    leader_of[doc->Find("component")->scalar()] = doc->Find("leader")->scalar();
+  }
+  EXPECT_EQ(leader_of.size(), spec->drones.size()) << "drones that logged a leader";
+  std::set<std::string> leaders;
+  for (const auto& [drone, leader] : leader_of) leaders.insert(leader);
+  EXPECT_EQ(leaders.size(), 1u) << "drones disagree on the last leader";
+
+  // Nothing labelled with the run stays (the runner removed it; RunSwarmTrial's sweep found nothing
+  // it could not remove).
+  docker::LabelSelector mine;
+  mine.equals[std::string(docker::kLabelRun)] = run->outcome.result.run_id;
+  auto containers = (*api)->ListContainers(mine, /*all=*/true);
+  ASSERT_TRUE(containers) << containers.error().ToString();
+  EXPECT_TRUE(containers->empty());
+  auto networks = (*api)->ListNetworks(mine);
+  ASSERT_TRUE(networks) << networks.error().ToString();
+  EXPECT_TRUE(networks->empty());
+  if (!HasFailure()) std::filesystem::remove_all(run->outcome.trial_dir);
+}
+
+}  // namespace
+}  // namespace swarmbox::swarm
