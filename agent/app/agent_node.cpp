@@ -148,7 +148,9 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   auto sub = node->sim_->CreateSubscriber<bus::SensorSample>(bus::SensorTopic(o.name), bus::Qos::kLockstep);
   if (!sub) return sub.error().Context("subscribing to sensor samples");
   node->sensor_sub_ = std::move(*sub);
-  auto pub = node->sim_->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic(o.name), bus::Qos::kLockstep);
+  // Every agent writes the one keyed topic sim/actuator (cmd_.drone is the key); the server reads it
+  // with one reader.
+  auto pub = node->sim_->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
   if (!pub) return pub.error().Context("publishing actuator commands");
   node->actuator_pub_ = std::move(*pub);
   const bool sar = o.mission.kind == MissionKind::kSar;

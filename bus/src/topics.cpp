@@ -25,9 +25,6 @@ std::string_view QosName(Qos qos) {
 }
 
 std::string SensorTopic(std::string_view drone) { return "sim/" + std::string(drone) + "/sensor"; }
-std::string ActuatorTopic(std::string_view drone) {
-  return "sim/" + std::string(drone) + "/actuator";
-}
 std::string CameraTopic(std::string_view drone) { return "sim/" + std::string(drone) + "/camera"; }
 std::string OffboardInputTopic(std::string_view drone) {
   return "offboard/" + std::string(drone) + "/input";

@@ -1,5 +1,6 @@
 #include "bus_transport.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 namespace swarmbox::physics {
@@ -31,6 +32,7 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
     const std::string& name = drones[i];
     if (auto s = bus::ValidateDroneName(name); !s) return s.error();
     DroneEndpoints e;
+    e.name = name;
     e.gps = gps_specs.at(i);
     auto sensor = t->participant_->CreatePublisher<bus::SensorSample>(bus::SensorTopic(name), bus::Qos::kLockstep);
     if (!sensor) return std::move(sensor).error();
@@ -38,22 +40,14 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
     auto camera = t->participant_->CreatePublisher<bus::CameraImage>(bus::CameraTopic(name), bus::Qos::kLockstep);
     if (!camera) return std::move(camera).error();
     e.camera = std::move(*camera);
-    auto act = t->participant_->CreateSubscriber<bus::ActuatorCommand>(
-        bus::ActuatorTopic(name), bus::Qos::kLockstep, [self, name](const bus::ActuatorCommand& c) {
-          {
-            std::lock_guard<std::mutex> lock(self->mu_);
-            // The topic names the drone; the message's own `drone` field is not trusted.
-            ActuatorInput in{name, c.step, c.armed, c.motor_throttle, c.raft_leader, {}, c.radio_out};
-            in.world.reserve(c.world.size());
-            for (const bus::WorldCommand& w : c.world) in.world.push_back({w.target, w.command, w.args, w.seq});
-            self->actuators_.push_back(std::move(in));
-          }
-          self->cv_.notify_one();
-        });
-    if (!act) return std::move(act).error();
-    e.actuator = std::move(*act);
+    t->index_of_.emplace(name, i);
     t->drones_.push_back(std::move(e));
   }
+  // One reader for every drone's answers (the topic is keyed by drone).
+  auto act = t->participant_->CreateSubscriber<bus::ActuatorCommand>(
+      bus::kActuatorTopic, bus::Qos::kLockstep, [self](const bus::ActuatorCommand& c) { self->OnActuator(c); });
+  if (!act) return std::move(act).error();
+  t->actuators_sub_ = std::move(*act);
   return t;
 }
 
@@ -120,14 +114,37 @@ Status BusTransport::PublishClock(std::uint64_t step, std::int64_t sim_time_ns, 
   return clock_->Publish(tick);
 }
 
-void BusTransport::WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) {
+// The middleware's thread, one call at a time.
+void BusTransport::OnActuator(const bus::ActuatorCommand& c) {
+  const auto it = index_of_.find(c.drone);
+  std::lock_guard<std::mutex> lock(mu_);
+  if (it == index_of_.end()) {
+    ++unknown_;
+    return;
+  }
+  ActuatorInput in{drones_[it->second].name, c.step, c.armed, c.motor_throttle, c.raft_leader, {}, c.radio_out};
+  in.world.reserve(c.world.size());
+  for (const bus::WorldCommand& w : c.world) in.world.push_back({w.target, w.command, w.args, w.seq});
+  actuators_.push_back(std::move(in));
+  // Notified under the lock: the waiter cannot miss it, and wakes only when its count is reached.
+  if (wake_at_ != 0 && actuators_.size() >= wake_at_) cv_.notify_one();
+}
+
+void BusTransport::WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) {
   std::unique_lock<std::mutex> lock(mu_);
   const auto deadline = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(deadline_ns));
-  cv_.wait_until(lock, deadline, [this] { return !actuators_.empty(); });
+  wake_at_ = std::max<std::size_t>(1, awaited);
+  cv_.wait_until(lock, deadline, [this] { return actuators_.size() >= wake_at_; });
+  wake_at_ = 0;
   while (!actuators_.empty()) {
     out->push_back(std::move(actuators_.front()));
     actuators_.pop_front();
   }
+}
+
+std::uint64_t BusTransport::unknown_commands() const {
+  std::lock_guard<std::mutex> lock(mu_);
+  return unknown_;
 }
 
 void BusTransport::TakeWorldCommands(std::vector<WorldCommandInput>* out) {

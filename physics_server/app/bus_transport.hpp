@@ -1,21 +1,27 @@
 // BusTransport: SimTransport on the SwarmBox sim bus (bus/topics.hpp): per drone a SensorSample
-// and CameraImage publisher and an ActuatorCommand subscriber, plus the clock publisher and the
-// world-command subscriber. Actuator commands arrive on middleware threads and are queued here.
+// and CameraImage publisher; one ActuatorCommand subscriber on sim/actuator for every drone (keyed
+// by drone); the clock publisher and the world-command subscriber. Actuator commands arrive on a
+// middleware thread (one callback call at a time), are matched to their drone by name in O(1) and
+// queued here; the server's thread is woken once the step's awaited answers are queued (or at its
+// deadline), not once per answer.
 //
 // Sensor mapping (physics SensorSample -> bus SensorSample): each sensor's `valid` means "a new
 // measurement at this step" (the physics `fresh` flag; stale values are repeated but invalid).
 // GPS: valid = a new fix; fix_type = kNone in a dropout (reports keep coming at the GPS rate with
 // valid = false), k3d otherwise. Baro altitude is relative to the world origin (ENU z).
 // camera_frame and radio_in come from SampleExtras. An ActuatorCommand's world commands keep
-// their seq (SimServer orders them); the `drone` fields of the message are not trusted (the topic
-// names the drone).
+// their seq (SimServer orders them). The command's key (`drone`) names the answering drone; a
+// command for a drone not in the trial is dropped and counted (unknown_commands()).
 #pragma once
 
 #include <condition_variable>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "sim_server.hpp"
@@ -36,28 +42,42 @@ class BusTransport final : public SimTransport {
                        const SampleExtras& extras) override;
   Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) override;
   Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) override;
-  void WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) override;
+  void WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) override;
   void TakeWorldCommands(std::vector<WorldCommandInput>* out) override;
+
+  // Actuator commands whose `drone` is not a drone of the trial (dropped).
+  std::uint64_t unknown_commands() const;
 
  private:
   BusTransport() = default;
   struct DroneEndpoints {
+    std::string name;
     std::unique_ptr<bus::Publisher<bus::SensorSample>> sensor;
     std::unique_ptr<bus::Publisher<bus::CameraImage>> camera;
-    std::unique_ptr<bus::Subscriber<bus::ActuatorCommand>> actuator;
     GpsSpec gps;
   };
+  struct NameHash {
+    using is_transparent = void;
+    std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
+  };
+  void OnActuator(const bus::ActuatorCommand& c);
+
   std::unique_ptr<bus::Participant> participant_;
   std::unique_ptr<bus::Publisher<bus::ClockTick>> clock_;
-  std::unique_ptr<bus::Subscriber<bus::WorldCommand>> world_commands_;
   std::vector<DroneEndpoints> drones_;
+  std::unordered_map<std::string, std::size_t, NameHash, std::equal_to<>> index_of_;  // set before the subscriber
   bus::SensorSample sample_msg_;
   bus::CameraImage camera_msg_;
 
-  std::mutex mu_;
+  mutable std::mutex mu_;
   std::condition_variable cv_;
   std::deque<ActuatorInput> actuators_;
   std::deque<WorldCommandInput> world_;
+  std::size_t wake_at_ = 0;  // 0: nobody waits; else notify once actuators_ holds this many
+  std::uint64_t unknown_ = 0;
+  // Last: destroyed first, so no callback runs while the members above go away.
+  std::unique_ptr<bus::Subscriber<bus::WorldCommand>> world_commands_;
+  std::unique_ptr<bus::Subscriber<bus::ActuatorCommand>> actuators_sub_;
 };
 
 }  // namespace swarmbox::physics

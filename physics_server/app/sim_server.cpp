@@ -446,7 +446,8 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
       }
     }
     inbox_.clear();
-    transport_.WaitActuators(std::min(lockstep_.NextDeadlineNs(), now + kPollNs), &inbox_);
+    transport_.WaitActuators(std::min(lockstep_.NextDeadlineNs(), now + kPollNs), std::max<std::size_t>(1, lockstep_.awaited()),
+                             &inbox_);
     for (ActuatorInput& cmd : inbox_) {
       const std::optional<std::size_t> i = world_.FindDrone(cmd.drone);
       if (!i) continue;

@@ -86,9 +86,11 @@ class SimTransport {
                                const SampleExtras& extras) = 0;
   virtual Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) = 0;
   virtual Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) = 0;
-  // Appends the actuator commands that arrived, waiting until one arrives or wall time
-  // `deadline_ns` (WallClock time) passes.
-  virtual void WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) = 0;
+  // Appends the actuator commands that arrived, waiting until `awaited` (>= 1: the live drones
+  // that have not answered the step) are queued or wall time `deadline_ns` (WallClock time)
+  // passes. Waking once per step rather than once per answer is what keeps 100 answers a step
+  // from costing 100 thread wake-ups; a duplicate or stale command only ends the wait early.
+  virtual void WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) = 0;
   virtual void TakeWorldCommands(std::vector<WorldCommandInput>* out) = 0;
 };
 

@@ -6,12 +6,40 @@
 
 namespace swarmbox::physics {
 
-Lockstep::Lockstep(std::size_t drone_count, LockstepOptions options) : options_(options), drones_(drone_count) {}
+Lockstep::Lockstep(std::size_t drone_count, LockstepOptions options) : options_(options), drones_(drone_count) {
+  Recount();
+}
+
+std::int64_t Lockstep::Deadline(const DroneState& d) const {
+  return d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
+                  : step_start_ns_ + options_.join_timeout_ns;
+}
+
+void Lockstep::Recount() const {
+  std::size_t pending = 0;
+  std::int64_t next = std::numeric_limits<std::int64_t>::max();
+  std::size_t at_next = 0;
+  for (const DroneState& d : drones_) {
+    if (!Pending(d)) continue;
+    ++pending;
+    const std::int64_t deadline = Deadline(d);
+    if (deadline < next) {
+      next = deadline;
+      at_next = 0;
+    }
+    if (deadline == next) ++at_next;
+  }
+  pending_ = pending;
+  next_deadline_ns_ = next;
+  at_next_deadline_ = at_next;
+  stale_ = false;
+}
 
 void Lockstep::BeginStep(std::uint64_t step, std::int64_t now_ns) {
   step_ = step;
   step_start_ns_ = now_ns;
   for (DroneState& d : drones_) d.answered = false;
+  Recount();
 }
 
 Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std::int64_t now_ns) {
@@ -20,6 +48,10 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
   DroneState& d = drones_[drone];
   if (d.out) return Answer::kOut;
   if (d.answered) return Answer::kDuplicate;
+  if (!d.lost) {  // it was pending: one fewer; the earliest deadline moves once all of its drones answered
+    --pending_;
+    if (Deadline(d) == next_deadline_ns_ && --at_next_deadline_ == 0) stale_ = true;
+  }
   d.answered = true;
   d.joined = true;
   d.last_heard_ns = now_ns;
@@ -31,30 +63,26 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
 }
 
 std::int64_t Lockstep::NextDeadlineNs() const {
-  std::int64_t next = std::numeric_limits<std::int64_t>::max();
-  for (const DroneState& d : drones_) {
-    if (d.lost || d.answered || d.out) continue;
-    const std::int64_t deadline = d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
-                                           : step_start_ns_ + options_.join_timeout_ns;
-    next = std::min(next, deadline);
-  }
-  return next;
+  if (pending_ == 0) return std::numeric_limits<std::int64_t>::max();
+  if (stale_) Recount();
+  return next_deadline_ns_;
 }
 
 bool Lockstep::StepComplete(std::int64_t now_ns) {
+  if (pending_ == 0) return true;
+  if (now_ns < NextDeadlineNs()) return false;  // nobody's time ran out: no scan
   bool complete = true;
   for (std::size_t i = 0; i < drones_.size(); ++i) {
     DroneState& d = drones_[i];
-    if (d.lost || d.answered || d.out) continue;
-    const std::int64_t deadline = d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
-                                           : step_start_ns_ + options_.join_timeout_ns;
-    if (now_ns >= deadline) {
+    if (!Pending(d)) continue;
+    if (now_ns >= Deadline(d)) {
       d.lost = true;
       newly_lost_.push_back(i);
     } else {
       complete = false;
     }
   }
+  Recount();
   return complete;
 }
 
@@ -62,6 +90,7 @@ void Lockstep::SetOut(std::size_t drone, bool out) {
   DroneState& d = drones_.at(drone);
   d.out = out;
   if (!out) d = DroneState{};
+  Recount();
 }
 
 std::vector<std::size_t> Lockstep::TakeNewlyLost() { return std::exchange(newly_lost_, {}); }

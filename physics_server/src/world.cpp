@@ -7,6 +7,10 @@
 #include <cmath>
 #include <mutex>
 #include <numbers>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
 
 #include "ground_renderer.hpp"
 #include "sensor_models.hpp"
@@ -106,6 +110,12 @@ struct World::Impl {
   dJointGroupID contacts = nullptr;
   std::vector<std::unique_ptr<GeomTag>> obstacle_tags;
   std::vector<std::unique_ptr<Drone>> drones;
+  struct NameHash {
+    using is_transparent = void;
+    std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
+  };
+  // drone name -> index: FindDrone in O(1), without allocating
+  std::unordered_map<std::string, std::size_t, NameHash, std::equal_to<>> index_of;
   WindModel wind;
   Vec3 wind_now;
   std::unique_ptr<GroundRenderer> renderer;
@@ -527,6 +537,7 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
   }
 
   d->sensors = std::make_unique<SensorSuite>(d->af, w.config, MixSeed(w.options.seed, 0x5E0000 + index));
+  w.index_of.emplace(d->name, w.drones.size());
   w.drones.push_back(std::move(d));
   Impl::Drone& added = *w.drones.back();
   if (payload && spawn.payload_attached) {
@@ -548,10 +559,10 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
 std::size_t World::drone_count() const { return impl_->drones.size(); }
 const std::string& World::drone_name(std::size_t i) const { return impl_->drones.at(i)->name; }
 std::optional<std::size_t> World::FindDrone(std::string_view name) const {
-  for (std::size_t i = 0; i < impl_->drones.size(); ++i) {
-    if (impl_->drones[i]->name == name) return i;
-  }
-  return std::nullopt;
+  // Once per actuator answer: a hash lookup, not a scan of every drone (O(N^2) per step at 100).
+  const auto it = impl_->index_of.find(name);
+  if (it == impl_->index_of.end()) return std::nullopt;
+  return it->second;
 }
 const Airframe& World::airframe(std::size_t i) const { return impl_->drones.at(i)->af; }
 const WorldConfig& World::config() const { return impl_->config; }

@@ -15,19 +15,23 @@
 //          (cross-vendor figures; the line then carries echo_backend=...),
 //          --mode=external: no echo is started; one must already run (swarmbox-bus-echo with the
 //          same --domain/--kind, e.g. in another network namespace),
-//          --scenario=rtt|fleet|all, --drones=<fleet size; default 10 (quick) or 10, 50, 100>,
+//          --scenario=rtt|fleet|lockstep_fleet|all (fleet and lockstep_fleet are one scenario),
+//          --drones=<fleet size; default 10 (quick) or 10, 50, 100>,
 //          --steps=<fleet lockstep steps; default 100 (quick) or 1000>.
 // Fleet lines: suite=bus scenario=lockstep_fleet backend=.. drones=N steps=.. step_p50_us=..
 //   step_p99_us=.. steps_s=.. msgs_s=.. (2N messages per step) max_hz_per_drone=.. timeouts=0
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "bench.hpp"
@@ -235,8 +239,54 @@ int RunScenario(const Scenario& sc, T ping, std::size_t payload_bytes, int n, in
 
 // Lockstep of a fleet across two processes: this process plays the physics server (publishes
 // every drone's SensorSample for step k, then waits for every drone's ActuatorCommand of step k),
-// the child plays `drones` agents. Figures: per-step latency (first publish to last command) and
-// steps per second; at 250 Hz real time needs steps_s >= 250.
+// the child plays `drones` agents. The server side reads answers as physics_server's BusTransport
+// does: one reader on the keyed sim/actuator for every drone, answers matched to their drone by
+// name in O(1) on the middleware's thread, and the main thread woken once the step's last answer
+// is in (not once per answer). Figures: per-step latency (first publish to last command) and steps
+// per second; at 250 Hz real time needs steps_s >= 250.
+class FleetAnswers {
+ public:
+  explicit FleetAnswers(const std::vector<std::string>& names) : answered_(names.size(), false) {
+    for (std::size_t i = 0; i < names.size(); ++i) index_of_.emplace(names[i], i);
+  }
+  // The middleware's thread.
+  void On(const ActuatorCommand& c) {
+    const auto it = index_of_.find(c.drone);
+    if (it == index_of_.end()) return;
+    std::lock_guard lock(mu_);
+    if (c.step != step_ || answered_[it->second]) return;  // stale or duplicate
+    answered_[it->second] = true;
+    if (++count_ == answered_.size()) cv_.notify_one();
+  }
+  void Begin(std::uint64_t step) {
+    std::lock_guard lock(mu_);
+    step_ = step;
+    count_ = 0;
+    std::fill(answered_.begin(), answered_.end(), false);
+  }
+  // True once every drone answered the step; false at the timeout.
+  bool WaitAll(std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mu_);
+    return cv_.wait_for(lock, timeout, [this] { return count_ == answered_.size(); });
+  }
+  std::vector<std::size_t> Missing() {
+    std::lock_guard lock(mu_);
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < answered_.size(); ++i) {
+      if (!answered_[i]) out.push_back(i);
+    }
+    return out;
+  }
+
+ private:
+  std::unordered_map<std::string, std::size_t> index_of_;  // read-only after construction
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::uint64_t step_ = 0;
+  std::size_t count_ = 0;
+  std::vector<bool> answered_;
+};
+
 int RunFleet(const Scenario& sc, int drones, int steps) {
   testing::EchoOptions o{.backend = sc.echo_backend, .domain_id = sc.domain,
                          .interface = sc.interface, .kind = "fleet", .drones = drones};
@@ -249,58 +299,54 @@ int RunFleet(const Scenario& sc, int drones, int steps) {
   }
   std::vector<std::string> names;
   std::vector<std::unique_ptr<Publisher<SensorSample>>> pubs;
-  std::vector<std::unique_ptr<Subscriber<ActuatorCommand>>> subs;
   for (int i = 0; i < drones; ++i) {
     names.push_back("drone_" + std::to_string(i));
     auto pub = (*p)->CreatePublisher<SensorSample>(SensorTopic(names.back()), Qos::kLockstep);
-    auto sub = (*p)->CreateSubscriber<ActuatorCommand>(ActuatorTopic(names.back()), Qos::kLockstep);
-    if (!pub || !sub) {
+    if (!pub) {
       std::fprintf(stderr, "bus bench: fleet: cannot create endpoints\n");
       return 1;
     }
     pubs.push_back(std::move(*pub));
-    subs.push_back(std::move(*sub));
+  }
+  FleetAnswers answers(names);  // before `sub`: the subscriber goes first, no callback outlives it
+  auto sub = (*p)->CreateSubscriber<ActuatorCommand>(kActuatorTopic, Qos::kLockstep,
+                                                     [&answers](const ActuatorCommand& c) { answers.On(c); });
+  if (!sub) {
+    std::fprintf(stderr, "bus bench: fleet: %s\n", sub.error().ToString().c_str());
+    return 1;
   }
   const auto match_deadline = Clock::now() + std::chrono::seconds(30);
   for (int i = 0; i < drones; ++i) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(match_deadline - Clock::now());
-    if (!pubs[static_cast<std::size_t>(i)]->WaitForSubscribers(1, left) ||
-        !subs[static_cast<std::size_t>(i)]->WaitForPublishers(1, left)) {
+    if (!pubs[static_cast<std::size_t>(i)]->WaitForSubscribers(1, left)) {
       std::fprintf(stderr, "bus bench: fleet: drone %d did not match within 30 s\n", i);
       return 1;
     }
   }
+  {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(match_deadline - Clock::now());
+    if (!(*sub)->WaitForPublishers(drones, left)) {
+      std::fprintf(stderr, "bus bench: fleet: the %d actuator writers did not match within 30 s\n", drones);
+      return 1;
+    }
+  }
   SensorSample s = testing::FullSensorSample(1);
-  ActuatorCommand cmd;
   // Handshake: resend step 0 to the drones that have not answered yet, every 100 ms.
-  std::vector<bool> answered(static_cast<std::size_t>(drones), false);
-  int missing = drones;
   s.step = 0;
-  for (const auto deadline = Clock::now() + std::chrono::seconds(30); missing > 0 && Clock::now() < deadline;) {
-    for (std::size_t i = 0; i < answered.size(); ++i) {
-      if (answered[i]) continue;
+  answers.Begin(0);
+  bool joined = false;
+  for (const auto deadline = Clock::now() + std::chrono::seconds(30); !joined && Clock::now() < deadline;) {
+    for (std::size_t i : answers.Missing()) {
       s.drone = names[i];
       (void)pubs[i]->Publish(s);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    for (std::size_t i = 0; i < answered.size(); ++i) {
-      while (!answered[i] && subs[i]->Take(cmd)) {
-        if (cmd.step == 0) {
-          answered[i] = true;
-          --missing;
-        }
-      }
-    }
+    joined = answers.WaitAll(std::chrono::milliseconds(100));
   }
-  if (missing > 0) {
-    std::fprintf(stderr, "bus bench: fleet: %d drones never answered step 0\n", missing);
+  if (!joined) {
+    std::fprintf(stderr, "bus bench: fleet: %zu drones never answered step 0\n", answers.Missing().size());
     return 1;
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  for (auto& sub : subs) {
-    while (sub->Take(cmd)) {
-    }
-  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));  // duplicate answers to the handshake
   std::vector<double> step_us;
   step_us.reserve(static_cast<std::size_t>(steps));
   int timeouts = 0;
@@ -308,24 +354,16 @@ int RunFleet(const Scenario& sc, int drones, int steps) {
   for (int k = 1; k <= steps && timeouts == 0; ++k) {
     const auto step = static_cast<std::uint64_t>(k);
     const auto t0 = Clock::now();
+    answers.Begin(step);
     s.step = step;
     s.sim_time_ns = k * 4'000'000LL;
     for (std::size_t i = 0; i < pubs.size(); ++i) {
       s.drone = names[i];
       (void)pubs[i]->Publish(s);
     }
-    for (std::size_t i = 0; i < subs.size(); ++i) {
-      bool got = false;
-      while (subs[i]->TakeFor(cmd, std::chrono::seconds(2))) {
-        if (cmd.step == step) {
-          got = true;
-          break;
-        }
-      }
-      if (!got) {
-        ++timeouts;
-        break;
-      }
+    if (!answers.WaitAll(std::chrono::seconds(2))) {
+      ++timeouts;
+      break;
     }
     step_us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
   }
@@ -356,9 +394,11 @@ int RunBusBench(const Args& args) {
   int domain = static_cast<int>(args.GetInt("domain", 200));
   const std::string interface = args.Get("interface", "lo");
   const std::string echo_backend = args.Get("echo-backend", "");
-  const std::string scenario = args.Get("scenario", "all");
+  std::string scenario = args.Get("scenario", "all");
+  // lockstep_fleet: the name the fleet lines carry (scenario=lockstep_fleet), accepted as well.
+  if (scenario == "lockstep_fleet") scenario = "fleet";
   if (scenario != "all" && scenario != "rtt" && scenario != "fleet") {
-    std::fprintf(stderr, "bus bench: unknown --scenario '%s': accepted rtt, fleet, all\n",
+    std::fprintf(stderr, "bus bench: unknown --scenario '%s': accepted rtt, fleet (lockstep_fleet), all\n",
                  scenario.c_str());
     return 2;
   }

@@ -42,7 +42,7 @@ Status ServeFleet(Participant& p, int drones, const std::atomic<bool>& stop) {
   for (int i = 0; i < drones; ++i) {
     const std::string name = "drone_" + std::to_string(i);
     auto agent = std::make_unique<Agent>();
-    auto pub = p.CreatePublisher<ActuatorCommand>(ActuatorTopic(name), Qos::kLockstep);
+    auto pub = p.CreatePublisher<ActuatorCommand>(kActuatorTopic, Qos::kLockstep);  // one writer per agent
     if (!pub) return std::move(pub).error().Context("fleet echo publisher");
     agent->pub = std::move(*pub);
     Agent* a = agent.get();
@@ -119,9 +119,9 @@ Status RunEcho(const EchoOptions& o, const std::atomic<bool>& stop) {
   if (o.kind == "fleet") return ServeFleet(**p, o.drones, stop);
   if (o.kind == "lockstep") {
     return Serve<SensorSample, ActuatorCommand>(
-        **p, SensorTopic(o.drone), ActuatorTopic(o.drone), stop,
+        **p, SensorTopic(o.drone), std::string(kActuatorTopic), stop,
         [](const SensorSample& s, ActuatorCommand& cmd) -> const ActuatorCommand& {
-          cmd.drone = s.drone;
+          cmd.drone = s.drone;  // the key of sim/actuator
           cmd.step = s.step;
           cmd.sim_time_ns = s.sim_time_ns;
           cmd.armed = true;

@@ -2,12 +2,13 @@
 // answers every sample on another, until told to stop.
 //
 // Kinds:
-//   lockstep  SensorSample on SensorTopic(drone) -> ActuatorCommand on ActuatorTopic(drone) with
-//             the same step (what an agent does for the physics server), Qos::kLockstep
+//   lockstep  SensorSample on SensorTopic(drone) -> ActuatorCommand on kActuatorTopic (keyed by
+//             drone) with the same step (what an agent does for the physics server), Qos::kLockstep
 //   small     RaftMessage on kBenchPingTopic -> the same message on kBenchPongTopic, kLockstep
 //   large     CameraImage on kBenchPingTopic -> the same message on kBenchPongTopic, kLockstep
-//   fleet     `drones` agents drone_0..drone_<n-1> in this process, each answering its SensorSample
-//             with an ActuatorCommand of the same step from the subscriber callback
+//   fleet     `drones` agents drone_0..drone_<n-1> in this process (one participant), each with
+//             its own sensor reader and actuator writer, answering its SensorSample with an
+//             ActuatorCommand of the same step from the subscriber callback
 // Options as key/value pairs: backend, domain, interface (default lo), kind, drone (default
 // drone_1), drones (fleet size, default 1). The swarmbox-bus-echo test helper and `swarmbox-bench bus --role=echo` both run it.
 #pragma once

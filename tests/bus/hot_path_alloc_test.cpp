@@ -79,7 +79,7 @@ TEST_P(BusHotPath, SensorSampleRoundTripDoesNotAllocateOnceWarm) {
 }
 
 TEST_P(BusHotPath, ActuatorCommandRoundTripDoesNotAllocateOnceWarm) {
-  EXPECT_EQ(AllocationsPerSteadyState(Domain(1), ActuatorTopic("drone_1"), testing::FullActuatorCommand(3)), 0);
+  EXPECT_EQ(AllocationsPerSteadyState(Domain(1), std::string(kActuatorTopic), testing::FullActuatorCommand(3)), 0);
 }
 
 TEST_P(BusHotPath, CameraImageRoundTripDoesNotAllocateOnceWarm) {

@@ -38,7 +38,7 @@ class BusInterop : public ::testing::TestWithParam<Direction> {
 // Lockstep types (sim domain, reliable).
 TEST_P(BusInterop, ClockTickCrossesVendors) { Check<ClockTick>(0, std::string(kClockTopic), Qos::kLockstep); }
 TEST_P(BusInterop, SensorSampleCrossesVendors) { Check<SensorSample>(1, SensorTopic("scout_1"), Qos::kLockstep); }
-TEST_P(BusInterop, ActuatorCommandCrossesVendors) { Check<ActuatorCommand>(2, ActuatorTopic("scout_1"), Qos::kLockstep); }
+TEST_P(BusInterop, ActuatorCommandCrossesVendors) { Check<ActuatorCommand>(2, std::string(kActuatorTopic), Qos::kLockstep); }
 TEST_P(BusInterop, CameraImageCrossesVendors) { Check<CameraImage>(3, CameraTopic("scout_1"), Qos::kLockstep); }
 TEST_P(BusInterop, WorldCommandCrossesVendors) { Check<WorldCommand>(4, std::string(kWorldCommandTopic), Qos::kLockstep); }
 // Radio and state types (mesh domain).

@@ -31,7 +31,7 @@ TEST_P(BusTwoProcess, LockstepAnswersEveryStepInOrder) {
   auto p = testing::MakeParticipant(pair.parent, pair.domain);
   ASSERT_TRUE(p);
   auto sensor = p->CreatePublisher<SensorSample>(SensorTopic("drone_1"), Qos::kLockstep);
-  auto command = p->CreateSubscriber<ActuatorCommand>(ActuatorTopic("drone_1"), Qos::kLockstep);
+  auto command = p->CreateSubscriber<ActuatorCommand>(kActuatorTopic, Qos::kLockstep);
   ASSERT_TRUE(sensor && command);
   ASSERT_TRUE((*sensor)->WaitForSubscribers(1, testing::kMatchTimeout));
   ASSERT_TRUE((*command)->WaitForPublishers(1, testing::kMatchTimeout));

@@ -36,8 +36,8 @@ void RunLockstepOverBus(const std::string& backend) {
   auto sub_a = (*agent)->CreateSubscriber<bus::SensorSample>(bus::SensorTopic("a"), bus::Qos::kLockstep);
   auto sub_b = (*agent)->CreateSubscriber<bus::SensorSample>(bus::SensorTopic("b"), bus::Qos::kLockstep);
   auto cam_a = (*agent)->CreateSubscriber<bus::CameraImage>(bus::CameraTopic("a"), bus::Qos::kLockstep);
-  auto pub_a = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic("a"), bus::Qos::kLockstep);
-  auto pub_b = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic("b"), bus::Qos::kLockstep);
+  auto pub_a = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
+  auto pub_b = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
   ASSERT_TRUE(sub_a.ok() && sub_b.ok() && cam_a.ok() && pub_a.ok() && pub_b.ok());
 
   auto transport = BusTransport::Create(pc, {"a", "b"}, {af.gps, af.gps});
@@ -76,6 +76,10 @@ void RunLockstepOverBus(const std::string& backend) {
       cmd.world.clear();
       if (s.step == 10) cmd.world.push_back({1, 0, "a", "gps_dropout", {0.1}});
       ASSERT_TRUE((*pub_a)->Publish(cmd).ok());
+      if (s.step == 20) {  // an answer for a drone not in the trial, on the shared topic: dropped
+        cmd.drone = "ghost";
+        ASSERT_TRUE((*pub_a)->Publish(cmd).ok());
+      }
       cmd.radio_out.clear();
       cmd.world.clear();
       cmd.raft_leader = false;
@@ -116,6 +120,7 @@ void RunLockstepOverBus(const std::string& backend) {
   EXPECT_GE(b_heard, 40u);        // a's frames of steps 0..49 (b answers, and hears, until 50)
   EXPECT_TRUE(world->Truth(1).lost);
   EXPECT_FALSE(world->Truth(0).lost);
+  EXPECT_GE((*transport)->unknown_commands(), 1u);  // "ghost": counted, not applied to anyone
   // a kept hovering on its agent's commands; b lost its motors at t = 0.2 s and fell.
   EXPECT_NEAR(world->Truth(0).position_m.z, 10.23, 0.01);
   EXPECT_LT(world->Truth(1).position_m.z, 9.0);

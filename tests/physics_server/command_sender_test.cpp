@@ -115,7 +115,7 @@ TEST(SendCommandProgram, GpsDropoutReachesTheServerAndTheDroneLosesItsFix) {
   auto agent = bus::Participant::Create(pc);
   ASSERT_TRUE(agent.ok()) << agent.error().ToString();
   auto sensors = (*agent)->CreateSubscriber<bus::SensorSample>(bus::SensorTopic("a"), bus::Qos::kLockstep);
-  auto actuators = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::ActuatorTopic("a"), bus::Qos::kLockstep);
+  auto actuators = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
   ASSERT_TRUE(sensors.ok() && actuators.ok());
   auto transport = BusTransport::Create(pc, {"a"}, {af.gps});
   ASSERT_TRUE(transport.ok()) << transport.error().ToString();

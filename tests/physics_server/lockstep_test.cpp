@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <vector>
+
 namespace swarmbox::physics {
 namespace {
 
@@ -116,6 +119,50 @@ TEST(Lockstep, OutDroneIsNeitherWaitedForNorHeardAndComesBackJoining) {
   EXPECT_TRUE(ls.StepComplete(6600 * kMs));
   EXPECT_TRUE(ls.joined(1));
   EXPECT_EQ(ls.live_count(), 2u);
+}
+
+// The server asks StepComplete/NextDeadlineNs/awaited after every answer: they answer from a cache
+// kept by OnCommand (no scan per answer), and must stay exact when the earliest deadline's drones
+// answer and a later one becomes the earliest.
+TEST(Lockstep, AwaitedAndNextDeadlineFollowEachAnswer) {
+  Lockstep ls(3, {.timeout_ns = 100 * kMs, .join_timeout_ns = 1000 * kMs});
+  ls.BeginStep(0, 0);
+  for (std::size_t i = 0; i < 3; ++i) ls.OnCommand(i, 0, 0);
+  ASSERT_TRUE(ls.StepComplete(0));
+  // Step 1 at 10 ms: drones 0 and 1 were heard at 0 (deadline 110 ms); drone 2 answered step 0
+  // late, at 50 ms (deadline 150 ms).
+  ls.BeginStep(1, 10 * kMs);
+  EXPECT_EQ(ls.awaited(), 3u);
+  EXPECT_EQ(ls.NextDeadlineNs(), 110 * kMs);
+  ls.OnCommand(0, 1, 20 * kMs);
+  EXPECT_EQ(ls.awaited(), 2u);
+  EXPECT_EQ(ls.NextDeadlineNs(), 110 * kMs);  // drone 1 still has it
+  EXPECT_EQ(ls.OnCommand(0, 1, 21 * kMs), Lockstep::Answer::kDuplicate);
+  EXPECT_EQ(ls.awaited(), 2u);
+  ls.OnCommand(1, 1, 30 * kMs);
+  EXPECT_EQ(ls.awaited(), 1u);
+  EXPECT_EQ(ls.NextDeadlineNs(), 110 * kMs);  // drone 2: max(10, 0) + 100
+  EXPECT_FALSE(ls.StepComplete(109 * kMs));
+  EXPECT_TRUE(ls.StepComplete(110 * kMs));
+  EXPECT_EQ(ls.awaited(), 0u);
+  EXPECT_EQ(ls.TakeNewlyLost(), std::vector<std::size_t>{2});
+  EXPECT_EQ(ls.NextDeadlineNs(), std::numeric_limits<std::int64_t>::max());
+}
+
+TEST(Lockstep, NextDeadlineMovesToTheLaterDroneOnceTheEarliestAnswered) {
+  Lockstep ls(2, {.timeout_ns = 100 * kMs, .join_timeout_ns = 1000 * kMs});
+  ls.BeginStep(0, 0);
+  ls.OnCommand(0, 0, 0);
+  ASSERT_FALSE(ls.StepComplete(0));  // drone 1 joins late: its first answer at 500 ms
+  ls.OnCommand(1, 0, 500 * kMs);
+  ASSERT_TRUE(ls.StepComplete(500 * kMs));
+  ls.BeginStep(1, 400 * kMs);      // drone 0: max(400, 0) + 100; drone 1: max(400, 500) + 100
+  EXPECT_EQ(ls.NextDeadlineNs(), 500 * kMs);
+  ls.OnCommand(0, 1, 450 * kMs);
+  EXPECT_EQ(ls.NextDeadlineNs(), 600 * kMs);
+  EXPECT_FALSE(ls.StepComplete(599 * kMs));
+  EXPECT_TRUE(ls.StepComplete(600 * kMs));
+  EXPECT_TRUE(ls.lost(1));
 }
 
 }  // namespace

@@ -51,7 +51,7 @@ class ScriptedAgents final : public SimTransport {
     last_clock_step = step;
     return Ok{};
   }
-  void WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) override {
+  void WaitActuators(std::int64_t deadline_ns, std::size_t /*awaited*/, std::vector<ActuatorInput>* out) override {
     if (pending_.empty()) {
       clock_.now_ns = std::max(clock_.now_ns, deadline_ns);
       return;

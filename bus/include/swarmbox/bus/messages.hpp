@@ -206,10 +206,11 @@ struct SensorSample {
   bool operator==(const SensorSample&) const = default;
 };
 
-// Motor commands for one step. Agent -> physics server, on ActuatorTopic(drone) with
-// Qos::kLockstep.
+// Motor commands for one step. Agent -> physics server, on kActuatorTopic (every agent's answers on
+// one topic) with Qos::kLockstep. Keyed by `drone` (the IDL's @key): one instance per drone, so the
+// keep-last depth holds per drone and 100 answers of one step never push each other out.
 struct ActuatorCommand {
-  std::string drone;
+  std::string drone;  // key: the answering drone; the physics server identifies the answer by it
   std::uint64_t step = 0;  // the SensorSample::step this command answers
   std::int64_t sim_time_ns = 0;
   bool armed = false;                 // false: motors off whatever motor_throttle says

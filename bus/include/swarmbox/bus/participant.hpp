@@ -8,7 +8,7 @@
 //
 //   auto sim = Participant::Create({.backend = "cyclonedds", .domain_id = 3, .interface = "eth1"});
 //   if (!sim) return sim.error();                     // unknown backend, no such interface, ...
-//   auto pub = (*sim)->CreatePublisher<ActuatorCommand>(ActuatorTopic("scout_1"), Qos::kLockstep);
+//   auto pub = (*sim)->CreatePublisher<ActuatorCommand>(kActuatorTopic, Qos::kLockstep);
 //   auto sub = (*sim)->CreateSubscriber<SensorSample>(SensorTopic("scout_1"), Qos::kLockstep);
 //   SensorSample s;                                   // reused: no allocation per step once warm
 //   while ((*sub)->TakeFor(s, std::chrono::milliseconds(500))) { ...; (*pub)->Publish(cmd); }

@@ -1,13 +1,16 @@
 // Topic names and QoS presets of the SwarmBox bus: which message travels where.
 //
-// Per-drone traffic has a topic per drone so it does not fan out to every drone (100 agents must
-// not each receive 100 sensor streams); radio-wide traffic shares one topic per type and is
-// addressed by drone name where needed (RaftMessage::to, RadioPing::to).
+// Traffic from the physics server to one drone has a topic per drone so it does not fan out to every
+// drone (100 agents must not each receive 100 sensor streams). Traffic from every drone to the
+// physics server shares one keyed topic (sim/actuator, keyed by ActuatorCommand::drone): the server
+// reads it with one reader, so its per-step work and its endpoint count do not grow with a reader
+// per drone, and no agent subscribes to it (no fan-out). Radio-wide traffic shares one topic per
+// type and is addressed by drone name where needed (RaftMessage::to, RadioPing::to).
 //
 //   domain  topic                      type             QoS         direction
 //   sim     sim/clock                  ClockTick        kLockstep   physics -> all
 //   sim     sim/<drone>/sensor         SensorSample     kLockstep   physics -> agent <drone>
-//   sim     sim/<drone>/actuator       ActuatorCommand  kLockstep   agent <drone> -> physics
+//   sim     sim/actuator               ActuatorCommand  kLockstep   every agent -> physics (keyed by drone)
 //   sim     sim/<drone>/camera         CameraImage      kLockstep   physics -> agent <drone>
 //   sim     sim/world_command          WorldCommand     kLockstep   orchestrator/tools -> physics
 //   mesh    mesh/state                 DroneState       kState      agent -> agents (keyed by drone)
@@ -35,9 +38,9 @@ namespace swarmbox::bus {
 // (a best-effort subscriber would also hear a reliable publisher, but not the reverse).
 // All presets are volatile (no history for late joiners) and keep-last.
 enum class Qos {
-  // Reliable, keep-last 16 per writer. For the lossless sim network: sensor/actuator lockstep,
-  // camera, clock, world commands. A dead reader never blocks the writer for long: history is
-  // keep-last, old samples are overwritten.
+  // Reliable, keep-last 16 (per instance: per drone on sim/actuator). For the lossless sim
+  // network: sensor/actuator lockstep, camera, clock, world commands. A dead reader never blocks
+  // the writer for long: history is keep-last, old samples are overwritten.
   kLockstep,
   // Best-effort, keep-last 256. For the radio: Raft, detections, pings, events. Loss on the mesh
   // stays visible to the application (Raft and the ping protocol do their own retries).
@@ -51,6 +54,9 @@ enum class Qos {
 std::string_view QosName(Qos qos);  // "lockstep", "radio", "state"
 
 inline constexpr std::string_view kClockTopic = "sim/clock";
+// Every agent's ActuatorCommand; the physics server reads it with one reader and identifies the
+// answer by its key, ActuatorCommand::drone.
+inline constexpr std::string_view kActuatorTopic = "sim/actuator";
 inline constexpr std::string_view kWorldCommandTopic = "sim/world_command";
 inline constexpr std::string_view kDroneStateTopic = "mesh/state";
 inline constexpr std::string_view kRaftTopic = "mesh/raft";
@@ -60,7 +66,6 @@ inline constexpr std::string_view kBrainMessageTopic = "mesh/brain";
 inline constexpr std::string_view kEventTopic = "event";
 
 std::string SensorTopic(std::string_view drone);    // "sim/<drone>/sensor"
-std::string ActuatorTopic(std::string_view drone);  // "sim/<drone>/actuator"
 std::string CameraTopic(std::string_view drone);    // "sim/<drone>/camera"
 std::string OffboardInputTopic(std::string_view drone);   // "offboard/<drone>/input"
 std::string OffboardOutputTopic(std::string_view drone);  // "offboard/<drone>/output"

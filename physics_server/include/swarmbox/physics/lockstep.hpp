@@ -12,6 +12,10 @@
 // instead (agents start slower than the server). A lost drone that answers the current step
 // rejoins (TakeRejoined()).
 //
+// Cost: OnCommand, StepComplete (until a deadline passes), NextDeadlineNs and awaited() are O(1)
+// amortised; BeginStep, SetOut and a passed deadline are O(drones). A step of N answers is O(N),
+// not O(N^2) (the server calls StepComplete and NextDeadlineNs after every arrival).
+//
 // A drone taken out of the trial (SetOut: a process fault of the radio plan) is neither waited for
 // nor heard (its commands are kOut) until SetOut(false), when it re-enters as a joining drone:
 // join_timeout_ns applies to its first answer again.
@@ -39,6 +43,8 @@ class Lockstep {
   bool StepComplete(std::int64_t now_ns);
   // The earliest time at which a waiting drone times out (for a bounded wait); INT64_MAX if none.
   std::int64_t NextDeadlineNs() const;
+  // Live drones (neither lost nor out) that have not answered the current step.
+  std::size_t awaited() const { return pending_; }
 
   // Out of the trial (true) or back as a joining drone (false; clears lost, answered and joined).
   void SetOut(std::size_t drone, bool out);
@@ -61,8 +67,19 @@ class Lockstep {
     bool out = false;
     std::int64_t last_heard_ns = 0;
   };
+  bool Pending(const DroneState& d) const { return !d.lost && !d.answered && !d.out; }
+  std::int64_t Deadline(const DroneState& d) const;
+  // Recomputes pending_ and the earliest deadline (O(drones)).
+  void Recount() const;
+
   LockstepOptions options_;
   std::vector<DroneState> drones_;
+  // Cache over drones_ (kept by every mutator): the pending drones, their earliest deadline and
+  // how many share it; `stale_`: that deadline's drones all answered, recompute before use.
+  mutable std::size_t pending_ = 0;
+  mutable std::int64_t next_deadline_ns_ = 0;
+  mutable std::size_t at_next_deadline_ = 0;
+  mutable bool stale_ = false;
   std::uint64_t step_ = 0;
   std::int64_t step_start_ns_ = 0;
   std::vector<std::size_t> newly_lost_;
