@@ -1,6 +1,6 @@
 // BusTransport: SimTransport on the SwarmBox sim bus (bus/topics.hpp): per drone a SensorSample
-// and CameraImage publisher and an ActuatorCommand subscriber, plus the clock publisher and the
-// world-command subscriber. Actuator commands arrive on middleware threads and are queued here.
+// and CameraImage publisher and an ActuatorCommand subscriber, plus the clock and status
+// publishers and the world-command subscriber. Actuator commands arrive on middleware threads and are queued here.
 //
 // Sensor mapping (physics SensorSample -> bus SensorSample): each sensor's `valid` means "a new
 // measurement at this step" (the physics `fresh` flag; stale values are repeated but invalid).
@@ -36,6 +36,7 @@ class BusTransport final : public SimTransport {
                        const SampleExtras& extras) override;
   Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) override;
   Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) override;
+  Status PublishStatus(const JoiningStatus& status, bool done) override;
   void WaitActuators(std::int64_t deadline_ns, std::vector<ActuatorInput>* out) override;
   void TakeWorldCommands(std::vector<WorldCommandInput>* out) override;
 
@@ -49,6 +50,7 @@ class BusTransport final : public SimTransport {
   };
   std::unique_ptr<bus::Participant> participant_;
   std::unique_ptr<bus::Publisher<bus::ClockTick>> clock_;
+  std::unique_ptr<bus::Publisher<bus::Event>> status_;  // sim/status
   std::unique_ptr<bus::Subscriber<bus::WorldCommand>> world_commands_;
   std::vector<DroneEndpoints> drones_;
   bus::SensorSample sample_msg_;

@@ -21,6 +21,7 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
   if (d.out) return Answer::kOut;
   if (d.answered) return Answer::kDuplicate;
   d.answered = true;
+  if (!d.joined) last_join_ns_ = std::max(last_join_ns_, now_ns);
   d.joined = true;
   d.last_heard_ns = now_ns;
   if (d.lost) {
@@ -30,12 +31,16 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
   return Answer::kAccepted;
 }
 
+std::int64_t Lockstep::JoinDeadlineNs() const {
+  return std::max(step_start_ns_, last_join_ns_) + options_.join_timeout_ns;
+}
+
 std::int64_t Lockstep::NextDeadlineNs() const {
   std::int64_t next = std::numeric_limits<std::int64_t>::max();
   for (const DroneState& d : drones_) {
     if (d.lost || d.answered || d.out) continue;
     const std::int64_t deadline = d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
-                                           : step_start_ns_ + options_.join_timeout_ns;
+                                           : JoinDeadlineNs();
     next = std::min(next, deadline);
   }
   return next;
@@ -47,7 +52,7 @@ bool Lockstep::StepComplete(std::int64_t now_ns) {
     DroneState& d = drones_[i];
     if (d.lost || d.answered || d.out) continue;
     const std::int64_t deadline = d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
-                                           : step_start_ns_ + options_.join_timeout_ns;
+                                           : JoinDeadlineNs();
     if (now_ns >= deadline) {
       d.lost = true;
       newly_lost_.push_back(i);
