@@ -8,6 +8,7 @@
 
 #include "brain_convert.hpp"
 #include "external_brain.hpp"
+#include "server_wait.hpp"
 #include "swarmbox/bus/topics.hpp"
 #include "swarmbox/brain/args.hpp"
 #include "swarmbox/brain/loader.hpp"
@@ -148,6 +149,10 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   auto sub = node->sim_->CreateSubscriber<bus::SensorSample>(bus::SensorTopic(o.name), bus::Qos::kLockstep);
   if (!sub) return sub.error().Context("subscribing to sensor samples");
   node->sensor_sub_ = std::move(*sub);
+  // The physics server's start (sim/status): while it comes, the first sample is waited for.
+  auto status = node->sim_->CreateSubscriber<bus::Event>(bus::kSimStatusTopic, bus::Qos::kLockstep);
+  if (!status) return status.error().Context("subscribing to the physics server's status");
+  node->status_sub_ = std::move(*status);
   // Every agent writes the one keyed topic sim/actuator (cmd_.drone is the key); the server reads it
   // with one reader.
   auto pub = node->sim_->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
@@ -591,20 +596,25 @@ Status AgentNode::Run() {
           .Add("plan", brain_host_ ? std::string("-") : options_.plan)
           .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
   bus::SensorSample msg;
+  bus::Event status;
   bool got_any = false;
   while (true) {
     const auto timeout = got_any ? options_.stall_timeout : options_.first_sample_timeout;
     // Wait in slices so a stop request is seen while no sample comes. The timeout counts the time
     // spent waiting, each slice at most its own length: a process stopped (SIGSTOP, docker pause)
     // or starved in the middle of a slice does not find its deadline gone when it resumes.
+    // Before the first sample the wait is for a sign of the server (server_wait.hpp): each
+    // sim/status message of its start starts it afresh.
     WaitBudget budget(timeout);
+    ServerWait server(options_.first_sample_timeout, options_.name);
+    auto spent = [&] { return got_any ? budget.spent() : server.spent(); };
     bool took = false;
     while (true) {
       if (options_.stop != nullptr && *options_.stop != 0) {
         Log(LogEvent(t_s_, options_.name, "stopped").Add("reason", "signal"));
         return Ok{};
       }
-      if (budget.spent()) {
+      if (spent()) {
         // Look at the topic once more before giving up (a sample may have come in the last slice).
         took = sensor_sub_->Take(msg);
         break;
@@ -613,21 +623,27 @@ Status AgentNode::Run() {
       // physics server is waiting for, a stalled server): Raft and the probe go on between
       // samples, every 10 ms without one.
       const bool idle_radio = options_.radio_model == RadioModel::kNetem && radio_ && (raft_ || probe_);
-      const auto slice = budget.Slice(idle_radio ? std::chrono::milliseconds(10) : std::chrono::milliseconds(50));
+      const auto max_slice = idle_radio ? std::chrono::milliseconds(10) : std::chrono::milliseconds(50);
+      const auto slice = got_any ? budget.Slice(max_slice) : server.Slice(max_slice);
       const auto start = std::chrono::steady_clock::now();
       if (sensor_sub_->TakeFor(msg, slice)) {
         took = true;
         break;
       }
-      budget.Spend(std::chrono::steady_clock::now() - start, slice);
+      if (got_any) {
+        budget.Spend(std::chrono::steady_clock::now() - start, slice);
+      } else {
+        server.Spend(std::chrono::steady_clock::now() - start, slice);
+        while (status_sub_->Take(status)) server.OnStatus(status);
+      }
       if (idle_radio) SWARMBOX_TRY(ServeRadioBetweenSteps());
     }
     if (!took) {
       const double secs = std::chrono::duration<double>(timeout).count();
       if (!got_any) {
         return Error(ErrorCode::kUnavailable,
-                     "no sensor sample on " + bus::SensorTopic(options_.name) + " within " + Seconds(secs) +
-                         " s: is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
+                     "no sensor sample on " + bus::SensorTopic(options_.name) + " " + server.Reason() +
+                         ": is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
                          std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
       }
       Log(LogEvent(t_s_, options_.name, "samples_stopped")

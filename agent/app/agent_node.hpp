@@ -87,7 +87,9 @@ struct AgentOptions {
   double payload_mass_kg = 0.0;         // initial load estimate
   bool swing_damping = true;
   double control_dt_s = 0.004;          // the physics server's lockstep period [s]
-  std::chrono::milliseconds first_sample_timeout{10000};  // wall clock
+  // Wall clock: no first sample and no sign of the physics server (sim/status) for this long ends
+  // the run (server_wait.hpp); each status of the server's start begins the wait afresh.
+  std::chrono::milliseconds first_sample_timeout{10000};
   std::chrono::milliseconds stall_timeout{5000};          // wall clock, after the first sample
   std::chrono::milliseconds camera_timeout{5000};         // wall clock, a flagged camera frame
   bool exit_when_done = false;          // exit once the plan is complete (landed)
@@ -157,6 +159,7 @@ class AgentNode final : private FrameHandler {
   std::unique_ptr<bus::Participant> sim_;
   std::unique_ptr<bus::Participant> mesh_;  // netem only
   std::unique_ptr<bus::Subscriber<bus::SensorSample>> sensor_sub_;
+  std::unique_ptr<bus::Subscriber<bus::Event>> status_sub_;  // sim/status: the server's start
   std::unique_ptr<bus::Publisher<bus::ActuatorCommand>> actuator_pub_;
   std::unique_ptr<radio::MeshRadio> radio_;   // after mesh_: destroyed before the participant
   SimClock sim_clock_;                        // the agent's simulated seconds (event lines)

@@ -91,7 +91,7 @@ int main(int argc, char** argv) {
   app.add_option("--start", start, "Take-off spot x,y,z [m, ENU] (the trial's pose); default: first GPS fix");
   app.add_option("--payload-mass", o.payload_mass_kg, "Load carried at start [kg] (initial estimate)")->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_flag("--no-swing-damping", no_damping, "Disable slung-load swing damping");
-  app.add_option("--sample-timeout", first_timeout_s, "Wall seconds to wait for the first sensor sample")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--sample-timeout,--first-sample-timeout", first_timeout_s, "Wall seconds to wait for the first sensor sample with no sign of the physics server (each sim/status message of its start begins the wait afresh)")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--stall-timeout", stall_timeout_s, "Wall seconds without samples after which the run ends")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--exit-when-done", o.exit_when_done, "Exit as soon as the plan is complete");
   std::string members;

@@ -20,6 +20,10 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
   auto clock = t->participant_->CreatePublisher<bus::ClockTick>(bus::kClockTopic, bus::Qos::kLockstep);
   if (!clock) return std::move(clock).error();
   t->clock_ = std::move(*clock);
+  // Created before the per-drone endpoints: announced first in discovery.
+  auto status = t->participant_->CreatePublisher<bus::Event>(bus::kSimStatusTopic, bus::Qos::kLockstep);
+  if (!status) return std::move(status).error();
+  t->status_ = std::move(*status);
   BusTransport* self = t.get();
   auto wc = t->participant_->CreateSubscriber<bus::WorldCommand>(
       bus::kWorldCommandTopic, bus::Qos::kLockstep, [self](const bus::WorldCommand& c) {
@@ -128,6 +132,22 @@ void BusTransport::OnActuator(const bus::ActuatorCommand& c) {
   actuators_.push_back(std::move(in));
   // Notified under the lock: the waiter cannot miss it, and wakes only when its count is reached.
   if (wake_at_ != 0 && actuators_.size() >= wake_at_) cv_.notify_one();
+}
+
+Status BusTransport::PublishStatus(const JoiningStatus& status, bool done) {
+  bus::Event e;
+  e.node = "physics";
+  e.sim_time_ns = 0;  // the first step
+  e.name = done ? "joined" : "joining";
+  std::string missing;
+  for (const std::string& name : status.missing) {
+    if (!missing.empty()) missing += ',';
+    missing += name;
+  }
+  e.fields = {{"joined", std::to_string(status.joined)},
+              {"expected", std::to_string(status.expected)},
+              {"missing", std::move(missing)}};
+  return status_->Publish(e);
 }
 
 void BusTransport::WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) {

@@ -4,6 +4,7 @@
 // middleware thread (one callback call at a time), are matched to their drone by name in O(1) and
 // queued here; the server's thread is woken once the step's awaited answers are queued (or at its
 // deadline), not once per answer.
+// The physics server's start progress goes out on sim/status (PublishStatus).
 //
 // Sensor mapping (physics SensorSample -> bus SensorSample): each sensor's `valid` means "a new
 // measurement at this step" (the physics `fresh` flag; stale values are repeated but invalid).
@@ -42,6 +43,7 @@ class BusTransport final : public SimTransport {
                        const SampleExtras& extras) override;
   Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) override;
   Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) override;
+  Status PublishStatus(const JoiningStatus& status, bool done) override;
   void WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) override;
   void TakeWorldCommands(std::vector<WorldCommandInput>* out) override;
 
@@ -64,6 +66,7 @@ class BusTransport final : public SimTransport {
 
   std::unique_ptr<bus::Participant> participant_;
   std::unique_ptr<bus::Publisher<bus::ClockTick>> clock_;
+  std::unique_ptr<bus::Publisher<bus::Event>> status_;  // sim/status
   std::vector<DroneEndpoints> drones_;
   std::unordered_map<std::string, std::size_t, NameHash, std::equal_to<>> index_of_;  // set before the subscriber
   bus::SensorSample sample_msg_;

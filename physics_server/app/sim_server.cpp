@@ -413,9 +413,38 @@ void SimServer::RunSchedule(std::int64_t now_ns) {
   while (next_entry_ < schedule.size() && schedule[next_entry_].at_ns <= now_ns) CarryOut(schedule[next_entry_++]);
 }
 
+JoiningStatus SimServer::Joining() const {
+  JoiningStatus status;
+  for (std::size_t i = 0; i < world_.drone_count(); ++i) {
+    if (lockstep_.out(i)) continue;
+    ++status.expected;
+    if (lockstep_.joined(i)) {
+      ++status.joined;
+    } else {
+      status.missing.push_back(world_.drone_name(i));
+    }
+  }
+  return status;
+}
+
+Status SimServer::ReportJoining(bool done) {
+  const JoiningStatus status = Joining();
+  if (done) {
+    const bool reported = joining_.reported();
+    const double wait_s = joining_.End(clock_.NowNs());
+    if (reported || lockstep_.lost_count() > 0) {
+      Log(JoinedEvent(world_.time_s(), options_.node, status, lockstep_.lost_count(), wait_s));
+    }
+  } else {
+    Log(JoiningEvent(world_.time_s(), options_.node, status));
+  }
+  return transport_.PublishStatus(status, done);
+}
+
 Status SimServer::RunStep(const std::atomic<bool>& stop) {
   const std::uint64_t step = world_.step_count();
   lockstep_.BeginStep(step, clock_.NowNs());
+  if (step == 0) joining_.Begin(clock_.NowNs());
   if (channel_) TakeDeliveries(world_.time_ns());
   for (std::size_t i = 0; i < world_.drone_count(); ++i) {
     if (lockstep_.out(i)) continue;
@@ -438,6 +467,9 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   while (!stop.load()) {
     const std::int64_t now = clock_.NowNs();
     if (lockstep_.StepComplete(now)) break;
+    if (joining_.Due(now)) {
+      if (auto s = ReportJoining(/*done=*/false); !s) return s;
+    }
     if (now - last_publish >= kRepublishNs) {
       last_publish = now;
       for (std::size_t i = 0; i < world_.drone_count(); ++i) {
@@ -457,6 +489,9 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   }
   for (std::size_t i : lockstep_.TakeNewlyLost()) world_.SetLost(i, true);
   if (stop.load()) return Ok{};
+  if (joining_.active()) {
+    if (auto s = ReportJoining(/*done=*/true); !s) return s;
+  }
 
   ApplyAnswers();
   world_inbox_.clear();

@@ -23,6 +23,8 @@
 // While waiting, every drone's sample is published again every 200 ms (agents that join late, a
 // lost message, and a keepalive for the drones that answered, so a long wait does not look like a
 // stalled server to them). Duplicate and stale commands are dropped (Lockstep).
+// While the first step waits, every second `event=joining joined=.. expected=.. missing=..` and the
+// same on sim/status (joining.hpp); `event=joined` once it completes.
 // Then World::Step(), truth.csv, pacing to the real-time factor. Events are printed as logfmt
 // lines on `events_out`, and every `clock_every_s` simulated seconds a progress line
 //   t=10.000 node=physics event=clock rtf=0.98 steps=2500 late=3 lost=0
@@ -39,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "joining.hpp"
 #include "radio_plan.hpp"
 #include "swarmbox/channel/channel.hpp"
 #include "swarmbox/bus/messages.hpp"
@@ -86,6 +89,10 @@ class SimTransport {
                                const SampleExtras& extras) = 0;
   virtual Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) = 0;
   virtual Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) = 0;
+  // The start's progress (joining.hpp), every second while the first step waits and once when it
+  // completes (`done`): on the bus, sim/status, the agents' sign of a live server before their
+  // first sample.
+  virtual Status PublishStatus(const JoiningStatus& status, bool done) = 0;
   // Appends the actuator commands that arrived, waiting until `awaited` (>= 1: the live drones
   // that have not answered the step) are queued or wall time `deadline_ns` (WallClock time)
   // passes. Waking once per step rather than once per answer is what keeps 100 answers a step
@@ -215,6 +222,8 @@ class SimServer {
   void LogChannel();
   void Apply(const WorldCommandInput& cmd);
   void Log(const LogEvent& event);
+  JoiningStatus Joining() const;
+  Status ReportJoining(bool done);
 
   World& world_;
   SimTransport& transport_;
@@ -253,6 +262,7 @@ class SimServer {
   std::int64_t pace_origin_wall_ns_ = -1;
   std::int64_t pace_origin_sim_ns_ = 0;
   std::optional<ClockProgress> progress_;  // empty: clock_every_s = 0
+  JoiningClock joining_{1'000'000'000};    // event=joining every wall second of the first step
 };
 
 }  // namespace swarmbox::physics

@@ -11,8 +11,7 @@ Lockstep::Lockstep(std::size_t drone_count, LockstepOptions options) : options_(
 }
 
 std::int64_t Lockstep::Deadline(const DroneState& d) const {
-  return d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns
-                  : step_start_ns_ + options_.join_timeout_ns;
+  return d.joined ? std::max(step_start_ns_, d.last_heard_ns) + options_.timeout_ns : JoinDeadlineNs();
 }
 
 void Lockstep::Recount() const {
@@ -53,6 +52,10 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
     if (Deadline(d) == next_deadline_ns_ && --at_next_deadline_ == 0) stale_ = true;
   }
   d.answered = true;
+  if (!d.joined) {  // a first answer moves every joining drone's deadline (JoinDeadlineNs): recount
+    last_join_ns_ = std::max(last_join_ns_, now_ns);
+    stale_ = true;
+  }
   d.joined = true;
   d.last_heard_ns = now_ns;
   if (d.lost) {
@@ -60,6 +63,10 @@ Lockstep::Answer Lockstep::OnCommand(std::size_t drone, std::uint64_t step, std:
     rejoined_.push_back(drone);
   }
   return Answer::kAccepted;
+}
+
+std::int64_t Lockstep::JoinDeadlineNs() const {
+  return std::max(step_start_ns_, last_join_ns_) + options_.join_timeout_ns;
 }
 
 std::int64_t Lockstep::NextDeadlineNs() const {

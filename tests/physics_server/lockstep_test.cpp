@@ -22,6 +22,25 @@ TEST(Lockstep, StepCompletesWhenEveryDroneAnswered) {
   EXPECT_TRUE(ls.TakeNewlyLost().empty());
 }
 
+// A start of many drones: the join timeout counts from the latest first answer, so the third
+// drone, joining 2.5 join timeouts after the step began, is still waited for; the fourth, silent
+// for a whole join timeout after the last join, is lost.
+TEST(Lockstep, JoinTimeoutCountsFromTheLatestJoin) {
+  Lockstep ls(4, {.timeout_ns = 100 * kMs, .join_timeout_ns = 1000 * kMs});
+  ls.BeginStep(0, 0);
+  EXPECT_EQ(ls.NextDeadlineNs(), 1000 * kMs);
+  ls.OnCommand(0, 0, 900 * kMs);
+  EXPECT_EQ(ls.NextDeadlineNs(), 1900 * kMs);
+  EXPECT_FALSE(ls.StepComplete(1500 * kMs));
+  ls.OnCommand(1, 0, 1800 * kMs);
+  EXPECT_FALSE(ls.StepComplete(2700 * kMs));
+  ls.OnCommand(2, 0, 2500 * kMs);
+  EXPECT_FALSE(ls.StepComplete(3499 * kMs));
+  EXPECT_TRUE(ls.TakeNewlyLost().empty());
+  EXPECT_TRUE(ls.StepComplete(3500 * kMs));
+  EXPECT_EQ(ls.TakeNewlyLost(), std::vector<std::size_t>{3});
+}
+
 TEST(Lockstep, RejectsWrongStepDuplicatesAndUnknownDrones) {
   Lockstep ls(1, {});
   ls.BeginStep(5, 0);

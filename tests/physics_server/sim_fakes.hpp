@@ -33,7 +33,7 @@ class ScriptedAgents final : public SimTransport {
     last_step[name] = s.step;
     published.push_back("sample " + name + " " + std::to_string(s.step) + (extras.camera_frame ? " camera_frame" : ""));
     for (const bus::RadioFrame& f : extras.radio_in) heard[name].push_back({s.step, f});
-    if (alive[name]) {
+    if (alive[name] && clock_.now_ns >= alive_from_ns[name]) {
       ActuatorInput in{name, s.step, !motors_off[name], std::vector<double>(4, throttle), leader[name], {}, {}};
       in.world = std::exchange(answer_world[name], {});
       in.radio_out = std::exchange(answer_radio[name], {});
@@ -51,6 +51,10 @@ class ScriptedAgents final : public SimTransport {
     last_clock_step = step;
     return Ok{};
   }
+  Status PublishStatus(const JoiningStatus& status, bool done) override {
+    statuses.push_back({clock_.now_ns, status, done});
+    return Ok{};
+  }
   void WaitActuators(std::int64_t deadline_ns, std::size_t /*awaited*/, std::vector<ActuatorInput>* out) override {
     if (pending_.empty()) {
       clock_.now_ns = std::max(clock_.now_ns, deadline_ns);
@@ -66,6 +70,7 @@ class ScriptedAgents final : public SimTransport {
   }
 
   std::map<std::string, bool> alive;
+  std::map<std::string, std::int64_t> alive_from_ns;                  // answers from then on
   std::map<std::string, bool> leader;                                 // raft_leader in answers
   std::map<std::string, bool> motors_off;                             // answers armed = false
   std::map<std::string, std::vector<WorldCommandInput>> answer_world;  // in the next answer
@@ -78,6 +83,12 @@ class ScriptedAgents final : public SimTransport {
   std::map<std::string, int> samples, frames;
   std::map<std::string, std::uint64_t> last_step;
   std::vector<std::string> published;  // "camera a 25", "sample a 25 camera_frame", in order
+  struct StatusSent {
+    std::int64_t wall_ns;  // the fake clock's time
+    JoiningStatus status;
+    bool done;
+  };
+  std::vector<StatusSent> statuses;    // PublishStatus, in order
   std::vector<WorldCommandInput> world_commands;
   double throttle = 0;
   std::uint64_t last_clock_step = 0;

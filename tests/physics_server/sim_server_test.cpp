@@ -499,3 +499,100 @@ TEST_F(SimServerTest, PlanWorldCommandAppliesAtItsTime) {
 
 }  // namespace
 }  // namespace swarmbox::physics
+
+namespace swarmbox::physics {
+namespace {
+
+// The start's account (joining.hpp): a line every wall second while the first step waits, the
+// same on sim/status, then event=joined once.
+TEST_F(SimServerTest, JoiningLinesNameTheMissingDronesEverySecondUntilEveryDroneJoined) {
+  // Given b, whose agent answers only from 2.5 s of wall time on (a container still starting),
+  agents_.alive_from_ns["b"] = 2500 * kMs;
+  SimServerOptions o = Options(0);
+  o.lockstep.join_timeout_ns = 5000 * kMs;
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  // when the first step runs,
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  // then at 1 s and 2 s the server said who was missing, and once b answered (the first re-sent
+  // sample past 2.5 s: re-sends are 200 ms apart on a clock polled every 20 ms) that the start
+  // was complete.
+  EXPECT_EQ(ReadFile(out_),
+            "t=0.000 node=physics event=joining joined=1 expected=2 missing=b\n"
+            "t=0.000 node=physics event=joining joined=1 expected=2 missing=b\n"
+            "t=0.000 node=physics event=joined joined=2 expected=2 lost=0 wait_s=2.614\n");
+  ASSERT_EQ(agents_.statuses.size(), 3u);
+  // (at the first look at the clock past each second: the wait polls every 20 ms)
+  EXPECT_GE(agents_.statuses[0].wall_ns, 1000 * kMs);
+  EXPECT_LT(agents_.statuses[0].wall_ns, 1020 * kMs);
+  EXPECT_GE(agents_.statuses[1].wall_ns, 2000 * kMs);
+  EXPECT_LT(agents_.statuses[1].wall_ns, 2020 * kMs);
+  EXPECT_EQ(agents_.statuses[0].status.missing, std::vector<std::string>{"b"});
+  EXPECT_FALSE(agents_.statuses[1].done);
+  EXPECT_TRUE(agents_.statuses[2].done);
+  EXPECT_EQ(agents_.statuses[2].status.joined, 2u);
+  EXPECT_FALSE(world_->Truth(1).lost);
+  // Later steps say nothing more about joining.
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  EXPECT_EQ(agents_.statuses.size(), 3u);
+}
+
+TEST_F(SimServerTest, AQuickCompleteStartPrintsNothingButPublishesItsEnd) {
+  SimServer server(*world_, agents_, clock_, nullptr, Options(0), out_);
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  EXPECT_EQ(ReadFile(out_), "");
+  ASSERT_EQ(agents_.statuses.size(), 1u);
+  EXPECT_TRUE(agents_.statuses[0].done);
+  EXPECT_EQ(agents_.statuses[0].status.expected, 2u);
+}
+
+// The join timeout counts from the latest join: drones that keep joining are all waited for,
+// however long the whole start takes; a drone is given up only when nobody joined for that long.
+TEST_F(SimServerTest, TheJoinTimeoutWaitsWhileDronesKeepJoining) {
+  // Given a join timeout of 500 ms, a answering from 0.4 s and b from 0.8 s (1.6x the timeout),
+  agents_.alive_from_ns["a"] = 400 * kMs;
+  agents_.alive_from_ns["b"] = 800 * kMs;
+  SimServer server(*world_, agents_, clock_, nullptr, Options(0), out_);
+  ASSERT_TRUE(server.RunStep(stop_).ok());
+  // then both joined and neither was lost.
+  EXPECT_FALSE(world_->Truth(0).lost);
+  EXPECT_FALSE(world_->Truth(1).lost);
+  EXPECT_EQ(ReadFile(out_), "");
+}
+
+TEST_F(SimServerTest, ADroneThatNeverJoinsIsNamedInTheJoinedLine) {
+  agents_.alive["b"] = false;
+  SimServer server(*world_, agents_, clock_, nullptr, Options(0), out_);
+  ASSERT_TRUE(server.RunStep(stop_).ok());  // a at once; b lost 500 ms after a joined
+  EXPECT_EQ(ReadFile(out_),
+            "t=0.000 node=physics event=drone_lost a=b\n"
+            "t=0.000 node=physics event=joined joined=1 expected=2 lost=1 wait_s=0.501 missing=b\n");
+}
+
+TEST(Joining, MissingListShowsTenNamesThenACount) {
+  std::vector<std::string> names;
+  for (int i = 1; i <= 12; ++i) names.push_back("scout_" + std::to_string(i));
+  EXPECT_EQ(MissingList(names),
+            "scout_1,scout_2,scout_3,scout_4,scout_5,scout_6,scout_7,scout_8,scout_9,scout_10,+2");
+  EXPECT_EQ(MissingList({"lifter"}), "lifter");
+  EXPECT_EQ(MissingList({}), "-");
+  EXPECT_EQ(MissingList(names, 2), "scout_1,scout_2,+10");
+}
+
+TEST(Joining, ClockIsDueEverySecondAndOnceAfterAStall) {
+  JoiningClock clock(1000 * kMs);
+  EXPECT_FALSE(clock.Due(5000 * kMs));  // not begun
+  clock.Begin(100 * kMs);
+  EXPECT_FALSE(clock.Due(1099 * kMs));
+  EXPECT_TRUE(clock.Due(1100 * kMs));
+  EXPECT_FALSE(clock.Due(1500 * kMs));
+  EXPECT_TRUE(clock.reported());
+  EXPECT_TRUE(clock.Due(5300 * kMs));  // a stalled server: one line, not four
+  EXPECT_FALSE(clock.Due(6000 * kMs));
+  EXPECT_TRUE(clock.Due(6100 * kMs));
+  EXPECT_DOUBLE_EQ(clock.End(6200 * kMs), 6.1);
+  EXPECT_FALSE(clock.Due(9000 * kMs));
+  EXPECT_FALSE(clock.active());
+}
+
+}  // namespace
+}  // namespace swarmbox::physics

@@ -19,6 +19,7 @@
 #include "swarmbox/runner/monitor.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/radio_schedule.hpp"
+#include "swarmbox/runner/start_progress.hpp"
 #include "swarmbox/runner/trajectories.hpp"
 #include "swarmbox/runner/user_images.hpp"
 
@@ -173,13 +174,19 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   eo.start_wall_s = t0;
   eo.interrupted = o.interrupted;
   eo.max_parallel = o.max_parallel > 0 ? o.max_parallel : ParallelFromEnvironment(eo.max_parallel);
+  // Created and started containers, counted (Trace calls are serialised by the engine).
+  StartProgress counts;
   eo.on_trace = [&](const dsl::Component& c, dsl::EventKind e, const Verdict& v) {
     events.Write(LifecycleEventJson(wall(), dsl::EventName(e), c.id(), v));
     if (!v.ok()) {
       say(std::string(dsl::EventName(e)) + " " + c.id() + ": " + v.ToString());
-    } else if (e == dsl::EventKind::kRun && dynamic_cast<const dsl::Plugin*>(&c) != nullptr) {
-      say("started " + c.id());
+      return;
     }
+    if (dynamic_cast<const dsl::Plugin*>(&c) == nullptr) return;
+    std::optional<std::string> line;
+    if (e == dsl::EventKind::kBuild) line = counts.OnCreated(wall());
+    if (e == dsl::EventKind::kRun) line = counts.OnStarted(wall());
+    if (line) say(*line);
   };
 
   std::unique_ptr<dsl::Trial> tree;
@@ -250,6 +257,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     auto planned = planner(run_id, *subnets);
     if (!planned) return planned.error().Context("planning the trial");
     tree = std::move(*planned);
+    counts = StartProgress(tree->Plugins().size());
     engine = std::make_unique<DockerEngine>(api, hub, clock, eo);
     bind_faults();
     start = tree->Start(*engine);
@@ -295,6 +303,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       }
     }
   };
+  bool joined_said = false;  // the physics server's start is over and was reported
   auto process = [&](const HubItem& item) {
     if (item.kind == HubItem::Kind::kLine) {
       const LogfmtFields fields = ParseLogfmt(item.text);
@@ -312,6 +321,12 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       }
       if (monitor && tree) {
         if (auto v = monitor->OnLine(item.component, item.text)) raise(item.component, *v, false);
+        if (!joined_said) {
+          if (auto line = JoinedLine(monitor->progress())) {
+            say(*line);
+            joined_said = true;
+          }
+        }
       }
       if (injector && tree && !tree->end_verdict()) {
         // The line may move simulated time on: `at:` faults fire at the line that crosses.
@@ -377,6 +392,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
                                           Verdict::Err(tree->restart_reason())));
           if (injector) (void)injector->RemoveActive();
           bind_faults();
+          counts = StartProgress(tree->Plugins().size());
           Verdict rv = tree->Restart(*engine);
           if (rv.ok()) rv = start_monitor();
           if (rv.ok()) rv = start_faults();
@@ -395,6 +411,11 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   }
 
   Verdict verdict = start.ok() ? *tree->end_verdict() : start;
+  // A trial that ends badly during its start (or with drones given up at it) names the drones
+  // that did not join, from the physics server's event=joining/joined lines.
+  if (!verdict.ok() && monitor) {
+    if (auto note = NotJoinedNote(monitor->progress())) verdict.reason += "; " + *note;
+  }
   say("ending: " + verdict.ToString());
   events.Write(LifecycleEventJson(wall(), "shutdown", info.name, verdict));
   if (tree && engine) {
@@ -405,8 +426,14 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       (void)injector->RemoveActive();
       if (dynamic_cast<dsl::Step*>(tree->Find(kFaultsStepId)) == nullptr) (void)injector->Teardown();
     }
+    const double stop_began_s = wall();
     Verdict stop = tree->Stop(*engine);
     stop.KeepWorse(engine->FinishStops());  // exit codes, artifacts, removals still under way
+    if (counts.created() > 0) {
+      char took[64];
+      std::snprintf(took, sizeof took, " in %.1f s", wall() - stop_began_s);
+      say("stopped and removed " + std::to_string(counts.created()) + " containers" + took);
+    }
     if (!stop.ok()) {
       result.problems.push_back("teardown: " + stop.ToString());
       verdict.KeepWorse(stop);

@@ -75,6 +75,16 @@ void TrialProgress::OnLine(std::string_view component, std::string_view line) {
     stage = "COMPLETE";
   } else if (*event == "sighting_reported") {
     if (!FindField(fields, "retry")) ++sightings;
+  } else if (*event == "joining" || *event == "joined") {
+    JoiningProgress j;
+    j.joined = IntField(fields, "joined").value_or(0);
+    j.expected = IntField(fields, "expected").value_or(0);
+    const auto missing = FindField(fields, "missing");
+    if (missing && *missing != "-") j.missing = std::string(*missing);
+    j.done = *event == "joined";
+    j.lost = IntField(fields, "lost").value_or(0);
+    j.wait_s = DoubleField(fields, "wait_s").value_or(0);
+    if (!joining || !joining->done) joining = std::move(j);  // the start is over once joined
   } else if (*event == "victim_confirmed") {
     if (auto id = IntField(fields, "id")) confirmed.insert(*id);
   } else if (*event == "victim_status") {
@@ -88,6 +98,9 @@ std::string RenderProgress(const TrialProgress& p, const ProgressFrame& frame) {
   std::string s = "sim " + Fixed(p.sim_s, 1) + "/" + Fixed(frame.timeout_sim_s, 1) + "s";
   if (p.rtf) s += "  rtf " + Fixed(*p.rtf, 2);
   s += "  wall " + Fixed(frame.wall_s, 1) + "s";
+  if (p.joining && !p.joining->done) {
+    s += "  joining " + std::to_string(p.joining->joined) + "/" + std::to_string(p.joining->expected);
+  }
   if (!p.stage.empty()) s += "  stage " + p.stage;
   if (!p.leader.empty()) s += "  leader " + p.leader;
   if (p.sightings > 0 || !p.confirmed.empty() || !p.rescued.empty()) {
@@ -95,6 +108,27 @@ std::string RenderProgress(const TrialProgress& p, const ProgressFrame& frame) {
          std::to_string(p.confirmed.size()) + " rescued " + std::to_string(p.rescued.size());
   }
   s += "  live " + std::to_string(frame.live) + "/" + std::to_string(frame.components);
+  return s;
+}
+
+}  // namespace swarmbox::runner
+
+namespace swarmbox::runner {
+
+std::optional<std::string> NotJoinedNote(const TrialProgress& p) {
+  if (!p.joining || p.joining->missing.empty()) return std::nullopt;
+  const JoiningProgress& j = *p.joining;
+  if (j.done && j.lost == 0) return std::nullopt;
+  return "drones that did not join: " + j.missing + " (" + (j.done ? "lost at the start, " : "") + "joined " +
+         std::to_string(j.joined) + "/" + std::to_string(j.expected) + ")";
+}
+
+std::optional<std::string> JoinedLine(const TrialProgress& p) {
+  if (!p.joining || !p.joining->done) return std::nullopt;
+  const JoiningProgress& j = *p.joining;
+  std::string s = "joined " + std::to_string(j.joined) + "/" + std::to_string(j.expected) + " in " +
+                  Fixed(j.wait_s, 1) + " s";
+  if (j.lost > 0) s += "; lost at the start: " + j.missing;
   return s;
 }
 

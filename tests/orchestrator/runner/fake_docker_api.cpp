@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <thread>
 
 #include "swarmbox/docker/tar_archive.hpp"
 
@@ -142,7 +143,27 @@ Status FakeDockerApi::RemoveNetwork(std::string_view id) {
   return Ok{};
 }
 
+FakeDockerApi::InFlight::InFlight(FakeDockerApi& api, const std::string& kind) : api_(api), kind_(kind) {
+  {
+    std::lock_guard lock(api_.flight_mu_);
+    const int now = ++api_.in_flight_[kind_];
+    api_.max_in_flight_[kind_] = std::max(api_.max_in_flight_[kind_], now);
+  }
+  if (auto it = api_.latency.find(kind_); it != api_.latency.end()) std::this_thread::sleep_for(it->second);
+}
+
+FakeDockerApi::InFlight::~InFlight() {
+  std::lock_guard lock(api_.flight_mu_);
+  --api_.in_flight_[kind_];
+}
+
+std::map<std::string, int> FakeDockerApi::MaxInFlight() const {
+  std::lock_guard lock(flight_mu_);
+  return max_in_flight_;
+}
+
 Result<std::string> FakeDockerApi::CreateContainer(const docker::ContainerSpec& spec) {
+  InFlight flight(*this, "create");
   std::unique_lock lock(mu_);
   if (auto label = spec.labels.find(std::string(docker::kLabelComponent)); label != spec.labels.end()) {
     const std::set<std::string> awaited = scripts[label->second].create_after_started;
@@ -234,6 +255,7 @@ bool FakeDockerApi::Rendezvous(std::unique_lock<std::mutex>& lock,
 }
 
 Status FakeDockerApi::StartContainer(std::string_view id) {
+  InFlight flight(*this, "start");
   std::unique_lock lock(mu_);
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
@@ -269,6 +291,7 @@ void FakeDockerApi::StartLocked(Container& c) {
 }
 
 Status FakeDockerApi::StopContainer(std::string_view id, int) {
+  InFlight flight(*this, "stop");
   std::unique_lock lock(mu_);
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
@@ -341,6 +364,7 @@ Result<std::int64_t> FakeDockerApi::WaitContainer(std::string_view, docker::Wait
 }
 
 Status FakeDockerApi::RemoveContainer(std::string_view id, bool force, bool) {
+  InFlight flight(*this, "remove");
   std::lock_guard lock(mu_);
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <functional>
 #include <map>
@@ -72,6 +73,13 @@ class FakeDockerApi : public docker::DockerApi {
   // instead of hanging it.
   std::set<std::string> start_together;
   std::set<std::string> stop_together;
+  // The engine's own time per call, by kind: "create", "start", "stop", "remove" (slept by the
+  // calling thread before the call takes effect, outside the fake's lock, so concurrent calls
+  // overlap): a slow engine, to measure how a runner overlaps its calls. Absent = none. Set
+  // before the run.
+  std::map<std::string, std::chrono::milliseconds> latency;
+  // The most calls of each kind ("create", "start", "stop", "remove") inside the engine at once.
+  std::map<std::string, int> MaxInFlight() const;
 
   // Inspection for tests.
   struct Container {
@@ -140,6 +148,21 @@ class FakeDockerApi : public docker::DockerApi {
   // Waits for the other members of `group` (mu_ held through `lock`); false after 10 s in vain.
   bool Rendezvous(std::unique_lock<std::mutex>& lock, const std::set<std::string>& group,
                   std::set<std::string>& arrived, const std::string& component);
+  // Counts the call of `kind` in flight for its lifetime and sleeps its latency first.
+  class InFlight {
+   public:
+    InFlight(FakeDockerApi& api, const std::string& kind);
+    ~InFlight();
+    InFlight(const InFlight&) = delete;
+    InFlight& operator=(const InFlight&) = delete;
+
+   private:
+    FakeDockerApi& api_;
+    std::string kind_;
+  };
+  mutable std::mutex flight_mu_;
+  std::map<std::string, int> in_flight_;      // guarded by flight_mu_
+  std::map<std::string, int> max_in_flight_;  // guarded by flight_mu_
   std::set<std::string> started_together_;
   std::set<std::string> stopped_together_;
   struct Exec {

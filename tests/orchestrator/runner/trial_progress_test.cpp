@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "swarmbox/runner/start_progress.hpp"
 #include "swarmbox/runner/trial_progress.hpp"
 
 namespace swarmbox::runner {
@@ -105,6 +106,58 @@ TEST(TrialProgress, IgnoresLinesThatAreNotEvents) {
   EXPECT_TRUE(p.leader.empty());
   EXPECT_TRUE(p.confirmed.empty());
   EXPECT_DOUBLE_EQ(p.sim_s, 3.0);
+}
+
+}  // namespace
+}  // namespace swarmbox::runner
+
+namespace swarmbox::runner {
+namespace {
+
+// The physics server's start (physics_server/app/joining.hpp), in the form it prints it.
+TEST(TrialProgress, JoiningLinesShowTheStartAndNameTheMissingDrones) {
+  TrialProgress p;
+  p.OnLine("physics", "t=0.000 node=physics event=ready drones=101");
+  EXPECT_EQ(NotJoinedNote(p), std::nullopt);
+  p.OnLine("physics", "t=0.000 node=physics event=joining joined=37 expected=101 "
+                      "missing=scout_16,scout_40,scout_41,scout_42,scout_43,scout_44,scout_45,scout_46,"
+                      "scout_47,scout_48,+54");
+  EXPECT_EQ(RenderProgress(p, {600, 8.0, 101, 101}), "sim 0.0/600.0s  wall 8.0s  joining 37/101  live 101/101");
+  EXPECT_EQ(NotJoinedNote(p),
+            "drones that did not join: scout_16,scout_40,scout_41,scout_42,scout_43,scout_44,scout_45,scout_46,"
+            "scout_47,scout_48,+54 (joined 37/101)");
+  EXPECT_EQ(JoinedLine(p), std::nullopt);
+  p.OnLine("physics", "t=0.000 node=physics event=joined joined=101 expected=101 lost=0 wait_s=6.214");
+  EXPECT_EQ(NotJoinedNote(p), std::nullopt);
+  EXPECT_EQ(JoinedLine(p), "joined 101/101 in 6.2 s");
+  EXPECT_EQ(RenderProgress(p, {600, 9.0, 101, 101}), "sim 0.0/600.0s  wall 9.0s  live 101/101");
+  // A joining line arriving late (another stream) does not reopen the start.
+  p.OnLine("physics", "t=0.000 node=physics event=joining joined=100 expected=101 missing=scout_7");
+  EXPECT_EQ(JoinedLine(p), "joined 101/101 in 6.2 s");
+}
+
+TEST(TrialProgress, DronesLostAtTheStartAreNamed) {
+  TrialProgress p;
+  p.OnLine("physics", "t=0.000 node=physics event=joined joined=99 expected=101 lost=2 wait_s=36.020 "
+                      "missing=scout_16,scout_40");
+  EXPECT_EQ(NotJoinedNote(p), "drones that did not join: scout_16,scout_40 (lost at the start, joined 99/101)");
+  EXPECT_EQ(JoinedLine(p), "joined 99/101 in 36.0 s; lost at the start: scout_16,scout_40");
+}
+
+TEST(StartProgress, CountsWithAtMostALineASecondAndTheTotalTime) {
+  StartProgress p(101);
+  std::vector<std::string> lines;
+  for (int i = 0; i < 101; ++i) {
+    if (auto line = p.OnCreated(0.1 + 0.02 * i)) lines.push_back(*line);
+  }
+  // The first, one a second after it, the last with the time since the run began.
+  EXPECT_EQ(lines, (std::vector<std::string>{"created 1/101", "created 51/101", "created 101/101 in 2.1 s"}));
+  EXPECT_EQ(p.OnStarted(3.0), "started 1/101");
+  EXPECT_EQ(p.OnStarted(3.5), std::nullopt);
+  EXPECT_EQ(p.created(), 101u);
+  EXPECT_EQ(p.started(), 2u);
+  StartProgress one(1);
+  EXPECT_EQ(one.OnStarted(0.25), "started 1/1 in 0.2 s");
 }
 
 }  // namespace

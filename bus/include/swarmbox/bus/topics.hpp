@@ -13,6 +13,7 @@
 //   sim     sim/actuator               ActuatorCommand  kLockstep   every agent -> physics (keyed by drone)
 //   sim     sim/<drone>/camera         CameraImage      kLockstep   physics -> agent <drone>
 //   sim     sim/world_command          WorldCommand     kLockstep   orchestrator/tools -> physics
+//   sim     sim/status                 Event            kLockstep   physics -> all (the start, 1 Hz)
 //   mesh    mesh/state                 DroneState       kState      agent -> agents (keyed by drone)
 //   mesh    mesh/raft                  RaftMessage      kRadio      agent -> agent `to`
 //   mesh    mesh/detection             Detection        kRadio      agent -> agents
@@ -58,6 +59,9 @@ inline constexpr std::string_view kClockTopic = "sim/clock";
 // answer by its key, ActuatorCommand::drone.
 inline constexpr std::string_view kActuatorTopic = "sim/actuator";
 inline constexpr std::string_view kWorldCommandTopic = "sim/world_command";
+// The physics server's start (physics_server/app/joining.hpp): Event "joining" every second while
+// the first step waits, "joined" once, with fields joined, expected, missing (every name, commas).
+inline constexpr std::string_view kSimStatusTopic = "sim/status";
 inline constexpr std::string_view kDroneStateTopic = "mesh/state";
 inline constexpr std::string_view kRaftTopic = "mesh/raft";
 inline constexpr std::string_view kDetectionTopic = "mesh/detection";

@@ -9,8 +9,10 @@
 //
 // A drone is lost when it has not answered the current step within timeout_ns of the later of
 // (the step's start, its last answer). Before a drone's first answer, join_timeout_ns applies
-// instead (agents start slower than the server). A lost drone that answers the current step
-// rejoins (TakeRejoined()).
+// instead (agents start slower than the server), counted from the later of the step's start and
+// the latest first answer of any drone: while drones keep joining (a 100-drone start takes
+// seconds) nobody is given up; once none has joined for join_timeout_ns, the silent ones are
+// lost. A lost drone that answers the current step rejoins (TakeRejoined()).
 //
 // Cost: OnCommand, StepComplete (until a deadline passes), NextDeadlineNs and awaited() are O(1)
 // amortised; BeginStep, SetOut and a passed deadline are O(drones). A step of N answers is O(N),
@@ -22,13 +24,14 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace swarmbox::physics {
 
 struct LockstepOptions {
   std::int64_t timeout_ns = 1'000'000'000;       // silence that marks a live drone lost
-  std::int64_t join_timeout_ns = 30'000'000'000; // before its first answer
+  std::int64_t join_timeout_ns = 30'000'000'000; // before its first answer, with no drone joining
 };
 
 class Lockstep {
@@ -82,6 +85,8 @@ class Lockstep {
   mutable bool stale_ = false;
   std::uint64_t step_ = 0;
   std::int64_t step_start_ns_ = 0;
+  std::int64_t last_join_ns_ = std::numeric_limits<std::int64_t>::min();  // latest first answer
+  std::int64_t JoinDeadlineNs() const;
   std::vector<std::size_t> newly_lost_;
   std::vector<std::size_t> rejoined_;
 };

@@ -17,6 +17,9 @@
 //   sightings   `event=sighting_reported` without `retry=` (a scout's first report of a find)
 //   confirmed   distinct `id=` of `event=victim_confirmed` (committed in the Raft log)
 //   rescued     distinct `id=` of `event=victim_status status=rescued`
+//   joining     the physics server's start (physics_server/app/joining.hpp): the latest
+//               `event=joining joined= expected= missing=`, then `event=joined` (done, with
+//               `lost=` and `wait_s=`)
 // Lines that are not logfmt events are ignored.
 #pragma once
 
@@ -29,6 +32,16 @@
 
 namespace swarmbox::runner {
 
+// The physics server's start as its lines said.
+struct JoiningProgress {
+  std::int64_t joined = 0;
+  std::int64_t expected = 0;
+  std::string missing;  // as the server printed it: at most 10 names, then "+N"; "" = none
+  bool done = false;    // event=joined: the first step completed
+  std::int64_t lost = 0;  // done: drones given up at the start (named in `missing`)
+  double wait_s = 0;      // done: wall seconds the start took on the server
+};
+
 struct TrialProgress {
   double sim_s = 0;
   std::optional<double> rtf;
@@ -39,6 +52,7 @@ struct TrialProgress {
   int sightings = 0;
   std::set<std::int64_t> confirmed;
   std::set<std::int64_t> rescued;
+  std::optional<JoiningProgress> joining;  // nullopt: no joining line (a quick complete start)
 
   void OnLine(std::string_view component, std::string_view line);
 };
@@ -51,7 +65,18 @@ struct ProgressFrame {
 };
 
 // "sim 41.2/600.0s  rtf 0.98  wall 43.0s  stage SEARCH  leader scout_2  victims sighted 3
-// confirmed 2 rescued 1  live 5/5": rtf, stage, leader and victims only once known.
+// confirmed 2 rescued 1  live 5/5": rtf, stage, leader and victims only once known; while the
+// physics server's start goes on, "joining 37/101" after the wall time.
 std::string RenderProgress(const TrialProgress& progress, const ProgressFrame& frame);
+
+// The drones that did not join, for the reason of a trial that ends badly: "drones that did not
+// join: scout_16,scout_40,+54 (joined 37/101)" while the start was still going on, "... (lost at
+// the start, joined 99/101)" when the server gave them up; nullopt when every drone joined or no
+// joining line came.
+std::optional<std::string> NotJoinedNote(const TrialProgress& progress);
+
+// The runner's line when the start completed: "joined 101/101 in 6.2 s" (the server's wait), with
+// "; lost at the start: scout_16,scout_40" when it gave some up; nullopt before.
+std::optional<std::string> JoinedLine(const TrialProgress& progress);
 
 }  // namespace swarmbox::runner
