@@ -43,6 +43,7 @@ Bytes EncodeMessage(const Message& m, std::uint32_t cluster_tag) {
     w.Varint(m.snapshot.index);
     w.Varint(m.snapshot.term);
     w.Blob(m.snapshot.data);
+    detail::WriteConfState(w, m.snapshot.conf);
   }
   return out;
 }
@@ -91,7 +92,7 @@ Result<Message> DecodeMessage(std::span<const std::uint8_t> bytes, std::uint32_t
     e.term = r.Varint();
     e.index = r.Varint();
     const std::uint8_t et = r.U8();
-    if (r.ok() && et > 1) return Protocol("invalid entry type " + std::to_string(et));
+    if (r.ok() && et > kMaxEntryType) return Protocol("invalid entry type " + std::to_string(et));
     e.type = static_cast<EntryType>(et);
     e.data = r.Blob();
     m.entries.push_back(std::move(e));
@@ -103,6 +104,7 @@ Result<Message> DecodeMessage(std::span<const std::uint8_t> bytes, std::uint32_t
     if (r.ok() && (m.snapshot.index == 0 || m.snapshot.term == 0)) {
       return Protocol("snapshot message without a snapshot");
     }
+    detail::ReadConfState(r, &m.snapshot.conf);
   }
   if (!r.ok()) return Protocol(r.error());
   if (!r.at_end()) {

@@ -22,7 +22,21 @@ Result<Config> DriverConfig::ToRaftConfig() const {
   if (auto s = ValidateTiming(); !s) return s.error();
   Config c;
   c.id = static_cast<NodeId>(it - names.begin()) + 1;
-  for (std::size_t k = 0; k < names.size(); ++k) c.voters.push_back(k + 1);
+  std::vector<std::string> voting = voters;
+  std::sort(voting.begin(), voting.end());
+  if (std::adjacent_find(voting.begin(), voting.end()) != voting.end()) {
+    return bad("voter names must be distinct");
+  }
+  for (const std::string& v : voting) {
+    if (!std::binary_search(names.begin(), names.end(), v)) {
+      return bad("voter '" + v + "' is not among the members");
+    }
+  }
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const bool votes = voting.empty() || std::binary_search(voting.begin(), voting.end(), names[k]);
+    (votes ? c.voters : c.learners).push_back(k + 1);
+  }
+  c.learner_heartbeat_ticks = learner_heartbeat_ms / tick_ms;
   c.heartbeat_ticks = heartbeat_ms / tick_ms;
   c.election_ticks = election_timeout_ms / tick_ms;
   c.pre_vote = pre_vote;
@@ -47,6 +61,11 @@ Status DriverConfig::ValidateTiming() const {
     return bad("election_timeout_ms (" + std::to_string(election_timeout_ms) +
                ") must be greater than heartbeat_ms (" + std::to_string(heartbeat_ms) + ")");
   }
+  if (learner_heartbeat_ms <= 0 || learner_heartbeat_ms % tick_ms != 0) {
+    return bad("learner_heartbeat_ms (" + std::to_string(learner_heartbeat_ms) +
+               ") must be a positive multiple of tick_ms (" + std::to_string(tick_ms) + ")");
+  }
+  if (voter_lost_ms < 0) return bad("voter_lost_ms must be >= 0 (0: 3 x election_timeout_ms)");
   if (snapshot_every_entries == 0) return bad("snapshot_every_entries must be > 0");
   if (max_entries_per_msg == 0) return bad("max_entries_per_msg must be > 0");
   return Ok{};
@@ -109,6 +128,8 @@ Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config,
   std::unique_ptr<NodeDriver> d(new NodeDriver(config, std::move(names), tag, std::move(*node),
                                                std::move(machine), applied, std::move(tap),
                                                storage, transport, clock, std::move(sink)));
+  d->conf_applied_ = d->node_.conf_state();  // as of the snapshot: later changes re-apply below
+  if (!rc->learners.empty()) d->target_voters_ = rc->voters.size();
   // Hand over what the restart produced (the term bump of a fresh node, re-applying the
   // committed entries after the snapshot).
   if (auto s = d->Process(); !s) return s.error();
@@ -148,6 +169,57 @@ Status NodeDriver::Stop(Error e) {
 Status NodeDriver::Tick() {
   if (stop_error_) return *stop_error_;
   node_.Tick();
+  SWARMBOX_TRY(Process());
+  return ReplaceLostVoters();
+}
+
+Status NodeDriver::ProposeConfChange(ConfChangeOp op, const std::string& node) {
+  if (stop_error_) return *stop_error_;
+  const NodeId id = IdOf(node);
+  if (id == kNoNode) {
+    return Error(ErrorCode::kInvalidArgument, "'" + node + "' is not a member of the trial", "raft driver");
+  }
+  Status s = node_.ProposeConfChange(ConfChange{op, id});
+  SWARMBOX_TRY(Process());
+  return s;
+}
+
+Status NodeDriver::ReplaceLostVoters() {
+  if (target_voters_ == 0 || !is_leader()) return Ok{};
+  if (node_.pending_conf_index() > node_.log().applied()) return Ok{};  // one change at a time
+  const ConfState& conf = node_.conf_state();
+  const int lost_ms = config_.voter_lost_ms > 0 ? config_.voter_lost_ms : 3 * config_.election_timeout_ms;
+  const int lost_ticks = (lost_ms + config_.tick_ms - 1) / config_.tick_ms;
+  const int fresh_ticks = 2 * config_.learner_heartbeat_ms / config_.tick_ms;
+  std::optional<ConfChange> change;
+  for (NodeId v : conf.voters) {
+    const Progress* pr = node_.progress(v);
+    if (v != node_.id() && pr != nullptr && pr->inactive_ticks >= lost_ticks) {
+      change = ConfChange{ConfChangeOp::kRemoveNode, v};
+      break;
+    }
+  }
+  if (!change && conf.voters.size() < target_voters_) {
+    const Progress* best = nullptr;
+    for (NodeId l : conf.learners) {
+      const Progress* pr = node_.progress(l);
+      if (pr == nullptr || !pr->heard || pr->inactive_ticks > fresh_ticks) continue;
+      if (best == nullptr || pr->match > best->match) {
+        best = pr;
+        change = ConfChange{ConfChangeOp::kPromoteLearner, l};
+      }
+    }
+  }
+  if (!change) {
+    for (NodeId id = 1; id <= names_.size(); ++id) {
+      if (!IsVoter(conf, id) && !IsLearner(conf, id)) {
+        change = ConfChange{ConfChangeOp::kAddLearner, id};
+        break;
+      }
+    }
+  }
+  if (!change) return Ok{};
+  (void)node_.ProposeConfChange(*change);  // refused only when leadership is lost: retried next tick
   return Process();
 }
 
@@ -191,9 +263,34 @@ Status NodeDriver::Propose(Bytes data) {
 
 Status NodeDriver::Propose(const MissionCommand& command) { return Propose(EncodeCommand(command)); }
 
+std::string NodeDriver::NameOrId(NodeId id) const {
+  return id >= 1 && id <= names_.size() ? NameOf(id) : "node" + std::to_string(id);
+}
+
+void NodeDriver::ApplyConfEntry(const Entry& e) {
+  auto change = DecodeConfChange(e.data);
+  if (!change) return;  // RawNode skips it the same way (invalid_conf_changes)
+  auto next = ApplyConfChange(conf_applied_, *change);
+  if (!next) return;
+  conf_applied_ = std::move(*next);
+  std::string voters;
+  for (NodeId v : conf_applied_.voters) voters += (voters.empty() ? "" : ",") + NameOrId(v);
+  Emit(LogEvent(clock_.NowS(), config_.self, "raft_conf_change")
+           .Add("op", ConfChangeOpName(change->op))
+           .Add("node", NameOrId(change->node))
+           .Add("voters", voters)
+           .Add("learners", static_cast<std::uint64_t>(conf_applied_.learners.size())));
+}
+
 void NodeDriver::ApplyEntry(const Entry& e) {
   if (e.index <= applied_) return;  // already in the restored snapshot
   applied_ = e.index;
+  if (e.type == EntryType::kConfChange) {
+    ApplyConfEntry(e);
+    // The machine sees a membership change as a no-op: its applied index stays the log's.
+    machine_->Apply(e.index, std::span<const std::uint8_t>(), EventOut(clock_.NowS(), config_.self, sink_));
+    return;
+  }
   // A kNormal entry is never empty (Propose refuses that); treat one like the no-op it carries.
   const bool noop = e.type == EntryType::kEmpty || e.data.empty();
   const std::span<const std::uint8_t> data = noop ? std::span<const std::uint8_t>() : e.data;
@@ -235,6 +332,7 @@ Status NodeDriver::Process() {
       }
       const std::uint64_t before = applied_;
       applied_ = rd.snapshot.index;
+      if (!rd.snapshot.conf.empty()) conf_applied_ = rd.snapshot.conf;
       if (mission_machine_ != nullptr && mission_machine_->mission().applied_index() != applied_) {
         return Stop(Error(ErrorCode::kProtocol, "snapshot index mismatch", "raft driver"));
       }
@@ -244,11 +342,13 @@ Status NodeDriver::Process() {
     }
     for (const Entry& e : rd.committed_entries) ApplyEntry(e);
     node_.Advance(rd);
+    // The events' view of the membership and Raft's are the same function of the same log.
+    SWARMBOX_CHECK(conf_applied_ == node_.conf_state());
   }
   // Raft §7: compact the log into a snapshot of the state machine once enough has been applied.
   const std::uint64_t applied = node_.log().applied();
   if (applied >= node_.log().snapshot_index() + config_.snapshot_every_entries) {
-    Snapshot snap{applied, *node_.log().Term(applied), machine_->Snapshot()};
+    Snapshot snap{applied, *node_.log().Term(applied), machine_->Snapshot(), node_.conf_state()};
     if (auto s = storage_.Compact(snap); !s) {
       return Stop(s.error().Context("raft storage failed while compacting, node stopped"));
     }

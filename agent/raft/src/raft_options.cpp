@@ -15,7 +15,9 @@ Status ReadRaftOptions(const yaml::Node& node, DriverConfig* config) {
       .Optional("snapshot_every_entries", &c.snapshot_every_entries)
       .Optional("max_entries_per_msg", &max_entries)
       .Optional("pre_vote", &c.pre_vote)
-      .Optional("check_quorum", &c.check_quorum);
+      .Optional("check_quorum", &c.check_quorum)
+      .Optional("learner_heartbeat_ms", &c.learner_heartbeat_ms)
+      .Optional("voter_lost_ms", &c.voter_lost_ms);
   if (auto s = r.Finish(); !s) return s;
   c.max_entries_per_msg = static_cast<std::size_t>(max_entries);
   if (auto s = c.ValidateTiming(); !s) {

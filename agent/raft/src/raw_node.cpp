@@ -51,7 +51,12 @@ Status Config::Validate() const {
     if (v == kNoNode) return bad("voter id 0 is reserved");
     if (!seen.insert(v).second) return bad("voter " + std::to_string(v) + " listed twice");
   }
-  if (!seen.count(id)) return bad("id " + std::to_string(id) + " is not among the voters");
+  for (NodeId l : learners) {
+    if (l == kNoNode) return bad("learner id 0 is reserved");
+    if (!seen.insert(l).second) return bad("learner " + std::to_string(l) + " listed twice or also a voter");
+  }
+  if (!seen.count(id)) return bad("id " + std::to_string(id) + " is not among the voters or the learners");
+  if (learner_heartbeat_ticks <= 0) return bad("learner_heartbeat_ticks must be > 0");
   if (heartbeat_ticks <= 0) return bad("heartbeat_ticks must be > 0");
   if (election_ticks <= heartbeat_ticks) {
     return bad("election_ticks (" + std::to_string(election_ticks) +
@@ -63,6 +68,10 @@ Status Config::Validate() const {
 
 RawNode::RawNode(const Config& config) : config_(config) {
   std::sort(config_.voters.begin(), config_.voters.end());
+  std::sort(config_.learners.begin(), config_.learners.end());
+  conf_ = ConfState{config_.voters, config_.learners};
+  known_.insert(conf_.voters.begin(), conf_.voters.end());
+  known_.insert(conf_.learners.begin(), conf_.learners.end());
   rng_state_ = config.seed ^ (0x9E3779B97F4A7C15ULL * config.id);
 }
 
@@ -94,6 +103,12 @@ Result<RawNode> RawNode::Create(const Config& config, PersistentState state) {
                  "raft state");
   }
   RawNode node(config);
+  if (!state.snapshot.conf.empty()) {
+    // The membership at the snapshot; the committed changes after it re-apply with the entries.
+    node.conf_ = state.snapshot.conf;
+    node.known_.insert(node.conf_.voters.begin(), node.conf_.voters.end());
+    node.known_.insert(node.conf_.learners.begin(), node.conf_.learners.end());
+  }
   node.log_ = RaftLog(state.snapshot, std::move(state.entries), std::max(hs.commit, snap_index));
   node.snapshot_ = std::move(state.snapshot);
   // A fresh node starts in term 1 (as etcd-io/raft bootstraps), so every wire message carries a
@@ -132,12 +147,25 @@ void RawNode::Reset(std::uint64_t term) {
   const auto span = static_cast<std::uint64_t>(config_.election_ticks);
   randomized_election_timeout_ = config_.election_ticks + static_cast<int>(NextRandom() % span);
   votes_.clear();
+  ResetProgress();
+}
+
+void RawNode::ResetProgress() {
   progress_.clear();
-  for (NodeId v : config_.voters) {
+  for (const auto* set : {&conf_.voters, &conf_.learners}) {
+    for (NodeId v : *set) {
+      Progress pr;
+      pr.next = log_.last_index() + 1;
+      if (v == config_.id) pr.match = log_.last_index();
+      progress_[v] = pr;
+    }
+  }
+  if (!progress_.count(config_.id)) {
+    // Removed from the configuration: keep our own entry so the leader-side code stays total.
     Progress pr;
     pr.next = log_.last_index() + 1;
-    if (v == config_.id) pr.match = log_.last_index();
-    progress_[v] = pr;
+    pr.match = log_.last_index();
+    progress_[config_.id] = pr;
   }
 }
 
@@ -175,6 +203,9 @@ void RawNode::BecomeLeader() {
   Entry noop;
   noop.type = EntryType::kEmpty;
   AppendEntries({noop});
+  // No membership change before the no-op of this term is applied (committed): a change proposed
+  // earlier could race one of a previous leader still in the log (thesis §4.1, the 2015 fix).
+  pending_conf_index_ = log_.last_index();
 }
 
 void RawNode::Campaign() {
@@ -203,7 +234,7 @@ void RawNode::StartCampaign(bool pre_vote) {
 
 void RawNode::SendVoteRequests() {
   const bool pre = role_ == Role::kPreCandidate;
-  for (NodeId v : config_.voters) {
+  for (NodeId v : conf_.voters) {
     if (v == config_.id || votes_.count(v)) continue;
     Message m;
     m.type = pre ? MessageType::kPreVote : MessageType::kVote;
@@ -218,9 +249,11 @@ void RawNode::SendVoteRequests() {
 RawNode::VoteResult RawNode::Poll(NodeId from, bool granted) {
   votes_.emplace(from, granted);  // the first answer from a voter counts
   std::size_t yes = 0, no = 0;
-  for (const auto& [id, v] : votes_) (v ? yes : no)++;
+  for (const auto& [id, v] : votes_) {
+    if (IsVoter(conf_, id)) (v ? yes : no)++;  // only the voters of our configuration count
+  }
   if (yes >= Quorum()) return VoteResult::kWon;
-  if (no > config_.voters.size() - Quorum()) return VoteResult::kLost;
+  if (no > conf_.voters.size() - Quorum()) return VoteResult::kLost;
   return VoteResult::kPending;
 }
 
@@ -257,6 +290,9 @@ void RawNode::TickElection() {
 void RawNode::TickHeartbeat() {
   ++heartbeat_elapsed_;
   ++election_elapsed_;
+  for (auto& [id, pr] : progress_) {
+    if (id != config_.id) ++pr.inactive_ticks;
+  }
   if (election_elapsed_ >= config_.election_ticks) {
     election_elapsed_ = 0;
     if (config_.check_quorum) {
@@ -272,6 +308,22 @@ void RawNode::TickHeartbeat() {
     m.type = MessageType::kBeat;
     (void)Step(m);
   }
+  TickLearners();
+}
+
+void RawNode::TickLearners() {
+  if (role_ != Role::kLeader || conf_.learners.empty()) return;
+  const auto period = static_cast<std::uint64_t>(config_.learner_heartbeat_ticks);
+  const std::uint64_t slot = learner_slot_++ % period;
+  for (std::uint64_t k = slot; k < conf_.learners.size(); k += period) {
+    const NodeId to = conf_.learners[static_cast<std::size_t>(k)];
+    const Progress& pr = progress_[to];
+    if (pr.match < log_.last_index() && !pr.IsPaused()) {
+      SendAppend(to);
+    } else {
+      SendHeartbeat(to);
+    }
+  }
 }
 
 // --- step ----------------------------------------------------------------------------------------
@@ -286,11 +338,32 @@ Status RawNode::Propose(Bytes data) {
   return Step(m);
 }
 
+Status RawNode::ProposeConfChange(const ConfChange& change) {
+  SWARMBOX_CHECK(!ready_outstanding_);
+  auto unavailable = [](std::string why) { return Error(ErrorCode::kUnavailable, std::move(why), "raft conf change"); };
+  if (role_ != Role::kLeader) return unavailable("not the leader");
+  if (pending_conf_index_ > log_.applied()) {
+    return unavailable("a membership change (or this leader's no-op) at index " + std::to_string(pending_conf_index_) +
+                       " is not applied yet (applied " + std::to_string(log_.applied()) + ")");
+  }
+  if (change.op == ConfChangeOp::kRemoveNode && change.node == config_.id) {
+    return Error(ErrorCode::kInvalidArgument, "the leader cannot remove itself", "raft conf change");
+  }
+  if (auto next = ApplyConfChange(conf_, change); !next) return next.error();
+  Entry e;
+  e.type = EntryType::kConfChange;
+  e.data = EncodeConfChange(change);
+  AppendEntries({e});
+  pending_conf_index_ = log_.last_index();
+  BcastAppend();
+  return Ok{};
+}
+
 Status RawNode::Step(const Message& m) {
   SWARMBOX_CHECK(!ready_outstanding_);
   const bool local = IsLocalMessage(m.type);
   if (!local && m.type != MessageType::kProp) {
-    if (!progress_.count(m.from) || m.from == config_.id) {
+    if (!known_.count(m.from) || m.from == config_.id) {
       return Error(ErrorCode::kInvalidArgument,
                    "message " + std::string(MessageTypeName(m.type)) + " from unknown node " +
                        std::to_string(m.from),
@@ -345,7 +418,8 @@ Status RawNode::Step(const Message& m) {
 
   switch (m.type) {
     case MessageType::kHup:
-      if (role_ != Role::kLeader) StartCampaign(config_.pre_vote);
+      // Only a voter campaigns (etcd's promotable()): learners and removed nodes never do.
+      if (role_ != Role::kLeader && is_voter()) StartCampaign(config_.pre_vote);
       return Ok{};
     case MessageType::kVote:
     case MessageType::kPreVote: {
@@ -408,7 +482,7 @@ void RawNode::StepLeader(const Message& m) {
       // so clients (and the mission) stop waiting on a leader that cannot commit.
       std::size_t active = 0;
       for (auto& [id, pr] : progress_) {
-        if (id == config_.id || pr.recent_active) ++active;
+        if (IsVoter(conf_, id) && (id == config_.id || pr.recent_active)) ++active;
         if (id != config_.id) pr.recent_active = false;
       }
       if (active < Quorum()) BecomeFollower(term_, kNoNode);
@@ -430,6 +504,8 @@ void RawNode::StepLeader(const Message& m) {
   switch (m.type) {
     case MessageType::kAppResp: {
       pr.recent_active = true;
+      pr.inactive_ticks = 0;
+      pr.heard = true;
       if (m.reject) {
         // Raft §5.3: after a rejection, decrement nextIndex and retry (faster with the hint).
         if (pr.MaybeDecrTo(m.index, m.reject_hint)) {
@@ -446,11 +522,17 @@ void RawNode::StepLeader(const Message& m) {
         pr.BecomeProbe();
         pr.BecomeReplicate();
       }
-      if (MaybeCommit()) {
+      const bool committed = MaybeCommit();
+      if (committed) {
         BcastAppend();  // tell followers the new commit index
-      } else if (was_paused) {
-        SendAppend(m.from);
       }
+      // Learner pacing: a learner less than one full message behind waits for its next slot;
+      // one further behind (restarted, new) catches up at the pace of its own answers.
+      if (IsLearner(conf_, m.from) &&
+          log_.last_index() - progress_[m.from].match < config_.max_entries_per_msg) {
+        return;
+      }
+      if (was_paused && !committed) SendAppend(m.from);
       // Keep the pipeline full while the follower lags behind.
       while (progress_[m.from].next <= log_.last_index() && SendAppend(m.from)) {
         if (progress_[m.from].state != Progress::State::kReplicate) break;
@@ -459,6 +541,8 @@ void RawNode::StepLeader(const Message& m) {
     }
     case MessageType::kHeartbeatResp: {
       pr.recent_active = true;
+      pr.inactive_ticks = 0;
+      pr.heard = true;
       pr.probe_sent = false;
       // The follower is alive: if an InstallSnapshot was lost, try again.
       if (pr.state == Progress::State::kSnapshot && pr.match < pr.pending_snapshot) pr.BecomeProbe();
@@ -559,8 +643,9 @@ void RawNode::AppendEntries(std::vector<Entry> entries) {
 
 bool RawNode::MaybeCommit() {
   // Raft §5.3/§5.4.2: the highest index replicated on a majority, if it is of the current term.
+  // Only the voters' logs count (learners never form a quorum).
   std::vector<std::uint64_t> matches;
-  for (const auto& [id, pr] : progress_) matches.push_back(pr.match);
+  for (NodeId v : conf_.voters) matches.push_back(progress_[v].match);
   std::sort(matches.begin(), matches.end(), std::greater<>());
   return log_.MaybeCommit(matches[Quorum() - 1], term_);
 }
@@ -595,7 +680,7 @@ bool RawNode::SendAppend(NodeId to) {
 }
 
 void RawNode::BcastAppend() {
-  for (NodeId v : config_.voters) {
+  for (NodeId v : conf_.voters) {
     if (v != config_.id) SendAppend(v);
   }
 }
@@ -610,7 +695,7 @@ void RawNode::SendHeartbeat(NodeId to) {
 }
 
 void RawNode::BcastHeartbeat() {
-  for (NodeId v : config_.voters) {
+  for (NodeId v : conf_.voters) {
     if (v != config_.id) SendHeartbeat(v);
   }
 }
@@ -658,9 +743,14 @@ bool RawNode::Restore(const Snapshot& s) {
     log_.CommitTo(s.index);
     return false;
   }
-  // Rule 7: discard the entire log and take the snapshot.
+  // Rule 7: discard the entire log and take the snapshot (and the membership at its index).
   log_.Restore(s);
   snapshot_ = s;
+  if (!s.conf.empty()) {
+    conf_ = s.conf;
+    known_.insert(conf_.voters.begin(), conf_.voters.end());
+    known_.insert(conf_.learners.begin(), conf_.learners.end());
+  }
   snapshot_pending_ = true;
   return true;
 }
@@ -709,7 +799,38 @@ void RawNode::Advance(const Ready& rd) {
   if (rd.hard_state) prev_hard_state_ = *rd.hard_state;
   if (!rd.snapshot.empty()) snapshot_pending_ = false;
   if (!rd.entries.empty()) log_.StableTo(rd.entries.back().index);
-  if (!rd.committed_entries.empty()) log_.AppliedTo(rd.committed_entries.back().index);
+  if (!rd.committed_entries.empty()) {
+    for (const Entry& e : rd.committed_entries) {
+      if (e.type == EntryType::kConfChange) ApplyConfEntry(e);
+    }
+    log_.AppliedTo(rd.committed_entries.back().index);
+  }
+}
+
+void RawNode::ApplyConfEntry(const Entry& e) {
+  auto change = DecodeConfChange(e.data);
+  Result<ConfState> next = change ? ApplyConfChange(conf_, *change) : Result<ConfState>(change.error());
+  if (!next) {
+    ++invalid_conf_changes_;  // the same on every node: the committed log and start are the same
+    return;
+  }
+  conf_ = std::move(*next);
+  known_.insert(change->node);
+  if (change->op == ConfChangeOp::kAddLearner) {
+    Progress pr;
+    pr.next = log_.last_index() + 1;
+    progress_.emplace(change->node, pr);
+  } else if (change->op == ConfChangeOp::kRemoveNode && change->node != config_.id) {
+    progress_.erase(change->node);
+    votes_.erase(change->node);
+  }
+  if (role_ != Role::kLeader) return;
+  if (!is_voter()) {
+    BecomeFollower(term_, kNoNode);  // removed: a non-voter cannot lead
+    return;
+  }
+  // A smaller quorum may commit more now (etcd: maybeCommit after a change).
+  if (MaybeCommit()) BcastAppend();
 }
 
 Status RawNode::Compact(std::uint64_t index, Bytes data) {
@@ -726,7 +847,7 @@ Status RawNode::Compact(std::uint64_t index, Bytes data) {
                      std::to_string(log_.applied()),
                  "raft compact");
   }
-  snapshot_ = Snapshot{index, *log_.Term(index), std::move(data)};
+  snapshot_ = Snapshot{index, *log_.Term(index), std::move(data), conf_};
   log_.Compact(index);
   return Ok{};
 }

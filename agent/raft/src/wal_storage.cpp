@@ -66,6 +66,7 @@ Bytes SnapshotFile(const Snapshot& s) {
   w.Varint(s.index);
   w.Varint(s.term);
   w.Blob(s.data);
+  detail::WriteConfState(w, s.conf);
   Bytes out;
   AppendRecord(&out, p);
   return out;
@@ -115,6 +116,8 @@ Status WalStorage::Recover() {
     state_.snapshot.index = p.Varint();
     state_.snapshot.term = p.Varint();
     state_.snapshot.data = p.Blob();
+    // The membership at the snapshot; absent in files written before membership changes.
+    if (p.ok() && !p.at_end()) detail::ReadConfState(p, &state_.snapshot.conf);
     if (!p.ok() || !p.at_end() || state_.snapshot.index == 0) {
       return Error(ErrorCode::kProtocol, "corrupt snapshot file: " + p.error(), snapshot_path_);
     }
@@ -176,9 +179,9 @@ Status WalStorage::Recover() {
       e.term = p.Varint();
       e.index = p.Varint();
       const std::uint8_t t = p.U8();
-      e.type = t == 1 ? EntryType::kEmpty : EntryType::kNormal;
+      e.type = static_cast<EntryType>(t <= kMaxEntryType ? t : 0);
       e.data = p.Blob();
-      good = t <= 1 && p.ok() && PutEntry(&st, std::move(e));
+      good = t <= kMaxEntryType && p.ok() && PutEntry(&st, std::move(e));
     } else if (kind == kBaseRecord) {
       good = record == 0;
       st.snapshot.index = p.Varint();

@@ -33,4 +33,17 @@ inline SimConfig HostileSimConfig(int nodes, std::uint64_t seed) {
   return c;
 }
 
+// The hostile set-up with a voting set: `voters` of `nodes` vote (n1..nV), the rest are learners
+// paced at 200 ms; the drivers' replacement policy replaces a voter silent for 600 ms, and the
+// simulator proposes a random membership change at the leader every ~0.5 s on top (membership
+// safety tests and `swarmbox-bench raft` scenario=membership_hostile).
+inline SimConfig MembershipSimConfig(int nodes, int voters, std::uint64_t seed) {
+  SimConfig c = HostileSimConfig(nodes, seed);
+  c.voters = voters;
+  c.learner_heartbeat_ms = 200;
+  c.voter_lost_ms = 600;
+  c.conf_change_interval_s = 0.5;
+  return c;
+}
+
 }  // namespace swarmbox::raft::sim

@@ -23,8 +23,6 @@ std::uint64_t EntryHash(const Entry& e) {
   return HashBytes(e.data) ^ (static_cast<std::uint64_t>(e.type) << 56);
 }
 
-// The hash a committed no-op has (EntryType::kEmpty, no data).
-std::uint64_t NoopHash() { return EntryHash(Entry{0, 0, EntryType::kEmpty, {}}); }
 
 std::unique_ptr<StateMachine> MakeMachine(SimMachine kind) {
   switch (kind) {
@@ -38,6 +36,14 @@ std::unique_ptr<StateMachine> MakeMachine(SimMachine kind) {
 }
 
 std::int64_t Us(double seconds) { return static_cast<std::int64_t>(std::llround(seconds * 1e6)); }
+
+std::uint64_t ConfHash(const ConfState& c) {
+  Bytes b;
+  for (NodeId v : c.voters) b.push_back(static_cast<std::uint8_t>(v));
+  b.push_back(0xff);
+  for (NodeId l : c.learners) b.push_back(static_cast<std::uint8_t>(l));
+  return HashBytes(b);
+}
 
 }  // namespace
 
@@ -108,15 +114,24 @@ struct ClusterSim::Node {
   std::uint64_t tapped_last = 0;  // the last index the tap yielded in this life
   std::vector<Committed> tapped;  // scratch for TakeCommitted
   std::uint64_t led_term = 0;  // last term this node was seen leading
+  ConfState conf_before;       // the node's configuration at its previous check
 };
 
 ClusterSim::ClusterSim(const SimConfig& config) : config_(config), rng_(config.seed) {
-  SWARMBOX_CHECK(config.nodes >= 1 && config.nodes <= 9);
+  SWARMBOX_CHECK(config.nodes >= 1 && config.nodes <= 200);
+  SWARMBOX_CHECK(config.voters >= 0);
   report_.seed = config.seed;
   clock_ = std::make_unique<SimClock>(*this);
   group_.assign(static_cast<std::size_t>(config.nodes), 0);
   std::vector<std::string> names;
   for (int i = 0; i < config.nodes; ++i) names.push_back(Name(i));
+  std::vector<std::pair<std::string, int>> sorted;
+  for (int i = 0; i < config.nodes; ++i) sorted.emplace_back(Name(i), i);
+  std::sort(sorted.begin(), sorted.end());
+  for (const auto& [name, i] : sorted) node_of_id_.push_back(i);
+  target_voters_ = static_cast<std::size_t>(
+      config.voters > 0 && config.voters < config.nodes ? config.voters : config.nodes);
+  std::sort(names.begin(), names.end());
   cluster_tag_ = ClusterTag(names);
   for (int i = 0; i < config.nodes; ++i) {
     auto n = std::make_unique<Node>();
@@ -132,6 +147,12 @@ ClusterSim::ClusterSim(const SimConfig& config) : config_(config), rng_(config.s
     e->action = [this] { CrashLeaderNow(); };
     Schedule(Us(t), e);
   }
+  for (double t : config.voter_crash_at_s) {
+    auto* e = new Event;
+    e->action = [this] { CrashVoterNow(); };
+    Schedule(Us(t), e);
+  }
+  if (config.conf_change_interval_s > 0) ScheduleNextConfChange();
 }
 
 ClusterSim::~ClusterSim() {
@@ -209,6 +230,11 @@ void ClusterSim::Restart(int node) {
   DriverConfig dc;
   dc.self = Name(node);
   for (int i = 0; i < size(); ++i) dc.members.push_back(Name(i));
+  if (config_.voters > 0 && config_.voters < size()) {
+    for (int i = 0; i < config_.voters; ++i) dc.voters.push_back(Name(i));
+  }
+  dc.learner_heartbeat_ms = config_.learner_heartbeat_ms;
+  dc.voter_lost_ms = config_.voter_lost_ms;
   dc.tick_ms = config_.tick_ms;
   dc.heartbeat_ms = config_.heartbeat_ms;
   dc.election_timeout_ms = config_.election_timeout_ms;
@@ -234,6 +260,7 @@ void ClusterSim::Restart(int node) {
   n.alive = true;
   ++n.epoch;
   n.checked_commit = n.driver->raft().log().snapshot_index();
+  n.conf_before = n.driver->conf_state();
   n.checked_applied = 0;
   n.tapped_last = 0;
   // A random phase for the node's tick clock.
@@ -273,6 +300,14 @@ Status ClusterSim::Propose(int node, const MissionCommand& command) {
   return Propose(node, EncodeCommand(command));
 }
 
+Status ClusterSim::ProposeConfChange(int node, ConfChangeOp op, int target) {
+  Node& n = *nodes_[static_cast<std::size_t>(node)];
+  if (!n.alive) return Error(ErrorCode::kUnavailable, Name(node) + " is down", "sim");
+  Status s = n.driver->ProposeConfChange(op, Name(target));
+  CheckNode(node);
+  return s;
+}
+
 Status ClusterSim::Propose(int node, Bytes data) {
   Node& n = *nodes_[static_cast<std::size_t>(node)];
   if (!n.alive) return Error(ErrorCode::kUnavailable, Name(node) + " is down", "sim");
@@ -294,6 +329,11 @@ void ClusterSim::SendMessage(int from, const std::string& to_name,
                              std::span<const std::uint8_t> bytes) {
   ++report_.messages_sent;
   const int to = std::stoi(to_name.substr(1)) - 1;
+  const NodeDriver* sender = nodes_[static_cast<std::size_t>(from)]->driver.get();
+  if (sender != nullptr && sender->is_leader()) {
+    ++report_.leader_messages;
+    report_.leader_burst_max = std::max(report_.leader_burst_max, ++leader_burst_);
+  }
   if (bytes.size() > 5 && bytes[5] == static_cast<std::uint8_t>(MessageType::kSnap)) {
     ++report_.snapshots_sent;
   }
@@ -431,6 +471,67 @@ void ClusterSim::CrashLeaderNow() {
   Schedule(now_us_ + Us(config_.leader_down_s), r);
 }
 
+void ClusterSim::CrashVoterNow() {
+  if (voter_crash_us_) ++report_.replacements_missed;
+  voter_crash_us_.reset();
+  const int leader = Leader();
+  if (leader < 0) {
+    ++report_.replacements_missed;
+    return;
+  }
+  std::vector<int> candidates;
+  for (NodeId v : driver(leader)->conf_state().voters) {
+    const int node = NodeOf(v);
+    if (node != leader && alive(node)) candidates.push_back(node);
+  }
+  if (candidates.empty()) {
+    ++report_.replacements_missed;
+    return;
+  }
+  const int victim = candidates[rng_() % candidates.size()];
+  voter_crash_us_ = now_us_;
+  crashed_voter_ = driver(victim)->raft().id();
+  Crash(victim);
+  auto* r = new Event;
+  r->action = [this, victim] { Restart(victim); };
+  Schedule(now_us_ + Us(config_.voter_down_s), r);
+}
+
+void ClusterSim::ScheduleNextConfChange() {
+  auto* e = new Event;
+  e->action = [this] {
+    RandomConfChange();
+    ScheduleNextConfChange();
+  };
+  Schedule(now_us_ + Us(config_.conf_change_interval_s * Uniform(0.5, 1.5)), e);
+}
+
+void ClusterSim::RandomConfChange() {
+  const int leader = Leader();
+  if (leader < 0) return;
+  const ConfState conf = driver(leader)->conf_state();
+  const NodeId self = driver(leader)->raft().id();
+  std::vector<NodeId> others;  // voters but the leader
+  for (NodeId v : conf.voters) {
+    if (v != self) others.push_back(v);
+  }
+  std::vector<NodeId> outside;
+  for (NodeId id = 1; id <= static_cast<NodeId>(size()); ++id) {
+    if (!IsVoter(conf, id) && !IsLearner(conf, id)) outside.push_back(id);
+  }
+  auto pick = [this](const std::vector<NodeId>& v) { return v[rng_() % v.size()]; };
+  const auto op = rng_() % 4;
+  if (op == 0 && !others.empty()) {
+    (void)ProposeConfChange(leader, ConfChangeOp::kRemoveNode, NodeOf(pick(others)));
+  } else if (op == 1 && !conf.learners.empty()) {
+    (void)ProposeConfChange(leader, ConfChangeOp::kPromoteLearner, NodeOf(pick(conf.learners)));
+  } else if (op == 2 && !conf.learners.empty()) {
+    (void)ProposeConfChange(leader, ConfChangeOp::kRemoveNode, NodeOf(pick(conf.learners)));
+  } else if (op == 3 && !outside.empty()) {
+    (void)ProposeConfChange(leader, ConfChangeOp::kAddLearner, NodeOf(pick(outside)));
+  }
+}
+
 // --- the event loop ------------------------------------------------------------------------------
 
 void ClusterSim::Step() {
@@ -438,6 +539,7 @@ void ClusterSim::Step() {
   queue_.pop();
   std::unique_ptr<Event> owned(e);
   now_us_ = e->at_us;
+  leader_burst_ = 0;
   switch (e->kind) {
     case Event::Kind::kTick: {
       Node& n = *nodes_[static_cast<std::size_t>(e->node)];
@@ -498,6 +600,23 @@ void ClusterSim::OnSave(int node, const std::optional<HardState>& hs,
                 Name(node) + " term " + std::to_string(d->raft().term()) + " writes entry " +
                     std::to_string(entries.front().index) + " over a log ending at " +
                     std::to_string(st.last_index()));
+    }
+    // One Change at a Time (thesis §4.1): no second change above the applied index, and none
+    // before the leader applied an entry of its own term.
+    const RaftLog& log = d->raft().log();
+    for (const Entry& e : entries) {
+      if (e.type != EntryType::kConfChange) continue;
+      if (log.Term(log.applied()) != d->raft().term()) {
+        Violation("One Change at a Time", Name(node) + " appends a change at " + std::to_string(e.index) +
+                                              " before applying an entry of its term " +
+                                              std::to_string(d->raft().term()));
+      }
+      for (std::uint64_t i = log.applied() + 1; i < e.index; ++i) {
+        if (i >= log.first_index() && log.At(i).type == EntryType::kConfChange) {
+          Violation("One Change at a Time", Name(node) + " appends a change at " + std::to_string(e.index) +
+                                                " with another one in flight at " + std::to_string(i));
+        }
+      }
     }
   }
   if (entries.empty()) return;
@@ -570,11 +689,13 @@ void ClusterSim::CheckNode(int node) {
   }
   for (std::uint64_t i = std::max(n.checked_commit, snap) + 1; i <= commit; ++i) {
     const Entry& e = log.At(i);
-    const CommitFact fact{e.term, EntryHash(e)};
-    if (committed_.size() < i) committed_.resize(i, CommitFact{0, 0});
+    const CommitFact fact{e.term, EntryHash(e), e.type == EntryType::kNormal};
+    if (committed_.size() < i) committed_.resize(i, CommitFact{0, 0, false});
     CommitFact& known = committed_[i - 1];
     if (known.term == 0) {
       known = fact;
+      if (e.type == EntryType::kConfChange) ++report_.conf_changes;
+      if (raw.role() == Role::kLeader) CheckCommitQuorum(raw, n.conf_before, i, e);
       auto p = proposed_at_us_.find(fact.data_hash);
       if (p != proposed_at_us_.end()) {
         report_.commit_ms.push_back(static_cast<double>(now_us_ - p->second) / 1000.0);
@@ -588,15 +709,27 @@ void ClusterSim::CheckNode(int node) {
     }
   }
   n.checked_commit = std::max(n.checked_commit, commit);
+  n.conf_before = raw.conf_state();
   report_.max_commit = std::max(report_.max_commit, commit);
 
   // Election Safety (Raft §5.2) and Leader Completeness (§5.4) when a node starts to lead.
+  if (raw.role() == Role::kLeader && !raw.is_voter()) {
+    Violation("Configuration", who + " leads term " + std::to_string(raw.term()) + " but is no voter");
+  }
+  if (raw.invalid_conf_changes() != 0) {
+    Violation("Configuration", who + " committed a membership change that does not apply");
+  }
+  if (raw.role() == Role::kLeader && voter_crash_us_ && !IsVoter(raw.conf_state(), crashed_voter_) &&
+      raw.conf_state().voters.size() >= target_voters_) {
+    report_.replacement_ms.push_back(static_cast<double>(now_us_ - *voter_crash_us_) / 1000.0);
+    voter_crash_us_.reset();
+  }
   if (raw.role() == Role::kLeader && n.led_term != raw.term()) {
     n.led_term = raw.term();
     auto [it, inserted] = leader_of_term_.emplace(raw.term(), raw.id());
     if (!inserted && it->second != raw.id()) {
-      Violation("Election Safety", "two leaders in term " + std::to_string(raw.term()) + ": n" +
-                                       std::to_string(it->second) + " and " + who);
+      Violation("Election Safety", "two leaders in term " + std::to_string(raw.term()) + ": " +
+                                       Name(NodeOf(it->second)) + " and " + who);
     }
     if (inserted) {
       ++report_.leader_terms;
@@ -630,7 +763,8 @@ void ClusterSim::CheckNode(int node) {
   }
   if (d.applied_index() != n.checked_applied) {
     n.checked_applied = d.applied_index();
-    const std::uint64_t h = HashBytes(d.machine().Snapshot());
+    // The machine's state and the membership (Configuration) after the same index.
+    const std::uint64_t h = HashBytes(d.machine().Snapshot()) ^ (ConfHash(d.conf_state()) * 31);
     auto [it, inserted] = state_hash_at_.emplace(d.applied_index(), h);
     if (!inserted && it->second != h) {
       Violation("State Machine Safety", who + " state after index " +
@@ -672,7 +806,7 @@ void ClusterSim::CheckTap(int node) {
     for (std::uint64_t i = n.tapped_last + 1; complete && i < c.index; ++i) {
       if (i > committed_.size()) break;
       const CommitFact& gap = committed_[i - 1];
-      if (gap.term != 0 && gap.data_hash != NoopHash()) {
+      if (gap.term != 0 && gap.application) {
         Violation("Committed Tap", who + " skipped committed entry " + std::to_string(i) +
                                        " (tapped " + std::to_string(c.index) + " after " +
                                        std::to_string(n.tapped_last) + ")");
@@ -681,6 +815,25 @@ void ClusterSim::CheckTap(int node) {
     }
     n.tapped_last = c.index;
   }
+}
+
+void ClusterSim::CheckCommitQuorum(const RawNode& leader, const ConfState& before, std::uint64_t index,
+                                   const Entry& e) {
+  // A step applies at most one change (the next is proposed only once it is applied, and commits
+  // only in a later step), so the commit was made under the configuration before the step or the
+  // one after it.
+  std::string held;
+  for (const ConfState* conf : {&before, &leader.conf_state()}) {
+    std::size_t holding = 0;
+    for (NodeId v : conf->voters) {
+      const MemoryStorage& st = *nodes_[static_cast<std::size_t>(NodeOf(v))]->storage;
+      if (index < st.state().snapshot.index || st.Term(index) == e.term) ++holding;
+    }
+    if (!conf->voters.empty() && holding >= conf->voters.size() / 2 + 1) return;
+    held += (held.empty() ? "" : ", ") + std::to_string(holding) + " of " + std::to_string(conf->voters.size());
+  }
+  Violation("Commit Quorum", Name(NodeOf(leader.id())) + " commits index " + std::to_string(index) +
+                                 " held by " + held + " voters (configuration before, after the step)");
 }
 
 SimReport RunSimulation(const SimConfig& config) {

@@ -2,8 +2,10 @@
 //
 // Layout (version 1), all integers LEB128 varints unless noted:
 //   u8 version=1 | fixed32 cluster_tag | u8 type | from | to | term | log_term | index | commit |
-//   u8 flags (bit0 reject) | reject_hint | entry count | entries... | [kSnap: index term data]
-//   entry := term | index | u8 type | data (varint length + bytes)
+//   u8 flags (bit0 reject) | reject_hint | entry count | entries... |
+//   [kSnap: index term data conf]
+//   entry := term | index | u8 type (0 normal, 1 no-op, 2 conf change) | data (length + bytes)
+//   conf  := voter count | voters... | learner count | learners...   (ascending ids)
 // cluster_tag (ClusterTag()) is a hash of the member names, so drones configured with different
 // member lists refuse each other's messages instead of mixing up node ids.
 //

@@ -12,6 +12,9 @@
 // Events are handed to the caller's sink as LogEvents (the logfmt contract):
 //   event=leader_elected term=3 leader=drone_2     every node, when it learns of a new leader
 //   event=raft_stopped reason="..."                storage failed: the node is dead (exit!)
+//   event=raft_conf_change op=remove node=scout_3 voters=scout_1,scout_2,scout_4,scout_5 learners=95
+//                                                  every node, when it applies a membership change
+//                                                  (op: add_learner | promote | remove)
 // plus the state machine's own lines, written while it applies an entry (MissionStateMachine:
 // event=mission_state, victim_confirmed, victim_status; mission_state_machine.hpp).
 //
@@ -50,6 +53,19 @@
 //                        (*node)->Propose(Bytes{...});   (*node)->TakeCommitted(&entries);
 // Any call returns the storage error once the node has stopped (stopped() is true): the agent
 // must then exit non-zero, since it can no longer promise what it voted or acknowledged.
+//
+// Swarm scale (conf_change.hpp, raw_node.hpp "Learners"): DriverConfig::voters names the starting
+// voting set (the trial's first V drones, the same list on every drone); every other member is a
+// learner. Empty, or every member: everyone votes and nothing below happens (as before learners
+// existed). With learners, the leader runs the lost-voter replacement policy after every tick, one
+// membership change at a time (each waits until the previous one is applied):
+//   1. a voter that has not answered for voter_lost_ms (default 3 x the election timeout, on the
+//      caller's clock) is removed (RemoveNode);
+//   2. while there are fewer voters than at the start, the learner with the highest match index
+//      that answered within the last 2 x learner_heartbeat_ms is promoted (PromoteLearner);
+//   3. a member of the trial in neither set (a removed voter) is added back as a learner
+//      (AddLearner), so it follows the log again when it returns.
+// A new leader knows nobody's history: its clocks for 1 and 2 start at its election.
 //
 // Timing defaults (radio: 100 ms +- 20 ms one-way delay, 5% loss): tick 50 ms, heartbeat 100 ms
 // (about half the round trip), election timeout 500 ms randomised to [500, 1000) ms (5x the
@@ -97,6 +113,11 @@ class Clock {
 struct DriverConfig {
   std::string self;
   std::vector<std::string> members;  // every drone of the cluster, including self
+  // The starting voters, a subset of members (same list on every drone); the others are learners.
+  // Empty: every member votes.
+  std::vector<std::string> voters;
+  int learner_heartbeat_ms = 1000;   // the leader serves each learner once per this [ms]
+  int voter_lost_ms = 0;             // replace a voter silent this long [ms]; 0: 3 x election
   int tick_ms = 50;                  // how often the caller calls Tick() [ms]
   int heartbeat_ms = 100;            // multiple of tick_ms
   int election_timeout_ms = 500;     // multiple of tick_ms, > heartbeat_ms
@@ -141,6 +162,9 @@ class NodeDriver {
   // The same for an encoded MissionCommand (for a MissionStateMachine).
   Status Propose(const MissionCommand& command);
   Status Campaign();  // start an election now
+  // Leader only: proposes a membership change (RawNode::ProposeConfChange: kUnavailable while one
+  // is in flight or when not leader; kInvalidArgument when it does not apply).
+  Status ProposeConfChange(ConfChangeOp op, const std::string& node);
 
   // Replaces *out with the application entries applied since the previous call (see the banner).
   void TakeCommitted(std::vector<Committed>* out);
@@ -160,6 +184,9 @@ class NodeDriver {
   std::string leader() const;  // the known leader's name, "" when none
   bool is_leader() const { return node_.role() == Role::kLeader; }
   const std::string& NameOf(NodeId id) const { return names_[id - 1]; }
+  // The configuration this driver has applied (the same as raft().conf_state() between calls).
+  const ConfState& conf_state() const { return node_.conf_state(); }
+  bool replaces_lost_voters() const { return target_voters_ > 0; }
   NodeId IdOf(const std::string& name) const;  // kNoNode when not a member
 
  private:
@@ -171,6 +198,9 @@ class NodeDriver {
   Status Stop(Error e);
   void Emit(const LogEvent& e) const;
   void ApplyEntry(const Entry& e);
+  void ApplyConfEntry(const Entry& e);
+  Status ReplaceLostVoters();  // the leader's policy (see the banner)
+  std::string NameOrId(NodeId id) const;
 
   DriverConfig config_;
   std::vector<std::string> names_;  // sorted; id = index + 1
@@ -187,6 +217,8 @@ class NodeDriver {
   std::optional<Error> stop_error_;
   NodeId announced_lead_ = kNoNode;
   std::uint64_t announced_term_ = 0;
+  ConfState conf_applied_;          // the membership as of applied_ (for the change events)
+  std::size_t target_voters_ = 0;   // > 0: replace lost voters up to this many (learners exist)
 };
 
 }  // namespace swarmbox::raft

@@ -16,6 +16,8 @@ struct Progress {
   bool probe_sent = false;        // probe: an append is in flight, wait for a reply or heartbeat
   std::uint64_t pending_snapshot = 0;  // snapshot: index of the snapshot sent
   bool recent_active = false;     // heard from since the last CheckQuorum (thesis §6.2)
+  int inactive_ticks = 0;         // leader ticks since this peer last answered (replacement policy)
+  bool heard = false;             // answered this leader at least once
 
   bool IsPaused() const {
     return state == State::kSnapshot || (state == State::kProbe && probe_sent);

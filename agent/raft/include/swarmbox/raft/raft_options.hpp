@@ -11,7 +11,8 @@
 //   }
 //
 // Keys (all optional): tick_ms, heartbeat_ms, election_timeout_ms, snapshot_every_entries,
-// max_entries_per_msg, pre_vote, check_quorum. Unknown keys, wrong types and timings that cannot
+// max_entries_per_msg, pre_vote, check_quorum, learner_heartbeat_ms, voter_lost_ms (the voting set
+// itself comes from the drone list: DriverConfig::voters). Unknown keys, wrong types and timings that cannot
 // work are kInvalidArgument errors located at the mapping (file:line:col).
 #pragma once
 

@@ -21,8 +21,21 @@
 // Implemented: leader election with randomised timeouts (Raft §5.2), log replication and the
 // commit rule (§5.3, §5.4.2), the election restriction (§5.4.1), the leader's no-op entry (§8),
 // PreVote (thesis §9.6), CheckQuorum and leader lease for votes (thesis §6.2, §4.2.3), proposal
-// forwarding to the leader, log compaction and InstallSnapshot (§7). Not implemented: membership
-// changes (the voter set is fixed per trial), leadership transfer, ReadIndex.
+// forwarding to the leader, log compaction and InstallSnapshot (§7), learners and one-at-a-time
+// membership changes (etcd-io/raft's ConfChange, conf_change.hpp). Not implemented: joint
+// consensus, leadership transfer, ReadIndex.
+//
+// Learners (etcd-io/raft's, for a swarm of 100 with a voting set of 5): a learner receives and
+// applies the log but never campaigns, is never asked for a vote and does not count for a commit
+// quorum or CheckQuorum. It answers appends and heartbeats like a follower, so the leader tracks
+// its progress (match/next) as for a voter. Learner pacing (not in etcd, which relies on TCP
+// flow control; our radio has a 50-frame queue): the leader does not broadcast appends or
+// heartbeats to learners. Each tick it serves the learners whose slot it is, slot k of
+// learner_heartbeat_ticks for the k-th learner (sorted by id) modulo that period: an append when
+// the learner is behind, else a heartbeat carrying the commit index. So 95 learners cost ~95/period
+// frames per tick, never 95 at once; the replies (and only they) drive any catch-up appends.
+// Membership changes take effect when their entry is applied (Advance), as in etcd; the
+// configuration is part of the snapshot. A leader that applies its own removal steps down.
 //
 // Two liveness-only additions for a lossy, slow radio (neither changes a term, vote or log entry,
 // so safety is untouched; the simulator checks it): (pre-)candidates re-send unanswered vote
@@ -34,9 +47,11 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <set>
 #include <vector>
 
 #include "swarmbox/common/result.hpp"
+#include "swarmbox/raft/conf_change.hpp"
 #include "swarmbox/raft/progress.hpp"
 #include "swarmbox/raft/raft_log.hpp"
 #include "swarmbox/raft/types.hpp"
@@ -48,7 +63,10 @@ std::string_view RoleName(Role role);
 
 struct Config {
   NodeId id = kNoNode;
-  std::vector<NodeId> voters;  // every member, including id; ids are non-zero and distinct
+  // The starting membership (a snapshot's ConfState replaces it): voters and learners, ids
+  // non-zero and distinct, id among one of them, at least one voter.
+  std::vector<NodeId> voters;
+  std::vector<NodeId> learners;
   // A follower starts an election after a random timeout in [election_ticks, 2*election_ticks)
   // without hearing from a leader (Raft §5.2); the leader sends heartbeats every heartbeat_ticks.
   int election_ticks = 10;
@@ -56,6 +74,8 @@ struct Config {
   bool pre_vote = true;      // thesis §9.6
   bool check_quorum = true;  // thesis §6.2
   std::size_t max_entries_per_msg = 64;
+  // The leader serves each learner once per this many ticks (see the banner: learner pacing).
+  int learner_heartbeat_ticks = 20;
   std::uint64_t seed = 1;    // seeds the election-timeout randomisation
 
   // kInvalidArgument with the reason when the configuration cannot work.
@@ -95,8 +115,13 @@ class RawNode {
   Status Step(const Message& m);
   // Proposes an application command (forwarded to the leader when we are a follower).
   Status Propose(Bytes data);
-  // Starts an election now (as an election timeout would).
+  // Starts an election now (as an election timeout would). A learner does not campaign.
   void Campaign();
+  // Leader only: appends a membership change (conf_change.hpp). kUnavailable when not leader, when
+  // a change is still in flight (appended, not applied) or before the leader applied an entry of
+  // its own term; kInvalidArgument when it does not apply to the current configuration or removes
+  // the leader itself.
+  Status ProposeConfChange(const ConfChange& change);
 
   bool HasReady() const;
   Ready GetReady();
@@ -116,6 +141,16 @@ class RawNode {
   const Snapshot& snapshot() const { return snapshot_; }
   const Config& config() const { return config_; }
   const Progress* progress(NodeId peer) const;
+  // The configuration in effect (changes applied up to log().applied()).
+  const ConfState& conf_state() const { return conf_; }
+  bool is_voter() const { return IsVoter(conf_, config_.id); }
+  bool is_learner() const { return IsLearner(conf_, config_.id); }
+  // The index of the last change this leader appended (0: none since it became leader... or the
+  // no-op of its term, see ProposeConfChange); a change is in flight while it is > applied.
+  std::uint64_t pending_conf_index() const { return pending_conf_index_; }
+  // Committed conf-change entries that did not apply (invalid for the configuration they met):
+  // skipped identically on every node; the simulator requires 0.
+  std::uint64_t invalid_conf_changes() const { return invalid_conf_changes_; }
   HardState hard_state() const { return {term_, vote_, log_.committed()}; }
   int randomized_election_timeout() const { return randomized_election_timeout_; }
 
@@ -138,7 +173,10 @@ class RawNode {
   void StartCampaign(bool pre_vote);
   void SendVoteRequests();  // to every voter that has not answered yet
   VoteResult Poll(NodeId from, bool granted);
-  std::size_t Quorum() const { return config_.voters.size() / 2 + 1; }
+  std::size_t Quorum() const { return conf_.voters.size() / 2 + 1; }
+  void ResetProgress();  // one Progress per member of conf_
+  void ApplyConfEntry(const Entry& e);
+  void TickLearners();   // leader: the learners whose slot this tick is
 
   void AppendEntries(std::vector<Entry> entries);  // leader: stamp term/index, append, commit
   bool MaybeCommit();
@@ -160,7 +198,12 @@ class RawNode {
   Role role_ = Role::kFollower;
   RaftLog log_;
   Snapshot snapshot_;  // latest snapshot, sent to followers that need compacted entries
-  std::map<NodeId, Progress> progress_;
+  std::map<NodeId, Progress> progress_;  // every member (voters, learners, self)
+  ConfState conf_;
+  std::set<NodeId> known_;  // every id ever in a configuration: messages from others are refused
+  std::uint64_t pending_conf_index_ = 0;
+  std::uint64_t invalid_conf_changes_ = 0;
+  std::uint64_t learner_slot_ = 0;
   std::map<NodeId, bool> votes_;
   int election_elapsed_ = 0;
   int heartbeat_elapsed_ = 0;

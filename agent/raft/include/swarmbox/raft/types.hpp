@@ -22,7 +22,9 @@ inline constexpr NodeId kNoNode = 0;
 enum class EntryType : std::uint8_t {
   kNormal = 0,  // an application command (opaque bytes)
   kEmpty = 1,   // the no-op a new leader appends to commit entries of earlier terms (Raft §8)
+  kConfChange = 2,  // a membership change (conf_change.hpp), applied when it is applied
 };
+inline constexpr std::uint8_t kMaxEntryType = 2;
 
 struct Entry {
   std::uint64_t term = 0;
@@ -43,12 +45,26 @@ struct HardState {
   bool operator==(const HardState&) const = default;
 };
 
-// A snapshot of the replicated state machine up to and including `index` (Raft §7).
-// `data` is the state machine's own encoding (MissionState::EncodeSnapshot). index 0 = none.
+// The cluster's membership (etcd-io/raft's ConfState): the voters, who elect the leader and form
+// the quorums, and the learners, who receive and apply the log but never vote, never campaign and
+// never count for a quorum. Both sorted, disjoint. Empty voters = "not recorded" (a snapshot
+// written before membership changes existed: the node's configured membership applies).
+struct ConfState {
+  std::vector<NodeId> voters;
+  std::vector<NodeId> learners;
+
+  bool empty() const { return voters.empty(); }
+  bool operator==(const ConfState&) const = default;
+};
+
+// A snapshot of the replicated state machine up to and including `index` (Raft §7), with the
+// membership in effect at that index. `data` is the state machine's own encoding
+// (MissionState::EncodeSnapshot). index 0 = none.
 struct Snapshot {
   std::uint64_t index = 0;
   std::uint64_t term = 0;
   Bytes data;
+  ConfState conf = {};
 
   bool empty() const { return index == 0; }
   bool operator==(const Snapshot&) const = default;

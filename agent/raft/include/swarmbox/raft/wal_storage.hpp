@@ -8,9 +8,11 @@
 // Files:
 //   <dir>/wal       records: fixed32 length | fixed32 crc32(payload) | payload, where payload is
 //                   u8 kind + fields: 1 hard state (term, vote, commit), 2 entry (term, index,
-//                   type, data), 3 base (snapshot index, term: first record of a rewritten file).
+//                   type 0 normal / 1 no-op / 2 conf change, data), 3 base (snapshot index, term: first record of a rewritten file).
 //                   An entry record for index i replaces any stored entry >= i (Raft §5.3).
-//   <dir>/snapshot  one record of the same framing: index, term, state machine data. Written
+//   <dir>/snapshot  one record of the same framing: index, term, state machine data, then the
+//                   membership (ConfState: voter count, voters, learner count, learners; absent
+//                   in files written before membership changes existed). Written
 //                   atomically (tmp + fsync + rename + fsync dir).
 // Save() appends every record of a Ready in one write and fsyncs once. Compact() writes the
 // snapshot file, then rewrites the WAL as base + hard state + the entries after the snapshot.

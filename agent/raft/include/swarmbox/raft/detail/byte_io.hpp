@@ -4,6 +4,7 @@
 // later read returns zeros, so a decoder checks ok() once at the end.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstring>
@@ -127,5 +128,36 @@ class ByteReader {
   std::size_t pos_ = 0;
   std::string error_;
 };
+
+// ConfState: voter count, voters, learner count, learners (varints, ascending ids).
+inline void WriteConfState(ByteWriter& w, const ConfState& conf) {
+  w.Varint(conf.voters.size());
+  for (NodeId v : conf.voters) w.Varint(v);
+  w.Varint(conf.learners.size());
+  for (NodeId l : conf.learners) w.Varint(l);
+}
+
+// Reads what WriteConfState wrote; latches an error in `r` for ids that are 0, not ascending, or
+// both voter and learner, and for learners without voters.
+inline void ReadConfState(ByteReader& r, ConfState* out) {
+  ConfState c;
+  for (auto* set : {&c.voters, &c.learners}) {
+    const std::uint64_t n = r.Count(1, "conf member");
+    for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
+      const NodeId id = r.Varint();
+      if (r.ok() && (id == kNoNode || (!set->empty() && id <= set->back()))) {
+        r.Fail("conf member ids must be non-zero and ascending");
+      }
+      set->push_back(id);
+    }
+  }
+  for (NodeId l : c.learners) {
+    if (r.ok() && std::find(c.voters.begin(), c.voters.end(), l) != c.voters.end()) {
+      r.Fail("conf node " + std::to_string(l) + " is both voter and learner");
+    }
+  }
+  if (r.ok() && c.voters.empty() && !c.learners.empty()) r.Fail("conf learners without voters");
+  if (r.ok()) *out = std::move(c);
+}
 
 }  // namespace swarmbox::raft::detail

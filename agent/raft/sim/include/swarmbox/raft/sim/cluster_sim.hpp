@@ -14,6 +14,13 @@
 //   Leader Completeness  a new leader holds every entry committed before its election
 //   State Machine Safety every node's state machine after applying index i is the same (its
 //                        Snapshot() bytes), and nodes commit the same entry at each index
+// plus, for membership (conf_change.hpp):
+//   Configuration        every node has the same configuration after applying index i; no
+//                        committed change fails to apply; a leader is a voter of its configuration
+//   One Change at a Time a leader appends a change only when no other change is in its log above
+//                        its applied index, and only after it applied an entry of its own term
+//   Commit Quorum        when an index is first committed, a majority of the committing leader's
+//                        voters hold it in durable storage (learners never make a quorum)
 // plus monotonic terms, and the committed-entries tap (NodeDriver::TakeCommitted, drained after
 // every step): per node life it yields committed entries only, with the committed data, in
 // strictly increasing index order; with the EntryLogMachine also every one of them from index 1
@@ -27,8 +34,12 @@
 //   SimReport r = RunSimulation(cfg);
 //   if (!r.ok()) std::puts(r.violations[0].c_str());   // "seed=42 t=12.340 Log Matching: ..."
 //
+// Swarm scale: SimConfig::voters = V > 0 makes n1..nV the starting voters and every other node a
+// learner; the drivers then run the lost-voter replacement policy (node_driver.hpp), and
+// conf_change_interval_s > 0 adds random membership changes at the leader on top.
+//
 // For scripted scenarios drive a ClusterSim directly: RunFor(), Crash(), Restart(),
-// Partition(), Heal(), Propose().
+// Partition(), Heal(), Propose(), ProposeConfChange().
 #pragma once
 
 #include <cstdint>
@@ -70,7 +81,17 @@ struct FaultModel {
 enum class SimMachine : std::uint8_t { kMission, kEntryLog };
 
 struct SimConfig {
-  int nodes = 5;
+  int nodes = 5;  // 1..200
+  int voters = 0;  // the starting voters n1..nV, the rest learners; 0 (or >= nodes): all vote
+  int learner_heartbeat_ms = 1000;
+  int voter_lost_ms = 0;  // 0: 3 x election_timeout_ms
+  // Random membership changes at the leader (remove a voter or a learner, promote a learner, add
+  // a non-member as learner), on top of the replacement policy; 0: none.
+  double conf_change_interval_s = 0;
+  // Voter-crash schedule (the replacement figure): at each time, crash a live voter that is not
+  // the leader; it stays down voter_down_s.
+  std::vector<double> voter_crash_at_s;
+  double voter_down_s = 30;
   SimMachine machine = SimMachine::kMission;  // every node's replicated state machine
   std::uint64_t seed = 1;
   double duration_s = 20;
@@ -104,6 +125,12 @@ struct SimReport {
   std::uint64_t snapshots_sent = 0;
   std::vector<std::string> events;  // with record_events
   std::uint64_t entries_tapped = 0;  // entries every node's tap yielded (replays included)
+  // Membership.
+  int conf_changes = 0;                 // membership changes committed (first commit seen)
+  std::vector<double> replacement_ms;   // voter crash -> the leader's configuration has replaced it
+  int replacements_missed = 0;          // voter crashes not replaced before the next one / the end
+  std::uint64_t leader_messages = 0;    // messages sent by nodes while leading
+  int leader_burst_max = 0;             // most messages the leader sent in one step (one tick...)
 
   bool ok() const { return violations.empty(); }
 };
@@ -127,6 +154,8 @@ class ClusterSim {
   void Heal();
   Status Propose(int node, const MissionCommand& command);  // encoded
   Status Propose(int node, Bytes data);
+  // At `node` (its driver's ProposeConfChange): the change of sim node `target`.
+  Status ProposeConfChange(int node, ConfChangeOp op, int target);
   // Drops every message for which the filter returns true (e.g. all vote responses), until
   // cleared with nullptr. Applied at send time.
   using DropFilter = std::function<bool(int from, int to, const Message& m)>;
@@ -140,6 +169,8 @@ class ClusterSim {
   // The live leader with the highest term, or -1.
   int Leader() const;
   std::string Name(int node) const { return "n" + std::to_string(node + 1); }
+  // The sim node of a Raft id (ids number the sorted names: n1, n10, n100, n11, ...).
+  int NodeOf(NodeId id) const { return node_of_id_[static_cast<std::size_t>(id - 1)]; }
   NetworkModel& net() { return config_.net; }
 
   const SimReport& report() const { return report_; }
@@ -165,6 +196,10 @@ class ClusterSim {
   void ScheduleNextProposal();
   void ProposeRandom();
   void CrashLeaderNow();
+  void CrashVoterNow();
+  void ScheduleNextConfChange();
+  void RandomConfChange();
+  void CheckCommitQuorum(const RawNode& leader, const ConfState& before, std::uint64_t index, const Entry& e);
   void Violation(const std::string& property, const std::string& details);
   void OnSave(int node, const std::optional<HardState>& hs, std::span<const Entry> entries,
               const Snapshot& snapshot);
@@ -193,6 +228,7 @@ class ClusterSim {
   struct CommitFact {
     std::uint64_t term;
     std::uint64_t data_hash;
+    bool application;  // a kNormal entry (what the tap yields); no-ops and conf changes are not
   };
   std::map<std::uint64_t, NodeId> leader_of_term_;
   std::map<std::pair<std::uint64_t, std::uint64_t>, EntryFact> entries_seen_;  // (index, term)
@@ -204,6 +240,11 @@ class ClusterSim {
   std::optional<std::int64_t> leader_crash_us_;
   std::uint64_t crashed_leader_term_ = 0;
   std::uint64_t sighting_seq_ = 0;
+  std::vector<int> node_of_id_;
+  int leader_burst_ = 0;                       // messages of the current step sent by the leader
+  std::optional<std::int64_t> voter_crash_us_;  // pending replacement: when
+  NodeId crashed_voter_ = kNoNode;              //   and whom
+  std::size_t target_voters_ = 0;
 };
 
 // Builds a ClusterSim from the config, runs it for config.duration_s, returns the report.
