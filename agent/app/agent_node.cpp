@@ -224,9 +224,11 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     node->raft_ = std::move(*raft);
   }
   if (o.ping_every_ms < 0) return Error(ErrorCode::kInvalidArgument, "--ping-every-ms must be >= 0");
+  if (o.ping_peers <= 0) return Error(ErrorCode::kInvalidArgument, "--ping-peers must be > 0");
   if (node->radio_ && o.ping_every_ms > 0 && o.raft.members.size() > 1) {
     radio::LinkProbeOptions po;
     po.ping_every = std::chrono::milliseconds(o.ping_every_ms);
+    po.ping_peers = o.ping_peers;
     auto probe = radio::LinkProbe::Create(o.name, o.raft.members, po, radio::RadioTime(node->radio_->now_ns()));
     if (!probe) return probe.error().Context("starting the link probe");
     node->probe_ = std::move(*probe);
@@ -404,6 +406,9 @@ void AgentNode::OnBrainMessage(const bus::BrainMessage& message, const bus::Radi
 Status AgentNode::ServeRadioBetweenSteps() {
   frames_.clear();
   radio_->TakeReceived(bus::SensorSample{}, &frames_);  // netem: the sample is not looked at
+  if (probe_) {
+    for (const bus::RadioFrame& f : frames_) probe_->Heard(f);  // the ping sampling's order
+  }
   DispatchFrames(frames_, options_.name, *this, &dispatched_);
   if (raft_) {
     if (Status s = raft_->Step(); !s) return s.error().Context("raft stopped");
@@ -427,6 +432,9 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
   frames_.clear();
   if (radio_) {
     radio_->TakeReceived(msg, &frames_);
+    if (probe_) {
+      for (const bus::RadioFrame& f : frames_) probe_->Heard(f);  // the ping sampling's order
+    }
     DispatchFrames(frames_, options_.name, *this, &dispatched_);
   }
   // c. Flight, Raft, the link probe, the mission or plan, the state broadcast.

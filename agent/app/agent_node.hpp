@@ -107,9 +107,11 @@ struct AgentOptions {
   // brain::Brain through BrainHost (Context from name, raft.members, raft.seed, the airframe,
   // mission.world_path and mission.payload; Raft on its own state or the entry log).
   BrainOptions brain;
-  // Radio link measurement (agent/radio LinkProbe): with a radio and raft.members, ping every
-  // other member every ping_every_ms of the radio's clock and log event=link per peer; 0 = off.
+  // Radio link measurement (agent/radio LinkProbe): with a radio and raft.members, every
+  // ping_every_ms of the radio's clock ping ping_peers other members (round-robin, those heard in
+  // the last 5 s first) and log event=link per sampled peer; ping_every_ms 0 = off.
   int ping_every_ms = 200;
+  int ping_peers = 3;  // > 0
 };
 
 class AgentNode final : private FrameHandler {

@@ -34,8 +34,9 @@
 // A library that does not load, has another ABI, lacks the name (the names it has are listed) or
 // whose constructor throws exits 2 with the reason.
 // Usage errors (unknown flag, bad value, a bad combination) exit 2, as the rest of bad input.
-// With --members, the radio link is measured (agent/radio): each agent pings every other member
-// every --ping-every-ms (default 200, 0 = off) and logs event=link per peer every 2 s (radio clock).
+// With --members, the radio link is measured (agent/radio): every --ping-every-ms (default 200,
+// 0 = off) each agent pings --ping-peers (default 3) other members, round-robin, and logs
+// event=link per sampled peer every 2 s (radio clock).
 #include <CLI/CLI.hpp>
 
 #include <csignal>
@@ -102,7 +103,8 @@ int main(int argc, char** argv) {
   app.add_option("--raft-heartbeat-ms", o.raft.heartbeat_ms, "Raft: heartbeat, a multiple of the tick [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--raft-election-timeout-ms", o.raft.election_timeout_ms, "Raft: election timeout, a multiple of the tick, > heartbeat [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--propose-every-ms", o.raft.propose_every_ms, "Raft diagnostic: the leader proposes a demo mission command every N ms (0 = never)")->check(CLI::NonNegativeNumber)->capture_default_str();
-  app.add_option("--ping-every-ms", o.ping_every_ms, "Radio: ping each other member every N ms of the radio's clock (simulated with channel, wall with netem) and log event=link per peer (needs --members; 0 = off)")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--ping-every-ms", o.ping_every_ms, "Radio: every N ms of the radio's clock (simulated with channel, wall with netem) ping --ping-peers other members and log event=link per sampled peer (needs --members; 0 = off)")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--ping-peers", o.ping_peers, "Radio: members pinged per --ping-every-ms round, round-robin (those heard in the last 5 s first, by name): the probe's cost is constant in the swarm's size")->check(CLI::PositiveNumber)->capture_default_str();
   std::string mission_kind = "plan";
   app.add_option("--mission", mission_kind, "What to fly: plan (the built-in --plan) or sar (the SAR mission; needs --members and --world)")->capture_default_str();
   app.add_option("--world", o.mission.world_path, "SAR: the world file (only its geofence and home are read)");

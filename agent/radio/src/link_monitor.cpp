@@ -52,9 +52,13 @@ LinkMonitor::LinkMonitor(std::vector<std::string> peers, LinkMonitorOptions opti
       options_(options),
       state_(peers_.size()),
       next_ping_(start),
-      next_report_(start + options.report_every) {
+      next_report_(start + options.report_every),
+      cursor_(0),
+      taken_round_(peers_.size(), 0) {
   SWARMBOX_CHECK(options_.ping_every.count() > 0 && options_.timeout.count() > 0 &&
-                 options_.report_every.count() > 0);
+                 options_.report_every.count() > 0 && options_.heard_within.count() > 0);
+  std::sort(peers_.begin(), peers_.end());
+  SWARMBOX_CHECK(std::adjacent_find(peers_.begin(), peers_.end()) == peers_.end());
   // At most the pings of one window plus those carried over from the last settle in a window: the
   // RTT samples then do not reallocate in the steady state.
   const auto per_window = static_cast<std::size_t>(options_.report_every / options_.ping_every +
@@ -65,14 +69,56 @@ LinkMonitor::LinkMonitor(std::vector<std::string> peers, LinkMonitorOptions opti
   }
 }
 
+void LinkMonitor::Heard(std::string_view peer, TimePoint at) {
+  const std::optional<std::size_t> index = FindPeer(peer);
+  if (!index) return;
+  Peer& p = state_[*index];
+  if (!p.heard || at > p.heard_at) p.heard_at = at;
+  p.heard = true;
+}
+
+bool LinkMonitor::Recent(const Peer& p, TimePoint now) const {
+  return p.heard && now - p.heard_at < options_.heard_within;
+}
+
+std::optional<std::size_t> LinkMonitor::NextSampled(TimePoint now, std::size_t taken) {
+  const std::size_t n = state_.size();
+  if (taken >= n) return std::nullopt;
+  // Two passes (recent, then the others) cover every peer once: a peer not yet taken this round
+  // is found within 2 n looks.
+  for (std::size_t looked = 0; looked < 2 * n; ++looked) {
+    const std::size_t i = cursor_;
+    const int pass = pass_;
+    if (++cursor_ == n) {
+      cursor_ = 0;
+      pass_ ^= 1;
+    }
+    if (taken_round_[i] == round_) continue;
+    if (Recent(state_[i], now) == (pass == 0)) return i;
+  }
+  return std::nullopt;
+}
+
 void LinkMonitor::DuePings(TimePoint now, std::vector<PingToSend>& out) {
   if (now < next_ping_) return;
-  for (std::size_t i = 0; i < state_.size(); ++i) {
+  auto ping = [&](std::size_t i) {
     Peer& p = state_[i];
     Forget(p, now);
     const std::uint64_t seq = p.next_seq++;
     p.entries.push_back(Entry{seq, now, State::kPending});
     out.push_back(PingToSend{i, seq});
+  };
+  const std::size_t k = options_.ping_peers;
+  if (k == 0 || k >= state_.size()) {
+    for (std::size_t i = 0; i < state_.size(); ++i) ping(i);  // every peer, every round
+  } else {
+    ++round_;
+    for (std::size_t taken = 0; taken < k; ++taken) {
+      const std::optional<std::size_t> i = NextSampled(now, taken);
+      if (!i) break;
+      taken_round_[*i] = round_;
+      ping(*i);
+    }
   }
   next_ping_ += options_.ping_every;
   if (next_ping_ <= now) next_ping_ = now + options_.ping_every;
@@ -157,10 +203,10 @@ void LinkMonitor::Forget(Peer& p, TimePoint now) {
 }
 
 std::optional<std::size_t> LinkMonitor::FindPeer(std::string_view name) const {
-  for (std::size_t i = 0; i < peers_.size(); ++i) {
-    if (peers_[i] == name) return i;
-  }
-  return std::nullopt;
+  const auto it = std::lower_bound(peers_.begin(), peers_.end(), name,
+                                   [](const std::string& a, std::string_view b) { return a < b; });
+  if (it == peers_.end() || *it != name) return std::nullopt;
+  return static_cast<std::size_t>(it - peers_.begin());
 }
 
 }  // namespace swarmbox::radio

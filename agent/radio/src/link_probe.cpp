@@ -18,6 +18,10 @@ Result<std::unique_ptr<LinkProbe>> LinkProbe::Create(std::string self, std::vect
                      std::to_string(options.timeout.count()) + " ms, " +
                      std::to_string(options.report_every.count()) + " ms)");
   }
+  if (options.ping_peers <= 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "link probe: ping_peers must be positive (got " + std::to_string(options.ping_peers) + ")");
+  }
   std::vector<std::string> unique;
   for (std::string& p : peers) {
     if (auto s = bus::ValidateDroneName(p); !s) return s.error().Context("link probe: peer");
@@ -35,9 +39,10 @@ LinkProbe::LinkProbe(std::string self, std::vector<std::string> peers, LinkProbe
       monitor_(std::move(peers),
                LinkMonitorOptions{.ping_every = options.ping_every,
                                   .timeout = options.timeout,
-                                  .report_every = options.report_every},
+                                  .report_every = options.report_every,
+                                  .ping_peers = static_cast<std::size_t>(options.ping_peers)},
                start) {
-  due_.reserve(monitor_.peers().size());
+  due_.reserve(std::min(monitor_.peers().size(), static_cast<std::size_t>(options.ping_peers)));
   out_.ping_msg.resize(1);
   out_.ping_msg[0].from = self_;
 }

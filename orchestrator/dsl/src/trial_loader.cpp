@@ -146,11 +146,14 @@ Status DecodeLimits(const Node& node, ContainerLimits* out) {
   return Ok{};
 }
 
-// `radio: {model: channel|netem, profile: NAME|PATH, ping_every_ms: N}`.
+// `radio: {model: channel|netem, profile: NAME|PATH, ping_every_ms: N, ping_peers: K}`.
 Status DecodeRadio(const Node& node, RadioLinkSpec* out) {
   std::string model(RadioModelName(out->model));
   yaml::MapReader r(node, "radio");
-  r.Optional("model", &model).Optional("profile", &out->profile).Optional("ping_every_ms", &out->ping_every_ms);
+  r.Optional("model", &model)
+      .Optional("profile", &out->profile)
+      .Optional("ping_every_ms", &out->ping_every_ms)
+      .Optional("ping_peers", &out->ping_peers);
   SWARMBOX_TRY(r.Finish());
   if (model == "channel") {
     out->model = RadioModel::kChannel;
@@ -171,6 +174,9 @@ Status DecodeRadio(const Node& node, RadioLinkSpec* out) {
   }
   if (out->ping_every_ms < 0) {
     return At(*node.Find("ping_every_ms"), "'ping_every_ms' must be >= 0 (0 = no link pings)");
+  }
+  if (out->ping_peers < 1) {
+    return At(*node.Find("ping_peers"), "'ping_peers' must be >= 1 (peers pinged per ping_every_ms round)");
   }
   return Ok{};
 }

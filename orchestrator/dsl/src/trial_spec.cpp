@@ -229,6 +229,7 @@ yaml::Node ToDocument(const TrialSpec& spec) {
   // The default profile is left implied (a profile written out is checked where it is written).
   if (spec.radio.profile != kDefaultRadioProfile) radio.Set("profile", Str(spec.radio.profile));
   radio.Set("ping_every_ms", Plain(std::to_string(spec.radio.ping_every_ms)));
+  radio.Set("ping_peers", Plain(std::to_string(spec.radio.ping_peers)));
   doc.Set("radio", std::move(radio));
   if (!spec.mesh_node.is_null()) {
     Node network = Node::Mapping();

@@ -142,8 +142,9 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
       "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
   });
-  // The radio link measurement (event=link per peer).
-  argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms)});
+  // The radio link measurement (event=link per sampled peer).
+  argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms),
+                           "--ping-peers", std::to_string(spec.radio.ping_peers)});
   // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
   argv.insert(argv.end(), {"--raft-dir", std::string(kAgentStateDir) + "/raft"});
   const dsl::BrainSpec& brain = d.brain;

@@ -66,6 +66,74 @@ TEST(LinkMonitor, PingsEveryPeerOncePerPeriodWithoutBursts) {
   EXPECT_EQ(out.size(), 2u);
 }
 
+// Names of the pings in `out` (peers() is sorted by name).
+std::vector<std::string> Pinged(const LinkMonitor& m, const std::vector<PingToSend>& out) {
+  std::vector<std::string> names;
+  for (const PingToSend& p : out) names.push_back(m.peers()[p.peer]);
+  return names;
+}
+
+TEST(LinkMonitor, KeepsPeersSortedByName) {
+  LinkMonitor m({"scout_2", "lifter", "scout_10", "scout_1"}, Opts(200ms, 1000ms, 2000ms), kStart);
+  EXPECT_EQ(m.peers(), (std::vector<std::string>{"lifter", "scout_1", "scout_10", "scout_2"}));
+  std::vector<PingToSend> out;
+  m.DuePings(kStart, out);  // ping_peers 0: every peer, in that order
+  EXPECT_EQ(Pinged(m, out), m.peers());
+}
+
+TEST(LinkMonitor, SamplesPingPeersPerRoundRoundRobinHeardFirst) {
+  // Given six peers, two pings per round, and c, e heard within the last 5 s, a heard long ago.
+  LinkMonitorOptions o = Opts(200ms, 1000ms, 2000ms);
+  o.ping_peers = 2;
+  LinkMonitor m({"f", "e", "d", "c", "b", "a"}, o, kStart);
+  m.Heard("a", kStart - 6s);
+  m.Heard("c", kStart - 1s);
+  m.Heard("e", kStart - 3500ms);
+  m.Heard("stranger", kStart);  // not a peer: ignored
+  // Then one cycle is the heard peers by name, then the others by name, two per round.
+  std::vector<std::string> order;
+  for (int round = 0; round < 6; ++round) {
+    std::vector<PingToSend> out;
+    m.DuePings(kStart + round * 200ms, out);
+    ASSERT_EQ(out.size(), 2u) << round;
+    for (const std::string& n : Pinged(m, out)) order.push_back(n);
+  }
+  // Round 0: c, e (heard); 1: a, b (a silent 6 s: the others' pass); 2: d, f; then again (at
+  // kStart + 1 s e was heard 4.5 s ago: still recent).
+  EXPECT_EQ(order, (std::vector<std::string>{"c", "e", "a", "b", "d", "f", "c", "e", "a", "b", "d", "f"}));
+  // Every peer's seq counts only its own pings.
+  std::vector<PingToSend> out;
+  m.DuePings(kStart + 1600ms, out);
+  EXPECT_EQ(out, (std::vector<PingToSend>{{2, 3}, {0, 3}}));  // e has aged out (5.1 s): c, then a
+}
+
+TEST(LinkMonitor, SamplingTakesNoPeerTwiceInARound) {
+  // Fewer peers in the cycle's remainder than ping_peers: the round wraps into the next pass
+  // without repeating a peer, and never sends more pings than peers.
+  LinkMonitorOptions o = Opts(100ms, 1000ms, 2000ms);
+  o.ping_peers = 2;
+  LinkMonitor m({"a", "b", "c"}, o, kStart);
+  m.Heard("b", kStart);
+  std::size_t pings = 0;
+  for (int round = 0; round < 30; ++round) {
+    std::vector<PingToSend> out;
+    m.DuePings(kStart + round * 100ms, out);
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_NE(out[0].peer, out[1].peer) << round;
+    pings += out.size();
+  }
+  EXPECT_EQ(pings, 60u);
+}
+
+TEST(LinkMonitor, PingPeersAtLeastThePeerCountPingsEveryPeerEveryRound) {
+  LinkMonitorOptions o = Opts(200ms, 1000ms, 2000ms);
+  o.ping_peers = 3;
+  LinkMonitor m({"c", "b", "d"}, o, kStart);
+  std::vector<PingToSend> out;
+  m.DuePings(kStart, out);
+  EXPECT_EQ(out, (std::vector<PingToSend>{{0, 1}, {1, 1}, {2, 1}}));
+}
+
 TEST(LinkMonitor, MatchesPongsBySeqAndReportsRtt) {
   LinkMonitor m({"b"}, Opts(100ms, 1000ms, 1000ms), kStart);
   std::vector<PingToSend> out;

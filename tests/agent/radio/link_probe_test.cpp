@@ -172,6 +172,47 @@ TEST(LinkProbe, PingsEveryPeerOnTheRadiosClock) {
   EXPECT_TRUE(lines.empty());
 }
 
+TEST(LinkProbe, PingsPingPeersPerRoundWhateverTheSwarmsSize) {
+  // 100 members, 3 pings per round: 5 rounds a second cost 15 pings whatever the size; the peers
+  // heard (any frame, here a state) come first.
+  std::vector<std::string> members;
+  for (int i = 1; i <= 100; ++i) members.push_back("scout_" + std::to_string(i));
+  auto probe = std::move(*LinkProbe::Create("scout_1", members, {.ping_every = 200ms, .ping_peers = 3}, RadioTime(0)));
+  bus::RadioFrame state;
+  state.from = "scout_42";
+  state.state_msg.resize(1);
+  probe->Heard(state);
+  RecordingRadio radio;
+  std::vector<LogEvent> lines;
+  for (std::int64_t t = 0; t < 1'000'000'000; t += kStepNs) probe->Step(RadioTime(t), 0.0, radio, &lines);
+  ASSERT_EQ(radio.sent.size(), 15u);
+  EXPECT_EQ(radio.sent[0].to, "scout_42");
+  EXPECT_EQ(radio.sent[1].to, "scout_10");  // then the others by name: scout_10 < scout_100 < scout_11
+  EXPECT_EQ(radio.sent[2].to, "scout_100");
+  EXPECT_EQ(probe->counters().pings_sent, 15u);
+}
+
+TEST(LinkProbe, ReportsOnlyTheSampledPeers) {
+  // A pinged peer that never answers gets loss=1 lines; a peer never pinged in a window, none.
+  auto probe = std::move(*LinkProbe::Create("a", {"a", "b", "c", "d"}, {.ping_every = 1000ms, .ping_peers = 1},
+                                            RadioTime(0)));
+  RecordingRadio radio;
+  std::vector<LogEvent> lines;
+  for (std::int64_t t = 0; t <= 4'000'000'000; t += kStepNs) probe->Step(RadioTime(t), 0.0, radio, &lines);
+  // Rounds at 0, 1, 2, 3, 4 s: b, c, d, b, c. Window (0, 2 s]: b settled lost at 1 s, c at 2 s;
+  // window (2, 4 s]: d and b.
+  ASSERT_EQ(radio.sent.size(), 5u);
+  std::vector<std::string> peers;
+  for (const LogEvent& l : lines) {
+    auto parsed = ParseLinkLine(l.str());
+    ASSERT_TRUE(parsed) << l.str();
+    EXPECT_EQ(parsed->sent, 1u) << l.str();
+    EXPECT_EQ(parsed->received, 0u) << l.str();
+    peers.push_back(parsed->peer);
+  }
+  EXPECT_EQ(peers, (std::vector<std::string>{"b", "c", "b", "d"}));
+}
+
 TEST(LinkProbe, RefusesBadArguments) {
   auto none = LinkProbe::Create("a", {"a"}, {}, RadioTime(0));
   ASSERT_FALSE(none);
@@ -182,6 +223,9 @@ TEST(LinkProbe, RefusesBadArguments) {
   auto zero = LinkProbe::Create("a", {"b"}, {.ping_every = 0ms}, RadioTime(0));
   ASSERT_FALSE(zero);
   EXPECT_NE(zero.error().ToString().find("must be positive"), std::string::npos);
+  auto no_peers = LinkProbe::Create("a", {"b"}, {.ping_peers = 0}, RadioTime(0));
+  ASSERT_FALSE(no_peers);
+  EXPECT_NE(no_peers.error().ToString().find("ping_peers must be positive"), std::string::npos);
 }
 
 }  // namespace

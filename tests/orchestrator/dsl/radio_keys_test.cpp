@@ -48,6 +48,19 @@ TEST(RadioKeys, DefaultIsTheChannelWithTheWifiMeshProfile) {
   EXPECT_EQ(spec->radio.profile, "wifi_5ghz_mesh");
   EXPECT_EQ(RadioProfileFile(spec->radio), "radios/wifi_5ghz_mesh.yaml");
   EXPECT_EQ(spec->radio.ping_every_ms, 200);
+  EXPECT_EQ(spec->radio.ping_peers, 3);
+}
+
+TEST(RadioKeys, PingPeersIsReadSetAndKeptInTheResolvedDocument) {
+  auto spec = LoadTrialText(With("ping_every_ms: 250", "ping_every_ms: 1000, ping_peers: 1"), "radio.yaml", Opts());
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  EXPECT_EQ(spec->radio.ping_peers, 1);
+  auto set = LoadTrialText(kTrial, "radio.yaml", Opts({"radio.ping_peers=5"}));
+  ASSERT_TRUE(set) << set.error().ToString();
+  EXPECT_EQ(set->radio.ping_peers, 5);
+  auto again = LoadTrialText(yaml::Emit(ToDocument(*set)), "again.yaml", Opts());
+  ASSERT_TRUE(again) << again.error().ToString();
+  EXPECT_EQ(again->radio.ping_peers, 5);
 }
 
 TEST(RadioKeys, AProfileNameResolvesUnderRadiosAndAPathUnderTheTrialsDirectory) {
@@ -87,6 +100,7 @@ TEST(RadioKeys, BadValuesFailAtFileLineColumnWithTheReason) {
       {"profile: telemetry_900mhz", "profile: ../radio.yaml", "radio.yaml:7:34",
        "inside the trials directory"},
       {"ping_every_ms: 250", "ping_every: 250", "radio.yaml:7:52", "unknown key 'ping_every' in radio"},
+      {"ping_every_ms: 250", "ping_every_ms: 250, ping_peers: 0", "radio.yaml:7:84", "'ping_peers' must be >= 1"},
   };
   for (const Case& c : cases) {
     auto spec = LoadTrialText(With(c.find, c.replace), "radio.yaml", Opts());

@@ -141,6 +141,7 @@ TEST_F(PlanTest, AgentsGetTheRaftMembersSeedTimingsAndTheirMission) {
   EXPECT_EQ(value_of("--world"), "<absent>");  // the agent refuses --world/--payload with plan
   EXPECT_EQ(value_of("--payload"), "<absent>");
   EXPECT_EQ(value_of("--ping-every-ms"), "200");  // radio: the default
+  EXPECT_EQ(value_of("--ping-peers"), "3");
   EXPECT_EQ(value_of("--sim-interface"), "eth0");
   EXPECT_EQ(value_of("--mesh-interface"), "eth1");
 }

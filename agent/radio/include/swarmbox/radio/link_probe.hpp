@@ -1,11 +1,14 @@
 // LinkProbe: what the radio actually does, measured by every agent over its MeshRadio (whichever
-// model: channel or netem). It pings each peer every `ping_every` of the radio's clock, answers
-// the pings addressed to it, matches pongs by (peer, seq) in a LinkMonitor (link_monitor.hpp) and
-// returns per peer per report window an `event=link` line (link_event.hpp).
+// model: channel or netem). Every `ping_every` of the radio's clock it pings `ping_peers` of its
+// peers, round-robin (those heard in the last 5 s first, by name, then the others: LinkMonitor's
+// "Sampling"), so its cost is constant in the swarm's size; it answers the pings addressed to it,
+// matches pongs by (peer, seq) in a LinkMonitor (link_monitor.hpp) and returns per sampled peer
+// per report window an `event=link` line (link_event.hpp).
 //
 //   auto probe = LinkProbe::Create("scout_1", {"scout_1", "scout_2", "scout_3"},
-//                                  {.ping_every = 200ms}, RadioTime(radio.now_ns()));
+//                                  {.ping_every = 200ms, .ping_peers = 3}, RadioTime(radio.now_ns()));
 //   // every lockstep step, after radio.TakeReceived(sample, &frames):
+//   for (const bus::RadioFrame& f : frames) probe->Heard(f);                  // the sampling order
 //   for (const bus::RadioFrame& f : frames) if (!f.ping_msg.empty()) probe->OnFrame(f, radio);
 //   probe->Step(RadioTime(radio.now_ns()), sim_t_s, radio, &lines);   // due pings, reports
 //
@@ -42,9 +45,10 @@ namespace swarmbox::radio {
 inline TimePoint RadioTime(std::int64_t ns) { return TimePoint(std::chrono::nanoseconds(ns)); }
 
 struct LinkProbeOptions {
-  std::chrono::milliseconds ping_every{200};     // per peer, radio clock (--ping-every-ms), > 0
+  std::chrono::milliseconds ping_every{200};     // one round of pings, radio clock (--ping-every-ms), > 0
   std::chrono::milliseconds timeout{1000};       // a ping unanswered this long is lost, > 0
   std::chrono::milliseconds report_every{2000};  // one event=link line per peer per window, > 0
+  int ping_peers = 3;                            // peers per round (--ping-peers), > 0
 };
 
 class LinkProbe {
@@ -59,6 +63,7 @@ class LinkProbe {
   // `peers` may contain `self` (the trial's member list): it is dropped, as are repeats.
   // kInvalidArgument for a bad drone name (bus::ValidateDroneName), a non-positive option or no
   // peer left. The first pings are due at `start`, the first report one window later.
+  // peers() is sorted by name.
   static Result<std::unique_ptr<LinkProbe>> Create(std::string self, std::vector<std::string> peers,
                                                    LinkProbeOptions options, TimePoint start);
 
@@ -66,6 +71,9 @@ class LinkProbe {
   // us is answered at once through `radio` (Send); a pong goes to the monitor, received at the
   // frame's delivered_ns.
   void OnFrame(const bus::RadioFrame& frame, MeshRadio& radio);
+  // Any frame the radio delivered (state, Raft, ping, ...): its sender counts as heard at the
+  // frame's delivered_ns, for the sampling order. O(log peers), no allocation.
+  void Heard(const bus::RadioFrame& frame) { monitor_.Heard(frame.from, RadioTime(frame.delivered_ns)); }
   // At `now` (the radio's clock): sends the due pings through `radio` and, when a report window
   // ended, appends its link lines stamped with `sim_t_s` to `lines` (peers with nothing settled
   // get none). Allocates only when a window ends.

@@ -107,14 +107,16 @@ struct RaftSpec {
 //   model netem    the real stack over the `mesh` Docker network, impaired from fault sidecars,
 //                  on the wall clock (meaningful at rtf 1 only).
 // `profile`: the channel's radio profile, a name (trials/radios/<NAME>.yaml) or a path relative to
-// the trials directory ending in .yaml (RadioProfileFile). Each agent pings every peer every
-// ping_every_ms (0 = off; simulated ms with channel, wall ms with netem) and logs event=link lines.
+// the trials directory ending in .yaml (RadioProfileFile). Every ping_every_ms (0 = off; simulated
+// ms with channel, wall ms with netem) each agent pings ping_peers (>= 1) of its peers, round-robin
+// (agent/radio LinkProbe), and logs event=link lines per sampled peer.
 enum class RadioModel { kChannel, kNetem };
 std::string_view RadioModelName(RadioModel model);  // "channel", "netem"
 inline constexpr std::string_view kDefaultRadioProfile = "wifi_5ghz_mesh";
 
 struct RadioLinkSpec {
   int ping_every_ms = 200;
+  int ping_peers = 3;
   RadioModel model = RadioModel::kChannel;
   std::string profile = std::string(kDefaultRadioProfile);
 };
