@@ -76,7 +76,10 @@ std::string EncodeMissionMode(Role role, std::string_view mode) {
   return std::string(swarm::RoleName(role)) + "/" + std::string(mode);
 }
 
-bool DecodeMissionMode(std::string_view text, Role* role, std::string* mode) {
+namespace {
+
+// DecodeMissionMode without a copy of the mode.
+bool SplitMissionMode(std::string_view text, Role* role, std::string_view* mode) {
   const std::size_t slash = text.find('/');
   if (slash == std::string_view::npos || slash + 1 >= text.size()) return false;
   const std::string_view r = text.substr(0, slash);
@@ -87,7 +90,51 @@ bool DecodeMissionMode(std::string_view text, Role* role, std::string* mode) {
   } else {
     return false;
   }
-  *mode = std::string(text.substr(slash + 1));
+  *mode = text.substr(slash + 1);
+  return true;
+}
+
+}  // namespace
+
+bool DecodeMissionMode(std::string_view text, Role* role, std::string* mode) {
+  std::string_view m;
+  if (!SplitMissionMode(text, role, &m)) return false;
+  *mode = std::string(m);
+  return true;
+}
+
+std::string EncodeStatusMessage(std::int64_t t_ns, std::string_view status, double x_m, double y_m) {
+  char xy[64];
+  std::snprintf(xy, sizeof xy, " %.2f %.2f", x_m, y_m);
+  return std::to_string(t_ns) + " " + std::string(status) + xy;
+}
+
+bool DecodeStatusMessage(std::string_view payload, std::int64_t* t_ns, std::string* status, double* x_m,
+                         double* y_m) {
+  // Four fields separated by single spaces; numbers parsed whole (from_chars), nothing after.
+  std::array<std::string_view, 4> f;
+  std::size_t from = 0;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    const std::size_t sp = i + 1 < f.size() ? payload.find(' ', from) : payload.size();
+    if (sp == std::string_view::npos || sp == from) return false;
+    f[i] = payload.substr(from, sp - from);
+    from = sp + 1;
+  }
+  if (f[3].find(' ') != std::string_view::npos) return false;
+  const auto whole = [](std::string_view text, auto* v) {
+    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), *v);
+    return ec == std::errc() && end == text.data() + text.size();
+  };
+  double x = 0, y = 0;
+  std::int64_t t = 0;
+  if (!whole(f[0], &t) || !whole(f[2], &x) || !whole(f[3], &y) || !std::isfinite(x) || !std::isfinite(y)) return false;
+  Role role;
+  std::string_view mode;
+  if (!SplitMissionMode(f[1], &role, &mode)) return false;
+  *t_ns = t;
+  status->assign(f[1]);
+  *x_m = x;
+  *y_m = y;
   return true;
 }
 
@@ -148,12 +195,14 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
       {"member_min_wall_s", &t.member_min_wall_s},
       {"assignment_settle_s", &t.assignment_settle_s},
       {"sighting_dedupe_m", &t.sighting_dedupe_m},
+      {"status_every_s", &t.status_every_s},
       {"load_check_climb_m", &t.load_check_climb_m},
       {"load_check_delay_s", &t.load_check_delay_s},
       {"load_check_fraction", &t.load_check_fraction},
   };
   for (const auto& [key, value] : tuning) SWARMBOX_TRY(ArgNumber(ctx, key, value));
   if (!(t.mission_dt_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg mission_dt_s must be > 0");
+  if (!(t.status_every_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg status_every_s must be > 0");
   if (!c.payload.empty()) {
     auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
                            [&](const flight::SlungPayload& p) { return p.name == c.payload; });
@@ -270,67 +319,74 @@ SarBrain::SarBrain(const SarBrainConfig& config, swarm::BatteryModel battery,
       role_(config.payload.empty() ? Role::kScout : Role::kLifter),
       battery_(std::move(battery)),
       flock_(FlockParams(config.tuning), swarm::Geofence::Centered(config.geofence_size_x_m, config.geofence_size_y_m)),
-      mode_(EncodeMissionMode(role_, "on_ground")) {
+      mode_(EncodeMissionMode(role_, "on_ground")),
+      members_(config_.members, config_.name) {
   neighbours_.reserve(config_.members.size());
+  // The periodic status messages of the members spread over the period (by place in the member
+  // list), not all in the same step.
+  const auto at = std::find(config_.members.begin(), config_.members.end(), config_.name);
+  const auto n = static_cast<double>(std::max<std::size_t>(1, config_.members.size()));
+  status_due_s_ = config_.tuning.status_every_s * static_cast<double>(at - config_.members.begin()) / n;
 }
 
 std::unique_ptr<SarMissionState> SarBrain::MakeMissionState() {
   return std::make_unique<SarMissionState>(log_);
 }
 
-void SarBrain::OnNeighbour(const brain::Neighbour& n) {
-  if (n.name == config_.name) return;
-  if (std::find(config_.members.begin(), config_.members.end(), n.name) == config_.members.end()) return;
-  auto [it, fresh] = peers_.try_emplace(n.name);
-  Peer& p = it->second;
-  if (!fresh && n.t_ns < p.t_ns) return;  // an older state than the one held
-  p.mode = n.status;
-  p.position_m = V(n.position_m);
-  p.velocity_m_s = V(n.velocity_m_s);
-  p.t_ns = n.t_ns;
-  p.sim_time_s = static_cast<double>(n.t_ns) * 1e-9;
-  p.received_wall_s = std::numeric_limits<double>::quiet_NaN();
-  if (wall_ != nullptr) {
-    // netem: when this very state was taken off the radio (the side channel keeps the newest).
-    const auto h = wall_->heard.find(n.name);
-    if (h != wall_->heard.end() && h->second.t_ns == n.t_ns) p.received_wall_s = h->second.wall_s;
+void SarBrain::OnNeighbours(const Now& now, std::span<const brain::Neighbour> neighbours) {
+  neighbours_.clear();
+  for (const brain::Neighbour& n : neighbours) {
+    if (n.name == config_.name) continue;
+    Role role;
+    std::string_view mode;
+    if (!SplitMissionMode(n.status, &role, &mode)) continue;  // not a SAR agent
+    double wall_s = std::numeric_limits<double>::quiet_NaN();
+    if (wall_ != nullptr) {
+      // netem: when this very state was taken off the radio (the side channel keeps the newest).
+      const auto h = wall_->heard.find(n.name);
+      if (h != wall_->heard.end() && h->second.t_ns == n.t_ns) wall_s = h->second.wall_s;
+    }
+    const double sent_s = static_cast<double>(n.t_ns) * 1e-9;
+    if (!members_.Update(n.name, sent_s, role, mode, Eigen::Vector2d(n.position_m.x, n.position_m.y), wall_s)) continue;
+    if (n.position_m.z < home_m_.z() + 1.5) continue;  // on the ground: not in the way
+    neighbours_.push_back({V(n.position_m), V(n.velocity_m_s), std::max(0.0, now.t_s - sent_s)});
   }
 }
 
-void SarBrain::Roster(const Now& now, std::vector<swarm::RosterEntry>* out) const {
-  out->clear();
-  swarm::RosterEntry own;
-  own.name = config_.name;
-  own.position_m = now.pos_m.head<2>();
-  own.wall_age_s = 0.0;
-  if (DecodeMissionMode(mode_, &own.role, &own.mode)) out->push_back(std::move(own));
-  for (const auto& [name, p] : peers_) {
-    swarm::RosterEntry e;
-    e.name = name;
-    // Age on the shared simulated clock (lockstep): see leader_planner.hpp for the timeout.
-    e.age_s = std::max(0.0, now.t_s - p.sim_time_s);
-    // And, netem only, on the wall clock since it was received (infinite without: the simulated
-    // age alone decides), so that a radio delay at rtf 0 is not taken for silence.
-    const double wall_age_s = now.wall_s - p.received_wall_s;
-    if (std::isfinite(wall_age_s)) e.wall_age_s = std::max(0.0, wall_age_s);
-    e.position_m = p.position_m.head<2>();
-    if (DecodeMissionMode(p.mode, &e.role, &e.mode)) out->push_back(std::move(e));
+void SarBrain::OnStatus(const Now& now, const brain::Message& m) {
+  std::int64_t t_ns = 0;
+  double x = 0, y = 0;
+  if (!DecodeStatusMessage(std::string_view(reinterpret_cast<const char*>(m.payload.data()), m.payload.size()), &t_ns,
+                           &status_scratch_, &x, &y)) {
+    return;
   }
+  Role role;
+  std::string_view mode;
+  (void)SplitMissionMode(status_scratch_, &role, &mode);  // DecodeStatusMessage checked it
+  // netem: received between the previous Step and this one (wall_->now_s is this Step's).
+  members_.Update(m.from, static_cast<double>(t_ns) * 1e-9, role, mode, Eigen::Vector2d(x, y),
+                  wall_ != nullptr ? now.wall_s : std::numeric_limits<double>::quiet_NaN());
+}
+
+void SarBrain::SendStatus(const Now& now, brain::Output& out) {
+  if (mode_ == sent_status_ && now.t_s < status_due_s_) return;
+  sent_status_ = mode_;
+  // The periodic ones keep their phase (spread over the members); a change goes out at once.
+  while (status_due_s_ <= now.t_s) status_due_s_ += config_.tuning.status_every_s;
+  const std::string text = EncodeStatusMessage(static_cast<std::int64_t>(std::llround(now.t_s * 1e9)), mode_,
+                                               now.pos_m.x(), now.pos_m.y());
+  brain::Message msg;
+  msg.topic = std::string(kStatusTopic);  // to "" = broadcast: every member keeps its table (a new leader too)
+  msg.payload.assign(text.begin(), text.end());
+  out.messages.push_back(std::move(msg));
 }
 
 void SarBrain::Start(const Now& now, brain::Output& out) {
   if (now.flight_mode == "init" || now.flight_mode.empty()) return;  // the estimator is not ready
   // Wait (up to 10 s) until every member was heard, so roles are known (lifter present or not).
-  std::size_t heard = 0;
-  bool lifter_present = role_ == Role::kLifter;
-  for (const auto& [name, p] : peers_) {
-    Role r;
-    std::string m;
-    if (DecodeMissionMode(p.mode, &r, &m)) {
-      ++heard;
-      lifter_present = lifter_present || r == Role::kLifter;
-    }
-  }
+  const bool lifter_present = role_ == Role::kLifter || members_.lifter_heard();
+  std::size_t heard = members_.heard();
+  if (members_.Find(config_.name) != nullptr) --heard;  // this drone (UpdateSelf) is not a peer
   if (heard + 1 < config_.members.size() && now.t_s < 10.0) return;
   home_m_ = config_.has_home ? config_.home_m : Vec3(now.pos_m - Vec3(0, 0, config_.base_height_m));
   const MissionTuning& t = config_.tuning;
@@ -410,7 +466,14 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
   now.is_leader = in.is_leader;
   for (const brain::FlightEvent& e : in.flight_events) now.hover_event = now.hover_event || e.name == "hover";
   now.mass_estimate_kg = in.self.mass_estimate_kg;
-  for (const brain::Neighbour& n : in.neighbours) OnNeighbour(n);
+  for (const brain::Message& m : in.messages) {
+    if (m.topic == kStatusTopic && m.from != config_.name) OnStatus(now, m);
+  }
+  // The neighbours once per mission tick (every Step until the mission starts): the host keeps
+  // the latest state of each, so nothing is missed, and the work per Step stays bounded.
+  const bool started = scout_ || lifter_;
+  const bool tick = now.t_s >= next_tick_s_;
+  if (!started || tick) OnNeighbours(now, in.neighbours);
   if (role_ == Role::kScout) {
     for (const brain::Detection& d : in.detections) {
       swarm::GroundDetection g;
@@ -423,9 +486,9 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
   }
 
   battery_.Step(config_.period_s, now.vel_mps, payload_mass_kg(), !now.on_ground);
-  if (!scout_ && !lifter_) Start(now, out);
+  if (!started) Start(now, out);
   if (scout_ || lifter_) {
-    if (now.t_s >= next_tick_s_) {
+    if (tick || !started) {
       next_tick_s_ = now.t_s + config_.tuning.mission_dt_s;
       if (role_ == Role::kLifter) CheckLoad(now, out);
       RunBehaviour(now, out);
@@ -440,6 +503,7 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
                                             .Add("rescued", rescued)));
     }
   }
+  SendStatus(now, out);
   out.status = mode_;
 }
 
@@ -468,9 +532,9 @@ void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
   Drive(now, behaviour_out_.setpoint, out);
 
   leader_->Track(now.t_s, *now.mission, now.wall_s);  // every drone: a new leader knows when sectors changed
+  members_.UpdateSelf(now.t_s, role_, behaviour_out_.mode, now.pos_m.head<2>());
   if (now.is_leader) {
-    std::vector<swarm::RosterEntry> roster;
-    Roster(now, &roster);
+    const std::span<const swarm::RosterEntry> roster = members_.Roster(now.t_s, now.wall_s);
     const bool everyone = roster.size() == config_.members.size();
     if (everyone || now.mission->phase() != raft::MissionPhase::kIdle || now.t_s >= config_.tuning.leader_start_timeout_s) {
       swarm::MissionOutput lead;
@@ -544,12 +608,6 @@ void SarBrain::Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Ou
       break;
     case SetpointKind::kFlock: {
       if (now.on_ground) break;
-      neighbours_.clear();
-      for (const auto& [name, p] : peers_) {
-        const double age = std::max(0.0, now.t_s - p.sim_time_s);
-        if (p.position_m.z() < home_m_.z() + 1.5) continue;  // on the ground: not in the way
-        neighbours_.push_back({p.position_m, p.velocity_m_s, age});
-      }
       if (changed) flock_.Reset(now.vel_mps);
       swarm::FlockingInput fi;
       fi.position_m = now.pos_m;

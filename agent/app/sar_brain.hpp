@@ -9,8 +9,12 @@
 // What it does with the Input:
 //   - its ReplicatedState is the committed mission (SarMissionState: raft::MissionState behind
 //     raft::MissionStateMachine; entries are encoded raft::MissionCommands, its proposals too);
-//   - neighbours: flocking, and the leader's roster from each one's status "<role>/<mode>"
-//     (e.g. "scout/searching", "lifter/on_ground"; its own Output::status likewise);
+//   - neighbours (the host's nearest few, read once per mission tick): flocking, and the member
+//     table from each one's status "<role>/<mode>" (e.g. "scout/searching", "lifter/on_ground";
+//     its own Output::status likewise);
+//   - messages on kStatusTopic: every member broadcasts its status on each change and every
+//     status_every_s (1 s), so the leader's member table (swarm::MemberTable, O(1) per message)
+//     holds every drone of a 100-drone swarm, not only the nearest the host hands it;
 //   - is_leader: LeaderPlanner on the leader (Track on every drone);
 //   - detections (the agent's PerceptionHost): sightings to report, scouts only;
 //   - flight events (`hover`) and the flight mode: take-off, climb, landing;
@@ -56,6 +60,7 @@
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/raft/mission_state.hpp"
 #include "swarmbox/raft/state_machine.hpp"
+#include "swarmbox/swarm/member_table.hpp"
 #include "swarmbox/swarm/swarm.hpp"
 
 namespace swarmbox::agent {
@@ -68,6 +73,14 @@ struct GroundPayload {
   double half_height_m = 0.0;
 };
 Result<GroundPayload> LoadGroundPayload(const std::string& airframe_path, const std::string& payload);
+
+// The brain message every SAR member broadcasts with its status (SarBrain::Step): payload
+// "<t_ns> <role>/<mode> <x> <y>" (the sender's simulated time, its status as Output::status, its
+// position [m, ENU, 2 decimals]), ~45 bytes.
+inline constexpr std::string_view kStatusTopic = "sar/status";
+std::string EncodeStatusMessage(std::int64_t t_ns, std::string_view status, double x_m, double y_m);
+// false for anything else.
+bool DecodeStatusMessage(std::string_view payload, std::int64_t* t_ns, std::string* status, double* x_m, double* y_m);
 
 // "<role>/<mode>" for Output::status (DroneState::mode), and back. Decode is false for anything
 // else (the flight modes a --mission plan agent publishes, another brain's status, garbage).
@@ -96,6 +109,10 @@ struct MissionTuning {
   double member_min_wall_s = 3.0;
   double assignment_settle_s = 10.0;
   double sighting_dedupe_m = 10.0;      // a sighting this close to a known victim is that victim
+  // Every member sends its status (kStatusTopic) on each change and at least this often, so the
+  // leader knows drones outside the neighbours the host hands it: 6 chances per member_timeout_s
+  // (0.05^6 at 5% loss) for 1 frame/s per drone [s].
+  double status_every_s = 1.0;
   // Load check (lifter): once lifted (attach height + load_check_climb_m) and load_check_delay_s
   // after an attach, the flight stack's mass estimate must show at least load_check_fraction of
   // the attached mass, or the hook is taken to be empty (event=payload_missing).
@@ -188,14 +205,6 @@ class SarBrain final : public brain::Brain {
   bool complete() const { return complete_logged_; }
 
  private:
-  struct Peer {
-    std::string mode;
-    flight::Vec3 position_m = flight::Vec3::Zero();
-    flight::Vec3 velocity_m_s = flight::Vec3::Zero();
-    double sim_time_s = 0.0;
-    std::int64_t t_ns = 0;
-    double received_wall_s = std::numeric_limits<double>::quiet_NaN();
-  };
   // What one Step knows, in the behaviours' types.
   struct Now {
     double t_s = 0.0;
@@ -213,13 +222,16 @@ class SarBrain final : public brain::Brain {
 
   SarBrain(const SarBrainConfig& config, swarm::BatteryModel battery, std::function<void(const brain::Event&)> log,
            const NetemWallClock* wall);
-  void OnNeighbour(const brain::Neighbour& n);
+  // The neighbours of this Input (at most the host's nearest few): the member table and the
+  // flocking neighbours. Once per mission tick (and every Step until the mission starts).
+  void OnNeighbours(const Now& now, std::span<const brain::Neighbour> neighbours);
+  void OnStatus(const Now& now, const brain::Message& m);  // a kStatusTopic message: O(1)
+  void SendStatus(const Now& now, brain::Output& out);     // on a change and every status_every_s
   void Start(const Now& now, brain::Output& out);  // builds the behaviour once the estimator is ready
   void RunBehaviour(const Now& now, brain::Output& out);
   void Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Output& out);
   void Apply(const swarm::PayloadRequest& p, brain::Output& out);
   void CheckLoad(const Now& now, brain::Output& out);
-  void Roster(const Now& now, std::vector<swarm::RosterEntry>* out) const;
 
   SarBrainConfig config_;
   std::function<void(const brain::Event&)> log_;
@@ -233,8 +245,13 @@ class SarBrain final : public brain::Brain {
   flight::Vec3 home_m_ = flight::Vec3::Zero();
   std::string mode_;
 
-  std::map<std::string, Peer> peers_;
-  std::vector<swarm::NeighbourState> neighbours_;
+  // Every member's latest word (its DroneState when near, its status message otherwise): the
+  // leader's roster. Updated per message, O(1) each.
+  swarm::MemberTable members_;
+  std::vector<swarm::NeighbourState> neighbours_;  // this tick's flocking neighbours (airborne)
+  std::string sent_status_;                         // the status last sent in a status message
+  std::string status_scratch_;                      // a received one, decoded (capacity kept)
+  double status_due_s_ = 0.0;                       // the next periodic one [s]
   std::vector<swarm::GroundDetection> visible_;
 
   swarm::MissionOutput behaviour_out_;

@@ -61,11 +61,21 @@ void LeaderPlanner::Track(double t_s, const raft::MissionState& m, double wall_s
   }
 }
 
-bool LeaderPlanner::GoneOwner(double t_s, const std::string& drone,
-                              std::span<const RosterEntry> roster) const {
-  for (const RosterEntry& r : roster) {
-    if (r.name == drone) return !Alive(r);
-  }
+void LeaderPlanner::Index(std::span<const RosterEntry> roster) {
+  by_name_.clear();
+  for (const RosterEntry& r : roster) by_name_.push_back(&r);
+  std::sort(by_name_.begin(), by_name_.end(),
+            [](const RosterEntry* a, const RosterEntry* b) { return a->name < b->name; });
+}
+
+const RosterEntry* LeaderPlanner::Find(const std::string& drone) const {
+  const auto it = std::lower_bound(by_name_.begin(), by_name_.end(), drone,
+                                   [](const RosterEntry* e, const std::string& n) { return e->name < n; });
+  return it != by_name_.end() && (*it)->name == drone ? *it : nullptr;
+}
+
+bool LeaderPlanner::GoneOwner(double t_s, const std::string& drone) const {
+  if (const RosterEntry* r = Find(drone)) return !Alive(*r);
   // Never heard (or not a mission agent): gone once everyone had time to be heard, on both clocks
   // (NaN wall times: no wall clock, the comparison below is false).
   return t_s - first_s_ >= config_.member_timeout_s && !(wall_s_ - first_wall_s_ < config_.member_min_wall_s);
@@ -91,7 +101,7 @@ std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raf
                                                            std::span<const RosterEntry> roster,
                                                            MissionOutput* out) const {
   std::vector<raft::Sector> keep, orphans;
-  for (const raft::Sector& s : m.sectors()) (GoneOwner(t_s, s.drone, roster) ? orphans : keep).push_back(s);
+  for (const raft::Sector& s : m.sectors()) (GoneOwner(t_s, s.drone) ? orphans : keep).push_back(s);
   if (orphans.empty()) return std::nullopt;
   struct Candidate {
     const RosterEntry* entry;
@@ -146,8 +156,10 @@ std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raf
 void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
                          std::span<const RosterEntry> roster, MissionOutput* out, double wall_s) {
   Track(t_s, m, wall_s);
+  Index(roster);
   ReportMembers(t_s, roster, out);
   std::vector<std::string> scouts;  // live ones
+  std::vector<Eigen::Vector2d> scout_xy;  // where each is
   const RosterEntry* lifter = nullptr;
   bool scouts_airborne = true;
   bool all_down = true;
@@ -159,9 +171,9 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
       continue;
     }
     scouts.push_back(r.name);
+    scout_xy.push_back(r.position_m);
     scouts_airborne = scouts_airborne && !IsOneOf(r.mode, {"on_ground", "taking_off"});
   }
-  std::sort(scouts.begin(), scouts.end());
 
   // Sectors of gone members go to live scouts first (any phase with sectors still to search).
   bool orphans = false;
@@ -176,16 +188,22 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
         for (LogEvent& e : scratch.events) out->events.push_back(std::move(e));
       }
     } else {
-      for (const raft::Sector& s : m.sectors()) orphans = orphans || GoneOwner(t_s, s.drone, roster);
+      for (const raft::Sector& s : m.sectors()) orphans = orphans || GoneOwner(t_s, s.drone);
     }
   }
   // The search is finished when every sector has a live owner that swept it (or left), every
   // live scout without a sector idles, and no hand-over is younger than the settle time.
   bool scouts_done = !orphans && t_s - sectors_changed_s_ >= config_.assignment_settle_s;
+  owners_.clear();
+  if (scouts_done) {
+    for (const raft::Sector& s : m.sectors()) owners_.push_back(&s.drone);
+    std::sort(owners_.begin(), owners_.end(), [](const std::string* a, const std::string* b) { return *a < *b; });
+  }
   for (const RosterEntry& r : roster) {
     if (!scouts_done) break;
     if (r.role != Role::kScout || !Alive(r)) continue;
-    const bool owns = m.SectorOf(r.name) != nullptr;
+    const bool owns = std::binary_search(owners_.begin(), owners_.end(), &r.name,
+                                         [](const std::string* a, const std::string* b) { return *a < *b; });
     scouts_done = ScoutDone(r.mode) || (!owns && r.mode == "awaiting_sector");
   }
 
@@ -203,7 +221,12 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
       if (!scouts.empty() && (scouts_airborne || t_s >= config_.start_timeout_s) &&
           Due("start", t_s)) {
         if (m.sectors().empty()) {
-          out->proposals.push_back(raft::AssignSectors{PartitionArea(config_.search_area, scouts)});
+          // One proposal for every scout: each gets the cell of the grid that matches its place
+          // in the swarm (PartitionOrder), so that nobody crosses another's path to its sector.
+          std::vector<std::string> ordered;
+          ordered.reserve(scouts.size());
+          for (const std::size_t i : PartitionOrder(config_.search_area, scouts, scout_xy)) ordered.push_back(scouts[i]);
+          out->proposals.push_back(raft::AssignSectors{PartitionArea(config_.search_area, ordered)});
         }
         out->proposals.push_back(raft::StartSearch{});
       }

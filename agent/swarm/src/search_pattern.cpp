@@ -23,30 +23,75 @@ double SweepSpacing(const CameraFootprint& footprint, double overlap) {
   return footprint.across_m * (1 - overlap);
 }
 
-std::vector<raft::Sector> PartitionArea(const Rect& area, std::span<const std::string> drones) {
+PartitionGrid PartitionGridFor(const Rect& area, std::size_t n) {
   SWARMBOX_CHECK(area.width_m() > 0 && area.height_m() > 0);
+  PartitionGrid g;
+  g.bands_along_y = area.width_m() >= area.height_m();
+  if (n == 0) return g;
+  const double long_m = std::max(area.width_m(), area.height_m());
+  const double short_m = std::min(area.width_m(), area.height_m());
+  const double ideal = std::sqrt(static_cast<double>(n) * short_m / long_m);
+  const std::size_t bands = std::clamp<std::size_t>(static_cast<std::size_t>(std::floor(ideal + 1e-9)), 1, n);
+  g.cells.assign(bands, n / bands);
+  for (std::size_t b = 0; b < n % bands; ++b) ++g.cells[b];
+  return g;
+}
+
+std::vector<raft::Sector> PartitionArea(const Rect& area, std::span<const std::string> drones) {
+  const PartitionGrid g = PartitionGridFor(area, drones.size());
+  // (u, w): u along the longer side (the cells of a band), w across it (the bands).
+  const double u_min = g.bands_along_y ? area.x_min_m : area.y_min_m;
+  const double u_max = g.bands_along_y ? area.x_max_m : area.y_max_m;
+  const double w_min = g.bands_along_y ? area.y_min_m : area.x_min_m;
+  const double w_max = g.bands_along_y ? area.y_max_m : area.x_max_m;
   std::vector<raft::Sector> out;
-  const auto n = static_cast<double>(drones.size());
-  const bool split_x = area.width_m() >= area.height_m();  // strips across the longer side
-  for (std::size_t i = 0; i < drones.size(); ++i) {
-    const double a = static_cast<double>(i) / n;
-    const double b = static_cast<double>(i + 1) / n;
-    raft::Sector s;
-    s.drone = drones[i];
-    if (split_x) {
-      s.x_min_m = area.x_min_m + a * area.width_m();
-      s.x_max_m = i + 1 == drones.size() ? area.x_max_m : area.x_min_m + b * area.width_m();
-      s.y_min_m = area.y_min_m;
-      s.y_max_m = area.y_max_m;
-    } else {
-      s.y_min_m = area.y_min_m + a * area.height_m();
-      s.y_max_m = i + 1 == drones.size() ? area.y_max_m : area.y_min_m + b * area.height_m();
-      s.x_min_m = area.x_min_m;
-      s.x_max_m = area.x_max_m;
+  out.reserve(drones.size());
+  std::size_t i = 0;
+  const std::size_t bands = g.cells.size();
+  for (std::size_t b = 0; b < bands; ++b) {
+    // The last band and cell end exactly on the area's edge (no rounding gap).
+    const double w0 = w_min + (w_max - w_min) * static_cast<double>(b) / static_cast<double>(bands);
+    const double w1 = b + 1 == bands ? w_max : w_min + (w_max - w_min) * static_cast<double>(b + 1) / static_cast<double>(bands);
+    const std::size_t k = g.cells[b];
+    for (std::size_t c = 0; c < k; ++c, ++i) {
+      const double u0 = u_min + (u_max - u_min) * static_cast<double>(c) / static_cast<double>(k);
+      const double u1 = c + 1 == k ? u_max : u_min + (u_max - u_min) * static_cast<double>(c + 1) / static_cast<double>(k);
+      raft::Sector s;
+      s.drone = drones[i];
+      if (g.bands_along_y) {
+        s.x_min_m = u0, s.x_max_m = u1, s.y_min_m = w0, s.y_max_m = w1;
+      } else {
+        s.x_min_m = w0, s.x_max_m = w1, s.y_min_m = u0, s.y_max_m = u1;
+      }
+      out.push_back(std::move(s));
     }
-    out.push_back(std::move(s));
   }
   return out;
+}
+
+std::vector<std::size_t> PartitionOrder(const Rect& area, std::span<const std::string> drones,
+                                        std::span<const Eigen::Vector2d> positions_m) {
+  SWARMBOX_CHECK(drones.size() == positions_m.size());
+  const PartitionGrid g = PartitionGridFor(area, drones.size());
+  const int u_axis = g.bands_along_y ? 0 : 1;
+  const int w_axis = 1 - u_axis;
+  std::vector<std::size_t> order(drones.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const auto by = [&](int axis) {
+    return [&, axis](std::size_t a, std::size_t b) {
+      const double pa = positions_m[a][axis], pb = positions_m[b][axis];
+      if (pa != pb) return pa < pb;
+      return drones[a] < drones[b];
+    };
+  };
+  std::sort(order.begin(), order.end(), by(w_axis));
+  std::size_t from = 0;
+  for (const std::size_t k : g.cells) {
+    const auto first = order.begin() + static_cast<std::ptrdiff_t>(from);
+    std::sort(first, first + static_cast<std::ptrdiff_t>(k), by(u_axis));
+    from += k;
+  }
+  return order;
 }
 
 std::vector<Waypoint> LawnmowerWaypoints(const Rect& sector, double spacing_m, double altitude_m,

@@ -121,7 +121,9 @@ class LeaderPlanner {
   std::optional<raft::AssignSectors> Reassign(double t_s, const raft::MissionState& m,
                                               std::span<const RosterEntry> roster,
                                               MissionOutput* out) const;
-  bool GoneOwner(double t_s, const std::string& drone, std::span<const RosterEntry> roster) const;
+  bool GoneOwner(double t_s, const std::string& drone) const;  // by_name_ of this Step
+  void Index(std::span<const RosterEntry> roster);              // fills by_name_
+  const RosterEntry* Find(const std::string& drone) const;      // O(log N) in by_name_
   void ReportMembers(double t_s, std::span<const RosterEntry> roster, MissionOutput* out);
 
   LeaderConfig config_;
@@ -136,6 +138,9 @@ class LeaderPlanner {
   std::vector<raft::Sector> sectors_;     // the committed list as last seen
   double sectors_changed_s_ = 0.0;        // when it last changed (or was first seen) [s]
   std::set<std::string> lost_;            // members reported lost (event=member_lost)
+  // Scratch of one Step (capacity kept): the roster by name, the sector owners by name.
+  std::vector<const RosterEntry*> by_name_;
+  std::vector<const std::string*> owners_;
 };
 
 }  // namespace swarmbox::swarm

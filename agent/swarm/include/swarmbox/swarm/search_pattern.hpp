@@ -43,10 +43,33 @@ CameraFootprint GroundFootprint(double altitude_m, double hfov_rad, int width_px
 // Lane spacing that gives `overlap` in [0, 1) side overlap between neighbouring swaths [m].
 double SweepSpacing(const CameraFootprint& footprint, double overlap);
 
-// Splits `area` into strips of equal width across its longer side, one per drone, assigned in
-// the order given (callers pass a sorted roster so that every drone computes the same plan).
-// Empty `drones` gives no sectors.
+// The grid PartitionArea cuts `area` into for `n` sectors: `bands` bands of equal width across
+// the shorter side (floor(sqrt(n * short / long)), at least 1), each cut along the longer side
+// into cells[b] cells of equal length (n / bands, the first n % bands bands one more). The cells
+// are then close to square (a lane of the sweep runs along a cell's longer side, so square cells
+// waste least at the turns), and fewer than 4 sectors per unit of aspect ratio stay strips: the
+// shipped 3-scout trials keep their strips. 100 sectors on a square: 10 x 10; 40: 6 bands of
+// 7,7,7,7,6,6.
+struct PartitionGrid {
+  bool bands_along_y = true;        // the longer side is x: bands are rows of cells along x
+  std::vector<std::size_t> cells;   // cells per band, band 0 at the low end of the shorter side
+};
+PartitionGrid PartitionGridFor(const Rect& area, std::size_t n);
+
+// Splits `area` into the cells of PartitionGridFor(area, drones.size()), assigned in the order
+// given: band by band from the low end of the shorter side, cells from the low end of the longer
+// side within a band. Callers pass a sorted roster (or one ordered by PartitionOrder) so that
+// every drone computes the same plan. Empty `drones` gives no sectors.
 std::vector<raft::Sector> PartitionArea(const Rect& area, std::span<const std::string> drones);
+
+// The order of `drones` (positions_m[i] is where drones[i] is, world ENU [m]) that hands each
+// drone the cell of PartitionArea matching its place in the swarm: sorted across the bands by the
+// shorter-side coordinate, cut into bands of PartitionGridFor's sizes, each band sorted along the
+// longer side (ties by name: the same order whoever computes it). Drones on a take-off grid then
+// fly to their cells without crossing each other's paths (the map keeps their left/right and
+// front/back order). Returns indices into `drones`.
+std::vector<std::size_t> PartitionOrder(const Rect& area, std::span<const std::string> drones,
+                                        std::span<const Eigen::Vector2d> positions_m);
 
 struct Waypoint {
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // world ENU [m]
