@@ -1,8 +1,8 @@
 // Cyclone DDS backend of the bus: C API, idlc-generated C types, converted by cyclone_convert.hpp.
 //
-// Each domain id gets one Cyclone domain per process, created with dds_create_domain() and an XML
-// configuration that binds it to the participant's interface (multicast forced on, so loopback
-// works for tests). Writers and readers each own their topic entity and hold a shared reference to
+// Each domain id gets one Cyclone domain per process, created with dds_create_domain() and the
+// XML configuration of cyclone_config.hpp (bound to the participant's interface, multicast forced
+// on so loopback works for tests, discovery and message sizes tuned for 100 participants). Writers and readers each own their topic entity and hold a shared reference to
 // the participant, so they may outlive the front-end Participant object.
 #include <dds/dds.h>
 
@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cyclone_convert.hpp"
+#include "swarmbox/bus/cyclone_config.hpp"
 #include "detail/backends.hpp"
 
 namespace swarmbox::bus::cyclone_detail {
@@ -43,15 +44,7 @@ class DomainRegistry {
       ++it->second.refs;
       return Ok{};
     }
-    const std::string xml =
-        "<CycloneDDS><Domain Id=\"any\"><General><Interfaces>"
-        "<NetworkInterface name=\"" + interface + "\" multicast=\"true\"/>"
-        "</Interfaces><AllowMulticast>true</AllowMulticast></General>" +
-        (writer_linger_ms >= 0
-             ? "<Internal><WriterLingerDuration>" + std::to_string(writer_linger_ms) + " ms</WriterLingerDuration></Internal>"
-             : std::string()) +
-        "<Tracing><Verbosity>severe</Verbosity><OutputFile>stderr</OutputFile></Tracing>"
-        "</Domain></CycloneDDS>";
+    const std::string xml = CycloneXml({.interface = interface, .writer_linger_ms = writer_linger_ms});
     const dds_entity_t domain = dds_create_domain(static_cast<dds_domainid_t>(domain_id), xml.c_str());
     if (domain < 0) {
       return DdsError(domain, "creating domain " + std::to_string(domain_id) + " on interface '" +

@@ -12,11 +12,13 @@
 
 #include "bus_test_util.hpp"
 #include "message_samples.hpp"
+#include "swarmbox/bus/cyclone_config.hpp"
 
 namespace swarmbox::bus {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 using testing::MakeParticipant;
 
 TEST(BusParticipant, UnknownBackendNamesTheAcceptedOnes) {
@@ -214,6 +216,23 @@ TEST_P(BusApi, StateKeepsTheLatestSamplePerDrone) {
 
 INSTANTIATE_TEST_SUITE_P(Backends, BusApi, ::testing::Values("cyclonedds", "fastdds"),
                          [](const auto& param_info) { return param_info.param; });
+
+// The configuration every process (and, through the runner's CYCLONEDDS_URI, every external brain
+// and component) gives Cyclone: the tuned settings are in it, and Cyclone accepts it (every
+// cyclonedds participant of these tests is created with it).
+TEST(BusCycloneConfig, CarriesTheSettingsTheReadmeExplains) {
+  const std::string xml = CycloneXml({.interface = "eth0"});
+  EXPECT_THAT(xml, HasSubstr("<NetworkInterface name=\"eth0\" multicast=\"true\"/>"));
+  EXPECT_THAT(xml, HasSubstr("<AllowMulticast>true</AllowMulticast>"));
+  EXPECT_THAT(xml, HasSubstr("<MaxMessageSize>65000B</MaxMessageSize><FragmentSize>62000B</FragmentSize>"));
+  EXPECT_THAT(xml, HasSubstr("<ParticipantIndex>none</ParticipantIndex>"));
+  EXPECT_THAT(xml, HasSubstr("<LeaseDuration>20 s</LeaseDuration>"));
+  EXPECT_THAT(xml, HasSubstr("<SPDPInterval>10 s</SPDPInterval>"));
+  EXPECT_THAT(xml, HasSubstr("<SocketReceiveBufferSize max=\"4MiB\"/>"));
+  EXPECT_THAT(xml, Not(HasSubstr("WriterLingerDuration")));
+  EXPECT_THAT(CycloneXml({.interface = "lo", .writer_linger_ms = 0}),
+              HasSubstr("<WriterLingerDuration>0 ms</WriterLingerDuration>"));
+}
 
 }  // namespace
 }  // namespace swarmbox::bus

@@ -6,6 +6,7 @@
 #include <set>
 #include <variant>
 
+#include "swarmbox/bus/cyclone_config.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/dsl/step.hpp"
 #include "swarmbox/images/standard_images.hpp"
@@ -290,8 +291,9 @@ std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl:
 }
 
 std::string CycloneUriFor(std::string_view interface) {
-  return "<CycloneDDS><Domain Id=\"any\"><General><Interfaces><NetworkInterface name=\"" + std::string(interface) +
-         "\" multicast=\"true\"/></Interfaces><AllowMulticast>true</AllowMulticast></General></Domain></CycloneDDS>";
+  // The agents' and the physics server's own configuration (swarmbox/bus/cyclone_config.hpp), so a
+  // program the runner starts discovers and fragments as they do.
+  return bus::CycloneXml({.interface = std::string(interface)});
 }
 
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {

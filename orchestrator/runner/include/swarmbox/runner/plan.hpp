@@ -136,8 +136,9 @@ std::string BrainId(std::string_view drone);
 // The agent's argv (swarmbox-agent) and an external brain's (for tests and `swarmbox compose`).
 std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
 std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
-// The CYCLONEDDS_URI an external brain or a component on sim gets: Cyclone on `interface` with
-// multicast (what the agents' bus configures for itself from --sim-interface).
+// The CYCLONEDDS_URI an external brain or a component on sim gets: bus::CycloneXml on
+// `interface`, the configuration the agents' bus gives itself from --sim-interface (multicast,
+// discovery and message sizes tuned for 100 participants; bus/README.md).
 std::string CycloneUriFor(std::string_view interface);
 inline constexpr std::string_view kFaultsStepId = "faults";
 // The agents' interfaces in their (or their sidecar's) namespace.
