@@ -10,6 +10,9 @@
 //       [--raft-dir DIR]            WAL + snapshot; default /tmp/swarmbox-raft/<name>; reuse it
 //                                   on restart so the node rejoins with its durable log
 //       [--raft-tick-ms 50] [--raft-heartbeat-ms 100] [--raft-election-timeout-ms 500]
+//       [--raft-voters a,b,c]       the voting set (same on every drone, a subset of --members);
+//                                   the other members are learners (agent/raft/README.md);
+//                                   absent: every member votes
 //       [--propose-every-ms N]      diagnostic: the leader proposes the next demo mission command
 //                                   every N ms (0 = never), until the mission layer does
 // Every *-ms timing is on the radio's clock: simulated ms with --radio-model channel (the physics
@@ -97,6 +100,8 @@ int main(int argc, char** argv) {
   app.add_flag("--exit-when-done", o.exit_when_done, "Exit as soon as the plan is complete");
   std::string members;
   app.add_option("--members", members, "Raft: every drone of the trial, comma-separated (incl. this one); Raft is off when absent");
+  std::string voters;
+  app.add_option("--raft-voters", voters, "Raft: the voting set, comma-separated, a subset of --members (same on every drone); the others are learners. Default: every member votes");
   app.add_option("--raft-dir", o.raft.raft_dir, "Raft: WAL directory (default /tmp/swarmbox-raft/<name>)");
   app.add_option("--seed", o.raft.seed, "Raft: the trial's seed (election timeouts)")->capture_default_str();
   app.add_option("--raft-tick-ms", o.raft.tick_ms, "Raft: tick on the radio's clock (simulated ms with channel, wall ms with netem) [ms]")->check(CLI::PositiveNumber)->capture_default_str();
@@ -154,6 +159,14 @@ int main(int argc, char** argv) {
       return 2;
     }
     o.raft.members = std::move(*list);
+    if (!voters.empty()) {
+      auto voting = swarmbox::agent::ParseVoters(voters, o.raft.members);
+      if (!voting) {
+        std::fprintf(stderr, "swarmbox-agent: %s\n", voting.error().ToString().c_str());
+        return 2;
+      }
+      o.raft.voters = std::move(*voting);
+    }
     if (o.raft.raft_dir.empty()) o.raft.raft_dir = swarmbox::agent::DefaultRaftDir(o.name);
   }
   if (auto model = swarmbox::agent::ParseRadioModel(radio_model)) {

@@ -31,6 +31,26 @@ Result<std::vector<std::string>> ParseMembers(std::string_view text, std::string
   return out;
 }
 
+Result<std::vector<std::string>> ParseVoters(std::string_view text, const std::vector<std::string>& members) {
+  std::vector<std::string> out;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string item(text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
+    if (item.empty()) return Error(ErrorCode::kInvalidArgument, "--raft-voters '" + std::string(text) + "': empty name");
+    if (std::find(members.begin(), members.end(), item) == members.end()) {
+      return Error(ErrorCode::kInvalidArgument, "--raft-voters: '" + item + "' is not in --members");
+    }
+    if (std::find(out.begin(), out.end(), item) != out.end()) {
+      return Error(ErrorCode::kInvalidArgument, "--raft-voters: '" + item + "' listed twice");
+    }
+    out.push_back(item);
+    if (comma == std::string_view::npos) break;
+    start = comma + 1;
+  }
+  return out;
+}
+
 std::string DefaultRaftDir(std::string_view name) { return "/tmp/swarmbox-raft/" + std::string(name); }
 
 std::string RestampLine(std::string_view line, double t_s) {
@@ -63,6 +83,7 @@ Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options
   mission::RaftServiceConfig rc;
   rc.driver.self = options.self;
   rc.driver.members = options.members;
+  rc.driver.voters = options.voters;
   rc.driver.seed = options.seed;
   rc.driver.tick_ms = options.tick_ms;
   rc.driver.heartbeat_ms = options.heartbeat_ms;

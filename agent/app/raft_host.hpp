@@ -50,6 +50,7 @@ namespace swarmbox::agent {
 struct RaftHostOptions {
   std::string self;                  // this drone's name
   std::vector<std::string> members;  // every drone of the trial, including self, same on all
+  std::vector<std::string> voters;   // the voting set (a subset of members); empty: all vote
   std::string raft_dir;              // WAL and snapshot directory (created when missing)
   std::uint64_t seed = 1;            // the trial's seed
   int tick_ms = 50;                  // Raft tick on the radio's clock [ms]
@@ -62,6 +63,9 @@ struct RaftHostOptions {
 // "a,b,c" -> {"a","b","c"}; kInvalidArgument for an empty item, a bad drone name, a duplicate, or
 // a list without `self`.
 Result<std::vector<std::string>> ParseMembers(std::string_view text, std::string_view self);
+
+// "a,b" -> {"a","b"}: the voting set, each a member, none twice; kInvalidArgument otherwise.
+Result<std::vector<std::string>> ParseVoters(std::string_view text, const std::vector<std::string>& members);
 
 // The default WAL directory of a drone: /tmp/swarmbox-raft/<name> (survives an agent restart on
 // the same machine or container; give --raft-dir a volume to survive the container).

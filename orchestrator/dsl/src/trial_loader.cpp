@@ -99,18 +99,20 @@ Status DecodeMission(const Node& node, MissionSpec* out) {
   return Ok{};
 }
 
-// `raft: {tick_ms, heartbeat_ms, election_timeout_ms}`: what the agent's Raft service accepts
+// `raft: {tick_ms, heartbeat_ms, election_timeout_ms, voters}`: what the agent's Raft service accepts
 // (positive, both timings multiples of the tick, heartbeat < election timeout).
 Status DecodeRaft(const Node& node, RaftSpec* out) {
   yaml::MapReader r(node, "raft");
   r.Optional("tick_ms", &out->tick_ms)
       .Optional("heartbeat_ms", &out->heartbeat_ms)
-      .Optional("election_timeout_ms", &out->election_timeout_ms);
+      .Optional("election_timeout_ms", &out->election_timeout_ms)
+      .Optional("voters", &out->voters);
   SWARMBOX_TRY(r.Finish());
   auto where = [&](const char* key) -> const Node& {
     const Node* n = node.Find(key);
     return n != nullptr ? *n : node;
   };
+  if (out->voters < 0) return At(where("voters"), "'voters' must be >= 0 (0: every drone votes)");
   for (const auto& [key, value] : {std::pair{"tick_ms", out->tick_ms}, std::pair{"heartbeat_ms", out->heartbeat_ms},
                                    std::pair{"election_timeout_ms", out->election_timeout_ms}}) {
     if (value <= 0) return At(where(key), "'" + std::string(key) + "' must be > 0 [ms]");

@@ -223,6 +223,7 @@ yaml::Node ToDocument(const TrialSpec& spec) {
   raft.Set("tick_ms", Plain(std::to_string(spec.raft.tick_ms)));
   raft.Set("heartbeat_ms", Plain(std::to_string(spec.raft.heartbeat_ms)));
   raft.Set("election_timeout_ms", Plain(std::to_string(spec.raft.election_timeout_ms)));
+  if (spec.raft.voters != RaftSpec{}.voters) raft.Set("voters", Plain(std::to_string(spec.raft.voters)));
   doc.Set("raft", std::move(raft));
   Node radio = Node::Mapping();
   radio.Set("model", Str(RadioModelName(spec.radio.model)));

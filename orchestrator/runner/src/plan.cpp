@@ -143,6 +143,15 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
       "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
   });
+  // Raft at swarm scale: the first raft.voters drones vote, the others are learners; with no more
+  // drones than voters every drone votes (no flag: the agent's default).
+  if (spec.raft.voters > 0 && static_cast<std::size_t>(spec.raft.voters) < spec.drones.size()) {
+    std::string voters;
+    for (int k = 0; k < spec.raft.voters; ++k) {
+      voters += (voters.empty() ? "" : ",") + spec.drones[static_cast<std::size_t>(k)].name;
+    }
+    argv.insert(argv.end(), {"--raft-voters", voters});
+  }
   // The radio link measurement (event=link per sampled peer).
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms),
                            "--ping-peers", std::to_string(spec.radio.ping_peers)});

@@ -46,6 +46,21 @@ TEST(RaftHostMembers, RejectsEmptyDuplicateAndBadNames) {
   EXPECT_NE(bad.error().ToString().find("--members"), std::string::npos) << bad.error().ToString();
 }
 
+TEST(RaftHostMembers, ParsesTheVotingSetAmongTheMembers) {
+  const std::vector<std::string> members = {"scout_1", "scout_2", "scout_3", "lifter"};
+  auto v = ParseVoters("scout_1,scout_2", members);
+  ASSERT_TRUE(v.ok()) << v.error().ToString();
+  EXPECT_EQ(*v, (std::vector<std::string>{"scout_1", "scout_2"}));
+  auto stranger = ParseVoters("scout_1,scout_9", members);
+  ASSERT_FALSE(stranger.ok());
+  EXPECT_NE(stranger.error().ToString().find("'scout_9' is not in --members"), std::string::npos)
+      << stranger.error().ToString();
+  auto twice = ParseVoters("scout_1,scout_1", members);
+  ASSERT_FALSE(twice.ok());
+  EXPECT_NE(twice.error().ToString().find("listed twice"), std::string::npos) << twice.error().ToString();
+  EXPECT_FALSE(ParseVoters("scout_1,", members).ok());
+}
+
 TEST(RaftHostMembers, DefaultWalDirectoryIsPerDrone) {
   EXPECT_EQ(DefaultRaftDir("drone_3"), "/tmp/swarmbox-raft/drone_3");
   EXPECT_NE(DefaultRaftDir("drone_1"), DefaultRaftDir("drone_2"));

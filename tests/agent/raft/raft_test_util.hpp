@@ -15,11 +15,14 @@
 
 namespace swarmbox::raft::testing {
 
+// Nodes 1..n; with voters > 0 only 1..voters vote and the others are learners.
 inline Config MakeConfig(NodeId id, int n, bool pre_vote = false, bool check_quorum = false,
-                         std::uint64_t seed = 1) {
+                         std::uint64_t seed = 1, int voters = 0) {
   Config c;
   c.id = id;
-  for (int i = 1; i <= n; ++i) c.voters.push_back(static_cast<NodeId>(i));
+  for (int i = 1; i <= n; ++i) {
+    (voters == 0 || i <= voters ? c.voters : c.learners).push_back(static_cast<NodeId>(i));
+  }
   c.election_ticks = 10;
   c.heartbeat_ticks = 1;
   c.pre_vote = pre_vote;
@@ -69,12 +72,14 @@ inline Entry Ent(std::uint64_t index, std::uint64_t term, std::string_view data 
 // A cluster of RawNodes exchanging messages synchronously (no delay) until quiet.
 class Network {
  public:
-  explicit Network(int n, bool pre_vote = false, bool check_quorum = false) {
+  // voters > 0: nodes 1..voters vote, the others are learners served every learner_ticks ticks.
+  explicit Network(int n, bool pre_vote = false, bool check_quorum = false, int voters = 0,
+                   int learner_ticks = 20) {
     for (int i = 1; i <= n; ++i) {
-      nodes_.emplace(static_cast<NodeId>(i),
-                     std::make_unique<RawNode>(MakeNode(
-                         MakeConfig(static_cast<NodeId>(i), n, pre_vote, check_quorum,
-                                    static_cast<std::uint64_t>(i)))));
+      Config c = MakeConfig(static_cast<NodeId>(i), n, pre_vote, check_quorum,
+                            static_cast<std::uint64_t>(i), voters);
+      c.learner_heartbeat_ticks = learner_ticks;
+      nodes_.emplace(static_cast<NodeId>(i), std::make_unique<RawNode>(MakeNode(c)));
     }
   }
   RawNode& operator[](NodeId id) { return *nodes_.at(id); }

@@ -46,6 +46,7 @@ TEST(AgentKeys, DefaultsAreTheSarMissionAndRadioStableRaftTimings) {
   EXPECT_EQ(spec->raft.tick_ms, 50);
   EXPECT_EQ(spec->raft.heartbeat_ms, 200);
   EXPECT_EQ(spec->raft.election_timeout_ms, 1500);
+  EXPECT_EQ(spec->raft.voters, 5);
   EXPECT_EQ(spec->radio.ping_every_ms, 200);
 }
 
@@ -64,12 +65,13 @@ TEST(AgentKeys, ValuesAreRead) {
 TEST(AgentKeys, SetOverridesThem) {
   auto spec = LoadTrialText(kBare, "bare.yaml",
                             Opts({"mission.kind=plan", "mission.plan=takeoff:5,land", "raft.heartbeat_ms=250",
-                                  "raft.election_timeout_ms=2000", "radio.ping_every_ms=0"}));
+                                  "raft.election_timeout_ms=2000", "radio.ping_every_ms=0", "raft.voters=3"}));
   ASSERT_TRUE(spec) << spec.error().ToString();
   EXPECT_EQ(spec->mission.kind, MissionKind::kPlan);
   EXPECT_EQ(spec->mission.plan, "takeoff:5,land");
   EXPECT_EQ(spec->raft.heartbeat_ms, 250);
   EXPECT_EQ(spec->raft.election_timeout_ms, 2000);
+  EXPECT_EQ(spec->raft.voters, 3);
   EXPECT_EQ(spec->radio.ping_every_ms, 0);
 
   auto bad = LoadTrialText(kBare, "bare.yaml", Opts({"raft.heartbeat_ms=75"}));
@@ -99,6 +101,7 @@ TEST(AgentKeys, BadValuesFailAtFileLineColumn) {
       {"election_timeout_ms: 800", "election_timeout_ms: 100", "keys.yaml:7:61",
        "'election_timeout_ms' (100) must be longer than heartbeat_ms (100)"},
       {"heartbeat_ms: 100", "heartbeat_ms: many", "keys.yaml:7:35", "expected an integer"},
+      {"election_timeout_ms: 800", "election_timeout_ms: 800, voters: -1", "keys.yaml:7:74", "'voters' must be >= 0"},
       {"ping_every_ms: 500", "ping_every_ms: -5", "keys.yaml:8:24", "'ping_every_ms' must be >= 0"},
       {"ping_every_ms: 500", "ping_ms: 500", "keys.yaml:8:9", "unknown key 'ping_ms' in radio"},
   };

@@ -136,6 +136,7 @@ TEST_F(PlanTest, AgentsGetTheRaftMembersSeedTimingsAndTheirMission) {
   EXPECT_EQ(value_of("--raft-tick-ms"), "25");
   EXPECT_EQ(value_of("--raft-heartbeat-ms"), "150");
   EXPECT_EQ(value_of("--raft-election-timeout-ms"), "900");
+  EXPECT_EQ(value_of("--raft-voters"), "<absent>");  // 4 drones, 5 voters: every drone votes
   EXPECT_EQ(value_of("--mission"), "plan");
   EXPECT_EQ(value_of("--plan"), "takeoff:4,hover:3,land");
   EXPECT_EQ(value_of("--world"), "<absent>");  // the agent refuses --world/--payload with plan
@@ -144,6 +145,26 @@ TEST_F(PlanTest, AgentsGetTheRaftMembersSeedTimingsAndTheirMission) {
   EXPECT_EQ(value_of("--ping-peers"), "3");
   EXPECT_EQ(value_of("--sim-interface"), "eth0");
   EXPECT_EQ(value_of("--mesh-interface"), "eth1");
+}
+
+// Raft at swarm scale: raft.voters = V below the drone count makes the first V drones in trial
+// order the voting set, the same list on every drone (design18 §2).
+TEST_F(PlanTest, AgentsGetTheFirstVotersDronesAsTheRaftVotingSet) {
+  spec_.raft.voters = 2;
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  for (const char* drone : {"scout_1", "scout_3", "lifter"}) {
+    const std::vector<std::string>& argv = (*trial)->FindPlugin(drone)->spec().argv;
+    auto it = std::find(argv.begin(), argv.end(), "--raft-voters");
+    ASSERT_NE(it, argv.end()) << drone;
+    ASSERT_NE(it + 1, argv.end()) << drone;
+    EXPECT_EQ(*(it + 1), "scout_1,scout_2") << drone;
+  }
+  spec_.raft.voters = 0;  // every drone votes: no flag
+  auto all = PlanTrial(spec_, options_);
+  ASSERT_TRUE(all) << all.error().ToString();
+  const std::vector<std::string>& argv = (*all)->FindPlugin("scout_1")->spec().argv;
+  EXPECT_EQ(std::find(argv.begin(), argv.end(), "--raft-voters"), argv.end());
 }
 
 // Mission kind sar: the world file in the container, the perception latency, and the lifter's

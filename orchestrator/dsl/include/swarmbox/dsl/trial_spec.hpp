@@ -93,10 +93,15 @@ struct MissionSpec {
 //                        ~160 ms at 3 sigma, is far below it), while failover stays ~1.5-3 s
 //                        (timeouts randomised in [T, 2T)).
 //   tick 50 ms         the service's resolution; both timings must be multiples of it.
+// `voters` (default 5): the size of the voting set at swarm scale, the first `voters` drones in
+// trial order (the runner's --raft-voters); every other drone is a Raft learner (follows the
+// mission log, never votes; agent/raft/README.md). 0, or at least the drone count: every drone
+// votes (as in trials of up to 5 drones).
 struct RaftSpec {
   int tick_ms = 50;
   int heartbeat_ms = 200;
   int election_timeout_ms = 1500;
+  int voters = 5;
 };
 
 // The radio between drones (`radio:`, ARCHITECTURE.md "Two networks per trial, two radio models"):
