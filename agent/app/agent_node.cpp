@@ -233,6 +233,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     bo.offboard_timeout_s = o.brain.offboard_timeout_ms * 1e-3;
     bo.offboard_hold_s = o.brain.offboard_hold_ms * 1e-3;
     bo.state = node->brain_state_.get();
+    bo.neighbours.max_listed = static_cast<std::size_t>(std::max(1, o.brain.neighbours));
     node->flight_port_ = std::make_unique<FlightAdapter>(node->fc_);
     if (node->raft_) node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
     node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(the_brain), *node->flight_port_, node->radio_.get(),
@@ -383,6 +384,9 @@ void AgentNode::OnState(const bus::DroneState& state, const bus::RadioFrame& fra
   if (sar_ != nullptr && options_.radio_model == RadioModel::kNetem && state.drone != options_.name) {
     netem_wall_.OnState(state.drone, state.sim_time_ns, static_cast<double>(frame.delivered_ns) * 1e-9);
   }
+  // SarBrain's roster must know every member, Input::neighbours holds only the nearest: it is fed
+  // each state as it comes (O(log N) per message), before the host's table.
+  if (sar_ != nullptr) sar_->OnNeighbour(NeighbourFromBus(state));
   if (brain_host_) brain_host_->OnState(state);
 }
 

@@ -279,11 +279,15 @@ std::unique_ptr<SarMissionState> SarBrain::MakeMissionState() {
 }
 
 void SarBrain::OnNeighbour(const brain::Neighbour& n) {
-  if (n.name == config_.name) return;
-  if (std::find(config_.members.begin(), config_.members.end(), n.name) == config_.members.end()) return;
-  auto [it, fresh] = peers_.try_emplace(n.name);
+  auto it = peers_.find(n.name);
+  if (it == peers_.end()) {
+    if (n.name == config_.name) return;
+    if (std::find(config_.members.begin(), config_.members.end(), n.name) == config_.members.end()) return;
+    it = peers_.try_emplace(n.name).first;
+  } else if (n.t_ns <= it->second.t_ns) {
+    return;  // the state held (fed per message and again in Input::neighbours), or an older one
+  }
   Peer& p = it->second;
-  if (!fresh && n.t_ns < p.t_ns) return;  // an older state than the one held
   p.mode = n.status;
   p.position_m = V(n.position_m);
   p.velocity_m_s = V(n.velocity_m_s);

@@ -186,6 +186,10 @@ class SarBrain final : public brain::Brain {
   double payload_mass_kg() const { return payload_attached_ ? payload_mass_kg_ : 0.0; }
   // The committed mission is complete (event=mission_complete logged).
   bool complete() const { return complete_logged_; }
+  // Another drone's state, per message (the agent feeds every DroneState it dispatches, so the
+  // roster knows every member although Input::neighbours holds only the nearest; Step also takes
+  // Input::neighbours through it). A state no newer than the one held costs one look-up.
+  void OnNeighbour(const brain::Neighbour& n);
 
  private:
   struct Peer {
@@ -213,7 +217,6 @@ class SarBrain final : public brain::Brain {
 
   SarBrain(const SarBrainConfig& config, swarm::BatteryModel battery, std::function<void(const brain::Event&)> log,
            const NetemWallClock* wall);
-  void OnNeighbour(const brain::Neighbour& n);
   void Start(const Now& now, brain::Output& out);  // builds the behaviour once the estimator is ready
   void RunBehaviour(const Now& now, brain::Output& out);
   void Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Output& out);
