@@ -240,6 +240,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     bo.offboard_timeout_s = o.brain.offboard_timeout_ms * 1e-3;
     bo.offboard_hold_s = o.brain.offboard_hold_ms * 1e-3;
     bo.state = node->brain_state_.get();
+    bo.neighbours.max_listed = static_cast<std::size_t>(std::max(1, o.brain.neighbours));
     node->flight_port_ = std::make_unique<FlightAdapter>(node->fc_);
     if (node->raft_) node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
     node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(the_brain), *node->flight_port_, node->radio_.get(),

@@ -64,18 +64,14 @@ BrainHost::BrainHost(BrainHostOptions options, std::unique_ptr<brain::Brain> bra
       radio_(radio),
       consensus_(consensus),
       log_(log),
-      failsafe_(options_.offboard_timeout_s, options_.offboard_hold_s) {
+      failsafe_(options_.offboard_timeout_s, options_.offboard_hold_s),
+      neighbours_(options_.self, options_.neighbours) {
   if (options_.period_steps < 1) options_.period_steps = 1;
 }
 
 void BrainHost::OnMessage(const bus::BrainMessage& message) { messages_.push_back(MessageFromBus(message)); }
 
-void BrainHost::OnState(const bus::DroneState& state) {
-  if (state.drone == options_.self) return;
-  auto it = neighbours_.find(state.drone);
-  if (it != neighbours_.end() && it->second.t_ns > state.sim_time_ns) return;  // an older one, reordered
-  neighbours_[state.drone] = NeighbourFromBus(state);
-}
+void BrainHost::OnState(const bus::DroneState& state) { neighbours_.OnState(state); }
 
 void BrainHost::OnFlightEvent(const flight::FlightEvent& event) { flight_events_.push_back(FlightEventOf(event)); }
 
@@ -103,10 +99,8 @@ void BrainHost::BuildInput(std::int64_t t_ns, const brain::Vehicle& vehicle) {
     in_.leader = consensus_->leader();
     consensus_->TakeCommitted(&committed_);
   }
-  neighbour_list_.clear();
-  for (const auto& [name, n] : neighbours_) neighbour_list_.push_back(n);
   in_.flight_events = flight_events_;
-  in_.neighbours = neighbour_list_;
+  in_.neighbours = neighbours_.List(t_ns, vehicle.position_m);
   in_.messages = messages_;
   in_.committed = committed_;
   in_.detections = detections_;

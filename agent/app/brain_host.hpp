@@ -14,8 +14,11 @@
 // One brain period (k % period_steps == 0):
 //   Input:  t_ns; self = `vehicle` (the flight stack's estimate, battery, mode; payload_mass_kg as
 //           this host last attached); flight events since the previous brain Step; is_leader and
-//           leader from the consensus; neighbours = the latest DroneState heard from each other
-//           drone (the newest by sim_time_ns), sorted by name; brain messages delivered since the
+//           leader from the consensus; neighbours = the newest DroneState (by sim_time_ns) of at
+//           most `neighbours.max_listed` (--brain-neighbours, 32) other drones, the nearest ones,
+//           sorted by name; drones silent for 3 s are forgotten (NeighbourTable, neighbour_table.hpp:
+//           O(log N) per message, the nearest set chosen anew every 200 ms of simulated time, nothing
+//           per step that grows with the swarm); brain messages delivered since the
 //           previous Step, in delivery order; entries committed since the previous Step (the
 //           consensus's tap, index order); detections since the previous Step.
 //   Output, in this order: commands (takeoff/land/hold to the flight stack; payload_attach/
@@ -46,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "neighbour_table.hpp"
 #include "swarmbox/brain/brain.hpp"
 #include "swarmbox/bus/messages.hpp"
 #include "swarmbox/common/logfmt.hpp"
@@ -90,6 +94,8 @@ struct BrainHostOptions {
   // The brain's own replicated state (Brain::MakeReplicatedState, kept by the consensus), handed
   // to every Step as Input::state; null: none.
   const brain::ReplicatedState* state = nullptr;
+  // Input::neighbours: how many (the nearest), when a silent drone is forgotten.
+  NeighbourTableOptions neighbours;
 };
 
 class BrainHost {
@@ -103,7 +109,7 @@ class BrainHost {
 
   // The inbox, filled between two Steps.
   void OnMessage(const bus::BrainMessage& message);  // in delivery order
-  void OnState(const bus::DroneState& state);        // another drone's broadcast
+  void OnState(const bus::DroneState& state);        // another drone's broadcast, O(log N)
   void OnFlightEvent(const flight::FlightEvent& event);
   void OnDetection(const brain::Detection& detection);
 
@@ -119,6 +125,7 @@ class BrainHost {
   bool failed() const { return failed_; }
   std::uint64_t answers() const { return answers_; }          // ... that answered
   brain::Brain& brain() { return *brain_; }
+  const NeighbourTable& neighbours() const { return neighbours_; }
 
  private:
   void BuildInput(std::int64_t t_ns, const brain::Vehicle& vehicle);
@@ -138,11 +145,10 @@ class BrainHost {
 
   // The inbox, since the previous brain Step.
   std::vector<brain::FlightEvent> flight_events_;
-  std::map<std::string, brain::Neighbour> neighbours_;  // name -> latest, sorted
+  NeighbourTable neighbours_;
   std::vector<brain::Message> messages_;
   std::vector<brain::Detection> detections_;
   // This period's Input storage and the Output (buffers reused).
-  std::vector<brain::Neighbour> neighbour_list_;
   std::vector<brain::Entry> committed_;
   brain::Input in_;
   brain::Output out_;

@@ -37,6 +37,7 @@ Status ValidateBrainOptions(const BrainOptions& o, bool mission_given, bool plan
   if (o.rate_hz < 0.0 || !std::isfinite(o.rate_hz)) return bad("--brain-rate-hz must be > 0");
   if (o.offboard_timeout_ms <= 0) return bad("--offboard-timeout-ms must be > 0");
   if (o.offboard_hold_ms < 0) return bad("--offboard-hold-ms must be >= 0");
+  if (o.neighbours <= 0) return bad("--brain-neighbours must be > 0");
   if (o.wait_ms <= 0) return bad("--brain-wait-ms must be > 0");
   if (o.start_ms <= 0) return bad("--brain-start-ms must be > 0");
   return Ok{};

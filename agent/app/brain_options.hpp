@@ -34,6 +34,7 @@ struct BrainOptions {
   int offboard_hold_ms = 5000;     // --offboard-hold-ms, simulated hold before landing
   int wait_ms = 3000;              // --brain-wait-ms, wall clock (external)
   int start_ms = 30000;            // --brain-start-ms, wall clock (external, the first answer)
+  int neighbours = 32;             // --brain-neighbours: Input::neighbours holds at most this many (the nearest), > 0
 };
 
 inline constexpr double kExternalDefaultRateHz = 50.0;

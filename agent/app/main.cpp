@@ -125,6 +125,7 @@ int main(int argc, char** argv) {
   app.add_option("--offboard-hold-ms", o.brain.offboard_hold_ms, "Offboard failsafe: simulated ms of holding before it lands")->capture_default_str();
   app.add_option("--brain-wait-ms", o.brain.wait_ms, "external: wall-clock ms to wait for an answer before event=brain_unresponsive")->capture_default_str();
   app.add_option("--brain-start-ms", o.brain.start_ms, "external: wall-clock ms to wait for the first answer")->capture_default_str();
+  app.add_option("--brain-neighbours", o.brain.neighbours, "Input::neighbours holds at most N other drones: the nearest (chosen every 200 ms), sorted by name; drones silent 3 s are dropped")->check(CLI::PositiveNumber)->capture_default_str();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -73,6 +73,8 @@ Flocking::Flocking(const FlockingParams& params, const Geofence& fence,
                  params_.fresh_age_s < params_.stale_timeout_s);
   SWARMBOX_CHECK(params_.p_mig_1_s > 0 && params_.p_frict_1_s > 0 && params_.p_shill_1_s > 0);
   SWARMBOX_CHECK(fence_.min_x_m < fence_.max_x_m && fence_.min_y_m < fence_.max_y_m);
+  SWARMBOX_CHECK(params_.max_neighbours > 0);
+  nearest_.reserve(static_cast<std::size_t>(params_.max_neighbours) + 1);
 }
 
 Vec2 Flocking::ShillTerm(const Vec2& p, const Vec2& v) const {
@@ -115,8 +117,9 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
       out.migration = speed * to_goal / d;
     }
     // Slide around obstacles: near one, the part of the migration that points into it turns
-    // along its face (keeping the speed; head-on, to the left), so that migration and the shill
-    // push do not cancel in front of a wall.
+    // along its face (keeping the speed; head-on, toward the nearer end of the face, to the left
+    // when in the middle), so that migration and the shill push do not cancel in front of a wall
+    // (nor do two drones head-on either side of the middle slide into each other and stall).
     for (const ObstacleFootprint& o : obstacles_) {
       Vec2 n;
       const double clearance = ObstacleClearance(o, p, &n);
@@ -124,37 +127,58 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
       if (clearance > k.obstacle_slide_range_m || into <= 0.0) continue;
       const double speed = out.migration.norm();
       Vec2 along = out.migration + into * n;  // tangential part
-      if (along.norm() < 0.05 * speed) along = Vec2(-n.y(), n.x());
+      if (along.norm() < 0.05 * speed) {
+        along = Vec2(-n.y(), n.x());
+        if ((p - o.center_m).dot(along) < 0.0) along = -along;
+      }
       out.migration = speed * along.normalized();
     }
   }
 
+  // The max_neighbours nearest in range and not stale (ties: the earlier in the input), kept
+  // sorted by distance in a buffer of max_neighbours + 1; then used in input order, so that with
+  // max_neighbours or fewer the sums are the same, term for term, as over every neighbour.
+  const auto keep = static_cast<std::size_t>(k.max_neighbours);
+  nearest_.clear();
+  for (std::size_t i = 0; i < in.neighbours.size(); ++i) {
+    const NeighbourState& n = in.neighbours[i];
+    if (!(n.age_s <= k.stale_timeout_s)) continue;  // stale (or NaN age): dropped
+    const double age = std::max(0.0, n.age_s);
+    // Distances are 3-D (a drone far above or below is no threat), pushes horizontal.
+    const Vec3 pj3 = n.position_m + age * n.velocity_m_s;
+    const double r = (in.position_m - pj3).norm();
+    if (r > k.sensing_range_m) continue;
+    if (r < k.r0_rep_m) {  // repulsion: from every drone this close (safety first), not only the nearest 7
+      Vec2 diff = p - pj3.head<2>();
+      const double r_xy = diff.norm();
+      if (r_xy < 1e-6) {  // stacked vertically: a deterministic direction per neighbour slot
+        const double angle = 2.39996322972865332 * static_cast<double>(i + 1);  // golden angle
+        diff = Vec2(std::cos(angle), std::sin(angle));
+      } else {
+        diff /= r_xy;
+      }
+      out.repulsion += k.p_rep_1_s * (k.r0_rep_m - r) * diff;
+    }
+    if (nearest_.size() == keep && !(r < nearest_.back().r_m)) continue;
+    auto at = std::upper_bound(nearest_.begin(), nearest_.end(), r,
+                               [](double value, const Near& e) { return value < e.r_m; });
+    nearest_.insert(at, Near{r, i});
+    if (nearest_.size() > keep) nearest_.pop_back();
+  }
+  std::sort(nearest_.begin(), nearest_.end(), [](const Near& a, const Near& b) { return a.index < b.index; });
+
   Vec2 centroid_sum = Vec2::Zero();
   Vec2 velocity_sum = Vec2::Zero();
   double weight_sum = 0.0;
-  std::size_t index = 0;
-  for (const NeighbourState& n : in.neighbours) {
-    ++index;
-    if (!(n.age_s <= k.stale_timeout_s)) continue;  // stale (or NaN age): dropped
+  for (const Near& near : nearest_) {
+    const NeighbourState& n = in.neighbours[near.index];
     const double age = std::max(0.0, n.age_s);
-    const Vec3 pj3 = n.position_m + age * n.velocity_m_s;
-    const Vec2 pj = pj3.head<2>();
+    const Vec2 pj = (n.position_m + age * n.velocity_m_s).head<2>();
     const Vec2 vj = n.velocity_m_s.head<2>();
-    // Distances are 3-D (a drone far above or below is no threat), pushes horizontal.
-    double r = (in.position_m - pj3).norm();
-    if (r > k.sensing_range_m) continue;
-    Vec2 diff = p - pj;
-    const double r_xy = diff.norm();
+    const double r = near.r_m;
     ++out.neighbours_used;
     const double w =
         age <= k.fresh_age_s ? 1.0 : (k.stale_timeout_s - age) / (k.stale_timeout_s - k.fresh_age_s);
-    if (r_xy < 1e-6) {  // stacked vertically: a deterministic direction per neighbour slot
-      const double angle = 2.39996322972865332 * static_cast<double>(index);  // golden angle
-      diff = Vec2(std::cos(angle), std::sin(angle));
-    } else {
-      diff /= r_xy;
-    }
-    if (r < k.r0_rep_m) out.repulsion += k.p_rep_1_s * (k.r0_rep_m - r) * diff;
     out.friction += w * FrictionRule(v, vj, r, k.r0_frict_m, k.v_frict_m_s, k.a_frict_m_s2,
                                      k.p_frict_1_s, k.c_frict);
     centroid_sum += w * pj;

@@ -158,9 +158,11 @@ struct Rig {
   std::vector<bus::WorldCommand> world;
   std::unique_ptr<BrainHost> host;
 
+  std::size_t max_neighbours = 32;
   void Make(std::unique_ptr<brain::Brain> b, int period = 1, double timeout_s = 1.0, double hold_s = 5.0) {
     BrainHostOptions o;
     o.self = "scout_1";
+    o.neighbours.max_listed = max_neighbours;
     o.period_steps = period;
     o.offboard_timeout_s = timeout_s;
     o.offboard_hold_s = hold_s;
@@ -214,6 +216,25 @@ TEST(BrainHost, AssemblesTheInputFromTheInboxSinceThePreviousStep) {
   EXPECT_TRUE(rig.seen[1].committed.empty());
   EXPECT_EQ(rig.seen[1].neighbours, (std::vector<std::string>{"lifter@2000:rv/takeoff", "scout_3@4000:rv/flying"}));
   EXPECT_EQ(rig.seen[1].t_ns, kStepNs);
+}
+
+TEST(BrainHost, HandsTheBrainAtMostBrainNeighboursOfTheNearestSortedByName) {
+  Rig rig;
+  rig.max_neighbours = 2;
+  rig.Make(std::make_unique<ScriptBrain>(&rig.seen, nullptr));
+  // scout_1 is at (1, 2, 10) (Airborne): c is 3 m away, a 5 m, b 40 m.
+  auto at = [](const std::string& name, double x) {
+    bus::DroneState s = State(name, 1'000, "m");
+    s.position_enu_m = {x, 2, 10};
+    return s;
+  };
+  rig.host->OnState(at("b", 41));
+  rig.host->OnState(at("a", 6));
+  rig.host->OnState(at("c", -2));
+  rig.Step(0);
+  ASSERT_EQ(rig.seen.size(), 1u);
+  EXPECT_EQ(rig.seen[0].neighbours, (std::vector<std::string>{"a@1000:m", "c@1000:m"}));
+  EXPECT_EQ(rig.host->neighbours().size(), 3u);  // the table knows every drone heard
 }
 
 TEST(BrainHost, RunsTheBrainEveryPeriodAndKeepsTheEventsInBetween) {

@@ -49,6 +49,10 @@ TEST(BrainOptions, RefusesBadCombinationsWithTheReason) {
   ext.offboard_hold_ms = 0;
   ext.wait_ms = 0;
   EXPECT_NE(Why(ext).find("--brain-wait-ms"), std::string::npos);
+  BrainOptions none;
+  EXPECT_EQ(none.neighbours, 32);
+  none.neighbours = 0;
+  EXPECT_NE(Why(none).find("--brain-neighbours must be > 0"), std::string::npos);
 }
 
 TEST(BrainOptions, ThePeriodIsAWholeNumberOfLockstepSteps) {

@@ -39,6 +39,74 @@ TEST(Flocking, RepulsionPushesAwayLinearlyInsideR0) {
   EXPECT_EQ(out.neighbours_used, 1);
 }
 
+// Ballerini et al., PNAS 105(4), 2008: starlings interact with their 6-7 nearest (topological)
+// neighbours. Of 20 neighbours in range only the 7 nearest steer, exactly as if only they had
+// been heard; stale ones and those out of range do not take a place among them.
+TEST(Flocking, OnlyTheSevenNearestNeighboursSteer) {
+  FlockingParams k;
+  ASSERT_EQ(k.max_neighbours, 7);
+  std::vector<NeighbourState> all;
+  for (int i = 0; i < 20; ++i) {
+    const double r = 4.0 + 2.5 * ((i * 7) % 20);  // 4 .. 51.5 m, shuffled
+    const double a = 0.7 * i;
+    all.push_back({Vec3(r * std::cos(a), r * std::sin(a), 10), Vec3(0.3 * std::sin(a), 0.5, 0), 0.1});
+  }
+  all.push_back({Vec3(1, 0, 10), Vec3::Zero(), 5.0});   // nearest, but stale
+  all.push_back({Vec3(0, 70, 10), Vec3::Zero(), 0.0});  // out of sensing range
+  std::vector<NeighbourState> nearest;  // the 7 within 4 .. 19 m, in input order
+  for (const NeighbourState& n : all) {
+    const double r = (n.position_m - Vec3(0, 0, 10)).norm();
+    if (n.age_s <= k.stale_timeout_s && r < 19.5) nearest.push_back(n);
+  }
+  ASSERT_EQ(nearest.size(), 7u);
+  Flocking f_all(k, Geofence{});
+  Flocking f_nearest(k, Geofence{});
+  const FlockingInput in{Vec3(0, 0, 10), Vec3(1, 0, 0), Vec3(100, 0, 10), all};
+  const FlockingOutput a = f_all.Step(in, kDt);
+  const FlockingOutput b = f_nearest.Step({in.position_m, in.velocity_m_s, in.goal_m, nearest}, kDt);
+  EXPECT_EQ(a.neighbours_used, 7);
+  EXPECT_EQ(a.repulsion, b.repulsion);
+  EXPECT_EQ(a.friction, b.friction);
+  EXPECT_EQ(a.alignment, b.alignment);
+  EXPECT_EQ(a.cohesion, b.cohesion);
+  EXPECT_EQ(a.velocity_m_s, b.velocity_m_s);
+  // A larger bound takes more.
+  FlockingParams wide = k;
+  wide.max_neighbours = 12;
+  Flocking f_wide(wide, Geofence{});
+  EXPECT_EQ(f_wide.Step(in, kDt).neighbours_used, 12);
+}
+
+// Safety first: repulsion comes from every drone inside r0_rep, also beyond the nearest 7.
+TEST(Flocking, RepulsionComesFromEveryDroneTooCloseNotOnlyTheNearestSeven) {
+  FlockingParams k;
+  Flocking f(k, Geofence{});
+  std::vector<NeighbourState> ring;  // 9 drones 5 m away on one side (+x half plane)
+  Vec2 expected = Vec2::Zero();
+  for (int i = 0; i < 9; ++i) {
+    const double a = -1.2 + 0.3 * i;
+    ring.push_back({Vec3(5 * std::cos(a), 5 * std::sin(a), 10), Vec3::Zero(), 0.0});
+    expected += k.p_rep_1_s * (k.r0_rep_m - 5.0) * Vec2(-std::cos(a), -std::sin(a));
+  }
+  const FlockingOutput out = f.Step({Vec3(0, 0, 10), Vec3::Zero(), Vec3(0, 0, 10), ring}, kDt);
+  EXPECT_EQ(out.neighbours_used, 7);
+  EXPECT_NEAR(out.repulsion.x(), expected.x(), 1e-9);
+  EXPECT_NEAR(out.repulsion.y(), expected.y(), 1e-9);
+}
+
+// Head-on to an obstacle face, migration turns toward the nearer end of the face: two drones
+// either side of the middle part (they used to both turn left, one into the other, and stall).
+TEST(Flocking, HeadOnToAnObstacleSlidesTowardTheNearerEnd) {
+  FlockingParams k;
+  const std::vector<ObstacleFootprint> wall = {{Vec2(20, 0), Vec2(2, 10), 0.0}};  // face at x = 18
+  Flocking above(k, Geofence{}, wall), below(k, Geofence{}, wall);
+  const FlockingOutput a = above.Step({Vec3(10, 2, 10), Vec3::Zero(), Vec3(200, 2, 10), {}}, kDt);
+  const FlockingOutput b = below.Step({Vec3(10, -2, 10), Vec3::Zero(), Vec3(200, -2, 10), {}}, kDt);
+  EXPECT_NEAR(a.migration.x(), 0.0, 1e-9);
+  EXPECT_GT(a.migration.y(), 0.0);
+  EXPECT_LT(b.migration.y(), 0.0);
+}
+
 TEST(Flocking, StaleNeighbourIsDroppedAndAgeingOneIsDeadReckoned) {
   FlockingParams k;
   Flocking f(k, Geofence{});

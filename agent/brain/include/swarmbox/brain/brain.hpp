@@ -42,7 +42,9 @@
 //     A brain that keeps a replicated state of its own makes one (MakeReplicatedState): Raft then
 //     snapshots it and restores it on a drone that fell behind or restarted.
 //   - Radio. Messages are best effort, delayed and lost by the trial's radio model; `to` empty
-//     broadcasts to every drone in range. Neighbours are the latest state heard from each drone.
+//     broadcasts to every drone in range. Neighbours are the latest state heard from the nearest
+//     drones: at most the agent's --brain-neighbours (default 32), chosen anew every 200 ms of
+//     simulated time, a drone silent for 3 s dropped.
 //   - ABI. A library brain is C++ loaded with dlopen into the agent: build it with the same
 //     compiler major version and C++ standard library as the installed SwarmBox
 //     (find_package(swarmbox) does), and export it with SWARMBOX_BRAIN. The loader refuses a
@@ -143,7 +145,7 @@ struct Input {
   std::span<const FlightEvent> flight_events;
   bool is_leader = false;                 // this drone leads the consensus
   std::string leader;                     // who leads, as far as this drone knows ("": nobody)
-  std::span<const Neighbour> neighbours;  // sorted by name
+  std::span<const Neighbour> neighbours;  // the nearest (at most --brain-neighbours, 32), sorted by name
   std::span<const Message> messages;      // delivered since the previous Step, in delivery order
   std::span<const Entry> committed;       // committed since the previous Step, in index order
   std::span<const Detection> detections;  // since the previous Step

@@ -31,13 +31,19 @@
 //  - limits      |v_xy| <= v_max, |v_z| <= v_z_max, |dv/dt| <= a_max (across steps).
 //
 // Neighbours: the position is dead-reckoned by velocity * age. A neighbour older than
-// stale_timeout_s is dropped (a drone that went silent stops steering us after that). Freshness
+// stale_timeout_s is dropped (a drone that went silent stops steering us after that). Of those
+// within sensing_range_m only the `max_neighbours` nearest (default 7) steer: starlings interact
+// with a fixed number of topological neighbours, six to seven, not with all birds within a
+// distance (Ballerini et al., "Interaction ruling animal collective behavior depends on topological
+// rather than metric distance", PNAS 105(4), 2008), which also keeps a step O(N) in the neighbours
+// given and its terms O(1) in the swarm's size (issue 18). Freshness
 // weight w = 1 up to fresh_age_s, falling linearly to 0 at stale_timeout_s, scales alignment,
 // friction and cohesion; repulsion keeps full weight until the timeout (safety first).
 //
 // Allocation: none in Step(). Not thread-safe (one instance per drone, one caller).
 #pragma once
 
+#include <cstddef>
 #include <span>
 #include <vector>
 
@@ -105,6 +111,7 @@ struct FlockingParams {
   double obstacle_slide_range_m = 12.0;  // migration turns along an obstacle face within this [m]
   // Neighbourhood.
   double sensing_range_m = 60.0;  // neighbours further than this are ignored [m]
+  int max_neighbours = 7;         // only the nearest this many steer (Ballerini 2008), > 0
   double fresh_age_s = 0.5;       // full weight up to this age [s]
   double stale_timeout_s = 2.0;   // dropped beyond this age [s]
   // Limits and altitude channel.
@@ -131,7 +138,7 @@ struct FlockingOutput {
   Vec2 alignment = Vec2::Zero();
   Vec2 cohesion = Vec2::Zero();
   Vec2 shill = Vec2::Zero();
-  int neighbours_used = 0;           // neighbours within range and fresher than the timeout
+  int neighbours_used = 0;           // the nearest (<= max_neighbours) in range and fresher than the timeout
 };
 
 // The V18 braking curve D(r, a, p) [m/s]: the speed from which one can stop within distance r with
@@ -164,6 +171,11 @@ class Flocking {
   std::vector<ObstacleFootprint> obstacles_;
   Vec3 last_command_m_s_ = Vec3::Zero();
   bool has_last_ = false;
+  struct Near {
+    double r_m;          // 3-D distance to the dead-reckoned position
+    std::size_t index;   // in FlockingInput::neighbours
+  };
+  std::vector<Near> nearest_;  // Step's scratch, capacity max_neighbours + 1 (no allocation)
 };
 
 }  // namespace swarmbox::swarm
