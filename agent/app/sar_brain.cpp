@@ -186,6 +186,8 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
       {"scout_altitude_m", &t.scout_altitude_m},
       {"scout_cruise_m_s", &t.scout_cruise_m_s},
       {"scout_takeoff_step_m", &t.scout_takeoff_step_m},
+      {"takeoff_wave_s", &t.takeoff_wave_s},
+      {"takeoff_grid_m", &t.takeoff_grid_m},
       {"scout_orbit_radius_m", &t.scout_orbit_radius_m},
       {"scout_orbit_time_s", &t.scout_orbit_time_s},
       {"lifter_transit_altitude_m", &t.lifter_transit_altitude_m},
@@ -202,6 +204,9 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
   };
   for (const auto& [key, value] : tuning) SWARMBOX_TRY(ArgNumber(ctx, key, value));
   if (!(t.mission_dt_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg mission_dt_s must be > 0");
+  if (!(t.takeoff_wave_s >= 0) || !(t.takeoff_grid_m > 0)) {
+    return Error(ErrorCode::kInvalidArgument, "sar brain: args takeoff_wave_s must be >= 0, takeoff_grid_m > 0");
+  }
   if (!(t.status_every_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg status_every_s must be > 0");
   if (!c.payload.empty()) {
     auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
@@ -396,7 +401,10 @@ void SarBrain::Start(const Now& now, brain::Output& out) {
     s.home_m = home_m_;
     s.base_height_m = config_.base_height_m;
     s.search_altitude_m = t.scout_altitude_m;
-    s.takeoff_delay_s = now.t_s + 2.0;  // the estimator settles on the ground (as the plan's preflight)
+    // The estimator settles on the ground (as the plan's preflight), then this scout's wave.
+    const int wave = swarm::TakeoffWave(home_m_.head<2>(), t.takeoff_grid_m);
+    s.takeoff_delay_s = now.t_s + 2.0 + t.takeoff_wave_s * wave;
+    s.return_layer = wave;  // home in the wave's altitude layer (swarm::ScoutConfig::return_layer)
     s.hfov_rad = config_.camera.hfov_rad;
     s.width_px = config_.camera.width_px;
     s.height_px = config_.camera.height_px;

@@ -95,6 +95,10 @@ struct MissionTuning {
   double scout_altitude_m = 30.0;       // above home [m]
   double scout_cruise_m_s = 7.0;
   double scout_takeoff_step_m = 3.0;    // flight-stack take-off height; then climb in position mode
+  // Staggered take-off: scouts take off in 4 waves this far apart, by their place on a grid of
+  // takeoff_grid_m (swarm::TakeoffWave has why) [s], [m].
+  double takeoff_wave_s = 1.5;
+  double takeoff_grid_m = 4.0;
   double scout_orbit_radius_m = 12.0;
   double scout_orbit_time_s = 20.0;     // a swept scout orbits a victim this long, then lands
   double lifter_transit_altitude_m = 10.0;

@@ -18,6 +18,15 @@ bool Over(MissionPhase p) { return p == MissionPhase::kReturn || p == MissionPha
 
 }  // namespace
 
+int TakeoffWave(const Eigen::Vector2d& home_xy_m, double grid_m) {
+  SWARMBOX_CHECK(grid_m > 0);
+  const auto parity = [&](double v) {
+    const auto i = static_cast<long long>(std::llround(v / grid_m));
+    return static_cast<int>(((i % 2) + 2) % 2);
+  };
+  return parity(home_xy_m.x()) + 2 * parity(home_xy_m.y());
+}
+
 std::string_view RoleName(Role role) { return role == Role::kScout ? "scout" : "lifter"; }
 
 std::string_view SetpointKindName(SetpointKind kind) {
@@ -313,8 +322,12 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
     case Stage::kReturning: {
       const double d = (p.head<2>() - home_xy).norm();
       sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
-      const double approach_z = config_.approach_height_m > 0 ? config_.home_m.z() + config_.approach_height_m : Altitude();
-      sp.target_m = {home_xy.x(), home_xy.y(), d > config_.home_approach_m ? Altitude() : approach_z};
+      const double layer_z = Altitude() + config_.return_layer * config_.return_layer_m;
+      const double approach_z = config_.approach_height_m > 0 ? config_.home_m.z() + config_.approach_height_m : layer_z;
+      // Home in this scout's layer, down only once over home (within 2 x home_reached_m): on a
+      // 4 m take-off grid a drone descending on the slant of the last approach_m would pass
+      // through its neighbours' columns at their heights; vertically it stays in its own.
+      sp.target_m = {home_xy.x(), home_xy.y(), d > 2 * config_.home_reached_m ? layer_z : approach_z};
       sp.yaw_rad = in.yaw_rad;
       if (d <= config_.home_reached_m && p.z() <= approach_z + 1.0) Enter(Stage::kLanding, in, out);
       break;

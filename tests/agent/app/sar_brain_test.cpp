@@ -173,8 +173,11 @@ class BrainRig {
     table_.clear();
     for (const auto& [name, n] : heard_) table_.push_back(n);
     in.neighbours = table_;
+    in.messages = inbox_;
     in.state = state_.get();
     brain_->Step(in, out_);
+    inbox_.clear();
+    for (const brain::Message& m : out_.messages) sent_messages_.push_back(m);
     EXPECT_EQ(out_.status, brain_->mode());
     return out_;
   }
@@ -212,6 +215,11 @@ class BrainRig {
     heard_[name] = n;
     wall_.OnState(name, n.t_ns, wall_.now_s);
   }
+  // A brain message delivered at the next Step.
+  void Tell(const std::string& from, const std::string& topic, const std::string& payload) {
+    inbox_.push_back({from, "", topic, std::vector<std::uint8_t>(payload.begin(), payload.end())});
+  }
+  std::vector<brain::Message>& sent_messages() { return sent_messages_; }
   void Commit(const raft::MissionCommand& c) { state_->Apply(++index_, raft::EncodeCommand(c)); }
   // The world runs `speed_up` times faster than the wall clock (1: rtf 1; ~8 at rtf 0 on
   // loopback); only read by a brain made with netem_wall.
@@ -230,6 +238,7 @@ class BrainRig {
   std::map<std::string, brain::Neighbour> heard_;
   std::vector<brain::Neighbour> table_;
   std::vector<raft::MissionCommand> proposals_;
+  std::vector<brain::Message> inbox_, sent_messages_;
   Vec3 pos_ = Vec3::Zero();
   std::int64_t t_ns_ = 0;
   std::uint64_t index_ = 0;
@@ -395,6 +404,71 @@ TEST(SarBrainScout, WithoutTheSideChannelTheSimulatedRuleDecidesAlone) {
   bool handed_over = false;
   for (const raft::MissionCommand& c : rig.proposals()) handed_over = handed_over || std::holds_alternative<raft::AssignSectors>(c);
   EXPECT_TRUE(handed_over);
+}
+
+TEST(StatusMessage, RoundTripsAndRejectsGarbage) {
+  const std::string text = EncodeStatusMessage(12'345'000'000, "scout/searching", -12.5, 300.25);
+  EXPECT_EQ(text, "12345000000 scout/searching -12.50 300.25");
+  std::int64_t t_ns = 0;
+  std::string status;
+  double x = 0, y = 0;
+  ASSERT_TRUE(DecodeStatusMessage(text, &t_ns, &status, &x, &y));
+  EXPECT_EQ(t_ns, 12'345'000'000);
+  EXPECT_EQ(status, "scout/searching");
+  EXPECT_DOUBLE_EQ(x, -12.5);
+  EXPECT_DOUBLE_EQ(y, 300.25);
+  for (const char* bad : {"", "1 scout/searching 1", "1 scout/searching 1 2 3", "x scout/searching 1 2",
+                          "1 pilot/x 1 2", "1 scout/searching 1 nan", "1  scout/searching 1 2", "1 scout/searching 1 2 "}) {
+    EXPECT_FALSE(DecodeStatusMessage(bad, &t_ns, &status, &x, &y)) << "'" << bad << "'";
+  }
+}
+
+// Every member broadcasts its status (kStatusTopic): at once on a change of stage, else every
+// status_every_s (1 s), so that a leader that does not get it among its nearest neighbours
+// still knows it.
+TEST(SarBrainScout, BroadcastsItsStatusOnEachChangeAndEverySecond) {
+  BrainRig rig(Scout("scout_1", {"scout_1"}));
+  rig.position() = Vec3(0, 0, 0.23);
+  rig.Run(2.9, "idle");
+  std::vector<std::string> texts;
+  for (const brain::Message& m : rig.sent_messages()) {
+    EXPECT_EQ(m.topic, kStatusTopic);
+    EXPECT_EQ(m.to, "");  // a broadcast: every member keeps its table
+    texts.emplace_back(m.payload.begin(), m.payload.end());
+  }
+  // 0 s (first word), 1 s, 2 s on the ground; at 2 s + a tick the take-off (a change) at once.
+  ASSERT_EQ(texts.size(), 4u);
+  EXPECT_NE(texts[0].find(" scout/on_ground 0.00 0.00"), std::string::npos) << texts[0];
+  EXPECT_NE(texts[2].find(" scout/on_ground "), std::string::npos) << texts[2];
+  EXPECT_NE(texts[3].find(" scout/taking_off "), std::string::npos) << texts[3];
+}
+
+// A member the leader hears only through status messages (never among its neighbours, as at 100
+// drones when it is not among the nearest 32) counts as heard and gets its sector.
+TEST(SarBrainScout, TheLeaderKnowsAMemberHeardOnlyThroughItsStatusMessages) {
+  BrainRig rig(Scout("scout_1", {"scout_1", "scout_2"}));
+  rig.position() = Vec3(0, 0, 0.23);
+  rig.Run(3.0, "idle", /*leader=*/true);
+  EXPECT_EQ(rig.brain().mode(), "scout/on_ground");  // scout_2 unheard: not started
+  rig.Tell("scout_2", std::string(kStatusTopic), EncodeStatusMessage(3'000'000'000, "scout/on_ground", 400, 0));
+  rig.Tell("ground", std::string(kStatusTopic), EncodeStatusMessage(3'000'000'000, "scout/on_ground", 0, 0));
+  rig.Step("idle", true);
+  rig.Run(3.0, "idle", true);
+  EXPECT_EQ(rig.brain().mode(), "scout/taking_off");  // started: every member heard
+  rig.position() = Vec3(0, 0, 30);
+  for (double t = 6.0; t < 8.0; t += 0.5) {
+    rig.Tell("scout_2", std::string(kStatusTopic), EncodeStatusMessage(static_cast<std::int64_t>(t * 1e9), "scout/awaiting_sector", 400, 0));
+    rig.Run(0.5, "position", true);
+  }
+  const raft::AssignSectors* assign = nullptr;
+  for (const raft::MissionCommand& c : rig.proposals()) {
+    if (const auto* a = std::get_if<raft::AssignSectors>(&c)) assign = a;
+  }
+  ASSERT_NE(assign, nullptr);
+  ASSERT_EQ(assign->sectors.size(), 2u);
+  // Strips in the order of where they are: scout_2 (x = 400 m) east of scout_1 (x = 0).
+  EXPECT_EQ(assign->sectors[0].drone, "scout_1");
+  EXPECT_EQ(assign->sectors[1].drone, "scout_2");
 }
 
 TEST(SarBrainLifter, TheLoadCheckDropsAnAttachTheWorldDidNotCarryOut) {

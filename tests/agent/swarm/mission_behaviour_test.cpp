@@ -195,9 +195,12 @@ TEST(ScoutBehaviour, KeepSearchingDuringRescueOrbitsOnlyOnceSweptThenLeavesTheOr
   EXPECT_TRUE(HasEvent(out, "victim_handled"));
   s.Step(Input(t += 0.1, m, on_orbit), &out);  // nothing left: home
   EXPECT_EQ(out.mode, "returning");
-  // Near home it descends in position mode to the approach height, then lands.
+  // Near home it flies over home in position mode at its altitude, then descends vertically to
+  // the approach height, then lands.
   s.Step(Input(t += 30, m, {3, 3, 30}), &out);
   EXPECT_EQ(out.setpoint.kind, SetpointKind::kPosition);
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(0, 0, 30));
+  s.Step(Input(t += 1, m, {1.0, 1.0, 30}), &out);
   EXPECT_EQ(out.setpoint.target_m, Vector3d(0, 0, 5));
   s.Step(Input(t += 1, m, {0.2, 0.1, 29}), &out);
   EXPECT_EQ(out.mode, "returning");  // over home but still high

@@ -41,7 +41,7 @@ MissionSim::MissionSim(MissionSimConfig config)
     modes_.push_back("on_ground");
     out_.emplace_back();
     detections_.emplace_back();
-    flock_.emplace_back(fp, Geofence::Centered(400, 400));
+    flock_.emplace_back(fp, Geofence::Centered(config_.geofence_m.x(), config_.geofence_m.y()));
     if (d.role == Role::kScout) {
       ScoutConfig c;
       c.name = d.name;
@@ -49,6 +49,16 @@ MissionSim::MissionSim(MissionSimConfig config)
       c.base_height_m = d.base_height_m;
       c.lifter_present = lifter_present;
       c.orbit_time_s = 15.0;
+      c.takeoff_delay_s = config_.takeoff_wave_s * TakeoffWave(d.home_m.head<2>(), 4.0);
+      if (config_.agent_tuning) {  // as SarBrain::Start
+        c.cruise_speed_m_s = 7.0;
+        c.orbit_radius_m = 12.0;
+        c.orbit_time_s = 20.0;
+        c.keep_searching_during_rescue = true;
+        c.return_when_swept = true;
+        c.approach_height_m = 5.0;
+        c.return_layer = TakeoffWave(d.home_m.head<2>(), 4.0);
+      }
       behaviour_of_.push_back(static_cast<int>(scouts_.size()));
       scouts_.emplace_back(c);
     } else {
@@ -276,7 +286,11 @@ void MissionSim::Step() {
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i + 1; j < n; ++j) {
       const double d = (pos_[i] - pos_[j]).norm();
-      if (pos_[i].z() > 2.0 && pos_[j].z() > 2.0) min_pair_m_ = std::min(min_pair_m_, d);
+      if (pos_[i].z() > 2.0 && pos_[j].z() > 2.0 && d < min_pair_m_) {
+        min_pair_m_ = d;
+        min_pair_where_ = "t=" + std::to_string(t_s_) + " " + config_.drones[i].name + "(" + std::string(modes_[i]) +
+                          ") " + config_.drones[j].name + "(" + std::string(modes_[j]) + ")";
+      }
       if (out_[i].setpoint.kind == SetpointKind::kFlock && out_[j].setpoint.kind == SetpointKind::kFlock) {
         min_flock_pair_m_ = std::min(min_flock_pair_m_, d);
       }

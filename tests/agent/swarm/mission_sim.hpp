@@ -37,6 +37,11 @@ struct MissionSimConfig {
   double dt_s = 0.05;
   double commit_delay_s = 0.3;
   Rect area{-100, -60, 100, 60};
+  Vec2 geofence_m{400, 400};  // the flocking geofence, centred [m]
+  // Scouts as SarBrain tunes them (keep searching during a rescue, home when swept, descend to
+  // 5 m before landing, orbit 20 s) instead of ScoutConfig's defaults.
+  bool agent_tuning = false;
+  double takeoff_wave_s = 0.0;  // > 0: staggered take-off, TakeoffWave(home, 4 m) waves apart [s]
   std::vector<SimDrone> drones;
   std::vector<Vec2> victims_m;
   double detection_sigma_m = 0.5;  // fake camera geolocation noise [m]
@@ -81,6 +86,8 @@ class MissionSim {
   // Closest approach of two airborne drones (> 2 m up), and of two drones both flocking [m].
   double min_pair_distance_m() const { return min_pair_m_; }
   double min_flocking_pair_distance_m() const { return min_flock_pair_m_; }
+  // Where the closest approach of two airborne drones happened: "t=.. a(mode) b(mode)".
+  const std::string& min_pair_where() const { return min_pair_where_; }
   std::size_t rejected_proposals() const { return rejected_; }
   std::size_t leader() const { return leader_index_; }
   // A failure from now on (e.g. once a drone logged its first sector progress).
@@ -124,6 +131,7 @@ class MissionSim {
   double next_camera_s_ = 0.0;
   double min_pair_m_ = 1e9;
   double min_flock_pair_m_ = 1e9;
+  std::string min_pair_where_;
   std::size_t rejected_ = 0;
   std::vector<std::string> log_;
   double t_s_ = 0.0;

@@ -1,6 +1,7 @@
 // Search geometry (agent/swarm/search_pattern.hpp): footprint, partition, lawnmower, orbit.
 #include "swarmbox/swarm/search_pattern.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -91,6 +92,69 @@ TEST(SearchPattern, OrbitWaypointsCircleTheTargetFacingIt) {
   // From angle 0 with a lead of 0.5 rad, the next waypoint is at 2 pi / 8 (counter-clockwise).
   EXPECT_EQ(NextOrbitWaypoint(o, V2(10, -5), V2(25, -5), 0.5), 1u);
   EXPECT_EQ(NextOrbitWaypoint(o, V2(10, -5), V2(10, 10), 0.5), 3u);  // at pi/2 -> 3 pi/4
+}
+
+// Sectors on a near-square grid for any N: the cells tile the area (no gap, no overlap: the areas
+// add up and no two overlap), bands across the shorter side, and fewer than 4 sectors per unit of
+// aspect ratio stay strips (the shipped 3-scout trials keep theirs).
+TEST(SearchPattern, PartitionTilesTheAreaWithNearSquareCellsForAnyN) {
+  const Rect square{-292, -292, 292, 292};
+  EXPECT_EQ(PartitionGridFor(square, 3).cells, (std::vector<std::size_t>{3}));
+  EXPECT_EQ(PartitionGridFor(square, 100).cells, std::vector<std::size_t>(10, 10));
+  EXPECT_EQ(PartitionGridFor(square, 40).cells, (std::vector<std::size_t>{7, 7, 7, 7, 6, 6}));
+  EXPECT_EQ(PartitionGridFor(Rect{0, 0, 100, 400}, 8).cells, (std::vector<std::size_t>{8}));  // 100 x 50 m
+  EXPECT_EQ(PartitionGridFor(Rect{0, 0, 100, 400}, 16).cells, (std::vector<std::size_t>{8, 8}));  // 50 x 50 m
+  EXPECT_FALSE(PartitionGridFor(Rect{0, 0, 100, 400}, 8).bands_along_y);  // taller than wide
+  for (const Rect& area : {square, Rect{-100, -60, 100, 60}, Rect{0, 0, 100, 400}}) {
+    for (std::size_t n = 1; n <= 120; ++n) {
+      std::vector<std::string> names;
+      for (std::size_t i = 0; i < n; ++i) names.push_back("d" + std::to_string(i));
+      const std::vector<raft::Sector> s = PartitionArea(area, names);
+      ASSERT_EQ(s.size(), n);
+      double total = 0;
+      double worst_aspect = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        EXPECT_EQ(s[i].drone, names[i]);
+        const Rect r = AsRect(s[i]);
+        ASSERT_GT(r.width_m(), 0);
+        ASSERT_GT(r.height_m(), 0);
+        EXPECT_TRUE(area.Contains({r.x_min_m, r.y_min_m}) && area.Contains({r.x_max_m, r.y_max_m}));
+        total += r.width_m() * r.height_m();
+        worst_aspect = std::max(worst_aspect, std::max(r.width_m(), r.height_m()) / std::min(r.width_m(), r.height_m()));
+        for (std::size_t j = 0; j < i; ++j) {
+          const Rect q = AsRect(s[j]);
+          const double ox = std::min(r.x_max_m, q.x_max_m) - std::max(r.x_min_m, q.x_min_m);
+          const double oy = std::min(r.y_max_m, q.y_max_m) - std::max(r.y_min_m, q.y_min_m);
+          EXPECT_FALSE(ox > 1e-6 && oy > 1e-6) << "cells " << i << " and " << j << " overlap";
+        }
+      }
+      EXPECT_NEAR(total, area.width_m() * area.height_m(), 1e-6) << n;
+      if (n >= 4) {
+        EXPECT_LT(worst_aspect, 4.5) << n << " sectors";  // near square once there are bands
+      }
+    }
+  }
+}
+
+// The order that hands each drone the cell matching its place: scouts on a shuffled 10 x 10 grid
+// get the cells of their own column and row, whatever order their names come in.
+TEST(SearchPattern, PartitionOrderMatchesCellsToWhereTheDronesAre) {
+  const Rect area{-292, -292, 292, 292};
+  std::vector<std::string> names;
+  std::vector<V2> where;
+  for (int k = 0; k < 100; ++k) {
+    const int i = (k * 37) % 100;  // a permutation of 0..99
+    names.push_back("scout_" + std::to_string(i + 1));
+    where.push_back(V2(4.0 * (i % 10), 4.0 * (i / 10)));
+  }
+  std::vector<std::string> ordered;
+  for (const std::size_t k : PartitionOrder(area, names, where)) ordered.push_back(names[k]);
+  const std::vector<raft::Sector> s = PartitionArea(area, ordered);
+  for (const raft::Sector& c : s) {
+    const int i = std::stoi(c.drone.substr(6)) - 1;
+    EXPECT_EQ(static_cast<int>(std::floor((c.x_min_m + 292 + 1e-6) / 58.4)), i % 10) << c.drone;
+    EXPECT_EQ(static_cast<int>(std::floor((c.y_min_m + 292 + 1e-6) / 58.4)), i / 10) << c.drone;
+  }
 }
 
 }  // namespace

@@ -71,6 +71,14 @@ struct ScoutConfig {
   bool return_when_swept = false;
   // Return and landing.
   double home_approach_m = 10.0;      // stop flocking and fly straight home within this [m]
+  // Altitude layer of the way home: fly home return_layer x return_layer_m above the search
+  // altitude, and descend only once over home. The agent gives each scout its TakeoffWave as its
+  // layer (4 layers, 4 m apart): the 8 grid neighbours of a home are all in other layers, so two
+  // scouts that swap sides on the way back (orbiting the same victim scrambles the order the
+  // sectors were handed out in) pass >= 4 m above each other instead of through each other
+  // (the kinematic rig saw 0.4 m at 49 scouts without layers).
+  int return_layer = 0;
+  double return_layer_m = 4.0;
   double home_reached_m = 1.0;
   // > 0: descend to this height above home (position mode, faster than the landing descent)
   // before landing; 0: land from the search altitude [m].
@@ -83,6 +91,18 @@ struct ScoutConfig {
   int report_tries = 4;               // proposals of one report at most
   std::uint64_t first_sighting_seq = 1;  // after an agent restart: seed above any used (sim ms)
 };
+
+// Staggered take-off from the trial's grid (design18: up to 100 scouts `spacing_m` = 4 m apart):
+// the wave, 0..3, of a scout whose home is `home_xy_m`, from the 2 x 2 checkerboard of grid
+// cells (x and y index parity) on a grid of `grid_m`. Scouts of one wave are at least two grid
+// steps (8 m, 13 x the x500's 0.62 m collision box) apart; each of a scout's 8 grid neighbours is
+// in another wave. The agent starts wave w at w x takeoff_wave_s (sar_brain.cpp): while a scout
+// climbs (2 m/s), its neighbours are on the ground or >= 3 m above it, so neither the flight
+// stack's take-off transient (a PX4-style take-off drifts < 1 m) nor the 3-D flocking repulsion
+// of a neighbour that reached the hold altitude can bring two climbing drones together, and the
+// swarm's 100 take-off commands and status changes are spread over 4 steps instead of one. Homes
+// off the grid only make the waves less ideal, never unsafe (a vertical climb stays in its column).
+int TakeoffWave(const Eigen::Vector2d& home_xy_m, double grid_m);
 
 class ScoutBehaviour {
  public:

@@ -4,12 +4,14 @@
 //
 //   flocking.hpp          Flocking              velocity setpoint from neighbours + goal (V18 Boids)
 //   flock_metrics.hpp     ComputeFlockMetrics   safety / order / union of a swarm snapshot
-//   search_pattern.hpp    PartitionArea, LawnmowerWaypoints, OrbitWaypoints, GroundFootprint
+//   search_pattern.hpp    PartitionArea (grid), PartitionOrder, LawnmowerWaypoints, OrbitWaypoints,
+//                         GroundFootprint
 //   battery_model.hpp     BatteryModel          energy, energy-to-home, battery_low
 //   mission_types.hpp     MissionInput / MissionOutput / SetpointRequest / PayloadRequest
 //   scout_behaviour.hpp   ScoutBehaviour        scout state machine
 //   lifter_sequence.hpp   LifterSequence        x8_heavy stretcher rescue state machine
 //   leader_planner.hpp    LeaderPlanner         what the Raft leader proposes
+//   member_table.hpp      MemberTable           every member's latest word, per message, O(1)
 //   victim_perception.hpp VictimPerception      detector + geolocation + latency queue
 //
 // Wiring sketch (agent/app; `driver` is the raft NodeDriver, `flight` the flight stack):
@@ -49,6 +51,7 @@
 #include "swarmbox/swarm/flocking.hpp"
 #include "swarmbox/swarm/leader_planner.hpp"
 #include "swarmbox/swarm/lifter_sequence.hpp"
+#include "swarmbox/swarm/member_table.hpp"
 #include "swarmbox/swarm/mission_types.hpp"
 #include "swarmbox/swarm/scout_behaviour.hpp"
 #include "swarmbox/swarm/search_pattern.hpp"
