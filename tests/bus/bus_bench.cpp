@@ -15,8 +15,9 @@
 //          (cross-vendor figures; the line then carries echo_backend=...),
 //          --mode=external: no echo is started; one must already run (swarmbox-bus-echo with the
 //          same --domain/--kind, e.g. in another network namespace),
-//          --scenario=rtt|fleet|lockstep_fleet|agent_step|all (fleet and lockstep_fleet are one
-//          scenario; agent_step, paced at 250 Hz, runs only when named),
+//          --scenario=rtt|fleet|lockstep_fleet|agent_step|udp_floor|all (fleet and lockstep_fleet
+//          are one scenario; agent_step, paced at 250 Hz, and udp_floor, the same 2N datagrams a
+//          step over plain UDP, run only when named),
 //          --drones=<fleet size; default 10 (quick) or 10, 50, 100>,
 //          --steps=<fleet lockstep steps; default 100 (quick) or 1000>.
 // Fleet lines: suite=bus scenario=lockstep_fleet backend=.. drones=N steps=.. step_p50_us=..
@@ -26,6 +27,12 @@
 //   two free cores) timeouts=0
 // Agent lines (--scenario=agent_step): suite=bus scenario=agent_step answer=waitset|callback
 //   agent_cpu_us_per_step=.. agent_switches_per_step=.. agent_core_fraction=.. (at 250 Hz)
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -493,6 +500,70 @@ int RunAgentStep(const Scenario& sc, const std::string& kind, int steps) {
   return timeouts == 0 ? 0 : 1;
 }
 
+// The kernel's floor under the lockstep fleet: the same 2N datagrams a step (N of 300 B out, N
+// back, one at a time), between this process and a forked child over UDP on loopback, no DDS.
+// Whatever middleware carries a per-drone sample and a per-drone answer sits above this.
+int RunUdpFloor(int drones, int steps) {
+  constexpr int kBytes = 300;  // about a SensorSample / ActuatorCommand on the wire
+  auto make = [](std::uint16_t port) {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    int size = 4 << 20;
+    (void)::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
+    if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) return -1;
+    return fd;
+  };
+  constexpr std::uint16_t kServerPort = 47311, kEchoPort = 47312;
+  auto to = [](std::uint16_t port) {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    return a;
+  };
+  const int server = make(kServerPort);
+  const int echo_fd = make(kEchoPort);
+  if (server < 0 || echo_fd < 0) {
+    std::fprintf(stderr, "bus bench: udp_floor: cannot bind UDP ports %d/%d on loopback\n", kServerPort, kEchoPort);
+    return 1;
+  }
+  const long total = static_cast<long>(drones) * steps;
+  const pid_t child = ::fork();
+  if (child == 0) {  // the echo: answer every datagram
+    char buf[2048];
+    const sockaddr_in back = to(kServerPort);
+    for (long i = 0; i < total; ++i) {
+      if (::recv(echo_fd, buf, sizeof buf, 0) < 0) ::_exit(1);
+      (void)::sendto(echo_fd, buf, kBytes, 0, reinterpret_cast<const sockaddr*>(&back), sizeof back);
+    }
+    ::_exit(0);
+  }
+  ::close(echo_fd);
+  char buf[2048] = {};
+  const sockaddr_in out = to(kEchoPort);
+  const ProcessUsage server0 = Usage(0), echo0 = Usage(child);
+  const auto t0 = Clock::now();
+  for (int k = 0; k < steps; ++k) {
+    for (int d = 0; d < drones; ++d) {
+      (void)::sendto(server, buf, kBytes, 0, reinterpret_cast<const sockaddr*>(&out), sizeof out);
+    }
+    for (int d = 0; d < drones; ++d) (void)::recv(server, buf, sizeof buf, 0);
+  }
+  const double secs = std::chrono::duration<double>(Clock::now() - t0).count();
+  const ProcessUsage server1 = Usage(0), echo1 = Usage(child);
+  int status = 0;
+  (void)::waitpid(child, &status, 0);
+  ::close(server);
+  const double cpu_us = static_cast<double>(server1.cpu_ns - server0.cpu_ns + echo1.cpu_ns - echo0.cpu_ns) / 1e3 / steps;
+  std::printf("suite=bus scenario=udp_floor drones=%d steps=%d steps_s=%.0f cpu_us_per_step=%.0f steps_s_2cores=%.0f\n",
+              drones, steps, secs > 0 ? steps / secs : 0.0, cpu_us, cpu_us > 0 ? 2e6 / cpu_us : 0.0);
+  std::fflush(stdout);
+  return 0;
+}
+
 std::vector<std::string> Pick(const std::string& value, std::vector<std::string> all) {
   if (value == "all") return all;
   return {value};
@@ -509,11 +580,17 @@ int RunBusBench(const Args& args) {
   std::string scenario = args.Get("scenario", "all");
   // lockstep_fleet: the name the fleet lines carry (scenario=lockstep_fleet), accepted as well.
   if (scenario == "lockstep_fleet") scenario = "fleet";
-  if (scenario != "all" && scenario != "rtt" && scenario != "fleet" && scenario != "agent_step") {
+  if (scenario != "all" && scenario != "rtt" && scenario != "fleet" && scenario != "agent_step" &&
+      scenario != "udp_floor") {
     std::fprintf(stderr,
-                 "bus bench: unknown --scenario '%s': accepted rtt, fleet (lockstep_fleet), agent_step, all\n",
+                 "bus bench: unknown --scenario '%s': accepted rtt, fleet (lockstep_fleet), agent_step, "
+                 "udp_floor, all\n",
                  scenario.c_str());
     return 2;
+  }
+  if (scenario == "udp_floor") {  // not part of "all"
+    return RunUdpFloor(static_cast<int>(args.GetInt("drones", 100)),
+                       static_cast<int>(args.GetInt("steps", args.quick ? 200 : 3000)));
   }
   if (scenario == "agent_step") {  // not part of "all": it runs paced, in real time
     int worst = 0;
