@@ -15,16 +15,33 @@
 //          (cross-vendor figures; the line then carries echo_backend=...),
 //          --mode=external: no echo is started; one must already run (swarmbox-bus-echo with the
 //          same --domain/--kind, e.g. in another network namespace),
-//          --scenario=rtt|fleet|lockstep_fleet|all (fleet and lockstep_fleet are one scenario),
+//          --scenario=rtt|fleet|lockstep_fleet|agent_step|udp_floor|all (fleet and lockstep_fleet
+//          are one scenario; agent_step, paced at 250 Hz, and udp_floor, the same 2N datagrams a
+//          step over plain UDP, run only when named),
 //          --drones=<fleet size; default 10 (quick) or 10, 50, 100>,
 //          --steps=<fleet lockstep steps; default 100 (quick) or 1000>.
 // Fleet lines: suite=bus scenario=lockstep_fleet backend=.. drones=N steps=.. step_p50_us=..
-//   step_p99_us=.. steps_s=.. msgs_s=.. (2N messages per step) max_hz_per_drone=.. timeouts=0
+//   step_p99_us=.. steps_s=.. msgs_s=.. (2N messages per step) max_hz_per_drone=..
+//   cpu_us_per_step=.. (both processes, every thread) server_cpu_us=.. agents_cpu_us=..
+//   switches_per_step=.. steps_s_2cores=.. (2 s of CPU per s over cpu_us_per_step: the ceiling on
+//   two free cores) timeouts=0
+// Agent lines (--scenario=agent_step): suite=bus scenario=agent_step answer=waitset|callback
+//   agent_cpu_us_per_step=.. agent_switches_per_step=.. agent_core_fraction=.. (at 250 Hz)
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <csignal>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <cstdio>
 #include <memory>
 #include <mutex>
@@ -100,6 +117,8 @@ class Echo {
   Echo() = default;
   Echo(Echo&&) = default;
   Echo& operator=(Echo&&) = delete;
+  // The child's pid (two_process), or -1.
+  pid_t pid() const { return child_ ? child_->pid() : -1; }
   ~Echo() {
     if (stop_) stop_->store(true);
     if (thread_.joinable()) thread_.join();
@@ -117,6 +136,32 @@ double Percentile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
   const auto idx = static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5);
   return v[std::min(idx, v.size() - 1)];
+}
+
+// CPU time of every thread of process `pid` (0: this process) [ns] and its context switches
+// (voluntary + involuntary), from /proc/<pid>/task/*/schedstat and status: nanosecond resolution,
+// and unlike wall time it holds on a busy host.
+struct ProcessUsage {
+  std::int64_t cpu_ns = 0;
+  std::int64_t switches = 0;
+};
+ProcessUsage Usage(pid_t pid) {
+  ProcessUsage u;
+  const std::string dir = pid > 0 ? "/proc/" + std::to_string(pid) + "/task" : std::string("/proc/self/task");
+  std::error_code ec;
+  for (const auto& task : std::filesystem::directory_iterator(dir, ec)) {
+    std::ifstream sched(task.path() / "schedstat");
+    std::int64_t run_ns = 0;
+    if (sched >> run_ns) u.cpu_ns += run_ns;
+    std::ifstream status(task.path() / "status");
+    std::string line;
+    while (std::getline(status, line)) {
+      if (line.rfind("voluntary_ctxt_switches:", 0) == 0 || line.rfind("nonvoluntary_ctxt_switches:", 0) == 0) {
+        u.switches += std::strtoll(line.c_str() + line.find(':') + 1, nullptr, 10);
+      }
+    }
+  }
+  return u;
 }
 
 struct Scenario {
@@ -350,6 +395,7 @@ int RunFleet(const Scenario& sc, int drones, int steps) {
   std::vector<double> step_us;
   step_us.reserve(static_cast<std::size_t>(steps));
   int timeouts = 0;
+  const ProcessUsage server0 = Usage(0), echo0 = Usage(echo->pid());
   const auto t_all = Clock::now();
   for (int k = 1; k <= steps && timeouts == 0; ++k) {
     const auto step = static_cast<std::uint64_t>(k);
@@ -369,16 +415,153 @@ int RunFleet(const Scenario& sc, int drones, int steps) {
   }
   const double secs = std::chrono::duration<double>(Clock::now() - t_all).count();
   const double steps_s = secs > 0 ? static_cast<double>(step_us.size()) / secs : 0.0;
+  const ProcessUsage server1 = Usage(0), echo1 = Usage(echo->pid());
+  const double n = std::max<double>(1.0, static_cast<double>(step_us.size()));
+  const double server_us = static_cast<double>(server1.cpu_ns - server0.cpu_ns) / 1e3 / n;
+  const double echo_us = static_cast<double>(echo1.cpu_ns - echo0.cpu_ns) / 1e3 / n;
   std::printf(
       "suite=bus scenario=lockstep_fleet backend=%s%s%s mode=two_process interface=%s drones=%d "
       "steps=%zu step_p50_us=%.1f step_p99_us=%.1f steps_s=%.0f msgs_s=%.0f "
-      "max_hz_per_drone=%.0f timeouts=%d\n",
+      "max_hz_per_drone=%.0f cpu_us_per_step=%.0f server_cpu_us=%.0f agents_cpu_us=%.0f "
+      "switches_per_step=%.1f steps_s_2cores=%.0f timeouts=%d\n",
       sc.backend.c_str(), sc.echo_backend == sc.backend ? "" : " echo_backend=",
       sc.echo_backend == sc.backend ? "" : sc.echo_backend.c_str(), sc.interface.c_str(), drones,
       step_us.size(), Percentile(step_us, 0.50), Percentile(step_us, 0.99), steps_s,
-      2.0 * drones * steps_s, steps_s, timeouts);
+      2.0 * drones * steps_s, steps_s, server_us + echo_us, server_us, echo_us,
+      static_cast<double>(server1.switches - server0.switches + echo1.switches - echo0.switches) / n,
+      server_us + echo_us > 0 ? 2e6 / (server_us + echo_us) : 0.0, timeouts);
   std::fflush(stdout);
   return timeouts == 0 ? 0 : 1;
+}
+
+// One agent's sim-bus cost per step at real time: this process publishes drone_0's SensorSample
+// every 4 ms (250 Hz, paced) and waits for its answer; the child answers as `kind` says:
+//   waitset   (echo kind lockstep) the agent's own loop: TakeFor on its main thread (Cyclone's
+//             receive thread takes the datagram and wakes the main thread), Publish from there;
+//   callback  (echo kind fleet, 1 drone) the answer written from the reader's callback on the
+//             receive thread: no hand-off to another thread.
+// Figures: the child's CPU per step (every thread) and its context switches per step.
+int RunAgentStep(const Scenario& sc, const std::string& kind, int steps) {
+  testing::EchoOptions o{.backend = sc.echo_backend, .domain_id = sc.domain, .interface = sc.interface,
+                         .kind = kind == "waitset" ? "lockstep" : "fleet", .drone = "drone_0", .drones = 1};
+  auto echo = Echo::Start("two_process", o);
+  if (!echo) return 1;
+  auto p = Participant::Create({.backend = sc.backend, .domain_id = sc.domain, .interface = sc.interface});
+  if (!p) {
+    std::fprintf(stderr, "bus bench: %s\n", p.error().ToString().c_str());
+    return 1;
+  }
+  const std::vector<std::string> names = {"drone_0"};
+  auto pub = (*p)->CreatePublisher<SensorSample>(SensorTopic(names[0]), Qos::kLockstep);
+  FleetAnswers answers(names);
+  auto sub = (*p)->CreateSubscriber<ActuatorCommand>(kActuatorTopic, Qos::kLockstep,
+                                                     [&answers](const ActuatorCommand& c) { answers.On(c); });
+  if (!pub || !sub || !(*pub)->WaitForSubscribers(1, std::chrono::seconds(15)) ||
+      !(*sub)->WaitForPublishers(1, std::chrono::seconds(15))) {
+    std::fprintf(stderr, "bus bench: agent_step: no match\n");
+    return 1;
+  }
+  SensorSample s = testing::FullSensorSample(1);
+  s.drone = names[0];
+  s.step = 0;
+  answers.Begin(0);
+  bool joined = false;
+  for (int i = 0; i < 100 && !joined; ++i) {
+    (void)(*pub)->Publish(s);
+    joined = answers.WaitAll(std::chrono::milliseconds(100));
+  }
+  if (!joined) {
+    std::fprintf(stderr, "bus bench: agent_step: the agent never answered\n");
+    return 1;
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  int timeouts = 0;
+  constexpr auto kPeriod = std::chrono::microseconds(4000);
+  const ProcessUsage agent0 = Usage(echo->pid());
+  const auto t_start = Clock::now();
+  int done = 0;
+  for (int k = 1; k <= steps && timeouts == 0; ++k, ++done) {
+    std::this_thread::sleep_until(t_start + k * kPeriod);
+    answers.Begin(static_cast<std::uint64_t>(k));
+    s.step = static_cast<std::uint64_t>(k);
+    (void)(*pub)->Publish(s);
+    if (!answers.WaitAll(std::chrono::seconds(2))) ++timeouts;
+  }
+  const ProcessUsage agent1 = Usage(echo->pid());
+  const double n = std::max(1, done);
+  std::printf(
+      "suite=bus scenario=agent_step backend=%s answer=%s interface=%s steps=%d rate_hz=250 "
+      "agent_cpu_us_per_step=%.1f agent_switches_per_step=%.2f agent_core_fraction=%.4f timeouts=%d\n",
+      sc.echo_backend.c_str(), kind.c_str(), sc.interface.c_str(), done,
+      static_cast<double>(agent1.cpu_ns - agent0.cpu_ns) / 1e3 / n,
+      static_cast<double>(agent1.switches - agent0.switches) / n,
+      static_cast<double>(agent1.cpu_ns - agent0.cpu_ns) / 1e3 / n / 4000.0, timeouts);
+  std::fflush(stdout);
+  return timeouts == 0 ? 0 : 1;
+}
+
+// The kernel's floor under the lockstep fleet: the same 2N datagrams a step (N of 300 B out, N
+// back, one at a time), between this process and a forked child over UDP on loopback, no DDS.
+// Whatever middleware carries a per-drone sample and a per-drone answer sits above this.
+int RunUdpFloor(int drones, int steps) {
+  constexpr int kBytes = 300;  // about a SensorSample / ActuatorCommand on the wire
+  auto make = [](std::uint16_t port) {
+    const int fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    int size = 4 << 20;
+    (void)::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &size, sizeof size);
+    if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) return -1;
+    return fd;
+  };
+  constexpr std::uint16_t kServerPort = 47311, kEchoPort = 47312;
+  auto to = [](std::uint16_t port) {
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(port);
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    return a;
+  };
+  const int server = make(kServerPort);
+  const int echo_fd = make(kEchoPort);
+  if (server < 0 || echo_fd < 0) {
+    std::fprintf(stderr, "bus bench: udp_floor: cannot bind UDP ports %d/%d on loopback\n", kServerPort, kEchoPort);
+    return 1;
+  }
+  const long total = static_cast<long>(drones) * steps;
+  const pid_t child = ::fork();
+  if (child == 0) {  // the echo: answer every datagram
+    char buf[2048];
+    const sockaddr_in back = to(kServerPort);
+    for (long i = 0; i < total; ++i) {
+      if (::recv(echo_fd, buf, sizeof buf, 0) < 0) ::_exit(1);
+      (void)::sendto(echo_fd, buf, kBytes, 0, reinterpret_cast<const sockaddr*>(&back), sizeof back);
+    }
+    ::_exit(0);
+  }
+  ::close(echo_fd);
+  char buf[2048] = {};
+  const sockaddr_in out = to(kEchoPort);
+  const ProcessUsage server0 = Usage(0), echo0 = Usage(child);
+  const auto t0 = Clock::now();
+  for (int k = 0; k < steps; ++k) {
+    for (int d = 0; d < drones; ++d) {
+      (void)::sendto(server, buf, kBytes, 0, reinterpret_cast<const sockaddr*>(&out), sizeof out);
+    }
+    for (int d = 0; d < drones; ++d) (void)::recv(server, buf, sizeof buf, 0);
+  }
+  const double secs = std::chrono::duration<double>(Clock::now() - t0).count();
+  const ProcessUsage server1 = Usage(0), echo1 = Usage(child);
+  int status = 0;
+  (void)::waitpid(child, &status, 0);
+  ::close(server);
+  const double cpu_us = static_cast<double>(server1.cpu_ns - server0.cpu_ns + echo1.cpu_ns - echo0.cpu_ns) / 1e3 / steps;
+  std::printf("suite=bus scenario=udp_floor drones=%d steps=%d steps_s=%.0f cpu_us_per_step=%.0f steps_s_2cores=%.0f\n",
+              drones, steps, secs > 0 ? steps / secs : 0.0, cpu_us, cpu_us > 0 ? 2e6 / cpu_us : 0.0);
+  std::fflush(stdout);
+  return 0;
 }
 
 std::vector<std::string> Pick(const std::string& value, std::vector<std::string> all) {
@@ -397,10 +580,29 @@ int RunBusBench(const Args& args) {
   std::string scenario = args.Get("scenario", "all");
   // lockstep_fleet: the name the fleet lines carry (scenario=lockstep_fleet), accepted as well.
   if (scenario == "lockstep_fleet") scenario = "fleet";
-  if (scenario != "all" && scenario != "rtt" && scenario != "fleet") {
-    std::fprintf(stderr, "bus bench: unknown --scenario '%s': accepted rtt, fleet (lockstep_fleet), all\n",
+  if (scenario != "all" && scenario != "rtt" && scenario != "fleet" && scenario != "agent_step" &&
+      scenario != "udp_floor") {
+    std::fprintf(stderr,
+                 "bus bench: unknown --scenario '%s': accepted rtt, fleet (lockstep_fleet), agent_step, "
+                 "udp_floor, all\n",
                  scenario.c_str());
     return 2;
+  }
+  if (scenario == "udp_floor") {  // not part of "all"
+    return RunUdpFloor(static_cast<int>(args.GetInt("drones", 100)),
+                       static_cast<int>(args.GetInt("steps", args.quick ? 200 : 3000)));
+  }
+  if (scenario == "agent_step") {  // not part of "all": it runs paced, in real time
+    int worst = 0;
+    for (const auto& backend : backends) {
+      for (const std::string kind : {"waitset", "callback"}) {
+        const Scenario sc{backend, echo_backend.empty() ? backend : echo_backend, "two_process", "agent",
+                          interface, domain++};
+        const int steps = static_cast<int>(args.GetInt("steps", args.quick ? 250 : 2500));
+        if (const int rc = RunAgentStep(sc, kind, steps); rc != 0) worst = rc;
+      }
+    }
+    return worst;
   }
   int worst = 0;
   for (const auto& backend : backends) {
