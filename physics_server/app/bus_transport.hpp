@@ -1,6 +1,6 @@
 // BusTransport: SimTransport on the SwarmBox sim bus (bus/topics.hpp): per drone a SensorSample
-// and CameraImage publisher and an ActuatorCommand subscriber, plus the clock and status
-// publishers and the world-command subscriber. Actuator commands arrive on middleware threads and are queued here.
+// and CameraImage publisher and an ActuatorCommand subscriber, plus the clock publisher and the
+// world-command subscriber. Actuator commands arrive on middleware threads and are queued here.
 //
 // Sensor mapping (physics SensorSample -> bus SensorSample): each sensor's `valid` means "a new
 // measurement at this step" (the physics `fresh` flag; stale values are repeated but invalid).

@@ -628,7 +628,8 @@ namespace {
 
 TEST_F(RunnerTest, TheServersCompleteStartIsSaidAndTimed) {
   api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready",
-                                   "t=0.000 node=physics event=joined joined=1 expected=1 lost=0 wait_s=1.250",
+                                   "t=0.000 node=physics event=joined joined=1 expected=1 lost=0 "
+                                   "wait_s=1.250",
                                    "t=1.000 node=physics event=tick"};
   api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
   std::ostringstream progress;
