@@ -210,6 +210,8 @@ void StatusOverBus(const std::string& backend) {
 
 TEST(BusLockstep, TheStartIsOnSimStatusCycloneDds) { StatusOverBus("cyclonedds"); }
 
+TEST(BusLockstep, TheStartIsOnSimStatusFastDds) { StatusOverBus("fastdds"); }
+
 TEST(BusLockstep, FakeAgentKeepsItsDroneAndASilentOneIsLostCycloneDds) { RunLockstepOverBus("cyclonedds"); }
 
 TEST(BusLockstep, FakeAgentKeepsItsDroneAndASilentOneIsLostFastDds) { RunLockstepOverBus("fastdds"); }
