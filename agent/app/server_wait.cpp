@@ -52,7 +52,8 @@ void ServerWait::OnStatus(const bus::Event& status) {
 }
 
 std::string ServerWait::Reason() const {
-  if (statuses_ == 0) return "within " + Seconds(timeout_) + " s and no sign of the physics server (sim/status)";
+  if (statuses_ == 0)
+    return "within " + Seconds(timeout_) + " s and no sign of the physics server (sim/status)";
   const std::string start = "joined " + std::to_string(joined_) + "/" + std::to_string(expected_);
   if (left_out_) return "and the physics server started without this drone (" + start + ")";
   return "for " + Seconds(timeout_) + " s after the physics server's last status (" + start +

@@ -58,7 +58,7 @@ class ServerWait {
   std::string drone_;
   int statuses_ = 0;
   std::uint64_t joined_ = 0, expected_ = 0;
-  bool listed_ = false;     // the last status named this drone as missing
+  bool listed_ = false;  // the last status named this drone as missing
   bool left_out_ = false;
 };
 

@@ -26,9 +26,9 @@
 namespace swarmbox::physics {
 
 struct JoiningStatus {
-  std::size_t joined = 0;             // drones that answered the first step
-  std::size_t expected = 0;           // drones in the trial
-  std::vector<std::string> missing;   // the others, in drone order
+  std::size_t joined = 0;            // drones that answered the first step
+  std::size_t expected = 0;          // drones in the trial
+  std::vector<std::string> missing;  // the others, in drone order
 };
 
 // "a,b,c": at most `max_names` names, then ",+N" for the rest; "-" when none.

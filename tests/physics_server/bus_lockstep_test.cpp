@@ -199,17 +199,23 @@ void StatusOverBus(const std::string& backend) {
   }
   const Status result = server.Join();
   ASSERT_TRUE(result.ok()) << result.error().ToString();
-  while ((*status)->TakeFor(ev, std::chrono::milliseconds(joined ? 0 : 2000))) joined = joined || ev.name == "joined";
+  while ((*status)->TakeFor(ev, std::chrono::milliseconds(joined ? 0 : 2000))) {
+    joined = joined || ev.name == "joined";
+  }
   EXPECT_TRUE(b_awaited);
   EXPECT_TRUE(joined);
   EXPECT_FALSE(world->Truth(1).lost);
   const std::string log = testing::ReadAll(out);
   std::fclose(out);
   EXPECT_NE(log.find("t=0.000 node=physics event=joining joined="), std::string::npos) << log;
-  EXPECT_NE(log.find("t=0.000 node=physics event=joined joined=2 expected=2 lost=0 wait_s="), std::string::npos) << log;
+  EXPECT_NE(log.find("t=0.000 node=physics event=joined joined=2 expected=2 lost=0 wait_s="),
+            std::string::npos)
+      << log;
 }
 
 TEST(BusLockstep, TheStartIsOnSimStatusCycloneDds) { StatusOverBus("cyclonedds"); }
+
+TEST(BusLockstep, TheStartIsOnSimStatusFastDds) { StatusOverBus("fastdds"); }
 
 TEST(BusLockstep, FakeAgentKeepsItsDroneAndASilentOneIsLostCycloneDds) { RunLockstepOverBus("cyclonedds"); }
 

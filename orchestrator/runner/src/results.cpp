@@ -81,6 +81,14 @@ std::string ResultJson(const TrialResult& r) {
   Node problems = Node::Sequence();
   for (const std::string& p : r.problems) problems.Append(Str(p));
   doc.Set("problems", std::move(problems));
+  Node timing = Node::Mapping();
+  auto seconds = [&](const std::optional<double>& v) { return v ? Bare(Num(*v)) : Node::Null(); };
+  timing.Set("containers", Bare(std::to_string(r.timing.containers)));
+  timing.Set("created_s", seconds(r.timing.created_s));
+  timing.Set("started_s", seconds(r.timing.started_s));
+  timing.Set("joined_s", seconds(r.timing.joined_s));
+  timing.Set("teardown_s", seconds(r.timing.teardown_s));
+  doc.Set("timing", std::move(timing));
   doc.Set("provenance", report::ProvenanceNode(r.provenance));
   return yaml::EmitJson(doc) + "\n";
 }

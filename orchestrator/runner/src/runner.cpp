@@ -20,6 +20,7 @@
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/radio_schedule.hpp"
 #include "swarmbox/runner/start_progress.hpp"
+#include "swarmbox/runner/trial_progress.hpp"
 #include "swarmbox/runner/trajectories.hpp"
 #include "swarmbox/runner/user_images.hpp"
 
@@ -303,7 +304,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       }
     }
   };
-  bool joined_said = false;  // the physics server's start is over and was reported
+  TrialProgress joining;  // the physics server's event=joining/joined lines only
   auto process = [&](const HubItem& item) {
     if (item.kind == HubItem::Kind::kLine) {
       const LogfmtFields fields = ParseLogfmt(item.text);
@@ -321,10 +322,15 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
       }
       if (monitor && tree) {
         if (auto v = monitor->OnLine(item.component, item.text)) raise(item.component, *v, false);
-        if (!joined_said) {
-          if (auto line = JoinedLine(monitor->progress())) {
+      }
+      // The physics server's start, folded apart from the monitor (which stops at the trial's end:
+      // the lines of the start may come after another stream's ending line).
+      if (auto ev = FindField(fields, "event"); ev && (*ev == "joining" || *ev == "joined")) {
+        joining.OnLine(item.component, item.text);
+        if (!result.timing.joined_s) {
+          if (auto line = JoinedLine(joining)) {
             say(*line);
-            joined_said = true;
+            result.timing.joined_s = item.wall_s;
           }
         }
       }
@@ -413,8 +419,8 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   Verdict verdict = start.ok() ? *tree->end_verdict() : start;
   // A trial that ends badly during its start (or with drones given up at it) names the drones
   // that did not join, from the physics server's event=joining/joined lines.
-  if (!verdict.ok() && monitor) {
-    if (auto note = NotJoinedNote(monitor->progress())) verdict.reason += "; " + *note;
+  if (!verdict.ok()) {
+    if (auto note = NotJoinedNote(joining)) verdict.reason += "; " + *note;
   }
   say("ending: " + verdict.ToString());
   events.Write(LifecycleEventJson(wall(), "shutdown", info.name, verdict));
@@ -430,10 +436,14 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     Verdict stop = tree->Stop(*engine);
     stop.KeepWorse(engine->FinishStops());  // exit codes, artifacts, removals still under way
     if (counts.created() > 0) {
+      result.timing.teardown_s = wall() - stop_began_s;
       char took[64];
-      std::snprintf(took, sizeof took, " in %.1f s", wall() - stop_began_s);
+      std::snprintf(took, sizeof took, " in %.1f s", *result.timing.teardown_s);
       say("stopped and removed " + std::to_string(counts.created()) + " containers" + took);
     }
+    result.timing.containers = counts.total();
+    result.timing.created_s = counts.all_created_s();
+    result.timing.started_s = counts.all_started_s();
     if (!stop.ok()) {
       result.problems.push_back("teardown: " + stop.ToString());
       verdict.KeepWorse(stop);

@@ -11,6 +11,7 @@ std::optional<std::string> StartProgress::Count(Counter& c, const char* what, do
     char in[48];
     std::snprintf(in, sizeof in, " in %.1f s", wall_s);
     c.last_line_s = wall_s;
+    c.all_s = wall_s;
     return count + in;
   }
   if (c.n > 1 && wall_s - c.last_line_s < every_s_) return std::nullopt;

@@ -13,7 +13,8 @@ bus::Event Status(const std::string& name, int joined, int expected, const std::
   bus::Event e;
   e.node = "physics";
   e.name = name;
-  e.fields = {{"joined", std::to_string(joined)}, {"expected", std::to_string(expected)}, {"missing", missing}};
+  e.fields = {
+      {"joined", std::to_string(joined)}, {"expected", std::to_string(expected)}, {"missing", missing}};
   return e;
 }
 
@@ -47,7 +48,8 @@ TEST(ServerWait, WaitsAsLongAsTheServersStartProgresses) {
   Wait(w, 1000);
   EXPECT_TRUE(w.spent());
   EXPECT_FALSE(w.left_out());
-  EXPECT_EQ(w.Reason(), "for 1.0 s after the physics server's last status (joined 69/101, this drone missing)");
+  EXPECT_EQ(w.Reason(),
+            "for 1.0 s after the physics server's last status (joined 69/101, this drone missing)");
 }
 
 TEST(ServerWait, AStartThatEndsWithoutThisDroneEndsTheWait) {

@@ -7,6 +7,21 @@
 namespace swarmbox::runner {
 namespace {
 
+// The start's and end's wall times; what did not happen is null.
+TEST(ResultJson, TimingHoldsTheStartAndTheTeardown) {
+  TrialResult r;
+  r.timing = {22, 3.4, 15.5, std::nullopt, 4.125};
+  auto doc = yaml::Parse(ResultJson(r), "result.json");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  const yaml::Node* t = doc->Find("timing");
+  ASSERT_NE(t, nullptr);
+  EXPECT_EQ(t->Find("containers")->scalar(), "22");
+  EXPECT_EQ(t->Find("created_s")->scalar(), "3.4");
+  EXPECT_EQ(t->Find("started_s")->scalar(), "15.5");
+  EXPECT_TRUE(t->Find("joined_s")->is_null());
+  EXPECT_EQ(t->Find("teardown_s")->scalar(), "4.125");
+}
+
 TEST(ResultJson, HoldsTheContractFields) {
   TrialResult r;
   r.trial = "sar-search";

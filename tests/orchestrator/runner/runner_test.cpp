@@ -610,10 +610,37 @@ TEST_F(RunnerTest, AHundredDroneTrialStartsAtOnceAndNamesTheDronesThatDidNotJoin
   EXPECT_THAT(said, HasSubstr("[mini] started 101/101 in "));
   EXPECT_THAT(said, HasSubstr("[mini] stopped and removed 101 containers in "));
   EXPECT_LT(std::count(said.begin(), said.end(), '\n'), 30) << said;
+  EXPECT_EQ(run.result.timing.containers, 101u);
+  ASSERT_TRUE(run.result.timing.created_s && run.result.timing.started_s && run.result.timing.teardown_s);
+  EXPECT_LE(*run.result.timing.created_s, *run.result.timing.started_s);
+  EXPECT_FALSE(run.result.timing.joined_s);  // the server never said its start was complete
   ExpectNothingLeft();
   // The figure for the record (one by one: 101 x 120 ms = 12.1 s of engine time).
   std::printf("100 drones on a 30/50/20/20 ms engine: whole run %.2f s wall\n", took_s);
   EXPECT_LT(took_s, 12.1);
+}
+
+}  // namespace
+}  // namespace swarmbox::runner
+
+namespace swarmbox::runner {
+namespace {
+
+TEST_F(RunnerTest, TheServersCompleteStartIsSaidAndTimed) {
+  api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready",
+                                   "t=0.000 node=physics event=joined joined=1 expected=1 lost=0 "
+                                   "wait_s=1.250",
+                                   "t=1.000 node=physics event=tick"};
+  api_.scripts["scout_1"].lines = {"t=2 node=scout_1 event=mission_complete"};
+  std::ostringstream progress;
+  options_.progress = &progress;
+  RunOutcome run = Run();
+  EXPECT_EQ(run.result.verdict.outcome, dsl::Outcome::kSuccess) << run.result.verdict.ToString();
+  EXPECT_THAT(progress.str(), HasSubstr("[mini] joined 1/1 in 1.2 s\n"));
+  EXPECT_TRUE(run.result.timing.joined_s);
+  const std::string json = ReadFile(fs::path(run.trial_dir) / "result.json");
+  EXPECT_THAT(json, HasSubstr("\"timing\":{\"containers\":"));
+  ExpectNothingLeft();
 }
 
 }  // namespace

@@ -122,10 +122,11 @@ TEST(TrialProgress, JoiningLinesShowTheStartAndNameTheMissingDrones) {
   p.OnLine("physics", "t=0.000 node=physics event=joining joined=37 expected=101 "
                       "missing=scout_16,scout_40,scout_41,scout_42,scout_43,scout_44,scout_45,scout_46,"
                       "scout_47,scout_48,+54");
-  EXPECT_EQ(RenderProgress(p, {600, 8.0, 101, 101}), "sim 0.0/600.0s  wall 8.0s  joining 37/101  live 101/101");
+  EXPECT_EQ(RenderProgress(p, {600, 8.0, 101, 101}),
+            "sim 0.0/600.0s  wall 8.0s  joining 37/101  live 101/101");
   EXPECT_EQ(NotJoinedNote(p),
-            "drones that did not join: scout_16,scout_40,scout_41,scout_42,scout_43,scout_44,scout_45,scout_46,"
-            "scout_47,scout_48,+54 (joined 37/101)");
+            "drones that did not join: scout_16,scout_40,scout_41,scout_42,scout_43,scout_44,scout_45,"
+            "scout_46,scout_47,scout_48,+54 (joined 37/101)");
   EXPECT_EQ(JoinedLine(p), std::nullopt);
   p.OnLine("physics", "t=0.000 node=physics event=joined joined=101 expected=101 lost=0 wait_s=6.214");
   EXPECT_EQ(NotJoinedNote(p), std::nullopt);
@@ -140,7 +141,8 @@ TEST(TrialProgress, DronesLostAtTheStartAreNamed) {
   TrialProgress p;
   p.OnLine("physics", "t=0.000 node=physics event=joined joined=99 expected=101 lost=2 wait_s=36.020 "
                       "missing=scout_16,scout_40");
-  EXPECT_EQ(NotJoinedNote(p), "drones that did not join: scout_16,scout_40 (lost at the start, joined 99/101)");
+  EXPECT_EQ(NotJoinedNote(p),
+            "drones that did not join: scout_16,scout_40 (lost at the start, joined 99/101)");
   EXPECT_EQ(JoinedLine(p), "joined 99/101 in 36.0 s; lost at the start: scout_16,scout_40");
 }
 

@@ -38,6 +38,16 @@ struct ComponentReport {
   std::uint64_t log_lines = 0;
 };
 
+// How long the trial took to start and to go, in wall seconds since the run began (result.json
+// "timing"; `swarmbox-bench swarm` reports them): nullopt = did not happen.
+struct TrialTiming {
+  std::size_t containers = 0;          // of the (last) tree
+  std::optional<double> created_s;     // the last container created
+  std::optional<double> started_s;     // the last container started
+  std::optional<double> joined_s;      // the physics server's event=joined (its start complete)
+  std::optional<double> teardown_s;    // duration: the first Stop to the last removal
+};
+
 struct TrialResult {
   std::string trial;
   std::string trial_id;
@@ -56,6 +66,7 @@ struct TrialResult {
   int restarts = 0;
   std::string ending_line;
   std::vector<std::string> problems;  // teardown/collection issues that did not change the outcome
+  TrialTiming timing;
 };
 
 std::string ResultJson(const TrialResult& result);

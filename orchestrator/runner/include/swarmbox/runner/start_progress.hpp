@@ -24,6 +24,9 @@ class StartProgress {
 
   std::optional<std::string> OnCreated(double wall_s) { return Count(created_, "created", wall_s); }
   std::optional<std::string> OnStarted(double wall_s) { return Count(started_, "started", wall_s); }
+  // When the last container was created / started (the wall_s given); nullopt before.
+  std::optional<double> all_created_s() const { return created_.all_s; }
+  std::optional<double> all_started_s() const { return started_.all_s; }
   std::size_t created() const { return created_.n; }
   std::size_t started() const { return started_.n; }
   std::size_t total() const { return total_; }
@@ -32,6 +35,7 @@ class StartProgress {
   struct Counter {
     std::size_t n = 0;
     double last_line_s = 0;
+    std::optional<double> all_s;
   };
   std::optional<std::string> Count(Counter& c, const char* what, double wall_s);
 
