@@ -20,6 +20,8 @@
 // and the steady clock with netem. The event lines (event=leader_elected, ...) carry `t` from
 // `event_clock` when given (the agent's simulated seconds, so that every line of an agent is on one
 // axis in both models), else from `clock`.
+// Swarm scale: options.voters (--raft-voters) is the voting set; the other members are learners
+// that follow the log and forward their proposals (agent/raft/README.md "Swarm scale").
 // The replicated state machine is the caller's (`machine` at Start; null: a MissionStateMachine,
 // the SAR mission, read through mission(); --mission sar hands it SarBrain's own). A brain reads the
 // committed log through TakeCommitted (every entry applied since the previous call, in index

@@ -118,8 +118,10 @@ struct ThreeRun {
 // Three drones on a lossless channel with a 10 ms delay, stepped every 4 ms of simulated time.
 // With `entry_log` each runs an EntryLogMachine and, from t = 1 s, proposes "hello <name>" until
 // a proposal is accepted.
-ThreeRun RunThree(std::uint64_t seed, double seconds, bool entry_log = false) {
-  const std::vector<std::string> members = {"drone_1", "drone_2", "drone_3"};
+// `members`/`voters`: another swarm (voters: the --raft-voters list, empty: every member votes).
+ThreeRun RunThree(std::uint64_t seed, double seconds, bool entry_log = false,
+                  const std::vector<std::string>& members = {"drone_1", "drone_2", "drone_3"},
+                  const std::vector<std::string>& voters = {}) {
   const std::string dir = swarmbox::testing::MakeTempDir("swarmbox_agent_raft_three_");
   struct Drone {
     std::unique_ptr<radio::ChannelRadio> radio;
@@ -137,6 +139,7 @@ ThreeRun RunThree(std::uint64_t seed, double seconds, bool entry_log = false) {
     RaftHostOptions o;
     o.self = members[i];
     o.members = members;
+    o.voters = voters;
     o.raft_dir = dir + "/" + members[i];
     o.seed = seed;
     std::unique_ptr<raft::StateMachine> machine;
@@ -238,6 +241,24 @@ TEST(RaftHostOnTheChannel, ReplicatesBytesThroughTheEntryLog) {
   for (const auto& [name, log] : run.logs) {
     EXPECT_EQ(log.find("event=mission_state"), std::string::npos) << name << ": no mission here";
   }
+}
+
+// --raft-voters: with two voters among five drones the leader is a voter, and the three learners
+// follow the log and get their own proposals committed (forwarded to the leader).
+TEST(RaftHostOnTheChannel, LearnersFollowTheLogAndTheirProposalsCommit) {
+  const std::vector<std::string> members = {"drone_1", "drone_2", "drone_3", "drone_4", "drone_5"};
+  const ThreeRun run = RunThree(7, 6.0, /*entry_log=*/true, members, {"drone_1", "drone_2"});
+  ASSERT_EQ(run.taps.size(), 5u);
+  const std::vector<raft::Committed>& first = run.taps.begin()->second;
+  std::set<std::string> texts;
+  for (const raft::Committed& c : first) texts.insert(std::string(c.data.begin(), c.data.end()));
+  EXPECT_EQ(texts, (std::set<std::string>{"hello drone_1", "hello drone_2", "hello drone_3", "hello drone_4",
+                                          "hello drone_5"}));
+  for (const auto& [name, tap] : run.taps) EXPECT_EQ(tap, first) << name;
+  std::set<std::string> leaders;
+  for (const auto& [name, leader] : run.leaders) leaders.insert(leader);
+  ASSERT_EQ(leaders.size(), 1u);
+  EXPECT_TRUE(*leaders.begin() == "drone_1" || *leaders.begin() == "drone_2") << *leaders.begin();
 }
 
 TEST(RaftHostMachine, MissionByDefaultAndTheDemoLoopOnlyWithIt) {

@@ -194,6 +194,17 @@ TEST(ClusterSim, LostVoterIsReplacedAndEveryNodeLogsTheChanges) {
   EXPECT_EQ(count("event=raft_conf_change op=remove node=" + name + " "), 11);
   EXPECT_EQ(count("event=raft_conf_change op=promote"), 11);
   EXPECT_EQ(count("event=raft_conf_change op=add_learner node=" + name + " "), 11);
+  // The configuration is durable: a learner that applied the changes has them again at once
+  // after a restart, from its storage alone (the WAL's replay of the committed entries).
+  int learner = -1;
+  for (int i = 3; i < sim.size() && learner < 0; ++i) {
+    if (sim.alive(i) && sim.driver(i)->raft().is_learner()) learner = i;
+  }
+  ASSERT_GE(learner, 0);
+  const ConfState before = sim.driver(learner)->conf_state();
+  sim.Crash(learner);
+  sim.Restart(learner);
+  EXPECT_EQ(sim.driver(learner)->conf_state(), before);
   sim.Restart(victim);
   sim.RunFor(4);
   ASSERT_TRUE(sim.report().ok()) << sim.report().violations.front();

@@ -2,6 +2,8 @@
 // FileSystem interface.
 #include "swarmbox/raft/wal_storage.hpp"
 
+#include "swarmbox/raft/conf_change.hpp"
+
 #include <gtest/gtest.h>
 #include <stdlib.h>
 
@@ -221,6 +223,23 @@ TEST_F(WalStorageTest, CompactionKeepsSnapshotAndLaterEntries) {
   ASSERT_EQ(st.entries.size(), 2u);
   EXPECT_EQ(st.entries[0].index, 4u);
   EXPECT_EQ(st.hard_state, (HardState{2, 1, 4}));
+}
+
+// The membership survives a restart: conf-change entries are stored with their type, and a
+// snapshot keeps the configuration in effect at its index (conf_change.hpp).
+TEST_F(WalStorageTest, MembershipSurvivesReopen) {
+  const ConfState conf{{1, 2, 5}, {3, 4, 6}};
+  Entry change{2, 5, EntryType::kConfChange, EncodeConfChange({ConfChangeOp::kPromoteLearner, 5})};
+  {
+    auto w = Open(posix_);
+    std::vector<Entry> e = {Ent(1, 1), Ent(2, 1), Ent(3, 2), Ent(4, 2), change};
+    ASSERT_TRUE(w->Save(HardState{2, 1, 5}, e, {}).ok());
+    ASSERT_TRUE(w->Compact(Snapshot{3, 2, Bytes{5, 5}, conf}).ok());
+  }
+  PersistentState st = Reload();
+  EXPECT_EQ(st.snapshot.conf, conf);
+  ASSERT_EQ(st.entries.size(), 2u);
+  EXPECT_EQ(st.entries[1], change);
 }
 
 TEST_F(WalStorageTest, SnapshotFromLeaderReplacesTheLog) {

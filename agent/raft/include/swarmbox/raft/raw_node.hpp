@@ -145,8 +145,8 @@ class RawNode {
   const ConfState& conf_state() const { return conf_; }
   bool is_voter() const { return IsVoter(conf_, config_.id); }
   bool is_learner() const { return IsLearner(conf_, config_.id); }
-  // The index of the last change this leader appended (0: none since it became leader... or the
-  // no-op of its term, see ProposeConfChange); a change is in flight while it is > applied.
+  // Leader: the index of the last change it appended, or of its own no-op until it appends one;
+  // no new change is accepted while this is above the applied index (ProposeConfChange).
   std::uint64_t pending_conf_index() const { return pending_conf_index_; }
   // Committed conf-change entries that did not apply (invalid for the configuration they met):
   // skipped identically on every node; the simulator requires 0.
