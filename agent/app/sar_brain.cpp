@@ -352,7 +352,9 @@ void SarBrain::OnNeighbours(const Now& now, std::span<const brain::Neighbour> ne
       if (h != wall_->heard.end() && h->second.t_ns == n.t_ns) wall_s = h->second.wall_s;
     }
     const double sent_s = static_cast<double>(n.t_ns) * 1e-9;
-    if (!members_.Update(n.name, sent_s, role, mode, Eigen::Vector2d(n.position_m.x, n.position_m.y), wall_s)) continue;
+    if (!members_.IsPeer(n.name)) continue;
+    // (Ignored by the table when its status message was newer: its state still steers flocking.)
+    members_.Update(n.name, sent_s, role, mode, Eigen::Vector2d(n.position_m.x, n.position_m.y), wall_s);
     if (n.position_m.z < home_m_.z() + 1.5) continue;  // on the ground: not in the way
     neighbours_.push_back({V(n.position_m), V(n.velocity_m_s), std::max(0.0, now.t_s - sent_s)});
   }
