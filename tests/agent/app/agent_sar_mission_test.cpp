@@ -354,7 +354,8 @@ TEST(AgentSarMission, TwelveScoutsFromTheFourMetreGridOnTheChannelComplete) {
   ASSERT_TRUE(swarm.started());
   const std::optional<Line> complete = swarm.Run(1s, 1200s, nullptr);
   const std::string logs = swarm.AllLogs();
-  ASSERT_TRUE(complete.has_value()) << "no event=mission_complete after " << swarm.wall_s() << " s wall:\n" << logs;
+  ASSERT_TRUE(complete.has_value()) << "no event=mission_complete after " << swarm.wall_s() << " s wall:\n"
+                                    << logs;
   EXPECT_LT(complete->t_s, kMaxMissionSimS) << logs;
   EXPECT_EQ(FindField(complete->fields, "rescued"), "2");
   for (std::size_t i = 0; i < 12; ++i) {
