@@ -127,7 +127,9 @@ bool DecodeStatusMessage(std::string_view payload, std::int64_t* t_ns, std::stri
   };
   double x = 0, y = 0;
   std::int64_t t = 0;
-  if (!whole(f[0], &t) || !whole(f[2], &x) || !whole(f[3], &y) || !std::isfinite(x) || !std::isfinite(y)) return false;
+  if (!whole(f[0], &t) || !whole(f[2], &x) || !whole(f[3], &y) || !std::isfinite(x) || !std::isfinite(y)) {
+    return false;
+  }
   Role role;
   std::string_view mode;
   if (!SplitMissionMode(f[1], &role, &mode)) return false;
@@ -137,7 +139,6 @@ bool DecodeStatusMessage(std::string_view payload, std::int64_t* t_ns, std::stri
   *y_m = y;
   return true;
 }
-
 
 brain::Event ToBrainEvent(const LogEvent& e) {
   brain::Event b;
@@ -205,9 +206,12 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
   for (const auto& [key, value] : tuning) SWARMBOX_TRY(ArgNumber(ctx, key, value));
   if (!(t.mission_dt_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg mission_dt_s must be > 0");
   if (!(t.takeoff_wave_s >= 0) || !(t.takeoff_grid_m > 0)) {
-    return Error(ErrorCode::kInvalidArgument, "sar brain: args takeoff_wave_s must be >= 0, takeoff_grid_m > 0");
+    return Error(ErrorCode::kInvalidArgument,
+                 "sar brain: args takeoff_wave_s must be >= 0, takeoff_grid_m > 0");
   }
-  if (!(t.status_every_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg status_every_s must be > 0");
+  if (!(t.status_every_s > 0)) {
+    return Error(ErrorCode::kInvalidArgument, "sar brain: arg status_every_s must be > 0");
+  }
   if (!c.payload.empty()) {
     auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
                            [&](const flight::SlungPayload& p) { return p.name == c.payload; });
@@ -323,7 +327,8 @@ SarBrain::SarBrain(const SarBrainConfig& config, swarm::BatteryModel battery,
       wall_(wall),
       role_(config.payload.empty() ? Role::kScout : Role::kLifter),
       battery_(std::move(battery)),
-      flock_(FlockParams(config.tuning), swarm::Geofence::Centered(config.geofence_size_x_m, config.geofence_size_y_m)),
+      flock_(FlockParams(config.tuning),
+             swarm::Geofence::Centered(config.geofence_size_x_m, config.geofence_size_y_m)),
       mode_(EncodeMissionMode(role_, "on_ground")),
       members_(config_.members, config_.name) {
   neighbours_.reserve(config_.members.size());
@@ -352,7 +357,9 @@ void SarBrain::OnNeighbours(const Now& now, std::span<const brain::Neighbour> ne
       if (h != wall_->heard.end() && h->second.t_ns == n.t_ns) wall_s = h->second.wall_s;
     }
     const double sent_s = static_cast<double>(n.t_ns) * 1e-9;
-    if (!members_.Update(n.name, sent_s, role, mode, Eigen::Vector2d(n.position_m.x, n.position_m.y), wall_s)) continue;
+    if (!members_.IsPeer(n.name)) continue;
+    // (Ignored by the table when its status message was newer: its state still steers flocking.)
+    members_.Update(n.name, sent_s, role, mode, Eigen::Vector2d(n.position_m.x, n.position_m.y), wall_s);
     if (n.position_m.z < home_m_.z() + 1.5) continue;  // on the ground: not in the way
     neighbours_.push_back({V(n.position_m), V(n.velocity_m_s), std::max(0.0, now.t_s - sent_s)});
   }
@@ -361,8 +368,9 @@ void SarBrain::OnNeighbours(const Now& now, std::span<const brain::Neighbour> ne
 void SarBrain::OnStatus(const Now& now, const brain::Message& m) {
   std::int64_t t_ns = 0;
   double x = 0, y = 0;
-  if (!DecodeStatusMessage(std::string_view(reinterpret_cast<const char*>(m.payload.data()), m.payload.size()), &t_ns,
-                           &status_scratch_, &x, &y)) {
+  if (!DecodeStatusMessage(
+          std::string_view(reinterpret_cast<const char*>(m.payload.data()), m.payload.size()), &t_ns,
+          &status_scratch_, &x, &y)) {
     return;
   }
   Role role;
@@ -381,7 +389,8 @@ void SarBrain::SendStatus(const Now& now, brain::Output& out) {
   const std::string text = EncodeStatusMessage(static_cast<std::int64_t>(std::llround(now.t_s * 1e9)), mode_,
                                                now.pos_m.x(), now.pos_m.y());
   brain::Message msg;
-  msg.topic = std::string(kStatusTopic);  // to "" = broadcast: every member keeps its table (a new leader too)
+  // to "" = broadcast: every member keeps its table (a new leader too)
+  msg.topic = std::string(kStatusTopic);
   msg.payload.assign(text.begin(), text.end());
   out.messages.push_back(std::move(msg));
 }

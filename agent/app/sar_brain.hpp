@@ -80,7 +80,8 @@ Result<GroundPayload> LoadGroundPayload(const std::string& airframe_path, const 
 inline constexpr std::string_view kStatusTopic = "sar/status";
 std::string EncodeStatusMessage(std::int64_t t_ns, std::string_view status, double x_m, double y_m);
 // false for anything else.
-bool DecodeStatusMessage(std::string_view payload, std::int64_t* t_ns, std::string* status, double* x_m, double* y_m);
+bool DecodeStatusMessage(std::string_view payload, std::int64_t* t_ns, std::string* status, double* x_m,
+                         double* y_m);
 
 // "<role>/<mode>" for Output::status (DroneState::mode), and back. Decode is false for anything
 // else (the flight modes a --mission plan agent publishes, another brain's status, garbage).
@@ -253,9 +254,9 @@ class SarBrain final : public brain::Brain {
   // leader's roster. Updated per message, O(1) each.
   swarm::MemberTable members_;
   std::vector<swarm::NeighbourState> neighbours_;  // this tick's flocking neighbours (airborne)
-  std::string sent_status_;                         // the status last sent in a status message
-  std::string status_scratch_;                      // a received one, decoded (capacity kept)
-  double status_due_s_ = 0.0;                       // the next periodic one [s]
+  std::string sent_status_;                        // the status last sent in a status message
+  std::string status_scratch_;                     // a received one, decoded (capacity kept)
+  double status_due_s_ = 0.0;                      // the next periodic one [s]
   std::vector<swarm::GroundDetection> visible_;
 
   swarm::MissionOutput behaviour_out_;

@@ -197,7 +197,8 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
   owners_.clear();
   if (scouts_done) {
     for (const raft::Sector& s : m.sectors()) owners_.push_back(&s.drone);
-    std::sort(owners_.begin(), owners_.end(), [](const std::string* a, const std::string* b) { return *a < *b; });
+    std::sort(owners_.begin(), owners_.end(),
+              [](const std::string* a, const std::string* b) { return *a < *b; });
   }
   for (const RosterEntry& r : roster) {
     if (!scouts_done) break;
@@ -225,7 +226,9 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
           // in the swarm (PartitionOrder), so that nobody crosses another's path to its sector.
           std::vector<std::string> ordered;
           ordered.reserve(scouts.size());
-          for (const std::size_t i : PartitionOrder(config_.search_area, scouts, scout_xy)) ordered.push_back(scouts[i]);
+          for (const std::size_t i : PartitionOrder(config_.search_area, scouts, scout_xy)) {
+            ordered.push_back(scouts[i]);
+          }
           out->proposals.push_back(raft::AssignSectors{PartitionArea(config_.search_area, ordered)});
         }
         out->proposals.push_back(raft::StartSearch{});

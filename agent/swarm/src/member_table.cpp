@@ -53,7 +53,8 @@ bool MemberTable::Update(const std::string& name, double t_s, Role role, std::st
   return true;
 }
 
-void MemberTable::UpdateSelf(double t_s, Role role, std::string_view mode, const Eigen::Vector2d& position_m) {
+void MemberTable::UpdateSelf(double t_s, Role role, std::string_view mode,
+                             const Eigen::Vector2d& position_m) {
   RosterEntry* e = Slot(self_, role);
   const std::size_t i = slot_.find(self_)->second;
   if (e->role != role) {
@@ -78,7 +79,8 @@ std::span<const RosterEntry> MemberTable::Roster(double t_s, double wall_s) {
     e.age_s = std::max(0.0, t_s - heard_[i].t_s);
     // And, netem only, on the wall clock since it was received (infinite without).
     const double wall_age_s = wall_s - heard_[i].wall_s;
-    e.wall_age_s = std::isfinite(wall_age_s) ? std::max(0.0, wall_age_s) : std::numeric_limits<double>::infinity();
+    e.wall_age_s =
+        std::isfinite(wall_age_s) ? std::max(0.0, wall_age_s) : std::numeric_limits<double>::infinity();
   }
   return roster_;
 }

@@ -323,7 +323,8 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
       const double d = (p.head<2>() - home_xy).norm();
       sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
       const double layer_z = Altitude() + config_.return_layer * config_.return_layer_m;
-      const double approach_z = config_.approach_height_m > 0 ? config_.home_m.z() + config_.approach_height_m : layer_z;
+      const double approach_z =
+          config_.approach_height_m > 0 ? config_.home_m.z() + config_.approach_height_m : layer_z;
       // Home in this scout's layer, down only once over home (within 2 x home_reached_m): on a
       // 4 m take-off grid a drone descending on the slant of the last approach_m would pass
       // through its neighbours' columns at their heights; vertically it stays in its own.

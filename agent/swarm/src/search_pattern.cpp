@@ -51,11 +51,14 @@ std::vector<raft::Sector> PartitionArea(const Rect& area, std::span<const std::s
   for (std::size_t b = 0; b < bands; ++b) {
     // The last band and cell end exactly on the area's edge (no rounding gap).
     const double w0 = w_min + (w_max - w_min) * static_cast<double>(b) / static_cast<double>(bands);
-    const double w1 = b + 1 == bands ? w_max : w_min + (w_max - w_min) * static_cast<double>(b + 1) / static_cast<double>(bands);
+    const double w1 = b + 1 == bands
+                          ? w_max
+                          : w_min + (w_max - w_min) * static_cast<double>(b + 1) / static_cast<double>(bands);
     const std::size_t k = g.cells[b];
     for (std::size_t c = 0; c < k; ++c, ++i) {
       const double u0 = u_min + (u_max - u_min) * static_cast<double>(c) / static_cast<double>(k);
-      const double u1 = c + 1 == k ? u_max : u_min + (u_max - u_min) * static_cast<double>(c + 1) / static_cast<double>(k);
+      const double u1 =
+          c + 1 == k ? u_max : u_min + (u_max - u_min) * static_cast<double>(c + 1) / static_cast<double>(k);
       raft::Sector s;
       s.drone = drones[i];
       if (g.bands_along_y) {

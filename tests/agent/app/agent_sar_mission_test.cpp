@@ -332,5 +332,45 @@ TEST(AgentSarMission, AScoutKilledMidSearchHasItsSectorSweptByTheOthers) {
   if (HasFailure()) std::fprintf(stderr, "logs in %s\n", dir.c_str());
 }
 
+// Issue 18: the swarm-scale mission logic in real flight, at the size this shared machine allows
+// outside containers: twelve x500 scouts on the trial's 4 m take-off grid (4 columns) and the
+// lifter, on the simulated channel. One AssignSectors for all twelve (each sector_started once,
+// nothing handed over), take-off in waves and the way home in layers without a collision, both
+// victims rescued, event=mission_complete. Prints the mission and wall time. DDS domains 56-61 (the
+// sim domain only, the channel: the mesh domain passed is never opened; 233+ is out of range).
+TEST(AgentSarMission, TwelveScoutsFromTheFourMetreGridOnTheChannelComplete) {
+  std::vector<std::string> text;
+  text.reserve(2 * 13);  // the Drones point into it: no reallocation
+  std::vector<Drone> drones;
+  for (int i = 0; i < 12; ++i) {
+    text.push_back("scout_" + std::to_string(i + 1));
+    text.push_back(std::to_string(4 * (i % 4)) + "," + std::to_string(4 * (i / 4)) + ",0");
+    drones.push_back({text[text.size() - 2].c_str(), "x500", text.back().c_str(), ""});
+  }
+  drones.push_back({"lifter", "x8_heavy", "0,-10,0", "stretcher"});
+  const std::string dir = MakeTempDir("swarmbox_sar_grid_it_");
+  ASSERT_FALSE(dir.empty());
+  SarSwarm swarm(drones, 56 + static_cast<int>(getpid() % 3) * 2, dir, /*channel=*/true);
+  ASSERT_TRUE(swarm.started());
+  const std::optional<Line> complete = swarm.Run(1s, 1200s, nullptr);
+  const std::string logs = swarm.AllLogs();
+  ASSERT_TRUE(complete.has_value()) << "no event=mission_complete after " << swarm.wall_s() << " s wall:\n"
+                                    << logs;
+  EXPECT_LT(complete->t_s, kMaxMissionSimS) << logs;
+  EXPECT_EQ(FindField(complete->fields, "rescued"), "2");
+  for (std::size_t i = 0; i < 12; ++i) {
+    const std::string log = swarm.Log(i);
+    EXPECT_EQ(Events(log, "sector_started").size(), 1u) << swarm.drone(i).name << ":\n" << log;
+    EXPECT_TRUE(Events(log, "sector_reassigned").empty()) << swarm.drone(i).name;
+  }
+  const std::string plog = swarm.PhysicsLog();
+  EXPECT_TRUE(Events(plog, "collision").empty()) << plog;
+  EXPECT_TRUE(Events(plog, "crash").empty()) << plog;
+  EXPECT_TRUE(Events(plog, "drone_lost").empty()) << plog;
+  std::printf("sar_grid scouts=12 mission_s=%.1f wall_s=%.1f\n", complete->t_s, swarm.wall_s());
+  std::fflush(stdout);
+  if (::testing::Test::HasFailure()) std::fprintf(stderr, "logs in %s\n", dir.c_str());
+}
+
 }  // namespace
 }  // namespace swarmbox::agent::testing

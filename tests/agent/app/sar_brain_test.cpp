@@ -417,8 +417,9 @@ TEST(StatusMessage, RoundTripsAndRejectsGarbage) {
   EXPECT_EQ(status, "scout/searching");
   EXPECT_DOUBLE_EQ(x, -12.5);
   EXPECT_DOUBLE_EQ(y, 300.25);
-  for (const char* bad : {"", "1 scout/searching 1", "1 scout/searching 1 2 3", "x scout/searching 1 2",
-                          "1 pilot/x 1 2", "1 scout/searching 1 nan", "1  scout/searching 1 2", "1 scout/searching 1 2 "}) {
+  for (const char* bad :
+       {"", "1 scout/searching 1", "1 scout/searching 1 2 3", "x scout/searching 1 2", "1 pilot/x 1 2",
+        "1 scout/searching 1 nan", "1  scout/searching 1 2", "1 scout/searching 1 2 "}) {
     EXPECT_FALSE(DecodeStatusMessage(bad, &t_ns, &status, &x, &y)) << "'" << bad << "'";
   }
 }
@@ -450,14 +451,16 @@ TEST(SarBrainScout, TheLeaderKnowsAMemberHeardOnlyThroughItsStatusMessages) {
   rig.position() = Vec3(0, 0, 0.23);
   rig.Run(3.0, "idle", /*leader=*/true);
   EXPECT_EQ(rig.brain().mode(), "scout/on_ground");  // scout_2 unheard: not started
-  rig.Tell("scout_2", std::string(kStatusTopic), EncodeStatusMessage(3'000'000'000, "scout/on_ground", 400, 0));
+  rig.Tell("scout_2", std::string(kStatusTopic),
+           EncodeStatusMessage(3'000'000'000, "scout/on_ground", 400, 0));
   rig.Tell("ground", std::string(kStatusTopic), EncodeStatusMessage(3'000'000'000, "scout/on_ground", 0, 0));
   rig.Step("idle", true);
   rig.Run(3.0, "idle", true);
   EXPECT_EQ(rig.brain().mode(), "scout/taking_off");  // started: every member heard
   rig.position() = Vec3(0, 0, 30);
   for (double t = 6.0; t < 8.0; t += 0.5) {
-    rig.Tell("scout_2", std::string(kStatusTopic), EncodeStatusMessage(static_cast<std::int64_t>(t * 1e9), "scout/awaiting_sector", 400, 0));
+    rig.Tell("scout_2", std::string(kStatusTopic),
+             EncodeStatusMessage(static_cast<std::int64_t>(t * 1e9), "scout/awaiting_sector", 400, 0));
     rig.Run(0.5, "position", true);
   }
   const raft::AssignSectors* assign = nullptr;

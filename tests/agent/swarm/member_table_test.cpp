@@ -2,13 +2,13 @@
 // kept per message, the planner hands all of them their sectors in one proposal.
 #include "swarmbox/swarm/member_table.hpp"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <set>
 #include <string>
 #include <variant>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace swarmbox::swarm {
 namespace {
@@ -28,9 +28,12 @@ TEST(MemberTable, KeepsTheNewestWordOfEachMemberAndIgnoresOthers) {
   EXPECT_EQ(t.heard(), 0u);
   EXPECT_TRUE(t.Update("scout_2", 1.0, Role::kScout, "taking_off", Vec2(4, 0)));
   EXPECT_TRUE(t.Update("scout_2", 2.0, Role::kScout, "searching", Vec2(50, 0)));
-  EXPECT_FALSE(t.Update("scout_2", 1.5, Role::kScout, "on_ground", Vec2(4, 0)));  // older: reordered
+  EXPECT_FALSE(t.Update("scout_2", 1.5, Role::kScout, "on_ground", Vec2(4, 0)));   // older: reordered
   EXPECT_FALSE(t.Update("ground_station", 2.0, Role::kScout, "x", Vec2::Zero()));  // not a member
   EXPECT_FALSE(t.Update("scout_1", 2.0, Role::kScout, "x", Vec2::Zero()));         // this drone
+  EXPECT_TRUE(t.IsPeer("lifter"));
+  EXPECT_FALSE(t.IsPeer("scout_1"));
+  EXPECT_FALSE(t.IsPeer("ground_station"));
   EXPECT_FALSE(t.lifter_heard());
   EXPECT_TRUE(t.Update("lifter", 2.0, Role::kLifter, "on_ground", Vec2(0, -10)));
   EXPECT_TRUE(t.lifter_heard());

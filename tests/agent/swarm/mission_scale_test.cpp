@@ -3,14 +3,14 @@
 // the swarm (geofence sqrt(N) x 60 m per side, the search area 8 m in from it, as SarBrain does),
 // one AssignSectors for all of them, the sweep, and event=mission_complete. Each size prints its
 // mission time (simulated) and the closest approach of two airborne drones.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <variant>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "mission_sim.hpp"
 #include "swarmbox/common/logfmt.hpp"
@@ -28,7 +28,8 @@ MissionSimConfig Scaled(int scouts, bool lifter) {
   c.area = {-side / 2 + 8, -side / 2 + 8, side / 2 - 8, side / 2 - 8};
   const int cols = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(scouts))));
   for (int i = 0; i < scouts; ++i) {
-    c.drones.push_back({"scout_" + std::to_string(i + 1), Role::kScout, Vec3(4.0 * (i % cols), 4.0 * (i / cols), 0), 0.23});
+    c.drones.push_back(
+        {"scout_" + std::to_string(i + 1), Role::kScout, Vec3(4.0 * (i % cols), 4.0 * (i / cols), 0), 0.23});
   }
   c.agent_tuning = true;
   c.takeoff_wave_s = 1.5;
@@ -48,7 +49,8 @@ Outcome RunMission(MissionSim& sim, double max_s) {
   Outcome o;
   o.complete = sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, max_s);
   o.t_s = sim.t_s();
-  for (const std::string& line : sim.log()) o.assign_proposals += line.find("event=sector_reassigned") != std::string::npos;
+  for (const std::string& line : sim.log())
+    o.assign_proposals += line.find("event=sector_reassigned") != std::string::npos;
   return o;
 }
 
@@ -70,7 +72,8 @@ TEST_P(MissionAtScale, EveryScoutSearchesItsCellAndTheMissionCompletes) {
   ASSERT_EQ(sim.mission().victims().size(), c.victims_m.size());
   for (const raft::Victim& v : sim.mission().victims()) EXPECT_EQ(v.status, raft::VictimStatus::kRescued);
   for (std::size_t i = 0; i < c.drones.size(); ++i) {
-    EXPECT_TRUE(sim.mode(i) == "landed" || sim.mode(i) == "on_ground") << c.drones[i].name << " " << sim.mode(i);
+    EXPECT_TRUE(sim.mode(i) == "landed" || sim.mode(i) == "on_ground")
+        << c.drones[i].name << " " << sim.mode(i);
   }
   // No contact (x500 collision box 0.62 m): the take-off is vertical in 4 waves (TakeoffWave),
   // the cells are handed out in the order of the grid (no crossing paths on the way out),
@@ -79,9 +82,10 @@ TEST_P(MissionAtScale, EveryScoutSearchesItsCellAndTheMissionCompletes) {
   // 2.2 m, 49 scouts 3.4 m, 100 scouts 1.7 m, the last two returning at once into the 36 m take-off
   // grid (the RETURN phase sends every scout still in the air home together).
   EXPECT_GT(sim.min_pair_distance_m(), 1.2);
-  std::printf("scouts=%d mission_s=%.1f search_done_s=%.1f min_pair_m=%.2f min_flock_pair_m=%.2f closest: %s\n", n,
-              o.t_s, sim.FirstTime("mission_state", "state=RETURN"), sim.min_pair_distance_m(),
-              sim.min_flocking_pair_distance_m(), sim.min_pair_where().c_str());
+  std::printf(
+      "scouts=%d mission_s=%.1f search_done_s=%.1f min_pair_m=%.2f min_flock_pair_m=%.2f closest: %s\n", n,
+      o.t_s, sim.FirstTime("mission_state", "state=RETURN"), sim.min_pair_distance_m(),
+      sim.min_flocking_pair_distance_m(), sim.min_pair_where().c_str());
   RecordProperty("mission_s", std::to_string(o.t_s));
 }
 

@@ -288,8 +288,9 @@ void MissionSim::Step() {
       const double d = (pos_[i] - pos_[j]).norm();
       if (pos_[i].z() > 2.0 && pos_[j].z() > 2.0 && d < min_pair_m_) {
         min_pair_m_ = d;
-        min_pair_where_ = "t=" + std::to_string(t_s_) + " " + config_.drones[i].name + "(" + std::string(modes_[i]) +
-                          ") " + config_.drones[j].name + "(" + std::string(modes_[j]) + ")";
+        min_pair_where_ = "t=" + std::to_string(t_s_) + " " + config_.drones[i].name + "(" +
+                          std::string(modes_[i]) + ") " + config_.drones[j].name + "(" +
+                          std::string(modes_[j]) + ")";
       }
       if (out_[i].setpoint.kind == SetpointKind::kFlock && out_[j].setpoint.kind == SetpointKind::kFlock) {
         min_flock_pair_m_ = std::min(min_flock_pair_m_, d);

@@ -1,13 +1,13 @@
 // Search geometry (agent/swarm/search_pattern.hpp): footprint, partition, lawnmower, orbit.
 #include "swarmbox/swarm/search_pattern.hpp"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 namespace swarmbox::swarm {
 namespace {
@@ -120,7 +120,8 @@ TEST(SearchPattern, PartitionTilesTheAreaWithNearSquareCellsForAnyN) {
         ASSERT_GT(r.height_m(), 0);
         EXPECT_TRUE(area.Contains({r.x_min_m, r.y_min_m}) && area.Contains({r.x_max_m, r.y_max_m}));
         total += r.width_m() * r.height_m();
-        worst_aspect = std::max(worst_aspect, std::max(r.width_m(), r.height_m()) / std::min(r.width_m(), r.height_m()));
+        worst_aspect =
+            std::max(worst_aspect, std::max(r.width_m(), r.height_m()) / std::min(r.width_m(), r.height_m()));
         for (std::size_t j = 0; j < i; ++j) {
           const Rect q = AsRect(s[j]);
           const double ox = std::min(r.x_max_m, q.x_max_m) - std::max(r.x_min_m, q.x_min_m);

@@ -129,8 +129,8 @@ class LeaderPlanner {
                                               std::span<const RosterEntry> roster,
                                               MissionOutput* out) const;
   bool GoneOwner(double t_s, const std::string& drone) const;  // by_name_ of this Step
-  void Index(std::span<const RosterEntry> roster);              // fills by_name_
-  const RosterEntry* Find(const std::string& drone) const;      // O(log N) in by_name_
+  void Index(std::span<const RosterEntry> roster);             // fills by_name_
+  const RosterEntry* Find(const std::string& drone) const;     // O(log N) in by_name_
   void ReportMembers(double t_s, std::span<const RosterEntry> roster, MissionOutput* out);
 
   LeaderConfig config_;

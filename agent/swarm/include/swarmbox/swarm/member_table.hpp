@@ -47,6 +47,8 @@ class MemberTable {
   std::span<const RosterEntry> Roster(double t_s, double wall_s = std::numeric_limits<double>::quiet_NaN());
 
   std::size_t heard() const { return roster_.size(); }  // members heard, this drone included
+  // `name` is another member of the mission (not this drone). O(1).
+  bool IsPeer(const std::string& name) const { return name != self_ && slot_.count(name) != 0; }
   std::size_t members() const { return slot_.size(); }
   bool lifter_heard() const { return lifters_ > 0; }
   // The entry of `name` (nullptr: not heard yet). Ages as of the last Roster().

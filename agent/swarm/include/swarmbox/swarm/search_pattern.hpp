@@ -51,8 +51,8 @@ double SweepSpacing(const CameraFootprint& footprint, double overlap);
 // shipped 3-scout trials keep their strips. 100 sectors on a square: 10 x 10; 40: 6 bands of
 // 7,7,7,7,6,6.
 struct PartitionGrid {
-  bool bands_along_y = true;        // the longer side is x: bands are rows of cells along x
-  std::vector<std::size_t> cells;   // cells per band, band 0 at the low end of the shorter side
+  bool bands_along_y = true;       // the longer side is x: bands are rows of cells along x
+  std::vector<std::size_t> cells;  // cells per band, band 0 at the low end of the shorter side
 };
 PartitionGrid PartitionGridFor(const Rect& area, std::size_t n);
 
