@@ -1,6 +1,7 @@
 // A real swarm in the suite (issue #18): trials/swarm_100.yaml with 50 scouts and the lifter, rtf 0,
 // 25 simulated seconds, through the trial runner on the real engine. Every drone joins (simulated
-// time moves: the lockstep has all 51), a Raft leader is elected and every drone hears of it, no
+// time moves: the lockstep has all 51), a Raft leader is elected among the 5 voters (raft.voters;
+// the other 46 drones are learners) and every drone hears of it, no
 // drone is lost to the infrastructure, and nothing of the run stays on the engine. The figures
 // line (swarm_figures.hpp) and the wall time go to the log.
 #include <gtest/gtest.h>
@@ -56,6 +57,11 @@ TEST(SwarmE2e, FiftyDronesJoinElectALeaderLoseNoneAndCleanUp) {
   std::set<std::string> leaders;
   for (const auto& [drone, leader] : leader_of) leaders.insert(leader);
   EXPECT_EQ(leaders.size(), 1u) << "drones disagree on the last leader";
+  // Only the voters (raft.voters: the first drones in file order) lead; the rest are learners.
+  ASSERT_GT(spec->raft.voters, 0);
+  std::set<std::string> voters;
+  for (int k = 0; k < spec->raft.voters; ++k) voters.insert(spec->drones[static_cast<std::size_t>(k)].name);
+  for (const std::string& leader : leaders) EXPECT_EQ(voters.count(leader), 1u) << leader << " is no voter";
 
   // Nothing labelled with the run stays (the runner removed it; RunSwarmTrial's sweep found nothing
   // it could not remove).
