@@ -5,7 +5,8 @@
 //                   sampling) and every neighbour copied into the brain's Input at every step (the
 //                   host's table before the bound; SarBrain then saw them only through the Input);
 //   mode=bounded    the defaults: --ping-peers 3 every 200 ms, --brain-neighbours 32 chosen every
-//                   200 ms, SarBrain fed per message;
+//                   200 ms (SarBrain's roster beyond them comes from sar/status messages, which the
+//                   synthetic scouts here do not send);
 //   mode=swarm      as bounded with the swarm trials' radio keys: ping_peers 1 every 1000 ms.
 //
 // scenario=radio_frames: N agents, each a ChannelRadio + LinkProbe (every 200 ms) + the 5 Hz
@@ -98,12 +99,11 @@ radio::LinkProbeOptions ProbeOptions(const Mode& mode, std::size_t n) {
 class Handler final : public agent::FrameHandler {
  public:
   Handler(radio::LinkProbe& probe, radio::MeshRadio& radio, agent::NeighbourTable& table,
-          agent::SarBrain* sar = nullptr, agent::BrainHost* host = nullptr)
-      : probe_(probe), radio_(radio), table_(table), sar_(sar), host_(host) {}
+          agent::BrainHost* host = nullptr)
+      : probe_(probe), radio_(radio), table_(table), host_(host) {}
   void OnRaftPayload(std::span<const std::uint8_t>) override {}
   void OnPing(const bus::RadioFrame& f) override { probe_.OnFrame(f, radio_); }
   void OnState(const bus::DroneState& s, const bus::RadioFrame&) override {
-    if (sar_ != nullptr) sar_->OnNeighbour(agent::NeighbourFromBus(s));
     if (host_ != nullptr) {
       host_->OnState(s);
     } else {
@@ -117,7 +117,6 @@ class Handler final : public agent::FrameHandler {
   radio::LinkProbe& probe_;
   radio::MeshRadio& radio_;
   agent::NeighbourTable& table_;
-  agent::SarBrain* sar_;
   agent::BrainHost* host_;
 };
 
@@ -278,7 +277,7 @@ int RunSarNeighbours(std::size_t n, double sim_s, const Mode& mode) {
   agent::BrainHost host(bo, std::move(*made), flight, &radio, &consensus, devnull);
   auto probe = std::move(*radio::LinkProbe::Create(names[0], names, ProbeOptions(mode, n), radio::RadioTime(0)));
   agent::NeighbourTable unused(names[0], {});
-  Handler handler(*probe, radio, unused, mode.bounded ? sar : nullptr, &host);
+  Handler handler(*probe, radio, unused, &host);
   std::vector<channel::Vec3d> pos(n);
   for (std::size_t i = 0; i < n; ++i) pos[i] = GridPosition(i, n);
   bus::SensorSample sample;
