@@ -134,6 +134,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
     argv.insert(argv.end(), {"--mesh-interface", std::string(kMeshInterface),
                              "--mesh-domain", std::to_string(kMeshDomain)});
   }
+  argv.insert(argv.end(), {"--sample-timeout", Num(kAgentStartPatienceS)});
   argv.insert(argv.end(), {
       "--start", Num(d.pose[0]) + "," + Num(d.pose[1]) + "," + Num(d.pose[2]),
       // Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`.

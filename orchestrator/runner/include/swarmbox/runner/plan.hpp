@@ -131,6 +131,14 @@ inline constexpr double kExternalBrainJoinTimeoutS = kAgentBrainStartMs / 1000.0
 // server waits this long (its own default, 1 s, stays for netem trials, whose failover tests
 // time the loss).
 inline constexpr double kChannelStepTimeoutS = 5.0;
+// How long an agent the runner starts waits for its first sample with no sign of the physics
+// server at all (--sample-timeout; the agent's own default, 10 s, is for a hand-started agent).
+// In a 40-100 drone start an agent's first discovery announcement can be lost in the start's
+// burst of discovery traffic; Cyclone announces again every SPDPInterval (10 s,
+// bus/cyclone_config.hpp), so 10 s of patience lost such agents (the 40-drone start of issue 18).
+// The runner bounds the start itself (the server gives up a drone that has not answered
+// --join-timeout after the latest join, and the trial then names the drones that did not join).
+inline constexpr double kAgentStartPatienceS = 60.0;
 // The external brain's container id: "<drone>-brain".
 std::string BrainId(std::string_view drone);
 // The agent's argv (swarmbox-agent) and an external brain's (for tests and `swarmbox compose`).
