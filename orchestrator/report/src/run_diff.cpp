@@ -13,6 +13,7 @@ namespace swarmbox::report {
 
 const std::vector<std::string_view> kIgnoredEventFields = {"rtf", "clock.late", "mechanism.detected",
                                                            "mechanism.host"};
+const std::vector<std::string_view> kIgnoredEvents = {"joining", "joined"};
 
 namespace {
 
@@ -266,6 +267,7 @@ Result<std::vector<Event>> ParseEvents(std::string_view text, Side side, const s
     }
     std::string kind = StringAt(*doc, "event");
     if (kind.empty()) kind = StringAt(*doc, "type");
+    if (std::find(kIgnoredEvents.begin(), kIgnoredEvents.end(), kind) != kIgnoredEvents.end()) continue;
     Event e;
     e.line = i + 1;
     e.stream = StreamOf(*doc);

@@ -156,6 +156,25 @@ TEST(RunDiff, IgnoredFieldsAreExactlyTheWallClockOnes) {
   EXPECT_FALSE(IgnoredEventField("x", "firewall_s"));
 }
 
+// The physics server's start progress is on the wall clock: who had answered after each wall
+// second (issue 18's event=joining / event=joined) differs between two runs of one trial.
+TEST(RunDiff, TheStartsJoiningProgressIsNotCompared) {
+  const std::string a =
+      R"({"component":"physics","t":0.000,"node":"physics","event":"joining","joined":1,"expected":4,"missing":"scout_1,scout_2,lifter"})" "\n"
+      R"({"component":"physics","t":0.000,"node":"physics","event":"joined","joined":4,"expected":4,"lost":0,"wait_s":1.2})" "\n"
+      R"({"component":"scout_1","t":3.0,"node":"scout_1","event":"takeoff"})" "\n";
+  const std::string b =
+      R"({"component":"physics","t":0.000,"node":"physics","event":"joining","joined":0,"expected":4,"missing":"scout_1,scout_2,scout_3,lifter"})" "\n"
+      R"({"component":"physics","t":0.000,"node":"physics","event":"joining","joined":3,"expected":4,"missing":"lifter"})" "\n"
+      R"({"component":"scout_1","t":3.0,"node":"scout_1","event":"takeoff"})" "\n";
+  const RunDiff d = Diff(Files(std::nullopt, a, std::nullopt), Files(std::nullopt, b, std::nullopt));
+  EXPECT_TRUE(d.identical()) << FormatRunDiff(d, "A", "B");
+  EXPECT_EQ(d.event_count, 1u);
+  // Any other event of the start still counts.
+  const std::string c = b + R"({"component":"physics","t":0.000,"node":"physics","event":"drone_lost","drone":"lifter"})" "\n";
+  EXPECT_FALSE(Diff(Files(std::nullopt, a, std::nullopt), Files(std::nullopt, c, std::nullopt)).identical());
+}
+
 TEST(RunDiff, RunIdInValuesIsNotADifference) {
   const std::string a =
       R"({"wall_s":1,"component":"orchestrator","event":"stop","target":"scout_1","outcome":"failure","reason":"swarmbox-20261126-1-scout_1 exited"})" "\n";

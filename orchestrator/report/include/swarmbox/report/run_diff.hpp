@@ -21,7 +21,9 @@
 //   `_`-separated words (`wall_s`, `requested_wall_s`, ...), `rtf` (the pace asked for and
 //   achieved: the wall clock against simulated time), `late` of `event=clock` (steps the pacing
 //   missed on the wall clock), `detected` and `host` of the `mechanism` record (whether this
-//   process probed the host or used its cache, and the machine's name). The run id (result.json's
+//   process probed the host or used its cache, and the machine's name); and whole events of the
+//   kinds in kIgnoredEvents: `joining` and `joined`, the physics server's start progress (who had
+//   answered the first step after each wall second of the start). The run id (result.json's
 //   `run_id`, part of container names and paths) is replaced by `<run>` in every value first.
 // - result.json: `outcome` and `reason` (nothing else: wall_s, sim_s at the moment the runner saw
 //   the end, provenance and metrics are about the machine or follow from the files above).
@@ -51,6 +53,9 @@ struct RunFiles {
 // Field names of events.jsonl never compared (besides every name with a `wall` word):
 // "rtf", "clock.late" (event=clock only), "mechanism.detected", "mechanism.host" (type=mechanism).
 extern const std::vector<std::string_view> kIgnoredEventFields;
+// Event kinds of events.jsonl never compared: "joining", "joined" (physics start progress, on the
+// wall clock; a drone lost at the start also has its drone_lost event, which is compared).
+extern const std::vector<std::string_view> kIgnoredEvents;
 // Whether events.jsonl field `name` of a record with `event` (or `type`) `kind` is ignored.
 bool IgnoredEventField(std::string_view kind, std::string_view name);
 
