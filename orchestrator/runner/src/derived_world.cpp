@@ -1,19 +1,13 @@
 #include "swarmbox/runner/derived_world.hpp"
 
-#include <charconv>
 #include <cmath>
 
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/runner/plan.hpp"
 
 namespace swarmbox::runner {
 
 namespace {
-
-std::string Num(double v) {
-  char buf[64];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
 
 // Whether (x, y) lies inside a geofence of `size_m` centred on the origin [m].
 bool Inside(double x, double y, const std::array<double, 2>& size_m) {
@@ -26,9 +20,9 @@ Status CheckInside(const yaml::Node& thing, std::string_view kind, double x, dou
   const yaml::Node* id = thing.Find("id");
   const std::string name = id != nullptr && id->is_scalar() ? id->scalar() : std::string("?");
   return Error(ErrorCode::kInvalidArgument,
-               std::string(kind) + " " + name + " at (" + Num(x) + ", " + Num(y) + ") m lies outside world_size_m [" +
-                   Num(size_m[0]) + ", " + Num(size_m[1]) + "] (the geofence spans |x| <= X/2, |y| <= Y/2): use at least [" +
-                   Num(std::ceil(2 * std::abs(x))) + ", " + Num(std::ceil(2 * std::abs(y))) + "]",
+               std::string(kind) + " " + name + " at (" + ShortestNumber(x) + ", " + ShortestNumber(y) + ") m lies outside world_size_m [" +
+                   ShortestNumber(size_m[0]) + ", " + ShortestNumber(size_m[1]) + "] (the geofence spans |x| <= X/2, |y| <= Y/2): use at least [" +
+                   ShortestNumber(std::ceil(2 * std::abs(x))) + ", " + ShortestNumber(std::ceil(2 * std::abs(y))) + "]",
                thing.Where());
 }
 
@@ -59,10 +53,10 @@ Result<std::string> DeriveWorld(std::string_view world_text, std::string_view wo
     }
   }
   yaml::Node geofence = yaml::Node::Mapping();
-  geofence.Set("size_x_m", yaml::Node::Scalar(Num(size_m[0])));
-  geofence.Set("size_y_m", yaml::Node::Scalar(Num(size_m[1])));
+  geofence.Set("size_x_m", yaml::Node::Scalar(ShortestNumber(size_m[0])));
+  geofence.Set("size_y_m", yaml::Node::Scalar(ShortestNumber(size_m[1])));
   doc->Set("geofence", std::move(geofence));
-  return "# " + std::string(world_file) + " with its geofence set to " + Num(size_m[0]) + " x " + Num(size_m[1]) +
+  return "# " + std::string(world_file) + " with its geofence set to " + ShortestNumber(size_m[0]) + " x " + ShortestNumber(size_m[1]) +
          " m by the trial's world_size_m (written by the swarmbox runner)\n" + yaml::Emit(*doc);
 }
 

@@ -14,13 +14,13 @@
 
 namespace swarmbox::runner {
 
-namespace {
-
-std::string Num(double v) {
+std::string ShortestNumber(double v) {
   char buf[64];
   auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
 }
+
+namespace {
 
 std::string InContainer(std::string_view relative) {
   return std::string(kContainerTrialsDir) + "/" + std::string(relative);
@@ -44,13 +44,13 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
       "--world", InContainer(spec.world),
       "--airframes-dir", InContainer("airframes"),
       "--seed", std::to_string(spec.seed),
-      "--rtf", Num(spec.rtf),
+      "--rtf", ShortestNumber(spec.rtf),
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
       "--sim-interface", std::string(kSimInterface),
       "--domain", std::to_string(kSimDomain),
       "--truth", std::string(kTruthCsvPath),
       // Stops (event=stopped t=...) when the trial's simulated time is up; truth.csv is flushed.
-      "--max-sim-time", Num(spec.timeout.sim.seconds()),
+      "--max-sim-time", ShortestNumber(spec.timeout.sim.seconds()),
   };
   // The simulated radio: the channel with its profile, and the plan of what happens at simulated
   // times (network.mesh, the faults with `at:`; radio_schedule.hpp).
@@ -65,22 +65,22 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
   // An agent with an external brain waits up to the brain's wall-clock bounds for its answer:
   // the server must wait longer before it calls that drone lost.
   if (spec.HasExternalBrain()) {
-    argv.insert(argv.end(), {"--step-timeout", Num(std::max(kExternalBrainStepTimeoutS, channel ? kChannelStepTimeoutS : 0.0)),
-                             "--join-timeout", Num(kExternalBrainJoinTimeoutS)});
+    argv.insert(argv.end(), {"--step-timeout", ShortestNumber(std::max(kExternalBrainStepTimeoutS, channel ? kChannelStepTimeoutS : 0.0)),
+                             "--join-timeout", ShortestNumber(kExternalBrainJoinTimeoutS)});
   } else if (channel) {
-    argv.insert(argv.end(), {"--step-timeout", Num(kChannelStepTimeoutS)});
+    argv.insert(argv.end(), {"--step-timeout", ShortestNumber(kChannelStepTimeoutS)});
   }
   for (const faults::Fault& f : spec.faults) {
     if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {
-      argv.insert(argv.end(), {"--clock-every", Num(kFaultClockEveryS)});
+      argv.insert(argv.end(), {"--clock-every", ShortestNumber(kFaultClockEveryS)});
       break;
     }
   }
   for (const dsl::DroneSpec& d : spec.drones) {
     // name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]]; a payload starts on the ground
     // under the drone (a lifter standing on the ground cannot spawn with it hanging).
-    std::string drone = d.name + ":" + d.airframe + ":" + Num(d.pose[0]) + "," + Num(d.pose[1]) +
-                        "," + Num(d.pose[2]);
+    std::string drone = d.name + ":" + d.airframe + ":" + ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) +
+                        "," + ShortestNumber(d.pose[2]);
     if (!d.payload.empty()) drone += ":0:" + d.payload + ":ground";
     argv.push_back("--drone");
     argv.push_back(std::move(drone));
@@ -98,7 +98,7 @@ std::vector<std::string> PhysicsCommandArgv(dsl::Middleware middleware, const fa
       "--middleware", std::string(dsl::MiddlewareName(middleware)),
       "--send-command", call.target.empty() ? "-" : call.target, call.command,
   };
-  for (double a : call.args) argv.push_back(Num(a));
+  for (double a : call.args) argv.push_back(ShortestNumber(a));
   return argv;
 }
 
@@ -134,9 +134,9 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
     argv.insert(argv.end(), {"--mesh-interface", std::string(kMeshInterface),
                              "--mesh-domain", std::to_string(kMeshDomain)});
   }
-  argv.insert(argv.end(), {"--sample-timeout", Num(kAgentStartPatienceS)});
+  argv.insert(argv.end(), {"--sample-timeout", ShortestNumber(kAgentStartPatienceS)});
   argv.insert(argv.end(), {
-      "--start", Num(d.pose[0]) + "," + Num(d.pose[1]) + "," + Num(d.pose[2]),
+      "--start", ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) + "," + ShortestNumber(d.pose[2]),
       // Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`.
       "--members", Members(spec),
       "--seed", std::to_string(spec.seed),
@@ -173,7 +173,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
     } else {
       argv.insert(argv.end(), {"--brain", "external"});
     }
-    if (brain.rate_hz > 0) argv.insert(argv.end(), {"--brain-rate-hz", Num(brain.rate_hz)});
+    if (brain.rate_hz > 0) argv.insert(argv.end(), {"--brain-rate-hz", ShortestNumber(brain.rate_hz)});
     if (brain.offboard.timeout_ms) {
       argv.insert(argv.end(), {"--offboard-timeout-ms", std::to_string(*brain.offboard.timeout_ms)});
     }

@@ -91,6 +91,9 @@ struct PlanOptions {
   std::string world_path;
 };
 
+// The shortest text that reads back as `v` (std::to_chars): numbers in argv and derived files.
+std::string ShortestNumber(double v);
+
 inline constexpr std::string_view kPhysicsId = "physics";
 inline constexpr std::string_view kDronesGroupId = "drones";
 inline constexpr std::string_view kSimNetworkId = "sim";
