@@ -131,6 +131,16 @@ class NetemGuest : public ::testing::Test {
            " ms late, i.e. the guest went unscheduled that long)";
   }
 
+  // netem's rate spaces the frames by their length at the rate, on a schedule fixed at enqueue, so
+  // the fitted rate can never come out above it (2 % for the fit). The guest is one process on a
+  // host that CI loads with a second test: when it goes short of CPU the guest drains the queue
+  // late and the rate comes out low (1942.9 kbit/s seen in CI, i.e. -2.9 %). Below, 10 % allows
+  // for that and still tells netem's rate from none (8,300 kbit/s offered) and from a wrong unit.
+  static void ExpectNetemRate(double wire_kbit, double rate_kbit) {
+    EXPECT_LE(wire_kbit, rate_kbit * 1.02);
+    EXPECT_GE(wire_kbit, rate_kbit * 0.90);
+  }
+
   // Traffic back to a bare veth: everything arrives, in well under the smallest delay asked for.
   void ExpectUnimpaired(const GuestRecord& r) {
     EXPECT_EQ(r.Field("received"), r.Field("sent")) << r.Field("probe");
@@ -198,14 +208,14 @@ TEST_F(NetemGuest, PerDestinationRuleDelaysAndLimitsOnlyThatPeer) {
   EXPECT_LT(Num(*to_c, "p50_ms"), 82.5) << Late(*to_c);  // the userspace test's allowance
   // The rule's rate: 1000-byte datagrams offered at 8.3 Mbit/s queue behind netem's 2000 kbit/s,
   // which it counts on the whole frame (payload + UDP + IP + Ethernet = 1042 bytes). netem spaces
-  // them by that exactly; 2 % covers the guest's late wake-ups (the slope is fitted over 300).
+  // them by that exactly. See ExpectNetemRate for the band.
   const GuestRecord* rate = Probe("rate_to_c");
   ASSERT_NE(rate, nullptr);
   std::printf(
       "kernel netem (guest), per-destination rate 2000 kbit/s: %s kbit/s on the wire (%s of %s arrived)\n",
       rate->Field("wire_kbit").c_str(), rate->Field("received").c_str(), rate->Field("sent").c_str());
   EXPECT_EQ(rate->Field("received"), rate->Field("sent"));
-  EXPECT_NEAR(Num(*rate, "wire_kbit"), 2000.0, 40.0) << Late(*rate);
+  ExpectNetemRate(Num(*rate, "wire_kbit"), 2000.0);
   // The fault's removal leaves the veth as it was.
   EXPECT_EQ(Tree("removed"), Tree("pristine"));
   const GuestRecord* after = Probe("after_removal");
@@ -224,7 +234,7 @@ TEST_F(NetemGuest, RateLimitsEveryPacketOnTheLink) {
       rate->Field("wire_kbit").c_str(), rate->Field("received").c_str(), rate->Field("sent").c_str(),
       rate->Field("max_ms").c_str());
   EXPECT_EQ(rate->Field("received"), rate->Field("sent"));
-  EXPECT_NEAR(Num(*rate, "wire_kbit"), 2000.0, 40.0);
+  ExpectNetemRate(Num(*rate, "wire_kbit"), 2000.0);
 }
 
 TEST_F(NetemGuest, ReorderSendsAFractionAtOnce) {
