@@ -9,6 +9,7 @@
 #include "brain_convert.hpp"
 #include "external_brain.hpp"
 #include "server_wait.hpp"
+#include "swarmbox/bus/cyclone_config.hpp"
 #include "swarmbox/bus/topics.hpp"
 #include "swarmbox/brain/args.hpp"
 #include "swarmbox/brain/loader.hpp"
@@ -142,8 +143,15 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   // participants (plan complete, samples stopped, errors); a SIGTERM stop skips the deletion
   // altogether (main.cpp, LeaveNow).
   constexpr int kNoLinger = 0;
-  auto sim = bus::Participant::Create(
-      {.backend = o.middleware, .domain_id = o.sim_domain, .interface = o.sim_interface, .writer_linger_ms = kNoLinger});
+  std::vector<std::string> peers;
+  for (const std::string& host : o.sim_peers) {
+    peers.push_back(host + ":" + std::to_string(bus::CycloneDiscoveryPort(o.sim_domain, 0)));
+  }
+  auto sim = bus::Participant::Create({.backend = o.middleware,
+                                       .domain_id = o.sim_domain,
+                                       .interface = o.sim_interface,
+                                       .writer_linger_ms = kNoLinger,
+                                       .peers = std::move(peers)});
   if (!sim) return sim.error().Context("joining the sim bus");
   node->sim_ = std::move(*sim);
   auto sub = node->sim_->CreateSubscriber<bus::SensorSample>(bus::SensorTopic(o.name), bus::Qos::kLockstep);

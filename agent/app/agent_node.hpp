@@ -76,6 +76,10 @@ struct AgentOptions {
   std::string middleware = "cyclonedds";
   std::string sim_interface = "lo";
   int sim_domain = 0;
+  // Discovery on the sim bus as a star (bus/cyclone_config.hpp): the hosts whose well-known
+  // participant (index 0) the agent announces itself to, by unicast only: the physics server's
+  // container and the drone's brain container. Empty: multicast discovery (a hand-started agent).
+  std::vector<std::string> sim_peers;
   std::string mesh_interface = "lo";
   int mesh_domain = 1;
   bool mesh = true;                     // have a radio (publish DroneState); false: --no-mesh

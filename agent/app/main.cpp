@@ -85,6 +85,9 @@ int main(int argc, char** argv) {
   app.add_option("--middleware", o.middleware, "DDS implementation")->check(CLI::IsMember({"cyclonedds", "fastdds"}))->capture_default_str();
   app.add_option("--sim-interface", o.sim_interface, "Network interface of the sim bus")->capture_default_str();
   app.add_option("--sim-domain", o.sim_domain, "DDS domain id of the sim bus")->check(CLI::Range(0, 232))->capture_default_str();
+  app.add_option("--sim-peer", o.sim_peers,
+                 "Discover the sim bus by unicast to this host's participant 0 only (repeat: the physics server, "
+                 "the brain); default: multicast");
   app.add_option("--mesh-interface", o.mesh_interface, "Network interface of the mesh (radio) bus")->capture_default_str();
   app.add_option("--mesh-domain", o.mesh_domain, "DDS domain id of the mesh bus")->check(CLI::Range(0, 232))->capture_default_str();
   app.add_flag("--no-mesh", no_mesh, "No radio: do not join the mesh bus (netem) nor send on the channel");

@@ -33,7 +33,8 @@ class DomainRegistry {
     return registry;
   }
 
-  Status Acquire(int domain_id, const std::string& interface, int writer_linger_ms) {
+  Status Acquire(int domain_id, const std::string& interface, int writer_linger_ms, int participant_index,
+                 const std::vector<std::string>& peers) {
     std::lock_guard lock(mu_);
     auto it = domains_.find(domain_id);
     if (it != domains_.end()) {
@@ -47,7 +48,10 @@ class DomainRegistry {
       ++it->second.refs;
       return Ok{};
     }
-    const std::string xml = CycloneXml({.interface = interface, .writer_linger_ms = writer_linger_ms});
+    const std::string xml = CycloneXml({.interface = interface,
+                                        .writer_linger_ms = writer_linger_ms,
+                                        .participant_index = participant_index,
+                                        .peers = peers});
     const dds_entity_t domain = dds_create_domain(static_cast<dds_domainid_t>(domain_id), xml.c_str());
     if (domain < 0) {
       return DdsError(domain, "creating domain " + std::to_string(domain_id) + " on interface '" +
@@ -413,7 +417,8 @@ Result<std::unique_ptr<ParticipantBackend>> CreateCycloneBackend(const Participa
                                                                  const std::string& ipv4) {
   (void)ipv4;  // Cyclone binds by interface name (the XML config); the address is for Fast DDS
   using cyclone_detail::DomainRegistry;
-  SWARMBOX_TRY(DomainRegistry::Instance().Acquire(config.domain_id, config.interface, config.writer_linger_ms));
+  SWARMBOX_TRY(DomainRegistry::Instance().Acquire(config.domain_id, config.interface, config.writer_linger_ms,
+                                                   config.participant_index, config.peers));
   const dds_entity_t pp =
       dds_create_participant(static_cast<dds_domainid_t>(config.domain_id), nullptr, nullptr);
   if (pp < 0) {

@@ -53,6 +53,11 @@ int main(int argc, char** argv) {
   app.add_option("--truth", o.truth_path, "Ground-truth CSV to write ('' = none)")->capture_default_str();
   app.add_option("--truth-rate-hz", o.truth_rate_hz, "truth.csv rows per simulated second per drone")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--sim-interface", o.sim_interface, "Network interface of the sim bus")->capture_default_str();
+  app.add_option("--participant-index", o.participant_index,
+                 "Well-known DDS discovery port of this index on the sim bus, for agents started with --sim-peer "
+                 "(-1: none)")
+      ->check(CLI::Range(-1, 119))
+      ->capture_default_str();
   app.add_option("--domain", o.domain, "DDS domain id of the sim bus")->check(CLI::Range(0, 232))->capture_default_str();
   app.add_option("--middleware", o.middleware, "DDS implementation")->check(CLI::IsMember({"cyclonedds", "fastdds"}))->capture_default_str();
   app.add_option("--max-sim-time", o.max_sim_time_s, "Stop after this many simulated seconds; 0 = run until SIGTERM")->check(CLI::NonNegativeNumber)->capture_default_str();
@@ -155,6 +160,7 @@ int main(int argc, char** argv) {
   pc.backend = o.middleware;
   pc.domain_id = o.domain;
   pc.interface = o.sim_interface;
+  pc.participant_index = o.participant_index;
   // No writer lingers at exit (Cyclone's default keeps one with unacknowledged samples up to 1 s,
   // ~0.2 s with agents still up): the samples and images sent last are of no use once the server
   // goes; truth.csv and the events are written before the transport is closed.

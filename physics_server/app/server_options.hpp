@@ -35,6 +35,9 @@ struct ServerOptions {
   std::string truth_path = "truth.csv"; // "" = none
   double truth_rate_hz = 50;
   std::string sim_interface = "lo";
+  // Discovery/ParticipantIndex of the server's sim participant (bus/cyclone_config.hpp): 0 in a
+  // trial, where the agents name the server's container as their one discovery peer; -1: none.
+  int participant_index = -1;
   int domain = 0;
   std::string middleware = "cyclonedds";
   double max_sim_time_s = 0;            // 0 = until SIGTERM

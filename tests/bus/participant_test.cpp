@@ -234,5 +234,21 @@ TEST(BusCycloneConfig, CarriesTheSettingsTheReadmeExplains) {
               HasSubstr("<WriterLingerDuration>0 ms</WriterLingerDuration>"));
 }
 
+// Discovery as a star (a trial's sim bus): the physics server at a well-known index, each agent
+// naming it as its one peer, with multicast off so the agents do not discover one another.
+TEST(BusCycloneConfig, StarDiscoveryNamesPeersAndTurnsMulticastOff) {
+  EXPECT_EQ(CycloneDiscoveryPort(0, 0), 7410);  // DDSI: 7400 + 250 d + 10 + 2 i
+  EXPECT_EQ(CycloneDiscoveryPort(3, 2), 7400 + 750 + 10 + 4);
+  const std::string server = CycloneXml({.interface = "eth0", .participant_index = 0});
+  EXPECT_THAT(server, HasSubstr("<ParticipantIndex>0</ParticipantIndex>"));
+  EXPECT_THAT(server, HasSubstr("<AllowMulticast>true</AllowMulticast>"));  // brains, components find it
+  EXPECT_THAT(server, Not(HasSubstr("<Peers>")));
+  const std::string agent = CycloneXml({.interface = "eth0", .peers = {"physics:7410", "scout_1-brain:7410"}});
+  EXPECT_THAT(agent, HasSubstr("<AllowMulticast>false</AllowMulticast>"));
+  EXPECT_THAT(agent, HasSubstr("<NetworkInterface name=\"eth0\"/>"));
+  EXPECT_THAT(agent, HasSubstr("<Peers><Peer Address=\"physics:7410\"/><Peer Address=\"scout_1-brain:7410\"/></Peers>"));
+  EXPECT_THAT(agent, HasSubstr("<ParticipantIndex>none</ParticipantIndex>"));
+}
+
 }  // namespace
 }  // namespace swarmbox::bus

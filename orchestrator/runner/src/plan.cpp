@@ -48,6 +48,9 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
       "--sim-interface", std::string(kSimInterface),
       "--domain", std::to_string(kSimDomain),
+      // Discovery on sim is a star around the server (bus/cyclone_config.hpp): its participant has
+      // the well-known index 0, which every agent names (--sim-peer) instead of multicasting.
+      "--participant-index", "0",
       "--truth", std::string(kTruthCsvPath),
       // Stops (event=stopped t=...) when the trial's simulated time is up; truth.csv is flushed.
       "--max-sim-time", ShortestNumber(spec.timeout.sim.seconds()),
@@ -126,7 +129,11 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       "--middleware", std::string(dsl::MiddlewareName(spec.middleware)),
       "--sim-interface", std::string(kSimInterface),
       "--sim-domain", std::to_string(kSimDomain),
+      // Discovery by unicast to the physics server (and the drone's brain) only: N agents make N
+      // discovery pairs, not N^2/2 (a 40-drone start no longer stalls in agent-agent discovery).
+      "--sim-peer", std::string(kPhysicsId),
   };
+  if (d.brain.external()) argv.insert(argv.end(), {"--sim-peer", BrainId(d.name)});
   if (spec.radio.model == dsl::RadioModel::kChannel) {
     // The radio is the physics server's channel, over the sim bus: no mesh network, no mesh domain.
     argv.insert(argv.end(), {"--radio-model", "channel"});
@@ -300,10 +307,10 @@ std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl:
   return BrainArgv(spec, drone);
 }
 
-std::string CycloneUriFor(std::string_view interface) {
+std::string CycloneUriFor(std::string_view interface, int participant_index) {
   // The agents' and the physics server's own configuration (swarmbox/bus/cyclone_config.hpp), so a
   // program the runner starts discovers and fragments as they do.
-  return bus::CycloneXml({.interface = std::string(interface)});
+  return bus::CycloneXml({.interface = std::string(interface), .participant_index = participant_index});
 }
 
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
@@ -456,7 +463,8 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
       bc.hostname = id;
       bc.labels = RoleLabels(options.run_id, trial_id, id, kRoleBrain);
       bc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id},
-                {"CYCLONEDDS_URI", CycloneUriFor(kSimInterface)}};
+                // index 0: the well-known port its agent names with --sim-peer
+                {"CYCLONEDDS_URI", CycloneUriFor(kSimInterface, 0)}};
       ConfineUser(spec.LimitsOf(&d), &bc);
       bc.stop_timeout_s = 5;
       brains.Add<dsl::Plugin>(id, std::move(bc), brains_level).On(sim_net, nets.sim.Host(next_sim_host++), {id});

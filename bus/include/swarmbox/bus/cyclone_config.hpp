@@ -24,16 +24,34 @@
 //                           server and for camera frames at a slow agent (capped by rmem_max)
 //   Internal/WriterLingerDuration  only when set (ParticipantConfig::writer_linger_ms)
 //   Tracing                 severe only, to stderr
+//
+// Discovery as a star (the sim domain of a trial; ARCHITECTURE.md "Discovery on the sim bus"):
+//   participant_index >= 0  Discovery/ParticipantIndex N: the participant's unicast discovery port is
+//                           the well-known DDSI one (CycloneDiscoveryPort), so others can name it
+//                           as a peer. The physics server: 0, alone in its container.
+//   peers non-empty         AllowMulticast false and Discovery/Peers: the participant announces
+//                           itself only to these "host:port"s and hears no multicast, so it
+//                           discovers them and whoever answers them, not every other participant.
+//                           An agent names the physics server (and its own brain): N agents make
+//                           N server-agent pairs, not N^2/2 agent-agent pairs whose endpoint
+//                           announcements (SEDP, reliable) swamped a 40-drone start on 2 cores.
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace swarmbox::bus {
 
 struct CycloneSettings {
   std::string interface;      // network interface name (not validated here)
   int writer_linger_ms = -1;  // Internal/WriterLingerDuration; -1: Cyclone's default (1 s)
+  int participant_index = -1;        // Discovery/ParticipantIndex; -1: none (ports from the kernel)
+  std::vector<std::string> peers = {};  // "host:port"; non-empty: unicast discovery to these only
 };
+
+// The DDSI well-known unicast discovery (metatraffic) port of participant index `index` on
+// domain `domain_id`: PB + DG * domain + d1 + PG * index with Cyclone's defaults (7400, 250, 10, 2).
+inline int CycloneDiscoveryPort(int domain_id, int index) { return 7400 + 250 * domain_id + 10 + 2 * index; }
 
 // The <CycloneDDS> document for every domain id (Domain Id="any").
 inline std::string CycloneXml(const CycloneSettings& s) {
@@ -41,11 +59,18 @@ inline std::string CycloneXml(const CycloneSettings& s) {
   if (s.writer_linger_ms >= 0) {
     internal += "<WriterLingerDuration>" + std::to_string(s.writer_linger_ms) + " ms</WriterLingerDuration>";
   }
+  const bool star = !s.peers.empty();
+  std::string peers;
+  for (const std::string& p : s.peers) peers += "<Peer Address=\"" + p + "\"/>";
+  const std::string index = s.participant_index >= 0 ? std::to_string(s.participant_index) : "none";
   return "<CycloneDDS><Domain Id=\"any\">"
-         "<General><Interfaces><NetworkInterface name=\"" + s.interface + "\" multicast=\"true\"/></Interfaces>"
-         "<AllowMulticast>true</AllowMulticast>"
+         "<General><Interfaces><NetworkInterface name=\"" + s.interface + "\"" +
+         (star ? std::string() : std::string(" multicast=\"true\"")) + "/></Interfaces>"
+         "<AllowMulticast>" + (star ? "false" : "true") + "</AllowMulticast>"
          "<MaxMessageSize>65000B</MaxMessageSize><FragmentSize>62000B</FragmentSize></General>"
-         "<Discovery><ParticipantIndex>none</ParticipantIndex><LeaseDuration>20 s</LeaseDuration>"
+         "<Discovery><ParticipantIndex>" + index + "</ParticipantIndex>" +
+         (star ? "<Peers>" + peers + "</Peers>" : std::string()) +
+         "<LeaseDuration>20 s</LeaseDuration>"
          "<SPDPInterval>10 s</SPDPInterval></Discovery>"
          "<Internal>" + internal + "</Internal>"
          "<Tracing><Verbosity>severe</Verbosity><OutputFile>stderr</OutputFile></Tracing>"

@@ -49,6 +49,12 @@ struct ParticipantConfig {
   // default (1 s). A process that must leave at once on a stop request and needs nothing it sent
   // last sets it low. Set by the first participant of a domain id in the process. Fast DDS: unused.
   int writer_linger_ms = -1;
+  // Cyclone DDS discovery (bus/cyclone_config.hpp; Fast DDS: unused). participant_index >= 0: the
+  // well-known discovery port of that index (the physics server of a trial: 0). peers ("host:port",
+  // e.g. the physics server's container and CycloneDiscoveryPort(domain, 0)): discovery by unicast
+  // to them only, no multicast (a trial's agents). Set by the first participant of a domain id.
+  int participant_index = -1;
+  std::vector<std::string> peers = {};
 };
 
 // The backend names Participant::Create accepts, in order: {"cyclonedds", "fastdds"}.

@@ -148,9 +148,11 @@ std::string BrainId(std::string_view drone);
 std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
 std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
 // The CYCLONEDDS_URI an external brain or a component on sim gets: bus::CycloneXml on
-// `interface`, the configuration the agents' bus gives itself from --sim-interface (multicast,
-// discovery and message sizes tuned for 100 participants; bus/README.md).
-std::string CycloneUriFor(std::string_view interface);
+// `interface` (multicast discovery and message sizes tuned for 100 participants; bus/README.md).
+// participant_index 0 for an external brain: the well-known port its agent names (--sim-peer);
+// -1 (none) for a component. A component discovers the physics server (which also hears
+// multicast) and the brains, not the agents: they announce themselves to the server only.
+std::string CycloneUriFor(std::string_view interface, int participant_index = -1);
 inline constexpr std::string_view kFaultsStepId = "faults";
 // The agents' interfaces in their (or their sidecar's) namespace.
 inline constexpr std::string_view kSimInterfaceName = "eth0";
