@@ -141,6 +141,14 @@ TEST_F(UserSoftwarePlanTest, AnExternalBrainGetsItsOwnContainerOnSim) {
   EXPECT_EQ(FlagValue(agent.argv, "--offboard-timeout-ms"), "800");
   EXPECT_EQ(FlagValue(agent.argv, "--offboard-hold-ms"), "0");
   EXPECT_THAT(agent.argv, Not(Contains("--brain-library")));
+  // Discovery on sim as a star: the agent names the physics server and its own brain, which has
+  // the well-known index 0 (bus/cyclone_config.hpp); a drone without a brain names the server only.
+  EXPECT_THAT(agent.argv, testing::IsSupersetOf({"physics", "scout_2-brain"}));
+  EXPECT_EQ(std::count(agent.argv.begin(), agent.argv.end(), std::string("--sim-peer")), 2);
+  const dsl::ContainerSpec& plain = trial->FindPlugin("scout_1")->spec();
+  EXPECT_EQ(FlagValue(plain.argv, "--sim-peer"), "physics");
+  EXPECT_EQ(std::count(plain.argv.begin(), plain.argv.end(), std::string("--sim-peer")), 1);
+  EXPECT_EQ(FlagValue(trial->FindPlugin("physics")->spec().argv, "--participant-index"), "0");
 
   const dsl::ContainerSpec& brain = trial->FindPlugin("scout_2-brain")->spec();
   EXPECT_EQ(brain.name, "byo-20261126-050000-abcd-scout_2-brain");
@@ -152,6 +160,7 @@ TEST_F(UserSoftwarePlanTest, AnExternalBrainGetsItsOwnContainerOnSim) {
   EXPECT_EQ(brain.labels.at("swarmbox.run"), "20261126-050000-abcd");
   EXPECT_EQ(brain.labels.at("swarmbox.component"), "scout_2-brain");
   EXPECT_THAT(brain.env.at("CYCLONEDDS_URI"), HasSubstr("<NetworkInterface name=\"eth0\" multicast=\"true\"/>"));
+  EXPECT_THAT(brain.env.at("CYCLONEDDS_URI"), HasSubstr("<ParticipantIndex>0</ParticipantIndex>"));
   ASSERT_EQ(brain.networks.size(), 1u);
   EXPECT_EQ(brain.networks[0].network, "sim");
   EXPECT_EQ(brain.networks[0].ipv4, "10.200.8.13");  // after the three drones (.10-.12)
