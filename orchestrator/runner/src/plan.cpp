@@ -315,7 +315,13 @@ std::string CycloneUriFor(std::string_view interface, int participant_index) {
 
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
   const double sim_s = spec.timeout.sim.seconds();
-  const double guard_s = spec.rtf > 0 ? sim_s / spec.rtf * 1.5 + 120.0 : sim_s * 3.0 + 120.0;
+  // A step waits for every drone's answer, so its wall cost grows with the fleet: on 2 cores ~10
+  // drones run near rtf 1 at rtf 0, 100 drones near 0.1-0.3 (BENCHMARKS.md "swarm"); the start
+  // takes ~0.6 s per drone (101 joined in 58.8 s). A fleet past 10 gets proportionally longer.
+  const double drones = static_cast<double>(spec.drones.size());
+  const double slower = std::max(1.0, drones / 10.0);
+  const double start_s = 120.0 + std::max(0.0, drones - 20.0);
+  const double guard_s = spec.rtf > 0 ? sim_s / spec.rtf * 1.5 * slower + start_s : sim_s * 3.0 * slower + start_s;
   return dsl::Duration::Ms(static_cast<std::int64_t>(guard_s * 1000.0));
 }
 
