@@ -15,6 +15,8 @@ PACKAGES=(
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
   # physics, maths, vision, formats, HTTP, archives
   libode-dev libeigen3-dev libopencv-dev libyaml-dev libcurl4-openssl-dev libssl-dev libarchive-dev zlib1g-dev
+  # recordings: MCAP chunk compression (record/)
+  libzstd-dev liblz4-dev
   # command line, netfilter queue (userspace netem fallback)
   libcli11-dev libnetfilter-queue-dev
   # tests and micro-benchmarks (swarmbox-microbench)
