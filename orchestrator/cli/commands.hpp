@@ -34,6 +34,9 @@ struct RunArgs {
   std::string run_id;
   bool quiet = false;
   bool json = false;
+  bool no_record = false;  // --no-record: the trial's record.enabled = false
+  bool view_requested = false;  // --view given (with or without its ADDR:PORT)
+  std::string view;             // its ADDR:PORT; "" = 127.0.0.1:8765
   ProgramPaths programs;
 };
 int RunCommand(const RunArgs& args);

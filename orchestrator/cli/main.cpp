@@ -87,6 +87,9 @@ int main(int argc, char** argv) {
   AddOutOption(run_cmd, run.out, "Output folder (default: runs)");
   AddSetOption(run_cmd, run.sets, "Override a key of the trial: key.path=value");
   AddLaunchOptions(run_cmd, run.run_id, run.quiet, run.json, run.programs);
+  run_cmd->add_flag("--no-record", run.no_record, "No recording.mcap (as the trial key record: {enabled: false})");
+  run_cmd->add_option("--view", run.view, "Serve the trial live (Foxglove WebSocket and the built-in page) on this host at ADDR:PORT (default 127.0.0.1:8765); the local Docker engine only")
+      ->expected(0, 1);
 
   ValidateArgs validate;
   auto* validate_cmd = app.add_subcommand(
@@ -164,7 +167,10 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
   }
-  if (*run_cmd) return RunCommand(run);
+  if (*run_cmd) {
+    run.view_requested = run_cmd->count("--view") > 0;
+    return RunCommand(run);
+  }
   if (*validate_cmd) return ValidateCommand(validate);
   if (*compose_cmd) return ComposeCommand(compose);
   if (*images_cmd) {
