@@ -450,11 +450,15 @@ Status LiveServer::Write(ChannelId channel, std::uint64_t log_time_ns, std::stri
   if (channel < 1 || channel > s.channels.size()) {
     return Error(ErrorCode::kInvalidArgument, "no such channel: " + std::to_string(channel));
   }
-  if (!s.image[channel - 1] || s.options.history_images) {
-    s.history[channel].push_back({channel, log_time_ns, s.next_seq++, data});
-    s.history_bytes += data->size();
-    s.TrimHistory();
+  std::deque<Message>& kept = s.history[channel];
+  if (s.image[channel - 1] && !s.options.history_images && !kept.empty()) {
+    // Of an image channel only the newest frame is kept, for the thumbnail of a late client.
+    s.history_bytes -= kept.front().json->size();
+    kept.pop_front();
   }
+  kept.push_back({channel, log_time_ns, s.next_seq++, data});
+  s.history_bytes += data->size();
+  s.TrimHistory();
   bool any = false;
   for (auto& [wsi, c] : s.clients) {
     auto sub = c.by_channel.find(channel);

@@ -97,7 +97,7 @@ class LiveServerTest : public ::testing::Test {
   std::string dir_;
 };
 
-TEST_F(LiveServerTest, FoxgloveClientGetsTheHistoryThenTheLiveStreamWithoutImageHistory) {
+TEST_F(LiveServerTest, FoxgloveClientGetsTheHistoryThenTheLiveStreamAndOnlyTheNewestImage) {
   ASSERT_TRUE(NodeReady());
   auto server = Start({.name = "swarmbox-test"});
   ASSERT_NE(server, nullptr);
@@ -111,13 +111,14 @@ TEST_F(LiveServerTest, FoxgloveClientGetsTheHistoryThenTheLiveStreamWithoutImage
   }
   for (int i = 0; i < 5; ++i) {
     ASSERT_TRUE(server->Write(camera, static_cast<std::uint64_t>(i) * 1'000'000'000u,
-                              R"({"timestamp":{"sec":0,"nsec":0},"frame_id":"scout_1","format":"jpeg","data":"AAAA"})"));
+                              R"({"timestamp":{"sec":0,"nsec":0},"frame_id":"scout_1","format":"jpeg","data":"AAA)" +
+                                  std::to_string(i) + R"("})"));
   }
   // When Foxglove's client subscribes to everything...
   const std::string ready = dir_ + "/ready";
   auto child = swarmbox::testing::ChildProcess::Spawn(
       {kNode, kJsDir + "/ws_client.mjs", "ws://127.0.0.1:" + std::to_string(server->port()), "--want",
-       "/tf=150", "--want", "/world=1", "--want", "/drones/scout_1/camera=2", "--ready", ready,
+       "/tf=150", "--want", "/world=1", "--want", "/drones/scout_1/camera=3", "--ready", ready,
        "--timeout-ms", "30000"},
       dir_ + "/out.json", dir_ + "/err.txt");
   ASSERT_TRUE(child) << child.error().ToString();
@@ -159,10 +160,12 @@ TEST_F(LiveServerTest, FoxgloveClientGetsTheHistoryThenTheLiveStreamWithoutImage
               static_cast<std::int64_t>(i));
   }
   EXPECT_EQ(received->Find("/world")->items().size(), 1u);
-  // ... and only the live camera frames: images are not kept as history.
+  // ... and of the camera only the newest frame of the history, then the live ones.
   const auto& frames = received->Find("/drones/scout_1/camera")->items();
-  ASSERT_EQ(frames.size(), 2u);
-  EXPECT_EQ(*frames[0].Find("data")->Find("data")->AsString(), "BBBB");
+  ASSERT_EQ(frames.size(), 3u);
+  EXPECT_EQ(*frames[0].Find("data")->Find("data")->AsString(), "AAA4");
+  EXPECT_EQ(*frames[0].Find("log_time_ns")->AsString(), "4000000000");
+  EXPECT_EQ(*frames[1].Find("data")->Find("data")->AsString(), "BBBB");
   EXPECT_EQ(server->dropped_messages(), 0u);
 }
 

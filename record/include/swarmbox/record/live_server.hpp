@@ -15,9 +15,10 @@
 // (opcode 0x01, subscription id u32 LE, log time u64 LE [ns], the JSON). Other client ops get a
 // status warning. The channel id a client sees is the ChannelId AddChannel returned (from 1).
 //
-// History: every message of every channel is kept (images only with history_images) until the
-// history holds history_bytes; then the oldest go first, but the latest message of each channel
-// is always kept (so /world, written once at t=0, reaches a client that comes an hour later).
+// History: every message of every channel is kept (of an image channel only the newest frame,
+// unless history_images) until the history holds history_bytes; then the oldest go first, but the
+// latest message of each channel is always kept (so /world, written once at t=0, reaches a client
+// that comes an hour later, and a late client has the current camera frames).
 // A subscription first gets the history of its channels in log-time order, then the live stream.
 //
 // Threads: one service thread owns the sockets. AddChannel() and Write() are thread-safe and never
@@ -42,7 +43,7 @@ struct LiveOptions {
   std::string name = "swarmbox";
   std::string mode = "live";  // serverInfo metadata "mode": "live" (a trial running) or "replay"
                               // (swarmbox view): the page follows the head or starts at t=0
-  std::size_t history_bytes = 256u << 20;  // per server; images are not kept
+  std::size_t history_bytes = 256u << 20;  // per server; images: the newest frame only
   bool history_images = false;             // keep foxglove.CompressedImage/RawImage too (replays)
   std::size_t client_queue_bytes = 32u << 20;  // live messages waiting for one client
 };
