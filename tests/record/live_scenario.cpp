@@ -8,12 +8,13 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "swarmbox/record/foxglove_schemas.hpp"
+
 namespace swarmbox::testing {
 namespace {
 
 using Vec3 = std::array<double, 3>;
 using record::ChannelId;
-using record::ChannelSpec;
 
 constexpr double kTakeoffEndS = 8.0;
 constexpr double kCruiseZ = 20.0;
@@ -109,9 +110,6 @@ Vec3 Along(const std::vector<Vec3>& path, double distance) {
 
 double Distance(const Vec3& a, const Vec3& b) { return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]); }
 
-std::string Schema(const std::string& title) {
-  return R"({"title":")" + title + R"(","type":"object","properties":{"timestamp":{"type":"object"}}})";
-}
 
 std::string CameraJpeg(const std::string& drone, double t, const Vec3& p) {
   cv::Mat img(120, 160, CV_8UC3, cv::Scalar(60, 110, 80));
@@ -213,7 +211,7 @@ std::array<double, 3> ScenarioPosition(const std::string& drone, double t) {
 
 Status WriteSarScenario(record::Sink& sink) {
   auto add = [&](const std::string& topic, const std::string& schema) -> Result<ChannelId> {
-    return sink.AddChannel(ChannelSpec{topic, schema, Schema(schema)});
+    return sink.AddChannel(record::MakeChannel(topic, schema));
   };
   std::map<std::string, ChannelId> ch;
   for (const auto& [topic, schema] : std::vector<std::pair<std::string, std::string>>{
