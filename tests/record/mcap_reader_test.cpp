@@ -233,6 +233,20 @@ TEST_F(McapCorruptionTest, AFlippedByteInAChunkFailsTheChunkCrcWhenNoDataCrcIsGi
   EXPECT_NE(s.error().message().find("chunk CRC mismatch"), std::string::npos) << s.error().ToString();
 }
 
+TEST_F(McapCorruptionTest, AnAbsurdChunkSizeIsRefusedNotAllocated) {
+  std::string bad = bytes_;
+  const std::uint64_t chunk = OffsetOf(0x06);
+  bad[chunk + 9 + 16 + 5] = 1;  // uncompressed_size += 2^40
+  const std::uint64_t data_end = OffsetOf(0x0F);
+  for (int i = 0; i < 4; ++i) bad[data_end + 9 + static_cast<std::uint64_t>(i)] = 0;
+  testing::WriteFile(path_, bad);
+  auto reader = McapReader::Open(path_);
+  ASSERT_TRUE(reader) << reader.error().ToString();
+  Status s = reader->ForEach([](const McapMessage&) {});
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message().find("exceeds the reader's limit"), std::string::npos) << s.error().ToString();
+}
+
 TEST_F(McapCorruptionTest, AFlippedByteInTheSummaryFailsTheSummaryCrc) {
   std::string bad = bytes_;
   const std::uint64_t summary = OffsetOf(0x0B);  // Statistics
