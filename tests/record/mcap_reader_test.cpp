@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "mcap_test_util.hpp"
@@ -179,6 +180,33 @@ TEST_F(McapReaderTest, OneMessageLargerThanAChunkGetsItsOwnChunk) {
   ASSERT_EQ(read.size(), 3u);
   EXPECT_EQ(read[1].data.size(), big.size());
   EXPECT_EQ(read[2].data, "after");
+}
+
+TEST_F(McapReaderTest, WritersOnSeveralThreadsLoseNothing) {
+  const std::string path = Path("threads.mcap");
+  McapOptions options;
+  options.chunk_bytes = 4 << 10;
+  auto writer = McapWriter::Create(path, options);
+  ASSERT_TRUE(writer);
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 4; ++k) {
+    threads.emplace_back([&, k] {
+      auto id = (*writer)->AddChannel({"/t" + std::to_string(k), "s", "{}"});
+      ASSERT_TRUE(id);
+      for (std::uint64_t i = 0; i < 2000; ++i) ASSERT_TRUE((*writer)->Write(*id, i, "{\"k\":" + std::to_string(k) + "}"));
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  ASSERT_TRUE((*writer)->Close());
+  auto reader = McapReader::Open(path);
+  ASSERT_TRUE(reader) << reader.error().ToString();
+  ASSERT_EQ(reader->channels().size(), 4u);
+  std::vector<int> counts(4, 0);
+  for (const McapMessage& m : ReadAll(*reader)) {
+    ++counts[m.channel];
+    EXPECT_EQ(m.data, "{\"k\":" + reader->channels()[m.channel].topic.substr(2) + "}");
+  }
+  EXPECT_EQ(counts, std::vector<int>(4, 2000));
 }
 
 // --- corruption ---------------------------------------------------------------------------------
