@@ -288,12 +288,12 @@ Status WriteSarScenario(record::Sink& sink) {
         }
       }
     }
-    if (tick % 5 == 0) {  // 2 Hz: the links the agents measured
-      std::string links = "{" + Stamp(t) + R"(,"links":[)";
-      bool first = true;
-      for (std::size_t i = 0; i < kScenarioDrones.size(); ++i) {
-        for (std::size_t j = i + 1; j < kScenarioDrones.size(); ++j) {
-          const std::string &a = kScenarioDrones[i], &b = kScenarioDrones[j];
+    if (tick % 5 == 0) {  // 2 Hz: the links each agent measured, one message per agent (as the recorder)
+      for (const std::string& a : kScenarioDrones) {
+        std::string links = "{" + Stamp(t) + R"(,"links":[)";
+        bool first = true;
+        for (const std::string& b : kScenarioDrones) {
+          if (a == b) continue;
           const double dist = Distance(pos[a], pos[b]);
           const bool cut = t >= kFailoverS && t < kNewLeaderS && (a == "scout_1" || b == "scout_1");
           const double loss = cut ? 1.0 : std::min(0.9, 0.02 + (dist / 250) * (dist / 250));
@@ -302,8 +302,8 @@ Status WriteSarScenario(record::Sink& sink) {
           links += R"({"from":")" + a + R"(","to":")" + b + R"(","loss":)" + Num(loss) + R"(,"rtt_ms":)" +
                    Num(200 + dist) + "}";
         }
+        if (auto s = write("/radio/links", t, links + "]}"); !s) return s;
       }
-      if (auto s = write("/radio/links", t, links + "]}"); !s) return s;
     }
     for (const std::string& d : kScenarioDrones) {
       if (d == "lifter" || tick % 5 != 0) continue;

@@ -160,6 +160,7 @@ TEST_F(LiveViewTest, SwarmboxViewReplaysARecordingInThePageUntilCtrlC) {
   EXPECT_GE(*report.Find("moved")->AsInt(), 3);
   EXPECT_EQ(*report.Find("cameraShown")->AsBool(), true);
   EXPECT_EQ(*report.Find("after")->Find("leader")->AsString(), "scout_2");
+  EXPECT_EQ(*report.Find("after")->Find("links")->AsInt(), 6) << "each pair of the 4 drones, from each one's report";
   EXPECT_TRUE(report.Find("eventJump")->is_mapping());
   EXPECT_GT(fs::file_size("view.png"), 10000u);
   // ... and Ctrl-C ends it cleanly.
