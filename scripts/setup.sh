@@ -17,10 +17,14 @@ PACKAGES=(
   libode-dev libeigen3-dev libopencv-dev libyaml-dev libcurl4-openssl-dev libssl-dev libarchive-dev zlib1g-dev
   # recordings: MCAP chunk compression (record/)
   libzstd-dev liblz4-dev
+  # the live view's WebSocket server (record::LiveServer)
+  libwebsockets-dev
   # command line, netfilter queue (userspace netem fallback)
   libcli11-dev libnetfilter-queue-dev
   # tests and micro-benchmarks (swarmbox-microbench)
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the page of the live view in a real browser (tests/js/page_check.mjs, headless)
+  chromium
   # containers, networks, hosts (procps: pgrep in netns_host.sh)
   docker.io docker-compose iptables iproute2 openssh-server openssh-client procps
   # a Linux kernel with sch_netem run as a process (user-mode Linux): the kernel netem path's guest test

@@ -97,6 +97,14 @@ struct DiffArgs {
 };
 int DiffCommand(const DiffArgs& args);
 
+// swarmbox view: replays RUN_DIR/recording.mcap in the built-in page (record::LiveServer) until
+// Ctrl-C/SIGTERM (exit 0); 2 no or unreadable recording, bad --addr; 3 cannot listen there.
+struct ViewArgs {
+  std::string run_dir;
+  std::string addr = "127.0.0.1:8765";  // ADDR:PORT; port 0 = any free one (the URL printed says)
+};
+int ViewCommand(const ViewArgs& args);
+
 struct GcArgs {
   std::string run_id;  // "" = every run not alive on this machine
   bool dry_run = false;  // list what would be removed, remove nothing

@@ -151,6 +151,13 @@ int main(int argc, char** argv) {
   AddJsonFlag(diff_cmd, diff.json);
   diff_cmd->footer(kDiffHelp);
 
+  ViewArgs view;
+  auto* view_cmd = app.add_subcommand(
+      "view", "Replay a trial's recording (RUN_DIR/recording.mcap) in the built-in page; Foxglove "
+              "connects to the same address. Serves until Ctrl-C (exit 0)");
+  view_cmd->add_option("run_dir", view.run_dir, "Trial folder (<out>/<trial>-<run id>)")->required();
+  view_cmd->add_option("--addr", view.addr, "Listen on ADDR:PORT (default 127.0.0.1:8765; port 0: any free)");
+
   GcArgs gc;
   auto* gc_cmd = app.add_subcommand("gc", "Remove containers and networks left by killed runs");
   gc_cmd->add_option("--run", gc.run_id, "Only this run id (default: every run not alive here)");
@@ -180,6 +187,7 @@ int main(int argc, char** argv) {
   if (*exp_cmd) return ExperimentCommand(exp);
   if (*report_cmd) return ReportCommand(report);
   if (*diff_cmd) return DiffCommand(diff);
+  if (*view_cmd) return ViewCommand(view);
   if (*gc_cmd) return GcCommand(gc);
   if (*version_cmd) {
     if (!version_json) {

@@ -1,9 +1,12 @@
-// The independent check: recordings written by McapWriter are read by @mcap/core, the TypeScript
-// reference implementation, through tests/js/verify_mcap.mjs (node). Its channels, counts, time
-// range, compression and chunks must match what was written, for every compression; a corrupted
-// recording must make it fail. Needs node and `npm ci` in tests/js (scripts/setup.sh does both).
+// The independent check, both ways. Recordings written by McapWriter are read by @mcap/core, the
+// TypeScript reference implementation, through tests/js/verify_mcap.mjs (node): its channels,
+// counts, time range, compression and chunks must match what was written, for every compression,
+// and a corrupted recording must make it fail. And files written by @mcap/core's own McapWriter
+// (tests/js/write_mcap_sample.mjs) are read by McapReader: the same messages in log-time order.
+// Needs node and `npm ci` in tests/js (scripts/setup.sh does both).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -163,6 +166,58 @@ TEST_F(McapNodeTest, McapCoreRejectsACorruptedRecording) {
   EXPECT_EQ(run->code, 1);
   EXPECT_NE(run->err.find("CRC"), std::string::npos) << run->err;
 }
+
+class McapForeignFileTest : public McapNodeTest {};
+
+TEST_P(McapForeignFileTest, McapReaderReadsWhatMcapCoreWrote) {
+  const std::string path = Path("foreign.mcap");
+  const std::string compression = GetParam() == Compression::kLz4 ? "lz4" : "none";
+  auto run = swarmbox::testing::RunToEnd(
+      {kNode, std::string(kJsDir) + "/write_mcap_sample.mjs", path, compression}, std::chrono::seconds(120), dir_);
+  ASSERT_TRUE(run) << run.error().ToString();
+  ASSERT_EQ(run->code, 0) << run->err;
+  auto doc = yaml::Parse(run->out, "write_mcap_sample output");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+
+  auto reader = McapReader::Open(path);
+  ASSERT_TRUE(reader) << reader.error().ToString();
+  EXPECT_EQ(reader->library(), "@mcap/core sample");
+  EXPECT_GT(reader->chunk_count(), 5u);
+  const auto& channels = doc->Find("channels")->items();
+  ASSERT_EQ(reader->channels().size(), channels.size());
+  for (std::size_t i = 0; i < channels.size(); ++i) {
+    EXPECT_EQ(reader->channels()[i].topic, channels[i].Find("topic")->scalar());
+    EXPECT_EQ(reader->channels()[i].schema_name, channels[i].Find("schema_name")->scalar());
+    EXPECT_NE(reader->channels()[i].schema.find("\"integer\""), std::string::npos);
+  }
+
+  struct Row {
+    ChannelId channel;
+    std::uint64_t t;
+    std::string data;
+  };
+  std::vector<Row> expected;
+  for (const yaml::Node& m : doc->Find("messages")->items()) {
+    expected.push_back({static_cast<ChannelId>(m.items()[0].AsInt().value_or(-1)),
+                        static_cast<std::uint64_t>(m.items()[1].AsInt().value_or(-1)), m.items()[2].scalar()});
+  }
+  ASSERT_EQ(expected.size(), 600u);
+  EXPECT_EQ(reader->message_count(), expected.size());
+  std::stable_sort(expected.begin(), expected.end(), [](const Row& a, const Row& b) { return a.t < b.t; });
+  std::vector<Row> read;
+  Status s = reader->ForEach([&](const McapMessage& m) { read.push_back({m.channel, m.log_time_ns, m.data}); });
+  ASSERT_TRUE(s) << s.error().ToString();
+  ASSERT_EQ(read.size(), expected.size());
+  for (std::size_t i = 0; i < read.size(); ++i) {
+    SCOPED_TRACE("message " + std::to_string(i));
+    EXPECT_EQ(read[i].channel, expected[i].channel);
+    EXPECT_EQ(read[i].t, expected[i].t);
+    EXPECT_EQ(read[i].data, expected[i].data);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Lz4AndNone, McapForeignFileTest, ::testing::Values(Compression::kLz4, Compression::kNone),
+                         [](const auto& p) { return std::string(CompressionName(p.param)); });
 
 }  // namespace
 }  // namespace swarmbox::record

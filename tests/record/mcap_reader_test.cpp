@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "mcap_test_util.hpp"
@@ -181,6 +182,33 @@ TEST_F(McapReaderTest, OneMessageLargerThanAChunkGetsItsOwnChunk) {
   EXPECT_EQ(read[2].data, "after");
 }
 
+TEST_F(McapReaderTest, WritersOnSeveralThreadsLoseNothing) {
+  const std::string path = Path("threads.mcap");
+  McapOptions options;
+  options.chunk_bytes = 4 << 10;
+  auto writer = McapWriter::Create(path, options);
+  ASSERT_TRUE(writer);
+  std::vector<std::thread> threads;
+  for (int k = 0; k < 4; ++k) {
+    threads.emplace_back([&, k] {
+      auto id = (*writer)->AddChannel({"/t" + std::to_string(k), "s", "{}"});
+      ASSERT_TRUE(id);
+      for (std::uint64_t i = 0; i < 2000; ++i) ASSERT_TRUE((*writer)->Write(*id, i, "{\"k\":" + std::to_string(k) + "}"));
+    });
+  }
+  for (std::thread& t : threads) t.join();
+  ASSERT_TRUE((*writer)->Close());
+  auto reader = McapReader::Open(path);
+  ASSERT_TRUE(reader) << reader.error().ToString();
+  ASSERT_EQ(reader->channels().size(), 4u);
+  std::vector<int> counts(4, 0);
+  for (const McapMessage& m : ReadAll(*reader)) {
+    ++counts[m.channel];
+    EXPECT_EQ(m.data, "{\"k\":" + reader->channels()[m.channel].topic.substr(2) + "}");
+  }
+  EXPECT_EQ(counts, std::vector<int>(4, 2000));
+}
+
 // --- corruption ---------------------------------------------------------------------------------
 
 class McapCorruptionTest : public McapReaderTest {
@@ -231,6 +259,20 @@ TEST_F(McapCorruptionTest, AFlippedByteInAChunkFailsTheChunkCrcWhenNoDataCrcIsGi
   Status s = reader->ForEach([](const McapMessage&) {});
   ASSERT_FALSE(s);
   EXPECT_NE(s.error().message().find("chunk CRC mismatch"), std::string::npos) << s.error().ToString();
+}
+
+TEST_F(McapCorruptionTest, AnAbsurdChunkSizeIsRefusedNotAllocated) {
+  std::string bad = bytes_;
+  const std::uint64_t chunk = OffsetOf(0x06);
+  bad[chunk + 9 + 16 + 5] = 1;  // uncompressed_size += 2^40
+  const std::uint64_t data_end = OffsetOf(0x0F);
+  for (int i = 0; i < 4; ++i) bad[data_end + 9 + static_cast<std::uint64_t>(i)] = 0;
+  testing::WriteFile(path_, bad);
+  auto reader = McapReader::Open(path_);
+  ASSERT_TRUE(reader) << reader.error().ToString();
+  Status s = reader->ForEach([](const McapMessage&) {});
+  ASSERT_FALSE(s);
+  EXPECT_NE(s.error().message().find("exceeds the reader's limit"), std::string::npos) << s.error().ToString();
 }
 
 TEST_F(McapCorruptionTest, AFlippedByteInTheSummaryFailsTheSummaryCrc) {

@@ -44,7 +44,8 @@ TEST(FoxgloveSchemas, FieldsTheContractNames) {
   EXPECT_NE(props(kLinks).Find("links"), nullptr);
   EXPECT_NE(props(kSectors).Find("sectors"), nullptr);
   for (const char* f : {"drone", "position", "confidence"}) EXPECT_NE(props(kDetection).Find(f), nullptr) << f;
-  const yaml::Node* entity = props(kSceneUpdate).Find("entities")->Find("items")->Find("properties");
+  const yaml::Node scene = props(kSceneUpdate);
+  const yaml::Node* entity = scene.Find("entities")->Find("items")->Find("properties");
   for (const char* f : {"id", "frame_id", "cubes", "arrows", "lines", "metadata"}) EXPECT_NE(entity->Find(f), nullptr) << f;
 }
 

@@ -5,11 +5,13 @@
 #include <zstd.h>
 
 #include <algorithm>
-#include <limits>
+#include <string>
 
 namespace swarmbox::record::detail {
 
 namespace {
+// A corrupt size field must not make the reader allocate without bound; real chunks are ~1 MiB.
+constexpr std::uint64_t kMaxChunkBytes = std::uint64_t{1} << 30;
 // zstd's default level: ~5x on the recording's JSON at a few hundred MB/s per core.
 constexpr int kZstdLevel = 3;
 }  // namespace
@@ -111,8 +113,9 @@ Status DecompressLz4(std::string_view in, std::string* out) {
 
 Status Decompress(std::string_view compression, std::string_view in, std::uint64_t uncompressed_size,
                   std::string* out) {
-  if (uncompressed_size > std::numeric_limits<std::size_t>::max() / 2) {
-    return Error(ErrorCode::kProtocol, "chunk uncompressed size too large");
+  if (uncompressed_size > kMaxChunkBytes) {
+    return Error(ErrorCode::kProtocol, "chunk uncompressed size " + std::to_string(uncompressed_size) +
+                                           " exceeds the reader's limit of " + std::to_string(kMaxChunkBytes));
   }
   const auto size = static_cast<std::size_t>(uncompressed_size);
   if (compression.empty()) {

@@ -60,8 +60,8 @@ class Compressor {
 };
 
 // Decompresses a chunk's records. `compression` is the chunk's field; `uncompressed_size` what the
-// chunk says it holds (the result must have exactly that size). kProtocol for an unknown
-// compression or a corrupt stream.
+// chunk says it holds (the result must have exactly that size; at most 1 GiB). kProtocol for an
+// unknown compression, a corrupt stream or a size over the limit.
 Status Decompress(std::string_view compression, std::string_view in, std::uint64_t uncompressed_size,
                   std::string* out);
 
