@@ -21,6 +21,7 @@
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/version.hpp"
 #include "swarmbox/physics/world.hpp"
+#include "swarmbox/record/live_server.hpp"
 #include "swarmbox/record/mcap.hpp"
 
 namespace {
@@ -79,6 +80,7 @@ int main(int argc, char** argv) {
   app.add_option("--record-camera-hz", o.record_camera_hz, "Recording: camera frames per simulated second per drone; 0 = none")->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--record-camera-scale", o.record_camera_scale, "Recording: camera frames are scaled by this (0, 1] before JPEG encoding")->capture_default_str();
   app.add_option("--record-jpeg-quality", o.record_jpeg_quality, "Recording: JPEG quality [1, 100]")->capture_default_str();
+  app.add_option("--view", o.view_addr, "Serve the recording's channels live at ADDR:PORT (Foxglove WebSocket protocol and the built-in page at /); '' = none");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -161,18 +163,39 @@ int main(int argc, char** argv) {
 
   // The recording: its sinks, then the recorder (both outlive the transport, which feeds it).
   std::unique_ptr<record::McapWriter> mcap;
+  std::unique_ptr<record::LiveServer> live;
   std::unique_ptr<Recorder> recorder;
-  if (!o.record_path.empty()) {
+  if (!o.record_path.empty() || !o.view_addr.empty()) {
     RecordOptions ro;
     ro.rate_hz = o.record_rate_hz;
     ro.camera_hz = o.cameras ? o.record_camera_hz : 0.0;
     ro.camera_scale = o.record_camera_scale;
     ro.jpeg_quality = o.record_jpeg_quality;
     if (Status v = ValidateRecordOptions(ro); !v) return Fail(2, v.error().ToString());
-    auto w = record::McapWriter::Create(o.record_path);
-    if (!w) return Fail(3, w.error().Context("--record " + o.record_path).ToString());
-    mcap = std::move(*w);
-    auto r = Recorder::Create({mcap.get()}, names, *world_config, ro);
+    std::vector<record::Sink*> sinks;
+    if (!o.record_path.empty()) {
+      auto w = record::McapWriter::Create(o.record_path);
+      if (!w) return Fail(3, w.error().Context("--record " + o.record_path).ToString());
+      mcap = std::move(*w);
+      sinks.push_back(mcap.get());
+    }
+    if (!o.view_addr.empty()) {
+      const auto colon = o.view_addr.rfind(':');
+      record::LiveOptions lo;
+      lo.address = colon == std::string::npos ? o.view_addr : o.view_addr.substr(0, colon);
+      char* end = nullptr;
+      const long port = colon == std::string::npos ? 8765 : std::strtol(o.view_addr.c_str() + colon + 1, &end, 10);
+      if (lo.address.empty() || port < 1 || port > 65535 || (end != nullptr && *end != '\0')) {
+        return Fail(2, "--view '" + o.view_addr + "': expected ADDR:PORT, e.g. 0.0.0.0:8765");
+      }
+      lo.port = static_cast<int>(port);
+      lo.name = "swarmbox " + world_config->name;
+      auto server = record::LiveServer::Start(lo);
+      if (!server) return Fail(3, server.error().Context("--view " + o.view_addr).ToString());
+      live = std::move(*server);
+      sinks.push_back(live.get());
+    }
+    auto r = Recorder::Create(sinks, names, *world_config, ro);
     if (!r) return Fail(3, r.error().ToString());
     recorder = std::move(*r);
   }

@@ -53,6 +53,8 @@ struct ServerOptions {
   double record_camera_hz = 1.0;
   double record_camera_scale = 0.5;
   int record_jpeg_quality = 75;
+  // --view ADDR:PORT: serve the same channels live (record::LiveServer); "" = none.
+  std::string view_addr;
 };
 
 // "name:airframe:x,y,z[:yaw_deg[:payload[:attached]]]".

@@ -4,7 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <time.h>
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <iostream>
 #include <limits>
 #include <map>
 #include <string>
@@ -12,6 +18,7 @@
 
 #include "recorder_json.hpp"
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/record/mcap.hpp"
 #include "swarmbox/record/foxglove_schemas.hpp"
 
 namespace swarmbox::physics {
@@ -281,6 +288,77 @@ TEST(Recorder, CameraFramesAreSubsampledScaledAndJpeg) {
   const yaml::Node n = Json(frames[0].json);
   EXPECT_EQ(S(At(n, "format")), "jpeg");
   EXPECT_EQ(S(At(n, "data")).rfind("/9j/", 0), 0u);  // base64 of the JPEG SOI marker FF D8 FF
+}
+
+// What recording costs (BENCHMARKS.md "Recording"): one simulated minute of 4 drones at the
+// defaults (poses and telemetry at 10 Hz, a 320x240 camera frame per drone per second: a textured
+// gradient, JPEG 75 at half size), through the real McapWriter (zstd) on a writer thread. Prints
+// the CPU time and the bytes per drone-minute; checks the file reads back with every message.
+TEST(Recorder, CostOfAFourDroneMinute) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("recorder-cost-" + std::to_string(::getpid()) + ".mcap")).string();
+  auto cpu_s = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+  };
+  const std::vector<std::string> drones = {"scout_1", "scout_2", "scout_3", "lifter"};
+  CameraImage img;
+  img.width_px = 320;
+  img.height_px = 240;
+  img.bgr.resize(320 * 240 * 3);
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * 320 + static_cast<std::size_t>(x)) * 3;
+      const int grain = ((x * 7919 + y * 104729) >> 3) % 23;  // ground texture
+      img.bgr[i] = static_cast<std::uint8_t>(60 + x / 8 + grain);
+      img.bgr[i + 1] = static_cast<std::uint8_t>(110 + y / 6 + grain);
+      img.bgr[i + 2] = static_cast<std::uint8_t>(70 + grain);
+    }
+  }
+  const double cpu0 = cpu_s();
+  std::uint64_t written = 0;
+  {
+    auto writer = record::McapWriter::Create(path);
+    ASSERT_TRUE(writer) << writer.error().ToString();
+    auto rec = Recorder::Create({writer->get()}, drones, SmallWorld(), RecordOptions{});
+    ASSERT_TRUE(rec);
+    (*rec)->Start();
+    std::vector<TruthPose> poses(drones.size());
+    for (std::int64_t step = 0; step <= 15'000; ++step) {  // 60 s of 4 ms lockstep steps
+      const std::int64_t t_ns = step * 4'000'000;
+      if (t_ns % 100'000'000 == 0) {
+        for (std::size_t d = 0; d < drones.size(); ++d) {
+          poses[d] = {drones[d], {static_cast<double>(step) * 0.01, static_cast<double>(d), 30}, {2.5, 0, 0}, {1, 0, 0, 0}};
+          bus::Telemetry t = SomeTelemetry(drones[d], t_ns);
+          t.sectors.clear();
+          t.detections.clear();
+          if (step % 500 != 0) t.links.clear();  // the probe reports every 2 s
+          if (step % 250 != 0) t.events.clear();  // an event a second per drone
+          (*rec)->OnTelemetry(t);
+        }
+        (*rec)->WriteTruth(static_cast<std::uint64_t>(t_ns), poses);
+        (*rec)->Drain();
+      }
+      if (t_ns % 200'000'000 == 0) {  // the 5 Hz camera, recorded at 1 Hz
+        img.time_ns = t_ns;
+        for (std::size_t d = 0; d < drones.size(); ++d) (*rec)->OnCamera(d, img);
+      }
+    }
+    ASSERT_TRUE((*rec)->Finish());
+    written = (*rec)->messages();
+    ASSERT_TRUE((*writer)->Close());
+  }
+  const double cpu = cpu_s() - cpu0;
+  const auto bytes = std::filesystem::file_size(path);
+  auto reader = record::McapReader::Open(path);
+  ASSERT_TRUE(reader) << reader.error().ToString();
+  EXPECT_EQ(reader->message_count(), written);
+  EXPECT_EQ(reader->end_ns(), 60'000'000'000u);
+  std::cout << "[recording cost] 4 drones x 60 simulated s: " << written << " messages, " << bytes << " bytes ("
+            << bytes / 4 << " bytes per drone-minute), CPU " << cpu << " s (" << cpu / 4 * 1000
+            << " ms per drone-minute, recorder + writer thread)" << std::endl;
+  std::filesystem::remove(path);
 }
 
 TEST(Recorder, RejectsBadOptionsNamingTheField) {

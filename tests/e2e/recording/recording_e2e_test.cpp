@@ -80,7 +80,9 @@ class RecordingE2e : public ::testing::Test {
     argv.insert(argv.end(), extra.begin(), extra.end());
     auto done = RunToEnd(argv, std::chrono::minutes(10), dir_.string());
     EXPECT_TRUE(done) << done.error().ToString();
-    if (done) EXPECT_TRUE(done->code == 0 || done->code == 1) << "exit " << done->code << "\n" << done->err;
+    if (done) {
+      EXPECT_TRUE(done->code == 0 || done->code == 1) << "exit " << done->code << "\n" << done->err;
+    }
     return dir_ / runner::TrialDirName("sar-search", id);
   }
 

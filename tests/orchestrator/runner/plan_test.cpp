@@ -65,7 +65,8 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   ASSERT_EQ(physics.networks.size(), 1u);
   EXPECT_EQ(physics.networks[0].network, "sim");
   EXPECT_EQ(physics.networks[0].ipv4, "10.200.8.2");
-  EXPECT_THAT(physics.artifacts, ElementsAre("/swarmbox/out/truth.csv"));
+  // truth.csv, and the recording (record: is on by default).
+  EXPECT_THAT(physics.artifacts, ElementsAre("/swarmbox/out/truth.csv", "/swarmbox/out/recording.mcap"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/worlds/open_field.yaml"));
   EXPECT_THAT(physics.argv, Contains("lifter:x8_heavy:0,-10,0:0:stretcher:ground"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/airframes"));
