@@ -572,7 +572,9 @@ void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
     t.raft_leader = r.leader();
     t.raft_commit_index = r.commit_index();
     // The leader's committed plan, on a change and every simulated second.
-    const raft::MissionState* mission = r.is_leader() ? raft_->FindMission() : nullptr;
+    // SarBrain's mission state is Raft's machine behind a reference (FindMission does not see through it).
+    const raft::MissionState* mission = nullptr;
+    if (r.is_leader()) mission = sar_state_ != nullptr ? &sar_state_->mission() : raft_->FindMission();
     if (mission != nullptr) {
       SectorsOf(mission->sectors(), &sectors_scratch_);
       if (t_s_ - sectors_sent_s_ >= 1.0 || sectors_scratch_ != sectors_sent_) {

@@ -44,7 +44,12 @@ struct Channel {
   std::uint64_t last_ns = 0;
 };
 
-std::uint64_t U(const yaml::Node* n) { return n == nullptr ? 0 : static_cast<std::uint64_t>(*n->AsDouble()); }
+// A count or time of verify_mcap's summary; an empty channel's first_ns/last_ns are null: 0.
+std::uint64_t U(const yaml::Node* n) {
+  if (n == nullptr || !n->is_scalar()) return 0;
+  auto v = n->AsDouble();
+  return v ? static_cast<std::uint64_t>(*v) : 0;
+}
 
 class RecordingE2e : public ::testing::Test {
  protected:
