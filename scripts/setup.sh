@@ -15,10 +15,16 @@ PACKAGES=(
   cyclonedds-dev cyclonedds-tools libfastrtps-dev libfastcdr-dev fastddsgen
   # physics, maths, vision, formats, HTTP, archives
   libode-dev libeigen3-dev libopencv-dev libyaml-dev libcurl4-openssl-dev libssl-dev libarchive-dev zlib1g-dev
+  # recordings: MCAP chunk compression (record/)
+  libzstd-dev liblz4-dev
+  # the live view's WebSocket server (record::LiveServer)
+  libwebsockets-dev
   # command line, netfilter queue (userspace netem fallback)
   libcli11-dev libnetfilter-queue-dev
   # tests and micro-benchmarks (swarmbox-microbench)
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the page of the live view in a real browser (tests/js/page_check.mjs, headless)
+  chromium
   # containers, networks, hosts (procps: pgrep in netns_host.sh)
   docker.io docker-compose iptables iproute2 openssh-server openssh-client procps
   # a Linux kernel with sch_netem run as a process (user-mode Linux): the kernel netem path's guest test
@@ -84,6 +90,32 @@ if ! docker_answers; then
   fi
   wait_for 30 docker_answers || { tail -n 20 /var/log/swarmbox-dockerd.log >&2 || true; die "the Docker engine did not answer on /var/run/docker.sock within 30 s"; }
   log "Docker engine is up ($(docker version --format '{{.Server.Version}}' 2>/dev/null || echo unknown version))"
+fi
+
+# The JS test packages (tests/js: @mcap/core and the other independent readers and clients the
+# tests check recordings and the live view with), pinned by tests/js/package-lock.json. Debian's
+# nodejs/npm only when no node is there (a newer node from elsewhere is kept). `npm ci` runs as the
+# calling user, and again only when the lock file changed since the last install (a stamp in
+# node_modules).
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+  log "installing nodejs and npm"
+  export DEBIAN_FRONTEND=noninteractive
+  "${SUDO[@]}" apt-get update -qq >/dev/null || die "apt-get update failed"
+  if ! "${SUDO[@]}" apt-get install -y -qq --no-install-recommends nodejs npm >/tmp/swarmbox-apt.log 2>&1; then
+    tail -n 30 /tmp/swarmbox-apt.log >&2
+    die "apt-get install nodejs npm failed (full log: /tmp/swarmbox-apt.log)"
+  fi
+fi
+js_dir="$(cd "$(dirname "$0")/.." && pwd)/tests/js"
+js_stamp="$js_dir/node_modules/.swarmbox-lock-sha256"
+js_lock_sum="$(sha256sum "$js_dir/package-lock.json" | cut -d' ' -f1)"
+if [ "$(cat "$js_stamp" 2>/dev/null)" != "$js_lock_sum" ]; then
+  log "installing the JS test packages (npm ci in tests/js)"
+  if ! (cd "$js_dir" && npm ci --no-audit --no-fund >/tmp/swarmbox-npm.log 2>&1); then
+    tail -n 30 /tmp/swarmbox-npm.log >&2
+    die "npm ci in tests/js failed (full log: /tmp/swarmbox-npm.log)"
+  fi
+  echo "$js_lock_sum" > "$js_stamp"
 fi
 
 # sshd (multi-host experiments) needs its privilege-separation directory.

@@ -31,7 +31,7 @@ ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" "$@"
 # overrides of the trial loader; the runner's log matching; Docker timestamps of the launch bench;
 # the simulated radio channel (its profile parser, hashing and delivery queues); swarmbox diff's
 # truth.csv/events.jsonl/result.json comparison; Raft's entry-log snapshots; a brain's JSON arguments;
-# the C brain's parsing of committed entries).
+# the C brain's parsing of committed entries; the MCAP recordings' records, chunks and CRCs).
 # Not every unit test: on the project's 2-core machines building all of them a second time with
 # ASan (the agent's Eigen-heavy flight/swarm code, the physics server, the DDS bus types) would
 # roughly double the CI time. SANITIZER_TARGETS widens the set (e.g. "swarmbox_unit_tests", the
@@ -45,7 +45,7 @@ if [ "$SANITIZE" != "off" ]; then
   read -r -a sanitizer_targets <<< "${SANITIZER_TARGETS:-common_test docker_unit_test images_unit_test \
 faults_unit_test raft_log_test raft_message_codec_test raft_wal_storage_test raw_node_test \
 dsl_trial_loader_test runner_pure_test cli_launch_timing_test channel_test report_run_diff_test \
-raft_state_machine_test brain_args_test c_brain_rendezvous_test}"
+raft_state_machine_test brain_args_test c_brain_rendezvous_test mcap_test}"
   stage_start=$(date +%s)
   echo "test.sh: sanitizer stage (-DSANITIZER=$SANITIZE) in $ASAN_BUILD_DIR: ${sanitizer_targets[*]}"
   # Warnings are not errors here: the first build already holds the code to -Werror, and GCC 12

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <opencv2/imgproc.hpp>
@@ -136,6 +137,20 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   auto fc = flight::FlightController::Create(*cfg, co);
   if (!fc) return fc.error();
   std::unique_ptr<AgentNode> node(new AgentNode(o, std::move(*fc), std::move(*plan)));
+  if (o.telemetry_hz < 0.0 || !std::isfinite(o.telemetry_hz)) {
+    return Error(ErrorCode::kInvalidArgument, "--telemetry-hz must be >= 0");
+  }
+  if (o.telemetry_hz > 0.0) {
+    // Every line printed on the log (the node's, Raft's, the brain host's) also goes to the
+    // telemetry's event queue: the log's bytes stay as they were.
+    AgentNode* n = node.get();
+    auto tee = LogTee::Create(o.log, [n](std::string_view line) { n->telemetry_events_.Push(line); });
+    if (!tee) return tee.error().Context("the telemetry's log tee");
+    node->log_tee_ = std::move(*tee);
+    node->options_.log = node->log_tee_->file();
+    node->telemetry_clock_ = TelemetryClock(o.telemetry_hz);
+  }
+  std::FILE* const log_out = node->options_.log;  // the tee's stream with telemetry
 
   // No writer lingers at exit (Cyclone's default keeps an unacknowledged one up to 1 s, ~0.2 s per
   // agent): what it sent last (the last actuator command, Raft messages the protocol resends,
@@ -166,6 +181,12 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   auto pub = node->sim_->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
   if (!pub) return pub.error().Context("publishing actuator commands");
   node->actuator_pub_ = std::move(*pub);
+  if (node->telemetry_clock_.enabled()) {
+    // Keyed by drone like sim/actuator: the physics server's recorder reads it with one reader.
+    auto tpub = node->sim_->CreatePublisher<bus::Telemetry>(bus::kTelemetryTopic, bus::Qos::kState);
+    if (!tpub) return tpub.error().Context("publishing telemetry");
+    node->telemetry_pub_ = std::move(*tpub);
+  }
   const bool sar = o.mission.kind == MissionKind::kSar;
   std::unique_ptr<brain::Brain> the_brain;
   if (brain) {
@@ -227,7 +248,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     } else if (brain) {
       machine = std::make_unique<raft::EntryLogMachine>();
     }
-    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, o.log, &node->sim_clock_, std::move(machine));
+    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, log_out, &node->sim_clock_, std::move(machine));
     if (!raft) return raft.error();
     node->raft_ = std::move(*raft);
   }
@@ -252,7 +273,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     node->flight_port_ = std::make_unique<FlightAdapter>(node->fc_);
     if (node->raft_) node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
     node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(the_brain), *node->flight_port_, node->radio_.get(),
-                                                    node->consensus_.get(), o.log);
+                                                    node->consensus_.get(), log_out);
     if (auto spec = swarm::BatterySpecFor(cfg->airframe)) node->battery_.emplace(*spec);
   }
   // Perception runs beside the brain on a scout of the SAR mission and, for any other brain, on
@@ -284,6 +305,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
 AgentNode::AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan)
     : options_(std::move(options)), fc_(std::move(fc)), plan_(std::move(plan)) {
   cmd_.drone = options_.name;
+  telemetry_.drone = options_.name;
   cmd_.motor_throttle.assign(fc_.mixer().rotor_count(), 0.0);
   state_.drone = options_.name;
   frames_.reserve(64);
@@ -506,7 +528,95 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
   if (Status s = actuator_pub_->Publish(cmd_); !s) {
     Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "actuator").Add("reason", s.error().ToString()));
   }
+  if (telemetry_pub_ && telemetry_clock_.Due(msg.sim_time_ns)) PublishTelemetry(msg);
   return Ok{};
+}
+
+void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  bus::Telemetry& t = telemetry_;
+  t.sim_time_ns = msg.sim_time_ns;
+  const flight::StateEstimate& est = fc_.estimate();
+  t.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
+  t.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  t.attitude_wxyz = {est.att.w(), est.att.x(), est.att.y(), est.att.z()};
+  const flight::FlightMode mode = fc_.mode();
+  t.flight_mode = std::string(flight::FlightModeName(mode));
+  // The setpoint: what a brain commanded (NaN = the axis it left unset), else the flight
+  // stack's shaped reference (the built-in plan).
+  const brain::Setpoint* flown = brain_host_ ? brain_host_->flown() : nullptr;
+  if (flown != nullptr) {
+    t.setpoint_position_enu_m = {flown->position_m.x, flown->position_m.y, flown->position_m.z};
+    t.setpoint_velocity_enu_m_s = {flown->velocity_m_s.x, flown->velocity_m_s.y, flown->velocity_m_s.z};
+    t.setpoint_yaw_rad = flown->yaw_rad;
+  } else if (brain_host_) {
+    t.setpoint_position_enu_m = {kNaN, kNaN, kNaN};
+    t.setpoint_velocity_enu_m_s = {kNaN, kNaN, kNaN};
+    t.setpoint_yaw_rad = kNaN;
+  } else {
+    const flight::TrajectoryPoint& ref = fc_.telemetry().reference;
+    t.setpoint_position_enu_m = {ref.pos_m.x(), ref.pos_m.y(), ref.pos_m.z()};
+    t.setpoint_velocity_enu_m_s = {ref.vel_mps.x(), ref.vel_mps.y(), ref.vel_mps.z()};
+    t.setpoint_yaw_rad = kNaN;
+  }
+  // Flocking (SarBrain): V18's horizontal terms; separation = repulsion, alignment = Reynolds'
+  // alignment + V18 friction, cohesion, and their sum.
+  const swarm::FlockingOutput* f = sar_ != nullptr ? sar_->flocking() : nullptr;
+  if (f != nullptr) {
+    const swarm::Vec2 align = f->alignment + f->friction;
+    const swarm::Vec2 sum = f->repulsion + align + f->cohesion;
+    t.flock_separation = {f->repulsion.x(), f->repulsion.y(), 0.0};
+    t.flock_alignment = {align.x(), align.y(), 0.0};
+    t.flock_cohesion = {f->cohesion.x(), f->cohesion.y(), 0.0};
+    t.flock_sum = {sum.x(), sum.y(), 0.0};
+  } else {
+    t.flock_separation = t.flock_alignment = t.flock_cohesion = t.flock_sum = {kNaN, kNaN, kNaN};
+  }
+  t.sectors.clear();
+  if (raft_) {
+    const mission::RaftService& r = raft_->service();
+    t.raft_role = r.is_learner() ? "learner" : std::string(raft::RoleName(r.role()));
+    t.raft_term = r.term();
+    t.raft_leader = r.leader();
+    t.raft_commit_index = r.commit_index();
+    // The leader's committed plan, on a change and every simulated second.
+    // SarBrain's mission state is Raft's machine behind a reference (FindMission does not see through it).
+    const raft::MissionState* mission = nullptr;
+    if (r.is_leader()) mission = sar_state_ != nullptr ? &sar_state_->mission() : raft_->FindMission();
+    if (mission != nullptr) {
+      SectorsOf(mission->sectors(), &sectors_scratch_);
+      if (t_s_ - sectors_sent_s_ >= 1.0 || sectors_scratch_ != sectors_sent_) {
+        sectors_sent_s_ = t_s_;
+        sectors_sent_ = sectors_scratch_;
+        t.sectors = sectors_scratch_;
+      }
+    }
+  } else {
+    t.raft_role.clear();
+    t.raft_term = 0;
+    t.raft_leader.clear();
+    t.raft_commit_index = 0;
+  }
+  if (sar_ != nullptr) {
+    t.battery_fraction = sar_->battery_fraction();
+  } else if (brain_host_) {
+    t.battery_fraction = vehicle_.battery_fraction;
+  } else {
+    t.battery_fraction = kNaN;  // the built-in plan has no battery model
+  }
+  t.mission_stage = brain_host_ ? brain_host_->status() : std::string(plan_.current());
+  t.armed = cmd_.armed;
+  t.landed = LandedMode(mode);
+  t.detections.swap(telemetry_detections_);
+  telemetry_detections_.clear();
+  t.events.clear();
+  telemetry_events_.TakeInto(&t.events);
+  t.links.clear();
+  for (const bus::Event& e : t.events) {
+    if (auto link = LinkOf(e)) t.links.push_back(std::move(*link));
+  }
+  // Best effort: the recording loses this one if the bus refuses it; the run goes on.
+  (void)telemetry_pub_->Publish(t);
 }
 
 void AgentNode::BroadcastState(const bus::SensorSample& msg) {
@@ -581,6 +691,9 @@ void AgentNode::StepMission(const bus::SensorSample& msg) {
     }
     perception_->PopVisible(t_s_, &detections_);
     for (const brain::Detection& d : detections_) brain_host_->OnDetection(d);
+    if (telemetry_pub_) {
+      for (const brain::Detection& d : detections_) telemetry_detections_.push_back(DetectionToBus(d, options_.name));
+    }
   }
   // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
   // time and nothing of the wall clock may feed a decision (the brain has no side channel then).

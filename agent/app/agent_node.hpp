@@ -51,7 +51,9 @@
 #include "radio_dispatch.hpp"
 #include "raft_host.hpp"
 #include "sar_brain.hpp"
+#include "telemetry.hpp"
 #include "swarmbox/bus/participant.hpp"
+#include "swarmbox/common/log_tee.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/flight/flight_controller.hpp"
@@ -116,6 +118,9 @@ struct AgentOptions {
   // the last 5 s first) and log event=link per sampled peer; ping_every_ms 0 = off.
   int ping_every_ms = 200;
   int ping_peers = 3;  // > 0
+  // The recording (telemetry.hpp): every 1/telemetry_hz of simulated time a bus::Telemetry on
+  // sim/telemetry with every log line printed since the last one; 0 = none. Nothing decides on it.
+  double telemetry_hz = 0.0;
 };
 
 class AgentNode final : private FrameHandler {
@@ -146,6 +151,9 @@ class AgentNode final : private FrameHandler {
   // --brain library|external: the vehicle as the brain sees it, then the BrainHost step.
   void StepBrain(const bus::SensorSample& msg);
   void BroadcastState(const bus::SensorSample& msg);
+  // Every 1/telemetry_hz of simulated time, after the step's answer: what only this agent knows,
+  // for the recording. Decides nothing.
+  void PublishTelemetry(const bus::SensorSample& msg);
   bool Done() const;  // the plan is complete, or the SAR mission is (and this drone is down)
   // FrameHandler (radio_dispatch.hpp).
   void OnRaftPayload(std::span<const std::uint8_t> bytes) override;
@@ -159,6 +167,9 @@ class AgentNode final : private FrameHandler {
 
   class FlightAdapter;  // FlightPort over fc_
 
+  // First: the log stream's tee outlives every part that prints to options_.log.
+  EventQueue telemetry_events_;     // the log lines since the last telemetry
+  std::unique_ptr<LogTee> log_tee_;  // telemetry_hz > 0: options_.log is its stream
   AgentOptions options_;
   flight::FlightController fc_;
   FlightPlan plan_;
@@ -196,6 +207,14 @@ class AgentNode final : private FrameHandler {
   bus::RadioFrame out_frame_;
   bus::ActuatorCommand cmd_;
   bus::DroneState state_;
+  // The recording's telemetry (telemetry_hz > 0).
+  std::unique_ptr<bus::Publisher<bus::Telemetry>> telemetry_pub_;
+  TelemetryClock telemetry_clock_{0.0};
+  bus::Telemetry telemetry_;
+  std::vector<bus::Detection> telemetry_detections_;  // since the last telemetry
+  double sectors_sent_s_ = -1e9;                       // when the leader last sent its plan
+  std::vector<bus::TelemetrySector> sectors_scratch_;
+  std::vector<bus::TelemetrySector> sectors_sent_;    // the plan last sent
   bool have_step_ = false;
   std::uint64_t last_step_ = 0;
   double t_s_ = 0.0;

@@ -119,6 +119,8 @@ class BrainHost {
             std::vector<bus::WorldCommand>* world);
 
   const std::string& status() const { return status_; }  // the brain's last Output::status
+  // The setpoint last commanded to the flight stack (NaN = unset); nullptr before the first.
+  const brain::Setpoint* flown() const { return has_flown_ ? &flown_ : nullptr; }
   double payload_mass_kg() const { return payload_mass_kg_; }
   flight::OffboardFailsafe::Action failsafe() const { return failsafe_.action(); }
   std::uint64_t brain_steps() const { return brain_steps_; }  // Step calls of the brain that returned

@@ -112,6 +112,7 @@ int main(int argc, char** argv) {
   app.add_option("--raft-election-timeout-ms", o.raft.election_timeout_ms, "Raft: election timeout, a multiple of the tick, > heartbeat [ms]")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--propose-every-ms", o.raft.propose_every_ms, "Raft diagnostic: the leader proposes a demo mission command every N ms (0 = never)")->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--ping-every-ms", o.ping_every_ms, "Radio: every N ms of the radio's clock (simulated with channel, wall with netem) ping --ping-peers other members and log event=link per sampled peer (needs --members; 0 = off)")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--telemetry-hz", o.telemetry_hz, "Recording: publish this drone's telemetry (estimate, setpoint, flocking, Raft, links, sectors, detections, its log events) on sim/telemetry every 1/N simulated seconds; 0 = off. Nothing decides on it")->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--ping-peers", o.ping_peers, "Radio: members pinged per --ping-every-ms round, round-robin (those heard in the last 5 s first, by name): the probe's cost is constant in the swarm's size")->check(CLI::PositiveNumber)->capture_default_str();
   std::string mission_kind = "plan";
   app.add_option("--mission", mission_kind, "What to fly: plan (the built-in --plan) or sar (the SAR mission; needs --members and --world)")->capture_default_str();

@@ -633,6 +633,7 @@ void SarBrain::Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Ou
       fi.neighbours = neighbours_;
       const swarm::FlockingOutput f = flock_.Step(fi, config_.tuning.mission_dt_s);
       out.setpoint.assign(1, brain::Setpoint::Velocity(B(f.velocity_m_s), sp.yaw_rad));
+      flocking_out_ = f;
       break;
     }
     case SetpointKind::kLand:
@@ -641,6 +642,7 @@ void SarBrain::Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Ou
   }
   if (sp.kind != SetpointKind::kPosition) sent_target_m_ = Vec3::Constant(1e9);
   sent_kind_ = sp.kind;
+  flocking_ = sp.kind == SetpointKind::kFlock;
 }
 
 }  // namespace swarmbox::agent

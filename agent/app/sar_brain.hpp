@@ -208,6 +208,8 @@ class SarBrain final : public brain::Brain {
   double payload_mass_kg() const { return payload_attached_ ? payload_mass_kg_ : 0.0; }
   // The committed mission is complete (event=mission_complete logged).
   bool complete() const { return complete_logged_; }
+  // The last flocking step's terms (for the recording); nullptr while the drone is not flocking.
+  const swarm::FlockingOutput* flocking() const { return flocking_ ? &flocking_out_ : nullptr; }
 
  private:
   // What one Step knows, in the behaviours' types.
@@ -269,6 +271,8 @@ class SarBrain final : public brain::Brain {
   flight::Vec3 sent_target_m_ = flight::Vec3::Constant(1e9);
   bool climb_sent_ = false;
   bool complete_logged_ = false;
+  swarm::FlockingOutput flocking_out_;  // the last flocking step's (flocking_: of the last Drive)
+  bool flocking_ = false;
 };
 
 // One LogEvent line (t, node, event, fields) as a brain::Event (event and fields; the host

@@ -17,6 +17,7 @@ std::string_view MessageTypeName(MessageType type) {
     case MessageType::kEvent: return "swarmbox::msg::Event";
     case MessageType::kBrainInput: return "swarmbox::msg::BrainInput";
     case MessageType::kBrainOutput: return "swarmbox::msg::BrainOutput";
+    case MessageType::kTelemetry: return "swarmbox::msg::Telemetry";
   }
   return "swarmbox::msg::<unknown>";
 }

@@ -34,6 +34,9 @@ struct RunArgs {
   std::string run_id;
   bool quiet = false;
   bool json = false;
+  bool no_record = false;  // --no-record: the trial's record.enabled = false
+  bool view_requested = false;  // --view given (with or without its ADDR:PORT)
+  std::string view;             // its ADDR:PORT; "" = 127.0.0.1:8765
   ProgramPaths programs;
 };
 int RunCommand(const RunArgs& args);
@@ -93,6 +96,14 @@ struct DiffArgs {
   bool json = false;
 };
 int DiffCommand(const DiffArgs& args);
+
+// swarmbox view: replays RUN_DIR/recording.mcap in the built-in page (record::LiveServer) until
+// Ctrl-C/SIGTERM (exit 0); 2 no or unreadable recording, bad --addr; 3 cannot listen there.
+struct ViewArgs {
+  std::string run_dir;
+  std::string addr = "127.0.0.1:8765";  // ADDR:PORT; port 0 = any free one (the URL printed says)
+};
+int ViewCommand(const ViewArgs& args);
 
 struct GcArgs {
   std::string run_id;  // "" = every run not alive on this machine

@@ -87,6 +87,9 @@ int main(int argc, char** argv) {
   AddOutOption(run_cmd, run.out, "Output folder (default: runs)");
   AddSetOption(run_cmd, run.sets, "Override a key of the trial: key.path=value");
   AddLaunchOptions(run_cmd, run.run_id, run.quiet, run.json, run.programs);
+  run_cmd->add_flag("--no-record", run.no_record, "No recording.mcap (as the trial key record: {enabled: false})");
+  run_cmd->add_option("--view", run.view, "Serve the trial live (Foxglove WebSocket and the built-in page) on this host at ADDR:PORT (default 127.0.0.1:8765); the local Docker engine only")
+      ->expected(0, 1);
 
   ValidateArgs validate;
   auto* validate_cmd = app.add_subcommand(
@@ -148,6 +151,13 @@ int main(int argc, char** argv) {
   AddJsonFlag(diff_cmd, diff.json);
   diff_cmd->footer(kDiffHelp);
 
+  ViewArgs view;
+  auto* view_cmd = app.add_subcommand(
+      "view", "Replay a trial's recording (RUN_DIR/recording.mcap) in the built-in page; Foxglove "
+              "connects to the same address. Serves until Ctrl-C (exit 0)");
+  view_cmd->add_option("run_dir", view.run_dir, "Trial folder (<out>/<trial>-<run id>)")->required();
+  view_cmd->add_option("--addr", view.addr, "Listen on ADDR:PORT (default 127.0.0.1:8765; port 0: any free)");
+
   GcArgs gc;
   auto* gc_cmd = app.add_subcommand("gc", "Remove containers and networks left by killed runs");
   gc_cmd->add_option("--run", gc.run_id, "Only this run id (default: every run not alive here)");
@@ -164,7 +174,10 @@ int main(int argc, char** argv) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitUsage;
   }
-  if (*run_cmd) return RunCommand(run);
+  if (*run_cmd) {
+    run.view_requested = run_cmd->count("--view") > 0;
+    return RunCommand(run);
+  }
   if (*validate_cmd) return ValidateCommand(validate);
   if (*compose_cmd) return ComposeCommand(compose);
   if (*images_cmd) {
@@ -174,6 +187,7 @@ int main(int argc, char** argv) {
   if (*exp_cmd) return ExperimentCommand(exp);
   if (*report_cmd) return ReportCommand(report);
   if (*diff_cmd) return DiffCommand(diff);
+  if (*view_cmd) return ViewCommand(view);
   if (*gc_cmd) return GcCommand(gc);
   if (*version_cmd) {
     if (!version_json) {

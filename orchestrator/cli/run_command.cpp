@@ -1,4 +1,4 @@
-// swarmbox run TRIAL.yaml [-o DIR] [--set key=value ...] [-q] [--json]
+// swarmbox run TRIAL.yaml [-o DIR] [--set key=value ...] [-q] [--json] [--no-record] [--view [ADDR:PORT]]
 #include <filesystem>
 #include <iostream>
 
@@ -9,6 +9,7 @@
 #include "load_trial.hpp"
 #include "program_images.hpp"
 #include "run_lock.hpp"
+#include "swarmbox/docker/engine_endpoint.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
 
@@ -37,6 +38,24 @@ void PrintJsonSummary(const runner::RunOutcome& run, const std::string& run_id, 
 int RunCommand(const RunArgs& args) {
   auto spec = LoadTrialOrPrintError(args.trial, args.sets);
   if (!spec) return kExitUsage;
+  if (args.no_record) spec->record.enabled = false;
+  std::optional<runner::ViewBinding> view;
+  if (args.view_requested) {
+    auto binding = runner::ParseViewAddress(args.view);
+    if (!binding) {
+      std::cerr << "swarmbox run: --view " << binding.error().message() << "\n";
+      return kExitUsage;
+    }
+    // Docker publishes the port on the engine's host: that is this machine only with a local engine.
+    auto endpoint = docker::EngineEndpointFromEnvironment();
+    if (endpoint && endpoint->kind != docker::EngineEndpoint::Kind::kUnix && endpoint->host != "127.0.0.1" &&
+        endpoint->host != "localhost" && endpoint->host != "::1") {
+      std::cerr << "swarmbox run: --view publishes the physics server's port on the Docker engine's host, and the engine ("
+                << endpoint->ToString() << ") is not this machine's: --view needs the local engine\n";
+      return kExitUsage;
+    }
+    view = *binding;
+  }
   // The radio profile (the default one is not checked by the loader), before anything starts.
   const std::string trials_dir = std::filesystem::absolute(spec->trials_dir).lexically_normal().string();
   if (Status s = runner::CheckRadioProfile(*spec, trials_dir); !s) {
@@ -80,6 +99,8 @@ int RunCommand(const RunArgs& args) {
   options.interrupted = &interrupted;
   options.interrupt_reason = [] { return std::string(InterruptName()); };
   options.progress = args.quiet ? nullptr : &std::cerr;
+  options.view = view;
+  if (view) std::cout << "view: " << view->url() << std::endl;
   auto run = runner::RunTrialSpec(*spec, client, clock, options);
   if (!run) {
     std::cerr << "swarmbox run: " << run.error().ToString() << "\n";

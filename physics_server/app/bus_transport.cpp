@@ -55,6 +55,13 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
   return t;
 }
 
+Status BusTransport::SubscribeTelemetry(std::function<void(const bus::Telemetry&)> on_telemetry) {
+  auto sub = participant_->CreateSubscriber<bus::Telemetry>(bus::kTelemetryTopic, bus::Qos::kState, std::move(on_telemetry));
+  if (!sub) return std::move(sub).error().Context("subscribing to telemetry");
+  telemetry_sub_ = std::move(*sub);
+  return Ok{};
+}
+
 Status BusTransport::PublishSample(std::size_t drone, const std::string& name, const SensorSample& s,
                                    const SampleExtras& extras) {
   bus::SensorSample& m = sample_msg_;

@@ -47,6 +47,10 @@ class BusTransport final : public SimTransport {
   void WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) override;
   void TakeWorldCommands(std::vector<WorldCommandInput>* out) override;
 
+  // The agents' telemetry for the recording (sim/telemetry, every agent on one keyed reader):
+  // each sample is handed to `on_telemetry` on a middleware thread. Once; before the agents start.
+  Status SubscribeTelemetry(std::function<void(const bus::Telemetry&)> on_telemetry);
+
   // Actuator commands whose `drone` is not a drone of the trial (dropped).
   std::uint64_t unknown_commands() const;
 
@@ -81,6 +85,7 @@ class BusTransport final : public SimTransport {
   // Last: destroyed first, so no callback runs while the members above go away.
   std::unique_ptr<bus::Subscriber<bus::WorldCommand>> world_commands_;
   std::unique_ptr<bus::Subscriber<bus::ActuatorCommand>> actuators_sub_;
+  std::unique_ptr<bus::Subscriber<bus::Telemetry>> telemetry_sub_;
 };
 
 }  // namespace swarmbox::physics

@@ -13,12 +13,16 @@
 #include <numbers>
 
 #include "bus_transport.hpp"
+#include "recorder.hpp"
 #include "send_command_main.hpp"
 #include "server_options.hpp"
 #include "sim_server.hpp"
+#include "swarmbox/common/log_tee.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/version.hpp"
 #include "swarmbox/physics/world.hpp"
+#include "swarmbox/record/live_server.hpp"
+#include "swarmbox/record/mcap.hpp"
 
 namespace {
 
@@ -76,6 +80,12 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"channel", "netem"}))
       ->capture_default_str();
   app.add_option("--radio-profile", o.radio_profile_path, "Radio profile YAML (trials/radios/*.yaml); required with --radio-model channel");
+  app.add_option("--record", o.record_path, "Write the recording (MCAP: true poses, the agents' telemetry, cameras, the world, every log event) to PATH; '' = none");
+  app.add_option("--record-rate-hz", o.record_rate_hz, "Recording: true poses per simulated second (the agents' --telemetry-hz should match)")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--record-camera-hz", o.record_camera_hz, "Recording: camera frames per simulated second per drone; 0 = none")->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--record-camera-scale", o.record_camera_scale, "Recording: camera frames are scaled by this (0, 1] before JPEG encoding")->capture_default_str();
+  app.add_option("--record-jpeg-quality", o.record_jpeg_quality, "Recording: JPEG quality [1, 100]")->capture_default_str();
+  app.add_option("--view", o.view_addr, "Serve the recording's channels live at ADDR:PORT (Foxglove WebSocket protocol and the built-in page at /); '' = none");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -156,6 +166,54 @@ int main(int argc, char** argv) {
     truth.emplace(std::move(*f));
   }
 
+  // The recording: its sinks, then the recorder (both outlive the transport, which feeds it).
+  std::unique_ptr<record::McapWriter> mcap;
+  std::unique_ptr<record::LiveServer> live;
+  std::unique_ptr<Recorder> recorder;
+  if (!o.record_path.empty() || !o.view_addr.empty()) {
+    RecordOptions ro;
+    ro.rate_hz = o.record_rate_hz;
+    ro.camera_hz = o.cameras ? o.record_camera_hz : 0.0;
+    ro.camera_scale = o.record_camera_scale;
+    ro.jpeg_quality = o.record_jpeg_quality;
+    if (Status v = ValidateRecordOptions(ro); !v) return Fail(2, v.error().ToString());
+    std::vector<record::Sink*> sinks;
+    if (!o.record_path.empty()) {
+      auto w = record::McapWriter::Create(o.record_path);
+      if (!w) return Fail(3, w.error().Context("--record " + o.record_path).ToString());
+      mcap = std::move(*w);
+      sinks.push_back(mcap.get());
+    }
+    if (!o.view_addr.empty()) {
+      const auto colon = o.view_addr.rfind(':');
+      record::LiveOptions lo;
+      lo.address = colon == std::string::npos ? o.view_addr : o.view_addr.substr(0, colon);
+      char* end = nullptr;
+      const long port = colon == std::string::npos ? 8765 : std::strtol(o.view_addr.c_str() + colon + 1, &end, 10);
+      if (lo.address.empty() || port < 1 || port > 65535 || (end != nullptr && *end != '\0')) {
+        return Fail(2, "--view '" + o.view_addr + "': expected ADDR:PORT, e.g. 0.0.0.0:8765");
+      }
+      lo.port = static_cast<int>(port);
+      lo.name = "swarmbox " + world_config->name;
+      auto server = record::LiveServer::Start(lo);
+      if (!server) return Fail(3, server.error().Context("--view " + o.view_addr).ToString());
+      live = std::move(*server);
+      sinks.push_back(live.get());
+    }
+    auto r = Recorder::Create(sinks, names, *world_config, ro);
+    if (!r) return Fail(3, r.error().ToString());
+    recorder = std::move(*r);
+  }
+  // With a recording, every event line also goes to it (its /log channel); stdout is unchanged.
+  std::unique_ptr<LogTee> tee;
+  std::FILE* events = stdout;
+  if (recorder) {
+    auto t = LogTee::Create(stdout, [r = recorder.get()](std::string_view line) { r->OnLogLine(line); });
+    if (!t) return Fail(3, t.error().ToString());
+    tee = std::move(*t);
+    events = tee->file();
+  }
+
   bus::ParticipantConfig pc;
   pc.backend = o.middleware;
   pc.domain_id = o.domain;
@@ -169,6 +227,11 @@ int main(int argc, char** argv) {
   if (!transport) {
     const ErrorCode c = transport.error().code();
     return Fail(c == ErrorCode::kInvalidArgument || c == ErrorCode::kNotFound ? 2 : 3, transport.error().ToString());
+  }
+  if (recorder) {
+    if (Status s = (*transport)->SubscribeTelemetry([r = recorder.get()](const bus::Telemetry& t) { r->OnTelemetry(t); }); !s) {
+      return Fail(3, s.error().ToString());
+    }
   }
 
   std::signal(SIGTERM, OnSignal);
@@ -184,9 +247,14 @@ int main(int argc, char** argv) {
   so.radio_profile = std::move(radio_profile);
   // The plan's seed when it has one (the trial's, written by the orchestrator), else --seed.
   so.radio_seed = so.plan.seed.value_or(o.seed);
+  so.observer = recorder.get();
   SteadyWallClock clock;
-  SimServer server(**world, **transport, clock, truth ? &*truth : nullptr, so, stdout);
-  std::printf("%s\n", LogEvent(0.0, "physics", "ready")
+  SimServer server(**world, **transport, clock, truth ? &*truth : nullptr, so, events);
+  if (recorder) {
+    recorder->Start();
+    recorder->OnStep(**world);  // the poses at t = 0
+  }
+  std::fprintf(events, "%s\n", LogEvent(0.0, "physics", "ready")
                           .Add("world", world_config->name)
                           .Add("drones", static_cast<std::int64_t>(names.size()))
                           .Add("middleware", o.middleware)
@@ -196,14 +264,21 @@ int main(int argc, char** argv) {
                           .Add("radio_model", o.radio_model)
                           .str()
                           .c_str());
-  std::fflush(stdout);
+  std::fflush(events);
   const Status s = server.Run(g_stop);
-  std::printf("%s\n", LogEvent((*world)->time_s(), "physics", "stopped")
+  std::fprintf(events, "%s\n", LogEvent((*world)->time_s(), "physics", "stopped")
                           .Add("reason", g_stop.load() ? "signal" : "max_sim_time")
                           .Add("steps", static_cast<std::uint64_t>((*world)->step_count()))
                           .str()
                           .c_str());
-  std::fflush(stdout);
+  std::fflush(events);
+  // The recording is complete before the process leaves (a signal's exit skips destructors).
+  if (recorder) {
+    if (Status f = recorder->Finish(); !f) std::fprintf(stderr, "swarmbox-physics: recording: %s\n", f.error().ToString().c_str());
+  }
+  if (mcap) {
+    if (Status c = mcap->Close(); !c) return Fail(3, c.error().Context("--record " + o.record_path).ToString());
+  }
   if (!s) return Fail(3, s.error().ToString());
   if (g_stop.load()) {
     // Stopped by a signal (a trial's end): truth.csv and event=stopped are out, so leave without

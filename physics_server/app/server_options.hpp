@@ -50,6 +50,14 @@ struct ServerOptions {
   std::string radio_plan_path;          // --radio-plan: radio_plan.hpp JSON; "" = none
   std::string radio_model = "netem";    // --radio-model channel|netem
   std::string radio_profile_path;       // --radio-profile (required with channel)
+  // The recording (recorder.hpp): --record PATH writes recording.mcap; "" = none.
+  std::string record_path;
+  double record_rate_hz = 10.0;
+  double record_camera_hz = 1.0;
+  double record_camera_scale = 0.5;
+  int record_jpeg_quality = 75;
+  // --view ADDR:PORT: serve the same channels live (record::LiveServer); "" = none.
+  std::string view_addr;
 };
 
 // "name:airframe:x,y,z[:yaw_deg[:payload[:attached]]]".

@@ -450,7 +450,10 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
     if (lockstep_.out(i)) continue;
     Slot& slot = slots_[i];
     slot.camera_frame = options_.cameras && world_.CameraDue(i) && !world_.Truth(i).lost;
-    if (slot.camera_frame) world_.RenderCamera(i, &slot.image);
+    if (slot.camera_frame) {
+      world_.RenderCamera(i, &slot.image);
+      if (options_.observer != nullptr) options_.observer->OnCamera(i, slot.image);
+    }
     if (auto s = PublishDrone(i, /*with_camera=*/true); !s) return s;
   }
   if (auto s = transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf); !s) {
@@ -513,6 +516,7 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   if (truth_ != nullptr) {
     if (auto s = truth_->MaybeWrite(world_); !s) return s;
   }
+  if (options_.observer != nullptr) options_.observer->OnStep(world_);
   bool late = false;
   std::int64_t now = clock_.NowNs();
   if (options_.rtf > 0) {

@@ -143,6 +143,17 @@ class ClockProgress {
   std::uint64_t late_ = 0;
 };
 
+// What a recording sees of the simulation (recorder.hpp). Called on the server's thread; nothing
+// it does feeds back into the run.
+class StepObserver {
+ public:
+  virtual ~StepObserver() = default;
+  // A camera frame rendered for drone `drone` at this step (before its sample goes out).
+  virtual void OnCamera(std::size_t drone, const CameraImage& image) = 0;
+  // After World::Step (and truth.csv): the world at its new time.
+  virtual void OnStep(const World& world) = 0;
+};
+
 struct SimServerOptions {
   double rtf = 1.0;                          // 0 = as fast as possible
   double max_sim_time_s = 0;                 // 0 = no limit
@@ -156,6 +167,7 @@ struct SimServerOptions {
   // channel::ValidateImpairment (CheckChannelPlan).
   std::optional<channel::RadioProfile> radio_profile;
   std::uint64_t radio_seed = 1;
+  StepObserver* observer = nullptr;          // the recording (--record, --view); null: none
 };
 
 // The plan's impairments against what the channel carries out (its distributions): the first one

@@ -236,6 +236,36 @@ BrainOutput FullBrainOutput(std::uint64_t seed) {
   return m;
 }
 
+Telemetry FullTelemetry(std::uint64_t seed) {
+  Telemetry m;
+  m.drone = S(seed, "drone");
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 222;
+  m.position_enu_m = {D(seed, 51), D(seed, 52), D(seed, 53)};
+  m.velocity_enu_m_s = {D(seed, 54), D(seed, 55), D(seed, 56)};
+  m.attitude_wxyz = {D(seed, 57), D(seed, 58), D(seed, 59), D(seed, 60)};
+  m.flight_mode = S(seed, "trajectory");
+  m.setpoint_position_enu_m = {D(seed, 61), D(seed, 62), D(seed, 63)};
+  m.setpoint_velocity_enu_m_s = {D(seed, 64), D(seed, 65), D(seed, 66)};
+  m.setpoint_yaw_rad = D(seed, 67);
+  m.flock_separation = {D(seed, 68), D(seed, 69), D(seed, 70)};
+  m.flock_alignment = {D(seed, 71), D(seed, 72), D(seed, 73)};
+  m.flock_cohesion = {D(seed, 74), D(seed, 75), D(seed, 76)};
+  m.flock_sum = {D(seed, 77), D(seed, 78), D(seed, 79)};
+  m.raft_role = S(seed, "leader");
+  m.raft_term = seed + 5;
+  m.raft_leader = S(seed, "leader_name");
+  m.raft_commit_index = seed + 17;
+  m.battery_fraction = D(seed, 80);
+  m.mission_stage = S(seed, "scout/searching");
+  m.armed = true;
+  m.landed = false;
+  m.links = {{S(seed, "peer_a"), D(seed, 81), D(seed, 82)}, {S(seed, "peer_b"), D(seed, 83), D(seed, 84)}};
+  m.sectors = {{S(seed, "sector_drone"), {D(seed, 85), D(seed, 86), D(seed, 87), D(seed, 88)}}, {S(seed, "empty"), {}}};
+  m.detections = {FullDetection(seed + 5), FullDetection(seed + 6)};
+  m.events = {FullEvent(seed + 7), FullEvent(seed + 8)};
+  return m;
+}
+
 template <> ClockTick Full<ClockTick>(std::uint64_t seed) { return FullClockTick(seed); }
 template <> SensorSample Full<SensorSample>(std::uint64_t seed) { return FullSensorSample(seed); }
 template <> ActuatorCommand Full<ActuatorCommand>(std::uint64_t seed) {
@@ -251,5 +281,6 @@ template <> BrainMessage Full<BrainMessage>(std::uint64_t seed) { return FullBra
 template <> Event Full<Event>(std::uint64_t seed) { return FullEvent(seed); }
 template <> BrainInput Full<BrainInput>(std::uint64_t seed) { return FullBrainInput(seed); }
 template <> BrainOutput Full<BrainOutput>(std::uint64_t seed) { return FullBrainOutput(seed); }
+template <> Telemetry Full<Telemetry>(std::uint64_t seed) { return FullTelemetry(seed); }
 
 }  // namespace swarmbox::bus::testing

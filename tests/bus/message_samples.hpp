@@ -27,6 +27,7 @@ RadioFrame FullRadioFrame(std::uint64_t seed, int which);
 Event FullEvent(std::uint64_t seed);
 BrainInput FullBrainInput(std::uint64_t seed);
 BrainOutput FullBrainOutput(std::uint64_t seed);
+Telemetry FullTelemetry(std::uint64_t seed);
 
 // Overload set for generic tests: Full<T>(seed).
 template <typename T>
@@ -44,5 +45,6 @@ template <> BrainMessage Full<BrainMessage>(std::uint64_t seed);
 template <> Event Full<Event>(std::uint64_t seed);
 template <> BrainInput Full<BrainInput>(std::uint64_t seed);
 template <> BrainOutput Full<BrainOutput>(std::uint64_t seed);
+template <> Telemetry Full<Telemetry>(std::uint64_t seed);
 
 }  // namespace swarmbox::bus::testing

@@ -84,6 +84,9 @@ std::vector<Rule> Rules() {
        .excluded = "4-5 minutes at real time; ReproducibleE2e runs it cut short by a simulated timeout"},
       {.line = cli + " diff runs/a/sar-search-* runs/b/sar-search-*",
        .excluded = "needs the two runs above; ReproducibleE2e diffs its runs with this command"},
+      {.line = cli + " view runs/sar-search-RUN_ID",
+       .excluded = "RUN_ID stands for a trial folder, and view serves until Ctrl-C; LiveViewTest "
+                   "(tests/record) runs view on a recording, loads the page in Chromium and stops it with SIGINT"},
       {.line = cli + " gc --dry-run", .timeout = 60s},  // removes nothing: says what gc would remove
       {.line = cli + " gc",
        .append = {"--run", "readme-commands-none"},

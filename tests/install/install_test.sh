@@ -35,7 +35,7 @@ for f in bin/swarmbox bin/swarmbox-physics bin/swarmbox-agent bin/swarmbox-netem
          share/doc/swarmbox/README.md share/doc/swarmbox/examples/CMakeLists.txt; do
   [ -e "$prefix/$f" ] || fail "missing $prefix/$f"
 done
-for lib in common docker images dsl faults runner hosts report experiment brain brain_loader; do
+for lib in common record docker images dsl faults runner hosts report experiment brain brain_loader; do
   [ -f "$prefix/lib/libswarmbox_$lib.a" ] || fail "missing $prefix/lib/libswarmbox_$lib.a"
 done
 # Every shipped trial, airframe, world, fault trial and experiment.

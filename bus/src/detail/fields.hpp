@@ -51,16 +51,25 @@
   F(drone) F(sim_time_ns) F(setpoint) F(commands) F(messages) F(proposals) F(status) F(events)
 #define SWARMBOX_BUS_FIELDS_KeyValue(F) F(key) F(value)
 #define SWARMBOX_BUS_FIELDS_Event(F) F(node) F(sim_time_ns) F(name) F(fields)
+#define SWARMBOX_BUS_FIELDS_TelemetryLink(F) F(peer) F(loss) F(rtt_ms)
+#define SWARMBOX_BUS_FIELDS_TelemetrySector(F) F(drone) F(polygon_xy_m)
+#define SWARMBOX_BUS_FIELDS_Telemetry(F)                                                       \
+  F(drone) F(sim_time_ns) F(position_enu_m) F(velocity_enu_m_s) F(attitude_wxyz) F(flight_mode)  \
+  F(setpoint_position_enu_m) F(setpoint_velocity_enu_m_s) F(setpoint_yaw_rad) F(flock_separation) \
+  F(flock_alignment) F(flock_cohesion) F(flock_sum) F(raft_role) F(raft_term) F(raft_leader)      \
+  F(raft_commit_index) F(battery_fraction) F(mission_stage) F(armed) F(landed) F(links)          \
+  F(sectors) F(detections) F(events)
 
 #define SWARMBOX_BUS_STRUCTS(S)                                                               \
   S(DroneState) S(RaftMessage) S(Detection) S(RadioPing) S(BrainMessage) S(RadioFrame)        \
   S(WorldCommand) S(ClockTick) S(ImuSample) S(BaroSample) S(MagSample) S(GpsSample)           \
   S(BatterySample) S(SensorSample) S(ActuatorCommand) S(CameraIntrinsics) S(Pose)             \
   S(CameraImage) S(KeyValue) S(Event) S(VehicleState) S(CommittedEntry) S(BrainInput)         \
-  S(TrajectorySetpoint) S(VehicleCommand) S(Proposal) S(BrainOutput)
+  S(TrajectorySetpoint) S(VehicleCommand) S(Proposal) S(BrainOutput) S(TelemetryLink)        \
+  S(TelemetrySector) S(Telemetry)
 
 // The top-level message types (those with a MessageType), for dispatch.
 #define SWARMBOX_BUS_MESSAGES(M)                                                              \
   M(ClockTick) M(SensorSample) M(ActuatorCommand) M(CameraImage) M(WorldCommand)              \
   M(DroneState) M(RaftMessage) M(Detection) M(RadioPing) M(BrainMessage) M(Event)            \
-  M(BrainInput) M(BrainOutput)
+  M(BrainInput) M(BrainOutput) M(Telemetry)

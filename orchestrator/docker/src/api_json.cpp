@@ -259,6 +259,11 @@ std::string CreateContainerBody(const ContainerSpec& spec, bool all_networks) {
   body.Set("AttachStderr", Bool(false));
   if (!spec.stop_signal.empty()) body.Set("StopSignal", Str(spec.stop_signal));
   if (spec.stop_timeout_s) body.Set("StopTimeout", Int(*spec.stop_timeout_s));
+  if (!spec.ports.empty()) {
+    Node exposed = Node::Mapping();
+    for (const PortBinding& p : spec.ports) exposed.Set(std::to_string(p.container_port) + "/tcp", Node::Mapping());
+    body.Set("ExposedPorts", std::move(exposed));
+  }
 
   Node host = Node::Mapping();
   if (!spec.mounts.empty()) {
@@ -295,6 +300,18 @@ std::string CreateContainerBody(const ContainerSpec& spec, bool all_networks) {
   if (!spec.resources.cpuset_cpus.empty()) host.Set("CpusetCpus", Str(spec.resources.cpuset_cpus));
   if (!spec.sysctls.empty()) host.Set("Sysctls", StrMap(spec.sysctls));
   if (!spec.extra_hosts.empty()) host.Set("ExtraHosts", StrList(spec.extra_hosts));
+  if (!spec.ports.empty()) {
+    Node bindings = Node::Mapping();
+    for (const PortBinding& p : spec.ports) {
+      Node binding = Node::Mapping();
+      binding.Set("HostIp", Str(p.host_ip));
+      binding.Set("HostPort", Str(std::to_string(p.host_port)));
+      Node list = Node::Sequence();
+      list.Append(std::move(binding));
+      bindings.Set(std::to_string(p.container_port) + "/tcp", std::move(list));
+    }
+    host.Set("PortBindings", std::move(bindings));
+  }
   host.Set("ReadonlyRootfs", Bool(spec.read_only_rootfs));
   if (spec.init) host.Set("Init", Bool(true));
   host.Set("AutoRemove", Bool(spec.auto_remove));

@@ -148,6 +148,31 @@ Status DecodeLimits(const Node& node, ContainerLimits* out) {
   return Ok{};
 }
 
+// `record: {enabled, rate_hz, camera_hz, camera_scale, jpeg_quality}` (every key optional).
+Status DecodeRecord(const Node& node, RecordSpec* out) {
+  yaml::MapReader r(node, "record");
+  r.Optional("enabled", &out->enabled)
+      .Optional("rate_hz", &out->rate_hz)
+      .Optional("camera_hz", &out->camera_hz)
+      .Optional("camera_scale", &out->camera_scale)
+      .Optional("jpeg_quality", &out->jpeg_quality);
+  SWARMBOX_TRY(r.Finish());
+  auto at = [&](std::string_view key, const std::string& what) { return At(*node.Find(key), what); };
+  if (!(out->rate_hz > 0 && out->rate_hz <= 250)) {
+    return at("rate_hz", "'rate_hz' must be in (0, 250]: true poses per simulated second (the lockstep runs at 250 Hz)");
+  }
+  if (!(out->camera_hz >= 0 && out->camera_hz <= 250)) {
+    return at("camera_hz", "'camera_hz' must be in [0, 250]: camera frames per simulated second per drone (0: none)");
+  }
+  if (!(out->camera_scale > 0 && out->camera_scale <= 1)) {
+    return at("camera_scale", "'camera_scale' must be in (0, 1]: the factor camera frames are resized by");
+  }
+  if (out->jpeg_quality < 1 || out->jpeg_quality > 100) {
+    return at("jpeg_quality", "'jpeg_quality' must be in [1, 100]");
+  }
+  return Ok{};
+}
+
 // `radio: {model: channel|netem, profile: NAME|PATH, ping_every_ms: N, ping_peers: K}`.
 Status DecodeRadio(const Node& node, RadioLinkSpec* out) {
   std::string model(RadioModelName(out->model));
@@ -246,6 +271,7 @@ Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& optio
   const Node* mission = r.Child("mission");
   const Node* raft = r.Child("raft");
   const Node* radio = r.Child("radio");
+  const Node* record = r.Child("record");
   const Node* network = r.Child("network");
   const Node* faults = r.Child("faults");
   const Node* end = r.Child("end");
@@ -334,6 +360,9 @@ Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& optio
   if (raft != nullptr && !raft->is_null()) SWARMBOX_TRY(DecodeRaft(*raft, &spec.raft));
   if (radio != nullptr && !radio->is_null()) {
     SWARMBOX_TRY(DecodeRadio(*radio, &spec.radio));
+  }
+  if (record != nullptr && !record->is_null()) {
+    SWARMBOX_TRY(DecodeRecord(*record, &spec.record));
   }
 
   if (components != nullptr) {

@@ -107,6 +107,11 @@ TrialSpec& TrialSpec::Radio(RadioLinkSpec value) {
   radio = value;
   return *this;
 }
+
+TrialSpec& TrialSpec::Record(RecordSpec value) {
+  record = value;
+  return *this;
+}
 TrialSpec& TrialSpec::Timeout(Duration sim, Outcome outcome, Duration wall) {
   timeout = {sim, wall, outcome};
   return *this;

@@ -381,6 +381,7 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
   spec.auto_remove = false;  // a crashed container keeps its logs until we collected them
   spec.cap_add = s.cap_add;
   spec.cap_drop = s.cap_drop;
+  for (const dsl::ContainerSpec::Port& p : s.ports) spec.ports.push_back({p.container_port, p.host_ip, p.host_port});
   if (s.no_new_privileges) spec.security_opt.push_back("no-new-privileges");
   spec.read_only_rootfs = s.read_only_rootfs;
   for (const std::string& v : s.volumes) {

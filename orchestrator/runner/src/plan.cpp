@@ -14,6 +14,43 @@
 
 namespace swarmbox::runner {
 
+Result<ViewBinding> ParseViewAddress(std::string_view text) {
+  ViewBinding b;
+  if (text.empty()) return b;
+  const std::string what = "'" + std::string(text) + "': expected ADDR:PORT (an IPv4 address of this host and a port 1-65535), e.g. 127.0.0.1:8765";
+  std::string_view addr = text;
+  const auto colon = text.rfind(':');
+  if (colon != std::string_view::npos) {
+    addr = text.substr(0, colon);
+    const std::string_view port = text.substr(colon + 1);
+    int p = 0;
+    auto [ptr, ec] = std::from_chars(port.data(), port.data() + port.size(), p);
+    if (port.empty() || ec != std::errc() || ptr != port.data() + port.size() || p < 1 || p > 65535) {
+      return Error(ErrorCode::kInvalidArgument, what);
+    }
+    b.host_port = p;
+  }
+  if (!addr.empty()) {
+    int parts = 0;
+    std::size_t start = 0;
+    while (true) {
+      const auto dot = addr.find('.', start);
+      const std::string_view part = addr.substr(start, dot == std::string_view::npos ? std::string_view::npos : dot - start);
+      int v = -1;
+      auto [ptr, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+      if (part.empty() || part.size() > 3 || ec != std::errc() || ptr != part.data() + part.size() || v > 255) {
+        return Error(ErrorCode::kInvalidArgument, what);
+      }
+      ++parts;
+      if (dot == std::string_view::npos) break;
+      start = dot + 1;
+    }
+    if (parts != 4) return Error(ErrorCode::kInvalidArgument, what);
+    b.host_ip = std::string(addr);
+  }
+  return b;
+}
+
 std::string ShortestNumber(double v) {
   char buf[64];
   auto r = std::to_chars(buf, buf + sizeof buf, v);
@@ -38,7 +75,7 @@ constexpr int kMeshDomain = 1;
 
 // swarmbox-physics (physics_server/README.md).
 constexpr double kFaultClockEveryS = 0.5;  // [simulated s]
-std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan) {
+std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan, bool view) {
   std::vector<std::string> argv = {
       images::kPhysicsBinaryInImage,
       "--world", InContainer(spec.world),
@@ -55,6 +92,16 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
       // Stops (event=stopped t=...) when the trial's simulated time is up; truth.csv is flushed.
       "--max-sim-time", ShortestNumber(spec.timeout.sim.seconds()),
   };
+  // The live view (swarmbox run --view): every address of the container, published by Docker.
+  if (view) argv.insert(argv.end(), {"--view", "0.0.0.0:" + std::to_string(kViewContainerPort)});
+  // The recording (record:), collected with truth.csv.
+  if (spec.record.enabled) {
+    argv.insert(argv.end(), {"--record", std::string(kRecordingPath),
+                             "--record-rate-hz", ShortestNumber(spec.record.rate_hz),
+                             "--record-camera-hz", ShortestNumber(spec.record.camera_hz),
+                             "--record-camera-scale", ShortestNumber(spec.record.camera_scale),
+                             "--record-jpeg-quality", std::to_string(spec.record.jpeg_quality)});
+  }
   // The simulated radio: the channel with its profile, and the plan of what happens at simulated
   // times (network.mesh, the faults with `at:`; radio_schedule.hpp).
   const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
@@ -163,6 +210,8 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   // The radio link measurement (event=link per sampled peer).
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms),
                            "--ping-peers", std::to_string(spec.radio.ping_peers)});
+  // The recording: the agent's telemetry at the rate of the true poses.
+  if (spec.record.enabled) argv.insert(argv.end(), {"--telemetry-hz", ShortestNumber(spec.record.rate_hz)});
   // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
   argv.insert(argv.end(), {"--raft-dir", std::string(kAgentStateDir) + "/raft"});
   const dsl::BrainSpec& brain = d.brain;
@@ -431,7 +480,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   const std::string physics_ip = nets.sim.Host(kPhysicsHost);
   const bool radio_plan = channel && !options.radio_plan_path.empty();
   dsl::ContainerSpec physics =
-      dsl::ContainerSpec::Image(options.images.physics, PhysicsArgv(spec, radio_plan));
+      dsl::ContainerSpec::Image(options.images.physics, PhysicsArgv(spec, radio_plan, options.view.has_value()));
   physics.name = name(kPhysicsId);
   physics.hostname = std::string(kPhysicsId);
   physics.labels = labels(kPhysicsId);
@@ -447,6 +496,8 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   }
   physics.scratch_dirs = {std::string(kContainerOutDir)};
   physics.artifacts = {std::string(kTruthCsvPath)};
+  if (spec.record.enabled) physics.artifacts.push_back(std::string(kRecordingPath));
+  if (options.view) physics.ports.push_back({kViewContainerPort, options.view->host_ip, options.view->host_port});
   Confine(spec.LimitsOf(nullptr), &physics);
   trial->Add<dsl::Plugin>(std::string(kPhysicsId), std::move(physics), physics_level)
       .On(sim_net, physics_ip, {std::string(kPhysicsId)})

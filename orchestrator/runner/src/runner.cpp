@@ -493,6 +493,10 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
 
 Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& api, Clock& clock,
                                 const RunOptions& options) {
+  if (options.view && options.host != "local") {
+    return Error(ErrorCode::kInvalidArgument, "--view publishes the live view on this machine; host '" + options.host +
+                                                  "' is remote (run the trial on the local engine to watch it)");
+  }
   const std::string trials_dir =
       fs::absolute(spec.trials_dir.empty() ? fs::path(".") : fs::path(spec.trials_dir))
           .lexically_normal()
@@ -574,6 +578,7 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
     p.faults_image = faults_image;
     p.subnets = subnets;
     p.trials_dir = trials_dir;
+    p.view = options.view;
     return PlanTrial(spec, p);
   };
   return RunTrial(info, planner, api, clock, options);

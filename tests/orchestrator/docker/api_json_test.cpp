@@ -356,6 +356,23 @@ TEST(ApiJson, SidecarSharesTheAgentsNetworkNamespace) {
   EXPECT_EQ(doc->Find("NetworkingConfig"), nullptr);
 }
 
+// A published port (swarmbox run --view): exposed, and bound to the host address and port.
+TEST(ApiJson, PublishesPortsOnTheHost) {
+  ContainerSpec spec;
+  spec.image = "swarmbox/physics:1";
+  spec.ports = {{8765, "127.0.0.1", 9000}};
+  auto doc = yaml::Parse(CreateContainerBody(spec, false));
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  ASSERT_NE(doc->Find("ExposedPorts"), nullptr);
+  EXPECT_NE(doc->Find("ExposedPorts")->Find("8765/tcp"), nullptr);
+  const yaml::Node* b = doc->Find("HostConfig")->Find("PortBindings")->Find("8765/tcp");
+  ASSERT_NE(b, nullptr);
+  ASSERT_EQ(b->items().size(), 1u);
+  EXPECT_EQ(b->items()[0].Find("HostIp")->scalar(), "127.0.0.1");
+  EXPECT_EQ(b->items()[0].Find("HostPort")->scalar(), "9000");
+  EXPECT_EQ(yaml::Parse(CreateContainerBody(ContainerSpec{}, false))->Find("ExposedPorts"), nullptr);
+}
+
 TEST(ApiJson, BuildsExecBodies) {
   ExecSpec spec;
   spec.cmd = {"/probe", "exit", "7"};

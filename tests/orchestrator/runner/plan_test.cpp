@@ -65,7 +65,8 @@ TEST_F(PlanTest, PhysicsThenOneAgentPerDroneWithFixedAddresses) {
   ASSERT_EQ(physics.networks.size(), 1u);
   EXPECT_EQ(physics.networks[0].network, "sim");
   EXPECT_EQ(physics.networks[0].ipv4, "10.200.8.2");
-  EXPECT_THAT(physics.artifacts, ElementsAre("/swarmbox/out/truth.csv"));
+  // truth.csv, and the recording (record: is on by default).
+  EXPECT_THAT(physics.artifacts, ElementsAre("/swarmbox/out/truth.csv", "/swarmbox/out/recording.mcap"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/worlds/open_field.yaml"));
   EXPECT_THAT(physics.argv, Contains("lifter:x8_heavy:0,-10,0:0:stretcher:ground"));
   EXPECT_THAT(physics.argv, Contains("/swarmbox/trials/airframes"));
@@ -145,6 +146,71 @@ TEST_F(PlanTest, AgentsGetTheRaftMembersSeedTimingsAndTheirMission) {
   EXPECT_EQ(value_of("--ping-peers"), "3");
   EXPECT_EQ(value_of("--sim-interface"), "eth0");
   EXPECT_EQ(value_of("--mesh-interface"), "eth1");
+}
+
+// The recording (record:): the physics server writes it where truth.csv is and it is collected the
+// same way; the agents send their telemetry at the same rate. record.enabled false: neither.
+TEST_F(PlanTest, RecordingIsPassedAndCollectedUnlessOff) {
+  spec_.record.rate_hz = 20;
+  spec_.record.jpeg_quality = 60;
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  auto value_in = [](const std::vector<std::string>& argv, const std::string& flag) -> std::string {
+    auto it = std::find(argv.begin(), argv.end(), flag);
+    return it == argv.end() || it + 1 == argv.end() ? "<absent>" : *(it + 1);
+  };
+  const dsl::ContainerSpec& physics = (*trial)->FindPlugin("physics")->spec();
+  EXPECT_EQ(value_in(physics.argv, "--record"), "/swarmbox/out/recording.mcap");
+  EXPECT_EQ(value_in(physics.argv, "--record-rate-hz"), "20");
+  EXPECT_EQ(value_in(physics.argv, "--record-camera-hz"), "1");
+  EXPECT_EQ(value_in(physics.argv, "--record-camera-scale"), "0.5");
+  EXPECT_EQ(value_in(physics.argv, "--record-jpeg-quality"), "60");
+  EXPECT_NE(std::find(physics.artifacts.begin(), physics.artifacts.end(), "/swarmbox/out/recording.mcap"),
+            physics.artifacts.end());
+  EXPECT_EQ(value_in((*trial)->FindPlugin("scout_2")->spec().argv, "--telemetry-hz"), "20");
+
+  spec_.record.enabled = false;
+  auto off = PlanTrial(spec_, options_);
+  ASSERT_TRUE(off) << off.error().ToString();
+  const dsl::ContainerSpec& quiet = (*off)->FindPlugin("physics")->spec();
+  EXPECT_EQ(value_in(quiet.argv, "--record"), "<absent>");
+  EXPECT_EQ(quiet.artifacts, std::vector<std::string>{"/swarmbox/out/truth.csv"});
+  EXPECT_EQ(value_in((*off)->FindPlugin("scout_2")->spec().argv, "--telemetry-hz"), "<absent>");
+}
+
+// swarmbox run --view: the physics server serves the live view on every address of its container,
+// Docker publishes that port on the host address asked for.
+TEST_F(PlanTest, ViewIsServedAndPublishedOnTheHost) {
+  options_.view = ViewBinding{"127.0.0.1", 9000};
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  const dsl::ContainerSpec& physics = (*trial)->FindPlugin("physics")->spec();
+  auto it = std::find(physics.argv.begin(), physics.argv.end(), "--view");
+  ASSERT_NE(it, physics.argv.end());
+  EXPECT_EQ(*(it + 1), "0.0.0.0:8765");
+  ASSERT_EQ(physics.ports.size(), 1u);
+  EXPECT_EQ(physics.ports[0].container_port, 8765);
+  EXPECT_EQ(physics.ports[0].host_ip, "127.0.0.1");
+  EXPECT_EQ(physics.ports[0].host_port, 9000);
+  EXPECT_TRUE((*trial)->FindPlugin("scout_1")->spec().ports.empty());
+}
+
+TEST(ViewAddress, DefaultsAndErrors) {
+  auto d = ParseViewAddress("");
+  ASSERT_TRUE(d);
+  EXPECT_EQ(d->url(), "http://127.0.0.1:8765/");
+  auto full = ParseViewAddress("0.0.0.0:9001");
+  ASSERT_TRUE(full);
+  EXPECT_EQ(full->host_ip, "0.0.0.0");
+  EXPECT_EQ(full->host_port, 9001);
+  auto addr_only = ParseViewAddress("192.168.1.20");
+  ASSERT_TRUE(addr_only);
+  EXPECT_EQ(addr_only->host_port, 8765);
+  for (const char* bad : {"localhost:80", "1.2.3:80", "1.2.3.4:0", "1.2.3.4:70000", "1.2.3.4:", "1.2.3.256:80"}) {
+    auto r = ParseViewAddress(bad);
+    ASSERT_FALSE(r) << bad;
+    EXPECT_NE(r.error().message().find("expected ADDR:PORT"), std::string::npos) << bad;
+  }
 }
 
 // Raft at swarm scale: raft.voters = V below the drone count makes the first V drones in trial

@@ -280,6 +280,61 @@ struct Event {
   bool operator==(const Event&) const = default;
 };
 
+// ---- sim domain, agents -> the physics server's recorder --------------------------------------
+
+// One measured radio link, as the agent's link probe last reported it (its event=link line).
+struct TelemetryLink {
+  std::string peer;
+  double loss = 0.0;    // [0, 1], over the probe's last window
+  double rtt_ms = 0.0;  // mean round trip [ms] on the radio's clock; NaN when none was answered
+  bool operator==(const TelemetryLink&) const = default;
+};
+
+// One drone's search sector of the committed mission plan: a polygon in world ENU [m], as
+// (x0, y0, x1, y1, ...).
+struct TelemetrySector {
+  std::string drone;
+  std::vector<double> polygon_xy_m;
+  bool operator==(const TelemetrySector&) const = default;
+};
+
+// What only the agent knows, for the recording (record/): on kTelemetryTopic with Qos::kState,
+// keyed by `drone`, every 1/record.rate_hz of simulated time. Nothing in an agent waits for it and
+// nothing decides on it: a lost or late one changes the recording, never the run. NaN = unset or
+// unknown (a setpoint axis the flight stack does not hold, the flocking terms of a drone that is not
+// flocking).
+struct Telemetry {
+  std::string drone;  // the key
+  std::int64_t sim_time_ns = 0;
+  // The flight stack's estimate (not the truth), world ENU.
+  std::array<double, 3> position_enu_m{};
+  std::array<double, 3> velocity_enu_m_s{};
+  std::array<double, 4> attitude_wxyz{1.0, 0.0, 0.0, 0.0};
+  std::string flight_mode;  // flight::FlightModeName
+  // The setpoint the flight stack tracks (its shaped reference), world ENU.
+  std::array<double, 3> setpoint_position_enu_m{};
+  std::array<double, 3> setpoint_velocity_enu_m_s{};
+  double setpoint_yaw_rad = 0.0;
+  // The flocking terms of the last flocking step (swarm::Flocking, V18), horizontal [m/s].
+  std::array<double, 3> flock_separation{};
+  std::array<double, 3> flock_alignment{};
+  std::array<double, 3> flock_cohesion{};
+  std::array<double, 3> flock_sum{};
+  std::string raft_role;  // follower, pre_candidate, candidate, leader; "" without Raft
+  std::uint64_t raft_term = 0;
+  std::string raft_leader;  // "" when none is known
+  std::uint64_t raft_commit_index = 0;
+  double battery_fraction = 0.0;  // [0, 1]
+  std::string mission_stage;      // the brain's status ("scout/searching"), else the flight mode
+  bool armed = false;
+  bool landed = true;
+  std::vector<TelemetryLink> links;        // the link probe's reports since the last telemetry
+  std::vector<TelemetrySector> sectors;    // the committed plan; sent by the Raft leader only
+  std::vector<Detection> detections;       // this drone's perception results since the last one
+  std::vector<Event> events;               // every log event of this agent since the last one
+  bool operator==(const Telemetry&) const = default;
+};
+
 // ---- sim domain, offboard: an agent's flight stack <-> a brain in its own process ------------
 //
 // brain: program. OffboardInputTopic(drone) carries BrainInput (agent -> brain) and
@@ -389,8 +444,9 @@ enum class MessageType : std::uint8_t {
   kEvent,
   kBrainInput,
   kBrainOutput,
+  kTelemetry,
 };
-inline constexpr int kMessageTypeCount = 13;
+inline constexpr int kMessageTypeCount = 14;
 
 // The DDS type name on the wire, e.g. "swarmbox::msg::SensorSample".
 std::string_view MessageTypeName(MessageType type);
@@ -416,6 +472,7 @@ SWARMBOX_BUS_MESSAGE_TRAITS(BrainMessage);
 SWARMBOX_BUS_MESSAGE_TRAITS(Event);
 SWARMBOX_BUS_MESSAGE_TRAITS(BrainInput);
 SWARMBOX_BUS_MESSAGE_TRAITS(BrainOutput);
+SWARMBOX_BUS_MESSAGE_TRAITS(Telemetry);
 #undef SWARMBOX_BUS_MESSAGE_TRAITS
 
 template <typename T>

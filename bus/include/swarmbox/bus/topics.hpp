@@ -14,6 +14,7 @@
 //   sim     sim/<drone>/camera         CameraImage      kLockstep   physics -> agent <drone>
 //   sim     sim/world_command          WorldCommand     kLockstep   orchestrator/tools -> physics
 //   sim     sim/status                 Event            kLockstep   physics -> all (the start, 1 Hz)
+//   sim     sim/telemetry              Telemetry        kState      every agent -> physics (keyed by drone; the recording)
 //   mesh    mesh/state                 DroneState       kState      agent -> agents (keyed by drone)
 //   mesh    mesh/raft                  RaftMessage      kRadio      agent -> agent `to`
 //   mesh    mesh/detection             Detection        kRadio      agent -> agents
@@ -62,6 +63,9 @@ inline constexpr std::string_view kWorldCommandTopic = "sim/world_command";
 // The physics server's start (physics_server/app/joining.hpp): Event "joining" every second while
 // the first step waits, "joined" once, with fields joined, expected, missing (every name, commas).
 inline constexpr std::string_view kSimStatusTopic = "sim/status";
+// Every agent's Telemetry for the physics server's recording (record/), keyed by drone; nothing
+// decides on it.
+inline constexpr std::string_view kTelemetryTopic = "sim/telemetry";
 inline constexpr std::string_view kDroneStateTopic = "mesh/state";
 inline constexpr std::string_view kRaftTopic = "mesh/raft";
 inline constexpr std::string_view kDetectionTopic = "mesh/detection";

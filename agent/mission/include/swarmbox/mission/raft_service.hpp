@@ -129,6 +129,8 @@ class RaftService {
   std::string leader() const { return driver_->leader(); }  // "" when none known
   bool is_leader() const { return driver_->is_leader(); }
   std::uint64_t term() const { return driver_->raft().term(); }
+  raft::Role role() const { return driver_->raft().role(); }
+  bool is_learner() const { return driver_->raft().is_learner(); }
   std::uint64_t commit_index() const { return driver_->raft().log().committed(); }
 
   // Ok while running; the driver's stop error once it stopped (storage failed: exit non-zero).

@@ -149,6 +149,14 @@ struct ResourceLimits {
   std::string cpuset_cpus;        // "0-1"; "" = any
 };
 
+// A container's TCP port published on the host (ExposedPorts and HostConfig.PortBindings).
+struct PortBinding {
+  int container_port = 0;  // e.g. 8765
+  std::string host_ip;     // e.g. "127.0.0.1"; "" = every address
+  int host_port = 0;       // e.g. 8765
+  bool operator==(const PortBinding&) const = default;
+};
+
 struct ContainerSpec {
   std::string name;                      // "" lets Docker choose
   std::string image;                     // reference, e.g. "swarmbox/agent:3f2a..."
@@ -174,6 +182,7 @@ struct ContainerSpec {
   ResourceLimits resources;
   std::map<std::string, std::string> sysctls;
   std::vector<std::string> extra_hosts;  // "name:ip"
+  std::vector<PortBinding> ports;        // TCP ports published on the host
   bool tty = false;                      // logs are then raw, not multiplexed
   bool open_stdin = false;
   bool read_only_rootfs = false;

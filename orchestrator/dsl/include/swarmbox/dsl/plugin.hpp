@@ -53,6 +53,13 @@ struct ContainerSpec {
   std::string network_of;
   // No network at all (Docker's NetworkMode "none"); `networks` must then be empty.
   bool no_network = false;
+  // TCP ports published on the host (the physics server's live view, `swarmbox run --view`).
+  struct Port {
+    int container_port = 0;
+    std::string host_ip;
+    int host_port = 0;
+  };
+  std::vector<Port> ports;
   std::vector<std::string> cap_add;   // e.g. "NET_ADMIN" (the fault sidecar only)
   std::vector<std::string> cap_drop;  // e.g. "ALL"
   // Least privilege: SecurityOpt no-new-privileges; a read-only root filesystem, where the

@@ -129,6 +129,18 @@ struct RadioLinkSpec {
 // itself for a path (it has a '/' or ends in ".yaml").
 std::string RadioProfileFile(const RadioLinkSpec& radio);
 
+// `record:` the trial's recording, RUN_DIR/.../recording.mcap (ARCHITECTURE.md "Recordings"),
+// written by the physics server: true poses every 1/rate_hz simulated s (and the agents' telemetry
+// at the same rate), camera frames at camera_hz per drone scaled by camera_scale and JPEG-encoded
+// at jpeg_quality. `swarmbox run --no-record` turns it off as `enabled: false` does.
+struct RecordSpec {
+  bool enabled = true;
+  double rate_hz = 10.0;      // > 0, at most 250 (the lockstep rate)
+  double camera_hz = 1.0;     // >= 0 (0: no camera channel)
+  double camera_scale = 0.5;  // (0, 1]
+  int jpeg_quality = 75;      // [1, 100]
+};
+
 struct TimeoutSpec {
   Duration sim;                         // simulated time; zero = none
   Duration wall;                        // wall-clock guard; zero = derived from sim and rtf
@@ -157,6 +169,7 @@ struct TrialSpec {
   MissionSpec mission;
   RaftSpec raft;
   RadioLinkSpec radio;
+  RecordSpec record;
   faults::MeshImpairment mesh;  // network.mesh, parsed by swarmbox_faults (tc netem semantics)
   yaml::Node mesh_node;         // network.mesh as written (null = an unimpaired radio)
   std::vector<faults::Fault> faults;
@@ -190,6 +203,7 @@ struct TrialSpec {
   TrialSpec& Mission(MissionSpec value);
   TrialSpec& Raft(RaftSpec value);
   TrialSpec& Radio(RadioLinkSpec value);
+  TrialSpec& Record(RecordSpec value);
   TrialSpec& Timeout(Duration sim, Outcome outcome = Outcome::kTimeout, Duration wall = {});
 
   TrialSpec& Limits(ContainerLimits value);

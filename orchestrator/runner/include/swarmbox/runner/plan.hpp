@@ -46,6 +46,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,18 @@ struct Images {
   std::map<std::string, std::string> components;
 };
 
+// `swarmbox run --view [ADDR:PORT]`: the physics server's live view (record::LiveServer on
+// 0.0.0.0:kViewContainerPort in its container) published on the host at host_ip:host_port.
+inline constexpr int kViewContainerPort = 8765;
+struct ViewBinding {
+  std::string host_ip = "127.0.0.1";
+  int host_port = kViewContainerPort;
+  std::string url() const { return "http://" + host_ip + ":" + std::to_string(host_port) + "/"; }
+};
+// "ADDR:PORT", "ADDR" (port 8765) or "" (127.0.0.1:8765); ADDR an IPv4 address, PORT 1..65535.
+// kInvalidArgument saying what is expected otherwise.
+Result<ViewBinding> ParseViewAddress(std::string_view text);
+
 struct PlanOptions {
   std::string run_id;
   std::string trial_id;  // "" = the trial's name
@@ -89,6 +102,8 @@ struct PlanOptions {
   // trial folder), copied in where the trial's world would be, so every container reads it.
   // "" = the trial's world file from trials_dir.
   std::string world_path;
+  // swarmbox run --view: the physics server serves the live view, published on the host here.
+  std::optional<ViewBinding> view;
 };
 
 // The shortest text that reads back as `v` (std::to_chars): numbers in argv and derived files.
@@ -105,6 +120,8 @@ inline constexpr std::string_view kContainerVolumeDir = "/swarmbox";
 inline constexpr std::string_view kContainerTrialsDir = "/swarmbox/trials";
 inline constexpr std::string_view kContainerOutDir = "/swarmbox/out";
 inline constexpr std::string_view kTruthCsvPath = "/swarmbox/out/truth.csv";
+// The recording (record:, ARCHITECTURE.md "Recordings"), collected into the trial folder.
+inline constexpr std::string_view kRecordingPath = "/swarmbox/out/recording.mcap";
 inline constexpr std::string_view kAgentStateDir = "/swarmbox/state";  // --raft-dir <it>/raft
 inline constexpr std::string_view kRadioPlanPath = "/swarmbox/radio_plan.json";  // in physics
 inline constexpr std::string_view kRadioPlanFile = "radio_plan.json";            // trial folder

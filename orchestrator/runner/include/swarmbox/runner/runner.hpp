@@ -71,6 +71,8 @@ struct RunOptions {
   // from it when `images.drone_agents` lacks that drone (user_images.hpp; brains' and components'
   // images missing from `images` are made the same way).
   std::string agent_binary;
+  // swarmbox run --view: publish the physics server's live view on this host (local engine only).
+  std::optional<ViewBinding> view;
 };
 
 struct RunOutcome {

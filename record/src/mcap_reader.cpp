@@ -1,0 +1,362 @@
+// McapReader: footer -> summary (CRC) -> data section CRC at Open; ForEach merges the chunks by
+// log time, decompressing each once. Spec: https://mcap.dev/spec.
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <queue>
+#include <tuple>
+#include <utility>
+
+#include "detail/bytes.hpp"
+#include "detail/mcap_format.hpp"
+#include "swarmbox/record/mcap.hpp"
+
+namespace swarmbox::record {
+
+using detail::ByteReader;
+using detail::Op;
+
+std::string_view CompressionName(Compression c) {
+  switch (c) {
+    case Compression::kNone:
+      return "none";
+    case Compression::kZstd:
+      return "zstd";
+    case Compression::kLz4:
+      return "lz4";
+  }
+  return "none";
+}
+
+Result<Compression> ParseCompression(std::string_view name) {
+  for (Compression c : {Compression::kZstd, Compression::kLz4, Compression::kNone}) {
+    if (name == CompressionName(c)) return c;
+  }
+  return Error(ErrorCode::kInvalidArgument,
+               "unknown compression \"" + std::string(name) + "\" (expected zstd, lz4 or none)");
+}
+
+namespace {
+
+// A read-only file with positioned reads; closes itself.
+class File {
+ public:
+  static Result<File> Open(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (f == nullptr) return Error(ErrorCode::kIo, std::string("cannot open: ") + std::strerror(errno), path);
+    File file(f, path);
+    if (std::fseek(f, 0, SEEK_END) != 0) return file.IoError("seek failed");
+    const long size = std::ftell(f);
+    if (size < 0) return file.IoError("cannot tell the size");
+    file.size_ = static_cast<std::uint64_t>(size);
+    return file;
+  }
+  File(File&& o) noexcept : f_(std::exchange(o.f_, nullptr)), path_(std::move(o.path_)), size_(o.size_) {}
+  File& operator=(File&&) = delete;
+  File(const File&) = delete;
+  File& operator=(const File&) = delete;
+  ~File() {
+    if (f_ != nullptr) std::fclose(f_);
+  }
+
+  std::uint64_t size() const { return size_; }
+
+  // Exactly `n` bytes at `offset` into *out.
+  Status Read(std::uint64_t offset, std::uint64_t n, std::string* out) {
+    if (offset > size_ || n > size_ - offset) {
+      return Error(ErrorCode::kProtocol,
+                   "record at byte " + std::to_string(offset) + " runs past the end of the file", path_);
+    }
+    out->resize(static_cast<std::size_t>(n));
+    if (std::fseek(f_, static_cast<long>(offset), SEEK_SET) != 0) return IoError("seek failed");
+    if (n > 0 && std::fread(out->data(), 1, out->size(), f_) != out->size()) return IoError("read failed");
+    return Ok{};
+  }
+
+  // CRC32 of bytes [0, end), read in blocks.
+  Result<std::uint32_t> Crc(std::uint64_t end) {
+    std::string block;
+    std::uint32_t crc = 0;
+    constexpr std::uint64_t kBlock = 1u << 20;
+    for (std::uint64_t at = 0; at < end; at += kBlock) {
+      SWARMBOX_TRY(Read(at, std::min(kBlock, end - at), &block));
+      crc = detail::Crc32(block, crc);
+    }
+    return crc;
+  }
+
+ private:
+  File(std::FILE* f, std::string path) : f_(f), path_(std::move(path)) {}
+  Error IoError(const char* what) const {
+    return Error(ErrorCode::kIo, std::string(what) + ": " + std::strerror(errno), path_);
+  }
+  std::FILE* f_;
+  std::string path_;
+  std::uint64_t size_ = 0;
+};
+
+Error Malformed(const std::string& path, std::uint64_t offset, const std::string& what) {
+  return Error(ErrorCode::kProtocol, what + " (at byte " + std::to_string(offset) + ")", path);
+}
+
+struct RawRecord {
+  Op op;
+  std::string_view content;
+  std::uint64_t offset;  // of the opcode, from the start of the file (or of the chunk's records)
+};
+
+// Splits `bytes` (which starts at file offset `base`) into records.
+Result<std::vector<RawRecord>> SplitRecords(std::string_view bytes, std::uint64_t base, const std::string& path) {
+  std::vector<RawRecord> out;
+  ByteReader r(bytes);
+  while (r.remaining() > 0) {
+    const std::uint64_t at = base + r.pos();
+    const auto op = static_cast<Op>(r.U8());
+    const std::uint64_t length = r.U64();
+    std::string_view content = r.Take(length);
+    if (!r.ok()) return Malformed(path, at, "truncated record");
+    out.push_back({op, content, at});
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<McapReader> McapReader::Open(const std::string& path) {
+  auto file = File::Open(path);
+  if (!file) return file.error();
+  const std::uint64_t size = file->size();
+  const std::uint64_t min_size = 2 * detail::kMagic.size() + detail::kRecordPrefixBytes + detail::kFooterRecordBytes;
+  if (size < min_size) return Malformed(path, 0, "not an MCAP file: " + std::to_string(size) + " bytes");
+
+  std::string buf;
+  SWARMBOX_TRY(file->Read(0, detail::kMagic.size() + detail::kRecordPrefixBytes, &buf));
+  if (std::string_view(buf).substr(0, detail::kMagic.size()) != detail::kMagic) {
+    return Malformed(path, 0, "not an MCAP file (no MCAP0 magic)");
+  }
+  McapReader reader;
+  reader.path_ = path;
+  {
+    ByteReader r(std::string_view(buf).substr(detail::kMagic.size()));
+    if (static_cast<Op>(r.U8()) != Op::kHeader) return Malformed(path, 8, "the first record is not a Header");
+    const std::uint64_t length = r.U64();
+    std::string header;
+    SWARMBOX_TRY(file->Read(detail::kMagic.size() + detail::kRecordPrefixBytes, length, &header));
+    ByteReader h(header);
+    reader.profile_ = std::string(h.Str());
+    reader.library_ = std::string(h.Str());
+    if (!h.ok()) return Malformed(path, 8, "truncated Header");
+  }
+
+  // Footer and the closing magic.
+  const std::uint64_t footer_at = size - detail::kMagic.size() - detail::kFooterRecordBytes;
+  SWARMBOX_TRY(file->Read(footer_at, detail::kFooterRecordBytes + detail::kMagic.size(), &buf));
+  const std::string footer = buf;
+  if (std::string_view(footer).substr(detail::kFooterRecordBytes) != detail::kMagic ||
+      static_cast<Op>(footer[0]) != Op::kFooter) {
+    return Malformed(path, footer_at,
+                     "no Footer and closing magic at the end: the file is truncated (its writer never closed it)");
+  }
+  ByteReader fr(std::string_view(footer).substr(1));
+  const std::uint64_t footer_length = fr.U64();
+  const std::uint64_t summary_start = fr.U64();
+  const std::uint64_t summary_offset_start = fr.U64();
+  const std::uint32_t summary_crc = fr.U32();
+  if (footer_length != detail::kFooterContentBytes) return Malformed(path, footer_at, "Footer of unexpected length");
+  if (summary_start == 0) {
+    return Malformed(path, footer_at, "no summary section: McapReader reads indexed files only");
+  }
+  if (summary_start < min_size - detail::kFooterRecordBytes || summary_start > footer_at ||
+      (summary_offset_start != 0 && (summary_offset_start < summary_start || summary_offset_start > footer_at))) {
+    return Malformed(path, footer_at, "Footer offsets outside the file");
+  }
+
+  // Summary (and summary offsets), checked against the footer's CRC.
+  std::string summary;
+  SWARMBOX_TRY(file->Read(summary_start, footer_at - summary_start, &summary));
+  if (summary_crc != 0) {
+    std::uint32_t crc = detail::Crc32(summary);
+    crc = detail::Crc32(std::string_view(footer).substr(0, detail::kRecordPrefixBytes + 16), crc);
+    if (crc != summary_crc) {
+      return Malformed(path, summary_start, "summary CRC mismatch: the summary section is corrupt");
+    }
+  }
+
+  // DataEnd right before the summary, and the data section's CRC.
+  if (summary_start < detail::kDataEndRecordBytes + detail::kMagic.size()) {
+    return Malformed(path, summary_start, "no DataEnd record before the summary");
+  }
+  const std::uint64_t data_end_at = summary_start - detail::kDataEndRecordBytes;
+  SWARMBOX_TRY(file->Read(data_end_at, detail::kDataEndRecordBytes, &buf));
+  {
+    ByteReader r(buf);
+    const auto op = static_cast<Op>(r.U8());
+    const std::uint64_t length = r.U64();
+    const std::uint32_t data_crc = r.U32();
+    if (op != Op::kDataEnd || length != 4) return Malformed(path, data_end_at, "no DataEnd record before the summary");
+    if (data_crc != 0) {
+      auto crc = file->Crc(data_end_at);
+      if (!crc) return crc.error();
+      if (*crc != data_crc) return Malformed(path, 0, "data section CRC mismatch: the data section is corrupt");
+    }
+  }
+
+  // Summary records up to the summary offsets.
+  const std::uint64_t summary_end = summary_offset_start != 0 ? summary_offset_start : footer_at;
+  auto records = SplitRecords(std::string_view(summary).substr(0, summary_end - summary_start), summary_start, path);
+  if (!records) return records.error();
+  struct SchemaInfo {
+    std::string name;
+    std::string data;
+  };
+  std::map<std::uint16_t, SchemaInfo> schemas;
+  std::map<std::uint16_t, std::pair<std::uint16_t, std::string>> channels;  // id -> (schema, topic)
+  bool have_statistics = false;
+  for (const RawRecord& rec : *records) {
+    ByteReader r(rec.content);
+    switch (rec.op) {
+      case Op::kSchema: {
+        const std::uint16_t id = r.U16();
+        SchemaInfo s{std::string(r.Str()), {}};
+        r.Str();  // encoding
+        s.data = std::string(r.Str());
+        if (!r.ok()) return Malformed(path, rec.offset, "truncated Schema record");
+        if (id != 0) schemas[id] = std::move(s);
+        break;
+      }
+      case Op::kChannel: {
+        const std::uint16_t id = r.U16();
+        const std::uint16_t schema = r.U16();
+        std::string topic(r.Str());
+        r.Str();  // message encoding
+        if (!r.ok()) return Malformed(path, rec.offset, "truncated Channel record");
+        channels[id] = {schema, std::move(topic)};
+        break;
+      }
+      case Op::kStatistics: {
+        reader.message_count_ = r.U64();
+        r.U16();  // schema count
+        r.U32();  // channel count
+        r.U32();  // attachment count
+        r.U32();  // metadata count
+        r.U32();  // chunk count
+        reader.start_ns_ = r.U64();
+        reader.end_ns_ = r.U64();
+        if (!r.ok()) return Malformed(path, rec.offset, "truncated Statistics record");
+        have_statistics = true;
+        break;
+      }
+      case Op::kChunkIndex: {
+        ChunkRef c;
+        c.start_ns = r.U64();
+        r.U64();  // end
+        c.offset = r.U64();
+        c.length = r.U64();
+        if (!r.ok()) return Malformed(path, rec.offset, "truncated ChunkIndex record");
+        if (c.offset >= data_end_at || c.length > data_end_at - c.offset) {
+          return Malformed(path, rec.offset, "ChunkIndex points outside the data section");
+        }
+        reader.chunks_.push_back(c);
+        break;
+      }
+      default:
+        break;  // other summary records (attachment/metadata indexes) are not needed here
+    }
+  }
+  if (!have_statistics) return Malformed(path, summary_start, "no Statistics record in the summary");
+  if (reader.message_count_ > 0 && reader.chunks_.empty()) {
+    return Malformed(path, summary_start, "messages but no ChunkIndex: McapReader reads chunked files only");
+  }
+  std::sort(reader.chunks_.begin(), reader.chunks_.end(), [](const ChunkRef& a, const ChunkRef& b) {
+    return std::tie(a.start_ns, a.offset) < std::tie(b.start_ns, b.offset);
+  });
+  for (auto& [id, channel] : channels) {
+    ChannelSpec spec;
+    spec.topic = std::move(channel.second);
+    if (channel.first != 0) {
+      auto it = schemas.find(channel.first);
+      if (it == schemas.end()) {
+        return Malformed(path, summary_start, "channel " + spec.topic + " names a schema the summary lacks");
+      }
+      spec.schema_name = it->second.name;
+      spec.schema = it->second.data;
+    }
+    reader.channel_index_[id] = static_cast<ChannelId>(reader.channels_.size());
+    reader.channels_.push_back(std::move(spec));
+  }
+  return reader;
+}
+
+Status McapReader::ForEach(const std::function<void(const McapMessage&)>& fn) const {
+  auto file = File::Open(path_);
+  if (!file) return file.error();
+
+  // Messages decoded but not yet delivered, smallest (log time, chunk offset, position) first.
+  struct Pending {
+    std::uint64_t log_time;
+    std::uint64_t chunk_offset;
+    std::uint64_t position;
+    McapMessage message;
+  };
+  auto later = [](const Pending& a, const Pending& b) {
+    return std::tie(a.log_time, a.chunk_offset, a.position) > std::tie(b.log_time, b.chunk_offset, b.position);
+  };
+  std::priority_queue<Pending, std::vector<Pending>, decltype(later)> pending(later);
+  auto deliver_before = [&](std::uint64_t time, std::uint64_t offset) {
+    while (!pending.empty() &&
+           std::tie(pending.top().log_time, pending.top().chunk_offset) < std::tie(time, offset)) {
+      fn(pending.top().message);
+      pending.pop();
+    }
+  };
+
+  std::string raw;
+  std::string records;
+  for (const ChunkRef& chunk : chunks_) {
+    // Every later chunk starts at or after (start_ns, offset): what sorts before it is final.
+    deliver_before(chunk.start_ns, chunk.offset);
+    SWARMBOX_TRY(file->Read(chunk.offset, chunk.length, &raw));
+    ByteReader r(raw);
+    const auto op = static_cast<Op>(r.U8());
+    r.U64();  // content length
+    r.U64();  // message_start_time
+    r.U64();  // message_end_time
+    const std::uint64_t uncompressed_size = r.U64();
+    const std::uint32_t uncompressed_crc = r.U32();
+    const std::string_view compression = r.Str();
+    const std::string_view compressed = r.Take(r.U64());
+    if (op != Op::kChunk || !r.ok()) return Malformed(path_, chunk.offset, "ChunkIndex does not point at a Chunk");
+    if (Status s = detail::Decompress(compression, compressed, uncompressed_size, &records); !s) {
+      return Malformed(path_, chunk.offset, s.error().message());
+    }
+    if (uncompressed_crc != 0 && detail::Crc32(records) != uncompressed_crc) {
+      return Malformed(path_, chunk.offset, "chunk CRC mismatch: the chunk is corrupt");
+    }
+    auto inner = SplitRecords(records, 0, path_);
+    if (!inner) return inner.error().Context("in the chunk at byte " + std::to_string(chunk.offset));
+    for (const RawRecord& rec : *inner) {
+      if (rec.op != Op::kMessage) continue;  // Schema/Channel copies: the summary has them
+      ByteReader m(rec.content);
+      const std::uint16_t channel = m.U16();
+      m.U32();  // sequence
+      const std::uint64_t log_time = m.U64();
+      m.U64();  // publish time
+      if (!m.ok()) return Malformed(path_, chunk.offset, "truncated Message record in a chunk");
+      auto it = channel_index_.find(channel);
+      if (it == channel_index_.end()) {
+        return Malformed(path_, chunk.offset, "message on channel " + std::to_string(channel) + " the summary lacks");
+      }
+      pending.push(Pending{log_time, chunk.offset, rec.offset,
+                           McapMessage{it->second, log_time, std::string(rec.content.substr(m.pos()))}});
+    }
+  }
+  while (!pending.empty()) {
+    fn(pending.top().message);
+    pending.pop();
+  }
+  return Ok{};
+}
+
+}  // namespace swarmbox::record
