@@ -142,6 +142,14 @@ std::string LineSvg(const LineChart& c, double t_end_s) {
   return s + "</svg>";
 }
 
+// The colour of label i of n: the palette while it suffices, else n hues around the circle in
+// two lightnesses (a SAR lifter goes through ~20 stages), so that no two labels share one.
+std::string LabelColour(std::size_t i, std::size_t n) {
+  if (n <= kPaletteSize) return kPalette[i];
+  const double hue = 360.0 * static_cast<double>(i) / static_cast<double>(n);
+  return "hsl(" + F1(hue) + ",62%," + (i % 2 == 0 ? "48%" : "68%") + ")";
+}
+
 std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string* legend) {
   std::vector<std::string> labels;
   {
@@ -153,11 +161,11 @@ std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string*
   }
   auto colour = [&](const std::string& label) {
     const auto i = static_cast<std::size_t>(std::find(labels.begin(), labels.end(), label) - labels.begin());
-    return std::string(kPalette[i % kPaletteSize]);
+    return LabelColour(i, labels.size());
   };
   const double rows_h = kH - kTop - kBottom;
   const double row = std::clamp(rows_h / static_cast<double>(std::max<std::size_t>(1, lanes.size())), 2.0, 18.0);
-  const double height = std::max(kH, kTop + kBottom + row * static_cast<double>(lanes.size()));
+  const double height = kTop + kBottom + row * static_cast<double>(lanes.size());
   Frame f{TimeAxis(t_end_s), PlotAxis{}};
   std::string s = "<svg width='" + F1(kW) + "' height='" + F1(height) + "' class='ts'>";
   const double bottom = kTop + row * static_cast<double>(lanes.size());
