@@ -119,7 +119,7 @@ std::string LineSvg(const LineChart& c, double t_end_s) {
   Frame f{TimeAxis(t_end_s), ChooseAxis(lo, hi, c.kind, 5)};
   std::string s = Axes(f, true);
   if (series.size() > kMaxLines) {
-    const std::vector<EnvelopeBin> env = Envelope(series, f.t.hi, kEnvelopeBins);
+    const std::vector<EnvelopeBin> env = Envelope(series, f.t.hi, kEnvelopeBins, c.step);
     std::string band, median;
     for (const EnvelopeBin& b : env) band += (band.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.max));
     for (auto it = env.rbegin(); it != env.rend(); ++it) band += "L" + F1(f.x(it->t_s)) + " " + F1(f.yv(it->min));
@@ -183,8 +183,9 @@ std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string*
     }
     for (const StateSpan& sp : lanes[i].spans) {
       const double x0 = f.x(sp.t0_s), x1 = f.x(std::max(sp.t1_s, sp.t0_s));
-      s += "<rect x='" + F1(x0) + "' y='" + F1(y + 0.5) + "' width='" + F1(std::max(0.8, x1 - x0)) + "' height='" +
-           F1(std::max(1.0, row - 1)) + "' fill='" + colour(sp.label) + "'><title>" + HtmlEscape(lanes[i].name) +
+      // Rows of 4 px or more keep a 1 px gap; thinner ones (many nodes) are solid.
+      s += "<rect x='" + F1(x0) + "' y='" + F1(y + (row >= 4 ? 0.5 : 0.0)) + "' width='" + F1(std::max(0.8, x1 - x0)) +
+           "' height='" + F1(row >= 4 ? row - 1 : row) + "' fill='" + colour(sp.label) + "'><title>" + HtmlEscape(lanes[i].name) +
            ": " + HtmlEscape(sp.label) + " " + F3(sp.t0_s) + "-" + F3(sp.t1_s) + " s</title></rect>";
     }
   }
@@ -213,12 +214,22 @@ std::map<std::string, std::string> DroneColours(const TrialSeries& s) {
 
 }  // namespace
 
-std::vector<EnvelopeBin> Envelope(const std::vector<Series>& series, double t_end_s, int bins) {
+std::vector<EnvelopeBin> Envelope(const std::vector<Series>& series, double t_end_s, int bins, bool step) {
   std::vector<EnvelopeBin> out;
   if (bins <= 0 || !(t_end_s > 0)) return out;
   const double width = t_end_s / bins;
   std::vector<std::vector<double>> values(static_cast<std::size_t>(bins));
   for (const Series& s : series) {
+    if (step) {
+      // Held values: each bin gets the series' value at the bin's end (once it has one).
+      std::size_t next = 0;
+      for (int i = 0; i < bins; ++i) {
+        const double end = (i + 1) * width;
+        while (next < s.points.size() && s.points[next].t_s <= end) ++next;
+        if (next > 0) values[static_cast<std::size_t>(i)].push_back(s.points[next - 1].value);
+      }
+      continue;
+    }
     for (const SeriesPoint& p : s.points) {
       const int i = std::clamp(static_cast<int>(std::floor(p.t_s / width)), 0, bins - 1);
       values[static_cast<std::size_t>(i)].push_back(p.value);
@@ -281,7 +292,7 @@ std::vector<TrialPanel> TrialPanels(const TrialSeries& s) {
   line("altitude [m]", s.altitude_m, from_zero, false, "no truth.csv", drones);
   line("speed [m/s]", s.speed_m_s, from_zero, false, "no truth.csv", drones);
   line("nearest neighbour [m]", s.nearest_m, from_zero, false, "no truth.csv with two drones or more", drones);
-  line("radio loss (per node, each event=link burst)", s.radio_loss, rate, false, "no event=link in the logs", drones);
+  line("radio loss per node", s.radio_loss, rate, false, "no event=link in the logs", drones);
   line("radio RTT [ms]", s.radio_rtt_ms, from_zero, false, "no event=link with an answered ping in the logs", drones);
   line("Raft term", s.raft_term, term, true, "no event=leader_elected in the logs", drones);
   band("Raft leader each node followed", s.raft_leader, "no event=leader_elected in the logs");
@@ -303,7 +314,7 @@ std::string TrialPlotsHtml(const TrialPlotsPage& page, const TrialSeries& s) {
   std::string h =
       "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" + HtmlEscape(page.title) +
       "</title>\n<style>body{font-family:sans-serif;margin:1.5em;color:#222}h1{font-size:20px}"
-      ".plots{display:flex;flex-wrap:wrap;gap:1em 1.5em}.plots figure{margin:0}"
+      ".plots{display:flex;flex-wrap:wrap;gap:1em 1.5em}.plots figure{margin:0;width:460px}"
       "figcaption{font-size:13px;color:#444;margin-bottom:2px}svg.ts text{font-size:10px;fill:#555}"
       "svg.ts .unit{fill:#888}.grid{stroke:#eee}.frame{fill:none;stroke:#bbb}"
       ".line{fill:none;stroke-width:1.4}.band{fill:#cfe2ff;stroke:none}.median{fill:none;stroke:#1f4e9c;"

@@ -153,6 +153,14 @@ TEST(TrialPlots, EnvelopeIsMinMedianMaxPerTimeBin) {
   EXPECT_DOUBLE_EQ(env[1].t_s, 9.5);
   EXPECT_DOUBLE_EQ(env[1].median, 15);
   EXPECT_TRUE(Envelope(series, 0.0, 10).empty());
+  // Held values (the Raft term): every bin from a series' first point on has its value.
+  const std::vector<Series> terms = {{"a", {{0.5, 2}, {4.2, 3}}}, {"b", {{2.5, 2}}}};
+  const std::vector<EnvelopeBin> held = Envelope(terms, 10.0, 10, /*step=*/true);
+  ASSERT_EQ(held.size(), 10u);
+  EXPECT_DOUBLE_EQ(held[0].max, 2);     // a only
+  EXPECT_DOUBLE_EQ(held[2].min, 2);     // a and b
+  EXPECT_DOUBLE_EQ(held[4].max, 3);     // a's term 3 from 4.2 s
+  EXPECT_DOUBLE_EQ(held[9].median, 2.5);
 }
 
 TrialSeries SmallTrial() {

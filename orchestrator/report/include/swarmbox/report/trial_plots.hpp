@@ -25,13 +25,15 @@ namespace swarmbox::report {
 
 inline constexpr std::size_t kMaxLines = 10;  // more series than this: the envelope
 
-// The envelope of many series over time: `bins` equal time bins over [0, t_end_s]; a bin with
-// no point is left out. Pure, for the chart and its test.
+// The envelope of many series over time: `bins` equal time bins over [0, t_end_s], each with the
+// values of the points in it; `step` series (a value held until the next point, the Raft term)
+// give each bin their value at its end instead. A bin with no value is left out. Pure, for the
+// chart and its test.
 struct EnvelopeBin {
   double t_s = 0;  // the bin's centre
   double min = 0, median = 0, max = 0;
 };
-std::vector<EnvelopeBin> Envelope(const std::vector<Series>& series, double t_end_s, int bins);
+std::vector<EnvelopeBin> Envelope(const std::vector<Series>& series, double t_end_s, int bins, bool step = false);
 
 struct TrialPlotsPage {
   std::string title;             // e.g. "sar-search (run 20261125-225940-62dd)"
