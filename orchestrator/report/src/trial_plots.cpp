@@ -65,7 +65,8 @@ std::string Axes(const Frame& f, bool time_ticks) {
            F1(kH - kBottom) + "' class='grid'/><text x='" + F1(f.x(v)) + "' y='" + F1(kH - kBottom + 14) +
            "' text-anchor='middle'>" + CsvNumber(v) + "</text>";
     }
-    s += "<text x='" + F1(kW - kRight) + "' y='" + F1(kH - 3) + "' text-anchor='end' class='unit'>simulated s</text>";
+    s += "<text x='" + F1(kW - kRight) + "' y='" + F1(kH - 3) +
+         "' text-anchor='end' class='unit'>simulated s</text>";
   }
   s += "<rect x='" + F1(kLeft) + "' y='" + F1(kTop) + "' width='" + F1(kW - kLeft - kRight) + "' height='" +
        F1(kH - kTop - kBottom) + "' class='frame'/>";
@@ -121,9 +122,12 @@ std::string LineSvg(const LineChart& c, double t_end_s) {
   if (series.size() > kMaxLines) {
     const std::vector<EnvelopeBin> env = Envelope(series, f.t.hi, kEnvelopeBins, c.step);
     std::string band, median;
-    for (const EnvelopeBin& b : env) band += (band.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.max));
-    for (auto it = env.rbegin(); it != env.rend(); ++it) band += "L" + F1(f.x(it->t_s)) + " " + F1(f.yv(it->min));
-    for (const EnvelopeBin& b : env) median += (median.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.median));
+    for (const EnvelopeBin& b : env)
+      band += (band.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.max));
+    for (auto it = env.rbegin(); it != env.rend(); ++it)
+      band += "L" + F1(f.x(it->t_s)) + " " + F1(f.yv(it->min));
+    for (const EnvelopeBin& b : env)
+      median += (median.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.median));
     s += "<path d='" + band + "Z' class='band'><title>min..max of " + std::to_string(series.size()) +
          "</title></path><path d='" + median + "' class='median'><title>median of " +
          std::to_string(series.size()) + "</title></path>";
@@ -131,11 +135,12 @@ std::string LineSvg(const LineChart& c, double t_end_s) {
     for (const Series& one : series) {
       auto colour = c.colours.find(one.name);
       s += "<path d='" + PathOf(f, one.points, c.step) + "' stroke='" +
-           (colour == c.colours.end() ? std::string(kPalette[0]) : colour->second) + "' class='line'><title>" +
-           HtmlEscape(one.name) + "</title></path>";
+           (colour == c.colours.end() ? std::string(kPalette[0]) : colour->second) +
+           "' class='line'><title>" + HtmlEscape(one.name) + "</title></path>";
       if (one.points.size() == 1) {  // a lone point shows as a dot
         s += "<circle cx='" + F1(f.x(one.points[0].t_s)) + "' cy='" + F1(f.yv(one.points[0].value)) +
-             "' r='2.5' fill='" + (colour == c.colours.end() ? std::string(kPalette[0]) : colour->second) + "'/>";
+             "' r='2.5' fill='" + (colour == c.colours.end() ? std::string(kPalette[0]) : colour->second) +
+             "'/>";
       }
     }
   }
@@ -164,7 +169,8 @@ std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string*
     return LabelColour(i, labels.size());
   };
   const double rows_h = kH - kTop - kBottom;
-  const double row = std::clamp(rows_h / static_cast<double>(std::max<std::size_t>(1, lanes.size())), 2.0, 18.0);
+  const double row =
+      std::clamp(rows_h / static_cast<double>(std::max<std::size_t>(1, lanes.size())), 2.0, 18.0);
   const double height = kTop + kBottom + row * static_cast<double>(lanes.size());
   Frame f{TimeAxis(t_end_s), PlotAxis{}};
   std::string s = "<svg width='" + F1(kW) + "' height='" + F1(height) + "' class='ts'>";
@@ -174,7 +180,8 @@ std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string*
          "' class='grid'/><text x='" + F1(f.x(v)) + "' y='" + F1(bottom + 14) + "' text-anchor='middle'>" +
          CsvNumber(v) + "</text>";
   }
-  s += "<text x='" + F1(kW - kRight) + "' y='" + F1(bottom + 27) + "' text-anchor='end' class='unit'>simulated s</text>";
+  s += "<text x='" + F1(kW - kRight) + "' y='" + F1(bottom + 27) +
+       "' text-anchor='end' class='unit'>simulated s</text>";
   for (std::size_t i = 0; i < lanes.size(); ++i) {
     const double y = kTop + row * static_cast<double>(i);
     if (row >= 9) {
@@ -184,9 +191,10 @@ std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string*
     for (const StateSpan& sp : lanes[i].spans) {
       const double x0 = f.x(sp.t0_s), x1 = f.x(std::max(sp.t1_s, sp.t0_s));
       // Rows of 4 px or more keep a 1 px gap; thinner ones (many nodes) are solid.
-      s += "<rect x='" + F1(x0) + "' y='" + F1(y + (row >= 4 ? 0.5 : 0.0)) + "' width='" + F1(std::max(0.8, x1 - x0)) +
-           "' height='" + F1(row >= 4 ? row - 1 : row) + "' fill='" + colour(sp.label) + "'><title>" + HtmlEscape(lanes[i].name) +
-           ": " + HtmlEscape(sp.label) + " " + F3(sp.t0_s) + "-" + F3(sp.t1_s) + " s</title></rect>";
+      s += "<rect x='" + F1(x0) + "' y='" + F1(y + (row >= 4 ? 0.5 : 0.0)) + "' width='" +
+           F1(std::max(0.8, x1 - x0)) + "' height='" + F1(row >= 4 ? row - 1 : row) + "' fill='" +
+           colour(sp.label) + "'><title>" + HtmlEscape(lanes[i].name) + ": " + HtmlEscape(sp.label) + " " +
+           F3(sp.t0_s) + "-" + F3(sp.t1_s) + " s</title></rect>";
     }
   }
   if (row < 9) {
@@ -195,7 +203,8 @@ std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string*
          "' text-anchor='end'>nodes</text>";
   }
   for (const std::string& label : labels) {
-    *legend += "<span class='key'><i style='background:" + colour(label) + "'></i>" + HtmlEscape(label) + "</span>";
+    *legend +=
+        "<span class='key'><i style='background:" + colour(label) + "'></i>" + HtmlEscape(label) + "</span>";
   }
   return s + "</svg>";
 }
@@ -265,7 +274,8 @@ std::vector<TrialPanel> TrialPanels(const TrialSeries& s) {
 
   std::vector<TrialPanel> panels;
   auto line = [&](std::string caption, const std::vector<Series>& series, AxisKind kind, bool step,
-                  std::string missing, const std::map<std::string, std::string>& colours, bool to_one = false) {
+                  std::string missing, const std::map<std::string, std::string>& colours,
+                  bool to_one = false) {
     TrialPanel p;
     p.caption = std::move(caption);
     if (series.empty()) {
@@ -273,7 +283,8 @@ std::vector<TrialPanel> TrialPanels(const TrialSeries& s) {
     } else {
       LineChart c{&series, kind, step, to_one, colours};
       p.svg = LineSvg(c, s.t_end_s);
-      if (series.size() > kMaxLines) p.caption += " (" + std::to_string(series.size()) + " series: min..max, median)";
+      if (series.size() > kMaxLines)
+        p.caption += " (" + std::to_string(series.size()) + " series: min..max, median)";
     }
     panels.push_back(std::move(p));
   };
@@ -291,9 +302,11 @@ std::vector<TrialPanel> TrialPanels(const TrialSeries& s) {
   };
   line("altitude [m]", s.altitude_m, from_zero, false, "no truth.csv", drones);
   line("speed [m/s]", s.speed_m_s, from_zero, false, "no truth.csv", drones);
-  line("nearest neighbour [m]", s.nearest_m, from_zero, false, "no truth.csv with two drones or more", drones);
+  line("nearest neighbour [m]", s.nearest_m, from_zero, false, "no truth.csv with two drones or more",
+       drones);
   line("radio loss per node", s.radio_loss, rate, false, "no event=link in the logs", drones);
-  line("radio RTT [ms]", s.radio_rtt_ms, from_zero, false, "no event=link with an answered ping in the logs", drones);
+  line("radio RTT [ms]", s.radio_rtt_ms, from_zero, false, "no event=link with an answered ping in the logs",
+       drones);
   line("Raft term", s.raft_term, term, true, "no event=leader_elected in the logs", drones);
   band("Raft leader each node followed", s.raft_leader, "no event=leader_elected in the logs");
   line("battery [fraction]", s.battery, rate, false, "no event=battery in the logs", drones);
@@ -303,7 +316,8 @@ std::vector<TrialPanel> TrialPanels(const TrialSeries& s) {
   if (!s.flock.empty()) {
     std::string legend;
     for (const Series& one : s.flock) {
-      legend += "<span class='key'><i style='background:" + flock_colours[one.name] + "'></i>" + one.name + "</span>";
+      legend += "<span class='key'><i style='background:" + flock_colours[one.name] + "'></i>" + one.name +
+                "</span>";
     }
     panels.back().svg += "<div class='legend'>" + legend + "</div>";
   }
@@ -319,7 +333,8 @@ std::string TrialPlotsHtml(const TrialPlotsPage& page, const TrialSeries& s) {
       "svg.ts .unit{fill:#888}.grid{stroke:#eee}.frame{fill:none;stroke:#bbb}"
       ".line{fill:none;stroke-width:1.4}.band{fill:#cfe2ff;stroke:none}.median{fill:none;stroke:#1f4e9c;"
       "stroke-width:1.6}.none{width:460px;color:#888;font-size:13px;border:1px dashed #ccc;padding:2em 0;"
-      "text-align:center}.legend,.keys{font-size:12px;max-width:460px}.key{margin-right:.9em;white-space:nowrap}"
+      "text-align:center}.legend,.keys{font-size:12px;max-width:460px}.key{margin-right:.9em;white-space:"
+      "nowrap}"
       ".key i{display:inline-block;width:10px;height:10px;margin-right:3px;vertical-align:-1px}"
       "img.traj{max-width:460px;border:1px solid #ddd}</style></head><body>\n<h1>" +
       HtmlEscape(page.title) + "</h1>\n";

@@ -139,7 +139,8 @@ void TrialSeriesBuilder::FlushTruthGroup() {
   for (std::size_t i = 0; i < group_.size(); ++i) {
     const TruthRow& r = group_[i];
     Add(altitude_, r.drone, t, r.z_m);
-    if (r.has_velocity) Add(speed_, r.drone, t, std::sqrt(r.vx_m_s * r.vx_m_s + r.vy_m_s * r.vy_m_s + r.vz_m_s * r.vz_m_s));
+    if (r.has_velocity)
+      Add(speed_, r.drone, t, std::sqrt(r.vx_m_s * r.vx_m_s + r.vy_m_s * r.vy_m_s + r.vz_m_s * r.vz_m_s));
     double nearest = std::numeric_limits<double>::infinity();
     for (std::size_t j = 0; j < group_.size(); ++j) {
       if (j == i || group_[j].drone == r.drone) continue;

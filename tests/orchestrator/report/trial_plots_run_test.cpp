@@ -74,7 +74,8 @@ TEST_F(SarTrialPlots, EverySeriesComesFromTheFolderAndAgreesWithTheRun) {
     EXPECT_LT(top, 43.0) << scout;
   }
   double lifter_top = 0;
-  for (const SeriesPoint& p : Named(s.altitude_m, "lifter")->points) lifter_top = std::max(lifter_top, p.value);
+  for (const SeriesPoint& p : Named(s.altitude_m, "lifter")->points)
+    lifter_top = std::max(lifter_top, p.value);
   EXPECT_NEAR(lifter_top, 10.0, 1.5);
   // One sample per simulated second per drone.
   EXPECT_GE(s.altitude_m[0].points.size(), 220u);
@@ -114,18 +115,19 @@ TEST_F(SarTrialPlots, EverySeriesComesFromTheFolderAndAgreesWithTheRun) {
   // Mission stages: every drone took off; the scouts searched.
   ASSERT_EQ(s.mission_stage.size(), 4u);
   for (const Lane& lane : s.mission_stage) {
-    EXPECT_TRUE(std::any_of(lane.spans.begin(), lane.spans.end(),
-                            [](const StateSpan& sp) { return sp.label.find("tak") != std::string::npos; }))
-        << lane.name;
-    for (std::size_t i = 1; i < lane.spans.size(); ++i) EXPECT_DOUBLE_EQ(lane.spans[i].t0_s, lane.spans[i - 1].t1_s);
+    EXPECT_TRUE(std::any_of(lane.spans.begin(), lane.spans.end(), [](const StateSpan& sp) {
+      return sp.label.find("tak") != std::string::npos;
+    })) << lane.name;
+    for (std::size_t i = 1; i < lane.spans.size(); ++i)
+      EXPECT_DOUBLE_EQ(lane.spans[i].t0_s, lane.spans[i - 1].t1_s);
   }
   for (const std::string scout : {"scout_1", "scout_2", "scout_3"}) {
     const Lane* lane = nullptr;
     for (const Lane& l : s.mission_stage) lane = l.name == scout ? &l : lane;
     ASSERT_NE(lane, nullptr);
-    EXPECT_TRUE(std::any_of(lane->spans.begin(), lane->spans.end(),
-                            [](const StateSpan& sp) { return sp.label == "searching"; }))
-        << scout;
+    EXPECT_TRUE(std::any_of(lane->spans.begin(), lane->spans.end(), [](const StateSpan& sp) {
+      return sp.label == "searching";
+    })) << scout;
   }
   // Flocking: the leader's line once per simulated second (on a 1 s grid from its first, at the
   // first 10 Hz mission tick due), scores within their ranges.
@@ -161,7 +163,8 @@ TEST_F(SarTrialPlots, TheReportWritesAndLinksThePageAndKeepsAPrunedFoldersOwn) {
   auto rec = ReadTrialFolder(dir_.string());
   ASSERT_TRUE(rec) << rec.error().ToString();
   EXPECT_TRUE(rec->has_plots);
-  EXPECT_NE(ReportHtml("e", {}, {*rec}).find("<a href='sar-search-r1/plots.html'>plots</a>"), std::string::npos);
+  EXPECT_NE(ReportHtml("e", {}, {*rec}).find("<a href='sar-search-r1/plots.html'>plots</a>"),
+            std::string::npos);
 
   // A folder whose logs and truth.csv were pruned (docs/example-report) keeps the page it has.
   const fs::path pruned = root_ / "pruned";

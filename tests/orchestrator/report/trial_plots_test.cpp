@@ -1,12 +1,13 @@
 // A trial's series over time (trial_series.hpp) and plots.html (trial_plots.hpp): pure, on
 // hand-written event lines and truth rows with known answers.
+#include "swarmbox/report/trial_plots.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
 #include "swarmbox/report/report_html.hpp"
-#include "swarmbox/report/trial_plots.hpp"
 #include "swarmbox/report/trial_series.hpp"
 
 namespace swarmbox::report {
@@ -39,11 +40,15 @@ std::size_t Count(const std::string& text, const std::string& what) {
 TEST(TrialSeries, ALinkBurstIsOnePointPerNodeWeightedByPings) {
   TrialSeriesBuilder b;
   // Given scout_1's burst at 6.94 s over three peers (as the agents log it) and one at 16.316 s,
-  Feed(b, "scout_1", "t=6.940 node=scout_1 event=link peer=scout_2 sent=10 received=7 loss=0.3000 rtt_ms_mean=200");
-  Feed(b, "scout_1", "t=6.940 node=scout_1 event=link peer=scout_3 sent=10 received=9 loss=0.1000 rtt_ms_mean=100");
-  Feed(b, "scout_1", "t=6.940 node=scout_1 event=link peer=lifter sent=10 received=0 loss=1.0000 rtt_ms_mean=0");
+  Feed(b, "scout_1",
+       "t=6.940 node=scout_1 event=link peer=scout_2 sent=10 received=7 loss=0.3000 rtt_ms_mean=200");
+  Feed(b, "scout_1",
+       "t=6.940 node=scout_1 event=link peer=scout_3 sent=10 received=9 loss=0.1000 rtt_ms_mean=100");
+  Feed(b, "scout_1",
+       "t=6.940 node=scout_1 event=link peer=lifter sent=10 received=0 loss=1.0000 rtt_ms_mean=0");
   Feed(b, "scout_2", "t=7.000 node=scout_2 event=link peer=scout_1 sent=4 received=4 loss=0 rtt_ms_mean=50");
-  Feed(b, "scout_1", "t=16.316 node=scout_1 event=link peer=scout_2 sent=9 received=9 loss=0 rtt_ms_mean=210");
+  Feed(b, "scout_1",
+       "t=16.316 node=scout_1 event=link peer=scout_2 sent=9 received=9 loss=0 rtt_ms_mean=210");
   const TrialSeries s = b.Finish();
   // Then loss = 1 - 16/30 at 6.94 s and RTT the mean weighted by answers (the lifter's none).
   ASSERT_EQ(s.radio_loss.size(), 2u);
@@ -157,9 +162,9 @@ TEST(TrialPlots, EnvelopeIsMinMedianMaxPerTimeBin) {
   const std::vector<Series> terms = {{"a", {{0.5, 2}, {4.2, 3}}}, {"b", {{2.5, 2}}}};
   const std::vector<EnvelopeBin> held = Envelope(terms, 10.0, 10, /*step=*/true);
   ASSERT_EQ(held.size(), 10u);
-  EXPECT_DOUBLE_EQ(held[0].max, 2);     // a only
-  EXPECT_DOUBLE_EQ(held[2].min, 2);     // a and b
-  EXPECT_DOUBLE_EQ(held[4].max, 3);     // a's term 3 from 4.2 s
+  EXPECT_DOUBLE_EQ(held[0].max, 2);  // a only
+  EXPECT_DOUBLE_EQ(held[2].min, 2);  // a and b
+  EXPECT_DOUBLE_EQ(held[4].max, 3);  // a's term 3 from 4.2 s
   EXPECT_DOUBLE_EQ(held[9].median, 2.5);
 }
 
@@ -182,7 +187,7 @@ TEST(TrialPlots, EveryPanelDrawnOrSaysWhichEventsItLacks) {
   EXPECT_NE(panels[0].svg.find("<title>scout_1</title>"), std::string::npos);
   EXPECT_EQ(Count(panels[0].svg, "class='line'"), 2u);  // one line per drone
   EXPECT_EQ(panels[2].caption, "nearest neighbour [m]");
-  EXPECT_FALSE(panels[3].svg.empty());                   // radio loss
+  EXPECT_FALSE(panels[3].svg.empty());                                          // radio loss
   EXPECT_NE(panels[6].svg.find("scout_1: scout_2 3-20 s"), std::string::npos);  // leader band
   EXPECT_TRUE(panels[7].svg.empty());
   EXPECT_EQ(panels[7].missing, "no event=battery in the logs");

@@ -78,7 +78,7 @@ class FlockMetricsLog {
  private:
   struct Track {
     std::string name;
-    double word_t_s = 0;               // the word's simulated time at the previous sample
+    double word_t_s = 0;  // the word's simulated time at the previous sample
     Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
     Eigen::Vector2d velocity_m_s = Eigen::Vector2d::Zero();
     bool seen = false;

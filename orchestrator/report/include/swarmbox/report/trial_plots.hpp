@@ -1,7 +1,7 @@
 // plots.html: one trial's quantities over simulated time as small multiples, one self-contained
 // page (inline CSS and SVG, no script, no external resource but the trial's own
-// trajectories.png beside it). Pure: TrialSeries in, text out (trial_plots_file.hpp reads the
-// folder and writes the file).
+// trajectories.png beside it). Pure: TrialSeries in, text out (WriteTrialPlots in
+// trial_record.hpp reads the folder and writes the file).
 //
 // Panels, all on the same time axis (0 .. the trial's last simulated time):
 //   altitude, speed, nearest neighbour (truth.csv); radio loss and RTT (event=link); Raft term
@@ -33,12 +33,13 @@ struct EnvelopeBin {
   double t_s = 0;  // the bin's centre
   double min = 0, median = 0, max = 0;
 };
-std::vector<EnvelopeBin> Envelope(const std::vector<Series>& series, double t_end_s, int bins, bool step = false);
+std::vector<EnvelopeBin> Envelope(const std::vector<Series>& series, double t_end_s, int bins,
+                                  bool step = false);
 
 struct TrialPlotsPage {
-  std::string title;             // e.g. "sar-search (run 20261125-225940-62dd)"
-  std::string summary;           // one line under the title (outcome, reason), may be empty
-  bool has_trajectories = false; // show trajectories.png beside the page
+  std::string title;              // e.g. "sar-search (run 20261125-225940-62dd)"
+  std::string summary;            // one line under the title (outcome, reason), may be empty
+  bool has_trajectories = false;  // show trajectories.png beside the page
 };
 
 // The panels' SVGs in page order with their captions (for tests and the page).

@@ -1,5 +1,5 @@
 // A trial's quantities over simulated time, as plots.html draws them (pure: feed the logs' event
-// lines and truth.csv's rows, take the series; ReadTrialSeries in trial_plots_file.hpp feeds it a
+// lines and truth.csv's rows, take the series; ReadTrialSeries in trial_record.hpp feeds it a
 // trial folder).
 //
 //   TrialSeriesBuilder b;                              // truth.csv sampled once per 1 s
