@@ -1,4 +1,4 @@
-#include "ground_renderer.hpp"
+#include "swarmbox/physics/ground_renderer.hpp"
 
 #include <algorithm>
 #include <array>
@@ -69,18 +69,69 @@ struct Projector {
   }
 };
 
-void FillProjected(cv::Mat& img, const Projector& cam, const std::vector<Vec3>& pts, const cv::Scalar& colour) {
+// Projects a convex 3D polygon to a fixed-point convex hull (kShift fractional bits); false when
+// any vertex lies behind the camera.
+constexpr int kShift = 4;  // sub-pixel accuracy for fillConvexPoly
+bool ProjectHull(const Projector& cam, const std::vector<Vec3>& pts, std::vector<cv::Point>* hull) {
   std::vector<cv::Point> poly;
   poly.reserve(pts.size());
-  constexpr int kShift = 4;  // sub-pixel accuracy for fillConvexPoly
   for (const Vec3& p : pts) {
     cv::Point2f q;
-    if (!cam.Project(p, &q)) return;
+    if (!cam.Project(p, &q)) return false;
     poly.emplace_back(static_cast<int>(std::lround(q.x * (1 << kShift))), static_cast<int>(std::lround(q.y * (1 << kShift))));
   }
+  cv::convexHull(poly, *hull);
+  return true;
+}
+
+// Fills the projected polygon in `img` and, when `labels` is set, writes `label` there too
+// (a person's index + 1, or 0 for what hides people).
+void FillProjected(cv::Mat& img, const Projector& cam, const std::vector<Vec3>& pts, const cv::Scalar& colour,
+                   cv::Mat* labels = nullptr, int label = 0) {
   std::vector<cv::Point> hull;
-  cv::convexHull(poly, hull);
+  if (!ProjectHull(cam, pts, &hull)) return;
   cv::fillConvexPoly(img, hull, colour, cv::LINE_8, kShift);
+  if (labels != nullptr) cv::fillConvexPoly(*labels, hull, cv::Scalar(label), cv::LINE_8, kShift);
+}
+
+// Bounding box (whole pixels) of the projected polygons; false if any point is behind the camera.
+bool ProjectedBounds(const Projector& cam, const std::vector<std::vector<Vec3>>& shapes, cv::Rect* box) {
+  float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+  for (const auto& pts : shapes) {
+    for (const Vec3& p : pts) {
+      cv::Point2f q;
+      if (!cam.Project(p, &q)) return false;
+      x0 = std::min(x0, q.x), y0 = std::min(y0, q.y), x1 = std::max(x1, q.x), y1 = std::max(y1, q.y);
+    }
+  }
+  // fillConvexPoly covers pixel centres within the polygon (pixel (x, y) is centred on (x, y)).
+  const int ix0 = static_cast<int>(std::floor(x0)), iy0 = static_cast<int>(std::floor(y0));
+  *box = cv::Rect(ix0, iy0, static_cast<int>(std::ceil(x1)) - ix0 + 1, static_cast<int>(std::ceil(y1)) - iy0 + 1);
+  return true;
+}
+
+// Pixels the polygons cover when drawn whole (also outside the image), with `scratch` as canvas.
+double FullAreaPx(const Projector& cam, const std::vector<std::vector<Vec3>>& shapes, const cv::Rect& box,
+                  cv::Mat* scratch) {
+  constexpr int kMaxSide = 4096;  // a figure filling more than this is measured by its polygons
+  if (box.width > kMaxSide || box.height > kMaxSide) {
+    double area = 0;
+    for (const auto& pts : shapes) {
+      std::vector<cv::Point> hull;
+      if (ProjectHull(cam, pts, &hull)) area += cv::contourArea(hull) / double(1 << (2 * kShift));
+    }
+    return area;
+  }
+  scratch->create(box.height, box.width, CV_8U);
+  scratch->setTo(0);
+  const cv::Point offset(-box.x * (1 << kShift), -box.y * (1 << kShift));
+  for (const auto& pts : shapes) {
+    std::vector<cv::Point> hull;
+    if (!ProjectHull(cam, pts, &hull)) continue;
+    for (cv::Point& p : hull) p += offset;
+    cv::fillConvexPoly(*scratch, hull, cv::Scalar(1), cv::LINE_8, kShift);
+  }
+  return cv::countNonZero(*scratch);
 }
 
 std::vector<Vec3> Ellipse(double cx, double cy, double heading, double a, double b, double z) {
@@ -118,6 +169,7 @@ Pose OpticalPose(const Pose& body, const CameraSpec& spec) {
 
 GroundRenderer::GroundRenderer(const WorldConfig& config) : config_(&config) {
   constexpr double kMarginM = 60;  // texture beyond the geofence (what a camera at the edge sees)
+  labels_.create(1, 1, CV_16U);
   const int cols = static_cast<int>(std::ceil((config.size_x_m + 2 * kMarginM) / texel_m_));
   const int rows = static_cast<int>(std::ceil((config.size_y_m + 2 * kMarginM) / texel_m_));
   origin_x_m_ = -config.size_x_m / 2 - kMarginM;
@@ -163,8 +215,16 @@ GroundRenderer::GroundRenderer(const WorldConfig& config) : config_(&config) {
   }
 }
 
+GroundRenderer::~GroundRenderer() = default;
+
 void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::uint64_t noise_seed,
-                            CameraImage* out) {
+                            CameraImage* out, std::vector<VisiblePerson>* people) {
+  Render(body_pose, Vec3{}, spec, noise_seed, out, people);
+}
+
+void GroundRenderer::Render(const Pose& body_pose, const Vec3& /*body_rates_rad_s*/, const CameraSpec& spec,
+                            std::uint64_t noise_seed, CameraImage* out, std::vector<VisiblePerson>* people) {
+  if (people != nullptr) people->clear();
   const int w = spec.width_px, h = spec.height_px;
   out->width_px = w;
   out->height_px = h;
@@ -211,13 +271,33 @@ void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::
     if (sky.size() >= 3) cv::fillConvexPoly(img, sky, cv::Scalar(235, 206, 135));
   }
 
+  // Truth: each person's label (index + 1) under everything drawn over it; 0 elsewhere.
+  cv::Mat* labels = nullptr;
+  if (people != nullptr) {
+    labels_.create(h, w, CV_16U);
+    labels_.setTo(0);
+    labels = &labels_;
+  }
+  const cv::Rect frame(0, 0, w, h);
+  struct InView {
+    std::size_t index;
+    cv::Rect box;  // unclipped
+  };
+  std::vector<InView> in_view;
+
   // Victims (on the ground, under any obstacle drawn later).
-  for (const Victim& v : config_->victims) {
+  for (std::size_t i = 0; i < config_->victims.size(); ++i) {
+    const Victim& v = config_->victims[i];
     const double ch = std::cos(v.heading_rad), sh = std::sin(v.heading_rad);
-    FillProjected(img, cam, Ellipse(v.x_m - 0.15 * ch, v.y_m - 0.15 * sh, v.heading_rad, 0.72, 0.24, 0.0),
-                  cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]));
-    FillProjected(img, cam, Ellipse(v.x_m + 0.7 * ch, v.y_m + 0.7 * sh, v.heading_rad, 0.13, 0.11, 0.0),
-                  cv::Scalar(kVictimHeadBgr[0], kVictimHeadBgr[1], kVictimHeadBgr[2]));
+    const std::vector<std::vector<Vec3>> shapes = {
+        Ellipse(v.x_m - 0.15 * ch, v.y_m - 0.15 * sh, v.heading_rad, 0.72, 0.24, 0.0),
+        Ellipse(v.x_m + 0.7 * ch, v.y_m + 0.7 * sh, v.heading_rad, 0.13, 0.11, 0.0)};
+    cv::Rect box;
+    if (!ProjectedBounds(cam, shapes, &box) || (box & frame).empty()) continue;
+    const int label = static_cast<int>(i + 1);
+    FillProjected(img, cam, shapes[0], cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]), labels, label);
+    FillProjected(img, cam, shapes[1], cv::Scalar(kVictimHeadBgr[0], kVictimHeadBgr[1], kVictimHeadBgr[2]), labels, label);
+    if (people != nullptr) in_view.push_back({i, box});
   }
 
   // Obstacles, lowest top first.
@@ -239,10 +319,28 @@ void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::
       if (i & 4) top.push_back(p);
     }
     if (C.z > b->center_m.z + b->size_m.z / 2) {
-      FillProjected(img, cam, all, cv::Scalar(70, 75, 80));
+      FillProjected(img, cam, all, cv::Scalar(70, 75, 80), labels, 0);
       FillProjected(img, cam, top, cv::Scalar(150, 155, 160));
     } else {
-      FillProjected(img, cam, all, cv::Scalar(90, 95, 100));
+      FillProjected(img, cam, all, cv::Scalar(90, 95, 100), labels, 0);
+    }
+  }
+
+  // What is left of each person in view.
+  if (people != nullptr) {
+    for (const InView& p : in_view) {
+      const Victim& v = config_->victims[p.index];
+      const cv::Rect clipped = p.box & frame;
+      cv::Mat same;
+      cv::compare(labels_(clipped), cv::Scalar(static_cast<double>(p.index + 1)), same, cv::CMP_EQ);
+      const int seen = cv::countNonZero(same);
+      if (seen == 0) continue;
+      const double ch = std::cos(v.heading_rad), sh = std::sin(v.heading_rad);
+      const std::vector<std::vector<Vec3>> shapes = {
+          Ellipse(v.x_m - 0.15 * ch, v.y_m - 0.15 * sh, v.heading_rad, 0.72, 0.24, 0.0),
+          Ellipse(v.x_m + 0.7 * ch, v.y_m + 0.7 * sh, v.heading_rad, 0.13, 0.11, 0.0)};
+      const double full = FullAreaPx(cam, shapes, p.box, &scratch_);
+      people->push_back({v.id, clipped, std::min(1.0, seen / std::max(1.0, full))});
     }
   }
 

@@ -3,6 +3,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
+
+#include "swarmbox/physics/ground_renderer.hpp"
 
 #include "test_util.hpp"
 
@@ -137,6 +140,73 @@ TEST(Camera, ObstacleTopsAreSeenFromAbove) {
   EXPECT_NEAR(img.bgr[c + 2], 160, 20);
   EXPECT_NEAR(img.bgr[c + 1], 155, 20);
   EXPECT_NEAR(img.bgr[c], 150, 20);
+}
+
+// The truth the renderer reports matches what it drew: the box holds every figure pixel, tightly,
+// and the visible fraction falls as an obstacle or the image border hides the figure.
+TEST(Camera, TruthBoxesMatchDrawnPeople) {
+  WorldConfig config = CalmWorld();
+  config.victims.push_back({.id = "seen", .x_m = 2.0, .y_m = 1.0, .heading_rad = 0.3});
+  config.victims.push_back({.id = "far", .x_m = 80.0, .y_m = 80.0, .heading_rad = 0.0});
+  GroundRenderer renderer(config);
+  CameraSpec spec;  // 320 x 240
+  spec.noise_std = 0;
+  const Pose pose{Vec3{0, 0, 10}, Quat{}};
+  CameraImage img;
+  std::vector<VisiblePerson> people;
+  renderer.Render(pose, spec, 1, &img, &people);
+  ASSERT_EQ(people.size(), 1u);  // "far" is out of view
+  EXPECT_EQ(people[0].id, "seen");
+  EXPECT_NEAR(people[0].visible_fraction, 1.0, 1e-9);
+  // Figure pixels (R high, B low): all inside the box, touching each of its sides.
+  int x0 = img.width_px, y0 = img.height_px, x1 = -1, y1 = -1;
+  for (int y = 0; y < img.height_px; ++y) {
+    for (int x = 0; x < img.width_px; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width_px) + static_cast<std::size_t>(x)) * 3;
+      if (img.bgr[i + 2] < 215 || img.bgr[i] > 90) continue;
+      x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+    }
+  }
+  ASSERT_GE(x1, 0);
+  const cv::Rect box = people[0].box_px;
+  EXPECT_GE(x0, box.x);
+  EXPECT_GE(y0, box.y);
+  EXPECT_LE(x1, box.x + box.width - 1);
+  EXPECT_LE(y1, box.y + box.height - 1);
+  EXPECT_LE(x0 - box.x, 1);
+  EXPECT_LE(y0 - box.y, 1);
+  EXPECT_LE(box.x + box.width - 1 - x1, 1);
+  EXPECT_LE(box.y + box.height - 1 - y1, 1);
+}
+
+TEST(Camera, TruthVisibleFractionFallsUnderObstaclesAndAtTheBorder) {
+  WorldConfig config = CalmWorld();
+  // A lying figure along x (heading 0) centred at the origin; a box hides its feet end.
+  config.victims.push_back({.id = "v", .x_m = 0.0, .y_m = 0.0, .heading_rad = 0.0});
+  config.obstacles.push_back({.id = "slab", .center_m = {-0.55, 0, 0.05}, .size_m = {0.8, 2, 0.1}, .yaw_rad = 0});
+  GroundRenderer renderer(config);
+  CameraSpec spec;
+  spec.noise_std = 0;
+  CameraImage img;
+  std::vector<VisiblePerson> people;
+  renderer.Render(Pose{Vec3{0, 0, 8}, Quat{}}, spec, 1, &img, &people);
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_GT(people[0].visible_fraction, 0.3);
+  EXPECT_LT(people[0].visible_fraction, 0.8);
+
+  // No obstacle, the camera moved half an image height east: image up is body +x (east), so the
+  // bottom image border now runs through the figure's centre.
+  config.obstacles.clear();
+  GroundRenderer clear(config);
+  const double fx = 160.0 / std::tan(0.6);
+  const double half_height_m = 120.0 / fx * 8.0;  // ground half-height of the image at 8 m
+  clear.Render(Pose{Vec3{half_height_m, 0, 8}, Quat{}}, spec, 1, &img, &people);
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_GT(people[0].visible_fraction, 0.2);
+  EXPECT_LT(people[0].visible_fraction, 0.8);
+  const cv::Rect box = people[0].box_px;
+  EXPECT_EQ(box.y + box.height, img.height_px);  // clipped at the bottom edge (world -x of the camera)
+  EXPECT_GE(box.y, 0);
 }
 
 TEST(Camera, DueAtItsRate) {
