@@ -97,11 +97,15 @@ Status ReadVictims(const Node& list, std::vector<Victim>* out) {
     std::string pose_text;
     std::array<int, 3> clothing{};
     r.Required("id", &v.id).Required("x_m", &v.x_m).Required("y_m", &v.y_m).Optional("heading_deg", &heading_deg)
-        .Optional("pose", &pose_text).Optional("clothing_bgr", &clothing).Optional("cover", &v.cover);
+        .Optional("pose", &pose_text).Optional("clothing_bgr", &clothing).Optional("cover", &v.cover)
+        .Optional("height_m", &v.height_m);
     if (auto s = r.Finish(); !s) return s.error();
     const std::string what = "victim '" + v.id + "':";
     if (auto s = ReadEnum(item, "pose", kPoses, what, &v.pose); !s) return s;
     if (auto s = ReadBgr(item, "clothing_bgr", what, &v.clothing_bgr); !s) return s;
+    if (!(v.height_m >= 0.8 && v.height_m <= 2.2)) {
+      return Error(ErrorCode::kInvalidArgument, what + " height_m must be within 0.8..2.2", item.Find("height_m")->Where());
+    }
     if (!(v.cover >= 0 && v.cover <= 1)) {
       return Error(ErrorCode::kInvalidArgument, what + " cover must be within 0..1", item.Find("cover")->Where());
     }

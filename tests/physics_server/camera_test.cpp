@@ -60,11 +60,11 @@ void CheckVictimPixel(double yaw, double victim_heading) {
   world->SetPinned(d, true);
   CameraImage img;
   world->RenderCamera(d, &img);
-  ASSERT_EQ(img.width_px, 320);
-  ASSERT_EQ(img.height_px, 240);
-  ASSERT_EQ(img.bgr.size(), 320u * 240u * 3u);
-  EXPECT_NEAR(img.intrinsics.fx_px, 160.0 / std::tan(0.6), 1e-9);
-  EXPECT_DOUBLE_EQ(img.intrinsics.cx_px, 160.0);
+  ASSERT_EQ(img.width_px, af.camera.width_px);
+  ASSERT_EQ(img.height_px, af.camera.height_px);
+  ASSERT_EQ(img.bgr.size(), static_cast<std::size_t>(af.camera.width_px * af.camera.height_px * 3));
+  EXPECT_NEAR(img.intrinsics.fx_px, af.camera.width_px / 2.0 / std::tan(af.camera.hfov_rad / 2), 1e-9);
+  EXPECT_DOUBLE_EQ(img.intrinsics.cx_px, af.camera.width_px / 2.0);
 
   const Vec3 cam = world->Truth(d).position_m + Vec3{0, 0, af.camera.offset_m.z};
   EXPECT_NEAR(img.camera_pose.position_m.z, cam.z, 1e-9);
@@ -136,7 +136,7 @@ TEST(Camera, ObstacleTopsAreSeenFromAbove) {
   CameraImage img;
   world->RenderCamera(d, &img);
   // The image centre looks straight down onto the block's top (grey ~155, noise 4).
-  const std::size_t c = (120u * 320u + 160u) * 3u;
+  const std::size_t c = (static_cast<std::size_t>(img.height_px / 2 * img.width_px + img.width_px / 2)) * 3u;
   EXPECT_NEAR(img.bgr[c + 2], 160, 20);
   EXPECT_NEAR(img.bgr[c + 1], 155, 20);
   EXPECT_NEAR(img.bgr[c], 150, 20);

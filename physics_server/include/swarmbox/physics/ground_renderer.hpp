@@ -26,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,9 @@
 #include "swarmbox/physics/world_config.hpp"
 
 namespace swarmbox::physics {
+namespace detail {
+struct RenderScene;
+}
 
 // Pixel colours (BGR) of the default victim figure (no clothing_bgr): orange body, amber head.
 inline constexpr std::uint8_t kVictimBodyBgr[3] = {0, 120, 255};
@@ -74,15 +78,15 @@ class GroundRenderer {
   double texel_m() const { return texel_m_; }
 
  private:
-  struct Scene;  // the world's drawables, built once
   const WorldConfig* config_;
+  std::unique_ptr<detail::RenderScene> scene_;  // texture and drawables, built once
   double texel_m_ = 0.125;
-  double origin_x_m_ = 0;   // world x of texel column 0's left edge
-  double top_y_m_ = 0;      // world y of texel row 0's top edge
-  cv::Mat texture_;         // CV_8UC3
   cv::Mat noise_tile_;      // CV_16SC3 i.i.d. N(0, 1) * 16, drawn once; frames use seeded windows
   cv::Mat labels_;          // CV_16U person index + 1 per pixel (only when truth is asked for)
   cv::Mat scratch_;         // CV_8U, the figure's full area
+  cv::Mat blur_pad_, blur_acc_;
+  cv::Mat gain_map_;        // CV_8UC3 light colour x vignetting, 100 = unit gain
+  double gain_map_vignetting_ = -1;
 };
 
 }  // namespace swarmbox::physics

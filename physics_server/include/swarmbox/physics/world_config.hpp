@@ -43,6 +43,7 @@ struct Victim {
   double y_m = 0;
   double heading_rad = 0;  // direction from feet to head, ENU yaw
   VictimPose pose = VictimPose::kLying;
+  double height_m = 1.75;  // body height [m] (children ~1.2, tall adults ~1.95)
   std::optional<Bgr> clothing_bgr{};
   double cover = 0;        // [0, 1]: share of the figure hidden under rubble or vegetation
 };
