@@ -145,7 +145,7 @@ Result<std::string> GenerateWorld(const GenerateSpec& spec, std::uint64_t seed) 
   for (int i = 0; i < spec.obstacles; ++i) {
     bool placed = false;
     for (int attempt = 0; attempt < 400 && !placed; ++attempt) {
-      const bool tree = kind == WorldKind::kForestEdge ? p.Chance(0.9) : kind == WorldKind::kOpenField ? p.Chance(0.3) : p.Chance(0.1);
+      const bool tree = kind == WorldKind::kForestEdge ? p.Chance(0.9) : kind == WorldKind::kOpenField && p.Chance(0.3);
       double sx, sy, sz;
       if (tree) {
         sx = sy = p.U(3.0, 8.0), sz = p.U(6.0, 15.0);

@@ -8,11 +8,12 @@
 // unless the recipe gives one, so an experiment over seeds is an experiment over worlds.
 //
 // Kinds (world YAML schema: trials/worlds/open_field.yaml):
-// - rubble_field: rubble terrain, collapsed slabs and walls (boxes 1-5 m tall), people mostly lying
-//   or curled, partly under debris (cover up to 0.6), debris and tarps among the distractors;
+// - rubble_field: rubble terrain, collapsed slabs and walls (boxes 1-5 m tall; no trees, nothing
+//   above the lifter's 10 m transit), people mostly lying or curled, partly under debris (cover up
+//   to 0.6), debris and tarps among the distractors;
 // - forest_edge: grass/soil/gravel mix with small ponds, trees (kind: tree, 6-15 m) dense on one
 //   side of a wandering edge line and sparse on the other, people near the edge under vegetation;
-// - open_field: grass with ponds, a few sheds and bales, people in the open.
+// - open_field: grass with ponds, sheds and bales (1.5-3.5 m) and a few trees, people in the open.
 // Every kind: time of day 7-18 h and overcast 0-1 drawn from the seed; victims at least 8 m apart,
 // 3 m clear of obstacles and 2 m of distractors; obstacles and trees leave the 15 m around the
 // origin (the launch area) and a 5 m border clear; everything inside the geofence.
