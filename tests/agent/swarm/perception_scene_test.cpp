@@ -4,7 +4,7 @@
 // the median geolocation error under 1 m at 30 m altitude.
 #include <gtest/gtest.h>
 
-#include "perception_scenes.hpp"
+#include "perception_score.hpp"
 
 namespace swarmbox::swarm {
 namespace {
