@@ -56,7 +56,7 @@ function(swarmbox_install_program target)
           RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 endfunction()
 
-foreach(lib common record docker images dsl faults runner hosts report experiment)
+foreach(lib common record docker images worlds dsl faults runner hosts report experiment)
   swarmbox_install_library(swarmbox_${lib} ${lib})
 endforeach()
 # The brain SDK (agent/brain): what a brain library links, the loader, and swarmbox_add_brain().

@@ -124,6 +124,10 @@ struct MissionTuning {
   double load_check_climb_m = 3.0;
   double load_check_delay_s = 4.0;
   double load_check_fraction = 0.5;
+  // Sightings: when a candidate is confirmed, rejected or revisited (swarm/sighting_fusion.hpp
+  // has each default's reason); args fusion_<field> (e.g. fusion_min_baseline_m).
+  swarm::FusionParams fusion{};
+  double revisit_look_s = 2.0;  // a revisit looks this long before it reports a miss [s]
 };
 
 struct SarBrainConfig {

@@ -101,19 +101,14 @@ int ComposeCommand(const ComposeArgs& args) {
   // plan; printed to stdout the services would read the trial's world with its own geofence.
   std::string world_text;
   fs::path world_file;
-  if (spec->HasWorldSize()) {
-    const std::string source = (fs::path(trials_dir) / spec->world).string();
-    std::ifstream in(source, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    auto derived = runner::DeriveWorld(text.str(), source, spec->world_size_m);
-    if (!in || !derived) {
-      std::cerr << "swarmbox compose: world_size_m: "
-                << (derived ? "cannot read " + source : derived.error().ToString()) << "\n";
+  if (spec->HasDerivedWorld()) {
+    auto derived = runner::DerivedWorldText(*spec, trials_dir);
+    if (!derived) {
+      std::cerr << "swarmbox compose: " << derived.error().ToString() << "\n";
       return kExitUsage;
     }
     if (args.output.empty()) {
-      std::cerr << "swarmbox compose: error: world_size_m needs -o FILE (the derived world is written next to it)\n";
+      std::cerr << "swarmbox compose: error: world_size_m or a generated world needs -o FILE (the derived world is written next to it)\n";
       return kExitUsage;
     }
     world_text = std::move(*derived);

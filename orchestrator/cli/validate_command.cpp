@@ -14,6 +14,7 @@
 #include "json_out.hpp"
 #include "load_trial.hpp"
 #include "swarmbox/dsl/trial_loader.hpp"
+#include "swarmbox/runner/derived_world.hpp"
 
 namespace swarmbox::cli {
 
@@ -58,6 +59,19 @@ FileReport ValidateTrial(const std::string& file, const std::vector<std::string>
     components += (components.empty() ? "" : ", ") + c.name + " (" + std::string(dsl::ComponentSourceName(c.source)) + ")";
   }
   if (!components.empty()) r.summary += ", components " + components;
+  // A generated world is generated here as the runner would (it can fail: an area too small).
+  if (spec->world_generate) {
+    const worlds::GenerateSpec& g = *spec->world_generate;
+    auto world = runner::DerivedWorldText(*spec, spec->trials_dir);
+    if (!world) {
+      r.errors.push_back(file + ": world: " + world.error().ToString());
+      std::cerr << r.errors.back() << "\n";  // as LoadTrialOrPrintError does for the trial's errors
+      return r;
+    }
+    r.summary += ", world " + std::string(worlds::KindName(g.kind)) + " seed " +
+                 std::to_string(worlds::WorldSeed(g, spec->seed)) + " (" + std::to_string(g.victims) + " victims, " +
+                 std::to_string(g.obstacles) + " obstacles, " + std::to_string(g.distractors) + " distractors)";
+  }
   return r;
 }
 

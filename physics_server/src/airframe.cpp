@@ -130,7 +130,12 @@ void ReadCamera(MapReader& parent, Airframe* af) {
     Checked(r, n)
         .Positive("hfov_rad", &c.hfov_rad, false)
         .Positive("rate_hz", &c.rate_hz, false)
-        .NonNegative("noise_std", &c.noise_std);
+        .NonNegative("noise_std", &c.noise_std)
+        .NonNegative("exposure_ms", &c.exposure_ms)
+        .NonNegative("vignetting", &c.vignetting);
+    if (r.ok() && c.vignetting >= 1) {
+      r.Fail(Error(ErrorCode::kInvalidArgument, "camera vignetting must be below 1", n.Find("vignetting")->Where()));
+    }
     if (r.ok() && (c.width_px < 16 || c.height_px < 16 || c.width_px > 4096 || c.height_px > 4096)) {
       r.Fail(Error(ErrorCode::kInvalidArgument, "camera size must be within 16..4096 pixels", n.Where()));
     }

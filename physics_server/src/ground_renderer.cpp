@@ -1,10 +1,12 @@
-#include "ground_renderer.hpp"
+#include "swarmbox/physics/ground_renderer.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
 #include <vector>
+
+#include "detail/render_scene.hpp"
 
 #include <opencv2/imgproc.hpp>
 
@@ -69,30 +71,81 @@ struct Projector {
   }
 };
 
-void FillProjected(cv::Mat& img, const Projector& cam, const std::vector<Vec3>& pts, const cv::Scalar& colour) {
+// Projects a convex 3D polygon to a fixed-point convex hull (kShift fractional bits); false when
+// any vertex lies behind the camera.
+constexpr int kShift = 4;  // sub-pixel accuracy for fillConvexPoly
+bool ProjectHull(const Projector& cam, const std::vector<Vec3>& pts, std::vector<cv::Point>* hull) {
   std::vector<cv::Point> poly;
   poly.reserve(pts.size());
-  constexpr int kShift = 4;  // sub-pixel accuracy for fillConvexPoly
   for (const Vec3& p : pts) {
     cv::Point2f q;
-    if (!cam.Project(p, &q)) return;
+    if (!cam.Project(p, &q)) return false;
     poly.emplace_back(static_cast<int>(std::lround(q.x * (1 << kShift))), static_cast<int>(std::lround(q.y * (1 << kShift))));
   }
-  std::vector<cv::Point> hull;
-  cv::convexHull(poly, hull);
-  cv::fillConvexPoly(img, hull, colour, cv::LINE_8, kShift);
+  cv::convexHull(poly, *hull);
+  return true;
 }
 
-std::vector<Vec3> Ellipse(double cx, double cy, double heading, double a, double b, double z) {
-  std::vector<Vec3> pts;
-  constexpr int kN = 20;
-  const double ch = std::cos(heading), sh = std::sin(heading);
-  for (int i = 0; i < kN; ++i) {
-    const double t = 2 * std::numbers::pi * i / kN;
-    const double u = a * std::cos(t), v = b * std::sin(t);
-    pts.push_back({cx + u * ch - v * sh, cy + u * sh + v * ch, z});
+// Fills the projected polygon in `img` and, when `labels` is set, writes `label` there too
+// (a person's index + 1, or 0 for what hides people).
+void FillProjected(cv::Mat& img, const Projector& cam, const std::vector<Vec3>& pts, const cv::Scalar& colour,
+                   cv::Mat* labels = nullptr, int label = 0) {
+  std::vector<cv::Point> hull;
+  if (!ProjectHull(cam, pts, &hull)) return;
+  cv::fillConvexPoly(img, hull, colour, cv::LINE_8, kShift);
+  if (labels != nullptr) cv::fillConvexPoly(*labels, hull, cv::Scalar(label), cv::LINE_8, kShift);
+}
+
+// Bounding box (whole pixels) of the projected polygons; false if any point is behind the camera.
+bool ProjectedBounds(const Projector& cam, const std::vector<detail::Part>& shapes, cv::Rect* box) {
+  float x0 = 1e9f, y0 = 1e9f, x1 = -1e9f, y1 = -1e9f;
+  for (const auto& part : shapes) {
+    for (const Vec3& p : part.pts) {
+      cv::Point2f q;
+      if (!cam.Project(p, &q)) return false;
+      x0 = std::min(x0, q.x), y0 = std::min(y0, q.y), x1 = std::max(x1, q.x), y1 = std::max(y1, q.y);
+    }
   }
-  return pts;
+  // fillConvexPoly covers pixel centres within the polygon (pixel (x, y) is centred on (x, y)).
+  const int ix0 = static_cast<int>(std::floor(x0)), iy0 = static_cast<int>(std::floor(y0));
+  *box = cv::Rect(ix0, iy0, static_cast<int>(std::ceil(x1)) - ix0 + 1, static_cast<int>(std::ceil(y1)) - iy0 + 1);
+  return true;
+}
+
+// Pixels the polygons cover when drawn whole (also outside the image), with `scratch` as canvas.
+double FullAreaPx(const Projector& cam, const std::vector<detail::Part>& shapes, const cv::Rect& box,
+                  cv::Mat* scratch) {
+  constexpr int kMaxSide = 4096;  // a figure filling more than this is measured by its polygons
+  if (box.width > kMaxSide || box.height > kMaxSide) {
+    double area = 0;
+    for (const auto& part : shapes) {
+      std::vector<cv::Point> hull;
+      if (ProjectHull(cam, part.pts, &hull)) area += cv::contourArea(hull) / double(1 << (2 * kShift));
+    }
+    return area;
+  }
+  scratch->create(box.height, box.width, CV_8U);
+  scratch->setTo(0);
+  const cv::Point offset(-box.x * (1 << kShift), -box.y * (1 << kShift));
+  for (const auto& part : shapes) {
+    std::vector<cv::Point> hull;
+    if (!ProjectHull(cam, part.pts, &hull)) continue;
+    for (cv::Point& p : hull) p += offset;
+    cv::fillConvexPoly(*scratch, hull, cv::Scalar(1), cv::LINE_8, kShift);
+  }
+  return cv::countNonZero(*scratch);
+}
+
+// Whether a ground disc (centre, radius) can show in the image: its centre projects within the
+// image grown by the disc's size in pixels at that range (a cheap cull before projecting parts).
+bool MayShow(const Projector& cam, const Vec3& centre, double radius_m, int w, int h) {
+  const Vec3 d = centre - cam.c;
+  const double zc = cam.r_wc[2] * d.x + cam.r_wc[5] * d.y + cam.r_wc[8] * d.z;
+  if (zc < 0.5) return true;  // close or behind: let the parts decide
+  cv::Point2f q;
+  if (!cam.Project(centre, &q)) return true;
+  const double margin = cam.k.fx_px * (radius_m + 2.0) / zc;
+  return q.x > -margin && q.y > -margin && q.x < w + margin && q.y < h + margin;
 }
 
 constexpr int kNoiseTilePx = 1024;
@@ -116,55 +169,22 @@ Pose OpticalPose(const Pose& body, const CameraSpec& spec) {
   return p;
 }
 
-GroundRenderer::GroundRenderer(const WorldConfig& config) : config_(&config) {
-  constexpr double kMarginM = 60;  // texture beyond the geofence (what a camera at the edge sees)
-  const int cols = static_cast<int>(std::ceil((config.size_x_m + 2 * kMarginM) / texel_m_));
-  const int rows = static_cast<int>(std::ceil((config.size_y_m + 2 * kMarginM) / texel_m_));
-  origin_x_m_ = -config.size_x_m / 2 - kMarginM;
-  top_y_m_ = config.size_y_m / 2 + kMarginM;
-
-  // Value noise: a few octaves of random grids, upsampled smoothly, summed.
-  cv::RNG rng(config.ground_texture_seed * 0x9E3779B97F4A7C15ULL + 1);
-  cv::Mat acc(rows, cols, CV_32F, cv::Scalar(0));
-  cv::Mat soil(rows, cols, CV_32F);
-  const std::array<std::pair<int, float>, 4> octaves = {{{8, 0.35f}, {24, 0.3f}, {96, 0.2f}, {400, 0.15f}}};
-  for (const auto& [cells, weight] : octaves) {
-    cv::Mat grid(std::max(2, cells * rows / cols), cells, CV_32F);
-    rng.fill(grid, cv::RNG::UNIFORM, 0.0, 1.0);
-    cv::Mat up;
-    cv::resize(grid, up, acc.size(), 0, 0, cv::INTER_CUBIC);
-    acc += up * weight;
-  }
-  {
-    cv::Mat grid(6, 6, CV_32F);
-    rng.fill(grid, cv::RNG::UNIFORM, 0.0, 1.0);
-    cv::resize(grid, soil, acc.size(), 0, 0, cv::INTER_CUBIC);
-  }
-  // Fine grain per texel.
-  cv::Mat grain(rows, cols, CV_32F);
-  rng.fill(grain, cv::RNG::NORMAL, 0.0, 0.06);
-  acc += grain;
-
-  texture_.create(rows, cols, CV_8UC3);
-  for (int r = 0; r < rows; ++r) {
-    const float* a = acc.ptr<float>(r);
-    const float* s = soil.ptr<float>(r);
-    auto* px = texture_.ptr<cv::Vec3b>(r);
-    for (int c = 0; c < cols; ++c) {
-      const float v = std::clamp(a[c], 0.0f, 1.2f);
-      const float soil_mix = std::clamp((s[c] - 0.62f) * 4.0f, 0.0f, 1.0f);  // brown patches
-      // grass: B 30..70, G 80..150, R 40..90; soil: B 50..80, G 70..100, R 90..120
-      const float gb = 30 + 40 * v, gg = 80 + 70 * v, gr = 40 + 50 * v;
-      const float sb = 50 + 30 * v, sg = 70 + 30 * v, sr = 90 + 30 * v;
-      px[c] = cv::Vec3b(cv::saturate_cast<std::uint8_t>(gb + (sb - gb) * soil_mix),
-                        cv::saturate_cast<std::uint8_t>(gg + (sg - gg) * soil_mix),
-                        cv::saturate_cast<std::uint8_t>(gr + (sr - gr) * soil_mix));
-    }
-  }
+GroundRenderer::GroundRenderer(const WorldConfig& config)
+    : config_(&config), scene_(std::make_unique<detail::RenderScene>(detail::BuildScene(config))) {
+  texel_m_ = scene_->texel_m;
 }
 
+GroundRenderer::~GroundRenderer() = default;
+
 void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::uint64_t noise_seed,
-                            CameraImage* out) {
+                            CameraImage* out, std::vector<VisiblePerson>* people) {
+  Render(body_pose, Vec3{}, spec, noise_seed, out, people);
+}
+
+void GroundRenderer::Render(const Pose& body_pose, const Vec3& body_rates_rad_s, const CameraSpec& spec,
+                            std::uint64_t noise_seed, CameraImage* out, std::vector<VisiblePerson>* people) {
+  if (people != nullptr) people->clear();
+  const detail::RenderScene& scene = *scene_;
   const int w = spec.width_px, h = spec.height_px;
   out->width_px = w;
   out->height_px = h;
@@ -182,10 +202,11 @@ void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::
   cv::Matx33d K(k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
   cv::Matx33d Rcw(R[0], R[3], R[6], R[1], R[4], R[7], R[2], R[5], R[8]);
   cv::Matx33d M(1, 0, -C.x, 0, 1, -C.y, 0, 0, -C.z);
-  cv::Matx33d T(texel_m_, 0, origin_x_m_ + texel_m_ / 2, 0, -texel_m_, top_y_m_ - texel_m_ / 2, 0, 0, 1);
+  const double t = scene.texel_m;
+  cv::Matx33d T(t, 0, scene.origin_x_m + t / 2, 0, -t, scene.top_y_m - t / 2, 0, 0, 1);
   const cv::Matx33d H = K * Rcw * M * T;
   if (C.z > 0.01) {
-    cv::warpPerspective(texture_, img, cv::Mat(H), img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT101);
+    cv::warpPerspective(scene.texture, img, cv::Mat(H), img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT101);
   } else {
     img.setTo(cv::Scalar(40, 60, 70));  // camera at/below the ground: dark
   }
@@ -203,47 +224,123 @@ void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::
       const double fp = f(p), fq = f(q);
       if (fp >= 0) sky.emplace_back(cv::Point(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y))));
       if ((fp >= 0) != (fq >= 0)) {
-        const double t = fp / (fp - fq);
-        const cv::Point2d x = p + (q - p) * t;
+        const double s = fp / (fp - fq);
+        const cv::Point2d x = p + (q - p) * s;
         sky.emplace_back(cv::Point(static_cast<int>(std::lround(x.x)), static_cast<int>(std::lround(x.y))));
       }
     }
     if (sky.size() >= 3) cv::fillConvexPoly(img, sky, cv::Scalar(235, 206, 135));
   }
 
-  // Victims (on the ground, under any obstacle drawn later).
-  for (const Victim& v : config_->victims) {
-    const double ch = std::cos(v.heading_rad), sh = std::sin(v.heading_rad);
-    FillProjected(img, cam, Ellipse(v.x_m - 0.15 * ch, v.y_m - 0.15 * sh, v.heading_rad, 0.72, 0.24, 0.0),
-                  cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]));
-    FillProjected(img, cam, Ellipse(v.x_m + 0.7 * ch, v.y_m + 0.7 * sh, v.heading_rad, 0.13, 0.11, 0.0),
-                  cv::Scalar(kVictimHeadBgr[0], kVictimHeadBgr[1], kVictimHeadBgr[2]));
+  // Truth: each person's label (index + 1) under everything drawn over it; 0 elsewhere.
+  cv::Mat* labels = nullptr;
+  if (people != nullptr) {
+    labels_.create(h, w, CV_16U);
+    labels_.setTo(0);
+    labels = &labels_;
+  }
+  const cv::Rect frame(0, 0, w, h);
+  struct InView {
+    const detail::Figure* figure;
+    cv::Rect box;  // unclipped
+  };
+  std::vector<InView> in_view;
+
+  // Distractors, then people (with their cover), then obstacles and trees, lowest top first.
+  for (const detail::Drawable& d : scene.flats) {
+    if (!MayShow(cam, d.centre_m, d.radius_m, w, h)) continue;
+    for (const detail::Part& p : d.parts) FillProjected(img, cam, p.pts, p.colour);
+  }
+  for (const detail::Figure& f : scene.figures) {
+    if (!MayShow(cam, f.centre_m, f.radius_m, w, h)) continue;
+    cv::Rect box;
+    if (!ProjectedBounds(cam, f.parts, &box) || (box & frame).empty()) continue;
+    const int label = static_cast<int>(f.victim + 1);
+    for (const detail::Part& p : f.parts) FillProjected(img, cam, p.pts, p.colour, labels, label);
+    for (const detail::Part& p : f.cover) FillProjected(img, cam, p.pts, p.colour, labels, 0);
+    if (people != nullptr) in_view.push_back({&f, box});
+  }
+  for (const detail::Drawable& d : scene.obstacles) {
+    if (!MayShow(cam, d.centre_m, d.radius_m, w, h)) continue;
+    if (d.is_box) {
+      if (C.z > d.top_m) {
+        FillProjected(img, cam, d.parts[0].pts, d.parts[0].colour, labels, 0);
+        FillProjected(img, cam, d.parts[1].pts, d.parts[1].colour);
+      } else {
+        FillProjected(img, cam, d.parts[0].pts, cv::Scalar(90, 95, 100), labels, 0);
+      }
+      continue;
+    }
+    for (const detail::Part& p : d.parts) FillProjected(img, cam, p.pts, p.colour, labels, 0);
   }
 
-  // Obstacles, lowest top first.
-  std::vector<const ObstacleBox*> boxes;
-  boxes.reserve(config_->obstacles.size());
-  for (const ObstacleBox& b : config_->obstacles) boxes.push_back(&b);
-  std::stable_sort(boxes.begin(), boxes.end(), [](const ObstacleBox* l, const ObstacleBox* r) {
-    return l->center_m.z + l->size_m.z / 2 < r->center_m.z + r->size_m.z / 2;
-  });
-  for (const ObstacleBox* b : boxes) {
-    const double cy = std::cos(b->yaw_rad), sy = std::sin(b->yaw_rad);
-    std::vector<Vec3> all, top;
-    for (int i = 0; i < 8; ++i) {
-      const double dx = ((i & 1) ? 0.5 : -0.5) * b->size_m.x;
-      const double dy = ((i & 2) ? 0.5 : -0.5) * b->size_m.y;
-      const double dz = ((i & 4) ? 0.5 : -0.5) * b->size_m.z;
-      const Vec3 p{b->center_m.x + dx * cy - dy * sy, b->center_m.y + dx * sy + dy * cy, b->center_m.z + dz};
-      all.push_back(p);
-      if (i & 4) top.push_back(p);
+  // What is left of each person in view.
+  if (people != nullptr) {
+    for (const InView& p : in_view) {
+      const cv::Rect clipped = p.box & frame;
+      cv::Mat same;
+      cv::compare(labels_(clipped), cv::Scalar(static_cast<double>(p.figure->victim + 1)), same, cv::CMP_EQ);
+      const int seen = cv::countNonZero(same);
+      if (seen == 0) continue;
+      const double full = FullAreaPx(cam, p.figure->parts, p.box, &scratch_);
+      people->push_back({config_->victims[p.figure->victim].id, clipped, std::min(1.0, seen / std::max(1.0, full))});
     }
-    if (C.z > b->center_m.z + b->size_m.z / 2) {
-      FillProjected(img, cam, all, cv::Scalar(70, 75, 80));
-      FillProjected(img, cam, top, cv::Scalar(150, 155, 160));
-    } else {
-      FillProjected(img, cam, all, cv::Scalar(90, 95, 100));
+  }
+
+  // Exposure: auto-exposure lengthens the exposure as the light falls (up to 8x), then raises the
+  // analog gain (up to 4x); a frame's exposure misses its target by a seeded few per cent.
+  cv::RNG rng(noise_seed);
+  const detail::Light& light = scene.light;
+  double exposure_s = spec.exposure_ms * 1e-3, gain = 1.0, analog = 1.0;
+  if (light.enabled) {
+    const double stretch = std::min(8.0, 1.0 / light.level);
+    exposure_s *= stretch;
+    analog = std::min(4.0, 1.0 / (light.level * stretch));
+    gain = light.level * stretch * analog * (1.0 + 0.06 * std::clamp(rng.gaussian(1.0), -2.5, 2.5));
+  }
+
+  // Motion blur: the image moves by f * rate * exposure during the exposure (roll rate along u,
+  // pitch rate along v; the yaw rate's rotation about the optical axis is left out). Averages up
+  // to 16 shifted copies.
+  if (exposure_s > 0) {
+    // Optical x = -body y, optical y = -body x: a body roll rate p (about +x) turns the view about
+    // optical -y, moving the image along u; a pitch rate q along v.
+    const double du = k.fx_px * body_rates_rad_s.x * exposure_s;
+    const double dv = k.fy_px * body_rates_rad_s.y * exposure_s;
+    const double len = std::hypot(du, dv);
+    if (len >= 1.0) {
+      const int n = std::min(16, static_cast<int>(std::ceil(len)) + 1);
+      const int pad = static_cast<int>(std::ceil(len / 2)) + 1;
+      cv::copyMakeBorder(img, blur_pad_, pad, pad, pad, pad, cv::BORDER_REPLICATE);
+      blur_acc_.create(h, w, CV_16UC3);
+      blur_acc_.setTo(cv::Scalar::all(0));
+      for (int i = 0; i < n; ++i) {
+        const double s = static_cast<double>(i) / (n - 1) - 0.5;
+        const int sx = static_cast<int>(std::lround(du * s)), sy = static_cast<int>(std::lround(dv * s));
+        cv::add(blur_acc_, blur_pad_(cv::Rect(pad + sx, pad + sy, w, h)), blur_acc_, cv::noArray(), CV_16UC3);
+      }
+      blur_acc_.convertTo(img, CV_8UC3, 1.0 / n);
     }
+  }
+
+  // Light colour, exposure gain and vignetting in one multiply (8-bit map, 128 = unit gain).
+  if (light.enabled || spec.vignetting > 0) {
+    if (gain_map_.size() != img.size() || gain_map_vignetting_ != spec.vignetting) {
+      gain_map_.create(h, w, CV_8UC3);
+      const double r2max = (w * w + h * h) / 4.0;
+      for (int y = 0; y < h; ++y) {
+        auto* g = gain_map_.ptr<cv::Vec3b>(y);
+        for (int x = 0; x < w; ++x) {
+          const double dx = x + 0.5 - w / 2.0, dy = y + 0.5 - h / 2.0;
+          const double v = 1.0 - spec.vignetting * (dx * dx + dy * dy) / r2max;
+          for (int c = 0; c < 3; ++c) {
+            g[x][c] = cv::saturate_cast<std::uint8_t>(100.0 * v * (light.enabled ? light.colour[c] : 1.0));
+          }
+        }
+      }
+      gain_map_vignetting_ = spec.vignetting;
+    }
+    cv::multiply(img, gain_map_, img, gain / 100.0);
   }
 
   if (spec.noise_std > 0) {
@@ -252,7 +349,6 @@ void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::
       noise_tile_.create(kNoiseTilePx, kNoiseTilePx, CV_16SC3);
       tile_rng.fill(noise_tile_, cv::RNG::NORMAL, 0.0, kNoiseScale);
     }
-    cv::RNG rng(noise_seed);
     const int x0 = rng.uniform(0, kNoiseTilePx - std::min(w, kNoiseTilePx) + 1);
     const int y0 = rng.uniform(0, kNoiseTilePx - std::min(h, kNoiseTilePx) + 1);
     // Images larger than the tile (rare) reuse it in pieces.
@@ -263,7 +359,7 @@ void GroundRenderer::Render(const Pose& body_pose, const CameraSpec& spec, std::
       for (int tx = 0, cw = 0; tx < w; tx += cw) {
         const int sx = tx == 0 ? x0 : 0;
         cw = std::min(kNoiseTilePx - sx, w - tx);
-        noise_tile_(cv::Rect(sx, sy, cw, ch)).convertTo(scaled, CV_16SC3, spec.noise_std / kNoiseScale);
+        noise_tile_(cv::Rect(sx, sy, cw, ch)).convertTo(scaled, CV_16SC3, analog * spec.noise_std / kNoiseScale);
         cv::Mat target = img(cv::Rect(tx, ty, cw, ch));
         cv::add(target, scaled, target, cv::noArray(), CV_8UC3);
       }

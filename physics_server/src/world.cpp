@@ -12,7 +12,7 @@
 #include <string_view>
 #include <unordered_map>
 
-#include "ground_renderer.hpp"
+#include "swarmbox/physics/ground_renderer.hpp"
 #include "sensor_models.hpp"
 
 namespace swarmbox::physics {
@@ -728,12 +728,12 @@ void World::SetPinned(std::size_t index, bool pinned) {
   }
 }
 
-void World::RenderCamera(std::size_t index, CameraImage* out) {
+void World::RenderCamera(std::size_t index, CameraImage* out, std::vector<VisiblePerson>* people) {
   Impl& w = *impl_;
   const Impl::Drone& d = *w.drones.at(index);
   const TrueKinematics k = w.Kinematics(d);
-  w.renderer->Render(Pose{k.position_m, k.attitude}, d.af.camera,
-                     MixSeed(w.options.seed, (static_cast<std::uint64_t>(index) << 40) ^ w.step), out);
+  w.renderer->Render(Pose{k.position_m, k.attitude}, k.body_rates_rad_s, d.af.camera,
+                     MixSeed(w.options.seed, (static_cast<std::uint64_t>(index) << 40) ^ w.step), out, people);
   out->time_ns = w.time_ns;
 }
 

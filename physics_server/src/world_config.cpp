@@ -1,8 +1,11 @@
 #include "swarmbox/physics/world_config.hpp"
 
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <set>
+#include <string_view>
 
 #include "detail/yaml_read.hpp"
 
@@ -14,6 +17,49 @@ using detail::Nested;
 using yaml::MapReader;
 using yaml::Node;
 
+template <typename E, std::size_t N>
+Status ReadEnum(const Node& map, std::string_view key, const std::array<E, N>& values, std::string_view what, E* out) {
+  const Node* n = map.Find(std::string(key));
+  if (n == nullptr) return Ok{};
+  std::string text;
+  if (auto s = yaml::Decode(*n, &text); !s) return s;
+  std::string names;
+  for (E v : values) {
+    if (text == ToString(v)) {
+      *out = v;
+      return Ok{};
+    }
+    names += (names.empty() ? "" : "|") + std::string(ToString(v));
+  }
+  return Error(ErrorCode::kInvalidArgument,
+               std::string(what) + " " + std::string(key) + " '" + text + "' is not one of " + names, n->Where());
+}
+
+// [b, g, r], each 0..255.
+Status ReadBgr(const Node& map, std::string_view key, std::string_view what, std::optional<Bgr>* out) {
+  const Node* n = map.Find(std::string(key));
+  if (n == nullptr) return Ok{};
+  std::array<int, 3> v{};
+  if (auto s = yaml::Decode(*n, &v); !s) return s;
+  Bgr bgr{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (v[i] < 0 || v[i] > 255) {
+      return Error(ErrorCode::kInvalidArgument, std::string(what) + " " + std::string(key) + " must be 0..255 each",
+                   n->Where());
+    }
+    bgr[i] = static_cast<std::uint8_t>(v[i]);
+  }
+  *out = bgr;
+  return Ok{};
+}
+
+constexpr std::array kObstacleKinds = {ObstacleKind::kBox, ObstacleKind::kTree};
+constexpr std::array kPoses = {VictimPose::kLying, VictimPose::kSitting, VictimPose::kCurled, VictimPose::kStanding};
+constexpr std::array kTerrains = {TerrainKind::kGrass, TerrainKind::kSoil, TerrainKind::kGravel, TerrainKind::kRubble,
+                                  TerrainKind::kMixed};
+constexpr std::array kDistractorKinds = {DistractorKind::kTarp, DistractorKind::kCone, DistractorKind::kBackpack,
+                                         DistractorKind::kDebris, DistractorKind::kRock};
+
 Status ReadObstacles(const Node& list, std::vector<ObstacleBox>* out) {
   if (list.is_null()) return Ok{};
   if (!list.is_sequence()) return Error(ErrorCode::kInvalidArgument, "'obstacles' must be a list", list.Where());
@@ -22,9 +68,11 @@ Status ReadObstacles(const Node& list, std::vector<ObstacleBox>* out) {
     MapReader r(item, "obstacle");
     ObstacleBox box;
     double yaw_deg = 0;
+    std::string kind_text;
     r.Required("id", &box.id).Required("center_m", &box.center_m).Required("size_m", &box.size_m)
-        .Optional("yaw_deg", &yaw_deg);
+        .Optional("yaw_deg", &yaw_deg).Optional("kind", &kind_text);
     if (auto s = r.Finish(); !s) return s.error();
+    if (auto s = ReadEnum(item, "kind", kObstacleKinds, "obstacle '" + box.id + "':", &box.kind); !s) return s;
     if (box.size_m.x <= 0 || box.size_m.y <= 0 || box.size_m.z <= 0) {
       return Error(ErrorCode::kInvalidArgument, "obstacle '" + box.id + "': size_m must be positive",
                    item.Find("size_m")->Where());
@@ -46,8 +94,21 @@ Status ReadVictims(const Node& list, std::vector<Victim>* out) {
     MapReader r(item, "victim");
     Victim v;
     double heading_deg = 0;
-    r.Required("id", &v.id).Required("x_m", &v.x_m).Required("y_m", &v.y_m).Optional("heading_deg", &heading_deg);
+    std::string pose_text;
+    std::array<int, 3> clothing{};
+    r.Required("id", &v.id).Required("x_m", &v.x_m).Required("y_m", &v.y_m).Optional("heading_deg", &heading_deg)
+        .Optional("pose", &pose_text).Optional("clothing_bgr", &clothing).Optional("cover", &v.cover)
+        .Optional("height_m", &v.height_m);
     if (auto s = r.Finish(); !s) return s.error();
+    const std::string what = "victim '" + v.id + "':";
+    if (auto s = ReadEnum(item, "pose", kPoses, what, &v.pose); !s) return s;
+    if (auto s = ReadBgr(item, "clothing_bgr", what, &v.clothing_bgr); !s) return s;
+    if (!(v.height_m >= 0.8 && v.height_m <= 2.2)) {
+      return Error(ErrorCode::kInvalidArgument, what + " height_m must be within 0.8..2.2", item.Find("height_m")->Where());
+    }
+    if (!(v.cover >= 0 && v.cover <= 1)) {
+      return Error(ErrorCode::kInvalidArgument, what + " cover must be within 0..1", item.Find("cover")->Where());
+    }
     if (!ids.insert(v.id).second) {
       return Error(ErrorCode::kInvalidArgument, "duplicate victim id '" + v.id + "'", item.Find("id")->Where());
     }
@@ -57,7 +118,95 @@ Status ReadVictims(const Node& list, std::vector<Victim>* out) {
   return Ok{};
 }
 
+Status ReadDistractors(const Node& list, std::vector<Distractor>* out) {
+  if (list.is_null()) return Ok{};
+  if (!list.is_sequence()) return Error(ErrorCode::kInvalidArgument, "'distractors' must be a list", list.Where());
+  for (const Node& item : list.items()) {
+    MapReader r(item, "distractor");
+    Distractor d;
+    std::string kind_text;
+    double heading_deg = 0;
+    std::array<int, 3> colour{};
+    r.Required("kind", &kind_text).Required("x_m", &d.x_m).Required("y_m", &d.y_m).Optional("heading_deg", &heading_deg)
+        .Optional("size_m", &d.size_m).Optional("colour_bgr", &colour);
+    if (auto s = r.Finish(); !s) return s.error();
+    if (auto s = ReadEnum(item, "kind", kDistractorKinds, "distractor", &d.kind); !s) return s;
+    std::optional<Bgr> bgr;
+    if (auto s = ReadBgr(item, "colour_bgr", "distractor", &bgr); !s) return s;
+    d.colour_bgr = bgr.value_or(DefaultColour(d.kind));
+    if (d.size_m < 0) {
+      return Error(ErrorCode::kInvalidArgument, "distractor size_m must be positive", item.Find("size_m")->Where());
+    }
+    if (d.size_m == 0) d.size_m = DefaultSizeM(d.kind);
+    d.heading_rad = heading_deg * std::numbers::pi / 180.0;
+    out->push_back(d);
+  }
+  return Ok{};
+}
+
 }  // namespace
+
+const char* ToString(ObstacleKind kind) {
+  switch (kind) {
+    case ObstacleKind::kBox: return "box";
+    case ObstacleKind::kTree: return "tree";
+  }
+  return "box";
+}
+
+const char* ToString(VictimPose pose) {
+  switch (pose) {
+    case VictimPose::kLying: return "lying";
+    case VictimPose::kSitting: return "sitting";
+    case VictimPose::kCurled: return "curled";
+    case VictimPose::kStanding: return "standing";
+  }
+  return "lying";
+}
+
+const char* ToString(TerrainKind kind) {
+  switch (kind) {
+    case TerrainKind::kGrass: return "grass";
+    case TerrainKind::kSoil: return "soil";
+    case TerrainKind::kGravel: return "gravel";
+    case TerrainKind::kRubble: return "rubble";
+    case TerrainKind::kMixed: return "mixed";
+  }
+  return "grass";
+}
+
+const char* ToString(DistractorKind kind) {
+  switch (kind) {
+    case DistractorKind::kTarp: return "tarp";
+    case DistractorKind::kCone: return "cone";
+    case DistractorKind::kBackpack: return "backpack";
+    case DistractorKind::kDebris: return "debris";
+    case DistractorKind::kRock: return "rock";
+  }
+  return "tarp";
+}
+
+double DefaultSizeM(DistractorKind kind) {
+  switch (kind) {
+    case DistractorKind::kTarp: return 2.0;      // a 2 x 1.5 m tarpaulin
+    case DistractorKind::kCone: return 0.5;      // a traffic cone's base, seen from above
+    case DistractorKind::kBackpack: return 0.6;
+    case DistractorKind::kDebris: return 1.5;    // a plank, a door, sheet metal
+    case DistractorKind::kRock: return 1.0;
+  }
+  return 1.0;
+}
+
+Bgr DefaultColour(DistractorKind kind) {
+  switch (kind) {
+    case DistractorKind::kTarp: return {20, 90, 230};      // orange
+    case DistractorKind::kCone: return {10, 80, 250};      // safety orange
+    case DistractorKind::kBackpack: return {40, 40, 200};  // red
+    case DistractorKind::kDebris: return {120, 130, 140};  // weathered wood / metal
+    case DistractorKind::kRock: return {190, 200, 205};    // pale limestone
+  }
+  return {128, 128, 128};
+}
 
 Result<WorldConfig> ParseWorld(const yaml::Node& root, std::string source) {
   WorldConfig w;
@@ -75,6 +224,20 @@ Result<WorldConfig> ParseWorld(const yaml::Node& root, std::string source) {
   if (const Node* victims = r.Child("victims"); victims && r.ok()) {
     if (auto s = ReadVictims(*victims, &w.victims); !s) r.Fail(s.error());
   }
+  if (const Node* distractors = r.Child("distractors"); distractors && r.ok()) {
+    if (auto s = ReadDistractors(*distractors, &w.distractors); !s) r.Fail(s.error());
+  }
+  Nested(r, "lighting", "lighting", false, [&w](MapReader& g, const Node&) {
+    Lighting l;
+    g.Optional("time_of_day_h", &l.time_of_day_h).Optional("overcast", &l.overcast);
+    w.lighting = l;
+  });
+  Nested(r, "terrain", "terrain", false, [&w](MapReader& g, const Node&) {
+    Terrain t;
+    std::string kind_text;
+    g.Optional("kind", &kind_text).Optional("water_fraction", &t.water_fraction);
+    w.terrain = t;
+  });
   Nested(r, "wind", "wind", false, [&w](MapReader& g, const Node& n) {
     g.Optional("mean_m_s", &w.wind.mean_m_s);
     Checked(g, n).NonNegative("gust_std_m_s", &w.wind.gust_std_m_s).Positive("gust_time_s", &w.wind.gust_time_s, false);
@@ -84,6 +247,22 @@ Result<WorldConfig> ParseWorld(const yaml::Node& root, std::string source) {
     g.Required("lat_deg", &w.home_lat_deg).Required("lon_deg", &w.home_lon_deg).Optional("alt_m", &w.home_alt_m);
   });
   if (auto s = r.Finish(); !s) return s.error().Context("world");
+  if (w.lighting) {
+    const Node& n = *root.Find("lighting");
+    if (!(w.lighting->time_of_day_h >= 0 && w.lighting->time_of_day_h <= 24)) {
+      return Error(ErrorCode::kInvalidArgument, "world: lighting time_of_day_h must be within 0..24", n.Where());
+    }
+    if (!(w.lighting->overcast >= 0 && w.lighting->overcast <= 1)) {
+      return Error(ErrorCode::kInvalidArgument, "world: lighting overcast must be within 0..1", n.Where());
+    }
+  }
+  if (w.terrain) {
+    const Node& n = *root.Find("terrain");
+    if (auto s = ReadEnum(n, "kind", kTerrains, "world: terrain", &w.terrain->kind); !s) return s.error();
+    if (!(w.terrain->water_fraction >= 0 && w.terrain->water_fraction < 1)) {
+      return Error(ErrorCode::kInvalidArgument, "world: terrain water_fraction must be within 0..1 (below 1)", n.Where());
+    }
+  }
   if (std::abs(w.home_lat_deg) > 89.0 || std::abs(w.home_lon_deg) > 180.0) {
     return Error(ErrorCode::kInvalidArgument, "world: home lat/lon out of range", root.Find("home")->Where());
   }
@@ -91,6 +270,13 @@ Result<WorldConfig> ParseWorld(const yaml::Node& root, std::string source) {
     if (std::abs(v.x_m) > w.size_x_m / 2 || std::abs(v.y_m) > w.size_y_m / 2) {
       return Error(ErrorCode::kInvalidArgument, "world: victim '" + v.id + "' lies outside the geofence",
                    root.Find("victims")->Where());
+    }
+  }
+  for (const Distractor& d : w.distractors) {
+    if (std::abs(d.x_m) > w.size_x_m / 2 || std::abs(d.y_m) > w.size_y_m / 2) {
+      return Error(ErrorCode::kInvalidArgument,
+                   std::string("world: a ") + ToString(d.kind) + " distractor lies outside the geofence",
+                   root.Find("distractors")->Where());
     }
   }
   return w;

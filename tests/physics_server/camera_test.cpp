@@ -3,6 +3,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
+
+#include "swarmbox/physics/ground_renderer.hpp"
 
 #include "test_util.hpp"
 
@@ -57,11 +60,11 @@ void CheckVictimPixel(double yaw, double victim_heading) {
   world->SetPinned(d, true);
   CameraImage img;
   world->RenderCamera(d, &img);
-  ASSERT_EQ(img.width_px, 320);
-  ASSERT_EQ(img.height_px, 240);
-  ASSERT_EQ(img.bgr.size(), 320u * 240u * 3u);
-  EXPECT_NEAR(img.intrinsics.fx_px, 160.0 / std::tan(0.6), 1e-9);
-  EXPECT_DOUBLE_EQ(img.intrinsics.cx_px, 160.0);
+  ASSERT_EQ(img.width_px, af.camera.width_px);
+  ASSERT_EQ(img.height_px, af.camera.height_px);
+  ASSERT_EQ(img.bgr.size(), static_cast<std::size_t>(af.camera.width_px * af.camera.height_px * 3));
+  EXPECT_NEAR(img.intrinsics.fx_px, af.camera.width_px / 2.0 / std::tan(af.camera.hfov_rad / 2), 1e-9);
+  EXPECT_DOUBLE_EQ(img.intrinsics.cx_px, af.camera.width_px / 2.0);
 
   const Vec3 cam = world->Truth(d).position_m + Vec3{0, 0, af.camera.offset_m.z};
   EXPECT_NEAR(img.camera_pose.position_m.z, cam.z, 1e-9);
@@ -133,10 +136,77 @@ TEST(Camera, ObstacleTopsAreSeenFromAbove) {
   CameraImage img;
   world->RenderCamera(d, &img);
   // The image centre looks straight down onto the block's top (grey ~155, noise 4).
-  const std::size_t c = (120u * 320u + 160u) * 3u;
+  const std::size_t c = (static_cast<std::size_t>(img.height_px / 2 * img.width_px + img.width_px / 2)) * 3u;
   EXPECT_NEAR(img.bgr[c + 2], 160, 20);
   EXPECT_NEAR(img.bgr[c + 1], 155, 20);
   EXPECT_NEAR(img.bgr[c], 150, 20);
+}
+
+// The truth the renderer reports matches what it drew: the box holds every figure pixel, tightly,
+// and the visible fraction falls as an obstacle or the image border hides the figure.
+TEST(Camera, TruthBoxesMatchDrawnPeople) {
+  WorldConfig config = CalmWorld();
+  config.victims.push_back({.id = "seen", .x_m = 2.0, .y_m = 1.0, .heading_rad = 0.3});
+  config.victims.push_back({.id = "far", .x_m = 80.0, .y_m = 80.0, .heading_rad = 0.0});
+  GroundRenderer renderer(config);
+  CameraSpec spec;  // 320 x 240
+  spec.noise_std = 0;
+  const Pose pose{Vec3{0, 0, 10}, Quat{}};
+  CameraImage img;
+  std::vector<VisiblePerson> people;
+  renderer.Render(pose, spec, 1, &img, &people);
+  ASSERT_EQ(people.size(), 1u);  // "far" is out of view
+  EXPECT_EQ(people[0].id, "seen");
+  EXPECT_NEAR(people[0].visible_fraction, 1.0, 1e-9);
+  // Figure pixels (R high, B low): all inside the box, touching each of its sides.
+  int x0 = img.width_px, y0 = img.height_px, x1 = -1, y1 = -1;
+  for (int y = 0; y < img.height_px; ++y) {
+    for (int x = 0; x < img.width_px; ++x) {
+      const std::size_t i = (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width_px) + static_cast<std::size_t>(x)) * 3;
+      if (img.bgr[i + 2] < 215 || img.bgr[i] > 90) continue;
+      x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+    }
+  }
+  ASSERT_GE(x1, 0);
+  const cv::Rect box = people[0].box_px;
+  EXPECT_GE(x0, box.x);
+  EXPECT_GE(y0, box.y);
+  EXPECT_LE(x1, box.x + box.width - 1);
+  EXPECT_LE(y1, box.y + box.height - 1);
+  EXPECT_LE(x0 - box.x, 1);
+  EXPECT_LE(y0 - box.y, 1);
+  EXPECT_LE(box.x + box.width - 1 - x1, 1);
+  EXPECT_LE(box.y + box.height - 1 - y1, 1);
+}
+
+TEST(Camera, TruthVisibleFractionFallsUnderObstaclesAndAtTheBorder) {
+  WorldConfig config = CalmWorld();
+  // A lying figure along x (heading 0) centred at the origin; a box hides its feet end.
+  config.victims.push_back({.id = "v", .x_m = 0.0, .y_m = 0.0, .heading_rad = 0.0});
+  config.obstacles.push_back({.id = "slab", .center_m = {-0.55, 0, 0.05}, .size_m = {0.8, 2, 0.1}, .yaw_rad = 0});
+  GroundRenderer renderer(config);
+  CameraSpec spec;
+  spec.noise_std = 0;
+  CameraImage img;
+  std::vector<VisiblePerson> people;
+  renderer.Render(Pose{Vec3{0, 0, 8}, Quat{}}, spec, 1, &img, &people);
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_GT(people[0].visible_fraction, 0.3);
+  EXPECT_LT(people[0].visible_fraction, 0.8);
+
+  // No obstacle, the camera moved half an image height east: image up is body +x (east), so the
+  // bottom image border now runs through the figure's centre.
+  config.obstacles.clear();
+  GroundRenderer clear(config);
+  const double fx = 160.0 / std::tan(0.6);
+  const double half_height_m = 120.0 / fx * 8.0;  // ground half-height of the image at 8 m
+  clear.Render(Pose{Vec3{half_height_m, 0, 8}, Quat{}}, spec, 1, &img, &people);
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_GT(people[0].visible_fraction, 0.2);
+  EXPECT_LT(people[0].visible_fraction, 0.8);
+  const cv::Rect box = people[0].box_px;
+  EXPECT_EQ(box.y + box.height, img.height_px);  // clipped at the bottom edge (world -x of the camera)
+  EXPECT_GE(box.y, 0);
 }
 
 TEST(Camera, DueAtItsRate) {

@@ -11,7 +11,8 @@ using detail::Overloaded;
 std::string_view CommandName(const MissionCommand& command) {
   static constexpr std::string_view kNames[] = {
       "start_search", "assign_sectors", "report_sighting", "confirm_victim", "converge_on",
-      "begin_rescue", "mark_rescued",   "return_home",     "complete_mission"};
+      "begin_rescue", "mark_rescued",   "return_home",     "complete_mission", "report_miss",
+      "request_revisit", "confirm_sighting", "reject_sighting"};
   return kNames[command.index()];
 }
 
@@ -37,6 +38,28 @@ Bytes EncodeCommand(const MissionCommand& command) {
                  [&](const MarkRescued& c) { w.Varint(c.victim_id); },
                  [](const ReturnHome&) {},
                  [](const CompleteMission&) {},
+                 [&](const ReportMiss& c) {
+                   w.Str(c.reporter);
+                   w.Varint(c.seq);
+                   w.Varint(c.candidate);
+                   w.F64(c.viewer_x_m);
+                   w.F64(c.viewer_y_m);
+                   w.F64(c.viewer_height_m);
+                   w.F64(c.t_s);
+                 },
+                 [&](const RequestRevisit& c) {
+                   w.Varint(c.candidate);
+                   w.Str(c.drone);
+                   w.F64(c.t_s);
+                 },
+                 [&](const ConfirmSighting& c) {
+                   w.Varint(c.candidate);
+                   w.F64(c.belief);
+                 },
+                 [&](const RejectSighting& c) {
+                   w.Varint(c.candidate);
+                   w.F64(c.belief);
+                 },
              },
              command);
   return out;
@@ -80,6 +103,40 @@ Result<MissionCommand> DecodeCommand(std::span<const std::uint8_t> bytes) {
     case 6: cmd = MarkRescued{victim_id()}; break;
     case 7: cmd = ReturnHome{}; break;
     case 8: cmd = CompleteMission{}; break;
+    case 9: {
+      ReportMiss c;
+      c.reporter = r.Str();
+      c.seq = r.Varint();
+      c.candidate = victim_id();
+      c.viewer_x_m = r.F64();
+      c.viewer_y_m = r.F64();
+      c.viewer_height_m = r.F64();
+      c.t_s = r.F64();
+      cmd = std::move(c);
+      break;
+    }
+    case 10: {
+      RequestRevisit c;
+      c.candidate = victim_id();
+      c.drone = r.Str();
+      c.t_s = r.F64();
+      cmd = std::move(c);
+      break;
+    }
+    case 11: {
+      ConfirmSighting c;
+      c.candidate = victim_id();
+      c.belief = r.F64();
+      cmd = c;
+      break;
+    }
+    case 12: {
+      RejectSighting c;
+      c.candidate = victim_id();
+      c.belief = r.F64();
+      cmd = c;
+      break;
+    }
     default:
       return Error(ErrorCode::kProtocol, "unknown command kind " + std::to_string(kind),
                    "mission command");

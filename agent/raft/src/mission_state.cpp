@@ -1,5 +1,6 @@
 #include "swarmbox/raft/mission_state.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "swarmbox/raft/detail/byte_io.hpp"
@@ -25,6 +26,15 @@ std::string_view VictimStatusName(VictimStatus status) {
     case VictimStatus::kConfirmed: return "confirmed";
     case VictimStatus::kBeingRescued: return "being_rescued";
     case VictimStatus::kRescued: return "rescued";
+  }
+  return "unknown";
+}
+
+std::string_view CandidateStatusName(CandidateStatus status) {
+  switch (status) {
+    case CandidateStatus::kPending: return "pending";
+    case CandidateStatus::kConfirmed: return "confirmed";
+    case CandidateStatus::kRejected: return "rejected";
   }
   return "unknown";
 }
@@ -55,6 +65,62 @@ const Victim* MissionState::FindVictim(std::uint32_t id) const {
     if (v.id == id) return &v;
   }
   return nullptr;
+}
+
+const Candidate* MissionState::FindCandidate(std::uint32_t id) const {
+  for (const Candidate& c : candidates_) {
+    if (c.id == id) return &c;
+  }
+  return nullptr;
+}
+
+Candidate* MissionState::MutableCandidate(std::uint32_t id) {
+  for (Candidate& c : candidates_) {
+    if (c.id == id) return &c;
+  }
+  return nullptr;
+}
+
+Candidate* MissionState::NearCandidate(double x_m, double y_m) {
+  Candidate* best = nullptr;
+  double best_d = kConfirmRadiusM;
+  for (Candidate& c : candidates_) {
+    if (c.status == CandidateStatus::kConfirmed) continue;  // its victim takes the sightings
+    const double d = Distance(c.x_m, c.y_m, x_m, y_m);
+    if (d <= best_d) {
+      best = &c;
+      best_d = d;
+    }
+  }
+  return best;
+}
+
+void MissionState::AddView(Candidate& c, SightingView v) {
+  // The revisit is done once the drone sent there reports what it saw (a view or a miss).
+  if (!c.revisit_drone.empty() && v.reporter == c.revisit_drone && v.t_s >= c.revisit_t_s) {
+    c.revisit_drone.clear();
+    ++c.revisits;
+  }
+  c.views.push_back(std::move(v));
+  double w = 0, x = 0, y = 0;
+  for (const SightingView& e : c.views) {
+    if (!e.detected) continue;
+    w += e.confidence;
+    x += e.confidence * e.x_m;
+    y += e.confidence * e.y_m;
+  }
+  if (w > 0) {
+    c.x_m = x / w;
+    c.y_m = y / w;
+  }
+}
+
+std::string MissionState::CheckSeq(const std::string& reporter, std::uint64_t seq) const {
+  auto it = last_seq_.find(reporter);
+  if (seq == 0 || (it != last_seq_.end() && seq <= it->second)) {
+    return "duplicate or out-of-order sighting seq " + std::to_string(seq) + " from " + reporter;
+  }
+  return "";
 }
 
 const Sector* MissionState::SectorOf(std::string_view drone) const {
@@ -222,6 +288,53 @@ ApplyResult MissionState::Apply(std::uint64_t index, const MissionCommand& comma
             SetPhase(MissionPhase::kComplete, &r);
             return r;
           },
+          [&](const ReportMiss& c) -> ApplyResult {
+            if (!active) return Reject("miss ignored" + in_phase);
+            return ApplyMiss(c);
+          },
+          [&](const RequestRevisit& c) -> ApplyResult {
+            if (!active) return Reject("cannot request a revisit" + in_phase);
+            if (c.drone.empty() || !Finite(c.t_s)) return Reject("revisit without a drone or a time");
+            Candidate* k = MutableCandidate(c.candidate);
+            if (k == nullptr || k->status != CandidateStatus::kPending) {
+              return Reject("no pending candidate " + std::to_string(c.candidate));
+            }
+            k->revisit_drone = c.drone;
+            k->revisit_t_s = c.t_s;
+            return r;
+          },
+          [&](const ConfirmSighting& c) -> ApplyResult {
+            if (!active) return Reject("cannot confirm a sighting" + in_phase);
+            if (!Finite(c.belief) || c.belief < 0 || c.belief > 1) return Reject("belief outside [0, 1]");
+            Candidate* k = MutableCandidate(c.candidate);
+            if (k == nullptr || k->status == CandidateStatus::kConfirmed) {
+              return Reject("no undecided candidate " + std::to_string(c.candidate));
+            }
+            if (Victim* v = NearVictim(k->x_m, k->y_m)) {
+              return Reject("victim " + std::to_string(v->id) + " is already confirmed there");
+            }
+            std::vector<std::string> by;
+            for (const SightingView& e : k->views) {
+              if (e.detected && std::find(by.begin(), by.end(), e.reporter) == by.end()) by.push_back(e.reporter);
+            }
+            k->status = CandidateStatus::kConfirmed;
+            k->revisit_drone.clear();
+            k->belief = c.belief;
+            k->victim_id = AddVictim(k->x_m, k->y_m, std::move(by), &r).id;
+            return r;
+          },
+          [&](const RejectSighting& c) -> ApplyResult {
+            if (!active) return Reject("cannot reject a sighting" + in_phase);
+            if (!Finite(c.belief) || c.belief < 0 || c.belief > 1) return Reject("belief outside [0, 1]");
+            Candidate* k = MutableCandidate(c.candidate);
+            if (k == nullptr || k->status != CandidateStatus::kPending) {
+              return Reject("no pending candidate " + std::to_string(c.candidate));
+            }
+            k->status = CandidateStatus::kRejected;
+            k->revisit_drone.clear();
+            k->belief = c.belief;
+            return r;
+          },
       },
       command);
 }
@@ -229,48 +342,63 @@ ApplyResult MissionState::Apply(std::uint64_t index, const MissionCommand& comma
 ApplyResult MissionState::ApplySighting(const ReportSighting& c) {
   if (c.reporter.empty()) return Reject("sighting without a reporter");
   if (!Finite(c.x_m) || !Finite(c.y_m) || !Finite(c.confidence) || c.confidence < 0 ||
-      c.confidence > 1) {
+      c.confidence > 1 || !Finite(c.viewer_x_m) || !Finite(c.viewer_y_m) ||
+      !Finite(c.viewer_height_m) || !Finite(c.t_s)) {
     return Reject("sighting with a non-finite position or a confidence outside [0, 1]");
   }
-  auto seq_it = last_seq_.find(c.reporter);
-  if (c.seq == 0 || (seq_it != last_seq_.end() && c.seq <= seq_it->second)) {
-    return Reject("duplicate or out-of-order sighting seq " + std::to_string(c.seq) + " from " +
-                  c.reporter);
-  }
+  if (std::string why = CheckSeq(c.reporter, c.seq); !why.empty()) return Reject(std::move(why));
   if (c.confidence < kMinConfidence) return Reject("sighting confidence below 0.5");
-  last_seq_[c.reporter] = c.seq;
   ApplyResult r;
   r.accepted = true;
   if (Victim* v = NearVictim(c.x_m, c.y_m)) {
+    last_seq_[c.reporter] = c.seq;
     bool known = false;
     for (const std::string& b : v->confirmed_by) known = known || b == c.reporter;
     if (!known) v->confirmed_by.push_back(c.reporter);
     return r;
   }
-  if (c.confidence >= kHighConfidence) {
-    AddVictim(c.x_m, c.y_m, {c.reporter}, &r);
-    return r;
+  SightingView view{c.reporter, c.seq, c.x_m, c.y_m, c.confidence, c.viewer_x_m, c.viewer_y_m,
+                    c.viewer_height_m, c.t_s, true};
+  Candidate* k = NearCandidate(c.x_m, c.y_m);
+  if (k != nullptr && k->views.size() >= kMaxViews) {
+    return Reject("candidate " + std::to_string(k->id) + " holds " + std::to_string(kMaxViews) + " views");
   }
-  // The nearest pending sighting from another drone within the radius confirms.
-  std::size_t match = pending_.size();
-  double best_d = kConfirmRadiusM;
-  for (std::size_t k = 0; k < pending_.size(); ++k) {
-    const Sighting& s = pending_[k];
-    if (s.reporter == c.reporter) continue;
-    const double d = Distance(s.x_m, s.y_m, c.x_m, c.y_m);
-    if (d <= best_d) {
-      best_d = d;
-      match = k;
+  last_seq_[c.reporter] = c.seq;
+  if (k == nullptr) {
+    if (candidates_.size() >= kMaxCandidates) {
+      auto old = std::find_if(candidates_.begin(), candidates_.end(),
+                              [](const Candidate& x) { return x.status != CandidateStatus::kPending; });
+      candidates_.erase(old != candidates_.end() ? old : candidates_.begin());
     }
+    Candidate fresh;
+    fresh.id = next_candidate_id_++;
+    fresh.x_m = c.x_m;
+    fresh.y_m = c.y_m;
+    candidates_.push_back(std::move(fresh));
+    k = &candidates_.back();
   }
-  if (match < pending_.size()) {
-    const Sighting s = pending_[match];
-    pending_.erase(pending_.begin() + static_cast<std::ptrdiff_t>(match));
-    AddVictim((s.x_m + c.x_m) / 2, (s.y_m + c.y_m) / 2, {s.reporter, c.reporter}, &r);
-    return r;
+  AddView(*k, std::move(view));
+  return r;
+}
+
+ApplyResult MissionState::ApplyMiss(const ReportMiss& c) {
+  if (c.reporter.empty()) return Reject("miss without a reporter");
+  if (!Finite(c.viewer_x_m) || !Finite(c.viewer_y_m) || !Finite(c.viewer_height_m) || !Finite(c.t_s)) {
+    return Reject("miss with a non-finite viewpoint");
   }
-  pending_.push_back(Sighting{c.reporter, c.seq, c.x_m, c.y_m, c.confidence});
-  if (pending_.size() > kMaxPendingSightings) pending_.erase(pending_.begin());
+  if (std::string why = CheckSeq(c.reporter, c.seq); !why.empty()) return Reject(std::move(why));
+  Candidate* k = MutableCandidate(c.candidate);
+  if (k == nullptr || k->status == CandidateStatus::kConfirmed) {
+    return Reject("no undecided candidate " + std::to_string(c.candidate));
+  }
+  if (k->views.size() >= kMaxViews) {
+    return Reject("candidate " + std::to_string(k->id) + " holds " + std::to_string(kMaxViews) + " views");
+  }
+  last_seq_[c.reporter] = c.seq;
+  AddView(*k, SightingView{c.reporter, c.seq, k->x_m, k->y_m, 0.0, c.viewer_x_m, c.viewer_y_m,
+                           c.viewer_height_m, c.t_s, false});
+  ApplyResult r;
+  r.accepted = true;
   return r;
 }
 
@@ -290,8 +418,24 @@ Bytes MissionState::EncodeSnapshot() const {
     w.Str(reporter);
     w.Varint(seq);
   }
-  w.Varint(pending_.size());
-  for (const Sighting& s : pending_) detail::WriteSighting(w, s);
+  w.Varint(next_candidate_id_);
+  w.Varint(candidates_.size());
+  for (const Candidate& c : candidates_) {
+    w.Varint(c.id);
+    w.F64(c.x_m);
+    w.F64(c.y_m);
+    w.U8(static_cast<std::uint8_t>(c.status));
+    w.Str(c.revisit_drone);
+    w.F64(c.revisit_t_s);
+    w.Varint(c.revisits);
+    w.Varint(c.victim_id);
+    w.F64(c.belief);
+    w.Varint(c.views.size());
+    for (const SightingView& v : c.views) {
+      detail::WriteSighting(w, v);
+      w.U8(v.detected ? 1 : 0);
+    }
+  }
   w.Varint(victims_.size());
   for (const Victim& v : victims_) {
     w.Varint(v.id);
@@ -335,9 +479,30 @@ Result<MissionState> MissionState::DecodeSnapshot(std::span<const std::uint8_t> 
     std::string reporter = r.Str();
     m.last_seq_[reporter] = r.Varint();
   }
-  n = r.Count(26, "sighting");
+  m.next_candidate_id_ = u32("next candidate id");
+  n = r.Count(38, "candidate");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-    m.pending_.push_back(detail::ReadSighting<Sighting>(r));
+    Candidate c;
+    c.id = u32("candidate id");
+    c.x_m = r.F64();
+    c.y_m = r.F64();
+    const std::uint8_t status = r.U8();
+    if (r.ok() && status > static_cast<std::uint8_t>(CandidateStatus::kRejected)) {
+      return fail("invalid candidate status " + std::to_string(status));
+    }
+    c.status = static_cast<CandidateStatus>(status);
+    c.revisit_drone = r.Str();
+    c.revisit_t_s = r.F64();
+    c.revisits = u32("revisits");
+    c.victim_id = u32("candidate victim");
+    c.belief = r.F64();
+    const std::uint64_t nv = r.Count(59, "view");
+    for (std::uint64_t j = 0; j < nv && r.ok(); ++j) {
+      SightingView v = detail::ReadSighting<SightingView>(r);
+      v.detected = r.U8() != 0;
+      c.views.push_back(std::move(v));
+    }
+    m.candidates_.push_back(std::move(c));
   }
   n = r.Count(20, "victim");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
@@ -38,6 +39,7 @@ LeaderPlanner::LeaderPlanner(LeaderConfig config) : config_(std::move(config)) {
   SWARMBOX_CHECK(config_.retry_s > 0);
   SWARMBOX_CHECK(config_.member_timeout_s > 0 && config_.assignment_settle_s >= 0);
   SWARMBOX_CHECK(config_.member_min_wall_s >= 0);
+  CheckFusionParams(config_.fusion);
 }
 
 bool LeaderPlanner::Due(const std::string& key, double t_s) {
@@ -59,6 +61,119 @@ void LeaderPlanner::Track(double t_s, const raft::MissionState& m, double wall_s
     sectors_ = m.sectors();
     sectors_changed_s_ = t_s;
   }
+  if (t_s != tracked_s_) evidence_events_.clear();  // a new tick: the old ones were the last tick's
+  tracked_s_ = t_s;
+  TrackCandidates(t_s, m, first);
+}
+
+void LeaderPlanner::TrackCandidates(double t_s, const raft::MissionState& m, bool learn_only) {
+  for (const raft::Candidate& c : m.candidates()) {
+    SeenCandidate& seen = seen_[c.id];
+    if (learn_only) {
+      seen = {c.views.size(), c.status, c.revisit_drone};
+      continue;
+    }
+    if (seen.views == c.views.size() && seen.status == c.status && seen.revisit_drone == c.revisit_drone) continue;
+    // The fused belief after each new view, in record order.
+    raft::Candidate upto = c;
+    for (std::size_t k = seen.views; k < c.views.size(); ++k) {
+      upto.views.assign(c.views.begin(), c.views.begin() + static_cast<std::ptrdiff_t>(k + 1));
+      const FusionAssessment a = AssessCandidate(upto, config_.fusion);
+      const raft::SightingView& v = c.views[k];
+      char viewer[64];
+      std::snprintf(viewer, sizeof viewer, "%.1f:%.1f:%.1f", v.viewer_x_m, v.viewer_y_m, v.viewer_height_m);
+      LogEvent e(t_s, config_.name, "sighting");
+      e.Add("candidate", static_cast<std::int64_t>(c.id))
+          .Add("reporter", v.reporter)
+          .Add("seen", v.detected)
+          .Add("confidence", v.detected ? v.confidence : 0.0, 3)
+          .Add("x", v.x_m, 2)
+          .Add("y", v.y_m, 2)
+          .Add("viewer", viewer)
+          .Add("capture_t", v.t_s, 2)
+          .Add("belief", a.belief, 3)
+          .Add("counted", a.counted_detections)
+          .Add("counted_misses", a.counted_misses);
+      evidence_events_.push_back(std::move(e));
+    }
+    if (!c.revisit_drone.empty() && c.revisit_drone != seen.revisit_drone) {
+      evidence_events_.push_back(std::move(LogEvent(t_s, config_.name, "revisit")
+                                               .Add("candidate", static_cast<std::int64_t>(c.id))
+                                               .Add("drone", c.revisit_drone)
+                                               .Add("x", c.x_m, 2)
+                                               .Add("y", c.y_m, 2)
+                                               .Add("revisits_done", static_cast<std::int64_t>(c.revisits))));
+    }
+    if (c.status != seen.status && c.status != raft::CandidateStatus::kPending) {
+      const FusionAssessment a = AssessCandidate(c, config_.fusion);
+      const bool confirmed = c.status == raft::CandidateStatus::kConfirmed;
+      LogEvent e(t_s, config_.name, confirmed ? "confirmed" : "rejected");
+      if (confirmed) {
+        e.Add("victim", static_cast<std::int64_t>(c.victim_id));
+      } else {
+        e.Add("reason", a.undecided ? "undecided" : "belief");
+      }
+      e.Add("decided_belief", c.belief, 3);
+      AddEvidence(e, c, a);
+      evidence_events_.push_back(std::move(e));
+    }
+    seen = {c.views.size(), c.status, c.revisit_drone};
+  }
+}
+
+bool LeaderPlanner::PlanCandidates(double t_s, const raft::MissionState& m, std::span<const RosterEntry> roster,
+                                   MissionOutput* out) {
+  const FusionParams& fp = config_.fusion;
+  bool pending = false;
+  // Scouts already sent somewhere: one revisit each at a time.
+  std::set<std::string> busy;
+  for (const raft::Candidate& c : m.candidates()) {
+    if (!c.revisit_drone.empty() && c.status == raft::CandidateStatus::kPending) busy.insert(c.revisit_drone);
+  }
+  for (const raft::Candidate& c : m.candidates()) {
+    if (c.status == raft::CandidateStatus::kConfirmed) continue;
+    const FusionAssessment a = AssessCandidate(c, fp);
+    const std::string id = std::to_string(c.id);
+    if (a.decision == FusionDecision::kConfirm) {
+      pending = pending || c.status == raft::CandidateStatus::kPending;
+      if (Due("confirm:" + id, t_s)) out->proposals.push_back(raft::ConfirmSighting{c.id, a.belief});
+      continue;
+    }
+    if (c.status != raft::CandidateStatus::kPending) continue;  // rejected: new evidence may still confirm it
+    pending = true;
+    if (a.decision == FusionDecision::kReject) {
+      if (Due("reject:" + id, t_s)) out->proposals.push_back(raft::RejectSighting{c.id, a.belief});
+      continue;
+    }
+    bool need = false;
+    if (c.revisit_drone.empty()) {
+      need = t_s - a.last_view_s >= fp.revisit_after_s;
+    } else {
+      need = GoneOwner(t_s, c.revisit_drone) || t_s - c.revisit_t_s >= fp.revisit_timeout_s;
+    }
+    if (!need) continue;
+    const Eigen::Vector2d at(c.x_m, c.y_m);
+    const RosterEntry* best = nullptr;
+    int best_rank = 0;
+    double best_d = 0;
+    for (const RosterEntry& r : roster) {
+      if (r.role != Role::kScout || !Alive(r) || busy.count(r.name) != 0 || r.name == c.revisit_drone) continue;
+      if (IsOneOf(r.mode, {"taking_off", "landing"})) continue;
+      const int rank = Availability(r.mode);
+      const double d = (r.position_m - at).norm();
+      if (best == nullptr || rank < best_rank || (rank == best_rank && (d < best_d || (d == best_d && r.name < best->name)))) {
+        best = &r;
+        best_rank = rank;
+        best_d = d;
+      }
+    }
+    if (best == nullptr) continue;
+    if (Due("revisit:" + id, t_s)) {
+      out->proposals.push_back(raft::RequestRevisit{c.id, best->name, t_s});
+      busy.insert(best->name);
+    }
+  }
+  return pending;
 }
 
 void LeaderPlanner::Index(std::span<const RosterEntry> roster) {
@@ -156,6 +271,8 @@ std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raf
 void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
                          std::span<const RosterEntry> roster, MissionOutput* out, double wall_s) {
   Track(t_s, m, wall_s);
+  for (LogEvent& e : evidence_events_) out->events.push_back(std::move(e));
+  evidence_events_.clear();
   Index(roster);
   ReportMembers(t_s, roster, out);
   std::vector<std::string> scouts;  // live ones
@@ -207,6 +324,10 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
                                          [](const std::string* a, const std::string* b) { return *a < *b; });
     scouts_done = ScoutDone(r.mode) || (!owns && r.mode == "awaiting_sector");
   }
+
+  const bool active = m.phase() == MissionPhase::kSearch || m.phase() == MissionPhase::kConverge ||
+                      m.phase() == MissionPhase::kRescue;
+  const bool undecided = active && PlanCandidates(t_s, m, roster, out);
 
   const raft::Victim* candidate = nullptr;  // confirmed, not yet rescued or handled
   bool rescue_running = false;
@@ -264,7 +385,7 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
         if (Due("converge:" + std::to_string(candidate->id), t_s)) {
           out->proposals.push_back(raft::ConvergeOn{candidate->id});
         }
-      } else if (scouts_done && !rescue_running && Due("return", t_s)) {
+      } else if (scouts_done && !rescue_running && !undecided && Due("return", t_s)) {
         out->proposals.push_back(raft::ReturnHome{});
       }
       break;

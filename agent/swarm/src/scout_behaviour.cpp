@@ -51,6 +51,7 @@ std::string_view ScoutBehaviour::StageName(Stage stage) {
     case Stage::kReturning: return "returning";
     case Stage::kLanding: return "landing";
     case Stage::kLanded: return "landed";
+    case Stage::kRevisiting: return "revisiting";
   }
   return "?";
 }
@@ -72,6 +73,7 @@ void ScoutBehaviour::Enter(Stage stage, const MissionInput& in, MissionOutput* o
   e.Add("role", "scout").Add("stage", StageName(stage));
   if (stage == Stage::kSearching && has_plan_) e.Add("lane", static_cast<std::int64_t>(lane_index_ / 2));
   if (stage == Stage::kOrbiting) e.Add("victim", static_cast<std::int64_t>(orbit_victim_));
+  if (stage == Stage::kRevisiting) e.Add("candidate", static_cast<std::int64_t>(revisit_id_));
   out->events.push_back(std::move(e));
 }
 
@@ -101,6 +103,7 @@ const raft::Victim* ScoutBehaviour::OrbitTarget(const MissionInput& in) const {
 
 void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out) {
   const raft::MissionState& m = *in.mission;
+  const raft::Candidate* revisit = stage_ == Stage::kRevisiting ? m.FindCandidate(revisit_id_) : nullptr;
   for (const GroundDetection& d : in.detections) {
     if (d.confidence < config_.min_report_confidence) continue;
     const Eigen::Vector2d p = d.position_m.head<2>();
@@ -108,33 +111,42 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
     for (const raft::Victim& v : m.victims()) {
       known = known || (Eigen::Vector2d(v.x_m, v.y_m) - p).norm() <= config_.dedupe_radius_m;
     }
-    const double high = raft::MissionState::kHighConfidence;
-    for (const RecentReport& r : recent_) {
-      const bool better = d.confidence >= high && r.confidence < high;
-      known = known || ((r.position_m - p).norm() <= config_.dedupe_radius_m &&
-                        in.t_s - r.t_s < config_.report_cooldown_s && !better);
-    }
     if (known) continue;
-    recent_[recent_next_] = {p, in.t_s, d.confidence};
+    // The first sight of the candidate on a revisit always goes out: it is the revisit's answer.
+    const bool answer = revisit != nullptr && !revisit_seen_ &&
+                        (Eigen::Vector2d(revisit->x_m, revisit->y_m) - p).norm() <= config_.dedupe_radius_m;
+    for (const RecentReport& r : recent_) {
+      known = known || ((r.position_m - p).norm() <= config_.dedupe_radius_m &&
+                        in.t_s - r.t_s < config_.report_cooldown_s &&
+                        (r.viewer_m - d.viewer_m).norm() < config_.report_baseline_m);
+    }
+    if (known && !answer) continue;
+    if (answer) revisit_seen_ = true;
+    recent_[recent_next_] = {p, d.viewer_m, in.t_s};
     recent_next_ = (recent_next_ + 1) % recent_.size();
     // A new report of a place supersedes an outstanding one there.
     std::erase_if(outstanding_, [&](const Outstanding& o) {
-      return (o.position_m - p).norm() <= config_.dedupe_radius_m;
+      return (o.detection.position_m.head<2>() - p).norm() <= config_.dedupe_radius_m;
     });
     if (outstanding_.size() >= recent_.size()) outstanding_.erase(outstanding_.begin());
-    Propose(in, p, d.confidence, 1, out);
+    Propose(in, d, 1, out);
   }
 }
 
-void ScoutBehaviour::Propose(const MissionInput& in, const Eigen::Vector2d& p, double confidence,
-                             int tries, MissionOutput* out) {
+void ScoutBehaviour::Propose(const MissionInput& in, const GroundDetection& d, int tries, MissionOutput* out) {
   const std::uint64_t seq = next_seq_++;
-  out->proposals.push_back(raft::ReportSighting{config_.name, seq, p.x(), p.y(), confidence});
+  const Eigen::Vector2d p = d.position_m.head<2>();
+  raft::ReportSighting r{config_.name, seq, p.x(), p.y(), d.confidence};
+  r.viewer_x_m = d.viewer_m.x();
+  r.viewer_y_m = d.viewer_m.y();
+  r.viewer_height_m = d.viewer_m.z() - config_.home_m.z();
+  r.t_s = d.capture_time_s;
+  out->proposals.push_back(r);
   LogEvent e(in.t_s, config_.name, "sighting_reported");
-  e.Add("seq", static_cast<std::uint64_t>(seq)).Add("x", p.x(), 2).Add("y", p.y(), 2).Add("confidence", confidence, 3);
+  e.Add("seq", static_cast<std::uint64_t>(seq)).Add("x", p.x(), 2).Add("y", p.y(), 2).Add("confidence", d.confidence, 3);
   if (tries > 1) e.Add("retry", tries - 1);
   out->events.push_back(std::move(e));
-  outstanding_.push_back({seq, p, confidence, in.t_s, tries});
+  outstanding_.push_back({seq, d, in.t_s, tries});
 }
 
 void ScoutBehaviour::RetrySightings(const MissionInput& in, MissionOutput* out) {
@@ -143,23 +155,76 @@ void ScoutBehaviour::RetrySightings(const MissionInput& in, MissionOutput* out) 
   std::vector<Outstanding> keep;
   for (std::size_t i = 0; i < n; ++i) {
     const Outstanding o = outstanding_[i];
+    const Eigen::Vector2d p = o.detection.position_m.head<2>();
     bool committed = false;
-    for (const raft::Sighting& s : m.pending_sightings()) {
-      committed = committed || (s.reporter == config_.name && s.seq == o.seq);
+    for (const raft::Candidate& c : m.candidates()) {
+      for (const raft::SightingView& v : c.views) committed = committed || (v.reporter == config_.name && v.seq == o.seq);
     }
     for (const raft::Victim& v : m.victims()) {
-      committed = committed || (Eigen::Vector2d(v.x_m, v.y_m) - o.position_m).norm() <= config_.dedupe_radius_m;
+      committed = committed || (Eigen::Vector2d(v.x_m, v.y_m) - p).norm() <= config_.dedupe_radius_m;
     }
     if (committed) continue;
     if (in.t_s - o.sent_s < config_.report_retry_s) {
       keep.push_back(o);
     } else if (o.tries < config_.report_tries) {
-      Propose(in, o.position_m, o.confidence, o.tries + 1, out);
+      Propose(in, o.detection, o.tries + 1, out);
       keep.push_back(outstanding_.back());
       outstanding_.pop_back();
     }
   }
   outstanding_ = std::move(keep);
+}
+
+const raft::Candidate* ScoutBehaviour::RevisitTask(const raft::MissionState& m) const {
+  if (!Active(m.phase())) return nullptr;
+  for (const raft::Candidate& c : m.candidates()) {
+    if (c.status == raft::CandidateStatus::kPending && c.revisit_drone == config_.name) return &c;
+  }
+  return nullptr;
+}
+
+void ScoutBehaviour::ProposeMiss(const MissionInput& in, MissionOutput* out) {
+  const raft::Candidate* c = in.mission->FindCandidate(revisit_id_);
+  SWARMBOX_CHECK(c != nullptr);
+  const std::uint64_t seq = next_seq_++;
+  raft::ReportMiss miss{config_.name, seq, revisit_id_, in.position_m.x(), in.position_m.y(),
+                        in.position_m.z() - config_.home_m.z(), in.t_s};
+  out->proposals.push_back(miss);
+  ++miss_tries_;
+  miss_sent_s_ = in.t_s;
+  LogEvent e(in.t_s, config_.name, "miss_reported");
+  e.Add("seq", static_cast<std::uint64_t>(seq))
+      .Add("candidate", static_cast<std::int64_t>(revisit_id_))
+      .Add("offset_m", (in.position_m.head<2>() - Eigen::Vector2d(c->x_m, c->y_m)).norm(), 2)
+      .Add("height_m", miss.viewer_height_m, 1)
+      .Add("look_s", in.t_s - look_start_s_, 1);
+  if (miss_tries_ > 1) e.Add("retry", miss_tries_ - 1);
+  out->events.push_back(std::move(e));
+}
+
+void ScoutBehaviour::RunRevisit(const MissionInput& in, MissionOutput* out) {
+  const raft::Candidate* c = in.mission->FindCandidate(revisit_id_);
+  SetpointRequest& sp = out->setpoint;
+  const Eigen::Vector3d& p = in.position_m;
+  if (c == nullptr) {  // dropped from the bounded list: Decide leaves this stage next tick
+    sp.kind = SetpointKind::kPosition;
+    sp.target_m = p;
+    sp.yaw_rad = in.yaw_rad;
+    return;
+  }
+  const Eigen::Vector2d at(c->x_m, c->y_m);
+  const double d = (p.head<2>() - at).norm();
+  // Flock on the way (spacing from the others), a position hold over the spot.
+  sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
+  sp.target_m = {at.x(), at.y(), Altitude()};
+  sp.yaw_rad = in.yaw_rad;
+  const bool under = d <= config_.revisit_arrive_m && std::abs(p.z() - Altitude()) <= 2.0;
+  if (look_start_s_ < 0 && under) look_start_s_ = in.t_s;
+  if (look_start_s_ < 0 || revisit_seen_ || !under) return;
+  const bool first = miss_tries_ == 0 && in.t_s - look_start_s_ >= config_.revisit_look_s;
+  const bool retry = miss_tries_ > 0 && miss_tries_ < config_.report_tries &&
+                     in.t_s - miss_sent_s_ >= config_.report_retry_s;
+  if (first || retry) ProposeMiss(in, out);
 }
 
 void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
@@ -173,7 +238,8 @@ void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
     if (stage_ == before) break;
   }
   const bool reporting = stage_ == Stage::kSearching || stage_ == Stage::kSwept ||
-                         stage_ == Stage::kOrbiting || stage_ == Stage::kAwaitingSector;
+                         stage_ == Stage::kOrbiting || stage_ == Stage::kAwaitingSector ||
+                         stage_ == Stage::kRevisiting;
   if (reporting && Active(in.mission->phase())) {
     ReportSightings(in, out);
     RetrySightings(in, out);
@@ -202,15 +268,18 @@ void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
     Enter(Stage::kTakingOff, in, out);
   }
 
-  // Back to work: a sector handed over after this scout had finished (not with a low battery).
-  if (Active(m.phase()) && !battery_low_reported_ && !in.battery_low && NextSector(m) != nullptr) {
+  // Back to work: a sector handed over after this scout had finished, or a revisit (not with a
+  // low battery).
+  const raft::Candidate* revisit = battery_low_reported_ || in.battery_low ? nullptr : RevisitTask(m);
+  if (Active(m.phase()) && !battery_low_reported_ && !in.battery_low && (NextSector(m) != nullptr || revisit != nullptr)) {
     if (stage_ == Stage::kReturning) Enter(Stage::kAwaitingSector, in, out);
     if (stage_ == Stage::kLanded) Enter(Stage::kTakingOff, in, out);
   }
 
   // Mission stages: orbit a target, search the sector, or wait for one.
   const bool on_mission = stage_ == Stage::kAwaitingSector || stage_ == Stage::kSearching ||
-                          stage_ == Stage::kSwept || stage_ == Stage::kOrbiting;
+                          stage_ == Stage::kSwept || stage_ == Stage::kOrbiting ||
+                          stage_ == Stage::kRevisiting;
   if (on_mission) {
     const raft::Sector* sector = Active(m.phase()) ? NextSector(m) : nullptr;
     const bool owns = Active(m.phase()) && m.SectorOf(config_.name) != nullptr;
@@ -226,7 +295,16 @@ void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
     const raft::Victim* target = OrbitTarget(in);
     const bool still_sweeping = sector != nullptr;
     if (config_.keep_searching_during_rescue && still_sweeping && stage_ != Stage::kOrbiting) target = nullptr;
-    if (target != nullptr) {
+    if (revisit != nullptr) {
+      if (revisit->id != revisit_id_ || stage_ != Stage::kRevisiting) {
+        revisit_id_ = revisit->id;
+        look_start_s_ = -1.0;
+        revisit_seen_ = false;
+        miss_sent_s_ = -1.0;
+        miss_tries_ = 0;
+      }
+      Enter(Stage::kRevisiting, in, out);
+    } else if (target != nullptr) {
       if (orbit_victim_ != target->id || stage_ != Stage::kOrbiting) {
         orbit_victim_ = target->id;
         orbit_reached_s_ = -1.0;
@@ -333,6 +411,9 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
       if (d <= config_.home_reached_m && p.z() <= approach_z + 1.0) Enter(Stage::kLanding, in, out);
       break;
     }
+    case Stage::kRevisiting:
+      RunRevisit(in, out);
+      break;
     case Stage::kLanding:
       sp.kind = SetpointKind::kLand;
       sp.target_m = config_.home_m;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
-#include <cstdint>
 
 #include <opencv2/imgproc.hpp>
 
@@ -11,100 +10,120 @@
 
 namespace swarmbox::swarm {
 
-VictimDetector::VictimDetector(const VictimDetectorParams& params)
-    : params_(params), kernel_(cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3))) {
-  SWARMBOX_CHECK(params_.min_area_ratio > 0 && params_.min_area_ratio < params_.full_size_ratio);
-  SWARMBOX_CHECK(params_.full_size_ratio <= params_.full_size_max_ratio &&
-                 params_.full_size_max_ratio < params_.max_area_ratio);
+// VictimDetector(params), with the shipped model, is defined in shipped_model.cpp (its own library,
+// so that the trainer links the detector without a model).
+VictimDetector::VictimDetector(std::shared_ptr<const VictimDetectorModel> model, const VictimDetectorParams& params)
+    : model_(std::move(model)), params_(params) {
+  SWARMBOX_CHECK(model_ && model_->forest && static_cast<int>(model_->kernels.size()) == kChannels);
+  SWARMBOX_CHECK(params_.max_candidates > 0 && params_.nms_radius_m >= 0);
+  candidates_.reserve(static_cast<std::size_t>(params_.max_candidates) * 4);
+  scratch_.reserve(static_cast<std::size_t>(params_.max_candidates));
+}
+
+const std::vector<VictimDetector::Candidate>& VictimDetector::Candidates(const cv::Mat& bgr, double pixels_per_m,
+                                                                         int max_candidates, double threshold) {
+  SWARMBOX_CHECK(bgr.type() == CV_8UC3 && pixels_per_m > 0);
+  candidates_.clear();
+  ComputeChannels(bgr, kCanonicalPxPerM / pixels_per_m, &maps_);
+  const int rows = maps_.rows() - kWindowCells + 1, cols = maps_.cols() - kWindowCells + 1;
+  if (rows <= 0 || cols <= 0) return candidates_;
+  score_.create(maps_.rows(), maps_.cols(), CV_32F);
+  score_.setTo(cv::Scalar(model_->bias));
+  for (int c = 0; c < kChannels; ++c) {
+    cv::filter2D(maps_.cells[static_cast<std::size_t>(c)], filtered_, CV_32F, model_->kernels[static_cast<std::size_t>(c)],
+                 cv::Point(0, 0), 0, cv::BORDER_CONSTANT);
+    score_ += filtered_;
+  }
+  const cv::Mat valid = score_(cv::Rect(0, 0, cols, rows));
+  cv::dilate(valid, dilated_, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(-1e9));
+  for (int r = 0; r < rows; ++r) {
+    const float* s = valid.ptr<float>(r);
+    const float* d = dilated_.ptr<float>(r);
+    for (int c = 0; c < cols; ++c) {
+      if (s[c] < threshold || s[c] < d[c]) continue;
+      Candidate cand{r, c, s[c], static_cast<double>(r), static_cast<double>(c)};
+      // Parabolic refinement of the peak along each axis.
+      auto refine = [](double left, double mid, double right) {
+        const double den = left - 2 * mid + right;
+        return den < 0 ? std::clamp(0.5 * (left - right) / den, -0.5, 0.5) : 0.0;
+      };
+      if (c > 0 && c + 1 < cols) cand.sub_col += refine(s[c - 1], s[c], s[c + 1]);
+      if (r > 0 && r + 1 < rows) {
+        cand.sub_row += refine(valid.at<float>(r - 1, c), s[c], valid.at<float>(r + 1, c));
+      }
+      candidates_.push_back(cand);
+    }
+  }
+  std::sort(candidates_.begin(), candidates_.end(),
+            [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  if (static_cast<int>(candidates_.size()) > max_candidates) candidates_.resize(static_cast<std::size_t>(max_candidates));
+  return candidates_;
 }
 
 void VictimDetector::Detect(const cv::Mat& bgr, double pixels_per_m, std::vector<ImageBlob>* out) {
-  SWARMBOX_CHECK(pixels_per_m > 0);
-  const double expected = params_.person_area_m2 * pixels_per_m * pixels_per_m;
-  DetectImpl(bgr, [expected](const Eigen::Vector2d&) { return expected; }, out);
+  DetectImpl(bgr, pixels_per_m, [](const Eigen::Vector2d&) { return true; }, out);
 }
 
 void VictimDetector::Detect(const cv::Mat& bgr, const PinholeIntrinsics& k, const OpticalPose& pose,
                             double ground_z_m, std::vector<ImageBlob>* out) {
   SWARMBOX_CHECK(k.fx_px > 0 && k.fy_px > 0);
-  const double f2 = k.fx_px * k.fy_px;
-  const double area = params_.person_area_m2;
+  out->clear();
+  const std::optional<Eigen::Vector3d> centre = PixelToGround({k.cx_px, k.cy_px}, k, pose, ground_z_m);
+  double range_m = 0;
+  if (centre) {
+    const Eigen::Vector3d axis = pose.rotation * Eigen::Vector3d::UnitZ();
+    range_m = (*centre - pose.position_m).dot(axis);
+  } else {
+    // The optical axis misses the ground: scale from the height (the nearest ground is below).
+    range_m = pose.position_m.z() - ground_z_m;
+  }
+  if (!(range_m > 0.1)) return;
   DetectImpl(
-      bgr,
-      [&](const Eigen::Vector2d& px) {
-        const Eigen::Vector3d ray = PixelRay(px, k, pose);
-        const std::optional<Eigen::Vector3d> g = PixelToGround(px, k, pose, ground_z_m);
-        if (!g) return 0.0;  // no ground there: no person either
-        const double range = (*g - pose.position_m).norm();
-        // Projected area ~ A cos(incidence) / range^2 in steradians, times f^2 / cos^3(off-axis)
-        // for the pixel footprint of that solid angle.
-        const Eigen::Vector3d axis = pose.rotation * Eigen::Vector3d::UnitZ();
-        const double off_axis = std::max(0.05, ray.dot(axis));
-        return area * std::abs(ray.z()) * f2 / (range * range) / (off_axis * off_axis * off_axis);
-      },
-      out);
+      bgr, k.fx_px / range_m,
+      [&](const Eigen::Vector2d& px) { return PixelToGround(px, k, pose, ground_z_m).has_value(); }, out);
 }
 
-template <typename ExpectedAreaFn>
-void VictimDetector::DetectImpl(const cv::Mat& bgr, ExpectedAreaFn expected_area_px,
-                                std::vector<ImageBlob>* out) {
+template <typename KeepFn>
+void VictimDetector::DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn keep, std::vector<ImageBlob>* out) {
   SWARMBOX_CHECK(bgr.type() == CV_8UC3);
+  SWARMBOX_CHECK(pixels_per_m > 0);
   out->clear();
-  const VictimDetectorParams& k = params_;
-  mask_.create(bgr.size(), CV_8UC1);
-  for (int r = 0; r < bgr.rows; ++r) {
-    const auto* px = bgr.ptr<cv::Vec3b>(r);
-    auto* m = mask_.ptr<std::uint8_t>(r);
-    for (int c = 0; c < bgr.cols; ++c) {
-      const int b = px[c][0], g = px[c][1], red = px[c][2];
-      m[c] = (red >= k.min_red && red - b >= k.min_red_minus_blue && red - g >= k.min_red_minus_green)
-                 ? 255 : 0;
-    }
+  const double scale = kCanonicalPxPerM / pixels_per_m;
+  const std::vector<Candidate>& cands = Candidates(bgr, pixels_per_m, params_.max_candidates, model_->stage1_threshold);
+  if (cands.empty()) return;
+  const int n = static_cast<int>(cands.size());
+  samples_.resize(static_cast<std::size_t>(kForestFeatures));
+  const double expected_area = params_.person_area_m2 * pixels_per_m * pixels_per_m;
+  const double half_px = params_.partial_half_extent_m * pixels_per_m;
+  scratch_.clear();
+  for (int i = 0; i < n; ++i) {
+    const Candidate& c = cands[static_cast<std::size_t>(i)];
+    WindowFeatures(maps_, c.row, c.col, samples_.data());
+    samples_[static_cast<std::size_t>(kWindowFeatures)] = static_cast<float>(c.score);
+    ImageBlob b;
+    b.votes = model_->Votes(samples_.data());
+    b.confidence = model_->Probability(b.votes);
+    if (b.confidence < params_.min_confidence) continue;
+    b.linear_score = c.score;
+    b.centroid_px = {CanonicalToInput(kShrink * (c.sub_col + kWindowCells / 2.0), scale),
+                     CanonicalToInput(kShrink * (c.sub_row + kWindowCells / 2.0), scale)};
+    const double u = b.centroid_px.x(), v = b.centroid_px.y();
+    if (u < -0.5 || v < -0.5 || u > bgr.cols - 0.5 || v > bgr.rows - 0.5) continue;  // centre off the image
+    if (!keep(b.centroid_px)) continue;
+    b.expected_area_px = expected_area;
+    b.area_px = expected_area;
+    b.partial = u < half_px || v < half_px || u > bgr.cols - half_px || v > bgr.rows - half_px;
+    if (b.partial) b.confidence = std::min(b.confidence, params_.partial_confidence_cap);
+    scratch_.push_back(b);
   }
-  cv::morphologyEx(mask_, closed_, cv::MORPH_CLOSE, kernel_);
-  const int n = cv::connectedComponentsWithStats(closed_, labels_, stats_, centroids_, 8, CV_32S);
-  for (int i = 1; i < n; ++i) {
-    const int area = stats_.at<int>(i, cv::CC_STAT_AREA);
-    if (area < k.min_area_px) continue;
-    const int x = stats_.at<int>(i, cv::CC_STAT_LEFT), y = stats_.at<int>(i, cv::CC_STAT_TOP);
-    const int w = stats_.at<int>(i, cv::CC_STAT_WIDTH), h = stats_.at<int>(i, cv::CC_STAT_HEIGHT);
-    ImageBlob blob;
-    blob.centroid_px = {centroids_.at<double>(i, 0), centroids_.at<double>(i, 1)};
-    const double expected = expected_area_px(blob.centroid_px);
-    if (!(expected > 0)) continue;
-    blob.area_px = area;
-    blob.expected_area_px = expected;
-    blob.partial = x <= k.border_px || y <= k.border_px || x + w >= bgr.cols - k.border_px ||
-                   y + h >= bgr.rows - k.border_px;
-    const double ratio = area / expected;
-    if (ratio > k.max_area_ratio) continue;
-    if (!blob.partial && ratio < k.min_area_ratio) continue;
-    if (ratio < k.full_size_ratio) {
-      blob.size_score = blob.partial ? ratio / k.full_size_ratio
-                                     : (ratio - k.min_area_ratio) / (k.full_size_ratio - k.min_area_ratio);
-    } else if (ratio <= k.full_size_max_ratio) {
-      blob.size_score = 1.0;
-    } else {
-      blob.size_score = (k.max_area_ratio - ratio) / (k.max_area_ratio - k.full_size_max_ratio);
-    }
-    // Colour: mean R - B over the blob's thresholded pixels, scaled from the threshold to 200.
-    double sum_rb = 0;
-    int count = 0;
-    for (int r = y; r < y + h; ++r) {
-      const auto* px = bgr.ptr<cv::Vec3b>(r);
-      const auto* lab = labels_.ptr<int>(r);
-      const auto* m = mask_.ptr<std::uint8_t>(r);
-      for (int c = x; c < x + w; ++c) {
-        if (lab[c] != i || m[c] == 0) continue;
-        sum_rb += px[c][2] - px[c][0];
-        ++count;
-      }
-    }
-    const double mean_rb = count > 0 ? sum_rb / count : 0.0;
-    blob.colour_score = std::clamp((mean_rb - k.min_red_minus_blue) / (200.0 - k.min_red_minus_blue), 0.0, 1.0);
-    blob.confidence = 0.5 + 0.49 * std::clamp(blob.size_score, 0.0, 1.0) * blob.colour_score;
-    if (blob.partial) blob.confidence = std::min(blob.confidence, k.partial_confidence_cap);
-    out->push_back(blob);
+  // Non-maximum suppression, most confident first.
+  std::stable_sort(scratch_.begin(), scratch_.end(),
+                   [](const ImageBlob& a, const ImageBlob& b) { return a.confidence > b.confidence; });
+  const double r2 = std::pow(params_.nms_radius_m * pixels_per_m, 2);
+  for (const ImageBlob& b : scratch_) {
+    bool suppressed = false;
+    for (const ImageBlob& kept : *out) suppressed = suppressed || (kept.centroid_px - b.centroid_px).squaredNorm() < r2;
+    if (!suppressed) out->push_back(b);
   }
 }
 

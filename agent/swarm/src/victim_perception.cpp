@@ -30,6 +30,7 @@ int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& 
     d.confidence = b.confidence;
     d.pixel = b.centroid_px;
     d.area_px = b.area_px;
+    d.viewer_m = camera_pose.position_m;
     queue_.Push(d, capture_time_s);
     ++queued;
   }

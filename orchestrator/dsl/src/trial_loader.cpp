@@ -263,8 +263,8 @@ Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& optio
   std::string middleware = "cyclonedds";
   r.Required("name", &spec.name)
       .Optional("seed", &spec.seed)
-      .Optional("middleware", &middleware)
-      .Required("world", &spec.world);
+      .Optional("middleware", &middleware);
+  const Node* world = r.Child("world", /*required=*/true);
   const Node* world_size = r.Child("world_size_m");
   const Node* physics = r.Child("physics");
   const Node* drones = r.Child("drones", /*required=*/true);
@@ -285,6 +285,14 @@ Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& optio
   software.file_kind = options.file_kind;
   if (limits != nullptr && !limits->is_null()) SWARMBOX_TRY(DecodeLimits(*limits, &spec.limits));
 
+  if (world != nullptr && world->is_mapping()) {  // a generated world (worlds/generator.hpp)
+    auto generate = worlds::ParseGenerateSpec(*world);
+    if (!generate) return generate.error();
+    spec.world_generate = *generate;
+    spec.world = "worlds/generated_" + std::string(worlds::KindName(generate->kind)) + ".yaml";
+  } else if (world != nullptr) {
+    if (auto s = yaml::Decode(*world, &spec.world); !s) return s.error();
+  }
   if (world_size != nullptr && !world_size->is_null()) {
     const std::string what = "'world_size_m' must be [X, Y], the geofence's size in metres (both > 0)";
     if (!world_size->is_sequence() || world_size->items().size() != 2) return At(*world_size, what);
@@ -481,12 +489,14 @@ Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& optio
     }
     auto exists = options.file_exists ? options.file_exists : DefaultFileExists;
     const std::filesystem::path dir(spec.trials_dir);
-    if (std::filesystem::path(spec.world).is_absolute() || spec.world.find("..") != std::string::npos) {
-      return At(*doc.Find("world"), "'world' must be a path inside the trials directory, such as worlds/open_field.yaml");
-    }
-    const std::string world_path = (dir / spec.world).string();
-    if (!exists(world_path)) {
-      return At(*doc.Find("world"), "world '" + spec.world + "' not found (no file " + world_path + ")");
+    if (!spec.world_generate) {
+      if (std::filesystem::path(spec.world).is_absolute() || spec.world.find("..") != std::string::npos) {
+        return At(*doc.Find("world"), "'world' must be a path inside the trials directory, such as worlds/open_field.yaml");
+      }
+      const std::string world_path = (dir / spec.world).string();
+      if (!exists(world_path)) {
+        return At(*doc.Find("world"), "world '" + spec.world + "' not found (no file " + world_path + ")");
+      }
     }
     // A profile the file names is checked here, at its key; the default one (trials/radios/
     // wifi_5ghz_mesh.yaml, shipped) when the trial is planned (runner::CheckRadioProfile).

@@ -186,7 +186,7 @@ yaml::Node ToDocument(const TrialSpec& spec) {
   doc.Set("name", Str(spec.name));
   doc.Set("seed", Plain(std::to_string(spec.seed)));
   doc.Set("middleware", Str(MiddlewareName(spec.middleware)));
-  doc.Set("world", Str(spec.world));
+  doc.Set("world", spec.world_generate ? worlds::ToNode(*spec.world_generate) : Str(spec.world));
   if (spec.HasWorldSize()) {
     Node size = Node::Sequence();
     for (double v : spec.world_size_m) size.Append(Plain(Number(v)));

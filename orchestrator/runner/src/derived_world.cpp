@@ -1,9 +1,13 @@
 #include "swarmbox/runner/derived_world.hpp"
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/runner/plan.hpp"
+#include "swarmbox/worlds/generator.hpp"
 
 namespace swarmbox::runner {
 
@@ -58,6 +62,24 @@ Result<std::string> DeriveWorld(std::string_view world_text, std::string_view wo
   doc->Set("geofence", std::move(geofence));
   return "# " + std::string(world_file) + " with its geofence set to " + ShortestNumber(size_m[0]) + " x " + ShortestNumber(size_m[1]) +
          " m by the trial's world_size_m (written by the swarmbox runner)\n" + yaml::Emit(*doc);
+}
+
+Result<std::string> DerivedWorldText(const dsl::TrialSpec& spec, const std::string& trials_dir) {
+  if (spec.world_generate) {
+    worlds::GenerateSpec recipe = *spec.world_generate;
+    if (spec.HasWorldSize()) recipe.size_m = spec.world_size_m;
+    auto text = worlds::GenerateWorld(recipe, worlds::WorldSeed(recipe, spec.seed));
+    if (!text) return text.error().Context("generating the world");
+    return text;
+  }
+  const std::string source = (std::filesystem::path(trials_dir) / spec.world).string();
+  std::ifstream in(source, std::ios::binary);
+  if (!in) return Error(ErrorCode::kNotFound, "cannot read the world file", source);
+  std::ostringstream text;
+  text << in.rdbuf();
+  auto derived = DeriveWorld(text.str(), source, spec.world_size_m);
+  if (!derived) return derived.error().Context("world_size_m");
+  return derived;
 }
 
 }  // namespace swarmbox::runner

@@ -377,6 +377,9 @@ dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
 Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
                                               const PlanOptions& options) {
   if (options.run_id.empty()) return Error(ErrorCode::kInvalidArgument, "PlanTrial: no run id");
+  if (spec.world_generate && options.world_path.empty()) {
+    return Error(ErrorCode::kInvalidArgument, "PlanTrial: a generated world needs PlanOptions::world_path (DerivedWorldText)");
+  }
   if (options.images.physics.empty() || options.images.agent.empty()) {
     return Error(ErrorCode::kInvalidArgument, "PlanTrial: images for physics and agent are needed");
   }
@@ -446,7 +449,7 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   auto input = [&](const std::string& relative) {
     return dsl::InputFile{host_file(relative), InContainer(relative)};
   };
-  // The world every container reads: the trial's, or the one derived from it (world_size_m).
+  // The world every container reads: the trial's, or the derived one (world_size_m, generated).
   const dsl::InputFile world_input = options.world_path.empty()
                                          ? input(spec.world)
                                          : dsl::InputFile{options.world_path, InContainer(spec.world)};

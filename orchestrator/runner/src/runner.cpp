@@ -470,7 +470,7 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
     std::ostringstream csv;
     csv << in.rdbuf();
     auto tracks = ParseTruthCsv(csv.str());
-    const bool derived = info.files.count(std::string(kDerivedWorldFile)) > 0;  // world_size_m
+    const bool derived = info.files.count(std::string(kDerivedWorldFile)) > 0;  // world_size_m, generated
     const std::string world_file = derived ? (dir / kDerivedWorldFile).string() : info.world_file;
     auto world = world_file.empty() ? Result<WorldPicture>(WorldPicture{}) : LoadWorldPicture(world_file);
     if (!tracks) {
@@ -517,13 +517,9 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
   info.rtf = spec.rtf;
   info.resolved_yaml = yaml::Emit(spec.document.is_null() ? dsl::ToDocument(spec) : spec.document);
   info.world_file = (fs::path(trials_dir) / spec.world).string();
-  if (spec.HasWorldSize()) {  // the world every container reads, written into the trial folder
-    std::ifstream in(info.world_file, std::ios::binary);
-    if (!in) return Error(ErrorCode::kNotFound, "cannot read the world file", info.world_file);
-    std::ostringstream text;
-    text << in.rdbuf();
-    auto derived = DeriveWorld(text.str(), info.world_file, spec.world_size_m);
-    if (!derived) return derived.error().Context("world_size_m");
+  if (spec.HasDerivedWorld()) {  // the world every container reads, written into the trial folder
+    auto derived = DerivedWorldText(spec, trials_dir);
+    if (!derived) return derived.error();
     info.files[std::string(kDerivedWorldFile)] = std::move(*derived);
   }
   if (auto payloads = LoadPayloadMasses(spec, trials_dir); !payloads) {
@@ -578,7 +574,7 @@ Result<RunOutcome> RunTrialSpec(const dsl::TrialSpec& spec, docker::DockerApi& a
       p.radio_plan_path =
           (fs::absolute(options.out_dir) / TrialDirName(spec.name, run_id) / kRadioPlanFile).lexically_normal().string();
     }
-    if (spec.HasWorldSize()) {  // RunTrial wrote it (info.files) into the trial folder
+    if (spec.HasDerivedWorld()) {  // RunTrial wrote it (info.files) into the trial folder
       p.world_path =
           (fs::absolute(options.out_dir) / TrialDirName(spec.name, run_id) / kDerivedWorldFile).lexically_normal().string();
     }

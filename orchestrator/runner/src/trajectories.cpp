@@ -105,9 +105,10 @@ Result<WorldPicture> LoadWorldPicture(const std::string& path) {
           c->items().size() < 2 || s->items().size() < 2) {
         return Error(ErrorCode::kInvalidArgument, "obstacle without center_m/size_m", o.Where());
       }
+      const yaml::Node* kind = o.Find("kind");
       w.obstacles.push_back({num(&c->items()[0], 0), num(&c->items()[1], 0),
                              num(&s->items()[0], 1), num(&s->items()[1], 1),
-                             num(o.Find("yaw_deg"), 0)});
+                             num(o.Find("yaw_deg"), 0), kind != nullptr && kind->is_scalar() && kind->scalar() == "tree"});
     }
   }
   if (const yaml::Node* vs = doc->Find("victims"); vs != nullptr && vs->is_sequence()) {
@@ -148,6 +149,11 @@ Status DrawTrajectories(
   cv::rectangle(img, px(-world.size_x_m / 2, world.size_y_m / 2),
                 px(world.size_x_m / 2, -world.size_y_m / 2), cv::Scalar(90, 90, 90), 2);
   for (const auto& o : world.obstacles) {
+    if (o.tree) {
+      cv::circle(img, px(o.x_m, o.y_m), std::max(1, static_cast<int>(std::min(o.sx_m, o.sy_m) / 2 * scale)),
+                 cv::Scalar(80, 150, 90), cv::FILLED, cv::LINE_AA);
+      continue;
+    }
     cv::RotatedRect r(cv::Point2f(static_cast<float>((o.x_m + half) * scale),
                                   static_cast<float>((half - o.y_m) * scale)),
                       cv::Size2f(static_cast<float>(o.sx_m * scale), static_cast<float>(o.sy_m * scale)),

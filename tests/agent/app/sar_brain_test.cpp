@@ -96,6 +96,26 @@ TEST(SarBrainConfigFrom, ReadsTheAirframeWorldPayloadStartAndTuningFromTheContex
   EXPECT_DOUBLE_EQ(c->period_s, 0.004);
 }
 
+// The sightings' fusion parameters are args too; values that would let one view confirm (or a
+// miss not count) are refused at start-up with the reason.
+TEST(SarBrainConfigFrom, ReadsTheFusionArgsAndRefusesOnesWhereOneViewWouldConfirm) {
+  brain::Context ctx = LifterContext();
+  ctx.args["fusion_min_baseline_m"] = "12";
+  ctx.args["fusion_confirm_views"] = "3";
+  ctx.args["revisit_look_s"] = "3";
+  auto c = SarBrainConfigFrom(ctx);
+  ASSERT_TRUE(c.ok()) << c.error().ToString();
+  EXPECT_DOUBLE_EQ(c->tuning.fusion.min_baseline_m, 12.0);
+  EXPECT_EQ(c->tuning.fusion.confirm_views, 3);
+  EXPECT_DOUBLE_EQ(c->tuning.revisit_look_s, 3.0);
+  EXPECT_DOUBLE_EQ(c->tuning.fusion.prior, 0.5);  // untouched
+  ctx.args["fusion_confirm_views"] = "1";
+  c = SarBrainConfigFrom(ctx);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().ToString().find("confirm_views must be >= 2: a single view never confirms"), std::string::npos)
+      << c.error().ToString();
+}
+
 TEST(SarBrainConfigFrom, NamesTheBadArgOrPayload) {
   brain::Context ctx = LifterContext();
   ctx.args["member_timeout_s"] = "six";

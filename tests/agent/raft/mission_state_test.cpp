@@ -1,4 +1,4 @@
-// The replicated mission state machine: phases, confirmation rule, determinism, snapshots.
+// The replicated mission state machine: phases, candidates and decisions, determinism, snapshots.
 #include "swarmbox/raft/mission_state.hpp"
 
 #include <gtest/gtest.h>
@@ -26,7 +26,11 @@ TEST_F(MissionStateTest, FullMissionWalksThroughEveryPhase) {
                   .accepted);
   ASSERT_NE(m_.SectorOf("scout_2"), nullptr);
   EXPECT_EQ(m_.SectorOf("scout_2")->x_min_m, 50);
-  r = Do(ReportSighting{"scout_1", 1, 40, 60, 0.95});
+  r = Do(ReportSighting{"scout_1", 1, 40, 60, 0.95, 40, 50, 30, 20});
+  ASSERT_TRUE(r.accepted);
+  EXPECT_TRUE(r.events.empty());  // one view: a candidate, not a victim
+  ASSERT_EQ(m_.candidates().size(), 1u);
+  r = Do(ConfirmSighting{1, 0.99});  // the leader's decision, once a second view came
   ASSERT_TRUE(r.accepted);
   ASSERT_EQ(r.events.size(), 1u);
   EXPECT_EQ(r.events[0].kind, MissionEvent::Kind::kVictimConfirmed);
@@ -43,7 +47,7 @@ TEST_F(MissionStateTest, FullMissionWalksThroughEveryPhase) {
   ASSERT_TRUE(Do(ReturnHome{}).accepted);
   ASSERT_TRUE(Do(CompleteMission{}).accepted);
   EXPECT_EQ(m_.phase(), MissionPhase::kComplete);
-  EXPECT_EQ(m_.applied_index(), 8u);
+  EXPECT_EQ(m_.applied_index(), 9u);
 }
 
 TEST_F(MissionStateTest, InvalidTransitionsAreRejectedWithReason) {
@@ -61,28 +65,90 @@ TEST_F(MissionStateTest, InvalidTransitionsAreRejectedWithReason) {
   EXPECT_EQ(m_.phase(), MissionPhase::kSearch);
 }
 
-TEST_F(MissionStateTest, TwoIndependentSightingsConfirmAtTheirMean) {
+TEST_F(MissionStateTest, SightingsGatherIntoCandidatesAndNoneConfirmsByItself) {
   Do(StartSearch{});
-  ApplyResult r = Do(ReportSighting{"scout_1", 1, 10, 20, 0.6});
+  // However confident, a sighting opens a candidate; it never makes a victim by itself.
+  ApplyResult r = Do(ReportSighting{"scout_1", 1, 10, 20, 0.99, 10, 5, 30, 40.0});
+  EXPECT_TRUE(r.accepted);
   EXPECT_TRUE(r.events.empty());
-  // The same drone again does not confirm its own sighting.
-  r = Do(ReportSighting{"scout_1", 2, 11, 20, 0.6});
-  EXPECT_TRUE(r.events.empty());
-  // Another drone more than 5 m away does not either.
-  r = Do(ReportSighting{"scout_2", 1, 30, 20, 0.6});
-  EXPECT_TRUE(r.events.empty());
-  r = Do(ReportSighting{"scout_2", 2, 14, 20, 0.7});
+  EXPECT_TRUE(m_.victims().empty());
+  // Within 5 m: a second view of the same candidate (any drone); beyond: another candidate.
+  EXPECT_TRUE(Do(ReportSighting{"scout_2", 1, 14, 20, 0.7, 14, 35, 30, 41.0}).events.empty());
+  EXPECT_TRUE(Do(ReportSighting{"scout_2", 2, 30, 20, 0.6, 30, 5, 30, 42.0}).events.empty());
+  ASSERT_EQ(m_.candidates().size(), 2u);
+  const Candidate& c = m_.candidates()[0];
+  EXPECT_EQ(c.id, 1u);
+  EXPECT_EQ(c.status, CandidateStatus::kPending);
+  ASSERT_EQ(c.views.size(), 2u);
+  EXPECT_EQ(c.views[1].reporter, "scout_2");
+  EXPECT_DOUBLE_EQ(c.views[1].viewer_y_m, 35);
+  EXPECT_DOUBLE_EQ(c.views[1].t_s, 41.0);
+  // The position is the confidence-weighted mean of the detections.
+  EXPECT_DOUBLE_EQ(c.x_m, (0.99 * 10 + 0.7 * 14) / (0.99 + 0.7));
+  // The leader's decision makes the victim, confirmed by every drone that saw it.
+  r = Do(ConfirmSighting{1, 0.98});
   ASSERT_EQ(r.events.size(), 1u);
   EXPECT_EQ(r.events[0].kind, MissionEvent::Kind::kVictimConfirmed);
-  // Nearest pending from another drone: (11, 20) -> mean (12.5, 20).
-  EXPECT_DOUBLE_EQ(r.events[0].victim.x_m, 12.5);
-  EXPECT_DOUBLE_EQ(r.events[0].victim.y_m, 20);
   EXPECT_EQ(r.events[0].victim.confirmed_by, (std::vector<std::string>{"scout_1", "scout_2"}));
-  // A third sighting nearby is the same victim.
+  EXPECT_EQ(m_.FindCandidate(1)->status, CandidateStatus::kConfirmed);
+  EXPECT_EQ(m_.FindCandidate(1)->victim_id, 1u);
+  EXPECT_DOUBLE_EQ(m_.FindCandidate(1)->belief, 0.98);
+  EXPECT_EQ(Do(ConfirmSighting{1, 0.98}).reason, "no undecided candidate 1");
+  // A later sighting there is the victim, not a new candidate.
   r = Do(ReportSighting{"scout_3", 1, 13, 21, 0.99});
   EXPECT_TRUE(r.events.empty());
-  EXPECT_EQ(m_.victims().size(), 1u);
+  EXPECT_EQ(m_.candidates().size(), 2u);
   EXPECT_EQ(m_.victims()[0].confirmed_by.size(), 3u);
+}
+
+TEST_F(MissionStateTest, ARevisitIsDoneByItsDronesMissAndARejectedCandidateKeepsItsEvidence) {
+  Do(StartSearch{});
+  Do(ReportSighting{"scout_1", 1, 10, 20, 0.9, 10, 10, 30, 5.0});
+  EXPECT_EQ(Do(RequestRevisit{7, "scout_2", 20}).reason, "no pending candidate 7");
+  ASSERT_TRUE(Do(RequestRevisit{1, "scout_2", 20}).accepted);
+  EXPECT_EQ(m_.FindCandidate(1)->revisit_drone, "scout_2");
+  // Another drone's view does not complete scout_2's revisit; scout_2's miss does.
+  Do(ReportSighting{"scout_3", 1, 11, 20, 0.6, 11, 30, 30, 21.0});
+  EXPECT_EQ(m_.FindCandidate(1)->revisit_drone, "scout_2");
+  ASSERT_TRUE(Do(ReportMiss{"scout_2", 1, 1, 10.5, 20, 30, 30.0}).accepted);
+  const Candidate* c = m_.FindCandidate(1);
+  EXPECT_TRUE(c->revisit_drone.empty());
+  EXPECT_EQ(c->revisits, 1u);
+  ASSERT_EQ(c->views.size(), 3u);
+  EXPECT_FALSE(c->views[2].detected);
+  EXPECT_DOUBLE_EQ(c->views[2].viewer_height_m, 30);
+  // Misses share the reporter's seq with its sightings.
+  EXPECT_EQ(Do(ReportMiss{"scout_2", 1, 1, 10.5, 20, 30, 31.0}).reason,
+            "duplicate or out-of-order sighting seq 1 from scout_2");
+  EXPECT_EQ(Do(ReportMiss{"scout_2", 2, 9, 10.5, 20, 30, 31.0}).reason, "no undecided candidate 9");
+  ASSERT_TRUE(Do(RejectSighting{1, 0.1}).accepted);
+  EXPECT_EQ(m_.FindCandidate(1)->status, CandidateStatus::kRejected);
+  EXPECT_EQ(Do(RejectSighting{1, 0.1}).reason, "no pending candidate 1");
+  // Rejected is not forgotten: new views still join it, and enough of them may confirm it.
+  Do(ReportSighting{"scout_4", 1, 10, 21, 0.95, 30, 21, 30, 90.0});
+  EXPECT_EQ(m_.FindCandidate(1)->views.size(), 4u);
+  EXPECT_EQ(m_.candidates().size(), 1u);
+  ASSERT_TRUE(Do(ConfirmSighting{1, 0.96}).accepted);
+  EXPECT_EQ(m_.victims().size(), 1u);
+}
+
+TEST_F(MissionStateTest, CandidatesAndTheirViewsAreBounded) {
+  Do(StartSearch{});
+  std::uint64_t seq = 0;
+  for (std::size_t k = 0; k < MissionState::kMaxViews; ++k) {
+    ASSERT_TRUE(Do(ReportSighting{"a", ++seq, 0, 0, 0.6}).accepted);
+  }
+  EXPECT_EQ(Do(ReportSighting{"a", ++seq, 0, 0, 0.6}).reason, "candidate 1 holds 24 views");
+  Do(RejectSighting{1, 0.1});
+  for (std::size_t k = 1; k < MissionState::kMaxCandidates; ++k) {
+    ASSERT_TRUE(Do(ReportSighting{"a", ++seq, 20.0 * static_cast<double>(k), 0, 0.6}).accepted);
+  }
+  ASSERT_EQ(m_.candidates().size(), MissionState::kMaxCandidates);
+  // Full: the oldest decided one (the rejected candidate 1) makes room.
+  ASSERT_TRUE(Do(ReportSighting{"a", ++seq, -50, -50, 0.6}).accepted);
+  EXPECT_EQ(m_.candidates().size(), MissionState::kMaxCandidates);
+  EXPECT_EQ(m_.FindCandidate(1), nullptr);
+  EXPECT_NE(m_.FindCandidate(MissionState::kMaxCandidates + 1), nullptr);
 }
 
 TEST_F(MissionStateTest, LowConfidenceAndDuplicateSightingsAreRejected) {
@@ -99,8 +165,13 @@ TEST_F(MissionStateTest, LowConfidenceAndDuplicateSightingsAreRejected) {
 TEST_F(MissionStateTest, SnapshotRoundTripsEveryField) {
   Do(StartSearch{});
   Do(AssignSectors{{Sector{"a", 0, 0, 1, 1}}});
-  Do(ReportSighting{"a", 1, 5, 5, 0.6});
-  Do(ReportSighting{"b", 4, 100, 5, 0.95});
+  Do(ReportSighting{"a", 1, 5, 5, 0.6, 5, 1, 30, 3.5});
+  Do(ReportSighting{"b", 4, 100, 5, 0.95, 90, 5, 28, 4.5});
+  Do(ReportSighting{"c", 2, 101, 5, 0.9, 110, 5, 31, 9});
+  Do(RequestRevisit{1, "c", 10});
+  Do(ReportMiss{"c", 3, 1, 5, 5, 30, 12});
+  Do(RejectSighting{1, 0.15});
+  Do(ConfirmSighting{2, 0.99});
   Do(ConvergeOn{1});
   Do(BeginRescue{1, "lifter"});
   auto back = MissionState::DecodeSnapshot(m_.EncodeSnapshot());
@@ -108,7 +179,7 @@ TEST_F(MissionStateTest, SnapshotRoundTripsEveryField) {
   EXPECT_EQ(*back, m_);
   // The restored state goes on exactly like the original.
   MissionState copy = *back;
-  EXPECT_EQ(copy.Apply(7, MarkRescued{1}).accepted, m_.Apply(7, MarkRescued{1}).accepted);
+  EXPECT_EQ(copy.Apply(12, MarkRescued{1}).accepted, m_.Apply(12, MarkRescued{1}).accepted);
   EXPECT_EQ(copy, m_);
 }
 
@@ -131,7 +202,7 @@ TEST_F(MissionStateTest, CorruptSnapshotIsAnErrorNotACrash) {
 }
 
 TEST_F(MissionStateTest, UndecodableCommandIsRejectedDeterministically) {
-  const Bytes junk{1, 200, 3};
+  const Bytes junk{kCommandVersion, 200, 3};
   ApplyResult r = m_.ApplyEncoded(1, junk);
   EXPECT_FALSE(r.accepted);
   EXPECT_EQ(r.reason, "undecodable command: unknown command kind 200");
@@ -141,8 +212,10 @@ TEST_F(MissionStateTest, UndecodableCommandIsRejectedDeterministically) {
 TEST(MissionCommand, EveryCommandRoundTrips) {
   const std::vector<MissionCommand> all = {
       StartSearch{}, AssignSectors{{Sector{"x", -1, -2, 3, 4}}},
-      ReportSighting{"s", 9, 1.25, -3.5, 0.75}, ConfirmVictim{"ground", 7, 8}, ConvergeOn{3},
-      BeginRescue{3, "lifter"}, MarkRescued{3}, ReturnHome{}, CompleteMission{}};
+      ReportSighting{"s", 9, 1.25, -3.5, 0.75, 2, -1, 29.5, 61.25}, ConfirmVictim{"ground", 7, 8}, ConvergeOn{3},
+      BeginRescue{3, "lifter"}, MarkRescued{3}, ReturnHome{}, CompleteMission{},
+      ReportMiss{"s", 10, 4, 1, 2, 30, 70.5}, RequestRevisit{4, "scout_9", 65.0}, ConfirmSighting{4, 0.97},
+      RejectSighting{5, 0.12}};
   for (const MissionCommand& c : all) {
     auto back = DecodeCommand(EncodeCommand(c));
     ASSERT_TRUE(back.ok()) << CommandName(c) << ": " << back.error().ToString();
@@ -156,8 +229,14 @@ TEST(MissionCommand, SameLogSameStateOnEveryReplica) {
   MissionState a, b;
   for (std::uint64_t i = 1; i <= 2000; ++i) {
     MissionCommand c;
-    switch (rng() % 6) {
+    switch (rng() % 9) {
       case 0: c = StartSearch{}; break;
+      case 6: c = ConfirmSighting{static_cast<std::uint32_t>(1 + rng() % 8), 0.97}; break;
+      case 7: c = RejectSighting{static_cast<std::uint32_t>(1 + rng() % 8), 0.1}; break;
+      case 8:
+        c = ReportMiss{"d" + std::to_string(rng() % 3), i, static_cast<std::uint32_t>(1 + rng() % 8), 0, 0, 30,
+                       static_cast<double>(i)};
+        break;
       case 1: c = ConvergeOn{static_cast<std::uint32_t>(1 + rng() % 4)}; break;
       case 2: c = BeginRescue{static_cast<std::uint32_t>(1 + rng() % 4), "lifter"}; break;
       case 3: c = MarkRescued{static_cast<std::uint32_t>(1 + rng() % 4)}; break;

@@ -138,7 +138,8 @@ TEST_F(DriverCluster, ElectsLeaderAndEveryDronePrintsContractEvents) {
   // A follower's proposal is forwarded to the leader and committed everywhere.
   ASSERT_TRUE(drivers_["scout_2"]->Propose(StartSearch{}).ok());
   Pump();
-  ASSERT_TRUE(drivers_["scout_1"]->Propose(ReportSighting{"scout_1", 1, 41.5, -12, 0.95}).ok());
+  // (An operator's word: since #19 one sighting never confirms a victim on its own.)
+  ASSERT_TRUE(drivers_["scout_1"]->Propose(ConfirmVictim{"scout_1", 41.5, -12}).ok());
   Pump();
   TickAll(2);  // commit index reaches the followers
   for (const auto& n : names_) {
@@ -409,7 +410,7 @@ TEST(NodeDriver, SingleDroneRestartsFromWalOnDisk) {
       ASSERT_TRUE((*d)->Propose(ReportSighting{"solo", s, 7.0 * static_cast<double>(s), 1, 0.9}).ok());
     }
     before = (*d)->mission();
-    EXPECT_EQ(before.victims().size(), 9u);
+    EXPECT_EQ(before.candidates().size(), 9u);  // 7 m apart: nine places, none confirmed by one view
   }
   {
     auto wal = WalStorage::Open(fs, tmpl);

@@ -56,7 +56,7 @@ TEST(RaftScenario, LeaderCrashFailsOverAndOldLeaderRejoins) {
   ASSERT_GE(new_leader, 0);
   EXPECT_NE(new_leader, old_leader);
   EXPECT_LT(sim.now_s() - t0, 2.0);
-  ASSERT_TRUE(sim.Propose(new_leader, ReportSighting{"n9", 1, 3, 4, 0.95}).ok());
+  ASSERT_TRUE(sim.Propose(new_leader, ConfirmVictim{"n9", 3, 4}).ok());
   sim.RunFor(1);
   EXPECT_EQ(sim.driver(new_leader)->mission().victims().size(), 1u);
   sim.Restart(old_leader);

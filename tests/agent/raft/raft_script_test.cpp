@@ -172,7 +172,8 @@ class ScriptRunner {
       } else if (what == "return_home") {
         cmd = ReturnHome{};
       } else {
-        cmd = ReportSighting{sim_->Name(n), ++seq_, 10.0 * static_cast<double>(seq_), 0, 0.95};
+        // A victim per proposal: an operator's word (one sighting no longer confirms, #19).
+        cmd = ConfirmVictim{sim_->Name(n), 10.0 * static_cast<double>(++seq_), 0};
       }
       Status s = sim_->Propose(n, cmd);
       return s.ok() ? "ok\n" : "error: " + s.error().message() + "\n";

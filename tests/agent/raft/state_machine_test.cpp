@@ -111,7 +111,7 @@ TEST(MissionStateMachine, PrintsTheMissionEventLinesOfTheLogContract) {
   m.Apply(1, {}, out.At(1.0, "scout_1"));  // no-op: advances, prints nothing
   EXPECT_EQ(m.mission().applied_index(), 1u);
   m.Apply(2, EncodeCommand(StartSearch{}), out.At(1.5, "scout_1"));
-  m.Apply(3, EncodeCommand(ReportSighting{"scout_2", 1, 41.5, -12, 0.95}), out.At(2.25, "scout_1"));
+  m.Apply(3, EncodeCommand(ConfirmVictim{"scout_2", 41.5, -12}), out.At(2.25, "scout_1"));
   m.Apply(4, EncodeCommand(ConvergeOn{1}), out.At(3, "scout_1"));
   m.Apply(5, EncodeCommand(BeginRescue{1, "lifter"}), out.At(4, "scout_1"));
   m.Apply(6, EncodeCommand(MarkRescued{1}), out.At(5, "scout_1"));

@@ -195,9 +195,11 @@ TEST_F(FailoverTest, ANewLeaderRebuildsFromTheCommittedStateAndTakesOverTheLeade
   old_leader.Step(20.0, m.state, Roster("searching", "searching", "searching", 7.0), &out);
   m.Apply(Get<raft::AssignSectors>(out));
   next.Track(20.3, m.state);
-  // A victim confirmed (two sightings committed), then the old leader is killed before ConvergeOn.
-  m.Apply(raft::ReportSighting{"scout_1", 1, 40, 40, 0.7});
-  m.Apply(raft::ReportSighting{"scout_2", 1, 41, 40, 0.7});
+  // A victim confirmed (two sightings and the decision committed), then the old leader is killed
+  // before ConvergeOn.
+  m.Apply(raft::ReportSighting{"scout_1", 1, 40, 40, 0.9, 30, 40, 30, 25});
+  m.Apply(raft::ReportSighting{"scout_2", 1, 41, 40, 0.9, 50, 40, 30, 26});
+  m.Apply(raft::ConfirmSighting{1, 0.99});
   ASSERT_EQ(m.state.victims().size(), 1u);
   next.Track(30.0, m.state);
   out.Clear();
@@ -505,7 +507,7 @@ TEST(ScoutReports, ReproposesAReportUntilTheCommittedStateShowsIt) {
   EXPECT_EQ(Get<raft::ReportSighting>(out).seq, 2u);
   EXPECT_DOUBLE_EQ(Get<raft::ReportSighting>(out).x_m, 20.0);
   EXPECT_TRUE(HasEvent(out, "sighting_reported", "retry=1"));
-  m.Apply(Get<raft::ReportSighting>(out));  // committed (pending: one drone, below 0.9)
+  m.Apply(Get<raft::ReportSighting>(out));  // committed (a candidate: one view)
   s.Step(Input(20.0, m, {10, 10, 30}), &out);
   EXPECT_TRUE(out.proposals.empty());
   // Never committed: report_tries proposals in all, then it is given up.

@@ -134,35 +134,45 @@ TEST(ScoutBehaviour, ReportsASightingOnceAndNothingNearAKnownVictim) {
   EXPECT_TRUE(out.proposals.empty());
 }
 
-TEST(ScoutBehaviour, ReportsAHighConfidenceViewWithinTheCooldownOfAPartialOne) {
-  // A victim entering the image at its edge is a partial view (confidence capped below
-  // kHighConfidence); the full view a moment later must still go out: it confirms on its own.
+TEST(ScoutBehaviour, ReportsASecondViewOnceItMovedABaselineFromItsLastReport) {
+  // One pass over a spot: a view every report_baseline_m of flight while it is in the footprint
+  // (the second view the fusion needs), nothing in between, each with where it was seen from.
   Mission m;
   m.Apply(raft::AssignSectors{{kSector}});
   m.Apply(raft::StartSearch{});
-  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .report_cooldown_s = 10.0});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 1.0), .report_cooldown_s = 10.0,
+                    .report_baseline_m = 10.0});
   MissionOutput out;
-  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
-  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  s.Step(Input(0.0, m, {0, 0, 1.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 31}), &out);
   GroundDetection d;
   d.position_m = {20, 30, 0};
   d.confidence = 0.75;
+  d.capture_time_s = 1.96;
+  d.viewer_m = {0, 20, 31};
   std::vector<GroundDetection> dets = {d};
-  MissionInput in = Input(2.0, m, {0, 0, 30});
+  MissionInput in = Input(2.0, m, {0, 20, 31});
   in.detections = dets;
   s.Step(in, &out);
   ASSERT_EQ(out.proposals.size(), 1u);
-  dets[0].confidence = 0.8;  // still partial: silent within the cooldown
-  in.t_s = 2.2;
+  const auto& first = std::get<raft::ReportSighting>(out.proposals[0]);
+  EXPECT_DOUBLE_EQ(first.viewer_y_m, 20);
+  EXPECT_DOUBLE_EQ(first.viewer_height_m, 30);  // above the home's ground
+  EXPECT_DOUBLE_EQ(first.t_s, 1.96);
+  dets[0].viewer_m = {0, 26, 31};  // 6 m on: the same view, silent
+  dets[0].confidence = 0.97;
+  in.t_s = 2.9;
   s.Step(in, &out);
   EXPECT_TRUE(out.proposals.empty());
-  dets[0].confidence = 0.97;  // the full view
+  dets[0].viewer_m = {0, 30.5, 31};  // 10.5 m from the first: a second view
   dets[0].position_m = {20.5, 30.2, 0};
-  in.t_s = 2.4;
+  in.t_s = 3.5;
   s.Step(in, &out);
   ASSERT_EQ(out.proposals.size(), 1u);
   EXPECT_DOUBLE_EQ(std::get<raft::ReportSighting>(out.proposals[0]).confidence, 0.97);
-  in.t_s = 2.6;  // once a high-confidence report went out: silent again
+  EXPECT_DOUBLE_EQ(std::get<raft::ReportSighting>(out.proposals[0]).viewer_y_m, 30.5);
+  dets[0].viewer_m = {0, 36, 31};  // within the baseline of the second: silent again
+  in.t_s = 4.2;
   s.Step(in, &out);
   EXPECT_TRUE(out.proposals.empty());
 }

@@ -23,7 +23,7 @@ std::string EventLine(const raft::MissionEvent& e, double t_s) {
 }  // namespace
 
 MissionSim::MissionSim(MissionSimConfig config)
-    : config_(std::move(config)), rng_(config_.seed) {
+    : config_(std::move(config)), rng_(config_.seed), false_alarm_fired_(config_.false_alarms_m.size(), false) {
   for (const SimDrone& d : config_.drones) {
     planners_.emplace_back(LeaderConfig{.name = d.name, .search_area = config_.area, .retry_s = 2.0,
                                         .start_timeout_s = 60.0, .handle_time_s = 20.0});
@@ -57,6 +57,7 @@ MissionSim::MissionSim(MissionSimConfig config)
         c.keep_searching_during_rescue = true;
         c.return_when_swept = true;
         c.approach_height_m = 5.0;
+        c.home_approach_m = 3.0;
         c.return_layer = TakeoffWave(d.home_m.head<2>(), 4.0);
       }
       behaviour_of_.push_back(static_cast<int>(scouts_.size()));
@@ -141,18 +142,31 @@ void MissionSim::Step() {
     const double height = pos_[i].z() - d.home_m.z();
     if (!camera || d.role != Role::kScout || height < 5.0) continue;
     const CameraFootprint fp = GroundFootprint(height, 1.2, 320, 240);
-    for (const Vec2& v : config_.victims_m) {
+    const auto in_view = [&](const Vec2& v) {
       const Vec2 w = v - pos_[i].head<2>();
       const double c = std::cos(yaw_[i]), s = std::sin(yaw_[i]);
       const Vec2 b(c * w.x() + s * w.y(), -s * w.x() + c * w.y());  // body x forward, y left
-      if (std::abs(b.x()) > 0.45 * fp.along_m || std::abs(b.y()) > 0.45 * fp.across_m) continue;
+      return std::abs(b.x()) <= 0.45 * fp.along_m && std::abs(b.y()) <= 0.45 * fp.across_m;
+    };
+    const auto detect = [&](const Vec2& v, double confidence) {
       GroundDetection g;
       g.capture_time_s = t_s_;
       g.visible_time_s = t_s_ + 0.04;
       g.position_m = Vec3(v.x() + noise(rng_), v.y() + noise(rng_), 0.0);
       g.sigma_m = config_.detection_sigma_m;
-      g.confidence = 0.95;
+      g.confidence = confidence;
+      g.viewer_m = pos_[i];
       detections_[i].push_back(g);
+    };
+    for (const Vec2& v : config_.victims_m) {
+      if (!in_view(v)) continue;
+      if (config_.recall < 1.0 && std::uniform_real_distribution<double>(0.0, 1.0)(rng_) >= config_.recall) continue;
+      detect(v, config_.victim_confidence);
+    }
+    for (std::size_t k = 0; k < config_.false_alarms_m.size(); ++k) {
+      if (false_alarm_fired_[k] || !in_view(config_.false_alarms_m[k])) continue;
+      false_alarm_fired_[k] = true;
+      detect(config_.false_alarms_m[k], config_.false_alarm_confidence);
     }
   }
   // Behaviours.

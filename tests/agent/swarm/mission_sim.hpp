@@ -45,6 +45,13 @@ struct MissionSimConfig {
   std::vector<SimDrone> drones;
   std::vector<Vec2> victims_m;
   double detection_sigma_m = 0.5;  // fake camera geolocation noise [m]
+  double victim_confidence = 0.95;  // of every detection of a victim
+  // Chance that a frame with a victim in the footprint detects it (seeded): < 1 makes misses.
+  double recall = 1.0;
+  // False alarms: places where the fake camera reports a victim once (the first frame any scout
+  // has one in its footprint, at false_alarm_confidence) and never again: a revisit sees nothing.
+  std::vector<Vec2> false_alarms_m;
+  double false_alarm_confidence = 0.9;
   double loading_time_s = 10.0;
   double battery_fraction_at_start = 1.0;
   double battery_drain_per_s = 0.0;  // fraction per second (crude: tests of battery_low)
@@ -124,6 +131,7 @@ class MissionSim {
   std::vector<std::string_view> modes_;
   std::vector<MissionOutput> out_;
   std::vector<std::vector<GroundDetection>> detections_;
+  std::vector<bool> false_alarm_fired_;
   std::vector<NeighbourState> scratch_;
   Vec2 stretcher_xy_ = Vec2::Zero();
   bool attached_ = false;

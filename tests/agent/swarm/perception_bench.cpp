@@ -1,13 +1,23 @@
-// swarmbox-bench perception: the perception acceptance figures on physics-rendered scenes, one
-// logfmt line per scenario: precision, recall, geolocation error (median, p90) and time per frame.
+// swarmbox-bench perception [--seed N] [--scenes K] [--quick]: the detector's figures on
+// physics-rendered scenes of seed N (never a training seed of the shipped model: refused), in the
+// varied look (perception_scenes.hpp: terrains, light, poses, clothing, cover, distractors), one
+// logfmt line per case:
+//   case=altitude     altitude_m=10|20|30|40|60 (30 % of the people partly covered, 2 distractors each)
+//   case=occlusion    occluded_fraction=0|0.5|1 at 30 m (share of the people under 20-80 % cover)
+//   case=distractors  distractors=0|2|6 per person at 30 m
+// with persons (at least half visible), tp, fp, precision and recall at confidence 0.5, ap (VOC,
+// all detections) and ms_per_frame (Detect() on one core: cv::setNumThreads(1)); then the pipeline
+// scenarios (latency queue, geolocation with estimated poses, tilted cameras) as before.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <numbers>
 #include <string>
 
+#include <opencv2/core.hpp>
+
 #include "bench.hpp"
-#include "perception_scenes.hpp"
+#include "perception_score.hpp"
 #include "swarmbox/common/logfmt.hpp"
 
 namespace {
@@ -23,7 +33,63 @@ struct Scenario {
   bool acceptance = true;          // false: a stress case, reported only
 };
 
+struct CurveCase {
+  std::string kind;
+  std::string key;
+  double value;
+  SceneSetParams scenes;
+};
+
+int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed) {
+  const int n = args.quick ? 12 : static_cast<int>(args.GetInt("scenes", 240));
+  auto at = [&](double altitude, double occluded, int distractors) {
+    return SceneSetParams{.seed = seed, .scenes = n, .scenes_per_world = 12, .min_altitude_m = altitude,
+                          .max_altitude_m = altitude, .near_victim_fraction = 0.85, .near_victim_offset = 1.0,
+                          .occluded_fraction = occluded, .distractors = distractors, .varied_look = true};
+  };
+  std::vector<CurveCase> cases;
+  for (double a : {10.0, 20.0, 30.0, 40.0, 60.0}) cases.push_back({"altitude", "altitude_m", a, at(a, 0.3, 2)});
+  for (double o : {0.0, 0.5, 1.0}) cases.push_back({"occlusion", "occluded_fraction", o, at(30, o, 2)});
+  for (int d : {0, 2, 6}) cases.push_back({"distractors", "distractors", static_cast<double>(d), at(30, 0.3, d)});
+  if (args.quick) cases.resize(2);
+  cv::setNumThreads(1);
+  VictimDetector detector;
+  for (const CurveCase& c : cases) {
+    swarmbox::Result<std::vector<Scene>> scenes = RenderScenes(c.scenes);
+    if (!scenes) {
+      std::fprintf(stderr, "perception bench: %s\n", scenes.error().ToString().c_str());
+      return 1;
+    }
+    const DetectionCurve d = ScoreDetections(*scenes, detector);
+    swarmbox::LogEvent line(0.0, "bench", "bench_result");
+    line.Add("suite", "perception").Add("case", c.kind).Add("seed", seed);
+    line.Add(c.key, c.value, c.key == "occluded_fraction" ? 1 : 0);
+    if (c.kind != "altitude") line.Add("altitude_m", 30);
+    line.Add("scenes", d.scenes)
+        .Add("persons", d.persons)
+        .Add("tp", d.tp)
+        .Add("fp", d.fp)
+        .Add("precision", d.precision, 4)
+        .Add("recall", d.recall, 4)
+        .Add("ap", d.ap, 4)
+        .Add("ms_per_frame", d.ms_per_frame, 2);
+    std::puts(line.str().c_str());
+  }
+  cv::setNumThreads(-1);
+  return 0;
+}
+
 int RunPerceptionBench(const swarmbox::bench::Args& args) {
+  const auto seed = static_cast<std::uint64_t>(args.GetInt("seed", 20261121));
+  for (const auto* list : {&ShippedDetectorModel()->training_seeds, &ShippedDetectorModel()->calibration_seeds}) {
+    if (std::find(list->begin(), list->end(), seed) != list->end()) {
+      std::fprintf(stderr, "perception bench: seed %llu is one the shipped detector was trained or calibrated on\n",
+                   static_cast<unsigned long long>(seed));
+      return 2;
+    }
+  }
+  if (int rc = RunCurves(args, seed); rc != 0) return rc;
+  if (args.GetInt("curves_only", 0) != 0) return 0;
   const int n = args.quick ? 48 : static_cast<int>(args.GetInt("scenes", 320));
   const double latency_s = args.GetDouble("latency_s", 0.040);
   const PoseNoise estimated{.seed = 3, .position_sigma_m = 0.3, .attitude_sigma_rad = 0.5 * std::numbers::pi / 180};

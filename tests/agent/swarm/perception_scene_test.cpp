@@ -4,7 +4,7 @@
 // the median geolocation error under 1 m at 30 m altitude.
 #include <gtest/gtest.h>
 
-#include "perception_scenes.hpp"
+#include "perception_score.hpp"
 
 namespace swarmbox::swarm {
 namespace {
@@ -56,7 +56,9 @@ TEST_F(PerceptionScenes, TheSceneSetCoversAltitudesNoiseAndPartialViews) {
   }
   EXPECT_LT(lo, 12.0);
   EXPECT_GT(hi, 38.0);
-  EXPECT_GE(full, 150);   // enough must-detect instances for a meaningful recall
+  // Enough must-detect instances for a meaningful recall (the x500's 16:9 camera, 640 x 360, sees
+  // about 8 % fewer whole figures per view than the former 4:3 one: 138 at seed 1).
+  EXPECT_GE(full, 125);
   EXPECT_GE(partial, 30);
 }
 
@@ -72,7 +74,7 @@ TEST_F(PerceptionScenes, PrecisionAndRecallAreAtLeastNinetyFivePercent) {
 // an estimated pose off by 0.3 m per axis and 0.5 deg per axis (1-sigma, seeded).
 TEST_F(PerceptionScenesAt30m, MedianGeolocationErrorIsUnderOneMetre) {
   const PerceptionScore exact = ScorePerception(*scenes_30m_, PerceptionParams{}, PoseNoise{});
-  ASSERT_GE(exact.errors_m.size(), 80u);
+  ASSERT_GE(exact.errors_m.size(), 70u);  // 76 with the 16:9 x500 camera (80 with the 4:3 one)
   EXPECT_LT(exact.median_error_m(), 1.0);
   EXPECT_LT(exact.median_error_m(), 0.3);  // true pose: only the centroid-vs-centre offset
   const PerceptionScore est =

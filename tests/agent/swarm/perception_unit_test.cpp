@@ -1,5 +1,5 @@
-// Perception building blocks on synthetic inputs: geolocation (pinhole ray casting), the latency
-// queue, and the detector on images drawn with OpenCV.
+// Perception building blocks: geolocation (pinhole ray casting), the latency queue, the detector on
+// frames of the physics renderer (with clutter painted on them) and the pipeline on a synthetic frame.
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -12,6 +12,7 @@
 #include "swarmbox/swarm/latency_queue.hpp"
 #include "swarmbox/swarm/victim_detector.hpp"
 #include "swarmbox/swarm/victim_perception.hpp"
+#include "perception_score.hpp"
 
 namespace swarmbox::swarm {
 namespace {
@@ -105,24 +106,7 @@ TEST(LatencyQueue, KeepsVisibleTimeOrderAndDropsTheOldestWhenFull) {
   EXPECT_DOUBLE_EQ(out[2].capture_time_s, 4.0);
 }
 
-// A synthetic frame: grass-like noise, an optional person figure drawn at `centre_px` with the
-// renderer's colours at `px_per_m`, optional clutter.
-cv::Mat Frame(std::uint64_t seed) {
-  cv::Mat img(240, 320, CV_8UC3);
-  cv::RNG rng(seed);
-  rng.fill(img, cv::RNG::UNIFORM, cv::Scalar(30, 80, 40), cv::Scalar(80, 150, 120));
-  return img;
-}
-void DrawPerson(cv::Mat& img, cv::Point2d centre_px, double px_per_m, double heading_deg) {
-  const double a = heading_deg * std::numbers::pi / 180;
-  const cv::Point2d h(std::cos(a), -std::sin(a));
-  const cv::Point2d body = centre_px - 0.15 * px_per_m * h;
-  const cv::Point2d head = centre_px + 0.70 * px_per_m * h;
-  cv::ellipse(img, cv::RotatedRect(body, cv::Size2f(static_cast<float>(1.44 * px_per_m), static_cast<float>(0.48 * px_per_m)), static_cast<float>(-heading_deg)),
-              cv::Scalar(0, 120, 255), cv::FILLED);
-  cv::ellipse(img, cv::RotatedRect(head, cv::Size2f(static_cast<float>(0.26 * px_per_m), static_cast<float>(0.22 * px_per_m)), static_cast<float>(-heading_deg)),
-              cv::Scalar(40, 210, 255), cv::FILLED);
-}
+// Pixel noise on top of a rendered frame (the clutter painted on it gets its share).
 void AddNoise(cv::Mat& img, double std, std::uint64_t seed) {
   cv::Mat n(img.size(), CV_16SC3);
   cv::RNG rng(seed);
@@ -130,18 +114,40 @@ void AddNoise(cv::Mat& img, double std, std::uint64_t seed) {
   cv::add(img, n, img, cv::noArray(), CV_8UC3);
 }
 
+// The detector is trained on the physics renderer's frames (tools/train_detector): its unit tests
+// look at frames of that renderer with a victim placed in the world, and paint clutter on them.
+physics::Victim Person(double x_m, double y_m, double heading_rad) {
+  physics::Victim v;
+  v.id = "v1";
+  v.x_m = x_m;
+  v.y_m = y_m;
+  v.heading_rad = heading_rad;
+  return v;
+}
+Result<testing::Scene> View(std::vector<physics::Victim> victims, const Vector2d& centre_m, double altitude_m,
+                            double noise_std) {
+  physics::WorldConfig w;
+  w.name = "unit";
+  w.ground_texture_seed = 11;
+  w.victims = std::move(victims);
+  return perception_scenes::RenderView(w, centre_m, altitude_m, 0.0, noise_std);
+}
+cv::Mat BgrOf(testing::Scene& s) { return cv::Mat(s.image.height_px, s.image.width_px, CV_8UC3, s.image.bgr.data()); }
+
 TEST(VictimDetector, FindsAPersonAtItsCentroidWithHighConfidence) {
   VictimDetector det;
   std::vector<ImageBlob> blobs;
-  for (double ppm : {233.0 / 10, 233.0 / 25, 233.0 / 40}) {  // 10, 25 and 40 m altitude
-    cv::Mat img = Frame(1);
-    DrawPerson(img, {150, 110}, ppm, 30.0);
-    AddNoise(img, 6.0, 2);
-    det.Detect(img, ppm, &blobs);
-    ASSERT_EQ(blobs.size(), 1u) << "px/m " << ppm;
-    // The area-weighted centre of the figure is ~0.085 m toward the feet of `centre`.
-    EXPECT_LT((blobs[0].centroid_px - Vector2d(150, 110)).norm(), 0.15 * ppm + 1.0) << "px/m " << ppm;
-    EXPECT_GE(blobs[0].confidence, 0.9) << "px/m " << ppm;
+  for (double altitude : {10.0, 25.0, 40.0}) {
+    Result<testing::Scene> s = View({Person(3.0, -2.0, 30.0 * std::numbers::pi / 180)}, {1.0, -1.0}, altitude, 6.0);
+    ASSERT_TRUE(s.ok()) << s.error().ToString();
+    const auto px = ProjectToPixel(Vector3d(3.0, -2.0, 0.0), s->intrinsics, s->true_pose);
+    ASSERT_TRUE(px.has_value());
+    const double ppm = s->intrinsics.fx_px / s->altitude_m;
+    det.Detect(BgrOf(*s), ppm, &blobs);
+    ASSERT_EQ(blobs.size(), 1u) << "altitude " << altitude;
+    // A window centre, refined between cells of 0.25 m: within 0.3 m of the person's centre.
+    EXPECT_LT((blobs[0].centroid_px - *px).norm(), 0.3 * ppm + 1.0) << "altitude " << altitude;
+    EXPECT_GE(blobs[0].confidence, 0.9) << "altitude " << altitude;
     EXPECT_FALSE(blobs[0].partial);
   }
 }
@@ -149,46 +155,53 @@ TEST(VictimDetector, FindsAPersonAtItsCentroidWithHighConfidence) {
 TEST(VictimDetector, RejectsBlobsOfTheWrongSizeAndNoise) {
   VictimDetector det;
   std::vector<ImageBlob> blobs;
-  const double ppm = 233.0 / 20;
-  cv::Mat img = Frame(3);
-  cv::rectangle(img, cv::Rect(20, 20, 80, 60), cv::Scalar(0, 120, 255), cv::FILLED);   // a tarp: too big
-  cv::circle(img, cv::Point(250, 200), 1, cv::Scalar(0, 120, 255), cv::FILLED);        // a speck
+  Result<testing::Scene> s = View({}, {20.0, 30.0}, 20.0, 4.0);
+  ASSERT_TRUE(s.ok()) << s.error().ToString();
+  const double ppm = s->intrinsics.fx_px / s->altitude_m;
+  cv::Mat img = BgrOf(*s);
+  cv::rectangle(img, cv::Rect(20, 20, 80, 60), cv::Scalar(0, 120, 255), cv::FILLED);     // a tarp: too big
+  cv::circle(img, cv::Point(250, 200), 1, cv::Scalar(0, 120, 255), cv::FILLED);          // a speck
   cv::rectangle(img, cv::Rect(200, 40, 30, 30), cv::Scalar(160, 155, 150), cv::FILLED);  // grey roof
   AddNoise(img, 8.0, 4);
   det.Detect(img, ppm, &blobs);
-  EXPECT_TRUE(blobs.empty());
-  cv::Mat plain = Frame(5);
-  AddNoise(plain, 12.0, 6);
-  det.Detect(plain, ppm, &blobs);
+  EXPECT_TRUE(blobs.empty()) << blobs.size() << " detections, the first at " << blobs[0].centroid_px.transpose();
+  Result<testing::Scene> plain = View({}, {-40.0, 10.0}, 20.0, 12.0);
+  ASSERT_TRUE(plain.ok());
+  det.Detect(BgrOf(*plain), ppm, &blobs);
   EXPECT_TRUE(blobs.empty());
 }
 
 TEST(VictimDetector, APersonCutByTheBorderIsAPartialViewBelowTheConfirmationThreshold) {
   VictimDetector det;
   std::vector<ImageBlob> blobs;
-  const double ppm = 233.0 / 15;
-  cv::Mat img = Frame(7);
-  DrawPerson(img, {3, 120}, ppm, 0.0);  // half of it beyond the left edge
-  det.Detect(img, ppm, &blobs);
+  // Camera yaw 0: image left is north. The person lies north-south with its centre 3 px from the
+  // left edge: half of it beyond the border.
+  const double altitude = 15.0;
+  Result<testing::Scene> probe = View({}, {0.0, 0.0}, altitude, 4.0);
+  ASSERT_TRUE(probe.ok()) << probe.error().ToString();
+  const double north = (probe->intrinsics.cx_px - 3.0) * probe->altitude_m / probe->intrinsics.fx_px;
+  Result<testing::Scene> s = View({Person(0.0, 0.0, std::numbers::pi / 2)}, {0.0, -north}, altitude, 4.0);
+  ASSERT_TRUE(s.ok()) << s.error().ToString();
+  const auto px = ProjectToPixel(Vector3d(0, 0, 0), s->intrinsics, s->true_pose);
+  ASSERT_TRUE(px.has_value());
+  ASSERT_NEAR(px->x(), 3.0, 0.5);
+  det.Detect(BgrOf(*s), s->intrinsics.fx_px / s->altitude_m, &blobs);
   ASSERT_EQ(blobs.size(), 1u);
   EXPECT_TRUE(blobs[0].partial);
   EXPECT_LE(blobs[0].confidence, 0.8);
   EXPECT_LT(blobs[0].confidence, 0.9);  // MissionState::kHighConfidence: cannot confirm alone
 }
 
-// The whole pipeline on a synthetic frame: the detection appears only after the latency, on the
-// ground where the person was drawn.
+// The whole pipeline on a rendered frame: the detection appears only after the latency, on the
+// ground where the person lies.
 TEST(VictimPerception, GeolocatesAndDelaysByTheInferenceLatency) {
-  const OpticalPose cam = OpticalPoseFromBody(Vector3d(0, 0, 20), Yaw(0.0), Vector3d::Zero());
   const Vector3d person(4.0, -3.0, 0.0);
-  const auto px = ProjectToPixel(person, kK, cam);
-  ASSERT_TRUE(px.has_value());
-  cv::Mat img = Frame(9);
-  DrawPerson(img, {px->x(), px->y()}, kK.fx_px / 20.0, 90.0);
+  Result<testing::Scene> s = View({Person(person.x(), person.y(), std::numbers::pi / 2)}, {0.0, 0.0}, 20.0, 4.0);
+  ASSERT_TRUE(s.ok()) << s.error().ToString();
   PerceptionParams params;
   params.latency_s = 0.040;
   VictimPerception perception(params);
-  EXPECT_EQ(perception.ProcessFrame(img, kK, cam, 5.0), 1);
+  EXPECT_EQ(perception.ProcessFrame(BgrOf(*s), s->intrinsics, s->true_pose, 5.0), 1);
   std::vector<GroundDetection> out;
   perception.PopVisible(5.039, &out);
   EXPECT_TRUE(out.empty());

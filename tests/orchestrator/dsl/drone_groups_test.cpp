@@ -158,5 +158,42 @@ TEST(DroneGroups, AddressesGroupMemberOnlyForExpandedNames) {
   EXPECT_FALSE(AddressesGroupMember(*doc, "seed=3"));
 }
 
+// `world: {generate: ...}` (design20 #19): a recipe instead of a file; no file is looked for, the
+// trial reads a derived world, and the resolved document keeps the recipe.
+TEST(GeneratedWorld, ARecipeIsADerivedWorldWithoutAFile) {
+  auto spec = LoadTrialText(With("world: worlds/open_field.yaml\nworld_size_m: [300, 240]\n",
+                                 "world: {generate: rubble_field, size_m: [220, 180], victims: 4, obstacles: 25}\n"),
+                            "swarm.yaml", FakeTree());
+  ASSERT_TRUE(spec.ok()) << spec.error().ToString();
+  ASSERT_TRUE(spec->world_generate.has_value());
+  EXPECT_EQ(spec->world_generate->kind, worlds::WorldKind::kRubbleField);
+  EXPECT_EQ(spec->world_generate->victims, 4);
+  EXPECT_FALSE(spec->world_generate->seed.has_value());
+  EXPECT_FALSE(spec->HasWorldSize());
+  EXPECT_TRUE(spec->HasDerivedWorld());
+  EXPECT_EQ(spec->world, "worlds/generated_rubble_field.yaml");
+  auto again = DecodeTrial(ToDocument(*spec), FakeTree());
+  ASSERT_TRUE(again.ok()) << again.error().ToString();
+  ASSERT_TRUE(again->world_generate.has_value());
+  EXPECT_EQ(again->world_generate->obstacles, 25);
+  EXPECT_EQ(again->world_generate->size_m, (std::array<double, 2>{220, 180}));
+}
+
+TEST(GeneratedWorld, OverridesReachTheRecipe) {
+  auto spec = LoadTrialText(With("world: worlds/open_field.yaml\n", "world: {generate: open_field}\n"), "swarm.yaml",
+                            FakeTree({"world.generate=forest_edge", "world.seed=12"}));
+  ASSERT_TRUE(spec.ok()) << spec.error().ToString();
+  EXPECT_EQ(spec->world_generate->kind, worlds::WorldKind::kForestEdge);
+  EXPECT_EQ(spec->world_generate->seed, std::optional<std::uint64_t>(12));
+  EXPECT_TRUE(spec->HasWorldSize());  // world_size_m stays: the runner generates at that size
+}
+
+TEST(GeneratedWorld, ABadRecipeIsReportedAtItsKey) {
+  auto spec = LoadTrialText(With("world: worlds/open_field.yaml\n", "world: {generate: lava_lake}\n"), "swarm.yaml", FakeTree());
+  ASSERT_FALSE(spec.ok());
+  EXPECT_NE(spec.error().message().find("generate 'lava_lake' is not one of"), std::string::npos) << spec.error().message();
+  EXPECT_EQ(spec.error().where(), "swarm.yaml:2:19");
+}
+
 }  // namespace
 }  // namespace swarmbox::dsl

@@ -11,6 +11,7 @@
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/dsl/trial_loader.hpp"
 #include "swarmbox/runner/plan.hpp"
+#include "swarmbox/worlds/generator.hpp"
 
 namespace swarmbox::runner {
 namespace {
@@ -94,6 +95,44 @@ TEST(PlanWorldSize, EveryContainerReadsTheDerivedWorldAtTheWorldsPath) {
     ++readers;
   }
   EXPECT_EQ(readers, 5);
+}
+
+// A generated world (design20 #19.5): the text is the generator's for the trial's seed (so
+// another trial seed is another world), world_size_m sets its size, and the plan needs the path
+// the runner wrote it to.
+TEST(GeneratedWorld, TheDerivedWorldIsGeneratedFromTheTrialSeed) {
+  auto spec = dsl::LoadTrial(std::string(SWARMBOX_SOURCE_DIR) + "/trials/sar_rubble.yaml", dsl::LoadOptions{});
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  ASSERT_TRUE(spec->world_generate.has_value());
+  auto text = DerivedWorldText(*spec, "/nowhere");  // no file is read
+  ASSERT_TRUE(text) << text.error().ToString();
+  auto expected = worlds::GenerateWorld(*spec->world_generate, worlds::WorldSeed(*spec->world_generate, spec->seed));
+  ASSERT_TRUE(expected);
+  EXPECT_EQ(*text, *expected);
+  EXPECT_NE(text->find("geofence: {size_x_m: 160, size_y_m: 160}"), std::string::npos) << *text;
+
+  dsl::TrialSpec other = *spec;
+  other.seed = spec->seed + 1;
+  EXPECT_NE(*DerivedWorldText(other, "/nowhere"), *text);
+  other.world_size_m = {300, 200};
+  EXPECT_NE(DerivedWorldText(other, "/nowhere")->find("geofence: {size_x_m: 300, size_y_m: 200}"), std::string::npos);
+
+  PlanOptions options;
+  options.run_id = "20261126-090000-aaaa";
+  options.images = {"swarmbox/physics:abc", "swarmbox/agent:def"};
+  options.subnets = {*Ipv4Net::Parse("10.200.8.0/24"), *Ipv4Net::Parse("10.200.9.0/24")};
+  options.trials_dir = "/src/trials";
+  auto unplanned = PlanTrial(*spec, options);
+  ASSERT_FALSE(unplanned);
+  EXPECT_NE(unplanned.error().message().find("a generated world needs PlanOptions::world_path"), std::string::npos);
+  options.world_path = "/runs/sar-rubble-20261126-090000-aaaa/world.yaml";
+  auto trial = PlanTrial(*spec, options);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  const dsl::ContainerSpec& physics = (*trial)->FindPlugin("physics")->spec();
+  const bool reads = std::any_of(physics.inputs.begin(), physics.inputs.end(), [&](const dsl::InputFile& in) {
+    return in.host_path == options.world_path && in.container_path == "/swarmbox/trials/worlds/generated_rubble_field.yaml";
+  });
+  EXPECT_TRUE(reads);
 }
 
 }  // namespace

@@ -86,7 +86,12 @@ struct CameraSpec {
   int height_px = 240;
   double hfov_rad = 1.2;           // horizontal field of view
   double rate_hz = 5;
-  double noise_std = 4.0;          // Gaussian pixel noise, 8-bit levels
+  double noise_std = 4.0;          // Gaussian pixel noise, 8-bit levels (at unit analog gain)
+  // Exposure time in full daylight [ms]; auto-exposure lengthens it as the light falls (up to 8x,
+  // then raises the analog gain, and the noise with it, up to 4x). Motion blur is the image's
+  // motion from the body rates over the exposure. 0: no motion blur.
+  double exposure_ms = 0.0;
+  double vignetting = 0.0;         // [0, 1): brightness lost in the image corners (radial, r^2)
   Vec3 offset_m{0, 0, -0.05};      // camera centre in the body frame [m]
 };
 

@@ -29,6 +29,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/physics/airframe.hpp"
@@ -39,6 +40,8 @@
 #include "swarmbox/physics/world_config.hpp"
 
 namespace swarmbox::physics {
+
+struct VisiblePerson;  // ground_renderer.hpp
 
 struct WorldOptions {
   std::uint64_t seed = 1;                        // drives every noise source and the wind
@@ -124,9 +127,11 @@ class World {
   // Test rigs: pins the drone's body to the world where it is (a fixed joint) or frees it.
   void SetPinned(std::size_t index, bool pinned);
 
-  // Renders the drone's downward camera at its true pose now (about 1 ms at 320x240). `out` is
-  // resized as needed (reuse it to avoid allocation).
-  void RenderCamera(std::size_t index, CameraImage* out);
+  // Renders the drone's downward camera at its true pose and body rates now (GroundRenderer;
+  // BENCHMARKS.md "Camera" has the cost per frame). `out` is resized as needed (reuse it to avoid
+  // allocation). `people` (optional, ground truth for training and evaluation, never for agents)
+  // receives the people the frame shows.
+  void RenderCamera(std::size_t index, CameraImage* out, std::vector<VisiblePerson>* people = nullptr);
   // Whether a camera frame is due at the current step (camera.rate_hz of the airframe).
   bool CameraDue(std::size_t index) const;
 

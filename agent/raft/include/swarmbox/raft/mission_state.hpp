@@ -11,14 +11,23 @@
 // after RETURN. A command that does not fit the current state is *rejected*: the state does not
 // change, the same way on every drone, and the result says why.
 //
-// Victim confirmation rule (deterministic, applied to ReportSighting in log order):
-//   - a sighting with confidence >= kHighConfidence (0.9) confirms a victim on its own;
-//   - otherwise two sightings with confidence >= kMinConfidence (0.5) from two *different* drones
-//     within kConfirmRadiusM (5 m) of each other confirm a victim at their mean position;
-//   - a sighting within kConfirmRadiusM of a known victim is that victim (no duplicate);
-//   - sightings below kMinConfidence are rejected; unconfirmed sightings are kept (at most
-//     kMaxPendingSightings, oldest dropped first) for a later match;
-//   - each reporter's seq must increase: a retried proposal that commits twice is applied once.
+// Sightings, candidates and victims (deterministic, applied in log order; #19: a single view
+// never confirms, however confident):
+//   - a ReportSighting (confidence >= kMinConfidence, else rejected) within kConfirmRadiusM of a
+//     confirmed victim is that victim (its reporter joins confirmed_by);
+//   - otherwise it is a view of the nearest candidate within kConfirmRadiusM (pending or
+//     rejected), or it opens a new candidate (ids count up from 1). A candidate's position is the
+//     confidence-weighted mean of its detections; it keeps at most kMaxViews pieces of evidence;
+//   - ReportMiss: a revisit saw nothing where the candidate is (evidence against it);
+//   - RequestRevisit: the leader sends a drone to look again; the drone's next view or miss of
+//     that candidate completes the revisit (revisits counts them);
+//   - ConfirmSighting / RejectSighting: the leader's decision from the fused evidence
+//     (swarm/sighting_fusion.hpp weighs it; this state only records it, so that every drone and
+//     every later leader sees the same decisions). Confirming adds a Victim; a rejected candidate
+//     keeps collecting evidence and may still be confirmed later;
+//   - each reporter's seq must increase (sightings and misses share it): a retried proposal that
+//     commits twice is applied once;
+//   - at most kMaxCandidates are kept: the oldest decided one goes first, else the oldest.
 // ConfirmVictim (an operator's word) confirms directly. Victim ids count up from 1.
 #pragma once
 
@@ -40,11 +49,34 @@ std::string_view PhaseName(MissionPhase phase);  // "IDLE", "SEARCH", ...
 enum class VictimStatus : std::uint8_t { kConfirmed, kBeingRescued, kRescued };
 std::string_view VictimStatusName(VictimStatus status);  // "confirmed", "being_rescued", "rescued"
 
-struct Sighting {
+// One piece of evidence about a candidate: a detection (detected: its geolocated position and
+// confidence) or a miss (not detected: a revisit had the candidate's place in view and saw
+// nothing; x/y are the candidate's position then, confidence 0).
+struct SightingView {
   std::string reporter;
   std::uint64_t seq = 0;
   double x_m = 0, y_m = 0, confidence = 0;
-  bool operator==(const Sighting&) const = default;
+  double viewer_x_m = 0, viewer_y_m = 0, viewer_height_m = 0;  // the camera: ENU [m], above ground [m]
+  double t_s = 0;                                               // capture, simulated [s]
+  bool detected = true;
+  bool operator==(const SightingView&) const = default;
+};
+
+enum class CandidateStatus : std::uint8_t { kPending, kConfirmed, kRejected };
+std::string_view CandidateStatusName(CandidateStatus status);  // "pending", "confirmed", "rejected"
+
+// A place where some drone's detector fired, and everything seen there since.
+struct Candidate {
+  std::uint32_t id = 0;
+  double x_m = 0, y_m = 0;  // ENU world frame [m]
+  CandidateStatus status = CandidateStatus::kPending;
+  std::vector<SightingView> views;  // in log order
+  std::string revisit_drone;        // a revisit requested and not done yet ("": none)
+  double revisit_t_s = 0;           // when it was requested (the leader's simulated time) [s]
+  std::uint32_t revisits = 0;       // revisits done
+  std::uint32_t victim_id = 0;      // kConfirmed: the victim it became
+  double belief = 0;                // the fused belief of the decision (kConfirmed/kRejected)
+  bool operator==(const Candidate&) const = default;
 };
 
 struct Victim {
@@ -78,11 +110,11 @@ struct ApplyResult {
 
 class MissionState {
  public:
-  static constexpr double kHighConfidence = 0.9;
   static constexpr double kMinConfidence = 0.5;
   static constexpr double kConfirmRadiusM = 5.0;
-  static constexpr std::size_t kMaxPendingSightings = 64;
-  static constexpr std::uint8_t kSnapshotVersion = 1;
+  static constexpr std::size_t kMaxCandidates = 64;
+  static constexpr std::size_t kMaxViews = 24;  // evidence per candidate; more is rejected
+  static constexpr std::uint8_t kSnapshotVersion = 2;
 
   // Applies the command committed at log `index` (> applied_index(); aborts otherwise).
   ApplyResult Apply(std::uint64_t index, const MissionCommand& command);
@@ -98,7 +130,8 @@ class MissionState {
   MissionPhase phase() const { return phase_; }
   std::uint32_t target_victim() const { return target_victim_; }  // 0 = none
   const std::vector<Sector>& sectors() const { return sectors_; }
-  const std::vector<Sighting>& pending_sightings() const { return pending_; }
+  const std::vector<Candidate>& candidates() const { return candidates_; }
+  const Candidate* FindCandidate(std::uint32_t id) const;
   const std::vector<Victim>& victims() const { return victims_; }
   const Victim* FindVictim(std::uint32_t id) const;
   // The sector assigned to `drone`, or nullptr.
@@ -109,6 +142,12 @@ class MissionState {
  private:
   ApplyResult Reject(std::string reason) const;
   ApplyResult ApplySighting(const ReportSighting& c);
+  ApplyResult ApplyMiss(const ReportMiss& c);
+  // The reporter/seq rule shared by sightings and misses: empty when `seq` may be applied.
+  std::string CheckSeq(const std::string& reporter, std::uint64_t seq) const;
+  Candidate* NearCandidate(double x_m, double y_m);
+  Candidate* MutableCandidate(std::uint32_t id);
+  void AddView(Candidate& c, SightingView v);
   Victim* NearVictim(double x_m, double y_m);
   Victim& AddVictim(double x_m, double y_m, std::vector<std::string> by, ApplyResult* r);
   void SetPhase(MissionPhase phase, ApplyResult* r);
@@ -119,7 +158,8 @@ class MissionState {
   std::uint32_t next_victim_id_ = 1;
   std::vector<Sector> sectors_;
   std::map<std::string, std::uint64_t> last_seq_;  // per reporter
-  std::vector<Sighting> pending_;
+  std::uint32_t next_candidate_id_ = 1;
+  std::vector<Candidate> candidates_;
   std::vector<Victim> victims_;
 };
 

@@ -16,6 +16,9 @@ struct GroundDetection {
   double confidence = 0.0;      // [0, 1]
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // blob centroid (u right, v down) [px]
   double area_px = 0.0;         // blob area [px^2]
+  // Where the camera was (its estimated position at capture, world ENU [m]): the viewpoint the
+  // mission's fusion needs to tell a second view from the same one (sighting_fusion.hpp).
+  Eigen::Vector3d viewer_m = Eigen::Vector3d::Zero();
 };
 
 }  // namespace swarmbox::swarm

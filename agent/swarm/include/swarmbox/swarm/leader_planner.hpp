@@ -8,6 +8,12 @@
 //             (PartitionArea's near-square grid, cells matched to where the scouts are by
 //             PartitionOrder), StartSearch
 //   SEARCH    a confirmed victim                         -> ConvergeOn(lowest id)
+//   SEARCH/CONVERGE/RESCUE  candidates (unconfirmed sightings, raft::Candidate), weighed by
+//             sighting_fusion.hpp: enough independent evidence -> ConfirmSighting (a victim, to
+//             be rescued like any other; only confirmed victims are rescued); too little after
+//             misses -> RejectSighting; no new view for revisit_after_s -> RequestRevisit (a
+//             live scout, idle ones first, then the nearest, one revisit per scout at a time; a
+//             revisit not done in revisit_timeout_s or whose drone is gone goes to another)
 //   CONVERGE  a live lifter on the ground or "standby"   -> BeginRescue(target, lifter)
 //             no lifter in the roster: after handle_time_s the victim counts as handled (scouts
 //             orbited it) and the next confirmed victim is converged on
@@ -16,7 +22,8 @@
 //             split (along their longer side) among live scouts, nearest idle ones first
 //   SEARCH/CONVERGE  every sector owned by a live scout that is done ("swept"/returning/landed),
 //             every live scout done or without a sector, the sector list unchanged for
-//             assignment_settle_s, and every victim rescued or handled -> ReturnHome
+//             assignment_settle_s, no candidate pending, and every victim rescued or handled
+//             -> ReturnHome
 //   RETURN    every live drone "landed"/"on_ground"      -> CompleteMission
 //   COMPLETE  once: event=mission_complete victims=<n> rescued=<n>
 //
@@ -47,6 +54,15 @@
 // lost) is re-learned from the committed state and the roster. Track() runs on every drone each
 // mission tick so that a follower that becomes leader already knows when the list last changed.
 //
+// Evidence events (the leader logs them, from the committed state, with the fused belief):
+//   event=sighting   a new view or miss of a candidate (candidate, reporter, seen, confidence,
+//                    viewer x:y:h, capture t, and the belief after it)
+//   event=revisit    a revisit committed (candidate, drone, belief)
+//   event=confirmed  a candidate confirmed (victim id and every view: drones, confidences, viewers, t)
+//   event=rejected   a candidate rejected (reason=belief|undecided and every view)
+// Track() notices them on every drone (so a new leader does not repeat what it saw before it
+// led) and Step() hands over those of the current tick; a drone's first Track() only learns.
+//
 //   planner.Track(t_s, driver.mission(), wall_s);               // every drone, every tick
 //   planner.Step(t_s, driver.mission(), roster, &out, wall_s);  // the leader: appends proposals
 //
@@ -69,6 +85,7 @@
 
 #include "swarmbox/swarm/mission_types.hpp"
 #include "swarmbox/swarm/search_pattern.hpp"
+#include "swarmbox/swarm/sighting_fusion.hpp"
 
 namespace swarmbox::swarm {
 
@@ -100,6 +117,7 @@ struct LeaderConfig {
   // here, a few retries under 5% loss) and is heard 0.2 s later: 10 s of simulated time covers
   // that up to a ~10x speed-up [s].
   double assignment_settle_s = 10.0;
+  FusionParams fusion{};  // confirming, rejecting and revisiting candidates (sighting_fusion.hpp)
 };
 
 class LeaderPlanner {
@@ -132,6 +150,11 @@ class LeaderPlanner {
   void Index(std::span<const RosterEntry> roster);             // fills by_name_
   const RosterEntry* Find(const std::string& drone) const;     // O(log N) in by_name_
   void ReportMembers(double t_s, std::span<const RosterEntry> roster, MissionOutput* out);
+  // Evidence events of the committed candidates that changed since the last Track().
+  void TrackCandidates(double t_s, const raft::MissionState& m, bool learn_only);
+  // Decisions and revisits for the candidates (active phases); returns whether any is pending.
+  bool PlanCandidates(double t_s, const raft::MissionState& m, std::span<const RosterEntry> roster,
+                      MissionOutput* out);
 
   LeaderConfig config_;
   std::map<std::string, double> last_proposed_s_;
@@ -145,6 +168,14 @@ class LeaderPlanner {
   std::vector<raft::Sector> sectors_;     // the committed list as last seen
   double sectors_changed_s_ = 0.0;        // when it last changed (or was first seen) [s]
   std::set<std::string> lost_;            // members reported lost (event=member_lost)
+  struct SeenCandidate {
+    std::size_t views = 0;
+    raft::CandidateStatus status = raft::CandidateStatus::kPending;
+    std::string revisit_drone;
+  };
+  std::map<std::uint32_t, SeenCandidate> seen_;  // the candidates as last tracked
+  double tracked_s_ = -1.0;                      // the latest Track()'s time [s]
+  std::vector<LogEvent> evidence_events_;        // of the latest tracked tick, for Step()
   // Scratch of one Step (capacity kept): the roster by name, the sector owners by name.
   std::vector<const RosterEntry*> by_name_;
   std::vector<const std::string*> owners_;

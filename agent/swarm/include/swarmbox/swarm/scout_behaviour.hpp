@@ -16,13 +16,20 @@
 //       trial, after orbit_time_s on the orbit: the victim is then handled)
 //   (keep_searching_during_rescue: only a scout with its sector swept orbits; return_when_swept:
 //    "swept" with no victim to orbit goes straight to "returning")
+//   any mission stage (and "returning"/"landed" when not for a low battery) --(a committed
+//       revisit of a pending candidate for this drone)--> kRevisiting "revisiting": fly over the
+//       candidate at search altitude, look revisit_look_s with it under the camera; a detection
+//       there is reported as a sighting, nothing is reported as a raft ReportMiss (with where it
+//       looked from); back to what it did (the sweep resumes at its lane) once the committed
+//       state shows the revisit done, decided or given to another drone
 //   airborne --(phase RETURN/COMPLETE, or battery low: event=battery_low)--> kReturning
 //       "returning" --(over home)--> kLanding "landing" --(touch-down)--> kLanded "landed".
-// Detections (after the latency queue) become Raft ReportSighting proposals, except near a known
-// victim or near the drone's own recent report (cooldown), and only in an active phase. A better
-// view within the cooldown is still reported when it reaches MissionState::kHighConfidence and
-// the recent report did not (a victim first seen partly at the image edge is capped below it; the
-// full view a moment later confirms it on its own).
+// Detections (after the latency queue) become Raft ReportSighting proposals with their viewpoint
+// (camera position, height, capture time), except near a confirmed victim or near the drone's own
+// recent report of the place (cooldown) taken from within report_baseline_m, and only in an active
+// phase: one pass over a spot sends a view every report_baseline_m of flight while it is in the
+// footprint, the second views the leader's fusion needs (sighting_fusion.hpp; no single view
+// confirms).
 // A report is re-proposed (next seq) every report_retry_s until the committed state shows it (a
 // pending sighting with its seq, or a victim there), at most report_tries times: a proposal
 // forwarded over the lossy radio, or caught in the leader's log when the leader died, is lost
@@ -87,6 +94,13 @@ struct ScoutConfig {
   double min_report_confidence = raft::MissionState::kMinConfidence;
   double dedupe_radius_m = raft::MissionState::kConfirmRadiusM;
   double report_cooldown_s = 10.0;    // re-report the same place after this (a lost proposal) [s]
+  // ... or sooner once this far from every own report of it: a second view for the fusion
+  // (FusionParams::min_baseline_m has why 10 m) [m].
+  double report_baseline_m = 10.0;
+  // Revisit: the candidate counts as under the camera within this of the nadir and 2 m of the
+  // search altitude; look this long (10 frames at the x500's 5 Hz) before reporting a miss.
+  double revisit_arrive_m = 2.0;
+  double revisit_look_s = 2.0;
   double report_retry_s = 5.0;        // re-propose a report not yet in the committed state [s]
   int report_tries = 4;               // proposals of one report at most
   std::uint64_t first_sighting_seq = 1;  // after an agent restart: seed above any used (sim ms)
@@ -108,7 +122,7 @@ class ScoutBehaviour {
  public:
   enum class Stage {
     kOnGround, kTakingOff, kAwaitingSector, kSearching, kSwept, kOrbiting, kReturning, kLanding,
-    kLanded,
+    kLanded, kRevisiting,
   };
   static std::string_view StageName(Stage stage);
 
@@ -127,8 +141,11 @@ class ScoutBehaviour {
   void RunStage(const MissionInput& in, MissionOutput* out);  // the stage's setpoint
   void ReportSightings(const MissionInput& in, MissionOutput* out);
   void RetrySightings(const MissionInput& in, MissionOutput* out);
-  void Propose(const MissionInput& in, const Eigen::Vector2d& p, double confidence, int tries,
-               MissionOutput* out);
+  void Propose(const MissionInput& in, const GroundDetection& d, int tries, MissionOutput* out);
+  // The pending candidate the committed state sends this drone to, or nullptr.
+  const raft::Candidate* RevisitTask(const raft::MissionState& m) const;
+  void RunRevisit(const MissionInput& in, MissionOutput* out);
+  void ProposeMiss(const MissionInput& in, MissionOutput* out);
   void PlanSector(const raft::Sector& sector, const Eigen::Vector3d& position_m);
   // This drone's first committed sector it has not swept yet, or nullptr.
   const raft::Sector* NextSector(const raft::MissionState& m) const;
@@ -152,19 +169,24 @@ class ScoutBehaviour {
   std::uint64_t next_seq_ = 1;
   struct RecentReport {
     Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
+    Eigen::Vector3d viewer_m = Eigen::Vector3d::Zero();
     double t_s = -1e9;
-    double confidence = 0.0;
   };
   std::array<RecentReport, 16> recent_{};
   std::size_t recent_next_ = 0;
   struct Outstanding {  // a report not seen in the committed state yet
     std::uint64_t seq = 0;
-    Eigen::Vector2d position_m = Eigen::Vector2d::Zero();
-    double confidence = 0.0;
+    GroundDetection detection;
     double sent_s = 0.0;
     int tries = 0;
   };
   std::vector<Outstanding> outstanding_;  // at most recent_.size()
+  // The revisit under way (candidate id 0: none).
+  std::uint32_t revisit_id_ = 0;
+  double look_start_s_ = -1.0;  // when the candidate came under the camera [s]
+  bool revisit_seen_ = false;   // a detection there during this revisit (reported as a sighting)
+  double miss_sent_s_ = -1.0;   // the miss proposed (latest try) [s]
+  int miss_tries_ = 0;
 };
 
 }  // namespace swarmbox::swarm

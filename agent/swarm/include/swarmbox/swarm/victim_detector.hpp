@@ -1,81 +1,104 @@
-// VictimDetector: finds people lying on the ground in a downward camera frame (8-bit BGR), with a
-// classical pipeline: colour threshold -> morphological closing -> connected components -> gates
-// on the blob area expected at this altitude -> a confidence per blob.
+// VictimDetector: finds people on the ground in a downward camera frame (8-bit BGR) with a trained
+// sliding-window detector (the model: victim_detector_model.hpp, trained by tools/train_detector
+// on frames the physics server's renderer draws from seeds disjoint from the evaluation seeds).
 //
-//   VictimDetector det;                        // reuse one per camera: scratch images are kept
+//   VictimDetector det;                        // the shipped model; reuse one per camera
 //   det.Detect(bgr, fx_px / height_above_ground_m, &blobs);
 //
-// What a victim looks like (physics GroundRenderer, the SITL ground truth of the project): a warm
-// hi-vis figure, an orange body ellipse (BGR 0,120,255; 1.44 x 0.48 m) and an amber head (BGR
-// 40,210,255), about 0.59 m^2 seen from above; ground is grass/soil (R <= ~125), obstacles grey,
-// sky pale blue, plus Gaussian pixel noise (std ~4 levels). The threshold keeps pixels with a
-// strong red channel well above blue and green ("R high, B low"). The blob's expected area is
-// person_area_m2 * pixels_per_m^2 (nadir view), or, given the camera pose, the person's area seen at
-// the blob's ground point (range and incidence: tilted and oblique views): blobs far smaller or
-// larger are not people.
-// Confidence in [0, 1]: 0.5 + 0.49 * size_score * colour_score; a blob that touches the image border
-// is a partial view, its confidence is capped at partial_confidence_cap (it cannot confirm a
-// victim alone under MissionState's rule, which needs 0.9).
+// Per frame:
+//   1. scale: the frame is resized so the ground is kCanonicalPxPerM (8 px/m) at the image centre
+//      (the expected person size from the altitude: one pyramid level per frame, chosen by the
+//      altitude, instead of searching every scale), padded by 1 m so people cut by the border are
+//      still windows;
+//   2. features: aggregated channel features (Luv, gradient magnitude, 4 orientations, 0.25 m
+//      cells), windows of 3 x 3 m at a stride of one cell;
+//   3. first stage: a linear score for every window (one correlation per channel), its local
+//      maxima above the trained threshold, at most max_candidates of them;
+//   4. second stage: a random forest (cv::ml::RTrees) on each candidate, its vote fraction mapped
+//      to a probability by the trained Platt sigmoid: the confidence, in [0, 1];
+//   5. non-maximum suppression: of candidates closer than nms_radius_m, the most confident stays.
+// A detection whose person box (centre +- 1 m) leaves the image is a partial view, its confidence
+// capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
+// Detections under min_confidence are not reported.
 //
-// Allocation: the scratch images are reused once they have the frame's size; OpenCV's morphology
-// and connected components still allocate a few dozen small internal buffers per frame (measured
-// in allocation_test.cpp). Frames come at 5 Hz, outside the control loop.
+// Cost: about 2-8 ms per 320 x 240 frame on one core (BENCHMARKS.md "Perception"; the scale of step
+// 1 makes low altitudes cheaper and 60 m dearer). Scratch images are kept between frames; OpenCV's
+// filters and the forest still allocate internal buffers per frame (allocation_test.cpp). Frames
+// come at 5 Hz, outside the control loop.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "swarmbox/swarm/geolocation.hpp"
+#include "swarmbox/swarm/victim_detector_model.hpp"
 
 namespace swarmbox::swarm {
 
 struct VictimDetectorParams {
-  int min_red = 170;                 // R >= this [0, 255]
-  int min_red_minus_blue = 90;       // R - B >= this
-  int min_red_minus_green = 20;      // R - G >= this (the amber head has R - G ~ 45)
-  double person_area_m2 = 0.59;      // plan-view area of a lying person [m^2]
-  double min_area_ratio = 0.3;       // blob / expected area, for blobs inside the image
-  double max_area_ratio = 3.0;       // larger blobs are not a person (tarp, vehicle...)
-  double full_size_ratio = 0.6;      // size score is 1 from this ratio up to full_size_max_ratio
-  double full_size_max_ratio = 1.7;
-  int min_area_px = 4;               // smaller blobs are noise whatever the altitude
-  int border_px = 1;                 // a blob within this of the edge is a partial view
+  double person_area_m2 = 0.59;       // plan-view area of a lying person [m^2] (expected_area_px)
+  int max_candidates = 48;            // first-stage maxima passed to the forest, best first
+  double nms_radius_m = 1.0;          // detections closer than this on the ground are one
+  double min_confidence = 0.05;       // detections below are dropped
+  double partial_half_extent_m = 1.0; // a detection this close to the border is a partial view
   double partial_confidence_cap = 0.8;
 };
 
 struct ImageBlob {
-  Eigen::Vector2d centroid_px = Eigen::Vector2d::Zero();  // (u right, v down)
-  double area_px = 0;
-  double expected_area_px = 0;
-  bool partial = false;        // touches the image border
-  double colour_score = 0;     // [0, 1]
-  double size_score = 0;       // [0, 1]
-  double confidence = 0;       // [0, 1]
+  Eigen::Vector2d centroid_px = Eigen::Vector2d::Zero();  // window centre (u right, v down)
+  double area_px = 0;            // the person's expected plan area at this scale [px^2]
+  double expected_area_px = 0;   // the same (kept for geolocation's consumers)
+  bool partial = false;          // the person box leaves the image
+  double linear_score = 0;       // first-stage score (margin of the linear stage)
+  double votes = 0;              // second-stage vote fraction for "person" [0, 1]
+  double confidence = 0;         // calibrated probability [0, 1] (capped for partial views)
 };
 
 class VictimDetector {
  public:
+  // The model compiled into the binary (ShippedDetectorModel()).
   explicit VictimDetector(const VictimDetectorParams& params = {});
+  VictimDetector(std::shared_ptr<const VictimDetectorModel> model, const VictimDetectorParams& params);
 
   // bgr: CV_8UC3. pixels_per_m: image scale on the ground at the image centre [px/m]
   // (fx_px / height above ground for a nadir camera), > 0. `out` is cleared first.
   void Detect(const cv::Mat& bgr, double pixels_per_m, std::vector<ImageBlob>* out);
-  // Same, with the expected area of each blob from the camera pose: the person's area seen at the
-  // blob's ground point, (f / range)^2 * cos(incidence) (tilted camera, oblique views).
+  // Same, with the scale from the camera pose: fx over the range along the optical axis to the
+  // ground (tilted cameras), and no detection where a pixel's ray misses the ground.
   void Detect(const cv::Mat& bgr, const PinholeIntrinsics& k, const OpticalPose& pose,
               double ground_z_m, std::vector<ImageBlob>* out);
 
   const VictimDetectorParams& params() const { return params_; }
-  const cv::Mat& mask() const { return mask_; }  // the last thresholded mask, for debugging
+  const VictimDetectorModel& model() const { return *model_; }
+  const ChannelMaps& channels() const { return maps_; }  // of the last frame (training, debugging)
+
+  // Steps 1-3 on their own (training mines the forest's samples from these): the first-stage
+  // candidates of `bgr` at `pixels_per_m`, as (row, col, score) of the window's top-left cell,
+  // best first. Uses the model's kernels and threshold; fills channels().
+  struct Candidate {
+    int row = 0;
+    int col = 0;
+    double score = 0;
+    double sub_row = 0;  // peak position refined to a fraction of a cell
+    double sub_col = 0;
+  };
+  const std::vector<Candidate>& Candidates(const cv::Mat& bgr, double pixels_per_m, int max_candidates,
+                                           double threshold);
 
  private:
-  template <typename ExpectedAreaFn>
-  void DetectImpl(const cv::Mat& bgr, ExpectedAreaFn expected_area_px, std::vector<ImageBlob>* out);
+  template <typename KeepFn>
+  void DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn keep, std::vector<ImageBlob>* out);
 
+  std::shared_ptr<const VictimDetectorModel> model_;
   VictimDetectorParams params_;
-  cv::Mat mask_, closed_, labels_, stats_, centroids_, kernel_;
+  ChannelMaps maps_;
+  cv::Mat score_, filtered_, dilated_;
+  std::vector<float> samples_;
+  std::vector<Candidate> candidates_;
+  std::vector<ImageBlob> scratch_;
 };
 
 }  // namespace swarmbox::swarm

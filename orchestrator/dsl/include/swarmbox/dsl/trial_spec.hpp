@@ -24,6 +24,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,6 +35,7 @@
 #include "swarmbox/faults/fault_spec.hpp"
 #include "swarmbox/faults/netem_spec.hpp"
 #include "swarmbox/dsl/user_software.hpp"
+#include "swarmbox/worlds/generator.hpp"
 
 namespace swarmbox::dsl {
 
@@ -158,7 +160,10 @@ struct TrialSpec {
   std::string name;  // [a-z0-9][a-z0-9_.-]*, at most 40 characters; used in folder/Docker names
   std::uint64_t seed = 0;
   Middleware middleware = Middleware::kCycloneDds;
-  std::string world;  // relative to the trials directory
+  std::string world;  // relative to the trials directory (generated: worlds/generated_<kind>.yaml, no file)
+  // `world: {generate: ...}` (worlds/generator.hpp): the runner generates the world (seeded by the
+  // trial seed unless the recipe gives one) and writes it as the derived world, as world_size_m.
+  std::optional<worlds::GenerateSpec> world_generate;
   // `world_size_m: [X, Y]`: the world's geofence set to X x Y m (the SAR search area); {0, 0} = the
   // world file's own. The runner writes the derived world into the trial folder and every container
   // reads that one (runner/derived_world.hpp).
@@ -217,6 +222,8 @@ struct TrialSpec {
   const UserComponentSpec* FindComponent(std::string_view component_name) const;
   bool HasExternalBrain() const;
   bool HasWorldSize() const { return world_size_m[0] > 0 && world_size_m[1] > 0; }
+  // Whether every container reads a world the runner writes (world_size_m or a generated world).
+  bool HasDerivedWorld() const { return HasWorldSize() || world_generate.has_value(); }
   // The limits a container runs with: the drone's (nullptr = the physics server's) overrides over
   // the trial's.
   ContainerLimits LimitsOf(const DroneSpec* drone) const;

@@ -1,4 +1,5 @@
-// The world a trial runs in when it sets `world_size_m: [X, Y]` (design18 §1): the trial's world
+// The world a trial runs in when it sets `world_size_m: [X, Y]` (design18 §1) or generates its
+// world (`world: {generate: ...}`, design20 #19). world_size_m: the trial's world
 // file with its geofence set to X x Y m, everything else (victims, obstacles, wind, home) as it is.
 // The SAR search area is the geofence, so this scales the search with the swarm.
 //
@@ -12,6 +13,7 @@
 #include <string_view>
 
 #include "swarmbox/common/result.hpp"
+#include "swarmbox/dsl/trial_spec.hpp"
 
 namespace swarmbox::runner {
 
@@ -23,5 +25,11 @@ inline constexpr std::string_view kDerivedWorldFile = "world.yaml";  // in the t
 // or fly around it): the message names it and the size that would hold it.
 Result<std::string> DeriveWorld(std::string_view world_text, std::string_view world_file,
                                 const std::array<double, 2>& size_m);
+
+// The derived world of a trial with HasDerivedWorld(): the generated one (`world: {generate:
+// ...}`, worlds/generator.hpp, seeded by WorldSeed(recipe, spec.seed); world_size_m, when also
+// given, is its size), else the world file under `trials_dir` with world_size_m (DeriveWorld).
+// kNotFound when the world file cannot be read.
+Result<std::string> DerivedWorldText(const dsl::TrialSpec& spec, const std::string& trials_dir);
 
 }  // namespace swarmbox::runner

@@ -29,6 +29,7 @@ struct WorldPicture {
   double size_y_m = 200;
   struct Box {
     double x_m, y_m, sx_m, sy_m, yaw_deg;
+    bool tree = false;  // kind: tree, drawn as a round crown
   };
   std::vector<Box> obstacles;
   struct Victim {

@@ -2,6 +2,7 @@
 // (mission_state.cpp) share, so both encodings stay byte-for-byte the same where they overlap:
 //   sector list: varint count | per sector: str drone | f64 x_min y_min x_max y_max
 //   sighting:    str reporter | varint seq | f64 x | f64 y | f64 confidence
+//                | f64 viewer_x | f64 viewer_y | f64 viewer_height | f64 t
 // The readers follow ByteReader's rule: on malformed input they stop and leave the error latched
 // in the reader (check r.ok() afterwards).
 #pragma once
@@ -41,7 +42,7 @@ inline std::vector<Sector> ReadSectors(ByteReader& r) {
   return sectors;
 }
 
-// S is ReportSighting (a command) or Sighting (a pending one in the snapshot): same fields.
+// S is ReportSighting (a command) or SightingView (evidence in the snapshot): same fields.
 template <class S>
 void WriteSighting(ByteWriter& w, const S& s) {
   w.Str(s.reporter);
@@ -49,6 +50,10 @@ void WriteSighting(ByteWriter& w, const S& s) {
   w.F64(s.x_m);
   w.F64(s.y_m);
   w.F64(s.confidence);
+  w.F64(s.viewer_x_m);
+  w.F64(s.viewer_y_m);
+  w.F64(s.viewer_height_m);
+  w.F64(s.t_s);
 }
 
 template <class S>
@@ -59,6 +64,10 @@ S ReadSighting(ByteReader& r) {
   s.x_m = r.F64();
   s.y_m = r.F64();
   s.confidence = r.F64();
+  s.viewer_x_m = r.F64();
+  s.viewer_y_m = r.F64();
+  s.viewer_height_m = r.F64();
+  s.t_s = r.F64();
   return s;
 }
 

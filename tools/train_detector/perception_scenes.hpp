@@ -1,6 +1,8 @@
 // Seeded perception scenes rendered by the physics server's camera (swarmbox::physics::World::
-// RenderCamera, the same GroundRenderer the SITL server publishes), with ground truth, and the
-// scoring used by the perception tests and `swarmbox-bench perception`.
+// RenderCamera, the same GroundRenderer the SITL server publishes), with ground truth: what the
+// detector is trained on (tools/train_detector) and evaluated on (the perception tests and
+// `swarmbox-bench perception`, scoring in tests/agent/swarm/perception_score.hpp), from disjoint
+// seeds (kEvaluationSeeds below; the trainer refuses them).
 //
 // A scene set is made of worlds (200 x 200 m, seeded ground texture, 8 victims at random headings,
 // 12 obstacle boxes 1-8 m tall as clutter, kept 2 m clear of the victims) and, per world, camera
@@ -8,7 +10,18 @@
 // so that victims are often cut by the image border) and yaws, with a per-scene pixel noise.
 // Victims are classified per scene: kFull (the whole figure inside the image and not hidden by an
 // obstacle: must be detected), kPartial (cut by the border or partly hidden: "don't care", a
-// detection of it is neither a true nor a false positive), kAbsent.
+// detection of it is neither a true nor a false positive), kAbsent; and by visible_fraction (the
+// share of the figure's outline samples inside the image with a clear line of sight), which the
+// detection curves use ("at least half visible" must be detected).
+//
+// The look (SceneSetParams::varied_look, the world schema of #19): each world gets a terrain kind
+// and water, a time of day and overcast; each person a pose (lying most often), clothing from a
+// palette of greens, browns, greys, dark and bright colours (one in six keeps the hi-vis figure)
+// and, for occluded_fraction of them, cover 0.2-0.8 (rubble or vegetation); `distractors` of
+// random kinds (tarps, cones, backpacks, debris, rocks) lie 2-9 m from each person. Without
+// varied_look the worlds are the original hi-vis look, and occlusion is a low slab (0.3-0.6 m
+// rubble) over part of the figure, distractors small low boxes.
+// visible_fraction comes from the renderer's own truth (GroundRenderer's VisiblePerson).
 #pragma once
 
 #include <cstdint>
@@ -18,16 +31,20 @@
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/physics/camera_image.hpp"
+#include "swarmbox/physics/world_config.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
-#include "swarmbox/swarm/victim_perception.hpp"
 
-namespace swarmbox::swarm::testing {
+namespace swarmbox::perception_scenes {
+
+using swarm::OpticalPose;
+using swarm::PinholeIntrinsics;
 
 enum class Visibility { kFull, kPartial, kAbsent };
 
 struct SceneVictim {
   Eigen::Vector2d position_m = Eigen::Vector2d::Zero();  // world ENU [m]
   Visibility visibility = Visibility::kAbsent;
+  double visible_fraction = 0.0;  // [0, 1]
 };
 
 struct Scene {
@@ -50,10 +67,21 @@ struct SceneSetParams {
   double max_noise_std = 10.0;
   double near_victim_fraction = 0.75;  // share of views centred near a victim
   double near_victim_offset = 1.2;     // view centre up to this * half the footprint width away
+  double occluded_fraction = 0.0;      // share of victims partly covered by a low slab
+  int distractors = 0;                 // distractors near each victim
+  bool varied_look = false;            // terrain, light, poses, clothing, cover, distractor kinds
 };
+
+// Scene-set seeds the perception tests and the bench evaluate on by default: never trained on.
+inline constexpr std::uint64_t kEvaluationSeeds[] = {20261121, 30, 40, 77, 78, 1, 2, 3, 4, 5};
 
 // Renders the scene set. Fails (kNotFound...) when the x500 airframe file cannot be read.
 Result<std::vector<Scene>> RenderScenes(const SceneSetParams& params);
+
+// One nadir view of `world` from a camera drone hovering at altitude_m over centre_m with the
+// given yaw and pixel noise (unit tests place a victim or draw a distractor and look).
+Result<Scene> RenderView(const physics::WorldConfig& world, const Eigen::Vector2d& centre_m, double altitude_m,
+                         double yaw_rad, double noise_std);
 
 // Tilted views: the camera drones are spawned hovering (rotors at hover speed) and given a random
 // differential rotor command (+-differential on throttle, by rotor position) for burst_s of
@@ -62,30 +90,4 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& params);
 Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& params, double differential,
                                               double burst_s);
 
-struct PerceptionScore {
-  int scenes = 0;
-  int full_victims = 0;        // must-detect instances
-  int true_positives = 0;      // detections matched to a kFull victim (one per victim)
-  int false_positives = 0;     // detections matching no victim in view
-  int partial_detected = 0;    // detections matched to a kPartial victim (not scored)
-  int partial_victims = 0;
-  std::vector<double> errors_m;  // geolocation error of each true positive [m]
-  double precision() const;
-  double recall() const;
-  double median_error_m() const;
-  double p90_error_m() const;
-};
-
-// Runs the pipeline on every scene with the camera pose `perturb`ed (seeded: position 1-sigma
-// position_sigma_m per axis, attitude 1-sigma attitude_sigma_rad per axis; zero = true pose) and
-// scores it: a detection matches the nearest victim within match_radius_m (victims lie >= 6 m
-// apart, so 2.5 m cannot match the wrong one; MissionState merges sightings within 5 m).
-struct PoseNoise {
-  std::uint64_t seed = 7;
-  double position_sigma_m = 0.0;
-  double attitude_sigma_rad = 0.0;
-};
-PerceptionScore ScorePerception(const std::vector<Scene>& scenes, const PerceptionParams& params,
-                                const PoseNoise& pose_noise, double match_radius_m = 2.5);
-
-}  // namespace swarmbox::swarm::testing
+}  // namespace swarmbox::perception_scenes

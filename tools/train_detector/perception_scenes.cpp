@@ -10,6 +10,7 @@
 #include <opencv2/core.hpp>
 
 #include "swarmbox/physics/airframe.hpp"
+#include "swarmbox/physics/ground_renderer.hpp"
 #include "swarmbox/physics/world.hpp"
 #include "swarmbox/physics/world_config.hpp"
 
@@ -17,7 +18,7 @@
 #error "SWARMBOX_TRIALS_DIR must point at the project's trials/ folder"
 #endif
 
-namespace swarmbox::swarm::testing {
+namespace swarmbox::perception_scenes {
 namespace {
 
 using Eigen::Vector2d;
@@ -52,7 +53,7 @@ bool SegmentHitsBox(const Vector3d& a, const Vector3d& b, const physics::Obstacl
 // the feet, head ellipse 0.13 x 0.11 m 0.7 m toward the head): kFull when every boundary sample
 // projects inside the image (1 px margin) with a clear line of sight, kAbsent when none projects
 // within 1 px of the image, kPartial otherwise.
-Visibility Classify(const physics::Victim& v, const Scene& scene, const physics::WorldConfig& world) {
+SceneVictim Classify(const physics::Victim& v, const Scene& scene, const physics::WorldConfig& world) {
   const double ch = std::cos(v.heading_rad), sh = std::sin(v.heading_rad);
   const Vector2d h(ch, sh), perp(-sh, ch);
   const Vector2d c(v.x_m, v.y_m);
@@ -64,26 +65,103 @@ Visibility Classify(const physics::Victim& v, const Scene& scene, const physics:
     pts.push_back(c + 0.70 * h + 0.13 * std::cos(t) * h + 0.11 * std::sin(t) * perp);
   }
   const double w = scene.image.width_px, hgt = scene.image.height_px;
-  std::size_t inside = 0, near = 0, hidden = 0;
+  std::size_t inside = 0, near = 0, hidden = 0, seen = 0;
   for (const Vector2d& q : pts) {
     const Vector3d g(q.x(), q.y(), 0.0);
     const std::optional<Vector2d> px = ProjectToPixel(g, scene.intrinsics, scene.true_pose);
     if (!px) continue;
     if (px->x() >= 1 && px->y() >= 1 && px->x() <= w - 2 && px->y() <= hgt - 2) ++inside;
     if (px->x() >= -1 && px->y() >= -1 && px->x() <= w && px->y() <= hgt) ++near;
+    const bool in = px->x() >= 1 && px->y() >= 1 && px->x() <= w - 2 && px->y() <= hgt - 2;
+    bool blocked = false;
     for (const physics::ObstacleBox& b : world.obstacles) {
       if (SegmentHitsBox(scene.true_pose.position_m, g, b)) {
-        ++hidden;
+        blocked = true;
         break;
       }
     }
+    hidden += blocked ? 1 : 0;
+    seen += in && !blocked ? 1 : 0;
   }
-  if (near == 0) return Visibility::kAbsent;
-  if (inside == pts.size() && hidden == 0) return Visibility::kFull;
-  return Visibility::kPartial;
+  SceneVictim out{Vector2d(v.x_m, v.y_m), Visibility::kPartial,
+                  static_cast<double>(seen) / static_cast<double>(pts.size())};
+  if (near == 0) out.visibility = Visibility::kAbsent;
+  else if (inside == pts.size() && hidden == 0) out.visibility = Visibility::kFull;
+  return out;
 }
 
-physics::WorldConfig MakeWorld(std::mt19937_64& rng, int index) {
+// The renderer's truth replaces the outline estimate of Classify (it knows cover and poses).
+void SetVisibleFractions(const physics::WorldConfig& config, const std::vector<physics::VisiblePerson>& people,
+                         Scene* s) {
+  for (std::size_t i = 0; i < config.victims.size(); ++i) {
+    double f = 0.0;
+    for (const physics::VisiblePerson& p : people) {
+      if (p.id == config.victims[i].id) f = p.visible_fraction;
+    }
+    s->victims[i].visible_fraction = f;
+  }
+}
+
+physics::Bgr Jitter(std::mt19937_64& rng, physics::Bgr c, int amount) {
+  std::uniform_int_distribution<int> j(-amount, amount);
+  for (auto& x : c) x = static_cast<std::uint8_t>(std::clamp(x + j(rng), 0, 255));
+  return c;
+}
+
+void VaryLook(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfig* w) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  static constexpr physics::TerrainKind kTerrains[] = {physics::TerrainKind::kGrass, physics::TerrainKind::kSoil,
+                                                       physics::TerrainKind::kGravel, physics::TerrainKind::kRubble,
+                                                       physics::TerrainKind::kMixed};
+  physics::Terrain terrain;
+  terrain.kind = kTerrains[rng() % 5];
+  terrain.water_fraction = unit(rng) < 0.3 ? 0.15 * unit(rng) : 0.0;
+  w->terrain = terrain;
+  physics::Lighting light;
+  light.time_of_day_h = 7.0 + 11.0 * unit(rng);
+  light.overcast = unit(rng);
+  w->lighting = light;
+  for (physics::ObstacleBox& b : w->obstacles) {
+    if (unit(rng) < 0.5) b.kind = physics::ObstacleKind::kTree;
+  }
+  // Clothing: greens, browns, greys, dark and bright colours (BGR).
+  static constexpr physics::Bgr kClothes[] = {
+      {40, 90, 40},   {60, 110, 70},  {50, 80, 60},   {40, 70, 110}, {30, 60, 90},  {60, 90, 120},
+      {110, 110, 110}, {70, 70, 70},  {150, 150, 150}, {90, 40, 20},  {30, 30, 30},  {220, 220, 220},
+      {30, 30, 200},  {30, 200, 230}, {200, 90, 30},  {160, 100, 230}, {0, 120, 255}, {120, 60, 140}};
+  for (physics::Victim& v : w->victims) {
+    const double pose = unit(rng);
+    v.pose = pose < 0.55 ? physics::VictimPose::kLying
+             : pose < 0.75 ? physics::VictimPose::kCurled
+             : pose < 0.92 ? physics::VictimPose::kSitting
+                           : physics::VictimPose::kStanding;
+    if (unit(rng) >= 1.0 / 6.0) v.clothing_bgr = Jitter(rng, kClothes[rng() % std::size(kClothes)], 15);
+    v.cover = unit(rng) < p.occluded_fraction ? 0.2 + 0.6 * unit(rng) : 0.0;
+  }
+  static constexpr physics::DistractorKind kKinds[] = {physics::DistractorKind::kTarp, physics::DistractorKind::kCone,
+                                                       physics::DistractorKind::kBackpack,
+                                                       physics::DistractorKind::kDebris, physics::DistractorKind::kRock};
+  const std::vector<physics::Victim> people = w->victims;
+  for (const physics::Victim& v : people) {
+    for (int k = 0; k < p.distractors; ++k) {
+      physics::Distractor d;
+      d.kind = kKinds[rng() % std::size(kKinds)];
+      const double r = 2.0 + 7.0 * unit(rng), a = 2 * std::numbers::pi * unit(rng);
+      d.x_m = v.x_m + r * std::cos(a);
+      d.y_m = v.y_m + r * std::sin(a);
+      d.heading_rad = 2 * std::numbers::pi * unit(rng);
+      d.size_m = physics::DefaultSizeM(d.kind) * (0.7 + 0.6 * unit(rng));
+      d.colour_bgr = physics::DefaultColour(d.kind);
+      if (d.kind == physics::DistractorKind::kTarp && unit(rng) < 0.5) {
+        d.colour_bgr = unit(rng) < 0.5 ? physics::Bgr{0, 110, 250} : physics::Bgr{30, 30, 190};
+      }
+      d.colour_bgr = Jitter(rng, d.colour_bgr, 20);
+      w->distractors.push_back(d);
+    }
+  }
+}
+
+physics::WorldConfig MakeWorld(std::mt19937_64& rng, int index, const SceneSetParams& p) {
   physics::WorldConfig w;
   w.name = "perception_" + std::to_string(index);
   w.size_x_m = 200;
@@ -112,6 +190,33 @@ physics::WorldConfig MakeWorld(std::mt19937_64& rng, int index) {
     for (const physics::Victim& v : w.victims) ok = ok && std::hypot(v.x_m - b.center_m.x, v.y_m - b.center_m.y) > reach;
     if (ok) w.obstacles.push_back(b);
   }
+  // Occluders, distractors and the varied look draw from the generator only when asked for, so the
+  // scene sets of the defaults stay what they were.
+  if (p.varied_look) {
+    VaryLook(rng, p, &w);
+    return w;
+  }
+  for (const physics::Victim& v : w.victims) {
+    if (p.occluded_fraction > 0 && unit(rng) < p.occluded_fraction) {
+      physics::ObstacleBox b;
+      b.id = "slab" + std::to_string(w.obstacles.size());
+      b.size_m = {0.5 + 0.7 * unit(rng), 0.4 + 0.5 * unit(rng), 0.3 + 0.3 * unit(rng)};
+      // Along the figure, from the feet (-0.9 m) to the head (+0.8 m).
+      const double along = -0.9 + 1.7 * unit(rng);
+      b.center_m = {v.x_m + along * std::cos(v.heading_rad), v.y_m + along * std::sin(v.heading_rad), b.size_m.z / 2};
+      b.yaw_rad = std::numbers::pi * unit(rng);
+      w.obstacles.push_back(b);
+    }
+    for (int k = 0; k < p.distractors; ++k) {
+      physics::ObstacleBox b;
+      b.id = "debris" + std::to_string(w.obstacles.size());
+      b.size_m = {0.3 + 1.2 * unit(rng), 0.3 + 0.8 * unit(rng), 0.1 + 0.5 * unit(rng)};
+      const double r = 2.5 + 6.0 * unit(rng), a = 2 * std::numbers::pi * unit(rng);
+      b.center_m = {v.x_m + r * std::cos(a), v.y_m + r * std::sin(a), b.size_m.z / 2};
+      b.yaw_rad = std::numbers::pi * unit(rng);
+      w.obstacles.push_back(b);
+    }
+  }
   return w;
 }
 
@@ -126,7 +231,7 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
   scenes.reserve(static_cast<std::size_t>(p.scenes));
   int world_index = 0;
   while (static_cast<int>(scenes.size()) < p.scenes) {
-    const physics::WorldConfig config = MakeWorld(rng, world_index);
+    const physics::WorldConfig config = MakeWorld(rng, world_index, p);
     Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = rng()});
     if (!world) return world.error().Context("creating perception world");
     const int count = std::min(p.scenes_per_world, p.scenes - static_cast<int>(scenes.size()));
@@ -151,7 +256,8 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
       Result<std::size_t> d = (*world)->AddDrone(spawn);
       if (!d) return d.error().Context("placing camera drone");
       Scene s;
-      (*world)->RenderCamera(*d, &s.image);
+      std::vector<physics::VisiblePerson> people;
+      (*world)->RenderCamera(*d, &s.image, &people);
       s.intrinsics = {s.image.intrinsics.fx_px, s.image.intrinsics.fy_px, s.image.intrinsics.cx_px,
                       s.image.intrinsics.cy_px};
       const physics::Pose& cp = s.image.camera_pose;
@@ -160,8 +266,9 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
       s.altitude_m = cp.position_m.z;
       s.noise_std = af.camera.noise_std;
       for (const physics::Victim& v : config.victims) {
-        s.victims.push_back({Vector2d(v.x_m, v.y_m), Classify(v, s, config)});
+        s.victims.push_back(Classify(v, s, config));
       }
+      SetVisibleFractions(config, people, &s);
       scenes.push_back(std::move(s));
     }
     ++world_index;
@@ -171,7 +278,8 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
 
 namespace {
 
-Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& config, double noise_std) {
+Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& config, double noise_std,
+                     const std::vector<physics::VisiblePerson>& people) {
   Scene s;
   s.image = std::move(image);
   s.intrinsics = {s.image.intrinsics.fx_px, s.image.intrinsics.fy_px, s.image.intrinsics.cx_px,
@@ -184,12 +292,34 @@ Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& con
   const Vector3d axis = s.true_pose.rotation * Vector3d::UnitZ();  // optical axis in the world
   s.tilt_rad = std::acos(std::clamp(-axis.z(), -1.0, 1.0));
   for (const physics::Victim& v : config.victims) {
-    s.victims.push_back({Vector2d(v.x_m, v.y_m), Classify(v, s, config)});
+    s.victims.push_back(Classify(v, s, config));
   }
+  SetVisibleFractions(config, people, &s);
   return s;
 }
 
 }  // namespace
+
+Result<Scene> RenderView(const physics::WorldConfig& config, const Vector2d& centre, double altitude,
+                         double yaw, double noise_std) {
+  Result<physics::Airframe> x500 = physics::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
+  if (!x500) return x500.error().Context("loading the x500 airframe for the camera");
+  Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = 1});
+  if (!world) return world.error().Context("creating perception world");
+  physics::Airframe af = *x500;
+  af.camera.noise_std = noise_std;
+  physics::DroneSpawn spawn;
+  spawn.name = "cam";
+  spawn.airframe = af;
+  spawn.position_m = {centre.x(), centre.y(), altitude - af.base_height_m};
+  spawn.yaw_rad = yaw;
+  Result<std::size_t> d = (*world)->AddDrone(spawn);
+  if (!d) return d.error().Context("placing camera drone");
+  physics::CameraImage img;
+  std::vector<physics::VisiblePerson> people;
+  (*world)->RenderCamera(*d, &img, &people);
+  return SceneFromImage(std::move(img), config, noise_std, people);
+}
 
 Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double differential, double burst_s) {
   Result<physics::Airframe> x500 = physics::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
@@ -199,7 +329,7 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double di
   std::vector<Scene> scenes;
   int world_index = 0;
   while (static_cast<int>(scenes.size()) < p.scenes) {
-    const physics::WorldConfig config = MakeWorld(rng, 1000 + world_index++);
+    const physics::WorldConfig config = MakeWorld(rng, 1000 + world_index++, p);
     Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = rng()});
     if (!world) return world.error().Context("creating perception world");
     const int count = std::min(p.scenes_per_world, p.scenes - static_cast<int>(scenes.size()));
@@ -240,78 +370,12 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double di
     }
     for (std::size_t i = 0; i < drones.size(); ++i) {
       physics::CameraImage img;
-      (*world)->RenderCamera(drones[i], &img);
-      scenes.push_back(SceneFromImage(std::move(img), config, noise[i]));
+      std::vector<physics::VisiblePerson> people;
+      (*world)->RenderCamera(drones[i], &img, &people);
+      scenes.push_back(SceneFromImage(std::move(img), config, noise[i], people));
     }
   }
   return scenes;
 }
 
-double PerceptionScore::precision() const {
-  const int positives = true_positives + false_positives;
-  return positives == 0 ? 1.0 : static_cast<double>(true_positives) / positives;
-}
-double PerceptionScore::recall() const {
-  return full_victims == 0 ? 1.0 : static_cast<double>(true_positives) / full_victims;
-}
-static double Quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  const auto i = static_cast<std::size_t>(std::floor(q * static_cast<double>(v.size() - 1) + 0.5));
-  return v[i];
-}
-double PerceptionScore::median_error_m() const { return Quantile(errors_m, 0.5); }
-double PerceptionScore::p90_error_m() const { return Quantile(errors_m, 0.9); }
-
-PerceptionScore ScorePerception(const std::vector<Scene>& scenes, const PerceptionParams& params,
-                                const PoseNoise& noise, double match_radius_m) {
-  PerceptionScore score;
-  VictimPerception perception(params);
-  std::mt19937_64 rng(noise.seed);
-  std::normal_distribution<double> n01(0.0, 1.0);
-  std::vector<GroundDetection> ready;
-  double t = 0.0;
-  for (const Scene& s : scenes) {
-    ++score.scenes;
-    OpticalPose est = s.true_pose;
-    est.position_m += noise.position_sigma_m * Vector3d(n01(rng), n01(rng), n01(rng));
-    const Vector3d rv = noise.attitude_sigma_rad * Vector3d(n01(rng), n01(rng), n01(rng));
-    if (rv.norm() > 0) est.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(rv.norm(), rv.normalized())) * est.rotation;
-    cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
-    perception.ProcessFrame(bgr, s.intrinsics, est, t);
-    ready.clear();
-    perception.PopVisible(t + params.latency_s, &ready);
-    t += 1.0;
-    std::vector<bool> matched(s.victims.size(), false);
-    for (const SceneVictim& v : s.victims) {
-      score.full_victims += v.visibility == Visibility::kFull ? 1 : 0;
-      score.partial_victims += v.visibility == Visibility::kPartial ? 1 : 0;
-    }
-    for (const GroundDetection& d : ready) {
-      std::size_t best = s.victims.size();
-      double best_d = match_radius_m;
-      for (std::size_t i = 0; i < s.victims.size(); ++i) {
-        if (s.victims[i].visibility == Visibility::kAbsent) continue;
-        const double e = (s.victims[i].position_m - d.position_m.head<2>()).norm();
-        if (e <= best_d) {
-          best_d = e;
-          best = i;
-        }
-      }
-      if (best == s.victims.size()) {
-        ++score.false_positives;
-      } else if (s.victims[best].visibility == Visibility::kPartial) {
-        ++score.partial_detected;
-      } else if (!matched[best]) {
-        matched[best] = true;
-        ++score.true_positives;
-        score.errors_m.push_back(best_d);
-      } else {
-        ++score.false_positives;  // a second detection of the same victim
-      }
-    }
-  }
-  return score;
-}
-
-}  // namespace swarmbox::swarm::testing
+}  // namespace swarmbox::perception_scenes

@@ -1,0 +1,114 @@
+// VictimDetectorModel: the trained part of the victim detector (victim_detector.hpp), its features
+// and its file format. Written by `tools/train_detector` (target `train-detector`), shipped as
+// agent/swarm/models/victim_detector.yml.gz and compiled into the agent (ShippedDetectorModel()).
+//
+// Features (aggregated channel features, Dollar et al., "Fast Feature Pyramids for Object
+// Detection", PAMI 2014), computed on the frame rescaled to kCanonicalPxPerM (so a person is the
+// same size in pixels at every altitude) and padded by kPadCells on every side:
+//   channels  L, u, v (CIE Luv, 8-bit scaled to [0, 1]), gradient magnitude of L, and the magnitude
+//             in kOrientations unsigned orientation bins: kChannels maps;
+//   cells     each channel averaged over kShrink x kShrink pixels (a cell is 0.25 m);
+//   window    kWindowCells x kWindowCells cells (3 x 3 m, a lying adult with room around it).
+// A window's feature vector: the gradient cells as they are, the colour cells minus the window's
+// mean of that channel (a person differs from the ground around it, whatever the light), and the
+// window's three colour means: kFeatures values.
+//
+// Classifier: a linear first stage (ridge-regression discriminant, weights per channel cell,
+// evaluated densely as one correlation per channel), then cv::ml::RTrees (a random forest) on the
+// first stage's local maxima with the first-stage score as one more feature, and a Platt sigmoid
+// that maps the forest's vote fraction to a probability (fitted on calibration scenes).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+#include <opencv2/ml.hpp>
+
+#include "swarmbox/common/result.hpp"
+
+namespace swarmbox::swarm {
+
+inline constexpr double kCanonicalPxPerM = 8.0;
+inline constexpr int kShrink = 2;
+inline constexpr int kWindowCells = 12;
+inline constexpr int kPadCells = 4;           // 1 m: people cut by the border are still seen
+inline constexpr int kOrientations = 4;
+inline constexpr int kColourChannels = 3;
+inline constexpr int kChannels = kColourChannels + 1 + kOrientations;
+inline constexpr int kWindowFeatures = kChannels * kWindowCells * kWindowCells + kColourChannels;
+inline constexpr int kForestFeatures = kWindowFeatures + 1;  // + the first-stage score
+
+// Channel maps at cell resolution (CV_32F each), with scratch images kept between frames.
+struct ChannelMaps {
+  std::vector<cv::Mat> cells;  // kChannels maps, rows x cols cells
+  cv::Mat canonical, padded, luv, l, gx, gy, mag, angle;
+  std::vector<cv::Mat> full;   // kChannels maps at canonical pixel resolution
+  int rows() const { return cells.empty() ? 0 : cells[0].rows; }
+  int cols() const { return cells.empty() ? 0 : cells[0].cols; }
+};
+
+// Rescales `bgr` (CV_8UC3) by `scale` (canonical px per input px), pads and computes the maps.
+void ComputeChannels(const cv::Mat& bgr, double scale, ChannelMaps* maps);
+
+// The window with top-left cell (row, col): kWindowFeatures values appended to `out`.
+void WindowFeatures(const ChannelMaps& maps, int row, int col, float* out);
+
+// Canonical-pixel position (padded image) of a window's centre, and back to an input pixel.
+inline double WindowCentreCanonical(int cell) { return kShrink * (cell + kWindowCells / 2.0); }
+inline double CanonicalToInput(double padded_canonical_px, double scale) {
+  return (padded_canonical_px - kPadCells * kShrink) / scale - 0.5;
+}
+inline double InputToCanonical(double input_px, double scale) {
+  return (input_px + 0.5) * scale + kPadCells * kShrink;
+}
+
+struct VictimDetectorModel {
+  // First stage: score(window) = bias + sum over channels of the correlation of the cell map with
+  // kernels[c] (kWindowCells x kWindowCells, CV_32F); candidates score >= stage1_threshold.
+  std::vector<cv::Mat> kernels;
+  double bias = 0;
+  double stage1_threshold = 0;
+  cv::Ptr<cv::ml::RTrees> forest;  // class 1 = person; kForestFeatures inputs
+  double platt_a = -8.0;           // p = 1 / (1 + exp(platt_a * votes + platt_b))
+  double platt_b = 4.0;
+  std::vector<std::uint64_t> training_seeds;     // scene-set seeds the forest was trained on
+  std::vector<std::uint64_t> calibration_seeds;  // scene-set seeds the sigmoid was fitted on
+
+  // The forest flattened for prediction without allocation (FlattenForest(); the same decisions
+  // as cv::ml::DTrees::predict for ordered variables: value <= threshold goes left, unless the split
+  // is inversed).
+  struct ForestNode {
+    int var = -1;          // -1: a leaf
+    float threshold = 0;
+    int left = -1;         // indices into nodes
+    int right = -1;
+    float person = 0;      // leaf: 1 when it votes "person"
+  };
+  std::vector<ForestNode> nodes;
+  std::vector<int> roots;
+
+  // Rebuilds nodes/roots from `forest`.
+  void FlattenForest();
+  // Fraction of the trees voting "person" for kForestFeatures values.
+  double Votes(const float* forest_features) const;
+  // First-stage score of one feature vector (the same sum as the dense correlation).
+  double LinearScore(const float* window_features) const;
+  // Linear weights over kWindowFeatures in feature order (for training: folded into kernels).
+  void SetLinear(const std::vector<double>& weights, double bias);
+  double Probability(double votes) const;
+};
+
+Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& path);
+Result<std::shared_ptr<const VictimDetectorModel>> LoadDetectorModel(const std::string& path);
+// From the text of the YAML file (the shipped model is compiled in gzip-compressed).
+Result<std::shared_ptr<const VictimDetectorModel>> LoadDetectorModelFromText(const std::string& yaml);
+Result<std::string> GunzipText(const unsigned char* data, std::size_t size);
+
+// The model compiled into the binary from agent/swarm/models/victim_detector.yml.gz. Loaded once;
+// aborts (SWARMBOX_CHECK) when the compiled-in bytes do not parse: a broken build, not a runtime
+// condition.
+std::shared_ptr<const VictimDetectorModel> ShippedDetectorModel();
+
+}  // namespace swarmbox::swarm

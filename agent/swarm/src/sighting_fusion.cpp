@@ -1,0 +1,130 @@
+#include "swarmbox/swarm/sighting_fusion.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "swarmbox/common/result.hpp"
+
+namespace swarmbox::swarm {
+namespace {
+
+double Logit(double p) { return std::log(p / (1.0 - p)); }
+
+struct Viewpoint {
+  double x, y, h, t;
+};
+
+}  // namespace
+
+std::string FusionParamsProblem(const FusionParams& p) {
+  if (!(p.prior > 0 && p.prior < 1)) return "prior must be in (0, 1)";
+  if (!(p.max_view_confidence > 0.5 && p.max_view_confidence < 1)) return "max_view_confidence must be in (0.5, 1)";
+  if (!(p.min_baseline_m >= 0 && p.min_pass_interval_s >= 0)) return "min_baseline_m and min_pass_interval_s must be >= 0";
+  if (!(p.detector_recall > 0 && p.detector_recall < 1)) return "detector_recall must be in (0, 1)";
+  if (!(p.false_repeat >= 0 && p.false_repeat < p.detector_recall)) {
+    return "false_repeat must be in [0, detector_recall): a miss must count against a candidate";
+  }
+  if (!(p.reject_belief > 0 && p.reject_belief < p.confirm_belief && p.confirm_belief < 1)) {
+    return "expected 0 < reject_belief < confirm_belief < 1";
+  }
+  if (p.confirm_views < 2) return "confirm_views must be >= 2: a single view never confirms";
+  if (!(p.miss_in_view_m > 0 && p.min_miss_height_m >= 0 && p.max_miss_height_m > p.min_miss_height_m)) {
+    return "expected miss_in_view_m > 0 and 0 <= min_miss_height_m < max_miss_height_m";
+  }
+  if (p.max_revisits < 1) return "max_revisits must be >= 1";
+  if (!(p.revisit_after_s >= 0 && p.revisit_timeout_s > 0)) return "expected revisit_after_s >= 0, revisit_timeout_s > 0";
+  return "";
+}
+
+void CheckFusionParams(const FusionParams& p) {
+  const std::string why = FusionParamsProblem(p);
+  if (!why.empty()) {
+    std::fprintf(stderr, "FusionParams: %s\n", why.c_str());
+    std::abort();
+  }
+}
+
+double ViewLogOdds(const raft::SightingView& view, const FusionParams& p) {
+  if (view.detected) return Logit(std::clamp(view.confidence, 1e-6, p.max_view_confidence));
+  return std::log((1.0 - p.detector_recall) / (1.0 - p.false_repeat));
+}
+
+bool MissInView(const raft::SightingView& view, double candidate_x_m, double candidate_y_m, const FusionParams& p) {
+  const double off = std::hypot(view.viewer_x_m - candidate_x_m, view.viewer_y_m - candidate_y_m);
+  return off <= p.miss_in_view_m && view.viewer_height_m >= p.min_miss_height_m &&
+         view.viewer_height_m <= p.max_miss_height_m;
+}
+
+FusionAssessment AssessCandidate(const raft::Candidate& c, const FusionParams& p) {
+  FusionAssessment a;
+  a.log_odds = Logit(p.prior);
+  std::vector<Viewpoint> counted;
+  counted.reserve(c.views.size());
+  for (const raft::SightingView& v : c.views) {
+    a.last_view_s = std::max(a.last_view_s, v.t_s);
+    if (v.detected) {
+      ++a.detections;
+    } else {
+      ++a.misses;
+      if (!MissInView(v, c.x_m, c.y_m, p)) continue;  // the place was not (well) in view: no evidence
+    }
+    bool independent = true;
+    for (const Viewpoint& q : counted) {
+      const double baseline = std::sqrt((v.viewer_x_m - q.x) * (v.viewer_x_m - q.x) +
+                                        (v.viewer_y_m - q.y) * (v.viewer_y_m - q.y) +
+                                        (v.viewer_height_m - q.h) * (v.viewer_height_m - q.h));
+      independent = independent && (baseline >= p.min_baseline_m || std::abs(v.t_s - q.t) >= p.min_pass_interval_s);
+    }
+    if (!independent) continue;
+    counted.push_back({v.viewer_x_m, v.viewer_y_m, v.viewer_height_m, v.t_s});
+    a.log_odds += ViewLogOdds(v, p);
+    (v.detected ? a.counted_detections : a.counted_misses) += 1;
+  }
+  a.belief = 1.0 / (1.0 + std::exp(-a.log_odds));
+  if (c.status == raft::CandidateStatus::kConfirmed) return a;
+  if (a.belief >= p.confirm_belief && a.counted_detections >= p.confirm_views) {
+    a.decision = FusionDecision::kConfirm;
+  } else if (c.status == raft::CandidateStatus::kPending) {
+    if (a.belief <= p.reject_belief && a.counted_misses >= 1) {
+      a.decision = FusionDecision::kReject;
+    } else if (static_cast<int>(c.revisits) >= p.max_revisits && c.revisit_drone.empty()) {
+      a.decision = FusionDecision::kReject;
+      a.undecided = true;
+    }
+  }
+  return a;
+}
+
+void AddEvidence(LogEvent& e, const raft::Candidate& c, const FusionAssessment& a) {
+  std::string drones, confidences, viewers, times;
+  char buf[96];
+  for (const raft::SightingView& v : c.views) {
+    const char* sep = drones.empty() ? "" : ",";
+    drones += sep + v.reporter;
+    std::snprintf(buf, sizeof buf, "%s%.3f", sep, v.detected ? v.confidence : 0.0);
+    confidences += buf;
+    std::snprintf(buf, sizeof buf, "%s%.1f:%.1f:%.1f", sep, v.viewer_x_m, v.viewer_y_m, v.viewer_height_m);
+    viewers += buf;
+    std::snprintf(buf, sizeof buf, "%s%.2f", sep, v.t_s);
+    times += buf;
+  }
+  e.Add("candidate", static_cast<std::int64_t>(c.id))
+      .Add("x", c.x_m, 2)
+      .Add("y", c.y_m, 2)
+      .Add("belief", a.belief, 3)
+      .Add("log_odds", a.log_odds, 2)
+      .Add("views", a.detections)
+      .Add("counted", a.counted_detections)
+      .Add("misses", a.misses)
+      .Add("counted_misses", a.counted_misses)
+      .Add("drones", drones)
+      .Add("confidences", confidences)
+      .Add("viewers", viewers)
+      .Add("view_t", times);
+}
+
+}  // namespace swarmbox::swarm

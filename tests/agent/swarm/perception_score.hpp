@@ -1,0 +1,65 @@
+// Scoring of the perception pipeline on the seeded scenes of tools/train_detector/
+// perception_scenes.hpp (rendered by the physics server's camera), used by the perception tests and
+// `swarmbox-bench perception`.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "perception_scenes.hpp"
+#include "swarmbox/swarm/victim_perception.hpp"
+
+namespace swarmbox::swarm::testing {
+
+using perception_scenes::RenderScenes;
+using perception_scenes::RenderTiltedScenes;
+using perception_scenes::Scene;
+using perception_scenes::SceneSetParams;
+using perception_scenes::SceneVictim;
+using perception_scenes::Visibility;
+
+struct PerceptionScore {
+  int scenes = 0;
+  int full_victims = 0;        // must-detect instances
+  int true_positives = 0;      // detections matched to a kFull victim (one per victim)
+  int false_positives = 0;     // detections matching no victim in view
+  int partial_detected = 0;    // detections matched to a kPartial victim (not scored)
+  int partial_victims = 0;
+  std::vector<double> errors_m;  // geolocation error of each true positive [m]
+  double precision() const;
+  double recall() const;
+  double median_error_m() const;
+  double p90_error_m() const;
+};
+
+// Runs the pipeline on every scene with the camera pose `perturb`ed (seeded: position 1-sigma
+// position_sigma_m per axis, attitude 1-sigma attitude_sigma_rad per axis; zero = true pose) and
+// scores it: a detection matches the nearest victim within match_radius_m (victims lie >= 6 m
+// apart, so 2.5 m cannot match the wrong one; MissionState merges sightings within 5 m).
+struct PoseNoise {
+  std::uint64_t seed = 7;
+  double position_sigma_m = 0.0;
+  double attitude_sigma_rad = 0.0;
+};
+PerceptionScore ScorePerception(const std::vector<Scene>& scenes, const PerceptionParams& params,
+                                const PoseNoise& pose_noise, double match_radius_m = 2.5);
+
+// Detection curves of the detector alone (no latency queue): every detection of every scene with
+// its confidence, geolocated with the true pose; a detection within match_radius_m of a person at
+// least must_fraction visible is a true positive (the first one; a second is a false positive),
+// one near a less visible person is not counted, any other is a false positive.
+struct DetectionCurve {
+  int scenes = 0;
+  int persons = 0;                 // at least must_fraction visible
+  int tp = 0;                      // at confidence >= operating_point
+  int fp = 0;
+  double precision = 1.0;          // at the operating point
+  double recall = 1.0;
+  double ap = 0.0;                 // area under the interpolated precision-recall curve (VOC)
+  double ms_per_frame = 0.0;       // Detect() wall time per frame (the caller sets the threads)
+};
+DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector,
+                               double operating_point = 0.5, double must_fraction = 0.5,
+                               double match_radius_m = 1.5);
+
+}  // namespace swarmbox::swarm::testing

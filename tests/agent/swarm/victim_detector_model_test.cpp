@@ -1,0 +1,111 @@
+// The shipped detector model (agent/swarm/models/, written by `cmake --build build --target
+// train-detector`): it loads, it was trained and calibrated on scene seeds the evaluation never
+// uses, the binary carries the same model as the committed file, and the flattened forest the
+// detector runs decides as OpenCV's RTrees.
+#include <algorithm>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "perception_scenes.hpp"
+#include "swarmbox/swarm/victim_detector_model.hpp"
+
+#ifndef SWARMBOX_DETECTOR_MODELS_DIR
+#error "SWARMBOX_DETECTOR_MODELS_DIR must point at agent/swarm/models"
+#endif
+
+namespace swarmbox::swarm {
+namespace {
+
+const std::string kModelDir = SWARMBOX_DETECTOR_MODELS_DIR;
+
+TEST(VictimDetectorModel, TheCommittedModelWasTrainedOnSeedsDisjointFromTheEvaluationSeeds) {
+  Result<std::shared_ptr<const VictimDetectorModel>> m = LoadDetectorModel(kModelDir + "/victim_detector.yml.gz");
+  ASSERT_TRUE(m.ok()) << m.error().ToString();
+  const VictimDetectorModel& model = **m;
+  ASSERT_FALSE(model.training_seeds.empty());
+  ASSERT_FALSE(model.calibration_seeds.empty());
+  for (std::uint64_t e : perception_scenes::kEvaluationSeeds) {
+    EXPECT_EQ(std::count(model.training_seeds.begin(), model.training_seeds.end(), e), 0) << e;
+    EXPECT_EQ(std::count(model.calibration_seeds.begin(), model.calibration_seeds.end(), e), 0) << e;
+  }
+  for (std::uint64_t t : model.training_seeds) {
+    EXPECT_EQ(std::count(model.calibration_seeds.begin(), model.calibration_seeds.end(), t), 0) << t;
+  }
+  // The report beside it names the same seeds.
+  std::ifstream f(kModelDir + "/victim_detector.json");
+  ASSERT_TRUE(f.good());
+  std::stringstream json;
+  json << f.rdbuf();
+  std::ostringstream seeds;
+  seeds << "\"training_seeds\": [";
+  for (std::size_t i = 0; i < model.training_seeds.size(); ++i) seeds << (i ? ", " : "") << model.training_seeds[i];
+  seeds << "]";
+  EXPECT_NE(json.str().find(seeds.str()), std::string::npos) << seeds.str();
+}
+
+TEST(VictimDetectorModel, TheBinaryCarriesTheCommittedModel) {
+  Result<std::shared_ptr<const VictimDetectorModel>> file = LoadDetectorModel(kModelDir + "/victim_detector.yml.gz");
+  ASSERT_TRUE(file.ok()) << file.error().ToString();
+  const std::shared_ptr<const VictimDetectorModel> shipped = ShippedDetectorModel();
+  EXPECT_EQ(shipped->training_seeds, (*file)->training_seeds);
+  EXPECT_DOUBLE_EQ(shipped->bias, (*file)->bias);
+  EXPECT_DOUBLE_EQ(shipped->stage1_threshold, (*file)->stage1_threshold);
+  EXPECT_DOUBLE_EQ(shipped->platt_a, (*file)->platt_a);
+  EXPECT_EQ(shipped->nodes.size(), (*file)->nodes.size());
+  EXPECT_EQ(cv::norm(shipped->kernels[3], (*file)->kernels[3], cv::NORM_INF), 0.0);
+}
+
+TEST(VictimDetectorModel, TheFlattenedForestVotesAsRTrees) {
+  const std::shared_ptr<const VictimDetectorModel> m = ShippedDetectorModel();
+  std::mt19937_64 rng(3);
+  // Feature values around the split thresholds: random draws from the thresholds themselves.
+  std::vector<float> thresholds;
+  for (const VictimDetectorModel::ForestNode& n : m->nodes) {
+    if (n.var >= 0) thresholds.push_back(n.threshold);
+  }
+  ASSERT_FALSE(thresholds.empty());
+  cv::Mat x(200, kForestFeatures, CV_32F);
+  std::uniform_int_distribution<std::size_t> pick(0, thresholds.size() - 1);
+  for (int i = 0; i < x.rows; ++i) {
+    for (int j = 0; j < x.cols; ++j) x.at<float>(i, j) = thresholds[pick(rng)];
+  }
+  cv::Mat votes;
+  m->forest->getVotes(x, votes, 0);
+  const int person_col = votes.at<int>(0, 0) == 1 ? 0 : 1;
+  for (int i = 0; i < x.rows; ++i) {
+    const double trees = votes.at<int>(i + 1, 0) + votes.at<int>(i + 1, 1);
+    EXPECT_DOUBLE_EQ(m->Votes(x.ptr<float>(i)), votes.at<int>(i + 1, person_col) / trees) << "sample " << i;
+  }
+}
+
+TEST(VictimDetectorModel, ConfidenceIsACalibratedIncreasingProbability) {
+  const std::shared_ptr<const VictimDetectorModel> m = ShippedDetectorModel();
+  EXPECT_LT(m->platt_a, 0.0);  // more votes, more confidence
+  double last = -1;
+  for (double v = 0; v <= 1.0; v += 0.05) {
+    const double p = m->Probability(v);
+    EXPECT_GE(p, 0.0);
+    EXPECT_LE(p, 1.0);
+    EXPECT_GT(p, last);
+    last = p;
+  }
+}
+
+TEST(VictimDetectorModel, AModelOfAnotherLayoutIsRefusedWithTheReason) {
+  const std::string path = ::testing::TempDir() + "/other_layout.yml";
+  {
+    cv::FileStorage fs(path, cv::FileStorage::WRITE);
+    fs << "format_version" << 1 << "canonical_px_per_m" << 8.0 << "shrink" << 4;
+  }
+  Result<std::shared_ptr<const VictimDetectorModel>> m = LoadDetectorModel(path);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.error().message().find("retrain"), std::string::npos) << m.error().ToString();
+  EXPECT_FALSE(LoadDetectorModel(path + ".missing").ok());
+}
+
+}  // namespace
+}  // namespace swarmbox::swarm

@@ -1,0 +1,90 @@
+// swarmbox-train-detector: trains the victim detector and writes the model and its report.
+//
+//   swarmbox-train-detector --out-dir agent/swarm/models
+//   (the build runs it: cmake --build build --target train-detector)
+//   swarmbox-train-detector --out-dir agent/swarm/models --recalibrate
+//   (steps 4-5 only, on the model in --out-dir: the sigmoid and the figures; the JSON keeps the
+//   training lines and gets "recalibrated": true)
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <string_view>
+
+#include "train_detector.hpp"
+
+int main(int argc, char** argv) {
+  std::string out_dir;
+  bool recalibrate = false;
+  swarmbox::train_detector::TrainingOptions options = swarmbox::train_detector::DefaultTrainingOptions();
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "--out-dir" && i + 1 < argc) {
+      out_dir = argv[++i];
+    } else if (a == "--recalibrate") {
+      recalibrate = true;
+    } else if (a == "--scenes-per-set" && i + 1 < argc) {
+      options.scenes_per_set = std::stoi(argv[++i]);
+    } else {
+      std::fprintf(stderr, "usage: swarmbox-train-detector --out-dir DIR [--scenes-per-set N]\n");
+      return 2;
+    }
+  }
+  if (out_dir.empty()) {
+    std::fprintf(stderr, "swarmbox-train-detector: --out-dir is required\n");
+    return 2;
+  }
+  swarmbox::train_detector::TrainingReport report;
+  const std::string model_path = out_dir + "/victim_detector.yml.gz";
+  const std::string json_path = out_dir + "/victim_detector.json";
+  std::string old_json;
+  if (recalibrate) {
+    std::ifstream in(json_path);
+    std::stringstream text;
+    text << in.rdbuf();
+    old_json = text.str();
+  }
+  swarmbox::Result<swarmbox::swarm::VictimDetectorModel> model =
+      recalibrate ? swarmbox::train_detector::Recalibrate(options, model_path, &report)
+                  : swarmbox::train_detector::Train(options, &report);
+  if (!model) {
+    std::fprintf(stderr, "swarmbox-train-detector: %s\n", model.error().ToString().c_str());
+    return 1;
+  }
+  if (swarmbox::Status s = swarmbox::swarm::SaveDetectorModel(*model, model_path); !s) {
+    std::fprintf(stderr, "swarmbox-train-detector: %s\n", s.error().ToString().c_str());
+    return 1;
+  }
+  std::string text = swarmbox::train_detector::ReportJson(*model, options, report);
+  if (recalibrate) {
+    // The training lines of the old report, the calibration lines of the new one.
+    std::istringstream old_lines(old_json), new_lines(text);
+    std::string line, merged;
+    auto calibration_line = [](const std::string& l) {
+      return l.find("\"platt\"") != std::string::npos || l.find("\"calibration_figures\"") != std::string::npos ||
+             l.find("\"stage1_calibration_recall\"") != std::string::npos;
+    };
+    std::string fresh;
+    while (std::getline(new_lines, line)) {
+      if (calibration_line(line)) fresh += line + "\n";
+    }
+    while (std::getline(old_lines, line)) {
+      if (calibration_line(line)) continue;
+      if (line.find("\"training_seconds\"") != std::string::npos) {
+        merged += fresh + "  \"recalibrated\": true,\n";
+      }
+      merged += line + "\n";
+    }
+    text = merged;
+  }
+  std::ofstream json(json_path);
+  json << text;
+  if (!json) {
+    std::fprintf(stderr, "swarmbox-train-detector: cannot write %s\n", json_path.c_str());
+    return 1;
+  }
+  std::printf("train-detector: wrote %s and %s (precision %.4f recall %.4f at 0.5 on %d calibration scenes, %.0f s)\n",
+              model_path.c_str(), json_path.c_str(), report.precision, report.recall, report.calibration_scenes,
+              report.seconds);
+  return 0;
+}

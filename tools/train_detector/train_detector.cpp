@@ -1,0 +1,551 @@
+#include "train_detector.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "swarmbox/swarm/geolocation.hpp"
+#include "swarmbox/swarm/victim_detector.hpp"
+
+namespace swarmbox::train_detector {
+namespace {
+
+using perception_scenes::Scene;
+using perception_scenes::SceneVictim;
+
+constexpr double kMustDetectFraction = 0.5;   // "at least half visible"
+constexpr double kPositiveRadiusM = 0.75;
+constexpr double kNegativeRadiusM = 1.5;
+constexpr int kRandomNegativesPerScene = 40;
+constexpr int kStage2CandidatesPerScene = 96;
+// A window one cell (0.25 m) off a person's centre is taught a lower score than the centred one, so
+// the first stage peaks on the person (geolocation) rather than anywhere on a plateau.
+constexpr float kShiftedTarget = 0.3f;
+
+// Ground scale at the image centre, as VictimDetector::Detect(pose) computes it.
+double PixelsPerMetre(const Scene& s) {
+  const std::optional<Eigen::Vector3d> c =
+      swarm::PixelToGround({s.intrinsics.cx_px, s.intrinsics.cy_px}, s.intrinsics, s.true_pose, 0.0);
+  const Eigen::Vector3d axis = s.true_pose.rotation * Eigen::Vector3d::UnitZ();
+  const double range = c ? (*c - s.true_pose.position_m).dot(axis) : s.altitude_m;
+  return s.intrinsics.fx_px / range;
+}
+
+// A person's centre in padded canonical pixels, or nothing when it does not project.
+std::optional<Eigen::Vector2d> CanonicalOf(const SceneVictim& v, const Scene& s, double scale) {
+  const std::optional<Eigen::Vector2d> px =
+      swarm::ProjectToPixel(Eigen::Vector3d(v.position_m.x(), v.position_m.y(), 0.0), s.intrinsics, s.true_pose);
+  if (!px) return std::nullopt;
+  return Eigen::Vector2d(swarm::InputToCanonical(px->x(), scale), swarm::InputToCanonical(px->y(), scale));
+}
+
+struct Labelled {
+  std::vector<float> x;  // rows of kForestFeatures (stage 2) or kWindowFeatures (stage 1)
+  std::vector<int> y;
+  std::vector<float> target;  // stage 1: regression target (1 centred, kShiftedTarget shifted, -1)
+  int rows() const { return static_cast<int>(y.size()); }
+};
+
+cv::Mat BgrOf(const Scene& s) {
+  return cv::Mat(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
+}
+
+// Nearest person (any visibility > 0) to a canonical point, in metres, and whether it must be detected.
+std::pair<double, bool> NearestPerson(const Scene& s, double scale, const Eigen::Vector2d& canonical) {
+  double best = 1e9;
+  bool must = false;
+  for (const SceneVictim& v : s.victims) {
+    if (v.visible_fraction <= 0) continue;
+    const std::optional<Eigen::Vector2d> c = CanonicalOf(v, s, scale);
+    if (!c) continue;
+    const double d = (*c - canonical).norm() / swarm::kCanonicalPxPerM;
+    if (d < best) {
+      best = d;
+      must = v.visible_fraction >= kMustDetectFraction;
+    }
+  }
+  return {best, must};
+}
+
+// Clutter painted on a rendered frame, away from every person: tarps and sheets (rotated
+// rectangles 0.5-4 m, any colour, orange and red often), round things (cones, rocks, backpacks seen
+// from above: 0.2-0.8 m) and specks. What the renderer cannot draw yet, so the forest also learns
+// that colour alone is not a person.
+void PaintClutter(Scene& s, double ppm, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0, 1);
+  cv::Mat img(s.image.height_px, s.image.width_px, CV_8UC3, s.image.bgr.data());
+  const int count = static_cast<int>(u(rng) * 4);
+  for (int k = 0; k < count; ++k) {
+    const double size_m = u(rng) < 0.5 ? 0.5 + 3.5 * u(rng) : 0.2 + 0.6 * u(rng);
+    const cv::Point2d c(u(rng) * img.cols, u(rng) * img.rows);
+    bool clear = true;
+    for (const SceneVictim& v : s.victims) {
+      const std::optional<Eigen::Vector2d> px =
+          swarm::ProjectToPixel(Eigen::Vector3d(v.position_m.x(), v.position_m.y(), 0.0), s.intrinsics, s.true_pose);
+      if (px && std::hypot(px->x() - c.x, px->y() - c.y) < (1.5 + size_m) * ppm) clear = false;
+    }
+    if (!clear) continue;
+    cv::Scalar colour(255 * u(rng), 255 * u(rng), 255 * u(rng));
+    const double pick = u(rng);
+    if (pick < 0.3) colour = cv::Scalar(20 * u(rng), 80 + 80 * u(rng), 200 + 55 * u(rng));  // orange
+    else if (pick < 0.45) colour = cv::Scalar(30 * u(rng), 30 * u(rng), 150 + 105 * u(rng));  // red
+    const double w = size_m * ppm, h = size_m * (0.4 + 0.6 * u(rng)) * ppm;
+    if (size_m > 0.8 || u(rng) < 0.5) {
+      const cv::RotatedRect r(c, cv::Size2f(static_cast<float>(w), static_cast<float>(h)), static_cast<float>(180 * u(rng)));
+      cv::Point2f p[4];
+      r.points(p);
+      std::vector<cv::Point> poly(p, p + 4);
+      cv::fillConvexPoly(img, poly, colour, cv::LINE_AA);
+    } else {
+      cv::circle(img, c, std::max(1, static_cast<int>(w / 2)), colour, cv::FILLED, cv::LINE_AA);
+    }
+  }
+}
+
+std::size_t NearestIndex(const Scene& s, double scale, const Eigen::Vector2d& canonical) {
+  std::size_t best = s.victims.size();
+  double best_d = 1e18;
+  for (std::size_t i = 0; i < s.victims.size(); ++i) {
+    const std::optional<Eigen::Vector2d> c = CanonicalOf(s.victims[i], s, scale);
+    if (!c) continue;
+    const double d = (*c - canonical).norm();
+    if (d < best_d) {
+      best_d = d;
+      best = i;
+    }
+  }
+  return best;
+}
+
+Result<std::vector<Scene>> RenderSets(const std::vector<std::uint64_t>& seeds, int scenes) {
+  std::vector<Scene> all;
+  std::mt19937_64 rng(0xC1A77E5);
+  for (std::uint64_t seed : seeds) {
+    Result<std::vector<Scene>> s = perception_scenes::RenderScenes(TrainingSceneSet(seed, scenes));
+    if (!s) return s.error().Context("rendering training scene set " + std::to_string(seed));
+    for (Scene& x : *s) {
+      if (std::uniform_real_distribution<double>(0, 1)(rng) < 0.5) PaintClutter(x, PixelsPerMetre(x), rng);
+      all.push_back(std::move(x));
+    }
+  }
+  return all;
+}
+
+// Ridge-regression discriminant on standardised features, targets +-1 with the classes weighted
+// equally; returns weights and bias over raw features.
+std::pair<std::vector<double>, double> FitLinear(const Labelled& d, double lambda) {
+  const int n = d.rows(), f = swarm::kWindowFeatures;
+  cv::Mat x(n, f, CV_32F, const_cast<float*>(d.x.data()));
+  cv::Mat mean, stddev;
+  cv::Mat mean_row(1, f, CV_64F), std_row(1, f, CV_64F);
+  for (int j = 0; j < f; ++j) {
+    cv::meanStdDev(x.col(j), mean, stddev);
+    mean_row.at<double>(j) = mean.at<double>(0);
+    std_row.at<double>(j) = std::max(stddev.at<double>(0), 1e-6);
+  }
+  int pos = 0;
+  for (int y : d.y) pos += y;
+  const double wp = 0.5 / std::max(1, pos), wn = 0.5 / std::max(1, n - pos);
+  cv::Mat z(n, f + 1, CV_32F), t(n, 1, CV_32F);
+  for (int i = 0; i < n; ++i) {
+    const float* xi = x.ptr<float>(i);
+    float* zi = z.ptr<float>(i);
+    const double sw = std::sqrt(d.y[static_cast<std::size_t>(i)] ? wp : wn);
+    for (int j = 0; j < f; ++j) {
+      zi[j] = static_cast<float>(sw * (xi[j] - mean_row.at<double>(j)) / std_row.at<double>(j));
+    }
+    zi[f] = static_cast<float>(sw);
+    t.at<float>(i) = static_cast<float>(sw * d.target[static_cast<std::size_t>(i)]);
+  }
+  cv::Mat ztz, ztt;
+  cv::mulTransposed(z, ztz, true);
+  ztt = z.t() * t;
+  cv::Mat a, b;
+  ztz.convertTo(a, CV_64F);
+  ztt.convertTo(b, CV_64F);
+  for (int j = 0; j < f; ++j) a.at<double>(j, j) += lambda;  // the bias is not shrunk
+  cv::Mat w;
+  cv::solve(a, b, w, cv::DECOMP_CHOLESKY);
+  std::vector<double> weights(static_cast<std::size_t>(f));
+  double bias = w.at<double>(f);
+  for (int j = 0; j < f; ++j) {
+    weights[static_cast<std::size_t>(j)] = w.at<double>(j) / std_row.at<double>(j);
+    bias -= w.at<double>(j) * mean_row.at<double>(j) / std_row.at<double>(j);
+  }
+  return {weights, bias};
+}
+
+// Platt's sigmoid p = 1 / (1 + exp(a v + b)) by Newton's method on the log loss, with his
+// smoothed targets (N+ + 1) / (N+ + 2) and 1 / (N- + 2).
+std::pair<double, double> FitPlatt(const std::vector<double>& v, const std::vector<int>& y) {
+  double np = 0, nn = 0;
+  for (int l : y) (l ? np : nn) += 1;
+  const double tp = (np + 1) / (np + 2), tn = 1 / (nn + 2);
+  // Numerically stable log loss of targets t against p = 1 / (1 + exp(f)), f = a v + b.
+  auto loss = [&](double a, double b) {
+    double l = 0;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const double f = a * v[i] + b, t = y[i] ? tp : tn;
+      l += f >= 0 ? t * f + std::log1p(std::exp(-f)) : (t - 1) * f + std::log1p(std::exp(f));
+    }
+    return l;
+  };
+  // Newton's method with backtracking (Lin, Lin and Weng 2007, "A note on Platt's probabilistic
+  // outputs for support vector machines").
+  double a = 0, b = std::log((nn + 1) / (np + 1));
+  double fval = loss(a, b);
+  for (int it = 0; it < 100; ++it) {
+    double ga = 0, gb = 0, haa = 1e-12, hab = 0, hbb = 1e-12;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const double f = a * v[i] + b;
+      const double p = f >= 0 ? std::exp(-f) / (1 + std::exp(-f)) : 1 / (1 + std::exp(f));
+      const double t = y[i] ? tp : tn;
+      const double g = t - p, h = p * (1 - p);
+      ga += g * v[i];
+      gb += g;
+      haa += h * v[i] * v[i];
+      hab += h * v[i];
+      hbb += h;
+    }
+    if (std::abs(ga) < 1e-5 && std::abs(gb) < 1e-5) break;
+    const double det = haa * hbb - hab * hab;
+    if (std::abs(det) < 1e-18) break;
+    const double da = -(hbb * ga - hab * gb) / det, db = -(haa * gb - hab * ga) / det;
+    const double gd = ga * da + gb * db;
+    double step = 1;
+    while (step >= 1e-10) {
+      const double na = a + step * da, nb = b + step * db, nf = loss(na, nb);
+      if (nf < fval + 1e-4 * step * gd) {
+        a = na;
+        b = nb;
+        fval = nf;
+        break;
+      }
+      step /= 2;
+    }
+    if (step < 1e-10) break;
+  }
+  return {a, b};
+}
+
+}  // namespace
+
+TrainingOptions DefaultTrainingOptions() {
+  TrainingOptions o;
+  for (std::uint64_t i = 1; i <= 8; ++i) o.training_seeds.push_back(7'000'000 + i);
+  for (std::uint64_t i = 1; i <= 2; ++i) o.calibration_seeds.push_back(7'100'000 + i);
+  return o;
+}
+
+perception_scenes::SceneSetParams TrainingSceneSet(std::uint64_t seed, int scenes) {
+  return {.seed = seed,
+          .scenes = scenes,
+          .scenes_per_world = 20,
+          .min_altitude_m = 8.0,
+          .max_altitude_m = 65.0,
+          .min_noise_std = 2.0,
+          .max_noise_std = 12.0,
+          .near_victim_fraction = 0.8,
+          .near_victim_offset = 1.0,
+          .occluded_fraction = 0.3,
+          .distractors = 2,
+          .varied_look = seed % 4 != 0};
+}
+
+Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorModel* model_out,
+                 TrainingReport* report) {
+  swarm::VictimDetectorModel& model = *model_out;
+  const std::vector<Scene>* cal = &calibration;
+  std::shared_ptr<swarm::VictimDetectorModel> shared;
+  // Calibration on scenes the forest has not seen.
+  shared = std::make_shared<swarm::VictimDetectorModel>(model);
+  swarm::VictimDetectorParams raw;
+  raw.min_confidence = 0.0;
+  raw.partial_confidence_cap = 1.0;
+  swarm::VictimDetector det(shared, raw);
+  std::vector<double> votes;
+  std::vector<int> labels;
+  struct Det {
+    std::size_t scene;
+    std::size_t person;
+    double votes;
+    int label;
+  };
+  std::vector<Det> dets;
+  std::vector<swarm::ImageBlob> blobs;
+  for (std::size_t i = 0; i < cal->size(); ++i) {
+    const Scene& s = (*cal)[i];
+    const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+    det.Detect(BgrOf(s), s.intrinsics, s.true_pose, 0.0, &blobs);
+    for (const swarm::ImageBlob& b : blobs) {
+      const Eigen::Vector2d c(swarm::InputToCanonical(b.centroid_px.x(), scale),
+                              swarm::InputToCanonical(b.centroid_px.y(), scale));
+      const auto [dist, must] = NearestPerson(s, scale, c);
+      int label = -1;
+      if (dist <= 1.0 && must) label = 1;
+      if (dist >= kNegativeRadiusM) label = 0;
+      if (label < 0) continue;
+      votes.push_back(b.votes);
+      labels.push_back(label);
+      dets.push_back({i, NearestIndex(s, scale, c), b.votes, label});
+    }
+    for (const SceneVictim& v : s.victims) report->calibration_persons += v.visible_fraction >= kMustDetectFraction ? 1 : 0;
+  }
+  // First-stage recall on the calibration scenes: must-detect people with a candidate within
+  // kPositiveRadiusM.
+  int hit = 0, must_total = 0;
+  for (const Scene& s : *cal) {
+    const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+    const auto& cands = det.Candidates(BgrOf(s), ppm, raw.max_candidates, model.stage1_threshold);
+    for (const SceneVictim& v : s.victims) {
+      if (v.visible_fraction < kMustDetectFraction) continue;
+      const std::optional<Eigen::Vector2d> c = CanonicalOf(v, s, scale);
+      if (!c) continue;
+      ++must_total;
+      for (const auto& k : cands) {
+        const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * k.sub_col,
+                                     swarm::WindowCentreCanonical(0) + swarm::kShrink * k.sub_row);
+        if ((centre - *c).norm() / swarm::kCanonicalPxPerM <= kPositiveRadiusM) {
+          ++hit;
+          break;
+        }
+      }
+    }
+  }
+  report->stage1_calibration_recall = must_total ? static_cast<double>(hit) / must_total : 1.0;
+  std::fprintf(stderr, "train-detector: first-stage recall on the calibration scenes %.4f (%d people)\n",
+               report->stage1_calibration_recall, must_total);
+  const auto [a, b] = FitPlatt(votes, labels);
+  model.platt_a = a;
+  model.platt_b = b;
+  report->calibration_detections = static_cast<int>(dets.size());
+  std::set<std::pair<std::size_t, std::size_t>> found;  // (scene, person) detected at 0.5
+  for (const Det& d : dets) {
+    if (model.Probability(d.votes) < 0.5) continue;
+    if (d.label) {
+      found.insert({d.scene, d.person});
+    } else {
+      ++report->calibration_fp;
+    }
+  }
+  report->calibration_tp = static_cast<int>(found.size());
+  const int called = report->calibration_tp + report->calibration_fp;
+  report->precision = called ? static_cast<double>(report->calibration_tp) / called : 1.0;
+  report->recall = report->calibration_persons ? static_cast<double>(report->calibration_tp) / report->calibration_persons : 1.0;
+  return Ok{};
+}
+
+Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const std::string& model_path,
+                                               TrainingReport* report) {
+  Result<std::shared_ptr<const swarm::VictimDetectorModel>> loaded = swarm::LoadDetectorModel(model_path);
+  if (!loaded) return loaded.error();
+  swarm::VictimDetectorModel model = **loaded;
+  if (model.calibration_seeds != o.calibration_seeds) {
+    return Error(ErrorCode::kInvalidArgument, "recalibrate: the model was calibrated on other seeds", model_path);
+  }
+  Result<std::vector<Scene>> cal = RenderSets(o.calibration_seeds, o.scenes_per_set);
+  if (!cal) return cal.error();
+  report->calibration_scenes = static_cast<int>(cal->size());
+  if (Status st = Calibrate(*cal, &model, report); !st) return st.error();
+  return model;
+}
+
+Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  for (const auto* list : {&o.training_seeds, &o.calibration_seeds}) {
+    for (std::uint64_t s : *list) {
+      for (std::uint64_t e : perception_scenes::kEvaluationSeeds) {
+        if (s == e) return Error(ErrorCode::kInvalidArgument, "training seed " + std::to_string(s) + " is an evaluation seed");
+      }
+    }
+  }
+  Result<std::vector<Scene>> train = RenderSets(o.training_seeds, o.scenes_per_set);
+  if (!train) return train.error();
+  Result<std::vector<Scene>> cal = RenderSets(o.calibration_seeds, o.scenes_per_set);
+  if (!cal) return cal.error();
+  report->training_scenes = static_cast<int>(train->size());
+  report->calibration_scenes = static_cast<int>(cal->size());
+  std::fprintf(stderr, "train-detector: rendered %d training and %d calibration scenes\n", report->training_scenes,
+               report->calibration_scenes);
+
+  // Stage 1 samples.
+  swarm::VictimDetectorModel model;
+  model.training_seeds = o.training_seeds;
+  model.calibration_seeds = o.calibration_seeds;
+  model.SetLinear(std::vector<double>(swarm::kWindowFeatures, 0.0), 0.0);
+  model.forest = cv::ml::RTrees::create();  // replaced below; the detector needs one to exist
+  std::mt19937_64 rng(0x7EA1);
+  Labelled s1;
+  std::vector<std::size_t> centred;  // rows of s1 that are unshifted positives
+  std::vector<float> f(swarm::kWindowFeatures);
+  swarm::ChannelMaps maps;
+  for (const Scene& s : *train) {
+    const double scale = swarm::kCanonicalPxPerM / PixelsPerMetre(s);
+    swarm::ComputeChannels(BgrOf(s), scale, &maps);
+    const int rows = maps.rows() - swarm::kWindowCells + 1, cols = maps.cols() - swarm::kWindowCells + 1;
+    if (rows <= 0 || cols <= 0) continue;
+    auto add = [&](int r, int c, int label, float target) {
+      if (r < 0 || c < 0 || r >= rows || c >= cols) return false;
+      swarm::WindowFeatures(maps, r, c, f.data());
+      s1.x.insert(s1.x.end(), f.begin(), f.end());
+      s1.y.push_back(label);
+      s1.target.push_back(target);
+      return true;
+    };
+    for (const SceneVictim& v : s.victims) {
+      if (v.visible_fraction < kMustDetectFraction) continue;
+      const std::optional<Eigen::Vector2d> c = CanonicalOf(v, s, scale);
+      if (!c) continue;
+      const int r0 = static_cast<int>(std::lround(c->y() / swarm::kShrink - swarm::kWindowCells / 2.0));
+      const int c0 = static_cast<int>(std::lround(c->x() / swarm::kShrink - swarm::kWindowCells / 2.0));
+      if (add(r0, c0, 1, 1.0f)) centred.push_back(s1.y.size() - 1);
+      add(r0 - 1, c0, 1, kShiftedTarget);
+      add(r0 + 1, c0, 1, kShiftedTarget);
+      add(r0, c0 - 1, 1, kShiftedTarget);
+      add(r0, c0 + 1, 1, kShiftedTarget);
+    }
+    std::uniform_int_distribution<int> rr(0, rows - 1), cc(0, cols - 1);
+    for (int k = 0, tries = 0; k < kRandomNegativesPerScene && tries < 400; ++tries) {
+      const int r = rr(rng), c = cc(rng);
+      const Eigen::Vector2d centre(swarm::WindowCentreCanonical(c), swarm::WindowCentreCanonical(r));
+      if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
+      add(r, c, 0, -1.0f);
+      ++k;
+    }
+  }
+  for (int y : s1.y) (y ? report->stage1_positives : report->stage1_negatives) += 1;
+  std::fprintf(stderr, "train-detector: stage 1 on %d positives, %d negatives\n", report->stage1_positives,
+               report->stage1_negatives);
+  const auto [weights, bias] = FitLinear(s1, o.ridge_lambda);
+  model.SetLinear(weights, bias);
+  std::vector<double> centred_scores;
+  for (std::size_t i : centred) centred_scores.push_back(model.LinearScore(&s1.x[i * swarm::kWindowFeatures]));
+  std::sort(centred_scores.begin(), centred_scores.end());
+  model.stage1_threshold = centred_scores.empty() ? 0.0 : centred_scores[centred_scores.size() / 200];
+  report->stage1_positive_recall = 0.995;
+  // The first stage's positives (centred and shifted) are second-stage positives too, with their
+  // first-stage score.
+  Labelled s2, neg;
+  std::vector<float> g(swarm::kForestFeatures);
+  for (std::size_t i = 0; i < s1.y.size(); ++i) {
+    if (!s1.y[i]) continue;
+    const float* x = &s1.x[i * swarm::kWindowFeatures];
+    std::copy(x, x + swarm::kWindowFeatures, g.begin());
+    g[swarm::kWindowFeatures] = static_cast<float>(model.LinearScore(x));
+    s2.x.insert(s2.x.end(), g.begin(), g.end());
+    s2.y.push_back(1);
+  }
+  s1 = {};
+
+  // Stage 2 samples: the first stage's candidates on the training scenes.
+  auto shared = std::make_shared<swarm::VictimDetectorModel>(model);
+  swarm::VictimDetector first(shared, {});
+  for (const Scene& s : *train) {
+    const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+    // Every local maximum, whatever its score (the first stage alone is precise on these scenes:
+    // above its threshold too few negatives remain to teach the forest).
+    const auto& cands = first.Candidates(BgrOf(s), ppm, kStage2CandidatesPerScene, -1e30);
+    for (const auto& c : cands) {
+      const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_col,
+                                   swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_row);
+      const auto [dist, must] = NearestPerson(s, scale, centre);
+      int label = -1;
+      if (dist <= kPositiveRadiusM && must) label = 1;
+      if (dist >= kNegativeRadiusM) label = 0;
+      if (label < 0) continue;
+      swarm::WindowFeatures(first.channels(), c.row, c.col, g.data());
+      g[swarm::kWindowFeatures] = static_cast<float>(c.score);
+      Labelled& dst = label ? s2 : neg;
+      dst.x.insert(dst.x.end(), g.begin(), g.end());
+      dst.y.push_back(label);
+    }
+  }
+  // A seeded sample of the negatives.
+  std::vector<int> order(static_cast<std::size_t>(neg.rows()));
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::shuffle(order.begin(), order.end(), rng);
+  if (static_cast<int>(order.size()) > o.max_negatives) order.resize(static_cast<std::size_t>(o.max_negatives));
+  report->stage2_positives = s2.rows();
+  for (int i : order) {
+    s2.x.insert(s2.x.end(), neg.x.begin() + static_cast<std::ptrdiff_t>(i) * swarm::kForestFeatures,
+                neg.x.begin() + static_cast<std::ptrdiff_t>(i + 1) * swarm::kForestFeatures);
+    s2.y.push_back(0);
+  }
+  report->stage2_negatives = static_cast<int>(order.size());
+  std::fprintf(stderr, "train-detector: stage 2 on %d positives, %d negatives (of %d)\n", report->stage2_positives,
+               report->stage2_negatives, neg.rows());
+  if (report->stage2_positives < 50) {
+    return Error(ErrorCode::kInternal, "train-detector: the first stage left fewer than 50 positives");
+  }
+  neg = {};
+  cv::Mat x(s2.rows(), swarm::kForestFeatures, CV_32F, s2.x.data());
+  cv::Mat y(s2.rows(), 1, CV_32S, s2.y.data());
+  cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
+  forest->setMaxDepth(o.forest_depth);
+  forest->setMinSampleCount(4);
+  forest->setActiveVarCount(0);  // sqrt(features)
+  forest->setCalculateVarImportance(false);
+  forest->setTermCriteria(cv::TermCriteria(cv::TermCriteria::MAX_ITER, o.forest_trees, 0));
+  cv::theRNG().state = 0x5EED;  // the forest's bootstrap samples and variable subsets
+  if (!forest->train(cv::ml::TrainData::create(x, cv::ml::ROW_SAMPLE, y))) {
+    return Error(ErrorCode::kInternal, "train-detector: RTrees training failed");
+  }
+  model.forest = forest;
+  model.FlattenForest();
+  {  // The flattened forest decides as OpenCV's own prediction.
+    cv::Mat votes;
+    forest->getVotes(x, votes, 0);
+    int person_col = votes.at<int>(0, 0) == 1 ? 0 : 1, disagree = 0;
+    for (int i = 0; i < x.rows; ++i) {
+      const double v = static_cast<double>(votes.at<int>(i + 1, person_col)) / o.forest_trees;
+      disagree += std::abs(v - model.Votes(x.ptr<float>(i))) > 1e-9 ? 1 : 0;
+    }
+    if (disagree > 0) {
+      return Error(ErrorCode::kInternal, "train-detector: the flattened forest disagrees with RTrees on " +
+                                             std::to_string(disagree) + " samples");
+    }
+  }
+
+  if (Status st = Calibrate(*cal, &model, report); !st) return st.error();
+  report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return model;
+}
+
+std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& o, const TrainingReport& r) {
+  std::ostringstream j;
+  auto list = [&](const std::vector<std::uint64_t>& v) {
+    j << "[";
+    for (std::size_t i = 0; i < v.size(); ++i) j << (i ? ", " : "") << v[i];
+    j << "]";
+  };
+  j << "{\n  \"model\": \"victim_detector.yml.gz\",\n";
+  j << "  \"method\": \"aggregated channel features (Luv, gradient magnitude, 4 orientations; 0.25 m cells, "
+       "3 x 3 m windows at 8 px/m), ridge linear first stage, cv::ml::RTrees second stage, Platt sigmoid\",\n";
+  j << "  \"training_seeds\": ";
+  list(model.training_seeds);
+  j << ",\n  \"calibration_seeds\": ";
+  list(model.calibration_seeds);
+  j << ",\n  \"scenes_per_set\": " << o.scenes_per_set << ",\n";
+  j << "  \"training_scenes\": " << r.training_scenes << ",\n  \"calibration_scenes\": " << r.calibration_scenes << ",\n";
+  j << "  \"stage1\": {\"positives\": " << r.stage1_positives << ", \"negatives\": " << r.stage1_negatives
+    << ", \"threshold\": " << model.stage1_threshold << ", \"ridge_lambda\": " << o.ridge_lambda << "},\n";
+  j << "  \"stage1_calibration_recall\": " << r.stage1_calibration_recall << ",\n";
+  j << "  \"stage2\": {\"positives\": " << r.stage2_positives << ", \"negatives\": " << r.stage2_negatives
+    << ", \"trees\": " << o.forest_trees << ", \"max_depth\": " << o.forest_depth << "},\n";
+  j << "  \"platt\": {\"a\": " << model.platt_a << ", \"b\": " << model.platt_b << "},\n";
+  j << "  \"calibration_figures\": {\"persons_at_least_half_visible\": " << r.calibration_persons
+    << ", \"detections_labelled\": " << r.calibration_detections << ", \"tp_at_0.5\": " << r.calibration_tp
+    << ", \"fp_at_0.5\": " << r.calibration_fp << ", \"precision_at_0.5\": " << r.precision
+    << ", \"recall_at_0.5\": " << r.recall << "},\n";
+  j << "  \"training_seconds\": " << r.seconds << "\n}\n";
+  return j.str();
+}
+
+}  // namespace swarmbox::train_detector

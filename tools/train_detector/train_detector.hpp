@@ -1,0 +1,82 @@
+// Training of the victim detector (agent/swarm victim_detector*.hpp) on scenes the physics server's
+// renderer draws (perception_scenes.hpp), as a reproducible build step:
+//
+//   cmake --build build --target train-detector
+//     -> agent/swarm/models/victim_detector.yml.gz (the model, cv::FileStorage)
+//        agent/swarm/models/victim_detector.json   (seeds, sample counts, training figures)
+//
+// Steps, all seeded (the same sources and seeds give the same model):
+//   1. render the training scene sets (kTrainingSeeds) and the calibration sets
+//      (kCalibrationSeeds): never one of perception_scenes::kEvaluationSeeds; half of the frames
+//      get painted clutter (tarps, cones, rocks, specks of any colour, away from the people);
+//   2. first stage: windows centred on every person at least half visible (and 4 one-cell shifts)
+//      against random ground windows at least 1.5 m from any person; a ridge-regression linear
+//      discriminant on standardised features; threshold at the 0.5th percentile of the centred
+//      positives' scores;
+//   3. second stage: the first stage's positive windows, and on the training scenes the first
+//      stage's local maxima (the best 96 per frame, any score) within 0.75 m of a person as
+//      positives, those at least 1.5 m from every person as negatives (hard negatives: what the
+//      linear stage likes most); a cv::ml::RTrees forest;
+//   4. calibration: the whole detector on the calibration scenes, detections labelled by the
+//      ground truth, Platt's sigmoid fitted to the vote fractions (Platt 1999, with his target
+//      smoothing);
+//   5. figures on the calibration scenes: precision and recall at confidence 0.5.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "perception_scenes.hpp"
+#include "swarmbox/common/result.hpp"
+#include "swarmbox/swarm/victim_detector_model.hpp"
+
+namespace swarmbox::train_detector {
+
+struct TrainingOptions {
+  std::vector<std::uint64_t> training_seeds;     // one scene set each
+  std::vector<std::uint64_t> calibration_seeds;
+  int scenes_per_set = 60;
+  int forest_trees = 60;
+  int forest_depth = 14;
+  int max_negatives = 24000;  // second-stage negatives kept (a seeded sample)
+  double ridge_lambda = 1e-2;
+};
+
+TrainingOptions DefaultTrainingOptions();
+
+// The scene mix of one training or calibration set: altitudes 8-65 m, noise 2-12 levels, 30 % of
+// the people partly covered, 2 distractors per person, the varied look (perception_scenes.hpp)
+// except for every seed divisible by 4 (the original hi-vis look).
+perception_scenes::SceneSetParams TrainingSceneSet(std::uint64_t seed, int scenes);
+
+struct TrainingReport {
+  int training_scenes = 0;
+  int calibration_scenes = 0;
+  int stage1_positives = 0;
+  int stage1_negatives = 0;
+  int stage2_positives = 0;
+  int stage2_negatives = 0;
+  double stage1_positive_recall = 0;  // share of centred positives at or above the threshold
+  double stage1_calibration_recall = 0;  // must-detect people with a first-stage candidate
+  int calibration_detections = 0;
+  int calibration_persons = 0;   // at least half visible
+  int calibration_tp = 0;        // at confidence >= 0.5
+  int calibration_fp = 0;
+  double precision = 0;
+  double recall = 0;
+  double seconds = 0;
+};
+
+// Renders, trains and calibrates. Fails when a seed is an evaluation seed or rendering fails.
+Result<swarm::VictimDetectorModel> Train(const TrainingOptions& options, TrainingReport* report);
+
+// Steps 4-5 again on a trained model (its first stage and forest kept): for a calibration fix
+// without retraining. The model must name the same calibration seeds.
+Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& options, const std::string& model_path,
+                                               TrainingReport* report);
+
+std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& options,
+                       const TrainingReport& report);
+
+}  // namespace swarmbox::train_detector
