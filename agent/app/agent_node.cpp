@@ -509,6 +509,13 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
       Log(LogEvent(t_s_, options_.name, "plan_complete"));
     }
   }
+  if (brain_host_ && t_s_ >= next_battery_log_s_) {
+    // The battery once per simulated second, for the trial's plots (SarBrain: its own model, as
+    // BroadcastState sends it).
+    next_battery_log_s_ = std::floor(t_s_) + 1.0;
+    Log(LogEvent(t_s_, options_.name, "battery")
+            .Add("fraction", sar_ != nullptr ? sar_->battery_fraction() : vehicle_.battery_fraction, 4));
+  }
   BroadcastState(msg);
   // d. The step's answer: motors, world commands, Raft leadership, the radio's frames.
   if (radio_) {

@@ -215,6 +215,7 @@ class AgentNode final : private FrameHandler {
   std::uint64_t last_step_ = 0;
   double t_s_ = 0.0;
   double next_state_s_ = 0.0;
+  double next_battery_log_s_ = 0.0;  // event=battery, once per simulated second (brains)
   std::size_t plan_index_logged_ = static_cast<std::size_t>(-1);
   bool plan_done_logged_ = false;
 };

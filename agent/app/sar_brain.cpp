@@ -552,6 +552,8 @@ void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
   members_.UpdateSelf(now.t_s, role_, behaviour_out_.mode, now.pos_m.head<2>());
   if (now.is_leader) {
     const std::span<const swarm::RosterEntry> roster = members_.Roster(now.t_s, now.wall_s);
+    // How the swarm flocks, for the logs and the trial's plots (agent/swarm flock_metrics.hpp).
+    if (auto line = flock_log_.Sample(now.t_s, config_.name, roster)) out.events.push_back(ToBrainEvent(*line));
     const bool everyone = roster.size() == config_.members.size();
     if (everyone || now.mission->phase() != raft::MissionPhase::kIdle || now.t_s >= config_.tuning.leader_start_timeout_s) {
       swarm::MissionOutput lead;

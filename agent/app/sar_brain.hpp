@@ -260,6 +260,9 @@ class SarBrain final : public brain::Brain {
   std::string status_scratch_;                     // a received one, decoded (capacity kept)
   double status_due_s_ = 0.0;                      // the next periodic one [s]
   std::vector<swarm::GroundDetection> visible_;
+  // The leader's event=flock_metrics, once per simulated second from members_ (pairs closer than
+  // 3 m are unsafe; "united" within the flocking's 60 m sensing range).
+  swarm::FlockMetricsLog flock_log_{{.separation_m = 3.0, .link_range_m = 60.0}};
 
   swarm::MissionOutput behaviour_out_;
   double next_tick_s_ = 0.0;

@@ -1,5 +1,5 @@
-// swarmbox report DIR: regenerates DIR/results.csv, DIR/report.html and DIR/plots/ from the
-// trial folders (experiment_runner.hpp WriteReports). Exit 2 when DIR is not a folder or holds
+// swarmbox report DIR: regenerates DIR/results.csv, DIR/report.html, DIR/plots/ and each trial's
+// plots.html from the trial folders (experiment_runner.hpp WriteReports). Exit 2 when DIR is not a folder or holds
 // no trial.
 #include <filesystem>
 #include <iostream>
@@ -27,7 +27,7 @@ int ReportCommand(const ReportArgs& args) {
     return kExitUsage;
   }
   std::cout << args.dir << "/results.csv, " << args.dir << "/report.html, " << args.dir
-            << "/plots/: " << *n << " trials\n";
+            << "/plots/, <trial>/plots.html: " << *n << " trials\n";
   return kExitOk;
 }
 

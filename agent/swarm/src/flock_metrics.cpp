@@ -1,6 +1,7 @@
 #include "swarmbox/swarm/flock_metrics.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 #include <vector>
@@ -50,6 +51,44 @@ FlockMetrics ComputeFlockMetrics(std::span<const Eigen::Vector3d> positions_m,
   m.mean_nearest_m = std::accumulate(nearest.begin(), nearest.end(), 0.0) / static_cast<double>(n);
   m.max_nearest_m = *std::max_element(nearest.begin(), nearest.end());
   return m;
+}
+
+std::optional<LogEvent> FlockMetricsLog::Sample(double t_s, std::string_view node,
+                                                std::span<const RosterEntry> roster) {
+  if (due_s_ && t_s < *due_s_) return std::nullopt;
+  due_s_ = due_s_ ? *due_s_ + period_s_ : t_s + period_s_;
+  while (*due_s_ <= t_s) *due_s_ += period_s_;  // a long gap: the next on the period's grid
+  if (tracks_.size() < roster.size()) tracks_.resize(roster.size());
+  positions_m_.clear();
+  velocities_m_s_.clear();
+  for (std::size_t i = 0; i < roster.size(); ++i) {
+    const RosterEntry& e = roster[i];
+    Track& track = tracks_[i];
+    if (track.name != e.name) track = Track{e.name};  // another member in this slot: start afresh
+    const double word_t_s = t_s - e.age_s;
+    if (track.seen && word_t_s > track.word_t_s + 1e-6) {
+      track.velocity_m_s = (e.position_m - track.position_m) / (word_t_s - track.word_t_s);
+    }
+    if (!track.seen || word_t_s > track.word_t_s + 1e-6) {
+      track.word_t_s = word_t_s;
+      track.position_m = e.position_m;
+      track.seen = true;
+    }
+    if (e.age_s > max_age_s_) continue;  // gone (the leader's member timeout)
+    positions_m_.emplace_back(e.position_m.x(), e.position_m.y(), 0.0);
+    velocities_m_s_.emplace_back(track.velocity_m_s.x(), track.velocity_m_s.y(), 0.0);
+  }
+  if (positions_m_.size() < 2) return std::nullopt;
+  const FlockMetrics m = ComputeFlockMetrics(positions_m_, velocities_m_s_, params_);
+  LogEvent line(t_s, node, "flock_metrics");
+  line.Add("members", static_cast<std::int64_t>(positions_m_.size()))
+      .Add("order", m.order, 3)
+      .Add("safety", m.safety, 3)
+      .Add("union", m.union_, 3)
+      .Add("components", m.components)
+      .Add("min_m", m.min_distance_m, 2)
+      .Add("mean_nearest_m", m.mean_nearest_m, 2);
+  return line;
 }
 
 }  // namespace swarmbox::swarm

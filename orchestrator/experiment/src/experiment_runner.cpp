@@ -314,6 +314,16 @@ Result<std::string> EnsurePlanFaultsImage(const ExperimentPlan& plan, docker::Do
 
 Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::string>* problems) {
   auto records = report::ReadExperimentFolder(out_dir, problems);
+  // Each trial's plots.html again from its logs and truth.csv (a folder without them keeps its own).
+  for (report::TrialRecord& r : records) {
+    report::TrialPlotsPage page;
+    page.title = r.meta.id;
+    page.summary = r.outcome + (r.reason.empty() ? "" : ": " + r.reason);
+    page.has_trajectories = r.has_trajectories;
+    auto written = report::WriteTrialPlots((fs::path(out_dir) / r.folder).string(), page);
+    if (!written && problems != nullptr) problems->push_back(r.folder + "/plots.html: " + written.error().ToString());
+    if (written && *written) r.has_plots = true;
+  }
   const auto factors = report::FactorNames(out_dir, records);
   SWARMBOX_TRY(WriteFileAtomic((fs::path(out_dir) / "results.csv").string(),
                                report::ResultsCsv(factors, records)));

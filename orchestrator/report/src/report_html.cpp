@@ -256,7 +256,7 @@ std::string ReportHtml(std::string_view title, const std::vector<std::string>& f
   h += "<h2>Trials</h2>\n<table><tr><th>trial</th><th>code</th>";
   for (const std::string& f : factors) h += "<th>" + HtmlEscape(f) + "</th>";
   h += "<th>rep</th><th>seed</th><th>host</th><th>outcome</th><th>reason</th><th>wall s</th>"
-       "<th>sim s</th><th>trajectories</th></tr>\n";
+       "<th>sim s</th><th>over time</th><th>trajectories</th></tr>\n";
   for (const TrialRecord& r : records) {
     const std::string folder = HtmlEscape(r.folder);
     h += "<tr><td><a href='" + folder + "/'>" + HtmlEscape(r.meta.id) + "</a> (<a href='" +
@@ -270,6 +270,8 @@ std::string ReportHtml(std::string_view title, const std::vector<std::string>& f
          HtmlEscape(r.outcome) + "</td><td>" + HtmlEscape(r.reason) + "</td><td>" +
          (r.wall_s ? CsvNumber(*r.wall_s) : "") + "</td><td>" +
          (r.sim_s ? CsvNumber(*r.sim_s) : "") + "</td><td>";
+    h += r.has_plots ? "<a href='" + folder + "/plots.html'>plots</a>" : std::string("none");
+    h += "</td><td>";
     if (r.has_trajectories) {
       h += "<a href='" + folder + "/trajectories.png'><img class='thumb' loading='lazy' src='" +
            folder + "/trajectories.png' alt='trajectories of " + HtmlEscape(r.meta.id) + "'></a>";

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <sstream>
 
@@ -51,12 +52,13 @@ std::vector<std::string> StringsAt(const Node& doc, std::string_view key) {
   return out;
 }
 
-// Feeds truth.csv (t_s, drone, x_m, y_m, z_m columns by header) into the metrics.
-void ReadTruth(const fs::path& path, TrialMetrics& metrics) {
+}  // namespace
+
+bool ReadTruthCsv(const std::string& path, const std::function<void(const TruthRow&)>& on_row) {
   std::ifstream in(path);
-  if (!in) return;
+  if (!in) return false;
   std::string line;
-  if (!std::getline(in, line)) return;
+  if (!std::getline(in, line)) return false;
   std::vector<std::string> header;
   {
     std::stringstream ss(line);
@@ -68,24 +70,45 @@ void ReadTruth(const fs::path& path, TrialMetrics& metrics) {
     return it == header.end() ? -1 : static_cast<int>(it - header.begin());
   };
   const int ct = col("t_s"), cd = col("drone"), cx = col("x_m"), cy = col("y_m"), cz = col("z_m");
-  if (ct < 0 || cd < 0 || cx < 0 || cy < 0 || cz < 0) return;
-  std::vector<std::string> cells;
+  const int cvx = col("vx_m_s"), cvy = col("vy_m_s"), cvz = col("vz_m_s");
+  if (ct < 0 || cd < 0 || cx < 0 || cy < 0 || cz < 0) return false;
+  const bool velocity = cvx >= 0 && cvy >= 0 && cvz >= 0;
+  const auto need = static_cast<std::size_t>(std::max({ct, cd, cx, cy, cz}));
+  const auto need_v = static_cast<std::size_t>(std::max({cvx, cvy, cvz}));
+  std::vector<std::string_view> cells;
+  TruthRow row;
   while (std::getline(in, line)) {
     cells.clear();
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) cells.push_back(cell);
-    const auto need = static_cast<std::size_t>(std::max({ct, cd, cx, cy, cz}));
+    std::string_view rest(line);
+    while (true) {
+      const std::size_t comma = rest.find(',');
+      cells.push_back(rest.substr(0, comma));
+      if (comma == std::string_view::npos) break;
+      rest.remove_prefix(comma + 1);
+    }
     if (cells.size() <= need) continue;
-    auto t = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(ct)]);
-    auto x = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(cx)]);
-    auto y = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(cy)]);
-    auto z = yaml::ScalarAsDouble(cells[static_cast<std::size_t>(cz)]);
-    if (t && x && y && z) metrics.OnTruth(*t, cells[static_cast<std::size_t>(cd)], *x, *y, *z);
+    auto num = [&](int c) { return yaml::ScalarAsDouble(cells[static_cast<std::size_t>(c)]); };
+    auto t = num(ct), x = num(cx), y = num(cy), z = num(cz);
+    if (!t || !x || !y || !z) continue;
+    row.t_s = *t;
+    row.drone.assign(cells[static_cast<std::size_t>(cd)]);
+    row.x_m = *x;
+    row.y_m = *y;
+    row.z_m = *z;
+    row.has_velocity = false;
+    if (velocity && cells.size() > need_v) {
+      auto vx = num(cvx), vy = num(cvy), vz = num(cvz);
+      if (vx && vy && vz) {
+        row.vx_m_s = *vx;
+        row.vy_m_s = *vy;
+        row.vz_m_s = *vz;
+        row.has_velocity = true;
+      }
+    }
+    on_row(row);
   }
+  return true;
 }
-
-}  // namespace
 
 std::string TrialMetaJson(const TrialMeta& m) {
   Node doc = Node::Mapping();
@@ -162,7 +185,9 @@ std::optional<MetricValues> ReadTrialMetrics(const std::string& dir_text) {
       metrics.OnOrchestratorEvent(StringAt(*j, "event"), StringAt(*j, "target"), t);
     }
   }
-  ReadTruth(dir / "truth.csv", metrics);
+  ReadTruthCsv((dir / "truth.csv").string(), [&](const TruthRow& r) {
+    metrics.OnTruth(r.t_s, r.drone, r.x_m, r.y_m, r.z_m);
+  });
   return metrics.Values();
 }
 
@@ -204,7 +229,52 @@ Result<TrialRecord> ReadTrialFolder(const std::string& dir_text) {
   if (const Node* p = result->Find("provenance"); p != nullptr) rec.provenance = ParseProvenance(*p);
   std::error_code ec;
   rec.has_trajectories = fs::exists(dir / "trajectories.png", ec);
+  rec.has_plots = fs::exists(dir / "plots.html", ec);
   return rec;
+}
+
+TrialSeries ReadTrialSeries(const std::string& dir_text, bool* found) {
+  const fs::path dir(dir_text);
+  TrialSeriesBuilder builder;
+  bool any = false;
+  std::error_code ec;
+  std::vector<fs::path> logs;
+  for (const auto& e : fs::directory_iterator(dir / "logs", ec)) {
+    if (e.path().extension() == ".log") logs.push_back(e.path());
+  }
+  std::sort(logs.begin(), logs.end());
+  for (const fs::path& log : logs) {
+    const std::string component = log.stem().string();
+    std::ifstream in(log);
+    std::string line;
+    while (std::getline(in, line)) {
+      any = true;
+      builder.OnLogEvent(component, ParseLogfmt(line));
+    }
+  }
+  ReadTruthCsv((dir / "truth.csv").string(), [&](const TruthRow& r) {
+    any = true;
+    builder.OnTruth(r);
+  });
+  if (found != nullptr) *found = any;
+  return builder.Finish();
+}
+
+Result<bool> WriteTrialPlots(const std::string& dir, const TrialPlotsPage& page) {
+  bool found = false;
+  const TrialSeries series = ReadTrialSeries(dir, &found);
+  if (!found) return false;
+  const fs::path path = fs::path(dir) / "plots.html";
+  const fs::path tmp = fs::path(dir) / ".plots.html.tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << TrialPlotsHtml(page, series);
+    if (!out) return Error(ErrorCode::kIo, "cannot write", tmp.string());
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) return Error(ErrorCode::kIo, "cannot rename to plots.html: " + ec.message(), path.string());
+  return true;
 }
 
 std::vector<TrialRecord> ReadExperimentFolder(const std::string& dir,

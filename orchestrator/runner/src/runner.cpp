@@ -485,6 +485,16 @@ Result<RunOutcome> RunTrial(const TrialInfo& info, const Planner& planner, docke
   } else {
     result.problems.push_back("trajectories.png not drawn: no truth.csv was collected");
   }
+  // plots.html: the trial's quantities over simulated time, from the same logs and truth.csv.
+  {
+    report::TrialPlotsPage page;
+    page.title = (o.trial_id.empty() ? info.name : o.trial_id) + " (run " + run_id + ")";
+    page.summary = verdict.ToString();
+    page.has_trajectories = fs::exists(dir / "trajectories.png");
+    if (auto written = report::WriteTrialPlots(dir.string(), page); !written) {
+      result.problems.push_back("plots.html: " + written.error().ToString());
+    }
+  }
 
   SWARMBOX_TRY(WriteFile(dir / "result.json", ResultJson(result)));
   say("result: " + verdict.ToString() + " (" + (dir / "result.json").string() + ")");

@@ -474,6 +474,32 @@ TEST(SarBrainScout, TheLeaderKnowsAMemberHeardOnlyThroughItsStatusMessages) {
   EXPECT_EQ(assign->sectors[1].drone, "scout_2");
 }
 
+// The leader logs how the swarm flocks (agent/swarm flock_metrics.hpp) from its member table once
+// per simulated second; a follower does not.
+TEST(SarBrainScout, TheLeaderLogsFlockMetricsFromItsMemberTableOncePerSecond) {
+  for (const bool leader : {true, false}) {
+    BrainRig rig(Scout("scout_1", {"scout_1", "scout_2"}));
+    rig.position() = Vec3(0, 0, 0.23);
+    rig.Tell("scout_2", std::string(kStatusTopic), EncodeStatusMessage(0, "scout/on_ground", 6, 8));
+    std::vector<brain::Event> lines;
+    for (int step = 0; step < 875; ++step) {  // 3.5 s
+      for (const brain::Event& e : rig.Step("idle", leader).events) {
+        if (e.name == "flock_metrics") lines.push_back(e);
+      }
+    }
+    if (!leader) {
+      EXPECT_TRUE(lines.empty());
+      continue;
+    }
+    // At the first mission tick (4 ms), then 1.004, 2.004 and 3.004 s.
+    ASSERT_EQ(lines.size(), 4u);
+    EXPECT_EQ(Field(lines[0], "members"), "2");
+    EXPECT_EQ(Field(lines[0], "safety"), "1.000");  // 10 m apart
+    EXPECT_EQ(Field(lines[0], "min_m"), "10.00");
+    EXPECT_EQ(Field(lines[3], "union"), "1.000");
+  }
+}
+
 TEST(SarBrainLifter, TheLoadCheckDropsAnAttachTheWorldDidNotCarryOut) {
   SarBrainConfig c;
   c.name = "lifter";

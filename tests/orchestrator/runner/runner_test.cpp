@@ -116,6 +116,9 @@ TEST_F(RunnerTest, EndsOnALogPatternWithItsOutcome) {
   EXPECT_THAT(ReadFile(dir / "trial.yaml"), HasSubstr("name: \"mini\""));
   EXPECT_TRUE(fs::exists(dir / "truth.csv"));
   EXPECT_TRUE(fs::exists(dir / "trajectories.png"));
+  // plots.html from the same logs and truth.csv, titled by the trial and its run.
+  EXPECT_THAT(ReadFile(dir / "plots.html"), HasSubstr("<title>mini (run 20261121-120000-abcd)</title>"));
+  EXPECT_THAT(ReadFile(dir / "plots.html"), HasSubstr("src='trajectories.png'"));
 
   auto result = yaml::Parse(ReadFile(dir / "result.json"), "result.json");
   ASSERT_TRUE(result) << result.error().ToString();

@@ -113,7 +113,8 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
                                         const ExperimentOptions& options);
 
 // results.csv, report.html and plots/*.svg (the page's box plots as files) of an experiment
-// folder, from its trial folders (also `swarmbox report DIR`). Returns the number of trials found.
+// folder, and each trial's plots.html, from its trial folders (also `swarmbox report DIR`).
+// Returns the number of trials found.
 Result<std::size_t> WriteReports(const std::string& out_dir, std::vector<std::string>* problems);
 
 }  // namespace swarmbox::experiment

@@ -1,5 +1,5 @@
 // report.html: a self-contained page (inline CSS and SVG, no scripts, no external files except
-// each trial's own trajectories.png, linked relative to the experiment folder). Pure.
+// each trial's own trajectories.png and plots.html, linked relative to the experiment folder). Pure.
 //
 //   1. totals: trials per outcome;
 //   2. per factor, outcome counts per level;
@@ -7,7 +7,7 @@
 //      whiskers to the furthest points within 1.5 IQR, points beyond drawn as outliers; n under
 //      each box);
 //   4. a table of every trial (levels, seed, host, outcome, reason, times) linking its folder,
-//      logs and trajectories.png.
+//      logs, plots.html (its quantities over time, trial_plots.hpp) and trajectories.png.
 #pragma once
 
 #include <string>
