@@ -18,10 +18,12 @@ namespace fs = std::filesystem;
 const fs::path kRoot = fs::path(SWARMBOX_SOURCE_DIR).lexically_normal();
 
 // Build trees (build/, build-asan/, any folder with a CMakeCache.txt), VCS and hidden folders,
-// and trial outputs are not the project's docs.
+// trial outputs and installed npm packages (tests/js/node_modules, git-ignored) are not the
+// project's docs.
 bool Skipped(const fs::path& dir) {
   const std::string name = dir.filename().string();
   return name.empty() || name[0] == '.' || name.rfind("build", 0) == 0 || name == "runs" ||
+         name == "node_modules" ||
          fs::exists(dir / "CMakeCache.txt");
 }
 
