@@ -306,7 +306,7 @@ Result<std::unique_ptr<McapWriter>> McapWriter::Create(const std::string& path, 
   impl->path = path;
   impl->options = std::move(options);
   impl->file = file;
-  impl->records.reserve(impl->options.chunk_bytes + (64u << 10));
+  impl->records.reserve(std::min<std::size_t>(impl->options.chunk_bytes, 64u << 20) + (64u << 10));
 
   std::string head;
   ByteWriter w(&head);

@@ -153,6 +153,25 @@ INSTANTIATE_TEST_SUITE_P(EveryCompression, McapNodeTest,
                          ::testing::Values(Compression::kZstd, Compression::kLz4, Compression::kNone),
                          [](const auto& p) { return std::string(CompressionName(p.param)); });
 
+TEST_F(McapNodeTest, McapCoreReadsAnEmptyRecording) {
+  const std::string path = Path("empty.mcap");
+  {
+    auto writer = McapWriter::Create(path);
+    ASSERT_TRUE(writer);
+    ASSERT_TRUE((*writer)->AddChannel(MakeChannel("/log", kLog)));  // a channel, no messages
+    ASSERT_TRUE((*writer)->Close());
+  }
+  auto run = Verify(path);
+  ASSERT_TRUE(run) << run.error().ToString();
+  ASSERT_EQ(run->code, 0) << run->err;
+  auto doc = yaml::Parse(run->out, "verify_mcap output");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  EXPECT_EQ(doc->Find("message_count")->scalar(), "0");
+  EXPECT_EQ(doc->Find("chunks")->scalar(), "0");
+  ASSERT_EQ(doc->Find("channels")->items().size(), 1u);
+  EXPECT_EQ(doc->Find("channels")->items()[0].Find("count")->scalar(), "0");
+}
+
 TEST_F(McapNodeTest, McapCoreRejectsACorruptedRecording) {
   const std::string path = Path("recording.mcap");
   WriteTrialLike(path, Compression::kNone);
