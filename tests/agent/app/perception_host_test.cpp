@@ -1,4 +1,4 @@
-// PerceptionHost (agent/app/perception_host.hpp): a synthetic frame geolocated with the estimate
+// PerceptionHost (agent/app/perception_host.hpp): a rendered frame geolocated with the estimate
 // of its capture step, handed over as brain::Detection after the inference latency; frames taken
 // tilted, turning or without an estimate of their step are skipped.
 #include "perception_host.hpp"
@@ -10,25 +10,28 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "perception_scenes.hpp"
+
 namespace swarmbox::agent {
 namespace {
 
 using Eigen::Vector3d;
 
-const swarm::PinholeIntrinsics kK{160.0 / std::tan(0.6), 160.0 / std::tan(0.6), 160.0, 120.0};
-
-// Grass, and a person in orange lying at `centre_px` (as the detector's own tests draw one).
-cv::Mat FrameWithPerson(cv::Point2d centre_px, double px_per_m) {
-  cv::Mat img(240, 320, CV_8UC3);
-  cv::RNG rng(9);
-  rng.fill(img, cv::RNG::UNIFORM, cv::Scalar(30, 80, 40), cv::Scalar(80, 150, 120));
-  const cv::Point2d body = centre_px - 0.15 * px_per_m * cv::Point2d(0, -1);
-  const cv::Point2d head = centre_px + 0.70 * px_per_m * cv::Point2d(0, -1);
-  cv::ellipse(img, cv::RotatedRect(body, cv::Size2f(static_cast<float>(1.44 * px_per_m), static_cast<float>(0.48 * px_per_m)), -90.0f),
-              cv::Scalar(0, 120, 255), cv::FILLED);
-  cv::ellipse(img, cv::RotatedRect(head, cv::Size2f(static_cast<float>(0.26 * px_per_m), static_cast<float>(0.22 * px_per_m)), -90.0f),
-              cv::Scalar(40, 210, 255), cv::FILLED);
-  return img;
+// A frame of the physics renderer (the detector is trained on its frames): a person lying
+// north-south at `person` seen from 20 m over the origin, camera yaw 0.
+perception_scenes::Scene RenderedFrame(const Vector3d& person) {
+  physics::WorldConfig w;
+  w.name = "host";
+  w.ground_texture_seed = 9;
+  physics::Victim v;
+  v.id = "v1";
+  v.x_m = person.x();
+  v.y_m = person.y();
+  v.heading_rad = M_PI / 2;
+  w.victims.push_back(v);
+  Result<perception_scenes::Scene> s = perception_scenes::RenderView(w, {0.0, 0.0}, 20.0, 0.0, 4.0);
+  SWARMBOX_CHECK(s.ok());
+  return std::move(*s);
 }
 
 class PerceptionRig {
@@ -39,13 +42,13 @@ class PerceptionRig {
     host_ = std::move(*PerceptionHost::Create(c));
     est_.valid = true;
     est_.pos_m = Vector3d(0, 0, 20);
-    const auto px = swarm::ProjectToPixel(person_, kK, swarm::OpticalPoseFromBody(est_.pos_m, est_.att, Vector3d::Zero()));
-    frame_ = FrameWithPerson({px->x(), px->y()}, kK.fx_px / 20.0);
+    scene_ = RenderedFrame(person_);
+    frame_ = cv::Mat(scene_.image.height_px, scene_.image.width_px, CV_8UC3, scene_.image.bgr.data());
   }
   // Estimates every 4 ms up to `t_s`; a frame captured at `capture_s`; what is visible at `t_s`.
   std::vector<brain::Detection> Run(double capture_s, double t_s) {
     for (; t_ < t_s - 1e-9; t_ += 0.004) host_->RecordEstimate(t_, est_);
-    host_->OnCameraFrame(frame_, kK, capture_s);
+    host_->OnCameraFrame(frame_, scene_.intrinsics, capture_s);
     std::vector<brain::Detection> out;
     host_->PopVisible(t_s, &out);
     return out;
@@ -58,6 +61,7 @@ class PerceptionRig {
   std::unique_ptr<PerceptionHost> host_;
   flight::StateEstimate est_;
   Vector3d person_{4.0, -3.0, 0.0};
+  perception_scenes::Scene scene_;
   cv::Mat frame_;
   double t_ = 0.0;
 };

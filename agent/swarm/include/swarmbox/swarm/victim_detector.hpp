@@ -21,8 +21,9 @@
 // capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
 // Detections under min_confidence are not reported.
 //
-// Cost: about 2-8 ms per 320 x 240 frame on one core (BENCHMARKS.md "Perception"; the scale of step
-// 1 makes low altitudes cheaper and 60 m dearer). Scratch images are kept between frames; OpenCV's
+// Cost: about 4-14 ms per 640 x 360 frame at 10-40 m on one core, ~39 ms at 60 m (wall time on a
+// loaded machine, BENCHMARKS.md "Perception"; the scale of step 1 makes low altitudes cheaper and
+// high ones dearer: at 60 m the frame is enlarged to keep 8 px/m). Scratch images are kept between frames; OpenCV's
 // filters and the forest still allocate internal buffers per frame (allocation_test.cpp). Frames
 // come at 5 Hz, outside the control loop.
 #pragma once
