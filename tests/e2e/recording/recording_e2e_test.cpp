@@ -7,10 +7,16 @@
 //   - counts: /tf and each truth channel at record.rate_hz (10 Hz) over the simulated time; the
 //     agents' status close to that (their telemetry, best effort); /log holds the run's log events;
 //   - time range: from 0 to the end of truth.csv.
-// And `--no-record` leaves no recording.
+// And `--no-record` leaves no recording; and `swarmbox run --view` serves the same channels live
+// while the trial runs: Foxglove's own client (@foxglove/ws-protocol, tests/js/ws_client.mjs)
+// subscribes to the running trial and receives its poses (issue #20.2).
 #include <gtest/gtest.h>
 
+#include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
+
+#include <thread>
 
 #include <cmath>
 #include <filesystem>
@@ -31,6 +37,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using swarmbox::testing::ReadWholeFile;
+using swarmbox::testing::ChildProcess;
 using swarmbox::testing::RunToEnd;
 
 constexpr char kSwarmbox[] = SWARMBOX_CLI_EXE;
@@ -76,12 +83,15 @@ class RecordingE2e : public ::testing::Test {
     fs::remove_all(dir_);
   }
 
+  std::vector<std::string> RunArgv(const std::string& id, const std::string& sim_timeout) const {
+    return {kSwarmbox, "run", kTrials + "/sar_search.yaml", "--out", dir_.string(), "--run-id", id, "--quiet",
+            "--set", "seed=7", "--set", "timeout.sim=" + sim_timeout, "--set", "physics.rtf=0"};
+  }
+
   fs::path Run(const std::string& sim_timeout, const std::vector<std::string>& extra) {
     const std::string id = runner::NewRunId();
     run_ids_.push_back(id);
-    std::vector<std::string> argv = {kSwarmbox, "run", kTrials + "/sar_search.yaml", "--out", dir_.string(),
-                                     "--run-id", id, "--quiet", "--set", "seed=7", "--set", "timeout.sim=" + sim_timeout,
-                                     "--set", "physics.rtf=0"};
+    std::vector<std::string> argv = RunArgv(id, sim_timeout);
     argv.insert(argv.end(), extra.begin(), extra.end());
     auto done = RunToEnd(argv, std::chrono::minutes(10), dir_.string());
     EXPECT_TRUE(done) << done.error().ToString();
@@ -208,6 +218,67 @@ TEST_F(RecordingE2e, NoRecordLeavesNone) {
   const fs::path trial = Run("5s", {"--no-record"});
   EXPECT_TRUE(fs::exists(trial / "truth.csv")) << trial;
   EXPECT_FALSE(fs::exists(trial / "recording.mcap"));
+}
+
+// A free TCP port on 127.0.0.1 (bound, read back, released: the engine binds it next).
+int FreePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = 0;
+  socklen_t len = sizeof(a);
+  int port = 0;
+  if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
+    port = ntohs(a.sin_port);
+  }
+  if (fd >= 0) ::close(fd);
+  return port;
+}
+
+TEST_F(RecordingE2e, TheLiveViewServesARunningTrialToFoxglovesClient) {
+  const int port = FreePort();
+  ASSERT_GT(port, 0);
+  const std::string id = runner::NewRunId();
+  run_ids_.push_back(id);
+  std::vector<std::string> argv = RunArgv(id, "30s");
+  argv.insert(argv.end(), {"--view", "127.0.0.1:" + std::to_string(port)});
+  const std::string out = (dir_ / "run.out").string();
+  auto run = ChildProcess::Spawn(argv, out, out);
+  ASSERT_TRUE(run) << run.error().ToString();
+
+  // The client connects once the physics server listens (the engine publishes its port when the
+  // container starts): until then it exits 2 (no connection), and is started again.
+  const std::string url = "ws://127.0.0.1:" + std::to_string(port);
+  std::optional<testing::Finished> got;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::minutes(5);
+  while (std::chrono::steady_clock::now() < deadline && run->running()) {
+    auto client = RunToEnd({SWARMBOX_NODE, std::string(SWARMBOX_JS_DIR) + "/ws_client.mjs", url, "--want", "/tf=20",
+                            "--want", "/log=1", "--timeout-ms", "120000"},
+                           std::chrono::minutes(3), dir_.string());
+    ASSERT_TRUE(client) << client.error().ToString();
+    if (client->code != 2) {
+      got = *client;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
+  const std::optional<int> code = run->Wait(std::chrono::minutes(8));
+  const std::string printed = ReadWholeFile(out);
+  ASSERT_TRUE(got) << "the client never reached " << url << " while the trial ran:\n" << printed;
+  EXPECT_EQ(got->code, 0) << got->err;
+  auto doc = yaml::Parse(got->out, "ws_client");
+  ASSERT_TRUE(doc) << doc.error().ToString();
+  const yaml::Node* tf = doc->Find("received") != nullptr ? doc->Find("received")->Find("/tf") : nullptr;
+  ASSERT_NE(tf, nullptr) << got->out.substr(0, 2000);
+  EXPECT_GE(tf->items().size(), 20u);
+  // The poses are the trial's drones, as the recording has them.
+  const std::string first = yaml::EmitJson(tf->items().front());
+  EXPECT_NE(first.find("scout_1"), std::string::npos) << first.substr(0, 500);
+  ASSERT_TRUE(code.has_value()) << "swarmbox run did not end";
+  EXPECT_TRUE(*code == 0 || *code == 1) << "exit " << *code << "\n" << printed;
+  EXPECT_NE(printed.find("view: http://127.0.0.1:" + std::to_string(port) + "/"), std::string::npos) << printed;
 }
 
 }  // namespace
