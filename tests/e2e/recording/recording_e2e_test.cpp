@@ -7,7 +7,8 @@
 //   - counts: /tf and each truth channel at record.rate_hz (10 Hz) over the simulated time; the
 //     agents' status close to that (their telemetry, best effort); /log holds the run's log events;
 //   - time range: from 0 to the end of truth.csv.
-// And `--no-record` leaves no recording; and `swarmbox run --view` serves the same channels live
+// The same recording replays in the built-in page (`swarmbox view`, headless Chromium). And
+// `--no-record` leaves no recording; and `swarmbox run --view` serves the same channels live
 // while the trial runs: Foxglove's own client (@foxglove/ws-protocol, tests/js/ws_client.mjs)
 // subscribes to the running trial and receives its poses (issue #20.2).
 #include <gtest/gtest.h>
@@ -58,6 +59,23 @@ std::uint64_t U(const yaml::Node* n) {
   return v ? static_cast<std::uint64_t>(*v) : 0;
 }
 
+// A free TCP port on 127.0.0.1 (bound, read back, released: the engine binds it next).
+int FreePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = 0;
+  socklen_t len = sizeof(a);
+  int port = 0;
+  if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
+    port = ntohs(a.sin_port);
+  }
+  if (fd >= 0) ::close(fd);
+  return port;
+}
+
 class RecordingE2e : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -99,6 +117,30 @@ class RecordingE2e : public ::testing::Test {
       EXPECT_TRUE(done->code == 0 || done->code == 1) << "exit " << done->code << "\n" << done->err;
     }
     return dir_ / runner::TrialDirName("sar-search", id);
+  }
+
+  // The recording of a real trial replays in the built-in page: `swarmbox view RUN_DIR` serves it,
+  // headless Chromium loads the page (tests/js/page_check.mjs: the drones appear, the slider moves
+  // them, a drone's camera frame shows, an event click jumps to its time) and saves a screenshot.
+  void ExpectThePageReplays(const fs::path& trial) {
+    const int port = FreePort();
+    ASSERT_GT(port, 0);
+    const std::string out = (dir_ / "view.out").string();
+    auto view = ChildProcess::Spawn({kSwarmbox, "view", trial.string(), "--addr", "127.0.0.1:" + std::to_string(port)},
+                                    out, out);
+    ASSERT_TRUE(view) << view.error().ToString();
+    const std::string url = "http://127.0.0.1:" + std::to_string(port) + "/";
+    for (int i = 0; i < 100 && ReadWholeFile(out).find("view: ") == std::string::npos && view->running(); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    const std::string shot = (dir_ / "view.png").string();
+    auto page = RunToEnd({SWARMBOX_NODE, std::string(SWARMBOX_JS_DIR) + "/page_check.mjs", url, "--drones", "4",
+                          "--screenshot", shot, "--timeout-ms", "90000"},
+                         std::chrono::minutes(3), dir_.string());
+    ASSERT_TRUE(page) << page.error().ToString();
+    EXPECT_EQ(page->code, 0) << page->out.substr(0, 3000) << "\n" << page->err << "\nview: " << ReadWholeFile(out);
+    EXPECT_TRUE(fs::exists(shot));
+    EXPECT_EQ(view->Stop(std::chrono::seconds(5)), 0) << ReadWholeFile(out);
   }
 
   std::unique_ptr<docker::DockerClient> api_;
@@ -212,29 +254,13 @@ TEST_F(RecordingE2e, SarSearchRecordingMatchesTruthAndEvents) {
     std::cout << "[recording] /log " << log->count << " messages, events.jsonl " << events << " events" << std::endl;
     EXPECT_GE(static_cast<double>(log->count), 0.9 * static_cast<double>(events));
   }
+  ExpectThePageReplays(trial);
 }
 
 TEST_F(RecordingE2e, NoRecordLeavesNone) {
   const fs::path trial = Run("5s", {"--no-record"});
   EXPECT_TRUE(fs::exists(trial / "truth.csv")) << trial;
   EXPECT_FALSE(fs::exists(trial / "recording.mcap"));
-}
-
-// A free TCP port on 127.0.0.1 (bound, read back, released: the engine binds it next).
-int FreePort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in a{};
-  a.sin_family = AF_INET;
-  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  a.sin_port = 0;
-  socklen_t len = sizeof(a);
-  int port = 0;
-  if (fd >= 0 && ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
-      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
-    port = ntohs(a.sin_port);
-  }
-  if (fd >= 0) ::close(fd);
-  return port;
 }
 
 TEST_F(RecordingE2e, TheLiveViewServesARunningTrialToFoxglovesClient) {
