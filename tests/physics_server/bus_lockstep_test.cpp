@@ -105,8 +105,8 @@ void RunLockstepOverBus(const std::string& backend) {
     bus::CameraImage img;
     while ((*cam_a)->Take(img)) {
       ++images;
-      EXPECT_EQ(img.width_px, 320u);
-      EXPECT_EQ(img.data.size(), 320u * 240u * 3u);
+      EXPECT_EQ(img.width_px, 640u);  // the x500 camera (trials/airframes/x500.yaml)
+      EXPECT_EQ(img.data.size(), 640u * 360u * 3u);
       EXPECT_EQ(img.encoding, "bgr8");
     }
   }

@@ -44,7 +44,7 @@ class ScriptedAgents final : public SimTransport {
   Status PublishCamera(std::size_t, const std::string& name, std::uint64_t step, const CameraImage& img) override {
     ++frames[name];
     published.push_back("camera " + name + " " + std::to_string(step));
-    EXPECT_EQ(img.bgr.size(), 320u * 240u * 3u);
+    EXPECT_EQ(img.bgr.size(), 640u * 360u * 3u);  // the x500 camera (trials/airframes/x500.yaml)
     return Ok{};
   }
   Status PublishClock(std::uint64_t step, std::int64_t, std::int64_t, double) override {
