@@ -51,9 +51,10 @@ TEST(MissionMode, RoundTripsRoleAndModeAndRejectsOthers) {
 TEST(AirframeExtras, ReadsTheCameraAndWhereTheStretcherLies) {
   auto cam = LoadCameraSpec(SWARMBOX_TRIALS_DIR "/airframes/x500.yaml");
   ASSERT_TRUE(cam.ok()) << cam.error().ToString();
-  EXPECT_EQ(cam->width_px, 320);
-  EXPECT_EQ(cam->height_px, 240);
-  EXPECT_DOUBLE_EQ(cam->hfov_rad, 1.2);
+  // The OAK-D Lite RGB of PX4's x500_depth, scaled 3:1 (trials/airframes/x500.yaml).
+  EXPECT_EQ(cam->width_px, 640);
+  EXPECT_EQ(cam->height_px, 360);
+  EXPECT_DOUBLE_EQ(cam->hfov_rad, 1.204);
   EXPECT_EQ(cam->offset_m, Vec3(0, 0, -0.05));
   // x8_heavy: collision box 4.4 m wide, stretcher 0.6 m wide -> 2.2 + 0.3 + 0.5 = 3 m to the south.
   auto g = LoadGroundPayload(SWARMBOX_TRIALS_DIR "/airframes/x8_heavy.yaml", "stretcher");
