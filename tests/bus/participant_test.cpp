@@ -243,10 +243,10 @@ TEST(BusCycloneConfig, StarDiscoveryNamesPeersAndTurnsMulticastOff) {
   EXPECT_THAT(server, HasSubstr("<ParticipantIndex>0</ParticipantIndex>"));
   EXPECT_THAT(server, HasSubstr("<AllowMulticast>true</AllowMulticast>"));  // brains, components find it
   EXPECT_THAT(server, Not(HasSubstr("<Peers>")));
-  const std::string agent = CycloneXml({.interface = "eth0", .peers = {"physics:7410", "scout_1-brain:7410"}});
+  const std::string agent = CycloneXml({.interface = "eth0", .peers = {"physics:7410", "brain-scout-1:7410"}});
   EXPECT_THAT(agent, HasSubstr("<AllowMulticast>false</AllowMulticast>"));
   EXPECT_THAT(agent, HasSubstr("<NetworkInterface name=\"eth0\"/>"));
-  EXPECT_THAT(agent, HasSubstr("<Peers><Peer Address=\"physics:7410\"/><Peer Address=\"scout_1-brain:7410\"/></Peers>"));
+  EXPECT_THAT(agent, HasSubstr("<Peers><Peer Address=\"physics:7410\"/><Peer Address=\"brain-scout-1:7410\"/></Peers>"));
   EXPECT_THAT(agent, HasSubstr("<ParticipantIndex>none</ParticipantIndex>"));
 }
 

@@ -133,7 +133,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
       // discovery pairs, not N^2/2 (a 40-drone start no longer stalls in agent-agent discovery).
       "--sim-peer", std::string(kPhysicsId),
   };
-  if (d.brain.external()) argv.insert(argv.end(), {"--sim-peer", BrainId(d.name)});
+  if (d.brain.external()) argv.insert(argv.end(), {"--sim-peer", BrainHostName(d.name)});
   if (spec.radio.model == dsl::RadioModel::kChannel) {
     // The radio is the physics server's channel, over the sim bus: no mesh network, no mesh domain.
     argv.insert(argv.end(), {"--radio-model", "channel"});
@@ -299,6 +299,11 @@ bool NeedsFaultSidecars(const dsl::TrialSpec& spec) {
 
 std::string SidecarId(std::string_view drone) { return std::string(drone) + "-faults"; }
 std::string BrainId(std::string_view drone) { return std::string(drone) + "-brain"; }
+std::string BrainHostName(std::string_view drone) {
+  std::string host = "brain-" + std::string(drone);
+  std::replace(host.begin(), host.end(), '_', '-');
+  return host;
+}
 
 std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone) {
   return AgentArgv(spec, drone);
@@ -473,7 +478,8 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
                 {"CYCLONEDDS_URI", CycloneUriFor(kSimInterface, 0)}};
       ConfineUser(spec.LimitsOf(&d), &bc);
       bc.stop_timeout_s = 5;
-      brains.Add<dsl::Plugin>(id, std::move(bc), brains_level).On(sim_net, nets.sim.Host(next_sim_host++), {id});
+      brains.Add<dsl::Plugin>(id, std::move(bc), brains_level)
+          .On(sim_net, nets.sim.Host(next_sim_host++), {id, BrainHostName(d.name)});
     }
   }
 

@@ -143,7 +143,7 @@ TEST_F(UserSoftwarePlanTest, AnExternalBrainGetsItsOwnContainerOnSim) {
   EXPECT_THAT(agent.argv, Not(Contains("--brain-library")));
   // Discovery on sim as a star: the agent names the physics server and its own brain, which has
   // the well-known index 0 (bus/cyclone_config.hpp); a drone without a brain names the server only.
-  EXPECT_THAT(agent.argv, testing::IsSupersetOf({"physics", "scout_2-brain"}));
+  EXPECT_THAT(agent.argv, testing::IsSupersetOf({"physics", "brain-scout-2"}));
   EXPECT_EQ(std::count(agent.argv.begin(), agent.argv.end(), std::string("--sim-peer")), 2);
   const dsl::ContainerSpec& plain = trial->FindPlugin("scout_1")->spec();
   EXPECT_EQ(FlagValue(plain.argv, "--sim-peer"), "physics");
@@ -164,6 +164,7 @@ TEST_F(UserSoftwarePlanTest, AnExternalBrainGetsItsOwnContainerOnSim) {
   ASSERT_EQ(brain.networks.size(), 1u);
   EXPECT_EQ(brain.networks[0].network, "sim");
   EXPECT_EQ(brain.networks[0].ipv4, "10.200.8.13");  // after the three drones (.10-.12)
+  EXPECT_THAT(brain.networks[0].aliases, ElementsAre("scout_2-brain", "brain-scout-2"));
   EXPECT_THAT(brain.cap_drop, ElementsAre("ALL"));
   EXPECT_TRUE(brain.no_new_privileges);
   EXPECT_EQ(brain.memory_mib, 512);

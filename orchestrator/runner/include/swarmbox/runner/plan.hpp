@@ -144,6 +144,10 @@ inline constexpr double kChannelStepTimeoutS = 5.0;
 inline constexpr double kAgentStartPatienceS = 60.0;
 // The external brain's container id: "<drone>-brain".
 std::string BrainId(std::string_view drone);
+// The brain container's DNS alias on sim, which its agent names with --sim-peer: "brain-scout-2"
+// for scout_2 (the resolver refuses '_' in a host name, as "scout_2-brain" has; drone names have no
+// '-', so the alias stays unique).
+std::string BrainHostName(std::string_view drone);
 // The agent's argv (swarmbox-agent) and an external brain's (for tests and `swarmbox compose`).
 std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
 std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
