@@ -25,7 +25,7 @@
 //   Internal/WriterLingerDuration  only when set (ParticipantConfig::writer_linger_ms)
 //   Tracing                 severe only, to stderr
 //
-// Discovery as a star (the sim domain of a trial; ARCHITECTURE.md "Discovery on the sim bus"):
+// Discovery as a star (the sim domain of a trial; ARCHITECTURE.md, "Two radio models"):
 //   participant_index >= 0  Discovery/ParticipantIndex N: the participant's unicast discovery port is
 //                           the well-known DDSI one (CycloneDiscoveryPort), so others can name it
 //                           as a peer. The physics server: 0, alone in its container.
