@@ -34,7 +34,7 @@
 
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/yaml.hpp"
-#include "swarmbox/faults/command_runner.hpp"
+#include "swarmbox/faults/posix_command_runner.hpp"
 #include "swarmbox/faults/netem_spec.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
 #include "swarmbox/mission/raft_radio.hpp"

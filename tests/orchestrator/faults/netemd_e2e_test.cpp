@@ -17,7 +17,7 @@
 
 #include <gtest/gtest.h>
 
-#include "swarmbox/faults/command_runner.hpp"
+#include "swarmbox/faults/posix_command_runner.hpp"
 #include "swarmbox/faults/partition_plan.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
 #include "test_util.hpp"

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "fake_docker_api.hpp"
+#include "swarmbox/faults/docker_actions.hpp"
 #include "swarmbox/faults/docker_exec_runner.hpp"
 
 namespace swarmbox::faults {
