@@ -14,6 +14,7 @@
 
 #include "support/fake_clock.hpp"
 #include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/runner/runner.hpp"
 
@@ -24,12 +25,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 constexpr char kRun[] = "20261126-020000-c4a7";
 std::string Name(const std::string& component) { return std::string("chan-") + kRun + "-" + component; }

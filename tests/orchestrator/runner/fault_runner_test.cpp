@@ -16,6 +16,7 @@
 
 #include "support/fake_clock.hpp"
 #include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/runner/runner.hpp"
 
@@ -26,12 +27,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 constexpr char kRun[] = "20261121-160000-f00d";
 constexpr char kProbe[] = "tc qdisc replace dev lo root netem delay 0ms";

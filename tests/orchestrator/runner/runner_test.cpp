@@ -17,6 +17,7 @@
 
 #include "support/fake_clock.hpp"
 #include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/version.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
@@ -29,12 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 class RunnerTest : public ::testing::Test {
  protected:

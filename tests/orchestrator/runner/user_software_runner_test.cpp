@@ -13,6 +13,7 @@
 
 #include "support/fake_clock.hpp"
 #include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/runner/runner.hpp"
 
 namespace swarmbox::runner {
@@ -21,12 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 class UserSoftwareRunnerTest : public ::testing::Test {
  protected:
