@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_docker_api.hpp"
 #include "swarmbox/experiment/host_pool.hpp"
 
 namespace swarmbox::experiment {
