@@ -11,18 +11,6 @@ Error Bad(const yaml::Node& at, const std::string& msg) {
   return Error(ErrorCode::kInvalidArgument, msg, at.Where());
 }
 
-Result<double> NumberAt(const yaml::Node& map, std::string_view key, const std::string& what) {
-  const yaml::Node* n = map.Find(key);
-  if (n == nullptr) return Bad(map, what + ": missing '" + std::string(key) + "'");
-  return n->AsDouble();
-}
-
-Result<Vec3> Vec3At(const yaml::Node& n) {
-  std::array<double, 3> a{};
-  if (auto s = yaml::Decode(n, &a); !s) return s.error();
-  return Vec3(a[0], a[1], a[2]);
-}
-
 Status ReadControl(const yaml::Node& control, FlightConfig* cfg) {
   if (!control.is_mapping()) return Bad(control, "control: expected a mapping");
   yaml::MapReader top(control, "control");
@@ -128,110 +116,46 @@ Status ReadControl(const yaml::Node& control, FlightConfig* cfg) {
 
 }  // namespace
 
-Result<FlightConfig> ParseFlightConfig(const yaml::Node& root, std::string source) {
-  if (!root.is_mapping()) return Bad(root, "airframe: expected a mapping");
+Result<FlightConfig> FlightConfigFrom(const airframe::Airframe& af) {
   FlightConfig cfg;
-  cfg.source = std::move(source);
-  if (const yaml::Node* n = root.Find("name")) {
-    auto s = n->AsString();
-    if (!s) return s.error();
-    cfg.airframe = *s;
-  }
-  auto mass = NumberAt(root, "mass_kg", "airframe");
-  if (!mass) return mass.error();
-  cfg.mass_kg = *mass;
-  if (!(cfg.mass_kg > 0.0)) return Bad(root, "airframe: mass_kg must be > 0");
-  if (root.Find("base_height_m") != nullptr) {
-    auto bh = NumberAt(root, "base_height_m", "airframe");
-    if (!bh) return bh.error();
-    cfg.base_height_m = *bh;
-  }
-
-  const yaml::Node* motor = root.Find("motor");
-  if (motor == nullptr || !motor->is_mapping()) return Bad(root, "airframe: missing 'motor' mapping");
-  auto k = NumberAt(*motor, "motor_constant", "motor");
-  auto km = NumberAt(*motor, "moment_constant", "motor");
-  auto wmax = NumberAt(*motor, "max_rot_velocity_rad_s", "motor");
-  if (!k) return k.error();
-  if (!km) return km.error();
-  if (!wmax) return wmax.error();
-
-  const yaml::Node* rotors = root.Find("rotors");
-  if (rotors == nullptr || !rotors->is_sequence()) return Bad(root, "airframe: missing 'rotors' list");
-  for (const yaml::Node& r : rotors->items()) {
-    const yaml::Node* pos = r.Find("position_m");
-    const yaml::Node* dir = r.Find("direction");
-    if (pos == nullptr || dir == nullptr) return Bad(r, "rotor: needs position_m and direction");
-    auto p = Vec3At(*pos);
-    if (!p) return p.error();
-    auto d = dir->AsString();
-    if (!d) return d.error();
-    if (*d != "ccw" && *d != "cw") return Bad(*dir, "rotor direction must be ccw or cw, got '" + *d + "'");
+  cfg.airframe = af.name;
+  cfg.source = af.source;
+  cfg.mass_kg = af.mass_kg;
+  cfg.base_height_m = af.base_height_m;
+  for (const airframe::RotorSpec& r : af.rotors) {
     RotorGeometry g;
-    g.pos_m = *p;
-    g.spin_dir = *d == "ccw" ? 1 : -1;
-    g.motor_constant = *k;
-    g.moment_constant = *km;
-    g.max_rot_velocity = *wmax;
+    g.pos_m = Vec3(r.position_m.x, r.position_m.y, r.position_m.z);
+    g.spin_dir = r.ccw ? 1 : -1;
+    g.motor_constant = af.motor.motor_constant;
+    g.moment_constant = af.motor.moment_constant;
+    g.max_rot_velocity = af.motor.max_rot_velocity_rad_s;
     cfg.rotors.push_back(g);
   }
-
-  // Sensor noise figures for the estimator (defaults if the file has none).
-  if (const yaml::Node* sensors = root.Find("sensors")) {
-    if (const yaml::Node* gps = sensors->Find("gps")) {
-      if (const yaml::Node* h = gps->Find("horizontal_std_m")) {
-        auto v = h->AsDouble();
-        if (!v) return v.error();
-        cfg.estimator.gps_pos_h_std_m = *v;
-      }
-      if (const yaml::Node* h = gps->Find("vertical_std_m")) {
-        auto v = h->AsDouble();
-        if (!v) return v.error();
-        cfg.estimator.gps_pos_v_std_m = *v;
-      }
-      if (const yaml::Node* h = gps->Find("velocity_std_m_s")) {
-        auto v = h->AsDouble();
-        if (!v) return v.error();
-        cfg.estimator.gps_vel_std_mps = *v;
-      }
-    }
+  // Sensor noise figures for the estimator: the standalone receiver's accuracy (its defaults are
+  // the airframe's). With fix: rtk the estimator keeps its standalone prior, as it always has.
+  if (af.gps.fix == airframe::GpsFix::kStandalone) {
+    cfg.estimator.gps_pos_h_std_m = af.gps.horizontal_std_m;
+    cfg.estimator.gps_pos_v_std_m = af.gps.vertical_std_m;
   }
-  if (const yaml::Node* payloads = root.Find("payloads")) {
-    if (!payloads->is_sequence()) return Bad(*payloads, "payloads: expected a list");
-    for (const yaml::Node& p : payloads->items()) {
-      SlungPayload sp;
-      if (const yaml::Node* n = p.Find("name")) {
-        auto s = n->AsString();
-        if (!s) return s.error();
-        sp.name = *s;
-      }
-      auto m = NumberAt(p, "mass_kg", "payload");
-      auto l = NumberAt(p, "sling_length_m", "payload");
-      if (!m) return m.error();
-      if (!l) return l.error();
-      sp.mass_kg = *m;
-      sp.sling_length_m = *l;
-      if (const yaml::Node* h = p.Find("hook_m")) {
-        auto v = Vec3At(*h);
-        if (!v) return v.error();
-        sp.hook_m = *v;
-      }
-      cfg.payloads.push_back(sp);
-    }
-  }
-  if (const yaml::Node* control = root.Find("control"); control != nullptr && !control->is_null()) {
-    SWARMBOX_TRY(ReadControl(*control, &cfg));
-  }
+  cfg.estimator.gps_vel_std_mps = af.gps.velocity_std_m_s;
+  cfg.payloads = af.payloads;
+  if (!af.control.is_null()) SWARMBOX_TRY(ReadControl(af.control, &cfg));
   cfg.position.vel_max_xy_mps = cfg.limits.vel_max_xy_mps;
   cfg.position.vel_max_up_mps = cfg.limits.vel_max_up_mps;
   cfg.position.vel_max_down_mps = cfg.limits.vel_max_down_mps;
   return cfg;
 }
 
+Result<FlightConfig> ParseFlightConfig(const yaml::Node& root, std::string source) {
+  auto af = airframe::ParseAirframe(root, std::move(source));
+  if (!af) return af.error();
+  return FlightConfigFrom(*af);
+}
+
 Result<FlightConfig> LoadFlightConfig(const std::string& path) {
-  auto doc = yaml::ParseFile(path);
-  if (!doc) return doc.error();
-  return ParseFlightConfig(*doc, path);
+  auto af = airframe::LoadAirframe(path);
+  if (!af) return af.error();
+  return FlightConfigFrom(*af);
 }
 
 }  // namespace swarmbox::flight

@@ -114,8 +114,8 @@ FlightController::FlightController(const FlightConfig& config, const ControllerO
   output_.count = mixer_.rotor_count();
 
   // Swing damping: needs a slung payload in the airframe and both switches on.
-  const SlungPayload* payload = nullptr;
-  for (const SlungPayload& p : config_.payloads) {
+  const airframe::PayloadSpec* payload = nullptr;
+  for (const airframe::PayloadSpec& p : config_.payloads) {
     if (options_.payload_name[0] == '\0' || p.name == options_.payload_name) {
       payload = &p;
       break;
