@@ -126,6 +126,29 @@ brain::Event ToBrainEvent(const LogEvent& e) {
   return b;
 }
 
+namespace {
+
+// The lifter's payload from the airframe model: its sling, and where it lies on the ground (the
+// model's rule, the one the physics server places it by).
+Status ApplyLifterPayload(const airframe::Airframe& af, SarBrainConfig* c) {
+  auto payload = af.FindPayload(c->payload);
+  if (!payload) {
+    std::string known;
+    for (const airframe::PayloadSpec& p : af.payloads) known += (known.empty() ? "" : ", ") + p.name;
+    return Error(ErrorCode::kInvalidArgument, "--payload '" + c->payload + "': airframe " + af.name + " has " +
+                                                  (known.empty() ? std::string("no payloads") : "payloads " + known));
+  }
+  const airframe::PayloadSpec& p = **payload;
+  c->payload_sling_length_m = p.sling_length_m;
+  c->payload_hook_m = Vec3(p.hook_m.x, p.hook_m.y, p.hook_m.z);
+  const airframe::GroundPlacement ground = airframe::PayloadOnGround(af, p);
+  c->payload_offset_m = Eigen::Vector2d(ground.offset_x_m, ground.offset_y_m);
+  c->payload_half_height_m = ground.half_height_m;
+  return Ok{};
+}
+
+}  // namespace
+
 Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
   auto af = airframe::LoadAirframe(ctx.airframe_path);
   if (!af) return af.error().Context("sar brain: loading the airframe");
@@ -215,21 +238,7 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airfr
     return Error(ErrorCode::kInvalidArgument, "sar brain: fusion args: " + why);
   }
   if (!(t.revisit_look_s >= 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg revisit_look_s must be >= 0");
-  if (!c.payload.empty()) {
-    auto payload = af.FindPayload(c.payload);
-    if (!payload) {
-      std::string known;
-      for (const airframe::PayloadSpec& p : af.payloads) known += (known.empty() ? "" : ", ") + p.name;
-      return Error(ErrorCode::kInvalidArgument, "--payload '" + c.payload + "': airframe " + af.name + " has " +
-                                                    (known.empty() ? std::string("no payloads") : "payloads " + known));
-    }
-    const airframe::PayloadSpec& p = **payload;
-    c.payload_sling_length_m = p.sling_length_m;
-    c.payload_hook_m = Vec3(p.hook_m.x, p.hook_m.y, p.hook_m.z);
-    const airframe::GroundPlacement ground = airframe::PayloadOnGround(af, p);
-    c.payload_offset_m = Eigen::Vector2d(ground.offset_x_m, ground.offset_y_m);
-    c.payload_half_height_m = ground.half_height_m;
-  }
+  if (!c.payload.empty()) SWARMBOX_TRY(ApplyLifterPayload(af, &c));
   return c;
 }
 
