@@ -15,7 +15,7 @@
 #include "swarmbox/brain/args.hpp"
 #include "swarmbox/brain/loader.hpp"
 #include "swarmbox/common/logfmt.hpp"
-#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/airframe/airframe.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 #include "swarmbox/radio/dds_radio.hpp"
 #include "wait_budget.hpp"
@@ -84,7 +84,11 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
     return Error(ErrorCode::kInvalidArgument,
                  "the sim and mesh buses need different DDS domain ids (both are " + std::to_string(o.sim_domain) + ")");
   }
-  auto cfg = flight::LoadFlightConfig(o.airframe_path);
+  // The airframe file, parsed and validated once: the flight stack, the SAR brain and perception
+  // all take what they need from this one model.
+  auto af = airframe::LoadAirframe(o.airframe_path);
+  if (!af) return af.error().Context("loading airframe");
+  auto cfg = flight::FlightConfigFrom(*af);
   if (!cfg) return cfg.error().Context("loading airframe");
   // --mission sar: SarBrain's Context (what any brain is told) and the agent's perception,
   // checked before anything joins the bus.
@@ -107,7 +111,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
       std::snprintf(start, sizeof start, "%.17g,%.17g,%.17g", o.start_m.x(), o.start_m.y(), o.start_m.z());
       ctx.args["start"] = start;
     }
-    auto c = SarBrainConfigFrom(ctx);
+    auto c = SarBrainConfigFrom(ctx, *af);
     if (!c) return c.error();
     sar_config = std::move(*c);
     perception.camera = sar_config->camera;
@@ -281,12 +285,8 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   // frames only when the trial asks for cameras; without frames nothing is detected.)
   bool perceive = node->sar_ != nullptr && node->sar_->role() == swarm::Role::kScout;
   if (brain) {
-    auto airframe = yaml::ParseFile(o.airframe_path);
-    if (!airframe) return airframe.error().Context("loading airframe");
-    if (airframe->is_mapping() && airframe->Find("camera") != nullptr) {
-      auto camera = LoadCameraSpec(o.airframe_path);
-      if (!camera) return camera.error().Context("the airframe's camera");
-      perception.camera = *camera;
+    if (af->has_camera) {
+      perception.camera = af->camera;
       perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
       perceive = true;
     }

@@ -1,10 +1,7 @@
 #include "perception_host.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-
-#include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -13,33 +10,6 @@ using flight::Vec3;
 
 constexpr std::size_t kHistory = 128;  // control steps of estimates kept (0.5 s at 250 Hz)
 
-Status ReadCamera(const yaml::Node& cam, CameraSpec* c) {
-  if (!cam.is_mapping()) return Error(ErrorCode::kInvalidArgument, "camera: expected a mapping", cam.Where());
-  auto num = [&](std::string_view key, double* out) -> Status {
-    const yaml::Node* n = cam.Find(key);
-    if (n == nullptr) return Ok{};
-    auto v = n->AsDouble();
-    if (!v) return v.error();
-    if (!(*v > 0)) return Error(ErrorCode::kInvalidArgument, "camera: " + std::string(key) + " must be > 0", n->Where());
-    *out = *v;
-    return Ok{};
-  };
-  double w = c->width_px, h = c->height_px;
-  SWARMBOX_TRY(num("width_px", &w));
-  SWARMBOX_TRY(num("height_px", &h));
-  SWARMBOX_TRY(num("hfov_rad", &c->hfov_rad));
-  SWARMBOX_TRY(num("rate_hz", &c->rate_hz));
-  if (!(c->hfov_rad < M_PI)) return Error(ErrorCode::kInvalidArgument, "camera: hfov_rad must be < pi", cam.Where());
-  c->width_px = static_cast<int>(w);
-  c->height_px = static_cast<int>(h);
-  if (const yaml::Node* off = cam.Find("offset_m")) {
-    std::array<double, 3> a{};
-    SWARMBOX_TRY(yaml::Decode(*off, &a));
-    c->offset_m = Vec3(a[0], a[1], a[2]);
-  }
-  return Ok{};
-}
-
 swarm::PerceptionParams PerceptionFor(double latency_s) {
   swarm::PerceptionParams p;
   p.latency_s = latency_s;
@@ -47,16 +17,6 @@ swarm::PerceptionParams PerceptionFor(double latency_s) {
 }
 
 }  // namespace
-
-Result<CameraSpec> LoadCameraSpec(const std::string& airframe_path) {
-  auto doc = yaml::ParseFile(airframe_path);
-  if (!doc) return doc.error();
-  const yaml::Node* cam = doc->is_mapping() ? doc->Find("camera") : nullptr;
-  if (cam == nullptr) return Error(ErrorCode::kInvalidArgument, "airframe has no camera mapping", doc->Where());
-  CameraSpec c;
-  SWARMBOX_TRY(ReadCamera(*cam, &c));
-  return c;
-}
 
 Result<std::unique_ptr<PerceptionHost>> PerceptionHost::Create(const PerceptionConfig& config) {
   if (!(config.inference_latency_s >= 0)) {
@@ -85,7 +45,8 @@ void PerceptionHost::OnCameraFrame(const cv::Mat& bgr, const swarm::PinholeIntri
   const Vec3 up = best->att * Vec3::UnitZ();
   if (std::acos(std::clamp(up.z(), -1.0, 1.0)) > config_.max_tilt_rad) return;
   if (best->rate_radps.norm() > config_.max_rate_rad_s) return;
-  const swarm::OpticalPose pose = swarm::OpticalPoseFromBody(best->pos_m, best->att, config_.camera.offset_m);
+  const airframe::Vec3& offset = config_.camera.offset_m;
+  const swarm::OpticalPose pose = swarm::OpticalPoseFromBody(best->pos_m, best->att, Vec3(offset.x, offset.y, offset.z));
   (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s);
 }
 

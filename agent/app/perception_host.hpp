@@ -4,7 +4,7 @@
 // on the radio as bus::Detection). No bus here: AgentNode converts the images at its edge, so
 // perception is tested without DDS (tests/agent/app/perception_host_test.cpp).
 //
-//   auto p = PerceptionHost::Create({.camera = *LoadCameraSpec(airframe), .inference_latency_s = 0.04});
+//   auto p = PerceptionHost::Create({.camera = airframe.camera, .inference_latency_s = 0.04});
 //   p->RecordEstimate(t_s, est);                       // every control step (capture-time lookup)
 //   p->OnCameraFrame(bgr, k, capture_t_s);             // each camera image of this step
 //   p->PopVisible(t_s, &detections);                   // capture + latency <= t_s: to the brain
@@ -21,6 +21,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "swarmbox/airframe/airframe.hpp"
 #include "swarmbox/brain/brain.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/flight/estimator.hpp"
@@ -29,19 +30,8 @@
 
 namespace swarmbox::agent {
 
-// The downward camera of an airframe file (`camera:` mapping).
-struct CameraSpec {
-  int width_px = 320;
-  int height_px = 240;
-  double hfov_rad = 1.2;
-  double rate_hz = 5.0;
-  flight::Vec3 offset_m = flight::Vec3::Zero();  // camera centre in the body frame [m]
-};
-// kInvalidArgument (file:line:col) for a bad or missing `camera:` mapping.
-Result<CameraSpec> LoadCameraSpec(const std::string& airframe_path);
-
 struct PerceptionConfig {
-  CameraSpec camera;
+  airframe::CameraSpec camera;                 // the airframe's (offset_m: where the frames are taken from)
   double inference_latency_s = 0.040;          // simulated detector latency [s], >= 0
   double max_tilt_rad = 0.2;                   // frames taken more tilted are not used
   double max_rate_rad_s = 0.5;                 // nor while turning faster

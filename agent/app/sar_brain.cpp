@@ -45,33 +45,6 @@ Status ArgNumber(const brain::Context& ctx, const std::string& key, double* out)
 
 }  // namespace
 
-Result<GroundPayload> LoadGroundPayload(const std::string& airframe_path, const std::string& payload) {
-  auto doc = yaml::ParseFile(airframe_path);
-  if (!doc) return doc.error();
-  if (!doc->is_mapping()) return Error(ErrorCode::kInvalidArgument, "airframe: expected a mapping", doc->Where());
-  const yaml::Node* collision = doc->Find("collision");
-  const yaml::Node* box = collision != nullptr && collision->is_mapping() ? collision->Find("box_m") : nullptr;
-  if (box == nullptr) return Error(ErrorCode::kInvalidArgument, "airframe has no collision.box_m", doc->Where());
-  std::array<double, 3> box_m{};
-  SWARMBOX_TRY(yaml::Decode(*box, &box_m));
-  const yaml::Node* list = doc->Find("payloads");
-  if (list != nullptr && list->is_sequence()) {
-    for (const yaml::Node& p : list->items()) {
-      const yaml::Node* name = p.is_mapping() ? p.Find("name") : nullptr;
-      if (name == nullptr || name->scalar() != payload) continue;
-      const yaml::Node* size = p.Find("size_m");
-      if (size == nullptr) return Error(ErrorCode::kInvalidArgument, "payload " + payload + " has no size_m", p.Where());
-      std::array<double, 3> size_m{};
-      SWARMBOX_TRY(yaml::Decode(*size, &size_m));
-      GroundPayload g;
-      g.offset_m = Eigen::Vector2d(0.0, -(box_m[1] / 2 + size_m[1] / 2 + 0.5));
-      g.half_height_m = size_m[2] / 2;
-      return g;
-    }
-  }
-  return Error(ErrorCode::kInvalidArgument, "airframe has no payload '" + payload + "'", doc->Where());
-}
-
 std::string EncodeMissionMode(Role role, std::string_view mode) {
   return std::string(swarm::RoleName(role)) + "/" + std::string(mode);
 }
@@ -153,23 +126,52 @@ brain::Event ToBrainEvent(const LogEvent& e) {
   return b;
 }
 
+namespace {
+
+// The lifter's payload from the airframe model: its sling, and where it lies on the ground (the
+// model's rule, the one the physics server places it by).
+Status ApplyLifterPayload(const airframe::Airframe& af, SarBrainConfig* c) {
+  auto payload = af.FindPayload(c->payload);
+  if (!payload) {
+    std::string known;
+    for (const airframe::PayloadSpec& p : af.payloads) known += (known.empty() ? "" : ", ") + p.name;
+    return Error(ErrorCode::kInvalidArgument, "--payload '" + c->payload + "': airframe " + af.name + " has " +
+                                                  (known.empty() ? std::string("no payloads") : "payloads " + known));
+  }
+  const airframe::PayloadSpec& p = **payload;
+  c->payload_sling_length_m = p.sling_length_m;
+  c->payload_hook_m = Vec3(p.hook_m.x, p.hook_m.y, p.hook_m.z);
+  const airframe::GroundPlacement ground = airframe::PayloadOnGround(af, p);
+  c->payload_offset_m = Eigen::Vector2d(ground.offset_x_m, ground.offset_y_m);
+  c->payload_half_height_m = ground.half_height_m;
+  return Ok{};
+}
+
+}  // namespace
+
 Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
-  auto cfg = flight::LoadFlightConfig(ctx.airframe_path);
-  if (!cfg) return cfg.error().Context("sar brain: loading the airframe");
+  auto af = airframe::LoadAirframe(ctx.airframe_path);
+  if (!af) return af.error().Context("sar brain: loading the airframe");
+  return SarBrainConfigFrom(ctx, *af);
+}
+
+Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airframe::Airframe& af) {
   auto world = LoadWorldView(ctx.world_path);
   if (!world) return world.error();
-  auto camera = LoadCameraSpec(ctx.airframe_path);
-  if (!camera) return camera.error().Context("loading the airframe's camera");
+  if (!af.has_camera) {
+    return Error(ErrorCode::kInvalidArgument, "loading the airframe's camera: airframe has no camera mapping",
+                 af.source);
+  }
   SarBrainConfig c;
   c.name = ctx.self;
   c.members = ctx.members;
-  c.airframe = cfg->airframe;
+  c.airframe = af.name;
   c.payload = ctx.payload;
-  c.base_height_m = cfg->base_height_m;
-  c.vehicle_mass_kg = cfg->mass_kg;
+  c.base_height_m = af.base_height_m;
+  c.vehicle_mass_kg = af.mass_kg;
   c.geofence_size_x_m = world->size_x_m;
   c.geofence_size_y_m = world->size_y_m;
-  c.camera = *camera;
+  c.camera = af.camera;
   c.period_s = static_cast<double>(ctx.period_ns) * 1e-9;
   if (const auto it = ctx.args.find("start"); it != ctx.args.end()) {
     double x = 0, y = 0, z = 0;
@@ -236,22 +238,7 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
     return Error(ErrorCode::kInvalidArgument, "sar brain: fusion args: " + why);
   }
   if (!(t.revisit_look_s >= 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg revisit_look_s must be >= 0");
-  if (!c.payload.empty()) {
-    auto it = std::find_if(cfg->payloads.begin(), cfg->payloads.end(),
-                           [&](const flight::SlungPayload& p) { return p.name == c.payload; });
-    if (it == cfg->payloads.end()) {
-      std::string known;
-      for (const flight::SlungPayload& p : cfg->payloads) known += (known.empty() ? "" : ", ") + p.name;
-      return Error(ErrorCode::kInvalidArgument, "--payload '" + c.payload + "': airframe " + cfg->airframe + " has " +
-                                                    (known.empty() ? std::string("no payloads") : "payloads " + known));
-    }
-    c.payload_sling_length_m = it->sling_length_m;
-    c.payload_hook_m = it->hook_m;
-    auto ground = LoadGroundPayload(ctx.airframe_path, c.payload);
-    if (!ground) return ground.error().Context("--payload");
-    c.payload_offset_m = ground->offset_m;
-    c.payload_half_height_m = ground->half_height_m;
-  }
+  if (!c.payload.empty()) SWARMBOX_TRY(ApplyLifterPayload(af, &c));
   return c;
 }
 

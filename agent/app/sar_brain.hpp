@@ -55,6 +55,7 @@
 #include <vector>
 
 #include "perception_host.hpp"
+#include "swarmbox/airframe/airframe.hpp"
 #include "swarmbox/brain/brain.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
@@ -64,15 +65,6 @@
 #include "swarmbox/swarm/swarm.hpp"
 
 namespace swarmbox::agent {
-
-// Where a payload that starts on the ground lies relative to the drone's spawn point, and its
-// half height, from the airframe file: the physics server (World::AddDrone) lays it flat beside
-// the drone, on the world -y side, (collision box y + payload y) / 2 + 0.5 m from the spawn.
-struct GroundPayload {
-  Eigen::Vector2d offset_m = Eigen::Vector2d::Zero();  // from the spawn point, world ENU [m]
-  double half_height_m = 0.0;
-};
-Result<GroundPayload> LoadGroundPayload(const std::string& airframe_path, const std::string& payload);
 
 // The brain message every SAR member broadcasts with its status (SarBrain::Step): payload
 // "<t_ns> <role>/<mode> <x> <y>" (the sender's simulated time, its status as Output::status, its
@@ -145,13 +137,17 @@ struct SarBrainConfig {
   flight::Vec3 home_m = flight::Vec3::Zero();  // ground point under the drone at start [m]
   double geofence_size_x_m = 200.0;
   double geofence_size_y_m = 200.0;
-  CameraSpec camera;                  // the sweep's footprint (scouts)
+  airframe::CameraSpec camera;        // the sweep's footprint (scouts)
   double period_s = 0.004;            // between Steps (Context::period_ns) [s]
   MissionTuning tuning;
 };
 
-// The config from a brain::Context (the files it names and its args); kInvalidArgument naming
-// the file, the flag or the arg otherwise.
+// The config from a brain::Context (the world file it names and its args) and the airframe the
+// caller has parsed once (the agent's node: the same one its flight stack and perception use);
+// kInvalidArgument naming the file, the flag or the arg otherwise. Where a ground payload lies is
+// the airframe model's rule (airframe::PayloadOnGround), the one the physics server places it by.
+Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airframe::Airframe& af);
+// The same, parsing ctx.airframe_path first (a brain made from its Context alone).
 Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx);
 
 // The SAR-private side channel of the wall clock, netem only (banner). The node owns it, sets

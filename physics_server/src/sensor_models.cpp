@@ -48,11 +48,6 @@ GpsErrorModel::Split GpsErrorModel::SplitFor(double total_h_m, double total_v_m)
   return s;
 }
 
-GpsErrorModel::Accuracy GpsErrorModel::RtkAccuracy(double baseline_km) {
-  const double err = kRtkConstantM + kRtkPpm * std::max(0.0, baseline_km) * 1000.0;
-  return {err / kCepPerSigma, err / kR50PerSigma};
-}
-
 GpsErrorModel::Split GpsErrorModel::RtkSplit(double baseline_km) {
   const Accuracy total = RtkAccuracy(baseline_km);
   const Accuracy constant = RtkAccuracy(0.0);

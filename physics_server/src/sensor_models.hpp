@@ -75,24 +75,18 @@ class GpsErrorModel {
   static constexpr double kWhiteHStdM = 0.2;
   static constexpr double kWhiteVStdM = 0.5;
 
-  // RTK fixed (ZED-F9P datasheet): 0.01 m + 1 ppm, CEP horizontally, R50 vertically.
-  static constexpr double kRtkConstantM = 0.01;
-  static constexpr double kRtkPpm = 1e-6;
-  static constexpr double kCepPerSigma = 1.1774;  // sqrt(2 ln 2): CEP of a circular Gaussian
-  static constexpr double kR50PerSigma = 0.6745;  // median |x| of a 1-D Gaussian
+  // RTK fixed: the receiver's white noise; its datasheet total is airframe::RtkAccuracy.
   static constexpr double kRtkWhiteHStdM = 0.004;
   static constexpr double kRtkWhiteVStdM = 0.007;
 
   struct Split {  // per-axis 1-sigma of each component for a total (h, v) accuracy [m]
     double slow_h, slow_v, wander_h, wander_v, white_h, white_v;
   };
-  struct Accuracy {  // total 1-sigma per axis [m]
-    double h, v;
-  };
+  using Accuracy = airframe::GpsAccuracy;  // total 1-sigma per axis [m]
   // The split of an airframe's total per-axis accuracy (h, v) [m] (standalone receiver).
   static Split SplitFor(double total_h_m, double total_v_m);
   // An RTK-fixed ZED-F9P's accuracy and its split, `baseline_km` from its base.
-  static Accuracy RtkAccuracy(double baseline_km);
+  static Accuracy RtkAccuracy(double baseline_km) { return airframe::RtkAccuracy(baseline_km); }
   static Split RtkSplit(double baseline_km);
   // The split of a receiver as the airframe describes it (standalone or rtk).
   static Split SplitForSpec(const GpsSpec& spec);

@@ -465,13 +465,9 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
   }
   const PayloadSpec* payload = nullptr;
   if (!spawn.payload.empty()) {
-    for (const PayloadSpec& p : af.payloads) {
-      if (p.name == spawn.payload) payload = &p;
-    }
-    if (payload == nullptr) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "drone '" + spawn.name + "': airframe " + af.name + " has no payload '" + spawn.payload + "'");
-    }
+    auto found = af.FindPayload(spawn.payload);
+    if (!found) return Error(ErrorCode::kInvalidArgument, "drone '" + spawn.name + "': " + found.error().message());
+    payload = *found;
   }
   const std::size_t index = w.drones.size();
   auto d = std::make_unique<Impl::Drone>();
@@ -524,8 +520,8 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
     if (spawn.payload_attached) {
       at = origin + Rotate(q, payload->hook_m) - Vec3{0, 0, payload->sling_length_m};
     } else {
-      const double side = af.collision_box_m.y / 2 + payload->size_m.y / 2 + 0.5;
-      at = Vec3{spawn.position_m.x, spawn.position_m.y - side, payload->size_m.z / 2};
+      const airframe::GroundPlacement g = airframe::PayloadOnGround(af, *payload);
+      at = Vec3{spawn.position_m.x + g.offset_x_m, spawn.position_m.y + g.offset_y_m, g.half_height_m};
     }
     dBodySetPosition(d->payload_body, at.x, at.y, at.z);
     dBodySetQuaternion(d->payload_body, dq);

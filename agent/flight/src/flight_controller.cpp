@@ -8,10 +8,18 @@
 namespace swarmbox::flight {
 namespace {
 
-constexpr double kArriveTol_m = 0.3;
-constexpr double kArriveSpeed_mps = 0.3;
-constexpr double kYawRateLimit_radps = 1.5;
-constexpr double kAngAccelCutoff_hz = 30.0;
+// Every threshold of the step, named. Where PX4 has a parameter for the same role it is cited.
+constexpr double kMaxStepGap_s = 0.1;         // a longer gap between samples is a restart: use control_dt_s
+constexpr double kArriveTol_m = 0.3;          // "arrived" within this of the target (role of PX4 NAV_ACC_RAD)
+constexpr double kArriveSpeed_mps = 0.3;      // and slower than this
+constexpr double kArriveSettled_m = 0.05;     // with the reference this close to the target
+constexpr double kYawRateLimit_radps = 1.5;   // trajectory yawspeed limit (role of PX4 MPC_YAWRAUTO_MAX)
+constexpr double kAngAccelCutoff_hz = 30.0;   // D-term angular acceleration low-pass (PX4 IMU_DGYRO_CUTOFF)
+constexpr double kLandAccelFraction = 0.5;    // Land eases into its descent at this fraction of acc_max_z
+constexpr double kSwingDampingMinLandHeight_m = 2.0;  // in Land, swing damping stops below this height
+constexpr double kMinBrakeAccel_mps2 = 0.1;   // Hold/trajectory braking distance: at least this deceleration
+constexpr double kVelocityChaseFactor = 1.2;  // the position loop may chase the reference this much faster
+constexpr double kMinHoverMassFraction = 0.5; // hover thrust estimate: at least this fraction of the empty vehicle
 
 bool Flying(FlightMode m) {
   return m == FlightMode::kTakeoff || m == FlightMode::kHold || m == FlightMode::kPosition ||
@@ -97,25 +105,27 @@ FlightController::FlightController(const FlightConfig& config, const ControllerO
   pp.thrust_min_n = config_.thrust_min_frac * mixer_.max_thrust_n();
   pp.thrust_max_n = config_.thrust_max_frac * mixer_.max_thrust_n();
   // The controller may chase the reference a little faster than the reference itself moves.
-  pp.vel_max_xy_mps = 1.2 * config_.limits.vel_max_xy_mps;
-  pp.vel_max_up_mps = 1.2 * config_.limits.vel_max_up_mps;
-  pp.vel_max_down_mps = 1.2 * config_.limits.vel_max_down_mps;
+  pp.vel_max_xy_mps = kVelocityChaseFactor * config_.limits.vel_max_xy_mps;
+  pp.vel_max_up_mps = kVelocityChaseFactor * config_.limits.vel_max_up_mps;
+  pp.vel_max_down_mps = kVelocityChaseFactor * config_.limits.vel_max_down_mps;
   position_.SetParams(pp);
   attitude_.SetGains(config_.attitude);
   rate_.SetGains(config_.rate);
   trajectory_.SetLimits(config_.limits);
   // Hover thrust estimate: between half the empty vehicle and the most the position loop may ask.
   HoverThrustParams hp = config_.hover_thrust;
-  hp.min_hover = 0.5 * config_.mass_kg * kGravity_mps2 / mixer_.max_thrust_n();
+  hp.min_hover = kMinHoverMassFraction * config_.mass_kg * kGravity_mps2 / mixer_.max_thrust_n();
   hp.max_hover = config_.thrust_max_frac;
-  hte_.SetParams(hp);
-  hte_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
-  mass_kg_ = MassFor(hte_.hover_thrust());
+  HoverThrustModuleParams hm;
+  hm.thrust_lag_s = config_.hover_thrust_lag_s;
+  hover_.Configure(hm, hp, mixer_.max_thrust_n());
+  hover_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
+  mass_kg_ = MassFor(hover_.hover_thrust());
   output_.count = mixer_.rotor_count();
 
   // Swing damping: needs a slung payload in the airframe and both switches on.
-  const SlungPayload* payload = nullptr;
-  for (const SlungPayload& p : config_.payloads) {
+  const airframe::PayloadSpec* payload = nullptr;
+  for (const airframe::PayloadSpec& p : config_.payloads) {
     if (options_.payload_name[0] == '\0' || p.name == options_.payload_name) {
       payload = &p;
       break;
@@ -146,8 +156,8 @@ void FlightController::SetPayloadMass(double payload_mass_kg) {
   options_.payload_mass_kg = payload_mass_kg;
   // A prior as uncertain as a fresh start: the estimator corrects it within seconds when the
   // announced load is not what the drone lifts (a refused hook, a heavier evacuee).
-  hte_.SetPrior(HoverThrustFor(config_.mass_kg + payload_mass_kg), config_.hover_thrust.init_std);
-  mass_kg_ = MassFor(hte_.hover_thrust());
+  hover_.SetPrior(HoverThrustFor(config_.mass_kg + payload_mass_kg), config_.hover_thrust.init_std);
+  mass_kg_ = MassFor(hover_.hover_thrust());
 }
 
 void FlightController::Emit(FlightEventKind kind, double t_s) {
@@ -210,10 +220,9 @@ bool FlightController::Command(const Setpoint& sp) {
       home_z_m_ = s.pos_m.z();
       yaw_sp_rad_ = YawOf(s.att);
       ResetControllers();
-      hte_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
-      mass_kg_ = MassFor(hte_.hover_thrust());
-      thrust_lagged_n_ = 0.0;
-      hte_in_air_ = false;
+      hover_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
+      mass_kg_ = MassFor(hover_.hover_thrust());
+      land_.Reset();
       airborne_s_ = 0.0;
       trajectory_.Reset(s.pos_m, Vec3::Zero());
       if (shaper_.configured()) shaper_.Reset(trajectory_.reference());
@@ -254,7 +263,8 @@ bool FlightController::Command(const Setpoint& sp) {
       // Stop where braking at the acceleration limit ends.
       const TrajectoryPoint& r = trajectory_.reference();
       const double v = r.vel_mps.norm();
-      const double a = std::max(0.1, std::min(config_.limits.acc_max_xy_mps2, config_.limits.acc_max_z_mps2));
+      const double a =
+          std::max(kMinBrakeAccel_mps2, std::min(config_.limits.acc_max_xy_mps2, config_.limits.acc_max_z_mps2));
       trajectory_.SetPositionTarget(r.pos_m + r.vel_mps * (v / (2.0 * a)));
       SetMode(FlightMode::kHold, t);
       return true;
@@ -264,7 +274,7 @@ bool FlightController::Command(const Setpoint& sp) {
       land_xy_m_ = trajectory_.reference().pos_m;
       land_xy_m_.z() = s.pos_m.z();
       land_vz_mps_ = std::min(0.0, s.vel_mps.z());
-      landed_timer_s_ = 0.0;
+      land_.StartLanding();
       SetMode(FlightMode::kLand, t);
       Emit(FlightEventKind::kLanding, t);
       return true;
@@ -290,7 +300,8 @@ bool FlightController::CommandTrajectory(const TrajectoryTarget& target, double 
     const bool unset = std::isnan(target.pos_m[a]) && std::isnan(target.vel_mps[a]) && std::isnan(target.acc_mps2[a]);
     if (unset && !(continuing && traj_held_[i])) {
       // Hold where braking at the acceleration limit from the estimated velocity ends (as Hold).
-      const double acc_max = std::max(0.1, a < 2 ? config_.limits.acc_max_xy_mps2 : config_.limits.acc_max_z_mps2);
+      const double acc_max =
+          std::max(kMinBrakeAccel_mps2, a < 2 ? config_.limits.acc_max_xy_mps2 : config_.limits.acc_max_z_mps2);
       const double v = s.vel_mps[a];
       traj_hold_m_[a] = s.pos_m[a] + v * std::abs(v) / (2.0 * acc_max);
     }
@@ -350,17 +361,18 @@ void FlightController::DisarmedOutput() {
   output_.armed = false;
   output_.u.fill(0.0);
   last_thrust_n_ = 0.0;
-  thrust_lagged_n_ = 0.0;
+  hover_.ClearThrust();
 }
 
-const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
-  double dt = last_t_s_ < 0.0 ? options_.control_dt_s : sample.t_s - last_t_s_;
-  if (!(dt > 0.0) || dt > 0.1) dt = options_.control_dt_s;
-  last_t_s_ = sample.t_s;
-  t_s_ = sample.t_s;
-  estimator_.SetAtRest(!Flying(mode_));
-  const StateEstimate& s = estimator_.Update(sample);
+double FlightController::StepPeriod(double t_s) {
+  double dt = last_t_s_ < 0.0 ? options_.control_dt_s : t_s - last_t_s_;
+  if (!(dt > 0.0) || dt > kMaxStepGap_s) dt = options_.control_dt_s;
+  last_t_s_ = t_s;
+  t_s_ = t_s;
+  return dt;
+}
 
+bool FlightController::Armed(const StateEstimate& s) {
   if (mode_ == FlightMode::kInit) {
     if (s.valid) {
       mode_ = FlightMode::kIdle;
@@ -369,7 +381,7 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
       Emit(FlightEventKind::kReady, t_s_);
     }
     DisarmedOutput();
-    return output_;
+    return false;
   }
   if (s.gps_ok != gps_ok_) {
     gps_ok_ = s.gps_ok;
@@ -378,123 +390,117 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
   if (!Flying(mode_)) {
     DisarmedOutput();
     ResetControllers();
-    return output_;
+    return false;
   }
-  airborne_s_ += dt;
+  return true;
+}
 
-  // Hover thrust (effective mass) estimate, PX4's mc_hover_thrust_estimator: the vertical
-  // acceleration against the vertical thrust that produced it, once clear of the ground. The
-  // thrust goes through the rotors' lag first (what the rotors deliver, not what was asked).
+void FlightController::UpdateHoverThrust(const StateEstimate& s, double dt_s) {
+  // In the air (latched until the next take-off): the land detector's answer. The vertical
+  // acceleration against the vertical thrust the rotors delivered (hover_thrust_module.hpp).
+  const bool in_air = land_.InAir(airborne_s_, s.pos_m.z() - home_z_m_, s.vel_mps.z());
   const Vec3 body_z = s.att * Vec3::UnitZ();
-  const double lag_s = config_.hover_thrust_lag_s;
-  thrust_lagged_n_ += (lag_s > 0.0 ? std::min(1.0, dt / lag_s) : 1.0) * (last_thrust_n_ - thrust_lagged_n_);
-  // In the air (latched until the next take-off): 0.5 m above the take-off point, or sinking
-  // (an airborne start whose first thrust was too low for its load).
-  if (airborne_s_ > 1.0 && (s.pos_m.z() - home_z_m_ > 0.5 || s.vel_mps.z() < -0.3)) hte_in_air_ = true;
-  if (hte_in_air_ && thrust_lagged_n_ > 0.0) {
-    hte_.Predict(dt);
-    const double thrust_z = thrust_lagged_n_ * body_z.z() / mixer_.max_thrust_n();
-    // De-weight fast vertical (drag, prop wash) and horizontal flight, as PX4 (HTE_VZ_THR 2 m/s,
-    // HTE_VXY_THR 10 m/s).
-    const double scale = std::max({1.0, std::abs(s.vel_mps.z()) - 2.0 + 1.0, s.vel_mps.head<2>().norm() - 10.0 + 1.0});
-    hte_.Fuse(s.accel_mps2.z(), thrust_z, dt, scale);
-    mass_kg_ = MassFor(hte_.hover_thrust());
+  if (hover_.Update(in_air, last_thrust_n_, body_z.z(), s.accel_mps2.z(), s.vel_mps, dt_s)) {
+    mass_kg_ = MassFor(hover_.hover_thrust());
   }
+}
 
-  // Yaw setpoint slews to the wanted heading.
-  const double yaw_now = YawOf(s.att);
-  (void)yaw_now;
+bool FlightController::LandReference(const StateEstimate& s, double dt_s, PositionSetpoint* psp) {
+  const double height = s.pos_m.z() - home_z_m_;
+  const double v_target = height < config_.land_slow_below_m ? config_.land_slow_speed_mps : config_.land_speed_mps;
+  const double dv = config_.limits.acc_max_z_mps2 * kLandAccelFraction * dt_s;
+  land_vz_mps_ = std::clamp(-v_target, land_vz_mps_ - dv, land_vz_mps_ + dv);
+  psp->axes = {AxisControl::kPosition, AxisControl::kPosition, AxisControl::kVelocity};
+  psp->pos_m = land_xy_m_;
+  psp->vel_mps = Vec3(0.0, 0.0, land_vz_mps_);
+  telemetry_.reference.pos_m = land_xy_m_;
+  telemetry_.reference.vel_mps = psp->vel_mps;
+  telemetry_.reference.acc_mps2.setZero();
+  if (!land_.UpdateTouchdown(dt_s, t_s_ - mode_since_s_, s.vel_mps.z(), land_vz_mps_, last_thrust_n_, mass_kg_)) {
+    return true;
+  }
+  SetMode(FlightMode::kLanded, t_s_);
+  Emit(FlightEventKind::kLanded, t_s_);
+  DisarmedOutput();
+  ResetControllers();
+  return false;
+}
 
-  // Reference for this step.
-  PositionSetpoint psp;
-  psp.yaw_rad = yaw_sp_rad_;
-  double yawspeed_ff_radps = 0.0;
+void FlightController::SmoothedReference(const StateEstimate& s, double dt_s, PositionSetpoint* psp) {
+  TrajectoryPoint ref = trajectory_.Step(dt_s);
+  if (shaper_.configured()) {
+    const TrajectoryPoint shaped = shaper_.Shape(ref);
+    ref.pos_m.head<2>() = shaped.pos_m.head<2>();
+    ref.vel_mps.head<2>() = shaped.vel_mps.head<2>();
+    ref.acc_mps2.head<2>() = shaped.acc_mps2.head<2>();
+  }
+  telemetry_.reference = ref;
+  if (mode_ == FlightMode::kVelocity) {
+    psp->axes = {AxisControl::kVelocity, AxisControl::kVelocity, AxisControl::kVelocity};
+  }
+  psp->pos_m = ref.pos_m;
+  psp->vel_mps = ref.vel_mps;
+  psp->acc_mps2 = ref.acc_mps2;
+
+  const bool near = (s.pos_m - trajectory_.target()).norm() < kArriveTol_m && s.vel_mps.norm() < kArriveSpeed_mps &&
+                    trajectory_.Settled(kArriveSettled_m);
+  if (mode_ == FlightMode::kTakeoff && near) {
+    trajectory_.SetLimits(config_.limits);
+    SetMode(FlightMode::kHold, t_s_);
+    Emit(FlightEventKind::kHover, t_s_);
+  } else if (mode_ == FlightMode::kPosition && near && !arrived_reported_) {
+    arrived_reported_ = true;
+    Emit(FlightEventKind::kArrived, t_s_);
+  }
+}
+
+bool FlightController::Reference(const StateEstimate& s, double dt_s, PositionSetpoint* psp,
+                                 double* yawspeed_ff_radps) {
+  psp->yaw_rad = yaw_sp_rad_;
+  *yawspeed_ff_radps = 0.0;
   if (mode_ == FlightMode::kTrajectory) {
-    psp = TrajectoryStep(s, dt, &yawspeed_ff_radps);
-    telemetry_.reference.pos_m = psp.pos_m;
-    telemetry_.reference.vel_mps = psp.vel_mps;
-    telemetry_.reference.acc_mps2 = psp.acc_mps2;
-  } else if (mode_ == FlightMode::kLand) {
-    const double height = s.pos_m.z() - home_z_m_;
-    const double v_target = height < config_.land_slow_below_m ? config_.land_slow_speed_mps : config_.land_speed_mps;
-    const double dv = config_.limits.acc_max_z_mps2 * 0.5 * dt;
-    land_vz_mps_ = std::clamp(-v_target, land_vz_mps_ - dv, land_vz_mps_ + dv);
-    psp.axes = {AxisControl::kPosition, AxisControl::kPosition, AxisControl::kVelocity};
-    psp.pos_m = land_xy_m_;
-    psp.vel_mps = Vec3(0.0, 0.0, land_vz_mps_);
-    telemetry_.reference.pos_m = land_xy_m_;
-    telemetry_.reference.vel_mps = psp.vel_mps;
-    telemetry_.reference.acc_mps2.setZero();
-    // Touch-down: asked to descend, not descending, thrust well under hover, for 1 s.
-    const bool still = std::abs(s.vel_mps.z()) < 0.15 && land_vz_mps_ < -0.1;
-    const bool low_thrust = last_thrust_n_ < 0.85 * mass_kg_ * kGravity_mps2;
-    landed_timer_s_ = (t_s_ - mode_since_s_ > 1.0 && still && low_thrust) ? landed_timer_s_ + dt : 0.0;
-    if (landed_timer_s_ > 1.0) {
-      SetMode(FlightMode::kLanded, t_s_);
-      Emit(FlightEventKind::kLanded, t_s_);
-      DisarmedOutput();
-      ResetControllers();
-      return output_;
-    }
-  } else {
-    TrajectoryPoint ref = trajectory_.Step(dt);
-    if (shaper_.configured()) {
-      const TrajectoryPoint shaped = shaper_.Shape(ref);
-      ref.pos_m.head<2>() = shaped.pos_m.head<2>();
-      ref.vel_mps.head<2>() = shaped.vel_mps.head<2>();
-      ref.acc_mps2.head<2>() = shaped.acc_mps2.head<2>();
-    }
-    telemetry_.reference = ref;
-    if (mode_ == FlightMode::kVelocity) {
-      psp.axes = {AxisControl::kVelocity, AxisControl::kVelocity, AxisControl::kVelocity};
-    }
-    psp.pos_m = ref.pos_m;
-    psp.vel_mps = ref.vel_mps;
-    psp.acc_mps2 = ref.acc_mps2;
-
-    const bool near = (s.pos_m - trajectory_.target()).norm() < kArriveTol_m &&
-                      s.vel_mps.norm() < kArriveSpeed_mps && trajectory_.Settled(0.05);
-    if (mode_ == FlightMode::kTakeoff && near) {
-      trajectory_.SetLimits(config_.limits);
-      SetMode(FlightMode::kHold, t_s_);
-      Emit(FlightEventKind::kHover, t_s_);
-    } else if (mode_ == FlightMode::kPosition && near && !arrived_reported_) {
-      arrived_reported_ = true;
-      Emit(FlightEventKind::kArrived, t_s_);
-    }
+    *psp = TrajectoryStep(s, dt_s, yawspeed_ff_radps);
+    telemetry_.reference.pos_m = psp->pos_m;
+    telemetry_.reference.vel_mps = psp->vel_mps;
+    telemetry_.reference.acc_mps2 = psp->acc_mps2;
+    return true;
   }
+  if (mode_ == FlightMode::kLand) return LandReference(s, dt_s, psp);
+  SmoothedReference(s, dt_s, psp);
+  return true;
+}
 
-  // Swing damping from the vehicle's own motion.
-  if (damping_on_) {
-    if (sample.imu_fresh) {
-      swing_.Update(sample.accel_mps2, s.att, s.accel_mps2, mass_kg_ - config_.mass_kg, dt);
-    }
-    if (mode_ != FlightMode::kLand || s.pos_m.z() - home_z_m_ > 2.0) {
-      const double gain = LoadScaledDampingGain(config_.swing.gain, mass_kg_ - config_.mass_kg, config_.mass_kg,
-                                                config_.swing.full_gain_load_ratio);
-      psp.acc_mps2 += swing_.DampingAcceleration(gain);
-      // (velocity counterpart left out: it fights the position loop into a slow oscillation)
-    }
-    telemetry_.swing_estimate_rad = swing_.swing_angle_rad();
+void FlightController::AddSwingDamping(const SensorSample& sample, const StateEstimate& s, double dt_s,
+                                       PositionSetpoint* psp) {
+  if (!damping_on_) return;
+  const double load_kg = mass_kg_ - config_.mass_kg;
+  if (sample.imu_fresh) swing_.Update(sample.accel_mps2, s.att, s.accel_mps2, load_kg, dt_s);
+  if (mode_ != FlightMode::kLand || s.pos_m.z() - home_z_m_ > kSwingDampingMinLandHeight_m) {
+    const double gain =
+        LoadScaledDampingGain(config_.swing.gain, load_kg, config_.mass_kg, config_.swing.full_gain_load_ratio);
+    psp->acc_mps2 += swing_.DampingAcceleration(gain);
+    // (velocity counterpart left out: it fights the position loop into a slow oscillation)
   }
+  telemetry_.swing_estimate_rad = swing_.swing_angle_rad();
+}
 
-  const PositionOutput po = position_.Update(s, psp, mass_kg_, dt);
+void FlightController::RunCascade(const StateEstimate& s, const PositionSetpoint& psp, double yawspeed_ff_radps,
+                                  double dt_s) {
+  const PositionOutput po = position_.Update(s, psp, mass_kg_, dt_s);
   telemetry_.position = po;
   telemetry_.mass_estimate_kg = mass_kg_;
-  telemetry_.hover_thrust = hte_.hover_thrust();
-  telemetry_.hover_thrust_std = std::sqrt(hte_.variance());
-  if (!po.valid) {
-    // Non-finite estimate or setpoint: nothing sane to fly. Keep the last output, report once.
-    return output_;
-  }
+  telemetry_.hover_thrust = hover_.hover_thrust();
+  telemetry_.hover_thrust_std = std::sqrt(hover_.variance());
+  // Non-finite estimate or setpoint: nothing sane to fly. Keep the last output.
+  if (!po.valid) return;
   const Vec3 rate_sp = attitude_.Update(s.att, po.att_sp, yawspeed_ff_radps);
 
   // Angular acceleration for the D term: differentiated, low-passed rate.
-  const double alpha = dt / (dt + 1.0 / (2.0 * kPi * kAngAccelCutoff_hz));
-  ang_accel_ += alpha * ((s.rate_radps - last_rate_) / dt - ang_accel_);
+  const double alpha = dt_s / (dt_s + 1.0 / (2.0 * kPi * kAngAccelCutoff_hz));
+  ang_accel_ += alpha * ((s.rate_radps - last_rate_) / dt_s - ang_accel_);
   last_rate_ = s.rate_radps;
-  const bool on_ground_phase = airborne_s_ < 0.5;
-  const Vec3 torque_norm = rate_.Update(s.rate_radps, rate_sp, ang_accel_, dt, on_ground_phase);
+  const Vec3 torque_norm =
+      rate_.Update(s.rate_radps, rate_sp, ang_accel_, dt_s, land_.GroundContactPhase(airborne_s_));
   const Vec3 torque_nm = torque_norm.cwiseProduct(mixer_.torque_scale_nm());
   const MixerOutput mo = mixer_.Mix(torque_nm, po.thrust_n);
   rate_.SetSaturation(mo.sat_positive, mo.sat_negative);
@@ -506,6 +512,22 @@ const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
   output_.u = mo.u;
   telemetry_.rate_sp_radps = rate_sp;
   telemetry_.torque_nm = torque_nm;
+}
+
+// The control step as PX4 runs its modules: estimator, land detector + hover thrust estimator,
+// the mode's reference (flight tasks), swing damping, then position -> attitude -> rate -> mixer.
+const ActuatorOutput& FlightController::Step(const SensorSample& sample) {
+  const double dt = StepPeriod(sample.t_s);
+  estimator_.SetAtRest(!Flying(mode_));
+  const StateEstimate& s = estimator_.Update(sample);
+  if (!Armed(s)) return output_;  // not ready, or on the ground: motors off
+  airborne_s_ += dt;
+  UpdateHoverThrust(s, dt);
+  PositionSetpoint psp;
+  double yawspeed_ff_radps = 0.0;
+  if (!Reference(s, dt, &psp, &yawspeed_ff_radps)) return output_;  // touched down: motors off
+  AddSwingDamping(sample, s, dt, &psp);
+  RunCascade(s, psp, yawspeed_ff_radps, dt);
   return output_;
 }
 

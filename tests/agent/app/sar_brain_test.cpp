@@ -49,20 +49,26 @@ TEST(MissionMode, RoundTripsRoleAndModeAndRejectsOthers) {
 }
 
 TEST(AirframeExtras, ReadsTheCameraAndWhereTheStretcherLies) {
-  auto cam = LoadCameraSpec(SWARMBOX_TRIALS_DIR "/airframes/x500.yaml");
-  ASSERT_TRUE(cam.ok()) << cam.error().ToString();
+  // The one airframe model (airframe/) the agent's brain, perception and flight stack share.
+  auto x500 = airframe::LoadAirframe(SWARMBOX_TRIALS_DIR "/airframes/x500.yaml");
+  ASSERT_TRUE(x500.ok()) << x500.error().ToString();
+  ASSERT_TRUE(x500->has_camera);
+  const airframe::CameraSpec* cam = &x500->camera;
   // The OAK-D Lite RGB of PX4's x500_depth, scaled 3:1 (trials/airframes/x500.yaml).
   EXPECT_EQ(cam->width_px, 640);
   EXPECT_EQ(cam->height_px, 360);
   EXPECT_DOUBLE_EQ(cam->hfov_rad, 1.204);
-  EXPECT_EQ(cam->offset_m, Vec3(0, 0, -0.05));
+  EXPECT_EQ(cam->offset_m, (airframe::Vec3{0, 0, -0.05}));
   // x8_heavy: collision box 4.4 m wide, stretcher 0.6 m wide -> 2.2 + 0.3 + 0.5 = 3 m to the south.
-  auto g = LoadGroundPayload(SWARMBOX_TRIALS_DIR "/airframes/x8_heavy.yaml", "stretcher");
-  ASSERT_TRUE(g.ok()) << g.error().ToString();
-  EXPECT_NEAR(g->offset_m.x(), 0.0, 1e-12);
-  EXPECT_NEAR(g->offset_m.y(), -3.0, 1e-12);
-  EXPECT_NEAR(g->half_height_m, 0.125, 1e-12);
-  auto none = LoadGroundPayload(SWARMBOX_TRIALS_DIR "/airframes/x500.yaml", "stretcher");
+  auto x8 = airframe::LoadAirframe(SWARMBOX_TRIALS_DIR "/airframes/x8_heavy.yaml");
+  ASSERT_TRUE(x8.ok()) << x8.error().ToString();
+  auto stretcher = x8->FindPayload("stretcher");
+  ASSERT_TRUE(stretcher.ok()) << stretcher.error().ToString();
+  const airframe::GroundPlacement g = airframe::PayloadOnGround(*x8, **stretcher);
+  EXPECT_NEAR(g.offset_x_m, 0.0, 1e-12);
+  EXPECT_NEAR(g.offset_y_m, -3.0, 1e-12);
+  EXPECT_NEAR(g.half_height_m, 0.125, 1e-12);
+  auto none = x500->FindPayload("stretcher");
   ASSERT_FALSE(none.ok());
   EXPECT_NE(none.error().ToString().find("no payload 'stretcher'"), std::string::npos) << none.error().ToString();
 }

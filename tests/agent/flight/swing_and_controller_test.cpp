@@ -53,8 +53,11 @@ TEST(SwingObserver, RestsWithoutAPayload) {
 constexpr const char* kQuad = R"(
 name: testquad
 mass_kg: 2.0
+inertia_kg_m2: [0.0217, 0.0217, 0.04]
+collision: {box_m: [0.5, 0.5, 0.2]}
 base_height_m: 0.2
-motor: {motor_constant: 8.54858e-06, moment_constant: 0.016, max_rot_velocity_rad_s: 1000.0}
+motor: {motor_constant: 8.54858e-06, moment_constant: 0.016, max_rot_velocity_rad_s: 1000.0,
+        time_constant_up_s: 0.0125, time_constant_down_s: 0.025}
 rotors:
   - {position_m: [0.174, -0.174, 0.06], direction: ccw}
   - {position_m: [-0.174, 0.174, 0.06], direction: ccw}

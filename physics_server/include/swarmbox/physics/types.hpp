@@ -6,31 +6,15 @@
 
 #include <cmath>
 
+#include "swarmbox/airframe/vec3.hpp"
+
 namespace swarmbox::physics {
 
-struct Vec3 {
-  double x = 0;
-  double y = 0;
-  double z = 0;
-
-  constexpr Vec3 operator+(const Vec3& o) const { return {x + o.x, y + o.y, z + o.z}; }
-  constexpr Vec3 operator-(const Vec3& o) const { return {x - o.x, y - o.y, z - o.z}; }
-  constexpr Vec3 operator*(double s) const { return {x * s, y * s, z * s}; }
-  constexpr Vec3 operator-() const { return {-x, -y, -z}; }
-  constexpr Vec3& operator+=(const Vec3& o) {
-    x += o.x;
-    y += o.y;
-    z += o.z;
-    return *this;
-  }
-  constexpr bool operator==(const Vec3&) const = default;
-};
-
-constexpr double Dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-constexpr Vec3 Cross(const Vec3& a, const Vec3& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-inline double Norm(const Vec3& a) { return std::sqrt(Dot(a, a)); }
+// The airframe model's vector (swarmbox/airframe/vec3.hpp): one type for the file and the world.
+using Vec3 = airframe::Vec3;
+using airframe::Cross;
+using airframe::Dot;
+using airframe::Norm;
 
 // Unit quaternion (w, x, y, z), body -> world.
 struct Quat {

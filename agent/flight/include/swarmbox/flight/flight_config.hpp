@@ -1,11 +1,12 @@
-// The flight stack's configuration, read from an airframe file (trials/airframes/<name>.yaml).
+// The flight stack's configuration, from the airframe model (swarmbox/airframe/airframe.hpp: the
+// file trials/airframes/<name>.yaml, parsed and validated once by the airframe library).
 //
-// The physics engineer owns the physical part of the file; the flight stack reads from it only
+// The airframe library owns the physical part of the file; the flight stack takes from it only
 // what a real companion computer would be configured with (empty mass, rotor geometry and motor
-// constants for the mixer, sensor noise figures for the estimator, the payload's sling for swing
-// damping) and owns the top-level `control:` mapping (gains and limits), read strictly: unknown
-// keys there are errors with file:line:col. Every key of `control:` is optional; missing ones keep
-// PX4's x500 defaults below.
+// constants for the mixer, sensor noise figures for the estimator, the payloads' slings for swing
+// damping) and owns the top-level `control:` mapping (gains and limits), which it reads here from
+// the parsed document (Airframe::control), strictly: unknown keys there are errors with
+// file:line:col. Every key of `control:` is optional; missing ones keep PX4's x500 defaults below.
 //
 //   control:
 //     position: {xy_p: 0.95, z_p: 1.0, vel_xy_pid: [1.8, 0.4, 0.2], vel_z_pid: [4.0, 2.0, 0.0],
@@ -20,12 +21,14 @@
 //     swing_damping: {enabled: true, gain: 1.0, shaper: true, full_gain_load_ratio: 0.0}
 //     hover_thrust: {process_noise: 0.0036, init_std: 0.1, gate_sd: 3.0, thrust_lag_s: 0.0}
 //
-//   Result<FlightConfig> cfg = LoadFlightConfig("trials/airframes/x500.yaml");
+//   Result<airframe::Airframe> af = airframe::LoadAirframe("trials/airframes/x500.yaml");
+//   Result<FlightConfig> cfg = FlightConfigFrom(*af);      // or LoadFlightConfig(path): both at once
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "swarmbox/airframe/airframe.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/flight/attitude_control.hpp"
@@ -37,13 +40,6 @@
 #include "swarmbox/flight/trajectory.hpp"
 
 namespace swarmbox::flight {
-
-struct SlungPayload {
-  std::string name;
-  double mass_kg = 0.0;
-  double sling_length_m = 0.0;        // hook -> payload centre [m]
-  Vec3 hook_m = Vec3::Zero();         // hook in the body frame [m]
-};
 
 struct SwingDampingParams {
   bool enabled = true;
@@ -71,7 +67,7 @@ struct FlightConfig {
   double land_speed_mps = 0.7;
   double land_slow_speed_mps = 0.3;
   double land_slow_below_m = 2.0;     // height above the take-off point where landing slows [m]
-  std::vector<SlungPayload> payloads;
+  std::vector<airframe::PayloadSpec> payloads;  // the airframe's (swing damping: sling_length_m)
   SwingDampingParams swing;
   // Hover thrust estimator (PX4 HTE_HT_NOISE, HTE_HT_ERR_INIT, HTE_ACC_GATE); its bounds are
   // set by the controller from the airframe.
@@ -79,6 +75,9 @@ struct FlightConfig {
   double hover_thrust_lag_s = 0.0;    // rotor lag applied to the thrust it is fed [s]
 };
 
+// kInvalidArgument (file:line:col) for a bad `control:` mapping.
+Result<FlightConfig> FlightConfigFrom(const airframe::Airframe& af);
+// The airframe parsed (airframe::ParseAirframe / LoadAirframe) and then FlightConfigFrom.
 Result<FlightConfig> ParseFlightConfig(const yaml::Node& airframe_root, std::string source = {});
 Result<FlightConfig> LoadFlightConfig(const std::string& path);
 

@@ -1,9 +1,13 @@
 // FlightController: the whole flight stack of one drone as one pure object. Sensor sample in,
 // actuator command out, on simulated time; setpoints in from the layers above, events out.
 //
-//   sample -> Estimator -> modes/setpoints -> Trajectory (limits, smoothing) [-> InputShaper]
+//   sample -> Estimator -> LandDetector + HoverThrustModule (the effective mass)
+//          -> modes/setpoints -> Trajectory (limits, smoothing) [-> InputShaper]
 //          -> PositionControl (+ swing damping feed-forward) -> AttitudeControl -> RateControl
 //          -> Mixer -> u[i] in [0, 1]
+// Step() is that sequence of calls, one per unit, as PX4 splits it into modules (land_detector,
+// mc_hover_thrust_estimator, flight tasks, mc_pos_control, mc_att_control, mc_rate_control); each
+// unit has its named parameters (PX4's parameter names cited where PX4 has one) and its own test.
 // The trajectory kind (a brain's PX4 TrajectorySetpoint stream, setpoint.hpp) skips the
 // smoothing: its targets go to PositionControl per axis, within the same velocity and tilt limits.
 // When a brain's stream stops, OffboardFailsafe (offboard_failsafe.hpp) tells the caller to send
@@ -24,7 +28,8 @@
 #include "swarmbox/flight/attitude_control.hpp"
 #include "swarmbox/flight/estimator.hpp"
 #include "swarmbox/flight/flight_config.hpp"
-#include "swarmbox/flight/hover_thrust_estimator.hpp"
+#include "swarmbox/flight/hover_thrust_module.hpp"
+#include "swarmbox/flight/land_detector.hpp"
 #include "swarmbox/flight/mixer.hpp"
 #include "swarmbox/flight/position_control.hpp"
 #include "swarmbox/flight/rate_control.hpp"
@@ -106,6 +111,19 @@ class FlightController {
   bool CommandTrajectory(const TrajectoryTarget& target, double t_s);
   // The trajectory kind's setpoint for this step (per-axis control, heading), from target_.
   PositionSetpoint TrajectoryStep(const StateEstimate& s, double dt_s, double* yawspeed_ff_radps);
+  // Step()'s parts, in order. The step period from the sample time [s].
+  double StepPeriod(double t_s);
+  // Mode bookkeeping before flight (ready, GPS lost/recovered); false (motors off) unless flying.
+  bool Armed(const StateEstimate& s);
+  // Land detector's in-air answer -> hover thrust estimate -> mass_kg_.
+  void UpdateHoverThrust(const StateEstimate& s, double dt_s);
+  // The mode's setpoint for this step; false when the drone has just touched down (disarmed).
+  bool Reference(const StateEstimate& s, double dt_s, PositionSetpoint* psp, double* yawspeed_ff_radps);
+  bool LandReference(const StateEstimate& s, double dt_s, PositionSetpoint* psp);
+  void SmoothedReference(const StateEstimate& s, double dt_s, PositionSetpoint* psp);
+  void AddSwingDamping(const SensorSample& sample, const StateEstimate& s, double dt_s, PositionSetpoint* psp);
+  // Position -> attitude -> rate -> mixer into output_.
+  void RunCascade(const StateEstimate& s, const PositionSetpoint& psp, double yawspeed_ff_radps, double dt_s);
   double HoverThrustFor(double mass_kg) const;   // normalised hover thrust of a total mass
   double MassFor(double hover_thrust) const;
 
@@ -116,7 +134,8 @@ class FlightController {
   Trajectory trajectory_;
   InputShaper shaper_;
   SwingObserver swing_;
-  HoverThrustEstimator hte_;
+  HoverThrustModule hover_;
+  LandDetector land_;
   PositionControl position_;
   AttitudeControl attitude_;
   RateControl rate_;
@@ -131,13 +150,10 @@ class FlightController {
   double home_z_m_ = 0.0;
   Vec3 land_xy_m_ = Vec3::Zero();
   double land_vz_mps_ = 0.0;
-  double landed_timer_s_ = 0.0;
   bool arrived_reported_ = true;
   bool gps_ok_ = true;
   double mass_kg_ = 0.0;            // hover-thrust (effective mass) estimate [kg]
-  double last_thrust_n_ = 0.0;
-  double thrust_lagged_n_ = 0.0;    // last_thrust_n_ through the rotors' lag [N]
-  bool hte_in_air_ = false;         // the hover thrust estimator may learn (cleared at take-off)
+  double last_thrust_n_ = 0.0;      // collective thrust commanded last step [N]
   Vec3 last_rate_ = Vec3::Zero();
   Vec3 ang_accel_ = Vec3::Zero();
   bool damping_on_ = false;

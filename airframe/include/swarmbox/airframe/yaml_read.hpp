@@ -1,13 +1,14 @@
-// Helpers for reading the physics YAML schemas (airframes, worlds) with common/yaml.hpp.
+// Helpers for reading the airframe and world YAML schemas with common/yaml.hpp (the airframe
+// library's parser and the physics server's world parser use them).
 #pragma once
 
 #include <string>
 #include <string_view>
 
 #include "swarmbox/common/yaml.hpp"
-#include "swarmbox/physics/types.hpp"
+#include "swarmbox/airframe/vec3.hpp"
 
-namespace swarmbox::physics {
+namespace swarmbox::airframe {
 
 // A Vec3 is written as a list of three numbers: [x, y, z]. Found by MapReader through ADL.
 Status Decode(const yaml::Node& node, Vec3* out);
@@ -42,4 +43,4 @@ void Nested(yaml::MapReader& parent, std::string_view key, std::string what, boo
 }
 
 }  // namespace detail
-}  // namespace swarmbox::physics
+}  // namespace swarmbox::airframe

@@ -1,12 +1,13 @@
-#include "swarmbox/physics/airframe.hpp"
+#include "swarmbox/airframe/airframe.hpp"
 
 #include <cmath>
 #include <numbers>
 
-#include "detail/yaml_read.hpp"
-#include "sensor_models.hpp"
+#include <algorithm>
 
-namespace swarmbox::physics {
+#include "swarmbox/airframe/yaml_read.hpp"
+
+namespace swarmbox::airframe {
 namespace {
 
 using detail::Checked;
@@ -14,7 +15,23 @@ using detail::Nested;
 using yaml::MapReader;
 using yaml::Node;
 
-void ReadMotor(MapReader& r, const Node& n, MotorSpec* m) {
+// ---- one reader per top-level section (kSections) ----------------------------------------------
+
+void ReadCollision(MapReader& parent, Airframe* af) {
+  Nested(parent, "collision", "collision", true, [af](MapReader& c, const Node&) {
+    c.Required("box_m", &af->collision_box_m).Optional("offset_m", &af->collision_offset_m);
+  });
+}
+
+void ReadImpact(MapReader& parent, Airframe* af) {
+  Nested(parent, "impact", "impact", false, [af](MapReader& c, const Node& n) {
+    Checked(c, n)
+        .Positive("hard_landing_speed_m_s", &af->hard_landing_speed_m_s, false)
+        .Positive("crash_speed_m_s", &af->crash_speed_m_s, false);
+  });
+}
+
+void ReadMotorFields(MapReader& r, const Node& n, MotorSpec* m) {
   Checked(r, n)
       .Positive("motor_constant", &m->motor_constant)
       .NonNegative("moment_constant", &m->moment_constant, true)
@@ -23,6 +40,10 @@ void ReadMotor(MapReader& r, const Node& n, MotorSpec* m) {
       .Positive("max_rot_velocity_rad_s", &m->max_rot_velocity_rad_s)
       .NonNegative("rotor_drag_coefficient", &m->rotor_drag_coefficient)
       .NonNegative("rolling_moment_coefficient", &m->rolling_moment_coefficient);
+}
+
+void ReadMotor(MapReader& parent, Airframe* af) {
+  Nested(parent, "motor", "motor", true, [af](MapReader& m, const Node& n) { ReadMotorFields(m, n, &af->motor); });
 }
 
 void ReadRotors(MapReader& parent, Airframe* af) {
@@ -125,6 +146,7 @@ void ReadSensors(MapReader& parent, Airframe* af) {
 
 void ReadCamera(MapReader& parent, Airframe* af) {
   Nested(parent, "camera", "camera", false, [af](MapReader& r, const Node& n) {
+    af->has_camera = true;
     CameraSpec& c = af->camera;
     r.Optional("width_px", &c.width_px).Optional("height_px", &c.height_px).Optional("offset_m", &c.offset_m);
     Checked(r, n)
@@ -171,36 +193,19 @@ void ReadPayloads(MapReader& parent, Airframe* af) {
   }
 }
 
-}  // namespace
-
-double Airframe::HoverRotorSpeed(double extra_mass_kg, double gravity_m_s2) const {
-  const double n = static_cast<double>(rotors.size());
-  return std::sqrt((mass_kg + extra_mass_kg) * gravity_m_s2 / (n * motor.motor_constant));
+void ReadControl(MapReader& parent, Airframe* af) {
+  if (const Node* control = parent.Child("control", false)) af->control = *control;  // the flight stack's
 }
 
-Result<Airframe> ParseAirframe(const yaml::Node& root, std::string source) {
-  Airframe af;
-  af.source = std::move(source);
-  MapReader r(root, "airframe");
-  r.Required("name", &af.name).Required("inertia_kg_m2", &af.inertia_kg_m2);
-  Checked(r, root).Positive("mass_kg", &af.mass_kg).NonNegative("base_height_m", &af.base_height_m, true);
-  r.Optional("body_drag_coefficient", &af.body_drag_coefficient);
-  Nested(r, "collision", "collision", true, [&af](MapReader& c, const Node&) {
-    c.Required("box_m", &af.collision_box_m).Optional("offset_m", &af.collision_offset_m);
-  });
-  Nested(r, "impact", "impact", false, [&af](MapReader& c, const Node& n) {
-    Checked(c, n)
-        .Positive("hard_landing_speed_m_s", &af.hard_landing_speed_m_s, false)
-        .Positive("crash_speed_m_s", &af.crash_speed_m_s, false);
-  });
-  Nested(r, "motor", "motor", true, [&af](MapReader& m, const Node& n) { ReadMotor(m, n, &af.motor); });
-  if (r.ok()) ReadRotors(r, &af);
-  if (r.ok()) ReadSensors(r, &af);
-  if (r.ok()) ReadCamera(r, &af);
-  if (r.ok()) ReadPayloads(r, &af);
-  if (const Node* control = r.Child("control", false)) af.control = *control;  // flight stack's
-  if (auto s = r.Finish(); !s) return s.error().Context("airframe");
+// The top-level sections, read in this order after the scalar keys; the first error wins. A new
+// section: its reader here (a field of Airframe filled by a parse function in its own file).
+using SectionReader = void (*)(MapReader& parent, Airframe* af);
+constexpr SectionReader kSections[] = {
+    ReadCollision, ReadImpact, ReadMotor, ReadRotors, ReadSensors, ReadCamera, ReadPayloads, ReadControl,
+};
 
+// Checks across keys, once every section is read.
+Status CheckConsistency(const Node& root, const Airframe& af) {
   auto fail = [&](const char* key, const std::string& msg) -> Error {
     const Node* n = root.Find(key);
     return Error(ErrorCode::kInvalidArgument, "airframe: " + msg, (n ? *n : root).Where());
@@ -218,11 +223,53 @@ Result<Airframe> ParseAirframe(const yaml::Node& root, std::string source) {
   if (af.crash_speed_m_s < af.hard_landing_speed_m_s) {
     return fail("impact", "crash_speed_m_s must be >= hard_landing_speed_m_s");
   }
+  return Ok{};
+}
+
+}  // namespace
+
+double Airframe::HoverRotorSpeed(double extra_mass_kg, double gravity_m_s2) const {
+  const double n = static_cast<double>(rotors.size());
+  return std::sqrt((mass_kg + extra_mass_kg) * gravity_m_s2 / (n * motor.motor_constant));
+}
+
+Result<const PayloadSpec*> Airframe::FindPayload(std::string_view payload_name) const {
+  auto it = std::find_if(payloads.begin(), payloads.end(), [&](const PayloadSpec& p) { return p.name == payload_name; });
+  if (it == payloads.end()) {
+    return Error(ErrorCode::kInvalidArgument, "airframe " + name + " has no payload '" + std::string(payload_name) + "'");
+  }
+  return &*it;
+}
+
+GroundPlacement PayloadOnGround(const Airframe& af, const PayloadSpec& payload) {
+  GroundPlacement g;
+  g.offset_y_m = -(af.collision_box_m.y / 2 + payload.size_m.y / 2 + kGroundPayloadGapM);
+  g.half_height_m = payload.size_m.z / 2;
+  return g;
+}
+
+Result<Airframe> ParseAirframe(const yaml::Node& root, std::string source) {
+  Airframe af;
+  af.source = std::move(source);
+  MapReader r(root, "airframe");
+  r.Required("name", &af.name).Required("inertia_kg_m2", &af.inertia_kg_m2);
+  Checked(r, root).Positive("mass_kg", &af.mass_kg).NonNegative("base_height_m", &af.base_height_m, true);
+  r.Optional("body_drag_coefficient", &af.body_drag_coefficient);
+  for (SectionReader read : kSections) {
+    if (r.ok()) read(r, &af);
+  }
+  if (auto s = r.Finish(); !s) return s.error().Context("airframe");
+  SWARMBOX_TRY(CheckConsistency(root, af));
   return af;
 }
 
+GpsAccuracy RtkAccuracy(double baseline_km) {
+  const double err = kRtkConstantM + kRtkPpm * std::max(0.0, baseline_km) * 1000.0;
+  return {err / kCepPerSigma, err / kR50PerSigma};
+}
+
 void SetRtkFix(GpsSpec* gps, double baseline_km) {
-  const GpsErrorModel::Accuracy a = GpsErrorModel::RtkAccuracy(baseline_km);
+  const GpsAccuracy a = RtkAccuracy(baseline_km);
   gps->fix = GpsFix::kRtk;
   gps->rtk_baseline_km = baseline_km;
   gps->horizontal_std_m = a.h;
@@ -235,4 +282,4 @@ Result<Airframe> LoadAirframe(const std::string& path) {
   return ParseAirframe(*doc, path);
 }
 
-}  // namespace swarmbox::physics
+}  // namespace swarmbox::airframe

@@ -1,9 +1,9 @@
-#include "detail/yaml_read.hpp"
+#include "swarmbox/airframe/yaml_read.hpp"
 
 #include <array>
 #include <cmath>
 
-namespace swarmbox::physics {
+namespace swarmbox::airframe {
 
 Status Decode(const yaml::Node& node, Vec3* out) {
   std::array<double, 3> v{};
@@ -45,4 +45,4 @@ Checked& Checked::Range(std::string_view key, double* out, bool required, bool s
 }
 
 }  // namespace detail
-}  // namespace swarmbox::physics
+}  // namespace swarmbox::airframe
