@@ -7,7 +7,8 @@
 # Layout (GNUInstallDirs):
 #   P/bin/swarmbox, swarmbox-physics, swarmbox-agent, swarmbox-netemd   side by side: an installed
 #                                  swarmbox finds its companions next to itself (images::FindProgram)
-#   P/lib/libswarmbox_*.a          common, record, docker, images, dsl, faults, runner, hosts, report, experiment;
+#   P/lib/libswarmbox_*.a          common, record, docker, images, dsl, faults_model, faults, runner, hosts,
+#                                  report, experiment;
 #                                  brain (what a brain library links, PIC) and brain_loader
 #   P/include/swarmbox/<component>/...   their public headers
 #   P/lib/cmake/swarmbox/          swarmboxConfig.cmake, swarmboxConfigVersion.cmake, swarmboxTargets.cmake,
@@ -56,7 +57,7 @@ function(swarmbox_install_program target)
           RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime)
 endfunction()
 
-foreach(lib common record docker images worlds dsl faults runner hosts report experiment)
+foreach(lib common record docker images worlds faults_model dsl faults runner hosts report experiment)
   swarmbox_install_library(swarmbox_${lib} ${lib})
 endforeach()
 # The brain SDK (agent/brain): what a brain library links, the loader, and swarmbox_add_brain().

@@ -64,14 +64,16 @@ fi
 # ThreadSanitizer stage: the orchestrator's concurrent code, against the fake Docker API (the
 # runner creates, starts and stops a level's containers from a pool of threads, creates later
 # levels ahead while earlier ones start, and the experiment runner removes finished trials in the
-# background while its slots launch the next ones). scripts/tsan.supp names the one report from
+# background while its slots launch the next ones), and DockerEngine's parts on their own (its
+# JobQueue and LogFollowers: runner_engine_parts_test). scripts/tsan.supp names the one report from
 # outside the project (a lock-order report inside libgdal, which OpenCV's image codecs load).
 if [ "${TSAN:-on}" != "off" ]; then
   TSAN_BUILD_DIR=${TSAN_BUILD_DIR:-build-tsan}
   stage_start=$(date +%s)
-  echo "test.sh: ThreadSanitizer stage in $TSAN_BUILD_DIR: runner_fake_docker_test experiment_test"
+  tsan_targets=(runner_engine_parts_test runner_fake_docker_test experiment_test)
+  echo "test.sh: ThreadSanitizer stage in $TSAN_BUILD_DIR: ${tsan_targets[*]}"
   cmake --preset tsan -B "$TSAN_BUILD_DIR" >/dev/null
-  cmake --build "$TSAN_BUILD_DIR" -j "$JOBS" --target runner_fake_docker_test experiment_test
+  cmake --build "$TSAN_BUILD_DIR" -j "$JOBS" --target "${tsan_targets[@]}"
   TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp} \
     ctest --test-dir "$TSAN_BUILD_DIR" --output-on-failure -j "$JOBS" -L unit \
       -LE bench -E '^ShippedTrialsValidate$'

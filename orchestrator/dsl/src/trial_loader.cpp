@@ -255,268 +255,329 @@ Result<TrialSpec> DecodeTrial(const yaml::Node& document, const LoadOptions& opt
 
 namespace {
 
-Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& options) {
-  TrialSpec spec;
-  spec.document = doc;
-  spec.trials_dir = options.trials_dir;
+// The trial's top-level keys (the mapping checked: unknown keys, required ones), each section's
+// node or null when absent.
+struct Sections {
+  const Node* world = nullptr;
+  const Node* world_size = nullptr;
+  const Node* physics = nullptr;
+  const Node* drones = nullptr;
+  const Node* mission = nullptr;
+  const Node* raft = nullptr;
+  const Node* radio = nullptr;
+  const Node* record = nullptr;
+  const Node* network = nullptr;
+  const Node* faults = nullptr;
+  const Node* end = nullptr;
+  const Node* timeout = nullptr;
+  const Node* limits = nullptr;
+  const Node* components = nullptr;
+};
+
+// `name`, `seed` and `middleware` into *spec and *middleware, the sections' nodes.
+Result<Sections> ReadSections(const Node& doc, TrialSpec* spec, std::string* middleware) {
+  Sections s;
   yaml::MapReader r(doc, "trial");
-  std::string middleware = "cyclonedds";
-  r.Required("name", &spec.name)
-      .Optional("seed", &spec.seed)
-      .Optional("middleware", &middleware);
-  const Node* world = r.Child("world", /*required=*/true);
-  const Node* world_size = r.Child("world_size_m");
-  const Node* physics = r.Child("physics");
-  const Node* drones = r.Child("drones", /*required=*/true);
-  const Node* mission = r.Child("mission");
-  const Node* raft = r.Child("raft");
-  const Node* radio = r.Child("radio");
-  const Node* record = r.Child("record");
-  const Node* network = r.Child("network");
-  const Node* faults = r.Child("faults");
-  const Node* end = r.Child("end");
-  const Node* timeout = r.Child("timeout", /*required=*/true);
-  const Node* limits = r.Child("limits");
-  const Node* components = r.Child("components");
+  r.Required("name", &spec->name).Optional("seed", &spec->seed).Optional("middleware", middleware);
+  s.world = r.Child("world", /*required=*/true);
+  s.world_size = r.Child("world_size_m");
+  s.physics = r.Child("physics");
+  s.drones = r.Child("drones", /*required=*/true);
+  s.mission = r.Child("mission");
+  s.raft = r.Child("raft");
+  s.radio = r.Child("radio");
+  s.record = r.Child("record");
+  s.network = r.Child("network");
+  s.faults = r.Child("faults");
+  s.end = r.Child("end");
+  s.timeout = r.Child("timeout", /*required=*/true);
+  s.limits = r.Child("limits");
+  s.components = r.Child("components");
   SWARMBOX_TRY(r.Finish());
-  detail::SoftwareContext software;
-  software.base_dir = options.base_dir;
-  software.check_files = options.check_references;
-  software.file_kind = options.file_kind;
-  if (limits != nullptr && !limits->is_null()) SWARMBOX_TRY(DecodeLimits(*limits, &spec.limits));
+  return s;
+}
 
-  if (world != nullptr && world->is_mapping()) {  // a generated world (worlds/generator.hpp)
-    auto generate = worlds::ParseGenerateSpec(*world);
+bool Present(const Node* node) { return node != nullptr && !node->is_null(); }
+
+// `world: worlds/open_field.yaml`, or `world: {generate: ...}` (worlds/generator.hpp).
+Status DecodeWorld(const Node& world, TrialSpec* spec) {
+  if (world.is_mapping()) {
+    auto generate = worlds::ParseGenerateSpec(world);
     if (!generate) return generate.error();
-    spec.world_generate = *generate;
-    spec.world = "worlds/generated_" + std::string(worlds::KindName(generate->kind)) + ".yaml";
-  } else if (world != nullptr) {
-    if (auto s = yaml::Decode(*world, &spec.world); !s) return s.error();
+    spec->world_generate = *generate;
+    spec->world = "worlds/generated_" + std::string(worlds::KindName(generate->kind)) + ".yaml";
+    return Ok{};
   }
-  if (world_size != nullptr && !world_size->is_null()) {
-    const std::string what = "'world_size_m' must be [X, Y], the geofence's size in metres (both > 0)";
-    if (!world_size->is_sequence() || world_size->items().size() != 2) return At(*world_size, what);
-    for (std::size_t i = 0; i < 2; ++i) {
-      auto v = world_size->items()[i].AsDouble();
-      if (!v || !(*v > 0) || !std::isfinite(*v)) return At(world_size->items()[i], what);
-      spec.world_size_m[i] = *v;
-    }
-  }
+  return yaml::Decode(world, &spec->world);
+}
 
-  if (!IsTrialName(spec.name)) {
-    return At(*doc.Find("name"),
-              "trial name '" + spec.name + "' must be 1-40 characters of a-z, 0-9, '-', '_', '.', "
-              "starting with a letter or digit (it names folders and containers)");
+// `world_size_m: [X, Y]`: the geofence's size [m].
+Status DecodeWorldSize(const Node& world_size, TrialSpec* spec) {
+  const std::string what = "'world_size_m' must be [X, Y], the geofence's size in metres (both > 0)";
+  if (!world_size.is_sequence() || world_size.items().size() != 2) return At(world_size, what);
+  for (std::size_t i = 0; i < 2; ++i) {
+    auto v = world_size.items()[i].AsDouble();
+    if (!v || !(*v > 0) || !std::isfinite(*v)) return At(world_size.items()[i], what);
+    spec->world_size_m[i] = *v;
   }
+  return Ok{};
+}
+
+Status CheckTrialName(const Node& doc, const TrialSpec& spec) {
+  if (IsTrialName(spec.name)) return Ok{};
+  return At(*doc.Find("name"), "trial name '" + spec.name + "' must be 1-40 characters of a-z, 0-9, '-', '_', '.', "
+                                   "starting with a letter or digit (it names folders and containers)");
+}
+
+// `middleware: cyclonedds|fastdds`.
+Status DecodeMiddleware(const Node& doc, const std::string& middleware, TrialSpec* spec) {
   if (middleware == "cyclonedds") {
-    spec.middleware = Middleware::kCycloneDds;
+    spec->middleware = Middleware::kCycloneDds;
   } else if (middleware == "fastdds") {
-    spec.middleware = Middleware::kFastDds;
+    spec->middleware = Middleware::kFastDds;
   } else {
-    return At(*doc.Find("middleware"),
-              "unknown middleware '" + middleware + "' (expected cyclonedds or fastdds)");
+    return At(*doc.Find("middleware"), "unknown middleware '" + middleware + "' (expected cyclonedds or fastdds)");
   }
+  return Ok{};
+}
 
-  if (physics != nullptr) {
-    yaml::MapReader p(*physics, "physics");
-    p.Optional("rtf", &spec.rtf);
-    const Node* physics_limits = p.Child("limits");
-    SWARMBOX_TRY(p.Finish());
-    if (physics_limits != nullptr && !physics_limits->is_null()) {
-      SWARMBOX_TRY(DecodeLimits(*physics_limits, &spec.physics_limits));
-    }
-    if (spec.rtf < 0) return At(*physics->Find("rtf"), "'rtf' must be >= 0 (0 = as fast as possible)");
-  }
+// `physics: {rtf, limits}`.
+Status DecodePhysics(const Node& physics, TrialSpec* spec) {
+  yaml::MapReader p(physics, "physics");
+  p.Optional("rtf", &spec->rtf);
+  const Node* physics_limits = p.Child("limits");
+  SWARMBOX_TRY(p.Finish());
+  if (Present(physics_limits)) SWARMBOX_TRY(DecodeLimits(*physics_limits, &spec->physics_limits));
+  if (spec->rtf < 0) return At(*physics.Find("rtf"), "'rtf' must be >= 0 (0 = as fast as possible)");
+  return Ok{};
+}
 
-  if (!drones->is_sequence() || drones->items().empty()) {
-    return At(*drones, "'drones' must be a non-empty list of {name, airframe, pose}");
-  }
-  if (drones->items().size() > kMaxDrones) {
-    return At(*drones, "at most " + std::to_string(kMaxDrones) + " drones per trial");
-  }
-  for (const Node& item : drones->items()) {
-    DroneSpec d;
-    d.mark = item.mark();
-    yaml::MapReader dr(item, "drone");
-    dr.Required("name", &d.name)
-        .Required("airframe", &d.airframe)
-        .Optional("pose", &d.pose)
-        .Optional("payload", &d.payload);
-    const Node* drone_limits = dr.Child("limits");
-    const Node* brain = dr.Child("brain");
-    SWARMBOX_TRY(dr.Finish());
-    if (brain != nullptr) {
-      auto decoded = detail::DecodeBrain(*brain, software);
-      if (!decoded) return decoded.error();
-      d.brain = std::move(*decoded);
-    }
-    if (drone_limits != nullptr && !drone_limits->is_null()) {
-      SWARMBOX_TRY(DecodeLimits(*drone_limits, &d.limits));
-    }
-    if (!IsDroneName(d.name) || d.name == kPhysics || d.name == kRaftLeader) {
-      return At(*item.Find("name"), "drone name '" + d.name +
-                                        "' must be 1-32 characters of a-z, 0-9, '_', starting "
-                                        "with a letter, and not physics or raft_leader");
-    }
-    if (spec.FindDrone(d.name) != nullptr) {
-      return At(*item.Find("name"), "drone name '" + d.name + "' is used twice");
-    }
-    spec.drones.push_back(std::move(d));
-  }
-
-  if (mission != nullptr && !mission->is_null()) SWARMBOX_TRY(DecodeMission(*mission, &spec.mission));
-  if (raft != nullptr && !raft->is_null()) SWARMBOX_TRY(DecodeRaft(*raft, &spec.raft));
-  if (radio != nullptr && !radio->is_null()) {
-    SWARMBOX_TRY(DecodeRadio(*radio, &spec.radio));
-  }
-  if (record != nullptr && !record->is_null()) {
-    SWARMBOX_TRY(DecodeRecord(*record, &spec.record));
-  }
-
-  if (components != nullptr) {
-    auto decoded = detail::DecodeComponents(*components, spec, software);
+// One item of `drones:` {name, airframe, pose, payload, limits, brain}; its name checked against
+// the drones before it.
+Result<DroneSpec> DecodeDrone(const Node& item, const detail::SoftwareContext& software, const TrialSpec& spec) {
+  DroneSpec d;
+  d.mark = item.mark();
+  yaml::MapReader dr(item, "drone");
+  dr.Required("name", &d.name).Required("airframe", &d.airframe).Optional("pose", &d.pose).Optional("payload", &d.payload);
+  const Node* drone_limits = dr.Child("limits");
+  const Node* brain = dr.Child("brain");
+  SWARMBOX_TRY(dr.Finish());
+  if (brain != nullptr) {
+    auto decoded = detail::DecodeBrain(*brain, software);
     if (!decoded) return decoded.error();
-    spec.components = std::move(*decoded);
+    d.brain = std::move(*decoded);
   }
+  if (Present(drone_limits)) SWARMBOX_TRY(DecodeLimits(*drone_limits, &d.limits));
+  if (!IsDroneName(d.name) || d.name == kPhysics || d.name == kRaftLeader) {
+    return At(*item.Find("name"), "drone name '" + d.name +
+                                      "' must be 1-32 characters of a-z, 0-9, '_', starting "
+                                      "with a letter, and not physics or raft_leader");
+  }
+  if (spec.FindDrone(d.name) != nullptr) return At(*item.Find("name"), "drone name '" + d.name + "' is used twice");
+  return d;
+}
 
-  // Every drone is a member of the swarm's one Raft log. The SAR mission's planner runs on the Raft
-  // leader only, so a SAR drone next to drones on other brains could wait forever under a leader
-  // that never plans (and the brains would ignore each other's entries): refused up front.
-  if (spec.mission.kind == MissionKind::kSar) {
-    const DroneSpec* builtin = nullptr;
-    const DroneSpec* other = nullptr;
-    for (const DroneSpec& d : spec.drones) {
-      const DroneSpec*& first = d.brain.kind == BrainKind::kBuiltin ? builtin : other;
-      if (first == nullptr) first = &d;
-    }
-    if (builtin != nullptr && other != nullptr) {
-      return AtMark(other->mark,
-                   "drone '" + other->name + "' flies its own brain while '" + builtin->name +
-                       "' flies the sar mission: they would share one consensus log (Raft) whose leader "
-                       "plans the search only if it flies sar; give every drone a brain, or none "
-                       "(mission: {kind: plan} for builtin drones beside brains)");
-    }
+// `drones:` a non-empty list of at most kMaxDrones.
+Status DecodeDrones(const Node& drones, const detail::SoftwareContext& software, TrialSpec* spec) {
+  if (!drones.is_sequence() || drones.items().empty()) {
+    return At(drones, "'drones' must be a non-empty list of {name, airframe, pose}");
   }
+  if (drones.items().size() > kMaxDrones) {
+    return At(drones, "at most " + std::to_string(kMaxDrones) + " drones per trial");
+  }
+  for (const Node& item : drones.items()) {
+    auto d = DecodeDrone(item, software, *spec);
+    if (!d) return d.error();
+    spec->drones.push_back(std::move(*d));
+  }
+  return Ok{};
+}
 
-  if (network != nullptr) {
-    yaml::MapReader nr(*network, "network");
-    const Node* mesh = nr.Child("mesh");
-    SWARMBOX_TRY(nr.Finish());
-    if (mesh != nullptr) {
-      auto parsed = faults::ParseMeshBlock(*mesh);
-      if (!parsed) return parsed.error();
-      std::vector<std::string> names;
-      for (const DroneSpec& d : spec.drones) names.push_back(d.name);
-      SWARMBOX_TRY(faults::ValidateRadioPeers(parsed->rules, names));
-      spec.mesh = std::move(*parsed);
-      spec.mesh_node = *mesh;
-    }
+// Every drone is a member of the swarm's one Raft log. The SAR mission's planner runs on the Raft
+// leader only, so a SAR drone next to drones on other brains could wait forever under a leader
+// that never plans (and the brains would ignore each other's entries): refused up front.
+Status CheckSarBrains(const TrialSpec& spec) {
+  if (spec.mission.kind != MissionKind::kSar) return Ok{};
+  const DroneSpec* builtin = nullptr;
+  const DroneSpec* other = nullptr;
+  for (const DroneSpec& d : spec.drones) {
+    const DroneSpec*& first = d.brain.kind == BrainKind::kBuiltin ? builtin : other;
+    if (first == nullptr) first = &d;
   }
+  if (builtin == nullptr || other == nullptr) return Ok{};
+  return AtMark(other->mark, "drone '" + other->name + "' flies its own brain while '" + builtin->name +
+                                 "' flies the sar mission: they would share one consensus log (Raft) whose leader "
+                                 "plans the search only if it flies sar; give every drone a brain, or none "
+                                 "(mission: {kind: plan} for builtin drones beside brains)");
+}
 
-  if (faults != nullptr && !faults->is_null()) {
-    // The fault injector's schema (swarmbox_faults): shape, values, then names against the drones.
-    auto parsed = faults::ParseFaults(*faults);
-    if (!parsed) return parsed.error();
-    std::vector<std::string> names;
-    for (const DroneSpec& d : spec.drones) names.push_back(d.name);
-    SWARMBOX_TRY(faults::ValidateFaults(*parsed, names));
-    spec.faults = std::move(*parsed);
-    spec.faults_node = *faults;
-  }
+std::vector<std::string> DroneNames(const TrialSpec& spec) {
+  std::vector<std::string> names;
+  for (const DroneSpec& d : spec.drones) names.push_back(d.name);
+  return names;
+}
 
-  // The simulated channel refuses what it does not carry out, before anything starts (with the
-  // reason and where; radio.model netem does all of it).
-  if (spec.radio.model == RadioModel::kChannel) {
-    SWARMBOX_TRY(faults::CheckChannelSupports(spec.mesh.rules, "network.mesh"));
-    SWARMBOX_TRY(faults::CheckChannelFaults(spec.faults));
-  }
+// `network: {mesh: ...}` (the fault injector's schema, swarmbox_faults), names against the drones.
+Status DecodeNetwork(const Node& network, TrialSpec* spec) {
+  yaml::MapReader nr(network, "network");
+  const Node* mesh = nr.Child("mesh");
+  SWARMBOX_TRY(nr.Finish());
+  if (mesh == nullptr) return Ok{};
+  auto parsed = faults::ParseMeshBlock(*mesh);
+  if (!parsed) return parsed.error();
+  SWARMBOX_TRY(faults::ValidateRadioPeers(parsed->rules, DroneNames(*spec)));
+  spec->mesh = std::move(*parsed);
+  spec->mesh_node = *mesh;
+  return Ok{};
+}
 
-  if (end != nullptr && !end->is_null()) {
-    if (!end->is_sequence()) return At(*end, "'end' must be a list of {on, outcome, reason}");
-    for (const Node& item : end->items()) {
-      EndSpec e;
-      std::string outcome;
-      yaml::MapReader er(item, "end condition");
-      er.Required("on", &e.on)
-          .Required("outcome", &outcome)
-          .Optional("reason", &e.reason)
-          .Optional("from", &e.from);
-      SWARMBOX_TRY(er.Finish());
-      try {
-        std::regex check(e.on, std::regex::ECMAScript);
-      } catch (const std::regex_error& ex) {
-        return At(*item.Find("on"), "'on' is not a valid regular expression: " + std::string(ex.what()));
-      }
-      if (e.on.empty()) return At(*item.Find("on"), "'on' must not be empty");
-      auto o = ParseOutcome(outcome);
-      if (!o) {
-        return At(*item.Find("outcome"),
-                  "unknown outcome '" + outcome + "' (expected success, failure, timeout or error)");
-      }
-      e.outcome = *o;
-      if (!e.from.empty()) {
-        SWARMBOX_TRY(CheckComponent(spec, item.Find("from")->mark(), e.from, true, false));
-      }
-      spec.end.push_back(std::move(e));
-    }
-  }
+// `faults:` the fault injector's schema (swarmbox_faults): shape, values, then names against the drones.
+Status DecodeFaults(const Node& faults, TrialSpec* spec) {
+  auto parsed = faults::ParseFaults(faults);
+  if (!parsed) return parsed.error();
+  SWARMBOX_TRY(faults::ValidateFaults(*parsed, DroneNames(*spec)));
+  spec->faults = std::move(*parsed);
+  spec->faults_node = faults;
+  return Ok{};
+}
 
-  {
-    std::string outcome = "timeout";
-    yaml::MapReader tr(*timeout, "timeout");
-    tr.Required("sim", &spec.timeout.sim)
-        .Optional("wall", &spec.timeout.wall)
-        .Optional("outcome", &outcome);
-    SWARMBOX_TRY(tr.Finish());
-    auto o = ParseOutcome(outcome);
-    if (!o) {
-      return At(*timeout->Find("outcome"),
-                "unknown outcome '" + outcome + "' (expected success, failure, timeout or error)");
-    }
-    spec.timeout.outcome = *o;
-    if (spec.timeout.sim.zero()) return At(*timeout->Find("sim"), "'sim' must be longer than 0s");
+// The simulated channel refuses what it does not carry out, before anything starts (with the
+// reason and where; radio.model netem does all of it).
+Status CheckChannelSupport(const TrialSpec& spec) {
+  if (spec.radio.model != RadioModel::kChannel) return Ok{};
+  SWARMBOX_TRY(faults::CheckChannelSupports(spec.mesh.rules, "network.mesh"));
+  return faults::CheckChannelFaults(spec.faults);
+}
+
+// One item of `end:` {on, outcome, reason, from}.
+Result<EndSpec> DecodeEndCondition(const Node& item, const TrialSpec& spec) {
+  EndSpec e;
+  std::string outcome;
+  yaml::MapReader er(item, "end condition");
+  er.Required("on", &e.on).Required("outcome", &outcome).Optional("reason", &e.reason).Optional("from", &e.from);
+  SWARMBOX_TRY(er.Finish());
+  try {
+    std::regex check(e.on, std::regex::ECMAScript);
+  } catch (const std::regex_error& ex) {
+    return At(*item.Find("on"), "'on' is not a valid regular expression: " + std::string(ex.what()));
   }
+  if (e.on.empty()) return At(*item.Find("on"), "'on' must not be empty");
+  auto o = ParseOutcome(outcome);
+  if (!o) {
+    return At(*item.Find("outcome"), "unknown outcome '" + outcome + "' (expected success, failure, timeout or error)");
+  }
+  e.outcome = *o;
+  if (!e.from.empty()) SWARMBOX_TRY(CheckComponent(spec, item.Find("from")->mark(), e.from, true, false));
+  return e;
+}
+
+Status DecodeEnd(const Node& end, TrialSpec* spec) {
+  if (!end.is_sequence()) return At(end, "'end' must be a list of {on, outcome, reason}");
+  for (const Node& item : end.items()) {
+    auto e = DecodeEndCondition(item, *spec);
+    if (!e) return e.error();
+    spec->end.push_back(std::move(*e));
+  }
+  return Ok{};
+}
+
+// `timeout: {sim, wall, outcome}`.
+Status DecodeTimeout(const Node& timeout, TrialSpec* spec) {
+  std::string outcome = "timeout";
+  yaml::MapReader tr(timeout, "timeout");
+  tr.Required("sim", &spec->timeout.sim).Optional("wall", &spec->timeout.wall).Optional("outcome", &outcome);
+  SWARMBOX_TRY(tr.Finish());
+  auto o = ParseOutcome(outcome);
+  if (!o) {
+    return At(*timeout.Find("outcome"),
+              "unknown outcome '" + outcome + "' (expected success, failure, timeout or error)");
+  }
+  spec->timeout.outcome = *o;
+  if (spec->timeout.sim.zero()) return At(*timeout.Find("sim"), "'sim' must be longer than 0s");
+  return Ok{};
+}
+
+// A fault at a simulated time after the timeout would never fire.
+Status CheckFaultTimes(const TrialSpec& spec) {
   for (const faults::Fault& f : spec.faults) {
     if (f.start.clock == faults::FaultStart::Clock::kSim && f.start.at_ms > spec.timeout.sim.ms()) {
       return AtMark(f.mark, "fault " + f.id + " at " + Duration::Ms(f.start.at_ms).ToString() +
                                 " is after the timeout (" + spec.timeout.sim.ToString() + ")");
     }
   }
+  return Ok{};
+}
 
-  if (options.check_references) {
-    if (spec.trials_dir.empty()) {
-      return AtMark(doc.mark(), "no trials directory to resolve world and airframes against");
+// LoadOptions::check_references: the world, a radio profile the file names and every airframe
+// are files in the trials directory.
+Status CheckReferences(const Node& doc, const Sections& sections, const LoadOptions& options, const TrialSpec& spec) {
+  if (spec.trials_dir.empty()) return AtMark(doc.mark(), "no trials directory to resolve world and airframes against");
+  auto exists = options.file_exists ? options.file_exists : DefaultFileExists;
+  const std::filesystem::path dir(spec.trials_dir);
+  if (!spec.world_generate) {
+    if (std::filesystem::path(spec.world).is_absolute() || spec.world.find("..") != std::string::npos) {
+      return At(*doc.Find("world"), "'world' must be a path inside the trials directory, such as worlds/open_field.yaml");
     }
-    auto exists = options.file_exists ? options.file_exists : DefaultFileExists;
-    const std::filesystem::path dir(spec.trials_dir);
-    if (!spec.world_generate) {
-      if (std::filesystem::path(spec.world).is_absolute() || spec.world.find("..") != std::string::npos) {
-        return At(*doc.Find("world"), "'world' must be a path inside the trials directory, such as worlds/open_field.yaml");
-      }
-      const std::string world_path = (dir / spec.world).string();
-      if (!exists(world_path)) {
-        return At(*doc.Find("world"), "world '" + spec.world + "' not found (no file " + world_path + ")");
-      }
-    }
-    // A profile the file names is checked here, at its key; the default one (trials/radios/
-    // wifi_5ghz_mesh.yaml, shipped) when the trial is planned (runner::CheckRadioProfile).
-    if (const Node* profile = radio != nullptr ? radio->Find("profile") : nullptr;
-        profile != nullptr && spec.radio.model == RadioModel::kChannel) {
-      const std::string profile_path = (dir / RadioProfileFile(spec.radio)).string();
-      if (!exists(profile_path)) {
-        return At(*profile, "radio profile '" + spec.radio.profile + "' not found (no file " + profile_path + ")");
-      }
-    }
-    std::size_t i = 0;
-    for (const DroneSpec& d : spec.drones) {
-      const Node& item = drones->items()[i++];
-      const std::string airframe_path = (dir / "airframes" / (d.airframe + ".yaml")).string();
-      if (d.airframe.find('/') != std::string::npos || !exists(airframe_path)) {
-        return At(*item.Find("airframe"),
-                  "unknown airframe '" + d.airframe + "' (no file " + airframe_path + ")");
-      }
+    const std::string world_path = (dir / spec.world).string();
+    if (!exists(world_path)) return At(*doc.Find("world"), "world '" + spec.world + "' not found (no file " + world_path + ")");
+  }
+  // A profile the file names is checked here, at its key; the default one (trials/radios/
+  // wifi_5ghz_mesh.yaml, shipped) when the trial is planned (runner::CheckRadioProfile).
+  if (const Node* profile = sections.radio != nullptr ? sections.radio->Find("profile") : nullptr;
+      profile != nullptr && spec.radio.model == RadioModel::kChannel) {
+    const std::string profile_path = (dir / RadioProfileFile(spec.radio)).string();
+    if (!exists(profile_path)) {
+      return At(*profile, "radio profile '" + spec.radio.profile + "' not found (no file " + profile_path + ")");
     }
   }
+  std::size_t i = 0;
+  for (const DroneSpec& d : spec.drones) {
+    const Node& item = sections.drones->items()[i++];
+    const std::string airframe_path = (dir / "airframes" / (d.airframe + ".yaml")).string();
+    if (d.airframe.find('/') != std::string::npos || !exists(airframe_path)) {
+      return At(*item.Find("airframe"), "unknown airframe '" + d.airframe + "' (no file " + airframe_path + ")");
+    }
+  }
+  return Ok{};
+}
+
+// The sections in the order their errors are reported.
+Result<TrialSpec> DecodeExpanded(const yaml::Node& doc, const LoadOptions& options) {
+  TrialSpec spec;
+  spec.document = doc;
+  spec.trials_dir = options.trials_dir;
+  std::string middleware = "cyclonedds";
+  auto sections = ReadSections(doc, &spec, &middleware);
+  if (!sections) return sections.error();
+  const Sections& s = *sections;
+  detail::SoftwareContext software;
+  software.base_dir = options.base_dir;
+  software.check_files = options.check_references;
+  software.file_kind = options.file_kind;
+  if (Present(s.limits)) SWARMBOX_TRY(DecodeLimits(*s.limits, &spec.limits));
+  if (s.world != nullptr) SWARMBOX_TRY(DecodeWorld(*s.world, &spec));
+  if (Present(s.world_size)) SWARMBOX_TRY(DecodeWorldSize(*s.world_size, &spec));
+  SWARMBOX_TRY(CheckTrialName(doc, spec));
+  SWARMBOX_TRY(DecodeMiddleware(doc, middleware, &spec));
+  if (s.physics != nullptr) SWARMBOX_TRY(DecodePhysics(*s.physics, &spec));
+  SWARMBOX_TRY(DecodeDrones(*s.drones, software, &spec));
+  if (Present(s.mission)) SWARMBOX_TRY(DecodeMission(*s.mission, &spec.mission));
+  if (Present(s.raft)) SWARMBOX_TRY(DecodeRaft(*s.raft, &spec.raft));
+  if (Present(s.radio)) SWARMBOX_TRY(DecodeRadio(*s.radio, &spec.radio));
+  if (Present(s.record)) SWARMBOX_TRY(DecodeRecord(*s.record, &spec.record));
+  if (s.components != nullptr) {
+    auto decoded = detail::DecodeComponents(*s.components, spec, software);
+    if (!decoded) return decoded.error();
+    spec.components = std::move(*decoded);
+  }
+  SWARMBOX_TRY(CheckSarBrains(spec));
+  if (s.network != nullptr) SWARMBOX_TRY(DecodeNetwork(*s.network, &spec));
+  if (Present(s.faults)) SWARMBOX_TRY(DecodeFaults(*s.faults, &spec));
+  SWARMBOX_TRY(CheckChannelSupport(spec));
+  if (Present(s.end)) SWARMBOX_TRY(DecodeEnd(*s.end, &spec));
+  SWARMBOX_TRY(DecodeTimeout(*s.timeout, &spec));
+  SWARMBOX_TRY(CheckFaultTimes(spec));
+  if (options.check_references) SWARMBOX_TRY(CheckReferences(doc, s, options, spec));
   return spec;
 }
 

@@ -1,18 +1,12 @@
 #include "swarmbox/runner/docker_engine.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <thread>
 
-#include <algorithm>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <future>
-#include <set>
-#include <sstream>
-
 #include "swarmbox/docker/remove_labelled.hpp"
-#include "swarmbox/docker/tar_archive.hpp"
+#include "swarmbox/runner/container_files.hpp"
 #include "swarmbox/runner/end_matcher.hpp"
 
 namespace swarmbox::runner {
@@ -20,22 +14,15 @@ namespace swarmbox::runner {
 namespace fs = std::filesystem;
 using dsl::Verdict;
 
-struct DockerEngine::Follower {
-  docker::CancelToken cancel;
-  std::thread thread;
-  std::atomic<bool> done{false};
-  std::atomic<bool> clean_end{false};  // the stream ended by itself: the container's output closed
-  std::atomic<std::uint64_t> lines{0};
-};
-
-// The second half of a container's stop, finished while the tree goes on: Docker's stop call
-// returns only after the engine has torn down the container's network (~0.1-0.4 s each, one at a
-// time inside the engine), then the exit code, artifacts and removal.
-struct DockerEngine::PendingStop {
-  std::thread thread;
-  bool stop_returned = false;  // guarded by DockerEngine::done_mu_
-  std::promise<void> logs_joined;
-  Verdict verdict;  // written by `thread`, read after joining it
+// What the second half of a stop needs, copied out of the plugin (the tree may go on).
+struct DockerEngine::StopRequest {
+  std::string id;         // Docker's
+  std::string component;
+  std::string name;       // the container's
+  std::string path;       // the plugin's, for verdicts
+  int grace_s = 0;
+  std::vector<std::string> artifacts;
+  std::string artifacts_dir;
 };
 
 namespace {
@@ -75,26 +62,29 @@ Verdict RunConcurrently(const std::vector<std::function<Verdict()>>& steps, int 
 
 DockerEngine::DockerEngine(docker::DockerApi& api, LogHub& hub, Clock& clock,
                            EngineOptions options)
-    : api_(api), hub_(hub), clock_(clock), options_(std::move(options)) {
+    : api_(api),
+      hub_(hub),
+      clock_(clock),
+      options_(std::move(options)),
+      followers_(api, hub, clock,
+                 {(fs::path(options_.trial_dir) / "logs").string(), options_.start_wall_s,
+                  [this] { NotifyEnded(); }}),
+      create_workers_(options_.max_parallel) {
   std::error_code ec;
   fs::create_directories(fs::path(options_.trial_dir) / "logs", ec);
 }
 
 DockerEngine::~DockerEngine() {
-  CloseQueue();
-  JoinStops();
-  for (auto& [component, f] : followers_) f->cancel.Cancel();
-  for (auto& [component, f] : followers_) {
-    if (f->thread.joinable()) f->thread.join();
-  }
+  create_workers_.Close();
+  stops_.Join();
+  // followers_ cancels and joins the followers still running as it goes.
 }
 
 void DockerEngine::Trace(const dsl::Component& component, dsl::EventKind event,
                          const Verdict& verdict) {
   if (event == dsl::EventKind::kBuild) {
     // A container's creation running ahead traces its build itself, once it has finished.
-    std::lock_guard lock(mu_);
-    if (build_traced_by_create_.erase(component.id()) > 0) return;
+    if (creates_.TakeBuildTrace(component.id())) return;
   }
   std::lock_guard lock(trace_mu_);
   if (options_.on_trace) options_.on_trace(component, event, verdict);
@@ -111,64 +101,14 @@ Verdict DockerEngine::RunSiblings(const std::vector<std::function<Verdict()>>& s
   return RunConcurrently(steps, threads);
 }
 
-void DockerEngine::Enqueue(std::function<void(bool)> job) {
-  std::unique_lock lock(queue_mu_);
-  if (closing_) {
-    lock.unlock();
-    job(true);
-    return;
-  }
-  jobs_.push_back(std::move(job));
-  if (idle_workers_ == 0 && static_cast<int>(workers_.size()) < options_.max_parallel) {
-    workers_.emplace_back([this] {
-      std::unique_lock worker_lock(queue_mu_);
-      while (true) {
-        ++idle_workers_;
-        queue_cv_.wait(worker_lock, [this] { return closing_ || !jobs_.empty(); });
-        --idle_workers_;
-        if (jobs_.empty()) return;  // closing
-        std::function<void(bool)> next = std::move(jobs_.front());
-        jobs_.pop_front();
-        const bool cancelled = closing_;
-        worker_lock.unlock();
-        next(cancelled);
-        worker_lock.lock();
-      }
-    });
-  } else {
-    queue_cv_.notify_one();
-  }
-}
-
-void DockerEngine::CloseQueue() {
-  std::vector<std::thread> workers;
-  {
-    std::lock_guard lock(queue_mu_);
-    closing_ = true;
-    workers.swap(workers_);
-  }
-  queue_cv_.notify_all();
-  for (std::thread& t : workers) t.join();
-}
-
 std::optional<Verdict> DockerEngine::WaitCreated(const std::string& component) {
-  std::shared_future<Verdict> created;
-  {
-    std::lock_guard lock(mu_);
-    auto it = creates_.find(component);
-    if (it == creates_.end()) return std::nullopt;
-    created = it->second;
-  }
-  return created.get();
+  auto created = creates_.Find(component);
+  if (!created) return std::nullopt;
+  return created->get();
 }
 
 void DockerEngine::FinishCreates() {
-  std::vector<std::shared_future<Verdict>> all;
-  {
-    std::lock_guard lock(mu_);
-    for (const auto& [component, created] : creates_) all.push_back(created);
-  }
-  for (const auto& created : all) created.wait();
+  for (const auto& created : creates_.All()) created.wait();
 }
 
 void DockerEngine::AddProblem(std::string problem) {
@@ -184,7 +124,7 @@ std::optional<std::string> DockerEngine::ContainerId(const std::string& componen
 }
 
 Verdict DockerEngine::CreateNetwork(dsl::Network& network) {
-  JoinStops();  // a rebuild: the containers of the last build are gone first
+  stops_.Join();  // a rebuild: the containers of the last build are gone first
   const dsl::NetworkSpec& s = network.spec();
   docker::NetworkSpec spec;
   spec.name = s.name;
@@ -204,7 +144,7 @@ Verdict DockerEngine::CreateNetwork(dsl::Network& network) {
 }
 
 Verdict DockerEngine::RemoveNetwork(dsl::Network& network) {
-  JoinStops();  // its containers are removed first
+  stops_.Join();  // its containers are removed first
   std::string id;
   {
     std::lock_guard lock(mu_);
@@ -227,83 +167,11 @@ Verdict DockerEngine::RemoveNetwork(dsl::Network& network) {
   return Verdict::Success();
 }
 
-namespace {
-
-// The volume a path lies under ("" = none): Docker's archive endpoint writes into a read-only
-// container only there ("container rootfs is marked read-only" elsewhere; a tmpfs is not mounted
-// before the start, so what is put there is hidden once it runs).
-std::string VolumeOf(const dsl::ContainerSpec& spec, const std::string& path) {
-  for (const std::string& v : spec.volumes) {
-    const std::string prefix = !v.empty() && v.back() == '/' ? v : v + "/";
-    if (path.rfind(prefix, 0) == 0) return v;
-  }
-  return {};
-}
-
-}  // namespace
-
-Status DockerEngine::CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id) {
-  if (spec.inputs.empty() && spec.scratch_dirs.empty()) return Ok{};
-  // One archive per destination: "/" for a writable root filesystem, else each volume.
-  struct Archive {
-    docker::TarWriter tar;
-    std::set<std::string> dirs;
-  };
-  std::map<std::string, Archive> archives;
-  auto archive_for = [&](const std::string& path, std::string* relative) -> Result<Archive*> {
-    std::string dest = "/";
-    if (spec.read_only_rootfs) {
-      dest = VolumeOf(spec, path);
-      if (dest.empty()) {
-        return Error(ErrorCode::kInvalidArgument,
-                     "the root filesystem is read-only and " + path + " lies in none of its volumes");
-      }
-    }
-    *relative = fs::path(path).lexically_relative(dest).string();
-    return &archives[dest];
-  };
-  auto add_parents = [](Archive& a, const std::string& relative) -> Status {
-    std::vector<std::string> chain;
-    for (fs::path p = fs::path(relative).parent_path(); !p.empty(); p = p.parent_path()) {
-      chain.push_back(p.string());
-    }
-    for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
-      if (a.dirs.insert(*it).second) SWARMBOX_TRY(a.tar.AddDirectory(*it, 0755));
-    }
-    return Ok{};
-  };
-  for (const std::string& dir : spec.scratch_dirs) {
-    std::string relative;
-    auto a = archive_for(dir, &relative);
-    if (!a) return a.error();
-    SWARMBOX_TRY(add_parents(**a, relative));
-    if ((*a)->dirs.insert(relative).second) SWARMBOX_TRY((*a)->tar.AddDirectory(relative, 01777));
-  }
-  for (const dsl::InputFile& in : spec.inputs) {
-    std::ifstream f(in.host_path, std::ios::binary);
-    if (!f) return Error(ErrorCode::kNotFound, "cannot read input file", in.host_path);
-    std::ostringstream content;
-    content << f.rdbuf();
-    std::string relative;
-    auto a = archive_for(in.container_path, &relative);
-    if (!a) return a.error();
-    SWARMBOX_TRY(add_parents(**a, relative));
-    SWARMBOX_TRY((*a)->tar.AddFile(relative, content.str(), 0644));
-  }
-  for (auto& [dest, a] : archives) {
-    auto bytes = a.tar.Finish();
-    if (!bytes) return bytes.error();
-    SWARMBOX_TRY(api_.PutArchive(container_id, dest, *bytes));
-  }
-  return Ok{};
-}
-
 Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
   if (options_.max_parallel <= 1) return CreateNow(plugin);
   const std::string component = plugin.id();
   // What can be checked now is checked now: the tree's Build walk fails where it did before.
   const dsl::ContainerSpec& s = plugin.spec();
-  std::optional<std::shared_future<Verdict>> owner;
   {
     std::lock_guard lock(mu_);
     for (const dsl::Attachment& a : s.networks) {
@@ -312,54 +180,39 @@ Verdict DockerEngine::CreateContainer(dsl::Plugin& plugin) {
                             plugin.Path());
       }
     }
-    if (!s.network_of.empty()) {
-      auto it = creates_.find(s.network_of);
-      if (it != creates_.end()) owner = it->second;
-    }
   }
-  auto promise = std::make_shared<std::promise<Verdict>>();
+  std::optional<std::shared_future<Verdict>> owner;
+  if (!s.network_of.empty()) owner = creates_.Find(s.network_of);
   const int priority = plugin.run_priority();
-  {
-    std::lock_guard lock(mu_);
-    creates_[component] = promise->get_future().share();
-    build_traced_by_create_.insert(component);
-    ++unfinished_creates_[priority];
-  }
+  auto promise = creates_.Add(component, priority);
   // What a creation waits for (the earlier levels' creations, the owner of a shared network
   // namespace) was queued before it: workers take jobs in order, so it is running or done and
   // the wait cannot starve the queue.
-  Enqueue([this, &plugin, promise, owner, priority](bool cancelled) {
-    if (!cancelled) {
-      std::unique_lock lock(mu_);
-      create_cv_.wait(lock, [&] {
-        for (const auto& [p, n] : unfinished_creates_) {
-          if (p < priority && n > 0) return false;
-        }
-        return true;
-      });
-    }
-    Verdict v;
-    if (cancelled) {
-      v = Verdict::Err("not created: the run was torn down first", plugin.Path());
-    } else if (owner && !owner->get().ok()) {
-      v = Verdict::Err("the network namespace of " + plugin.id() + " belongs to '" +
-                           plugin.spec().network_of + "', which was not created",
-                       plugin.Path());
-    } else {
-      v = CreateNow(plugin);
-    }
-    {
-      std::lock_guard lock(trace_mu_);
-      if (options_.on_trace) options_.on_trace(plugin, dsl::EventKind::kBuild, v);
-    }
-    {
-      std::lock_guard lock(mu_);
-      --unfinished_creates_[priority];
-    }
-    create_cv_.notify_all();
-    promise->set_value(v);
+  create_workers_.Post([this, &plugin, promise, owner, priority](bool cancelled) {
+    CreateAhead(plugin, priority, cancelled, owner, promise);
   });
   return Verdict::Success();
+}
+
+void DockerEngine::CreateAhead(dsl::Plugin& plugin, int priority, bool cancelled,
+                               const std::optional<std::shared_future<Verdict>>& owner,
+                               const std::shared_ptr<std::promise<Verdict>>& promise) {
+  if (!cancelled) creates_.WaitForEarlierLevels(priority);
+  Verdict v;
+  if (cancelled) {
+    v = Verdict::Err("not created: the run was torn down first", plugin.Path());
+  } else if (owner && !owner->get().ok()) {
+    v = Verdict::Err("the network namespace of " + plugin.id() + " belongs to '" +
+                         plugin.spec().network_of + "', which was not created",
+                     plugin.Path());
+  } else {
+    v = CreateNow(plugin);
+  }
+  {
+    std::lock_guard lock(trace_mu_);
+    if (options_.on_trace) options_.on_trace(plugin, dsl::EventKind::kBuild, v);
+  }
+  creates_.Finished(priority, promise, v);
 }
 
 Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
@@ -431,7 +284,7 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
   reports_[plugin.id()] = ComponentReport{plugin.id(), std::nullopt, false,
                                           "logs/" + plugin.id() + ".log", 0};
   lock.unlock();
-  if (Status st = CopyInputs(s, *id); !st) {
+  if (Status st = CopyInputs(api_, s, *id); !st) {
     return Verdict::FromError(st.error().Context("copying input files into " + s.name),
                               plugin.Path());
   }
@@ -440,82 +293,25 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
 
 void DockerEngine::StartFollower(const std::string& component, const std::string& container_id,
                                  std::uint64_t skip_lines) {
-  JoinFollower(component, /*cancel=*/true);
-  auto f = std::make_unique<Follower>();
-  Follower* raw = f.get();
-  std::uint64_t generation = 0;
-  {
-    std::lock_guard lock(mu_);
-    generation = next_generation_++;
-    generations_[component] = generation;
-  }
-  const std::string path = (fs::path(options_.trial_dir) / "logs" / (component + ".log")).string();
-  raw->thread = std::thread([this, raw, component, container_id, path, generation, skip_lines] {
-    std::uint64_t to_skip = skip_lines;
-    std::FILE* out = std::fopen(path.c_str(), "ab");
-    docker::LogOptions opts;
-    opts.follow = true;
-    Status s = api_.FollowLogs(
-        container_id, opts,
-        [&](const docker::LogLine& line) {
-          if (to_skip > 0) {  // delivered by an earlier follower (the container ran before)
-            --to_skip;
-            return;
-          }
-          if (out != nullptr) {
-            std::fwrite(line.text.data(), 1, line.text.size(), out);
-            std::fputc('\n', out);
-            std::fflush(out);
-          }
-          raw->lines.fetch_add(1);
-          hub_.Push({HubItem::Kind::kLine, component, line.text,
-                     clock_.NowS() - options_.start_wall_s, generation});
-        },
-        &raw->cancel);
-    if (out != nullptr) std::fclose(out);
-    std::string why;
-    if (!s && s.error().code() != ErrorCode::kCancelled) why = s.error().ToString();
-    if (out == nullptr) why = "cannot write " + path;
-    hub_.Push({HubItem::Kind::kStreamEnd, component, why, clock_.NowS() - options_.start_wall_s,
-               generation});
-    raw->clean_end.store(s.ok());
-    {
-      std::lock_guard lock(done_mu_);
-      raw->done.store(true);
-    }
-    done_cv_.notify_all();
-  });
-  std::lock_guard lock(mu_);
-  followers_[component] = std::move(f);
+  CountLines(component, followers_.Start(component, container_id, skip_lines));
 }
 
-void DockerEngine::JoinFollower(const std::string& component, bool cancel) {
-  std::unique_ptr<Follower> follower;
-  {
-    std::lock_guard lock(mu_);
-    auto it = followers_.find(component);
-    if (it == followers_.end()) return;
-    follower = std::move(it->second);
-    followers_.erase(it);
-  }
-  Follower& f = *follower;
-  if (!cancel) {
-    // The stream ends by itself once the container stopped; give it a moment to deliver the rest.
-    const auto deadline = std::chrono::steady_clock::now() + kStreamEndGrace;
-    while (!f.done.load() && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-  }
-  f.cancel.Cancel();
-  if (f.thread.joinable()) f.thread.join();
+void DockerEngine::CountLines(const std::string& component, std::uint64_t lines) {
+  if (lines == 0) return;
   std::lock_guard lock(mu_);
-  reports_[component].log_lines += f.lines.load();
+  reports_[component].log_lines += lines;
+}
+
+void DockerEngine::NotifyEnded() {
+  { std::lock_guard lock(ended_mu_); }  // a waiter checks its flags under the lock: none is missed
+  ended_cv_.notify_all();
 }
 
 Status DockerEngine::ResumeLogs(const std::string& component) {
   auto id = ContainerId(component);
   if (!id) return Error(ErrorCode::kNotFound, "no container for component " + component);
-  JoinFollower(component, /*cancel=*/true);  // counts its lines into the report
+  // Counts its lines into the report.
+  CountLines(component, followers_.Finish(component, std::chrono::milliseconds(0)));
   std::uint64_t delivered = 0;
   {
     std::lock_guard lock(mu_);
@@ -526,11 +322,7 @@ Status DockerEngine::ResumeLogs(const std::string& component) {
   return Ok{};
 }
 
-bool DockerEngine::IsCurrent(const HubItem& item) const {
-  std::lock_guard lock(mu_);
-  auto it = generations_.find(item.component);
-  return it != generations_.end() && it->second == item.generation;
-}
+bool DockerEngine::IsCurrent(const HubItem& item) const { return followers_.IsCurrent(item); }
 
 Verdict DockerEngine::StartContainer(dsl::Plugin& plugin) {
   const dsl::ContainerSpec& s = plugin.spec();
@@ -569,140 +361,75 @@ Verdict DockerEngine::StartContainer(dsl::Plugin& plugin) {
   return Verdict::Err("unreachable", plugin.Path());
 }
 
-void DockerEngine::CollectArtifacts(const std::string& component,
-                                    const std::vector<std::string>& artifacts,
-                                    const std::string& artifacts_dir,
-                                    const std::string& container_id) {
-  const fs::path dest_dir = fs::path(options_.trial_dir) / artifacts_dir;
-  if (!artifacts_dir.empty() && !artifacts.empty()) {
-    std::error_code ec;
-    fs::create_directories(dest_dir, ec);
-    if (ec) {
-      AddProblem(component + ": cannot create " + dest_dir.string() + ": " + ec.message());
-      return;
-    }
-  }
-  for (const std::string& path : artifacts) {
-    auto tar = api_.GetArchive(container_id, path);
-    if (!tar) {
-      AddProblem(component + ": artifact " + path + " not collected: " + tar.error().ToString());
-      continue;
-    }
-    auto entries = docker::ReadTar(*tar);
-    if (!entries) {
-      AddProblem(component + ": artifact " + path + " unreadable: " + entries.error().ToString());
-      continue;
-    }
-    for (const docker::TarEntry& e : *entries) {
-      if (e.type != docker::TarEntry::Type::kFile) continue;
-      // The trial folder keeps file names (truth.csv); an artifacts_dir keeps a folder's layout.
-      const fs::path relative = fs::path(e.path).lexically_normal();
-      if (relative.empty() || relative.is_absolute() || *relative.begin() == "..") continue;
-      const std::string name = artifacts_dir.empty() ? relative.filename().string()
-                                                     : (fs::path(artifacts_dir) / relative).string();
-      if (!artifacts_dir.empty() && relative.has_parent_path()) {
-        std::error_code ec;
-        fs::create_directories(dest_dir / relative.parent_path(), ec);
-      }
-      const std::string dest = artifacts_dir.empty() ? (fs::path(options_.trial_dir) / name).string()
-                                                     : (dest_dir / relative).string();
-      std::ofstream out(dest, std::ios::binary | std::ios::trunc);
-      out.write(e.content.data(), static_cast<std::streamsize>(e.content.size()));
-      if (!out) {
-        AddProblem(component + ": cannot write " + dest);
-        continue;
-      }
-      std::lock_guard lock(mu_);
-      artifacts_[name] = dest;
-    }
-  }
-}
-
 Verdict DockerEngine::StopContainer(dsl::Plugin& plugin) {
   const std::string component = plugin.id();
   (void)WaitCreated(component);  // a creation still under way finishes first, then goes
-  std::string id;
+  creates_.Forget(component);
+  StopRequest request;
   {
     std::lock_guard lock(mu_);
-    creates_.erase(component);
     auto it = container_ids_.find(component);
     if (it == container_ids_.end()) return Verdict::Success();
-    id = it->second;
+    request.id = it->second;
     container_ids_.erase(it);  // a rebuild may create the component again while this one goes
   }
-  auto pending = std::make_unique<PendingStop>();
-  PendingStop* raw = pending.get();
-  std::shared_future<void> logs_joined = raw->logs_joined.get_future().share();
-  raw->thread = std::thread([this, raw, logs_joined, id, component, name = plugin.spec().name,
-                             path = plugin.Path(), grace_s = plugin.spec().stop_timeout_s,
-                             artifacts = plugin.spec().artifacts,
-                             artifacts_dir = plugin.spec().artifacts_dir] {
-    // SIGTERM, SIGKILL after the grace; returns once the engine has cleaned the container up.
-    Status s = api_.StopContainer(id, grace_s);
-    if (!s && s.error().code() != ErrorCode::kNotFound) {
-      raw->verdict.KeepWorse(Verdict::FromError(s.error().Context("stopping " + name), path));
-    }
-    {
-      std::lock_guard lock(done_mu_);
-      raw->stop_returned = true;
-    }
-    done_cv_.notify_all();
-    logs_joined.wait();  // the log is complete: the container may go
-    if (auto info = api_.InspectContainer(id)) {
-      std::lock_guard lock(mu_);
-      reports_[component].exit_code = info->state.exit_code;
-      reports_[component].oom_killed = info->state.oom_killed;
-    }
-    CollectArtifacts(component, artifacts, artifacts_dir, id);
-    if (Status r = api_.RemoveContainer(id, /*force=*/true, /*remove_volumes=*/true);
-        !r && r.error().code() != ErrorCode::kNotFound) {
-      raw->verdict.KeepWorse(Verdict::FromError(r.error().Context("removing " + name), path));
-    }
-  });
+  const dsl::ContainerSpec& s = plugin.spec();
+  request.component = component;
+  request.name = s.name;
+  request.path = plugin.Path();
+  request.grace_s = s.stop_timeout_s;
+  request.artifacts = s.artifacts;
+  request.artifacts_dir = s.artifacts_dir;
+  auto stop_returned = std::make_shared<std::atomic<bool>>(false);
+  std::promise<void> log_joined;
+  auto pending = detail::BackgroundStops::Launch(
+      [this, request, stop_returned, log_complete = log_joined.get_future().share()] {
+        return FinishStop(request, *stop_returned, log_complete);
+      });
   // The container counts as stopped once its program has exited: its log stream ends by itself
   // (its output closed). A stream that broke, or a container without one, waits for Docker's stop.
   {
-    std::unique_lock lock(done_mu_);
-    done_cv_.wait(lock, [&] { return raw->stop_returned || LogEndedByItself(component); });
+    std::unique_lock lock(ended_mu_);
+    ended_cv_.wait(lock,
+                   [&] { return stop_returned->load() || followers_.EndedByItself(component); });
   }
-  JoinFollower(component, /*cancel=*/false);
-  raw->logs_joined.set_value();
-  std::lock_guard lock(mu_);
-  pending_stops_.push_back(std::move(pending));
+  CountLines(component, followers_.Finish(component, kStreamEndGrace));
+  log_joined.set_value();
+  stops_.Keep(std::move(pending));
   return Verdict::Success();
 }
 
-bool DockerEngine::LogEndedByItself(const std::string& component) const {
-  std::lock_guard lock(mu_);
-  auto it = followers_.find(component);
-  return it != followers_.end() && it->second->done.load() && it->second->clean_end.load();
-}
-
-void DockerEngine::JoinStops() {
-  // One joiner at a time: a second caller (the other network of the level) returns only once the
-  // first has joined everything.
-  std::lock_guard joining(join_mu_);
-  std::vector<std::unique_ptr<PendingStop>> pending;
+Verdict DockerEngine::FinishStop(const StopRequest& r, std::atomic<bool>& stop_returned,
+                                 const std::shared_future<void>& log_complete) {
+  Verdict v;
+  // SIGTERM, SIGKILL after the grace; returns once the engine has cleaned the container up.
+  Status s = api_.StopContainer(r.id, r.grace_s);
+  if (!s && s.error().code() != ErrorCode::kNotFound) {
+    v.KeepWorse(Verdict::FromError(s.error().Context("stopping " + r.name), r.path));
+  }
+  stop_returned.store(true);
+  NotifyEnded();
+  log_complete.wait();  // the log is complete: the container may go
+  if (auto info = api_.InspectContainer(r.id)) {
+    std::lock_guard lock(mu_);
+    reports_[r.component].exit_code = info->state.exit_code;
+    reports_[r.component].oom_killed = info->state.oom_killed;
+  }
+  CollectedArtifacts collected =
+      CollectArtifacts(api_, r.id, r.component, r.artifacts, options_.trial_dir, r.artifacts_dir);
   {
     std::lock_guard lock(mu_);
-    pending.swap(pending_stops_);
+    problems_.insert(problems_.end(), collected.problems.begin(), collected.problems.end());
+    for (auto& [name, dest] : collected.files) artifacts_[name] = dest;
   }
-  Verdict v;
-  for (auto& p : pending) {
-    if (p->thread.joinable()) p->thread.join();
-    v.KeepWorse(p->verdict);
+  if (Status rm = api_.RemoveContainer(r.id, /*force=*/true, /*remove_volumes=*/true);
+      !rm && rm.error().code() != ErrorCode::kNotFound) {
+    v.KeepWorse(Verdict::FromError(rm.error().Context("removing " + r.name), r.path));
   }
-  std::lock_guard lock(mu_);
-  stops_verdict_.KeepWorse(v);
-}
-
-Verdict DockerEngine::FinishStops() {
-  JoinStops();
-  std::lock_guard lock(mu_);
-  Verdict v = stops_verdict_;
-  stops_verdict_ = Verdict::Success();
   return v;
 }
+
+Verdict DockerEngine::FinishStops() { return stops_.Take(); }
 
 Result<docker::ContainerState> DockerEngine::Inspect(const std::string& component) {
   const auto id = ContainerId(component);

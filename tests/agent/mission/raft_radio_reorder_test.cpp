@@ -34,10 +34,11 @@
 
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/yaml.hpp"
-#include "swarmbox/faults/command_runner.hpp"
+#include "swarmbox/faults/posix_command_runner.hpp"
 #include "swarmbox/faults/netem_spec.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
 #include "swarmbox/mission/raft_radio.hpp"
+#include "support/veth_pair.hpp"
 
 namespace swarmbox::mission {
 namespace {
@@ -180,47 +181,15 @@ class ReorderingRadio : public ::testing::Test {
   void SetUp() override {
     ASSERT_EQ(geteuid(), 0u) << "this test creates network namespaces and needs root (CAP_SYS_ADMIN, "
                                 "CAP_NET_ADMIN); run it as root";
-    const std::string tag = std::to_string(getpid());
-    ns_a_ = "sbr-" + tag + "-a";
-    ns_b_ = "sbr-" + tag + "-b";
-    if_a_ = "sbra" + tag;
-    if_b_ = "sbrb" + tag;
-    dir_ = std::filesystem::temp_directory_path() / ("swarmbox-raft-reorder-" + tag);
-    std::filesystem::create_directories(dir_ / "a");
-    std::filesystem::create_directories(dir_ / "b");
-    created_ = true;
-    Must({"ip", "netns", "add", ns_a_});
-    Must({"ip", "netns", "add", ns_b_});
-    Must({"ip", "link", "add", if_a_, "netns", ns_a_, "type", "veth", "peer", "name", if_b_, "netns", ns_b_});
-    Must({"ip", "-n", ns_a_, "addr", "add", std::string(kAddrA) + "/24", "dev", if_a_});
-    Must({"ip", "-n", ns_b_, "addr", "add", std::string(kAddrB) + "/24", "dev", if_b_});
-    Must({"ip", "-n", ns_a_, "link", "set", if_a_, "up"});
-    Must({"ip", "-n", ns_b_, "link", "set", if_b_, "up"});
     // Loopback too, as in a container: Cyclone DDS wakes its receive threads at shutdown with a
     // datagram to its own address.
-    Must({"ip", "-n", ns_a_, "link", "set", "lo", "up"});
-    Must({"ip", "-n", ns_b_, "link", "set", "lo", "up"});
+    const Status made = pair_.Create({"sbr", "swarmbox-raft-reorder", kAddrA, kAddrB, /*loopback_up=*/true,
+                                      SWARMBOX_NETEMD_PATH});
+    ASSERT_TRUE(made) << made.error().ToString();
   }
 
-  void TearDown() override {
-    if (!created_) return;
-    for (const char* side : {"a", "b"}) {  // daemons by their pidfiles, then the namespaces
-      std::error_code ec;
-      for (const auto& entry : std::filesystem::directory_iterator(dir_ / side, ec)) {
-        (void)runner_.Run({SWARMBOX_NETEMD_PATH, "stop", "--pidfile", entry.path().string()});
-      }
-    }
-    (void)runner_.Run({"ip", "netns", "del", ns_a_});
-    (void)runner_.Run({"ip", "netns", "del", ns_b_});
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
-  }
-
-  void Must(const std::vector<std::string>& argv) {
-    auto out = runner_.Run(argv);
-    ASSERT_TRUE(out) << out.error().ToString();
-    ASSERT_EQ(out->exit_code, 0) << "`" << faults::CommandText(argv) << "` failed: " << out->stderr_text;
-  }
+  // Daemons by their pidfiles, then the namespaces.
+  void TearDown() override { pair_.Remove(); }
 
   // The mesh block {delay_ms: 50, jitter_ms: 20, normal, loss} on one end, as the runner applies it.
   void Impair(const std::string& ns, const std::string& node, const std::string& iface, const std::string& peer,
@@ -242,9 +211,12 @@ class ReorderingRadio : public ::testing::Test {
   }
 
   faults::PosixCommandRunner runner_;
-  std::string ns_a_, ns_b_, if_a_, if_b_;
-  std::filesystem::path dir_;
-  bool created_ = false;
+  swarmbox::testing::VethPair pair_{runner_};
+  const std::string& ns_a_ = pair_.ns_a;
+  const std::string& ns_b_ = pair_.ns_b;
+  const std::string& if_a_ = pair_.if_a;
+  const std::string& if_b_ = pair_.if_b;
+  const std::filesystem::path& dir_ = pair_.dir;
 };
 
 TEST_F(ReorderingRadio, MessagesToOnePeerAreLostOnlyAsConfigured) {

@@ -12,7 +12,8 @@
 #include <mutex>
 #include <optional>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_clock.hpp"
+#include "support/fake_docker_api.hpp"
 #include "swarmbox/experiment/background_removal.hpp"
 #include "swarmbox/experiment/experiment_runner.hpp"
 #include "swarmbox/runner/runner.hpp"
@@ -63,18 +64,6 @@ class GatedRemovalApi : public testing::FakeDockerApi {
   int waiting_ = 0;
 };
 
-class FixedClock : public runner::Clock {
- public:
-  double NowS() override {
-    std::lock_guard lock(mu_);
-    return now_ += 0.001;
-  }
-
- private:
-  std::mutex mu_;
-  double now_ = 100;
-};
-
 dsl::TrialSpec MiniTrial(const std::string& name) {
   dsl::TrialSpec spec = dsl::TrialSpec::Named(name)
                             .Seed(3)
@@ -110,7 +99,7 @@ TEST_F(BackgroundRemovalTest, TheTrialsResultIsWrittenWhileItsRemovalIsStillHeld
   o.run_id = "20261121-220000-beef";
   o.images = {"swarmbox/physics:test", "swarmbox/agent:test"};
   o.poll = std::chrono::milliseconds(5);
-  FixedClock clock;
+  swarmbox::testing::FakeClock clock(100, 0.001);
   std::optional<Result<runner::RunOutcome>> ran;
   {
     DeferredRemovalApi deferred(api, remover);

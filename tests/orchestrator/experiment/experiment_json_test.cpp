@@ -2,7 +2,7 @@
 // with the fake engine's GET /version.
 #include <gtest/gtest.h>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_docker_api.hpp"
 #include "swarmbox/common/version.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/experiment/experiment_runner.hpp"

@@ -1,4 +1,4 @@
-#include "swarmbox/faults/command_runner.hpp"
+#include "swarmbox/faults/posix_command_runner.hpp"
 
 #include <gtest/gtest.h>
 

@@ -5,13 +5,13 @@
 
 #include <gtest/gtest.h>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_docker_api.hpp"
 #include "test_util.hpp"
 
 namespace swarmbox::faults {
 namespace {
 
-using testing::FakeDockerApi;
+using swarmbox::testing::FakeDockerApi;
 using testing::Yaml;
 
 TEST(InjectionFlow, MeshThenScheduleOnAHostWithoutNetem) {
@@ -27,6 +27,10 @@ TEST(InjectionFlow, MeshThenScheduleOnAHostWithoutNetem) {
   ASSERT_TRUE(ValidateFaults(*faults, drones));
 
   FakeDockerApi api;
+  for (const auto& d : drones) {  // each agent and its fault sidecar, running
+    api.AddRunning(d);
+    api.AddRunning(d + "-faults");
+  }
   api.exec_answers["tc qdisc replace dev lo root netem delay 0ms"] = {{}, {"Error: Specified qdisc kind is unknown."}, 2};
   std::map<std::string, std::unique_ptr<DockerExecCommandRunner>> sidecar;
   for (const auto& d : drones) sidecar[d] = std::make_unique<DockerExecCommandRunner>(api, d + "-faults");
@@ -113,15 +117,16 @@ TEST(InjectionFlow, MeshThenScheduleOnAHostWithoutNetem) {
   EXPECT_NE(events[1].find("\"mechanism\":\"userspace-nfqueue\""), std::string::npos) << events[1];
   EXPECT_NE(events[2].find("\"phase\":\"removed\",\"fault\":\"fade\""), std::string::npos) << events[2];
   // The leader was killed through the API, and b's radio went mesh -> fade -> mesh in its sidecar.
-  EXPECT_NE(std::find(api.calls.begin(), api.calls.end(), "kill b SIGKILL"), api.calls.end());
+  const std::vector<std::string> calls = api.Calls();
+  EXPECT_NE(std::find(calls.begin(), calls.end(), "kill b SIGKILL"), calls.end());
   const std::string fade_rule =
       "exec b-faults iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.3 -j DROP";
-  EXPECT_NE(std::find(api.calls.begin(), api.calls.end(), fade_rule), api.calls.end());
+  EXPECT_NE(std::find(calls.begin(), calls.end(), fade_rule), calls.end());
   const auto mesh_rule_count = std::count(
-      api.calls.begin(), api.calls.end(),
+      calls.begin(), calls.end(),
       "exec b-faults iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.05 -j DROP");
   EXPECT_EQ(mesh_rule_count, 2);  // at the start, and again when the fade ended
-  EXPECT_EQ(std::count_if(api.calls.begin(), api.calls.end(),
+  EXPECT_EQ(std::count_if(calls.begin(), calls.end(),
                           [](const std::string& c) { return c.rfind("exec a-faults", 0) == 0; }),
             1 + 7);  // the probe, and a's mesh plan only (netemd, 3 egress and 3 ingress rules)
 }

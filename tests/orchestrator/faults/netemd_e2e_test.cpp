@@ -17,9 +17,10 @@
 
 #include <gtest/gtest.h>
 
-#include "swarmbox/faults/command_runner.hpp"
+#include "swarmbox/faults/posix_command_runner.hpp"
 #include "swarmbox/faults/partition_plan.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
+#include "support/veth_pair.hpp"
 #include "test_util.hpp"
 #include "udp_probe.hpp"
 
@@ -36,38 +37,16 @@ class NetnsPair : public ::testing::Test {
   void SetUp() override {
     ASSERT_EQ(geteuid(), 0u) << "this e2e test creates network namespaces and needs root (CAP_SYS_ADMIN, "
                                 "CAP_NET_ADMIN); run it as root";
-    const std::string tag = std::to_string(getpid());
-    ns_a_ = "sbf-" + tag + "-a";
-    ns_b_ = "sbf-" + tag + "-b";
-    if_a_ = "sbfa" + tag;
-    if_b_ = "sbfb" + tag;
-    dir_ = std::filesystem::temp_directory_path() / ("swarmbox-faults-e2e-" + tag);
-    std::filesystem::create_directories(dir_ / "a");
-    std::filesystem::create_directories(dir_ / "b");
     created_ = true;
-    Must({"ip", "netns", "add", ns_a_});
-    Must({"ip", "netns", "add", ns_b_});
-    Must({"ip", "link", "add", if_a_, "netns", ns_a_, "type", "veth", "peer", "name", if_b_, "netns", ns_b_});
-    Must({"ip", "-n", ns_a_, "addr", "add", std::string(kAddrA) + "/24", "dev", if_a_});
-    Must({"ip", "-n", ns_b_, "addr", "add", std::string(kAddrB) + "/24", "dev", if_b_});
-    Must({"ip", "-n", ns_a_, "link", "set", if_a_, "up"});
-    Must({"ip", "-n", ns_b_, "link", "set", if_b_, "up"});
+    const Status made = pair_.Create({"sbf", "swarmbox-faults-e2e", kAddrA, kAddrB, false, SWARMBOX_NETEMD_PATH});
+    ASSERT_TRUE(made) << made.error().ToString();
   }
 
   void TearDown() override {
     if (!created_) return;
     // Stop any daemon the test left (their pidfiles), then delete the namespaces (veth and
     // iptables rules go with them) and the scratch directory. Best effort, every path.
-    for (const char* side : {"a", "b"}) {
-      std::error_code ec;
-      for (const auto& entry : std::filesystem::directory_iterator(dir_ / side, ec)) {
-        (void)runner_.Run({SWARMBOX_NETEMD_PATH, "stop", "--pidfile", entry.path().string()});
-      }
-    }
-    (void)runner_.Run({"ip", "netns", "del", ns_a_});
-    (void)runner_.Run({"ip", "netns", "del", ns_b_});
-    std::error_code ec;
-    std::filesystem::remove_all(dir_, ec);
+    pair_.Remove();
     auto left = runner_.Run({"ip", "netns", "list"});
     if (left) {
       EXPECT_EQ(left->stdout_text.find("sbf-" + std::to_string(getpid())), std::string::npos);
@@ -144,8 +123,12 @@ class NetnsPair : public ::testing::Test {
   static constexpr std::uint16_t kPort = 47001;
 
   PosixCommandRunner runner_;
-  std::string ns_a_, ns_b_, if_a_, if_b_;
-  std::filesystem::path dir_;
+  swarmbox::testing::VethPair pair_{runner_};
+  const std::string& ns_a_ = pair_.ns_a;
+  const std::string& ns_b_ = pair_.ns_b;
+  const std::string& if_a_ = pair_.if_a;
+  const std::string& if_b_ = pair_.if_b;
+  const std::filesystem::path& dir_ = pair_.dir;
   bool created_ = false;
 };
 

@@ -2,14 +2,15 @@
 
 #include <gtest/gtest.h>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_docker_api.hpp"
+#include "swarmbox/faults/docker_actions.hpp"
 #include "swarmbox/faults/docker_exec_runner.hpp"
 
 namespace swarmbox::faults {
 namespace {
 
 using K = DockerAction::Kind;
-using testing::FakeDockerApi;
+using swarmbox::testing::FakeDockerApi;
 
 ProcessFault Process(ProcessAction action) {
   ProcessFault f;
@@ -47,31 +48,35 @@ TEST(ProcessPlan, EachActionAndItsUndo) {
 
 TEST(ProcessPlan, ExecutesThroughDockerApi) {
   FakeDockerApi api;
+  api.AddRunning("a");
+  api.AddRunning("b");
   const ProcessPlan plan = PlanProcessFault(Process(ProcessAction::kPause), {"a", "b"}, true);
   ASSERT_TRUE(ExecuteDockerActions(api, plan.apply));
   ASSERT_TRUE(ExecuteDockerActions(api, plan.undo));
-  EXPECT_EQ(api.calls, (std::vector<std::string>{"pause a", "pause b", "unpause a", "unpause b"}));
+  EXPECT_EQ(api.Calls(), (std::vector<std::string>{"pause a", "pause b", "unpause a", "unpause b"}));
 }
 
 TEST(ProcessPlan, StopsAtTheFirstFailureAndSaysWhich) {
   FakeDockerApi api;
+  for (const char* c : {"a", "b", "c"}) api.AddRunning(c);
   api.fail.insert("kill b SIGKILL");
   const ProcessPlan plan = PlanProcessFault(Process(ProcessAction::kKill), {"a", "b", "c"}, false);
   Status s = ExecuteDockerActions(api, plan.apply);
   ASSERT_FALSE(s);
   EXPECT_EQ(s.error().message(), "kill b SIGKILL: container is not running");
-  EXPECT_EQ(api.calls, (std::vector<std::string>{"kill a SIGKILL", "kill b SIGKILL"}));
+  EXPECT_EQ(api.Calls(), (std::vector<std::string>{"kill a SIGKILL", "kill b SIGKILL"}));
 }
 
 TEST(DockerExecCommandRunner, RunsArgvInTheSidecarAndCollectsOutput) {
   FakeDockerApi api;
+  api.AddRunning("t1-scout_1-faults");
   api.exec_answers["tc qdisc replace dev lo root netem delay 0ms"] = {{}, {"Error: Specified qdisc kind is unknown."}, 2};
   DockerExecCommandRunner runner(api, "t1-scout_1-faults");
   auto out = runner.Run({"tc", "qdisc", "replace", "dev", "lo", "root", "netem", "delay", "0ms"});
   ASSERT_TRUE(out) << out.error().ToString();
   EXPECT_EQ(out->exit_code, 2);
   EXPECT_EQ(out->stderr_text, "Error: Specified qdisc kind is unknown.\n");
-  EXPECT_EQ(api.calls, (std::vector<std::string>{"exec t1-scout_1-faults tc qdisc replace dev lo root netem delay 0ms"}));
+  EXPECT_EQ(api.Calls(), (std::vector<std::string>{"exec t1-scout_1-faults tc qdisc replace dev lo root netem delay 0ms"}));
 }
 
 }  // namespace

@@ -25,7 +25,7 @@
 
 #include "guest_measurements.hpp"
 #include "swarmbox/common/result.hpp"
-#include "swarmbox/faults/command_runner.hpp"
+#include "swarmbox/faults/posix_command_runner.hpp"
 #include "swarmbox/faults/partition_plan.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
 #include "udp_probe.hpp"

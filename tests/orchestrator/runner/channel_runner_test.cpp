@@ -12,7 +12,9 @@
 #include <mutex>
 #include <sstream>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_clock.hpp"
+#include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/runner/runner.hpp"
 
@@ -23,25 +25,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-class StepClock : public Clock {
- public:
-  double NowS() override {
-    std::lock_guard lock(mu_);
-    now_ += 0.001;
-    return now_;
-  }
-
- private:
-  std::mutex mu_;
-  double now_ = 1000;
-};
-
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 constexpr char kRun[] = "20261126-020000-c4a7";
 std::string Name(const std::string& component) { return std::string("chan-") + kRun + "-" + component; }
@@ -104,7 +88,7 @@ class ChannelRunnerTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(root_); }
 
   RunOutcome Run() {
-    StepClock clock;
+    testing::FakeClock clock(1000, 0.001);
     auto run = RunTrialSpec(spec_, api_, clock, options_);
     EXPECT_TRUE(run) << run.error().ToString();
     if (!run) return {};
@@ -376,7 +360,7 @@ TEST_F(ChannelRunnerTest, NetemAtAnotherRtfThanOneIsWarnedAbout) {
 // The default profile must exist before anything is created.
 TEST_F(ChannelRunnerTest, AMissingRadioProfileStopsBeforeAnythingIsCreated) {
   spec_.radio.profile = "no_such_radio";
-  StepClock clock;
+  testing::FakeClock clock(1000, 0.001);
   auto run = RunTrialSpec(spec_, api_, clock, options_);
   ASSERT_FALSE(run);
   EXPECT_THAT(run.error().message(), HasSubstr("radio profile 'no_such_radio' not found"));

@@ -15,17 +15,13 @@
 #include <filesystem>
 #include <thread>
 
-#include "swarmbox/docker/docker_client.hpp"
-#include "swarmbox/docker/remove_labelled.hpp"
 #include "swarmbox/faults/docker_exec_runner.hpp"
 #include "swarmbox/faults/mechanism.hpp"
-#include "swarmbox/images/ensure_image.hpp"
 #include "swarmbox/images/process_capture.hpp"
-#include "swarmbox/images/standard_images.hpp"
-#include "swarmbox/runner/fault_image.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
 #include "support/files.hpp"
+#include "support/trial_on_docker.hpp"
 
 namespace swarmbox::runner {
 namespace {
@@ -72,16 +68,10 @@ std::string HostIptables() {
 }
 
 TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemoved) {
-  auto client = docker::DockerClient::Connect(docker::DockerClientOptions{});
-  ASSERT_TRUE(client) << "this test needs a Docker engine: " << client.error().ToString();
-  docker::DockerApi& api = **client;
-
-  auto physics = images::EnsureImage(api, images::PhysicsImage(SWARMBOX_PHYSICS_BIN), {}, nullptr);
-  ASSERT_TRUE(physics) << physics.error().ToString();
-  auto agent = images::EnsureImage(api, images::AgentImage(SWARMBOX_AGENT_BIN), {}, nullptr);
-  ASSERT_TRUE(agent) << agent.error().ToString();
-  auto faults_image = EnsureFaultsImage(api, SWARMBOX_NETEMD_BIN, {});
-  ASSERT_TRUE(faults_image) << faults_image.error().ToString();
+  swarmbox::testing::TrialOnDocker engine;
+  const Status ready = engine.Prepare("fault-e2e", {SWARMBOX_PHYSICS_BIN, SWARMBOX_AGENT_BIN, SWARMBOX_NETEMD_BIN});
+  ASSERT_TRUE(ready) << ready.error().ToString();
+  docker::DockerApi& api = engine.api();
 
   dsl::TrialSpec spec = dsl::TrialSpec::Named("fault-e2e")
                             .Seed(17)
@@ -97,22 +87,9 @@ TEST(FaultE2e, MeshImpairmentIsAppliedInTheSidecarsWithTheHostsMechanismAndRemov
   spec.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
   spec.radio.model = dsl::RadioModel::kNetem;  // the sidecars' impairment is what is inspected
 
-  const fs::path out = fs::temp_directory_path() / "swarmbox-fault-e2e";
-  fs::remove_all(out);
-  RunOptions options;
-  options.out_dir = out.string();
-  options.run_id = NewRunId();
-  options.images = {physics->tag, agent->tag};
-  options.faults_image = *faults_image;
-  options.host = "fault-e2e-local";
-  options.poll = std::chrono::milliseconds(50);
-  docker::LabelSelector mine;
-  mine.equals[std::string(docker::kLabelRun)] = options.run_id;
-  struct Cleanup {
-    docker::DockerApi& api;
-    docker::LabelSelector selector;
-    ~Cleanup() { (void)docker::RemoveLabelled(api, selector, false); }
-  } cleanup{api, mine};
+  const fs::path out = engine.options().out_dir;
+  const RunOptions& options = engine.options();
+  const docker::LabelSelector& mine = engine.mine();
 
   // The trial runs on its own thread; this one inspects the sidecars while the agents fly.
   SteadyClock clock;

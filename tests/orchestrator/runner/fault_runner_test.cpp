@@ -14,7 +14,9 @@
 #include <mutex>
 #include <sstream>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_clock.hpp"
+#include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/runner/runner.hpp"
 
@@ -25,45 +27,7 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-class StepClock : public Clock {
- public:
-  explicit StepClock(double step) : step_(step) {}
-  double NowS() override {
-    std::lock_guard lock(mu_);
-    now_ += step_;
-    return now_;
-  }
-
- private:
-  std::mutex mu_;
-  double now_ = 1000;
-  double step_;
-};
-
-// A StepClock that also jumps on request (a slow exec in a sidecar).
-class JumpClock : public Clock {
- public:
-  double NowS() override {
-    std::lock_guard lock(mu_);
-    now_ += 0.001;
-    return now_;
-  }
-  void Jump(double s) {
-    std::lock_guard lock(mu_);
-    now_ += s;
-  }
-
- private:
-  std::mutex mu_;
-  double now_ = 1000;
-};
-
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 constexpr char kRun[] = "20261121-160000-f00d";
 constexpr char kProbe[] = "tc qdisc replace dev lo root netem delay 0ms";
@@ -138,7 +102,7 @@ class FaultRunnerTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(out_); }
 
   RunOutcome Run(double clock_step = 0.001) {
-    StepClock clock(clock_step);
+    testing::FakeClock clock(1000, clock_step);
     auto run = RunTrialSpec(spec_, api_, clock, options_);
     EXPECT_TRUE(run) << run.error().ToString();
     if (!run) return {};
@@ -301,7 +265,7 @@ TEST_F(FaultRunnerTest, AFaultIsRecordedRequestedThenAppliedOnceEveryTargetConfi
   api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.000 node=physics event=tick",
                                    "t=2.500 node=physics event=tick", "t=4.000 node=physics event=tick",
                                    "t=5.000 node=physics event=done"};
-  JumpClock clock;
+  testing::FakeClock clock;
   const std::string slow = "exec " + Name("scout_2-faults") + " iptables -w -I INPUT -i eth1 -j SWARMBOX-PART-0";
   std::atomic<bool> slow_done{false};
   api_.on_exec = [&](const std::string& call) {
@@ -431,7 +395,7 @@ TEST_F(FaultRunnerTest, InterruptedRunLeavesNothingAndExecsNoUndoInTheSidecars) 
   options_.interrupted = &interrupted;
   // Ctrl-C once the radio fault is in place (the exec of its loss rule).
   api_.exec_answers["iptables -w -A SWARMBOX-RADIO-IN -m statistic --mode random --probability 0.3 -j DROP"] = {};
-  StepClock clock(0.001);
+  testing::FakeClock clock(1000, 0.001);
   std::thread stopper([&] {
     for (int i = 0; i < 2000 && !interrupted.load(); ++i) {
       if (!Matching(api_.Calls(), "--probability 0.3").empty()) interrupted.store(true);

@@ -15,7 +15,9 @@
 #include <sstream>
 #include <thread>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_clock.hpp"
+#include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/common/version.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/docker/remove_labelled.hpp"
@@ -28,28 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-// Advances by `step` seconds on every reading; thread-safe.
-class FakeClock : public Clock {
- public:
-  explicit FakeClock(double step) : step_(step) {}
-  double NowS() override {
-    std::lock_guard lock(mu_);
-    now_ += step_;
-    return now_;
-  }
-
- private:
-  std::mutex mu_;
-  double now_ = 1000;
-  double step_;
-};
-
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 class RunnerTest : public ::testing::Test {
  protected:
@@ -80,7 +61,7 @@ class RunnerTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(out_); }
 
   RunOutcome Run(double clock_step = 0.001) {
-    FakeClock clock(clock_step);
+    testing::FakeClock clock(1000, clock_step);
     auto run = RunTrialSpec(spec_, api_, clock, options_);
     EXPECT_TRUE(run) << run.error().ToString();
     if (!run) return {};

@@ -12,12 +12,10 @@
 #include <fstream>
 #include <sstream>
 
-#include "swarmbox/docker/docker_client.hpp"
-#include "swarmbox/docker/remove_labelled.hpp"
-#include "swarmbox/images/ensure_image.hpp"
-#include "swarmbox/images/standard_images.hpp"
 #include "swarmbox/runner/naming.hpp"
 #include "swarmbox/runner/runner.hpp"
+#include "support/files.hpp"
+#include "support/trial_on_docker.hpp"
 
 namespace swarmbox::runner {
 namespace {
@@ -26,21 +24,13 @@ namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 using ::testing::Not;
 
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 TEST(SensorFaultE2e, GpsDropoutAndDegradationAreSentToThePhysicsServerAndRecorded) {
-  auto client = docker::DockerClient::Connect(docker::DockerClientOptions{});
-  ASSERT_TRUE(client) << "this test needs a Docker engine: " << client.error().ToString();
-  docker::DockerApi& api = **client;
-  auto physics = images::EnsureImage(api, images::PhysicsImage(SWARMBOX_PHYSICS_BIN), {}, nullptr);
-  ASSERT_TRUE(physics) << physics.error().ToString();
-  auto agent = images::EnsureImage(api, images::AgentImage(SWARMBOX_AGENT_BIN), {}, nullptr);
-  ASSERT_TRUE(agent) << agent.error().ToString();
+  swarmbox::testing::TrialOnDocker engine;
+  const Status ready = engine.Prepare("sensor-fault-e2e", {SWARMBOX_PHYSICS_BIN, SWARMBOX_AGENT_BIN, ""});
+  ASSERT_TRUE(ready) << ready.error().ToString();
+  docker::DockerApi& api = engine.api();
 
   dsl::TrialSpec spec = dsl::TrialSpec::Named("sensor-fault-e2e")
                             .Seed(5)
@@ -56,21 +46,9 @@ TEST(SensorFaultE2e, GpsDropoutAndDegradationAreSentToThePhysicsServerAndRecorde
   spec.trials_dir = std::string(SWARMBOX_SOURCE_DIR) + "/trials";
   spec.radio.model = dsl::RadioModel::kNetem;  // sent by `--send-command` (the channel's plan has them)
 
-  const fs::path out = fs::temp_directory_path() / "swarmbox-sensor-fault-e2e";
-  fs::remove_all(out);
-  RunOptions options;
-  options.out_dir = out.string();
-  options.run_id = NewRunId();
-  options.images = {physics->tag, agent->tag};
-  options.host = "sensor-fault-e2e-local";
-  options.poll = std::chrono::milliseconds(50);
-  docker::LabelSelector mine;
-  mine.equals[std::string(docker::kLabelRun)] = options.run_id;
-  struct Cleanup {
-    docker::DockerApi& api;
-    docker::LabelSelector selector;
-    ~Cleanup() { (void)docker::RemoveLabelled(api, selector, false); }
-  } cleanup{api, mine};
+  const fs::path out = engine.options().out_dir;
+  const RunOptions& options = engine.options();
+  const docker::LabelSelector& mine = engine.mine();
 
   SteadyClock clock;
   Result<RunOutcome> run = RunTrialSpec(spec, api, clock, options);

@@ -11,7 +11,9 @@
 #include <mutex>
 #include <sstream>
 
-#include "fake_docker_api.hpp"
+#include "support/fake_clock.hpp"
+#include "support/fake_docker_api.hpp"
+#include "support/files.hpp"
 #include "swarmbox/runner/runner.hpp"
 
 namespace swarmbox::runner {
@@ -20,25 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
 
-class StepClock : public Clock {
- public:
-  double NowS() override {
-    std::lock_guard lock(mu_);
-    now_ += 0.001;
-    return now_;
-  }
-
- private:
-  std::mutex mu_;
-  double now_ = 100;
-};
-
-std::string ReadFile(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+std::string ReadFile(const fs::path& p) { return swarmbox::testing::ReadWholeFile(p.string()); }
 
 class UserSoftwareRunnerTest : public ::testing::Test {
  protected:
@@ -74,7 +58,7 @@ class UserSoftwareRunnerTest : public ::testing::Test {
   void TearDown() override { fs::remove_all(out_); }
 
   RunOutcome Run() {
-    StepClock clock;
+    testing::FakeClock clock(100, 0.001);
     auto run = RunTrialSpec(spec_, api_, clock, options_);
     EXPECT_TRUE(run) << run.error().ToString();
     return run ? *run : RunOutcome{};

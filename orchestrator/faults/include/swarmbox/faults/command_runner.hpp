@@ -1,10 +1,11 @@
 // Command and CommandRunner: how fault plans touch the system (STYLE.md 3).
 //
 // A plan is a list of argv arrays (no shell anywhere). Where they run is the runner's business:
-// PosixCommandRunner spawns them on this machine (posix_spawnp, stdout and stderr captured),
-// PrefixCommandRunner prepends a fixed argv (e.g. {"ip", "netns", "exec", "ns1"} or
+// PosixCommandRunner (posix_command_runner.hpp, I/O) spawns them on this machine (posix_spawnp,
+// stdout and stderr captured), PrefixCommandRunner prepends a fixed argv (e.g. {"ip", "netns", "exec", "ns1"} or
 // {"nsenter", "-t", PID, "-n"}), DockerExecCommandRunner (docker_exec_runner.hpp) runs them in the
-// fault sidecar; tests use a fake that records argv.
+// fault sidecar (I/O, docker_exec_runner.hpp); tests use a fake that records argv. This header
+// and RunCommands are part of the pure fault model (swarmbox_faults_model).
 //
 //   PosixCommandRunner local;
 //   Status s = RunCommands(local, plan.apply);   // stops at the first failure, says which argv
@@ -40,11 +41,6 @@ class CommandRunner {
   // Runs argv to completion. An Error only when it could not run at all (no such program: kNotFound;
   // spawn failure: kIo); a non-zero exit is a successful Result with exit_code set.
   virtual Result<CommandOutput> Run(const std::vector<std::string>& argv) = 0;
-};
-
-class PosixCommandRunner : public CommandRunner {
- public:
-  Result<CommandOutput> Run(const std::vector<std::string>& argv) override;
 };
 
 class PrefixCommandRunner : public CommandRunner {

@@ -1,6 +1,9 @@
 // swarmbox_faults: fault injection for SwarmBox trials (ARCHITECTURE.md "Faults", "Two networks
 // per trial"). This header includes the whole API and says how the runner wires it; each piece is
-// pure except the edges named "I/O".
+// pure except the edges named "I/O". Two libraries: swarmbox_faults_model (swarmbox::faults_model,
+// the pure pieces: common alone, what the DSL links) and swarmbox_faults (swarmbox::faults: the
+// model and the I/O edges PosixCommandRunner, DockerExecCommandRunner and ExecuteDockerActions,
+// on the Docker client).
 //
 // 1. Parse and validate (at `swarmbox validate` / `run` time; errors are file:line:col):
 //      auto mesh   = ParseMeshBlock(*trial.Find("network")->Find("mesh"));   // netem_spec.hpp
@@ -58,6 +61,7 @@
 #include "swarmbox/faults/channel_support.hpp"
 #include "swarmbox/faults/command_runner.hpp"
 #include "swarmbox/faults/delay_scheduler.hpp"
+#include "swarmbox/faults/docker_actions.hpp"
 #include "swarmbox/faults/docker_exec_runner.hpp"
 #include "swarmbox/faults/duration_ms.hpp"
 #include "swarmbox/faults/fault_event.hpp"
@@ -70,6 +74,7 @@
 #include "swarmbox/faults/netemd_args.hpp"
 #include "swarmbox/faults/partition_plan.hpp"
 #include "swarmbox/faults/physics_plan.hpp"
+#include "swarmbox/faults/posix_command_runner.hpp"
 #include "swarmbox/faults/process_plan.hpp"
 #include "swarmbox/faults/radio_layers.hpp"
 #include "swarmbox/faults/radio_plan.hpp"

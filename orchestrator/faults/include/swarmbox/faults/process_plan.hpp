@@ -1,5 +1,6 @@
 // Process faults as plans of Docker calls: kill (a signal), stop/start, pause/unpause, restart,
-// planned purely and carried out through DockerApi.
+// planned purely here and carried out through DockerApi by ExecuteDockerActions
+// (docker_actions.hpp, I/O).
 //
 //   auto targets = ResolveTarget(fault.target, drones, leaders, rng);     // target_resolver.hpp
 //   ProcessPlan plan = PlanProcessFault(fault, ContainersOf(*targets), has_duration);
@@ -14,7 +15,6 @@
 #include <vector>
 
 #include "swarmbox/common/result.hpp"
-#include "swarmbox/docker/docker_api.hpp"
 #include "swarmbox/faults/fault_spec.hpp"
 
 namespace swarmbox::faults {
@@ -38,8 +38,5 @@ struct ProcessPlan {
 
 ProcessPlan PlanProcessFault(const ProcessFault& fault, const std::vector<std::string>& containers,
                              bool has_duration);
-
-// Runs the actions in order; the first failure stops it, with the action in the message.
-Status ExecuteDockerActions(docker::DockerApi& api, const std::vector<DockerAction>& actions);
 
 }  // namespace swarmbox::faults

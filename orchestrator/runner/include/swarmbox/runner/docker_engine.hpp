@@ -29,29 +29,36 @@
 // Thread-safety: the tree (runner's thread) calls the dsl::Engine methods, concurrently for the
 // components of one level; Trace calls are serialised. Inspect, ResumeLogs and IsCurrent may be
 // called from the runner's thread at any time; problems() and artifacts() once no walk runs.
+//
+// The parts, each owning its state under its own lock: JobQueue (job_queue.hpp, the create
+// workers), LogFollowers (log_follower.hpp, one follower thread per container and the generations
+// that tell a current follower's items from a replaced one's), detail::CreatesAhead and
+// detail::BackgroundStops (detail/engine_pipelines.hpp, the creations running ahead by level and
+// the stops finishing in the background), CopyInputs and CollectArtifacts (container_files.hpp).
+// This class is the adapter between them and dsl::Engine; its own lock guards only its maps.
 #pragma once
 
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <future>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <set>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "swarmbox/docker/docker_api.hpp"
 #include "swarmbox/dsl/network.hpp"
 #include "swarmbox/dsl/plugin.hpp"
 #include "swarmbox/runner/clock.hpp"
+#include "swarmbox/runner/detail/engine_pipelines.hpp"
+#include "swarmbox/runner/log_follower.hpp"
 #include "swarmbox/runner/log_hub.hpp"
 #include "swarmbox/runner/results.hpp"
+#include "swarmbox/runner/job_queue.hpp"
 
 namespace swarmbox::runner {
 
@@ -115,22 +122,22 @@ class DockerEngine final : public dsl::Engine {
   const std::map<std::string, std::string>& artifacts() const { return artifacts_; }
 
  private:
-  struct Follower;
+  struct StopRequest;
   dsl::Verdict CreateNow(dsl::Plugin& plugin);
+  // The queued creation of the component (CreatesAhead) run on a create worker.
+  void CreateAhead(dsl::Plugin& plugin, int priority, bool cancelled,
+                   const std::optional<std::shared_future<dsl::Verdict>>& owner,
+                   const std::shared_ptr<std::promise<dsl::Verdict>>& promise);
   // The creation of the component's container queued by CreateContainer, if any; waits for it.
   std::optional<dsl::Verdict> WaitCreated(const std::string& component);
-  // Runs job(false) on a create worker; job(true) when the engine closes before it ran.
-  void Enqueue(std::function<void(bool cancelled)> job);
-  void CloseQueue();
+  // The second half of a stop (a BackgroundStops thread): Docker's stop call, then, once the log
+  // is complete, the exit code, the artifacts and the removal.
+  dsl::Verdict FinishStop(const StopRequest& request, std::atomic<bool>& stop_returned,
+                          const std::shared_future<void>& log_complete);
   void StartFollower(const std::string& component, const std::string& container_id,
                      std::uint64_t skip_lines = 0);
-  void JoinFollower(const std::string& component, bool cancel);
-  Status CopyInputs(const dsl::ContainerSpec& spec, const std::string& container_id);
-  void CollectArtifacts(const std::string& component, const std::vector<std::string>& artifacts,
-                        const std::string& artifacts_dir, const std::string& container_id);
-  struct PendingStop;
-  bool LogEndedByItself(const std::string& component) const;
-  void JoinStops();
+  void CountLines(const std::string& component, std::uint64_t lines);
+  void NotifyEnded();  // a follower's stream ended or a Docker stop returned
   void AddProblem(std::string problem);
   std::optional<std::string> ContainerId(const std::string& component) const;
 
@@ -142,35 +149,18 @@ class DockerEngine final : public dsl::Engine {
   mutable std::mutex mu_;  // guards the maps and lists below (never held across a Docker call)
   std::map<std::string, std::string> network_ids_;    // component id -> Docker id
   std::map<std::string, std::string> container_ids_;  // component id -> Docker id
-  std::map<std::string, std::unique_ptr<Follower>> followers_;
   std::map<std::string, ComponentReport> reports_;
   std::vector<std::string> problems_;
   std::map<std::string, std::string> artifacts_;
-  std::map<std::string, std::uint64_t> generations_;  // component -> current follower
-  std::uint64_t next_generation_ = 1;
   std::atomic<bool> subnet_conflict_{false};
-  std::vector<std::unique_ptr<PendingStop>> pending_stops_;  // guarded by mu_
-  std::mutex join_mu_;  // held while JoinStops joins
-  dsl::Verdict stops_verdict_;                               // guarded by mu_
-  // Creates running ahead (guarded by mu_): component -> its verdict once created; the ids
-  // whose build trace (from the tree, before the creation finished) is left to the creation.
-  std::map<std::string, std::shared_future<dsl::Verdict>> creates_;
-  std::set<std::string> build_traced_by_create_;
-  // Creations queued and not finished, by run priority: a level's creation waits for the earlier
-  // levels' (so the physics server is not created among twenty agents), then overlaps their
-  // starts and readiness waits. Guarded by mu_; create_cv_ is signalled when one finishes.
-  std::map<int, int> unfinished_creates_;
-  std::condition_variable create_cv_;
-  // The create workers (up to max_parallel, started when needed; they live until the destructor).
-  std::mutex queue_mu_;
-  std::condition_variable queue_cv_;
-  std::deque<std::function<void(bool)>> jobs_;  // guarded by queue_mu_
-  std::vector<std::thread> workers_;        // guarded by queue_mu_
-  int idle_workers_ = 0;                    // guarded by queue_mu_
-  bool closing_ = false;                    // guarded by queue_mu_
-  // Signalled when a follower ends or a Docker stop returns (StopContainer waits on either).
-  std::mutex done_mu_;
-  std::condition_variable done_cv_;
+  // Signalled when a follower's stream ends or a Docker stop returns (StopContainer waits on
+  // either; the flags it waits for are atomics, set before the signal).
+  std::mutex ended_mu_;
+  std::condition_variable ended_cv_;
+  detail::CreatesAhead creates_;
+  detail::BackgroundStops stops_;
+  LogFollowers followers_;
+  JobQueue create_workers_;  // up to max_parallel, started when needed
 };
 
 }  // namespace swarmbox::runner

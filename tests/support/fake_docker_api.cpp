@@ -1,4 +1,4 @@
-#include "fake_docker_api.hpp"
+#include "support/fake_docker_api.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -19,6 +19,25 @@ bool FakeDockerApi::Selects(const docker::LabelSelector& selector, const docker:
     if (it == labels.end() || (!v.empty() && it->second != v)) return false;
   }
   return true;
+}
+
+Status FakeDockerApi::Record(const std::string& call) {
+  calls_.push_back(call);
+  if (fail.count(call) != 0) return Error(ErrorCode::kInvalidArgument, "container is not running", "fake");
+  return Ok{};
+}
+
+std::string FakeDockerApi::AddRunning(const std::string& name) {
+  std::lock_guard lock(mu_);
+  const std::string id = "c" + std::to_string(next_id_++);
+  Container c;
+  c.spec.name = name;
+  c.component = name;
+  c.starts = 1;
+  c.state.status = "running";
+  c.state.running = true;
+  containers_[id] = c;
+  return id;
 }
 
 FakeDockerApi::Container* FakeDockerApi::Find(std::string_view id) {
@@ -75,7 +94,7 @@ Status FakeDockerApi::RemoveImage(std::string_view, bool) { return NotModelled("
 
 Result<std::string> FakeDockerApi::CreateNetwork(const docker::NetworkSpec& spec) {
   std::lock_guard lock(mu_);
-  calls_.push_back("create-network " + spec.name);
+  if (Status f = Record("create-network " + spec.name); !f) return f.error();
   subnets_tried_.push_back(spec.subnet);
   if (network_conflicts > 0) {
     --network_conflicts;
@@ -126,7 +145,7 @@ Status FakeDockerApi::RemoveNetwork(std::string_view id) {
   std::lock_guard lock(mu_);
   auto it = networks_.find(std::string(id));
   if (it == networks_.end()) return Error(ErrorCode::kNotFound, "no such network");
-  calls_.push_back("remove-network " + it->second.name);
+  if (Status f = Record("remove-network " + it->second.name); !f) return f;
   if (stale_endpoints > 0) {
     --stale_endpoints;
     return Error(ErrorCode::kUnavailable,
@@ -179,7 +198,7 @@ Result<std::string> FakeDockerApi::CreateContainer(const docker::ContainerSpec& 
                    "POST /containers/create");
     }
   }
-  calls_.push_back("create " + spec.name);
+  if (Status f = Record("create " + spec.name); !f) return f.error();
   if (Find(spec.name) != nullptr) return Error(ErrorCode::kAlreadyExists, "name in use");
   if (auto label = spec.labels.find(std::string(docker::kLabelComponent));
       label != spec.labels.end() && scripts[label->second].fail_create) {
@@ -265,7 +284,7 @@ Status FakeDockerApi::StartContainer(std::string_view id) {
   }
   c = Find(id);  // the map may have changed while we waited
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
-  calls_.push_back("start " + c->spec.name);
+  if (Status f = Record("start " + c->spec.name); !f) return f;
   if (scripts[c->component].fail_start) {
     return Error(ErrorCode::kInternal, "exec format error", "POST /containers/start");
   }
@@ -301,7 +320,7 @@ Status FakeDockerApi::StopContainer(std::string_view id, int) {
   }
   c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
-  calls_.push_back("stop " + c->spec.name);
+  if (Status f = Record("stop " + c->spec.name); !f) return f;
   if (c->state.running) {
     c->state.running = false;
     c->state.status = "exited";
@@ -315,7 +334,7 @@ Status FakeDockerApi::RestartContainer(std::string_view id, int timeout_s) {
   std::lock_guard lock(mu_);
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
-  calls_.push_back("restart " + c->spec.name + " " + std::to_string(timeout_s));
+  if (Status f = Record("restart " + c->spec.name + " " + std::to_string(timeout_s)); !f) return f;
   StartLocked(*c);  // a new run: a follower of the old one sees `starts` change and ends
   cv_.notify_all();
   return Ok{};
@@ -325,7 +344,7 @@ Status FakeDockerApi::KillContainer(std::string_view id, std::string_view signal
   std::lock_guard lock(mu_);
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
-  calls_.push_back("kill " + c->spec.name + " " + std::string(signal));
+  if (Status f = Record("kill " + c->spec.name + " " + std::string(signal)); !f) return f;
   if (!c->state.running) {
     return Error(ErrorCode::kInvalidArgument, "Container " + std::string(id) + " is not running");
   }
@@ -341,7 +360,7 @@ Status FakeDockerApi::PauseContainer(std::string_view id) {
   std::lock_guard lock(mu_);
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
-  calls_.push_back("pause " + c->spec.name);
+  if (Status f = Record("pause " + c->spec.name); !f) return f;
   if (!c->state.running) return Error(ErrorCode::kInvalidArgument, "container is not running");
   c->state.paused = true;
   c->state.status = "paused";
@@ -352,7 +371,7 @@ Status FakeDockerApi::UnpauseContainer(std::string_view id) {
   std::lock_guard lock(mu_);
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
-  calls_.push_back("unpause " + c->spec.name);
+  if (Status f = Record("unpause " + c->spec.name); !f) return f;
   if (!c->state.paused) return Error(ErrorCode::kInvalidArgument, "container is not paused");
   c->state.paused = false;
   c->state.status = "running";
@@ -369,7 +388,7 @@ Status FakeDockerApi::RemoveContainer(std::string_view id, bool force, bool) {
   Container* c = Find(id);
   if (c == nullptr) return Error(ErrorCode::kNotFound, "no such container");
   if (c->state.running && !force) return Error(ErrorCode::kInvalidArgument, "container is running");
-  calls_.push_back("remove " + c->spec.name);
+  if (Status f = Record("remove " + c->spec.name); !f) return f;
   for (auto it = containers_.begin(); it != containers_.end(); ++it) {
     if (&it->second == c) {
       containers_.erase(it);
@@ -469,7 +488,7 @@ Status FakeDockerApi::StartExec(std::string_view exec_id, const docker::LogLineF
     std::string text;
     for (const auto& a : it->second.cmd) text += (text.empty() ? "" : " ") + a;
     call = "exec " + it->second.container + " " + text;
-    calls_.push_back(call);
+    if (Status f = Record(call); !f) return f;
     if (auto a = exec_answers.find(text); a != exec_answers.end()) answer = a->second;
     it->second.exit_code = answer.exit_code;
   }

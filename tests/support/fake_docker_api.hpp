@@ -1,4 +1,5 @@
-// FakeDockerApi: an in-memory Docker engine for the runner's tests. Containers follow a script
+// FakeDockerApi: an in-memory Docker engine for the orchestrator's tests (runner, experiment,
+// faults; the one fake of DockerApi). Containers follow a script
 // per component (the swarmbox.component label): lines they log once started, whether they exit by
 // themselves (and with which code), files they hold for GetArchive. Networks check subnet overlap
 // like Docker does. Thread-safe (the runner follows logs from several threads).
@@ -7,6 +8,8 @@
 // command's text; unlisted commands exit 0) and is recorded as "exec <container name> <argv>";
 // kill/pause/unpause/restart change the state ("kill <name> <signal>", ...); a container created
 // with network_mode "container:<id>" needs that container to exist, and to run when it starts.
+// A test that only acts on containers (fault plans) puts them in place with AddRunning, and may
+// make any recorded call fail with `fail`.
 // Methods the runner never calls (images, events, wait...) return kInternal "not modelled by
 // FakeDockerApi" so a test notices if that changes.
 #pragma once
@@ -78,6 +81,12 @@ class FakeDockerApi : public docker::DockerApi {
   // overlap): a slow engine, to measure how a runner overlaps its calls. Absent = none. Set
   // before the run.
   std::map<std::string, std::chrono::milliseconds> latency;
+  // Calls (as Calls() records them: "kill b SIGKILL", "pause a") that fail, once recorded and
+  // before they take effect, with kInvalidArgument "container is not running".
+  std::set<std::string> fail;
+  // A running container named `name` (component `name`, no script), as if created and started
+  // before the test: no call is recorded. Returns its id.
+  std::string AddRunning(const std::string& name);
   // The most calls of each kind ("create", "start", "stop", "remove") inside the engine at once.
   std::map<std::string, int> MaxInFlight() const;
 
@@ -143,6 +152,8 @@ class FakeDockerApi : public docker::DockerApi {
   static Error NotModelled(std::string_view what);
   static bool Selects(const docker::LabelSelector& selector, const docker::Labels& labels);
   Container* Find(std::string_view id);  // by id or name; mu_ held
+  // Records the call; fails it when `fail` names it. mu_ held.
+  Status Record(const std::string& call);
 
   void StartLocked(Container& c);  // mu_ held
   // Waits for the other members of `group` (mu_ held through `lock`); false after 10 s in vain.
