@@ -5,6 +5,10 @@
 //   swarmbox-train-detector --out-dir agent/swarm/models --recalibrate
 //   (steps 4-5 only, on the model in --out-dir: the sigmoid and the figures; the JSON keeps the
 //   training lines and gets "recalibrated": true)
+//   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):
+//   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
+//   --stage1-percentile P, --balance-classes, --hard-negative-rounds N
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -25,8 +29,29 @@ int main(int argc, char** argv) {
       recalibrate = true;
     } else if (a == "--scenes-per-set" && i + 1 < argc) {
       options.scenes_per_set = std::stoi(argv[++i]);
+    } else if (a == "--training-sets" && i + 1 < argc) {
+      const int n = std::stoi(argv[++i]);
+      if (n < 1 || n > 99) {
+        std::fprintf(stderr, "swarmbox-train-detector: --training-sets must be 1..99\n");
+        return 2;
+      }
+      options.training_seeds.clear();
+      for (int k = 1; k <= n; ++k) options.training_seeds.push_back(7'000'000 + static_cast<std::uint64_t>(k));
+    } else if (a == "--trees" && i + 1 < argc) {
+      options.forest_trees = std::stoi(argv[++i]);
+    } else if (a == "--max-negatives" && i + 1 < argc) {
+      options.max_negatives = std::stoi(argv[++i]);
+    } else if (a == "--stage1-percentile" && i + 1 < argc) {
+      options.stage1_percentile = std::stod(argv[++i]);
+    } else if (a == "--balance-classes") {
+      options.balance_classes = true;
+    } else if (a == "--hard-negative-rounds" && i + 1 < argc) {
+      options.hard_negative_rounds = std::stoi(argv[++i]);
     } else {
-      std::fprintf(stderr, "usage: swarmbox-train-detector --out-dir DIR [--scenes-per-set N]\n");
+      std::fprintf(stderr,
+                   "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
+                   "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
+                   "[--balance-classes] [--hard-negative-rounds N]\n");
       return 2;
     }
   }

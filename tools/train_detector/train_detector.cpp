@@ -28,6 +28,14 @@ constexpr int kStage2CandidatesPerScene = 96;
 // A window one cell (0.25 m) off a person's centre is taught a lower score than the centred one, so
 // the first stage peaks on the person (geolocation) rather than anywhere on a plateau.
 constexpr float kShiftedTarget = 0.3f;
+// Detections of the first forest at least this sure of a person where there is none are mined as
+// hard negatives for the second.
+constexpr double kHardNegativeVotes = 0.2;
+
+double Seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 
 // Ground scale at the image centre, as VictimDetector::Detect(pose) computes it.
 double PixelsPerMetre(const Scene& s) {
@@ -52,6 +60,29 @@ struct Labelled {
   std::vector<float> target;  // stage 1: regression target (1 centred, kShiftedTarget shifted, -1)
   int rows() const { return static_cast<int>(y.size()); }
 };
+
+// The second stage: cv::ml::RTrees on kForestFeatures rows, seeded; with balance_classes the
+// classes weighted equally (priors inverse to their counts: ten negatives or more to a positive).
+Result<cv::Ptr<cv::ml::RTrees>> TrainForest(Labelled& d, const TrainingOptions& o) {
+  int pos = 0;
+  for (int y : d.y) pos += y;
+  cv::Mat x(d.rows(), swarm::kForestFeatures, CV_32F, d.x.data());
+  cv::Mat y(d.rows(), 1, CV_32S, d.y.data());
+  cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
+  forest->setMaxDepth(o.forest_depth);
+  forest->setMinSampleCount(4);
+  forest->setActiveVarCount(0);  // sqrt(features)
+  forest->setCalculateVarImportance(false);
+  if (o.balance_classes) {
+    forest->setPriors(cv::Mat(cv::Matx12f(1.0f, static_cast<float>(d.rows() - pos) / static_cast<float>(std::max(1, pos)))));
+  }
+  forest->setTermCriteria(cv::TermCriteria(cv::TermCriteria::MAX_ITER, o.forest_trees, 0));
+  cv::theRNG().state = 0x5EED;  // the forest's bootstrap samples and variable subsets
+  if (!forest->train(cv::ml::TrainData::create(x, cv::ml::ROW_SAMPLE, y))) {
+    return Error(ErrorCode::kInternal, "train-detector: RTrees training failed");
+  }
+  return forest;
+}
 
 cv::Mat BgrOf(const Scene& s) {
   return cv::Mat(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
@@ -359,6 +390,12 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
 
 Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
+      o.hard_negative_rounds < 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
+                 "hard_negative_rounds >= 0");
+  }
   for (const auto* list : {&o.training_seeds, &o.calibration_seeds}) {
     for (std::uint64_t s : *list) {
       for (std::uint64_t e : perception_scenes::kEvaluationSeeds) {
@@ -372,8 +409,8 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
   if (!cal) return cal.error();
   report->training_scenes = static_cast<int>(train->size());
   report->calibration_scenes = static_cast<int>(cal->size());
-  std::fprintf(stderr, "train-detector: rendered %d training and %d calibration scenes\n", report->training_scenes,
-               report->calibration_scenes);
+  std::fprintf(stderr, "train-detector: rendered %d training and %d calibration scenes (%.0f s)\n",
+               report->training_scenes, report->calibration_scenes, Seconds(t0));
 
   // Stage 1 samples.
   swarm::VictimDetectorModel model;
@@ -421,18 +458,20 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
     }
   }
   for (int y : s1.y) (y ? report->stage1_positives : report->stage1_negatives) += 1;
-  std::fprintf(stderr, "train-detector: stage 1 on %d positives, %d negatives\n", report->stage1_positives,
-               report->stage1_negatives);
+  std::fprintf(stderr, "train-detector: stage 1 on %d positives, %d negatives (%.0f s)\n", report->stage1_positives,
+               report->stage1_negatives, Seconds(t0));
   const auto [weights, bias] = FitLinear(s1, o.ridge_lambda);
   model.SetLinear(weights, bias);
   std::vector<double> centred_scores;
   for (std::size_t i : centred) centred_scores.push_back(model.LinearScore(&s1.x[i * swarm::kWindowFeatures]));
   std::sort(centred_scores.begin(), centred_scores.end());
-  model.stage1_threshold = centred_scores.empty() ? 0.0 : centred_scores[centred_scores.size() / 200];
-  report->stage1_positive_recall = 0.995;
+  const auto at = static_cast<std::size_t>(
+      std::floor(o.stage1_percentile / 100.0 * static_cast<double>(centred_scores.size()) + 1e-9));
+  model.stage1_threshold = centred_scores.empty() ? 0.0 : centred_scores[std::min(at, centred_scores.size() - 1)];
+  report->stage1_positive_recall = 1.0 - o.stage1_percentile / 100.0;
   // The first stage's positives (centred and shifted) are second-stage positives too, with their
   // first-stage score.
-  Labelled s2, neg;
+  Labelled s2;
   std::vector<float> g(swarm::kForestFeatures);
   for (std::size_t i = 0; i < s1.y.size(); ++i) {
     if (!s1.y[i]) continue;
@@ -447,6 +486,7 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
   // Stage 2 samples: the first stage's candidates on the training scenes.
   auto shared = std::make_shared<swarm::VictimDetectorModel>(model);
   swarm::VictimDetector first(shared, {});
+  Labelled neg;
   for (const Scene& s : *train) {
     const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
     // Every local maximum, whatever its score (the first stage alone is precise on these scenes:
@@ -479,29 +519,59 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
     s2.y.push_back(0);
   }
   report->stage2_negatives = static_cast<int>(order.size());
-  std::fprintf(stderr, "train-detector: stage 2 on %d positives, %d negatives (of %d)\n", report->stage2_positives,
-               report->stage2_negatives, neg.rows());
+  std::fprintf(stderr, "train-detector: stage 2 on %d positives, %d negatives (of %d) (%.0f s)\n",
+               report->stage2_positives, report->stage2_negatives, neg.rows(), Seconds(t0));
   if (report->stage2_positives < 50) {
     return Error(ErrorCode::kInternal, "train-detector: the first stage left fewer than 50 positives");
   }
   neg = {};
-  cv::Mat x(s2.rows(), swarm::kForestFeatures, CV_32F, s2.x.data());
-  cv::Mat y(s2.rows(), 1, CV_32S, s2.y.data());
-  cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
-  forest->setMaxDepth(o.forest_depth);
-  forest->setMinSampleCount(4);
-  forest->setActiveVarCount(0);  // sqrt(features)
-  forest->setCalculateVarImportance(false);
-  forest->setTermCriteria(cv::TermCriteria(cv::TermCriteria::MAX_ITER, o.forest_trees, 0));
-  cv::theRNG().state = 0x5EED;  // the forest's bootstrap samples and variable subsets
-  if (!forest->train(cv::ml::TrainData::create(x, cv::ml::ROW_SAMPLE, y))) {
-    return Error(ErrorCode::kInternal, "train-detector: RTrees training failed");
-  }
-  model.forest = forest;
+  Result<cv::Ptr<cv::ml::RTrees>> forest = TrainForest(s2, o);
+  if (!forest) return forest.error();
+  model.forest = *forest;
   model.FlattenForest();
+  std::fprintf(stderr, "train-detector: forest on %d samples (%.0f s)\n", s2.rows(), Seconds(t0));
+
+  // Hard negatives (bootstrapping, Felzenszwalb et al. 2010), hard_negative_rounds times: the
+  // detector on the training frames; its candidates at least 1.5 m from every person that the
+  // forest gives at least kHardNegativeVotes join the negatives, and the forest is trained again.
+  for (int round = 0; round < o.hard_negative_rounds; ++round) {
+    auto mined = std::make_shared<swarm::VictimDetectorModel>(model);
+    swarm::VictimDetectorParams raw;
+    raw.min_confidence = 0.0;
+    raw.partial_confidence_cap = 1.0;
+    raw.nms_radius_m = 0.0;
+    swarm::VictimDetector det(mined, raw);
+    int hard = 0;
+    for (const Scene& s : *train) {
+      const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+      const auto& cands = det.Candidates(BgrOf(s), ppm, raw.max_candidates, model.stage1_threshold);
+      for (const auto& c : cands) {
+        const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_col,
+                                     swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_row);
+        if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
+        swarm::WindowFeatures(det.channels(), c.row, c.col, g.data());
+        g[swarm::kWindowFeatures] = static_cast<float>(c.score);
+        if (model.Votes(g.data()) < kHardNegativeVotes) continue;
+        if (hard >= o.max_hard_negatives) break;
+        s2.x.insert(s2.x.end(), g.begin(), g.end());
+        s2.y.push_back(0);
+        ++hard;
+      }
+    }
+    report->stage2_hard_negatives += hard;
+    std::fprintf(stderr, "train-detector: round %d: %d hard negatives (votes >= %.2f) (%.0f s)\n", round + 1, hard,
+                 kHardNegativeVotes, Seconds(t0));
+    report->stage2_negatives = s2.rows() - report->stage2_positives;
+    forest = TrainForest(s2, o);
+    if (!forest) return forest.error();
+    model.forest = *forest;
+    model.FlattenForest();
+    std::fprintf(stderr, "train-detector: forest on %d samples (%.0f s)\n", s2.rows(), Seconds(t0));
+  }
   {  // The flattened forest decides as OpenCV's own prediction.
+    cv::Mat x(s2.rows(), swarm::kForestFeatures, CV_32F, s2.x.data());
     cv::Mat votes;
-    forest->getVotes(x, votes, 0);
+    model.forest->getVotes(x, votes, 0);
     int person_col = votes.at<int>(0, 0) == 1 ? 0 : 1, disagree = 0;
     for (int i = 0; i < x.rows; ++i) {
       const double v = static_cast<double>(votes.at<int>(i + 1, person_col)) / o.forest_trees;
@@ -512,7 +582,6 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
                                              std::to_string(disagree) + " samples");
     }
   }
-
   if (Status st = Calibrate(*cal, &model, report); !st) return st.error();
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return model;
@@ -535,10 +604,12 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
   j << ",\n  \"scenes_per_set\": " << o.scenes_per_set << ",\n";
   j << "  \"training_scenes\": " << r.training_scenes << ",\n  \"calibration_scenes\": " << r.calibration_scenes << ",\n";
   j << "  \"stage1\": {\"positives\": " << r.stage1_positives << ", \"negatives\": " << r.stage1_negatives
-    << ", \"threshold\": " << model.stage1_threshold << ", \"ridge_lambda\": " << o.ridge_lambda << "},\n";
+    << ", \"threshold\": " << model.stage1_threshold << ", \"threshold_percentile\": " << o.stage1_percentile
+    << ", \"ridge_lambda\": " << o.ridge_lambda << "},\n";
   j << "  \"stage1_calibration_recall\": " << r.stage1_calibration_recall << ",\n";
   j << "  \"stage2\": {\"positives\": " << r.stage2_positives << ", \"negatives\": " << r.stage2_negatives
-    << ", \"trees\": " << o.forest_trees << ", \"max_depth\": " << o.forest_depth << "},\n";
+    << ", \"balance_classes\": " << (o.balance_classes ? "true" : "false") << ", \"hard_negative_rounds\": "
+    << o.hard_negative_rounds << ", \"hard_negatives\": " << r.stage2_hard_negatives << ", \"trees\": " << o.forest_trees << ", \"max_depth\": " << o.forest_depth << "},\n";
   j << "  \"platt\": {\"a\": " << model.platt_a << ", \"b\": " << model.platt_b << "},\n";
   j << "  \"calibration_figures\": {\"persons_at_least_half_visible\": " << r.calibration_persons
     << ", \"detections_labelled\": " << r.calibration_detections << ", \"tp_at_0.5\": " << r.calibration_tp

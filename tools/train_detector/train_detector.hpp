@@ -41,8 +41,17 @@ struct TrainingOptions {
   int forest_depth = 14;
   int max_negatives = 24000;  // second-stage negatives kept (a seeded sample)
   double ridge_lambda = 1e-2;
+  // The stage-1 threshold: this percentile of the centred positives' scores [%].
+  double stage1_percentile = 0.5;
+  // Weigh the forest's classes equally (cv::ml priors inverse to the class counts).
+  bool balance_classes = false;
+  // Rounds of hard negatives: the forest's false candidates on the training frames (votes >= 0.2)
+  // join the negatives (at most max_hard_negatives per round) and the forest is trained again.
+  int hard_negative_rounds = 0;
+  int max_hard_negatives = 20000;
 };
 
+// The recipe of the shipped model: 8 training sets (7000001-7000008), 2 calibration sets.
 TrainingOptions DefaultTrainingOptions();
 
 // The scene mix of one training or calibration set: altitudes 8-65 m, noise 2-12 levels, 30 % of
@@ -57,6 +66,7 @@ struct TrainingReport {
   int stage1_negatives = 0;
   int stage2_positives = 0;
   int stage2_negatives = 0;
+  int stage2_hard_negatives = 0;
   double stage1_positive_recall = 0;  // share of centred positives at or above the threshold
   double stage1_calibration_recall = 0;  // must-detect people with a first-stage candidate
   int calibration_detections = 0;

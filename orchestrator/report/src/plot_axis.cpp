@@ -8,7 +8,8 @@ namespace swarmbox::report {
 AxisKind AxisKindOf(std::string_view metric) {
   AxisKind k;
   if (metric == "detections" || metric == "victims_confirmed" || metric == "victims_rescued" ||
-      metric == "collisions" || metric == "leader_changes") {
+      metric == "collisions" || metric == "leader_changes" || metric == "false_alarms_rejected" ||
+      metric == "false_victims_confirmed" || metric == "false_victims_rescued" || metric == "victims_missed") {
     k.from_zero = true;
     k.integer = true;
   } else if (metric == "radio_loss") {

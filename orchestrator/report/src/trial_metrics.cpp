@@ -24,7 +24,8 @@ const std::vector<std::string>& MetricNames() {
   static const std::vector<std::string> kNames = {
       "mission_time_s", "first_detection_s", "detections",   "victims_confirmed",
       "min_separation_m", "collisions",       "leader_changes", "failover_s",
-      "radio_rtt_ms",   "radio_loss",        "victims_rescued"};
+      "radio_rtt_ms",   "radio_loss",        "victims_rescued", "false_alarms_rejected",
+      "false_victims_confirmed", "false_victims_rescued", "victims_missed"};
   return kNames;
 }
 
@@ -45,7 +46,11 @@ void TrialMetrics::OnLogEvent(std::string_view component, const LogfmtFields& fi
     if (!victim) victim = FindField(fields, "victim");
     if (victim && e != "sighting_reported") {
       detected_.insert(*victim);
-      if (e == "victim_confirmed") confirmed_.insert(*victim);
+      if (e == "victim_confirmed") {
+        confirmed_.insert(*victim);
+        const auto x = Number(fields, "x"), y = Number(fields, "y");
+        if (x && y) confirmed_at_[*victim] = {*x, *y};
+      }
     } else if (e == "victim_detected") {
       ++anonymous_detections_;
     } else if (e == "victim_confirmed") {
@@ -60,6 +65,9 @@ void TrialMetrics::OnLogEvent(std::string_view component, const LogfmtFields& fi
     if (victim && FindField(fields, "status") == std::optional<std::string>("rescued")) {
       rescued_.insert(*victim);
     }
+  } else if (e == "rejected") {
+    perception_seen_ = true;
+    if (const auto candidate = FindField(fields, "candidate")) rejected_.insert(*candidate);
   } else if (e == "mission_state") {
     perception_seen_ = true;  // the mission runs: zero detections is then a real zero
   } else if (e == "collision") {
@@ -130,6 +138,28 @@ MetricValues TrialMetrics::Values() {
     v["detections"] = static_cast<double>(detected_.size() + anonymous_detections_);
     v["victims_confirmed"] = static_cast<double>(confirmed_.size() + anonymous_confirmed_);
     v["victims_rescued"] = static_cast<double>(rescued_.size());
+    v["false_alarms_rejected"] = static_cast<double>(rejected_.size());
+    if (!world_victims_.empty()) {
+      double false_confirmed = 0, false_rescued = 0;
+      for (const auto& [id, at] : confirmed_at_) {
+        double nearest = 1e300;
+        for (const auto& w : world_victims_) nearest = std::min(nearest, std::hypot(at[0] - w[0], at[1] - w[1]));
+        if (nearest < kFalseVictimRadiusM) continue;
+        ++false_confirmed;
+        if (rescued_.count(id) != 0) ++false_rescued;
+      }
+      v["false_victims_confirmed"] = false_confirmed;
+      v["false_victims_rescued"] = false_rescued;
+      double missed = 0;
+      for (const auto& w : world_victims_) {
+        bool rescued = false;
+        for (const auto& [id, at] : confirmed_at_) {
+          rescued = rescued || (rescued_.count(id) != 0 && std::hypot(at[0] - w[0], at[1] - w[1]) < kFalseVictimRadiusM);
+        }
+        missed += rescued ? 0 : 1;
+      }
+      v["victims_missed"] = missed;
+    }
   }
   v["min_separation_m"] = min_sep_;
   if (physics_log_ || collisions_ > 0) v["collisions"] = static_cast<double>(collisions_);

@@ -188,6 +188,17 @@ std::optional<MetricValues> ReadTrialMetrics(const std::string& dir_text) {
   ReadTruthCsv((dir / "truth.csv").string(), [&](const TruthRow& r) {
     metrics.OnTruth(r.t_s, r.drone, r.x_m, r.y_m, r.z_m);
   });
+  // The world's victims (the runner writes the trial's world, generated or given, as world.yaml).
+  if (auto world_text = ReadText(dir / "world.yaml")) {
+    if (auto world = yaml::Parse(*world_text, (dir / "world.yaml").string()); world && world->is_mapping()) {
+      if (const yaml::Node* victims = world->Find("victims"); victims != nullptr && victims->is_sequence()) {
+        for (const yaml::Node& v : victims->items()) {
+          const std::optional<double> x = NumberAt(v, "x_m"), y = NumberAt(v, "y_m");
+          if (x && y) metrics.OnWorldVictim(*x, *y);
+        }
+      }
+    }
+  }
   return metrics.Values();
 }
 

@@ -1,5 +1,7 @@
-// swarmbox-bench perception [--seed N] [--scenes K] [--quick]: the detector's figures on
-// physics-rendered scenes of seed N (never a training seed of the shipped model: refused), in the
+// swarmbox-bench perception [--seed N] [--scenes K] [--quick] [--model FILE]: the detector's figures
+// on physics-rendered scenes of seed N (never a training or calibration seed of the model: refused),
+// of the shipped model or of a model file train-detector wrote elsewhere (--model: the curves only,
+// to compare a recipe before shipping it; --only altitude:30 runs one case), in the
 // varied look (perception_scenes.hpp: terrains, light, poses, clothing, cover, distractors), one
 // logfmt line per case:
 //   case=altitude     altitude_m=10|20|30|40|60 (30 % of the people partly covered, 2 distractors each)
@@ -11,6 +13,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <memory>
 #include <numbers>
 #include <string>
 
@@ -40,7 +43,8 @@ struct CurveCase {
   SceneSetParams scenes;
 };
 
-int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed) {
+int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
+              const std::shared_ptr<const VictimDetectorModel>& model) {
   const int n = args.quick ? 12 : static_cast<int>(args.GetInt("scenes", 240));
   auto at = [&](double altitude, double occluded, int distractors) {
     return SceneSetParams{.seed = seed, .scenes = n, .scenes_per_world = 12, .min_altitude_m = altitude,
@@ -52,8 +56,21 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed) {
   for (double o : {0.0, 0.5, 1.0}) cases.push_back({"occlusion", "occluded_fraction", o, at(30, o, 2)});
   for (int d : {0, 2, 6}) cases.push_back({"distractors", "distractors", static_cast<double>(d), at(30, 0.3, d)});
   if (args.quick) cases.resize(2);
+  // --only KIND:VALUE (e.g. altitude:30, distractors:0): that case alone.
+  if (const std::string only = args.Get("only", ""); !only.empty()) {
+    std::erase_if(cases, [&](const CurveCase& c) {
+      char name[64];
+      std::snprintf(name, sizeof name, "%s:%g", c.kind.c_str(), c.value);
+      return only != name;
+    });
+    if (cases.empty()) {
+      std::fprintf(stderr, "perception bench: --only %s names no case (altitude:10|20|30|40|60, occlusion:0|0.5|1, "
+                   "distractors:0|2|6)\n", only.c_str());
+      return 2;
+    }
+  }
   cv::setNumThreads(1);
-  VictimDetector detector;
+  VictimDetector detector(model, VictimDetectorParams{});
   for (const CurveCase& c : cases) {
     swarmbox::Result<std::vector<Scene>> scenes = RenderScenes(c.scenes);
     if (!scenes) {
@@ -81,15 +98,26 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed) {
 
 int RunPerceptionBench(const swarmbox::bench::Args& args) {
   const auto seed = static_cast<std::uint64_t>(args.GetInt("seed", 20261121));
-  for (const auto* list : {&ShippedDetectorModel()->training_seeds, &ShippedDetectorModel()->calibration_seeds}) {
+  std::shared_ptr<const VictimDetectorModel> model = ShippedDetectorModel();
+  const auto model_file = args.options.find("model");
+  if (model_file != args.options.end()) {
+    swarmbox::Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(model_file->second);
+    if (!loaded) {
+      std::fprintf(stderr, "perception bench: %s\n", loaded.error().ToString().c_str());
+      return 2;
+    }
+    model = *loaded;
+  }
+  for (const auto* list : {&model->training_seeds, &model->calibration_seeds}) {
     if (std::find(list->begin(), list->end(), seed) != list->end()) {
-      std::fprintf(stderr, "perception bench: seed %llu is one the shipped detector was trained or calibrated on\n",
+      std::fprintf(stderr, "perception bench: seed %llu is one the detector was trained or calibrated on\n",
                    static_cast<unsigned long long>(seed));
       return 2;
     }
   }
-  if (int rc = RunCurves(args, seed); rc != 0) return rc;
-  if (args.GetInt("curves_only", 0) != 0) return 0;
+  if (int rc = RunCurves(args, seed, model); rc != 0) return rc;
+  // The pipeline scenarios run the shipped model (VictimPerception): a --model file gets the curves.
+  if (args.GetInt("curves_only", 0) != 0 || model_file != args.options.end()) return 0;
   const int n = args.quick ? 48 : static_cast<int>(args.GetInt("scenes", 320));
   const double latency_s = args.GetDouble("latency_s", 0.040);
   const PoseNoise estimated{.seed = 3, .position_sigma_m = 0.3, .attitude_sigma_rad = 0.5 * std::numbers::pi / 180};

@@ -80,6 +80,34 @@ TEST(TrialMetrics, VictimsAsTheAgentsLogThemMatchTheEndingLine) {
   EXPECT_EQ(v["mission_time_s"], 257.3);
 }
 
+TEST(TrialMetrics, FalseVictimsAreConfirmedFarFromEveryVictimOfTheWorld) {
+  TrialMetrics m;
+  Feed(m, "scout_1", "t=5 node=scout_1 event=mission_state state=search index=3");
+  Feed(m, "scout_1", "t=30 node=scout_1 event=victim_confirmed id=1 x=40.0 y=12.0 index=17");
+  Feed(m, "scout_1", "t=52 node=scout_1 event=victim_confirmed id=2 x=-35.0 y=60.0 index=31");
+  Feed(m, "scout_1", "t=60 node=scout_1 event=victim_confirmed id=3 x=0.0 y=0.0 index=35");
+  Feed(m, "scout_1", "t=140 node=scout_1 event=victim_status id=1 status=rescued index=55");
+  Feed(m, "scout_1", "t=150 node=scout_1 event=victim_status id=3 status=rescued index=57");
+  Feed(m, "scout_2", "t=70 node=scout_2 event=rejected candidate=4 reason=belief decided_belief=0.1");
+  Feed(m, "scout_3", "t=71 node=scout_3 event=rejected candidate=4 reason=belief decided_belief=0.1");
+  Feed(m, "scout_3", "t=80 node=scout_3 event=rejected candidate=6 reason=undecided decided_belief=0.5");
+  // Without the world's victims the false ones are unknown, not zero.
+  MetricValues unknown = m.Values();
+  EXPECT_EQ(unknown["false_alarms_rejected"], 2.0);
+  EXPECT_FALSE(unknown["false_victims_confirmed"].has_value());
+  EXPECT_FALSE(unknown["false_victims_rescued"].has_value());
+  m.OnWorldVictim(41.0, 13.5);   // victim 1, 1.8 m away
+  m.OnWorldVictim(-35.0, 57.5);  // victim 2, 2.5 m away
+  m.OnWorldVictim(3.0, 0.5);     // 3.04 m from the confirmed victim 3: that one is false
+  MetricValues v = m.Values();
+  EXPECT_EQ(v["victims_confirmed"], 3.0);
+  EXPECT_EQ(v["false_victims_confirmed"], 1.0);
+  EXPECT_EQ(v["false_victims_rescued"], 1.0);
+  EXPECT_EQ(v["false_alarms_rejected"], 2.0);
+  EXPECT_EQ(v["victims_missed"], 2.0);  // victim 2 was confirmed, not rescued; the third has no true find
+  EXPECT_FALSE(unknown["victims_missed"].has_value());
+}
+
 TEST(TrialMetrics, RadioFiguresAreWeightedByPingsAndVictimsKnownById) {
   TrialMetrics m;
   // The agents' format: counts per window; a window with nothing answered has no RTT.
@@ -160,13 +188,14 @@ TEST(ResultsCsv, ContractColumnsQuotingAndEmptyCells) {
   const std::string header =
       "trial_id,code,loss,swarm,repetition,seed,host,outcome,reason,wall_s,sim_s,mission_time_s,"
       "first_detection_s,detections,victims_confirmed,min_separation_m,collisions,leader_changes,"
-      "failover_s,radio_rtt_ms,radio_loss,victims_rescued,swarmbox_version,swarmbox_commit,"
+      "failover_s,radio_rtt_ms,radio_loss,victims_rescued,false_alarms_rejected,false_victims_confirmed,"
+      "false_victims_rescued,victims_missed,swarmbox_version,swarmbox_commit,"
       "build_type,images,docker_version,docker_api_version,kernel,fault_mechanism,rtf_requested,"
       "rtf_achieved,host_name\n";
   ASSERT_EQ(csv.substr(0, header.size()), header);
   EXPECT_EQ(csv.substr(header.size()),
             "e-ab-r1,ab,0.05,\"three, spread\",1,7,local,timeout,\"sim time \"\"60 s\"\" reached\","
-            "12.25,60,,,,,,0,,,201.5,,,,,,,,,,,,,\n");
+            "12.25,60,,,,,,0,,,201.5,,,,,,,,,,,,,,,,,\n");
   EXPECT_EQ(CsvNumber(0.1 + 0.2), "0.3");
   EXPECT_EQ(CsvNumber(3), "3");
 }
@@ -359,7 +388,12 @@ TEST(TrialRecordTest, ReadsResultMetaLogsAndTruthFromAFolder) {
       << R"("seed":99,"host":"local","metrics":{}})";
   std::ofstream(trial / "logs" / "physics.log") << "t=0.000 node=physics event=ready\n";
   std::ofstream(trial / "logs" / "scout_1.log")
-      << "t=3.000 node=scout_1 event=leader_elected term=1 leader=scout_1\nplain text\n";
+      << "t=3.000 node=scout_1 event=leader_elected term=1 leader=scout_1\nplain text\n"
+      << "t=9.000 node=scout_1 event=victim_confirmed id=1 x=10.5 y=-3.0 index=9\n"
+      << "t=9.500 node=scout_1 event=victim_confirmed id=2 x=60.0 y=60.0 index=11\n";
+  // The trial's world as the runner writes it (generated worlds): the victims' truth.
+  std::ofstream(trial / "world.yaml") << "name: w\nvictims:\n  - {id: v1, x_m: 10.0, y_m: -2.0}\n"
+                                         "  - {id: v2, x_m: -20.0, y_m: 5.0}\n";
   std::ofstream(trial / "truth.csv") << "t_s,drone,x_m,y_m,z_m,vx_m_s\n0,a,0,0,0,0\n0,b,0,6,8,0\n";
   fs::create_directories(dir / ".staging" / "e-aa-r1.1");
   fs::create_directories(dir / "e-ba-r1");  // no result.json: not a trial yet
@@ -375,6 +409,10 @@ TEST(TrialRecordTest, ReadsResultMetaLogsAndTruthFromAFolder) {
   EXPECT_EQ(rec->metrics["collisions"], 0.0);
   EXPECT_EQ(rec->metrics["leader_changes"], 0.0);
   EXPECT_DOUBLE_EQ(*rec->metrics["min_separation_m"], 10.0);
+  EXPECT_EQ(rec->metrics["victims_confirmed"], 2.0);
+  EXPECT_EQ(rec->metrics["false_victims_confirmed"], 1.0);  // id 2: no victim near (60, 60)
+  EXPECT_EQ(rec->metrics["false_victims_rescued"], 0.0);
+  EXPECT_EQ(rec->metrics["victims_missed"], 2.0);  // nothing rescued
   EXPECT_FALSE(rec->has_trajectories);
 
   std::vector<std::string> problems;

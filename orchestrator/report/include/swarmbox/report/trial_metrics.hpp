@@ -26,6 +26,16 @@
 //                         for lines without counts)
 //   victims_rescued       distinct victims (`id`) in event=victim_status status=rescued: the ending
 //                         line's `rescued=`; empty like detections
+//   false_alarms_rejected distinct candidates in event=rejected (the leader's planner: a sighting
+//                         the fused evidence of a revisit rejected); empty like detections
+//   false_victims_confirmed  confirmed victims (event=victim_confirmed x= y=) farther than
+//                         kFalseVictimRadiusM from every victim of the world (OnWorldVictim; the
+//                         trial folder's world.yaml): empty when the world's victims are unknown
+//   false_victims_rescued the rescued ones among those (same condition)
+//   victims_missed        victims of the world with no rescued victim confirmed within
+//                         kFalseVictimRadiusM of them (same condition); a mission trial met issue
+//                         #19's target when it succeeded with victims_missed and
+//                         false_victims_rescued both 0
 // The agents log victim_confirmed/victim_status with `id=` (agent/raft node_driver.cpp) and
 // sighting_reported without one (agent/swarm scout_behaviour.cpp); `victim=` is also accepted.
 #pragma once
@@ -43,6 +53,9 @@
 
 namespace swarmbox::report {
 
+// A confirmed victim this far or farther from every victim of the world is a false one [m].
+inline constexpr double kFalseVictimRadiusM = 3.0;
+
 // The metric columns, in results.csv order.
 const std::vector<std::string>& MetricNames();
 
@@ -57,6 +70,8 @@ class TrialMetrics {
   void OnOrchestratorEvent(std::string_view event, std::string_view target, std::optional<double> t_s);
   // One truth.csv sample.
   void OnTruth(double t_s, std::string_view drone, double x_m, double y_m, double z_m);
+  // One victim of the world (ground truth, from the trial's world.yaml), for the false_* metrics.
+  void OnWorldVictim(double x_m, double y_m) { world_victims_.push_back({x_m, y_m}); }
   // Says that the physics server's log was read (collisions are then 0, not unknown).
   void SawPhysicsLog() { physics_log_ = true; }
 
@@ -71,6 +86,9 @@ class TrialMetrics {
   std::set<std::string> detected_;
   std::set<std::string> confirmed_;
   std::set<std::string> rescued_;
+  std::set<std::string> rejected_;                                  // candidate ids
+  std::map<std::string, std::array<double, 2>> confirmed_at_;      // victim id -> x, y
+  std::vector<std::array<double, 2>> world_victims_;
   std::uint64_t anonymous_detections_ = 0;
   std::uint64_t anonymous_confirmed_ = 0;
   bool physics_log_ = false;
