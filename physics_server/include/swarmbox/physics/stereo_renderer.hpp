@@ -8,7 +8,8 @@
 //   renderer.Render(body_pose, spec, /*noise_seed=*/k, &frame);
 //   // frame.left / frame.right: CV_8U, rectified; frame.depth_truth_m: CV_32F (0: no surface)
 //
-// Image model, per pixel: radiance = albedo * (ambient + projector), where ambient is the cell's
+// Image model, per pixel (one ray through its centre; 2 x 2 rays per pixel cost 4x and gave the
+// same depth errors, BENCHMARKS.md "stereo"): radiance = albedo * (ambient + projector), where ambient is the cell's
 // in-band irradiance (sun or shade, StereoScene) and projector = optical_power / (FOI solid angle
 // * d^2) * pattern, d the distance from the projector, pattern the dot field (mean 1 over the
 // field of illumination, 1/dot_fill on a dot, 0 between dots); nothing beyond range_m. Both
