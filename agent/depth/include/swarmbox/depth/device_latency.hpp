@@ -42,6 +42,11 @@ class DeviceLatency {
     return out;
   }
 
+  // The release time of the oldest frame still queued.
+  std::optional<std::int64_t> NextRelease() const {
+    if (queue_.empty()) return std::nullopt;
+    return queue_.front().first;
+  }
   std::size_t pending() const { return queue_.size(); }
 
  private:
