@@ -44,7 +44,10 @@ class ScriptedAgents final : public SimTransport {
   Status PublishCamera(std::size_t, const std::string& name, std::uint64_t step, const CameraImage& img) override {
     ++frames[name];
     published.push_back("camera " + name + " " + std::to_string(step));
-    EXPECT_EQ(img.bgr.size(), 640u * 360u * 3u);  // the x500 camera (trials/airframes/x500.yaml)
+    // A shipped airframe's camera (trials/airframes): x500 640 x 360, x8_heavy 320 x 240.
+    const bool shipped = (img.width_px == 640 && img.height_px == 360) || (img.width_px == 320 && img.height_px == 240);
+    EXPECT_TRUE(shipped) << name << ": " << img.width_px << " x " << img.height_px;
+    EXPECT_EQ(img.bgr.size(), static_cast<std::size_t>(img.width_px) * static_cast<std::size_t>(img.height_px) * 3u);
     return Ok{};
   }
   Status PublishClock(std::uint64_t step, std::int64_t, std::int64_t, double) override {
