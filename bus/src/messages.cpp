@@ -18,6 +18,7 @@ std::string_view MessageTypeName(MessageType type) {
     case MessageType::kBrainInput: return "swarmbox::msg::BrainInput";
     case MessageType::kBrainOutput: return "swarmbox::msg::BrainOutput";
     case MessageType::kTelemetry: return "swarmbox::msg::Telemetry";
+    case MessageType::kDepthSummary: return "swarmbox::msg::DepthSummary";
   }
   return "swarmbox::msg::<unknown>";
 }

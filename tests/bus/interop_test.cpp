@@ -52,6 +52,7 @@ TEST_P(BusInterop, BrainMessageCrossesVendors) { Check<BrainMessage>(8, std::str
 TEST_P(BusInterop, BrainInputCrossesVendors) { Check<BrainInput>(1, OffboardInputTopic("scout_1"), Qos::kLockstep); }
 TEST_P(BusInterop, BrainOutputCrossesVendors) { Check<BrainOutput>(2, OffboardOutputTopic("scout_1"), Qos::kLockstep); }
 TEST_P(BusInterop, TelemetryCrossesVendors) { Check<Telemetry>(5, std::string(kTelemetryTopic), Qos::kState); }
+TEST_P(BusInterop, DepthSummaryCrossesVendors) { Check<DepthSummary>(6, std::string(kDepthTopic), Qos::kState); }
 
 // A camera-sized image is fragmented by one vendor and reassembled by the other.
 TEST_P(BusInterop, CameraSizedImageCrossesVendors) {

@@ -266,6 +266,22 @@ Telemetry FullTelemetry(std::uint64_t seed) {
   return m;
 }
 
+DepthSummary FullDepthSummary(std::uint64_t seed) {
+  DepthSummary m;
+  m.drone = S(seed, "drone");
+  m.capture_ns = static_cast<std::int64_t>(seed) + 333;
+  m.sim_time_ns = static_cast<std::int64_t>(seed) + 444;
+  m.fill_rate = D(seed, 91);
+  m.median_m = D(seed, 92);
+  m.near_p5_m = D(seed, 93);
+  m.grid_cols = 2;
+  m.grid_rows = 1;
+  m.grid_m = {D(seed, 94), D(seed, 95)};
+  m.camera_pose.position_enu_m = {D(seed, 96), D(seed, 97), D(seed, 98)};
+  m.camera_pose.orientation_wxyz = {D(seed, 99), D(seed, 100), D(seed, 101), D(seed, 102)};
+  return m;
+}
+
 template <> ClockTick Full<ClockTick>(std::uint64_t seed) { return FullClockTick(seed); }
 template <> SensorSample Full<SensorSample>(std::uint64_t seed) { return FullSensorSample(seed); }
 template <> ActuatorCommand Full<ActuatorCommand>(std::uint64_t seed) {
@@ -282,5 +298,6 @@ template <> Event Full<Event>(std::uint64_t seed) { return FullEvent(seed); }
 template <> BrainInput Full<BrainInput>(std::uint64_t seed) { return FullBrainInput(seed); }
 template <> BrainOutput Full<BrainOutput>(std::uint64_t seed) { return FullBrainOutput(seed); }
 template <> Telemetry Full<Telemetry>(std::uint64_t seed) { return FullTelemetry(seed); }
+template <> DepthSummary Full<DepthSummary>(std::uint64_t seed) { return FullDepthSummary(seed); }
 
 }  // namespace swarmbox::bus::testing

@@ -28,6 +28,7 @@ Event FullEvent(std::uint64_t seed);
 BrainInput FullBrainInput(std::uint64_t seed);
 BrainOutput FullBrainOutput(std::uint64_t seed);
 Telemetry FullTelemetry(std::uint64_t seed);
+DepthSummary FullDepthSummary(std::uint64_t seed);
 
 // Overload set for generic tests: Full<T>(seed).
 template <typename T>
@@ -46,5 +47,6 @@ template <> Event Full<Event>(std::uint64_t seed);
 template <> BrainInput Full<BrainInput>(std::uint64_t seed);
 template <> BrainOutput Full<BrainOutput>(std::uint64_t seed);
 template <> Telemetry Full<Telemetry>(std::uint64_t seed);
+template <> DepthSummary Full<DepthSummary>(std::uint64_t seed);
 
 }  // namespace swarmbox::bus::testing

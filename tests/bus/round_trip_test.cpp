@@ -42,6 +42,7 @@ TEST_P(BusRoundTrip, BrainMessageArrivesIntact) { Check<BrainMessage>(8, std::st
 TEST_P(BusRoundTrip, BrainInputArrivesIntact) { Check<BrainInput>(1, OffboardInputTopic("drone_7"), Qos::kLockstep); }
 TEST_P(BusRoundTrip, BrainOutputArrivesIntact) { Check<BrainOutput>(2, OffboardOutputTopic("drone_7"), Qos::kLockstep); }
 TEST_P(BusRoundTrip, TelemetryArrivesIntact) { Check<Telemetry>(5, std::string(kTelemetryTopic), Qos::kState); }
+TEST_P(BusRoundTrip, DepthSummaryArrivesIntact) { Check<DepthSummary>(6, std::string(kDepthTopic), Qos::kState); }
 
 // A camera-sized image (320x240 mono8, 76,800 bytes of pixels) is fragmented on the wire by both
 // backends and must still arrive byte for byte.

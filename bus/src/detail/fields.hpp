@@ -59,6 +59,9 @@
   F(flock_alignment) F(flock_cohesion) F(flock_sum) F(raft_role) F(raft_term) F(raft_leader)      \
   F(raft_commit_index) F(battery_fraction) F(mission_stage) F(armed) F(landed) F(links)          \
   F(sectors) F(detections) F(events)
+#define SWARMBOX_BUS_FIELDS_DepthSummary(F)                                                    \
+  F(drone) F(capture_ns) F(sim_time_ns) F(fill_rate) F(median_m) F(near_p5_m) F(grid_cols)      \
+  F(grid_rows) F(grid_m) F(camera_pose)
 
 #define SWARMBOX_BUS_STRUCTS(S)                                                               \
   S(DroneState) S(RaftMessage) S(Detection) S(RadioPing) S(BrainMessage) S(RadioFrame)        \
@@ -66,10 +69,10 @@
   S(BatterySample) S(SensorSample) S(ActuatorCommand) S(CameraIntrinsics) S(Pose)             \
   S(CameraImage) S(KeyValue) S(Event) S(VehicleState) S(CommittedEntry) S(BrainInput)         \
   S(TrajectorySetpoint) S(VehicleCommand) S(Proposal) S(BrainOutput) S(TelemetryLink)        \
-  S(TelemetrySector) S(Telemetry)
+  S(TelemetrySector) S(Telemetry) S(DepthSummary)
 
 // The top-level message types (those with a MessageType), for dispatch.
 #define SWARMBOX_BUS_MESSAGES(M)                                                              \
   M(ClockTick) M(SensorSample) M(ActuatorCommand) M(CameraImage) M(WorldCommand)              \
   M(DroneState) M(RaftMessage) M(Detection) M(RadioPing) M(BrainMessage) M(Event)            \
-  M(BrainInput) M(BrainOutput) M(Telemetry)
+  M(BrainInput) M(BrainOutput) M(Telemetry) M(DepthSummary)

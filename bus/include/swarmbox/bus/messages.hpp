@@ -428,6 +428,25 @@ struct BrainOutput {
   bool operator==(const BrainOutput&) const = default;
 };
 
+// ---- sim domain, agents -> anyone: stereo depth (agent/depth, issue #23) -----------------------
+
+// One depth frame of the drone's stereo camera in a few numbers (swarmbox::depth::DepthSummary):
+// on kDepthTopic, keyed by drone, Qos::kState. Released by the agent the device's latency
+// (30-50 ms of simulated time) after the exposure.
+struct DepthSummary {
+  std::string drone;
+  std::int64_t capture_ns = 0;       // exposure (simulated time)
+  std::int64_t sim_time_ns = 0;      // release: capture_ns + the device's latency
+  double fill_rate = 0.0;            // share of pixels with depth [0, 1]
+  double median_m = 0.0;             // median depth over them (0: none)
+  double near_p5_m = 0.0;            // 5th percentile: the nearest surfaces
+  std::uint32_t grid_cols = 0;
+  std::uint32_t grid_rows = 0;
+  std::vector<double> grid_m;        // grid_rows x grid_cols median depths, row-major; 0 = none
+  Pose camera_pose;                  // left camera's optical frame at the exposure
+  bool operator==(const DepthSummary&) const = default;
+};
+
 // ---- type registry (used by the API to pick the backend's generated type) -----------------
 
 enum class MessageType : std::uint8_t {
@@ -445,8 +464,9 @@ enum class MessageType : std::uint8_t {
   kBrainInput,
   kBrainOutput,
   kTelemetry,
+  kDepthSummary,
 };
-inline constexpr int kMessageTypeCount = 14;
+inline constexpr int kMessageTypeCount = 15;
 
 // The DDS type name on the wire, e.g. "swarmbox::msg::SensorSample".
 std::string_view MessageTypeName(MessageType type);
@@ -473,6 +493,7 @@ SWARMBOX_BUS_MESSAGE_TRAITS(Event);
 SWARMBOX_BUS_MESSAGE_TRAITS(BrainInput);
 SWARMBOX_BUS_MESSAGE_TRAITS(BrainOutput);
 SWARMBOX_BUS_MESSAGE_TRAITS(Telemetry);
+SWARMBOX_BUS_MESSAGE_TRAITS(DepthSummary);
 #undef SWARMBOX_BUS_MESSAGE_TRAITS
 
 template <typename T>

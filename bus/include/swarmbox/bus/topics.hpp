@@ -15,6 +15,7 @@
 //   sim     sim/world_command          WorldCommand     kLockstep   orchestrator/tools -> physics
 //   sim     sim/status                 Event            kLockstep   physics -> all (the start, 1 Hz)
 //   sim     sim/telemetry              Telemetry        kState      every agent -> physics (keyed by drone; the recording)
+//   sim     sim/depth                  DepthSummary     kState      every agent -> anyone (keyed by drone; stereo depth)
 //   mesh    mesh/state                 DroneState       kState      agent -> agents (keyed by drone)
 //   mesh    mesh/raft                  RaftMessage      kRadio      agent -> agent `to`
 //   mesh    mesh/detection             Detection        kRadio      agent -> agents
@@ -66,6 +67,8 @@ inline constexpr std::string_view kSimStatusTopic = "sim/status";
 // Every agent's Telemetry for the physics server's recording (record/), keyed by drone; nothing
 // decides on it.
 inline constexpr std::string_view kTelemetryTopic = "sim/telemetry";
+// Every agent's stereo depth summaries (DepthSummary, keyed by drone; issue #23).
+inline constexpr std::string_view kDepthTopic = "sim/depth";
 inline constexpr std::string_view kDroneStateTopic = "mesh/state";
 inline constexpr std::string_view kRaftTopic = "mesh/raft";
 inline constexpr std::string_view kDetectionTopic = "mesh/detection";

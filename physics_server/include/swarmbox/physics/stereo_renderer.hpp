@@ -1,0 +1,70 @@
+// StereoRenderer: the OAK-D Pro's stereo pair (StereoSpec) over a StereoScene, ray-cast per pixel
+// so that each view sees the world from its own pose (parallax: a point at depth Z is
+// f * B / Z pixels further right in the left image than in the right one), with the IR dot
+// projector's pattern drawn into both views and the true depth of every left pixel.
+//
+//   StereoRenderer renderer(&scene);            // draws the projector's dot pattern once
+//   StereoFrame frame;
+//   renderer.Render(body_pose, spec, /*noise_seed=*/k, &frame);
+//   // frame.left / frame.right: CV_8U, rectified; frame.depth_truth_m: CV_32F (0: no surface)
+//
+// Image model, per pixel (one ray through its centre; 2 x 2 rays per pixel cost 4x and gave the
+// same depth errors, BENCHMARKS.md "stereo"): radiance = albedo * (ambient + projector), where ambient is the cell's
+// in-band irradiance (sun or shade, StereoScene) and projector = optical_power / (FOI solid angle
+// * d^2) * pattern, d the distance from the projector, pattern the dot field (mean 1 over the
+// field of illumination, 1/dot_fill on a dot, 0 between dots); nothing beyond range_m. Both
+// views share one auto-exposure (the left view's mean radiance to level 100, gain capped), then
+// Gaussian read noise (seeded, independent per view) and 8-bit clipping. So the dots fade with
+// the inverse square of the distance and drown in sunlight: the ambient sets the exposure, and a
+// dot a few per cent above it is a level or two, under the noise.
+// Not modelled: the projector's own occlusion (a dot lands wherever the camera's ray does),
+// shading by the surface normal, cast shadows within the height field, lens distortion.
+//
+// Pure: no clock; the same pose, spec and seed give the same images. Not thread-safe (scratch
+// buffers); one renderer per thread. Keeps a pointer to the scene, which must outlive it.
+#pragma once
+
+#include <cstdint>
+
+#include <opencv2/core.hpp>
+
+#include "swarmbox/physics/stereo_scene.hpp"
+#include "swarmbox/physics/stereo_spec.hpp"
+#include "swarmbox/physics/types.hpp"
+
+namespace swarmbox::physics {
+
+struct StereoFrame {
+  cv::Mat left;              // CV_8U, width_px x height_px, rectified
+  cv::Mat right;             // CV_8U
+  cv::Mat depth_truth_m;     // CV_32F: depth along the left optical axis; 0 where no surface
+  double focal_px = 0;       // both cameras
+  double cx_px = 0;
+  double cy_px = 0;
+  double baseline_m = 0;
+  Pose left_optical_pose;    // optical frame (x right, y down, z forward) -> world
+  double exposure_gain = 0;  // 8-bit levels per W/m^2 of (albedo-weighted) irradiance
+};
+
+class StereoRenderer {
+ public:
+  explicit StereoRenderer(const StereoScene* scene);
+
+  void Render(const Pose& body_pose, const StereoSpec& spec, std::uint64_t noise_seed, StereoFrame* out);
+
+ private:
+  // Radiance of each pixel of one view (and its depth when `depth` is set).
+  void CastView(const Vec3& centre, const double* r_wc, const StereoSpec& spec, const Vec3& projector,
+                cv::Mat* radiance, cv::Mat* depth);
+  void EnsurePattern(const ProjectorSpec& p);
+
+  const StereoScene* scene_;
+  cv::Mat pattern_;          // CV_32F dot field over tan-angle space, mean 1
+  double pattern_res_ = 0;   // tan units per pattern pixel
+  double pattern_tan_h_ = 0, pattern_tan_v_ = 0;
+  int pattern_dots_ = -1;
+  double pattern_fill_ = -1;
+  cv::Mat radiance_l_, radiance_r_, noise_;
+};
+
+}  // namespace swarmbox::physics

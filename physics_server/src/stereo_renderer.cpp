@@ -1,0 +1,177 @@
+#include "swarmbox/physics/stereo_renderer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+namespace swarmbox::physics {
+namespace {
+
+// Optical frame -> world rotation (row-major, columns = optical axes in world): optical
+// x = body -y, y = body -x, z = body -z, as the RGB camera (ground_renderer.cpp).
+std::array<double, 9> OpticalToWorld(const Quat& body) {
+  const Vec3 ex = Rotate(body, Vec3{0, -1, 0});
+  const Vec3 ey = Rotate(body, Vec3{-1, 0, 0});
+  const Vec3 ez = Rotate(body, Vec3{0, 0, -1});
+  return {ex.x, ey.x, ez.x, ex.y, ey.y, ez.y, ex.z, ey.z, ez.z};
+}
+
+Quat QuatOf(const std::array<double, 9>& m) {
+  const double tr = m[0] + m[4] + m[8];
+  if (tr > 0) {
+    const double s = std::sqrt(tr + 1.0) * 2;
+    return {0.25 * s, (m[7] - m[5]) / s, (m[2] - m[6]) / s, (m[3] - m[1]) / s};
+  }
+  if (m[0] > m[4] && m[0] > m[8]) {
+    const double s = std::sqrt(1.0 + m[0] - m[4] - m[8]) * 2;
+    return {(m[7] - m[5]) / s, 0.25 * s, (m[1] + m[3]) / s, (m[2] + m[6]) / s};
+  }
+  if (m[4] > m[8]) {
+    const double s = std::sqrt(1.0 + m[4] - m[0] - m[8]) * 2;
+    return {(m[2] - m[6]) / s, (m[1] + m[3]) / s, 0.25 * s, (m[5] + m[7]) / s};
+  }
+  const double s = std::sqrt(1.0 + m[8] - m[0] - m[4]) * 2;
+  return {(m[3] - m[1]) / s, (m[2] + m[6]) / s, (m[5] + m[7]) / s, 0.25 * s};
+}
+
+constexpr double kPatternTanPerPx = 0.001;  // pattern sampling: ~5 samples across a dot
+constexpr double kMaxGain = 400.0;          // auto-exposure limit [levels per W/m^2]
+constexpr double kTargetLevel = 100.0;      // auto-exposure target (mean level of the left view)
+constexpr float kSkyRadiance = 0.0f;        // rays that miss the ground (never, looking down)
+
+}  // namespace
+
+StereoRenderer::StereoRenderer(const StereoScene* scene) : scene_(scene) {}
+
+void StereoRenderer::EnsurePattern(const ProjectorSpec& p) {
+  if (pattern_dots_ == p.dot_count && pattern_fill_ == p.dot_fill && pattern_tan_h_ == std::tan(p.foi_h_rad / 2) &&
+      pattern_tan_v_ == std::tan(p.foi_v_rad / 2)) {
+    return;
+  }
+  pattern_tan_h_ = std::tan(p.foi_h_rad / 2);
+  pattern_tan_v_ = std::tan(p.foi_v_rad / 2);
+  pattern_res_ = kPatternTanPerPx;
+  const int w = static_cast<int>(std::ceil(2 * pattern_tan_h_ / pattern_res_));
+  const int h = static_cast<int>(std::ceil(2 * pattern_tan_v_ / pattern_res_));
+  cv::Mat dots = cv::Mat::zeros(h, w, CV_8U);
+  // Dot radius so that dot_count dots cover dot_fill of the field (in tan-angle area).
+  const double radius_px = std::sqrt(p.dot_fill * w * h / (p.dot_count * CV_PI));
+  cv::RNG rng(0xD075);  // the projector's fixed pattern (a diffractive element: one per device)
+  constexpr int kShift = 4;
+  for (int i = 0; i < p.dot_count; ++i) {
+    const cv::Point c(static_cast<int>(rng.uniform(0.0, double(w)) * (1 << kShift)),
+                      static_cast<int>(rng.uniform(0.0, double(h)) * (1 << kShift)));
+    cv::circle(dots, c, static_cast<int>(radius_px * (1 << kShift)), cv::Scalar(255), cv::FILLED, cv::LINE_AA, kShift);
+  }
+  dots.convertTo(pattern_, CV_32F);
+  const double mean = cv::mean(pattern_)[0];
+  pattern_ *= 1.0 / std::max(mean, 1e-9);
+  pattern_dots_ = p.dot_count;
+  pattern_fill_ = p.dot_fill;
+}
+
+void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoSpec& spec, const Vec3& projector,
+                              cv::Mat* radiance, cv::Mat* depth) {
+  const StereoScene& s = *scene_;
+  const int w = spec.width_px, h = spec.height_px;
+  const double f = spec.FocalPx(), cx = w / 2.0, cy = h / 2.0;
+  radiance->create(h, w, CV_32F);
+  if (depth != nullptr) depth->create(h, w, CV_32F);
+  const ProjectorSpec& p = spec.projector;
+  const bool dots = p.enabled && p.optical_power_w > 0;
+  // Irradiance of the pattern's mean at 1 m: power over the field's solid angle (a rectangle of
+  // tan half-widths a, b spans 4 asin(a b / sqrt((1 + a^2)(1 + b^2))) sr).
+  const double a = pattern_tan_h_, b = pattern_tan_v_;
+  const double solid_angle = 4 * std::asin(a * b / std::sqrt((1 + a * a) * (1 + b * b)));
+  const double e1 = dots ? p.optical_power_w / solid_angle : 0.0;
+  const double step_m = s.cell_m;
+  for (int v = 0; v < h; ++v) {
+    auto* rad = radiance->ptr<float>(v);
+    float* dep = depth != nullptr ? depth->ptr<float>(v) : nullptr;
+    for (int u = 0; u < w; ++u) {
+      // Ray: centre + t * d, with t the depth along the optical axis (d's optical z is 1).
+      const double xn = (u + 0.5 - cx) / f, yn = (v + 0.5 - cy) / f;
+      const Vec3 d{r[0] * xn + r[1] * yn + r[2], r[3] * xn + r[4] * yn + r[5], r[6] * xn + r[7] * yn + r[8]};
+      if (d.z > -1e-6) {
+        rad[u] = kSkyRadiance;
+        if (dep != nullptr) dep[u] = 0;
+        continue;
+      }
+      double t = std::max(0.05, (centre.z - s.max_height_m) / -d.z);
+      const double t_end = (centre.z - s.min_height_m) / -d.z + 1e-3;
+      const double dt = step_m / std::max(std::hypot(d.x, d.y), -d.z);
+      double prev_t = t, prev_f = 1.0;
+      bool hit = false;
+      for (; t <= t_end + dt; t += dt) {
+        const double tt = std::min(t, t_end);
+        const double fz = centre.z + tt * d.z - s.HeightAt(centre.x + tt * d.x, centre.y + tt * d.y);
+        if (fz <= 0) {
+          // Secant between the last point above and this one below the surface.
+          t = fz == prev_f ? tt : prev_t + (tt - prev_t) * prev_f / (prev_f - fz);
+          hit = true;
+          break;
+        }
+        prev_t = tt;
+        prev_f = fz;
+      }
+      if (!hit) t = t_end;
+      const Vec3 hp = centre + d * t;
+      const int col = std::clamp(static_cast<int>(std::lround((hp.x - s.origin_x_m) / s.cell_m)), 0, s.albedo.cols - 1);
+      const int row = std::clamp(static_cast<int>(std::lround((hp.y - s.origin_y_m) / s.cell_m)), 0, s.albedo.rows - 1);
+      double irr = s.ambient_w_m2.at<float>(row, col);
+      if (e1 > 0) {
+        const Vec3 q = hp - projector;
+        const double qx = r[0] * q.x + r[3] * q.y + r[6] * q.z;  // into the optical frame
+        const double qy = r[1] * q.x + r[4] * q.y + r[7] * q.z;
+        const double qz = r[2] * q.x + r[5] * q.y + r[8] * q.z;
+        const double dist2 = Dot(q, q);
+        if (qz > 0.05 && dist2 < p.range_m * p.range_m) {
+          const double px = (qx / qz + a) / pattern_res_ - 0.5, py = (qy / qz + b) / pattern_res_ - 0.5;
+          if (px >= 0 && py >= 0 && px < pattern_.cols - 1 && py < pattern_.rows - 1) {
+            const int ix = static_cast<int>(px), iy = static_cast<int>(py);
+            const float ax = static_cast<float>(px - ix), ay = static_cast<float>(py - iy);
+            const float* p0 = pattern_.ptr<float>(iy);
+            const float* p1 = pattern_.ptr<float>(iy + 1);
+            const double pat = (p0[ix] * (1 - ax) + p0[ix + 1] * ax) * (1 - ay) + (p1[ix] * (1 - ax) + p1[ix + 1] * ax) * ay;
+            irr += e1 * pat / dist2;
+          }
+        }
+      }
+      rad[u] = static_cast<float>(s.albedo.at<float>(row, col) * irr);
+      if (dep != nullptr) dep[u] = static_cast<float>(t);
+    }
+  }
+}
+
+void StereoRenderer::Render(const Pose& body_pose, const StereoSpec& spec, std::uint64_t noise_seed,
+                            StereoFrame* out) {
+  EnsurePattern(spec.projector);
+  const std::array<double, 9> r = OpticalToWorld(body_pose.attitude);
+  const Vec3 mid = body_pose.position_m + Rotate(body_pose.attitude, spec.offset_m);
+  const Vec3 ex{r[0], r[3], r[6]};  // optical x in world
+  const Vec3 left = mid - ex * (spec.baseline_m / 2), right = mid + ex * (spec.baseline_m / 2);
+  CastView(left, r.data(), spec, mid, &radiance_l_, &out->depth_truth_m);
+  CastView(right, r.data(), spec, mid, &radiance_r_, nullptr);
+
+  // One auto-exposure for both views (the device syncs them): the left view's mean to kTargetLevel.
+  const double mean = cv::mean(radiance_l_)[0];
+  const double gain = std::min(kMaxGain, kTargetLevel / std::max(mean, 1e-9));
+  cv::RNG rng(noise_seed);
+  for (auto [rad, img] : {std::pair{&radiance_l_, &out->left}, std::pair{&radiance_r_, &out->right}}) {
+    noise_.create(rad->size(), CV_32F);
+    rng.fill(noise_, cv::RNG::NORMAL, 0.0, spec.noise_std);
+    cv::Mat level = *rad * gain + noise_;
+    level.convertTo(*img, CV_8U);  // rounds and clips to 0..255
+  }
+  out->focal_px = spec.FocalPx();
+  out->cx_px = spec.width_px / 2.0;
+  out->cy_px = spec.height_px / 2.0;
+  out->baseline_m = spec.baseline_m;
+  out->exposure_gain = gain;
+  out->left_optical_pose.position_m = left;
+  out->left_optical_pose.attitude = QuatOf(r);
+}
+
+}  // namespace swarmbox::physics

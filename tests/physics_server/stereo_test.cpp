@@ -1,0 +1,186 @@
+// The stereo pair: the `stereo:` airframe key (ParseStereoSpec) and the ray-cast renderer's
+// parallax, truth depth and projector dots.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "swarmbox/physics/stereo_renderer.hpp"
+#include "swarmbox/physics/stereo_scene.hpp"
+#include "swarmbox/physics/stereo_spec.hpp"
+
+namespace swarmbox::physics {
+namespace {
+
+Result<StereoSpec> ParseText(const std::string& text) {
+  auto doc = yaml::Parse(text, "af.yaml");
+  if (!doc) return doc.error();
+  return ParseStereoSpec(doc->Find("stereo"));
+}
+
+TEST(StereoSpec, AbsentKeyIsOffAndCostsNothing) {
+  auto spec = ParseText("name: x\n");
+  ASSERT_TRUE(spec.ok()) << spec.error().ToString();
+  EXPECT_FALSE(spec->enabled);
+  auto null_spec = ParseStereoSpec(nullptr);
+  ASSERT_TRUE(null_spec.ok());
+  EXPECT_FALSE(null_spec->enabled);
+}
+
+TEST(StereoSpec, ReferenceFileIsTheOakDProDatasheet) {
+  auto doc = yaml::ParseFile(std::string(SWARMBOX_TRIALS_DIR) + "/sensors/oak_d_pro_stereo.yaml");
+  ASSERT_TRUE(doc.ok()) << doc.error().ToString();
+  auto spec = ParseStereoSpec(doc->Find("stereo"));
+  ASSERT_TRUE(spec.ok()) << spec.error().ToString();
+  EXPECT_TRUE(spec->enabled);
+  EXPECT_DOUBLE_EQ(spec->baseline_m, 0.075);  // REFERENCES.md 2.1 [C1]: 75 mm
+  EXPECT_EQ(spec->width_px, 640);             // 1280 x 800 halved
+  EXPECT_EQ(spec->height_px, 400);
+  // f = 882.5 px at 800P [C3], halved: 441 px within a pixel.
+  EXPECT_NEAR(spec->FocalPx(), 882.5 / 2, 1.0);
+  EXPECT_NEAR(spec->projector.foi_h_rad * 180 / M_PI, 78.0, 0.1);  // Belago1.1 FOI [C4]
+  EXPECT_NEAR(spec->projector.foi_v_rad * 180 / M_PI, 61.0, 0.1);
+  EXPECT_DOUBLE_EQ(spec->latency_min_ms, 30);
+  EXPECT_DOUBLE_EQ(spec->latency_max_ms, 50);
+}
+
+TEST(StereoSpec, EnabledFalseInsideTheMappingTurnsItOff) {
+  auto spec = ParseText("stereo: {enabled: false, baseline_m: 0.1}\n");
+  ASSERT_TRUE(spec.ok()) << spec.error().ToString();
+  EXPECT_FALSE(spec->enabled);
+  EXPECT_DOUBLE_EQ(spec->baseline_m, 0.1);
+}
+
+TEST(StereoSpec, ErrorsNameTheKeyAndWhere) {
+  struct Case {
+    const char* yaml;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"stereo: {baseline_m: -1}\n", "'baseline_m' must be > 0"},
+      {"stereo: {colour: true}\n", "colour"},
+      {"stereo: {num_disparities: 40}\n", "multiple of 16"},
+      {"stereo: {latency_min_ms: 50, latency_max_ms: 30}\n", "latency_max_ms must be >= latency_min_ms"},
+      {"stereo: {projector: {pattern: stripes}}\n", "pattern must be 'dots'"},
+      {"stereo: {projector: {dot_fill: 0.7}}\n", "dot_fill must be below 0.5"},
+      {"stereo: {width_px: 8}\n", "32..4096"},
+  };
+  for (const Case& c : cases) {
+    auto spec = ParseText(c.yaml);
+    ASSERT_FALSE(spec.ok()) << c.yaml;
+    EXPECT_NE(spec.error().ToString().find(c.message), std::string::npos) << spec.error().ToString();
+    EXPECT_NE(spec.error().ToString().find("af.yaml:1:"), std::string::npos) << spec.error().ToString();
+  }
+}
+
+// A dark flat ground with a bright 2 m x 2 m box 2 m tall at the origin and a bright 1 m patch
+// on the ground at y = -3 (image right), seen from 10 m straight down.
+class StereoParallax : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scene_ = MakeSurfaceScene(StereoSurface::kConcreteShade, 30.0, 1);
+    scene_.albedo.setTo(0.1);
+    AddBox(&scene_, {0, 0, 0}, {2, 2, 0}, 2.0, 0.9);
+    AddBox(&scene_, {0, -3, 0}, {1, 1, 0}, 0.0, 0.9);
+    spec_.enabled = true;
+    spec_.noise_std = 0;
+    spec_.offset_m = {0, 0, 0};
+    spec_.projector.enabled = false;
+    body_.position_m = {0, 0, 10};
+  }
+  // First column from `from` on the middle row where the image turns bright.
+  static double RisingEdge(const cv::Mat& img, int from) {
+    const int v = img.rows / 2;
+    for (int u = from; u < img.cols; ++u) {
+      if (img.at<std::uint8_t>(v, u) > 128) return u;
+    }
+    return -1;
+  }
+  StereoScene scene_;
+  StereoSpec spec_;
+  Pose body_;
+};
+
+TEST_F(StereoParallax, ABoxShiftsByFocalTimesBaselineOverItsDepth) {
+  spec_.baseline_m = 0.5;  // a wide baseline so the disparities are tens of pixels
+  StereoRenderer renderer(&scene_);
+  StereoFrame frame;
+  renderer.Render(body_, spec_, 1, &frame);
+  const double f = spec_.FocalPx();
+  // The box top is 8 m away, the ground 10 m.
+  EXPECT_NEAR(frame.depth_truth_m.at<float>(spec_.height_px / 2, spec_.width_px / 2), 8.0, 0.02);
+  EXPECT_NEAR(frame.depth_truth_m.at<float>(5, 5), 10.0, 0.02);
+  const double box_l = RisingEdge(frame.left, 0), box_r = RisingEdge(frame.right, 0);
+  ASSERT_GT(box_l, 0);
+  ASSERT_GT(box_r, 0);
+  EXPECT_NEAR(box_l - box_r, f * spec_.baseline_m / 8.0, 1.5);  // 27.6 px
+  // The patch on the ground (right of the box) shifts less: 22.1 px.
+  const double patch_l = RisingEdge(frame.left, spec_.width_px / 2 + 120);
+  const double patch_r = RisingEdge(frame.right, spec_.width_px / 2 + 100);
+  ASSERT_GT(patch_l, 0);
+  ASSERT_GT(patch_r, 0);
+  // (Each view's edge is whole pixels: the difference is within +-1 px, plus the 5 cm cells.)
+  EXPECT_NEAR(patch_l - patch_r, f * spec_.baseline_m / 10.0, 1.5);
+}
+
+TEST_F(StereoParallax, TheOakBaselineGivesSubPixelDisparitiesFarAway) {
+  StereoRenderer renderer(&scene_);
+  StereoFrame frame;
+  renderer.Render(body_, spec_, 1, &frame);
+  EXPECT_NEAR(frame.baseline_m, 0.075, 1e-12);
+  // 441 px * 0.075 m / 8 m = 4.1 px: the edges move by 4 or 5 whole pixels.
+  const double shift = RisingEdge(frame.left, 0) - RisingEdge(frame.right, 0);
+  EXPECT_GE(shift, 3);
+  EXPECT_LE(shift, 5);
+}
+
+// Mean absolute difference of the two views of a textureless slab in shade: the projector's dots
+// make them differ from a flat grey, more near than far, and the sun drowns them.
+double DotContrast(StereoSurface surface, double range_m, bool projector) {
+  StereoScene scene = MakeSurfaceScene(surface, 40.0, 3);
+  StereoSpec spec;
+  spec.enabled = true;
+  spec.noise_std = 0;
+  spec.projector.enabled = projector;
+  Pose body;
+  body.position_m = {0, 0, range_m + scene.max_height_m};
+  StereoRenderer renderer(&scene);
+  StereoFrame frame;
+  renderer.Render(body, spec, 1, &frame);
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(frame.left, mean, stddev);
+  return stddev[0] / std::max(1.0, mean[0]);
+}
+
+TEST(StereoRenderer, DotsFadeWithDistanceAndDrownInSunlight) {
+  const double shade_off = DotContrast(StereoSurface::kConcreteShade, 5, false);
+  const double shade_near = DotContrast(StereoSurface::kConcreteShade, 3, true);
+  const double shade_far = DotContrast(StereoSurface::kConcreteShade, 15, true);
+  const double sun_near = DotContrast(StereoSurface::kSandSun, 3, true);
+  EXPECT_LT(shade_off, 0.03);           // the slab alone: a 1 % ripple
+  // At 3 m a dot is ~0.49 W/m^2 (0.3 W / (1.37 sr * 9 m^2 * 0.05)), 80 % of the shade's 0.6
+  // W/m^2, on 5 % of the pixels: a relative std of ~0.18 (0.8 * sqrt(0.05)).
+  EXPECT_GT(shade_near, 0.08);
+  EXPECT_GT(shade_near, 3 * shade_far);  // inverse square
+  EXPECT_LT(sun_near, shade_near / 4);   // full sun is ~20x the shade's ambient
+}
+
+TEST(StereoRenderer, SameSeedSameImages) {
+  StereoScene scene = MakeSurfaceScene(StereoSurface::kRubble, 20.0, 5);
+  StereoSpec spec;
+  spec.enabled = true;
+  Pose body;
+  body.position_m = {1, 2, 6};
+  body.attitude = Quat::FromYaw(0.4);
+  StereoRenderer renderer(&scene);
+  StereoFrame a, b;
+  renderer.Render(body, spec, 9, &a);
+  renderer.Render(body, spec, 9, &b);
+  EXPECT_EQ(cv::norm(a.left, b.left, cv::NORM_L1), 0.0);
+  EXPECT_EQ(cv::norm(a.right, b.right, cv::NORM_L1), 0.0);
+  renderer.Render(body, spec, 10, &b);
+  EXPECT_GT(cv::norm(a.left, b.left, cv::NORM_L1), 0.0);  // another noise draw
+}
+
+}  // namespace
+}  // namespace swarmbox::physics
