@@ -3,13 +3,13 @@
 #include <cmath>
 #include <numbers>
 
-#include "detail/yaml_read.hpp"
+#include "swarmbox/airframe/yaml_read.hpp"
 
 namespace swarmbox::physics {
 namespace {
 
-using detail::Checked;
-using detail::Nested;
+using airframe::detail::Checked;
+using airframe::detail::Nested;
 using yaml::MapReader;
 using yaml::Node;
 
