@@ -441,10 +441,21 @@ Status SimServer::ReportJoining(bool done) {
   return transport_.PublishStatus(status, done);
 }
 
+// Waits until `deadline_ns` at most (not at all when it has passed) for the awaited answers and
+// hands each accepted one to the step.
+void SimServer::TakeAnswers(std::int64_t deadline_ns) {
+  inbox_.clear();
+  transport_.WaitActuators(deadline_ns, std::max<std::size_t>(1, lockstep_.awaited()), &inbox_);
+  for (ActuatorInput& cmd : inbox_) {
+    const std::optional<std::size_t> i = world_.FindDrone(cmd.drone);
+    if (!i) continue;
+    if (lockstep_.OnCommand(*i, cmd.step, clock_.NowNs()) != Lockstep::Answer::kAccepted) continue;
+    Accept(*i, cmd);
+  }
+}
+
 Status SimServer::RunStep(const std::atomic<bool>& stop) {
   const std::uint64_t step = world_.step_count();
-  lockstep_.BeginStep(step, clock_.NowNs());
-  if (step == 0) joining_.Begin(clock_.NowNs());
   if (channel_) TakeDeliveries(world_.time_ns());
   for (std::size_t i = 0; i < world_.drone_count(); ++i) {
     if (lockstep_.out(i)) continue;
@@ -459,6 +470,11 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   if (auto s = transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf); !s) {
     return s;
   }
+  // The step starts for the lockstep once its samples are out: rendering and publishing the
+  // cameras (a 640 x 360 frame is 691 kB) can take a while on a loaded host, and no agent can
+  // answer before it has its sample, so that time does not count against the drones.
+  lockstep_.BeginStep(step, clock_.NowNs());
+  if (step == 0) joining_.Begin(clock_.NowNs());
   constexpr std::int64_t kPollNs = 20'000'000;        // re-check `stop` at least this often
   // While a step waits, every drone's sample is sent again at this period: unanswered ones for
   // late joiners and lost messages (the lockstep QoS is volatile; an unanswered drone gets its
@@ -469,6 +485,10 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
   std::int64_t last_publish = clock_.NowNs();
   while (!stop.load()) {
     const std::int64_t now = clock_.NowNs();
+    // A server that was itself held up past a deadline (descheduled, a slow publish) takes the
+    // answers that arrived meanwhile before it judges anyone lost: otherwise its own stall would
+    // mark every drone lost at once.
+    if (now >= lockstep_.NextDeadlineNs()) TakeAnswers(now);
     if (lockstep_.StepComplete(now)) break;
     if (joining_.Due(now)) {
       if (auto s = ReportJoining(/*done=*/false); !s) return s;
@@ -480,15 +500,7 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
         if (auto s = PublishDrone(i, /*with_camera=*/!lockstep_.answered(i)); !s) return s;
       }
     }
-    inbox_.clear();
-    transport_.WaitActuators(std::min(lockstep_.NextDeadlineNs(), now + kPollNs), std::max<std::size_t>(1, lockstep_.awaited()),
-                             &inbox_);
-    for (ActuatorInput& cmd : inbox_) {
-      const std::optional<std::size_t> i = world_.FindDrone(cmd.drone);
-      if (!i) continue;
-      if (lockstep_.OnCommand(*i, cmd.step, clock_.NowNs()) != Lockstep::Answer::kAccepted) continue;
-      Accept(*i, cmd);
-    }
+    TakeAnswers(std::min(lockstep_.NextDeadlineNs(), now + kPollNs));
   }
   for (std::size_t i : lockstep_.TakeNewlyLost()) world_.SetLost(i, true);
   if (stop.load()) return Ok{};

@@ -222,6 +222,7 @@ class SimServer {
   };
   Status PublishDrone(std::size_t i, bool with_camera);
   void Accept(std::size_t i, ActuatorInput& cmd);
+  void TakeAnswers(std::int64_t deadline_ns);
   void ApplyAnswers();
   void RunSchedule(std::int64_t now_ns);
   void CarryOut(const PlanEntry& e);

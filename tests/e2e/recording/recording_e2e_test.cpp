@@ -149,7 +149,9 @@ class RecordingE2e : public ::testing::Test {
 };
 
 TEST_F(RecordingE2e, SarSearchRecordingMatchesTruthAndEvents) {
-  const fs::path trial = Run("20s", {});
+  // 30 simulated s: the scouts climb for about 17 s before they fly out to their sectors, and the
+  // page check wants them to have moved across the map by 75 % of the recording.
+  const fs::path trial = Run("30s", {});
   const fs::path mcap = trial / "recording.mcap";
   ASSERT_TRUE(fs::exists(mcap)) << "no recording in " << trial;
 

@@ -170,7 +170,9 @@ TEST_F(PrivilegeE2e, ADroneOverItsMemoryLimitIsReportedAsOomKilled) {
   auto run = RunTrialSpec(spec, *api_, clock, options_);
   ASSERT_TRUE(run) << run.error().ToString();
   EXPECT_EQ(run->result.verdict.outcome, dsl::Outcome::kFailure) << run->result.verdict.ToString();
-  EXPECT_EQ(run->result.verdict.reason, "scout_1 was killed for lack of memory");
+  // The cause first; when the physics server reported the start before the kill, the drones that
+  // did not join follow it ("; drones that did not join: ..."), which depends on timing.
+  EXPECT_THAT(run->result.verdict.reason, ::testing::StartsWith("scout_1 was killed for lack of memory"));
   auto doc = yaml::ParseFile((fs::path(run->trial_dir) / "result.json").string());
   ASSERT_TRUE(doc) << doc.error().ToString();
   const yaml::Node* oom = doc->Find("oom_killed");

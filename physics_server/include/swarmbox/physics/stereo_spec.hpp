@@ -11,7 +11,7 @@
 // offset_m - baseline/2 along optical x, the right one at +baseline/2, so the pair is rectified
 // by construction: a point at depth Z shows at u_left - u_right = f * baseline / Z.
 // The projector sits at offset_m, oriented like the cameras. Figures and their sources: the
-// reference file trials/airframes/oak_d_pro_stereo.yaml and physics_server/README.md "Stereo".
+// reference file trials/sensors/oak_d_pro_stereo.yaml and physics_server/README.md "Stereo".
 #pragma once
 
 #include <string>
