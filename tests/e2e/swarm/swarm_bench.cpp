@@ -54,6 +54,15 @@ int RunSwarmBench(const bench::Args& args) {
   const std::vector<int> sizes = ParseSizes(args.Get("drones", args.quick ? "3" : "10,50,100"));
   const double sim_s = args.GetDouble("sim-s", args.quick ? 10.0 : 60.0);
   const bool keep = args.options.count("keep") > 0;
+  // --record=off runs the trials with `record: {enabled: false}`: the pair of runs gives what the
+  // recording costs the physics server at each size (physics_cpu with and without).
+  const std::string record = args.Get("record", "on");
+  if (record != "on" && record != "off") {
+    std::fprintf(stderr, "swarm bench: --record=%s: on or off\n", record.c_str());
+    return 2;
+  }
+  std::vector<std::string> sets;
+  if (record == "off") sets.push_back("record.enabled=false");
   const std::string out =
       args.Get("out", (std::filesystem::temp_directory_path() / "swarmbox-bench-swarm").string());
   if (sizes.empty()) {
@@ -73,7 +82,7 @@ int RunSwarmBench(const bench::Args& args) {
   }
   int failures = 0;
   for (int n : sizes) {
-    auto spec = swarm::LoadSwarmTrial(n, sim_s);
+    auto spec = swarm::LoadSwarmTrial(n, sim_s, sets);
     if (!spec) {
       std::fprintf(stderr, "swarm bench: %s\n", spec.error().ToString().c_str());
       return 1;
@@ -109,5 +118,5 @@ int RunSwarmBench(const bench::Args& args) {
 
 }  // namespace
 
-SWARMBOX_BENCH_SUITE(swarm, "the SAR swarm in containers at several sizes: rtf, CPU and memory per drone",
+SWARMBOX_BENCH_SUITE(swarm, "the SAR swarm in containers at several sizes: rtf, CPU and memory per drone (--drones=10,50,100 --sim-s=60 --record=on|off --keep --out=DIR)",
                      RunSwarmBench);
