@@ -1,7 +1,8 @@
 // StereoSpec: the active stereo depth camera of a scout (Luxonis OAK-D Pro): two global-shutter
 // mono cameras a baseline apart looking down, and an IR dot projector between them. Read from the
-// airframe's `stereo:` mapping by ParseStereoSpec (its own function: the airframe parser calls it
-// for that one key). Absent key: `enabled == false`, nothing is rendered or matched.
+// `stereo:` mapping by ParseStereoSpec (the bench and tests call it on trials/sensors/
+// oak_d_pro_stereo.yaml; the airframe library does not read the key yet and rejects it, see
+// ARCHITECTURE.md "Planned"). Absent key: `enabled == false`, nothing is rendered or matched.
 //
 //   auto spec = ParseStereoSpec(root.Find("stereo"));   // nullptr or null node: disabled
 //   if (!spec) return spec.error();                     // file:line:col: stereo: ...
