@@ -5,7 +5,6 @@
 
 #include "swarmbox/raft/detail/byte_io.hpp"
 #include "swarmbox/raft/detail/mission_io.hpp"
-#include "swarmbox/raft/detail/overloaded.hpp"
 
 namespace swarmbox::raft {
 
@@ -40,8 +39,6 @@ std::string_view CandidateStatusName(CandidateStatus status) {
 }
 
 namespace {
-
-using detail::Overloaded;
 
 bool Finite(double v) { return std::isfinite(v); }
 
@@ -190,153 +187,180 @@ ApplyResult MissionState::ApplyEncoded(std::uint64_t index, std::span<const std:
 ApplyResult MissionState::Apply(std::uint64_t index, const MissionCommand& command) {
   SWARMBOX_CHECK(index > applied_index_);
   applied_index_ = index;
-  const MissionPhase phase = phase_;
-  const bool active = phase == MissionPhase::kSearch || phase == MissionPhase::kConverge ||
-                      phase == MissionPhase::kRescue;
-  const std::string in_phase = std::string(" in phase ") + std::string(PhaseName(phase));
+  return std::visit([this](const auto& c) { return Handle(c); }, command);
+}
+
+// --- one handler per command: each checks the phase, then the command, then applies it -----------
+
+bool MissionState::Active() const {
+  return phase_ == MissionPhase::kSearch || phase_ == MissionPhase::kConverge ||
+         phase_ == MissionPhase::kRescue;
+}
+
+std::string MissionState::InPhase() const {
+  return std::string(" in phase ") + std::string(PhaseName(phase_));
+}
+
+ApplyResult MissionState::Accepted() {
   ApplyResult r;
   r.accepted = true;
-  return std::visit(
-      Overloaded{
-          [&](const StartSearch&) -> ApplyResult {
-            if (phase != MissionPhase::kIdle) return Reject("cannot start search" + in_phase);
-            SetPhase(MissionPhase::kSearch, &r);
-            return r;
-          },
-          [&](const AssignSectors& c) -> ApplyResult {
-            if (phase == MissionPhase::kComplete) return Reject("cannot assign sectors" + in_phase);
-            for (const Sector& s : c.sectors) {
-              if (s.drone.empty()) return Reject("sector without a drone");
-              if (!Finite(s.x_min_m) || !Finite(s.y_min_m) || !Finite(s.x_max_m) ||
-                  !Finite(s.y_max_m) || s.x_min_m >= s.x_max_m || s.y_min_m >= s.y_max_m) {
-                return Reject("sector of " + s.drone + " is not a rectangle with min < max");
-              }
-            }
-            sectors_ = c.sectors;
-            return r;
-          },
-          [&](const ReportSighting& c) -> ApplyResult {
-            if (!active) return Reject("sighting ignored" + in_phase);
-            return ApplySighting(c);
-          },
-          [&](const ConfirmVictim& c) -> ApplyResult {
-            if (!active) return Reject("cannot confirm a victim" + in_phase);
-            if (!Finite(c.x_m) || !Finite(c.y_m)) return Reject("victim position is not finite");
-            if (Victim* v = NearVictim(c.x_m, c.y_m)) {
-              return Reject("victim " + std::to_string(v->id) + " is already confirmed there");
-            }
-            AddVictim(c.x_m, c.y_m, {c.by}, &r);
-            return r;
-          },
-          [&](const ConvergeOn& c) -> ApplyResult {
-            if (phase != MissionPhase::kSearch && phase != MissionPhase::kConverge) {
-              return Reject("cannot converge" + in_phase);
-            }
-            const Victim* v = FindVictim(c.victim_id);
-            if (!v) return Reject("no victim " + std::to_string(c.victim_id));
-            if (v->status != VictimStatus::kConfirmed) {
-              return Reject("victim " + std::to_string(c.victim_id) + " is " +
-                            std::string(VictimStatusName(v->status)));
-            }
-            target_victim_ = c.victim_id;
-            SetPhase(MissionPhase::kConverge, &r);
-            return r;
-          },
-          [&](const BeginRescue& c) -> ApplyResult {
-            if (phase != MissionPhase::kConverge || target_victim_ != c.victim_id) {
-              return Reject("cannot begin rescue of victim " + std::to_string(c.victim_id) +
-                            in_phase + " (target " + std::to_string(target_victim_) + ")");
-            }
-            if (c.lifter.empty()) return Reject("rescue without a lifter");
-            Victim* v = nullptr;
-            for (Victim& x : victims_) {
-              if (x.id == c.victim_id) v = &x;
-            }
-            SWARMBOX_CHECK(v != nullptr);  // the target is always a known victim
-            v->status = VictimStatus::kBeingRescued;
-            v->rescuer = c.lifter;
-            SetPhase(MissionPhase::kRescue, &r);
-            r.events.push_back(
-                VictimEvent(MissionEvent::Kind::kVictimStatus, phase_, applied_index_, *v));
-            return r;
-          },
-          [&](const MarkRescued& c) -> ApplyResult {
-            if (phase != MissionPhase::kRescue || target_victim_ != c.victim_id) {
-              return Reject("victim " + std::to_string(c.victim_id) + " is not being rescued" +
-                            in_phase);
-            }
-            Victim* v = nullptr;
-            for (Victim& x : victims_) {
-              if (x.id == c.victim_id) v = &x;
-            }
-            SWARMBOX_CHECK(v != nullptr);
-            v->status = VictimStatus::kRescued;
-            target_victim_ = 0;
-            r.events.push_back(
-                VictimEvent(MissionEvent::Kind::kVictimStatus, phase_, applied_index_, *v));
-            SetPhase(MissionPhase::kSearch, &r);
-            return r;
-          },
-          [&](const ReturnHome&) -> ApplyResult {
-            if (!active) return Reject("cannot return home" + in_phase);
-            target_victim_ = 0;
-            SetPhase(MissionPhase::kReturn, &r);
-            return r;
-          },
-          [&](const CompleteMission&) -> ApplyResult {
-            if (phase != MissionPhase::kReturn) return Reject("cannot complete" + in_phase);
-            SetPhase(MissionPhase::kComplete, &r);
-            return r;
-          },
-          [&](const ReportMiss& c) -> ApplyResult {
-            if (!active) return Reject("miss ignored" + in_phase);
-            return ApplyMiss(c);
-          },
-          [&](const RequestRevisit& c) -> ApplyResult {
-            if (!active) return Reject("cannot request a revisit" + in_phase);
-            if (c.drone.empty() || !Finite(c.t_s)) return Reject("revisit without a drone or a time");
-            Candidate* k = MutableCandidate(c.candidate);
-            if (k == nullptr || k->status != CandidateStatus::kPending) {
-              return Reject("no pending candidate " + std::to_string(c.candidate));
-            }
-            k->revisit_drone = c.drone;
-            k->revisit_t_s = c.t_s;
-            return r;
-          },
-          [&](const ConfirmSighting& c) -> ApplyResult {
-            if (!active) return Reject("cannot confirm a sighting" + in_phase);
-            if (!Finite(c.belief) || c.belief < 0 || c.belief > 1) return Reject("belief outside [0, 1]");
-            Candidate* k = MutableCandidate(c.candidate);
-            if (k == nullptr || k->status == CandidateStatus::kConfirmed) {
-              return Reject("no undecided candidate " + std::to_string(c.candidate));
-            }
-            if (Victim* v = NearVictim(k->x_m, k->y_m)) {
-              return Reject("victim " + std::to_string(v->id) + " is already confirmed there");
-            }
-            std::vector<std::string> by;
-            for (const SightingView& e : k->views) {
-              if (e.detected && std::find(by.begin(), by.end(), e.reporter) == by.end()) by.push_back(e.reporter);
-            }
-            k->status = CandidateStatus::kConfirmed;
-            k->revisit_drone.clear();
-            k->belief = c.belief;
-            k->victim_id = AddVictim(k->x_m, k->y_m, std::move(by), &r).id;
-            return r;
-          },
-          [&](const RejectSighting& c) -> ApplyResult {
-            if (!active) return Reject("cannot reject a sighting" + in_phase);
-            if (!Finite(c.belief) || c.belief < 0 || c.belief > 1) return Reject("belief outside [0, 1]");
-            Candidate* k = MutableCandidate(c.candidate);
-            if (k == nullptr || k->status != CandidateStatus::kPending) {
-              return Reject("no pending candidate " + std::to_string(c.candidate));
-            }
-            k->status = CandidateStatus::kRejected;
-            k->revisit_drone.clear();
-            k->belief = c.belief;
-            return r;
-          },
-      },
-      command);
+  return r;
+}
+
+Victim& MissionState::MutableVictim(std::uint32_t id) {
+  Victim* v = nullptr;
+  for (Victim& x : victims_) {
+    if (x.id == id) v = &x;
+  }
+  SWARMBOX_CHECK(v != nullptr);  // the target is always a known victim
+  return *v;
+}
+
+ApplyResult MissionState::Handle(const StartSearch&) {
+  if (phase_ != MissionPhase::kIdle) return Reject("cannot start search" + InPhase());
+  ApplyResult r = Accepted();
+  SetPhase(MissionPhase::kSearch, &r);
+  return r;
+}
+
+ApplyResult MissionState::Handle(const AssignSectors& c) {
+  if (phase_ == MissionPhase::kComplete) return Reject("cannot assign sectors" + InPhase());
+  for (const Sector& s : c.sectors) {
+    if (s.drone.empty()) return Reject("sector without a drone");
+    if (!Finite(s.x_min_m) || !Finite(s.y_min_m) || !Finite(s.x_max_m) || !Finite(s.y_max_m) ||
+        s.x_min_m >= s.x_max_m || s.y_min_m >= s.y_max_m) {
+      return Reject("sector of " + s.drone + " is not a rectangle with min < max");
+    }
+  }
+  sectors_ = c.sectors;
+  return Accepted();
+}
+
+ApplyResult MissionState::Handle(const ReportSighting& c) {
+  if (!Active()) return Reject("sighting ignored" + InPhase());
+  return ApplySighting(c);
+}
+
+ApplyResult MissionState::Handle(const ConfirmVictim& c) {
+  if (!Active()) return Reject("cannot confirm a victim" + InPhase());
+  if (!Finite(c.x_m) || !Finite(c.y_m)) return Reject("victim position is not finite");
+  if (Victim* v = NearVictim(c.x_m, c.y_m)) {
+    return Reject("victim " + std::to_string(v->id) + " is already confirmed there");
+  }
+  ApplyResult r = Accepted();
+  AddVictim(c.x_m, c.y_m, {c.by}, &r);
+  return r;
+}
+
+ApplyResult MissionState::Handle(const ConvergeOn& c) {
+  if (phase_ != MissionPhase::kSearch && phase_ != MissionPhase::kConverge) {
+    return Reject("cannot converge" + InPhase());
+  }
+  const Victim* v = FindVictim(c.victim_id);
+  if (!v) return Reject("no victim " + std::to_string(c.victim_id));
+  if (v->status != VictimStatus::kConfirmed) {
+    return Reject("victim " + std::to_string(c.victim_id) + " is " +
+                  std::string(VictimStatusName(v->status)));
+  }
+  target_victim_ = c.victim_id;
+  ApplyResult r = Accepted();
+  SetPhase(MissionPhase::kConverge, &r);
+  return r;
+}
+
+ApplyResult MissionState::Handle(const BeginRescue& c) {
+  if (phase_ != MissionPhase::kConverge || target_victim_ != c.victim_id) {
+    return Reject("cannot begin rescue of victim " + std::to_string(c.victim_id) + InPhase() +
+                  " (target " + std::to_string(target_victim_) + ")");
+  }
+  if (c.lifter.empty()) return Reject("rescue without a lifter");
+  Victim& v = MutableVictim(c.victim_id);
+  v.status = VictimStatus::kBeingRescued;
+  v.rescuer = c.lifter;
+  ApplyResult r = Accepted();
+  SetPhase(MissionPhase::kRescue, &r);
+  r.events.push_back(VictimEvent(MissionEvent::Kind::kVictimStatus, phase_, applied_index_, v));
+  return r;
+}
+
+ApplyResult MissionState::Handle(const MarkRescued& c) {
+  if (phase_ != MissionPhase::kRescue || target_victim_ != c.victim_id) {
+    return Reject("victim " + std::to_string(c.victim_id) + " is not being rescued" + InPhase());
+  }
+  Victim& v = MutableVictim(c.victim_id);
+  v.status = VictimStatus::kRescued;
+  target_victim_ = 0;
+  ApplyResult r = Accepted();
+  r.events.push_back(VictimEvent(MissionEvent::Kind::kVictimStatus, phase_, applied_index_, v));
+  SetPhase(MissionPhase::kSearch, &r);
+  return r;
+}
+
+ApplyResult MissionState::Handle(const ReturnHome&) {
+  if (!Active()) return Reject("cannot return home" + InPhase());
+  target_victim_ = 0;
+  ApplyResult r = Accepted();
+  SetPhase(MissionPhase::kReturn, &r);
+  return r;
+}
+
+ApplyResult MissionState::Handle(const CompleteMission&) {
+  if (phase_ != MissionPhase::kReturn) return Reject("cannot complete" + InPhase());
+  ApplyResult r = Accepted();
+  SetPhase(MissionPhase::kComplete, &r);
+  return r;
+}
+
+ApplyResult MissionState::Handle(const ReportMiss& c) {
+  if (!Active()) return Reject("miss ignored" + InPhase());
+  return ApplyMiss(c);
+}
+
+ApplyResult MissionState::Handle(const RequestRevisit& c) {
+  if (!Active()) return Reject("cannot request a revisit" + InPhase());
+  if (c.drone.empty() || !Finite(c.t_s)) return Reject("revisit without a drone or a time");
+  Candidate* k = MutableCandidate(c.candidate);
+  if (k == nullptr || k->status != CandidateStatus::kPending) {
+    return Reject("no pending candidate " + std::to_string(c.candidate));
+  }
+  k->revisit_drone = c.drone;
+  k->revisit_t_s = c.t_s;
+  return Accepted();
+}
+
+ApplyResult MissionState::Handle(const ConfirmSighting& c) {
+  if (!Active()) return Reject("cannot confirm a sighting" + InPhase());
+  if (!Finite(c.belief) || c.belief < 0 || c.belief > 1) return Reject("belief outside [0, 1]");
+  Candidate* k = MutableCandidate(c.candidate);
+  if (k == nullptr || k->status == CandidateStatus::kConfirmed) {
+    return Reject("no undecided candidate " + std::to_string(c.candidate));
+  }
+  if (Victim* v = NearVictim(k->x_m, k->y_m)) {
+    return Reject("victim " + std::to_string(v->id) + " is already confirmed there");
+  }
+  std::vector<std::string> by;
+  for (const SightingView& e : k->views) {
+    if (e.detected && std::find(by.begin(), by.end(), e.reporter) == by.end()) by.push_back(e.reporter);
+  }
+  k->status = CandidateStatus::kConfirmed;
+  k->revisit_drone.clear();
+  k->belief = c.belief;
+  ApplyResult r = Accepted();
+  k->victim_id = AddVictim(k->x_m, k->y_m, std::move(by), &r).id;
+  return r;
+}
+
+ApplyResult MissionState::Handle(const RejectSighting& c) {
+  if (!Active()) return Reject("cannot reject a sighting" + InPhase());
+  if (!Finite(c.belief) || c.belief < 0 || c.belief > 1) return Reject("belief outside [0, 1]");
+  Candidate* k = MutableCandidate(c.candidate);
+  if (k == nullptr || k->status != CandidateStatus::kPending) {
+    return Reject("no pending candidate " + std::to_string(c.candidate));
+  }
+  k->status = CandidateStatus::kRejected;
+  k->revisit_drone.clear();
+  k->belief = c.belief;
+  return Accepted();
 }
 
 ApplyResult MissionState::ApplySighting(const ReportSighting& c) {
@@ -364,21 +388,23 @@ ApplyResult MissionState::ApplySighting(const ReportSighting& c) {
     return Reject("candidate " + std::to_string(k->id) + " holds " + std::to_string(kMaxViews) + " views");
   }
   last_seq_[c.reporter] = c.seq;
-  if (k == nullptr) {
-    if (candidates_.size() >= kMaxCandidates) {
-      auto old = std::find_if(candidates_.begin(), candidates_.end(),
-                              [](const Candidate& x) { return x.status != CandidateStatus::kPending; });
-      candidates_.erase(old != candidates_.end() ? old : candidates_.begin());
-    }
-    Candidate fresh;
-    fresh.id = next_candidate_id_++;
-    fresh.x_m = c.x_m;
-    fresh.y_m = c.y_m;
-    candidates_.push_back(std::move(fresh));
-    k = &candidates_.back();
-  }
+  if (k == nullptr) k = &NewCandidate(c.x_m, c.y_m);
   AddView(*k, std::move(view));
   return r;
+}
+
+Candidate& MissionState::NewCandidate(double x_m, double y_m) {
+  if (candidates_.size() >= kMaxCandidates) {
+    auto old = std::find_if(candidates_.begin(), candidates_.end(),
+                            [](const Candidate& x) { return x.status != CandidateStatus::kPending; });
+    candidates_.erase(old != candidates_.end() ? old : candidates_.begin());
+  }
+  Candidate fresh;
+  fresh.id = next_candidate_id_++;
+  fresh.x_m = x_m;
+  fresh.y_m = y_m;
+  candidates_.push_back(std::move(fresh));
+  return candidates_.back();
 }
 
 ApplyResult MissionState::ApplyMiss(const ReportMiss& c) {
@@ -404,6 +430,90 @@ ApplyResult MissionState::ApplyMiss(const ReportMiss& c) {
 
 // --- snapshot ------------------------------------------------------------------------------------
 
+namespace {
+
+void WriteCandidate(detail::ByteWriter& w, const Candidate& c) {
+  w.Varint(c.id);
+  w.F64(c.x_m);
+  w.F64(c.y_m);
+  w.U8(static_cast<std::uint8_t>(c.status));
+  w.Str(c.revisit_drone);
+  w.F64(c.revisit_t_s);
+  w.Varint(c.revisits);
+  w.Varint(c.victim_id);
+  w.F64(c.belief);
+  w.Varint(c.views.size());
+  for (const SightingView& v : c.views) {
+    detail::WriteSighting(w, v);
+    w.U8(v.detected ? 1 : 0);
+  }
+}
+
+void WriteVictim(detail::ByteWriter& w, const Victim& v) {
+  w.Varint(v.id);
+  w.F64(v.x_m);
+  w.F64(v.y_m);
+  w.U8(static_cast<std::uint8_t>(v.status));
+  w.Str(v.rescuer);
+  w.Varint(v.confirmed_by.size());
+  for (const std::string& b : v.confirmed_by) w.Str(b);
+}
+
+// A varint that must fit 32 bits; a larger one latches "<what> out of range" in `r`.
+std::uint32_t ReadU32(detail::ByteReader& r, const char* what) {
+  const std::uint64_t v = r.Varint();
+  if (v > UINT32_MAX) r.Fail(std::string(what) + " out of range");
+  return static_cast<std::uint32_t>(v);
+}
+
+// An enum byte no larger than `last`; a larger one sets *invalid to "invalid <what> <byte>".
+template <class E>
+E ReadEnum(detail::ByteReader& r, E last, const char* what, std::string* invalid) {
+  const std::uint8_t v = r.U8();
+  if (r.ok() && v > static_cast<std::uint8_t>(last)) {
+    *invalid = std::string("invalid ") + what + " " + std::to_string(v);
+  }
+  return static_cast<E>(v);
+}
+
+// Stops after the status when it is invalid (*invalid is then set).
+Candidate ReadCandidate(detail::ByteReader& r, std::string* invalid) {
+  Candidate c;
+  c.id = ReadU32(r, "candidate id");
+  c.x_m = r.F64();
+  c.y_m = r.F64();
+  c.status = ReadEnum(r, CandidateStatus::kRejected, "candidate status", invalid);
+  if (!invalid->empty()) return c;
+  c.revisit_drone = r.Str();
+  c.revisit_t_s = r.F64();
+  c.revisits = ReadU32(r, "revisits");
+  c.victim_id = ReadU32(r, "candidate victim");
+  c.belief = r.F64();
+  const std::uint64_t nv = r.Count(59, "view");
+  for (std::uint64_t j = 0; j < nv && r.ok(); ++j) {
+    SightingView v = detail::ReadSighting<SightingView>(r);
+    v.detected = r.U8() != 0;
+    c.views.push_back(std::move(v));
+  }
+  return c;
+}
+
+// Stops after the status when it is invalid (*invalid is then set).
+Victim ReadVictim(detail::ByteReader& r, std::string* invalid) {
+  Victim v;
+  v.id = ReadU32(r, "victim id");
+  v.x_m = r.F64();
+  v.y_m = r.F64();
+  v.status = ReadEnum(r, VictimStatus::kRescued, "victim status", invalid);
+  if (!invalid->empty()) return v;
+  v.rescuer = r.Str();
+  const std::uint64_t nb = r.Count(1, "confirmer");
+  for (std::uint64_t b = 0; b < nb && r.ok(); ++b) v.confirmed_by.push_back(r.Str());
+  return v;
+}
+
+}  // namespace
+
 Bytes MissionState::EncodeSnapshot() const {
   Bytes out;
   detail::ByteWriter w(&out);
@@ -420,32 +530,9 @@ Bytes MissionState::EncodeSnapshot() const {
   }
   w.Varint(next_candidate_id_);
   w.Varint(candidates_.size());
-  for (const Candidate& c : candidates_) {
-    w.Varint(c.id);
-    w.F64(c.x_m);
-    w.F64(c.y_m);
-    w.U8(static_cast<std::uint8_t>(c.status));
-    w.Str(c.revisit_drone);
-    w.F64(c.revisit_t_s);
-    w.Varint(c.revisits);
-    w.Varint(c.victim_id);
-    w.F64(c.belief);
-    w.Varint(c.views.size());
-    for (const SightingView& v : c.views) {
-      detail::WriteSighting(w, v);
-      w.U8(v.detected ? 1 : 0);
-    }
-  }
+  for (const Candidate& c : candidates_) WriteCandidate(w, c);
   w.Varint(victims_.size());
-  for (const Victim& v : victims_) {
-    w.Varint(v.id);
-    w.F64(v.x_m);
-    w.F64(v.y_m);
-    w.U8(static_cast<std::uint8_t>(v.status));
-    w.Str(v.rescuer);
-    w.Varint(v.confirmed_by.size());
-    for (const std::string& b : v.confirmed_by) w.Str(b);
-  }
+  for (const Victim& v : victims_) WriteVictim(w, v);
   return out;
 }
 
@@ -459,65 +546,30 @@ Result<MissionState> MissionState::DecodeSnapshot(std::span<const std::uint8_t> 
   if (version != kSnapshotVersion) {
     return fail("unsupported snapshot version " + std::to_string(version));
   }
-  auto u32 = [&r](const char* what) {
-    const std::uint64_t v = r.Varint();
-    if (v > UINT32_MAX) r.Fail(std::string(what) + " out of range");
-    return static_cast<std::uint32_t>(v);
-  };
   MissionState m;
+  std::string invalid;  // an enum byte out of range (ReadEnum)
   m.applied_index_ = r.Varint();
-  const std::uint8_t phase = r.U8();
-  if (r.ok() && phase > static_cast<std::uint8_t>(MissionPhase::kComplete)) {
-    return fail("invalid phase " + std::to_string(phase));
-  }
-  m.phase_ = static_cast<MissionPhase>(phase);
-  m.target_victim_ = u32("target victim");
-  m.next_victim_id_ = u32("next victim id");
+  m.phase_ = ReadEnum(r, MissionPhase::kComplete, "phase", &invalid);
+  if (!invalid.empty()) return fail(invalid);
+  m.target_victim_ = ReadU32(r, "target victim");
+  m.next_victim_id_ = ReadU32(r, "next victim id");
   m.sectors_ = detail::ReadSectors(r);
   std::uint64_t n = r.Count(2, "reporter");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
     std::string reporter = r.Str();
     m.last_seq_[reporter] = r.Varint();
   }
-  m.next_candidate_id_ = u32("next candidate id");
+  m.next_candidate_id_ = ReadU32(r, "next candidate id");
   n = r.Count(38, "candidate");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-    Candidate c;
-    c.id = u32("candidate id");
-    c.x_m = r.F64();
-    c.y_m = r.F64();
-    const std::uint8_t status = r.U8();
-    if (r.ok() && status > static_cast<std::uint8_t>(CandidateStatus::kRejected)) {
-      return fail("invalid candidate status " + std::to_string(status));
-    }
-    c.status = static_cast<CandidateStatus>(status);
-    c.revisit_drone = r.Str();
-    c.revisit_t_s = r.F64();
-    c.revisits = u32("revisits");
-    c.victim_id = u32("candidate victim");
-    c.belief = r.F64();
-    const std::uint64_t nv = r.Count(59, "view");
-    for (std::uint64_t j = 0; j < nv && r.ok(); ++j) {
-      SightingView v = detail::ReadSighting<SightingView>(r);
-      v.detected = r.U8() != 0;
-      c.views.push_back(std::move(v));
-    }
+    Candidate c = ReadCandidate(r, &invalid);
+    if (!invalid.empty()) return fail(invalid);
     m.candidates_.push_back(std::move(c));
   }
   n = r.Count(20, "victim");
   for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-    Victim v;
-    v.id = u32("victim id");
-    v.x_m = r.F64();
-    v.y_m = r.F64();
-    const std::uint8_t status = r.U8();
-    if (r.ok() && status > static_cast<std::uint8_t>(VictimStatus::kRescued)) {
-      return fail("invalid victim status " + std::to_string(status));
-    }
-    v.status = static_cast<VictimStatus>(status);
-    v.rescuer = r.Str();
-    const std::uint64_t nb = r.Count(1, "confirmer");
-    for (std::uint64_t b = 0; b < nb && r.ok(); ++b) v.confirmed_by.push_back(r.Str());
+    Victim v = ReadVictim(r, &invalid);
+    if (!invalid.empty()) return fail(invalid);
     m.victims_.push_back(std::move(v));
   }
   if (!r.ok()) return fail(r.error());

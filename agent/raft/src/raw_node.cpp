@@ -75,8 +75,11 @@ RawNode::RawNode(const Config& config) : config_(config) {
   rng_state_ = config.seed ^ (0x9E3779B97F4A7C15ULL * config.id);
 }
 
-Result<RawNode> RawNode::Create(const Config& config, PersistentState state) {
-  if (auto s = config.Validate(); !s) return s.error();
+namespace {
+
+// The stored state a node may start from: entries contiguous after the snapshot, the commit
+// within them, the term not below the last entry's.
+Status CheckPersistentState(const PersistentState& state) {
   const std::uint64_t snap_index = state.snapshot.index;
   for (std::size_t k = 0; k < state.entries.size(); ++k) {
     if (state.entries[k].index != snap_index + 1 + k) {
@@ -88,7 +91,7 @@ Result<RawNode> RawNode::Create(const Config& config, PersistentState state) {
     }
   }
   const std::uint64_t last = snap_index + state.entries.size();
-  const HardState hs = state.hard_state;
+  const HardState& hs = state.hard_state;
   if (hs.commit > last) {
     return Error(ErrorCode::kInvalidArgument,
                  "stored commit " + std::to_string(hs.commit) + " is beyond the last stored index " +
@@ -102,6 +105,16 @@ Result<RawNode> RawNode::Create(const Config& config, PersistentState state) {
                      std::to_string(last_term),
                  "raft state");
   }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<RawNode> RawNode::Create(const Config& config, PersistentState state) {
+  if (auto s = config.Validate(); !s) return s.error();
+  if (auto s = CheckPersistentState(state); !s) return s.error();
+  const std::uint64_t snap_index = state.snapshot.index;
+  const HardState hs = state.hard_state;
   RawNode node(config);
   if (!state.snapshot.conf.empty()) {
     // The membership at the snapshot; the committed changes after it re-apply with the entries.
@@ -359,100 +372,29 @@ Status RawNode::ProposeConfChange(const ConfChange& change) {
   return Ok{};
 }
 
+// Step follows etcd-io/raft's raft.Step: check the message, settle the term (Raft §5.1), answer
+// the messages every role handles (a campaign, a vote request), then step by role, one handler
+// per message type.
 Status RawNode::Step(const Message& m) {
   SWARMBOX_CHECK(!ready_outstanding_);
-  const bool local = IsLocalMessage(m.type);
-  if (!local && m.type != MessageType::kProp) {
-    if (!known_.count(m.from) || m.from == config_.id) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "message " + std::string(MessageTypeName(m.type)) + " from unknown node " +
-                       std::to_string(m.from),
-                   "raft step");
-    }
-  }
-  if (!local && m.type != MessageType::kProp && m.term == 0) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "message " + std::string(MessageTypeName(m.type)) + " without a term", "raft step");
-  }
-  if (local || m.type == MessageType::kProp) {
+  if (auto s = CheckMessage(m); !s) return s;
+  if (IsLocalMessage(m.type) || m.type == MessageType::kProp) {
     // Local messages and proposals carry no term.
   } else if (m.term > term_) {
-    if (m.type == MessageType::kVote || m.type == MessageType::kPreVote) {
-      // thesis §4.2.3 / §6.2: while we hear from a leader within the minimum election timeout,
-      // ignore (pre-)votes, so a node cut off and rejoining cannot depose a healthy leader.
-      const bool in_lease = config_.check_quorum && lead_ != kNoNode &&
-                            election_elapsed_ < config_.election_ticks;
-      if (in_lease) return Ok{};
-    }
-    if (m.type == MessageType::kPreVote) {
-      // thesis §9.6: never change our term in response to a PreVote.
-    } else if (m.type == MessageType::kPreVoteResp && !m.reject) {
-      // A granted pre-vote carries the future term we asked for: not a reason to step down.
-    } else {
-      // Raft §5.1: a higher term makes us a follower of that term.
-      const bool from_leader = m.type == MessageType::kApp || m.type == MessageType::kHeartbeat ||
-                               m.type == MessageType::kSnap;
-      BecomeFollower(m.term, from_leader ? m.from : kNoNode);
-    }
+    if (!StepHigherTerm(m)) return Ok{};
   } else if (m.term < term_) {
-    if ((config_.check_quorum || config_.pre_vote) &&
-        (m.type == MessageType::kHeartbeat || m.type == MessageType::kApp)) {
-      // A stale leader (e.g. rejoining after a partition) would never learn of the new term if
-      // we stayed silent, since PreVote keeps our term from reaching it through elections: answer
-      // with our term so it steps down (etcd-io/raft).
-      Message r;
-      r.type = MessageType::kAppResp;
-      r.to = m.from;
-      Send(std::move(r));
-    } else if (m.type == MessageType::kPreVote) {
-      Message r;
-      r.type = MessageType::kPreVoteResp;
-      r.to = m.from;
-      r.term = term_;
-      r.reject = true;
-      Send(std::move(r));
-    }
-    // Raft §5.1: otherwise a stale-term request is ignored.
+    StepLowerTerm(m);
     return Ok{};
   }
-
   switch (m.type) {
     case MessageType::kHup:
       // Only a voter campaigns (etcd's promotable()): learners and removed nodes never do.
       if (role_ != Role::kLeader && is_voter()) StartCampaign(config_.pre_vote);
       return Ok{};
     case MessageType::kVote:
-    case MessageType::kPreVote: {
-      // Raft §5.2: one vote per term, first come first served; §5.4.1: only for a log at least as
-      // up-to-date as ours. A pre-vote for a future term does not bind us.
-      const bool can_vote = vote_ == m.from || (vote_ == kNoNode && lead_ == kNoNode) ||
-                            (m.type == MessageType::kPreVote && m.term > term_);
-      Message r;
-      r.type = m.type == MessageType::kVote ? MessageType::kVoteResp : MessageType::kPreVoteResp;
-      r.to = m.from;
-      if (can_vote && log_.IsUpToDate(m.index, m.log_term)) {
-        r.term = m.term;
-        if (m.type == MessageType::kVote) {
-          election_elapsed_ = 0;
-          vote_ = m.from;
-        }
-      } else {
-        r.term = term_;
-        r.reject = true;
-      }
-      Send(std::move(r));
-      // Pre-candidate yield (a SwarmBox addition, not in etcd-io/raft): on a slow radio
-      // (round trip ~ 200 ms) the pre-vote round lets followers whose timers fired within ~100 ms
-      // of each other all reach the real election and split the vote. A pre-candidate that hears
-      // the pre-vote of a better one (more up-to-date log, ties broken by the higher id) steps
-      // back and restarts its timer. Only timing changes: no term, vote or log does.
-      if (m.type == MessageType::kPreVote && role_ == Role::kPreCandidate && !r.reject &&
-          std::tuple(m.log_term, m.index, m.from) >
-              std::tuple(log_.last_term(), log_.last_index(), config_.id)) {
-        BecomeFollower(term_, kNoNode);
-      }
+    case MessageType::kPreVote:
+      HandleVoteRequest(m);
       return Ok{};
-    }
     default:
       break;
   }
@@ -472,22 +414,102 @@ Status RawNode::Step(const Message& m) {
   return Ok{};
 }
 
+Status RawNode::CheckMessage(const Message& m) const {
+  if (IsLocalMessage(m.type) || m.type == MessageType::kProp) return Ok{};
+  if (!known_.count(m.from) || m.from == config_.id) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "message " + std::string(MessageTypeName(m.type)) + " from unknown node " +
+                     std::to_string(m.from),
+                 "raft step");
+  }
+  if (m.term == 0) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "message " + std::string(MessageTypeName(m.type)) + " without a term", "raft step");
+  }
+  return Ok{};
+}
+
+bool RawNode::StepHigherTerm(const Message& m) {
+  if (m.type == MessageType::kVote || m.type == MessageType::kPreVote) {
+    // thesis §4.2.3 / §6.2: while we hear from a leader within the minimum election timeout,
+    // ignore (pre-)votes, so a node cut off and rejoining cannot depose a healthy leader.
+    const bool in_lease = config_.check_quorum && lead_ != kNoNode &&
+                          election_elapsed_ < config_.election_ticks;
+    if (in_lease) return false;
+  }
+  if (m.type == MessageType::kPreVote) {
+    // thesis §9.6: never change our term in response to a PreVote.
+  } else if (m.type == MessageType::kPreVoteResp && !m.reject) {
+    // A granted pre-vote carries the future term we asked for: not a reason to step down.
+  } else {
+    // Raft §5.1: a higher term makes us a follower of that term.
+    const bool from_leader = m.type == MessageType::kApp || m.type == MessageType::kHeartbeat ||
+                             m.type == MessageType::kSnap;
+    BecomeFollower(m.term, from_leader ? m.from : kNoNode);
+  }
+  return true;
+}
+
+void RawNode::StepLowerTerm(const Message& m) {
+  if ((config_.check_quorum || config_.pre_vote) &&
+      (m.type == MessageType::kHeartbeat || m.type == MessageType::kApp)) {
+    // A stale leader (e.g. rejoining after a partition) would never learn of the new term if
+    // we stayed silent, since PreVote keeps our term from reaching it through elections: answer
+    // with our term so it steps down (etcd-io/raft).
+    Message r;
+    r.type = MessageType::kAppResp;
+    r.to = m.from;
+    Send(std::move(r));
+  } else if (m.type == MessageType::kPreVote) {
+    Message r;
+    r.type = MessageType::kPreVoteResp;
+    r.to = m.from;
+    r.term = term_;
+    r.reject = true;
+    Send(std::move(r));
+  }
+  // Raft §5.1: otherwise a stale-term request is ignored.
+}
+
+void RawNode::HandleVoteRequest(const Message& m) {
+  // Raft §5.2: one vote per term, first come first served; §5.4.1: only for a log at least as
+  // up-to-date as ours. A pre-vote for a future term does not bind us.
+  const bool can_vote = vote_ == m.from || (vote_ == kNoNode && lead_ == kNoNode) ||
+                        (m.type == MessageType::kPreVote && m.term > term_);
+  Message r;
+  r.type = m.type == MessageType::kVote ? MessageType::kVoteResp : MessageType::kPreVoteResp;
+  r.to = m.from;
+  if (can_vote && log_.IsUpToDate(m.index, m.log_term)) {
+    r.term = m.term;
+    if (m.type == MessageType::kVote) {
+      election_elapsed_ = 0;
+      vote_ = m.from;
+    }
+  } else {
+    r.term = term_;
+    r.reject = true;
+  }
+  Send(std::move(r));
+  // Pre-candidate yield (a SwarmBox addition, not in etcd-io/raft): on a slow radio
+  // (round trip ~ 200 ms) the pre-vote round lets followers whose timers fired within ~100 ms
+  // of each other all reach the real election and split the vote. A pre-candidate that hears
+  // the pre-vote of a better one (more up-to-date log, ties broken by the higher id) steps
+  // back and restarts its timer. Only timing changes: no term, vote or log does.
+  if (m.type == MessageType::kPreVote && role_ == Role::kPreCandidate && !r.reject &&
+      std::tuple(m.log_term, m.index, m.from) >
+          std::tuple(log_.last_term(), log_.last_index(), config_.id)) {
+    BecomeFollower(term_, kNoNode);
+  }
+}
+
 void RawNode::StepLeader(const Message& m) {
   switch (m.type) {
     case MessageType::kBeat:
       BcastHeartbeat();
       return;
-    case MessageType::kCheckQuorum: {
-      // thesis §6.2: a leader that has not heard from a quorum in an election timeout steps down,
-      // so clients (and the mission) stop waiting on a leader that cannot commit.
-      std::size_t active = 0;
-      for (auto& [id, pr] : progress_) {
-        if (IsVoter(conf_, id) && (id == config_.id || pr.recent_active)) ++active;
-        if (id != config_.id) pr.recent_active = false;
-      }
-      if (active < Quorum()) BecomeFollower(term_, kNoNode);
+    case MessageType::kCheckQuorum:
+      CheckQuorum();
       return;
-    }
     case MessageType::kProp: {
       std::vector<Entry> entries = m.entries;
       for (Entry& e : entries) e.type = EntryType::kNormal;
@@ -500,58 +522,69 @@ void RawNode::StepLeader(const Message& m) {
   }
   auto it = progress_.find(m.from);
   if (it == progress_.end()) return;
-  Progress& pr = it->second;
-  switch (m.type) {
-    case MessageType::kAppResp: {
-      pr.recent_active = true;
-      pr.inactive_ticks = 0;
-      pr.heard = true;
-      if (m.reject) {
-        // Raft §5.3: after a rejection, decrement nextIndex and retry (faster with the hint).
-        if (pr.MaybeDecrTo(m.index, m.reject_hint)) {
-          if (pr.state == Progress::State::kReplicate) pr.BecomeProbe();
-          SendAppend(m.from);
-        }
-        return;
-      }
-      const bool was_paused = pr.IsPaused();
-      if (!pr.MaybeUpdate(m.index)) return;
-      if (pr.state == Progress::State::kProbe) {
-        pr.BecomeReplicate();
-      } else if (pr.state == Progress::State::kSnapshot && pr.match >= pr.pending_snapshot) {
-        pr.BecomeProbe();
-        pr.BecomeReplicate();
-      }
-      const bool committed = MaybeCommit();
-      if (committed) {
-        BcastAppend();  // tell followers the new commit index
-      }
-      // Learner pacing: a learner less than one full message behind waits for its next slot;
-      // one further behind (restarted, new) catches up at the pace of its own answers.
-      if (IsLearner(conf_, m.from) &&
-          log_.last_index() - progress_[m.from].match < config_.max_entries_per_msg) {
-        return;
-      }
-      if (was_paused && !committed) SendAppend(m.from);
-      // Keep the pipeline full while the follower lags behind.
-      while (progress_[m.from].next <= log_.last_index() && SendAppend(m.from)) {
-        if (progress_[m.from].state != Progress::State::kReplicate) break;
-      }
-      return;
-    }
-    case MessageType::kHeartbeatResp: {
-      pr.recent_active = true;
-      pr.inactive_ticks = 0;
-      pr.heard = true;
-      pr.probe_sent = false;
-      // The follower is alive: if an InstallSnapshot was lost, try again.
-      if (pr.state == Progress::State::kSnapshot && pr.match < pr.pending_snapshot) pr.BecomeProbe();
-      if (pr.match < log_.last_index()) SendAppend(m.from);
-      return;
-    }
-    default:
-      return;
+  if (m.type == MessageType::kAppResp) {
+    HandleAppendResponse(it->second, m);
+  } else if (m.type == MessageType::kHeartbeatResp) {
+    HandleHeartbeatResponse(it->second, m);
   }
+}
+
+void RawNode::CheckQuorum() {
+  // thesis §6.2: a leader that has not heard from a quorum in an election timeout steps down,
+  // so clients (and the mission) stop waiting on a leader that cannot commit.
+  std::size_t active = 0;
+  for (auto& [id, pr] : progress_) {
+    if (IsVoter(conf_, id) && (id == config_.id || pr.recent_active)) ++active;
+    if (id != config_.id) pr.recent_active = false;
+  }
+  if (active < Quorum()) BecomeFollower(term_, kNoNode);
+}
+
+void RawNode::HandleAppendResponse(Progress& pr, const Message& m) {
+  pr.recent_active = true;
+  pr.inactive_ticks = 0;
+  pr.heard = true;
+  if (m.reject) {
+    // Raft §5.3: after a rejection, decrement nextIndex and retry (faster with the hint).
+    if (pr.MaybeDecrTo(m.index, m.reject_hint)) {
+      if (pr.state == Progress::State::kReplicate) pr.BecomeProbe();
+      SendAppend(m.from);
+    }
+    return;
+  }
+  const bool was_paused = pr.IsPaused();
+  if (!pr.MaybeUpdate(m.index)) return;
+  if (pr.state == Progress::State::kProbe) {
+    pr.BecomeReplicate();
+  } else if (pr.state == Progress::State::kSnapshot && pr.match >= pr.pending_snapshot) {
+    pr.BecomeProbe();
+    pr.BecomeReplicate();
+  }
+  const bool committed = MaybeCommit();
+  if (committed) {
+    BcastAppend();  // tell followers the new commit index
+  }
+  // Learner pacing: a learner less than one full message behind waits for its next slot;
+  // one further behind (restarted, new) catches up at the pace of its own answers.
+  if (IsLearner(conf_, m.from) &&
+      log_.last_index() - progress_[m.from].match < config_.max_entries_per_msg) {
+    return;
+  }
+  if (was_paused && !committed) SendAppend(m.from);
+  // Keep the pipeline full while the follower lags behind.
+  while (progress_[m.from].next <= log_.last_index() && SendAppend(m.from)) {
+    if (progress_[m.from].state != Progress::State::kReplicate) break;
+  }
+}
+
+void RawNode::HandleHeartbeatResponse(Progress& pr, const Message& m) {
+  pr.recent_active = true;
+  pr.inactive_ticks = 0;
+  pr.heard = true;
+  pr.probe_sent = false;
+  // The follower is alive: if an InstallSnapshot was lost, try again.
+  if (pr.state == Progress::State::kSnapshot && pr.match < pr.pending_snapshot) pr.BecomeProbe();
+  if (pr.match < log_.last_index()) SendAppend(m.from);
 }
 
 Status RawNode::StepCandidate(const Message& m) {
@@ -576,24 +609,26 @@ Status RawNode::StepCandidate(const Message& m) {
     default:
       break;
   }
-  if (m.type == my_resp) {
-    switch (Poll(m.from, !m.reject)) {
-      case VoteResult::kWon:
-        if (role_ == Role::kPreCandidate) {
-          StartCampaign(false);
-        } else {
-          BecomeLeader();
-          BcastAppend();
-        }
-        break;
-      case VoteResult::kLost:
-        BecomeFollower(term_, kNoNode);
-        break;
-      case VoteResult::kPending:
-        break;
-    }
-  }
+  if (m.type == my_resp) HandleVoteResponse(m);
   return Ok{};
+}
+
+void RawNode::HandleVoteResponse(const Message& m) {
+  switch (Poll(m.from, !m.reject)) {
+    case VoteResult::kWon:
+      if (role_ == Role::kPreCandidate) {
+        StartCampaign(false);
+      } else {
+        BecomeLeader();
+        BcastAppend();
+      }
+      break;
+    case VoteResult::kLost:
+      BecomeFollower(term_, kNoNode);
+      break;
+    case VoteResult::kPending:
+      break;
+  }
 }
 
 Status RawNode::StepFollower(const Message& m) {

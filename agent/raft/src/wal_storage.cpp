@@ -82,6 +82,101 @@ bool PutEntry(PersistentState* st, Entry e) {
   return true;
 }
 
+// The snapshot file: one framed record (written atomically: any damage is corruption).
+Result<Snapshot> ParseSnapshotFile(const Bytes& bytes, const std::string& path) {
+  detail::ByteReader r(bytes);
+  const std::uint32_t len = r.Fixed32();
+  const std::uint32_t crc = r.Fixed32();
+  if (!r.ok() || len != r.remaining()) {
+    return Error(ErrorCode::kProtocol, "corrupt snapshot file (bad length)", path);
+  }
+  std::span<const std::uint8_t> payload(bytes.data() + 8, len);
+  if (Crc32(payload) != crc) {
+    return Error(ErrorCode::kProtocol, "corrupt snapshot file (crc mismatch)", path);
+  }
+  detail::ByteReader p(payload);
+  Snapshot snapshot;
+  snapshot.index = p.Varint();
+  snapshot.term = p.Varint();
+  snapshot.data = p.Blob();
+  // The membership at the snapshot; absent in files written before membership changes.
+  if (p.ok() && !p.at_end()) detail::ReadConfState(p, &snapshot.conf);
+  if (!p.ok() || !p.at_end() || snapshot.index == 0) {
+    return Error(ErrorCode::kProtocol, "corrupt snapshot file: " + p.error(), path);
+  }
+  return snapshot;
+}
+
+// The payload of the WAL record framed at `pos`, or nullopt when the rest of the file is a write
+// torn by a crash (too short, or a bad crc on the last record); a damaged record followed by more
+// records is corruption.
+using Frame = std::optional<std::span<const std::uint8_t>>;  // nullopt: a torn write
+Result<Frame> ReadFrame(const Bytes& data, std::size_t pos, const std::string& path) {
+  const std::size_t left = data.size() - pos;
+  if (left < 8) return Frame{};
+  detail::ByteReader h(std::span<const std::uint8_t>(data.data() + pos, 8));
+  const std::uint32_t len = h.Fixed32();
+  const std::uint32_t crc = h.Fixed32();
+  if (len > WalStorage::kMaxRecordBytes) {
+    return Error(ErrorCode::kProtocol,
+                 "corrupt record at byte " + std::to_string(pos) + " (length " +
+                     std::to_string(len) + ")",
+                 path);
+  }
+  if (len > left - 8) return Frame{};
+  std::span<const std::uint8_t> payload(data.data() + pos + 8, len);
+  if (Crc32(payload) != crc) {
+    if (pos + 8 + len == data.size()) return Frame{};
+    return Error(ErrorCode::kProtocol,
+                 "corrupt record at byte " + std::to_string(pos) +
+                     " (crc mismatch) followed by more records: not a torn write",
+                 path);
+  }
+  return Frame(payload);
+}
+
+// Replays one record of kind `kind` (already read from `p`) into the log being rebuilt; false
+// when the record is invalid there (a bad entry type, a gap, a base record that is not first).
+bool ReplayRecord(detail::ByteReader& p, std::uint8_t kind, std::size_t record,
+                  PersistentState* st) {
+  if (kind == kHardStateRecord) {
+    st->hard_state.term = p.Varint();
+    st->hard_state.vote = p.Varint();
+    st->hard_state.commit = p.Varint();
+    return true;
+  }
+  if (kind == kEntryRecord) {
+    Entry e;
+    e.term = p.Varint();
+    e.index = p.Varint();
+    const std::uint8_t t = p.U8();
+    e.type = static_cast<EntryType>(t <= kMaxEntryType ? t : 0);
+    e.data = p.Blob();
+    return t <= kMaxEntryType && p.ok() && PutEntry(st, std::move(e));
+  }
+  if (kind == kBaseRecord) {
+    st->snapshot.index = p.Varint();
+    st->snapshot.term = p.Varint();
+    return record == 0;
+  }
+  return false;
+}
+
+// Drops the rebuilt log's entries up to the snapshot file's index; keeps the ones after it only
+// when the entry at the snapshot's index has the snapshot's term.
+void TrimToSnapshot(const Snapshot& file_snapshot, PersistentState* st) {
+  if (file_snapshot.index <= st->snapshot.index) return;
+  const std::uint64_t base = st->snapshot.index;
+  const std::uint64_t last = base + st->entries.size();
+  std::vector<Entry> rest;
+  if (file_snapshot.index < last &&
+      st->entries[file_snapshot.index - base - 1].term == file_snapshot.term) {
+    rest.assign(st->entries.begin() + static_cast<std::ptrdiff_t>(file_snapshot.index - base),
+                st->entries.end());
+  }
+  st->entries = std::move(rest);
+}
+
 }  // namespace
 
 WalStorage::WalStorage(FileSystem& fs, std::string dir)
@@ -97,146 +192,84 @@ Result<std::unique_ptr<WalStorage>> WalStorage::Open(FileSystem& fs, std::string
   return w;
 }
 
+// Recover reads the segments (the snapshot file, then the WAL), checks them, and replays the WAL
+// onto the snapshot: read, replay, reconcile.
 Status WalStorage::Recover() {
-  // 1. The snapshot file (written atomically: any damage is corruption).
+  // 1. The snapshot file.
   auto snap_bytes = fs_.ReadFile(snapshot_path_);
   if (!snap_bytes && snap_bytes.error().code() != ErrorCode::kNotFound) return snap_bytes.error();
+  Snapshot file_snapshot;
   if (snap_bytes) {
-    detail::ByteReader r(*snap_bytes);
-    const std::uint32_t len = r.Fixed32();
-    const std::uint32_t crc = r.Fixed32();
-    if (!r.ok() || len != r.remaining()) {
-      return Error(ErrorCode::kProtocol, "corrupt snapshot file (bad length)", snapshot_path_);
-    }
-    std::span<const std::uint8_t> payload(snap_bytes->data() + 8, len);
-    if (Crc32(payload) != crc) {
-      return Error(ErrorCode::kProtocol, "corrupt snapshot file (crc mismatch)", snapshot_path_);
-    }
-    detail::ByteReader p(payload);
-    state_.snapshot.index = p.Varint();
-    state_.snapshot.term = p.Varint();
-    state_.snapshot.data = p.Blob();
-    // The membership at the snapshot; absent in files written before membership changes.
-    if (p.ok() && !p.at_end()) detail::ReadConfState(p, &state_.snapshot.conf);
-    if (!p.ok() || !p.at_end() || state_.snapshot.index == 0) {
-      return Error(ErrorCode::kProtocol, "corrupt snapshot file: " + p.error(), snapshot_path_);
-    }
+    auto parsed = ParseSnapshotFile(*snap_bytes, snapshot_path_);
+    if (!parsed) return parsed.error();
+    file_snapshot = std::move(*parsed);
   }
-  const Snapshot file_snapshot = state_.snapshot;
-
-  // 2. The WAL.
+  // 2. The WAL: rebuild the log from its base (an older snapshot, possibly).
   auto wal_bytes = fs_.ReadFile(wal_path_);
   if (!wal_bytes && wal_bytes.error().code() != ErrorCode::kNotFound) return wal_bytes.error();
   const Bytes data = wal_bytes ? std::move(*wal_bytes) : Bytes{};
-  // Rebuild the log from the WAL's base (an older snapshot, possibly), then reconcile below.
   PersistentState st;
+  if (auto s = ReplayWal(data, &st); !s) return s;
+  // 3. Reconcile the two.
+  if (auto s = Reconcile(file_snapshot, &st); !s) return s;
+  state_ = std::move(st);
+  return Ok{};
+}
+
+Status WalStorage::ReplayWal(const Bytes& data, PersistentState* st) {
   std::size_t pos = 0;
   std::size_t record = 0;
   while (pos < data.size()) {
-    const std::size_t left = data.size() - pos;
-    // A damaged last record is a write torn by a crash: cut it off (see the header).
-    auto torn = [&]() -> Status {
-      torn_bytes_dropped_ = left;
+    auto payload = ReadFrame(data, pos, wal_path_);
+    if (!payload) return payload.error();
+    if (!*payload) {
+      // A damaged last record is a write torn by a crash: cut it off (see the header).
+      torn_bytes_dropped_ = data.size() - pos;
       return fs_.Truncate(wal_path_, pos);
-    };
-    if (left < 8) {
-      if (auto s = torn(); !s) return s;
-      break;
     }
-    detail::ByteReader h(std::span<const std::uint8_t>(data.data() + pos, 8));
-    const std::uint32_t len = h.Fixed32();
-    const std::uint32_t crc = h.Fixed32();
-    if (len > kMaxRecordBytes) {
-      return Error(ErrorCode::kProtocol,
-                   "corrupt record at byte " + std::to_string(pos) + " (length " +
-                       std::to_string(len) + ")",
-                   wal_path_);
-    }
-    if (len > left - 8) {
-      if (auto s = torn(); !s) return s;
-      break;
-    }
-    std::span<const std::uint8_t> payload(data.data() + pos + 8, len);
-    if (Crc32(payload) != crc) {
-      if (pos + 8 + len == data.size()) {
-        if (auto s = torn(); !s) return s;
-        break;
-      }
-      return Error(ErrorCode::kProtocol,
-                   "corrupt record at byte " + std::to_string(pos) +
-                       " (crc mismatch) followed by more records: not a torn write",
-                   wal_path_);
-    }
-    detail::ByteReader p(payload);
+    detail::ByteReader p(**payload);
     const std::uint8_t kind = p.U8();
-    bool good = true;
-    if (kind == kHardStateRecord) {
-      st.hard_state.term = p.Varint();
-      st.hard_state.vote = p.Varint();
-      st.hard_state.commit = p.Varint();
-    } else if (kind == kEntryRecord) {
-      Entry e;
-      e.term = p.Varint();
-      e.index = p.Varint();
-      const std::uint8_t t = p.U8();
-      e.type = static_cast<EntryType>(t <= kMaxEntryType ? t : 0);
-      e.data = p.Blob();
-      good = t <= kMaxEntryType && p.ok() && PutEntry(&st, std::move(e));
-    } else if (kind == kBaseRecord) {
-      good = record == 0;
-      st.snapshot.index = p.Varint();
-      st.snapshot.term = p.Varint();
-    } else {
-      good = false;
-    }
+    const bool good = ReplayRecord(p, kind, record, st);
     if (!good || !p.ok() || !p.at_end()) {
       return Error(ErrorCode::kProtocol,
                    "invalid record " + std::to_string(record) + " (kind " + std::to_string(kind) +
                        ") at byte " + std::to_string(pos) + (p.ok() ? "" : ": " + p.error()),
                    wal_path_);
     }
-    pos += 8 + len;
+    pos += 8 + (*payload)->size();
     ++record;
   }
+  return Ok{};
+}
 
-  // 3. Reconcile: the snapshot file is written before the WAL is rewritten, so its index is at
-  // least the WAL's base.
-  if (st.snapshot.index > file_snapshot.index) {
+Status WalStorage::Reconcile(const Snapshot& file_snapshot, PersistentState* st) const {
+  // The snapshot file is written before the WAL is rewritten, so its index is at least the
+  // WAL's base.
+  if (st->snapshot.index > file_snapshot.index) {
     return Error(ErrorCode::kProtocol,
-                 "wal starts after snapshot " + std::to_string(st.snapshot.index) +
+                 "wal starts after snapshot " + std::to_string(st->snapshot.index) +
                      " but the snapshot file holds " + std::to_string(file_snapshot.index),
                  wal_path_);
   }
-  if (file_snapshot.index > st.snapshot.index) {
-    const std::uint64_t base = st.snapshot.index;
-    const std::uint64_t last = base + st.entries.size();
-    std::vector<Entry> rest;
-    if (file_snapshot.index < last &&
-        st.entries[file_snapshot.index - base - 1].term == file_snapshot.term) {
-      rest.assign(st.entries.begin() + static_cast<std::ptrdiff_t>(file_snapshot.index - base),
-                  st.entries.end());
-    }
-    st.entries = std::move(rest);
-  }
-  st.snapshot = file_snapshot;
+  TrimToSnapshot(file_snapshot, st);
+  st->snapshot = file_snapshot;
   // Save() writes a Ready's entries before its hard state. A write torn between them leaves
   // entries of a term the stored hard state has not reached: we saw that term, but cast no vote
   // in it that anyone heard of (messages go out only after the fsync), so take the term with no
   // vote.
-  const std::uint64_t last_term = st.entries.empty() ? st.snapshot.term : st.entries.back().term;
-  if (last_term > st.hard_state.term) {
-    st.hard_state.term = last_term;
-    st.hard_state.vote = kNoNode;
+  const std::uint64_t last_term = st->entries.empty() ? st->snapshot.term : st->entries.back().term;
+  if (last_term > st->hard_state.term) {
+    st->hard_state.term = last_term;
+    st->hard_state.vote = kNoNode;
   }
-  const std::uint64_t last = st.snapshot.index + st.entries.size();
-  if (st.hard_state.commit < st.snapshot.index) st.hard_state.commit = st.snapshot.index;
-  if (st.hard_state.commit > last) {
+  const std::uint64_t last = st->snapshot.index + st->entries.size();
+  if (st->hard_state.commit < st->snapshot.index) st->hard_state.commit = st->snapshot.index;
+  if (st->hard_state.commit > last) {
     return Error(ErrorCode::kProtocol,
-                 "hard state commit " + std::to_string(st.hard_state.commit) +
+                 "hard state commit " + std::to_string(st->hard_state.commit) +
                      " beyond the last stored entry " + std::to_string(last),
                  wal_path_);
   }
-  state_ = std::move(st);
   return Ok{};
 }
 

@@ -140,12 +140,34 @@ class MissionState {
   bool operator==(const MissionState&) const = default;
 
  private:
+  // One handler per command (Apply dispatches): the phase, then the command, then the change.
+  ApplyResult Handle(const StartSearch& c);
+  ApplyResult Handle(const AssignSectors& c);
+  ApplyResult Handle(const ReportSighting& c);
+  ApplyResult Handle(const ConfirmVictim& c);
+  ApplyResult Handle(const ConvergeOn& c);
+  ApplyResult Handle(const BeginRescue& c);
+  ApplyResult Handle(const MarkRescued& c);
+  ApplyResult Handle(const ReturnHome& c);
+  ApplyResult Handle(const CompleteMission& c);
+  ApplyResult Handle(const ReportMiss& c);
+  ApplyResult Handle(const RequestRevisit& c);
+  ApplyResult Handle(const ConfirmSighting& c);
+  ApplyResult Handle(const RejectSighting& c);
+  // SEARCH, CONVERGE or RESCUE: the phases that take sightings, misses and decisions.
+  bool Active() const;
+  std::string InPhase() const;  // " in phase SEARCH", for rejections
+  static ApplyResult Accepted();
   ApplyResult Reject(std::string reason) const;
+  Victim& MutableVictim(std::uint32_t id);  // aborts when there is no such victim
   ApplyResult ApplySighting(const ReportSighting& c);
   ApplyResult ApplyMiss(const ReportMiss& c);
   // The reporter/seq rule shared by sightings and misses: empty when `seq` may be applied.
   std::string CheckSeq(const std::string& reporter, std::uint64_t seq) const;
   Candidate* NearCandidate(double x_m, double y_m);
+  // A new pending candidate at (x_m, y_m); at kMaxCandidates the oldest decided one (or else the
+  // oldest) makes room.
+  Candidate& NewCandidate(double x_m, double y_m);
   Candidate* MutableCandidate(std::uint32_t id);
   void AddView(Candidate& c, SightingView v);
   Victim* NearVictim(double x_m, double y_m);

@@ -161,8 +161,18 @@ class RawNode {
 
   void TickElection();
   void TickHeartbeat();
+  // Step's parts, in etcd-io/raft's shape: the checks and the term, then one step per role and
+  // one handler per message type.
+  Status CheckMessage(const Message& m) const;  // a known sender and a term (remote messages)
+  bool StepHigherTerm(const Message& m);        // false: the message is dropped (leader lease)
+  void StepLowerTerm(const Message& m);         // answers a stale leader or pre-candidate
+  void HandleVoteRequest(const Message& m);     // kVote / kPreVote, in every role
   void StepLeader(const Message& m);
+  void CheckQuorum();
+  void HandleAppendResponse(Progress& pr, const Message& m);
+  void HandleHeartbeatResponse(Progress& pr, const Message& m);
   Status StepCandidate(const Message& m);
+  void HandleVoteResponse(const Message& m);
   Status StepFollower(const Message& m);
 
   void Reset(std::uint64_t term);

@@ -54,6 +54,11 @@ class WalStorage final : public Storage {
  private:
   WalStorage(FileSystem& fs, std::string dir);
   Status Recover();
+  // Rebuilds *st from the WAL's records; cuts off a torn last record.
+  Status ReplayWal(const Bytes& data, PersistentState* st);
+  // Puts the WAL's log onto the snapshot file's snapshot and repairs a hard state torn from its
+  // entries.
+  Status Reconcile(const Snapshot& file_snapshot, PersistentState* st) const;
   Status RewriteWal();
   Status Fail(Error e);
 
