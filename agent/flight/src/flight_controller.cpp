@@ -205,46 +205,10 @@ bool FlightController::Command(const Setpoint& sp) {
   const double t = t_s_;
   const bool finite = sp.value.allFinite();
   const bool on_ground = mode_ == FlightMode::kIdle || mode_ == FlightMode::kLanded;
-  if (!finite || mode_ == FlightMode::kInit) {
-    Emit(FlightEventKind::kRejected, t);
-    return false;
-  }
+  if (!finite || mode_ == FlightMode::kInit) return Reject(t);
   if (!std::isnan(sp.yaw_rad)) yaw_sp_rad_ = WrapPi(sp.yaw_rad);
-  switch (sp.kind) {
-    case Setpoint::Kind::kTakeoff: {
-      if (!on_ground || !(sp.value.z() > 0.0)) {
-        Emit(FlightEventKind::kRejected, t);
-        return false;
-      }
-      const StateEstimate& s = estimator_.state();
-      home_z_m_ = s.pos_m.z();
-      yaw_sp_rad_ = YawOf(s.att);
-      ResetControllers();
-      hover_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
-      mass_kg_ = MassFor(hover_.hover_thrust());
-      land_.Reset();
-      airborne_s_ = 0.0;
-      trajectory_.Reset(s.pos_m, Vec3::Zero());
-      if (shaper_.configured()) shaper_.Reset(trajectory_.reference());
-      TrajectoryLimits lim = config_.limits;
-      lim.vel_max_up_mps = std::min(lim.vel_max_up_mps, config_.takeoff_speed_mps);
-      trajectory_.SetLimits(lim);
-      trajectory_.SetPositionTarget(s.pos_m + Vec3(0.0, 0.0, sp.value.z()));
-      SetMode(FlightMode::kTakeoff, t);
-      Emit(FlightEventKind::kTakeoff, t);
-      return true;
-    }
-    case Setpoint::Kind::kPosition:
-    case Setpoint::Kind::kVelocity:
-    case Setpoint::Kind::kHold:
-    case Setpoint::Kind::kLand:
-    case Setpoint::Kind::kTrajectory:
-      break;
-  }
-  if (on_ground) {
-    Emit(FlightEventKind::kRejected, t);
-    return false;
-  }
+  if (sp.kind == Setpoint::Kind::kTakeoff) return on_ground ? CommandTakeoff(sp, t) : Reject(t);
+  if (on_ground) return Reject(t);
   if (sp.kind == Setpoint::Kind::kTrajectory) return CommandTrajectory(sp.trajectory, t);
   trajectory_.SetLimits(config_.limits);
   // The reference generator did not run in Land and Trajectory: restart it where the drone is.
@@ -259,32 +223,63 @@ bool FlightController::Command(const Setpoint& sp) {
       trajectory_.SetVelocityTarget(sp.value);
       SetMode(FlightMode::kVelocity, t);
       return true;
-    case Setpoint::Kind::kHold: {
-      // Stop where braking at the acceleration limit ends.
-      const TrajectoryPoint& r = trajectory_.reference();
-      const double v = r.vel_mps.norm();
-      const double a =
-          std::max(kMinBrakeAccel_mps2, std::min(config_.limits.acc_max_xy_mps2, config_.limits.acc_max_z_mps2));
-      trajectory_.SetPositionTarget(r.pos_m + r.vel_mps * (v / (2.0 * a)));
-      SetMode(FlightMode::kHold, t);
+    case Setpoint::Kind::kHold:
+      CommandHold(t);
       return true;
-    }
-    case Setpoint::Kind::kLand: {
-      const StateEstimate& s = estimator_.state();
-      land_xy_m_ = trajectory_.reference().pos_m;
-      land_xy_m_.z() = s.pos_m.z();
-      land_vz_mps_ = std::min(0.0, s.vel_mps.z());
-      land_.StartLanding();
-      SetMode(FlightMode::kLand, t);
-      Emit(FlightEventKind::kLanding, t);
+    case Setpoint::Kind::kLand:
+      CommandLand(t);
       return true;
-    }
     case Setpoint::Kind::kTakeoff:
     case Setpoint::Kind::kTrajectory:
       break;
   }
-  Emit(FlightEventKind::kRejected, t);
+  return Reject(t);
+}
+
+bool FlightController::Reject(double t_s) {
+  Emit(FlightEventKind::kRejected, t_s);
   return false;
+}
+
+bool FlightController::CommandTakeoff(const Setpoint& sp, double t_s) {
+  if (!(sp.value.z() > 0.0)) return Reject(t_s);
+  const StateEstimate& s = estimator_.state();
+  home_z_m_ = s.pos_m.z();
+  yaw_sp_rad_ = YawOf(s.att);
+  ResetControllers();
+  hover_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
+  mass_kg_ = MassFor(hover_.hover_thrust());
+  land_.Reset();
+  airborne_s_ = 0.0;
+  trajectory_.Reset(s.pos_m, Vec3::Zero());
+  if (shaper_.configured()) shaper_.Reset(trajectory_.reference());
+  TrajectoryLimits lim = config_.limits;
+  lim.vel_max_up_mps = std::min(lim.vel_max_up_mps, config_.takeoff_speed_mps);
+  trajectory_.SetLimits(lim);
+  trajectory_.SetPositionTarget(s.pos_m + Vec3(0.0, 0.0, sp.value.z()));
+  SetMode(FlightMode::kTakeoff, t_s);
+  Emit(FlightEventKind::kTakeoff, t_s);
+  return true;
+}
+
+void FlightController::CommandHold(double t_s) {
+  // Stop where braking at the acceleration limit ends.
+  const TrajectoryPoint& r = trajectory_.reference();
+  const double v = r.vel_mps.norm();
+  const double a =
+      std::max(kMinBrakeAccel_mps2, std::min(config_.limits.acc_max_xy_mps2, config_.limits.acc_max_z_mps2));
+  trajectory_.SetPositionTarget(r.pos_m + r.vel_mps * (v / (2.0 * a)));
+  SetMode(FlightMode::kHold, t_s);
+}
+
+void FlightController::CommandLand(double t_s) {
+  const StateEstimate& s = estimator_.state();
+  land_xy_m_ = trajectory_.reference().pos_m;
+  land_xy_m_.z() = s.pos_m.z();
+  land_vz_mps_ = std::min(0.0, s.vel_mps.z());
+  land_.StartLanding();
+  SetMode(FlightMode::kLand, t_s);
+  Emit(FlightEventKind::kLanding, t_s);
 }
 
 bool FlightController::CommandTrajectory(const TrajectoryTarget& target, double t_s) {

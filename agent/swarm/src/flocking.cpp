@@ -108,33 +108,59 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
   FlockingOutput out;
   const Vec2 p = in.position_m.head<2>();
   const Vec2 v = in.velocity_m_s.head<2>();
+  if (in.migrate) out.migration = MigrationTerm(in, p);
+  ScanNeighbours(in, p, &out);
+  FollowNeighbours(in, p, v, &out);
+  out.shill = ShillTerm(p, v);
 
-  if (in.migrate) {
-    const Vec2 to_goal = in.goal_m.head<2>() - p;
-    const double d = to_goal.norm();
-    if (d > 1e-6) {
-      const double speed = std::min(k.v_flock_m_s, BrakingCurve(d, k.a_mig_m_s2, k.p_mig_1_s));
-      out.migration = speed * to_goal / d;
-    }
-    // Slide around obstacles: near one, the part of the migration that points into it turns
-    // along its face (keeping the speed; head-on, toward the nearer end of the face, to the left
-    // when in the middle), so that migration and the shill push do not cancel in front of a wall
-    // (nor do two drones head-on either side of the middle slide into each other and stall).
-    for (const ObstacleFootprint& o : obstacles_) {
-      Vec2 n;
-      const double clearance = ObstacleClearance(o, p, &n);
-      const double into = -out.migration.dot(n);
-      if (clearance > k.obstacle_slide_range_m || into <= 0.0) continue;
-      const double speed = out.migration.norm();
-      Vec2 along = out.migration + into * n;  // tangential part
-      if (along.norm() < 0.05 * speed) {
-        along = Vec2(-n.y(), n.x());
-        if ((p - o.center_m).dot(along) < 0.0) along = -along;
-      }
-      out.migration = speed * along.normalized();
-    }
+  const Vec2 v_xy = ClampNorm(out.migration + out.repulsion + out.friction + out.alignment +
+                                  out.cohesion + out.shill,
+                              k.v_max_m_s);
+  const double v_z =
+      std::clamp(k.p_z_1_s * (in.goal_m.z() - in.position_m.z()), -k.v_z_max_m_s, k.v_z_max_m_s);
+  Vec3 desired(v_xy.x(), v_xy.y(), v_z);
+
+  const Vec3 previous = has_last_ ? last_command_m_s_ : in.velocity_m_s;
+  Vec3 dv = desired - previous;
+  const double dv_max = k.a_max_m_s2 * dt_s;
+  if (dv.norm() > dv_max) dv *= dv_max / dv.norm();
+  out.velocity_m_s = previous + dv;
+  last_command_m_s_ = out.velocity_m_s;
+  has_last_ = true;
+  return out;
+}
+
+Vec2 Flocking::MigrationTerm(const FlockingInput& in, const Vec2& p) const {
+  const FlockingParams& k = params_;
+  Vec2 migration = Vec2::Zero();
+  const Vec2 to_goal = in.goal_m.head<2>() - p;
+  const double d = to_goal.norm();
+  if (d > 1e-6) {
+    const double speed = std::min(k.v_flock_m_s, BrakingCurve(d, k.a_mig_m_s2, k.p_mig_1_s));
+    migration = speed * to_goal / d;
   }
+  // Slide around obstacles: near one, the part of the migration that points into it turns
+  // along its face (keeping the speed; head-on, toward the nearer end of the face, to the left
+  // when in the middle), so that migration and the shill push do not cancel in front of a wall
+  // (nor do two drones head-on either side of the middle slide into each other and stall).
+  for (const ObstacleFootprint& o : obstacles_) {
+    Vec2 n;
+    const double clearance = ObstacleClearance(o, p, &n);
+    const double into = -migration.dot(n);
+    if (clearance > k.obstacle_slide_range_m || into <= 0.0) continue;
+    const double speed = migration.norm();
+    Vec2 along = migration + into * n;  // tangential part
+    if (along.norm() < 0.05 * speed) {
+      along = Vec2(-n.y(), n.x());
+      if ((p - o.center_m).dot(along) < 0.0) along = -along;
+    }
+    migration = speed * along.normalized();
+  }
+  return migration;
+}
 
+void Flocking::ScanNeighbours(const FlockingInput& in, const Vec2& p, FlockingOutput* out) {
+  const FlockingParams& k = params_;
   // The max_neighbours nearest in range and not stale (ties: the earlier in the input), kept
   // sorted by distance in a buffer of max_neighbours + 1; then used in input order, so that with
   // max_neighbours or fewer the sums are the same, term for term, as over every neighbour.
@@ -157,7 +183,7 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
       } else {
         diff /= r_xy;
       }
-      out.repulsion += k.p_rep_1_s * (k.r0_rep_m - r) * diff;
+      out->repulsion += k.p_rep_1_s * (k.r0_rep_m - r) * diff;
     }
     if (nearest_.size() == keep && !(r < nearest_.back().r_m)) continue;
     auto at = std::upper_bound(nearest_.begin(), nearest_.end(), r,
@@ -166,7 +192,11 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
     if (nearest_.size() > keep) nearest_.pop_back();
   }
   std::sort(nearest_.begin(), nearest_.end(), [](const Near& a, const Near& b) { return a.index < b.index; });
+}
 
+void Flocking::FollowNeighbours(const FlockingInput& in, const Vec2& p, const Vec2& v,
+                                FlockingOutput* out) const {
+  const FlockingParams& k = params_;
   Vec2 centroid_sum = Vec2::Zero();
   Vec2 velocity_sum = Vec2::Zero();
   double weight_sum = 0.0;
@@ -176,40 +206,23 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
     const Vec2 pj = (n.position_m + age * n.velocity_m_s).head<2>();
     const Vec2 vj = n.velocity_m_s.head<2>();
     const double r = near.r_m;
-    ++out.neighbours_used;
+    ++out->neighbours_used;
     const double w =
         age <= k.fresh_age_s ? 1.0 : (k.stale_timeout_s - age) / (k.stale_timeout_s - k.fresh_age_s);
-    out.friction += w * FrictionRule(v, vj, r, k.r0_frict_m, k.v_frict_m_s, k.a_frict_m_s2,
-                                     k.p_frict_1_s, k.c_frict);
+    out->friction += w * FrictionRule(v, vj, r, k.r0_frict_m, k.v_frict_m_s, k.a_frict_m_s2,
+                                      k.p_frict_1_s, k.c_frict);
     centroid_sum += w * pj;
     velocity_sum += w * vj;
     weight_sum += w;
   }
   if (weight_sum > 1e-9) {
-    out.alignment = k.c_align * (velocity_sum / weight_sum - v);
+    out->alignment = k.c_align * (velocity_sum / weight_sum - v);
     const Vec2 to_centroid = centroid_sum / weight_sum - p;
     const double d = to_centroid.norm();
     if (d > k.r0_coh_m) {
-      out.cohesion = std::min(k.p_coh_1_s * (d - k.r0_coh_m), k.v_coh_max_m_s) * to_centroid / d;
+      out->cohesion = std::min(k.p_coh_1_s * (d - k.r0_coh_m), k.v_coh_max_m_s) * to_centroid / d;
     }
   }
-  out.shill = ShillTerm(p, v);
-
-  const Vec2 v_xy = ClampNorm(out.migration + out.repulsion + out.friction + out.alignment +
-                                  out.cohesion + out.shill,
-                              k.v_max_m_s);
-  const double v_z =
-      std::clamp(k.p_z_1_s * (in.goal_m.z() - in.position_m.z()), -k.v_z_max_m_s, k.v_z_max_m_s);
-  Vec3 desired(v_xy.x(), v_xy.y(), v_z);
-
-  const Vec3 previous = has_last_ ? last_command_m_s_ : in.velocity_m_s;
-  Vec3 dv = desired - previous;
-  const double dv_max = k.a_max_m_s2 * dt_s;
-  if (dv.norm() > dv_max) dv *= dv_max / dv.norm();
-  out.velocity_m_s = previous + dv;
-  last_command_m_s_ = out.velocity_m_s;
-  has_last_ = true;
-  return out;
 }
 
 }  // namespace swarmbox::swarm

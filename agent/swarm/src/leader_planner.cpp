@@ -268,6 +268,15 @@ std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raf
   return a;
 }
 
+// The swarm as one Step sees it.
+struct LeaderPlanner::Fleet {
+  std::vector<std::string> scouts;        // live ones
+  std::vector<Eigen::Vector2d> scout_xy;  // where each is
+  const RosterEntry* lifter = nullptr;    // the first live lifter
+  bool scouts_airborne = true;
+  bool all_down = true;                   // every live drone landed or on the ground
+};
+
 void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
                          std::span<const RosterEntry> roster, MissionOutput* out, double wall_s) {
   Track(t_s, m, wall_s);
@@ -275,39 +284,73 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
   evidence_events_.clear();
   Index(roster);
   ReportMembers(t_s, roster, out);
-  std::vector<std::string> scouts;  // live ones
-  std::vector<Eigen::Vector2d> scout_xy;  // where each is
-  const RosterEntry* lifter = nullptr;
-  bool scouts_airborne = true;
-  bool all_down = true;
+  const Fleet fleet = Survey(roster);
+  const bool orphans = ProposeReassign(t_s, m, roster, out);
+  const bool scouts_done = ScoutsDone(t_s, m, roster, orphans);
+  const bool active = m.phase() == MissionPhase::kSearch || m.phase() == MissionPhase::kConverge ||
+                      m.phase() == MissionPhase::kRescue;
+  const bool undecided = active && PlanCandidates(t_s, m, roster, out);
+  switch (m.phase()) {
+    case MissionPhase::kIdle:
+      PlanStart(t_s, m, fleet, out);
+      break;
+    case MissionPhase::kSearch:
+    case MissionPhase::kConverge: {
+      const bool rescue_running =
+          std::any_of(m.victims().begin(), m.victims().end(),
+                      [](const raft::Victim& v) { return v.status == VictimStatus::kBeingRescued; });
+      PlanSearch(t_s, m, fleet, scouts_done && !rescue_running && !undecided, out);
+      break;
+    }
+    case MissionPhase::kRescue:
+      break;  // the lifter proposes MarkRescued
+    case MissionPhase::kReturn:
+      if (fleet.all_down && Due("complete", t_s)) out->proposals.push_back(raft::CompleteMission{});
+      break;
+    case MissionPhase::kComplete:
+      ReportComplete(t_s, m, out);
+      break;
+  }
+}
+
+LeaderPlanner::Fleet LeaderPlanner::Survey(std::span<const RosterEntry> roster) const {
+  Fleet f;
   for (const RosterEntry& r : roster) {
     if (!Alive(r)) continue;  // a dead drone's last mode says nothing any more
-    all_down = all_down && IsOneOf(r.mode, {"landed", "on_ground"});
+    f.all_down = f.all_down && IsOneOf(r.mode, {"landed", "on_ground"});
     if (r.role == Role::kLifter) {
-      if (lifter == nullptr) lifter = &r;
+      if (f.lifter == nullptr) f.lifter = &r;
       continue;
     }
-    scouts.push_back(r.name);
-    scout_xy.push_back(r.position_m);
-    scouts_airborne = scouts_airborne && !IsOneOf(r.mode, {"on_ground", "taking_off"});
+    f.scouts.push_back(r.name);
+    f.scout_xy.push_back(r.position_m);
+    f.scouts_airborne = f.scouts_airborne && !IsOneOf(r.mode, {"on_ground", "taking_off"});
   }
+  return f;
+}
 
+bool LeaderPlanner::ProposeReassign(double t_s, const raft::MissionState& m,
+                                    std::span<const RosterEntry> roster, MissionOutput* out) {
   // Sectors of gone members go to live scouts first (any phase with sectors still to search).
   bool orphans = false;
   const bool searching = m.phase() == MissionPhase::kIdle || m.phase() == MissionPhase::kSearch ||
                          m.phase() == MissionPhase::kConverge || m.phase() == MissionPhase::kRescue;
-  if (searching && !m.sectors().empty()) {
-    MissionOutput scratch;
-    if (auto a = Reassign(t_s, m, roster, &scratch)) {
-      orphans = true;
-      if (Due("reassign", t_s)) {
-        out->proposals.push_back(std::move(*a));
-        for (LogEvent& e : scratch.events) out->events.push_back(std::move(e));
-      }
-    } else {
-      for (const raft::Sector& s : m.sectors()) orphans = orphans || GoneOwner(t_s, s.drone);
+  if (!searching || m.sectors().empty()) return false;
+  MissionOutput scratch;
+  if (auto a = Reassign(t_s, m, roster, &scratch)) {
+    orphans = true;
+    if (Due("reassign", t_s)) {
+      out->proposals.push_back(std::move(*a));
+      for (LogEvent& e : scratch.events) out->events.push_back(std::move(e));
     }
+  } else {
+    for (const raft::Sector& s : m.sectors()) orphans = orphans || GoneOwner(t_s, s.drone);
   }
+  return orphans;
+}
+
+bool LeaderPlanner::ScoutsDone(double t_s, const raft::MissionState& m,
+                               std::span<const RosterEntry> roster, bool orphans) {
   // The search is finished when every sector has a live owner that swept it (or left), every
   // live scout without a sector idles, and no hand-over is younger than the settle time.
   bool scouts_done = !orphans && t_s - sectors_changed_s_ >= config_.assignment_settle_s;
@@ -324,89 +367,76 @@ void LeaderPlanner::Step(double t_s, const raft::MissionState& m,
                                          [](const std::string* a, const std::string* b) { return *a < *b; });
     scouts_done = ScoutDone(r.mode) || (!owns && r.mode == "awaiting_sector");
   }
+  return scouts_done;
+}
 
-  const bool active = m.phase() == MissionPhase::kSearch || m.phase() == MissionPhase::kConverge ||
-                      m.phase() == MissionPhase::kRescue;
-  const bool undecided = active && PlanCandidates(t_s, m, roster, out);
-
-  const raft::Victim* candidate = nullptr;  // confirmed, not yet rescued or handled
-  bool rescue_running = false;
+const raft::Victim* LeaderPlanner::FirstUnhandled(const raft::MissionState& m) const {
   for (const raft::Victim& v : m.victims()) {
-    if (v.status == VictimStatus::kBeingRescued) rescue_running = true;
-    if (v.status == VictimStatus::kConfirmed && handled_.count(v.id) == 0 && candidate == nullptr) {
-      candidate = &v;
-    }
+    if (v.status == VictimStatus::kConfirmed && handled_.count(v.id) == 0) return &v;
   }
+  return nullptr;
+}
 
-  switch (m.phase()) {
-    case MissionPhase::kIdle:
-      if (!scouts.empty() && (scouts_airborne || t_s >= config_.start_timeout_s) &&
-          Due("start", t_s)) {
-        if (m.sectors().empty()) {
-          // One proposal for every scout: each gets the cell of the grid that matches its place
-          // in the swarm (PartitionOrder), so that nobody crosses another's path to its sector.
-          std::vector<std::string> ordered;
-          ordered.reserve(scouts.size());
-          for (const std::size_t i : PartitionOrder(config_.search_area, scouts, scout_xy)) {
-            ordered.push_back(scouts[i]);
-          }
-          out->proposals.push_back(raft::AssignSectors{PartitionArea(config_.search_area, ordered)});
-        }
-        out->proposals.push_back(raft::StartSearch{});
-      }
-      break;
-    case MissionPhase::kSearch:
-    case MissionPhase::kConverge: {
-      const std::uint32_t target = m.target_victim();
-      const raft::Victim* tv = m.FindVictim(target);
-      if (m.phase() == MissionPhase::kConverge && tv != nullptr &&
-          tv->status == VictimStatus::kConfirmed && handled_.count(target) == 0) {
-        if (lifter != nullptr) {
-          if (IsOneOf(lifter->mode, {"on_ground", "standby"}) && Due("rescue:" + std::to_string(target), t_s)) {
-            out->proposals.push_back(raft::BeginRescue{target, lifter->name});
-          }
-          break;
-        }
-        auto [it, inserted] = converge_since_s_.emplace(target, t_s);
-        if (t_s - it->second < config_.handle_time_s) break;
-        handled_.insert(target);
-        out->events.push_back(std::move(LogEvent(t_s, config_.name, "victim_handled")
-                                            .Add("id", static_cast<std::int64_t>(target))
-                                            .Add("by", "orbit")));
-        candidate = nullptr;
-        for (const raft::Victim& v : m.victims()) {
-          if (v.status == VictimStatus::kConfirmed && handled_.count(v.id) == 0) {
-            candidate = &v;
-            break;
-          }
-        }
-      }
-      if (candidate != nullptr) {
-        if (Due("converge:" + std::to_string(candidate->id), t_s)) {
-          out->proposals.push_back(raft::ConvergeOn{candidate->id});
-        }
-      } else if (scouts_done && !rescue_running && !undecided && Due("return", t_s)) {
-        out->proposals.push_back(raft::ReturnHome{});
-      }
-      break;
-    }
-    case MissionPhase::kRescue:
-      break;  // the lifter proposes MarkRescued
-    case MissionPhase::kReturn:
-      if (all_down && Due("complete", t_s)) out->proposals.push_back(raft::CompleteMission{});
-      break;
-    case MissionPhase::kComplete:
-      if (!complete_reported_) {
-        complete_reported_ = true;
-        std::int64_t rescued = 0;
-        for (const raft::Victim& v : m.victims()) rescued += v.status == VictimStatus::kRescued ? 1 : 0;
-        out->events.push_back(std::move(LogEvent(t_s, config_.name, "mission_complete")
-                                            .Add("victims", static_cast<std::int64_t>(m.victims().size()))
-                                            .Add("rescued", rescued)
-                                            .Add("handled", static_cast<std::int64_t>(handled_.size()))));
-      }
-      break;
+void LeaderPlanner::PlanStart(double t_s, const raft::MissionState& m, const Fleet& fleet,
+                              MissionOutput* out) {
+  if (fleet.scouts.empty() || !(fleet.scouts_airborne || t_s >= config_.start_timeout_s) ||
+      !Due("start", t_s)) {
+    return;
   }
+  if (m.sectors().empty()) {
+    // One proposal for every scout: each gets the cell of the grid that matches its place
+    // in the swarm (PartitionOrder), so that nobody crosses another's path to its sector.
+    std::vector<std::string> ordered;
+    ordered.reserve(fleet.scouts.size());
+    for (const std::size_t i : PartitionOrder(config_.search_area, fleet.scouts, fleet.scout_xy)) {
+      ordered.push_back(fleet.scouts[i]);
+    }
+    out->proposals.push_back(raft::AssignSectors{PartitionArea(config_.search_area, ordered)});
+  }
+  out->proposals.push_back(raft::StartSearch{});
+}
+
+void LeaderPlanner::PlanSearch(double t_s, const raft::MissionState& m, const Fleet& fleet,
+                               bool search_finished, MissionOutput* out) {
+  const raft::Victim* candidate = FirstUnhandled(m);  // confirmed, not yet rescued or handled
+  const std::uint32_t target = m.target_victim();
+  const raft::Victim* tv = m.FindVictim(target);
+  if (m.phase() == MissionPhase::kConverge && tv != nullptr &&
+      tv->status == VictimStatus::kConfirmed && handled_.count(target) == 0) {
+    if (fleet.lifter != nullptr) {
+      if (IsOneOf(fleet.lifter->mode, {"on_ground", "standby"}) &&
+          Due("rescue:" + std::to_string(target), t_s)) {
+        out->proposals.push_back(raft::BeginRescue{target, fleet.lifter->name});
+      }
+      return;
+    }
+    // No lifter: the scouts orbit the victim for handle_time_s, then it counts as handled.
+    auto [it, inserted] = converge_since_s_.emplace(target, t_s);
+    if (t_s - it->second < config_.handle_time_s) return;
+    handled_.insert(target);
+    out->events.push_back(std::move(LogEvent(t_s, config_.name, "victim_handled")
+                                        .Add("id", static_cast<std::int64_t>(target))
+                                        .Add("by", "orbit")));
+    candidate = FirstUnhandled(m);
+  }
+  if (candidate != nullptr) {
+    if (Due("converge:" + std::to_string(candidate->id), t_s)) {
+      out->proposals.push_back(raft::ConvergeOn{candidate->id});
+    }
+  } else if (search_finished && Due("return", t_s)) {
+    out->proposals.push_back(raft::ReturnHome{});
+  }
+}
+
+void LeaderPlanner::ReportComplete(double t_s, const raft::MissionState& m, MissionOutput* out) {
+  if (complete_reported_) return;
+  complete_reported_ = true;
+  std::int64_t rescued = 0;
+  for (const raft::Victim& v : m.victims()) rescued += v.status == VictimStatus::kRescued ? 1 : 0;
+  out->events.push_back(std::move(LogEvent(t_s, config_.name, "mission_complete")
+                                      .Add("victims", static_cast<std::int64_t>(m.victims().size()))
+                                      .Add("rescued", rescued)
+                                      .Add("handled", static_cast<std::int64_t>(handled_.size()))));
 }
 
 }  // namespace swarmbox::swarm

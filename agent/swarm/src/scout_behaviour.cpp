@@ -280,50 +280,55 @@ void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
   const bool on_mission = stage_ == Stage::kAwaitingSector || stage_ == Stage::kSearching ||
                           stage_ == Stage::kSwept || stage_ == Stage::kOrbiting ||
                           stage_ == Stage::kRevisiting;
-  if (on_mission) {
-    const raft::Sector* sector = Active(m.phase()) ? NextSector(m) : nullptr;
-    const bool owns = Active(m.phase()) && m.SectorOf(config_.name) != nullptr;
-    if (sector != nullptr && (!has_plan_ || !(*sector == planned_sector_))) {
-      PlanSector(*sector, p);
-      out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_started")
-                                          .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))
-                                          .Add("x_min", sector->x_min_m, 1)
-                                          .Add("y_min", sector->y_min_m, 1)
-                                          .Add("x_max", sector->x_max_m, 1)
-                                          .Add("y_max", sector->y_max_m, 1)));
+  if (on_mission) DecideMissionStage(in, revisit, out);
+}
+
+void ScoutBehaviour::DecideMissionStage(const MissionInput& in, const raft::Candidate* revisit,
+                                        MissionOutput* out) {
+  const raft::MissionState& m = *in.mission;
+  const raft::Sector* sector = Active(m.phase()) ? NextSector(m) : nullptr;
+  const bool owns = Active(m.phase()) && m.SectorOf(config_.name) != nullptr;
+  if (sector != nullptr && (!has_plan_ || !(*sector == planned_sector_))) StartSector(*sector, in, out);
+  const raft::Victim* target = OrbitTarget(in);
+  const bool still_sweeping = sector != nullptr;
+  if (config_.keep_searching_during_rescue && still_sweeping && stage_ != Stage::kOrbiting) target = nullptr;
+  if (revisit != nullptr) {
+    if (revisit->id != revisit_id_ || stage_ != Stage::kRevisiting) {
+      revisit_id_ = revisit->id;
+      look_start_s_ = -1.0;
+      revisit_seen_ = false;
+      miss_sent_s_ = -1.0;
+      miss_tries_ = 0;
     }
-    const raft::Victim* target = OrbitTarget(in);
-    const bool still_sweeping = sector != nullptr;
-    if (config_.keep_searching_during_rescue && still_sweeping && stage_ != Stage::kOrbiting) target = nullptr;
-    if (revisit != nullptr) {
-      if (revisit->id != revisit_id_ || stage_ != Stage::kRevisiting) {
-        revisit_id_ = revisit->id;
-        look_start_s_ = -1.0;
-        revisit_seen_ = false;
-        miss_sent_s_ = -1.0;
-        miss_tries_ = 0;
-      }
-      Enter(Stage::kRevisiting, in, out);
-    } else if (target != nullptr) {
-      if (orbit_victim_ != target->id || stage_ != Stage::kOrbiting) {
-        orbit_victim_ = target->id;
-        orbit_reached_s_ = -1.0;
-        orbit_ = OrbitWaypoints({target->x_m, target->y_m}, config_.orbit_radius_m, Altitude(),
-                                config_.orbit_points, 0.0);
-      }
-      Enter(Stage::kOrbiting, in, out);
-    } else if (sector != nullptr) {
-      Enter(Stage::kSearching, in, out);
-    } else if (owns) {
-      Enter(config_.return_when_swept ? Stage::kReturning : Stage::kSwept, in, out);
-    } else {
-      Enter(Stage::kAwaitingSector, in, out);
+    Enter(Stage::kRevisiting, in, out);
+  } else if (target != nullptr) {
+    if (orbit_victim_ != target->id || stage_ != Stage::kOrbiting) {
+      orbit_victim_ = target->id;
+      orbit_reached_s_ = -1.0;
+      orbit_ = OrbitWaypoints({target->x_m, target->y_m}, config_.orbit_radius_m, Altitude(),
+                              config_.orbit_points, 0.0);
     }
+    Enter(Stage::kOrbiting, in, out);
+  } else if (sector != nullptr) {
+    Enter(Stage::kSearching, in, out);
+  } else if (owns) {
+    Enter(config_.return_when_swept ? Stage::kReturning : Stage::kSwept, in, out);
+  } else {
+    Enter(Stage::kAwaitingSector, in, out);
   }
 }
 
+void ScoutBehaviour::StartSector(const raft::Sector& sector, const MissionInput& in, MissionOutput* out) {
+  PlanSector(sector, in.position_m);
+  out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_started")
+                                      .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))
+                                      .Add("x_min", sector.x_min_m, 1)
+                                      .Add("y_min", sector.y_min_m, 1)
+                                      .Add("x_max", sector.x_max_m, 1)
+                                      .Add("y_max", sector.y_max_m, 1)));
+}
+
 void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
-  const raft::MissionState& m = *in.mission;
   const Eigen::Vector3d& p = in.position_m;
   const Eigen::Vector2d home_xy = config_.home_m.head<2>();
   SetpointRequest& sp = out->setpoint;
@@ -347,27 +352,9 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
       sp.target_m = {home_xy.x(), home_xy.y(), Altitude()};
       sp.yaw_rad = in.yaw_rad;
       break;
-    case Stage::kSearching: {
-      if ((lanes_[lane_index_].position_m.head<2>() - p.head<2>()).norm() <= config_.waypoint_radius_m) {
-        ++lane_index_;
-        if (lane_index_ == lanes_.size()) {
-          swept_.push_back(planned_sector_);
-          out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_swept")
-                                              .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
-          Enter(Stage::kSwept, in, out);
-          break;
-        }
-        if (lane_index_ % 2 == 0) {  // the end of a lane
-          out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_progress")
-                                              .Add("lanes_done", static_cast<std::int64_t>(lane_index_ / 2))
-                                              .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
-        }
-      }
-      sp.kind = SetpointKind::kFlock;
-      sp.target_m = lanes_[lane_index_].position_m;
-      sp.yaw_rad = lanes_[lane_index_].yaw_rad;
+    case Stage::kSearching:
+      RunSearch(in, out);
       break;
-    }
     case Stage::kSwept: {
       const Eigen::Vector2d c = AsRect(planned_sector_).center_m();
       sp.kind = SetpointKind::kFlock;
@@ -375,42 +362,12 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
       sp.yaw_rad = in.yaw_rad;
       break;
     }
-    case Stage::kOrbiting: {
-      const raft::Victim* v = m.FindVictim(orbit_victim_);
-      SWARMBOX_CHECK(v != nullptr);
-      const Eigen::Vector2d c(v->x_m, v->y_m);
-      const double from_centre = (p.head<2>() - c).norm();
-      if (orbit_reached_s_ < 0 && std::abs(from_centre - config_.orbit_radius_m) < 5.0) {
-        orbit_reached_s_ = in.t_s;
-      }
-      const std::size_t k =
-          NextOrbitWaypoint(orbit_, c, p.head<2>(), config_.orbit_lead_rad);
-      sp.kind = SetpointKind::kFlock;
-      sp.target_m = orbit_[k].position_m;
-      sp.yaw_rad = orbit_[k].yaw_rad;
-      if ((!config_.lifter_present || config_.return_when_swept) && orbit_reached_s_ >= 0 &&
-          in.t_s - orbit_reached_s_ >= config_.orbit_time_s) {
-        handled_.insert(orbit_victim_);
-        out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "victim_handled")
-                                            .Add("id", static_cast<std::int64_t>(orbit_victim_))
-                                            .Add("orbit_s", in.t_s - orbit_reached_s_, 1)));
-      }
+    case Stage::kOrbiting:
+      RunOrbit(in, out);
       break;
-    }
-    case Stage::kReturning: {
-      const double d = (p.head<2>() - home_xy).norm();
-      sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
-      const double layer_z = Altitude() + config_.return_layer * config_.return_layer_m;
-      const double approach_z =
-          config_.approach_height_m > 0 ? config_.home_m.z() + config_.approach_height_m : layer_z;
-      // Home in this scout's layer, down only once over home (within 2 x home_reached_m): on a
-      // 4 m take-off grid a drone descending on the slant of the last approach_m would pass
-      // through its neighbours' columns at their heights; vertically it stays in its own.
-      sp.target_m = {home_xy.x(), home_xy.y(), d > 2 * config_.home_reached_m ? layer_z : approach_z};
-      sp.yaw_rad = in.yaw_rad;
-      if (d <= config_.home_reached_m && p.z() <= approach_z + 1.0) Enter(Stage::kLanding, in, out);
+    case Stage::kReturning:
+      RunReturn(in, out);
       break;
-    }
     case Stage::kRevisiting:
       RunRevisit(in, out);
       break;
@@ -423,7 +380,70 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
       }
       break;
   }
+}
 
+void ScoutBehaviour::RunSearch(const MissionInput& in, MissionOutput* out) {
+  const Eigen::Vector3d& p = in.position_m;
+  if ((lanes_[lane_index_].position_m.head<2>() - p.head<2>()).norm() <= config_.waypoint_radius_m) {
+    ++lane_index_;
+    if (lane_index_ == lanes_.size()) {
+      swept_.push_back(planned_sector_);
+      out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_swept")
+                                          .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
+      Enter(Stage::kSwept, in, out);
+      return;
+    }
+    if (lane_index_ % 2 == 0) {  // the end of a lane
+      out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "sector_progress")
+                                          .Add("lanes_done", static_cast<std::int64_t>(lane_index_ / 2))
+                                          .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
+    }
+  }
+  SetpointRequest& sp = out->setpoint;
+  sp.kind = SetpointKind::kFlock;
+  sp.target_m = lanes_[lane_index_].position_m;
+  sp.yaw_rad = lanes_[lane_index_].yaw_rad;
+}
+
+void ScoutBehaviour::RunOrbit(const MissionInput& in, MissionOutput* out) {
+  const Eigen::Vector3d& p = in.position_m;
+  const raft::Victim* v = in.mission->FindVictim(orbit_victim_);
+  SWARMBOX_CHECK(v != nullptr);
+  const Eigen::Vector2d c(v->x_m, v->y_m);
+  const double from_centre = (p.head<2>() - c).norm();
+  if (orbit_reached_s_ < 0 && std::abs(from_centre - config_.orbit_radius_m) < 5.0) {
+    orbit_reached_s_ = in.t_s;
+  }
+  const std::size_t k =
+      NextOrbitWaypoint(orbit_, c, p.head<2>(), config_.orbit_lead_rad);
+  SetpointRequest& sp = out->setpoint;
+  sp.kind = SetpointKind::kFlock;
+  sp.target_m = orbit_[k].position_m;
+  sp.yaw_rad = orbit_[k].yaw_rad;
+  if ((!config_.lifter_present || config_.return_when_swept) && orbit_reached_s_ >= 0 &&
+      in.t_s - orbit_reached_s_ >= config_.orbit_time_s) {
+    handled_.insert(orbit_victim_);
+    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "victim_handled")
+                                        .Add("id", static_cast<std::int64_t>(orbit_victim_))
+                                        .Add("orbit_s", in.t_s - orbit_reached_s_, 1)));
+  }
+}
+
+void ScoutBehaviour::RunReturn(const MissionInput& in, MissionOutput* out) {
+  const Eigen::Vector3d& p = in.position_m;
+  const Eigen::Vector2d home_xy = config_.home_m.head<2>();
+  SetpointRequest& sp = out->setpoint;
+  const double d = (p.head<2>() - home_xy).norm();
+  sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
+  const double layer_z = Altitude() + config_.return_layer * config_.return_layer_m;
+  const double approach_z =
+      config_.approach_height_m > 0 ? config_.home_m.z() + config_.approach_height_m : layer_z;
+  // Home in this scout's layer, down only once over home (within 2 x home_reached_m): on a
+  // 4 m take-off grid a drone descending on the slant of the last approach_m would pass
+  // through its neighbours' columns at their heights; vertically it stays in its own.
+  sp.target_m = {home_xy.x(), home_xy.y(), d > 2 * config_.home_reached_m ? layer_z : approach_z};
+  sp.yaw_rad = in.yaw_rad;
+  if (d <= config_.home_reached_m && p.z() <= approach_z + 1.0) Enter(Stage::kLanding, in, out);
 }
 
 }  // namespace swarmbox::swarm

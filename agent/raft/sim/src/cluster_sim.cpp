@@ -217,16 +217,7 @@ void ClusterSim::Crash(int node) {
   ++report_.crashes;
 }
 
-void ClusterSim::Restart(int node) {
-  Node& n = *nodes_[static_cast<std::size_t>(node)];
-  if (n.alive) return;
-  if (config_.faults.wipe_storage_on_restart && n.restarts > 0) {
-    n.storage = std::make_unique<CheckedStorage>(*this, node);
-    // The per-node term/vote memory goes too, so that what the checker reports is the damage to
-    // the cluster (two leaders, lost commits), not the amnesia itself.
-    n.last_term = 0;
-    n.last_vote = kNoNode;
-  }
+DriverConfig ClusterSim::DriverConfigOf(int node, int restarts) const {
   DriverConfig dc;
   dc.self = Name(node);
   for (int i = 0; i < size(); ++i) dc.members.push_back(Name(i));
@@ -243,7 +234,21 @@ void ClusterSim::Restart(int node) {
   dc.snapshot_every_entries = config_.snapshot_every_entries;
   dc.seed = config_.seed * std::uint64_t{1000003} +
             static_cast<std::uint64_t>(node) * std::uint64_t{7919} +
-            static_cast<std::uint64_t>(n.restarts);
+            static_cast<std::uint64_t>(restarts);
+  return dc;
+}
+
+void ClusterSim::Restart(int node) {
+  Node& n = *nodes_[static_cast<std::size_t>(node)];
+  if (n.alive) return;
+  if (config_.faults.wipe_storage_on_restart && n.restarts > 0) {
+    n.storage = std::make_unique<CheckedStorage>(*this, node);
+    // The per-node term/vote memory goes too, so that what the checker reports is the damage to
+    // the cluster (two leaders, lost commits), not the amnesia itself.
+    n.last_term = 0;
+    n.last_vote = kNoNode;
+  }
+  const DriverConfig dc = DriverConfigOf(node, n.restarts);
   ++n.restarts;
   n.transport = std::make_unique<NodeTransport>(*this, node);
   EventSink sink;
@@ -601,24 +606,34 @@ void ClusterSim::OnSave(int node, const std::optional<HardState>& hs,
                     std::to_string(entries.front().index) + " over a log ending at " +
                     std::to_string(st.last_index()));
     }
-    // One Change at a Time (thesis §4.1): no second change above the applied index, and none
-    // before the leader applied an entry of its own term.
-    const RaftLog& log = d->raft().log();
-    for (const Entry& e : entries) {
-      if (e.type != EntryType::kConfChange) continue;
-      if (log.Term(log.applied()) != d->raft().term()) {
+    CheckOneChangeAtATime(node, *d, entries);
+  }
+  CheckLogMatching(node, st, entries, snapshot);
+}
+
+void ClusterSim::CheckOneChangeAtATime(int node, const NodeDriver& d,
+                                       std::span<const Entry> entries) {
+  // One Change at a Time (thesis §4.1): no second change above the applied index, and none
+  // before the leader applied an entry of its own term.
+  const RaftLog& log = d.raft().log();
+  for (const Entry& e : entries) {
+    if (e.type != EntryType::kConfChange) continue;
+    if (log.Term(log.applied()) != d.raft().term()) {
+      Violation("One Change at a Time", Name(node) + " appends a change at " + std::to_string(e.index) +
+                                            " before applying an entry of its term " +
+                                            std::to_string(d.raft().term()));
+    }
+    for (std::uint64_t i = log.applied() + 1; i < e.index; ++i) {
+      if (i >= log.first_index() && log.At(i).type == EntryType::kConfChange) {
         Violation("One Change at a Time", Name(node) + " appends a change at " + std::to_string(e.index) +
-                                              " before applying an entry of its term " +
-                                              std::to_string(d->raft().term()));
-      }
-      for (std::uint64_t i = log.applied() + 1; i < e.index; ++i) {
-        if (i >= log.first_index() && log.At(i).type == EntryType::kConfChange) {
-          Violation("One Change at a Time", Name(node) + " appends a change at " + std::to_string(e.index) +
-                                                " with another one in flight at " + std::to_string(i));
-        }
+                                              " with another one in flight at " + std::to_string(i));
       }
     }
   }
+}
+
+void ClusterSim::CheckLogMatching(int node, const MemoryStorage& st, std::span<const Entry> entries,
+                                  const Snapshot& snapshot) {
   if (entries.empty()) return;
   std::optional<std::uint64_t> prev;
   const std::uint64_t first = entries.front().index;
@@ -660,9 +675,15 @@ void ClusterSim::CheckNode(int node) {
     return;
   }
   const RawNode& raw = d.raft();
-  const RaftLog& log = raw.log();
   const std::string who = Name(node);
+  CheckTermAndVote(n, raw, who);
+  CheckCommits(n, raw, who);
+  CheckLeader(n, raw, who);
+  CheckStateMachine(n, d, who);
+  CheckTap(node);
+}
 
+void ClusterSim::CheckTermAndVote(Node& n, const RawNode& raw, const std::string& who) {
   // Terms never go back; one vote per term (Raft §5.2), across restarts too.
   if (raw.term() < n.last_term) {
     Violation("Election Safety", who + " term went back from " + std::to_string(n.last_term) +
@@ -678,7 +699,10 @@ void ClusterSim::CheckNode(int node) {
     }
     n.last_vote = raw.vote();
   }
+}
 
+void ClusterSim::CheckCommits(Node& n, const RawNode& raw, const std::string& who) {
+  const RaftLog& log = raw.log();
   // Commits: every node commits the same entry at each index.
   const std::uint64_t commit = log.committed();
   const std::uint64_t snap = log.snapshot_index();
@@ -711,7 +735,9 @@ void ClusterSim::CheckNode(int node) {
   n.checked_commit = std::max(n.checked_commit, commit);
   n.conf_before = raw.conf_state();
   report_.max_commit = std::max(report_.max_commit, commit);
+}
 
+void ClusterSim::CheckLeader(Node& n, const RawNode& raw, const std::string& who) {
   // Election Safety (Raft §5.2) and Leader Completeness (§5.4) when a node starts to lead.
   if (raw.role() == Role::kLeader && !raw.is_voter()) {
     Violation("Configuration", who + " leads term " + std::to_string(raw.term()) + " but is no voter");
@@ -738,18 +764,27 @@ void ClusterSim::CheckNode(int node) {
         leader_crash_us_.reset();
       }
     }
-    for (std::uint64_t i = snap + 1; i <= committed_.size(); ++i) {
-      const CommitFact& known = committed_[i - 1];
-      if (known.term == 0) continue;
-      if (i > log.last_index() || log.At(i).term != known.term ||
-          EntryHash(log.At(i)) != known.data_hash) {
-        Violation("Leader Completeness", who + " leads term " + std::to_string(raw.term()) +
-                                             " without committed entry " + std::to_string(i));
-        break;
-      }
+    CheckLeaderCompleteness(raw, who);
+  }
+}
+
+void ClusterSim::CheckLeaderCompleteness(const RawNode& raw, const std::string& who) {
+  const RaftLog& log = raw.log();
+  const std::uint64_t snap = log.snapshot_index();
+  for (std::uint64_t i = snap + 1; i <= committed_.size(); ++i) {
+    const CommitFact& known = committed_[i - 1];
+    if (known.term == 0) continue;
+    if (i > log.last_index() || log.At(i).term != known.term ||
+        EntryHash(log.At(i)) != known.data_hash) {
+      Violation("Leader Completeness", who + " leads term " + std::to_string(raw.term()) +
+                                           " without committed entry " + std::to_string(i));
+      break;
     }
   }
+}
 
+void ClusterSim::CheckStateMachine(Node& n, const NodeDriver& d, const std::string& who) {
+  const RaftLog& log = d.raft().log();
   // State Machine Safety (Raft §5.4.3): the same state after applying the same index.
   if (d.applied_index() != log.applied()) {
     Violation("State Machine Safety", who + " state machine applied " +
@@ -771,7 +806,6 @@ void ClusterSim::CheckNode(int node) {
                                             std::to_string(d.applied_index()) + " differs");
     }
   }
-  CheckTap(node);
 }
 
 void ClusterSim::CheckTap(int node) {

@@ -127,8 +127,22 @@ class Estimator {
     double out_dv = 0.0;
     std::array<double, kHistory> hist_p{}, hist_v{};
   };
+  // Update's steps, in order (each allocation-free, in the estimator's translation unit).
+  bool StartAttitude(const SensorSample& s);  // false while waiting for the first samples
   void InitAttitude(const SensorSample& s);
+  void TrackGpsAcceleration(const SensorSample& s, double dt);
   void UpdateAttitude(const SensorSample& s, double dt);
+  // The expected specific force in the world (gravity plus the reference acceleration) [m/s^2].
+  Vec3 TiltReference(const SensorSample& s) const;
+  // The attitude errors the accelerometer and the magnetometer see (body frame) [rad]; false
+  // when the sample gives none (gated out, no fresh field).
+  bool TiltError(const SensorSample& s, Vec3* e) const;
+  bool HeadingError(const SensorSample& s, Vec3* e_b) const;
+  void InitPosition(const SensorSample& s);  // on the initial position or the first fix
+  void TakeBaro(const SensorSample& s);
+  void PushHistory(double t_s);
+  void FuseGps(const SensorSample& s);       // the delayed fix, against the history
+  void Publish(const SensorSample& s);       // state_ from the filters
   void Predict(Axis* ax, int axis, double acc, double dt) const;
   // Scalar measurement with row h, innovation y, variance r; the correction is also carried into
   // the history (mapped back through the motion model) and into the output glide.

@@ -108,6 +108,12 @@ class FlightController {
   void ResetControllers();
   void StartTrajectoryHere();
   void DisarmedOutput();
+  // Command()'s parts: a rejection (event, false), and the setpoints that do more than set a
+  // target.
+  bool Reject(double t_s);
+  bool CommandTakeoff(const Setpoint& sp, double t_s);  // on the ground
+  void CommandHold(double t_s);
+  void CommandLand(double t_s);
   bool CommandTrajectory(const TrajectoryTarget& target, double t_s);
   // The trajectory kind's setpoint for this step (per-axis control, heading), from target_.
   PositionSetpoint TrajectoryStep(const StateEstimate& s, double dt_s, double* yawspeed_ff_radps);

@@ -77,6 +77,22 @@ class PositionControl {
   const Vec3& integral() const { return integral_; }
 
  private:
+  // The thrust before and after its limits [N] (world frame; xy with z = 0).
+  struct ThrustSplit {
+    double z_raw = 0.0;
+    double z = 0.0;
+    Vec3 xy_raw = Vec3::Zero();
+    Vec3 xy = Vec3::Zero();
+  };
+  // Update's steps (PX4's _positionControl, _velocityControl, thrust limits, anti-windup).
+  Vec3 VelocitySetpoint(const StateEstimate& state, const PositionSetpoint& sp) const;
+  // Acceleration-only axes: *vel_sp becomes NaN and *vel_err 0 there.
+  Vec3 AccelerationSetpoint(const StateEstimate& state, const PositionSetpoint& sp, Vec3* vel_sp,
+                            Vec3* vel_err) const;
+  ThrustSplit LimitThrust(const Vec3& acc_sp, double mass_kg) const;
+  void UpdateIntegral(const PositionSetpoint& sp, const ThrustSplit& f, const Vec3& vel_err, double mass_kg,
+                      double dt_s);
+
   PositionParams params_;
   Vec3 integral_ = Vec3::Zero();  // [m/s^2]
 };

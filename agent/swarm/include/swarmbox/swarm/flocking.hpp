@@ -164,6 +164,13 @@ class Flocking {
   const Geofence& fence() const { return fence_; }
 
  private:
+  // Step's terms (allocation-free, in this translation unit): migration toward the goal, sliding
+  // around obstacles; repulsion from every close neighbour while the nearest are picked into
+  // nearest_; friction, alignment and cohesion with those; the walls' and obstacles' shill push.
+  Vec2 MigrationTerm(const FlockingInput& in, const Vec2& p) const;
+  void ScanNeighbours(const FlockingInput& in, const Vec2& p, FlockingOutput* out);
+  void FollowNeighbours(const FlockingInput& in, const Vec2& p, const Vec2& v,
+                        FlockingOutput* out) const;
   Vec2 ShillTerm(const Vec2& p, const Vec2& v) const;
 
   FlockingParams params_;

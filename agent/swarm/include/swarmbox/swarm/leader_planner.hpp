@@ -140,7 +140,23 @@ class LeaderPlanner {
   }
 
  private:
+  struct Fleet;
   bool Due(const std::string& key, double t_s);
+  // Step's parts, in order: the live scouts and lifter; the sectors of gone drones handed over
+  // (returns whether any sector is orphaned); whether the search is finished; then one plan per
+  // phase.
+  Fleet Survey(std::span<const RosterEntry> roster) const;
+  bool ProposeReassign(double t_s, const raft::MissionState& m, std::span<const RosterEntry> roster,
+                       MissionOutput* out);
+  bool ScoutsDone(double t_s, const raft::MissionState& m, std::span<const RosterEntry> roster,
+                  bool orphans);
+  const raft::Victim* FirstUnhandled(const raft::MissionState& m) const;  // confirmed, not handled
+  void PlanStart(double t_s, const raft::MissionState& m, const Fleet& fleet, MissionOutput* out);
+  // SEARCH / CONVERGE: rescue or orbit the target, converge on the next victim, or go home once
+  // `search_finished` (scouts done, no rescue running, no candidate undecided).
+  void PlanSearch(double t_s, const raft::MissionState& m, const Fleet& fleet, bool search_finished,
+                  MissionOutput* out);
+  void ReportComplete(double t_s, const raft::MissionState& m, MissionOutput* out);
   // The sectors of drones that are gone handed to live scouts; nullopt when there is nothing to
   // hand over or nobody to take it.
   std::optional<raft::AssignSectors> Reassign(double t_s, const raft::MissionState& m,

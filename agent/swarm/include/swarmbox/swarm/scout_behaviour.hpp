@@ -138,7 +138,14 @@ class ScoutBehaviour {
 
  private:
   void Decide(const MissionInput& in, MissionOutput* out);    // stage changes from the mission
+  // On a mission stage: revisit, orbit, search, or wait (revisit: the task, or nullptr).
+  void DecideMissionStage(const MissionInput& in, const raft::Candidate* revisit, MissionOutput* out);
+  void StartSector(const raft::Sector& sector, const MissionInput& in, MissionOutput* out);
   void RunStage(const MissionInput& in, MissionOutput* out);  // the stage's setpoint
+  // The setpoints of the longer stages (RunRevisit below is the fourth).
+  void RunSearch(const MissionInput& in, MissionOutput* out);
+  void RunOrbit(const MissionInput& in, MissionOutput* out);
+  void RunReturn(const MissionInput& in, MissionOutput* out);
   void ReportSightings(const MissionInput& in, MissionOutput* out);
   void RetrySightings(const MissionInput& in, MissionOutput* out);
   void Propose(const MissionInput& in, const GroundDetection& d, int tries, MissionOutput* out);

@@ -203,7 +203,22 @@ class ClusterSim {
   void Violation(const std::string& property, const std::string& details);
   void OnSave(int node, const std::optional<HardState>& hs, std::span<const Entry> entries,
               const Snapshot& snapshot);
+  // OnSave's checks: One Change at a Time (thesis §4.1) on a leader's appends, Log Matching
+  // (Raft §5.3) on every node's.
+  void CheckOneChangeAtATime(int node, const NodeDriver& d, std::span<const Entry> entries);
+  void CheckLogMatching(int node, const MemoryStorage& st, std::span<const Entry> entries,
+                        const Snapshot& snapshot);
   void CheckNode(int node);
+  // The driver configuration of `node` after `restarts` restarts (its seed changes with each).
+  DriverConfig DriverConfigOf(int node, int restarts) const;
+  // CheckNode's checks, in order: Election Safety of terms and votes (Raft §5.2), State Machine
+  // Safety of commits (§5.4.3), a new leader's safety and completeness (§5.2, §5.4), the applied
+  // state.
+  void CheckTermAndVote(Node& n, const RawNode& raw, const std::string& who);
+  void CheckCommits(Node& n, const RawNode& raw, const std::string& who);
+  void CheckLeader(Node& n, const RawNode& raw, const std::string& who);
+  void CheckLeaderCompleteness(const RawNode& raw, const std::string& who);
+  void CheckStateMachine(Node& n, const NodeDriver& d, const std::string& who);
   void CheckTap(int node);
   double Uniform(double lo, double hi);
   bool Chance(double p);
