@@ -51,11 +51,50 @@ class SinceStartClock final : public swarmbox::raft::Clock {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
 };
 
+// Prints "swarmbox-raft-node: <context><error>" and returns `code`.
+int Fail(int code, const char* context, const swarmbox::Error& e) {
+  std::fprintf(stderr, "swarmbox-raft-node: %s%s\n", context, e.ToString().c_str());
+  return code;
+}
+
+// The wall-clock loop (see the banner) until a signal, --duration-s, or a storage failure (1).
+int RunLoop(swarmbox::mission::RaftService& raft, swarmbox::mission::PayloadInbox& inbox,
+            const SinceStartClock& clock, const swarmbox::mission::RaftNodeOptions& opts) {
+  using namespace swarmbox;
+  using namespace std::chrono;
+  const auto start = steady_clock::now();
+  const auto propose_every = milliseconds(opts.propose_every_ms);
+  auto next_propose = start + propose_every;
+  std::vector<raft::Bytes> batch;
+  while (g_signal == 0) {
+    // Wake for the next tick, the next proposal, the first arrival, or at least every 20 ms (a
+    // signal or the duration ending).
+    auto wake = std::min(clock.At(raft.next_tick_s()), steady_clock::now() + milliseconds(20));
+    if (opts.propose_every_ms > 0) wake = std::min(wake, next_propose);
+    inbox.WaitUntil(wake);
+    batch.clear();
+    inbox.Drain(&batch);
+    for (const raft::Bytes& b : batch) raft.OnPayload(b);
+    (void)raft.Tick();
+    const auto now = steady_clock::now();
+    if (opts.propose_every_ms > 0 && now >= next_propose && !raft.stopped()) {
+      next_propose = now + propose_every;
+      if (raft.is_leader()) {
+        if (auto cmd = mission::NextDemoCommand(raft.mission(), raft.self())) {
+          (void)raft.Propose(*cmd);  // kUnavailable (leadership just lost): the next round retries
+        }
+      }
+    }
+    if (Status h = raft.health(); !h) return Fail(1, "stopped: ", h.error());
+    if (opts.duration_s > 0 && now - start >= duration<double>(opts.duration_s)) break;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace swarmbox;
-  using namespace std::chrono;
   std::vector<std::string> args(argv + 1, argv + argc);
   auto opts = mission::ParseRaftNodeArgs(args);
   if (!opts) {
@@ -72,61 +111,20 @@ int main(int argc, char** argv) {
 
   auto mesh = bus::Participant::Create(
       {.backend = opts->middleware, .domain_id = opts->domain, .interface = opts->interface});
-  if (!mesh) {
-    std::fprintf(stderr, "swarmbox-raft-node: mesh bus: %s\n", mesh.error().ToString().c_str());
-    return 3;
-  }
+  if (!mesh) return Fail(3, "mesh bus: ", mesh.error());
   SinceStartClock clock;
   mission::PayloadInbox inbox;  // before the radio: its callback pushes here until it is gone
   // A writer per member (RaftRadio: reordering on the radio must not become extra loss).
   auto radio = mission::RaftRadio::Create(**mesh, opts->driver.self, opts->driver.members,
                                           [&inbox](std::span<const std::uint8_t> b) { inbox.Push(b); });
-  if (!radio) {
-    std::fprintf(stderr, "swarmbox-raft-node: %s\n", radio.error().ToString().c_str());
-    return 3;
-  }
+  if (!radio) return Fail(3, "", radio.error());
   mission::RaftServiceConfig cfg;
   cfg.driver = opts->driver;
   cfg.driver.tap_committed = false;  // the demo reads the mission's state, never the entries
   cfg.data_dir = opts->data_dir;
   auto service = mission::RaftService::Start(cfg, **radio, clock);
-  if (!service) {
-    std::fprintf(stderr, "swarmbox-raft-node: %s\n", service.error().ToString().c_str());
-    return 3;
-  }
-  mission::RaftService& raft = **service;
-
-  const auto start = steady_clock::now();
-  const auto propose_every = milliseconds(opts->propose_every_ms);
-  auto next_propose = start + propose_every;
-  std::vector<raft::Bytes> batch;
-  int code = 0;
-  while (g_signal == 0) {
-    // Wake for the next tick, the next proposal, the first arrival, or at least every 20 ms (a
-    // signal or the duration ending).
-    auto wake = std::min(clock.At(raft.next_tick_s()), steady_clock::now() + milliseconds(20));
-    if (opts->propose_every_ms > 0) wake = std::min(wake, next_propose);
-    inbox.WaitUntil(wake);
-    batch.clear();
-    inbox.Drain(&batch);
-    for (const raft::Bytes& b : batch) raft.OnPayload(b);
-    (void)raft.Tick();
-    const auto now = steady_clock::now();
-    if (opts->propose_every_ms > 0 && now >= next_propose && !raft.stopped()) {
-      next_propose = now + propose_every;
-      if (raft.is_leader()) {
-        if (auto cmd = mission::NextDemoCommand(raft.mission(), raft.self())) {
-          (void)raft.Propose(*cmd);  // kUnavailable (leadership just lost): the next round retries
-        }
-      }
-    }
-    if (Status h = raft.health(); !h) {
-      std::fprintf(stderr, "swarmbox-raft-node: stopped: %s\n", h.error().ToString().c_str());
-      code = 1;
-      break;
-    }
-    if (opts->duration_s > 0 && now - start >= duration<double>(opts->duration_s)) break;
-  }
+  if (!service) return Fail(3, "", service.error());
+  const int code = RunLoop(**service, inbox, clock, *opts);
   service->reset();
   radio->reset();  // no callback into the inbox after this
   return code;

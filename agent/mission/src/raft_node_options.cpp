@@ -43,6 +43,77 @@ std::string RaftNodeUsage() {
          "         [--election-timeout-ms N]\n";
 }
 
+namespace {
+
+bool IsNumberFlag(const std::string& flag) {
+  return flag == "--domain" || flag == "--seed" || flag == "--propose-every-ms" ||
+         flag == "--duration-s" || flag == "--tick-ms" || flag == "--heartbeat-ms" ||
+         flag == "--election-timeout-ms";
+}
+
+// One of the IsNumberFlag flags with its value.
+Status ApplyNumberFlag(const std::string& flag, const std::string& v, RaftNodeOptions* o) {
+  if (flag == "--seed") {
+    auto n = ParseNumber<std::uint64_t>(flag, v);
+    if (!n) return n.error();
+    o->driver.seed = *n;
+    return Ok{};
+  }
+  if (flag == "--duration-s") {
+    auto n = ParseNumber<double>(flag, v);
+    if (!n) return n.error();
+    if (!(*n >= 0)) return Bad("--duration-s: must be >= 0");
+    o->duration_s = *n;
+    return Ok{};
+  }
+  auto n = ParseNumber<int>(flag, v);
+  if (!n) return n.error();
+  if (flag == "--propose-every-ms" && *n < 0) return Bad("--propose-every-ms: must be >= 0");
+  int& field = flag == "--domain"             ? o->domain
+               : flag == "--propose-every-ms" ? o->propose_every_ms
+               : flag == "--tick-ms"          ? o->driver.tick_ms
+               : flag == "--heartbeat-ms"     ? o->driver.heartbeat_ms
+                                              : o->driver.election_timeout_ms;
+  field = *n;
+  return Ok{};
+}
+
+Status ApplyFlag(const std::string& flag, const std::string& v, RaftNodeOptions* o, bool* have_members) {
+  if (IsNumberFlag(flag)) return ApplyNumberFlag(flag, v, o);
+  if (flag == "--name") {
+    o->driver.self = v;
+  } else if (flag == "--members") {
+    o->driver.members = SplitComma(v);
+    *have_members = true;
+  } else if (flag == "--data-dir") {
+    o->data_dir = v;
+  } else if (flag == "--interface") {
+    o->interface = v;
+  } else if (flag == "--middleware") {
+    if (v != "cyclonedds" && v != "fastdds") {
+      return Bad("--middleware: '" + v + "' is not cyclonedds or fastdds");
+    }
+    o->middleware = v;
+  } else {
+    return Bad("unknown flag '" + flag + "'");
+  }
+  return Ok{};
+}
+
+Status CheckOptions(const RaftNodeOptions& o, bool have_members) {
+  if (o.driver.self.empty()) return Bad("--name is required");
+  if (!have_members) return Bad("--members is required");
+  if (o.data_dir.empty()) return Bad("--data-dir is required");
+  if (auto s = bus::ValidateDroneName(o.driver.self); !s) return s.error().Context("--name");
+  for (const std::string& m : o.driver.members) {
+    if (auto s = bus::ValidateDroneName(m); !s) return s.error().Context("--members");
+  }
+  if (auto c = o.driver.ToRaftConfig(); !c) return c.error();
+  return Ok{};
+}
+
+}  // namespace
+
 Result<RaftNodeOptions> ParseRaftNodeArgs(const std::vector<std::string>& args) {
   RaftNodeOptions o;
   bool have_members = false;
@@ -55,58 +126,9 @@ Result<RaftNodeOptions> ParseRaftNodeArgs(const std::vector<std::string>& args) 
     if (flag.rfind("--", 0) != 0) return Bad("unexpected argument '" + flag + "'");
     if (i + 1 >= args.size()) return Bad(flag + ": missing value");
     const std::string& v = args[++i];
-    if (flag == "--name") {
-      o.driver.self = v;
-    } else if (flag == "--members") {
-      o.driver.members = SplitComma(v);
-      have_members = true;
-    } else if (flag == "--data-dir") {
-      o.data_dir = v;
-    } else if (flag == "--domain") {
-      auto n = ParseNumber<int>(flag, v);
-      if (!n) return n.error();
-      o.domain = *n;
-    } else if (flag == "--interface") {
-      o.interface = v;
-    } else if (flag == "--middleware") {
-      if (v != "cyclonedds" && v != "fastdds") {
-        return Bad("--middleware: '" + v + "' is not cyclonedds or fastdds");
-      }
-      o.middleware = v;
-    } else if (flag == "--seed") {
-      auto n = ParseNumber<std::uint64_t>(flag, v);
-      if (!n) return n.error();
-      o.driver.seed = *n;
-    } else if (flag == "--propose-every-ms") {
-      auto n = ParseNumber<int>(flag, v);
-      if (!n) return n.error();
-      if (*n < 0) return Bad("--propose-every-ms: must be >= 0");
-      o.propose_every_ms = *n;
-    } else if (flag == "--duration-s") {
-      auto n = ParseNumber<double>(flag, v);
-      if (!n) return n.error();
-      if (!(*n >= 0)) return Bad("--duration-s: must be >= 0");
-      o.duration_s = *n;
-    } else if (flag == "--tick-ms" || flag == "--heartbeat-ms" ||
-               flag == "--election-timeout-ms") {
-      auto n = ParseNumber<int>(flag, v);
-      if (!n) return n.error();
-      int& field = flag == "--tick-ms"        ? o.driver.tick_ms
-                   : flag == "--heartbeat-ms" ? o.driver.heartbeat_ms
-                                              : o.driver.election_timeout_ms;
-      field = *n;
-    } else {
-      return Bad("unknown flag '" + flag + "'");
-    }
+    if (auto s = ApplyFlag(flag, v, &o, &have_members); !s) return s.error();
   }
-  if (o.driver.self.empty()) return Bad("--name is required");
-  if (!have_members) return Bad("--members is required");
-  if (o.data_dir.empty()) return Bad("--data-dir is required");
-  if (auto s = bus::ValidateDroneName(o.driver.self); !s) return s.error().Context("--name");
-  for (const std::string& m : o.driver.members) {
-    if (auto s = bus::ValidateDroneName(m); !s) return s.error().Context("--members");
-  }
-  if (auto c = o.driver.ToRaftConfig(); !c) return c.error();
+  if (auto s = CheckOptions(o, have_members); !s) return s.error();
   return o;
 }
 

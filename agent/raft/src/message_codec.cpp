@@ -54,6 +54,59 @@ Error Protocol(std::string what) {
   return Error(ErrorCode::kProtocol, std::move(what), "raft message");
 }
 
+
+// The entries of a message; a non-empty result is why they are invalid (an unknown entry type).
+std::string ReadEntries(detail::ByteReader& r, std::vector<Entry>* entries) {
+  const std::uint64_t n = r.Count(4, "entry");
+  entries->reserve(static_cast<std::size_t>(n));
+  for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
+    Entry e;
+    e.term = r.Varint();
+    e.index = r.Varint();
+    const std::uint8_t et = r.U8();
+    if (r.ok() && et > kMaxEntryType) return "invalid entry type " + std::to_string(et);
+    e.type = static_cast<EntryType>(et);
+    e.data = r.Blob();
+    entries->push_back(std::move(e));
+  }
+  return {};
+}
+
+// A kSnap message's snapshot; non-empty: why it is invalid.
+std::string ReadSnapshot(detail::ByteReader& r, Snapshot* snapshot) {
+  snapshot->index = r.Varint();
+  snapshot->term = r.Varint();
+  snapshot->data = r.Blob();
+  if (r.ok() && (snapshot->index == 0 || snapshot->term == 0)) {
+    return "snapshot message without a snapshot";
+  }
+  detail::ReadConfState(r, &snapshot->conf);
+  return {};
+}
+
+// What a well-formed message must also be: a sender, a term (but proposals), entries only in
+// proposals and appends, an append's entries contiguous after `index` and within `term`.
+// Non-empty: why the message is invalid.
+std::string CheckMessageFields(const Message& m) {
+  if (m.from == kNoNode) return "message without a sender";
+  if (m.type != MessageType::kProp && m.term == 0) return "message without a term";
+  if (m.type == MessageType::kApp) {
+    // The receiver appends these as they are: they must follow `index` and not outrun `term`.
+    std::uint64_t prev_term = m.log_term;
+    for (std::size_t k = 0; k < m.entries.size(); ++k) {
+      const Entry& e = m.entries[k];
+      if (e.index != m.index + 1 + k || e.term < prev_term || e.term > m.term) {
+        return "append entries are not contiguous (entry " + std::to_string(k) + ")";
+      }
+      prev_term = e.term;
+    }
+    if (m.log_term > m.term) return "append log_term beyond the message term";
+  } else if (m.type != MessageType::kProp && !m.entries.empty()) {
+    return "entries in a " + std::string(MessageTypeName(m.type)) + " message";
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<Message> DecodeMessage(std::span<const std::uint8_t> bytes, std::uint32_t cluster_tag) {
@@ -85,48 +138,16 @@ Result<Message> DecodeMessage(std::span<const std::uint8_t> bytes, std::uint32_t
   if (r.ok() && flags > 1) return Protocol("invalid flags " + std::to_string(flags));
   m.reject = flags == 1;
   m.reject_hint = r.Varint();
-  const std::uint64_t n = r.Count(4, "entry");
-  m.entries.reserve(static_cast<std::size_t>(n));
-  for (std::uint64_t k = 0; k < n && r.ok(); ++k) {
-    Entry e;
-    e.term = r.Varint();
-    e.index = r.Varint();
-    const std::uint8_t et = r.U8();
-    if (r.ok() && et > kMaxEntryType) return Protocol("invalid entry type " + std::to_string(et));
-    e.type = static_cast<EntryType>(et);
-    e.data = r.Blob();
-    m.entries.push_back(std::move(e));
-  }
+  if (std::string why = ReadEntries(r, &m.entries); !why.empty()) return Protocol(std::move(why));
   if (m.type == MessageType::kSnap) {
-    m.snapshot.index = r.Varint();
-    m.snapshot.term = r.Varint();
-    m.snapshot.data = r.Blob();
-    if (r.ok() && (m.snapshot.index == 0 || m.snapshot.term == 0)) {
-      return Protocol("snapshot message without a snapshot");
-    }
-    detail::ReadConfState(r, &m.snapshot.conf);
+    if (std::string why = ReadSnapshot(r, &m.snapshot); !why.empty()) return Protocol(std::move(why));
   }
   if (!r.ok()) return Protocol(r.error());
   if (!r.at_end()) {
     return Protocol(std::to_string(r.remaining()) + " trailing bytes at byte " +
                     std::to_string(r.offset()));
   }
-  if (m.from == kNoNode) return Protocol("message without a sender");
-  if (m.type != MessageType::kProp && m.term == 0) return Protocol("message without a term");
-  if (m.type == MessageType::kApp) {
-    // The receiver appends these as they are: they must follow `index` and not outrun `term`.
-    std::uint64_t prev_term = m.log_term;
-    for (std::size_t k = 0; k < m.entries.size(); ++k) {
-      const Entry& e = m.entries[k];
-      if (e.index != m.index + 1 + k || e.term < prev_term || e.term > m.term) {
-        return Protocol("append entries are not contiguous (entry " + std::to_string(k) + ")");
-      }
-      prev_term = e.term;
-    }
-    if (m.log_term > m.term) return Protocol("append log_term beyond the message term");
-  } else if (m.type != MessageType::kProp && !m.entries.empty()) {
-    return Protocol("entries in a " + std::string(MessageTypeName(m.type)) + " message");
-  }
+  if (std::string why = CheckMessageFields(m); !why.empty()) return Protocol(std::move(why));
   return m;
 }
 
