@@ -43,7 +43,6 @@ Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::
                  "dds radio: Raft and pings need another member besides '" + self + "'");
   }
   std::unique_ptr<DdsRadio> radio(new DdsRadio(std::move(self), std::move(peers)));
-  DdsRadio* raw = radio.get();
   auto sp = mesh.CreatePublisher<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState);
   if (!sp) return sp.error().Context("dds radio: publishing drone state");
   radio->state_pub_ = std::move(*sp);
@@ -51,77 +50,96 @@ Result<std::unique_ptr<DdsRadio>> DdsRadio::Create(bus::Participant& mesh, std::
   if (!dp) return dp.error().Context("dds radio: publishing detections");
   radio->detection_pub_ = std::move(*dp);
   if (options.pings) {
-    auto writer = [&mesh]() {
-      return mesh.CreatePublisher<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio);
-    };
-    for (std::size_t i = 0; i < radio->peers_.size(); ++i) {
-      auto ping = writer();
-      if (!ping) return ping.error().Context("dds radio: creating a ping writer");
-      radio->ping_writers_.push_back(std::move(*ping));
-      auto pong = writer();
-      if (!pong) return pong.error().Context("dds radio: creating a pong writer");
-      radio->pong_writers_.push_back(std::move(*pong));
-    }
-    auto other = writer();
-    if (!other) return other.error().Context("dds radio: creating the pong writer");
-    radio->other_pong_writer_ = std::move(*other);
-    auto sub = mesh.CreateSubscriber<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio,
-                                                     [raw](const bus::RadioPing& m) {
-                                                       if (m.to != raw->self_ || m.from == raw->self_) return;
-                                                       bus::RadioFrame f;
-                                                       f.from = m.from;
-                                                       f.to = m.to;
-                                                       f.ping_msg.push_back(m);
-                                                       raw->Push(std::move(f));
-                                                     });
-    if (!sub) return sub.error().Context("dds radio: hearing pings");
-    radio->ping_sub_ = std::move(*sub);
+    if (auto s = radio->OpenPings(mesh); !s) return s.error();
   }
   if (options.raft) {
-    auto rr = mission::RaftRadio::Create(mesh, radio->self_, radio->peers_,
-                                         [raw](std::span<const std::uint8_t> bytes) {
-                                           bus::RadioFrame f;
-                                           f.to = raw->self_;
-                                           bus::RaftMessage m;
-                                           m.to = raw->self_;
-                                           m.term = mission::PeekRaftTerm(bytes);
-                                           m.payload.assign(bytes.begin(), bytes.end());
-                                           f.raft_msg.push_back(std::move(m));
-                                           raw->Push(std::move(f));
-                                         });
-    if (!rr) return rr.error().Context("dds radio: raft");
-    radio->raft_ = std::move(*rr);
+    if (auto s = radio->OpenRaft(mesh); !s) return s.error();
   }
   if (options.hear_states) {
-    auto sub = mesh.CreateSubscriber<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState,
-                                                      [raw](const bus::DroneState& m) {
-                                                        if (m.drone == raw->self_) return;
-                                                        bus::RadioFrame f;
-                                                        f.from = m.drone;
-                                                        f.state_msg.push_back(m);
-                                                        raw->Push(std::move(f));
-                                                      });
-    if (!sub) return sub.error().Context("dds radio: hearing drone states");
-    radio->state_sub_ = std::move(*sub);
+    if (auto s = radio->HearStates(mesh); !s) return s.error();
   }
   if (options.brains) {
-    auto bp = mesh.CreatePublisher<bus::BrainMessage>(bus::kBrainMessageTopic, bus::Qos::kRadio);
-    if (!bp) return bp.error().Context("dds radio: publishing brain messages");
-    radio->brain_pub_ = std::move(*bp);
-    auto sub = mesh.CreateSubscriber<bus::BrainMessage>(bus::kBrainMessageTopic, bus::Qos::kRadio,
-                                                        [raw](const bus::BrainMessage& m) {
-                                                          if (m.from == raw->self_) return;
-                                                          if (!m.to.empty() && m.to != raw->self_) return;
-                                                          bus::RadioFrame f;
-                                                          f.from = m.from;
-                                                          f.to = m.to;
-                                                          f.brain_msg.push_back(m);
-                                                          raw->Push(std::move(f));
-                                                        });
-    if (!sub) return sub.error().Context("dds radio: hearing brain messages");
-    radio->brain_sub_ = std::move(*sub);
+    if (auto s = radio->OpenBrains(mesh); !s) return s.error();
   }
   return radio;
+}
+
+Status DdsRadio::OpenPings(bus::Participant& mesh) {
+  auto writer = [&mesh]() {
+    return mesh.CreatePublisher<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio);
+  };
+  for (std::size_t i = 0; i < peers_.size(); ++i) {
+    auto ping = writer();
+    if (!ping) return ping.error().Context("dds radio: creating a ping writer");
+    ping_writers_.push_back(std::move(*ping));
+    auto pong = writer();
+    if (!pong) return pong.error().Context("dds radio: creating a pong writer");
+    pong_writers_.push_back(std::move(*pong));
+  }
+  auto other = writer();
+  if (!other) return other.error().Context("dds radio: creating the pong writer");
+  other_pong_writer_ = std::move(*other);
+  auto sub = mesh.CreateSubscriber<bus::RadioPing>(bus::kRadioPingTopic, bus::Qos::kRadio,
+                                                   [this](const bus::RadioPing& m) {
+                                                     if (m.to != self_ || m.from == self_) return;
+                                                     bus::RadioFrame f;
+                                                     f.from = m.from;
+                                                     f.to = m.to;
+                                                     f.ping_msg.push_back(m);
+                                                     Push(std::move(f));
+                                                   });
+  if (!sub) return sub.error().Context("dds radio: hearing pings");
+  ping_sub_ = std::move(*sub);
+  return Ok{};
+}
+
+Status DdsRadio::OpenRaft(bus::Participant& mesh) {
+  auto rr = mission::RaftRadio::Create(mesh, self_, peers_, [this](std::span<const std::uint8_t> bytes) {
+    bus::RadioFrame f;
+    f.to = self_;
+    bus::RaftMessage m;
+    m.to = self_;
+    m.term = mission::PeekRaftTerm(bytes);
+    m.payload.assign(bytes.begin(), bytes.end());
+    f.raft_msg.push_back(std::move(m));
+    Push(std::move(f));
+  });
+  if (!rr) return rr.error().Context("dds radio: raft");
+  raft_ = std::move(*rr);
+  return Ok{};
+}
+
+Status DdsRadio::HearStates(bus::Participant& mesh) {
+  auto sub = mesh.CreateSubscriber<bus::DroneState>(bus::kDroneStateTopic, bus::Qos::kState,
+                                                    [this](const bus::DroneState& m) {
+                                                      if (m.drone == self_) return;
+                                                      bus::RadioFrame f;
+                                                      f.from = m.drone;
+                                                      f.state_msg.push_back(m);
+                                                      Push(std::move(f));
+                                                    });
+  if (!sub) return sub.error().Context("dds radio: hearing drone states");
+  state_sub_ = std::move(*sub);
+  return Ok{};
+}
+
+Status DdsRadio::OpenBrains(bus::Participant& mesh) {
+  auto bp = mesh.CreatePublisher<bus::BrainMessage>(bus::kBrainMessageTopic, bus::Qos::kRadio);
+  if (!bp) return bp.error().Context("dds radio: publishing brain messages");
+  brain_pub_ = std::move(*bp);
+  auto sub = mesh.CreateSubscriber<bus::BrainMessage>(bus::kBrainMessageTopic, bus::Qos::kRadio,
+                                                      [this](const bus::BrainMessage& m) {
+                                                        if (m.from == self_) return;
+                                                        if (!m.to.empty() && m.to != self_) return;
+                                                        bus::RadioFrame f;
+                                                        f.from = m.from;
+                                                        f.to = m.to;
+                                                        f.brain_msg.push_back(m);
+                                                        Push(std::move(f));
+                                                      });
+  if (!sub) return sub.error().Context("dds radio: hearing brain messages");
+  brain_sub_ = std::move(*sub);
+  return Ok{};
 }
 
 void DdsRadio::Push(bus::RadioFrame frame) {

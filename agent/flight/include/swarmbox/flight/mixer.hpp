@@ -60,6 +60,20 @@ class Mixer {
   const Eigen::Matrix<double, 4, Eigen::Dynamic>& effectiveness() const { return b_; }
 
  private:
+  // Each rotor's thrust share of the roll/pitch torque, the yaw torque and the collective [N].
+  struct Shares {
+    std::array<double, kMaxRotors> rp{};
+    std::array<double, kMaxRotors> yaw{};
+    std::array<double, kMaxRotors> col{};
+  };
+  // Mix()'s priorities, in order: the roll/pitch scale, the collective shift that makes it fit,
+  // the yaw scale that still fits.
+  double RollPitchScale(const Shares& sh) const;
+  double CollectiveShift(const Shares& sh, double rp_scale) const;
+  double YawScale(const Shares& sh, double rp_scale, double shift) const;
+  // alloc_ from b_ (its pseudo-inverse); fails when the geometry has rank < 4.
+  Status Allocate();
+
   std::size_t n_ = 0;
   std::array<double, kMaxRotors> max_thrust_{};
   std::array<double, kMaxRotors> inv_k_wmax2_{};

@@ -83,6 +83,13 @@ class DdsRadio final : public MeshRadio {
  private:
   using PingWriter = bus::Publisher<bus::RadioPing>;
   DdsRadio(std::string self, std::vector<std::string> peers);
+  // Create's optional parts (DdsRadioOptions): a ping and a pong writer per peer and the ping
+  // reader; Raft over the radio; the neighbours' states; brain messages. Callbacks run on
+  // middleware threads and only Push().
+  Status OpenPings(bus::Participant& mesh);
+  Status OpenRaft(bus::Participant& mesh);
+  Status HearStates(bus::Participant& mesh);
+  Status OpenBrains(bus::Participant& mesh);
   void Push(bus::RadioFrame frame);  // middleware threads
   PingWriter& PingWriterFor(const bus::RadioPing& m);
   bool Publish(const bus::RadioFrame& frame);
