@@ -133,64 +133,73 @@ void SensorSuite::Sample(std::int64_t time_ns, const TrueKinematics& t, bool gps
     history_count_ = std::min(history_count_ + 1, kHistory);
   }
   out->imu.fresh = out->baro.fresh = out->mag.fresh = out->gps.fresh = false;
-  const double g = world_->gravity_m_s2;
+  // Each sensor when it is due, in this order (the noise draws share one generator).
+  if (time_ns >= imu_next_ns_) SampleImu(time_ns, t, out);
+  if (time_ns >= baro_next_ns_) SampleBaro(time_ns, t, out);
+  if (time_ns >= mag_next_ns_) SampleMag(time_ns, t, out);
+  if (time_ns >= gps_next_ns_) SampleGps(time_ns, gps_dropout, out);
+}
 
-  if (time_ns >= imu_next_ns_) {
-    const double dt_s = static_cast<double>(imu_period_ns_) * 1e-9;
-    const double aw = imu_.accel_bias_walk_std_m_s2 * std::sqrt(dt_s);
-    const double gw = imu_.gyro_bias_walk_std_rad_s * std::sqrt(dt_s);
-    accel_bias_ += Vec3{Gauss(aw), Gauss(aw), Gauss(aw)};
-    gyro_bias_ += Vec3{Gauss(gw), Gauss(gw), Gauss(gw)};
-    const Vec3 specific = RotateInverse(t.attitude, t.accel_m_s2 + Vec3{0, 0, g});
-    const double an = imu_.accel_noise_std_m_s2, gn = imu_.gyro_noise_std_rad_s;
-    out->imu.accel_m_s2 = specific + accel_bias_ + Vec3{Gauss(an), Gauss(an), Gauss(an)};
-    out->imu.gyro_rad_s = t.body_rates_rad_s + gyro_bias_ + Vec3{Gauss(gn), Gauss(gn), Gauss(gn)};
-    out->imu.fresh = true;
-    imu_next_ns_ += imu_period_ns_;
-    if (imu_next_ns_ <= time_ns) imu_next_ns_ = time_ns + imu_period_ns_;
+void SensorSuite::Reschedule(std::int64_t time_ns, std::int64_t period_ns, std::int64_t* next_ns) {
+  *next_ns += period_ns;
+  if (*next_ns <= time_ns) *next_ns = time_ns + period_ns;
+}
+
+void SensorSuite::SampleImu(std::int64_t time_ns, const TrueKinematics& t, SensorSample* out) {
+  const double g = world_->gravity_m_s2;
+  const double dt_s = static_cast<double>(imu_period_ns_) * 1e-9;
+  const double aw = imu_.accel_bias_walk_std_m_s2 * std::sqrt(dt_s);
+  const double gw = imu_.gyro_bias_walk_std_rad_s * std::sqrt(dt_s);
+  accel_bias_ += Vec3{Gauss(aw), Gauss(aw), Gauss(aw)};
+  gyro_bias_ += Vec3{Gauss(gw), Gauss(gw), Gauss(gw)};
+  const Vec3 specific = RotateInverse(t.attitude, t.accel_m_s2 + Vec3{0, 0, g});
+  const double an = imu_.accel_noise_std_m_s2, gn = imu_.gyro_noise_std_rad_s;
+  out->imu.accel_m_s2 = specific + accel_bias_ + Vec3{Gauss(an), Gauss(an), Gauss(an)};
+  out->imu.gyro_rad_s = t.body_rates_rad_s + gyro_bias_ + Vec3{Gauss(gn), Gauss(gn), Gauss(gn)};
+  out->imu.fresh = true;
+  Reschedule(time_ns, imu_period_ns_, &imu_next_ns_);
+}
+
+void SensorSuite::SampleBaro(std::int64_t time_ns, const TrueKinematics& t, SensorSample* out) {
+  const double amsl = world_->home_alt_m + t.position_m.z;
+  const double p = IsaPressurePa(amsl) + Gauss(baro_.noise_std_pa);
+  out->baro.pressure_pa = p;
+  out->baro.altitude_m = IsaAltitudeM(p) - world_->home_alt_m;
+  out->baro.temperature_c = IsaTemperatureC(amsl);
+  out->baro.fresh = true;
+  Reschedule(time_ns, baro_period_ns_, &baro_next_ns_);
+}
+
+void SensorSuite::SampleMag(std::int64_t time_ns, const TrueKinematics& t, SensorSample* out) {
+  const double n = mag_.noise_std_gauss;
+  out->mag.field_gauss = RotateInverse(t.attitude, world_->magnetic_field_gauss) + Vec3{Gauss(n), Gauss(n), Gauss(n)};
+  out->mag.fresh = true;
+  Reschedule(time_ns, mag_period_ns_, &mag_next_ns_);
+}
+
+void SensorSuite::SampleGps(std::int64_t time_ns, bool gps_dropout, SensorSample* out) {
+  GpsSample& gps = out->gps;
+  gps.fresh = true;
+  if (gps_dropout) {
+    gps.valid = false;
+    gps.fix_type = 0;
+  } else {
+    const double h = gps_.horizontal_std_m, v = gps_.vertical_std_m, s = gps_.velocity_std_m_s;
+    const double dt_s = last_fix_ns_ < 0 ? 0.0 : static_cast<double>(time_ns - last_fix_ns_) * 1e-9;
+    last_fix_ns_ = time_ns;
+    const PastState& past = Delayed(time_ns);
+    gps.valid = true;
+    gps.fix_type = 3;
+    gps.position_m = past.position_m + gps_error_.Next(dt_s, gps_split_);
+    gps.velocity_m_s = past.velocity_m_s + Vec3{Gauss(s), Gauss(s), Gauss(s)};
+    const double lat0 = world_->home_lat_deg * std::numbers::pi / 180.0;
+    gps.lat_deg = world_->home_lat_deg + gps.position_m.y / kEarthRadiusM * 180.0 / std::numbers::pi;
+    gps.lon_deg = world_->home_lon_deg + gps.position_m.x / (kEarthRadiusM * std::cos(lat0)) * 180.0 / std::numbers::pi;
+    gps.alt_m = world_->home_alt_m + gps.position_m.z;
+    gps.h_acc_m = h;
+    gps.v_acc_m = v;
   }
-  if (time_ns >= baro_next_ns_) {
-    const double amsl = world_->home_alt_m + t.position_m.z;
-    const double p = IsaPressurePa(amsl) + Gauss(baro_.noise_std_pa);
-    out->baro.pressure_pa = p;
-    out->baro.altitude_m = IsaAltitudeM(p) - world_->home_alt_m;
-    out->baro.temperature_c = IsaTemperatureC(amsl);
-    out->baro.fresh = true;
-    baro_next_ns_ += baro_period_ns_;
-    if (baro_next_ns_ <= time_ns) baro_next_ns_ = time_ns + baro_period_ns_;
-  }
-  if (time_ns >= mag_next_ns_) {
-    const double n = mag_.noise_std_gauss;
-    out->mag.field_gauss = RotateInverse(t.attitude, world_->magnetic_field_gauss) + Vec3{Gauss(n), Gauss(n), Gauss(n)};
-    out->mag.fresh = true;
-    mag_next_ns_ += mag_period_ns_;
-    if (mag_next_ns_ <= time_ns) mag_next_ns_ = time_ns + mag_period_ns_;
-  }
-  if (time_ns >= gps_next_ns_) {
-    GpsSample& gps = out->gps;
-    gps.fresh = true;
-    if (gps_dropout) {
-      gps.valid = false;
-      gps.fix_type = 0;
-    } else {
-      const double h = gps_.horizontal_std_m, v = gps_.vertical_std_m, s = gps_.velocity_std_m_s;
-      const double dt_s = last_fix_ns_ < 0 ? 0.0 : static_cast<double>(time_ns - last_fix_ns_) * 1e-9;
-      last_fix_ns_ = time_ns;
-      const PastState& past = Delayed(time_ns);
-      gps.valid = true;
-      gps.fix_type = 3;
-      gps.position_m = past.position_m + gps_error_.Next(dt_s, gps_split_);
-      gps.velocity_m_s = past.velocity_m_s + Vec3{Gauss(s), Gauss(s), Gauss(s)};
-      const double lat0 = world_->home_lat_deg * std::numbers::pi / 180.0;
-      gps.lat_deg = world_->home_lat_deg + gps.position_m.y / kEarthRadiusM * 180.0 / std::numbers::pi;
-      gps.lon_deg = world_->home_lon_deg + gps.position_m.x / (kEarthRadiusM * std::cos(lat0)) * 180.0 / std::numbers::pi;
-      gps.alt_m = world_->home_alt_m + gps.position_m.z;
-      gps.h_acc_m = h;
-      gps.v_acc_m = v;
-    }
-    gps_next_ns_ += gps_period_ns_;
-    if (gps_next_ns_ <= time_ns) gps_next_ns_ = time_ns + gps_period_ns_;
-  }
+  Reschedule(time_ns, gps_period_ns_, &gps_next_ns_);
 }
 
 void SensorSuite::SetGpsAccuracy(double horizontal_std_m, double vertical_std_m) {

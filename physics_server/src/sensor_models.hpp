@@ -128,6 +128,13 @@ class SensorSuite {
  private:
   double Gauss(double std) { return std * normal_(rng_); }
   static std::int64_t PeriodNs(double rate_hz);
+  // Sample()'s sensors, each when due; then its next time one period on (or one period from now
+  // after a gap).
+  static void Reschedule(std::int64_t time_ns, std::int64_t period_ns, std::int64_t* next_ns);
+  void SampleImu(std::int64_t time_ns, const TrueKinematics& t, SensorSample* out);
+  void SampleBaro(std::int64_t time_ns, const TrueKinematics& t, SensorSample* out);
+  void SampleMag(std::int64_t time_ns, const TrueKinematics& t, SensorSample* out);
+  void SampleGps(std::int64_t time_ns, bool gps_dropout, SensorSample* out);
   struct PastState {
     std::int64_t time_ns = 0;
     Vec3 position_m, velocity_m_s;

@@ -355,6 +355,13 @@ struct World::Impl {
     d.sample.step = step;
   }
 
+  // AddDrone's parts: the drone's bodies, geoms, motors and sensors (not yet in the world's
+  // lists); its payload's body; then, once listed, the sling and the broad-phase slots.
+  std::unique_ptr<Drone> NewDrone(const DroneSpawn& spawn, const PayloadSpec* payload, std::size_t index);
+  void AddPayloadBody(Drone& d, const DroneSpawn& spawn, std::size_t index);
+  void AttachSling(Drone& d, const DroneSpawn& spawn);
+  void GrowBroadPhase(const Drone& added);
+
   void Dispatch() {
     if (sink != nullptr) {
       for (std::size_t k = 0; k < pending_count; ++k) {
@@ -452,10 +459,11 @@ Result<std::unique_ptr<World>> World::Create(const WorldConfig& config, const Wo
   return std::unique_ptr<World>(new World(std::move(impl)));
 }
 
-Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
-  Impl& w = *impl_;
-  if (spawn.name.empty()) return Error(ErrorCode::kInvalidArgument, "drone name is empty");
-  if (FindDrone(spawn.name)) return Error(ErrorCode::kAlreadyExists, "duplicate drone name '" + spawn.name + "'");
+namespace {
+
+// The spawn's checks after its name: a usable airframe, above the ground, a known payload with
+// room to hang. The payload (in spawn.airframe), or nullptr.
+Result<const PayloadSpec*> CheckSpawn(const DroneSpawn& spawn) {
   const Airframe& af = spawn.airframe;
   if (af.rotors.empty() || af.rotors.size() > 8 || af.mass_kg <= 0) {
     return Error(ErrorCode::kInvalidArgument, "drone '" + spawn.name + "': airframe has no valid rotors/mass");
@@ -463,31 +471,13 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
   if (spawn.position_m.z < 0) {
     return Error(ErrorCode::kInvalidArgument, "drone '" + spawn.name + "': start position below the ground");
   }
-  const PayloadSpec* payload = nullptr;
-  if (!spawn.payload.empty()) {
-    auto found = af.FindPayload(spawn.payload);
-    if (!found) return Error(ErrorCode::kInvalidArgument, "drone '" + spawn.name + "': " + found.error().message());
-    payload = *found;
-  }
-  const std::size_t index = w.drones.size();
-  auto d = std::make_unique<Impl::Drone>();
-  d->name = spawn.name;
-  d->af = af;
-  d->rotor_count = af.rotors.size();
-  if (payload) payload = &d->af.payloads[static_cast<std::size_t>(payload - af.payloads.data())];
-  const double dt = w.dt_s;
-  d->alpha_up = 1.0 - std::exp(-dt / af.motor.time_constant_up_s);
-  d->alpha_down = 1.0 - std::exp(-dt / af.motor.time_constant_down_s);
-  const double throttle = std::clamp(spawn.initial_throttle, 0.0, 1.0);
-  for (std::size_t r = 0; r < d->rotor_count; ++r) {
-    d->u[r] = throttle;
-    d->omega[r] = throttle * af.motor.max_rot_velocity_rad_s;
-  }
-
-  const Vec3 origin = spawn.position_m + Vec3{0, 0, af.base_height_m};
-  const Quat q = Quat::FromYaw(spawn.yaw_rad);
-  if (payload && spawn.payload_attached) {
-    const Vec3 hook = origin + Rotate(q, payload->hook_m);
+  if (spawn.payload.empty()) return static_cast<const PayloadSpec*>(nullptr);
+  auto found = af.FindPayload(spawn.payload);
+  if (!found) return Error(ErrorCode::kInvalidArgument, "drone '" + spawn.name + "': " + found.error().message());
+  const PayloadSpec* payload = *found;
+  if (spawn.payload_attached) {
+    const Vec3 origin = spawn.position_m + Vec3{0, 0, af.base_height_m};
+    const Vec3 hook = origin + Rotate(Quat::FromYaw(spawn.yaw_rad), payload->hook_m);
     if (hook.z - payload->sling_length_m - payload->size_m.z / 2 < 0) {
       return Error(ErrorCode::kInvalidArgument,
                    "drone '" + spawn.name + "': too low to spawn with the " + payload->name +
@@ -495,7 +485,28 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
                        " m above the ground)");
     }
   }
-  d->body = dBodyCreate(w.world);
+  return payload;
+}
+
+}  // namespace
+
+std::unique_ptr<World::Impl::Drone> World::Impl::NewDrone(const DroneSpawn& spawn, const PayloadSpec* payload,
+                                                          std::size_t index) {
+  const Airframe& af = spawn.airframe;
+  auto d = std::make_unique<Drone>();
+  d->name = spawn.name;
+  d->af = af;
+  d->rotor_count = af.rotors.size();
+  d->alpha_up = 1.0 - std::exp(-dt_s / af.motor.time_constant_up_s);
+  d->alpha_down = 1.0 - std::exp(-dt_s / af.motor.time_constant_down_s);
+  const double throttle = std::clamp(spawn.initial_throttle, 0.0, 1.0);
+  for (std::size_t r = 0; r < d->rotor_count; ++r) {
+    d->u[r] = throttle;
+    d->omega[r] = throttle * af.motor.max_rot_velocity_rad_s;
+  }
+  const Vec3 origin = spawn.position_m + Vec3{0, 0, af.base_height_m};
+  const Quat q = Quat::FromYaw(spawn.yaw_rad);
+  d->body = dBodyCreate(world);
   dMass m;
   dMassSetParameters(&m, af.mass_kg, 0, 0, 0, af.inertia_kg_m2.x, af.inertia_kg_m2.y, af.inertia_kg_m2.z, 0, 0, 0);
   dBodySetMass(d->body, &m);
@@ -508,46 +519,71 @@ Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
   dGeomSetOffsetPosition(d->geom, af.collision_offset_m.x, af.collision_offset_m.y, af.collision_offset_m.z);
   d->tag = std::make_unique<GeomTag>(GeomTag{GeomTag::kDrone, index});
   dGeomSetData(d->geom, d->tag.get());
-
   if (payload) {
-    d->payload = payload;
-    d->payload_body = dBodyCreate(w.world);
-    dMass pm;
-    dMassSetBoxTotal(&pm, payload->mass_kg, payload->size_m.x, payload->size_m.y, payload->size_m.z);
-    dBodySetMass(d->payload_body, &pm);
-    dBodySetAutoDisableFlag(d->payload_body, 0);
-    Vec3 at;
-    if (spawn.payload_attached) {
-      at = origin + Rotate(q, payload->hook_m) - Vec3{0, 0, payload->sling_length_m};
-    } else {
-      const airframe::GroundPlacement g = airframe::PayloadOnGround(af, *payload);
-      at = Vec3{spawn.position_m.x + g.offset_x_m, spawn.position_m.y + g.offset_y_m, g.half_height_m};
-    }
-    dBodySetPosition(d->payload_body, at.x, at.y, at.z);
-    dBodySetQuaternion(d->payload_body, dq);
-    d->payload_geom = dCreateBox(nullptr, payload->size_m.x, payload->size_m.y, payload->size_m.z);
-    dGeomSetBody(d->payload_geom, d->payload_body);
-    d->payload_tag = std::make_unique<GeomTag>(GeomTag{GeomTag::kPayload, index});
-    dGeomSetData(d->payload_geom, d->payload_tag.get());
-    d->payload_drag = 0.5 * w.config.air_density_kg_m3 * 1.0 * payload->size_m.x * payload->size_m.y;
+    // The drone's own copy of the airframe holds the payload it carries.
+    d->payload = &d->af.payloads[static_cast<std::size_t>(payload - af.payloads.data())];
+    AddPayloadBody(*d, spawn, index);
   }
+  d->sensors = std::make_unique<SensorSuite>(d->af, config, MixSeed(options.seed, 0x5E0000 + index));
+  return d;
+}
 
-  d->sensors = std::make_unique<SensorSuite>(d->af, w.config, MixSeed(w.options.seed, 0x5E0000 + index));
+void World::Impl::AddPayloadBody(Drone& d, const DroneSpawn& spawn, std::size_t index) {
+  const PayloadSpec& payload = *d.payload;
+  const Vec3 origin = spawn.position_m + Vec3{0, 0, d.af.base_height_m};
+  const Quat q = Quat::FromYaw(spawn.yaw_rad);
+  const dQuaternion dq = {q.w, q.x, q.y, q.z};
+  d.payload_body = dBodyCreate(world);
+  dMass pm;
+  dMassSetBoxTotal(&pm, payload.mass_kg, payload.size_m.x, payload.size_m.y, payload.size_m.z);
+  dBodySetMass(d.payload_body, &pm);
+  dBodySetAutoDisableFlag(d.payload_body, 0);
+  Vec3 at;
+  if (spawn.payload_attached) {
+    at = origin + Rotate(q, payload.hook_m) - Vec3{0, 0, payload.sling_length_m};
+  } else {
+    const airframe::GroundPlacement g = airframe::PayloadOnGround(d.af, payload);
+    at = Vec3{spawn.position_m.x + g.offset_x_m, spawn.position_m.y + g.offset_y_m, g.half_height_m};
+  }
+  dBodySetPosition(d.payload_body, at.x, at.y, at.z);
+  dBodySetQuaternion(d.payload_body, dq);
+  d.payload_geom = dCreateBox(nullptr, payload.size_m.x, payload.size_m.y, payload.size_m.z);
+  dGeomSetBody(d.payload_geom, d.payload_body);
+  d.payload_tag = std::make_unique<GeomTag>(GeomTag{GeomTag::kPayload, index});
+  dGeomSetData(d.payload_geom, d.payload_tag.get());
+  d.payload_drag = 0.5 * config.air_density_kg_m3 * 1.0 * payload.size_m.x * payload.size_m.y;
+}
+
+void World::Impl::AttachSling(Drone& d, const DroneSpawn& spawn) {
+  const Vec3 origin = spawn.position_m + Vec3{0, 0, d.af.base_height_m};
+  const Vec3 hook = origin + Rotate(Quat::FromYaw(spawn.yaw_rad), d.payload->hook_m);
+  d.sling = dJointCreateBall(world, nullptr);
+  dJointAttach(d.sling, d.body, d.payload_body);
+  dJointSetBallAnchor(d.sling, hook.x, hook.y, hook.z);
+}
+
+void World::Impl::GrowBroadPhase(const Drone& added) {
+  // Broad-phase slots for the new geoms (allocation happens here, not in Step()).
+  const std::size_t geoms = bounds.size() + (added.payload_geom ? 2 : 1);
+  bounds.resize(geoms);
+  order.clear();
+  for (std::size_t k = 0; k < geoms; ++k) order.push_back(static_cast<std::uint32_t>(k));
+}
+
+Result<std::size_t> World::AddDrone(const DroneSpawn& spawn) {
+  Impl& w = *impl_;
+  if (spawn.name.empty()) return Error(ErrorCode::kInvalidArgument, "drone name is empty");
+  if (FindDrone(spawn.name)) return Error(ErrorCode::kAlreadyExists, "duplicate drone name '" + spawn.name + "'");
+  auto payload = CheckSpawn(spawn);
+  if (!payload) return payload.error();
+  const std::size_t index = w.drones.size();
+  auto d = w.NewDrone(spawn, *payload, index);
   w.index_of.emplace(d->name, w.drones.size());
   w.drones.push_back(std::move(d));
   Impl::Drone& added = *w.drones.back();
-  if (payload && spawn.payload_attached) {
-    added.sling = dJointCreateBall(w.world, nullptr);
-    dJointAttach(added.sling, added.body, added.payload_body);
-    const Vec3 hook = origin + Rotate(q, payload->hook_m);
-    dJointSetBallAnchor(added.sling, hook.x, hook.y, hook.z);
-  }
+  if (*payload && spawn.payload_attached) w.AttachSling(added, spawn);
   added.prev_velocity = V(dBodyGetLinearVel(added.body));
-  // Broad-phase slots for the new geoms (allocation happens here, not in Step()).
-  const std::size_t geoms = w.bounds.size() + (added.payload_geom ? 2 : 1);
-  w.bounds.resize(geoms);
-  w.order.clear();
-  for (std::size_t k = 0; k < geoms; ++k) w.order.push_back(static_cast<std::uint32_t>(k));
+  w.GrowBroadPhase(added);
   w.SampleSensors(added);
   return index;
 }

@@ -79,6 +79,67 @@ constexpr std::array<Bgr, 5> kSkin = {{{130, 160, 215}, {105, 140, 190}, {80, 11
 constexpr std::array<Bgr, 4> kHair = {{{20, 25, 30}, {30, 50, 80}, {70, 110, 150}, {40, 40, 45}}};
 constexpr std::array<Bgr, 5> kTrousers = {{{95, 65, 45}, {40, 50, 60}, {55, 55, 55}, {80, 100, 95}, {30, 35, 40}}};
 
+// Adds a figure's parts in the victim's frame `f`, at `s` times the size of a 1.75 m person.
+struct FigureBuilder {
+  Frame2 f;
+  double s;
+  std::vector<Part>* parts;
+  void Limb(Vec3 p, Vec3 q, double r, const cv::Scalar& c) const {
+    parts->push_back({Capsule(f, {p.x * s, p.y * s, p.z * s}, {q.x * s, q.y * s, q.z * s}, r * s), c});
+  }
+  void Disc(double u, double w, double a, double b, double z, const cv::Scalar& c) const {
+    parts->push_back({Ring(f, u * s, w * s, a * s, b * s, z * s), c});
+  }
+  // An upright trunk: a ring at z0 under one at z1 (sitting and standing).
+  void Trunk(double u1, double a0, double b0, double z0, double a1, double b1, double z1, const cv::Scalar& c) const {
+    parts->push_back({Concat(Ring(f, 0, 0, a0 * s, b0 * s, z0 * s), Ring(f, u1 * s, 0, a1 * s, b1 * s, z1 * s)), c});
+  }
+};
+
+struct FigureColours {
+  cv::Scalar cloth, legs, skin, hair;
+};
+
+void PoseFigure(VictimPose pose, const FigureBuilder& b, const FigureColours& c, double arm_swing) {
+  switch (pose) {
+    case VictimPose::kLying:
+      b.Limb({-0.85, 0.10, 0.04}, {-0.05, 0.10, 0.06}, 0.085, c.legs);
+      b.Limb({-0.85, -0.10, 0.04}, {-0.05, -0.10, 0.06}, 0.085, c.legs);
+      b.Disc(0.25, 0, 0.33, 0.21, 0.1, c.cloth);
+      b.Limb({0.50, 0.25, 0.08}, {0.02 + 2 * arm_swing, 0.30 - 0.15 * arm_swing, 0.05}, 0.055, c.cloth);
+      b.Limb({0.50, -0.25, 0.08}, {0.02, -0.30, 0.05}, 0.055, c.cloth);
+      b.Disc(0.75, 0, 0.115, 0.095, 0.12, c.skin);
+      b.Disc(0.80, 0, 0.085, 0.085, 0.14, c.hair);
+      return;
+    case VictimPose::kSitting:
+      b.Limb({-0.85, 0.10, 0.05}, {0.0, 0.10, 0.12}, 0.085, c.legs);
+      b.Limb({-0.85, -0.10, 0.05}, {0.0, -0.10, 0.12}, 0.085, c.legs);
+      b.Trunk(0.06, 0.14, 0.19, 0.12, 0.12, 0.22, 0.6, c.cloth);
+      b.Limb({0.06, 0.24, 0.55}, {-0.35, 0.20, 0.22}, 0.055, c.cloth);
+      b.Limb({0.06, -0.24, 0.55}, {-0.35, -0.20, 0.22}, 0.055, c.cloth);
+      b.Disc(0.08, 0, 0.1, 0.09, 0.82, c.skin);
+      b.Disc(0.11, 0, 0.08, 0.08, 0.88, c.hair);
+      return;
+    case VictimPose::kCurled:
+      b.Disc(0.15, 0, 0.30, 0.18, 0.15, c.cloth);
+      b.Limb({-0.10, 0.0, 0.12}, {0.05, -0.35, 0.12}, 0.09, c.legs);
+      b.Limb({0.05, -0.35, 0.10}, {-0.30, -0.38, 0.06}, 0.07, c.legs);
+      b.Limb({0.35, 0.05, 0.18}, {0.20, -0.25, 0.12}, 0.055, c.cloth);
+      b.Disc(0.55, -0.05, 0.11, 0.095, 0.15, c.skin);
+      b.Disc(0.59, -0.05, 0.08, 0.08, 0.17, c.hair);
+      return;
+    case VictimPose::kStanding:
+      b.Limb({0.0, 0.10, 0.0}, {0.0, 0.10, 0.9}, 0.08, c.legs);
+      b.Limb({0.0, -0.10, 0.0}, {0.0, -0.10, 0.9}, 0.08, c.legs);
+      b.Trunk(0, 0.12, 0.18, 0.9, 0.12, 0.23, 1.45, c.cloth);
+      b.Limb({0.0, 0.26, 1.42}, {0.05, 0.30, 0.82}, 0.05, c.cloth);
+      b.Limb({0.0, -0.26, 1.42}, {0.05, -0.30, 0.82}, 0.05, c.cloth);
+      b.Disc(0.0, 0, 0.1, 0.09, 1.62, c.skin);
+      b.Disc(-0.02, 0, 0.085, 0.08, 1.7, c.hair);
+      return;
+  }
+}
+
 std::vector<Part> FigureParts(const Victim& v) {
   const Frame2 f{v.x_m, v.y_m, std::cos(v.heading_rad), std::sin(v.heading_rad)};
   if (!v.clothing_bgr && v.pose == VictimPose::kLying) {
@@ -87,56 +148,14 @@ std::vector<Part> FigureParts(const Victim& v) {
             {Ring(f, 0.7, 0, 0.13, 0.11, 0.0, 20), cv::Scalar(kVictimHeadBgr[0], kVictimHeadBgr[1], kVictimHeadBgr[2])}};
   }
   const std::uint64_t h = HashOf(v.id);
-  const cv::Scalar cloth = v.clothing_bgr ? S(*v.clothing_bgr) : cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]);
-  const cv::Scalar legs = ((h >> 8) % 4 == 0) ? Scale(cloth, 0.85) : S(kTrousers[(h >> 12) % kTrousers.size()]);
-  const cv::Scalar skin = S(kSkin[(h >> 16) % kSkin.size()]);
-  const cv::Scalar hair = S(kHair[(h >> 20) % kHair.size()]);
-  const double s = v.height_m / 1.75;
+  FigureColours c;
+  c.cloth = v.clothing_bgr ? S(*v.clothing_bgr) : cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]);
+  c.legs = ((h >> 8) % 4 == 0) ? Scale(c.cloth, 0.85) : S(kTrousers[(h >> 12) % kTrousers.size()]);
+  c.skin = S(kSkin[(h >> 16) % kSkin.size()]);
+  c.hair = S(kHair[(h >> 20) % kHair.size()]);
   std::vector<Part> parts;
-  auto limb = [&](Vec3 p, Vec3 q, double r, const cv::Scalar& c) {
-    parts.push_back({Capsule(f, {p.x * s, p.y * s, p.z * s}, {q.x * s, q.y * s, q.z * s}, r * s), c});
-  };
-  auto disc = [&](double u, double w, double a, double b, double z, const cv::Scalar& c) {
-    parts.push_back({Ring(f, u * s, w * s, a * s, b * s, z * s), c});
-  };
   const double arm_swing = ((h >> 24) % 3 == 0) ? 0.45 : 0.0;  // one arm above the head, sometimes
-  switch (v.pose) {
-    case VictimPose::kLying:
-      limb({-0.85, 0.10, 0.04}, {-0.05, 0.10, 0.06}, 0.085, legs);
-      limb({-0.85, -0.10, 0.04}, {-0.05, -0.10, 0.06}, 0.085, legs);
-      disc(0.25, 0, 0.33, 0.21, 0.1, cloth);
-      limb({0.50, 0.25, 0.08}, {0.02 + 2 * arm_swing, 0.30 - 0.15 * arm_swing, 0.05}, 0.055, cloth);
-      limb({0.50, -0.25, 0.08}, {0.02, -0.30, 0.05}, 0.055, cloth);
-      disc(0.75, 0, 0.115, 0.095, 0.12, skin);
-      disc(0.80, 0, 0.085, 0.085, 0.14, hair);
-      break;
-    case VictimPose::kSitting:
-      limb({-0.85, 0.10, 0.05}, {0.0, 0.10, 0.12}, 0.085, legs);
-      limb({-0.85, -0.10, 0.05}, {0.0, -0.10, 0.12}, 0.085, legs);
-      parts.push_back({Concat(Ring(f, 0, 0, 0.14 * s, 0.19 * s, 0.12 * s), Ring(f, 0.06 * s, 0, 0.12 * s, 0.22 * s, 0.6 * s)), cloth});
-      limb({0.06, 0.24, 0.55}, {-0.35, 0.20, 0.22}, 0.055, cloth);
-      limb({0.06, -0.24, 0.55}, {-0.35, -0.20, 0.22}, 0.055, cloth);
-      disc(0.08, 0, 0.1, 0.09, 0.82, skin);
-      disc(0.11, 0, 0.08, 0.08, 0.88, hair);
-      break;
-    case VictimPose::kCurled:
-      disc(0.15, 0, 0.30, 0.18, 0.15, cloth);
-      limb({-0.10, 0.0, 0.12}, {0.05, -0.35, 0.12}, 0.09, legs);
-      limb({0.05, -0.35, 0.10}, {-0.30, -0.38, 0.06}, 0.07, legs);
-      limb({0.35, 0.05, 0.18}, {0.20, -0.25, 0.12}, 0.055, cloth);
-      disc(0.55, -0.05, 0.11, 0.095, 0.15, skin);
-      disc(0.59, -0.05, 0.08, 0.08, 0.17, hair);
-      break;
-    case VictimPose::kStanding:
-      limb({0.0, 0.10, 0.0}, {0.0, 0.10, 0.9}, 0.08, legs);
-      limb({0.0, -0.10, 0.0}, {0.0, -0.10, 0.9}, 0.08, legs);
-      parts.push_back({Concat(Ring(f, 0, 0, 0.12 * s, 0.18 * s, 0.9 * s), Ring(f, 0, 0, 0.12 * s, 0.23 * s, 1.45 * s)), cloth});
-      limb({0.0, 0.26, 1.42}, {0.05, 0.30, 0.82}, 0.05, cloth);
-      limb({0.0, -0.26, 1.42}, {0.05, -0.30, 0.82}, 0.05, cloth);
-      disc(0.0, 0, 0.1, 0.09, 1.62, skin);
-      disc(-0.02, 0, 0.085, 0.08, 1.7, hair);
-      break;
-  }
+  PoseFigure(v.pose, FigureBuilder{f, v.height_m / 1.75, &parts}, c, arm_swing);
   return parts;
 }
 
@@ -362,6 +381,104 @@ const Palette kRubbleP{{95, 100, 105}, {145, 150, 155}, 18};
 
 cv::Vec3f Lerp(const Palette& p, float t) { return p.lo + (p.hi - p.lo) * t; }
 
+constexpr float kWaterEdge = 0.012f;  // muddy band above the water level
+
+// The level under which the smooth field `water` is water: its lowest water_fraction, after
+// raising it 4 m around every victim (drawn into *water) so that nobody lies in water; -1: none.
+float WaterLevel(const WorldConfig& config, const Terrain& terrain, double texel_m, double origin_x_m,
+                 double top_y_m, cv::Mat* water) {
+  if (!(terrain.water_fraction > 0)) return -1;
+  for (const Victim& v : config.victims) {
+    const cv::Point c(static_cast<int>((v.x_m - origin_x_m) / texel_m), static_cast<int>((top_y_m - v.y_m) / texel_m));
+    cv::circle(*water, c, static_cast<int>(4.0 / texel_m), cv::Scalar(2.0), cv::FILLED);
+  }
+  cv::Mat sample;
+  cv::resize(*water, sample, cv::Size(256, 256), 0, 0, cv::INTER_NEAREST);
+  std::vector<float> values(sample.begin<float>(), sample.end<float>());
+  std::nth_element(values.begin(), values.begin() + static_cast<long>(terrain.water_fraction * double(values.size())), values.end());
+  return values[static_cast<std::size_t>(terrain.water_fraction * double(values.size()))];
+}
+
+// One texel's ground colour for brightness noise `v` and the region noises `g`, `g2`; its speckle
+// in *grain_std.
+cv::Vec3f GroundColour(TerrainKind kind, float v, float g, float g2, float* grain_std) {
+  const float dry = std::clamp((g2 - 0.55f) * 5.0f, 0.0f, 1.0f);
+  auto grass = [&] { return Lerp(kGrassP, v) * (1 - dry) + Lerp(kDryGrassP, v) * dry; };
+  switch (kind) {
+    case TerrainKind::kGrass:
+      *grain_std = kGrassP.grain;
+      return grass();
+    case TerrainKind::kSoil: {
+      const float grassy = std::clamp((g - 0.7f) * 5.0f, 0.0f, 1.0f);
+      *grain_std = kSoilP.grain;
+      return Lerp(kSoilP, v) * (1 - grassy) + grass() * grassy;
+    }
+    case TerrainKind::kGravel:
+      *grain_std = kGravelP.grain;
+      return Lerp(kGravelP, v);
+    case TerrainKind::kRubble: {
+      const float dirt = std::clamp((g - 0.5f) * 4.0f, 0.0f, 1.0f);
+      *grain_std = kRubbleP.grain;
+      return Lerp(kRubbleP, v) * (1 - dirt) + Lerp(kSoilP, v) * dirt;
+    }
+    case TerrainKind::kMixed:
+      if (g < 0.45f) {
+        *grain_std = kGrassP.grain;
+        return grass();
+      }
+      if (g < 0.62f) {
+        *grain_std = kSoilP.grain;
+        return Lerp(kSoilP, v);
+      }
+      *grain_std = kGravelP.grain;
+      return Lerp(kGravelP, v);
+  }
+  *grain_std = 0;
+  return cv::Vec3f();
+}
+
+// Water below the level (deeper, darker), mud in a band above it; `col` elsewhere.
+cv::Vec3f WithWater(const cv::Vec3f& col, float w, float water_level, float n) {
+  if (w < water_level) {
+    const float depth = std::clamp((water_level - w) * 12.0f, 0.0f, 1.0f);
+    return cv::Vec3f(70, 75, 50) * (1 - depth) + cv::Vec3f(85, 70, 35) * depth + cv::Vec3f(1, 1, 1) * (3 * n);
+  }
+  if (w < water_level + kWaterEdge) {
+    const float t = (w - water_level) / kWaterEdge;  // mud at the waterline, drying outwards
+    return cv::Vec3f(40, 55, 65) * (1 - t) + col * t;
+  }
+  return col;
+}
+
+// Chunks of concrete and brick scattered over the ground (rubble everywhere, gravel areas of
+// mixed), never in the water or its muddy band.
+void ScatterRubble(const Terrain& terrain, double texel_m, const cv::Mat& region, const cv::Mat& water,
+                   float water_level, cv::RNG& rng, cv::Mat* texture) {
+  const cv::Size size = texture->size();
+  const double area = (size.width * texel_m) * (size.height * texel_m);
+  const int count = static_cast<int>(area * (terrain.kind == TerrainKind::kRubble ? 0.6 : 0.1));
+  for (int k = 0; k < count; ++k) {
+    const cv::Point2d c(rng.uniform(0.0, double(size.width)), rng.uniform(0.0, double(size.height)));
+    if (terrain.kind == TerrainKind::kMixed && region.at<float>(static_cast<int>(c.y), static_cast<int>(c.x)) < 0.62f) continue;
+    if (water.at<float>(static_cast<int>(c.y), static_cast<int>(c.x)) < water_level + kWaterEdge) continue;
+    const double rr = rng.uniform(0.1, 0.45) / texel_m;
+    std::vector<cv::Point> pts;
+    const int n = 5 + rng.uniform(0, 3);
+    const double ph = rng.uniform(0.0, 2 * kPi);
+    for (int i = 0; i < n; ++i) {
+      const double t = ph + 2 * kPi * i / n, q = rr * rng.uniform(0.55, 1.0);
+      pts.emplace_back(static_cast<int>((c.x + q * std::cos(t)) * 16), static_cast<int>((c.y + q * std::sin(t)) * 16));
+    }
+    const int kind = rng.uniform(0, 4);
+    const cv::Scalar col = kind == 0 ? cv::Scalar(rng.uniform(60, 80), rng.uniform(75, 100), rng.uniform(125, 165))
+                           : kind == 3 ? cv::Scalar(55, 60, 65)
+                                       : cv::Scalar::all(rng.uniform(125, 185)) + cv::Scalar(0, 3, 6);
+    std::vector<cv::Point> hull;
+    cv::convexHull(pts, hull);
+    cv::fillConvexPoly(*texture, hull, col, cv::LINE_8, 4);
+  }
+}
+
 void TerrainTexture(const WorldConfig& config, const Terrain& terrain, double texel_m, double origin_x_m, double top_y_m,
                     cv::Mat* texture) {
   const cv::Size size = texture->size();
@@ -372,22 +489,7 @@ void TerrainTexture(const WorldConfig& config, const Terrain& terrain, double te
   cv::Mat water = Noise(rng, size, {{4, 0.55f}, {12, 0.3f}, {40, 0.15f}});
   cv::Mat grain(size, CV_32F);
   rng.fill(grain, cv::RNG::NORMAL, 0.0, 1.0);
-
-  // Water: the lowest water_fraction of a smooth field, kept 4 m away from every victim.
-  float water_level = -1;
-  if (terrain.water_fraction > 0) {
-    for (const Victim& v : config.victims) {
-      const cv::Point c(static_cast<int>((v.x_m - origin_x_m) / texel_m), static_cast<int>((top_y_m - v.y_m) / texel_m));
-      cv::circle(water, c, static_cast<int>(4.0 / texel_m), cv::Scalar(2.0), cv::FILLED);
-    }
-    cv::Mat sample;
-    cv::resize(water, sample, cv::Size(256, 256), 0, 0, cv::INTER_NEAREST);
-    std::vector<float> values(sample.begin<float>(), sample.end<float>());
-    std::nth_element(values.begin(), values.begin() + static_cast<long>(terrain.water_fraction * double(values.size())), values.end());
-    water_level = values[static_cast<std::size_t>(terrain.water_fraction * double(values.size()))];
-  }
-  constexpr float kEdge = 0.012f;  // muddy band above the water level
-
+  const float water_level = WaterLevel(config, terrain, texel_m, origin_x_m, top_y_m, &water);
   for (int r = 0; r < size.height; ++r) {
     const float* a = base.ptr<float>(r);
     const float* g = region.ptr<float>(r);
@@ -397,72 +499,16 @@ void TerrainTexture(const WorldConfig& config, const Terrain& terrain, double te
     auto* px = texture->ptr<cv::Vec3b>(r);
     for (int c = 0; c < size.width; ++c) {
       const float v = std::clamp(a[c], 0.0f, 1.2f) / 1.2f;
-      const float dry = std::clamp((g2[c] - 0.55f) * 5.0f, 0.0f, 1.0f);
-      cv::Vec3f col;
       float grain_std = 0;
-      auto grass = [&] { return Lerp(kGrassP, v) * (1 - dry) + Lerp(kDryGrassP, v) * dry; };
-      switch (terrain.kind) {
-        case TerrainKind::kGrass:
-          col = grass(), grain_std = kGrassP.grain;
-          break;
-        case TerrainKind::kSoil: {
-          const float grassy = std::clamp((g[c] - 0.7f) * 5.0f, 0.0f, 1.0f);
-          col = Lerp(kSoilP, v) * (1 - grassy) + grass() * grassy, grain_std = kSoilP.grain;
-          break;
-        }
-        case TerrainKind::kGravel:
-          col = Lerp(kGravelP, v), grain_std = kGravelP.grain;
-          break;
-        case TerrainKind::kRubble: {
-          const float dirt = std::clamp((g[c] - 0.5f) * 4.0f, 0.0f, 1.0f);
-          col = Lerp(kRubbleP, v) * (1 - dirt) + Lerp(kSoilP, v) * dirt, grain_std = kRubbleP.grain;
-          break;
-        }
-        case TerrainKind::kMixed: {
-          const float t = g[c];
-          if (t < 0.45f) col = grass(), grain_std = kGrassP.grain;
-          else if (t < 0.62f) col = Lerp(kSoilP, v), grain_std = kSoilP.grain;
-          else col = Lerp(kGravelP, v), grain_std = kGravelP.grain;
-          break;
-        }
-      }
+      cv::Vec3f col = GroundColour(terrain.kind, v, g[c], g2[c], &grain_std);
       col += cv::Vec3f(1, 1, 1) * (grain_std * n[c]);
-      if (w[c] < water_level) {
-        const float depth = std::clamp((water_level - w[c]) * 12.0f, 0.0f, 1.0f);
-        col = cv::Vec3f(70, 75, 50) * (1 - depth) + cv::Vec3f(85, 70, 35) * depth + cv::Vec3f(1, 1, 1) * (3 * n[c]);
-      } else if (w[c] < water_level + kEdge) {
-        const float t = (w[c] - water_level) / kEdge;  // mud at the waterline, drying outwards
-        col = cv::Vec3f(40, 55, 65) * (1 - t) + col * t;
-      }
+      col = WithWater(col, w[c], water_level, n[c]);
       px[c] = cv::Vec3b(cv::saturate_cast<std::uint8_t>(col[0]), cv::saturate_cast<std::uint8_t>(col[1]),
                         cv::saturate_cast<std::uint8_t>(col[2]));
     }
   }
-
   if (terrain.kind == TerrainKind::kRubble || terrain.kind == TerrainKind::kMixed) {
-    // Chunks of concrete and brick scattered over the ground (rubble everywhere, gravel areas of mixed).
-    const double area = (size.width * texel_m) * (size.height * texel_m);
-    const int count = static_cast<int>(area * (terrain.kind == TerrainKind::kRubble ? 0.6 : 0.1));
-    for (int k = 0; k < count; ++k) {
-      const cv::Point2d c(rng.uniform(0.0, double(size.width)), rng.uniform(0.0, double(size.height)));
-      if (terrain.kind == TerrainKind::kMixed && region.at<float>(static_cast<int>(c.y), static_cast<int>(c.x)) < 0.62f) continue;
-      if (water.at<float>(static_cast<int>(c.y), static_cast<int>(c.x)) < water_level + kEdge) continue;
-      const double rr = rng.uniform(0.1, 0.45) / texel_m;
-      std::vector<cv::Point> pts;
-      const int n = 5 + rng.uniform(0, 3);
-      const double ph = rng.uniform(0.0, 2 * kPi);
-      for (int i = 0; i < n; ++i) {
-        const double t = ph + 2 * kPi * i / n, q = rr * rng.uniform(0.55, 1.0);
-        pts.emplace_back(static_cast<int>((c.x + q * std::cos(t)) * 16), static_cast<int>((c.y + q * std::sin(t)) * 16));
-      }
-      const int kind = rng.uniform(0, 4);
-      const cv::Scalar col = kind == 0 ? cv::Scalar(rng.uniform(60, 80), rng.uniform(75, 100), rng.uniform(125, 165))
-                             : kind == 3 ? cv::Scalar(55, 60, 65)
-                                         : cv::Scalar::all(rng.uniform(125, 185)) + cv::Scalar(0, 3, 6);
-      std::vector<cv::Point> hull;
-      cv::convexHull(pts, hull);
-      cv::fillConvexPoly(*texture, hull, col, cv::LINE_8, 4);
-    }
+    ScatterRubble(terrain, texel_m, region, water, water_level, rng, texture);
   }
 }
 
