@@ -289,11 +289,10 @@ void SimServer::LogChannel() {
 Status SimServer::PublishDrone(std::size_t i, bool with_camera) {
   Slot& slot = slots_[i];
   const std::string& name = world_.drone_name(i);
-  const bool frame = with_camera && slot.camera_frame;  // a re-sent sample carries none
-  if (frame) {
+  if (with_camera && slot.camera_frame) {
     if (auto s = transport_.PublishCamera(i, name, world_.step_count(), slot.image); !s) return s;
   }
-  return transport_.PublishSample(i, name, world_.sensors(i), SampleExtras{frame, slot.radio_in});
+  return transport_.PublishSample(i, name, world_.sensors(i), SampleExtras{slot.camera_frame, slot.radio_in});
 }
 
 void SimServer::Accept(std::size_t i, ActuatorInput& cmd) {
@@ -484,13 +483,12 @@ Status SimServer::PublishStep(std::uint64_t step) {
 // joiners and lost messages (the lockstep QoS is volatile), answered ones as a keepalive, so an
 // agent that did answer does not take a long wait (a fleet still starting, a silent drone's
 // timeout) for a stalled server (its --stall-timeout). It answers again; Lockstep drops the
-// duplicate. Camera frames go out once per capture, never with a re-sent sample (which then says
-// it carries none, so no agent waits for one): at 640 x 360 a frame is 691 kB, and re-sending it
-// every 200 ms to each drone still joining grew the start's traffic with the fleet.
+// duplicate. An unanswered drone gets its camera frame again first (its sample says a frame goes
+// with it, and an agent waits for that frame before it answers).
 Status SimServer::Republish() {
   for (std::size_t i = 0; i < world_.drone_count(); ++i) {
     if (lockstep_.out(i)) continue;
-    if (auto s = PublishDrone(i, /*with_camera=*/false); !s) return s;
+    if (auto s = PublishDrone(i, /*with_camera=*/!lockstep_.answered(i)); !s) return s;
   }
   return Ok{};
 }

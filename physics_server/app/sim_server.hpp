@@ -22,8 +22,8 @@
 // the channel with send time t_k (drone order, then seq), before the plan's entries of t_k.
 // While waiting, every drone's sample is published again every 200 ms (agents that join late, a
 // lost message, and a keepalive for the drones that answered, so a long wait does not look like a
-// stalled server to them); camera frames go out once, with the step's first samples (a re-sent
-// sample has camera_frame = false). Duplicate and stale commands are dropped (Lockstep).
+// stalled server to them; an unanswered drone's camera frame goes again first). Duplicate and
+// stale commands are dropped (Lockstep).
 // A camera is due by its airframe's trigger (CameraTrigger: rate_hz, or distance-triggered).
 // While the first step waits, every second `event=joining joined=.. expected=.. missing=..` and the
 // same on sim/status (joining.hpp); `event=joined` once it completes.
@@ -213,7 +213,7 @@ class SimServer {
   // Per drone: what this step published and what its answer carried.
   struct Slot {
     bool camera_frame = false;
-    CameraImage image;                         // this step's frame (sent once, with the first sample)
+    CameraImage image;                         // this step's frame, re-sent with a re-sent sample
     std::vector<bus::RadioFrame> radio_in;
     std::vector<WorldCommandInput> world;      // the accepted answer's
     std::vector<bus::RadioFrame> radio_out;    // the accepted answer's
