@@ -312,6 +312,18 @@ void UpdateGainMap(const detail::Light& light, double vignetting, int w, int h, 
   }
 }
 
+// Light colour, exposure gain and vignetting in one multiply; `map` (and the vignetting it was
+// built for) is kept between frames.
+void ApplyGain(const detail::Light& light, double vignetting, double gain, cv::Mat& img, cv::Mat* map,
+               double* map_vignetting) {
+  if (!light.enabled && vignetting <= 0) return;
+  if (map->size() != img.size() || *map_vignetting != vignetting) {
+    UpdateGainMap(light, vignetting, img.cols, img.rows, map);
+    *map_vignetting = vignetting;
+  }
+  cv::multiply(img, *map, img, gain / 100.0);
+}
+
 // Gaussian pixel noise: a seeded window of the pre-drawn tile, scaled to the frame's noise std
 // (images larger than the tile, rare, reuse it in pieces).
 void AddNoise(const cv::Mat& tile, double noise_std, cv::RNG& rng, cv::Mat& img) {
@@ -390,14 +402,7 @@ void GroundRenderer::Render(const Pose& body_pose, const Vec3& body_rates_rad_s,
   cv::RNG rng(noise_seed);
   const Exposure e = ExposureOf(scene.light, spec, rng);
   MotionBlur(out->intrinsics, body_rates_rad_s, e.exposure_s, img, &blur_pad_, &blur_acc_);
-  // Light colour, exposure gain and vignetting in one multiply.
-  if (scene.light.enabled || spec.vignetting > 0) {
-    if (gain_map_.size() != img.size() || gain_map_vignetting_ != spec.vignetting) {
-      UpdateGainMap(scene.light, spec.vignetting, w, h, &gain_map_);
-      gain_map_vignetting_ = spec.vignetting;
-    }
-    cv::multiply(img, gain_map_, img, e.gain / 100.0);
-  }
+  ApplyGain(scene.light, spec.vignetting, e.gain, img, &gain_map_, &gain_map_vignetting_);
   if (spec.noise_std > 0) {
     if (noise_tile_.empty()) {
       cv::RNG tile_rng(0x6E015E);
