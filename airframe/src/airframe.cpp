@@ -152,6 +152,8 @@ void ReadCamera(MapReader& parent, Airframe* af) {
     Checked(r, n)
         .Positive("hfov_rad", &c.hfov_rad, false)
         .Positive("rate_hz", &c.rate_hz, false)
+        .NonNegative("trigger_distance_m", &c.trigger_distance_m)
+        .NonNegative("trigger_interval_max_s", &c.trigger_interval_max_s)
         .NonNegative("noise_std", &c.noise_std)
         .NonNegative("exposure_ms", &c.exposure_ms)
         .NonNegative("vignetting", &c.vignetting);

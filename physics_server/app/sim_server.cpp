@@ -58,7 +58,8 @@ SimServer::SimServer(World& world, SimTransport& transport, WallClock& clock, Tr
       lockstep_(world.drone_count(), options_.lockstep),
       zeros_(8, 0.0),
       base_wind_(world.config().wind),
-      slots_(world.drone_count()) {
+      slots_(world.drone_count()),
+      trigger_(world.drone_count()) {
   world_.SetEventSink(&sink_);
   if (options_.radio_profile) {
     const std::size_t n = world.drone_count();
@@ -454,34 +455,55 @@ void SimServer::TakeAnswers(std::int64_t deadline_ns) {
   }
 }
 
-Status SimServer::RunStep(const std::atomic<bool>& stop) {
-  const std::uint64_t step = world_.step_count();
+// The camera of drone `i` at this step: due by its trigger (camera_trigger.hpp), rendered, shown
+// to the recording.
+bool SimServer::CaptureCamera(std::size_t i) {
+  Slot& slot = slots_[i];
+  if (!options_.cameras || world_.Truth(i).lost) return false;
+  const Vec3 position_m = world_.Truth(i).position_m;
+  if (!trigger_.Due(i, world_.airframe(i).camera, world_.CameraDue(i), world_.time_ns(), position_m)) return false;
+  trigger_.Captured(i, world_.time_ns(), position_m);
+  world_.RenderCamera(i, &slot.image);
+  if (options_.observer != nullptr) options_.observer->OnCamera(i, slot.image);
+  return true;
+}
+
+// Step k's cameras and samples (each frame before its sample), then the clock.
+Status SimServer::PublishStep(std::uint64_t step) {
   if (channel_) TakeDeliveries(world_.time_ns());
   for (std::size_t i = 0; i < world_.drone_count(); ++i) {
     if (lockstep_.out(i)) continue;
-    Slot& slot = slots_[i];
-    slot.camera_frame = options_.cameras && world_.CameraDue(i) && !world_.Truth(i).lost;
-    if (slot.camera_frame) {
-      world_.RenderCamera(i, &slot.image);
-      if (options_.observer != nullptr) options_.observer->OnCamera(i, slot.image);
-    }
+    slots_[i].camera_frame = CaptureCamera(i);
     if (auto s = PublishDrone(i, /*with_camera=*/true); !s) return s;
   }
-  if (auto s = transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf); !s) {
-    return s;
+  return transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf);
+}
+
+// While a step waits, every drone's sample is sent again at this period: unanswered ones for late
+// joiners and lost messages (the lockstep QoS is volatile), answered ones as a keepalive, so an
+// agent that did answer does not take a long wait (a fleet still starting, a silent drone's
+// timeout) for a stalled server (its --stall-timeout). It answers again; Lockstep drops the
+// duplicate. An unanswered drone gets its camera frame again first (its sample says a frame goes
+// with it, and an agent waits for that frame before it answers).
+Status SimServer::Republish() {
+  for (std::size_t i = 0; i < world_.drone_count(); ++i) {
+    if (lockstep_.out(i)) continue;
+    if (auto s = PublishDrone(i, /*with_camera=*/!lockstep_.answered(i)); !s) return s;
   }
+  return Ok{};
+}
+
+// Waits for every live drone's answer to the step (or its timeout), re-sending samples meanwhile
+// and reporting the start's progress while the first step waits. Returns when the step is
+// complete or `stop` is set.
+Status SimServer::AwaitAnswers(std::uint64_t step, const std::atomic<bool>& stop) {
   // The step starts for the lockstep once its samples are out: rendering and publishing the
   // cameras (a 640 x 360 frame is 691 kB) can take a while on a loaded host, and no agent can
   // answer before it has its sample, so that time does not count against the drones.
   lockstep_.BeginStep(step, clock_.NowNs());
   if (step == 0) joining_.Begin(clock_.NowNs());
   constexpr std::int64_t kPollNs = 20'000'000;        // re-check `stop` at least this often
-  // While a step waits, every drone's sample is sent again at this period: unanswered ones for
-  // late joiners and lost messages (the lockstep QoS is volatile; an unanswered drone gets its
-  // camera frame again first), answered ones as a keepalive, so an agent that did answer does not
-  // take a long wait (a fleet still starting, a silent drone's timeout) for a stalled server (its
-  // --stall-timeout). It answers again; Lockstep drops the duplicate.
-  constexpr std::int64_t kRepublishNs = 200'000'000;
+  constexpr std::int64_t kRepublishNs = 200'000'000;  // Republish()
   std::int64_t last_publish = clock_.NowNs();
   while (!stop.load()) {
     const std::int64_t now = clock_.NowNs();
@@ -495,26 +517,16 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
     }
     if (now - last_publish >= kRepublishNs) {
       last_publish = now;
-      for (std::size_t i = 0; i < world_.drone_count(); ++i) {
-        if (lockstep_.out(i)) continue;
-        if (auto s = PublishDrone(i, /*with_camera=*/!lockstep_.answered(i)); !s) return s;
-      }
+      if (auto s = Republish(); !s) return s;
     }
     TakeAnswers(std::min(lockstep_.NextDeadlineNs(), now + kPollNs));
   }
   for (std::size_t i : lockstep_.TakeNewlyLost()) world_.SetLost(i, true);
-  if (stop.load()) return Ok{};
-  if (joining_.active()) {
-    if (auto s = ReportJoining(/*done=*/true); !s) return s;
-  }
+  return Ok{};
+}
 
-  ApplyAnswers();
-  world_inbox_.clear();
-  transport_.TakeWorldCommands(&world_inbox_);
-  for (const WorldCommandInput& c : world_inbox_) Apply(c);
-  if (channel_) SendRadio(world_.time_ns());
-  RunSchedule(world_.time_ns());
-  world_.Step();
+// The world commands timed by Apply (gps_dropout, gps_degrade, wind_gust) that end now.
+void SimServer::EndTimedCommands() {
   for (auto it = timed_.begin(); it != timed_.end();) {
     if (world_.time_ns() < it->until_ns) {
       ++it;
@@ -525,37 +537,71 @@ Status SimServer::RunStep(const std::atomic<bool>& stop) {
     if (it->kind == Timed::kWindBack) world_.SetWind(base_wind_);
     it = timed_.erase(it);
   }
+}
+
+// The step's commands, radio and plan at t_k, then World::Step() to t_{k+1} and what records it.
+Status SimServer::AdvanceWorld() {
+  ApplyAnswers();
+  world_inbox_.clear();
+  transport_.TakeWorldCommands(&world_inbox_);
+  for (const WorldCommandInput& c : world_inbox_) Apply(c);
+  if (channel_) SendRadio(world_.time_ns());
+  RunSchedule(world_.time_ns());
+  world_.Step();
+  EndTimedCommands();
   if (truth_ != nullptr) {
     if (auto s = truth_->MaybeWrite(world_); !s) return s;
   }
   if (options_.observer != nullptr) options_.observer->OnStep(world_);
-  bool late = false;
+  return Ok{};
+}
+
+// Sleeps to the requested real-time factor (rtf > 0); returns the wall time after it and whether
+// the step ended behind its paced wall time.
+std::int64_t SimServer::Pace(bool* late) {
+  *late = false;
   std::int64_t now = clock_.NowNs();
-  if (options_.rtf > 0) {
-    if (pace_origin_wall_ns_ < 0) {
-      pace_origin_wall_ns_ = now;
-      pace_origin_sim_ns_ = world_.time_ns();
-    }
-    const auto target = pace_origin_wall_ns_ +
-                        static_cast<std::int64_t>(static_cast<double>(world_.time_ns() - pace_origin_sim_ns_) / options_.rtf);
-    if (target > now) {
-      clock_.SleepUntilNs(target);
-      now = target;  // what the wall clock says after the sleep, without reading it again
-    } else {
-      late = target < now;
-      if (now - target > 500'000'000) pace_origin_wall_ns_ = -1;  // fell behind by > 0.5 s (agents
-                                                                   // slow): re-anchor, no catch-up burst
-    }
+  if (options_.rtf <= 0) return now;
+  if (pace_origin_wall_ns_ < 0) {
+    pace_origin_wall_ns_ = now;
+    pace_origin_sim_ns_ = world_.time_ns();
   }
-  if (progress_ && progress_->OnStep(world_.time_ns(), now, late)) {
-    const ClockProgress::Line line = progress_->Take();
-    Log(LogEvent(world_.time_s(), options_.node, "clock")
-            .Add("rtf", line.rtf, 2)
-            .Add("steps", static_cast<std::uint64_t>(world_.step_count()))
-            .Add("late", line.late)
-            .Add("lost", static_cast<std::uint64_t>(lockstep_.lost_count())));
-    if (channel_) LogChannel();
+  const auto target = pace_origin_wall_ns_ +
+                      static_cast<std::int64_t>(static_cast<double>(world_.time_ns() - pace_origin_sim_ns_) / options_.rtf);
+  if (target > now) {
+    clock_.SleepUntilNs(target);
+    return target;  // what the wall clock says after the sleep, without reading it again
   }
+  *late = target < now;
+  if (now - target > 500'000'000) pace_origin_wall_ns_ = -1;  // fell behind by > 0.5 s (agents
+                                                               // slow): re-anchor, no catch-up burst
+  return now;
+}
+
+// event=clock (and event=channel) when a line is due.
+void SimServer::ReportProgress(std::int64_t wall_ns, bool late) {
+  if (!progress_ || !progress_->OnStep(world_.time_ns(), wall_ns, late)) return;
+  const ClockProgress::Line line = progress_->Take();
+  Log(LogEvent(world_.time_s(), options_.node, "clock")
+          .Add("rtf", line.rtf, 2)
+          .Add("steps", static_cast<std::uint64_t>(world_.step_count()))
+          .Add("late", line.late)
+          .Add("lost", static_cast<std::uint64_t>(lockstep_.lost_count())));
+  if (channel_) LogChannel();
+}
+
+Status SimServer::RunStep(const std::atomic<bool>& stop) {
+  const std::uint64_t step = world_.step_count();
+  if (auto s = PublishStep(step); !s) return s;
+  if (auto s = AwaitAnswers(step, stop); !s) return s;
+  if (stop.load()) return Ok{};
+  if (joining_.active()) {
+    if (auto s = ReportJoining(/*done=*/true); !s) return s;
+  }
+  if (auto s = AdvanceWorld(); !s) return s;
+  bool late = false;
+  const std::int64_t now = Pace(&late);
+  ReportProgress(now, late);
   return Ok{};
 }
 

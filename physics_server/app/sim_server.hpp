@@ -22,7 +22,9 @@
 // the channel with send time t_k (drone order, then seq), before the plan's entries of t_k.
 // While waiting, every drone's sample is published again every 200 ms (agents that join late, a
 // lost message, and a keepalive for the drones that answered, so a long wait does not look like a
-// stalled server to them). Duplicate and stale commands are dropped (Lockstep).
+// stalled server to them; an unanswered drone's camera frame goes again first). Duplicate and
+// stale commands are dropped (Lockstep).
+// A camera is due by its airframe's trigger (CameraTrigger: rate_hz, or distance-triggered).
 // While the first step waits, every second `event=joining joined=.. expected=.. missing=..` and the
 // same on sim/status (joining.hpp); `event=joined` once it completes.
 // Then World::Step(), truth.csv, pacing to the real-time factor. Events are printed as logfmt
@@ -41,6 +43,7 @@
 #include <string>
 #include <vector>
 
+#include "camera_trigger.hpp"
 #include "joining.hpp"
 #include "radio_plan.hpp"
 #include "swarmbox/channel/channel.hpp"
@@ -220,6 +223,14 @@ class SimServer {
     std::int64_t back_ns = -1;                 // out: when it comes back; -1 = never (or not out)
     std::string out_fault;                     // out: the plan entry's name
   };
+  bool CaptureCamera(std::size_t i);
+  Status PublishStep(std::uint64_t step);
+  Status Republish();
+  Status AwaitAnswers(std::uint64_t step, const std::atomic<bool>& stop);
+  void EndTimedCommands();
+  Status AdvanceWorld();
+  std::int64_t Pace(bool* late);
+  void ReportProgress(std::int64_t wall_ns, bool late);
   Status PublishDrone(std::size_t i, bool with_camera);
   void Accept(std::size_t i, ActuatorInput& cmd);
   void TakeAnswers(std::int64_t deadline_ns);
@@ -252,6 +263,7 @@ class SimServer {
   std::vector<Timed> timed_;
   WindConfig base_wind_;
   std::vector<Slot> slots_;
+  CameraTrigger trigger_;
   std::size_t next_entry_ = 0;               // options_.plan.schedule[next_entry_] is due next
 
   // radio.model channel.

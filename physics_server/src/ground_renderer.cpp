@@ -151,6 +151,199 @@ bool MayShow(const Projector& cam, const Vec3& centre, double radius_m, int w, i
 constexpr int kNoiseTilePx = 1024;
 constexpr double kNoiseScale = 16.0;  // tile std; frames rescale to their noise_std
 
+// The ground plane z = 0 through one homography texel -> pixel:
+// pixel ~ K * R_cw * [e1 e2 -C] * T * texel. A camera at or below the ground sees dark.
+void DrawGround(const detail::RenderScene& scene, const Projector& cam, cv::Mat& img) {
+  const auto& R = cam.r_wc;
+  const Vec3& C = cam.c;
+  const CameraIntrinsics& k = cam.k;
+  cv::Matx33d K(k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
+  cv::Matx33d Rcw(R[0], R[3], R[6], R[1], R[4], R[7], R[2], R[5], R[8]);
+  cv::Matx33d M(1, 0, -C.x, 0, 1, -C.y, 0, 0, -C.z);
+  const double t = scene.texel_m;
+  cv::Matx33d T(t, 0, scene.origin_x_m + t / 2, 0, -t, scene.top_y_m - t / 2, 0, 0, 1);
+  const cv::Matx33d H = K * Rcw * M * T;
+  if (C.z > 0.01) {
+    cv::warpPerspective(scene.texture, img, cv::Mat(H), img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT101);
+  } else {
+    img.setTo(cv::Scalar(40, 60, 70));
+  }
+}
+
+// Sky: pixels whose ray has world z >= 0. ray_w.z = a*u + b*v + c, a half-plane of the image.
+void DrawSky(const Projector& cam, cv::Mat& img) {
+  const auto& R = cam.r_wc;
+  const CameraIntrinsics& k = cam.k;
+  const int w = img.cols, h = img.rows;
+  const double a = R[6] / k.fx_px, b = R[7] / k.fy_px;
+  const double c = R[8] - R[6] * k.cx_px / k.fx_px - R[7] * k.cy_px / k.fy_px;
+  std::vector<cv::Point2d> rect = {{0, 0}, {double(w), 0}, {double(w), double(h)}, {0, double(h)}};
+  std::vector<cv::Point> sky;
+  auto f = [&](const cv::Point2d& p) { return a * p.x + b * p.y + c + 1e-3; };  // >= 0: sky
+  for (std::size_t i = 0; i < rect.size(); ++i) {
+    const cv::Point2d& p = rect[i];
+    const cv::Point2d& q = rect[(i + 1) % rect.size()];
+    const double fp = f(p), fq = f(q);
+    if (fp >= 0) sky.emplace_back(cv::Point(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y))));
+    if ((fp >= 0) != (fq >= 0)) {
+      const double s = fp / (fp - fq);
+      const cv::Point2d x = p + (q - p) * s;
+      sky.emplace_back(cv::Point(static_cast<int>(std::lround(x.x)), static_cast<int>(std::lround(x.y))));
+    }
+  }
+  if (sky.size() >= 3) cv::fillConvexPoly(img, sky, cv::Scalar(235, 206, 135));
+}
+
+// A person in view: its figure and its unclipped box.
+struct InView {
+  const detail::Figure* figure;
+  cv::Rect box;
+};
+
+// Distractors, then people (with their cover), then obstacles and trees, lowest top first; each
+// person's label (index + 1) into `labels` (when set) under everything drawn over it. Appends the
+// people in view to `in_view` when `want_people`.
+void DrawScene(const detail::RenderScene& scene, const Projector& cam, cv::Mat& img, cv::Mat* labels, bool want_people,
+               std::vector<InView>* in_view) {
+  const int w = img.cols, h = img.rows;
+  const cv::Rect frame(0, 0, w, h);
+  for (const detail::Drawable& d : scene.flats) {
+    if (!MayShow(cam, d.centre_m, d.radius_m, w, h)) continue;
+    for (const detail::Part& p : d.parts) FillProjected(img, cam, p.pts, p.colour);
+  }
+  for (const detail::Figure& f : scene.figures) {
+    if (!MayShow(cam, f.centre_m, f.radius_m, w, h)) continue;
+    cv::Rect box;
+    if (!ProjectedBounds(cam, f.parts, &box) || (box & frame).empty()) continue;
+    const int label = static_cast<int>(f.victim + 1);
+    for (const detail::Part& p : f.parts) FillProjected(img, cam, p.pts, p.colour, labels, label);
+    for (const detail::Part& p : f.cover) FillProjected(img, cam, p.pts, p.colour, labels, 0);
+    if (want_people) in_view->push_back({&f, box});
+  }
+  for (const detail::Drawable& d : scene.obstacles) {
+    if (!MayShow(cam, d.centre_m, d.radius_m, w, h)) continue;
+    if (d.is_box) {
+      if (cam.c.z > d.top_m) {
+        FillProjected(img, cam, d.parts[0].pts, d.parts[0].colour, labels, 0);
+        FillProjected(img, cam, d.parts[1].pts, d.parts[1].colour);
+      } else {
+        FillProjected(img, cam, d.parts[0].pts, cv::Scalar(90, 95, 100), labels, 0);
+      }
+      continue;
+    }
+    for (const detail::Part& p : d.parts) FillProjected(img, cam, p.pts, p.colour, labels, 0);
+  }
+}
+
+// What is left of each person in view: `labels` holds the drawn truth (DrawScene), `scratch` is a
+// canvas for a figure's full area.
+void ListVisible(const WorldConfig& config, const cv::Mat& labels, const Projector& cam, const std::vector<InView>& in_view,
+                 cv::Mat* scratch, std::vector<VisiblePerson>* people) {
+  const cv::Rect frame(0, 0, labels.cols, labels.rows);
+  for (const InView& p : in_view) {
+    const cv::Rect clipped = p.box & frame;
+    cv::Mat same;
+    cv::compare(labels(clipped), cv::Scalar(static_cast<double>(p.figure->victim + 1)), same, cv::CMP_EQ);
+    const int seen = cv::countNonZero(same);
+    if (seen == 0) continue;
+    const double full = FullAreaPx(cam, p.figure->parts, p.box, scratch);
+    people->push_back({config.victims[p.figure->victim].id, clipped, std::min(1.0, seen / std::max(1.0, full))});
+  }
+}
+
+// Exposure: auto-exposure lengthens the exposure as the light falls (up to 8x), then raises the
+// analog gain (up to 4x); a frame's exposure misses its target by a seeded few per cent.
+struct Exposure {
+  double exposure_s;
+  double gain = 1.0;    // applied to the pixels
+  double analog = 1.0;  // scales the noise
+};
+Exposure ExposureOf(const detail::Light& light, const CameraSpec& spec, cv::RNG& rng) {
+  Exposure e{spec.exposure_ms * 1e-3};
+  if (light.enabled) {
+    const double stretch = std::min(8.0, 1.0 / light.level);
+    e.exposure_s *= stretch;
+    e.analog = std::min(4.0, 1.0 / (light.level * stretch));
+    e.gain = light.level * stretch * e.analog * (1.0 + 0.06 * std::clamp(rng.gaussian(1.0), -2.5, 2.5));
+  }
+  return e;
+}
+
+// Motion blur: the image moves by f * rate * exposure during the exposure (roll rate along u,
+// pitch rate along v; the yaw rate's rotation about the optical axis is left out). Averages up
+// to 16 shifted copies; `pad` and `acc` are scratch.
+void MotionBlur(const CameraIntrinsics& k, const Vec3& body_rates_rad_s, double exposure_s, cv::Mat& img, cv::Mat* pad_img,
+                cv::Mat* acc) {
+  if (exposure_s <= 0) return;
+  const int w = img.cols, h = img.rows;
+  // Optical x = -body y, optical y = -body x: a body roll rate p (about +x) turns the view about
+  // optical -y, moving the image along u; a pitch rate q along v.
+  const double du = k.fx_px * body_rates_rad_s.x * exposure_s;
+  const double dv = k.fy_px * body_rates_rad_s.y * exposure_s;
+  const double len = std::hypot(du, dv);
+  if (len < 1.0) return;
+  const int n = std::min(16, static_cast<int>(std::ceil(len)) + 1);
+  const int pad = static_cast<int>(std::ceil(len / 2)) + 1;
+  cv::copyMakeBorder(img, *pad_img, pad, pad, pad, pad, cv::BORDER_REPLICATE);
+  acc->create(h, w, CV_16UC3);
+  acc->setTo(cv::Scalar::all(0));
+  for (int i = 0; i < n; ++i) {
+    const double s = static_cast<double>(i) / (n - 1) - 0.5;
+    const int sx = static_cast<int>(std::lround(du * s)), sy = static_cast<int>(std::lround(dv * s));
+    cv::add(*acc, (*pad_img)(cv::Rect(pad + sx, pad + sy, w, h)), *acc, cv::noArray(), CV_16UC3);
+  }
+  acc->convertTo(img, CV_8UC3, 1.0 / n);
+}
+
+// The light colour x vignetting map (8-bit, 100 = unit gain), rebuilt when the size or the
+// vignetting changes.
+void UpdateGainMap(const detail::Light& light, double vignetting, int w, int h, cv::Mat* map) {
+  map->create(h, w, CV_8UC3);
+  const double r2max = (w * w + h * h) / 4.0;
+  for (int y = 0; y < h; ++y) {
+    auto* g = map->ptr<cv::Vec3b>(y);
+    for (int x = 0; x < w; ++x) {
+      const double dx = x + 0.5 - w / 2.0, dy = y + 0.5 - h / 2.0;
+      const double v = 1.0 - vignetting * (dx * dx + dy * dy) / r2max;
+      for (int c = 0; c < 3; ++c) {
+        g[x][c] = cv::saturate_cast<std::uint8_t>(100.0 * v * (light.enabled ? light.colour[c] : 1.0));
+      }
+    }
+  }
+}
+
+// Light colour, exposure gain and vignetting in one multiply; `map` (and the vignetting it was
+// built for) is kept between frames.
+void ApplyGain(const detail::Light& light, double vignetting, double gain, cv::Mat& img, cv::Mat* map,
+               double* map_vignetting) {
+  if (!light.enabled && vignetting <= 0) return;
+  if (map->size() != img.size() || *map_vignetting != vignetting) {
+    UpdateGainMap(light, vignetting, img.cols, img.rows, map);
+    *map_vignetting = vignetting;
+  }
+  cv::multiply(img, *map, img, gain / 100.0);
+}
+
+// Gaussian pixel noise: a seeded window of the pre-drawn tile, scaled to the frame's noise std
+// (images larger than the tile, rare, reuse it in pieces).
+void AddNoise(const cv::Mat& tile, double noise_std, cv::RNG& rng, cv::Mat& img) {
+  const int w = img.cols, h = img.rows;
+  const int x0 = rng.uniform(0, kNoiseTilePx - std::min(w, kNoiseTilePx) + 1);
+  const int y0 = rng.uniform(0, kNoiseTilePx - std::min(h, kNoiseTilePx) + 1);
+  cv::Mat scaled;
+  for (int ty = 0, ch = 0; ty < h; ty += ch) {
+    const int sy = ty == 0 ? y0 : 0;
+    ch = std::min(kNoiseTilePx - sy, h - ty);
+    for (int tx = 0, cw = 0; tx < w; tx += cw) {
+      const int sx = tx == 0 ? x0 : 0;
+      cw = std::min(kNoiseTilePx - sx, w - tx);
+      tile(cv::Rect(sx, sy, cw, ch)).convertTo(scaled, CV_16SC3, noise_std / kNoiseScale);
+      cv::Mat target = img(cv::Rect(tx, ty, cw, ch));
+      cv::add(target, scaled, target, cv::noArray(), CV_8UC3);
+    }
+  }
+}
+
 }  // namespace
 
 CameraIntrinsics IntrinsicsFor(const CameraSpec& spec) {
@@ -192,178 +385,31 @@ void GroundRenderer::Render(const Pose& body_pose, const Vec3& body_rates_rad_s,
   out->camera_pose = OpticalPose(body_pose, spec);
   out->bgr.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3);
   cv::Mat img(h, w, CV_8UC3, out->bgr.data());
+  const Projector cam{Mul(RotationOf(body_pose.attitude), kBodyFromOptical), out->camera_pose.position_m, out->intrinsics};
 
-  const CameraIntrinsics& k = out->intrinsics;
-  const Projector cam{Mul(RotationOf(body_pose.attitude), kBodyFromOptical), out->camera_pose.position_m, k};
-  const auto& R = cam.r_wc;
-  const Vec3& C = cam.c;
-
-  // Ground: homography texel -> pixel. pixel ~ K * R_cw * [e1 e2 -C] * T * texel.
-  cv::Matx33d K(k.fx_px, 0, k.cx_px, 0, k.fy_px, k.cy_px, 0, 0, 1);
-  cv::Matx33d Rcw(R[0], R[3], R[6], R[1], R[4], R[7], R[2], R[5], R[8]);
-  cv::Matx33d M(1, 0, -C.x, 0, 1, -C.y, 0, 0, -C.z);
-  const double t = scene.texel_m;
-  cv::Matx33d T(t, 0, scene.origin_x_m + t / 2, 0, -t, scene.top_y_m - t / 2, 0, 0, 1);
-  const cv::Matx33d H = K * Rcw * M * T;
-  if (C.z > 0.01) {
-    cv::warpPerspective(scene.texture, img, cv::Mat(H), img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT101);
-  } else {
-    img.setTo(cv::Scalar(40, 60, 70));  // camera at/below the ground: dark
-  }
-
-  // Sky: pixels whose ray has world z >= 0. ray_w.z = a*u + b*v + c, a half-plane of the image.
-  {
-    const double a = R[6] / k.fx_px, b = R[7] / k.fy_px;
-    const double c = R[8] - R[6] * k.cx_px / k.fx_px - R[7] * k.cy_px / k.fy_px;
-    std::vector<cv::Point2d> rect = {{0, 0}, {double(w), 0}, {double(w), double(h)}, {0, double(h)}};
-    std::vector<cv::Point> sky;
-    auto f = [&](const cv::Point2d& p) { return a * p.x + b * p.y + c + 1e-3; };  // >= 0: sky
-    for (std::size_t i = 0; i < rect.size(); ++i) {
-      const cv::Point2d& p = rect[i];
-      const cv::Point2d& q = rect[(i + 1) % rect.size()];
-      const double fp = f(p), fq = f(q);
-      if (fp >= 0) sky.emplace_back(cv::Point(static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y))));
-      if ((fp >= 0) != (fq >= 0)) {
-        const double s = fp / (fp - fq);
-        const cv::Point2d x = p + (q - p) * s;
-        sky.emplace_back(cv::Point(static_cast<int>(std::lround(x.x)), static_cast<int>(std::lround(x.y))));
-      }
-    }
-    if (sky.size() >= 3) cv::fillConvexPoly(img, sky, cv::Scalar(235, 206, 135));
-  }
-
-  // Truth: each person's label (index + 1) under everything drawn over it; 0 elsewhere.
-  cv::Mat* labels = nullptr;
+  DrawGround(scene, cam, img);
+  DrawSky(cam, img);
+  cv::Mat* labels = nullptr;  // truth: each person's label (index + 1), 0 elsewhere
   if (people != nullptr) {
     labels_.create(h, w, CV_16U);
     labels_.setTo(0);
     labels = &labels_;
   }
-  const cv::Rect frame(0, 0, w, h);
-  struct InView {
-    const detail::Figure* figure;
-    cv::Rect box;  // unclipped
-  };
   std::vector<InView> in_view;
+  DrawScene(scene, cam, img, labels, people != nullptr, &in_view);
+  if (people != nullptr) ListVisible(*config_, labels_, cam, in_view, &scratch_, people);
 
-  // Distractors, then people (with their cover), then obstacles and trees, lowest top first.
-  for (const detail::Drawable& d : scene.flats) {
-    if (!MayShow(cam, d.centre_m, d.radius_m, w, h)) continue;
-    for (const detail::Part& p : d.parts) FillProjected(img, cam, p.pts, p.colour);
-  }
-  for (const detail::Figure& f : scene.figures) {
-    if (!MayShow(cam, f.centre_m, f.radius_m, w, h)) continue;
-    cv::Rect box;
-    if (!ProjectedBounds(cam, f.parts, &box) || (box & frame).empty()) continue;
-    const int label = static_cast<int>(f.victim + 1);
-    for (const detail::Part& p : f.parts) FillProjected(img, cam, p.pts, p.colour, labels, label);
-    for (const detail::Part& p : f.cover) FillProjected(img, cam, p.pts, p.colour, labels, 0);
-    if (people != nullptr) in_view.push_back({&f, box});
-  }
-  for (const detail::Drawable& d : scene.obstacles) {
-    if (!MayShow(cam, d.centre_m, d.radius_m, w, h)) continue;
-    if (d.is_box) {
-      if (C.z > d.top_m) {
-        FillProjected(img, cam, d.parts[0].pts, d.parts[0].colour, labels, 0);
-        FillProjected(img, cam, d.parts[1].pts, d.parts[1].colour);
-      } else {
-        FillProjected(img, cam, d.parts[0].pts, cv::Scalar(90, 95, 100), labels, 0);
-      }
-      continue;
-    }
-    for (const detail::Part& p : d.parts) FillProjected(img, cam, p.pts, p.colour, labels, 0);
-  }
-
-  // What is left of each person in view.
-  if (people != nullptr) {
-    for (const InView& p : in_view) {
-      const cv::Rect clipped = p.box & frame;
-      cv::Mat same;
-      cv::compare(labels_(clipped), cv::Scalar(static_cast<double>(p.figure->victim + 1)), same, cv::CMP_EQ);
-      const int seen = cv::countNonZero(same);
-      if (seen == 0) continue;
-      const double full = FullAreaPx(cam, p.figure->parts, p.box, &scratch_);
-      people->push_back({config_->victims[p.figure->victim].id, clipped, std::min(1.0, seen / std::max(1.0, full))});
-    }
-  }
-
-  // Exposure: auto-exposure lengthens the exposure as the light falls (up to 8x), then raises the
-  // analog gain (up to 4x); a frame's exposure misses its target by a seeded few per cent.
   cv::RNG rng(noise_seed);
-  const detail::Light& light = scene.light;
-  double exposure_s = spec.exposure_ms * 1e-3, gain = 1.0, analog = 1.0;
-  if (light.enabled) {
-    const double stretch = std::min(8.0, 1.0 / light.level);
-    exposure_s *= stretch;
-    analog = std::min(4.0, 1.0 / (light.level * stretch));
-    gain = light.level * stretch * analog * (1.0 + 0.06 * std::clamp(rng.gaussian(1.0), -2.5, 2.5));
-  }
-
-  // Motion blur: the image moves by f * rate * exposure during the exposure (roll rate along u,
-  // pitch rate along v; the yaw rate's rotation about the optical axis is left out). Averages up
-  // to 16 shifted copies.
-  if (exposure_s > 0) {
-    // Optical x = -body y, optical y = -body x: a body roll rate p (about +x) turns the view about
-    // optical -y, moving the image along u; a pitch rate q along v.
-    const double du = k.fx_px * body_rates_rad_s.x * exposure_s;
-    const double dv = k.fy_px * body_rates_rad_s.y * exposure_s;
-    const double len = std::hypot(du, dv);
-    if (len >= 1.0) {
-      const int n = std::min(16, static_cast<int>(std::ceil(len)) + 1);
-      const int pad = static_cast<int>(std::ceil(len / 2)) + 1;
-      cv::copyMakeBorder(img, blur_pad_, pad, pad, pad, pad, cv::BORDER_REPLICATE);
-      blur_acc_.create(h, w, CV_16UC3);
-      blur_acc_.setTo(cv::Scalar::all(0));
-      for (int i = 0; i < n; ++i) {
-        const double s = static_cast<double>(i) / (n - 1) - 0.5;
-        const int sx = static_cast<int>(std::lround(du * s)), sy = static_cast<int>(std::lround(dv * s));
-        cv::add(blur_acc_, blur_pad_(cv::Rect(pad + sx, pad + sy, w, h)), blur_acc_, cv::noArray(), CV_16UC3);
-      }
-      blur_acc_.convertTo(img, CV_8UC3, 1.0 / n);
-    }
-  }
-
-  // Light colour, exposure gain and vignetting in one multiply (8-bit map, 128 = unit gain).
-  if (light.enabled || spec.vignetting > 0) {
-    if (gain_map_.size() != img.size() || gain_map_vignetting_ != spec.vignetting) {
-      gain_map_.create(h, w, CV_8UC3);
-      const double r2max = (w * w + h * h) / 4.0;
-      for (int y = 0; y < h; ++y) {
-        auto* g = gain_map_.ptr<cv::Vec3b>(y);
-        for (int x = 0; x < w; ++x) {
-          const double dx = x + 0.5 - w / 2.0, dy = y + 0.5 - h / 2.0;
-          const double v = 1.0 - spec.vignetting * (dx * dx + dy * dy) / r2max;
-          for (int c = 0; c < 3; ++c) {
-            g[x][c] = cv::saturate_cast<std::uint8_t>(100.0 * v * (light.enabled ? light.colour[c] : 1.0));
-          }
-        }
-      }
-      gain_map_vignetting_ = spec.vignetting;
-    }
-    cv::multiply(img, gain_map_, img, gain / 100.0);
-  }
-
+  const Exposure e = ExposureOf(scene.light, spec, rng);
+  MotionBlur(out->intrinsics, body_rates_rad_s, e.exposure_s, img, &blur_pad_, &blur_acc_);
+  ApplyGain(scene.light, spec.vignetting, e.gain, img, &gain_map_, &gain_map_vignetting_);
   if (spec.noise_std > 0) {
     if (noise_tile_.empty()) {
       cv::RNG tile_rng(0x6E015E);
       noise_tile_.create(kNoiseTilePx, kNoiseTilePx, CV_16SC3);
       tile_rng.fill(noise_tile_, cv::RNG::NORMAL, 0.0, kNoiseScale);
     }
-    const int x0 = rng.uniform(0, kNoiseTilePx - std::min(w, kNoiseTilePx) + 1);
-    const int y0 = rng.uniform(0, kNoiseTilePx - std::min(h, kNoiseTilePx) + 1);
-    // Images larger than the tile (rare) reuse it in pieces.
-    cv::Mat scaled;
-    for (int ty = 0, ch = 0; ty < h; ty += ch) {
-      const int sy = ty == 0 ? y0 : 0;
-      ch = std::min(kNoiseTilePx - sy, h - ty);
-      for (int tx = 0, cw = 0; tx < w; tx += cw) {
-        const int sx = tx == 0 ? x0 : 0;
-        cw = std::min(kNoiseTilePx - sx, w - tx);
-        noise_tile_(cv::Rect(sx, sy, cw, ch)).convertTo(scaled, CV_16SC3, analog * spec.noise_std / kNoiseScale);
-        cv::Mat target = img(cv::Rect(tx, ty, cw, ch));
-        cv::add(target, scaled, target, cv::noArray(), CV_8UC3);
-      }
-    }
+    AddNoise(noise_tile_, e.analog * spec.noise_std, rng, img);
   }
 }
 

@@ -1,6 +1,10 @@
 // swarmbox-bench camera: the cost of one downward camera frame (GroundRenderer) on one core, per
 // world look, at the x500's camera (trials/airframes/x500.yaml), and the cost of building the scene.
 //   suite=camera scenario=rubble_dusk width_px=640 height_px=360 frames=... ms_per_frame=... build_ms=...
+//     copy_ms=... jpeg_quality=90 jpeg_kb=... jpeg_encode_ms=... jpeg_decode_ms=...
+// copy_ms is one copy of the raw bgr8 frame (what each hop of it costs: the server's message, DDS's
+// serialisation, the agent's); jpeg_*: the frame compressed as the camera could deliver it
+// (OpenCV's libjpeg at quality 90), its size and what encoding and decoding it cost.
 // A frame's cost is the process's CPU time (OpenCV's worker threads included: what a frame costs
 // the machine, whatever the load), averaged over views at
 // 10, 20, 30, 40 and 60 m near a person with random yaw, level and rolling (motion blur). --png=DIR also writes
@@ -74,6 +78,8 @@ WorldConfig ShowcaseWorld(const char* name, std::optional<Terrain> terrain, std:
   return w;
 }
 
+constexpr int kJpegQuality = 90;
+
 int RunCameraBench(const swarmbox::bench::Args& args) {
   auto af = LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
   auto field = LoadWorld(std::string(SWARMBOX_TRIALS_DIR) + "/worlds/open_field.yaml");
@@ -105,7 +111,9 @@ int RunCameraBench(const swarmbox::bench::Args& args) {
     std::uniform_real_distribution<double> unit(0, 1);
     CameraImage img;
     std::vector<VisiblePerson> people;
-    double render_s = 0;
+    double render_s = 0, copy_s = 0, encode_s = 0, decode_s = 0, jpeg_bytes = 0;
+    std::vector<std::uint8_t> copy, jpeg;
+    cv::Mat decoded;
     for (int i = 0; i < frames; ++i) {
       const double alt = altitudes[i % 5], yaw = unit(rng) * 2 * std::numbers::pi;
       // Views near a person (a tenth of the altitude off), as a searching drone's.
@@ -119,6 +127,16 @@ int RunCameraBench(const swarmbox::bench::Args& args) {
       const double t0 = ThreadCpuS();
       renderer.Render(pose, rates, spec, static_cast<std::uint64_t>(i), &img, nullptr);
       render_s += ThreadCpuS() - t0;
+      const cv::Mat frame(img.height_px, img.width_px, CV_8UC3, img.bgr.data());
+      const double t1 = ThreadCpuS();
+      copy.assign(img.bgr.begin(), img.bgr.end());
+      const double t2 = ThreadCpuS();
+      cv::imencode(".jpg", frame, jpeg, {cv::IMWRITE_JPEG_QUALITY, kJpegQuality});
+      const double t3 = ThreadCpuS();
+      decoded = cv::imdecode(jpeg, cv::IMREAD_COLOR);
+      const double t4 = ThreadCpuS();
+      copy_s += t2 - t1, encode_s += t3 - t2, decode_s += t4 - t3;
+      jpeg_bytes += static_cast<double>(jpeg.size());
       if (!png.empty() && i < 5) {
         renderer.Render(pose, Vec3{}, spec, static_cast<std::uint64_t>(i), &img, &people);
         cv::Mat m(img.height_px, img.width_px, CV_8UC3, img.bgr.data());
@@ -130,8 +148,10 @@ int RunCameraBench(const swarmbox::bench::Args& args) {
         cv::imwrite(png + "/camera_" + s.name + "_" + std::to_string(static_cast<int>(alt)) + "m_truth.png", boxed);
       }
     }
-    std::printf("suite=camera scenario=%s width_px=%d height_px=%d frames=%d ms_per_frame=%.3f build_ms=%.1f\n", s.name,
-                spec.width_px, spec.height_px, frames, render_s / frames * 1e3, build_ms);
+    std::printf("suite=camera scenario=%s width_px=%d height_px=%d frames=%d ms_per_frame=%.3f build_ms=%.1f copy_ms=%.3f "
+                "jpeg_quality=%d jpeg_kb=%.1f jpeg_encode_ms=%.3f jpeg_decode_ms=%.3f\n",
+                s.name, spec.width_px, spec.height_px, frames, render_s / frames * 1e3, build_ms, copy_s / frames * 1e3,
+                kJpegQuality, jpeg_bytes / frames / 1e3, encode_s / frames * 1e3, decode_s / frames * 1e3);
     std::fflush(stdout);
   }
   return 0;

@@ -25,7 +25,8 @@ class SimServerTest : public ::testing::Test {
  protected:
   void SetUp() override {
     world_ = testing::MakeWorld(testing::CalmWorld());
-    const Airframe af = testing::LoadShippedAirframe("x500");
+    Airframe af = testing::LoadShippedAirframe("x500");
+    af.camera.trigger_distance_m = 0;  // the fixed 5 Hz these tests count (SimServerCameraTrigger: the shipped trigger)
     u_ = af.HoverRotorSpeed() / af.motor.max_rot_velocity_rad_s;
     testing::Spawn(*world_, testing::MakeSpawn("a", af, Vec3{0, 0, 10}, 0, u_));
     testing::Spawn(*world_, testing::MakeSpawn("b", af, Vec3{5, 0, 10}, 0, u_));
@@ -360,6 +361,36 @@ TEST_F(SimServerTest, CameraFrameGoesOutBeforeItsSampleWhichSaysSo) {
   EXPECT_EQ(std::count_if(agents_.published.begin(), agents_.published.end(),
                           [](const std::string& l) { return l.find("camera_frame") != std::string::npos; }),
             4);
+}
+
+// The shipped x500 triggers its camera by distance (x500.yaml, camera_trigger.hpp): a drone holding
+// its position takes its first frame at once, then one per trigger_interval_max_s (0.5 s, on the
+// 5 Hz grid: 0.6 s), not 5 a second.
+TEST(SimServerCameraTrigger, TheShippedX500HoldingItsPositionTakesAFrameAtItsFloorInterval) {
+  auto world = testing::MakeWorld(testing::CalmWorld());
+  const Airframe af = testing::LoadShippedAirframe("x500");
+  ASSERT_DOUBLE_EQ(af.camera.trigger_distance_m, 3.0);
+  ASSERT_DOUBLE_EQ(af.camera.trigger_interval_max_s, 0.5);
+  const double u = af.HoverRotorSpeed() / af.motor.max_rot_velocity_rad_s;
+  testing::Spawn(*world, testing::MakeSpawn("a", af, Vec3{0, 0, 10}, 0, u));
+  testing::FakeClock clock;
+  ScriptedAgents agents{clock};
+  agents.throttle = u;
+  agents.alive = {{"a", true}};
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  SimServerOptions o;
+  o.rtf = 0;
+  o.lockstep = {.timeout_ns = 200 * kMs, .join_timeout_ns = 500 * kMs};
+  SimServer server(*world, agents, clock, nullptr, o, out);
+  std::atomic<bool> stop{false};
+  for (int k = 0; k < 301; ++k) ASSERT_TRUE(server.RunStep(stop).ok());
+  std::fclose(out);
+  std::vector<std::string> framed;
+  for (const std::string& line : agents.published) {
+    if (line.rfind("camera ", 0) == 0) framed.push_back(line);
+  }
+  EXPECT_EQ(framed, (std::vector<std::string>{"camera a 0", "camera a 150", "camera a 300"}));
 }
 
 // World commands inside the answers: applied once every drone answered, before the world steps,

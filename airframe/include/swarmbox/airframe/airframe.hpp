@@ -104,13 +104,21 @@ void SetRtkFix(GpsSpec* gps, double baseline_km);
 inline constexpr double kRtkMaxRateHz = 20.0;
 // Downward camera (`camera:`): pinhole looking along body -z; image "up" is body +x (forward), image
 // right is body -y (right). The physics server renders it on demand (World::RenderCamera) at
-// rate_hz; the agent geolocates its detections with offset_m. Valid: 16..4096 pixels a side,
-// 0 < hfov_rad < 0.9 pi, rate_hz > 0, noise_std and exposure_ms >= 0, 0 <= vignetting < 1.
+// rate_hz, or with trigger_distance_m by distance travelled (physics_server/app/camera_trigger.hpp);
+// the agent geolocates its detections with offset_m. Valid: 16..4096 pixels a side,
+// 0 < hfov_rad < 0.9 pi, rate_hz > 0, noise_std, exposure_ms, trigger_distance_m and
+// trigger_interval_max_s >= 0, 0 <= vignetting < 1.
 struct CameraSpec {
   int width_px = 320;
   int height_px = 240;
   double hfov_rad = 1.2;           // horizontal field of view
-  double rate_hz = 5;
+  double rate_hz = 5;              // the frame rate; with trigger_distance_m its upper bound [Hz]
+  // Distance-triggered capture (PX4 TRIG_MODE 3, TRIG_DISTANCE): a frame once the camera has moved
+  // this far horizontally since the last one [m]; 0: every frame of rate_hz.
+  double trigger_distance_m = 0;
+  // With trigger_distance_m: a frame at least this often while the drone does not move (hover,
+  // climb, hold) [s]; 0: none.
+  double trigger_interval_max_s = 0;
   double noise_std = 4.0;          // Gaussian pixel noise, 8-bit levels (at unit analog gain)
   // Exposure time in full daylight [ms]; auto-exposure lengthens it as the light falls (up to 8x,
   // then raises the analog gain, and the noise with it, up to 4x). Motion blur is the image's
