@@ -169,6 +169,18 @@ void ReadCamera(MapReader& parent, Airframe* af) {
   });
 }
 
+// `stereo:` (stereo_spec.cpp): absent or null leaves af->stereo disabled.
+void ReadStereo(MapReader& parent, Airframe* af) {
+  const Node* n = parent.Child("stereo", false);
+  if (n == nullptr) return;
+  auto spec = ParseStereoSpec(n);
+  if (!spec) {
+    parent.Fail(spec.error());
+    return;
+  }
+  af->stereo = *spec;
+}
+
 void ReadPayloads(MapReader& parent, Airframe* af) {
   const Node* list = parent.Child("payloads", false);
   if (list == nullptr || list->is_null()) return;
@@ -203,7 +215,7 @@ void ReadControl(MapReader& parent, Airframe* af) {
 // section: its reader here (a field of Airframe filled by a parse function in its own file).
 using SectionReader = void (*)(MapReader& parent, Airframe* af);
 constexpr SectionReader kSections[] = {
-    ReadCollision, ReadImpact, ReadMotor, ReadRotors, ReadSensors, ReadCamera, ReadPayloads, ReadControl,
+    ReadCollision, ReadImpact, ReadMotor, ReadRotors, ReadSensors, ReadCamera, ReadStereo, ReadPayloads, ReadControl,
 };
 
 // Checks across keys, once every section is read.

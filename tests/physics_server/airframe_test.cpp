@@ -162,5 +162,50 @@ TEST(Airframe, SyntaxErrorIsReportedWithPosition) {
   EXPECT_EQ(af.error().where().rfind("af.yaml:", 0), 0u) << af.error().where();
 }
 
+TEST(Airframe, AbsentStereoKeyIsOffAndTheScoutHasNone) {
+  auto af = ParseText(kMinimal);
+  ASSERT_TRUE(af.ok()) << af.error().ToString();
+  EXPECT_FALSE(af->stereo.enabled);
+  auto x500 = LoadAirframe(AirframePath("x500"));
+  ASSERT_TRUE(x500.ok()) << x500.error().ToString();
+  EXPECT_FALSE(x500->stereo.enabled);  // existing trials keep their behaviour: no depth
+}
+
+TEST(Airframe, StereoSectionIsReadAndItsErrorsKeepTheirPlace) {
+  auto af = ParseText(std::string(kMinimal) + "stereo: {baseline_m: 0.1, width_px: 320, height_px: 200}\n");
+  ASSERT_TRUE(af.ok()) << af.error().ToString();
+  EXPECT_TRUE(af->stereo.enabled);
+  EXPECT_DOUBLE_EQ(af->stereo.baseline_m, 0.1);
+  EXPECT_EQ(af->stereo.width_px, 320);
+  auto bad = ParseText(std::string(kMinimal) + "stereo: {baseline_m: 0.1, lens: fisheye}\n");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.error().ToString().find("lens"), std::string::npos) << bad.error().ToString();
+  EXPECT_EQ(bad.error().where().rfind("af.yaml:", 0), 0u) << bad.error().where();
+}
+
+// x500_depth / x8_heavy_depth are their base file plus `stereo:` (trials/sensors/oak_d_pro_stereo.yaml's
+// figures): the same document key for key otherwise, so a change to the base must be made to both.
+TEST(Airframe, DepthVariantsAreTheirBasePlusStereo) {
+  auto reference = yaml::ParseFile(testing::TrialsDir() + "/sensors/oak_d_pro_stereo.yaml");
+  ASSERT_TRUE(reference.ok()) << reference.error().ToString();
+  for (const char* base : {"x500", "x8_heavy"}) {
+    auto base_doc = yaml::ParseFile(AirframePath(base));
+    auto depth_doc = yaml::ParseFile(AirframePath(std::string(base) + "_depth"));
+    ASSERT_TRUE(base_doc.ok() && depth_doc.ok()) << base;
+    ASSERT_NE(depth_doc->Find("stereo"), nullptr) << base;
+    yaml::Node stereo = *depth_doc->Find("stereo");
+    depth_doc->Erase("stereo");
+    EXPECT_TRUE(*depth_doc == *base_doc) << base << "_depth.yaml differs from " << base << ".yaml above `stereo:`";
+    // The reference's figures, but where the camera sits on this airframe.
+    yaml::Node figures = *reference->Find("stereo");
+    figures.Set("offset_m", *stereo.Find("offset_m"));
+    EXPECT_TRUE(stereo == figures) << base << "_depth.yaml's stereo: is not oak_d_pro_stereo.yaml's";
+    auto af = LoadAirframe(AirframePath(std::string(base) + "_depth"));
+    ASSERT_TRUE(af.ok()) << af.error().ToString();
+    EXPECT_TRUE(af->stereo.enabled);
+    EXPECT_EQ(af->name, base);
+  }
+}
+
 }  // namespace
 }  // namespace swarmbox::physics

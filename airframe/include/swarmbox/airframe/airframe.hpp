@@ -18,8 +18,8 @@
 //
 // The file is read strictly: an unknown top-level key is an error. Each top-level section has one
 // reader in src/airframe.cpp (the kSections table: collision, impact, motor, rotors, sensors,
-// camera, payloads); a new section (e.g. `stereo:`) is a field here, a parse function in its own
-// file, and one row in that table (airframe/README.md, "Adding a section"). The top-level
+// camera, stereo, payloads); a new section is a field here, a parse function in its own file, and
+// one row in that table (airframe/README.md, "Adding a section"; `stereo:` is built so). The top-level
 // `control:` mapping is owned by the flight stack (controller gains): it is kept untouched in
 // Airframe::control and interpreted only by agent/flight (FlightConfigFrom).
 #pragma once
@@ -30,6 +30,7 @@
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/airframe/stereo_spec.hpp"
 #include "swarmbox/airframe/vec3.hpp"
 
 namespace swarmbox::airframe {
@@ -159,6 +160,7 @@ struct Airframe {
   GpsSpec gps;
   CameraSpec camera;
   bool has_camera = false;              // the file has a `camera:` mapping (else `camera` is the default)
+  StereoSpec stereo;                    // `stereo:` (OAK-D Pro depth); absent: stereo.enabled == false
   std::vector<PayloadSpec> payloads;    // what this airframe can carry (x8_heavy: the stretcher)
   yaml::Node control;                   // flight-stack gains, passed through untouched (may be null)
 

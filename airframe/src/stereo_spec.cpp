@@ -1,15 +1,15 @@
-#include "swarmbox/physics/stereo_spec.hpp"
+#include "swarmbox/airframe/stereo_spec.hpp"
 
 #include <cmath>
 #include <numbers>
 
 #include "swarmbox/airframe/yaml_read.hpp"
 
-namespace swarmbox::physics {
+namespace swarmbox::airframe {
 namespace {
 
-using airframe::detail::Checked;
-using airframe::detail::Nested;
+using detail::Checked;
+using detail::Nested;
 using yaml::MapReader;
 using yaml::Node;
 
@@ -80,4 +80,4 @@ Result<StereoSpec> ParseStereoSpec(const Node* node) {
   return s;
 }
 
-}  // namespace swarmbox::physics
+}  // namespace swarmbox::airframe
