@@ -75,6 +75,56 @@ constexpr int kMeshDomain = 1;
 
 // swarmbox-physics (physics_server/README.md).
 constexpr double kFaultClockEveryS = 0.5;  // [simulated s]
+// The recording (record:), collected with truth.csv.
+void AppendRecordFlags(const dsl::TrialSpec& spec, std::vector<std::string>* argv) {
+  if (!spec.record.enabled) return;
+  argv->insert(argv->end(), {"--record", std::string(kRecordingPath),
+                             "--record-rate-hz", ShortestNumber(spec.record.rate_hz),
+                             "--record-camera-hz", ShortestNumber(spec.record.camera_hz),
+                             "--record-camera-scale", ShortestNumber(spec.record.camera_scale),
+                             "--record-jpeg-quality", std::to_string(spec.record.jpeg_quality)});
+}
+
+// The simulated radio: the channel with its profile, and the plan of what happens at simulated
+// times (network.mesh, the faults with `at:`; radio_schedule.hpp); the step and join timeouts.
+void AppendRadioAndTimeoutFlags(const dsl::TrialSpec& spec, bool radio_plan, std::vector<std::string>* argv) {
+  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
+  if (channel) {
+    argv->insert(argv->end(), {"--radio-model", "channel", "--radio-profile", InContainer(dsl::RadioProfileFile(spec.radio))});
+    if (radio_plan) argv->insert(argv->end(), {"--radio-plan", std::string(kRadioPlanPath)});
+  }
+  // netem: faults at simulated times fire at the log line that crosses their time (the fault
+  // injector's timeline): with such faults the physics server reports its clock every 0.5 s
+  // (default 10 s), so they fire at most 0.5 s late. With the channel they are in the plan.
+  // An agent with an external brain waits up to the brain's wall-clock bounds for its answer:
+  // the server must wait longer before it calls that drone lost.
+  if (spec.HasExternalBrain()) {
+    argv->insert(argv->end(), {"--step-timeout", ShortestNumber(std::max(kExternalBrainStepTimeoutS, channel ? kChannelStepTimeoutS : 0.0)),
+                               "--join-timeout", ShortestNumber(kExternalBrainJoinTimeoutS)});
+  } else if (channel) {
+    argv->insert(argv->end(), {"--step-timeout", ShortestNumber(kChannelStepTimeoutS)});
+  }
+  for (const faults::Fault& f : spec.faults) {
+    if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {
+      argv->insert(argv->end(), {"--clock-every", ShortestNumber(kFaultClockEveryS)});
+      break;
+    }
+  }
+}
+
+// name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]]; a payload starts on the ground
+// under the drone (a lifter standing on the ground cannot spawn with it hanging).
+void AppendDroneFlags(const dsl::TrialSpec& spec, std::vector<std::string>* argv) {
+  for (const dsl::DroneSpec& d : spec.drones) {
+    std::string drone = d.name + ":" + d.airframe + ":" + ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) +
+                        "," + ShortestNumber(d.pose[2]);
+    if (!d.payload.empty()) drone += ":0:" + d.payload + ":ground";
+    argv->push_back("--drone");
+    argv->push_back(std::move(drone));
+  }
+}
+
+// swarmbox-physics's command line.
 std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan, bool view) {
   std::vector<std::string> argv = {
       images::kPhysicsBinaryInImage,
@@ -94,47 +144,9 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
   };
   // The live view (swarmbox run --view): every address of the container, published by Docker.
   if (view) argv.insert(argv.end(), {"--view", "0.0.0.0:" + std::to_string(kViewContainerPort)});
-  // The recording (record:), collected with truth.csv.
-  if (spec.record.enabled) {
-    argv.insert(argv.end(), {"--record", std::string(kRecordingPath),
-                             "--record-rate-hz", ShortestNumber(spec.record.rate_hz),
-                             "--record-camera-hz", ShortestNumber(spec.record.camera_hz),
-                             "--record-camera-scale", ShortestNumber(spec.record.camera_scale),
-                             "--record-jpeg-quality", std::to_string(spec.record.jpeg_quality)});
-  }
-  // The simulated radio: the channel with its profile, and the plan of what happens at simulated
-  // times (network.mesh, the faults with `at:`; radio_schedule.hpp).
-  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
-  if (channel) {
-    argv.insert(argv.end(), {"--radio-model", "channel", "--radio-profile", InContainer(dsl::RadioProfileFile(spec.radio))});
-    if (radio_plan) argv.insert(argv.end(), {"--radio-plan", std::string(kRadioPlanPath)});
-  }
-  // netem: faults at simulated times fire at the log line that crosses their time (the fault
-  // injector's timeline): with such faults the physics server reports its clock every 0.5 s
-  // (default 10 s), so they fire at most 0.5 s late. With the channel they are in the plan.
-  // An agent with an external brain waits up to the brain's wall-clock bounds for its answer:
-  // the server must wait longer before it calls that drone lost.
-  if (spec.HasExternalBrain()) {
-    argv.insert(argv.end(), {"--step-timeout", ShortestNumber(std::max(kExternalBrainStepTimeoutS, channel ? kChannelStepTimeoutS : 0.0)),
-                             "--join-timeout", ShortestNumber(kExternalBrainJoinTimeoutS)});
-  } else if (channel) {
-    argv.insert(argv.end(), {"--step-timeout", ShortestNumber(kChannelStepTimeoutS)});
-  }
-  for (const faults::Fault& f : spec.faults) {
-    if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {
-      argv.insert(argv.end(), {"--clock-every", ShortestNumber(kFaultClockEveryS)});
-      break;
-    }
-  }
-  for (const dsl::DroneSpec& d : spec.drones) {
-    // name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]]; a payload starts on the ground
-    // under the drone (a lifter standing on the ground cannot spawn with it hanging).
-    std::string drone = d.name + ":" + d.airframe + ":" + ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) +
-                        "," + ShortestNumber(d.pose[2]);
-    if (!d.payload.empty()) drone += ":0:" + d.payload + ":ground";
-    argv.push_back("--drone");
-    argv.push_back(std::move(drone));
-  }
+  AppendRecordFlags(spec, &argv);
+  AppendRadioAndTimeoutFlags(spec, radio_plan, &argv);
+  AppendDroneFlags(spec, &argv);
   return argv;
 }
 
@@ -166,6 +178,64 @@ std::string BrainLibraryInImage(const dsl::BrainSpec& brain) {
   return std::string(kBrainsDir) + "/" + BasenameOf(brain.host_path.empty() ? brain.path : brain.host_path);
 }
 
+// Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`. At swarm
+// scale the first raft.voters drones vote, the others are learners; with no more drones than
+// voters every drone votes (no flag: the agent's default).
+void AppendRaftFlags(const dsl::TrialSpec& spec, std::vector<std::string>* argv) {
+  argv->insert(argv->end(), {
+      "--members", Members(spec),
+      "--seed", std::to_string(spec.seed),
+      "--raft-tick-ms", std::to_string(spec.raft.tick_ms),
+      "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
+      "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
+  });
+  if (spec.raft.voters > 0 && static_cast<std::size_t>(spec.raft.voters) < spec.drones.size()) {
+    std::string voters;
+    for (int k = 0; k < spec.raft.voters; ++k) {
+      voters += (voters.empty() ? "" : ",") + spec.drones[static_cast<std::size_t>(k)].name;
+    }
+    argv->insert(argv->end(), {"--raft-voters", voters});
+  }
+}
+
+// The user's brain (design24 "Agent flags"): its context gets the world and the payload; the
+// mission keys are the builtin brain's.
+void AppendUserBrainFlags(const dsl::TrialSpec& spec, const dsl::DroneSpec& d, std::vector<std::string>* argv) {
+  const dsl::BrainSpec& brain = d.brain;
+  argv->insert(argv->end(), {"--world", InContainer(spec.world),
+                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
+  if (!d.payload.empty()) argv->insert(argv->end(), {"--payload", d.payload});
+  if (brain.kind == dsl::BrainKind::kLibrary) {
+    argv->insert(argv->end(), {"--brain", "library",
+                               "--brain-library", BrainLibraryInImage(brain),
+                               "--brain-name", brain.name,
+                               "--brain-args", brain.ArgsJson()});
+  } else {
+    argv->insert(argv->end(), {"--brain", "external"});
+  }
+  if (brain.rate_hz > 0) argv->insert(argv->end(), {"--brain-rate-hz", ShortestNumber(brain.rate_hz)});
+  if (brain.offboard.timeout_ms) {
+    argv->insert(argv->end(), {"--offboard-timeout-ms", std::to_string(*brain.offboard.timeout_ms)});
+  }
+  if (brain.offboard.hold_ms) {
+    argv->insert(argv->end(), {"--offboard-hold-ms", std::to_string(*brain.offboard.hold_ms)});
+  }
+}
+
+// What decides: the user's brain, else the builtin brain's plan or SAR mission.
+void AppendBrainFlags(const dsl::TrialSpec& spec, const dsl::DroneSpec& d, std::vector<std::string>* argv) {
+  if (d.brain.kind != dsl::BrainKind::kBuiltin) {
+    AppendUserBrainFlags(spec, d, argv);
+  } else if (spec.mission.kind == dsl::MissionKind::kPlan) {
+    argv->insert(argv->end(), {"--mission", "plan", "--plan", spec.mission.plan});
+  } else {
+    argv->insert(argv->end(), {"--mission", "sar", "--world", InContainer(spec.world),
+                               "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
+    // The lifter starts with its payload on the ground under it (as the physics server places it).
+    if (!d.payload.empty()) argv->insert(argv->end(), {"--payload", d.payload});
+  }
+}
+
 // swarmbox-agent (agent/app/main.cpp --help): the shared contract's flags. An agent given a flag it
 // does not know exits 2, so a new flag goes here only once agent/app/main.cpp has it.
 std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
@@ -189,24 +259,9 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
                              "--mesh-domain", std::to_string(kMeshDomain)});
   }
   argv.insert(argv.end(), {"--sample-timeout", ShortestNumber(kAgentStartPatienceS)});
-  argv.insert(argv.end(), {
-      "--start", ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) + "," + ShortestNumber(d.pose[2]),
-      // Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`.
-      "--members", Members(spec),
-      "--seed", std::to_string(spec.seed),
-      "--raft-tick-ms", std::to_string(spec.raft.tick_ms),
-      "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
-      "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
-  });
-  // Raft at swarm scale: the first raft.voters drones vote, the others are learners; with no more
-  // drones than voters every drone votes (no flag: the agent's default).
-  if (spec.raft.voters > 0 && static_cast<std::size_t>(spec.raft.voters) < spec.drones.size()) {
-    std::string voters;
-    for (int k = 0; k < spec.raft.voters; ++k) {
-      voters += (voters.empty() ? "" : ",") + spec.drones[static_cast<std::size_t>(k)].name;
-    }
-    argv.insert(argv.end(), {"--raft-voters", voters});
-  }
+  argv.insert(argv.end(), {"--start", ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) + "," +
+                                          ShortestNumber(d.pose[2])});
+  AppendRaftFlags(spec, &argv);
   // The radio link measurement (event=link per sampled peer).
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms),
                            "--ping-peers", std::to_string(spec.radio.ping_peers)});
@@ -214,36 +269,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   if (spec.record.enabled) argv.insert(argv.end(), {"--telemetry-hz", ShortestNumber(spec.record.rate_hz)});
   // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
   argv.insert(argv.end(), {"--raft-dir", std::string(kAgentStateDir) + "/raft"});
-  const dsl::BrainSpec& brain = d.brain;
-  if (brain.kind != dsl::BrainKind::kBuiltin) {
-    // The user's brain (design24 "Agent flags"): its context gets the world and the payload; the
-    // mission keys are the builtin brain's.
-    argv.insert(argv.end(), {"--world", InContainer(spec.world),
-                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
-    if (!d.payload.empty()) argv.insert(argv.end(), {"--payload", d.payload});
-    if (brain.kind == dsl::BrainKind::kLibrary) {
-      argv.insert(argv.end(), {"--brain", "library",
-                               "--brain-library", BrainLibraryInImage(brain),
-                               "--brain-name", brain.name,
-                               "--brain-args", brain.ArgsJson()});
-    } else {
-      argv.insert(argv.end(), {"--brain", "external"});
-    }
-    if (brain.rate_hz > 0) argv.insert(argv.end(), {"--brain-rate-hz", ShortestNumber(brain.rate_hz)});
-    if (brain.offboard.timeout_ms) {
-      argv.insert(argv.end(), {"--offboard-timeout-ms", std::to_string(*brain.offboard.timeout_ms)});
-    }
-    if (brain.offboard.hold_ms) {
-      argv.insert(argv.end(), {"--offboard-hold-ms", std::to_string(*brain.offboard.hold_ms)});
-    }
-  } else if (spec.mission.kind == dsl::MissionKind::kPlan) {
-    argv.insert(argv.end(), {"--mission", "plan", "--plan", spec.mission.plan});
-  } else {
-    argv.insert(argv.end(), {"--mission", "sar", "--world", InContainer(spec.world),
-                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
-    // The lifter starts with its payload on the ground under it (as the physics server places it).
-    if (!d.payload.empty()) argv.insert(argv.end(), {"--payload", d.payload});
-  }
+  AppendBrainFlags(spec, d, &argv);
   // The agent starts unloaded (--payload-mass 0): its payload lies on the ground.
   return argv;
 }
