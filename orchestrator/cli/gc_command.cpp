@@ -78,6 +78,91 @@ Result<RunLeftovers> ListRun(docker::DockerApi& api, const std::string& run) {
 
 }  // namespace
 
+namespace {
+
+// What gc did (or would do, with --dry-run): the runs listed, the counts, what failed.
+struct GcOutcome {
+  std::size_t containers = 0;
+  std::size_t networks = 0;
+  std::vector<Error> failures;
+  std::vector<RunLeftovers> listed;
+};
+
+// Lists each run of the plan and removes it (not with --dry-run); an exit code when the engine
+// fails.
+int RemoveRuns(docker::DockerClient& client, const GcPlan& plan, bool dry_run, GcOutcome* out) {
+  for (const std::string& run : plan.remove) {
+    auto left = ListRun(client, run);
+    if (!left) {
+      std::cerr << "swarmbox gc: " << left.error().ToString() << "\n";
+      return kExitInfrastructure;
+    }
+    out->listed.push_back(*left);
+    if (dry_run) {
+      out->containers += left->containers.size();
+      out->networks += left->networks.size();
+      continue;
+    }
+    docker::LabelSelector selector;
+    selector.equals[std::string(docker::kLabelRun)] = run;
+    auto report = docker::RemoveLabelled(client, selector, /*include_images=*/false);
+    if (!report) {
+      std::cerr << "swarmbox gc: " << report.error().ToString() << "\n";
+      return kExitInfrastructure;
+    }
+    out->containers += report->containers.size();
+    out->networks += report->networks.size();
+    out->failures.insert(out->failures.end(), report->failures.begin(), report->failures.end());
+  }
+  return kExitOk;
+}
+
+void PrintGcJson(const GcArgs& args, const GcPlan& plan, const GcOutcome& g, int code) {
+  yaml::Node o = yaml::Node::Mapping();
+  o.Set("dry_run", json::Bool(args.dry_run));
+  yaml::Node list = yaml::Node::Sequence();
+  for (const RunLeftovers& r : g.listed) {
+    yaml::Node item = yaml::Node::Mapping();
+    item.Set("run", json::Str(r.run));
+    item.Set("containers", json::Strs(r.containers));
+    item.Set("networks", json::Strs(r.networks));
+    list.Append(std::move(item));
+  }
+  o.Set("runs", std::move(list));
+  o.Set(args.dry_run ? "would_remove_containers" : "removed_containers",
+        json::Int(static_cast<std::int64_t>(g.containers)));
+  o.Set(args.dry_run ? "would_remove_networks" : "removed_networks",
+        json::Int(static_cast<std::int64_t>(g.networks)));
+  o.Set("left_live", json::Strs(plan.skip_live));
+  std::vector<std::string> failed;
+  for (const Error& e : g.failures) failed.push_back(e.ToString());
+  o.Set("failures", json::Strs(failed));
+  o.Set("exit_code", json::Int(code));
+  json::Print(o);
+}
+
+void PrintGcText(const GcArgs& args, const GcPlan& plan, const GcOutcome& g) {
+  const std::string of_run = args.run_id.empty() ? "" : " of run " + args.run_id;
+  if (args.dry_run) {
+    std::cout << "would remove " << g.containers << " containers and " << g.networks << " networks"
+              << of_run << " (dry run: nothing removed)\n";
+    for (const RunLeftovers& r : g.listed) {
+      for (const std::string& c : r.containers) std::cout << "  container " << c << "  run " << r.run << "\n";
+      for (const std::string& n : r.networks) std::cout << "  network " << n << "  run " << r.run << "\n";
+    }
+  } else {
+    std::cout << "removed " << g.containers << " containers and " << g.networks << " networks" << of_run
+              << "\n";
+  }
+  for (const std::string& run : plan.skip_live) {
+    std::cout << "left run " << run << ": it is still running here (its swarmbox holds "
+              << RunLockDir() << "/" << run << ".lock; `swarmbox gc --run " << run
+              << "` removes it anyway)\n";
+  }
+}
+
+}  // namespace
+
 int GcCommand(const GcArgs& args) {
   EngineConnection engine = ConnectEngineOrPrintError("gc");
   if (!engine.client) return engine.exit_code;
@@ -92,74 +177,14 @@ int GcCommand(const GcArgs& args) {
     runs = std::move(*found);
   }
   const GcPlan plan = PlanGc(runs, args.run_id, IsRunLive);
-  std::size_t containers = 0, networks = 0;
-  std::vector<Error> failures;
-  std::vector<RunLeftovers> listed;
-  for (const std::string& run : plan.remove) {
-    auto left = ListRun(client, run);
-    if (!left) {
-      std::cerr << "swarmbox gc: " << left.error().ToString() << "\n";
-      return kExitInfrastructure;
-    }
-    listed.push_back(*left);
-    if (args.dry_run) {
-      containers += left->containers.size();
-      networks += left->networks.size();
-      continue;
-    }
-    docker::LabelSelector selector;
-    selector.equals[std::string(docker::kLabelRun)] = run;
-    auto report = docker::RemoveLabelled(client, selector, /*include_images=*/false);
-    if (!report) {
-      std::cerr << "swarmbox gc: " << report.error().ToString() << "\n";
-      return kExitInfrastructure;
-    }
-    containers += report->containers.size();
-    networks += report->networks.size();
-    failures.insert(failures.end(), report->failures.begin(), report->failures.end());
-  }
-  for (const Error& e : failures) std::cerr << "  failed: " << e.ToString() << "\n";
-  const int code = failures.empty() ? kExitOk : kExitInfrastructure;
+  GcOutcome outcome;
+  if (int code = RemoveRuns(client, plan, args.dry_run, &outcome); code != kExitOk) return code;
+  for (const Error& e : outcome.failures) std::cerr << "  failed: " << e.ToString() << "\n";
+  const int code = outcome.failures.empty() ? kExitOk : kExitInfrastructure;
   if (args.json) {
-    yaml::Node o = yaml::Node::Mapping();
-    o.Set("dry_run", json::Bool(args.dry_run));
-    yaml::Node list = yaml::Node::Sequence();
-    for (const RunLeftovers& r : listed) {
-      yaml::Node item = yaml::Node::Mapping();
-      item.Set("run", json::Str(r.run));
-      item.Set("containers", json::Strs(r.containers));
-      item.Set("networks", json::Strs(r.networks));
-      list.Append(std::move(item));
-    }
-    o.Set("runs", std::move(list));
-    o.Set(args.dry_run ? "would_remove_containers" : "removed_containers",
-          json::Int(static_cast<std::int64_t>(containers)));
-    o.Set(args.dry_run ? "would_remove_networks" : "removed_networks",
-          json::Int(static_cast<std::int64_t>(networks)));
-    o.Set("left_live", json::Strs(plan.skip_live));
-    std::vector<std::string> failed;
-    for (const Error& e : failures) failed.push_back(e.ToString());
-    o.Set("failures", json::Strs(failed));
-    o.Set("exit_code", json::Int(code));
-    json::Print(o);
-    return code;
-  }
-  const std::string of_run = args.run_id.empty() ? "" : " of run " + args.run_id;
-  if (args.dry_run) {
-    std::cout << "would remove " << containers << " containers and " << networks << " networks"
-              << of_run << " (dry run: nothing removed)\n";
-    for (const RunLeftovers& r : listed) {
-      for (const std::string& c : r.containers) std::cout << "  container " << c << "  run " << r.run << "\n";
-      for (const std::string& n : r.networks) std::cout << "  network " << n << "  run " << r.run << "\n";
-    }
+    PrintGcJson(args, plan, outcome, code);
   } else {
-    std::cout << "removed " << containers << " containers and " << networks << " networks" << of_run
-              << "\n";
-  }
-  for (const std::string& run : plan.skip_live) {
-    std::cout << "left run " << run << ": it is still running here (its swarmbox holds "
-              << RunLockDir() << "/" << run << ".lock; `swarmbox gc --run " << run
-              << "` removes it anyway)\n";
+    PrintGcText(args, plan, outcome);
   }
   return code;
 }

@@ -12,17 +12,15 @@
 
 namespace swarmbox::cli {
 
-int ImagesCommand(const ImagesArgs& args) {
-  EngineConnection engine = ConnectEngineOrPrintError("images");
-  if (!engine.client) return engine.exit_code;
-  docker::DockerClient& client = *engine.client;
-  auto progress = [&](std::string_view line) {
-    if (!args.quiet) std::cerr << "  " << line << "\n";
-  };
-  struct Wanted {
-    const char* what;
-    Result<images::ImageSpec> spec;
-  };
+namespace {
+
+// An image to ensure, or why its spec could not be made (a program not found).
+struct Wanted {
+  const char* what;
+  Result<images::ImageSpec> spec;
+};
+
+std::vector<Wanted> WantedImages(const ImagesArgs& args) {
   std::vector<Wanted> wanted;
   auto physics = FindProgram("swarmbox-physics", args.programs.physics_bin);
   wanted.push_back({"physics", physics ? Result<images::ImageSpec>(images::PhysicsImage(*physics))
@@ -36,15 +34,24 @@ int ImagesCommand(const ImagesArgs& args) {
     wanted.push_back({"faults", netemd ? images::FaultSidecarImage(*netemd)
                                        : Result<images::ImageSpec>(netemd.error())});
   }
+  return wanted;
+}
+
+// Each image ensured, printed (a line, or an item of `listed` for --json); failures on stderr
+// and in `listed`. Returns the number of failures.
+int EnsureWanted(const ImagesArgs& args, docker::DockerClient& client, std::vector<Wanted>& wanted,
+                 yaml::Node* listed) {
+  auto progress = [&](std::string_view line) {
+    if (!args.quiet) std::cerr << "  " << line << "\n";
+  };
   int failures = 0;
-  yaml::Node listed = yaml::Node::Sequence();  // --json
   auto failed = [&](const char* what, const Error& e) {
     std::cerr << what << ": " << e.ToString() << "\n";
     ++failures;
     yaml::Node item = yaml::Node::Mapping();
     item.Set("image", json::Str(what));
     item.Set("error", json::Str(e.ToString()));
-    listed.Append(std::move(item));
+    listed->Append(std::move(item));
   };
   // Remembers the tags, so the next `swarmbox run` does not pack the same programs again.
   const images::TagCache cache(images::DefaultTagCacheDir());
@@ -64,12 +71,24 @@ int ImagesCommand(const ImagesArgs& args) {
       item.Set("tag", json::Str(r->tag));
       item.Set("built", json::Bool(r->built));
       item.Set("size_bytes", json::Int(static_cast<std::int64_t>(r->image_size_bytes)));
-      listed.Append(std::move(item));
+      listed->Append(std::move(item));
     } else {
       std::cout << r->tag << (r->built ? "  built" : "  present") << "  "
                 << r->image_size_bytes / (1024 * 1024) << " MiB\n";
     }
   }
+  return failures;
+}
+
+}  // namespace
+
+int ImagesCommand(const ImagesArgs& args) {
+  EngineConnection engine = ConnectEngineOrPrintError("images");
+  if (!engine.client) return engine.exit_code;
+  docker::DockerClient& client = *engine.client;
+  std::vector<Wanted> wanted = WantedImages(args);
+  yaml::Node listed = yaml::Node::Sequence();  // --json
+  const int failures = EnsureWanted(args, client, wanted, &listed);
   const int code = failures == 0 ? kExitOk : kExitInfrastructure;
   if (args.json) {
     yaml::Node o = yaml::Node::Mapping();

@@ -35,41 +35,47 @@ void PrintJsonSummary(const runner::RunOutcome& run, const std::string& run_id, 
 
 }  // namespace
 
-int RunCommand(const RunArgs& args) {
-  auto spec = LoadTrialOrPrintError(args.trial, args.sets);
-  if (!spec) return kExitUsage;
-  if (args.no_record) spec->record.enabled = false;
-  std::optional<runner::ViewBinding> view;
-  if (args.view_requested) {
-    auto binding = runner::ParseViewAddress(args.view);
-    if (!binding) {
-      std::cerr << "swarmbox run: --view " << binding.error().message() << "\n";
-      return kExitUsage;
-    }
-    // Docker publishes the port on the engine's host: that is this machine only with a local engine.
-    auto endpoint = docker::EngineEndpointFromEnvironment();
-    if (endpoint && endpoint->kind != docker::EngineEndpoint::Kind::kUnix && endpoint->host != "127.0.0.1" &&
-        endpoint->host != "localhost" && endpoint->host != "::1") {
-      std::cerr << "swarmbox run: --view publishes the physics server's port on the Docker engine's host, and the engine ("
-                << endpoint->ToString() << ") is not this machine's: --view needs the local engine\n";
-      return kExitUsage;
-    }
-    view = *binding;
+namespace {
+
+constexpr int kContinue = -1;  // a step's "no exit yet"
+
+// --view: its address, and a local engine (Docker publishes the port on the engine's host: that
+// is this machine only with a local engine).
+int ResolveView(const RunArgs& args, std::optional<runner::ViewBinding>* view) {
+  if (!args.view_requested) return kContinue;
+  auto binding = runner::ParseViewAddress(args.view);
+  if (!binding) {
+    std::cerr << "swarmbox run: --view " << binding.error().message() << "\n";
+    return kExitUsage;
   }
-  // The radio profile (the default one is not checked by the loader), before anything starts.
-  const std::string trials_dir = std::filesystem::absolute(spec->trials_dir).lexically_normal().string();
-  if (Status s = runner::CheckRadioProfile(*spec, trials_dir); !s) {
+  auto endpoint = docker::EngineEndpointFromEnvironment();
+  if (endpoint && endpoint->kind != docker::EngineEndpoint::Kind::kUnix && endpoint->host != "127.0.0.1" &&
+      endpoint->host != "localhost" && endpoint->host != "::1") {
+    std::cerr << "swarmbox run: --view publishes the physics server's port on the Docker engine's host, and the engine ("
+              << endpoint->ToString() << ") is not this machine's: --view needs the local engine\n";
+    return kExitUsage;
+  }
+  *view = *binding;
+  return kContinue;
+}
+
+// The radio profile (the default one is not checked by the loader), before anything starts; the
+// warning of a radio model at an rtf it cannot keep.
+int CheckRadio(const dsl::TrialSpec& spec) {
+  const std::string trials_dir = std::filesystem::absolute(spec.trials_dir).lexically_normal().string();
+  if (Status s = runner::CheckRadioProfile(spec, trials_dir); !s) {
     std::cerr << "swarmbox run: " << s.error().ToString() << "\n";
     return kExitUsage;
   }
-  if (auto warning = runner::RadioRtfWarning(dsl::RadioModelName(spec->radio.model), spec->rtf)) {
+  if (auto warning = runner::RadioRtfWarning(dsl::RadioModelName(spec.radio.model), spec.rtf)) {
     std::cerr << "swarmbox run: warning: " << *warning << "\n";  // events.jsonl has it too
   }
-  EngineConnection engine = ConnectEngineOrPrintError("run");
-  if (!engine.client) return engine.exit_code;
-  docker::DockerClient& client = *engine.client;
-  // Before the (possibly long) image step, so a Ctrl-C there is not lost: the run then ends at once.
-  const std::atomic<bool>& interrupted = InstallInterruptHandlers();
+  return kContinue;
+}
+
+// The images of the installed programs; an exit code when they cannot be had or a signal came.
+int PrepareImages(const RunArgs& args, docker::DockerClient& client, const std::atomic<bool>& interrupted,
+                  runner::Images* out) {
   auto images = EnsureTrialImages(client, args.programs, [&](std::string_view line) {
     if (!args.quiet) std::cerr << "  " << line << "\n";
   });
@@ -82,6 +88,54 @@ int RunCommand(const RunArgs& args) {
               << " before the trial started; nothing was created\n";
     return InterruptExitCode();
   }
+  *out = std::move(*images);
+  return kContinue;
+}
+
+runner::RunOptions TrialRunOptions(const RunArgs& args, const std::string& run_id, const runner::Images& images,
+                                   const std::atomic<bool>& interrupted,
+                                   const std::optional<runner::ViewBinding>& view) {
+  runner::RunOptions options;
+  options.out_dir = args.out;
+  options.run_id = run_id;
+  options.images = images;
+  // A library brain's agent image is packed from the same swarmbox-agent (user_images.hpp).
+  if (auto agent_bin = FindProgram("swarmbox-agent", args.programs.agent_bin)) options.agent_binary = *agent_bin;
+  options.interrupted = &interrupted;
+  options.interrupt_reason = [] { return std::string(InterruptName()); };
+  options.progress = args.quiet ? nullptr : &std::cerr;
+  options.view = view;
+  return options;
+}
+
+void PrintRunSummary(const RunArgs& args, const runner::RunOutcome& run, const std::string& run_id, int code) {
+  const runner::TrialResult& r = run.result;
+  for (const std::string& p : r.problems) std::cerr << "  note: " << p << "\n";
+  if (args.json) {
+    PrintJsonSummary(run, run_id, code);
+  } else {
+    std::cout << run.trial_dir << ": " << dsl::OutcomeName(r.verdict.outcome)
+              << (r.verdict.reason.empty() ? "" : " (" + r.verdict.reason + ")") << ", sim "
+              << r.sim_s << " s, wall " << r.wall_s << " s\n";
+  }
+}
+
+}  // namespace
+
+int RunCommand(const RunArgs& args) {
+  auto spec = LoadTrialOrPrintError(args.trial, args.sets);
+  if (!spec) return kExitUsage;
+  if (args.no_record) spec->record.enabled = false;
+  std::optional<runner::ViewBinding> view;
+  if (int code = ResolveView(args, &view); code != kContinue) return code;
+  if (int code = CheckRadio(*spec); code != kContinue) return code;
+  EngineConnection engine = ConnectEngineOrPrintError("run");
+  if (!engine.client) return engine.exit_code;
+  docker::DockerClient& client = *engine.client;
+  // Before the (possibly long) image step, so a Ctrl-C there is not lost: the run then ends at once.
+  const std::atomic<bool>& interrupted = InstallInterruptHandlers();
+  runner::Images images;
+  if (int code = PrepareImages(args, client, interrupted, &images); code != kContinue) return code;
   // Held until this process ends, however it ends: `swarmbox gc` leaves a live run alone.
   const std::string run_id = args.run_id.empty() ? runner::NewRunId() : args.run_id;
   auto run_lock = RunLock::Acquire(run_id);
@@ -90,33 +144,16 @@ int RunCommand(const RunArgs& args) {
     return run_lock.error().code() == ErrorCode::kUnavailable ? kExitUsage : kExitInfrastructure;
   }
   runner::SteadyClock clock;
-  runner::RunOptions options;
-  options.out_dir = args.out;
-  options.run_id = run_id;
-  options.images = *images;
-  // A library brain's agent image is packed from the same swarmbox-agent (user_images.hpp).
-  if (auto agent_bin = FindProgram("swarmbox-agent", args.programs.agent_bin)) options.agent_binary = *agent_bin;
-  options.interrupted = &interrupted;
-  options.interrupt_reason = [] { return std::string(InterruptName()); };
-  options.progress = args.quiet ? nullptr : &std::cerr;
-  options.view = view;
+  const runner::RunOptions options = TrialRunOptions(args, run_id, images, interrupted, view);
   if (view) std::cout << "view: " << view->url() << std::endl;
   auto run = runner::RunTrialSpec(*spec, client, clock, options);
   if (!run) {
     std::cerr << "swarmbox run: " << run.error().ToString() << "\n";
     return interrupted.load() ? InterruptExitCode() : kExitInfrastructure;
   }
-  const runner::TrialResult& r = run->result;
   // The user stopped it (130 / 143): neither an infrastructure error nor the trial's own outcome.
-  const int code = interrupted.load() ? InterruptExitCode() : runner::ExitCodeFor(r.verdict);
-  for (const std::string& p : r.problems) std::cerr << "  note: " << p << "\n";
-  if (args.json) {
-    PrintJsonSummary(*run, run_id, code);
-  } else {
-    std::cout << run->trial_dir << ": " << dsl::OutcomeName(r.verdict.outcome)
-              << (r.verdict.reason.empty() ? "" : " (" + r.verdict.reason + ")") << ", sim "
-              << r.sim_s << " s, wall " << r.wall_s << " s\n";
-  }
+  const int code = interrupted.load() ? InterruptExitCode() : runner::ExitCodeFor(run->result.verdict);
+  PrintRunSummary(args, *run, run_id, code);
   return code;
 }
 

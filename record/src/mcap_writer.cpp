@@ -188,15 +188,74 @@ struct McapWriter::Impl {
     return Ok{};
   }
 
-  Status WriteSummaryAndFooter() {
-    SWARMBOX_TRY(FlushChunk());
+  Status WriteDataEnd() {
     std::string tail;
     ByteWriter w(&tail);
     const std::size_t at = BeginRecord(w, Op::kDataEnd);
     w.U32(data_crc);
     EndRecord(w, at);
-    SWARMBOX_TRY(Out(tail));
+    return Out(tail);
+  }
 
+  void StatisticsRecord(ByteWriter& sw) const {
+    const std::size_t s = BeginRecord(sw, Op::kStatistics);
+    sw.U64(message_count);
+    sw.U16(static_cast<std::uint16_t>(schemas.size()));
+    sw.U32(static_cast<std::uint32_t>(channels.size()));
+    sw.U32(0);  // attachments
+    sw.U32(0);  // metadata
+    sw.U32(static_cast<std::uint32_t>(chunk_indexes.size()));
+    sw.U64(start_ns);
+    sw.U64(end_ns);
+    sw.U32(static_cast<std::uint32_t>(channels.size() * (2 + 8)));
+    for (std::size_t i = 0; i < channels.size(); ++i) {
+      sw.U16(static_cast<std::uint16_t>(i));
+      sw.U64(channels[i].count);
+    }
+    EndRecord(sw, s);
+  }
+
+  void ChunkIndexRecords(ByteWriter& sw) const {
+    for (const ChunkIndexEntry& c : chunk_indexes) {
+      const std::size_t s = BeginRecord(sw, Op::kChunkIndex);
+      sw.U64(c.start_ns);
+      sw.U64(c.end_ns);
+      sw.U64(c.offset);
+      sw.U64(c.length);
+      sw.U32(static_cast<std::uint32_t>(c.index_offsets.size() * (2 + 8)));
+      for (const auto& [channel, offset] : c.index_offsets) {
+        sw.U16(channel);
+        sw.U64(offset);
+      }
+      sw.U64(c.index_length);
+      sw.Str(detail::CompressionField(options.compression));
+      sw.U64(c.compressed_size);
+      sw.U64(c.uncompressed_size);
+      EndRecord(sw, s);
+    }
+  }
+
+  // A SummaryOffset per group (opcode, start, length), then the footer up to its summary_crc
+  // (the summary CRC covers the summary, the offsets and the footer up to summary_crc).
+  static void SummaryOffsetsAndFooterHead(ByteWriter& sw,
+                                          const std::vector<std::tuple<Op, std::uint64_t, std::uint64_t>>& groups,
+                                          std::uint64_t summary_start, std::uint64_t summary_offset_start) {
+    for (const auto& [op, start, length] : groups) {
+      const std::size_t s = BeginRecord(sw, Op::kSummaryOffset);
+      sw.U8(static_cast<std::uint8_t>(op));
+      sw.U64(start);
+      sw.U64(length);
+      EndRecord(sw, s);
+    }
+    sw.U8(static_cast<std::uint8_t>(Op::kFooter));
+    sw.U64(detail::kFooterContentBytes);
+    sw.U64(summary_start);
+    sw.U64(summary_offset_start);
+  }
+
+  Status WriteSummaryAndFooter() {
+    SWARMBOX_TRY(FlushChunk());
+    SWARMBOX_TRY(WriteDataEnd());
     // Summary: one group per opcode, remembered for the SummaryOffset records.
     in_summary = true;
     const std::uint64_t summary_start = pos;
@@ -216,55 +275,9 @@ struct McapWriter::Impl {
         ChannelRecord(sw, static_cast<std::uint16_t>(i), channels[i]);
       }
     });
-    group(Op::kStatistics, [&] {
-      const std::size_t s = BeginRecord(sw, Op::kStatistics);
-      sw.U64(message_count);
-      sw.U16(static_cast<std::uint16_t>(schemas.size()));
-      sw.U32(static_cast<std::uint32_t>(channels.size()));
-      sw.U32(0);  // attachments
-      sw.U32(0);  // metadata
-      sw.U32(static_cast<std::uint32_t>(chunk_indexes.size()));
-      sw.U64(start_ns);
-      sw.U64(end_ns);
-      sw.U32(static_cast<std::uint32_t>(channels.size() * (2 + 8)));
-      for (std::size_t i = 0; i < channels.size(); ++i) {
-        sw.U16(static_cast<std::uint16_t>(i));
-        sw.U64(channels[i].count);
-      }
-      EndRecord(sw, s);
-    });
-    group(Op::kChunkIndex, [&] {
-      for (const ChunkIndexEntry& c : chunk_indexes) {
-        const std::size_t s = BeginRecord(sw, Op::kChunkIndex);
-        sw.U64(c.start_ns);
-        sw.U64(c.end_ns);
-        sw.U64(c.offset);
-        sw.U64(c.length);
-        sw.U32(static_cast<std::uint32_t>(c.index_offsets.size() * (2 + 8)));
-        for (const auto& [channel, offset] : c.index_offsets) {
-          sw.U16(channel);
-          sw.U64(offset);
-        }
-        sw.U64(c.index_length);
-        sw.Str(detail::CompressionField(options.compression));
-        sw.U64(c.compressed_size);
-        sw.U64(c.uncompressed_size);
-        EndRecord(sw, s);
-      }
-    });
-    const std::uint64_t summary_offset_start = summary_start + summary.size();
-    for (const auto& [op, start, length] : groups) {
-      const std::size_t s = BeginRecord(sw, Op::kSummaryOffset);
-      sw.U8(static_cast<std::uint8_t>(op));
-      sw.U64(start);
-      sw.U64(length);
-      EndRecord(sw, s);
-    }
-    // Footer: the summary CRC covers the summary, the offsets and the footer up to summary_crc.
-    sw.U8(static_cast<std::uint8_t>(Op::kFooter));
-    sw.U64(detail::kFooterContentBytes);
-    sw.U64(summary_start);
-    sw.U64(summary_offset_start);
+    group(Op::kStatistics, [&] { StatisticsRecord(sw); });
+    group(Op::kChunkIndex, [&] { ChunkIndexRecords(sw); });
+    SummaryOffsetsAndFooterHead(sw, groups, summary_start, summary_start + summary.size());
     SWARMBOX_TRY(Out(summary));
     std::string end;
     ByteWriter ew(&end);

@@ -17,16 +17,27 @@
 
 #include "train_detector.hpp"
 
-int main(int argc, char** argv) {
+namespace {
+
+namespace td = swarmbox::train_detector;
+
+struct Args {
   std::string out_dir;
   bool recalibrate = false;
-  swarmbox::train_detector::TrainingOptions options = swarmbox::train_detector::DefaultTrainingOptions();
+  td::TrainingOptions options = td::DefaultTrainingOptions();
+};
+
+constexpr int kContinue = -1;  // ParseArgs: no exit yet
+
+// The flags into *args; an exit code for a usage error.
+int ParseArgs(int argc, char** argv, Args* args) {
+  td::TrainingOptions& options = args->options;
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (a == "--out-dir" && i + 1 < argc) {
-      out_dir = argv[++i];
+      args->out_dir = argv[++i];
     } else if (a == "--recalibrate") {
-      recalibrate = true;
+      args->recalibrate = true;
     } else if (a == "--scenes-per-set" && i + 1 < argc) {
       options.scenes_per_set = std::stoi(argv[++i]);
     } else if (a == "--training-sets" && i + 1 < argc) {
@@ -55,23 +66,54 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (out_dir.empty()) {
+  if (args->out_dir.empty()) {
     std::fprintf(stderr, "swarmbox-train-detector: --out-dir is required\n");
     return 2;
   }
-  swarmbox::train_detector::TrainingReport report;
-  const std::string model_path = out_dir + "/victim_detector.yml.gz";
-  const std::string json_path = out_dir + "/victim_detector.json";
-  std::string old_json;
-  if (recalibrate) {
-    std::ifstream in(json_path);
-    std::stringstream text;
-    text << in.rdbuf();
-    old_json = text.str();
+  return kContinue;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// The training lines of the old report, the calibration lines of the new one.
+std::string MergeRecalibratedReport(const std::string& old_json, const std::string& text) {
+  std::istringstream old_lines(old_json), new_lines(text);
+  std::string line, merged;
+  auto calibration_line = [](const std::string& l) {
+    return l.find("\"platt\"") != std::string::npos || l.find("\"calibration_figures\"") != std::string::npos ||
+           l.find("\"stage1_calibration_recall\"") != std::string::npos;
+  };
+  std::string fresh;
+  while (std::getline(new_lines, line)) {
+    if (calibration_line(line)) fresh += line + "\n";
   }
+  while (std::getline(old_lines, line)) {
+    if (calibration_line(line)) continue;
+    if (line.find("\"training_seconds\"") != std::string::npos) {
+      merged += fresh + "  \"recalibrated\": true,\n";
+    }
+    merged += line + "\n";
+  }
+  return merged;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args args;
+  if (int code = ParseArgs(argc, argv, &args); code != kContinue) return code;
+  const td::TrainingOptions& options = args.options;
+  td::TrainingReport report;
+  const std::string model_path = args.out_dir + "/victim_detector.yml.gz";
+  const std::string json_path = args.out_dir + "/victim_detector.json";
+  const std::string old_json = args.recalibrate ? ReadText(json_path) : std::string();
   swarmbox::Result<swarmbox::swarm::VictimDetectorModel> model =
-      recalibrate ? swarmbox::train_detector::Recalibrate(options, model_path, &report)
-                  : swarmbox::train_detector::Train(options, &report);
+      args.recalibrate ? td::Recalibrate(options, model_path, &report) : td::Train(options, &report);
   if (!model) {
     std::fprintf(stderr, "swarmbox-train-detector: %s\n", model.error().ToString().c_str());
     return 1;
@@ -80,28 +122,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "swarmbox-train-detector: %s\n", s.error().ToString().c_str());
     return 1;
   }
-  std::string text = swarmbox::train_detector::ReportJson(*model, options, report);
-  if (recalibrate) {
-    // The training lines of the old report, the calibration lines of the new one.
-    std::istringstream old_lines(old_json), new_lines(text);
-    std::string line, merged;
-    auto calibration_line = [](const std::string& l) {
-      return l.find("\"platt\"") != std::string::npos || l.find("\"calibration_figures\"") != std::string::npos ||
-             l.find("\"stage1_calibration_recall\"") != std::string::npos;
-    };
-    std::string fresh;
-    while (std::getline(new_lines, line)) {
-      if (calibration_line(line)) fresh += line + "\n";
-    }
-    while (std::getline(old_lines, line)) {
-      if (calibration_line(line)) continue;
-      if (line.find("\"training_seconds\"") != std::string::npos) {
-        merged += fresh + "  \"recalibrated\": true,\n";
-      }
-      merged += line + "\n";
-    }
-    text = merged;
-  }
+  std::string text = td::ReportJson(*model, options, report);
+  if (args.recalibrate) text = MergeRecalibratedReport(old_json, text);
   std::ofstream json(json_path);
   json << text;
   if (!json) {

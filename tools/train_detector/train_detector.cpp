@@ -290,29 +290,25 @@ perception_scenes::SceneSetParams TrainingSceneSet(std::uint64_t seed, int scene
           .varied_look = seed % 4 != 0};
 }
 
-Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorModel* model_out,
-                 TrainingReport* report) {
-  swarm::VictimDetectorModel& model = *model_out;
-  const std::vector<Scene>* cal = &calibration;
-  std::shared_ptr<swarm::VictimDetectorModel> shared;
-  // Calibration on scenes the forest has not seen.
-  shared = std::make_shared<swarm::VictimDetectorModel>(model);
-  swarm::VictimDetectorParams raw;
-  raw.min_confidence = 0.0;
-  raw.partial_confidence_cap = 1.0;
-  swarm::VictimDetector det(shared, raw);
-  std::vector<double> votes;
-  std::vector<int> labels;
-  struct Det {
-    std::size_t scene;
-    std::size_t person;
-    double votes;
-    int label;
-  };
-  std::vector<Det> dets;
+namespace {
+
+// A calibration detection: its scene, the nearest person, the forest's votes, and whether it is
+// a person (1) or clearly none (0).
+struct CalibrationDetection {
+  std::size_t scene;
+  std::size_t person;
+  double votes;
+  int label;
+};
+
+// The detector at no threshold on the calibration scenes: each detection within 1 m of a
+// must-detect person is a positive, one kNegativeRadiusM from every person a negative.
+std::vector<CalibrationDetection> LabelledDetections(const std::vector<Scene>& cal, swarm::VictimDetector& det,
+                                                     TrainingReport* report) {
+  std::vector<CalibrationDetection> dets;
   std::vector<swarm::ImageBlob> blobs;
-  for (std::size_t i = 0; i < cal->size(); ++i) {
-    const Scene& s = (*cal)[i];
+  for (std::size_t i = 0; i < cal.size(); ++i) {
+    const Scene& s = cal[i];
     const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
     det.Detect(BgrOf(s), s.intrinsics, s.true_pose, 0.0, &blobs);
     for (const swarm::ImageBlob& b : blobs) {
@@ -323,18 +319,21 @@ Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorMod
       if (dist <= 1.0 && must) label = 1;
       if (dist >= kNegativeRadiusM) label = 0;
       if (label < 0) continue;
-      votes.push_back(b.votes);
-      labels.push_back(label);
       dets.push_back({i, NearestIndex(s, scale, c), b.votes, label});
     }
     for (const SceneVictim& v : s.victims) report->calibration_persons += v.visible_fraction >= kMustDetectFraction ? 1 : 0;
   }
-  // First-stage recall on the calibration scenes: must-detect people with a candidate within
-  // kPositiveRadiusM.
+  return dets;
+}
+
+// First-stage recall on the calibration scenes: must-detect people with a candidate within
+// kPositiveRadiusM.
+void MeasureStage1Recall(const std::vector<Scene>& cal, swarm::VictimDetector& det, int max_candidates,
+                         double threshold, TrainingReport* report) {
   int hit = 0, must_total = 0;
-  for (const Scene& s : *cal) {
+  for (const Scene& s : cal) {
     const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
-    const auto& cands = det.Candidates(BgrOf(s), ppm, raw.max_candidates, model.stage1_threshold);
+    const auto& cands = det.Candidates(BgrOf(s), ppm, max_candidates, threshold);
     for (const SceneVictim& v : s.victims) {
       if (v.visible_fraction < kMustDetectFraction) continue;
       const std::optional<Eigen::Vector2d> c = CanonicalOf(v, s, scale);
@@ -353,12 +352,15 @@ Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorMod
   report->stage1_calibration_recall = must_total ? static_cast<double>(hit) / must_total : 1.0;
   std::fprintf(stderr, "train-detector: first-stage recall on the calibration scenes %.4f (%d people)\n",
                report->stage1_calibration_recall, must_total);
-  const auto [a, b] = FitPlatt(votes, labels);
-  model.platt_a = a;
-  model.platt_b = b;
+}
+
+// The calibrated model's figures at probability 0.5: people found (once each), false positives,
+// precision and recall.
+void CountCalibrationFigures(const swarm::VictimDetectorModel& model, const std::vector<CalibrationDetection>& dets,
+                             TrainingReport* report) {
   report->calibration_detections = static_cast<int>(dets.size());
   std::set<std::pair<std::size_t, std::size_t>> found;  // (scene, person) detected at 0.5
-  for (const Det& d : dets) {
+  for (const CalibrationDetection& d : dets) {
     if (model.Probability(d.votes) < 0.5) continue;
     if (d.label) {
       found.insert({d.scene, d.person});
@@ -370,6 +372,32 @@ Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorMod
   const int called = report->calibration_tp + report->calibration_fp;
   report->precision = called ? static_cast<double>(report->calibration_tp) / called : 1.0;
   report->recall = report->calibration_persons ? static_cast<double>(report->calibration_tp) / report->calibration_persons : 1.0;
+}
+
+}  // namespace
+
+// Calibration on scenes the forest has not seen: the Platt sigmoid on the labelled detections'
+// votes, and the figures.
+Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorModel* model_out,
+                 TrainingReport* report) {
+  swarm::VictimDetectorModel& model = *model_out;
+  auto shared = std::make_shared<swarm::VictimDetectorModel>(model);
+  swarm::VictimDetectorParams raw;
+  raw.min_confidence = 0.0;
+  raw.partial_confidence_cap = 1.0;
+  swarm::VictimDetector det(shared, raw);
+  const std::vector<CalibrationDetection> dets = LabelledDetections(calibration, det, report);
+  MeasureStage1Recall(calibration, det, raw.max_candidates, model.stage1_threshold, report);
+  std::vector<double> votes;
+  std::vector<int> labels;
+  for (const CalibrationDetection& d : dets) {
+    votes.push_back(d.votes);
+    labels.push_back(d.label);
+  }
+  const auto [a, b] = FitPlatt(votes, labels);
+  model.platt_a = a;
+  model.platt_b = b;
+  CountCalibrationFigures(model, dets, report);
   return Ok{};
 }
 
@@ -388,8 +416,9 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
   return model;
 }
 
-Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingReport* report) {
-  const auto t0 = std::chrono::steady_clock::now();
+namespace {
+
+Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
       o.hard_negative_rounds < 0) {
     return Error(ErrorCode::kInvalidArgument,
@@ -403,74 +432,80 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
       }
     }
   }
-  Result<std::vector<Scene>> train = RenderSets(o.training_seeds, o.scenes_per_set);
-  if (!train) return train.error();
-  Result<std::vector<Scene>> cal = RenderSets(o.calibration_seeds, o.scenes_per_set);
-  if (!cal) return cal.error();
-  report->training_scenes = static_cast<int>(train->size());
-  report->calibration_scenes = static_cast<int>(cal->size());
-  std::fprintf(stderr, "train-detector: rendered %d training and %d calibration scenes (%.0f s)\n",
-               report->training_scenes, report->calibration_scenes, Seconds(t0));
+  return Ok{};
+}
 
-  // Stage 1 samples.
-  swarm::VictimDetectorModel model;
-  model.training_seeds = o.training_seeds;
-  model.calibration_seeds = o.calibration_seeds;
-  model.SetLinear(std::vector<double>(swarm::kWindowFeatures, 0.0), 0.0);
-  model.forest = cv::ml::RTrees::create();  // replaced below; the detector needs one to exist
-  std::mt19937_64 rng(0x7EA1);
-  Labelled s1;
-  std::vector<std::size_t> centred;  // rows of s1 that are unshifted positives
+// What the training's stages share: the options, the report, the start time (for the progress
+// lines), the seeded generator (stage 1's random negatives, then the negatives' sample) and the
+// model being trained.
+struct Training {
+  const TrainingOptions& o;
+  TrainingReport* report;
+  std::chrono::steady_clock::time_point t0;
+  std::mt19937_64 rng{0x7EA1};
+  swarm::VictimDetectorModel model = {};
+};
+
+// One scene's stage 1 samples: each must-detect person's window, centred (its row into *centred)
+// and shifted by a cell each way, and random negatives away from every person.
+void AddStage1Samples(const Scene& s, std::mt19937_64& rng, swarm::ChannelMaps& maps, Labelled* s1,
+                      std::vector<std::size_t>* centred) {
   std::vector<float> f(swarm::kWindowFeatures);
-  swarm::ChannelMaps maps;
-  for (const Scene& s : *train) {
-    const double scale = swarm::kCanonicalPxPerM / PixelsPerMetre(s);
-    swarm::ComputeChannels(BgrOf(s), scale, &maps);
-    const int rows = maps.rows() - swarm::kWindowCells + 1, cols = maps.cols() - swarm::kWindowCells + 1;
-    if (rows <= 0 || cols <= 0) continue;
-    auto add = [&](int r, int c, int label, float target) {
-      if (r < 0 || c < 0 || r >= rows || c >= cols) return false;
-      swarm::WindowFeatures(maps, r, c, f.data());
-      s1.x.insert(s1.x.end(), f.begin(), f.end());
-      s1.y.push_back(label);
-      s1.target.push_back(target);
-      return true;
-    };
-    for (const SceneVictim& v : s.victims) {
-      if (v.visible_fraction < kMustDetectFraction) continue;
-      const std::optional<Eigen::Vector2d> c = CanonicalOf(v, s, scale);
-      if (!c) continue;
-      const int r0 = static_cast<int>(std::lround(c->y() / swarm::kShrink - swarm::kWindowCells / 2.0));
-      const int c0 = static_cast<int>(std::lround(c->x() / swarm::kShrink - swarm::kWindowCells / 2.0));
-      if (add(r0, c0, 1, 1.0f)) centred.push_back(s1.y.size() - 1);
-      add(r0 - 1, c0, 1, kShiftedTarget);
-      add(r0 + 1, c0, 1, kShiftedTarget);
-      add(r0, c0 - 1, 1, kShiftedTarget);
-      add(r0, c0 + 1, 1, kShiftedTarget);
-    }
-    std::uniform_int_distribution<int> rr(0, rows - 1), cc(0, cols - 1);
-    for (int k = 0, tries = 0; k < kRandomNegativesPerScene && tries < 400; ++tries) {
-      const int r = rr(rng), c = cc(rng);
-      const Eigen::Vector2d centre(swarm::WindowCentreCanonical(c), swarm::WindowCentreCanonical(r));
-      if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
-      add(r, c, 0, -1.0f);
-      ++k;
-    }
+  const double scale = swarm::kCanonicalPxPerM / PixelsPerMetre(s);
+  swarm::ComputeChannels(BgrOf(s), scale, &maps);
+  const int rows = maps.rows() - swarm::kWindowCells + 1, cols = maps.cols() - swarm::kWindowCells + 1;
+  if (rows <= 0 || cols <= 0) return;
+  auto add = [&](int r, int c, int label, float target) {
+    if (r < 0 || c < 0 || r >= rows || c >= cols) return false;
+    swarm::WindowFeatures(maps, r, c, f.data());
+    s1->x.insert(s1->x.end(), f.begin(), f.end());
+    s1->y.push_back(label);
+    s1->target.push_back(target);
+    return true;
+  };
+  for (const SceneVictim& v : s.victims) {
+    if (v.visible_fraction < kMustDetectFraction) continue;
+    const std::optional<Eigen::Vector2d> c = CanonicalOf(v, s, scale);
+    if (!c) continue;
+    const int r0 = static_cast<int>(std::lround(c->y() / swarm::kShrink - swarm::kWindowCells / 2.0));
+    const int c0 = static_cast<int>(std::lround(c->x() / swarm::kShrink - swarm::kWindowCells / 2.0));
+    if (add(r0, c0, 1, 1.0f)) centred->push_back(s1->y.size() - 1);
+    add(r0 - 1, c0, 1, kShiftedTarget);
+    add(r0 + 1, c0, 1, kShiftedTarget);
+    add(r0, c0 - 1, 1, kShiftedTarget);
+    add(r0, c0 + 1, 1, kShiftedTarget);
   }
-  for (int y : s1.y) (y ? report->stage1_positives : report->stage1_negatives) += 1;
-  std::fprintf(stderr, "train-detector: stage 1 on %d positives, %d negatives (%.0f s)\n", report->stage1_positives,
-               report->stage1_negatives, Seconds(t0));
-  const auto [weights, bias] = FitLinear(s1, o.ridge_lambda);
-  model.SetLinear(weights, bias);
+  std::uniform_int_distribution<int> rr(0, rows - 1), cc(0, cols - 1);
+  for (int k = 0, tries = 0; k < kRandomNegativesPerScene && tries < 400; ++tries) {
+    const int r = rr(rng), c = cc(rng);
+    const Eigen::Vector2d centre(swarm::WindowCentreCanonical(c), swarm::WindowCentreCanonical(r));
+    if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
+    add(r, c, 0, -1.0f);
+    ++k;
+  }
+}
+
+// The ridge first stage on `s1`, its threshold at the stage1_percentile of the centred positives'
+// scores.
+void FitStage1(Training& t, const Labelled& s1, const std::vector<std::size_t>& centred) {
+  for (int y : s1.y) (y ? t.report->stage1_positives : t.report->stage1_negatives) += 1;
+  std::fprintf(stderr, "train-detector: stage 1 on %d positives, %d negatives (%.0f s)\n",
+               t.report->stage1_positives, t.report->stage1_negatives, Seconds(t.t0));
+  const auto [weights, bias] = FitLinear(s1, t.o.ridge_lambda);
+  t.model.SetLinear(weights, bias);
   std::vector<double> centred_scores;
-  for (std::size_t i : centred) centred_scores.push_back(model.LinearScore(&s1.x[i * swarm::kWindowFeatures]));
+  for (std::size_t i : centred) centred_scores.push_back(t.model.LinearScore(&s1.x[i * swarm::kWindowFeatures]));
   std::sort(centred_scores.begin(), centred_scores.end());
   const auto at = static_cast<std::size_t>(
-      std::floor(o.stage1_percentile / 100.0 * static_cast<double>(centred_scores.size()) + 1e-9));
-  model.stage1_threshold = centred_scores.empty() ? 0.0 : centred_scores[std::min(at, centred_scores.size() - 1)];
-  report->stage1_positive_recall = 1.0 - o.stage1_percentile / 100.0;
-  // The first stage's positives (centred and shifted) are second-stage positives too, with their
-  // first-stage score.
+      std::floor(t.o.stage1_percentile / 100.0 * static_cast<double>(centred_scores.size()) + 1e-9));
+  t.model.stage1_threshold =
+      centred_scores.empty() ? 0.0 : centred_scores[std::min(at, centred_scores.size() - 1)];
+  t.report->stage1_positive_recall = 1.0 - t.o.stage1_percentile / 100.0;
+}
+
+// The first stage's positives (centred and shifted) are second-stage positives too, with their
+// first-stage score.
+Labelled Stage2Positives(const swarm::VictimDetectorModel& model, const Labelled& s1) {
   Labelled s2;
   std::vector<float> g(swarm::kForestFeatures);
   for (std::size_t i = 0; i < s1.y.size(); ++i) {
@@ -481,13 +516,30 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
     s2.x.insert(s2.x.end(), g.begin(), g.end());
     s2.y.push_back(1);
   }
-  s1 = {};
+  return s2;
+}
 
-  // Stage 2 samples: the first stage's candidates on the training scenes.
-  auto shared = std::make_shared<swarm::VictimDetectorModel>(model);
+// Stage 1 from the training scenes; returns stage 2's positives.
+Labelled TrainStage1(Training& t, const std::vector<Scene>& train) {
+  t.model.training_seeds = t.o.training_seeds;
+  t.model.calibration_seeds = t.o.calibration_seeds;
+  t.model.SetLinear(std::vector<double>(swarm::kWindowFeatures, 0.0), 0.0);
+  t.model.forest = cv::ml::RTrees::create();  // replaced below; the detector needs one to exist
+  Labelled s1;
+  std::vector<std::size_t> centred;  // rows of s1 that are unshifted positives
+  swarm::ChannelMaps maps;
+  for (const Scene& s : train) AddStage1Samples(s, t.rng, maps, &s1, &centred);
+  FitStage1(t, s1, centred);
+  return Stage2Positives(t.model, s1);
+}
+
+// Stage 2 samples: the first stage's candidates on the training scenes, positives into *s2 and
+// negatives into *neg.
+void AddStage2Candidates(const Training& t, const std::vector<Scene>& train, Labelled* s2, Labelled* neg) {
+  auto shared = std::make_shared<swarm::VictimDetectorModel>(t.model);
   swarm::VictimDetector first(shared, {});
-  Labelled neg;
-  for (const Scene& s : *train) {
+  std::vector<float> g(swarm::kForestFeatures);
+  for (const Scene& s : train) {
     const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
     // Every local maximum, whatever its score (the first stage alone is precise on these scenes:
     // above its threshold too few negatives remain to teach the forest).
@@ -502,89 +554,122 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
       if (label < 0) continue;
       swarm::WindowFeatures(first.channels(), c.row, c.col, g.data());
       g[swarm::kWindowFeatures] = static_cast<float>(c.score);
-      Labelled& dst = label ? s2 : neg;
+      Labelled& dst = label ? *s2 : *neg;
       dst.x.insert(dst.x.end(), g.begin(), g.end());
       dst.y.push_back(label);
     }
   }
-  // A seeded sample of the negatives.
+}
+
+// Stage 2's samples: the candidates' positives and a seeded sample of their negatives.
+Status CollectStage2(Training& t, const std::vector<Scene>& train, Labelled* s2) {
+  Labelled neg;
+  AddStage2Candidates(t, train, s2, &neg);
   std::vector<int> order(static_cast<std::size_t>(neg.rows()));
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
-  std::shuffle(order.begin(), order.end(), rng);
-  if (static_cast<int>(order.size()) > o.max_negatives) order.resize(static_cast<std::size_t>(o.max_negatives));
-  report->stage2_positives = s2.rows();
+  std::shuffle(order.begin(), order.end(), t.rng);
+  if (static_cast<int>(order.size()) > t.o.max_negatives) order.resize(static_cast<std::size_t>(t.o.max_negatives));
+  t.report->stage2_positives = s2->rows();
   for (int i : order) {
-    s2.x.insert(s2.x.end(), neg.x.begin() + static_cast<std::ptrdiff_t>(i) * swarm::kForestFeatures,
-                neg.x.begin() + static_cast<std::ptrdiff_t>(i + 1) * swarm::kForestFeatures);
-    s2.y.push_back(0);
+    s2->x.insert(s2->x.end(), neg.x.begin() + static_cast<std::ptrdiff_t>(i) * swarm::kForestFeatures,
+                 neg.x.begin() + static_cast<std::ptrdiff_t>(i + 1) * swarm::kForestFeatures);
+    s2->y.push_back(0);
   }
-  report->stage2_negatives = static_cast<int>(order.size());
+  t.report->stage2_negatives = static_cast<int>(order.size());
   std::fprintf(stderr, "train-detector: stage 2 on %d positives, %d negatives (of %d) (%.0f s)\n",
-               report->stage2_positives, report->stage2_negatives, neg.rows(), Seconds(t0));
-  if (report->stage2_positives < 50) {
+               t.report->stage2_positives, t.report->stage2_negatives, neg.rows(), Seconds(t.t0));
+  if (t.report->stage2_positives < 50) {
     return Error(ErrorCode::kInternal, "train-detector: the first stage left fewer than 50 positives");
   }
-  neg = {};
-  Result<cv::Ptr<cv::ml::RTrees>> forest = TrainForest(s2, o);
-  if (!forest) return forest.error();
-  model.forest = *forest;
-  model.FlattenForest();
-  std::fprintf(stderr, "train-detector: forest on %d samples (%.0f s)\n", s2.rows(), Seconds(t0));
+  return Ok{};
+}
 
-  // Hard negatives (bootstrapping, Felzenszwalb et al. 2010), hard_negative_rounds times: the
-  // detector on the training frames; its candidates at least 1.5 m from every person that the
-  // forest gives at least kHardNegativeVotes join the negatives, and the forest is trained again.
+Status TrainModelForest(Training& t, Labelled& s2) {
+  Result<cv::Ptr<cv::ml::RTrees>> forest = TrainForest(s2, t.o);
+  if (!forest) return forest.error();
+  t.model.forest = *forest;
+  t.model.FlattenForest();
+  std::fprintf(stderr, "train-detector: forest on %d samples (%.0f s)\n", s2.rows(), Seconds(t.t0));
+  return Ok{};
+}
+
+// One round of hard negatives (bootstrapping, Felzenszwalb et al. 2010): the detector on the
+// training frames; its candidates at least 1.5 m from every person that the forest gives at least
+// kHardNegativeVotes join the negatives.
+void MineHardNegatives(Training& t, const std::vector<Scene>& train, int round, Labelled* s2) {
+  auto mined = std::make_shared<swarm::VictimDetectorModel>(t.model);
+  swarm::VictimDetectorParams raw;
+  raw.min_confidence = 0.0;
+  raw.partial_confidence_cap = 1.0;
+  raw.nms_radius_m = 0.0;
+  swarm::VictimDetector det(mined, raw);
+  std::vector<float> g(swarm::kForestFeatures);
+  int hard = 0;
+  for (const Scene& s : train) {
+    const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+    const auto& cands = det.Candidates(BgrOf(s), ppm, raw.max_candidates, t.model.stage1_threshold);
+    for (const auto& c : cands) {
+      const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_col,
+                                   swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_row);
+      if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
+      swarm::WindowFeatures(det.channels(), c.row, c.col, g.data());
+      g[swarm::kWindowFeatures] = static_cast<float>(c.score);
+      if (t.model.Votes(g.data()) < kHardNegativeVotes) continue;
+      if (hard >= t.o.max_hard_negatives) break;
+      s2->x.insert(s2->x.end(), g.begin(), g.end());
+      s2->y.push_back(0);
+      ++hard;
+    }
+  }
+  t.report->stage2_hard_negatives += hard;
+  std::fprintf(stderr, "train-detector: round %d: %d hard negatives (votes >= %.2f) (%.0f s)\n", round + 1, hard,
+               kHardNegativeVotes, Seconds(t.t0));
+  t.report->stage2_negatives = s2->rows() - t.report->stage2_positives;
+}
+
+// The flattened forest decides as OpenCV's own prediction.
+Status CheckFlattenedForest(const Training& t, Labelled& s2) {
+  cv::Mat x(s2.rows(), swarm::kForestFeatures, CV_32F, s2.x.data());
+  cv::Mat votes;
+  t.model.forest->getVotes(x, votes, 0);
+  int person_col = votes.at<int>(0, 0) == 1 ? 0 : 1, disagree = 0;
+  for (int i = 0; i < x.rows; ++i) {
+    const double v = static_cast<double>(votes.at<int>(i + 1, person_col)) / t.o.forest_trees;
+    disagree += std::abs(v - t.model.Votes(x.ptr<float>(i))) > 1e-9 ? 1 : 0;
+  }
+  if (disagree > 0) {
+    return Error(ErrorCode::kInternal, "train-detector: the flattened forest disagrees with RTrees on " +
+                                           std::to_string(disagree) + " samples");
+  }
+  return Ok{};
+}
+
+}  // namespace
+
+Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  SWARMBOX_TRY(CheckTrainingOptions(o));
+  Result<std::vector<Scene>> train = RenderSets(o.training_seeds, o.scenes_per_set);
+  if (!train) return train.error();
+  Result<std::vector<Scene>> cal = RenderSets(o.calibration_seeds, o.scenes_per_set);
+  if (!cal) return cal.error();
+  report->training_scenes = static_cast<int>(train->size());
+  report->calibration_scenes = static_cast<int>(cal->size());
+  std::fprintf(stderr, "train-detector: rendered %d training and %d calibration scenes (%.0f s)\n",
+               report->training_scenes, report->calibration_scenes, Seconds(t0));
+  Training t{.o = o, .report = report, .t0 = t0};
+  Labelled s2 = TrainStage1(t, *train);
+  SWARMBOX_TRY(CollectStage2(t, *train, &s2));
+  SWARMBOX_TRY(TrainModelForest(t, s2));
+  // Hard negatives, hard_negative_rounds times, each followed by the forest trained again.
   for (int round = 0; round < o.hard_negative_rounds; ++round) {
-    auto mined = std::make_shared<swarm::VictimDetectorModel>(model);
-    swarm::VictimDetectorParams raw;
-    raw.min_confidence = 0.0;
-    raw.partial_confidence_cap = 1.0;
-    raw.nms_radius_m = 0.0;
-    swarm::VictimDetector det(mined, raw);
-    int hard = 0;
-    for (const Scene& s : *train) {
-      const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
-      const auto& cands = det.Candidates(BgrOf(s), ppm, raw.max_candidates, model.stage1_threshold);
-      for (const auto& c : cands) {
-        const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_col,
-                                     swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_row);
-        if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
-        swarm::WindowFeatures(det.channels(), c.row, c.col, g.data());
-        g[swarm::kWindowFeatures] = static_cast<float>(c.score);
-        if (model.Votes(g.data()) < kHardNegativeVotes) continue;
-        if (hard >= o.max_hard_negatives) break;
-        s2.x.insert(s2.x.end(), g.begin(), g.end());
-        s2.y.push_back(0);
-        ++hard;
-      }
-    }
-    report->stage2_hard_negatives += hard;
-    std::fprintf(stderr, "train-detector: round %d: %d hard negatives (votes >= %.2f) (%.0f s)\n", round + 1, hard,
-                 kHardNegativeVotes, Seconds(t0));
-    report->stage2_negatives = s2.rows() - report->stage2_positives;
-    forest = TrainForest(s2, o);
-    if (!forest) return forest.error();
-    model.forest = *forest;
-    model.FlattenForest();
-    std::fprintf(stderr, "train-detector: forest on %d samples (%.0f s)\n", s2.rows(), Seconds(t0));
+    MineHardNegatives(t, *train, round, &s2);
+    SWARMBOX_TRY(TrainModelForest(t, s2));
   }
-  {  // The flattened forest decides as OpenCV's own prediction.
-    cv::Mat x(s2.rows(), swarm::kForestFeatures, CV_32F, s2.x.data());
-    cv::Mat votes;
-    model.forest->getVotes(x, votes, 0);
-    int person_col = votes.at<int>(0, 0) == 1 ? 0 : 1, disagree = 0;
-    for (int i = 0; i < x.rows; ++i) {
-      const double v = static_cast<double>(votes.at<int>(i + 1, person_col)) / o.forest_trees;
-      disagree += std::abs(v - model.Votes(x.ptr<float>(i))) > 1e-9 ? 1 : 0;
-    }
-    if (disagree > 0) {
-      return Error(ErrorCode::kInternal, "train-detector: the flattened forest disagrees with RTrees on " +
-                                             std::to_string(disagree) + " samples");
-    }
-  }
-  if (Status st = Calibrate(*cal, &model, report); !st) return st.error();
+  SWARMBOX_TRY(CheckFlattenedForest(t, s2));
+  if (Status st = Calibrate(*cal, &t.model, report); !st) return st.error();
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return model;
+  return t.model;
 }
 
 std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& o, const TrainingReport& r) {

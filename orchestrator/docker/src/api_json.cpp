@@ -243,45 +243,65 @@ std::string BuildQuery(const BuildRequest& request) {
   return q;
 }
 
-std::string CreateContainerBody(const ContainerSpec& spec, bool all_networks) {
-  Node body = Node::Mapping();
-  body.Set("Image", Str(spec.image));
-  if (!spec.entrypoint.empty()) body.Set("Entrypoint", StrList(spec.entrypoint));
-  if (!spec.cmd.empty()) body.Set("Cmd", StrList(spec.cmd));
-  if (!spec.env.empty()) body.Set("Env", EnvList(spec.env));
-  if (!spec.user.empty()) body.Set("User", Str(spec.user));
-  if (!spec.working_dir.empty()) body.Set("WorkingDir", Str(spec.working_dir));
-  if (!spec.hostname.empty()) body.Set("Hostname", Str(spec.hostname));
-  body.Set("Labels", StrMap(spec.labels));
-  body.Set("Tty", Bool(spec.tty));
-  body.Set("OpenStdin", Bool(spec.open_stdin));
-  body.Set("AttachStdout", Bool(false));
-  body.Set("AttachStderr", Bool(false));
-  if (!spec.stop_signal.empty()) body.Set("StopSignal", Str(spec.stop_signal));
-  if (spec.stop_timeout_s) body.Set("StopTimeout", Int(*spec.stop_timeout_s));
+namespace {
+
+// The container's own settings (Config): image, command, environment, identity, ports exposed.
+void SetContainerConfig(const ContainerSpec& spec, Node* body) {
+  body->Set("Image", Str(spec.image));
+  if (!spec.entrypoint.empty()) body->Set("Entrypoint", StrList(spec.entrypoint));
+  if (!spec.cmd.empty()) body->Set("Cmd", StrList(spec.cmd));
+  if (!spec.env.empty()) body->Set("Env", EnvList(spec.env));
+  if (!spec.user.empty()) body->Set("User", Str(spec.user));
+  if (!spec.working_dir.empty()) body->Set("WorkingDir", Str(spec.working_dir));
+  if (!spec.hostname.empty()) body->Set("Hostname", Str(spec.hostname));
+  body->Set("Labels", StrMap(spec.labels));
+  body->Set("Tty", Bool(spec.tty));
+  body->Set("OpenStdin", Bool(spec.open_stdin));
+  body->Set("AttachStdout", Bool(false));
+  body->Set("AttachStderr", Bool(false));
+  if (!spec.stop_signal.empty()) body->Set("StopSignal", Str(spec.stop_signal));
+  if (spec.stop_timeout_s) body->Set("StopTimeout", Int(*spec.stop_timeout_s));
   if (!spec.ports.empty()) {
     Node exposed = Node::Mapping();
     for (const PortBinding& p : spec.ports) exposed.Set(std::to_string(p.container_port) + "/tcp", Node::Mapping());
-    body.Set("ExposedPorts", std::move(exposed));
+    body->Set("ExposedPorts", std::move(exposed));
   }
+}
 
+Node MountNode(const Mount& m) {
+  Node mount = Node::Mapping();
+  mount.Set("Type", Str(MountTypeName(m.type)));
+  if (m.type != Mount::Type::kTmpfs) mount.Set("Source", Str(m.source));
+  mount.Set("Target", Str(m.target));
+  mount.Set("ReadOnly", Bool(m.read_only));
+  if (m.type == Mount::Type::kTmpfs && (m.tmpfs_size_bytes > 0 || m.tmpfs_mode > 0)) {
+    Node tmpfs = Node::Mapping();
+    if (m.tmpfs_size_bytes > 0) tmpfs.Set("SizeBytes", Int(m.tmpfs_size_bytes));
+    if (m.tmpfs_mode > 0) tmpfs.Set("Mode", Int(m.tmpfs_mode));
+    mount.Set("TmpfsOptions", std::move(tmpfs));
+  }
+  return mount;
+}
+
+Node PortBindingsNode(const std::vector<PortBinding>& ports) {
+  Node bindings = Node::Mapping();
+  for (const PortBinding& p : ports) {
+    Node binding = Node::Mapping();
+    binding.Set("HostIp", Str(p.host_ip));
+    binding.Set("HostPort", Str(std::to_string(p.host_port)));
+    Node list = Node::Sequence();
+    list.Append(std::move(binding));
+    bindings.Set(std::to_string(p.container_port) + "/tcp", std::move(list));
+  }
+  return bindings;
+}
+
+// HostConfig: mounts, network mode, capabilities, resources, ports, root filesystem.
+Node HostConfigNode(const ContainerSpec& spec) {
   Node host = Node::Mapping();
   if (!spec.mounts.empty()) {
     Node mounts = Node::Sequence();
-    for (const Mount& m : spec.mounts) {
-      Node mount = Node::Mapping();
-      mount.Set("Type", Str(MountTypeName(m.type)));
-      if (m.type != Mount::Type::kTmpfs) mount.Set("Source", Str(m.source));
-      mount.Set("Target", Str(m.target));
-      mount.Set("ReadOnly", Bool(m.read_only));
-      if (m.type == Mount::Type::kTmpfs && (m.tmpfs_size_bytes > 0 || m.tmpfs_mode > 0)) {
-        Node tmpfs = Node::Mapping();
-        if (m.tmpfs_size_bytes > 0) tmpfs.Set("SizeBytes", Int(m.tmpfs_size_bytes));
-        if (m.tmpfs_mode > 0) tmpfs.Set("Mode", Int(m.tmpfs_mode));
-        mount.Set("TmpfsOptions", std::move(tmpfs));
-      }
-      mounts.Append(std::move(mount));
-    }
+    for (const Mount& m : spec.mounts) mounts.Append(MountNode(m));
     host.Set("Mounts", std::move(mounts));
   }
   std::string network_mode = spec.network_mode;
@@ -300,23 +320,19 @@ std::string CreateContainerBody(const ContainerSpec& spec, bool all_networks) {
   if (!spec.resources.cpuset_cpus.empty()) host.Set("CpusetCpus", Str(spec.resources.cpuset_cpus));
   if (!spec.sysctls.empty()) host.Set("Sysctls", StrMap(spec.sysctls));
   if (!spec.extra_hosts.empty()) host.Set("ExtraHosts", StrList(spec.extra_hosts));
-  if (!spec.ports.empty()) {
-    Node bindings = Node::Mapping();
-    for (const PortBinding& p : spec.ports) {
-      Node binding = Node::Mapping();
-      binding.Set("HostIp", Str(p.host_ip));
-      binding.Set("HostPort", Str(std::to_string(p.host_port)));
-      Node list = Node::Sequence();
-      list.Append(std::move(binding));
-      bindings.Set(std::to_string(p.container_port) + "/tcp", std::move(list));
-    }
-    host.Set("PortBindings", std::move(bindings));
-  }
+  if (!spec.ports.empty()) host.Set("PortBindings", PortBindingsNode(spec.ports));
   host.Set("ReadonlyRootfs", Bool(spec.read_only_rootfs));
   if (spec.init) host.Set("Init", Bool(true));
   host.Set("AutoRemove", Bool(spec.auto_remove));
-  body.Set("HostConfig", std::move(host));
+  return host;
+}
 
+}  // namespace
+
+std::string CreateContainerBody(const ContainerSpec& spec, bool all_networks) {
+  Node body = Node::Mapping();
+  SetContainerConfig(spec, &body);
+  body.Set("HostConfig", HostConfigNode(spec));
   if (!spec.networks.empty()) {
     Node endpoints = Node::Mapping();
     const std::size_t n = all_networks ? spec.networks.size() : 1;

@@ -97,6 +97,133 @@ ErrorCode MapCurlCode(CURLcode code) {
   }
 }
 
+// The request's headers; an empty Expect: stops libcurl from waiting a second for "100 Continue"
+// on large bodies. The caller frees the list (curl_slist_free_all).
+curl_slist* RequestHeaders(const HttpRequest& request) {
+  curl_slist* headers = nullptr;
+  headers = curl_slist_append(headers, "Expect:");
+  if (!request.content_type.empty()) {
+    headers = curl_slist_append(headers, ("Content-Type: " + request.content_type).c_str());
+  }
+  for (const auto& [name, value] : request.headers) {
+    headers = curl_slist_append(headers, (name + ": " + value).c_str());
+  }
+  return headers;
+}
+
+// How to reach the engine: its unix socket, or TCP with TLS as the docker CLI does it.
+void SetEngineOptions(CURL* e, const EngineEndpoint& engine) {
+  if (engine.kind == EngineEndpoint::Kind::kUnix) {
+    curl_easy_setopt(e, CURLOPT_UNIX_SOCKET_PATH, engine.socket_path.c_str());
+  } else if (engine.tls) {
+    // As the docker CLI: the engine's certificate against ca.pem (or the system's CAs), the
+    // client's own certificate when there is one; DOCKER_TLS alone checks nothing.
+    if (!engine.ca_file.empty()) curl_easy_setopt(e, CURLOPT_CAINFO, engine.ca_file.c_str());
+    if (!engine.cert_file.empty()) {
+      curl_easy_setopt(e, CURLOPT_SSLCERT, engine.cert_file.c_str());
+      curl_easy_setopt(e, CURLOPT_SSLKEY, engine.key_file.c_str());
+    }
+    curl_easy_setopt(e, CURLOPT_SSL_VERIFYPEER, engine.tls_verify ? 1L : 0L);
+    curl_easy_setopt(e, CURLOPT_SSL_VERIFYHOST, engine.tls_verify ? 2L : 0L);
+  }
+}
+
+// The URL, headers, error buffer and the callbacks that fill ex->response.
+void SetTransferOptions(CURL* e, const std::string& url, curl_slist* headers, char* error_buffer, Exchange* ex) {
+  curl_easy_setopt(e, CURLOPT_URL, url.c_str());
+  curl_easy_setopt(e, CURLOPT_HTTPHEADER, headers);
+  curl_easy_setopt(e, CURLOPT_ERRORBUFFER, error_buffer);
+  curl_easy_setopt(e, CURLOPT_NOSIGNAL, 1L);
+  curl_easy_setopt(e, CURLOPT_HEADERFUNCTION, &OnHeader);
+  curl_easy_setopt(e, CURLOPT_HEADERDATA, ex);
+  curl_easy_setopt(e, CURLOPT_WRITEFUNCTION, &OnBody);
+  curl_easy_setopt(e, CURLOPT_WRITEDATA, ex);
+}
+
+// The method, and the body read from ex->upload for POST, PUT and other methods with a body.
+void SetMethodOptions(CURL* e, const HttpRequest& request, Exchange* ex) {
+  if (request.method == "GET") {
+    curl_easy_setopt(e, CURLOPT_HTTPGET, 1L);
+  } else if (request.method == "HEAD") {
+    curl_easy_setopt(e, CURLOPT_NOBODY, 1L);
+  } else if (request.method != "POST" && request.method != "PUT" && request.body.empty()) {
+    curl_easy_setopt(e, CURLOPT_CUSTOMREQUEST, request.method.c_str());  // DELETE
+  } else {
+    if (request.method == "POST") {
+      curl_easy_setopt(e, CURLOPT_POST, 1L);
+    } else {
+      curl_easy_setopt(e, CURLOPT_UPLOAD, 1L);
+      curl_easy_setopt(e, CURLOPT_CUSTOMREQUEST, request.method.c_str());
+    }
+    curl_easy_setopt(e, CURLOPT_READFUNCTION, &OnUpload);
+    curl_easy_setopt(e, CURLOPT_READDATA, ex);
+    if (request.method == "POST") {
+      curl_easy_setopt(e, CURLOPT_POSTFIELDSIZE_LARGE,
+                       static_cast<curl_off_t>(request.body.size()));
+    } else {
+      curl_easy_setopt(e, CURLOPT_INFILESIZE_LARGE, static_cast<curl_off_t>(request.body.size()));
+    }
+  }
+}
+
+// How a transfer ended: libcurl's result (CURLE_RECV_ERROR when the multi interface failed, its
+// message in the error buffer), or cancelled.
+struct TransferEnd {
+  CURLcode result = CURLE_OK;
+  bool cancelled = false;
+};
+
+// Drives the transfer until it is done, fails or `cancel` fires (which wakes the poll).
+TransferEnd Perform(CURLM* multi, CancelToken* cancel, char (&error_buffer)[CURL_ERROR_SIZE]) {
+  std::uint64_t waker = 0;
+  if (cancel != nullptr) waker = cancel->Register([multi] { curl_multi_wakeup(multi); });
+  TransferEnd end;
+  bool done = false;
+  while (!done) {
+    int running = 0;
+    CURLMcode mc = curl_multi_perform(multi, &running);
+    if (mc != CURLM_OK) {
+      end.result = CURLE_RECV_ERROR;
+      std::snprintf(error_buffer, sizeof(error_buffer), "curl_multi_perform: %s",
+                    curl_multi_strerror(mc));
+      break;
+    }
+    int queued = 0;
+    while (CURLMsg* msg = curl_multi_info_read(multi, &queued)) {
+      if (msg->msg == CURLMSG_DONE) {
+        end.result = msg->data.result;
+        done = true;
+      }
+    }
+    if (done) break;
+    if (cancel != nullptr && cancel->cancelled()) {
+      end.cancelled = true;
+      break;
+    }
+    mc = curl_multi_poll(multi, nullptr, 0, 1000, nullptr);
+    if (mc != CURLM_OK) {
+      end.result = CURLE_RECV_ERROR;
+      std::snprintf(error_buffer, sizeof(error_buffer), "curl_multi_poll: %s",
+                    curl_multi_strerror(mc));
+      break;
+    }
+  }
+  if (cancel != nullptr) cancel->Unregister(waker);
+  return end;
+}
+
+// The error of a failed transfer: libcurl's message, and for a refused connection where no engine
+// answers.
+Error TransferError(CURLcode result, const char* error_buffer, const EngineEndpoint& engine,
+                    const std::string& where) {
+  std::string detail = error_buffer[0] != '\0' ? error_buffer : curl_easy_strerror(result);
+  if (result == CURLE_COULDNT_CONNECT) {
+    const std::string at = engine.kind == EngineEndpoint::Kind::kUnix ? engine.socket_path : engine.ToString();
+    detail = "no Docker engine answers at " + at + " (" + detail + ")";
+  }
+  return Error(MapCurlCode(result), detail, where);
+}
+
 }  // namespace
 
 std::string HttpResponse::Header(std::string_view name) const {
@@ -115,7 +242,6 @@ Result<HttpResponse> CurlTransport::Send(const HttpRequest& request,
   if (cancel != nullptr && cancel->cancelled()) {
     return Error(ErrorCode::kCancelled, "cancelled before sending", where);
   }
-
   Exchange ex;
   ex.on_chunk = &on_chunk;
   ex.upload = request.body;
@@ -126,105 +252,18 @@ Result<HttpResponse> CurlTransport::Send(const HttpRequest& request,
     if (multi != nullptr) curl_multi_cleanup(multi);
     return Error(ErrorCode::kInternal, "libcurl could not allocate a handle", where);
   }
-
   const std::string url = base_url_ + request.target;
   char error_buffer[CURL_ERROR_SIZE] = {0};
-  curl_slist* headers = nullptr;
-  // An empty Expect: stops libcurl from waiting a second for "100 Continue" on large bodies.
-  headers = curl_slist_append(headers, "Expect:");
-  if (!request.content_type.empty()) {
-    headers = curl_slist_append(headers, ("Content-Type: " + request.content_type).c_str());
-  }
-  for (const auto& [name, value] : request.headers) {
-    headers = curl_slist_append(headers, (name + ": " + value).c_str());
-  }
-
+  curl_slist* headers = RequestHeaders(request);
   CURL* e = ex.easy;
-  if (engine_.kind == EngineEndpoint::Kind::kUnix) {
-    curl_easy_setopt(e, CURLOPT_UNIX_SOCKET_PATH, engine_.socket_path.c_str());
-  } else if (engine_.tls) {
-    // As the docker CLI: the engine's certificate against ca.pem (or the system's CAs), the
-    // client's own certificate when there is one; DOCKER_TLS alone checks nothing.
-    if (!engine_.ca_file.empty()) curl_easy_setopt(e, CURLOPT_CAINFO, engine_.ca_file.c_str());
-    if (!engine_.cert_file.empty()) {
-      curl_easy_setopt(e, CURLOPT_SSLCERT, engine_.cert_file.c_str());
-      curl_easy_setopt(e, CURLOPT_SSLKEY, engine_.key_file.c_str());
-    }
-    curl_easy_setopt(e, CURLOPT_SSL_VERIFYPEER, engine_.tls_verify ? 1L : 0L);
-    curl_easy_setopt(e, CURLOPT_SSL_VERIFYHOST, engine_.tls_verify ? 2L : 0L);
-  }
-  curl_easy_setopt(e, CURLOPT_URL, url.c_str());
-  curl_easy_setopt(e, CURLOPT_HTTPHEADER, headers);
-  curl_easy_setopt(e, CURLOPT_ERRORBUFFER, error_buffer);
-  curl_easy_setopt(e, CURLOPT_NOSIGNAL, 1L);
-  curl_easy_setopt(e, CURLOPT_HEADERFUNCTION, &OnHeader);
-  curl_easy_setopt(e, CURLOPT_HEADERDATA, &ex);
-  curl_easy_setopt(e, CURLOPT_WRITEFUNCTION, &OnBody);
-  curl_easy_setopt(e, CURLOPT_WRITEDATA, &ex);
+  SetEngineOptions(e, engine_);
+  SetTransferOptions(e, url, headers, error_buffer, &ex);
   curl_easy_setopt(e, CURLOPT_CONNECTTIMEOUT_MS, static_cast<long>(connect_timeout_.count()));
   curl_easy_setopt(e, CURLOPT_TIMEOUT_MS, static_cast<long>(request.timeout.count()));
   curl_easy_setopt(e, CURLOPT_BUFFERSIZE, 64L * 1024L);
-  if (request.method == "GET") {
-    curl_easy_setopt(e, CURLOPT_HTTPGET, 1L);
-  } else if (request.method == "HEAD") {
-    curl_easy_setopt(e, CURLOPT_NOBODY, 1L);
-  } else if (request.method != "POST" && request.method != "PUT" && request.body.empty()) {
-    curl_easy_setopt(e, CURLOPT_CUSTOMREQUEST, request.method.c_str());  // DELETE
-  } else {
-    if (request.method == "POST") {
-      curl_easy_setopt(e, CURLOPT_POST, 1L);
-    } else {
-      curl_easy_setopt(e, CURLOPT_UPLOAD, 1L);
-      curl_easy_setopt(e, CURLOPT_CUSTOMREQUEST, request.method.c_str());
-    }
-    curl_easy_setopt(e, CURLOPT_READFUNCTION, &OnUpload);
-    curl_easy_setopt(e, CURLOPT_READDATA, &ex);
-    if (request.method == "POST") {
-      curl_easy_setopt(e, CURLOPT_POSTFIELDSIZE_LARGE,
-                       static_cast<curl_off_t>(request.body.size()));
-    } else {
-      curl_easy_setopt(e, CURLOPT_INFILESIZE_LARGE, static_cast<curl_off_t>(request.body.size()));
-    }
-  }
+  SetMethodOptions(e, request, &ex);
   curl_multi_add_handle(multi, e);
-
-  std::uint64_t waker = 0;
-  if (cancel != nullptr) waker = cancel->Register([multi] { curl_multi_wakeup(multi); });
-
-  CURLcode result = CURLE_OK;
-  bool done = false;
-  bool cancelled = false;
-  while (!done) {
-    int running = 0;
-    CURLMcode mc = curl_multi_perform(multi, &running);
-    if (mc != CURLM_OK) {
-      result = CURLE_RECV_ERROR;
-      std::snprintf(error_buffer, sizeof(error_buffer), "curl_multi_perform: %s",
-                    curl_multi_strerror(mc));
-      break;
-    }
-    int queued = 0;
-    while (CURLMsg* msg = curl_multi_info_read(multi, &queued)) {
-      if (msg->msg == CURLMSG_DONE) {
-        result = msg->data.result;
-        done = true;
-      }
-    }
-    if (done) break;
-    if (cancel != nullptr && cancel->cancelled()) {
-      cancelled = true;
-      break;
-    }
-    mc = curl_multi_poll(multi, nullptr, 0, 1000, nullptr);
-    if (mc != CURLM_OK) {
-      result = CURLE_RECV_ERROR;
-      std::snprintf(error_buffer, sizeof(error_buffer), "curl_multi_poll: %s",
-                    curl_multi_strerror(mc));
-      break;
-    }
-  }
-  if (cancel != nullptr) cancel->Unregister(waker);
-
+  const TransferEnd end = Perform(multi, cancel, error_buffer);
   if (!ex.status_known) {
     long code = 0;
     curl_easy_getinfo(e, CURLINFO_RESPONSE_CODE, &code);
@@ -234,17 +273,8 @@ Result<HttpResponse> CurlTransport::Send(const HttpRequest& request,
   curl_easy_cleanup(e);
   curl_multi_cleanup(multi);
   curl_slist_free_all(headers);
-
-  if (cancelled) return Error(ErrorCode::kCancelled, "cancelled", where);
-  if (result != CURLE_OK) {
-    std::string detail = error_buffer[0] != '\0' ? error_buffer : curl_easy_strerror(result);
-    if (result == CURLE_COULDNT_CONNECT) {
-      const std::string at =
-          engine_.kind == EngineEndpoint::Kind::kUnix ? engine_.socket_path : endpoint();
-      detail = "no Docker engine answers at " + at + " (" + detail + ")";
-    }
-    return Error(MapCurlCode(result), detail, where);
-  }
+  if (end.cancelled) return Error(ErrorCode::kCancelled, "cancelled", where);
+  if (end.result != CURLE_OK) return TransferError(end.result, error_buffer, engine_, where);
   return std::move(ex.response);
 }
 

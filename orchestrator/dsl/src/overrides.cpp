@@ -29,6 +29,51 @@ bool IsIndex(const std::string& s) {
 
 }  // namespace
 
+namespace {
+
+// The item of a list that `part` names: by index, or the item whose `name` is `part`.
+Result<yaml::Node*> ListItem(yaml::Node& list, const std::string& part, const std::string& walked,
+                             const std::string& where) {
+  if (IsIndex(part)) {
+    const std::size_t index = std::stoul(part);
+    if (index >= list.items().size()) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "'" + walked + "': index " + part + " is past the end of a list of " +
+                       std::to_string(list.items().size()),
+                   where);
+    }
+    return &list.items()[index];
+  }
+  yaml::Node* next = nullptr;
+  for (yaml::Node& item : list.items()) {
+    const yaml::Node* name = item.is_mapping() ? item.Find("name") : nullptr;
+    if (name != nullptr && name->is_scalar() && name->scalar() == part) next = &item;
+  }
+  if (next == nullptr) {
+    return Error(ErrorCode::kInvalidArgument, "'" + walked + "': no list item named '" + part + "'", where);
+  }
+  return next;
+}
+
+// The entry `part` of a mapping (a null node becomes one). A new entry (*created) is the value
+// when it is the `last` segment, else an empty mapping; new keys carry the override's mark, so
+// schema errors about them point at the --set.
+Result<yaml::Node*> MapEntry(yaml::Node& node, const std::string& part, bool last, const yaml::Node& value,
+                             const std::string& walked, const std::string& where, bool* created) {
+  if (node.is_null()) node = yaml::Node::Mapping(node.mark());
+  if (!node.is_mapping()) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "'" + walked + "': cannot descend into a scalar (" + node.Where() + ")", where);
+  }
+  const yaml::Mark mark = value.mark();
+  if (yaml::Node* next = node.Find(part)) return next;
+  node.entries().emplace_back(yaml::Node::Scalar(part, mark), last ? value : yaml::Node::Mapping(mark));
+  *created = true;
+  return &node.entries().back().second;
+}
+
+}  // namespace
+
 Status ApplyOverride(yaml::Node& document, std::string_view assignment) {
   const std::string where = "--set " + std::string(assignment);
   const std::size_t eq = assignment.find('=');
@@ -49,52 +94,15 @@ Status ApplyOverride(yaml::Node& document, std::string_view assignment) {
     if (part.empty()) return Error(ErrorCode::kInvalidArgument, "empty path segment in key", where);
     const bool last = i + 1 == parts.size();
     walked += (walked.empty() ? "" : ".") + part;
-    if (node->is_sequence()) {
-      yaml::Node* next = nullptr;
-      if (IsIndex(part)) {
-        const std::size_t index = std::stoul(part);
-        if (index >= node->items().size()) {
-          return Error(ErrorCode::kInvalidArgument,
-                       "'" + walked + "': index " + part + " is past the end of a list of " +
-                           std::to_string(node->items().size()),
-                       where);
-        }
-        next = &node->items()[index];
-      } else {
-        for (yaml::Node& item : node->items()) {
-          const yaml::Node* name = item.is_mapping() ? item.Find("name") : nullptr;
-          if (name != nullptr && name->is_scalar() && name->scalar() == part) next = &item;
-        }
-        if (next == nullptr) {
-          return Error(ErrorCode::kInvalidArgument,
-                       "'" + walked + "': no list item named '" + part + "'", where);
-        }
-      }
-      if (last) {
-        *next = *value;
-        return Ok{};
-      }
-      node = next;
-      continue;
-    }
-    if (node->is_null()) *node = yaml::Node::Mapping(node->mark());
-    if (!node->is_mapping()) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "'" + walked + "': cannot descend into a scalar (" + node->Where() + ")", where);
-    }
-    // New keys carry the override's mark, so schema errors about them point at the --set.
-    const yaml::Mark mark = value->mark();
-    yaml::Node* next = node->Find(part);
-    if (next == nullptr) {
-      node->entries().emplace_back(yaml::Node::Scalar(part, mark),
-                                   last ? *value : yaml::Node::Mapping(mark));
-      next = &node->entries().back().second;
-      if (last) return Ok{};
-    } else if (last) {
-      *next = *value;
+    bool created = false;
+    auto next = node->is_sequence() ? ListItem(*node, part, walked, where)
+                                    : MapEntry(*node, part, last, *value, walked, where, &created);
+    if (!next) return next.error();
+    if (last) {
+      if (!created) **next = *value;
       return Ok{};
     }
-    node = next;
+    node = *next;
   }
   return Ok{};
 }

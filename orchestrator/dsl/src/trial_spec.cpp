@@ -181,6 +181,107 @@ Node Plain(std::string s) { return Node::Scalar(std::move(s)); }
 
 }  // namespace
 
+namespace {
+
+Node LimitsNode(const ContainerLimits& l) {
+  Node n = Node::Mapping();
+  if (l.memory_mib > 0) n.Set("memory_mib", Plain(std::to_string(l.memory_mib)));
+  if (l.pids > 0) n.Set("pids", Plain(std::to_string(l.pids)));
+  return n;
+}
+
+Node PhysicsNode(const TrialSpec& spec) {
+  Node physics = Node::Mapping();
+  physics.Set("rtf", Plain(Number(spec.rtf)));
+  if (spec.physics_limits.memory_mib > 0 || spec.physics_limits.pids > 0) {
+    physics.Set("limits", LimitsNode(spec.physics_limits));
+  }
+  return physics;
+}
+
+Node DronesNode(const TrialSpec& spec) {
+  Node drones = Node::Sequence();
+  for (const DroneSpec& d : spec.drones) {
+    Node dn = Node::Mapping();
+    dn.Set("name", Str(d.name));
+    dn.Set("airframe", Str(d.airframe));
+    Node pose = Node::Sequence();
+    for (double v : d.pose) pose.Append(Plain(Number(v)));
+    dn.Set("pose", std::move(pose));
+    if (!d.payload.empty()) dn.Set("payload", Str(d.payload));
+    if (d.limits.memory_mib > 0 || d.limits.pids > 0) dn.Set("limits", LimitsNode(d.limits));
+    if (d.brain.kind != BrainKind::kBuiltin) dn.Set("brain", BrainToNode(d.brain));
+    drones.Append(std::move(dn));
+  }
+  return drones;
+}
+
+Node MissionNode(const MissionSpec& m) {
+  Node mission = Node::Mapping();
+  mission.Set("kind", Str(MissionKindName(m.kind)));
+  if (m.kind == MissionKind::kPlan) mission.Set("plan", Str(m.plan));
+  mission.Set("inference_latency_ms", Plain(std::to_string(m.inference_latency_ms)));
+  return mission;
+}
+
+Node RaftNode(const RaftSpec& r) {
+  Node raft = Node::Mapping();
+  raft.Set("tick_ms", Plain(std::to_string(r.tick_ms)));
+  raft.Set("heartbeat_ms", Plain(std::to_string(r.heartbeat_ms)));
+  raft.Set("election_timeout_ms", Plain(std::to_string(r.election_timeout_ms)));
+  if (r.voters != RaftSpec{}.voters) raft.Set("voters", Plain(std::to_string(r.voters)));
+  return raft;
+}
+
+Node RadioNode(const RadioLinkSpec& r) {
+  Node radio = Node::Mapping();
+  radio.Set("model", Str(RadioModelName(r.model)));
+  // The default profile is left implied (a profile written out is checked where it is written).
+  if (r.profile != kDefaultRadioProfile) radio.Set("profile", Str(r.profile));
+  radio.Set("ping_every_ms", Plain(std::to_string(r.ping_every_ms)));
+  radio.Set("ping_peers", Plain(std::to_string(r.ping_peers)));
+  return radio;
+}
+
+Node EndNode(const std::vector<EndSpec>& ends) {
+  Node end = Node::Sequence();
+  for (const EndSpec& e : ends) {
+    Node en = Node::Mapping();
+    en.Set("on", Str(e.on));
+    en.Set("outcome", Str(OutcomeName(e.outcome)));
+    if (!e.reason.empty()) en.Set("reason", Str(e.reason));
+    if (!e.from.empty()) en.Set("from", Str(e.from));
+    end.Append(std::move(en));
+  }
+  return end;
+}
+
+Node TimeoutNode(const TrialSpec& spec) {
+  Node timeout = Node::Mapping();
+  timeout.Set("sim", Str(spec.timeout.sim.ToString()));
+  if (!spec.timeout.wall.zero()) timeout.Set("wall", Str(spec.timeout.wall.ToString()));
+  timeout.Set("outcome", Str(OutcomeName(spec.timeout.outcome)));
+  return timeout;
+}
+
+// network, faults, components and end: each only when the trial has it.
+void SetOptionalSections(const TrialSpec& spec, Node* doc) {
+  if (!spec.mesh_node.is_null()) {
+    Node network = Node::Mapping();
+    network.Set("mesh", spec.mesh_node);
+    doc->Set("network", std::move(network));
+  }
+  if (!spec.faults_node.is_null()) doc->Set("faults", spec.faults_node);
+  if (!spec.components.empty()) {
+    Node components = Node::Sequence();
+    for (const UserComponentSpec& c : spec.components) components.Append(ComponentToNode(c));
+    doc->Set("components", std::move(components));
+  }
+  if (!spec.end.empty()) doc->Set("end", EndNode(spec.end));
+}
+
+}  // namespace
+
 yaml::Node ToDocument(const TrialSpec& spec) {
   Node doc = Node::Mapping();
   doc.Set("name", Str(spec.name));
@@ -192,79 +293,14 @@ yaml::Node ToDocument(const TrialSpec& spec) {
     for (double v : spec.world_size_m) size.Append(Plain(Number(v)));
     doc.Set("world_size_m", std::move(size));
   }
-  auto limits_node = [](const ContainerLimits& l) {
-    Node n = Node::Mapping();
-    if (l.memory_mib > 0) n.Set("memory_mib", Plain(std::to_string(l.memory_mib)));
-    if (l.pids > 0) n.Set("pids", Plain(std::to_string(l.pids)));
-    return n;
-  };
-  Node physics = Node::Mapping();
-  physics.Set("rtf", Plain(Number(spec.rtf)));
-  if (spec.physics_limits.memory_mib > 0 || spec.physics_limits.pids > 0) {
-    physics.Set("limits", limits_node(spec.physics_limits));
-  }
-  doc.Set("physics", std::move(physics));
-  doc.Set("limits", limits_node(spec.limits));
-  Node drones = Node::Sequence();
-  for (const DroneSpec& d : spec.drones) {
-    Node dn = Node::Mapping();
-    dn.Set("name", Str(d.name));
-    dn.Set("airframe", Str(d.airframe));
-    Node pose = Node::Sequence();
-    for (double v : d.pose) pose.Append(Plain(Number(v)));
-    dn.Set("pose", std::move(pose));
-    if (!d.payload.empty()) dn.Set("payload", Str(d.payload));
-    if (d.limits.memory_mib > 0 || d.limits.pids > 0) dn.Set("limits", limits_node(d.limits));
-    if (d.brain.kind != BrainKind::kBuiltin) dn.Set("brain", BrainToNode(d.brain));
-    drones.Append(std::move(dn));
-  }
-  doc.Set("drones", std::move(drones));
-  Node mission = Node::Mapping();
-  mission.Set("kind", Str(MissionKindName(spec.mission.kind)));
-  if (spec.mission.kind == MissionKind::kPlan) mission.Set("plan", Str(spec.mission.plan));
-  mission.Set("inference_latency_ms", Plain(std::to_string(spec.mission.inference_latency_ms)));
-  doc.Set("mission", std::move(mission));
-  Node raft = Node::Mapping();
-  raft.Set("tick_ms", Plain(std::to_string(spec.raft.tick_ms)));
-  raft.Set("heartbeat_ms", Plain(std::to_string(spec.raft.heartbeat_ms)));
-  raft.Set("election_timeout_ms", Plain(std::to_string(spec.raft.election_timeout_ms)));
-  if (spec.raft.voters != RaftSpec{}.voters) raft.Set("voters", Plain(std::to_string(spec.raft.voters)));
-  doc.Set("raft", std::move(raft));
-  Node radio = Node::Mapping();
-  radio.Set("model", Str(RadioModelName(spec.radio.model)));
-  // The default profile is left implied (a profile written out is checked where it is written).
-  if (spec.radio.profile != kDefaultRadioProfile) radio.Set("profile", Str(spec.radio.profile));
-  radio.Set("ping_every_ms", Plain(std::to_string(spec.radio.ping_every_ms)));
-  radio.Set("ping_peers", Plain(std::to_string(spec.radio.ping_peers)));
-  doc.Set("radio", std::move(radio));
-  if (!spec.mesh_node.is_null()) {
-    Node network = Node::Mapping();
-    network.Set("mesh", spec.mesh_node);
-    doc.Set("network", std::move(network));
-  }
-  if (!spec.faults_node.is_null()) doc.Set("faults", spec.faults_node);
-  if (!spec.components.empty()) {
-    Node components = Node::Sequence();
-    for (const UserComponentSpec& c : spec.components) components.Append(ComponentToNode(c));
-    doc.Set("components", std::move(components));
-  }
-  if (!spec.end.empty()) {
-    Node end = Node::Sequence();
-    for (const EndSpec& e : spec.end) {
-      Node en = Node::Mapping();
-      en.Set("on", Str(e.on));
-      en.Set("outcome", Str(OutcomeName(e.outcome)));
-      if (!e.reason.empty()) en.Set("reason", Str(e.reason));
-      if (!e.from.empty()) en.Set("from", Str(e.from));
-      end.Append(std::move(en));
-    }
-    doc.Set("end", std::move(end));
-  }
-  Node timeout = Node::Mapping();
-  timeout.Set("sim", Str(spec.timeout.sim.ToString()));
-  if (!spec.timeout.wall.zero()) timeout.Set("wall", Str(spec.timeout.wall.ToString()));
-  timeout.Set("outcome", Str(OutcomeName(spec.timeout.outcome)));
-  doc.Set("timeout", std::move(timeout));
+  doc.Set("physics", PhysicsNode(spec));
+  doc.Set("limits", LimitsNode(spec.limits));
+  doc.Set("drones", DronesNode(spec));
+  doc.Set("mission", MissionNode(spec.mission));
+  doc.Set("raft", RaftNode(spec.raft));
+  doc.Set("radio", RadioNode(spec.radio));
+  SetOptionalSections(spec, &doc);
+  doc.Set("timeout", TimeoutNode(spec));
   return doc;
 }
 

@@ -109,6 +109,87 @@ constexpr const char* kReservedNames[] = {"physics", "raft_leader", "sim", "mesh
 
 }  // namespace
 
+namespace {
+
+// library: needs a name; its args a mapping (they become --brain-args JSON).
+Status DecodeLibraryBrain(const Node& node, const Node& key, const Node* args, const SoftwareContext& context,
+                          BrainSpec* brain) {
+  brain->kind = BrainKind::kLibrary;
+  if (brain->name.empty()) {
+    return At(node, "a library brain needs 'name': the SWARMBOX_BRAIN name in the library");
+  }
+  auto path = CheckFile(key, "brain library", brain->path, FileKind::kElfShared,
+                        " (a MODULE library, e.g. swarmbox_add_brain)", context);
+  if (!path) return path.error();
+  brain->host_path = *path;
+  if (args != nullptr && !args->is_null()) {
+    if (!args->is_mapping()) {
+      return At(*args, "'args' of a library brain must be a mapping, e.g. {radius_m: 6} (it becomes --brain-args JSON)");
+    }
+    brain->args = *args;
+  }
+  return Ok{};
+}
+
+// program, dockerfile or image: one program, no name; its args a list.
+Status DecodeProgramBrain(const Node& node, const Node& key, const std::string& source_key, const Node* args,
+                          const SoftwareContext& context, BrainSpec* brain) {
+  if (const Node* name = node.Find("name")) {
+    return At(*name, "'name' belongs to library brains (a " + source_key + " brain is one program)");
+  }
+  if (source_key == "program") {
+    brain->kind = BrainKind::kProgram;
+    auto path = CheckFile(key, "brain program", brain->path, FileKind::kElfExecutable,
+                          " (it is packed into an image with its shared libraries)", context);
+    if (!path) return path.error();
+    brain->host_path = *path;
+  } else if (source_key == "dockerfile") {
+    brain->kind = BrainKind::kDockerfile;
+    auto path = CheckFile(key, "brain dockerfile", brain->path, FileKind::kOther, "", context);
+    if (!path) return path.error();
+    brain->host_path = *path;
+  } else {
+    brain->kind = BrainKind::kImage;
+    SWARMBOX_TRY(CheckImageReference(key, brain->path));
+  }
+  if (args != nullptr) {
+    auto list = DecodeArgList(*args, "a " + source_key + " brain");
+    if (!list) return list.error();
+    if (!args->is_null()) brain->args = *args;
+  }
+  return Ok{};
+}
+
+Status CheckBrainRate(const Node& node, const BrainSpec& brain) {
+  if (const Node* rate = node.Find("rate_hz")) {
+    const double steps = brain.rate_hz > 0 ? kAgentStepHz / brain.rate_hz : 0;
+    if (!(brain.rate_hz > 0) || brain.rate_hz > kAgentStepHz || std::fabs(steps - std::round(steps)) > 1e-9) {
+      return At(*rate, "'rate_hz' must divide the agent's 250 Hz step into whole steps (250, 125, 50, 25, 10, ...)");
+    }
+  }
+  return Ok{};
+}
+
+Status DecodeOffboard(const Node& offboard, BrainSpec* brain) {
+  if (offboard.is_null()) return Ok{};
+  yaml::MapReader o(offboard, "offboard");
+  int timeout_ms = 0;
+  int hold_ms = 0;
+  o.Optional("timeout_ms", &timeout_ms).Optional("hold_ms", &hold_ms);
+  SWARMBOX_TRY(o.Finish());
+  if (const Node* t = offboard.Find("timeout_ms")) {
+    if (timeout_ms <= 0) return At(*t, "'timeout_ms' must be > 0 [simulated ms]");
+    brain->offboard.timeout_ms = timeout_ms;
+  }
+  if (const Node* h = offboard.Find("hold_ms")) {
+    if (hold_ms < 0) return At(*h, "'hold_ms' must be >= 0 [simulated ms]");
+    brain->offboard.hold_ms = hold_ms;
+  }
+  return Ok{};
+}
+
+}  // namespace
+
 Result<BrainSpec> DecodeBrain(const Node& node, const SoftwareContext& context) {
   BrainSpec brain;
   brain.mark = node.mark();
@@ -129,70 +210,158 @@ Result<BrainSpec> DecodeBrain(const Node& node, const SoftwareContext& context) 
   auto source = OneSource(node, {"library", "program", "dockerfile", "image"}, "'brain'");
   if (!source) return source.error();
   brain.path = source->value;
-  const Node& key = *source->node;
   if (source->key == "library") {
-    brain.kind = BrainKind::kLibrary;
-    if (brain.name.empty()) {
-      return At(node, "a library brain needs 'name': the SWARMBOX_BRAIN name in the library");
-    }
-    auto path = CheckFile(key, "brain library", brain.path, FileKind::kElfShared,
-                          " (a MODULE library, e.g. swarmbox_add_brain)", context);
-    if (!path) return path.error();
-    brain.host_path = *path;
-    if (args != nullptr && !args->is_null()) {
-      if (!args->is_mapping()) {
-        return At(*args, "'args' of a library brain must be a mapping, e.g. {radius_m: 6} (it becomes --brain-args JSON)");
-      }
-      brain.args = *args;
-    }
+    SWARMBOX_TRY(DecodeLibraryBrain(node, *source->node, args, context, &brain));
   } else {
-    if (const Node* name = node.Find("name")) {
-      return At(*name, "'name' belongs to library brains (a " + source->key + " brain is one program)");
-    }
-    if (source->key == "program") {
-      brain.kind = BrainKind::kProgram;
-      auto path = CheckFile(key, "brain program", brain.path, FileKind::kElfExecutable,
-                            " (it is packed into an image with its shared libraries)", context);
-      if (!path) return path.error();
-      brain.host_path = *path;
-    } else if (source->key == "dockerfile") {
-      brain.kind = BrainKind::kDockerfile;
-      auto path = CheckFile(key, "brain dockerfile", brain.path, FileKind::kOther, "", context);
-      if (!path) return path.error();
-      brain.host_path = *path;
-    } else {
-      brain.kind = BrainKind::kImage;
-      SWARMBOX_TRY(CheckImageReference(key, brain.path));
-    }
-    if (args != nullptr) {
-      auto list = DecodeArgList(*args, "a " + source->key + " brain");
-      if (!list) return list.error();
-      if (!args->is_null()) brain.args = *args;
-    }
+    SWARMBOX_TRY(DecodeProgramBrain(node, *source->node, source->key, args, context, &brain));
   }
-  if (const Node* rate = node.Find("rate_hz")) {
-    const double steps = brain.rate_hz > 0 ? kAgentStepHz / brain.rate_hz : 0;
-    if (!(brain.rate_hz > 0) || brain.rate_hz > kAgentStepHz || std::fabs(steps - std::round(steps)) > 1e-9) {
-      return At(*rate, "'rate_hz' must divide the agent's 250 Hz step into whole steps (250, 125, 50, 25, 10, ...)");
-    }
-  }
-  if (offboard != nullptr && !offboard->is_null()) {
-    yaml::MapReader o(*offboard, "offboard");
-    int timeout_ms = 0;
-    int hold_ms = 0;
-    o.Optional("timeout_ms", &timeout_ms).Optional("hold_ms", &hold_ms);
-    SWARMBOX_TRY(o.Finish());
-    if (const Node* t = offboard->Find("timeout_ms")) {
-      if (timeout_ms <= 0) return At(*t, "'timeout_ms' must be > 0 [simulated ms]");
-      brain.offboard.timeout_ms = timeout_ms;
-    }
-    if (const Node* h = offboard->Find("hold_ms")) {
-      if (hold_ms < 0) return At(*h, "'hold_ms' must be >= 0 [simulated ms]");
-      brain.offboard.hold_ms = hold_ms;
-    }
-  }
+  SWARMBOX_TRY(CheckBrainRate(node, brain));
+  if (offboard != nullptr) SWARMBOX_TRY(DecodeOffboard(*offboard, &brain));
   return brain;
 }
+
+namespace {
+
+Status CheckComponentName(const Node& name_node, const std::string& name, const std::vector<UserComponentSpec>& out,
+                          const std::set<std::string>& taken) {
+  if (!IsComponentName(name)) {
+    return At(name_node, "component name '" + name +
+                             "' must be 1-32 characters of a-z, 0-9, '_', '-', starting with a letter");
+  }
+  for (const UserComponentSpec& other : out) {
+    if (other.name == name) return At(name_node, "component name '" + name + "' is used twice");
+  }
+  if (taken.count(name) > 0) {
+    return At(name_node, "component name '" + name +
+                             "' is taken by the trial (a drone, a drone's brain or sidecar, or one of "
+                             "physics, raft_leader, sim, mesh, drones, sidecars, faults, components, brains, "
+                             "orchestrator, user)");
+  }
+  return Ok{};
+}
+
+// image, program or dockerfile: exactly one.
+Status DecodeComponentSource(const Node& item, const SoftwareContext& context, UserComponentSpec* c) {
+  auto source = OneSource(item, {"image", "program", "dockerfile"}, "component '" + c->name + "'");
+  if (!source) return source.error();
+  c->ref = source->value;
+  if (source->key == "image") {
+    c->source = ComponentSource::kImage;
+    return CheckImageReference(*source->node, c->ref);
+  }
+  if (source->key == "program") {
+    c->source = ComponentSource::kProgram;
+    auto path = CheckFile(*source->node, "component program", c->ref, FileKind::kElfExecutable,
+                          " (it is packed into an image with its shared libraries)", context);
+    if (!path) return path.error();
+    c->host_path = *path;
+    return Ok{};
+  }
+  c->source = ComponentSource::kDockerfile;
+  auto path = CheckFile(*source->node, "component dockerfile", c->ref, FileKind::kOther, "", context);
+  if (!path) return path.error();
+  c->host_path = *path;
+  return Ok{};
+}
+
+Status DecodeComponentEnv(const Node& env, UserComponentSpec* c) {
+  if (env.is_null()) return Ok{};
+  if (!env.is_mapping()) return At(env, "'env' must be a mapping of NAME: value");
+  for (const auto& [key, v] : env.entries()) {
+    const std::string& k = key.scalar();
+    if (!IsEnvName(k)) return At(v, "environment variable name '" + k + "' must be [A-Za-z_][A-Za-z0-9_]*");
+    if (!v.is_scalar()) return At(v, "the value of '" + k + "' must be a string");
+    c->env[k] = v.scalar();
+  }
+  return Ok{};
+}
+
+Status DecodeComponentNetworks(const Node& networks, const TrialSpec& spec, UserComponentSpec* c) {
+  if (networks.is_null()) return Ok{};
+  if (!networks.is_sequence()) return At(networks, "'networks' must be a list of sim, mesh (or empty: none)");
+  for (const Node& n : networks.items()) {
+    const std::string net = n.is_scalar() ? n.scalar() : std::string();
+    if (net != "sim" && net != "mesh") {
+      return At(n, "unknown network '" + net + "' (expected sim, the physics/agents bus, or mesh, the netem radio)");
+    }
+    if (net == "mesh" && spec.radio.model != RadioModel::kNetem) {
+      return At(n, "network 'mesh' exists with radio.model netem only (this trial's radio is the simulated channel)");
+    }
+    for (const std::string& seen : c->networks) {
+      if (seen == net) return At(n, "network '" + net + "' is listed twice");
+    }
+    c->networks.push_back(net);
+  }
+  return Ok{};
+}
+
+// `priority` in range and `ready` a non-empty regular expression.
+Status CheckPriorityAndReady(const Node& item, const UserComponentSpec& c) {
+  if (const Node* p = item.Find("priority");
+      p != nullptr && (c.priority < kMinComponentPriority || c.priority > kMaxComponentPriority)) {
+    return At(*p, "'priority' must be in [" + std::to_string(kMinComponentPriority) + ", " +
+                      std::to_string(kMaxComponentPriority) + "] (the drones are " +
+                      std::to_string(kDronesPriority) + ")");
+  }
+  if (const Node* ready = item.Find("ready")) {
+    if (c.ready.empty()) return At(*ready, "'ready' must not be empty (leave it out: ready once started)");
+    try {
+      std::regex check(c.ready, std::regex::ECMAScript);
+    } catch (const std::regex_error& ex) {
+      return At(*ready, "'ready' is not a valid regular expression: " + std::string(ex.what()));
+    }
+  }
+  return Ok{};
+}
+
+Status DecodeComponentCollect(const Node& collect, UserComponentSpec* c) {
+  if (collect.is_null()) return Ok{};
+  if (!collect.is_sequence()) return At(collect, "'collect' must be a list of absolute paths in the container");
+  std::set<std::string> basenames;
+  for (const Node& p : collect.items()) {
+    const std::string path = p.is_scalar() ? p.scalar() : std::string();
+    const std::string base = std::filesystem::path(path).filename().string();
+    if (path.empty() || path.front() != '/' || base.empty() || base == "." || base == "..") {
+      return At(p, "'collect' paths must be absolute paths of files or folders in the container, such as /tmp/out.csv");
+    }
+    if (!basenames.insert(base).second) {
+      return At(p, "'collect' has two paths named '" + base + "' (both would be components/" + c->name + "/" + base + ")");
+    }
+    c->collect.push_back(path);
+  }
+  return Ok{};
+}
+
+// One item of `components`; `out` holds the ones before it, `taken` the trial's names.
+Result<UserComponentSpec> DecodeComponent(const Node& item, const TrialSpec& spec, const SoftwareContext& context,
+                                          const std::set<std::string>& taken,
+                                          const std::vector<UserComponentSpec>& out) {
+  UserComponentSpec c;
+  c.mark = item.mark();
+  yaml::MapReader r(item, "component");
+  std::string unused;
+  r.Required("name", &c.name).Optional("image", &unused).Optional("program", &unused)
+      .Optional("dockerfile", &unused).Optional("priority", &c.priority).Optional("ready", &c.ready);
+  const Node* args = r.Child("args");
+  const Node* env = r.Child("env");
+  const Node* networks = r.Child("networks");
+  const Node* collect = r.Child("collect");
+  SWARMBOX_TRY(r.Finish());
+  SWARMBOX_TRY(CheckComponentName(*item.Find("name"), c.name, out, taken));
+  SWARMBOX_TRY(DecodeComponentSource(item, context, &c));
+  if (args != nullptr) {
+    auto list = DecodeArgList(*args, "component '" + c.name + "'");
+    if (!list) return list.error();
+    c.args = std::move(*list);
+  }
+  if (env != nullptr) SWARMBOX_TRY(DecodeComponentEnv(*env, &c));
+  if (networks != nullptr) SWARMBOX_TRY(DecodeComponentNetworks(*networks, spec, &c));
+  SWARMBOX_TRY(CheckPriorityAndReady(item, c));
+  if (collect != nullptr) SWARMBOX_TRY(DecodeComponentCollect(*collect, &c));
+  return c;
+}
+
+}  // namespace
 
 Result<std::vector<UserComponentSpec>> DecodeComponents(const Node& node, const TrialSpec& spec,
                                                         const SoftwareContext& context) {
@@ -209,109 +378,9 @@ Result<std::vector<UserComponentSpec>> DecodeComponents(const Node& node, const 
     taken.insert(d.name + "-faults");
   }
   for (const Node& item : node.items()) {
-    UserComponentSpec c;
-    c.mark = item.mark();
-    yaml::MapReader r(item, "component");
-    std::string unused;
-    r.Required("name", &c.name).Optional("image", &unused).Optional("program", &unused)
-        .Optional("dockerfile", &unused).Optional("priority", &c.priority).Optional("ready", &c.ready);
-    const Node* args = r.Child("args");
-    const Node* env = r.Child("env");
-    const Node* networks = r.Child("networks");
-    const Node* collect = r.Child("collect");
-    SWARMBOX_TRY(r.Finish());
-    const Node& name_node = *item.Find("name");
-    if (!IsComponentName(c.name)) {
-      return At(name_node, "component name '" + c.name +
-                               "' must be 1-32 characters of a-z, 0-9, '_', '-', starting with a letter");
-    }
-    for (const UserComponentSpec& other : out) {
-      if (other.name == c.name) return At(name_node, "component name '" + c.name + "' is used twice");
-    }
-    if (taken.count(c.name) > 0) {
-      return At(name_node, "component name '" + c.name +
-                               "' is taken by the trial (a drone, a drone's brain or sidecar, or one of "
-                               "physics, raft_leader, sim, mesh, drones, sidecars, faults, components, brains, "
-                               "orchestrator, user)");
-    }
-    auto source = OneSource(item, {"image", "program", "dockerfile"}, "component '" + c.name + "'");
-    if (!source) return source.error();
-    c.ref = source->value;
-    if (source->key == "image") {
-      c.source = ComponentSource::kImage;
-      SWARMBOX_TRY(CheckImageReference(*source->node, c.ref));
-    } else if (source->key == "program") {
-      c.source = ComponentSource::kProgram;
-      auto path = CheckFile(*source->node, "component program", c.ref, FileKind::kElfExecutable,
-                            " (it is packed into an image with its shared libraries)", context);
-      if (!path) return path.error();
-      c.host_path = *path;
-    } else {
-      c.source = ComponentSource::kDockerfile;
-      auto path = CheckFile(*source->node, "component dockerfile", c.ref, FileKind::kOther, "", context);
-      if (!path) return path.error();
-      c.host_path = *path;
-    }
-    if (args != nullptr) {
-      auto list = DecodeArgList(*args, "component '" + c.name + "'");
-      if (!list) return list.error();
-      c.args = std::move(*list);
-    }
-    if (env != nullptr && !env->is_null()) {
-      if (!env->is_mapping()) return At(*env, "'env' must be a mapping of NAME: value");
-      for (const auto& [key, v] : env->entries()) {
-        const std::string& k = key.scalar();
-        if (!IsEnvName(k)) return At(v, "environment variable name '" + k + "' must be [A-Za-z_][A-Za-z0-9_]*");
-        if (!v.is_scalar()) return At(v, "the value of '" + k + "' must be a string");
-        c.env[k] = v.scalar();
-      }
-    }
-    if (networks != nullptr && !networks->is_null()) {
-      if (!networks->is_sequence()) return At(*networks, "'networks' must be a list of sim, mesh (or empty: none)");
-      for (const Node& n : networks->items()) {
-        const std::string net = n.is_scalar() ? n.scalar() : std::string();
-        if (net != "sim" && net != "mesh") {
-          return At(n, "unknown network '" + net + "' (expected sim, the physics/agents bus, or mesh, the netem radio)");
-        }
-        if (net == "mesh" && spec.radio.model != RadioModel::kNetem) {
-          return At(n, "network 'mesh' exists with radio.model netem only (this trial's radio is the simulated channel)");
-        }
-        for (const std::string& seen : c.networks) {
-          if (seen == net) return At(n, "network '" + net + "' is listed twice");
-        }
-        c.networks.push_back(net);
-      }
-    }
-    if (const Node* p = item.Find("priority");
-        p != nullptr && (c.priority < kMinComponentPriority || c.priority > kMaxComponentPriority)) {
-      return At(*p, "'priority' must be in [" + std::to_string(kMinComponentPriority) + ", " +
-                        std::to_string(kMaxComponentPriority) + "] (the drones are " +
-                        std::to_string(kDronesPriority) + ")");
-    }
-    if (const Node* ready = item.Find("ready")) {
-      if (c.ready.empty()) return At(*ready, "'ready' must not be empty (leave it out: ready once started)");
-      try {
-        std::regex check(c.ready, std::regex::ECMAScript);
-      } catch (const std::regex_error& ex) {
-        return At(*ready, "'ready' is not a valid regular expression: " + std::string(ex.what()));
-      }
-    }
-    if (collect != nullptr && !collect->is_null()) {
-      if (!collect->is_sequence()) return At(*collect, "'collect' must be a list of absolute paths in the container");
-      std::set<std::string> basenames;
-      for (const Node& p : collect->items()) {
-        const std::string path = p.is_scalar() ? p.scalar() : std::string();
-        const std::string base = std::filesystem::path(path).filename().string();
-        if (path.empty() || path.front() != '/' || base.empty() || base == "." || base == "..") {
-          return At(p, "'collect' paths must be absolute paths of files or folders in the container, such as /tmp/out.csv");
-        }
-        if (!basenames.insert(base).second) {
-          return At(p, "'collect' has two paths named '" + base + "' (both would be components/" + c.name + "/" + base + ")");
-        }
-        c.collect.push_back(path);
-      }
-    }
-    out.push_back(std::move(c));
+    auto c = DecodeComponent(item, spec, context, taken, out);
+    if (!c) return c.error();
+    out.push_back(std::move(*c));
   }
   return out;
 }

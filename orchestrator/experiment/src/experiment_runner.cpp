@@ -218,6 +218,70 @@ class Observer final : public ScheduleObserver {
 
 }  // namespace
 
+namespace {
+
+// A pool host's name, images and engine (GET /version; empty when it does not answer).
+Node HostProvenance(const PoolHost& h) {
+  Node host = Node::Mapping();
+  host.Set("name", Str(h.name));
+  Node images = Node::Sequence();
+  for (const std::string& image : {h.images.agent, h.images.physics, h.faults_image}) {
+    if (!image.empty()) images.Append(Str(image));
+  }
+  host.Set("images", std::move(images));
+  docker::EngineVersion engine;
+  if (h.api != nullptr) {
+    if (auto v = h.api->Version()) engine = *v;
+  }
+  host.Set("docker_version", Str(engine.version));
+  host.Set("docker_api_version", Str(engine.api_version));
+  host.Set("kernel", Str(engine.kernel_version));
+  return host;
+}
+
+// From the trials run so far (their result.json): the fault mechanisms used, the rtf achieved.
+void SetTrialsProvenance(const std::vector<report::Provenance>& trials, Node* prov) {
+  std::set<std::string> mechanisms;
+  std::optional<double> rtf_min, rtf_max;
+  for (const report::Provenance& t : trials) {
+    if (!t.fault_mechanism.empty()) mechanisms.insert(t.fault_mechanism);
+    if (t.rtf_achieved) {
+      rtf_min = rtf_min ? std::min(*rtf_min, *t.rtf_achieved) : *t.rtf_achieved;
+      rtf_max = rtf_max ? std::max(*rtf_max, *t.rtf_achieved) : *t.rtf_achieved;
+    }
+  }
+  Node used = Node::Sequence();
+  for (const std::string& m : mechanisms) used.Append(Str(m));
+  prov->Set("fault_mechanisms", std::move(used));
+  auto number = [](const std::optional<double>& v) {
+    return v ? Node::Scalar(report::CsvNumber(*v)) : Node::Null();
+  };
+  prov->Set("rtf_achieved_min", number(rtf_min));
+  prov->Set("rtf_achieved_max", number(rtf_max));
+}
+
+// What every trial shares; each trial's result.json (and results.csv row) has its own engine,
+// fault mechanism and rtf achieved.
+Node ExperimentProvenance(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
+                          const std::vector<report::Provenance>& trials) {
+  const report::Provenance local = report::LocalProvenance();
+  Node prov = Node::Mapping();
+  prov.Set("swarmbox_version", Str(local.swarmbox_version));
+  prov.Set("swarmbox_commit", Str(local.swarmbox_commit));
+  prov.Set("build_type", Str(local.build_type));
+  prov.Set("host_name", Str(local.host_name));
+  std::set<double> rtfs;
+  for (const auto& [id, spec] : plan.specs) rtfs.insert(spec.rtf);
+  prov.Set("rtf_requested", rtfs.size() == 1 ? Node::Scalar(report::CsvNumber(*rtfs.begin())) : Node::Null());
+  Node hosts = Node::Sequence();
+  for (const PoolHost& h : pool) hosts.Append(HostProvenance(h));
+  prov.Set("hosts", std::move(hosts));
+  SetTrialsProvenance(trials, &prov);
+  return prov;
+}
+
+}  // namespace
+
 std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::string>& run_ids,
                            const std::vector<PoolHost>& pool,
                            const std::vector<report::Provenance>& trials) {
@@ -232,56 +296,7 @@ std::string ExperimentJson(const ExperimentPlan& plan, const std::vector<std::st
   Node ids = Node::Sequence();
   for (const std::string& id : run_ids) ids.Append(Str(id));
   doc.Set("run_ids", std::move(ids));
-
-  // What every trial shares; each trial's result.json (and results.csv row) has its own engine,
-  // fault mechanism and rtf achieved.
-  const report::Provenance local = report::LocalProvenance();
-  Node prov = Node::Mapping();
-  prov.Set("swarmbox_version", Str(local.swarmbox_version));
-  prov.Set("swarmbox_commit", Str(local.swarmbox_commit));
-  prov.Set("build_type", Str(local.build_type));
-  prov.Set("host_name", Str(local.host_name));
-  std::set<double> rtfs;
-  for (const auto& [id, spec] : plan.specs) rtfs.insert(spec.rtf);
-  prov.Set("rtf_requested", rtfs.size() == 1 ? Node::Scalar(report::CsvNumber(*rtfs.begin())) : Node::Null());
-  Node hosts = Node::Sequence();
-  for (const PoolHost& h : pool) {
-    Node host = Node::Mapping();
-    host.Set("name", Str(h.name));
-    Node images = Node::Sequence();
-    for (const std::string& image : {h.images.agent, h.images.physics, h.faults_image}) {
-      if (!image.empty()) images.Append(Str(image));
-    }
-    host.Set("images", std::move(images));
-    docker::EngineVersion engine;
-    if (h.api != nullptr) {
-      if (auto v = h.api->Version()) engine = *v;
-    }
-    host.Set("docker_version", Str(engine.version));
-    host.Set("docker_api_version", Str(engine.api_version));
-    host.Set("kernel", Str(engine.kernel_version));
-    hosts.Append(std::move(host));
-  }
-  prov.Set("hosts", std::move(hosts));
-  // From the trials run so far (their result.json): the fault mechanisms used, the rtf achieved.
-  std::set<std::string> mechanisms;
-  std::optional<double> rtf_min, rtf_max;
-  for (const report::Provenance& t : trials) {
-    if (!t.fault_mechanism.empty()) mechanisms.insert(t.fault_mechanism);
-    if (t.rtf_achieved) {
-      rtf_min = rtf_min ? std::min(*rtf_min, *t.rtf_achieved) : *t.rtf_achieved;
-      rtf_max = rtf_max ? std::max(*rtf_max, *t.rtf_achieved) : *t.rtf_achieved;
-    }
-  }
-  Node used = Node::Sequence();
-  for (const std::string& m : mechanisms) used.Append(Str(m));
-  prov.Set("fault_mechanisms", std::move(used));
-  auto number = [](const std::optional<double>& v) {
-    return v ? Node::Scalar(report::CsvNumber(*v)) : Node::Null();
-  };
-  prov.Set("rtf_achieved_min", number(rtf_min));
-  prov.Set("rtf_achieved_max", number(rtf_max));
-  doc.Set("provenance", std::move(prov));
+  doc.Set("provenance", ExperimentProvenance(plan, pool, trials));
   return yaml::EmitJson(doc) + "\n";
 }
 
@@ -374,32 +389,195 @@ Result<std::vector<std::string>> CheckOutFolder(const ExperimentPlan& plan, cons
   return run_ids;
 }
 
-Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
-                                        const ExperimentOptions& options) {
-  auto dir_lock = DirLock::Acquire(options.out_dir);
-  if (!dir_lock) return dir_lock.error();
-  TrialStore store(options.out_dir);
-  const fs::path meta_path = fs::path(options.out_dir) / "experiment.json";
-  auto previous = CheckOutFolder(plan, options.out_dir, options.resume);
-  if (!previous) return previous.error();
-  std::vector<std::string> run_ids = std::move(*previous);
-  ExperimentSummary summary;
-  // What a killed earlier run of this folder left on the hosts (its run ids).
+namespace {
+
+// What a killed earlier run of this folder left on the hosts (its run ids).
+void RemoveEarlierRuns(const std::vector<std::string>& run_ids, const std::vector<PoolHost>& pool,
+                       std::vector<std::string>* problems) {
   for (const std::string& old : run_ids) {
     docker::LabelSelector sel;
     sel.equals[std::string(docker::kLabelRun)] = old;
     for (const PoolHost& h : pool) {
       if (auto removed = docker::RemoveLabelled(*h.api, sel, false);
           removed && !removed->containers.empty()) {
-        summary.problems.push_back("removed " + std::to_string(removed->containers.size()) +
-                                   " containers of the earlier run " + old + " on " + h.name);
+        problems->push_back("removed " + std::to_string(removed->containers.size()) +
+                            " containers of the earlier run " + old + " on " + h.name);
       }
     }
   }
+}
+
+// The printer: redraws in place on a terminal, else prints the board every progress_every_s.
+// Start() and Stop() from the experiment's thread; Stop() draws the board a last time.
+class ProgressPrinter {
+ public:
+  ProgressPrinter(const ExperimentOptions& options, ProgressBoard& board, std::mutex& board_mu, runner::Clock& clock)
+      : options_(options), board_(board), board_mu_(board_mu), clock_(clock) {}
+
+  void Start() {
+    if (options_.progress == nullptr) return;
+    printer_ = std::thread([this] {
+      const auto every = std::chrono::milliseconds(
+          static_cast<long>((options_.progress_tty ? 1.0 : options_.progress_every_s) * 1000));
+      std::unique_lock lock(stop_mu_);
+      while (!stop_) {
+        lock.unlock();
+        Draw();
+        lock.lock();
+        stop_cv_.wait_for(lock, every, [&] { return stop_; });
+      }
+    });
+  }
+
+  void Stop() {
+    if (!printer_.joinable()) return;
+    {
+      std::lock_guard lock(stop_mu_);
+      stop_ = true;
+    }
+    stop_cv_.notify_all();
+    printer_.join();
+    Draw();
+  }
+
+ private:
+  void Draw() {
+    if (options_.progress == nullptr) return;
+    std::vector<std::string> lines;
+    {
+      std::lock_guard lock(board_mu_);
+      lines = board_.Render(clock_.NowS());
+    }
+    std::string out;
+    if (options_.progress_tty && drawn_ > 0) out += "\x1b[" + std::to_string(drawn_) + "A";
+    for (const std::string& l : lines) out += (options_.progress_tty ? "\x1b[2K" : "") + l + "\n";
+    *options_.progress << out << std::flush;
+    drawn_ = lines.size();
+  }
+
+  const ExperimentOptions& options_;
+  ProgressBoard& board_;
+  std::mutex& board_mu_;
+  runner::Clock& clock_;
+  std::mutex stop_mu_;
+  std::condition_variable stop_cv_;
+  bool stop_ = false;
+  std::thread printer_;
+  std::size_t drawn_ = 0;  // lines of the last drawing (the printer's thread, then Stop's)
+};
+
+// One executor per host (and its background remover when asked). The removers are declared
+// before the executors, so they outlive them; each drains its queue when destroyed.
+struct PoolWorkers {
+  std::vector<std::unique_ptr<BackgroundRemover>> removers;
+  std::vector<std::unique_ptr<TrialExecutor>> executors;
+  std::vector<HostWorker*> workers;
+};
+
+PoolWorkers MakePoolWorkers(Session& session, const std::vector<PoolHost>& pool, const ExperimentOptions& options) {
+  PoolWorkers w;
+  for (const PoolHost& h : pool) {
+    BackgroundRemover* remover = nullptr;
+    if (options.remove_in_background) {
+      w.removers.push_back(std::make_unique<BackgroundRemover>(*h.api, h.name));
+      remover = w.removers.back().get();
+    }
+    w.executors.push_back(std::make_unique<TrialExecutor>(session, h, remover));
+    w.workers.push_back(w.executors.back().get());
+  }
+  return w;
+}
+
+// Every removal still queued is carried out before the leftover sweep (and on Ctrl-C too).
+void DrainRemovers(const PoolWorkers& w, std::vector<std::string>* problems) {
+  for (const auto& remover : w.removers) {
+    remover->Drain();
+    for (std::string& p : remover->TakeProblems()) problems->push_back("clean-up: " + std::move(p));
+  }
+}
+
+// Nothing of this run may stay on any host it can still reach.
+void SweepLeftovers(const std::vector<PoolHost>& pool, const std::string& run_id, std::vector<std::string>* problems) {
+  docker::LabelSelector sel;
+  sel.equals[std::string(docker::kLabelRun)] = run_id;
+  for (const PoolHost& h : pool) {
+    if (Status up = h.check(); !up) {
+      problems->push_back("could not check " + h.name + " for leftovers (" + up.error().message() +
+                          "): when it is back, run `swarmbox gc --run " + run_id + "` against it");
+      continue;
+    }
+    auto removed = docker::RemoveLabelled(*h.api, sel, false);
+    if (!removed) {
+      problems->push_back("listing leftovers on " + h.name + ": " + removed.error().ToString());
+    } else if (!removed->containers.empty() || !removed->networks.empty()) {
+      problems->push_back("removed leftovers on " + h.name + ": " + std::to_string(removed->containers.size()) +
+                          " containers, " + std::to_string(removed->networks.size()) + " networks");
+    }
+  }
+}
+
+// The committed trials into *summary (count, outcomes); returns their provenance.
+std::vector<report::Provenance> CountCommitted(const ExperimentPlan& plan, const TrialStore& store,
+                                               ExperimentSummary* summary) {
+  std::vector<report::Provenance> trials;
+  for (const PlannedTrial& t : plan.trials) {
+    if (!store.Done(t.id)) continue;
+    ++summary->committed;
+    if (auto rec = report::ReadTrialFolder(store.TrialDir(t.id))) {
+      summary->outcomes[rec->outcome] += 1;
+      trials.push_back(rec->provenance);
+    }
+  }
+  return trials;
+}
+
+}  // namespace
+
+namespace {
+
+// The folder checked (a fresh one, or the one to resume), what earlier runs of it left on the
+// hosts removed, its staging cleared and experiment.json written; returns every run id of the
+// folder, this one last.
+Result<std::vector<std::string>> OpenOutFolder(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
+                                               const ExperimentOptions& options, TrialStore& store,
+                                               const fs::path& meta_path, ExperimentSummary* summary) {
+  auto previous = CheckOutFolder(plan, options.out_dir, options.resume);
+  if (!previous) return previous.error();
+  std::vector<std::string> run_ids = std::move(*previous);
+  RemoveEarlierRuns(run_ids, pool, &summary->problems);
   SWARMBOX_TRY(store.ClearStaging());
   run_ids.push_back(options.run_id);
   SWARMBOX_TRY(WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids, pool)));
+  return run_ids;
+}
 
+// After the schedule: the leftover sweep, the reports, the counts and experiment.json again, with
+// what the trials' result.json say about their fault mechanism and pace.
+void CloseOutFolder(const ExperimentPlan& plan, const std::vector<PoolHost>& pool, const ExperimentOptions& options,
+                    const TrialStore& store, const fs::path& meta_path, const std::vector<std::string>& run_ids,
+                    std::vector<std::string>& problems, ExperimentSummary* summary) {
+  SweepLeftovers(pool, options.run_id, &problems);
+  summary->problems.insert(summary->problems.end(), problems.begin(), problems.end());
+  if (auto n = WriteReports(options.out_dir, &summary->problems); !n) {
+    summary->problems.push_back("writing results.csv/report.html: " + n.error().ToString());
+  }
+  std::vector<report::Provenance> trials = CountCommitted(plan, store, summary);
+  if (Status s = WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids, pool, trials)); !s) {
+    summary->problems.push_back("writing experiment.json: " + s.error().ToString());
+  }
+}
+
+}  // namespace
+
+Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::vector<PoolHost>& pool,
+                                        const ExperimentOptions& options) {
+  auto dir_lock = DirLock::Acquire(options.out_dir);
+  if (!dir_lock) return dir_lock.error();
+  TrialStore store(options.out_dir);
+  const fs::path meta_path = fs::path(options.out_dir) / "experiment.json";
+  ExperimentSummary summary;
+  auto run_ids = OpenOutFolder(plan, pool, options, store, meta_path, &summary);
+  if (!run_ids) return run_ids.error();
   const std::vector<PlannedTrial> pending = store.Pending(plan.trials);
   summary.total = plan.trials.size();
   summary.done_before = plan.trials.size() - pending.size();
@@ -414,110 +592,18 @@ Result<ExperimentSummary> RunExperiment(const ExperimentPlan& plan, const std::v
   std::mutex board_mu;
   std::vector<std::string> problems;
   Observer observer(session, board, board_mu, problems);
+  ProgressPrinter printer(options, board, board_mu, session.clock);
+  printer.Start();
 
-  // The printer: redraws in place on a terminal, else prints the board every progress_every_s.
-  std::mutex stop_mu;
-  std::condition_variable stop_cv;
-  bool stop = false;
-  std::thread printer;
-  std::size_t drawn = 0;
-  auto draw = [&] {
-    if (options.progress == nullptr) return;
-    std::vector<std::string> lines;
-    {
-      std::lock_guard lock(board_mu);
-      lines = board.Render(session.clock.NowS());
-    }
-    std::string out;
-    if (options.progress_tty && drawn > 0) out += "\x1b[" + std::to_string(drawn) + "A";
-    for (const std::string& l : lines) out += (options.progress_tty ? "\x1b[2K" : "") + l + "\n";
-    *options.progress << out << std::flush;
-    drawn = lines.size();
-  };
-  if (options.progress != nullptr) {
-    printer = std::thread([&] {
-      const auto every = std::chrono::milliseconds(
-          static_cast<long>((options.progress_tty ? 1.0 : options.progress_every_s) * 1000));
-      std::unique_lock lock(stop_mu);
-      while (!stop) {
-        lock.unlock();
-        draw();
-        lock.lock();
-        stop_cv.wait_for(lock, every, [&] { return stop; });
-      }
-    });
-  }
-
-  // Declared before the executors, so they outlive them; each drains its queue when destroyed.
-  std::vector<std::unique_ptr<BackgroundRemover>> removers;
-  std::vector<std::unique_ptr<TrialExecutor>> executors;
-  std::vector<HostWorker*> workers;
-  for (const PoolHost& h : pool) {
-    BackgroundRemover* remover = nullptr;
-    if (options.remove_in_background) {
-      removers.push_back(std::make_unique<BackgroundRemover>(*h.api, h.name));
-      remover = removers.back().get();
-    }
-    executors.push_back(std::make_unique<TrialExecutor>(session, h, remover));
-    workers.push_back(executors.back().get());
-  }
+  PoolWorkers workers = MakePoolWorkers(session, pool, options);
   ScheduleOptions so;
   so.max_attempts = options.max_attempts;
   so.interrupted = options.interrupted;
-  summary.reports = RunSchedule(pending, workers, so, observer);
+  summary.reports = RunSchedule(pending, workers.workers, so, observer);
   (void)store.ClearStaging();  // every attempt has ended: committed, discarded or cancelled
-  // Every removal still queued is carried out before the leftover sweep (and on Ctrl-C too).
-  for (const auto& remover : removers) {
-    remover->Drain();
-    for (std::string& p : remover->TakeProblems()) problems.push_back("clean-up: " + std::move(p));
-  }
-
-  if (printer.joinable()) {
-    {
-      std::lock_guard lock(stop_mu);
-      stop = true;
-    }
-    stop_cv.notify_all();
-    printer.join();
-    draw();
-  }
-
-  // Nothing of this run may stay on any host it can still reach.
-  docker::LabelSelector sel;
-  sel.equals[std::string(docker::kLabelRun)] = options.run_id;
-  for (const PoolHost& h : pool) {
-    if (Status up = h.check(); !up) {
-      problems.push_back("could not check " + h.name + " for leftovers (" + up.error().message() +
-                         "): when it is back, run `swarmbox gc --run " + options.run_id +
-                         "` against it");
-      continue;
-    }
-    auto removed = docker::RemoveLabelled(*h.api, sel, false);
-    if (!removed) {
-      problems.push_back("listing leftovers on " + h.name + ": " + removed.error().ToString());
-    } else if (!removed->containers.empty() || !removed->networks.empty()) {
-      problems.push_back("removed leftovers on " + h.name + ": " +
-                         std::to_string(removed->containers.size()) + " containers, " +
-                         std::to_string(removed->networks.size()) + " networks");
-    }
-  }
-  summary.problems.insert(summary.problems.end(), problems.begin(), problems.end());
-  if (auto n = WriteReports(options.out_dir, &summary.problems); !n) {
-    summary.problems.push_back("writing results.csv/report.html: " + n.error().ToString());
-  }
-  std::vector<report::Provenance> trials;
-  for (const PlannedTrial& t : plan.trials) {
-    if (!store.Done(t.id)) continue;
-    ++summary.committed;
-    if (auto rec = report::ReadTrialFolder(store.TrialDir(t.id))) {
-      summary.outcomes[rec->outcome] += 1;
-      trials.push_back(rec->provenance);
-    }
-  }
-  // experiment.json again, with what the trials' result.json say about their fault mechanism and pace.
-  if (Status s = WriteFileAtomic(meta_path.string(), ExperimentJson(plan, run_ids, pool, trials)); !s) {
-    summary.problems.push_back("writing experiment.json: " + s.error().ToString());
-  }
+  DrainRemovers(workers, &problems);
+  printer.Stop();
+  CloseOutFolder(plan, pool, options, store, meta_path, *run_ids, problems, &summary);
   return summary;
 }
 

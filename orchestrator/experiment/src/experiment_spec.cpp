@@ -43,6 +43,79 @@ Result<std::vector<std::string>> OverridesOf(const Node& mapping, std::string_vi
   return out;
 }
 
+// 'keys': not with 'key', at least one, none empty.
+Status CheckFactorKeys(const Node& node, const Factor& f) {
+  const Node* keys = node.Find("keys");
+  if (keys == nullptr) return Ok{};
+  if (node.Find("key") != nullptr) {
+    return At(*keys, "give 'key' (one trial key per level) or 'keys' (several), not both");
+  }
+  if (f.keys.empty()) return At(*keys, "'keys' must list at least one trial key");
+  for (std::size_t i = 0; i < f.keys.size(); ++i) {
+    if (f.keys[i].empty()) return At(keys->items()[i], "expected a trial key (a.b.c)");
+  }
+  return Ok{};
+}
+
+// A level's overrides and label from its value: one key's value, a list with one value per key,
+// or (without key and keys) a mapping of overrides.
+Status DecodeLevelValue(const Factor& f, const Node& k, const Node& v, Level* level) {
+  if (!f.key.empty()) {
+    level->overrides.push_back(Assignment(f.key, v));
+    level->label = v.is_scalar() ? v.scalar() : std::string(1, level->code);
+  } else if (!f.keys.empty()) {
+    if (!v.is_sequence() || v.items().size() != f.keys.size()) {
+      return At(v, "level '" + k.scalar() + "' must be a list of " + std::to_string(f.keys.size()) +
+                       " values, one per key of 'keys' in that order");
+    }
+    for (std::size_t i = 0; i < f.keys.size(); ++i) level->overrides.push_back(Assignment(f.keys[i], v.items()[i]));
+    const Node& first = v.items().front();
+    level->label = first.is_scalar() ? first.scalar() : std::string(1, level->code);
+  } else {
+    auto o = OverridesOf(v, "a level of a factor without 'key'");
+    if (!o) return o.error();
+    level->overrides = std::move(*o);
+    level->label = std::string(1, level->code);
+  }
+  return Ok{};
+}
+
+// 'levels': one-letter codes, each once, sorted by code.
+Status DecodeLevels(const Node& levels, Factor* f) {
+  if (!levels.is_mapping() || levels.entries().empty()) {
+    return At(levels, "'levels' must be a non-empty mapping of one-letter codes to values");
+  }
+  for (const auto& [k, v] : levels.entries()) {
+    if (!k.is_scalar() || k.scalar().size() != 1 || k.scalar()[0] < 'a' || k.scalar()[0] > 'z') {
+      return At(k, "a level code is one letter a-z, got '" + k.scalar() + "'");
+    }
+    Level level;
+    level.code = k.scalar()[0];
+    if (f->FindLevel(level.code) != nullptr) {
+      return At(k, "level '" + k.scalar() + "' is given twice in factor " + f->name);
+    }
+    SWARMBOX_TRY(DecodeLevelValue(*f, k, v, &level));
+    f->levels.push_back(std::move(level));
+  }
+  std::sort(f->levels.begin(), f->levels.end(),
+            [](const Level& a, const Level& b) { return a.code < b.code; });
+  return Ok{};
+}
+
+// 'labels': names for known level codes.
+Status DecodeLabels(const Node& labels, Factor* f) {
+  if (!labels.is_mapping()) return At(labels, "'labels' must map level codes to names");
+  for (const auto& [k, v] : labels.entries()) {
+    auto level = std::find_if(f->levels.begin(), f->levels.end(), [&](const Level& l) {
+      return k.is_scalar() && k.scalar().size() == 1 && l.code == k.scalar()[0];
+    });
+    if (level == f->levels.end()) return At(k, "label for an unknown level '" + k.scalar() + "'");
+    if (!v.is_scalar()) return At(v, "a label is a plain name");
+    level->label = v.scalar();
+  }
+  return Ok{};
+}
+
 Result<Factor> ParseFactor(const Node& node) {
   Factor f;
   if (!node.is_mapping()) return At(node, "a factor is a mapping {name, key or keys, levels, labels}");
@@ -51,63 +124,13 @@ Result<Factor> ParseFactor(const Node& node) {
   const Node* levels = r.Child("levels", /*required=*/true);
   const Node* labels = r.Child("labels");
   SWARMBOX_TRY(r.Finish());
-  if (const Node* keys = node.Find("keys")) {
-    if (node.Find("key") != nullptr) {
-      return At(*keys, "give 'key' (one trial key per level) or 'keys' (several), not both");
-    }
-    if (f.keys.empty()) return At(*keys, "'keys' must list at least one trial key");
-    for (std::size_t i = 0; i < f.keys.size(); ++i) {
-      if (f.keys[i].empty()) return At(keys->items()[i], "expected a trial key (a.b.c)");
-    }
-  }
+  SWARMBOX_TRY(CheckFactorKeys(node, f));
   if (!IsName(f.name) || f.name.find('.') != std::string::npos) {
     return At(*node.Find("name"), "factor name '" + f.name +
                                       "' must be a-z, 0-9, '-', '_', starting with a letter or digit");
   }
-  if (!levels->is_mapping() || levels->entries().empty()) {
-    return At(*levels, "'levels' must be a non-empty mapping of one-letter codes to values");
-  }
-  for (const auto& [k, v] : levels->entries()) {
-    if (!k.is_scalar() || k.scalar().size() != 1 || k.scalar()[0] < 'a' || k.scalar()[0] > 'z') {
-      return At(k, "a level code is one letter a-z, got '" + k.scalar() + "'");
-    }
-    Level level;
-    level.code = k.scalar()[0];
-    if (f.FindLevel(level.code) != nullptr) {
-      return At(k, "level '" + k.scalar() + "' is given twice in factor " + f.name);
-    }
-    if (!f.key.empty()) {
-      level.overrides.push_back(Assignment(f.key, v));
-      level.label = v.is_scalar() ? v.scalar() : std::string(1, level.code);
-    } else if (!f.keys.empty()) {
-      if (!v.is_sequence() || v.items().size() != f.keys.size()) {
-        return At(v, "level '" + k.scalar() + "' must be a list of " + std::to_string(f.keys.size()) +
-                         " values, one per key of 'keys' in that order");
-      }
-      for (std::size_t i = 0; i < f.keys.size(); ++i) level.overrides.push_back(Assignment(f.keys[i], v.items()[i]));
-      const Node& first = v.items().front();
-      level.label = first.is_scalar() ? first.scalar() : std::string(1, level.code);
-    } else {
-      auto o = OverridesOf(v, "a level of a factor without 'key'");
-      if (!o) return o.error();
-      level.overrides = std::move(*o);
-      level.label = std::string(1, level.code);
-    }
-    f.levels.push_back(std::move(level));
-  }
-  std::sort(f.levels.begin(), f.levels.end(),
-            [](const Level& a, const Level& b) { return a.code < b.code; });
-  if (labels != nullptr) {
-    if (!labels->is_mapping()) return At(*labels, "'labels' must map level codes to names");
-    for (const auto& [k, v] : labels->entries()) {
-      auto level = std::find_if(f.levels.begin(), f.levels.end(), [&](const Level& l) {
-        return k.is_scalar() && k.scalar().size() == 1 && l.code == k.scalar()[0];
-      });
-      if (level == f.levels.end()) return At(k, "label for an unknown level '" + k.scalar() + "'");
-      if (!v.is_scalar()) return At(v, "a label is a plain name");
-      level->label = v.scalar();
-    }
-  }
+  SWARMBOX_TRY(DecodeLevels(*levels, &f));
+  if (labels != nullptr) SWARMBOX_TRY(DecodeLabels(*labels, &f));
   return f;
 }
 
@@ -126,6 +149,71 @@ const Level* Factor::FindLevel(char code) const {
   }
   return nullptr;
 }
+
+namespace {
+
+// 'factors': a non-empty list of distinct {name, key, levels}.
+Status DecodeFactors(const Node& factors, ExperimentSpec* spec) {
+  if (!factors.is_sequence() || factors.items().empty()) {
+    return At(factors, "'factors' must be a non-empty list of {name, key, levels}");
+  }
+  std::set<std::string> names;
+  for (const Node& item : factors.items()) {
+    auto f = ParseFactor(item);
+    if (!f) return f.error();
+    if (!names.insert(f->name).second) {
+      return At(item, "factor '" + f->name + "' is given twice");
+    }
+    spec->factors.push_back(std::move(*f));
+  }
+  return Ok{};
+}
+
+// repetitions, seed and seeds.
+Status DecodeSeeding(const Node& doc, std::optional<std::int64_t> seed, const std::string& seeds, ExperimentSpec* spec) {
+  if (spec->repetitions < 1) {
+    return At(*doc.Find("repetitions"), "'repetitions' must be at least 1");
+  }
+  if (seed) {
+    if (*seed < 0) return At(*doc.Find("seed"), "'seed' must not be negative");
+    spec->seed = static_cast<std::uint64_t>(*seed);
+    spec->seed_given = true;
+  }
+  if (seeds == "paired") {
+    spec->seeds = SeedMode::kPaired;
+  } else if (seeds == "independent") {
+    spec->seeds = SeedMode::kIndependent;
+  } else {
+    return At(*doc.Find("seeds"), "'seeds' is paired or independent, got '" + seeds + "'");
+  }
+  return Ok{};
+}
+
+// The longest trial id must still be a valid trial name; codes and filter patterns fit the factors.
+Status CheckIdsCodesAndFilter(const Node& doc, const Node* filter, const ExperimentSpec& spec) {
+  const std::string longest =
+      TrialId(spec.name, std::string(spec.factors.size(), 'a'), spec.repetitions);
+  if (longest.size() > kMaxTrialName) {
+    return At(*doc.Find("name"), "trial ids like '" + longest + "' exceed " +
+                                     std::to_string(kMaxTrialName) +
+                                     " characters (they name folders and containers): use a "
+                                     "shorter experiment name");
+  }
+  for (const std::string& code : spec.codes) {
+    if (auto s = CheckCode(spec.factors, code); !s) {
+      return At(*doc.Find("codes"), s.error().message());
+    }
+  }
+  for (const std::string& pattern : spec.filter) {
+    if (pattern.size() != spec.factors.size()) {
+      return At(*filter, "filter pattern '" + pattern + "' must have one letter or '?' per factor (" +
+                             std::to_string(spec.factors.size()) + ")");
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace
 
 Result<ExperimentSpec> ParseExperiment(const yaml::Node& doc, std::string_view file) {
   ExperimentSpec spec;
@@ -155,18 +243,7 @@ Result<ExperimentSpec> ParseExperiment(const yaml::Node& doc, std::string_view f
     if (!o) return o.error();
     spec.set = std::move(*o);
   }
-  if (!factors->is_sequence() || factors->items().empty()) {
-    return At(*factors, "'factors' must be a non-empty list of {name, key, levels}");
-  }
-  std::set<std::string> names;
-  for (const Node& item : factors->items()) {
-    auto f = ParseFactor(item);
-    if (!f) return f.error();
-    if (!names.insert(f->name).second) {
-      return At(item, "factor '" + f->name + "' is given twice");
-    }
-    spec.factors.push_back(std::move(*f));
-  }
+  SWARMBOX_TRY(DecodeFactors(*factors, &spec));
   if (filter != nullptr) {
     if (filter->is_scalar()) {
       spec.filter.push_back(filter->scalar());
@@ -174,41 +251,8 @@ Result<ExperimentSpec> ParseExperiment(const yaml::Node& doc, std::string_view f
       return s.error();
     }
   }
-  if (spec.repetitions < 1) {
-    return At(*doc.Find("repetitions"), "'repetitions' must be at least 1");
-  }
-  if (seed) {
-    if (*seed < 0) return At(*doc.Find("seed"), "'seed' must not be negative");
-    spec.seed = static_cast<std::uint64_t>(*seed);
-    spec.seed_given = true;
-  }
-  if (seeds == "paired") {
-    spec.seeds = SeedMode::kPaired;
-  } else if (seeds == "independent") {
-    spec.seeds = SeedMode::kIndependent;
-  } else {
-    return At(*doc.Find("seeds"), "'seeds' is paired or independent, got '" + seeds + "'");
-  }
-  // The longest trial id must still be a valid trial name.
-  const std::string longest =
-      TrialId(spec.name, std::string(spec.factors.size(), 'a'), spec.repetitions);
-  if (longest.size() > kMaxTrialName) {
-    return At(*doc.Find("name"), "trial ids like '" + longest + "' exceed " +
-                                     std::to_string(kMaxTrialName) +
-                                     " characters (they name folders and containers): use a "
-                                     "shorter experiment name");
-  }
-  for (const std::string& code : spec.codes) {
-    if (auto s = CheckCode(spec.factors, code); !s) {
-      return At(*doc.Find("codes"), s.error().message());
-    }
-  }
-  for (const std::string& pattern : spec.filter) {
-    if (pattern.size() != spec.factors.size()) {
-      return At(*filter, "filter pattern '" + pattern + "' must have one letter or '?' per factor (" +
-                             std::to_string(spec.factors.size()) + ")");
-    }
-  }
+  SWARMBOX_TRY(DecodeSeeding(doc, seed, seeds, &spec));
+  SWARMBOX_TRY(CheckIdsCodesAndFilter(doc, filter, spec));
   return spec;
 }
 

@@ -102,86 +102,92 @@ Result<PartitionFault> ParsePartition(const yaml::Node& value) {
   return out;
 }
 
-Result<FaultAction> ParseAction(std::string_view kind, const yaml::Node& value) {
-  if (kind == "radio") {
-    RadioFault out;
-    if (!value.is_mapping()) {
-      return Invalid("expected radio to be a mapping of netem keys (delay_ms, loss, ...)", value.Where());
-    }
-    if (const yaml::Node* t = value.Find("target")) {
-      auto target = ParseTarget(*t);
-      if (!target) return target.error();
-      out.target = std::move(*target);
-    }
-    auto rules = ParseRadioRules(value, "radio", {"target"});
-    if (!rules) return rules.error();
-    out.rules = std::move(*rules);
-    return FaultAction(std::move(out));
+Result<FaultAction> ParseRadioAction(std::string_view /*kind*/, const yaml::Node& value) {
+  RadioFault out;
+  if (!value.is_mapping()) {
+    return Invalid("expected radio to be a mapping of netem keys (delay_ms, loss, ...)", value.Where());
   }
-  if (kind == "partition") {
-    auto p = ParsePartition(value);
-    if (!p) return p.error();
-    return FaultAction(std::move(*p));
-  }
-  if (kind == "kill" || kind == "stop" || kind == "pause" || kind == "restart") {
-    ProcessAction action = kind == "kill"   ? ProcessAction::kKill
-                           : kind == "stop" ? ProcessAction::kStop
-                           : kind == "pause" ? ProcessAction::kPause
-                                             : ProcessAction::kRestart;
-    auto p = ParseProcess(value, action);
-    if (!p) return p.error();
-    return FaultAction(std::move(*p));
-  }
-  if (kind == "gps_dropout") {
-    const yaml::Node* options = nullptr;
-    auto target = ReadShortTarget(value, kind, &options);
-    if (!target) return target.error();
-    if (options != nullptr) {
-      yaml::MapReader r(*options, "gps_dropout");
-      r.Child("target");
-      SWARMBOX_TRY(r.Finish());
-    }
-    return FaultAction(GpsDropout{std::move(*target)});
-  }
-  if (kind == "gps_degrade") {
-    GpsDegrade out;
-    if (!value.is_mapping()) {
-      return Invalid("expected gps_degrade to be a mapping such as {target: scout_1, h_acc_m: 5, v_acc_m: 8}",
-                     value.Where());
-    }
-    yaml::MapReader r(value, "gps_degrade");
-    const yaml::Node* t = r.Child("target", /*required=*/true);
-    r.Required("h_acc_m", &out.h_acc_m).Required("v_acc_m", &out.v_acc_m);
-    SWARMBOX_TRY(r.Finish());
+  if (const yaml::Node* t = value.Find("target")) {
     auto target = ParseTarget(*t);
     if (!target) return target.error();
     out.target = std::move(*target);
-    for (const char* key : {"h_acc_m", "v_acc_m"}) {
-      const double v = std::string_view(key) == "h_acc_m" ? out.h_acc_m : out.v_acc_m;
-      if (!(v > 0.0 && v <= kMaxGpsAccuracyM)) {
-        return Invalid("'" + std::string(key) + "' is the degraded 1-sigma accuracy in metres, in (0, " +
-                           detail::FormatDecimal(kMaxGpsAccuracyM) + "]; got " + detail::FormatDecimal(v) +
-                           " (for no fix at all use gps_dropout)",
-                       value.Find(key)->Where());
-      }
-    }
-    return FaultAction(std::move(out));
   }
-  if (kind == "imu_bias") {
-    ImuBias out;
-    yaml::MapReader r(value, "imu_bias");
-    const yaml::Node* t = r.Child("target", /*required=*/true);
-    r.Optional("accel_mps2", &out.accel_mps2).Optional("gyro_rad_s", &out.gyro_rad_s);
+  auto rules = ParseRadioRules(value, "radio", {"target"});
+  if (!rules) return rules.error();
+  out.rules = std::move(*rules);
+  return FaultAction(std::move(out));
+}
+
+Result<FaultAction> ParsePartitionAction(std::string_view /*kind*/, const yaml::Node& value) {
+  auto p = ParsePartition(value);
+  if (!p) return p.error();
+  return FaultAction(std::move(*p));
+}
+
+// kill, stop, pause, restart.
+Result<FaultAction> ParseProcessAction(std::string_view kind, const yaml::Node& value) {
+  ProcessAction action = kind == "kill"   ? ProcessAction::kKill
+                         : kind == "stop" ? ProcessAction::kStop
+                         : kind == "pause" ? ProcessAction::kPause
+                                           : ProcessAction::kRestart;
+  auto p = ParseProcess(value, action);
+  if (!p) return p.error();
+  return FaultAction(std::move(*p));
+}
+
+Result<FaultAction> ParseGpsDropout(std::string_view kind, const yaml::Node& value) {
+  const yaml::Node* options = nullptr;
+  auto target = ReadShortTarget(value, kind, &options);
+  if (!target) return target.error();
+  if (options != nullptr) {
+    yaml::MapReader r(*options, "gps_dropout");
+    r.Child("target");
     SWARMBOX_TRY(r.Finish());
-    auto target = ParseTarget(*t);
-    if (!target) return target.error();
-    out.target = std::move(*target);
-    if (out.accel_mps2 == std::array<double, 3>{} && out.gyro_rad_s == std::array<double, 3>{}) {
-      return Invalid("imu_bias changes nothing: give accel_mps2 and/or gyro_rad_s", value.Where());
-    }
-    return FaultAction(std::move(out));
   }
-  // wind_gust
+  return FaultAction(GpsDropout{std::move(*target)});
+}
+
+Result<FaultAction> ParseGpsDegrade(std::string_view /*kind*/, const yaml::Node& value) {
+  GpsDegrade out;
+  if (!value.is_mapping()) {
+    return Invalid("expected gps_degrade to be a mapping such as {target: scout_1, h_acc_m: 5, v_acc_m: 8}",
+                   value.Where());
+  }
+  yaml::MapReader r(value, "gps_degrade");
+  const yaml::Node* t = r.Child("target", /*required=*/true);
+  r.Required("h_acc_m", &out.h_acc_m).Required("v_acc_m", &out.v_acc_m);
+  SWARMBOX_TRY(r.Finish());
+  auto target = ParseTarget(*t);
+  if (!target) return target.error();
+  out.target = std::move(*target);
+  for (const char* key : {"h_acc_m", "v_acc_m"}) {
+    const double v = std::string_view(key) == "h_acc_m" ? out.h_acc_m : out.v_acc_m;
+    if (!(v > 0.0 && v <= kMaxGpsAccuracyM)) {
+      return Invalid("'" + std::string(key) + "' is the degraded 1-sigma accuracy in metres, in (0, " +
+                         detail::FormatDecimal(kMaxGpsAccuracyM) + "]; got " + detail::FormatDecimal(v) +
+                         " (for no fix at all use gps_dropout)",
+                     value.Find(key)->Where());
+    }
+  }
+  return FaultAction(std::move(out));
+}
+
+Result<FaultAction> ParseImuBias(std::string_view /*kind*/, const yaml::Node& value) {
+  ImuBias out;
+  yaml::MapReader r(value, "imu_bias");
+  const yaml::Node* t = r.Child("target", /*required=*/true);
+  r.Optional("accel_mps2", &out.accel_mps2).Optional("gyro_rad_s", &out.gyro_rad_s);
+  SWARMBOX_TRY(r.Finish());
+  auto target = ParseTarget(*t);
+  if (!target) return target.error();
+  out.target = std::move(*target);
+  if (out.accel_mps2 == std::array<double, 3>{} && out.gyro_rad_s == std::array<double, 3>{}) {
+    return Invalid("imu_bias changes nothing: give accel_mps2 and/or gyro_rad_s", value.Where());
+  }
+  return FaultAction(std::move(out));
+}
+
+Result<FaultAction> ParseWindGust(std::string_view /*kind*/, const yaml::Node& value) {
   WindGust out;
   yaml::MapReader r(value, "wind_gust");
   r.Required("speed_mps", &out.speed_mps).Optional("direction_deg", &out.direction_deg)
@@ -194,6 +200,20 @@ Result<FaultAction> ParseAction(std::string_view kind, const yaml::Node& value) 
     return Invalid("'direction_deg' must be in [0, 360)", value.Find("direction_deg")->Where());
   }
   return FaultAction(out);
+}
+
+// A fault kind's action parser; any other kind (the caller has checked it) is wind_gust.
+Result<FaultAction> ParseAction(std::string_view kind, const yaml::Node& value) {
+  using Parser = Result<FaultAction> (*)(std::string_view, const yaml::Node&);
+  static constexpr std::pair<std::string_view, Parser> kParsers[] = {
+      {"radio", &ParseRadioAction},     {"partition", &ParsePartitionAction}, {"kill", &ParseProcessAction},
+      {"stop", &ParseProcessAction},    {"pause", &ParseProcessAction},       {"restart", &ParseProcessAction},
+      {"gps_dropout", &ParseGpsDropout}, {"gps_degrade", &ParseGpsDegrade},   {"imu_bias", &ParseImuBias},
+  };
+  for (const auto& [name, parse] : kParsers) {
+    if (kind == name) return parse(kind, value);
+  }
+  return ParseWindGust(kind, value);
 }
 
 Result<Fault> ParseOne(const yaml::Node& node, std::size_t index) {

@@ -152,100 +152,120 @@ Argv Tee(const std::string& chain, const LinkTarget& link, const std::string& pe
                    detail::FormatDecimal(p, 6), "-j", "TEE", "--gateway", link.peer_ipv4.at(peer)});
 }
 
-RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanOptions& o) {
-  RadioPlan plan;
-  plan.mechanism = Mechanism::kUserspace;
+// Rate: tbf for all traffic, htb classes when there are per-destination rules; returns the undo.
+std::vector<Command> PlanUserspaceRate(const Split& s, const LinkTarget& link, std::vector<Command>* apply) {
   const std::string& dev = link.mesh_interface;
-  const std::string out_chain(kRadioChainOut);
-  const std::string in_chain(kRadioChainIn);
-  std::vector<Command> undo_rate, undo_daemons, undo_out, undo_in;
-
-  // Rate: tbf for all traffic, htb classes when there are per-destination rules.
   const bool any_rate = (s.all != nullptr && s.all->spec.rate_kbit) ||
                         std::any_of(s.per.begin(), s.per.end(), [](const RadioRule* r) { return r->spec.rate_kbit.has_value(); });
-  if (any_rate) {
-    if (s.per.empty()) {
-      const double rate_kbit = *s.all->spec.rate_kbit;
-      const double burst_bytes = std::max(1600.0, std::ceil(rate_kbit * 1000.0 / 8.0 / 100.0));  // 10 ms
-      plan.apply.push_back(Cmd(Tc(dev, {"qdisc", "replace", "root", "tbf", "rate", Kbit(rate_kbit), "burst",
-                                        detail::FormatDecimal(burst_bytes, 0), "latency", "500ms"})));
-    } else {
-      AddHtbTree(dev, s, link, /*rate_only=*/true, &plan.apply);
-    }
-    undo_rate.push_back(Cmd(Tc(dev, {"qdisc", "del", "root"})));
+  if (!any_rate) return {};
+  if (s.per.empty()) {
+    const double rate_kbit = *s.all->spec.rate_kbit;
+    const double burst_bytes = std::max(1600.0, std::ceil(rate_kbit * 1000.0 / 8.0 / 100.0));  // 10 ms
+    apply->push_back(Cmd(Tc(dev, {"qdisc", "replace", "root", "tbf", "rate", Kbit(rate_kbit), "burst",
+                                  detail::FormatDecimal(burst_bytes, 0), "latency", "500ms"})));
+  } else {
+    AddHtbTree(dev, s, link, /*rate_only=*/true, apply);
   }
+  return {Cmd(Tc(dev, {"qdisc", "del", "root"}))};
+}
 
-  // Delay: one daemon per delaying rule, queue numbers in rule order (all-traffic rule first).
+// The swarmbox-netemd arguments of a delaying rule on `queue`.
+NetemdArgs DelayDaemonArgs(const RadioRule& r, const LinkTarget& link, const RadioPlanOptions& o, unsigned queue) {
+  NetemdArgs args;
+  args.queue = static_cast<std::uint16_t>(queue);
+  args.delay.delay_us = std::llround(r.spec.delay_ms * 1000.0);
+  args.delay.jitter_us = std::llround(r.spec.jitter_ms * 1000.0);
+  args.delay.distribution = r.spec.distribution;
+  args.delay.correlation = r.spec.correlation;
+  args.delay.reorder = r.spec.reorder;
+  args.delay.reorder_correlation = r.spec.reorder_correlation;
+  args.delay.reorder_gap = r.spec.reorder_gap;
+  args.gilbert_elliott = r.spec.gilbert_elliott;
+  args.corrupt = r.spec.corrupt;
+  args.seed = DaemonSeed(o.seed, link.node, queue);
+  args.queue_maxlen = std::min(NetemLimitPackets(r.spec, link.link_rate_kbit), kNetemdMaxQueueLen);
+  args.pidfile = o.pid_dir + "/swarmbox-netemd-" + std::to_string(queue) + ".pid";
+  args.daemonize = true;
+  return args;
+}
+
+// Delay: one daemon per delaying rule, queue numbers in rule order (all-traffic rule first);
+// *queue_of gets each delaying rule's queue. Returns the undo.
+std::vector<Command> PlanDelayDaemons(const Split& s, const LinkTarget& link, const RadioPlanOptions& o,
+                                      std::map<const RadioRule*, unsigned>* queue_of, std::vector<Command>* apply) {
+  std::vector<Command> undo;
   std::vector<const RadioRule*> ordered;
   if (s.all != nullptr) ordered.push_back(s.all);
   ordered.insert(ordered.end(), s.per.begin(), s.per.end());
-  std::map<const RadioRule*, unsigned> queue_of;
   for (std::size_t i = 0; i < ordered.size(); ++i) {
     const RadioRule* r = ordered[i];
     if (!Delays(r)) continue;
     const unsigned queue = o.first_queue + static_cast<unsigned>(i);
-    queue_of[r] = queue;
-    NetemdArgs args;
-    args.queue = static_cast<std::uint16_t>(queue);
-    args.delay.delay_us = std::llround(r->spec.delay_ms * 1000.0);
-    args.delay.jitter_us = std::llround(r->spec.jitter_ms * 1000.0);
-    args.delay.distribution = r->spec.distribution;
-    args.delay.correlation = r->spec.correlation;
-    args.delay.reorder = r->spec.reorder;
-    args.delay.reorder_correlation = r->spec.reorder_correlation;
-    args.delay.reorder_gap = r->spec.reorder_gap;
-    args.gilbert_elliott = r->spec.gilbert_elliott;
-    args.corrupt = r->spec.corrupt;
-    args.seed = DaemonSeed(o.seed, link.node, queue);
-    args.queue_maxlen = std::min(NetemLimitPackets(r->spec, link.link_rate_kbit), kNetemdMaxQueueLen);
-    args.pidfile = o.pid_dir + "/swarmbox-netemd-" + std::to_string(queue) + ".pid";
-    args.daemonize = true;
-    plan.apply.push_back(Cmd(NetemdRunArgv(o.netemd, args)));
-    undo_daemons.push_back(Cmd(NetemdStopArgv(o.netemd, args.pidfile)));
+    (*queue_of)[r] = queue;
+    const NetemdArgs args = DelayDaemonArgs(*r, link, o, queue);
+    apply->push_back(Cmd(NetemdRunArgv(o.netemd, args)));
+    undo.push_back(Cmd(NetemdStopArgv(o.netemd, args.pidfile)));
   }
+  return undo;
+}
 
-  // Egress chain: per-destination rules first (they win), the all-traffic rule last; a rule's
-  // duplication (TEE) before its NFQUEUE, since an accepted packet leaves the chain.
+// Egress chain: per-destination rules first (they win), the all-traffic rule last; a rule's
+// duplication (TEE) before its NFQUEUE, since an accepted packet leaves the chain. Returns the undo.
+std::vector<Command> PlanEgressChain(const Split& s, const LinkTarget& link,
+                                     const std::map<const RadioRule*, unsigned>& queue_of, std::vector<Command>* apply) {
+  const std::string& dev = link.mesh_interface;
+  const std::string out_chain(kRadioChainOut);
   const bool any_duplicate = Duplicates(s.all) || std::any_of(s.per.begin(), s.per.end(), Duplicates);
-  if (!queue_of.empty() || any_duplicate) {
-    plan.apply.push_back(Cmd(Iptables({"-N", out_chain})));
-    for (const RadioRule* r : s.per) {
-      for (const auto& peer : r->to) {
-        if (Duplicates(r)) plan.apply.push_back(Cmd(Tee(out_chain, link, peer, r->spec.duplicate)));
-        Argv rule = Iptables({"-A", out_chain, "-d", PeerCidr(link, peer)});
-        plan.apply.push_back(Cmd(Delays(r) ? Concat(rule, Nfqueue(queue_of.at(r))) : Concat(rule, {"-j", "RETURN"})));
-      }
+  if (queue_of.empty() && !any_duplicate) return {};
+  apply->push_back(Cmd(Iptables({"-N", out_chain})));
+  for (const RadioRule* r : s.per) {
+    for (const auto& peer : r->to) {
+      if (Duplicates(r)) apply->push_back(Cmd(Tee(out_chain, link, peer, r->spec.duplicate)));
+      Argv rule = Iptables({"-A", out_chain, "-d", PeerCidr(link, peer)});
+      apply->push_back(Cmd(Delays(r) ? Concat(rule, Nfqueue(queue_of.at(r))) : Concat(rule, {"-j", "RETURN"})));
     }
-    if (Duplicates(s.all)) {
-      // Unicast to each known peer (TEE needs a gateway); multicast and broadcast are not duplicated.
-      for (const auto& [peer, ip] : link.peer_ipv4) plan.apply.push_back(Cmd(Tee(out_chain, link, peer, s.all->spec.duplicate)));
-    }
-    if (Delays(s.all)) plan.apply.push_back(Cmd(Concat(Iptables({"-A", out_chain}), Nfqueue(queue_of.at(s.all)))));
-    plan.apply.push_back(Cmd(Iptables({"-I", "OUTPUT", "-o", dev, "-j", out_chain})));
-    undo_out = {Cmd(Iptables({"-D", "OUTPUT", "-o", dev, "-j", out_chain})), Cmd(Iptables({"-F", out_chain})),
-                Cmd(Iptables({"-X", out_chain}))};
   }
+  if (Duplicates(s.all)) {
+    // Unicast to each known peer (TEE needs a gateway); multicast and broadcast are not duplicated.
+    for (const auto& [peer, ip] : link.peer_ipv4) apply->push_back(Cmd(Tee(out_chain, link, peer, s.all->spec.duplicate)));
+  }
+  if (Delays(s.all)) apply->push_back(Cmd(Concat(Iptables({"-A", out_chain}), Nfqueue(queue_of.at(s.all)))));
+  apply->push_back(Cmd(Iptables({"-I", "OUTPUT", "-o", dev, "-j", out_chain})));
+  return {Cmd(Iptables({"-D", "OUTPUT", "-o", dev, "-j", out_chain})), Cmd(Iptables({"-F", out_chain})),
+          Cmd(Iptables({"-X", out_chain}))};
+}
 
-  // Ingress chain: random loss with iptables statistic.
+// Ingress chain: random loss with iptables statistic. Returns the undo.
+std::vector<Command> PlanIngressChain(const Split& s, const LinkTarget& link, std::vector<Command>* apply) {
+  const std::string& dev = link.mesh_interface;
+  const std::string in_chain(kRadioChainIn);
   const bool any_loss = Drops(s.all) || std::any_of(s.per.begin(), s.per.end(), Drops);
-  if (any_loss) {
-    auto drop = [](double p) -> Argv {
-      return {"-m", "statistic", "--mode", "random", "--probability", detail::FormatDecimal(p, 6), "-j", "DROP"};
-    };
-    plan.apply.push_back(Cmd(Iptables({"-N", in_chain})));
-    for (const RadioRule* r : s.per) {
-      for (const auto& peer : r->to) {
-        Argv rule = Iptables({"-A", in_chain, "-s", PeerCidr(link, peer)});
-        plan.apply.push_back(Cmd(Drops(r) ? Concat(rule, drop(r->spec.loss)) : Concat(rule, {"-j", "RETURN"})));
-      }
+  if (!any_loss) return {};
+  auto drop = [](double p) -> Argv {
+    return {"-m", "statistic", "--mode", "random", "--probability", detail::FormatDecimal(p, 6), "-j", "DROP"};
+  };
+  apply->push_back(Cmd(Iptables({"-N", in_chain})));
+  for (const RadioRule* r : s.per) {
+    for (const auto& peer : r->to) {
+      Argv rule = Iptables({"-A", in_chain, "-s", PeerCidr(link, peer)});
+      apply->push_back(Cmd(Drops(r) ? Concat(rule, drop(r->spec.loss)) : Concat(rule, {"-j", "RETURN"})));
     }
-    if (Drops(s.all)) plan.apply.push_back(Cmd(Concat(Iptables({"-A", in_chain}), drop(s.all->spec.loss))));
-    plan.apply.push_back(Cmd(Iptables({"-I", "INPUT", "-i", dev, "-j", in_chain})));
-    undo_in = {Cmd(Iptables({"-D", "INPUT", "-i", dev, "-j", in_chain})), Cmd(Iptables({"-F", in_chain})),
-               Cmd(Iptables({"-X", in_chain}))};
   }
+  if (Drops(s.all)) apply->push_back(Cmd(Concat(Iptables({"-A", in_chain}), drop(s.all->spec.loss))));
+  apply->push_back(Cmd(Iptables({"-I", "INPUT", "-i", dev, "-j", in_chain})));
+  return {Cmd(Iptables({"-D", "INPUT", "-i", dev, "-j", in_chain})), Cmd(Iptables({"-F", in_chain})),
+          Cmd(Iptables({"-X", in_chain}))};
+}
 
-  for (auto* part : {&undo_in, &undo_out, &undo_daemons, &undo_rate}) {
+RadioPlan PlanUserspace(const Split& s, const LinkTarget& link, const RadioPlanOptions& o) {
+  RadioPlan plan;
+  plan.mechanism = Mechanism::kUserspace;
+  std::map<const RadioRule*, unsigned> queue_of;
+  const std::vector<Command> undo_rate = PlanUserspaceRate(s, link, &plan.apply);
+  const std::vector<Command> undo_daemons = PlanDelayDaemons(s, link, o, &queue_of, &plan.apply);
+  const std::vector<Command> undo_out = PlanEgressChain(s, link, queue_of, &plan.apply);
+  const std::vector<Command> undo_in = PlanIngressChain(s, link, &plan.apply);
+  for (const auto* part : {&undo_in, &undo_out, &undo_daemons, &undo_rate}) {
     plan.undo.insert(plan.undo.end(), part->begin(), part->end());
   }
   return plan;

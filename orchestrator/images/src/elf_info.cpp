@@ -69,41 +69,41 @@ bool LooksLikeElf(std::string_view bytes) {
   return bytes.size() >= 4 && std::memcmp(bytes.data(), "\x7f" "ELF", 4) == 0;
 }
 
-Result<ElfInfo> ReadElfInfo(std::string_view bytes, std::string_view what) {
-  auto bad = [&](std::string_view why) {
-    return Error(ErrorCode::kInvalidArgument, "not a usable ELF file: " + std::string(why),
-                 std::string(what));
-  };
-  if (!LooksLikeElf(bytes)) return bad("no ELF magic");
-  if (bytes.size() < 52) return bad("truncated ELF header");
-  const auto cls = static_cast<unsigned char>(bytes[4]);
-  const auto data = static_cast<unsigned char>(bytes[5]);
-  if ((cls != 1 && cls != 2) || (data != 1 && data != 2)) return bad("unknown ELF class or data");
-  ElfInfo info;
-  info.is_64 = cls == 2;
-  const Reader r(bytes, data == 1);
-  const std::size_t word = info.is_64 ? 8 : 4;
+namespace {
 
+// The helpers below return why the file is unusable, or nullptr.
+using Failure = const char*;
+
+// e_type and e_machine into *info; the program header table's place.
+struct ProgramHeaders {
+  std::uint64_t offset = 0;
+  std::uint64_t entry_size = 0;
+  std::uint64_t count = 0;
+};
+
+Failure ReadFileHeader(const Reader& r, ElfInfo* info, ProgramHeaders* ph) {
+  const std::size_t word = info->is_64 ? 8 : 4;
   const auto e_type = r.Read(16, 2);
   const auto e_machine = r.Read(18, 2);
-  const auto e_phoff = r.Read(info.is_64 ? 32 : 28, word);
-  const auto e_phentsize = r.Read(info.is_64 ? 54 : 42, 2);
-  const auto e_phnum = r.Read(info.is_64 ? 56 : 44, 2);
-  if (!e_type || !e_machine || !e_phoff || !e_phentsize || !e_phnum) {
-    return bad("truncated ELF header");
-  }
-  info.kind = *e_type == 2   ? ElfInfo::Kind::kExecutable
-              : *e_type == 3 ? ElfInfo::Kind::kSharedObject
-                             : ElfInfo::Kind::kOther;
-  info.machine = static_cast<std::uint16_t>(*e_machine);
+  const auto e_phoff = r.Read(info->is_64 ? 32 : 28, word);
+  const auto e_phentsize = r.Read(info->is_64 ? 54 : 42, 2);
+  const auto e_phnum = r.Read(info->is_64 ? 56 : 44, 2);
+  if (!e_type || !e_machine || !e_phoff || !e_phentsize || !e_phnum) return "truncated ELF header";
+  info->kind = *e_type == 2   ? ElfInfo::Kind::kExecutable
+               : *e_type == 3 ? ElfInfo::Kind::kSharedObject
+                              : ElfInfo::Kind::kOther;
+  info->machine = static_cast<std::uint16_t>(*e_machine);
+  *ph = {*e_phoff, *e_phentsize, *e_phnum};
+  return nullptr;
+}
 
-  std::vector<Segment> segments;
-  for (std::uint64_t i = 0; i < *e_phnum; ++i) {
-    const std::uint64_t ph = *e_phoff + i * *e_phentsize;
+Failure ReadSegments(const Reader& r, bool is_64, const ProgramHeaders& table, std::vector<Segment>* segments) {
+  for (std::uint64_t i = 0; i < table.count; ++i) {
+    const std::uint64_t ph = table.offset + i * table.entry_size;
     Segment s;
     const auto type = r.Read(ph, 4);
     std::optional<std::uint64_t> offset, vaddr, filesz;
-    if (info.is_64) {
+    if (is_64) {
       offset = r.Read(ph + 8, 8);
       vaddr = r.Read(ph + 16, 8);
       filesz = r.Read(ph + 32, 8);
@@ -112,58 +112,92 @@ Result<ElfInfo> ReadElfInfo(std::string_view bytes, std::string_view what) {
       vaddr = r.Read(ph + 8, 4);
       filesz = r.Read(ph + 16, 4);
     }
-    if (!type || !offset || !vaddr || !filesz) return bad("program header table out of bounds");
+    if (!type || !offset || !vaddr || !filesz) return "program header table out of bounds";
     s.type = static_cast<std::uint32_t>(*type);
     s.offset = *offset;
     s.vaddr = *vaddr;
     s.filesz = *filesz;
-    segments.push_back(s);
+    segments->push_back(s);
   }
+  return nullptr;
+}
 
-  auto vaddr_to_offset = [&](std::uint64_t vaddr) -> std::optional<std::uint64_t> {
-    for (const Segment& s : segments) {
-      if (s.type == kPtLoad && vaddr >= s.vaddr && vaddr < s.vaddr + s.filesz) {
-        return s.offset + (vaddr - s.vaddr);
-      }
+std::optional<std::uint64_t> VaddrToOffset(const std::vector<Segment>& segments, std::uint64_t vaddr) {
+  for (const Segment& s : segments) {
+    if (s.type == kPtLoad && vaddr >= s.vaddr && vaddr < s.vaddr + s.filesz) {
+      return s.offset + (vaddr - s.vaddr);
     }
-    return std::nullopt;
-  };
+  }
+  return std::nullopt;
+}
 
+Failure ReadInterpreter(const Reader& r, const std::vector<Segment>& segments, ElfInfo* info) {
   for (const Segment& s : segments) {
     if (s.type == kPtInterp) {
       auto interp = r.CString(s.offset);
-      if (!interp) return bad("PT_INTERP out of bounds");
-      info.interpreter = *interp;
+      if (!interp) return "PT_INTERP out of bounds";
+      info->interpreter = *interp;
     }
   }
+  return nullptr;
+}
+
+// One PT_DYNAMIC segment: DT_NEEDED, DT_RUNPATH, DT_RPATH and DT_SONAME into *info.
+Failure ReadDynamicSegment(const Reader& r, const Segment& s, const std::vector<Segment>& segments, ElfInfo* info) {
+  const std::size_t word = info->is_64 ? 8 : 4;
+  info->dynamic = true;
+  const std::size_t entry = 2 * word;
+  std::vector<std::pair<std::int64_t, std::uint64_t>> dyn;
+  std::optional<std::uint64_t> strtab;
+  for (std::uint64_t off = s.offset; off + entry <= s.offset + s.filesz; off += entry) {
+    const auto tag = r.Read(off, word);
+    const auto val = r.Read(off + word, word);
+    if (!tag || !val) return "dynamic section out of bounds";
+    const auto t = static_cast<std::int64_t>(*tag);
+    if (t == kDtNull) break;
+    if (t == kDtStrtab) strtab = VaddrToOffset(segments, *val);
+    dyn.emplace_back(t, *val);
+  }
+  if (!strtab) return dyn.empty() ? nullptr : "dynamic section without a string table";
+  for (const auto& [tag, val] : dyn) {
+    if (tag != kDtNeeded && tag != kDtRunpath && tag != kDtRpath && tag != kDtSoname) continue;
+    auto text = r.CString(*strtab + val);
+    if (!text) return "dynamic string out of bounds";
+    if (tag == kDtNeeded) info->needed.push_back(*text);
+    if (tag == kDtRunpath) info->runpath = SplitColon(*text);
+    if (tag == kDtRpath) info->rpath = SplitColon(*text);
+    if (tag == kDtSoname) info->soname = *text;
+  }
+  return nullptr;
+}
+
+// The ELF file's header, program headers, interpreter and dynamic section into *info.
+Failure ReadElf(std::string_view bytes, ElfInfo* info) {
+  if (!LooksLikeElf(bytes)) return "no ELF magic";
+  if (bytes.size() < 52) return "truncated ELF header";
+  const auto cls = static_cast<unsigned char>(bytes[4]);
+  const auto data = static_cast<unsigned char>(bytes[5]);
+  if ((cls != 1 && cls != 2) || (data != 1 && data != 2)) return "unknown ELF class or data";
+  info->is_64 = cls == 2;
+  const Reader r(bytes, data == 1);
+  ProgramHeaders table;
+  if (Failure f = ReadFileHeader(r, info, &table)) return f;
+  std::vector<Segment> segments;
+  if (Failure f = ReadSegments(r, info->is_64, table, &segments)) return f;
+  if (Failure f = ReadInterpreter(r, segments, info)) return f;
   for (const Segment& s : segments) {
     if (s.type != kPtDynamic) continue;
-    info.dynamic = true;
-    const std::size_t entry = 2 * word;
-    std::vector<std::pair<std::int64_t, std::uint64_t>> dyn;
-    std::optional<std::uint64_t> strtab;
-    for (std::uint64_t off = s.offset; off + entry <= s.offset + s.filesz; off += entry) {
-      const auto tag = r.Read(off, word);
-      const auto val = r.Read(off + word, word);
-      if (!tag || !val) return bad("dynamic section out of bounds");
-      const auto t = static_cast<std::int64_t>(*tag);
-      if (t == kDtNull) break;
-      if (t == kDtStrtab) strtab = vaddr_to_offset(*val);
-      dyn.emplace_back(t, *val);
-    }
-    if (!strtab) {
-      if (dyn.empty()) continue;
-      return bad("dynamic section without a string table");
-    }
-    for (const auto& [tag, val] : dyn) {
-      if (tag != kDtNeeded && tag != kDtRunpath && tag != kDtRpath && tag != kDtSoname) continue;
-      auto text = r.CString(*strtab + val);
-      if (!text) return bad("dynamic string out of bounds");
-      if (tag == kDtNeeded) info.needed.push_back(*text);
-      if (tag == kDtRunpath) info.runpath = SplitColon(*text);
-      if (tag == kDtRpath) info.rpath = SplitColon(*text);
-      if (tag == kDtSoname) info.soname = *text;
-    }
+    if (Failure f = ReadDynamicSegment(r, s, segments, info)) return f;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+Result<ElfInfo> ReadElfInfo(std::string_view bytes, std::string_view what) {
+  ElfInfo info;
+  if (Failure why = ReadElf(bytes, &info)) {
+    return Error(ErrorCode::kInvalidArgument, "not a usable ELF file: " + std::string(why), std::string(what));
   }
   return info;
 }

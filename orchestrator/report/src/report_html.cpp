@@ -198,21 +198,25 @@ std::string StandalonePlotSvg(const ReportPlot& plot) {
          svg.substr(open_end + 1) + "\n";
 }
 
-std::string ReportHtml(std::string_view title, const std::vector<std::string>& factors,
-                       const std::vector<TrialRecord>& records) {
-  std::string h =
-      "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" + HtmlEscape(title) +
-      "</title>\n<style>body{font-family:sans-serif;margin:2em;color:#222}"
-      "table{border-collapse:collapse;margin:.5em 0 1.5em}td,th{border:1px solid #ccc;"
-      "padding:3px 8px;text-align:left;font-size:13px}th{background:#f3f3f3}"
-      ".success{color:#1a7f37}.failure{color:#b42318}.timeout{color:#b54708}.error{color:#6941c6}"
-      "svg.box text{font-size:11px;fill:#333}svg.box .n{fill:#777}.grid{stroke:#eee}"
-      ".whisker{stroke:#555}.iqr{fill:#cfe2ff;stroke:#1f4e9c}.median{stroke:#1f4e9c;"
-      "stroke-width:2}.outlier{fill:none;stroke:#b42318}.plots{display:flex;flex-wrap:wrap;"
-      "gap:1.5em}.plots figure{margin:0}figcaption{font-size:13px;color:#555}"
-      "img.thumb{width:90px;height:90px;object-fit:contain;border:1px solid #ddd}</style>"
-      "</head><body>\n<h1>" + HtmlEscape(title) + "</h1>\n";
+namespace {
 
+std::string HtmlHead(std::string_view title) {
+  return "<!DOCTYPE html>\n<html><head><meta charset='utf-8'><title>" + HtmlEscape(title) +
+         "</title>\n<style>body{font-family:sans-serif;margin:2em;color:#222}"
+         "table{border-collapse:collapse;margin:.5em 0 1.5em}td,th{border:1px solid #ccc;"
+         "padding:3px 8px;text-align:left;font-size:13px}th{background:#f3f3f3}"
+         ".success{color:#1a7f37}.failure{color:#b42318}.timeout{color:#b54708}.error{color:#6941c6}"
+         "svg.box text{font-size:11px;fill:#333}svg.box .n{fill:#777}.grid{stroke:#eee}"
+         ".whisker{stroke:#555}.iqr{fill:#cfe2ff;stroke:#1f4e9c}.median{stroke:#1f4e9c;"
+         "stroke-width:2}.outlier{fill:none;stroke:#b42318}.plots{display:flex;flex-wrap:wrap;"
+         "gap:1.5em}.plots figure{margin:0}figcaption{font-size:13px;color:#555}"
+         "img.thumb{width:90px;height:90px;object-fit:contain;border:1px solid #ddd}</style>"
+         "</head><body>\n<h1>" + HtmlEscape(title) + "</h1>\n";
+}
+
+// The outcome totals, then a table of outcomes per level of each factor.
+std::string OutcomesSection(const std::vector<std::string>& factors, const std::vector<TrialRecord>& records) {
+  std::string h;
   std::map<std::string, int> totals;
   for (const TrialRecord& r : records) totals[r.outcome] += 1;
   h += "<p>" + std::to_string(records.size()) + " trials:";
@@ -235,8 +239,12 @@ std::string ReportHtml(std::string_view title, const std::vector<std::string>& f
     }
     h += "</table>\n";
   }
+  return h;
+}
 
-  h += "<h2>Metrics per factor level</h2>\n";
+// The box plots of each metric by each factor.
+std::string MetricsSection(const std::vector<std::string>& factors, const std::vector<TrialRecord>& records) {
+  std::string h = "<h2>Metrics per factor level</h2>\n";
   const std::vector<ReportPlot> plots = ReportPlots(factors, records);
   for (std::size_t k = 0; k < plots.size(); ++k) {
     if (k == 0 || plots[k].metric != plots[k - 1].metric) {
@@ -252,36 +260,51 @@ std::string ReportHtml(std::string_view title, const std::vector<std::string>& f
            std::any_of(r.metrics.begin(), r.metrics.end(), [](const auto& kv) { return kv.second.has_value(); });
   });
   if (!any_metric) h += "<p>No trial reported a metric.</p>\n";
+  return h;
+}
 
-  h += "<h2>Trials</h2>\n<table><tr><th>trial</th><th>code</th>";
+// One row of the trials table: links, levels, result, plots and the trajectories' thumbnail.
+std::string TrialRow(const std::vector<std::string>& factors, const TrialRecord& r) {
+  const std::string folder = HtmlEscape(r.folder);
+  std::string h = "<tr><td><a href='" + folder + "/'>" + HtmlEscape(r.meta.id) + "</a> (<a href='" +
+                  folder + "/logs/'>logs</a>, <a href='" + folder + "/result.json'>result</a>)</td><td>" +
+                  HtmlEscape(r.meta.code) + "</td>";
+  for (std::size_t i = 0; i < factors.size(); ++i) {
+    h += "<td>" + (i < r.meta.levels.size() ? HtmlEscape(r.meta.levels[i]) : "") + "</td>";
+  }
+  h += "<td>" + std::to_string(r.meta.repetition) + "</td><td>" + std::to_string(r.meta.seed) +
+       "</td><td>" + HtmlEscape(r.host) + "</td><td class='" + HtmlEscape(r.outcome) + "'>" +
+       HtmlEscape(r.outcome) + "</td><td>" + HtmlEscape(r.reason) + "</td><td>" +
+       (r.wall_s ? CsvNumber(*r.wall_s) : "") + "</td><td>" +
+       (r.sim_s ? CsvNumber(*r.sim_s) : "") + "</td><td>";
+  h += r.has_plots ? "<a href='" + folder + "/plots.html'>plots</a>" : std::string("none");
+  h += "</td><td>";
+  if (r.has_trajectories) {
+    h += "<a href='" + folder + "/trajectories.png'><img class='thumb' loading='lazy' src='" +
+         folder + "/trajectories.png' alt='trajectories of " + HtmlEscape(r.meta.id) + "'></a>";
+  } else {
+    h += "none";
+  }
+  h += "</td></tr>\n";
+  return h;
+}
+
+std::string TrialsSection(const std::vector<std::string>& factors, const std::vector<TrialRecord>& records) {
+  std::string h = "<h2>Trials</h2>\n<table><tr><th>trial</th><th>code</th>";
   for (const std::string& f : factors) h += "<th>" + HtmlEscape(f) + "</th>";
   h += "<th>rep</th><th>seed</th><th>host</th><th>outcome</th><th>reason</th><th>wall s</th>"
        "<th>sim s</th><th>over time</th><th>trajectories</th></tr>\n";
-  for (const TrialRecord& r : records) {
-    const std::string folder = HtmlEscape(r.folder);
-    h += "<tr><td><a href='" + folder + "/'>" + HtmlEscape(r.meta.id) + "</a> (<a href='" +
-         folder + "/logs/'>logs</a>, <a href='" + folder + "/result.json'>result</a>)</td><td>" +
-         HtmlEscape(r.meta.code) + "</td>";
-    for (std::size_t i = 0; i < factors.size(); ++i) {
-      h += "<td>" + (i < r.meta.levels.size() ? HtmlEscape(r.meta.levels[i]) : "") + "</td>";
-    }
-    h += "<td>" + std::to_string(r.meta.repetition) + "</td><td>" + std::to_string(r.meta.seed) +
-         "</td><td>" + HtmlEscape(r.host) + "</td><td class='" + HtmlEscape(r.outcome) + "'>" +
-         HtmlEscape(r.outcome) + "</td><td>" + HtmlEscape(r.reason) + "</td><td>" +
-         (r.wall_s ? CsvNumber(*r.wall_s) : "") + "</td><td>" +
-         (r.sim_s ? CsvNumber(*r.sim_s) : "") + "</td><td>";
-    h += r.has_plots ? "<a href='" + folder + "/plots.html'>plots</a>" : std::string("none");
-    h += "</td><td>";
-    if (r.has_trajectories) {
-      h += "<a href='" + folder + "/trajectories.png'><img class='thumb' loading='lazy' src='" +
-           folder + "/trajectories.png' alt='trajectories of " + HtmlEscape(r.meta.id) + "'></a>";
-    } else {
-      h += "none";
-    }
-    h += "</td></tr>\n";
-  }
-  h += "</table>\n</body></html>\n";
+  for (const TrialRecord& r : records) h += TrialRow(factors, r);
+  h += "</table>\n";
   return h;
+}
+
+}  // namespace
+
+std::string ReportHtml(std::string_view title, const std::vector<std::string>& factors,
+                       const std::vector<TrialRecord>& records) {
+  return HtmlHead(title) + OutcomesSection(factors, records) + MetricsSection(factors, records) +
+         TrialsSection(factors, records) + "</body></html>\n";
 }
 
 }  // namespace swarmbox::report

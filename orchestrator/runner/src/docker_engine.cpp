@@ -215,8 +215,10 @@ void DockerEngine::CreateAhead(dsl::Plugin& plugin, int priority, bool cancelled
   creates_.Finished(priority, promise, v);
 }
 
-Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
-  const dsl::ContainerSpec& s = plugin.spec();
+namespace {
+
+// The plugin's container as the Docker API creates it, networks aside.
+docker::ContainerSpec ContainerSpecOf(const dsl::ContainerSpec& s) {
   docker::ContainerSpec spec;
   spec.name = s.name;
   spec.image = s.image;
@@ -245,10 +247,19 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
   }
   spec.resources.memory_bytes = s.memory_mib << 20;
   spec.resources.pids_limit = s.pids_limit;
-  std::unique_lock lock(mu_);
+  return spec;
+}
+
+// The network mode and networks of *spec from the containers and networks created so far
+// (component id -> Docker id); a verdict when the plugin names one that was not created or
+// combines them wrongly.
+std::optional<Verdict> AttachNetworks(const dsl::Plugin& plugin, const std::map<std::string, std::string>& container_ids,
+                                      const std::map<std::string, std::string>& network_ids,
+                                      docker::ContainerSpec* spec) {
+  const dsl::ContainerSpec& s = plugin.spec();
   if (!s.network_of.empty()) {
-    auto owner = container_ids_.find(s.network_of);
-    if (owner == container_ids_.end()) {
+    auto owner = container_ids.find(s.network_of);
+    if (owner == container_ids.end()) {
       return Verdict::Err("the network namespace of " + plugin.id() + " belongs to '" + s.network_of +
                               "', which was not created",
                           plugin.Path());
@@ -258,22 +269,32 @@ Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
                               ": it can have no networks or hostname of its own",
                           plugin.Path());
     }
-    spec.network_mode = "container:" + owner->second;
+    spec->network_mode = "container:" + owner->second;
   }
   if (s.no_network) {
     if (!s.networks.empty() || !s.network_of.empty()) {
       return Verdict::Err(plugin.id() + " has no network: it can join none", plugin.Path());
     }
-    spec.network_mode = "none";
+    spec->network_mode = "none";
   }
   for (const dsl::Attachment& a : s.networks) {
-    auto it = network_ids_.find(a.network);
-    if (it == network_ids_.end()) {
+    auto it = network_ids.find(a.network);
+    if (it == network_ids.end()) {
       return Verdict::Err("network '" + a.network + "' of " + plugin.id() + " was not created",
                           plugin.Path());
     }
-    spec.networks.push_back({it->second, a.ipv4, a.aliases});
+    spec->networks.push_back({it->second, a.ipv4, a.aliases});
   }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Verdict DockerEngine::CreateNow(dsl::Plugin& plugin) {
+  const dsl::ContainerSpec& s = plugin.spec();
+  docker::ContainerSpec spec = ContainerSpecOf(s);
+  std::unique_lock lock(mu_);
+  if (auto refused = AttachNetworks(plugin, container_ids_, network_ids_, &spec)) return *refused;
   lock.unlock();
   auto id = api_.CreateContainer(spec);
   if (!id) {

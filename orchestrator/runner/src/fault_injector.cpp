@@ -114,6 +114,18 @@ faults::RadioPlanOptions FaultInjector::PlanOptions() const {
 Verdict FaultInjector::Setup() {
   if (set_up_) return Verdict::Success();
   set_up_ = true;
+  if (auto done = CheckSetupNeeds()) return *done;
+  auto mech = DetectMechanismOnce();
+  if (!mech) return Verdict::FromError(mech.error(), "faults");
+  // Refuse, before any agent starts, what this host's mechanism cannot honour.
+  if (Status s = CheckMechanismHonours(*mech); !s) return Verdict::FromError(s.error(), "faults");
+  if (config_.mesh.empty()) return Verdict::Success();
+  return ApplyMesh(*mech);
+}
+
+// A physics fault needs the physics container; network faults need a sidecar per drone on the
+// mesh. Without network faults and sidecars there is nothing more to set up (success).
+std::optional<Verdict> FaultInjector::CheckSetupNeeds() const {
   for (const faults::Fault& f : config_.faults) {
     if (faults::IsPhysicsFault(f) && (config_.physics_container.empty() || !config_.physics_command_argv)) {
       return Verdict::Err("fault " + f.id + " (" + std::string(f.kind()) + ", " + f.mark.ToString() +
@@ -137,42 +149,48 @@ Verdict FaultInjector::Setup() {
       return Verdict::Err("drone " + d + " has no fault sidecar on the mesh network", "faults");
     }
   }
+  return std::nullopt;
+}
 
+// The host's mechanism (probed in the first drone's sidecar, once per host) into mechanism_, and
+// its event.
+Result<faults::Mechanism> FaultInjector::DetectMechanismOnce() {
   const std::string& probe_drone = config_.drones.front();
   bool detected_now = false;
   auto mech = mechanisms_->Get(config_.host, [&]() {
     detected_now = true;
     return faults::DetectMechanism(Sidecar(probe_drone));
   });
-  if (!mech) {
-    return Verdict::FromError(mech.error().Context("detecting the netem mechanism in the sidecar of " +
-                                                   probe_drone),
-                              "faults");
-  }
+  if (!mech) return mech.error().Context("detecting the netem mechanism in the sidecar of " + probe_drone);
   mechanism_ = *mech;
   if (events_) events_(MechanismEventJson(config_.host, *mech, !detected_now, wall_s_ ? wall_s_() : 0.0));
+  return *mech;
+}
 
-  // Refuse, before any agent starts, what this host's mechanism cannot honour.
-  if (Status s = faults::CheckMechanismSupports(config_.mesh.rules, *mech); !s) {
-    return Verdict::FromError(s.error().Context("network.mesh"), "faults");
+Status FaultInjector::CheckMechanismHonours(faults::Mechanism mech) const {
+  if (Status s = faults::CheckMechanismSupports(config_.mesh.rules, mech); !s) {
+    return s.error().Context("network.mesh");
   }
   for (const faults::Fault& f : config_.faults) {
     if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) {
-      if (Status s = faults::CheckMechanismSupports(radio->rules, *mech); !s) {
-        return Verdict::FromError(s.error().Context("fault " + f.id), "faults");
+      if (Status s = faults::CheckMechanismSupports(radio->rules, mech); !s) {
+        return s.error().Context("fault " + f.id);
       }
     }
   }
+  return Ok{};
+}
 
-  if (config_.mesh.empty()) return Verdict::Success();
-  // Every sidecar at once (each is a few docker exec round trips); results recorded in trial order.
-  const std::string mechanism_name(faults::MechanismName(*mech));
+// network.mesh on every sidecar at once (each is a few docker exec round trips); results
+// recorded in trial order, the first failure the verdict.
+Verdict FaultInjector::ApplyMesh(faults::Mechanism mech) {
+  const std::string mechanism_name(faults::MechanismName(mech));
   std::vector<std::pair<std::string, std::future<Status>>> jobs;
   for (const std::string& drone : config_.drones) {
     const auto rules = layers_.Effective(drone);
     installed_[drone] = rules;  // partly applied counts: teardown undoes it (undo may fail)
     faults::CommandRunner& sidecar = Sidecar(drone);
-    auto plan = faults::PlanRadio(rules, LinkOf(drone), *mech, PlanOptions());
+    auto plan = faults::PlanRadio(rules, LinkOf(drone), mech, PlanOptions());
     if (!plan) {
       std::promise<Status> failed;
       failed.set_value(plan.error());
@@ -327,72 +345,80 @@ Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record)
 Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record, bool trial_end) {
   const faults::Fault& f = timeline_.faults()[index];
   if (auto t = targets_.find(index); t != targets_.end()) record->targets = t->second;
-  if (std::holds_alternative<faults::RadioFault>(f.action)) {
-    if (mechanism_) record->mechanism = std::string(faults::MechanismName(*mechanism_));
-    const auto before = installed_;
-    const auto changed = layers_.Pop(f.id);
-    if (trial_end) {
-      // Its qdiscs, iptables chains and delay daemons live in the sidecars' network namespaces
-      // (the daemons are processes of the sidecars): they go when the sidecars stop, right after.
-      for (const std::string& drone : changed) installed_[drone] = layers_.Effective(drone);
-      record->note = std::string(kWithNamespace);
-      return Ok{};
-    }
-    return ChangeRadio(before, changed);
-  }
-  if (std::holds_alternative<faults::PartitionFault>(f.action)) {
-    record->mechanism = "iptables";
-    auto it = partitions_.find(index);
-    if (it == partitions_.end()) return Ok{};
-    if (trial_end) {  // iptables chains in the sidecars' namespaces, as above
-      partitions_.erase(it);
-      record->note = std::string(kWithNamespace);
-      return Ok{};
-    }
-    Status first = RunOnSidecars(it->second.undo, /*run_all=*/true);
-    partitions_.erase(it);
-    return first;
-  }
-  if (std::holds_alternative<faults::ProcessFault>(f.action)) {
-    record->mechanism = "docker";
-    auto it = processes_.find(index);
-    if (it == processes_.end()) return Ok{};
-    std::vector<faults::DockerAction> undo = it->second.undo;
-    // A pause without a duration lasts until the end: unpaused here, so teardown can stop it.
-    if (undo.empty()) {
-      for (const auto& a : it->second.apply) {
-        if (a.kind == faults::DockerAction::Kind::kPause) {
-          undo.push_back({faults::DockerAction::Kind::kUnpause, a.container, "", 0});
-        }
-      }
-    }
-    Status s = faults::ExecuteDockerActions(api_, undo);
-    bool started = false;
-    for (const auto& a : undo) started = started || a.kind == faults::DockerAction::Kind::kStart;
-    if (started && s) {
-      for (const std::string& d : record->targets) {
-        disrupted_.erase(d);
-        resumed_.push_back(d);
-      }
-    }
-    processes_.erase(it);
-    return s;
-  }
-  if (faults::IsPhysicsFault(f)) {
-    // gps_dropout, gps_degrade and wind_gust end in the physics server itself (their duration
-    // travelled with the command); an imu_bias with a duration is taken back by the negated jump.
-    record->mechanism = std::string(kPhysicsMechanism);
-    auto it = physics_.find(index);
-    if (it == physics_.end()) return Ok{};
-    const std::vector<faults::WorldCommandCall> undo = it->second.undo;
-    physics_.erase(it);
-    if (trial_end) {  // the physics server stops with the trial: its world state goes with it
-      if (!undo.empty()) record->note = std::string(kWithPhysics);
-      return Ok{};
-    }
-    return SendToPhysics(undo);
-  }
+  if (std::holds_alternative<faults::RadioFault>(f.action)) return RemoveRadio(f, record, trial_end);
+  if (std::holds_alternative<faults::PartitionFault>(f.action)) return RemovePartition(index, record, trial_end);
+  if (std::holds_alternative<faults::ProcessFault>(f.action)) return RemoveProcessFault(index, record);
+  if (faults::IsPhysicsFault(f)) return RemovePhysicsFault(index, record, trial_end);
   return Ok{};
+}
+
+Status FaultInjector::RemoveRadio(const faults::Fault& f, faults::FaultEventRecord* record, bool trial_end) {
+  if (mechanism_) record->mechanism = std::string(faults::MechanismName(*mechanism_));
+  const auto before = installed_;
+  const auto changed = layers_.Pop(f.id);
+  if (trial_end) {
+    // Its qdiscs, iptables chains and delay daemons live in the sidecars' network namespaces
+    // (the daemons are processes of the sidecars): they go when the sidecars stop, right after.
+    for (const std::string& drone : changed) installed_[drone] = layers_.Effective(drone);
+    record->note = std::string(kWithNamespace);
+    return Ok{};
+  }
+  return ChangeRadio(before, changed);
+}
+
+Status FaultInjector::RemovePartition(std::size_t index, faults::FaultEventRecord* record, bool trial_end) {
+  record->mechanism = "iptables";
+  auto it = partitions_.find(index);
+  if (it == partitions_.end()) return Ok{};
+  if (trial_end) {  // iptables chains in the sidecars' namespaces, as above
+    partitions_.erase(it);
+    record->note = std::string(kWithNamespace);
+    return Ok{};
+  }
+  Status first = RunOnSidecars(it->second.undo, /*run_all=*/true);
+  partitions_.erase(it);
+  return first;
+}
+
+Status FaultInjector::RemoveProcessFault(std::size_t index, faults::FaultEventRecord* record) {
+  record->mechanism = "docker";
+  auto it = processes_.find(index);
+  if (it == processes_.end()) return Ok{};
+  std::vector<faults::DockerAction> undo = it->second.undo;
+  // A pause without a duration lasts until the end: unpaused here, so teardown can stop it.
+  if (undo.empty()) {
+    for (const auto& a : it->second.apply) {
+      if (a.kind == faults::DockerAction::Kind::kPause) {
+        undo.push_back({faults::DockerAction::Kind::kUnpause, a.container, "", 0});
+      }
+    }
+  }
+  Status s = faults::ExecuteDockerActions(api_, undo);
+  bool started = false;
+  for (const auto& a : undo) started = started || a.kind == faults::DockerAction::Kind::kStart;
+  if (started && s) {
+    for (const std::string& d : record->targets) {
+      disrupted_.erase(d);
+      resumed_.push_back(d);
+    }
+  }
+  processes_.erase(it);
+  return s;
+}
+
+// gps_dropout, gps_degrade and wind_gust end in the physics server itself (their duration
+// travelled with the command); an imu_bias with a duration is taken back by the negated jump.
+Status FaultInjector::RemovePhysicsFault(std::size_t index, faults::FaultEventRecord* record, bool trial_end) {
+  record->mechanism = std::string(kPhysicsMechanism);
+  auto it = physics_.find(index);
+  if (it == physics_.end()) return Ok{};
+  const std::vector<faults::WorldCommandCall> undo = it->second.undo;
+  physics_.erase(it);
+  if (trial_end) {  // the physics server stops with the trial: its world state goes with it
+    if (!undo.empty()) record->note = std::string(kWithPhysics);
+    return Ok{};
+  }
+  return SendToPhysics(undo);
 }
 
 std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& actions, bool trial_end) {

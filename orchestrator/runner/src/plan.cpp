@@ -75,6 +75,56 @@ constexpr int kMeshDomain = 1;
 
 // swarmbox-physics (physics_server/README.md).
 constexpr double kFaultClockEveryS = 0.5;  // [simulated s]
+// The recording (record:), collected with truth.csv.
+void AppendRecordFlags(const dsl::TrialSpec& spec, std::vector<std::string>* argv) {
+  if (!spec.record.enabled) return;
+  argv->insert(argv->end(), {"--record", std::string(kRecordingPath),
+                             "--record-rate-hz", ShortestNumber(spec.record.rate_hz),
+                             "--record-camera-hz", ShortestNumber(spec.record.camera_hz),
+                             "--record-camera-scale", ShortestNumber(spec.record.camera_scale),
+                             "--record-jpeg-quality", std::to_string(spec.record.jpeg_quality)});
+}
+
+// The simulated radio: the channel with its profile, and the plan of what happens at simulated
+// times (network.mesh, the faults with `at:`; radio_schedule.hpp); the step and join timeouts.
+void AppendRadioAndTimeoutFlags(const dsl::TrialSpec& spec, bool radio_plan, std::vector<std::string>* argv) {
+  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
+  if (channel) {
+    argv->insert(argv->end(), {"--radio-model", "channel", "--radio-profile", InContainer(dsl::RadioProfileFile(spec.radio))});
+    if (radio_plan) argv->insert(argv->end(), {"--radio-plan", std::string(kRadioPlanPath)});
+  }
+  // netem: faults at simulated times fire at the log line that crosses their time (the fault
+  // injector's timeline): with such faults the physics server reports its clock every 0.5 s
+  // (default 10 s), so they fire at most 0.5 s late. With the channel they are in the plan.
+  // An agent with an external brain waits up to the brain's wall-clock bounds for its answer:
+  // the server must wait longer before it calls that drone lost.
+  if (spec.HasExternalBrain()) {
+    argv->insert(argv->end(), {"--step-timeout", ShortestNumber(std::max(kExternalBrainStepTimeoutS, channel ? kChannelStepTimeoutS : 0.0)),
+                               "--join-timeout", ShortestNumber(kExternalBrainJoinTimeoutS)});
+  } else if (channel) {
+    argv->insert(argv->end(), {"--step-timeout", ShortestNumber(kChannelStepTimeoutS)});
+  }
+  for (const faults::Fault& f : spec.faults) {
+    if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {
+      argv->insert(argv->end(), {"--clock-every", ShortestNumber(kFaultClockEveryS)});
+      break;
+    }
+  }
+}
+
+// name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]]; a payload starts on the ground
+// under the drone (a lifter standing on the ground cannot spawn with it hanging).
+void AppendDroneFlags(const dsl::TrialSpec& spec, std::vector<std::string>* argv) {
+  for (const dsl::DroneSpec& d : spec.drones) {
+    std::string drone = d.name + ":" + d.airframe + ":" + ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) +
+                        "," + ShortestNumber(d.pose[2]);
+    if (!d.payload.empty()) drone += ":0:" + d.payload + ":ground";
+    argv->push_back("--drone");
+    argv->push_back(std::move(drone));
+  }
+}
+
+// swarmbox-physics's command line.
 std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan, bool view) {
   std::vector<std::string> argv = {
       images::kPhysicsBinaryInImage,
@@ -94,47 +144,9 @@ std::vector<std::string> PhysicsArgv(const dsl::TrialSpec& spec, bool radio_plan
   };
   // The live view (swarmbox run --view): every address of the container, published by Docker.
   if (view) argv.insert(argv.end(), {"--view", "0.0.0.0:" + std::to_string(kViewContainerPort)});
-  // The recording (record:), collected with truth.csv.
-  if (spec.record.enabled) {
-    argv.insert(argv.end(), {"--record", std::string(kRecordingPath),
-                             "--record-rate-hz", ShortestNumber(spec.record.rate_hz),
-                             "--record-camera-hz", ShortestNumber(spec.record.camera_hz),
-                             "--record-camera-scale", ShortestNumber(spec.record.camera_scale),
-                             "--record-jpeg-quality", std::to_string(spec.record.jpeg_quality)});
-  }
-  // The simulated radio: the channel with its profile, and the plan of what happens at simulated
-  // times (network.mesh, the faults with `at:`; radio_schedule.hpp).
-  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
-  if (channel) {
-    argv.insert(argv.end(), {"--radio-model", "channel", "--radio-profile", InContainer(dsl::RadioProfileFile(spec.radio))});
-    if (radio_plan) argv.insert(argv.end(), {"--radio-plan", std::string(kRadioPlanPath)});
-  }
-  // netem: faults at simulated times fire at the log line that crosses their time (the fault
-  // injector's timeline): with such faults the physics server reports its clock every 0.5 s
-  // (default 10 s), so they fire at most 0.5 s late. With the channel they are in the plan.
-  // An agent with an external brain waits up to the brain's wall-clock bounds for its answer:
-  // the server must wait longer before it calls that drone lost.
-  if (spec.HasExternalBrain()) {
-    argv.insert(argv.end(), {"--step-timeout", ShortestNumber(std::max(kExternalBrainStepTimeoutS, channel ? kChannelStepTimeoutS : 0.0)),
-                             "--join-timeout", ShortestNumber(kExternalBrainJoinTimeoutS)});
-  } else if (channel) {
-    argv.insert(argv.end(), {"--step-timeout", ShortestNumber(kChannelStepTimeoutS)});
-  }
-  for (const faults::Fault& f : spec.faults) {
-    if (!channel && f.start.clock == faults::FaultStart::Clock::kSim) {
-      argv.insert(argv.end(), {"--clock-every", ShortestNumber(kFaultClockEveryS)});
-      break;
-    }
-  }
-  for (const dsl::DroneSpec& d : spec.drones) {
-    // name:airframe:x,y,z[:yaw_deg[:payload[:attached|ground]]]; a payload starts on the ground
-    // under the drone (a lifter standing on the ground cannot spawn with it hanging).
-    std::string drone = d.name + ":" + d.airframe + ":" + ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) +
-                        "," + ShortestNumber(d.pose[2]);
-    if (!d.payload.empty()) drone += ":0:" + d.payload + ":ground";
-    argv.push_back("--drone");
-    argv.push_back(std::move(drone));
-  }
+  AppendRecordFlags(spec, &argv);
+  AppendRadioAndTimeoutFlags(spec, radio_plan, &argv);
+  AppendDroneFlags(spec, &argv);
   return argv;
 }
 
@@ -166,6 +178,64 @@ std::string BrainLibraryInImage(const dsl::BrainSpec& brain) {
   return std::string(kBrainsDir) + "/" + BasenameOf(brain.host_path.empty() ? brain.path : brain.host_path);
 }
 
+// Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`. At swarm
+// scale the first raft.voters drones vote, the others are learners; with no more drones than
+// voters every drone votes (no flag: the agent's default).
+void AppendRaftFlags(const dsl::TrialSpec& spec, std::vector<std::string>* argv) {
+  argv->insert(argv->end(), {
+      "--members", Members(spec),
+      "--seed", std::to_string(spec.seed),
+      "--raft-tick-ms", std::to_string(spec.raft.tick_ms),
+      "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
+      "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
+  });
+  if (spec.raft.voters > 0 && static_cast<std::size_t>(spec.raft.voters) < spec.drones.size()) {
+    std::string voters;
+    for (int k = 0; k < spec.raft.voters; ++k) {
+      voters += (voters.empty() ? "" : ",") + spec.drones[static_cast<std::size_t>(k)].name;
+    }
+    argv->insert(argv->end(), {"--raft-voters", voters});
+  }
+}
+
+// The user's brain (design24 "Agent flags"): its context gets the world and the payload; the
+// mission keys are the builtin brain's.
+void AppendUserBrainFlags(const dsl::TrialSpec& spec, const dsl::DroneSpec& d, std::vector<std::string>* argv) {
+  const dsl::BrainSpec& brain = d.brain;
+  argv->insert(argv->end(), {"--world", InContainer(spec.world),
+                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
+  if (!d.payload.empty()) argv->insert(argv->end(), {"--payload", d.payload});
+  if (brain.kind == dsl::BrainKind::kLibrary) {
+    argv->insert(argv->end(), {"--brain", "library",
+                               "--brain-library", BrainLibraryInImage(brain),
+                               "--brain-name", brain.name,
+                               "--brain-args", brain.ArgsJson()});
+  } else {
+    argv->insert(argv->end(), {"--brain", "external"});
+  }
+  if (brain.rate_hz > 0) argv->insert(argv->end(), {"--brain-rate-hz", ShortestNumber(brain.rate_hz)});
+  if (brain.offboard.timeout_ms) {
+    argv->insert(argv->end(), {"--offboard-timeout-ms", std::to_string(*brain.offboard.timeout_ms)});
+  }
+  if (brain.offboard.hold_ms) {
+    argv->insert(argv->end(), {"--offboard-hold-ms", std::to_string(*brain.offboard.hold_ms)});
+  }
+}
+
+// What decides: the user's brain, else the builtin brain's plan or SAR mission.
+void AppendBrainFlags(const dsl::TrialSpec& spec, const dsl::DroneSpec& d, std::vector<std::string>* argv) {
+  if (d.brain.kind != dsl::BrainKind::kBuiltin) {
+    AppendUserBrainFlags(spec, d, argv);
+  } else if (spec.mission.kind == dsl::MissionKind::kPlan) {
+    argv->insert(argv->end(), {"--mission", "plan", "--plan", spec.mission.plan});
+  } else {
+    argv->insert(argv->end(), {"--mission", "sar", "--world", InContainer(spec.world),
+                               "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
+    // The lifter starts with its payload on the ground under it (as the physics server places it).
+    if (!d.payload.empty()) argv->insert(argv->end(), {"--payload", d.payload});
+  }
+}
+
 // swarmbox-agent (agent/app/main.cpp --help): the shared contract's flags. An agent given a flag it
 // does not know exits 2, so a new flag goes here only once agent/app/main.cpp has it.
 std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
@@ -189,24 +259,9 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
                              "--mesh-domain", std::to_string(kMeshDomain)});
   }
   argv.insert(argv.end(), {"--sample-timeout", ShortestNumber(kAgentStartPatienceS)});
-  argv.insert(argv.end(), {
-      "--start", ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) + "," + ShortestNumber(d.pose[2]),
-      // Raft on the mesh: every drone of the trial, in trial order; timings from `raft:`.
-      "--members", Members(spec),
-      "--seed", std::to_string(spec.seed),
-      "--raft-tick-ms", std::to_string(spec.raft.tick_ms),
-      "--raft-heartbeat-ms", std::to_string(spec.raft.heartbeat_ms),
-      "--raft-election-timeout-ms", std::to_string(spec.raft.election_timeout_ms),
-  });
-  // Raft at swarm scale: the first raft.voters drones vote, the others are learners; with no more
-  // drones than voters every drone votes (no flag: the agent's default).
-  if (spec.raft.voters > 0 && static_cast<std::size_t>(spec.raft.voters) < spec.drones.size()) {
-    std::string voters;
-    for (int k = 0; k < spec.raft.voters; ++k) {
-      voters += (voters.empty() ? "" : ",") + spec.drones[static_cast<std::size_t>(k)].name;
-    }
-    argv.insert(argv.end(), {"--raft-voters", voters});
-  }
+  argv.insert(argv.end(), {"--start", ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) + "," +
+                                          ShortestNumber(d.pose[2])});
+  AppendRaftFlags(spec, &argv);
   // The radio link measurement (event=link per sampled peer).
   argv.insert(argv.end(), {"--ping-every-ms", std::to_string(spec.radio.ping_every_ms),
                            "--ping-peers", std::to_string(spec.radio.ping_peers)});
@@ -214,36 +269,7 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   if (spec.record.enabled) argv.insert(argv.end(), {"--telemetry-hz", ShortestNumber(spec.record.rate_hz)});
   // The WAL in the container's volume (the root filesystem is read-only; a restart keeps it).
   argv.insert(argv.end(), {"--raft-dir", std::string(kAgentStateDir) + "/raft"});
-  const dsl::BrainSpec& brain = d.brain;
-  if (brain.kind != dsl::BrainKind::kBuiltin) {
-    // The user's brain (design24 "Agent flags"): its context gets the world and the payload; the
-    // mission keys are the builtin brain's.
-    argv.insert(argv.end(), {"--world", InContainer(spec.world),
-                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
-    if (!d.payload.empty()) argv.insert(argv.end(), {"--payload", d.payload});
-    if (brain.kind == dsl::BrainKind::kLibrary) {
-      argv.insert(argv.end(), {"--brain", "library",
-                               "--brain-library", BrainLibraryInImage(brain),
-                               "--brain-name", brain.name,
-                               "--brain-args", brain.ArgsJson()});
-    } else {
-      argv.insert(argv.end(), {"--brain", "external"});
-    }
-    if (brain.rate_hz > 0) argv.insert(argv.end(), {"--brain-rate-hz", ShortestNumber(brain.rate_hz)});
-    if (brain.offboard.timeout_ms) {
-      argv.insert(argv.end(), {"--offboard-timeout-ms", std::to_string(*brain.offboard.timeout_ms)});
-    }
-    if (brain.offboard.hold_ms) {
-      argv.insert(argv.end(), {"--offboard-hold-ms", std::to_string(*brain.offboard.hold_ms)});
-    }
-  } else if (spec.mission.kind == dsl::MissionKind::kPlan) {
-    argv.insert(argv.end(), {"--mission", "plan", "--plan", spec.mission.plan});
-  } else {
-    argv.insert(argv.end(), {"--mission", "sar", "--world", InContainer(spec.world),
-                             "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
-    // The lifter starts with its payload on the ground under it (as the physics server places it).
-    if (!d.payload.empty()) argv.insert(argv.end(), {"--payload", d.payload});
-  }
+  AppendBrainFlags(spec, d, &argv);
   // The agent starts unloaded (--payload-mass 0): its payload lies on the ground.
   return argv;
 }
@@ -379,8 +405,9 @@ dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {
   return dsl::Duration::Ms(static_cast<std::int64_t>(guard_s * 1000.0));
 }
 
-Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
-                                              const PlanOptions& options) {
+namespace {
+
+Status CheckPlanOptions(const dsl::TrialSpec& spec, const PlanOptions& options) {
   if (options.run_id.empty()) return Error(ErrorCode::kInvalidArgument, "PlanTrial: no run id");
   if (spec.world_generate && options.world_path.empty()) {
     return Error(ErrorCode::kInvalidArgument, "PlanTrial: a generated world needs PlanOptions::world_path (DerivedWorldText)");
@@ -388,9 +415,13 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
   if (options.images.physics.empty() || options.images.agent.empty()) {
     return Error(ErrorCode::kInvalidArgument, "PlanTrial: images for physics and agent are needed");
   }
-  const bool sidecars = NeedsFaultSidecars(spec) && !options.faults_image.empty();
-  // Fixed addresses: drones from kFirstDroneHost, then the external brains and the components on
-  // sim (and on mesh) right after them.
+  return Ok{};
+}
+
+// Every brain and component has its image, no component takes a trial name, and the fixed
+// addresses fit a /24: drones from kFirstDroneHost, then the external brains and the components on
+// sim (and on mesh) right after them.
+Status CheckImagesAndAddresses(const dsl::TrialSpec& spec, const PlanOptions& options) {
   std::size_t sim_hosts = spec.drones.size();
   std::size_t mesh_hosts = spec.drones.size();
   for (const dsl::DroneSpec& d : spec.drones) {
@@ -415,157 +446,191 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     return Error(ErrorCode::kInvalidArgument,
                  "too many drones, brains and components for a /24: " + std::to_string(std::max(sim_hosts, mesh_hosts)));
   }
-  // A group's plugins carry the group's level as their own priority: the engine orders creations
-  // by plugin priority across the whole tree (a level's creations wait for the lower ones'), so
-  // the numbers must be comparable between groups.
-  // Run levels: networks 0; components below the drones' priority, each priority its own level;
-  // physics; external brains; sidecars and their set-up step; the drones (with the components of
-  // priority kDronesPriority); the components above it.
+  return Ok{};
+}
+
+// The tree's run priorities (0 for unused stages).
+struct RunLevels {
+  std::map<int, int> of_component;  // component priority -> tree run priority
+  int physics = 0;
+  int brains = 0;
+  int sidecars = 0;
+  int faults = 0;
+  int drones = 0;
+};
+
+// A group's plugins carry the group's level as their own priority: the engine orders creations
+// by plugin priority across the whole tree (a level's creations wait for the lower ones'), so
+// the numbers must be comparable between groups.
+// Run levels: networks 0; components below the drones' priority, each priority its own level;
+// physics; external brains; sidecars and their set-up step; the drones (with the components of
+// priority kDronesPriority); the components above it.
+Result<RunLevels> PlanRunLevels(const dsl::TrialSpec& spec, bool sidecars) {
   std::set<int> before;
   std::set<int> after;
   for (const dsl::UserComponentSpec& c : spec.components) {
     if (c.priority < dsl::kDronesPriority) before.insert(c.priority);
     if (c.priority > dsl::kDronesPriority) after.insert(c.priority);
   }
-  std::map<int, int> level_of;  // component priority -> tree run priority
+  RunLevels levels;
   int next_level = 1;
-  for (int p : before) level_of[p] = next_level++;
-  const int physics_level = next_level++;
-  const bool external_brains = spec.HasExternalBrain();
-  const int brains_level = external_brains ? next_level++ : 0;
-  const int sidecars_level = sidecars ? next_level++ : 0;
-  const int faults_level = sidecars ? next_level++ : 0;
-  const int drones_level = next_level++;
-  level_of[dsl::kDronesPriority] = drones_level;
-  for (int p : after) level_of[p] = next_level++;
+  for (int p : before) levels.of_component[p] = next_level++;
+  levels.physics = next_level++;
+  levels.brains = spec.HasExternalBrain() ? next_level++ : 0;
+  levels.sidecars = sidecars ? next_level++ : 0;
+  levels.faults = sidecars ? next_level++ : 0;
+  levels.drones = next_level++;
+  levels.of_component[dsl::kDronesPriority] = levels.drones;
+  for (int p : after) levels.of_component[p] = next_level++;
   if (next_level - 1 > dsl::kMaxRunPriority) {
     return Error(ErrorCode::kInvalidArgument, "too many component priorities: " + std::to_string(before.size() + after.size()));
   }
-  const std::string trial_id = options.trial_id.empty() ? spec.name : options.trial_id;
-  auto name = [&](std::string_view component) {
+  return levels;
+}
+
+// What the plan's stages share: the trial being built, its networks and the next free host
+// addresses after the drones' (external brains, then components).
+struct TreeBuilder {
+  const dsl::TrialSpec& spec;
+  const PlanOptions& options;
+  const TrialSubnets& nets;
+  std::string trial_id;
+  dsl::Trial& trial;
+  dsl::InputFile world_input = {};
+  dsl::Network* sim_net = nullptr;
+  dsl::Network* mesh_net = nullptr;  // null with the channel radio
+  std::uint32_t next_sim_host = 0;
+  std::uint32_t next_mesh_host = 0;
+
+  std::string Name(std::string_view component) const {
     return ResourceName(spec.name, options.run_id, component);
-  };
-  auto labels = [&](std::string_view component) {
+  }
+  std::map<std::string, std::string> Labels(std::string_view component) const {
     return RunLabels(options.run_id, trial_id, component);
-  };
-  auto host_file = [&](const std::string& relative) {
-    return (std::filesystem::path(options.trials_dir) / relative).lexically_normal().string();
-  };
-  auto input = [&](const std::string& relative) {
-    return dsl::InputFile{host_file(relative), InContainer(relative)};
-  };
-  // The world every container reads: the trial's, or the derived one (world_size_m, generated).
-  const dsl::InputFile world_input = options.world_path.empty()
-                                         ? input(spec.world)
-                                         : dsl::InputFile{options.world_path, InContainer(spec.world)};
+  }
+  dsl::InputFile Input(const std::string& relative) const {
+    return dsl::InputFile{(std::filesystem::path(options.trials_dir) / relative).lexically_normal().string(),
+                          InContainer(relative)};
+  }
+  std::map<std::string, std::string> RunEnv() const {
+    return {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
+  }
+  bool channel() const { return spec.radio.model == dsl::RadioModel::kChannel; }
+};
 
-  auto trial = std::make_unique<dsl::Trial>(spec.name, options.run_id);
-  const TrialSubnets& nets = options.subnets;
-
-  // Docker names a container's interfaces in the order of its networks' names (libnetwork sorts
-  // the endpoints), not in the order they were attached: "net1-sim" < "net2-mesh" makes sim eth0
-  // and mesh eth1 in every agent, as kSimInterface/kMeshInterface say (measured on 20.10).
-  dsl::NetworkSpec sim = dsl::NetworkSpec::Subnet(name("net1-sim"), nets.sim.ToString(),
-                                                  nets.sim.Host(kGatewayHost));
-  sim.labels = labels(kSimNetworkId);
+// Docker names a container's interfaces in the order of its networks' names (libnetwork sorts
+// the endpoints), not in the order they were attached: "net1-sim" < "net2-mesh" makes sim eth0
+// and mesh eth1 in every agent, as kSimInterface/kMeshInterface say (measured on 20.10).
+void AddNetworks(TreeBuilder& b) {
+  dsl::NetworkSpec sim = dsl::NetworkSpec::Subnet(b.Name("net1-sim"), b.nets.sim.ToString(),
+                                                  b.nets.sim.Host(kGatewayHost));
+  sim.labels = b.Labels(kSimNetworkId);
   // Not `internal`: Docker's isolation rules for internal networks drop every packet whose
   // destination is outside the subnet, DDS discovery multicast (239.255.0.1) included, once
   // bridged traffic goes through iptables (br_netfilter; measured on this host).
   sim.internal = false;
-  auto& sim_net = trial->Add<dsl::Network>(std::string(kSimNetworkId), std::move(sim), 0);
+  b.sim_net = &b.trial.Add<dsl::Network>(std::string(kSimNetworkId), std::move(sim), 0);
   // The mesh network carries the netem model's radio; the channel's radio is simulated.
-  const bool channel = spec.radio.model == dsl::RadioModel::kChannel;
-  dsl::Network* mesh_net = nullptr;
-  if (!channel) {
-    dsl::NetworkSpec mesh = dsl::NetworkSpec::Subnet(name("net2-mesh"), nets.mesh.ToString(),
-                                                     nets.mesh.Host(kGatewayHost));
-    mesh.labels = labels(kMeshNetworkId);
-    mesh.internal = false;
-    mesh_net = &trial->Add<dsl::Network>(std::string(kMeshNetworkId), std::move(mesh), 0);
-  }
+  if (b.channel()) return;
+  dsl::NetworkSpec mesh = dsl::NetworkSpec::Subnet(b.Name("net2-mesh"), b.nets.mesh.ToString(),
+                                                   b.nets.mesh.Host(kGatewayHost));
+  mesh.labels = b.Labels(kMeshNetworkId);
+  mesh.internal = false;
+  b.mesh_net = &b.trial.Add<dsl::Network>(std::string(kMeshNetworkId), std::move(mesh), 0);
+}
 
-  // The physics server: owns simulated time, writes truth.csv.
-  const std::string physics_ip = nets.sim.Host(kPhysicsHost);
-  const bool radio_plan = channel && !options.radio_plan_path.empty();
+// The physics server's files: the world, each airframe once, the channel's profile and plan.
+void AddPhysicsInputs(const TreeBuilder& b, bool radio_plan, dsl::ContainerSpec* physics) {
+  physics->inputs.push_back(b.world_input);
+  std::set<std::string> airframes;
+  for (const dsl::DroneSpec& d : b.spec.drones) {
+    if (airframes.insert(d.airframe).second) physics->inputs.push_back(b.Input(AirframeRelative(d)));
+  }
+  if (b.channel()) {
+    physics->inputs.push_back(b.Input(dsl::RadioProfileFile(b.spec.radio)));
+    if (radio_plan) physics->inputs.push_back({b.options.radio_plan_path, std::string(kRadioPlanPath)});
+  }
+}
+
+// The physics server: owns simulated time, writes truth.csv.
+void AddPhysics(TreeBuilder& b, int level) {
+  const dsl::TrialSpec& spec = b.spec;
+  const PlanOptions& options = b.options;
+  const std::string physics_ip = b.nets.sim.Host(kPhysicsHost);
+  const bool radio_plan = b.channel() && !options.radio_plan_path.empty();
   dsl::ContainerSpec physics =
       dsl::ContainerSpec::Image(options.images.physics, PhysicsArgv(spec, radio_plan, options.view.has_value()));
-  physics.name = name(kPhysicsId);
+  physics.name = b.Name(kPhysicsId);
   physics.hostname = std::string(kPhysicsId);
-  physics.labels = labels(kPhysicsId);
-  physics.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
-  physics.inputs.push_back(world_input);
-  std::set<std::string> airframes;
-  for (const dsl::DroneSpec& d : spec.drones) {
-    if (airframes.insert(d.airframe).second) physics.inputs.push_back(input(AirframeRelative(d)));
-  }
-  if (channel) {
-    physics.inputs.push_back(input(dsl::RadioProfileFile(spec.radio)));
-    if (radio_plan) physics.inputs.push_back({options.radio_plan_path, std::string(kRadioPlanPath)});
-  }
+  physics.labels = b.Labels(kPhysicsId);
+  physics.env = b.RunEnv();
+  AddPhysicsInputs(b, radio_plan, &physics);
   physics.scratch_dirs = {std::string(kContainerOutDir)};
   physics.artifacts = {std::string(kTruthCsvPath)};
   if (spec.record.enabled) physics.artifacts.push_back(std::string(kRecordingPath));
   if (options.view) physics.ports.push_back({kViewContainerPort, options.view->host_ip, options.view->host_port});
   Confine(spec.LimitsOf(nullptr), &physics);
-  trial->Add<dsl::Plugin>(std::string(kPhysicsId), std::move(physics), physics_level)
-      .On(sim_net, physics_ip, {std::string(kPhysicsId)})
+  b.trial.Add<dsl::Plugin>(std::string(kPhysicsId), std::move(physics), level)
+      .On(*b.sim_net, physics_ip, {std::string(kPhysicsId)})
       .ReadyOn(std::string(kPhysicsReadyPattern), dsl::Duration::Seconds(60));
+}
 
-  // One agent per drone; with network faults, each agent lives in its fault sidecar's network
-  // namespace (sidecars [2], the injector's set-up step [3], agents [4]).
-  std::uint32_t next_sim_host = kFirstDroneHost + static_cast<std::uint32_t>(spec.drones.size());
-  std::uint32_t next_mesh_host = next_sim_host;
-
-  // External brains: their own containers on sim, started before the agents that wait for them.
-  if (external_brains) {
-    auto& brains = trial->Add<dsl::Component>(std::string(kBrainsGroupId), brains_level);
-    for (const dsl::DroneSpec& d : spec.drones) {
-      if (!d.brain.external()) continue;
-      const std::string id = BrainId(d.name);
-      dsl::ContainerSpec bc = dsl::ContainerSpec::Image(options.images.brains.at(d.name), BrainArgv(spec, d));
-      bc.argv_is_cmd = d.brain.kind != dsl::BrainKind::kProgram;
-      bc.name = name(id);
-      bc.hostname = id;
-      bc.labels = RoleLabels(options.run_id, trial_id, id, kRoleBrain);
-      bc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id},
-                // index 0: the well-known port its agent names with --sim-peer
-                {"CYCLONEDDS_URI", CycloneUriFor(kSimInterface, 0)}};
-      ConfineUser(spec.LimitsOf(&d), &bc);
-      bc.stop_timeout_s = 5;
-      brains.Add<dsl::Plugin>(id, std::move(bc), brains_level)
-          .On(sim_net, nets.sim.Host(next_sim_host++), {id, BrainHostName(d.name)});
-    }
+// External brains: their own containers on sim, started before the agents that wait for them.
+void AddExternalBrains(TreeBuilder& b, int level) {
+  if (!b.spec.HasExternalBrain()) return;
+  auto& brains = b.trial.Add<dsl::Component>(std::string(kBrainsGroupId), level);
+  for (const dsl::DroneSpec& d : b.spec.drones) {
+    if (!d.brain.external()) continue;
+    const std::string id = BrainId(d.name);
+    dsl::ContainerSpec bc = dsl::ContainerSpec::Image(b.options.images.brains.at(d.name), BrainArgv(b.spec, d));
+    bc.argv_is_cmd = d.brain.kind != dsl::BrainKind::kProgram;
+    bc.name = b.Name(id);
+    bc.hostname = id;
+    bc.labels = RoleLabels(b.options.run_id, b.trial_id, id, kRoleBrain);
+    bc.env = b.RunEnv();
+    // index 0: the well-known port its agent names with --sim-peer
+    bc.env["CYCLONEDDS_URI"] = CycloneUriFor(kSimInterface, 0);
+    ConfineUser(b.spec.LimitsOf(&d), &bc);
+    bc.stop_timeout_s = 5;
+    brains.Add<dsl::Plugin>(id, std::move(bc), level)
+        .On(*b.sim_net, b.nets.sim.Host(b.next_sim_host++), {id, BrainHostName(d.name)});
   }
+}
 
-  // The trial's components, each at the level of its priority.
-  for (const dsl::UserComponentSpec& c : spec.components) {
-    std::vector<std::string> argv;
-    if (c.source == dsl::ComponentSource::kProgram) {
-      argv.push_back(std::string(kProgramDirInImage) + "/" + BasenameOf(c.host_path.empty() ? c.ref : c.host_path));
-    }
-    argv.insert(argv.end(), c.args.begin(), c.args.end());
-    dsl::ContainerSpec cc = dsl::ContainerSpec::Image(options.images.components.at(c.name), std::move(argv));
-    cc.argv_is_cmd = c.source != dsl::ComponentSource::kProgram;
-    cc.name = name(c.name);
-    cc.labels = RoleLabels(options.run_id, trial_id, c.name, kRoleComponent);
-    cc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
-    const bool on_sim = std::find(c.networks.begin(), c.networks.end(), kSimNetworkId) != c.networks.end();
-    if (on_sim) cc.env["CYCLONEDDS_URI"] = CycloneUriFor(kSimInterface);  // sim sorts first: eth0
-    for (const auto& [k, v] : c.env) cc.env[k] = v;  // the trial's env wins
-    ConfineUser(spec.limits, &cc);  // the trial's (physics: {limits} is the server's own)
-    cc.artifacts = c.collect;
-    cc.artifacts_dir = std::string(kComponentsDir) + "/" + c.name;
-    if (c.networks.empty()) {
-      cc.no_network = true;
-    } else {
-      cc.hostname = c.name;
-    }
-    auto& plugin = trial->Add<dsl::Plugin>(c.name, std::move(cc), level_of.at(c.priority));
+dsl::ContainerSpec ComponentContainer(const TreeBuilder& b, const dsl::UserComponentSpec& c) {
+  std::vector<std::string> argv;
+  if (c.source == dsl::ComponentSource::kProgram) {
+    argv.push_back(std::string(kProgramDirInImage) + "/" + BasenameOf(c.host_path.empty() ? c.ref : c.host_path));
+  }
+  argv.insert(argv.end(), c.args.begin(), c.args.end());
+  dsl::ContainerSpec cc = dsl::ContainerSpec::Image(b.options.images.components.at(c.name), std::move(argv));
+  cc.argv_is_cmd = c.source != dsl::ComponentSource::kProgram;
+  cc.name = b.Name(c.name);
+  cc.labels = RoleLabels(b.options.run_id, b.trial_id, c.name, kRoleComponent);
+  cc.env = b.RunEnv();
+  const bool on_sim = std::find(c.networks.begin(), c.networks.end(), kSimNetworkId) != c.networks.end();
+  if (on_sim) cc.env["CYCLONEDDS_URI"] = CycloneUriFor(kSimInterface);  // sim sorts first: eth0
+  for (const auto& [k, v] : c.env) cc.env[k] = v;  // the trial's env wins
+  ConfineUser(b.spec.limits, &cc);  // the trial's (physics: {limits} is the server's own)
+  cc.artifacts = c.collect;
+  cc.artifacts_dir = std::string(kComponentsDir) + "/" + c.name;
+  if (c.networks.empty()) {
+    cc.no_network = true;
+  } else {
+    cc.hostname = c.name;
+  }
+  return cc;
+}
+
+// The trial's components, each at the level of its priority.
+Status AddComponents(TreeBuilder& b, const RunLevels& levels) {
+  for (const dsl::UserComponentSpec& c : b.spec.components) {
+    auto& plugin = b.trial.Add<dsl::Plugin>(c.name, ComponentContainer(b, c), levels.of_component.at(c.priority));
     for (const std::string& n : c.networks) {
       if (n == kSimNetworkId) {
-        plugin.On(sim_net, nets.sim.Host(next_sim_host++), {c.name});
-      } else if (mesh_net != nullptr) {
-        plugin.On(*mesh_net, nets.mesh.Host(next_mesh_host++), {c.name});
+        plugin.On(*b.sim_net, b.nets.sim.Host(b.next_sim_host++), {c.name});
+      } else if (b.mesh_net != nullptr) {
+        plugin.On(*b.mesh_net, b.nets.mesh.Host(b.next_mesh_host++), {c.name});
       } else {
         return Error(ErrorCode::kInvalidArgument,
                      "component " + c.name + " joins mesh, which only a radio.model netem trial has", c.mark.ToString());
@@ -573,62 +638,98 @@ Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
     }
     if (!c.ready.empty()) plugin.ReadyOn(c.ready, dsl::Duration::Seconds(kComponentReadySeconds));
   }
+  return Ok{};
+}
 
-  if (sidecars) {
-    auto& radios = trial->Add<dsl::Component>(std::string(kSidecarsGroupId), sidecars_level);
-    std::uint32_t host = kFirstDroneHost;
-    for (const dsl::DroneSpec& d : spec.drones) {
-      const std::string id = SidecarId(d.name);
-      dsl::ContainerSpec sc = dsl::ContainerSpec::Image(options.faults_image, SidecarArgv());
-      sc.name = name(id);
-      sc.hostname = d.name;
-      sc.labels = labels(id);
-      sc.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
-      // tc and iptables-nft talk netlink: NET_ADMIN alone (no NET_RAW: the fault e2e test runs
-      // both with just this); no-new-privileges holds, as root keeps its set across exec.
-      sc.cap_drop = {"ALL"};
-      sc.cap_add = {"NET_ADMIN"};
-      sc.no_new_privileges = true;
-      sc.user = "0:0";  // NET_ADMIN reaches no non-root user on Docker 20.10 (standard_images.hpp)
-      sc.stop_timeout_s = 2;
-      radios.Add<dsl::Plugin>(id, std::move(sc), sidecars_level)
-          .On(sim_net, nets.sim.Host(host), {d.name})
-          .On(*mesh_net, nets.mesh.Host(host), {d.name});
-      ++host;
-    }
-    trial->Add<dsl::Step>(std::string(kFaultsStepId), faults_level);
-  }
-  auto& drones = trial->Add<dsl::Component>(std::string(kDronesGroupId), drones_level);
+// With network faults, each agent lives in its fault sidecar's network namespace (sidecars, then
+// the injector's set-up step, then the agents).
+void AddFaultSidecars(TreeBuilder& b, const RunLevels& levels) {
+  auto& radios = b.trial.Add<dsl::Component>(std::string(kSidecarsGroupId), levels.sidecars);
   std::uint32_t host = kFirstDroneHost;
-  for (const dsl::DroneSpec& d : spec.drones) {
-    const std::string sim_ip = nets.sim.Host(host);
-    const std::string mesh_ip = nets.mesh.Host(host);
+  for (const dsl::DroneSpec& d : b.spec.drones) {
+    const std::string id = SidecarId(d.name);
+    dsl::ContainerSpec sc = dsl::ContainerSpec::Image(b.options.faults_image, SidecarArgv());
+    sc.name = b.Name(id);
+    sc.hostname = d.name;
+    sc.labels = b.Labels(id);
+    sc.env = b.RunEnv();
+    // tc and iptables-nft talk netlink: NET_ADMIN alone (no NET_RAW: the fault e2e test runs
+    // both with just this); no-new-privileges holds, as root keeps its set across exec.
+    sc.cap_drop = {"ALL"};
+    sc.cap_add = {"NET_ADMIN"};
+    sc.no_new_privileges = true;
+    sc.user = "0:0";  // NET_ADMIN reaches no non-root user on Docker 20.10 (standard_images.hpp)
+    sc.stop_timeout_s = 2;
+    radios.Add<dsl::Plugin>(id, std::move(sc), levels.sidecars)
+        .On(*b.sim_net, b.nets.sim.Host(host), {d.name})
+        .On(*b.mesh_net, b.nets.mesh.Host(host), {d.name});
     ++host;
-    const auto own_agent = options.images.drone_agents.find(d.name);
+  }
+  b.trial.Add<dsl::Step>(std::string(kFaultsStepId), levels.faults);
+}
+
+// One agent per drone: in its sidecar's namespace when there are sidecars, else on the networks.
+void AddDrones(TreeBuilder& b, int level, bool sidecars) {
+  auto& drones = b.trial.Add<dsl::Component>(std::string(kDronesGroupId), level);
+  std::uint32_t host = kFirstDroneHost;
+  for (const dsl::DroneSpec& d : b.spec.drones) {
+    const std::string sim_ip = b.nets.sim.Host(host);
+    const std::string mesh_ip = b.nets.mesh.Host(host);
+    ++host;
+    const auto own_agent = b.options.images.drone_agents.find(d.name);
     dsl::ContainerSpec agent = dsl::ContainerSpec::Image(
-        own_agent != options.images.drone_agents.end() ? own_agent->second : options.images.agent, AgentArgv(spec, d));
-    agent.name = name(d.name);
-    agent.labels = labels(d.name);
-    agent.env = {{"SWARMBOX_RUN", options.run_id}, {"SWARMBOX_TRIAL", trial_id}};
-    agent.inputs = {world_input, input(AirframeRelative(d))};
+        own_agent != b.options.images.drone_agents.end() ? own_agent->second : b.options.images.agent,
+        AgentArgv(b.spec, d));
+    agent.name = b.Name(d.name);
+    agent.labels = b.Labels(d.name);
+    agent.env = b.RunEnv();
+    agent.inputs = {b.world_input, b.Input(AirframeRelative(d))};
     agent.scratch_dirs = {std::string(kAgentStateDir)};
-    Confine(spec.LimitsOf(&d), &agent);
+    Confine(b.spec.LimitsOf(&d), &agent);
     if (sidecars) {
       agent.network_of = SidecarId(d.name);  // Docker refuses a hostname here
-      drones.Add<dsl::Plugin>(d.name, std::move(agent), drones_level);
+      drones.Add<dsl::Plugin>(d.name, std::move(agent), level);
     } else {
       agent.hostname = d.name;
-      auto& plugin = drones.Add<dsl::Plugin>(d.name, std::move(agent), drones_level).On(sim_net, sim_ip, {d.name});
-      if (mesh_net != nullptr) plugin.On(*mesh_net, mesh_ip, {d.name});
+      auto& plugin = drones.Add<dsl::Plugin>(d.name, std::move(agent), level).On(*b.sim_net, sim_ip, {d.name});
+      if (b.mesh_net != nullptr) plugin.On(*b.mesh_net, mesh_ip, {d.name});
     }
   }
+}
 
-  for (const dsl::EndSpec& e : spec.end) trial->EndOn(e.on, e.outcome, e.reason, e.from);
+void SetEndAndTimeout(const dsl::TrialSpec& spec, dsl::Trial& trial) {
+  for (const dsl::EndSpec& e : spec.end) trial.EndOn(e.on, e.outcome, e.reason, e.from);
   dsl::TimeoutPolicy timeout = dsl::TimeoutPolicy::Sim(
       spec.timeout.sim, spec.timeout.wall.zero() ? DefaultWallGuard(spec) : spec.timeout.wall,
       std::string(kPhysicsId));
   timeout.outcome = spec.timeout.outcome;
-  trial->SetTimeout(timeout);
+  trial.SetTimeout(timeout);
+}
+
+}  // namespace
+
+Result<std::unique_ptr<dsl::Trial>> PlanTrial(const dsl::TrialSpec& spec,
+                                              const PlanOptions& options) {
+  SWARMBOX_TRY(CheckPlanOptions(spec, options));
+  const bool sidecars = NeedsFaultSidecars(spec) && !options.faults_image.empty();
+  SWARMBOX_TRY(CheckImagesAndAddresses(spec, options));
+  auto levels = PlanRunLevels(spec, sidecars);
+  if (!levels) return levels.error();
+  auto trial = std::make_unique<dsl::Trial>(spec.name, options.run_id);
+  TreeBuilder b{.spec = spec, .options = options, .nets = options.subnets,
+                .trial_id = options.trial_id.empty() ? spec.name : options.trial_id, .trial = *trial};
+  // The world every container reads: the trial's, or the derived one (world_size_m, generated).
+  b.world_input = options.world_path.empty() ? b.Input(spec.world)
+                                             : dsl::InputFile{options.world_path, InContainer(spec.world)};
+  b.next_sim_host = kFirstDroneHost + static_cast<std::uint32_t>(spec.drones.size());
+  b.next_mesh_host = b.next_sim_host;
+  AddNetworks(b);
+  AddPhysics(b, levels->physics);
+  AddExternalBrains(b, levels->brains);
+  SWARMBOX_TRY(AddComponents(b, *levels));
+  if (sidecars) AddFaultSidecars(b, *levels);
+  AddDrones(b, levels->drones, sidecars);
+  SetEndAndTimeout(spec, *trial);
   return trial;
 }
 

@@ -76,6 +76,123 @@ bool InRadioSchedule(const faults::Fault& fault) {
   return fault.start.clock == faults::FaultStart::Clock::kSim;
 }
 
+namespace {
+
+// What one fault's entries are planned from: the trial's drones and the generator `random` draws from.
+struct ScheduleContext {
+  const std::vector<std::string>& drones;
+  std::mt19937_64& rng;
+  RadioSchedule& plan;
+};
+
+Error InFault(const faults::Fault& f, const Error& e) {
+  return e.Context("fault " + f.id + " (" + f.mark.ToString() + ")");
+}
+
+// The fault indexes in the order they fire (ties: schedule order), so `random` draws as the
+// injector would.
+std::vector<std::size_t> FiringOrder(const dsl::TrialSpec& spec) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < spec.faults.size(); ++i) {
+    if (InRadioSchedule(spec.faults[i])) order.push_back(i);
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return spec.faults[a].start.at_ms < spec.faults[b].start.at_ms;
+  });
+  return order;
+}
+
+Status ScheduleDroneOut(ScheduleContext& ctx, const faults::Fault& f, const faults::ProcessFault& process,
+                        ScheduleEntry e) {
+  auto targets = Targets(process.target, ctx.drones, ctx.rng);
+  if (!targets) return InFault(f, targets.error());
+  e.kind = ScheduleEntry::Kind::kDroneOut;
+  e.mode = process.action;
+  e.targets = std::move(*targets);
+  // The physics server's modes (physics_server/app/radio_plan.hpp): a kill stays out (0); a
+  // kill that ends is out for its duration and back as a new process, its `restart`; stop and
+  // pause need an end (none: the rest of the trial); a restart is out for one lockstep step.
+  if (process.action == faults::ProcessAction::kKill && f.duration_ms) {
+    e.mode = faults::ProcessAction::kRestart;
+  } else if (process.action == faults::ProcessAction::kRestart) {
+    e.duration_s = kRestartOutS;
+  } else if (process.action != faults::ProcessAction::kKill && !f.duration_ms) {
+    e.duration_s = faults::kUntilEndS;
+  }
+  ctx.plan.schedule.push_back(std::move(e));
+  return Ok{};
+}
+
+Status ScheduleRadio(ScheduleContext& ctx, const faults::Fault& f, const faults::RadioFault& radio, ScheduleEntry e) {
+  auto targets = Targets(radio.target, ctx.drones, ctx.rng);
+  if (!targets) return InFault(f, targets.error());
+  e.kind = ScheduleEntry::Kind::kRadio;
+  e.targets = std::move(*targets);
+  if (!radio.rules.empty()) e.impairment = radio.rules.front().spec;
+  ctx.plan.schedule.push_back(std::move(e));
+  return Ok{};
+}
+
+// The partition's groups, and the drones no group lists as one more group.
+void SchedulePartition(ScheduleContext& ctx, const faults::PartitionFault& partition, ScheduleEntry e) {
+  e.kind = ScheduleEntry::Kind::kPartition;
+  e.groups = partition.groups;
+  e.oneway = partition.oneway;
+  std::set<std::string> listed;
+  for (const auto& g : e.groups) listed.insert(g.begin(), g.end());
+  std::vector<std::string> rest;
+  for (const std::string& d : ctx.drones) {
+    if (listed.count(d) == 0) rest.push_back(d);
+  }
+  if (!rest.empty()) e.groups.push_back(std::move(rest));
+  ctx.plan.schedule.push_back(std::move(e));
+}
+
+// The world commands of a physics fault, its undo at its end.
+Status SchedulePhysicsFault(ScheduleContext& ctx, const faults::Fault& f, const ScheduleEntry& e) {
+  std::vector<std::string> targets;
+  if (const faults::FaultTarget* target = f.target()) {
+    auto resolved = Targets(*target, ctx.drones, ctx.rng);
+    if (!resolved) return InFault(f, resolved.error());
+    targets = std::move(*resolved);
+  }
+  const faults::PhysicsPlan calls = faults::PlanPhysicsFault(f, targets);
+  auto add = [&](const std::vector<faults::WorldCommandCall>& list, double at_s) {
+    for (const faults::WorldCommandCall& call : list) {
+      ScheduleEntry w;
+      w.kind = ScheduleEntry::Kind::kWorldCommand;
+      w.at_s = at_s;
+      w.name = f.id;
+      w.target = call.target;
+      w.command = call.command;
+      w.args = call.args;
+      ctx.plan.schedule.push_back(std::move(w));
+    }
+  };
+  add(calls.apply, e.at_s);
+  add(calls.undo, e.at_s + e.duration_s);  // an imu_bias with a duration: its negated jump
+  return Ok{};
+}
+
+Status ScheduleFault(ScheduleContext& ctx, const faults::Fault& f) {
+  ScheduleEntry e;
+  e.at_s = Seconds(f.start.at_ms);
+  e.name = f.id;
+  e.duration_s = f.duration_ms ? Seconds(*f.duration_ms) : 0.0;
+  if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
+    return ScheduleDroneOut(ctx, f, *process, std::move(e));
+  }
+  if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) return ScheduleRadio(ctx, f, *radio, std::move(e));
+  if (const auto* partition = std::get_if<faults::PartitionFault>(&f.action)) {
+    SchedulePartition(ctx, *partition, std::move(e));
+    return Ok{};
+  }
+  if (faults::IsPhysicsFault(f)) return SchedulePhysicsFault(ctx, f, e);
+  return Ok{};
+}
+
+}  // namespace
+
 Result<RadioSchedule> PlanRadioSchedule(const dsl::TrialSpec& spec) {
   if (spec.radio.model != dsl::RadioModel::kChannel) {
     return Error(ErrorCode::kInvalidArgument,
@@ -85,90 +202,14 @@ Result<RadioSchedule> PlanRadioSchedule(const dsl::TrialSpec& spec) {
   }
   SWARMBOX_TRY(faults::CheckChannelSupports(spec.mesh.rules, "network.mesh"));
   SWARMBOX_TRY(faults::CheckChannelFaults(spec.faults));
-
   std::vector<std::string> drones;
   for (const dsl::DroneSpec& d : spec.drones) drones.push_back(d.name);
-
   RadioSchedule plan;
   plan.seed = spec.seed;
   if (!spec.mesh.empty()) plan.mesh = spec.mesh.rules.front().spec;
-
-  // In the order the faults fire (ties: schedule order), so `random` draws as the injector would.
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < spec.faults.size(); ++i) {
-    if (InRadioSchedule(spec.faults[i])) order.push_back(i);
-  }
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return spec.faults[a].start.at_ms < spec.faults[b].start.at_ms;
-  });
   std::mt19937_64 rng(spec.seed);
-  for (std::size_t i : order) {
-    const faults::Fault& f = spec.faults[i];
-    auto where = [&](const Error& e) { return e.Context("fault " + f.id + " (" + f.mark.ToString() + ")"); };
-    ScheduleEntry e;
-    e.at_s = Seconds(f.start.at_ms);
-    e.name = f.id;
-    e.duration_s = f.duration_ms ? Seconds(*f.duration_ms) : 0.0;
-    if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
-      auto targets = Targets(process->target, drones, rng);
-      if (!targets) return where(targets.error());
-      e.kind = ScheduleEntry::Kind::kDroneOut;
-      e.mode = process->action;
-      e.targets = std::move(*targets);
-      // The physics server's modes (physics_server/app/radio_plan.hpp): a kill stays out (0); a
-      // kill that ends is out for its duration and back as a new process, its `restart`; stop and
-      // pause need an end (none: the rest of the trial); a restart is out for one lockstep step.
-      if (process->action == faults::ProcessAction::kKill && f.duration_ms) {
-        e.mode = faults::ProcessAction::kRestart;
-      } else if (process->action == faults::ProcessAction::kRestart) {
-        e.duration_s = kRestartOutS;
-      } else if (process->action != faults::ProcessAction::kKill && !f.duration_ms) {
-        e.duration_s = faults::kUntilEndS;
-      }
-      plan.schedule.push_back(std::move(e));
-    } else if (const auto* radio = std::get_if<faults::RadioFault>(&f.action)) {
-      auto targets = Targets(radio->target, drones, rng);
-      if (!targets) return where(targets.error());
-      e.kind = ScheduleEntry::Kind::kRadio;
-      e.targets = std::move(*targets);
-      if (!radio->rules.empty()) e.impairment = radio->rules.front().spec;
-      plan.schedule.push_back(std::move(e));
-    } else if (const auto* partition = std::get_if<faults::PartitionFault>(&f.action)) {
-      e.kind = ScheduleEntry::Kind::kPartition;
-      e.groups = partition->groups;
-      e.oneway = partition->oneway;
-      std::set<std::string> listed;
-      for (const auto& g : e.groups) listed.insert(g.begin(), g.end());
-      std::vector<std::string> rest;
-      for (const std::string& d : drones) {
-        if (listed.count(d) == 0) rest.push_back(d);
-      }
-      if (!rest.empty()) e.groups.push_back(std::move(rest));
-      plan.schedule.push_back(std::move(e));
-    } else if (faults::IsPhysicsFault(f)) {
-      std::vector<std::string> targets;
-      if (const faults::FaultTarget* target = f.target()) {
-        auto resolved = Targets(*target, drones, rng);
-        if (!resolved) return where(resolved.error());
-        targets = std::move(*resolved);
-      }
-      const faults::PhysicsPlan calls = faults::PlanPhysicsFault(f, targets);
-      auto add = [&](const std::vector<faults::WorldCommandCall>& list, double at_s) {
-        for (const faults::WorldCommandCall& call : list) {
-          ScheduleEntry w;
-          w.kind = ScheduleEntry::Kind::kWorldCommand;
-          w.at_s = at_s;
-          w.name = f.id;
-          w.target = call.target;
-          w.command = call.command;
-          w.args = call.args;
-          plan.schedule.push_back(std::move(w));
-        }
-      };
-      add(calls.apply, e.at_s);
-      add(calls.undo, e.at_s + e.duration_s);  // an imu_bias with a duration: its negated jump
-    }
-  }
+  ScheduleContext ctx{drones, rng, plan};
+  for (std::size_t i : FiringOrder(spec)) SWARMBOX_TRY(ScheduleFault(ctx, spec.faults[i]));
   // The undo entries land later than their fault's: the whole schedule by time (ties: as added).
   std::stable_sort(plan.schedule.begin(), plan.schedule.end(),
                    [](const ScheduleEntry& a, const ScheduleEntry& b) { return a.at_s < b.at_s; });

@@ -121,11 +121,21 @@ Result<WorldPicture> LoadWorldPicture(const std::string& path) {
   return w;
 }
 
-Status DrawTrajectories(
-    const std::vector<std::pair<std::string, std::vector<TrackPoint>>>& tracks,
-    const WorldPicture& world, const std::vector<Detection>& detections, const std::string& path,
-    int size_px) {
-  // The view: the geofence, grown to every track point, plus a margin.
+namespace {
+
+// The picture's frame: the geofence, grown to every track point, plus a margin; metres to pixels
+// with y north up.
+struct View {
+  double half = 0;   // [m] from the centre to each edge
+  double scale = 0;  // [px/m]
+  cv::Point Px(double x, double y) const {
+    return cv::Point(static_cast<int>(std::lround((x + half) * scale)),
+                     static_cast<int>(std::lround((half - y) * scale)));
+  }
+};
+
+View FrameOf(const std::vector<std::pair<std::string, std::vector<TrackPoint>>>& tracks, const WorldPicture& world,
+             int size_px) {
   double half_x = world.size_x_m / 2, half_y = world.size_y_m / 2;
   for (const auto& [name, pts] : tracks) {
     for (const TrackPoint& p : pts) {
@@ -133,30 +143,31 @@ Status DrawTrajectories(
       half_y = std::max(half_y, std::fabs(p.y_m));
     }
   }
-  const double half = std::max(half_x, half_y) * 1.05 + 1.0;
-  const double scale = size_px / (2 * half);  // px per m
-  auto px = [&](double x, double y) {
-    return cv::Point(static_cast<int>(std::lround((x + half) * scale)),
-                     static_cast<int>(std::lround((half - y) * scale)));
-  };
-  cv::Mat img(size_px, size_px, CV_8UC3, cv::Scalar(250, 250, 250));
-  // Grid every 10 m, axes darker.
+  View v;
+  v.half = std::max(half_x, half_y) * 1.05 + 1.0;
+  v.scale = size_px / (2 * v.half);
+  return v;
+}
+
+// Grid every 10 m (axes darker), the geofence, the obstacles (trees as discs) and the victims.
+void DrawWorld(const View& v, const WorldPicture& world, cv::Mat& img) {
+  const double half = v.half;
   for (double g = -std::floor(half / 10) * 10; g <= half; g += 10) {
     const cv::Scalar c = std::fabs(g) < 1e-9 ? cv::Scalar(170, 170, 170) : cv::Scalar(228, 228, 228);
-    cv::line(img, px(g, -half), px(g, half), c, 1);
-    cv::line(img, px(-half, g), px(half, g), c, 1);
+    cv::line(img, v.Px(g, -half), v.Px(g, half), c, 1);
+    cv::line(img, v.Px(-half, g), v.Px(half, g), c, 1);
   }
-  cv::rectangle(img, px(-world.size_x_m / 2, world.size_y_m / 2),
-                px(world.size_x_m / 2, -world.size_y_m / 2), cv::Scalar(90, 90, 90), 2);
+  cv::rectangle(img, v.Px(-world.size_x_m / 2, world.size_y_m / 2),
+                v.Px(world.size_x_m / 2, -world.size_y_m / 2), cv::Scalar(90, 90, 90), 2);
   for (const auto& o : world.obstacles) {
     if (o.tree) {
-      cv::circle(img, px(o.x_m, o.y_m), std::max(1, static_cast<int>(std::min(o.sx_m, o.sy_m) / 2 * scale)),
+      cv::circle(img, v.Px(o.x_m, o.y_m), std::max(1, static_cast<int>(std::min(o.sx_m, o.sy_m) / 2 * v.scale)),
                  cv::Scalar(80, 150, 90), cv::FILLED, cv::LINE_AA);
       continue;
     }
-    cv::RotatedRect r(cv::Point2f(static_cast<float>((o.x_m + half) * scale),
-                                  static_cast<float>((half - o.y_m) * scale)),
-                      cv::Size2f(static_cast<float>(o.sx_m * scale), static_cast<float>(o.sy_m * scale)),
+    cv::RotatedRect r(cv::Point2f(static_cast<float>((o.x_m + half) * v.scale),
+                                  static_cast<float>((half - o.y_m) * v.scale)),
+                      cv::Size2f(static_cast<float>(o.sx_m * v.scale), static_cast<float>(o.sy_m * v.scale)),
                       static_cast<float>(-o.yaw_deg));
     cv::Point2f corners[4];
     r.points(corners);
@@ -164,17 +175,22 @@ Status DrawTrajectories(
     for (const auto& c : corners) poly.emplace_back(static_cast<int>(c.x), static_cast<int>(c.y));
     cv::fillConvexPoly(img, poly, cv::Scalar(120, 120, 120));
   }
-  for (const auto& v : world.victims) {
-    cv::drawMarker(img, px(v.x_m, v.y_m), cv::Scalar(0, 0, 220), cv::MARKER_STAR, 18, 2);
-    cv::putText(img, v.id, px(v.x_m, v.y_m) + cv::Point(10, -10), cv::FONT_HERSHEY_SIMPLEX, 0.45,
+  for (const auto& victim : world.victims) {
+    cv::drawMarker(img, v.Px(victim.x_m, victim.y_m), cv::Scalar(0, 0, 220), cv::MARKER_STAR, 18, 2);
+    cv::putText(img, victim.id, v.Px(victim.x_m, victim.y_m) + cv::Point(10, -10), cv::FONT_HERSHEY_SIMPLEX, 0.45,
                 cv::Scalar(0, 0, 180), 1, cv::LINE_AA);
   }
+}
+
+// Each track in its palette colour (start circle, end cross) with its legend line.
+void DrawTracks(const View& v, const std::vector<std::pair<std::string, std::vector<TrackPoint>>>& tracks,
+                cv::Mat& img) {
   int legend_y = 24;
   std::size_t colour = 0;
   for (const auto& [name, pts] : tracks) {
     const cv::Scalar c = kPalette[colour++ % (sizeof kPalette / sizeof kPalette[0])];
     std::vector<cv::Point> line;
-    for (const TrackPoint& p : pts) line.push_back(px(p.x_m, p.y_m));
+    for (const TrackPoint& p : pts) line.push_back(v.Px(p.x_m, p.y_m));
     if (line.size() > 1) cv::polylines(img, line, false, c, 2, cv::LINE_AA);
     if (!line.empty()) {
       cv::circle(img, line.front(), 5, c, 2, cv::LINE_AA);
@@ -185,8 +201,20 @@ Status DrawTrajectories(
                 cv::LINE_AA);
     legend_y += 20;
   }
+}
+
+}  // namespace
+
+Status DrawTrajectories(
+    const std::vector<std::pair<std::string, std::vector<TrackPoint>>>& tracks,
+    const WorldPicture& world, const std::vector<Detection>& detections, const std::string& path,
+    int size_px) {
+  const View view = FrameOf(tracks, world, size_px);
+  cv::Mat img(size_px, size_px, CV_8UC3, cv::Scalar(250, 250, 250));
+  DrawWorld(view, world, img);
+  DrawTracks(view, tracks, img);
   for (const Detection& d : detections) {
-    cv::circle(img, px(d.x_m, d.y_m), d.confirmed ? 9 : 6,
+    cv::circle(img, view.Px(d.x_m, d.y_m), d.confirmed ? 9 : 6,
                d.confirmed ? cv::Scalar(0, 160, 0) : cv::Scalar(0, 140, 255), 2, cv::LINE_AA);
   }
   cv::putText(img, "10 m grid, x east, y north", {12, size_px - 12}, cv::FONT_HERSHEY_SIMPLEX, 0.45,

@@ -78,6 +78,15 @@ class TrialMetrics {
   MetricValues Values();
 
  private:
+  // OnLogEvent's events: the perception's detections and confirmations, a new Raft term's
+  // leader, a radio link measurement.
+  void OnVictimEvent(const std::string& e, std::optional<double> t, const LogfmtFields& fields);
+  void OnLeaderElected(std::optional<double> t, const LogfmtFields& fields);
+  void OnLinkEvent(const LogfmtFields& fields);
+  // Values' parts: the perception's counts, those against the world's victims, Raft's leaders.
+  void PerceptionValues(MetricValues* v) const;
+  void WorldVictimValues(MetricValues* v) const;
+  void LeaderValues(MetricValues* v);
   void FlushTruthTime();
 
   std::optional<double> mission_time_s_;

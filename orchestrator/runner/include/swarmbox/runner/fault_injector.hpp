@@ -130,6 +130,12 @@ class FaultInjector {
   const std::vector<std::string>& problems() const { return problems_; }
 
  private:
+  // Setup's steps: what the trial needs of the host (a verdict ends Setup there), the mechanism
+  // (detected once per host), what it cannot honour, network.mesh on every sidecar.
+  std::optional<dsl::Verdict> CheckSetupNeeds() const;
+  Result<faults::Mechanism> DetectMechanismOnce();
+  Status CheckMechanismHonours(faults::Mechanism mech) const;
+  dsl::Verdict ApplyMesh(faults::Mechanism mech);
   // trial_end: the removals come from RemoveActive (see the banner).
   std::optional<dsl::Verdict> Carry(const std::vector<faults::TimelineAction>& actions, bool trial_end);
   // The fault's targets (and mechanism) into `record` and targets_ (pure: the leader tracker, the
@@ -137,6 +143,12 @@ class FaultInjector {
   Status Resolve(std::size_t index, faults::FaultEventRecord* record);
   Status Apply(std::size_t index, faults::FaultEventRecord* record);
   Status Remove(std::size_t index, faults::FaultEventRecord* record, bool trial_end);
+  // Remove's kinds: the radio's layer, a partition's chains, a process fault's docker undo, a
+  // physics fault's undo commands.
+  Status RemoveRadio(const faults::Fault& f, faults::FaultEventRecord* record, bool trial_end);
+  Status RemovePartition(std::size_t index, faults::FaultEventRecord* record, bool trial_end);
+  Status RemoveProcessFault(std::size_t index, faults::FaultEventRecord* record);
+  Status RemovePhysicsFault(std::size_t index, faults::FaultEventRecord* record, bool trial_end);
   Status ChangeRadio(const std::map<std::string, std::vector<faults::RadioRule>>& before,
                      const std::vector<std::string>& changed);
   // Runs each drone's commands in its sidecar, all sidecars concurrently (RunCommands, or
