@@ -61,8 +61,8 @@ flight::SensorSample FromBus(const bus::SensorSample& m) {
   flight::SensorSample s;
   s.t_s = static_cast<double>(m.sim_time_ns) * 1e-9;
   s.imu_fresh = m.imu.valid;
-  s.accel_mps2 = V(m.imu.accel_m_s2);
-  s.gyro_radps = V(m.imu.gyro_rad_s);
+  s.accel_m_s2 = V(m.imu.accel_m_s2);
+  s.gyro_rad_s = V(m.imu.gyro_rad_s);
   s.baro_fresh = m.baro.valid;
   s.baro_alt_m = m.baro.altitude_m;
   s.mag_fresh = m.mag.valid;
@@ -71,7 +71,7 @@ flight::SensorSample FromBus(const bus::SensorSample& m) {
   s.gps_fresh = m.gps.valid;
   s.gps_valid = m.gps.valid && m.gps.fix_type == bus::GpsFix::k3d;
   s.gps_pos_m = V(m.gps.position_enu_m);
-  s.gps_vel_mps = V(m.gps.velocity_enu_m_s);
+  s.gps_vel_m_s = V(m.gps.velocity_enu_m_s);
   s.gps_eph_m = m.gps.h_acc_m;  // the receiver's reported accuracy: how much the estimator trusts it
   s.gps_epv_m = m.gps.v_acc_m;
   return s;
@@ -545,7 +545,7 @@ void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
   t.sim_time_ns = msg.sim_time_ns;
   const flight::StateEstimate& est = fc_.estimate();
   t.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
-  t.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  t.velocity_enu_m_s = {est.vel_m_s.x(), est.vel_m_s.y(), est.vel_m_s.z()};
   t.attitude_wxyz = {est.att.w(), est.att.x(), est.att.y(), est.att.z()};
   const flight::FlightMode mode = fc_.mode();
   t.flight_mode = std::string(flight::FlightModeName(mode));
@@ -563,7 +563,7 @@ void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
   } else {
     const flight::TrajectoryPoint& ref = fc_.telemetry().reference;
     t.setpoint_position_enu_m = {ref.pos_m.x(), ref.pos_m.y(), ref.pos_m.z()};
-    t.setpoint_velocity_enu_m_s = {ref.vel_mps.x(), ref.vel_mps.y(), ref.vel_mps.z()};
+    t.setpoint_velocity_enu_m_s = {ref.vel_m_s.x(), ref.vel_m_s.y(), ref.vel_m_s.z()};
     t.setpoint_yaw_rad = kNaN;
   }
   // Flocking (SarBrain): V18's horizontal terms; separation = repulsion, alignment = Reynolds'
@@ -581,7 +581,7 @@ void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
   }
   t.sectors.clear();
   if (raft_) {
-    const mission::RaftService& r = raft_->service();
+    const raft_service::RaftService& r = raft_->service();
     t.raft_role = r.is_learner() ? "learner" : std::string(raft::RoleName(r.role()));
     t.raft_term = r.term();
     t.raft_leader = r.leader();
@@ -641,7 +641,7 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
                                   .count()
                             : 0;
   state_.position_enu_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
-  state_.velocity_enu_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  state_.velocity_enu_m_s = {est.vel_m_s.x(), est.vel_m_s.y(), est.vel_m_s.z()};
   state_.heading_rad = flight::YawOf(est.att);
   if (brain_host_) {
     // The brain's status (Neighbour::status on the other drones); the flight mode until it says.
@@ -659,17 +659,17 @@ void AgentNode::BroadcastState(const bus::SensorSample& msg) {
 void AgentNode::StepBrain(const bus::SensorSample& msg) {
   const flight::StateEstimate& est = fc_.estimate();
   const flight::FlightMode mode = fc_.mode();
-  if (battery_) battery_->Step(options_.control_dt_s, est.vel_mps, brain_host_->payload_mass_kg(), !LandedMode(mode));
+  if (battery_) battery_->Step(options_.control_dt_s, est.vel_m_s, brain_host_->payload_mass_kg(), !LandedMode(mode));
   brain::Vehicle& v = vehicle_;
   v.name = options_.name;
   v.step = msg.step;
   v.position_m = {est.pos_m.x(), est.pos_m.y(), est.pos_m.z()};
-  v.velocity_m_s = {est.vel_mps.x(), est.vel_mps.y(), est.vel_mps.z()};
+  v.velocity_m_s = {est.vel_m_s.x(), est.vel_m_s.y(), est.vel_m_s.z()};
   v.attitude_wxyz[0] = est.att.w();
   v.attitude_wxyz[1] = est.att.x();
   v.attitude_wxyz[2] = est.att.y();
   v.attitude_wxyz[3] = est.att.z();
-  v.angular_rate_rad_s = {est.rate_radps.x(), est.rate_radps.y(), est.rate_radps.z()};
+  v.angular_rate_rad_s = {est.rate_rad_s.x(), est.rate_rad_s.y(), est.rate_rad_s.z()};
   v.heading_rad = flight::YawOf(est.att);
   v.battery_fraction = battery_ ? battery_->fraction() : 1.0;
   v.battery_voltage_v = 0.0;  // not modelled: the battery model counts energy

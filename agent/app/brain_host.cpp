@@ -48,10 +48,10 @@ brain::FlightEvent FlightEventOf(const flight::FlightEvent& e) {
 flight::Setpoint FlightSetpointOf(const brain::Setpoint& sp) {
   flight::TrajectoryTarget t;
   t.pos_m = flight::Vec3(sp.position_m.x, sp.position_m.y, sp.position_m.z);
-  t.vel_mps = flight::Vec3(sp.velocity_m_s.x, sp.velocity_m_s.y, sp.velocity_m_s.z);
-  t.acc_mps2 = flight::Vec3(sp.acceleration_m_s2.x, sp.acceleration_m_s2.y, sp.acceleration_m_s2.z);
+  t.vel_m_s = flight::Vec3(sp.velocity_m_s.x, sp.velocity_m_s.y, sp.velocity_m_s.z);
+  t.acc_m_s2 = flight::Vec3(sp.acceleration_m_s2.x, sp.acceleration_m_s2.y, sp.acceleration_m_s2.z);
   t.yaw_rad = sp.yaw_rad;
-  t.yawspeed_radps = sp.yawspeed_rad_s;
+  t.yawspeed_rad_s = sp.yawspeed_rad_s;
   return flight::Setpoint::FromTrajectory(t);
 }
 

@@ -29,7 +29,7 @@ PerceptionHost::PerceptionHost(const PerceptionConfig& config)
     : config_(config), perception_(PerceptionFor(config.inference_latency_s)), history_(kHistory) {}
 
 void PerceptionHost::RecordEstimate(double t_s, const flight::StateEstimate& est) {
-  history_[history_next_] = {t_s, est.pos_m, est.att, est.rate_radps};
+  history_[history_next_] = {t_s, est.pos_m, est.att, est.rate_rad_s};
   history_next_ = (history_next_ + 1) % history_.size();
 }
 
@@ -44,7 +44,7 @@ void PerceptionHost::OnCameraFrame(const cv::Mat& bgr, const swarm::PinholeIntri
   // Geolocation needs a steady camera: a tilted or turning drone multiplies attitude errors.
   const Vec3 up = best->att * Vec3::UnitZ();
   if (std::acos(std::clamp(up.z(), -1.0, 1.0)) > config_.max_tilt_rad) return;
-  if (best->rate_radps.norm() > config_.max_rate_rad_s) return;
+  if (best->rate_rad_s.norm() > config_.max_rate_rad_s) return;
   const airframe::Vec3& offset = config_.camera.offset_m;
   const swarm::OpticalPose pose = swarm::OpticalPoseFromBody(best->pos_m, best->att, Vec3(offset.x, offset.y, offset.z));
   (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s);

@@ -56,7 +56,7 @@ class PerceptionHost {
     double t_s = -1.0;
     flight::Vec3 pos_m = flight::Vec3::Zero();
     flight::Quat att = flight::Quat::Identity();
-    flight::Vec3 rate_radps = flight::Vec3::Zero();
+    flight::Vec3 rate_rad_s = flight::Vec3::Zero();
   };
 
   PerceptionConfig config_;

@@ -1,6 +1,6 @@
 #include "radio_dispatch.hpp"
 
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 
 namespace swarmbox::agent {
 
@@ -25,18 +25,18 @@ void DispatchFrames(std::span<const bus::RadioFrame> frames, std::string_view se
     }
     if (!f.raft_msg.empty()) {
       const bus::RaftMessage& m = f.raft_msg.front();
-      switch (mission::ClassifyRaftMessage(m, self)) {
-        case mission::RaftDelivery::kDeliver:
+      switch (raft_service::ClassifyRaftMessage(m, self)) {
+        case raft_service::RaftDelivery::kDeliver:
           ++counts->raft;
           handler.OnRaftPayload(m.payload);
           break;
-        case mission::RaftDelivery::kOwn:
+        case raft_service::RaftDelivery::kOwn:
           ++counts->own;
           break;
-        case mission::RaftDelivery::kNotForUs:
+        case raft_service::RaftDelivery::kNotForUs:
           ++counts->not_for_us;
           break;
-        case mission::RaftDelivery::kEmpty:
+        case raft_service::RaftDelivery::kEmpty:
           ++counts->malformed;
           break;
       }

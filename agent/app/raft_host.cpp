@@ -4,8 +4,8 @@
 #include <utility>
 
 #include "swarmbox/bus/topics.hpp"
-#include "swarmbox/mission/demo_mission.hpp"
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/demo_mission.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 
 namespace swarmbox::agent {
 
@@ -64,7 +64,7 @@ std::string RestampLine(std::string_view line, double t_s) {
 void RadioTransport::Send(const std::string& to, std::span<const std::uint8_t> bytes) {
   bus::RadioFrame f;
   f.to = to;
-  f.raft_msg.push_back(mission::WrapRaftPayload(self_, to, bytes));
+  f.raft_msg.push_back(raft_service::WrapRaftPayload(self_, to, bytes));
   radio_.Send(std::move(f));
 }
 
@@ -80,7 +80,7 @@ Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options
   }
   if (options.raft_dir.empty()) return Error(ErrorCode::kInvalidArgument, "--raft-dir must not be empty");
   std::unique_ptr<RaftHost> host(new RaftHost(options, radio, clock));
-  mission::RaftServiceConfig rc;
+  raft_service::RaftServiceConfig rc;
   rc.driver.self = options.self;
   rc.driver.members = options.members;
   rc.driver.voters = options.voters;
@@ -90,7 +90,7 @@ Result<std::unique_ptr<RaftHost>> RaftHost::Start(const RaftHostOptions& options
   rc.driver.election_timeout_ms = options.election_timeout_ms;
   rc.data_dir = options.raft_dir;
   rc.file_system = options.file_system;
-  auto service = mission::RaftService::Start(rc, host->transport_, clock, [log, event_clock](const std::string& line) {
+  auto service = raft_service::RaftService::Start(rc, host->transport_, clock, [log, event_clock](const std::string& line) {
     const std::string out = event_clock != nullptr ? RestampLine(line, event_clock->NowS()) : line;
     std::fprintf(log, "%s\n", out.c_str());
     std::fflush(log);
@@ -109,7 +109,7 @@ Status RaftHost::Step() {
       next_propose_s_ = now + options_.propose_every_ms * 1e-3;
       const raft::MissionState* mission = service_->FindMission();
       if (service_->is_leader() && mission != nullptr) {
-        if (auto cmd = mission::NextDemoCommand(*mission, service_->self())) {
+        if (auto cmd = raft_service::NextDemoCommand(*mission, service_->self())) {
           (void)service_->Propose(*cmd);  // kUnavailable (leadership just lost): the next round retries
         }
       }

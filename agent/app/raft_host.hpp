@@ -1,4 +1,4 @@
-// RaftHost: the agent's Raft node (agent/mission's passive RaftService) driven by the control
+// RaftHost: the agent's Raft node (agent/raft_service's passive RaftService) driven by the control
 // loop on the radio's clock, its messages carried by the agent's MeshRadio, plus the storage
 // failure check and a diagnostic proposal loop.
 //
@@ -41,7 +41,7 @@
 #include <vector>
 
 #include "swarmbox/common/result.hpp"
-#include "swarmbox/mission/raft_service.hpp"
+#include "swarmbox/raft_service/raft_service.hpp"
 #include "swarmbox/radio/mesh_radio.hpp"
 #include "swarmbox/raft/file_system.hpp"
 #include "swarmbox/raft/node_driver.hpp"
@@ -122,7 +122,7 @@ class RaftHost {
   // error (storage failed) once it stopped, on every later call.
   Status Step();
   bool stopped() const { return service_->stopped(); }
-  mission::RaftService& service() { return *service_; }
+  raft_service::RaftService& service() { return *service_; }
 
   // The committed-entries tap: replaces *out with the entries applied since the previous call.
   void TakeCommitted(std::vector<raft::Committed>* out) { service_->TakeCommitted(out); }
@@ -143,7 +143,7 @@ class RaftHost {
   RaftHostOptions options_;
   RadioTransport transport_;  // before service_: outlives it
   const raft::Clock& clock_;
-  std::unique_ptr<mission::RaftService> service_;
+  std::unique_ptr<raft_service::RaftService> service_;
   double next_propose_s_ = 0.0;
 };
 

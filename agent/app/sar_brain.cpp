@@ -496,7 +496,7 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
   now.flight_mode = in.self.flight_mode;
   now.on_ground = OnGround(in.self.flight_mode);
   now.pos_m = V(in.self.position_m);
-  now.vel_mps = V(in.self.velocity_m_s);
+  now.vel_m_s = V(in.self.velocity_m_s);
   now.yaw_rad = YawOf(in.self.attitude_wxyz);
   now.mission = &state->mission();
   now.is_leader = in.is_leader;
@@ -524,7 +524,7 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
     }
   }
 
-  battery_.Step(config_.period_s, now.vel_mps, payload_mass_kg(), !now.on_ground);
+  battery_.Step(config_.period_s, now.vel_m_s, payload_mass_kg(), !now.on_ground);
   if (!started) Start(now, out);
   if (scout_ || lifter_) {
     if (tick || !started) {
@@ -551,7 +551,7 @@ void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
   mi.t_s = now.t_s;
   mi.mission = now.mission;
   mi.position_m = now.pos_m;
-  mi.velocity_m_s = now.vel_mps;
+  mi.velocity_m_s = now.vel_m_s;
   mi.yaw_rad = now.yaw_rad;
   mi.battery_fraction = battery_.fraction();
   const double to_home = (now.pos_m.head<2>() - home_m_.head<2>()).norm();
@@ -649,10 +649,10 @@ void SarBrain::Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Ou
       break;
     case SetpointKind::kFlock: {
       if (now.on_ground) break;
-      if (changed) flock_.Reset(now.vel_mps);
+      if (changed) flock_.Reset(now.vel_m_s);
       swarm::FlockingInput fi;
       fi.position_m = now.pos_m;
-      fi.velocity_m_s = now.vel_mps;
+      fi.velocity_m_s = now.vel_m_s;
       fi.goal_m = sp.target_m;
       fi.neighbours = neighbours_;
       const swarm::FlockingOutput f = flock_.Step(fi, config_.tuning.mission_dt_s);

@@ -219,7 +219,7 @@ class SarBrain final : public brain::Brain {
     std::string_view flight_mode;
     bool on_ground = true;
     flight::Vec3 pos_m = flight::Vec3::Zero();
-    flight::Vec3 vel_mps = flight::Vec3::Zero();
+    flight::Vec3 vel_m_s = flight::Vec3::Zero();
     double yaw_rad = 0.0;
     const raft::MissionState* mission = nullptr;
     bool is_leader = false;

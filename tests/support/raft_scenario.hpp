@@ -1,7 +1,7 @@
 // The leader-kill scenario of a three-member Raft cluster whose members are separate programs
 // printing their Raft events as logfmt lines (event=leader_elected leader= term=, event=
 // mission_state index= state= [from=snapshot]). Shared by tests/agent/app/agent_raft_test.cpp
-// (swarmbox-agent processes) and tests/agent/mission/raft_cluster_test.cpp (swarmbox-raft-node):
+// (swarmbox-agent processes) and tests/agent/raft_service/raft_cluster_test.cpp (swarmbox-raft-node):
 //
 //   LeaderKillScenario s(members, "[cluster fastdds]", 10ms);
 //   ASSERT_TRUE(s.AgreeOnLeader(40s));          // 1. one leader, agreed by all

@@ -15,7 +15,7 @@ void AttitudeControl::SetGains(const AttitudeGains& gains) {
   if (yaw_w_ > 1e-6) p_eff_.z() = gains.p.z() / yaw_w_;
 }
 
-Vec3 AttitudeControl::Update(const Quat& q_in, const Quat& q_sp_in, double yawspeed_ff_radps) const {
+Vec3 AttitudeControl::Update(const Quat& q_in, const Quat& q_sp_in, double yawspeed_ff_rad_s) const {
   const Quat q = q_in.normalized();
   Quat qd = q_sp_in.normalized();
 
@@ -45,9 +45,9 @@ Vec3 AttitudeControl::Update(const Quat& q_in, const Quat& q_sp_in, double yawsp
 
   Vec3 rate_sp = p_eff_.cwiseProduct(eq);
   // Yaw-rate feed-forward is about world z: express it in the body frame.
-  rate_sp += q.inverse() * (Vec3::UnitZ() * yawspeed_ff_radps);
+  rate_sp += q.inverse() * (Vec3::UnitZ() * yawspeed_ff_rad_s);
   for (int a = 0; a < 3; ++a) {
-    rate_sp[a] = std::clamp(rate_sp[a], -gains_.rate_max_radps[a], gains_.rate_max_radps[a]);
+    rate_sp[a] = std::clamp(rate_sp[a], -gains_.rate_max_rad_s[a], gains_.rate_max_rad_s[a]);
   }
   return rate_sp;
 }

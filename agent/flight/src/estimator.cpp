@@ -27,7 +27,7 @@ Estimator::Estimator(const EstimatorParams& params) : params_(params) {
 
 void Estimator::InitAttitude(const SensorSample& s) {
   // Tilt from gravity (the drone is assumed still at power-up), heading from the magnetometer.
-  const Vec3 up_b = s.accel_mps2.norm() > 1e-3 ? Vec3(s.accel_mps2.normalized()) : Vec3::UnitZ();
+  const Vec3 up_b = s.accel_m_s2.norm() > 1e-3 ? Vec3(s.accel_m_s2.normalized()) : Vec3::UnitZ();
   const Quat tilt = Quat::FromTwoVectors(up_b, Vec3::UnitZ());  // body -> level frame
   double yaw = 0.0;
   if (s.mag_fresh && s.mag_body.norm() > 1e-9) {
@@ -62,9 +62,9 @@ void Estimator::UpdateAttitude(const SensorSample& s, double dt) {
   }
   if (!aligning) gyro_bias_ += bias_rate * dt;
   for (int a = 0; a < 3; ++a) gyro_bias_[a] = std::clamp(gyro_bias_[a], -0.1, 0.1);
-  const Vec3 w = s.gyro_radps - gyro_bias_ + corr;
+  const Vec3 w = s.gyro_rad_s - gyro_bias_ + corr;
   q_ = (q_ * ExpMap(w * dt)).normalized();
-  state_.rate_radps = s.gyro_radps - gyro_bias_;
+  state_.rate_rad_s = s.gyro_rad_s - gyro_bias_;
 }
 
 Vec3 Estimator::TiltReference(const SensorSample& s) const {
@@ -81,19 +81,19 @@ Vec3 Estimator::TiltReference(const SensorSample& s) const {
   const bool gps_recent = s.t_s - t_last_gps_s_ < params_.gps_timeout_s;
   if (!at_rest_ && pos_init_) {
     if (params_.tilt_ref_from_filter && gps_recent) {
-      a_ref = state_.accel_mps2;
-    } else if (const double ga = gps_acc_.norm(); ga > params_.gps_acc_deadband_mps2) {
-      a_ref = gps_acc_ * (1.0 - params_.gps_acc_deadband_mps2 / ga);
+      a_ref = state_.accel_m_s2;
+    } else if (const double ga = gps_acc_.norm(); ga > params_.gps_acc_deadband_m_s2) {
+      a_ref = gps_acc_ * (1.0 - params_.gps_acc_deadband_m_s2 / ga);
     }
   }
-  return a_ref + Vec3(0.0, 0.0, kGravity_mps2);
+  return a_ref + Vec3(0.0, 0.0, kGravity_m_s2);
 }
 
 bool Estimator::TiltError(const SensorSample& s, Vec3* e) const {
   const Vec3 expected_w = TiltReference(s);
-  const double fm = s.accel_mps2.norm();
-  if (!(fm > 1e-3 && std::abs(fm - expected_w.norm()) < params_.acc_gate_mps2)) return false;
-  const Vec3 meas = s.accel_mps2 / fm;
+  const double fm = s.accel_m_s2.norm();
+  if (!(fm > 1e-3 && std::abs(fm - expected_w.norm()) < params_.acc_gate_m_s2)) return false;
+  const Vec3 meas = s.accel_m_s2 / fm;
   const Vec3 expect = q_.inverse() * expected_w.normalized();
   *e = meas.cross(expect);
   return true;
@@ -120,7 +120,7 @@ void Estimator::Predict(Axis* ax, int axis, double acc, double dt) const {
   x(kP) += x(kV) * dt + 0.5 * (acc - x(kBa)) * dt * dt;
   x(kV) += (acc - x(kBa)) * dt;
   Mat5 q = Mat5::Zero();
-  const double qa = params_.accel_noise_mps2 * params_.accel_noise_mps2;
+  const double qa = params_.accel_noise_m_s2 * params_.accel_noise_m_s2;
   q(kP, kP) = 0.25 * dt * dt * dt * dt * qa;
   // In flight the horizontal position lives in the receiver's (wandering) frame; standing on the
   // ground the drone is known not to move, and the GPS error state takes the wander instead.
@@ -143,8 +143,8 @@ void Estimator::Predict(Axis* ax, int axis, double acc, double dt) const {
     ax->p.col(kBb).setZero();
   }
   // The output glides after the corrections at bounded rates.
-  ax->out_dp -= std::clamp(ax->out_dp, -params_.max_pos_correction_mps * dt, params_.max_pos_correction_mps * dt);
-  ax->out_dv -= std::clamp(ax->out_dv, -params_.max_vel_correction_mps2 * dt, params_.max_vel_correction_mps2 * dt);
+  ax->out_dp -= std::clamp(ax->out_dp, -params_.max_pos_correction_m_s * dt, params_.max_pos_correction_m_s * dt);
+  ax->out_dv -= std::clamp(ax->out_dv, -params_.max_vel_correction_m_s2 * dt, params_.max_vel_correction_m_s2 * dt);
 }
 
 void Estimator::Correct(Axis* ax, const Row5& h, double y, double r) const {
@@ -202,7 +202,7 @@ const StateEstimate& Estimator::Update(const SensorSample& s) {
   TrackGpsAcceleration(s, dt);
   UpdateAttitude(s, dt);
   // World acceleration from the IMU, gravity removed.
-  if (s.imu_fresh) acc_world_ = q_ * s.accel_mps2 - Vec3(0.0, 0.0, kGravity_mps2);
+  if (s.imu_fresh) acc_world_ = q_ * s.accel_m_s2 - Vec3(0.0, 0.0, kGravity_m_s2);
   if (!pos_init_) InitPosition(s);
   TakeBaro(s);
   if (pos_init_) {
@@ -241,11 +241,11 @@ void Estimator::TrackGpsAcceleration(const SensorSample& s, double dt) {
   // GPS-derived acceleration for the tilt reference (zero when GPS is lost: hover assumption).
   if (s.gps_fresh && s.gps_valid) {
     if (last_gps_vel_t_s_ >= 0.0 && s.t_s - last_gps_vel_t_s_ > 1e-3 && s.t_s - last_gps_vel_t_s_ < 0.5) {
-      const Vec3 a = (s.gps_vel_mps - last_gps_vel_) / (s.t_s - last_gps_vel_t_s_);
+      const Vec3 a = (s.gps_vel_m_s - last_gps_vel_) / (s.t_s - last_gps_vel_t_s_);
       const double alpha = std::min(1.0, (s.t_s - last_gps_vel_t_s_) / params_.gps_acc_tau_s);
       gps_acc_ += alpha * (a - gps_acc_);
     }
-    last_gps_vel_ = s.gps_vel_mps;
+    last_gps_vel_ = s.gps_vel_m_s;
     last_gps_vel_t_s_ = s.t_s;
   } else if (s.t_s - last_gps_vel_t_s_ > params_.gps_timeout_s) {
     gps_acc_ *= std::max(0.0, 1.0 - dt / params_.gps_acc_tau_s);
@@ -261,7 +261,7 @@ void Estimator::InitPosition(const SensorSample& s) {
     ax.x.setZero();
     ax.p.setZero();
     ax.x(kP) = p0[a];
-    ax.x(kV) = have_gps ? s.gps_vel_mps[a] : 0.0;
+    ax.x(kV) = have_gps ? s.gps_vel_m_s[a] : 0.0;
     const double total = a == 2 ? params_.gps_pos_v_std_m : params_.gps_pos_h_std_m;
     // Known start: the position is sure, the GPS error is what the receiver's spec says.
     // Else the first fix is all there is: position and GPS error share its uncertainty.
@@ -317,7 +317,7 @@ void Estimator::FuseGps(const SensorSample& s) {
     Row5 hv = Row5::Zero();
     hv(kV) = 1.0;
     hv(kBa) = d;
-    Correct(&ax, hv, s.gps_vel_mps[a] - ax.hist_v[i], params_.gps_vel_std_mps * params_.gps_vel_std_mps);
+    Correct(&ax, hv, s.gps_vel_m_s[a] - ax.hist_v[i], params_.gps_vel_std_m_s * params_.gps_vel_std_m_s);
     // Position: p(t - d) + b_gps, p(t - d) = p - d v - d^2/2 b_acc (+ known inputs).
     Row5 hp = Row5::Zero();
     hp(kP) = 1.0;
@@ -333,9 +333,9 @@ void Estimator::FuseGps(const SensorSample& s) {
 void Estimator::Publish(const SensorSample& s) {
   for (int a = 0; a < 3; ++a) {
     state_.pos_m[a] = ax_[a].x(kP) - ax_[a].out_dp;
-    state_.vel_mps[a] = ax_[a].x(kV) - ax_[a].out_dv;
+    state_.vel_m_s[a] = ax_[a].x(kV) - ax_[a].out_dv;
     acc_bias_[a] = ax_[a].x(kBa);
-    state_.accel_mps2[a] = acc_world_[a] - ax_[a].x(kBa);
+    state_.accel_m_s2[a] = acc_world_[a] - ax_[a].x(kBa);
     state_.pos_std_m[a] = std::sqrt(std::max(0.0, ax_[a].p(kP, kP)));
   }
   state_.t_s = s.t_s;

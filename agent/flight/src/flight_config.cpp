@@ -19,14 +19,14 @@ Status ReadPosition(const yaml::Node& n, FlightConfig* cfg) {
   std::array<double, 3> z{p.vel_p.z(), p.vel_i.z(), p.vel_d.z()};
   double tilt_deg = p.tilt_max_rad * 180.0 / kPi;
   r.Optional("xy_p", &p.xy_p).Optional("z_p", &p.z_p).Optional("vel_xy_pid", &xy)
-      .Optional("vel_z_pid", &z).Optional("vel_max_xy_mps", &cfg->limits.vel_max_xy_mps)
-      .Optional("vel_max_up_mps", &cfg->limits.vel_max_up_mps)
-      .Optional("vel_max_down_mps", &cfg->limits.vel_max_down_mps)
-      .Optional("acc_max_xy_mps2", &cfg->limits.acc_max_xy_mps2)
-      .Optional("acc_max_z_mps2", &cfg->limits.acc_max_z_mps2)
+      .Optional("vel_z_pid", &z).Optional("vel_max_xy_m_s", &cfg->limits.vel_max_xy_m_s)
+      .Optional("vel_max_up_m_s", &cfg->limits.vel_max_up_m_s)
+      .Optional("vel_max_down_m_s", &cfg->limits.vel_max_down_m_s)
+      .Optional("acc_max_xy_m_s2", &cfg->limits.acc_max_xy_m_s2)
+      .Optional("acc_max_z_m_s2", &cfg->limits.acc_max_z_m_s2)
       .Optional("tilt_max_deg", &tilt_deg).Optional("thrust_min", &cfg->thrust_min_frac)
       .Optional("thrust_max", &cfg->thrust_max_frac)
-      .Optional("integral_max_mps2", &p.integral_max_mps2);
+      .Optional("integral_max_m_s2", &p.integral_max_m_s2);
   SWARMBOX_TRY(r.Finish());
   p.vel_p = Vec3(xy[0], xy[0], z[0]);
   p.vel_i = Vec3(xy[1], xy[1], z[1]);
@@ -42,13 +42,13 @@ Status ReadPosition(const yaml::Node& n, FlightConfig* cfg) {
 
 Status ReadAttitude(const yaml::Node& n, FlightConfig* cfg) {
   yaml::MapReader r(n, "control.attitude");
-  std::array<double, 3> rate_max_deg{cfg->attitude.rate_max_radps.x() * 180.0 / kPi,
-                                     cfg->attitude.rate_max_radps.y() * 180.0 / kPi,
-                                     cfg->attitude.rate_max_radps.z() * 180.0 / kPi};
+  std::array<double, 3> rate_max_deg{cfg->attitude.rate_max_rad_s.x() * 180.0 / kPi,
+                                     cfg->attitude.rate_max_rad_s.y() * 180.0 / kPi,
+                                     cfg->attitude.rate_max_rad_s.z() * 180.0 / kPi};
   r.Optional("roll_p", &cfg->attitude.p.x()).Optional("pitch_p", &cfg->attitude.p.y())
       .Optional("yaw_p", &cfg->attitude.p.z()).Optional("rate_max_deg_s", &rate_max_deg);
   SWARMBOX_TRY(r.Finish());
-  cfg->attitude.rate_max_radps = Vec3(rate_max_deg[0], rate_max_deg[1], rate_max_deg[2]) * kPi / 180.0;
+  cfg->attitude.rate_max_rad_s = Vec3(rate_max_deg[0], rate_max_deg[1], rate_max_deg[2]) * kPi / 180.0;
   return Ok{};
 }
 
@@ -70,13 +70,13 @@ Status ReadRate(const yaml::Node& n, FlightConfig* cfg) {
 
 Status ReadTakeoff(const yaml::Node& n, FlightConfig* cfg) {
   yaml::MapReader r(n, "control.takeoff");
-  r.Optional("speed_mps", &cfg->takeoff_speed_mps);
+  r.Optional("speed_m_s", &cfg->takeoff_speed_m_s);
   return r.Finish();
 }
 
 Status ReadLand(const yaml::Node& n, FlightConfig* cfg) {
   yaml::MapReader r(n, "control.land");
-  r.Optional("speed_mps", &cfg->land_speed_mps).Optional("slow_speed_mps", &cfg->land_slow_speed_mps)
+  r.Optional("speed_m_s", &cfg->land_speed_m_s).Optional("slow_speed_m_s", &cfg->land_slow_speed_m_s)
       .Optional("slow_below_m", &cfg->land_slow_below_m);
   return r.Finish();
 }
@@ -109,10 +109,10 @@ Status ReadEstimator(const yaml::Node& n, FlightConfig* cfg) {
   yaml::MapReader r(n, "control.estimator");
   EstimatorParams& e = cfg->estimator;
   r.Optional("acc_kp", &e.acc_kp).Optional("acc_ki", &e.acc_ki).Optional("mag_kp", &e.mag_kp)
-      .Optional("accel_noise_mps2", &e.accel_noise_mps2).Optional("accel_bias_walk", &e.accel_bias_walk)
-      .Optional("gps_acc_deadband_mps2", &e.gps_acc_deadband_mps2).Optional("gps_acc_tau_s", &e.gps_acc_tau_s)
-      .Optional("max_pos_correction_mps", &e.max_pos_correction_mps)
-      .Optional("max_vel_correction_mps2", &e.max_vel_correction_mps2)
+      .Optional("accel_noise_m_s2", &e.accel_noise_m_s2).Optional("accel_bias_walk", &e.accel_bias_walk)
+      .Optional("gps_acc_deadband_m_s2", &e.gps_acc_deadband_m_s2).Optional("gps_acc_tau_s", &e.gps_acc_tau_s)
+      .Optional("max_pos_correction_m_s", &e.max_pos_correction_m_s)
+      .Optional("max_vel_correction_m_s2", &e.max_vel_correction_m_s2)
       .Optional("gps_noise_h_m", &e.gps_noise_h_m).Optional("gps_noise_v_m", &e.gps_noise_v_m)
       .Optional("gps_noise_floor_h_m", &e.gps_noise_floor_h_m)
       .Optional("gps_noise_floor_v_m", &e.gps_noise_floor_v_m)
@@ -165,12 +165,12 @@ Result<FlightConfig> FlightConfigFrom(const airframe::Airframe& af) {
     cfg.estimator.gps_pos_h_std_m = af.gps.horizontal_std_m;
     cfg.estimator.gps_pos_v_std_m = af.gps.vertical_std_m;
   }
-  cfg.estimator.gps_vel_std_mps = af.gps.velocity_std_m_s;
+  cfg.estimator.gps_vel_std_m_s = af.gps.velocity_std_m_s;
   cfg.payloads = af.payloads;
   if (!af.control.is_null()) SWARMBOX_TRY(ReadControl(af.control, &cfg));
-  cfg.position.vel_max_xy_mps = cfg.limits.vel_max_xy_mps;
-  cfg.position.vel_max_up_mps = cfg.limits.vel_max_up_mps;
-  cfg.position.vel_max_down_mps = cfg.limits.vel_max_down_mps;
+  cfg.position.vel_max_xy_m_s = cfg.limits.vel_max_xy_m_s;
+  cfg.position.vel_max_up_m_s = cfg.limits.vel_max_up_m_s;
+  cfg.position.vel_max_down_m_s = cfg.limits.vel_max_down_m_s;
   return cfg;
 }
 

@@ -29,19 +29,19 @@ void HoverThrustEstimator::Predict(double dt_s) {
   var_ += params_.process_noise * params_.process_noise * dt_s * dt_s;
 }
 
-HoverThrustStatus HoverThrustEstimator::Fuse(double acc_up_mps2, double thrust_z, double dt_s,
+HoverThrustStatus HoverThrustEstimator::Fuse(double acc_up_m_s2, double thrust_z, double dt_s,
                                              double noise_scale) {
   HoverThrustStatus st;
-  if (!std::isfinite(acc_up_mps2) || !std::isfinite(thrust_z) || !(dt_s > 0.0) || !(thrust_z > 0.0)) {
+  if (!std::isfinite(acc_up_m_s2) || !std::isfinite(thrust_z) || !(dt_s > 0.0) || !(thrust_z > 0.0)) {
     return st;
   }
-  const double g = kGravity_mps2;
+  const double g = kGravity_m_s2;
   const double scale = std::max(1.0, noise_scale);
   // Linearised measurement: d a_z / d h = -g thrust / h^2.
   const double h_meas = -g * thrust_z / (hover_ * hover_);
   const double r = acc_var_ * scale * scale;
   const double innov_var = std::max(h_meas * var_ * h_meas + r, r);
-  const double innov = acc_up_mps2 - (g * thrust_z / hover_ - g);
+  const double innov = acc_up_m_s2 - (g * thrust_z / hover_ - g);
   const double k = var_ * h_meas / innov_var;
   const double ratio = innov * innov / (params_.gate_sd * params_.gate_sd * innov_var);
 
@@ -49,7 +49,7 @@ HoverThrustStatus HoverThrustEstimator::Fuse(double acc_up_mps2, double thrust_z
   if (ratio < 1.0) {
     hover_ = std::clamp(hover_ + k * innov, params_.min_hover, params_.max_hover);
     var_ = std::clamp((1.0 - k * h_meas) * var_, 1e-10, 1.0);
-    residual = acc_up_mps2 - (g * thrust_z / hover_ - g);
+    residual = acc_up_m_s2 - (g * thrust_z / hover_ - g);
     st.fused = true;
   } else if (std::abs(ratio_lpf_) > params_.offset_ratio) {
     // Measurements rejected on one side for a while: the hover thrust jumped (load change) or the

@@ -38,8 +38,8 @@ Quat AttitudeFromThrustAndYaw(const Vec3& body_z_in, double yaw_rad) {
 PositionOutput PositionControl::Update(const StateEstimate& state, const PositionSetpoint& sp,
                                        double mass_kg, double dt_s) {
   PositionOutput out;
-  if (!Finite(state.pos_m) || !Finite(state.vel_mps) || !Finite(sp.pos_m) || !Finite(sp.vel_mps) ||
-      !Finite(sp.acc_mps2) || !std::isfinite(sp.yaw_rad) || !(mass_kg > 0.0)) {
+  if (!Finite(state.pos_m) || !Finite(state.vel_m_s) || !Finite(sp.pos_m) || !Finite(sp.vel_m_s) ||
+      !Finite(sp.acc_m_s2) || !std::isfinite(sp.yaw_rad) || !(mass_kg > 0.0)) {
     return out;
   }
   Vec3 vel_sp = VelocitySetpoint(state, sp);
@@ -52,15 +52,15 @@ PositionOutput PositionControl::Update(const StateEstimate& state, const Positio
   out.thrust_world_n = thrust;
   out.thrust_n = thrust.norm();
   out.att_sp = AttitudeFromThrustAndYaw(thrust, sp.yaw_rad);
-  out.vel_sp_mps = vel_sp;
-  out.acc_sp_mps2 = Vec3(f.xy.x() / mass_kg, f.xy.y() / mass_kg, f.z / mass_kg - kGravity_mps2);
+  out.vel_sp_m_s = vel_sp;
+  out.acc_sp_m_s2 = Vec3(f.xy.x() / mass_kg, f.xy.y() / mass_kg, f.z / mass_kg - kGravity_m_s2);
   return out;
 }
 
 Vec3 PositionControl::VelocitySetpoint(const StateEstimate& state, const PositionSetpoint& sp) const {
   const PositionParams& p = params_;
   // Position P -> velocity setpoint, with the velocity limits. Acceleration-only axes have none.
-  Vec3 vel_sp = sp.vel_mps;
+  Vec3 vel_sp = sp.vel_m_s;
   for (int a = 0; a < 3; ++a) {
     if (AxisIs(sp, a, AxisControl::kPosition)) {
       vel_sp[a] += (a < 2 ? p.xy_p : p.z_p) * (sp.pos_m[a] - state.pos_m[a]);
@@ -68,11 +68,11 @@ Vec3 PositionControl::VelocitySetpoint(const StateEstimate& state, const Positio
       vel_sp[a] = 0.0;
     }
   }
-  const double vel_max_xy = std::min(p.vel_max_xy_mps, sp.vel_cap_xy_mps);
+  const double vel_max_xy = std::min(p.vel_max_xy_m_s, sp.vel_cap_xy_m_s);
   const double vxy = vel_sp.head<2>().norm();
   if (vxy > vel_max_xy) vel_sp.head<2>() *= vel_max_xy / vxy;
-  vel_sp.z() = std::clamp(vel_sp.z(), -std::min(p.vel_max_down_mps, sp.vel_cap_down_mps),
-                          std::min(p.vel_max_up_mps, sp.vel_cap_up_mps));
+  vel_sp.z() = std::clamp(vel_sp.z(), -std::min(p.vel_max_down_m_s, sp.vel_cap_down_m_s),
+                          std::min(p.vel_max_up_m_s, sp.vel_cap_up_m_s));
   return vel_sp;
 }
 
@@ -81,14 +81,14 @@ Vec3 PositionControl::AccelerationSetpoint(const StateEstimate& state, const Pos
   const PositionParams& p = params_;
   // Velocity PID -> acceleration setpoint (D on the measured acceleration); acceleration-only
   // axes take the feed-forward alone (PX4: a NaN velocity setpoint leaves the axis to it).
-  *vel_err = *vel_sp - state.vel_mps;
-  Vec3 acc_sp = p.vel_p.cwiseProduct(*vel_err) + integral_ - p.vel_d.cwiseProduct(state.accel_mps2) +
-                sp.acc_mps2;
+  *vel_err = *vel_sp - state.vel_m_s;
+  Vec3 acc_sp = p.vel_p.cwiseProduct(*vel_err) + integral_ - p.vel_d.cwiseProduct(state.accel_m_s2) +
+                sp.acc_m_s2;
   for (int a = 0; a < 3; ++a) {
     if (AxisIs(sp, a, AxisControl::kAcceleration)) {
       (*vel_err)[a] = 0.0;
       (*vel_sp)[a] = std::numeric_limits<double>::quiet_NaN();
-      acc_sp[a] = sp.acc_mps2[a];
+      acc_sp[a] = sp.acc_m_s2[a];
     }
   }
   return acc_sp;
@@ -101,7 +101,7 @@ PositionControl::ThrustSplit PositionControl::LimitThrust(const Vec3& acc_sp, do
   const double f_min = p.thrust_min_n;
   const double f_max = p.thrust_max_n;
   ThrustSplit f;
-  f.z_raw = mass_kg * (acc_sp.z() + kGravity_mps2);
+  f.z_raw = mass_kg * (acc_sp.z() + kGravity_m_s2);
   f.z = std::clamp(f.z_raw, std::max(f_min, 1e-3), f_max);
   f.xy_raw = Vec3(mass_kg * acc_sp.x(), mass_kg * acc_sp.y(), 0.0);
   double f_xy_max = f.z * std::tan(std::min(p.tilt_max_rad, 89.0 * kPi / 180.0));
@@ -129,7 +129,7 @@ void PositionControl::UpdateIntegral(const PositionSetpoint& sp, const ThrustSpl
     integral_[a] += p.vel_i[a] * e * dt_s;
   }
   for (int a = 0; a < 3; ++a) {
-    integral_[a] = std::clamp(integral_[a], -p.integral_max_mps2, p.integral_max_mps2);
+    integral_[a] = std::clamp(integral_[a], -p.integral_max_m_s2, p.integral_max_m_s2);
   }
 }
 

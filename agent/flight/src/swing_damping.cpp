@@ -40,8 +40,8 @@ TrajectoryPoint InputShaper::Shape(const TrajectoryPoint& raw) {
   const TrajectoryPoint& p2 = buffer_[(head_ + n - full_) % n];
   TrajectoryPoint out;
   out.pos_m = a0_ * raw.pos_m + a1_ * p1.pos_m + a2_ * p2.pos_m;
-  out.vel_mps = a0_ * raw.vel_mps + a1_ * p1.vel_mps + a2_ * p2.vel_mps;
-  out.acc_mps2 = a0_ * raw.acc_mps2 + a1_ * p1.acc_mps2 + a2_ * p2.acc_mps2;
+  out.vel_m_s = a0_ * raw.vel_m_s + a1_ * p1.vel_m_s + a2_ * p2.vel_m_s;
+  out.acc_m_s2 = a0_ * raw.acc_m_s2 + a1_ * p1.acc_m_s2 + a2_ * p2.acc_m_s2;
   return out;
 }
 
@@ -69,7 +69,7 @@ void SwingObserver::Update(const Vec3& f_body, const Quat& att, const Vec3& acc_
   }
   // Cable direction in the body from the part of the specific force perpendicular to body z:
   // m_d f_xy = T_c u_xy with tension T_c ~ m_p (g + a_z) (quasi-static).
-  const double tension_n = payload_mass_kg * std::max(2.0, kGravity_mps2 + acc_world.z());
+  const double tension_n = payload_mass_kg * std::max(2.0, kGravity_m_s2 + acc_world.z());
   Vec3 u_b(drone_mass_kg_ * f_body.x() / tension_n, drone_mass_kg_ * f_body.y() / tension_n, 0.0);
   const double h2 = u_b.head<2>().squaredNorm();
   if (h2 > 0.64) u_b.head<2>() *= std::sqrt(0.64 / h2);  // clamp at ~53 deg from body -z
@@ -85,7 +85,7 @@ void SwingObserver::Update(const Vec3& f_body, const Quat& att, const Vec3& acc_
   }
   // Pendulum observer, per horizontal axis, driven by the hook's (the drone's) acceleration.
   // Gains put the observer poles near 2-3x the pendulum frequency.
-  const double w2 = kGravity_mps2 / length_m_;
+  const double w2 = kGravity_m_s2 / length_m_;
   const double l1 = 3.0 * std::sqrt(w2);
   const double l2 = 3.0 * w2;
   // A slow offset state takes what the pendulum model cannot explain (a steady lean of the sling
@@ -106,13 +106,13 @@ double SwingObserver::swing_angle_rad() const {
 
 Vec3 SwingObserver::DampingAcceleration(double gain) const {
   if (!active_) return Vec3::Zero();
-  const double k = gain * std::sqrt(kGravity_mps2 * length_m_);
+  const double k = gain * std::sqrt(kGravity_m_s2 * length_m_);
   return Vec3(k * s_dot_.x(), k * s_dot_.y(), 0.0);
 }
 
 Vec3 SwingObserver::DampingVelocity(double gain) const {
   if (!active_) return Vec3::Zero();
-  const double k = gain * std::sqrt(kGravity_mps2 * length_m_);
+  const double k = gain * std::sqrt(kGravity_m_s2 * length_m_);
   return Vec3(k * s_.x(), k * s_.y(), 0.0);
 }
 

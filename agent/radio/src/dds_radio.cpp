@@ -4,7 +4,7 @@
 #include <utility>
 
 #include "swarmbox/bus/topics.hpp"
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 
 namespace swarmbox::radio {
 namespace {
@@ -94,12 +94,12 @@ Status DdsRadio::OpenPings(bus::Participant& mesh) {
 }
 
 Status DdsRadio::OpenRaft(bus::Participant& mesh) {
-  auto rr = mission::RaftRadio::Create(mesh, self_, peers_, [this](std::span<const std::uint8_t> bytes) {
+  auto rr = raft_service::RaftRadio::Create(mesh, self_, peers_, [this](std::span<const std::uint8_t> bytes) {
     bus::RadioFrame f;
     f.to = self_;
     bus::RaftMessage m;
     m.to = self_;
-    m.term = mission::PeekRaftTerm(bytes);
+    m.term = raft_service::PeekRaftTerm(bytes);
     m.payload.assign(bytes.begin(), bytes.end());
     f.raft_msg.push_back(std::move(m));
     Push(std::move(f));

@@ -83,11 +83,11 @@ std::string DescribeFault(const Fault& fault) {
     }
     std::string operator()(const ImuBias& b) const {
       auto v = [](const std::array<double, 3>& a) { return "[" + Num(a[0]) + ", " + Num(a[1]) + ", " + Num(a[2]) + "]"; };
-      return "accel_mps2=" + v(b.accel_mps2) + " gyro_rad_s=" + v(b.gyro_rad_s);
+      return "accel_m_s2=" + v(b.accel_m_s2) + " gyro_rad_s=" + v(b.gyro_rad_s);
     }
     std::string operator()(const WindGust& w) const {
-      return "speed_mps=" + Num(w.speed_mps) + " direction_deg=" + Num(w.direction_deg) +
-             " vertical_mps=" + Num(w.vertical_mps);
+      return "speed_m_s=" + Num(w.speed_m_s) + " direction_deg=" + Num(w.direction_deg) +
+             " vertical_m_s=" + Num(w.vertical_m_s);
     }
   };
   std::string out = std::visit(Visitor{}, fault.action);

@@ -176,13 +176,13 @@ Result<FaultAction> ParseImuBias(std::string_view /*kind*/, const yaml::Node& va
   ImuBias out;
   yaml::MapReader r(value, "imu_bias");
   const yaml::Node* t = r.Child("target", /*required=*/true);
-  r.Optional("accel_mps2", &out.accel_mps2).Optional("gyro_rad_s", &out.gyro_rad_s);
+  r.Optional("accel_m_s2", &out.accel_m_s2).Optional("gyro_rad_s", &out.gyro_rad_s);
   SWARMBOX_TRY(r.Finish());
   auto target = ParseTarget(*t);
   if (!target) return target.error();
   out.target = std::move(*target);
-  if (out.accel_mps2 == std::array<double, 3>{} && out.gyro_rad_s == std::array<double, 3>{}) {
-    return Invalid("imu_bias changes nothing: give accel_mps2 and/or gyro_rad_s", value.Where());
+  if (out.accel_m_s2 == std::array<double, 3>{} && out.gyro_rad_s == std::array<double, 3>{}) {
+    return Invalid("imu_bias changes nothing: give accel_m_s2 and/or gyro_rad_s", value.Where());
   }
   return FaultAction(std::move(out));
 }
@@ -190,11 +190,11 @@ Result<FaultAction> ParseImuBias(std::string_view /*kind*/, const yaml::Node& va
 Result<FaultAction> ParseWindGust(std::string_view /*kind*/, const yaml::Node& value) {
   WindGust out;
   yaml::MapReader r(value, "wind_gust");
-  r.Required("speed_mps", &out.speed_mps).Optional("direction_deg", &out.direction_deg)
-      .Optional("vertical_mps", &out.vertical_mps);
+  r.Required("speed_m_s", &out.speed_m_s).Optional("direction_deg", &out.direction_deg)
+      .Optional("vertical_m_s", &out.vertical_m_s);
   SWARMBOX_TRY(r.Finish());
-  if (!(out.speed_mps >= 0.0 && out.speed_mps <= 100.0)) {
-    return Invalid("'speed_mps' must be in [0, 100] m/s", value.Find("speed_mps")->Where());
+  if (!(out.speed_m_s >= 0.0 && out.speed_m_s <= 100.0)) {
+    return Invalid("'speed_m_s' must be in [0, 100] m/s", value.Find("speed_m_s")->Where());
   }
   if (!(out.direction_deg >= 0.0 && out.direction_deg < 360.0)) {
     return Invalid("'direction_deg' must be in [0, 360)", value.Find("direction_deg")->Where());

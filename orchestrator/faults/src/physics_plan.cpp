@@ -17,7 +17,7 @@ std::array<double, 3> GustVelocityEnu(const WindGust& gust) {
   const double from = gust.direction_deg * std::numbers::pi / 180.0;
   // To the micrometre per second, so 270 deg gives (s, 0, w), not (s, -1.8e-15, w); + 0.0 makes -0 0.
   auto um = [](double v) { return std::round(v * 1e6) / 1e6 + 0.0; };
-  return {um(-gust.speed_mps * std::sin(from)), um(-gust.speed_mps * std::cos(from)), gust.vertical_mps};
+  return {um(-gust.speed_m_s * std::sin(from)), um(-gust.speed_m_s * std::cos(from)), gust.vertical_m_s};
 }
 
 PhysicsPlan PlanPhysicsFault(const Fault& fault, const std::vector<std::string>& targets) {
@@ -31,7 +31,7 @@ PhysicsPlan PlanPhysicsFault(const Fault& fault, const std::vector<std::string>&
       plan.apply.push_back({t, "gps_degrade", {duration_s, degrade->h_acc_m, degrade->v_acc_m}});
     }
   } else if (const auto* bias = std::get_if<ImuBias>(&fault.action)) {
-    const auto& a = bias->accel_mps2;
+    const auto& a = bias->accel_m_s2;
     const auto& g = bias->gyro_rad_s;
     for (const std::string& t : targets) {
       plan.apply.push_back({t, "imu_bias_jump", {a[0], a[1], a[2], g[0], g[1], g[2]}});

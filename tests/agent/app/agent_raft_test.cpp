@@ -8,7 +8,7 @@
 // re-applies its WAL (Raft §5.3: at least the pre-kill committed index, before hearing from a
 // leader) and catches up to the survivors with the same states (State Machine Safety, §5.4.3).
 // The scenario steps 1-5 are tests/support/raft_scenario.hpp's, shared with
-// tests/agent/mission/raft_cluster_test.cpp. Waits add up to < 240 s (the TIMEOUT).
+// tests/agent/raft_service/raft_cluster_test.cpp. Waits add up to < 240 s (the TIMEOUT).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>

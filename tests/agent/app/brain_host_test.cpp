@@ -315,7 +315,7 @@ TEST(BrainHost, FliesAMixedSetpointAsATrajectory) {
   EXPECT_EQ(t.kind, flight::Setpoint::Kind::kTrajectory);
   EXPECT_EQ(t.trajectory.pos_m.x(), 1.0);
   EXPECT_TRUE(std::isnan(t.trajectory.pos_m.z()));
-  EXPECT_EQ(t.trajectory.vel_mps.z(), 0.5);
+  EXPECT_EQ(t.trajectory.vel_m_s.z(), 0.5);
 }
 
 TEST(BrainHost, HoldsThenLandsWhenTheBrainFallsSilent) {

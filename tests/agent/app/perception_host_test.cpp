@@ -92,7 +92,7 @@ TEST(PerceptionHost, SkipsTiltedTurningAndUnknownCaptureSteps) {
   }
   {
     PerceptionRig rig;
-    rig.estimate().rate_radps = Vector3d(0, 0, 0.8);  // turning at 0.8 rad/s > 0.5 rad/s
+    rig.estimate().rate_rad_s = Vector3d(0, 0, 0.8);  // turning at 0.8 rad/s > 0.5 rad/s
     EXPECT_TRUE(rig.Run(5.0, 5.1).empty());
   }
   {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -44,7 +44,7 @@ bus::RadioFrame Raft(const std::string& from, const std::string& to, std::size_t
   bus::RadioFrame f;
   f.from = from;
   f.to = to;
-  f.raft_msg.push_back(mission::WrapRaftPayload(from, to, std::vector<std::uint8_t>(bytes, 7)));
+  f.raft_msg.push_back(raft_service::WrapRaftPayload(from, to, std::vector<std::uint8_t>(bytes, 7)));
   return f;
 }
 

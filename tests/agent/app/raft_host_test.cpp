@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "support/files.hpp"
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 #include "swarmbox/radio/channel_radio.hpp"
 
 namespace swarmbox::agent {
@@ -167,7 +167,7 @@ ThreeRun RunThree(std::uint64_t seed, double seconds, bool entry_log = false,
       std::vector<bus::RadioFrame> frames;
       d.radio->TakeReceived(s, &frames);
       for (const bus::RadioFrame& f : frames) {
-        if (mission::ClassifyRaftMessage(f.raft_msg[0], members[i]) == mission::RaftDelivery::kDeliver) {
+        if (raft_service::ClassifyRaftMessage(f.raft_msg[0], members[i]) == raft_service::RaftDelivery::kDeliver) {
           d.host->OnPayload(f.raft_msg[0].payload);
         }
       }

@@ -91,7 +91,7 @@ TEST(PositionControl, HoverAtSetpointAsksForWeight) {
   sp.pos_m = Vec3(0.0, 0.0, 5.0);
   const PositionOutput out = pc.Update(Hovering(), sp, 2.0, 0.004);
   ASSERT_TRUE(out.valid);
-  EXPECT_NEAR(out.thrust_n, 2.0 * kGravity_mps2, 1e-9);
+  EXPECT_NEAR(out.thrust_n, 2.0 * kGravity_m_s2, 1e-9);
   EXPECT_NEAR(out.att_sp.angularDistance(Quat::Identity()), 0.0, 1e-9);
 }
 
@@ -109,8 +109,8 @@ TEST(PositionControl, TiltIsLimitedAndAltitudeKeepsPriority) {
   const Vec3 z = out.att_sp * Vec3::UnitZ();
   EXPECT_NEAR(std::acos(z.z()), 30.0 * kPi / 180.0, 1e-6);  // at the limit, not beyond
   EXPECT_GT(z.x(), 0.0);                                    // leaning east
-  EXPECT_NEAR(out.thrust_world_n.z(), 2.0 * kGravity_mps2, 1e-9);  // vertical untouched
-  EXPECT_NEAR(out.vel_sp_mps.x(), p.vel_max_xy_mps, 1e-9);  // velocity limit
+  EXPECT_NEAR(out.thrust_world_n.z(), 2.0 * kGravity_m_s2, 1e-9);  // vertical untouched
+  EXPECT_NEAR(out.vel_sp_m_s.x(), p.vel_max_xy_m_s, 1e-9);  // velocity limit
 }
 
 TEST(PositionControl, NonFiniteInputIsRejected) {
@@ -135,13 +135,13 @@ TEST(Trajectory, PositionStepRespectsLimitsAndArrivesWithoutOvershoot) {
   double max_v = 0.0, max_a = 0.0, max_x = 0.0, t_arrive = -1.0;
   for (int k = 1; k <= 2500; ++k) {
     const TrajectoryPoint p = tr.Step(0.004);
-    max_v = std::max(max_v, p.vel_mps.norm());
-    max_a = std::max(max_a, p.acc_mps2.norm());
+    max_v = std::max(max_v, p.vel_m_s.norm());
+    max_a = std::max(max_a, p.acc_m_s2.norm());
     max_x = std::max(max_x, p.pos_m.x());
     if (t_arrive < 0 && std::abs(p.pos_m.x() - 10.0) < 0.01) t_arrive = k * 0.004;
   }
-  EXPECT_LE(max_v, lim.vel_max_xy_mps + 1e-9);
-  EXPECT_LE(max_a, lim.acc_max_xy_mps2 + 1e-9);
+  EXPECT_LE(max_v, lim.vel_max_xy_m_s + 1e-9);
+  EXPECT_LE(max_a, lim.acc_max_xy_m_s2 + 1e-9);
   EXPECT_LE(max_x, 10.0 + 1e-6);  // no overshoot
   ASSERT_GT(t_arrive, 0.0);
   EXPECT_LT(t_arrive, 5.0);  // 10 m at 3 m/s^2 and 5 m/s: ~4 s
@@ -153,8 +153,8 @@ TEST(Trajectory, ClimbUsesVerticalLimits) {
   tr.Reset(Vec3::Zero(), Vec3::Zero());
   tr.SetPositionTarget(Vec3(0.0, 0.0, -20.0));
   double min_vz = 0.0;
-  for (int k = 0; k < 5000; ++k) min_vz = std::min(min_vz, tr.Step(0.004).vel_mps.z());
-  EXPECT_NEAR(min_vz, -lim.vel_max_down_mps, 1e-9);
+  for (int k = 0; k < 5000; ++k) min_vz = std::min(min_vz, tr.Step(0.004).vel_m_s.z());
+  EXPECT_NEAR(min_vz, -lim.vel_max_down_m_s, 1e-9);
   EXPECT_TRUE(tr.Settled());
 }
 
@@ -163,9 +163,9 @@ TEST(Trajectory, VelocityTargetRampsAtAccelerationLimit) {
   tr.Reset(Vec3::Zero(), Vec3::Zero());
   tr.SetVelocityTarget(Vec3(3.0, 0.0, 0.0));
   const TrajectoryPoint p = tr.Step(0.1);
-  EXPECT_NEAR(p.vel_mps.x(), 0.3, 1e-9);  // 3 m/s^2 * 0.1 s
+  EXPECT_NEAR(p.vel_m_s.x(), 0.3, 1e-9);  // 3 m/s^2 * 0.1 s
   for (int k = 0; k < 100; ++k) tr.Step(0.1);
-  EXPECT_NEAR(tr.reference().vel_mps.x(), 3.0, 1e-9);
+  EXPECT_NEAR(tr.reference().vel_m_s.x(), 3.0, 1e-9);
 }
 
 }  // namespace

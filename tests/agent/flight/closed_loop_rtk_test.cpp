@@ -37,9 +37,9 @@ TEST_P(ClosedLoopRtk, X500HorizontalStepSettlesFastWithoutOvershoot) {
   auto m = RunStep(GetParam(), 10.0, 0.0, 0.0, Receiver::kRtk);
   ASSERT_TRUE(m.ok()) << m.error().ToString();
   std::printf("seed=%llu step10 receiver=rtk: settle_target_s=%.2f settle_truth_s=%.2f settle_s=%.2f "
-              "overshoot_truth_pct=%.1f overshoot_pct=%.1f peak_mps=%.2f\n",
+              "overshoot_truth_pct=%.1f overshoot_pct=%.1f peak_m_s=%.2f\n",
               static_cast<unsigned long long>(GetParam()), m->settle_target_s, m->settle_truth_s, m->settle_s,
-              m->overshoot_truth_pct, m->overshoot_pct, m->peak_speed_mps);
+              m->overshoot_truth_pct, m->overshoot_pct, m->peak_speed_m_s);
   EXPECT_TRUE(m->settled);
   EXPECT_LT(m->settle_target_s, 6.0);  // true position within 0.2 m of the commanded target
   EXPECT_LT(m->settle_truth_s, 6.0);   // true displacement within 0.2 m of the step
@@ -50,9 +50,9 @@ TEST_P(ClosedLoopRtk, X500ClimbSettlesFastWithoutOvershoot) {
   auto m = RunStep(GetParam(), 0.0, 0.0, 5.0, Receiver::kRtk);
   ASSERT_TRUE(m.ok()) << m.error().ToString();
   std::printf("seed=%llu climb5 receiver=rtk: settle_target_s=%.2f settle_truth_s=%.2f settle_s=%.2f "
-              "overshoot_truth_pct=%.1f overshoot_pct=%.1f peak_mps=%.2f\n",
+              "overshoot_truth_pct=%.1f overshoot_pct=%.1f peak_m_s=%.2f\n",
               static_cast<unsigned long long>(GetParam()), m->settle_target_s, m->settle_truth_s, m->settle_s,
-              m->overshoot_truth_pct, m->overshoot_pct, m->peak_speed_mps);
+              m->overshoot_truth_pct, m->overshoot_pct, m->peak_speed_m_s);
   EXPECT_TRUE(m->settled);
   EXPECT_LT(m->settle_target_s, 6.0);
   EXPECT_LT(m->settle_truth_s, 6.0);

@@ -42,8 +42,8 @@ class FakeVehicle {
     SensorSample s;
     s.t_s = k * dt;
     s.imu_fresh = true;
-    s.accel_mps2 = att.inverse() * (acc + Vec3(0.0, 0.0, kGravity_mps2)) + Noise(0.02);
-    s.gyro_radps = rate + Vec3(0.003, -0.002, 0.001) + Noise(0.002);  // with a constant bias
+    s.accel_m_s2 = att.inverse() * (acc + Vec3(0.0, 0.0, kGravity_m_s2)) + Noise(0.02);
+    s.gyro_rad_s = rate + Vec3(0.003, -0.002, 0.001) + Noise(0.002);  // with a constant bias
     s.baro_fresh = k % 5 == 0;
     s.baro_alt_m = pos.z() + 488.0 + N(0.12);
     s.mag_fresh = k % 3 == 0;
@@ -56,7 +56,7 @@ class FakeVehicle {
     s.gps_pos_m = past_pos_[then] + gps_offset + Vec3(N(gps_noise), N(gps_noise), N(gps_noise_v));
     s.gps_eph_m = eph;
     s.gps_epv_m = epv;
-    s.gps_vel_mps = past_vel_[then] + Noise(0.1);
+    s.gps_vel_m_s = past_vel_[then] + Noise(0.1);
     return s;
   }
   // Moves the truth (and its recent history) by d: a jump the estimator cannot see coming.
@@ -107,7 +107,7 @@ TEST(Estimator, TracksAnAcceleratingVehicleWithoutTiltingTheAttitude) {
   for (int i = 0; i < 500; ++i) est.Update(v.Step(0.004));
   // Without the GPS-derived reference the filter would lean ~0.09 rad towards level here.
   EXPECT_LT(worst_tilt, 0.06);                                      // < 3.4 deg
-  EXPECT_LT((est.state().vel_mps - v.vel).norm(), 0.15);            // 6 m/s, within 0.15
+  EXPECT_LT((est.state().vel_m_s - v.vel).norm(), 0.15);            // 6 m/s, within 0.15
   EXPECT_LT((est.state().pos_m - v.pos).head<2>().norm(), 0.5);
 }
 
@@ -137,7 +137,7 @@ TEST(Estimator, DeadReckonsThroughGpsDropoutWithGrowingUncertaintyAndGlidesBack)
     // in (1 m/s per axis) on top of the estimated velocity (itself gliding, < 0.5 m/s here).
     // Horizontal only: z also takes the (ungated, centimetre) barometer corrections.
     max_rate = std::max(max_rate, (est.state().pos_m - last).head<2>().norm() / 0.004);
-    max_speed = std::max(max_speed, est.state().vel_mps.norm());
+    max_speed = std::max(max_speed, est.state().vel_m_s.norm());
     last = est.state().pos_m;
   }
   EXPECT_TRUE(est.state().gps_ok);
@@ -167,7 +167,7 @@ TEST(Estimator, ReportingTheAirframesAccuracyChangesNothing) {
     b.Update(reporting.Step(0.004));
   }
   EXPECT_EQ(a.state().pos_m, b.state().pos_m);
-  EXPECT_EQ(a.state().vel_mps, b.state().vel_mps);
+  EXPECT_EQ(a.state().vel_m_s, b.state().vel_m_s);
   EXPECT_EQ(a.state().pos_std_m, b.state().pos_std_m);
 }
 

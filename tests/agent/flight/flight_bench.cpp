@@ -62,7 +62,7 @@ int RunSeed(std::uint64_t seed) {
             .Add("seed", seed_l).Add("settle_s", m->settle_s, 2).Add("settle_3d_s", m->settle_3d_s, 2)
             .Add("truth_settle_s", m->settle_truth_s, 2).Add("target_settle_s", m->settle_target_s, 2)
             .Add("overshoot_pct", m->overshoot_pct, 1).Add("truth_overshoot_pct", m->overshoot_truth_pct, 1)
-            .Add("peak_speed_mps", m->peak_speed_mps, 2)
+            .Add("peak_speed_m_s", m->peak_speed_m_s, 2)
             .Add("pass", m->settled && settle < 6.0 && overshoot < 10.0);
         Print(e);
       } else {
@@ -73,7 +73,7 @@ int RunSeed(std::uint64_t seed) {
   if (auto m = ft::RunHover(seed, window, 5.0, 1.5); m) {
     LogEvent e(0.0, "bench", "result");
     e.Add("suite", "flight").Add("scenario", "x500_wind_5mps").Add("receiver", "standalone")
-        .Add("seed", seed_l).Add("gust_std_mps", 1.5, 1)
+        .Add("seed", seed_l).Add("gust_std_m_s", 1.5, 1)
         .Add("target_rms_m", m->target_rms_m).Add("max_m", m->max_m).Add("truth_rms_m", m->truth_rms_m)
         .Add("pass", m->target_rms_m < 0.5);
     Print(e);
@@ -85,7 +85,7 @@ int RunSeed(std::uint64_t seed) {
     e.Add("suite", "flight").Add("scenario", "x500_gps_dropout_5s").Add("receiver", "standalone")
         .Add("seed", seed_l).Add("max_drift_m", m->max_drift_m)
         .Add("est_err_end_m", m->est_err_at_end_m).Add("max_err_after_m", m->max_err_after_m)
-        .Add("final_err_m", m->final_err_m).Add("max_speed_after_mps", m->max_speed_after_mps, 2)
+        .Add("final_err_m", m->final_err_m).Add("max_speed_after_m_s", m->max_speed_after_m_s, 2)
         .Add("crashed", m->crashed).Add("pass", !m->crashed && m->max_drift_m < 1.0 && m->final_err_m < 0.3);
     Print(e);
   } else {

@@ -25,7 +25,7 @@ class Feed {
     const int steps = static_cast<int>(std::lround(seconds / kDt));
     for (int k = 0; k < steps; ++k) {
       const double u = thrust(t_);
-      const double acc = kGravity_mps2 * u / h_true - kGravity_mps2 + n(rng_);
+      const double acc = kGravity_m_s2 * u / h_true - kGravity_m_s2 + n(rng_);
       hte.Predict(kDt);
       hte.Fuse(acc, u, kDt);
       t_ += kDt;
@@ -128,7 +128,7 @@ TEST(HoverThrustEstimator, HighNoiseScaleSlowsLearning) {
     hte.Reset(0.5);
     for (int k = 0; k < 250; ++k) {
       hte.Predict(kDt);
-      hte.Fuse(kGravity_mps2 * 0.4 / 0.4 - kGravity_mps2, 0.4, kDt, scale);
+      hte.Fuse(kGravity_m_s2 * 0.4 / 0.4 - kGravity_m_s2, 0.4, kDt, scale);
     }
     return 0.5 - hte.hover_thrust();
   };

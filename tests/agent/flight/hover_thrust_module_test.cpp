@@ -25,7 +25,7 @@ HoverThrustModule Made(double lag_s = 0.0) {
 // One step of a vehicle whose true hover thrust is h_true, flown level at thrust_n.
 bool Feed(HoverThrustModule& m, bool in_air, double thrust_n, double h_true, const Vec3& vel = Vec3::Zero()) {
   const double u = thrust_n / kMaxThrustN;
-  const double acc = kGravity_mps2 * u / h_true - kGravity_mps2;
+  const double acc = kGravity_m_s2 * u / h_true - kGravity_m_s2;
   return m.Update(in_air, thrust_n, 1.0, acc, vel, kDt);
 }
 
@@ -60,8 +60,8 @@ TEST(HoverThrustModule, FastFlightLearnsMoreSlowly) {
   const HoverThrustModuleParams p;
   for (int i = 0; i < 100; ++i) {
     Feed(hover, true, 24.0, 0.4);
-    Feed(climb, true, 24.0, 0.4, Vec3(0.0, 0.0, p.vz_threshold_mps + 4.0));
-    Feed(cruise, true, 24.0, 0.4, Vec3(p.vxy_threshold_mps + 4.0, 0.0, 0.0));
+    Feed(climb, true, 24.0, 0.4, Vec3(0.0, 0.0, p.vz_threshold_m_s + 4.0));
+    Feed(cruise, true, 24.0, 0.4, Vec3(p.vxy_threshold_m_s + 4.0, 0.0, 0.0));
   }
   EXPECT_LT(std::abs(hover.hover_thrust() - 0.4), std::abs(climb.hover_thrust() - 0.4));
   EXPECT_LT(std::abs(hover.hover_thrust() - 0.4), std::abs(cruise.hover_thrust() - 0.4));
@@ -69,7 +69,7 @@ TEST(HoverThrustModule, FastFlightLearnsMoreSlowly) {
   HoverThrustModule slow = Made();
   HoverThrustModule still = Made();
   for (int i = 0; i < 100; ++i) {
-    Feed(slow, true, 24.0, 0.4, Vec3(p.vxy_threshold_mps - 1.0, 0.0, p.vz_threshold_mps - 1.0));
+    Feed(slow, true, 24.0, 0.4, Vec3(p.vxy_threshold_m_s - 1.0, 0.0, p.vz_threshold_m_s - 1.0));
     Feed(still, true, 24.0, 0.4);
   }
   EXPECT_DOUBLE_EQ(slow.hover_thrust(), still.hover_thrust());

@@ -12,7 +12,7 @@ namespace {
 
 constexpr double kDt = 0.004;
 constexpr double kMassKg = 2.0;
-constexpr double kWeightN = kMassKg * kGravity_mps2;
+constexpr double kWeightN = kMassKg * kGravity_m_s2;
 
 TEST(LandDetector, InAirLatchesOnceArmedLongEnoughAndClimbedOrSinking) {
   LandDetector ld;
@@ -23,7 +23,7 @@ TEST(LandDetector, InAirLatchesOnceArmedLongEnoughAndClimbedOrSinking) {
   EXPECT_TRUE(ld.InAir(p.in_air_after_s + kDt, 0.0, 0.0));     // latched
   ld.Reset();                                                  // the next take-off
   EXPECT_FALSE(ld.in_air());
-  EXPECT_TRUE(ld.InAir(p.in_air_after_s + kDt, 0.0, -p.sinking_mps - 0.01));  // an airborne start sinking
+  EXPECT_TRUE(ld.InAir(p.in_air_after_s + kDt, 0.0, -p.sinking_m_s - 0.01));  // an airborne start sinking
 }
 
 TEST(LandDetector, GroundContactPhaseIsTheFirstMomentsAfterArming) {
@@ -58,11 +58,11 @@ TEST(LandDetector, AnyLandedConditionFailingRestartsTheTimer) {
   ld.StartLanding();
   for (int i = 0; i < 200; ++i) ASSERT_FALSE(ld.UpdateTouchdown(kDt, 2.0, 0.0, -0.3, low_thrust_n, kMassKg));
   // Still descending, hover thrust, or no descent asked: each resets the count.
-  EXPECT_FALSE(ld.UpdateTouchdown(kDt, 2.0, -(p.vz_max_mps + 0.01), -0.3, low_thrust_n, kMassKg));
+  EXPECT_FALSE(ld.UpdateTouchdown(kDt, 2.0, -(p.vz_max_m_s + 0.01), -0.3, low_thrust_n, kMassKg));
   for (int i = 0; i < 200; ++i) ASSERT_FALSE(ld.UpdateTouchdown(kDt, 2.0, 0.0, -0.3, low_thrust_n, kMassKg));
   EXPECT_FALSE(ld.UpdateTouchdown(kDt, 2.0, 0.0, -0.3, p.low_thrust_ratio * kWeightN + 0.01, kMassKg));
   for (int i = 0; i < 200; ++i) ASSERT_FALSE(ld.UpdateTouchdown(kDt, 2.0, 0.0, -0.3, low_thrust_n, kMassKg));
-  EXPECT_FALSE(ld.UpdateTouchdown(kDt, 2.0, 0.0, -p.descend_cmd_mps + 0.01, low_thrust_n, kMassKg));
+  EXPECT_FALSE(ld.UpdateTouchdown(kDt, 2.0, 0.0, -p.descend_cmd_m_s + 0.01, low_thrust_n, kMassKg));
   // 200 steps (0.8 s) since the last reset: not yet; the trigger time after it: landed.
   for (int i = 0; i < 200; ++i) ASSERT_FALSE(ld.UpdateTouchdown(kDt, 2.0, 0.0, -0.3, low_thrust_n, kMassKg));
   bool landed = false;

@@ -53,7 +53,7 @@ TEST(NoAllocation, ControlStepsAndSetpointsDoNotAllocate) {
   auto fc = FlightController::Create(*cfg, {});  // swing damping (shaper buffer) allocated here
   ASSERT_TRUE(fc.ok()) << fc.error().ToString();
   SensorSample s;
-  s.accel_mps2 = Vec3(0.0, 0.0, kGravity_mps2);
+  s.accel_m_s2 = Vec3(0.0, 0.0, kGravity_m_s2);
   s.mag_fresh = true;
   s.mag_body = Vec3(0.0, 0.21, -0.42);
   s.baro_fresh = true;
@@ -88,7 +88,7 @@ TEST(NoAllocation, TrajectoryStreamAndOffboardFailsafeDoNotAllocate) {
   ASSERT_TRUE(fc.ok()) << fc.error().ToString();
   OffboardFailsafe failsafe(1.0, 5.0);
   SensorSample s;
-  s.accel_mps2 = Vec3(0.0, 0.0, kGravity_mps2);
+  s.accel_m_s2 = Vec3(0.0, 0.0, kGravity_m_s2);
   s.mag_fresh = true;
   s.mag_body = Vec3(0.0, 0.21, -0.42);
   s.baro_fresh = true;
@@ -96,9 +96,9 @@ TEST(NoAllocation, TrajectoryStreamAndOffboardFailsafeDoNotAllocate) {
   const double nan = std::nan("");
   TrajectoryTarget t;
   t.pos_m = Vec3(2.0, nan, nan);
-  t.vel_mps = Vec3(0.5, 1.0, nan);
-  t.acc_mps2 = Vec3(nan, nan, 0.2);
-  t.yawspeed_radps = 0.3;
+  t.vel_m_s = Vec3(0.5, 1.0, nan);
+  t.acc_m_s2 = Vec3(nan, nan, 0.2);
+  t.yawspeed_rad_s = 0.3;
   FlightEvent e;
   OffboardFailsafe::Event fe;
   const long before = g_news.load();

@@ -40,13 +40,13 @@ Status TwinOk(const Rig& r) {
 
 const char* ReceiverName(Receiver receiver) { return receiver == Receiver::kRtk ? "rtk" : "standalone"; }
 
-Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_mps, double gust_std_mps,
+Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_m_s, double gust_std_m_s,
                               Receiver receiver) {
   RigOptions o;
   o.seed = seed;
   o.gps_fix = receiver;
-  o.wind.mean_m_s = physics::Vec3{wind_mps, 0.0, 0.0};
-  o.wind.gust_std_m_s = gust_std_mps;
+  o.wind.mean_m_s = physics::Vec3{wind_m_s, 0.0, 0.0};
+  o.wind.gust_std_m_s = gust_std_m_s;
   o.wind.gust_time_s = 2.0;
   auto rig = HoveringRig(o, 5.0);
   if (!rig) return rig.error();
@@ -124,7 +124,7 @@ Result<StepMetrics> RunStep(std::uint64_t seed, double dx, double dy, double dz,
   m.settled = last_out < 14.0;
   m.overshoot_pct = std::max(0.0, (max_along - step.norm()) / step.norm() * 100.0);
   m.overshoot_truth_pct = std::max(0.0, (max_truth - step.norm()) / step.norm() * 100.0);
-  m.peak_speed_mps = peak_v;
+  m.peak_speed_m_s = peak_v;
   SWARMBOX_TRY(TwinOk(r));
   return m;
 }
@@ -145,7 +145,7 @@ Result<DropoutMetrics> RunGpsDropout(std::uint64_t seed, double dropout_s) {
   r.Run(10.0, {}, [&] {
     m.max_err_after_m = std::max(m.max_err_after_m, (r.nav_pos() - target).norm());
     const auto v = r.truth().velocity_m_s;
-    m.max_speed_after_mps = std::max(m.max_speed_after_mps, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
+    m.max_speed_after_m_s = std::max(m.max_speed_after_m_s, std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z));
   });
   m.final_err_m = (r.nav_pos() - target).norm();
   SWARMBOX_TRY(TwinOk(r));

@@ -36,8 +36,8 @@ using Receiver = physics::GpsFix;
 const char* ReceiverName(Receiver receiver);  // "standalone" | "rtk"
 
 // Takes off to 5 m, settles, then holds for window_s; optional mean wind with gusts.
-Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_mps = 0.0,
-                              double gust_std_mps = 0.0, Receiver receiver = Receiver::kStandalone);
+Result<HoverMetrics> RunHover(std::uint64_t seed, double window_s, double wind_m_s = 0.0,
+                              double gust_std_m_s = 0.0, Receiver receiver = Receiver::kStandalone);
 
 struct StepMetrics {         // the step response: displacement from where the drone was at the
                              // command, receiver's frame
@@ -50,7 +50,7 @@ struct StepMetrics {         // the step response: displacement from where the d
                               // command and the estimate's error)
   double overshoot_pct = 0;  // beyond the step along its direction, % of the step
   double overshoot_truth_pct = 0;  // the same on absolute truth
-  double peak_speed_mps = 0;
+  double peak_speed_m_s = 0;
   bool settled = false;
 };
 // From a 5 m hover, a step of `step_m` (world ENU) to the position setpoint.
@@ -62,7 +62,7 @@ struct DropoutMetrics {              // receiver's frame throughout
   double est_err_at_end_m = 0;   // estimator error when GPS comes back
   double max_err_after_m = 0;    // truth to hold point in the 10 s after recovery
   double final_err_m = 0;        // truth to hold point 10 s after recovery
-  double max_speed_after_mps = 0;  // no violent reaction to the recovery
+  double max_speed_after_m_s = 0;  // no violent reaction to the recovery
   bool events_ok = false;        // gps_lost and gps_recovered were reported
   bool crashed = false;
 };

@@ -17,8 +17,8 @@ SensorSample FromPhysics(const physics::SensorSample& s) {
   SensorSample out;
   out.t_s = static_cast<double>(s.time_ns) * 1e-9;
   out.imu_fresh = s.imu.fresh;
-  out.accel_mps2 = E(s.imu.accel_m_s2);
-  out.gyro_radps = E(s.imu.gyro_rad_s);
+  out.accel_m_s2 = E(s.imu.accel_m_s2);
+  out.gyro_rad_s = E(s.imu.gyro_rad_s);
   out.baro_fresh = s.baro.fresh;
   out.baro_alt_m = s.baro.altitude_m;
   out.mag_fresh = s.mag.fresh;
@@ -26,7 +26,7 @@ SensorSample FromPhysics(const physics::SensorSample& s) {
   out.gps_fresh = s.gps.fresh;
   out.gps_valid = s.gps.valid;
   out.gps_pos_m = E(s.gps.position_m);
-  out.gps_vel_mps = E(s.gps.velocity_m_s);
+  out.gps_vel_m_s = E(s.gps.velocity_m_s);
   out.gps_eph_m = s.gps.h_acc_m;
   out.gps_epv_m = s.gps.v_acc_m;
   return out;

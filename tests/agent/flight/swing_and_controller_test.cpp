@@ -33,8 +33,8 @@ TEST(SwingObserver, MeasuresTheSlingAngleFromTheCablePullOnTheImu) {
   // Payload of 80 kg hanging 10 deg east of the hook, drone level and still: the cable pulls the
   // drone east and down; the accelerometer's body x reads the horizontal pull / drone mass.
   const double th = 10.0 * kPi / 180.0;
-  const double t = 80.0 * kGravity_mps2;  // quasi-static tension
-  const Vec3 f_body(t * std::sin(th) / 120.0, 0.0, kGravity_mps2);
+  const double t = 80.0 * kGravity_m_s2;  // quasi-static tension
+  const Vec3 f_body(t * std::sin(th) / 120.0, 0.0, kGravity_m_s2);
   for (int i = 0; i < 500; ++i) obs.Update(f_body, Quat::Identity(), Vec3::Zero(), 80.0, 0.004);
   EXPECT_NEAR(obs.measured_swing().x(), std::sin(th), 1e-9);
   for (int i = 0; i < 10000; ++i) obs.Update(f_body, Quat::Identity(), Vec3::Zero(), 80.0, 0.004);
@@ -46,7 +46,7 @@ TEST(SwingObserver, MeasuresTheSlingAngleFromTheCablePullOnTheImu) {
 TEST(SwingObserver, RestsWithoutAPayload) {
   SwingObserver obs;
   obs.Configure(4.0, 120.0);
-  obs.Update(Vec3(1.0, 0.0, kGravity_mps2), Quat::Identity(), Vec3::Zero(), 0.0, 0.004);
+  obs.Update(Vec3(1.0, 0.0, kGravity_m_s2), Quat::Identity(), Vec3::Zero(), 0.0, 0.004);
   EXPECT_EQ(obs.DampingAcceleration(1.0).norm(), 0.0);
 }
 
@@ -102,7 +102,7 @@ TEST(FlightController, RejectsSetpointsTheModeCannotTakeAndReportsThem) {
   ASSERT_TRUE(fc.ok()) << fc.error().ToString();
   EXPECT_FALSE(fc->Command(Setpoint::Takeoff(5.0)));  // estimator not aligned yet
   SensorSample s;
-  s.accel_mps2 = Vec3(0.0, 0.0, kGravity_mps2);
+  s.accel_m_s2 = Vec3(0.0, 0.0, kGravity_m_s2);
   s.mag_fresh = true;
   s.mag_body = Vec3(0.0, 0.21, -0.42);
   s.gps_fresh = s.gps_valid = true;

@@ -81,21 +81,21 @@ TEST_P(TrajectoryClosedLoop, PositionTargetIsReachedWithinTheSpeedLimit) {
   });
   EXPECT_EQ(r.fc().mode(), FlightMode::kTrajectory);
   const double err = (r.nav_pos() - goal).norm();
-  std::printf("seed=%llu trajectory_position: arrive_s=%.2f final_err_m=%.3f peak_xy_mps=%.2f peak_up_mps=%.2f\n",
+  std::printf("seed=%llu trajectory_position: arrive_s=%.2f final_err_m=%.3f peak_xy_m_s=%.2f peak_up_m_s=%.2f\n",
               static_cast<unsigned long long>(seed()), arrive_s, err, peak_xy, peak_up);
   EXPECT_GT(arrive_s, 0.0);
   EXPECT_LT(err, 0.3);
   const TrajectoryLimits& lim = r.fc().config().limits;
-  EXPECT_LT(peak_xy, lim.vel_max_xy_mps + 0.3);  // the airframe's limit (5 m/s), overshoot of the
-  EXPECT_LT(peak_up, lim.vel_max_up_mps + 0.3);  // velocity loop only
-  EXPECT_GT(peak_xy, 0.8 * lim.vel_max_xy_mps);  // and it did fly at it (a raw P loop, unsmoothed)
+  EXPECT_LT(peak_xy, lim.vel_max_xy_m_s + 0.3);  // the airframe's limit (5 m/s), overshoot of the
+  EXPECT_LT(peak_up, lim.vel_max_up_m_s + 0.3);  // velocity loop only
+  EXPECT_GT(peak_xy, 0.8 * lim.vel_max_xy_m_s);  // and it did fly at it (a raw P loop, unsmoothed)
 }
 
 TEST_P(TrajectoryClosedLoop, MixedAxesXyPositionZVelocity) {
   Rig& r = *rig_;
   TrajectoryTarget t;
   t.pos_m = Vec3(start_.x() + 6.0, start_.y() + 2.0, kNan);
-  t.vel_mps = Vec3(kNan, kNan, 1.0);  // climb at 1 m/s whatever the height
+  t.vel_m_s = Vec3(kNan, kNan, 1.0);  // climb at 1 m/s whatever the height
   double vz_sum = 0.0;
   int vz_n = 0;
   Stream(t, 4.0, [&] {});
@@ -106,7 +106,7 @@ TEST_P(TrajectoryClosedLoop, MixedAxesXyPositionZVelocity) {
   const double vz_mean = vz_sum / vz_n;
   const Vec3 nav = r.nav_pos();
   const double xy_err = (nav - t.pos_m).head<2>().norm();
-  std::printf("seed=%llu trajectory_mixed: vz_mean_mps=%.3f climbed_m=%.2f xy_err_m=%.3f\n",
+  std::printf("seed=%llu trajectory_mixed: vz_mean_m_s=%.3f climbed_m=%.2f xy_err_m=%.3f\n",
               static_cast<unsigned long long>(seed()), vz_mean, nav.z() - start_.z(), xy_err);
   EXPECT_NEAR(vz_mean, 1.0, 0.1);                  // z: the velocity (seconds 4-8)
   EXPECT_NEAR(nav.z() - start_.z(), 8.0, 1.0);     // 8 s at 1 m/s, less the first ramp-up
@@ -116,7 +116,7 @@ TEST_P(TrajectoryClosedLoop, MixedAxesXyPositionZVelocity) {
 TEST_P(TrajectoryClosedLoop, VelocityAndAccelerationFeedForwardAreFollowed) {
   Rig& r = *rig_;
   TrajectoryTarget t;
-  t.vel_mps = Vec3(0.0, 3.0, 0.0);
+  t.vel_m_s = Vec3(0.0, 3.0, 0.0);
   t.pos_m = Vec3(kNan, kNan, start_.z());
   Stream(t, 6.0);
   const Vec3 v = TrueVel(r);
@@ -127,8 +127,8 @@ TEST_P(TrajectoryClosedLoop, VelocityAndAccelerationFeedForwardAreFollowed) {
   // Acceleration only on y: from 3 m/s north, -1 m/s^2 for 2 s leaves about 1 m/s.
   TrajectoryTarget a;
   a.pos_m = Vec3(kNan, kNan, start_.z());
-  a.vel_mps = Vec3(0.0, kNan, kNan);
-  a.acc_mps2 = Vec3(kNan, -1.0, kNan);
+  a.vel_m_s = Vec3(0.0, kNan, kNan);
+  a.acc_m_s2 = Vec3(kNan, -1.0, kNan);
   Stream(a, 2.0);
   const double vy = TrueVel(r).y();
   std::printf("seed=%llu trajectory_acceleration: vy_after_2s=%.3f\n", static_cast<unsigned long long>(seed()), vy);
@@ -140,9 +140,9 @@ TEST_P(TrajectoryClosedLoop, YawspeedTurnsTheDrone) {
   const double yaw0 = TrueYaw(r);
   TrajectoryTarget t;
   t.pos_m = start_;
-  t.yawspeed_radps = 0.5;
+  t.yawspeed_rad_s = 0.5;
   Stream(t, 4.0);
-  t.yawspeed_radps = kNan;  // both unset: keep the heading reached
+  t.yawspeed_rad_s = kNan;  // both unset: keep the heading reached
   Stream(t, 2.0);
   const double turned = WrapPi(TrueYaw(r) - yaw0);
   std::printf("seed=%llu trajectory_yawspeed: turned_rad=%.3f\n", static_cast<unsigned long long>(seed()), turned);
@@ -165,7 +165,7 @@ TEST_P(TrajectoryClosedLoop, YawspeedTurnsTheDrone) {
 TEST_P(TrajectoryClosedLoop, AllUnsetHoldsWhereItStops) {
   Rig& r = *rig_;
   TrajectoryTarget go;
-  go.vel_mps = Vec3(3.0, 0.0, 0.0);
+  go.vel_m_s = Vec3(3.0, 0.0, 0.0);
   go.pos_m = Vec3(kNan, kNan, start_.z());
   Stream(go, 5.0);
   ASSERT_GT(TrueVel(r).x(), 2.5);
@@ -175,8 +175,8 @@ TEST_P(TrajectoryClosedLoop, AllUnsetHoldsWhereItStops) {
   const Vec3 stop = r.nav_pos();
   double max_dev = 0.0;
   Stream(hold, 10.0, [&] { max_dev = std::max(max_dev, (r.nav_pos() - stop).norm()); });
-  const double brake = 3.0 * 3.0 / (2.0 * r.fc().config().limits.acc_max_xy_mps2);
-  std::printf("seed=%llu trajectory_hold: stopped_after_m=%.2f (braking %.2f) drift_max_m=%.3f speed_mps=%.3f\n",
+  const double brake = 3.0 * 3.0 / (2.0 * r.fc().config().limits.acc_max_xy_m_s2);
+  std::printf("seed=%llu trajectory_hold: stopped_after_m=%.2f (braking %.2f) drift_max_m=%.3f speed_m_s=%.3f\n",
               static_cast<unsigned long long>(seed()), (stop - at_release).x(), brake, max_dev, TrueVel(r).norm());
   EXPECT_NEAR((stop - at_release).x(), brake, 1.0);
   // Held: no drift over 10 s beyond the hover's own scatter (closed_loop_test: max 0.35 m from

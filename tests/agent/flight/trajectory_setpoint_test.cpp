@@ -41,22 +41,22 @@ TEST(PositionControlAxes, VelocityAxisIgnoresThePositionAndTracksTheVelocity) {
   PositionSetpoint sp;
   sp.axes = {AxisControl::kVelocity, AxisControl::kPosition, AxisControl::kPosition};
   sp.pos_m = Vec3(100.0, 0.0, 5.0);  // x far away: must not matter on a velocity axis
-  sp.vel_mps = Vec3(1.0, 0.0, 0.0);
+  sp.vel_m_s = Vec3(1.0, 0.0, 0.0);
   const PositionOutput out = pc.Update(Hovering(), sp, 2.0, 0.004);
   ASSERT_TRUE(out.valid);
-  EXPECT_DOUBLE_EQ(out.vel_sp_mps.x(), 1.0);
-  EXPECT_DOUBLE_EQ(out.vel_sp_mps.y(), 0.0);
-  EXPECT_NEAR(out.acc_sp_mps2.x(), pc.params().vel_p.x() * 1.0, 1e-9);  // P on 1 m/s
+  EXPECT_DOUBLE_EQ(out.vel_sp_m_s.x(), 1.0);
+  EXPECT_DOUBLE_EQ(out.vel_sp_m_s.y(), 0.0);
+  EXPECT_NEAR(out.acc_sp_m_s2.x(), pc.params().vel_p.x() * 1.0, 1e-9);  // P on 1 m/s
 }
 
 TEST(PositionControlAxes, PositionAxisAddsTheVelocityFeedForward) {
   PositionControl pc = Controller();
   PositionSetpoint sp;
   sp.pos_m = Vec3(1.0, 0.0, 5.0);
-  sp.vel_mps = Vec3(0.5, 0.0, 0.0);
+  sp.vel_m_s = Vec3(0.5, 0.0, 0.0);
   const PositionOutput out = pc.Update(Hovering(), sp, 2.0, 0.004);
   ASSERT_TRUE(out.valid);
-  EXPECT_NEAR(out.vel_sp_mps.x(), 0.5 + pc.params().xy_p * 1.0, 1e-12);
+  EXPECT_NEAR(out.vel_sp_m_s.x(), 0.5 + pc.params().xy_p * 1.0, 1e-12);
 }
 
 TEST(PositionControlAxes, AccelerationAxisTakesTheFeedForwardAloneAndFreezesItsIntegral) {
@@ -64,17 +64,17 @@ TEST(PositionControlAxes, AccelerationAxisTakesTheFeedForwardAloneAndFreezesItsI
   PositionSetpoint sp;
   sp.axes = {AxisControl::kPosition, AxisControl::kPosition, AxisControl::kAcceleration};
   sp.pos_m = Vec3(0.0, 0.0, 50.0);  // z far up: ignored, the axis flies on acceleration alone
-  sp.vel_mps = Vec3(0.0, 0.0, 3.0);
-  sp.acc_mps2 = Vec3(0.0, 0.0, 1.5);
+  sp.vel_m_s = Vec3(0.0, 0.0, 3.0);
+  sp.acc_m_s2 = Vec3(0.0, 0.0, 1.5);
   StateEstimate s = Hovering();
-  s.vel_mps = Vec3(0.0, 0.0, -1.0);      // a velocity error the velocity loop would act on
-  s.accel_mps2 = Vec3(0.0, 0.0, 0.7);    // and a D term
+  s.vel_m_s = Vec3(0.0, 0.0, -1.0);      // a velocity error the velocity loop would act on
+  s.accel_m_s2 = Vec3(0.0, 0.0, 0.7);    // and a D term
   for (int i = 0; i < 250; ++i) {
     const PositionOutput out = pc.Update(s, sp, 2.0, 0.004);
     ASSERT_TRUE(out.valid);
-    EXPECT_NEAR(out.thrust_world_n.z(), 2.0 * (1.5 + kGravity_mps2), 1e-9);
-    EXPECT_TRUE(std::isnan(out.vel_sp_mps.z()));
-    EXPECT_DOUBLE_EQ(out.acc_sp_mps2.z(), 1.5);
+    EXPECT_NEAR(out.thrust_world_n.z(), 2.0 * (1.5 + kGravity_m_s2), 1e-9);
+    EXPECT_TRUE(std::isnan(out.vel_sp_m_s.z()));
+    EXPECT_DOUBLE_EQ(out.acc_sp_m_s2.z(), 1.5);
   }
   EXPECT_EQ(pc.integral().z(), 0.0);  // frozen
 }
@@ -84,11 +84,11 @@ TEST(PositionControlAxes, HorizontalAccelerationOnlyLeansTheWayAsked) {
   PositionSetpoint sp;
   sp.axes = {AxisControl::kAcceleration, AxisControl::kPosition, AxisControl::kPosition};
   sp.pos_m = Vec3(-30.0, 0.0, 5.0);
-  sp.acc_mps2 = Vec3(2.0, 0.0, 0.0);
+  sp.acc_m_s2 = Vec3(2.0, 0.0, 0.0);
   const PositionOutput out = pc.Update(Hovering(), sp, 2.0, 0.004);
   ASSERT_TRUE(out.valid);
   EXPECT_NEAR(out.thrust_world_n.x(), 2.0 * 2.0, 1e-9);
-  EXPECT_NEAR(out.thrust_world_n.z(), 2.0 * kGravity_mps2, 1e-9);
+  EXPECT_NEAR(out.thrust_world_n.z(), 2.0 * kGravity_m_s2, 1e-9);
   EXPECT_EQ(pc.integral().x(), 0.0);
 }
 
@@ -96,14 +96,14 @@ TEST(PositionControlAxes, VelocityCapsTightenTheParamsLimits) {
   PositionControl pc = Controller();
   PositionSetpoint sp;
   sp.pos_m = Vec3(100.0, 0.0, 100.0);
-  sp.vel_cap_xy_mps = 2.0;
-  sp.vel_cap_up_mps = 1.0;
+  sp.vel_cap_xy_m_s = 2.0;
+  sp.vel_cap_up_m_s = 1.0;
   const PositionOutput out = pc.Update(Hovering(), sp, 2.0, 0.004);
-  EXPECT_NEAR(out.vel_sp_mps.x(), 2.0, 1e-12);
-  EXPECT_NEAR(out.vel_sp_mps.z(), 1.0, 1e-12);
+  EXPECT_NEAR(out.vel_sp_m_s.x(), 2.0, 1e-12);
+  EXPECT_NEAR(out.vel_sp_m_s.z(), 1.0, 1e-12);
   sp.pos_m = Vec3(0.0, 0.0, -100.0);
-  sp.vel_cap_down_mps = 0.5;
-  EXPECT_NEAR(pc.Update(Hovering(), sp, 2.0, 0.004).vel_sp_mps.z(), -0.5, 1e-12);
+  sp.vel_cap_down_m_s = 0.5;
+  EXPECT_NEAR(pc.Update(Hovering(), sp, 2.0, 0.004).vel_sp_m_s.z(), -0.5, 1e-12);
 }
 
 // ---- Setpoint::FromTrajectory ----------------------------------------------------------------
@@ -117,24 +117,24 @@ TEST(SetpointFromTrajectory, PurePositionAndPureVelocityKeepTheirSmoothedKinds) 
   EXPECT_EQ(sp.value, Vec3(1.0, 2.0, 3.0));
   EXPECT_EQ(sp.yaw_rad, 0.5);
   TrajectoryTarget v;
-  v.vel_mps = Vec3(1.0, 0.0, 0.0);
+  v.vel_m_s = Vec3(1.0, 0.0, 0.0);
   sp = Setpoint::FromTrajectory(v);
   EXPECT_EQ(sp.kind, Setpoint::Kind::kVelocity);
   EXPECT_TRUE(std::isnan(sp.yaw_rad));  // heading kept
   // Anything else stays a trajectory: a feed-forward, a partial position, a yaw rate.
   TrajectoryTarget ff = t;
-  ff.vel_mps = Vec3(1.0, 0.0, 0.0);
+  ff.vel_m_s = Vec3(1.0, 0.0, 0.0);
   EXPECT_EQ(Setpoint::FromTrajectory(ff).kind, Setpoint::Kind::kTrajectory);
   TrajectoryTarget partial;
   partial.pos_m = Vec3(1.0, 2.0, kNan);
   EXPECT_EQ(Setpoint::FromTrajectory(partial).kind, Setpoint::Kind::kTrajectory);
   TrajectoryTarget spin = t;
   spin.yaw_rad = kNan;
-  spin.yawspeed_radps = 0.3;
+  spin.yawspeed_rad_s = 0.3;
   EXPECT_EQ(Setpoint::FromTrajectory(spin).kind, Setpoint::Kind::kTrajectory);
   EXPECT_EQ(Setpoint::FromTrajectory(TrajectoryTarget{}).kind, Setpoint::Kind::kTrajectory);
   const Setpoint tr = Setpoint::Trajectory(spin);
-  EXPECT_EQ(tr.trajectory.yawspeed_radps, 0.3);
+  EXPECT_EQ(tr.trajectory.yawspeed_rad_s, 0.3);
   EXPECT_TRUE(std::isnan(tr.yaw_rad));
 }
 
@@ -167,7 +167,7 @@ class TrajectoryKind : public ::testing::Test {
     auto fc = FlightController::Create(*cfg, {});
     ASSERT_TRUE(fc.ok()) << fc.error().ToString();
     fc_ = std::make_unique<FlightController>(std::move(*fc));
-    s_.accel_mps2 = Vec3(0.0, 0.0, kGravity_mps2);
+    s_.accel_m_s2 = Vec3(0.0, 0.0, kGravity_m_s2);
     s_.mag_fresh = true;
     s_.mag_body = Vec3(0.0, 0.21, -0.42);
     s_.baro_fresh = true;
@@ -221,11 +221,11 @@ TEST_F(TrajectoryKind, AcceptedInTheAirAsItsOwnModeNamedTrajectory) {
   EXPECT_TRUE(fc_->Step(s_).armed);
   // Infinity is not "unset": rejected, the mode and target unchanged.
   TrajectoryTarget bad = t;
-  bad.vel_mps.z() = std::numeric_limits<double>::infinity();
+  bad.vel_m_s.z() = std::numeric_limits<double>::infinity();
   Count(FlightEventKind::kRejected);
   EXPECT_FALSE(fc_->Command(Setpoint::Trajectory(bad)));
   TrajectoryTarget bad_yaw;
-  bad_yaw.yawspeed_radps = -std::numeric_limits<double>::infinity();
+  bad_yaw.yawspeed_rad_s = -std::numeric_limits<double>::infinity();
   EXPECT_FALSE(fc_->Command(Setpoint::Trajectory(bad_yaw)));
   EXPECT_EQ(Count(FlightEventKind::kRejected), 2);
   Steps(1);
@@ -238,11 +238,11 @@ TEST_F(TrajectoryKind, PositionAxesGoToThePositionWithTheVelocityFeedForwardAtTh
   const Vec3 here = fc_->estimate().pos_m;
   TrajectoryTarget t;
   t.pos_m = here + Vec3(1.0, -0.5, 0.2);
-  t.vel_mps = Vec3(0.25, kNan, kNan);  // x feeds forward; y, z: 0
+  t.vel_m_s = Vec3(0.25, kNan, kNan);  // x feeds forward; y, z: 0
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(1);
   const Vec3 err = t.pos_m - fc_->estimate().pos_m;
-  const Vec3 v = Pos().vel_sp_mps;
+  const Vec3 v = Pos().vel_sp_m_s;
   EXPECT_NEAR(v.x(), 0.25 + fc_->config().position.xy_p * err.x(), 1e-9);
   EXPECT_NEAR(v.y(), fc_->config().position.xy_p * err.y(), 1e-9);
   EXPECT_NEAR(v.z(), fc_->config().position.z_p * err.z(), 1e-9);
@@ -251,30 +251,30 @@ TEST_F(TrajectoryKind, PositionAxesGoToThePositionWithTheVelocityFeedForwardAtTh
   t.pos_m = here + Vec3(300.0, 400.0, 100.0);
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(1);
-  EXPECT_NEAR(Pos().vel_sp_mps.head<2>().norm(), fc_->config().limits.vel_max_xy_mps, 1e-9);
-  EXPECT_NEAR(Pos().vel_sp_mps.z(), fc_->config().limits.vel_max_up_mps, 1e-9);
+  EXPECT_NEAR(Pos().vel_sp_m_s.head<2>().norm(), fc_->config().limits.vel_max_xy_m_s, 1e-9);
+  EXPECT_NEAR(Pos().vel_sp_m_s.z(), fc_->config().limits.vel_max_up_m_s, 1e-9);
 }
 
 TEST_F(TrajectoryKind, VelocityAxesTrackTheVelocityWithinTheLimits) {
   Airborne();
   TrajectoryTarget t;
-  t.vel_mps = Vec3(1.0, -2.0, -0.5);
-  t.acc_mps2 = Vec3(0.3, kNan, kNan);
+  t.vel_m_s = Vec3(1.0, -2.0, -0.5);
+  t.acc_m_s2 = Vec3(0.3, kNan, kNan);
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(1);
-  EXPECT_NEAR(Pos().vel_sp_mps.x(), 1.0, 1e-12);
-  EXPECT_NEAR(Pos().vel_sp_mps.y(), -2.0, 1e-12);
-  EXPECT_NEAR(Pos().vel_sp_mps.z(), -0.5, 1e-12);
-  EXPECT_EQ(fc_->telemetry().reference.acc_mps2.x(), 0.3);
-  EXPECT_EQ(fc_->telemetry().reference.acc_mps2.y(), 0.0);
+  EXPECT_NEAR(Pos().vel_sp_m_s.x(), 1.0, 1e-12);
+  EXPECT_NEAR(Pos().vel_sp_m_s.y(), -2.0, 1e-12);
+  EXPECT_NEAR(Pos().vel_sp_m_s.z(), -0.5, 1e-12);
+  EXPECT_EQ(fc_->telemetry().reference.acc_m_s2.x(), 0.3);
+  EXPECT_EQ(fc_->telemetry().reference.acc_m_s2.y(), 0.0);
   // Beyond the limits: horizontal scaled along its direction, vertical clamped.
-  t.vel_mps = Vec3(30.0, 40.0, -9.0);
+  t.vel_m_s = Vec3(30.0, 40.0, -9.0);
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(1);
-  const double vmax = fc_->config().limits.vel_max_xy_mps;
-  EXPECT_NEAR(Pos().vel_sp_mps.x(), 0.6 * vmax, 1e-9);
-  EXPECT_NEAR(Pos().vel_sp_mps.y(), 0.8 * vmax, 1e-9);
-  EXPECT_NEAR(Pos().vel_sp_mps.z(), -fc_->config().limits.vel_max_down_mps, 1e-9);
+  const double vmax = fc_->config().limits.vel_max_xy_m_s;
+  EXPECT_NEAR(Pos().vel_sp_m_s.x(), 0.6 * vmax, 1e-9);
+  EXPECT_NEAR(Pos().vel_sp_m_s.y(), 0.8 * vmax, 1e-9);
+  EXPECT_NEAR(Pos().vel_sp_m_s.z(), -fc_->config().limits.vel_max_down_m_s, 1e-9);
 }
 
 TEST_F(TrajectoryKind, AccelerationOnlyAxesHaveNoVelocityLoop) {
@@ -282,13 +282,13 @@ TEST_F(TrajectoryKind, AccelerationOnlyAxesHaveNoVelocityLoop) {
   const Vec3 here = fc_->estimate().pos_m;
   TrajectoryTarget t;
   t.pos_m = Vec3(kNan, here.y(), here.z());  // y, z held at where it is: thrust to spare
-  t.acc_mps2 = Vec3(1.5, kNan, kNan);
+  t.acc_m_s2 = Vec3(1.5, kNan, kNan);
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(1);
-  EXPECT_TRUE(std::isnan(Pos().vel_sp_mps.x()));
-  EXPECT_FALSE(std::isnan(Pos().vel_sp_mps.y()));
+  EXPECT_TRUE(std::isnan(Pos().vel_sp_m_s.x()));
+  EXPECT_FALSE(std::isnan(Pos().vel_sp_m_s.y()));
   // What the position loop asked for on x: the acceleration, within the tilt (not limiting here).
-  EXPECT_NEAR(Pos().acc_sp_mps2.x(), 1.5, 1e-9);
+  EXPECT_NEAR(Pos().acc_sp_m_s2.x(), 1.5, 1e-9);
 }
 
 TEST_F(TrajectoryKind, MixedAxesXyPositionZVelocity) {
@@ -296,12 +296,12 @@ TEST_F(TrajectoryKind, MixedAxesXyPositionZVelocity) {
   const Vec3 here = fc_->estimate().pos_m;
   TrajectoryTarget t;
   t.pos_m = Vec3(here.x() + 2.0, here.y(), kNan);
-  t.vel_mps = Vec3(kNan, kNan, 0.8);
+  t.vel_m_s = Vec3(kNan, kNan, 0.8);
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(1);
   const Vec3 err = t.pos_m - fc_->estimate().pos_m;
-  EXPECT_NEAR(Pos().vel_sp_mps.x(), fc_->config().position.xy_p * err.x(), 1e-9);
-  EXPECT_NEAR(Pos().vel_sp_mps.z(), 0.8, 1e-12);  // z: the velocity, whatever the height
+  EXPECT_NEAR(Pos().vel_sp_m_s.x(), fc_->config().position.xy_p * err.x(), 1e-9);
+  EXPECT_NEAR(Pos().vel_sp_m_s.z(), 0.8, 1e-12);  // z: the velocity, whatever the height
 }
 
 TEST_F(TrajectoryKind, AllUnsetHoldsEachAxisAtItsLatchedPoint) {
@@ -321,10 +321,10 @@ TEST_F(TrajectoryKind, AllUnsetHoldsEachAxisAtItsLatchedPoint) {
   }
   // One axis leaves the hold (velocity on x), the others stay at their points.
   TrajectoryTarget vx;
-  vx.vel_mps.x() = 1.0;
+  vx.vel_m_s.x() = 1.0;
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(vx)));
   Steps(1);
-  EXPECT_NEAR(Pos().vel_sp_mps.x(), 1.0, 1e-12);
+  EXPECT_NEAR(Pos().vel_sp_m_s.x(), 1.0, 1e-12);
   EXPECT_EQ(fc_->telemetry().reference.pos_m.y(), latched.y());
   EXPECT_EQ(fc_->telemetry().reference.pos_m.z(), latched.z());
 }
@@ -336,16 +336,16 @@ TEST_F(TrajectoryKind, AHeldAxisLatchesWhereBrakingEnds) {
   for (int i = 0; i < 500; ++i) {
     s_.t_s += 0.004;
     s_.gps_pos_m = Vec3(3.0 * (s_.t_s - 1.2), 0.0, 0.0);
-    s_.gps_vel_mps = Vec3(3.0, 0.0, 0.0);
+    s_.gps_vel_m_s = Vec3(3.0, 0.0, 0.0);
     s_.gps_fresh = i % 25 == 0;
     fc_->Step(s_);
   }
   const StateEstimate e = fc_->estimate();
-  ASSERT_GT(e.vel_mps.x(), 1.0);
+  ASSERT_GT(e.vel_m_s.x(), 1.0);
   TrajectoryTarget hold;
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(hold)));
-  const double a = fc_->config().limits.acc_max_xy_mps2;
-  const double expect_x = e.pos_m.x() + e.vel_mps.x() * std::abs(e.vel_mps.x()) / (2.0 * a);
+  const double a = fc_->config().limits.acc_max_xy_m_s2;
+  const double expect_x = e.pos_m.x() + e.vel_m_s.x() * std::abs(e.vel_m_s.x()) / (2.0 * a);
   s_.gps_fresh = false;
   fc_->Step(s_);
   EXPECT_NEAR(fc_->telemetry().reference.pos_m.x(), expect_x, 1e-9);
@@ -361,17 +361,17 @@ TEST_F(TrajectoryKind, YawSetsTheHeadingYawspeedTurnsItAndNeitherKeepsIt) {
   EXPECT_NEAR(YawSp(), 1.0, 1e-9);
   // Yawspeed: the heading setpoint turns at that rate, 0.5 rad/s for 1 s (250 steps of 4 ms).
   t.yaw_rad = kNan;
-  t.yawspeed_radps = 0.5;
+  t.yawspeed_rad_s = 0.5;
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(250);
   EXPECT_NEAR(YawSp(), 1.5, 1e-6);
   // Neither: kept.
-  t.yawspeed_radps = kNan;
+  t.yawspeed_rad_s = kNan;
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(100);
   EXPECT_NEAR(YawSp(), 1.5, 1e-6);
   // A rate beyond the limit turns at the limit (1.5 rad/s), through +-pi.
-  t.yawspeed_radps = -10.0;
+  t.yawspeed_rad_s = -10.0;
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(1000);  // 4 s: -6 rad
   EXPECT_NEAR(YawSp(), WrapPi(1.5 - 6.0), 1e-6);
@@ -380,7 +380,7 @@ TEST_F(TrajectoryKind, YawSetsTheHeadingYawspeedTurnsItAndNeitherKeepsIt) {
 TEST_F(TrajectoryKind, OtherKindsAfterATrajectoryStartFromWhereTheDroneIs) {
   Airborne();
   TrajectoryTarget t;
-  t.vel_mps = Vec3(2.0, 0.0, 0.0);
+  t.vel_m_s = Vec3(2.0, 0.0, 0.0);
   ASSERT_TRUE(fc_->Command(Setpoint::Trajectory(t)));
   Steps(100);
   ASSERT_TRUE(fc_->Command(Setpoint::Hold()));

@@ -78,7 +78,7 @@ TEST(LoadTrial, FaultsUseTheFaultInjectorsSchema) {
   - {at: 40s, duration: 10s, pause: scout_2}
   - {at: 1m, duration: 20s, partition: {groups: [[scout_1, scout_2], [lifter]]}}
   - {at: 10s, duration: 5s, gps_dropout: scout_1}
-  - {at: 50s, duration: 3s, wind_gust: {speed_mps: 8, direction_deg: 90}}
+  - {at: 50s, duration: 3s, wind_gust: {speed_m_s: 8, direction_deg: 90}}
 )");
   auto spec = LoadTrialText(text, "sar.yaml", FakeTree());
   ASSERT_TRUE(spec) << spec.error().ToString();

@@ -77,8 +77,8 @@ TEST(FaultEvent, DescribesEveryKind) {
   EXPECT_EQ(DescribeFault(First("- {at: 1s, duration: 2s, gps_dropout: a}")), "duration=2s");
   EXPECT_EQ(DescribeFault(First("- {at: 1s, duration: 4s, gps_degrade: {target: a, h_acc_m: 5, v_acc_m: 8.5}}")),
             "h_acc_m=5 v_acc_m=8.5 duration=4s");
-  EXPECT_EQ(DescribeFault(First("- {at: 1s, wind_gust: {speed_mps: 12, direction_deg: 270}}")),
-            "speed_mps=12 direction_deg=270 vertical_mps=0");
+  EXPECT_EQ(DescribeFault(First("- {at: 1s, wind_gust: {speed_m_s: 12, direction_deg: 270}}")),
+            "speed_m_s=12 direction_deg=270 vertical_m_s=0");
   EXPECT_EQ(DescribeFault(First("- {at: 1s, radio: {rules: [{to: [b], delay_ms: 5}, {rate_kbit: 64}]}}")),
             "delay_ms=5 to=[b]; rate_kbit=64");
 }

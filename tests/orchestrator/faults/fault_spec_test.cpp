@@ -91,8 +91,8 @@ TEST(FaultSpec, ParsesPartitionsAndSensorFaults) {
   auto faults = Parse(
       "- {at: 60s, duration: 30s, partition: {groups: [[scout_1, scout_2], [lifter]], oneway: true}}\n"
       "- {at: 20s, duration: 10s, gps_dropout: scout_2}\n"
-      "- {at: 25s, imu_bias: {target: lifter, accel_mps2: [0.2, 0, 0], gyro_rad_s: [0, 0, 0.01]}}\n"
-      "- {at: 50s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270}}\n");
+      "- {at: 25s, imu_bias: {target: lifter, accel_m_s2: [0.2, 0, 0], gyro_rad_s: [0, 0, 0.01]}}\n"
+      "- {at: 50s, duration: 5s, wind_gust: {speed_m_s: 12, direction_deg: 270}}\n");
   ASSERT_TRUE(faults) << faults.error().ToString();
   const auto& p = std::get<PartitionFault>((*faults)[0].action);
   EXPECT_TRUE(p.oneway);
@@ -100,10 +100,10 @@ TEST(FaultSpec, ParsesPartitionsAndSensorFaults) {
   EXPECT_EQ((*faults)[1].kind(), "gps_dropout");
   EXPECT_EQ((*faults)[1].target()->names, std::vector<std::string>{"scout_2"});
   const auto& bias = std::get<ImuBias>((*faults)[2].action);
-  EXPECT_EQ(bias.accel_mps2[0], 0.2);
+  EXPECT_EQ(bias.accel_m_s2[0], 0.2);
   EXPECT_EQ(bias.gyro_rad_s[2], 0.01);
   const auto& gust = std::get<WindGust>((*faults)[3].action);
-  EXPECT_EQ(gust.speed_mps, 12);
+  EXPECT_EQ(gust.speed_m_s, 12);
   EXPECT_EQ(gust.direction_deg, 270);
   EXPECT_EQ((*faults)[3].target(), nullptr);
   EXPECT_TRUE(ValidateFaults(*faults, kDrones));
@@ -142,7 +142,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadFault{"- {at: 3s, kill: \"a b\"}", "trial.yaml:1:18", "neither a drone name"},
         BadFault{"- {at: 3s, pause: [a, a]}", "trial.yaml:1:23", "listed twice"},
         BadFault{"- {at: 3s, partition: {groups: [[a], []]}}", "trial.yaml:1:38", "group 1 is empty"},
-        BadFault{"- {at: 3s, wind_gust: {speed_mps: 500}}", "trial.yaml:1:35", "'speed_mps' must be in [0, 100]"},
+        BadFault{"- {at: 3s, wind_gust: {speed_m_s: 500}}", "trial.yaml:1:35", "'speed_m_s' must be in [0, 100]"},
         BadFault{"- {at: 3s, imu_bias: {target: a}}", "trial.yaml:1:22", "imu_bias changes nothing"},
         BadFault{"- {at: 3s, gps_degrade: a}", "trial.yaml:1:25", "expected gps_degrade to be a mapping"},
         BadFault{"- {at: 3s, gps_degrade: {h_acc_m: 5, v_acc_m: 8}}", "trial.yaml:1:25",

@@ -42,7 +42,7 @@ TEST(PhysicsPlan, GpsDegradeSendsDurationAndBothAccuraciesPerTargetAndNeedsNoUnd
 
 TEST(PhysicsPlan, ImuBiasWithDurationIsTakenBackByTheNegatedJump) {
   ImuBias bias;
-  bias.accel_mps2 = {0.3, 0, 0};
+  bias.accel_m_s2 = {0.3, 0, 0};
   bias.gyro_rad_s = {0, 0, 0.02};
   const PhysicsPlan plan = PlanPhysicsFault(Make(bias, 30000), {"lifter"});
   EXPECT_EQ(plan.apply, (std::vector<WorldCommandCall>{{"lifter", "imu_bias_jump", {0.3, 0, 0, 0, 0, 0.02}}}));
@@ -53,9 +53,9 @@ TEST(PhysicsPlan, ImuBiasWithDurationIsTakenBackByTheNegatedJump) {
 
 TEST(PhysicsPlan, GustFromTheWestBlowsEastInEnuForTheWholeWorld) {
   WindGust gust;
-  gust.speed_mps = 12;
+  gust.speed_m_s = 12;
   gust.direction_deg = 270;
-  gust.vertical_mps = -1.5;
+  gust.vertical_m_s = -1.5;
   const PhysicsPlan plan = PlanPhysicsFault(Make(gust, 5000), {"ignored"});
   EXPECT_EQ(plan.apply, (std::vector<WorldCommandCall>{{"", "wind_gust", {12.0, 0.0, -1.5, 5.0}}}));
   EXPECT_EQ(WorldCommandText(plan.apply[0]), "wind_gust - 12 0 -1.5 5");

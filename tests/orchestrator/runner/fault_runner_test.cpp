@@ -528,8 +528,8 @@ TEST_F(FaultRunnerTest, GpsDegradeIsSentWithItsDurationAndAccuraciesToEveryTarge
 }
 
 TEST_F(FaultRunnerTest, ImuBiasIsTakenBackByTheNegatedJumpAndAGustCarriesItsVector) {
-  spec_.Fault("{name: bias, at: 1s, duration: 1s, imu_bias: {target: all, accel_mps2: [0.3, 0, 0], gyro_rad_s: [0, 0, 0.02]}}");
-  spec_.Fault("{name: gust, at: 1s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270, vertical_mps: -1.5}}");
+  spec_.Fault("{name: bias, at: 1s, duration: 1s, imu_bias: {target: all, accel_m_s2: [0.3, 0, 0], gyro_rad_s: [0, 0, 0.02]}}");
+  spec_.Fault("{name: gust, at: 1s, duration: 5s, wind_gust: {speed_m_s: 12, direction_deg: 270, vertical_m_s: -1.5}}");
   api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=clock",
                                    "t=2.500 node=physics event=clock", "t=3.000 node=physics event=done"};
   RunOutcome run = Run();
@@ -580,7 +580,7 @@ TEST_F(FaultRunnerTest, WithoutFaultsNoSidecarIsCreated) {
 }
 
 TEST_F(FaultRunnerTest, AnImuBiasStillActiveAtTheEndIsNotTakenBack) {
-  spec_.Fault("{name: bias, at: 1s, duration: 60s, imu_bias: {target: scout_1, accel_mps2: [0.3, 0, 0]}}");
+  spec_.Fault("{name: bias, at: 1s, duration: 60s, imu_bias: {target: scout_1, accel_m_s2: [0.3, 0, 0]}}");
   api_.scripts["physics"].lines = {"t=0.000 node=physics event=ready", "t=1.500 node=physics event=clock",
                                    "t=3.000 node=physics event=done"};
   RunOutcome run = Run();

@@ -156,8 +156,8 @@ TEST(RadioSchedule, RandomTargetsComeFromTheTrialsSeed) {
 TEST(RadioSchedule, SensorAndWorldFaultsAreWorldCommandsWithTheirUndoAtTheEnd) {
   dsl::TrialSpec spec =
       Trial()
-          .Fault("{name: bias, at: 40s, duration: 30s, imu_bias: {target: lifter, accel_mps2: [0.3, 0, 0]}}")
-          .Fault("{name: gust, at: 60s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270}}")
+          .Fault("{name: bias, at: 40s, duration: 30s, imu_bias: {target: lifter, accel_m_s2: [0.3, 0, 0]}}")
+          .Fault("{name: gust, at: 60s, duration: 5s, wind_gust: {speed_m_s: 12, direction_deg: 270}}")
           .Fault(
               "{name: fix, at: 50s, duration: 20s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}");
   auto plan = PlanRadioSchedule(spec);

@@ -34,8 +34,8 @@
 //    correction maps to the present through the motion model (H * Phi(-delay)), as PX4's EKF2
 //    fuses delayed measurements on a delayed horizon and predicts forward.
 //  * Output smoothing: every correction is applied to the filter at once (it stays consistent);
-//    what the controllers see glides after it at most at `max_pos_correction_mps` /
-//    `max_vel_correction_mps2`. In steady fusion that is invisible (millimetres per fix); after
+//    what the controllers see glides after it at most at `max_pos_correction_m_s` /
+//    `max_vel_correction_m_s2`. In steady fusion that is invisible (millimetres per fix); after
 //    a dropout the estimate glides back to the GPS instead of jumping, so the controller is not
 //    kicked.
 //
@@ -57,15 +57,15 @@ struct EstimatorParams {
   double mag_kp = 0.3;              // heading correction gain [(rad/s)/rad]
   double mag_ki = 0.01;             // yaw gyro bias gain [(rad/s^2)/rad]
   double align_time_s = 1.0;        // high-gain alignment period after start [s]
-  double acc_gate_mps2 = 2.5;       // skip tilt correction when |f| differs from expected by more
+  double acc_gate_m_s2 = 2.5;       // skip tilt correction when |f| differs from expected by more
   bool tilt_ref_from_filter = true;  // tilt reference in flight: the filter's acceleration, or
                                     // (false) differentiated GPS velocity; see UpdateAttitude
   double gps_acc_tau_s = 0.5;       // low-pass of the GPS-derived acceleration [s]
-  double gps_acc_deadband_mps2 = 0.3;  // soft dead band on it [m/s^2]
+  double gps_acc_deadband_m_s2 = 0.3;  // soft dead band on it [m/s^2]
   Vec3 mag_field_world = Vec3(0.0, 0.21, -0.42);  // Earth field, ENU (only its horizontal
                                                    // direction matters) [gauss]
   // Translational Kalman filters.
-  double accel_noise_mps2 = 0.2;   // process noise on the IMU-derived acceleration [m/s^2]
+  double accel_noise_m_s2 = 0.2;   // process noise on the IMU-derived acceleration [m/s^2]
                                    // (EKF2_ACC_NOISE; covers attitude errors too)
   double accel_bias_walk = 0.01;    // bias random walk [m/s^2 / sqrt(s)] (EKF2_ACC_B_NOISE)
   double baro_bias_walk = 0.003;     // barometer offset random walk [m / sqrt(s)]
@@ -86,11 +86,11 @@ struct EstimatorParams {
   double gps_bias_walk_v = 0.11;    // Vertically the wander's, sqrt(2 0.55^2 / 60 s): height
                                     // follows the barometer, GPS only anchors it.
   double gps_delay_s = 0.12;        // age of a fix when it arrives (EKF2_GPS_DELAY) [s]
-  double gps_vel_std_mps = 0.1;     // GPS velocity noise (EKF2_GPS_V_NOISE) [m/s]
+  double gps_vel_std_m_s = 0.1;     // GPS velocity noise (EKF2_GPS_V_NOISE) [m/s]
   double baro_std_m = 0.15;
   double gps_timeout_s = 0.5;       // no fix for this long: GPS lost
-  double max_pos_correction_mps = 1.0;    // slew limit of the position correction [m/s]
-  double max_vel_correction_mps2 = 1.0;   // slew limit of the velocity correction [m/s^2]
+  double max_pos_correction_m_s = 1.0;    // slew limit of the position correction [m/s]
+  double max_vel_correction_m_s2 = 1.0;   // slew limit of the velocity correction [m/s^2]
   // Known start point (a surveyed take-off spot, as PX4's home): when set, the filter starts
   // there with `initial_pos_std_m` instead of on the first, noisy GPS fix; the barometer offset
   // is then anchored to the known start altitude.

@@ -10,14 +10,14 @@
 //
 //   control:
 //     position: {xy_p: 0.95, z_p: 1.0, vel_xy_pid: [1.8, 0.4, 0.2], vel_z_pid: [4.0, 2.0, 0.0],
-//                vel_max_xy_mps: 5, vel_max_up_mps: 3, vel_max_down_mps: 1.5,
-//                acc_max_xy_mps2: 3, acc_max_z_mps2: 2, tilt_max_deg: 45,
+//                vel_max_xy_m_s: 5, vel_max_up_m_s: 3, vel_max_down_m_s: 1.5,
+//                acc_max_xy_m_s2: 3, acc_max_z_m_s2: 2, tilt_max_deg: 45,
 //                thrust_min: 0.1, thrust_max: 0.9}          # fractions of the total max thrust
 //     attitude: {roll_p: 6.5, pitch_p: 6.5, yaw_p: 2.8, rate_max_deg_s: [220, 220, 200]}
 //     rate: {roll_pid: [0.15, 0.2, 0.003], pitch_pid: [0.15, 0.2, 0.003], yaw_pid: [0.2, 0.1, 0.0],
 //            integrator_limit: [0.3, 0.3, 0.3]}
-//     takeoff: {speed_mps: 1.5}
-//     land: {speed_mps: 0.7, slow_speed_mps: 0.3, slow_below_m: 2.0}
+//     takeoff: {speed_m_s: 1.5}
+//     land: {speed_m_s: 0.7, slow_speed_m_s: 0.3, slow_below_m: 2.0}
 //     swing_damping: {enabled: true, gain: 1.0, shaper: true, full_gain_load_ratio: 0.0}
 //     hover_thrust: {process_noise: 0.0036, init_std: 0.1, gate_sd: 3.0, thrust_lag_s: 0.0}
 //
@@ -63,9 +63,9 @@ struct FlightConfig {
   AttitudeGains attitude;
   RateGains rate;
   EstimatorParams estimator;
-  double takeoff_speed_mps = 1.5;
-  double land_speed_mps = 0.7;
-  double land_slow_speed_mps = 0.3;
+  double takeoff_speed_m_s = 1.5;
+  double land_speed_m_s = 0.7;
+  double land_slow_speed_m_s = 0.3;
   double land_slow_below_m = 2.0;     // height above the take-off point where landing slows [m]
   std::vector<airframe::PayloadSpec> payloads;  // the airframe's (swing damping: sling_length_m)
   SwingDampingParams swing;

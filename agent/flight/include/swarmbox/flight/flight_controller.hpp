@@ -62,7 +62,7 @@ struct ActuatorOutput {
 struct ControllerTelemetry {
   TrajectoryPoint reference;        // after shaping
   PositionOutput position;
-  Vec3 rate_sp_radps = Vec3::Zero();
+  Vec3 rate_sp_rad_s = Vec3::Zero();
   Vec3 torque_nm = Vec3::Zero();
   double mass_estimate_kg = 0.0;   // vehicle + load from the hover thrust estimate [kg]
   double hover_thrust = 0.0;       // learnt hover thrust, fraction of the maximum thrust
@@ -116,7 +116,7 @@ class FlightController {
   void CommandLand(double t_s);
   bool CommandTrajectory(const TrajectoryTarget& target, double t_s);
   // The trajectory kind's setpoint for this step (per-axis control, heading), from target_.
-  PositionSetpoint TrajectoryStep(const StateEstimate& s, double dt_s, double* yawspeed_ff_radps);
+  PositionSetpoint TrajectoryStep(const StateEstimate& s, double dt_s, double* yawspeed_ff_rad_s);
   // Step()'s parts, in order. The step period from the sample time [s].
   double StepPeriod(double t_s);
   // Mode bookkeeping before flight (ready, GPS lost/recovered); false (motors off) unless flying.
@@ -124,12 +124,12 @@ class FlightController {
   // Land detector's in-air answer -> hover thrust estimate -> mass_kg_.
   void UpdateHoverThrust(const StateEstimate& s, double dt_s);
   // The mode's setpoint for this step; false when the drone has just touched down (disarmed).
-  bool Reference(const StateEstimate& s, double dt_s, PositionSetpoint* psp, double* yawspeed_ff_radps);
+  bool Reference(const StateEstimate& s, double dt_s, PositionSetpoint* psp, double* yawspeed_ff_rad_s);
   bool LandReference(const StateEstimate& s, double dt_s, PositionSetpoint* psp);
   void SmoothedReference(const StateEstimate& s, double dt_s, PositionSetpoint* psp);
   void AddSwingDamping(const SensorSample& sample, const StateEstimate& s, double dt_s, PositionSetpoint* psp);
   // Position -> attitude -> rate -> mixer into output_.
-  void RunCascade(const StateEstimate& s, const PositionSetpoint& psp, double yawspeed_ff_radps, double dt_s);
+  void RunCascade(const StateEstimate& s, const PositionSetpoint& psp, double yawspeed_ff_rad_s, double dt_s);
   double HoverThrustFor(double mass_kg) const;   // normalised hover thrust of a total mass
   double MassFor(double hover_thrust) const;
 
@@ -155,7 +155,7 @@ class FlightController {
   double yaw_sp_rad_ = 0.0;
   double home_z_m_ = 0.0;
   Vec3 land_xy_m_ = Vec3::Zero();
-  double land_vz_mps_ = 0.0;
+  double land_vz_m_s_ = 0.0;
   bool arrived_reported_ = true;
   bool gps_ok_ = true;
   double mass_kg_ = 0.0;            // hover-thrust (effective mass) estimate [kg]

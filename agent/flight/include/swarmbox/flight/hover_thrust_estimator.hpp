@@ -60,10 +60,10 @@ class HoverThrustEstimator {
 
   // Grows the state variance over dt [s].
   void Predict(double dt_s);
-  // Fuses one measurement: acc_up_mps2 = vertical acceleration, world up, gravity removed;
+  // Fuses one measurement: acc_up_m_s2 = vertical acceleration, world up, gravity removed;
   // thrust_z = vertical component of the collective thrust / maximum collective thrust.
   // noise_scale >= 1 de-weights the measurement (fast climbs, drag). dt_s sizes the low-passes.
-  HoverThrustStatus Fuse(double acc_up_mps2, double thrust_z, double dt_s, double noise_scale = 1.0);
+  HoverThrustStatus Fuse(double acc_up_m_s2, double thrust_z, double dt_s, double noise_scale = 1.0);
 
   double hover_thrust() const { return hover_; }
   double variance() const { return var_; }

@@ -18,8 +18,8 @@ namespace swarmbox::flight {
 
 struct HoverThrustModuleParams {
   double thrust_lag_s = 0.0;         // rotor lag applied to the thrust fed [s] (control.hover_thrust.thrust_lag_s)
-  double vz_threshold_mps = 2.0;     // de-weight above this vertical speed (PX4 HTE_VZ_THR)
-  double vxy_threshold_mps = 10.0;   // de-weight above this horizontal speed (PX4 HTE_VXY_THR)
+  double vz_threshold_m_s = 2.0;     // de-weight above this vertical speed (PX4 HTE_VZ_THR)
+  double vxy_threshold_m_s = 10.0;   // de-weight above this horizontal speed (PX4 HTE_VXY_THR)
 };
 
 class HoverThrustModule {
@@ -35,9 +35,9 @@ class HoverThrustModule {
   void ClearThrust() { thrust_lagged_n_ = 0.0; }
 
   // One control step: thrust_n = the collective thrust commanded last step [N], body_z_up = the
-  // world-up component of the body z axis, acc_up_mps2 = vertical acceleration (gravity removed),
-  // vel_mps = estimated velocity. Fuses only in the air and with thrust; true when it did.
-  bool Update(bool in_air, double thrust_n, double body_z_up, double acc_up_mps2, const Vec3& vel_mps, double dt_s);
+  // world-up component of the body z axis, acc_up_m_s2 = vertical acceleration (gravity removed),
+  // vel_m_s = estimated velocity. Fuses only in the air and with thrust; true when it did.
+  bool Update(bool in_air, double thrust_n, double body_z_up, double acc_up_m_s2, const Vec3& vel_m_s, double dt_s);
 
   double hover_thrust() const { return ekf_.hover_thrust(); }
   double variance() const { return ekf_.variance(); }

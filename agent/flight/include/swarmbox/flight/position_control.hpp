@@ -27,35 +27,35 @@ struct PositionParams {
   Vec3 vel_p = Vec3(1.8, 1.8, 4.0);   // [(m/s^2)/(m/s)]
   Vec3 vel_i = Vec3(0.4, 0.4, 2.0);   // [(m/s^2)/m]
   Vec3 vel_d = Vec3(0.2, 0.2, 0.0);   // [(m/s^2)/(m/s^2)]
-  double vel_max_xy_mps = 5.0;
-  double vel_max_up_mps = 3.0;
-  double vel_max_down_mps = 1.5;
+  double vel_max_xy_m_s = 5.0;
+  double vel_max_up_m_s = 3.0;
+  double vel_max_down_m_s = 1.5;
   double tilt_max_rad = 45.0 * kPi / 180.0;
   double thrust_min_n = 0.0;     // collective thrust bounds [N] (from the airframe)
   double thrust_max_n = 1.0;
-  double integral_max_mps2 = 4.0;  // |velocity integral| per axis [m/s^2]
+  double integral_max_m_s2 = 4.0;  // |velocity integral| per axis [m/s^2]
 };
 
 // How one world axis is controlled (PX4 PositionControl with NaN setpoints).
 enum class AxisControl : std::uint8_t {
-  kPosition,      // position P; vel_mps and acc_mps2 feed forward
-  kVelocity,      // vel_mps tracked by the velocity PID; acc_mps2 feeds forward
-  kAcceleration,  // acc_mps2 alone: no velocity loop on this axis, its integral frozen
+  kPosition,      // position P; vel_m_s and acc_m_s2 feed forward
+  kVelocity,      // vel_m_s tracked by the velocity PID; acc_m_s2 feeds forward
+  kAcceleration,  // acc_m_s2 alone: no velocity loop on this axis, its integral frozen
 };
 
 // What the layers above want, per world axis (x, y, z). Feed-forwards are world ENU.
 struct PositionSetpoint {
   std::array<AxisControl, 3> axes{AxisControl::kPosition, AxisControl::kPosition, AxisControl::kPosition};
   Vec3 pos_m = Vec3::Zero();       // used on kPosition axes
-  Vec3 vel_mps = Vec3::Zero();     // feed-forward (kPosition) or setpoint (kVelocity)
-  Vec3 acc_mps2 = Vec3::Zero();    // feed-forward, or the setpoint (kAcceleration)
+  Vec3 vel_m_s = Vec3::Zero();     // feed-forward (kPosition) or setpoint (kVelocity)
+  Vec3 acc_m_s2 = Vec3::Zero();    // feed-forward, or the setpoint (kAcceleration)
   double yaw_rad = 0.0;
-  double yawspeed_radps = 0.0;     // feed-forward
+  double yawspeed_rad_s = 0.0;     // feed-forward
   // Velocity limits of this setpoint when tighter than the params' (the trajectory kind flies at
   // the airframe's limits, with no reference to chase) [m/s]; infinity: the params' alone.
-  double vel_cap_xy_mps = std::numeric_limits<double>::infinity();
-  double vel_cap_up_mps = std::numeric_limits<double>::infinity();
-  double vel_cap_down_mps = std::numeric_limits<double>::infinity();
+  double vel_cap_xy_m_s = std::numeric_limits<double>::infinity();
+  double vel_cap_up_m_s = std::numeric_limits<double>::infinity();
+  double vel_cap_down_m_s = std::numeric_limits<double>::infinity();
 };
 
 struct PositionOutput {
@@ -63,8 +63,8 @@ struct PositionOutput {
   Vec3 thrust_world_n = Vec3::Zero();
   double thrust_n = 0.0;            // collective thrust along body z [N]
   Quat att_sp = Quat::Identity();   // body FLU -> world ENU
-  Vec3 vel_sp_mps = Vec3::Zero();   // after limits, for logs and tests; NaN on kAcceleration axes
-  Vec3 acc_sp_mps2 = Vec3::Zero();  // after limits
+  Vec3 vel_sp_m_s = Vec3::Zero();   // after limits, for logs and tests; NaN on kAcceleration axes
+  Vec3 acc_sp_m_s2 = Vec3::Zero();  // after limits
 };
 
 class PositionControl {

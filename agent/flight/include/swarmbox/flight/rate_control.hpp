@@ -2,7 +2,7 @@
 //
 //   RateControl rc;
 //   rc.SetGains(gains);
-//   Vec3 torque_norm = rc.Update(rate_radps, rate_sp_radps, ang_accel_radps2, dt_s, landed);
+//   Vec3 torque_norm = rc.Update(rate_rad_s, rate_sp_rad_s, ang_accel_rad_s2, dt_s, landed);
 //   ... mixer ...
 //   rc.SetSaturation(mixer_output.sat_positive, mixer_output.sat_negative);
 //

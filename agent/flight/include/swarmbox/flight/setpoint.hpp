@@ -7,7 +7,7 @@
 //   controller.Command(Setpoint::Hold());                  // stop and hold where it is
 //   controller.Command(Setpoint::Land());
 //   TrajectoryTarget t;                                    // PX4 TrajectorySetpoint: NaN = unset
-//   t.pos_m = Vec3(10, 0, kUnset); t.vel_mps = Vec3(kUnset, kUnset, 0.5);
+//   t.pos_m = Vec3(10, 0, kUnset); t.vel_m_s = Vec3(kUnset, kUnset, 0.5);
 //   controller.Command(Setpoint::Trajectory(t));           // x, y to 10, 0; climb at 0.5 m/s
 //   FlightEvent e; while (controller.PopEvent(&e)) log(e);   // takeoff, hover, arrived, landed...
 //
@@ -47,10 +47,10 @@ inline constexpr double kUnset = std::numeric_limits<double>::quiet_NaN();
 // (NaN) = unset, per component. Default: everything unset (= hold, keep the heading).
 struct TrajectoryTarget {
   Vec3 pos_m = Vec3::Constant(kUnset);      // world ENU [m]
-  Vec3 vel_mps = Vec3::Constant(kUnset);    // world ENU [m/s]
-  Vec3 acc_mps2 = Vec3::Constant(kUnset);   // world ENU [m/s^2], gravity not included
+  Vec3 vel_m_s = Vec3::Constant(kUnset);    // world ENU [m/s]
+  Vec3 acc_m_s2 = Vec3::Constant(kUnset);   // world ENU [m/s^2], gravity not included
   double yaw_rad = kUnset;                  // heading, ENU (0 = east, counter-clockwise)
-  double yawspeed_radps = kUnset;           // heading rate, counter-clockwise positive [rad/s]
+  double yawspeed_rad_s = kUnset;           // heading rate, counter-clockwise positive [rad/s]
 };
 
 struct Setpoint {
@@ -64,7 +64,7 @@ struct Setpoint {
 
   static Setpoint Takeoff(double height_m) { return {Kind::kTakeoff, Vec3(0.0, 0.0, height_m), std::nan("")}; }
   static Setpoint Position(const Vec3& pos_m, double yaw_rad) { return {Kind::kPosition, pos_m, yaw_rad}; }
-  static Setpoint Velocity(const Vec3& vel_mps, double yaw_rad) { return {Kind::kVelocity, vel_mps, yaw_rad}; }
+  static Setpoint Velocity(const Vec3& vel_m_s, double yaw_rad) { return {Kind::kVelocity, vel_m_s, yaw_rad}; }
   static Setpoint Hold() { return {Kind::kHold, Vec3::Zero(), std::nan("")}; }
   static Setpoint Land() { return {Kind::kLand, Vec3::Zero(), std::nan("")}; }
   static Setpoint Trajectory(const TrajectoryTarget& target) {

@@ -10,7 +10,7 @@
 //
 //   Trajectory tr(limits);  tr.Reset(pos_now, vel_now);
 //   tr.SetPositionTarget(goal);
-//   TrajectoryPoint ref = tr.Step(dt_s);   // ref.pos_m, ref.vel_mps, ref.acc_mps2
+//   TrajectoryPoint ref = tr.Step(dt_s);   // ref.pos_m, ref.vel_m_s, ref.acc_m_s2
 #pragma once
 
 #include "swarmbox/flight/types.hpp"
@@ -18,18 +18,18 @@
 namespace swarmbox::flight {
 
 struct TrajectoryLimits {
-  double vel_max_xy_mps = 5.0;
-  double vel_max_up_mps = 3.0;
-  double vel_max_down_mps = 1.5;
-  double acc_max_xy_mps2 = 3.0;
-  double acc_max_z_mps2 = 2.0;
+  double vel_max_xy_m_s = 5.0;
+  double vel_max_up_m_s = 3.0;
+  double vel_max_down_m_s = 1.5;
+  double acc_max_xy_m_s2 = 3.0;
+  double acc_max_z_m_s2 = 2.0;
   double approach_gain = 2.5;      // k: the final approach is first-order with this rate [1/s]
 };
 
 struct TrajectoryPoint {
   Vec3 pos_m = Vec3::Zero();
-  Vec3 vel_mps = Vec3::Zero();
-  Vec3 acc_mps2 = Vec3::Zero();
+  Vec3 vel_m_s = Vec3::Zero();
+  Vec3 acc_m_s2 = Vec3::Zero();
 };
 
 class Trajectory {
@@ -39,9 +39,9 @@ class Trajectory {
   const TrajectoryLimits& limits() const { return limits_; }
 
   // Restarts the reference at the vehicle's state (on mode changes, at take-off).
-  void Reset(const Vec3& pos_m, const Vec3& vel_mps);
+  void Reset(const Vec3& pos_m, const Vec3& vel_m_s);
   void SetPositionTarget(const Vec3& pos_m);
-  void SetVelocityTarget(const Vec3& vel_mps);
+  void SetVelocityTarget(const Vec3& vel_m_s);
   TrajectoryPoint Step(double dt_s);
 
   const TrajectoryPoint& reference() const { return ref_; }

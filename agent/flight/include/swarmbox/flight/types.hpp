@@ -19,7 +19,7 @@ namespace swarmbox::flight {
 using Vec3 = Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;
 
-constexpr double kGravity_mps2 = 9.80665;
+constexpr double kGravity_m_s2 = 9.80665;
 constexpr double kPi = 3.14159265358979323846;
 
 // One lockstep sensor sample, as the companion computer sees it. Never ground truth.
@@ -27,8 +27,8 @@ constexpr double kPi = 3.14159265358979323846;
 struct SensorSample {
   double t_s = 0.0;                   // simulated time [s]
   bool imu_fresh = true;
-  Vec3 accel_mps2 = Vec3::Zero();     // specific force, body FLU [m/s^2] (reads +g on z at rest)
-  Vec3 gyro_radps = Vec3::Zero();     // angular rate, body FLU [rad/s]
+  Vec3 accel_m_s2 = Vec3::Zero();     // specific force, body FLU [m/s^2] (reads +g on z at rest)
+  Vec3 gyro_rad_s = Vec3::Zero();     // angular rate, body FLU [rad/s]
   bool baro_fresh = false;
   double baro_alt_m = 0.0;            // barometric altitude [m]; a constant offset is estimated
   bool mag_fresh = false;
@@ -36,7 +36,7 @@ struct SensorSample {
   bool gps_fresh = false;             // a new GPS report (fix or no-fix) at this step
   bool gps_valid = false;             // the report has a fix (false during a dropout)
   Vec3 gps_pos_m = Vec3::Zero();      // position, world ENU [m]
-  Vec3 gps_vel_mps = Vec3::Zero();    // velocity, world ENU [m/s]
+  Vec3 gps_vel_m_s = Vec3::Zero();    // velocity, world ENU [m/s]
   double gps_eph_m = 0.0;             // the receiver's reported accuracy (u-blox hAcc, PX4's
   double gps_epv_m = 0.0;             // eph/epv): 1-sigma per horizontal axis / vertically [m];
                                       // 0: not reported
@@ -46,10 +46,10 @@ struct SensorSample {
 struct StateEstimate {
   double t_s = 0.0;
   Vec3 pos_m = Vec3::Zero();           // world ENU [m]
-  Vec3 vel_mps = Vec3::Zero();         // world ENU [m/s]
-  Vec3 accel_mps2 = Vec3::Zero();      // kinematic acceleration, world ENU [m/s^2] (gravity removed)
+  Vec3 vel_m_s = Vec3::Zero();         // world ENU [m/s]
+  Vec3 accel_m_s2 = Vec3::Zero();      // kinematic acceleration, world ENU [m/s^2] (gravity removed)
   Quat att = Quat::Identity();         // body FLU -> world ENU
-  Vec3 rate_radps = Vec3::Zero();      // bias-corrected angular rate, body FLU [rad/s]
+  Vec3 rate_rad_s = Vec3::Zero();      // bias-corrected angular rate, body FLU [rad/s]
   Vec3 pos_std_m = Vec3::Zero();       // 1-sigma position uncertainty per world axis [m]
   bool gps_ok = false;                 // GPS fused within the last dropout timeout
   double since_gps_s = 0.0;            // time since the last fused GPS sample [s]

@@ -3,7 +3,7 @@
 // netem or its userspace fallback impairs on the wall clock:
 //   state_msg      bus::DroneState on kDroneStateTopic (Qos::kState)
 //   detection_msg  bus::Detection on kDetectionTopic (Qos::kRadio)
-//   raft_msg       mission::RaftRadio on kRaftTopic (its lanes: kLanesPerPeer writers per member)
+//   raft_msg       raft_service::RaftRadio on kRaftTopic (its lanes: kLanesPerPeer writers per member)
 //   ping_msg       bus::RadioPing on kRadioPingTopic (Qos::kRadio), one writer per peer for pings
 //                  and one per peer for pongs (a best-effort reader drops what one writer's stream
 //                  reorders: radio_link history in agent/radio/README.md), one for anyone else
@@ -40,14 +40,14 @@
 
 #include "swarmbox/bus/participant.hpp"
 #include "swarmbox/common/result.hpp"
-#include "swarmbox/mission/raft_radio.hpp"
+#include "swarmbox/raft_service/raft_radio.hpp"
 #include "swarmbox/radio/mesh_radio.hpp"
 
 namespace swarmbox::radio {
 
 struct DdsRadioOptions {
   std::vector<std::string> members;  // the trial's drones (self dropped): Raft lanes, ping writers
-  bool raft = false;                 // carry raft_msg (mission::RaftRadio); needs members
+  bool raft = false;                 // carry raft_msg (raft_service::RaftRadio); needs members
   bool pings = false;                // ping/pong writers per member, hear mesh/ping; needs members
   bool hear_states = false;          // hear the others' DroneStates (the SAR mission's peers)
   bool brains = false;               // carry brain_msg (send and hear mesh/brain)
@@ -113,7 +113,7 @@ class DdsRadio final : public MeshRadio {
   std::vector<std::unique_ptr<PingWriter>> pong_writers_;  // per peer
   std::unique_ptr<PingWriter> other_pong_writer_;
   // Declared last: destroyed first, so no callback runs into a half-destroyed radio.
-  std::unique_ptr<mission::RaftRadio> raft_;
+  std::unique_ptr<raft_service::RaftRadio> raft_;
   std::unique_ptr<bus::Subscriber<bus::RadioPing>> ping_sub_;
   std::unique_ptr<bus::Subscriber<bus::DroneState>> state_sub_;
   std::unique_ptr<bus::Subscriber<bus::BrainMessage>> brain_sub_;

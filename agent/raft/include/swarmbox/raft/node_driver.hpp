@@ -43,7 +43,7 @@
 //     std::puts(e.str().c_str());
 //   });
 //   if (!node) { print node.error(); exit(1); }
-//   every cfg.tick_ms of the caller's clock: (*node)->Tick();    // mission::RaftService does this
+//   every cfg.tick_ms of the caller's clock: (*node)->Tick();    // raft_service::RaftService does this
 //   on a radio sample addressed to self:    (*node)->Receive(bytes);   // errors: log, go on
 //   to change the mission:                  (*node)->Propose(StartSearch{});  // kUnavailable:
 //                                                     // no leader yet, retry later

@@ -1,7 +1,7 @@
 // BatteryModel: a simple per-airframe energy model for the mission's `battery_low` decision.
 //
 //   BatteryModel battery(*BatterySpecFor("x500"));
-//   battery.Step(dt_s, est.vel_mps, payload_mass_kg);                 // every control step
+//   battery.Step(dt_s, est.vel_m_s, payload_mass_kg);                 // every control step
 //   if (battery.IsLow(distance_home_m, altitude_m, payload_mass_kg))  // -> event=battery_low
 //
 // Power [W] (momentum theory for the induced part, flat-plate drag for the parasitic part):

@@ -13,7 +13,7 @@
 //     if (s.drone != self)
 //       neighbours_.push_back({ToVec3(s.position_enu_m), ToVec3(s.velocity_enu_m_s),
 //                              now_s - s.sim_time_ns * 1e-9});
-//   swarm::FlockingOutput out = flock.Step({est.pos_m, est.vel_mps, goal_m, neighbours_}, dt_s);
+//   swarm::FlockingOutput out = flock.Step({est.pos_m, est.vel_m_s, goal_m, neighbours_}, dt_s);
 //   flight.SetVelocitySetpoint(out.velocity_m_s, yaw_rad);
 //
 // Terms (all horizontal, world ENU x/y; z is a separate altitude-hold channel). Distances to

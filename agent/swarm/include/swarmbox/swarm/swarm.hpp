@@ -26,9 +26,9 @@
 //   // on bus::CameraImage (5 Hz): perception.ProcessFrame(bgr, k, OpticalPoseFromBody(...), t_img)
 //
 //   // every control step (dt):
-//   battery.Step(dt, est.vel_mps, payload_kg, airborne);
+//   battery.Step(dt, est.vel_m_s, payload_kg, airborne);
 //   detections.clear(); perception.PopVisible(now, &detections);   // publish as bus::Detection
-//   in = {now, &driver.mission(), est.pos_m, est.vel_mps, yaw, battery.fraction(),
+//   in = {now, &driver.mission(), est.pos_m, est.vel_m_s, yaw, battery.fraction(),
 //         battery.IsLow(dist_home, height, payload_kg), payload_attached, detections};
 //   scout.Step(in, &out);                                // or lifter.Step(in, &out)
 //   leader.Track(now, driver.mission());                 // every drone: sector list changes
@@ -38,7 +38,7 @@
 //   for (auto& e : out.events) std::puts(e.str().c_str());
 //   if (out.payload.action != PayloadAction::kNone) publish bus::WorldCommand payload_attach/release
 //   switch (out.setpoint.kind) {
-//     case SetpointKind::kFlock:  flight.Velocity(flock.Step({est.pos_m, est.vel_mps,
+//     case SetpointKind::kFlock:  flight.Velocity(flock.Step({est.pos_m, est.vel_m_s,
 //                                   out.setpoint.target_m, neighbours}, dt).velocity_m_s, yaw); ...
 //     case SetpointKind::kPosition: flight.Position(out.setpoint.target_m, out.setpoint.yaw_rad); ...
 //     case SetpointKind::kTakeoff / kLand / kIdle: flight.Takeoff / Land / Disarm ...

@@ -12,8 +12,8 @@
 //     - {at: 60s, duration: 30s, partition: {groups: [[scout_1, scout_2], [lifter]], oneway: false}}
 //     - {at: 20s, duration: 10s, gps_dropout: scout_2}
 //     - {at: 30s, duration: 20s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}
-//     - {at: 25s, duration: 10s, imu_bias: {target: lifter, accel_mps2: [0.2, 0, 0]}}
-//     - {at: 50s, duration: 5s, wind_gust: {speed_mps: 12, direction_deg: 270}}
+//     - {at: 25s, duration: 10s, imu_bias: {target: lifter, accel_m_s2: [0.2, 0, 0]}}
+//     - {at: 50s, duration: 5s, wind_gust: {speed_m_s: 12, direction_deg: 270}}
 //
 // Targets: a drone name, a list of names, a glob pattern ("scout_*"), `all`, `raft_leader` (the
 // leader of the latest `event=leader_elected` seen in the logs when the fault fires) or `random`
@@ -91,13 +91,13 @@ struct GpsDegrade {
 inline constexpr double kMaxGpsAccuracyM = 1000.0;
 struct ImuBias {
   FaultTarget target;
-  std::array<double, 3> accel_mps2{};  // added to the accelerometer [m/s^2], body frame FRD
+  std::array<double, 3> accel_m_s2{};  // added to the accelerometer [m/s^2], body frame FRD
   std::array<double, 3> gyro_rad_s{};  // added to the gyroscope [rad/s], body frame FRD
 };
 struct WindGust {
-  double speed_mps = 0.0;      // horizontal gust speed [m/s]
+  double speed_m_s = 0.0;      // horizontal gust speed [m/s]
   double direction_deg = 0.0;  // direction the wind blows FROM, degrees clockwise from north
-  double vertical_mps = 0.0;   // up positive [m/s]
+  double vertical_m_s = 0.0;   // up positive [m/s]
 };
 
 using FaultAction =

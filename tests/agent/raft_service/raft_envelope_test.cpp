@@ -1,11 +1,11 @@
 // RaftMessage <-> raft::Transport mapping and the receiver's addressing rule, without DDS.
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 
 #include <gtest/gtest.h>
 
 #include "swarmbox/raft/message_codec.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 raft::Bytes EncodedHeartbeat(std::uint64_t term) {
@@ -81,4 +81,4 @@ TEST(RaftEnvelope, DeliveryNamesAreStable) {
 }
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -1,10 +1,10 @@
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 
 #include <string>
 
 #include "swarmbox/raft/message_codec.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 // Reads one LEB128 varint at `*pos`; false when truncated or longer than 10 bytes.
@@ -64,4 +64,4 @@ RaftDelivery ClassifyRaftMessage(const bus::RaftMessage& m, std::string_view sel
   return RaftDelivery::kDeliver;
 }
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

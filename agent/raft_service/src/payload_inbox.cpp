@@ -1,9 +1,9 @@
-#include "swarmbox/mission/payload_inbox.hpp"
+#include "swarmbox/raft_service/payload_inbox.hpp"
 
 #include <algorithm>
 #include <iterator>
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 PayloadInbox::PayloadInbox(std::size_t capacity) : capacity_(std::max<std::size_t>(1, capacity)) {}
 
@@ -43,4 +43,4 @@ std::uint64_t PayloadInbox::drops() const {
   return drops_;
 }
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -1,6 +1,6 @@
 // PayloadInbox (unit): arrival order, the bound (oldest dropped and counted), and hand-over from
 // several producer threads with nothing lost or duplicated.
-#include "swarmbox/mission/payload_inbox.hpp"
+#include "swarmbox/raft_service/payload_inbox.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 using namespace std::chrono_literals;
@@ -90,4 +90,4 @@ TEST(PayloadInbox, ManyProducersOneConsumerLoseNothing) {
 }
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -4,7 +4,7 @@
 // restart re-applying the log (the mission's, and the entry log's replay to the tap); three nodes electing and committing, byte for byte the same event
 // lines for the same inputs; and the failover time after a leader stops, with the trial's
 // timings over a 100 +- 20 ms / 5% link.
-#include "swarmbox/mission/raft_service.hpp"
+#include "swarmbox/raft_service/raft_service.hpp"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +24,7 @@
 #include "support/flaky_file_system.hpp"
 #include "swarmbox/common/logfmt.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 using testing::ManualClock;
@@ -535,4 +535,4 @@ TEST(RaftServiceSim, FailoverAfterTheLeaderStopsWithTheTrialTimingsOnALossyLink)
 }
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

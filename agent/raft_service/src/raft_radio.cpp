@@ -1,11 +1,11 @@
-#include "swarmbox/mission/raft_radio.hpp"
+#include "swarmbox/raft_service/raft_radio.hpp"
 
 #include <algorithm>
 #include <utility>
 
-#include "swarmbox/mission/raft_envelope.hpp"
+#include "swarmbox/raft_service/raft_envelope.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 RaftRadio::RaftRadio(std::string self, std::vector<std::string> peers, PayloadHandler on_payload)
     : self_(std::move(self)), on_payload_(std::move(on_payload)), peers_(std::move(peers)) {}
@@ -104,4 +104,4 @@ RaftRadio::Counters RaftRadio::counters() const {
   return c;
 }
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

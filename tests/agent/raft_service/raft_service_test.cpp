@@ -3,7 +3,7 @@
 // driven by the test's loop (PayloadInbox from the middleware threads, Tick on the test's clock),
 // its events carrying that clock. The service's behaviour without DDS (storage failure, junk,
 // restart, the tick grid, determinism) is in raft_service_sim_test.cpp.
-#include "swarmbox/mission/raft_service.hpp"
+#include "swarmbox/raft_service/raft_service.hpp"
 
 #include <gtest/gtest.h>
 
@@ -20,10 +20,10 @@
 #include "support/files.hpp"
 #include "support/wait_until.hpp"
 #include "swarmbox/common/logfmt.hpp"
-#include "swarmbox/mission/payload_inbox.hpp"
-#include "swarmbox/mission/raft_radio.hpp"
+#include "swarmbox/raft_service/payload_inbox.hpp"
+#include "swarmbox/raft_service/raft_radio.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 using namespace std::chrono_literals;
@@ -219,4 +219,4 @@ TEST(RaftService, TwoNodesOverTheRadioElectAndCommit) {
 }
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -29,7 +29,7 @@
 
 #include "swarmbox/raft/node_driver.hpp"
 
-namespace swarmbox::mission::testing {
+namespace swarmbox::raft_service::testing {
 
 class ManualClock final : public raft::Clock {
  public:
@@ -142,4 +142,4 @@ class SimRadio {
   std::uint64_t lost_ = 0;
 };
 
-}  // namespace swarmbox::mission::testing
+}  // namespace swarmbox::raft_service::testing

@@ -37,10 +37,10 @@
 #include "swarmbox/faults/posix_command_runner.hpp"
 #include "swarmbox/faults/netem_spec.hpp"
 #include "swarmbox/faults/radio_plan.hpp"
-#include "swarmbox/mission/raft_radio.hpp"
+#include "swarmbox/raft_service/raft_radio.hpp"
 #include "support/veth_pair.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 using namespace std::chrono_literals;
@@ -288,4 +288,4 @@ TEST_F(ReorderingRadio, MessagesToOnePeerAreLostOnlyAsConfigured) {
 }
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

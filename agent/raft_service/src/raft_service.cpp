@@ -1,11 +1,11 @@
-#include "swarmbox/mission/raft_service.hpp"
+#include "swarmbox/raft_service/raft_service.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 // The clock in whole microseconds: a step time such as 25 * 0.004 s lands on the 100 ms tick
@@ -96,4 +96,4 @@ Status RaftService::health() const {
 
 double RaftService::next_tick_s() const { return static_cast<double>(next_tick_us_) * 1e-6; }
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -1,11 +1,11 @@
-#include "swarmbox/mission/raft_node_options.hpp"
+#include "swarmbox/raft_service/raft_node_options.hpp"
 
 #include <charconv>
 #include <string_view>
 
 #include "swarmbox/bus/topics.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 Error Bad(const std::string& msg) { return Error(ErrorCode::kInvalidArgument, msg); }
@@ -132,4 +132,4 @@ Result<RaftNodeOptions> ParseRaftNodeArgs(const std::vector<std::string>& args) 
   return o;
 }
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -73,7 +73,7 @@
 #include "swarmbox/raft/state_machine.hpp"
 #include "swarmbox/raft/wal_storage.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 struct RaftServiceConfig {
   raft::DriverConfig driver;  // self, members, seed, timings (tick_ms: the Tick() grid)
@@ -163,4 +163,4 @@ class RaftService {
   std::uint64_t protocol_errors_ = 0;
 };
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -1,5 +1,5 @@
 // swarmbox-raft-node: one drone's Raft node (RaftService) on the mesh radio, as a program.
-// Used by the integration tests (tests/agent/mission/) and for trying consensus over a real
+// Used by the integration tests (tests/agent/raft_service/) and for trying consensus over a real
 // (netem) radio by hand:
 //
 //   swarmbox-raft-node --name scout_1 --members scout_1,scout_2,lifter --data-dir /tmp/r1
@@ -24,11 +24,11 @@
 #include <vector>
 
 #include "swarmbox/bus/participant.hpp"
-#include "swarmbox/mission/demo_mission.hpp"
-#include "swarmbox/mission/payload_inbox.hpp"
-#include "swarmbox/mission/raft_node_options.hpp"
-#include "swarmbox/mission/raft_radio.hpp"
-#include "swarmbox/mission/raft_service.hpp"
+#include "swarmbox/raft_service/demo_mission.hpp"
+#include "swarmbox/raft_service/payload_inbox.hpp"
+#include "swarmbox/raft_service/raft_node_options.hpp"
+#include "swarmbox/raft_service/raft_radio.hpp"
+#include "swarmbox/raft_service/raft_service.hpp"
 
 namespace {
 
@@ -58,8 +58,8 @@ int Fail(int code, const char* context, const swarmbox::Error& e) {
 }
 
 // The wall-clock loop (see the banner) until a signal, --duration-s, or a storage failure (1).
-int RunLoop(swarmbox::mission::RaftService& raft, swarmbox::mission::PayloadInbox& inbox,
-            const SinceStartClock& clock, const swarmbox::mission::RaftNodeOptions& opts) {
+int RunLoop(swarmbox::raft_service::RaftService& raft, swarmbox::raft_service::PayloadInbox& inbox,
+            const SinceStartClock& clock, const swarmbox::raft_service::RaftNodeOptions& opts) {
   using namespace swarmbox;
   using namespace std::chrono;
   const auto start = steady_clock::now();
@@ -80,7 +80,7 @@ int RunLoop(swarmbox::mission::RaftService& raft, swarmbox::mission::PayloadInbo
     if (opts.propose_every_ms > 0 && now >= next_propose && !raft.stopped()) {
       next_propose = now + propose_every;
       if (raft.is_leader()) {
-        if (auto cmd = mission::NextDemoCommand(raft.mission(), raft.self())) {
+        if (auto cmd = raft_service::NextDemoCommand(raft.mission(), raft.self())) {
           (void)raft.Propose(*cmd);  // kUnavailable (leadership just lost): the next round retries
         }
       }
@@ -96,14 +96,14 @@ int RunLoop(swarmbox::mission::RaftService& raft, swarmbox::mission::PayloadInbo
 int main(int argc, char** argv) {
   using namespace swarmbox;
   std::vector<std::string> args(argv + 1, argv + argc);
-  auto opts = mission::ParseRaftNodeArgs(args);
+  auto opts = raft_service::ParseRaftNodeArgs(args);
   if (!opts) {
     std::fprintf(stderr, "swarmbox-raft-node: %s\n%s", opts.error().ToString().c_str(),
-                 mission::RaftNodeUsage().c_str());
+                 raft_service::RaftNodeUsage().c_str());
     return 2;
   }
   if (opts->help) {
-    std::fputs(mission::RaftNodeUsage().c_str(), stdout);
+    std::fputs(raft_service::RaftNodeUsage().c_str(), stdout);
     return 0;
   }
   std::signal(SIGTERM, OnSignal);
@@ -113,16 +113,16 @@ int main(int argc, char** argv) {
       {.backend = opts->middleware, .domain_id = opts->domain, .interface = opts->interface});
   if (!mesh) return Fail(3, "mesh bus: ", mesh.error());
   SinceStartClock clock;
-  mission::PayloadInbox inbox;  // before the radio: its callback pushes here until it is gone
+  raft_service::PayloadInbox inbox;  // before the radio: its callback pushes here until it is gone
   // A writer per member (RaftRadio: reordering on the radio must not become extra loss).
-  auto radio = mission::RaftRadio::Create(**mesh, opts->driver.self, opts->driver.members,
+  auto radio = raft_service::RaftRadio::Create(**mesh, opts->driver.self, opts->driver.members,
                                           [&inbox](std::span<const std::uint8_t> b) { inbox.Push(b); });
   if (!radio) return Fail(3, "", radio.error());
-  mission::RaftServiceConfig cfg;
+  raft_service::RaftServiceConfig cfg;
   cfg.driver = opts->driver;
   cfg.driver.tap_committed = false;  // the demo reads the mission's state, never the entries
   cfg.data_dir = opts->data_dir;
-  auto service = mission::RaftService::Start(cfg, **radio, clock);
+  auto service = raft_service::RaftService::Start(cfg, **radio, clock);
   if (!service) return Fail(3, "", service.error());
   const int code = RunLoop(**service, inbox, clock, *opts);
   service->reset();

@@ -19,7 +19,7 @@
 // of the same writer (RTPS sequence numbers), so a radio with jitter (netem and the NFQUEUE delayer
 // both reorder packets) would turn reordering into extra loss on one shared writer: a heartbeat
 // broadcast is four samples at once, and the reader of each peer sees all four (measured in
-// mission_raft_radio_reorder_test at 50 +- 20 ms / 5 %: 52.7 % of a leader's messages to one
+// raft_service_radio_reorder_test at 50 +- 20 ms / 5 %: 52.7 % of a leader's messages to one
 // follower lost with one writer, 4.0 % with these lanes). With a writer of its own per destination
 // a reader only loses what its own stream reorders, and with two lanes per peer two messages sent
 // to one peer back to back (an append and a heartbeat, a response pair) are on different writers
@@ -47,7 +47,7 @@
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/raft/node_driver.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 class RaftRadio final : public raft::Transport {
  public:
@@ -115,4 +115,4 @@ class RaftRadio final : public raft::Transport {
   std::unique_ptr<bus::Subscriber<bus::RaftMessage>> subscriber_;
 };
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

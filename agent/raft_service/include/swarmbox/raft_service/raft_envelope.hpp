@@ -18,7 +18,7 @@
 
 #include "swarmbox/bus/messages.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 // What a receiver does with a RaftMessage sample it heard on the radio topic.
 enum class RaftDelivery : std::uint8_t {
@@ -41,4 +41,4 @@ std::uint64_t PeekRaftTerm(std::span<const std::uint8_t> bytes);
 // Addressing rule of the receiver `self` (drone names compare exactly).
 RaftDelivery ClassifyRaftMessage(const bus::RaftMessage& m, std::string_view self);
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -1,11 +1,11 @@
 // The stand-alone node's proposal script walks the mission state machine without getting stuck.
-#include "swarmbox/mission/demo_mission.hpp"
+#include "swarmbox/raft_service/demo_mission.hpp"
 
 #include <gtest/gtest.h>
 
 #include <variant>
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 TEST(DemoMission, CyclesSearchConvergeRescueWithOneNewVictimPerRound) {
@@ -56,4 +56,4 @@ TEST(DemoMission, ReturnLeadsToCompleteAndThenNothing) {
 }
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

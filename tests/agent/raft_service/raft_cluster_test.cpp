@@ -24,7 +24,7 @@
 #include "support/logged_child.hpp"
 #include "support/raft_scenario.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 using namespace std::chrono_literals;
@@ -108,4 +108,4 @@ INSTANTIATE_TEST_SUITE_P(Middleware, RaftCluster,
                          [](const ::testing::TestParamInfo<Backend>& i) { return i.param.name; });
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -18,11 +18,11 @@
 #include "swarmbox/raft/mission_command.hpp"
 #include "swarmbox/raft/mission_state.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 inline constexpr double kDemoVictimSpacingM = 30.0;  // > MissionState::kConfirmRadiusM
 
 std::optional<raft::MissionCommand> NextDemoCommand(const raft::MissionState& committed,
                                                     std::string_view self);
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -1,8 +1,8 @@
-#include "swarmbox/mission/raft_node_options.hpp"
+#include "swarmbox/raft_service/raft_node_options.hpp"
 
 #include <gtest/gtest.h>
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 namespace {
 
 TEST(RaftNodeOptions, ParsesEveryFlag) {
@@ -67,4 +67,4 @@ TEST(RaftNodeOptions, HelpNeedsNothingElse) {
 }
 
 }  // namespace
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

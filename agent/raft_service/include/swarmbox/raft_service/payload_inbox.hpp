@@ -27,7 +27,7 @@
 
 #include "swarmbox/raft/types.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 class PayloadInbox {
  public:
@@ -54,4 +54,4 @@ class PayloadInbox {
   std::uint64_t drops_ = 0;
 };
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

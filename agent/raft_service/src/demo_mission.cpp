@@ -1,8 +1,8 @@
-#include "swarmbox/mission/demo_mission.hpp"
+#include "swarmbox/raft_service/demo_mission.hpp"
 
 #include <string>
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 std::optional<raft::MissionCommand> NextDemoCommand(const raft::MissionState& committed,
                                                     std::string_view self) {
@@ -29,4 +29,4 @@ std::optional<raft::MissionCommand> NextDemoCommand(const raft::MissionState& co
   return std::nullopt;
 }
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service

@@ -17,7 +17,7 @@
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/raft/node_driver.hpp"
 
-namespace swarmbox::mission {
+namespace swarmbox::raft_service {
 
 struct RaftNodeOptions {
   raft::DriverConfig driver;  // self = --name, members = --members, seed = --seed, timings
@@ -34,4 +34,4 @@ struct RaftNodeOptions {
 Result<RaftNodeOptions> ParseRaftNodeArgs(const std::vector<std::string>& args);
 std::string RaftNodeUsage();
 
-}  // namespace swarmbox::mission
+}  // namespace swarmbox::raft_service
