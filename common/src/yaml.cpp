@@ -608,10 +608,37 @@ void MapReader::Fail(Error error) {
   if (!first_error_) first_error_ = std::move(error);
 }
 
+namespace {
+
+// Issue #21 spelled each unit one way: m/s `_m_s`, m/s^2 `_m_s2`, rad/s `_rad_s`, deg/s `_deg_s`.
+// A key in the old spelling (`speed` + `_mps`) is the key of today in the new one; empty if `key`
+// has no old unit suffix. (The suffixes stand alone in these strings so that the rename script,
+// which rewrites `<name>_mps`, leaves them as they are.)
+std::string RespelledUnitKey(std::string_view key) {
+  static constexpr std::pair<std::string_view, std::string_view> kOldToNew[] = {
+      {"_mps", "_m_s"},     {"_mps2", "_m_s2"},     {"_radps", "_rad_s"},
+      {"_radps2", "_rad_s2"}, {"_degps", "_deg_s"}, {"_degps2", "_deg_s2"}};
+  for (const auto& [old_suffix, new_suffix] : kOldToNew) {
+    if (key.size() > old_suffix.size() && key.ends_with(old_suffix)) {
+      return std::string(key.substr(0, key.size() - old_suffix.size())) + std::string(new_suffix);
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 Status MapReader::Finish() {
   if (first_error_) return *first_error_;
   for (const auto& [k, v] : node_.entries()) {
     if (std::find(known_.begin(), known_.end(), k.scalar()) == known_.end()) {
+      const std::string respelled = RespelledUnitKey(k.scalar());
+      if (!respelled.empty() && std::find(known_.begin(), known_.end(), respelled) != known_.end()) {
+        return Error(ErrorCode::kInvalidArgument,
+                     "unknown key '" + k.scalar() + "' in " + what_ + ": it is spelled '" + respelled +
+                         "' now (units are spelled _m_s, _m_s2, _rad_s, _deg_s)",
+                     k.Where());
+      }
       std::string accepted;
       for (const auto& name : known_) accepted += (accepted.empty() ? "" : ", ") + name;
       return Error(ErrorCode::kInvalidArgument,
