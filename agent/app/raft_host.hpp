@@ -5,7 +5,7 @@
 // The swarm agrees on its mission through Raft (agent/raft). The service has no thread and no
 // bus: every lockstep step the node hands it the Raft payloads the radio delivered (OnPayload,
 // in delivery order), then calls Step(), which runs the ticks due by the Raft clock and, with
-// propose_every_ms > 0, proposes the next demo mission command (mission/demo_mission.hpp) when
+// propose_every_ms > 0, proposes the next demo mission command (raft_service/demo_mission.hpp) when
 // this node leads. Its messages go out as RadioFrames (raft_msg: one RaftMessage {from, to, term,
 // payload}) through radio.Send, inside those calls.
 //

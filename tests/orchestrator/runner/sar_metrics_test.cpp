@@ -6,9 +6,9 @@
 // SarRunMetrics.ARealRunsFolderAgrees: the logs of a real `swarmbox run trials/sar_search.yaml`
 // (data/sar_search, its README says how it was written), also against the result.json its runner
 // wrote. SarRunMetrics.ResultJsonResultsCsvAndTheEndingLineAgree: the same on a small folder whose
-// lines are in the formats the agents write them (agent/raft/src/node_driver.cpp:
+// lines are in the formats the agents write them (agent/raft/src/mission_state_machine.cpp:
 // victim_confirmed/victim_status by `id`, logged by every node as it applies the entry;
-// agent/swarm/src/scout_behaviour.cpp: sighting_reported without an id; agent/app/mission_host.cpp:
+// agent/swarm/src/scout_behaviour.cpp: sighting_reported without an id; agent/app/sar_brain.cpp:
 // mission_complete victims= rescued=), with the ending line of the example report's trial
 // radio-abb-r1 (docs/example-report), whose result.json said victims_confirmed 1 and
 // victims_detected 0 before. The same agreement on a real run's logs: cli_sar_search_e2e_test.

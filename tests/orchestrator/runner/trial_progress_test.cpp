@@ -28,8 +28,8 @@ const std::vector<std::pair<std::string, std::string>> kSarLines = {
     {"scout_1", "t=16.352 node=scout_1 event=mission_state state=SEARCH index=3"},
     {"scout_1", "t=16.432 node=scout_1 event=mission_stage role=scout stage=searching lane=0"},
     {"physics", "t=20.000 node=physics event=clock rtf=1.00 steps=5000 late=663 lost=0"},
-    // Later events in the form the agents print them (node_driver.cpp, scout_behaviour.cpp,
-    // lifter_sequence.cpp, mission_host.cpp).
+    // Later events in the form the agents print them (mission_state_machine.cpp, scout_behaviour.cpp,
+    // lifter_sequence.cpp, sar_brain.cpp).
     {"scout_3", "t=41.200 node=scout_3 event=sighting_reported seq=1 x=35.6 y=19.6 confidence=0.91"},
     {"scout_3", "t=46.200 node=scout_3 event=sighting_reported seq=1 x=35.6 y=19.6 confidence=0.91 retry=1"},
     {"scout_2", "t=46.500 node=scout_2 event=victim_confirmed id=1 x=35.600 y=19.600 index=12"},

@@ -1,6 +1,6 @@
 // GroundDetection: one victim detection geolocated on the ground, the output of the perception
 // pipeline (victim_detector.hpp + geolocation.hpp, delayed by latency_queue.hpp) and an input of
-// the mission behaviour (mission_behaviour.hpp), which turns it into a Raft ReportSighting.
+// the scout's behaviour (scout_behaviour.hpp), which turns it into a Raft ReportSighting.
 // On the mesh it travels as bus::Detection (label "victim").
 #pragma once
 

@@ -1,5 +1,6 @@
-// The interface of the SAR mission behaviour (mission_behaviour.hpp): what the agent feeds in
-// every mission tick and what it gets back. Plain values; the agent converts at its edges:
+// The interface of the SAR mission behaviours (scout_behaviour.hpp, lifter_sequence.hpp,
+// leader_planner.hpp): what the agent feeds in every mission tick and what it gets back. Plain
+// values; the agent converts at its edges:
 //   SetpointRequest  -> the flight stack (takeoff / position+yaw / velocity+yaw from Flocking /
 //                       land / idle),
 //   PayloadRequest   -> bus::WorldCommand "payload_attach" {mass_kg} or "payload_release" {},
