@@ -67,13 +67,6 @@ int Recorder::Add(std::string topic) {
   return static_cast<int>(topics_.size() - 1);
 }
 
-int Recorder::ChannelIndex(std::string_view topic) const {
-  for (std::size_t i = 0; i < topics_.size(); ++i) {
-    if (topics_[i] == topic) return static_cast<int>(i);
-  }
-  return -1;
-}
-
 Status Recorder::AddChannels() {
   using namespace record;
   std::vector<std::string_view> schemas;

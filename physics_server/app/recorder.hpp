@@ -73,8 +73,6 @@ class Recorder final : public StepObserver {
   // Written so far (for tests and the benchmark).
   std::uint64_t messages() const { return messages_; }
   std::uint64_t bytes() const { return bytes_; }
-  // Channel index of a topic (tests); -1 when there is none.
-  int ChannelIndex(std::string_view topic) const;
 
   // Without the world: the true poses of this time (tests; OnStep builds them from the World).
   void WriteTruth(std::uint64_t t_ns, std::span<const TruthPose> poses);

@@ -110,10 +110,4 @@ Vec3 SwingObserver::DampingAcceleration(double gain) const {
   return Vec3(k * s_dot_.x(), k * s_dot_.y(), 0.0);
 }
 
-Vec3 SwingObserver::DampingVelocity(double gain) const {
-  if (!active_) return Vec3::Zero();
-  const double k = gain * std::sqrt(kGravity_m_s2 * length_m_);
-  return Vec3(k * s_.x(), k * s_.y(), 0.0);
-}
-
 }  // namespace swarmbox::flight

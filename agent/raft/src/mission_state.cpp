@@ -29,15 +29,6 @@ std::string_view VictimStatusName(VictimStatus status) {
   return "unknown";
 }
 
-std::string_view CandidateStatusName(CandidateStatus status) {
-  switch (status) {
-    case CandidateStatus::kPending: return "pending";
-    case CandidateStatus::kConfirmed: return "confirmed";
-    case CandidateStatus::kRejected: return "rejected";
-  }
-  return "unknown";
-}
-
 namespace {
 
 bool Finite(double v) { return std::isfinite(v); }

@@ -29,17 +29,6 @@ int TakeoffWave(const Eigen::Vector2d& home_xy_m, double grid_m) {
 
 std::string_view RoleName(Role role) { return role == Role::kScout ? "scout" : "lifter"; }
 
-std::string_view SetpointKindName(SetpointKind kind) {
-  switch (kind) {
-    case SetpointKind::kIdle: return "idle";
-    case SetpointKind::kTakeoff: return "takeoff";
-    case SetpointKind::kPosition: return "position";
-    case SetpointKind::kFlock: return "flock";
-    case SetpointKind::kLand: return "land";
-  }
-  return "?";
-}
-
 std::string_view ScoutBehaviour::StageName(Stage stage) {
   switch (stage) {
     case Stage::kOnGround: return "on_ground";

@@ -8,17 +8,6 @@
 
 namespace swarmbox::experiment {
 
-std::string_view TrialStatusName(TrialStatus status) {
-  switch (status) {
-    case TrialStatus::kPending: return "pending";
-    case TrialStatus::kRunning: return "running";
-    case TrialStatus::kCompleted: return "completed";
-    case TrialStatus::kExhausted: return "exhausted";
-    case TrialStatus::kNotRun: return "not_run";
-  }
-  return "?";
-}
-
 WorkQueue::WorkQueue(std::size_t trials, std::vector<std::string> hosts, int max_attempts)
     : hosts_(std::move(hosts)),
       host_up_(hosts_.size(), true),

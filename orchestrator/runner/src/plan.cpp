@@ -380,13 +380,6 @@ std::string BrainHostName(std::string_view drone) {
   return host;
 }
 
-std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone) {
-  return AgentArgv(spec, drone);
-}
-std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone) {
-  return BrainArgv(spec, drone);
-}
-
 std::string CycloneUriFor(std::string_view interface, int participant_index) {
   // The agents' and the physics server's own configuration (swarmbox/bus/cyclone_config.hpp), so a
   // program the runner starts discovers and fragments as they do.

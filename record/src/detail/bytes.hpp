@@ -25,8 +25,7 @@ class ByteWriter {
     out_->append(s);
   }
   void Raw(std::string_view s) { out_->append(s); }
-  // Overwrites 4/8 bytes at `at` (a length prefix written before its content was known).
-  void PatchU32(std::size_t at, std::uint32_t v) { Put(at, v, 4); }
+  // Overwrites 8 bytes at `at` (a length prefix written before its content was known).
   void PatchU64(std::size_t at, std::uint64_t v) { Put(at, v, 8); }
   std::size_t size() const { return out_->size(); }
 

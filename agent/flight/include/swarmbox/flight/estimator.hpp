@@ -108,9 +108,7 @@ class Estimator {
   void SetAtRest(bool at_rest) { at_rest_ = at_rest; }
   const StateEstimate& state() const { return state_; }
   const Vec3& gyro_bias() const { return gyro_bias_; }
-  const Vec3& accel_bias_world() const { return acc_bias_; }
   // The estimated GPS position error (fix minus true position), world ENU [m].
-  Vec3 gps_error_estimate() const { return Vec3(ax_[0].x(3), ax_[1].x(3), ax_[2].x(3)); }
 
  private:
   using Vec5 = Eigen::Matrix<double, 5, 1>;

@@ -99,7 +99,6 @@ class FlightController {
   const ControllerTelemetry& telemetry() const { return telemetry_; }
   const FlightConfig& config() const { return config_; }
   const Mixer& mixer() const { return mixer_; }
-  bool swing_damping_active() const { return damping_on_; }
 
  private:
   FlightController(const FlightConfig& config, const ControllerOptions& options, Mixer mixer);

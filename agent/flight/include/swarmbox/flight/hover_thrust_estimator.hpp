@@ -67,8 +67,6 @@ class HoverThrustEstimator {
 
   double hover_thrust() const { return hover_; }
   double variance() const { return var_; }
-  double accel_noise_var() const { return acc_var_; }
-  double signed_test_ratio_lpf() const { return ratio_lpf_; }
 
  private:
   HoverThrustParams params_;

@@ -72,13 +72,10 @@ class SwingObserver {
   // Swinging part of the horizontal payload offset over sling length (world x, y; z = 0),
   // ~ the swing angles [rad]; swing_angle_rad() adds the steady lean.
   const Vec3& swing() const { return s_; }
-  const Vec3& swing_rate() const { return s_dot_; }
   const Vec3& measured_swing() const { return s_meas_; }
   double swing_angle_rad() const;
-  // Hook acceleration that damps the swing: gain * sqrt(g L) * s' (world, horizontal) [m/s^2],
-  // and its velocity counterpart gain * sqrt(g L) * s [m/s] for the velocity feed-forward.
+  // Hook acceleration that damps the swing: gain * sqrt(g L) * s' (world, horizontal) [m/s^2].
   Vec3 DampingAcceleration(double gain) const;
-  Vec3 DampingVelocity(double gain) const;
 
  private:
   double length_m_ = 0.0;

@@ -46,7 +46,6 @@ class Trajectory {
 
   const TrajectoryPoint& reference() const { return ref_; }
   const Vec3& target() const { return target_; }
-  bool velocity_mode() const { return velocity_mode_; }
   // The reference has arrived (position mode: at the target and at rest).
   bool Settled(double tol_m = 0.01) const;
 

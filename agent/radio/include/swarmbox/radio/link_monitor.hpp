@@ -118,7 +118,6 @@ class LinkMonitor {
   std::optional<std::vector<LinkWindow>> TakeReport(TimePoint now);
 
   // When the next ping round is due (DuePings does nothing before).
-  TimePoint next_ping_due() const { return next_ping_; }
   const std::vector<std::string>& peers() const { return peers_; }
   std::uint64_t refused() const { return refused_; }
   const LinkMonitorOptions& options() const { return options_; }

@@ -63,7 +63,6 @@ struct SightingView {
 };
 
 enum class CandidateStatus : std::uint8_t { kPending, kConfirmed, kRejected };
-std::string_view CandidateStatusName(CandidateStatus status);  // "pending", "confirmed", "rejected"
 
 // A place where some drone's detector fired, and everything seen there since.
 struct Candidate {

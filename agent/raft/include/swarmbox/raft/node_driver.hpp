@@ -186,7 +186,6 @@ class NodeDriver {
   const std::string& NameOf(NodeId id) const { return names_[id - 1]; }
   // The configuration this driver has applied (the same as raft().conf_state() between calls).
   const ConfState& conf_state() const { return node_.conf_state(); }
-  bool replaces_lost_voters() const { return target_voters_ > 0; }
   NodeId IdOf(const std::string& name) const;  // kNoNode when not a member
 
  private:

@@ -49,7 +49,6 @@ class WalStorage final : public Storage {
 
   // Bytes cut off the WAL's tail at Open (0 when the file ended cleanly).
   std::uint64_t torn_bytes_dropped() const { return torn_bytes_dropped_; }
-  const std::string& wal_path() const { return wal_path_; }
 
  private:
   WalStorage(FileSystem& fs, std::string dir);

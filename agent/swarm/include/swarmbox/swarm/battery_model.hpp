@@ -59,7 +59,6 @@ class BatteryModel {
   double EnergyToHome(double distance_m, double altitude_m, double payload_mass_kg) const;  // [J]
   bool IsLow(double distance_home_m, double altitude_m, double payload_mass_kg) const;
 
-  double remaining_j() const { return remaining_j_; }
   double fraction() const { return remaining_j_ / capacity_j_; }  // state of charge [0, 1]
   const BatterySpec& spec() const { return spec_; }
 

@@ -33,7 +33,6 @@ enum class SetpointKind {
   kFlock,     // Flocking::Step with goal target_m -> velocity setpoint + yaw_rad
   kLand,      // descend and touch down at target_m.x/y, then disarm
 };
-std::string_view SetpointKindName(SetpointKind kind);
 
 struct SetpointRequest {
   SetpointKind kind = SetpointKind::kIdle;

@@ -49,7 +49,6 @@ class VictimPerception {
   // Appends the detections that are visible at now_s (capture + latency <= now_s).
   void PopVisible(double now_s, std::vector<GroundDetection>* out) { queue_.PopVisible(now_s, out); }
 
-  const std::vector<ImageBlob>& last_blobs() const { return blobs_; }
   const LatencyQueue& queue() const { return queue_; }
   const PerceptionParams& params() const { return params_; }
 

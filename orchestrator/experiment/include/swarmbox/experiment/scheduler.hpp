@@ -35,7 +35,6 @@ struct AttemptResult {
 };
 
 enum class TrialStatus { kPending, kRunning, kCompleted, kExhausted, kNotRun };
-std::string_view TrialStatusName(TrialStatus status);
 
 struct TrialReport {
   TrialStatus status = TrialStatus::kPending;

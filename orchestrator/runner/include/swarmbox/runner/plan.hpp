@@ -165,9 +165,6 @@ std::string BrainId(std::string_view drone);
 // for scout_2 (the resolver refuses '_' in a host name, as "scout_2-brain" has; drone names have no
 // '-', so the alias stays unique).
 std::string BrainHostName(std::string_view drone);
-// The agent's argv (swarmbox-agent) and an external brain's (for tests and `swarmbox compose`).
-std::vector<std::string> AgentCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
-std::vector<std::string> BrainCommandLine(const dsl::TrialSpec& spec, const dsl::DroneSpec& drone);
 // The CYCLONEDDS_URI an external brain or a component on sim gets: bus::CycloneXml on
 // `interface` (multicast discovery and message sizes tuned for 100 participants; bus/README.md).
 // participant_index 0 for an external brain: the well-known port its agent names (--sim-peer);

@@ -188,7 +188,6 @@ class ClusterSim {
 
   void Schedule(std::int64_t at_us, Event* e);
   void Step();
-  void DeliverMessage(int from, int to, std::uint32_t epoch_to, Bytes bytes);
   void SendMessage(int from, const std::string& to_name, std::span<const std::uint8_t> bytes);
   void ScheduleTick(int node);
   void ScheduleNextCrash();
