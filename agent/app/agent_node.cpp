@@ -441,6 +441,10 @@ Status AgentNode::ServeRadioBetweenSteps() {
     for (const bus::RadioFrame& f : frames_) probe_->Heard(f);  // the ping sampling's order
   }
   DispatchFrames(frames_, options_.name, *this, &dispatched_);
+  return StepRaftAndProbe();
+}
+
+Status AgentNode::StepRaftAndProbe() {
   if (raft_) {
     if (Status s = raft_->Step(); !s) return s.error().Context("raft stopped");
   }
@@ -494,14 +498,7 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
     Log(le);
   }
-  if (raft_) {
-    if (Status s = raft_->Step(); !s) return s.error().Context("raft stopped");
-  }
-  if (probe_) {
-    lines_.clear();
-    probe_->Step(radio::RadioTime(radio_->now_ns()), t_s_, *radio_, &lines_);
-    for (const LogEvent& line : lines_) Log(line);
-  }
+  if (Status s = StepRaftAndProbe(); !s) return s;
   if (sar_ != nullptr) {
     StepMission(msg);
   } else if (brain_host_) {

@@ -145,6 +145,8 @@ class AgentNode final : private FrameHandler {
   // netem only, while waiting for a sample: the radio's deliveries dispatched, Raft's ticks and
   // the probe on the wall clock (as the mesh does not wait for the lockstep). Raft's error.
   Status ServeRadioBetweenSteps();
+  // Raft's ticks due, then the link probe's round (its lines logged). Raft's error.
+  Status StepRaftAndProbe();
   // --mission sar: perception (camera frames -> detections to the brain, also broadcast), netem's
   // wall clock for SarBrain's side channel, then StepBrain.
   void StepMission(const bus::SensorSample& msg);

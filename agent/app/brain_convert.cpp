@@ -1,6 +1,8 @@
 #include "brain_convert.hpp"
 
+#include <algorithm>
 #include <array>
+#include <iterator>
 #include <cmath>
 #include <map>
 #include <utility>
@@ -17,14 +19,90 @@ constexpr std::array<brain::Command::Kind, 7> kCommandKinds = {
 std::array<double, 3> A(const brain::Vec3& v) { return {v.x, v.y, v.z}; }
 brain::Vec3 V(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
 
-bus::Event EventToBus(const std::string& node, std::int64_t t_ns, const std::string& name,
-                      const std::map<std::string, std::string>& fields) {
+// The field lists below pair each brain field with its wire field once (brain first); ToWire
+// walks them brain -> bus, FromWire bus -> brain, so both directions convert the same fields.
+struct ToWire {
+  void operator()(const brain::Vec3& from, std::array<double, 3>& to) const { to = A(from); }
+  void operator()(const double (&from)[4], std::array<double, 4>& to) const {
+    std::copy(std::begin(from), std::end(from), to.begin());
+  }
+  template <typename T>
+  void operator()(const T& from, T& to) const {
+    to = from;
+  }
+};
+struct FromWire {
+  void operator()(brain::Vec3& to, const std::array<double, 3>& from) const { to = V(from); }
+  void operator()(double (&to)[4], const std::array<double, 4>& from) const {
+    std::copy(from.begin(), from.end(), std::begin(to));
+  }
+  template <typename T>
+  void operator()(T& to, const T& from) const {
+    to = from;
+  }
+};
+
+template <typename Vehicle, typename State, typename Copy>
+void VehicleFields(Vehicle& v, State& s, const Copy& copy) {
+  copy(v.name, s.drone);
+  copy(v.step, s.step);
+  copy(v.position_m, s.position_enu_m);
+  copy(v.velocity_m_s, s.velocity_enu_m_s);
+  copy(v.attitude_wxyz, s.attitude_wxyz);
+  copy(v.angular_rate_rad_s, s.angular_rate_flu_rad_s);
+  copy(v.battery_fraction, s.battery_fraction);
+  copy(v.battery_voltage_v, s.battery_voltage_v);
+  copy(v.flight_mode, s.flight_mode);
+  copy(v.armed, s.armed);
+  copy(v.landed, s.landed);
+  copy(v.payload_mass_kg, s.payload_mass_kg);
+  copy(v.mass_estimate_kg, s.mass_estimate_kg);
+}
+
+template <typename Setpoint, typename Trajectory, typename Copy>
+void SetpointFields(Setpoint& sp, Trajectory& t, const Copy& copy) {
+  copy(sp.position_m, t.position_enu_m);
+  copy(sp.velocity_m_s, t.velocity_enu_m_s);
+  copy(sp.acceleration_m_s2, t.acceleration_enu_m_s2);
+  copy(sp.yaw_rad, t.yaw_rad);
+  copy(sp.yawspeed_rad_s, t.yawspeed_rad_s);
+}
+
+template <typename Neighbour, typename State, typename Copy>
+void NeighbourFields(Neighbour& n, State& s, const Copy& copy) {
+  copy(n.name, s.drone);
+  copy(n.t_ns, s.sim_time_ns);
+  copy(n.position_m, s.position_enu_m);
+  copy(n.velocity_m_s, s.velocity_enu_m_s);
+  copy(n.heading_rad, s.heading_rad);
+  copy(n.battery_fraction, s.battery_fraction);
+  copy(n.status, s.mode);
+}
+
+template <typename Detection, typename Wire, typename Copy>
+void DetectionFields(Detection& d, Wire& w, const Copy& copy) {
+  copy(d.t_ns, w.sim_time_ns);
+  copy(d.label, w.label);
+  copy(d.confidence, w.confidence);
+  copy(d.position_m, w.position_enu_m);
+  copy(d.sigma_m, w.position_sigma_m);
+}
+
+// `fields`: a brain::FlightEvent's map or a brain::Event's list of pairs.
+template <typename Fields>
+bus::Event EventToBus(const std::string& node, std::int64_t t_ns, const std::string& name, const Fields& fields) {
   bus::Event e;
   e.node = node;
   e.sim_time_ns = t_ns;
   e.name = name;
   for (const auto& [k, v] : fields) e.fields.push_back({k, v});
   return e;
+}
+
+bus::DroneState NeighbourToBus(const brain::Neighbour& n) {
+  bus::DroneState s;
+  NeighbourFields(n, s, ToWire{});
+  return s;
 }
 
 }  // namespace
@@ -41,13 +119,7 @@ Result<brain::Command::Kind> ParseCommandName(std::string_view name) {
 
 brain::Neighbour NeighbourFromBus(const bus::DroneState& s) {
   brain::Neighbour n;
-  n.name = s.drone;
-  n.t_ns = s.sim_time_ns;
-  n.position_m = V(s.position_enu_m);
-  n.velocity_m_s = V(s.velocity_enu_m_s);
-  n.heading_rad = s.heading_rad;
-  n.battery_fraction = s.battery_fraction;
-  n.status = s.mode;
+  NeighbourFields(n, s, FromWire{});
   return n;
 }
 
@@ -64,22 +136,14 @@ bus::BrainMessage MessageToBus(const brain::Message& m) {
 
 brain::Detection DetectionFromBus(const bus::Detection& d) {
   brain::Detection out;
-  out.t_ns = d.sim_time_ns;
-  out.label = d.label;
-  out.confidence = d.confidence;
-  out.position_m = V(d.position_enu_m);
-  out.sigma_m = d.position_sigma_m;
+  DetectionFields(out, d, FromWire{});
   return out;
 }
 
 bus::Detection DetectionToBus(const brain::Detection& d, const std::string& from) {
   bus::Detection out;
   out.from = from;
-  out.sim_time_ns = d.t_ns;
-  out.label = d.label;
-  out.confidence = d.confidence;
-  out.position_enu_m = A(d.position_m);
-  out.position_sigma_m = d.sigma_m;
+  DetectionFields(d, out, ToWire{});
   return out;
 }
 
@@ -87,59 +151,29 @@ bus::VehicleState VehicleToBus(const brain::Vehicle& v, std::int64_t t_ns) {
   bus::VehicleState s;
   s.drone = v.name;
   s.step = v.step;
+  VehicleFields(v, s, ToWire{});
   s.sim_time_ns = t_ns;
-  s.position_enu_m = A(v.position_m);
-  s.velocity_enu_m_s = A(v.velocity_m_s);
-  for (int i = 0; i < 4; ++i) s.attitude_wxyz[static_cast<std::size_t>(i)] = v.attitude_wxyz[i];
-  s.angular_rate_flu_rad_s = A(v.angular_rate_rad_s);
-  s.battery_fraction = v.battery_fraction;
-  s.battery_voltage_v = v.battery_voltage_v;
-  s.flight_mode = v.flight_mode;
-  s.armed = v.armed;
-  s.landed = v.landed;
-  s.payload_mass_kg = v.payload_mass_kg;
-  s.mass_estimate_kg = v.mass_estimate_kg;
   return s;
 }
 
 brain::Vehicle VehicleFromBus(const bus::VehicleState& s) {
   brain::Vehicle v;
-  v.name = s.drone;
-  v.step = s.step;
-  v.position_m = V(s.position_enu_m);
-  v.velocity_m_s = V(s.velocity_enu_m_s);
-  for (int i = 0; i < 4; ++i) v.attitude_wxyz[i] = s.attitude_wxyz[static_cast<std::size_t>(i)];
-  v.angular_rate_rad_s = V(s.angular_rate_flu_rad_s);
+  VehicleFields(v, s, FromWire{});
   // The heading is not on the wire: yaw of the (w, x, y, z) attitude, ENU.
   const double w = v.attitude_wxyz[0], x = v.attitude_wxyz[1], y = v.attitude_wxyz[2], z = v.attitude_wxyz[3];
   v.heading_rad = std::atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
-  v.battery_fraction = s.battery_fraction;
-  v.battery_voltage_v = s.battery_voltage_v;
-  v.flight_mode = s.flight_mode;
-  v.armed = s.armed;
-  v.landed = s.landed;
-  v.payload_mass_kg = s.payload_mass_kg;
-  v.mass_estimate_kg = s.mass_estimate_kg;
   return v;
 }
 
 bus::TrajectorySetpoint SetpointToBus(const brain::Setpoint& sp) {
   bus::TrajectorySetpoint t;
-  t.position_enu_m = A(sp.position_m);
-  t.velocity_enu_m_s = A(sp.velocity_m_s);
-  t.acceleration_enu_m_s2 = A(sp.acceleration_m_s2);
-  t.yaw_rad = sp.yaw_rad;
-  t.yawspeed_rad_s = sp.yawspeed_rad_s;
+  SetpointFields(sp, t, ToWire{});
   return t;
 }
 
 brain::Setpoint SetpointFromBus(const bus::TrajectorySetpoint& t) {
   brain::Setpoint sp;
-  sp.position_m = V(t.position_enu_m);
-  sp.velocity_m_s = V(t.velocity_enu_m_s);
-  sp.acceleration_m_s2 = V(t.acceleration_enu_m_s2);
-  sp.yaw_rad = t.yaw_rad;
-  sp.yawspeed_rad_s = t.yawspeed_rad_s;
+  SetpointFields(sp, t, FromWire{});
   return sp;
 }
 
@@ -154,17 +188,7 @@ void ToBus(const brain::Input& in, const std::string& drone, bus::BrainInput* ou
   out->is_leader = in.is_leader;
   out->leader = in.leader;
   out->neighbours.clear();
-  for (const brain::Neighbour& n : in.neighbours) {
-    bus::DroneState s;
-    s.drone = n.name;
-    s.sim_time_ns = n.t_ns;
-    s.position_enu_m = A(n.position_m);
-    s.velocity_enu_m_s = A(n.velocity_m_s);
-    s.heading_rad = n.heading_rad;
-    s.battery_fraction = n.battery_fraction;
-    s.mode = n.status;
-    out->neighbours.push_back(std::move(s));
-  }
+  for (const brain::Neighbour& n : in.neighbours) out->neighbours.push_back(NeighbourToBus(n));
   out->messages.clear();
   for (const brain::Message& m : in.messages) out->messages.push_back(MessageToBus(m));
   out->committed.clear();
@@ -216,14 +240,7 @@ void ToBus(const brain::Output& out, const std::string& drone, std::int64_t t_ns
   for (const std::vector<std::uint8_t>& p : out.proposals) wire->proposals.push_back({p});
   wire->status = out.status;
   wire->events.clear();
-  for (const brain::Event& e : out.events) {
-    bus::Event b;
-    b.node = drone;
-    b.sim_time_ns = t_ns;
-    b.name = e.name;
-    for (const auto& [k, v] : e.fields) b.fields.push_back({k, v});
-    wire->events.push_back(std::move(b));
-  }
+  for (const brain::Event& e : out.events) wire->events.push_back(EventToBus(drone, t_ns, e.name, e.fields));
 }
 
 Status FromBus(const bus::BrainOutput& wire, brain::Output* out) {

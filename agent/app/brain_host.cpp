@@ -6,15 +6,10 @@
 #include <utility>
 
 #include "brain_convert.hpp"
+#include "swarmbox/common/format.hpp"
 
 namespace swarmbox::agent {
 namespace {
-
-std::string Fixed(double v, int decimals) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
 
 double Seconds(std::int64_t t_ns) { return static_cast<double>(t_ns) * 1e-9; }
 
@@ -39,9 +34,9 @@ brain::FlightEvent FlightEventOf(const flight::FlightEvent& e) {
   out.name = std::string(flight::FlightEventName(e.kind));
   out.t_ns = std::llround(e.t_s * 1e9);
   if (e.kind == flight::FlightEventKind::kModeChange) out.fields["mode"] = std::string(flight::FlightModeName(e.mode));
-  out.fields["x"] = Fixed(e.pos_m.x(), 2);
-  out.fields["y"] = Fixed(e.pos_m.y(), 2);
-  out.fields["z"] = Fixed(e.pos_m.z(), 2);
+  out.fields["x"] = FormatFixed(e.pos_m.x(), 2);
+  out.fields["y"] = FormatFixed(e.pos_m.y(), 2);
+  out.fields["z"] = FormatFixed(e.pos_m.z(), 2);
   return out;
 }
 
@@ -231,7 +226,7 @@ void BrainHost::Step(std::uint64_t step, std::int64_t t_ns, const brain::Vehicle
     brain::FlightEvent fe;
     fe.name = std::string(flight::OffboardFailsafe::EventName(e.kind));
     fe.t_ns = std::llround(e.t_s * 1e9);
-    fe.fields["silent_s"] = Fixed(e.silent_s, 3);
+    fe.fields["silent_s"] = FormatFixed(e.silent_s, 3);
     fe.fields["action"] = std::string(flight::OffboardFailsafe::ActionName(e.action));
     flight_events_.push_back(std::move(fe));
   }

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "detail/backslash_escape.hpp"
+#include "swarmbox/common/format.hpp"
 
 namespace swarmbox {
 
@@ -54,13 +55,8 @@ LogEvent& LogEvent::Add(std::string_view key, std::string_view value) {
 }
 
 LogEvent& LogEvent::Add(std::string_view key, double value, int decimals) {
-  char buf[64];
-  if (std::isfinite(value)) {
-    std::snprintf(buf, sizeof buf, "%.*f", decimals, value);
-  } else {
-    std::snprintf(buf, sizeof buf, "%s", std::isnan(value) ? "nan" : (value > 0 ? "inf" : "-inf"));
-  }
-  return Add(key, std::string_view(buf));
+  if (std::isfinite(value)) return Add(key, std::string_view(FormatFixed(value, decimals)));
+  return Add(key, std::string_view(std::isnan(value) ? "nan" : (value > 0 ? "inf" : "-inf")));
 }
 
 LogEvent& LogEvent::Add(std::string_view key, std::int64_t value) {

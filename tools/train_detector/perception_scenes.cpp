@@ -220,11 +220,31 @@ physics::WorldConfig MakeWorld(std::mt19937_64& rng, int index, const SceneSetPa
   return w;
 }
 
+Result<physics::Airframe> CameraAirframe() {
+  Result<physics::Airframe> x500 = physics::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
+  if (!x500) return x500.error().Context("loading the x500 airframe for the camera");
+  return x500;
+}
+
+// A camera drone `name` over `centre` at `altitude` [m] above the ground, its camera's noise
+// `noise_std`, heading `yaw_rad`.
+physics::DroneSpawn CameraSpawn(const physics::Airframe& x500, std::string name, const Vector2d& centre,
+                                double altitude, double noise_std, double yaw_rad) {
+  physics::Airframe af = x500;
+  af.camera.noise_std = noise_std;
+  physics::DroneSpawn spawn;
+  spawn.name = std::move(name);
+  spawn.airframe = af;
+  spawn.position_m = {centre.x(), centre.y(), altitude - af.base_height_m};
+  spawn.yaw_rad = yaw_rad;
+  return spawn;
+}
+
 }  // namespace
 
 Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
-  Result<physics::Airframe> x500 = physics::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
-  if (!x500) return x500.error().Context("loading the x500 airframe for the camera");
+  Result<physics::Airframe> x500 = CameraAirframe();
+  if (!x500) return x500.error();
   std::mt19937_64 rng(p.seed);
   std::uniform_real_distribution<double> unit(0, 1);
   std::vector<Scene> scenes;
@@ -246,13 +266,8 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
       } else {
         centre = Vector2d(160 * unit(rng) - 80, 160 * unit(rng) - 80);
       }
-      physics::Airframe af = *x500;
-      af.camera.noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
-      physics::DroneSpawn spawn;
-      spawn.name = "cam_" + std::to_string(i);
-      spawn.airframe = af;
-      spawn.position_m = {centre.x(), centre.y(), altitude - af.base_height_m};
-      spawn.yaw_rad = yaw;
+      const double noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
+      const physics::DroneSpawn spawn = CameraSpawn(*x500, "cam_" + std::to_string(i), centre, altitude, noise_std, yaw);
       Result<std::size_t> d = (*world)->AddDrone(spawn);
       if (!d) return d.error().Context("placing camera drone");
       Scene s;
@@ -264,7 +279,7 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
       s.true_pose.position_m = {cp.position_m.x, cp.position_m.y, cp.position_m.z};
       s.true_pose.rotation = Eigen::Quaterniond(cp.attitude.w, cp.attitude.x, cp.attitude.y, cp.attitude.z);
       s.altitude_m = cp.position_m.z;
-      s.noise_std = af.camera.noise_std;
+      s.noise_std = noise_std;
       for (const physics::Victim& v : config.victims) {
         s.victims.push_back(Classify(v, s, config));
       }
@@ -302,18 +317,11 @@ Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& con
 
 Result<Scene> RenderView(const physics::WorldConfig& config, const Vector2d& centre, double altitude,
                          double yaw, double noise_std) {
-  Result<physics::Airframe> x500 = physics::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
-  if (!x500) return x500.error().Context("loading the x500 airframe for the camera");
+  Result<physics::Airframe> x500 = CameraAirframe();
+  if (!x500) return x500.error();
   Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = 1});
   if (!world) return world.error().Context("creating perception world");
-  physics::Airframe af = *x500;
-  af.camera.noise_std = noise_std;
-  physics::DroneSpawn spawn;
-  spawn.name = "cam";
-  spawn.airframe = af;
-  spawn.position_m = {centre.x(), centre.y(), altitude - af.base_height_m};
-  spawn.yaw_rad = yaw;
-  Result<std::size_t> d = (*world)->AddDrone(spawn);
+  Result<std::size_t> d = (*world)->AddDrone(CameraSpawn(*x500, "cam", centre, altitude, noise_std, yaw));
   if (!d) return d.error().Context("placing camera drone");
   physics::CameraImage img;
   std::vector<physics::VisiblePerson> people;
@@ -322,8 +330,8 @@ Result<Scene> RenderView(const physics::WorldConfig& config, const Vector2d& cen
 }
 
 Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double differential, double burst_s) {
-  Result<physics::Airframe> x500 = physics::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
-  if (!x500) return x500.error().Context("loading the x500 airframe for the camera");
+  Result<physics::Airframe> x500 = CameraAirframe();
+  if (!x500) return x500.error();
   std::mt19937_64 rng(p.seed);
   std::uniform_real_distribution<double> unit(0, 1);
   std::vector<Scene> scenes;
@@ -342,24 +350,20 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double di
       const physics::Victim& v = config.victims[static_cast<std::size_t>(rng() % config.victims.size())];
       const double half_w = altitude * std::tan(x500->camera.hfov_rad / 2);
       const Vector2d centre = Vector2d(v.x_m, v.y_m) + 0.5 * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
-      physics::Airframe af = *x500;
-      af.camera.noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
-      physics::DroneSpawn spawn;
-      spawn.name = "tilt_" + std::to_string(i);
-      spawn.airframe = af;
-      spawn.position_m = {centre.x(), centre.y(), altitude - af.base_height_m};
-      spawn.yaw_rad = 2 * std::numbers::pi * unit(rng);
+      const double noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
+      const double yaw = 2 * std::numbers::pi * unit(rng);
+      physics::DroneSpawn spawn = CameraSpawn(*x500, "tilt_" + std::to_string(i), centre, altitude, noise_std, yaw);
       spawn.initial_throttle = hover_u;
       Result<std::size_t> d = (*world)->AddDrone(spawn);
       if (!d) return d.error().Context("placing camera drone");
       const double a = differential * (2 * unit(rng) - 1), b = differential * (2 * unit(rng) - 1);
       std::vector<double> u;
-      for (const physics::RotorSpec& r : af.rotors) {
+      for (const physics::RotorSpec& r : x500->rotors) {
         u.push_back(hover_u + a * (r.position_m.x > 0 ? 1 : -1) + b * (r.position_m.y > 0 ? 1 : -1));
       }
       drones.push_back(*d);
       commands.push_back(std::move(u));
-      noise.push_back(af.camera.noise_std);
+      noise.push_back(noise_std);
     }
     const auto steps = static_cast<int>(std::lround(burst_s * 1e9 / static_cast<double>((*world)->options().control_period_ns)));
     for (int k = 0; k < steps; ++k) {

@@ -43,10 +43,7 @@ void WriteBody(ByteWriter& w, const ReportMiss& c) {
   w.Str(c.reporter);
   w.Varint(c.seq);
   w.Varint(c.candidate);
-  w.F64(c.viewer_x_m);
-  w.F64(c.viewer_y_m);
-  w.F64(c.viewer_height_m);
-  w.F64(c.t_s);
+  detail::WriteViewpoint(w, c);
 }
 void WriteBody(ByteWriter& w, const RequestRevisit& c) {
   w.Varint(c.candidate);
@@ -89,10 +86,7 @@ void ReadBody(ByteReader& r, ReportMiss* c) {
   c->reporter = r.Str();
   c->seq = r.Varint();
   c->candidate = ReadId(r);
-  c->viewer_x_m = r.F64();
-  c->viewer_y_m = r.F64();
-  c->viewer_height_m = r.F64();
-  c->t_s = r.F64();
+  detail::ReadViewpoint(r, c);
 }
 void ReadBody(ByteReader& r, RequestRevisit* c) {
   c->candidate = ReadId(r);

@@ -96,30 +96,38 @@ Status TarWriter::Add(const TarEntry& entry) {
   return status;
 }
 
-Status TarWriter::AddFile(std::string_view path, std::string_view content, std::uint32_t mode) {
+TarEntry FileEntry(std::string_view path, std::string_view content, std::uint32_t mode) {
   TarEntry entry;
   entry.path = std::string(path);
   entry.content = std::string(content);
   entry.mode = mode;
-  return Add(entry);
+  return entry;
 }
 
-Status TarWriter::AddDirectory(std::string_view path, std::uint32_t mode) {
+TarEntry DirectoryEntry(std::string_view path, std::uint32_t mode) {
   TarEntry entry;
   entry.type = TarEntry::Type::kDirectory;
   entry.path = std::string(path);
   entry.mode = mode;
-  return Add(entry);
+  return entry;
 }
 
-Status TarWriter::AddSymlink(std::string_view path, std::string_view target) {
+TarEntry SymlinkEntry(std::string_view path, std::string_view target) {
   TarEntry entry;
   entry.type = TarEntry::Type::kSymlink;
   entry.path = std::string(path);
   entry.content = std::string(target);
   entry.mode = 0777;
-  return Add(entry);
+  return entry;
 }
+
+Status TarWriter::AddFile(std::string_view path, std::string_view content, std::uint32_t mode) {
+  return Add(FileEntry(path, content, mode));
+}
+
+Status TarWriter::AddDirectory(std::string_view path, std::uint32_t mode) { return Add(DirectoryEntry(path, mode)); }
+
+Status TarWriter::AddSymlink(std::string_view path, std::string_view target) { return Add(SymlinkEntry(path, target)); }
 
 Result<std::string> TarWriter::Finish() {
   if (impl_->finished) return Error(ErrorCode::kInternal, "tar already finished", "libarchive");

@@ -137,11 +137,7 @@ Result<PackedContext> AssembleContext(const ImageSpec& spec, std::vector<TarEntr
       }
       continue;
     }
-    TarEntry d;
-    d.type = TarEntry::Type::kDirectory;
-    d.path = "rootfs/" + p;
-    d.mode = 0755;
-    by_path.emplace(p, std::move(d));
+    by_path.emplace(p, docker::DirectoryEntry("rootfs/" + p, 0755));
   }
 
   PackedContext ctx;
@@ -187,28 +183,9 @@ Result<PackedContext> PackContext(const ImageSpec& spec) {
       rootfs.push_back(std::move(*e));
     }
   }
-  for (const auto& [path, content] : spec.inline_files) {
-    TarEntry e;
-    e.path = path;
-    e.content = content;
-    e.mode = 0644;
-    rootfs.push_back(std::move(e));
-  }
-  for (const auto& [path, target] : spec.symlinks) {
-    TarEntry e;
-    e.type = TarEntry::Type::kSymlink;
-    e.path = path;
-    e.content = target;
-    e.mode = 0777;
-    rootfs.push_back(std::move(e));
-  }
-  for (const auto& [path, mode] : spec.directories) {
-    TarEntry e;
-    e.type = TarEntry::Type::kDirectory;
-    e.path = path;
-    e.mode = mode;
-    rootfs.push_back(std::move(e));
-  }
+  for (const auto& [path, content] : spec.inline_files) rootfs.push_back(docker::FileEntry(path, content, 0644));
+  for (const auto& [path, target] : spec.symlinks) rootfs.push_back(docker::SymlinkEntry(path, target));
+  for (const auto& [path, mode] : spec.directories) rootfs.push_back(docker::DirectoryEntry(path, mode));
   std::vector<std::string> host_files;
   for (const auto* group : {&spec.executables, &spec.plugins, &spec.files}) {
     for (const HostFile& f : *group) host_files.push_back(f.host_path);

@@ -3,18 +3,13 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "swarmbox/common/format.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/runner/end_matcher.hpp"
 
 namespace swarmbox::runner {
 
 namespace {
-
-std::string Fixed(double v, int digits) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
 
 std::optional<std::int64_t> IntField(const LogfmtFields& fields, std::string_view key) {
   auto v = FindField(fields, key);
@@ -95,9 +90,9 @@ void TrialProgress::OnLine(std::string_view component, std::string_view line) {
 }
 
 std::string RenderProgress(const TrialProgress& p, const ProgressFrame& frame) {
-  std::string s = "sim " + Fixed(p.sim_s, 1) + "/" + Fixed(frame.timeout_sim_s, 1) + "s";
-  if (p.rtf) s += "  rtf " + Fixed(*p.rtf, 2);
-  s += "  wall " + Fixed(frame.wall_s, 1) + "s";
+  std::string s = "sim " + FormatFixed(p.sim_s, 1) + "/" + FormatFixed(frame.timeout_sim_s, 1) + "s";
+  if (p.rtf) s += "  rtf " + FormatFixed(*p.rtf, 2);
+  s += "  wall " + FormatFixed(frame.wall_s, 1) + "s";
   if (p.joining && !p.joining->done) {
     s += "  joining " + std::to_string(p.joining->joined) + "/" + std::to_string(p.joining->expected);
   }
@@ -127,7 +122,7 @@ std::optional<std::string> JoinedLine(const TrialProgress& p) {
   if (!p.joining || !p.joining->done) return std::nullopt;
   const JoiningProgress& j = *p.joining;
   std::string s = "joined " + std::to_string(j.joined) + "/" + std::to_string(j.expected) + " in " +
-                  Fixed(j.wait_s, 1) + " s";
+                  FormatFixed(j.wait_s, 1) + " s";
   if (j.lost > 0) s += "; lost at the start: " + j.missing;
   return s;
 }

@@ -37,6 +37,12 @@ struct TarEntry {
   std::map<std::string, std::string> xattrs;
 };
 
+// The three kinds of entry, owned by root with mtime 0 (what TarWriter::AddFile, AddDirectory and
+// AddSymlink write).
+TarEntry FileEntry(std::string_view path, std::string_view content, std::uint32_t mode = 0644);
+TarEntry DirectoryEntry(std::string_view path, std::uint32_t mode = 0755);
+TarEntry SymlinkEntry(std::string_view path, std::string_view target);  // mode 0777
+
 class TarWriter {
  public:
   TarWriter();

@@ -1,8 +1,8 @@
 // The field layouts that mission commands (mission_command.cpp) and mission snapshots
 // (mission_state.cpp) share, so both encodings stay byte-for-byte the same where they overlap:
 //   sector list: varint count | per sector: str drone | f64 x_min y_min x_max y_max
-//   sighting:    str reporter | varint seq | f64 x | f64 y | f64 confidence
-//                | f64 viewer_x | f64 viewer_y | f64 viewer_height | f64 t
+//   sighting:    str reporter | varint seq | f64 x | f64 y | f64 confidence | viewpoint
+//   viewpoint:   f64 viewer_x | f64 viewer_y | f64 viewer_height | f64 t  (a sighting's, a miss's)
 // The readers follow ByteReader's rule: on malformed input they stop and leave the error latched
 // in the reader (check r.ok() afterwards).
 #pragma once
@@ -42,6 +42,23 @@ inline std::vector<Sector> ReadSectors(ByteReader& r) {
   return sectors;
 }
 
+// Where the camera was and when: S is ReportSighting, SightingView or ReportMiss.
+template <class S>
+void WriteViewpoint(ByteWriter& w, const S& s) {
+  w.F64(s.viewer_x_m);
+  w.F64(s.viewer_y_m);
+  w.F64(s.viewer_height_m);
+  w.F64(s.t_s);
+}
+
+template <class S>
+void ReadViewpoint(ByteReader& r, S* s) {
+  s->viewer_x_m = r.F64();
+  s->viewer_y_m = r.F64();
+  s->viewer_height_m = r.F64();
+  s->t_s = r.F64();
+}
+
 // S is ReportSighting (a command) or SightingView (evidence in the snapshot): same fields.
 template <class S>
 void WriteSighting(ByteWriter& w, const S& s) {
@@ -50,10 +67,7 @@ void WriteSighting(ByteWriter& w, const S& s) {
   w.F64(s.x_m);
   w.F64(s.y_m);
   w.F64(s.confidence);
-  w.F64(s.viewer_x_m);
-  w.F64(s.viewer_y_m);
-  w.F64(s.viewer_height_m);
-  w.F64(s.t_s);
+  WriteViewpoint(w, s);
 }
 
 template <class S>
@@ -64,10 +78,7 @@ S ReadSighting(ByteReader& r) {
   s.x_m = r.F64();
   s.y_m = r.F64();
   s.confidence = r.F64();
-  s.viewer_x_m = r.F64();
-  s.viewer_y_m = r.F64();
-  s.viewer_height_m = r.F64();
-  s.t_s = r.F64();
+  ReadViewpoint(r, &s);
   return s;
 }
 
