@@ -126,6 +126,14 @@ int main(int argc, char** argv) {
   for (const DroneSpec& d : o.drones) {
     auto af = LoadAirframe(AirframePathFor(d.airframe, o.airframes_dir));
     if (!af) return Fail(2, af.error().ToString());
+    if (af->stereo.enabled) {
+      // Issue #23: the pair is parsed and benchmarked (swarmbox-bench stereo) but this server does
+      // not render or publish it yet; a trial that asks for depth must not run without it.
+      return Fail(2, d.where + ": airframe '" + d.airframe +
+                         "' has a stereo depth camera ('stereo:'), which trials cannot fly yet: the physics "
+                         "server does not render stereo pairs (issue #23; swarmbox-bench stereo measures the "
+                         "model); use the airframe without '_depth'");
+    }
     DroneSpawn spawn;
     spawn.name = d.name;
     spawn.airframe = *af;
