@@ -586,28 +586,6 @@ MapReader::MapReader(const Node& node, std::string what) : node_(node), what_(st
   }
 }
 
-const Node* MapReader::Take(std::string_view key, bool required) {
-  known_.emplace_back(key);
-  if (!node_.is_mapping()) return nullptr;
-  const Node* child = node_.Find(key);
-  if (child == nullptr && required && !first_error_) {
-    first_error_ = Error(ErrorCode::kInvalidArgument,
-                         "missing required key '" + std::string(key) + "' in " + what_, node_.Where());
-  }
-  return child;
-}
-
-void MapReader::Keep(Status status, std::string_view key) {
-  if (!status && !first_error_) {
-    first_error_ = Error(status.error().code(),
-                         "'" + std::string(key) + "': " + status.error().message(), status.error().where());
-  }
-}
-
-void MapReader::Fail(Error error) {
-  if (!first_error_) first_error_ = std::move(error);
-}
-
 namespace {
 
 // Issue #21 spelled each unit one way: m/s `_m_s`, m/s^2 `_m_s2`, rad/s `_rad_s`, deg/s `_deg_s`.
@@ -626,7 +604,49 @@ std::string RespelledUnitKey(std::string_view key) {
   return {};
 }
 
+// The key of `map` that is `key` in the units' old spelling; nullptr if none.
+const Node* OldSpellingOf(const Node& map, std::string_view key) {
+  for (const auto& [k, v] : map.entries()) {
+    if (RespelledUnitKey(k.scalar()) == key) return &k;
+  }
+  return nullptr;
+}
+
+// The error for `old`, a key in the units' old spelling of `key`, in the mapping `what`.
+Error RespelledKeyError(const Node& old, std::string_view key, const std::string& what) {
+  return Error(ErrorCode::kInvalidArgument,
+               "unknown key '" + old.scalar() + "' in " + what + ": it is spelled '" + std::string(key) +
+                   "' now (units are spelled _m_s, _m_s2, _rad_s, _deg_s)",
+               old.Where());
+}
+
 }  // namespace
+
+const Node* MapReader::Take(std::string_view key, bool required) {
+  known_.emplace_back(key);
+  if (!node_.is_mapping()) return nullptr;
+  const Node* child = node_.Find(key);
+  if (child == nullptr && required && !first_error_) {
+    if (const Node* old = OldSpellingOf(node_, key)) {
+      first_error_ = RespelledKeyError(*old, key, what_);
+    } else {
+      first_error_ = Error(ErrorCode::kInvalidArgument,
+                           "missing required key '" + std::string(key) + "' in " + what_, node_.Where());
+    }
+  }
+  return child;
+}
+
+void MapReader::Keep(Status status, std::string_view key) {
+  if (!status && !first_error_) {
+    first_error_ = Error(status.error().code(),
+                         "'" + std::string(key) + "': " + status.error().message(), status.error().where());
+  }
+}
+
+void MapReader::Fail(Error error) {
+  if (!first_error_) first_error_ = std::move(error);
+}
 
 Status MapReader::Finish() {
   if (first_error_) return *first_error_;
@@ -634,10 +654,7 @@ Status MapReader::Finish() {
     if (std::find(known_.begin(), known_.end(), k.scalar()) == known_.end()) {
       const std::string respelled = RespelledUnitKey(k.scalar());
       if (!respelled.empty() && std::find(known_.begin(), known_.end(), respelled) != known_.end()) {
-        return Error(ErrorCode::kInvalidArgument,
-                     "unknown key '" + k.scalar() + "' in " + what_ + ": it is spelled '" + respelled +
-                         "' now (units are spelled _m_s, _m_s2, _rad_s, _deg_s)",
-                     k.Where());
+        return RespelledKeyError(k, respelled, what_);
       }
       std::string accepted;
       for (const auto& name : known_) accepted += (accepted.empty() ? "" : ", ") + name;

@@ -141,6 +141,20 @@ TEST(MapReader, OldUnitSpellingNamesTheNewKey) {
             "(units are spelled _m_s, _m_s2, _rad_s, _deg_s)");
 }
 
+// A required key written in the old spelling gets the same answer, not "missing required key".
+TEST(MapReader, OldUnitSpellingOfARequiredKeyNamesTheNewKey) {
+  auto doc = Parse("direction_deg: 270\nspeed" "_mps: 12\n", "trial.yaml");
+  ASSERT_TRUE(doc);
+  double speed = 0, direction = 0;
+  MapReader r(*doc, "wind_gust");
+  r.Required("speed_m_s", &speed).Optional("direction_deg", &direction);
+  auto s = r.Finish();
+  ASSERT_FALSE(s);
+  EXPECT_EQ(s.error().ToString(),
+            "trial.yaml:2:1: unknown key 'speed" "_mps' in wind_gust: it is spelled 'speed_m_s' now "
+            "(units are spelled _m_s, _m_s2, _rad_s, _deg_s)");
+}
+
 // An old suffix on a key that has no new spelling here is an ordinary unknown key.
 TEST(MapReader, OldUnitSuffixOfNoKnownKeyIsAnUnknownKey) {
   auto doc = Parse("rate" "_radps: 1\n", "af.yaml");
