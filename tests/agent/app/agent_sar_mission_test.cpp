@@ -96,7 +96,10 @@ class SarSwarm {
                                      std::to_string(domain), "--max-sim-time", "600", "--seed", "42",
                                      "--truth", dir + "/truth.csv"};
     if (channel) {
-      for (const char* a : {"--radio-model", "channel", "--radio-profile", SWARMBOX_TRIALS_DIR "/radios/wifi_5ghz_mesh.yaml"}) {
+      // As the runner plans a channel trial (runner::kChannelStepTimeoutS): the lost-drone rule is a
+      // liveness net, not a judge of an agent the suite's load stalled for a second.
+      for (const char* a : {"--radio-model", "channel", "--radio-profile", SWARMBOX_TRIALS_DIR "/radios/wifi_5ghz_mesh.yaml",
+                            "--step-timeout", "30"}) {
         phys.push_back(a);
       }
     }
