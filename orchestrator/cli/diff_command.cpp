@@ -51,16 +51,54 @@ yaml::Node Opt(const std::optional<std::string>& v) { return v ? json::Str(*v) :
 yaml::Node OptNum(const std::optional<double>& v) { return v ? json::Num(*v) : yaml::Node::Null(); }
 yaml::Node SideName(report::Side s) { return json::Str(s == report::Side::kA ? "a" : "b"); }
 
-yaml::Node Fields(const std::vector<report::FieldDiff>& fields) {
+// A JSON list of `items`, each as `to_json` writes it.
+template <typename T, typename ToJson>
+yaml::Node ListJson(const std::vector<T>& items, ToJson to_json) {
   yaml::Node list = yaml::Node::Sequence();
-  for (const report::FieldDiff& f : fields) {
+  for (const T& item : items) list.Append(to_json(item));
+  return list;
+}
+
+yaml::Node Fields(const std::vector<report::FieldDiff>& fields) {
+  return ListJson(fields, [](const report::FieldDiff& f) {
     yaml::Node o = yaml::Node::Mapping();
     o.Set("field", json::Str(f.field));
     o.Set("a", Opt(f.a));
     o.Set("b", Opt(f.b));
-    list.Append(std::move(o));
-  }
-  return list;
+    return o;
+  });
+}
+
+yaml::Node MissingJson(const std::vector<report::MissingFile>& missing) {
+  return ListJson(missing, [](const report::MissingFile& m) {
+    yaml::Node x = yaml::Node::Mapping();
+    x.Set("file", json::Str(m.file));
+    x.Set("missing_in", SideName(m.missing_in));
+    return x;
+  });
+}
+
+yaml::Node TruthJson(const report::TruthDivergence& truth) {
+  yaml::Node t = yaml::Node::Mapping();
+  t.Set("line", json::Int(static_cast<std::int64_t>(truth.line)));
+  t.Set("t_s", OptNum(truth.t_s));
+  t.Set("drone", json::Str(truth.drone));
+  t.Set("fields", Fields(truth.fields));
+  t.Set("ended", truth.ended ? SideName(*truth.ended) : yaml::Node::Null());
+  return t;
+}
+
+yaml::Node EventsJson(const report::EventDivergence& events) {
+  yaml::Node e = yaml::Node::Mapping();
+  e.Set("stream", json::Str(events.stream));
+  e.Set("index", json::Int(static_cast<std::int64_t>(events.index)));
+  e.Set("t_s", OptNum(events.t_s));
+  e.Set("line_a", events.line_a ? json::Int(static_cast<std::int64_t>(events.line_a)) : yaml::Node::Null());
+  e.Set("line_b", events.line_b ? json::Int(static_cast<std::int64_t>(events.line_b)) : yaml::Node::Null());
+  e.Set("event_a", events.event_a.empty() ? yaml::Node::Null() : json::Str(events.event_a));
+  e.Set("event_b", events.event_b.empty() ? yaml::Node::Null() : json::Str(events.event_b));
+  e.Set("fields", Fields(events.fields));
+  return e;
 }
 
 yaml::Node DiffJson(const report::RunDiff& d, const DiffArgs& args, int exit_code) {
@@ -75,39 +113,9 @@ yaml::Node DiffJson(const report::RunDiff& d, const DiffArgs& args, int exit_cod
   o.Set("truth_rows_alike", json::Int(static_cast<std::int64_t>(d.truth_rows)));
   o.Set("events", json::Int(static_cast<std::int64_t>(d.event_count)));
   o.Set("streams", json::Int(static_cast<std::int64_t>(d.streams)));
-  yaml::Node missing = yaml::Node::Sequence();
-  for (const report::MissingFile& m : d.missing) {
-    yaml::Node x = yaml::Node::Mapping();
-    x.Set("file", json::Str(m.file));
-    x.Set("missing_in", SideName(m.missing_in));
-    missing.Append(std::move(x));
-  }
-  o.Set("missing", std::move(missing));
-  if (d.truth) {
-    yaml::Node t = yaml::Node::Mapping();
-    t.Set("line", json::Int(static_cast<std::int64_t>(d.truth->line)));
-    t.Set("t_s", OptNum(d.truth->t_s));
-    t.Set("drone", json::Str(d.truth->drone));
-    t.Set("fields", Fields(d.truth->fields));
-    t.Set("ended", d.truth->ended ? SideName(*d.truth->ended) : yaml::Node::Null());
-    o.Set("truth", std::move(t));
-  } else {
-    o.Set("truth", yaml::Node::Null());
-  }
-  if (d.events) {
-    yaml::Node e = yaml::Node::Mapping();
-    e.Set("stream", json::Str(d.events->stream));
-    e.Set("index", json::Int(static_cast<std::int64_t>(d.events->index)));
-    e.Set("t_s", OptNum(d.events->t_s));
-    e.Set("line_a", d.events->line_a ? json::Int(static_cast<std::int64_t>(d.events->line_a)) : yaml::Node::Null());
-    e.Set("line_b", d.events->line_b ? json::Int(static_cast<std::int64_t>(d.events->line_b)) : yaml::Node::Null());
-    e.Set("event_a", d.events->event_a.empty() ? yaml::Node::Null() : json::Str(d.events->event_a));
-    e.Set("event_b", d.events->event_b.empty() ? yaml::Node::Null() : json::Str(d.events->event_b));
-    e.Set("fields", Fields(d.events->fields));
-    o.Set("events_divergence", std::move(e));
-  } else {
-    o.Set("events_divergence", yaml::Node::Null());
-  }
+  o.Set("missing", MissingJson(d.missing));
+  o.Set("truth", d.truth ? TruthJson(*d.truth) : yaml::Node::Null());
+  o.Set("events_divergence", d.events ? EventsJson(*d.events) : yaml::Node::Null());
   o.Set("result", d.result ? Fields(d.result->fields) : yaml::Node::Null());
   o.Set("notes", json::Strs(d.notes));
   o.Set("exit_code", json::Int(exit_code));

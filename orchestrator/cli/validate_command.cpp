@@ -29,6 +29,42 @@ struct FileReport {
   std::vector<std::string> errors;
 };
 
+// "trial NAME, 101 drones (scout x100), 3 end conditions, timeout 600s": groups counted expanded.
+std::string TrialSummary(const dsl::TrialSpec& spec) {
+  std::string groups;
+  for (const dsl::DroneGroup& g : spec.groups) {
+    groups += (groups.empty() ? " (" : ", ") + g.name + " x" + std::to_string(g.count);
+  }
+  if (!groups.empty()) groups += ")";
+  return "trial " + spec.name + ", " + std::to_string(spec.drones.size()) + " drones" + groups + ", " +
+         std::to_string(spec.end.size()) + " end conditions, timeout " + spec.timeout.sim.ToString();
+}
+
+// The user's software, when there is some: ", brains scout_1 library, scout_2 program, components
+// probe (program)".
+std::string UserSoftwareSummary(const dsl::TrialSpec& spec) {
+  std::string brains;
+  for (const dsl::DroneSpec& d : spec.drones) {
+    if (d.brain.kind == dsl::BrainKind::kBuiltin) continue;
+    brains += (brains.empty() ? "" : ", ") + d.name + " " + std::string(dsl::BrainKindName(d.brain.kind));
+  }
+  std::string components;
+  for (const dsl::UserComponentSpec& c : spec.components) {
+    components += (components.empty() ? "" : ", ") + c.name + " (" + std::string(dsl::ComponentSourceName(c.source)) + ")";
+  }
+  std::string summary;
+  if (!brains.empty()) summary += ", brains " + brains;
+  if (!components.empty()) summary += ", components " + components;
+  return summary;
+}
+
+// ", world KIND seed N (V victims, O obstacles, D distractors)".
+std::string WorldSummary(const worlds::GenerateSpec& g, std::uint64_t trial_seed) {
+  return ", world " + std::string(worlds::KindName(g.kind)) + " seed " +
+         std::to_string(worlds::WorldSeed(g, trial_seed)) + " (" + std::to_string(g.victims) + " victims, " +
+         std::to_string(g.obstacles) + " obstacles, " + std::to_string(g.distractors) + " distractors)";
+}
+
 FileReport ValidateTrial(const std::string& file, const std::vector<std::string>& sets) {
   FileReport r{file, "trial", "", "", 1, {}};
   auto spec = LoadTrialOrPrintError(file, sets);
@@ -37,42 +73,44 @@ FileReport ValidateTrial(const std::string& file, const std::vector<std::string>
     return r;
   }
   r.name = spec->name;
-  // Groups are counted expanded: "101 drones (scout x100)".
-  std::string groups;
-  for (const dsl::DroneGroup& g : spec->groups) {
-    groups += (groups.empty() ? " (" : ", ") + g.name + " x" + std::to_string(g.count);
-  }
-  if (!groups.empty()) groups += ")";
-  r.summary = "trial " + spec->name + ", " + std::to_string(spec->drones.size()) + " drones" + groups + ", " +
-              std::to_string(spec->end.size()) + " end conditions, timeout " +
-              spec->timeout.sim.ToString();
-  // The user's software, when there is some: "brains scout_1 library, scout_2 program; components
-  // probe (program)".
-  std::string brains;
-  for (const dsl::DroneSpec& d : spec->drones) {
-    if (d.brain.kind == dsl::BrainKind::kBuiltin) continue;
-    brains += (brains.empty() ? "" : ", ") + d.name + " " + std::string(dsl::BrainKindName(d.brain.kind));
-  }
-  if (!brains.empty()) r.summary += ", brains " + brains;
-  std::string components;
-  for (const dsl::UserComponentSpec& c : spec->components) {
-    components += (components.empty() ? "" : ", ") + c.name + " (" + std::string(dsl::ComponentSourceName(c.source)) + ")";
-  }
-  if (!components.empty()) r.summary += ", components " + components;
+  r.summary = TrialSummary(*spec) + UserSoftwareSummary(*spec);
   // A generated world is generated here as the runner would (it can fail: an area too small).
   if (spec->world_generate) {
-    const worlds::GenerateSpec& g = *spec->world_generate;
     auto world = runner::DerivedWorldText(*spec, spec->trials_dir);
     if (!world) {
       r.errors.push_back(file + ": world: " + world.error().ToString());
       std::cerr << r.errors.back() << "\n";  // as LoadTrialOrPrintError does for the trial's errors
       return r;
     }
-    r.summary += ", world " + std::string(worlds::KindName(g.kind)) + " seed " +
-                 std::to_string(worlds::WorldSeed(g, spec->seed)) + " (" + std::to_string(g.victims) + " victims, " +
-                 std::to_string(g.obstacles) + " obstacles, " + std::to_string(g.distractors) + " distractors)";
+    r.summary += WorldSummary(*spec->world_generate, spec->seed);
   }
   return r;
+}
+
+// Every expanded trial loaded: one error per distinct error (the first trial that has it named,
+// located in the experiment), with how many trials have it.
+std::vector<Error> TrialLoadErrors(const experiment::ExperimentSpec& spec, const yaml::Node& document,
+                                   const std::vector<experiment::PlannedTrial>& trials) {
+  std::vector<std::pair<std::string, Error>> order;  // the error as LoadTrial gave it, located
+  std::map<std::string, int> count;
+  for (const experiment::PlannedTrial& t : trials) {
+    dsl::LoadOptions load;
+    load.overrides = t.overrides;
+    auto trial = dsl::LoadTrial(spec.base_trial, load);
+    if (trial) continue;
+    const std::string key = trial.error().ToString();
+    if (count[key]++ == 0) order.emplace_back(key, LocateInExperiment(trial.error(), document, t));
+  }
+  std::vector<Error> errors;
+  for (const auto& [key, located] : order) {
+    const int others = count[key] - 1;
+    errors.push_back(others == 0 ? located
+                                 : Error(located.code(),
+                                         located.message() + " (and " + std::to_string(others) +
+                                             (others == 1 ? " more trial)" : " more trials)"),
+                                         located.where()));
+  }
+  return errors;
 }
 
 FileReport ValidateExperiment(const std::string& file, const yaml::Node& document,
@@ -94,26 +132,8 @@ FileReport ValidateExperiment(const std::string& file, const yaml::Node& documen
     fail(trials.error());
     return r;
   }
-  // One line per distinct error (the first trial that has it named), with how many trials have it.
-  std::vector<std::pair<std::string, Error>> order;  // the error as LoadTrial gave it, located
-  std::map<std::string, int> count;
-  for (const experiment::PlannedTrial& t : *trials) {
-    dsl::LoadOptions load;
-    load.overrides = t.overrides;
-    auto trial = dsl::LoadTrial(spec->base_trial, load);
-    ++r.trials;
-    if (trial) continue;
-    const std::string key = trial.error().ToString();
-    if (count[key]++ == 0) order.emplace_back(key, LocateInExperiment(trial.error(), document, t));
-  }
-  for (const auto& [key, located] : order) {
-    const int others = count[key] - 1;
-    fail(others == 0 ? located
-                     : Error(located.code(),
-                             located.message() + " (and " + std::to_string(others) +
-                                 (others == 1 ? " more trial)" : " more trials)"),
-                             located.where()));
-  }
+  r.trials = trials->size();
+  for (const Error& e : TrialLoadErrors(*spec, document, *trials)) fail(e);
   if (r.errors.empty()) {
     r.summary = "experiment " + spec->name + ", " + std::to_string(trials->size()) + " trials of " +
                 spec->base_trial + ", " + std::to_string(spec->factors.size()) + " factors";

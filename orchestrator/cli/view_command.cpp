@@ -22,6 +22,9 @@
 namespace swarmbox::cli {
 namespace {
 
+// How often the serving loop looks for Ctrl-C.
+constexpr std::chrono::milliseconds kStopPoll{100};
+
 Result<std::pair<std::string, int>> ParseListenAddress(const std::string& text) {
   const auto colon = text.rfind(':');
   if (colon == std::string::npos || colon == 0 || colon + 1 == text.size()) {
@@ -39,68 +42,76 @@ Result<std::pair<std::string, int>> ParseListenAddress(const std::string& text) 
   return std::make_pair(text.substr(0, colon), port);
 }
 
-}  // namespace
+int Refuse(const std::string& message, int exit_code) {
+  std::cerr << "swarmbox view: " << message << "\n";
+  return exit_code;
+}
 
-int ViewCommand(const ViewArgs& args) {
-  auto addr = ParseListenAddress(args.addr);
-  if (!addr) {
-    std::cerr << "swarmbox view: --addr " << addr.error().ToString() << "\n";
-    return kExitUsage;
-  }
-  const std::string path = (std::filesystem::path(args.run_dir) / "recording.mcap").string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    std::cerr << "swarmbox view: " << path << ": no recording there (" << args.run_dir
-              << " is not a trial folder, or the trial ran with --no-record / record.enabled false)\n";
-    return kExitUsage;
-  }
-  auto reader = record::McapReader::Open(path);
-  if (!reader) {
-    std::cerr << "swarmbox view: " << reader.error().ToString() << "\n";
-    return kExitUsage;
-  }
-
+record::LiveOptions ReplayOptions(const std::pair<std::string, int>& addr, const std::string& run_dir) {
   record::LiveOptions options;
-  options.address = addr->first;
-  options.port = addr->second;
-  options.name = "swarmbox view " + std::filesystem::path(args.run_dir).filename().string();
+  options.address = addr.first;
+  options.port = addr.second;
+  options.name = "swarmbox view " + std::filesystem::path(run_dir).filename().string();
   options.mode = "replay";
   options.history_bytes = std::numeric_limits<std::size_t>::max();  // the whole recording
   options.history_images = true;
-  auto server = record::LiveServer::Start(options);
-  if (!server) {
-    std::cerr << "swarmbox view: " << server.error().ToString() << "\n";
-    return server.error().code() == ErrorCode::kInvalidArgument ? kExitUsage : kExitInfrastructure;
-  }
+  return options;
+}
+
+// Every channel and message of the recording into the server's history.
+Status LoadHistory(record::LiveServer& server, const record::McapReader& reader) {
   std::vector<record::ChannelId> ids;  // the reader's channel id -> the server's
-  for (const record::ChannelSpec& spec : reader->channels()) {
+  for (const record::ChannelSpec& spec : reader.channels()) {
     if (spec.topic.empty()) {  // an id the file does not use
       ids.push_back(0);
       continue;
     }
-    auto id = (*server)->AddChannel(spec);
-    if (!id) {
-      std::cerr << "swarmbox view: " << path << ": " << id.error().ToString() << "\n";
-      return kExitUsage;
-    }
+    auto id = server.AddChannel(spec);
+    if (!id) return id.error();
     ids.push_back(*id);
   }
   Status written = Ok{};
-  const Status read = reader->ForEach([&](const record::McapMessage& m) {
+  const Status read = reader.ForEach([&](const record::McapMessage& m) {
     if (!written || m.channel >= ids.size() || ids[m.channel] == 0) return;
-    written = (*server)->Write(ids[m.channel], m.log_time_ns, m.data);
+    written = server.Write(ids[m.channel], m.log_time_ns, m.data);
   });
-  if (!read || !written) {
-    std::cerr << "swarmbox view: " << path << ": " << (!read ? read.error() : written.error()).ToString() << "\n";
-    return kExitUsage;
-  }
+  return !read ? read : written;
+}
+
+// Says what is served and where, then serves until Ctrl-C or SIGTERM.
+void ServeUntilStopped(const record::LiveServer& server, const record::McapReader& reader, const std::string& path) {
   const auto& stop = InstallInterruptHandlers();
   std::fprintf(stderr, "swarmbox view: %s: %llu messages on %zu channels, t = %.1f .. %.1f s; Ctrl-C stops\n",
-               path.c_str(), static_cast<unsigned long long>(reader->message_count()), reader->channels().size(),
-               static_cast<double>(reader->start_ns()) / 1e9, static_cast<double>(reader->end_ns()) / 1e9);
-  std::cout << "view: " << (*server)->url() << std::endl;
-  while (!stop.load()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+               path.c_str(), static_cast<unsigned long long>(reader.message_count()), reader.channels().size(),
+               static_cast<double>(reader.start_ns()) / 1e9, static_cast<double>(reader.end_ns()) / 1e9);
+  std::cout << "view: " << server.url() << std::endl;
+  while (!stop.load()) std::this_thread::sleep_for(kStopPoll);
   std::cerr << "swarmbox view: " << InterruptName() << ", stopped\n";
+}
+
+}  // namespace
+
+int ViewCommand(const ViewArgs& args) {
+  auto addr = ParseListenAddress(args.addr);
+  if (!addr) return Refuse("--addr " + addr.error().ToString(), kExitUsage);
+  const std::string path = (std::filesystem::path(args.run_dir) / "recording.mcap").string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    return Refuse(path + ": no recording there (" + args.run_dir +
+                      " is not a trial folder, or the trial ran with --no-record / record.enabled false)",
+                  kExitUsage);
+  }
+  auto reader = record::McapReader::Open(path);
+  if (!reader) return Refuse(reader.error().ToString(), kExitUsage);
+  auto server = record::LiveServer::Start(ReplayOptions(*addr, args.run_dir));
+  if (!server) {
+    return Refuse(server.error().ToString(),
+                  server.error().code() == ErrorCode::kInvalidArgument ? kExitUsage : kExitInfrastructure);
+  }
+  if (Status loaded = LoadHistory(**server, *reader); !loaded) {
+    return Refuse(path + ": " + loaded.error().ToString(), kExitUsage);
+  }
+  ServeUntilStopped(**server, *reader, path);
   return kExitOk;
 }
 

@@ -127,6 +127,38 @@ std::string StripSlash(std::string name) {
   return name;
 }
 
+// Docker's answer as a JSON object; kProtocol naming `what` when it is not one.
+Result<Node> ParseJsonObject(std::string_view body, std::string_view what) {
+  auto doc = ParseJson(body, what);
+  if (!doc) return doc.error();
+  if (!doc->is_mapping()) return Malformed(what, "an object");
+  return doc;
+}
+
+// Docker's answer as a JSON array; kProtocol naming `what` when it is not one.
+Result<Node> ParseJsonArray(std::string_view body, std::string_view what) {
+  auto doc = ParseJson(body, what);
+  if (!doc) return doc.error();
+  if (!doc->is_sequence()) return Malformed(what, "an array");
+  return doc;
+}
+
+// An inspect answer: an object with a non-empty "Id".
+Result<Node> ParseJsonWithId(std::string_view body, std::string_view what) {
+  auto doc = ParseJson(body, what);
+  if (!doc) return doc.error();
+  if (!doc->is_mapping() || GetStr(*doc, "Id").empty()) return Malformed(what, "Id");
+  return doc;
+}
+
+// An object in which `key` is present and not null.
+Result<Node> ParseJsonWithKey(std::string_view body, std::string_view what, std::string_view key) {
+  auto doc = ParseJson(body, what);
+  if (!doc) return doc.error();
+  if (!doc->is_mapping() || Child(*doc, key) == nullptr) return Malformed(what, key);
+  return doc;
+}
+
 // "2026-11-21T13:05:29.123456789Z" -> unix seconds (UTC; fractional part dropped). 0 if unparsable.
 std::int64_t ParseRfc3339(const std::string& text) {
   std::tm tm{};
@@ -405,9 +437,8 @@ std::string ExecStartBody(bool tty) {
 }
 
 Result<EngineVersion> ParseVersion(std::string_view body) {
-  auto doc = ParseJson(body, "GET /version");
+  auto doc = ParseJsonObject(body, "GET /version");
   if (!doc) return doc.error();
-  if (!doc->is_mapping()) return Malformed("GET /version", "an object");
   EngineVersion v;
   v.version = GetStr(*doc, "Version");
   v.api_version = GetStr(*doc, "ApiVersion");
@@ -420,104 +451,114 @@ Result<EngineVersion> ParseVersion(std::string_view body) {
 }
 
 Result<ImageInfo> ParseImageInspect(std::string_view body) {
-  auto doc = ParseJson(body, "image inspect");
+  auto doc = ParseJsonWithId(body, "image inspect");
   if (!doc) return doc.error();
-  if (!doc->is_mapping() || GetStr(*doc, "Id").empty()) return Malformed("image inspect", "Id");
   return ImageFromNode(*doc, /*from_list=*/false);
 }
 
 Result<std::vector<ImageInfo>> ParseImageList(std::string_view body) {
-  auto doc = ParseJson(body, "image list");
+  auto doc = ParseJsonArray(body, "image list");
   if (!doc) return doc.error();
-  if (!doc->is_sequence()) return Malformed("image list", "an array");
   std::vector<ImageInfo> out;
   for (const Node& item : doc->items()) out.push_back(ImageFromNode(item, /*from_list=*/true));
   return out;
 }
 
 Result<NetworkInfo> ParseNetwork(std::string_view body) {
-  auto doc = ParseJson(body, "network inspect");
+  auto doc = ParseJsonWithId(body, "network inspect");
   if (!doc) return doc.error();
-  if (!doc->is_mapping() || GetStr(*doc, "Id").empty()) return Malformed("network inspect", "Id");
   return NetworkFromNode(*doc);
 }
 
 Result<std::vector<NetworkInfo>> ParseNetworkList(std::string_view body) {
-  auto doc = ParseJson(body, "network list");
+  auto doc = ParseJsonArray(body, "network list");
   if (!doc) return doc.error();
-  if (!doc->is_sequence()) return Malformed("network list", "an array");
   std::vector<NetworkInfo> out;
   for (const Node& item : doc->items()) out.push_back(NetworkFromNode(item));
   return out;
 }
 
-Result<ContainerInfo> ParseContainerInspect(std::string_view body) {
-  auto doc = ParseJson(body, "container inspect");
-  if (!doc) return doc.error();
-  if (!doc->is_mapping() || GetStr(*doc, "Id").empty()) {
-    return Malformed("container inspect", "Id");
+namespace {
+
+ContainerState ContainerStateFromNode(const Node& state) {
+  ContainerState out;
+  out.status = GetStr(state, "Status");
+  out.running = GetBool(state, "Running");
+  out.paused = GetBool(state, "Paused");
+  out.oom_killed = GetBool(state, "OOMKilled");
+  out.pid = static_cast<int>(GetInt(state, "Pid"));
+  out.exit_code = GetInt(state, "ExitCode");
+  out.error = GetStr(state, "Error");
+  out.started_at = GetStr(state, "StartedAt");
+  out.finished_at = GetStr(state, "FinishedAt");
+  return out;
+}
+
+// One entry of HostConfig.Mounts; an unknown type reads as a bind mount.
+Mount MountFromNode(const Node& m) {
+  Mount mount;
+  const std::string type = GetStr(m, "Type");
+  mount.type = type == "volume"  ? Mount::Type::kVolume
+               : type == "tmpfs" ? Mount::Type::kTmpfs
+                                 : Mount::Type::kBind;
+  mount.source = GetStr(m, "Source");
+  mount.target = GetStr(m, "Target");
+  mount.read_only = GetBool(m, "ReadOnly");
+  if (const Node* tmpfs = Child(m, "TmpfsOptions")) {
+    mount.tmpfs_size_bytes = GetInt(*tmpfs, "SizeBytes");
+    mount.tmpfs_mode = static_cast<int>(GetInt(*tmpfs, "Mode"));
   }
+  return mount;
+}
+
+ContainerHostConfig HostConfigFromNode(const Node& host) {
+  ContainerHostConfig hc;
+  hc.cap_add = GetStrList(host, "CapAdd");
+  hc.cap_drop = GetStrList(host, "CapDrop");
+  hc.security_opt = GetStrList(host, "SecurityOpt");
+  hc.read_only_rootfs = GetBool(host, "ReadonlyRootfs");
+  hc.memory_bytes = GetInt(host, "Memory");
+  hc.pids_limit = std::max<std::int64_t>(0, GetInt(host, "PidsLimit"));
+  hc.network_mode = GetStr(host, "NetworkMode");
+  if (const Node* mounts = Child(host, "Mounts"); mounts != nullptr && mounts->is_sequence()) {
+    for (const Node& m : mounts->items()) hc.mounts.push_back(MountFromNode(m));
+  }
+  return hc;
+}
+
+// NetworkSettings.Networks: network name -> the container's address on it.
+std::map<std::string, std::string> NetworkIpsFromNode(const Node& settings) {
+  std::map<std::string, std::string> ips;
+  if (const Node* networks = Child(settings, "Networks"); networks != nullptr && networks->is_mapping()) {
+    for (const auto& [name, endpoint] : networks->entries()) {
+      ips[name.scalar()] = GetStr(endpoint, "IPAddress");
+    }
+  }
+  return ips;
+}
+
+}  // namespace
+
+Result<ContainerInfo> ParseContainerInspect(std::string_view body) {
+  auto doc = ParseJsonWithId(body, "container inspect");
+  if (!doc) return doc.error();
   ContainerInfo info;
   info.id = GetStr(*doc, "Id");
   info.name = StripSlash(GetStr(*doc, "Name"));
   info.image = GetStr(*doc, "Image");
-  if (const Node* state = Child(*doc, "State")) {
-    info.state.status = GetStr(*state, "Status");
-    info.state.running = GetBool(*state, "Running");
-    info.state.paused = GetBool(*state, "Paused");
-    info.state.oom_killed = GetBool(*state, "OOMKilled");
-    info.state.pid = static_cast<int>(GetInt(*state, "Pid"));
-    info.state.exit_code = GetInt(*state, "ExitCode");
-    info.state.error = GetStr(*state, "Error");
-    info.state.started_at = GetStr(*state, "StartedAt");
-    info.state.finished_at = GetStr(*state, "FinishedAt");
-  }
+  if (const Node* state = Child(*doc, "State")) info.state = ContainerStateFromNode(*state);
   if (const Node* config = Child(*doc, "Config")) {
     info.labels = GetStrMap(*config, "Labels");
     info.tty = GetBool(*config, "Tty");
   }
-  if (const Node* host = Child(*doc, "HostConfig")) {
-    ContainerHostConfig& hc = info.host_config;
-    hc.cap_add = GetStrList(*host, "CapAdd");
-    hc.cap_drop = GetStrList(*host, "CapDrop");
-    hc.security_opt = GetStrList(*host, "SecurityOpt");
-    hc.read_only_rootfs = GetBool(*host, "ReadonlyRootfs");
-    hc.memory_bytes = GetInt(*host, "Memory");
-    hc.pids_limit = std::max<std::int64_t>(0, GetInt(*host, "PidsLimit"));
-    hc.network_mode = GetStr(*host, "NetworkMode");
-    if (const Node* mounts = Child(*host, "Mounts"); mounts != nullptr && mounts->is_sequence()) {
-      for (const Node& m : mounts->items()) {
-        Mount mount;
-        const std::string type = GetStr(m, "Type");
-        mount.type = type == "volume"  ? Mount::Type::kVolume
-                     : type == "tmpfs" ? Mount::Type::kTmpfs
-                                       : Mount::Type::kBind;
-        mount.source = GetStr(m, "Source");
-        mount.target = GetStr(m, "Target");
-        mount.read_only = GetBool(m, "ReadOnly");
-        if (const Node* tmpfs = Child(m, "TmpfsOptions")) {
-          mount.tmpfs_size_bytes = GetInt(*tmpfs, "SizeBytes");
-          mount.tmpfs_mode = static_cast<int>(GetInt(*tmpfs, "Mode"));
-        }
-        hc.mounts.push_back(std::move(mount));
-      }
-    }
-  }
-  if (const Node* settings = Child(*doc, "NetworkSettings")) {
-    if (const Node* networks = Child(*settings, "Networks"); networks != nullptr &&
-                                                             networks->is_mapping()) {
-      for (const auto& [name, endpoint] : networks->entries()) {
-        info.network_ips[name.scalar()] = GetStr(endpoint, "IPAddress");
-      }
-    }
-  }
+  if (const Node* host = Child(*doc, "HostConfig")) info.host_config = HostConfigFromNode(*host);
+  if (const Node* settings = Child(*doc, "NetworkSettings")) info.network_ips = NetworkIpsFromNode(*settings);
   return info;
 }
 
 Result<std::vector<ContainerSummary>> ParseContainerList(std::string_view body) {
-  auto doc = ParseJson(body, "container list");
+  auto doc = ParseJsonArray(body, "container list");
   if (!doc) return doc.error();
-  if (!doc->is_sequence()) return Malformed("container list", "an array");
   std::vector<ContainerSummary> out;
   for (const Node& item : doc->items()) {
     ContainerSummary s;
@@ -541,11 +582,8 @@ Result<std::string> ParseIdResponse(std::string_view body) {
 }
 
 Result<std::int64_t> ParseWaitResponse(std::string_view body) {
-  auto doc = ParseJson(body, "wait response");
+  auto doc = ParseJsonWithKey(body, "wait response", "StatusCode");
   if (!doc) return doc.error();
-  if (!doc->is_mapping() || Child(*doc, "StatusCode") == nullptr) {
-    return Malformed("wait response", "StatusCode");
-  }
   if (const Node* error = Child(*doc, "Error")) {
     std::string message = GetStr(*error, "Message");
     if (!message.empty()) return Error(ErrorCode::kInternal, "wait failed: " + message);
@@ -554,11 +592,8 @@ Result<std::int64_t> ParseWaitResponse(std::string_view body) {
 }
 
 Result<ExecState> ParseExecInspect(std::string_view body) {
-  auto doc = ParseJson(body, "exec inspect");
+  auto doc = ParseJsonWithKey(body, "exec inspect", "Running");
   if (!doc) return doc.error();
-  if (!doc->is_mapping() || Child(*doc, "Running") == nullptr) {
-    return Malformed("exec inspect", "Running");
-  }
   ExecState state;
   state.running = GetBool(*doc, "Running");
   state.pid = static_cast<int>(GetInt(*doc, "Pid"));
@@ -570,9 +605,8 @@ Result<ExecState> ParseExecInspect(std::string_view body) {
 }
 
 Result<Event> ParseEvent(std::string_view line) {
-  auto doc = ParseJson(line, "event");
+  auto doc = ParseJsonObject(line, "event");
   if (!doc) return doc.error();
-  if (!doc->is_mapping()) return Malformed("event", "an object");
   Event e;
   e.type = GetStr(*doc, "Type");
   e.action = GetStr(*doc, "Action");
@@ -588,9 +622,8 @@ Result<Event> ParseEvent(std::string_view line) {
 }
 
 Result<BuildMessage> ParseBuildLine(std::string_view line) {
-  auto doc = ParseJson(line, "build output");
+  auto doc = ParseJsonObject(line, "build output");
   if (!doc) return doc.error();
-  if (!doc->is_mapping()) return Malformed("build output", "an object");
   BuildMessage m;
   m.stream = GetStr(*doc, "stream");
   m.status = GetStr(*doc, "status");

@@ -149,41 +149,74 @@ Result<EngineVersion> DockerClient::Version() {
 
 // --- images ---------------------------------------------------------------------------------------
 
-Result<BuildResult> DockerClient::BuildImage(const BuildRequest& request,
-                                             const BuildProgressFn& progress,
+namespace {
+
+// What a POST /build response stream said.
+struct BuildOutcome {
+  std::string image_id;          // aux.ID, "" when the engine did not say
+  std::string build_error;       // the first error
+  std::string parse_error;       // the first line that is not a build message
+  std::string last_stream_line;  // for the message when there is no image id
+};
+
+// The state of one POST /build response stream: JSON lines in, progress lines and the outcome out.
+class BuildStream {
+ public:
+  explicit BuildStream(const BuildProgressFn& progress) : progress_(progress) {}
+
+  void Feed(std::string_view chunk) {
+    chunk_lines_.Feed(chunk, [this](std::string_view line) { OnLine(line); });
+  }
+
+  // Flushes a last line without "\n" from both the response and the build output.
+  void Finish() {
+    const std::string rest = chunk_lines_.TakeRest();
+    if (!rest.empty()) OnLine(rest);
+    Emit(output_lines_.TakeRest());
+  }
+
+  const BuildOutcome& outcome() const { return outcome_; }
+
+ private:
+  void Emit(std::string_view text) {
+    if (text.empty()) return;
+    outcome_.last_stream_line = std::string(text);
+    if (progress_) progress_(text);
+  }
+
+  void OnLine(std::string_view line) {
+    if (line.empty()) return;
+    auto message = ParseBuildLine(line);
+    if (!message) {
+      if (outcome_.parse_error.empty()) outcome_.parse_error = message.error().message();
+      return;
+    }
+    if (!message->error.empty() && outcome_.build_error.empty()) outcome_.build_error = message->error;
+    if (!message->aux_id.empty()) outcome_.image_id = message->aux_id;
+    // Output text arrives in pieces ("Step 1/4 : FROM scratch", then "\n"): reassemble lines.
+    if (!message->stream.empty()) {
+      output_lines_.Feed(message->stream, [this](std::string_view text) { Emit(text); });
+    } else if (!message->status.empty()) {
+      Emit(message->status);
+    }
+  }
+
+  const BuildProgressFn& progress_;
+  BuildOutcome outcome_;
+  LineSplitter chunk_lines_;
+  LineSplitter output_lines_;
+};
+
+}  // namespace
+
+Result<BuildResult> DockerClient::BuildImage(const BuildRequest& request, const BuildProgressFn& progress,
                                              CancelToken* cancel) {
   const std::string where = "POST /v" + version_.ToString() + "/build (" + transport_->endpoint() + ")";
   if (request.tags.empty()) {
     return Error(ErrorCode::kInvalidArgument, "a build needs at least one tag", where);
   }
-  LineSplitter splitter;
-  BuildResult result;
-  std::string build_error;
-  std::string parse_error;
-  std::string last_stream_line;
-  LineSplitter output;
-  auto emit = [&](std::string_view text) {
-    if (text.empty()) return;
-    last_stream_line = std::string(text);
-    if (progress) progress(text);
-  };
-  auto on_line = [&](std::string_view line) {
-    if (line.empty()) return;
-    auto message = ParseBuildLine(line);
-    if (!message) {
-      if (parse_error.empty()) parse_error = message.error().message();
-      return;
-    }
-    if (!message->error.empty() && build_error.empty()) build_error = message->error;
-    if (!message->aux_id.empty()) result.image_id = message->aux_id;
-    // Output text arrives in pieces ("Step 1/4 : FROM scratch", then "\n"): reassemble lines.
-    if (!message->stream.empty()) {
-      output.Feed(message->stream, emit);
-    } else if (!message->status.empty()) {
-      emit(message->status);
-    }
-  };
-  BodyChunkFn on_chunk = [&](std::string_view chunk) { splitter.Feed(chunk, on_line); };
+  BuildStream stream(progress);
+  BodyChunkFn on_chunk = [&stream](std::string_view chunk) { stream.Feed(chunk); };
   Call call("POST", "/build");
   call.query = BuildQuery(request);
   call.content_type = "application/x-tar";
@@ -193,25 +226,22 @@ Result<BuildResult> DockerClient::BuildImage(const BuildRequest& request,
   call.cancel = cancel;
   auto r = Do(call);
   if (!r) return r.error();
-  const std::string rest = splitter.TakeRest();
-  if (!rest.empty()) on_line(rest);
-  emit(output.TakeRest());
-  if (!build_error.empty()) {
-    return Error(ErrorCode::kInvalidArgument, "image build failed: " + build_error, where);
+  stream.Finish();
+  const BuildOutcome& outcome = stream.outcome();
+  if (!outcome.build_error.empty()) {
+    return Error(ErrorCode::kInvalidArgument, "image build failed: " + outcome.build_error, where);
   }
-  if (!parse_error.empty()) return Error(ErrorCode::kProtocol, parse_error, where);
-  if (result.image_id.empty()) {
-    // Older engines only say "Successfully built <id>"; ask for the tag instead.
-    auto info = InspectImage(request.tags.front());
-    if (!info) {
-      return Error(ErrorCode::kProtocol,
-                   "the build ended without an image id (last output: '" + last_stream_line +
-                       "'): " + info.error().message(),
-                   where);
-    }
-    result.image_id = info->id;
+  if (!outcome.parse_error.empty()) return Error(ErrorCode::kProtocol, outcome.parse_error, where);
+  if (!outcome.image_id.empty()) return BuildResult{outcome.image_id};
+  // Older engines only say "Successfully built <id>"; ask for the tag instead.
+  auto info = InspectImage(request.tags.front());
+  if (!info) {
+    return Error(ErrorCode::kProtocol,
+                 "the build ended without an image id (last output: '" + outcome.last_stream_line +
+                     "'): " + info.error().message(),
+                 where);
   }
-  return result;
+  return BuildResult{info->id};
 }
 
 Result<ImageInfo> DockerClient::InspectImage(std::string_view reference) {

@@ -63,6 +63,54 @@ EngineEndpoint UnixEngine(std::string socket_path) {
   return e;
 }
 
+namespace {
+
+// Docker's ports for the engine API: plain HTTP and TLS.
+constexpr int kDefaultTcpPort = 2375;
+constexpr int kDefaultTlsPort = 2376;
+
+// TLS settings from DOCKER_TLS_VERIFY / DOCKER_TLS / DOCKER_CERT_PATH (or ~/.docker), as the
+// docker CLI reads them.
+Status SetTlsFiles(const DockerEnvironment& env, EngineEndpoint& e) {
+  e.tls_verify = !env.tls_verify.empty();
+  e.tls = e.tls_verify || !env.tls.empty();
+  if (!e.tls) return Ok{};
+  const std::string dir = !env.cert_path.empty() ? env.cert_path
+                          : !env.home.empty()    ? env.home + "/.docker"
+                                                 : std::string();
+  if (dir.empty()) {
+    return Bad(env.docker_host,
+               "TLS is on but neither DOCKER_CERT_PATH nor HOME says where the certificates are");
+  }
+  if (e.tls_verify) e.ca_file = dir + "/ca.pem";
+  e.cert_file = dir + "/cert.pem";
+  e.key_file = dir + "/key.pem";
+  return Ok{};
+}
+
+// The part of DOCKER_HOST after "tcp://": HOST[:PORT][/].
+Result<EngineEndpoint> ParseTcpEngine(std::string_view rest, const DockerEnvironment& env) {
+  const std::string& value = env.docker_host;
+  std::string_view authority = rest;
+  const std::size_t slash = authority.find('/');
+  if (slash != std::string_view::npos) {
+    if (authority.substr(slash) != "/") {
+      return Bad(value, "a path after the address is not supported (expected tcp://HOST:PORT)");
+    }
+    authority = authority.substr(0, slash);
+  }
+  auto hp = SplitHostPort(authority, value);
+  if (!hp) return hp.error();
+  EngineEndpoint e;
+  e.kind = EngineEndpoint::Kind::kTcp;
+  e.host = hp->first;
+  if (Status tls = SetTlsFiles(env, e); !tls) return tls.error();
+  e.port = hp->second != 0 ? hp->second : (e.tls ? kDefaultTlsPort : kDefaultTcpPort);
+  return e;
+}
+
+}  // namespace
+
 Result<EngineEndpoint> ParseEngineEndpoint(const DockerEnvironment& env) {
   const std::string& value = env.docker_host;
   if (value.empty()) return UnixEngine(kDefaultDockerSocket);
@@ -77,36 +125,7 @@ Result<EngineEndpoint> ParseEngineEndpoint(const DockerEnvironment& env) {
     if (rest.front() != '/') return Bad(value, "the socket path must be absolute (unix:///path)");
     return UnixEngine(std::string(rest));
   }
-  if (scheme == "tcp") {
-    std::string_view authority = rest;
-    const std::size_t slash = authority.find('/');
-    if (slash != std::string_view::npos) {
-      if (authority.substr(slash) != "/") {
-        return Bad(value, "a path after the address is not supported (expected tcp://HOST:PORT)");
-      }
-      authority = authority.substr(0, slash);
-    }
-    auto hp = SplitHostPort(authority, value);
-    if (!hp) return hp.error();
-    EngineEndpoint e;
-    e.kind = EngineEndpoint::Kind::kTcp;
-    e.host = hp->first;
-    e.tls_verify = !env.tls_verify.empty();
-    e.tls = e.tls_verify || !env.tls.empty();
-    e.port = hp->second != 0 ? hp->second : (e.tls ? 2376 : 2375);
-    if (e.tls) {
-      const std::string dir = !env.cert_path.empty() ? env.cert_path
-                              : !env.home.empty()    ? env.home + "/.docker"
-                                                     : std::string();
-      if (dir.empty()) {
-        return Bad(value, "TLS is on but neither DOCKER_CERT_PATH nor HOME says where the certificates are");
-      }
-      if (e.tls_verify) e.ca_file = dir + "/ca.pem";
-      e.cert_file = dir + "/cert.pem";
-      e.key_file = dir + "/key.pem";
-    }
-    return e;
-  }
+  if (scheme == "tcp") return ParseTcpEngine(rest, env);
   if (scheme == "ssh") {
     return Bad(value,
                "ssh:// engines are not opened by `swarmbox run/images/gc`; use `swarmbox experiment "

@@ -224,6 +224,18 @@ Error TransferError(CURLcode result, const char* error_buffer, const EngineEndpo
   return Error(MapCurlCode(result), detail, where);
 }
 
+// Takes the status from libcurl when no status line was seen, then frees both handles.
+void EndExchange(CURLM* multi, Exchange& ex) {
+  if (!ex.status_known) {
+    long code = 0;
+    curl_easy_getinfo(ex.easy, CURLINFO_RESPONSE_CODE, &code);
+    ex.response.status = static_cast<int>(code);
+  }
+  curl_multi_remove_handle(multi, ex.easy);
+  curl_easy_cleanup(ex.easy);
+  curl_multi_cleanup(multi);
+}
+
 }  // namespace
 
 std::string HttpResponse::Header(std::string_view name) const {
@@ -264,14 +276,7 @@ Result<HttpResponse> CurlTransport::Send(const HttpRequest& request,
   SetMethodOptions(e, request, &ex);
   curl_multi_add_handle(multi, e);
   const TransferEnd end = Perform(multi, cancel, error_buffer);
-  if (!ex.status_known) {
-    long code = 0;
-    curl_easy_getinfo(e, CURLINFO_RESPONSE_CODE, &code);
-    ex.response.status = static_cast<int>(code);
-  }
-  curl_multi_remove_handle(multi, e);
-  curl_easy_cleanup(e);
-  curl_multi_cleanup(multi);
+  EndExchange(multi, ex);
   curl_slist_free_all(headers);
   if (end.cancelled) return Error(ErrorCode::kCancelled, "cancelled", where);
   if (end.result != CURLE_OK) return TransferError(end.result, error_buffer, engine_, where);

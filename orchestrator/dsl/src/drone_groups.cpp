@@ -64,6 +64,69 @@ Result<Group> ReadGroup(const Node& item) {
   return g;
 }
 
+// Whether the list has a group (an item with `count:`); `spacing_m` without `count` is an error.
+Result<bool> HasGroups(const Node& drones) {
+  bool any = false;
+  for (const Node& item : drones.items()) {
+    if (item.is_mapping() && item.Find("spacing_m") != nullptr && item.Find("count") == nullptr) {
+      return At(*item.Find("spacing_m"), "'spacing_m' spaces the drones of a group: give 'count' too");
+    }
+    any = any || IsGroup(item);
+  }
+  return any;
+}
+
+// Name -> the name node (the group's for a member), to report a clash at the group.
+using TakenNames = std::map<std::string, const Node*>;
+
+// The names of the list's single drones.
+TakenNames SingleDroneNames(const Node& drones) {
+  TakenNames taken;
+  for (const Node& item : drones.items()) {
+    if (IsGroup(item)) continue;
+    const Node* name = item.is_mapping() ? item.Find("name") : nullptr;
+    if (name != nullptr && name->is_scalar()) taken.emplace(name->scalar(), name);
+  }
+  return taken;
+}
+
+// Member `i` (1-based) of the group `item`: its keys but count and spacing_m, named `member`,
+// at its grid pose (marked where the group's pose, else the group, is).
+Node GroupMember(const Node& item, const Group& group, int i, const std::string& member) {
+  Node drone = Node::Mapping(item.mark());
+  for (const auto& [key, value] : item.entries()) {
+    const std::string& k = key.scalar();
+    if (k == "count" || k == "spacing_m" || k == "pose") continue;  // the pose: written below
+    drone.entries().emplace_back(key, k == "name" ? Node::Scalar(member, value.mark()) : value);
+  }
+  const Node* pose_node = item.Find("pose");
+  const yaml::Mark pose_mark = pose_node != nullptr ? pose_node->mark() : item.mark();
+  Node pose = Node::Sequence(pose_mark);
+  for (double v : GroupGridPose(group.origin, group.spacing_m, group.count, i - 1)) {
+    pose.Append(Node::Scalar(Number(v), pose_mark));
+  }
+  drone.Set("pose", std::move(pose));
+  return drone;
+}
+
+// The group `item`'s members onto `expanded`, each name into `taken` (a clash is an error).
+Status ExpandGroup(const Node& item, TakenNames& taken, Node* expanded) {
+  auto group = ReadGroup(item);
+  if (!group) return group.error();
+  const Node& name_node = *item.Find("name");
+  for (int i = 1; i <= group->count; ++i) {
+    const std::string member = MemberName(group->name, i);
+    auto [it, inserted] = taken.emplace(member, &name_node);
+    if (!inserted) {
+      return At(name_node, "group '" + group->name + "' (count " + std::to_string(group->count) +
+                               ") expands to '" + member + "', which is also the name of the drone at " +
+                               it->second->Where() + ": rename the group or that drone");
+    }
+    expanded->Append(GroupMember(item, *group, i, member));
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 std::array<double, 3> GroupGridPose(const std::array<double, 3>& origin, double spacing_m, int count, int index) {
@@ -75,59 +138,16 @@ std::array<double, 3> GroupGridPose(const std::array<double, 3>& origin, double 
 Status ExpandDroneGroups(Node& document) {
   Node* drones = document.is_mapping() ? document.Find("drones") : nullptr;
   if (drones == nullptr || !drones->is_sequence()) return Ok{};
-  bool any = false;
-  for (const Node& item : drones->items()) {
-    if (item.is_mapping() && item.Find("spacing_m") != nullptr && item.Find("count") == nullptr) {
-      return At(*item.Find("spacing_m"), "'spacing_m' spaces the drones of a group: give 'count' too");
-    }
-    any = any || IsGroup(item);
-  }
-  if (!any) return Ok{};
-
-  // Every name the list will have, with where it comes from, to report a clash at the group.
-  std::map<std::string, const Node*> taken;  // name -> the item's name node (or the item)
-  for (const Node& item : drones->items()) {
-    if (IsGroup(item)) continue;
-    const Node* name = item.is_mapping() ? item.Find("name") : nullptr;
-    if (name != nullptr && name->is_scalar()) taken.emplace(name->scalar(), name);
-  }
+  auto any = HasGroups(*drones);
+  if (!any) return any.error();
+  if (!*any) return Ok{};
+  TakenNames taken = SingleDroneNames(*drones);
   Node expanded = Node::Sequence(drones->mark());
   for (const Node& item : drones->items()) {
-    if (!IsGroup(item)) {
+    if (IsGroup(item)) {
+      SWARMBOX_TRY(ExpandGroup(item, taken, &expanded));
+    } else {
       expanded.Append(item);
-      continue;
-    }
-    auto group = ReadGroup(item);
-    if (!group) return group.error();
-    const Node& name_node = *item.Find("name");
-    for (int i = 1; i <= group->count; ++i) {
-      const std::string member = MemberName(group->name, i);
-      auto [it, inserted] = taken.emplace(member, &name_node);
-      if (!inserted) {
-        return At(name_node, "group '" + group->name + "' (count " + std::to_string(group->count) +
-                                 ") expands to '" + member + "', which is also the name of the drone at " +
-                                 it->second->Where() + ": rename the group or that drone");
-      }
-      Node drone = Node::Mapping(item.mark());
-      for (const auto& [key, value] : item.entries()) {
-        const std::string& k = key.scalar();
-        if (k == "count" || k == "spacing_m") continue;
-        if (k == "name") {
-          drone.entries().emplace_back(key, Node::Scalar(member, value.mark()));
-        } else if (k == "pose") {
-          continue;  // written below, for every member
-        } else {
-          drone.entries().emplace_back(key, value);
-        }
-      }
-      const Node* pose_node = item.Find("pose");
-      const yaml::Mark pose_mark = pose_node != nullptr ? pose_node->mark() : item.mark();
-      Node pose = Node::Sequence(pose_mark);
-      for (double v : GroupGridPose(group->origin, group->spacing_m, group->count, i - 1)) {
-        pose.Append(Node::Scalar(Number(v), pose_mark));
-      }
-      drone.Set("pose", std::move(pose));
-      expanded.Append(std::move(drone));
     }
   }
   *drones = std::move(expanded);

@@ -107,17 +107,8 @@ class TrialExecutor final : public HostWorker {
     s_.AttemptOn(t.id, host_.name);
     auto staging = s_.store->Staging(t.id, attempt);
     if (!staging) return Lost("cannot make the staging folder: " + staging.error().ToString());
-    const ExperimentOptions& eo = *s_.options;
-    runner::RunOptions o = eo.trial_options;
-    o.out_dir = *staging;
-    o.run_id = eo.run_id;
-    o.trial_id = t.id;
-    o.host = host_.name;
-    o.images = host_.images;
-    if (!host_.faults_image.empty()) o.faults_image = host_.faults_image;
-    o.interrupted = eo.interrupted;
     std::ofstream log(fs::path(*staging) / "orchestrator.log");
-    o.progress = &log;
+    const runner::RunOptions o = OptionsFor(t, *staging, &log);
     // With a remover, the trial's containers and networks are removed while this slot goes on
     // (background_removal.hpp): the attempt ends once result.json, the logs and truth.csv are in.
     std::optional<DeferredRemovalApi> deferred;
@@ -125,42 +116,65 @@ class TrialExecutor final : public HostWorker {
     docker::DockerApi& api = deferred ? static_cast<docker::DockerApi&>(*deferred) : *host_.api;
     auto run = runner::RunTrialSpec(s_.plan->specs.at(t.id), api, s_.clock, o);
     log.close();
+    const ExperimentOptions& eo = *s_.options;
     const bool interrupted = eo.interrupted != nullptr && eo.interrupted->load();
     if (interrupted) {
       return {AttemptResult::Kind::kCancelled, "", "interrupted (Ctrl-C)"};
     }
-    if (!run) {
-      if (Status h = host_.check(); !h) return Lost(h.error().message(), *staging, t.id, attempt);
-      // The host answers but the trial could not start (not the host's fault): an outcome.
-      const std::string reason = "could not start: " + run.error().ToString();
-      if (Status c = CommitError(s_, t, attempt, host_.name, reason); !c) {
-        return Lost("cannot record the trial: " + c.error().ToString());
-      }
-      return {AttemptResult::Kind::kCompleted, "error", reason};
-    }
-    const runner::TrialResult& r = run->result;
-    if (r.verdict.outcome == dsl::Outcome::kError) {
-      if (Status h = host_.check(); !h) {
-        return Lost(h.error().message() + " (trial: " + r.verdict.reason + ")", run->trial_dir,
-                    t.id, attempt);
-      }
-    }
-    std::error_code ec;
-    fs::rename(fs::path(*staging) / "orchestrator.log",
-               fs::path(run->trial_dir) / "orchestrator.log", ec);
-    Status meta = WriteFileAtomic(
-        (fs::path(run->trial_dir) / "trial_meta.json").string(),
-        report::TrialMetaJson(MetaOf(s_.plan->spec, t, attempt, s_.HostsOf(t.id))));
-    if (!meta) return Lost("cannot write trial_meta.json: " + meta.error().ToString());
-    if (Status c = s_.store->Commit(t.id, run->trial_dir); !c) {
-      return Lost("cannot commit the trial: " + c.error().ToString());
-    }
-    fs::remove_all(*staging, ec);
-    return {AttemptResult::Kind::kCompleted, std::string(dsl::OutcomeName(r.verdict.outcome)),
-            r.verdict.reason};
+    if (!run) return CouldNotStart(t, attempt, *staging, run.error());
+    return CommitRun(t, attempt, *staging, *run);
   }
 
  private:
+  // The experiment's trial options for this attempt on this host, its progress into `log`.
+  runner::RunOptions OptionsFor(const PlannedTrial& t, const std::string& staging, std::ostream* log) const {
+    const ExperimentOptions& eo = *s_.options;
+    runner::RunOptions o = eo.trial_options;
+    o.out_dir = staging;
+    o.run_id = eo.run_id;
+    o.trial_id = t.id;
+    o.host = host_.name;
+    o.images = host_.images;
+    if (!host_.faults_image.empty()) o.faults_image = host_.faults_image;
+    o.interrupted = eo.interrupted;
+    o.progress = log;
+    return o;
+  }
+
+  // The trial did not start: the host's fault when it no longer answers, else the trial's outcome
+  // error (committed).
+  AttemptResult CouldNotStart(const PlannedTrial& t, int attempt, const std::string& staging, const Error& error) {
+    if (Status h = host_.check(); !h) return Lost(h.error().message(), staging, t.id, attempt);
+    // The host answers but the trial could not start (not the host's fault): an outcome.
+    const std::string reason = "could not start: " + error.ToString();
+    if (Status c = CommitError(s_, t, attempt, host_.name, reason); !c) {
+      return Lost("cannot record the trial: " + c.error().ToString());
+    }
+    return {AttemptResult::Kind::kCompleted, "error", reason};
+  }
+
+  // The trial ran: an outcome error from a host that no longer answers is the host's; else its
+  // folder gets the orchestrator log and trial_meta.json and is committed.
+  AttemptResult CommitRun(const PlannedTrial& t, int attempt, const std::string& staging,
+                          const runner::RunOutcome& run) {
+    const runner::TrialResult& r = run.result;
+    if (r.verdict.outcome == dsl::Outcome::kError) {
+      if (Status h = host_.check(); !h) {
+        return Lost(h.error().message() + " (trial: " + r.verdict.reason + ")", run.trial_dir, t.id, attempt);
+      }
+    }
+    std::error_code ec;
+    fs::rename(fs::path(staging) / "orchestrator.log", fs::path(run.trial_dir) / "orchestrator.log", ec);
+    Status meta = WriteFileAtomic((fs::path(run.trial_dir) / "trial_meta.json").string(),
+                                  report::TrialMetaJson(MetaOf(s_.plan->spec, t, attempt, s_.HostsOf(t.id))));
+    if (!meta) return Lost("cannot write trial_meta.json: " + meta.error().ToString());
+    if (Status c = s_.store->Commit(t.id, run.trial_dir); !c) {
+      return Lost("cannot commit the trial: " + c.error().ToString());
+    }
+    fs::remove_all(staging, ec);
+    return {AttemptResult::Kind::kCompleted, std::string(dsl::OutcomeName(r.verdict.outcome)), r.verdict.reason};
+  }
+
   AttemptResult Lost(std::string reason, const std::string& dir = {}, const std::string& id = {},
                      int attempt = 0) {
     if (!dir.empty()) (void)s_.store->Discard(id, attempt, dir);

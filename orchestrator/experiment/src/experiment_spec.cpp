@@ -330,8 +330,10 @@ std::string TrialId(std::string_view name, std::string_view code, int rep) {
   return std::string(name) + "-" + std::string(code) + "-r" + std::to_string(rep);
 }
 
-Result<std::vector<PlannedTrial>> ExpandTrials(const ExperimentSpec& spec) {
-  std::vector<std::string> codes = spec.codes.empty() ? FactorialCodes(spec.factors) : spec.codes;
+namespace {
+
+// The codes (each valid, none twice) and filter patterns (one letter or '?' per factor) checked.
+Status CheckCodesAndFilter(const ExperimentSpec& spec, const std::vector<std::string>& codes) {
   std::set<std::string> seen;
   for (const std::string& code : codes) {
     SWARMBOX_TRY(CheckCode(spec.factors, code));
@@ -347,28 +349,40 @@ Result<std::vector<PlannedTrial>> ExpandTrials(const ExperimentSpec& spec) {
                    spec.file);
     }
   }
+  return Ok{};
+}
+
+// Repetition `rep` of the checked `code`: its id, seed, levels and overrides (the experiment's
+// `set:`, each level's, then the seed and the name).
+PlannedTrial PlannedTrialOf(const ExperimentSpec& spec, const std::string& code, int rep) {
+  PlannedTrial t;
+  t.code = code;
+  t.repetition = rep;
+  t.id = TrialId(spec.name, code, rep);
+  t.seed = DeriveSeed(spec.seed, spec.seeds, code, rep);
+  t.overrides = spec.set;
+  for (std::size_t i = 0; i < code.size(); ++i) {
+    const Level* level = spec.factors[i].FindLevel(code[i]);
+    t.levels.push_back(level->label);
+    t.overrides.insert(t.overrides.end(), level->overrides.begin(), level->overrides.end());
+  }
+  t.overrides.push_back("seed=" + std::to_string(t.seed));
+  t.overrides.push_back("name=" + t.id);
+  return t;
+}
+
+}  // namespace
+
+Result<std::vector<PlannedTrial>> ExpandTrials(const ExperimentSpec& spec) {
+  std::vector<std::string> codes = spec.codes.empty() ? FactorialCodes(spec.factors) : spec.codes;
+  SWARMBOX_TRY(CheckCodesAndFilter(spec, codes));
   std::vector<PlannedTrial> trials;
   for (const std::string& code : codes) {
     const bool keep = spec.filter.empty() ||
                       std::any_of(spec.filter.begin(), spec.filter.end(),
                                   [&](const std::string& p) { return CodeMatches(code, p); });
     if (!keep) continue;
-    for (int rep = 1; rep <= spec.repetitions; ++rep) {
-      PlannedTrial t;
-      t.code = code;
-      t.repetition = rep;
-      t.id = TrialId(spec.name, code, rep);
-      t.seed = DeriveSeed(spec.seed, spec.seeds, code, rep);
-      t.overrides = spec.set;
-      for (std::size_t i = 0; i < code.size(); ++i) {
-        const Level* level = spec.factors[i].FindLevel(code[i]);
-        t.levels.push_back(level->label);
-        t.overrides.insert(t.overrides.end(), level->overrides.begin(), level->overrides.end());
-      }
-      t.overrides.push_back("seed=" + std::to_string(t.seed));
-      t.overrides.push_back("name=" + t.id);
-      trials.push_back(std::move(t));
-    }
+    for (int rep = 1; rep <= spec.repetitions; ++rep) trials.push_back(PlannedTrialOf(spec, code, rep));
   }
   if (trials.empty()) {
     return Error(ErrorCode::kInvalidArgument, "the filter leaves no trial to run", spec.file);

@@ -73,35 +73,28 @@ void ProgressBoard::Exhausted(const std::string& /*trial*/) {
   if (requeued_ > 0) --requeued_;
 }
 
-std::vector<std::string> ProgressBoard::Render(double now_s) const {
-  std::vector<std::string> lines;
-  std::size_t width = 4;
-  for (const HostRow& h : hosts_) width = std::max(width, h.name.size());
-  std::size_t running = 0;
-  int slots_up = 0;
-  for (const HostRow& h : hosts_) {
-    std::string line = h.name + std::string(width - h.name.size() + 2, ' ');
-    line += std::to_string(h.slots) + (h.slots == 1 ? " slot   " : " slots  ");
-    line += h.up ? "up    " : "DOWN  ";
-    line += "done " + std::to_string(h.done);
-    if (!h.running.empty()) {
-      line += "  running";
-      bool first = true;
-      for (const auto& [trial, t0] : h.running) {
-        line += (first ? " " : ", ") + trial + " " + FormatDuration(now_s - t0);
-        first = false;
-      }
+std::string ProgressBoard::HostLine(const HostRow& h, std::size_t width, double now_s) const {
+  std::string line = h.name + std::string(width - h.name.size() + 2, ' ');
+  line += std::to_string(h.slots) + (h.slots == 1 ? " slot   " : " slots  ");
+  line += h.up ? "up    " : "DOWN  ";
+  line += "done " + std::to_string(h.done);
+  if (!h.running.empty()) {
+    line += "  running";
+    bool first = true;
+    for (const auto& [trial, t0] : h.running) {
+      line += (first ? " " : ", ") + trial + " " + FormatDuration(now_s - t0);
+      first = false;
     }
-    if (!h.up) line += "  (" + h.reason.substr(0, 160) + ")";
-    running += h.running.size();
-    if (h.up) slots_up += h.slots;
-    lines.push_back(std::move(line));
   }
-  constexpr int kBar = 20;
+  if (!h.up) line += "  (" + h.reason.substr(0, kReasonChars) + ")";
+  return line;
+}
+
+std::string ProgressBoard::SummaryLine(std::size_t running, int slots_up) const {
   const double frac = total_ == 0 ? 1.0 : static_cast<double>(done_) / static_cast<double>(total_);
-  const int filled = static_cast<int>(std::floor(frac * kBar));
+  const int filled = static_cast<int>(std::floor(frac * kBarChars));
   std::string bar = "[" + std::string(static_cast<std::size_t>(filled), '#') +
-                    std::string(static_cast<std::size_t>(kBar - filled), '.') + "] " +
+                    std::string(static_cast<std::size_t>(kBarChars - filled), '.') + "] " +
                     std::to_string(done_) + "/" + std::to_string(total_) + " ";
   for (const char* o : {"success", "failure", "timeout", "error"}) {
     auto it = outcomes_.find(o);
@@ -119,7 +112,21 @@ std::vector<std::string> ProgressBoard::Render(double now_s) const {
     const double waves = std::ceil(static_cast<double>(left) / slots_up);
     bar += " | ETA " + FormatDuration(waves * mean);
   }
-  lines.push_back(std::move(bar));
+  return bar;
+}
+
+std::vector<std::string> ProgressBoard::Render(double now_s) const {
+  std::vector<std::string> lines;
+  std::size_t width = 4;
+  for (const HostRow& h : hosts_) width = std::max(width, h.name.size());
+  std::size_t running = 0;
+  int slots_up = 0;
+  for (const HostRow& h : hosts_) {
+    lines.push_back(HostLine(h, width, now_s));
+    running += h.running.size();
+    if (h.up) slots_up += h.slots;
+  }
+  lines.push_back(SummaryLine(running, slots_up));
   return lines;
 }
 

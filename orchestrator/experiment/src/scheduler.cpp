@@ -91,78 +91,122 @@ void WorkQueue::AbandonPending(const std::string& reason) {
 
 bool WorkQueue::Finished() const { return pending_.empty() && running_ == 0; }
 
+namespace {
+
+// RunSchedule's shared state: the queue under `mu_` (slots wait on `cv_` for work to come back),
+// the observer's calls serialised by `observer_mu_` (taken before `mu_` where both are held).
+class ScheduleRun {
+ public:
+  ScheduleRun(const std::vector<PlannedTrial>& trials, const std::vector<HostWorker*>& hosts,
+              const ScheduleOptions& options, ScheduleObserver& observer)
+      : trials_(trials), hosts_(hosts), options_(options), observer_(observer), names_(HostNames(hosts)),
+        queue_(trials.size(), names_, options.max_attempts) {}
+
+  // One thread per slot of every host, until the queue has nothing more for them.
+  std::vector<TrialReport> Run() {
+    std::vector<std::thread> threads;
+    for (std::size_t h = 0; h < hosts_.size(); ++h) {
+      for (int s = 0; s < std::max(1, hosts_[h]->slots()); ++s) threads.emplace_back([this, h] { Slot(h); });
+    }
+    for (std::thread& th : threads) th.join();
+    std::lock_guard lock(mu_);
+    if (!queue_.Finished()) queue_.Stop("stopped");
+    return queue_.reports();
+  }
+
+ private:
+  struct Taken {
+    std::size_t trial = 0;
+    int attempt = 0;
+  };
+
+  static std::vector<std::string> HostNames(const std::vector<HostWorker*>& hosts) {
+    std::vector<std::string> names;
+    for (HostWorker* h : hosts) names.push_back(h->name());
+    return names;
+  }
+
+  bool Interrupted() const { return options_.interrupted != nullptr && options_.interrupted->load(); }
+
+  // One slot of host `h`: takes trials and runs them one after another.
+  void Slot(std::size_t h) {
+    while (std::optional<Taken> taken = Take(h)) {
+      {
+        std::lock_guard olock(observer_mu_);
+        observer_.OnStart(names_[h], trials_[taken->trial], taken->attempt);
+      }
+      const AttemptResult result = hosts_[h]->Run(trials_[taken->trial], taken->attempt);
+      Finish(h, taken->trial, result);
+      cv_.notify_all();
+    }
+  }
+
+  // The next trial for host `h`, waiting while work may come back (a failed host's trial is
+  // re-queued); nullopt when the slot is done (the other slots are woken to see it too).
+  std::optional<Taken> Take(std::size_t h) {
+    std::unique_lock lock(mu_);
+    std::optional<std::size_t> t;
+    while (true) {
+      if (Interrupted()) queue_.Stop("interrupted (Ctrl-C)");
+      t = queue_.Take(h);
+      if (t || queue_.Finished() || !queue_.host_up(h) || Interrupted()) break;
+      cv_.wait_for(lock, kWaitForReport);
+    }
+    if (!t) {
+      cv_.notify_all();
+      return std::nullopt;
+    }
+    return Taken{*t, queue_.reports()[*t].attempts};
+  }
+
+  // The attempt's result into the queue, then to the observer (the host's fall and the trial's
+  // exhaustion with it).
+  void Finish(std::size_t h, std::size_t t, const AttemptResult& result) {
+    bool exhausted = false;
+    bool went_down = false;
+    std::string down_reason;
+    {
+      std::lock_guard lock(mu_);
+      const bool was_up = queue_.host_up(h);
+      queue_.Report(h, t, result);
+      exhausted = queue_.reports()[t].status == TrialStatus::kExhausted;
+      went_down = was_up && !queue_.host_up(h);
+      down_reason = queue_.host_down_reason(h);
+    }
+    std::lock_guard olock(observer_mu_);
+    observer_.OnFinish(names_[h], trials_[t], result);
+    if (went_down) observer_.OnHostDown(names_[h], down_reason);
+    if (exhausted) {
+      std::string reason;
+      {
+        std::lock_guard lock(mu_);
+        reason = queue_.reports()[t].reason;
+      }
+      observer_.OnExhausted(trials_[t], reason);
+    }
+  }
+
+  // How long an idle slot waits for a report before it looks at the queue (and Ctrl-C) again.
+  static constexpr std::chrono::milliseconds kWaitForReport{200};
+
+  const std::vector<PlannedTrial>& trials_;
+  const std::vector<HostWorker*>& hosts_;
+  const ScheduleOptions& options_;
+  ScheduleObserver& observer_;
+  const std::vector<std::string> names_;
+  std::mutex mu_;
+  std::condition_variable cv_;
+  std::mutex observer_mu_;
+  WorkQueue queue_;  // under mu_
+};
+
+}  // namespace
+
 std::vector<TrialReport> RunSchedule(const std::vector<PlannedTrial>& trials,
                                      const std::vector<HostWorker*>& hosts,
                                      const ScheduleOptions& options, ScheduleObserver& observer) {
-  std::vector<std::string> names;
-  for (HostWorker* h : hosts) names.push_back(h->name());
-  WorkQueue queue(trials.size(), names, options.max_attempts);
-  std::mutex mu;
-  std::condition_variable cv;
-  std::mutex observer_mu;
-
-  auto interrupted = [&] { return options.interrupted != nullptr && options.interrupted->load(); };
-
-  auto slot = [&](std::size_t h) {
-    while (true) {
-      std::optional<std::size_t> t;
-      int attempt = 0;
-      {
-        std::unique_lock lock(mu);
-        while (true) {
-          if (interrupted()) queue.Stop("interrupted (Ctrl-C)");
-          t = queue.Take(h);
-          if (t || queue.Finished() || !queue.host_up(h) || interrupted()) break;
-          // Work may come back (a failed host's trial is re-queued): wait for a report.
-          cv.wait_for(lock, std::chrono::milliseconds(200));
-        }
-        if (!t) {
-          cv.notify_all();
-          return;
-        }
-        attempt = queue.reports()[*t].attempts;
-      }
-      {
-        std::lock_guard olock(observer_mu);
-        observer.OnStart(names[h], trials[*t], attempt);
-      }
-      AttemptResult result = hosts[h]->Run(trials[*t], attempt);
-      bool exhausted = false;
-      bool went_down = false;
-      std::string down_reason;
-      {
-        std::lock_guard lock(mu);
-        const bool was_up = queue.host_up(h);
-        queue.Report(h, *t, result);
-        exhausted = queue.reports()[*t].status == TrialStatus::kExhausted;
-        went_down = was_up && !queue.host_up(h);
-        down_reason = queue.host_down_reason(h);
-      }
-      {
-        std::lock_guard olock(observer_mu);
-        observer.OnFinish(names[h], trials[*t], result);
-        if (went_down) observer.OnHostDown(names[h], down_reason);
-        if (exhausted) {
-          std::string reason;
-          {
-            std::lock_guard lock(mu);
-            reason = queue.reports()[*t].reason;
-          }
-          observer.OnExhausted(trials[*t], reason);
-        }
-      }
-      cv.notify_all();
-    }
-  };
-
-  std::vector<std::thread> threads;
-  for (std::size_t h = 0; h < hosts.size(); ++h) {
-    for (int s = 0; s < std::max(1, hosts[h]->slots()); ++s) threads.emplace_back(slot, h);
-  }
-  for (std::thread& th : threads) th.join();
-  std::lock_guard lock(mu);
-  if (!queue.Finished()) queue.Stop("stopped");
-  return queue.reports();
+  ScheduleRun run(trials, hosts, options, observer);
+  return run.Run();
 }
 
 }  // namespace swarmbox::experiment

@@ -45,6 +45,35 @@ int Serve(const swarmbox::faults::NetemdArgs& args, const std::function<void()>&
   return 0;
 }
 
+// "stop --pidfile P": SIGTERM to the daemon the pidfile names, waiting up to kStopTimeoutMs.
+int StopCommand(const std::vector<std::string>& words) {
+  constexpr int kStopTimeoutMs = 5000;
+  if (words.size() != 2 || words[0] != "--pidfile") {
+    std::fputs(kUsage, stderr);
+    return 2;
+  }
+  auto s = swarmbox::faults::StopByPidfile(words[1], kStopTimeoutMs);
+  if (!s) {
+    std::fprintf(stderr, "swarmbox-netemd: %s\n", s.error().ToString().c_str());
+    return 1;
+  }
+  return 0;
+}
+
+// "run ...": serves the queue in the foreground, or as a daemon once the queue is bound.
+int RunCommand(const std::vector<std::string>& words) {
+  auto args = swarmbox::faults::ParseNetemdRunArgs(words);
+  if (!args) {
+    std::fprintf(stderr, "swarmbox-netemd: %s\n%s", args.error().message().c_str(), kUsage);
+    return 2;
+  }
+  if (args->daemonize) {
+    return swarmbox::faults::Daemonize(
+        args->pidfile, [&](const std::function<void()>& ready) { return Serve(*args, ready); });
+  }
+  return Serve(*args, [] {});
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -60,31 +89,10 @@ int main(int argc, char** argv) {
   const std::string command = words[0];
   words.erase(words.begin());
   if (command == "sleep") return swarmbox::faults::SleepAsInit();
-  if (command == "stop") {
-    if (words.size() != 2 || words[0] != "--pidfile") {
-      std::fputs(kUsage, stderr);
-      return 2;
-    }
-    auto s = swarmbox::faults::StopByPidfile(words[1], 5000);
-    if (!s) {
-      std::fprintf(stderr, "swarmbox-netemd: %s\n", s.error().ToString().c_str());
-      return 1;
-    }
-    return 0;
-  }
+  if (command == "stop") return StopCommand(words);
   if (command != "run") {
     std::fprintf(stderr, "swarmbox-netemd: unknown command '%s'\n%s", command.c_str(), kUsage);
     return 2;
   }
-  auto args = swarmbox::faults::ParseNetemdRunArgs(words);
-  if (!args) {
-    std::fprintf(stderr, "swarmbox-netemd: %s\n%s", args.error().message().c_str(), kUsage);
-    return 2;
-  }
-  if (args->daemonize) {
-    return swarmbox::faults::Daemonize(args->pidfile, [&](const std::function<void()>& ready) {
-      return Serve(*args, ready);
-    });
-  }
-  return Serve(*args, [] {});
+  return RunCommand(words);
 }

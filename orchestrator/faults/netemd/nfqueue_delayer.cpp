@@ -11,6 +11,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,9 @@ namespace {
 Error SysError(const std::string& call) {
   return Error(ErrorCode::kIo, call + ": " + std::strerror(errno), "swarmbox-netemd");
 }
+
+// One read of the queue socket: the largest netlink message the queue sends (64 KiB).
+constexpr std::size_t kReceiveBufferBytes = std::size_t{1} << 16;
 
 }  // namespace
 
@@ -114,6 +118,44 @@ void NfqueueDelayer::ReleaseDue(std::int64_t now_us) {
   }
 }
 
+namespace {
+
+// How long ppoll may sleep: until the next release, or with no packet held, until woken (nullptr).
+timespec* TimeUntilRelease(std::optional<std::int64_t> next_release_us, std::int64_t now_us,
+                           timespec* storage) {
+  if (!next_release_us) return nullptr;
+  const std::int64_t wait_us = std::max<std::int64_t>(0, *next_release_us - now_us);
+  storage->tv_sec = static_cast<time_t>(wait_us / 1000000);
+  storage->tv_nsec = static_cast<long>((wait_us % 1000000) * 1000);
+  return storage;
+}
+
+}  // namespace
+
+Status NfqueueDelayer::DrainQueueSocket(int fd, std::vector<char>& buf) {
+  for (;;) {
+    const ssize_t len = ::recv(fd, buf.data(), buf.size(), MSG_DONTWAIT);
+    if (len > 0) {
+      nfq_handle_packet(handle_, buf.data(), static_cast<int>(len));
+      continue;
+    }
+    if (len < 0 && errno == ENOBUFS) {
+      ++stats_.receive_overruns;
+      continue;
+    }
+    if (len < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) return Ok{};
+    return SysError("recv on the netfilter queue socket");
+  }
+}
+
+void NfqueueDelayer::ReleaseAllAndSummarize() {
+  const std::int64_t now_us = MonotonicUs();
+  while (!scheduler_.empty()) Accept(scheduler_.PopNext(), now_us);
+  stats_.reordered = scheduler_.reordered();
+  const std::uint64_t held = stats_.packets - stats_.dropped;
+  stats_.mean_hold_ms = held > 0 ? hold_sum_ms_ / static_cast<double>(held) : 0.0;
+}
+
 Status NfqueueDelayer::Run() {
   sigset_t mask;
   sigemptyset(&mask);
@@ -123,19 +165,13 @@ Status NfqueueDelayer::Run() {
   const int sfd = signalfd(-1, &mask, SFD_CLOEXEC | SFD_NONBLOCK);
   if (sfd < 0) return SysError("signalfd");
   const int fd = nfq_fd(handle_);
-  std::vector<char> buf(1 << 16);
+  std::vector<char> buf(kReceiveBufferBytes);
   Status result;
   for (bool stop = false; !stop;) {
-    std::int64_t now_us = MonotonicUs();
+    const std::int64_t now_us = MonotonicUs();
     ReleaseDue(now_us);
     timespec timeout{};
-    timespec* timeout_ptr = nullptr;
-    if (auto next = scheduler_.NextReleaseUs()) {
-      const std::int64_t wait_us = std::max<std::int64_t>(0, *next - now_us);
-      timeout.tv_sec = static_cast<time_t>(wait_us / 1000000);
-      timeout.tv_nsec = static_cast<long>((wait_us % 1000000) * 1000);
-      timeout_ptr = &timeout;
-    }
+    timespec* timeout_ptr = TimeUntilRelease(scheduler_.NextReleaseUs(), now_us, &timeout);
     pollfd fds[2] = {{fd, POLLIN, 0}, {sfd, POLLIN, 0}};
     const int n = ::ppoll(fds, 2, timeout_ptr, nullptr);
     if (n < 0) {
@@ -145,29 +181,13 @@ Status NfqueueDelayer::Run() {
     }
     if ((fds[1].revents & POLLIN) != 0) stop = true;
     if ((fds[0].revents & POLLIN) != 0) {
-      for (;;) {
-        const ssize_t len = ::recv(fd, buf.data(), buf.size(), MSG_DONTWAIT);
-        if (len > 0) {
-          nfq_handle_packet(handle_, buf.data(), static_cast<int>(len));
-          continue;
-        }
-        if (len < 0 && errno == ENOBUFS) {
-          ++stats_.receive_overruns;
-          continue;
-        }
-        if (len < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) break;
-        result = SysError("recv on the netfilter queue socket");
+      if (Status drained = DrainQueueSocket(fd, buf); !drained) {
+        result = drained;
         stop = true;
-        break;
       }
     }
   }
-  // Leaving: nothing stays held.
-  const std::int64_t now_us = MonotonicUs();
-  while (!scheduler_.empty()) Accept(scheduler_.PopNext(), now_us);
-  stats_.reordered = scheduler_.reordered();
-  const std::uint64_t held = stats_.packets - stats_.dropped;
-  stats_.mean_hold_ms = held > 0 ? hold_sum_ms_ / static_cast<double>(held) : 0.0;
+  ReleaseAllAndSummarize();  // leaving: nothing stays held
   ::close(sfd);
   return result;
 }

@@ -53,6 +53,10 @@ class NfqueueDelayer {
   static int OnPacket(nfq_q_handle* queue, ::nfgenmsg* msg, ::nfq_data* data, void* self);
   void ReleaseDue(std::int64_t now_us);
   void Accept(const HeldPacket& packet, std::int64_t now_us);
+  // Hands every message waiting on the queue socket to libnetfilter_queue; a failed recv is the error.
+  Status DrainQueueSocket(int fd, std::vector<char>& buf);
+  // Accepts every held packet now and fills the final stats (reordered, mean hold).
+  void ReleaseAllAndSummarize();
 
   NetemdArgs args_;
   DelayScheduler scheduler_;

@@ -40,7 +40,75 @@ char ProcessState(pid_t pid) {
 
 }  // namespace
 
-int Daemonize(const std::string& pidfile, const std::function<int(const std::function<void()>& ready)>& ready_work) {
+namespace {
+
+// The parent's side: reads the pipe until the child closes it; "ok" means ready, anything else is
+// the child's own stderr lines (already prefixed), printed before reaping the child.
+int WaitForDaemonReady(pid_t pid, int read_fd) {
+  std::string message;
+  char buf[512];
+  for (;;) {
+    const ssize_t n = ::read(read_fd, buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    message.append(buf, static_cast<std::size_t>(n));
+  }
+  ::close(read_fd);
+  if (message == "ok") return 0;
+  std::fputs(message.empty() ? "swarmbox-netemd: the daemon exited before it was ready\n" : message.c_str(),
+             stderr);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  return 1;
+}
+
+// The child's readiness: pidfile written, stdio on /dev/null, "ok" down the pipe, pipe closed.
+// A pidfile that cannot be written ends the child with the reason down the pipe.
+void AnnounceReady(const std::string& pidfile, int ready_fd) {
+  if (!pidfile.empty()) {
+    std::ofstream out(pidfile, std::ios::trunc);
+    out << ::getpid() << "\n";
+    if (!out) {
+      WriteAll(ready_fd, "swarmbox-netemd: cannot write pidfile " + pidfile + "\n");
+      ::_exit(1);
+    }
+  }
+  const int null_fd = ::open("/dev/null", O_RDWR);
+  if (null_fd >= 0) {
+    ::dup2(null_fd, 0);
+    ::dup2(null_fd, 1);
+    ::dup2(null_fd, 2);
+    ::close(null_fd);
+  }
+  WriteAll(ready_fd, "ok");
+  ::close(ready_fd);
+}
+
+// The child's side: a new session, stderr into the pipe until ready (so the parent prints the
+// errors of a failed start), then the work; exits with its code and never returns.
+[[noreturn]] void RunDaemonChild(int ready_fd, const std::string& pidfile,
+                                 const std::function<int(const std::function<void()>& ready)>& ready_work) {
+  ::setsid();
+  bool said_ready = false;
+  const int saved_stderr = ::dup(2);
+  ::dup2(ready_fd, 2);
+  const int code = ready_work([&] {
+    if (saved_stderr >= 0) {
+      ::dup2(saved_stderr, 2);
+      ::close(saved_stderr);
+    }
+    AnnounceReady(pidfile, ready_fd);
+    said_ready = true;
+  });
+  if (!said_ready) ::close(ready_fd);
+  if (!pidfile.empty() && said_ready) ::unlink(pidfile.c_str());
+  ::_exit(code);
+}
+
+}  // namespace
+
+int Daemonize(const std::string& pidfile,
+              const std::function<int(const std::function<void()>& ready)>& ready_work) {
   int fds[2];
   if (::pipe(fds) != 0) {
     std::fprintf(stderr, "swarmbox-netemd: pipe: %s\n", std::strerror(errno));
@@ -53,61 +121,10 @@ int Daemonize(const std::string& pidfile, const std::function<int(const std::fun
   }
   if (pid > 0) {  // parent: wait for "ok" or the child's error text
     ::close(fds[1]);
-    std::string message;
-    char buf[512];
-    for (;;) {
-      const ssize_t n = ::read(fds[0], buf, sizeof buf);
-      if (n < 0 && errno == EINTR) continue;
-      if (n <= 0) break;
-      message.append(buf, static_cast<std::size_t>(n));
-    }
-    ::close(fds[0]);
-    if (message == "ok") return 0;
-    // The child's own stderr lines (already prefixed) came through the pipe.
-    std::fputs(message.empty() ? "swarmbox-netemd: the daemon exited before it was ready\n" : message.c_str(), stderr);
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    return 1;
+    return WaitForDaemonReady(pid, fds[0]);
   }
-  // child
   ::close(fds[0]);
-  ::setsid();
-  const int ready_fd = fds[1];
-  bool said_ready = false;
-  auto ready = [&] {
-    if (!pidfile.empty()) {
-      std::ofstream out(pidfile, std::ios::trunc);
-      out << ::getpid() << "\n";
-      if (!out) {
-        WriteAll(ready_fd, "swarmbox-netemd: cannot write pidfile " + pidfile + "\n");
-        ::_exit(1);
-      }
-    }
-    const int null_fd = ::open("/dev/null", O_RDWR);
-    if (null_fd >= 0) {
-      ::dup2(null_fd, 0);
-      ::dup2(null_fd, 1);
-      ::dup2(null_fd, 2);
-      ::close(null_fd);
-    }
-    WriteAll(ready_fd, "ok");
-    ::close(ready_fd);
-    said_ready = true;
-  };
-  // The child's errors before readiness go to the parent through stderr: redirect stderr into
-  // the pipe until ready, so the parent can print them.
-  const int saved_stderr = ::dup(2);
-  ::dup2(ready_fd, 2);
-  const int code = ready_work([&] {
-    if (saved_stderr >= 0) {
-      ::dup2(saved_stderr, 2);
-      ::close(saved_stderr);
-    }
-    ready();
-  });
-  if (!said_ready) ::close(ready_fd);
-  if (!pidfile.empty() && said_ready) ::unlink(pidfile.c_str());
-  ::_exit(code);
+  RunDaemonChild(fds[1], pidfile, ready_work);
 }
 
 Status StopByPidfile(const std::string& pidfile, int timeout_ms) {

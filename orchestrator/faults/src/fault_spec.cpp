@@ -35,6 +35,17 @@ std::string KindList() {
   return out;
 }
 
+// `{target: TARGET, ...fields}` (target required): read_fields(reader) declares the other keys;
+// returns the target, parsed after the mapping checked out.
+template <typename ReadFields>
+Result<FaultTarget> ReadTargetedMapping(const yaml::Node& value, const char* kind, ReadFields&& read_fields) {
+  yaml::MapReader r(value, kind);
+  const yaml::Node* t = r.Child("target", /*required=*/true);
+  read_fields(r);
+  SWARMBOX_TRY(r.Finish());
+  return ParseTarget(*t);
+}
+
 // kill/stop/pause/restart/gps_dropout: `kind: TARGET` or `kind: {target: TARGET, ...options}`.
 // Returns the options mapping (nullptr when the value was a bare target).
 Result<FaultTarget> ReadShortTarget(const yaml::Node& value, std::string_view kind,
@@ -153,11 +164,9 @@ Result<FaultAction> ParseGpsDegrade(std::string_view /*kind*/, const yaml::Node&
     return Invalid("expected gps_degrade to be a mapping such as {target: scout_1, h_acc_m: 5, v_acc_m: 8}",
                    value.Where());
   }
-  yaml::MapReader r(value, "gps_degrade");
-  const yaml::Node* t = r.Child("target", /*required=*/true);
-  r.Required("h_acc_m", &out.h_acc_m).Required("v_acc_m", &out.v_acc_m);
-  SWARMBOX_TRY(r.Finish());
-  auto target = ParseTarget(*t);
+  auto target = ReadTargetedMapping(value, "gps_degrade", [&out](yaml::MapReader& r) {
+    r.Required("h_acc_m", &out.h_acc_m).Required("v_acc_m", &out.v_acc_m);
+  });
   if (!target) return target.error();
   out.target = std::move(*target);
   for (const char* key : {"h_acc_m", "v_acc_m"}) {
@@ -174,11 +183,9 @@ Result<FaultAction> ParseGpsDegrade(std::string_view /*kind*/, const yaml::Node&
 
 Result<FaultAction> ParseImuBias(std::string_view /*kind*/, const yaml::Node& value) {
   ImuBias out;
-  yaml::MapReader r(value, "imu_bias");
-  const yaml::Node* t = r.Child("target", /*required=*/true);
-  r.Optional("accel_m_s2", &out.accel_m_s2).Optional("gyro_rad_s", &out.gyro_rad_s);
-  SWARMBOX_TRY(r.Finish());
-  auto target = ParseTarget(*t);
+  auto target = ReadTargetedMapping(value, "imu_bias", [&out](yaml::MapReader& r) {
+    r.Optional("accel_m_s2", &out.accel_m_s2).Optional("gyro_rad_s", &out.gyro_rad_s);
+  });
   if (!target) return target.error();
   out.target = std::move(*target);
   if (out.accel_m_s2 == std::array<double, 3>{} && out.gyro_rad_s == std::array<double, 3>{}) {
@@ -216,6 +223,65 @@ Result<FaultAction> ParseAction(std::string_view kind, const yaml::Node& value) 
   return ParseWindGust(kind, value);
 }
 
+// The keys of one fault mapping: its start, duration and the one kind key with its value.
+struct FaultKeys {
+  const yaml::Node* at = nullptr;
+  const yaml::Node* at_wall = nullptr;
+  const yaml::Node* on = nullptr;
+  const yaml::Node* duration = nullptr;
+  const yaml::Node* kind_node = nullptr;
+  std::string kind;
+};
+
+// Reads `name` into fault->id and finds the other keys; an unknown key, two kinds or none is an error.
+Result<FaultKeys> ReadFaultKeys(const yaml::Node& node, Fault* fault) {
+  FaultKeys keys;
+  yaml::MapReader r(node, "fault");
+  r.Optional("name", &fault->id);
+  keys.at = r.Child("at");
+  keys.at_wall = r.Child("at_wall");
+  keys.on = r.Child("on");
+  keys.duration = r.Child("duration");
+  for (auto k : kKinds) {
+    if (const yaml::Node* v = r.Child(k)) {
+      if (keys.kind_node != nullptr) {
+        return Invalid(
+            "a fault has exactly one kind; got both '" + keys.kind + "' and '" + std::string(k) + "'",
+            node.Where());
+      }
+      keys.kind_node = v;
+      keys.kind = std::string(k);
+    }
+  }
+  SWARMBOX_TRY(r.Finish());
+  if (keys.kind_node == nullptr) return Invalid("a fault needs one kind: " + KindList(), node.Where());
+  return keys;
+}
+
+// Exactly one of at (simulated time), at_wall (wall time) and on (a log event pattern).
+Status ParseFaultStart(const yaml::Node& node, const FaultKeys& keys, FaultStart* start) {
+  const int starts = (keys.at != nullptr) + (keys.at_wall != nullptr) + (keys.on != nullptr);
+  if (starts != 1) {
+    return Invalid("a fault needs exactly one start: at (simulated time), at_wall (wall time) or on "
+                   "(a log event such as \"event=leader_elected\")",
+                   node.Where());
+  }
+  if (keys.at != nullptr) {
+    start->clock = FaultStart::Clock::kSim;
+    return DecodeDurationMs(*keys.at, &start->at_ms);
+  }
+  if (keys.at_wall != nullptr) {
+    start->clock = FaultStart::Clock::kWall;
+    return DecodeDurationMs(*keys.at_wall, &start->at_ms);
+  }
+  start->clock = FaultStart::Clock::kEvent;
+  SWARMBOX_TRY(yaml::Decode(*keys.on, &start->event_pattern));
+  if (start->event_pattern.find('=') == std::string::npos) {
+    return Invalid("'on' is a log pattern such as \"event=leader_elected\"", keys.on->Where());
+  }
+  return Ok{};
+}
+
 Result<Fault> ParseOne(const yaml::Node& node, std::size_t index) {
   Fault fault;
   fault.mark = node.mark();
@@ -223,58 +289,21 @@ Result<Fault> ParseOne(const yaml::Node& node, std::size_t index) {
   if (!node.is_mapping()) {
     return Invalid("expected a fault to be a mapping such as {at: 30s, kill: raft_leader}", node.Where());
   }
-  yaml::MapReader r(node, "fault");
-  r.Optional("name", &fault.id);
-  const yaml::Node* at = r.Child("at");
-  const yaml::Node* at_wall = r.Child("at_wall");
-  const yaml::Node* on = r.Child("on");
-  const yaml::Node* duration = r.Child("duration");
-  const yaml::Node* kind_node = nullptr;
-  std::string kind;
-  for (auto k : kKinds) {
-    if (const yaml::Node* v = r.Child(k)) {
-      if (kind_node != nullptr) {
-        return Invalid("a fault has exactly one kind; got both '" + kind + "' and '" + std::string(k) + "'",
-                       node.Where());
-      }
-      kind_node = v;
-      kind = std::string(k);
-    }
-  }
-  SWARMBOX_TRY(r.Finish());
-  if (kind_node == nullptr) return Invalid("a fault needs one kind: " + KindList(), node.Where());
+  auto keys = ReadFaultKeys(node, &fault);
+  if (!keys) return keys.error();
   if (!IsName(fault.id)) return Invalid("'name' must be a plain identifier", node.Find("name")->Where());
-
-  const int starts = (at != nullptr) + (at_wall != nullptr) + (on != nullptr);
-  if (starts != 1) {
-    return Invalid("a fault needs exactly one start: at (simulated time), at_wall (wall time) or on "
-                   "(a log event such as \"event=leader_elected\")",
-                   node.Where());
-  }
-  if (at != nullptr) {
-    fault.start.clock = FaultStart::Clock::kSim;
-    SWARMBOX_TRY(DecodeDurationMs(*at, &fault.start.at_ms));
-  } else if (at_wall != nullptr) {
-    fault.start.clock = FaultStart::Clock::kWall;
-    SWARMBOX_TRY(DecodeDurationMs(*at_wall, &fault.start.at_ms));
-  } else {
-    fault.start.clock = FaultStart::Clock::kEvent;
-    SWARMBOX_TRY(yaml::Decode(*on, &fault.start.event_pattern));
-    if (fault.start.event_pattern.find('=') == std::string::npos) {
-      return Invalid("'on' is a log pattern such as \"event=leader_elected\"", on->Where());
-    }
-  }
-  if (duration != nullptr) {
+  SWARMBOX_TRY(ParseFaultStart(node, *keys, &fault.start));
+  if (keys->duration != nullptr) {
     std::int64_t ms = 0;
-    SWARMBOX_TRY(DecodeDurationMs(*duration, &ms));
-    if (ms <= 0) return Invalid("'duration' must be positive", duration->Where());
+    SWARMBOX_TRY(DecodeDurationMs(*keys->duration, &ms));
+    if (ms <= 0) return Invalid("'duration' must be positive", keys->duration->Where());
     fault.duration_ms = ms;
   }
-  auto action = ParseAction(kind, *kind_node);
+  auto action = ParseAction(keys->kind, *keys->kind_node);
   if (!action) return action.error();
   fault.action = std::move(*action);
-  if (fault.duration_ms && kind == "restart") {
-    return Invalid("restart is instantaneous and cannot have a 'duration'", duration->Where());
+  if (fault.duration_ms && keys->kind == "restart") {
+    return Invalid("restart is instantaneous and cannot have a 'duration'", keys->duration->Where());
   }
   return fault;
 }

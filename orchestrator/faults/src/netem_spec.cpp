@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 #include <string>
+#include <utility>
 
 namespace swarmbox::faults {
 namespace {
@@ -107,17 +108,33 @@ void ReadNetemKeys(yaml::MapReader& reader, NetemSpec* spec) {
   }
 }
 
-Status ValidateNetemSpec(const NetemSpec& spec, const yaml::Node& node) {
+namespace {
+
+constexpr double kMaxDelayMs = 600000.0;           // ten minutes
+constexpr std::uint32_t kMaxReorderGap = 1000000;  // packets
+
+// The probabilities of a spec, each with its YAML key, in the order they are checked.
+constexpr std::pair<double NetemSpec::*, std::string_view> kFractionKeys[] = {
+    {&NetemSpec::correlation, "correlation"},
+    {&NetemSpec::loss, "loss"},
+    {&NetemSpec::loss_correlation, "loss_correlation"},
+    {&NetemSpec::duplicate, "duplicate"},
+    {&NetemSpec::corrupt, "corrupt"},
+    {&NetemSpec::reorder, "reorder"},
+    {&NetemSpec::reorder_correlation, "reorder_correlation"},
+};
+
+// Delays non-negative and bounded, probabilities in [0, 1].
+Status CheckValueRanges(const NetemSpec& spec, const yaml::Node& node) {
   if (!(spec.delay_ms >= 0.0)) return Invalid("'delay_ms' must be >= 0", node, "delay_ms");
   if (!(spec.jitter_ms >= 0.0)) return Invalid("'jitter_ms' must be >= 0", node, "jitter_ms");
-  if (spec.delay_ms > 600000.0) return Invalid("'delay_ms' above 10 minutes", node, "delay_ms");
-  SWARMBOX_TRY(CheckFraction(spec.correlation, node, "correlation"));
-  SWARMBOX_TRY(CheckFraction(spec.loss, node, "loss"));
-  SWARMBOX_TRY(CheckFraction(spec.loss_correlation, node, "loss_correlation"));
-  SWARMBOX_TRY(CheckFraction(spec.duplicate, node, "duplicate"));
-  SWARMBOX_TRY(CheckFraction(spec.corrupt, node, "corrupt"));
-  SWARMBOX_TRY(CheckFraction(spec.reorder, node, "reorder"));
-  SWARMBOX_TRY(CheckFraction(spec.reorder_correlation, node, "reorder_correlation"));
+  if (spec.delay_ms > kMaxDelayMs) return Invalid("'delay_ms' above 10 minutes", node, "delay_ms");
+  for (const auto& [field, key] : kFractionKeys) SWARMBOX_TRY(CheckFraction(spec.*field, node, key));
+  return Ok{};
+}
+
+// Keys that only mean something together with another (jitter shapes, correlations, reordering).
+Status CheckKeyCombinations(const NetemSpec& spec, const yaml::Node& node) {
   if (spec.distribution != DelayDistribution::kUniform && spec.jitter_ms <= 0.0) {
     return Invalid("distribution '" + std::string(DistributionName(spec.distribution)) +
                        "' needs jitter_ms > 0 (it shapes the jitter around delay_ms)",
@@ -141,7 +158,17 @@ Status ValidateNetemSpec(const NetemSpec& spec, const yaml::Node& node) {
     return Invalid("'reorder_correlation' and 'reorder_gap' need reorder > 0", node,
                    spec.reorder_gap > 0 ? "reorder_gap" : "reorder_correlation");
   }
-  if (spec.reorder_gap > 1000000) return Invalid("'reorder_gap' above 1,000,000 packets", node, "reorder_gap");
+  return Ok{};
+}
+
+}  // namespace
+
+Status ValidateNetemSpec(const NetemSpec& spec, const yaml::Node& node) {
+  SWARMBOX_TRY(CheckValueRanges(spec, node));
+  SWARMBOX_TRY(CheckKeyCombinations(spec, node));
+  if (spec.reorder_gap > kMaxReorderGap) {
+    return Invalid("'reorder_gap' above 1,000,000 packets", node, "reorder_gap");
+  }
   if (spec.rate_kbit && !(*spec.rate_kbit > 0.0)) {
     return Invalid("'rate_kbit' must be > 0 [kbit/s]", node, "rate_kbit");
   }

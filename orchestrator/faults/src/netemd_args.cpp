@@ -70,72 +70,133 @@ std::vector<std::string> NetemdStopArgv(const std::string& program, const std::s
   return {program, "stop", "--pidfile", pidfile};
 }
 
-Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words) {
-  NetemdArgs a;
+namespace {
+
+// What the run flags fill in. The Gilbert-Elliott model counts only when all four --ge-* flags
+// are given.
+struct RunArgsBuilder {
+  NetemdArgs args;
   bool have_queue = false;
   GilbertElliott ge;
-  int ge_flags = 0;
+  unsigned ge_flags = 0;  // one bit per --ge-* flag seen
+};
+
+constexpr std::int64_t kMaxDelayUs = 600LL * 1000 * 1000;  // ten minutes
+constexpr std::uint16_t kMaxQueueNumber = 65535;           // NFQUEUE numbers are 16 bits
+constexpr std::uint32_t kMaxReorderGap = 1000000;
+constexpr unsigned kAllGeFlags = 0b1111;
+
+Status ParseGeFraction(const std::string& flag, const std::string& value, double GilbertElliott::*field,
+                       unsigned bit, RunArgsBuilder& b) {
+  SWARMBOX_TRY(ParseFraction(flag, value, &(b.ge.*field)));
+  b.ge_flags |= bit;
+  return Ok{};
+}
+
+using RunFlagParser = Status (*)(const std::string& flag, const std::string& value, RunArgsBuilder& b);
+
+struct RunFlag {
+  std::string_view name;
+  RunFlagParser parse;
+};
+
+// Every "run" flag that takes a value (--daemonize takes none).
+constexpr RunFlag kRunFlags[] = {
+    {"--queue",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) -> Status {
+       SWARMBOX_TRY(ParseInt<std::uint16_t>(f, v, 0, kMaxQueueNumber, &b.args.queue));
+       b.have_queue = true;
+       return Ok{};
+     }},
+    {"--delay-us",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) {
+       return ParseInt<std::int64_t>(f, v, 0, kMaxDelayUs, &b.args.delay.delay_us);
+     }},
+    {"--jitter-us",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) {
+       return ParseInt<std::int64_t>(f, v, 0, kMaxDelayUs, &b.args.delay.jitter_us);
+     }},
+    {"--distribution",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) -> Status {
+       auto d = DistributionFromName(v);
+       if (!d) return Bad(f, "expected uniform, normal, pareto or paretonormal, got '" + v + "'");
+       b.args.delay.distribution = *d;
+       return Ok{};
+     }},
+    {"--correlation", [](const std::string& f, const std::string& v,
+                         RunArgsBuilder& b) { return ParseFraction(f, v, &b.args.delay.correlation); }},
+    {"--reorder", [](const std::string& f, const std::string& v,
+                     RunArgsBuilder& b) { return ParseFraction(f, v, &b.args.delay.reorder); }},
+    {"--reorder-correlation",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) {
+       return ParseFraction(f, v, &b.args.delay.reorder_correlation);
+     }},
+    {"--reorder-gap",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) {
+       return ParseInt<std::uint32_t>(f, v, 0, kMaxReorderGap, &b.args.delay.reorder_gap);
+     }},
+    {"--seed",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) -> Status {
+       std::int64_t seed = 0;
+       SWARMBOX_TRY(ParseInt<std::int64_t>(f, v, 0, std::numeric_limits<std::int64_t>::max(), &seed));
+       b.args.seed = static_cast<std::uint64_t>(seed);
+       return Ok{};
+     }},
+    {"--queue-maxlen",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) {
+       return ParseInt<std::uint32_t>(f, v, 1, kNetemdMaxQueueLen, &b.args.queue_maxlen);
+     }},
+    {"--ge-p", [](const std::string& f, const std::string& v,
+                  RunArgsBuilder& b) { return ParseGeFraction(f, v, &GilbertElliott::p, 1U << 0, b); }},
+    {"--ge-r", [](const std::string& f, const std::string& v,
+                  RunArgsBuilder& b) { return ParseGeFraction(f, v, &GilbertElliott::r, 1U << 1, b); }},
+    {"--ge-loss-bad",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) {
+       return ParseGeFraction(f, v, &GilbertElliott::loss_bad, 1U << 2, b);
+     }},
+    {"--ge-loss-good",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) {
+       return ParseGeFraction(f, v, &GilbertElliott::loss_good, 1U << 3, b);
+     }},
+    {"--corrupt", [](const std::string& f, const std::string& v,
+                     RunArgsBuilder& b) { return ParseFraction(f, v, &b.args.corrupt); }},
+    {"--pidfile",
+     [](const std::string& f, const std::string& v, RunArgsBuilder& b) -> Status {
+       if (v.empty() || v[0] != '/') return Bad(f, "expected an absolute path, got '" + v + "'");
+       b.args.pidfile = v;
+       return Ok{};
+     }},
+};
+
+const RunFlag* FindRunFlag(std::string_view name) {
+  for (const RunFlag& flag : kRunFlags) {
+    if (flag.name == name) return &flag;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+Result<NetemdArgs> ParseNetemdRunArgs(const std::vector<std::string>& words) {
+  RunArgsBuilder b;
   for (std::size_t i = 0; i < words.size(); ++i) {
     const std::string& flag = words[i];
     if (flag == "--daemonize") {
-      a.daemonize = true;
+      b.args.daemonize = true;
       continue;
     }
     if (i + 1 >= words.size()) return Bad(flag, "missing value (or unknown flag)");
-    const std::string& v = words[++i];
-    constexpr std::int64_t kMaxUs = 600LL * 1000 * 1000;
-    if (flag == "--queue") {
-      SWARMBOX_TRY(ParseInt<std::uint16_t>(flag, v, 0, 65535, &a.queue));
-      have_queue = true;
-    } else if (flag == "--delay-us") {
-      SWARMBOX_TRY(ParseInt<std::int64_t>(flag, v, 0, kMaxUs, &a.delay.delay_us));
-    } else if (flag == "--jitter-us") {
-      SWARMBOX_TRY(ParseInt<std::int64_t>(flag, v, 0, kMaxUs, &a.delay.jitter_us));
-    } else if (flag == "--distribution") {
-      auto d = DistributionFromName(v);
-      if (!d) return Bad(flag, "expected uniform, normal, pareto or paretonormal, got '" + v + "'");
-      a.delay.distribution = *d;
-    } else if (flag == "--correlation") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &a.delay.correlation));
-    } else if (flag == "--reorder") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &a.delay.reorder));
-    } else if (flag == "--reorder-correlation") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &a.delay.reorder_correlation));
-    } else if (flag == "--reorder-gap") {
-      SWARMBOX_TRY(ParseInt<std::uint32_t>(flag, v, 0, 1000000, &a.delay.reorder_gap));
-    } else if (flag == "--seed") {
-      std::int64_t seed = 0;
-      SWARMBOX_TRY(ParseInt<std::int64_t>(flag, v, 0, std::numeric_limits<std::int64_t>::max(), &seed));
-      a.seed = static_cast<std::uint64_t>(seed);
-    } else if (flag == "--queue-maxlen") {
-      SWARMBOX_TRY(ParseInt<std::uint32_t>(flag, v, 1, kNetemdMaxQueueLen, &a.queue_maxlen));
-    } else if (flag == "--ge-p") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &ge.p));
-      ge_flags |= 1;
-    } else if (flag == "--ge-r") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &ge.r));
-      ge_flags |= 2;
-    } else if (flag == "--ge-loss-bad") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &ge.loss_bad));
-      ge_flags |= 4;
-    } else if (flag == "--ge-loss-good") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &ge.loss_good));
-      ge_flags |= 8;
-    } else if (flag == "--corrupt") {
-      SWARMBOX_TRY(ParseFraction(flag, v, &a.corrupt));
-    } else if (flag == "--pidfile") {
-      if (v.empty() || v[0] != '/') return Bad(flag, "expected an absolute path, got '" + v + "'");
-      a.pidfile = v;
-    } else {
-      return Bad(flag, "unknown flag");
-    }
+    const std::string& value = words[++i];
+    const RunFlag* known = FindRunFlag(flag);
+    if (known == nullptr) return Bad(flag, "unknown flag");
+    SWARMBOX_TRY(known->parse(flag, value, b));
   }
-  if (!have_queue) return Bad("--queue", "required");
-  if (ge_flags != 0 && ge_flags != 0b1111) {
+  if (!b.have_queue) return Bad("--queue", "required");
+  if (b.ge_flags != 0 && b.ge_flags != kAllGeFlags) {
     return Bad("--ge-p", "a Gilbert-Elliott model needs all of --ge-p, --ge-r, --ge-loss-bad and --ge-loss-good");
   }
-  if (ge_flags != 0) a.gilbert_elliott = ge;
-  return a;
+  if (b.ge_flags != 0) b.args.gilbert_elliott = b.ge;
+  return b.args;
 }
 
 }  // namespace swarmbox::faults

@@ -22,16 +22,11 @@ void CloseFd(int& fd) {
 
 }  // namespace
 
-Result<CommandOutput> PosixCommandRunner::Run(const std::vector<std::string>& argv) {
-  SWARMBOX_CHECK(!argv.empty());
-  int out_pipe[2] = {-1, -1};
-  int err_pipe[2] = {-1, -1};
-  if (::pipe2(out_pipe, O_CLOEXEC) != 0 || ::pipe2(err_pipe, O_CLOEXEC) != 0) {
-    const int e = errno;
-    CloseFd(out_pipe[0]);
-    CloseFd(out_pipe[1]);
-    return Error(ErrorCode::kIo, std::string("pipe: ") + std::strerror(e), CommandText(argv));
-  }
+namespace {
+
+// Spawns argv with stdin on /dev/null and stdout/stderr into the pipes' write ends, which are
+// closed here either way; a failed spawn also closes the read ends.
+Result<pid_t> SpawnIntoPipes(const std::vector<std::string>& argv, int out_pipe[2], int err_pipe[2]) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
@@ -52,8 +47,12 @@ Result<CommandOutput> PosixCommandRunner::Run(const std::vector<std::string>& ar
     return Error(rc == ENOENT ? ErrorCode::kNotFound : ErrorCode::kIo,
                  "cannot run '" + argv[0] + "': " + std::strerror(rc), CommandText(argv));
   }
-  CommandOutput output;
-  pollfd fds[2] = {{out_pipe[0], POLLIN, 0}, {err_pipe[0], POLLIN, 0}};
+  return pid;
+}
+
+// Reads both pipes until each reaches end of file (or fails), closing each as it ends.
+void ReadUntilClosed(int out_fd, int err_fd, CommandOutput& output) {
+  pollfd fds[2] = {{out_fd, POLLIN, 0}, {err_fd, POLLIN, 0}};
   std::string* sinks[2] = {&output.stdout_text, &output.stderr_text};
   int open_fds = 2;
   char buf[4096];
@@ -74,10 +73,33 @@ Result<CommandOutput> PosixCommandRunner::Run(const std::vector<std::string>& ar
       }
     }
   }
+}
+
+// The exit status, or 128 + the signal for a killed child (as a shell reports it).
+int WaitForExitCode(pid_t pid) {
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
-  output.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+}  // namespace
+
+Result<CommandOutput> PosixCommandRunner::Run(const std::vector<std::string>& argv) {
+  SWARMBOX_CHECK(!argv.empty());
+  int out_pipe[2] = {-1, -1};
+  int err_pipe[2] = {-1, -1};
+  if (::pipe2(out_pipe, O_CLOEXEC) != 0 || ::pipe2(err_pipe, O_CLOEXEC) != 0) {
+    const int e = errno;
+    CloseFd(out_pipe[0]);
+    CloseFd(out_pipe[1]);
+    return Error(ErrorCode::kIo, std::string("pipe: ") + std::strerror(e), CommandText(argv));
+  }
+  auto pid = SpawnIntoPipes(argv, out_pipe, err_pipe);
+  if (!pid) return pid.error();
+  CommandOutput output;
+  ReadUntilClosed(out_pipe[0], err_pipe[0], output);
+  output.exit_code = WaitForExitCode(*pid);
   return output;
 }
 

@@ -38,23 +38,8 @@ bool IsSocket(const std::string& path) {
   return ::stat(path.c_str(), &st) == 0 && S_ISSOCK(st.st_mode);
 }
 
-}  // namespace
-
-Result<std::unique_ptr<SshTunnel>> SshTunnel::Open(const HostSpec& spec, const std::string& workdir,
-                                                   std::chrono::milliseconds timeout) {
-  std::error_code ec;
-  fs::create_directories(workdir, ec);
-  if (ec) return Error(ErrorCode::kIo, "cannot create " + workdir + ": " + ec.message());
-  const std::string base = (fs::path(workdir) / SafeFileName(spec.name())).string();
-  const std::string sock = base + ".sock";
-  const std::string log = base + ".ssh.log";
-  // A unix socket path is limited to 108 bytes (sun_path).
-  if (sock.size() >= 100) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "the forwarded socket path is too long for a unix socket: " + sock);
-  }
-  fs::remove(sock, ec);
-  const std::vector<std::string> args = SshTunnelArgv(spec, sock, workdir);
+// Starts ssh with stdin and stdout on /dev/null and stderr into `log`, in its own process group.
+Result<pid_t> SpawnSsh(const std::vector<std::string>& args, const std::string& log) {
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
@@ -80,12 +65,33 @@ Result<std::unique_ptr<SshTunnel>> SshTunnel::Open(const HostSpec& spec, const s
                      (rc == ENOENT ? " (install openssh-client)" : ""),
                  "ssh");
   }
-  std::unique_ptr<SshTunnel> tunnel(new SshTunnel(pid, sock, log));
+  return pid;
+}
+
+}  // namespace
+
+Result<std::unique_ptr<SshTunnel>> SshTunnel::Open(const HostSpec& spec, const std::string& workdir,
+                                                   std::chrono::milliseconds timeout) {
+  std::error_code ec;
+  fs::create_directories(workdir, ec);
+  if (ec) return Error(ErrorCode::kIo, "cannot create " + workdir + ": " + ec.message());
+  const std::string base = (fs::path(workdir) / SafeFileName(spec.name())).string();
+  const std::string sock = base + ".sock";
+  const std::string log = base + ".ssh.log";
+  // A unix socket path is limited to 108 bytes (sun_path).
+  if (sock.size() >= 100) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "the forwarded socket path is too long for a unix socket: " + sock);
+  }
+  fs::remove(sock, ec);
+  auto pid = SpawnSsh(SshTunnelArgv(spec, sock, workdir), log);
+  if (!pid) return pid.error();
+  std::unique_ptr<SshTunnel> tunnel(new SshTunnel(*pid, sock, log));
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (true) {
     if (IsSocket(sock)) return tunnel;
     int status = 0;
-    if (::waitpid(pid, &status, WNOHANG) == pid) {
+    if (::waitpid(*pid, &status, WNOHANG) == *pid) {
       tunnel->reaped_ = true;
       const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
       return ClassifySshFailure(spec, tunnel->StderrText(), code);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <span>
 
 namespace swarmbox::hosts {
 
@@ -59,6 +60,69 @@ std::string HostSpec::name() const {
   return n;
 }
 
+namespace {
+
+constexpr int kMaxPort = 65535;
+constexpr int kMaxSlots = 64;
+
+// "[user@]host[:port]" (after "ssh://") into spec.user, spec.host and spec.port.
+Status ParseSshAddress(std::string_view rest, std::string_view text, HostSpec& spec) {
+  if (auto at = rest.find('@'); at != std::string_view::npos) {
+    spec.user = std::string(rest.substr(0, at));
+    rest = rest.substr(at + 1);
+    if (spec.user.empty()) return Bad(text, "empty user name");
+  }
+  if (auto colon = rest.rfind(':'); colon != std::string_view::npos && rest.front() != '[') {
+    if (!ParseInt(rest.substr(colon + 1), &spec.port) || spec.port < 1 || spec.port > kMaxPort) {
+      return Bad(text, "bad port '" + std::string(rest.substr(colon + 1)) + "'");
+    }
+    rest = rest.substr(0, colon);
+  }
+  if (rest.empty() || rest.find('/') != std::string_view::npos) {
+    return Bad(text, "missing or bad host name");
+  }
+  spec.host = std::string(rest);
+  return Ok{};
+}
+
+// One "key=value" of the query; identity and known_hosts only mean something for ssh hosts.
+Status ParseHostOption(std::string_view key, const std::string& value, std::string_view text,
+                       HostSpec& spec) {
+  if (key == "slots") {
+    if (!ParseInt(value, &spec.slots) || spec.slots < 1 || spec.slots > kMaxSlots) {
+      return Bad(text, "slots must be 1..64, got '" + value + "'");
+    }
+  } else if (key == "socket") {
+    if (value.empty() || value.front() != '/') return Bad(text, "socket must be an absolute path");
+    spec.socket = value;
+  } else if (key == "identity" && spec.kind == HostSpec::Kind::kSsh) {
+    spec.identity = value;
+  } else if (key == "known_hosts" && spec.kind == HostSpec::Kind::kSsh) {
+    spec.known_hosts = value;
+  } else {
+    return Bad(text, "unknown option '" + std::string(key) + "'");
+  }
+  return Ok{};
+}
+
+// The query after '?': "key=value" pairs joined by '&'.
+Status ParseHostOptions(std::string_view query, std::string_view text, HostSpec& spec) {
+  while (!query.empty()) {
+    const auto amp = query.find('&');
+    std::string_view kv = query.substr(0, amp);
+    query = amp == std::string_view::npos ? std::string_view() : query.substr(amp + 1);
+    const auto eq = kv.find('=');
+    if (eq == std::string_view::npos) return Bad(text, "option '" + std::string(kv) + "' needs =value");
+    if (Status option = ParseHostOption(kv.substr(0, eq), std::string(kv.substr(eq + 1)), text, spec);
+        !option) {
+      return option.error();
+    }
+  }
+  return Ok{};
+}
+
+}  // namespace
+
 Result<HostSpec> ParseHostSpec(std::string_view text) {
   HostSpec spec;
   spec.text = std::string(text);
@@ -73,48 +137,11 @@ Result<HostSpec> ParseHostSpec(std::string_view text) {
   } else if (main.substr(0, 6) == "ssh://") {
     spec.kind = HostSpec::Kind::kSsh;
     spec.socket = std::string(kDefaultRemoteSocket);
-    std::string_view rest = main.substr(6);
-    if (auto at = rest.find('@'); at != std::string_view::npos) {
-      spec.user = std::string(rest.substr(0, at));
-      rest = rest.substr(at + 1);
-      if (spec.user.empty()) return Bad(text, "empty user name");
-    }
-    if (auto colon = rest.rfind(':'); colon != std::string_view::npos && rest.front() != '[') {
-      if (!ParseInt(rest.substr(colon + 1), &spec.port) || spec.port < 1 || spec.port > 65535) {
-        return Bad(text, "bad port '" + std::string(rest.substr(colon + 1)) + "'");
-      }
-      rest = rest.substr(0, colon);
-    }
-    if (rest.empty() || rest.find('/') != std::string_view::npos) {
-      return Bad(text, "missing or bad host name");
-    }
-    spec.host = std::string(rest);
+    if (Status address = ParseSshAddress(main.substr(6), text, spec); !address) return address.error();
   } else {
     return Bad(text, "unknown kind of host");
   }
-  while (!query.empty()) {
-    const auto amp = query.find('&');
-    std::string_view kv = query.substr(0, amp);
-    query = amp == std::string_view::npos ? std::string_view() : query.substr(amp + 1);
-    const auto eq = kv.find('=');
-    if (eq == std::string_view::npos) return Bad(text, "option '" + std::string(kv) + "' needs =value");
-    const std::string_view key = kv.substr(0, eq);
-    const std::string value(kv.substr(eq + 1));
-    if (key == "slots") {
-      if (!ParseInt(value, &spec.slots) || spec.slots < 1 || spec.slots > 64) {
-        return Bad(text, "slots must be 1..64, got '" + value + "'");
-      }
-    } else if (key == "socket") {
-      if (value.empty() || value.front() != '/') return Bad(text, "socket must be an absolute path");
-      spec.socket = value;
-    } else if (key == "identity" && spec.kind == HostSpec::Kind::kSsh) {
-      spec.identity = value;
-    } else if (key == "known_hosts" && spec.kind == HostSpec::Kind::kSsh) {
-      spec.known_hosts = value;
-    } else {
-      return Bad(text, "unknown option '" + std::string(key) + "'");
-    }
-  }
+  if (Status options = ParseHostOptions(query, text, spec); !options) return options.error();
   return spec;
 }
 
@@ -160,57 +187,83 @@ std::vector<std::string> SshTunnelArgv(const HostSpec& spec, const std::string& 
   return argv;
 }
 
+namespace {
+
+// What ssh prints on stderr for each kind of failure, checked in this order.
+constexpr std::string_view kHostKeyChangedMarkers[] = {"REMOTE HOST IDENTIFICATION HAS CHANGED"};
+constexpr std::string_view kUnknownHostKeyMarkers[] = {"Host key verification failed", "No ED25519 host key",
+                                                       "host key for"};
+constexpr std::string_view kAuthRefusedMarkers[] = {"Permission denied (",
+                                                    "Too many authentication failures"};
+constexpr std::string_view kForwardFailedMarkers[] = {"open failed", "connect failed"};
+constexpr std::string_view kForwardDeniedMarkers[] = {"Permission denied", "prohibited"};
+constexpr std::string_view kUnreachableMarkers[] = {
+    "Could not resolve hostname", "No route to host",  "Connection refused", "timed out",
+    "Network is unreachable",     "Connection closed", "Broken pipe",        "Connection reset"};
+
+// The shell's exit status for a command it cannot find.
+constexpr int kCommandNotFoundExit = 127;
+
+bool ContainsAny(std::string_view hay, std::span<const std::string_view> needles) {
+  return std::any_of(needles.begin(), needles.end(),
+                     [hay](std::string_view needle) { return Contains(hay, needle); });
+}
+
+std::string UnknownHostKeyMessage(const HostSpec& spec) {
+  return "the host key of " + spec.name() + " is not in " +
+         (spec.known_hosts.empty() ? std::string("~/.ssh/known_hosts") : spec.known_hosts) +
+         " (host keys are always checked: add it, e.g. ssh-keyscan -p " + std::to_string(spec.port) + " " +
+         spec.host + " after checking it)";
+}
+
+std::string AuthRefusedMessage(const HostSpec& spec) {
+  return "ssh authentication to " + spec.name() + " was refused (key-only, BatchMode: is the key " +
+         (spec.identity.empty() ? std::string("in ~/.ssh or the agent") : spec.identity) +
+         " authorised for this user?)";
+}
+
+// The tunnel is up but the remote end of the socket forward failed.
+std::string ForwardFailedMessage(const HostSpec& spec, std::string_view err) {
+  const std::string socket = "the remote Docker socket " + spec.socket + " on " + spec.name();
+  if (ContainsAny(err, kForwardDeniedMarkers)) {
+    return socket +
+           " cannot be opened by this user (permission denied: add the user to "
+           "the docker group, or allow stream-local forwarding in sshd)";
+  }
+  return socket + " does not answer (is dockerd running there?)";
+}
+
+}  // namespace
+
 Error ClassifySshFailure(const HostSpec& spec, std::string_view err, int exit_code) {
   const std::string who = spec.name();
   const std::string quoted = QuoteSsh(err);
   const std::string tail = quoted.empty() ? std::string() : " [ssh: " + quoted + "]";
-  if (Contains(err, "REMOTE HOST IDENTIFICATION HAS CHANGED")) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "the host key of " + who + " changed: check the host, then fix known_hosts" + tail,
-                 "ssh");
+  const auto ssh_error = [&tail](ErrorCode code, const std::string& message) {
+    return Error(code, message + tail, "ssh");
+  };
+  if (ContainsAny(err, kHostKeyChangedMarkers)) {
+    return ssh_error(ErrorCode::kInvalidArgument,
+                     "the host key of " + who + " changed: check the host, then fix known_hosts");
   }
-  if (Contains(err, "Host key verification failed") || Contains(err, "No ED25519 host key") ||
-      Contains(err, "host key for") ) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "the host key of " + who + " is not in " +
-                     (spec.known_hosts.empty() ? std::string("~/.ssh/known_hosts")
-                                               : spec.known_hosts) +
-                     " (host keys are always checked: add it, e.g. ssh-keyscan -p " +
-                     std::to_string(spec.port) + " " + spec.host + " after checking it)" + tail,
-                 "ssh");
+  if (ContainsAny(err, kUnknownHostKeyMarkers)) {
+    return ssh_error(ErrorCode::kInvalidArgument, UnknownHostKeyMessage(spec));
   }
-  if (Contains(err, "Permission denied (") || Contains(err, "Too many authentication failures")) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "ssh authentication to " + who + " was refused (key-only, BatchMode: is the key " +
-                     (spec.identity.empty() ? std::string("in ~/.ssh or the agent")
-                                            : spec.identity) +
-                     " authorised for this user?)" + tail,
-                 "ssh");
+  if (ContainsAny(err, kAuthRefusedMarkers)) {
+    return ssh_error(ErrorCode::kInvalidArgument, AuthRefusedMessage(spec));
   }
-  if (Contains(err, "open failed") || Contains(err, "connect failed")) {
-    const bool perm = Contains(err, "Permission denied") || Contains(err, "prohibited");
-    return Error(ErrorCode::kInvalidArgument,
-                 perm ? "the remote Docker socket " + spec.socket + " on " + who +
-                            " cannot be opened by this user (permission denied: add the user to "
-                            "the docker group, or allow stream-local forwarding in sshd)" + tail
-                      : "the remote Docker socket " + spec.socket + " on " + who +
-                            " does not answer (is dockerd running there?)" + tail,
-                 "ssh");
+  if (ContainsAny(err, kForwardFailedMarkers)) {
+    return ssh_error(ErrorCode::kInvalidArgument, ForwardFailedMessage(spec, err));
   }
-  if (Contains(err, "Could not resolve hostname") || Contains(err, "No route to host") ||
-      Contains(err, "Connection refused") || Contains(err, "timed out") ||
-      Contains(err, "Network is unreachable") || Contains(err, "Connection closed") ||
-      Contains(err, "Broken pipe") || Contains(err, "Connection reset")) {
-    return Error(ErrorCode::kUnavailable, "cannot reach " + who + " over ssh" + tail, "ssh");
+  if (ContainsAny(err, kUnreachableMarkers)) {
+    return ssh_error(ErrorCode::kUnavailable, "cannot reach " + who + " over ssh");
   }
-  if (exit_code == 127) {
+  if (exit_code == kCommandNotFoundExit) {
     return Error(ErrorCode::kNotFound, "the ssh client is not installed (openssh-client)", "ssh");
   }
-  return Error(ErrorCode::kUnavailable,
-               "ssh to " + who + " failed" +
-                   (exit_code >= 0 ? " (exit " + std::to_string(exit_code) + ")" : std::string()) +
-                   tail,
-               "ssh");
+  return ssh_error(ErrorCode::kUnavailable,
+                   "ssh to " + who + " failed" +
+                       (exit_code >= 0 ? " (exit " + std::to_string(exit_code) + ")" : std::string()));
 }
 
 }  // namespace swarmbox::hosts

@@ -104,11 +104,13 @@ std::string GenerateDockerfile(const ImageSpec& spec) {
   return d;
 }
 
-Result<PackedContext> AssembleContext(const ImageSpec& spec, std::vector<TarEntry> rootfs) {
-  if (spec.repository.empty()) {
-    return Error(ErrorCode::kInvalidArgument, "an image spec needs a repository name");
-  }
-  std::map<std::string, TarEntry> by_path;
+namespace {
+
+using RootfsByPath = std::map<std::string, TarEntry>;  // path without the leading '/' -> entry
+
+// The root filesystem's entries by path, each moved under "rootfs/" (paths absolute, no two the same).
+Result<RootfsByPath> RootfsEntries(const ImageSpec& spec, std::vector<TarEntry> rootfs) {
+  RootfsByPath by_path;
   for (TarEntry& e : rootfs) {
     if (e.path.empty() || e.path.front() != '/') {
       return Error(ErrorCode::kInvalidArgument,
@@ -122,7 +124,11 @@ Result<PackedContext> AssembleContext(const ImageSpec& spec, std::vector<TarEntr
     e.path = "rootfs/" + key;
     by_path.emplace(key, std::move(e));
   }
-  // Parent directories, where not given explicitly.
+  return by_path;
+}
+
+// Parent directories, where not given explicitly (a parent given as a file is an error).
+Status AddParentDirectories(const ImageSpec& spec, RootfsByPath& by_path) {
   std::set<std::string> parents;
   for (const auto& [key, e] : by_path) {
     for (std::size_t slash = key.find('/'); slash != std::string::npos; slash = key.find('/', slash + 1)) {
@@ -139,12 +145,23 @@ Result<PackedContext> AssembleContext(const ImageSpec& spec, std::vector<TarEntr
     }
     by_path.emplace(p, docker::DirectoryEntry("rootfs/" + p, 0755));
   }
+  return Ok{};
+}
 
+}  // namespace
+
+Result<PackedContext> AssembleContext(const ImageSpec& spec, std::vector<TarEntry> rootfs) {
+  if (spec.repository.empty()) {
+    return Error(ErrorCode::kInvalidArgument, "an image spec needs a repository name");
+  }
+  auto by_path = RootfsEntries(spec, std::move(rootfs));
+  if (!by_path) return by_path.error();
+  SWARMBOX_TRY(AddParentDirectories(spec, *by_path));
   PackedContext ctx;
   docker::TarWriter tar;
   SWARMBOX_TRY(tar.AddFile("Dockerfile", GenerateDockerfile(spec), 0644));
   SWARMBOX_TRY(tar.AddDirectory("rootfs", 0755));
-  for (auto& [key, e] : by_path) {  // std::map: sorted, parents before children
+  for (auto& [key, e] : *by_path) {  // std::map: sorted, parents before children
     if (e.type == TarEntry::Type::kFile) ctx.payload_bytes += e.content.size();
     SWARMBOX_TRY(tar.Add(e));
     ctx.image_paths.push_back("/" + key);

@@ -42,9 +42,20 @@ std::vector<std::pair<char, std::string>> LevelsOf(const std::vector<TrialRecord
   return {by_code.begin(), by_code.end()};
 }
 
-std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxes,
-                       const AxisKind& kind) {
-  constexpr double kW = 110, kH = 220, kTop = 14, kBottom = 40, kLeft = 56;
+// A box plot's geometry [px]: one column kBoxColumnW wide per box after the kBoxLeft margin.
+constexpr double kBoxColumnW = 110, kBoxPlotH = 220, kBoxTop = 14, kBoxBottom = 40, kBoxLeft = 56;
+constexpr double kBoxW = 36;  // the IQR box's width
+
+// Where values go on a box plot: the axis, and the y of a value.
+struct BoxFrame {
+  PlotAxis axis;
+  double y(double v) const {
+    return kBoxTop + (axis.hi - v) / (axis.hi - axis.lo) * (kBoxPlotH - kBoxTop - kBoxBottom);
+  }
+};
+
+// The axis over all boxes that have values.
+PlotAxis BoxAxis(const std::vector<std::pair<std::string, BoxStats>>& boxes, const AxisKind& kind) {
   double data_lo = 0, data_hi = 0;
   bool any = false;
   for (const auto& [label, b] : boxes) {
@@ -53,42 +64,45 @@ std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxe
     data_hi = any ? std::max(data_hi, b.max) : b.max;
     any = true;
   }
-  const PlotAxis axis = ChooseAxis(data_lo, data_hi, kind);
-  const double lo = axis.lo, hi = axis.hi;
-  const double width = kLeft + kW * static_cast<double>(boxes.size()) + 10;
-  const double plot_h = kH - kTop - kBottom;
-  auto y = [&](double v) { return kTop + (hi - v) / (hi - lo) * plot_h; };
-  std::string s = "<svg width='" + Fmt(width) + "' height='" +
-                  Fmt(kH) + "' class='box'>";
-  for (double v : axis.Ticks()) {
-    s += "<line x1='" + Fmt(kLeft - 4) + "' x2='" + Fmt(width - 10) + "' y1='" + Fmt(y(v)) +
-         "' y2='" + Fmt(y(v)) + "' class='grid'/><text x='" + Fmt(kLeft - 6) + "' y='" +
-         Fmt(y(v) + 4) + "' text-anchor='end'>" + CsvNumber(v) + "</text>";
+  return ChooseAxis(data_lo, data_hi, kind);
+}
+
+// One box centred at cx: whisker line and caps, the IQR box with its numbers, median, outliers.
+std::string BoxSvg(const std::string& label, const BoxStats& b, double cx, const BoxFrame& f) {
+  std::string s = "<line x1='" + Fmt(cx) + "' x2='" + Fmt(cx) + "' y1='" + Fmt(f.y(b.whisker_low)) +
+                  "' y2='" + Fmt(f.y(b.whisker_high)) + "' class='whisker'/>";
+  for (double w : {b.whisker_low, b.whisker_high}) {
+    s += "<line x1='" + Fmt(cx - kBoxW / 4) + "' x2='" + Fmt(cx + kBoxW / 4) + "' y1='" + Fmt(f.y(w)) +
+         "' y2='" + Fmt(f.y(w)) + "' class='whisker'/>";
+  }
+  s += "<rect x='" + Fmt(cx - kBoxW / 2) + "' y='" + Fmt(f.y(b.q3)) + "' width='" + Fmt(kBoxW) +
+       "' height='" + Fmt(std::max(1.0, f.y(b.q1) - f.y(b.q3))) + "' class='iqr'><title>" +
+       HtmlEscape(label) + ": n=" + std::to_string(b.n) + " min " + Fmt(b.min) + " q1 " + Fmt(b.q1) +
+       " median " + Fmt(b.median) + " q3 " + Fmt(b.q3) + " max " + Fmt(b.max) + "</title></rect>";
+  s += "<line x1='" + Fmt(cx - kBoxW / 2) + "' x2='" + Fmt(cx + kBoxW / 2) + "' y1='" + Fmt(f.y(b.median)) +
+       "' y2='" + Fmt(f.y(b.median)) + "' class='median'/>";
+  for (double o : b.outliers) {
+    s += "<circle cx='" + Fmt(cx) + "' cy='" + Fmt(f.y(o)) + "' r='3' class='outlier'/>";
+  }
+  return s;
+}
+
+std::string BoxPlotSvg(const std::vector<std::pair<std::string, BoxStats>>& boxes, const AxisKind& kind) {
+  const BoxFrame f{BoxAxis(boxes, kind)};
+  const double width = kBoxLeft + kBoxColumnW * static_cast<double>(boxes.size()) + 10;
+  std::string s = "<svg width='" + Fmt(width) + "' height='" + Fmt(kBoxPlotH) + "' class='box'>";
+  for (double v : f.axis.Ticks()) {
+    s += "<line x1='" + Fmt(kBoxLeft - 4) + "' x2='" + Fmt(width - 10) + "' y1='" + Fmt(f.y(v)) + "' y2='" +
+         Fmt(f.y(v)) + "' class='grid'/><text x='" + Fmt(kBoxLeft - 6) + "' y='" + Fmt(f.y(v) + 4) +
+         "' text-anchor='end'>" + CsvNumber(v) + "</text>";
   }
   for (std::size_t i = 0; i < boxes.size(); ++i) {
     const auto& [label, b] = boxes[i];
-    const double cx = kLeft + kW * (static_cast<double>(i) + 0.5);
-    s += "<text x='" + Fmt(cx) + "' y='" + Fmt(kH - kBottom + 16) + "' text-anchor='middle'>" +
-         HtmlEscape(label) + "</text><text x='" + Fmt(cx) + "' y='" + Fmt(kH - kBottom + 32) +
+    const double cx = kBoxLeft + kBoxColumnW * (static_cast<double>(i) + 0.5);
+    s += "<text x='" + Fmt(cx) + "' y='" + Fmt(kBoxPlotH - kBoxBottom + 16) + "' text-anchor='middle'>" +
+         HtmlEscape(label) + "</text><text x='" + Fmt(cx) + "' y='" + Fmt(kBoxPlotH - kBoxBottom + 32) +
          "' text-anchor='middle' class='n'>n=" + std::to_string(b.n) + "</text>";
-    if (b.n == 0) continue;
-    const double bw = 36;
-    s += "<line x1='" + Fmt(cx) + "' x2='" + Fmt(cx) + "' y1='" + Fmt(y(b.whisker_low)) +
-         "' y2='" + Fmt(y(b.whisker_high)) + "' class='whisker'/>";
-    for (double w : {b.whisker_low, b.whisker_high}) {
-      s += "<line x1='" + Fmt(cx - bw / 4) + "' x2='" + Fmt(cx + bw / 4) + "' y1='" + Fmt(y(w)) +
-           "' y2='" + Fmt(y(w)) + "' class='whisker'/>";
-    }
-    s += "<rect x='" + Fmt(cx - bw / 2) + "' y='" + Fmt(y(b.q3)) + "' width='" + Fmt(bw) +
-         "' height='" + Fmt(std::max(1.0, y(b.q1) - y(b.q3))) + "' class='iqr'><title>" +
-         HtmlEscape(label) + ": n=" + std::to_string(b.n) + " min " + Fmt(b.min) + " q1 " +
-         Fmt(b.q1) + " median " + Fmt(b.median) + " q3 " + Fmt(b.q3) + " max " + Fmt(b.max) +
-         "</title></rect>";
-    s += "<line x1='" + Fmt(cx - bw / 2) + "' x2='" + Fmt(cx + bw / 2) + "' y1='" +
-         Fmt(y(b.median)) + "' y2='" + Fmt(y(b.median)) + "' class='median'/>";
-    for (double o : b.outliers) {
-      s += "<circle cx='" + Fmt(cx) + "' cy='" + Fmt(y(o)) + "' r='3' class='outlier'/>";
-    }
+    if (b.n != 0) s += BoxSvg(label, b, cx, f);
   }
   return s + "</svg>";
 }

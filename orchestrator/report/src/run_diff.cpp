@@ -142,6 +142,37 @@ Result<TruthTable> ParseTruth(std::string_view text, Side side, std::optional<do
   return t;
 }
 
+// The cells that differ, named by `names` where it has a name for the column, else "column N".
+std::vector<FieldDiff> CellDiffs(const std::vector<std::string_view>& ca,
+                                 const std::vector<std::string_view>& cb,
+                                 const std::vector<std::string_view>& names) {
+  std::vector<FieldDiff> fields;
+  const std::size_t n = std::max(ca.size(), cb.size());
+  for (std::size_t c = 0; c < n; ++c) {
+    FieldDiff f{c < names.size() ? std::string(names[c]) : "column " + std::to_string(c + 1), std::nullopt,
+                std::nullopt};
+    if (c < ca.size()) f.a = std::string(ca[c]);
+    if (c < cb.size()) f.b = std::string(cb[c]);
+    if (f.a != f.b) fields.push_back(std::move(f));
+  }
+  return fields;
+}
+
+// The divergence at data row `row`: one file ended there (the other's row tells time and drone),
+// or the two lines differ.
+TruthDivergence RowDivergence(const TruthTable& a, const TruthTable& b, std::size_t row) {
+  const bool end_a = row >= a.rows;
+  const bool end_b = row >= b.rows;
+  TruthDivergence d;
+  d.line = row + 2;
+  if (end_a || end_b) d.ended = end_a ? Side::kA : Side::kB;
+  const auto ca = SplitCsv((end_a ? b : a).lines[row + 1]);
+  if (ca.size() > a.t_col) d.t_s = Number(ca[a.t_col]);
+  if (ca.size() > a.drone_col) d.drone = std::string(ca[a.drone_col]);
+  if (!d.ended) d.fields = CellDiffs(ca, SplitCsv(b.lines[row + 1]), a.header);
+  return d;
+}
+
 std::optional<TruthDivergence> CompareTruth(const TruthTable& a, const TruthTable& b,
                                             std::size_t* rows_alike) {
   const bool a_empty = a.lines.empty();
@@ -156,47 +187,18 @@ std::optional<TruthDivergence> CompareTruth(const TruthTable& a, const TruthTabl
   if (a.header != b.header) {
     TruthDivergence d;
     d.line = 1;
-    const std::size_t n = std::max(a.header.size(), b.header.size());
-    for (std::size_t c = 0; c < n; ++c) {
-      FieldDiff f{"column " + std::to_string(c + 1), std::nullopt, std::nullopt};
-      if (c < a.header.size()) f.a = std::string(a.header[c]);
-      if (c < b.header.size()) f.b = std::string(b.header[c]);
-      if (f.a != f.b) d.fields.push_back(std::move(f));
-    }
+    d.fields = CellDiffs(a.header, b.header, {});
     return d;
   }
   for (std::size_t row = 0;; ++row) {
     const bool end_a = row >= a.rows;
     const bool end_b = row >= b.rows;
     if (end_a && end_b) return std::nullopt;
-    TruthDivergence d;
-    d.line = row + 2;
-    if (end_a || end_b) {
-      d.ended = end_a ? Side::kA : Side::kB;
-      const auto cells = SplitCsv((end_a ? b : a).lines[row + 1]);
-      if (cells.size() > a.t_col) d.t_s = Number(cells[a.t_col]);
-      if (cells.size() > a.drone_col) d.drone = std::string(cells[a.drone_col]);
-      return d;
-    }
-    const std::string_view la = a.lines[row + 1];
-    const std::string_view lb = b.lines[row + 1];
-    if (la == lb) {
+    if (!end_a && !end_b && a.lines[row + 1] == b.lines[row + 1]) {
       *rows_alike = row + 1;
       continue;
     }
-    const auto ca = SplitCsv(la);
-    const auto cb = SplitCsv(lb);
-    if (ca.size() > a.t_col) d.t_s = Number(ca[a.t_col]);
-    if (ca.size() > a.drone_col) d.drone = std::string(ca[a.drone_col]);
-    const std::size_t n = std::max(ca.size(), cb.size());
-    for (std::size_t c = 0; c < n; ++c) {
-      FieldDiff f{c < a.header.size() ? std::string(a.header[c]) : "column " + std::to_string(c + 1),
-                  std::nullopt, std::nullopt};
-      if (c < ca.size()) f.a = std::string(ca[c]);
-      if (c < cb.size()) f.b = std::string(cb[c]);
-      if (f.a != f.b) d.fields.push_back(std::move(f));
-    }
-    return d;
+    return RowDivergence(a, b, row);
   }
 }
 
@@ -315,15 +317,60 @@ std::vector<FieldDiff> EventFields(const Event& a, const Event& b) {
   return out;
 }
 
-std::optional<EventDivergence> CompareEvents(const std::vector<Event>& a, const std::vector<Event>& b,
-                                             std::size_t* streams) {
-  const Streams sa = ByStream(a);
-  const Streams sb = ByStream(b);
+// The stream names of both runs: A's in order, then B's that A lacks.
+std::vector<std::string> StreamNames(const Streams& sa, const Streams& sb) {
   std::vector<std::string> keys;
   for (const auto& [k, _] : sa) keys.push_back(k);
   for (const auto& [k, _] : sb) {
     if (sa.count(k) == 0) keys.push_back(k);
   }
+  return keys;
+}
+
+// The divergence at position i of a stream (x or y nullptr: that run's stream ended). Its time
+// is the earlier of the two events' times, else the last time both streams agreed on.
+EventDivergence EventDivergenceAt(const std::string& stream, std::size_t i, const Event* x, const Event* y,
+                                  std::optional<double> last_t) {
+  EventDivergence d;
+  d.stream = stream;
+  d.index = i;
+  std::optional<double> t;
+  for (const Event* e : {x, y}) {
+    if (e != nullptr && e->t_s && (!t || *e->t_s < *t)) t = e->t_s;
+  }
+  d.t_s = t ? t : last_t;
+  if (x != nullptr) {
+    d.line_a = x->line;
+    d.event_a = x->json;
+  }
+  if (y != nullptr) {
+    d.line_b = y->line;
+    d.event_b = y->json;
+  }
+  if (x != nullptr && y != nullptr) d.fields = EventFields(*x, *y);
+  return d;
+}
+
+// The first position where one stream's events differ between the runs.
+std::optional<EventDivergence> FirstStreamDivergence(const std::string& stream,
+                                                     const std::vector<const Event*>& ea,
+                                                     const std::vector<const Event*>& eb) {
+  std::optional<double> last_t;
+  for (std::size_t i = 0; i < std::max(ea.size(), eb.size()); ++i) {
+    const Event* x = i < ea.size() ? ea[i] : nullptr;
+    const Event* y = i < eb.size() ? eb[i] : nullptr;
+    if (x == nullptr || y == nullptr || x->json != y->json) return EventDivergenceAt(stream, i, x, y, last_t);
+    if (x->t_s) last_t = x->t_s;
+  }
+  return std::nullopt;
+}
+
+// The earliest of the streams' first divergences: by time (timed before untimed), then line.
+std::optional<EventDivergence> CompareEvents(const std::vector<Event>& a, const std::vector<Event>& b,
+                                             std::size_t* streams) {
+  const Streams sa = ByStream(a);
+  const Streams sb = ByStream(b);
+  const std::vector<std::string> keys = StreamNames(sa, sb);
   *streams = keys.size();
   static const std::vector<const Event*> kNone;
   std::optional<EventDivergence> best;
@@ -334,36 +381,9 @@ std::optional<EventDivergence> CompareEvents(const std::vector<Event>& a, const 
   for (const std::string& key : keys) {
     auto ia = sa.find(key);
     auto ib = sb.find(key);
-    const auto& ea = ia != sa.end() ? ia->second : kNone;
-    const auto& eb = ib != sb.end() ? ib->second : kNone;
-    std::optional<double> last_t;
-    for (std::size_t i = 0; i < std::max(ea.size(), eb.size()); ++i) {
-      const Event* x = i < ea.size() ? ea[i] : nullptr;
-      const Event* y = i < eb.size() ? eb[i] : nullptr;
-      if (x != nullptr && y != nullptr && x->json == y->json) {
-        if (x->t_s) last_t = x->t_s;
-        continue;
-      }
-      EventDivergence d;
-      d.stream = key;
-      d.index = i;
-      std::optional<double> t;
-      for (const Event* e : {x, y}) {
-        if (e != nullptr && e->t_s && (!t || *e->t_s < *t)) t = e->t_s;
-      }
-      d.t_s = t ? t : last_t;
-      if (x != nullptr) {
-        d.line_a = x->line;
-        d.event_a = x->json;
-      }
-      if (y != nullptr) {
-        d.line_b = y->line;
-        d.event_b = y->json;
-      }
-      if (x != nullptr && y != nullptr) d.fields = EventFields(*x, *y);
-      if (!best || rank(d) < rank(*best)) best = std::move(d);
-      break;
-    }
+    std::optional<EventDivergence> d =
+        FirstStreamDivergence(key, ia != sa.end() ? ia->second : kNone, ib != sb.end() ? ib->second : kNone);
+    if (d && (!best || rank(*d) < rank(*best))) best = std::move(d);
   }
   return best;
 }
@@ -411,28 +431,27 @@ std::optional<double> RunDiff::first_t_s() const {
   return std::nullopt;
 }
 
-Result<RunDiff> DiffRuns(const RunFiles& a, const RunFiles& b) {
-  RunDiff diff;
-  auto note_missing = [&](const std::string& file, bool in_a, bool in_b) {
-    if (in_a && in_b) {
-      diff.compared.push_back(file);
-    } else if (in_a != in_b) {
-      diff.missing.push_back({file, in_a ? Side::kB : Side::kA});
-    }
-    return in_a && in_b;
-  };
+namespace {
 
-  std::optional<ResultFacts> ra, rb;
-  if (a.result_json) {
-    auto r = ParseResult(*a.result_json, Side::kA);
-    if (!r) return r.error();
-    ra = std::move(*r);
+// Records whether `file` is compared (in both runs) or missing from one; true when compared.
+bool NoteCompared(RunDiff& diff, const std::string& file, bool in_a, bool in_b) {
+  if (in_a && in_b) {
+    diff.compared.push_back(file);
+  } else if (in_a != in_b) {
+    diff.missing.push_back({file, in_a ? Side::kB : Side::kA});
   }
-  if (b.result_json) {
-    auto r = ParseResult(*b.result_json, Side::kB);
-    if (!r) return r.error();
-    rb = std::move(*r);
-  }
+  return in_a && in_b;
+}
+
+Result<std::optional<ResultFacts>> ParseResultIfAny(const std::optional<std::string>& text, Side side) {
+  if (!text) return std::optional<ResultFacts>();
+  auto r = ParseResult(*text, side);
+  if (!r) return r.error();
+  return std::optional<ResultFacts>(std::move(*r));
+}
+
+// The earlier of the two runs' ending lines bounds the comparison.
+void SetHorizon(const std::optional<ResultFacts>& ra, const std::optional<ResultFacts>& rb, RunDiff& diff) {
   for (const auto& [r, side] : {std::pair{&ra, Side::kA}, std::pair{&rb, Side::kB}}) {
     if (*r && (*r)->end_t_s && (!diff.horizon_s || *(*r)->end_t_s < *diff.horizon_s)) {
       diff.horizon_s = (*r)->end_t_s;
@@ -440,45 +459,74 @@ Result<RunDiff> DiffRuns(const RunFiles& a, const RunFiles& b) {
                             std::string(SideName(side)) + ")";
     }
   }
+}
 
-  if (note_missing("truth.csv", a.truth_csv.has_value(), b.truth_csv.has_value())) {
-    auto ta = ParseTruth(*a.truth_csv, Side::kA, diff.horizon_s);
-    if (!ta) return ta.error();
-    auto tb = ParseTruth(*b.truth_csv, Side::kB, diff.horizon_s);
-    if (!tb) return tb.error();
-    diff.truth = CompareTruth(*ta, *tb, &diff.truth_rows);
+Status DiffTruth(const std::string& a, const std::string& b, RunDiff& diff) {
+  auto ta = ParseTruth(a, Side::kA, diff.horizon_s);
+  if (!ta) return ta.error();
+  auto tb = ParseTruth(b, Side::kB, diff.horizon_s);
+  if (!tb) return tb.error();
+  diff.truth = CompareTruth(*ta, *tb, &diff.truth_rows);
+  return Ok{};
+}
+
+// run_id_a/b: each run's id, replaced by a placeholder in the events' values.
+Status DiffEvents(const std::string& a, const std::string& b, const std::string& run_id_a,
+                  const std::string& run_id_b, RunDiff& diff) {
+  auto ea = ParseEvents(a, Side::kA, run_id_a, diff.horizon_s);
+  if (!ea) return ea.error();
+  auto eb = ParseEvents(b, Side::kB, run_id_b, diff.horizon_s);
+  if (!eb) return eb.error();
+  diff.events = CompareEvents(*ea, *eb, &diff.streams);
+  diff.event_count = ea->size();
+  return Ok{};
+}
+
+// Outcome and reason (run ids replaced) are divergences; other seeds or trials are notes.
+void DiffResults(const ResultFacts& ra, const ResultFacts& rb, RunDiff& diff) {
+  ResultDivergence r;
+  if (ra.outcome != rb.outcome) r.fields.push_back({"outcome", ra.outcome, rb.outcome});
+  const std::string reason_a = ReplaceAll(ra.reason, ra.run_id, kRunPlaceholder);
+  const std::string reason_b = ReplaceAll(rb.reason, rb.run_id, kRunPlaceholder);
+  if (reason_a != reason_b) r.fields.push_back({"reason", reason_a, reason_b});
+  if (!r.fields.empty()) diff.result = std::move(r);
+  if (ra.seed != rb.seed) diff.notes.push_back("the seeds differ: " + ra.seed + " (A), " + rb.seed + " (B)");
+  if (ra.trial != rb.trial) {
+    diff.notes.push_back("the trials differ: " + ra.trial + " (A), " + rb.trial + " (B)");
   }
-  if (note_missing("events.jsonl", a.events_jsonl.has_value(), b.events_jsonl.has_value())) {
-    auto ea = ParseEvents(*a.events_jsonl, Side::kA, ra ? ra->run_id : "", diff.horizon_s);
-    if (!ea) return ea.error();
-    auto eb = ParseEvents(*b.events_jsonl, Side::kB, rb ? rb->run_id : "", diff.horizon_s);
-    if (!eb) return eb.error();
-    diff.events = CompareEvents(*ea, *eb, &diff.streams);
-    diff.event_count = ea->size();
+}
+
+}  // namespace
+
+Result<RunDiff> DiffRuns(const RunFiles& a, const RunFiles& b) {
+  RunDiff diff;
+  auto ra = ParseResultIfAny(a.result_json, Side::kA);
+  if (!ra) return ra.error();
+  auto rb = ParseResultIfAny(b.result_json, Side::kB);
+  if (!rb) return rb.error();
+  SetHorizon(*ra, *rb, diff);
+  if (NoteCompared(diff, "truth.csv", a.truth_csv.has_value(), b.truth_csv.has_value())) {
+    SWARMBOX_TRY(DiffTruth(*a.truth_csv, *b.truth_csv, diff));
   }
-  if (note_missing("result.json", ra.has_value(), rb.has_value())) {
-    ResultDivergence r;
-    if (ra->outcome != rb->outcome) r.fields.push_back({"outcome", ra->outcome, rb->outcome});
-    const std::string reason_a = ReplaceAll(ra->reason, ra->run_id, kRunPlaceholder);
-    const std::string reason_b = ReplaceAll(rb->reason, rb->run_id, kRunPlaceholder);
-    if (reason_a != reason_b) r.fields.push_back({"reason", reason_a, reason_b});
-    if (!r.fields.empty()) diff.result = std::move(r);
-    if (ra->seed != rb->seed) diff.notes.push_back("the seeds differ: " + ra->seed + " (A), " + rb->seed + " (B)");
-    if (ra->trial != rb->trial) diff.notes.push_back("the trials differ: " + ra->trial + " (A), " + rb->trial + " (B)");
+  if (NoteCompared(diff, "events.jsonl", a.events_jsonl.has_value(), b.events_jsonl.has_value())) {
+    SWARMBOX_TRY(DiffEvents(*a.events_jsonl, *b.events_jsonl, *ra ? (*ra)->run_id : "",
+                            *rb ? (*rb)->run_id : "", diff));
   }
+  if (NoteCompared(diff, "result.json", ra->has_value(), rb->has_value())) DiffResults(**ra, **rb, diff);
   return diff;
 }
 
-std::string FormatRunDiff(const RunDiff& d, std::string_view name_a, std::string_view name_b) {
-  std::string out;
-  const std::string a(name_a), b(name_b);
-  if (d.identical()) {
-    out += "identical: A " + a + ", B " + b + "\n";
-  } else {
-    out += "differ: A " + a + ", B " + b + "; first divergence in " + *d.first_file();
-    if (auto t = d.first_t_s()) out += " at t=" + Seconds(*t) + " s";
-    out += "\n";
-  }
+namespace {
+
+// "identical: ..." or "differ: ...; first divergence in FILE at t=...".
+std::string Headline(const RunDiff& d, const std::string& a, const std::string& b) {
+  if (d.identical()) return "identical: A " + a + ", B " + b + "\n";
+  std::string out = "differ: A " + a + ", B " + b + "; first divergence in " + *d.first_file();
+  if (auto t = d.first_t_s()) out += " at t=" + Seconds(*t) + " s";
+  return out + "\n";
+}
+
+std::string ComparedLine(const RunDiff& d) {
   std::string compared = "compared:";
   for (const std::string& f : d.compared) {
     compared += " " + f;
@@ -488,36 +536,45 @@ std::string FormatRunDiff(const RunDiff& d, std::string_view name_a, std::string
     }
   }
   if (d.compared.empty()) compared += " nothing (no file is in both runs)";
-  out += compared + "\n";
+  return compared + "\n";
+}
+
+std::string TruthDivergenceText(const TruthDivergence& t) {
+  std::string out = "truth.csv line " + std::to_string(t.line);
+  if (t.t_s) out += ", t=" + Seconds(*t.t_s) + " s";
+  if (!t.drone.empty()) out += ", drone " + t.drone;
+  if (t.ended) {
+    const Side other = *t.ended == Side::kA ? Side::kB : Side::kA;
+    return out + ": run " + std::string(SideName(*t.ended)) + "'s file ended first" +
+           (t.line > 1 ? " (run " + std::string(SideName(other)) + " goes on with this row)" : "") + "\n";
+  }
+  out += (t.line == 1 ? ": the headers differ\n" : ":\n");
+  AppendFields(&out, t.fields);
+  return out;
+}
+
+std::string EventDivergenceText(const EventDivergence& e) {
+  std::string out = "events.jsonl stream " + e.stream + ", event " + std::to_string(e.index + 1);
+  if (e.t_s) out += ", t=" + Seconds(*e.t_s) + " s";
+  out += " (line " + (e.line_a ? std::to_string(e.line_a) : std::string("-")) + " of A, line " +
+         (e.line_b ? std::to_string(e.line_b) : std::string("-")) + " of B):\n";
+  out += "  A: " + (e.event_a.empty() ? std::string("(the stream ended)") : e.event_a) + "\n";
+  out += "  B: " + (e.event_b.empty() ? std::string("(the stream ended)") : e.event_b) + "\n";
+  AppendFields(&out, e.fields);
+  return out;
+}
+
+}  // namespace
+
+std::string FormatRunDiff(const RunDiff& d, std::string_view name_a, std::string_view name_b) {
+  std::string out = Headline(d, std::string(name_a), std::string(name_b)) + ComparedLine(d);
   if (d.horizon_s) out += "up to t=" + Seconds(*d.horizon_s) + " s: " + d.horizon_reason + "\n";
   for (const std::string& n : d.notes) out += "note: " + n + "\n";
   for (const MissingFile& m : d.missing) {
     out += m.file + ": not in run " + std::string(SideName(m.missing_in)) + "\n";
   }
-  if (d.truth) {
-    const TruthDivergence& t = *d.truth;
-    out += "truth.csv line " + std::to_string(t.line);
-    if (t.t_s) out += ", t=" + Seconds(*t.t_s) + " s";
-    if (!t.drone.empty()) out += ", drone " + t.drone;
-    if (t.ended) {
-      const Side other = *t.ended == Side::kA ? Side::kB : Side::kA;
-      out += ": run " + std::string(SideName(*t.ended)) + "'s file ended first" +
-             (t.line > 1 ? " (run " + std::string(SideName(other)) + " goes on with this row)" : "") + "\n";
-    } else {
-      out += (t.line == 1 ? ": the headers differ\n" : ":\n");
-      AppendFields(&out, t.fields);
-    }
-  }
-  if (d.events) {
-    const EventDivergence& e = *d.events;
-    out += "events.jsonl stream " + e.stream + ", event " + std::to_string(e.index + 1);
-    if (e.t_s) out += ", t=" + Seconds(*e.t_s) + " s";
-    out += " (line " + (e.line_a ? std::to_string(e.line_a) : std::string("-")) + " of A, line " +
-           (e.line_b ? std::to_string(e.line_b) : std::string("-")) + " of B):\n";
-    out += "  A: " + (e.event_a.empty() ? std::string("(the stream ended)") : e.event_a) + "\n";
-    out += "  B: " + (e.event_b.empty() ? std::string("(the stream ended)") : e.event_b) + "\n";
-    AppendFields(&out, e.fields);
-  }
+  if (d.truth) out += TruthDivergenceText(*d.truth);
+  if (d.events) out += EventDivergenceText(*d.events);
   if (d.result) {
     out += "result.json:\n";
     AppendFields(&out, d.result->fields);

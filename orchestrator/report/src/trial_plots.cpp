@@ -105,8 +105,8 @@ struct LineChart {
   std::map<std::string, std::string> colours;
 };
 
-std::string LineSvg(const LineChart& c, double t_end_s) {
-  const std::vector<Series>& series = *c.series;
+// The lowest and highest value over all points (0, 0 with no points).
+std::pair<double, double> ValueRange(const std::vector<Series>& series) {
   double lo = 0, hi = 0;
   bool any = false;
   for (const Series& s : series) {
@@ -116,34 +116,50 @@ std::string LineSvg(const LineChart& c, double t_end_s) {
       any = true;
     }
   }
+  return {lo, hi};
+}
+
+// Too many series for a line each: the min..max band and the median line over time bins.
+std::string EnvelopeSvg(const Frame& f, const std::vector<Series>& series, bool step) {
+  const std::vector<EnvelopeBin> env = Envelope(series, f.t.hi, kEnvelopeBins, step);
+  std::string band, median;
+  for (const EnvelopeBin& b : env) {
+    band += (band.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.max));
+  }
+  for (auto it = env.rbegin(); it != env.rend(); ++it) {
+    band += "L" + F1(f.x(it->t_s)) + " " + F1(f.yv(it->min));
+  }
+  for (const EnvelopeBin& b : env) {
+    median += (median.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.median));
+  }
+  return "<path d='" + band + "Z' class='band'><title>min..max of " + std::to_string(series.size()) +
+         "</title></path><path d='" + median + "' class='median'><title>median of " +
+         std::to_string(series.size()) + "</title></path>";
+}
+
+// One line per series in its colour (the first palette colour when it has none); a lone point
+// shows as a dot.
+std::string SeriesLinesSvg(const Frame& f, const LineChart& c) {
+  std::string s;
+  for (const Series& one : *c.series) {
+    auto found = c.colours.find(one.name);
+    const std::string colour = found == c.colours.end() ? std::string(kPalette[0]) : found->second;
+    s += "<path d='" + PathOf(f, one.points, c.step) + "' stroke='" + colour + "' class='line'><title>" +
+         HtmlEscape(one.name) + "</title></path>";
+    if (one.points.size() == 1) {
+      s += "<circle cx='" + F1(f.x(one.points[0].t_s)) + "' cy='" + F1(f.yv(one.points[0].value)) +
+           "' r='2.5' fill='" + colour + "'/>";
+    }
+  }
+  return s;
+}
+
+std::string LineSvg(const LineChart& c, double t_end_s) {
+  auto [lo, hi] = ValueRange(*c.series);
   if (c.to_one) hi = std::max(hi, 1.0);
   Frame f{TimeAxis(t_end_s), ChooseAxis(lo, hi, c.kind, 5)};
   std::string s = Axes(f, true);
-  if (series.size() > kMaxLines) {
-    const std::vector<EnvelopeBin> env = Envelope(series, f.t.hi, kEnvelopeBins, c.step);
-    std::string band, median;
-    for (const EnvelopeBin& b : env)
-      band += (band.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.max));
-    for (auto it = env.rbegin(); it != env.rend(); ++it)
-      band += "L" + F1(f.x(it->t_s)) + " " + F1(f.yv(it->min));
-    for (const EnvelopeBin& b : env)
-      median += (median.empty() ? "M" : "L") + F1(f.x(b.t_s)) + " " + F1(f.yv(b.median));
-    s += "<path d='" + band + "Z' class='band'><title>min..max of " + std::to_string(series.size()) +
-         "</title></path><path d='" + median + "' class='median'><title>median of " +
-         std::to_string(series.size()) + "</title></path>";
-  } else {
-    for (const Series& one : series) {
-      auto colour = c.colours.find(one.name);
-      s += "<path d='" + PathOf(f, one.points, c.step) + "' stroke='" +
-           (colour == c.colours.end() ? std::string(kPalette[0]) : colour->second) +
-           "' class='line'><title>" + HtmlEscape(one.name) + "</title></path>";
-      if (one.points.size() == 1) {  // a lone point shows as a dot
-        s += "<circle cx='" + F1(f.x(one.points[0].t_s)) + "' cy='" + F1(f.yv(one.points[0].value)) +
-             "' r='2.5' fill='" + (colour == c.colours.end() ? std::string(kPalette[0]) : colour->second) +
-             "'/>";
-      }
-    }
-  }
+  s += c.series->size() > kMaxLines ? EnvelopeSvg(f, *c.series, c.step) : SeriesLinesSvg(f, c);
   return s + "</svg>";
 }
 
@@ -155,56 +171,77 @@ std::string LabelColour(std::size_t i, std::size_t n) {
   return "hsl(" + F1(hue) + ",62%," + (i % 2 == 0 ? "48%" : "68%") + ")";
 }
 
-std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string* legend) {
-  std::vector<std::string> labels;
-  {
+// The distinct state labels of all lanes, sorted, each with its colour.
+class LaneLabels {
+ public:
+  explicit LaneLabels(const std::vector<Lane>& lanes) {
     std::set<std::string> seen;
     for (const Lane& l : lanes) {
       for (const StateSpan& sp : l.spans) seen.insert(sp.label);
     }
-    labels.assign(seen.begin(), seen.end());
+    labels_.assign(seen.begin(), seen.end());
   }
-  auto colour = [&](const std::string& label) {
-    const auto i = static_cast<std::size_t>(std::find(labels.begin(), labels.end(), label) - labels.begin());
-    return LabelColour(i, labels.size());
-  };
+  const std::vector<std::string>& labels() const { return labels_; }
+  std::string Colour(const std::string& label) const {
+    const auto i =
+        static_cast<std::size_t>(std::find(labels_.begin(), labels_.end(), label) - labels_.begin());
+    return LabelColour(i, labels_.size());
+  }
+
+ private:
+  std::vector<std::string> labels_;
+};
+
+// The time grid, its tick labels and the unit under the lanes, which end at `bottom`.
+std::string LaneTimeAxis(const Frame& f, double bottom) {
+  std::string s;
+  for (double v : f.t.Ticks()) {
+    s += "<line x1='" + F1(f.x(v)) + "' x2='" + F1(f.x(v)) + "' y1='" + F1(kTop) + "' y2='" + F1(bottom) +
+         "' class='grid'/><text x='" + F1(f.x(v)) + "' y='" + F1(bottom + 14) + "' text-anchor='middle'>" +
+         CsvNumber(v) + "</text>";
+  }
+  return s + "<text x='" + F1(kW - kRight) + "' y='" + F1(bottom + 27) +
+         "' text-anchor='end' class='unit'>simulated s</text>";
+}
+
+// One lane of height `row` at `y`: its name when the row is tall enough, a rectangle per span.
+std::string LaneRowSvg(const Frame& f, const Lane& lane, double y, double row, const LaneLabels& labels) {
+  std::string s;
+  if (row >= 9) {
+    s += "<text x='" + F1(kLeft - 5) + "' y='" + F1(y + row / 2 + 4) + "' text-anchor='end'>" +
+         HtmlEscape(lane.name) + "</text>";
+  }
+  for (const StateSpan& sp : lane.spans) {
+    const double x0 = f.x(sp.t0_s), x1 = f.x(std::max(sp.t1_s, sp.t0_s));
+    // Rows of 4 px or more keep a 1 px gap; thinner ones (many nodes) are solid.
+    s += "<rect x='" + F1(x0) + "' y='" + F1(y + (row >= 4 ? 0.5 : 0.0)) + "' width='" +
+         F1(std::max(0.8, x1 - x0)) + "' height='" + F1(row >= 4 ? row - 1 : row) + "' fill='" +
+         labels.Colour(sp.label) + "'><title>" + HtmlEscape(lane.name) + ": " + HtmlEscape(sp.label) + " " +
+         F3(sp.t0_s) + "-" + F3(sp.t1_s) + " s</title></rect>";
+  }
+  return s;
+}
+
+std::string LaneSvg(const std::vector<Lane>& lanes, double t_end_s, std::string* legend) {
+  const LaneLabels labels(lanes);
   const double rows_h = kH - kTop - kBottom;
   const double row =
       std::clamp(rows_h / static_cast<double>(std::max<std::size_t>(1, lanes.size())), 2.0, 18.0);
   const double height = kTop + kBottom + row * static_cast<double>(lanes.size());
   Frame f{TimeAxis(t_end_s), PlotAxis{}};
   std::string s = "<svg width='" + F1(kW) + "' height='" + F1(height) + "' class='ts'>";
-  const double bottom = kTop + row * static_cast<double>(lanes.size());
-  for (double v : f.t.Ticks()) {
-    s += "<line x1='" + F1(f.x(v)) + "' x2='" + F1(f.x(v)) + "' y1='" + F1(kTop) + "' y2='" + F1(bottom) +
-         "' class='grid'/><text x='" + F1(f.x(v)) + "' y='" + F1(bottom + 14) + "' text-anchor='middle'>" +
-         CsvNumber(v) + "</text>";
-  }
-  s += "<text x='" + F1(kW - kRight) + "' y='" + F1(bottom + 27) +
-       "' text-anchor='end' class='unit'>simulated s</text>";
+  s += LaneTimeAxis(f, kTop + row * static_cast<double>(lanes.size()));
   for (std::size_t i = 0; i < lanes.size(); ++i) {
-    const double y = kTop + row * static_cast<double>(i);
-    if (row >= 9) {
-      s += "<text x='" + F1(kLeft - 5) + "' y='" + F1(y + row / 2 + 4) + "' text-anchor='end'>" +
-           HtmlEscape(lanes[i].name) + "</text>";
-    }
-    for (const StateSpan& sp : lanes[i].spans) {
-      const double x0 = f.x(sp.t0_s), x1 = f.x(std::max(sp.t1_s, sp.t0_s));
-      // Rows of 4 px or more keep a 1 px gap; thinner ones (many nodes) are solid.
-      s += "<rect x='" + F1(x0) + "' y='" + F1(y + (row >= 4 ? 0.5 : 0.0)) + "' width='" +
-           F1(std::max(0.8, x1 - x0)) + "' height='" + F1(row >= 4 ? row - 1 : row) + "' fill='" +
-           colour(sp.label) + "'><title>" + HtmlEscape(lanes[i].name) + ": " + HtmlEscape(sp.label) + " " +
-           F3(sp.t0_s) + "-" + F3(sp.t1_s) + " s</title></rect>";
-    }
+    s += LaneRowSvg(f, lanes[i], kTop + row * static_cast<double>(i), row, labels);
   }
-  if (row < 9) {
+  if (row < 9) {  // rows too thin for names: the count instead
     s += "<text x='" + F1(kLeft - 5) + "' y='" + F1(kTop + 10) + "' text-anchor='end'>" +
          std::to_string(lanes.size()) + "</text><text x='" + F1(kLeft - 5) + "' y='" + F1(kTop + 22) +
          "' text-anchor='end'>nodes</text>";
   }
-  for (const std::string& label : labels) {
-    *legend +=
-        "<span class='key'><i style='background:" + colour(label) + "'></i>" + HtmlEscape(label) + "</span>";
+  for (const std::string& label : labels.labels()) {
+    *legend += "<span class='key'><i style='background:" + labels.Colour(label) + "'></i>" +
+               HtmlEscape(label) + "</span>";
   }
   return s + "</svg>";
 }
@@ -257,71 +294,103 @@ std::vector<EnvelopeBin> Envelope(const std::vector<Series>& series, double t_en
   return out;
 }
 
+namespace {
+
+// The y axes of the line panels.
+struct PanelAxes {
+  AxisKind from_zero;  // lengths, speeds, times
+  AxisKind rate;       // 0..1 fractions
+  AxisKind term;       // integers
+  AxisKind score;      // order is a mean cosine: -1..1; safety and union 0..1
+};
+
+PanelAxes MakePanelAxes() {
+  PanelAxes axes;
+  axes.from_zero.from_zero = true;
+  axes.rate = axes.from_zero;
+  axes.rate.max = 1.0;
+  axes.term.integer = true;
+  axes.score.from_zero = true;
+  axes.score.non_negative = false;
+  axes.score.max = 1.0;
+  return axes;
+}
+
+TrialPanel LinePanel(std::string caption, const LineChart& chart, double t_end_s, std::string missing) {
+  TrialPanel p;
+  p.caption = std::move(caption);
+  if (chart.series->empty()) {
+    p.missing = std::move(missing);
+  } else {
+    p.svg = LineSvg(chart, t_end_s);
+    if (chart.series->size() > kMaxLines) {
+      p.caption += " (" + std::to_string(chart.series->size()) + " series: min..max, median)";
+    }
+  }
+  return p;
+}
+
+TrialPanel LanePanel(std::string caption, const std::vector<Lane>& rows, double t_end_s,
+                     std::string missing) {
+  TrialPanel p;
+  p.caption = std::move(caption);
+  if (rows.empty()) {
+    p.missing = std::move(missing);
+  } else {
+    std::string legend;
+    p.svg = LaneSvg(rows, t_end_s, &legend);
+    p.svg += "<div class='legend'>" + legend + "</div>";
+  }
+  return p;
+}
+
+// The flocking panel's legend: one key per score in its colour.
+std::string FlockLegend(const std::vector<Series>& flock, const std::map<std::string, std::string>& colours) {
+  std::string legend;
+  for (const Series& one : flock) {
+    const auto colour = colours.find(one.name);
+    legend += "<span class='key'><i style='background:" + (colour == colours.end() ? "" : colour->second) +
+              "'></i>" + one.name + "</span>";
+  }
+  return "<div class='legend'>" + legend + "</div>";
+}
+
+// "flocking": order, safety and union in fixed colours, 0..1 (order down to -1), with a legend.
+TrialPanel FlockPanel(const TrialSeries& s, const AxisKind& score,
+                      const std::map<std::string, std::string>& colours) {
+  TrialPanel p = LinePanel("flocking: order, safety, union (the leader's member table)",
+                           {&s.flock, score, false, /*to_one=*/true, colours}, s.t_end_s,
+                           "no event=flock_metrics in the logs");
+  if (!s.flock.empty()) p.svg += FlockLegend(s.flock, colours);
+  return p;
+}
+
+}  // namespace
+
 std::vector<TrialPanel> TrialPanels(const TrialSeries& s) {
   const std::map<std::string, std::string> drones = DroneColours(s);
-  AxisKind from_zero;
-  from_zero.from_zero = true;
-  AxisKind rate = from_zero;
-  rate.max = 1.0;
-  AxisKind term;
-  term.integer = true;
-  AxisKind score;  // order is a mean cosine: -1..1; safety and union 0..1
-  score.from_zero = true;
-  score.non_negative = false;
-  score.max = 1.0;
-  std::map<std::string, std::string> flock_colours = {
+  const PanelAxes axes = MakePanelAxes();
+  const std::map<std::string, std::string> flock_colours = {
       {"order", kPalette[0]}, {"safety", kPalette[2]}, {"union", kPalette[4]}};
-
-  std::vector<TrialPanel> panels;
-  auto line = [&](std::string caption, const std::vector<Series>& series, AxisKind kind, bool step,
-                  std::string missing, const std::map<std::string, std::string>& colours,
-                  bool to_one = false) {
-    TrialPanel p;
-    p.caption = std::move(caption);
-    if (series.empty()) {
-      p.missing = std::move(missing);
-    } else {
-      LineChart c{&series, kind, step, to_one, colours};
-      p.svg = LineSvg(c, s.t_end_s);
-      if (series.size() > kMaxLines)
-        p.caption += " (" + std::to_string(series.size()) + " series: min..max, median)";
-    }
-    panels.push_back(std::move(p));
+  const double t = s.t_end_s;
+  const std::string no_truth = "no truth.csv";
+  const std::string no_leader = "no event=leader_elected in the logs";
+  return {
+      LinePanel("altitude [m]", {&s.altitude_m, axes.from_zero, false, false, drones}, t, no_truth),
+      LinePanel("speed [m/s]", {&s.speed_m_s, axes.from_zero, false, false, drones}, t, no_truth),
+      LinePanel("nearest neighbour [m]", {&s.nearest_m, axes.from_zero, false, false, drones}, t,
+                "no truth.csv with two drones or more"),
+      LinePanel("radio loss per node", {&s.radio_loss, axes.rate, false, false, drones}, t,
+                "no event=link in the logs"),
+      LinePanel("radio RTT [ms]", {&s.radio_rtt_ms, axes.from_zero, false, false, drones}, t,
+                "no event=link with an answered ping in the logs"),
+      LinePanel("Raft term", {&s.raft_term, axes.term, /*step=*/true, false, drones}, t, no_leader),
+      LanePanel("Raft leader each node followed", s.raft_leader, t, no_leader),
+      LinePanel("battery [fraction]", {&s.battery, axes.rate, false, false, drones}, t,
+                "no event=battery in the logs"),
+      LanePanel("mission stage", s.mission_stage, t, "no event=mission_stage in the logs"),
+      FlockPanel(s, axes.score, flock_colours),
   };
-  auto band = [&](std::string caption, const std::vector<Lane>& rows, std::string missing) {
-    TrialPanel p;
-    p.caption = std::move(caption);
-    if (rows.empty()) {
-      p.missing = std::move(missing);
-    } else {
-      std::string legend;
-      p.svg = LaneSvg(rows, s.t_end_s, &legend);
-      p.svg += "<div class='legend'>" + legend + "</div>";
-    }
-    panels.push_back(std::move(p));
-  };
-  line("altitude [m]", s.altitude_m, from_zero, false, "no truth.csv", drones);
-  line("speed [m/s]", s.speed_m_s, from_zero, false, "no truth.csv", drones);
-  line("nearest neighbour [m]", s.nearest_m, from_zero, false, "no truth.csv with two drones or more",
-       drones);
-  line("radio loss per node", s.radio_loss, rate, false, "no event=link in the logs", drones);
-  line("radio RTT [ms]", s.radio_rtt_ms, from_zero, false, "no event=link with an answered ping in the logs",
-       drones);
-  line("Raft term", s.raft_term, term, true, "no event=leader_elected in the logs", drones);
-  band("Raft leader each node followed", s.raft_leader, "no event=leader_elected in the logs");
-  line("battery [fraction]", s.battery, rate, false, "no event=battery in the logs", drones);
-  band("mission stage", s.mission_stage, "no event=mission_stage in the logs");
-  line("flocking: order, safety, union (the leader's member table)", s.flock, score, false,
-       "no event=flock_metrics in the logs", flock_colours, /*to_one=*/true);
-  if (!s.flock.empty()) {
-    std::string legend;
-    for (const Series& one : s.flock) {
-      legend += "<span class='key'><i style='background:" + flock_colours[one.name] + "'></i>" + one.name +
-                "</span>";
-    }
-    panels.back().svg += "<div class='legend'>" + legend + "</div>";
-  }
-  return panels;
 }
 
 std::string TrialPlotsHtml(const TrialPlotsPage& page, const TrialSeries& s) {

@@ -54,58 +54,93 @@ std::vector<std::string> StringsAt(const Node& doc, std::string_view key) {
 
 }  // namespace
 
+namespace {
+
+// Where truth.csv's columns are; the velocity columns are optional (older recordings lack them).
+struct TruthColumns {
+  int t = -1, drone = -1, x = -1, y = -1, z = -1;
+  int vx = -1, vy = -1, vz = -1;
+  bool velocity = false;
+  std::size_t need = 0;    // a row needs more cells than this
+  std::size_t need_v = 0;  // ... and more than this for its velocity
+};
+
+// Splits `line` at every ',' into `cells` (views into line).
+void SplitCells(std::string_view line, std::vector<std::string_view>& cells) {
+  cells.clear();
+  while (true) {
+    const std::size_t comma = line.find(',');
+    cells.push_back(line.substr(0, comma));
+    if (comma == std::string_view::npos) return;
+    line.remove_prefix(comma + 1);
+  }
+}
+
+// The columns by name in the header line; nullopt without time, drone and position.
+std::optional<TruthColumns> FindTruthColumns(const std::string& line) {
+  std::vector<std::string> header;
+  std::stringstream ss(line);
+  std::string cell;
+  while (std::getline(ss, cell, ',')) header.push_back(cell);
+  auto col = [&](std::string_view name) -> int {
+    auto it = std::find(header.begin(), header.end(), name);
+    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
+  };
+  TruthColumns c;
+  c.t = col("t_s");
+  c.drone = col("drone");
+  c.x = col("x_m");
+  c.y = col("y_m");
+  c.z = col("z_m");
+  c.vx = col("vx_m_s");
+  c.vy = col("vy_m_s");
+  c.vz = col("vz_m_s");
+  if (c.t < 0 || c.drone < 0 || c.x < 0 || c.y < 0 || c.z < 0) return std::nullopt;
+  c.velocity = c.vx >= 0 && c.vy >= 0 && c.vz >= 0;
+  c.need = static_cast<std::size_t>(std::max({c.t, c.drone, c.x, c.y, c.z}));
+  c.need_v = static_cast<std::size_t>(std::max({c.vx, c.vy, c.vz}));
+  return c;
+}
+
+// Fills `row` from one line's cells; false for a short or unparsable row (skipped). The
+// velocity is kept only when all three of its cells parse.
+bool ParseTruthRow(const std::vector<std::string_view>& cells, const TruthColumns& c, TruthRow& row) {
+  if (cells.size() <= c.need) return false;
+  auto num = [&](int i) { return yaml::ScalarAsDouble(cells[static_cast<std::size_t>(i)]); };
+  auto t = num(c.t), x = num(c.x), y = num(c.y), z = num(c.z);
+  if (!t || !x || !y || !z) return false;
+  row.t_s = *t;
+  row.drone.assign(cells[static_cast<std::size_t>(c.drone)]);
+  row.x_m = *x;
+  row.y_m = *y;
+  row.z_m = *z;
+  row.has_velocity = false;
+  if (c.velocity && cells.size() > c.need_v) {
+    auto vx = num(c.vx), vy = num(c.vy), vz = num(c.vz);
+    if (vx && vy && vz) {
+      row.vx_m_s = *vx;
+      row.vy_m_s = *vy;
+      row.vz_m_s = *vz;
+      row.has_velocity = true;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 bool ReadTruthCsv(const std::string& path, const std::function<void(const TruthRow&)>& on_row) {
   std::ifstream in(path);
   if (!in) return false;
   std::string line;
   if (!std::getline(in, line)) return false;
-  std::vector<std::string> header;
-  {
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) header.push_back(cell);
-  }
-  auto col = [&](std::string_view name) -> int {
-    auto it = std::find(header.begin(), header.end(), name);
-    return it == header.end() ? -1 : static_cast<int>(it - header.begin());
-  };
-  const int ct = col("t_s"), cd = col("drone"), cx = col("x_m"), cy = col("y_m"), cz = col("z_m");
-  const int cvx = col("vx_m_s"), cvy = col("vy_m_s"), cvz = col("vz_m_s");
-  if (ct < 0 || cd < 0 || cx < 0 || cy < 0 || cz < 0) return false;
-  const bool velocity = cvx >= 0 && cvy >= 0 && cvz >= 0;
-  const auto need = static_cast<std::size_t>(std::max({ct, cd, cx, cy, cz}));
-  const auto need_v = static_cast<std::size_t>(std::max({cvx, cvy, cvz}));
+  const std::optional<TruthColumns> columns = FindTruthColumns(line);
+  if (!columns) return false;
   std::vector<std::string_view> cells;
   TruthRow row;
   while (std::getline(in, line)) {
-    cells.clear();
-    std::string_view rest(line);
-    while (true) {
-      const std::size_t comma = rest.find(',');
-      cells.push_back(rest.substr(0, comma));
-      if (comma == std::string_view::npos) break;
-      rest.remove_prefix(comma + 1);
-    }
-    if (cells.size() <= need) continue;
-    auto num = [&](int c) { return yaml::ScalarAsDouble(cells[static_cast<std::size_t>(c)]); };
-    auto t = num(ct), x = num(cx), y = num(cy), z = num(cz);
-    if (!t || !x || !y || !z) continue;
-    row.t_s = *t;
-    row.drone.assign(cells[static_cast<std::size_t>(cd)]);
-    row.x_m = *x;
-    row.y_m = *y;
-    row.z_m = *z;
-    row.has_velocity = false;
-    if (velocity && cells.size() > need_v) {
-      auto vx = num(cvx), vy = num(cvy), vz = num(cvz);
-      if (vx && vy && vz) {
-        row.vx_m_s = *vx;
-        row.vy_m_s = *vy;
-        row.vz_m_s = *vz;
-        row.has_velocity = true;
-      }
-    }
-    on_row(row);
+    SplitCells(line, cells);
+    if (ParseTruthRow(cells, *columns, row)) on_row(row);
   }
   return true;
 }
@@ -140,16 +175,72 @@ Result<TrialMeta> ParseTrialMetaJson(std::string_view text, std::string_view whe
   return m;
 }
 
-std::optional<MetricValues> ReadTrialMetrics(const std::string& dir_text) {
-  const fs::path dir(dir_text);
-  TrialMetrics metrics;
+namespace {
+
+// The folder's logs/*.log, sorted by path.
+std::vector<fs::path> SortedLogs(const fs::path& dir) {
   std::error_code ec;
   std::vector<fs::path> logs;
   for (const auto& e : fs::directory_iterator(dir / "logs", ec)) {
     if (e.path().extension() == ".log") logs.push_back(e.path());
   }
-  if (logs.empty()) return std::nullopt;
   std::sort(logs.begin(), logs.end());
+  return logs;
+}
+
+// One record of events.jsonl: a process fault applied (its targets are lost from then on), or
+// an orchestrator/fault component's event.
+void OnEventsRecord(const Node& j, TrialMetrics& metrics) {
+  if (StringAt(j, "type") == "fault") {
+    // A process fault's record (faults/fault_event.hpp).
+    const std::string kind = StringAt(j, "kind");
+    const bool process = kind == "kill" || kind == "stop" || kind == "pause" || kind == "restart";
+    if (StringAt(j, "phase") != "applied" || !process) return;
+    for (const std::string& target : StringsAt(j, "targets")) {
+      metrics.OnOrchestratorEvent(kind + "_fault", target, NumberAt(j, "t_sim_s"));
+    }
+    return;
+  }
+  const std::string component = StringAt(j, "component");
+  if (component != "orchestrator" && component.find("fault") == std::string::npos) return;
+  std::optional<double> t = NumberAt(j, "t");
+  if (!t) t = NumberAt(j, "sim_s");
+  metrics.OnOrchestratorEvent(StringAt(j, "event"), StringAt(j, "target"), t);
+}
+
+void ReadOrchestratorEvents(const fs::path& dir, TrialMetrics& metrics) {
+  std::ifstream in(dir / "events.jsonl");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.find("\"orchestrator\"") == std::string::npos && line.find("fault") == std::string::npos) {
+      continue;  // agent/physics events are read from logs/
+    }
+    auto j = yaml::Parse(line, "events.jsonl");
+    if (j && j->is_mapping()) OnEventsRecord(*j, metrics);
+  }
+}
+
+// The world's victims (the runner writes the trial's world, generated or given, as world.yaml).
+void ReadWorldVictims(const fs::path& dir, TrialMetrics& metrics) {
+  auto world_text = ReadText(dir / "world.yaml");
+  if (!world_text) return;
+  auto world = yaml::Parse(*world_text, (dir / "world.yaml").string());
+  if (!world || !world->is_mapping()) return;
+  const yaml::Node* victims = world->Find("victims");
+  if (victims == nullptr || !victims->is_sequence()) return;
+  for (const yaml::Node& v : victims->items()) {
+    const std::optional<double> x = NumberAt(v, "x_m"), y = NumberAt(v, "y_m");
+    if (x && y) metrics.OnWorldVictim(*x, *y);
+  }
+}
+
+}  // namespace
+
+std::optional<MetricValues> ReadTrialMetrics(const std::string& dir_text) {
+  const fs::path dir(dir_text);
+  TrialMetrics metrics;
+  const std::vector<fs::path> logs = SortedLogs(dir);
+  if (logs.empty()) return std::nullopt;
   for (const fs::path& log : logs) {
     const std::string component = log.stem().string();
     if (component == "physics") metrics.SawPhysicsLog();
@@ -157,50 +248,44 @@ std::optional<MetricValues> ReadTrialMetrics(const std::string& dir_text) {
     std::string line;
     while (std::getline(in, line)) metrics.OnLogEvent(component, ParseLogfmt(line));
   }
-  {
-    std::ifstream in(dir / "events.jsonl");
-    std::string line;
-    while (std::getline(in, line)) {
-      if (line.find("\"orchestrator\"") == std::string::npos &&
-          line.find("fault") == std::string::npos) {
-        continue;  // agent/physics events are read from logs/
-      }
-      auto j = yaml::Parse(line, "events.jsonl");
-      if (!j || !j->is_mapping()) continue;
-      if (StringAt(*j, "type") == "fault") {
-        // A process fault's record (faults/fault_event.hpp): its targets are lost from the time
-        // it was applied.
-        const std::string kind = StringAt(*j, "kind");
-        const bool process = kind == "kill" || kind == "stop" || kind == "pause" || kind == "restart";
-        if (StringAt(*j, "phase") != "applied" || !process) continue;
-        for (const std::string& target : StringsAt(*j, "targets")) {
-          metrics.OnOrchestratorEvent(kind + "_fault", target, NumberAt(*j, "t_sim_s"));
-        }
-        continue;
-      }
-      const std::string component = StringAt(*j, "component");
-      if (component != "orchestrator" && component.find("fault") == std::string::npos) continue;
-      std::optional<double> t = NumberAt(*j, "t");
-      if (!t) t = NumberAt(*j, "sim_s");
-      metrics.OnOrchestratorEvent(StringAt(*j, "event"), StringAt(*j, "target"), t);
-    }
-  }
+  ReadOrchestratorEvents(dir, metrics);
   ReadTruthCsv((dir / "truth.csv").string(), [&](const TruthRow& r) {
     metrics.OnTruth(r.t_s, r.drone, r.x_m, r.y_m, r.z_m);
   });
-  // The world's victims (the runner writes the trial's world, generated or given, as world.yaml).
-  if (auto world_text = ReadText(dir / "world.yaml")) {
-    if (auto world = yaml::Parse(*world_text, (dir / "world.yaml").string()); world && world->is_mapping()) {
-      if (const yaml::Node* victims = world->Find("victims"); victims != nullptr && victims->is_sequence()) {
-        for (const yaml::Node& v : victims->items()) {
-          const std::optional<double> x = NumberAt(v, "x_m"), y = NumberAt(v, "y_m");
-          if (x && y) metrics.OnWorldVictim(*x, *y);
-        }
-      }
-    }
-  }
+  ReadWorldVictims(dir, metrics);
   return metrics.Values();
 }
+
+namespace {
+
+// trial_meta.json when the experiment runner wrote one; else (a plain `swarmbox run` folder)
+// what result.json says.
+Status ReadTrialMeta(const fs::path& dir, const Node& result, TrialRecord& rec) {
+  auto meta_text = ReadText(dir / "trial_meta.json");
+  if (!meta_text) {
+    rec.meta.id = StringAt(result, "trial_id").empty() ? rec.folder : StringAt(result, "trial_id");
+    rec.meta.seed = static_cast<std::uint64_t>(NumberAt(result, "seed").value_or(0));
+    return Ok{};
+  }
+  auto meta = ParseTrialMetaJson(*meta_text, (dir / "trial_meta.json").string());
+  if (!meta) return meta.error();
+  rec.meta = std::move(*meta);
+  return Ok{};
+}
+
+// The metrics from logs/; with logs/ pruned, what the runner computed with the same definitions
+// when it wrote result.json.
+MetricValues ReadOrStoredMetrics(const fs::path& dir, const Node& result) {
+  if (auto metrics = ReadTrialMetrics(dir.string())) return std::move(*metrics);
+  MetricValues values;
+  for (const std::string& name : MetricNames()) values[name] = std::nullopt;
+  if (const Node* stored = result.Find("metrics"); stored != nullptr && stored->is_mapping()) {
+    for (const std::string& name : MetricNames()) values[name] = NumberAt(*stored, name);
+  }
+  return values;
+}
+
+}  // namespace
 
 Result<TrialRecord> ReadTrialFolder(const std::string& dir_text) {
   const fs::path dir(dir_text);
@@ -218,25 +303,8 @@ Result<TrialRecord> ReadTrialFolder(const std::string& dir_text) {
   rec.host = StringAt(*result, "host");
   rec.wall_s = NumberAt(*result, "wall_s");
   rec.sim_s = NumberAt(*result, "sim_s");
-  if (auto meta_text = ReadText(dir / "trial_meta.json")) {
-    auto meta = ParseTrialMetaJson(*meta_text, (dir / "trial_meta.json").string());
-    if (!meta) return meta.error();
-    rec.meta = std::move(*meta);
-  } else {
-    // A plain `swarmbox run` folder: what result.json says.
-    rec.meta.id = StringAt(*result, "trial_id").empty() ? rec.folder : StringAt(*result, "trial_id");
-    rec.meta.seed = static_cast<std::uint64_t>(NumberAt(*result, "seed").value_or(0));
-  }
-
-  if (auto metrics = ReadTrialMetrics(dir.string())) {
-    rec.metrics = std::move(*metrics);
-  } else {
-    // logs/ pruned: what the runner computed with the same definitions when it wrote result.json.
-    for (const std::string& name : MetricNames()) rec.metrics[name] = std::nullopt;
-    if (const Node* stored = result->Find("metrics"); stored != nullptr && stored->is_mapping()) {
-      for (const std::string& name : MetricNames()) rec.metrics[name] = NumberAt(*stored, name);
-    }
-  }
+  SWARMBOX_TRY(ReadTrialMeta(dir, *result, rec));
+  rec.metrics = ReadOrStoredMetrics(dir, *result);
   if (const Node* p = result->Find("provenance"); p != nullptr) rec.provenance = ParseProvenance(*p);
   std::error_code ec;
   rec.has_trajectories = fs::exists(dir / "trajectories.png", ec);
@@ -248,13 +316,7 @@ TrialSeries ReadTrialSeries(const std::string& dir_text, bool* found) {
   const fs::path dir(dir_text);
   TrialSeriesBuilder builder;
   bool any = false;
-  std::error_code ec;
-  std::vector<fs::path> logs;
-  for (const auto& e : fs::directory_iterator(dir / "logs", ec)) {
-    if (e.path().extension() == ".log") logs.push_back(e.path());
-  }
-  std::sort(logs.begin(), logs.end());
-  for (const fs::path& log : logs) {
+  for (const fs::path& log : SortedLogs(dir)) {
     const std::string component = log.stem().string();
     std::ifstream in(log);
     std::string line;

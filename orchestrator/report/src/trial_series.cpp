@@ -75,26 +75,7 @@ void TrialSeriesBuilder::OnLogEvent(std::string_view component, const LogfmtFiel
   const std::string node = FindField(fields, "node").value_or(std::string(component));
   const std::string& e = *event;
   if (e == "link") {
-    LinkBurst& burst = link_[node];
-    if (burst.t_s != *t) {
-      FlushLink(node, burst);
-      burst = LinkBurst{};
-      burst.t_s = *t;
-    }
-    const auto sent = Number(fields, "sent");
-    const auto received = Number(fields, "received");
-    if (sent && received) {
-      burst.sent += *sent;
-      burst.received += *received;
-    } else if (auto loss = Number(fields, "loss")) {
-      burst.loss_sum += *loss;
-      burst.loss_n += 1;
-    }
-    const auto rtt = Number(fields, "rtt_ms_mean");
-    if (rtt && received && *received > 0) {
-      burst.rtt_sum += *rtt * *received;
-      burst.rtt_w += *received;
-    }
+    OnLinkEvent(node, *t, fields);
   } else if (e == "leader_elected") {
     if (auto term = Number(fields, "term")) Add(term_, node, *t, *term);
     if (auto leader = FindField(fields, "leader")) Enter(leader_, node, *t, *leader);
@@ -109,6 +90,29 @@ void TrialSeriesBuilder::OnLogEvent(std::string_view component, const LogfmtFiel
     for (const char* key : {"order", "safety", "union"}) {
       if (auto v = Number(fields, key)) Add(flock_, key, *t, *v);
     }
+  }
+}
+
+void TrialSeriesBuilder::OnLinkEvent(const std::string& node, double t_s, const LogfmtFields& fields) {
+  LinkBurst& burst = link_[node];
+  if (burst.t_s != t_s) {
+    FlushLink(node, burst);
+    burst = LinkBurst{};
+    burst.t_s = t_s;
+  }
+  const auto sent = Number(fields, "sent");
+  const auto received = Number(fields, "received");
+  if (sent && received) {
+    burst.sent += *sent;
+    burst.received += *received;
+  } else if (auto loss = Number(fields, "loss")) {
+    burst.loss_sum += *loss;
+    burst.loss_n += 1;
+  }
+  const auto rtt = Number(fields, "rtt_ms_mean");
+  if (rtt && received && *received > 0) {
+    burst.rtt_sum += *rtt * *received;
+    burst.rtt_w += *received;
   }
 }
 

@@ -313,24 +313,7 @@ Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record)
     return RunOnSidecars(plan->apply, /*run_all=*/false);
   }
   if (const auto* process = std::get_if<faults::ProcessFault>(&f.action)) {
-    std::vector<std::string> containers;
-    for (const std::string& d : targets) {
-      auto c = config_.agents.find(d);
-      if (c == config_.agents.end()) return Error(ErrorCode::kInternal, "no container for drone " + d);
-      containers.push_back(c->second);
-    }
-    faults::ProcessPlan plan = faults::PlanProcessFault(*process, containers, f.duration_ms.has_value());
-    const bool takes_down = process->action != faults::ProcessAction::kPause;
-    if (takes_down) disrupted_.insert(targets.begin(), targets.end());
-    processes_[index] = plan;
-    Status s = faults::ExecuteDockerActions(api_, plan.apply);
-    if (process->action == faults::ProcessAction::kRestart) {
-      for (const std::string& d : targets) {
-        disrupted_.erase(d);
-        resumed_.push_back(d);
-      }
-    }
-    return s;
+    return ApplyProcessFault(index, *process, targets);
   }
   if (faults::IsPhysicsFault(f)) {
     faults::PhysicsPlan plan = faults::PlanPhysicsFault(f, targets);
@@ -340,6 +323,31 @@ Status FaultInjector::Apply(std::size_t index, faults::FaultEventRecord* record)
   return Error(ErrorCode::kInvalidArgument,
                "fault " + f.id + " (" + std::string(f.kind()) + ") cannot be carried out by the runner",
                f.mark.ToString());
+}
+
+Status FaultInjector::ApplyProcessFault(std::size_t index, const faults::ProcessFault& process,
+                                        const std::vector<std::string>& targets) {
+  std::vector<std::string> containers;
+  for (const std::string& d : targets) {
+    auto c = config_.agents.find(d);
+    if (c == config_.agents.end()) return Error(ErrorCode::kInternal, "no container for drone " + d);
+    containers.push_back(c->second);
+  }
+  const bool has_duration = timeline_.faults()[index].duration_ms.has_value();
+  faults::ProcessPlan plan = faults::PlanProcessFault(process, containers, has_duration);
+  const bool takes_down = process.action != faults::ProcessAction::kPause;
+  if (takes_down) disrupted_.insert(targets.begin(), targets.end());
+  processes_[index] = plan;
+  Status s = faults::ExecuteDockerActions(api_, plan.apply);
+  if (process.action == faults::ProcessAction::kRestart) {
+    for (const std::string& d : targets) MarkResumed(d);
+  }
+  return s;
+}
+
+void FaultInjector::MarkResumed(const std::string& drone) {
+  disrupted_.erase(drone);
+  resumed_.push_back(drone);
 }
 
 Status FaultInjector::Remove(std::size_t index, faults::FaultEventRecord* record, bool trial_end) {
@@ -397,10 +405,7 @@ Status FaultInjector::RemoveProcessFault(std::size_t index, faults::FaultEventRe
   bool started = false;
   for (const auto& a : undo) started = started || a.kind == faults::DockerAction::Kind::kStart;
   if (started && s) {
-    for (const std::string& d : record->targets) {
-      disrupted_.erase(d);
-      resumed_.push_back(d);
-    }
+    for (const std::string& d : record->targets) MarkResumed(d);
   }
   processes_.erase(it);
   return s;
@@ -437,28 +442,13 @@ std::optional<Verdict> FaultInjector::Carry(const std::vector<TimelineAction>& a
     } else if (auto t = targets_.find(action.fault); t != targets_.end()) {
       record.targets = t->second;
     }
-    if (events_) events_(faults::FaultEventJson(f, record));
+    Emit(f, record);
     if (s) {
-      const double requested_wall_s = record.wall_s;
-      const double requested_sim_s = record.t_sim_s;
       s = apply ? Apply(action.fault, &record) : Remove(action.fault, &record, trial_end);
-      const faults::FaultEventRecord done = Record(apply ? FaultPhase::kApplied : FaultPhase::kRemoved);
-      record.phase = done.phase;
-      record.t_sim_s = done.t_sim_s;
-      record.wall_s = done.wall_s;
-      record.requested_t_sim_s = requested_sim_s;
-      record.requested_wall_s = requested_wall_s;
+      record = Confirmed(std::move(record), apply ? FaultPhase::kApplied : FaultPhase::kRemoved);
     }
-    if (!s) {
-      record.phase = FaultPhase::kFailed;
-      record.error = s.error().ToString();
-      if (!failure) {
-        failure = Verdict::Err("fault " + f.id + " (" + std::string(f.kind()) + ") could not be " +
-                                   (apply ? "applied" : "removed") + ": " + s.error().ToString(),
-                               "faults");
-      }
-    }
-    if (events_) events_(faults::FaultEventJson(f, record));
+    auto verdict = Conclude(f, std::move(record), s, apply ? "applied" : "removed");
+    if (verdict && !failure) failure = std::move(verdict);
   }
   return failure;
 }
@@ -470,10 +460,7 @@ std::optional<Verdict> FaultInjector::OnPlannedEvent(const std::string& line) {
     return std::nullopt;
   }
   const std::string name = FindField(fields, "fault").value_or("");
-  const faults::Fault* fault = nullptr;
-  for (const faults::Fault& f : config_.planned) {
-    if (f.id == name) fault = &f;
-  }
+  const faults::Fault* fault = PlannedFault(name);
   if (fault == nullptr) {
     return Verdict::Err("the physics server reported fault '" + name + "', which is not in the radio plan: " + line,
                         "faults");
@@ -489,11 +476,23 @@ std::optional<Verdict> FaultInjector::OnPlannedEvent(const std::string& line) {
     record.t_sim_s = t_sim_s;
     record.mechanism = "physics";
     record.error = "skipped by the physics server: " + FindField(fields, "reason").value_or("no reason given");
-    if (events_) events_(faults::FaultEventJson(*fault, record));
+    Emit(*fault, record);
     return std::nullopt;
   }
-  // radio_fault: the channel carried it out in the physics server; recorded as it happened.
-  const std::string state = FindField(fields, "state").value_or("");
+  return RecordChannelFault(*fault, FindField(fields, "state").value_or(""), line, t_sim_s);
+}
+
+const faults::Fault* FaultInjector::PlannedFault(const std::string& id) const {
+  const faults::Fault* fault = nullptr;
+  for (const faults::Fault& f : config_.planned) {
+    if (f.id == id) fault = &f;
+  }
+  return fault;
+}
+
+// radio_fault: the channel carried it out in the physics server; recorded as it happened.
+std::optional<Verdict> FaultInjector::RecordChannelFault(const faults::Fault& fault, const std::string& state,
+                                                         const std::string& line, double t_sim_s) {
   if (state != "on" && state != "off") {
     return Verdict::Err("the physics server reported a radio fault with state '" + state + "': " + line, "faults");
   }
@@ -502,66 +501,97 @@ std::optional<Verdict> FaultInjector::OnPlannedEvent(const std::string& line) {
   record.requested_t_sim_s = t_sim_s;
   record.requested_wall_s = record.wall_s;
   record.mechanism = "channel";
-  if (events_) events_(faults::FaultEventJson(*fault, record));
+  Emit(fault, record);
   return std::nullopt;
 }
 
-std::optional<Verdict> FaultInjector::DroneOut(const faults::Fault& fault, const std::string& drone,
-                                               double t_sim_s) {
-  const auto* process = std::get_if<faults::ProcessFault>(&fault.action);
-  auto container = config_.agents.find(drone);
-  faults::FaultEventRecord record = Record(FaultPhase::kRequested);
+namespace {
+
+// The docker actions that take an agent's container out for a planned process fault (the server's
+// mode says how it keeps the drone out: a kill with a duration is its `restart`; the fault says
+// what happens to the container), and the one that brings it back.
+struct DroneOutActions {
+  std::vector<faults::DockerAction> apply;
+  std::vector<faults::DockerAction> undo;
+};
+
+DroneOutActions PlanDroneOut(const faults::ProcessFault& process, const std::string& container) {
+  using Kind = faults::DockerAction::Kind;
+  DroneOutActions actions;
+  switch (process.action) {
+    case faults::ProcessAction::kKill: actions.apply = {{Kind::kKill, container, process.signal, 0}}; break;
+    case faults::ProcessAction::kStop:
+    case faults::ProcessAction::kRestart: actions.apply = {{Kind::kStop, container, "", process.timeout_s}}; break;
+    case faults::ProcessAction::kPause: actions.apply = {{Kind::kPause, container, "", 0}}; break;
+  }
+  const bool paused = process.action == faults::ProcessAction::kPause;
+  actions.undo = {{paused ? Kind::kUnpause : Kind::kStart, container, "", 0}};
+  return actions;
+}
+
+}  // namespace
+
+void FaultInjector::Emit(const faults::Fault& fault, const faults::FaultEventRecord& record) const {
+  if (events_) events_(faults::FaultEventJson(fault, record));
+}
+
+faults::FaultEventRecord FaultInjector::DroneRecord(FaultPhase phase, const std::string& drone, double t_sim_s) const {
+  faults::FaultEventRecord record = Record(phase);
   record.t_sim_s = t_sim_s;
   record.targets = {drone};
   record.mechanism = "docker";
-  std::string error;
-  if (process == nullptr) {
-    error = "the physics server took " + drone + " out for fault " + fault.id + ", which is a " +
-            std::string(fault.kind()) + " fault, not a process fault";
-  } else if (container == config_.agents.end()) {
-    error = "the physics server took out '" + drone + "', which is not a drone of this trial";
-  }
-  // The fault's own action: the server's mode says how it keeps the drone out (a kill with a
-  // duration is its `restart`), the fault what happens to the container.
-  const faults::ProcessAction action = process != nullptr ? process->action : faults::ProcessAction::kKill;
-  Status s = Ok{};
-  if (error.empty()) {
-    if (events_) events_(faults::FaultEventJson(fault, record));
-    using Kind = faults::DockerAction::Kind;
-    const std::string& c = container->second;
-    Out out{&fault, {}};
-    std::vector<faults::DockerAction> apply;
-    switch (action) {
-      case faults::ProcessAction::kKill: apply = {{Kind::kKill, c, process->signal, 0}}; break;
-      case faults::ProcessAction::kStop:
-      case faults::ProcessAction::kRestart: apply = {{Kind::kStop, c, "", process->timeout_s}}; break;
-      case faults::ProcessAction::kPause: apply = {{Kind::kPause, c, "", 0}}; break;
-    }
-    out.undo = {{action == faults::ProcessAction::kPause ? Kind::kUnpause : Kind::kStart, c, "", 0}};
-    if (action != faults::ProcessAction::kPause) disrupted_.insert(drone);
-    out_[drone] = out;  // stored first: a half-done action is undone too
-    s = faults::ExecuteDockerActions(api_, apply);
-    const double requested_wall_s = record.wall_s;
-    record = Record(FaultPhase::kApplied);
-    record.t_sim_s = t_sim_s;  // out of the lockstep at exactly this time; the container followed
-    record.targets = {drone};
-    record.mechanism = "docker";
-    record.requested_t_sim_s = t_sim_s;
-    record.requested_wall_s = requested_wall_s;
-  } else {
-    s = Error(ErrorCode::kInvalidArgument, error);
-  }
+  return record;
+}
+
+faults::FaultEventRecord FaultInjector::Confirmed(faults::FaultEventRecord requested, FaultPhase phase) const {
+  const faults::FaultEventRecord done = Record(phase);
+  requested.requested_t_sim_s = requested.t_sim_s;
+  requested.requested_wall_s = requested.wall_s;
+  requested.phase = done.phase;
+  requested.t_sim_s = done.t_sim_s;
+  requested.wall_s = done.wall_s;
+  return requested;
+}
+
+std::optional<Verdict> FaultInjector::Conclude(const faults::Fault& fault, faults::FaultEventRecord record,
+                                               const Status& s, std::string_view done) const {
   if (!s) {
     record.phase = FaultPhase::kFailed;
     record.error = s.error().ToString();
   }
-  if (events_) events_(faults::FaultEventJson(fault, record));
-  if (!s) {
-    return Verdict::Err("fault " + fault.id + " (" + std::string(fault.kind()) + ") could not be applied: " +
-                            s.error().ToString(),
-                        "faults");
+  Emit(fault, record);
+  if (s) return std::nullopt;
+  return Verdict::Err("fault " + fault.id + " (" + std::string(fault.kind()) + ") could not be " + std::string(done) +
+                          ": " + s.error().ToString(),
+                      "faults");
+}
+
+std::string FaultInjector::DroneOutRefusal(const faults::Fault& fault, const std::string& drone) const {
+  if (!std::holds_alternative<faults::ProcessFault>(fault.action)) {
+    return "the physics server took " + drone + " out for fault " + fault.id + ", which is a " +
+           std::string(fault.kind()) + " fault, not a process fault";
   }
-  return std::nullopt;
+  if (config_.agents.count(drone) == 0) {
+    return "the physics server took out '" + drone + "', which is not a drone of this trial";
+  }
+  return "";
+}
+
+std::optional<Verdict> FaultInjector::DroneOut(const faults::Fault& fault, const std::string& drone,
+                                               double t_sim_s) {
+  faults::FaultEventRecord record = DroneRecord(FaultPhase::kRequested, drone, t_sim_s);
+  if (const std::string refusal = DroneOutRefusal(fault, drone); !refusal.empty()) {
+    return Conclude(fault, std::move(record), Error(ErrorCode::kInvalidArgument, refusal), "applied");
+  }
+  Emit(fault, record);
+  const auto& process = std::get<faults::ProcessFault>(fault.action);
+  DroneOutActions actions = PlanDroneOut(process, config_.agents.at(drone));
+  if (process.action != faults::ProcessAction::kPause) disrupted_.insert(drone);
+  out_[drone] = Out{&fault, std::move(actions.undo)};  // stored first: a half-done action is undone too
+  const Status s = faults::ExecuteDockerActions(api_, actions.apply);
+  record = Confirmed(std::move(record), FaultPhase::kApplied);
+  record.t_sim_s = t_sim_s;  // out of the lockstep at exactly this time; the container followed
+  return Conclude(fault, std::move(record), s, "applied");
 }
 
 std::optional<Verdict> FaultInjector::DroneBack(std::string drone, double t_sim_s, bool trial_end) {
@@ -572,38 +602,17 @@ std::optional<Verdict> FaultInjector::DroneBack(std::string drone, double t_sim_
   const Out out = it->second;
   out_.erase(it);
   const faults::Fault& fault = *out.fault;
-  faults::FaultEventRecord record = Record(FaultPhase::kRemoveRequested);
-  record.t_sim_s = t_sim_s;
-  record.targets = {drone};
-  record.mechanism = "docker";
-  if (events_) events_(faults::FaultEventJson(fault, record));
+  faults::FaultEventRecord record = DroneRecord(FaultPhase::kRemoveRequested, drone, t_sim_s);
+  Emit(fault, record);
   const bool paused = !out.undo.empty() && out.undo.front().kind == faults::DockerAction::Kind::kUnpause;
   Status s = Ok{};
   // At the trial's end only a paused agent is brought back (so it can stop); the others stay down.
   if (!trial_end || paused) s = faults::ExecuteDockerActions(api_, out.undo);
-  const double requested_wall_s = record.wall_s;
-  record = Record(FaultPhase::kRemoved);
+  record = Confirmed(std::move(record), FaultPhase::kRemoved);
   if (!trial_end) record.t_sim_s = t_sim_s;
-  record.targets = {drone};
-  record.mechanism = "docker";
-  record.requested_t_sim_s = t_sim_s;
-  record.requested_wall_s = requested_wall_s;
   if (trial_end && !paused) record.note = "left down: the trial's end stops every container";
-  if (s && !trial_end && !paused) {
-    disrupted_.erase(drone);
-    resumed_.push_back(drone);
-  }
-  if (!s) {
-    record.phase = FaultPhase::kFailed;
-    record.error = s.error().ToString();
-  }
-  if (events_) events_(faults::FaultEventJson(fault, record));
-  if (!s) {
-    return Verdict::Err("fault " + fault.id + " (" + std::string(fault.kind()) + ") could not be removed: " +
-                            s.error().ToString(),
-                        "faults");
-  }
-  return std::nullopt;
+  if (s && !trial_end && !paused) MarkResumed(drone);
+  return Conclude(fault, std::move(record), s, "removed");
 }
 
 std::optional<Verdict> FaultInjector::OnLogLine(const std::string& component, const std::string& line) {

@@ -191,6 +191,43 @@ Status ScheduleFault(ScheduleContext& ctx, const faults::Fault& f) {
   return Ok{};
 }
 
+// One entry of the schedule: when, what, and the fields of its kind.
+Node ScheduleEntryNode(const ScheduleEntry& e) {
+  Node n = Node::Mapping();
+  n.Set("at_s", Num(e.at_s));
+  n.Set("name", Str(e.name));
+  n.Set("kind", Str(KindName(e.kind)));
+  switch (e.kind) {
+    case ScheduleEntry::Kind::kDroneOut:
+      n.Set("mode", Str(faults::ProcessActionName(e.mode)));
+      n.Set("targets", StrList(e.targets));
+      n.Set("duration_s", Num(e.duration_s));
+      break;
+    case ScheduleEntry::Kind::kRadio:
+      n.Set("targets", StrList(e.targets));
+      n.Set("impairment", Impairment(e.impairment));
+      n.Set("duration_s", Num(e.duration_s));
+      break;
+    case ScheduleEntry::Kind::kPartition: {
+      Node groups = Node::Sequence();
+      for (const auto& g : e.groups) groups.Append(StrList(g));
+      n.Set("groups", std::move(groups));
+      n.Set("oneway", Node::Scalar(e.oneway ? "true" : "false"));
+      n.Set("duration_s", Num(e.duration_s));
+      break;
+    }
+    case ScheduleEntry::Kind::kWorldCommand: {
+      n.Set("target", Str(e.target));
+      n.Set("command", Str(e.command));
+      Node args = Node::Sequence();
+      for (double a : e.args) args.Append(Num(a));
+      n.Set("args", std::move(args));
+      break;
+    }
+  }
+  return n;
+}
+
 }  // namespace
 
 Result<RadioSchedule> PlanRadioSchedule(const dsl::TrialSpec& spec) {
@@ -221,41 +258,7 @@ std::string RadioScheduleJson(const RadioSchedule& plan) {
   root.Set("seed", Node::Scalar(std::to_string(plan.seed)));
   if (plan.mesh) root.Set("mesh", Impairment(*plan.mesh));
   Node schedule = Node::Sequence();
-  for (const ScheduleEntry& e : plan.schedule) {
-    Node n = Node::Mapping();
-    n.Set("at_s", Num(e.at_s));
-    n.Set("name", Str(e.name));
-    n.Set("kind", Str(KindName(e.kind)));
-    switch (e.kind) {
-      case ScheduleEntry::Kind::kDroneOut:
-        n.Set("mode", Str(faults::ProcessActionName(e.mode)));
-        n.Set("targets", StrList(e.targets));
-        n.Set("duration_s", Num(e.duration_s));
-        break;
-      case ScheduleEntry::Kind::kRadio:
-        n.Set("targets", StrList(e.targets));
-        n.Set("impairment", Impairment(e.impairment));
-        n.Set("duration_s", Num(e.duration_s));
-        break;
-      case ScheduleEntry::Kind::kPartition: {
-        Node groups = Node::Sequence();
-        for (const auto& g : e.groups) groups.Append(StrList(g));
-        n.Set("groups", std::move(groups));
-        n.Set("oneway", Node::Scalar(e.oneway ? "true" : "false"));
-        n.Set("duration_s", Num(e.duration_s));
-        break;
-      }
-      case ScheduleEntry::Kind::kWorldCommand: {
-        n.Set("target", Str(e.target));
-        n.Set("command", Str(e.command));
-        Node args = Node::Sequence();
-        for (double a : e.args) args.Append(Num(a));
-        n.Set("args", std::move(args));
-        break;
-      }
-    }
-    schedule.Append(std::move(n));
-  }
+  for (const ScheduleEntry& e : plan.schedule) schedule.Append(ScheduleEntryNode(e));
   root.Set("schedule", std::move(schedule));
   return yaml::EmitJson(root);
 }

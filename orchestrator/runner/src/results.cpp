@@ -32,6 +32,64 @@ Node Value(const std::string& v) {
   return Str(v);
 }
 
+Node RadioNode(const TrialResult& r) {
+  Node radio = Node::Mapping();
+  radio.Set("model", Str(r.radio_model));
+  radio.Set("profile", r.radio_profile.empty() ? Node::Null() : Str(r.radio_profile));
+  return radio;
+}
+
+// Every metric of report::MetricNames, in its order: null where the trial has no value.
+Node MetricsNode(const TrialResult& r) {
+  Node metrics = Node::Mapping();
+  for (const std::string& name : report::MetricNames()) {
+    auto it = r.metrics.find(name);
+    metrics.Set(name, it != r.metrics.end() && it->second ? Bare(report::CsvNumber(*it->second))
+                                                           : Node::Null());
+  }
+  return metrics;
+}
+
+Node ComponentsNode(const std::vector<ComponentReport>& components) {
+  Node sequence = Node::Sequence();
+  for (const ComponentReport& c : components) {
+    Node cn = Node::Mapping();
+    cn.Set("name", Str(c.name));
+    cn.Set("exit_code", c.exit_code ? Bare(std::to_string(*c.exit_code)) : Node::Null());
+    cn.Set("oom_killed", Bare(c.oom_killed ? "true" : "false"));
+    cn.Set("log", Str(c.log_file));
+    cn.Set("log_lines", Bare(std::to_string(c.log_lines)));
+    sequence.Append(std::move(cn));
+  }
+  return sequence;
+}
+
+// The containers killed for going over their memory limit (`limits:`), at a glance.
+Node OomKilledNode(const std::vector<ComponentReport>& components) {
+  Node oom_killed = Node::Sequence();
+  for (const ComponentReport& c : components) {
+    if (c.oom_killed) oom_killed.Append(Str(c.name));
+  }
+  return oom_killed;
+}
+
+Node StringsNode(const std::vector<std::string>& strings) {
+  Node sequence = Node::Sequence();
+  for (const std::string& s : strings) sequence.Append(Str(s));
+  return sequence;
+}
+
+Node TimingNode(const TrialTiming& t) {
+  Node timing = Node::Mapping();
+  auto seconds = [&](const std::optional<double>& v) { return v ? Bare(Num(*v)) : Node::Null(); };
+  timing.Set("containers", Bare(std::to_string(t.containers)));
+  timing.Set("created_s", seconds(t.created_s));
+  timing.Set("started_s", seconds(t.started_s));
+  timing.Set("joined_s", seconds(t.joined_s));
+  timing.Set("teardown_s", seconds(t.teardown_s));
+  return timing;
+}
+
 }  // namespace
 
 std::string ResultJson(const TrialResult& r) {
@@ -43,52 +101,17 @@ std::string ResultJson(const TrialResult& r) {
   doc.Set("sim_s", Bare(Num(r.sim_s)));
   doc.Set("seed", Bare(std::to_string(r.seed)));
   doc.Set("host", Str(r.host));
-  if (!r.radio_model.empty()) {
-    Node radio = Node::Mapping();
-    radio.Set("model", Str(r.radio_model));
-    radio.Set("profile", r.radio_profile.empty() ? Node::Null() : Str(r.radio_profile));
-    doc.Set("radio", std::move(radio));
-  }
-  Node metrics = Node::Mapping();
-  for (const std::string& name : report::MetricNames()) {
-    auto it = r.metrics.find(name);
-    metrics.Set(name, it != r.metrics.end() && it->second ? Bare(report::CsvNumber(*it->second))
-                                                           : Node::Null());
-  }
-  doc.Set("metrics", std::move(metrics));
+  if (!r.radio_model.empty()) doc.Set("radio", RadioNode(r));
+  doc.Set("metrics", MetricsNode(r));
   doc.Set("trial_id", Str(r.trial_id));
   doc.Set("run_id", Str(r.run_id));
   doc.Set("source", Str(r.verdict.source));
   doc.Set("ending_line", Str(r.ending_line));
   doc.Set("restarts", Bare(std::to_string(r.restarts)));
-  Node components = Node::Sequence();
-  for (const ComponentReport& c : r.components) {
-    Node cn = Node::Mapping();
-    cn.Set("name", Str(c.name));
-    cn.Set("exit_code", c.exit_code ? Bare(std::to_string(*c.exit_code)) : Node::Null());
-    cn.Set("oom_killed", Bare(c.oom_killed ? "true" : "false"));
-    cn.Set("log", Str(c.log_file));
-    cn.Set("log_lines", Bare(std::to_string(c.log_lines)));
-    components.Append(std::move(cn));
-  }
-  doc.Set("components", std::move(components));
-  // The containers killed for going over their memory limit (`limits:`), at a glance.
-  Node oom_killed = Node::Sequence();
-  for (const ComponentReport& c : r.components) {
-    if (c.oom_killed) oom_killed.Append(Str(c.name));
-  }
-  doc.Set("oom_killed", std::move(oom_killed));
-  Node problems = Node::Sequence();
-  for (const std::string& p : r.problems) problems.Append(Str(p));
-  doc.Set("problems", std::move(problems));
-  Node timing = Node::Mapping();
-  auto seconds = [&](const std::optional<double>& v) { return v ? Bare(Num(*v)) : Node::Null(); };
-  timing.Set("containers", Bare(std::to_string(r.timing.containers)));
-  timing.Set("created_s", seconds(r.timing.created_s));
-  timing.Set("started_s", seconds(r.timing.started_s));
-  timing.Set("joined_s", seconds(r.timing.joined_s));
-  timing.Set("teardown_s", seconds(r.timing.teardown_s));
-  doc.Set("timing", std::move(timing));
+  doc.Set("components", ComponentsNode(r.components));
+  doc.Set("oom_killed", OomKilledNode(r.components));
+  doc.Set("problems", StringsNode(r.problems));
+  doc.Set("timing", TimingNode(r.timing));
   doc.Set("provenance", report::ProvenanceNode(r.provenance));
   return yaml::EmitJson(doc) + "\n";
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -29,15 +30,58 @@ const cv::Scalar kPalette[] = {
     {75, 86, 140},  {194, 119, 227}, {127, 127, 127}, {34, 189, 188}, {207, 190, 23},
 };
 
+using Tracks = std::vector<std::pair<std::string, std::vector<TrackPoint>>>;
+
+// The columns of truth.csv a picture needs, found in its header (nullopt when one is missing);
+// `count` is the header's width, which every row must have at least.
+struct TruthColumns {
+  std::size_t t = 0, drone = 0, x = 0, y = 0;
+  std::size_t count = 0;
+
+  static std::optional<TruthColumns> FromHeader(const std::vector<std::string_view>& cells) {
+    int col_t = -1, col_drone = -1, col_x = -1, col_y = -1;
+    for (std::size_t i = 0; i < cells.size(); ++i) {
+      if (cells[i] == "t_s") col_t = static_cast<int>(i);
+      if (cells[i] == "drone") col_drone = static_cast<int>(i);
+      if (cells[i] == "x_m") col_x = static_cast<int>(i);
+      if (cells[i] == "y_m") col_y = static_cast<int>(i);
+    }
+    if (col_t < 0 || col_drone < 0 || col_x < 0 || col_y < 0) return std::nullopt;
+    return TruthColumns{static_cast<std::size_t>(col_t), static_cast<std::size_t>(col_drone),
+                        static_cast<std::size_t>(col_x), static_cast<std::size_t>(col_y), cells.size()};
+  }
+};
+
+// One data row onto its drone's track (tracks in order of first appearance).
+Status AddTruthRow(const std::vector<std::string_view>& cells, const TruthColumns& columns, int line_no,
+                   Tracks* tracks) {
+  const std::string where = "truth.csv:" + std::to_string(line_no);
+  if (cells.size() < columns.count) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "expected " + std::to_string(columns.count) + " columns, got " + std::to_string(cells.size()),
+                 where);
+  }
+  auto t = yaml::ScalarAsDouble(cells[columns.t]), x = yaml::ScalarAsDouble(cells[columns.x]),
+       y = yaml::ScalarAsDouble(cells[columns.y]);
+  if (!t || !x || !y) return Error(ErrorCode::kInvalidArgument, "t_s, x_m and y_m must be numbers", where);
+  const std::string drone(cells[columns.drone]);
+  auto it = std::find_if(tracks->begin(), tracks->end(), [&](const auto& tr) { return tr.first == drone; });
+  if (it == tracks->end()) {
+    tracks->emplace_back(drone, std::vector<TrackPoint>{});
+    it = tracks->end() - 1;
+  }
+  it->second.push_back({*t, *x, *y});
+  return Ok{};
+}
+
 }  // namespace
 
 Result<std::vector<std::pair<std::string, std::vector<TrackPoint>>>> ParseTruthCsv(
     std::string_view csv) {
-  std::vector<std::pair<std::string, std::vector<TrackPoint>>> tracks;
+  Tracks tracks;
   std::size_t pos = 0;
   int line_no = 0;
-  int col_t = -1, col_drone = -1, col_x = -1, col_y = -1;
-  std::size_t columns = 0;
+  std::optional<TruthColumns> columns;
   while (pos < csv.size()) {
     auto nl = csv.find('\n', pos);
     std::string_view line = csv.substr(pos, nl == std::string_view::npos ? nl : nl - pos);
@@ -45,41 +89,15 @@ Result<std::vector<std::pair<std::string, std::vector<TrackPoint>>>> ParseTruthC
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.empty()) continue;
-    auto cells = SplitCsv(line);
-    if (col_t < 0) {
-      for (std::size_t i = 0; i < cells.size(); ++i) {
-        if (cells[i] == "t_s") col_t = static_cast<int>(i);
-        if (cells[i] == "drone") col_drone = static_cast<int>(i);
-        if (cells[i] == "x_m") col_x = static_cast<int>(i);
-        if (cells[i] == "y_m") col_y = static_cast<int>(i);
-      }
-      if (col_t < 0 || col_drone < 0 || col_x < 0 || col_y < 0) {
-        return Error(ErrorCode::kInvalidArgument,
-                     "truth.csv header lacks t_s, drone, x_m or y_m", "truth.csv:1");
-      }
-      columns = cells.size();
+    const auto cells = SplitCsv(line);
+    if (columns) {
+      SWARMBOX_TRY(AddTruthRow(cells, *columns, line_no, &tracks));
       continue;
     }
-    if (cells.size() < columns) {
-      return Error(ErrorCode::kInvalidArgument,
-                   "expected " + std::to_string(columns) + " columns, got " +
-                       std::to_string(cells.size()),
-                   "truth.csv:" + std::to_string(line_no));
+    columns = TruthColumns::FromHeader(cells);
+    if (!columns) {
+      return Error(ErrorCode::kInvalidArgument, "truth.csv header lacks t_s, drone, x_m or y_m", "truth.csv:1");
     }
-    auto num = [&](int col) { return yaml::ScalarAsDouble(cells[static_cast<std::size_t>(col)]); };
-    auto t = num(col_t), x = num(col_x), y = num(col_y);
-    if (!t || !x || !y) {
-      return Error(ErrorCode::kInvalidArgument, "t_s, x_m and y_m must be numbers",
-                   "truth.csv:" + std::to_string(line_no));
-    }
-    const std::string drone(cells[static_cast<std::size_t>(col_drone)]);
-    auto it = std::find_if(tracks.begin(), tracks.end(),
-                           [&](const auto& tr) { return tr.first == drone; });
-    if (it == tracks.end()) {
-      tracks.emplace_back(drone, std::vector<TrackPoint>{});
-      it = tracks.end() - 1;
-    }
-    it->second.push_back({*t, *x, *y});
   }
   return tracks;
 }

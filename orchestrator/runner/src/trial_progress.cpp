@@ -38,6 +38,75 @@ std::optional<double> DoubleField(const LogfmtFields& fields, std::string_view k
   }
 }
 
+// What one contract event folds into the progress (the header's table).
+void FoldClock(TrialProgress& p, const LogfmtFields& fields) {
+  if (auto r = DoubleField(fields, "rtf")) p.rtf = *r;
+}
+
+void FoldLeaderElected(TrialProgress& p, const LogfmtFields& fields) {
+  const auto term = IntField(fields, "term");
+  const auto elected = FindField(fields, "leader");
+  if (term && elected && *term > p.leader_term) {
+    p.leader_term = *term;
+    p.leader = *elected;
+  }
+}
+
+void FoldMissionState(TrialProgress& p, const LogfmtFields& fields) {
+  const auto index = IntField(fields, "index");
+  const auto state = FindField(fields, "state");
+  if (index && state && *index > p.stage_index && p.stage != "COMPLETE") {
+    p.stage_index = *index;
+    p.stage = std::string(*state);
+  }
+}
+
+void FoldMissionComplete(TrialProgress& p, const LogfmtFields&) { p.stage = "COMPLETE"; }
+
+void FoldSightingReported(TrialProgress& p, const LogfmtFields& fields) {
+  if (!FindField(fields, "retry")) ++p.sightings;
+}
+
+// event=joining and event=joined.
+void FoldJoining(TrialProgress& p, const LogfmtFields& fields) {
+  JoiningProgress j;
+  j.joined = IntField(fields, "joined").value_or(0);
+  j.expected = IntField(fields, "expected").value_or(0);
+  const auto missing = FindField(fields, "missing");
+  if (missing && *missing != "-") j.missing = std::string(*missing);
+  j.done = FindField(fields, "event") == "joined";
+  j.lost = IntField(fields, "lost").value_or(0);
+  j.wait_s = DoubleField(fields, "wait_s").value_or(0);
+  if (!p.joining || !p.joining->done) p.joining = std::move(j);  // the start is over once joined
+}
+
+void FoldVictimConfirmed(TrialProgress& p, const LogfmtFields& fields) {
+  if (auto id = IntField(fields, "id")) p.confirmed.insert(*id);
+}
+
+void FoldVictimStatus(TrialProgress& p, const LogfmtFields& fields) {
+  const auto id = IntField(fields, "id");
+  const auto status = FindField(fields, "status");
+  if (id && status && *status == "rescued") p.rescued.insert(*id);
+}
+
+struct EventFold {
+  std::string_view event;
+  void (*fold)(TrialProgress&, const LogfmtFields&);
+};
+
+constexpr EventFold kEventFolds[] = {
+    {"clock", FoldClock},
+    {"leader_elected", FoldLeaderElected},
+    {"mission_state", FoldMissionState},
+    {"mission_complete", FoldMissionComplete},
+    {"sighting_reported", FoldSightingReported},
+    {"joining", FoldJoining},
+    {"joined", FoldJoining},
+    {"victim_confirmed", FoldVictimConfirmed},
+    {"victim_status", FoldVictimStatus},
+};
+
 }  // namespace
 
 void TrialProgress::OnLine(std::string_view component, std::string_view line) {
@@ -50,42 +119,8 @@ void TrialProgress::OnLine(std::string_view component, std::string_view line) {
   if (auto t = DoubleField(fields, "t"); t && *t > sim_s) sim_s = *t;
   const auto event = FindField(fields, "event");
   if (!event) return;
-  if (*event == "clock") {
-    if (auto r = DoubleField(fields, "rtf")) rtf = *r;
-  } else if (*event == "leader_elected") {
-    const auto term = IntField(fields, "term");
-    const auto elected = FindField(fields, "leader");
-    if (term && elected && *term > leader_term) {
-      leader_term = *term;
-      leader = *elected;
-    }
-  } else if (*event == "mission_state") {
-    const auto index = IntField(fields, "index");
-    const auto state = FindField(fields, "state");
-    if (index && state && *index > stage_index && stage != "COMPLETE") {
-      stage_index = *index;
-      stage = std::string(*state);
-    }
-  } else if (*event == "mission_complete") {
-    stage = "COMPLETE";
-  } else if (*event == "sighting_reported") {
-    if (!FindField(fields, "retry")) ++sightings;
-  } else if (*event == "joining" || *event == "joined") {
-    JoiningProgress j;
-    j.joined = IntField(fields, "joined").value_or(0);
-    j.expected = IntField(fields, "expected").value_or(0);
-    const auto missing = FindField(fields, "missing");
-    if (missing && *missing != "-") j.missing = std::string(*missing);
-    j.done = *event == "joined";
-    j.lost = IntField(fields, "lost").value_or(0);
-    j.wait_s = DoubleField(fields, "wait_s").value_or(0);
-    if (!joining || !joining->done) joining = std::move(j);  // the start is over once joined
-  } else if (*event == "victim_confirmed") {
-    if (auto id = IntField(fields, "id")) confirmed.insert(*id);
-  } else if (*event == "victim_status") {
-    const auto id = IntField(fields, "id");
-    const auto status = FindField(fields, "status");
-    if (id && status && *status == "rescued") rescued.insert(*id);
+  for (const EventFold& f : kEventFolds) {
+    if (*event == f.event) f.fold(*this, fields);
   }
 }
 

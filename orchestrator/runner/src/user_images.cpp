@@ -89,46 +89,69 @@ images::ImageSpec ProgramImage(const std::string& repository, const std::string&
   return spec;
 }
 
-Result<DockerfileContext> PackDockerfileContext(const std::string& dockerfile, std::string_view name) {
-  const fs::path file = fs::absolute(dockerfile).lexically_normal();
-  const fs::path folder = file.parent_path();
-  std::error_code ec;
-  if (!fs::is_regular_file(file, ec)) {
-    return Error(ErrorCode::kNotFound, "Dockerfile not found", file.string());
+namespace {
+
+// One entry of a Dockerfile's folder into `e`: a symlink, a directory or a regular file (false for
+// what a build context leaves out: sockets, fifos). An unreadable file is the error; a symlink that
+// cannot be read sets `ec`.
+Result<bool> ReadContextEntry(const fs::path& path, const fs::file_status& status, docker::TarEntry* e,
+                              std::error_code& ec) {
+  if (fs::is_symlink(status)) {
+    e->type = docker::TarEntry::Type::kSymlink;
+    e->content = fs::read_symlink(path, ec).string();
+    e->mode = 0777;
+    return true;
   }
+  if (fs::is_directory(status)) {
+    e->type = docker::TarEntry::Type::kDirectory;
+    e->mode = static_cast<std::uint32_t>(status.permissions()) & 07777;
+    return true;
+  }
+  if (!fs::is_regular_file(status)) return false;
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (!in) return Error(ErrorCode::kIo, "cannot read a file of the Dockerfile's context", path.string());
+  e->content = bytes.str();
+  e->mode = static_cast<std::uint32_t>(status.permissions()) & 07777;
+  return true;
+}
+
+// Everything below the Dockerfile's folder, sorted by path (the tar, and so its hash, does not
+// depend on the order the file system lists it in).
+Result<std::vector<docker::TarEntry>> ReadContextFolder(const fs::path& folder) {
+  std::error_code ec;
   std::vector<docker::TarEntry> entries;
   for (fs::recursive_directory_iterator it(folder, fs::directory_options::none, ec), end; !ec && it != end;
        it.increment(ec)) {
-    const fs::path relative = it->path().lexically_relative(folder);
     docker::TarEntry e;
-    e.path = relative.generic_string();
+    e.path = it->path().lexically_relative(folder).generic_string();
     const auto status = it->symlink_status(ec);
     if (ec) break;
-    if (fs::is_symlink(status)) {
-      e.type = docker::TarEntry::Type::kSymlink;
-      e.content = fs::read_symlink(it->path(), ec).string();
-      e.mode = 0777;
-    } else if (fs::is_directory(status)) {
-      e.type = docker::TarEntry::Type::kDirectory;
-      e.mode = static_cast<std::uint32_t>(status.permissions()) & 07777;
-    } else if (fs::is_regular_file(status)) {
-      std::ifstream in(it->path(), std::ios::binary);
-      std::ostringstream bytes;
-      bytes << in.rdbuf();
-      if (!in) return Error(ErrorCode::kIo, "cannot read a file of the Dockerfile's context", it->path().string());
-      e.content = bytes.str();
-      e.mode = static_cast<std::uint32_t>(status.permissions()) & 07777;
-    } else {
-      continue;  // sockets, fifos: not part of a build context
-    }
+    auto kept = ReadContextEntry(it->path(), status, &e, ec);
+    if (!kept) return kept.error();
+    if (!*kept) continue;
     if (ec) break;
     entries.push_back(std::move(e));
   }
   if (ec) return Error(ErrorCode::kIo, "cannot read the Dockerfile's folder: " + ec.message(), folder.string());
   std::sort(entries.begin(), entries.end(),
             [](const docker::TarEntry& a, const docker::TarEntry& b) { return a.path < b.path; });
+  return entries;
+}
+
+}  // namespace
+
+Result<DockerfileContext> PackDockerfileContext(const std::string& dockerfile, std::string_view name) {
+  const fs::path file = fs::absolute(dockerfile).lexically_normal();
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) {
+    return Error(ErrorCode::kNotFound, "Dockerfile not found", file.string());
+  }
+  auto entries = ReadContextFolder(file.parent_path());
+  if (!entries) return entries.error();
   docker::TarWriter writer;
-  for (const docker::TarEntry& e : entries) SWARMBOX_TRY(writer.Add(e));
+  for (const docker::TarEntry& e : *entries) SWARMBOX_TRY(writer.Add(e));
   auto tar = writer.Finish();
   if (!tar) return tar.error();
   DockerfileContext out;
@@ -158,93 +181,138 @@ Result<std::string> EnsureDockerfileImage(docker::DockerApi& api, const std::str
   return ctx->tag;
 }
 
+namespace {
+
+// An external brain's or a user component's image as the trial gives it: a program packed into
+// an image, a Dockerfile built, or an image reference already on the engine.
+struct UserImage {
+  enum class Source { kProgram, kDockerfile, kImage };
+  Source source = Source::kImage;
+  std::string name;        // the drone (brain) or the component: its key in Images
+  std::string who;         // in errors: "the brain of scout_1", "component recorder"
+  std::string path;        // kProgram, kDockerfile: on the host
+  std::string reference;   // kImage
+  std::string build_name;  // kDockerfile: the image's name (BrainId for a brain)
+  // kProgram: ProgramImage's repository, component and collected files.
+  std::string repository;
+  std::string component;
+  std::vector<std::string> collect;
+};
+
+UserImage BrainImage(const dsl::DroneSpec& d) {
+  UserImage u;
+  u.source = d.brain.kind == dsl::BrainKind::kProgram      ? UserImage::Source::kProgram
+             : d.brain.kind == dsl::BrainKind::kDockerfile ? UserImage::Source::kDockerfile
+                                                           : UserImage::Source::kImage;
+  u.name = d.name;
+  u.who = "the brain of " + d.name;
+  u.path = HostPath(d.brain.host_path, d.brain.path);
+  u.reference = d.brain.path;
+  u.build_name = BrainId(d.name);
+  u.repository = std::string(kBrainRepository);
+  u.component = "brain";
+  return u;
+}
+
+UserImage ComponentImage(const dsl::UserComponentSpec& c) {
+  UserImage u;
+  u.source = c.source == dsl::ComponentSource::kProgram      ? UserImage::Source::kProgram
+             : c.source == dsl::ComponentSource::kDockerfile ? UserImage::Source::kDockerfile
+                                                             : UserImage::Source::kImage;
+  u.name = c.name;
+  u.who = "component " + c.name;
+  u.path = HostPath(c.host_path, c.ref);
+  u.reference = c.ref;
+  u.build_name = c.name;
+  u.repository = std::string(kComponentRepository);
+  u.component = c.name;
+  u.collect = c.collect;
+  return u;
+}
+
+// The image on the engine (packed, built or checked), its tag.
+Result<std::string> EnsureUserImage(docker::DockerApi& api, const UserImage& u,
+                                    const std::function<void(std::string_view)>& progress,
+                                    const images::TagCache* cache) {
+  switch (u.source) {
+    case UserImage::Source::kProgram: {
+      auto r = images::EnsureImage(api, ProgramImage(u.repository, u.component, u.path, u.collect), progress,
+                                   nullptr, cache);
+      if (!r) return r.error().Context(u.who);
+      return r->tag;
+    }
+    case UserImage::Source::kDockerfile: {
+      auto tag = EnsureDockerfileImage(api, u.path, u.build_name, progress);
+      if (!tag) return tag.error().Context(u.who);
+      return tag;
+    }
+    case UserImage::Source::kImage: break;
+  }
+  SWARMBOX_TRY(CheckLocalImage(api, u.reference, u.who));
+  return u.reference;
+}
+
+// The tag the image would have, without an engine (a program's packed context, a Dockerfile's
+// folder, the reference itself).
+Result<std::string> UserImageTag(const UserImage& u) {
+  switch (u.source) {
+    case UserImage::Source::kProgram: {
+      auto ctx = images::PackContext(ProgramImage(u.repository, u.component, u.path, u.collect));
+      if (!ctx) return ctx.error().Context(u.name);
+      return ctx->tag;
+    }
+    case UserImage::Source::kDockerfile: {
+      auto ctx = PackDockerfileContext(u.path, u.build_name);
+      if (!ctx) return ctx.error();
+      return ctx->tag;
+    }
+    case UserImage::Source::kImage: break;
+  }
+  return u.reference;
+}
+
+}  // namespace
+
 Result<Images> EnsureUserImages(docker::DockerApi& api, const dsl::TrialSpec& spec,
                                 const std::string& agent_binary, Images base,
                                 const std::function<void(std::string_view)>& progress,
                                 const images::TagCache* cache) {
   const Needs needs = WhatTheTrialNeeds(spec);
-  auto ensure = [&](const images::ImageSpec& image, const std::string& who) -> Result<std::string> {
-    auto r = images::EnsureImage(api, image, progress, nullptr, cache);
-    if (!r) return r.error().Context(who);
-    return r->tag;
-  };
   for (const dsl::DroneSpec* d : needs.library_brains) {
     SWARMBOX_TRY(NeedAgentBinary(agent_binary, *d));
-    auto tag = ensure(AgentWithBrainImage(agent_binary, HostPath(d->brain.host_path, d->brain.path)),
-                      "the agent image of " + d->name + " with its brain library");
-    if (!tag) return tag.error();
-    base.drone_agents[d->name] = *tag;
+    const auto image = AgentWithBrainImage(agent_binary, HostPath(d->brain.host_path, d->brain.path));
+    auto r = images::EnsureImage(api, image, progress, nullptr, cache);
+    if (!r) return r.error().Context("the agent image of " + d->name + " with its brain library");
+    base.drone_agents[d->name] = r->tag;
   }
   for (const dsl::DroneSpec* d : needs.external_brains) {
-    const std::string who = "the brain of " + d->name;
-    const std::string path = HostPath(d->brain.host_path, d->brain.path);
-    if (d->brain.kind == dsl::BrainKind::kProgram) {
-      auto tag = ensure(ProgramImage(kBrainRepository, "brain", path), who);
-      if (!tag) return tag.error();
-      base.brains[d->name] = *tag;
-    } else if (d->brain.kind == dsl::BrainKind::kDockerfile) {
-      auto tag = EnsureDockerfileImage(api, path, BrainId(d->name), progress);
-      if (!tag) return tag.error().Context(who);
-      base.brains[d->name] = *tag;
-    } else {
-      SWARMBOX_TRY(CheckLocalImage(api, d->brain.path, who));
-      base.brains[d->name] = d->brain.path;
-    }
+    auto tag = EnsureUserImage(api, BrainImage(*d), progress, cache);
+    if (!tag) return tag.error();
+    base.brains[d->name] = *tag;
   }
   for (const dsl::UserComponentSpec& c : spec.components) {
-    const std::string who = "component " + c.name;
-    const std::string path = HostPath(c.host_path, c.ref);
-    if (c.source == dsl::ComponentSource::kProgram) {
-      auto tag = ensure(ProgramImage(kComponentRepository, c.name, path, c.collect), who);
-      if (!tag) return tag.error();
-      base.components[c.name] = *tag;
-    } else if (c.source == dsl::ComponentSource::kDockerfile) {
-      auto tag = EnsureDockerfileImage(api, path, c.name, progress);
-      if (!tag) return tag.error().Context(who);
-      base.components[c.name] = *tag;
-    } else {
-      SWARMBOX_TRY(CheckLocalImage(api, c.ref, who));
-      base.components[c.name] = c.ref;
-    }
+    auto tag = EnsureUserImage(api, ComponentImage(c), progress, cache);
+    if (!tag) return tag.error();
+    base.components[c.name] = *tag;
   }
   return base;
 }
 
 Result<Images> UserImageTags(const dsl::TrialSpec& spec, const std::string& agent_binary, Images base) {
   const Needs needs = WhatTheTrialNeeds(spec);
-  auto tag_of = [](const images::ImageSpec& image, const std::string& who) -> Result<std::string> {
-    auto ctx = images::PackContext(image);
-    if (!ctx) return ctx.error().Context(who);
-    return ctx->tag;
-  };
   for (const dsl::DroneSpec* d : needs.library_brains) {
     SWARMBOX_TRY(NeedAgentBinary(agent_binary, *d));
-    auto tag = tag_of(AgentWithBrainImage(agent_binary, HostPath(d->brain.host_path, d->brain.path)),
-                      "the agent image of " + d->name);
-    if (!tag) return tag.error();
-    base.drone_agents[d->name] = *tag;
+    auto ctx = images::PackContext(AgentWithBrainImage(agent_binary, HostPath(d->brain.host_path, d->brain.path)));
+    if (!ctx) return ctx.error().Context("the agent image of " + d->name);
+    base.drone_agents[d->name] = ctx->tag;
   }
   for (const dsl::DroneSpec* d : needs.external_brains) {
-    const std::string path = HostPath(d->brain.host_path, d->brain.path);
-    Result<std::string> tag = d->brain.path;
-    if (d->brain.kind == dsl::BrainKind::kProgram) tag = tag_of(ProgramImage(kBrainRepository, "brain", path), d->name);
-    if (d->brain.kind == dsl::BrainKind::kDockerfile) {
-      auto ctx = PackDockerfileContext(path, BrainId(d->name));
-      tag = ctx ? Result<std::string>(ctx->tag) : Result<std::string>(ctx.error());
-    }
+    auto tag = UserImageTag(BrainImage(*d));
     if (!tag) return tag.error();
     base.brains[d->name] = *tag;
   }
   for (const dsl::UserComponentSpec& c : spec.components) {
-    const std::string path = HostPath(c.host_path, c.ref);
-    Result<std::string> tag = c.ref;
-    if (c.source == dsl::ComponentSource::kProgram) {
-      tag = tag_of(ProgramImage(kComponentRepository, c.name, path, c.collect), c.name);
-    }
-    if (c.source == dsl::ComponentSource::kDockerfile) {
-      auto ctx = PackDockerfileContext(path, c.name);
-      tag = ctx ? Result<std::string>(ctx->tag) : Result<std::string>(ctx.error());
-    }
+    auto tag = UserImageTag(ComponentImage(c));
     if (!tag) return tag.error();
     base.components[c.name] = *tag;
   }

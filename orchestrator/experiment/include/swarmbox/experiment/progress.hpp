@@ -44,6 +44,12 @@ class ProgressBoard {
     std::map<std::string, double> running;  // trial -> start time [s]
   };
   HostRow* Find(const std::string& host);
+  // One host's row ("local  4 slots  up    done 3  running e1-001 12s"), its name padded to
+  // `width`, and the last row: the bar, the outcomes, the running count and the ETA.
+  std::string HostLine(const HostRow& h, std::size_t width, double now_s) const;
+  std::string SummaryLine(std::size_t running, int slots_up) const;
+  static constexpr int kBarChars = 20;              // the progress bar's width
+  static constexpr std::size_t kReasonChars = 160;  // a down host's reason, cut to this
 
   std::vector<HostRow> hosts_;
   std::size_t total_;

@@ -102,6 +102,8 @@ class TrialSeriesBuilder {
     double sent = 0, received = 0, loss_sum = 0, loss_n = 0, rtt_sum = 0, rtt_w = 0;
   };
   void FlushTruthGroup();
+  // One event=link line: starts the node's next burst when its time differs from the current one.
+  void OnLinkEvent(const std::string& node, double t_s, const LogfmtFields& fields);
   void FlushLink(const std::string& node, LinkBurst& burst);
   void SeeTime(double t_s);
 

@@ -63,6 +63,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "swarmbox/docker/docker_api.hpp"
@@ -142,6 +143,11 @@ class FaultInjector {
   // random draw); Apply then carries it out on them.
   Status Resolve(std::size_t index, faults::FaultEventRecord* record);
   Status Apply(std::size_t index, faults::FaultEventRecord* record);
+  // Apply's process fault: the docker actions on the targets' agent containers.
+  Status ApplyProcessFault(std::size_t index, const faults::ProcessFault& process,
+                           const std::vector<std::string>& targets);
+  // A drone a process fault took down is back (TakeResumed hands it to the runner).
+  void MarkResumed(const std::string& drone);
   Status Remove(std::size_t index, faults::FaultEventRecord* record, bool trial_end);
   // Remove's kinds: the radio's layer, a partition's chains, a process fault's docker undo, a
   // physics fault's undo commands.
@@ -161,9 +167,26 @@ class FaultInjector {
   // Sends the world commands through the physics container, all at once; the first failure.
   Status SendToPhysics(const std::vector<faults::WorldCommandCall>& calls);
   faults::FaultEventRecord Record(faults::FaultPhase phase) const;
+  // A planned fault's record of one drone's container (mechanism docker) at `t_sim_s`.
+  faults::FaultEventRecord DroneRecord(faults::FaultPhase phase, const std::string& drone, double t_sim_s) const;
+  // The `requested` record confirmed now: `phase` with the clocks' times, the request's times as
+  // requested_t_sim_s/requested_wall_s, targets, mechanism and note kept.
+  faults::FaultEventRecord Confirmed(faults::FaultEventRecord requested, faults::FaultPhase phase) const;
+  // The event of a fault's step (failed with the error when `s` is one), and then the verdict
+  // "fault ID (KIND) could not be DONE: ERROR" for a failure, nullopt for success.
+  std::optional<dsl::Verdict> Conclude(const faults::Fault& fault, faults::FaultEventRecord record,
+                                       const Status& s, std::string_view done) const;
+  void Emit(const faults::Fault& fault, const faults::FaultEventRecord& record) const;
   // A physics server line reporting a planned fault (drone_out, drone_back, radio_fault); nullopt
   // verdict when carried out (or not such a line).
   std::optional<dsl::Verdict> OnPlannedEvent(const std::string& line);
+  // The planned fault of that id (nullptr when the plan has none).
+  const faults::Fault* PlannedFault(const std::string& id) const;
+  // A radio_fault line (state on/off): the channel carried it out; recorded as it happened.
+  std::optional<dsl::Verdict> RecordChannelFault(const faults::Fault& fault, const std::string& state,
+                                                 const std::string& line, double t_sim_s);
+  // Why the physics server cannot take `drone` out for `fault` ("" when it can).
+  std::string DroneOutRefusal(const faults::Fault& fault, const std::string& drone) const;
   std::optional<dsl::Verdict> DroneOut(const faults::Fault& fault, const std::string& drone, double t_sim_s);
   // `drone` by value: RemoveActive passes a key of out_, which this erases before it is done.
   std::optional<dsl::Verdict> DroneBack(std::string drone, double t_sim_s, bool trial_end);
