@@ -74,7 +74,7 @@ dsl::TrialSpec BaseTrial() {
 // (what a factor with `key:`, `levels:` and `labels:` in an experiment file becomes).
 experiment::Factor KeyFactor(std::string name, std::string key,
                              std::vector<std::pair<std::string, std::string>> label_json) {
-  experiment::Factor f{std::move(name), std::move(key), {}};
+  experiment::Factor f{std::move(name), std::move(key), /*keys=*/{}, /*levels=*/{}};
   char code = 'a';
   for (auto& [label, json] : label_json) {
     f.levels.push_back({code++, std::move(label), {f.key + "=" + json}});
