@@ -26,6 +26,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -73,7 +74,7 @@ dsl::TrialSpec BaseTrial() {
 // (what a factor with `key:`, `levels:` and `labels:` in an experiment file becomes).
 experiment::Factor KeyFactor(std::string name, std::string key,
                              std::vector<std::pair<std::string, std::string>> label_json) {
-  experiment::Factor f{std::move(name), std::move(key), {}};
+  experiment::Factor f{std::move(name), std::move(key), /*keys=*/{}, /*levels=*/{}};
   char code = 'a';
   for (auto& [label, json] : label_json) {
     f.levels.push_back({code++, std::move(label), {f.key + "=" + json}});
@@ -144,74 +145,49 @@ Result<swarmbox::runner::Images> EnsureImages(swarmbox::docker::DockerApi& api) 
 std::atomic<bool> g_interrupted{false};
 extern "C" void OnInterrupt(int) { g_interrupted.store(true); }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  std::string out, trials_dir = SWARMBOX_TRIALS_DIR;
+// The command line.
+struct Args {
+  std::string out;  // empty: runs/<experiment>-<run id>
+  std::string trials_dir = SWARMBOX_TRIALS_DIR;
   int slots = 2;
   std::vector<std::string> filter;
+};
+
+// Parses argv into `args`. An exit code when the program ends here: --help (0), bad usage (2).
+std::optional<int> ParseArgs(int argc, char** argv, Args& args) {
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (i + 1 < argc && a == "--out") {
-      out = argv[++i];
+      args.out = argv[++i];
     } else if (i + 1 < argc && a == "--slots") {
-      slots = std::atoi(argv[++i]);
+      args.slots = std::atoi(argv[++i]);
     } else if (i + 1 < argc && a == "--filter") {
-      filter.emplace_back(argv[++i]);
+      args.filter.emplace_back(argv[++i]);
     } else if (i + 1 < argc && a == "--trials-dir") {
-      trials_dir = argv[++i];
+      args.trials_dir = argv[++i];
     } else {
       std::cerr << "usage: hover_experiment [--out DIR] [--slots N] [--filter PATTERN ...] "
                    "[--trials-dir DIR]\n";
       return a == "--help" ? kExitOk : kExitUsage;
     }
   }
-  if (slots < 1) {
+  if (args.slots < 1) {
     std::cerr << "hover_experiment: --slots must be at least 1\n";
     return kExitUsage;
   }
+  return std::nullopt;
+}
 
-  // 1-2. The experiment, and every trial it expands to, checked before anything runs.
-  experiment::ExperimentSpec spec = Experiment();
-  spec.filter = filter;
-  auto plan = Plan(spec, BaseTrial(), trials_dir);
-  if (!plan) {
-    std::cerr << "hover_experiment: " << plan.error().ToString() << "\n";
-    return kExitUsage;
-  }
-  const std::string run_id = swarmbox::runner::NewRunId();
-  if (out.empty()) out = "runs/" + spec.name + "-" + run_id;
-  if (auto checked = experiment::CheckOutFolder(*plan, out, /*resume=*/false); !checked) {
-    std::cerr << "hover_experiment: " << checked.error().ToString() << "\n";
-    return kExitUsage;
-  }
-  std::cerr << "hover_experiment: " << plan->trials.size() << " trials, run " << run_id << " -> "
-            << out << "\n";
+// Says why the program stops ("hover_experiment: [what]reason") and gives its exit code.
+int Fail(const swarmbox::Error& error, int exit_code, std::string_view what = {}) {
+  std::cerr << "hover_experiment: " << what << error.ToString() << "\n";
+  return exit_code;
+}
 
-  // 3. The local engine and the images of the installed programs.
-  auto host_spec = swarmbox::hosts::ParseHostSpec("local?slots=" + std::to_string(slots));
-  if (!host_spec) {
-    std::cerr << "hover_experiment: " << host_spec.error().ToString() << "\n";
-    return kExitUsage;
-  }
-  const std::string workdir = (fs::temp_directory_path() / ("swarmbox-" + run_id)).string();
-  auto host = swarmbox::hosts::ConnectHost(*host_spec, workdir);
-  if (!host) {
-    std::cerr << "hover_experiment: " << host.error().ToString() << "\n";
-    return kExitInfrastructure;
-  }
-  auto images = EnsureImages((*host)->api());
-  if (!images) {
-    std::cerr << "hover_experiment: images: " << images.error().ToString() << "\n";
-    return kExitInfrastructure;
-  }
-  swarmbox::hosts::Host* h = host->get();
-  // No trial of this experiment impairs the mesh: no fault sidecar image (see
-  // experiment::EnsurePlanFaultsImage for experiments that do).
-  std::vector<experiment::PoolHost> pool = {
-      {h->name(), h->slots(), &h->api(), [h] { return h->Check(); }, *images, ""}};
-
-  // 4. Run every trial; results.csv and report.html are written at the end.
+// 4. Runs every trial on `pool`; results.csv and report.html are written at the end. The exit
+// code (SIGINT/SIGTERM mark the run interrupted: 1).
+int RunAndReport(const experiment::ExperimentPlan& plan, const std::vector<experiment::PoolHost>& pool,
+                 const std::string& out, const std::string& run_id, const std::string& workdir) {
   std::signal(SIGINT, OnInterrupt);
   std::signal(SIGTERM, OnInterrupt);
   experiment::ExperimentOptions options;
@@ -219,17 +195,49 @@ int main(int argc, char** argv) {
   options.run_id = run_id;
   options.interrupted = &g_interrupted;
   options.progress = &std::cerr;
-  auto summary = experiment::RunExperiment(*plan, pool, options);
+  auto summary = experiment::RunExperiment(plan, pool, options);
   std::error_code ec;
   fs::remove_all(workdir, ec);
-  if (!summary) {
-    std::cerr << "hover_experiment: " << summary.error().ToString() << "\n";
-    return kExitInfrastructure;
-  }
+  if (!summary) return Fail(summary.error(), kExitInfrastructure);
   for (const std::string& p : summary->problems) std::cerr << "  note: " << p << "\n";
   std::cout << out << ": " << summary->committed << "/" << summary->total << " trials";
   for (const auto& [outcome, n] : summary->outcomes) std::cout << ", " << outcome << " " << n;
   std::cout << "; " << out << "/results.csv, " << out << "/report.html\n";
   if (g_interrupted.load()) return kExitInterrupted;
   return summary->committed == summary->total ? kExitOk : kExitInfrastructure;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args args;
+  if (std::optional<int> exit_code = ParseArgs(argc, argv, args)) return *exit_code;
+
+  // 1-2. The experiment, and every trial it expands to, checked before anything runs.
+  experiment::ExperimentSpec spec = Experiment();
+  spec.filter = args.filter;
+  auto plan = Plan(spec, BaseTrial(), args.trials_dir);
+  if (!plan) return Fail(plan.error(), kExitUsage);
+  const std::string run_id = swarmbox::runner::NewRunId();
+  const std::string out = args.out.empty() ? "runs/" + spec.name + "-" + run_id : args.out;
+  if (auto checked = experiment::CheckOutFolder(*plan, out, /*resume=*/false); !checked) {
+    return Fail(checked.error(), kExitUsage);
+  }
+  std::cerr << "hover_experiment: " << plan->trials.size() << " trials, run " << run_id << " -> "
+            << out << "\n";
+
+  // 3. The local engine and the images of the installed programs.
+  auto host_spec = swarmbox::hosts::ParseHostSpec("local?slots=" + std::to_string(args.slots));
+  if (!host_spec) return Fail(host_spec.error(), kExitUsage);
+  const std::string workdir = (fs::temp_directory_path() / ("swarmbox-" + run_id)).string();
+  auto host = swarmbox::hosts::ConnectHost(*host_spec, workdir);
+  if (!host) return Fail(host.error(), kExitInfrastructure);
+  auto images = EnsureImages((*host)->api());
+  if (!images) return Fail(images.error(), kExitInfrastructure, "images: ");
+  swarmbox::hosts::Host* h = host->get();
+  // No trial of this experiment impairs the mesh: no fault sidecar image (see
+  // experiment::EnsurePlanFaultsImage for experiments that do).
+  const std::vector<experiment::PoolHost> pool = {
+      {h->name(), h->slots(), &h->api(), [h] { return h->Check(); }, *images, ""}};
+  return RunAndReport(*plan, pool, out, run_id, workdir);
 }

@@ -8,16 +8,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "brain_convert.hpp"
-#include "external_brain.hpp"
 #include "server_wait.hpp"
-#include "swarmbox/bus/cyclone_config.hpp"
 #include "swarmbox/bus/topics.hpp"
-#include "swarmbox/brain/args.hpp"
-#include "swarmbox/brain/loader.hpp"
 #include "swarmbox/common/logfmt.hpp"
-#include "swarmbox/airframe/airframe.hpp"
-#include "swarmbox/radio/channel_radio.hpp"
-#include "swarmbox/radio/dds_radio.hpp"
 #include "wait_budget.hpp"
 
 namespace swarmbox::agent {
@@ -37,17 +30,24 @@ double SteadyS() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();  // the telemetry's "none"
+
+// Flocking (SarBrain): V18's horizontal terms; separation = repulsion, alignment = Reynolds'
+// alignment + V18 friction, cohesion, and their sum. None (NaN) without SarBrain.
+void FillTelemetryFlocking(const swarm::FlockingOutput* f, bus::Telemetry& t) {
+  if (f == nullptr) {
+    t.flock_separation = t.flock_alignment = t.flock_cohesion = t.flock_sum = {kNaN, kNaN, kNaN};
+    return;
+  }
+  const swarm::Vec2 align = f->alignment + f->friction;
+  const swarm::Vec2 sum = f->repulsion + align + f->cohesion;
+  t.flock_separation = {f->repulsion.x(), f->repulsion.y(), 0.0};
+  t.flock_alignment = {align.x(), align.y(), 0.0};
+  t.flock_cohesion = {f->cohesion.x(), f->cohesion.y(), 0.0};
+  t.flock_sum = {sum.x(), sum.y(), 0.0};
+}
+
 }  // namespace
-
-class AgentNode::FlightAdapter final : public FlightPort {
- public:
-  explicit FlightAdapter(flight::FlightController& fc) : fc_(fc) {}
-  bool Command(const flight::Setpoint& setpoint) override { return fc_.Command(setpoint); }
-  void SetPayloadMass(double payload_mass_kg) override { fc_.SetPayloadMass(payload_mass_kg); }
-
- private:
-  flight::FlightController& fc_;
-};
 
 Result<RadioModel> ParseRadioModel(std::string_view text) {
   if (text == "netem") return RadioModel::kNetem;
@@ -77,231 +77,6 @@ flight::SensorSample FromBus(const bus::SensorSample& m) {
   return s;
 }
 
-Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
-  SWARMBOX_TRY(bus::ValidateDroneName(o.name));
-  const bool channel = o.radio_model == RadioModel::kChannel;
-  if (o.mesh && !channel && o.mesh_domain == o.sim_domain) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "the sim and mesh buses need different DDS domain ids (both are " + std::to_string(o.sim_domain) + ")");
-  }
-  // The airframe file, parsed and validated once: the flight stack, the SAR brain and perception
-  // all take what they need from this one model.
-  auto af = airframe::LoadAirframe(o.airframe_path);
-  if (!af) return af.error().Context("loading airframe");
-  auto cfg = flight::FlightConfigFrom(*af);
-  if (!cfg) return cfg.error().Context("loading airframe");
-  // --mission sar: SarBrain's Context (what any brain is told) and the agent's perception,
-  // checked before anything joins the bus.
-  std::optional<SarBrainConfig> sar_config;
-  PerceptionConfig perception;
-  if (o.mission.kind == MissionKind::kSar) {
-    if (o.raft.members.empty()) return Error(ErrorCode::kInvalidArgument, "--mission sar needs --members");
-    if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--mission sar needs the mesh bus (drop --no-mesh)");
-    brain::Context ctx;
-    ctx.self = o.name;
-    ctx.members = o.raft.members;
-    ctx.seed = o.raft.seed;
-    ctx.period_ns = std::llround(o.control_dt_s * 1e9);
-    ctx.airframe = cfg->airframe;
-    ctx.airframe_path = o.airframe_path;
-    ctx.world_path = o.mission.world_path;
-    ctx.payload = o.mission.payload;
-    if (o.has_start) {
-      char start[96];
-      std::snprintf(start, sizeof start, "%.17g,%.17g,%.17g", o.start_m.x(), o.start_m.y(), o.start_m.z());
-      ctx.args["start"] = start;
-    }
-    auto c = SarBrainConfigFrom(ctx, *af);
-    if (!c) return c.error();
-    sar_config = std::move(*c);
-    perception.camera = sar_config->camera;
-    perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
-  }
-  const bool brain = o.brain.kind != BrainKind::kBuiltin;
-  int period_steps = 1;
-  if (brain) {
-    auto steps = BrainPeriodSteps(o.brain, o.control_dt_s);
-    if (!steps) return steps.error();
-    period_steps = *steps;
-    if (o.mission.kind != MissionKind::kPlan) {
-      return Error(ErrorCode::kInvalidArgument, "--mission is for --brain builtin (the brain decides what to fly)");
-    }
-  }
-  auto plan = FlightPlan::Parse(o.plan);  // --mission sar, a brain: parsed (the default) but not flown
-  if (!plan) return plan.error().Context("--plan");
-  plan->SetPreflight(o.preflight_s);
-  flight::ControllerOptions co;
-  co.control_dt_s = o.control_dt_s;
-  co.payload_mass_kg = o.payload_mass_kg;
-  co.swing_damping = o.swing_damping;
-  if (o.has_start) {
-    co.has_start_pos = true;
-    co.start_pos_m = o.start_m + flight::Vec3(0.0, 0.0, cfg->base_height_m);
-  }
-  auto fc = flight::FlightController::Create(*cfg, co);
-  if (!fc) return fc.error();
-  std::unique_ptr<AgentNode> node(new AgentNode(o, std::move(*fc), std::move(*plan)));
-  if (o.telemetry_hz < 0.0 || !std::isfinite(o.telemetry_hz)) {
-    return Error(ErrorCode::kInvalidArgument, "--telemetry-hz must be >= 0");
-  }
-  if (o.telemetry_hz > 0.0) {
-    // Every line printed on the log (the node's, Raft's, the brain host's) also goes to the
-    // telemetry's event queue: the log's bytes stay as they were.
-    AgentNode* n = node.get();
-    auto tee = LogTee::Create(o.log, [n](std::string_view line) { n->telemetry_events_.Push(line); });
-    if (!tee) return tee.error().Context("the telemetry's log tee");
-    node->log_tee_ = std::move(*tee);
-    node->options_.log = node->log_tee_->file();
-    node->telemetry_clock_ = TelemetryClock(o.telemetry_hz);
-  }
-  std::FILE* const log_out = node->options_.log;  // the tee's stream with telemetry
-
-  // No writer lingers at exit (Cyclone's default keeps an unacknowledged one up to 1 s, ~0.2 s per
-  // agent): what it sent last (the last actuator command, Raft messages the protocol resends,
-  // state, detections) is of no use once the agent goes. This is for the exits that delete the
-  // participants (plan complete, samples stopped, errors); a SIGTERM stop skips the deletion
-  // altogether (main.cpp, LeaveNow).
-  constexpr int kNoLinger = 0;
-  std::vector<std::string> peers;
-  for (const std::string& host : o.sim_peers) {
-    peers.push_back(host + ":" + std::to_string(bus::CycloneDiscoveryPort(o.sim_domain, 0)));
-  }
-  auto sim = bus::Participant::Create({.backend = o.middleware,
-                                       .domain_id = o.sim_domain,
-                                       .interface = o.sim_interface,
-                                       .writer_linger_ms = kNoLinger,
-                                       .peers = std::move(peers)});
-  if (!sim) return sim.error().Context("joining the sim bus");
-  node->sim_ = std::move(*sim);
-  auto sub = node->sim_->CreateSubscriber<bus::SensorSample>(bus::SensorTopic(o.name), bus::Qos::kLockstep);
-  if (!sub) return sub.error().Context("subscribing to sensor samples");
-  node->sensor_sub_ = std::move(*sub);
-  // The physics server's start (sim/status): while it comes, the first sample is waited for.
-  auto status = node->sim_->CreateSubscriber<bus::Event>(bus::kSimStatusTopic, bus::Qos::kLockstep);
-  if (!status) return status.error().Context("subscribing to the physics server's status");
-  node->status_sub_ = std::move(*status);
-  // Every agent writes the one keyed topic sim/actuator (cmd_.drone is the key); the server reads it
-  // with one reader.
-  auto pub = node->sim_->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
-  if (!pub) return pub.error().Context("publishing actuator commands");
-  node->actuator_pub_ = std::move(*pub);
-  if (node->telemetry_clock_.enabled()) {
-    // Keyed by drone like sim/actuator: the physics server's recorder reads it with one reader.
-    auto tpub = node->sim_->CreatePublisher<bus::Telemetry>(bus::kTelemetryTopic, bus::Qos::kState);
-    if (!tpub) return tpub.error().Context("publishing telemetry");
-    node->telemetry_pub_ = std::move(*tpub);
-  }
-  const bool sar = o.mission.kind == MissionKind::kSar;
-  std::unique_ptr<brain::Brain> the_brain;
-  if (brain) {
-    auto made = node->MakeBrain(*cfg, period_steps);
-    if (!made) return made.error();
-    the_brain = std::move(*made);
-    // Its own replicated state, made once before Raft starts (Raft replays its WAL into it).
-    node->brain_state_ = the_brain->MakeReplicatedState();
-  } else if (sar_config) {
-    // The builtin SAR brain, through BrainHost as any brain; its replicated state is the mission.
-    AgentNode* n = node.get();
-    auto log = [n](const brain::Event& e) {
-      LogEvent line(n->t_s_, n->options_.name, e.name);
-      for (const auto& [k, v] : e.fields) line.Add(k, v);
-      n->Log(line);
-    };
-    auto made = SarBrain::Create(*sar_config, log, channel ? nullptr : &node->netem_wall_);
-    if (!made) return made.error();
-    node->sar_ = made->get();
-    auto state = node->sar_->MakeMissionState();
-    node->sar_state_ = state.get();
-    node->brain_state_ = std::move(state);
-    the_brain = std::move(*made);
-  }
-  if (o.mesh && channel) {
-    // No mesh domain at all: every frame rides the lockstep to the physics server's channel.
-    node->radio_ = std::make_unique<radio::ChannelRadio>(o.name);
-  } else if (o.mesh) {
-    auto mesh = bus::Participant::Create({.backend = o.middleware,
-                                          .domain_id = o.mesh_domain,
-                                          .interface = o.mesh_interface,
-                                          .writer_linger_ms = kNoLinger});
-    if (!mesh) return mesh.error().Context("joining the mesh bus");
-    node->mesh_ = std::move(*mesh);
-    radio::DdsRadioOptions ro;
-    ro.members = o.raft.members;
-    ro.raft = o.raft.members.size() > 1;
-    ro.pings = o.ping_every_ms > 0 && o.raft.members.size() > 1;
-    ro.hear_states = sar || brain;
-    ro.brains = brain;
-    auto dds = radio::DdsRadio::Create(*node->mesh_, o.name, ro);
-    if (!dds) return dds.error().Context("starting the mesh radio");
-    node->radio_ = std::move(*dds);
-  }
-  if (!o.raft.members.empty()) {
-    if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--members (Raft) needs the mesh bus (drop --no-mesh)");
-    RaftHostOptions ro = o.raft;
-    ro.self = o.name;
-    ro.election_timeout_ms = ElectionTimeoutMsFor(o.mission, o.raft.election_timeout_ms);
-    // Raft's clock: simulated seconds (channel: the radio's clock is the lockstep's, from 0), or
-    // wall seconds since now (netem: the steady clock). Its lines carry the simulated time.
-    node->raft_clock_ = std::make_unique<RadioClock>(*node->radio_, channel ? 0 : node->radio_->now_ns());
-    std::unique_ptr<raft::StateMachine> machine;  // null: the SAR mission's
-    if (node->sar_state_ != nullptr) {
-      // SarBrain's state is raft's MissionStateMachine: Raft applies it with its own event lines.
-      machine = node->sar_state_->RaftMachine();
-    } else if (brain && node->brain_state_) {
-      machine = std::make_unique<ReplicatedStateMachine>(node->brain_state_.get());
-    } else if (brain) {
-      machine = std::make_unique<raft::EntryLogMachine>();
-    }
-    auto raft = RaftHost::Start(ro, *node->radio_, *node->raft_clock_, log_out, &node->sim_clock_, std::move(machine));
-    if (!raft) return raft.error();
-    node->raft_ = std::move(*raft);
-  }
-  if (o.ping_every_ms < 0) return Error(ErrorCode::kInvalidArgument, "--ping-every-ms must be >= 0");
-  if (o.ping_peers <= 0) return Error(ErrorCode::kInvalidArgument, "--ping-peers must be > 0");
-  if (node->radio_ && o.ping_every_ms > 0 && o.raft.members.size() > 1) {
-    radio::LinkProbeOptions po;
-    po.ping_every = std::chrono::milliseconds(o.ping_every_ms);
-    po.ping_peers = o.ping_peers;
-    auto probe = radio::LinkProbe::Create(o.name, o.raft.members, po, radio::RadioTime(node->radio_->now_ns()));
-    if (!probe) return probe.error().Context("starting the link probe");
-    node->probe_ = std::move(*probe);
-  }
-  if (brain || node->sar_ != nullptr) {
-    BrainHostOptions bo;
-    bo.self = o.name;
-    bo.period_steps = period_steps;
-    bo.offboard_timeout_s = o.brain.offboard_timeout_ms * 1e-3;
-    bo.offboard_hold_s = o.brain.offboard_hold_ms * 1e-3;
-    bo.state = node->brain_state_.get();
-    bo.neighbours.max_listed = static_cast<std::size_t>(std::max(1, o.brain.neighbours));
-    node->flight_port_ = std::make_unique<FlightAdapter>(node->fc_);
-    if (node->raft_) node->consensus_ = std::make_unique<RaftConsensus>(*node->raft_);
-    node->brain_host_ = std::make_unique<BrainHost>(bo, std::move(the_brain), *node->flight_port_, node->radio_.get(),
-                                                    node->consensus_.get(), log_out);
-    if (auto spec = swarm::BatterySpecFor(cfg->airframe)) node->battery_.emplace(*spec);
-  }
-  // Perception runs beside the brain on a scout of the SAR mission and, for any other brain, on
-  // an airframe with a camera: its detections are Input::detections. (The physics server renders
-  // frames only when the trial asks for cameras; without frames nothing is detected.)
-  bool perceive = node->sar_ != nullptr && node->sar_->role() == swarm::Role::kScout;
-  if (brain) {
-    if (af->has_camera) {
-      perception.camera = af->camera;
-      perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
-      perceive = true;
-    }
-  }
-  if (perceive) {
-    auto p = PerceptionHost::Create(perception);
-    if (!p) return p.error();
-    node->perception_ = std::move(*p);
-    auto cam = node->sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(o.name), bus::Qos::kLockstep);
-    if (!cam) return cam.error().Context("subscribing to the camera");
-    node->camera_sub_ = std::move(*cam);
-  }
-  return node;
-}
-
 AgentNode::AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan)
     : options_(std::move(options)), fc_(std::move(fc)), plan_(std::move(plan)) {
   cmd_.drone = options_.name;
@@ -319,52 +94,6 @@ AgentNode::~AgentNode() = default;
 void AgentNode::Log(const LogEvent& e) {
   std::fprintf(options_.log, "%s\n", e.str().c_str());
   std::fflush(options_.log);
-}
-
-Result<std::unique_ptr<brain::Brain>> AgentNode::MakeBrain(const flight::FlightConfig& config, int period_steps) {
-  const BrainOptions& b = options_.brain;
-  brain::Context ctx;
-  ctx.self = options_.name;
-  ctx.members = options_.raft.members.empty() ? std::vector<std::string>{options_.name} : options_.raft.members;
-  ctx.seed = options_.raft.seed;
-  ctx.period_ns = static_cast<std::int64_t>(std::llround(period_steps * options_.control_dt_s * 1e9));
-  ctx.airframe = config.airframe;
-  ctx.airframe_path = options_.airframe_path;
-  ctx.world_path = options_.mission.world_path;
-  ctx.payload = options_.mission.payload;
-  auto args = brain::ParseBrainArgs(b.args_json);
-  if (!args) return args.error();
-  ctx.args = std::move(*args);
-  ctx.log = [this](const brain::Event& e) {
-    LogEvent line(t_s_, options_.name, e.name);
-    for (const auto& [k, v] : e.fields) line.Add(k, v);
-    Log(line);
-  };
-  LogEvent loaded(0.0, options_.name, "brain_loaded");
-  loaded.Add("kind", BrainKindName(b.kind));
-  std::unique_ptr<brain::Brain> made;
-  if (b.kind == BrainKind::kLibrary) {
-    auto lib = brain::LoadBrain(b.library_path, b.name, ctx);
-    if (!lib) return lib.error().Context("--brain library");
-    loaded.Add("name", b.name).Add("library", b.library_path);
-    made = std::move(*lib);
-  } else {
-    ExternalBrainOptions eo;
-    eo.drone = options_.name;
-    eo.wait = std::chrono::milliseconds(b.wait_ms);
-    eo.start = std::chrono::milliseconds(b.start_ms);
-    eo.stop = options_.stop;
-    eo.log = options_.log;
-    auto ext = ExternalBrain::Create(*sim_, eo);
-    if (!ext) return ext.error().Context("--brain external");
-    loaded.Add("name", bus::OffboardInputTopic(options_.name));
-    made = std::move(*ext);
-  }
-  loaded.Add("period_ms", static_cast<double>(ctx.period_ns) * 1e-6, 1)
-      .Add("offboard_timeout_ms", b.offboard_timeout_ms)
-      .Add("offboard_hold_ms", b.offboard_hold_ms);
-  Log(loaded);
-  return made;
 }
 
 bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
@@ -434,13 +163,18 @@ void AgentNode::OnBrainMessage(const bus::BrainMessage& message, const bus::Radi
   if (brain_host_) brain_host_->OnMessage(message);
 }
 
-Status AgentNode::ServeRadioBetweenSteps() {
+void AgentNode::TakeRadioFrames(const bus::SensorSample& msg) {
   frames_.clear();
-  radio_->TakeReceived(bus::SensorSample{}, &frames_);  // netem: the sample is not looked at
+  if (!radio_) return;
+  radio_->TakeReceived(msg, &frames_);
   if (probe_) {
     for (const bus::RadioFrame& f : frames_) probe_->Heard(f);  // the ping sampling's order
   }
   DispatchFrames(frames_, options_.name, *this, &dispatched_);
+}
+
+Status AgentNode::ServeRadioBetweenSteps() {
+  TakeRadioFrames(bus::SensorSample{});  // netem: the sample is not looked at
   return StepRaftAndProbe();
 }
 
@@ -457,22 +191,33 @@ Status AgentNode::StepRaftAndProbe() {
 }
 
 Status AgentNode::HandleSample(const bus::SensorSample& msg) {
-  using flight::FlightEventKind;
   t_s_ = static_cast<double>(msg.sim_time_ns) * 1e-9;
   sim_clock_.Set(t_s_);
   // a. The camera frame of this step.
   if (!TakeCamera(msg)) return Ok{};  // stop requested: Run() logs it
   cmd_.world.clear();
   // b. What the radio delivered for this step, in delivery order.
-  frames_.clear();
-  if (radio_) {
-    radio_->TakeReceived(msg, &frames_);
-    if (probe_) {
-      for (const bus::RadioFrame& f : frames_) probe_->Heard(f);  // the ping sampling's order
-    }
-    DispatchFrames(frames_, options_.name, *this, &dispatched_);
-  }
+  TakeRadioFrames(msg);
   // c. Flight, Raft, the link probe, the mission or plan, the state broadcast.
+  const FlightStatus st = StepFlight(msg);
+  if (Status s = StepRaftAndProbe(); !s) return s;
+  if (sar_ != nullptr) {
+    StepMission(msg);
+  } else if (brain_host_) {
+    StepBrain(msg);
+  } else {
+    StepPlan(st);
+  }
+  LogBattery();
+  BroadcastState(msg);
+  // d. The step's answer: motors, world commands, Raft leadership, the radio's frames.
+  PublishAnswer();
+  if (telemetry_pub_ && telemetry_clock_.Due(msg.sim_time_ns)) PublishTelemetry(msg);
+  return Ok{};
+}
+
+FlightStatus AgentNode::StepFlight(const bus::SensorSample& msg) {
+  using flight::FlightEventKind;
   const flight::ActuatorOutput& out = fc_.Step(FromBus(msg));
   cmd_.step = msg.step;
   cmd_.sim_time_ns = msg.sim_time_ns;
@@ -498,31 +243,31 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
     le.Add("x", e.pos_m.x(), 2).Add("y", e.pos_m.y(), 2).Add("z", e.pos_m.z(), 2);
     Log(le);
   }
-  if (Status s = StepRaftAndProbe(); !s) return s;
-  if (sar_ != nullptr) {
-    StepMission(msg);
-  } else if (brain_host_) {
-    StepBrain(msg);
-  } else {
-    if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
-    if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
-      plan_index_logged_ = plan_.index();
-      Log(LogEvent(t_s_, options_.name, "plan_step").Add("step", plan_.current()));
-    }
-    if (plan_.finished() && !plan_done_logged_) {
-      plan_done_logged_ = true;
-      Log(LogEvent(t_s_, options_.name, "plan_complete"));
-    }
+  return st;
+}
+
+void AgentNode::StepPlan(const FlightStatus& st) {
+  if (auto sp = plan_.Tick(st)) (void)fc_.Command(*sp);
+  if (plan_.index() != plan_index_logged_ && !plan_.finished()) {
+    plan_index_logged_ = plan_.index();
+    Log(LogEvent(t_s_, options_.name, "plan_step").Add("step", plan_.current()));
   }
-  if (brain_host_ && t_s_ >= next_battery_log_s_) {
-    // The battery once per simulated second, for the trial's plots (SarBrain: its own model, as
-    // BroadcastState sends it).
-    next_battery_log_s_ = std::floor(t_s_) + 1.0;
-    Log(LogEvent(t_s_, options_.name, "battery")
-            .Add("fraction", sar_ != nullptr ? sar_->battery_fraction() : vehicle_.battery_fraction, 4));
+  if (plan_.finished() && !plan_done_logged_) {
+    plan_done_logged_ = true;
+    Log(LogEvent(t_s_, options_.name, "plan_complete"));
   }
-  BroadcastState(msg);
-  // d. The step's answer: motors, world commands, Raft leadership, the radio's frames.
+}
+
+void AgentNode::LogBattery() {
+  if (!brain_host_ || t_s_ < next_battery_log_s_) return;
+  // The battery once per simulated second, for the trial's plots (SarBrain: its own model, as
+  // BroadcastState sends it).
+  next_battery_log_s_ = std::floor(t_s_) + 1.0;
+  Log(LogEvent(t_s_, options_.name, "battery")
+          .Add("fraction", sar_ != nullptr ? sar_->battery_fraction() : vehicle_.battery_fraction, 4));
+}
+
+void AgentNode::PublishAnswer() {
   if (radio_) {
     radio_->Flush(&cmd_);
   } else {
@@ -532,12 +277,9 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
   if (Status s = actuator_pub_->Publish(cmd_); !s) {
     Log(LogEvent(t_s_, options_.name, "bus_error").Add("what", "actuator").Add("reason", s.error().ToString()));
   }
-  if (telemetry_pub_ && telemetry_clock_.Due(msg.sim_time_ns)) PublishTelemetry(msg);
-  return Ok{};
 }
 
 void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   bus::Telemetry& t = telemetry_;
   t.sim_time_ns = msg.sim_time_ns;
   const flight::StateEstimate& est = fc_.estimate();
@@ -546,61 +288,9 @@ void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
   t.attitude_wxyz = {est.att.w(), est.att.x(), est.att.y(), est.att.z()};
   const flight::FlightMode mode = fc_.mode();
   t.flight_mode = std::string(flight::FlightModeName(mode));
-  // The setpoint: what a brain commanded (NaN = the axis it left unset), else the flight
-  // stack's shaped reference (the built-in plan).
-  const brain::Setpoint* flown = brain_host_ ? brain_host_->flown() : nullptr;
-  if (flown != nullptr) {
-    t.setpoint_position_enu_m = {flown->position_m.x, flown->position_m.y, flown->position_m.z};
-    t.setpoint_velocity_enu_m_s = {flown->velocity_m_s.x, flown->velocity_m_s.y, flown->velocity_m_s.z};
-    t.setpoint_yaw_rad = flown->yaw_rad;
-  } else if (brain_host_) {
-    t.setpoint_position_enu_m = {kNaN, kNaN, kNaN};
-    t.setpoint_velocity_enu_m_s = {kNaN, kNaN, kNaN};
-    t.setpoint_yaw_rad = kNaN;
-  } else {
-    const flight::TrajectoryPoint& ref = fc_.telemetry().reference;
-    t.setpoint_position_enu_m = {ref.pos_m.x(), ref.pos_m.y(), ref.pos_m.z()};
-    t.setpoint_velocity_enu_m_s = {ref.vel_m_s.x(), ref.vel_m_s.y(), ref.vel_m_s.z()};
-    t.setpoint_yaw_rad = kNaN;
-  }
-  // Flocking (SarBrain): V18's horizontal terms; separation = repulsion, alignment = Reynolds'
-  // alignment + V18 friction, cohesion, and their sum.
-  const swarm::FlockingOutput* f = sar_ != nullptr ? sar_->flocking() : nullptr;
-  if (f != nullptr) {
-    const swarm::Vec2 align = f->alignment + f->friction;
-    const swarm::Vec2 sum = f->repulsion + align + f->cohesion;
-    t.flock_separation = {f->repulsion.x(), f->repulsion.y(), 0.0};
-    t.flock_alignment = {align.x(), align.y(), 0.0};
-    t.flock_cohesion = {f->cohesion.x(), f->cohesion.y(), 0.0};
-    t.flock_sum = {sum.x(), sum.y(), 0.0};
-  } else {
-    t.flock_separation = t.flock_alignment = t.flock_cohesion = t.flock_sum = {kNaN, kNaN, kNaN};
-  }
-  t.sectors.clear();
-  if (raft_) {
-    const raft_service::RaftService& r = raft_->service();
-    t.raft_role = r.is_learner() ? "learner" : std::string(raft::RoleName(r.role()));
-    t.raft_term = r.term();
-    t.raft_leader = r.leader();
-    t.raft_commit_index = r.commit_index();
-    // The leader's committed plan, on a change and every simulated second.
-    // SarBrain's mission state is Raft's machine behind a reference (FindMission does not see through it).
-    const raft::MissionState* mission = nullptr;
-    if (r.is_leader()) mission = sar_state_ != nullptr ? &sar_state_->mission() : raft_->FindMission();
-    if (mission != nullptr) {
-      SectorsOf(mission->sectors(), &sectors_scratch_);
-      if (t_s_ - sectors_sent_s_ >= 1.0 || sectors_scratch_ != sectors_sent_) {
-        sectors_sent_s_ = t_s_;
-        sectors_sent_ = sectors_scratch_;
-        t.sectors = sectors_scratch_;
-      }
-    }
-  } else {
-    t.raft_role.clear();
-    t.raft_term = 0;
-    t.raft_leader.clear();
-    t.raft_commit_index = 0;
-  }
+  FillTelemetrySetpoint(t);
+  FillTelemetryFlocking(sar_ != nullptr ? sar_->flocking() : nullptr, t);
+  FillTelemetryRaft(t);
   if (sar_ != nullptr) {
     t.battery_fraction = sar_->battery_fraction();
   } else if (brain_host_) {
@@ -621,6 +311,53 @@ void AgentNode::PublishTelemetry(const bus::SensorSample& msg) {
   }
   // Best effort: the recording loses this one if the bus refuses it; the run goes on.
   (void)telemetry_pub_->Publish(t);
+}
+
+void AgentNode::FillTelemetrySetpoint(bus::Telemetry& t) const {
+  // The setpoint: what a brain commanded (NaN = the axis it left unset), else the flight
+  // stack's shaped reference (the built-in plan).
+  const brain::Setpoint* flown = brain_host_ ? brain_host_->flown() : nullptr;
+  if (flown != nullptr) {
+    t.setpoint_position_enu_m = {flown->position_m.x, flown->position_m.y, flown->position_m.z};
+    t.setpoint_velocity_enu_m_s = {flown->velocity_m_s.x, flown->velocity_m_s.y, flown->velocity_m_s.z};
+    t.setpoint_yaw_rad = flown->yaw_rad;
+  } else if (brain_host_) {
+    t.setpoint_position_enu_m = {kNaN, kNaN, kNaN};
+    t.setpoint_velocity_enu_m_s = {kNaN, kNaN, kNaN};
+    t.setpoint_yaw_rad = kNaN;
+  } else {
+    const flight::TrajectoryPoint& ref = fc_.telemetry().reference;
+    t.setpoint_position_enu_m = {ref.pos_m.x(), ref.pos_m.y(), ref.pos_m.z()};
+    t.setpoint_velocity_enu_m_s = {ref.vel_m_s.x(), ref.vel_m_s.y(), ref.vel_m_s.z()};
+    t.setpoint_yaw_rad = kNaN;
+  }
+}
+
+void AgentNode::FillTelemetryRaft(bus::Telemetry& t) {
+  t.sectors.clear();
+  if (!raft_) {
+    t.raft_role.clear();
+    t.raft_term = 0;
+    t.raft_leader.clear();
+    t.raft_commit_index = 0;
+    return;
+  }
+  const raft_service::RaftService& r = raft_->service();
+  t.raft_role = r.is_learner() ? "learner" : std::string(raft::RoleName(r.role()));
+  t.raft_term = r.term();
+  t.raft_leader = r.leader();
+  t.raft_commit_index = r.commit_index();
+  // The leader's committed plan, on a change and every simulated second.
+  // SarBrain's mission state is Raft's machine behind a reference (FindMission does not see through it).
+  const raft::MissionState* mission = nullptr;
+  if (r.is_leader()) mission = sar_state_ != nullptr ? &sar_state_->mission() : raft_->FindMission();
+  if (mission == nullptr) return;
+  SectorsOf(mission->sectors(), &sectors_scratch_);
+  if (t_s_ - sectors_sent_s_ >= 1.0 || sectors_scratch_ != sectors_sent_) {
+    sectors_sent_s_ = t_s_;
+    sectors_sent_ = sectors_scratch_;
+    t.sectors = sectors_scratch_;
+  }
 }
 
 void AgentNode::BroadcastState(const bus::SensorSample& msg) {
@@ -719,80 +456,55 @@ bool AgentNode::Done() const {
   return plan_.finished();
 }
 
+// One wait for the next sample. The timeout counts the time spent waiting, each slice at most its
+// own length: a process stopped (SIGSTOP, docker pause) or starved in the middle of a slice does
+// not find its deadline gone when it resumes. After the first sample the bound is stall_timeout;
+// before it, the wait is for a sign of the server (server_wait.hpp): each sim/status message of
+// its start starts it afresh.
+class AgentNode::SampleWait {
+ public:
+  SampleWait(bool got_any, const AgentOptions& o)
+      : got_any_(got_any),
+        timeout_(got_any ? o.stall_timeout : o.first_sample_timeout),
+        budget_(timeout_),
+        server_(o.first_sample_timeout, o.name) {}
+
+  bool got_any() const { return got_any_; }
+  std::chrono::milliseconds timeout() const { return timeout_; }
+  const ServerWait& server() const { return server_; }
+  bool spent() const { return got_any_ ? budget_.spent() : server_.spent(); }
+  std::chrono::milliseconds Slice(std::chrono::milliseconds max) const {
+    return got_any_ ? budget_.Slice(max) : server_.Slice(max);
+  }
+  // A slice waited without a sample; before the first sample, the server's statuses since.
+  void Spend(std::chrono::steady_clock::duration elapsed, std::chrono::milliseconds slice,
+             bus::Subscriber<bus::Event>& status_sub, bus::Event& status) {
+    if (got_any_) {
+      budget_.Spend(elapsed, slice);
+      return;
+    }
+    server_.Spend(elapsed, slice);
+    while (status_sub.Take(status)) server_.OnStatus(status);
+  }
+
+ private:
+  bool got_any_;
+  std::chrono::milliseconds timeout_;
+  WaitBudget budget_;
+  ServerWait server_;
+};
+
 Status AgentNode::Run() {
-  Log(LogEvent(0.0, options_.name, "ready")
-          .Add("sim_domain", options_.sim_domain)
-          .Add("sim_interface", options_.sim_interface)
-          .Add("middleware", options_.middleware)
-          .Add("radio_model", RadioModelName(options_.radio_model))
-          .Add("brain", BrainKindName(options_.brain.kind))
-          .Add("mission", brain_host_ && sar_ == nullptr ? std::string_view("-") : MissionKindName(options_.mission.kind))
-          .Add("plan", brain_host_ ? std::string("-") : options_.plan)
-          .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
+  LogReady();
   bus::SensorSample msg;
   bus::Event status;
   bool got_any = false;
   while (true) {
-    const auto timeout = got_any ? options_.stall_timeout : options_.first_sample_timeout;
-    // Wait in slices so a stop request is seen while no sample comes. The timeout counts the time
-    // spent waiting, each slice at most its own length: a process stopped (SIGSTOP, docker pause)
-    // or starved in the middle of a slice does not find its deadline gone when it resumes.
-    // Before the first sample the wait is for a sign of the server (server_wait.hpp): each
-    // sim/status message of its start starts it afresh.
-    WaitBudget budget(timeout);
-    ServerWait server(options_.first_sample_timeout, options_.name);
-    auto spent = [&] { return got_any ? budget.spent() : server.spent(); };
-    bool took = false;
-    while (true) {
-      if (options_.stop != nullptr && *options_.stop != 0) {
-        Log(LogEvent(t_s_, options_.name, "stopped").Add("reason", "signal"));
-        return Ok{};
-      }
-      if (spent()) {
-        // Look at the topic once more before giving up (a sample may have come in the last slice).
-        took = sensor_sub_->Take(msg);
-        break;
-      }
-      // netem: the mesh lives on the wall clock whether or not the lockstep moves (a drone the
-      // physics server is waiting for, a stalled server): Raft and the probe go on between
-      // samples, every 10 ms without one.
-      const bool idle_radio = options_.radio_model == RadioModel::kNetem && radio_ && (raft_ || probe_);
-      const auto max_slice = idle_radio ? std::chrono::milliseconds(10) : std::chrono::milliseconds(50);
-      const auto slice = got_any ? budget.Slice(max_slice) : server.Slice(max_slice);
-      const auto start = std::chrono::steady_clock::now();
-      if (sensor_sub_->TakeFor(msg, slice)) {
-        took = true;
-        break;
-      }
-      if (got_any) {
-        budget.Spend(std::chrono::steady_clock::now() - start, slice);
-      } else {
-        server.Spend(std::chrono::steady_clock::now() - start, slice);
-        while (status_sub_->Take(status)) server.OnStatus(status);
-      }
-      if (idle_radio) SWARMBOX_TRY(ServeRadioBetweenSteps());
-    }
-    if (!took) {
-      const double secs = std::chrono::duration<double>(timeout).count();
-      if (!got_any) {
-        return Error(ErrorCode::kUnavailable,
-                     "no sensor sample on " + bus::SensorTopic(options_.name) + " " + server.Reason() +
-                         ": is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
-                         std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
-      }
-      Log(LogEvent(t_s_, options_.name, "samples_stopped")
-              .Add("after_s", secs, 1)
-              .Add("plan", sar_ != nullptr ? std::string_view("sar") : brain_host_ ? std::string_view("brain") : plan_.current()));
-      // A brain has no end of its own: the trial's end stops the samples.
-      if ((brain_host_ && sar_ == nullptr) || Done() || (sar_ != nullptr && sar_->complete())) return Ok{};
-      if (sar_ != nullptr) {
-        return Error(ErrorCode::kUnavailable, "sensor samples stopped for " + Seconds(secs) +
-                                                  " s before the SAR mission was complete (" + sar_->mode() + ")");
-      }
-      return Error(ErrorCode::kUnavailable,
-                   "sensor samples stopped for " + Seconds(secs) + " s before the plan was complete (at '" +
-                       std::string(plan_.current()) + "')");
-    }
+    SampleWait wait(got_any, options_);
+    auto waited = WaitForSample(wait, msg, status);
+    if (!waited) return waited.error();
+    if (*waited == Waited::kStopped) return Ok{};
+    if (*waited == Waited::kTimedOut) return SamplesStopped(wait);
     if (have_step_ && msg.step == last_step_) {
       (void)actuator_pub_->Publish(cmd_);  // a resent sample: answer it again, do not step twice
       continue;
@@ -804,6 +516,64 @@ Status AgentNode::Run() {
     SWARMBOX_TRY(HandleSample(msg));
     if (options_.exit_when_done && Done()) return Ok{};
   }
+}
+
+void AgentNode::LogReady() {
+  Log(LogEvent(0.0, options_.name, "ready")
+          .Add("sim_domain", options_.sim_domain)
+          .Add("sim_interface", options_.sim_interface)
+          .Add("middleware", options_.middleware)
+          .Add("radio_model", RadioModelName(options_.radio_model))
+          .Add("brain", BrainKindName(options_.brain.kind))
+          .Add("mission", brain_host_ && sar_ == nullptr ? std::string_view("-") : MissionKindName(options_.mission.kind))
+          .Add("plan", brain_host_ ? std::string("-") : options_.plan)
+          .Add("raft", raft_ ? options_.raft.raft_dir : std::string("off")));
+}
+
+Result<AgentNode::Waited> AgentNode::WaitForSample(SampleWait& wait, bus::SensorSample& msg, bus::Event& status) {
+  // In slices, so a stop request is seen while no sample comes.
+  while (true) {
+    if (options_.stop != nullptr && *options_.stop != 0) {
+      Log(LogEvent(t_s_, options_.name, "stopped").Add("reason", "signal"));
+      return Waited::kStopped;
+    }
+    if (wait.spent()) {
+      // Look at the topic once more before giving up (a sample may have come in the last slice).
+      return sensor_sub_->Take(msg) ? Waited::kSample : Waited::kTimedOut;
+    }
+    // netem: the mesh lives on the wall clock whether or not the lockstep moves (a drone the
+    // physics server is waiting for, a stalled server): Raft and the probe go on between
+    // samples, every 10 ms without one.
+    const bool idle_radio = options_.radio_model == RadioModel::kNetem && radio_ && (raft_ || probe_);
+    const auto max_slice = idle_radio ? std::chrono::milliseconds(10) : std::chrono::milliseconds(50);
+    const auto slice = wait.Slice(max_slice);
+    const auto start = std::chrono::steady_clock::now();
+    if (sensor_sub_->TakeFor(msg, slice)) return Waited::kSample;
+    wait.Spend(std::chrono::steady_clock::now() - start, slice, *status_sub_, status);
+    if (idle_radio) SWARMBOX_TRY(ServeRadioBetweenSteps());
+  }
+}
+
+Status AgentNode::SamplesStopped(const SampleWait& wait) {
+  const double secs = std::chrono::duration<double>(wait.timeout()).count();
+  if (!wait.got_any()) {
+    return Error(ErrorCode::kUnavailable,
+                 "no sensor sample on " + bus::SensorTopic(options_.name) + " " + wait.server().Reason() +
+                     ": is swarmbox-physics running with this drone on " + options_.middleware + " domain " +
+                     std::to_string(options_.sim_domain) + ", interface " + options_.sim_interface + "?");
+  }
+  Log(LogEvent(t_s_, options_.name, "samples_stopped")
+          .Add("after_s", secs, 1)
+          .Add("plan", sar_ != nullptr ? std::string_view("sar") : brain_host_ ? std::string_view("brain") : plan_.current()));
+  // A brain has no end of its own: the trial's end stops the samples.
+  if ((brain_host_ && sar_ == nullptr) || Done() || (sar_ != nullptr && sar_->complete())) return Ok{};
+  if (sar_ != nullptr) {
+    return Error(ErrorCode::kUnavailable, "sensor samples stopped for " + Seconds(secs) +
+                                              " s before the SAR mission was complete (" + sar_->mode() + ")");
+  }
+  return Error(ErrorCode::kUnavailable,
+               "sensor samples stopped for " + Seconds(secs) + " s before the plan was complete (at '" +
+                   std::string(plan_.current()) + "')");
 }
 
 }  // namespace swarmbox::agent

@@ -138,10 +138,26 @@ class AgentNode final : private FrameHandler {
  private:
   AgentNode(AgentOptions options, flight::FlightController fc, FlightPlan plan);
   void Log(const LogEvent& e);
+  void LogReady();  // event=ready: what the node was started with
+  // Run's wait for the next sample (the stall or the first-sample bound, in slices).
+  class SampleWait;
+  enum class Waited { kSample, kTimedOut, kStopped };
+  // kStopped: stop requested (event=stopped logged). netem: serves the radio while it waits;
+  // Raft's error.
+  Result<Waited> WaitForSample(SampleWait& wait, bus::SensorSample& msg, bus::Event& status);
+  // No sample for the wait's timeout: Ok when the run was over anyway (event=samples_stopped),
+  // else why it ended early.
+  Status SamplesStopped(const SampleWait& wait);
   // Takes the camera frames waiting; with msg.camera_frame, waits (camera_timeout) for the one
   // of this step. false: stop requested while waiting.
   bool TakeCamera(const bus::SensorSample& msg);
   Status HandleSample(const bus::SensorSample& msg);
+  // HandleSample's parts, in its order.
+  void TakeRadioFrames(const bus::SensorSample& msg);  // dispatched to the FrameHandler below
+  FlightStatus StepFlight(const bus::SensorSample& msg);  // the command's motors, event lines
+  void StepPlan(const FlightStatus& st);                  // the built-in plan
+  void LogBattery();                                      // event=battery, brains
+  void PublishAnswer();                                   // the step's ActuatorCommand
   // netem only, while waiting for a sample: the radio's deliveries dispatched, Raft's ticks and
   // the probe on the wall clock (as the mesh does not wait for the lockstep). Raft's error.
   Status ServeRadioBetweenSteps();
@@ -156,6 +172,8 @@ class AgentNode final : private FrameHandler {
   // Every 1/telemetry_hz of simulated time, after the step's answer: what only this agent knows,
   // for the recording. Decides nothing.
   void PublishTelemetry(const bus::SensorSample& msg);
+  void FillTelemetrySetpoint(bus::Telemetry& t) const;
+  void FillTelemetryRaft(bus::Telemetry& t);  // role, term, leader; the leader's plan when it changed
   bool Done() const;  // the plan is complete, or the SAR mission is (and this drone is down)
   // FrameHandler (radio_dispatch.hpp).
   void OnRaftPayload(std::span<const std::uint8_t> bytes) override;
@@ -163,9 +181,29 @@ class AgentNode final : private FrameHandler {
   void OnState(const bus::DroneState& state, const bus::RadioFrame& frame) override;
   void OnDetection(const bus::Detection& detection, const bus::RadioFrame& frame) override;
   void OnBrainMessage(const bus::BrainMessage& message, const bus::RadioFrame& frame) override;
-  // Creates the brain of options_.brain (library or external) with its Context; kInvalidArgument
-  // for what the user must fix (exit 2), bus errors otherwise.
+  void LogBrainEvent(const brain::Event& e);  // a brain's event line, at the agent's simulated time
+
+  // Create's phases, in its order (agent_node_start.cpp). kInvalidArgument for what the user must
+  // fix (exit 2), bus errors otherwise.
+  struct Startup;  // the airframe model and what the brain and perception are made from
+  static Result<Startup> LoadStartup(const AgentOptions& o);  // no bus joined yet
+  static Result<std::unique_ptr<AgentNode>> MakeNode(const AgentOptions& o, const flight::FlightConfig& config);
+  Status StartTelemetry();  // telemetry_hz > 0: the log's tee and the telemetry's clock
+  Status JoinSimBus();      // the sim participant, the sensor and sim/status readers
+  Status StartSimPublishers();  // sim/actuator; sim/telemetry with telemetry_hz > 0
+  // The brain that flies (library, external or SarBrain) and its replicated state; null for the
+  // built-in plan.
+  Result<std::unique_ptr<brain::Brain>> MakeFlyingBrain(const Startup& s);
+  // Creates the brain of options_.brain (library or external) with its Context, logs brain_loaded.
   Result<std::unique_ptr<brain::Brain>> MakeBrain(const flight::FlightConfig& config, int period_steps);
+  Result<std::unique_ptr<brain::Brain>> LoadLibraryBrain(const brain::Context& ctx, LogEvent& loaded);
+  Result<std::unique_ptr<brain::Brain>> StartExternalBrain(LogEvent& loaded);
+  Status StartRadio(bool brain);  // with the mesh: the channel's radio or the mesh domain's
+  Status StartRaft(bool brain);   // with raft.members
+  std::unique_ptr<raft::StateMachine> RaftMachine(bool brain);  // what Raft replicates
+  Status StartLinkProbe();
+  void StartBrainHost(const Startup& s, std::unique_ptr<brain::Brain> brain);  // a brain or SarBrain
+  Status StartPerception(const Startup& s);  // a SAR scout, or a brain on an airframe with a camera
 
   class FlightAdapter;  // FlightPort over fc_
 

@@ -63,9 +63,56 @@ std::vector<std::uint8_t> PosEntry(const std::string& name, double x, double y) 
 
 std::vector<std::uint8_t> ArrivedEntry(const std::string& name) { return Bytes("arrived " + name); }
 
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Where each member stands seen from P: centred (within sqrt(kCentredM2) of P, no bearing: 0.0),
+// else its bearing in (-pi, pi].
+struct Bearings {
+  std::vector<bool> centred;
+  std::vector<double> bearing;
+};
+
+Bearings BearingsFromCentre(const std::vector<double>& x, const std::vector<double>& y, double px, double py) {
+  const std::size_t n = x.size();
+  Bearings b{std::vector<bool>(n), std::vector<double>(n)};
+  for (std::size_t i = 0; i < n; ++i) {
+    const double dx = x[i] - px;
+    const double dy = y[i] - py;
+    b.centred[i] = dx * dx + dy * dy < kCentredM2;
+    double bearing = 0.0;
+    if (!b.centred[i]) {
+      bearing = std::atan2(dy, dx);
+      if (bearing <= -kPi) bearing = kPi;  // (-pi, pi]: atan2(-0.0, -1) is -pi
+    }
+    b.bearing[i] = bearing;
+  }
+  return b;
+}
+
+// Each member's rank on the ring: how many members come before it.
+std::vector<std::size_t> RanksOnRing(const Bearings& b) {
+  const std::size_t n = b.centred.size();
+  // Whether member j comes before member i on the ring.
+  const auto before = [&](std::size_t j, std::size_t i) {
+    if (b.centred[j] != b.centred[i]) return static_cast<bool>(b.centred[i]);  // the centred ones last
+    if (!b.centred[i] && b.bearing[j] != b.bearing[i]) return b.bearing[j] < b.bearing[i];
+    return j < i;  // the same bearing (exactly), or both centred: by name
+  };
+  std::vector<std::size_t> rank(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < n; ++j) {
+      if (j != i && before(j, i)) ++rank[i];
+    }
+  }
+  return rank;
+}
+
+}  // namespace
+
 Ring PlaceRing(const std::vector<double>& x, const std::vector<double>& y, double radius_m,
                double altitude_m) {
-  constexpr double kPi = std::numbers::pi;
   const std::size_t n = x.size();
   Ring ring;
   double sx = 0.0;
@@ -78,32 +125,11 @@ Ring PlaceRing(const std::vector<double>& x, const std::vector<double>& y, doubl
   ring.px = sx / count;
   ring.py = sy / count;
 
-  std::vector<bool> centred(n);
-  std::vector<double> bearing(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double dx = x[i] - ring.px;
-    const double dy = y[i] - ring.py;
-    centred[i] = dx * dx + dy * dy < kCentredM2;
-    double b = 0.0;
-    if (!centred[i]) {
-      b = std::atan2(dy, dx);
-      if (b <= -kPi) b = kPi;  // (-pi, pi]: atan2(-0.0, -1) is -pi
-    }
-    bearing[i] = b;
-  }
-  // Whether member j comes before member i on the ring.
-  const auto before = [&](std::size_t j, std::size_t i) {
-    if (centred[j] != centred[i]) return static_cast<bool>(centred[i]);  // the centred ones last
-    if (!centred[i] && bearing[j] != bearing[i]) return bearing[j] < bearing[i];
-    return j < i;  // the same bearing (exactly), or both centred: by name
-  };
-  std::vector<std::size_t> rank(n, 0);
+  const Bearings b = BearingsFromCentre(x, y, ring.px, ring.py);
+  const std::vector<std::size_t> rank = RanksOnRing(b);
   double a0 = 0.0;  // the first one's bearing; 0 when every member is centred
   for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t j = 0; j < n; ++j) {
-      if (j != i && before(j, i)) ++rank[i];
-    }
-    if (rank[i] == 0 && !centred[i]) a0 = bearing[i];
+    if (rank[i] == 0 && !b.centred[i]) a0 = b.bearing[i];
   }
   ring.slots.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -166,79 +192,98 @@ void RendezvousBrain::SetpointToSlot(sb::Output& out) const {
 
 void RendezvousBrain::Step(const sb::Input& in, sb::Output& out) {
   for (const sb::Entry& entry : in.committed) Apply(entry);
-
-  if (phase_ == Phase::kTakeoff) {
-    bool rejected = false;
-    for (const sb::FlightEvent& ev : in.flight_events) rejected = rejected || ev.name == "setpoint_rejected";
-    // A take-off refused on the ground (the estimator was not ready) is asked again.
-    if (rejected && in.self.landed) takeoff_asked_ = false;
-    if (!takeoff_asked_ && in.self.landed && in.self.flight_mode != "init") {
-      out.commands.push_back(sb::Command::Takeoff(altitude_m_));
-      takeoff_asked_ = true;
-    } else if (takeoff_asked_ && Airborne(in)) {
-      phase_ = Phase::kVoting;
-      proposed_ = false;
-      pos_entry_ = PosEntry(self_, in.self.position_m.x, in.self.position_m.y);
-    }
-  }
-  if (phase_ == Phase::kVoting) {
-    ProposeUntil(positions_.count(self_) > 0, pos_entry_, in.t_ns, out);
-    if (positions_.size() == members_.size()) {
-      std::vector<double> x;
-      std::vector<double> y;
-      for (const std::string& m : members_) {  // sorted order: the same ring on every drone
-        x.push_back(positions_.at(m).x);
-        y.push_back(positions_.at(m).y);
-      }
-      const Ring ring = PlaceRing(x, y, radius_m_, altitude_m_);
-      slot_ = ring.slots[index_];
-      out.events.push_back({"rendezvous_point", {{"x", Fixed3(ring.px)}, {"y", Fixed3(ring.py)}}});
-      phase_ = Phase::kFlying;
-    }
-  }
-  if (phase_ == Phase::kFlying) {
-    SetpointToSlot(out);
-    const double dx = in.self.position_m.x - slot_.x;
-    const double dy = in.self.position_m.y - slot_.y;
-    if (std::hypot(dx, dy) <= kArrivedM) {
-      phase_ = Phase::kArrived;
-      proposed_ = false;
-    }
-  }
-  if (phase_ == Phase::kArrived) {
-    if (out.setpoint.empty()) SetpointToSlot(out);
-    ProposeUntil(arrived_.count(self_) > 0, ArrivedEntry(self_), in.t_ns, out);
-    if (arrived_.size() == members_.size()) {
-      phase_ = Phase::kHolding;
-      land_at_ns_ = in.t_ns + hold_ns_;
-    }
-  }
+  // A phase that ends hands the same step to the next one.
+  if (phase_ == Phase::kTakeoff) StepTakeoff(in, out);
+  if (phase_ == Phase::kVoting) StepVoting(in, out);
+  if (phase_ == Phase::kFlying) StepFlying(in, out);
+  if (phase_ == Phase::kArrived) StepArrived(in, out);
   if (phase_ == Phase::kHolding) {
-    if (in.t_ns >= land_at_ns_) {
-      out.setpoint.clear();  // the land command is the last word
-      out.commands.push_back(sb::Command::Land());
-      phase_ = Phase::kLanding;
-    } else if (out.setpoint.empty()) {
-      SetpointToSlot(out);
-    }
+    StepHolding(in, out);
   } else if (phase_ == Phase::kLanding) {
-    bool landed = in.self.landed;
-    for (const sb::FlightEvent& ev : in.flight_events) landed = landed || ev.name == "landed";
-    if (landed) {
-      out.events.push_back({"rendezvous_complete", {{"members", std::to_string(members_.size())}}});
-      phase_ = Phase::kDone;
-    }
+    StepLanding(in, out);
   }
+  out.status = StatusOf(phase_);
+}
 
-  switch (phase_) {
-    case Phase::kTakeoff: out.status = "rendezvous/takeoff"; break;
-    case Phase::kVoting: out.status = "rendezvous/voting"; break;
-    case Phase::kFlying: out.status = "rendezvous/flying"; break;
-    case Phase::kArrived: out.status = "rendezvous/arrived"; break;
-    case Phase::kHolding:
-    case Phase::kLanding: out.status = "rendezvous/landing"; break;
-    case Phase::kDone: out.status = "rendezvous/done"; break;
+void RendezvousBrain::StepTakeoff(const sb::Input& in, sb::Output& out) {
+  bool rejected = false;
+  for (const sb::FlightEvent& ev : in.flight_events) rejected = rejected || ev.name == "setpoint_rejected";
+  // A take-off refused on the ground (the estimator was not ready) is asked again.
+  if (rejected && in.self.landed) takeoff_asked_ = false;
+  if (!takeoff_asked_ && in.self.landed && in.self.flight_mode != "init") {
+    out.commands.push_back(sb::Command::Takeoff(altitude_m_));
+    takeoff_asked_ = true;
+  } else if (takeoff_asked_ && Airborne(in)) {
+    phase_ = Phase::kVoting;
+    proposed_ = false;
+    pos_entry_ = PosEntry(self_, in.self.position_m.x, in.self.position_m.y);
   }
+}
+
+void RendezvousBrain::StepVoting(const sb::Input& in, sb::Output& out) {
+  ProposeUntil(positions_.count(self_) > 0, pos_entry_, in.t_ns, out);
+  if (positions_.size() != members_.size()) return;
+  std::vector<double> x;
+  std::vector<double> y;
+  for (const std::string& m : members_) {  // sorted order: the same ring on every drone
+    x.push_back(positions_.at(m).x);
+    y.push_back(positions_.at(m).y);
+  }
+  const Ring ring = PlaceRing(x, y, radius_m_, altitude_m_);
+  slot_ = ring.slots[index_];
+  out.events.push_back({"rendezvous_point", {{"x", Fixed3(ring.px)}, {"y", Fixed3(ring.py)}}});
+  phase_ = Phase::kFlying;
+}
+
+void RendezvousBrain::StepFlying(const sb::Input& in, sb::Output& out) {
+  SetpointToSlot(out);
+  const double dx = in.self.position_m.x - slot_.x;
+  const double dy = in.self.position_m.y - slot_.y;
+  if (std::hypot(dx, dy) <= kArrivedM) {
+    phase_ = Phase::kArrived;
+    proposed_ = false;
+  }
+}
+
+void RendezvousBrain::StepArrived(const sb::Input& in, sb::Output& out) {
+  if (out.setpoint.empty()) SetpointToSlot(out);
+  ProposeUntil(arrived_.count(self_) > 0, ArrivedEntry(self_), in.t_ns, out);
+  if (arrived_.size() == members_.size()) {
+    phase_ = Phase::kHolding;
+    land_at_ns_ = in.t_ns + hold_ns_;
+  }
+}
+
+void RendezvousBrain::StepHolding(const sb::Input& in, sb::Output& out) {
+  if (in.t_ns >= land_at_ns_) {
+    out.setpoint.clear();  // the land command is the last word
+    out.commands.push_back(sb::Command::Land());
+    phase_ = Phase::kLanding;
+  } else if (out.setpoint.empty()) {
+    SetpointToSlot(out);
+  }
+}
+
+void RendezvousBrain::StepLanding(const sb::Input& in, sb::Output& out) {
+  bool landed = in.self.landed;
+  for (const sb::FlightEvent& ev : in.flight_events) landed = landed || ev.name == "landed";
+  if (landed) {
+    out.events.push_back({"rendezvous_complete", {{"members", std::to_string(members_.size())}}});
+    phase_ = Phase::kDone;
+  }
+}
+
+const char* RendezvousBrain::StatusOf(Phase phase) {
+  switch (phase) {
+    case Phase::kTakeoff: return "rendezvous/takeoff";
+    case Phase::kVoting: return "rendezvous/voting";
+    case Phase::kFlying: return "rendezvous/flying";
+    case Phase::kArrived: return "rendezvous/arrived";
+    case Phase::kHolding:
+    case Phase::kLanding: return "rendezvous/landing";
+    case Phase::kDone: return "rendezvous/done";
+  }
+  return "rendezvous/done";  // not reached: every phase is listed above
 }
 
 }  // namespace rendezvous

@@ -77,6 +77,14 @@ class RendezvousBrain final : public swarmbox::brain::Brain {
   void ProposeUntil(bool committed, const std::vector<std::uint8_t>& entry, std::int64_t t_ns,
                     swarmbox::brain::Output& out);
   void SetpointToSlot(swarmbox::brain::Output& out) const;
+  // One step of each phase (Step runs them in order: a phase that ends hands the step on).
+  void StepTakeoff(const swarmbox::brain::Input& in, swarmbox::brain::Output& out);
+  void StepVoting(const swarmbox::brain::Input& in, swarmbox::brain::Output& out);  // then the ring
+  void StepFlying(const swarmbox::brain::Input& in, swarmbox::brain::Output& out);
+  void StepArrived(const swarmbox::brain::Input& in, swarmbox::brain::Output& out);
+  void StepHolding(const swarmbox::brain::Input& in, swarmbox::brain::Output& out);
+  void StepLanding(const swarmbox::brain::Input& in, swarmbox::brain::Output& out);
+  static const char* StatusOf(Phase phase);  // Output::status
 
   std::string self_;
   std::vector<std::string> members_;  // sorted
