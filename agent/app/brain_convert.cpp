@@ -99,6 +99,13 @@ bus::Event EventToBus(const std::string& node, std::int64_t t_ns, const std::str
   return e;
 }
 
+// `to` cleared, then each element of `from` converted into it, in order.
+template <typename From, typename To, typename Convert>
+void ConvertAll(const From& from, To* to, const Convert& convert) {
+  to->clear();
+  for (const auto& x : from) to->push_back(convert(x));
+}
+
 bus::DroneState NeighbourToBus(const brain::Neighbour& n) {
   bus::DroneState s;
   NeighbourFields(n, s, ToWire{});
@@ -181,39 +188,33 @@ void ToBus(const brain::Input& in, const std::string& drone, bus::BrainInput* ou
   out->drone = drone;
   out->sim_time_ns = in.t_ns;
   out->vehicle = VehicleToBus(in.self, in.t_ns);
-  out->flight_events.clear();
-  for (const brain::FlightEvent& e : in.flight_events) {
-    out->flight_events.push_back(EventToBus(drone, e.t_ns, e.name, e.fields));
-  }
+  ConvertAll(in.flight_events, &out->flight_events,
+             [&drone](const brain::FlightEvent& e) { return EventToBus(drone, e.t_ns, e.name, e.fields); });
   out->is_leader = in.is_leader;
   out->leader = in.leader;
-  out->neighbours.clear();
-  for (const brain::Neighbour& n : in.neighbours) out->neighbours.push_back(NeighbourToBus(n));
-  out->messages.clear();
-  for (const brain::Message& m : in.messages) out->messages.push_back(MessageToBus(m));
-  out->committed.clear();
-  for (const brain::Entry& e : in.committed) out->committed.push_back({e.index, e.data});
-  out->detections.clear();
-  for (const brain::Detection& d : in.detections) out->detections.push_back(DetectionToBus(d, drone));
+  ConvertAll(in.neighbours, &out->neighbours, NeighbourToBus);
+  ConvertAll(in.messages, &out->messages, MessageToBus);
+  ConvertAll(in.committed, &out->committed, [](const brain::Entry& e) {
+    return bus::CommittedEntry{e.index, e.data};
+  });
+  ConvertAll(in.detections, &out->detections,
+             [&drone](const brain::Detection& d) { return DetectionToBus(d, drone); });
 }
 
 void FromBus(const bus::BrainInput& in, InputBuffers* out) {
-  out->flight_events.clear();
-  for (const bus::Event& e : in.flight_events) {
+  ConvertAll(in.flight_events, &out->flight_events, [](const bus::Event& e) {
     brain::FlightEvent f;
     f.name = e.name;
     f.t_ns = e.sim_time_ns;
     for (const bus::KeyValue& kv : e.fields) f.fields[kv.key] = kv.value;
-    out->flight_events.push_back(std::move(f));
-  }
-  out->neighbours.clear();
-  for (const bus::DroneState& s : in.neighbours) out->neighbours.push_back(NeighbourFromBus(s));
-  out->messages.clear();
-  for (const bus::BrainMessage& m : in.messages) out->messages.push_back(MessageFromBus(m));
-  out->committed.clear();
-  for (const bus::CommittedEntry& e : in.committed) out->committed.push_back({e.index, e.data});
-  out->detections.clear();
-  for (const bus::Detection& d : in.detections) out->detections.push_back(DetectionFromBus(d));
+    return f;
+  });
+  ConvertAll(in.neighbours, &out->neighbours, NeighbourFromBus);
+  ConvertAll(in.messages, &out->messages, MessageFromBus);
+  ConvertAll(in.committed, &out->committed, [](const bus::CommittedEntry& e) {
+    return brain::Entry{e.index, e.data};
+  });
+  ConvertAll(in.detections, &out->detections, DetectionFromBus);
   brain::Input& i = out->input;
   i = brain::Input{};
   i.t_ns = in.sim_time_ns;
@@ -230,17 +231,16 @@ void FromBus(const bus::BrainInput& in, InputBuffers* out) {
 void ToBus(const brain::Output& out, const std::string& drone, std::int64_t t_ns, bus::BrainOutput* wire) {
   wire->drone = drone;
   wire->sim_time_ns = t_ns;
-  wire->setpoint.clear();
-  for (const brain::Setpoint& sp : out.setpoint) wire->setpoint.push_back(SetpointToBus(sp));
-  wire->commands.clear();
-  for (const brain::Command& c : out.commands) wire->commands.push_back({brain::CommandName(c.kind), c.param});
-  wire->messages.clear();
-  for (const brain::Message& m : out.messages) wire->messages.push_back(MessageToBus(m));
-  wire->proposals.clear();
-  for (const std::vector<std::uint8_t>& p : out.proposals) wire->proposals.push_back({p});
+  ConvertAll(out.setpoint, &wire->setpoint, SetpointToBus);
+  ConvertAll(out.commands, &wire->commands, [](const brain::Command& c) {
+    return bus::VehicleCommand{std::string(brain::CommandName(c.kind)), c.param};
+  });
+  ConvertAll(out.messages, &wire->messages, MessageToBus);
+  ConvertAll(out.proposals, &wire->proposals,
+             [](const std::vector<std::uint8_t>& p) { return bus::Proposal{p}; });
   wire->status = out.status;
-  wire->events.clear();
-  for (const brain::Event& e : out.events) wire->events.push_back(EventToBus(drone, t_ns, e.name, e.fields));
+  ConvertAll(out.events, &wire->events,
+             [&drone, t_ns](const brain::Event& e) { return EventToBus(drone, t_ns, e.name, e.fields); });
 }
 
 Status FromBus(const bus::BrainOutput& wire, brain::Output* out) {

@@ -142,22 +142,22 @@ void BrainHost::ApplyCommand(const brain::Command& c, std::int64_t t_ns, std::ve
   }
 }
 
-void BrainHost::Apply(std::int64_t t_ns, std::vector<bus::WorldCommand>* world, bool fly) {
-  const double t_s = Seconds(t_ns);
-  if (fly) {
-    for (const brain::Command& c : out_.commands) ApplyCommand(c, t_ns, world);
-    if (!out_.commands.empty()) has_flown_ = false;  // a command replaced what was flying
-    if (!out_.setpoint.empty()) {
-      if (out_.setpoint.size() > 1) Reject(t_s, "setpoint", "more than one setpoint; the first is flown");
-      const brain::Setpoint& sp = out_.setpoint.front();
-      // The same setpoint streamed again (PX4 offboard style) keeps flying the one commanded:
-      // commanding it anew would restart the position trajectory at every period.
-      if (!has_flown_ || !SameSetpoint(sp, flown_)) {
-        has_flown_ = flight_.Command(FlightSetpointOf(sp));
-        flown_ = sp;
-      }
-    }
+void BrainHost::Fly(std::int64_t t_ns, std::vector<bus::WorldCommand>* world) {
+  for (const brain::Command& c : out_.commands) ApplyCommand(c, t_ns, world);
+  if (!out_.commands.empty()) has_flown_ = false;  // a command replaced what was flying
+  if (out_.setpoint.empty()) return;
+  if (out_.setpoint.size() > 1)
+    Reject(Seconds(t_ns), "setpoint", "more than one setpoint; the first is flown");
+  const brain::Setpoint& sp = out_.setpoint.front();
+  // The same setpoint streamed again (PX4 offboard style) keeps flying the one commanded:
+  // commanding it anew would restart the position trajectory at every period.
+  if (!has_flown_ || !SameSetpoint(sp, flown_)) {
+    has_flown_ = flight_.Command(FlightSetpointOf(sp));
+    flown_ = sp;
   }
+}
+
+void BrainHost::SendMessages(double t_s) {
   for (const brain::Message& m : out_.messages) {
     if (radio_ == nullptr) {
       if (!warned_radio_) Reject(t_s, "message", "no radio (--no-mesh)");
@@ -171,6 +171,9 @@ void BrainHost::Apply(std::int64_t t_ns, std::vector<bus::WorldCommand>* world, 
     f.brain_msg.push_back(std::move(b));
     radio_->Send(std::move(f));  // best effort, as the radio
   }
+}
+
+void BrainHost::Propose(double t_s) {
   for (const std::vector<std::uint8_t>& p : out_.proposals) {
     if (consensus_ == nullptr) {
       if (!warned_consensus_) Reject(t_s, "proposal", "no consensus (--members)");
@@ -183,6 +186,13 @@ void BrainHost::Apply(std::int64_t t_ns, std::vector<bus::WorldCommand>* world, 
     }
     (void)consensus_->Propose(p);  // not accepted (no leader yet): the brain re-proposes
   }
+}
+
+void BrainHost::Apply(std::int64_t t_ns, std::vector<bus::WorldCommand>* world, bool fly) {
+  const double t_s = Seconds(t_ns);
+  if (fly) Fly(t_ns, world);
+  SendMessages(t_s);
+  Propose(t_s);
   status_ = out_.status;
   for (const brain::Event& e : out_.events) {
     LogEvent line(t_s, options_.self, e.name);
@@ -191,53 +201,70 @@ void BrainHost::Apply(std::int64_t t_ns, std::vector<bus::WorldCommand>* world, 
   }
 }
 
-void BrainHost::Step(std::uint64_t step, std::int64_t t_ns, const brain::Vehicle& vehicle,
-                     std::vector<bus::WorldCommand>* world) {
-  const double t_s = Seconds(t_ns);
+bool BrainHost::StepBrain(std::int64_t t_ns, const brain::Vehicle& vehicle) {
+  BuildInput(t_ns, vehicle);
+  out_.Clear();
   bool answered = false;
-  if (step % static_cast<std::uint64_t>(options_.period_steps) == 0) {
-    BuildInput(t_ns, vehicle);
-    out_.Clear();
-    if (!failed_) {
-      try {
-        brain_->Step(in_, out_);
-        ++brain_steps_;
-        answered = remote_ == nullptr || remote_->answered();
-      } catch (const std::exception& e) {
-        // A broken contract (Step must not throw): the brain is not called again, its state is
-        // unknown; the offboard failsafe brings the drone down.
-        failed_ = true;
-        Log(LogEvent(t_s, options_.self, "brain_failed").Add("reason", e.what()));
-      } catch (...) {
-        failed_ = true;
-        Log(LogEvent(t_s, options_.self, "brain_failed").Add("reason", "a non-standard exception"));
-      }
+  if (!failed_) {
+    try {
+      brain_->Step(in_, out_);
+      ++brain_steps_;
+      answered = remote_ == nullptr || remote_->answered();
+    } catch (const std::exception& e) {
+      // A broken contract (Step must not throw): the brain is not called again, its state is
+      // unknown; the offboard failsafe brings the drone down.
+      failed_ = true;
+      Log(LogEvent(Seconds(t_ns), options_.self, "brain_failed").Add("reason", e.what()));
+    } catch (...) {
+      failed_ = true;
+      Log(LogEvent(Seconds(t_ns), options_.self, "brain_failed").Add("reason", "a non-standard exception"));
     }
-    flight_events_.clear();
-    messages_.clear();
-    detections_.clear();
   }
+  flight_events_.clear();
+  messages_.clear();
+  detections_.clear();
+  return answered;
+}
+
+namespace {
+
+// A failsafe event as the brain sees it among its flight events.
+brain::FlightEvent FailsafeFlightEvent(const flight::OffboardFailsafe::Event& e) {
+  brain::FlightEvent fe;
+  fe.name = std::string(flight::OffboardFailsafe::EventName(e.kind));
+  fe.t_ns = std::llround(e.t_s * 1e9);
+  fe.fields["silent_s"] = FormatFixed(e.silent_s, 3);
+  fe.fields["action"] = std::string(flight::OffboardFailsafe::ActionName(e.action));
+  return fe;
+}
+
+}  // namespace
+
+flight::OffboardFailsafe::Action BrainHost::UpdateFailsafe(double t_s, bool answered, bool landed) {
   using Action = flight::OffboardFailsafe::Action;
   const Action before = failsafe_.action();
   const Action action = failsafe_.Update(t_s, answered);
   flight::OffboardFailsafe::Event e;
   while (failsafe_.PopEvent(&e)) {
     Log(flight::OffboardFailsafe::ToLogEvent(e, options_.self));
-    brain::FlightEvent fe;
-    fe.name = std::string(flight::OffboardFailsafe::EventName(e.kind));
-    fe.t_ns = std::llround(e.t_s * 1e9);
-    fe.fields["silent_s"] = FormatFixed(e.silent_s, 3);
-    fe.fields["action"] = std::string(flight::OffboardFailsafe::ActionName(e.action));
-    flight_events_.push_back(std::move(fe));
+    flight_events_.push_back(FailsafeFlightEvent(e));
   }
   if (action != before) has_flown_ = false;  // the failsafe took over (or gave back)
-  if (action != before && !vehicle.landed) {  // on the ground there is nothing to hold or land
+  if (action != before && !landed) {         // on the ground there is nothing to hold or land
     if (action == Action::kHold) (void)flight_.Command(flight::Setpoint::Hold());
     if (action == Action::kLand) (void)flight_.Command(flight::Setpoint::Land());
   }
+  return action;
+}
+
+void BrainHost::Step(std::uint64_t step, std::int64_t t_ns, const brain::Vehicle& vehicle,
+                     std::vector<bus::WorldCommand>* world) {
+  const bool period = step % static_cast<std::uint64_t>(options_.period_steps) == 0;
+  const bool answered = period && StepBrain(t_ns, vehicle);
+  const auto action = UpdateFailsafe(Seconds(t_ns), answered, vehicle.landed);
   if (answered) {
     ++answers_;
-    Apply(t_ns, world, action == Action::kNone);
+    Apply(t_ns, world, action == flight::OffboardFailsafe::Action::kNone);
   }
 }
 

@@ -131,7 +131,17 @@ class BrainHost {
 
  private:
   void BuildInput(std::int64_t t_ns, const brain::Vehicle& vehicle);
+  // The brain's period: its Step on this Input (unless it failed), the inbox emptied; true when
+  // it answered.
+  bool StepBrain(std::int64_t t_ns, const brain::Vehicle& vehicle);
+  // The failsafe after this step (its events logged and handed to the brain's next Input); a
+  // change takes the flight stack over, in the air.
+  flight::OffboardFailsafe::Action UpdateFailsafe(double t_s, bool answered, bool landed);
+  // The Output: flown (fly: the failsafe is not in charge), sent, proposed, logged.
   void Apply(std::int64_t t_ns, std::vector<bus::WorldCommand>* world, bool fly);
+  void Fly(std::int64_t t_ns, std::vector<bus::WorldCommand>* world);  // commands, then the setpoint
+  void SendMessages(double t_s);
+  void Propose(double t_s);
   void ApplyCommand(const brain::Command& c, std::int64_t t_ns, std::vector<bus::WorldCommand>* world);
   void Log(const LogEvent& e);
   void Reject(double t_s, const std::string& what, const std::string& reason);

@@ -36,48 +36,57 @@ bool ExternalBrain::TakeAnswer(std::int64_t t_ns, std::chrono::milliseconds slic
   return false;
 }
 
-void ExternalBrain::Step(const brain::Input& in, brain::Output& out) {
-  answered_ = false;
-  const double t_s = static_cast<double>(in.t_ns) * 1e-9;
+void ExternalBrain::PublishInput(const brain::Input& in, double t_s) {
   ToBus(in, options_.drone, &wire_in_);
   if (Status s = input_pub_->Publish(wire_in_); !s && options_.log != nullptr) {
     std::fprintf(options_.log, "%s\n",
                  LogEvent(t_s, options_.drone, "bus_error").Add("what", "brain_input").Add("reason", s.error().ToString()).str().c_str());
   }
-  heard_ = false;
-  bool got = false;
-  if (unresponsive_) {
-    got = TakeAnswer(in.t_ns, std::chrono::milliseconds(0));  // no waiting until it answers again
-    if (heard_) {
-      unresponsive_ = false;
-      Log(t_s, "brain_responsive", -1.0);
+}
+
+bool ExternalBrain::PollUnresponsive(std::int64_t t_ns, double t_s) {
+  const bool got = TakeAnswer(t_ns, std::chrono::milliseconds(0));  // no waiting until it answers again
+  if (heard_) {
+    unresponsive_ = false;
+    Log(t_s, "brain_responsive", -1.0);
+  }
+  return got;
+}
+
+bool ExternalBrain::WaitForAnswer(std::int64_t t_ns, double t_s) {
+  const std::chrono::milliseconds bound = ever_answered_ ? options_.wait : options_.start;
+  WaitBudget budget(bound);
+  auto next_resend = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
+  while (true) {
+    if (options_.stop != nullptr && *options_.stop != 0) return false;
+    if (budget.spent()) {
+      const bool got = TakeAnswer(t_ns, std::chrono::milliseconds(0));  // once more before giving up
+      if (!got) {
+        unresponsive_ = true;
+        Log(t_s, "brain_unresponsive", std::chrono::duration<double>(bound).count());
+      }
+      return got;
     }
-  } else {
-    const std::chrono::milliseconds bound = ever_answered_ ? options_.wait : options_.start;
-    WaitBudget budget(bound);
-    auto next_resend = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
-    while (!got) {
-      if (options_.stop != nullptr && *options_.stop != 0) return;
-      if (budget.spent()) {
-        got = TakeAnswer(in.t_ns, std::chrono::milliseconds(0));  // once more before giving up
-        if (!got) {
-          unresponsive_ = true;
-          Log(t_s, "brain_unresponsive", std::chrono::duration<double>(bound).count());
-        }
-        break;
-      }
-      const auto slice = budget.Slice(std::chrono::milliseconds(50));
-      const auto start = std::chrono::steady_clock::now();
-      got = TakeAnswer(in.t_ns, slice);
-      const auto now = std::chrono::steady_clock::now();
-      budget.Spend(now - start, slice);
-      if (!got && !ever_answered_ && now >= next_resend) {
-        // Not heard from yet: its reader may have matched after the input went out.
-        (void)input_pub_->Publish(wire_in_);
-        next_resend = now + std::chrono::milliseconds(100);
-      }
+    const auto slice = budget.Slice(std::chrono::milliseconds(50));
+    const auto start = std::chrono::steady_clock::now();
+    const bool got = TakeAnswer(t_ns, slice);
+    const auto now = std::chrono::steady_clock::now();
+    budget.Spend(now - start, slice);
+    if (got) return true;
+    if (!ever_answered_ && now >= next_resend) {
+      // Not heard from yet: its reader may have matched after the input went out.
+      (void)input_pub_->Publish(wire_in_);
+      next_resend = now + std::chrono::milliseconds(100);
     }
   }
+}
+
+void ExternalBrain::Step(const brain::Input& in, brain::Output& out) {
+  answered_ = false;
+  const double t_s = static_cast<double>(in.t_ns) * 1e-9;
+  PublishInput(in, t_s);
+  heard_ = false;
+  const bool got = unresponsive_ ? PollUnresponsive(in.t_ns, t_s) : WaitForAnswer(in.t_ns, t_s);
   if (!got) return;
   if (Status s = FromBus(wire_out_, &out); !s) {
     out = brain::Output{};

@@ -54,6 +54,12 @@ class ExternalBrain final : public RemoteBrain {
   // in wire_out_.
   bool TakeAnswer(std::int64_t t_ns, std::chrono::milliseconds slice);
   void Log(double t_s, const char* event, double after_wall_s);
+  void PublishInput(const brain::Input& in, double t_s);  // a bus error is logged, not fatal
+  // The answer to the input at t_ns, into wire_out_: unresponsive, only what has arrived (and
+  // back to responsive once anything arrives); otherwise waiting up to the wall-clock bound,
+  // resending until the first answer ever. false: none (or options_.stop was set).
+  bool PollUnresponsive(std::int64_t t_ns, double t_s);
+  bool WaitForAnswer(std::int64_t t_ns, double t_s);
 
   ExternalBrainOptions options_;
   std::unique_ptr<bus::Publisher<bus::BrainInput>> input_pub_;

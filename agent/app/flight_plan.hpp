@@ -70,6 +70,11 @@ class FlightPlan final : public SetpointSource {
   const std::vector<Step>& steps() const { return steps_; }
 
  private:
+  // A take-off waits on the ground for the preflight time; every other step starts at once.
+  bool ReadyToStart(const Step& step, const FlightStatus& status);
+  // The started step is done (or refused); `out`: a setpoint to end it with (a velocity leg holds).
+  bool StepDone(const Step& step, const FlightStatus& status, std::optional<flight::Setpoint>* out) const;
+
   std::vector<Step> steps_;
   std::size_t index_ = 0;
   bool started_ = false;       // the current step's setpoint was sent

@@ -1,6 +1,7 @@
 #include "raft_host.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <utility>
 
 #include "swarmbox/bus/topics.hpp"
@@ -9,22 +10,39 @@
 
 namespace swarmbox::agent {
 
-Result<std::vector<std::string>> ParseMembers(std::string_view text, std::string_view self) {
+namespace {
+
+// The comma-separated names of `flag`: none empty, each passing `check`, none twice (checked in
+// that order for each name, in the list's order).
+Result<std::vector<std::string>> ParseNameList(std::string_view text, const std::string& flag,
+                                               const std::function<Status(const std::string&)>& check) {
   std::vector<std::string> out;
   std::size_t start = 0;
   while (true) {
     const std::size_t comma = text.find(',', start);
     const std::string item(text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    if (item.empty()) return Error(ErrorCode::kInvalidArgument, "--members '" + std::string(text) + "': empty name");
-    if (Status s = bus::ValidateDroneName(item); !s) return s.error().Context("--members");
+    if (item.empty())
+      return Error(ErrorCode::kInvalidArgument, flag + " '" + std::string(text) + "': empty name");
+    SWARMBOX_TRY(check(item));
     if (std::find(out.begin(), out.end(), item) != out.end()) {
-      return Error(ErrorCode::kInvalidArgument, "--members: '" + item + "' listed twice");
+      return Error(ErrorCode::kInvalidArgument, flag + ": '" + item + "' listed twice");
     }
     out.push_back(item);
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
-  if (std::find(out.begin(), out.end(), self) == out.end()) {
+  return out;
+}
+
+}  // namespace
+
+Result<std::vector<std::string>> ParseMembers(std::string_view text, std::string_view self) {
+  auto out = ParseNameList(text, "--members", [](const std::string& item) -> Status {
+    if (Status s = bus::ValidateDroneName(item); !s) return s.error().Context("--members");
+    return Ok{};
+  });
+  if (!out) return out.error();
+  if (std::find(out->begin(), out->end(), self) == out->end()) {
     return Error(ErrorCode::kInvalidArgument,
                  "--members '" + std::string(text) + "' does not include this drone ('" + std::string(self) + "')");
   }
@@ -32,23 +50,12 @@ Result<std::vector<std::string>> ParseMembers(std::string_view text, std::string
 }
 
 Result<std::vector<std::string>> ParseVoters(std::string_view text, const std::vector<std::string>& members) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (true) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item(text.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start));
-    if (item.empty()) return Error(ErrorCode::kInvalidArgument, "--raft-voters '" + std::string(text) + "': empty name");
+  return ParseNameList(text, "--raft-voters", [&members](const std::string& item) -> Status {
     if (std::find(members.begin(), members.end(), item) == members.end()) {
       return Error(ErrorCode::kInvalidArgument, "--raft-voters: '" + item + "' is not in --members");
     }
-    if (std::find(out.begin(), out.end(), item) != out.end()) {
-      return Error(ErrorCode::kInvalidArgument, "--raft-voters: '" + item + "' listed twice");
-    }
-    out.push_back(item);
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return out;
+    return Ok{};
+  });
 }
 
 std::string DefaultRaftDir(std::string_view name) { return "/tmp/swarmbox-raft/" + std::string(name); }

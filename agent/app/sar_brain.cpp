@@ -155,13 +155,55 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx) {
   return SarBrainConfigFrom(ctx, *af);
 }
 
-Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airframe::Airframe& af) {
-  auto world = LoadWorldView(ctx.world_path);
-  if (!world) return world.error();
-  if (!af.has_camera) {
-    return Error(ErrorCode::kInvalidArgument, "loading the airframe's camera: airframe has no camera mapping",
-                 af.source);
-  }
+namespace {
+
+// A MissionTuning number an arg may set: a field of MissionTuning or of its FusionParams (the
+// other pointer null). In the order the args are read (the first bad one is the one reported).
+struct TuningArg {
+  const char* key;
+  double MissionTuning::*field;
+  double swarm::FusionParams::*fusion_field;
+};
+
+constexpr TuningArg kTuningArgs[] = {
+    {"mission_dt_s", &MissionTuning::mission_dt_s, nullptr},
+    {"search_margin_m", &MissionTuning::search_margin_m, nullptr},
+    {"scout_altitude_m", &MissionTuning::scout_altitude_m, nullptr},
+    {"scout_cruise_m_s", &MissionTuning::scout_cruise_m_s, nullptr},
+    {"scout_takeoff_step_m", &MissionTuning::scout_takeoff_step_m, nullptr},
+    {"takeoff_wave_s", &MissionTuning::takeoff_wave_s, nullptr},
+    {"takeoff_grid_m", &MissionTuning::takeoff_grid_m, nullptr},
+    {"scout_orbit_radius_m", &MissionTuning::scout_orbit_radius_m, nullptr},
+    {"scout_orbit_time_s", &MissionTuning::scout_orbit_time_s, nullptr},
+    {"lifter_transit_altitude_m", &MissionTuning::lifter_transit_altitude_m, nullptr},
+    {"lifter_loading_time_s", &MissionTuning::lifter_loading_time_s, nullptr},
+    {"leader_start_timeout_s", &MissionTuning::leader_start_timeout_s, nullptr},
+    {"member_timeout_s", &MissionTuning::member_timeout_s, nullptr},
+    {"member_min_wall_s", &MissionTuning::member_min_wall_s, nullptr},
+    {"assignment_settle_s", &MissionTuning::assignment_settle_s, nullptr},
+    {"sighting_dedupe_m", &MissionTuning::sighting_dedupe_m, nullptr},
+    {"status_every_s", &MissionTuning::status_every_s, nullptr},
+    {"load_check_climb_m", &MissionTuning::load_check_climb_m, nullptr},
+    {"load_check_delay_s", &MissionTuning::load_check_delay_s, nullptr},
+    {"load_check_fraction", &MissionTuning::load_check_fraction, nullptr},
+    {"fusion_prior", nullptr, &swarm::FusionParams::prior},
+    {"fusion_max_view_confidence", nullptr, &swarm::FusionParams::max_view_confidence},
+    {"fusion_min_baseline_m", nullptr, &swarm::FusionParams::min_baseline_m},
+    {"fusion_min_pass_interval_s", nullptr, &swarm::FusionParams::min_pass_interval_s},
+    {"fusion_detector_recall", nullptr, &swarm::FusionParams::detector_recall},
+    {"fusion_false_repeat", nullptr, &swarm::FusionParams::false_repeat},
+    {"fusion_confirm_belief", nullptr, &swarm::FusionParams::confirm_belief},
+    {"fusion_reject_belief", nullptr, &swarm::FusionParams::reject_belief},
+    {"fusion_miss_in_view_m", nullptr, &swarm::FusionParams::miss_in_view_m},
+    {"fusion_min_miss_height_m", nullptr, &swarm::FusionParams::min_miss_height_m},
+    {"fusion_max_miss_height_m", nullptr, &swarm::FusionParams::max_miss_height_m},
+    {"fusion_revisit_after_s", nullptr, &swarm::FusionParams::revisit_after_s},
+    {"fusion_revisit_timeout_s", nullptr, &swarm::FusionParams::revisit_timeout_s},
+    {"revisit_look_s", &MissionTuning::revisit_look_s, nullptr},
+};
+
+// The fields of the config that come straight from the Context, the airframe and the world.
+SarBrainConfig BaseConfig(const brain::Context& ctx, const airframe::Airframe& af, const WorldView& world) {
   SarBrainConfig c;
   c.name = ctx.self;
   c.members = ctx.members;
@@ -169,75 +211,69 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airfr
   c.payload = ctx.payload;
   c.base_height_m = af.base_height_m;
   c.vehicle_mass_kg = af.mass_kg;
-  c.geofence_size_x_m = world->size_x_m;
-  c.geofence_size_y_m = world->size_y_m;
+  c.geofence_size_x_m = world.size_x_m;
+  c.geofence_size_y_m = world.size_y_m;
   c.camera = af.camera;
   c.period_s = static_cast<double>(ctx.period_ns) * 1e-9;
-  if (const auto it = ctx.args.find("start"); it != ctx.args.end()) {
-    double x = 0, y = 0, z = 0;
-    char tail = 0;
-    if (std::sscanf(it->second.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &tail) != 3) {
-      return Error(ErrorCode::kInvalidArgument, "sar brain: arg start '" + it->second + "': expected x,y,z in metres");
-    }
-    c.has_home = true;
-    c.home_m = Vec3(x, y, z);
+  return c;
+}
+
+// args `start` "x,y,z": the take-off spot; absent: unchanged (the first estimate decides).
+Status ApplyStartArg(const brain::Context& ctx, SarBrainConfig* c) {
+  const auto it = ctx.args.find("start");
+  if (it == ctx.args.end()) return Ok{};
+  double x = 0, y = 0, z = 0;
+  char tail = 0;
+  if (std::sscanf(it->second.c_str(), "%lf,%lf,%lf%c", &x, &y, &z, &tail) != 3) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "sar brain: arg start '" + it->second + "': expected x,y,z in metres");
   }
-  MissionTuning& t = c.tuning;
-  double fusion_confirm_views = t.fusion.confirm_views;
-  double fusion_max_revisits = t.fusion.max_revisits;
-  const std::pair<const char*, double*> tuning[] = {
-      {"mission_dt_s", &t.mission_dt_s},
-      {"search_margin_m", &t.search_margin_m},
-      {"scout_altitude_m", &t.scout_altitude_m},
-      {"scout_cruise_m_s", &t.scout_cruise_m_s},
-      {"scout_takeoff_step_m", &t.scout_takeoff_step_m},
-      {"takeoff_wave_s", &t.takeoff_wave_s},
-      {"takeoff_grid_m", &t.takeoff_grid_m},
-      {"scout_orbit_radius_m", &t.scout_orbit_radius_m},
-      {"scout_orbit_time_s", &t.scout_orbit_time_s},
-      {"lifter_transit_altitude_m", &t.lifter_transit_altitude_m},
-      {"lifter_loading_time_s", &t.lifter_loading_time_s},
-      {"leader_start_timeout_s", &t.leader_start_timeout_s},
-      {"member_timeout_s", &t.member_timeout_s},
-      {"member_min_wall_s", &t.member_min_wall_s},
-      {"assignment_settle_s", &t.assignment_settle_s},
-      {"sighting_dedupe_m", &t.sighting_dedupe_m},
-      {"status_every_s", &t.status_every_s},
-      {"load_check_climb_m", &t.load_check_climb_m},
-      {"load_check_delay_s", &t.load_check_delay_s},
-      {"load_check_fraction", &t.load_check_fraction},
-      {"fusion_prior", &t.fusion.prior},
-      {"fusion_max_view_confidence", &t.fusion.max_view_confidence},
-      {"fusion_min_baseline_m", &t.fusion.min_baseline_m},
-      {"fusion_min_pass_interval_s", &t.fusion.min_pass_interval_s},
-      {"fusion_detector_recall", &t.fusion.detector_recall},
-      {"fusion_false_repeat", &t.fusion.false_repeat},
-      {"fusion_confirm_belief", &t.fusion.confirm_belief},
-      {"fusion_reject_belief", &t.fusion.reject_belief},
-      {"fusion_miss_in_view_m", &t.fusion.miss_in_view_m},
-      {"fusion_min_miss_height_m", &t.fusion.min_miss_height_m},
-      {"fusion_max_miss_height_m", &t.fusion.max_miss_height_m},
-      {"fusion_revisit_after_s", &t.fusion.revisit_after_s},
-      {"fusion_revisit_timeout_s", &t.fusion.revisit_timeout_s},
-      {"revisit_look_s", &t.revisit_look_s},
-  };
-  for (const auto& [key, value] : tuning) SWARMBOX_TRY(ArgNumber(ctx, key, value));
-  if (!(t.mission_dt_s > 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg mission_dt_s must be > 0");
-  if (!(t.takeoff_wave_s >= 0) || !(t.takeoff_grid_m > 0)) {
+  c->has_home = true;
+  c->home_m = Vec3(x, y, z);
+  return Ok{};
+}
+
+// The args kTuningArgs names, then the fusion's two counts, each checked.
+Status ApplyTuningArgs(const brain::Context& ctx, MissionTuning* t) {
+  for (const TuningArg& arg : kTuningArgs) {
+    double* value = arg.field != nullptr ? &(t->*arg.field) : &(t->fusion.*arg.fusion_field);
+    SWARMBOX_TRY(ArgNumber(ctx, arg.key, value));
+  }
+  if (!(t->mission_dt_s > 0))
+    return Error(ErrorCode::kInvalidArgument, "sar brain: arg mission_dt_s must be > 0");
+  if (!(t->takeoff_wave_s >= 0) || !(t->takeoff_grid_m > 0)) {
     return Error(ErrorCode::kInvalidArgument,
                  "sar brain: args takeoff_wave_s must be >= 0, takeoff_grid_m > 0");
   }
-  if (!(t.status_every_s > 0)) {
+  if (!(t->status_every_s > 0)) {
     return Error(ErrorCode::kInvalidArgument, "sar brain: arg status_every_s must be > 0");
   }
+  double fusion_confirm_views = t->fusion.confirm_views;
+  double fusion_max_revisits = t->fusion.max_revisits;
   SWARMBOX_TRY(ArgNumber(ctx, "fusion_confirm_views", &fusion_confirm_views));
   SWARMBOX_TRY(ArgNumber(ctx, "fusion_max_revisits", &fusion_max_revisits));
-  t.fusion.confirm_views = static_cast<int>(fusion_confirm_views);
-  t.fusion.max_revisits = static_cast<int>(fusion_max_revisits);
-  if (const std::string why = swarm::FusionParamsProblem(t.fusion); !why.empty()) {
+  t->fusion.confirm_views = static_cast<int>(fusion_confirm_views);
+  t->fusion.max_revisits = static_cast<int>(fusion_max_revisits);
+  if (const std::string why = swarm::FusionParamsProblem(t->fusion); !why.empty()) {
     return Error(ErrorCode::kInvalidArgument, "sar brain: fusion args: " + why);
   }
-  if (!(t.revisit_look_s >= 0)) return Error(ErrorCode::kInvalidArgument, "sar brain: arg revisit_look_s must be >= 0");
+  if (!(t->revisit_look_s >= 0))
+    return Error(ErrorCode::kInvalidArgument, "sar brain: arg revisit_look_s must be >= 0");
+  return Ok{};
+}
+
+}  // namespace
+
+Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airframe::Airframe& af) {
+  auto world = LoadWorldView(ctx.world_path);
+  if (!world) return world.error();
+  if (!af.has_camera) {
+    return Error(ErrorCode::kInvalidArgument, "loading the airframe's camera: airframe has no camera mapping",
+                 af.source);
+  }
+  SarBrainConfig c = BaseConfig(ctx, af, *world);
+  SWARMBOX_TRY(ApplyStartArg(ctx, &c));
+  SWARMBOX_TRY(ApplyTuningArgs(ctx, &c.tuning));
   if (!c.payload.empty()) SWARMBOX_TRY(ApplyLifterPayload(af, &c));
   return c;
 }
@@ -406,6 +442,85 @@ void SarBrain::SendStatus(const Now& now, brain::Output& out) {
   out.messages.push_back(std::move(msg));
 }
 
+namespace {
+
+// The scout's behaviour for a mission started at t_s from home_m.
+swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, double t_s,
+                                  bool lifter_present) {
+  const MissionTuning& t = c.tuning;
+  swarm::ScoutConfig s;
+  s.name = c.name;
+  s.home_m = home_m;
+  s.base_height_m = c.base_height_m;
+  s.search_altitude_m = t.scout_altitude_m;
+  // The estimator settles on the ground (as the plan's preflight), then this scout's wave.
+  const int wave = swarm::TakeoffWave(home_m.head<2>(), t.takeoff_grid_m);
+  s.takeoff_delay_s = t_s + 2.0 + t.takeoff_wave_s * wave;
+  s.return_layer = wave;  // home in the wave's altitude layer (swarm::ScoutConfig::return_layer)
+  s.hfov_rad = c.camera.hfov_rad;
+  s.width_px = c.camera.width_px;
+  s.height_px = c.camera.height_px;
+  s.cruise_speed_m_s = t.scout_cruise_m_s;
+  s.orbit_radius_m = t.scout_orbit_radius_m;
+  s.lifter_present = lifter_present;
+  s.dedupe_radius_m = t.sighting_dedupe_m;
+  s.report_baseline_m = t.fusion.min_baseline_m;  // one view per counted baseline, no more
+  s.revisit_look_s = t.revisit_look_s;
+  s.keep_searching_during_rescue = true;  // the lifter does the rescue; scouts finish the search
+  s.return_when_swept = true;             // nothing left to see: land, do not loiter
+  s.approach_height_m = 5.0;              // descend at vel_max_down, land the last 5 m
+  // Flock (with its repulsion) until 3 m from home, less than the 4 m take-off grid, so the
+  // straight position-mode leg stays in the drone's own cell: from 10 m out it crossed the
+  // columns of neighbours descending over their homes (kinematic rig, 25 scouts: 0.81 m; with
+  // 3 m the closest approach is the flock's, 4.05 m).
+  s.home_approach_m = 3.0;
+  s.orbit_time_s = t.scout_orbit_time_s;
+  // After a restart, sighting sequence numbers continue above any used before (sim ms).
+  s.first_sighting_seq = static_cast<std::uint64_t>(t_s * 1000.0) + 1;
+  return s;
+}
+
+// The lifter's sequence from home_m, with the payload of the config.
+swarm::LifterConfig LifterConfigFor(const SarBrainConfig& c, const Vec3& home_m) {
+  swarm::LifterConfig l;
+  l.name = c.name;
+  l.home_m = home_m;
+  l.base_height_m = c.base_height_m;
+  l.transit_altitude_m = c.tuning.lifter_transit_altitude_m;
+  l.hook_below_body_m = -c.payload_hook_m.z();
+  l.sling_length_m = c.payload_sling_length_m;
+  l.payload_half_height_m = c.payload_half_height_m;
+  l.loading_time_s = c.tuning.lifter_loading_time_s;
+  l.stretcher_start_offset_m = c.payload_offset_m;
+  l.standby_after_delivery = true;
+  l.release_sink_m = -0.3;  // let go 0.3 m above the ground: no drag on a grounded stretcher
+  // Hooking needs the hook within 4 +- 0.5 m of the stretcher's centre: 1 m sideways at 4 m
+  // below changes that distance by 0.12 m, so the horizontal tolerance can be 1 m.
+  l.position_tolerance_m = 1.0;
+  l.settle_speed_m_s = 0.5;
+  return l;
+}
+
+// The leader's planner (every drone holds one: a new leader knows the sectors): the geofence
+// shrunk by the search margin.
+swarm::LeaderConfig LeaderConfigFor(const SarBrainConfig& c) {
+  const MissionTuning& t = c.tuning;
+  swarm::LeaderConfig lc;
+  lc.name = c.name;
+  const double m = t.search_margin_m;
+  lc.search_area = {-c.geofence_size_x_m / 2 + m, -c.geofence_size_y_m / 2 + m, c.geofence_size_x_m / 2 - m,
+                    c.geofence_size_y_m / 2 - m};
+  lc.retry_s = 2.0;
+  lc.start_timeout_s = t.leader_start_timeout_s;
+  lc.member_timeout_s = t.member_timeout_s;
+  lc.member_min_wall_s = t.member_min_wall_s;
+  lc.assignment_settle_s = t.assignment_settle_s;
+  lc.fusion = t.fusion;
+  return lc;
+}
+
+}  // namespace
+
 void SarBrain::Start(const Now& now, brain::Output& out) {
   if (now.flight_mode == "init" || now.flight_mode.empty()) return;  // the estimator is not ready
   // Wait (up to 10 s) until every member was heard, so roles are known (lifter present or not).
@@ -414,69 +529,12 @@ void SarBrain::Start(const Now& now, brain::Output& out) {
   if (members_.Find(config_.name) != nullptr) --heard;  // this drone (UpdateSelf) is not a peer
   if (heard + 1 < config_.members.size() && now.t_s < 10.0) return;
   home_m_ = config_.has_home ? config_.home_m : Vec3(now.pos_m - Vec3(0, 0, config_.base_height_m));
-  const MissionTuning& t = config_.tuning;
   if (role_ == Role::kScout) {
-    swarm::ScoutConfig s;
-    s.name = config_.name;
-    s.home_m = home_m_;
-    s.base_height_m = config_.base_height_m;
-    s.search_altitude_m = t.scout_altitude_m;
-    // The estimator settles on the ground (as the plan's preflight), then this scout's wave.
-    const int wave = swarm::TakeoffWave(home_m_.head<2>(), t.takeoff_grid_m);
-    s.takeoff_delay_s = now.t_s + 2.0 + t.takeoff_wave_s * wave;
-    s.return_layer = wave;  // home in the wave's altitude layer (swarm::ScoutConfig::return_layer)
-    s.hfov_rad = config_.camera.hfov_rad;
-    s.width_px = config_.camera.width_px;
-    s.height_px = config_.camera.height_px;
-    s.cruise_speed_m_s = t.scout_cruise_m_s;
-    s.orbit_radius_m = t.scout_orbit_radius_m;
-    s.lifter_present = lifter_present;
-    s.dedupe_radius_m = t.sighting_dedupe_m;
-    s.report_baseline_m = t.fusion.min_baseline_m;  // one view per counted baseline, no more
-    s.revisit_look_s = t.revisit_look_s;
-    s.keep_searching_during_rescue = true;  // the lifter does the rescue; scouts finish the search
-    s.return_when_swept = true;             // nothing left to see: land, do not loiter
-    s.approach_height_m = 5.0;              // descend at vel_max_down, land the last 5 m
-    // Flock (with its repulsion) until 3 m from home, less than the 4 m take-off grid, so the
-    // straight position-mode leg stays in the drone's own cell: from 10 m out it crossed the
-    // columns of neighbours descending over their homes (kinematic rig, 25 scouts: 0.81 m; with
-    // 3 m the closest approach is the flock's, 4.05 m).
-    s.home_approach_m = 3.0;
-    s.orbit_time_s = t.scout_orbit_time_s;
-    // After a restart, sighting sequence numbers continue above any used before (sim ms).
-    s.first_sighting_seq = static_cast<std::uint64_t>(now.t_s * 1000.0) + 1;
-    scout_.emplace(std::move(s));
+    scout_.emplace(ScoutConfigFor(config_, home_m_, now.t_s, lifter_present));
   } else {
-    swarm::LifterConfig l;
-    l.name = config_.name;
-    l.home_m = home_m_;
-    l.base_height_m = config_.base_height_m;
-    l.transit_altitude_m = t.lifter_transit_altitude_m;
-    l.hook_below_body_m = -config_.payload_hook_m.z();
-    l.sling_length_m = config_.payload_sling_length_m;
-    l.payload_half_height_m = config_.payload_half_height_m;
-    l.loading_time_s = t.lifter_loading_time_s;
-    l.stretcher_start_offset_m = config_.payload_offset_m;
-    l.standby_after_delivery = true;
-    l.release_sink_m = -0.3;  // let go 0.3 m above the ground: no drag on a grounded stretcher
-    // Hooking needs the hook within 4 +- 0.5 m of the stretcher's centre: 1 m sideways at 4 m
-    // below changes that distance by 0.12 m, so the horizontal tolerance can be 1 m.
-    l.position_tolerance_m = 1.0;
-    l.settle_speed_m_s = 0.5;
-    lifter_.emplace(std::move(l));
+    lifter_.emplace(LifterConfigFor(config_, home_m_));
   }
-  swarm::LeaderConfig lc;
-  lc.name = config_.name;
-  const double m = t.search_margin_m;
-  lc.search_area = {-config_.geofence_size_x_m / 2 + m, -config_.geofence_size_y_m / 2 + m,
-                    config_.geofence_size_x_m / 2 - m, config_.geofence_size_y_m / 2 - m};
-  lc.retry_s = 2.0;
-  lc.start_timeout_s = t.leader_start_timeout_s;
-  lc.member_timeout_s = t.member_timeout_s;
-  lc.member_min_wall_s = t.member_min_wall_s;
-  lc.assignment_settle_s = t.assignment_settle_s;
-  lc.fusion = t.fusion;
-  leader_.emplace(std::move(lc));
+  leader_.emplace(LeaderConfigFor(config_));
   out.events.push_back(ToBrainEvent(LogEvent(now.t_s, config_.name, "mission_start")
                                         .Add("role", swarm::RoleName(role_))
                                         .Add("home_x", home_m_.x(), 2)
@@ -484,12 +542,20 @@ void SarBrain::Start(const Now& now, brain::Output& out) {
                                         .Add("lifter_present", lifter_present)));
 }
 
-void SarBrain::Step(const brain::Input& in, brain::Output& out) {
+namespace {
+
+const SarMissionState& MissionStateOf(const brain::Input& in) {
   const auto* state = dynamic_cast<const SarMissionState*>(in.state);
   if (state == nullptr) {
     std::fprintf(stderr, "SarBrain::Step: Input::state is not the brain's SarMissionState (a wiring bug)\n");
     std::abort();
   }
+  return *state;
+}
+
+}  // namespace
+
+SarBrain::Now SarBrain::ReadNow(const brain::Input& in) const {
   Now now;
   now.t_s = static_cast<double>(in.t_ns) * 1e-9;
   if (wall_ != nullptr) now.wall_s = wall_->now_s;
@@ -498,10 +564,40 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
   now.pos_m = V(in.self.position_m);
   now.vel_m_s = V(in.self.velocity_m_s);
   now.yaw_rad = YawOf(in.self.attitude_wxyz);
-  now.mission = &state->mission();
+  now.mission = &MissionStateOf(in).mission();
   now.is_leader = in.is_leader;
   for (const brain::FlightEvent& e : in.flight_events) now.hover_event = now.hover_event || e.name == "hover";
   now.mass_estimate_kg = in.self.mass_estimate_kg;
+  return now;
+}
+
+void SarBrain::OnDetections(const Now& now, std::span<const brain::Detection> detections) {
+  for (const brain::Detection& d : detections) {
+    swarm::GroundDetection g;
+    g.capture_time_s = static_cast<double>(d.t_ns) * 1e-9;
+    g.position_m = V(d.position_m);
+    g.sigma_m = d.sigma_m;
+    g.confidence = d.confidence;
+    // The viewpoint: this drone's estimate now, when the detection became visible (capture +
+    // the inference latency, 40 ms: <= 0.3 m of flight at 7 m/s, against a 10 m baseline).
+    g.viewer_m = now.pos_m;
+    visible_.push_back(g);
+  }
+}
+
+void SarBrain::LogCompleteOnce(const Now& now, brain::Output& out) {
+  const raft::MissionState& mission = *now.mission;
+  if (mission.phase() != raft::MissionPhase::kComplete || complete_logged_) return;
+  complete_logged_ = true;
+  std::int64_t rescued = 0;
+  for (const raft::Victim& v : mission.victims()) rescued += v.status == raft::VictimStatus::kRescued ? 1 : 0;
+  out.events.push_back(ToBrainEvent(LogEvent(now.t_s, config_.name, "mission_complete")
+                                        .Add("victims", static_cast<std::int64_t>(mission.victims().size()))
+                                        .Add("rescued", rescued)));
+}
+
+void SarBrain::Step(const brain::Input& in, brain::Output& out) {
+  const Now now = ReadNow(in);
   for (const brain::Message& m : in.messages) {
     if (m.topic == kStatusTopic && m.from != config_.name) OnStatus(now, m);
   }
@@ -510,19 +606,7 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
   const bool started = scout_ || lifter_;
   const bool tick = now.t_s >= next_tick_s_;
   if (!started || tick) OnNeighbours(now, in.neighbours);
-  if (role_ == Role::kScout) {
-    for (const brain::Detection& d : in.detections) {
-      swarm::GroundDetection g;
-      g.capture_time_s = static_cast<double>(d.t_ns) * 1e-9;
-      g.position_m = V(d.position_m);
-      g.sigma_m = d.sigma_m;
-      g.confidence = d.confidence;
-      // The viewpoint: this drone's estimate now, when the detection became visible (capture +
-      // the inference latency, 40 ms: <= 0.3 m of flight at 7 m/s, against a 10 m baseline).
-      g.viewer_m = now.pos_m;
-      visible_.push_back(g);
-    }
-  }
+  if (role_ == Role::kScout) OnDetections(now, in.detections);
 
   battery_.Step(config_.period_s, now.vel_m_s, payload_mass_kg(), !now.on_ground);
   if (!started) Start(now, out);
@@ -532,21 +616,13 @@ void SarBrain::Step(const brain::Input& in, brain::Output& out) {
       if (role_ == Role::kLifter) CheckLoad(now, out);
       RunBehaviour(now, out);
     }
-    const raft::MissionState& mission = *now.mission;
-    if (mission.phase() == raft::MissionPhase::kComplete && !complete_logged_) {
-      complete_logged_ = true;
-      std::int64_t rescued = 0;
-      for (const raft::Victim& v : mission.victims()) rescued += v.status == raft::VictimStatus::kRescued ? 1 : 0;
-      out.events.push_back(ToBrainEvent(LogEvent(now.t_s, config_.name, "mission_complete")
-                                            .Add("victims", static_cast<std::int64_t>(mission.victims().size()))
-                                            .Add("rescued", rescued)));
-    }
+    LogCompleteOnce(now, out);
   }
   SendStatus(now, out);
   out.status = mode_;
 }
 
-void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
+swarm::MissionInput SarBrain::BehaviourInput(const Now& now) const {
   swarm::MissionInput mi;
   mi.t_s = now.t_s;
   mi.mission = now.mission;
@@ -558,6 +634,11 @@ void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
   mi.battery_low = battery_.IsLow(to_home, std::max(0.0, now.pos_m.z() - home_m_.z()), payload_mass_kg());
   mi.payload_attached = payload_attached_;
   mi.detections = visible_;
+  return mi;
+}
+
+void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
+  const swarm::MissionInput mi = BehaviourInput(now);
   if (scout_) {
     scout_->Step(mi, &behaviour_out_);
   } else {
@@ -572,20 +653,24 @@ void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
 
   leader_->Track(now.t_s, *now.mission, now.wall_s);  // every drone: a new leader knows when sectors changed
   members_.UpdateSelf(now.t_s, role_, behaviour_out_.mode, now.pos_m.head<2>());
-  if (now.is_leader) {
-    const std::span<const swarm::RosterEntry> roster = members_.Roster(now.t_s, now.wall_s);
-    // How the swarm flocks, for the logs and the trial's plots (agent/swarm flock_metrics.hpp).
-    if (auto line = flock_log_.Sample(now.t_s, config_.name, roster)) out.events.push_back(ToBrainEvent(*line));
-    const bool everyone = roster.size() == config_.members.size();
-    if (everyone || now.mission->phase() != raft::MissionPhase::kIdle || now.t_s >= config_.tuning.leader_start_timeout_s) {
-      swarm::MissionOutput lead;
-      leader_->Step(now.t_s, *now.mission, roster, &lead, now.wall_s);
-      for (const raft::MissionCommand& c : lead.proposals) out.proposals.push_back(raft::EncodeCommand(c));
-      for (const LogEvent& e : lead.events) {
-        // Every drone logs mission_complete itself when it applies COMPLETE (Step()).
-        if (e.str().find(" event=mission_complete") == std::string::npos) out.events.push_back(ToBrainEvent(e));
-      }
-    }
+  if (now.is_leader) RunLeader(now, out);
+}
+
+void SarBrain::RunLeader(const Now& now, brain::Output& out) {
+  const std::span<const swarm::RosterEntry> roster = members_.Roster(now.t_s, now.wall_s);
+  // How the swarm flocks, for the logs and the trial's plots (agent/swarm flock_metrics.hpp).
+  if (auto line = flock_log_.Sample(now.t_s, config_.name, roster)) out.events.push_back(ToBrainEvent(*line));
+  const bool everyone = roster.size() == config_.members.size();
+  if (!(everyone || now.mission->phase() != raft::MissionPhase::kIdle ||
+        now.t_s >= config_.tuning.leader_start_timeout_s)) {
+    return;  // the search starts once everyone is heard, or at the start timeout
+  }
+  swarm::MissionOutput lead;
+  leader_->Step(now.t_s, *now.mission, roster, &lead, now.wall_s);
+  for (const raft::MissionCommand& c : lead.proposals) out.proposals.push_back(raft::EncodeCommand(c));
+  for (const LogEvent& e : lead.events) {
+    // Every drone logs mission_complete itself when it applies COMPLETE (Step()).
+    if (e.str().find(" event=mission_complete") == std::string::npos) out.events.push_back(ToBrainEvent(e));
   }
 }
 
@@ -621,25 +706,43 @@ void SarBrain::CheckLoad(const Now& now, brain::Output& out) {
   if (!ok) payload_attached_ = false;  // the world refused the hook: the lifter goes back for it
 }
 
+void SarBrain::DriveTakeoff(const Now& now, const swarm::SetpointRequest& sp, bool changed,
+                            brain::Output& out) {
+  // A short flight-stack take-off, then the climb in position mode (faster: vel_max_up).
+  const double height = sp.target_m.z() - now.pos_m.z();
+  if (now.on_ground) {
+    if (changed || now.flight_mode != "takeoff") {
+      out.commands.push_back(
+          brain::Command::Takeoff(std::clamp(height, 0.5, config_.tuning.scout_takeoff_step_m)));
+      climb_sent_ = false;
+    }
+  } else if (!climb_sent_ && (now.hover_event || now.flight_mode == "hold")) {
+    out.setpoint.assign(1, brain::Setpoint::Position(B(sp.target_m)));
+    climb_sent_ = true;
+  }
+}
+
+void SarBrain::DriveFlock(const Now& now, const swarm::SetpointRequest& sp, bool changed,
+                          brain::Output& out) {
+  if (changed) flock_.Reset(now.vel_m_s);
+  swarm::FlockingInput fi;
+  fi.position_m = now.pos_m;
+  fi.velocity_m_s = now.vel_m_s;
+  fi.goal_m = sp.target_m;
+  fi.neighbours = neighbours_;
+  const swarm::FlockingOutput f = flock_.Step(fi, config_.tuning.mission_dt_s);
+  out.setpoint.assign(1, brain::Setpoint::Velocity(B(f.velocity_m_s), sp.yaw_rad));
+  flocking_out_ = f;
+}
+
 void SarBrain::Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Output& out) {
   const bool changed = sp.kind != sent_kind_;
   switch (sp.kind) {
     case SetpointKind::kIdle:
       break;
-    case SetpointKind::kTakeoff: {
-      // A short flight-stack take-off, then the climb in position mode (faster: vel_max_up).
-      const double height = sp.target_m.z() - now.pos_m.z();
-      if (now.on_ground) {
-        if (changed || now.flight_mode != "takeoff") {
-          out.commands.push_back(brain::Command::Takeoff(std::clamp(height, 0.5, config_.tuning.scout_takeoff_step_m)));
-          climb_sent_ = false;
-        }
-      } else if (!climb_sent_ && (now.hover_event || now.flight_mode == "hold")) {
-        out.setpoint.assign(1, brain::Setpoint::Position(B(sp.target_m)));
-        climb_sent_ = true;
-      }
+    case SetpointKind::kTakeoff:
+      DriveTakeoff(now, sp, changed, out);
       break;
-    }
     case SetpointKind::kPosition:
       if (now.on_ground) break;
       if (changed || (sp.target_m - sent_target_m_).norm() > 0.05) {
@@ -647,19 +750,9 @@ void SarBrain::Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Ou
         sent_target_m_ = sp.target_m;
       }
       break;
-    case SetpointKind::kFlock: {
-      if (now.on_ground) break;
-      if (changed) flock_.Reset(now.vel_m_s);
-      swarm::FlockingInput fi;
-      fi.position_m = now.pos_m;
-      fi.velocity_m_s = now.vel_m_s;
-      fi.goal_m = sp.target_m;
-      fi.neighbours = neighbours_;
-      const swarm::FlockingOutput f = flock_.Step(fi, config_.tuning.mission_dt_s);
-      out.setpoint.assign(1, brain::Setpoint::Velocity(B(f.velocity_m_s), sp.yaw_rad));
-      flocking_out_ = f;
+    case SetpointKind::kFlock:
+      if (!now.on_ground) DriveFlock(now, sp, changed, out);
       break;
-    }
     case SetpointKind::kLand:
       if (!now.on_ground && (changed || now.flight_mode != "land")) out.commands.push_back(brain::Command::Land());
       break;

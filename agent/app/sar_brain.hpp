@@ -234,9 +234,17 @@ class SarBrain final : public brain::Brain {
   void OnNeighbours(const Now& now, std::span<const brain::Neighbour> neighbours);
   void OnStatus(const Now& now, const brain::Message& m);  // a kStatusTopic message: O(1)
   void SendStatus(const Now& now, brain::Output& out);     // on a change and every status_every_s
+  Now ReadNow(const brain::Input& in) const;               // aborts when in.state is not a SarMissionState
+  void OnDetections(const Now& now, std::span<const brain::Detection> detections);  // scouts: visible_
   void Start(const Now& now, brain::Output& out);  // builds the behaviour once the estimator is ready
+  swarm::MissionInput BehaviourInput(const Now& now) const;
   void RunBehaviour(const Now& now, brain::Output& out);
+  void RunLeader(const Now& now, brain::Output& out);        // the leader's planner and flock metrics
+  void LogCompleteOnce(const Now& now, brain::Output& out);  // event=mission_complete
   void Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Output& out);
+  // Drive's take-off (a short take-off, then the climb) and flocking (a velocity every tick).
+  void DriveTakeoff(const Now& now, const swarm::SetpointRequest& sp, bool changed, brain::Output& out);
+  void DriveFlock(const Now& now, const swarm::SetpointRequest& sp, bool changed, brain::Output& out);
   void Apply(const swarm::PayloadRequest& p, brain::Output& out);
   void CheckLoad(const Now& now, brain::Output& out);
 

@@ -17,42 +17,51 @@ Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::Participan
   auto participant = bus::Participant::Create(config);
   if (!participant) return std::move(participant).error().Context("sim bus");
   t->participant_ = std::move(*participant);
-  auto clock = t->participant_->CreatePublisher<bus::ClockTick>(bus::kClockTopic, bus::Qos::kLockstep);
-  if (!clock) return std::move(clock).error();
-  t->clock_ = std::move(*clock);
-  // Created before the per-drone endpoints: announced first in discovery.
-  auto status = t->participant_->CreatePublisher<bus::Event>(bus::kSimStatusTopic, bus::Qos::kLockstep);
-  if (!status) return std::move(status).error();
-  t->status_ = std::move(*status);
-  BusTransport* self = t.get();
-  auto wc = t->participant_->CreateSubscriber<bus::WorldCommand>(
-      bus::kWorldCommandTopic, bus::Qos::kLockstep, [self](const bus::WorldCommand& c) {
-        std::lock_guard<std::mutex> lock(self->mu_);
-        self->world_.push_back({c.target, c.command, c.args, c.seq});
-      });
-  if (!wc) return std::move(wc).error();
-  t->world_commands_ = std::move(*wc);
+  if (Status s = t->OpenWorldEndpoints(); !s) return s.error();
   for (std::size_t i = 0; i < drones.size(); ++i) {
-    const std::string& name = drones[i];
-    if (auto s = bus::ValidateDroneName(name); !s) return s.error();
-    DroneEndpoints e;
-    e.name = name;
-    e.gps = gps_specs.at(i);
-    auto sensor = t->participant_->CreatePublisher<bus::SensorSample>(bus::SensorTopic(name), bus::Qos::kLockstep);
-    if (!sensor) return std::move(sensor).error();
-    e.sensor = std::move(*sensor);
-    auto camera = t->participant_->CreatePublisher<bus::CameraImage>(bus::CameraTopic(name), bus::Qos::kLockstep);
-    if (!camera) return std::move(camera).error();
-    e.camera = std::move(*camera);
-    t->index_of_.emplace(name, i);
-    t->drones_.push_back(std::move(e));
+    if (Status s = t->AddDroneEndpoints(drones[i], gps_specs.at(i), i); !s) return s.error();
   }
   // One reader for every drone's answers (the topic is keyed by drone).
+  BusTransport* self = t.get();
   auto act = t->participant_->CreateSubscriber<bus::ActuatorCommand>(
       bus::kActuatorTopic, bus::Qos::kLockstep, [self](const bus::ActuatorCommand& c) { self->OnActuator(c); });
   if (!act) return std::move(act).error();
   t->actuators_sub_ = std::move(*act);
   return t;
+}
+
+Status BusTransport::OpenWorldEndpoints() {
+  auto clock = participant_->CreatePublisher<bus::ClockTick>(bus::kClockTopic, bus::Qos::kLockstep);
+  if (!clock) return std::move(clock).error();
+  clock_ = std::move(*clock);
+  // Created before the per-drone endpoints: announced first in discovery.
+  auto status = participant_->CreatePublisher<bus::Event>(bus::kSimStatusTopic, bus::Qos::kLockstep);
+  if (!status) return std::move(status).error();
+  status_ = std::move(*status);
+  auto wc = participant_->CreateSubscriber<bus::WorldCommand>(
+      bus::kWorldCommandTopic, bus::Qos::kLockstep, [this](const bus::WorldCommand& c) {
+        std::lock_guard<std::mutex> lock(mu_);
+        world_.push_back({c.target, c.command, c.args, c.seq});
+      });
+  if (!wc) return std::move(wc).error();
+  world_commands_ = std::move(*wc);
+  return Ok{};
+}
+
+Status BusTransport::AddDroneEndpoints(const std::string& name, const GpsSpec& gps, std::size_t index) {
+  if (auto s = bus::ValidateDroneName(name); !s) return s.error();
+  DroneEndpoints e;
+  e.name = name;
+  e.gps = gps;
+  auto sensor = participant_->CreatePublisher<bus::SensorSample>(bus::SensorTopic(name), bus::Qos::kLockstep);
+  if (!sensor) return std::move(sensor).error();
+  e.sensor = std::move(*sensor);
+  auto camera = participant_->CreatePublisher<bus::CameraImage>(bus::CameraTopic(name), bus::Qos::kLockstep);
+  if (!camera) return std::move(camera).error();
+  e.camera = std::move(*camera);
+  index_of_.emplace(name, index);
+  drones_.push_back(std::move(e));
+  return Ok{};
 }
 
 Status BusTransport::SubscribeTelemetry(std::function<void(const bus::Telemetry&)> on_telemetry) {

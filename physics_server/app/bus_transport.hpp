@@ -67,6 +67,10 @@ class BusTransport final : public SimTransport {
     std::size_t operator()(std::string_view s) const { return std::hash<std::string_view>{}(s); }
   };
   void OnActuator(const bus::ActuatorCommand& c);
+  // Create's steps, in discovery order: the clock, status and world-command endpoints, then each
+  // drone's sensor and camera publishers.
+  Status OpenWorldEndpoints();
+  Status AddDroneEndpoints(const std::string& name, const GpsSpec& gps, std::size_t index);
 
   std::unique_ptr<bus::Participant> participant_;
   std::unique_ptr<bus::Publisher<bus::ClockTick>> clock_;

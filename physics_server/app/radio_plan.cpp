@@ -14,15 +14,9 @@ Error Bad(const yaml::Node& node, const std::string& message) {
 
 Result<PlanImpairment> ParseImpairment(const yaml::Node& node, const std::string& what) {
   if (!node.is_mapping()) return Bad(node, "expected a mapping for " + what);
-  PlanImpairment m;
-  yaml::MapReader r(node, what);
-  r.Optional("delay_ms", &m.delay_ms)
-      .Optional("jitter_ms", &m.jitter_ms)
-      .Optional("distribution", &m.distribution)
-      .Optional("loss", &m.loss)
-      .Optional("rate_kbit", &m.rate_kbit)
-      .Optional("duplicate", &m.duplicate);
-  if (auto s = r.Finish(); !s) return s.error();
+  Result<PlanImpairment> read = channel::ReadImpairmentKeys(node, what);
+  if (!read) return read.error();
+  const PlanImpairment& m = *read;
   auto non_negative = [](double v) { return std::isfinite(v) && v >= 0; };
   if (!non_negative(m.delay_ms) || !non_negative(m.jitter_ms) || !non_negative(m.rate_kbit)) {
     return Bad(node, what + ": delay_ms, jitter_ms and rate_kbit must be >= 0");
@@ -39,6 +33,60 @@ Result<PlanImpairment> ParseImpairment(const yaml::Node& node, const std::string
 
 std::int64_t ToNs(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
 
+// The keys of the entry's kind into *r (read by its Finish), the drone_out mode into *mode.
+Status ReadKindKeys(const yaml::Node& node, const std::string& kind, yaml::MapReader& r, PlanEntry* e,
+                    std::string* mode) {
+  if (kind == "drone_out") {
+    e->kind = PlanEntry::Kind::kDroneOut;
+    r.Required("mode", mode).Required("targets", &e->targets);
+  } else if (kind == "world_command") {
+    e->kind = PlanEntry::Kind::kWorldCommand;
+    r.Optional("target", &e->target).Required("command", &e->command).Optional("args", &e->args);
+  } else if (kind == "radio") {
+    e->kind = PlanEntry::Kind::kRadio;
+    r.Required("targets", &e->targets);
+    if (const yaml::Node* imp = r.Child("impairment", /*required=*/true)) {
+      auto m = ParseImpairment(*imp, "impairment");
+      if (!m) return m.error();
+      e->impairment = *m;
+    }
+  } else if (kind == "partition") {
+    e->kind = PlanEntry::Kind::kPartition;
+    r.Required("groups", &e->groups).Optional("oneway", &e->oneway);
+  } else {
+    return Bad(node, "unknown kind '" + kind + "' (drone_out, world_command, radio, partition)");
+  }
+  return Ok{};
+}
+
+// A drone_out's mode: a kill stays out, the others come back after duration_s.
+Status SetDroneOutMode(const yaml::Node& node, const std::string& mode, PlanEntry* e) {
+  if (mode == "kill") {
+    e->mode = PlanEntry::Mode::kKill;
+    if (e->duration_ns != 0) return Bad(node, "a kill stays out: duration_s must be 0");
+  } else if (mode == "stop" || mode == "pause" || mode == "restart") {
+    e->mode = mode == "stop" ? PlanEntry::Mode::kStop : mode == "pause" ? PlanEntry::Mode::kPause : PlanEntry::Mode::kRestart;
+    if (e->duration_ns <= 0) return Bad(node, "mode " + mode + " needs duration_s > 0 (the drone comes back after it)");
+  } else {
+    return Bad(node, "unknown mode '" + mode + "' (kill, stop, pause, restart)");
+  }
+  return Ok{};
+}
+
+// Who an entry acts on: targets for drone_out and radio, two or more non-empty groups for a partition.
+Status CheckParties(const yaml::Node& node, const PlanEntry& e) {
+  if ((e.kind == PlanEntry::Kind::kDroneOut || e.kind == PlanEntry::Kind::kRadio) && e.targets.empty()) {
+    return Bad(node, "targets must name at least one drone");
+  }
+  if (e.kind == PlanEntry::Kind::kPartition) {
+    if (e.groups.size() < 2) return Bad(node, "a partition needs at least two groups");
+    for (const auto& g : e.groups) {
+      if (g.empty()) return Bad(node, "a partition group is empty");
+    }
+  }
+  return Ok{};
+}
+
 Result<PlanEntry> ParseEntry(const yaml::Node& node) {
   if (!node.is_mapping()) return Bad(node, "expected a mapping for a schedule entry");
   PlanEntry e;
@@ -52,47 +100,12 @@ Result<PlanEntry> ParseEntry(const yaml::Node& node) {
   if (!std::isfinite(duration_s) || duration_s < 0) return Bad(node, "duration_s must be >= 0");
   e.at_ns = ToNs(at_s);
   e.duration_ns = ToNs(duration_s);
-  if (kind == "drone_out") {
-    e.kind = PlanEntry::Kind::kDroneOut;
-    r.Required("mode", &mode).Required("targets", &e.targets);
-  } else if (kind == "world_command") {
-    e.kind = PlanEntry::Kind::kWorldCommand;
-    r.Optional("target", &e.target).Required("command", &e.command).Optional("args", &e.args);
-  } else if (kind == "radio") {
-    e.kind = PlanEntry::Kind::kRadio;
-    r.Required("targets", &e.targets);
-    if (const yaml::Node* imp = r.Child("impairment", /*required=*/true)) {
-      auto m = ParseImpairment(*imp, "impairment");
-      if (!m) return m.error();
-      e.impairment = *m;
-    }
-  } else if (kind == "partition") {
-    e.kind = PlanEntry::Kind::kPartition;
-    r.Required("groups", &e.groups).Optional("oneway", &e.oneway);
-  } else {
-    return Bad(node, "unknown kind '" + kind + "' (drone_out, world_command, radio, partition)");
-  }
+  if (Status s = ReadKindKeys(node, kind, r, &e, &mode); !s) return s.error();
   if (auto s = r.Finish(); !s) return s.error();
   if (e.kind == PlanEntry::Kind::kDroneOut) {
-    if (mode == "kill") {
-      e.mode = PlanEntry::Mode::kKill;
-      if (e.duration_ns != 0) return Bad(node, "a kill stays out: duration_s must be 0");
-    } else if (mode == "stop" || mode == "pause" || mode == "restart") {
-      e.mode = mode == "stop" ? PlanEntry::Mode::kStop : mode == "pause" ? PlanEntry::Mode::kPause : PlanEntry::Mode::kRestart;
-      if (e.duration_ns <= 0) return Bad(node, "mode " + mode + " needs duration_s > 0 (the drone comes back after it)");
-    } else {
-      return Bad(node, "unknown mode '" + mode + "' (kill, stop, pause, restart)");
-    }
+    if (Status s = SetDroneOutMode(node, mode, &e); !s) return s.error();
   }
-  if ((e.kind == PlanEntry::Kind::kDroneOut || e.kind == PlanEntry::Kind::kRadio) && e.targets.empty()) {
-    return Bad(node, "targets must name at least one drone");
-  }
-  if (e.kind == PlanEntry::Kind::kPartition) {
-    if (e.groups.size() < 2) return Bad(node, "a partition needs at least two groups");
-    for (const auto& g : e.groups) {
-      if (g.empty()) return Bad(node, "a partition group is empty");
-    }
-  }
+  if (Status s = CheckParties(node, e); !s) return s.error();
   return e;
 }
 

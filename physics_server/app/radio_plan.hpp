@@ -32,22 +32,17 @@
 #include <string>
 #include <vector>
 
+#include "swarmbox/channel/channel.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::physics {
 
-// netem-like egress impairment of a sender (the trial's network.mesh keys). Units in the names;
-// loss and duplicate are probabilities in [0, 1]; distribution: normal|uniform|pareto|paretonormal.
-struct PlanImpairment {
-  double delay_ms = 0;
-  double jitter_ms = 0;
-  std::string distribution = "normal";
-  double loss = 0;
-  double rate_kbit = 0;
-  double duplicate = 0;
-  bool operator==(const PlanImpairment&) const = default;
-};
+// netem-like egress impairment of a sender (the trial's network.mesh keys): the channel's own
+// struct. Units in the names; loss and duplicate are probabilities in [0, 1]; the plan accepts
+// every netem distribution (normal|uniform|pareto|paretonormal), the channel fewer
+// (CheckChannelPlan).
+using PlanImpairment = channel::Impairment;
 
 // The target that names the drone leading the Raft group at the entry's time.
 inline constexpr const char* kRaftLeaderTarget = "raft_leader";

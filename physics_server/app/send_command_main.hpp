@@ -2,7 +2,17 @@
 // command line over when it sees that flag.
 #pragma once
 
+#include <optional>
+
+namespace CLI {
+class App;
+}  // namespace CLI
+
 namespace swarmbox::physics {
+
+// Both modes' command-line parse: nothing when the flags are good, else the exit code (0 after
+// --help or --version, 2 for a usage error, CLI11's message printed).
+std::optional<int> ParseOrExitCode(CLI::App& app, int argc, char** argv);
 
 // Whether argv asks for the one-shot sender.
 bool IsSendCommand(int argc, char** argv);

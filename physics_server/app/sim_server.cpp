@@ -64,7 +64,7 @@ SimServer::SimServer(World& world, SimTransport& transport, WallClock& clock, Tr
   if (options_.radio_profile) {
     const std::size_t n = world.drone_count();
     channel_.emplace(*options_.radio_profile, n, options_.radio_seed, ChannelObstacles(world.config()));
-    if (options_.plan.mesh) channel_->SetImpairment(std::nullopt, ToChannelImpairment(*options_.plan.mesh));
+    if (options_.plan.mesh) channel_->SetImpairment(std::nullopt, *options_.plan.mesh);
     positions_.resize(n);
     impairments_.resize(n);
     blocked_.assign(n * n, 0);
@@ -89,11 +89,19 @@ void SimServer::Apply(const WorldCommandInput& cmd) {
     drone = world_.FindDrone(cmd.target);
     if (!drone) return reject("unknown drone");
   }
-  const std::int64_t now = world_.time_ns();
-  auto seconds = [](double s) { return static_cast<std::int64_t>(s * 1e9); };
   if (Status ok = CheckWorldCommand(cmd.command, drone.has_value(), cmd.args); !ok) {
     return reject(ok.error().message());
   }
+  if (std::optional<std::string> why = Execute(cmd, drone)) return reject(*why);
+  LogEvent done(t, options_.node, "world_command");
+  done.Add("command", cmd.command).Add("target", cmd.target);
+  if (cmd.command == "payload_attach" && !cmd.args.empty()) done.Add("mass_kg", cmd.args[0]);
+  Log(done);
+}
+
+std::optional<std::string> SimServer::Execute(const WorldCommandInput& cmd, std::optional<std::size_t> drone) {
+  const std::int64_t now = world_.time_ns();
+  auto seconds = [](double s) { return static_cast<std::int64_t>(s * 1e9); };
   if (cmd.command == "gps_dropout") {
     world_.SetGpsDropout(*drone, true);
     timed_.push_back({now + seconds(cmd.args[0]), *drone, Timed::kGpsBack});
@@ -108,19 +116,21 @@ void SimServer::Apply(const WorldCommandInput& cmd) {
     world_.SetWind(gust);
     timed_.push_back({now + seconds(cmd.args[3]), 0, Timed::kWindBack});
   } else {  // payload_attach / payload_release (the table knows no other name)
-    // payload_attach [mass_kg]: the payload's mass from now on (the lifter's stretcher is 15 kg
-    // empty, 80 kg with the evacuee); absent or 0 keeps its current mass.
-    if (cmd.command == "payload_attach" && (cmd.args.size() > 1 || (!cmd.args.empty() && !(cmd.args[0] >= 0)))) {
-      return reject("payload_attach takes at most one argument, mass_kg >= 0");
-    }
-    const double mass_kg = cmd.args.empty() ? 0.0 : cmd.args[0];
-    const Status s = cmd.command == "payload_attach" ? world_.AttachPayload(*drone, mass_kg) : world_.ReleasePayload(*drone);
-    if (!s) return reject(s.error().message());
+    return ExecutePayload(cmd, *drone);
   }
-  LogEvent done(t, options_.node, "world_command");
-  done.Add("command", cmd.command).Add("target", cmd.target);
-  if (cmd.command == "payload_attach" && !cmd.args.empty()) done.Add("mass_kg", cmd.args[0]);
-  Log(done);
+  return std::nullopt;
+}
+
+std::optional<std::string> SimServer::ExecutePayload(const WorldCommandInput& cmd, std::size_t drone) {
+  // payload_attach [mass_kg]: the payload's mass from now on (the lifter's stretcher is 15 kg
+  // empty, 80 kg with the evacuee); absent or 0 keeps its current mass.
+  if (cmd.command == "payload_attach" && (cmd.args.size() > 1 || (!cmd.args.empty() && !(cmd.args[0] >= 0)))) {
+    return "payload_attach takes at most one argument, mass_kg >= 0";
+  }
+  const double mass_kg = cmd.args.empty() ? 0.0 : cmd.args[0];
+  const Status s = cmd.command == "payload_attach" ? world_.AttachPayload(drone, mass_kg) : world_.ReleasePayload(drone);
+  if (!s) return s.error().message();
+  return std::nullopt;
 }
 
 namespace {
@@ -132,26 +142,15 @@ constexpr std::int64_t kFrameKeepNs = 120'000'000'000;
 
 }  // namespace
 
-channel::Impairment ToChannelImpairment(const PlanImpairment& m) {
-  channel::Impairment c;
-  c.delay_ms = m.delay_ms;
-  c.jitter_ms = m.jitter_ms;
-  c.distribution = m.distribution;
-  c.loss = m.loss;
-  c.rate_kbit = m.rate_kbit;
-  c.duplicate = m.duplicate;
-  return c;
-}
-
 Status CheckChannelPlan(const RadioPlan& plan) {
   if (plan.mesh) {
-    if (Status s = channel::ValidateImpairment(ToChannelImpairment(*plan.mesh)); !s) {
+    if (Status s = channel::ValidateImpairment(*plan.mesh); !s) {
       return Error(ErrorCode::kInvalidArgument, "mesh: " + s.error().message());
     }
   }
   for (const PlanEntry& e : plan.schedule) {
     if (e.kind != PlanEntry::Kind::kRadio) continue;
-    if (Status s = channel::ValidateImpairment(ToChannelImpairment(e.impairment)); !s) {
+    if (Status s = channel::ValidateImpairment(e.impairment); !s) {
       return Error(ErrorCode::kInvalidArgument, "entry '" + e.name + "': " + s.error().message(), e.where);
     }
   }
@@ -232,7 +231,7 @@ void SimServer::SetImpairmentOf(std::size_t drone) {
   if (active.empty()) {
     channel_->ClearImpairment(drone);
   } else {
-    channel_->SetImpairment(drone, ToChannelImpairment(options_.plan.schedule[active.back()].impairment));
+    channel_->SetImpairment(drone, options_.plan.schedule[active.back()].impairment);
   }
 }
 

@@ -176,7 +176,6 @@ struct SimServerOptions {
 // The plan's impairments against what the channel carries out (its distributions): the first one
 // it cannot, at its entry.
 Status CheckChannelPlan(const RadioPlan& plan);
-channel::Impairment ToChannelImpairment(const PlanImpairment& impairment);
 // The world's obstacle boxes as the channel's (same centre, size and yaw).
 std::vector<channel::Box> ChannelObstacles(const WorldConfig& world);
 
@@ -245,6 +244,9 @@ class SimServer {
   void SetImpairmentOf(std::size_t drone);
   void LogChannel();
   void Apply(const WorldCommandInput& cmd);
+  // Carries out a checked command (Apply logs the outcome); the reason when the world refuses it.
+  std::optional<std::string> Execute(const WorldCommandInput& cmd, std::optional<std::size_t> drone);
+  std::optional<std::string> ExecutePayload(const WorldCommandInput& cmd, std::size_t drone);
   void Log(const LogEvent& event);
   JoiningStatus Joining() const;
   Status ReportJoining(bool done);

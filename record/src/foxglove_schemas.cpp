@@ -90,34 +90,48 @@ std::string Color(std::string_view d) {
                                    {"b", Num("Blue value between 0 and 1")}, {"a", Num("Alpha value between 0 and 1")}});
 }
 
-std::string SceneEntity() {
-  const std::string arrow = Obj("foxglove.ArrowPrimitive", "A primitive representing an arrow",
+std::string ArrowPrimitive() {
+  return Obj("foxglove.ArrowPrimitive", "A primitive representing an arrow",
       {{"pose", Pose("Position of the arrow's tail and orientation of the arrow (identity: +x)")},
        {"shaft_length", Num("Length of the arrow shaft")}, {"shaft_diameter", Num("Diameter of the arrow shaft")},
        {"head_length", Num("Length of the arrow head")}, {"head_diameter", Num("Diameter of the arrow head")},
        {"color", Color("Color of the arrow")}});
-  auto sized = [](std::string_view title, std::string_view what) {
-    return Obj(title, std::string("A primitive representing a ") + std::string(what),
-               {{"pose", Pose("Position of the center and orientation")},
-                {"size", Vector3("Size along each axis")}, {"color", Color("Color")}});
-  };
-  const std::string cylinder = Obj("foxglove.CylinderPrimitive", "A primitive representing a cylinder, elliptic cylinder, or truncated cone",
+}
+
+// A cube or a sphere: a pose, a size and a colour.
+std::string SizedPrimitive(std::string_view title, std::string_view what) {
+  return Obj(title, std::string("A primitive representing a ") + std::string(what),
+             {{"pose", Pose("Position of the center and orientation")},
+              {"size", Vector3("Size along each axis")}, {"color", Color("Color")}});
+}
+
+std::string CylinderPrimitive() {
+  return Obj("foxglove.CylinderPrimitive", "A primitive representing a cylinder, elliptic cylinder, or truncated cone",
       {{"pose", Pose("Position of the center and orientation")}, {"size", Vector3("Size of the bounding box")},
        {"bottom_scale", Num("0-1, ratio of the diameter of the bottom face to the bounding box")},
        {"top_scale", Num("0-1, ratio of the diameter of the top face to the bounding box")},
        {"color", Color("Color")}});
-  const std::string line = Obj("foxglove.LinePrimitive", "A primitive representing a series of points connected by lines",
+}
+
+std::string LinePrimitive() {
+  return Obj("foxglove.LinePrimitive", "A primitive representing a series of points connected by lines",
       {{"type", Enum("foxglove.LineType", {{"LINE_STRIP", 0}, {"LINE_LOOP", 1}, {"LINE_LIST", 2}}, "Drawing primitive to use for lines")},
        {"pose", Pose("Origin of lines relative to reference frame")},
        {"thickness", Num("Line thickness")},
        {"scale_invariant", Bool("Whether thickness is in pixels (true) or in the frame's units (false)")},
        {"points", Arr(Point3(), "Points along the line")}, {"color", Color("Solid color for the whole line")},
        {"colors", Arr(Color(""), "Per-point colors")}, {"indices", Arr(UInt(""), "Indices into points")}});
-  const std::string text = Obj("foxglove.TextPrimitive", "A primitive representing a text label",
+}
+
+std::string TextPrimitive() {
+  return Obj("foxglove.TextPrimitive", "A primitive representing a text label",
       {{"pose", Pose("Position of the center of the text box and orientation of the text")},
        {"billboard", Bool("Whether the text always faces the camera")}, {"font_size", Num("Font size (height of one line of text)")},
        {"scale_invariant", Bool("Whether font_size is in pixels (true) or in the frame's units (false)")},
        {"color", Color("Color of the text")}, {"text", Str("Text")}});
+}
+
+std::string SceneEntity() {
   const std::string kv = Obj("foxglove.KeyValuePair", "A key with its associated value",
                              {{"key", Str("Key")}, {"value", Str("Value")}});
   return Obj("foxglove.SceneEntity", "A visual element in a 3D scene",
@@ -126,11 +140,11 @@ std::string SceneEntity() {
        {"lifetime", Duration("Time after timestamp when the entity is removed; zero: until replaced or deleted")},
        {"frame_locked", Bool("Whether the entity follows frame_id as it moves (true) or stays where it was (false)")},
        {"metadata", Arr(kv, "Additional metadata (keys unique)")},
-       {"arrows", Arr(arrow, "Arrow primitives")},
-       {"cubes", Arr(sized("foxglove.CubePrimitive", "cube or rectangular prism"), "Cube primitives")},
-       {"spheres", Arr(sized("foxglove.SpherePrimitive", "sphere or ellipsoid"), "Sphere primitives")},
-       {"cylinders", Arr(cylinder, "Cylinder primitives")}, {"lines", Arr(line, "Line primitives")},
-       {"texts", Arr(text, "Text primitives")}});
+       {"arrows", Arr(ArrowPrimitive(), "Arrow primitives")},
+       {"cubes", Arr(SizedPrimitive("foxglove.CubePrimitive", "cube or rectangular prism"), "Cube primitives")},
+       {"spheres", Arr(SizedPrimitive("foxglove.SpherePrimitive", "sphere or ellipsoid"), "Sphere primitives")},
+       {"cylinders", Arr(CylinderPrimitive(), "Cylinder primitives")}, {"lines", Arr(LinePrimitive(), "Line primitives")},
+       {"texts", Arr(TextPrimitive(), "Text primitives")}});
 }
 
 std::string SceneUpdate() {

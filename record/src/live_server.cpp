@@ -325,54 +325,62 @@ struct LiveServer::Impl {
     }
   }
 
+  // GET / (also /index.html, /view.html): the page's headers, then its body on writable; else 404.
+  static int OnHttpRequest(lws* wsi, HttpSession* session, const void* in) {
+    const std::string uri(static_cast<const char*>(in), std::strlen(static_cast<const char*>(in)));
+    if (uri != "/" && uri != "/index.html" && uri != "/view.html") {
+      if (lws_return_http_status(wsi, HTTP_STATUS_NOT_FOUND, nullptr) != 0) return -1;
+      return lws_http_transaction_completed(wsi) != 0 ? -1 : 0;
+    }
+    unsigned char headers[LWS_PRE + 1024];
+    unsigned char* start = headers + LWS_PRE;
+    unsigned char* p = start;
+    unsigned char* end = headers + sizeof(headers) - 1;
+    if (lws_add_http_common_headers(wsi, HTTP_STATUS_OK, "text/html; charset=utf-8",
+                                    kViewPageSize, &p, end) != 0) {
+      return 1;
+    }
+    static constexpr char kNoCache[] = "no-store";
+    if (lws_add_http_header_by_token(wsi, WSI_TOKEN_HTTP_CACHE_CONTROL,
+                                     reinterpret_cast<const unsigned char*>(kNoCache),
+                                     static_cast<int>(sizeof(kNoCache) - 1), &p, end) != 0) {
+      return 1;
+    }
+    if (lws_finalize_write_http_header(wsi, start, &p, end) != 0) return 1;
+    session->sent = 0;
+    session->page = true;
+    lws_callback_on_writable(wsi);
+    return 0;
+  }
+
+  // The page's next chunk (kHttpChunk bytes at most); the transaction ends after the last.
+  static int OnHttpWritable(lws* wsi, HttpSession* session) {
+    if (session == nullptr || !session->page) return 0;
+    const std::size_t n = std::min(kHttpChunk, kViewPageSize - session->sent);
+    std::vector<unsigned char> buf(LWS_PRE + n);
+    std::memcpy(buf.data() + LWS_PRE, kViewPage + session->sent, n);
+    session->sent += n;
+    const bool last = session->sent == kViewPageSize;
+    if (lws_write(wsi, buf.data() + LWS_PRE, n, last ? LWS_WRITE_HTTP_FINAL : LWS_WRITE_HTTP) !=
+        static_cast<int>(n)) {
+      return 1;
+    }
+    if (last) {
+      session->page = false;
+      return lws_http_transaction_completed(wsi) != 0 ? -1 : 0;
+    }
+    lws_callback_on_writable(wsi);
+    return 0;
+  }
+
   static int HttpCallback(lws* wsi, lws_callback_reasons reason, void* user, void* in,
                           std::size_t len) {
     auto* session = static_cast<HttpSession*>(user);
     switch (reason) {
-      case LWS_CALLBACK_HTTP: {
-        const std::string uri(static_cast<const char*>(in), std::strlen(static_cast<const char*>(in)));
-        if (uri != "/" && uri != "/index.html" && uri != "/view.html") {
-          if (lws_return_http_status(wsi, HTTP_STATUS_NOT_FOUND, nullptr) != 0) return -1;
-          return lws_http_transaction_completed(wsi) != 0 ? -1 : 0;
-        }
-        unsigned char headers[LWS_PRE + 1024];
-        unsigned char* start = headers + LWS_PRE;
-        unsigned char* p = start;
-        unsigned char* end = headers + sizeof(headers) - 1;
-        if (lws_add_http_common_headers(wsi, HTTP_STATUS_OK, "text/html; charset=utf-8",
-                                        kViewPageSize, &p, end) != 0) {
-          return 1;
-        }
-        static constexpr char kNoCache[] = "no-store";
-        if (lws_add_http_header_by_token(wsi, WSI_TOKEN_HTTP_CACHE_CONTROL,
-                                         reinterpret_cast<const unsigned char*>(kNoCache),
-                                         static_cast<int>(sizeof(kNoCache) - 1), &p, end) != 0) {
-          return 1;
-        }
-        if (lws_finalize_write_http_header(wsi, start, &p, end) != 0) return 1;
-        session->sent = 0;
-        session->page = true;
-        lws_callback_on_writable(wsi);
-        return 0;
-      }
-      case LWS_CALLBACK_HTTP_WRITEABLE: {
-        if (session == nullptr || !session->page) return 0;
-        const std::size_t n = std::min(kHttpChunk, kViewPageSize - session->sent);
-        std::vector<unsigned char> buf(LWS_PRE + n);
-        std::memcpy(buf.data() + LWS_PRE, kViewPage + session->sent, n);
-        session->sent += n;
-        const bool last = session->sent == kViewPageSize;
-        if (lws_write(wsi, buf.data() + LWS_PRE, n, last ? LWS_WRITE_HTTP_FINAL : LWS_WRITE_HTTP) !=
-            static_cast<int>(n)) {
-          return 1;
-        }
-        if (last) {
-          session->page = false;
-          return lws_http_transaction_completed(wsi) != 0 ? -1 : 0;
-        }
-        lws_callback_on_writable(wsi);
-        return 0;
-      }
+      case LWS_CALLBACK_HTTP:
+        return OnHttpRequest(wsi, session, in);
+      case LWS_CALLBACK_HTTP_WRITEABLE:
+        return OnHttpWritable(wsi, session);
       case LWS_CALLBACK_EVENT_WAIT_CANCELLED:
         return 0;
       default:

@@ -424,47 +424,62 @@ Result<std::vector<ChunkMessage>> ChunkMessages(const std::string& records, std:
   return out;
 }
 
-}  // namespace
+// Messages decoded but not yet delivered, smallest (log time, chunk offset, position) first.
+class OrderedDelivery {
+ public:
+  explicit OrderedDelivery(const std::function<void(const McapMessage&)>& fn) : fn_(fn) {}
 
-Status McapReader::ForEach(const std::function<void(const McapMessage&)>& fn) const {
-  auto file = File::Open(path_);
-  if (!file) return file.error();
+  void Push(std::uint64_t log_time, std::uint64_t chunk_offset, std::uint64_t position, McapMessage message) {
+    pending_.push(Pending{log_time, chunk_offset, position, std::move(message)});
+  }
+  // Delivers every message that sorts before (time, offset).
+  void DeliverBefore(std::uint64_t time, std::uint64_t offset) {
+    while (!pending_.empty() &&
+           std::tie(pending_.top().log_time, pending_.top().chunk_offset) < std::tie(time, offset)) {
+      fn_(pending_.top().message);
+      pending_.pop();
+    }
+  }
+  void DeliverAll() {
+    while (!pending_.empty()) {
+      fn_(pending_.top().message);
+      pending_.pop();
+    }
+  }
 
-  // Messages decoded but not yet delivered, smallest (log time, chunk offset, position) first.
+ private:
   struct Pending {
     std::uint64_t log_time;
     std::uint64_t chunk_offset;
     std::uint64_t position;
     McapMessage message;
   };
-  auto later = [](const Pending& a, const Pending& b) {
-    return std::tie(a.log_time, a.chunk_offset, a.position) > std::tie(b.log_time, b.chunk_offset, b.position);
-  };
-  std::priority_queue<Pending, std::vector<Pending>, decltype(later)> pending(later);
-  auto deliver_before = [&](std::uint64_t time, std::uint64_t offset) {
-    while (!pending.empty() &&
-           std::tie(pending.top().log_time, pending.top().chunk_offset) < std::tie(time, offset)) {
-      fn(pending.top().message);
-      pending.pop();
+  struct Later {
+    bool operator()(const Pending& a, const Pending& b) const {
+      return std::tie(a.log_time, a.chunk_offset, a.position) > std::tie(b.log_time, b.chunk_offset, b.position);
     }
   };
+  const std::function<void(const McapMessage&)>& fn_;
+  std::priority_queue<Pending, std::vector<Pending>, Later> pending_;
+};
 
+}  // namespace
+
+Status McapReader::ForEach(const std::function<void(const McapMessage&)>& fn) const {
+  auto file = File::Open(path_);
+  if (!file) return file.error();
+  OrderedDelivery delivery(fn);
   std::string raw;
   std::string records;
   for (const ChunkRef& chunk : chunks_) {
     // Every later chunk starts at or after (start_ns, offset): what sorts before it is final.
-    deliver_before(chunk.start_ns, chunk.offset);
+    delivery.DeliverBefore(chunk.start_ns, chunk.offset);
     SWARMBOX_TRY(ReadChunk(*file, path_, chunk.offset, chunk.length, &raw, &records));
     auto messages = ChunkMessages(records, chunk.offset, path_, channel_index_);
     if (!messages) return messages.error();
-    for (ChunkMessage& m : *messages) {
-      pending.push(Pending{m.log_time, chunk.offset, m.position, std::move(m.message)});
-    }
+    for (ChunkMessage& m : *messages) delivery.Push(m.log_time, chunk.offset, m.position, std::move(m.message));
   }
-  while (!pending.empty()) {
-    fn(pending.top().message);
-    pending.pop();
-  }
+  delivery.DeliverAll();
   return Ok{};
 }
 

@@ -137,6 +137,42 @@ struct McapWriter::Impl {
     EndRecord(w, at);
   }
 
+  // The Chunk record's opening (everything before the compressed records).
+  std::string ChunkHead(std::string_view compression) const {
+    std::string head;
+    ByteWriter w(&head);
+    w.U8(static_cast<std::uint8_t>(Op::kChunk));
+    w.U64(8 + 8 + 8 + 4 + 4 + compression.size() + 8 + compressed.size());
+    w.U64(chunk_start_ns);
+    w.U64(chunk_end_ns);
+    w.U64(records.size());
+    w.U32(detail::Crc32(records));
+    w.Str(compression);
+    w.U64(compressed.size());
+    return head;
+  }
+
+  // One MessageIndex per channel, entries in log-time order (file order among equal times); their
+  // offsets (the file starts them at `at`) into entry.
+  std::string MessageIndexes(std::uint64_t at, ChunkIndexEntry* entry) {
+    std::string index;
+    ByteWriter iw(&index);
+    for (auto& [channel, entries] : chunk_index) {
+      std::stable_sort(entries.begin(), entries.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+      entry->index_offsets.emplace_back(channel, at + index.size());
+      const std::size_t start = BeginRecord(iw, Op::kMessageIndex);
+      iw.U16(channel);
+      iw.U32(static_cast<std::uint32_t>(entries.size() * 16));
+      for (const auto& [time, offset] : entries) {
+        iw.U64(time);
+        iw.U64(offset);
+      }
+      EndRecord(iw, start);
+    }
+    return index;
+  }
+
   Status FlushChunk() {
     if (records.empty()) return Ok{};
     SWARMBOX_TRY(compressor.Compress(options.compression, records, &compressed));
@@ -146,38 +182,10 @@ struct McapWriter::Impl {
     entry.offset = pos;
     entry.compressed_size = compressed.size();
     entry.uncompressed_size = records.size();
-
-    std::string head;
-    ByteWriter w(&head);
-    const std::string_view compression = detail::CompressionField(options.compression);
-    w.U8(static_cast<std::uint8_t>(Op::kChunk));
-    w.U64(8 + 8 + 8 + 4 + 4 + compression.size() + 8 + compressed.size());
-    w.U64(chunk_start_ns);
-    w.U64(chunk_end_ns);
-    w.U64(records.size());
-    w.U32(detail::Crc32(records));
-    w.Str(compression);
-    w.U64(compressed.size());
-    SWARMBOX_TRY(Out(head));
+    SWARMBOX_TRY(Out(ChunkHead(detail::CompressionField(options.compression))));
     SWARMBOX_TRY(Out(compressed));
     entry.length = pos - entry.offset;
-
-    // One MessageIndex per channel, entries in log-time order (file order among equal times).
-    std::string index;
-    ByteWriter iw(&index);
-    for (auto& [channel, entries] : chunk_index) {
-      std::stable_sort(entries.begin(), entries.end(),
-                       [](const auto& a, const auto& b) { return a.first < b.first; });
-      entry.index_offsets.emplace_back(channel, pos + index.size());
-      const std::size_t at = BeginRecord(iw, Op::kMessageIndex);
-      iw.U16(channel);
-      iw.U32(static_cast<std::uint32_t>(entries.size() * 16));
-      for (const auto& [time, offset] : entries) {
-        iw.U64(time);
-        iw.U64(offset);
-      }
-      EndRecord(iw, at);
-    }
+    const std::string index = MessageIndexes(pos, &entry);
     entry.index_length = index.size();
     SWARMBOX_TRY(Out(index));
     chunk_indexes.push_back(std::move(entry));

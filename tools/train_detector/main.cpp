@@ -29,46 +29,65 @@ struct Args {
 
 constexpr int kContinue = -1;  // ParseArgs: no exit yet
 
+constexpr int kUsageError = 2;
+
+// --training-sets N: the seeds 7000001..7000000+N.
+bool SetTrainingSets(const char* value, Args* args) {
+  const int n = std::stoi(value);
+  if (n < 1 || n > 99) {
+    std::fprintf(stderr, "swarmbox-train-detector: --training-sets must be 1..99\n");
+    return false;
+  }
+  args->options.training_seeds.clear();
+  for (int k = 1; k <= n; ++k) args->options.training_seeds.push_back(7'000'000 + static_cast<std::uint64_t>(k));
+  return true;
+}
+
+// A flag: its name, whether a value follows it, and what it sets (false: a usage error, printed).
+struct Flag {
+  std::string_view name;
+  bool takes_value;
+  bool (*apply)(const char* value, Args* args);
+};
+
+constexpr Flag kFlags[] = {
+    {"--out-dir", true, [](const char* v, Args* a) { a->out_dir = v; return true; }},
+    {"--recalibrate", false, [](const char*, Args* a) { a->recalibrate = true; return true; }},
+    {"--scenes-per-set", true, [](const char* v, Args* a) { a->options.scenes_per_set = std::stoi(v); return true; }},
+    {"--training-sets", true, SetTrainingSets},
+    {"--trees", true, [](const char* v, Args* a) { a->options.forest_trees = std::stoi(v); return true; }},
+    {"--max-negatives", true, [](const char* v, Args* a) { a->options.max_negatives = std::stoi(v); return true; }},
+    {"--stage1-percentile", true, [](const char* v, Args* a) { a->options.stage1_percentile = std::stod(v); return true; }},
+    {"--balance-classes", false, [](const char*, Args* a) { a->options.balance_classes = true; return true; }},
+    {"--hard-negative-rounds", true,
+     [](const char* v, Args* a) { a->options.hard_negative_rounds = std::stoi(v); return true; }},
+};
+
+// The flag named `a` when it is complete at argv[i] (its value, if it takes one, follows).
+const Flag* FindFlag(std::string_view a, int i, int argc) {
+  for (const Flag& f : kFlags) {
+    if (a == f.name && (!f.takes_value || i + 1 < argc)) return &f;
+  }
+  return nullptr;
+}
+
 // The flags into *args; an exit code for a usage error.
 int ParseArgs(int argc, char** argv, Args* args) {
-  td::TrainingOptions& options = args->options;
   for (int i = 1; i < argc; ++i) {
-    const std::string_view a = argv[i];
-    if (a == "--out-dir" && i + 1 < argc) {
-      args->out_dir = argv[++i];
-    } else if (a == "--recalibrate") {
-      args->recalibrate = true;
-    } else if (a == "--scenes-per-set" && i + 1 < argc) {
-      options.scenes_per_set = std::stoi(argv[++i]);
-    } else if (a == "--training-sets" && i + 1 < argc) {
-      const int n = std::stoi(argv[++i]);
-      if (n < 1 || n > 99) {
-        std::fprintf(stderr, "swarmbox-train-detector: --training-sets must be 1..99\n");
-        return 2;
-      }
-      options.training_seeds.clear();
-      for (int k = 1; k <= n; ++k) options.training_seeds.push_back(7'000'000 + static_cast<std::uint64_t>(k));
-    } else if (a == "--trees" && i + 1 < argc) {
-      options.forest_trees = std::stoi(argv[++i]);
-    } else if (a == "--max-negatives" && i + 1 < argc) {
-      options.max_negatives = std::stoi(argv[++i]);
-    } else if (a == "--stage1-percentile" && i + 1 < argc) {
-      options.stage1_percentile = std::stod(argv[++i]);
-    } else if (a == "--balance-classes") {
-      options.balance_classes = true;
-    } else if (a == "--hard-negative-rounds" && i + 1 < argc) {
-      options.hard_negative_rounds = std::stoi(argv[++i]);
-    } else {
+    const Flag* flag = FindFlag(argv[i], i, argc);
+    if (flag == nullptr) {
       std::fprintf(stderr,
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
                    "[--balance-classes] [--hard-negative-rounds N]\n");
-      return 2;
+      return kUsageError;
     }
+    const char* value = flag->takes_value ? argv[++i] : nullptr;
+    if (!flag->apply(value, args)) return kUsageError;
   }
   if (args->out_dir.empty()) {
     std::fprintf(stderr, "swarmbox-train-detector: --out-dir is required\n");
-    return 2;
+    return kUsageError;
   }
   return kContinue;
 }

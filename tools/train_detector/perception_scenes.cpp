@@ -108,7 +108,8 @@ physics::Bgr Jitter(std::mt19937_64& rng, physics::Bgr c, int amount) {
   return c;
 }
 
-void VaryLook(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfig* w) {
+// The ground: a terrain kind and water, a time of day and overcast, half the boxes trees.
+void VaryGround(std::mt19937_64& rng, physics::WorldConfig* w) {
   std::uniform_real_distribution<double> unit(0, 1);
   static constexpr physics::TerrainKind kTerrains[] = {physics::TerrainKind::kGrass, physics::TerrainKind::kSoil,
                                                        physics::TerrainKind::kGravel, physics::TerrainKind::kRubble,
@@ -124,6 +125,11 @@ void VaryLook(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfi
   for (physics::ObstacleBox& b : w->obstacles) {
     if (unit(rng) < 0.5) b.kind = physics::ObstacleKind::kTree;
   }
+}
+
+// The people: a pose (lying most often), clothing (one in six keeps the hi-vis figure), cover.
+void VaryPeople(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfig* w) {
+  std::uniform_real_distribution<double> unit(0, 1);
   // Clothing: greens, browns, greys, dark and bright colours (BGR).
   static constexpr physics::Bgr kClothes[] = {
       {40, 90, 40},   {60, 110, 70},  {50, 80, 60},   {40, 70, 110}, {30, 60, 90},  {60, 90, 120},
@@ -138,6 +144,11 @@ void VaryLook(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfi
     if (unit(rng) >= 1.0 / 6.0) v.clothing_bgr = Jitter(rng, kClothes[rng() % std::size(kClothes)], 15);
     v.cover = unit(rng) < p.occluded_fraction ? 0.2 + 0.6 * unit(rng) : 0.0;
   }
+}
+
+// p.distractors of random kinds 2-9 m from each person (tarps often orange or red).
+void AddDistractors(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfig* w) {
+  std::uniform_real_distribution<double> unit(0, 1);
   static constexpr physics::DistractorKind kKinds[] = {physics::DistractorKind::kTarp, physics::DistractorKind::kCone,
                                                        physics::DistractorKind::kBackpack,
                                                        physics::DistractorKind::kDebris, physics::DistractorKind::kRock};
@@ -161,62 +172,81 @@ void VaryLook(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfi
   }
 }
 
+// 8 victims at random headings, at least 6 m apart.
+void PlaceVictims(std::mt19937_64& rng, physics::WorldConfig* w) {
+  std::uniform_real_distribution<double> coord(-80, 80), unit(0, 1);
+  while (w->victims.size() < 8) {
+    physics::Victim v;
+    v.id = "v" + std::to_string(w->victims.size() + 1);
+    v.x_m = coord(rng);
+    v.y_m = coord(rng);
+    v.heading_rad = 2 * std::numbers::pi * unit(rng);
+    bool ok = true;
+    for (const physics::Victim& o : w->victims) ok = ok && std::hypot(o.x_m - v.x_m, o.y_m - v.y_m) > 6.0;
+    if (ok) w->victims.push_back(v);
+  }
+}
+
+// Up to 12 boxes 1-8 m tall as clutter, kept 2 m clear of the victims.
+void PlaceObstacles(std::mt19937_64& rng, physics::WorldConfig* w) {
+  std::uniform_real_distribution<double> coord(-80, 80), unit(0, 1);
+  int attempts = 0;
+  while (w->obstacles.size() < 12 && ++attempts < 1000) {
+    physics::ObstacleBox b;
+    b.id = "box" + std::to_string(w->obstacles.size());
+    b.size_m = {2 + 8 * unit(rng), 2 + 8 * unit(rng), 1 + 7 * unit(rng)};
+    b.center_m = {coord(rng), coord(rng), b.size_m.z / 2};
+    b.yaw_rad = std::numbers::pi * unit(rng);
+    const double reach = std::hypot(b.size_m.x, b.size_m.y) / 2 + 2.0 + 1.0;  // 2 m clear + figure
+    bool ok = true;
+    for (const physics::Victim& v : w->victims) ok = ok && std::hypot(v.x_m - b.center_m.x, v.y_m - b.center_m.y) > reach;
+    if (ok) w->obstacles.push_back(b);
+  }
+}
+
+// The hi-vis look's occlusion and distractors: low slabs over part of a figure, small debris boxes.
+void AddSlabsAndDebris(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfig* w) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (const physics::Victim& v : w->victims) {
+    if (p.occluded_fraction > 0 && unit(rng) < p.occluded_fraction) {
+      physics::ObstacleBox b;
+      b.id = "slab" + std::to_string(w->obstacles.size());
+      b.size_m = {0.5 + 0.7 * unit(rng), 0.4 + 0.5 * unit(rng), 0.3 + 0.3 * unit(rng)};
+      // Along the figure, from the feet (-0.9 m) to the head (+0.8 m).
+      const double along = -0.9 + 1.7 * unit(rng);
+      b.center_m = {v.x_m + along * std::cos(v.heading_rad), v.y_m + along * std::sin(v.heading_rad), b.size_m.z / 2};
+      b.yaw_rad = std::numbers::pi * unit(rng);
+      w->obstacles.push_back(b);
+    }
+    for (int k = 0; k < p.distractors; ++k) {
+      physics::ObstacleBox b;
+      b.id = "debris" + std::to_string(w->obstacles.size());
+      b.size_m = {0.3 + 1.2 * unit(rng), 0.3 + 0.8 * unit(rng), 0.1 + 0.5 * unit(rng)};
+      const double r = 2.5 + 6.0 * unit(rng), a = 2 * std::numbers::pi * unit(rng);
+      b.center_m = {v.x_m + r * std::cos(a), v.y_m + r * std::sin(a), b.size_m.z / 2};
+      b.yaw_rad = std::numbers::pi * unit(rng);
+      w->obstacles.push_back(b);
+    }
+  }
+}
+
 physics::WorldConfig MakeWorld(std::mt19937_64& rng, int index, const SceneSetParams& p) {
   physics::WorldConfig w;
   w.name = "perception_" + std::to_string(index);
   w.size_x_m = 200;
   w.size_y_m = 200;
   w.ground_texture_seed = rng();
-  std::uniform_real_distribution<double> coord(-80, 80), unit(0, 1);
-  while (w.victims.size() < 8) {
-    physics::Victim v;
-    v.id = "v" + std::to_string(w.victims.size() + 1);
-    v.x_m = coord(rng);
-    v.y_m = coord(rng);
-    v.heading_rad = 2 * std::numbers::pi * unit(rng);
-    bool ok = true;
-    for (const physics::Victim& o : w.victims) ok = ok && std::hypot(o.x_m - v.x_m, o.y_m - v.y_m) > 6.0;
-    if (ok) w.victims.push_back(v);
-  }
-  int attempts = 0;
-  while (w.obstacles.size() < 12 && ++attempts < 1000) {
-    physics::ObstacleBox b;
-    b.id = "box" + std::to_string(w.obstacles.size());
-    b.size_m = {2 + 8 * unit(rng), 2 + 8 * unit(rng), 1 + 7 * unit(rng)};
-    b.center_m = {coord(rng), coord(rng), b.size_m.z / 2};
-    b.yaw_rad = std::numbers::pi * unit(rng);
-    const double reach = std::hypot(b.size_m.x, b.size_m.y) / 2 + 2.0 + 1.0;  // 2 m clear + figure
-    bool ok = true;
-    for (const physics::Victim& v : w.victims) ok = ok && std::hypot(v.x_m - b.center_m.x, v.y_m - b.center_m.y) > reach;
-    if (ok) w.obstacles.push_back(b);
-  }
+  PlaceVictims(rng, &w);
+  PlaceObstacles(rng, &w);
   // Occluders, distractors and the varied look draw from the generator only when asked for, so the
   // scene sets of the defaults stay what they were.
   if (p.varied_look) {
-    VaryLook(rng, p, &w);
+    VaryGround(rng, &w);
+    VaryPeople(rng, p, &w);
+    AddDistractors(rng, p, &w);
     return w;
   }
-  for (const physics::Victim& v : w.victims) {
-    if (p.occluded_fraction > 0 && unit(rng) < p.occluded_fraction) {
-      physics::ObstacleBox b;
-      b.id = "slab" + std::to_string(w.obstacles.size());
-      b.size_m = {0.5 + 0.7 * unit(rng), 0.4 + 0.5 * unit(rng), 0.3 + 0.3 * unit(rng)};
-      // Along the figure, from the feet (-0.9 m) to the head (+0.8 m).
-      const double along = -0.9 + 1.7 * unit(rng);
-      b.center_m = {v.x_m + along * std::cos(v.heading_rad), v.y_m + along * std::sin(v.heading_rad), b.size_m.z / 2};
-      b.yaw_rad = std::numbers::pi * unit(rng);
-      w.obstacles.push_back(b);
-    }
-    for (int k = 0; k < p.distractors; ++k) {
-      physics::ObstacleBox b;
-      b.id = "debris" + std::to_string(w.obstacles.size());
-      b.size_m = {0.3 + 1.2 * unit(rng), 0.3 + 0.8 * unit(rng), 0.1 + 0.5 * unit(rng)};
-      const double r = 2.5 + 6.0 * unit(rng), a = 2 * std::numbers::pi * unit(rng);
-      b.center_m = {v.x_m + r * std::cos(a), v.y_m + r * std::sin(a), b.size_m.z / 2};
-      b.yaw_rad = std::numbers::pi * unit(rng);
-      w.obstacles.push_back(b);
-    }
-  }
+  AddSlabsAndDebris(rng, p, &w);
   return w;
 }
 
@@ -240,59 +270,8 @@ physics::DroneSpawn CameraSpawn(const physics::Airframe& x500, std::string name,
   return spawn;
 }
 
-}  // namespace
-
-Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
-  Result<physics::Airframe> x500 = CameraAirframe();
-  if (!x500) return x500.error();
-  std::mt19937_64 rng(p.seed);
-  std::uniform_real_distribution<double> unit(0, 1);
-  std::vector<Scene> scenes;
-  scenes.reserve(static_cast<std::size_t>(p.scenes));
-  int world_index = 0;
-  while (static_cast<int>(scenes.size()) < p.scenes) {
-    const physics::WorldConfig config = MakeWorld(rng, world_index, p);
-    Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = rng()});
-    if (!world) return world.error().Context("creating perception world");
-    const int count = std::min(p.scenes_per_world, p.scenes - static_cast<int>(scenes.size()));
-    for (int i = 0; i < count; ++i) {
-      const double altitude = p.min_altitude_m + (p.max_altitude_m - p.min_altitude_m) * unit(rng);
-      const double yaw = 2 * std::numbers::pi * unit(rng) - std::numbers::pi;
-      const double half_w = altitude * std::tan(x500->camera.hfov_rad / 2);
-      Vector2d centre;
-      if (unit(rng) < p.near_victim_fraction) {
-        const physics::Victim& v = config.victims[static_cast<std::size_t>(rng() % config.victims.size())];
-        centre = Vector2d(v.x_m, v.y_m) + p.near_victim_offset * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
-      } else {
-        centre = Vector2d(160 * unit(rng) - 80, 160 * unit(rng) - 80);
-      }
-      const double noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
-      const physics::DroneSpawn spawn = CameraSpawn(*x500, "cam_" + std::to_string(i), centre, altitude, noise_std, yaw);
-      Result<std::size_t> d = (*world)->AddDrone(spawn);
-      if (!d) return d.error().Context("placing camera drone");
-      Scene s;
-      std::vector<physics::VisiblePerson> people;
-      (*world)->RenderCamera(*d, &s.image, &people);
-      s.intrinsics = {s.image.intrinsics.fx_px, s.image.intrinsics.fy_px, s.image.intrinsics.cx_px,
-                      s.image.intrinsics.cy_px};
-      const physics::Pose& cp = s.image.camera_pose;
-      s.true_pose.position_m = {cp.position_m.x, cp.position_m.y, cp.position_m.z};
-      s.true_pose.rotation = Eigen::Quaterniond(cp.attitude.w, cp.attitude.x, cp.attitude.y, cp.attitude.z);
-      s.altitude_m = cp.position_m.z;
-      s.noise_std = noise_std;
-      for (const physics::Victim& v : config.victims) {
-        s.victims.push_back(Classify(v, s, config));
-      }
-      SetVisibleFractions(config, people, &s);
-      scenes.push_back(std::move(s));
-    }
-    ++world_index;
-  }
-  return scenes;
-}
-
-namespace {
-
+// The scene of a rendered image: intrinsics, true pose and altitude from the image, each victim
+// classified (the renderer's visible fractions). The tilt is left at 0 (WithTilt measures it).
 Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& config, double noise_std,
                      const std::vector<physics::VisiblePerson>& people) {
   Scene s;
@@ -304,8 +283,6 @@ Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& con
   s.true_pose.rotation = Eigen::Quaterniond(cp.attitude.w, cp.attitude.x, cp.attitude.y, cp.attitude.z);
   s.altitude_m = cp.position_m.z;
   s.noise_std = noise_std;
-  const Vector3d axis = s.true_pose.rotation * Vector3d::UnitZ();  // optical axis in the world
-  s.tilt_rad = std::acos(std::clamp(-axis.z(), -1.0, 1.0));
   for (const physics::Victim& v : config.victims) {
     s.victims.push_back(Classify(v, s, config));
   }
@@ -313,7 +290,116 @@ Scene SceneFromImage(physics::CameraImage image, const physics::WorldConfig& con
   return s;
 }
 
+// The scene with its tilt: the angle between the optical axis and straight down.
+Scene WithTilt(Scene s) {
+  const Vector3d axis = s.true_pose.rotation * Vector3d::UnitZ();  // optical axis in the world
+  s.tilt_rad = std::acos(std::clamp(-axis.z(), -1.0, 1.0));
+  return s;
+}
+
+// Renders drone `drone`'s camera in `world` into a scene.
+Scene SceneOfCamera(physics::World& world, std::size_t drone, const physics::WorldConfig& config, double noise_std) {
+  physics::CameraImage img;
+  std::vector<physics::VisiblePerson> people;
+  world.RenderCamera(drone, &img, &people);
+  return SceneFromImage(std::move(img), config, noise_std, people);
+}
+
+// A nadir view's centre: mostly near a victim (up to near_victim_offset half footprints away),
+// else anywhere in the central 160 x 160 m.
+Vector2d ViewCentre(std::mt19937_64& rng, const SceneSetParams& p, const physics::WorldConfig& config, double half_w) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  if (unit(rng) < p.near_victim_fraction) {
+    const physics::Victim& v = config.victims[static_cast<std::size_t>(rng() % config.victims.size())];
+    return Vector2d(v.x_m, v.y_m) + p.near_victim_offset * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
+  }
+  return Vector2d(160 * unit(rng) - 80, 160 * unit(rng) - 80);
+}
+
+// `count` nadir views of one world from camera drones added to it, onto *scenes.
+Status RenderNadirViews(std::mt19937_64& rng, const SceneSetParams& p, const physics::Airframe& x500,
+                        const physics::WorldConfig& config, physics::World& world, int count, std::vector<Scene>* scenes) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (int i = 0; i < count; ++i) {
+    const double altitude = p.min_altitude_m + (p.max_altitude_m - p.min_altitude_m) * unit(rng);
+    const double yaw = 2 * std::numbers::pi * unit(rng) - std::numbers::pi;
+    const double half_w = altitude * std::tan(x500.camera.hfov_rad / 2);
+    const Vector2d centre = ViewCentre(rng, p, config, half_w);
+    const double noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
+    const physics::DroneSpawn spawn = CameraSpawn(x500, "cam_" + std::to_string(i), centre, altitude, noise_std, yaw);
+    Result<std::size_t> d = world.AddDrone(spawn);
+    if (!d) return d.error().Context("placing camera drone");
+    scenes->push_back(SceneOfCamera(world, *d, config, noise_std));
+  }
+  return Ok{};
+}
+
+// A world's tilted camera drones: spawned hovering, each with its differential rotor command.
+struct TiltedDrones {
+  std::vector<std::size_t> drones;
+  std::vector<std::vector<double>> commands;
+  std::vector<double> noise;
+};
+
+Status AddTiltedDrones(std::mt19937_64& rng, const SceneSetParams& p, const physics::Airframe& x500,
+                       const physics::WorldConfig& config, double differential, int count, physics::World& world,
+                       TiltedDrones* out) {
+  std::uniform_real_distribution<double> unit(0, 1);
+  const double hover_u = x500.HoverRotorSpeed() / x500.motor.max_rot_velocity_rad_s;
+  for (int i = 0; i < count; ++i) {  // every drone is added before the first Step()
+    const double altitude = p.min_altitude_m + (p.max_altitude_m - p.min_altitude_m) * unit(rng);
+    const physics::Victim& v = config.victims[static_cast<std::size_t>(rng() % config.victims.size())];
+    const double half_w = altitude * std::tan(x500.camera.hfov_rad / 2);
+    const Vector2d centre = Vector2d(v.x_m, v.y_m) + 0.5 * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
+    const double noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
+    const double yaw = 2 * std::numbers::pi * unit(rng);
+    physics::DroneSpawn spawn = CameraSpawn(x500, "tilt_" + std::to_string(i), centre, altitude, noise_std, yaw);
+    spawn.initial_throttle = hover_u;
+    Result<std::size_t> d = world.AddDrone(spawn);
+    if (!d) return d.error().Context("placing camera drone");
+    const double a = differential * (2 * unit(rng) - 1), b = differential * (2 * unit(rng) - 1);
+    std::vector<double> u;
+    for (const physics::RotorSpec& r : x500.rotors) {
+      u.push_back(hover_u + a * (r.position_m.x > 0 ? 1 : -1) + b * (r.position_m.y > 0 ? 1 : -1));
+    }
+    out->drones.push_back(*d);
+    out->commands.push_back(std::move(u));
+    out->noise.push_back(noise_std);
+  }
+  return Ok{};
+}
+
+// burst_s of simulated flight with every drone on its command.
+Status FlyBurst(const TiltedDrones& tilted, double burst_s, physics::World& world) {
+  const auto steps = static_cast<int>(std::lround(burst_s * 1e9 / static_cast<double>(world.options().control_period_ns)));
+  for (int k = 0; k < steps; ++k) {
+    for (std::size_t i = 0; i < tilted.drones.size(); ++i) {
+      if (Status st = world.SetActuators(tilted.drones[i], tilted.commands[i]); !st) return st.error();
+    }
+    world.Step();
+  }
+  return Ok{};
+}
+
 }  // namespace
+
+Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
+  Result<physics::Airframe> x500 = CameraAirframe();
+  if (!x500) return x500.error();
+  std::mt19937_64 rng(p.seed);
+  std::vector<Scene> scenes;
+  scenes.reserve(static_cast<std::size_t>(p.scenes));
+  int world_index = 0;
+  while (static_cast<int>(scenes.size()) < p.scenes) {
+    const physics::WorldConfig config = MakeWorld(rng, world_index, p);
+    Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = rng()});
+    if (!world) return world.error().Context("creating perception world");
+    const int count = std::min(p.scenes_per_world, p.scenes - static_cast<int>(scenes.size()));
+    if (Status st = RenderNadirViews(rng, p, *x500, config, **world, count, &scenes); !st) return st.error();
+    ++world_index;
+  }
+  return scenes;
+}
 
 Result<Scene> RenderView(const physics::WorldConfig& config, const Vector2d& centre, double altitude,
                          double yaw, double noise_std) {
@@ -323,17 +409,13 @@ Result<Scene> RenderView(const physics::WorldConfig& config, const Vector2d& cen
   if (!world) return world.error().Context("creating perception world");
   Result<std::size_t> d = (*world)->AddDrone(CameraSpawn(*x500, "cam", centre, altitude, noise_std, yaw));
   if (!d) return d.error().Context("placing camera drone");
-  physics::CameraImage img;
-  std::vector<physics::VisiblePerson> people;
-  (*world)->RenderCamera(*d, &img, &people);
-  return SceneFromImage(std::move(img), config, noise_std, people);
+  return WithTilt(SceneOfCamera(**world, *d, config, noise_std));
 }
 
 Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double differential, double burst_s) {
   Result<physics::Airframe> x500 = CameraAirframe();
   if (!x500) return x500.error();
   std::mt19937_64 rng(p.seed);
-  std::uniform_real_distribution<double> unit(0, 1);
   std::vector<Scene> scenes;
   int world_index = 0;
   while (static_cast<int>(scenes.size()) < p.scenes) {
@@ -341,42 +423,11 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double di
     Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = rng()});
     if (!world) return world.error().Context("creating perception world");
     const int count = std::min(p.scenes_per_world, p.scenes - static_cast<int>(scenes.size()));
-    const double hover_u = x500->HoverRotorSpeed() / x500->motor.max_rot_velocity_rad_s;
-    std::vector<std::size_t> drones;
-    std::vector<std::vector<double>> commands;
-    std::vector<double> noise;
-    for (int i = 0; i < count; ++i) {  // every drone is added before the first Step()
-      const double altitude = p.min_altitude_m + (p.max_altitude_m - p.min_altitude_m) * unit(rng);
-      const physics::Victim& v = config.victims[static_cast<std::size_t>(rng() % config.victims.size())];
-      const double half_w = altitude * std::tan(x500->camera.hfov_rad / 2);
-      const Vector2d centre = Vector2d(v.x_m, v.y_m) + 0.5 * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
-      const double noise_std = p.min_noise_std + (p.max_noise_std - p.min_noise_std) * unit(rng);
-      const double yaw = 2 * std::numbers::pi * unit(rng);
-      physics::DroneSpawn spawn = CameraSpawn(*x500, "tilt_" + std::to_string(i), centre, altitude, noise_std, yaw);
-      spawn.initial_throttle = hover_u;
-      Result<std::size_t> d = (*world)->AddDrone(spawn);
-      if (!d) return d.error().Context("placing camera drone");
-      const double a = differential * (2 * unit(rng) - 1), b = differential * (2 * unit(rng) - 1);
-      std::vector<double> u;
-      for (const physics::RotorSpec& r : x500->rotors) {
-        u.push_back(hover_u + a * (r.position_m.x > 0 ? 1 : -1) + b * (r.position_m.y > 0 ? 1 : -1));
-      }
-      drones.push_back(*d);
-      commands.push_back(std::move(u));
-      noise.push_back(noise_std);
-    }
-    const auto steps = static_cast<int>(std::lround(burst_s * 1e9 / static_cast<double>((*world)->options().control_period_ns)));
-    for (int k = 0; k < steps; ++k) {
-      for (std::size_t i = 0; i < drones.size(); ++i) {
-        if (Status st = (*world)->SetActuators(drones[i], commands[i]); !st) return st.error();
-      }
-      (*world)->Step();
-    }
-    for (std::size_t i = 0; i < drones.size(); ++i) {
-      physics::CameraImage img;
-      std::vector<physics::VisiblePerson> people;
-      (*world)->RenderCamera(drones[i], &img, &people);
-      scenes.push_back(SceneFromImage(std::move(img), config, noise[i], people));
+    TiltedDrones tilted;
+    if (Status st = AddTiltedDrones(rng, p, *x500, config, differential, count, **world, &tilted); !st) return st.error();
+    if (Status st = FlyBurst(tilted, burst_s, **world); !st) return st.error();
+    for (std::size_t i = 0; i < tilted.drones.size(); ++i) {
+      scenes.push_back(WithTilt(SceneOfCamera(**world, tilted.drones[i], config, tilted.noise[i])));
     }
   }
   return scenes;

@@ -1,9 +1,11 @@
 #include "train_detector.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
@@ -169,18 +171,25 @@ Result<std::vector<Scene>> RenderSets(const std::vector<std::uint64_t>& seeds, i
   return all;
 }
 
-// Ridge-regression discriminant on standardised features, targets +-1 with the classes weighted
-// equally; returns weights and bias over raw features.
-std::pair<std::vector<double>, double> FitLinear(const Labelled& d, double lambda) {
-  const int n = d.rows(), f = swarm::kWindowFeatures;
-  cv::Mat x(n, f, CV_32F, const_cast<float*>(d.x.data()));
+// Each feature's mean and standard deviation (at least 1e-6) over the rows of x.
+struct Standardisation {
+  cv::Mat mean_row, std_row;  // 1 x features, CV_64F
+};
+
+Standardisation Standardise(const cv::Mat& x, int f) {
+  Standardisation st{cv::Mat(1, f, CV_64F), cv::Mat(1, f, CV_64F)};
   cv::Mat mean, stddev;
-  cv::Mat mean_row(1, f, CV_64F), std_row(1, f, CV_64F);
   for (int j = 0; j < f; ++j) {
     cv::meanStdDev(x.col(j), mean, stddev);
-    mean_row.at<double>(j) = mean.at<double>(0);
-    std_row.at<double>(j) = std::max(stddev.at<double>(0), 1e-6);
+    st.mean_row.at<double>(j) = mean.at<double>(0);
+    st.std_row.at<double>(j) = std::max(stddev.at<double>(0), 1e-6);
   }
+  return st;
+}
+
+// The ridge solution w (features + bias) of the class-weighted standardised design.
+cv::Mat SolveRidge(const Labelled& d, const cv::Mat& x, const Standardisation& st, double lambda) {
+  const int n = d.rows(), f = swarm::kWindowFeatures;
   int pos = 0;
   for (int y : d.y) pos += y;
   const double wp = 0.5 / std::max(1, pos), wn = 0.5 / std::max(1, n - pos);
@@ -190,7 +199,7 @@ std::pair<std::vector<double>, double> FitLinear(const Labelled& d, double lambd
     float* zi = z.ptr<float>(i);
     const double sw = std::sqrt(d.y[static_cast<std::size_t>(i)] ? wp : wn);
     for (int j = 0; j < f; ++j) {
-      zi[j] = static_cast<float>(sw * (xi[j] - mean_row.at<double>(j)) / std_row.at<double>(j));
+      zi[j] = static_cast<float>(sw * (xi[j] - st.mean_row.at<double>(j)) / st.std_row.at<double>(j));
     }
     zi[f] = static_cast<float>(sw);
     t.at<float>(i) = static_cast<float>(sw * d.target[static_cast<std::size_t>(i)]);
@@ -204,35 +213,43 @@ std::pair<std::vector<double>, double> FitLinear(const Labelled& d, double lambd
   for (int j = 0; j < f; ++j) a.at<double>(j, j) += lambda;  // the bias is not shrunk
   cv::Mat w;
   cv::solve(a, b, w, cv::DECOMP_CHOLESKY);
+  return w;
+}
+
+// Ridge-regression discriminant on standardised features, targets +-1 with the classes weighted
+// equally; returns weights and bias over raw features.
+std::pair<std::vector<double>, double> FitLinear(const Labelled& d, double lambda) {
+  const int n = d.rows(), f = swarm::kWindowFeatures;
+  cv::Mat x(n, f, CV_32F, const_cast<float*>(d.x.data()));
+  const Standardisation st = Standardise(x, f);
+  const cv::Mat w = SolveRidge(d, x, st, lambda);
   std::vector<double> weights(static_cast<std::size_t>(f));
   double bias = w.at<double>(f);
   for (int j = 0; j < f; ++j) {
-    weights[static_cast<std::size_t>(j)] = w.at<double>(j) / std_row.at<double>(j);
-    bias -= w.at<double>(j) * mean_row.at<double>(j) / std_row.at<double>(j);
+    weights[static_cast<std::size_t>(j)] = w.at<double>(j) / st.std_row.at<double>(j);
+    bias -= w.at<double>(j) * st.mean_row.at<double>(j) / st.std_row.at<double>(j);
   }
   return {weights, bias};
 }
 
-// Platt's sigmoid p = 1 / (1 + exp(a v + b)) by Newton's method on the log loss, with his
-// smoothed targets (N+ + 1) / (N+ + 2) and 1 / (N- + 2).
-std::pair<double, double> FitPlatt(const std::vector<double>& v, const std::vector<int>& y) {
-  double np = 0, nn = 0;
-  for (int l : y) (l ? np : nn) += 1;
-  const double tp = (np + 1) / (np + 2), tn = 1 / (nn + 2);
+// Platt's fit: scores v, labels y, his smoothed targets (N+ + 1) / (N+ + 2) and 1 / (N- + 2).
+struct PlattProblem {
+  const std::vector<double>& v;
+  const std::vector<int>& y;
+  double tp, tn;
+
   // Numerically stable log loss of targets t against p = 1 / (1 + exp(f)), f = a v + b.
-  auto loss = [&](double a, double b) {
+  double Loss(double a, double b) const {
     double l = 0;
     for (std::size_t i = 0; i < v.size(); ++i) {
       const double f = a * v[i] + b, t = y[i] ? tp : tn;
       l += f >= 0 ? t * f + std::log1p(std::exp(-f)) : (t - 1) * f + std::log1p(std::exp(f));
     }
     return l;
-  };
-  // Newton's method with backtracking (Lin, Lin and Weng 2007, "A note on Platt's probabilistic
-  // outputs for support vector machines").
-  double a = 0, b = std::log((nn + 1) / (np + 1));
-  double fval = loss(a, b);
-  for (int it = 0; it < 100; ++it) {
+  }
+
+  // The Newton direction at (a, b) and the gradient along it; nothing when converged or singular.
+  std::optional<std::array<double, 3>> Direction(double a, double b) const {
     double ga = 0, gb = 0, haa = 1e-12, hab = 0, hbb = 1e-12;
     for (std::size_t i = 0; i < v.size(); ++i) {
       const double f = a * v[i] + b;
@@ -245,14 +262,31 @@ std::pair<double, double> FitPlatt(const std::vector<double>& v, const std::vect
       hab += h * v[i];
       hbb += h;
     }
-    if (std::abs(ga) < 1e-5 && std::abs(gb) < 1e-5) break;
+    if (std::abs(ga) < 1e-5 && std::abs(gb) < 1e-5) return std::nullopt;
     const double det = haa * hbb - hab * hab;
-    if (std::abs(det) < 1e-18) break;
+    if (std::abs(det) < 1e-18) return std::nullopt;
     const double da = -(hbb * ga - hab * gb) / det, db = -(haa * gb - hab * ga) / det;
-    const double gd = ga * da + gb * db;
+    return std::array<double, 3>{da, db, ga * da + gb * db};
+  }
+};
+
+// Platt's sigmoid p = 1 / (1 + exp(a v + b)) by Newton's method on the log loss, with his
+// smoothed targets (N+ + 1) / (N+ + 2) and 1 / (N- + 2).
+std::pair<double, double> FitPlatt(const std::vector<double>& v, const std::vector<int>& y) {
+  double np = 0, nn = 0;
+  for (int l : y) (l ? np : nn) += 1;
+  const PlattProblem problem{v, y, (np + 1) / (np + 2), 1 / (nn + 2)};
+  // Newton's method with backtracking (Lin, Lin and Weng 2007, "A note on Platt's probabilistic
+  // outputs for support vector machines").
+  double a = 0, b = std::log((nn + 1) / (np + 1));
+  double fval = problem.Loss(a, b);
+  for (int it = 0; it < 100; ++it) {
+    const std::optional<std::array<double, 3>> dir = problem.Direction(a, b);
+    if (!dir) break;
+    const auto [da, db, gd] = *dir;
     double step = 1;
     while (step >= 1e-10) {
-      const double na = a + step * da, nb = b + step * db, nf = loss(na, nb);
+      const double na = a + step * da, nb = b + step * db, nf = problem.Loss(na, nb);
       if (nf < fval + 1e-4 * step * gd) {
         a = na;
         b = nb;

@@ -50,7 +50,8 @@ struct OpenLibrary {
   std::vector<std::string> names;
 };
 
-Result<OpenLibrary> Open(const std::string& path) {
+// The library loaded, closed when the last owner lets go.
+Result<std::shared_ptr<void>> DlOpen(const std::string& path) {
   dlerror();  // clear a stale error
   void* raw = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (raw == nullptr) {
@@ -61,11 +62,12 @@ Result<OpenLibrary> Open(const std::string& path) {
     }
     return LoadError(path, message);
   }
-  OpenLibrary lib;
-  lib.handle = std::shared_ptr<void>(raw, [](void* h) { dlclose(h); });
+  return std::shared_ptr<void>(raw, [](void* h) { dlclose(h); });
+}
 
-  // dlsym on the handle searches this library (and its dependencies) only, never the agent.
-  void* abi_sym = dlsym(raw, "swarmbox_brain_abi_version");
+// dlsym on the handle searches this library (and its dependencies) only, never the agent.
+Status CheckAbiVersion(const std::string& path, void* handle) {
+  void* abi_sym = dlsym(handle, "swarmbox_brain_abi_version");
   if (abi_sym == nullptr) {
     return LoadError(path,
                      "not a SwarmBox brain library: it exports no swarmbox_brain_abi_version (link "
@@ -78,8 +80,14 @@ Result<OpenLibrary> Open(const std::string& path) {
                                std::to_string(kAbiVersion) +
                                ": rebuild the library against this SwarmBox's package");
   }
-  void* cxx_sym = dlsym(raw, "swarmbox_brain_cxx_library");
-  void* registry_sym = dlsym(raw, "swarmbox_brain_registry");
+  return Ok{};
+}
+
+// The library's C++ standard library checked against the agent's; then its registry function
+// into *registry_fn.
+Status CheckCxxLibrary(const std::string& path, void* handle, RegistryFn* registry_fn) {
+  void* cxx_sym = dlsym(handle, "swarmbox_brain_cxx_library");
+  void* registry_sym = dlsym(handle, "swarmbox_brain_registry");
   if (cxx_sym == nullptr || registry_sym == nullptr) {
     return LoadError(path, "not a SwarmBox brain library: it exports swarmbox_brain_abi_version but no " +
                                std::string(cxx_sym == nullptr ? "swarmbox_brain_cxx_library"
@@ -91,18 +99,36 @@ Result<OpenLibrary> Open(const std::string& path) {
                                (cxx != nullptr ? cxx : "(none)") + ", this agent uses " + CxxLibrary() +
                                ": rebuild it with the agent's compiler and standard library");
   }
-  const std::vector<Registration>* registry = reinterpret_cast<RegistryFn>(registry_sym)();
-  if (registry != nullptr) lib.registry = *registry;
-  for (const Registration& r : lib.registry) {
+  *registry_fn = reinterpret_cast<RegistryFn>(registry_sym);
+  return Ok{};
+}
+
+// The registry's brains and their names, each name once.
+Status ReadRegistry(const std::string& path, RegistryFn registry_fn, OpenLibrary* lib) {
+  const std::vector<Registration>* registry = registry_fn();
+  if (registry != nullptr) lib->registry = *registry;
+  for (const Registration& r : lib->registry) {
     const std::string name = r.name != nullptr ? r.name : "";
-    for (const std::string& seen : lib.names) {
+    for (const std::string& seen : lib->names) {
       if (seen == name) {
         return LoadError(path, "the library registers brain \"" + name +
                                    "\" twice (two SWARMBOX_BRAIN lines with one name)");
       }
     }
-    lib.names.push_back(name);
+    lib->names.push_back(name);
   }
+  return Ok{};
+}
+
+Result<OpenLibrary> Open(const std::string& path) {
+  auto handle = DlOpen(path);
+  if (!handle) return handle.error();
+  OpenLibrary lib;
+  lib.handle = std::move(*handle);
+  SWARMBOX_TRY(CheckAbiVersion(path, lib.handle.get()));
+  RegistryFn registry_fn = nullptr;
+  SWARMBOX_TRY(CheckCxxLibrary(path, lib.handle.get(), &registry_fn));
+  SWARMBOX_TRY(ReadRegistry(path, registry_fn, &lib));
   return lib;
 }
 

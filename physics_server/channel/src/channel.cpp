@@ -101,9 +101,9 @@ Status ValidateImpairment(const Impairment& m) {
   return Ok{};
 }
 
-Result<Impairment> ParseImpairment(const yaml::Node& node) {
+Result<Impairment> ReadImpairmentKeys(const yaml::Node& node, const std::string& what) {
   Impairment m;
-  yaml::MapReader r(node, "impairment");
+  yaml::MapReader r(node, what);
   r.Optional("delay_ms", &m.delay_ms)
       .Optional("jitter_ms", &m.jitter_ms)
       .Optional("distribution", &m.distribution)
@@ -111,6 +111,13 @@ Result<Impairment> ParseImpairment(const yaml::Node& node) {
       .Optional("rate_kbit", &m.rate_kbit)
       .Optional("duplicate", &m.duplicate);
   if (auto s = r.Finish(); !s) return s.error();
+  return m;
+}
+
+Result<Impairment> ParseImpairment(const yaml::Node& node) {
+  Result<Impairment> read = ReadImpairmentKeys(node, "impairment");
+  if (!read) return read.error();
+  const Impairment& m = *read;
   if (auto p = ImpairmentProblem(m)) {
     const yaml::Node* at = node.Find(p->first);
     return Error(ErrorCode::kInvalidArgument, std::move(p->second), at != nullptr ? at->Where() : node.Where());
@@ -194,46 +201,60 @@ void Channel::Send(std::int64_t now_ns, const Packet& p) {
     ++stats_.lost_out;
     return;
   }
-  auto draw = [&](std::uint64_t purpose) {
-    return detail::Uniform01(DrawHash(seed_, purpose, p.from, p.seq, p.sent_ns, kNoReceiver));
-  };
   const Impairment* imp = ImpairmentOf(p.from);
   std::uint32_t copies = 1;
   std::int64_t base_ns = now_ns;
   if (imp != nullptr) {
-    // netem_enqueue: a duplicate adds a copy, a loss takes one away.
-    if (imp->duplicate > 0 && draw(PurposeCode(Purpose::kDuplicate)) < imp->duplicate) ++copies;
-    if (imp->loss > 0 && draw(PurposeCode(Purpose::kLoss)) < imp->loss) --copies;
-    if (copies == 0) {
-      ++stats_.lost_impairment;
-      return;
-    }
-    if (copies == 2) ++stats_.duplicated;
-    if (imp->rate_kbit > 0) {
-      const double tx_s = static_cast<double>(p.size_bytes) * 8.0 / (imp->rate_kbit * 1000.0);
-      s.serialiser_free_ns = std::max(now_ns, s.serialiser_free_ns) + NsFromSeconds(tx_s);
-      base_ns = s.serialiser_free_ns;
-    }
+    copies = ImpairedCopies(now_ns, p, *imp, s, &base_ns);
+    if (copies == 0) return;
   }
   for (std::uint32_t copy = 0; copy < copies; ++copy) {
-    std::int64_t at_ns = base_ns;
-    if (imp != nullptr) {
-      double delay_ms = imp->delay_ms;
-      if (imp->jitter_ms > 0) {
-        const std::uint64_t h = DrawHash(seed_, PurposeCode(Purpose::kJitter, copy), p.from, p.seq, p.sent_ns, kNoReceiver);
-        delay_ms += imp->distribution == "uniform" ? imp->jitter_ms * (2.0 * detail::Uniform01(h) - 1.0)
-                                                   : imp->jitter_ms * detail::StandardNormal(h);
-      }
-      at_ns += NsFromSeconds(std::max(0.0, delay_ms) * 1e-3);
-    }
-    if (profile_.access_wait_max_us > 0) {
-      at_ns += NsFromSeconds(draw(PurposeCode(Purpose::kAccessWait, copy)) * profile_.access_wait_max_us * 1e-6);
-    }
-    pending_.push_back(Egress{at_ns, copy, p});
+    pending_.push_back(Egress{EgressNs(base_ns, p, imp, copy), copy, p});
     std::push_heap(pending_.begin(), pending_.end(), [](const Egress& a, const Egress& b) {
       return EgressAfter(a.egress_ns, a.packet, a.copy, b.egress_ns, b.packet, b.copy);
     });
   }
+}
+
+std::uint32_t Channel::ImpairedCopies(std::int64_t now_ns, const Packet& p, const Impairment& imp, SenderState& s,
+                                      std::int64_t* base_ns) {
+  auto draw = [&](std::uint64_t purpose) {
+    return detail::Uniform01(DrawHash(seed_, purpose, p.from, p.seq, p.sent_ns, kNoReceiver));
+  };
+  std::uint32_t copies = 1;
+  // netem_enqueue: a duplicate adds a copy, a loss takes one away.
+  if (imp.duplicate > 0 && draw(PurposeCode(Purpose::kDuplicate)) < imp.duplicate) ++copies;
+  if (imp.loss > 0 && draw(PurposeCode(Purpose::kLoss)) < imp.loss) --copies;
+  if (copies == 0) {
+    ++stats_.lost_impairment;
+    return 0;
+  }
+  if (copies == 2) ++stats_.duplicated;
+  if (imp.rate_kbit > 0) {
+    const double tx_s = static_cast<double>(p.size_bytes) * 8.0 / (imp.rate_kbit * 1000.0);
+    s.serialiser_free_ns = std::max(now_ns, s.serialiser_free_ns) + NsFromSeconds(tx_s);
+    *base_ns = s.serialiser_free_ns;
+  }
+  return copies;
+}
+
+std::int64_t Channel::EgressNs(std::int64_t base_ns, const Packet& p, const Impairment* imp, std::uint32_t copy) const {
+  std::int64_t at_ns = base_ns;
+  if (imp != nullptr) {
+    double delay_ms = imp->delay_ms;
+    if (imp->jitter_ms > 0) {
+      const std::uint64_t h = DrawHash(seed_, PurposeCode(Purpose::kJitter, copy), p.from, p.seq, p.sent_ns, kNoReceiver);
+      delay_ms += imp->distribution == "uniform" ? imp->jitter_ms * (2.0 * detail::Uniform01(h) - 1.0)
+                                                 : imp->jitter_ms * detail::StandardNormal(h);
+    }
+    at_ns += NsFromSeconds(std::max(0.0, delay_ms) * 1e-3);
+  }
+  if (profile_.access_wait_max_us > 0) {
+    const double wait = detail::Uniform01(
+        DrawHash(seed_, PurposeCode(Purpose::kAccessWait, copy), p.from, p.seq, p.sent_ns, kNoReceiver));
+    at_ns += NsFromSeconds(wait * profile_.access_wait_max_us * 1e-6);
+  }
+  return at_ns;
 }
 
 void Channel::Admit(const Egress& e) {

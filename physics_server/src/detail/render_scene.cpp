@@ -161,21 +161,42 @@ std::vector<Part> FigureParts(const Victim& v) {
 
 // Cover: blobs of debris or foliage laid over the figure until `cover` of its plan area (measured
 // on a 2 cm raster) is hidden.
+// The plan raster of CoverParts: 2 cm cells over +-1.2 m around the victim.
+struct CoverRaster {
+  static constexpr double kRes = 0.02;  // m per raster cell
+  static constexpr int kHalf = 60;      // raster spans +-1.2 m around the victim
+  double x_m, y_m;                      // the victim
+
+  cv::Point Cell(const Vec3& p) const {
+    return cv::Point(static_cast<int>(std::lround((p.x - x_m) / kRes)) + kHalf, static_cast<int>(std::lround((p.y - y_m) / kRes)) + kHalf);
+  }
+  // The convex hull of pts, filled into mask.
+  void Fill(const std::vector<Vec3>& pts, cv::Mat& mask) const {
+    std::vector<cv::Point> poly, hull;
+    for (const Vec3& p : pts) poly.push_back(Cell(p));
+    cv::convexHull(poly, hull);
+    cv::fillConvexPoly(mask, hull, cv::Scalar(255));
+  }
+};
+
+// A blob of cover's colour: foliage, or concrete, brick, soil and wood.
+cv::Scalar CoverColour(bool vegetation, cv::RNG& rng) {
+  if (vegetation) return cv::Scalar(rng.uniform(25, 50), rng.uniform(75, 125), rng.uniform(35, 70));
+  const int kind = rng.uniform(0, 3);
+  return kind == 0 ? cv::Scalar(rng.uniform(120, 160), rng.uniform(125, 165), rng.uniform(130, 170))   // concrete
+         : kind == 1 ? cv::Scalar(rng.uniform(50, 75), rng.uniform(65, 95), rng.uniform(120, 160))   // brick
+                     : cv::Scalar(rng.uniform(45, 70), rng.uniform(70, 95), rng.uniform(90, 120));   // soil, wood
+}
+
+// Cover: blobs of debris or foliage laid over the figure until `cover` of its plan area (measured
+// on a 2 cm raster) is hidden.
 std::vector<Part> CoverParts(const Victim& v, const std::vector<Part>& figure, bool vegetation, std::uint64_t seed) {
   std::vector<Part> out;
   if (v.cover <= 0) return out;
-  constexpr double kRes = 0.02;  // m per raster cell
-  constexpr int kHalf = 60;      // raster spans +-1.2 m around the victim
+  const CoverRaster raster{v.x_m, v.y_m};
+  constexpr int kHalf = CoverRaster::kHalf;
   cv::Mat fig(2 * kHalf, 2 * kHalf, CV_8U, cv::Scalar(0)), hidden(fig.size(), CV_8U, cv::Scalar(0));
-  auto cell = [&](const Vec3& p) {
-    return cv::Point(static_cast<int>(std::lround((p.x - v.x_m) / kRes)) + kHalf, static_cast<int>(std::lround((p.y - v.y_m) / kRes)) + kHalf);
-  };
-  for (const Part& part : figure) {
-    std::vector<cv::Point> poly, hull;
-    for (const Vec3& p : part.pts) poly.push_back(cell(p));
-    cv::convexHull(poly, hull);
-    cv::fillConvexPoly(fig, hull, cv::Scalar(255));
-  }
+  for (const Part& part : figure) raster.Fill(part.pts, fig);
   std::vector<cv::Point> cells;
   cv::findNonZero(fig, cells);
   if (cells.empty()) return out;
@@ -188,22 +209,11 @@ std::vector<Part> CoverParts(const Victim& v, const std::vector<Part>& figure, b
     cv::bitwise_and(fig, hidden, both);
     if (cv::countNonZero(both) >= v.cover * total) break;
     const cv::Point c = cells[static_cast<std::size_t>(rng.uniform(0, static_cast<int>(cells.size())))];
-    const double x = (c.x - kHalf) * kRes + v.x_m, y = (c.y - kHalf) * kRes + v.y_m;
+    const double x = (c.x - kHalf) * CoverRaster::kRes + v.x_m, y = (c.y - kHalf) * CoverRaster::kRes + v.y_m;
     const double r = rng.uniform(0.15, 0.32);
-    cv::Scalar colour;
-    if (vegetation) {
-      colour = cv::Scalar(rng.uniform(25, 50), rng.uniform(75, 125), rng.uniform(35, 70));
-    } else {
-      const int kind = rng.uniform(0, 3);
-      colour = kind == 0 ? cv::Scalar(rng.uniform(120, 160), rng.uniform(125, 165), rng.uniform(130, 170))   // concrete
-               : kind == 1 ? cv::Scalar(rng.uniform(50, 75), rng.uniform(65, 95), rng.uniform(120, 160))   // brick
-                           : cv::Scalar(rng.uniform(45, 70), rng.uniform(70, 95), rng.uniform(90, 120));   // soil, wood
-    }
+    const cv::Scalar colour = CoverColour(vegetation, rng);
     std::vector<Vec3> pts = Blob(world, x, y, r, top_z, 0.45, rng);
-    std::vector<cv::Point> poly, hull;
-    for (const Vec3& p : pts) poly.push_back(cell(p));
-    cv::convexHull(poly, hull);
-    cv::fillConvexPoly(hidden, hull, cv::Scalar(255));
+    raster.Fill(pts, hidden);
     out.push_back({std::move(pts), colour});
   }
   return out;
@@ -211,62 +221,74 @@ std::vector<Part> CoverParts(const Victim& v, const std::vector<Part>& figure, b
 
 // ---- distractors, trees, boxes --------------------------------------------------------------
 
+// A flat quad (u0, v0)-(u1, v1) in the frame at height z.
+std::vector<Vec3> Quad(const Frame2& f, double u0, double v0, double u1, double v1, double z) {
+  return std::vector<Vec3>{f(u0, v0, z), f(u1, v0, z), f(u1, v1, z), f(u0, v1, z)};
+}
+
+// One distractor's parts and height: what DistractorDrawable draws of its kind (size s, colour c;
+// the random folds, planks and blobs from rng).
+struct DistractorShape {
+  const Frame2& f;
+  double s;
+  cv::Scalar c;
+  cv::RNG& rng;
+  Drawable* out;
+
+  void Tarp() const {
+    const double a = s / 2, b = 0.375 * s;
+    out->parts.push_back({Quad(f, -a, -b, a, b, 0.02), c});
+    const double fold = rng.uniform(-0.3, 0.3) * s;  // a fold: one side in its own shade
+    out->parts.push_back({{f(fold - 0.1 * s, -b, 0.03), f(a, -b, 0.03), f(a, b, 0.03), f(fold + 0.1 * s, b, 0.03)}, Scale(c, 0.8)});
+    out->top_m = 0.05;
+  }
+  void Cone() const {
+    const double r = s / 2, hgt = 1.4 * s;
+    out->parts.push_back({Concat(Ring(f, 0, 0, r, r, 0), {f(0, 0, hgt)}), c});
+    out->parts.push_back({Concat(Ring(f, 0, 0, 0.55 * r, 0.55 * r, 0.45 * hgt), Ring(f, 0, 0, 0.42 * r, 0.42 * r, 0.6 * hgt)),
+                          cv::Scalar(225, 230, 230)});
+    out->parts.push_back({Concat(Ring(f, 0, 0, 0.3 * r, 0.3 * r, 0.7 * hgt), {f(0, 0, hgt)}), c});
+    out->top_m = hgt;
+  }
+  void Backpack() const {
+    const double a = s / 2, b = 0.33 * s, hgt = 0.4 * s;
+    out->parts.push_back({Concat(Quad(f, -a, -b, a, b, 0), Quad(f, -a, -b, a, b, hgt)), Scale(c, 0.7)});
+    out->parts.push_back({Quad(f, -a * 0.95, -b * 0.95, a * 0.95, b * 0.95, hgt), c});
+    out->parts.push_back({Quad(f, a * 0.25, -b * 0.9, a * 0.95, b * 0.9, hgt + 0.01), Scale(c, 0.6)});  // the flap
+    out->top_m = hgt;
+  }
+  void Debris() const {
+    if (rng.uniform(0, 2) == 0) {  // a plank
+      const double a = s / 2, b = 0.12 * s;
+      out->parts.push_back({Quad(f, -a, -b, a, b, 0.05), c});
+      out->parts.push_back({Quad(f, -a, -b * 0.2, a, b * 0.2, 0.06), Scale(c, 0.75)});
+    } else {  // a broken sheet
+      out->parts.push_back({Blob(f, 0, 0, s / 2, 0.05, 0.5, rng, 7), c});
+    }
+    out->top_m = 0.06;
+  }
+  void Rock() const {
+    const double r = s / 2;
+    out->parts.push_back({Blob(f, 0, 0, r, 0, 0.3, rng, 9), Scale(c, 0.75)});
+    out->parts.push_back({Blob(f, -0.1 * r, 0.1 * r, 0.75 * r, 0.45 * r, 0.3, rng, 9), c});
+    out->top_m = 0.45 * r;
+  }
+};
+
 Drawable DistractorDrawable(const Distractor& d, std::uint64_t seed) {
   const Frame2 f{d.x_m, d.y_m, std::cos(d.heading_rad), std::sin(d.heading_rad)};
-  const double s = d.size_m;
-  const cv::Scalar c = S(d.colour_bgr);
   cv::RNG rng(seed);
   Drawable out;
   out.centre_m = {d.x_m, d.y_m, 0};
-  out.radius_m = s;
+  out.radius_m = d.size_m;
   out.hides_people = false;
-  auto quad = [&](double u0, double v0, double u1, double v1, double z) {
-    return std::vector<Vec3>{f(u0, v0, z), f(u1, v0, z), f(u1, v1, z), f(u0, v1, z)};
-  };
+  const DistractorShape shape{f, d.size_m, S(d.colour_bgr), rng, &out};
   switch (d.kind) {
-    case DistractorKind::kTarp: {
-      const double a = s / 2, b = 0.375 * s;
-      out.parts.push_back({quad(-a, -b, a, b, 0.02), c});
-      const double fold = rng.uniform(-0.3, 0.3) * s;  // a fold: one side in its own shade
-      out.parts.push_back({{f(fold - 0.1 * s, -b, 0.03), f(a, -b, 0.03), f(a, b, 0.03), f(fold + 0.1 * s, b, 0.03)}, Scale(c, 0.8)});
-      out.top_m = 0.05;
-      break;
-    }
-    case DistractorKind::kCone: {
-      const double r = s / 2, hgt = 1.4 * s;
-      out.parts.push_back({Concat(Ring(f, 0, 0, r, r, 0), {f(0, 0, hgt)}), c});
-      out.parts.push_back({Concat(Ring(f, 0, 0, 0.55 * r, 0.55 * r, 0.45 * hgt), Ring(f, 0, 0, 0.42 * r, 0.42 * r, 0.6 * hgt)),
-                           cv::Scalar(225, 230, 230)});
-      out.parts.push_back({Concat(Ring(f, 0, 0, 0.3 * r, 0.3 * r, 0.7 * hgt), {f(0, 0, hgt)}), c});
-      out.top_m = hgt;
-      break;
-    }
-    case DistractorKind::kBackpack: {
-      const double a = s / 2, b = 0.33 * s, hgt = 0.4 * s;
-      out.parts.push_back({Concat(quad(-a, -b, a, b, 0), quad(-a, -b, a, b, hgt)), Scale(c, 0.7)});
-      out.parts.push_back({quad(-a * 0.95, -b * 0.95, a * 0.95, b * 0.95, hgt), c});
-      out.parts.push_back({quad(a * 0.25, -b * 0.9, a * 0.95, b * 0.9, hgt + 0.01), Scale(c, 0.6)});  // the flap
-      out.top_m = hgt;
-      break;
-    }
-    case DistractorKind::kDebris: {
-      if (rng.uniform(0, 2) == 0) {  // a plank
-        const double a = s / 2, b = 0.12 * s;
-        out.parts.push_back({quad(-a, -b, a, b, 0.05), c});
-        out.parts.push_back({quad(-a, -b * 0.2, a, b * 0.2, 0.06), Scale(c, 0.75)});
-      } else {  // a broken sheet
-        out.parts.push_back({Blob(f, 0, 0, s / 2, 0.05, 0.5, rng, 7), c});
-      }
-      out.top_m = 0.06;
-      break;
-    }
-    case DistractorKind::kRock: {
-      const double r = s / 2;
-      out.parts.push_back({Blob(f, 0, 0, r, 0, 0.3, rng, 9), Scale(c, 0.75)});
-      out.parts.push_back({Blob(f, -0.1 * r, 0.1 * r, 0.75 * r, 0.45 * r, 0.3, rng, 9), c});
-      out.top_m = 0.45 * r;
-      break;
-    }
+    case DistractorKind::kTarp: shape.Tarp(); break;
+    case DistractorKind::kCone: shape.Cone(); break;
+    case DistractorKind::kBackpack: shape.Backpack(); break;
+    case DistractorKind::kDebris: shape.Debris(); break;
+    case DistractorKind::kRock: shape.Rock(); break;
   }
   return out;
 }
@@ -569,6 +591,52 @@ Light LightOf(const WorldConfig& config) {
   return l;
 }
 
+namespace {
+
+// The people, each with its cover (foliage on grass and mixed ground, else rubble).
+void AddFigures(const WorldConfig& config, RenderScene* s) {
+  const bool vegetation = !config.terrain || config.terrain->kind == TerrainKind::kGrass ||
+                          config.terrain->kind == TerrainKind::kMixed;
+  for (std::size_t i = 0; i < config.victims.size(); ++i) {
+    const Victim& v = config.victims[i];
+    Figure f;
+    f.victim = i;
+    f.parts = FigureParts(v);
+    f.cover = CoverParts(v, f.parts, vegetation, Mix(config.ground_texture_seed ^ HashOf(v.id)));
+    f.centre_m = {v.x_m, v.y_m, 0};
+    f.radius_m = 1.5 * v.height_m / 1.75 + 0.4;
+    s->figures.push_back(std::move(f));
+  }
+}
+
+// The distractors (flats), and the boxes and trees sorted by top height (painter's order).
+void AddFlatsAndObstacles(const WorldConfig& config, RenderScene* s) {
+  for (std::size_t i = 0; i < config.distractors.size(); ++i) {
+    s->flats.push_back(DistractorDrawable(config.distractors[i], Mix(config.ground_texture_seed * 31 + i)));
+  }
+  for (const ObstacleBox& b : config.obstacles) {
+    s->obstacles.push_back(b.kind == ObstacleKind::kTree ? TreeDrawable(b, Mix(config.ground_texture_seed ^ HashOf(b.id)), s->light)
+                                                         : BoxDrawable(b));
+  }
+  std::stable_sort(s->obstacles.begin(), s->obstacles.end(), [](const Drawable& l, const Drawable& r) { return l.top_m < r.top_m; });
+}
+
+// What throws a shadow: obstacles and trees, distractors taller than 0.1 m, people upright.
+std::vector<const std::vector<Part>*> ShadowCasters(const WorldConfig& config, const RenderScene& s) {
+  std::vector<const std::vector<Part>*> casters;
+  for (const Drawable& d : s.obstacles) casters.push_back(&d.parts);
+  for (const Drawable& d : s.flats) {
+    if (d.top_m > 0.1) casters.push_back(&d.parts);
+  }
+  for (const Figure& f : s.figures) {
+    const VictimPose pose = config.victims[f.victim].pose;
+    if (pose == VictimPose::kStanding || pose == VictimPose::kSitting) casters.push_back(&f.parts);
+  }
+  return casters;
+}
+
+}  // namespace
+
 RenderScene BuildScene(const WorldConfig& config) {
   RenderScene s;
   constexpr double kMarginM = 60;  // texture beyond the geofence (what a camera at the edge sees)
@@ -583,38 +651,9 @@ RenderScene BuildScene(const WorldConfig& config) {
     LegacyTexture(config, &s.texture);
   }
   s.light = LightOf(config);
-
-  const bool vegetation = !config.terrain || config.terrain->kind == TerrainKind::kGrass ||
-                          config.terrain->kind == TerrainKind::kMixed;
-  for (std::size_t i = 0; i < config.victims.size(); ++i) {
-    const Victim& v = config.victims[i];
-    Figure f;
-    f.victim = i;
-    f.parts = FigureParts(v);
-    f.cover = CoverParts(v, f.parts, vegetation, Mix(config.ground_texture_seed ^ HashOf(v.id)));
-    f.centre_m = {v.x_m, v.y_m, 0};
-    f.radius_m = 1.5 * v.height_m / 1.75 + 0.4;
-    s.figures.push_back(std::move(f));
-  }
-  for (std::size_t i = 0; i < config.distractors.size(); ++i) {
-    s.flats.push_back(DistractorDrawable(config.distractors[i], Mix(config.ground_texture_seed * 31 + i)));
-  }
-  for (const ObstacleBox& b : config.obstacles) {
-    s.obstacles.push_back(b.kind == ObstacleKind::kTree ? TreeDrawable(b, Mix(config.ground_texture_seed ^ HashOf(b.id)), s.light)
-                                                        : BoxDrawable(b));
-  }
-  std::stable_sort(s.obstacles.begin(), s.obstacles.end(), [](const Drawable& l, const Drawable& r) { return l.top_m < r.top_m; });
-
-  std::vector<const std::vector<Part>*> casters;
-  for (const Drawable& d : s.obstacles) casters.push_back(&d.parts);
-  for (const Drawable& d : s.flats) {
-    if (d.top_m > 0.1) casters.push_back(&d.parts);
-  }
-  for (const Figure& f : s.figures) {
-    const VictimPose pose = config.victims[f.victim].pose;
-    if (pose == VictimPose::kStanding || pose == VictimPose::kSitting) casters.push_back(&f.parts);
-  }
-  BakeShadows(casters, s.light, s.texel_m, s.origin_x_m, s.top_y_m, &s.texture);
+  AddFigures(config, &s);
+  AddFlatsAndObstacles(config, &s);
+  BakeShadows(ShadowCasters(config, s), s.light, s.texel_m, s.origin_x_m, s.top_y_m, &s.texture);
   return s;
 }
 

@@ -30,15 +30,8 @@ std::uint32_t Crc32(std::string_view bytes, std::uint32_t crc) {
 }
 
 std::string_view CompressionField(Compression c) {
-  switch (c) {
-    case Compression::kZstd:
-      return "zstd";
-    case Compression::kLz4:
-      return "lz4";
-    case Compression::kNone:
-      return "";
-  }
-  return "";
+  // MCAP's field is the name, except "" for none.
+  return c == Compression::kZstd || c == Compression::kLz4 ? CompressionName(c) : std::string_view();
 }
 
 Compressor::Compressor() = default;

@@ -69,6 +69,7 @@ struct Impairment {
   double loss = 0;                       // 0..1
   double rate_kbit = 0;                  // 0 = no rate limit
   double duplicate = 0;                  // 0..1
+  bool operator==(const Impairment&) const = default;
 };
 // Ok, or why the channel cannot carry the impairment out (an unsupported distribution names the
 // supported ones).
@@ -77,6 +78,9 @@ Status ValidateImpairment(const Impairment& impairment);
 // optional: the radio plan's `mesh` and `impairment` objects) and validates it. Errors carry
 // file:line:col of the offending key; unknown keys (reorder_gap, corrupt...) are errors.
 Result<Impairment> ParseImpairment(const yaml::Node& node);
+// The keys alone, unvalidated (`what` names the mapping in errors): ParseImpairment's reading, and
+// the radio plan's, which allows every netem distribution.
+Result<Impairment> ReadImpairmentKeys(const yaml::Node& node, const std::string& what);
 
 struct Packet {
   std::size_t from = 0;                  // drone index
@@ -171,6 +175,11 @@ class Channel {
   const Impairment* ImpairmentOf(std::size_t sender) const;
   void AdvanceMedium(std::int64_t until_ns);
   void Admit(const Egress& e);
+  // Send's steps: how many copies of `p` the sender's impairment lets out (0: lost; the rate
+  // limit's serialiser moves *base_ns), and when copy `copy` leaves (delay, jitter, access wait).
+  std::uint32_t ImpairedCopies(std::int64_t now_ns, const Packet& p, const Impairment& imp, SenderState& s,
+                               std::int64_t* base_ns);
+  std::int64_t EgressNs(std::int64_t base_ns, const Packet& p, const Impairment* imp, std::uint32_t copy) const;
   void Transmit(std::int64_t start_ns, const Egress& e);
   void Receive(std::int64_t end_ns, const Egress& e, std::size_t to);
   double ShadowingDb(std::size_t a, std::size_t b) const;
