@@ -11,9 +11,12 @@ namespace swarmbox::airframe {
 namespace {
 
 using detail::Checked;
+using detail::InvalidAt;
 using detail::Nested;
 using yaml::MapReader;
 using yaml::Node;
+
+constexpr double kRtkMaxBaselineKm = 100.0;  // RTK needs a base station within tens of km
 
 // ---- one reader per top-level section (kSections) ----------------------------------------------
 
@@ -76,18 +79,67 @@ void ReadRotors(MapReader& parent, Airframe* af) {
   }
 }
 
+void ReadImu(MapReader& s, const Node& m, ImuSpec* imu) {
+  Checked(s, m)
+      .Positive("rate_hz", &imu->rate_hz, false)
+      .NonNegative("accel_noise_std_m_s2", &imu->accel_noise_std_m_s2)
+      .NonNegative("accel_bias_std_m_s2", &imu->accel_bias_std_m_s2)
+      .NonNegative("accel_bias_walk_std_m_s2", &imu->accel_bias_walk_std_m_s2)
+      .NonNegative("gyro_noise_std_rad_s", &imu->gyro_noise_std_rad_s)
+      .NonNegative("gyro_bias_std_rad_s", &imu->gyro_bias_std_rad_s)
+      .NonNegative("gyro_bias_walk_std_rad_s", &imu->gyro_bias_walk_std_rad_s);
+}
+
+// fix: standalone: the accuracy figures are the file's; no RTK baseline.
+void ReadStandaloneGps(MapReader& s, const Node& m, GpsSpec* gps) {
+  Checked(s, m)
+      .NonNegative("horizontal_std_m", &gps->horizontal_std_m)
+      .NonNegative("vertical_std_m", &gps->vertical_std_m);
+  if (s.ok() && m.Find("rtk_baseline_km") != nullptr) {
+    s.Fail(InvalidAt(m, "rtk_baseline_km", "gps rtk_baseline_km needs fix: rtk"));
+  }
+}
+
+// fix: rtk: the accuracy is the receiver's datasheet figure for the baseline, not a free number.
+void ReadRtkGps(MapReader& s, const Node& m, GpsSpec* gps) {
+  for (const char* key : {"horizontal_std_m", "vertical_std_m"}) {
+    if (s.ok() && m.Find(key) != nullptr) {
+      s.Fail(InvalidAt(m, key,
+                       std::string("gps ") + key + " is set by the RTK receiver model with fix: rtk "
+                           "(0.01 m + 1 ppm of rtk_baseline_km); leave it out"));
+    }
+  }
+  double baseline_km = gps->rtk_baseline_km;
+  Checked(s, m).NonNegative("rtk_baseline_km", &baseline_km);
+  if (s.ok() && baseline_km > kRtkMaxBaselineKm) {
+    s.Fail(InvalidAt(m, "rtk_baseline_km",
+                     "gps rtk_baseline_km must be at most 100 (RTK needs a base within tens of km)"));
+  }
+  if (s.ok() && gps->rate_hz > kRtkMaxRateHz) {
+    s.Fail(InvalidAt(m, "rate_hz",
+                     "gps rate_hz must be at most 20 with fix: rtk (the ZED-F9P's RTK navigation rate)"));
+  }
+  SetRtkFix(gps, baseline_km);
+}
+
+void ReadGps(MapReader& s, const Node& m, GpsSpec* gps) {
+  std::string fix = "standalone";
+  s.Optional("fix", &fix);
+  if (s.ok() && fix != "standalone" && fix != "rtk") {
+    s.Fail(InvalidAt(m, "fix", "gps fix must be 'standalone' or 'rtk' (got '" + fix + "')"));
+    return;
+  }
+  Checked(s, m).Positive("rate_hz", &gps->rate_hz, false).NonNegative("velocity_std_m_s", &gps->velocity_std_m_s);
+  if (fix == "standalone") {
+    ReadStandaloneGps(s, m, gps);
+  } else {
+    ReadRtkGps(s, m, gps);
+  }
+}
+
 void ReadSensors(MapReader& parent, Airframe* af) {
-  Nested(parent, "sensors", "sensors", false, [af](MapReader& r, const Node& n) {
-    Nested(r, "imu", "imu", false, [af](MapReader& s, const Node& m) {
-      Checked(s, m)
-          .Positive("rate_hz", &af->imu.rate_hz, false)
-          .NonNegative("accel_noise_std_m_s2", &af->imu.accel_noise_std_m_s2)
-          .NonNegative("accel_bias_std_m_s2", &af->imu.accel_bias_std_m_s2)
-          .NonNegative("accel_bias_walk_std_m_s2", &af->imu.accel_bias_walk_std_m_s2)
-          .NonNegative("gyro_noise_std_rad_s", &af->imu.gyro_noise_std_rad_s)
-          .NonNegative("gyro_bias_std_rad_s", &af->imu.gyro_bias_std_rad_s)
-          .NonNegative("gyro_bias_walk_std_rad_s", &af->imu.gyro_bias_walk_std_rad_s);
-    });
+  Nested(parent, "sensors", "sensors", false, [af](MapReader& r, const Node&) {
+    Nested(r, "imu", "imu", false, [af](MapReader& s, const Node& m) { ReadImu(s, m, &af->imu); });
     Nested(r, "baro", "baro", false, [af](MapReader& s, const Node& m) {
       Checked(s, m).Positive("rate_hz", &af->baro.rate_hz, false).NonNegative("noise_std_pa", &af->baro.noise_std_pa);
     });
@@ -96,51 +148,7 @@ void ReadSensors(MapReader& parent, Airframe* af) {
           .Positive("rate_hz", &af->mag.rate_hz, false)
           .NonNegative("noise_std_gauss", &af->mag.noise_std_gauss);
     });
-    Nested(r, "gps", "gps", false, [af](MapReader& s, const Node& m) {
-      std::string fix = "standalone";
-      s.Optional("fix", &fix);
-      if (s.ok() && fix != "standalone" && fix != "rtk") {
-        s.Fail(Error(ErrorCode::kInvalidArgument,
-                     "gps fix must be 'standalone' or 'rtk' (got '" + fix + "')", m.Find("fix")->Where()));
-        return;
-      }
-      Checked(s, m)
-          .Positive("rate_hz", &af->gps.rate_hz, false)
-          .NonNegative("velocity_std_m_s", &af->gps.velocity_std_m_s);
-      if (fix == "standalone") {
-        Checked(s, m)
-            .NonNegative("horizontal_std_m", &af->gps.horizontal_std_m)
-            .NonNegative("vertical_std_m", &af->gps.vertical_std_m);
-        if (s.ok() && m.Find("rtk_baseline_km") != nullptr) {
-          s.Fail(Error(ErrorCode::kInvalidArgument, "gps rtk_baseline_km needs fix: rtk",
-                       m.Find("rtk_baseline_km")->Where()));
-        }
-        return;
-      }
-      // RTK: the accuracy is the receiver's datasheet figure for the baseline, not a free number.
-      for (const char* key : {"horizontal_std_m", "vertical_std_m"}) {
-        if (s.ok() && m.Find(key) != nullptr) {
-          s.Fail(Error(ErrorCode::kInvalidArgument,
-                       std::string("gps ") + key + " is set by the RTK receiver model with fix: rtk "
-                           "(0.01 m + 1 ppm of rtk_baseline_km); leave it out",
-                       m.Find(key)->Where()));
-        }
-      }
-      double baseline_km = af->gps.rtk_baseline_km;
-      Checked(s, m).NonNegative("rtk_baseline_km", &baseline_km);
-      if (s.ok() && baseline_km > 100.0) {
-        s.Fail(Error(ErrorCode::kInvalidArgument,
-                     "gps rtk_baseline_km must be at most 100 (RTK needs a base within tens of km)",
-                     m.Find("rtk_baseline_km")->Where()));
-      }
-      if (s.ok() && af->gps.rate_hz > kRtkMaxRateHz) {
-        s.Fail(Error(ErrorCode::kInvalidArgument,
-                     "gps rate_hz must be at most 20 with fix: rtk (the ZED-F9P's RTK navigation rate)",
-                     m.Find("rate_hz")->Where()));
-      }
-      SetRtkFix(&af->gps, baseline_km);
-    });
-    (void)n;
+    Nested(r, "gps", "gps", false, [af](MapReader& s, const Node& m) { ReadGps(s, m, &af->gps); });
   });
 }
 
@@ -220,10 +228,7 @@ constexpr SectionReader kSections[] = {
 
 // Checks across keys, once every section is read.
 Status CheckConsistency(const Node& root, const Airframe& af) {
-  auto fail = [&](const char* key, const std::string& msg) -> Error {
-    const Node* n = root.Find(key);
-    return Error(ErrorCode::kInvalidArgument, "airframe: " + msg, (n ? *n : root).Where());
-  };
+  auto fail = [&](const char* key, const std::string& msg) { return InvalidAt(root, key, "airframe: " + msg); };
   const Vec3& I = af.inertia_kg_m2;
   if (I.x <= 0 || I.y <= 0 || I.z <= 0) return fail("inertia_kg_m2", "inertia must be positive");
   if (I.x + I.y < I.z || I.y + I.z < I.x || I.x + I.z < I.y) {

@@ -14,8 +14,7 @@ using yaml::MapReader;
 using yaml::Node;
 
 Error Bad(const Node& map, const char* key, const std::string& msg) {
-  const Node* n = map.Find(key);
-  return Error(ErrorCode::kInvalidArgument, "stereo: " + msg, (n != nullptr ? *n : map).Where());
+  return detail::InvalidAt(map, key, "stereo: " + msg);
 }
 
 void ReadProjector(MapReader& parent, ProjectorSpec* p) {

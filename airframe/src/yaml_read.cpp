@@ -2,6 +2,7 @@
 
 #include <array>
 #include <cmath>
+#include <utility>
 
 namespace swarmbox::airframe {
 
@@ -16,6 +17,11 @@ Status Decode(const yaml::Node& node, Vec3* out) {
 }
 
 namespace detail {
+
+Error InvalidAt(const yaml::Node& map, std::string_view key, std::string msg) {
+  const yaml::Node* n = map.Find(key);
+  return Error(ErrorCode::kInvalidArgument, std::move(msg), (n != nullptr ? *n : map).Where());
+}
 
 Checked& Checked::Positive(std::string_view key, double* out, bool required) {
   return Range(key, out, required, /*strict=*/true);

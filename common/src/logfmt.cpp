@@ -75,17 +75,44 @@ LogEvent& LogEvent::Add(std::string_view key, bool value) {
   return Add(key, std::string_view(value ? "true" : "false"));
 }
 
+namespace {
+
+bool IsKeyChar(char c) { return c != ' ' && c != '=' && c != '"' && c != '\t' && c != '\r' && c != '\n'; }
+bool IsValueEnd(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
+
+// The value that starts at line[*i] (after the '='), quoted or bare; *i moves past it.
+std::string ReadValue(std::string_view line, std::size_t* i) {
+  const std::size_t n = line.size();
+  std::string value;
+  if (*i >= n || line[*i] != '"') {
+    const std::size_t v_start = *i;
+    while (*i < n && !IsValueEnd(line[*i])) ++*i;
+    return std::string(line.substr(v_start, *i - v_start));
+  }
+  ++*i;  // opening quote
+  while (*i < n && line[*i] != '"') {
+    if (line[*i] == '\\' && *i + 1 < n) {
+      ++*i;
+      value.push_back(detail::BackslashUnescape(line[*i]));
+    } else {
+      value.push_back(line[*i]);
+    }
+    ++*i;
+  }
+  if (*i < n) ++*i;  // closing quote
+  return value;
+}
+
+}  // namespace
+
 LogfmtFields ParseLogfmt(std::string_view line) {
   LogfmtFields out;
   std::size_t i = 0;
   const std::size_t n = line.size();
-  auto is_key_char = [](char c) {
-    return c != ' ' && c != '=' && c != '"' && c != '\t' && c != '\r' && c != '\n';
-  };
   while (i < n) {
-    while (i < n && !is_key_char(line[i])) ++i;
+    while (i < n && !IsKeyChar(line[i])) ++i;
     std::size_t key_start = i;
-    while (i < n && is_key_char(line[i])) ++i;
+    while (i < n && IsKeyChar(line[i])) ++i;
     if (i == key_start) break;
     std::string key(line.substr(key_start, i - key_start));
     if (i >= n || line[i] != '=') {
@@ -94,37 +121,7 @@ LogfmtFields ParseLogfmt(std::string_view line) {
       continue;
     }
     ++i;  // '='
-    std::string value;
-    if (i < n && line[i] == '"') {
-      ++i;
-      while (i < n && line[i] != '"') {
-        if (line[i] == '\\' && i + 1 < n) {
-          ++i;
-          switch (line[i]) {
-            case 'n':
-              value.push_back('\n');
-              break;
-            case 'r':
-              value.push_back('\r');
-              break;
-            case 't':
-              value.push_back('\t');
-              break;
-            default:
-              value.push_back(line[i]);
-          }
-        } else {
-          value.push_back(line[i]);
-        }
-        ++i;
-      }
-      if (i < n) ++i;  // closing quote
-    } else {
-      std::size_t v_start = i;
-      while (i < n && line[i] != ' ' && line[i] != '\t' && line[i] != '\r' && line[i] != '\n') ++i;
-      value = std::string(line.substr(v_start, i - v_start));
-    }
-    out.emplace_back(std::move(key), std::move(value));
+    out.emplace_back(std::move(key), ReadValue(line, &i));
   }
   // A line without a single k=v pair is not logfmt (bare words alone are prose).
   if (line.find('=') == std::string_view::npos) out.clear();

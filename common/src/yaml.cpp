@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "detail/backslash_escape.hpp"
@@ -270,62 +271,70 @@ class Builder {
   }
 
   Result<Node> FromEvent(yaml_event_t& event) {
-    Mark mark = MarkOf(event.start_mark);
+    const Mark mark = MarkOf(event.start_mark);
     switch (event.type) {
-      case YAML_SCALAR_EVENT: {
-        std::string value(reinterpret_cast<const char*>(event.data.scalar.value), event.data.scalar.length);
-        const bool quoted = event.data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
-                            event.data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE ||
-                            event.data.scalar.style == YAML_LITERAL_SCALAR_STYLE ||
-                            event.data.scalar.style == YAML_FOLDED_SCALAR_STYLE;
-        Node n = Node::Scalar(std::move(value), mark, quoted);
-        if (!quoted && IsNullScalar(n)) return Node::Null(mark);
-        return n;
-      }
-      case YAML_SEQUENCE_START_EVENT: {
-        Node seq = Node::Sequence(mark);
-        while (true) {
-          yaml_event_t child;
-          if (!yaml_parser_parse(&parser_, &child)) return ParserError();
-          if (child.type == YAML_SEQUENCE_END_EVENT) {
-            yaml_event_delete(&child);
-            break;
-          }
-          Result<Node> item = FromEvent(child);
-          yaml_event_delete(&child);
-          if (!item) return item.error();
-          seq.Append(std::move(*item));
-        }
-        return seq;
-      }
-      case YAML_MAPPING_START_EVENT: {
-        Node map = Node::Mapping(mark);
-        while (true) {
-          yaml_event_t key_event;
-          if (!yaml_parser_parse(&parser_, &key_event)) return ParserError();
-          if (key_event.type == YAML_MAPPING_END_EVENT) {
-            yaml_event_delete(&key_event);
-            break;
-          }
-          Result<Node> key = FromEvent(key_event);
-          yaml_event_delete(&key_event);
-          if (!key) return key.error();
-          if (!key->is_scalar()) {
-            return Error(ErrorCode::kInvalidArgument, "mapping keys must be plain strings", key->Where());
-          }
-          if (map.Find(key->scalar()) != nullptr) {
-            return Error(ErrorCode::kInvalidArgument, "duplicate key '" + key->scalar() + "'", key->Where());
-          }
-          Result<Node> value = ParseNode();
-          if (!value) return value.error();
-          map.entries().emplace_back(std::move(*key), std::move(*value));
-        }
-        return map;
-      }
+      case YAML_SCALAR_EVENT: return FromScalar(event, mark);
+      case YAML_SEQUENCE_START_EVENT: return ParseSequence(mark);
+      case YAML_MAPPING_START_EVENT: return ParseMapping(mark);
       case YAML_ALIAS_EVENT:
         return Error(ErrorCode::kInvalidArgument, "YAML aliases (*name) are not supported", mark.ToString());
       default:
         return Error(ErrorCode::kInvalidArgument, "unexpected YAML structure", mark.ToString());
+    }
+  }
+
+  static Node FromScalar(const yaml_event_t& event, const Mark& mark) {
+    const auto& scalar = event.data.scalar;
+    std::string value(reinterpret_cast<const char*>(scalar.value), scalar.length);
+    const bool quoted = scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
+                        scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE ||
+                        scalar.style == YAML_LITERAL_SCALAR_STYLE || scalar.style == YAML_FOLDED_SCALAR_STYLE;
+    Node n = Node::Scalar(std::move(value), mark, quoted);
+    if (!quoted && IsNullScalar(n)) return Node::Null(mark);
+    return n;
+  }
+
+  // The next item of the sequence or mapping being read (a mapping's key), or nullopt at its
+  // `end` event.
+  Result<std::optional<Node>> ParseItem(yaml_event_type_t end) {
+    yaml_event_t event;
+    if (!yaml_parser_parse(&parser_, &event)) return ParserError();
+    if (event.type == end) {
+      yaml_event_delete(&event);
+      return std::optional<Node>();
+    }
+    Result<Node> item = FromEvent(event);
+    yaml_event_delete(&event);
+    if (!item) return item.error();
+    return std::optional<Node>(std::move(*item));
+  }
+
+  Result<Node> ParseSequence(const Mark& mark) {
+    Node seq = Node::Sequence(mark);
+    while (true) {
+      Result<std::optional<Node>> item = ParseItem(YAML_SEQUENCE_END_EVENT);
+      if (!item) return item.error();
+      if (!*item) return seq;
+      seq.Append(std::move(**item));
+    }
+  }
+
+  Result<Node> ParseMapping(const Mark& mark) {
+    Node map = Node::Mapping(mark);
+    while (true) {
+      Result<std::optional<Node>> key = ParseItem(YAML_MAPPING_END_EVENT);
+      if (!key) return key.error();
+      if (!*key) return map;
+      const Node& k = **key;
+      if (!k.is_scalar()) {
+        return Error(ErrorCode::kInvalidArgument, "mapping keys must be plain strings", k.Where());
+      }
+      if (map.Find(k.scalar()) != nullptr) {
+        return Error(ErrorCode::kInvalidArgument, "duplicate key '" + k.scalar() + "'", k.Where());
+      }
+      Result<Node> value = ParseNode();
+      if (!value) return value.error();
+      map.entries().emplace_back(std::move(**key), std::move(*value));
     }
   }
 

@@ -40,6 +40,28 @@ constexpr double kPatternTanPerPx = 0.001;  // pattern sampling: ~5 samples acro
 constexpr double kMaxGain = 400.0;          // auto-exposure limit [levels per W/m^2]
 constexpr double kTargetLevel = 100.0;      // auto-exposure target (mean level of the left view)
 constexpr float kSkyRadiance = 0.0f;        // rays that miss the ground (never, looking down)
+constexpr double kMinDownward = 1e-6;       // a ray's world z below -this meets the ground
+constexpr double kNearClip_m = 0.05;        // the march starts no nearer than this
+constexpr double kEndMargin_m = 1e-3;       // the march ends this far below the lowest cell
+constexpr double kProjectorNear_m = 0.05;   // no dots nearer the projector than this (optical z)
+
+// Depth t (along the optical axis) where the ray centre + t * d (d.z < 0) first meets the height
+// field: marched in steps of about one cell from the highest cell's level down to the lowest's,
+// then a secant between the last point above and the first below the surface. A ray that never
+// dips below it ends at the lowest level.
+double MarchToSurface(const StereoScene& s, const Vec3& centre, const Vec3& d) {
+  const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
+  const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
+  double prev_t = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z), prev_f = 1.0;
+  for (double t = prev_t; t <= t_end + dt; t += dt) {
+    const double tt = std::min(t, t_end);
+    const double fz = centre.z + tt * d.z - s.HeightAt(centre.x + tt * d.x, centre.y + tt * d.y);
+    if (fz <= 0) return fz == prev_f ? tt : prev_t + (tt - prev_t) * prev_f / (prev_f - fz);
+    prev_t = tt;
+    prev_f = fz;
+  }
+  return t_end;
+}
 
 }  // namespace
 
@@ -79,14 +101,7 @@ void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoS
   const double f = spec.FocalPx(), cx = w / 2.0, cy = h / 2.0;
   radiance->create(h, w, CV_32F);
   if (depth != nullptr) depth->create(h, w, CV_32F);
-  const ProjectorSpec& p = spec.projector;
-  const bool dots = p.enabled && p.optical_power_w > 0;
-  // Irradiance of the pattern's mean at 1 m: power over the field's solid angle (a rectangle of
-  // tan half-widths a, b spans 4 asin(a b / sqrt((1 + a^2)(1 + b^2))) sr).
-  const double a = pattern_tan_h_, b = pattern_tan_v_;
-  const double solid_angle = 4 * std::asin(a * b / std::sqrt((1 + a * a) * (1 + b * b)));
-  const double e1 = dots ? p.optical_power_w / solid_angle : 0.0;
-  const double step_m = s.cell_m;
+  const double e1 = PatternIrradianceAt1m(spec.projector);
   for (int v = 0; v < h; ++v) {
     auto* rad = radiance->ptr<float>(v);
     float* dep = depth != nullptr ? depth->ptr<float>(v) : nullptr;
@@ -94,55 +109,50 @@ void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoS
       // Ray: centre + t * d, with t the depth along the optical axis (d's optical z is 1).
       const double xn = (u + 0.5 - cx) / f, yn = (v + 0.5 - cy) / f;
       const Vec3 d{r[0] * xn + r[1] * yn + r[2], r[3] * xn + r[4] * yn + r[5], r[6] * xn + r[7] * yn + r[8]};
-      if (d.z > -1e-6) {
+      if (d.z > -kMinDownward) {
         rad[u] = kSkyRadiance;
         if (dep != nullptr) dep[u] = 0;
         continue;
       }
-      double t = std::max(0.05, (centre.z - s.max_height_m) / -d.z);
-      const double t_end = (centre.z - s.min_height_m) / -d.z + 1e-3;
-      const double dt = step_m / std::max(std::hypot(d.x, d.y), -d.z);
-      double prev_t = t, prev_f = 1.0;
-      bool hit = false;
-      for (; t <= t_end + dt; t += dt) {
-        const double tt = std::min(t, t_end);
-        const double fz = centre.z + tt * d.z - s.HeightAt(centre.x + tt * d.x, centre.y + tt * d.y);
-        if (fz <= 0) {
-          // Secant between the last point above and this one below the surface.
-          t = fz == prev_f ? tt : prev_t + (tt - prev_t) * prev_f / (prev_f - fz);
-          hit = true;
-          break;
-        }
-        prev_t = tt;
-        prev_f = fz;
-      }
-      if (!hit) t = t_end;
+      const double t = MarchToSurface(s, centre, d);
       const Vec3 hp = centre + d * t;
       const int col = std::clamp(static_cast<int>(std::lround((hp.x - s.origin_x_m) / s.cell_m)), 0, s.albedo.cols - 1);
       const int row = std::clamp(static_cast<int>(std::lround((hp.y - s.origin_y_m) / s.cell_m)), 0, s.albedo.rows - 1);
       double irr = s.ambient_w_m2.at<float>(row, col);
-      if (e1 > 0) {
-        const Vec3 q = hp - projector;
-        const double qx = r[0] * q.x + r[3] * q.y + r[6] * q.z;  // into the optical frame
-        const double qy = r[1] * q.x + r[4] * q.y + r[7] * q.z;
-        const double qz = r[2] * q.x + r[5] * q.y + r[8] * q.z;
-        const double dist2 = Dot(q, q);
-        if (qz > 0.05 && dist2 < p.range_m * p.range_m) {
-          const double px = (qx / qz + a) / pattern_res_ - 0.5, py = (qy / qz + b) / pattern_res_ - 0.5;
-          if (px >= 0 && py >= 0 && px < pattern_.cols - 1 && py < pattern_.rows - 1) {
-            const int ix = static_cast<int>(px), iy = static_cast<int>(py);
-            const float ax = static_cast<float>(px - ix), ay = static_cast<float>(py - iy);
-            const float* p0 = pattern_.ptr<float>(iy);
-            const float* p1 = pattern_.ptr<float>(iy + 1);
-            const double pat = (p0[ix] * (1 - ax) + p0[ix + 1] * ax) * (1 - ay) + (p1[ix] * (1 - ax) + p1[ix + 1] * ax) * ay;
-            irr += e1 * pat / dist2;
-          }
-        }
-      }
+      if (e1 > 0) irr += PatternIrradiance(hp, projector, r, e1, spec.projector.range_m);
       rad[u] = static_cast<float>(s.albedo.at<float>(row, col) * irr);
       if (dep != nullptr) dep[u] = static_cast<float>(t);
     }
   }
+}
+
+double StereoRenderer::PatternIrradianceAt1m(const ProjectorSpec& p) const {
+  if (!p.enabled || !(p.optical_power_w > 0)) return 0.0;
+  // Power over the field's solid angle (a rectangle of tan half-widths a, b spans
+  // 4 asin(a b / sqrt((1 + a^2)(1 + b^2))) sr).
+  const double a = pattern_tan_h_, b = pattern_tan_v_;
+  const double solid_angle = 4 * std::asin(a * b / std::sqrt((1 + a * a) * (1 + b * b)));
+  return p.optical_power_w / solid_angle;
+}
+
+double StereoRenderer::PatternIrradiance(const Vec3& hit, const Vec3& projector, const double* r, double e1,
+                                         double range_m) const {
+  const Vec3 q = hit - projector;
+  const double qx = r[0] * q.x + r[3] * q.y + r[6] * q.z;  // into the optical frame
+  const double qy = r[1] * q.x + r[4] * q.y + r[7] * q.z;
+  const double qz = r[2] * q.x + r[5] * q.y + r[8] * q.z;
+  const double dist2 = Dot(q, q);
+  if (!(qz > kProjectorNear_m && dist2 < range_m * range_m)) return 0.0;
+  const double px = (qx / qz + pattern_tan_h_) / pattern_res_ - 0.5;
+  const double py = (qy / qz + pattern_tan_v_) / pattern_res_ - 0.5;
+  if (!(px >= 0 && py >= 0 && px < pattern_.cols - 1 && py < pattern_.rows - 1)) return 0.0;
+  // Bilinear in the pattern.
+  const int ix = static_cast<int>(px), iy = static_cast<int>(py);
+  const float ax = static_cast<float>(px - ix), ay = static_cast<float>(py - iy);
+  const float* p0 = pattern_.ptr<float>(iy);
+  const float* p1 = pattern_.ptr<float>(iy + 1);
+  const double pat = (p0[ix] * (1 - ax) + p0[ix + 1] * ax) * (1 - ay) + (p1[ix] * (1 - ax) + p1[ix + 1] * ax) * ay;
+  return e1 * pat / dist2;
 }
 
 void StereoRenderer::Render(const Pose& body_pose, const StereoSpec& spec, std::uint64_t noise_seed,

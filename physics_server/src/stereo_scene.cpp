@@ -41,6 +41,80 @@ void Ripple(StereoScene* s, double ripple, cv::RNG& rng) {
   cv::multiply(s->albedo, factor, s->albedo);
 }
 
+constexpr double kCell_m = 0.05;  // the benchmark surfaces' grid
+constexpr auto kSun_w_m2 = static_cast<float>(kSunInBandWm2);
+
+// Rubble's texture: broken concrete, brick and dust, strong contrast over several scales.
+void AddRubbleTexture(StereoScene* s, cv::RNG& rng) {
+  cv::Mat tex = SmoothNoise(s->albedo.rows, s->albedo.cols, kCell_m, kCell_m, rng) * 0.08 +
+                SmoothNoise(s->albedo.rows, s->albedo.cols, kCell_m, 0.3, rng) * 0.10 +
+                SmoothNoise(s->albedo.rows, s->albedo.cols, kCell_m, 1.5, rng) * 0.05;
+  s->albedo += tex;
+}
+
+// Raises the cells around (cx, cy) to a Gaussian mound of height `h` (keeping higher cells),
+// cut off at 3 sigma.
+void RaiseMound(StereoScene* s, double cx, double cy, double h, double sigma) {
+  const int r = static_cast<int>(3 * sigma / kCell_m);
+  const int col = static_cast<int>((cx - s->origin_x_m) / kCell_m), row = static_cast<int>((cy - s->origin_y_m) / kCell_m);
+  for (int y = std::max(0, row - r); y < std::min(s->height_m.rows, row + r); ++y) {
+    auto* hp = s->height_m.ptr<float>(y);
+    for (int x = std::max(0, col - r); x < std::min(s->height_m.cols, col + r); ++x) {
+      const double dx = (x - col) * kCell_m, dy = (y - row) * kCell_m;
+      hp[x] = std::max(hp[x], static_cast<float>(h * std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma))));
+    }
+  }
+}
+
+// Heaps: smooth mounds up to ~1.2 m, one per 40 m^2.
+void AddHeaps(StereoScene* s, double size_m, cv::RNG& rng) {
+  const int heaps = static_cast<int>(size_m * size_m / 40.0);
+  for (int i = 0; i < heaps; ++i) {
+    const double cx = rng.uniform(-size_m / 2, size_m / 2), cy = rng.uniform(-size_m / 2, size_m / 2);
+    const double h = rng.uniform(0.3, 1.2), sigma = rng.uniform(0.8, 2.5);
+    RaiseMound(s, cx, cy, h, sigma);
+  }
+}
+
+// Chunks: slabs and bricks lying on the heaps, one per 4 m^2.
+void AddChunks(StereoScene* s, double size_m, cv::RNG& rng) {
+  const int chunks = static_cast<int>(size_m * size_m / 4.0);
+  for (int i = 0; i < chunks; ++i) {
+    const Vec3 c{rng.uniform(-size_m / 2, size_m / 2), rng.uniform(-size_m / 2, size_m / 2), 0};
+    const Vec3 sz{rng.uniform(0.15, 0.7), rng.uniform(0.15, 0.7), 0};
+    const double top = s->HeightAt(c.x, c.y) + rng.uniform(0.05, 0.3);
+    AddBox(s, c, sz, top, rng.uniform(0.15, 0.65));
+  }
+}
+
+StereoScene MakeRubble(double size_m, cv::RNG& rng) {
+  StereoScene s = Blank(size_m, kCell_m, 0.35f, kSun_w_m2);
+  AddRubbleTexture(&s, rng);
+  AddHeaps(&s, size_m, rng);
+  s.height_m += SmoothNoise(s.height_m.rows, s.height_m.cols, kCell_m, 0.25, rng) * 0.03;
+  AddChunks(&s, size_m, rng);
+  cv::max(s.albedo, 0.02, s.albedo);
+  cv::min(s.albedo, 0.95, s.albedo);
+  s.UpdateHeightRange();
+  return s;
+}
+
+StereoScene MakeConcreteShade(double size_m, cv::RNG& rng) {
+  StereoScene s = Blank(size_m, kCell_m, 0.45f, kSun_w_m2 * static_cast<float>(kShadeFraction));
+  Ripple(&s, 0.01, rng);
+  s.UpdateHeightRange();
+  return s;
+}
+
+StereoScene MakeSandSun(double size_m, cv::RNG& rng) {
+  StereoScene s = Blank(size_m, kCell_m, 0.55f, kSun_w_m2);
+  Ripple(&s, 0.01, rng);
+  cv::Mat dunes = SmoothNoise(s.height_m.rows, s.height_m.cols, kCell_m, 6.0, rng) * 0.1 + 0.15;
+  cv::max(dunes, 0.0, s.height_m);
+  s.UpdateHeightRange();
+  return s;
+}
+
 }  // namespace
 
 float StereoScene::HeightAt(double x_m, double y_m) const {
@@ -70,60 +144,11 @@ const char* StereoSurfaceName(StereoSurface surface) {
 }
 
 StereoScene MakeSurfaceScene(StereoSurface surface, double size_m, std::uint64_t seed) {
-  constexpr double kCell = 0.05;
   cv::RNG rng(seed);
-  const auto sun = static_cast<float>(kSunInBandWm2);
   switch (surface) {
-    case StereoSurface::kRubble: {
-      StereoScene s = Blank(size_m, kCell, 0.35f, sun);
-      // Texture: broken concrete, brick and dust, strong contrast over several scales.
-      cv::Mat tex = SmoothNoise(s.albedo.rows, s.albedo.cols, kCell, kCell, rng) * 0.08 +
-                    SmoothNoise(s.albedo.rows, s.albedo.cols, kCell, 0.3, rng) * 0.10 +
-                    SmoothNoise(s.albedo.rows, s.albedo.cols, kCell, 1.5, rng) * 0.05;
-      s.albedo += tex;
-      // Heaps: smooth mounds up to ~1.2 m.
-      const int heaps = static_cast<int>(size_m * size_m / 40.0);
-      for (int i = 0; i < heaps; ++i) {
-        const double cx = rng.uniform(-size_m / 2, size_m / 2), cy = rng.uniform(-size_m / 2, size_m / 2);
-        const double h = rng.uniform(0.3, 1.2), sigma = rng.uniform(0.8, 2.5);
-        const int r = static_cast<int>(3 * sigma / kCell);
-        const int col = static_cast<int>((cx - s.origin_x_m) / kCell), row = static_cast<int>((cy - s.origin_y_m) / kCell);
-        for (int y = std::max(0, row - r); y < std::min(s.height_m.rows, row + r); ++y) {
-          auto* hp = s.height_m.ptr<float>(y);
-          for (int x = std::max(0, col - r); x < std::min(s.height_m.cols, col + r); ++x) {
-            const double dx = (x - col) * kCell, dy = (y - row) * kCell;
-            hp[x] = std::max(hp[x], static_cast<float>(h * std::exp(-(dx * dx + dy * dy) / (2 * sigma * sigma))));
-          }
-        }
-      }
-      s.height_m += SmoothNoise(s.height_m.rows, s.height_m.cols, kCell, 0.25, rng) * 0.03;
-      // Chunks: slabs and bricks lying on the heaps.
-      const int chunks = static_cast<int>(size_m * size_m / 4.0);
-      for (int i = 0; i < chunks; ++i) {
-        const Vec3 c{rng.uniform(-size_m / 2, size_m / 2), rng.uniform(-size_m / 2, size_m / 2), 0};
-        const Vec3 sz{rng.uniform(0.15, 0.7), rng.uniform(0.15, 0.7), 0};
-        const double top = s.HeightAt(c.x, c.y) + rng.uniform(0.05, 0.3);
-        AddBox(&s, c, sz, top, rng.uniform(0.15, 0.65));
-      }
-      cv::max(s.albedo, 0.02, s.albedo);
-      cv::min(s.albedo, 0.95, s.albedo);
-      s.UpdateHeightRange();
-      return s;
-    }
-    case StereoSurface::kConcreteShade: {
-      StereoScene s = Blank(size_m, kCell, 0.45f, sun * static_cast<float>(kShadeFraction));
-      Ripple(&s, 0.01, rng);
-      s.UpdateHeightRange();
-      return s;
-    }
-    case StereoSurface::kSandSun: {
-      StereoScene s = Blank(size_m, kCell, 0.55f, sun);
-      Ripple(&s, 0.01, rng);
-      cv::Mat dunes = SmoothNoise(s.height_m.rows, s.height_m.cols, kCell, 6.0, rng) * 0.1 + 0.15;
-      cv::max(dunes, 0.0, s.height_m);
-      s.UpdateHeightRange();
-      return s;
-    }
+    case StereoSurface::kRubble: return MakeRubble(size_m, rng);
+    case StereoSurface::kConcreteShade: return MakeConcreteShade(size_m, rng);
+    case StereoSurface::kSandSun: return MakeSandSun(size_m, rng);
   }
   return {};
 }

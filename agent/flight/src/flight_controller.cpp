@@ -112,7 +112,13 @@ FlightController::FlightController(const FlightConfig& config, const ControllerO
   attitude_.SetGains(config_.attitude);
   rate_.SetGains(config_.rate);
   trajectory_.SetLimits(config_.limits);
-  // Hover thrust estimate: between half the empty vehicle and the most the position loop may ask.
+  ConfigureHoverThrust();
+  output_.count = mixer_.rotor_count();
+  ConfigureSwingDamping();
+}
+
+// Hover thrust estimate: between half the empty vehicle and the most the position loop may ask.
+void FlightController::ConfigureHoverThrust() {
   HoverThrustParams hp = config_.hover_thrust;
   hp.min_hover = kMinHoverMassFraction * config_.mass_kg * kGravity_m_s2 / mixer_.max_thrust_n();
   hp.max_hover = config_.thrust_max_frac;
@@ -121,9 +127,10 @@ FlightController::FlightController(const FlightConfig& config, const ControllerO
   hover_.Configure(hm, hp, mixer_.max_thrust_n());
   hover_.Reset(HoverThrustFor(config_.mass_kg + options_.payload_mass_kg));
   mass_kg_ = MassFor(hover_.hover_thrust());
-  output_.count = mixer_.rotor_count();
+}
 
-  // Swing damping: needs a slung payload in the airframe and both switches on.
+// Swing damping: needs a slung payload in the airframe and both switches on.
+void FlightController::ConfigureSwingDamping() {
   const airframe::PayloadSpec* payload = nullptr;
   for (const airframe::PayloadSpec& p : config_.payloads) {
     if (options_.payload_name[0] == '\0' || p.name == options_.payload_name) {
@@ -166,20 +173,11 @@ void FlightController::Emit(FlightEventKind kind, double t_s) {
   e.t_s = t_s;
   e.mode = mode_;
   e.pos_m = estimator_.state().pos_m;
-  if (ev_count_ == kEventCapacity) {  // full: drop the oldest
-    ev_head_ = (ev_head_ + 1) % kEventCapacity;
-    --ev_count_;
-  }
-  events_[(ev_head_ + ev_count_) % kEventCapacity] = e;
-  ++ev_count_;
+  events_.Push(e);  // full (nobody pops): the oldest is dropped
 }
 
 bool FlightController::PopEvent(FlightEvent* out) {
-  if (ev_count_ == 0) return false;
-  *out = events_[ev_head_];
-  ev_head_ = (ev_head_ + 1) % kEventCapacity;
-  --ev_count_;
-  return true;
+  return events_.Pop(out);
 }
 
 void FlightController::SetMode(FlightMode mode, double t_s) {
@@ -340,16 +338,19 @@ PositionSetpoint FlightController::TrajectoryStep(const StateEstimate& s, double
   psp.vel_cap_xy_m_s = lim.vel_max_xy_m_s;
   psp.vel_cap_up_m_s = lim.vel_max_up_m_s;
   psp.vel_cap_down_m_s = lim.vel_max_down_m_s;
-  // Heading: yaw (set at the command), else turn at yawspeed, else keep.
-  *yawspeed_ff_rad_s = 0.0;
-  if (std::isnan(traj_.yaw_rad) && !std::isnan(traj_.yawspeed_rad_s)) {
-    const double rate = std::clamp(traj_.yawspeed_rad_s, -kYawRateLimit_rad_s, kYawRateLimit_rad_s);
-    yaw_sp_rad_ = WrapPi(yaw_sp_rad_ + rate * dt_s);
-    *yawspeed_ff_rad_s = rate;
-  }
+  *yawspeed_ff_rad_s = TrajectoryHeading(dt_s);
   psp.yaw_rad = yaw_sp_rad_;
   psp.yawspeed_rad_s = *yawspeed_ff_rad_s;
   return psp;
+}
+
+// Heading: yaw (set at the command), else turn at yawspeed, else keep. Returns the yawspeed
+// feed-forward [rad/s].
+double FlightController::TrajectoryHeading(double dt_s) {
+  if (!std::isnan(traj_.yaw_rad) || std::isnan(traj_.yawspeed_rad_s)) return 0.0;
+  const double rate = std::clamp(traj_.yawspeed_rad_s, -kYawRateLimit_rad_s, kYawRateLimit_rad_s);
+  yaw_sp_rad_ = WrapPi(yaw_sp_rad_ + rate * dt_s);
+  return rate;
 }
 
 void FlightController::DisarmedOutput() {

@@ -29,6 +29,19 @@ void HoverThrustEstimator::Predict(double dt_s) {
   var_ += params_.process_noise * params_.process_noise * dt_s * dt_s;
 }
 
+void HoverThrustEstimator::TrackResidual(double residual, double signed_ratio, double h_meas, double dt_s) {
+  // Low-passed residual (its bias) and signed test ratio (the change detector).
+  const double a = dt_s / (params_.lpf_tau_s + dt_s);
+  residual_lpf_ += a * (residual - residual_lpf_);
+  ratio_lpf_ += a * (std::clamp(signed_ratio, -1.0, 1.0) - ratio_lpf_);
+
+  // Learn the acceleration noise from the unbiased residual.
+  const double b = dt_s / (params_.noise_tau_s + dt_s);
+  const double res = residual - residual_lpf_;
+  acc_var_ = std::clamp((1.0 - b) * acc_var_ + b * (res * res + h_meas * var_ * h_meas), params_.acc_var_min,
+                        params_.acc_var_max);
+}
+
 HoverThrustStatus HoverThrustEstimator::Fuse(double acc_up_m_s2, double thrust_z, double dt_s,
                                              double noise_scale) {
   HoverThrustStatus st;
@@ -56,19 +69,7 @@ HoverThrustStatus HoverThrustEstimator::Fuse(double acc_up_m_s2, double thrust_z
     // filter diverged. Widen the variance so the gate opens again.
     var_ = std::min(1.0, var_ + params_.bump * params_.process_noise * params_.process_noise * dt_s);
   }
-
-  // Low-passed residual (its bias) and signed test ratio (the change detector).
-  const double a = dt_s / (params_.lpf_tau_s + dt_s);
-  residual_lpf_ += a * (residual - residual_lpf_);
-  const double signed_ratio = std::clamp(innov >= 0.0 ? ratio : -ratio, -1.0, 1.0);
-  ratio_lpf_ += a * (signed_ratio - ratio_lpf_);
-
-  // Learn the acceleration noise from the unbiased residual.
-  const double b = dt_s / (params_.noise_tau_s + dt_s);
-  const double res = residual - residual_lpf_;
-  acc_var_ = std::clamp((1.0 - b) * acc_var_ + b * (res * res + h_meas * var_ * h_meas), params_.acc_var_min,
-                        params_.acc_var_max);
-
+  TrackResidual(residual, innov >= 0.0 ? ratio : -ratio, h_meas, dt_s);
   st.innovation = innov;
   st.innovation_var = innov_var;
   st.test_ratio = ratio;

@@ -51,20 +51,11 @@ void OffboardFailsafe::Emit(EventKind kind, double t_s, double silent_s) {
   e.t_s = t_s;
   e.silent_s = silent_s;
   e.action = action_;
-  if (ev_count_ == kEventCapacity) {  // nobody pops: drop the oldest
-    ev_head_ = (ev_head_ + 1) % kEventCapacity;
-    --ev_count_;
-  }
-  events_[(ev_head_ + ev_count_) % kEventCapacity] = e;
-  ++ev_count_;
+  events_.Push(e);  // full (nobody pops): the oldest is dropped
 }
 
 bool OffboardFailsafe::PopEvent(Event* out) {
-  if (ev_count_ == 0) return false;
-  *out = events_[ev_head_];
-  ev_head_ = (ev_head_ + 1) % kEventCapacity;
-  --ev_count_;
-  return true;
+  return events_.Pop(out);
 }
 
 std::string_view OffboardFailsafe::EventName(EventKind kind) {

@@ -32,29 +32,25 @@ Vec3 Trajectory::LimitVelocity(const Vec3& v) const {
   return v * scale;
 }
 
+Vec3 Trajectory::ApproachVelocity() const {
+  const Vec3 d = target_ - ref_.pos_m;
+  const double dist = d.norm();
+  if (dist < 1e-9) return Vec3::Zero();
+  // Braking acceleration along the way: the smaller of the axis limits it projects onto.
+  const Vec3 dir = d / dist;
+  const double a_h = limits_.acc_max_xy_m_s2, a_v = limits_.acc_max_z_m_s2;
+  const double dxy = dir.head<2>().norm(), dz = std::abs(dir.z());
+  double a_along = 1e9;
+  if (dxy > 1e-9) a_along = std::min(a_along, a_h / dxy);
+  if (dz > 1e-9) a_along = std::min(a_along, a_v / dz);
+  // Brake a little early (0.8 a) so discretisation never overshoots the target.
+  const double speed = std::min(std::sqrt(2.0 * 0.8 * a_along * dist), limits_.approach_gain * dist);
+  return LimitVelocity(dir * speed);
+}
+
 TrajectoryPoint Trajectory::Step(double dt_s) {
   if (!(dt_s > 0.0)) return ref_;
-  Vec3 v_des;
-  if (velocity_mode_) {
-    v_des = target_;
-  } else {
-    const Vec3 d = target_ - ref_.pos_m;
-    const double dist = d.norm();
-    if (dist < 1e-9) {
-      v_des.setZero();
-    } else {
-      // Braking acceleration along the way: the smaller of the axis limits it projects onto.
-      const Vec3 dir = d / dist;
-      const double a_h = limits_.acc_max_xy_m_s2, a_v = limits_.acc_max_z_m_s2;
-      const double dxy = dir.head<2>().norm(), dz = std::abs(dir.z());
-      double a_along = 1e9;
-      if (dxy > 1e-9) a_along = std::min(a_along, a_h / dxy);
-      if (dz > 1e-9) a_along = std::min(a_along, a_v / dz);
-      // Brake a little early (0.8 a) so discretisation never overshoots the target.
-      const double speed = std::min(std::sqrt(2.0 * 0.8 * a_along * dist), limits_.approach_gain * dist);
-      v_des = LimitVelocity(dir * speed);
-    }
-  }
+  const Vec3 v_des = velocity_mode_ ? target_ : ApproachVelocity();
   // Velocity change limited per axis group (horizontal vector norm, vertical).
   Vec3 dv = v_des - ref_.vel_m_s;
   const double max_dxy = limits_.acc_max_xy_m_s2 * dt_s;

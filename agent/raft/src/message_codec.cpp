@@ -55,6 +55,22 @@ Error Protocol(std::string what) {
 }
 
 
+// The wire version and the cluster tag before the fields; non-empty: why the message is refused.
+std::string ReadHeader(detail::ByteReader& r, std::uint32_t cluster_tag) {
+  const std::uint8_t version = r.U8();
+  if (!r.ok()) return "empty message";
+  if (version != kWireVersion) {
+    return "unsupported wire version " + std::to_string(version) + " (expected " +
+           std::to_string(kWireVersion) + ")";
+  }
+  const std::uint32_t tag = r.Fixed32();
+  if (r.ok() && tag != cluster_tag) {
+    return "message from another cluster (tag " + std::to_string(tag) + ", ours " +
+           std::to_string(cluster_tag) + "): member lists differ";
+  }
+  return {};
+}
+
 // The entries of a message; a non-empty result is why they are invalid (an unknown entry type).
 std::string ReadEntries(detail::ByteReader& r, std::vector<Entry>* entries) {
   const std::uint64_t n = r.Count(4, "entry");
@@ -111,17 +127,7 @@ std::string CheckMessageFields(const Message& m) {
 
 Result<Message> DecodeMessage(std::span<const std::uint8_t> bytes, std::uint32_t cluster_tag) {
   detail::ByteReader r(bytes);
-  const std::uint8_t version = r.U8();
-  if (!r.ok()) return Protocol("empty message");
-  if (version != kWireVersion) {
-    return Protocol("unsupported wire version " + std::to_string(version) + " (expected " +
-                    std::to_string(kWireVersion) + ")");
-  }
-  const std::uint32_t tag = r.Fixed32();
-  if (r.ok() && tag != cluster_tag) {
-    return Protocol("message from another cluster (tag " + std::to_string(tag) + ", ours " +
-                    std::to_string(cluster_tag) + "): member lists differ");
-  }
+  if (std::string why = ReadHeader(r, cluster_tag); !why.empty()) return Protocol(std::move(why));
   Message m;
   const std::uint8_t type = r.U8();
   if (r.ok() && (type > kMaxMessageType || IsLocalMessage(static_cast<MessageType>(type)))) {

@@ -125,6 +125,12 @@ ApplyResult MissionState::Reject(std::string reason) const {
   return r;
 }
 
+ApplyResult MissionState::AcceptedEntering(MissionPhase phase) {
+  ApplyResult r = Accepted();
+  SetPhase(phase, &r);
+  return r;
+}
+
 void MissionState::SetPhase(MissionPhase phase, ApplyResult* r) {
   if (phase == phase_) return;
   phase_ = phase;
@@ -209,9 +215,7 @@ Victim& MissionState::MutableVictim(std::uint32_t id) {
 
 ApplyResult MissionState::Handle(const StartSearch&) {
   if (phase_ != MissionPhase::kIdle) return Reject("cannot start search" + InPhase());
-  ApplyResult r = Accepted();
-  SetPhase(MissionPhase::kSearch, &r);
-  return r;
+  return AcceptedEntering(MissionPhase::kSearch);
 }
 
 ApplyResult MissionState::Handle(const AssignSectors& c) {
@@ -254,9 +258,7 @@ ApplyResult MissionState::Handle(const ConvergeOn& c) {
                   std::string(VictimStatusName(v->status)));
   }
   target_victim_ = c.victim_id;
-  ApplyResult r = Accepted();
-  SetPhase(MissionPhase::kConverge, &r);
-  return r;
+  return AcceptedEntering(MissionPhase::kConverge);
 }
 
 ApplyResult MissionState::Handle(const BeginRescue& c) {
@@ -268,8 +270,7 @@ ApplyResult MissionState::Handle(const BeginRescue& c) {
   Victim& v = MutableVictim(c.victim_id);
   v.status = VictimStatus::kBeingRescued;
   v.rescuer = c.lifter;
-  ApplyResult r = Accepted();
-  SetPhase(MissionPhase::kRescue, &r);
+  ApplyResult r = AcceptedEntering(MissionPhase::kRescue);
   r.events.push_back(VictimEvent(MissionEvent::Kind::kVictimStatus, phase_, applied_index_, v));
   return r;
 }
@@ -290,16 +291,12 @@ ApplyResult MissionState::Handle(const MarkRescued& c) {
 ApplyResult MissionState::Handle(const ReturnHome&) {
   if (!Active()) return Reject("cannot return home" + InPhase());
   target_victim_ = 0;
-  ApplyResult r = Accepted();
-  SetPhase(MissionPhase::kReturn, &r);
-  return r;
+  return AcceptedEntering(MissionPhase::kReturn);
 }
 
 ApplyResult MissionState::Handle(const CompleteMission&) {
   if (phase_ != MissionPhase::kReturn) return Reject("cannot complete" + InPhase());
-  ApplyResult r = Accepted();
-  SetPhase(MissionPhase::kComplete, &r);
-  return r;
+  return AcceptedEntering(MissionPhase::kComplete);
 }
 
 ApplyResult MissionState::Handle(const ReportMiss& c) {

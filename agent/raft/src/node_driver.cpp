@@ -6,6 +6,25 @@
 #include "swarmbox/raft/message_codec.hpp"
 
 namespace swarmbox::raft {
+namespace {
+
+// Open's restart from the snapshot in storage: `machine` holds the state as of its index.
+Status RestoreStoredSnapshot(const Snapshot& snapshot, StateMachine& machine) {
+  if (auto s = machine.Restore(snapshot.data); !s) {
+    return s.error().Context("restoring the state machine from the stored snapshot " +
+                             std::to_string(snapshot.index));
+  }
+  const auto* m = dynamic_cast<const MissionStateMachine*>(&machine);
+  if (m != nullptr && m->mission().applied_index() != snapshot.index) {
+    return Error(ErrorCode::kProtocol,
+                 "stored snapshot " + std::to_string(snapshot.index) + " holds a mission applied to " +
+                     std::to_string(m->mission().applied_index()),
+                 "raft storage");
+  }
+  return Ok{};
+}
+
+}  // namespace
 
 Result<Config> DriverConfig::ToRaftConfig() const {
   auto bad = [](std::string msg) {
@@ -106,18 +125,8 @@ Result<std::unique_ptr<NodeDriver>> NodeDriver::Open(const DriverConfig& config,
   std::uint64_t applied = 0;
   std::vector<Committed> tap;
   if (!state->snapshot.empty()) {
-    if (auto s = machine->Restore(state->snapshot.data); !s) {
-      return s.error().Context("restoring the state machine from the stored snapshot " +
-                               std::to_string(state->snapshot.index));
-    }
+    if (auto s = RestoreStoredSnapshot(state->snapshot, *machine); !s) return s.error();
     applied = state->snapshot.index;
-    const auto* m = dynamic_cast<const MissionStateMachine*>(machine.get());
-    if (m != nullptr && m->mission().applied_index() != applied) {
-      return Error(ErrorCode::kProtocol,
-                   "stored snapshot " + std::to_string(applied) + " holds a mission applied to " +
-                       std::to_string(m->mission().applied_index()),
-                   "raft storage");
-    }
     if (config.tap_committed) machine->ReplayRestored(0, &tap);
   }
   auto node = RawNode::Create(*rc, std::move(*state));
@@ -311,41 +320,54 @@ Status NodeDriver::Process() {
       const Bytes bytes = EncodeMessage(m, cluster_tag_);
       transport_.Send(NameOf(m.to), bytes);
     }
-    if (rd.soft_state && rd.soft_state->lead != kNoNode &&
-        (rd.soft_state->lead != announced_lead_ || node_.term() != announced_term_)) {
-      announced_lead_ = rd.soft_state->lead;
-      announced_term_ = node_.term();
-      Emit(LogEvent(clock_.NowS(), config_.self, "leader_elected")
-               .Add("term", node_.term())
-               .Add("leader", NameOf(announced_lead_)));
-    }
+    AnnounceLeader(rd.soft_state);
     if (!rd.snapshot.empty()) {
-      // The snapshot is the state after its index; nothing before it is applied again.
-      if (rd.snapshot.index < applied_) {
-        return Stop(Error(ErrorCode::kProtocol,
-                          "snapshot at " + std::to_string(rd.snapshot.index) +
-                              " is behind the applied index " + std::to_string(applied_),
-                          "raft driver"));
-      }
-      if (auto s = machine_->Restore(rd.snapshot.data); !s) {
-        return Stop(s.error().Context("leader sent an unreadable snapshot"));
-      }
-      const std::uint64_t before = applied_;
-      applied_ = rd.snapshot.index;
-      if (!rd.snapshot.conf.empty()) conf_applied_ = rd.snapshot.conf;
-      if (mission_machine_ != nullptr && mission_machine_->mission().applied_index() != applied_) {
-        return Stop(Error(ErrorCode::kProtocol, "snapshot index mismatch", "raft driver"));
-      }
-      machine_->OnSnapshotInstalled(rd.snapshot.index,
-                                    EventOut(clock_.NowS(), config_.self, sink_));
-      if (config_.tap_committed) machine_->ReplayRestored(before, &tap_);
+      if (auto s = InstallSnapshot(rd.snapshot); !s) return s;
     }
     for (const Entry& e : rd.committed_entries) ApplyEntry(e);
     node_.Advance(rd);
     // The events' view of the membership and Raft's are the same function of the same log.
     SWARMBOX_CHECK(conf_applied_ == node_.conf_state());
   }
-  // Raft §7: compact the log into a snapshot of the state machine once enough has been applied.
+  return CompactIfDue();
+}
+
+void NodeDriver::AnnounceLeader(const std::optional<SoftState>& soft_state) {
+  if (!soft_state || soft_state->lead == kNoNode ||
+      (soft_state->lead == announced_lead_ && node_.term() == announced_term_)) {
+    return;
+  }
+  announced_lead_ = soft_state->lead;
+  announced_term_ = node_.term();
+  Emit(LogEvent(clock_.NowS(), config_.self, "leader_elected")
+           .Add("term", node_.term())
+           .Add("leader", NameOf(announced_lead_)));
+}
+
+Status NodeDriver::InstallSnapshot(const Snapshot& snapshot) {
+  // The snapshot is the state after its index; nothing before it is applied again.
+  if (snapshot.index < applied_) {
+    return Stop(Error(ErrorCode::kProtocol,
+                      "snapshot at " + std::to_string(snapshot.index) +
+                          " is behind the applied index " + std::to_string(applied_),
+                      "raft driver"));
+  }
+  if (auto s = machine_->Restore(snapshot.data); !s) {
+    return Stop(s.error().Context("leader sent an unreadable snapshot"));
+  }
+  const std::uint64_t before = applied_;
+  applied_ = snapshot.index;
+  if (!snapshot.conf.empty()) conf_applied_ = snapshot.conf;
+  if (mission_machine_ != nullptr && mission_machine_->mission().applied_index() != applied_) {
+    return Stop(Error(ErrorCode::kProtocol, "snapshot index mismatch", "raft driver"));
+  }
+  machine_->OnSnapshotInstalled(snapshot.index, EventOut(clock_.NowS(), config_.self, sink_));
+  if (config_.tap_committed) machine_->ReplayRestored(before, &tap_);
+  return Ok{};
+}
+
+// Raft §7: compact the log into a snapshot of the state machine once enough has been applied.
+Status NodeDriver::CompactIfDue() {
   const std::uint64_t applied = node_.log().applied();
   if (applied >= node_.log().snapshot_index() + config_.snapshot_every_entries) {
     Snapshot snap{applied, *node_.log().Term(applied), machine_->Snapshot(), node_.conf_state()};

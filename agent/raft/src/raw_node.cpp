@@ -643,24 +643,19 @@ Status RawNode::StepFollower(const Message& m) {
       Send(std::move(fwd));
       return Ok{};
     }
-    case MessageType::kApp:
-      election_elapsed_ = 0;
-      lead_ = m.from;
-      HandleAppendEntries(m);
-      return Ok{};
-    case MessageType::kHeartbeat:
-      election_elapsed_ = 0;
-      lead_ = m.from;
-      HandleHeartbeat(m);
-      return Ok{};
-    case MessageType::kSnap:
-      election_elapsed_ = 0;
-      lead_ = m.from;
-      HandleSnapshot(m);
-      return Ok{};
+    case MessageType::kApp: return FromLeader(m, &RawNode::HandleAppendEntries);
+    case MessageType::kHeartbeat: return FromLeader(m, &RawNode::HandleHeartbeat);
+    case MessageType::kSnap: return FromLeader(m, &RawNode::HandleSnapshot);
     default:
       return Ok{};
   }
+}
+
+Status RawNode::FromLeader(const Message& m, void (RawNode::*handle)(const Message&)) {
+  election_elapsed_ = 0;
+  lead_ = m.from;
+  (this->*handle)(m);
+  return Ok{};
 }
 
 // --- replication ---------------------------------------------------------------------------------

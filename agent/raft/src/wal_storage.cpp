@@ -30,34 +30,38 @@ void AppendRecord(Bytes* out, const Bytes& payload) {
   out->insert(out->end(), payload.begin(), payload.end());
 }
 
-Bytes HardStatePayload(const HardState& hs) {
+// One record's payload: its kind byte, then the fields `write_fields(w)` writes.
+template <typename WriteFields>
+Bytes RecordPayload(std::uint8_t kind, WriteFields write_fields) {
   Bytes p;
   detail::ByteWriter w(&p);
-  w.U8(kHardStateRecord);
-  w.Varint(hs.term);
-  w.Varint(hs.vote);
-  w.Varint(hs.commit);
+  w.U8(kind);
+  write_fields(w);
   return p;
+}
+
+Bytes HardStatePayload(const HardState& hs) {
+  return RecordPayload(kHardStateRecord, [&](detail::ByteWriter& w) {
+    w.Varint(hs.term);
+    w.Varint(hs.vote);
+    w.Varint(hs.commit);
+  });
 }
 
 Bytes EntryPayload(const Entry& e) {
-  Bytes p;
-  detail::ByteWriter w(&p);
-  w.U8(kEntryRecord);
-  w.Varint(e.term);
-  w.Varint(e.index);
-  w.U8(static_cast<std::uint8_t>(e.type));
-  w.Blob(e.data);
-  return p;
+  return RecordPayload(kEntryRecord, [&](detail::ByteWriter& w) {
+    w.Varint(e.term);
+    w.Varint(e.index);
+    w.U8(static_cast<std::uint8_t>(e.type));
+    w.Blob(e.data);
+  });
 }
 
 Bytes BasePayload(std::uint64_t index, std::uint64_t term) {
-  Bytes p;
-  detail::ByteWriter w(&p);
-  w.U8(kBaseRecord);
-  w.Varint(index);
-  w.Varint(term);
-  return p;
+  return RecordPayload(kBaseRecord, [&](detail::ByteWriter& w) {
+    w.Varint(index);
+    w.Varint(term);
+  });
 }
 
 Bytes SnapshotFile(const Snapshot& s) {

@@ -10,6 +10,39 @@
 
 namespace swarmbox::swarm {
 
+namespace {
+
+constexpr double kMovingSpeed_m_s = 0.1;  // slower drones have no heading to align
+
+// Union-find over drone indices: the groups of drones linked within link range.
+class LinkedGroups {
+ public:
+  explicit LinkedGroups(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), std::size_t{0}); }
+  void Link(std::size_t i, std::size_t j) { parent_[Find(i)] = Find(j); }
+  int Count() {
+    int groups = 0;
+    for (std::size_t i = 0; i < parent_.size(); ++i) groups += Find(i) == i ? 1 : 0;
+    return groups;
+  }
+
+ private:
+  std::size_t Find(std::size_t i) {
+    while (parent_[i] != i) i = parent_[i] = parent_[parent_[i]];
+    return i;
+  }
+  std::vector<std::size_t> parent_;
+};
+
+// Cosine of the angle between two horizontal velocities; 0 when either drone barely moves.
+double HeadingAlignment(const Eigen::Vector3d& a_m_s, const Eigen::Vector3d& b_m_s) {
+  const Eigen::Vector2d vi = a_m_s.head<2>();
+  const Eigen::Vector2d vj = b_m_s.head<2>();
+  if (vi.norm() > kMovingSpeed_m_s && vj.norm() > kMovingSpeed_m_s) return vi.dot(vj) / (vi.norm() * vj.norm());
+  return 0.0;
+}
+
+}  // namespace
+
 FlockMetrics ComputeFlockMetrics(std::span<const Eigen::Vector3d> positions_m,
                                  std::span<const Eigen::Vector3d> velocities_m_s,
                                  const FlockMetricsParams& params) {
@@ -17,12 +50,7 @@ FlockMetrics ComputeFlockMetrics(std::span<const Eigen::Vector3d> positions_m,
   FlockMetrics m;
   const std::size_t n = positions_m.size();
   if (n < 2) return m;
-  std::vector<std::size_t> parent(n);
-  std::iota(parent.begin(), parent.end(), std::size_t{0});
-  auto find = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
+  LinkedGroups groups(n);
   std::vector<double> nearest(n, std::numeric_limits<double>::infinity());
   std::size_t pairs = 0;
   std::size_t safe_pairs = 0;
@@ -36,18 +64,14 @@ FlockMetrics ComputeFlockMetrics(std::span<const Eigen::Vector3d> positions_m,
       m.min_distance_m = std::min(m.min_distance_m, d);
       nearest[i] = std::min(nearest[i], d);
       nearest[j] = std::min(nearest[j], d);
-      const Eigen::Vector2d vi = velocities_m_s[i].head<2>();
-      const Eigen::Vector2d vj = velocities_m_s[j].head<2>();
-      if (vi.norm() > 0.1 && vj.norm() > 0.1) order_sum += vi.dot(vj) / (vi.norm() * vj.norm());
-      if (d <= params.link_range_m) parent[find(i)] = find(j);
+      order_sum += HeadingAlignment(velocities_m_s[i], velocities_m_s[j]);
+      if (d <= params.link_range_m) groups.Link(i, j);
     }
   }
   m.safety = static_cast<double>(safe_pairs) / static_cast<double>(pairs);
   m.order = order_sum / static_cast<double>(pairs);
-  int components = 0;
-  for (std::size_t i = 0; i < n; ++i) components += find(i) == i ? 1 : 0;
-  m.components = components;
-  m.union_ = 1.0 - static_cast<double>(components - 1) / static_cast<double>(n - 1);
+  m.components = groups.Count();
+  m.union_ = 1.0 - static_cast<double>(m.components - 1) / static_cast<double>(n - 1);
   m.mean_nearest_m = std::accumulate(nearest.begin(), nearest.end(), 0.0) / static_cast<double>(n);
   m.max_nearest_m = *std::max_element(nearest.begin(), nearest.end());
   return m;

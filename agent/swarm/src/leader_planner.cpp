@@ -32,6 +32,75 @@ int Availability(const std::string& mode) {
   return 1;
 }
 
+// A live scout that could take over a sector, and how soon (Availability; raised as it gets work).
+struct ScoutRank {
+  const RosterEntry* entry;
+  int rank;
+};
+
+// The scouts that take over the orphaned sector `rect`, in name order (the same plan whoever
+// computes it): at most as many as near-square pieces fit, the most available and nearest first.
+std::vector<std::string> PickTakers(const Rect& rect, std::vector<ScoutRank>* cands) {
+  const double long_m = std::max(rect.width_m(), rect.height_m());
+  const double short_m = std::min(rect.width_m(), rect.height_m());
+  const std::size_t fit = static_cast<std::size_t>(std::max(1.0, std::round(long_m / short_m)));
+  const std::size_t k = std::min(cands->size(), fit);
+  const Eigen::Vector2d c = rect.center_m();
+  std::sort(cands->begin(), cands->end(), [&](const ScoutRank& x, const ScoutRank& y) {
+    if (x.rank != y.rank) return x.rank < y.rank;
+    const double dx = (x.entry->position_m - c).norm(), dy = (y.entry->position_m - c).norm();
+    if (dx != dy) return dx < dy;
+    return x.entry->name < y.entry->name;
+  });
+  std::vector<std::string> to;
+  for (std::size_t i = 0; i < k; ++i) {
+    to.push_back((*cands)[i].entry->name);
+    (*cands)[i].rank = std::max((*cands)[i].rank, 1) + 1;  // has work now: others first next time
+  }
+  std::sort(to.begin(), to.end());
+  return to;
+}
+
+// event=sighting: one view of candidate `c` (its index `k`) and the fused belief up to it.
+LogEvent SightingEvent(double t_s, const std::string& leader, const raft::Candidate& c, std::size_t k,
+                       const FusionParams& fusion) {
+  raft::Candidate upto = c;
+  upto.views.assign(c.views.begin(), c.views.begin() + static_cast<std::ptrdiff_t>(k + 1));
+  const FusionAssessment a = AssessCandidate(upto, fusion);
+  const raft::SightingView& v = c.views[k];
+  char viewer[64];
+  std::snprintf(viewer, sizeof viewer, "%.1f:%.1f:%.1f", v.viewer_x_m, v.viewer_y_m, v.viewer_height_m);
+  LogEvent e(t_s, leader, "sighting");
+  e.Add("candidate", static_cast<std::int64_t>(c.id))
+      .Add("reporter", v.reporter)
+      .Add("seen", v.detected)
+      .Add("confidence", v.detected ? v.confidence : 0.0, 3)
+      .Add("x", v.x_m, 2)
+      .Add("y", v.y_m, 2)
+      .Add("viewer", viewer)
+      .Add("capture_t", v.t_s, 2)
+      .Add("belief", a.belief, 3)
+      .Add("counted", a.counted_detections)
+      .Add("counted_misses", a.counted_misses);
+  return e;
+}
+
+// event=confirmed / event=rejected for a decided candidate, with its evidence.
+LogEvent DecisionEvent(double t_s, const std::string& leader, const raft::Candidate& c,
+                       const FusionParams& fusion) {
+  const FusionAssessment a = AssessCandidate(c, fusion);
+  const bool confirmed = c.status == raft::CandidateStatus::kConfirmed;
+  LogEvent e(t_s, leader, confirmed ? "confirmed" : "rejected");
+  if (confirmed) {
+    e.Add("victim", static_cast<std::int64_t>(c.victim_id));
+  } else {
+    e.Add("reason", a.undecided ? "undecided" : "belief");
+  }
+  e.Add("decided_belief", c.belief, 3);
+  AddEvidence(e, c, a);
+  return e;
+}
+
 }  // namespace
 
 LeaderPlanner::LeaderPlanner(LeaderConfig config) : config_(std::move(config)) {
@@ -75,26 +144,8 @@ void LeaderPlanner::TrackCandidates(double t_s, const raft::MissionState& m, boo
     }
     if (seen.views == c.views.size() && seen.status == c.status && seen.revisit_drone == c.revisit_drone) continue;
     // The fused belief after each new view, in record order.
-    raft::Candidate upto = c;
     for (std::size_t k = seen.views; k < c.views.size(); ++k) {
-      upto.views.assign(c.views.begin(), c.views.begin() + static_cast<std::ptrdiff_t>(k + 1));
-      const FusionAssessment a = AssessCandidate(upto, config_.fusion);
-      const raft::SightingView& v = c.views[k];
-      char viewer[64];
-      std::snprintf(viewer, sizeof viewer, "%.1f:%.1f:%.1f", v.viewer_x_m, v.viewer_y_m, v.viewer_height_m);
-      LogEvent e(t_s, config_.name, "sighting");
-      e.Add("candidate", static_cast<std::int64_t>(c.id))
-          .Add("reporter", v.reporter)
-          .Add("seen", v.detected)
-          .Add("confidence", v.detected ? v.confidence : 0.0, 3)
-          .Add("x", v.x_m, 2)
-          .Add("y", v.y_m, 2)
-          .Add("viewer", viewer)
-          .Add("capture_t", v.t_s, 2)
-          .Add("belief", a.belief, 3)
-          .Add("counted", a.counted_detections)
-          .Add("counted_misses", a.counted_misses);
-      evidence_events_.push_back(std::move(e));
+      evidence_events_.push_back(SightingEvent(t_s, config_.name, c, k, config_.fusion));
     }
     if (!c.revisit_drone.empty() && c.revisit_drone != seen.revisit_drone) {
       evidence_events_.push_back(std::move(LogEvent(t_s, config_.name, "revisit")
@@ -105,17 +156,7 @@ void LeaderPlanner::TrackCandidates(double t_s, const raft::MissionState& m, boo
                                                .Add("revisits_done", static_cast<std::int64_t>(c.revisits))));
     }
     if (c.status != seen.status && c.status != raft::CandidateStatus::kPending) {
-      const FusionAssessment a = AssessCandidate(c, config_.fusion);
-      const bool confirmed = c.status == raft::CandidateStatus::kConfirmed;
-      LogEvent e(t_s, config_.name, confirmed ? "confirmed" : "rejected");
-      if (confirmed) {
-        e.Add("victim", static_cast<std::int64_t>(c.victim_id));
-      } else {
-        e.Add("reason", a.undecided ? "undecided" : "belief");
-      }
-      e.Add("decided_belief", c.belief, 3);
-      AddEvidence(e, c, a);
-      evidence_events_.push_back(std::move(e));
+      evidence_events_.push_back(DecisionEvent(t_s, config_.name, c, config_.fusion));
     }
     seen = {c.views.size(), c.status, c.revisit_drone};
   }
@@ -123,7 +164,6 @@ void LeaderPlanner::TrackCandidates(double t_s, const raft::MissionState& m, boo
 
 bool LeaderPlanner::PlanCandidates(double t_s, const raft::MissionState& m, std::span<const RosterEntry> roster,
                                    MissionOutput* out) {
-  const FusionParams& fp = config_.fusion;
   bool pending = false;
   // Scouts already sent somewhere: one revisit each at a time.
   std::set<std::string> busy;
@@ -132,7 +172,7 @@ bool LeaderPlanner::PlanCandidates(double t_s, const raft::MissionState& m, std:
   }
   for (const raft::Candidate& c : m.candidates()) {
     if (c.status == raft::CandidateStatus::kConfirmed) continue;
-    const FusionAssessment a = AssessCandidate(c, fp);
+    const FusionAssessment a = AssessCandidate(c, config_.fusion);
     const std::string id = std::to_string(c.id);
     if (a.decision == FusionDecision::kConfirm) {
       pending = pending || c.status == raft::CandidateStatus::kPending;
@@ -145,28 +185,8 @@ bool LeaderPlanner::PlanCandidates(double t_s, const raft::MissionState& m, std:
       if (Due("reject:" + id, t_s)) out->proposals.push_back(raft::RejectSighting{c.id, a.belief});
       continue;
     }
-    bool need = false;
-    if (c.revisit_drone.empty()) {
-      need = t_s - a.last_view_s >= fp.revisit_after_s;
-    } else {
-      need = GoneOwner(t_s, c.revisit_drone) || t_s - c.revisit_t_s >= fp.revisit_timeout_s;
-    }
-    if (!need) continue;
-    const Eigen::Vector2d at(c.x_m, c.y_m);
-    const RosterEntry* best = nullptr;
-    int best_rank = 0;
-    double best_d = 0;
-    for (const RosterEntry& r : roster) {
-      if (r.role != Role::kScout || !Alive(r) || busy.count(r.name) != 0 || r.name == c.revisit_drone) continue;
-      if (IsOneOf(r.mode, {"taking_off", "landing"})) continue;
-      const int rank = Availability(r.mode);
-      const double d = (r.position_m - at).norm();
-      if (best == nullptr || rank < best_rank || (rank == best_rank && (d < best_d || (d == best_d && r.name < best->name)))) {
-        best = &r;
-        best_rank = rank;
-        best_d = d;
-      }
-    }
+    if (!RevisitNeeded(t_s, c, a)) continue;
+    const RosterEntry* best = PickRevisitor(c, roster, busy);
     if (best == nullptr) continue;
     if (Due("revisit:" + id, t_s)) {
       out->proposals.push_back(raft::RequestRevisit{c.id, best->name, t_s});
@@ -174,6 +194,31 @@ bool LeaderPlanner::PlanCandidates(double t_s, const raft::MissionState& m, std:
     }
   }
   return pending;
+}
+
+bool LeaderPlanner::RevisitNeeded(double t_s, const raft::Candidate& c, const FusionAssessment& a) const {
+  if (c.revisit_drone.empty()) return t_s - a.last_view_s >= config_.fusion.revisit_after_s;
+  return GoneOwner(t_s, c.revisit_drone) || t_s - c.revisit_t_s >= config_.fusion.revisit_timeout_s;
+}
+
+const RosterEntry* LeaderPlanner::PickRevisitor(const raft::Candidate& c, std::span<const RosterEntry> roster,
+                                                const std::set<std::string>& busy) const {
+  const Eigen::Vector2d at(c.x_m, c.y_m);
+  const RosterEntry* best = nullptr;
+  int best_rank = 0;
+  double best_d = 0;
+  for (const RosterEntry& r : roster) {
+    if (r.role != Role::kScout || !Alive(r) || busy.count(r.name) != 0 || r.name == c.revisit_drone) continue;
+    if (IsOneOf(r.mode, {"taking_off", "landing"})) continue;
+    const int rank = Availability(r.mode);
+    const double d = (r.position_m - at).norm();
+    if (best == nullptr || rank < best_rank || (rank == best_rank && (d < best_d || (d == best_d && r.name < best->name)))) {
+      best = &r;
+      best_rank = rank;
+      best_d = d;
+    }
+  }
+  return best;
 }
 
 void LeaderPlanner::Index(std::span<const RosterEntry> roster) {
@@ -218,11 +263,7 @@ std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raf
   std::vector<raft::Sector> keep, orphans;
   for (const raft::Sector& s : m.sectors()) (GoneOwner(t_s, s.drone) ? orphans : keep).push_back(s);
   if (orphans.empty()) return std::nullopt;
-  struct Candidate {
-    const RosterEntry* entry;
-    int rank;
-  };
-  std::vector<Candidate> cands;
+  std::vector<ScoutRank> cands;
   for (const RosterEntry& r : roster) {
     if (r.role == Role::kScout && Alive(r)) cands.push_back({&r, Availability(r.mode)});
   }
@@ -235,25 +276,8 @@ std::optional<raft::AssignSectors> LeaderPlanner::Reassign(double t_s, const raf
   a.sectors = std::move(keep);
   for (const raft::Sector& o : orphans) {
     const Rect rect = AsRect(o);
-    const double long_m = std::max(rect.width_m(), rect.height_m());
-    const double short_m = std::min(rect.width_m(), rect.height_m());
-    const std::size_t fit = static_cast<std::size_t>(std::max(1.0, std::round(long_m / short_m)));
-    const std::size_t k = std::min(cands.size(), fit);
-    const Eigen::Vector2d c = rect.center_m();
-    std::sort(cands.begin(), cands.end(), [&](const Candidate& x, const Candidate& y) {
-      if (x.rank != y.rank) return x.rank < y.rank;
-      const double dx = (x.entry->position_m - c).norm(), dy = (y.entry->position_m - c).norm();
-      if (dx != dy) return dx < dy;
-      return x.entry->name < y.entry->name;
-    });
-    std::vector<std::string> to;
-    for (std::size_t i = 0; i < k; ++i) {
-      to.push_back(cands[i].entry->name);
-      cands[i].rank = std::max(cands[i].rank, 1) + 1;  // has work now: others first next time
-    }
-    std::sort(to.begin(), to.end());  // pieces in name order: the same plan whoever computes it
     std::string list;
-    for (raft::Sector& piece : PartitionArea(rect, to)) {
+    for (raft::Sector& piece : PartitionArea(rect, PickTakers(rect, &cands))) {
       list += (list.empty() ? "" : ",") + piece.drone;
       a.sectors.push_back(std::move(piece));
     }

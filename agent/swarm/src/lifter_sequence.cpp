@@ -11,6 +11,20 @@ using raft::MissionPhase;
 using Vec3 = Eigen::Vector3d;
 using Vec2 = Eigen::Vector2d;
 
+namespace {
+
+constexpr double kSlowSpeed_m_s = 0.5;          // vertical legs near the ground
+constexpr double kTakeoffUntilAboveBase_m = 1.5;  // take off (not position hold) below this
+constexpr double kClimbDoneTolerance_m = 1.0;     // a climb ends this close to transit altitude
+constexpr double kLandingPointAboveAttach_m = 1.0;  // the move to the landing point stays this high
+constexpr double kLandingPointSpeed_m_s = 0.5;  // over the landing point: slower than this
+constexpr double kOnGroundAboveBase_m = 0.15;   // touched down: body this close to base height
+constexpr double kOnGroundSpeed_m_s = 0.3;
+
+Vec3 At(const Vec2& xy_m, double z_m) { return {xy_m.x(), xy_m.y(), z_m}; }
+
+}  // namespace
+
 std::string_view LifterSequence::StageName(Stage stage) {
   switch (stage) {
     case Stage::kOnGround: return "on_ground";
@@ -89,40 +103,8 @@ void LifterSequence::RequestPayload(const MissionInput& in, PayloadAction action
 void LifterSequence::Step(const MissionInput& in, MissionOutput* out) {
   SWARMBOX_CHECK(in.mission != nullptr);
   out->Clear();
-  const raft::MissionState& m = *in.mission;
-  const Vec3& p = in.position_m;
-  const Vec2 home_xy = config_.home_m.head<2>();
-
-  // MarkRescued until it is committed (proposals can be lost with a leader change).
-  if (delivered_victim_ != 0) {
-    const raft::Victim* v = m.FindVictim(delivered_victim_);
-    if (v == nullptr || v->status == raft::VictimStatus::kRescued) {
-      delivered_victim_ = 0;
-    } else if (in.t_s - last_proposal_s_ >= config_.proposal_retry_s) {
-      last_proposal_s_ = in.t_s;
-      out->proposals.push_back(raft::MarkRescued{delivered_victim_});
-    }
-  }
-
-  // Battery low: abandon what is not loaded yet and go home.
-  if (in.battery_low && !battery_low_reported_ && stage_ != Stage::kOnGround) {
-    battery_low_reported_ = true;
-    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "battery_low")
-                                        .Add("battery", in.battery_fraction, 3)
-                                        .Add("distance_home_m", (p.head<2>() - home_xy).norm(), 1)));
-    // Not loaded yet: abandon the rescue (the stretcher comes home if it still hangs below).
-    // Loaded (kClimbWithLoad and later): already on the way home with the evacuee.
-    const bool loaded = stage_ > Stage::kAttachLoaded ||
-                        (stage_ == Stage::kAttachLoaded && in.payload_attached);
-    if (!loaded) {
-      out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "rescue_abandoned")
-                                          .Add("victim", static_cast<std::int64_t>(victim_))
-                                          .Add("reason", "battery_low")));
-      victim_ = 0;
-      Enter(in.payload_attached ? Stage::kCarryHome : Stage::kMoveToLandingPoint, in, out);
-    }
-  }
-
+  RepeatMarkRescued(in, out);
+  HandleBatteryLow(in, out);
   // A transition re-runs the new stage at once, so the setpoint always belongs to out.mode.
   for (int pass = 0; pass < 4; ++pass) {
     const Stage before = stage_;
@@ -130,6 +112,37 @@ void LifterSequence::Step(const MissionInput& in, MissionOutput* out) {
     if (stage_ == before) break;
   }
   out->mode = StageName(stage_);
+}
+
+// MarkRescued until it is committed (proposals can be lost with a leader change).
+void LifterSequence::RepeatMarkRescued(const MissionInput& in, MissionOutput* out) {
+  if (delivered_victim_ == 0) return;
+  const raft::Victim* v = in.mission->FindVictim(delivered_victim_);
+  if (v == nullptr || v->status == raft::VictimStatus::kRescued) {
+    delivered_victim_ = 0;
+  } else if (in.t_s - last_proposal_s_ >= config_.proposal_retry_s) {
+    last_proposal_s_ = in.t_s;
+    out->proposals.push_back(raft::MarkRescued{delivered_victim_});
+  }
+}
+
+// Battery low: abandon what is not loaded yet and go home.
+void LifterSequence::HandleBatteryLow(const MissionInput& in, MissionOutput* out) {
+  if (!in.battery_low || battery_low_reported_ || stage_ == Stage::kOnGround) return;
+  battery_low_reported_ = true;
+  out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "battery_low")
+                                      .Add("battery", in.battery_fraction, 3)
+                                      .Add("distance_home_m", (in.position_m.head<2>() - HomeXy()).norm(), 1)));
+  // Not loaded yet: abandon the rescue (the stretcher comes home if it still hangs below).
+  // Loaded (kClimbWithLoad and later): already on the way home with the evacuee.
+  const bool loaded = stage_ > Stage::kAttachLoaded ||
+                      (stage_ == Stage::kAttachLoaded && in.payload_attached);
+  if (loaded) return;
+  out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "rescue_abandoned")
+                                      .Add("victim", static_cast<std::int64_t>(victim_))
+                                      .Add("reason", "battery_low")));
+  victim_ = 0;
+  Enter(in.payload_attached ? Stage::kCarryHome : Stage::kMoveToLandingPoint, in, out);
 }
 
 bool LifterSequence::TakeRescue(const MissionInput& in) {
@@ -141,181 +154,191 @@ bool LifterSequence::TakeRescue(const MissionInput& in) {
   }
   victim_ = v->id;
   victim_xy_m_ = {v->x_m, v->y_m};
-  const Vec2 home_xy = config_.home_m.head<2>();
-  Vec2 toward_home = home_xy - victim_xy_m_;
+  Vec2 toward_home = HomeXy() - victim_xy_m_;
   toward_home = toward_home.norm() > 1e-6 ? Vec2(toward_home.normalized()) : Vec2(1, 0);
   drop_xy_m_ = victim_xy_m_ + config_.stretcher_offset_m * toward_home;
   return true;
 }
 
 void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
-  const raft::MissionState& m = *in.mission;
-  const Vec3& p = in.position_m;
-  const Vec2 home_xy = config_.home_m.head<2>();
-  const double attach_z = Ground() + config_.AttachHeight();
-  const double release_z = attach_z - config_.release_sink_m;
-  const double transit_z = Ground() + config_.transit_altitude_m;
-  const double cruise = config_.cruise_speed_m_s;
-  const double slow = 0.5;  // vertical legs near the ground [m/s]
   SetpointRequest& sp = out->setpoint;
   sp = {};
   sp.yaw_rad = in.yaw_rad;
-  sp.target_m = p;
+  sp.target_m = in.position_m;
   switch (stage_) {
-    case Stage::kOnGround:
-      sp.kind = SetpointKind::kIdle;
-      if (TakeRescue(in)) Enter(Stage::kTakeoffForPickup, in, out);
-      break;
-    case Stage::kStandby: {
-      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z}, slow, false, out);
-      if (TakeRescue(in)) {  // over the stretcher already: settle, then hook it
-        Enter(Stage::kTakeoffForPickup, in, out);
-        break;
-      }
-      bool waiting = false;  // a confirmed victim nobody rescues yet
-      for (const raft::Victim& v : m.victims()) waiting = waiting || v.status == raft::VictimStatus::kConfirmed;
-      const bool over = m.phase() == MissionPhase::kReturn || m.phase() == MissionPhase::kComplete;
-      if (!waiting || over || in.battery_low) Enter(Stage::kMoveToLandingPoint, in, out);
-      break;
-    }
-    case Stage::kTakeoffForPickup: {
-      const Vec3 pickup(stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z);
-      if (p.z() < Ground() + config_.base_height_m + 1.5) {
-        sp.kind = SetpointKind::kTakeoff;
-        sp.target_m = {p.x(), p.y(), attach_z};
-      } else {
-        Hold(pickup, slow, false, out);
-      }
-      if (Settled(in, pickup)) Enter(Stage::kAttachEmpty, in, out);
-      break;
-    }
-    case Stage::kAttachEmpty:
-      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z}, slow, false, out);
-      if (in.payload_attached) {
-        Enter(Stage::kClimbToTransit, in, out);
-      } else {
-        RequestPayload(in, PayloadAction::kAttach, config_.empty_stretcher_mass_kg, out);
-      }
-      break;
-    case Stage::kClimbToTransit: {
-      if (!in.payload_attached) {  // the load check found the hook empty: go back for it
-        Enter(Stage::kTakeoffForPickup, in, out);
-        break;
-      }
-      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), transit_z}, cruise, true, out);
-      if (std::abs(p.z() - transit_z) <= 1.0) Enter(Stage::kTransitToVictim, in, out);
-      break;
-    }
-    case Stage::kTransitToVictim:
-      if (!in.payload_attached) {
-        Enter(Stage::kTakeoffForPickup, in, out);
-        break;
-      }
-      Hold({drop_xy_m_.x(), drop_xy_m_.y(), transit_z}, cruise, true, out);
-      if ((p.head<2>() - drop_xy_m_).norm() <= config_.arrive_tolerance_m &&
-          in.velocity_m_s.norm() < config_.arrive_speed_m_s) {
-        Enter(Stage::kDescendToRelease, in, out);
-      }
-      break;
-    case Stage::kDescendToRelease: {
-      const Vec3 target(drop_xy_m_.x(), drop_xy_m_.y(), release_z);
-      Hold(target, slow, true, out);
-      if (Settled(in, target, /*release=*/true)) Enter(Stage::kRelease, in, out);
-      break;
-    }
-    case Stage::kRelease:
-      Hold({drop_xy_m_.x(), drop_xy_m_.y(), release_z}, slow, true, out);
-      if (!in.payload_attached) {
-        stretcher_xy_m_ = p.head<2>();  // it hung under us (release tolerance: not exactly at the drop point)
-        out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "stretcher_released")
-                                            .Add("victim", static_cast<std::int64_t>(victim_))
-                                            .Add("x", drop_xy_m_.x(), 2)
-                                            .Add("y", drop_xy_m_.y(), 2)));
-        Enter(Stage::kWaitLoading, in, out);
-      } else {
-        RequestPayload(in, PayloadAction::kRelease, 0.0, out);
-      }
-      break;
-    case Stage::kWaitLoading:
-      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z}, slow, false, out);
-      if (in.t_s - stage_start_s_ >= config_.loading_time_s) Enter(Stage::kAttachLoaded, in, out);
-      break;
-    case Stage::kAttachLoaded: {
-      const Vec3 target(stretcher_xy_m_.x(), stretcher_xy_m_.y(), attach_z);
-      Hold(target, slow, false, out);
-      if (in.payload_attached) {
-        out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "evacuee_loaded")
-                                            .Add("victim", static_cast<std::int64_t>(victim_))
-                                            .Add("mass_kg", config_.loaded_mass_kg, 1)));
-        Enter(Stage::kClimbWithLoad, in, out);
-      } else if (Settled(in, target)) {
-        RequestPayload(in, PayloadAction::kAttach, config_.loaded_mass_kg, out);
-      }
-      break;
-    }
-    case Stage::kClimbWithLoad:
-      if (!in.payload_attached) {  // the evacuee's stretcher stayed on the ground
-        Enter(Stage::kAttachLoaded, in, out);
-        break;
-      }
-      Hold({stretcher_xy_m_.x(), stretcher_xy_m_.y(), transit_z}, slow, true, out);
-      if (std::abs(p.z() - transit_z) <= 1.0) Enter(Stage::kCarryHome, in, out);
-      break;
-    case Stage::kCarryHome:
-      if (!in.payload_attached && victim_ != 0) {
-        Enter(Stage::kAttachLoaded, in, out);
-        break;
-      }
-      Hold({home_xy.x(), home_xy.y(), transit_z}, victim_ != 0 ? config_.loaded_speed_m_s : cruise,
-           in.payload_attached, out);
-      if ((p.head<2>() - home_xy).norm() <= config_.arrive_tolerance_m &&
-          in.velocity_m_s.norm() < config_.arrive_speed_m_s) {
-        Enter(in.payload_attached ? Stage::kDescendToDrop : Stage::kMoveToLandingPoint, in, out);
-      }
-      break;
-    case Stage::kDescendToDrop: {
-      const Vec3 target(home_xy.x(), home_xy.y(), release_z);
-      Hold(target, slow, true, out);
-      if (Settled(in, target, /*release=*/true)) Enter(Stage::kReleaseAtHome, in, out);
-      break;
-    }
-    case Stage::kReleaseAtHome:
-      Hold({home_xy.x(), home_xy.y(), release_z}, slow, true, out);
-      if (!in.payload_attached) {
-        stretcher_xy_m_ = p.head<2>();
-        if (victim_ != 0) {
-          delivered_victim_ = victim_;
-          last_proposal_s_ = in.t_s;
-          out->proposals.push_back(raft::MarkRescued{victim_});
-          out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "victim_delivered")
-                                              .Add("victim", static_cast<std::int64_t>(victim_))));
-          victim_ = 0;
-        }
-        Enter(config_.standby_after_delivery && !in.battery_low ? Stage::kStandby : Stage::kMoveToLandingPoint, in, out);
-      } else {
-        RequestPayload(in, PayloadAction::kRelease, 0.0, out);
-      }
-      break;
-    case Stage::kMoveToLandingPoint: {
-      const Vec2 pad = home_xy + config_.land_offset_m;
-      const double z = std::max(attach_z + 1.0, std::min(p.z(), transit_z));
-      Hold({pad.x(), pad.y(), z}, cruise, false, out);
-      if ((p.head<2>() - pad).norm() <= config_.position_tolerance_m && in.velocity_m_s.norm() < 0.5) {
-        Enter(Stage::kLanding, in, out);
-      }
-      break;
-    }
-    case Stage::kLanding: {
-      const Vec2 pad = home_xy + config_.land_offset_m;
-      sp.kind = SetpointKind::kLand;
-      sp.target_m = {pad.x(), pad.y(), Ground()};
-      if (p.z() <= Ground() + config_.base_height_m + 0.15 && in.velocity_m_s.norm() < 0.3) {
-        Enter(Stage::kOnGround, in, out);
-      }
-      break;
-    }
+    case Stage::kOnGround: return RunOnGround(in, out);
+    case Stage::kStandby: return RunStandby(in, out);
+    case Stage::kTakeoffForPickup: return RunTakeoffForPickup(in, out);
+    case Stage::kAttachEmpty: return RunAttachEmpty(in, out);
+    case Stage::kClimbToTransit:  // the load check found the hook empty: go back for it
+      return RunClimb(in, Stage::kTakeoffForPickup, config_.cruise_speed_m_s, Stage::kTransitToVictim, out);
+    case Stage::kTransitToVictim: return RunTransitToVictim(in, out);
+    case Stage::kDescendToRelease: return RunDescend(in, drop_xy_m_, Stage::kRelease, out);
+    case Stage::kRelease: return RunRelease(in, out);
+    case Stage::kWaitLoading: return RunWaitLoading(in, out);
+    case Stage::kAttachLoaded: return RunAttachLoaded(in, out);
+    case Stage::kClimbWithLoad:  // the evacuee's stretcher stayed on the ground
+      return RunClimb(in, Stage::kAttachLoaded, kSlowSpeed_m_s, Stage::kCarryHome, out);
+    case Stage::kCarryHome: return RunCarryHome(in, out);
+    case Stage::kDescendToDrop: return RunDescend(in, HomeXy(), Stage::kReleaseAtHome, out);
+    case Stage::kReleaseAtHome: return RunReleaseAtHome(in, out);
+    case Stage::kMoveToLandingPoint: return RunMoveToLandingPoint(in, out);
+    case Stage::kLanding: return RunLanding(in, out);
   }
 }
 
+bool LifterSequence::Arrived(const MissionInput& in, const Vec2& xy_m) const {
+  return (in.position_m.head<2>() - xy_m).norm() <= config_.arrive_tolerance_m &&
+         in.velocity_m_s.norm() < config_.arrive_speed_m_s;
+}
+
+void LifterSequence::RunOnGround(const MissionInput& in, MissionOutput* out) {
+  out->setpoint.kind = SetpointKind::kIdle;
+  if (TakeRescue(in)) Enter(Stage::kTakeoffForPickup, in, out);
+}
+
+void LifterSequence::RunStandby(const MissionInput& in, MissionOutput* out) {
+  const raft::MissionState& m = *in.mission;
+  Hold(At(stretcher_xy_m_, AttachZ()), kSlowSpeed_m_s, false, out);
+  if (TakeRescue(in)) {  // over the stretcher already: settle, then hook it
+    Enter(Stage::kTakeoffForPickup, in, out);
+    return;
+  }
+  bool waiting = false;  // a confirmed victim nobody rescues yet
+  for (const raft::Victim& v : m.victims()) waiting = waiting || v.status == raft::VictimStatus::kConfirmed;
+  const bool over = m.phase() == MissionPhase::kReturn || m.phase() == MissionPhase::kComplete;
+  if (!waiting || over || in.battery_low) Enter(Stage::kMoveToLandingPoint, in, out);
+}
+
+void LifterSequence::RunTakeoffForPickup(const MissionInput& in, MissionOutput* out) {
+  const Vec3& p = in.position_m;
+  const Vec3 pickup = At(stretcher_xy_m_, AttachZ());
+  if (p.z() < Ground() + config_.base_height_m + kTakeoffUntilAboveBase_m) {
+    out->setpoint.kind = SetpointKind::kTakeoff;
+    out->setpoint.target_m = {p.x(), p.y(), AttachZ()};
+  } else {
+    Hold(pickup, kSlowSpeed_m_s, false, out);
+  }
+  if (Settled(in, pickup)) Enter(Stage::kAttachEmpty, in, out);
+}
+
+void LifterSequence::RunAttachEmpty(const MissionInput& in, MissionOutput* out) {
+  Hold(At(stretcher_xy_m_, AttachZ()), kSlowSpeed_m_s, false, out);
+  if (in.payload_attached) {
+    Enter(Stage::kClimbToTransit, in, out);
+  } else {
+    RequestPayload(in, PayloadAction::kAttach, config_.empty_stretcher_mass_kg, out);
+  }
+}
+
+// Climbs over the stretcher to transit altitude with the load damped; an empty hook sends the
+// lifter back to `if_unhooked`.
+void LifterSequence::RunClimb(const MissionInput& in, Stage if_unhooked, double speed_m_s, Stage next,
+                              MissionOutput* out) {
+  if (!in.payload_attached) {
+    Enter(if_unhooked, in, out);
+    return;
+  }
+  Hold(At(stretcher_xy_m_, TransitZ()), speed_m_s, true, out);
+  if (std::abs(in.position_m.z() - TransitZ()) <= kClimbDoneTolerance_m) Enter(next, in, out);
+}
+
+void LifterSequence::RunTransitToVictim(const MissionInput& in, MissionOutput* out) {
+  if (!in.payload_attached) {
+    Enter(Stage::kTakeoffForPickup, in, out);
+    return;
+  }
+  Hold(At(drop_xy_m_, TransitZ()), config_.cruise_speed_m_s, true, out);
+  if (Arrived(in, drop_xy_m_)) Enter(Stage::kDescendToRelease, in, out);
+}
+
+void LifterSequence::RunDescend(const MissionInput& in, const Vec2& xy_m, Stage next, MissionOutput* out) {
+  const Vec3 target = At(xy_m, ReleaseZ());
+  Hold(target, kSlowSpeed_m_s, true, out);
+  if (Settled(in, target, /*release=*/true)) Enter(next, in, out);
+}
+
+bool LifterSequence::ReleasedAt(const MissionInput& in, const Vec2& xy_m, MissionOutput* out) {
+  Hold(At(xy_m, ReleaseZ()), kSlowSpeed_m_s, true, out);
+  if (in.payload_attached) {
+    RequestPayload(in, PayloadAction::kRelease, 0.0, out);
+    return false;
+  }
+  stretcher_xy_m_ = in.position_m.head<2>();  // it hung under us (release tolerance: not exactly at xy_m)
+  return true;
+}
+
+void LifterSequence::RunRelease(const MissionInput& in, MissionOutput* out) {
+  if (!ReleasedAt(in, drop_xy_m_, out)) return;
+  out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "stretcher_released")
+                                      .Add("victim", static_cast<std::int64_t>(victim_))
+                                      .Add("x", drop_xy_m_.x(), 2)
+                                      .Add("y", drop_xy_m_.y(), 2)));
+  Enter(Stage::kWaitLoading, in, out);
+}
+
+void LifterSequence::RunWaitLoading(const MissionInput& in, MissionOutput* out) {
+  Hold(At(stretcher_xy_m_, AttachZ()), kSlowSpeed_m_s, false, out);
+  if (in.t_s - stage_start_s_ >= config_.loading_time_s) Enter(Stage::kAttachLoaded, in, out);
+}
+
+void LifterSequence::RunAttachLoaded(const MissionInput& in, MissionOutput* out) {
+  const Vec3 target = At(stretcher_xy_m_, AttachZ());
+  Hold(target, kSlowSpeed_m_s, false, out);
+  if (in.payload_attached) {
+    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "evacuee_loaded")
+                                        .Add("victim", static_cast<std::int64_t>(victim_))
+                                        .Add("mass_kg", config_.loaded_mass_kg, 1)));
+    Enter(Stage::kClimbWithLoad, in, out);
+  } else if (Settled(in, target)) {
+    RequestPayload(in, PayloadAction::kAttach, config_.loaded_mass_kg, out);
+  }
+}
+
+void LifterSequence::RunCarryHome(const MissionInput& in, MissionOutput* out) {
+  if (!in.payload_attached && victim_ != 0) {
+    Enter(Stage::kAttachLoaded, in, out);
+    return;
+  }
+  Hold(At(HomeXy(), TransitZ()), victim_ != 0 ? config_.loaded_speed_m_s : config_.cruise_speed_m_s,
+       in.payload_attached, out);
+  if (Arrived(in, HomeXy())) {
+    Enter(in.payload_attached ? Stage::kDescendToDrop : Stage::kMoveToLandingPoint, in, out);
+  }
+}
+
+void LifterSequence::RunReleaseAtHome(const MissionInput& in, MissionOutput* out) {
+  if (!ReleasedAt(in, HomeXy(), out)) return;
+  if (victim_ != 0) {
+    delivered_victim_ = victim_;
+    last_proposal_s_ = in.t_s;
+    out->proposals.push_back(raft::MarkRescued{victim_});
+    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "victim_delivered")
+                                        .Add("victim", static_cast<std::int64_t>(victim_))));
+    victim_ = 0;
+  }
+  Enter(config_.standby_after_delivery && !in.battery_low ? Stage::kStandby : Stage::kMoveToLandingPoint, in, out);
+}
+
+void LifterSequence::RunMoveToLandingPoint(const MissionInput& in, MissionOutput* out) {
+  const Vec3& p = in.position_m;
+  const Vec2 pad = HomeXy() + config_.land_offset_m;
+  const double z = std::max(AttachZ() + kLandingPointAboveAttach_m, std::min(p.z(), TransitZ()));
+  Hold(At(pad, z), config_.cruise_speed_m_s, false, out);
+  if ((p.head<2>() - pad).norm() <= config_.position_tolerance_m &&
+      in.velocity_m_s.norm() < kLandingPointSpeed_m_s) {
+    Enter(Stage::kLanding, in, out);
+  }
+}
+
+void LifterSequence::RunLanding(const MissionInput& in, MissionOutput* out) {
+  const Vec2 pad = HomeXy() + config_.land_offset_m;
+  out->setpoint.kind = SetpointKind::kLand;
+  out->setpoint.target_m = At(pad, Ground());
+  if (in.position_m.z() <= Ground() + config_.base_height_m + kOnGroundAboveBase_m &&
+      in.velocity_m_s.norm() < kOnGroundSpeed_m_s) {
+    Enter(Stage::kOnGround, in, out);
+  }
+}
 
 }  // namespace swarmbox::swarm

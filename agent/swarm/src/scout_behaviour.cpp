@@ -11,6 +11,10 @@ namespace {
 
 using raft::MissionPhase;
 
+constexpr double kTakeoffDoneBelowAltitude_m = 1.0;  // the climb ends this close to search altitude
+constexpr double kOnGroundAboveBase_m = 0.15;  // touched down: body this close to base height
+constexpr double kOnGroundSpeed_m_s = 0.3;
+
 bool Active(MissionPhase p) {
   return p == MissionPhase::kSearch || p == MissionPhase::kConverge || p == MissionPhase::kRescue;
 }
@@ -318,7 +322,6 @@ void ScoutBehaviour::StartSector(const raft::Sector& sector, const MissionInput&
 }
 
 void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
-  const Eigen::Vector3d& p = in.position_m;
   const Eigen::Vector2d home_xy = config_.home_m.head<2>();
   SetpointRequest& sp = out->setpoint;
   sp = {};
@@ -327,47 +330,43 @@ void ScoutBehaviour::RunStage(const MissionInput& in, MissionOutput* out) {
     case Stage::kOnGround:
     case Stage::kLanded:
       sp.kind = SetpointKind::kIdle;
-      sp.target_m = p;
+      sp.target_m = in.position_m;
       sp.max_speed_m_s = 0;
       break;
-    case Stage::kTakingOff:
-      sp.kind = SetpointKind::kTakeoff;
-      sp.target_m = {home_xy.x(), home_xy.y(), Altitude()};
-      sp.yaw_rad = in.yaw_rad;
-      if (p.z() >= Altitude() - 1.0) Enter(Stage::kAwaitingSector, in, out);
-      break;
-    case Stage::kAwaitingSector:
-      sp.kind = SetpointKind::kFlock;
-      sp.target_m = {home_xy.x(), home_xy.y(), Altitude()};
-      sp.yaw_rad = in.yaw_rad;
-      break;
-    case Stage::kSearching:
-      RunSearch(in, out);
-      break;
-    case Stage::kSwept: {
-      const Eigen::Vector2d c = AsRect(planned_sector_).center_m();
-      sp.kind = SetpointKind::kFlock;
-      sp.target_m = {c.x(), c.y(), Altitude()};
-      sp.yaw_rad = in.yaw_rad;
-      break;
-    }
-    case Stage::kOrbiting:
-      RunOrbit(in, out);
-      break;
-    case Stage::kReturning:
-      RunReturn(in, out);
-      break;
-    case Stage::kRevisiting:
-      RunRevisit(in, out);
-      break;
-    case Stage::kLanding:
-      sp.kind = SetpointKind::kLand;
-      sp.target_m = config_.home_m;
-      sp.yaw_rad = in.yaw_rad;
-      if (p.z() <= config_.home_m.z() + config_.base_height_m + 0.15 && in.velocity_m_s.norm() < 0.3) {
-        Enter(Stage::kLanded, in, out);
-      }
-      break;
+    case Stage::kTakingOff: return RunTakeoff(in, out);
+    case Stage::kAwaitingSector: return FlockOver(home_xy, in, out);
+    case Stage::kSearching: return RunSearch(in, out);
+    case Stage::kSwept: return FlockOver(AsRect(planned_sector_).center_m(), in, out);
+    case Stage::kOrbiting: return RunOrbit(in, out);
+    case Stage::kReturning: return RunReturn(in, out);
+    case Stage::kRevisiting: return RunRevisit(in, out);
+    case Stage::kLanding: return RunLanding(in, out);
+  }
+}
+
+void ScoutBehaviour::RunTakeoff(const MissionInput& in, MissionOutput* out) {
+  SetpointRequest& sp = out->setpoint;
+  sp.kind = SetpointKind::kTakeoff;
+  sp.target_m = {config_.home_m.x(), config_.home_m.y(), Altitude()};
+  sp.yaw_rad = in.yaw_rad;
+  if (in.position_m.z() >= Altitude() - kTakeoffDoneBelowAltitude_m) Enter(Stage::kAwaitingSector, in, out);
+}
+
+void ScoutBehaviour::FlockOver(const Eigen::Vector2d& xy_m, const MissionInput& in, MissionOutput* out) const {
+  SetpointRequest& sp = out->setpoint;
+  sp.kind = SetpointKind::kFlock;
+  sp.target_m = {xy_m.x(), xy_m.y(), Altitude()};
+  sp.yaw_rad = in.yaw_rad;
+}
+
+void ScoutBehaviour::RunLanding(const MissionInput& in, MissionOutput* out) {
+  SetpointRequest& sp = out->setpoint;
+  sp.kind = SetpointKind::kLand;
+  sp.target_m = config_.home_m;
+  sp.yaw_rad = in.yaw_rad;
+  if (in.position_m.z() <= config_.home_m.z() + config_.base_height_m + kOnGroundAboveBase_m &&
+      in.velocity_m_s.norm() < kOnGroundSpeed_m_s) {
+    Enter(Stage::kLanded, in, out);
   }
 }
 

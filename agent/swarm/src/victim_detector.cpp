@@ -9,6 +9,22 @@
 #include "swarmbox/common/result.hpp"
 
 namespace swarmbox::swarm {
+namespace {
+
+// Non-maximum suppression, most confident first: appends to `out` each blob of `blobs` (sorted
+// here) not within `radius_px` of one kept before it.
+void SuppressNonMaxima(std::vector<ImageBlob>* blobs, double radius_px, std::vector<ImageBlob>* out) {
+  std::stable_sort(blobs->begin(), blobs->end(),
+                   [](const ImageBlob& a, const ImageBlob& b) { return a.confidence > b.confidence; });
+  const double r2 = std::pow(radius_px, 2);
+  for (const ImageBlob& b : *blobs) {
+    bool suppressed = false;
+    for (const ImageBlob& kept : *out) suppressed = suppressed || (kept.centroid_px - b.centroid_px).squaredNorm() < r2;
+    if (!suppressed) out->push_back(b);
+  }
+}
+
+}  // namespace
 
 // VictimDetector(params), with the shipped model, is defined in shipped_model.cpp (its own library,
 // so that the trainer links the detector without a model).
@@ -116,15 +132,7 @@ void VictimDetector::DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn 
     if (b.partial) b.confidence = std::min(b.confidence, params_.partial_confidence_cap);
     scratch_.push_back(b);
   }
-  // Non-maximum suppression, most confident first.
-  std::stable_sort(scratch_.begin(), scratch_.end(),
-                   [](const ImageBlob& a, const ImageBlob& b) { return a.confidence > b.confidence; });
-  const double r2 = std::pow(params_.nms_radius_m * pixels_per_m, 2);
-  for (const ImageBlob& b : scratch_) {
-    bool suppressed = false;
-    for (const ImageBlob& kept : *out) suppressed = suppressed || (kept.centroid_px - b.centroid_px).squaredNorm() < r2;
-    if (!suppressed) out->push_back(b);
-  }
+  SuppressNonMaxima(&scratch_, params_.nms_radius_m * pixels_per_m, out);
 }
 
 }  // namespace swarmbox::swarm

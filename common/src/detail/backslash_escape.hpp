@@ -20,4 +20,15 @@ inline std::string_view BackslashEscape(char c) {
   }
 }
 
+// The character a backslash followed by `c` stands for when read back ('n' -> newline, 'r', 't';
+// any other `c` stands for itself, as `"` and `\` do).
+inline char BackslashUnescape(char c) {
+  switch (c) {
+    case 'n': return '\n';
+    case 'r': return '\r';
+    case 't': return '\t';
+    default: return c;
+  }
+}
+
 }  // namespace swarmbox::detail

@@ -3,19 +3,15 @@
 #include <string>
 #include <vector>
 
+#include "swarmbox/common/split.hpp"
+
 namespace swarmbox::dsl {
 
 namespace {
 
 std::vector<std::string> SplitPath(std::string_view key) {
   std::vector<std::string> parts;
-  std::size_t start = 0;
-  while (true) {
-    std::size_t dot = key.find('.', start);
-    parts.emplace_back(key.substr(start, dot == std::string_view::npos ? dot : dot - start));
-    if (dot == std::string_view::npos) break;
-    start = dot + 1;
-  }
+  for (std::string_view part : SplitOn(key, '.')) parts.emplace_back(part);
   return parts;
 }
 

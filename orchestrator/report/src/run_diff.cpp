@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/split.hpp"
 #include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::report {
@@ -40,20 +41,6 @@ std::vector<std::string_view> Lines(std::string_view text) {
     pos = end + 1;
   }
   return lines;
-}
-
-std::vector<std::string_view> SplitCsv(std::string_view line) {
-  std::vector<std::string_view> cells;
-  std::size_t pos = 0;
-  while (true) {
-    const std::size_t comma = line.find(',', pos);
-    if (comma == std::string_view::npos) {
-      cells.push_back(line.substr(pos));
-      return cells;
-    }
-    cells.push_back(line.substr(pos, comma - pos));
-    pos = comma + 1;
-  }
 }
 
 std::optional<double> Number(std::string_view text) {
@@ -115,7 +102,7 @@ Result<TruthTable> ParseTruth(std::string_view text, Side side, std::optional<do
   TruthTable t;
   t.lines = Lines(text);
   if (t.lines.empty()) return t;  // nothing written: compared as a file with no header and no row
-  t.header = SplitCsv(t.lines[0]);
+  t.header = SplitOn(t.lines[0], ',');
   auto col = [&](std::string_view name) -> std::optional<std::size_t> {
     auto it = std::find(t.header.begin(), t.header.end(), name);
     if (it == t.header.end()) return std::nullopt;
@@ -131,7 +118,7 @@ Result<TruthTable> ParseTruth(std::string_view text, Side side, std::optional<do
   t.rows = t.lines.size() - 1;
   if (horizon_s) {
     for (std::size_t i = 1; i < t.lines.size(); ++i) {
-      const auto cells = SplitCsv(t.lines[i]);
+      const auto cells = SplitOn(t.lines[i], ',');
       const auto ts = cells.size() > t.t_col ? Number(cells[t.t_col]) : std::nullopt;
       if (ts && *ts > *horizon_s) {
         t.rows = i - 1;
@@ -166,10 +153,10 @@ TruthDivergence RowDivergence(const TruthTable& a, const TruthTable& b, std::siz
   TruthDivergence d;
   d.line = row + 2;
   if (end_a || end_b) d.ended = end_a ? Side::kA : Side::kB;
-  const auto ca = SplitCsv((end_a ? b : a).lines[row + 1]);
+  const auto ca = SplitOn((end_a ? b : a).lines[row + 1], ',');
   if (ca.size() > a.t_col) d.t_s = Number(ca[a.t_col]);
   if (ca.size() > a.drone_col) d.drone = std::string(ca[a.drone_col]);
-  if (!d.ended) d.fields = CellDiffs(ca, SplitCsv(b.lines[row + 1]), a.header);
+  if (!d.ended) d.fields = CellDiffs(ca, SplitOn(b.lines[row + 1], ','), a.header);
   return d;
 }
 

@@ -7,23 +7,12 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "swarmbox/common/split.hpp"
 #include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::runner {
 
 namespace {
-
-std::vector<std::string_view> SplitCsv(std::string_view line) {
-  std::vector<std::string_view> out;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = line.find(',', start);
-    out.push_back(line.substr(start, comma == std::string_view::npos ? comma : comma - start));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
 
 const cv::Scalar kPalette[] = {
     {180, 119, 31}, {14, 127, 255}, {44, 160, 44},  {40, 39, 214},  {189, 103, 148},
@@ -89,7 +78,7 @@ Result<std::vector<std::pair<std::string, std::vector<TrackPoint>>>> ParseTruthC
     ++line_no;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
     if (line.empty()) continue;
-    const auto cells = SplitCsv(line);
+    const auto cells = SplitOn(line, ',');
     if (columns) {
       SWARMBOX_TRY(AddTruthRow(cells, *columns, line_no, &tracks));
       continue;

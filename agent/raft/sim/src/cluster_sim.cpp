@@ -139,7 +139,7 @@ ClusterSim::ClusterSim(const SimConfig& config) : config_(config), rng_(config.s
     nodes_.push_back(std::move(n));
   }
   for (int i = 0; i < config.nodes; ++i) Restart(i);
-  if (config.propose_interval_s > 0) ScheduleNextProposal();
+  if (config.propose_interval_s > 0) ScheduleEvery(config_.propose_interval_s, &ClusterSim::ProposeRandom);
   ScheduleNextCrash();
   ScheduleNextPartition();
   for (double t : config.leader_crash_at_s) {
@@ -152,7 +152,7 @@ ClusterSim::ClusterSim(const SimConfig& config) : config_(config), rng_(config.s
     e->action = [this] { CrashVoterNow(); };
     Schedule(Us(t), e);
   }
-  if (config.conf_change_interval_s > 0) ScheduleNextConfChange();
+  if (config.conf_change_interval_s > 0) ScheduleEvery(config_.conf_change_interval_s, &ClusterSim::RandomConfChange);
 }
 
 ClusterSim::~ClusterSim() {
@@ -414,13 +414,13 @@ void ClusterSim::ScheduleNextPartition() {
            e);
 }
 
-void ClusterSim::ScheduleNextProposal() {
+void ClusterSim::ScheduleEvery(double interval_s, void (ClusterSim::*action)()) {
   auto* e = new Event;
-  e->action = [this] {
-    ProposeRandom();
-    ScheduleNextProposal();
+  e->action = [this, interval_s, action] {
+    (this->*action)();
+    ScheduleEvery(interval_s, action);
   };
-  Schedule(now_us_ + Us(config_.propose_interval_s * Uniform(0.5, 1.5)), e);
+  Schedule(now_us_ + Us(interval_s * Uniform(0.5, 1.5)), e);
 }
 
 void ClusterSim::ProposeRandom() {
@@ -500,15 +500,6 @@ void ClusterSim::CrashVoterNow() {
   auto* r = new Event;
   r->action = [this, victim] { Restart(victim); };
   Schedule(now_us_ + Us(config_.voter_down_s), r);
-}
-
-void ClusterSim::ScheduleNextConfChange() {
-  auto* e = new Event;
-  e->action = [this] {
-    RandomConfChange();
-    ScheduleNextConfChange();
-  };
-  Schedule(now_us_ + Us(config_.conf_change_interval_s * Uniform(0.5, 1.5)), e);
 }
 
 void ClusterSim::RandomConfChange() {
@@ -837,18 +828,22 @@ void ClusterSim::CheckTap(int node) {
       return;
     }
     // The entry log replays the whole log: nothing but no-ops between two tapped entries.
-    for (std::uint64_t i = n.tapped_last + 1; complete && i < c.index; ++i) {
-      if (i > committed_.size()) break;
-      const CommitFact& gap = committed_[i - 1];
-      if (gap.term != 0 && gap.application) {
-        Violation("Committed Tap", who + " skipped committed entry " + std::to_string(i) +
-                                       " (tapped " + std::to_string(c.index) + " after " +
-                                       std::to_string(n.tapped_last) + ")");
-        return;
-      }
+    if (const std::uint64_t skipped = complete ? SkippedApplication(n.tapped_last, c.index) : 0; skipped != 0) {
+      Violation("Committed Tap", who + " skipped committed entry " + std::to_string(skipped) +
+                                     " (tapped " + std::to_string(c.index) + " after " +
+                                     std::to_string(n.tapped_last) + ")");
+      return;
     }
     n.tapped_last = c.index;
   }
+}
+
+std::uint64_t ClusterSim::SkippedApplication(std::uint64_t after, std::uint64_t before) const {
+  for (std::uint64_t i = after + 1; i < before && i <= committed_.size(); ++i) {
+    const CommitFact& gap = committed_[i - 1];
+    if (gap.term != 0 && gap.application) return i;
+  }
+  return 0;
 }
 
 void ClusterSim::CheckCommitQuorum(const RawNode& leader, const ConfState& before, std::uint64_t index,

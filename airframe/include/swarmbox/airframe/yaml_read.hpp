@@ -15,6 +15,9 @@ Status Decode(const yaml::Node& node, Vec3* out);
 
 namespace detail {
 
+// An invalid-argument error at `map.key`'s mark (the map's own when the key is absent).
+Error InvalidAt(const yaml::Node& map, std::string_view key, std::string msg);
+
 // Reads an optional/required number and checks `lo <= value` (strictly above lo when
 // `strict`); errors point at the value's own mark.
 class Checked {

@@ -56,6 +56,12 @@ class StereoRenderer {
   // Radiance of each pixel of one view (and its depth when `depth` is set).
   void CastView(const Vec3& centre, const double* r_wc, const StereoSpec& spec, const Vec3& projector,
                 cv::Mat* radiance, cv::Mat* depth);
+  // CastView's parts. The pattern's mean irradiance at 1 m from the projector [W/m^2] (0: no dots).
+  double PatternIrradianceAt1m(const ProjectorSpec& p) const;
+  // The dot pattern's irradiance at world point `hit` [W/m^2]: e1 (the mean at 1 m) times the
+  // pattern there over the squared distance; 0 outside the field of illumination or beyond range_m.
+  double PatternIrradiance(const Vec3& hit, const Vec3& projector, const double* r_wc, double e1,
+                           double range_m) const;
   void EnsurePattern(const ProjectorSpec& p);
 
   const StereoScene* scene_;

@@ -26,6 +26,7 @@
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/flight/attitude_control.hpp"
+#include "swarmbox/flight/detail/event_ring.hpp"
 #include "swarmbox/flight/estimator.hpp"
 #include "swarmbox/flight/flight_config.hpp"
 #include "swarmbox/flight/hover_thrust_module.hpp"
@@ -102,6 +103,9 @@ class FlightController {
 
  private:
   FlightController(const FlightConfig& config, const ControllerOptions& options, Mixer mixer);
+  // The constructor's parts: the hover thrust module (and mass_kg_), the swing observer and shaper.
+  void ConfigureHoverThrust();
+  void ConfigureSwingDamping();
   void SetMode(FlightMode mode, double t_s);
   void Emit(FlightEventKind kind, double t_s);
   void ResetControllers();
@@ -116,6 +120,7 @@ class FlightController {
   bool CommandTrajectory(const TrajectoryTarget& target, double t_s);
   // The trajectory kind's setpoint for this step (per-axis control, heading), from target_.
   PositionSetpoint TrajectoryStep(const StateEstimate& s, double dt_s, double* yawspeed_ff_rad_s);
+  double TrajectoryHeading(double dt_s);  // advances yaw_sp_rad_; the yawspeed feed-forward
   // Step()'s parts, in order. The step period from the sample time [s].
   double StepPeriod(double t_s);
   // Mode bookkeeping before flight (ready, GPS lost/recovered); false (motors off) unless flying.
@@ -169,10 +174,7 @@ class FlightController {
   std::array<bool, 3> traj_held_{};
   Vec3 traj_hold_m_ = Vec3::Zero();
 
-  static constexpr std::size_t kEventCapacity = 32;
-  std::array<FlightEvent, kEventCapacity> events_{};
-  std::size_t ev_head_ = 0;
-  std::size_t ev_count_ = 0;
+  detail::EventRing<FlightEvent, 32> events_;
 };
 
 }  // namespace swarmbox::flight

@@ -69,6 +69,10 @@ class HoverThrustEstimator {
   double variance() const { return var_; }
 
  private:
+  // Fuse's tail: the residual's bias, the signed test ratio's low-pass (the change detector) and
+  // the acceleration noise learnt from the unbiased residual (h_meas: the measurement Jacobian).
+  void TrackResidual(double residual, double signed_ratio, double h_meas, double dt_s);
+
   HoverThrustParams params_;
   double hover_ = 0.5;
   double var_ = 0.01;

@@ -34,6 +34,7 @@
 #include <string_view>
 
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/flight/detail/event_ring.hpp"
 
 namespace swarmbox::flight {
 
@@ -86,10 +87,7 @@ class OffboardFailsafe {
   double last_answer_s_;
   bool started_ = false;
 
-  static constexpr std::size_t kEventCapacity = 8;
-  std::array<Event, kEventCapacity> events_{};
-  std::size_t ev_head_ = 0;
-  std::size_t ev_count_ = 0;
+  detail::EventRing<Event, 8> events_;
 };
 
 }  // namespace swarmbox::flight

@@ -52,6 +52,8 @@ class Trajectory {
  private:
   // Scales v so that its horizontal and vertical parts respect the limits (direction kept).
   Vec3 LimitVelocity(const Vec3& v) const;
+  // Position mode: the velocity toward target_ that can still brake to a stop on it (limited).
+  Vec3 ApproachVelocity() const;
 
   TrajectoryLimits limits_;
   TrajectoryPoint ref_;

@@ -157,6 +157,7 @@ class MissionState {
   bool Active() const;
   std::string InPhase() const;  // " in phase SEARCH", for rejections
   static ApplyResult Accepted();
+  ApplyResult AcceptedEntering(MissionPhase phase);  // Accepted() with the phase change's event
   ApplyResult Reject(std::string reason) const;
   Victim& MutableVictim(std::uint32_t id);  // aborts when there is no such victim
   ApplyResult ApplySighting(const ReportSighting& c);

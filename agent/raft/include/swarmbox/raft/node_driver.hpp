@@ -193,7 +193,11 @@ class NodeDriver {
              std::unique_ptr<StateMachine> machine, std::uint64_t applied,
              std::vector<Committed> tap, Storage& storage, Transport& transport,
              const Clock& clock, EventSink sink);
+  // Hands every Ready over (persist, send, announce, install, apply, advance), then compacts.
   Status Process();
+  void AnnounceLeader(const std::optional<SoftState>& soft_state);  // event=leader_elected once per term
+  Status InstallSnapshot(const Snapshot& snapshot);  // the leader's, as a Ready delivers it
+  Status CompactIfDue();
   Status Stop(Error e);
   void Emit(const LogEvent& e) const;
   void ApplyEntry(const Entry& e);

@@ -174,6 +174,8 @@ class RawNode {
   Status StepCandidate(const Message& m);
   void HandleVoteResponse(const Message& m);
   Status StepFollower(const Message& m);
+  // A follower hears its leader: the election timer restarts, lead_ is the sender, `handle` runs.
+  Status FromLeader(const Message& m, void (RawNode::*handle)(const Message&));
 
   void Reset(std::uint64_t term);
   void BecomeFollower(std::uint64_t term, NodeId lead);

@@ -171,6 +171,11 @@ class LeaderPlanner {
   // Decisions and revisits for the candidates (active phases); returns whether any is pending.
   bool PlanCandidates(double t_s, const raft::MissionState& m, std::span<const RosterEntry> roster,
                       MissionOutput* out);
+  // PlanCandidates' parts: whether a pending candidate needs a (new) revisit; the scout to send
+  // (live, not busy, most available, then nearest, then by name; null: none).
+  bool RevisitNeeded(double t_s, const raft::Candidate& c, const FusionAssessment& a) const;
+  const RosterEntry* PickRevisitor(const raft::Candidate& c, std::span<const RosterEntry> roster,
+                                   const std::set<std::string>& busy) const;
 
   LeaderConfig config_;
   std::map<std::string, double> last_proposed_s_;

@@ -103,7 +103,33 @@ class LifterSequence {
   const LifterConfig& config() const { return config_; }
 
  private:
+  // Step's parts: re-propose MarkRescued until committed; react once to a low battery.
+  void RepeatMarkRescued(const MissionInput& in, MissionOutput* out);
+  void HandleBatteryLow(const MissionInput& in, MissionOutput* out);
+  // One pass of the state machine: the current stage's setpoint and transition.
   void RunStage(const MissionInput& in, MissionOutput* out);
+  // One handler per stage (the two descents and the two releases share one each).
+  void RunOnGround(const MissionInput& in, MissionOutput* out);
+  void RunStandby(const MissionInput& in, MissionOutput* out);
+  void RunTakeoffForPickup(const MissionInput& in, MissionOutput* out);
+  void RunAttachEmpty(const MissionInput& in, MissionOutput* out);
+  void RunClimb(const MissionInput& in, Stage if_unhooked, double speed_m_s, Stage next,
+                MissionOutput* out);
+  void RunTransitToVictim(const MissionInput& in, MissionOutput* out);
+  // Lowers the slung load onto the ground at `xy_m`; settled there -> `next`.
+  void RunDescend(const MissionInput& in, const Eigen::Vector2d& xy_m, Stage next, MissionOutput* out);
+  // Holds at release height over `xy_m` and asks for the release; true once the hook is empty
+  // (the stretcher then lies under the lifter).
+  bool ReleasedAt(const MissionInput& in, const Eigen::Vector2d& xy_m, MissionOutput* out);
+  void RunRelease(const MissionInput& in, MissionOutput* out);
+  void RunWaitLoading(const MissionInput& in, MissionOutput* out);
+  void RunAttachLoaded(const MissionInput& in, MissionOutput* out);
+  void RunCarryHome(const MissionInput& in, MissionOutput* out);
+  void RunReleaseAtHome(const MissionInput& in, MissionOutput* out);
+  void RunMoveToLandingPoint(const MissionInput& in, MissionOutput* out);
+  void RunLanding(const MissionInput& in, MissionOutput* out);
+  // Over `xy_m` and slow enough to start the descent (arrive tolerances).
+  bool Arrived(const MissionInput& in, const Eigen::Vector2d& xy_m) const;
   // A rescue committed for this drone (phase RESCUE, its victim being rescued by it): takes it
   // (victim, drop point) and returns true.
   bool TakeRescue(const MissionInput& in);
@@ -115,6 +141,12 @@ class LifterSequence {
   void RequestPayload(const MissionInput& in, PayloadAction action, double mass_kg,
                       MissionOutput* out);
   double Ground() const { return config_.home_m.z(); }
+  // Body heights [m, world]: the hook reaches the stretcher lying flat; the load is set down;
+  // transit altitude.
+  double AttachZ() const { return Ground() + config_.AttachHeight(); }
+  double ReleaseZ() const { return AttachZ() - config_.release_sink_m; }
+  double TransitZ() const { return Ground() + config_.transit_altitude_m; }
+  Eigen::Vector2d HomeXy() const { return config_.home_m.head<2>(); }
 
   LifterConfig config_;
   Stage stage_ = Stage::kOnGround;

@@ -146,6 +146,10 @@ class ScoutBehaviour {
   void RunSearch(const MissionInput& in, MissionOutput* out);
   void RunOrbit(const MissionInput& in, MissionOutput* out);
   void RunReturn(const MissionInput& in, MissionOutput* out);
+  void RunTakeoff(const MissionInput& in, MissionOutput* out);
+  void RunLanding(const MissionInput& in, MissionOutput* out);
+  // Flocks toward `xy_m` at search altitude (waiting for a sector, or over the swept one).
+  void FlockOver(const Eigen::Vector2d& xy_m, const MissionInput& in, MissionOutput* out) const;
   void ReportSightings(const MissionInput& in, MissionOutput* out);
   void RetrySightings(const MissionInput& in, MissionOutput* out);
   void Propose(const MissionInput& in, const GroundDetection& d, int tries, MissionOutput* out);

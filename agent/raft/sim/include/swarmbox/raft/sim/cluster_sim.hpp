@@ -192,11 +192,12 @@ class ClusterSim {
   void ScheduleTick(int node);
   void ScheduleNextCrash();
   void ScheduleNextPartition();
-  void ScheduleNextProposal();
+  // Runs `action` again and again, each time after interval_s times U(0.5, 1.5) (the random
+  // proposals and configuration changes).
+  void ScheduleEvery(double interval_s, void (ClusterSim::*action)());
   void ProposeRandom();
   void CrashLeaderNow();
   void CrashVoterNow();
-  void ScheduleNextConfChange();
   void RandomConfChange();
   void CheckCommitQuorum(const RawNode& leader, const ConfState& before, std::uint64_t index, const Entry& e);
   void Violation(const std::string& property, const std::string& details);
@@ -219,6 +220,8 @@ class ClusterSim {
   void CheckLeaderCompleteness(const RawNode& raw, const std::string& who);
   void CheckStateMachine(Node& n, const NodeDriver& d, const std::string& who);
   void CheckTap(int node);
+  // The first committed application entry strictly between two indices (0: none seen).
+  std::uint64_t SkippedApplication(std::uint64_t after, std::uint64_t before) const;
   double Uniform(double lo, double hi);
   bool Chance(double p);
 
