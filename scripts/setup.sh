@@ -21,8 +21,9 @@ PACKAGES=(
   libwebsockets-dev
   # command line, netfilter queue (userspace netem fallback)
   libcli11-dev libnetfilter-queue-dev
-  # tests and micro-benchmarks (swarmbox-microbench)
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and micro-benchmarks (swarmbox-microbench); universal-ctags: the function-length check
+  # (scripts/long_functions.sh, ctest HouseFunctionLength)
+  libgtest-dev libgmock-dev libbenchmark-dev universal-ctags
   # the page of the live view in a real browser (tests/js/page_check.mjs, headless)
   chromium
   # containers, networks, hosts (procps: pgrep in netns_host.sh)
