@@ -1,5 +1,5 @@
 # swarmbox_add_test(NAME <name> SOURCES <files...> LIBS <targets...> [LABELS <labels...>]
-#                   [TIMEOUT <s>] [RESOURCE_LOCK <names...>] [OPTIMIZED])
+#                   [TIMEOUT <s>] [RESOURCE_LOCK <names...>] [OPTIMIZED] [SERIAL])
 # Builds one GoogleTest executable and registers each of its TEST()s with CTest
 # (gtest_discover_tests), so ctest's summary counts test cases, not binaries.
 # Labels: "unit" (pure logic, fast, default), "integration" (processes over the bus on loopback),
@@ -10,7 +10,8 @@
 # lives in the libraries, built at the build type's level (-O2). GoogleTest's macros make test
 # sources the slowest to compile (runner_test.cpp: 21.0 s at -O2 -g1, 13.3 s at -O1 -g1), and test
 # sources are two thirds of the build. OPTIMIZED keeps the build type's level, for a test whose own
-# sources do heavy numeric work.
+# sources do heavy numeric work. SERIAL (CTest RUN_SERIAL): nothing else of the suite runs beside
+# the test, for the ones that time packets to a millisecond (the netns delayer tests).
 include(GoogleTest)
 if(NOT TARGET swarmbox_unit_tests)
   add_custom_target(swarmbox_unit_tests)
@@ -32,7 +33,7 @@ function(swarmbox_test_cost out labels)
 endfunction()
 
 function(swarmbox_add_test)
-  cmake_parse_arguments(T "OPTIMIZED" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS;RESOURCE_LOCK" ${ARGN})
+  cmake_parse_arguments(T "OPTIMIZED;SERIAL" "NAME;TIMEOUT" "SOURCES;LIBS;LABELS;RESOURCE_LOCK" ${ARGN})
   if(NOT T_LABELS)
     set(T_LABELS unit)
   endif()
@@ -59,6 +60,9 @@ function(swarmbox_add_test)
   set(lock_prop "")
   if(T_RESOURCE_LOCK)
     set(lock_prop " RESOURCE_LOCK \"${T_RESOURCE_LOCK}\"")
+  endif()
+  if(T_SERIAL)
+    string(APPEND lock_prop " RUN_SERIAL ON")
   endif()
   swarmbox_test_cost(cost "${T_LABELS}")
   file(WRITE ${label_file}
