@@ -12,9 +12,14 @@
 // depth_bias_median_m the median of depth - truth (a matcher that locks on whole pixels of
 // disparity reads far surfaces too near or too far).
 // render_ms: both views; sgbm_ms: the matcher on the pair (one thread each, this machine).
+// pair_fnv: a 64-bit FNV-1a hash of the left, right and truth-depth images' bytes, so that a
+// change to the renderer that must not change its output (a faster ray march) can be checked by
+// diffing two runs' lines without the timing fields.
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -27,6 +32,18 @@
 namespace {
 
 using swarmbox::physics::StereoSurface;
+
+// FNV-1a over the bytes of `images` (each continuous, as the renderer allocates them).
+std::uint64_t PairHash(std::initializer_list<const cv::Mat*> images) {
+  constexpr std::uint64_t kFnvOffset = 14695981039346656037ULL, kFnvPrime = 1099511628211ULL;
+  std::uint64_t h = kFnvOffset;
+  for (const cv::Mat* m : images) {
+    const cv::Mat c = m->isContinuous() ? *m : m->clone();
+    const auto* p = c.ptr<unsigned char>(0);
+    for (std::size_t i = 0, n = c.total() * c.elemSize(); i < n; ++i) h = (h ^ p[i]) * kFnvPrime;
+  }
+  return h;
+}
 
 double Quantile(std::vector<double>* v, double q) {
   if (v->empty()) return 0;
@@ -79,8 +96,9 @@ int RunStereoBench(const swarmbox::bench::Args& args) {
         const double med = Quantile(&err, 0.5), p90 = Quantile(&err, 0.9), bias = Quantile(&signed_err, 0.5);
         std::printf(
             "suite=stereo surface=%s projector=%s range_m=%g fill_rate=%.3f depth_err_median_m=%.3f "
-            "depth_err_p90_m=%.3f depth_bias_median_m=%.3f render_ms=%.1f sgbm_ms=%.1f\n",
+            "depth_err_p90_m=%.3f depth_bias_median_m=%.3f pair_fnv=%016llx render_ms=%.1f sgbm_ms=%.1f\n",
             swarmbox::physics::StereoSurfaceName(surface), projector ? "on" : "off", range, fill, med, p90, bias,
+            static_cast<unsigned long long>(PairHash({&frame.left, &frame.right, &frame.depth_truth_m})),
             std::chrono::duration<double, std::milli>(t1 - t0).count(),
             std::chrono::duration<double, std::milli>(t2 - t1).count());
         std::fflush(stdout);

@@ -2,6 +2,7 @@
 // parallax, truth depth and projector dots.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -180,6 +181,63 @@ TEST(StereoRenderer, SameSeedSameImages) {
   EXPECT_EQ(cv::norm(a.right, b.right, cv::NORM_L1), 0.0);
   renderer.Render(body, spec, 10, &b);
   EXPECT_GT(cv::norm(a.left, b.left, cv::NORM_L1), 0.0);  // another noise draw
+}
+
+// The renderer's ray march as the reference, step for step: from the highest cell's level down in
+// steps of about a cell, then a secant. A faster march (issue #23: a max-height pyramid that skips
+// samples it proves above the surface) must give these depths to the bit, so that the images and
+// the benchmark's figures do not change either.
+double PlainMarch(const StereoScene& s, const Vec3& centre, const Vec3& d) {
+  constexpr double kNearClip_m = 0.05, kEndMargin_m = 1e-3;  // stereo_renderer.cpp's
+  const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
+  const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
+  double prev_t = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z), prev_f = 1.0;
+  for (double t = prev_t; t <= t_end + dt; t += dt) {
+    const double tt = std::min(t, t_end);
+    const double fz = centre.z + tt * d.z - s.HeightAt(centre.x + tt * d.x, centre.y + tt * d.y);
+    if (fz <= 0) return fz == prev_f ? tt : prev_t + (tt - prev_t) * prev_f / (prev_f - fz);
+    prev_t = tt;
+    prev_f = fz;
+  }
+  return t_end;
+}
+
+// Rubble (heaps, chunks, columns) seen obliquely from 2.5 m above its highest cell, so that rays
+// graze heaps, pass over tiles of every pyramid level and leave the grid: every left pixel's
+// truth depth is the reference march's through the same ray (the renderer's ray set-up, repeated).
+TEST(StereoRenderer, TruthDepthIsTheReferenceMarchsToTheBit) {
+  StereoScene scene = MakeSurfaceScene(StereoSurface::kRubble, 12.0, 5);
+  AddBox(&scene, {1, -1, 0}, {0.5, 0.5, 0}, 3.0, 0.5);  // a column up past the camera's level
+  scene.UpdateHeightRange();
+  StereoSpec spec;
+  spec.enabled = true;
+  spec.width_px = 160;
+  spec.height_px = 100;
+  Pose body;
+  body.position_m = {0.5, -0.3, scene.max_height_m + 2.5};
+  const double roll = 0.5, yaw = 0.3;  // yaw about z, then roll about body x: a tilted view
+  body.attitude = {std::cos(yaw / 2) * std::cos(roll / 2), std::cos(yaw / 2) * std::sin(roll / 2),
+                   std::sin(yaw / 2) * std::sin(roll / 2), std::sin(yaw / 2) * std::cos(roll / 2)};
+  StereoRenderer renderer(&scene);
+  StereoFrame frame;
+  renderer.Render(body, spec, 1, &frame);
+  const Vec3 ex = Rotate(body.attitude, Vec3{0, -1, 0}), ey = Rotate(body.attitude, Vec3{-1, 0, 0}),
+             ez = Rotate(body.attitude, Vec3{0, 0, -1});
+  const Vec3 mid = body.position_m + Rotate(body.attitude, spec.offset_m);
+  const Vec3 left = mid - ex * (spec.baseline_m / 2);
+  const double f = spec.FocalPx(), cx = spec.width_px / 2.0, cy = spec.height_px / 2.0;
+  int compared = 0, differ = 0;
+  for (int v = 0; v < spec.height_px; ++v) {
+    for (int u = 0; u < spec.width_px; ++u) {
+      const double xn = (u + 0.5 - cx) / f, yn = (v + 0.5 - cy) / f;
+      const Vec3 d{ex.x * xn + ey.x * yn + ez.x, ex.y * xn + ey.y * yn + ez.y, ex.z * xn + ey.z * yn + ez.z};
+      if (d.z > -1e-6) continue;  // the renderer's sky
+      ++compared;
+      if (frame.depth_truth_m.at<float>(v, u) != static_cast<float>(PlainMarch(scene, left, d))) ++differ;
+    }
+  }
+  EXPECT_GT(compared, spec.width_px * spec.height_px / 2);
+  EXPECT_EQ(differ, 0) << "of " << compared << " pixels";
 }
 
 }  // namespace
