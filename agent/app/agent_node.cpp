@@ -458,9 +458,10 @@ bool AgentNode::Done() const {
 
 // One wait for the next sample. The timeout counts the time spent waiting, each slice at most its
 // own length: a process stopped (SIGSTOP, docker pause) or starved in the middle of a slice does
-// not find its deadline gone when it resumes. After the first sample the bound is stall_timeout;
-// before it, the wait is for a sign of the server (server_wait.hpp): each sim/status message of
-// its start starts it afresh.
+// not find its deadline gone when it resumes. After the first sample the bound is stall_timeout,
+// started afresh by each sim/status `joining` (the server waits for other drones); before it, the
+// wait is for a sign of the server (server_wait.hpp): each sim/status message of its start starts
+// it afresh.
 class AgentNode::SampleWait {
  public:
   SampleWait(bool got_any, const AgentOptions& o)
@@ -481,6 +482,12 @@ class AgentNode::SampleWait {
              bus::Subscriber<bus::Event>& status_sub, bus::Event& status) {
     if (got_any_) {
       budget_.Spend(elapsed, slice);
+      // The server's start still going on (sim/status `joining`): a drone that joined early has
+      // its first sample and then none until every drone has joined, which at 100 drones takes
+      // longer than the stall timeout. That pause is the start's, not a stall: wait afresh.
+      while (status_sub.Take(status)) {
+        if (status.name == "joining") budget_ = WaitBudget(timeout_);
+      }
       return;
     }
     server_.Spend(elapsed, slice);
