@@ -14,6 +14,7 @@
 
 #include "swarm_run.hpp"
 #include "swarmbox/common/yaml.hpp"
+#include "swarmbox/docker/remove_labelled.hpp"
 
 namespace swarmbox::swarm {
 namespace {
@@ -23,6 +24,36 @@ namespace {
 // no start of more than about 31 agents completed on this host.
 constexpr int kScouts = 49;
 constexpr double kSimS = 25.0;
+
+// Docker 20.10 (Debian 12's docker.io) can lose one decrement of a network's stored endpoint count
+// when many of its containers exit at once: the network then refuses removal with "has active
+// endpoints" though nothing is attached, until dockerd restarts (its log then says "Fixing
+// inconsistent endpoint_cnt ... Expected=0, Actual=1"; moby#43286, moby#42119). It hit this
+// 50-container teardown once in a CI run (2026-11-27). A network the run left passes only when it
+// is exactly that: no container attached, the engine still refusing with that message, and the
+// runner's result naming it as a problem with the advice (`swarmbox gc` after a restart).
+void ExpectOnlyTheEnginesStaleEndpoint(docker::DockerApi& api, const docker::NetworkInfo& network,
+                                       const std::vector<std::string>& problems) {
+  auto info = api.InspectNetwork(network.id);
+  ASSERT_TRUE(info) << info.error().ToString();
+  EXPECT_TRUE(info->container_ids.empty())
+      << "network " << network.name << " left with " << info->container_ids.size() << " endpoints";
+  const Status again = api.RemoveNetwork(network.id);
+  if (again) {
+    ADD_FAILURE() << "network " << network.name << " was left though the engine removes it";
+    return;
+  }
+  EXPECT_TRUE(docker::IsStaleEndpointRefusal(again)) << again.error().ToString();
+  bool reported = false;
+  for (const std::string& p : problems) {
+    reported = reported || (p.find(network.name) != std::string::npos &&
+                            p.find("moby#43286") != std::string::npos);
+  }
+  EXPECT_TRUE(reported) << "the runner did not report network " << network.name << " as left";
+  std::printf("SwarmE2e: network %s kept by the engine's stale endpoint count (moby#43286), "
+              "reported by the runner; removed by `swarmbox gc` after a dockerd restart\n",
+              network.name.c_str());
+}
 
 TEST(SwarmE2e, FiftyDronesJoinElectALeaderLoseNoneAndCleanUp) {
   auto api = ConnectDocker();
@@ -67,7 +98,7 @@ TEST(SwarmE2e, FiftyDronesJoinElectALeaderLoseNoneAndCleanUp) {
   for (const std::string& leader : leaders) EXPECT_EQ(voters.count(leader), 1u) << leader << " is no voter";
 
   // Nothing labelled with the run stays (the runner removed it; RunSwarmTrial's sweep found nothing
-  // it could not remove).
+  // it could not remove), apart from a network the engine itself will not let go of (above).
   docker::LabelSelector mine;
   mine.equals[std::string(docker::kLabelRun)] = run->outcome.result.run_id;
   auto containers = (*api)->ListContainers(mine, /*all=*/true);
@@ -75,7 +106,9 @@ TEST(SwarmE2e, FiftyDronesJoinElectALeaderLoseNoneAndCleanUp) {
   EXPECT_TRUE(containers->empty());
   auto networks = (*api)->ListNetworks(mine);
   ASSERT_TRUE(networks) << networks.error().ToString();
-  EXPECT_TRUE(networks->empty());
+  for (const docker::NetworkInfo& n : *networks) {
+    ExpectOnlyTheEnginesStaleEndpoint(**api, n, run->outcome.result.problems);
+  }
   if (!HasFailure()) std::filesystem::remove_all(run->outcome.trial_dir);
 }
 
