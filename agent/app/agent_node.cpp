@@ -458,15 +458,18 @@ bool AgentNode::Done() const {
 
 // One wait for the next sample. The timeout counts the time spent waiting, each slice at most its
 // own length: a process stopped (SIGSTOP, docker pause) or starved in the middle of a slice does
-// not find its deadline gone when it resumes. After the first sample the bound is stall_timeout,
-// started afresh by each sim/status `joining` (the server waits for other drones); before it, the
-// wait is for a sign of the server (server_wait.hpp): each sim/status message of its start starts
-// it afresh.
+// not find its deadline gone when it resumes. Before the first sample the wait is for a sign of
+// the server (server_wait.hpp): each sim/status message of its start starts it afresh. After it,
+// each sim/status `joining` (the server waits for other drones) starts the wait afresh too, and
+// the bound is the start's patience (first_sample_timeout) while the lockstep is still at its
+// first step, stall_timeout once it has moved: at 100 drones on a loaded host the server's start
+// itself can pause for longer than a stall timeout (2026-11-27, load ~70: 10-12 s between two of
+// its joining lines, and the three drones that had joined gave up after 5 s).
 class AgentNode::SampleWait {
  public:
-  SampleWait(bool got_any, const AgentOptions& o)
+  SampleWait(bool got_any, bool lockstep_moved, const AgentOptions& o)
       : got_any_(got_any),
-        timeout_(got_any ? o.stall_timeout : o.first_sample_timeout),
+        timeout_(got_any && lockstep_moved ? o.stall_timeout : o.first_sample_timeout),
         budget_(timeout_),
         server_(o.first_sample_timeout, o.name) {}
 
@@ -507,7 +510,7 @@ Status AgentNode::Run() {
   bus::Event status;
   bool got_any = false;
   while (true) {
-    SampleWait wait(got_any, options_);
+    SampleWait wait(got_any, have_step_ && last_step_ > 0, options_);
     auto waited = WaitForSample(wait, msg, status);
     if (!waited) return waited.error();
     if (*waited == Waited::kStopped) return Ok{};
