@@ -258,7 +258,8 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
     argv.insert(argv.end(), {"--mesh-interface", std::string(kMeshInterface),
                              "--mesh-domain", std::to_string(kMeshDomain)});
   }
-  argv.insert(argv.end(), {"--sample-timeout", ShortestNumber(kAgentStartPatienceS)});
+  argv.insert(argv.end(), {"--sample-timeout", ShortestNumber(kAgentStartPatienceS),
+                           "--stall-timeout", ShortestNumber(AgentStallTimeoutS(spec.drones.size()))});
   argv.insert(argv.end(), {"--start", ShortestNumber(d.pose[0]) + "," + ShortestNumber(d.pose[1]) + "," +
                                           ShortestNumber(d.pose[2])});
   AppendRaftFlags(spec, &argv);
@@ -384,6 +385,12 @@ std::string CycloneUriFor(std::string_view interface, int participant_index) {
   // The agents' and the physics server's own configuration (swarmbox/bus/cyclone_config.hpp), so a
   // program the runner starts discovers and fragments as they do.
   return bus::CycloneXml({.interface = std::string(interface), .participant_index = participant_index});
+}
+
+double AgentStallTimeoutS(std::size_t drones) {
+  constexpr double kBaseS = 5.0;
+  constexpr double kPerDroneS = 0.15;
+  return kBaseS + kPerDroneS * static_cast<double>(drones);
 }
 
 dsl::Duration DefaultWallGuard(const dsl::TrialSpec& spec) {

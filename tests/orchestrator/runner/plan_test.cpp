@@ -146,6 +146,15 @@ TEST_F(PlanTest, AgentsGetTheRaftMembersSeedTimingsAndTheirMission) {
   EXPECT_EQ(value_of("--ping-peers"), "3");
   EXPECT_EQ(value_of("--sim-interface"), "eth0");
   EXPECT_EQ(value_of("--mesh-interface"), "eth1");
+  // The start's patience, and the stall bound for 4 drones: 5 s + 0.15 s per drone.
+  EXPECT_EQ(value_of("--sample-timeout"), "60");
+  EXPECT_EQ(value_of("--stall-timeout"), "5.6");
+}
+
+TEST(AgentStallTimeout, GrowsWithTheFleet) {
+  EXPECT_DOUBLE_EQ(AgentStallTimeoutS(1), 5.15);
+  EXPECT_DOUBLE_EQ(AgentStallTimeoutS(10), 6.5);
+  EXPECT_DOUBLE_EQ(AgentStallTimeoutS(101), 20.15);
 }
 
 // The recording (record:): the physics server writes it where truth.csv is and it is collected the

@@ -161,6 +161,13 @@ inline constexpr double kChannelStepTimeoutS = 30.0;
 // The runner bounds the start itself (the server gives up a drone that has not answered
 // --join-timeout after the latest join, and the trial then names the drones that did not join).
 inline constexpr double kAgentStartPatienceS = 60.0;
+// How long an agent the runner starts waits for its next sample once the lockstep has moved before
+// it ends its run (--stall-timeout; the agent's own default is 5 s): a step waits for every drone,
+// so on a loaded 2-core host a 100-drone server is starved for longer than a small fleet's (at load
+// ~70, 101 agents and a second trial on the host, the three first drones' 5 s ran out at 4 simulated
+// s, 2026-11-27). 5 s plus 0.15 s per drone: 6.5 s for 10 drones, 20 s for 100. The runner sees
+// a dead server by its container's exit; this bound only keeps an agent from flying on without it.
+double AgentStallTimeoutS(std::size_t drones);
 // The external brain's container id: "<drone>-brain".
 std::string BrainId(std::string_view drone);
 // The brain container's DNS alias on sim, which its agent names with --sim-peer: "brain-scout-2"
