@@ -310,7 +310,7 @@ std::string RecipeText(const TrainingOptions& o) {
     << " --trees " << o.forest_trees << " --max-negatives " << o.max_negatives << " --stage1-percentile "
     << o.stage1_percentile << " --hard-negative-rounds " << o.hard_negative_rounds;
   if (o.balance_classes) r << " --balance-classes";
-  if (!o.blob_features) r << " --no-blob-features";
+  if (o.blob_features) r << " --blob-features";
   return r.str();
 }
 

@@ -50,8 +50,9 @@ struct TrainingOptions {
   int hard_negative_rounds = 0;
   int max_hard_negatives = 20000;
   // The second stage also sees each candidate's blob features (swarm/blob_features.hpp: size,
-  // shape, parts, edge orientations); false trains the format-1 layout (window features and score).
-  bool blob_features = true;
+  // shape, parts, edge orientations, model format 2); false (the shipped model's recipe) trains the
+  // format-1 layout (window features and score).
+  bool blob_features = false;
 };
 
 // The options as the trainer's command line (recorded in the model and its JSON report).
