@@ -7,7 +7,7 @@
 //   training lines and gets "recalibrated": true)
 //   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):
 //   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
-//   --stage1-percentile P, --balance-classes, --hard-negative-rounds N
+//   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -61,6 +61,7 @@ constexpr Flag kFlags[] = {
     {"--balance-classes", false, [](const char*, Args* a) { a->options.balance_classes = true; return true; }},
     {"--hard-negative-rounds", true,
      [](const char* v, Args* a) { a->options.hard_negative_rounds = std::stoi(v); return true; }},
+    {"--blob-features", false, [](const char*, Args* a) { a->options.blob_features = true; return true; }},
 };
 
 // The flag named `a` when it is complete at argv[i] (its value, if it takes one, follows).
@@ -79,7 +80,7 @@ int ParseArgs(int argc, char** argv, Args* args) {
       std::fprintf(stderr,
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
-                   "[--balance-classes] [--hard-negative-rounds N]\n");
+                   "[--balance-classes] [--hard-negative-rounds N] [--blob-features]\n");
       return kUsageError;
     }
     const char* value = flag->takes_value ? argv[++i] : nullptr;

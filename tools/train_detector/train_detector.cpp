@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "swarmbox/swarm/blob_features.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
 #include "swarmbox/swarm/victim_detector.hpp"
 
@@ -57,18 +58,19 @@ std::optional<Eigen::Vector2d> CanonicalOf(const SceneVictim& v, const Scene& s,
 }
 
 struct Labelled {
-  std::vector<float> x;  // rows of kForestFeatures (stage 2) or kWindowFeatures (stage 1)
+  std::vector<float> x;  // rows of the model's forest_inputs() (stage 2) or kWindowFeatures (stage 1)
+  std::vector<float> blob;  // stage 1 with blob features: kBlobFeatures per row
   std::vector<int> y;
   std::vector<float> target;  // stage 1: regression target (1 centred, kShiftedTarget shifted, -1)
   int rows() const { return static_cast<int>(y.size()); }
 };
 
-// The second stage: cv::ml::RTrees on kForestFeatures rows, seeded; with balance_classes the
+// The second stage: cv::ml::RTrees on rows of `inputs` features, seeded; with balance_classes the
 // classes weighted equally (priors inverse to their counts: ten negatives or more to a positive).
-Result<cv::Ptr<cv::ml::RTrees>> TrainForest(Labelled& d, const TrainingOptions& o) {
+Result<cv::Ptr<cv::ml::RTrees>> TrainForest(Labelled& d, int inputs, const TrainingOptions& o) {
   int pos = 0;
   for (int y : d.y) pos += y;
-  cv::Mat x(d.rows(), swarm::kForestFeatures, CV_32F, d.x.data());
+  cv::Mat x(d.rows(), inputs, CV_32F, d.x.data());
   cv::Mat y(d.rows(), 1, CV_32S, d.y.data());
   cv::Ptr<cv::ml::RTrees> forest = cv::ml::RTrees::create();
   forest->setMaxDepth(o.forest_depth);
@@ -302,6 +304,16 @@ std::pair<double, double> FitPlatt(const std::vector<double>& v, const std::vect
 
 }  // namespace
 
+std::string RecipeText(const TrainingOptions& o) {
+  std::ostringstream r;
+  r << "swarmbox-train-detector --training-sets " << o.training_seeds.size() << " --scenes-per-set " << o.scenes_per_set
+    << " --trees " << o.forest_trees << " --max-negatives " << o.max_negatives << " --stage1-percentile "
+    << o.stage1_percentile << " --hard-negative-rounds " << o.hard_negative_rounds;
+  if (o.balance_classes) r << " --balance-classes";
+  if (o.blob_features) r << " --blob-features";
+  return r.str();
+}
+
 TrainingOptions DefaultTrainingOptions() {
   TrainingOptions o;
   for (std::uint64_t i = 1; i <= 8; ++i) o.training_seeds.push_back(7'000'000 + i);
@@ -480,41 +492,60 @@ struct Training {
   swarm::VictimDetectorModel model = {};
 };
 
-// One scene's stage 1 samples: each must-detect person's window, centred (its row into *centred)
-// and shifted by a cell each way, and random negatives away from every person.
-void AddStage1Samples(const Scene& s, std::mt19937_64& rng, swarm::ChannelMaps& maps, Labelled* s1,
-                      std::vector<std::size_t>* centred) {
-  std::vector<float> f(swarm::kWindowFeatures);
-  const double scale = swarm::kCanonicalPxPerM / PixelsPerMetre(s);
-  swarm::ComputeChannels(BgrOf(s), scale, &maps);
-  const int rows = maps.rows() - swarm::kWindowCells + 1, cols = maps.cols() - swarm::kWindowCells + 1;
-  if (rows <= 0 || cols <= 0) return;
-  auto add = [&](int r, int c, int label, float target) {
+// Windows of one scene into stage 1's samples, with their blob features when `blob` is set (the
+// second stage's positives are taken from these rows too).
+struct Stage1Sampler {
+  const swarm::ChannelMaps& maps;
+  swarm::BlobFeatureExtractor* blob;  // null: a model without blob features
+  double scale;                       // canonical pixels per frame pixel
+  int rows, cols;                     // window positions
+  Labelled* s1;
+  std::vector<float> window = std::vector<float>(swarm::kWindowFeatures);
+  std::vector<float> shape = std::vector<float>(swarm::kBlobFeatures);
+
+  bool Add(int r, int c, int label, float target) {
     if (r < 0 || c < 0 || r >= rows || c >= cols) return false;
-    swarm::WindowFeatures(maps, r, c, f.data());
-    s1->x.insert(s1->x.end(), f.begin(), f.end());
+    swarm::WindowFeatures(maps, r, c, window.data());
+    s1->x.insert(s1->x.end(), window.begin(), window.end());
     s1->y.push_back(label);
     s1->target.push_back(target);
+    if (blob != nullptr) {
+      blob->Extract({swarm::CanonicalToInput(swarm::WindowCentreCanonical(c), scale),
+                     swarm::CanonicalToInput(swarm::WindowCentreCanonical(r), scale)},
+                    shape.data());
+      s1->blob.insert(s1->blob.end(), shape.begin(), shape.end());
+    }
     return true;
-  };
+  }
+};
+
+// One scene's stage 1 samples: each must-detect person's window, centred (its row into *centred)
+// and shifted by a cell each way, and random negatives away from every person.
+void AddStage1Samples(const Scene& s, std::mt19937_64& rng, swarm::ChannelMaps& maps, swarm::BlobFeatureExtractor* blob,
+                      Labelled* s1, std::vector<std::size_t>* centred) {
+  const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+  swarm::ComputeChannels(BgrOf(s), scale, &maps);
+  if (blob != nullptr) blob->SetFrame(BgrOf(s), ppm);
+  Stage1Sampler add{maps, blob, scale, maps.rows() - swarm::kWindowCells + 1, maps.cols() - swarm::kWindowCells + 1, s1};
+  if (add.rows <= 0 || add.cols <= 0) return;
   for (const SceneVictim& v : s.victims) {
     if (v.visible_fraction < kMustDetectFraction) continue;
     const std::optional<Eigen::Vector2d> c = CanonicalOf(v, s, scale);
     if (!c) continue;
     const int r0 = static_cast<int>(std::lround(c->y() / swarm::kShrink - swarm::kWindowCells / 2.0));
     const int c0 = static_cast<int>(std::lround(c->x() / swarm::kShrink - swarm::kWindowCells / 2.0));
-    if (add(r0, c0, 1, 1.0f)) centred->push_back(s1->y.size() - 1);
-    add(r0 - 1, c0, 1, kShiftedTarget);
-    add(r0 + 1, c0, 1, kShiftedTarget);
-    add(r0, c0 - 1, 1, kShiftedTarget);
-    add(r0, c0 + 1, 1, kShiftedTarget);
+    if (add.Add(r0, c0, 1, 1.0f)) centred->push_back(s1->y.size() - 1);
+    add.Add(r0 - 1, c0, 1, kShiftedTarget);
+    add.Add(r0 + 1, c0, 1, kShiftedTarget);
+    add.Add(r0, c0 - 1, 1, kShiftedTarget);
+    add.Add(r0, c0 + 1, 1, kShiftedTarget);
   }
-  std::uniform_int_distribution<int> rr(0, rows - 1), cc(0, cols - 1);
+  std::uniform_int_distribution<int> rr(0, add.rows - 1), cc(0, add.cols - 1);
   for (int k = 0, tries = 0; k < kRandomNegativesPerScene && tries < 400; ++tries) {
     const int r = rr(rng), c = cc(rng);
     const Eigen::Vector2d centre(swarm::WindowCentreCanonical(c), swarm::WindowCentreCanonical(r));
     if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
-    add(r, c, 0, -1.0f);
+    add.Add(r, c, 0, -1.0f);
     ++k;
   }
 }
@@ -541,12 +572,16 @@ void FitStage1(Training& t, const Labelled& s1, const std::vector<std::size_t>& 
 // first-stage score.
 Labelled Stage2Positives(const swarm::VictimDetectorModel& model, const Labelled& s1) {
   Labelled s2;
-  std::vector<float> g(swarm::kForestFeatures);
+  std::vector<float> g(static_cast<std::size_t>(model.forest_inputs()));
   for (std::size_t i = 0; i < s1.y.size(); ++i) {
     if (!s1.y[i]) continue;
     const float* x = &s1.x[i * swarm::kWindowFeatures];
     std::copy(x, x + swarm::kWindowFeatures, g.begin());
     g[swarm::kWindowFeatures] = static_cast<float>(model.LinearScore(x));
+    if (model.blob_features > 0) {
+      const float* b = &s1.blob[i * swarm::kBlobFeatures];
+      std::copy(b, b + swarm::kBlobFeatures, g.begin() + swarm::kForestFeatures);
+    }
     s2.x.insert(s2.x.end(), g.begin(), g.end());
     s2.y.push_back(1);
   }
@@ -559,10 +594,13 @@ Labelled TrainStage1(Training& t, const std::vector<Scene>& train) {
   t.model.calibration_seeds = t.o.calibration_seeds;
   t.model.SetLinear(std::vector<double>(swarm::kWindowFeatures, 0.0), 0.0);
   t.model.forest = cv::ml::RTrees::create();  // replaced below; the detector needs one to exist
+  t.model.blob_features = t.o.blob_features ? swarm::kBlobFeatures : 0;
+  t.model.recipe = RecipeText(t.o);
   Labelled s1;
   std::vector<std::size_t> centred;  // rows of s1 that are unshifted positives
   swarm::ChannelMaps maps;
-  for (const Scene& s : train) AddStage1Samples(s, t.rng, maps, &s1, &centred);
+  swarm::BlobFeatureExtractor blob;
+  for (const Scene& s : train) AddStage1Samples(s, t.rng, maps, t.o.blob_features ? &blob : nullptr, &s1, &centred);
   FitStage1(t, s1, centred);
   return Stage2Positives(t.model, s1);
 }
@@ -572,7 +610,7 @@ Labelled TrainStage1(Training& t, const std::vector<Scene>& train) {
 void AddStage2Candidates(const Training& t, const std::vector<Scene>& train, Labelled* s2, Labelled* neg) {
   auto shared = std::make_shared<swarm::VictimDetectorModel>(t.model);
   swarm::VictimDetector first(shared, {});
-  std::vector<float> g(swarm::kForestFeatures);
+  std::vector<float> g(static_cast<std::size_t>(t.model.forest_inputs()));
   for (const Scene& s : train) {
     const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
     // Every local maximum, whatever its score (the first stage alone is precise on these scenes:
@@ -586,8 +624,7 @@ void AddStage2Candidates(const Training& t, const std::vector<Scene>& train, Lab
       if (dist <= kPositiveRadiusM && must) label = 1;
       if (dist >= kNegativeRadiusM) label = 0;
       if (label < 0) continue;
-      swarm::WindowFeatures(first.channels(), c.row, c.col, g.data());
-      g[swarm::kWindowFeatures] = static_cast<float>(c.score);
+      first.ForestFeatures(c, g.data());
       Labelled& dst = label ? *s2 : *neg;
       dst.x.insert(dst.x.end(), g.begin(), g.end());
       dst.y.push_back(label);
@@ -604,9 +641,9 @@ Status CollectStage2(Training& t, const std::vector<Scene>& train, Labelled* s2)
   std::shuffle(order.begin(), order.end(), t.rng);
   if (static_cast<int>(order.size()) > t.o.max_negatives) order.resize(static_cast<std::size_t>(t.o.max_negatives));
   t.report->stage2_positives = s2->rows();
+  const std::ptrdiff_t inputs = t.model.forest_inputs();
   for (int i : order) {
-    s2->x.insert(s2->x.end(), neg.x.begin() + static_cast<std::ptrdiff_t>(i) * swarm::kForestFeatures,
-                 neg.x.begin() + static_cast<std::ptrdiff_t>(i + 1) * swarm::kForestFeatures);
+    s2->x.insert(s2->x.end(), neg.x.begin() + i * inputs, neg.x.begin() + (i + 1) * inputs);
     s2->y.push_back(0);
   }
   t.report->stage2_negatives = static_cast<int>(order.size());
@@ -619,7 +656,7 @@ Status CollectStage2(Training& t, const std::vector<Scene>& train, Labelled* s2)
 }
 
 Status TrainModelForest(Training& t, Labelled& s2) {
-  Result<cv::Ptr<cv::ml::RTrees>> forest = TrainForest(s2, t.o);
+  Result<cv::Ptr<cv::ml::RTrees>> forest = TrainForest(s2, t.model.forest_inputs(), t.o);
   if (!forest) return forest.error();
   t.model.forest = *forest;
   t.model.FlattenForest();
@@ -637,7 +674,7 @@ void MineHardNegatives(Training& t, const std::vector<Scene>& train, int round, 
   raw.partial_confidence_cap = 1.0;
   raw.nms_radius_m = 0.0;
   swarm::VictimDetector det(mined, raw);
-  std::vector<float> g(swarm::kForestFeatures);
+  std::vector<float> g(static_cast<std::size_t>(t.model.forest_inputs()));
   int hard = 0;
   for (const Scene& s : train) {
     const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
@@ -646,8 +683,7 @@ void MineHardNegatives(Training& t, const std::vector<Scene>& train, int round, 
       const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_col,
                                    swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_row);
       if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
-      swarm::WindowFeatures(det.channels(), c.row, c.col, g.data());
-      g[swarm::kWindowFeatures] = static_cast<float>(c.score);
+      det.ForestFeatures(c, g.data());
       if (t.model.Votes(g.data()) < kHardNegativeVotes) continue;
       if (hard >= t.o.max_hard_negatives) break;
       s2->x.insert(s2->x.end(), g.begin(), g.end());
@@ -663,7 +699,7 @@ void MineHardNegatives(Training& t, const std::vector<Scene>& train, int round, 
 
 // The flattened forest decides as OpenCV's own prediction.
 Status CheckFlattenedForest(const Training& t, Labelled& s2) {
-  cv::Mat x(s2.rows(), swarm::kForestFeatures, CV_32F, s2.x.data());
+  cv::Mat x(s2.rows(), t.model.forest_inputs(), CV_32F, s2.x.data());
   cv::Mat votes;
   t.model.forest->getVotes(x, votes, 0);
   int person_col = votes.at<int>(0, 0) == 1 ? 0 : 1, disagree = 0;
@@ -715,7 +751,12 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
   };
   j << "{\n  \"model\": \"victim_detector.yml.gz\",\n";
   j << "  \"method\": \"aggregated channel features (Luv, gradient magnitude, 4 orientations; 0.25 m cells, "
-       "3 x 3 m windows at 8 px/m), ridge linear first stage, cv::ml::RTrees second stage, Platt sigmoid\",\n";
+       "3 x 3 m windows at 8 px/m), ridge linear first stage, cv::ml::RTrees second stage"
+    << (model.blob_features > 0 ? " on the window, the first-stage score and " + std::to_string(model.blob_features) +
+                                      " blob features (size, shape, parts, edge orientations; 16 px/m)"
+                                : std::string())
+    << ", Platt sigmoid\",\n";
+  j << "  \"recipe\": \"" << model.recipe << "\",\n";
   j << "  \"training_seeds\": ";
   list(model.training_seeds);
   j << ",\n  \"calibration_seeds\": ";

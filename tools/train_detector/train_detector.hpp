@@ -49,7 +49,14 @@ struct TrainingOptions {
   // join the negatives (at most max_hard_negatives per round) and the forest is trained again.
   int hard_negative_rounds = 0;
   int max_hard_negatives = 20000;
+  // The second stage also sees each candidate's blob features (swarm/blob_features.hpp: size,
+  // shape, parts, edge orientations, model format 2); false (the shipped model's recipe) trains the
+  // format-1 layout (window features and score).
+  bool blob_features = false;
 };
+
+// The options as the trainer's command line (recorded in the model and its JSON report).
+std::string RecipeText(const TrainingOptions& options);
 
 // The recipe of the shipped model: 8 training sets (7000001-7000008), 2 calibration sets.
 TrainingOptions DefaultTrainingOptions();

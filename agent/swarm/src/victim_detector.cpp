@@ -24,6 +24,31 @@ void SuppressNonMaxima(std::vector<ImageBlob>* blobs, double radius_px, std::vec
   }
 }
 
+// The local maxima of `valid` (its 3 x 3 dilation `dilated`) at or above `threshold`, each peak
+// refined to a fraction of a cell, appended to *out.
+void LocalMaxima(const cv::Mat& valid, const cv::Mat& dilated, double threshold,
+                 std::vector<VictimDetector::Candidate>* out) {
+  const int rows = valid.rows, cols = valid.cols;
+  for (int r = 0; r < rows; ++r) {
+    const float* s = valid.ptr<float>(r);
+    const float* d = dilated.ptr<float>(r);
+    for (int c = 0; c < cols; ++c) {
+      if (s[c] < threshold || s[c] < d[c]) continue;
+      VictimDetector::Candidate cand{r, c, s[c], static_cast<double>(r), static_cast<double>(c)};
+      // Parabolic refinement of the peak along each axis.
+      auto refine = [](double left, double mid, double right) {
+        const double den = left - 2 * mid + right;
+        return den < 0 ? std::clamp(0.5 * (left - right) / den, -0.5, 0.5) : 0.0;
+      };
+      if (c > 0 && c + 1 < cols) cand.sub_col += refine(s[c - 1], s[c], s[c + 1]);
+      if (r > 0 && r + 1 < rows) {
+        cand.sub_row += refine(valid.at<float>(r - 1, c), s[c], valid.at<float>(r + 1, c));
+      }
+      out->push_back(cand);
+    }
+  }
+}
+
 }  // namespace
 
 // VictimDetector(params), with the shipped model, is defined in shipped_model.cpp (its own library,
@@ -40,7 +65,9 @@ const std::vector<VictimDetector::Candidate>& VictimDetector::Candidates(const c
                                                                          int max_candidates, double threshold) {
   SWARMBOX_CHECK(bgr.type() == CV_8UC3 && pixels_per_m > 0);
   candidates_.clear();
-  ComputeChannels(bgr, kCanonicalPxPerM / pixels_per_m, &maps_);
+  scale_ = kCanonicalPxPerM / pixels_per_m;
+  ComputeChannels(bgr, scale_, &maps_);
+  if (model_->blob_features > 0) blob_.SetFrame(bgr, pixels_per_m);
   const int rows = maps_.rows() - kWindowCells + 1, cols = maps_.cols() - kWindowCells + 1;
   if (rows <= 0 || cols <= 0) return candidates_;
   score_.create(maps_.rows(), maps_.cols(), CV_32F);
@@ -52,28 +79,22 @@ const std::vector<VictimDetector::Candidate>& VictimDetector::Candidates(const c
   }
   const cv::Mat valid = score_(cv::Rect(0, 0, cols, rows));
   cv::dilate(valid, dilated_, cv::Mat(), cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(-1e9));
-  for (int r = 0; r < rows; ++r) {
-    const float* s = valid.ptr<float>(r);
-    const float* d = dilated_.ptr<float>(r);
-    for (int c = 0; c < cols; ++c) {
-      if (s[c] < threshold || s[c] < d[c]) continue;
-      Candidate cand{r, c, s[c], static_cast<double>(r), static_cast<double>(c)};
-      // Parabolic refinement of the peak along each axis.
-      auto refine = [](double left, double mid, double right) {
-        const double den = left - 2 * mid + right;
-        return den < 0 ? std::clamp(0.5 * (left - right) / den, -0.5, 0.5) : 0.0;
-      };
-      if (c > 0 && c + 1 < cols) cand.sub_col += refine(s[c - 1], s[c], s[c + 1]);
-      if (r > 0 && r + 1 < rows) {
-        cand.sub_row += refine(valid.at<float>(r - 1, c), s[c], valid.at<float>(r + 1, c));
-      }
-      candidates_.push_back(cand);
-    }
-  }
+  LocalMaxima(valid, dilated_, threshold, &candidates_);
   std::sort(candidates_.begin(), candidates_.end(),
             [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
   if (static_cast<int>(candidates_.size()) > max_candidates) candidates_.resize(static_cast<std::size_t>(max_candidates));
   return candidates_;
+}
+
+Eigen::Vector2d VictimDetector::CentrePx(const Candidate& c) const {
+  return {CanonicalToInput(kShrink * (c.sub_col + kWindowCells / 2.0), scale_),
+          CanonicalToInput(kShrink * (c.sub_row + kWindowCells / 2.0), scale_)};
+}
+
+void VictimDetector::ForestFeatures(const Candidate& c, float* out) {
+  WindowFeatures(maps_, c.row, c.col, out);
+  out[kWindowFeatures] = static_cast<float>(c.score);
+  if (model_->blob_features > 0) blob_.Extract(CentrePx(c), out + kForestFeatures);
 }
 
 void VictimDetector::Detect(const cv::Mat& bgr, double pixels_per_m, std::vector<ImageBlob>* out) {
@@ -104,28 +125,25 @@ void VictimDetector::DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn 
   SWARMBOX_CHECK(bgr.type() == CV_8UC3);
   SWARMBOX_CHECK(pixels_per_m > 0);
   out->clear();
-  const double scale = kCanonicalPxPerM / pixels_per_m;
   const std::vector<Candidate>& cands = Candidates(bgr, pixels_per_m, params_.max_candidates, model_->stage1_threshold);
   if (cands.empty()) return;
   const int n = static_cast<int>(cands.size());
-  samples_.resize(static_cast<std::size_t>(kForestFeatures));
+  samples_.resize(static_cast<std::size_t>(model_->forest_inputs()));
   const double expected_area = params_.person_area_m2 * pixels_per_m * pixels_per_m;
   const double half_px = params_.partial_half_extent_m * pixels_per_m;
   scratch_.clear();
   for (int i = 0; i < n; ++i) {
     const Candidate& c = cands[static_cast<std::size_t>(i)];
-    WindowFeatures(maps_, c.row, c.col, samples_.data());
-    samples_[static_cast<std::size_t>(kWindowFeatures)] = static_cast<float>(c.score);
     ImageBlob b;
+    b.centroid_px = CentrePx(c);
+    const double u = b.centroid_px.x(), v = b.centroid_px.y();
+    if (u < -0.5 || v < -0.5 || u > bgr.cols - 0.5 || v > bgr.rows - 0.5) continue;  // centre off the image
+    if (!keep(b.centroid_px)) continue;
+    ForestFeatures(c, samples_.data());
     b.votes = model_->Votes(samples_.data());
     b.confidence = model_->Probability(b.votes);
     if (b.confidence < params_.min_confidence) continue;
     b.linear_score = c.score;
-    b.centroid_px = {CanonicalToInput(kShrink * (c.sub_col + kWindowCells / 2.0), scale),
-                     CanonicalToInput(kShrink * (c.sub_row + kWindowCells / 2.0), scale)};
-    const double u = b.centroid_px.x(), v = b.centroid_px.y();
-    if (u < -0.5 || v < -0.5 || u > bgr.cols - 0.5 || v > bgr.rows - 0.5) continue;  // centre off the image
-    if (!keep(b.centroid_px)) continue;
     b.expected_area_px = expected_area;
     b.area_px = expected_area;
     b.partial = u < half_px || v < half_px || u > bgr.cols - half_px || v > bgr.rows - half_px;

@@ -8,11 +8,15 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "swarmbox/swarm/blob_features.hpp"
+
 namespace swarmbox::swarm {
 namespace {
 
 constexpr int kCellsPerWindow = kWindowCells * kWindowCells;
-constexpr int kFormatVersion = 1;
+// 2: the blob features after the window features and score (blob_features), and the recipe.
+constexpr int kFormatVersion = 2;
+constexpr int kWindowOnlyFormatVersion = 1;
 
 }  // namespace
 
@@ -162,6 +166,7 @@ Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& pa
     std::vector<double> seeds(model.training_seeds.begin(), model.training_seeds.end());
     std::vector<double> cal(model.calibration_seeds.begin(), model.calibration_seeds.end());
     fs << "training_seeds" << seeds << "calibration_seeds" << cal;
+    fs << "blob_features" << model.blob_features << "recipe" << model.recipe;
     fs << "kernels" << "[";
     for (const cv::Mat& k : model.kernels) fs << k;
     fs << "]";
@@ -176,9 +181,11 @@ Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& pa
 
 namespace {
 
-Result<std::shared_ptr<const VictimDetectorModel>> Read(cv::FileStorage& fs, const std::string& where) {
-  auto m = std::make_shared<VictimDetectorModel>();
-  if (static_cast<int>(fs["format_version"]) != kFormatVersion ||
+// The layout the file was written for (format, scale, cells, channels, blob features) into *m,
+// or the reason it is not this build's.
+Status ReadLayout(cv::FileStorage& fs, const std::string& where, VictimDetectorModel* m) {
+  const int version = static_cast<int>(fs["format_version"]);
+  if ((version != kFormatVersion && version != kWindowOnlyFormatVersion) ||
       static_cast<double>(fs["canonical_px_per_m"]) != kCanonicalPxPerM ||
       static_cast<int>(fs["shrink"]) != kShrink || static_cast<int>(fs["window_cells"]) != kWindowCells ||
       static_cast<int>(fs["channels"]) != kChannels) {
@@ -186,15 +193,19 @@ Result<std::shared_ptr<const VictimDetectorModel>> Read(cv::FileStorage& fs, con
                  "detector model: another format or feature layout than this build (retrain: target train-detector)",
                  where);
   }
-  m->bias = static_cast<double>(fs["bias"]);
-  m->stage1_threshold = static_cast<double>(fs["stage1_threshold"]);
-  m->platt_a = static_cast<double>(fs["platt_a"]);
-  m->platt_b = static_cast<double>(fs["platt_b"]);
-  std::vector<double> seeds, cal;
-  fs["training_seeds"] >> seeds;
-  fs["calibration_seeds"] >> cal;
-  for (double s : seeds) m->training_seeds.push_back(static_cast<std::uint64_t>(s));
-  for (double s : cal) m->calibration_seeds.push_back(static_cast<std::uint64_t>(s));
+  if (version == kFormatVersion) {
+    m->blob_features = static_cast<int>(fs["blob_features"]);
+    m->recipe = static_cast<std::string>(fs["recipe"]);
+  }
+  if (m->blob_features != 0 && m->blob_features != kBlobFeatures) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "detector model: another blob feature layout than this build (retrain: target train-detector)", where);
+  }
+  return Ok{};
+}
+
+// The first stage's kernels into *m.
+Status ReadKernels(cv::FileStorage& fs, const std::string& where, VictimDetectorModel* m) {
   const cv::FileNode kernels = fs["kernels"];
   for (auto it = kernels.begin(); it != kernels.end(); ++it) {
     cv::Mat k;
@@ -207,9 +218,25 @@ Result<std::shared_ptr<const VictimDetectorModel>> Read(cv::FileStorage& fs, con
   if (static_cast<int>(m->kernels.size()) != kChannels) {
     return Error(ErrorCode::kInvalidArgument, "detector model: wrong number of first-stage kernels", where);
   }
+  return Ok{};
+}
+
+Result<std::shared_ptr<const VictimDetectorModel>> Read(cv::FileStorage& fs, const std::string& where) {
+  auto m = std::make_shared<VictimDetectorModel>();
+  SWARMBOX_TRY(ReadLayout(fs, where, m.get()));
+  m->bias = static_cast<double>(fs["bias"]);
+  m->stage1_threshold = static_cast<double>(fs["stage1_threshold"]);
+  m->platt_a = static_cast<double>(fs["platt_a"]);
+  m->platt_b = static_cast<double>(fs["platt_b"]);
+  std::vector<double> seeds, cal;
+  fs["training_seeds"] >> seeds;
+  fs["calibration_seeds"] >> cal;
+  for (double s : seeds) m->training_seeds.push_back(static_cast<std::uint64_t>(s));
+  for (double s : cal) m->calibration_seeds.push_back(static_cast<std::uint64_t>(s));
+  SWARMBOX_TRY(ReadKernels(fs, where, m.get()));
   m->forest = cv::ml::RTrees::create();
   m->forest->read(fs["forest"]);
-  if (!m->forest->isTrained() || m->forest->getVarCount() != kForestFeatures) {
+  if (!m->forest->isTrained() || m->forest->getVarCount() != m->forest_inputs()) {
     return Error(ErrorCode::kInvalidArgument, "detector model: the forest is missing or has the wrong inputs", where);
   }
   m->FlattenForest();

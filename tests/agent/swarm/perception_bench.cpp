@@ -1,7 +1,8 @@
 // swarmbox-bench perception [--seed N] [--scenes K] [--quick] [--model FILE]: the detector's figures
 // on physics-rendered scenes of seed N (never a training or calibration seed of the model: refused),
 // of the shipped model or of a model file train-detector wrote elsewhere (--model: the curves only,
-// to compare a recipe before shipping it; --only altitude:30 runs one case), in the
+// to compare a recipe before shipping it; --only altitude:30 runs one case; --max-candidates N
+// the first stage's cap instead of VictimDetectorParams' default), in the
 // varied look (perception_scenes.hpp: terrains, light, poses, clothing, cover, distractors), one
 // logfmt line per case:
 //   case=altitude     altitude_m=10|20|30|40|60 (30 % of the people partly covered, 2 distractors each)
@@ -70,7 +71,9 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
     }
   }
   cv::setNumThreads(1);
-  VictimDetector detector(model, VictimDetectorParams{});
+  VictimDetectorParams params;
+  params.max_candidates = static_cast<int>(args.GetInt("max-candidates", params.max_candidates));
+  VictimDetector detector(model, params);
   for (const CurveCase& c : cases) {
     swarmbox::Result<std::vector<Scene>> scenes = RenderScenes(c.scenes);
     if (!scenes) {

@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include "perception_scenes.hpp"
+#include "swarmbox/swarm/blob_features.hpp"
+#include "swarmbox/swarm/victim_detector.hpp"
 #include "swarmbox/swarm/victim_detector_model.hpp"
 
 #ifndef SWARMBOX_DETECTOR_MODELS_DIR
@@ -68,7 +70,7 @@ TEST(VictimDetectorModel, TheFlattenedForestVotesAsRTrees) {
     if (n.var >= 0) thresholds.push_back(n.threshold);
   }
   ASSERT_FALSE(thresholds.empty());
-  cv::Mat x(200, kForestFeatures, CV_32F);
+  cv::Mat x(200, m->forest_inputs(), CV_32F);
   std::uniform_int_distribution<std::size_t> pick(0, thresholds.size() - 1);
   for (int i = 0; i < x.rows; ++i) {
     for (int j = 0; j < x.cols; ++j) x.at<float>(i, j) = thresholds[pick(rng)];
@@ -105,6 +107,68 @@ TEST(VictimDetectorModel, AModelOfAnotherLayoutIsRefusedWithTheReason) {
   ASSERT_FALSE(m.ok());
   EXPECT_NE(m.error().message().find("retrain"), std::string::npos) << m.error().ToString();
   EXPECT_FALSE(LoadDetectorModel(path + ".missing").ok());
+}
+
+// A small model with a forest of `inputs` inputs (random data: the file format is under test).
+VictimDetectorModel SmallModel(int inputs, int blob_features) {
+  VictimDetectorModel m;
+  m.SetLinear(std::vector<double>(kWindowFeatures, 0.01), -0.5);
+  cv::Mat x(60, inputs, CV_32F), y(60, 1, CV_32S);
+  cv::theRNG().state = 5;
+  cv::randu(x, 0.0, 1.0);
+  for (int i = 0; i < y.rows; ++i) y.at<int>(i) = i % 2;
+  m.forest = cv::ml::RTrees::create();
+  m.forest->setMaxDepth(3);
+  m.forest->setTermCriteria(cv::TermCriteria(cv::TermCriteria::MAX_ITER, 3, 0));
+  EXPECT_TRUE(m.forest->train(cv::ml::TrainData::create(x, cv::ml::ROW_SAMPLE, y)));
+  m.blob_features = blob_features;
+  m.training_seeds = {7000001};
+  m.calibration_seeds = {7100001};
+  m.recipe = "swarmbox-train-detector --training-sets 1 --trees 3";
+  return m;
+}
+
+std::string ReadAll(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream text;
+  text << f.rdbuf();
+  return text.str();
+}
+
+TEST(VictimDetectorModel, AModelWithBlobFeaturesKeepsThemAndItsRecipeThroughTheFile) {
+  const std::string path = ::testing::TempDir() + "/blob_model.yml";
+  ASSERT_TRUE(SaveDetectorModel(SmallModel(kForestFeatures + kBlobFeatures, kBlobFeatures), path).ok());
+  Result<std::shared_ptr<const VictimDetectorModel>> m = LoadDetectorModel(path);
+  ASSERT_TRUE(m.ok()) << m.error().ToString();
+  EXPECT_EQ((*m)->blob_features, kBlobFeatures);
+  EXPECT_EQ((*m)->forest_inputs(), kForestFeatures + kBlobFeatures);
+  EXPECT_EQ((*m)->recipe, "swarmbox-train-detector --training-sets 1 --trees 3");
+}
+
+TEST(VictimDetectorModel, AFormatOneModelStillLoadsAndRunsWithoutBlobFeatures) {
+  const std::string path = ::testing::TempDir() + "/format1_model.yml";
+  ASSERT_TRUE(SaveDetectorModel(SmallModel(kForestFeatures, 0), path).ok());
+  std::string text = ReadAll(path);
+  const std::size_t at = text.find("format_version: 2");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 17, "format_version: 1");
+  std::ofstream(path) << text;
+  Result<std::shared_ptr<const VictimDetectorModel>> m = LoadDetectorModel(path);
+  ASSERT_TRUE(m.ok()) << m.error().ToString();
+  EXPECT_EQ((*m)->blob_features, 0);
+  VictimDetector det(*m, VictimDetectorParams{});
+  cv::Mat img(120, 160, CV_8UC3, cv::Scalar(60, 110, 80));
+  std::vector<ImageBlob> blobs;
+  det.Detect(img, 15.0, &blobs);  // runs on the window features alone
+  for (const ImageBlob& b : blobs) EXPECT_GE(b.confidence, 0.0);
+}
+
+TEST(VictimDetectorModel, AForestThatDoesNotTakeTheBlobFeaturesItClaimsIsRefused) {
+  const std::string path = ::testing::TempDir() + "/wrong_inputs.yml";
+  ASSERT_TRUE(SaveDetectorModel(SmallModel(kForestFeatures, kBlobFeatures), path).ok());
+  Result<std::shared_ptr<const VictimDetectorModel>> m = LoadDetectorModel(path);
+  ASSERT_FALSE(m.ok());
+  EXPECT_NE(m.error().message().find("wrong inputs"), std::string::npos) << m.error().ToString();
 }
 
 }  // namespace

@@ -14,8 +14,9 @@
 //      cells), windows of 3 x 3 m at a stride of one cell;
 //   3. first stage: a linear score for every window (one correlation per channel), its local
 //      maxima above the trained threshold, at most max_candidates of them;
-//   4. second stage: a random forest (cv::ml::RTrees) on each candidate, its vote fraction mapped
-//      to a probability by the trained Platt sigmoid: the confidence, in [0, 1];
+//   4. second stage: a random forest (cv::ml::RTrees) on each candidate (its window features, its
+//      first-stage score and, when the model has them, its blob features: blob_features.hpp), its
+//      vote fraction mapped to a probability by the trained Platt sigmoid: the confidence, in [0, 1];
 //   5. non-maximum suppression: of candidates closer than nms_radius_m, the most confident stays.
 // A detection whose person box (centre +- 1 m) leaves the image is a partial view, its confidence
 // capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
@@ -25,7 +26,8 @@
 // loaded machine, BENCHMARKS.md "Perception"; the scale of step 1 makes low altitudes cheaper and
 // high ones dearer: at 60 m the frame is enlarged to keep 8 px/m). Scratch images are kept between frames; OpenCV's
 // filters and the forest still allocate internal buffers per frame (allocation_test.cpp). Frames
-// come at 5 Hz, outside the control loop.
+// come at 5 Hz, outside the control loop. A model with blob features adds them per candidate
+// (0.25 ms of CPU each measured at load ~9: BENCHMARKS.md "Blob features for the second stage").
 #pragma once
 
 #include <memory>
@@ -34,6 +36,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "swarmbox/swarm/blob_features.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
 #include "swarmbox/swarm/victim_detector_model.hpp"
 
@@ -41,7 +44,11 @@ namespace swarmbox::swarm {
 
 struct VictimDetectorParams {
   double person_area_m2 = 0.59;       // plan-view area of a lying person [m^2] (expected_area_px)
-  int max_candidates = 48;            // first-stage maxima passed to the forest, best first
+  // First-stage maxima passed to the forest, best first. At 48 the cap loses people: 3 of 30 at
+  // 30 m on held-out scenes (seed 7100003, neither trained, calibrated nor evaluated on), none at
+  // 96. It stays 48 while the shipped model's sigmoid is the one fitted with 48 candidates (a model
+  // calibrated with another cap is run with it: swarmbox-bench perception --max-candidates N).
+  int max_candidates = 48;
   double nms_radius_m = 1.0;          // detections closer than this on the ground are one
   double min_confidence = 0.05;       // detections below are dropped
   double partial_half_extent_m = 1.0; // a detection this close to the border is a partial view
@@ -78,7 +85,8 @@ class VictimDetector {
 
   // Steps 1-3 on their own (training mines the forest's samples from these): the first-stage
   // candidates of `bgr` at `pixels_per_m`, as (row, col, score) of the window's top-left cell,
-  // best first. Uses the model's kernels and threshold; fills channels().
+  // best first. Uses the model's kernels and threshold; fills channels() and, when the model has
+  // blob features, gives the frame to the blob feature extractor (ForestFeatures()).
   struct Candidate {
     int row = 0;
     int col = 0;
@@ -88,6 +96,11 @@ class VictimDetector {
   };
   const std::vector<Candidate>& Candidates(const cv::Mat& bgr, double pixels_per_m, int max_candidates,
                                            double threshold);
+  // The forest's model().forest_inputs() values for candidate `c` of the last Candidates() call
+  // (the same frame and scale): what the second stage sees.
+  void ForestFeatures(const Candidate& c, float* out);
+  // A candidate's window centre in pixels of the frame of the last Candidates() call.
+  Eigen::Vector2d CentrePx(const Candidate& c) const;
 
  private:
   template <typename KeepFn>
@@ -96,6 +109,8 @@ class VictimDetector {
   std::shared_ptr<const VictimDetectorModel> model_;
   VictimDetectorParams params_;
   ChannelMaps maps_;
+  BlobFeatureExtractor blob_;
+  double scale_ = 1;  // canonical pixels per frame pixel, of the last Candidates() call
   cv::Mat score_, filtered_, dilated_;
   std::vector<float> samples_;
   std::vector<Candidate> candidates_;

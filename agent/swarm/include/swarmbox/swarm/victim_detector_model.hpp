@@ -15,8 +15,11 @@
 //
 // Classifier: a linear first stage (ridge-regression discriminant, weights per channel cell,
 // evaluated densely as one correlation per channel), then cv::ml::RTrees (a random forest) on the
-// first stage's local maxima with the first-stage score as one more feature, and a Platt sigmoid
-// that maps the forest's vote fraction to a probability (fitted on calibration scenes).
+// first stage's local maxima with the first-stage score as one more feature and, in models of
+// format 2 with blob_features = kBlobFeatures, the candidate's blob features (blob_features.hpp:
+// size, shape, parts and edge orientations, independent of the person's heading), and a Platt
+// sigmoid that maps the forest's vote fraction to a probability (fitted on calibration scenes).
+// Format 1 models (window features and score only) still load and run.
 #pragma once
 
 #include <memory>
@@ -39,6 +42,7 @@ inline constexpr int kColourChannels = 3;
 inline constexpr int kChannels = kColourChannels + 1 + kOrientations;
 inline constexpr int kWindowFeatures = kChannels * kWindowCells * kWindowCells + kColourChannels;
 inline constexpr int kForestFeatures = kWindowFeatures + 1;  // + the first-stage score
+// (then the blob features when the model has them: VictimDetectorModel::forest_inputs())
 
 // Channel maps at cell resolution (CV_32F each), with scratch images kept between frames.
 struct ChannelMaps {
@@ -70,11 +74,15 @@ struct VictimDetectorModel {
   std::vector<cv::Mat> kernels;
   double bias = 0;
   double stage1_threshold = 0;
-  cv::Ptr<cv::ml::RTrees> forest;  // class 1 = person; kForestFeatures inputs
+  cv::Ptr<cv::ml::RTrees> forest;  // class 1 = person; forest_inputs() inputs
+  int blob_features = 0;           // 0 (format 1) or kBlobFeatures, after the kForestFeatures
   double platt_a = -8.0;           // p = 1 / (1 + exp(platt_a * votes + platt_b))
   double platt_b = 4.0;
   std::vector<std::uint64_t> training_seeds;     // scene-set seeds the forest was trained on
   std::vector<std::uint64_t> calibration_seeds;  // scene-set seeds the sigmoid was fitted on
+  std::string recipe;  // the trainer's options, as its command line (the model's provenance)
+
+  int forest_inputs() const { return kForestFeatures + blob_features; }
 
   // The forest flattened for prediction without allocation (FlattenForest(); the same decisions
   // as cv::ml::DTrees::predict for ordered variables: value <= threshold goes left, unless the split
@@ -91,7 +99,7 @@ struct VictimDetectorModel {
 
   // Rebuilds nodes/roots from `forest`.
   void FlattenForest();
-  // Fraction of the trees voting "person" for kForestFeatures values.
+  // Fraction of the trees voting "person" for forest_inputs() values.
   double Votes(const float* forest_features) const;
   // First-stage score of one feature vector (the same sum as the dense correlation).
   double LinearScore(const float* window_features) const;
