@@ -158,7 +158,10 @@ Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& pa
   try {
     cv::FileStorage fs(path, cv::FileStorage::WRITE);
     if (!fs.isOpened()) return Error(ErrorCode::kIo, "cannot write the detector model", path);
-    fs << "format_version" << kFormatVersion;
+    // A window-only model keeps format 1's layout, so the default training step still writes the
+    // shipped file (agent/swarm/models) as before the blob features.
+    const bool blob = model.blob_features != 0;
+    fs << "format_version" << (blob ? kFormatVersion : kWindowOnlyFormatVersion);
     fs << "canonical_px_per_m" << kCanonicalPxPerM << "shrink" << kShrink << "window_cells" << kWindowCells
        << "channels" << kChannels;
     fs << "bias" << model.bias << "stage1_threshold" << model.stage1_threshold;
@@ -166,7 +169,7 @@ Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& pa
     std::vector<double> seeds(model.training_seeds.begin(), model.training_seeds.end());
     std::vector<double> cal(model.calibration_seeds.begin(), model.calibration_seeds.end());
     fs << "training_seeds" << seeds << "calibration_seeds" << cal;
-    fs << "blob_features" << model.blob_features << "recipe" << model.recipe;
+    if (blob) fs << "blob_features" << model.blob_features << "recipe" << model.recipe;
     fs << "kernels" << "[";
     for (const cv::Mat& k : model.kernels) fs << k;
     fs << "]";
