@@ -52,6 +52,7 @@ SensorSample FullSensorSample(std::uint64_t seed) {
   m.battery.current_a = D(seed, 26);
   m.battery.remaining = D(seed, 27);
   m.camera_frame = true;
+  m.stereo_frame = true;
   m.radio_in = {FullRadioFrame(seed, 0), FullRadioFrame(seed + 1, 1), FullRadioFrame(seed + 2, 2),
                 FullRadioFrame(seed + 3, 3), FullRadioFrame(seed + 4, 4)};
   return m;

@@ -15,7 +15,8 @@
   F(position_enu_m) F(velocity_enu_m_s) F(h_acc_m) F(v_acc_m)
 #define SWARMBOX_BUS_FIELDS_BatterySample(F) F(valid) F(voltage_v) F(current_a) F(remaining)
 #define SWARMBOX_BUS_FIELDS_SensorSample(F) \
-  F(drone) F(step) F(sim_time_ns) F(imu) F(baro) F(mag) F(gps) F(battery) F(camera_frame) F(radio_in)
+  F(drone) F(step) F(sim_time_ns) F(imu) F(baro) F(mag) F(gps) F(battery) F(camera_frame) F(stereo_frame) \
+  F(radio_in)
 #define SWARMBOX_BUS_FIELDS_ActuatorCommand(F) \
   F(drone) F(step) F(sim_time_ns) F(armed) F(motor_throttle) F(raft_leader) F(world) F(radio_out)
 #define SWARMBOX_BUS_FIELDS_CameraIntrinsics(F) F(fx_px) F(fy_px) F(cx_px) F(cy_px) F(distortion)

@@ -200,6 +200,9 @@ struct SensorSample {
   // A CameraImage of this step was published before this sample (the agent takes it before it
   // steps, so perception sees the same frames at any speed).
   bool camera_frame = false;
+  // A stereo pair of this step (a CameraImage on StereoTopic(drone), see CameraImage) was published
+  // before this sample; only for an airframe with stereo enabled.
+  bool stereo_frame = false;
   // radio.model channel: the frames the channel delivered to this drone in (previous step, this
   // step], in delivery order. Empty with radio.model netem.
   std::vector<RadioFrame> radio_in;
@@ -245,6 +248,18 @@ struct Pose {
 
 // One camera frame. Physics server -> agent, on CameraTopic(drone) with Qos::kLockstep (5 Hz,
 // 320x240 mono8/bgr8, ~80 KB).
+//
+// A stereo pair (issue #23) is one CameraImage on StereoTopic(drone), Qos::kLockstep, published
+// before the step's SensorSample (which then has stereo_frame = true):
+//   encoding "mono8"; the left and right rectified NIR images of W x H pixels side by side: the
+//   left in columns [0, W), the right in [W, 2W); width_px = 2 W, height_px = H,
+//   row_stride_bytes = 2 W;
+//   intrinsics: fx_px = fy_px = the focal length [px], cx_px, cy_px the LEFT camera's principal
+//   point (as StereoFrame's cx_px, cy_px; the right image's columns are then x - W), distortion 0
+//   (rectified);
+//   camera_pose: the left camera's optical frame at the exposure (as for the RGB camera);
+//   sim_time_ns, step: the step's time (the exposure) and the step.
+// The baseline is the airframe's stereo.baseline_m (the agent reads the same airframe file).
 struct CameraImage {
   std::string drone;
   std::uint64_t step = 0;  // the control step at which the image was captured

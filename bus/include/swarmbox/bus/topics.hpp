@@ -12,6 +12,7 @@
 //   sim     sim/<drone>/sensor         SensorSample     kLockstep   physics -> agent <drone>
 //   sim     sim/actuator               ActuatorCommand  kLockstep   every agent -> physics (keyed by drone)
 //   sim     sim/<drone>/camera         CameraImage      kLockstep   physics -> agent <drone>
+//   sim     sim/<drone>/stereo         CameraImage      kLockstep   physics -> agent <drone> (a stereo pair)
 //   sim     sim/world_command          WorldCommand     kLockstep   orchestrator/tools -> physics
 //   sim     sim/status                 Event            kLockstep   physics -> all (the start, 1 Hz)
 //   sim     sim/telemetry              Telemetry        kState      every agent -> physics (keyed by drone; the recording)
@@ -78,6 +79,9 @@ inline constexpr std::string_view kEventTopic = "event";
 
 std::string SensorTopic(std::string_view drone);    // "sim/<drone>/sensor"
 std::string CameraTopic(std::string_view drone);    // "sim/<drone>/camera"
+// A stereo airframe's rectified pair, one CameraImage per pair, left and right side by side
+// (the layout is CameraImage's comment in messages.hpp); issue #23.
+std::string StereoTopic(std::string_view drone);    // "sim/<drone>/stereo"
 std::string OffboardInputTopic(std::string_view drone);   // "offboard/<drone>/input"
 std::string OffboardOutputTopic(std::string_view drone);  // "offboard/<drone>/output"
 
