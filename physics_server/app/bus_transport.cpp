@@ -12,14 +12,16 @@ std::array<double, 3> A(const Vec3& v) { return {v.x, v.y, v.z}; }
 
 Result<std::unique_ptr<BusTransport>> BusTransport::Create(const bus::ParticipantConfig& config,
                                                            const std::vector<std::string>& drones,
-                                                           const std::vector<GpsSpec>& gps_specs) {
+                                                           const std::vector<GpsSpec>& gps_specs,
+                                                           const std::vector<bool>& stereo_drones) {
   std::unique_ptr<BusTransport> t(new BusTransport());
   auto participant = bus::Participant::Create(config);
   if (!participant) return std::move(participant).error().Context("sim bus");
   t->participant_ = std::move(*participant);
   if (Status s = t->OpenWorldEndpoints(); !s) return s.error();
   for (std::size_t i = 0; i < drones.size(); ++i) {
-    if (Status s = t->AddDroneEndpoints(drones[i], gps_specs.at(i), i); !s) return s.error();
+    const bool stereo = i < stereo_drones.size() && stereo_drones[i];
+    if (Status s = t->AddDroneEndpoints(drones[i], gps_specs.at(i), stereo, i); !s) return s.error();
   }
   // One reader for every drone's answers (the topic is keyed by drone).
   BusTransport* self = t.get();
@@ -48,7 +50,7 @@ Status BusTransport::OpenWorldEndpoints() {
   return Ok{};
 }
 
-Status BusTransport::AddDroneEndpoints(const std::string& name, const GpsSpec& gps, std::size_t index) {
+Status BusTransport::AddDroneEndpoints(const std::string& name, const GpsSpec& gps, bool stereo, std::size_t index) {
   if (auto s = bus::ValidateDroneName(name); !s) return s.error();
   DroneEndpoints e;
   e.name = name;
@@ -59,6 +61,11 @@ Status BusTransport::AddDroneEndpoints(const std::string& name, const GpsSpec& g
   auto camera = participant_->CreatePublisher<bus::CameraImage>(bus::CameraTopic(name), bus::Qos::kLockstep);
   if (!camera) return std::move(camera).error();
   e.camera = std::move(*camera);
+  if (stereo) {
+    auto pair = participant_->CreatePublisher<bus::CameraImage>(bus::StereoTopic(name), bus::Qos::kLockstep);
+    if (!pair) return std::move(pair).error();
+    e.stereo = std::move(*pair);
+  }
   index_of_.emplace(name, index);
   drones_.push_back(std::move(e));
   return Ok{};
@@ -100,6 +107,7 @@ Status BusTransport::PublishSample(std::size_t drone, const std::string& name, c
   m.gps.v_acc_m = s.gps.valid ? s.gps.v_acc_m : spec.vertical_std_m;
   m.battery.valid = false;  // no battery model in the physics server
   m.camera_frame = extras.camera_frame;
+  m.stereo_frame = extras.stereo_frame;
   m.radio_in.assign(extras.radio_in.begin(), extras.radio_in.end());
   return drones_[drone].sensor->Publish(m);
 }
@@ -123,6 +131,12 @@ Status BusTransport::PublishCamera(std::size_t drone, const std::string& name, s
   m.camera_pose.orientation_wxyz = {q.w, q.x, q.y, q.z};
   m.data.assign(img.bgr.begin(), img.bgr.end());
   return drones_.at(drone).camera->Publish(m);
+}
+
+Status BusTransport::PublishStereo(std::size_t drone, const bus::CameraImage& pair) {
+  const DroneEndpoints& e = drones_.at(drone);
+  if (!e.stereo) return Error(ErrorCode::kInternal, "drone '" + e.name + "' has no stereo pair publisher");
+  return e.stereo->Publish(pair);
 }
 
 Status BusTransport::PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) {

@@ -1,5 +1,6 @@
 // BusTransport: SimTransport on the SwarmBox sim bus (bus/topics.hpp): per drone a SensorSample
-// and CameraImage publisher; one ActuatorCommand subscriber on sim/actuator for every drone (keyed
+// and CameraImage publisher, and a stereo pair publisher (StereoTopic) for a drone whose airframe
+// has stereo enabled (none otherwise: no endpoint for nothing); one ActuatorCommand subscriber on sim/actuator for every drone (keyed
 // by drone); the clock publisher and the world-command subscriber. Actuator commands arrive on a
 // middleware thread (one callback call at a time), are matched to their drone by name in O(1) and
 // queued here; the server's thread is woken once the step's awaited answers are queued (or at its
@@ -10,7 +11,7 @@
 // measurement at this step" (the physics `fresh` flag; stale values are repeated but invalid).
 // GPS: valid = a new fix; fix_type = kNone in a dropout (reports keep coming at the GPS rate with
 // valid = false), k3d otherwise. Baro altitude is relative to the world origin (ENU z).
-// camera_frame and radio_in come from SampleExtras. An ActuatorCommand's world commands keep
+// camera_frame, stereo_frame and radio_in come from SampleExtras. An ActuatorCommand's world commands keep
 // their seq (SimServer orders them). The command's key (`drone`) names the answering drone; a
 // command for a drone not in the trial is dropped and counted (unknown_commands()).
 #pragma once
@@ -34,14 +35,17 @@ namespace swarmbox::physics {
 class BusTransport final : public SimTransport {
  public:
   // Creates the participant and every drone's endpoints. `airframes[i]` gives drone i's GPS spec
-  // (accuracy fields).
+  // (accuracy fields); `stereo_drones[i]` (absent: false) whether drone i publishes stereo pairs.
   static Result<std::unique_ptr<BusTransport>> Create(const bus::ParticipantConfig& config,
                                                       const std::vector<std::string>& drones,
-                                                      const std::vector<GpsSpec>& gps_specs);
+                                                      const std::vector<GpsSpec>& gps_specs,
+                                                      const std::vector<bool>& stereo_drones = {});
 
   Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample,
                        const SampleExtras& extras) override;
   Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) override;
+  // kInternal for a drone created without a stereo publisher (a bug: SimServer sends none).
+  Status PublishStereo(std::size_t drone, const bus::CameraImage& pair) override;
   Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) override;
   Status PublishStatus(const JoiningStatus& status, bool done) override;
   void WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) override;
@@ -60,6 +64,7 @@ class BusTransport final : public SimTransport {
     std::string name;
     std::unique_ptr<bus::Publisher<bus::SensorSample>> sensor;
     std::unique_ptr<bus::Publisher<bus::CameraImage>> camera;
+    std::unique_ptr<bus::Publisher<bus::CameraImage>> stereo;  // null: no stereo pair
     GpsSpec gps;
   };
   struct NameHash {
@@ -70,7 +75,7 @@ class BusTransport final : public SimTransport {
   // Create's steps, in discovery order: the clock, status and world-command endpoints, then each
   // drone's sensor and camera publishers.
   Status OpenWorldEndpoints();
-  Status AddDroneEndpoints(const std::string& name, const GpsSpec& gps, std::size_t index);
+  Status AddDroneEndpoints(const std::string& name, const GpsSpec& gps, bool stereo, std::size_t index);
 
   std::unique_ptr<bus::Participant> participant_;
   std::unique_ptr<bus::Publisher<bus::ClockTick>> clock_;

@@ -61,6 +61,7 @@ struct Trial {
   std::unique_ptr<World> world;
   std::vector<std::string> names;
   std::vector<GpsSpec> gps;
+  std::vector<bool> stereo;  // per drone: its airframe has a stereo pair (issue #23)
   RadioPlan plan;
   std::optional<channel::RadioProfile> radio_profile;
   std::optional<TruthCsvFile> truth;
@@ -173,14 +174,6 @@ ExitOr LoadInputs(CommandLine* cl, Trial* t) {
 ExitOr SpawnDrone(const DroneSpec& d, const ServerOptions& o, Trial* t) {
   auto af = LoadAirframe(AirframePathFor(d.airframe, o.airframes_dir));
   if (!af) return Fail(kExitBadInput, af.error().ToString());
-  if (af->stereo.enabled) {
-    // Issue #23: the pair is parsed and benchmarked (swarmbox-bench stereo) but this server does
-    // not render or publish it yet; a trial that asks for depth must not run without it.
-    return Fail(kExitBadInput, d.where + ": airframe '" + d.airframe +
-                                   "' has a stereo depth camera ('stereo:'), which trials cannot fly yet: the physics "
-                                   "server does not render stereo pairs (issue #23; swarmbox-bench stereo measures the "
-                                   "model); use the airframe without '_depth'");
-  }
   DroneSpawn spawn;
   spawn.name = d.name;
   spawn.airframe = *af;
@@ -192,6 +185,7 @@ ExitOr SpawnDrone(const DroneSpec& d, const ServerOptions& o, Trial* t) {
   if (!idx) return Fail(kExitBadInput, d.where + ": " + idx.error().message());
   t->names.push_back(d.name);
   t->gps.push_back(af->gps);
+  t->stereo.push_back(af->stereo.enabled);  // the server renders its pairs (StereoCapture)
   return std::nullopt;
 }
 
@@ -308,7 +302,7 @@ ExitOr OpenTransport(const ServerOptions& o, Trial* t) {
   // ~0.2 s with agents still up): the samples and images sent last are of no use once the server
   // goes; truth.csv and the events are written before the transport is closed.
   pc.writer_linger_ms = 0;
-  auto transport = BusTransport::Create(pc, t->names, t->gps);
+  auto transport = BusTransport::Create(pc, t->names, t->gps, t->stereo);
   if (!transport) {
     const ErrorCode c = transport.error().code();
     return Fail(c == ErrorCode::kInvalidArgument || c == ErrorCode::kNotFound ? kExitBadInput : kExitInfrastructure,

@@ -69,6 +69,7 @@ SimServer::SimServer(World& world, SimTransport& transport, WallClock& clock, Tr
     impairments_.resize(n);
     blocked_.assign(n * n, 0);
   }
+  if (auto stereo = std::make_unique<StereoCapture>(world); stereo->any()) stereo_ = std::move(stereo);
   if (options_.clock_every_s > 0) {
     progress_.emplace(static_cast<std::int64_t>(options_.clock_every_s * 1e9));
   }
@@ -291,7 +292,11 @@ Status SimServer::PublishDrone(std::size_t i, bool with_camera) {
   if (with_camera && slot.camera_frame) {
     if (auto s = transport_.PublishCamera(i, name, world_.step_count(), slot.image); !s) return s;
   }
-  return transport_.PublishSample(i, name, world_.sensors(i), SampleExtras{slot.camera_frame, slot.radio_in});
+  if (with_camera && slot.stereo_frame) {
+    if (auto s = transport_.PublishStereo(i, slot.stereo); !s) return s;
+  }
+  return transport_.PublishSample(i, name, world_.sensors(i),
+                                  SampleExtras{slot.camera_frame, slot.radio_in, slot.stereo_frame});
 }
 
 void SimServer::Accept(std::size_t i, ActuatorInput& cmd) {
@@ -343,6 +348,7 @@ void SimServer::TakeOut(std::size_t i, const PlanEntry& e) {
   if (channel_) channel_->SetOut(i, true);
   slot.leader = false;
   slot.camera_frame = false;
+  slot.stereo_frame = false;
   slot.radio_in.clear();
   slot.radio_out.clear();
   slot.back_ns = e.duration_ns > 0 ? world_.time_ns() + e.duration_ns : -1;
@@ -467,12 +473,21 @@ bool SimServer::CaptureCamera(std::size_t i) {
   return true;
 }
 
-// Step k's cameras and samples (each frame before its sample), then the clock.
+// The stereo pair of drone `i` at step `step`: due on its fixed schedule (StereoCapture), not for
+// a lost drone; rendered into the slot.
+bool SimServer::CaptureStereo(std::size_t i, std::uint64_t step) {
+  if (!stereo_ || !stereo_->Due(i, step) || world_.Truth(i).lost) return false;
+  stereo_->Capture(world_, i, step, &slots_[i].stereo);
+  return true;
+}
+
+// Step k's cameras, stereo pairs and samples (each frame before its sample), then the clock.
 Status SimServer::PublishStep(std::uint64_t step) {
   if (channel_) TakeDeliveries(world_.time_ns());
   for (std::size_t i = 0; i < world_.drone_count(); ++i) {
     if (lockstep_.out(i)) continue;
     slots_[i].camera_frame = CaptureCamera(i);
+    slots_[i].stereo_frame = CaptureStereo(i, step);
     if (auto s = PublishDrone(i, /*with_camera=*/true); !s) return s;
   }
   return transport_.PublishClock(step, world_.time_ns(), world_.options().control_period_ns, options_.rtf);

@@ -6,9 +6,11 @@
 //
 // Per control step k (t_k = k * control period), the simulated time line of everything an agent
 // hears:
-//   1. for each drone in order: its camera frame if due, FIRST, then its sample k with
-//      camera_frame = true when a frame went out (lost drones get samples too, so they can
-//      rejoin; drones out of the trial by a plan's drone_out get nothing);
+//   1. for each drone in order: its camera frame if due, FIRST, then its stereo pair if due
+//      (StereoCapture: airframes with stereo enabled, a fixed step schedule; not for a lost drone),
+//      then its sample k with camera_frame / stereo_frame = true when a frame / pair went out
+//      (lost drones get samples too, so they can rejoin; drones out of the trial by a plan's
+//      drone_out get nothing);
 //   2. wait until every live drone has answered step k (Lockstep); drones silent past the
 //      timeout are marked lost (motors off, event=drone_lost) and the step goes on;
 //   3. apply the answers' `world` commands (drone order, then seq), then those of the
@@ -22,7 +24,7 @@
 // the channel with send time t_k (drone order, then seq), before the plan's entries of t_k.
 // While waiting, every drone's sample is published again every 200 ms (agents that join late, a
 // lost message, and a keepalive for the drones that answered, so a long wait does not look like a
-// stalled server to them; an unanswered drone's camera frame goes again first). Duplicate and
+// stalled server to them; an unanswered drone's camera frame and stereo pair go again first). Duplicate and
 // stale commands are dropped (Lockstep).
 // A camera is due by its airframe's trigger (CameraTrigger: rate_hz, or distance-triggered).
 // While the first step waits, every second `event=joining joined=.. expected=.. missing=..` and the
@@ -46,6 +48,7 @@
 #include "camera_trigger.hpp"
 #include "joining.hpp"
 #include "radio_plan.hpp"
+#include "stereo_capture.hpp"
 #include "swarmbox/channel/channel.hpp"
 #include "swarmbox/bus/messages.hpp"
 #include "swarmbox/common/result.hpp"
@@ -83,6 +86,7 @@ struct ActuatorInput {
 struct SampleExtras {
   bool camera_frame = false;                 // this step's camera frame was published before it
   std::span<const bus::RadioFrame> radio_in; // deliveries in (t_{k-1}, t_k], in delivery order
+  bool stereo_frame = false;                 // this step's stereo pair was published before it
 };
 
 class SimTransport {
@@ -91,6 +95,9 @@ class SimTransport {
   virtual Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample,
                                const SampleExtras& extras) = 0;
   virtual Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) = 0;
+  // A stereo pair, already in the bus layout (bus/messages.hpp, CameraImage); only for drones whose
+  // airframe has stereo enabled.
+  virtual Status PublishStereo(std::size_t drone, const bus::CameraImage& pair) = 0;
   virtual Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) = 0;
   // The start's progress (joining.hpp), every second while the first step waits and once when it
   // completes (`done`): on the bus, sim/status, the agents' sign of a live server before their
@@ -213,6 +220,8 @@ class SimServer {
   struct Slot {
     bool camera_frame = false;
     CameraImage image;                         // this step's frame, re-sent with a re-sent sample
+    bool stereo_frame = false;
+    bus::CameraImage stereo;                   // this step's stereo pair, re-sent likewise
     std::vector<bus::RadioFrame> radio_in;
     std::vector<WorldCommandInput> world;      // the accepted answer's
     std::vector<bus::RadioFrame> radio_out;    // the accepted answer's
@@ -223,6 +232,7 @@ class SimServer {
     std::string out_fault;                     // out: the plan entry's name
   };
   bool CaptureCamera(std::size_t i);
+  bool CaptureStereo(std::size_t i, std::uint64_t step);
   Status PublishStep(std::uint64_t step);
   Status Republish();
   Status AwaitAnswers(std::uint64_t step, const std::atomic<bool>& stop);
@@ -266,6 +276,7 @@ class SimServer {
   WindConfig base_wind_;
   std::vector<Slot> slots_;
   CameraTrigger trigger_;
+  std::unique_ptr<StereoCapture> stereo_;    // null: no drone has a stereo pair (nothing to do)
   std::size_t next_entry_ = 0;               // options_.plan.schedule[next_entry_] is due next
 
   // radio.model channel.

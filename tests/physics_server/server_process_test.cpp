@@ -87,16 +87,22 @@ TEST(ServerProcess, BadAirframeFileIsReportedWithPositionAndExitTwo) {
       << out;
 }
 
-// The airframe library reads 'stereo:' (x500_depth), but the server renders no pairs yet (issue #23):
-// such a trial stops at the start with the reason instead of flying without the depth it asked for.
-TEST(ServerProcess, AStereoAirframeIsRefusedWithTheReasonAndExitTwo) {
+// A stereo airframe (x500_depth) flies (issue #23): the server starts with it, renders its pairs
+// and ends on SIGTERM as with any other drone (the pairs themselves: sim_server_stereo_test.cpp).
+TEST(ServerProcess, AStereoAirframeStartsAndStopsOnSigterm) {
+  const std::string domain = std::to_string(100 + (::getpid() + 53) % 100);
   LoggedChild c({SWARMBOX_PHYSICS_EXE, "--world", testing::WorldPath("open_field"), "--drone", "a:x500_depth:0,0,0",
-                 "--airframes-dir", testing::TrialsDir() + "/airframes"},
+                 "--airframes-dir", testing::TrialsDir() + "/airframes", "--domain", domain, "--join-timeout", "0.2",
+                 "--step-timeout", "0.2", "--rtf", "1", "--no-cameras"},
                 LogPath("stereo_airframe"));
-  EXPECT_EQ(c.Wait(60s), 2);
-  const std::string out = c.ReadLog();
-  EXPECT_NE(out.find("airframe 'x500_depth' has a stereo depth camera"), std::string::npos) << out;
-  EXPECT_NE(out.find("does not render stereo pairs"), std::string::npos) << out;
+  ASSERT_TRUE(c.WaitForLog("event=ready", 60s)) << c.ReadLog();
+  EXPECT_NE(c.ReadLog().find("node=physics event=ready world=open_field drones=1"), std::string::npos) << c.ReadLog();
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  ASSERT_TRUE(c.Signal(SIGTERM));
+  EXPECT_EQ(c.Wait(60s), 0) << c.ReadLog();
+  const std::string log = c.ReadLog();
+  EXPECT_EQ(log.find("stereo depth camera"), std::string::npos) << log;
+  EXPECT_NE(log.find("event=stopped reason=signal"), std::string::npos) << log;
 }
 
 TEST(ServerProcess, UsageErrorExitsTwo) {

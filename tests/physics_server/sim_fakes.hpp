@@ -31,7 +31,8 @@ class ScriptedAgents final : public SimTransport {
   Status PublishSample(std::size_t, const std::string& name, const SensorSample& s, const SampleExtras& extras) override {
     ++samples[name];
     last_step[name] = s.step;
-    published.push_back("sample " + name + " " + std::to_string(s.step) + (extras.camera_frame ? " camera_frame" : ""));
+    published.push_back("sample " + name + " " + std::to_string(s.step) + (extras.camera_frame ? " camera_frame" : "") +
+                        (extras.stereo_frame ? " stereo_frame" : ""));
     for (const bus::RadioFrame& f : extras.radio_in) heard[name].push_back({s.step, f});
     if (alive[name] && clock_.now_ns >= alive_from_ns[name]) {
       ActuatorInput in{name, s.step, !motors_off[name], std::vector<double>(4, throttle), leader[name], {}, {}};
@@ -48,6 +49,11 @@ class ScriptedAgents final : public SimTransport {
     const bool shipped = (img.width_px == 640 && img.height_px == 360) || (img.width_px == 320 && img.height_px == 240);
     EXPECT_TRUE(shipped) << name << ": " << img.width_px << " x " << img.height_px;
     EXPECT_EQ(img.bgr.size(), static_cast<std::size_t>(img.width_px) * static_cast<std::size_t>(img.height_px) * 3u);
+    return Ok{};
+  }
+  Status PublishStereo(std::size_t, const bus::CameraImage& pair) override {
+    published.push_back("stereo " + pair.drone + " " + std::to_string(pair.step));
+    pairs[pair.drone].push_back(pair);
     return Ok{};
   }
   Status PublishClock(std::uint64_t step, std::int64_t, std::int64_t, double) override {
@@ -85,7 +91,8 @@ class ScriptedAgents final : public SimTransport {
   std::map<std::string, std::vector<Heard>> heard;                     // radio_in, in order
   std::map<std::string, int> samples, frames;
   std::map<std::string, std::uint64_t> last_step;
-  std::vector<std::string> published;  // "camera a 25", "sample a 25 camera_frame", in order
+  std::vector<std::string> published;  // "camera a 25", "stereo a 25", "sample a 25 camera_frame", in order
+  std::map<std::string, std::vector<bus::CameraImage>> pairs;          // stereo pairs, in order
   struct StatusSent {
     std::int64_t wall_ns;  // the fake clock's time
     JoiningStatus status;
