@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdio>
 #include <thread>
+#include <vector>
 
 #include "bus_transport.hpp"
 #include "swarmbox/channel/radio_profile.hpp"
@@ -213,6 +214,64 @@ void StatusOverBus(const std::string& backend) {
             std::string::npos)
       << log;
 }
+
+// A stereo drone's pairs over the bus (issue #23): drone "a" flies x500_depth; its agent finds the
+// pair of every sample with stereo_frame on sim/a/stereo, of the same step, side by side mono8.
+void StereoPairsOverBus(const std::string& backend) {
+  const int domain = 100 + static_cast<int>((::getpid() + 71) % 100);
+  auto world = testing::MakeWorld(testing::CalmWorld());
+  const Airframe af = testing::LoadShippedAirframe("x500_depth");
+  const double u = af.HoverRotorSpeed() / af.motor.max_rot_velocity_rad_s;
+  testing::Spawn(*world, testing::MakeSpawn("a", af, Vec3{0, 0, 10}, 0, u));
+  bus::ParticipantConfig pc;
+  pc.backend = backend;
+  pc.domain_id = domain;
+  pc.interface = "lo";
+  auto agent = bus::Participant::Create(pc);
+  ASSERT_TRUE(agent.ok()) << agent.error().ToString();
+  auto sub = (*agent)->CreateSubscriber<bus::SensorSample>(bus::SensorTopic("a"), bus::Qos::kLockstep);
+  auto pairs = (*agent)->CreateSubscriber<bus::CameraImage>(bus::StereoTopic("a"), bus::Qos::kLockstep);
+  auto pub = (*agent)->CreatePublisher<bus::ActuatorCommand>(bus::kActuatorTopic, bus::Qos::kLockstep);
+  ASSERT_TRUE(sub.ok() && pairs.ok() && pub.ok());
+  auto transport = BusTransport::Create(pc, {"a"}, {af.gps}, {true});
+  ASSERT_TRUE(transport.ok()) << transport.error().ToString();
+  std::FILE* out = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  SimServerOptions so;
+  so.rtf = 0;
+  so.max_sim_time_s = 0.25;  // pairs at steps 0 and 50
+  so.cameras = false;
+  so.lockstep.join_timeout_ns = 20'000'000'000;
+  testing::ServerThread server(*world, **transport, so, out);
+  bus::SensorSample s;
+  bus::CameraImage pair;
+  bus::ActuatorCommand cmd;
+  cmd.drone = "a";
+  cmd.armed = true;
+  cmd.motor_throttle.assign(4, u);
+  std::vector<std::uint64_t> paired;
+  while (!server.done()) {
+    if (!(*sub)->TakeFor(s, std::chrono::milliseconds(5))) continue;
+    if (s.stereo_frame && (paired.empty() || paired.back() != s.step)) {
+      ASSERT_TRUE((*pairs)->TakeFor(pair, std::chrono::seconds(5))) << "step " << s.step;
+      EXPECT_EQ(pair.step, s.step);
+      EXPECT_EQ(pair.encoding, "mono8");
+      EXPECT_EQ(pair.width_px, 2u * static_cast<std::uint32_t>(af.stereo.width_px));
+      EXPECT_EQ(pair.data.size(), static_cast<std::size_t>(pair.row_stride_bytes) * pair.height_px);
+      paired.push_back(s.step);
+    }
+    cmd.step = s.step;
+    ASSERT_TRUE((*pub)->Publish(cmd).ok());
+  }
+  const Status result = server.Join();
+  ASSERT_TRUE(result.ok()) << result.error().ToString();
+  std::fclose(out);
+  EXPECT_EQ(paired, (std::vector<std::uint64_t>{0, 50}));
+}
+
+TEST(BusLockstep, StereoPairsGoWithTheirSamplesCycloneDds) { StereoPairsOverBus("cyclonedds"); }
+
+TEST(BusLockstep, StereoPairsGoWithTheirSamplesFastDds) { StereoPairsOverBus("fastdds"); }
 
 TEST(BusLockstep, TheStartIsOnSimStatusCycloneDds) { StatusOverBus("cyclonedds"); }
 
