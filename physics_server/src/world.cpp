@@ -54,6 +54,8 @@ struct PendingEvent {
   std::int64_t partner;  // see *Partner constants; obstacle k: -(2 + k)
   double speed_m_s;
   std::int64_t time_ns;
+  Vec3 position_m;   // kPayloadAtRest
+  double tilt_deg;   // kPayloadAtRest
 };
 
 }  // namespace
@@ -76,6 +78,8 @@ struct World::Impl {
     std::unique_ptr<GeomTag> payload_tag;
     dJointID sling = nullptr;
     double payload_drag = 0;
+    bool payload_settling = false;       // released, not yet reported at rest
+    std::int64_t payload_still_ns = -1;  // since when it has been slower than the rest speed; -1: moving
     dJointID pin = nullptr;
     Vec3 external_force;
     // state
@@ -149,7 +153,27 @@ struct World::Impl {
       ++dropped_events;
       return;
     }
-    pending[pending_count++] = {kind, a, partner, speed, time_ns};
+    pending[pending_count++] = {kind, a, partner, speed, time_ns, Vec3{}, 0.0};
+  }
+
+  // After a step: a released payload that has stayed slower than kPayloadRestSpeed_m_s for
+  // kPayloadRestTime_s is reported at rest, once.
+  void WatchPayload(Drone& d, std::size_t i) {
+    if (!d.payload_settling) return;
+    if (Norm(V(dBodyGetLinearVel(d.payload_body))) >= kPayloadRestSpeed_m_s) {
+      d.payload_still_ns = -1;
+      return;
+    }
+    if (d.payload_still_ns < 0) d.payload_still_ns = time_ns;
+    if (static_cast<double>(time_ns - d.payload_still_ns) * 1e-9 < kPayloadRestTime_s) return;
+    d.payload_settling = false;
+    const dReal* r = dBodyGetRotation(d.payload_body);  // row-major 3x4: r[10] = body z's world z
+    const double tilt_deg = std::acos(std::clamp(static_cast<double>(r[10]), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+    if (pending_count == pending.size()) {
+      ++dropped_events;
+      return;
+    }
+    pending[pending_count++] = {EventKind::kPayloadAtRest, i, 0, 0.0, time_ns, V(dBodyGetPosition(d.payload_body)), tilt_deg};
   }
 
   std::string PartnerName(std::int64_t p) const {
@@ -377,6 +401,8 @@ struct World::Impl {
           e.b = PartnerName(p.partner);
         }
         e.speed_m_s = p.speed_m_s;
+        e.position_m = p.position_m;
+        e.tilt_deg = p.tilt_deg;
         sink->OnEvent(e);
       }
     }
@@ -402,12 +428,17 @@ const char* EventName(EventKind kind) {
     case EventKind::kDroneLost: return "drone_lost";
     case EventKind::kDroneRejoined: return "drone_rejoined";
     case EventKind::kGeofence: return "geofence_breach";
+    case EventKind::kPayloadAtRest: return "payload_at_rest";
   }
   return "unknown";
 }
 
 LogEvent PhysicsEvent::ToLogEvent(const std::string& node) const {
   LogEvent e(t_s, node, EventName(kind));
+  if (kind == EventKind::kPayloadAtRest) {
+    return e.Add("drone", a).Add("x", position_m.x, 2).Add("y", position_m.y, 2).Add("z", position_m.z, 2)
+        .Add("tilt_deg", tilt_deg, 1);
+  }
   e.Add("a", a);
   if (!b.empty()) e.Add("b", b);
   if (kind == EventKind::kCollision || kind == EventKind::kCrash || kind == EventKind::kHardLanding) {
@@ -635,6 +666,7 @@ void World::Step() {
     const bool outside = std::abs(p.x) > w.config.size_x_m / 2 || std::abs(p.y) > w.config.size_y_m / 2;
     if (outside && !d.outside_geofence) w.Emit(EventKind::kGeofence, i, 0, 0.0);
     d.outside_geofence = outside;
+    w.WatchPayload(d, i);
     w.SampleSensors(d);
   }
   w.Dispatch();
@@ -695,6 +727,7 @@ Status World::AttachPayload(std::size_t index, double mass_kg) {
   d.sling = dJointCreateBall(w.world, nullptr);
   dJointAttach(d.sling, d.body, d.payload_body);
   dJointSetBallAnchor(d.sling, hook.x, hook.y, hook.z);
+  d.payload_settling = false;  // picked up again before it settled: nothing to report
   w.Emit(EventKind::kPayloadAttached, index, 0, 0.0);
   w.Dispatch();
   return Ok{};
@@ -707,6 +740,8 @@ Status World::ReleasePayload(std::size_t index) {
   if (d.sling == nullptr) return Error(ErrorCode::kInvalidArgument, "drone '" + d.name + "' carries no attached payload");
   dJointDestroy(d.sling);
   d.sling = nullptr;
+  d.payload_settling = true;
+  d.payload_still_ns = -1;
   w.Emit(EventKind::kPayloadReleased, index, 0, 0.0);
   w.Dispatch();
   return Ok{};

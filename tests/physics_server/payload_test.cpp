@@ -164,5 +164,64 @@ TEST(Payload, UnknownPayloadIsRefused) {
   EXPECT_EQ(r.error().message(), "drone 's': airframe x500 has no payload 'stretcher'");
 }
 
+// Where a released stretcher came to rest: drops it from a lifter pinned 6 m up at (x, 0) and
+// steps until event=payload_at_rest (at most 15 s). The events seen after the release.
+std::vector<PhysicsEvent> DropStretcher(const WorldConfig& config, double x_m) {
+  CollectingEventSink events;
+  auto world = MakeWorld(config);
+  world->SetEventSink(&events);
+  const auto d = Spawn(*world, testing::MakeSpawn("lifter", LoadShippedAirframe("x8_heavy"), Vec3{x_m, 0, 6}, 0.0, 0.0,
+                                                  "stretcher", true));
+  world->SetPinned(d, true);
+  EXPECT_TRUE(world->ReleasePayload(d).ok());
+  events.events.clear();
+  while (world->time_s() < 15.0 && events.events.empty()) world->Step();
+  for (int k = 0; k < 500; ++k) world->Step();  // 2 s more: reported once
+  return events.events;
+}
+
+TEST(Payload, AReleasedStretcherOnFlatGroundIsReportedAtRestLevelOnce) {
+  const std::vector<PhysicsEvent> events = DropStretcher(CalmWorld(), 3.0);
+  ASSERT_EQ(events.size(), 1u);
+  const PhysicsEvent& e = events[0];
+  EXPECT_EQ(e.kind, EventKind::kPayloadAtRest);
+  EXPECT_EQ(e.a, "lifter");
+  EXPECT_NEAR(e.position_m.x, 3.0, 0.1);
+  EXPECT_NEAR(e.position_m.y, 0.0, 0.1);
+  EXPECT_NEAR(e.position_m.z, 0.25 / 2, 0.02);  // the stretcher's half height
+  EXPECT_LT(e.tilt_deg, 1.0);
+  // Fallen ~1.5 m (0.55 s), then still for 1 s.
+  EXPECT_GT(e.t_s, 1.5);
+  EXPECT_LT(e.t_s, 5.0);
+  const std::string line = e.ToLogEvent().str();
+  EXPECT_NE(line.find(" node=physics event=payload_at_rest drone=lifter x=3.00 y="), std::string::npos) << line;
+  EXPECT_NE(line.find(" z=0.12 tilt_deg=0.0"), std::string::npos) << line;
+}
+
+TEST(Payload, AStretcherReleasedOverABoxEdgeIsReportedTiltedOrRaised) {
+  // A 1 m high box whose west edge is at x = 0; the stretcher (2 m along x) is dropped centred
+  // 0.2 m inside it: it lands across the edge (and stays on the box top, z = 1.12: measured).
+  WorldConfig config = CalmWorld();
+  config.obstacles.push_back({"block", {1.0, 0, 0.5}, {2.0, 3.0, 1.0}, 0.0, ObstacleKind::kBox});
+  const std::vector<PhysicsEvent> events = DropStretcher(config, 0.2);
+  ASSERT_EQ(events.size(), 1u);
+  const PhysicsEvent& e = events[0];
+  EXPECT_EQ(e.kind, EventKind::kPayloadAtRest);
+  EXPECT_TRUE(e.tilt_deg > 5.0 || e.position_m.z > 0.5) << e.ToLogEvent().str();
+}
+
+TEST(Payload, AStretcherPickedUpAgainBeforeItSettlesIsNotReported) {
+  CollectingEventSink events;
+  auto world = MakeWorld(CalmWorld());
+  world->SetEventSink(&events);
+  const auto d = Spawn(*world, testing::MakeSpawn("lifter", LoadShippedAirframe("x8_heavy"), Vec3{0, 0, 20}, 0.0, 0.0,
+                                                  "stretcher", true));
+  world->SetPinned(d, true);
+  ASSERT_TRUE(world->ReleasePayload(d).ok());
+  ASSERT_TRUE(world->AttachPayload(d).ok());  // still at sling length, hanging still
+  for (int k = 0; k < 750; ++k) world->Step();
+  for (const PhysicsEvent& e : events.events) EXPECT_NE(e.kind, EventKind::kPayloadAtRest);
+}
+
 }  // namespace
 }  // namespace swarmbox::physics

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/physics/types.hpp"
 
 namespace swarmbox::physics {
 
@@ -18,7 +19,15 @@ enum class EventKind {
   kDroneLost,         // lockstep timeout: motors off (a = drone)
   kDroneRejoined,     // a lost drone answered again
   kGeofence,          // a drone left the world's geofence
+  // A released payload came to rest (speed < kPayloadRestSpeed_m_s for kPayloadRestTime_s of
+  // simulated time), once per release: a = the drone that released it; position_m its centre,
+  // tilt_deg the angle between its up axis and world up (0: flat; 180: upside down). So a trial
+  // can judge where and how a stretcher was set down.
+  kPayloadAtRest,
 };
+
+inline constexpr double kPayloadRestSpeed_m_s = 0.05;
+inline constexpr double kPayloadRestTime_s = 1.0;
 
 const char* EventName(EventKind kind);  // "collision", "crash", "hard_landing", ...
 
@@ -28,8 +37,11 @@ struct PhysicsEvent {
   std::string a;               // drone name
   std::string b;               // other party (drone, obstacle id, "ground", payload) or ""
   double speed_m_s = 0;        // impact speed where it applies [m/s]
+  Vec3 position_m;             // kPayloadAtRest: the payload's centre [m, ENU]
+  double tilt_deg = 0;         // kPayloadAtRest: its up axis from world up [deg]
 
-  // `t=.. node=physics event=<kind> a=.. [b=..] [speed=..]`.
+  // `t=.. node=physics event=<kind> a=.. [b=..] [speed=..]`; kPayloadAtRest:
+  // `t=.. node=physics event=payload_at_rest drone=.. x=.. y=.. z=.. tilt_deg=..`.
   LogEvent ToLogEvent(const std::string& node = "physics") const;
 };
 
