@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "swarmbox/common/result.hpp"
+
 namespace swarmbox::depth {
 namespace {
 
@@ -248,6 +250,8 @@ bool Passes(const Evaluation& e, double ground_z_m, const DropSpotConfig& config
 DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics, const bus::Pose& camera,
                         double default_x_m, double default_y_m, double yaw_rad, double ground_z_m,
                         const DropSpotConfig& config) {
+  SWARMBOX_CHECK(depth_m.empty() || depth_m.type() == CV_32F);
+  SWARMBOX_CHECK(config.length_m > 0 && config.width_m > 0 && config.grid_step_m > 0 && config.search_radius_m >= 0);
   const Frame f{default_x_m, default_y_m, std::cos(yaw_rad), std::sin(yaw_rad), ground_z_m};
   CellGrid grid(config.search_radius_m + std::hypot(config.length_m, config.width_m) / 2 + kCell_m);
   grid.Summarize(BinPoints(depth_m, intrinsics, camera, f, grid));
