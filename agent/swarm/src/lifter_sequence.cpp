@@ -20,6 +20,9 @@ constexpr double kLandingPointAboveAttach_m = 1.0;  // the move to the landing p
 constexpr double kLandingPointSpeed_m_s = 0.5;  // over the landing point: slower than this
 constexpr double kOnGroundAboveBase_m = 0.15;   // touched down: body this close to base height
 constexpr double kOnGroundSpeed_m_s = 0.3;
+// The survey's depth image needs the camera near survey_height_m, not exactly there: 1 m is 12 %
+// of the ground resolution at 8 m.
+constexpr double kSurveyHeightTolerance_m = 1.0;
 
 Vec3 At(const Vec2& xy_m, double z_m) { return {xy_m.x(), xy_m.y(), z_m}; }
 
@@ -32,6 +35,7 @@ std::string_view LifterSequence::StageName(Stage stage) {
     case Stage::kAttachEmpty: return "attach_empty";
     case Stage::kClimbToTransit: return "climb";
     case Stage::kTransitToVictim: return "transit_to_victim";
+    case Stage::kSurveyDropPoint: return "survey_drop_point";
     case Stage::kDescendToRelease: return "descend_to_release";
     case Stage::kRelease: return "release";
     case Stage::kWaitLoading: return "loading";
@@ -54,6 +58,10 @@ LifterSequence::LifterSequence(LifterConfig config)
   SWARMBOX_CHECK(config_.sling_length_m > 0 && config_.transit_altitude_m > config_.AttachHeight());
   SWARMBOX_CHECK(config_.release_sink_m < config_.AttachHeight() &&
                  config_.transit_altitude_m > config_.AttachHeight() - config_.release_sink_m);
+  // The surveyed stretcher must hang clear of the ground, below transit altitude.
+  SWARMBOX_CHECK(!config_.survey_drop_point || (config_.survey_height_m > config_.AttachHeight() &&
+                                                config_.survey_height_m <= config_.transit_altitude_m &&
+                                                config_.survey_timeout_s > 0));
 }
 
 void LifterSequence::Enter(Stage stage, const MissionInput& in, MissionOutput* out) {
@@ -163,7 +171,7 @@ bool LifterSequence::TakeRescue(const MissionInput& in) {
 void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
   SetpointRequest& sp = out->setpoint;
   sp = {};
-  sp.yaw_rad = in.yaw_rad;
+  sp.yaw_rad = HoldsSurveyYaw() ? survey_yaw_rad_ : in.yaw_rad;
   sp.target_m = in.position_m;
   switch (stage_) {
     case Stage::kOnGround: return RunOnGround(in, out);
@@ -173,6 +181,7 @@ void LifterSequence::RunStage(const MissionInput& in, MissionOutput* out) {
     case Stage::kClimbToTransit:  // the load check found the hook empty: go back for it
       return RunClimb(in, Stage::kTakeoffForPickup, config_.cruise_speed_m_s, Stage::kTransitToVictim, out);
     case Stage::kTransitToVictim: return RunTransitToVictim(in, out);
+    case Stage::kSurveyDropPoint: return RunSurveyDropPoint(in, out);
     case Stage::kDescendToRelease: return RunDescend(in, drop_xy_m_, Stage::kRelease, out);
     case Stage::kRelease: return RunRelease(in, out);
     case Stage::kWaitLoading: return RunWaitLoading(in, out);
@@ -249,7 +258,77 @@ void LifterSequence::RunTransitToVictim(const MissionInput& in, MissionOutput* o
     return;
   }
   Hold(At(drop_xy_m_, TransitZ()), config_.cruise_speed_m_s, true, out);
+  if (!Arrived(in, drop_xy_m_)) return;
+  if (config_.survey_drop_point) {
+    survey_asked_s_ = -1.0;
+    survey_decided_ = false;
+    Enter(Stage::kSurveyDropPoint, in, out);
+  } else {
+    Enter(Stage::kDescendToRelease, in, out);
+  }
+}
+
+bool LifterSequence::HoldsSurveyYaw() const {
+  return survey_asked_s_ >= 0 &&
+         (stage_ == Stage::kSurveyDropPoint || stage_ == Stage::kDescendToRelease || stage_ == Stage::kRelease);
+}
+
+// Settles at survey height over the default point, asks every step until the answer or the
+// timeout, then flies over the decided point at survey height (the stretcher hangs ~3.5 m above
+// the ground there: a diagonal descent toward a spot metres away would swing it low over whatever
+// moved it) and descends.
+void LifterSequence::RunSurveyDropPoint(const MissionInput& in, MissionOutput* out) {
+  if (!in.payload_attached) {
+    Enter(Stage::kTakeoffForPickup, in, out);
+    return;
+  }
+  Hold(At(drop_xy_m_, SurveyZ()), kSlowSpeed_m_s, true, out);
+  const bool at_height = std::abs(in.position_m.z() - SurveyZ()) <= kSurveyHeightTolerance_m;
+  if (survey_decided_) {
+    if (at_height && Arrived(in, drop_xy_m_)) Enter(Stage::kDescendToRelease, in, out);
+    return;
+  }
+  if (survey_asked_s_ < 0) {
+    if (!at_height || !Arrived(in, drop_xy_m_)) return;
+    survey_asked_s_ = in.t_s;
+    survey_yaw_rad_ = in.yaw_rad;  // the stretcher's length lies along it; held to the release
+    out->setpoint.yaw_rad = survey_yaw_rad_;
+  }
+  if (in.drop_spot.has_value() && in.t_s > survey_asked_s_) {
+    TakeDropSpotAnswer(in, *in.drop_spot, out);
+  } else if (in.t_s - survey_asked_s_ >= config_.survey_timeout_s) {
+    survey_decided_ = true;
+    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "drop_spot_unverified")
+                                        .Add("victim", static_cast<std::int64_t>(victim_))
+                                        .Add("reason", "no_depth")));
+  } else {
+    out->want_drop_spot = true;
+    out->drop_spot_default_xy_m = drop_xy_m_;
+    out->drop_spot_yaw_rad = survey_yaw_rad_;
+    return;
+  }
   if (Arrived(in, drop_xy_m_)) Enter(Stage::kDescendToRelease, in, out);
+}
+
+void LifterSequence::TakeDropSpotAnswer(const MissionInput& in, const DropSpotAnswer& answer, MissionOutput* out) {
+  survey_decided_ = true;
+  if (!answer.found) {
+    out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "drop_spot_none")
+                                        .Add("victim", static_cast<std::int64_t>(victim_))
+                                        .Add("x", drop_xy_m_.x(), 2)
+                                        .Add("y", drop_xy_m_.y(), 2)));
+    return;
+  }
+  const double moved_m = (answer.xy_m - drop_xy_m_).norm();
+  drop_xy_m_ = answer.xy_m;
+  out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "drop_spot_chosen")
+                                      .Add("victim", static_cast<std::int64_t>(victim_))
+                                      .Add("x", drop_xy_m_.x(), 2)
+                                      .Add("y", drop_xy_m_.y(), 2)
+                                      .Add("moved_m", moved_m, 2)
+                                      .Add("slope_deg", answer.slope_deg, 1)
+                                      .Add("default_ok", answer.default_ok)));
+  out->setpoint.target_m = At(drop_xy_m_, SurveyZ());  // over the new point first
 }
 
 void LifterSequence::RunDescend(const MissionInput& in, const Vec2& xy_m, Stage next, MissionOutput* out) {

@@ -1,6 +1,7 @@
 // Scout, lifter and leader state machines (agent/swarm/{scout_behaviour,lifter_sequence,
 // leader_planner}.hpp) step by step against a raft::MissionState driven by hand.
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <variant>
 #include <vector>
@@ -494,6 +495,145 @@ TEST_F(LifterTest, BatteryLowBeforeLoadingAbandonsTheRescueAndBringsTheStretcher
   EXPECT_EQ(out.mode, "carry_home");
   EXPECT_EQ(lifter.victim(), 0u);
   EXPECT_EQ(out.setpoint.target_m, Vector3d(0, 0, 15));
+}
+
+// The drop-spot survey (survey_drop_point): after the transit the lifter descends to survey
+// height over the default drop point (37, 0), settles, asks the host for a spot with the
+// stretcher's yaw, and takes the answer, or times out, before the descent.
+class SurveyLifterTest : public LifterTest {
+ protected:
+  static constexpr double kYaw_rad = 0.4;
+  SurveyLifterTest() {
+    lifter = LifterSequence({.name = "lifter", .home_m = Vector3d(0, 0, 0), .loading_time_s = 5.0,
+                             .survey_drop_point = true});
+  }
+  void StepWith(double t, const Vector3d& p, double yaw_rad, std::optional<DropSpotAnswer> answer = std::nullopt) {
+    MissionInput in = Input(t, m, p);
+    in.payload_attached = true;
+    in.yaw_rad = yaw_rad;
+    in.drop_spot = answer;
+    lifter.Step(in, &out);
+  }
+  // Hooks the stretcher, climbs and flies to the default drop point; returns at "survey_drop_point".
+  void FlyToTheDropPoint() {
+    const double attach_z = lifter.config().AttachHeight();
+    const double transit_z = lifter.config().transit_altitude_m;
+    StepAt(0.0, {0, 0, 0.6}, false);
+    for (double t = 0.1; t < 2.0; t += 0.1) StepAt(t, {0, 0, attach_z}, false);
+    StepAt(2.0, {0, 0, attach_z}, true);
+    StepAt(2.1, {0, 0, transit_z}, true);
+    ASSERT_EQ(out.mode, "transit_to_victim");
+    StepAt(3.0, {37, 0, transit_z}, true);
+  }
+  double survey_z() const { return lifter.config().survey_height_m; }
+};
+
+TEST_F(SurveyLifterTest, DescendsToSurveyHeightAndAsksOnceSettledWithTheStretchersYaw) {
+  FlyToTheDropPoint();
+  ASSERT_EQ(out.mode, "survey_drop_point");
+  EXPECT_TRUE(HasEvent(out, "mission_stage"));
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(37, 0, survey_z()));
+  EXPECT_TRUE(out.setpoint.damp_swing);
+  EXPECT_FALSE(out.want_drop_spot);  // still at transit altitude
+  StepWith(4.0, {37, 0, 11.0}, kYaw_rad);
+  EXPECT_FALSE(out.want_drop_spot);  // descending
+  StepWith(5.0, {37, 0, survey_z()}, kYaw_rad);
+  ASSERT_TRUE(out.want_drop_spot);
+  EXPECT_EQ(out.drop_spot_default_xy_m, Vector2d(37, 0));
+  EXPECT_DOUBLE_EQ(out.drop_spot_yaw_rad, kYaw_rad);
+  EXPECT_EQ(out.mode, "survey_drop_point");
+  // It keeps asking, and holds the yaw it asked with though the body turns a little.
+  StepWith(5.1, {37, 0, survey_z()}, kYaw_rad + 0.05);
+  EXPECT_TRUE(out.want_drop_spot);
+  EXPECT_DOUBLE_EQ(out.drop_spot_yaw_rad, kYaw_rad);
+  EXPECT_DOUBLE_EQ(out.setpoint.yaw_rad, kYaw_rad);
+}
+
+TEST_F(SurveyLifterTest, AFoundSpotMovesTheDropPointAndTheStretcherGoesDownThere) {
+  FlyToTheDropPoint();
+  StepWith(5.0, {37, 0, survey_z()}, kYaw_rad);
+  ASSERT_TRUE(out.want_drop_spot);
+  const DropSpotAnswer answer{.found = true, .xy_m = Vector2d(37, 4), .slope_deg = 1.5, .height_m = 0.02};
+  StepWith(5.2, {37, 0, survey_z()}, kYaw_rad, answer);
+  EXPECT_TRUE(HasEvent(out, "drop_spot_chosen"));
+  EXPECT_FALSE(out.want_drop_spot);
+  EXPECT_EQ(lifter.drop_xy_m(), Vector2d(37, 4));
+  const std::string line = out.events.back().str();
+  EXPECT_NE(line.find("moved_m=4.00"), std::string::npos) << line;
+  EXPECT_NE(line.find("slope_deg=1.5"), std::string::npos) << line;
+  EXPECT_NE(line.find("default_ok=false"), std::string::npos) << line;
+  // First over the new point at survey height, then down.
+  EXPECT_EQ(out.mode, "survey_drop_point");
+  EXPECT_EQ(out.setpoint.target_m, Vector3d(37, 4, survey_z()));
+  StepWith(8.0, {37, 4, survey_z()}, kYaw_rad);
+  ASSERT_EQ(out.mode, "descend_to_release");
+  const Vector3d release = out.setpoint.target_m;
+  EXPECT_EQ(release.head<2>(), Vector2d(37, 4));
+  EXPECT_NEAR(release.z(), lifter.config().AttachHeight() - lifter.config().release_sink_m, 1e-12);
+  EXPECT_DOUBLE_EQ(out.setpoint.yaw_rad, kYaw_rad);
+  for (double t = 8.1; t < 10.0; t += 0.1) StepWith(t, release, kYaw_rad + 0.1);
+  ASSERT_EQ(out.mode, "release");
+  EXPECT_DOUBLE_EQ(out.setpoint.yaw_rad, kYaw_rad);  // the stretcher lies as surveyed
+  StepAt(10.1, release, false);
+  EXPECT_EQ(out.mode, "loading");
+  EXPECT_EQ(lifter.stretcher_xy_m(), Vector2d(37, 4));
+}
+
+TEST_F(SurveyLifterTest, NoSpotFoundKeepsTheDefaultPoint) {
+  FlyToTheDropPoint();
+  StepWith(5.0, {37, 0, survey_z()}, kYaw_rad);
+  StepWith(5.2, {37, 0, survey_z()}, kYaw_rad, DropSpotAnswer{.found = false});
+  EXPECT_TRUE(HasEvent(out, "drop_spot_none"));
+  EXPECT_EQ(lifter.drop_xy_m(), Vector2d(37, 0));
+  EXPECT_EQ(out.mode, "descend_to_release");
+  EXPECT_EQ(out.setpoint.target_m.head<2>(), Vector2d(37, 0));
+}
+
+TEST_F(SurveyLifterTest, NoAnswerWithinTheTimeoutDescendsUnverifiedAtTheDefaultPoint) {
+  FlyToTheDropPoint();
+  StepWith(5.0, {37, 0, survey_z()}, kYaw_rad);
+  ASSERT_TRUE(out.want_drop_spot);
+  const double timeout_s = lifter.config().survey_timeout_s;
+  for (double t = 5.1; t < 5.0 + timeout_s - 0.05; t += 0.1) {
+    StepWith(t, {37, 0, survey_z()}, kYaw_rad);
+    ASSERT_EQ(out.mode, "survey_drop_point") << t;
+    ASSERT_TRUE(out.want_drop_spot) << t;
+  }
+  StepWith(5.0 + timeout_s, {37, 0, survey_z()}, kYaw_rad);
+  EXPECT_TRUE(HasEvent(out, "drop_spot_unverified"));
+  EXPECT_NE(out.events.front().str().find("reason=no_depth"), std::string::npos) << out.events.front().str();
+  EXPECT_FALSE(out.want_drop_spot);
+  EXPECT_EQ(out.mode, "descend_to_release");
+  EXPECT_EQ(out.setpoint.target_m.head<2>(), Vector2d(37, 0));
+  // A late answer changes nothing.
+  StepWith(16.0, {37, 0, 5.0}, kYaw_rad, DropSpotAnswer{.found = true, .xy_m = Vector2d(40, 0)});
+  EXPECT_EQ(lifter.drop_xy_m(), Vector2d(37, 0));
+  EXPECT_FALSE(HasEvent(out, "drop_spot_chosen"));
+}
+
+// Off (the default): the sequence is the one above, step for step, whatever in.drop_spot holds.
+TEST_F(LifterTest, WithoutTheSurveyTheLifterNeverAsksAndIgnoresAnswers) {
+  EXPECT_FALSE(lifter.config().survey_drop_point);
+  const double attach_z = lifter.config().AttachHeight();
+  bool attached = false;
+  double t = 0;
+  std::vector<std::string> modes;
+  for (int guard = 1; out.mode != "move_to_land" && guard < 5000; ++guard) {
+    t += 0.1;
+    Vector3d p = out.setpoint.kind == SetpointKind::kTakeoff ? Vector3d(0, 0, attach_z) : out.setpoint.target_m;
+    if (out.mode == "on_ground" || guard == 1) p = {0, 0, 0.6};
+    if (out.payload.action == PayloadAction::kAttach) attached = true;
+    if (out.payload.action == PayloadAction::kRelease) attached = false;
+    MissionInput in = Input(t, m, p);
+    in.payload_attached = attached;
+    in.drop_spot = DropSpotAnswer{.found = true, .xy_m = Vector2d(50, 50)};
+    lifter.Step(in, &out);
+    EXPECT_FALSE(out.want_drop_spot);
+    if (modes.empty() || modes.back() != out.mode) modes.emplace_back(out.mode);
+  }
+  EXPECT_EQ(std::find(modes.begin(), modes.end(), "survey_drop_point"), modes.end());
+  EXPECT_NE(std::find(modes.begin(), modes.end(), "descend_to_release"), modes.end());
+  EXPECT_EQ(lifter.drop_xy_m(), Vector2d(37, 0));
 }
 
 // ---- leader --------------------------------------------------------------------------------

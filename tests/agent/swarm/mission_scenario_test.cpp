@@ -96,6 +96,64 @@ TEST(MissionScenario, ScoutsAndALifterFindAndRescueEveryVictim) {
   EXPECT_GT(sim.min_pair_distance_m(), 2.0);
 }
 
+// With the drop-spot survey: the lifter stops at survey height over each default drop point, the
+// fake depth host answers a spot 4 m aside, the stretcher goes down there, and the rescues complete
+// as before; with no depth at all the survey times out and the default point is used.
+std::vector<std::string> SurveyRescueStages() {
+  return {"takeoff_for_pickup", "attach_empty", "climb", "transit_to_victim", "survey_drop_point",
+          "descend_to_release", "release", "loading", "attach_loaded", "climb_loaded", "carry_home",
+          "descend_to_drop", "release_at_home", "move_to_land", "landing", "on_ground"};
+}
+
+std::size_t CountEvents(const MissionSim& sim, const std::string& event) {
+  return static_cast<std::size_t>(std::count_if(sim.log().begin(), sim.log().end(), [&](const std::string& line) {
+    return FindField(ParseLogfmt(line), "event") == event;
+  }));
+}
+
+TEST(MissionScenario, TheLifterSurveysEachDropPointAndSetsTheStretcherDownWhereTheDepthSays) {
+  MissionSimConfig c = BaseConfig();
+  c.drones.push_back({"lifter", Role::kLifter, Vec3(-80, -58, 0), 0.6});
+  c.lifter_survey_drop_point = true;
+  c.drop_spot_offset_m = Vec2(0.0, 4.0);
+  MissionSim sim(c);
+  ASSERT_TRUE(sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 2000.0));
+  for (const raft::Victim& v : sim.mission().victims()) EXPECT_EQ(v.status, raft::VictimStatus::kRescued);
+  std::vector<std::string> expected;
+  for (std::size_t i = 0; i < c.victims_m.size(); ++i) {
+    const std::vector<std::string> one = SurveyRescueStages();
+    expected.insert(expected.end(), one.begin(), one.end());
+  }
+  EXPECT_EQ(Stages(sim, "lifter"), expected);
+  EXPECT_EQ(CountEvents(sim, "drop_spot_chosen"), c.victims_m.size());
+  EXPECT_EQ(CountEvents(sim, "drop_spot_unverified"), 0u);
+  // Each stretcher went down at the chosen spot: 4 m from the default point, which is 3 m from
+  // the victim toward home.
+  for (const std::string& line : sim.log()) {
+    const LogfmtFields f = ParseLogfmt(line);
+    if (FindField(f, "event") != "drop_spot_chosen") continue;
+    EXPECT_EQ(FindField(f, "moved_m"), "4.00") << line;
+  }
+  const std::string released = sim.FirstLine("stretcher_released");
+  const std::string chosen = sim.FirstLine("drop_spot_chosen");
+  const LogfmtFields r = ParseLogfmt(released), ch = ParseLogfmt(chosen);
+  EXPECT_EQ(FindField(r, "x"), FindField(ch, "x")) << released << "\n" << chosen;
+  EXPECT_EQ(FindField(r, "y"), FindField(ch, "y")) << released << "\n" << chosen;
+  EXPECT_GT(sim.FirstTime("stretcher_released"), sim.FirstTime("drop_spot_chosen"));
+}
+
+TEST(MissionScenario, WithoutDepthTheLiftersSurveyTimesOutAndKeepsTheDefaultDropPoint) {
+  MissionSimConfig c = BaseConfig();
+  c.drones.push_back({"lifter", Role::kLifter, Vec3(-80, -58, 0), 0.6});
+  c.lifter_survey_drop_point = true;  // and no drop_spot_offset_m: nobody answers
+  MissionSim sim(c);
+  ASSERT_TRUE(sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 2000.0));
+  for (const raft::Victim& v : sim.mission().victims()) EXPECT_EQ(v.status, raft::VictimStatus::kRescued);
+  EXPECT_EQ(CountEvents(sim, "drop_spot_unverified"), c.victims_m.size());
+  EXPECT_EQ(CountEvents(sim, "drop_spot_chosen"), 0u);
+  EXPECT_NE(sim.FirstLine("drop_spot_unverified").find("reason=no_depth"), std::string::npos);
+}
+
 TEST(MissionScenario, WithoutALifterScoutsOrbitEachVictimThenComplete) {
   MissionSim sim(BaseConfig());
   ASSERT_TRUE(sim.RunUntil([](const MissionSim& s) { return s.Logged("mission_complete"); }, 2000.0));

@@ -40,6 +40,7 @@ MissionSim::MissionSim(MissionSimConfig config)
     yaw_.push_back(0.0);
     modes_.push_back("on_ground");
     out_.emplace_back();
+    drop_spot_answers_.emplace_back();
     detections_.emplace_back();
     flock_.emplace_back(fp, Geofence::Centered(config_.geofence_m.x(), config_.geofence_m.y()));
     if (d.role == Role::kScout) {
@@ -68,6 +69,7 @@ MissionSim::MissionSim(MissionSimConfig config)
       c.home_m = d.home_m;
       c.base_height_m = d.base_height_m;
       c.loading_time_s = config_.loading_time_s;
+      c.survey_drop_point = config_.lifter_survey_drop_point;
       behaviour_of_.push_back(static_cast<int>(lifters_.size()));
       lifters_.emplace_back(c);
       stretcher_xy_ = d.home_m.head<2>();
@@ -190,6 +192,7 @@ void MissionSim::Step() {
     in.battery_low = battery < 0.2;
     in.payload_attached = d.role == Role::kLifter && attached_;
     in.detections = detections_[i];
+    in.drop_spot = std::exchange(drop_spot_answers_[i], std::nullopt);
     MissionOutput& out = out_[i];
     if (d.role == Role::kScout) {
       scouts_[static_cast<std::size_t>(behaviour_of_[i])].Step(in, &out);
@@ -197,6 +200,10 @@ void MissionSim::Step() {
       lifters_[static_cast<std::size_t>(behaviour_of_[i])].Step(in, &out);
     }
     modes_[i] = out.mode;
+    if (out.want_drop_spot && config_.drop_spot_offset_m) {  // fake depth host: answers next step
+      drop_spot_answers_[i] = DropSpotAnswer{.found = true, .xy_m = out.drop_spot_default_xy_m + *config_.drop_spot_offset_m,
+                                             .slope_deg = 1.0, .height_m = d.home_m.z(), .default_ok = false};
+    }
     if (!Silent(i)) {
       heard_mode_[i] = std::string(out.mode);
       heard_pos_[i] = pos_[i].head<2>();

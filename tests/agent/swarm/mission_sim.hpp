@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -53,6 +54,11 @@ struct MissionSimConfig {
   std::vector<Vec2> false_alarms_m;
   double false_alarm_confidence = 0.9;
   double loading_time_s = 10.0;
+  // The lifter's drop-spot survey (LifterConfig::survey_drop_point) and the fake depth host's
+  // answer to want_drop_spot, on the next step: a flat spot at the default point plus
+  // drop_spot_offset_m; nullopt: no depth frames (it never answers).
+  bool lifter_survey_drop_point = false;
+  std::optional<Vec2> drop_spot_offset_m;
   double battery_fraction_at_start = 1.0;
   double battery_drain_per_s = 0.0;  // fraction per second (crude: tests of battery_low)
   bool scouts_only_report_once = false;
@@ -130,6 +136,7 @@ class MissionSim {
   std::vector<double> yaw_;
   std::vector<std::string_view> modes_;
   std::vector<MissionOutput> out_;
+  std::vector<std::optional<DropSpotAnswer>> drop_spot_answers_;  // by drone: for its next step
   std::vector<std::vector<GroundDetection>> detections_;
   std::vector<bool> false_alarm_fired_;
   std::vector<NeighbourState> scratch_;

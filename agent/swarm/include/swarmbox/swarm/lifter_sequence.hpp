@@ -6,6 +6,14 @@
 //   kAttachEmpty       settles, asks payload_attach {empty mass}, waits    ("attach_empty")
 //   kClimbToTransit    climbs to transit altitude, stretcher slung below   ("climb")
 //   kTransitToVictim   flies to the drop point beside the victim           ("transit_to_victim")
+//   kSurveyDropPoint   only with survey_drop_point: descends to survey_height_m over the default
+//                      drop point, settles, asks the host for a drop spot (want_drop_spot: the
+//                      point and the stretcher's yaw, the lifter's, then held until the release)
+//                      and takes its answer (in.drop_spot): found -> the drop point moves there
+//                      (event drop_spot_chosen; the lifter first flies over it at survey height);
+//                      not found -> drop_spot_none; no answer within survey_timeout_s ->
+//                      drop_spot_unverified reason=no_depth; both keep the default point
+//                                                                          ("survey_drop_point")
 //   kDescendToRelease  lowers the stretcher onto the ground                ("descend_to_release")
 //   kRelease           settles, asks payload_release, waits                ("release")
 //   kWaitLoading       holds while the evacuee is loaded, loading_time_s   ("loading")
@@ -78,6 +86,13 @@ struct LifterConfig {
   double arrive_speed_m_s = 1.0;
   double attach_retry_s = 3.0;
   double proposal_retry_s = 2.0;
+  // The drop-spot survey (kSurveyDropPoint; agent/depth drop_spot.hpp chooses the spot): the body's
+  // height above the ground at which the lifter looks at the drop point with its stereo camera (the
+  // sling hangs 4.5 m below the body, so the stretcher stays ~3.5 m above the ground there), and
+  // how long it waits for the host's answer once settled [m, s]. Off: the sequence is unchanged.
+  bool survey_drop_point = false;
+  double survey_height_m = 8.0;
+  double survey_timeout_s = 10.0;
 
   // Body height above the ground at which the hook reaches the stretcher lying flat [m].
   double AttachHeight() const { return payload_half_height_m + sling_length_m + hook_below_body_m; }
@@ -86,7 +101,7 @@ struct LifterConfig {
 class LifterSequence {
  public:
   enum class Stage {
-    kOnGround, kTakeoffForPickup, kAttachEmpty, kClimbToTransit, kTransitToVictim,
+    kOnGround, kTakeoffForPickup, kAttachEmpty, kClimbToTransit, kTransitToVictim, kSurveyDropPoint,
     kDescendToRelease, kRelease, kWaitLoading, kAttachLoaded, kClimbWithLoad, kCarryHome,
     kDescendToDrop, kReleaseAtHome, kMoveToLandingPoint, kLanding, kStandby,
   };
@@ -100,6 +115,9 @@ class LifterSequence {
   std::uint32_t victim() const { return victim_; }
   // Where the stretcher lies (or will be set down) on the ground [m, ENU].
   const Eigen::Vector2d& stretcher_xy_m() const { return stretcher_xy_m_; }
+  // Where the stretcher is to be set down beside the current victim: stretcher_offset_m from it
+  // toward home, or the spot the survey chose [m, ENU].
+  const Eigen::Vector2d& drop_xy_m() const { return drop_xy_m_; }
   const LifterConfig& config() const { return config_; }
 
  private:
@@ -116,6 +134,12 @@ class LifterSequence {
   void RunClimb(const MissionInput& in, Stage if_unhooked, double speed_m_s, Stage next,
                 MissionOutput* out);
   void RunTransitToVictim(const MissionInput& in, MissionOutput* out);
+  // kSurveyDropPoint: settle at survey height, ask, take the answer (or time out), then fly over
+  // the chosen point at survey height before the descent.
+  void RunSurveyDropPoint(const MissionInput& in, MissionOutput* out);
+  void TakeDropSpotAnswer(const MissionInput& in, const DropSpotAnswer& answer, MissionOutput* out);
+  // The stretcher's yaw as surveyed, held from the survey's settling to the release.
+  bool HoldsSurveyYaw() const;
   // Lowers the slung load onto the ground at `xy_m`; settled there -> `next`.
   void RunDescend(const MissionInput& in, const Eigen::Vector2d& xy_m, Stage next, MissionOutput* out);
   // Holds at release height over `xy_m` and asks for the release; true once the hook is empty
@@ -146,13 +170,14 @@ class LifterSequence {
   double AttachZ() const { return Ground() + config_.AttachHeight(); }
   double ReleaseZ() const { return AttachZ() - config_.release_sink_m; }
   double TransitZ() const { return Ground() + config_.transit_altitude_m; }
+  double SurveyZ() const { return Ground() + config_.survey_height_m; }
   Eigen::Vector2d HomeXy() const { return config_.home_m.head<2>(); }
 
   LifterConfig config_;
   Stage stage_ = Stage::kOnGround;
   std::uint32_t victim_ = 0;
   Eigen::Vector2d victim_xy_m_ = Eigen::Vector2d::Zero();
-  Eigen::Vector2d drop_xy_m_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d drop_xy_m_ = Eigen::Vector2d::Zero();  // where the stretcher is to be set down
   Eigen::Vector2d stretcher_xy_m_ = Eigen::Vector2d::Zero();
   double stage_start_s_ = 0.0;
   double settled_since_s_ = -1.0;
@@ -160,6 +185,11 @@ class LifterSequence {
   double last_proposal_s_ = -1e9;
   std::uint32_t delivered_victim_ = 0;  // MarkRescued to (re)propose until committed
   bool battery_low_reported_ = false;
+  // The drop-spot survey: when it settled and asked (-1: not yet), whether the answer (or the
+  // timeout) is in, the yaw it asked with.
+  double survey_asked_s_ = -1.0;
+  bool survey_decided_ = false;
+  double survey_yaw_rad_ = 0.0;
 };
 
 }  // namespace swarmbox::swarm

@@ -10,6 +10,7 @@
 // Frames: world ENU [m], yaw counter-clockwise from east [rad], simulated time [s].
 #pragma once
 
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -49,6 +50,17 @@ struct PayloadRequest {
   double mass_kg = 0.0;  // kAttach: the payload's mass from now on [kg]
 };
 
+// The host's answer to MissionOutput::want_drop_spot (the lifter's survey of its drop point): what
+// agent/depth's ChooseDropSpot found in a depth frame. Plain values, so that agent/swarm needs no
+// OpenCV.
+struct DropSpotAnswer {
+  bool found = false;                                // a flat, clear footprint at xy_m
+  Eigen::Vector2d xy_m = Eigen::Vector2d::Zero();    // its centre, world ENU [m]
+  double slope_deg = 0;                              // the ground's slope there [deg]
+  double height_m = 0;                               // the ground's height there, world [m]
+  bool default_ok = false;                           // the default point itself passed
+};
+
 struct MissionInput {
   double t_s = 0.0;
   const raft::MissionState* mission = nullptr;  // committed (applied) state; never null
@@ -59,6 +71,9 @@ struct MissionInput {
   bool battery_low = false;       // BatteryModel::IsLow(...)
   bool payload_attached = false;  // the slung load hangs on the hook (lifter)
   std::span<const GroundDetection> detections;  // newly visible detections (after the latency)
+  // The lifter's drop-spot survey: the answer to an earlier want_drop_spot, once (the host sets it
+  // on one step and clears it after).
+  std::optional<DropSpotAnswer> drop_spot;
 };
 
 struct MissionOutput {
@@ -67,9 +82,18 @@ struct MissionOutput {
   std::vector<raft::MissionCommand> proposals;
   std::vector<LogEvent> events;
   std::string_view mode = "on_ground";  // static string, e.g. "searching"
+  // The lifter asks for a drop spot (every step until answered or timed out): choose a footprint
+  // near drop_spot_default_xy_m with the stretcher's length along drop_spot_yaw_rad, from a depth
+  // frame taken now, and answer in MissionInput::drop_spot.
+  bool want_drop_spot = false;
+  Eigen::Vector2d drop_spot_default_xy_m = Eigen::Vector2d::Zero();  // world ENU [m]
+  double drop_spot_yaw_rad = 0;                                       // from east, CCW [rad]
 
   void Clear() {
     payload = {};
+    want_drop_spot = false;
+    drop_spot_default_xy_m = Eigen::Vector2d::Zero();
+    drop_spot_yaw_rad = 0;
     proposals.clear();
     events.clear();
   }

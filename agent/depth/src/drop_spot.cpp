@@ -1,0 +1,285 @@
+#include "swarmbox/depth/drop_spot.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "swarmbox/common/result.hpp"
+
+namespace swarmbox::depth {
+namespace {
+
+// The binning cell [m]: ~30 pixels at 8 m (18 mm a pixel at f = 441 px), and the footprint's
+// 2.6 x 1.2 m and the 0.5 m grid are whole numbers of cells, so a footprint is exactly its cells.
+constexpr double kCell_m = 0.1;
+// A cell is seen with this many points (its median height then says something) ...
+constexpr int kMinCellPoints = 4;
+// ... and a footprint is seen when this share of its cells is: SGBM leaves small holes (and a
+// 0.6 m box 3 m from the nadir hides a 0.25 m strip behind it from 8 m), but a footprint a fifth
+// out of the image (or in the matcher's blind left band) is not known to be clear.
+constexpr double kMinCoverage = 0.8;
+
+// The footprint's frame: origin the default point, axis `along` the stretcher's length; heights
+// relative to ground_z_m.
+struct Frame {
+  double x0_m, y0_m, cos_yaw, sin_yaw, ground_z_m;
+};
+
+// A pixel's point in the footprint's frame: a along, c across [m], z above ground_z_m [m].
+struct BinnedPoint {
+  int cell;
+  float a, c, z;
+};
+
+// A cell's points: how many, their centroid and median height (the median shrugs off SGBM's
+// mismatched blobs, tens of pixels a metre off).
+struct Cell {
+  int n = 0;
+  double a_m = 0, c_m = 0;
+  double median_z_m = 0;
+  double nearby_max_z_m = -1e9;  // the highest median among the seen cells of the 3 x 3 around it
+};
+
+// Square grid of cells, index (ia, ic) in [-half, half) along and across.
+class CellGrid {
+ public:
+  explicit CellGrid(double half_extent_m)
+      : half_(static_cast<int>(std::ceil(half_extent_m / kCell_m))),
+        side_(2 * half_),
+        cells_(static_cast<std::size_t>(side_) * static_cast<std::size_t>(side_)) {}
+
+  // The cell holding (a, c), or -1 outside the grid.
+  int IndexOf(double a_m, double c_m) const {
+    const int ia = static_cast<int>(std::floor(a_m / kCell_m)), ic = static_cast<int>(std::floor(c_m / kCell_m));
+    return Inside(ia, ic) ? (ia + half_) * side_ + ic + half_ : -1;
+  }
+  bool Inside(int ia, int ic) const { return ia >= -half_ && ia < half_ && ic >= -half_ && ic < half_; }
+  const Cell& At(int ia, int ic) const { return cells_[static_cast<std::size_t>((ia + half_) * side_ + ic + half_)]; }
+  void Summarize(const std::vector<BinnedPoint>& points);
+  // Each cell's nearby_max_z_m (after Summarize).
+  void SpreadMaxima();
+
+ private:
+  int half_, side_;
+  std::vector<Cell> cells_;
+};
+
+// Counting sort of the points' heights by cell, then each cell's median.
+void CellGrid::Summarize(const std::vector<BinnedPoint>& points) {
+  std::vector<std::size_t> start(cells_.size() + 1, 0);
+  for (const BinnedPoint& p : points) {
+    Cell& cell = cells_[static_cast<std::size_t>(p.cell)];
+    ++cell.n, cell.a_m += p.a, cell.c_m += p.c;
+    ++start[static_cast<std::size_t>(p.cell) + 1];
+  }
+  for (std::size_t i = 1; i < start.size(); ++i) start[i] += start[i - 1];
+  std::vector<float> z(points.size());
+  std::vector<std::size_t> next(start.begin(), start.end() - 1);
+  for (const BinnedPoint& p : points) z[next[static_cast<std::size_t>(p.cell)]++] = p.z;
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    Cell& cell = cells_[i];
+    if (cell.n == 0) continue;
+    cell.a_m /= cell.n, cell.c_m /= cell.n;
+    const auto first = z.begin() + static_cast<std::ptrdiff_t>(start[i]);
+    const auto mid = first + cell.n / 2;
+    std::nth_element(first, mid, z.begin() + static_cast<std::ptrdiff_t>(start[i + 1]));
+    cell.median_z_m = *mid;
+  }
+}
+
+void CellGrid::SpreadMaxima() {
+  for (int ia = -half_; ia < half_; ++ia) {
+    for (int ic = -half_; ic < half_; ++ic) {
+      double highest = -1e9;
+      for (int na = std::max(-half_, ia - 1); na <= std::min(half_ - 1, ia + 1); ++na) {
+        for (int nc = std::max(-half_, ic - 1); nc <= std::min(half_ - 1, ic + 1); ++nc) {
+          const Cell& n = At(na, nc);
+          if (n.n >= kMinCellPoints) highest = std::max(highest, n.median_z_m);
+        }
+      }
+      cells_[static_cast<std::size_t>((ia + half_) * side_ + ic + half_)].nearby_max_z_m = highest;
+    }
+  }
+}
+
+// Rotation matrix of a unit quaternion (w x y z), row-major: v_world = R v.
+std::array<double, 9> RotationMatrix(const std::array<double, 4>& q) {
+  const double w = q[0], x = q[1], y = q[2], z = q[3];
+  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
+          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
+          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+}
+
+// Back-projects every pixel with depth once (as FitGroundPlane) into the footprint's frame and
+// keeps those inside the grid.
+std::vector<BinnedPoint> BinPoints(const cv::Mat& depth_m, const CameraIntrinsics& k, const bus::Pose& camera,
+                                   const Frame& f, const CellGrid& grid) {
+  const std::array<double, 9> r = RotationMatrix(camera.orientation_wxyz);
+  const auto& c = camera.position_enu_m;
+  std::vector<BinnedPoint> points;
+  points.reserve(depth_m.total());
+  for (int v = 0; v < depth_m.rows; ++v) {
+    const auto* row = depth_m.ptr<float>(v);
+    const double oy_per_z = (v + 0.5 - k.cy_px) / k.focal_px;
+    for (int u = 0; u < depth_m.cols; ++u) {
+      const double z = row[u];
+      if (!(z > 0)) continue;
+      const double ox = (u + 0.5 - k.cx_px) / k.focal_px * z, oy = oy_per_z * z;
+      const double dx = c[0] + r[0] * ox + r[1] * oy + r[2] * z - f.x0_m;
+      const double dy = c[1] + r[3] * ox + r[4] * oy + r[5] * z - f.y0_m;
+      const double wz = c[2] + r[6] * ox + r[7] * oy + r[8] * z - f.ground_z_m;
+      const double a = dx * f.cos_yaw + dy * f.sin_yaw, across = -dx * f.sin_yaw + dy * f.cos_yaw;
+      const int cell = grid.IndexOf(a, across);
+      if (cell >= 0) points.push_back({cell, static_cast<float>(a), static_cast<float>(across), static_cast<float>(wz)});
+    }
+  }
+  return points;
+}
+
+// A candidate centre: (i, j) grid steps along and across from the default point.
+struct Candidate {
+  int i, j;
+};
+
+// The grid's centres within the search radius, nearest first (ties: smaller i, then smaller j).
+std::vector<Candidate> Candidates(const DropSpotConfig& config) {
+  const int n = static_cast<int>(std::floor(config.search_radius_m / config.grid_step_m));
+  const double r_steps = config.search_radius_m / config.grid_step_m;
+  std::vector<Candidate> out;
+  for (int i = -n; i <= n; ++i) {
+    for (int j = -n; j <= n; ++j) {
+      if (i * i + j * j <= r_steps * r_steps + 1e-9) out.push_back({i, j});
+    }
+  }
+  std::sort(out.begin(), out.end(), [](const Candidate& p, const Candidate& q) {
+    return std::make_tuple(p.i * p.i + p.j * p.j, p.i, p.j) < std::make_tuple(q.i * q.i + q.j * q.j, q.i, q.j);
+  });
+  return out;
+}
+
+// The cells whose centres lie inside the footprint centred at offset `centre_m` ([first, last]).
+std::pair<int, int> CellRange(double centre_m, double size_m) {
+  return {static_cast<int>(std::ceil((centre_m - size_m / 2) / kCell_m - 0.5 - 1e-9)),
+          static_cast<int>(std::floor((centre_m + size_m / 2) / kCell_m - 0.5 + 1e-9))};
+}
+
+// A footprint's seen cells: how many of its cells there are and are seen, the points in all of
+// them, and the least-squares sums of the seen cells' (a - a0, c - c0, median z).
+struct FootprintCells {
+  int cells = 0, seen = 0, points = 0;
+  double highest_m = -1e9;            // the highest seen cell's median in or next to it, above ground_z_m
+  std::pair<int, int> along, across;  // cell ranges
+  cv::Matx33d normal = cv::Matx33d::zeros();
+  cv::Vec3d rhs{0, 0, 0};
+};
+
+FootprintCells GatherCells(const CellGrid& grid, double a0_m, double c0_m, const DropSpotConfig& config) {
+  FootprintCells s;
+  s.along = CellRange(a0_m, config.length_m);
+  s.across = CellRange(c0_m, config.width_m);
+  for (int ia = s.along.first; ia <= s.along.second; ++ia) {
+    for (int ic = s.across.first; ic <= s.across.second; ++ic) {
+      ++s.cells;
+      if (!grid.Inside(ia, ic)) continue;
+      const Cell& cell = grid.At(ia, ic);
+      s.points += cell.n;
+      s.highest_m = std::max(s.highest_m, cell.nearby_max_z_m);
+      if (cell.n < kMinCellPoints) continue;
+      ++s.seen;
+      const cv::Vec3d row(1.0, cell.a_m - a0_m, cell.c_m - c0_m);
+      s.normal += row * row.t();
+      s.rhs += row * cell.median_z_m;
+    }
+  }
+  return s;
+}
+
+// RMS of the seen cells' median heights about the plane z = h + ga (a - a0) + gc (c - c0).
+double CellRoughness(const CellGrid& grid, const FootprintCells& s, double a0, double c0, const cv::Vec3d& plane) {
+  double sum_sq = 0;
+  for (int ia = s.along.first; ia <= s.along.second; ++ia) {
+    for (int ic = s.across.first; ic <= s.across.second; ++ic) {
+      if (!grid.Inside(ia, ic)) continue;
+      const Cell& cell = grid.At(ia, ic);
+      if (cell.n < kMinCellPoints) continue;
+      const double r = cell.median_z_m - (plane[0] + plane[1] * (cell.a_m - a0) + plane[2] * (cell.c_m - c0));
+      sum_sq += r * r;
+    }
+  }
+  return std::sqrt(sum_sq / s.seen);
+}
+
+// A candidate's fit, and its highest cell above ground_z_m [m] (-1e9 if none seen).
+struct Evaluation {
+  GroundFit fit;
+  double highest_cell_m = -1e9;
+};
+
+Evaluation Evaluate(const CellGrid& grid, const Frame& f, double a0, double c0, const DropSpotConfig& config) {
+  const FootprintCells s = GatherCells(grid, a0, c0, config);
+  Evaluation e;
+  GroundFit& fit = e.fit;
+  fit.points = s.points;
+  if (fit.points < config.min_points || s.seen < kMinCoverage * s.cells) return e;
+  cv::Vec3d plane;
+  if (!cv::solve(s.normal, s.rhs, plane, cv::DECOMP_CHOLESKY)) return e;  // cells on a line
+  fit.valid = true;
+  fit.height_m = f.ground_z_m + plane[0];
+  // z = h + ga a + gc c with a = dx cos + dy sin, c = -dx sin + dy cos.
+  fit.gradient_x = plane[1] * f.cos_yaw - plane[2] * f.sin_yaw;
+  fit.gradient_y = plane[1] * f.sin_yaw + plane[2] * f.cos_yaw;
+  fit.slope_rad = std::atan(std::hypot(plane[1], plane[2]));
+  fit.rms_residual_m = CellRoughness(grid, s, a0, c0, plane);
+  e.highest_cell_m = s.highest_m;
+  return e;
+}
+
+bool Passes(const Evaluation& e, double ground_z_m, const DropSpotConfig& config) {
+  const GroundFit& fit = e.fit;
+  return fit.valid && fit.slope_rad <= config.max_slope_rad && fit.rms_residual_m <= config.max_roughness_m &&
+         std::abs(fit.height_m - ground_z_m) <= config.max_height_above_ground_m &&
+         e.highest_cell_m <= config.max_height_above_ground_m;
+}
+
+}  // namespace
+
+DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics, const bus::Pose& camera,
+                        double default_x_m, double default_y_m, double yaw_rad, double ground_z_m,
+                        const DropSpotConfig& config) {
+  SWARMBOX_CHECK(depth_m.empty() || depth_m.type() == CV_32F);
+  SWARMBOX_CHECK(config.length_m > 0 && config.width_m > 0 && config.grid_step_m > 0 && config.search_radius_m >= 0);
+  const Frame f{default_x_m, default_y_m, std::cos(yaw_rad), std::sin(yaw_rad), ground_z_m};
+  CellGrid grid(config.search_radius_m + std::hypot(config.length_m, config.width_m) / 2 + kCell_m);
+  grid.Summarize(BinPoints(depth_m, intrinsics, camera, f, grid));
+  grid.SpreadMaxima();
+  DropSpot spot;
+  spot.x_m = default_x_m;
+  spot.y_m = default_y_m;
+  for (const Candidate& cand : Candidates(config)) {
+    const double a0 = cand.i * config.grid_step_m, c0 = cand.j * config.grid_step_m;
+    const Evaluation e = Evaluate(grid, f, a0, c0, config);
+    const GroundFit& fit = e.fit;
+    const bool ok = Passes(e, ground_z_m, config);
+    if (cand.i == 0 && cand.j == 0) {
+      spot.at_default = fit;
+      spot.default_ok = ok;
+    }
+    if (!fit.valid) continue;
+    ++spot.candidates;
+    if (!ok) continue;
+    ++spot.flat;
+    if (spot.found) continue;  // nearest first: the first to pass is the choice
+    spot.found = true;
+    spot.x_m = default_x_m + a0 * f.cos_yaw - c0 * f.sin_yaw;
+    spot.y_m = default_y_m + a0 * f.sin_yaw + c0 * f.cos_yaw;
+    spot.fit = fit;
+  }
+  if (!spot.found) spot.fit = spot.at_default;  // the spot stays the default point
+  return spot;
+}
+
+}  // namespace swarmbox::depth

@@ -1,0 +1,182 @@
+// ChooseDropSpot on rendered scenes: the lifter's stereo camera ~8 m over the default drop point
+// (its survey height), yawed so that the footprint's frame is not the world's, over a flat ground
+// with rubble's texture (strong in sun, so SGBM has something to match): a 2.5 x 2.5 x 0.6 m box
+// of rubble on the default point, the bare ground, and real rubble heaps. Each on the renderer's
+// true depth (the geometry) and on StereoSGBM's depth of the rendered pair (what the agent has).
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "swarmbox/depth/drop_spot.hpp"
+#include "swarmbox/depth/stereo_matcher.hpp"
+#include "swarmbox/physics/stereo_renderer.hpp"
+
+namespace swarmbox::depth {
+namespace {
+
+constexpr double kSceneSize_m = 40.0;
+constexpr double kDefaultX_m = 1.0, kDefaultY_m = -0.5;  // the default drop point
+constexpr double kBoxSize_m = 2.5, kBoxTop_m = 0.6;
+constexpr double kBodyHeight_m = 8.0;  // LifterConfig::survey_height_m
+constexpr double kYaw_rad = 0.6;       // the lifter's yaw: the stretcher's length lies along it
+
+// Rubble's texture on flat ground (heights zeroed).
+physics::StereoScene FlatTexturedGround() {
+  physics::StereoScene scene = physics::MakeSurfaceScene(physics::StereoSurface::kRubble, kSceneSize_m, 3);
+  scene.height_m.setTo(0.0f);
+  scene.UpdateHeightRange();
+  return scene;
+}
+
+// The box on the default point, its top textured like the rubble around it (AddBox paints one
+// albedo, which in sun leaves SGBM nothing to match on the top).
+physics::StereoScene BoxOnDefaultPoint() {
+  physics::StereoScene scene = FlatTexturedGround();
+  const cv::Mat texture = scene.albedo.clone();
+  physics::AddBox(&scene, {kDefaultX_m, kDefaultY_m, 0}, {kBoxSize_m, kBoxSize_m, 0}, kBoxTop_m, 0.4);
+  texture.copyTo(scene.albedo);
+  return scene;
+}
+
+// Rubble heaped everywhere: the rubble surface (its own heaps and chunks) with a mound 0.8 m high
+// (sigma 0.6 m) every 2.5 m, so that no 2.6 x 1.2 m footprint fits between them on flat ground.
+physics::StereoScene HeapedRubble() {
+  constexpr double kSpacing_m = 2.5, kMound_m = 0.8, kSigma_m = 0.6;
+  physics::StereoScene scene = physics::MakeSurfaceScene(physics::StereoSurface::kRubble, kSceneSize_m, 11);
+  for (int row = 0; row < scene.height_m.rows; ++row) {
+    const double y = scene.origin_y_m + row * scene.cell_m;
+    const double dy = y - kSpacing_m * std::round(y / kSpacing_m);
+    for (int col = 0; col < scene.height_m.cols; ++col) {
+      const double x = scene.origin_x_m + col * scene.cell_m;
+      const double dx = x - kSpacing_m * std::round(x / kSpacing_m);
+      scene.height_m.at<float>(row, col) +=
+          static_cast<float>(kMound_m * std::exp(-(dx * dx + dy * dy) / (2 * kSigma_m * kSigma_m)));
+    }
+  }
+  scene.UpdateHeightRange();
+  return scene;
+}
+
+bus::Pose ToBus(const physics::Pose& p) {
+  return {{p.position_m.x, p.position_m.y, p.position_m.z}, {p.attitude.w, p.attitude.x, p.attitude.y, p.attitude.z}};
+}
+
+struct Views {
+  physics::StereoFrame frame;
+  bus::Pose camera;
+  cv::Mat sgbm_depth_m;
+};
+
+// The pair from kBodyHeight_m over the default point, level, yawed kYaw_rad; SGBM's depth of it.
+Views Survey(const physics::StereoScene& scene) {
+  physics::StereoSpec spec;
+  spec.enabled = true;
+  physics::Pose body;
+  body.position_m = {kDefaultX_m, kDefaultY_m, kBodyHeight_m};
+  body.attitude = {std::cos(kYaw_rad / 2), 0.0, 0.0, std::sin(kYaw_rad / 2)};
+  physics::StereoRenderer renderer(&scene);
+  Views views;
+  renderer.Render(body, spec, 5, &views.frame);
+  views.camera = LeftCameraPose(ToBus(body), {.offset_body_m = {spec.offset_m.x, spec.offset_m.y, spec.offset_m.z},
+                                              .baseline_m = spec.baseline_m});
+  StereoMatcher matcher({.num_disparities = spec.num_disparities});
+  matcher.Compute(views.frame.left, views.frame.right, views.frame.focal_px, views.frame.baseline_m,
+                  &views.sgbm_depth_m);
+  return views;
+}
+
+DropSpot Choose(const Views& views, const cv::Mat& depth_m, const char* what) {
+  const CameraIntrinsics k{views.frame.focal_px, views.frame.cx_px, views.frame.cy_px};
+  const auto start = std::chrono::steady_clock::now();
+  const DropSpot spot = ChooseDropSpot(depth_m, k, views.camera, kDefaultX_m, kDefaultY_m, kYaw_rad, 0.0, {});
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  std::printf("%s: found=%d at (%.2f, %.2f) default_ok=%d candidates=%d flat=%d %.1f ms; default h=%.3f "
+              "slope=%.2f deg rms=%.3f valid=%d; chosen h=%.3f slope=%.2f deg rms=%.3f\n",
+              what, spot.found, spot.x_m, spot.y_m, spot.default_ok, spot.candidates, spot.flat, ms,
+              spot.at_default.height_m, spot.at_default.slope_rad * 180 / M_PI, spot.at_default.rms_residual_m,
+              spot.at_default.valid, spot.fit.height_m, spot.fit.slope_rad * 180 / M_PI, spot.fit.rms_residual_m);
+  return spot;
+}
+
+// Whether the stretcher's footprint (config size, along kYaw_rad) centred at (x, y) overlaps the
+// box: sampled every 2 cm.
+bool OverlapsBox(double x_m, double y_m, const DropSpotConfig& config = {}) {
+  constexpr double kSample_m = 0.02;
+  const double c = std::cos(kYaw_rad), s = std::sin(kYaw_rad);
+  for (double a = -config.length_m / 2; a <= config.length_m / 2; a += kSample_m) {
+    for (double b = -config.width_m / 2; b <= config.width_m / 2; b += kSample_m) {
+      const double px = x_m + a * c - b * s - kDefaultX_m, py = y_m + a * s + b * c - kDefaultY_m;
+      if (std::abs(px) <= kBoxSize_m / 2 && std::abs(py) <= kBoxSize_m / 2) return true;
+    }
+  }
+  return false;
+}
+
+// Every grid candidate nearer to the default point than (x, y) overlaps the box: the choice is the
+// nearest clear spot.
+void ExpectNearestClear(double x_m, double y_m) {
+  const DropSpotConfig config;
+  const double chosen = std::hypot(x_m - kDefaultX_m, y_m - kDefaultY_m);
+  const int n = static_cast<int>(config.search_radius_m / config.grid_step_m);
+  const double c = std::cos(kYaw_rad), s = std::sin(kYaw_rad);
+  for (int i = -n; i <= n; ++i) {
+    for (int j = -n; j <= n; ++j) {
+      const double a = i * config.grid_step_m, b = j * config.grid_step_m;
+      if (std::hypot(a, b) >= chosen - 1e-9) continue;
+      EXPECT_TRUE(OverlapsBox(kDefaultX_m + a * c - b * s, kDefaultY_m + a * s + b * c)) << i << " " << j;
+    }
+  }
+}
+
+TEST(DropSpot, OnTrueDepthTheBoxIsAvoidedForTheNearestClearSpot) {
+  const Views views = Survey(BoxOnDefaultPoint());
+  const DropSpot spot = Choose(views, views.frame.depth_truth_m, "box, truth");
+  ASSERT_TRUE(spot.found);
+  EXPECT_FALSE(spot.default_ok);
+  ASSERT_TRUE(spot.at_default.valid);
+  EXPECT_NEAR(spot.at_default.height_m, kBoxTop_m, 0.01);  // the box's flat top: level test fails
+  EXPECT_FALSE(OverlapsBox(spot.x_m, spot.y_m));
+  ExpectNearestClear(spot.x_m, spot.y_m);
+  EXPECT_NEAR(spot.fit.height_m, 0.0, 0.01);
+  EXPECT_GT(spot.flat, 0);
+  EXPECT_GT(spot.candidates, spot.flat);
+}
+
+TEST(DropSpot, OnStereoDepthTheBoxIsAvoidedForTheNearestClearSpot) {
+  const Views views = Survey(BoxOnDefaultPoint());
+  const DropSpot spot = Choose(views, views.sgbm_depth_m, "box, sgbm");
+  ASSERT_TRUE(spot.found);
+  EXPECT_FALSE(spot.default_ok);
+  EXPECT_FALSE(OverlapsBox(spot.x_m, spot.y_m));
+  ExpectNearestClear(spot.x_m, spot.y_m);
+}
+
+TEST(DropSpot, FlatGroundKeepsTheDefaultPoint) {
+  const Views views = Survey(FlatTexturedGround());
+  for (const auto& [depth, what] : {std::pair{views.frame.depth_truth_m, "flat, truth"},
+                                    std::pair{views.sgbm_depth_m, "flat, sgbm"}}) {
+    const DropSpot spot = Choose(views, depth, what);
+    ASSERT_TRUE(spot.found) << what;
+    EXPECT_TRUE(spot.default_ok) << what;
+    EXPECT_EQ(spot.x_m, kDefaultX_m);
+    EXPECT_EQ(spot.y_m, kDefaultY_m);
+  }
+}
+
+TEST(DropSpot, RubbleHeapsEverywhereLeaveNoSpot) {
+  const Views views = Survey(HeapedRubble());
+  for (const auto& [depth, what] : {std::pair{views.frame.depth_truth_m, "rubble, truth"},
+                                    std::pair{views.sgbm_depth_m, "rubble, sgbm"}}) {
+    const DropSpot spot = Choose(views, depth, what);
+    EXPECT_FALSE(spot.found) << what;
+    EXPECT_FALSE(spot.default_ok) << what;
+    EXPECT_GT(spot.candidates, 50) << what;  // seen, and none flat
+    EXPECT_EQ(spot.x_m, kDefaultX_m);
+  }
+}
+
+}  // namespace
+}  // namespace swarmbox::depth
