@@ -4,9 +4,12 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <tuple>
 #include <utility>
 #include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "swarmbox/common/result.hpp"
 
@@ -19,9 +22,18 @@ constexpr double kCell_m = 0.1;
 // A cell is seen with this many points (its median height then says something) ...
 constexpr int kMinCellPoints = 4;
 // ... and a footprint is seen when this share of its cells is: SGBM leaves small holes (and a
-// 0.6 m box 3 m from the nadir hides a 0.25 m strip behind it from 8 m), but a footprint a fifth
-// out of the image (or in the matcher's blind left band) is not known to be clear.
-constexpr double kMinCoverage = 0.8;
+// 0.6 m box 3 m from the nadir hides a 0.25 m strip behind it from 8 m), but a footprint partly
+// out of the image (or in the matcher's blind left band) is not known to be clear: with 80 %,
+// footprints at the image's edge over heaped rubble passed on SGBM's depth.
+constexpr double kMinCoverage = 0.9;
+// An obstacle: this many connected cells (0.06 m^2, a 25 cm stone) higher than
+// max_height_above_ground_m. SGBM's mismatched blobs from 8 m are mostly one or two cells; a
+// smaller stone still raises the footprint's roughness.
+constexpr int kMinObstacleCells = 6;
+// A footprint fails within this many cells of an obstacle cell (0.2 m): SGBM blurs and drops an
+// obstacle's edge (its 5 px block is 9 cm on the ground at 8 m, and its smoothing more); with one
+// cell, footprints whose margin clipped the box's corner passed.
+constexpr int kObstacleReachCells = 2;
 
 // The footprint's frame: origin the default point, axis `along` the stretcher's length; heights
 // relative to ground_z_m.
@@ -41,7 +53,7 @@ struct Cell {
   int n = 0;
   double a_m = 0, c_m = 0;
   double median_z_m = 0;
-  double nearby_max_z_m = -1e9;  // the highest median among the seen cells of the 3 x 3 around it
+  bool near_obstacle = false;  // an obstacle cell within kObstacleReachCells (MarkObstacles)
 };
 
 // Square grid of cells, index (ia, ic) in [-half, half) along and across.
@@ -60,8 +72,9 @@ class CellGrid {
   bool Inside(int ia, int ic) const { return ia >= -half_ && ia < half_ && ic >= -half_ && ic < half_; }
   const Cell& At(int ia, int ic) const { return cells_[static_cast<std::size_t>((ia + half_) * side_ + ic + half_)]; }
   void Summarize(const std::vector<BinnedPoint>& points);
-  // Each cell's nearby_max_z_m (after Summarize).
-  void SpreadMaxima();
+  // Each cell's near_obstacle (after Summarize): obstacle cells are seen cells higher than
+  // `tall_m` above the ground in a connected region of at least kMinObstacleCells.
+  void MarkObstacles(double tall_m);
 
  private:
   int half_, side_;
@@ -91,17 +104,29 @@ void CellGrid::Summarize(const std::vector<BinnedPoint>& points) {
   }
 }
 
-void CellGrid::SpreadMaxima() {
-  for (int ia = -half_; ia < half_; ++ia) {
-    for (int ic = -half_; ic < half_; ++ic) {
-      double highest = -1e9;
-      for (int na = std::max(-half_, ia - 1); na <= std::min(half_ - 1, ia + 1); ++na) {
-        for (int nc = std::max(-half_, ic - 1); nc <= std::min(half_ - 1, ic + 1); ++nc) {
-          const Cell& n = At(na, nc);
-          if (n.n >= kMinCellPoints) highest = std::max(highest, n.median_z_m);
-        }
+void CellGrid::MarkObstacles(double tall_m) {
+  cv::Mat tall(side_, side_, CV_8U, cv::Scalar(0));
+  for (int row = 0; row < side_; ++row) {
+    for (int col = 0; col < side_; ++col) {
+      const Cell& cell = cells_[static_cast<std::size_t>(row * side_ + col)];
+      if (cell.n >= kMinCellPoints && cell.median_z_m > tall_m) tall.at<std::uint8_t>(row, col) = 1;
+    }
+  }
+  cv::Mat labels, stats, centroids;
+  const int regions = cv::connectedComponentsWithStats(tall, labels, stats, centroids, 8, CV_32S);
+  cv::Mat obstacle(side_, side_, CV_8U, cv::Scalar(0));
+  for (int row = 0; row < side_; ++row) {
+    for (int col = 0; col < side_; ++col) {
+      const int label = labels.at<int>(row, col);
+      if (label > 0 && label < regions && stats.at<int>(label, cv::CC_STAT_AREA) >= kMinObstacleCells) {
+        obstacle.at<std::uint8_t>(row, col) = 1;
       }
-      cells_[static_cast<std::size_t>((ia + half_) * side_ + ic + half_)].nearby_max_z_m = highest;
+    }
+  }
+  cv::dilate(obstacle, obstacle, cv::Mat::ones(2 * kObstacleReachCells + 1, 2 * kObstacleReachCells + 1, CV_8U));
+  for (int row = 0; row < side_; ++row) {
+    for (int col = 0; col < side_; ++col) {
+      cells_[static_cast<std::size_t>(row * side_ + col)].near_obstacle = obstacle.at<std::uint8_t>(row, col) != 0;
     }
   }
 }
@@ -171,7 +196,7 @@ std::pair<int, int> CellRange(double centre_m, double size_m) {
 // them, and the least-squares sums of the seen cells' (a - a0, c - c0, median z).
 struct FootprintCells {
   int cells = 0, seen = 0, points = 0;
-  double highest_m = -1e9;            // the highest seen cell's median in or next to it, above ground_z_m
+  bool obstacle = false;              // an obstacle cell in it or next to it
   std::pair<int, int> along, across;  // cell ranges
   cv::Matx33d normal = cv::Matx33d::zeros();
   cv::Vec3d rhs{0, 0, 0};
@@ -187,7 +212,7 @@ FootprintCells GatherCells(const CellGrid& grid, double a0_m, double c0_m, const
       if (!grid.Inside(ia, ic)) continue;
       const Cell& cell = grid.At(ia, ic);
       s.points += cell.n;
-      s.highest_m = std::max(s.highest_m, cell.nearby_max_z_m);
+      s.obstacle = s.obstacle || cell.near_obstacle;
       if (cell.n < kMinCellPoints) continue;
       ++s.seen;
       const cv::Vec3d row(1.0, cell.a_m - a0_m, cell.c_m - c0_m);
@@ -213,10 +238,10 @@ double CellRoughness(const CellGrid& grid, const FootprintCells& s, double a0, d
   return std::sqrt(sum_sq / s.seen);
 }
 
-// A candidate's fit, and its highest cell above ground_z_m [m] (-1e9 if none seen).
+// A candidate's fit, and whether an obstacle reaches into it.
 struct Evaluation {
   GroundFit fit;
-  double highest_cell_m = -1e9;
+  bool obstacle = false;
 };
 
 Evaluation Evaluate(const CellGrid& grid, const Frame& f, double a0, double c0, const DropSpotConfig& config) {
@@ -234,15 +259,14 @@ Evaluation Evaluate(const CellGrid& grid, const Frame& f, double a0, double c0, 
   fit.gradient_y = plane[1] * f.sin_yaw + plane[2] * f.cos_yaw;
   fit.slope_rad = std::atan(std::hypot(plane[1], plane[2]));
   fit.rms_residual_m = CellRoughness(grid, s, a0, c0, plane);
-  e.highest_cell_m = s.highest_m;
+  e.obstacle = s.obstacle;
   return e;
 }
 
 bool Passes(const Evaluation& e, double ground_z_m, const DropSpotConfig& config) {
   const GroundFit& fit = e.fit;
   return fit.valid && fit.slope_rad <= config.max_slope_rad && fit.rms_residual_m <= config.max_roughness_m &&
-         std::abs(fit.height_m - ground_z_m) <= config.max_height_above_ground_m &&
-         e.highest_cell_m <= config.max_height_above_ground_m;
+         std::abs(fit.height_m - ground_z_m) <= config.max_height_above_ground_m && !e.obstacle;
 }
 
 }  // namespace
@@ -255,7 +279,7 @@ DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsi
   const Frame f{default_x_m, default_y_m, std::cos(yaw_rad), std::sin(yaw_rad), ground_z_m};
   CellGrid grid(config.search_radius_m + std::hypot(config.length_m, config.width_m) / 2 + kCell_m);
   grid.Summarize(BinPoints(depth_m, intrinsics, camera, f, grid));
-  grid.SpreadMaxima();
+  grid.MarkObstacles(config.max_height_above_ground_m);
   DropSpot spot;
   spot.x_m = default_x_m;
   spot.y_m = default_y_m;

@@ -1,13 +1,16 @@
 // ChooseDropSpot on rendered scenes: the lifter's stereo camera ~8 m over the default drop point
 // (its survey height), yawed so that the footprint's frame is not the world's, over a flat ground
 // with rubble's texture (strong in sun, so SGBM has something to match): a 2.5 x 2.5 x 0.6 m box
-// of rubble on the default point, the bare ground, and real rubble heaps. Each on the renderer's
-// true depth (the geometry) and on StereoSGBM's depth of the rendered pair (what the agent has).
+// of rubble on the default point, the bare ground, and rubble heaped everywhere. On the renderer's
+// true depth (the geometry: exact answers), and on StereoSGBM's depth of the rendered pair (what
+// the agent has) over several seeded scenes, since from 8 m SGBM corrupts about a quarter of the
+// footprints on flat ground (apparent slopes of 6-10 deg): the rates are what is asserted there.
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <vector>
 
 #include "swarmbox/depth/drop_spot.hpp"
@@ -23,9 +26,11 @@ constexpr double kBoxSize_m = 2.5, kBoxTop_m = 0.6;
 constexpr double kBodyHeight_m = 8.0;  // LifterConfig::survey_height_m
 constexpr double kYaw_rad = 0.6;       // the lifter's yaw: the stretcher's length lies along it
 
+constexpr std::uint64_t kTruthSeed = 3;
+
 // Rubble's texture on flat ground (heights zeroed).
-physics::StereoScene FlatTexturedGround() {
-  physics::StereoScene scene = physics::MakeSurfaceScene(physics::StereoSurface::kRubble, kSceneSize_m, 3);
+physics::StereoScene FlatTexturedGround(std::uint64_t seed) {
+  physics::StereoScene scene = physics::MakeSurfaceScene(physics::StereoSurface::kRubble, kSceneSize_m, seed);
   scene.height_m.setTo(0.0f);
   scene.UpdateHeightRange();
   return scene;
@@ -33,8 +38,8 @@ physics::StereoScene FlatTexturedGround() {
 
 // The box on the default point, its top textured like the rubble around it (AddBox paints one
 // albedo, which in sun leaves SGBM nothing to match on the top).
-physics::StereoScene BoxOnDefaultPoint() {
-  physics::StereoScene scene = FlatTexturedGround();
+physics::StereoScene BoxOnDefaultPoint(std::uint64_t seed) {
+  physics::StereoScene scene = FlatTexturedGround(seed);
   const cv::Mat texture = scene.albedo.clone();
   physics::AddBox(&scene, {kDefaultX_m, kDefaultY_m, 0}, {kBoxSize_m, kBoxSize_m, 0}, kBoxTop_m, 0.4);
   texture.copyTo(scene.albedo);
@@ -43,9 +48,9 @@ physics::StereoScene BoxOnDefaultPoint() {
 
 // Rubble heaped everywhere: the rubble surface (its own heaps and chunks) with a mound 0.8 m high
 // (sigma 0.6 m) every 2.5 m, so that no 2.6 x 1.2 m footprint fits between them on flat ground.
-physics::StereoScene HeapedRubble() {
+physics::StereoScene HeapedRubble(std::uint64_t seed) {
   constexpr double kSpacing_m = 2.5, kMound_m = 0.8, kSigma_m = 0.6;
-  physics::StereoScene scene = physics::MakeSurfaceScene(physics::StereoSurface::kRubble, kSceneSize_m, 11);
+  physics::StereoScene scene = physics::MakeSurfaceScene(physics::StereoSurface::kRubble, kSceneSize_m, seed);
   for (int row = 0; row < scene.height_m.rows; ++row) {
     const double y = scene.origin_y_m + row * scene.cell_m;
     const double dy = y - kSpacing_m * std::round(y / kSpacing_m);
@@ -70,8 +75,9 @@ struct Views {
   cv::Mat sgbm_depth_m;
 };
 
-// The pair from kBodyHeight_m over the default point, level, yawed kYaw_rad; SGBM's depth of it.
-Views Survey(const physics::StereoScene& scene) {
+// The pair from kBodyHeight_m over the default point, level, yawed kYaw_rad (read noise seeded
+// with `seed`); SGBM's depth of it.
+Views Survey(const physics::StereoScene& scene, std::uint64_t seed) {
   physics::StereoSpec spec;
   spec.enabled = true;
   physics::Pose body;
@@ -79,7 +85,7 @@ Views Survey(const physics::StereoScene& scene) {
   body.attitude = {std::cos(kYaw_rad / 2), 0.0, 0.0, std::sin(kYaw_rad / 2)};
   physics::StereoRenderer renderer(&scene);
   Views views;
-  renderer.Render(body, spec, 5, &views.frame);
+  renderer.Render(body, spec, seed, &views.frame);
   views.camera = LeftCameraPose(ToBus(body), {.offset_body_m = {spec.offset_m.x, spec.offset_m.y, spec.offset_m.z},
                                               .baseline_m = spec.baseline_m});
   StereoMatcher matcher({.num_disparities = spec.num_disparities});
@@ -103,11 +109,12 @@ DropSpot Choose(const Views& views, const cv::Mat& depth_m, const char* what) {
 
 // Whether the stretcher's footprint (config size, along kYaw_rad) centred at (x, y) overlaps the
 // box: sampled every 2 cm.
-bool OverlapsBox(double x_m, double y_m, const DropSpotConfig& config = {}) {
+bool OverlapsBox(double x_m, double y_m, double length_m = DropSpotConfig{}.length_m,
+                 double width_m = DropSpotConfig{}.width_m) {
   constexpr double kSample_m = 0.02;
   const double c = std::cos(kYaw_rad), s = std::sin(kYaw_rad);
-  for (double a = -config.length_m / 2; a <= config.length_m / 2; a += kSample_m) {
-    for (double b = -config.width_m / 2; b <= config.width_m / 2; b += kSample_m) {
+  for (double a = -length_m / 2; a <= length_m / 2; a += kSample_m) {
+    for (double b = -width_m / 2; b <= width_m / 2; b += kSample_m) {
       const double px = x_m + a * c - b * s - kDefaultX_m, py = y_m + a * s + b * c - kDefaultY_m;
       if (std::abs(px) <= kBoxSize_m / 2 && std::abs(py) <= kBoxSize_m / 2) return true;
     }
@@ -132,7 +139,7 @@ void ExpectNearestClear(double x_m, double y_m) {
 }
 
 TEST(DropSpot, OnTrueDepthTheBoxIsAvoidedForTheNearestClearSpot) {
-  const Views views = Survey(BoxOnDefaultPoint());
+  const Views views = Survey(BoxOnDefaultPoint(kTruthSeed), kTruthSeed);
   const DropSpot spot = Choose(views, views.frame.depth_truth_m, "box, truth");
   ASSERT_TRUE(spot.found);
   EXPECT_FALSE(spot.default_ok);
@@ -141,41 +148,60 @@ TEST(DropSpot, OnTrueDepthTheBoxIsAvoidedForTheNearestClearSpot) {
   EXPECT_FALSE(OverlapsBox(spot.x_m, spot.y_m));
   ExpectNearestClear(spot.x_m, spot.y_m);
   EXPECT_NEAR(spot.fit.height_m, 0.0, 0.01);
+  EXPECT_LT(spot.fit.slope_rad, 0.001);
   EXPECT_GT(spot.flat, 0);
   EXPECT_GT(spot.candidates, spot.flat);
 }
 
-TEST(DropSpot, OnStereoDepthTheBoxIsAvoidedForTheNearestClearSpot) {
-  const Views views = Survey(BoxOnDefaultPoint());
-  const DropSpot spot = Choose(views, views.sgbm_depth_m, "box, sgbm");
-  ASSERT_TRUE(spot.found);
-  EXPECT_FALSE(spot.default_ok);
-  EXPECT_FALSE(OverlapsBox(spot.x_m, spot.y_m));
-  ExpectNearestClear(spot.x_m, spot.y_m);
+TEST(DropSpot, OnTrueDepthFlatGroundKeepsTheDefaultAndHeapedRubbleHasNoSpot) {
+  const Views flat = Survey(FlatTexturedGround(kTruthSeed), kTruthSeed);
+  const DropSpot kept = Choose(flat, flat.frame.depth_truth_m, "flat, truth");
+  ASSERT_TRUE(kept.found);
+  EXPECT_TRUE(kept.default_ok);
+  EXPECT_EQ(kept.x_m, kDefaultX_m);
+  EXPECT_EQ(kept.y_m, kDefaultY_m);
+  EXPECT_EQ(kept.flat, kept.candidates);  // every footprint in view
+  EXPECT_GT(kept.candidates, 200);        // of ~450 within 6 m, those the 11.6 x 7.3 m view holds
+  const Views heaped = Survey(HeapedRubble(kTruthSeed), kTruthSeed);
+  const DropSpot none = Choose(heaped, heaped.frame.depth_truth_m, "rubble, truth");
+  EXPECT_FALSE(none.found);
+  EXPECT_FALSE(none.default_ok);
+  EXPECT_GT(none.candidates, 150);  // seen, and none flat
+  EXPECT_EQ(none.flat, 0);
+  EXPECT_EQ(none.x_m, kDefaultX_m);
+  EXPECT_EQ(none.y_m, kDefaultY_m);
 }
 
-TEST(DropSpot, FlatGroundKeepsTheDefaultPoint) {
-  const Views views = Survey(FlatTexturedGround());
-  for (const auto& [depth, what] : {std::pair{views.frame.depth_truth_m, "flat, truth"},
-                                    std::pair{views.sgbm_depth_m, "flat, sgbm"}}) {
-    const DropSpot spot = Choose(views, depth, what);
-    ASSERT_TRUE(spot.found) << what;
-    EXPECT_TRUE(spot.default_ok) << what;
-    EXPECT_EQ(spot.x_m, kDefaultX_m);
-    EXPECT_EQ(spot.y_m, kDefaultY_m);
+// Measured over seeds 1-8 and 20-39 (28 scenes; kFirstSeed/kSeeds changed by hand): the box ->
+// found, the stretcher itself clear and no nearer candidate clear every time, the whole footprint
+// (with its margins) clear 27 times (once a margin's corner clipped the box's); flat ground -> the
+// default kept 23 times (the false rejects, SGBM patches with 6-10 deg of apparent slope, send the
+// stretcher to the nearest passing spot: the safe side); heaped rubble -> no spot 28 times. Here
+// seeds 1-8 (7 and 7 of 8), the rates asserted at 6 of 8.
+TEST(DropSpot, OnStereoDepthFromEightMetresTheBoxIsAvoidedTheFlatKeptTheRubbleRefused) {
+  constexpr std::uint64_t kFirstSeed = 1, kSeeds = 8;
+  int box_footprint_clear = 0, flat_default_kept = 0;
+  for (std::uint64_t seed = kFirstSeed; seed < kFirstSeed + kSeeds; ++seed) {
+    const Views box = Survey(BoxOnDefaultPoint(seed), seed);
+    const DropSpot moved = Choose(box, box.sgbm_depth_m, "box, sgbm");
+    ASSERT_TRUE(moved.found) << seed;
+    EXPECT_FALSE(moved.default_ok) << seed;
+    EXPECT_FALSE(OverlapsBox(moved.x_m, moved.y_m, 2.0, 0.6)) << seed;  // the stretcher itself
+    ExpectNearestClear(moved.x_m, moved.y_m);
+    box_footprint_clear += OverlapsBox(moved.x_m, moved.y_m) ? 0 : 1;
+    const Views flat = Survey(FlatTexturedGround(seed), seed);
+    const DropSpot kept = Choose(flat, flat.sgbm_depth_m, "flat, sgbm");
+    ASSERT_TRUE(kept.found) << seed;
+    flat_default_kept += kept.default_ok ? 1 : 0;
+    const Views heaped = Survey(HeapedRubble(seed), seed);
+    const DropSpot none = Choose(heaped, heaped.sgbm_depth_m, "rubble, sgbm");
+    EXPECT_FALSE(none.found) << seed;
+    EXPECT_GT(none.candidates, 100) << seed;
   }
-}
-
-TEST(DropSpot, RubbleHeapsEverywhereLeaveNoSpot) {
-  const Views views = Survey(HeapedRubble());
-  for (const auto& [depth, what] : {std::pair{views.frame.depth_truth_m, "rubble, truth"},
-                                    std::pair{views.sgbm_depth_m, "rubble, sgbm"}}) {
-    const DropSpot spot = Choose(views, depth, what);
-    EXPECT_FALSE(spot.found) << what;
-    EXPECT_FALSE(spot.default_ok) << what;
-    EXPECT_GT(spot.candidates, 50) << what;  // seen, and none flat
-    EXPECT_EQ(spot.x_m, kDefaultX_m);
-  }
+  std::printf("SGBM from 8 m, %d scenes: box footprint clear %d, flat default kept %d\n", static_cast<int>(kSeeds),
+              box_footprint_clear, flat_default_kept);
+  EXPECT_GE(box_footprint_clear, 6);
+  EXPECT_GE(flat_default_kept, 6);
 }
 
 }  // namespace
