@@ -72,6 +72,12 @@ class CellGrid {
   bool Inside(int ia, int ic) const { return ia >= -half_ && ia < half_ && ic >= -half_ && ic < half_; }
   const Cell& At(int ia, int ic) const { return cells_[static_cast<std::size_t>((ia + half_) * side_ + ic + half_)]; }
   void Summarize(const std::vector<BinnedPoint>& points);
+  // The `quantile` (0..1) of the seen cells' median heights, or 0 with no cell seen (after
+  // Summarize).
+  double SeenHeightQuantile(double quantile) const;
+  // Every cell's median height moved by dz_m (the ground's height found in the view: heights are
+  // then above it).
+  void ShiftHeights(double dz_m);
   // Each cell's near_obstacle (after Summarize): obstacle cells are seen cells higher than
   // `tall_m` above the ground in a connected region of at least kMinObstacleCells.
   void MarkObstacles(double tall_m);
@@ -102,6 +108,21 @@ void CellGrid::Summarize(const std::vector<BinnedPoint>& points) {
     std::nth_element(first, mid, z.begin() + static_cast<std::ptrdiff_t>(start[i + 1]));
     cell.median_z_m = *mid;
   }
+}
+
+double CellGrid::SeenHeightQuantile(double quantile) const {
+  std::vector<double> heights;
+  for (const Cell& cell : cells_) {
+    if (cell.n >= kMinCellPoints) heights.push_back(cell.median_z_m);
+  }
+  if (heights.empty()) return 0.0;
+  const auto k = static_cast<std::ptrdiff_t>(quantile * static_cast<double>(heights.size() - 1));
+  std::nth_element(heights.begin(), heights.begin() + k, heights.end());
+  return heights[static_cast<std::size_t>(k)];
+}
+
+void CellGrid::ShiftHeights(double dz_m) {
+  for (Cell& cell : cells_) cell.median_z_m += dz_m;
 }
 
 void CellGrid::MarkObstacles(double tall_m) {
@@ -276,18 +297,32 @@ DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsi
                         const DropSpotConfig& config) {
   SWARMBOX_CHECK(depth_m.empty() || depth_m.type() == CV_32F);
   SWARMBOX_CHECK(config.length_m > 0 && config.width_m > 0 && config.grid_step_m > 0 && config.search_radius_m >= 0);
-  const Frame f{default_x_m, default_y_m, std::cos(yaw_rad), std::sin(yaw_rad), ground_z_m};
+  SWARMBOX_CHECK(config.ground_quantile < 1.0);
+  Frame f{default_x_m, default_y_m, std::cos(yaw_rad), std::sin(yaw_rad), ground_z_m};
   CellGrid grid(config.search_radius_m + std::hypot(config.length_m, config.width_m) / 2 + kCell_m);
   grid.Summarize(BinPoints(depth_m, intrinsics, camera, f, grid));
-  grid.MarkObstacles(config.max_height_above_ground_m);
   DropSpot spot;
+  if (config.ground_quantile >= 0) {  // the ground as the view shows it, not as given
+    const double offset_m = grid.SeenHeightQuantile(config.ground_quantile);
+    grid.ShiftHeights(-offset_m);
+    f.ground_z_m += offset_m;
+  }
+  spot.ground_z_m = f.ground_z_m;
+  grid.MarkObstacles(config.max_height_above_ground_m);
   spot.x_m = default_x_m;
   spot.y_m = default_y_m;
   for (const Candidate& cand : Candidates(config)) {
     const double a0 = cand.i * config.grid_step_m, c0 = cand.j * config.grid_step_m;
+    const double x_m = default_x_m + a0 * f.cos_yaw - c0 * f.sin_yaw;
+    const double y_m = default_y_m + a0 * f.sin_yaw + c0 * f.cos_yaw;
+    if (std::ranges::any_of(config.keep_out, [&](const KeepOut& k) {
+          return std::hypot(x_m - k.x_m, y_m - k.y_m) < k.radius_m;
+        })) {
+      continue;  // never closer than this to the victim (or anything else kept out)
+    }
     const Evaluation e = Evaluate(grid, f, a0, c0, config);
     const GroundFit& fit = e.fit;
-    const bool ok = Passes(e, ground_z_m, config);
+    const bool ok = Passes(e, f.ground_z_m, config);
     if (cand.i == 0 && cand.j == 0) {
       spot.at_default = fit;
       spot.default_ok = ok;
@@ -298,8 +333,8 @@ DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsi
     ++spot.flat;
     if (spot.found) continue;  // nearest first: the first to pass is the choice
     spot.found = true;
-    spot.x_m = default_x_m + a0 * f.cos_yaw - c0 * f.sin_yaw;
-    spot.y_m = default_y_m + a0 * f.sin_yaw + c0 * f.cos_yaw;
+    spot.x_m = x_m;
+    spot.y_m = y_m;
     spot.fit = fit;
   }
   if (!spot.found) spot.fit = spot.at_default;  // the spot stays the default point

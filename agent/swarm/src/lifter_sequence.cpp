@@ -305,6 +305,7 @@ void LifterSequence::RunSurveyDropPoint(const MissionInput& in, MissionOutput* o
     out->want_drop_spot = true;
     out->drop_spot_default_xy_m = drop_xy_m_;
     out->drop_spot_yaw_rad = survey_yaw_rad_;
+    out->drop_spot_victim_xy_m = victim_xy_m_;
     return;
   }
   if (Arrived(in, drop_xy_m_)) Enter(Stage::kDescendToRelease, in, out);

@@ -94,10 +94,10 @@ Views Survey(const physics::StereoScene& scene, std::uint64_t seed) {
   return views;
 }
 
-DropSpot Choose(const Views& views, const cv::Mat& depth_m, const char* what) {
+DropSpot Choose(const Views& views, const cv::Mat& depth_m, const char* what, const DropSpotConfig& config = {}) {
   const CameraIntrinsics k{views.frame.focal_px, views.frame.cx_px, views.frame.cy_px};
   const auto start = std::chrono::steady_clock::now();
-  const DropSpot spot = ChooseDropSpot(depth_m, k, views.camera, kDefaultX_m, kDefaultY_m, kYaw_rad, 0.0, {});
+  const DropSpot spot = ChooseDropSpot(depth_m, k, views.camera, kDefaultX_m, kDefaultY_m, kYaw_rad, 0.0, config);
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   std::printf("%s: found=%d at (%.2f, %.2f) default_ok=%d candidates=%d flat=%d %.1f ms; default h=%.3f "
               "slope=%.2f deg rms=%.3f valid=%d; chosen h=%.3f slope=%.2f deg rms=%.3f\n",
@@ -105,6 +105,13 @@ DropSpot Choose(const Views& views, const cv::Mat& depth_m, const char* what) {
               spot.at_default.height_m, spot.at_default.slope_rad * 180 / M_PI, spot.at_default.rms_residual_m,
               spot.at_default.valid, spot.fit.height_m, spot.fit.slope_rad * 180 / M_PI, spot.fit.rms_residual_m);
   return spot;
+}
+
+// The ground taken from the view, as the agent runs ChooseDropSpot (AgentNode::AnswerDropSpot).
+DropSpotConfig SeenGround() {
+  DropSpotConfig config;
+  config.ground_quantile = 0.3;
+  return config;
 }
 
 // Whether the stretcher's footprint (config size, along kYaw_rad) centred at (x, y) overlaps the
@@ -172,6 +179,40 @@ TEST(DropSpot, OnTrueDepthFlatGroundKeepsTheDefaultAndHeapedRubbleHasNoSpot) {
   EXPECT_EQ(none.y_m, kDefaultY_m);
 }
 
+// The drone's own height is off by half a metre (its estimate: the camera's pose is what it
+// believes): given the ground's height, every footprint looks 0.5 m below the ground and none
+// passes; with the ground taken from the view (ground_quantile, as the agent runs it) the box is
+// avoided as before and the ground's height is the believed one.
+TEST(DropSpot, TheGroundFromTheViewAbsorbsAnErrorInTheDronesOwnHeight) {
+  Views views = Survey(BoxOnDefaultPoint(kTruthSeed), kTruthSeed);
+  constexpr double kHeightError_m = 0.5;
+  views.camera.position_enu_m[2] += kHeightError_m;
+  const DropSpot given = Choose(views, views.frame.depth_truth_m, "box, truth, height off, ground given");
+  EXPECT_FALSE(given.found);
+  EXPECT_EQ(given.flat, 0);
+  const DropSpot seen = Choose(views, views.frame.depth_truth_m, "box, truth, height off, ground seen",
+                               SeenGround());
+  ASSERT_TRUE(seen.found);
+  EXPECT_FALSE(seen.default_ok);
+  EXPECT_NEAR(seen.ground_z_m, kHeightError_m, 0.01);
+  EXPECT_FALSE(OverlapsBox(seen.x_m, seen.y_m));
+  ExpectNearestClear(seen.x_m, seen.y_m);
+}
+
+// A keep-out circle (the victim) on the default point: no candidate centre falls in it, and the
+// nearest one outside is chosen on flat ground.
+TEST(DropSpot, NoCandidateInsideAKeepOut) {
+  const Views flat = Survey(FlatTexturedGround(kTruthSeed), kTruthSeed);
+  constexpr double kRadius_m = 2.0;
+  const DropSpot spot = Choose(flat, flat.frame.depth_truth_m, "flat, truth, keep-out",
+                               {.keep_out = {{.x_m = kDefaultX_m, .y_m = kDefaultY_m, .radius_m = kRadius_m}}});
+  ASSERT_TRUE(spot.found);
+  EXPECT_FALSE(spot.default_ok);
+  const double d = std::hypot(spot.x_m - kDefaultX_m, spot.y_m - kDefaultY_m);
+  EXPECT_GE(d, kRadius_m);
+  EXPECT_LT(d, kRadius_m + DropSpotConfig{}.grid_step_m);  // the nearest grid point outside
+}
+
 // Measured over seeds 1-8 and 20-39 (28 scenes; kFirstSeed/kSeeds changed by hand): the box ->
 // found, the stretcher itself clear and no nearer candidate clear every time, the whole footprint
 // (with its margins) clear 27 times (once a margin's corner clipped the box's); flat ground -> the
@@ -181,6 +222,8 @@ TEST(DropSpot, OnTrueDepthFlatGroundKeepsTheDefaultAndHeapedRubbleHasNoSpot) {
 TEST(DropSpot, OnStereoDepthFromEightMetresTheBoxIsAvoidedTheFlatKeptTheRubbleRefused) {
   constexpr std::uint64_t kFirstSeed = 1, kSeeds = 8;
   int box_footprint_clear = 0, flat_default_kept = 0;
+  int seen_box_footprint_clear = 0, seen_flat_default_kept = 0;
+  const DropSpotConfig kSeenGround = SeenGround();
   for (std::uint64_t seed = kFirstSeed; seed < kFirstSeed + kSeeds; ++seed) {
     const Views box = Survey(BoxOnDefaultPoint(seed), seed);
     const DropSpot moved = Choose(box, box.sgbm_depth_m, "box, sgbm");
@@ -197,7 +240,21 @@ TEST(DropSpot, OnStereoDepthFromEightMetresTheBoxIsAvoidedTheFlatKeptTheRubbleRe
     const DropSpot none = Choose(heaped, heaped.sgbm_depth_m, "rubble, sgbm");
     EXPECT_FALSE(none.found) << seed;
     EXPECT_GT(none.candidates, 100) << seed;
+    // The same with the ground from the view (as the agent runs it): SGBM's low bias cancels.
+    const DropSpot seen_moved = Choose(box, box.sgbm_depth_m, "box, sgbm, ground seen", kSeenGround);
+    ASSERT_TRUE(seen_moved.found) << seed;
+    EXPECT_FALSE(seen_moved.default_ok) << seed;
+    EXPECT_FALSE(OverlapsBox(seen_moved.x_m, seen_moved.y_m, 2.0, 0.6)) << seed;
+    seen_box_footprint_clear += OverlapsBox(seen_moved.x_m, seen_moved.y_m) ? 0 : 1;
+    const DropSpot seen_kept = Choose(flat, flat.sgbm_depth_m, "flat, sgbm, ground seen", kSeenGround);
+    ASSERT_TRUE(seen_kept.found) << seed;
+    seen_flat_default_kept += seen_kept.default_ok ? 1 : 0;
+    EXPECT_FALSE(Choose(heaped, heaped.sgbm_depth_m, "rubble, sgbm, ground seen", kSeenGround).found) << seed;
   }
+  std::printf("SGBM from 8 m, ground from the view, %d scenes: box footprint clear %d, flat default kept %d\n",
+              static_cast<int>(kSeeds), seen_box_footprint_clear, seen_flat_default_kept);
+  EXPECT_GE(seen_box_footprint_clear, 6);
+  EXPECT_GE(seen_flat_default_kept, 6);
   std::printf("SGBM from 8 m, %d scenes: box footprint clear %d, flat default kept %d\n", static_cast<int>(kSeeds),
               box_footprint_clear, flat_default_kept);
   EXPECT_GE(box_footprint_clear, 6);

@@ -44,6 +44,7 @@
 #pragma once
 
 #include <numbers>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -51,6 +52,13 @@
 #include "swarmbox/depth/ground_plane.hpp"
 
 namespace swarmbox::depth {
+
+// A circle no candidate's centre may fall in (the victim: the stretcher is set down beside them,
+// not on them).
+struct KeepOut {
+  double x_m = 0, y_m = 0;
+  double radius_m = 0;
+};
 
 struct DropSpotConfig {
   // The stretcher is 2.0 x 0.6 m; 0.3 m margin each side for the release's position error (the
@@ -71,6 +79,15 @@ struct DropSpotConfig {
   double search_radius_m = 6.0;  // candidate centres within this of the default point
   double grid_step_m = 0.5;      // candidate centres' spacing, along and across the footprint
   int min_points = 50;           // pixels in a footprint for a fit
+  // The ground's height from the view itself, this quantile of the seen cells' median heights
+  // (negative: ground_z_m as given). A drone knows its own height only as well as its estimate
+  // (baro and GPS: tenths of a metre), and SGBM reads flat ground 0.2-0.3 m low from 8 m (above):
+  // both shift every cell alike and cancel against the ground seen around the point. 0.3: the
+  // ground is taken to be the lowest surface covering at least 30 % of the view (a rubble field
+  // over most of the view then has its lowest parts as "ground", and its slopes and roughness
+  // still fail). The candidates' checks are then relative to that (DropSpot::ground_z_m).
+  double ground_quantile = -1.0;
+  std::vector<KeepOut> keep_out; // candidate centres inside any of these are skipped
 };
 
 struct DropSpot {
@@ -81,6 +98,7 @@ struct DropSpot {
   bool default_ok = false;     // the default point itself passed
   int candidates = 0;          // footprints evaluated with a valid fit
   int flat = 0;                // of them, passing
+  double ground_z_m = 0;       // the ground's height the checks used (ground_z_m, or the view's)
 };
 
 // `depth_m`: CV_32F along the optical axis, 0 = no depth (StereoMatcher's, or the renderer's

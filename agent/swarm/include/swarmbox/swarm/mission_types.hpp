@@ -88,12 +88,14 @@ struct MissionOutput {
   bool want_drop_spot = false;
   Eigen::Vector2d drop_spot_default_xy_m = Eigen::Vector2d::Zero();  // world ENU [m]
   double drop_spot_yaw_rad = 0;                                       // from east, CCW [rad]
+  Eigen::Vector2d drop_spot_victim_xy_m = Eigen::Vector2d::Zero();   // the spot stays off the victim
 
   void Clear() {
     payload = {};
     want_drop_spot = false;
     drop_spot_default_xy_m = Eigen::Vector2d::Zero();
     drop_spot_yaw_rad = 0;
+    drop_spot_victim_xy_m = Eigen::Vector2d::Zero();
     proposals.clear();
     events.clear();
   }
