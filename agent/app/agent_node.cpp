@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <utility>
 
 #include <opencv2/imgproc.hpp>
@@ -11,6 +12,7 @@
 #include "server_wait.hpp"
 #include "swarmbox/bus/topics.hpp"
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/depth/drop_spot.hpp"
 #include "wait_budget.hpp"
 
 namespace swarmbox::agent {
@@ -97,41 +99,17 @@ void AgentNode::Log(const LogEvent& e) {
 }
 
 bool AgentNode::TakeCamera(const bus::SensorSample& msg) {
-  image_count_ = 0;
+  camera_frames_.count = 0;
   if (!camera_sub_) return true;
-  bool have_step = false;
-  auto take = [&](bool wait, std::chrono::milliseconds slice) {
-    if (image_count_ == images_.size()) images_.emplace_back();
-    bus::CameraImage& img = images_[image_count_];
-    const bool took = wait ? camera_sub_->TakeFor(img, slice) : camera_sub_->Take(img);
-    if (!took) return false;
-    ++image_count_;
-    have_step = have_step || img.sim_time_ns == msg.sim_time_ns;
-    return true;
-  };
-  while (take(false, {})) {
-  }
-  // The physics server publishes a step's frame before its sample; DDS may still hand the sample
-  // over first (two readers). Wait for it: what the camera saw at t_k is part of step k.
-  if (!msg.camera_frame || have_step) return true;
-  WaitBudget budget(options_.camera_timeout);  // waiting time, as Run()'s
-  while (!have_step) {
-    if (options_.stop != nullptr && *options_.stop != 0) return false;
-    if (budget.spent()) {
-      // Past the liveness bound: look once more, then go on without it.
-      while (!have_step && take(false, {})) {
-      }
-      if (!have_step) {
-        Log(LogEvent(t_s_, options_.name, "camera_missing")
-                .Add("step", static_cast<std::int64_t>(msg.step))
-                .Add("after_wall_s", std::chrono::duration<double>(options_.camera_timeout).count(), 1));
-      }
+  switch (TakeStepFrames(*camera_sub_, msg.sim_time_ns, msg.camera_frame, options_.camera_timeout, options_.stop,
+                         &camera_frames_)) {
+    case FrameWait::kStopped: return false;
+    case FrameWait::kMissing:
+      Log(LogEvent(t_s_, options_.name, "camera_missing")
+              .Add("step", static_cast<std::int64_t>(msg.step))
+              .Add("after_wall_s", std::chrono::duration<double>(options_.camera_timeout).count(), 1));
       return true;
-    }
-    const auto slice = budget.Slice(std::chrono::milliseconds(50));
-    const auto start = std::chrono::steady_clock::now();
-    (void)take(true, slice);
-    budget.Spend(std::chrono::steady_clock::now() - start, slice);
+    case FrameWait::kTaken: return true;
   }
   return true;
 }
@@ -200,6 +178,7 @@ Status AgentNode::HandleSample(const bus::SensorSample& msg) {
   TakeRadioFrames(msg);
   // c. Flight, Raft, the link probe, the mission or plan, the state broadcast.
   const FlightStatus st = StepFlight(msg);
+  if (depth_ && !StepDepth(msg)) return Ok{};  // stop requested: Run() logs it
   if (Status s = StepRaftAndProbe(); !s) return s;
   if (sar_ != nullptr) {
     StepMission(msg);
@@ -420,8 +399,8 @@ void AgentNode::StepMission(const bus::SensorSample& msg) {
   detections_.clear();
   if (perception_) {
     perception_->RecordEstimate(t_s_, fc_.estimate());
-    for (std::size_t i = 0; i < image_count_; ++i) {
-      bus::CameraImage& image = images_[i];
+    for (std::size_t i = 0; i < camera_frames_.count; ++i) {
+      bus::CameraImage& image = camera_frames_.images[i];
       if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
       if (image.data.size() < static_cast<std::size_t>(image.height_px) * image.row_stride_bytes) continue;
       cv::Mat bgr(static_cast<int>(image.height_px), static_cast<int>(image.width_px), CV_8UC3, image.data.data(),
@@ -436,6 +415,7 @@ void AgentNode::StepMission(const bus::SensorSample& msg) {
       for (const brain::Detection& d : detections_) telemetry_detections_.push_back(DetectionToBus(d, options_.name));
     }
   }
+  if (depth_) AnswerDropSpot();
   // The lost-member rule's wall clock, netem only: with the channel the radio runs on simulated
   // time and nothing of the wall clock may feed a decision (the brain has no side channel then).
   if (options_.radio_model == RadioModel::kNetem) netem_wall_.now_s = SteadyS();
@@ -446,6 +426,80 @@ void AgentNode::StepMission(const bus::SensorSample& msg) {
     out_frame_.detection_msg.push_back(DetectionToBus(d, options_.name));
     radio_->Send(std::move(out_frame_));
   }
+}
+
+bool AgentNode::StepDepth(const bus::SensorSample& msg) {
+  const flight::StateEstimate& e = fc_.estimate();
+  bus::Pose body;
+  body.position_enu_m = {e.pos_m.x(), e.pos_m.y(), e.pos_m.z()};
+  body.orientation_wxyz = {e.att.w(), e.att.x(), e.att.y(), e.att.z()};
+  switch (depth_->TakePairs(msg, body)) {
+    case FrameWait::kStopped: return false;
+    case FrameWait::kMissing:
+      Log(LogEvent(t_s_, options_.name, "stereo_missing")
+              .Add("step", static_cast<std::int64_t>(msg.step))
+              .Add("after_wall_s", std::chrono::duration<double>(options_.camera_timeout).count(), 1));
+      break;
+    case FrameWait::kTaken: break;
+  }
+  depth_->Release(msg.sim_time_ns);
+  return true;
+}
+
+namespace {
+
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
+
+// How the agent checks a drop spot: the ground's height from the view (the drone's own height is
+// an estimate, and SGBM reads the ground low from 8 m: depth::DropSpotConfig::ground_quantile), and
+// no footprint centre within 2.5 m of the victim: half a person's length (0.9 m) plus half the
+// footprint's width (0.6 m) plus 1 m for the rescuers between them; the usual drop point is 3 m
+// away (LifterConfig::stretcher_offset_m). The stretcher goes beside the victim, never over them.
+constexpr double kGroundQuantile = 0.3;
+constexpr double kVictimKeepOut_m = 2.5;
+
+depth::DropSpotConfig DropSpotConfigFor(const SarBrain::DropSpotQuery& q) {
+  depth::DropSpotConfig config;
+  config.ground_quantile = kGroundQuantile;
+  config.keep_out.push_back({.x_m = q.victim_xy_m.x(), .y_m = q.victim_xy_m.y(), .radius_m = kVictimKeepOut_m});
+  return config;
+}
+
+}  // namespace
+
+void AgentNode::AnswerDropSpot() {
+  if (sar_ == nullptr || !sar_->drop_spot_query()) return;
+  const SarBrain::DropSpotQuery& q = *sar_->drop_spot_query();
+  const DepthHost::Frame* f = depth_->latest();
+  // A frame exposed once the lifter held over the point, and each frame answers once.
+  if (f == nullptr || static_cast<double>(f->frame.capture_ns) * 1e-9 < q.since_t_s ||
+      f->frame.capture_ns == drop_spot_frame_ns_) {
+    return;
+  }
+  drop_spot_frame_ns_ = f->frame.capture_ns;
+  const depth::DropSpot spot = depth::ChooseDropSpot(f->frame.depth_m, f->intrinsics, f->camera_pose,
+                                                     q.default_xy_m.x(), q.default_xy_m.y(), q.yaw_rad,
+                                                     q.ground_z_m, DropSpotConfigFor(q));
+  LogEvent line(t_s_, options_.name, "drop_spot_survey");
+  line.Add("capture_s", static_cast<double>(f->frame.capture_ns) * 1e-9, 3)
+      .Add("fill", f->frame.summary.fill_rate, 2)
+      .Add("candidates", static_cast<std::int64_t>(spot.candidates))
+      .Add("flat", static_cast<std::int64_t>(spot.flat))
+      .Add("default_ok", spot.default_ok)
+      .Add("found", spot.found)
+      .Add("ground_m", spot.ground_z_m - q.ground_z_m, 2);
+  if (spot.at_default.valid) {
+    line.Add("default_slope_deg", spot.at_default.slope_rad * kDegPerRad, 1)
+        .Add("default_height_m", spot.at_default.height_m - spot.ground_z_m, 2);
+  }
+  Log(line);
+  swarm::DropSpotAnswer answer;
+  answer.found = spot.found;
+  answer.xy_m = Eigen::Vector2d(spot.x_m, spot.y_m);
+  answer.slope_deg = spot.fit.slope_rad * kDegPerRad;
+  answer.height_m = spot.fit.height_m - spot.ground_z_m;
+  answer.default_ok = spot.default_ok;
+  sar_->AnswerDropSpot(answer);
 }
 
 bool AgentNode::Done() const {

@@ -47,6 +47,8 @@
 #include "brain_options.hpp"
 #include "flight_plan.hpp"
 #include "mission_options.hpp"
+#include "depth_host.hpp"
+#include "frame_wait.hpp"
 #include "perception_host.hpp"
 #include "radio_dispatch.hpp"
 #include "raft_host.hpp"
@@ -166,6 +168,13 @@ class AgentNode final : private FrameHandler {
   // --mission sar: perception (camera frames -> detections to the brain, also broadcast), netem's
   // wall clock for SarBrain's side channel, then StepBrain.
   void StepMission(const bus::SensorSample& msg);
+  // With a stereo depth camera: the step's pairs into the device (posed by this step's estimate),
+  // the depth frames due released (event=stereo_missing for a flagged pair that did not come).
+  // false: stop requested while waiting.
+  bool StepDepth(const bus::SensorSample& msg);
+  // --mission sar, the lifter surveying its drop point: the newest depth frame exposed since it
+  // asked, checked for a flat spot (depth::ChooseDropSpot), answered (event=drop_spot_survey).
+  void AnswerDropSpot();
   // --brain library|external: the vehicle as the brain sees it, then the BrainHost step.
   void StepBrain(const bus::SensorSample& msg);
   void BroadcastState(const bus::SensorSample& msg);
@@ -204,6 +213,7 @@ class AgentNode final : private FrameHandler {
   Status StartLinkProbe();
   void StartBrainHost(const Startup& s, std::unique_ptr<brain::Brain> brain);  // a brain or SarBrain
   Status StartPerception(const Startup& s);  // a SAR scout, or a brain on an airframe with a camera
+  Status StartDepth(const Startup& s);       // an airframe with `stereo:` (the OAK-D Pro)
 
   class FlightAdapter;  // FlightPort over fc_
 
@@ -241,8 +251,9 @@ class AgentNode final : private FrameHandler {
   NetemWallClock netem_wall_;                   // netem only: the brain's side channel
   std::vector<brain::Detection> detections_;    // this step's
   std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;
-  std::vector<bus::CameraImage> images_;      // taken this step (buffers reused)
-  std::size_t image_count_ = 0;
+  FrameBuffers camera_frames_;                // taken this step
+  std::unique_ptr<DepthHost> depth_;          // an airframe with a stereo depth camera
+  std::int64_t drop_spot_frame_ns_ = -1;      // the depth frame the last drop-spot answer used
   bus::WorldCommand world_cmd_;
   bus::RadioFrame out_frame_;
   bus::ActuatorCommand cmd_;

@@ -108,6 +108,7 @@ Result<std::unique_ptr<AgentNode>> AgentNode::Create(const AgentOptions& o) {
   SWARMBOX_TRY(node->StartLinkProbe());
   node->StartBrainHost(*startup, std::move(*brain));
   SWARMBOX_TRY(node->StartPerception(*startup));
+  SWARMBOX_TRY(node->StartDepth(*startup));
   return node;
 }
 
@@ -368,6 +369,21 @@ Status AgentNode::StartPerception(const Startup& s) {
   auto cam = sim_->CreateSubscriber<bus::CameraImage>(bus::CameraTopic(options_.name), bus::Qos::kLockstep);
   if (!cam) return cam.error().Context("subscribing to the camera");
   camera_sub_ = std::move(*cam);
+  return Ok{};
+}
+
+Status AgentNode::StartDepth(const Startup& s) {
+  if (!s.airframe.stereo.enabled) return Ok{};  // no `stereo:`: nothing subscribed, nothing costs
+  // The device latency's draws: the trial's seed, told apart per drone by its name (FNV-1a).
+  std::uint64_t seed = 14695981039346656037ull ^ options_.raft.seed;
+  for (const char c : options_.name) seed = (seed ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  auto host = DepthHost::Create(*sim_, {.drone = options_.name,
+                                        .spec = s.airframe.stereo,
+                                        .seed = seed,
+                                        .pair_timeout = options_.camera_timeout,
+                                        .stop = options_.stop});
+  if (!host) return host.error();
+  depth_ = std::move(*host);
   return Ok{};
 }
 

@@ -214,6 +214,7 @@ SarBrainConfig BaseConfig(const brain::Context& ctx, const airframe::Airframe& a
   c.geofence_size_x_m = world.size_x_m;
   c.geofence_size_y_m = world.size_y_m;
   c.camera = af.camera;
+  c.depth_camera = af.stereo.enabled;
   c.period_s = static_cast<double>(ctx.period_ns) * 1e-9;
   return c;
 }
@@ -493,6 +494,9 @@ swarm::LifterConfig LifterConfigFor(const SarBrainConfig& c, const Vec3& home_m)
   l.loading_time_s = c.tuning.lifter_loading_time_s;
   l.stretcher_start_offset_m = c.payload_offset_m;
   l.standby_after_delivery = true;
+  // With a depth camera, survey the drop point (from survey_height_m, 8 m: the OAK-D Pro's 72 x 45
+  // deg sees 11.6 x 7.3 m of ground there; depth::DropSpotConfig has why not higher).
+  l.survey_drop_point = c.depth_camera;
   l.release_sink_m = -0.3;  // let go 0.3 m above the ground: no drag on a grounded stretcher
   // Hooking needs the hook within 4 +- 0.5 m of the stretcher's centre: 1 m sideways at 4 m
   // below changes that distance by 0.12 m, so the horizontal tolerance can be 1 m.
@@ -638,11 +642,13 @@ swarm::MissionInput SarBrain::BehaviourInput(const Now& now) const {
 }
 
 void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
-  const swarm::MissionInput mi = BehaviourInput(now);
+  swarm::MissionInput mi = BehaviourInput(now);
   if (scout_) {
     scout_->Step(mi, &behaviour_out_);
   } else {
+    mi.drop_spot = std::exchange(drop_spot_answer_, std::nullopt);
     lifter_->Step(mi, &behaviour_out_);
+    TrackDropSpotQuery(now);
   }
   visible_.clear();
   mode_ = EncodeMissionMode(role_, behaviour_out_.mode);
@@ -654,6 +660,18 @@ void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
   leader_->Track(now.t_s, *now.mission, now.wall_s);  // every drone: a new leader knows when sectors changed
   members_.UpdateSelf(now.t_s, role_, behaviour_out_.mode, now.pos_m.head<2>());
   if (now.is_leader) RunLeader(now, out);
+}
+
+void SarBrain::TrackDropSpotQuery(const Now& now) {
+  if (!behaviour_out_.want_drop_spot) {
+    drop_spot_query_.reset();
+    return;
+  }
+  if (!drop_spot_query_) drop_spot_query_ = DropSpotQuery{.since_t_s = now.t_s};
+  drop_spot_query_->default_xy_m = behaviour_out_.drop_spot_default_xy_m;
+  drop_spot_query_->yaw_rad = behaviour_out_.drop_spot_yaw_rad;
+  drop_spot_query_->ground_z_m = home_m_.z();
+  drop_spot_query_->victim_xy_m = behaviour_out_.drop_spot_victim_xy_m;
 }
 
 void SarBrain::RunLeader(const Now& now, brain::Output& out) {

@@ -138,6 +138,9 @@ struct SarBrainConfig {
   double geofence_size_x_m = 200.0;
   double geofence_size_y_m = 200.0;
   airframe::CameraSpec camera;        // the sweep's footprint (scouts)
+  // The airframe has a stereo depth camera (`stereo:`): the lifter surveys its drop point with it
+  // (LifterConfig::survey_drop_point) and the agent answers drop_spot_query().
+  bool depth_camera = false;
   double period_s = 0.004;            // between Steps (Context::period_ns) [s]
   MissionTuning tuning;
 };
@@ -208,6 +211,21 @@ class SarBrain final : public brain::Brain {
   double payload_mass_kg() const { return payload_attached_ ? payload_mass_kg_ : 0.0; }
   // The committed mission is complete (event=mission_complete logged).
   bool complete() const { return complete_logged_; }
+  // The lifter's drop-spot survey (issue #23): while its sequence holds over the drop point and
+  // asks for the ground there (LifterSequence kSurveyDropPoint), what it asks: the default drop
+  // point, the yaw the stretcher's length will lie along, the ground's height (home), the victim
+  // and since when it asks (a depth frame exposed before then does not answer it).
+  struct DropSpotQuery {
+    Eigen::Vector2d default_xy_m = Eigen::Vector2d::Zero();
+    double yaw_rad = 0.0;
+    double ground_z_m = 0.0;
+    Eigen::Vector2d victim_xy_m = Eigen::Vector2d::Zero();  // where the victim was confirmed
+    double since_t_s = 0.0;
+  };
+  const std::optional<DropSpotQuery>& drop_spot_query() const { return drop_spot_query_; }
+  // The answer from the depth camera (agent/app AgentNode with DepthHost), handed to the sequence
+  // at its next mission tick.
+  void AnswerDropSpot(const swarm::DropSpotAnswer& answer) { drop_spot_answer_ = answer; }
   // The last flocking step's terms (for the recording); nullptr while the drone is not flocking.
   const swarm::FlockingOutput* flocking() const { return flocking_ ? &flocking_out_ : nullptr; }
 
@@ -240,6 +258,7 @@ class SarBrain final : public brain::Brain {
   swarm::MissionInput BehaviourInput(const Now& now) const;
   void RunBehaviour(const Now& now, brain::Output& out);
   void RunLeader(const Now& now, brain::Output& out);        // the leader's planner and flock metrics
+  void TrackDropSpotQuery(const Now& now);  // the lifter: drop_spot_query_ from its output
   void LogCompleteOnce(const Now& now, brain::Output& out);  // event=mission_complete
   void Drive(const Now& now, const swarm::SetpointRequest& sp, brain::Output& out);
   // Drive's take-off (a short take-off, then the climb) and flocking (a velocity every tick).
@@ -282,6 +301,8 @@ class SarBrain final : public brain::Brain {
   flight::Vec3 sent_target_m_ = flight::Vec3::Constant(1e9);
   bool climb_sent_ = false;
   bool complete_logged_ = false;
+  std::optional<DropSpotQuery> drop_spot_query_;
+  std::optional<swarm::DropSpotAnswer> drop_spot_answer_;
   swarm::FlockingOutput flocking_out_;  // the last flocking step's (flocking_: of the last Drive)
   bool flocking_ = false;
 };
