@@ -1,6 +1,6 @@
 // The lifter's drop-spot check with stereo depth (issue #23), end to end on loopback: the SAR
 // mission of trials/lifter_flat_spot.yaml (three x500 scouts, the lifter with the stretcher) in
-// worlds/rubble_drop.yaml, whose one victim lies beside a rubble field covering the lifter's usual
+// worlds/rubble_drop.yaml (gravel), whose one victim lies beside a rubble field covering the lifter's usual
 // drop point, flown as far as the stretcher coming to rest beside the victim (the physics server's
 // event=payload_at_rest after the first release). Twice, the lifter's airframe the only
 // difference:
@@ -37,7 +37,7 @@ constexpr std::array<std::array<double, 2>, 8> kHeaps = {{{31.02, 16.35}, {31.02
                                                           {34.42, 16.35}, {34.42, 18.05}}};
 // The stretcher (x8_heavy.yaml payload): 2.0 x 0.6 x 0.25 m; lying flat its centre is 0.125 m up.
 constexpr double kStretcherHalfHeight = 0.125;
-// Flat on flat ground: within 3 deg and 5 cm of lying on the meadow. On rubble: raised by at
+// Flat on flat ground: within 3 deg and 5 cm of lying on the ground. On rubble: raised by at
 // least 0.25 m or tilted by more than 5 deg (the heaps are 0.5-0.8 m high).
 constexpr double kFlatTiltDeg = 3.0;
 constexpr double kFlatRaiseM = 0.05;
@@ -133,7 +133,7 @@ TEST(LifterFlatSpot, WithDepthTheLifterChoosesAFlatSpotOffTheRubble) {
   const auto chosen = Events(f.lifter_log, "drop_spot_chosen");
   ASSERT_FALSE(chosen.empty()) << f.lifter_log;
   EXPECT_GT(Field(chosen.front(), "moved_m"), 1.0);
-  // The stretcher lies flat on the meadow, off every heap, beside (not on) the victim.
+  // The stretcher lies flat on the ground, off every heap, beside (not on) the victim.
   EXPECT_LT(f.rest.tilt_deg, kFlatTiltDeg);
   EXPECT_LT(std::abs(f.rest.z_m - kStretcherHalfHeight), kFlatRaiseM);
   EXPECT_GT(ClearanceFromHeaps(f.rest.x_m, f.rest.y_m), 0.0);
