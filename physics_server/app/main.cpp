@@ -105,7 +105,7 @@ void AddSteppingOptions(CLI::App& app, ServerOptions* o) {
   app.add_option("--join-timeout", o->join_timeout_s, "Seconds a drone may take to answer its first sample")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--physics-rate-hz", o->physics_rate_hz, "ODE sub-step rate")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--control-rate-hz", o->control_rate_hz, "Lockstep (sensor/actuator) rate")->check(CLI::PositiveNumber)->capture_default_str();
-  app.add_flag("!--no-cameras", o->cameras, "Do not render or publish camera images");
+  app.add_flag("!--no-cameras", o->cameras, "Do not render or publish camera images (stereo pairs of a stereo airframe still go out)");
   app.add_option("--clock-every", o->clock_every_s, "Simulated seconds between event=clock progress lines; 0 = none")->check(CLI::NonNegativeNumber)->capture_default_str();
 }
 

@@ -169,7 +169,7 @@ struct SimServerOptions {
   double max_sim_time_s = 0;                 // 0 = no limit
   double clock_every_s = 10.0;               // event=clock every this many simulated s; 0 = never
   LockstepOptions lockstep;
-  bool cameras = true;
+  bool cameras = true;                       // the RGB cameras; stereo pairs follow the airframes alone
   std::string node = "physics";              // logfmt node name
   RadioPlan plan;                            // simulated-time faults (--radio-plan); empty: none
   // radio.model channel: the radio profile (ValidateRadioProfile passed) and the channel's seed;

@@ -47,7 +47,10 @@ void PackStereoPair(const StereoFrame& frame, const std::string& drone, std::uin
 }
 
 std::uint64_t StereoCapture::PeriodSteps(double rate_hz, std::int64_t control_period_ns) {
-  const double steps = 1e9 / (rate_hz * static_cast<double>(control_period_ns));
+  // A rate so low that no pair would ever come (ParseStereoSpec only asks for > 0): capped, so the
+  // conversion stays defined (2^40 steps: over a century at 250 Hz).
+  constexpr double kMaxPeriodSteps = 1099511627776.0;
+  const double steps = std::min(kMaxPeriodSteps, 1e9 / (rate_hz * static_cast<double>(control_period_ns)));
   return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::llround(steps)));
 }
 

@@ -45,17 +45,55 @@ constexpr double kNearClip_m = 0.05;        // the march starts no nearer than t
 constexpr double kEndMargin_m = 1e-3;       // the march ends this far below the lowest cell
 constexpr double kProjectorNear_m = 0.05;   // no dots nearer the projector than this (optical z)
 
+constexpr int kTileCells = 8;               // TileMax: tiles of 8 x 8 cells (0.4 m at 5 cm)
+constexpr double kTileMargin_m = 1e-3;      // a sample this far above its tile's max is above the surface
+
+// The highest cell of each kTileCells square tile of a scene, over the tile's cells and the next
+// row and column (the cells HeightAt's bilinear interpolation reads from inside the tile), so
+// that HeightAt(x, y) <= TileMaxAt(x, y) anywhere, the grid's clamping included.
+void BuildTileMax(const StereoScene& s, cv::Mat* max_m) {
+  const int rows = s.height_m.rows, cols = s.height_m.cols;
+  max_m->create((rows + kTileCells - 1) / kTileCells, (cols + kTileCells - 1) / kTileCells, CV_32F);
+  for (int tr = 0; tr < max_m->rows; ++tr) {
+    for (int tc = 0; tc < max_m->cols; ++tc) {
+      const cv::Rect cells(tc * kTileCells, tr * kTileCells, std::min(kTileCells + 1, cols - tc * kTileCells),
+                           std::min(kTileCells + 1, rows - tr * kTileCells));
+      double hi = 0;
+      cv::minMaxLoc(s.height_m(cells), nullptr, &hi);
+      max_m->at<float>(tr, tc) = static_cast<float>(hi);
+    }
+  }
+}
+
+// As HeightAt: the cell of (x, y) clamped to the grid, then its tile's highest cell.
+float TileMaxAt(const StereoScene& s, const cv::Mat& max_m, double x_m, double y_m) {
+  const double fx = std::clamp((x_m - s.origin_x_m) / s.cell_m, 0.0, s.height_m.cols - 1.001);
+  const double fy = std::clamp((y_m - s.origin_y_m) / s.cell_m, 0.0, s.height_m.rows - 1.001);
+  return max_m.at<float>(static_cast<int>(fy) / kTileCells, static_cast<int>(fx) / kTileCells);
+}
+
 // Depth t (along the optical axis) where the ray centre + t * d (d.z < 0) first meets the height
 // field: marched in steps of about one cell from the highest cell's level down to the lowest's,
 // then a secant between the last point above and the first below the surface. A ray that never
-// dips below it ends at the lowest level.
-double MarchToSurface(const StereoScene& s, const Vec3& centre, const Vec3& d) {
+// dips below it ends at the lowest level. Samples well above their tile's highest cell are above
+// the surface without reading the height field; the sample before the crossing is then evaluated
+// as the plain march would, so the result is the plain march's to the bit (stereo_test.cpp).
+double MarchToSurface(const StereoScene& s, const cv::Mat& tile_max, const Vec3& centre, const Vec3& d) {
   const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
   const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
   double prev_t = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z), prev_f = 1.0;
+  bool prev_skipped = false;
   for (double t = prev_t; t <= t_end + dt; t += dt) {
     const double tt = std::min(t, t_end);
-    const double fz = centre.z + tt * d.z - s.HeightAt(centre.x + tt * d.x, centre.y + tt * d.y);
+    const double x = centre.x + tt * d.x, y = centre.y + tt * d.y, z = centre.z + tt * d.z;
+    if (z > TileMaxAt(s, tile_max, x, y) + kTileMargin_m) {
+      prev_t = tt;
+      prev_skipped = true;
+      continue;
+    }
+    if (prev_skipped) prev_f = centre.z + prev_t * d.z - s.HeightAt(centre.x + prev_t * d.x, centre.y + prev_t * d.y);
+    prev_skipped = false;
+    const double fz = z - s.HeightAt(x, y);
     if (fz <= 0) return fz == prev_f ? tt : prev_t + (tt - prev_t) * prev_f / (prev_f - fz);
     prev_t = tt;
     prev_f = fz;
@@ -114,7 +152,7 @@ void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoS
         if (dep != nullptr) dep[u] = 0;
         continue;
       }
-      const double t = MarchToSurface(s, centre, d);
+      const double t = MarchToSurface(s, tile_max_, centre, d);
       const Vec3 hp = centre + d * t;
       const int col = std::clamp(static_cast<int>(std::lround((hp.x - s.origin_x_m) / s.cell_m)), 0, s.albedo.cols - 1);
       const int row = std::clamp(static_cast<int>(std::lround((hp.y - s.origin_y_m) / s.cell_m)), 0, s.albedo.rows - 1);
@@ -158,6 +196,7 @@ double StereoRenderer::PatternIrradiance(const Vec3& hit, const Vec3& projector,
 void StereoRenderer::Render(const Pose& body_pose, const StereoSpec& spec, std::uint64_t noise_seed,
                             StereoFrame* out) {
   EnsurePattern(spec.projector);
+  BuildTileMax(*scene_, &tile_max_);  // the scene may have changed in place since the last pair
   const std::array<double, 9> r = OpticalToWorld(body_pose.attitude);
   const Vec3 mid = body_pose.position_m + Rotate(body_pose.attitude, spec.offset_m);
   const Vec3 ex{r[0], r[3], r[6]};  // optical x in world

@@ -24,14 +24,18 @@
 #include <vector>
 
 #include "bench.hpp"
+#include "stereo_capture.hpp"
 #include "swarmbox/depth/stereo_matcher.hpp"
 #include "swarmbox/physics/stereo_renderer.hpp"
+#include "swarmbox/physics/world.hpp"
+#include "swarmbox/physics/world_scene.hpp"
 
 #include <opencv2/core/utility.hpp>
 
 namespace {
 
 using swarmbox::physics::StereoSurface;
+using Clock = std::chrono::steady_clock;  // benchmark timing only
 
 // FNV-1a over the bytes of `images` (each continuous, as the renderer allocates them).
 std::uint64_t PairHash(std::initializer_list<const cv::Mat*> images) {
@@ -53,7 +57,6 @@ double Quantile(std::vector<double>* v, double q) {
 }
 
 int RunStereoBench(const swarmbox::bench::Args& args) {
-  using Clock = std::chrono::steady_clock;  // benchmark timing only
   cv::setNumThreads(1);                     // ms per frame on one core
   const auto seed = static_cast<std::uint64_t>(args.GetInt("seed", 11));
   const std::vector<double> ranges = args.quick ? std::vector<double>{2, 10}
@@ -108,7 +111,113 @@ int RunStereoBench(const swarmbox::bench::Args& args) {
   return 0;
 }
 
+// ---- stereo_world: what a trial pays for a stereo drone -----------------------------------------
+//
+// `swarmbox-bench stereo_world [--quick] [--world=rubble_block] [--seed=N]`: the physics server's
+// stereo path (issue #23) over a trial world (trials/worlds/<world>.yaml), looking down on its
+// slab_1 corner (x = 5, y = 12). One line per height:
+//
+//   suite=stereo_world world=rubble_block height_m=10 half_m=12.9 cells=265225 scene_ms=9.1
+//     render_ms=80.2 pack_ms=0.3
+//
+// scene_ms: MakeWorldScene's patch (PatchHalfSizeM); render_ms: StereoRenderer, both views;
+// pack_ms: PackStereoPair (the bus layout). Then one line for the trial step: one x500_depth held
+// (pinned) 10 m up there, `steps` World::Step()s alone and the same with StereoCapture's pairs on
+// their 5 Hz schedule, as the server runs them (no bus: publishing is BENCHMARKS.md "bus"):
+//
+//   suite=stereo_world scenario=trial_step steps=500 pairs=10 step_ms=0.05 step_with_pairs_ms=1.9
+//     pair_ms=90.1 cpu_s_per_sim_s=0.47
+
+double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr double kLookX_m = 5.0, kLookY_m = 12.0;  // rubble_block's slab_1, walls and a victim in view
+
+void PrintPairCosts(const swarmbox::physics::WorldConfig& world, const std::string& name, double height_m,
+                    std::uint64_t seed) {
+  namespace ph = swarmbox::physics;
+  ph::StereoSpec spec;  // trials/sensors/oak_d_pro_stereo.yaml's figures
+  spec.enabled = true;
+  const double half_m = ph::StereoCapture::PatchHalfSizeM(height_m, spec.hfov_rad);
+  auto t0 = Clock::now();
+  const ph::StereoScene scene = ph::MakeWorldScene(world, kLookX_m, kLookY_m, half_m, world.ground_texture_seed);
+  const double scene_ms = MsSince(t0);
+  ph::StereoRenderer renderer(&scene);
+  ph::Pose body;
+  body.position_m = {kLookX_m, kLookY_m, height_m};
+  ph::StereoFrame frame;
+  renderer.Render(body, spec, seed, &frame);  // the dot pattern is drawn once per renderer: not timed
+  t0 = Clock::now();
+  renderer.Render(body, spec, seed + 1, &frame);
+  const double render_ms = MsSince(t0);
+  swarmbox::bus::CameraImage pair;
+  t0 = Clock::now();
+  ph::PackStereoPair(frame, "bench", 0, 0, &pair);
+  const double pack_ms = MsSince(t0);
+  std::printf("suite=stereo_world world=%s height_m=%g half_m=%.1f cells=%d scene_ms=%.1f render_ms=%.1f pack_ms=%.2f\n",
+              name.c_str(), height_m, half_m, scene.height_m.rows * scene.height_m.cols, scene_ms, render_ms, pack_ms);
+  std::fflush(stdout);
+}
+
+// Mean ms of `steps` World::Step()s of a world with one x500_depth pinned `height_m` over the
+// look point, with (`pairs`) or without StereoCapture's pairs at their due steps.
+double StepMs(const swarmbox::physics::WorldConfig& config, double height_m, int steps, bool pairs, int* rendered) {
+  namespace ph = swarmbox::physics;
+  auto world = ph::World::Create(config, {.seed = 1});
+  auto af = ph::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500_depth.yaml");
+  if (!world || !af) return -1;
+  ph::DroneSpawn spawn;
+  spawn.name = "scout_1";
+  spawn.airframe = *af;
+  spawn.position_m = {kLookX_m, kLookY_m, height_m};
+  if (!(*world)->AddDrone(spawn)) return -1;
+  (*world)->SetPinned(0, true);
+  ph::StereoCapture capture(**world);
+  swarmbox::bus::CameraImage pair;
+  *rendered = 0;
+  const auto t0 = Clock::now();
+  for (int k = 0; k < steps; ++k) {
+    const std::uint64_t step = (*world)->step_count();
+    if (pairs && capture.Due(0, step)) {
+      capture.Capture(**world, 0, step, &pair);
+      ++*rendered;
+    }
+    (*world)->Step();
+  }
+  return MsSince(t0) / steps;
+}
+
+int RunStereoWorldBench(const swarmbox::bench::Args& args) {
+  cv::setNumThreads(1);
+  const std::string name = args.Get("world", "rubble_block");
+  const auto seed = static_cast<std::uint64_t>(args.GetInt("seed", 11));
+  auto world = swarmbox::physics::LoadWorld(std::string(SWARMBOX_TRIALS_DIR) + "/worlds/" + name + ".yaml");
+  if (!world) {
+    std::fprintf(stderr, "stereo_world: %s\n", world.error().ToString().c_str());
+    return 1;
+  }
+  const std::vector<double> heights = args.quick ? std::vector<double>{10} : std::vector<double>{3, 6, 10, 15, 20};
+  for (double h : heights) PrintPairCosts(*world, name, h, seed);
+  constexpr double kTrialHeight_m = 10.0;
+  const int steps = args.quick ? 100 : 500;
+  int rendered = 0;
+  const double plain_ms = StepMs(*world, kTrialHeight_m, steps, false, &rendered);
+  const double with_ms = StepMs(*world, kTrialHeight_m, steps, true, &rendered);
+  if (plain_ms < 0 || with_ms < 0 || rendered == 0) {
+    std::fprintf(stderr, "stereo_world: could not set up the trial step\n");
+    return 1;
+  }
+  const double pair_ms = (with_ms - plain_ms) * steps / rendered;
+  constexpr double kStepsPerSimS = 250.0;  // the server's default control rate
+  std::printf("suite=stereo_world scenario=trial_step world=%s height_m=%g steps=%d pairs=%d step_ms=%.3f "
+              "step_with_pairs_ms=%.3f pair_ms=%.1f cpu_s_per_sim_s=%.2f\n",
+              name.c_str(), kTrialHeight_m, steps, rendered, plain_ms, with_ms, pair_ms, with_ms * kStepsPerSimS / 1000.0);
+  return 0;
+}
+
 }  // namespace
+
+SWARMBOX_BENCH_SUITE(stereo_world, "A trial's stereo pairs: ms per pair over a world scene (patch, render, pack) and per step",
+                     RunStereoWorldBench);
 
 SWARMBOX_BENCH_SUITE(stereo, "OAK-D Pro stereo depth: fill and error per surface, projector, range; ms per pair",
                      RunStereoBench);

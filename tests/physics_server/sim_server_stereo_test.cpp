@@ -27,6 +27,7 @@ TEST(StereoCaptureSchedule, PeriodIsRoundedStepsAndPatchGrowsWithHeight) {
   EXPECT_EQ(StereoCapture::PeriodSteps(5.0, 4 * kMs), 50u);  // 5 Hz at 250 Hz
   EXPECT_EQ(StereoCapture::PeriodSteps(7.0, 4 * kMs), 36u);  // 35.7 rounded
   EXPECT_EQ(StereoCapture::PeriodSteps(1000.0, 4 * kMs), 1u);
+  EXPECT_EQ(StereoCapture::PeriodSteps(1e-30, 4 * kMs), 1ULL << 40);  // never, without overflow
   EXPECT_DOUBLE_EQ(StereoCapture::PatchHalfSizeM(0, 1.2566), kPatchMargin_m);
   EXPECT_NEAR(StereoCapture::PatchHalfSizeM(10, 1.2566), 10 * std::tan(0.6283) * 1.5 + 2, 1e-9);
   EXPECT_DOUBLE_EQ(StereoCapture::PatchHalfSizeM(200, 1.2566), kMaxPatchHalfSize_m);

@@ -9,6 +9,7 @@
 #include "swarmbox/physics/stereo_renderer.hpp"
 #include "swarmbox/physics/stereo_scene.hpp"
 #include "swarmbox/physics/stereo_spec.hpp"
+#include "swarmbox/physics/world_scene.hpp"
 
 namespace swarmbox::physics {
 namespace {
@@ -238,6 +239,42 @@ TEST(StereoRenderer, TruthDepthIsTheReferenceMarchsToTheBit) {
   }
   EXPECT_GT(compared, spec.width_px * spec.height_px / 2);
   EXPECT_EQ(differ, 0) << "of " << compared << " pixels";
+}
+
+// A trial world's patch (MakeWorldScene) with obstacles far taller than the ground's relief, seen
+// from 15 m: most of each ray's march lies above its tile's highest cell (skipped samples), and
+// every left pixel's truth depth is still the reference march's.
+TEST(StereoRenderer, TruthDepthOverAWorldPatchIsTheReferenceMarchsToTheBit) {
+  WorldConfig world;
+  world.terrain = Terrain{TerrainKind::kRubble, 0.0};
+  world.obstacles.push_back({"wall", {0, 6, 4}, {20, 1, 8}, 0.2, ObstacleKind::kBox});
+  world.obstacles.push_back({"block", {-4, -3, 6}, {4, 4, 12}, 0.7, ObstacleKind::kBox});
+  const StereoScene scene = MakeWorldScene(world, 0, 0, 15, 3);
+  StereoSpec spec;
+  spec.enabled = true;
+  spec.width_px = 160;
+  spec.height_px = 100;
+  Pose body;
+  body.position_m = {1.0, 0.5, 15.0};
+  StereoRenderer renderer(&scene);
+  StereoFrame frame;
+  renderer.Render(body, spec, 1, &frame);
+  const Vec3 ex = Rotate(body.attitude, Vec3{0, -1, 0}), ey = Rotate(body.attitude, Vec3{-1, 0, 0}),
+             ez = Rotate(body.attitude, Vec3{0, 0, -1});
+  const Vec3 left = body.position_m + Rotate(body.attitude, spec.offset_m) - ex * (spec.baseline_m / 2);
+  const double f = spec.FocalPx(), cx = spec.width_px / 2.0, cy = spec.height_px / 2.0;
+  int differ = 0, on_obstacles = 0;
+  for (int v = 0; v < spec.height_px; ++v) {
+    for (int u = 0; u < spec.width_px; ++u) {
+      const double xn = (u + 0.5 - cx) / f, yn = (v + 0.5 - cy) / f;
+      const Vec3 d{ex.x * xn + ey.x * yn + ez.x, ex.y * xn + ey.y * yn + ez.y, ex.z * xn + ey.z * yn + ez.z};
+      const float depth = frame.depth_truth_m.at<float>(v, u);
+      if (depth != static_cast<float>(PlainMarch(scene, left, d))) ++differ;
+      if (depth < 12.0f) ++on_obstacles;  // the wall's or the block's top
+    }
+  }
+  EXPECT_EQ(differ, 0) << "of " << spec.width_px * spec.height_px << " pixels";
+  EXPECT_GT(on_obstacles, 100);
 }
 
 }  // namespace

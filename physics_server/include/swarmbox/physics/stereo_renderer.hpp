@@ -71,6 +71,7 @@ class StereoRenderer {
   int pattern_dots_ = -1;
   double pattern_fill_ = -1;
   cv::Mat radiance_l_, radiance_r_, noise_;
+  cv::Mat tile_max_;         // the scene's highest cell per tile (the march's skip test), per Render
 };
 
 }  // namespace swarmbox::physics
