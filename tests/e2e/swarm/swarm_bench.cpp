@@ -1,7 +1,7 @@
 // swarmbox-bench swarm: the full SAR agent in containers at several swarm sizes, one after the
 // other, on the local Docker engine (BENCHMARKS.md "swarm").
 //
-//   swarmbox-bench swarm [--drones=10,50,100] [--sim-s 60] [--out DIR] [--keep=1] [--quick]
+//   swarmbox-bench swarm [--drones=10,50,100] [--sim-s 60] [--airframe=x500_depth] [--out DIR] [--keep=1] [--quick]
 //
 // For each size N: trials/swarm_100.yaml with N scouts (drones.scout.count, plus the lifter: N + 1
 // agents) on a search area of
@@ -63,6 +63,11 @@ int RunSwarmBench(const bench::Args& args) {
   }
   std::vector<std::string> sets;
   if (record == "off") sets.push_back("record.enabled=false");
+  // --airframe=x500_depth flies the scouts with the OAK-D Pro's stereo pair (issue #23): the pair
+  // of runs gives what depth costs at each size.
+  if (const std::string airframe = args.Get("airframe", ""); !airframe.empty()) {
+    sets.push_back("drones.scout.airframe=" + airframe);
+  }
   const std::string out =
       args.Get("out", (std::filesystem::temp_directory_path() / "swarmbox-bench-swarm").string());
   if (sizes.empty()) {
@@ -118,5 +123,5 @@ int RunSwarmBench(const bench::Args& args) {
 
 }  // namespace
 
-SWARMBOX_BENCH_SUITE(swarm, "the SAR swarm in containers at several sizes: rtf, CPU and memory per drone (--drones=10,50,100 --sim-s=60 --record=on|off --keep --out=DIR)",
+SWARMBOX_BENCH_SUITE(swarm, "the SAR swarm in containers at several sizes: rtf, CPU and memory per drone (--drones=10,50,100 --sim-s=60 --record=on|off --airframe=x500_depth --keep --out=DIR)",
                      RunSwarmBench);
