@@ -5,13 +5,15 @@
 // rendered pair (what the agent has) over several seeded scenes; the tolerances are SGBM's
 // measured errors at those ranges (BENCHMARKS.md "stereo"), the figures printed are in
 // agent/depth/README.md.
+#include "swarmbox/depth/clearance.hpp"
+
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 
-#include "swarmbox/depth/clearance.hpp"
 #include "swarmbox/depth/stereo_matcher.hpp"
 #include "swarmbox/physics/stereo_renderer.hpp"
 
@@ -54,7 +56,8 @@ physics::StereoScene BoxUnderScout(std::uint64_t seed) {
 }
 
 bus::Pose ToBus(const physics::Pose& p) {
-  return {{p.position_m.x, p.position_m.y, p.position_m.z}, {p.attitude.w, p.attitude.x, p.attitude.y, p.attitude.z}};
+  return {{p.position_m.x, p.position_m.y, p.position_m.z},
+          {p.attitude.w, p.attitude.x, p.attitude.y, p.attitude.z}};
 }
 
 struct Views {
@@ -74,16 +77,23 @@ Views Look(const physics::StereoScene& scene, double height_m, std::uint64_t see
   physics::StereoFrame frame;
   renderer.Render(body, spec, seed, &frame);
   const bus::Pose camera = LeftCameraPose(
-      ToBus(body), {.offset_body_m = {spec.offset_m.x, spec.offset_m.y, spec.offset_m.z}, .baseline_m = spec.baseline_m});
+      ToBus(body),
+      {.offset_body_m = {spec.offset_m.x, spec.offset_m.y, spec.offset_m.z}, .baseline_m = spec.baseline_m});
   StereoMatcher matcher({.num_disparities = spec.num_disparities});
   cv::Mat sgbm_m;
   matcher.Compute(frame.left, frame.right, frame.focal_px, frame.baseline_m, &sgbm_m);
   const CameraIntrinsics k{frame.focal_px, frame.cx_px, frame.cy_px};
-  Views v{ClearanceBelow(frame.depth_truth_m, k, camera, {}), ClearanceBelow(sgbm_m, k, camera, {})};
-  std::printf("%s seed %llu: camera z %.3f; truth valid=%d top %.3f clearance %.3f points %d; "
-              "sgbm valid=%d top %.3f clearance %.3f points %d\n",
-              what, static_cast<unsigned long long>(seed), camera.position_enu_m[2], v.truth.valid, v.truth.top_z_m,
-              v.truth.clearance_m, v.truth.points, v.sgbm.valid, v.sgbm.top_z_m, v.sgbm.clearance_m, v.sgbm.points);
+  const auto start = std::chrono::steady_clock::now();
+  const Clearance sgbm = ClearanceBelow(sgbm_m, k, camera, {});
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  Views v{ClearanceBelow(frame.depth_truth_m, k, camera, {}), sgbm};
+  std::printf(
+      "%s seed %llu: camera z %.3f; truth valid=%d top %.3f clearance %.3f points %d; "
+      "sgbm valid=%d top %.3f clearance %.3f points %d (%.1f ms)\n",
+      what, static_cast<unsigned long long>(seed), camera.position_enu_m[2], v.truth.valid, v.truth.top_z_m,
+      v.truth.clearance_m, v.truth.points, v.sgbm.valid, v.sgbm.top_z_m, v.sgbm.clearance_m, v.sgbm.points,
+      ms);
   return v;
 }
 

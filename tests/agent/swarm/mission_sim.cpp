@@ -330,8 +330,10 @@ std::optional<double> MissionSim::FakeDepth(std::size_t drone) const {
   std::optional<double> top;
   if (p.z() - ground_z_m <= config_.fake_depth_range_m) top = ground_z_m;
   for (const MissionSimConfig::Obstacle& o : config_.obstacles) {
-    const Vec2 nearest(std::clamp(p.x(), o.area.x_min_m, o.area.x_max_m), std::clamp(p.y(), o.area.y_min_m, o.area.y_max_m));
-    if ((nearest - p.head<2>()).norm() > config_.fake_depth_radius_m || p.z() - o.top_z_m > config_.fake_depth_range_m) continue;
+    const Vec2 nearest(std::clamp(p.x(), o.area.x_min_m, o.area.x_max_m),
+                       std::clamp(p.y(), o.area.y_min_m, o.area.y_max_m));
+    const bool near = (nearest - p.head<2>()).norm() <= config_.fake_depth_radius_m;
+    if (!near || p.z() - o.top_z_m > config_.fake_depth_range_m) continue;
     top = std::max(top.value_or(o.top_z_m), o.top_z_m);
   }
   return top;

@@ -73,8 +73,8 @@ struct MissionSimConfig {
   bool fake_depth = false;
   double fake_depth_radius_m = 5.0;
   double fake_depth_range_m = 15.0;
-  double scout_altitude_m = 30.0;       // ScoutConfig::search_altitude_m
-  double scout_min_clearance_m = 0.0;   // ScoutConfig::min_clearance_m
+  double scout_altitude_m = 30.0;      // ScoutConfig::search_altitude_m
+  double scout_min_clearance_m = 0.0;  // ScoutConfig::min_clearance_m
   // min_obstacle_clearance_m(true) ignores this band inside an obstacle's edges [m] (the climb).
   double obstacle_edge_m = 5.0;
   double battery_fraction_at_start = 1.0;
@@ -122,7 +122,9 @@ class MissionSim {
   std::size_t rejected_proposals() const { return rejected_; }
   // The least height of an airborne scout above an obstacle's top while over it (inner: at least
   // obstacle_edge_m inside its edges) [m]; 1e9 if never over one.
-  double min_obstacle_clearance_m(bool inner) const { return inner ? min_inner_clearance_m_ : min_clearance_m_; }
+  double min_obstacle_clearance_m(bool inner) const {
+    return inner ? min_inner_clearance_m_ : min_clearance_m_;
+  }
   std::size_t leader() const { return leader_index_; }
   // A failure from now on (e.g. once a drone logged its first sector progress).
   void AddOutage(MissionSimConfig::Outage outage) { config_.outages.push_back(std::move(outage)); }

@@ -2,10 +2,10 @@
 // MissionInput::obstacle_top_z_m): ScoutBehaviour step by step against a MissionState driven by
 // hand, and a scout sweeping across a stand of trees on the kinematic rig (mission_sim.hpp) with
 // and without the fake depth camera.
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <string>
-
-#include <gtest/gtest.h>
 
 #include "mission_sim.hpp"
 #include "swarmbox/common/logfmt.hpp"
@@ -32,14 +32,16 @@ class SafeHeight : public ::testing::Test {
   void SetUpScout(double min_clearance_m) {
     ASSERT_TRUE(mission_.Apply(1, raft::AssignSectors{{kSector}}).accepted);
     ASSERT_TRUE(mission_.Apply(2, raft::StartSearch{}).accepted);
-    scout_.emplace(ScoutConfig{.name = "scout_1", .home_m = Vector3d::Zero(), .min_clearance_m = min_clearance_m});
+    scout_.emplace(
+        ScoutConfig{.name = "scout_1", .home_m = Vector3d::Zero(), .min_clearance_m = min_clearance_m});
     Step(0.0, std::nullopt, {0, 0, 0.23});
     Step(1.0, std::nullopt, {0, 0, kSearchAltitude_m});
     Step(1.1, std::nullopt, {0, 0, kSearchAltitude_m});
     ASSERT_EQ(out_.mode, "searching");
   }
   // One tick at `t_s` with the depth camera's report `top_z_m` (nullopt: none).
-  const MissionOutput& Step(double t_s, std::optional<double> top_z_m, const Vector3d& p = {5, 5, kSearchAltitude_m}) {
+  const MissionOutput& Step(double t_s, std::optional<double> top_z_m,
+                            const Vector3d& p = {5, 5, kSearchAltitude_m}) {
     MissionInput in;
     in.t_s = t_s;
     in.mission = &mission_;
@@ -80,7 +82,7 @@ TEST_F(SafeHeight, HoldsTheRaisedAltitudeForTheHoldTimeAfterTheLastReportThenRet
   ASSERT_DOUBLE_EQ(out_.setpoint.target_m.z(), 33.0);
   Step(3.0, 23.5);  // a lower crown (31.5 m asked for): it does not come down, the hold restarts
   EXPECT_DOUBLE_EQ(out_.setpoint.target_m.z(), 33.0);
-  Step(3.2, 0.0);   // the ground (8 m asked for, under the search altitude): no restart
+  Step(3.2, 0.0);           // the ground (8 m asked for, under the search altitude): no restart
   Step(3.4, std::nullopt);  // no frame
   EXPECT_DOUBLE_EQ(out_.setpoint.target_m.z(), 33.0);
   Step(3.0 + hold_s - 0.1, 0.0);
@@ -150,8 +152,10 @@ TEST(SafeHeightScenario, ADepthCameraKeepsTheClearanceOverAStandOfTrees) {
     inner_m[depth] = sim.min_obstacle_clearance_m(true);
     all_m[depth] = sim.min_obstacle_clearance_m(false);
     EXPECT_EQ(sim.Logged("clearance_climb"), depth);
-    std::printf("depth=%d: min clearance over the trees %.2f m, >= %.0f m inside their edges %.2f m, swept at t=%.1f s\n",
-                depth, all_m[depth], kClimbEdge_m, inner_m[depth], sim.t_s());
+    std::printf(
+        "depth=%d: min clearance over the trees %.2f m, >= %.0f m inside their edges %.2f m, "
+        "swept at t=%.1f s\n",
+        depth, all_m[depth], kClimbEdge_m, inner_m[depth], sim.t_s());
   }
   EXPECT_NEAR(inner_m[0], kScoutAltitude_m - kTreesTop_m, 0.2);  // without: the 4 m the altitude leaves
   EXPECT_NEAR(all_m[0], kScoutAltitude_m - kTreesTop_m, 0.2);

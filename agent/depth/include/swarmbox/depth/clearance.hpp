@@ -31,7 +31,8 @@
 //   flat ground from 20 m (beyond the range): invalid (0 points true, 0-20 with SGBM)
 // The 12 m figure is the upper tail of the ground's error (the top is an upper order statistic;
 // SGBM's sub-pixel steps of 1/16 px are 0.24 m at 12 m): clearances read 1.2 m short there.
-// Cost: one pass over the image, a counting sort into ~10,000 cells.
+// Cost: one pass over the image, a counting sort into ~10,000 cells: 5-18 ms for a 640 x 400 frame
+// with depth (0.5-1 ms with none in range) on one core of the loaded dev machine.
 // Pure: no I/O, no clock.
 #pragma once
 
@@ -58,10 +59,10 @@ struct ClearanceConfig {
 };
 
 struct Clearance {
-  bool valid = false;       // at least min_points points and top_cells seen cells
-  double top_z_m = 0;       // the highest surface's world z (ENU) [m]
-  double clearance_m = 0;   // camera height - top_z_m [m]
-  int points = 0;           // pixels within radius_m and max_range_m
+  bool valid = false;      // at least min_points points and top_cells seen cells
+  double top_z_m = 0;      // the highest surface's world z (ENU) [m]
+  double clearance_m = 0;  // camera height - top_z_m [m]
+  int points = 0;          // pixels within radius_m and max_range_m
 };
 
 // `depth_m`: CV_32F along the optical axis, 0 = no depth (StereoMatcher's, or the renderer's
