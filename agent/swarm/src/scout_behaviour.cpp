@@ -60,6 +60,7 @@ ScoutBehaviour::ScoutBehaviour(ScoutConfig config)
   SWARMBOX_CHECK(!config_.name.empty());
   SWARMBOX_CHECK(config_.first_sighting_seq > 0);
   SWARMBOX_CHECK(config_.orbit_points >= 3 && config_.orbit_radius_m > 0);
+  SWARMBOX_CHECK(config_.min_clearance_m >= 0 && config_.clearance_hold_s >= 0);
 }
 
 void ScoutBehaviour::Enter(Stage stage, const MissionInput& in, MissionOutput* out) {
@@ -260,8 +261,7 @@ bool ScoutBehaviour::Cruising(const MissionInput& in) const {
 }
 
 void ScoutBehaviour::UpdateClearance(const MissionInput& in, MissionOutput* out) {
-  const bool raised = clearance_floor_z_m_ > -std::numeric_limits<double>::infinity();
-  if (raised && in.t_s - clearance_asked_s_ > config_.clearance_hold_s) {
+  if (ClearanceRaised() && in.t_s - clearance_asked_s_ > config_.clearance_hold_s) {
     clearance_floor_z_m_ = -std::numeric_limits<double>::infinity();  // back to the cruise altitude
   }
   if (config_.min_clearance_m <= 0 || !in.obstacle_top_z_m || !Cruising(in)) return;
@@ -269,7 +269,7 @@ void ScoutBehaviour::UpdateClearance(const MissionInput& in, MissionOutput* out)
   if (wanted_z_m <= Altitude()) return;
   clearance_asked_s_ = in.t_s;
   if (wanted_z_m <= clearance_floor_z_m_) return;  // already at or above it
-  const bool was_raised = clearance_floor_z_m_ > -std::numeric_limits<double>::infinity();
+  const bool was_raised = ClearanceRaised();
   clearance_floor_z_m_ = wanted_z_m;
   if (was_raised && wanted_z_m < clearance_logged_z_m_ + kClimbLogStep_m) return;
   clearance_logged_z_m_ = wanted_z_m;

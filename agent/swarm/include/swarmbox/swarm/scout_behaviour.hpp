@@ -194,6 +194,7 @@ class ScoutBehaviour {
   bool Cruising(const MissionInput& in) const;
   void UpdateClearance(const MissionInput& in, MissionOutput* out);
   double Raised(double cruise_z_m) const { return std::max(cruise_z_m, clearance_floor_z_m_); }
+  bool ClearanceRaised() const { return clearance_floor_z_m_ > -std::numeric_limits<double>::infinity(); }
   double Altitude() const { return config_.home_m.z() + config_.search_altitude_m; }
 
   ScoutConfig config_;
