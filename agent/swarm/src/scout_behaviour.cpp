@@ -14,6 +14,9 @@ using raft::MissionPhase;
 constexpr double kTakeoffDoneBelowAltitude_m = 1.0;  // the climb ends this close to search altitude
 constexpr double kOnGroundAboveBase_m = 0.15;  // touched down: body this close to base height
 constexpr double kOnGroundSpeed_m_s = 0.3;
+// A raised altitude is logged again (event=clearance_climb) when a taller obstacle raises it by
+// this much: SGBM's error on a crown 6-10 m below is 0.3-0.8 m, so smaller steps are its noise.
+constexpr double kClimbLogStep_m = 1.0;
 
 bool Active(MissionPhase p) {
   return p == MissionPhase::kSearch || p == MissionPhase::kConverge || p == MissionPhase::kRescue;
@@ -57,6 +60,7 @@ ScoutBehaviour::ScoutBehaviour(ScoutConfig config)
   SWARMBOX_CHECK(!config_.name.empty());
   SWARMBOX_CHECK(config_.first_sighting_seq > 0);
   SWARMBOX_CHECK(config_.orbit_points >= 3 && config_.orbit_radius_m > 0);
+  SWARMBOX_CHECK(config_.min_clearance_m >= 0 && config_.clearance_hold_s >= 0);
 }
 
 void ScoutBehaviour::Enter(Stage stage, const MissionInput& in, MissionOutput* out) {
@@ -209,9 +213,9 @@ void ScoutBehaviour::RunRevisit(const MissionInput& in, MissionOutput* out) {
   const double d = (p.head<2>() - at).norm();
   // Flock on the way (spacing from the others), a position hold over the spot.
   sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
-  sp.target_m = {at.x(), at.y(), Altitude()};
+  sp.target_m = {at.x(), at.y(), Raised(Altitude())};
   sp.yaw_rad = in.yaw_rad;
-  const bool under = d <= config_.revisit_arrive_m && std::abs(p.z() - Altitude()) <= 2.0;
+  const bool under = d <= config_.revisit_arrive_m && std::abs(p.z() - Raised(Altitude())) <= 2.0;
   if (look_start_s_ < 0 && under) look_start_s_ = in.t_s;
   if (look_start_s_ < 0 || revisit_seen_ || !under) return;
   const bool first = miss_tries_ == 0 && in.t_s - look_start_s_ >= config_.revisit_look_s;
@@ -223,6 +227,7 @@ void ScoutBehaviour::RunRevisit(const MissionInput& in, MissionOutput* out) {
 void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
   SWARMBOX_CHECK(in.mission != nullptr);
   out->Clear();
+  UpdateClearance(in, out);
   // A transition re-runs the new stage at once, so the setpoint always belongs to out.mode.
   for (int pass = 0; pass < 4; ++pass) {
     Decide(in, out);
@@ -238,6 +243,39 @@ void ScoutBehaviour::Step(const MissionInput& in, MissionOutput* out) {
     RetrySightings(in, out);
   }
   out->mode = StageName(stage_);
+}
+
+bool ScoutBehaviour::Cruising(const MissionInput& in) const {
+  switch (stage_) {
+    case Stage::kAwaitingSector:
+    case Stage::kSearching:
+    case Stage::kSwept:
+    case Stage::kOrbiting:
+    case Stage::kRevisiting:
+      return true;
+    case Stage::kReturning:  // in its layer; not over home, where it descends (RunReturn)
+      return (in.position_m.head<2>() - config_.home_m.head<2>()).norm() > 2 * config_.home_reached_m;
+    default:
+      return false;
+  }
+}
+
+void ScoutBehaviour::UpdateClearance(const MissionInput& in, MissionOutput* out) {
+  if (ClearanceRaised() && in.t_s - clearance_asked_s_ > config_.clearance_hold_s) {
+    clearance_floor_z_m_ = -std::numeric_limits<double>::infinity();  // back to the cruise altitude
+  }
+  if (config_.min_clearance_m <= 0 || !in.obstacle_top_z_m || !Cruising(in)) return;
+  const double wanted_z_m = *in.obstacle_top_z_m + config_.min_clearance_m;
+  if (wanted_z_m <= Altitude()) return;
+  clearance_asked_s_ = in.t_s;
+  if (wanted_z_m <= clearance_floor_z_m_) return;  // already at or above it
+  const bool was_raised = ClearanceRaised();
+  clearance_floor_z_m_ = wanted_z_m;
+  if (was_raised && wanted_z_m < clearance_logged_z_m_ + kClimbLogStep_m) return;
+  clearance_logged_z_m_ = wanted_z_m;
+  out->events.push_back(std::move(LogEvent(in.t_s, config_.name, "clearance_climb")
+                                      .Add("top_z", *in.obstacle_top_z_m, 2)
+                                      .Add("altitude", wanted_z_m, 2)));
 }
 
 void ScoutBehaviour::Decide(const MissionInput& in, MissionOutput* out) {
@@ -355,7 +393,7 @@ void ScoutBehaviour::RunTakeoff(const MissionInput& in, MissionOutput* out) {
 void ScoutBehaviour::FlockOver(const Eigen::Vector2d& xy_m, const MissionInput& in, MissionOutput* out) const {
   SetpointRequest& sp = out->setpoint;
   sp.kind = SetpointKind::kFlock;
-  sp.target_m = {xy_m.x(), xy_m.y(), Altitude()};
+  sp.target_m = {xy_m.x(), xy_m.y(), Raised(Altitude())};
   sp.yaw_rad = in.yaw_rad;
 }
 
@@ -390,6 +428,7 @@ void ScoutBehaviour::RunSearch(const MissionInput& in, MissionOutput* out) {
   SetpointRequest& sp = out->setpoint;
   sp.kind = SetpointKind::kFlock;
   sp.target_m = lanes_[lane_index_].position_m;
+  sp.target_m.z() = Raised(sp.target_m.z());
   sp.yaw_rad = lanes_[lane_index_].yaw_rad;
 }
 
@@ -407,6 +446,7 @@ void ScoutBehaviour::RunOrbit(const MissionInput& in, MissionOutput* out) {
   SetpointRequest& sp = out->setpoint;
   sp.kind = SetpointKind::kFlock;
   sp.target_m = orbit_[k].position_m;
+  sp.target_m.z() = Raised(sp.target_m.z());
   sp.yaw_rad = orbit_[k].yaw_rad;
   if ((!config_.lifter_present || config_.return_when_swept) && orbit_reached_s_ >= 0 &&
       in.t_s - orbit_reached_s_ >= config_.orbit_time_s) {
@@ -429,7 +469,7 @@ void ScoutBehaviour::RunReturn(const MissionInput& in, MissionOutput* out) {
   // Home in this scout's layer, down only once over home (within 2 x home_reached_m): on a
   // 4 m take-off grid a drone descending on the slant of the last approach_m would pass
   // through its neighbours' columns at their heights; vertically it stays in its own.
-  sp.target_m = {home_xy.x(), home_xy.y(), d > 2 * config_.home_reached_m ? layer_z : approach_z};
+  sp.target_m = {home_xy.x(), home_xy.y(), d > 2 * config_.home_reached_m ? Raised(layer_z) : approach_z};
   sp.yaw_rad = in.yaw_rad;
   if (d <= config_.home_reached_m && p.z() <= approach_z + 1.0) Enter(Stage::kLanding, in, out);
 }

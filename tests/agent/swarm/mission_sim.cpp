@@ -51,6 +51,8 @@ MissionSim::MissionSim(MissionSimConfig config)
       c.lifter_present = lifter_present;
       c.orbit_time_s = 15.0;
       c.takeoff_delay_s = config_.takeoff_wave_s * TakeoffWave(d.home_m.head<2>(), 4.0);
+      c.search_altitude_m = config_.scout_altitude_m;
+      c.min_clearance_m = config_.scout_min_clearance_m;
       if (config_.agent_tuning) {  // as SarBrain::Start
         c.cruise_speed_m_s = 7.0;
         c.orbit_radius_m = 12.0;
@@ -193,6 +195,7 @@ void MissionSim::Step() {
     in.payload_attached = d.role == Role::kLifter && attached_;
     in.detections = detections_[i];
     in.drop_spot = std::exchange(drop_spot_answers_[i], std::nullopt);
+    if (camera && config_.fake_depth && d.role == Role::kScout) in.obstacle_top_z_m = FakeDepth(i);
     MissionOutput& out = out_[i];
     if (d.role == Role::kScout) {
       scouts_[static_cast<std::size_t>(behaviour_of_[i])].Step(in, &out);
@@ -303,6 +306,7 @@ void MissionSim::Step() {
     }
     if (vel_[i].head<2>().norm() > 0.5) yaw_[i] = std::atan2(vel_[i].y(), vel_[i].x());
     if (d.role == Role::kLifter && attached_) stretcher_xy_ = pos_[i].head<2>();
+    MeasureClearance(i);
   }
   for (std::size_t i = 0; i < n; ++i) {
     for (std::size_t j = i + 1; j < n; ++j) {
@@ -317,6 +321,35 @@ void MissionSim::Step() {
         min_flock_pair_m_ = std::min(min_flock_pair_m_, d);
       }
     }
+  }
+}
+
+std::optional<double> MissionSim::FakeDepth(std::size_t drone) const {
+  const Vec3& p = pos_[drone];
+  const double ground_z_m = config_.drones[drone].home_m.z();
+  std::optional<double> top;
+  if (p.z() - ground_z_m <= config_.fake_depth_range_m) top = ground_z_m;
+  for (const MissionSimConfig::Obstacle& o : config_.obstacles) {
+    const Vec2 nearest(std::clamp(p.x(), o.area.x_min_m, o.area.x_max_m),
+                       std::clamp(p.y(), o.area.y_min_m, o.area.y_max_m));
+    const bool near = (nearest - p.head<2>()).norm() <= config_.fake_depth_radius_m;
+    if (!near || p.z() - o.top_z_m > config_.fake_depth_range_m) continue;
+    top = std::max(top.value_or(o.top_z_m), o.top_z_m);
+  }
+  return top;
+}
+
+void MissionSim::MeasureClearance(std::size_t drone) {
+  const SimDrone& d = config_.drones[drone];
+  if (d.role != Role::kScout || pos_[drone].z() < d.home_m.z() + 2.0) return;
+  const Vec2 p = pos_[drone].head<2>();
+  const double e = config_.obstacle_edge_m;
+  for (const MissionSimConfig::Obstacle& o : config_.obstacles) {
+    if (!o.area.Contains(p)) continue;
+    const double clearance_m = pos_[drone].z() - o.top_z_m;
+    min_clearance_m_ = std::min(min_clearance_m_, clearance_m);
+    const Rect inner{o.area.x_min_m + e, o.area.y_min_m + e, o.area.x_max_m - e, o.area.y_max_m - e};
+    if (inner.Contains(p)) min_inner_clearance_m_ = std::min(min_inner_clearance_m_, clearance_m);
   }
 }
 

@@ -59,6 +59,24 @@ struct MissionSimConfig {
   // drop_spot_offset_m; nullopt: no depth frames (it never answers).
   bool lifter_survey_drop_point = false;
   std::optional<Vec2> drop_spot_offset_m;
+  // The scouts' safe height (ScoutConfig::min_clearance_m, MissionInput::obstacle_top_z_m):
+  // obstacles (trees, walls) as boxes standing on the ground (z 0), and a fake depth host that
+  // gives each scout, at the camera's 5 Hz, the highest top (the ground's or an obstacle's)
+  // within fake_depth_radius_m of it horizontally and fake_depth_range_m below it (ClearanceBelow's
+  // defaults), nothing when none is within range. Without fake_depth the obstacles are only
+  // measured (min_obstacle_clearance_m).
+  struct Obstacle {
+    Rect area;
+    double top_z_m = 0;
+  };
+  std::vector<Obstacle> obstacles;
+  bool fake_depth = false;
+  double fake_depth_radius_m = 5.0;
+  double fake_depth_range_m = 15.0;
+  double scout_altitude_m = 30.0;      // ScoutConfig::search_altitude_m
+  double scout_min_clearance_m = 0.0;  // ScoutConfig::min_clearance_m
+  // min_obstacle_clearance_m(true) ignores this band inside an obstacle's edges [m] (the climb).
+  double obstacle_edge_m = 5.0;
   double battery_fraction_at_start = 1.0;
   double battery_drain_per_s = 0.0;  // fraction per second (crude: tests of battery_low)
   bool scouts_only_report_once = false;
@@ -102,6 +120,11 @@ class MissionSim {
   // Where the closest approach of two airborne drones happened: "t=.. a(mode) b(mode)".
   const std::string& min_pair_where() const { return min_pair_where_; }
   std::size_t rejected_proposals() const { return rejected_; }
+  // The least height of an airborne scout above an obstacle's top while over it (inner: at least
+  // obstacle_edge_m inside its edges) [m]; 1e9 if never over one.
+  double min_obstacle_clearance_m(bool inner) const {
+    return inner ? min_inner_clearance_m_ : min_clearance_m_;
+  }
   std::size_t leader() const { return leader_index_; }
   // A failure from now on (e.g. once a drone logged its first sector progress).
   void AddOutage(MissionSimConfig::Outage outage) { config_.outages.push_back(std::move(outage)); }
@@ -148,6 +171,10 @@ class MissionSim {
   double min_flock_pair_m_ = 1e9;
   std::string min_pair_where_;
   std::size_t rejected_ = 0;
+  double min_clearance_m_ = 1e9;
+  double min_inner_clearance_m_ = 1e9;
+  std::optional<double> FakeDepth(std::size_t drone) const;  // the fake depth host's top, or none
+  void MeasureClearance(std::size_t drone);
   std::vector<std::string> log_;
   double t_s_ = 0.0;
 };

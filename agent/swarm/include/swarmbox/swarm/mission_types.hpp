@@ -74,6 +74,11 @@ struct MissionInput {
   // The lifter's drop-spot survey: the answer to an earlier want_drop_spot, once (the host sets it
   // on one step and clears it after).
   std::optional<DropSpotAnswer> drop_spot;
+  // The scout's safe height (ScoutConfig::min_clearance_m): the highest surface under and around
+  // the drone from its depth camera (agent/depth ClearanceBelow's top_z_m), world z [m], from a
+  // fresh frame (the host sets it on the step a frame arrives); absent: no depth this step (none
+  // within the camera's 15 m range, no camera, or no new frame).
+  std::optional<double> obstacle_top_z_m;
 };
 
 struct MissionOutput {

@@ -30,6 +30,22 @@
 // phase: one pass over a spot sends a view every report_baseline_m of flight while it is in the
 // footprint, the second views the leader's fusion needs (sighting_fusion.hpp; no single view
 // confirms).
+// Safe height (issue #23; ScoutConfig::min_clearance_m > 0): the host feeds the highest surface
+// under and around the scout from its downward depth camera (MissionInput::obstacle_top_z_m,
+// agent/depth ClearanceBelow). Wherever the scout commands its cruise altitude (waiting for a
+// sector, searching, swept, orbiting, revisiting, and on the way home in its return layer; not
+// the take-off climb nor the descent over home), the commanded altitude becomes
+// max(cruise altitude, obstacle_top_z_m + min_clearance_m) (event=clearance_climb with top_z and
+// the new altitude when a climb starts, and again when a taller obstacle raises it by 1 m or more).
+// It never comes down during the raise: it holds the highest altitude asked for until
+// clearance_hold_s of simulated time have passed without a report asking for more than the
+// cruise altitude, then returns to the cruise altitude (no bobbing over each crown of a stand of
+// trees). A revisit looks from the raised altitude. With min_clearance_m == 0 or no
+// obstacle_top_z_m, nothing changes. What the camera gives (clearance.hpp): only obstacles within
+// its 15 m range are reported, so min_clearance_m must stay below 15 m minus SGBM's error there
+// (~1.3 m); looking straight down it sees an obstacle only ~0.59 x its range ahead of the nadir
+// (3.5 m for a crown 6 m below), so this holds a height over things, it does not avoid flying
+// into something taller than the scout: the search altitude must clear every obstacle by itself.
 // A report is re-proposed (next seq) every report_retry_s until the committed state shows it (a
 // pending sighting with its seq, or a victim there), at most report_tries times: a proposal
 // forwarded over the lossy radio, or caught in the leader's log when the leader died, is lost
@@ -39,8 +55,10 @@
 //   scout.Step(input, &output);   // each mission tick (e.g. 10 Hz)
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -104,6 +122,15 @@ struct ScoutConfig {
   double report_retry_s = 5.0;        // re-propose a report not yet in the committed state [s]
   int report_tries = 4;               // proposals of one report at most
   std::uint64_t first_sighting_seq = 1;  // after an agent restart: seed above any used (sim ms)
+  // Safe height (above): the least clearance over the highest surface the depth camera reports,
+  // world z above obstacle_top_z_m [m]; 0 = off (cruise altitude only).
+  double min_clearance_m = 0;
+  // How long a raised altitude is held after the last report asking for it [s, simulated]: 5 s
+  // is 25 m at the 5 m/s cruise (35 m at SarBrain's 7), more than the gaps between crowns in a
+  // stand of trees or between rubble heaps, and a descent of 6 m and the climb back take the
+  // flight stack ~5 s (1.5-3 m/s vertical), so a shorter hold would not even reach the cruise
+  // altitude before the next climb.
+  double clearance_hold_s = 5.0;
 };
 
 // Staggered take-off from the trial's grid (design18: up to 100 scouts `spacing_m` = 4 m apart):
@@ -162,6 +189,12 @@ class ScoutBehaviour {
   const raft::Sector* NextSector(const raft::MissionState& m) const;
   const raft::Victim* OrbitTarget(const MissionInput& in) const;
   void Enter(Stage stage, const MissionInput& in, MissionOutput* out);
+  // Safe height: whether this step commands a cruise altitude, the raise from its obstacle report
+  // (once a step, before the stages run), and a cruise altitude raised to the safe height.
+  bool Cruising(const MissionInput& in) const;
+  void UpdateClearance(const MissionInput& in, MissionOutput* out);
+  double Raised(double cruise_z_m) const { return std::max(cruise_z_m, clearance_floor_z_m_); }
+  bool ClearanceRaised() const { return clearance_floor_z_m_ > -std::numeric_limits<double>::infinity(); }
   double Altitude() const { return config_.home_m.z() + config_.search_altitude_m; }
 
   ScoutConfig config_;
@@ -198,6 +231,11 @@ class ScoutBehaviour {
   bool revisit_seen_ = false;   // a detection there during this revisit (reported as a sighting)
   double miss_sent_s_ = -1.0;   // the miss proposed (latest try) [s]
   int miss_tries_ = 0;
+  // Safe height: the raised cruise altitude (world z; -infinity: not raised), when a report last
+  // asked for a raise, and the altitude last logged (event=clearance_climb).
+  double clearance_floor_z_m_ = -std::numeric_limits<double>::infinity();
+  double clearance_asked_s_ = 0.0;
+  double clearance_logged_z_m_ = 0.0;
 };
 
 }  // namespace swarmbox::swarm
