@@ -12,6 +12,7 @@
 #include "server_wait.hpp"
 #include "swarmbox/bus/topics.hpp"
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/depth/clearance.hpp"
 #include "swarmbox/depth/drop_spot.hpp"
 #include "wait_budget.hpp"
 
@@ -442,7 +443,12 @@ bool AgentNode::StepDepth(const bus::SensorSample& msg) {
       break;
     case FrameWait::kTaken: break;
   }
-  depth_->Release(msg.sim_time_ns);
+  // A scout's safe height: the highest surface around it in each new depth frame.
+  if (depth_->Release(msg.sim_time_ns) > 0 && sar_ != nullptr && sar_->role() == swarm::Role::kScout) {
+    const DepthHost::Frame& f = *depth_->latest();
+    const depth::Clearance c = depth::ClearanceBelow(f.frame.depth_m, f.intrinsics, f.camera_pose, {});
+    if (c.valid) sar_->ReportObstacleTop(c.top_z_m);
+  }
   return true;
 }
 

@@ -183,6 +183,7 @@ constexpr TuningArg kTuningArgs[] = {
     {"assignment_settle_s", &MissionTuning::assignment_settle_s, nullptr},
     {"sighting_dedupe_m", &MissionTuning::sighting_dedupe_m, nullptr},
     {"status_every_s", &MissionTuning::status_every_s, nullptr},
+    {"scout_min_clearance_m", &MissionTuning::scout_min_clearance_m, nullptr},
     {"load_check_climb_m", &MissionTuning::load_check_climb_m, nullptr},
     {"load_check_delay_s", &MissionTuning::load_check_delay_s, nullptr},
     {"load_check_fraction", &MissionTuning::load_check_fraction, nullptr},
@@ -467,6 +468,7 @@ swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, d
   s.dedupe_radius_m = t.sighting_dedupe_m;
   s.report_baseline_m = t.fusion.min_baseline_m;  // one view per counted baseline, no more
   s.revisit_look_s = t.revisit_look_s;
+  s.min_clearance_m = c.depth_camera ? t.scout_min_clearance_m : 0.0;  // no depth camera: nothing seen
   s.keep_searching_during_rescue = true;  // the lifter does the rescue; scouts finish the search
   s.return_when_swept = true;             // nothing left to see: land, do not loiter
   s.approach_height_m = 5.0;              // descend at vel_max_down, land the last 5 m
@@ -644,6 +646,7 @@ swarm::MissionInput SarBrain::BehaviourInput(const Now& now) const {
 void SarBrain::RunBehaviour(const Now& now, brain::Output& out) {
   swarm::MissionInput mi = BehaviourInput(now);
   if (scout_) {
+    mi.obstacle_top_z_m = std::exchange(obstacle_top_z_m_, std::nullopt);
     scout_->Step(mi, &behaviour_out_);
   } else {
     mi.drop_spot = std::exchange(drop_spot_answer_, std::nullopt);

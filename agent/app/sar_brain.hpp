@@ -113,6 +113,11 @@ struct MissionTuning {
   // Load check (lifter): once lifted (attach height + load_check_climb_m) and load_check_delay_s
   // after an attach, the flight stack's mass estimate must show at least load_check_fraction of
   // the attached mass, or the hook is taken to be empty (event=payload_missing).
+  // Safe height (scouts with a depth camera, issue #23): cruise at least this far above the
+  // highest surface the depth camera sees under and around the scout (swarm::ScoutConfig
+  // min_clearance_m; only surfaces within the OAK-D Pro's 15 m range are seen, so it matters for a
+  // search flown low, e.g. scout_altitude_m 12 over 8 m trees) [m].
+  double scout_min_clearance_m = 6.0;
   double load_check_climb_m = 3.0;
   double load_check_delay_s = 4.0;
   double load_check_fraction = 0.5;
@@ -226,6 +231,9 @@ class SarBrain final : public brain::Brain {
   // The answer from the depth camera (agent/app AgentNode with DepthHost), handed to the sequence
   // at its next mission tick.
   void AnswerDropSpot(const swarm::DropSpotAnswer& answer) { drop_spot_answer_ = answer; }
+  // A scout's depth camera saw its highest surface around it at this world height (a new depth
+  // frame; depth::ClearanceBelow); handed to the scout at its next mission tick.
+  void ReportObstacleTop(double top_z_m) { obstacle_top_z_m_ = top_z_m; }
   // The last flocking step's terms (for the recording); nullptr while the drone is not flocking.
   const swarm::FlockingOutput* flocking() const { return flocking_ ? &flocking_out_ : nullptr; }
 
@@ -303,6 +311,7 @@ class SarBrain final : public brain::Brain {
   bool complete_logged_ = false;
   std::optional<DropSpotQuery> drop_spot_query_;
   std::optional<swarm::DropSpotAnswer> drop_spot_answer_;
+  std::optional<double> obstacle_top_z_m_;
   swarm::FlockingOutput flocking_out_;  // the last flocking step's (flocking_: of the last Drive)
   bool flocking_ = false;
 };

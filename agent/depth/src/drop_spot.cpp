@@ -292,6 +292,31 @@ bool Passes(const Evaluation& e, double ground_z_m, const DropSpotConfig& config
 
 }  // namespace
 
+namespace {
+
+// The candidate centre (x, y) lies in a keep-out circle.
+bool KeptOut(const DropSpotConfig& config, double x_m, double y_m) {
+  return std::ranges::any_of(config.keep_out,
+                             [&](const KeepOut& k) { return std::hypot(x_m - k.x_m, y_m - k.y_m) < k.radius_m; });
+}
+
+// The image's points binned around the default point, with the ground's height from the view
+// when config.ground_quantile asks for it (f.ground_z_m then moves to it), and the obstacle cells.
+CellGrid PrepareGrid(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics, const bus::Pose& camera,
+                     const DropSpotConfig& config, Frame* f) {
+  CellGrid grid(config.search_radius_m + std::hypot(config.length_m, config.width_m) / 2 + kCell_m);
+  grid.Summarize(BinPoints(depth_m, intrinsics, camera, *f, grid));
+  if (config.ground_quantile >= 0) {  // the ground as the view shows it, not as given
+    const double offset_m = grid.SeenHeightQuantile(config.ground_quantile);
+    grid.ShiftHeights(-offset_m);
+    f->ground_z_m += offset_m;
+  }
+  grid.MarkObstacles(config.max_height_above_ground_m);
+  return grid;
+}
+
+}  // namespace
+
 DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics, const bus::Pose& camera,
                         double default_x_m, double default_y_m, double yaw_rad, double ground_z_m,
                         const DropSpotConfig& config) {
@@ -299,35 +324,23 @@ DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsi
   SWARMBOX_CHECK(config.length_m > 0 && config.width_m > 0 && config.grid_step_m > 0 && config.search_radius_m >= 0);
   SWARMBOX_CHECK(config.ground_quantile < 1.0);
   Frame f{default_x_m, default_y_m, std::cos(yaw_rad), std::sin(yaw_rad), ground_z_m};
-  CellGrid grid(config.search_radius_m + std::hypot(config.length_m, config.width_m) / 2 + kCell_m);
-  grid.Summarize(BinPoints(depth_m, intrinsics, camera, f, grid));
+  const CellGrid grid = PrepareGrid(depth_m, intrinsics, camera, config, &f);
   DropSpot spot;
-  if (config.ground_quantile >= 0) {  // the ground as the view shows it, not as given
-    const double offset_m = grid.SeenHeightQuantile(config.ground_quantile);
-    grid.ShiftHeights(-offset_m);
-    f.ground_z_m += offset_m;
-  }
   spot.ground_z_m = f.ground_z_m;
-  grid.MarkObstacles(config.max_height_above_ground_m);
   spot.x_m = default_x_m;
   spot.y_m = default_y_m;
   for (const Candidate& cand : Candidates(config)) {
     const double a0 = cand.i * config.grid_step_m, c0 = cand.j * config.grid_step_m;
     const double x_m = default_x_m + a0 * f.cos_yaw - c0 * f.sin_yaw;
     const double y_m = default_y_m + a0 * f.sin_yaw + c0 * f.cos_yaw;
-    if (std::ranges::any_of(config.keep_out, [&](const KeepOut& k) {
-          return std::hypot(x_m - k.x_m, y_m - k.y_m) < k.radius_m;
-        })) {
-      continue;  // never closer than this to the victim (or anything else kept out)
-    }
+    if (KeptOut(config, x_m, y_m)) continue;  // never this close to the victim (or anything kept out)
     const Evaluation e = Evaluate(grid, f, a0, c0, config);
-    const GroundFit& fit = e.fit;
     const bool ok = Passes(e, f.ground_z_m, config);
     if (cand.i == 0 && cand.j == 0) {
-      spot.at_default = fit;
+      spot.at_default = e.fit;
       spot.default_ok = ok;
     }
-    if (!fit.valid) continue;
+    if (!e.fit.valid) continue;
     ++spot.candidates;
     if (!ok) continue;
     ++spot.flat;
@@ -335,7 +348,7 @@ DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsi
     spot.found = true;
     spot.x_m = x_m;
     spot.y_m = y_m;
-    spot.fit = fit;
+    spot.fit = e.fit;
   }
   if (!spot.found) spot.fit = spot.at_default;  // the spot stays the default point
   return spot;
