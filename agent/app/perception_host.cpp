@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+
+#include "swarmbox/depth/depth_surface.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -9,6 +12,21 @@ namespace {
 using flight::Vec3;
 
 constexpr std::size_t kHistory = 128;  // control steps of estimates kept (0.5 s at 250 Hz)
+
+// A depth frame's surface as geolocation asks for it: the height near a point within a radius.
+class DepthHeights : public swarm::GroundHeightSource {
+ public:
+  DepthHeights(const cv::Mat& depth_m, const depth::CameraIntrinsics& intrinsics, const bus::Pose& camera,
+               double radius_m)
+      : surface_(depth_m, intrinsics, camera, {}), radius_m_(radius_m) {}
+  std::optional<double> HeightNear(double x_m, double y_m) const override {
+    return surface_.HeightNear(x_m, y_m, radius_m_);
+  }
+
+ private:
+  depth::DepthSurface surface_;
+  double radius_m_;
+};
 
 swarm::PerceptionParams PerceptionFor(double latency_s) {
   swarm::PerceptionParams p;
@@ -21,6 +39,9 @@ swarm::PerceptionParams PerceptionFor(double latency_s) {
 Result<std::unique_ptr<PerceptionHost>> PerceptionHost::Create(const PerceptionConfig& config) {
   if (!(config.inference_latency_s >= 0)) {
     return Error(ErrorCode::kInvalidArgument, "perception: inference latency must be >= 0");
+  }
+  if (!(config.depth_max_age_s >= 0) || !(config.depth_height_radius_m > 0)) {
+    return Error(ErrorCode::kInvalidArgument, "perception: depth_max_age_s must be >= 0 and depth_height_radius_m > 0");
   }
   return std::unique_ptr<PerceptionHost>(new PerceptionHost(config));
 }
@@ -47,7 +68,22 @@ void PerceptionHost::OnCameraFrame(const cv::Mat& bgr, const swarm::PinholeIntri
   if (best->rate_rad_s.norm() > config_.max_rate_rad_s) return;
   const airframe::Vec3& offset = config_.camera.offset_m;
   const swarm::OpticalPose pose = swarm::OpticalPoseFromBody(best->pos_m, best->att, Vec3(offset.x, offset.y, offset.z));
-  (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s);
+  (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s, SurfaceFor(capture_t_s));
+}
+
+void PerceptionHost::OnDepthFrame(const depth::DepthFrame& frame, const bus::Pose& camera_pose,
+                                  const depth::CameraIntrinsics& intrinsics) {
+  depth_ = DepthView{frame.depth_m, static_cast<double>(frame.capture_ns) * 1e-9, camera_pose, intrinsics};
+  surface_.reset();
+}
+
+const swarm::GroundHeightSource* PerceptionHost::SurfaceFor(double capture_t_s) {
+  if (!depth_ || std::abs(depth_->capture_t_s - capture_t_s) > config_.depth_max_age_s) return nullptr;
+  if (!surface_) {
+    surface_ = std::make_unique<DepthHeights>(depth_->depth_m, depth_->intrinsics, depth_->camera_pose,
+                                              config_.depth_height_radius_m);
+  }
+  return surface_.get();
 }
 
 void PerceptionHost::PopVisible(double t_s, std::vector<brain::Detection>* out) {
