@@ -13,21 +13,6 @@ using flight::Vec3;
 
 constexpr std::size_t kHistory = 128;  // control steps of estimates kept (0.5 s at 250 Hz)
 
-// A depth frame's surface as geolocation asks for it: the height near a point within a radius.
-class DepthHeights : public swarm::GroundHeightSource {
- public:
-  DepthHeights(const cv::Mat& depth_m, const depth::CameraIntrinsics& intrinsics, const bus::Pose& camera,
-               double radius_m)
-      : surface_(depth_m, intrinsics, camera, {}), radius_m_(radius_m) {}
-  std::optional<double> HeightNear(double x_m, double y_m) const override {
-    return surface_.HeightNear(x_m, y_m, radius_m_);
-  }
-
- private:
-  depth::DepthSurface surface_;
-  double radius_m_;
-};
-
 swarm::PerceptionParams PerceptionFor(double latency_s) {
   swarm::PerceptionParams p;
   p.latency_s = latency_s;
@@ -35,6 +20,34 @@ swarm::PerceptionParams PerceptionFor(double latency_s) {
 }
 
 }  // namespace
+
+// A depth frame's surface as geolocation asks for it: the height near a point within a radius. The
+// depth::DepthSurface is built on the first question (the depth's pixels back-projected once).
+class DepthHeights : public swarm::GroundHeightSource {
+ public:
+  DepthHeights(const depth::DepthFrame& frame, const bus::Pose& camera_pose, const depth::CameraIntrinsics& intrinsics,
+               double radius_m)
+      : depth_m_(frame.depth_m),
+        capture_t_s_(static_cast<double>(frame.capture_ns) * 1e-9),
+        camera_pose_(camera_pose),
+        intrinsics_(intrinsics),
+        radius_m_(radius_m) {}
+  std::optional<double> HeightNear(double x_m, double y_m) const override {
+    if (!surface_) surface_.emplace(depth_m_, intrinsics_, camera_pose_, depth::DepthSurfaceConfig{});
+    return surface_->HeightNear(x_m, y_m, radius_m_);
+  }
+  double capture_t_s() const { return capture_t_s_; }
+
+ private:
+  cv::Mat depth_m_;
+  double capture_t_s_;
+  bus::Pose camera_pose_;
+  depth::CameraIntrinsics intrinsics_;
+  double radius_m_;
+  mutable std::optional<depth::DepthSurface> surface_;  // a cache: built on the first question
+};
+
+PerceptionHost::~PerceptionHost() = default;
 
 Result<std::unique_ptr<PerceptionHost>> PerceptionHost::Create(const PerceptionConfig& config) {
   if (!(config.inference_latency_s >= 0)) {
@@ -73,17 +86,12 @@ void PerceptionHost::OnCameraFrame(const cv::Mat& bgr, const swarm::PinholeIntri
 
 void PerceptionHost::OnDepthFrame(const depth::DepthFrame& frame, const bus::Pose& camera_pose,
                                   const depth::CameraIntrinsics& intrinsics) {
-  depth_ = DepthView{frame.depth_m, static_cast<double>(frame.capture_ns) * 1e-9, camera_pose, intrinsics};
-  surface_.reset();
+  depth_ = std::make_unique<const DepthHeights>(frame, camera_pose, intrinsics, config_.depth_height_radius_m);
 }
 
-const swarm::GroundHeightSource* PerceptionHost::SurfaceFor(double capture_t_s) {
-  if (!depth_ || std::abs(depth_->capture_t_s - capture_t_s) > config_.depth_max_age_s) return nullptr;
-  if (!surface_) {
-    surface_ = std::make_unique<DepthHeights>(depth_->depth_m, depth_->intrinsics, depth_->camera_pose,
-                                              config_.depth_height_radius_m);
-  }
-  return surface_.get();
+const swarm::GroundHeightSource* PerceptionHost::SurfaceFor(double capture_t_s) const {
+  if (!depth_ || std::abs(depth_->capture_t_s() - capture_t_s) > config_.depth_max_age_s) return nullptr;
+  return depth_.get();
 }
 
 void PerceptionHost::PopVisible(double t_s, std::vector<brain::Detection>* out) {

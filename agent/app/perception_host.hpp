@@ -21,14 +21,14 @@
 // built from it only when a camera frame needs it, and only if the depth was captured within
 // depth_max_age_s of the camera frame (the drone moves 1.25 m in 0.25 s at 5 m/s, but the surface
 // is in world coordinates: what matters is that the scene has not changed, and that the frame saw
-// the same ground). The heights are the median of the cells within depth_height_radius_m of
+// the same ground); it is built on the first detection to geolocate, not for frames without one
+// (8-16 ms for a frame with depth). The heights are the median of the cells within depth_height_radius_m of
 // where the ray lands. The depth reaches 15 m (DepthSurfaceConfig::max_range_m): a scout at its
 // 30 m search altitude has none, and geolocates on the flat plane as before.
 
 #pragma once
 
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -59,10 +59,13 @@ struct PerceptionConfig {
   double depth_height_radius_m = 0.5;
 };
 
+class DepthHeights;
+
 class PerceptionHost {
  public:
   // kInvalidArgument: a negative latency or depth_max_age_s, a depth_height_radius_m <= 0.
   static Result<std::unique_ptr<PerceptionHost>> Create(const PerceptionConfig& config);
+  ~PerceptionHost();
 
   void RecordEstimate(double t_s, const flight::StateEstimate& est);
   // Detects and geolocates; the detections wait out the latency. Frames without an estimate of
@@ -86,21 +89,15 @@ class PerceptionHost {
     flight::Vec3 rate_rad_s = flight::Vec3::Zero();
   };
 
-  // The surface's heights for a camera frame captured at capture_t_s (building them from the
-  // newest depth frame on first use), or nullptr: no depth frame, or none captured near enough.
-  const swarm::GroundHeightSource* SurfaceFor(double capture_t_s);
-
-  struct DepthView {
-    cv::Mat depth_m;
-    double capture_t_s = 0;
-    bus::Pose camera_pose;
-    depth::CameraIntrinsics intrinsics;
-  };
+  // The newest depth frame's heights for a camera frame captured at capture_t_s, or nullptr: no
+  // depth frame, or none captured near enough.
+  const swarm::GroundHeightSource* SurfaceFor(double capture_t_s) const;
 
   PerceptionConfig config_;
   swarm::VictimPerception perception_;
-  std::optional<DepthView> depth_;                           // the newest depth frame
-  std::unique_ptr<const swarm::GroundHeightSource> surface_;  // built from depth_ when first needed
+  // The newest depth frame; its depth::DepthSurface is built on the first height asked of it (a
+  // detection to geolocate), not per camera frame (perception_host.cpp).
+  std::unique_ptr<const DepthHeights> depth_;
   std::vector<Estimate> history_;  // ring, one entry per control step
   std::size_t history_next_ = 0;
   std::vector<swarm::GroundDetection> visible_;
