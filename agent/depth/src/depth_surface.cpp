@@ -44,6 +44,22 @@ std::vector<WorldPoint> BackProject(const cv::Mat& depth_m, const CameraIntrinsi
   return points;
 }
 
+// The grid over the points' bounding box: its corner and size in cells. The points are within
+// max_range_m of the camera, so at most 2 max_range_m / cell_m cells a side (120 at the defaults).
+struct Grid {
+  double origin_x_m, origin_y_m;
+  int cols, rows;
+};
+Grid BoundingGrid(const std::vector<WorldPoint>& points, double cell_m) {
+  double min_x = points[0].x_m, min_y = points[0].y_m, max_x = min_x, max_y = min_y;
+  for (const WorldPoint& p : points) {
+    min_x = std::min(min_x, p.x_m), min_y = std::min(min_y, p.y_m);
+    max_x = std::max(max_x, p.x_m), max_y = std::max(max_y, p.y_m);
+  }
+  return {min_x, min_y, static_cast<int>(std::floor((max_x - min_x) / cell_m)) + 1,
+          static_cast<int>(std::floor((max_y - min_y) / cell_m)) + 1};
+}
+
 }  // namespace
 
 DepthSurface::DepthSurface(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics, const bus::Pose& camera,
@@ -54,16 +70,8 @@ DepthSurface::DepthSurface(const cv::Mat& depth_m, const CameraIntrinsics& intri
   const std::vector<WorldPoint> points = BackProject(depth_m, intrinsics, camera, config.max_range_m);
   points_ = static_cast<int>(points.size());
   if (points.empty()) return;
-  // The grid over the points' bounding box: within max_range_m of the camera, so at most
-  // 2 max_range_m / cell_m cells a side (120 at the defaults).
-  double max_x = points[0].x_m, max_y = points[0].y_m;
-  origin_x_m_ = max_x, origin_y_m_ = max_y;
-  for (const WorldPoint& p : points) {
-    origin_x_m_ = std::min(origin_x_m_, p.x_m), origin_y_m_ = std::min(origin_y_m_, p.y_m);
-    max_x = std::max(max_x, p.x_m), max_y = std::max(max_y, p.y_m);
-  }
-  cols_ = static_cast<int>(std::floor((max_x - origin_x_m_) / config.cell_m)) + 1;
-  rows_ = static_cast<int>(std::floor((max_y - origin_y_m_) / config.cell_m)) + 1;
+  const Grid grid = BoundingGrid(points, config.cell_m);
+  origin_x_m_ = grid.origin_x_m, origin_y_m_ = grid.origin_y_m, cols_ = grid.cols, rows_ = grid.rows;
   const auto cells = static_cast<std::size_t>(cols_) * static_cast<std::size_t>(rows_);
   auto cell_of = [&](const WorldPoint& p) {
     const int col = std::min(static_cast<int>((p.x_m - origin_x_m_) / config.cell_m), cols_ - 1);
