@@ -443,8 +443,14 @@ bool AgentNode::StepDepth(const bus::SensorSample& msg) {
       break;
     case FrameWait::kTaken: break;
   }
+  const int released = depth_->Release(msg.sim_time_ns);
+  // Geolocation on the surface the depth saw (StepMission's camera frames come after this).
+  if (released > 0 && perception_) {
+    const DepthHost::Frame& f = *depth_->latest();
+    perception_->OnDepthFrame(f.frame, f.camera_pose, f.intrinsics);
+  }
   // A scout's safe height: the highest surface around it in each new depth frame.
-  if (depth_->Release(msg.sim_time_ns) > 0 && sar_ != nullptr && sar_->role() == swarm::Role::kScout) {
+  if (released > 0 && sar_ != nullptr && sar_->role() == swarm::Role::kScout) {
     const DepthHost::Frame& f = *depth_->latest();
     const depth::Clearance c = depth::ClearanceBelow(f.frame.depth_m, f.intrinsics, f.camera_pose, {});
     if (c.valid) sar_->ReportObstacleTop(c.top_z_m);

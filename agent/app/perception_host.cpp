@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
+
+#include "swarmbox/depth/depth_surface.hpp"
 
 namespace swarmbox::agent {
 namespace {
@@ -18,9 +21,40 @@ swarm::PerceptionParams PerceptionFor(double latency_s) {
 
 }  // namespace
 
+// A depth frame's surface as geolocation asks for it: the height near a point within a radius. The
+// depth::DepthSurface is built on the first question (the depth's pixels back-projected once).
+class DepthHeights : public swarm::GroundHeightSource {
+ public:
+  DepthHeights(const depth::DepthFrame& frame, const bus::Pose& camera_pose, const depth::CameraIntrinsics& intrinsics,
+               double radius_m)
+      : depth_m_(frame.depth_m),
+        capture_t_s_(static_cast<double>(frame.capture_ns) * 1e-9),
+        camera_pose_(camera_pose),
+        intrinsics_(intrinsics),
+        radius_m_(radius_m) {}
+  std::optional<double> HeightNear(double x_m, double y_m) const override {
+    if (!surface_) surface_.emplace(depth_m_, intrinsics_, camera_pose_, depth::DepthSurfaceConfig{});
+    return surface_->HeightNear(x_m, y_m, radius_m_);
+  }
+  double capture_t_s() const { return capture_t_s_; }
+
+ private:
+  cv::Mat depth_m_;
+  double capture_t_s_;
+  bus::Pose camera_pose_;
+  depth::CameraIntrinsics intrinsics_;
+  double radius_m_;
+  mutable std::optional<depth::DepthSurface> surface_;  // a cache: built on the first question
+};
+
+PerceptionHost::~PerceptionHost() = default;
+
 Result<std::unique_ptr<PerceptionHost>> PerceptionHost::Create(const PerceptionConfig& config) {
   if (!(config.inference_latency_s >= 0)) {
     return Error(ErrorCode::kInvalidArgument, "perception: inference latency must be >= 0");
+  }
+  if (!(config.depth_max_age_s >= 0) || !(config.depth_height_radius_m > 0)) {
+    return Error(ErrorCode::kInvalidArgument, "perception: depth_max_age_s must be >= 0 and depth_height_radius_m > 0");
   }
   return std::unique_ptr<PerceptionHost>(new PerceptionHost(config));
 }
@@ -47,7 +81,17 @@ void PerceptionHost::OnCameraFrame(const cv::Mat& bgr, const swarm::PinholeIntri
   if (best->rate_rad_s.norm() > config_.max_rate_rad_s) return;
   const airframe::Vec3& offset = config_.camera.offset_m;
   const swarm::OpticalPose pose = swarm::OpticalPoseFromBody(best->pos_m, best->att, Vec3(offset.x, offset.y, offset.z));
-  (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s);
+  (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s, SurfaceFor(capture_t_s));
+}
+
+void PerceptionHost::OnDepthFrame(const depth::DepthFrame& frame, const bus::Pose& camera_pose,
+                                  const depth::CameraIntrinsics& intrinsics) {
+  depth_ = std::make_unique<const DepthHeights>(frame, camera_pose, intrinsics, config_.depth_height_radius_m);
+}
+
+const swarm::GroundHeightSource* PerceptionHost::SurfaceFor(double capture_t_s) const {
+  if (!depth_ || std::abs(depth_->capture_t_s() - capture_t_s) > config_.depth_max_age_s) return nullptr;
+  return depth_.get();
 }
 
 void PerceptionHost::PopVisible(double t_s, std::vector<brain::Detection>* out) {

@@ -38,6 +38,20 @@ std::optional<Eigen::Vector3d> PixelToGround(const Eigen::Vector2d& pixel, const
   return pose.position_m + t * d;
 }
 
+std::optional<Eigen::Vector3d> PixelToSurface(const Eigen::Vector2d& pixel, const PinholeIntrinsics& k,
+                                              const OpticalPose& pose, double ground_z_m,
+                                              const GroundHeightSource& surface) {
+  std::optional<Eigen::Vector3d> p = PixelToGround(pixel, k, pose, ground_z_m);
+  for (int i = 0; p && i < kSurfaceRefinements; ++i) {
+    const std::optional<double> height_m = surface.HeightNear(p->x(), p->y());
+    if (!height_m) break;
+    const std::optional<Eigen::Vector3d> refined = PixelToGround(pixel, k, pose, *height_m);
+    if (!refined) break;  // a height at or above the camera: a mismatch, not a surface under it
+    p = refined;
+  }
+  return p;
+}
+
 std::optional<Eigen::Vector2d> ProjectToPixel(const Eigen::Vector3d& point_m,
                                               const PinholeIntrinsics& k, const OpticalPose& pose) {
   const Eigen::Vector3d p = pose.rotation.conjugate() * (point_m - pose.position_m);

@@ -10,7 +10,8 @@ VictimPerception::VictimPerception(const PerceptionParams& params)
 }
 
 int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& k,
-                                   const OpticalPose& camera_pose, double capture_time_s) {
+                                   const OpticalPose& camera_pose, double capture_time_s,
+                                   const GroundHeightSource* surface) {
   SWARMBOX_CHECK(k.fx_px > 0 && k.fy_px > 0);
   const double height = camera_pose.position_m.z() - params_.ground_z_m;
   if (height <= 0.5) {  // on or near the ground: nothing sensible to see
@@ -21,7 +22,9 @@ int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& 
   int queued = 0;
   for (const ImageBlob& b : blobs_) {
     if (b.confidence < params_.min_confidence) continue;
-    const std::optional<Eigen::Vector3d> p = PixelToGround(b.centroid_px, k, camera_pose, params_.ground_z_m);
+    const std::optional<Eigen::Vector3d> p =
+        surface == nullptr ? PixelToGround(b.centroid_px, k, camera_pose, params_.ground_z_m)
+                           : PixelToSurface(b.centroid_px, k, camera_pose, params_.ground_z_m, *surface);
     if (!p) continue;
     GroundDetection d;
     d.position_m = *p;

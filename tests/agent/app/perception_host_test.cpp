@@ -105,6 +105,77 @@ TEST(PerceptionHost, SkipsTiltedTurningAndUnknownCaptureSteps) {
   }
 }
 
+// A depth frame of the drone's stereo camera over the rig's 20 m: a flat surface `below_m` under
+// its left camera (a level body: every pixel's depth along the optical axis is below_m), 640 x 400,
+// f = 441 px (the OAK-D Pro's), captured at capture_s.
+struct DepthOfASurface {
+  depth::DepthFrame frame;
+  bus::Pose camera;
+  depth::CameraIntrinsics intrinsics{441.0, 320.0, 200.0};
+  double surface_z_m = 0;
+};
+DepthOfASurface FlatDepth(double below_m, double capture_s) {
+  DepthOfASurface d;
+  d.frame.capture_ns = static_cast<std::int64_t>(capture_s * 1e9);
+  d.frame.release_ns = d.frame.capture_ns + 40'000'000;
+  d.frame.depth_m = cv::Mat(400, 640, CV_32F, cv::Scalar(below_m));
+  d.camera = depth::LeftCameraPose({{0.0, 0.0, 20.0}, {1.0, 0.0, 0.0, 0.0}}, {});
+  d.surface_z_m = d.camera.position_enu_m[2] - below_m;
+  return d;
+}
+
+// Where the detection's ray (from the perception camera through the flat-plane answer) meets z.
+Vector3d AlongTheRay(const brain::Detection& flat, double z_m) {
+  const airframe::Vec3 offset = PerceptionConfig{}.camera.offset_m;
+  const Vector3d cam = swarm::OpticalPoseFromBody(Vector3d(0, 0, 20), Eigen::Quaterniond::Identity(),
+                                                  Vector3d(offset.x, offset.y, offset.z)).position_m;
+  const Vector3d p(flat.position_m.x, flat.position_m.y, flat.position_m.z);
+  return cam + (p - cam) * (cam.z() - z_m) / (cam.z() - p.z());
+}
+
+// With a depth frame captured within depth_max_age_s (0.1 s before the camera frame), the person
+// is placed where their pixel's ray meets the surface the depth saw (8 m up: a roof or a slab,
+// from 12 m: within the depth's 15 m); with one 0.3 s old, or one whose surface lies beyond the
+// 15 m (18 m below), the flat-plane answer as without depth, bit for bit.
+TEST(PerceptionHost, GeolocatesOnTheSurfaceOfARecentDepthFrame) {
+  PerceptionRig flat;
+  const std::vector<brain::Detection> without = flat.Run(5.0, 5.1);
+  ASSERT_EQ(without.size(), 1u);
+
+  PerceptionRig near;
+  const DepthOfASurface surface = FlatDepth(12.0, 4.9);
+  near.host().OnDepthFrame(surface.frame, surface.camera, surface.intrinsics);
+  const std::vector<brain::Detection> on_surface = near.Run(5.0, 5.1);
+  ASSERT_EQ(on_surface.size(), 1u);
+  const Vector3d expected = AlongTheRay(without[0], surface.surface_z_m);
+  EXPECT_NEAR(on_surface[0].position_m.z, surface.surface_z_m, 1e-4);
+  EXPECT_NEAR(on_surface[0].position_m.x, expected.x(), 1e-3);
+  EXPECT_NEAR(on_surface[0].position_m.y, expected.y(), 1e-3);
+  // 7.95 m of height x tan(off-nadir, 5 m from 20 m) = ~2 m nearer the nadir than the flat answer.
+  EXPECT_GT(std::hypot(on_surface[0].position_m.x - without[0].position_m.x,
+                       on_surface[0].position_m.y - without[0].position_m.y), 1.5);
+
+  for (const DepthOfASurface& unused : {FlatDepth(12.0, 4.7), FlatDepth(18.0, 4.9)}) {
+    PerceptionRig rig;
+    rig.host().OnDepthFrame(unused.frame, unused.camera, unused.intrinsics);
+    const std::vector<brain::Detection> out = rig.Run(5.0, 5.1);
+    ASSERT_EQ(out.size(), 1u);
+    EXPECT_EQ(out[0].position_m.x, without[0].position_m.x);
+    EXPECT_EQ(out[0].position_m.y, without[0].position_m.y);
+    EXPECT_EQ(out[0].position_m.z, without[0].position_m.z);
+    EXPECT_EQ(out[0].sigma_m, without[0].sigma_m);
+  }
+}
+
+TEST(PerceptionHost, RefusesBadDepthSettings) {
+  PerceptionConfig c;
+  c.depth_max_age_s = -0.1;
+  EXPECT_FALSE(PerceptionHost::Create(c).ok());
+  c = PerceptionConfig{};
+  c.depth_height_radius_m = 0.0;
+  EXPECT_FALSE(PerceptionHost::Create(c).ok());
+}
+
 TEST(PerceptionHost, RefusesANegativeLatency) {
   PerceptionConfig c;
   c.inference_latency_s = -0.01;

@@ -2,6 +2,7 @@
 // frames of the physics renderer (with clutter painted on them) and the pipeline on a synthetic frame.
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -66,6 +67,72 @@ TEST(Geolocation, RaysAboveTheHorizonHaveNoGroundPoint) {
   // And below the ground plane.
   const OpticalPose under = OpticalPoseFromBody(Vector3d(0, 0, -1), Quaterniond::Identity(), Vector3d::Zero());
   EXPECT_FALSE(PixelToGround({kK.cx_px, kK.cy_px}, kK, under, 0.0).has_value());
+}
+
+// Fake surfaces for PixelToSurface: a slab kSlabTop_m high over x in [5, 15], y in [-5, 5]
+// (the ground z = 0 elsewhere), a ramp z = kRampSlope x, and a surface never seen.
+constexpr double kSlabTop_m = 3.0;
+class Slab : public GroundHeightSource {
+ public:
+  std::optional<double> HeightNear(double x_m, double y_m) const override {
+    ++asked_;
+    return x_m >= 5.0 && x_m <= 15.0 && std::abs(y_m) <= 5.0 ? kSlabTop_m : 0.0;
+  }
+  int asked() const { return asked_; }
+
+ private:
+  mutable int asked_ = 0;
+};
+constexpr double kRampSlope = 0.3;
+class Ramp : public GroundHeightSource {
+ public:
+  std::optional<double> HeightNear(double x_m, double) const override { return kRampSlope * x_m; }
+};
+class Unseen : public GroundHeightSource {
+ public:
+  std::optional<double> HeightNear(double, double) const override { return std::nullopt; }
+};
+
+// A person on the slab 8 m ahead of a camera 20 m up (17 m above the slab): the ray is 25 deg off
+// nadir. The flat plane puts them 3 m x tan(25 deg) = 1.41 m beyond; the slab's height, asked
+// twice, puts them on the slab.
+TEST(Geolocation, PixelToSurfaceFindsASlabsTopWhereTheFlatPlaneOvershoots) {
+  const OpticalPose cam = OpticalPoseFromBody(Vector3d(0, 0, 20), Yaw(0.0), Vector3d::Zero());
+  const Vector3d person(8.0, 0.0, kSlabTop_m);
+  const auto px = ProjectToPixel(person, kK, cam);
+  ASSERT_TRUE(px.has_value());
+  const auto flat = PixelToGround(*px, kK, cam, 0.0);
+  ASSERT_TRUE(flat.has_value());
+  const double tan_off_nadir = 8.0 / (20.0 - kSlabTop_m);
+  EXPECT_NEAR((*flat - person).head<2>().norm(), kSlabTop_m * tan_off_nadir, 1e-9);  // 1.41 m
+  const Slab slab;
+  const auto refined = PixelToSurface(*px, kK, cam, 0.0, slab);
+  ASSERT_TRUE(refined.has_value());
+  EXPECT_LT((*refined - person).norm(), 0.01);
+  EXPECT_EQ(slab.asked(), kSurfaceRefinements);
+  // Where nothing is known: the flat plane's point, bit for bit.
+  const auto unseen = PixelToSurface(*px, kK, cam, 0.0, Unseen{});
+  ASSERT_TRUE(unseen.has_value());
+  EXPECT_EQ(*unseen, *flat);
+}
+
+// On a slope the refinement is a fixed-point iteration whose error shrinks by slope x tan(off-nadir
+// angle) a pass: two passes leave (0.3 x 0.47)^2 = 2 % of the flat plane's 2.7 m error here.
+TEST(Geolocation, PixelToSurfaceConvergesOnASlope) {
+  const OpticalPose cam = OpticalPoseFromBody(Vector3d(0, 0, 20), Yaw(0.0), Vector3d::Zero());
+  const Vector2d px(kK.cx_px, kK.cy_px - kK.fy_px * 0.47);  // 25 deg ahead (east)
+  const Vector3d d = PixelRay(px, kK, cam);
+  // Where the ray meets z = kRampSlope x.
+  const double t = (kRampSlope * cam.position_m.x() - cam.position_m.z()) / (d.z() - kRampSlope * d.x());
+  const Vector3d truth = cam.position_m + t * d;
+  const auto flat = PixelToGround(px, kK, cam, 0.0);
+  const auto refined = PixelToSurface(px, kK, cam, 0.0, Ramp{});
+  ASSERT_TRUE(flat && refined);
+  const double contraction = kRampSlope * std::abs(d.x() / d.z());
+  const double flat_error = (*flat - truth).norm(), refined_error = (*refined - truth).norm();
+  EXPECT_GT(flat_error, 1.0);  // [m]
+  EXPECT_LE(refined_error, flat_error * contraction * contraction * (1 + 1e-6));
+  EXPECT_LT(refined_error, 0.06);  // [m]: 5.4 cm
 }
 
 TEST(Geolocation, GroundSigmaAddsErrorsInQuadrature) {
@@ -211,6 +278,36 @@ TEST(VictimPerception, GeolocatesAndDelaysByTheInferenceLatency) {
   EXPECT_DOUBLE_EQ(out[0].capture_time_s, 5.0);
   EXPECT_GT(out[0].sigma_m, 0.0);
   EXPECT_GE(out[0].confidence, 0.9);
+}
+
+// The same frame with a surface's heights: the person's pixel is re-intersected with a slab 3 m
+// high under it (as if they lay on it), which moves the detection along its ray to z = 3 m, 3 m x
+// tan(off-nadir angle) nearer the nadir; without one (nullptr) the flat-plane answer, bit for bit.
+TEST(VictimPerception, GeolocatesOnTheSurfacesHeightWhenGivenOne) {
+  const Vector3d person(6.0, -3.0, 0.0);
+  Result<testing::Scene> s = View({Person(person.x(), person.y(), std::numbers::pi / 2)}, {0.0, 0.0}, 20.0, 4.0);
+  ASSERT_TRUE(s.ok()) << s.error().ToString();
+  VictimPerception flat, given_none, on_slab;
+  ASSERT_EQ(flat.ProcessFrame(BgrOf(*s), s->intrinsics, s->true_pose, 5.0), 1);
+  ASSERT_EQ(given_none.ProcessFrame(BgrOf(*s), s->intrinsics, s->true_pose, 5.0, nullptr), 1);
+  const Slab slab;
+  ASSERT_EQ(on_slab.ProcessFrame(BgrOf(*s), s->intrinsics, s->true_pose, 5.0, &slab), 1);
+  std::vector<GroundDetection> a, b, c;
+  flat.PopVisible(10.0, &a);
+  given_none.PopVisible(10.0, &b);
+  on_slab.PopVisible(10.0, &c);
+  ASSERT_TRUE(a.size() == 1u && b.size() == 1u && c.size() == 1u);
+  EXPECT_EQ(a[0].position_m, b[0].position_m);
+  EXPECT_EQ(a[0].sigma_m, b[0].sigma_m);
+  const Vector3d& cam = s->true_pose.position_m;
+  const Vector3d expected = cam + (a[0].position_m - cam) * (cam.z() - kSlabTop_m) / cam.z();
+  EXPECT_NEAR(c[0].position_m.z(), kSlabTop_m, 1e-9);
+  EXPECT_LT((c[0].position_m - expected).norm(), 1e-6);
+  // The flat answer is 3 m x tan(off-nadir) = 1.0 m beyond it (6.7 m off the nadir from 20 m).
+  const double tan_off_nadir = (a[0].position_m - cam).head<2>().norm() / cam.z();
+  EXPECT_NEAR((a[0].position_m - c[0].position_m).head<2>().norm(), kSlabTop_m * tan_off_nadir, 1e-6);
+  EXPECT_GT(kSlabTop_m * tan_off_nadir, 0.9);
+  EXPECT_LT(c[0].sigma_m, a[0].sigma_m);  // nearer the camera
 }
 
 }  // namespace

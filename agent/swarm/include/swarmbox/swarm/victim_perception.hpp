@@ -8,6 +8,8 @@
 //   const swarm::OpticalPose cam = swarm::OpticalPoseFromBody(est_at_capture.pos_m,
 //                                                             est_at_capture.att, camera_offset_m);
 //   perception.ProcessFrame(bgr, {k.fx_px, k.fy_px, k.cx_px, k.cy_px}, cam, img.sim_time_ns * 1e-9);
+//   // or, with the surface's heights from the drone's depth (a GroundHeightSource; PerceptionHost):
+//   perception.ProcessFrame(bgr, k, cam, t_s, &surface);
 //   ...                                                       // every control step:
 //   ready.clear();
 //   perception.PopVisible(now_s, &ready);                    // capture + latency <= now
@@ -44,8 +46,11 @@ class VictimPerception {
   explicit VictimPerception(const PerceptionParams& params = {});
 
   // Detects and geolocates; detections enter the latency queue. Returns how many were queued.
+  // Without `surface` each detection is where its pixel's ray meets the plane z = ground_z_m;
+  // with one, where it meets the surface's heights (PixelToSurface: a person on a rubble slab seen
+  // obliquely is not pushed height x tan(off-nadir angle) beyond it).
   int ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& k, const OpticalPose& camera_pose,
-                   double capture_time_s);
+                   double capture_time_s, const GroundHeightSource* surface = nullptr);
   // Appends the detections that are visible at now_s (capture + latency <= now_s).
   void PopVisible(double now_s, std::vector<GroundDetection>* out) { queue_.PopVisible(now_s, out); }
 
