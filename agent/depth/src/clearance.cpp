@@ -7,6 +7,7 @@
 #include <functional>
 #include <vector>
 
+#include "detail/rotation.hpp"
 #include "swarmbox/common/result.hpp"
 
 namespace swarmbox::depth {
@@ -17,14 +18,6 @@ constexpr double kCell_m = 0.1;
 // A cell's median height counts with this many points (as ChooseDropSpot's).
 constexpr int kMinCellPoints = 4;
 
-// Rotation matrix of a unit quaternion (w x y z), row-major: v_world = R v.
-std::array<double, 9> RotationMatrix(const std::array<double, 4>& q) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-}
-
 // A back-projected point: its cell (row-major over the square grid around the nadir) and height.
 struct CellPoint {
   int cell;
@@ -34,7 +27,7 @@ struct CellPoint {
 // The points within the radius and the range, binned around the camera's nadir (grid side `side`).
 std::vector<CellPoint> BinPoints(const cv::Mat& depth_m, const CameraIntrinsics& k, const bus::Pose& camera,
                                  const ClearanceConfig& config, int half) {
-  const std::array<double, 9> r = RotationMatrix(camera.orientation_wxyz);
+  const std::array<double, 9> r = detail::RotationMatrix(camera.orientation_wxyz);
   const auto& c = camera.position_enu_m;
   const double range = config.max_range_m, radius_sq = config.radius_m * config.radius_m;
   const int side = 2 * half;

@@ -6,18 +6,11 @@
 #include <cstddef>
 #include <limits>
 
+#include "detail/rotation.hpp"
 #include "swarmbox/common/result.hpp"
 
 namespace swarmbox::depth {
 namespace {
-
-// Rotation matrix of a unit quaternion (w x y z), row-major: v_world = R v.
-std::array<double, 9> RotationMatrix(const std::array<double, 4>& q) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-}
 
 struct WorldPoint {
   double x_m, y_m;
@@ -27,7 +20,7 @@ struct WorldPoint {
 // Every pixel with depth in (0, max_range_m], back-projected into the world.
 std::vector<WorldPoint> BackProject(const cv::Mat& depth_m, const CameraIntrinsics& k, const bus::Pose& camera,
                                     double max_range_m) {
-  const std::array<double, 9> r = RotationMatrix(camera.orientation_wxyz);
+  const std::array<double, 9> r = detail::RotationMatrix(camera.orientation_wxyz);
   const auto& c = camera.position_enu_m;
   std::vector<WorldPoint> points;
   for (int v = 0; v < depth_m.rows; ++v) {

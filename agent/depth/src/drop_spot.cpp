@@ -11,6 +11,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "detail/rotation.hpp"
 #include "swarmbox/common/result.hpp"
 
 namespace swarmbox::depth {
@@ -152,19 +153,11 @@ void CellGrid::MarkObstacles(double tall_m) {
   }
 }
 
-// Rotation matrix of a unit quaternion (w x y z), row-major: v_world = R v.
-std::array<double, 9> RotationMatrix(const std::array<double, 4>& q) {
-  const double w = q[0], x = q[1], y = q[2], z = q[3];
-  return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-          2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-          2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-}
-
 // Back-projects every pixel with depth once (as FitGroundPlane) into the footprint's frame and
 // keeps those inside the grid.
 std::vector<BinnedPoint> BinPoints(const cv::Mat& depth_m, const CameraIntrinsics& k, const bus::Pose& camera,
                                    const Frame& f, const CellGrid& grid) {
-  const std::array<double, 9> r = RotationMatrix(camera.orientation_wxyz);
+  const std::array<double, 9> r = detail::RotationMatrix(camera.orientation_wxyz);
   const auto& c = camera.position_enu_m;
   std::vector<BinnedPoint> points;
   points.reserve(depth_m.total());
