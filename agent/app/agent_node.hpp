@@ -12,7 +12,7 @@
 //   auto node = AgentNode::Create(o);           // bad airframe/plan/bus config: an error
 //   Status s = node->Run();                     // until the plan is done and samples stop
 //
-// One lockstep step k (sample k at t_k; design17 "The time line of one lockstep step"):
+// One lockstep step k (sample k at t_k; ARCHITECTURE.md "Time"):
 //   a. with sample.camera_frame, the CameraImage of step k is taken first (waited for; a wall
 //      clock liveness bound of camera_timeout, event=camera_missing when it fires);
 //   b. radio.TakeReceived -> DispatchFrames (radio_dispatch.hpp): Raft payloads to the Raft

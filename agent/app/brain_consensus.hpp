@@ -11,7 +11,7 @@
 //   auto raft = RaftHost::Start(options, radio, clock, log, &sim_clock, std::move(machine));
 //   RaftConsensus consensus(**raft);
 //
-// The SDK does not depend on Raft (design24): these adapters are the agent's. Ownership: the
+// The SDK does not depend on Raft (ARCHITECTURE.md "Brains"): these adapters are the agent's. Ownership: the
 // ReplicatedState and the RaftHost outlive their adapters. Not thread-safe (the control loop).
 #pragma once
 

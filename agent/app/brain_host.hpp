@@ -1,6 +1,6 @@
 // BrainHost: runs any brain (swarmbox/brain/brain.hpp) inside the agent: every brain period it
 // assembles brain::Input from what the agent knows, calls Brain::Step, and applies the Output to
-// the flight stack, the radio and the consensus log (design24 "The data flow"). The SAR mission
+// the flight stack, the radio and the consensus log (ARCHITECTURE.md "Brains"). The SAR mission
 // (SarBrain), a user's library brain and a brain in its own process (ExternalBrain) are all
 // driven through it. Pure enough to test without DDS: the flight controller, the consensus log and
 // the radio are reached through small interfaces (FlightPort, ConsensusPort, radio::MeshRadio).

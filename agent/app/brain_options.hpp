@@ -1,5 +1,5 @@
-// Which brain flies the drone (design24 "Agent flags"), from the command line, validated before
-// anything joins the bus (bad input: kInvalidArgument, the agent exits 2):
+// Which brain flies the drone (agent/app/README.md "Which brain flies"), from the command line, validated
+// before anything joins the bus (bad input: kInvalidArgument, the agent exits 2):
 //   --brain builtin   the built-in logic: --mission plan|sar as before (the default)
 //   --brain library   --brain-library PATH --brain-name NAME: a SWARMBOX_BRAIN in a shared library
 //   --brain external  a brain in its own process on the offboard topics (external_brain.hpp)

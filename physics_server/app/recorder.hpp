@@ -1,6 +1,6 @@
 // Recorder: the physics server's side of the recording (ARCHITECTURE.md "Recordings", the
-// channel table of design20): builds every channel's JSON and writes it to the record::Sinks it
-// was given (McapWriter for --record PATH, LiveServer for --view ADDR:PORT).
+// channel table of ARCHITECTURE.md "Recordings"): builds every channel's JSON and writes it to the
+// record::Sinks it was given (McapWriter for --record PATH, LiveServer for --view ADDR:PORT).
 //
 //   Recorder rec(sinks, {"scout_1", "scout_2"}, world_config, RecordOptions{});
 //   rec.Start();                          // /world at t=0

@@ -1,5 +1,5 @@
 // The recording's JSON builders and the Recorder with a fake sink: channels, timestamps, the
-// contract's fields (design20's channel table), rates, and that NaN becomes null.
+// contract's fields (ARCHITECTURE.md "Recordings"), rates, and that NaN becomes null.
 #include "recorder.hpp"
 
 #include <gtest/gtest.h>

@@ -198,7 +198,7 @@ void AppendRaftFlags(const dsl::TrialSpec& spec, std::vector<std::string>* argv)
   }
 }
 
-// The user's brain (design24 "Agent flags"): its context gets the world and the payload; the
+// The user's brain (agent/app/README.md "Which brain flies"): its context gets the world and the payload; the
 // mission keys are the builtin brain's.
 void AppendUserBrainFlags(const dsl::TrialSpec& spec, const dsl::DroneSpec& d, std::vector<std::string>* argv) {
   const dsl::BrainSpec& brain = d.brain;
@@ -275,8 +275,8 @@ std::vector<std::string> AgentArgv(const dsl::TrialSpec& spec, const dsl::DroneS
   return argv;
 }
 
-// An external brain (design24 "The C brain"): --drone, --domain (the sim bus), --members (trial
-// order) first, then the trial's args. A packed program is its image's entrypoint and comes first;
+// An external brain (agent/brain/README.md "The offboard topics"): --drone, --domain (the sim bus), --members
+// (trial order) first, then the trial's args. A packed program is its image's entrypoint and comes first;
 // an image or a Dockerfile's image keeps its ENTRYPOINT and gets these as its command.
 std::vector<std::string> BrainArgv(const dsl::TrialSpec& spec, const dsl::DroneSpec& d) {
   std::vector<std::string> argv;

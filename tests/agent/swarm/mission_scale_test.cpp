@@ -1,5 +1,5 @@
 // The SAR mission at swarm scale on the kinematic rig (mission_sim.hpp): N scouts take off from
-// the trial's 4 m grid (columns = ceil(sqrt(N)), design18 section 1) on a search area scaled with
+// the trial's 4 m grid (columns = ceil(sqrt(N)), dsl/README.md "Drone groups") on a search area scaled with
 // the swarm (geofence sqrt(N) x 60 m per side, the search area 8 m in from it, as SarBrain does),
 // one AssignSectors for all of them, the sweep, and event=mission_complete. Each size prints its
 // mission time (simulated) and the closest approach of two airborne drones.

@@ -2,8 +2,8 @@
 // short SAR search writes RUN_DIR/<trial>/recording.mcap; tests/js/verify_mcap.mjs reads it with
 // @mcap/core (CRCs, indexes, statistics, JSON) and the test compares what it found with the run's
 // truth.csv and events.jsonl:
-//   - the contract's channels (design20): /world once at t=0, /tf, and per drone of truth.csv its
-//     truth, estimate, setpoint, raft and status; /log; scouts' camera frames;
+//   - the contract's channels (ARCHITECTURE.md "Recordings"): /world once at t=0, /tf, and per drone of
+//     truth.csv its truth, estimate, setpoint, raft and status; /log; scouts' camera frames;
 //   - counts: /tf and each truth channel at record.rate_hz (10 Hz) over the simulated time; the
 //     agents' status close to that (their telemetry, best effort); /log holds the run's log events;
 //   - time range: from 0 to the end of truth.csv.

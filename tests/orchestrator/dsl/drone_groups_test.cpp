@@ -1,5 +1,5 @@
-// Drone groups (`count:`), `world_size_m` and their overrides (design18 §1): a group expands to
-// <name>_1 .. <name>_N on a grid; errors are file:line:col at the key (cases as data).
+// Drone groups (`count:`), `world_size_m` and their overrides (dsl/README.md "Drone groups"): a group expands
+// to <name>_1 .. <name>_N on a grid; errors are file:line:col at the key (cases as data).
 #include "swarmbox/dsl/drone_groups.hpp"
 
 #include <gtest/gtest.h>
@@ -158,7 +158,7 @@ TEST(DroneGroups, AddressesGroupMemberOnlyForExpandedNames) {
   EXPECT_FALSE(AddressesGroupMember(*doc, "seed=3"));
 }
 
-// `world: {generate: ...}` (design20 #19): a recipe instead of a file; no file is looked for, the
+// `world: {generate: ...}` (issue #19): a recipe instead of a file; no file is looked for, the
 // trial reads a derived world, and the resolved document keeps the recipe.
 TEST(GeneratedWorld, ARecipeIsADerivedWorldWithoutAFile) {
   auto spec = LoadTrialText(With("world: worlds/open_field.yaml\nworld_size_m: [300, 240]\n",

@@ -1,5 +1,5 @@
 // The recording's keys (`record: {enabled, rate_hz, camera_hz, camera_scale, jpeg_quality}`):
-// defaults (on, design20's figures), values, --set, and errors at file:line:col.
+// defaults (on, issue #20's figures), values, --set, and errors at file:line:col.
 #include <gtest/gtest.h>
 
 #include <string>

@@ -1,5 +1,5 @@
-// world_size_m (design18 §1): the derived world keeps everything but the geofence, refuses a size
-// that leaves a victim outside, and is what the physics server and every agent get as their world.
+// world_size_m (dsl/README.md "Drone groups"): the derived world keeps everything but the geofence, refuses a
+// size that leaves a victim outside, and is what the physics server and every agent get as their world.
 #include "swarmbox/runner/derived_world.hpp"
 
 #include <gtest/gtest.h>
@@ -97,7 +97,7 @@ TEST(PlanWorldSize, EveryContainerReadsTheDerivedWorldAtTheWorldsPath) {
   EXPECT_EQ(readers, 5);
 }
 
-// A generated world (design20 #19.5): the text is the generator's for the trial's seed (so
+// A generated world (issue #19, point 5): the text is the generator's for the trial's seed (so
 // another trial seed is another world), world_size_m sets its size, and the plan needs the path
 // the runner wrote it to.
 TEST(GeneratedWorld, TheDerivedWorldIsGeneratedFromTheTrialSeed) {

@@ -223,7 +223,7 @@ TEST(ViewAddress, DefaultsAndErrors) {
 }
 
 // Raft at swarm scale: raft.voters = V below the drone count makes the first V drones in trial
-// order the voting set, the same list on every drone (design18 §2).
+// order the voting set, the same list on every drone (orchestrator/dsl/README.md, `voters`).
 TEST_F(PlanTest, AgentsGetTheFirstVotersDronesAsTheRaftVotingSet) {
   spec_.raft.voters = 2;
   auto trial = PlanTrial(spec_, options_);

@@ -1,4 +1,4 @@
-// The radio plan of a channel trial (design17.md "Radio plan JSON"): the mesh impairment, every
+// The radio plan of a channel trial (ARCHITECTURE.md "Faults", the radio plan): the mesh impairment, every
 // fault at a simulated time as the physics server's entry, targets resolved except raft_leader,
 // what stays with the runner, refusals, and the JSON itself.
 #include "swarmbox/runner/radio_schedule.hpp"

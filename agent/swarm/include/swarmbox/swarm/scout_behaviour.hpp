@@ -133,7 +133,7 @@ struct ScoutConfig {
   double clearance_hold_s = 5.0;
 };
 
-// Staggered take-off from the trial's grid (design18: up to 100 scouts `spacing_m` = 4 m apart):
+// Staggered take-off from the trial's grid (issue #18: up to 100 scouts `spacing_m` = 4 m apart):
 // the wave, 0..3, of a scout whose home is `home_xy_m`, from the 2 x 2 checkerboard of grid
 // cells (x and y index parity) on a grid of `grid_m`. Scouts of one wave are at least two grid
 // steps (8 m, 13 x the x500's 0.62 m collision box) apart; each of a scout's 8 grid neighbours is

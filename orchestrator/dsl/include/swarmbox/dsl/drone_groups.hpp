@@ -1,4 +1,5 @@
-// Drone groups: one `drones:` item with `count: N` stands for N drones on a grid (design18 §1).
+// Drone groups: one `drones:` item with `count: N` stands for N drones on a grid (dsl/README.md "Drone
+// groups").
 //
 //   drones:
 //     - {name: scout, count: 100, airframe: x500, pose: [0, 0, 0], spacing_m: 4}

@@ -1,5 +1,5 @@
-// The world a trial runs in when it sets `world_size_m: [X, Y]` (design18 §1) or generates its
-// world (`world: {generate: ...}`, design20 #19). world_size_m: the trial's world
+// The world a trial runs in when it sets `world_size_m: [X, Y]` (dsl/README.md "Drone groups") or generates
+// its world (`world: {generate: ...}`, issue #19). world_size_m: the trial's world
 // file with its geofence set to X x Y m, everything else (victims, obstacles, wind, home) as it is.
 // The SAR search area is the geofence, so this scales the search with the swarm.
 //

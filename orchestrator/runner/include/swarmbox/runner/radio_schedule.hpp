@@ -1,5 +1,5 @@
 // The radio plan: what the physics server carries out in simulated time for a `radio.model:
-// channel` trial (the file it reads with --radio-plan; design17.md "Radio plan JSON"). Pure: a
+// channel` trial (the file it reads with --radio-plan; ARCHITECTURE.md "Faults", the radio plan). Pure: a
 // TrialSpec in, a plan and its JSON out; the runner writes it into the trial folder and copies it
 // into the physics container (plan.hpp kRadioPlanPath).
 //
