@@ -73,17 +73,22 @@ float TileMaxAt(const StereoScene& s, const cv::Mat& max_m, double x_m, double y
 }
 
 // Depth t (along the optical axis) where the ray centre + t * d (d.z < 0) first meets the height
-// field: marched in steps of about one cell from the highest cell's level down to the lowest's,
-// then a secant between the last point above and the first below the surface. A ray that never
-// dips below it ends at the lowest level. Samples well above their tile's highest cell are above
-// the surface without reading the height field; the sample before the crossing is then evaluated
-// as the plain march would, so the result is the plain march's to the bit (stereo_test.cpp).
+// field: sampled at t0 + k * dt (k = 0, 1, ...; dt about one cell) from the highest cell's level
+// down to the lowest's, then a secant between the last point above and the first below the
+// surface. A ray that never dips below it ends at the lowest level. The samples are a lattice (k
+// an integer, not t += dt accumulated) so that a march that jumps over samples lands on the same
+// floating values. Samples well above their tile's highest cell are above the surface without
+// reading the height field; the sample before the crossing is then evaluated as the plain march
+// would, so the result is the plain march's to the bit (stereo_test.cpp).
 double MarchToSurface(const StereoScene& s, const cv::Mat& tile_max, const Vec3& centre, const Vec3& d) {
   const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
   const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
-  double prev_t = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z), prev_f = 1.0;
+  const double t0 = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z);
+  double prev_t = t0, prev_f = 1.0;
   bool prev_skipped = false;
-  for (double t = prev_t; t <= t_end + dt; t += dt) {
+  for (double k = 0;; ++k) {  // k: a whole number in a double (exact far beyond any march's length)
+    const double t = t0 + k * dt;
+    if (!(t <= t_end + dt)) break;
     const double tt = std::min(t, t_end);
     const double x = centre.x + tt * d.x, y = centre.y + tt * d.y, z = centre.z + tt * d.z;
     if (z > TileMaxAt(s, tile_max, x, y) + kTileMargin_m) {

@@ -185,15 +185,18 @@ TEST(StereoRenderer, SameSeedSameImages) {
 }
 
 // The renderer's ray march as the reference, step for step: from the highest cell's level down in
-// steps of about a cell, then a secant. A faster march (issue #23: a max-height pyramid that skips
+// steps of about a cell (samples at t0 + k * dt), then a secant. A faster march (issue #23: a max-height pyramid that skips
 // samples it proves above the surface) must give these depths to the bit, so that the images and
 // the benchmark's figures do not change either.
 double PlainMarch(const StereoScene& s, const Vec3& centre, const Vec3& d) {
   constexpr double kNearClip_m = 0.05, kEndMargin_m = 1e-3;  // stereo_renderer.cpp's
   const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
   const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
-  double prev_t = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z), prev_f = 1.0;
-  for (double t = prev_t; t <= t_end + dt; t += dt) {
+  const double t0 = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z);
+  double prev_t = t0, prev_f = 1.0;
+  for (double k = 0;; ++k) {
+    const double t = t0 + k * dt;
+    if (!(t <= t_end + dt)) break;
     const double tt = std::min(t, t_end);
     const double fz = centre.z + tt * d.z - s.HeightAt(centre.x + tt * d.x, centre.y + tt * d.y);
     if (fz <= 0) return fz == prev_f ? tt : prev_t + (tt - prev_t) * prev_f / (prev_f - fz);
