@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <opencv2/imgproc.hpp>
 
@@ -46,16 +47,25 @@ constexpr double kEndMargin_m = 1e-3;       // the march ends this far below the
 constexpr double kProjectorNear_m = 0.05;   // no dots nearer the projector than this (optical z)
 
 constexpr int kTileCells = 8;               // TileMax: tiles of 8 x 8 cells (0.4 m at 5 cm)
+constexpr int kBlockTiles = 8;              // and blocks of 8 x 8 tiles (3.2 m)
+constexpr int kBlockCells = kTileCells * kBlockTiles;
 constexpr double kTileMargin_m = 1e-3;      // a sample this far above its tile's max is above the surface
+
+int TileRows(const StereoScene& s) { return (s.height_m.rows + kTileCells - 1) / kTileCells; }
 
 // The highest cell of each kTileCells square tile of a scene, over the tile's cells and the next
 // row and column (the cells HeightAt's bilinear interpolation reads from inside the tile), so
-// that HeightAt(x, y) <= TileMaxAt(x, y) anywhere, the grid's clamping included.
+// that HeightAt(x, y) <= the maximum of the tile of (x, y)'s cell anywhere, the grid's clamping
+// included (the clamped cell's tile, as MarchToSurface finds it). Then, in the rows below them
+// (one matrix, as the renderer keeps one), the highest of each block of kBlockTiles x kBlockTiles
+// tiles: block (row, col) at (TileRows(s) + row, col).
 void BuildTileMax(const StereoScene& s, cv::Mat* max_m) {
   const int rows = s.height_m.rows, cols = s.height_m.cols;
-  max_m->create((rows + kTileCells - 1) / kTileCells, (cols + kTileCells - 1) / kTileCells, CV_32F);
-  for (int tr = 0; tr < max_m->rows; ++tr) {
-    for (int tc = 0; tc < max_m->cols; ++tc) {
+  const int tile_rows = TileRows(s), tile_cols = (cols + kTileCells - 1) / kTileCells;
+  const int block_rows = (tile_rows + kBlockTiles - 1) / kBlockTiles;
+  max_m->create(tile_rows + block_rows, tile_cols, CV_32F);
+  for (int tr = 0; tr < tile_rows; ++tr) {
+    for (int tc = 0; tc < tile_cols; ++tc) {
       const cv::Rect cells(tc * kTileCells, tr * kTileCells, std::min(kTileCells + 1, cols - tc * kTileCells),
                            std::min(kTileCells + 1, rows - tr * kTileCells));
       double hi = 0;
@@ -63,34 +73,88 @@ void BuildTileMax(const StereoScene& s, cv::Mat* max_m) {
       max_m->at<float>(tr, tc) = static_cast<float>(hi);
     }
   }
+  for (int br = 0; br < block_rows; ++br) {
+    for (int bc = 0; bc * kBlockTiles < tile_cols; ++bc) {
+      const cv::Rect tiles(bc * kBlockTiles, br * kBlockTiles, std::min(kBlockTiles, tile_cols - bc * kBlockTiles),
+                           std::min(kBlockTiles, tile_rows - br * kBlockTiles));
+      double hi = 0;
+      cv::minMaxLoc((*max_m)(tiles), nullptr, &hi);
+      max_m->at<float>(tile_rows + br, bc) = static_cast<float>(hi);
+    }
+  }
 }
 
-// As HeightAt: the cell of (x, y) clamped to the grid, then its tile's highest cell.
-float TileMaxAt(const StereoScene& s, const cv::Mat& max_m, double x_m, double y_m) {
-  const double fx = std::clamp((x_m - s.origin_x_m) / s.cell_m, 0.0, s.height_m.cols - 1.001);
-  const double fy = std::clamp((y_m - s.origin_y_m) / s.cell_m, 0.0, s.height_m.rows - 1.001);
-  return max_m.at<float>(static_cast<int>(fy) / kTileCells, static_cast<int>(fx) / kTileCells);
+// Along one grid axis, a ray's cell coordinate before clamping is f(t) = f0 + t * df (inv_df =
+// 1 / df): the depth t at which its clamped coordinate leaves square `square` of `cells` cells
+// (cells [square, square + 1) * cells); never when it moves towards a border inside that square
+// (the clamp to [0, f_max] holds it there).
+double SquareExitT(double f0, double df, double inv_df, int square, int cells, double f_max) {
+  constexpr double kNever = std::numeric_limits<double>::infinity();
+  if (df > 0) {
+    const double edge = static_cast<double>((square + 1) * cells);
+    return edge > f_max ? kNever : (edge - f0) * inv_df;
+  }
+  if (df < 0) return square == 0 ? kNever : (static_cast<double>(square * cells) - f0) * inv_df;
+  return kNever;
 }
 
 // Depth t (along the optical axis) where the ray centre + t * d (d.z < 0) first meets the height
-// field: marched in steps of about one cell from the highest cell's level down to the lowest's,
-// then a secant between the last point above and the first below the surface. A ray that never
-// dips below it ends at the lowest level. Samples well above their tile's highest cell are above
-// the surface without reading the height field; the sample before the crossing is then evaluated
-// as the plain march would, so the result is the plain march's to the bit (stereo_test.cpp).
+// field: sampled at t0 + k * dt (k = 0, 1, ...; dt about one cell) from the highest cell's level
+// down to the lowest's, then a secant between the last point above and the first below the
+// surface. A ray that never dips below it ends at the lowest level. The samples are a lattice (k
+// an integer, not t += dt accumulated) so that the jumps below land on the plain march's floating
+// values. Empty-space skip: a sample well above its block's (3.2 m) or else its tile's (0.4 m)
+// highest cell is above the surface, and so is every later sample until the ray leaves that
+// square sideways or comes down to its highest cell (plus kTileMargin_m): the march jumps to the
+// first lattice sample at or past that depth without reading the height field (over 26 m
+// woodland, a ray beside the trees reaches the ground in a jump per block crossed, then a few per
+// tile, instead of a step per cell). The sample before the crossing is then
+// evaluated as the plain march would, so the result is the plain march's to the bit
+// (stereo_test.cpp). The margin (1 mm) covers the rounding of the jump's depths (~1e-12 m): a
+// sample the rounding puts a hair past the tile's edge reads the next tile's cells with weight
+// ~1e-13.
 double MarchToSurface(const StereoScene& s, const cv::Mat& tile_max, const Vec3& centre, const Vec3& d) {
   const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
   const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
-  double prev_t = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z), prev_f = 1.0;
+  const double t0 = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z);
+  // The ray in cell coordinates (HeightAt's, before clamping) and reciprocals, for the jumps.
+  const double fx0 = (centre.x - s.origin_x_m) / s.cell_m, dfx = d.x / s.cell_m, inv_dfx = 1 / dfx;
+  const double fy0 = (centre.y - s.origin_y_m) / s.cell_m, dfy = d.y / s.cell_m, inv_dfy = 1 / dfy;
+  const double fx_max = s.height_m.cols - 1.001, fy_max = s.height_m.rows - 1.001;
+  const double inv_down = 1 / -d.z, inv_dt = 1 / dt;
+  const int tile_rows = TileRows(s);
+  double prev_t = t0, prev_f = 1.0;
   bool prev_skipped = false;
-  for (double t = prev_t; t <= t_end + dt; t += dt) {
+  for (double k = 0;; ++k) {  // k: a whole number in a double (exact far beyond any march's length)
+    const double t = t0 + k * dt;
+    if (!(t <= t_end + dt)) break;
     const double tt = std::min(t, t_end);
-    const double x = centre.x + tt * d.x, y = centre.y + tt * d.y, z = centre.z + tt * d.z;
-    if (z > TileMaxAt(s, tile_max, x, y) + kTileMargin_m) {
+    const double z = centre.z + tt * d.z;
+    // The cell (clamped as HeightAt clamps), its block's and its tile's highest cell.
+    const int col = static_cast<int>(std::clamp(fx0 + tt * dfx, 0.0, fx_max));
+    const int row = static_cast<int>(std::clamp(fy0 + tt * dfy, 0.0, fy_max));
+    int cells = kBlockCells;
+    double top_m = tile_max.at<float>(tile_rows + row / kBlockCells, col / kBlockCells) + kTileMargin_m;
+    if (!(z > top_m)) {
+      cells = kTileCells;
+      top_m = tile_max.at<float>(row / kTileCells, col / kTileCells) + kTileMargin_m;
+    }
+    if (z > top_m) {
       prev_t = tt;
       prev_skipped = true;
+      // Every sample before t_leave is in this square (block or tile) and above top_m (t_leave <
+      // t_end, as top_m is above the lowest cell): the next that may not be is k_next.
+      const double t_leave = std::min({(centre.z - top_m) * inv_down,
+                                       SquareExitT(fx0, dfx, inv_dfx, col / cells, cells, fx_max),
+                                       SquareExitT(fy0, dfy, inv_dfy, row / cells, cells, fy_max)});
+      const double k_next = std::ceil((t_leave - t0) * inv_dt);
+      if (k_next - 1 > k) {
+        k = k_next - 1;  // the loop's ++k takes it to k_next
+        prev_t = t0 + k * dt;
+      }
       continue;
     }
+    const double x = centre.x + tt * d.x, y = centre.y + tt * d.y;
     if (prev_skipped) prev_f = centre.z + prev_t * d.z - s.HeightAt(centre.x + prev_t * d.x, centre.y + prev_t * d.y);
     prev_skipped = false;
     const double fz = z - s.HeightAt(x, y);

@@ -9,6 +9,7 @@
 #include "swarmbox/physics/stereo_renderer.hpp"
 #include "swarmbox/physics/stereo_scene.hpp"
 #include "swarmbox/physics/stereo_spec.hpp"
+#include "swarmbox/physics/world_config.hpp"
 #include "swarmbox/physics/world_scene.hpp"
 
 namespace swarmbox::physics {
@@ -185,15 +186,18 @@ TEST(StereoRenderer, SameSeedSameImages) {
 }
 
 // The renderer's ray march as the reference, step for step: from the highest cell's level down in
-// steps of about a cell, then a secant. A faster march (issue #23: a max-height pyramid that skips
+// steps of about a cell (samples at t0 + k * dt), then a secant. A faster march (issue #23: a max-height pyramid that skips
 // samples it proves above the surface) must give these depths to the bit, so that the images and
 // the benchmark's figures do not change either.
 double PlainMarch(const StereoScene& s, const Vec3& centre, const Vec3& d) {
   constexpr double kNearClip_m = 0.05, kEndMargin_m = 1e-3;  // stereo_renderer.cpp's
   const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
   const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
-  double prev_t = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z), prev_f = 1.0;
-  for (double t = prev_t; t <= t_end + dt; t += dt) {
+  const double t0 = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z);
+  double prev_t = t0, prev_f = 1.0;
+  for (double k = 0;; ++k) {
+    const double t = t0 + k * dt;
+    if (!(t <= t_end + dt)) break;
     const double tt = std::min(t, t_end);
     const double fz = centre.z + tt * d.z - s.HeightAt(centre.x + tt * d.x, centre.y + tt * d.y);
     if (fz <= 0) return fz == prev_f ? tt : prev_t + (tt - prev_t) * prev_f / (prev_f - fz);
@@ -275,6 +279,83 @@ TEST(StereoRenderer, TruthDepthOverAWorldPatchIsTheReferenceMarchsToTheBit) {
   }
   EXPECT_EQ(differ, 0) << "of " << spec.width_px * spec.height_px << " pixels";
   EXPECT_GT(on_obstacles, 100);
+}
+
+// Yaw about z, then roll about the body's x axis (a view tilted sideways by `roll_rad`).
+Quat YawThenRoll(double yaw_rad, double roll_rad) {
+  return {std::cos(yaw_rad / 2) * std::cos(roll_rad / 2), std::cos(yaw_rad / 2) * std::sin(roll_rad / 2),
+          std::sin(yaw_rad / 2) * std::sin(roll_rad / 2), std::sin(yaw_rad / 2) * std::cos(roll_rad / 2)};
+}
+
+// The left view's pixels whose truth depth is not the reference march's through the same ray (the
+// renderer's ray set-up, repeated), of `*compared` (the rays that look down).
+int DepthsOffTheReferenceMarch(const StereoScene& scene, const Pose& body, const StereoSpec& spec, int* compared) {
+  StereoRenderer renderer(&scene);
+  StereoFrame frame;
+  renderer.Render(body, spec, 1, &frame);
+  const Vec3 ex = Rotate(body.attitude, Vec3{0, -1, 0}), ey = Rotate(body.attitude, Vec3{-1, 0, 0}),
+             ez = Rotate(body.attitude, Vec3{0, 0, -1});
+  const Vec3 left = body.position_m + Rotate(body.attitude, spec.offset_m) - ex * (spec.baseline_m / 2);
+  const double f = spec.FocalPx(), cx = spec.width_px / 2.0, cy = spec.height_px / 2.0;
+  int differ = 0;
+  *compared = 0;
+  for (int v = 0; v < spec.height_px; ++v) {
+    for (int u = 0; u < spec.width_px; ++u) {
+      const double xn = (u + 0.5 - cx) / f, yn = (v + 0.5 - cy) / f;
+      const Vec3 d{ex.x * xn + ey.x * yn + ez.x, ex.y * xn + ey.y * yn + ez.y, ex.z * xn + ey.z * yn + ez.z};
+      if (d.z > -1e-6) continue;  // the renderer's sky
+      ++*compared;
+      if (frame.depth_truth_m.at<float>(v, u) != static_cast<float>(PlainMarch(scene, left, d))) ++differ;
+    }
+  }
+  return differ;
+}
+
+// The march's empty-space jumps (over tiles whose highest cell is far below the ray) over tall
+// columns: tree_lines' 26 m woodland strips and a rubble field with 26 m columns from one cell to
+// 3 m wide (edges on and off the 0.4 m tiles' edges), seen straight down from 4 and 30 m over the
+// crowns, from below the crowns, tilted up to 70 degrees (rays a tile long per few centimetres of
+// descent, and rays that leave the grid, where its border cells stand on) and from outside the
+// grid. Every left pixel's truth depth is the reference march's, sample for sample.
+TEST(StereoRenderer, TruthDepthOverTallColumnsIsTheReferenceMarchsToTheBit) {
+  auto woods = LoadWorld(std::string(SWARMBOX_TRIALS_DIR) + "/worlds/tree_lines.yaml");
+  ASSERT_TRUE(woods.ok()) << woods.error().ToString();
+  const StereoScene meadow = MakeWorldScene(*woods, 0, 0, 30, woods->ground_texture_seed);
+  StereoScene columns = MakeSurfaceScene(StereoSurface::kRubble, 24.0, 9);
+  constexpr double kCrown_m = 26.0;
+  AddBox(&columns, {3, 2, 0}, {3, 3, 0}, kCrown_m, 0.3);
+  AddBox(&columns, {-4.1, 1.3, 0}, {1.1, 0.7, 0}, kCrown_m, 0.3);
+  AddBox(&columns, {0.6, -3.3, 0}, {0.05, 0.05, 0}, kCrown_m, 0.3);  // one cell
+  AddBox(&columns, {-2, -6, 0}, {20, 0.4, 0}, kCrown_m - 6, 0.3);      // a wall on tile edges
+  AddBox(&columns, {11.8, 0, 0}, {0.4, 24, 0}, kCrown_m, 0.3);          // along the grid's border
+  columns.UpdateHeightRange();
+  StereoSpec spec;
+  spec.enabled = true;
+  spec.width_px = 320;
+  spec.height_px = 200;
+  struct View {
+    const char* name;
+    const StereoScene* scene;
+    Vec3 position_m;
+    double yaw_rad, roll_rad;
+  };
+  const View views[] = {
+      {"meadow, straight down from 30 m", &meadow, {0, 0, 30}, 0, 0},
+      {"meadow, 4 m over the crowns, tilted", &meadow, {18, -3, 30}, 0.4, 0.7},
+      {"meadow, below the crowns, tilted 70 deg", &meadow, {8, 5, 10}, 2.0, 1.2},
+      {"columns, straight down from 30 m", &columns, {0.3, -0.2, 30}, 0, 0},
+      {"columns, 4 m over the crowns, tilted", &columns, {-1, 1, 30}, -0.3, 0.6},
+      {"columns, below the crowns towards the border", &columns, {6, -1, 8}, 1.5, 1.1},
+      {"columns, from outside the grid", &columns, {16, 3, 28}, 0.0, -0.9},
+  };
+  for (const View& view : views) {
+    Pose body;
+    body.position_m = view.position_m;
+    body.attitude = YawThenRoll(view.yaw_rad, view.roll_rad);
+    int compared = 0;
+    EXPECT_EQ(DepthsOffTheReferenceMarch(*view.scene, body, spec, &compared), 0) << view.name << ", of " << compared;
+    EXPECT_GT(compared, spec.width_px * spec.height_px / 3) << view.name;
+  }
 }
 
 }  // namespace
