@@ -1,5 +1,6 @@
 # Warnings, sanitizers and the compiler launcher for every SwarmBox target, set in one place.
-# Usage: swarmbox_target_defaults(<target>) on every library and executable we own.
+# Usage: swarmbox_target_defaults(<target>) on every library and executable we own (a component's
+# library through swarmbox_add_library(), which calls it).
 # Generated code (idlc, fastddsgen) gets swarmbox_generated_defaults() instead: no warnings of ours.
 
 # ccache, when installed, as the compiler launcher (objects are reused across build folders and
@@ -39,6 +40,23 @@ function(swarmbox_target_defaults target)
     return()
   endif()
   target_compile_options(${target} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:${SWARMBOX_WARNINGS}>)
+endfunction()
+
+# swarmbox_add_library(<name> <add_library arguments>... [LINK <target_link_libraries arguments>...])
+# declares a component's library swarmbox_<name> and its alias swarmbox::<name>, with the
+# component's include/ folder as its public headers, its links and swarmbox_target_defaults().
+# What a component needs besides (a private include folder, system includes, properties) it adds
+# to swarmbox_<name> after the call.
+function(swarmbox_add_library name)
+  cmake_parse_arguments(PARSE_ARGV 1 arg "" "" "LINK")
+  set(target swarmbox_${name})
+  add_library(${target} ${arg_UNPARSED_ARGUMENTS})
+  add_library(swarmbox::${name} ALIAS ${target})
+  target_include_directories(${target} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  if(arg_LINK)
+    target_link_libraries(${target} ${arg_LINK})
+  endif()
+  swarmbox_target_defaults(${target})
 endfunction()
 
 function(swarmbox_generated_defaults target)

@@ -420,11 +420,17 @@ ApplyResult MissionState::ApplyMiss(const ReportMiss& c) {
 
 namespace {
 
+// A mission record (Candidate, Victim) starts with its id, position and status.
+template <class Record>
+void WriteRecordHead(detail::ByteWriter& w, const Record& rec) {
+  w.Varint(rec.id);
+  w.F64(rec.x_m);
+  w.F64(rec.y_m);
+  w.U8(static_cast<std::uint8_t>(rec.status));
+}
+
 void WriteCandidate(detail::ByteWriter& w, const Candidate& c) {
-  w.Varint(c.id);
-  w.F64(c.x_m);
-  w.F64(c.y_m);
-  w.U8(static_cast<std::uint8_t>(c.status));
+  WriteRecordHead(w, c);
   w.Str(c.revisit_drone);
   w.F64(c.revisit_t_s);
   w.Varint(c.revisits);
@@ -438,10 +444,7 @@ void WriteCandidate(detail::ByteWriter& w, const Candidate& c) {
 }
 
 void WriteVictim(detail::ByteWriter& w, const Victim& v) {
-  w.Varint(v.id);
-  w.F64(v.x_m);
-  w.F64(v.y_m);
-  w.U8(static_cast<std::uint8_t>(v.status));
+  WriteRecordHead(w, v);
   w.Str(v.rescuer);
   w.Varint(v.confirmed_by.size());
   for (const std::string& b : v.confirmed_by) w.Str(b);
@@ -464,14 +467,24 @@ E ReadEnum(detail::ByteReader& r, E last, const char* what, std::string* invalid
   return static_cast<E>(v);
 }
 
+// WriteRecordHead's fields into *rec, the status no larger than `last_status`. False when the status
+// is invalid (*invalid is then set): the rest of the record must not be read.
+template <class Record>
+bool ReadRecordHead(detail::ByteReader& r, Record* rec, decltype(Record::status) last_status,
+                    const char* id_what, const char* status_what, std::string* invalid) {
+  rec->id = ReadU32(r, id_what);
+  rec->x_m = r.F64();
+  rec->y_m = r.F64();
+  rec->status = ReadEnum(r, last_status, status_what, invalid);
+  return invalid->empty();
+}
+
 // Stops after the status when it is invalid (*invalid is then set).
 Candidate ReadCandidate(detail::ByteReader& r, std::string* invalid) {
   Candidate c;
-  c.id = ReadU32(r, "candidate id");
-  c.x_m = r.F64();
-  c.y_m = r.F64();
-  c.status = ReadEnum(r, CandidateStatus::kRejected, "candidate status", invalid);
-  if (!invalid->empty()) return c;
+  if (!ReadRecordHead(r, &c, CandidateStatus::kRejected, "candidate id", "candidate status", invalid)) {
+    return c;
+  }
   c.revisit_drone = r.Str();
   c.revisit_t_s = r.F64();
   c.revisits = ReadU32(r, "revisits");
@@ -489,11 +502,7 @@ Candidate ReadCandidate(detail::ByteReader& r, std::string* invalid) {
 // Stops after the status when it is invalid (*invalid is then set).
 Victim ReadVictim(detail::ByteReader& r, std::string* invalid) {
   Victim v;
-  v.id = ReadU32(r, "victim id");
-  v.x_m = r.F64();
-  v.y_m = r.F64();
-  v.status = ReadEnum(r, VictimStatus::kRescued, "victim status", invalid);
-  if (!invalid->empty()) return v;
+  if (!ReadRecordHead(r, &v, VictimStatus::kRescued, "victim id", "victim status", invalid)) return v;
   v.rescuer = r.Str();
   const std::uint64_t nb = r.Count(1, "confirmer");
   for (std::uint64_t b = 0; b < nb && r.ok(); ++b) v.confirmed_by.push_back(r.Str());

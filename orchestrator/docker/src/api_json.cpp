@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cstdio>
 #include <ctime>
+#include <type_traits>
 #include <utility>
 
 #include "swarmbox/common/yaml.hpp"
@@ -141,6 +142,17 @@ Result<Node> ParseJsonArray(std::string_view body, std::string_view what) {
   if (!doc) return doc.error();
   if (!doc->is_sequence()) return Malformed(what, "an array");
   return doc;
+}
+
+// A list answer (ParseJsonArray), each item read by `from_node` (a Node -> the item's struct).
+template <class FromNode>
+auto ParseListOf(std::string_view body, std::string_view what, FromNode from_node)
+    -> Result<std::vector<std::invoke_result_t<FromNode, const Node&>>> {
+  auto doc = ParseJsonArray(body, what);
+  if (!doc) return doc.error();
+  std::vector<std::invoke_result_t<FromNode, const Node&>> out;
+  for (const Node& item : doc->items()) out.push_back(from_node(item));
+  return out;
 }
 
 // An inspect answer: an object with a non-empty "Id".
@@ -457,11 +469,8 @@ Result<ImageInfo> ParseImageInspect(std::string_view body) {
 }
 
 Result<std::vector<ImageInfo>> ParseImageList(std::string_view body) {
-  auto doc = ParseJsonArray(body, "image list");
-  if (!doc) return doc.error();
-  std::vector<ImageInfo> out;
-  for (const Node& item : doc->items()) out.push_back(ImageFromNode(item, /*from_list=*/true));
-  return out;
+  return ParseListOf(body, "image list",
+                     [](const Node& item) { return ImageFromNode(item, /*from_list=*/true); });
 }
 
 Result<NetworkInfo> ParseNetwork(std::string_view body) {
@@ -471,11 +480,7 @@ Result<NetworkInfo> ParseNetwork(std::string_view body) {
 }
 
 Result<std::vector<NetworkInfo>> ParseNetworkList(std::string_view body) {
-  auto doc = ParseJsonArray(body, "network list");
-  if (!doc) return doc.error();
-  std::vector<NetworkInfo> out;
-  for (const Node& item : doc->items()) out.push_back(NetworkFromNode(item));
-  return out;
+  return ParseListOf(body, "network list", NetworkFromNode);
 }
 
 namespace {
@@ -557,10 +562,7 @@ Result<ContainerInfo> ParseContainerInspect(std::string_view body) {
 }
 
 Result<std::vector<ContainerSummary>> ParseContainerList(std::string_view body) {
-  auto doc = ParseJsonArray(body, "container list");
-  if (!doc) return doc.error();
-  std::vector<ContainerSummary> out;
-  for (const Node& item : doc->items()) {
+  return ParseListOf(body, "container list", [](const Node& item) {
     ContainerSummary s;
     s.id = GetStr(item, "Id");
     for (std::string& name : GetStrList(item, "Names")) s.names.push_back(StripSlash(name));
@@ -568,9 +570,8 @@ Result<std::vector<ContainerSummary>> ParseContainerList(std::string_view body) 
     s.state = GetStr(item, "State");
     s.status = GetStr(item, "Status");
     s.labels = GetStrMap(item, "Labels");
-    out.push_back(std::move(s));
-  }
-  return out;
+    return s;
+  });
 }
 
 Result<std::string> ParseIdResponse(std::string_view body) {
