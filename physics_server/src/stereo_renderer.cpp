@@ -98,6 +98,35 @@ double SquareExitT(double f0, double df, double inv_df, int square, int cells, d
   return kNever;
 }
 
+// The ray centre + t * d in the height field's cell coordinates (HeightAt's, before clamping), with
+// the reciprocals the jumps use.
+struct CellRay {
+  double fx0, dfx, inv_dfx, fy0, dfy, inv_dfy, fx_max, fy_max, z0, inv_down;
+  CellRay(const StereoScene& s, const Vec3& centre, const Vec3& d)
+      : fx0((centre.x - s.origin_x_m) / s.cell_m), dfx(d.x / s.cell_m), inv_dfx(1 / dfx),
+        fy0((centre.y - s.origin_y_m) / s.cell_m), dfy(d.y / s.cell_m), inv_dfy(1 / dfy),
+        fx_max(s.height_m.cols - 1.001), fy_max(s.height_m.rows - 1.001), z0(centre.z), inv_down(1 / -d.z) {}
+};
+
+// For the sample at depth tt and height z: when it is above its block's highest cell (else its
+// tile's; + kTileMargin_m), the depth where the ray leaves that square sideways or comes down to that
+// height (*t_leave), before which every sample is above the surface, and true; otherwise false (the
+// sample needs the height field). The cell is clamped as HeightAt clamps it.
+bool EmptyUntil(const cv::Mat& tile_max, int tile_rows, const CellRay& r, double tt, double z, double* t_leave) {
+  const int col = static_cast<int>(std::clamp(r.fx0 + tt * r.dfx, 0.0, r.fx_max));
+  const int row = static_cast<int>(std::clamp(r.fy0 + tt * r.dfy, 0.0, r.fy_max));
+  int cells = kBlockCells;
+  double top_m = tile_max.at<float>(tile_rows + row / kBlockCells, col / kBlockCells) + kTileMargin_m;
+  if (!(z > top_m)) {
+    cells = kTileCells;
+    top_m = tile_max.at<float>(row / kTileCells, col / kTileCells) + kTileMargin_m;
+  }
+  if (!(z > top_m)) return false;
+  *t_leave = std::min({(r.z0 - top_m) * r.inv_down, SquareExitT(r.fx0, r.dfx, r.inv_dfx, col / cells, cells, r.fx_max),
+                       SquareExitT(r.fy0, r.dfy, r.inv_dfy, row / cells, cells, r.fy_max)});
+  return true;
+}
+
 // Depth t (along the optical axis) where the ray centre + t * d (d.z < 0) first meets the height
 // field: sampled at t0 + k * dt (k = 0, 1, ...; dt about one cell) from the highest cell's level
 // down to the lowest's, then a secant between the last point above and the first below the
@@ -117,11 +146,8 @@ double MarchToSurface(const StereoScene& s, const cv::Mat& tile_max, const Vec3&
   const double t_end = (centre.z - s.min_height_m) / -d.z + kEndMargin_m;
   const double dt = s.cell_m / std::max(std::hypot(d.x, d.y), -d.z);
   const double t0 = std::max(kNearClip_m, (centre.z - s.max_height_m) / -d.z);
-  // The ray in cell coordinates (HeightAt's, before clamping) and reciprocals, for the jumps.
-  const double fx0 = (centre.x - s.origin_x_m) / s.cell_m, dfx = d.x / s.cell_m, inv_dfx = 1 / dfx;
-  const double fy0 = (centre.y - s.origin_y_m) / s.cell_m, dfy = d.y / s.cell_m, inv_dfy = 1 / dfy;
-  const double fx_max = s.height_m.cols - 1.001, fy_max = s.height_m.rows - 1.001;
-  const double inv_down = 1 / -d.z, inv_dt = 1 / dt;
+  const CellRay ray(s, centre, d);
+  const double inv_dt = 1 / dt;
   const int tile_rows = TileRows(s);
   double prev_t = t0, prev_f = 1.0;
   bool prev_skipped = false;
@@ -130,23 +156,12 @@ double MarchToSurface(const StereoScene& s, const cv::Mat& tile_max, const Vec3&
     if (!(t <= t_end + dt)) break;
     const double tt = std::min(t, t_end);
     const double z = centre.z + tt * d.z;
-    // The cell (clamped as HeightAt clamps), its block's and its tile's highest cell.
-    const int col = static_cast<int>(std::clamp(fx0 + tt * dfx, 0.0, fx_max));
-    const int row = static_cast<int>(std::clamp(fy0 + tt * dfy, 0.0, fy_max));
-    int cells = kBlockCells;
-    double top_m = tile_max.at<float>(tile_rows + row / kBlockCells, col / kBlockCells) + kTileMargin_m;
-    if (!(z > top_m)) {
-      cells = kTileCells;
-      top_m = tile_max.at<float>(row / kTileCells, col / kTileCells) + kTileMargin_m;
-    }
-    if (z > top_m) {
+    double t_leave = 0;
+    if (EmptyUntil(tile_max, tile_rows, ray, tt, z, &t_leave)) {
       prev_t = tt;
       prev_skipped = true;
-      // Every sample before t_leave is in this square (block or tile) and above top_m (t_leave <
-      // t_end, as top_m is above the lowest cell): the next that may not be is k_next.
-      const double t_leave = std::min({(centre.z - top_m) * inv_down,
-                                       SquareExitT(fx0, dfx, inv_dfx, col / cells, cells, fx_max),
-                                       SquareExitT(fy0, dfy, inv_dfy, row / cells, cells, fy_max)});
+      // Every sample before t_leave is above the surface (t_leave < t_end, as the square's top is
+      // above the lowest cell): the next that may not be is k_next.
       const double k_next = std::ceil((t_leave - t0) * inv_dt);
       if (k_next - 1 > k) {
         k = k_next - 1;  // the loop's ++k takes it to k_next
