@@ -61,6 +61,10 @@ Result<SarBrainConfig> SarConfigFor(const AgentOptions& o, const airframe::Airfr
   if (o.raft.members.empty()) return Error(ErrorCode::kInvalidArgument, "--mission sar needs --members");
   if (!o.mesh) return Error(ErrorCode::kInvalidArgument, "--mission sar needs the mesh bus (drop --no-mesh)");
   brain::Context ctx = BrainContextFor(o, config, /*period_steps=*/1);
+  // The trial's tuning first: its keys are tuning numbers only, never `start`.
+  auto tuning = ParseMissionTuning(o.mission.tuning_json);
+  if (!tuning) return tuning.error();
+  ctx.args = std::move(*tuning);
   if (o.has_start) {
     char start[96];
     std::snprintf(start, sizeof start, "%.17g,%.17g,%.17g", o.start_m.x(), o.start_m.y(), o.start_m.z());

@@ -25,6 +25,7 @@
 // the SAR mission (SarBrain, sar_brain.hpp, on the brain SDK) and needs --members and --world:
 //       --mission sar --world trials/worlds/open_field.yaml [--payload stretcher]
 //       [--inference-latency-ms 40]
+//       [--mission-tuning '{"scout_altitude_m": 12}']   SarBrain's tuning numbers (sar_brain.hpp)
 // Which brain flies (brain_options.hpp, agent/brain/README.md): --brain builtin (default: the
 // --mission above), library or external:
 //       --brain library --brain-library librendezvous.so --brain-name rendezvous
@@ -149,6 +150,7 @@ void AddMissionOptions(CLI::App& app, CommandLine& c) {
   app.add_option("--world", o.mission.world_path, "SAR: the world file (only its geofence and home are read)");
   app.add_option("--payload", o.mission.payload, "SAR: this drone's airframe payload NAME lies on the ground under it (the lifter)");
   app.add_option("--inference-latency-ms", o.mission.inference_latency_ms, "SAR: simulated perception latency [ms]")->capture_default_str();
+  app.add_option("--mission-tuning", o.mission.tuning_json, "SAR: the mission's tuning numbers, a JSON object, e.g. '{\"scout_altitude_m\": 12}'");
 }
 
 void AddBrainOptions(CLI::App& app, CommandLine& c) {
@@ -236,6 +238,8 @@ swarmbox::Status ResolveKinds(const CommandLine& c, agent::AgentOptions& o) {
   // --world and --payload are the SAR mission's with the builtin brain, any brain's Context otherwise.
   if (o.brain.kind == agent::BrainKind::kBuiltin) {
     SWARMBOX_TRY(agent::ValidateMissionOptions(o.mission, !o.raft.members.empty(), c.plan_given));
+  } else if (!o.mission.tuning_json.empty()) {
+    return swarmbox::Error(swarmbox::ErrorCode::kInvalidArgument, "--mission-tuning is for --mission sar (--brain builtin)");
   } else if (!o.mission.world_path.empty() && !std::filesystem::is_regular_file(o.mission.world_path)) {
     return swarmbox::Error(swarmbox::ErrorCode::kInvalidArgument, "--world '" + o.mission.world_path + "': no such file");
   }

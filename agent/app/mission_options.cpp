@@ -22,6 +22,7 @@ Status ValidateMissionOptions(const MissionOptions& o, bool has_members, bool pl
   if (o.kind == MissionKind::kPlan) {
     if (!o.world_path.empty()) return Error(ErrorCode::kInvalidArgument, "--world is for --mission sar (the plan flies without a world)");
     if (!o.payload.empty()) return Error(ErrorCode::kInvalidArgument, "--payload is for --mission sar (the lifter's rescue)");
+    if (!o.tuning_json.empty()) return Error(ErrorCode::kInvalidArgument, "--mission-tuning is for --mission sar");
     return Ok{};
   }
   if (!has_members) {

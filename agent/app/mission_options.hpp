@@ -27,12 +27,15 @@ struct MissionOptions {
   std::string world_path;         // --world: needed by sar
   std::string payload;            // --payload: a payload of this airframe lies under the drone
   int inference_latency_ms = 40;  // --inference-latency-ms: simulated perception latency [ms]
+  // --mission-tuning: SarBrain's tuning numbers as a JSON object, e.g. {"scout_altitude_m": 12}
+  // (the trial's mission.tuning; keys and values checked by ParseMissionTuning, sar_brain.hpp).
+  std::string tuning_json;
 };
 
 inline constexpr int kMaxInferenceLatencyMs = 10000;
 
 // Checks the combination: sar needs `has_members` (Raft) and a world path; plan takes neither a
-// world nor a payload; sar takes no plan (`plan_given`: --plan was on the command line); the
+// world nor a payload nor a tuning; sar takes no plan (`plan_given`: --plan was on the command line); the
 // latency lies in [0, kMaxInferenceLatencyMs].
 Status ValidateMissionOptions(const MissionOptions& options, bool has_members, bool plan_given);
 

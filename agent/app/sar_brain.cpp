@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "mission_options.hpp"
+#include "swarmbox/brain/args.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/flight/flight_config.hpp"
 #include "swarmbox/raft/mission_command.hpp"
@@ -30,16 +31,22 @@ brain::Vec3 B(const Vec3& v) { return {v.x(), v.y(), v.z()}; }
 double YawOf(const double q[4]) { return flight::YawOf(flight::Quat(q[0], q[1], q[2], q[3])); }
 
 // args[key] as a number; absent: unchanged. kInvalidArgument naming the key otherwise.
+// `text` as a whole finite number, or nullopt.
+std::optional<double> FiniteNumber(const std::string& text) {
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 Status ArgNumber(const brain::Context& ctx, const std::string& key, double* out) {
   const auto it = ctx.args.find(key);
   if (it == ctx.args.end()) return Ok{};
-  const std::string& text = it->second;
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(v)) {
-    return Error(ErrorCode::kInvalidArgument, "sar brain: arg " + key + " '" + text + "': expected a number");
+  const std::optional<double> v = FiniteNumber(it->second);
+  if (!v) {
+    return Error(ErrorCode::kInvalidArgument, "sar brain: arg " + key + " '" + it->second + "': expected a number");
   }
-  *out = v;
+  *out = *v;
   return Ok{};
 }
 
@@ -202,6 +209,9 @@ constexpr TuningArg kTuningArgs[] = {
     {"fusion_revisit_timeout_s", nullptr, &swarm::FusionParams::revisit_timeout_s},
     {"revisit_look_s", &MissionTuning::revisit_look_s, nullptr},
 };
+// The fusion's counts, read after kTuningArgs as whole numbers.
+constexpr const char* kFusionConfirmViewsArg = "fusion_confirm_views";
+constexpr const char* kFusionMaxRevisitsArg = "fusion_max_revisits";
 
 // The fields of the config that come straight from the Context, the airframe and the world.
 SarBrainConfig BaseConfig(const brain::Context& ctx, const airframe::Airframe& af, const WorldView& world) {
@@ -252,8 +262,8 @@ Status ApplyTuningArgs(const brain::Context& ctx, MissionTuning* t) {
   }
   double fusion_confirm_views = t->fusion.confirm_views;
   double fusion_max_revisits = t->fusion.max_revisits;
-  SWARMBOX_TRY(ArgNumber(ctx, "fusion_confirm_views", &fusion_confirm_views));
-  SWARMBOX_TRY(ArgNumber(ctx, "fusion_max_revisits", &fusion_max_revisits));
+  SWARMBOX_TRY(ArgNumber(ctx, kFusionConfirmViewsArg, &fusion_confirm_views));
+  SWARMBOX_TRY(ArgNumber(ctx, kFusionMaxRevisitsArg, &fusion_max_revisits));
   t->fusion.confirm_views = static_cast<int>(fusion_confirm_views);
   t->fusion.max_revisits = static_cast<int>(fusion_max_revisits);
   if (const std::string why = swarm::FusionParamsProblem(t->fusion); !why.empty()) {
@@ -265,6 +275,32 @@ Status ApplyTuningArgs(const brain::Context& ctx, MissionTuning* t) {
 }
 
 }  // namespace
+
+std::vector<std::string> SarTuningKeys() {
+  std::vector<std::string> keys;
+  for (const TuningArg& arg : kTuningArgs) keys.emplace_back(arg.key);
+  keys.emplace_back(kFusionConfirmViewsArg);
+  keys.emplace_back(kFusionMaxRevisitsArg);
+  return keys;
+}
+
+Result<std::map<std::string, std::string>> ParseMissionTuning(std::string_view json) {
+  auto args = brain::ParseBrainArgs(json, "--mission-tuning");
+  if (!args) return std::move(args).error();
+  const std::vector<std::string> known = SarTuningKeys();
+  for (const auto& [key, text] : *args) {
+    if (std::find(known.begin(), known.end(), key) == known.end()) {
+      std::string list;
+      for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+      return Error(ErrorCode::kInvalidArgument,
+                   "--mission-tuning: unknown key '" + key + "'; the SAR mission tunes " + list);
+    }
+    if (!FiniteNumber(text)) {
+      return Error(ErrorCode::kInvalidArgument, "--mission-tuning: " + key + " '" + text + "': expected a number");
+    }
+  }
+  return args;
+}
 
 Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airframe::Airframe& af) {
   auto world = LoadWorldView(ctx.world_path);

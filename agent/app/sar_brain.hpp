@@ -158,6 +158,16 @@ Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx, const airfr
 // The same, parsing ctx.airframe_path first (a brain made from its Context alone).
 Result<SarBrainConfig> SarBrainConfigFrom(const brain::Context& ctx);
 
+// The args that tune the mission (MissionTuning's numbers and the fusion's two counts), in the
+// order they are read: what a trial's `mission: {tuning: {...}}` may hold (`start` is not one).
+std::vector<std::string> SarTuningKeys();
+
+// The agent's --mission-tuning (the trial's mission.tuning as JSON, e.g. {"scout_altitude_m": 12})
+// as Context args: a JSON object whose keys are SarTuningKeys() and whose values are numbers.
+// kInvalidArgument naming the key (and, for an unknown one, the known ones) otherwise; an empty
+// text is no tuning.
+Result<std::map<std::string, std::string>> ParseMissionTuning(std::string_view json);
+
 // The SAR-private side channel of the wall clock, netem only (banner). The node owns it, sets
 // now_s before each Step and records, per drone, when its latest state (by simulated time) was
 // taken off the radio; the brain only reads it.

@@ -27,6 +27,7 @@ std::string_view QosName(Qos qos) {
 std::string SensorTopic(std::string_view drone) { return "sim/" + std::string(drone) + "/sensor"; }
 std::string CameraTopic(std::string_view drone) { return "sim/" + std::string(drone) + "/camera"; }
 std::string StereoTopic(std::string_view drone) { return "sim/" + std::string(drone) + "/stereo"; }
+std::string DepthImageTopic(std::string_view drone) { return "sim/" + std::string(drone) + "/depth"; }
 std::string OffboardInputTopic(std::string_view drone) {
   return "offboard/" + std::string(drone) + "/input";
 }

@@ -90,6 +90,7 @@ TEST(BusTopics, PerDroneNamesAndDroneNameRule) {
   EXPECT_EQ(kActuatorTopic, "sim/actuator");  // one keyed topic for every drone's answers
   EXPECT_EQ(CameraTopic("scout_1"), "sim/scout_1/camera");
   EXPECT_EQ(StereoTopic("scout_1"), "sim/scout_1/stereo");
+  EXPECT_EQ(DepthImageTopic("scout_1"), "sim/scout_1/depth");
   EXPECT_TRUE(ValidateDroneName("scout_1"));
   auto bad = ValidateDroneName("scout 1");
   ASSERT_FALSE(bad);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -67,12 +68,33 @@ Status CheckComponent(const TrialSpec& spec, const yaml::Mark& mark, const std::
   return AtMark(mark, "unknown component '" + name + "' (expected one of " + accepted + ")");
 }
 
-// `mission: {kind: sar|plan, plan: "takeoff:5,hover:10,land", inference_latency_ms: 40}`.
+// `mission: {..., tuning: {scout_altitude_m: 12, ...}}`: a mapping of plain numbers for kind sar.
+// The names are the agent's (it refuses an unknown one, naming the known ones); `start` never.
+Status DecodeMissionTuning(const Node& tuning, MissionSpec* out) {
+  if (tuning.is_null()) return Ok{};
+  if (!tuning.is_mapping()) {
+    return At(tuning, "'tuning' must be a mapping of numbers by name, e.g. {scout_altitude_m: 12}");
+  }
+  if (out->kind != MissionKind::kSar) return At(tuning, "'tuning' belongs to mission kind sar (this mission is kind plan)");
+  for (const auto& [key, value] : tuning.entries()) {
+    if (key.scalar() == "start") {
+      return At(key, "'start' is not a tuning number: a drone's take-off spot is its pose");
+    }
+    const std::optional<double> number =
+        value.is_scalar() && !value.quoted() ? yaml::ScalarAsDouble(value.scalar()) : std::nullopt;
+    if (!number || !std::isfinite(*number)) return At(value, "tuning '" + key.scalar() + "' must be a number");
+  }
+  out->tuning = tuning;
+  return Ok{};
+}
+
+// `mission: {kind: sar|plan, plan: "takeoff:5,hover:10,land", inference_latency_ms: 40, tuning: {...}}`.
 Status DecodeMission(const Node& node, MissionSpec* out) {
   std::string kind(MissionKindName(out->kind));
   yaml::MapReader r(node, "mission");
   r.Optional("kind", &kind).Optional("plan", &out->plan).Optional("inference_latency_ms",
                                                                    &out->inference_latency_ms);
+  const Node* tuning = r.Child("tuning");
   SWARMBOX_TRY(r.Finish());
   if (kind == "sar") {
     out->kind = MissionKind::kSar;
@@ -96,7 +118,7 @@ Status DecodeMission(const Node& node, MissionSpec* out) {
   if (out->inference_latency_ms < 0 || out->inference_latency_ms > 10000) {
     return At(*node.Find("inference_latency_ms"), "'inference_latency_ms' must be in [0, 10000] [ms]");
   }
-  return Ok{};
+  return tuning != nullptr ? DecodeMissionTuning(*tuning, out) : Ok{};
 }
 
 // `raft: {tick_ms, heartbeat_ms, election_timeout_ms, voters}`: what the agent's Raft service accepts

@@ -95,6 +95,11 @@ TrialSpec& TrialSpec::EndOn(std::string pattern, Outcome outcome, std::string re
   end.push_back({std::move(pattern), outcome, std::move(reason), std::move(from)});
   return *this;
 }
+std::string MissionSpec::TuningJson() const {
+  if (!tuning.is_mapping() || tuning.entries().empty()) return "";
+  return yaml::EmitJson(tuning);
+}
+
 TrialSpec& TrialSpec::Mission(MissionSpec value) {
   mission = std::move(value);
   return *this;
@@ -221,6 +226,7 @@ Node MissionNode(const MissionSpec& m) {
   mission.Set("kind", Str(MissionKindName(m.kind)));
   if (m.kind == MissionKind::kPlan) mission.Set("plan", Str(m.plan));
   mission.Set("inference_latency_ms", Plain(std::to_string(m.inference_latency_ms)));
+  if (!m.TuningJson().empty()) mission.Set("tuning", m.tuning);
   return mission;
 }
 

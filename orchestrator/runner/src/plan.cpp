@@ -233,6 +233,10 @@ void AppendBrainFlags(const dsl::TrialSpec& spec, const dsl::DroneSpec& d, std::
                                "--inference-latency-ms", std::to_string(spec.mission.inference_latency_ms)});
     // The lifter starts with its payload on the ground under it (as the physics server places it).
     if (!d.payload.empty()) argv->insert(argv->end(), {"--payload", d.payload});
+    // mission.tuning as JSON (the agent checks the names against SarBrain's and refuses others).
+    if (const std::string tuning = spec.mission.TuningJson(); !tuning.empty()) {
+      argv->insert(argv->end(), {"--mission-tuning", tuning});
+    }
   }
 }
 

@@ -37,6 +37,9 @@ TEST(MissionOptions, PlanTakesNoWorldNorPayload) {
   m.world_path.clear();
   m.payload = "stretcher";
   ExpectError(ValidateMissionOptions(m, true, false), "--payload is for --mission sar");
+  m.payload.clear();
+  m.tuning_json = R"({"scout_altitude_m": 12})";
+  ExpectError(ValidateMissionOptions(m, true, false), "--mission-tuning is for --mission sar");
 }
 
 TEST(MissionOptions, SarNeedsMembersAndAWorldAndNoPlan) {

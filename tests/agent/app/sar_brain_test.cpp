@@ -9,6 +9,7 @@
 
 #include "brain_host.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -294,6 +295,77 @@ TEST(SarBrainScout, TakesOffShortThenClimbsInPositionModeAndPublishesItsMode) {
   ASSERT_EQ(sent.size(), 1u);
   EXPECT_EQ(sent[0].kind, "position");
   EXPECT_EQ(sent[0].value, Vec3(0, 0, 30));  // then the climb to the search altitude
+}
+
+// A trial's mission.tuning reaches the brain as --mission-tuning's JSON: its numbers are Context
+// args (SarBrainConfigFrom reads them as any other), so a low search altitude is the scout's climb.
+TEST(SarBrainMissionTuning, TheTrialsScoutAltitudeIsTheScoutsClimb) {
+  auto tuning = ParseMissionTuning(R"({"scout_altitude_m": 12, "scout_min_clearance_m": 5})");
+  ASSERT_TRUE(tuning.ok()) << tuning.error().ToString();
+  brain::Context ctx = LifterContext();
+  ctx.args = *tuning;
+  auto c = SarBrainConfigFrom(ctx);
+  ASSERT_TRUE(c.ok()) << c.error().ToString();
+  EXPECT_DOUBLE_EQ(c->tuning.scout_altitude_m, 12.0);
+  EXPECT_DOUBLE_EQ(c->tuning.scout_min_clearance_m, 5.0);
+  EXPECT_DOUBLE_EQ(c->tuning.member_timeout_s, MissionTuning{}.member_timeout_s);  // untouched
+
+  SarBrainConfig scout = Scout("scout_1", {"scout_1"});
+  scout.tuning = c->tuning;
+  BrainRig rig(scout);
+  rig.position() = Vec3(0, 0, 0.23);
+  rig.Run(2.5, "idle");  // on the ground, then the short take-off
+  rig.position() = Vec3(0, 0, 3.2);
+  rig.Run(1.0, "takeoff");
+  const std::vector<Sent> sent = rig.Run(0.5, "hold");
+  ASSERT_EQ(sent.size(), 1u);
+  EXPECT_EQ(sent[0].kind, "position");
+  EXPECT_EQ(sent[0].value, Vec3(0, 0, 12));  // the trial's search altitude, not the default 30 m
+}
+
+TEST(SarBrainMissionTuning, EveryKeyIsATuningNumberAndNoneIsStart) {
+  const std::vector<std::string> keys = SarTuningKeys();
+  EXPECT_EQ(std::count(keys.begin(), keys.end(), "scout_altitude_m"), 1);
+  EXPECT_EQ(std::count(keys.begin(), keys.end(), "fusion_confirm_views"), 1);
+  EXPECT_EQ(std::count(keys.begin(), keys.end(), "start"), 0);
+  // Every key the parser accepts is one SarBrainConfigFrom reads: a number it reads as such.
+  brain::Context ctx = LifterContext();
+  for (const std::string& key : keys) ctx.args[key] = "not_a_number";
+  for (const std::string& key : keys) {
+    auto c = SarBrainConfigFrom(ctx);
+    ASSERT_FALSE(c.ok()) << key;
+    EXPECT_NE(c.error().ToString().find("arg " + key + " 'not_a_number'"), std::string::npos) << c.error().ToString();
+    ctx.args.erase(key);
+  }
+}
+
+TEST(SarBrainMissionTuning, NamesAnUnknownKeyAndTheKnownOnesAndRefusesNonNumbers) {
+  auto unknown = ParseMissionTuning(R"({"scout_altitude_m": 12, "scout_altitud_m": 12})");
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.error().code(), ErrorCode::kInvalidArgument);
+  const std::string text = unknown.error().ToString();
+  EXPECT_NE(text.find("--mission-tuning: unknown key 'scout_altitud_m'; the SAR mission tunes mission_dt_s, "),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("scout_altitude_m, "), std::string::npos) << text;
+  EXPECT_NE(text.find("fusion_max_revisits"), std::string::npos) << text;
+  auto start = ParseMissionTuning(R"({"start": "0,0,0"})");  // the take-off spot is --start's
+  ASSERT_FALSE(start.ok());
+  EXPECT_NE(start.error().ToString().find("unknown key 'start'"), std::string::npos) << start.error().ToString();
+  auto word = ParseMissionTuning(R"({"scout_altitude_m": "low"})");
+  ASSERT_FALSE(word.ok());
+  EXPECT_NE(word.error().ToString().find("--mission-tuning: scout_altitude_m 'low': expected a number"),
+            std::string::npos)
+      << word.error().ToString();
+  auto nested = ParseMissionTuning(R"({"scout_altitude_m": {"m": 12}})");
+  ASSERT_FALSE(nested.ok());
+  EXPECT_NE(nested.error().ToString().find("expected a number"), std::string::npos) << nested.error().ToString();
+  auto list = ParseMissionTuning("[12]");
+  ASSERT_FALSE(list.ok());
+  EXPECT_NE(list.error().ToString().find("--mission-tuning"), std::string::npos) << list.error().ToString();
+  auto none = ParseMissionTuning("");
+  ASSERT_TRUE(none.ok()) << none.error().ToString();
+  EXPECT_TRUE(none->empty());
 }
 
 TEST(SarBrainScout, TheHoverEventAloneStartsTheClimb) {

@@ -88,6 +88,55 @@ struct BadCase {
   const char* message;
 };
 
+constexpr const char* kTuned = R"(name: tuned
+world: worlds/open_field.yaml
+drones:
+  - {name: scout_1, airframe: x500}
+mission: {kind: sar, inference_latency_ms: 40, tuning: {scout_altitude_m: 12, scout_min_clearance_m: 5.5}}
+timeout: {sim: 60s}
+)";
+
+// mission.tuning: SarBrain's numbers by name, kept in order for the agent's --mission-tuning.
+TEST(AgentKeys, MissionTuningIsAMappingOfNumbersForTheSarMission) {
+  auto spec = LoadTrialText(kTuned, "tuned.yaml", Opts());
+  ASSERT_TRUE(spec) << spec.error().ToString();
+  ASSERT_TRUE(spec->mission.tuning.is_mapping());
+  ASSERT_EQ(spec->mission.tuning.entries().size(), 2u);
+  EXPECT_EQ(spec->mission.tuning.entries()[0].first.scalar(), "scout_altitude_m");
+  EXPECT_EQ(spec->mission.TuningJson(), R"({"scout_altitude_m":12,"scout_min_clearance_m":5.5})");
+  auto bare = LoadTrialText(kBare, "bare.yaml", Opts());
+  ASSERT_TRUE(bare) << bare.error().ToString();
+  EXPECT_EQ(bare->mission.TuningJson(), "");  // no tuning, no flag
+  auto set = LoadTrialText(kBare, "bare.yaml", Opts({"mission.tuning.scout_altitude_m=15"}));
+  ASSERT_TRUE(set) << set.error().ToString();
+  EXPECT_EQ(set->mission.TuningJson(), R"({"scout_altitude_m":15})");
+}
+
+TEST(AgentKeys, MissionTuningThatIsNotAMappingOfNumbersFailsAtItsKey) {
+  const BadCase cases[] = {
+      {"tuning: {scout_altitude_m: 12, scout_min_clearance_m: 5.5}", "tuning: 12", "tuned.yaml:5:56",
+       "'tuning' must be a mapping of numbers by name"},
+      {"tuning: {scout_altitude_m: 12, scout_min_clearance_m: 5.5}", "tuning: [12]", "tuned.yaml:5:56",
+       "'tuning' must be a mapping of numbers by name"},
+      {"scout_altitude_m: 12", "scout_altitude_m: low", "tuned.yaml:5:75", "tuning 'scout_altitude_m' must be a number"},
+      {"scout_altitude_m: 12", "scout_altitude_m: \"12\"", "tuned.yaml:5:75", "tuning 'scout_altitude_m' must be a number"},
+      {"scout_altitude_m: 12", "scout_altitude_m: {m: 12}", "tuned.yaml:5:75", "tuning 'scout_altitude_m' must be a number"},
+      {"scout_altitude_m: 12", "scout_altitude_m: .inf", "tuned.yaml:5:75", "tuning 'scout_altitude_m' must be a number"},
+      {"scout_altitude_m: 12", "start: 12", "tuned.yaml:5:57", "'start' is not a tuning number"},
+      {"kind: sar", "kind: plan", "tuned.yaml:5:57", "'tuning' belongs to mission kind sar"},
+  };
+  for (const BadCase& c : cases) {
+    std::string text = kTuned;
+    const auto pos = text.find(c.find);
+    ASSERT_NE(pos, std::string::npos) << c.find;
+    text.replace(pos, std::string(c.find).size(), c.replace);
+    auto spec = LoadTrialText(text, "tuned.yaml", Opts());
+    ASSERT_FALSE(spec) << c.replace;
+    EXPECT_EQ(spec.error().where(), c.where) << c.replace << " -> " << spec.error().ToString();
+    EXPECT_NE(spec.error().message().find(c.message), std::string::npos) << c.replace << " -> " << spec.error().ToString();
+  }
+}
+
 TEST(AgentKeys, BadValuesFailAtFileLineColumn) {
   const BadCase cases[] = {
       {"kind: plan", "kind: rescue", "keys.yaml:6:17", "unknown mission kind 'rescue' (expected sar or plan)"},

@@ -261,6 +261,23 @@ TEST_F(PlanTest, SarAgentsGetTheWorldLatencyAndTheLifterItsPayload) {
   EXPECT_EQ(value_of(lifter, "--plan"), "<absent>");
   EXPECT_EQ(value_of(argv_of("scout_1"), "--payload"), "<absent>");
   EXPECT_EQ(value_of(argv_of("scout_1"), "--mission"), "sar");
+  EXPECT_EQ(value_of(argv_of("scout_1"), "--mission-tuning"), "<absent>");  // no tuning: the defaults
+}
+
+// mission.tuning: every SAR agent gets it as one argv element of JSON (yaml::EmitJson), in order.
+TEST_F(PlanTest, SarAgentsGetTheMissionTuningAsJson) {
+  auto tuning = yaml::Parse("{scout_altitude_m: 12, scout_min_clearance_m: 5, fusion_prior: 0.25}");
+  ASSERT_TRUE(tuning) << tuning.error().ToString();
+  spec_.mission.tuning = *tuning;
+  auto trial = PlanTrial(spec_, options_);
+  ASSERT_TRUE(trial) << trial.error().ToString();
+  for (const char* drone : {"scout_1", "lifter"}) {
+    const std::vector<std::string>& argv = (*trial)->FindPlugin(drone)->spec().argv;
+    auto it = std::find(argv.begin(), argv.end(), "--mission-tuning");
+    ASSERT_NE(it, argv.end()) << drone;
+    ASSERT_NE(it + 1, argv.end()) << drone;
+    EXPECT_EQ(*(it + 1), R"({"scout_altitude_m":12,"scout_min_clearance_m":5,"fusion_prior":0.25})") << drone;
+  }
 }
 
 // With a fault sidecar image, a trial that impairs the mesh gets one sidecar per drone owning the

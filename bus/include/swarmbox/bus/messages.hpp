@@ -267,7 +267,8 @@ struct CameraImage {
   std::uint32_t width_px = 0;
   std::uint32_t height_px = 0;
   std::uint32_t row_stride_bytes = 0;  // bytes from one row to the next in `data`
-  std::string encoding;                // "mono8", "bgr8" or "rgb8" (OpenCV/ROS names)
+  // "mono8", "bgr8", "rgb8" (OpenCV/ROS names) or "16UC1" (a depth image: DepthImageTopic)
+  std::string encoding;
   CameraIntrinsics intrinsics;
   // Pose of the camera's optical frame (OpenCV convention: x right, y down, z along the optical
   // axis) at capture: position in world ENU and the rotation optical frame -> world.

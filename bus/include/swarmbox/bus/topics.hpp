@@ -17,6 +17,7 @@
 //   sim     sim/status                 Event            kLockstep   physics -> all (the start, 1 Hz)
 //   sim     sim/telemetry              Telemetry        kState      every agent -> physics (keyed by drone; the recording)
 //   sim     sim/depth                  DepthSummary     kState      every agent -> anyone (keyed by drone; stereo depth)
+//   sim     sim/<drone>/depth          CameraImage      kLockstep   agent <drone> -> anyone (its depth image, 16UC1 mm)
 //   mesh    mesh/state                 DroneState       kState      agent -> agents (keyed by drone)
 //   mesh    mesh/raft                  RaftMessage      kRadio      agent -> agent `to`
 //   mesh    mesh/detection             Detection        kRadio      agent -> agents
@@ -82,6 +83,21 @@ std::string CameraTopic(std::string_view drone);    // "sim/<drone>/camera"
 // A stereo airframe's rectified pair, one CameraImage per pair, left and right side by side
 // (the layout is CameraImage's comment in messages.hpp); issue #23.
 std::string StereoTopic(std::string_view drone);    // "sim/<drone>/stereo"
+// A stereo drone's depth images (issue #23), as its depth camera releases them: one CameraImage per
+// matched pair, published by the drone's agent at the same simulated time as the frame's
+// DepthSummary on kDepthTopic (the device's 30-50 ms after the exposure), Qos::kLockstep.
+//   encoding "16UC1": depth along the optical axis (Z, not range) in millimetres, little-endian
+//   uint16, 0 = no depth (ROS's REP 118 convention; what the OAK-D Pro itself puts out). Chosen over
+//   "32FC1" metres because it is half the bytes (640x400: 512,000 bytes a frame against 1,024,000)
+//   for 1 mm steps, far finer than SGBM's depth step (a 1/16 px disparity step is 0.19 m at 10 m);
+//   depth over 65.535 m (a disparity under 0.5 px at the OAK-D Pro's 640x400) is sent as 0.
+//   width_px, height_px: the left image's; row_stride_bytes = 2 * width_px;
+//   intrinsics, camera_pose: the LEFT camera's (rectified: distortion 0; the pose the drone's own
+//   estimate gave at the exposure), so a subscriber back-projects pixel (u, v) with depth Z to
+//   camera_pose * (Z (u - cx) / fx, Z (v - cy) / fy, Z);
+//   sim_time_ns, step: the exposure's (the pair's), as the summary's capture time.
+// Published only while a subscriber is matched: a drone nobody listens to pays nothing for it.
+std::string DepthImageTopic(std::string_view drone);  // "sim/<drone>/depth"
 std::string OffboardInputTopic(std::string_view drone);   // "offboard/<drone>/input"
 std::string OffboardOutputTopic(std::string_view drone);  // "offboard/<drone>/output"
 

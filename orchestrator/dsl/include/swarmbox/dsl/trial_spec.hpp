@@ -84,6 +84,15 @@ struct MissionSpec {
   MissionKind kind = MissionKind::kSar;
   std::string plan = std::string(kDefaultFlightPlan);  // kind plan only
   int inference_latency_ms = 40;                       // simulated perception latency [ms], >= 0
+  // kind sar only: the SAR mission's tuning numbers by name (`tuning: {scout_altitude_m: 12}`), a
+  // mapping of plain numbers in the order written; null = the mission's defaults. Which names
+  // exist is the agent's to say (SarTuningKeys, agent/app/sar_brain.hpp: an unknown one stops the
+  // agent with the known ones); the loader checks the shape and refuses `start` (the drone's pose).
+  yaml::Node tuning = yaml::Node();  // initialised: {kind, plan, latency} need not name it (-Wextra)
+
+  // The tuning as a JSON object (yaml::EmitJson), what the agent's --mission-tuning takes; "" when
+  // there is none (null or an empty mapping).
+  std::string TuningJson() const;
 };
 
 // Raft timings of every agent (`raft:`), on wall-clock time. The defaults are chosen to stay stable
