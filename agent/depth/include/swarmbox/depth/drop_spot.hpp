@@ -91,7 +91,7 @@ inline constexpr double kSlungPayloadMargin_m = 0.5;
 // camera's height down past the hook by sling_length_m + payload_half_diagonal_m +
 // kSlungPayloadMargin_m, within hook_from_camera_m + the hook's own swing with the drone's tilt +
 // the sling's swing (sling_length_m sin(max_tilt_rad)) + payload_half_diagonal_m + the margin of
-// the camera's nadir. x8_heavy_depth: 3.75 m around, down to 5.6 m under the camera; so the
+// the camera's nadir. x8_heavy_depth: 3.8 m around, down to 5.7 m under the camera; so the
 // lifter surveys from higher than that (8 m), or the ground too is masked.
 MaskedVolume SlungPayloadVolume(const bus::Pose& camera, const SlungPayload& payload);
 
