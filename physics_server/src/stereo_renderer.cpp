@@ -104,8 +104,8 @@ double MarchToSurface(const StereoScene& s, const cv::Mat& tile_max, const Vec3&
   return t_end;
 }
 
-// A box face's texture value at cell (iu, iv) of `scale` cells: uniform in [-1, 1), a function of
-// the box's seed, the face and the cell alone.
+// A box face's texture value at face point (u, v) [m], constant over cells of cell_m: uniform in
+// [-1, 1), a function of the box's seed, the face and the cell alone.
 double FaceNoise(std::uint64_t seed, int face, double u_m, double v_m, double cell_m) {
   const auto iu = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(u_m / cell_m)));
   const auto iv = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v_m / cell_m)));
