@@ -169,6 +169,7 @@ void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoS
   radiance->create(h, w, CV_32F);
   if (depth != nullptr) depth->create(h, w, CV_32F);
   const double e1 = PatternIrradianceAt1m(spec.projector);
+  if (!ray_boxes_.empty()) BoundBoxesInView(centre, r);
   for (int v = 0; v < h; ++v) {
     auto* rad = radiance->ptr<float>(v);
     float* dep = depth != nullptr ? depth->ptr<float>(v) : nullptr;
@@ -183,7 +184,7 @@ void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoS
       }
       float box_albedo = -1;  // < 0: the ray sees the height field
       double t = MarchToSurface(s, tile_max_, centre, d);
-      if (!ray_boxes_.empty()) t = NearestBoxHit(centre, d, t, &box_albedo);
+      if (!ray_boxes_.empty()) t = NearestBoxHit(centre, d, xn, yn, t, &box_albedo);
       const Vec3 hp = centre + d * t;
       const int col = std::clamp(static_cast<int>(std::lround((hp.x - s.origin_x_m) / s.cell_m)), 0, s.albedo.cols - 1);
       const int row = std::clamp(static_cast<int>(std::lround((hp.y - s.origin_y_m) / s.cell_m)), 0, s.albedo.rows - 1);
@@ -204,9 +205,29 @@ void StereoRenderer::PrepareBoxes() {
   }
 }
 
-double StereoRenderer::NearestBoxHit(const Vec3& centre, const Vec3& d, double t_surface_m, float* albedo) const {
+void StereoRenderer::BoundBoxesInView(const Vec3& centre, const double* r) {
+  constexpr double kWholeView = 1e9;  // a sphere reaching the camera's plane: every ray tests it
+  for (RayBox& rb : ray_boxes_) {
+    const Vec3 q = rb.box->centre_m - centre;
+    const double x = r[0] * q.x + r[3] * q.y + r[6] * q.z, y = r[1] * q.x + r[4] * q.y + r[7] * q.z;
+    const double z = r[2] * q.x + r[5] * q.y + r[8] * q.z, rad = BoundingRadiusM(*rb.box);
+    if (z - rad <= kNearClip_m) {
+      rb.xn_min = rb.yn_min = -kWholeView, rb.xn_max = rb.yn_max = kWholeView;
+      continue;
+    }
+    // Over the sphere a / z, with a in [c - rad, c + rad] and z in [z - rad, z + rad], lies
+    // between the quotients of those ends.
+    const double near = z - rad, far = z + rad;
+    rb.xn_min = std::min((x - rad) / near, (x - rad) / far), rb.xn_max = std::max((x + rad) / near, (x + rad) / far);
+    rb.yn_min = std::min((y - rad) / near, (y - rad) / far), rb.yn_max = std::max((y + rad) / near, (y + rad) / far);
+  }
+}
+
+double StereoRenderer::NearestBoxHit(const Vec3& centre, const Vec3& d, double xn, double yn, double t_surface_m,
+                                     float* albedo) const {
   double best_t = t_surface_m;
   for (const RayBox& rb : ray_boxes_) {
+    if (xn < rb.xn_min || xn > rb.xn_max || yn < rb.yn_min || yn > rb.yn_max) continue;  // not towards it
     const std::array<double, 9>& m = rb.world_to_box;
     const Vec3 q = centre - rb.box->centre_m;
     const double o[3] = {m[0] * q.x + m[1] * q.y + m[2] * q.z, m[3] * q.x + m[4] * q.y + m[5] * q.z,

@@ -71,13 +71,18 @@ class StereoRenderer {
   void EnsurePattern(const ProjectorSpec& p);
   // The scene's boxes in the form the per-ray test wants (world -> box rotation), per Render.
   void PrepareBoxes();
-  // The nearest box hit along centre + t * d before t_surface_m, and its textured albedo there;
-  // t_surface_m (and *albedo untouched) without one.
-  double NearestBoxHit(const Vec3& centre, const Vec3& d, double t_surface_m, float* albedo) const;
+  // Each box's bounding sphere's extent in a view from `centre` (normalised image coordinates), so
+  // that a ray tests only the boxes whose extent holds it.
+  void BoundBoxesInView(const Vec3& centre, const double* r_wc);
+  // The nearest box hit along centre + t * d (the ray of normalised image point (xn, yn)) before
+  // t_surface_m, and its textured albedo there; t_surface_m (and *albedo untouched) without one.
+  double NearestBoxHit(const Vec3& centre, const Vec3& d, double xn, double yn, double t_surface_m,
+                       float* albedo) const;
 
   struct RayBox {
     const SceneBox* box;
     std::array<double, 9> world_to_box;  // row-major
+    double xn_min = 0, xn_max = 0, yn_min = 0, yn_max = 0;  // in the current view (BoundBoxesInView)
   };
 
   const StereoScene* scene_;
