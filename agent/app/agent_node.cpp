@@ -470,10 +470,14 @@ constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 constexpr double kGroundQuantile = 0.3;
 constexpr double kVictimKeepOut_m = 2.5;
 
-depth::DropSpotConfig DropSpotConfigFor(const SarBrain::DropSpotQuery& q) {
+// The survey's config: the ground from the view, the victim kept clear, the lifter's own payload
+// (hanging under the camera at the exposure) masked out.
+depth::DropSpotConfig DropSpotConfigFor(const SarBrain::DropSpotQuery& q, const bus::Pose& camera,
+                                        const std::optional<depth::SlungPayload>& payload) {
   depth::DropSpotConfig config;
   config.ground_quantile = kGroundQuantile;
   config.keep_out.push_back({.x_m = q.victim_xy_m.x(), .y_m = q.victim_xy_m.y(), .radius_m = kVictimKeepOut_m});
+  if (payload) config.masked.push_back(depth::SlungPayloadVolume(camera, *payload));
   return config;
 }
 
@@ -491,7 +495,7 @@ void AgentNode::AnswerDropSpot() {
   drop_spot_frame_ns_ = f->frame.capture_ns;
   const depth::DropSpot spot = depth::ChooseDropSpot(f->frame.depth_m, f->intrinsics, f->camera_pose,
                                                      q.default_xy_m.x(), q.default_xy_m.y(), q.yaw_rad,
-                                                     q.ground_z_m, DropSpotConfigFor(q));
+                                                     q.ground_z_m, DropSpotConfigFor(q, f->camera_pose, slung_payload_));
   LogEvent line(t_s_, options_.name, "drop_spot_survey");
   line.Add("capture_s", static_cast<double>(f->frame.capture_ns) * 1e-9, 3)
       .Add("fill", f->frame.summary.fill_rate, 2)

@@ -58,6 +58,7 @@
 #include "swarmbox/common/log_tee.hpp"
 #include "swarmbox/common/logfmt.hpp"
 #include "swarmbox/common/result.hpp"
+#include "swarmbox/depth/drop_spot.hpp"
 #include "swarmbox/flight/flight_controller.hpp"
 #include "swarmbox/radio/link_probe.hpp"
 #include "swarmbox/radio/mesh_radio.hpp"
@@ -214,6 +215,7 @@ class AgentNode final : private FrameHandler {
   void StartBrainHost(const Startup& s, std::unique_ptr<brain::Brain> brain);  // a brain or SarBrain
   Status StartPerception(const Startup& s);  // a SAR scout, or a brain on an airframe with a camera
   Status StartDepth(const Startup& s);       // an airframe with `stereo:` (the OAK-D Pro)
+  static std::optional<depth::SlungPayload> SlungPayloadSeen(const Startup& s, const std::string& payload);
 
   class FlightAdapter;  // FlightPort over fc_
 
@@ -254,6 +256,9 @@ class AgentNode final : private FrameHandler {
   FrameBuffers camera_frames_;                // taken this step
   std::unique_ptr<DepthHost> depth_;          // an airframe with a stereo depth camera
   std::int64_t drop_spot_frame_ns_ = -1;      // the depth frame the last drop-spot answer used
+  // The lifter's own slung payload as its depth camera sees it (masked out of the drop-spot
+  // survey); none without a payload or a depth camera.
+  std::optional<depth::SlungPayload> slung_payload_;
   bus::WorldCommand world_cmd_;
   bus::RadioFrame out_frame_;
   bus::ActuatorCommand cmd_;

@@ -376,6 +376,22 @@ Status AgentNode::StartPerception(const Startup& s) {
   return Ok{};
 }
 
+// The payload this drone carries (`payload`, the airframe's) as its stereo camera sees it: the
+// hook and sling from the airframe, the mount's offset, the flight stack's tilt limit (the most
+// the sling swings while the lifter holds over the point); none without a payload.
+std::optional<depth::SlungPayload> AgentNode::SlungPayloadSeen(const Startup& s, const std::string& payload) {
+  if (payload.empty()) return std::nullopt;
+  const auto spec = s.airframe.FindPayload(payload);
+  if (!spec) return std::nullopt;
+  const airframe::PayloadSpec& p = **spec;
+  const airframe::Vec3& mount = s.airframe.stereo.offset_m;
+  return depth::SlungPayload{.hook_below_camera_m = mount.z - p.hook_m.z,
+                             .hook_from_camera_m = std::hypot(mount.x - p.hook_m.x, mount.y - p.hook_m.y),
+                             .sling_length_m = p.sling_length_m,
+                             .payload_half_diagonal_m = airframe::Norm(p.size_m) / 2,
+                             .max_tilt_rad = s.flight.position.tilt_max_rad};
+}
+
 Status AgentNode::StartDepth(const Startup& s) {
   if (!s.airframe.stereo.enabled) return Ok{};  // no `stereo:`: nothing subscribed, nothing costs
   // The device latency's draws: the trial's seed, told apart per drone by its name (FNV-1a).
@@ -388,6 +404,7 @@ Status AgentNode::StartDepth(const Startup& s) {
                                         .stop = options_.stop});
   if (!host) return host.error();
   depth_ = std::move(*host);
+  slung_payload_ = SlungPayloadSeen(s, options_.mission.payload);
   return Ok{};
 }
 

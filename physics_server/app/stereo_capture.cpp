@@ -4,17 +4,35 @@
 #include <cmath>
 #include <cstring>
 
+#include "swarmbox/physics/detail/mix64.hpp"
 #include "swarmbox/physics/world_scene.hpp"
 
 namespace swarmbox::physics {
+
+using detail::Mix64;
+
 namespace {
 
-std::uint64_t Mix64(std::uint64_t x) {  // splitmix64's finaliser
-  x ^= x >> 30;
-  x *= 0xBF58476D1CE4E5B9ULL;
-  x ^= x >> 27;
-  x *= 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
+// Texture salts: a drone's body and its payload look different.
+enum BodySalt : std::uint64_t { kDroneBodySalt = 1, kPayloadSalt = 2 };
+
+// The other drones' bodies and every payload (the drone's own included: it hangs in its view)
+// whose bounding sphere may be in the view of a camera at `camera_m` over a patch of `half_m`.
+// The drone's own body is not: the cameras are under it, looking away from it.
+void AddBodies(const World& world, std::size_t drone, const Vec3& camera_m, double half_m, StereoScene* scene) {
+  scene->boxes.clear();
+  for (std::size_t j = 0; j < world.drone_count(); ++j) {
+    const DroneTruth t = world.Truth(j);
+    const std::uint64_t seed = Mix64(static_cast<std::uint64_t>(j));
+    if (j != drone) {
+      const SceneBox body = DroneBodyBox(world.airframe(j), {t.position_m, t.attitude}, seed ^ kDroneBodySalt);
+      if (MayBeInView(body, camera_m, half_m)) scene->boxes.push_back(body);
+    }
+    if (const PayloadSpec* p = world.payload(j); p != nullptr) {
+      const SceneBox box = PayloadBox(*p, {t.payload_position_m, t.payload_attitude}, seed ^ kPayloadSalt);
+      if (MayBeInView(box, camera_m, half_m)) scene->boxes.push_back(box);
+    }
+  }
 }
 
 }  // namespace
@@ -84,6 +102,7 @@ void StereoCapture::Capture(const World& world, std::size_t drone, std::uint64_t
   const double half_m = PatchHalfSizeM(truth.position_m.z, spec.hfov_rad);
   scene_ = MakeWorldScene(world.config(), truth.position_m.x, truth.position_m.y, half_m,
                           world.config().ground_texture_seed);
+  AddBodies(world, drone, body.position_m + Rotate(body.attitude, spec.offset_m), half_m, &scene_);
   renderer_.Render(body, spec, NoiseSeed(world.options().seed, drone, step), &frame_);
   PackStereoPair(frame_, world.drone_name(drone), step, world.time_ns(), out);
 }

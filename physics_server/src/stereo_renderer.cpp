@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include <opencv2/imgproc.hpp>
+
+#include "swarmbox/physics/detail/mix64.hpp"
 
 namespace swarmbox::physics {
 namespace {
@@ -180,6 +183,32 @@ double MarchToSurface(const StereoScene& s, const cv::Mat& tile_max, const Vec3&
   return t_end;
 }
 
+// A box face's texture value at face point (u, v) [m], constant over cells of cell_m: uniform in
+// [-1, 1), a function of the box's seed, the face and the cell alone.
+double FaceNoise(std::uint64_t seed, int face, double u_m, double v_m, double cell_m) {
+  const auto iu = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(u_m / cell_m)));
+  const auto iv = static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v_m / cell_m)));
+  const std::uint64_t h =
+      detail::Mix64(seed ^ detail::Mix64(static_cast<std::uint64_t>(face) ^ detail::Mix64(iu ^ detail::Mix64(iv))));
+  return 2 * (static_cast<double>(h >> 11) * 0x1.0p-53) - 1;
+}
+
+constexpr int kCoarseTextureCells = 4;      // the texture's coarse scale, in fine cells (0.2 m)
+constexpr double kFineTextureShare = 0.6;   // the fine scale's share of the texture
+constexpr float kMinBoxAlbedo = 0.02f, kMaxBoxAlbedo = 0.95f;
+
+// The box's textured albedo at box-frame point p on face `axis` (0..2, the face's normal axis):
+// the face's two other coordinates index the texture.
+float BoxAlbedo(const SceneBox& b, int axis, const Vec3& p) {
+  const double c[3] = {p.x, p.y, p.z};
+  const double u = c[(axis + 1) % 3], v = c[(axis + 2) % 3];
+  const int face = 2 * axis + (c[axis] > 0 ? 1 : 0);
+  const double fine = FaceNoise(b.texture_seed, face, u, v, kSceneBoxTextureCell_m);
+  const double coarse = FaceNoise(b.texture_seed + 1, face, u, v, kSceneBoxTextureCell_m * kCoarseTextureCells);
+  const double noise = kFineTextureShare * fine + (1 - kFineTextureShare) * coarse;
+  return std::clamp(static_cast<float>(b.albedo * (1 + kSceneBoxTextureAmplitude * noise)), kMinBoxAlbedo, kMaxBoxAlbedo);
+}
+
 }  // namespace
 
 StereoRenderer::StereoRenderer(const StereoScene* scene) : scene_(scene) {}
@@ -219,6 +248,7 @@ void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoS
   radiance->create(h, w, CV_32F);
   if (depth != nullptr) depth->create(h, w, CV_32F);
   const double e1 = PatternIrradianceAt1m(spec.projector);
+  if (!ray_boxes_.empty()) BoundBoxesInView(centre, r);
   for (int v = 0; v < h; ++v) {
     auto* rad = radiance->ptr<float>(v);
     float* dep = depth != nullptr ? depth->ptr<float>(v) : nullptr;
@@ -231,16 +261,75 @@ void StereoRenderer::CastView(const Vec3& centre, const double* r, const StereoS
         if (dep != nullptr) dep[u] = 0;
         continue;
       }
-      const double t = MarchToSurface(s, tile_max_, centre, d);
+      float box_albedo = -1;  // < 0: the ray sees the height field
+      double t = MarchToSurface(s, tile_max_, centre, d);
+      if (!ray_boxes_.empty()) t = NearestBoxHit(centre, d, xn, yn, t, &box_albedo);
       const Vec3 hp = centre + d * t;
       const int col = std::clamp(static_cast<int>(std::lround((hp.x - s.origin_x_m) / s.cell_m)), 0, s.albedo.cols - 1);
       const int row = std::clamp(static_cast<int>(std::lround((hp.y - s.origin_y_m) / s.cell_m)), 0, s.albedo.rows - 1);
       double irr = s.ambient_w_m2.at<float>(row, col);
       if (e1 > 0) irr += PatternIrradiance(hp, projector, r, e1, spec.projector.range_m);
-      rad[u] = static_cast<float>(s.albedo.at<float>(row, col) * irr);
+      rad[u] = static_cast<float>((box_albedo >= 0 ? box_albedo : s.albedo.at<float>(row, col)) * irr);
       if (dep != nullptr) dep[u] = static_cast<float>(t);
     }
   }
+}
+
+void StereoRenderer::PrepareBoxes() {
+  ray_boxes_.clear();
+  for (const SceneBox& b : scene_->boxes) {
+    const Vec3 ex = Rotate(b.attitude, Vec3{1, 0, 0}), ey = Rotate(b.attitude, Vec3{0, 1, 0});
+    const Vec3 ez = Rotate(b.attitude, Vec3{0, 0, 1});
+    ray_boxes_.push_back({&b, {ex.x, ex.y, ex.z, ey.x, ey.y, ey.z, ez.x, ez.y, ez.z}});
+  }
+}
+
+void StereoRenderer::BoundBoxesInView(const Vec3& centre, const double* r) {
+  constexpr double kWholeView = 1e9;  // a sphere reaching the camera's plane: every ray tests it
+  for (RayBox& rb : ray_boxes_) {
+    const Vec3 q = rb.box->centre_m - centre;
+    const double x = r[0] * q.x + r[3] * q.y + r[6] * q.z, y = r[1] * q.x + r[4] * q.y + r[7] * q.z;
+    const double z = r[2] * q.x + r[5] * q.y + r[8] * q.z, rad = BoundingRadiusM(*rb.box);
+    if (z - rad <= kNearClip_m) {
+      rb.xn_min = rb.yn_min = -kWholeView, rb.xn_max = rb.yn_max = kWholeView;
+      continue;
+    }
+    // Over the sphere a / z, with a in [c - rad, c + rad] and z in [z - rad, z + rad], lies
+    // between the quotients of those ends.
+    const double near = z - rad, far = z + rad;
+    rb.xn_min = std::min((x - rad) / near, (x - rad) / far), rb.xn_max = std::max((x + rad) / near, (x + rad) / far);
+    rb.yn_min = std::min((y - rad) / near, (y - rad) / far), rb.yn_max = std::max((y + rad) / near, (y + rad) / far);
+  }
+}
+
+double StereoRenderer::NearestBoxHit(const Vec3& centre, const Vec3& d, double xn, double yn, double t_surface_m,
+                                     float* albedo) const {
+  double best_t = t_surface_m;
+  for (const RayBox& rb : ray_boxes_) {
+    if (xn < rb.xn_min || xn > rb.xn_max || yn < rb.yn_min || yn > rb.yn_max) continue;  // not towards it
+    const std::array<double, 9>& m = rb.world_to_box;
+    const Vec3 q = centre - rb.box->centre_m;
+    const double o[3] = {m[0] * q.x + m[1] * q.y + m[2] * q.z, m[3] * q.x + m[4] * q.y + m[5] * q.z,
+                         m[6] * q.x + m[7] * q.y + m[8] * q.z};
+    const double v[3] = {m[0] * d.x + m[1] * d.y + m[2] * d.z, m[3] * d.x + m[4] * d.y + m[5] * d.z,
+                         m[6] * d.x + m[7] * d.y + m[8] * d.z};
+    const double h[3] = {rb.box->half_size_m.x, rb.box->half_size_m.y, rb.box->half_size_m.z};
+    double t_in = kNearClip_m, t_out = best_t;  // slabs: the ray's span inside each pair of faces
+    int entry_axis = -1;
+    for (int a = 0; a < 3 && t_in <= t_out; ++a) {
+      if (v[a] == 0) {
+        if (std::abs(o[a]) > h[a]) t_out = -1;  // parallel to the slab, outside it
+        continue;
+      }
+      const double t0 = (-h[a] - o[a]) / v[a], t1 = (h[a] - o[a]) / v[a];
+      if (std::min(t0, t1) > t_in) t_in = std::min(t0, t1), entry_axis = a;
+      t_out = std::min(t_out, std::max(t0, t1));
+    }
+    if (entry_axis < 0 || t_in > t_out || t_in >= best_t) continue;  // missed, or starts inside the box
+    best_t = t_in;
+    *albedo = BoxAlbedo(*rb.box, entry_axis, Vec3{o[0] + t_in * v[0], o[1] + t_in * v[1], o[2] + t_in * v[2]});
+  }
+  return best_t;
 }
 
 double StereoRenderer::PatternIrradianceAt1m(const ProjectorSpec& p) const {
@@ -276,6 +365,7 @@ void StereoRenderer::Render(const Pose& body_pose, const StereoSpec& spec, std::
                             StereoFrame* out) {
   EnsurePattern(spec.projector);
   BuildTileMax(*scene_, &tile_max_);  // the scene may have changed in place since the last pair
+  PrepareBoxes();
   const std::array<double, 9> r = OpticalToWorld(body_pose.attitude);
   const Vec3 mid = body_pose.position_m + Rotate(body_pose.attitude, spec.offset_m);
   const Vec3 ex{r[0], r[3], r[6]};  // optical x in world

@@ -134,6 +134,16 @@ void StereoScene::UpdateHeightRange() {
   max_height_m = static_cast<float>(hi);
 }
 
+double BoundingRadiusM(const SceneBox& box) {
+  return std::sqrt(Dot(box.half_size_m, box.half_size_m));
+}
+
+bool MayBeInView(const SceneBox& box, const Vec3& camera_m, double half_size_m) {
+  const double reach_m = half_size_m + BoundingRadiusM(box);
+  return std::abs(box.centre_m.x - camera_m.x) <= reach_m && std::abs(box.centre_m.y - camera_m.y) <= reach_m &&
+         box.centre_m.z - BoundingRadiusM(box) < camera_m.z;
+}
+
 const char* StereoSurfaceName(StereoSurface surface) {
   switch (surface) {
     case StereoSurface::kRubble: return "rubble";

@@ -627,6 +627,8 @@ std::optional<std::size_t> World::FindDrone(std::string_view name) const {
   if (it == impl_->index_of.end()) return std::nullopt;
   return it->second;
 }
+const PayloadSpec* World::payload(std::size_t index) const { return impl_->drones.at(index)->payload; }
+
 const Airframe& World::airframe(std::size_t i) const { return impl_->drones.at(i)->af; }
 const WorldConfig& World::config() const { return impl_->config; }
 const WorldOptions& World::options() const { return impl_->options; }
@@ -693,6 +695,8 @@ DroneTruth World::Truth(std::size_t index) const {
   t.payload_swing_rad = impl_->SwingAngle(d);
   if (d.payload_body) {
     t.payload_position_m = V(dBodyGetPosition(d.payload_body));
+    const dReal* q = dBodyGetQuaternion(d.payload_body);
+    t.payload_attitude = Quat{q[0], q[1], q[2], q[3]};
     dMass pm;
     dBodyGetMass(d.payload_body, &pm);
     t.payload_mass_kg = pm.mass;

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "swarmbox/physics/detail/mix64.hpp"
 
 namespace swarmbox::physics {
 namespace {
@@ -32,13 +36,7 @@ constexpr float kMinAlbedo = 0.02f, kMaxAlbedo = 0.95f;
 // Salts: one noise field per use, so the ground, the boxes and the mix do not repeat each other.
 enum Salt : std::uint64_t { kGroundSalt = 1, kObstacleSalt = 2, kPersonSalt = 3, kMixSalt = 4 };
 
-std::uint64_t Mix64(std::uint64_t x) {  // splitmix64's finaliser
-  x ^= x >> 30;
-  x *= 0xBF58476D1CE4E5B9ULL;
-  x ^= x >> 27;
-  x *= 0x94D049BB133111EBULL;
-  return x ^ (x >> 31);
-}
+using detail::Mix64;
 
 // Unit-variance value at global lattice point (i, j) of one noise field.
 float LatticeValue(std::uint64_t seed, std::uint64_t field, std::int64_t i, std::int64_t j) {
@@ -121,10 +119,11 @@ cv::Mat GroundAlbedo(const WorldConfig& world, const Window& w, std::uint64_t se
   return albedo + rubble_part;
 }
 
-// Raises the cells of a yaw-rotated footprint (centre, size x along yaw, size y across) to top_m
-// where that is higher, giving them the albedo of `texture` there.
-void RaiseFootprint(StereoScene* s, const Window& w, const Vec3& centre, double size_x, double size_y, double yaw,
-                    double top_m, const cv::Mat& texture) {
+// Calls visit(row, col, height, albedo) for each cell of the patch whose centre lies in the
+// yaw-rotated footprint (centre, size x along yaw, size y across).
+template <typename Visit>
+void ForEachFootprintCell(StereoScene* s, const Window& w, const Vec3& centre, double size_x, double size_y, double yaw,
+                          Visit visit) {
   const double c = std::cos(yaw), sn = std::sin(yaw);
   const double ex = (std::abs(c) * size_x + std::abs(sn) * size_y) / 2, ey = (std::abs(sn) * size_x + std::abs(c) * size_y) / 2;
   const double cell = s->cell_m;
@@ -132,7 +131,6 @@ void RaiseFootprint(StereoScene* s, const Window& w, const Vec3& centre, double 
   const int c1 = std::min(w.cols - 1, static_cast<int>(std::ceil((centre.x + ex - s->origin_x_m) / cell)));
   const int r0 = std::max(0, static_cast<int>(std::floor((centre.y - ey - s->origin_y_m) / cell)));
   const int r1 = std::min(w.rows - 1, static_cast<int>(std::ceil((centre.y + ey - s->origin_y_m) / cell)));
-  const auto top = static_cast<float>(top_m);
   for (int r = r0; r <= r1; ++r) {
     auto* h = s->height_m.ptr<float>(r);
     auto* a = s->albedo.ptr<float>(r);
@@ -140,11 +138,36 @@ void RaiseFootprint(StereoScene* s, const Window& w, const Vec3& centre, double 
     for (int col = c0; col <= c1; ++col) {
       const double dx = static_cast<double>(w.ix0 + col) * cell - centre.x;
       const double u = dx * c + dy * sn, v = -dx * sn + dy * c;
-      if (std::abs(u) > size_x / 2 || std::abs(v) > size_y / 2 || h[col] > top) continue;
-      h[col] = top;
-      a[col] = texture.at<float>(r, col);
+      if (std::abs(u) > size_x / 2 || std::abs(v) > size_y / 2) continue;
+      visit(r, col, h[col], a[col]);
     }
   }
+}
+
+// Raises the cells of a yaw-rotated footprint (centre, size x along yaw, size y across) to top_m
+// where that is higher, giving them the albedo of `texture` there.
+void RaiseFootprint(StereoScene* s, const Window& w, const Vec3& centre, double size_x, double size_y, double yaw,
+                    double top_m, const cv::Mat& texture) {
+  const auto top = static_cast<float>(top_m);
+  ForEachFootprintCell(s, w, centre, size_x, size_y, yaw, [&](int r, int col, float& h, float& a) {
+    if (h > top) return;
+    h = top;
+    a = texture.at<float>(r, col);
+  });
+}
+
+// The median height of the footprint's cells [m] (0 with none in the patch): what a body lying
+// there rests on. The median, not the max: one brick under a shoulder does not lift the whole
+// body, and a body half over a heap's edge lies at the level most of it rests on (the higher
+// part of the heap then shows through it, as the footprint keeps higher cells).
+double FootprintMedianHeight(StereoScene* s, const Window& w, const Vec3& centre, double size_x, double size_y,
+                             double yaw) {
+  std::vector<float> heights;
+  ForEachFootprintCell(s, w, centre, size_x, size_y, yaw, [&](int, int, float& h, float&) { heights.push_back(h); });
+  if (heights.empty()) return 0.0;
+  const auto mid = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
+  std::nth_element(heights.begin(), mid, heights.end());
+  return *mid;
 }
 
 void AddObstacles(const WorldConfig& world, const Window& w, std::uint64_t seed, StereoScene* s) {
@@ -163,7 +186,8 @@ void AddPeople(const WorldConfig& world, const Window& w, std::uint64_t seed, St
   for (const Victim& v : world.victims) {
     Vec3 centre;
     const Vec3 size = ApproxVictimBox(v, &centre);
-    RaiseFootprint(s, w, centre, size.x, size.y, v.heading_rad, size.z, person);
+    const double base_m = FootprintMedianHeight(s, w, centre, size.x, size.y, v.heading_rad);
+    RaiseFootprint(s, w, centre, size.x, size.y, v.heading_rad, base_m + size.z, person);
   }
 }
 
@@ -194,6 +218,22 @@ Vec3 ApproxVictimBox(const Victim& v, Vec3* centre_m) {
   }
   *centre_m = Vec3{v.x_m + offset * std::cos(v.heading_rad), v.y_m + offset * std::sin(v.heading_rad), 0};
   return Vec3{along, across, top};
+}
+
+SceneBox DroneBodyBox(const Airframe& airframe, const Pose& body, std::uint64_t texture_seed) {
+  return {.centre_m = body.position_m + Rotate(body.attitude, airframe.collision_offset_m),
+          .attitude = body.attitude,
+          .half_size_m = airframe.collision_box_m * 0.5,
+          .albedo = kDroneBodyAlbedo,
+          .texture_seed = texture_seed};
+}
+
+SceneBox PayloadBox(const PayloadSpec& payload, const Pose& pose, std::uint64_t texture_seed) {
+  return {.centre_m = pose.position_m,
+          .attitude = pose.attitude,
+          .half_size_m = payload.size_m * 0.5,
+          .albedo = kPayloadAlbedo,
+          .texture_seed = texture_seed};
 }
 
 StereoScene MakeWorldScene(const WorldConfig& world, double centre_x_m, double centre_y_m, double half_size_m,

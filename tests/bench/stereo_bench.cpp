@@ -128,6 +128,10 @@ int RunStereoBench(const swarmbox::bench::Args& args) {
 //
 //   suite=stereo_world scenario=trial_step steps=500 pairs=10 step_ms=0.05 step_with_pairs_ms=1.9
 //     pair_ms=90.1 cpu_s_per_sim_s=0.47
+//
+// scenario=trial_step_bodies: the same with bodies in the pair (StereoScene::boxes): an
+// x8_heavy_depth with its stretcher hanging in its view and 99 x500s pinned around it 4 m lower
+// (a few in its view, the rest culled); what drawing bodies costs is its pair_ms less trial_step's.
 
 double MsSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
@@ -169,19 +173,43 @@ void PrintPairCosts(const swarmbox::physics::WorldConfig& world, const std::stri
   std::fflush(stdout);
 }
 
-// Mean ms of `steps` World::Step()s of a world with one x500_depth pinned `height_m` over the
-// look point, with (`pairs`) or without StereoCapture's pairs at their due steps.
-double StepMs(const swarmbox::physics::WorldConfig& config, double height_m, int steps, bool pairs, int* rendered) {
+// The trial step's drones: one stereo drone pinned `height_m` over the look point (x500_depth;
+// with `bodies`, x8_heavy_depth with its stretcher hanging in its view) and, with `bodies`,
+// kOtherDrones x500s pinned on a kGridSpacing_m grid 4 m under it around the look point (a few in
+// its view, the rest beyond the patch: culled).
+constexpr int kOtherDrones = 99;
+constexpr double kGridSpacing_m = 6.0;
+bool AddTrialDrones(swarmbox::physics::World& world, double height_m, bool bodies) {
   namespace ph = swarmbox::physics;
-  auto world = ph::World::Create(config, {.seed = 1});
-  auto af = ph::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500_depth.yaml");
-  if (!world || !af) return -1;
+  const std::string dir = std::string(SWARMBOX_TRIALS_DIR) + "/airframes/";
+  auto stereo = ph::LoadAirframe(dir + (bodies ? "x8_heavy_depth.yaml" : "x500_depth.yaml"));
+  auto x500 = ph::LoadAirframe(dir + "x500.yaml");
+  if (!stereo || !x500) return false;
   ph::DroneSpawn spawn;
   spawn.name = "scout_1";
-  spawn.airframe = *af;
+  spawn.airframe = *stereo;
   spawn.position_m = {kLookX_m, kLookY_m, height_m};
-  if (!(*world)->AddDrone(spawn)) return -1;
-  (*world)->SetPinned(0, true);
+  if (bodies) spawn.payload = "stretcher", spawn.payload_attached = true;
+  if (!world.AddDrone(spawn)) return false;
+  spawn.airframe = *x500;
+  spawn.payload = "", spawn.payload_attached = false;
+  for (int i = 0; bodies && i < kOtherDrones; ++i) {
+    spawn.name = "d" + std::to_string(i);
+    spawn.position_m = {kLookX_m + kGridSpacing_m * (i % 10 - 4.5), kLookY_m + kGridSpacing_m * (i / 10 - 4.5),
+                        height_m - 4};
+    if (!world.AddDrone(spawn)) return false;
+  }
+  for (std::size_t i = 0; i < world.drone_count(); ++i) world.SetPinned(i, true);
+  return true;
+}
+
+// Mean ms of `steps` World::Step()s of a world with AddTrialDrones' drones, with (`pairs`) or
+// without StereoCapture's pairs of drone 0 at their due steps.
+double StepMs(const swarmbox::physics::WorldConfig& config, double height_m, int steps, bool pairs, bool bodies,
+              int* rendered) {
+  namespace ph = swarmbox::physics;
+  auto world = ph::World::Create(config, {.seed = 1});
+  if (!world || !AddTrialDrones(**world, height_m, bodies)) return -1;
   ph::StereoCapture capture(**world);
   swarmbox::bus::CameraImage pair;
   *rendered = 0;
@@ -197,6 +225,23 @@ double StepMs(const swarmbox::physics::WorldConfig& config, double height_m, int
   return MsSince(t0) / steps;
 }
 
+// One trial_step line: the step's cost without and with the pairs, and a pair's share.
+bool PrintTrialStep(const swarmbox::physics::WorldConfig& config, const std::string& name, int steps, bool bodies) {
+  constexpr double kTrialHeight_m = 10.0;
+  int rendered = 0;
+  const double plain_ms = StepMs(config, kTrialHeight_m, steps, false, bodies, &rendered);
+  const double with_ms = StepMs(config, kTrialHeight_m, steps, true, bodies, &rendered);
+  if (plain_ms < 0 || with_ms < 0 || rendered == 0) return false;
+  const double pair_ms = (with_ms - plain_ms) * steps / rendered;
+  constexpr double kStepsPerSimS = 250.0;  // the server's default control rate
+  std::printf("suite=stereo_world scenario=%s world=%s height_m=%g steps=%d pairs=%d step_ms=%.3f "
+              "step_with_pairs_ms=%.3f pair_ms=%.1f cpu_s_per_sim_s=%.2f\n",
+              bodies ? "trial_step_bodies" : "trial_step", name.c_str(), kTrialHeight_m, steps, rendered, plain_ms,
+              with_ms, pair_ms, with_ms * kStepsPerSimS / 1000.0);
+  std::fflush(stdout);
+  return true;
+}
+
 int RunStereoWorldBench(const swarmbox::bench::Args& args) {
   cv::setNumThreads(1);
   const std::string name = args.Get("world", "rubble_block");
@@ -208,20 +253,11 @@ int RunStereoWorldBench(const swarmbox::bench::Args& args) {
   }
   const std::vector<double> heights = args.quick ? std::vector<double>{10} : std::vector<double>{3, 6, 10, 15, 20};
   for (double h : heights) PrintPairCosts(*world, name, "", kLookX_m, kLookY_m, h, seed);
-  constexpr double kTrialHeight_m = 10.0;
   const int steps = args.quick ? 100 : 500;
-  int rendered = 0;
-  const double plain_ms = StepMs(*world, kTrialHeight_m, steps, false, &rendered);
-  const double with_ms = StepMs(*world, kTrialHeight_m, steps, true, &rendered);
-  if (plain_ms < 0 || with_ms < 0 || rendered == 0) {
+  if (!PrintTrialStep(*world, name, steps, false) || !PrintTrialStep(*world, name, steps, true)) {
     std::fprintf(stderr, "stereo_world: could not set up the trial step\n");
     return 1;
   }
-  const double pair_ms = (with_ms - plain_ms) * steps / rendered;
-  constexpr double kStepsPerSimS = 250.0;  // the server's default control rate
-  std::printf("suite=stereo_world scenario=trial_step world=%s height_m=%g steps=%d pairs=%d step_ms=%.3f "
-              "step_with_pairs_ms=%.3f pair_ms=%.1f cpu_s_per_sim_s=%.2f\n",
-              name.c_str(), kTrialHeight_m, steps, rendered, plain_ms, with_ms, pair_ms, with_ms * kStepsPerSimS / 1000.0);
   return 0;
 }
 

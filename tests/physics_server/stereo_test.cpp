@@ -356,6 +356,104 @@ TEST(StereoRenderer, TruthDepthOverTallColumnsIsTheReferenceMarchsToTheBit) {
     EXPECT_EQ(DepthsOffTheReferenceMarch(*view.scene, body, spec, &compared), 0) << view.name << ", of " << compared;
     EXPECT_GT(compared, spec.width_px * spec.height_px / 3) << view.name;
   }
+
+// Bodies over the height field (StereoScene::boxes): a 2 x 0.6 x 0.25 m stretcher-sized box
+// hanging level with its top 4 m under a camera 10 m over flat concrete.
+class StereoBoxes : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    scene_ = MakeSurfaceScene(StereoSurface::kConcreteShade, 30.0, 1);
+    spec_.enabled = true;
+    spec_.width_px = 160;
+    spec_.height_px = 100;
+    spec_.offset_m = {0, 0, 0};
+    body_.position_m = {0, 0, 10};
+    box_ = {.centre_m = {0, 0, 6 - 0.125}, .attitude = {}, .half_size_m = {1.0, 0.3, 0.125}, .albedo = 0.45,
+            .texture_seed = 3};
+  }
+  StereoFrame Render(const StereoScene& scene) {
+    StereoRenderer renderer(&scene);
+    StereoFrame frame;
+    renderer.Render(body_, spec_, 4, &frame);
+    return frame;
+  }
+  StereoScene scene_;
+  StereoSpec spec_;
+  Pose body_;
+  SceneBox box_;
+};
+
+// Down the optical axis of the left camera (half the baseline beside the box's centre line): the
+// box's top, 4 m away; a ray past the box's end still sees the ground 10 m away.
+TEST_F(StereoBoxes, ARayStraightDownOntoABoxSeesItsTop) {
+  scene_.boxes.push_back(box_);
+  const StereoFrame frame = Render(scene_);
+  const int u = spec_.width_px / 2, v = spec_.height_px / 2;
+  EXPECT_NEAR(frame.depth_truth_m.at<float>(v, u), 4.0, 1e-4);
+  EXPECT_NEAR(frame.depth_truth_m.at<float>(0, u), 10.0, 1e-3);  // the top row looks past the box's end
+  int on_box = 0;
+  for (int r = 0; r < frame.depth_truth_m.rows; ++r) {
+    for (int c = 0; c < frame.depth_truth_m.cols; ++c) on_box += frame.depth_truth_m.at<float>(r, c) < 5.0f;
+  }
+  // The box's top covers 2.0 x 0.6 m at 4 m: (f * 2.0 / 4) x (f * 0.6 / 4) pixels.
+  const double f = spec_.FocalPx();
+  EXPECT_NEAR(on_box, (f * 2.0 / 4) * (f * 0.6 / 4), 0.15 * (f * 2.0 / 4) * (f * 0.6 / 4));
+}
+
+// A tilted box hit from above at a known point: its top face's plane, as the truth depth says.
+TEST_F(StereoBoxes, ATiltedBoxIsHitOnItsTiltedFace) {
+  const double roll = 0.3;  // about the box's x axis: its top's normal tips towards -y
+  box_.attitude = {std::cos(roll / 2), std::sin(roll / 2), 0, 0};
+  scene_.boxes.push_back(box_);
+  const StereoFrame frame = Render(scene_);
+  const int u = spec_.width_px / 2, v = spec_.height_px / 2;
+  // The centre pixel's ray from the left camera (0, B/2, 10): optical x is world -y, so the ray is
+  // (-yn, -xn, -1) t with xn = yn = 0.5 / f. The top face: -sin(roll) y + cos(roll) (z - cz) = half_z.
+  const double xn = 0.5 / spec_.FocalPx(), y0 = spec_.baseline_m / 2, sn = std::sin(roll), cs = std::cos(roll);
+  const double t = (cs * (10 - box_.centre_m.z) - box_.half_size_m.z - sn * y0) / (cs - sn * xn);
+  EXPECT_NEAR(frame.depth_truth_m.at<float>(v, u), t, 1e-4);
+}
+
+// A box outside the view (beside the patch, or above the camera) changes nothing, to the bit.
+TEST_F(StereoBoxes, ABoxOutsideTheViewChangesNothing) {
+  const StereoFrame plain = Render(scene_);
+  box_.centre_m = {40, 0, 1};
+  scene_.boxes.push_back(box_);
+  box_.centre_m = {0, 0, 12};
+  scene_.boxes.push_back(box_);
+  const StereoFrame with_boxes = Render(scene_);
+  EXPECT_EQ(cv::norm(plain.left, with_boxes.left, cv::NORM_L1), 0.0);
+  EXPECT_EQ(cv::norm(plain.right, with_boxes.right, cv::NORM_L1), 0.0);
+  EXPECT_EQ(cv::norm(plain.depth_truth_m, with_boxes.depth_truth_m, cv::NORM_L1), 0.0);
+}
+
+// The box is drawn textured and lit like the ground: the dots land on it, and its pixels are
+// not uniform (so that the matcher has texture on it).
+TEST_F(StereoBoxes, ABoxIsTexturedAndLitByTheProjector) {
+  scene_.boxes.push_back(box_);
+  const StereoFrame lit = Render(scene_);
+  spec_.projector.enabled = false;
+  const StereoFrame dark = Render(scene_);
+  const cv::Mat on_box = lit.depth_truth_m < 5.0f;
+  cv::Scalar mean_lit, std_dark, mean_dark;
+  mean_lit = cv::mean(lit.left, on_box);
+  cv::meanStdDev(dark.left, mean_dark, std_dark, on_box);
+  EXPECT_GT(mean_lit[0] / cv::mean(lit.left, ~on_box)[0], mean_dark[0] / cv::mean(dark.left, ~on_box)[0]);
+  EXPECT_GT(std_dark[0], 2.0);
+}
+
+// Culling (MayBeInView): a box whose bounding sphere is beyond the patch's half size of the
+// camera horizontally, or wholly above the camera, is not tested by any ray.
+TEST(SceneBox, MayBeInViewCullsByPatchAndHeight) {
+  const SceneBox box{.centre_m = {0, 0, 0}, .attitude = {}, .half_size_m = {1.0, 0.3, 0.125}, .albedo = 0.4};
+  const double r = BoundingRadiusM(box);
+  EXPECT_NEAR(r, std::sqrt(1.0 + 0.09 + 0.125 * 0.125), 1e-12);
+  EXPECT_TRUE(MayBeInView(box, {0, 0, 8}, 12));
+  EXPECT_TRUE(MayBeInView(box, {12 + r - 0.01, 0, 8}, 12));
+  EXPECT_FALSE(MayBeInView(box, {12 + r + 0.01, 0, 8}, 12));
+  EXPECT_FALSE(MayBeInView(box, {0, -(12 + r + 0.01), 8}, 12));
+  EXPECT_TRUE(MayBeInView(box, {0, 0, r - 0.01}, 12));   // reaches below the camera
+  EXPECT_FALSE(MayBeInView(box, {0, 0, -r - 0.01}, 12)); // wholly above it
 }
 
 }  // namespace

@@ -59,6 +59,32 @@ TEST(WorldScene, StandingPersonIsTallerThanLying) {
   EXPECT_FLOAT_EQ(CellHeight(s, 0, -5), 1.8f);
 }
 
+// A person lying on a 0.6 m rubble heap (a 3 x 3 m box) lies on its top, 0.25 m over it; one
+// lying half over the heap's edge rests at the level of most of the body (the median of the
+// cells under it): its 1.8 m body 1.2 m over the heap lies on the heap, 0.6 m of it beyond the
+// edge at that level; on open ground, on the ground.
+TEST(WorldScene, PeopleLieOnWhatIsUnderThem) {
+  WorldConfig w = TestWorld();
+  w.obstacles.push_back({"heap", {0, 5, 0.3}, {3, 3, 0.6}, 0, ObstacleKind::kBox});
+  Victim on_top = w.victims[0];
+  on_top.id = "on_top";
+  on_top.x_m = 0;  // the body's centre: from -0.9 to 0.9 (heading east), wholly on the heap
+  on_top.y_m = 5;
+  Victim on_edge = on_top;
+  on_edge.id = "on_edge";
+  on_edge.x_m = 1.2;  // from 0.3 to 2.1: 1.2 m on the heap (to 1.5), 0.6 m off it
+  on_edge.y_m = 6;
+  w.victims.push_back(on_top);
+  w.victims.push_back(on_edge);
+  const StereoScene s = MakeWorldScene(w, 0, 0, 10, kSeed);
+  const auto lying_on_heap = static_cast<float>(0.6 + kLyingVictimTop_m);
+  EXPECT_FLOAT_EQ(CellHeight(s, 0, 5), lying_on_heap);
+  EXPECT_FLOAT_EQ(CellHeight(s, 1.0, 6), lying_on_heap);
+  EXPECT_FLOAT_EQ(CellHeight(s, 2.0, 6), lying_on_heap);  // off the heap, the body still at its level
+  EXPECT_FLOAT_EQ(CellHeight(s, 1.0, 4), 0.6f);           // the heap beside them
+  EXPECT_FLOAT_EQ(CellHeight(s, 0.8, -5), static_cast<float>(kLyingVictimTop_m));  // the first, on the ground
+}
+
 // The (row, col) of world (x, y) in a scene, if inside.
 std::optional<cv::Point> CellOf(const StereoScene& s, double x, double y) {
   const auto col = static_cast<int>(std::lround((x - s.origin_x_m) / s.cell_m));

@@ -153,10 +153,17 @@ void CellGrid::MarkObstacles(double tall_m) {
   }
 }
 
+// Whether world point (x0 + dx, y0 + dy, ground_z + dz) lies in a masked volume.
+bool Masked(const std::vector<MaskedVolume>& masked, const Frame& f, double dx, double dy, double dz) {
+  return std::ranges::any_of(masked, [&](const MaskedVolume& m) {
+    return m.Contains(f.x0_m + dx, f.y0_m + dy, f.ground_z_m + dz);
+  });
+}
+
 // Back-projects every pixel with depth once (as FitGroundPlane) into the footprint's frame and
-// keeps those inside the grid.
+// keeps those inside the grid and outside the masked volumes.
 std::vector<BinnedPoint> BinPoints(const cv::Mat& depth_m, const CameraIntrinsics& k, const bus::Pose& camera,
-                                   const Frame& f, const CellGrid& grid) {
+                                   const Frame& f, const CellGrid& grid, const std::vector<MaskedVolume>& masked) {
   const std::array<double, 9> r = detail::RotationMatrix(camera.orientation_wxyz);
   const auto& c = camera.position_enu_m;
   std::vector<BinnedPoint> points;
@@ -173,6 +180,7 @@ std::vector<BinnedPoint> BinPoints(const cv::Mat& depth_m, const CameraIntrinsic
       const double wz = c[2] + r[6] * ox + r[7] * oy + r[8] * z - f.ground_z_m;
       const double a = dx * f.cos_yaw + dy * f.sin_yaw, across = -dx * f.sin_yaw + dy * f.cos_yaw;
       const int cell = grid.IndexOf(a, across);
+      if (cell >= 0 && !masked.empty() && Masked(masked, f, dx, dy, wz)) continue;
       if (cell >= 0) points.push_back({cell, static_cast<float>(a), static_cast<float>(across), static_cast<float>(wz)});
     }
   }
@@ -298,7 +306,7 @@ bool KeptOut(const DropSpotConfig& config, double x_m, double y_m) {
 CellGrid PrepareGrid(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics, const bus::Pose& camera,
                      const DropSpotConfig& config, Frame* f) {
   CellGrid grid(config.search_radius_m + std::hypot(config.length_m, config.width_m) / 2 + kCell_m);
-  grid.Summarize(BinPoints(depth_m, intrinsics, camera, *f, grid));
+  grid.Summarize(BinPoints(depth_m, intrinsics, camera, *f, grid, config.masked));
   if (config.ground_quantile >= 0) {  // the ground as the view shows it, not as given
     const double offset_m = grid.SeenHeightQuantile(config.ground_quantile);
     grid.ShiftHeights(-offset_m);
@@ -309,6 +317,17 @@ CellGrid PrepareGrid(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics,
 }
 
 }  // namespace
+
+MaskedVolume SlungPayloadVolume(const bus::Pose& camera, const SlungPayload& payload) {
+  const double swing_m = (payload.hook_below_camera_m + payload.sling_length_m) * std::sin(payload.max_tilt_rad);
+  const double top_z_m = camera.position_enu_m[2];
+  return {.x_m = camera.position_enu_m[0],
+          .y_m = camera.position_enu_m[1],
+          .radius_m = payload.hook_from_camera_m + swing_m + payload.payload_half_diagonal_m + kSlungPayloadMargin_m,
+          .bottom_z_m = top_z_m - payload.hook_below_camera_m - payload.sling_length_m -
+                        payload.payload_half_diagonal_m - kSlungPayloadMargin_m,
+          .top_z_m = top_z_m};
+}
 
 DropSpot ChooseDropSpot(const cv::Mat& depth_m, const CameraIntrinsics& intrinsics, const bus::Pose& camera,
                         double default_x_m, double default_y_m, double yaw_rad, double ground_z_m,

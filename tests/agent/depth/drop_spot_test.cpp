@@ -16,6 +16,7 @@
 #include "swarmbox/depth/drop_spot.hpp"
 #include "swarmbox/depth/stereo_matcher.hpp"
 #include "swarmbox/physics/stereo_renderer.hpp"
+#include "swarmbox/physics/world_scene.hpp"
 
 namespace swarmbox::depth {
 namespace {
@@ -211,6 +212,76 @@ TEST(DropSpot, NoCandidateInsideAKeepOut) {
   const double d = std::hypot(spot.x_m - kDefaultX_m, spot.y_m - kDefaultY_m);
   EXPECT_GE(d, kRadius_m);
   EXPECT_LT(d, kRadius_m + DropSpotConfig{}.grid_step_m);  // the nearest grid point outside
+}
+
+// The lifter's own stretcher (x8_heavy: 2.0 x 0.6 x 0.25 m, 4 m sling from a hook 0.4 m under
+// the body) hanging level under it, along its yaw, and the volume it can occupy as the agent
+// masks it (AgentNode::AnswerDropSpot: the airframe's figures, the flight stack's 25 deg tilt).
+constexpr double kHookZ_m = -0.4, kSling_m = 4.0;
+const physics::Vec3 kStretcherSize_m{2.0, 0.6, 0.25};
+
+// Hanging level, its centre `swing_m` from the body's nadir towards (dir_x, dir_y) (a unit vector)
+// and as much higher as a sling swung that far.
+physics::SceneBox HangingStretcher(double swing_m = 0, double dir_x = 1, double dir_y = 0) {
+  const double rise_m = kSling_m - std::sqrt(kSling_m * kSling_m - swing_m * swing_m);
+  return {.centre_m = {kDefaultX_m + swing_m * dir_x, kDefaultY_m + swing_m * dir_y,
+                       kBodyHeight_m + kHookZ_m - kSling_m + rise_m},
+          .attitude = {std::cos(kYaw_rad / 2), 0.0, 0.0, std::sin(kYaw_rad / 2)},
+          .half_size_m = kStretcherSize_m * 0.5,
+          .albedo = physics::kPayloadAlbedo,
+          .texture_seed = 1};
+}
+
+SlungPayload StretcherAsSeen() {
+  const physics::StereoSpec spec;  // the mount: offset_m from the body origin
+  return {.hook_below_camera_m = spec.offset_m.z - kHookZ_m,
+          .hook_from_camera_m = std::hypot(spec.offset_m.x, spec.offset_m.y),
+          .sling_length_m = kSling_m,
+          .payload_half_diagonal_m = physics::Norm(kStretcherSize_m) / 2,
+          .max_tilt_rad = 25.0 * M_PI / 180.0};
+}
+
+TEST(SlungPayloadVolume, ReachesFromTheCameraPastTheSwungPayload) {
+  const bus::Pose camera{{1, 2, 8}, {1, 0, 0, 0}};
+  const SlungPayload p{.hook_below_camera_m = 0.1, .hook_from_camera_m = 0.5, .sling_length_m = 4.0,
+                       .payload_half_diagonal_m = 1.05, .max_tilt_rad = 25.0 * M_PI / 180.0};
+  const MaskedVolume v = SlungPayloadVolume(camera, p);
+  EXPECT_DOUBLE_EQ(v.x_m, 1);
+  EXPECT_DOUBLE_EQ(v.y_m, 2);
+  EXPECT_DOUBLE_EQ(v.top_z_m, 8);
+  EXPECT_NEAR(v.bottom_z_m, 8 - 0.1 - 4.0 - 1.05 - kSlungPayloadMargin_m, 1e-12);
+  EXPECT_NEAR(v.radius_m, 0.5 + 4.1 * std::sin(25.0 * M_PI / 180.0) + 1.05 + kSlungPayloadMargin_m, 1e-12);
+  EXPECT_TRUE(v.Contains(1 + 3.0, 2, 4));     // swung out, level with the payload
+  EXPECT_FALSE(v.Contains(1, 2, 0.5));        // the ground under it
+  EXPECT_FALSE(v.Contains(1 + 4.0, 2, 4));    // beyond the swing
+}
+
+// The box on the default point sends the stretcher to the nearest clear spot, 2.5 m off. With
+// the lifter's own stretcher in the view, swung 2 m towards that spot (30 deg of sling: within
+// the masked volume's reach), the masked depth gives the same spot as the view without it; the
+// unmasked depth takes the stretcher for an obstacle 3.7 m high over that spot and moves on.
+TEST(DropSpot, TheLiftersOwnStretcherMaskedGivesTheSameSpotAsWithoutIt) {
+  const Views bare = Survey(BoxOnDefaultPoint(kTruthSeed), kTruthSeed);
+  const DropSpot without = Choose(bare, bare.frame.depth_truth_m, "box, truth, no stretcher", SeenGround());
+  ASSERT_TRUE(without.found);
+  const double to_spot_m = std::hypot(without.x_m - kDefaultX_m, without.y_m - kDefaultY_m);
+  constexpr double kSwing_m = 2.0;
+  physics::StereoScene scene = BoxOnDefaultPoint(kTruthSeed);
+  scene.boxes.push_back(HangingStretcher(kSwing_m, (without.x_m - kDefaultX_m) / to_spot_m,
+                                         (without.y_m - kDefaultY_m) / to_spot_m));
+  const Views hung = Survey(scene, kTruthSeed);
+  const cv::Mat on_stretcher = hung.frame.depth_truth_m < 5.0f;  // its top ~4 m under the camera
+  EXPECT_GT(cv::countNonZero(on_stretcher), 1000);
+  DropSpotConfig masked = SeenGround();
+  masked.masked.push_back(SlungPayloadVolume(hung.camera, StretcherAsSeen()));
+  const DropSpot with = Choose(hung, hung.frame.depth_truth_m, "box, truth, stretcher masked", masked);
+  const DropSpot unmasked = Choose(hung, hung.frame.depth_truth_m, "box, truth, stretcher unmasked", SeenGround());
+  ASSERT_TRUE(with.found);
+  EXPECT_DOUBLE_EQ(with.x_m, without.x_m);
+  EXPECT_DOUBLE_EQ(with.y_m, without.y_m);
+  EXPECT_NEAR(with.ground_z_m, without.ground_z_m, 0.01);
+  EXPECT_NEAR(with.fit.height_m, 0.0, 0.01);
+  EXPECT_FALSE(unmasked.found && unmasked.x_m == without.x_m && unmasked.y_m == without.y_m);
 }
 
 // Measured over seeds 1-8 and 20-39 (28 scenes; kFirstSeed/kSeeds changed by hand): the box ->

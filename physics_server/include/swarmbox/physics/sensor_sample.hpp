@@ -66,6 +66,7 @@ struct DroneTruth {
   bool payload_attached = false;
   double payload_swing_rad = 0;      // sling angle from the vertical (0 when no payload attached)
   Vec3 payload_position_m;           // payload centre, if the drone has one
+  Quat payload_attitude;             // payload box -> world, if the drone has one
   double payload_mass_kg = 0;        // the payload body's simulated mass, attached or not [kg]
   bool crashed = false;
   bool lost = false;

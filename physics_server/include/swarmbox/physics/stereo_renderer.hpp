@@ -17,6 +17,10 @@
 // Gaussian read noise (seeded, independent per view) and 8-bit clipping. So the dots fade with
 // the inverse square of the distance and drown in sunlight: the ambient sets the exposure, and a
 // dot a few per cent above it is a level or two, under the noise.
+// Bodies (StereoScene::boxes: drones, payloads) are oriented boxes intersected per ray; a ray
+// sees the nearer of its box hit and its height-field hit, the box's textured albedo lit by the
+// ambient of the cell under the hit and by the projector as any surface; the truth depth is the
+// nearer one. With no box in the scene the output is what it was without boxes, to the bit.
 // Not modelled: the projector's own occlusion (a dot lands wherever the camera's ray does),
 // shading by the surface normal, cast shadows within the height field, lens distortion.
 //
@@ -24,7 +28,9 @@
 // buffers); one renderer per thread. Keeps a pointer to the scene, which must outlive it.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -63,6 +69,21 @@ class StereoRenderer {
   double PatternIrradiance(const Vec3& hit, const Vec3& projector, const double* r_wc, double e1,
                            double range_m) const;
   void EnsurePattern(const ProjectorSpec& p);
+  // The scene's boxes in the form the per-ray test wants (world -> box rotation), per Render.
+  void PrepareBoxes();
+  // Each box's bounding sphere's extent in a view from `centre` (normalised image coordinates), so
+  // that a ray tests only the boxes whose extent holds it.
+  void BoundBoxesInView(const Vec3& centre, const double* r_wc);
+  // The nearest box hit along centre + t * d (the ray of normalised image point (xn, yn)) before
+  // t_surface_m, and its textured albedo there; t_surface_m (and *albedo untouched) without one.
+  double NearestBoxHit(const Vec3& centre, const Vec3& d, double xn, double yn, double t_surface_m,
+                       float* albedo) const;
+
+  struct RayBox {
+    const SceneBox* box;
+    std::array<double, 9> world_to_box;  // row-major
+    double xn_min = 0, xn_max = 0, yn_min = 0, yn_max = 0;  // in the current view (BoundBoxesInView)
+  };
 
   const StereoScene* scene_;
   cv::Mat pattern_;          // CV_32F dot field over tan-angle space, mean 1
@@ -71,6 +92,7 @@ class StereoRenderer {
   int pattern_dots_ = -1;
   double pattern_fill_ = -1;
   cv::Mat radiance_l_, radiance_r_, noise_;
+  std::vector<RayBox> ray_boxes_;  // the scene's boxes, per Render
   cv::Mat tile_max_;         // the scene's highest cell per tile (the march's skip test), per Render
 };
 

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -24,6 +25,29 @@ namespace swarmbox::physics {
 inline constexpr double kSunInBandWm2 = 12.0;
 inline constexpr double kShadeFraction = 0.05;
 
+// A body over the height field: an oriented box (a drone's frame, a payload), hit analytically
+// per ray by StereoRenderer (the nearer of it and the height field is seen). Its faces carry a
+// value-noise texture fixed to the box (cells of kSceneBoxTextureCell_m and 4x that, seeded by
+// texture_seed), so the matcher has something to match on it as on the ground.
+struct SceneBox {
+  Vec3 centre_m;                 // world ENU
+  Quat attitude;                 // box -> world
+  Vec3 half_size_m;              // along the box's own x, y, z
+  double albedo = 0;             // NIR reflectance, the texture's mean
+  std::uint64_t texture_seed = 0;
+};
+inline constexpr double kSceneBoxTextureCell_m = 0.05;
+// The texture's amplitude, relative to the albedo: straps, struts, rivets and labels.
+inline constexpr double kSceneBoxTextureAmplitude = 0.3;
+
+// The box's bounding sphere radius [m].
+double BoundingRadiusM(const SceneBox& box);
+// Whether a box can be in the view of a camera at `camera_m` looking down over a patch of half
+// size `half_size_m` (MakeWorldScene's): its bounding sphere within the patch's half size of the
+// camera horizontally and reaching below the camera. Only such boxes go into a scene, so bodies
+// far away cost the ray caster nothing.
+bool MayBeInView(const SceneBox& box, const Vec3& camera_m, double half_size_m);
+
 struct StereoScene {
   double cell_m = 0.05;
   double origin_x_m = 0;     // world x of column 0's centre (ENU)
@@ -33,6 +57,7 @@ struct StereoScene {
   cv::Mat ambient_w_m2;      // CV_32F, in-band ambient irradiance on the cell
   float min_height_m = 0;
   float max_height_m = 0;
+  std::vector<SceneBox> boxes;  // bodies over the height field (not in min/max_height_m)
 
   // Bilinear height at world (x, y); outside the grid: the nearest border cell.
   float HeightAt(double x_m, double y_m) const;

@@ -80,6 +80,9 @@ class World {
   const std::string& drone_name(std::size_t index) const;
   std::optional<std::size_t> FindDrone(std::string_view name) const;
   const Airframe& airframe(std::size_t index) const;
+  // The payload the drone carries or has carried (its airframe's, named at spawn), or nullptr;
+  // Truth() gives its pose.
+  const PayloadSpec* payload(std::size_t index) const;
   const WorldConfig& config() const;
   const WorldOptions& options() const;
 

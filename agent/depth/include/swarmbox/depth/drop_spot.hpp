@@ -43,6 +43,7 @@
 // Pure: no I/O, no clock.
 #pragma once
 
+#include <cmath>
 #include <numbers>
 #include <vector>
 
@@ -59,6 +60,40 @@ struct KeepOut {
   double x_m = 0, y_m = 0;
   double radius_m = 0;
 };
+
+// A volume whose points are dropped before binning: a vertical cylinder around (x, y) of
+// radius_m from bottom_z_m to top_z_m (world ENU). The lifter's own slung payload hangs in its
+// view (SlungPayloadVolume): real drones mask their payload out of their depth, or the stretcher
+// under the lifter would be a raised object over its drop point. (What it hides of the ground
+// stays unseen: footprints there fail as unseen, not as obstacles.)
+struct MaskedVolume {
+  double x_m = 0, y_m = 0;
+  double radius_m = 0;
+  double bottom_z_m = 0, top_z_m = 0;
+  bool Contains(double px_m, double py_m, double pz_m) const {
+    return pz_m >= bottom_z_m && pz_m <= top_z_m && std::hypot(px_m - x_m, py_m - y_m) <= radius_m;
+  }
+};
+
+// A slung payload as the drone's camera sees it (airframe/ PayloadSpec and the stereo mount).
+struct SlungPayload {
+  double hook_below_camera_m = 0;      // camera's z - hook's z, the drone level [m]
+  double hook_from_camera_m = 0;       // the hook's horizontal distance from the camera, level [m]
+  double sling_length_m = 0;           // hook -> payload centre [m]
+  double payload_half_diagonal_m = 0;  // half the payload box's diagonal (its reach from its centre) [m]
+  double max_tilt_rad = 0;             // the most the drone tilts (the sling swings as far) while it holds
+};
+// Room around the payload's reach: the sling's stretch, the swing's overshoot past the drone's
+// tilt, the camera pose's error between the exposure and its estimate.
+inline constexpr double kSlungPayloadMargin_m = 0.5;
+
+// The volume the payload can occupy under a camera at `camera` (the left optical frame): from the
+// camera's height down past the hook by sling_length_m + payload_half_diagonal_m +
+// kSlungPayloadMargin_m, within hook_from_camera_m + the hook's own swing with the drone's tilt +
+// the sling's swing (sling_length_m sin(max_tilt_rad)) + payload_half_diagonal_m + the margin of
+// the camera's nadir. x8_heavy_depth: 3.8 m around, down to 5.7 m under the camera; so the
+// lifter surveys from higher than that (8 m), or the ground too is masked.
+MaskedVolume SlungPayloadVolume(const bus::Pose& camera, const SlungPayload& payload);
 
 struct DropSpotConfig {
   // The stretcher is 2.0 x 0.6 m; 0.3 m margin each side for the release's position error (the
@@ -88,6 +123,7 @@ struct DropSpotConfig {
   // still fail). The candidates' checks are then relative to that (DropSpot::ground_z_m).
   double ground_quantile = -1.0;
   std::vector<KeepOut> keep_out; // candidate centres inside any of these are skipped
+  std::vector<MaskedVolume> masked{};  // points inside any of these are dropped before binning
 };
 
 struct DropSpot {
