@@ -356,6 +356,7 @@ TEST(StereoRenderer, TruthDepthOverTallColumnsIsTheReferenceMarchsToTheBit) {
     EXPECT_EQ(DepthsOffTheReferenceMarch(*view.scene, body, spec, &compared), 0) << view.name << ", of " << compared;
     EXPECT_GT(compared, spec.width_px * spec.height_px / 3) << view.name;
   }
+}
 
 // Bodies over the height field (StereoScene::boxes): a 2 x 0.6 x 0.25 m stretcher-sized box
 // hanging level with its top 4 m under a camera 10 m over flat concrete.
