@@ -316,6 +316,7 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.negatives_sets > 0) r << " --negatives-sets " << o.negatives_sets;
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
+  if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
   return r.str();
 }
 
@@ -460,12 +461,38 @@ void CountCalibrationFigures(const swarm::VictimDetectorModel& model, const std:
   report->recall = report->calibration_persons ? static_cast<double>(report->calibration_tp) / report->calibration_persons : 1.0;
 }
 
+// The lowest vote fraction at which the calibration detections reach `precision` (people found once
+// each, as CountCalibrationFigures counts them): the operating point that keeps the most people;
+// nullopt when no vote fraction reaches it.
+std::optional<double> VotesAtPrecision(const std::vector<CalibrationDetection>& dets, double precision) {
+  std::vector<double> thresholds;
+  for (const CalibrationDetection& d : dets) thresholds.push_back(d.votes);
+  std::sort(thresholds.begin(), thresholds.end());
+  thresholds.erase(std::unique(thresholds.begin(), thresholds.end()), thresholds.end());
+  for (double v : thresholds) {
+    std::set<std::pair<std::size_t, std::size_t>> found;
+    int fp = 0;
+    for (const CalibrationDetection& d : dets) {
+      if (d.votes < v) continue;
+      if (d.label) {
+        found.insert({d.scene, d.person});
+      } else {
+        ++fp;
+      }
+    }
+    const int called = static_cast<int>(found.size()) + fp;
+    if (called > 0 && static_cast<double>(found.size()) / called >= precision) return v;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 // Calibration on scenes the forest has not seen: the Platt sigmoid on the labelled detections'
-// votes, and the figures.
-Status Calibrate(const std::vector<Scene>& calibration, int max_candidates, swarm::VictimDetectorModel* model_out,
+// votes (moved to the operating point when o.operating_precision is set), and the figures.
+Status Calibrate(const std::vector<Scene>& calibration, const TrainingOptions& o, swarm::VictimDetectorModel* model_out,
                  TrainingReport* report) {
+  const int max_candidates = o.max_candidates;
   swarm::VictimDetectorModel& model = *model_out;
   auto shared = std::make_shared<swarm::VictimDetectorModel>(model);
   swarm::VictimDetectorParams raw;
@@ -484,6 +511,16 @@ Status Calibrate(const std::vector<Scene>& calibration, int max_candidates, swar
   const auto [a, b] = FitPlatt(votes, labels);
   model.platt_a = a;
   model.platt_b = b;
+  if (o.operating_precision > 0) {
+    const std::optional<double> v = VotesAtPrecision(dets, o.operating_precision);
+    if (!v || a >= 0) {
+      return Error(ErrorCode::kInvalidArgument, "train-detector: the calibration detections reach precision " +
+                                                    std::to_string(o.operating_precision) + " at no vote fraction");
+    }
+    // Probability(votes) = 1 / (1 + exp(a votes + b)) is 0.5 where a votes + b = 0.
+    model.platt_b = -a * *v;
+    std::fprintf(stderr, "train-detector: operating point at votes %.4f (Platt's 0.5 at %.4f)\n", *v, -b / a);
+  }
   CountCalibrationFigures(model, dets, report);
   return Ok{};
 }
@@ -499,7 +536,7 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
   Result<std::vector<Scene>> cal = RenderCalibrationSets(o);
   if (!cal) return cal.error();
   report->calibration_scenes = static_cast<int>(cal->size());
-  if (Status st = Calibrate(*cal, o.max_candidates, &model, report); !st) return st.error();
+  if (Status st = Calibrate(*cal, o, &model, report); !st) return st.error();
   // The recipe names the calibration's altitude band when it is not the training mix's.
   if (o.calibration_altitude_m > 0 && model.recipe.find("--calibration-altitude") == std::string::npos) {
     std::ostringstream r;
@@ -510,6 +547,11 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
       model.recipe.find("--max-candidates") == std::string::npos) {
     model.recipe += " --max-candidates " + std::to_string(o.max_candidates);
   }
+  if (o.operating_precision > 0 && model.recipe.find("--operating-precision") == std::string::npos) {
+    std::ostringstream r;
+    r << model.recipe << " --operating-precision " << o.operating_precision;
+    model.recipe = r.str();
+  }
   return model;
 }
 
@@ -517,10 +559,12 @@ namespace {
 
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
-      o.hard_negative_rounds < 0 || o.max_candidates < 1 || o.negatives_sets < 0 || o.calibration_altitude_m < 0) {
+      o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
+      o.negatives_sets < 0 || o.calibration_altitude_m < 0) {
     return Error(ErrorCode::kInvalidArgument,
                  "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
-                 "max_candidates >= 1, hard_negative_rounds, negatives_sets and calibration_altitude_m >= 0");
+                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets and "
+                 "calibration_altitude_m >= 0");
   }
   const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
   for (const auto* list : {&o.training_seeds, &o.calibration_seeds, &negatives_seeds}) {
@@ -796,7 +840,7 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
     SWARMBOX_TRY(TrainModelForest(t, s2));
   }
   SWARMBOX_TRY(CheckFlattenedForest(t, s2));
-  if (Status st = Calibrate(*cal, o.max_candidates, &t.model, report); !st) return st.error();
+  if (Status st = Calibrate(*cal, o, &t.model, report); !st) return st.error();
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t.model;
 }

@@ -61,6 +61,10 @@ struct TrainingOptions {
   // The first stage's cap on candidates per frame while calibrating and mining hard negatives (the
   // detector's default, VictimDetectorParams::max_candidates, unless set: a blob model is run at 96).
   int max_candidates = swarm::VictimDetectorParams{}.max_candidates;
+  // The operating point: when not 0, the sigmoid is moved along the votes so that probability 0.5
+  // falls at the lowest vote fraction where the calibration detections reach this precision (a
+  // threshold chosen on calibration frames only, never on an evaluation seed); 0: Platt's fit as is.
+  double operating_precision = 0;
   // The calibration frames' altitude band [m]: centre +- kCalibrationAltitudeBandM, the search
   // altitude, so that the sigmoid is fitted where the detector is used; 0: the training sets'
   // mixed altitudes (8-65 m, the shipped recipe).
