@@ -7,7 +7,11 @@
 //   training lines and gets "recalibrated": true)
 //   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):
 //   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
-//   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features
+//   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features,
+//   --negatives-sets N (cones-and-rubble sets 7200001..7200000+N), --calibration-altitude M
+//   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there), --max-candidates N
+//   (the first stage's cap while calibrating and mining), --operating-precision P (probability 0.5
+//   where the calibration detections reach precision P)
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -62,6 +66,12 @@ constexpr Flag kFlags[] = {
     {"--hard-negative-rounds", true,
      [](const char* v, Args* a) { a->options.hard_negative_rounds = std::stoi(v); return true; }},
     {"--blob-features", false, [](const char*, Args* a) { a->options.blob_features = true; return true; }},
+    {"--negatives-sets", true, [](const char* v, Args* a) { a->options.negatives_sets = std::stoi(v); return true; }},
+    {"--max-candidates", true, [](const char* v, Args* a) { a->options.max_candidates = std::stoi(v); return true; }},
+    {"--operating-precision", true,
+     [](const char* v, Args* a) { a->options.operating_precision = std::stod(v); return true; }},
+    {"--calibration-altitude", true,
+     [](const char* v, Args* a) { a->options.calibration_altitude_m = std::stod(v); return true; }},
 };
 
 // The flag named `a` when it is complete at argv[i] (its value, if it takes one, follows).
@@ -80,7 +90,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
       std::fprintf(stderr,
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
-                   "[--balance-classes] [--hard-negative-rounds N] [--blob-features]\n");
+                   "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] "
+                   "[--calibration-altitude M] [--max-candidates N] [--operating-precision P]\n");
       return kUsageError;
     }
     const char* value = flag->takes_value ? argv[++i] : nullptr;
@@ -100,12 +111,14 @@ std::string ReadText(const std::string& path) {
   return text.str();
 }
 
-// The training lines of the old report, the calibration lines of the new one.
+// The training lines of the old report, the calibration lines (and the recipe, which names the
+// calibration's options) of the new one.
 std::string MergeRecalibratedReport(const std::string& old_json, const std::string& text) {
   std::istringstream old_lines(old_json), new_lines(text);
   std::string line, merged;
   auto calibration_line = [](const std::string& l) {
-    return l.find("\"platt\"") != std::string::npos || l.find("\"calibration_figures\"") != std::string::npos ||
+    return l.find("\"recipe\"") != std::string::npos || l.find("\"platt\"") != std::string::npos ||
+           l.find("\"calibration_figures\"") != std::string::npos ||
            l.find("\"stage1_calibration_recall\"") != std::string::npos;
   };
   std::string fresh;

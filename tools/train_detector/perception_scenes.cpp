@@ -109,13 +109,15 @@ physics::Bgr Jitter(std::mt19937_64& rng, physics::Bgr c, int amount) {
 }
 
 // The ground: a terrain kind and water, a time of day and overcast, half the boxes trees.
-void VaryGround(std::mt19937_64& rng, physics::WorldConfig* w) {
+void VaryGround(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfig* w) {
   std::uniform_real_distribution<double> unit(0, 1);
   static constexpr physics::TerrainKind kTerrains[] = {physics::TerrainKind::kGrass, physics::TerrainKind::kSoil,
                                                        physics::TerrainKind::kGravel, physics::TerrainKind::kRubble,
                                                        physics::TerrainKind::kMixed};
   physics::Terrain terrain;
   terrain.kind = kTerrains[rng() % 5];
+  // The draw above stays, so that the rest of the world is what the all-kinds mix would draw.
+  if (p.distractor_mix == DistractorMix::kConesRubble) terrain.kind = physics::TerrainKind::kRubble;
   terrain.water_fraction = unit(rng) < 0.3 ? 0.15 * unit(rng) : 0.0;
   w->terrain = terrain;
   physics::Lighting light;
@@ -157,6 +159,7 @@ void AddDistractors(std::mt19937_64& rng, const SceneSetParams& p, physics::Worl
     for (int k = 0; k < p.distractors; ++k) {
       physics::Distractor d;
       d.kind = kKinds[rng() % std::size(kKinds)];
+      if (p.distractor_mix == DistractorMix::kConesRubble) d.kind = physics::DistractorKind::kCone;
       const double r = 2.0 + 7.0 * unit(rng), a = 2 * std::numbers::pi * unit(rng);
       d.x_m = v.x_m + r * std::cos(a);
       d.y_m = v.y_m + r * std::sin(a);
@@ -241,7 +244,7 @@ physics::WorldConfig MakeWorld(std::mt19937_64& rng, int index, const SceneSetPa
   // Occluders, distractors and the varied look draw from the generator only when asked for, so the
   // scene sets of the defaults stay what they were.
   if (p.varied_look) {
-    VaryGround(rng, &w);
+    VaryGround(rng, p, &w);
     VaryPeople(rng, p, &w);
     AddDistractors(rng, p, &w);
     return w;

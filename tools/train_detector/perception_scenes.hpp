@@ -57,6 +57,13 @@ struct Scene {
   std::vector<SceneVictim> victims;
 };
 
+// Which distractor kinds a varied-look world gets (perception_scenes.cpp AddDistractors).
+enum class DistractorMix {
+  kAllKinds,     // tarps, cones, backpacks, debris and rocks, equally often
+  kConesRubble,  // rubble terrain in every world and only traffic cones: the shipped blob model's
+                 // false alarms at 30 m (a cone and its shadow, rubble clumps), for hard negatives
+};
+
 struct SceneSetParams {
   std::uint64_t seed = 1;
   int scenes = 240;
@@ -70,6 +77,7 @@ struct SceneSetParams {
   double occluded_fraction = 0.0;      // share of victims partly covered by a low slab
   int distractors = 0;                 // distractors near each victim
   bool varied_look = false;            // terrain, light, poses, clothing, cover, distractor kinds
+  DistractorMix distractor_mix = DistractorMix::kAllKinds;  // with varied_look only
 };
 
 // Scene-set seeds the perception tests and the bench evaluate on by default: never trained on.

@@ -159,11 +159,13 @@ std::size_t NearestIndex(const Scene& s, double scale, const Eigen::Vector2d& ca
   return best;
 }
 
-Result<std::vector<Scene>> RenderSets(const std::vector<std::uint64_t>& seeds, int scenes) {
+// The scene sets of `seeds`, each made by set_params(seed, scenes); half of the frames get clutter.
+template <typename SetParams>
+Result<std::vector<Scene>> RenderSets(const std::vector<std::uint64_t>& seeds, int scenes, SetParams set_params) {
   std::vector<Scene> all;
   std::mt19937_64 rng(0xC1A77E5);
   for (std::uint64_t seed : seeds) {
-    Result<std::vector<Scene>> s = perception_scenes::RenderScenes(TrainingSceneSet(seed, scenes));
+    Result<std::vector<Scene>> s = perception_scenes::RenderScenes(set_params(seed, scenes));
     if (!s) return s.error().Context("rendering training scene set " + std::to_string(seed));
     for (Scene& x : *s) {
       if (std::uniform_real_distribution<double>(0, 1)(rng) < 0.5) PaintClutter(x, PixelsPerMetre(x), rng);
@@ -311,6 +313,10 @@ std::string RecipeText(const TrainingOptions& o) {
     << o.stage1_percentile << " --hard-negative-rounds " << o.hard_negative_rounds;
   if (o.balance_classes) r << " --balance-classes";
   if (o.blob_features) r << " --blob-features";
+  if (o.negatives_sets > 0) r << " --negatives-sets " << o.negatives_sets;
+  if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
+  if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
+  if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
   return r.str();
 }
 
@@ -335,6 +341,41 @@ perception_scenes::SceneSetParams TrainingSceneSet(std::uint64_t seed, int scene
           .distractors = 2,
           .varied_look = seed % 4 != 0};
 }
+
+perception_scenes::SceneSetParams NegativesSceneSet(std::uint64_t seed, int scenes) {
+  constexpr int kConesPerPerson = 4;
+  perception_scenes::SceneSetParams p = TrainingSceneSet(seed, scenes);
+  p.distractors = kConesPerPerson;
+  p.varied_look = true;
+  p.distractor_mix = perception_scenes::DistractorMix::kConesRubble;
+  return p;
+}
+
+perception_scenes::SceneSetParams CalibrationSceneSet(std::uint64_t seed, int scenes, double calibration_altitude_m) {
+  perception_scenes::SceneSetParams p = TrainingSceneSet(seed, scenes);
+  if (calibration_altitude_m > 0) {
+    p.min_altitude_m = calibration_altitude_m - kCalibrationAltitudeBandM;
+    p.max_altitude_m = calibration_altitude_m + kCalibrationAltitudeBandM;
+  }
+  return p;
+}
+
+namespace {
+
+// The seeds of the cones-and-rubble sets.
+std::vector<std::uint64_t> NegativesSeeds(const TrainingOptions& o) {
+  std::vector<std::uint64_t> seeds;
+  for (int k = 1; k <= o.negatives_sets; ++k) seeds.push_back(kNegativesSeedBase + static_cast<std::uint64_t>(k));
+  return seeds;
+}
+
+Result<std::vector<Scene>> RenderCalibrationSets(const TrainingOptions& o) {
+  return RenderSets(o.calibration_seeds, o.scenes_per_set, [&o](std::uint64_t seed, int scenes) {
+    return CalibrationSceneSet(seed, scenes, o.calibration_altitude_m);
+  });
+}
+
+}  // namespace
 
 namespace {
 
@@ -420,15 +461,42 @@ void CountCalibrationFigures(const swarm::VictimDetectorModel& model, const std:
   report->recall = report->calibration_persons ? static_cast<double>(report->calibration_tp) / report->calibration_persons : 1.0;
 }
 
+// The lowest vote fraction at which the calibration detections reach `precision` (people found once
+// each, as CountCalibrationFigures counts them): the operating point that keeps the most people;
+// nullopt when no vote fraction reaches it.
+std::optional<double> VotesAtPrecision(const std::vector<CalibrationDetection>& dets, double precision) {
+  std::vector<double> thresholds;
+  for (const CalibrationDetection& d : dets) thresholds.push_back(d.votes);
+  std::sort(thresholds.begin(), thresholds.end());
+  thresholds.erase(std::unique(thresholds.begin(), thresholds.end()), thresholds.end());
+  for (double v : thresholds) {
+    std::set<std::pair<std::size_t, std::size_t>> found;
+    int fp = 0;
+    for (const CalibrationDetection& d : dets) {
+      if (d.votes < v) continue;
+      if (d.label) {
+        found.insert({d.scene, d.person});
+      } else {
+        ++fp;
+      }
+    }
+    const int called = static_cast<int>(found.size()) + fp;
+    if (called > 0 && static_cast<double>(found.size()) / called >= precision) return v;
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 // Calibration on scenes the forest has not seen: the Platt sigmoid on the labelled detections'
-// votes, and the figures.
-Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorModel* model_out,
+// votes (moved to the operating point when o.operating_precision is set), and the figures.
+Status Calibrate(const std::vector<Scene>& calibration, const TrainingOptions& o, swarm::VictimDetectorModel* model_out,
                  TrainingReport* report) {
+  const int max_candidates = o.max_candidates;
   swarm::VictimDetectorModel& model = *model_out;
   auto shared = std::make_shared<swarm::VictimDetectorModel>(model);
   swarm::VictimDetectorParams raw;
+  raw.max_candidates = max_candidates;
   raw.min_confidence = 0.0;
   raw.partial_confidence_cap = 1.0;
   swarm::VictimDetector det(shared, raw);
@@ -443,6 +511,16 @@ Status Calibrate(const std::vector<Scene>& calibration, swarm::VictimDetectorMod
   const auto [a, b] = FitPlatt(votes, labels);
   model.platt_a = a;
   model.platt_b = b;
+  if (o.operating_precision > 0) {
+    const std::optional<double> v = VotesAtPrecision(dets, o.operating_precision);
+    if (!v || a >= 0) {
+      return Error(ErrorCode::kInvalidArgument, "train-detector: the calibration detections reach precision " +
+                                                    std::to_string(o.operating_precision) + " at no vote fraction");
+    }
+    // Probability(votes) = 1 / (1 + exp(a votes + b)) is 0.5 where a votes + b = 0.
+    model.platt_b = -a * *v;
+    std::fprintf(stderr, "train-detector: operating point at votes %.4f (Platt's 0.5 at %.4f)\n", *v, -b / a);
+  }
   CountCalibrationFigures(model, dets, report);
   return Ok{};
 }
@@ -455,10 +533,25 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
   if (model.calibration_seeds != o.calibration_seeds) {
     return Error(ErrorCode::kInvalidArgument, "recalibrate: the model was calibrated on other seeds", model_path);
   }
-  Result<std::vector<Scene>> cal = RenderSets(o.calibration_seeds, o.scenes_per_set);
+  Result<std::vector<Scene>> cal = RenderCalibrationSets(o);
   if (!cal) return cal.error();
   report->calibration_scenes = static_cast<int>(cal->size());
-  if (Status st = Calibrate(*cal, &model, report); !st) return st.error();
+  if (Status st = Calibrate(*cal, o, &model, report); !st) return st.error();
+  // The recipe names the calibration's altitude band when it is not the training mix's.
+  if (o.calibration_altitude_m > 0 && model.recipe.find("--calibration-altitude") == std::string::npos) {
+    std::ostringstream r;
+    r << model.recipe << " --calibration-altitude " << o.calibration_altitude_m;
+    model.recipe = r.str();
+  }
+  if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates &&
+      model.recipe.find("--max-candidates") == std::string::npos) {
+    model.recipe += " --max-candidates " + std::to_string(o.max_candidates);
+  }
+  if (o.operating_precision > 0 && model.recipe.find("--operating-precision") == std::string::npos) {
+    std::ostringstream r;
+    r << model.recipe << " --operating-precision " << o.operating_precision;
+    model.recipe = r.str();
+  }
   return model;
 }
 
@@ -466,12 +559,15 @@ namespace {
 
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
-      o.hard_negative_rounds < 0) {
+      o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
+      o.negatives_sets < 0 || o.calibration_altitude_m < 0) {
     return Error(ErrorCode::kInvalidArgument,
                  "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
-                 "hard_negative_rounds >= 0");
+                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets and "
+                 "calibration_altitude_m >= 0");
   }
-  for (const auto* list : {&o.training_seeds, &o.calibration_seeds}) {
+  const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
+  for (const auto* list : {&o.training_seeds, &o.calibration_seeds, &negatives_seeds}) {
     for (std::uint64_t s : *list) {
       for (std::uint64_t e : perception_scenes::kEvaluationSeeds) {
         if (s == e) return Error(ErrorCode::kInvalidArgument, "training seed " + std::to_string(s) + " is an evaluation seed");
@@ -591,6 +687,7 @@ Labelled Stage2Positives(const swarm::VictimDetectorModel& model, const Labelled
 // Stage 1 from the training scenes; returns stage 2's positives.
 Labelled TrainStage1(Training& t, const std::vector<Scene>& train) {
   t.model.training_seeds = t.o.training_seeds;
+  for (std::uint64_t seed : NegativesSeeds(t.o)) t.model.training_seeds.push_back(seed);
   t.model.calibration_seeds = t.o.calibration_seeds;
   t.model.SetLinear(std::vector<double>(swarm::kWindowFeatures, 0.0), 0.0);
   t.model.forest = cv::ml::RTrees::create();  // replaced below; the detector needs one to exist
@@ -673,6 +770,7 @@ void MineHardNegatives(Training& t, const std::vector<Scene>& train, int round, 
   raw.min_confidence = 0.0;
   raw.partial_confidence_cap = 1.0;
   raw.nms_radius_m = 0.0;
+  raw.max_candidates = t.o.max_candidates;
   swarm::VictimDetector det(mined, raw);
   std::vector<float> g(static_cast<std::size_t>(t.model.forest_inputs()));
   int hard = 0;
@@ -719,9 +817,14 @@ Status CheckFlattenedForest(const Training& t, Labelled& s2) {
 Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   SWARMBOX_TRY(CheckTrainingOptions(o));
-  Result<std::vector<Scene>> train = RenderSets(o.training_seeds, o.scenes_per_set);
+  Result<std::vector<Scene>> train = RenderSets(o.training_seeds, o.scenes_per_set, TrainingSceneSet);
   if (!train) return train.error();
-  Result<std::vector<Scene>> cal = RenderSets(o.calibration_seeds, o.scenes_per_set);
+  if (o.negatives_sets > 0) {
+    Result<std::vector<Scene>> extra = RenderSets(NegativesSeeds(o), o.scenes_per_set, NegativesSceneSet);
+    if (!extra) return extra.error();
+    for (Scene& x : *extra) train->push_back(std::move(x));
+  }
+  Result<std::vector<Scene>> cal = RenderCalibrationSets(o);
   if (!cal) return cal.error();
   report->training_scenes = static_cast<int>(train->size());
   report->calibration_scenes = static_cast<int>(cal->size());
@@ -737,7 +840,7 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
     SWARMBOX_TRY(TrainModelForest(t, s2));
   }
   SWARMBOX_TRY(CheckFlattenedForest(t, s2));
-  if (Status st = Calibrate(*cal, &t.model, report); !st) return st.error();
+  if (Status st = Calibrate(*cal, o, &t.model, report); !st) return st.error();
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t.model;
 }

@@ -29,6 +29,7 @@
 
 #include "perception_scenes.hpp"
 #include "swarmbox/common/result.hpp"
+#include "swarmbox/swarm/victim_detector.hpp"
 #include "swarmbox/swarm/victim_detector_model.hpp"
 
 namespace swarmbox::train_detector {
@@ -53,7 +54,28 @@ struct TrainingOptions {
   // shape, parts, edge orientations, model format 2); false (the shipped model's recipe) trains the
   // format-1 layout (window features and score).
   bool blob_features = false;
+  // Extra training sets (seeds kNegativesSeedBase + 1..N) of the cones-and-rubble mix
+  // (perception_scenes::DistractorMix::kConesRubble, 4 cones per person): more of the blob model's
+  // false alarms among the second stage's negatives. 0: none (the shipped recipe).
+  int negatives_sets = 0;
+  // The first stage's cap on candidates per frame while calibrating and mining hard negatives (the
+  // detector's default, VictimDetectorParams::max_candidates, unless set: a blob model is run at 96).
+  int max_candidates = swarm::VictimDetectorParams{}.max_candidates;
+  // The operating point: when not 0, the sigmoid is moved along the votes so that probability 0.5
+  // falls at the lowest vote fraction where the calibration detections reach this precision (a
+  // threshold chosen on calibration frames only, never on an evaluation seed); 0: Platt's fit as is.
+  double operating_precision = 0;
+  // The calibration frames' altitude band [m]: centre +- kCalibrationAltitudeBandM, the search
+  // altitude, so that the sigmoid is fitted where the detector is used; 0: the training sets'
+  // mixed altitudes (8-65 m, the shipped recipe).
+  double calibration_altitude_m = 0;
 };
+
+// The cones-and-rubble sets' seeds start above this (disjoint from training, calibration and
+// evaluation seeds).
+inline constexpr std::uint64_t kNegativesSeedBase = 7'200'000;
+// Half the width of the calibration altitude band [m].
+inline constexpr double kCalibrationAltitudeBandM = 3.0;
 
 // The options as the trainer's command line (recorded in the model and its JSON report).
 std::string RecipeText(const TrainingOptions& options);
@@ -65,6 +87,14 @@ TrainingOptions DefaultTrainingOptions();
 // the people partly covered, 2 distractors per person, the varied look (perception_scenes.hpp)
 // except for every seed divisible by 4 (the original hi-vis look).
 perception_scenes::SceneSetParams TrainingSceneSet(std::uint64_t seed, int scenes);
+
+// A cones-and-rubble set (TrainingOptions::negatives_sets): the training mix, every world in the
+// varied look on rubble terrain, 4 traffic cones per person.
+perception_scenes::SceneSetParams NegativesSceneSet(std::uint64_t seed, int scenes);
+
+// A calibration set: the training mix, at calibration_altitude_m +- kCalibrationAltitudeBandM when
+// that is not 0.
+perception_scenes::SceneSetParams CalibrationSceneSet(std::uint64_t seed, int scenes, double calibration_altitude_m);
 
 struct TrainingReport {
   int training_scenes = 0;
