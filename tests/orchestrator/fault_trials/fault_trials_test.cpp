@@ -143,8 +143,24 @@ TEST_F(FaultTrial, RadioImpairment) {
   const double n_rtt = static_cast<double>(during.received) / 2.0;
   const double rtt_tol = 4.0 * want_sd / std::sqrt(n_rtt) + 10.0;
   EXPECT_NEAR(during.rtt_mean_ms, want_rtt, rtt_tol);
-  const double sd_tol = 4.0 * want_sd / std::sqrt(2.0 * n_rtt) + 5.0;
-  EXPECT_NEAR(during.rtt_sd_ms, want_sd, sd_tol);
+  // The jitter, by the median window's own sd: the pooled sd also holds the host's bursts (on a
+  // CI run with a neighbour test: before pooled 21.2 ms against 1.7 ms in the median window, one
+  // window at 73 ms), which come and go between the phases and so cannot be subtracted. A
+  // window's sample sd of n pongs has a standard error of sd / sqrt(2 (n - 1)), its median over M
+  // windows ~1.25 times that / sqrt(M); + 5 ms for the small-n bias (the median sample sd is a few
+  // % under sigma) and the bursts that reach the median.
+  ASSERT_GE(before.sd_windows, 20u);
+  ASSERT_GE(during.sd_windows, 40u);
+  const double base_window_sd = before.rtt_sd_window_median_ms;
+  const double want_window_sd = std::sqrt(base_window_sd * base_window_sd + 2 * one_way_sd * one_way_sd);
+  const double window_sd_tol = 4.0 * 1.25 * want_window_sd / std::sqrt(2.0 * (during.pongs_per_sd_window - 1.0)) /
+                                   std::sqrt(static_cast<double>(during.sd_windows)) +
+                               5.0;
+  std::printf("fault_trial=radio_jitter before_window_sd_ms=%.2f during_window_sd_ms=%.2f want_ms=%.2f tol_ms=%.2f "
+              "windows=%zu pongs_per_window=%.1f\n",
+              base_window_sd, during.rtt_sd_window_median_ms, want_window_sd, window_sd_tol, during.sd_windows,
+              during.pongs_per_sd_window);
+  EXPECT_NEAR(during.rtt_sd_window_median_ms, want_window_sd, window_sd_tol);
   EXPECT_NEAR(during.rtt_p50_ms, want_rtt, rtt_tol + 5.0);  // normal: the median is the mean
   const double want_loss = 1.0 - 0.95 * 0.95;
   const double n_loss = static_cast<double>(during.sent) / 2.0;

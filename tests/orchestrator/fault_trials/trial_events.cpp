@@ -92,7 +92,8 @@ LinkSummary SummariseLinks(const std::vector<TrialEvent>& events, double from_s,
   std::map<std::pair<std::string, std::string>, bool> contact;
   // Pooled moments: sum of n, of n * mean, and of (n - 1) sd^2 + n mean^2 (= sum of squares).
   double n_total = 0.0, sum = 0.0, sum_sq = 0.0;
-  std::vector<double> p50s;
+  std::vector<double> p50s, sds;
+  double sd_pongs = 0.0;
   for (const TrialEvent& e : events) {
     if (!IsLink(e)) continue;
     const auto key = std::make_pair(e.Get("node"), e.Get("peer"));
@@ -114,6 +115,10 @@ LinkSummary SummariseLinks(const std::vector<TrialEvent>& events, double from_s,
     sum += n * mean;
     sum_sq += (n - 1.0) * sd * sd + n * mean * mean;
     if (auto p50 = e.Number("rtt_ms_p50")) p50s.push_back(*p50);
+    if (received >= kMinPongsForSd) {
+      sds.push_back(sd);
+      sd_pongs += n;
+    }
   }
   if (s.sent > 0) {
     s.loss = 1.0 - static_cast<double>(s.received) / static_cast<double>(s.sent);
@@ -125,6 +130,11 @@ LinkSummary SummariseLinks(const std::vector<TrialEvent>& events, double from_s,
                                                 (n_total - 1.0)));
     }
     s.rtt_p50_ms = Percentile(p50s, 0.5);
+  }
+  if (!sds.empty()) {
+    s.sd_windows = sds.size();
+    s.pongs_per_sd_window = sd_pongs / static_cast<double>(sds.size());
+    s.rtt_sd_window_median_ms = Percentile(sds, 0.5);
   }
   return s;
 }

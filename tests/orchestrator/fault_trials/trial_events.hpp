@@ -54,8 +54,16 @@ struct LinkSummary {
   double rtt_mean_ms = 0.0;  // over every received pong (window means weighted by count)
   double rtt_sd_ms = 0.0;    // pooled sample standard deviation of every received pong
   double rtt_p50_ms = 0.0;   // median of the windows' p50s (a robust centre)
+  // The median of the windows' own standard deviations (windows with at least kMinPongsForSd
+  // pongs) and how many windows that is: a robust spread. A busy host delays pongs in bursts (a
+  // neighbour test's build or start): a few windows then hold delays of tens of ms that the pooled
+  // sd takes in whole, while the median window is the link's own jitter.
+  double rtt_sd_window_median_ms = 0.0;
+  std::size_t sd_windows = 0;
+  double pongs_per_sd_window = 0.0;  // mean pongs in those windows
   std::map<std::string, std::uint64_t> sent_by_node;
 };
+inline constexpr std::uint64_t kMinPongsForSd = 5;
 LinkSummary SummariseLinks(const std::vector<TrialEvent>& events, double from_s, double to_s);
 
 // Leader failovers: for every applied kill/stop of a drone that was the leader at the time (the

@@ -62,6 +62,30 @@ TEST(SummariseLinks, SkipsDiscoveryWindowsAndPoolsMoments) {
   EXPECT_NEAR(all.rtt_sd_ms, std::sqrt(ss / 8.0), 1e-9);
 }
 
+TEST(SummariseLinks, TheWindowMedianSdIgnoresABurstAndThinWindows) {
+  // After discovery (the first window with a pong straddles it: skipped, as above), three
+  // windows of 6 pongs (sd 50, a host's burst; 3; 2) and one of 3 pongs (sd 99: too few to count).
+  auto events = Parse(
+      R"({"wall_s":1,"event":"link","node":"a","peer":"b","sent":"5","received":"0","loss":"1"})"
+      "\n"
+      R"({"wall_s":3,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"1","rtt_ms_p50":"10"})"
+      "\n"
+      R"({"wall_s":5,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"50","rtt_ms_p50":"10"})"
+      "\n"
+      R"({"wall_s":7,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"3","rtt_ms_p50":"10"})"
+      "\n"
+      R"({"wall_s":9,"event":"link","node":"a","peer":"b","sent":"6","received":"3","loss":"0.5","rtt_ms_mean":"10","rtt_ms_sd":"99","rtt_ms_p50":"10"})"
+      "\n"
+      R"({"wall_s":11,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"2","rtt_ms_p50":"10"})"
+      "\n");
+  const LinkSummary s = SummariseLinks(events, 0.0, 100.0);
+  EXPECT_EQ(s.windows, 4u);
+  EXPECT_EQ(s.sd_windows, 3u);
+  EXPECT_DOUBLE_EQ(s.pongs_per_sd_window, 6.0);
+  EXPECT_DOUBLE_EQ(s.rtt_sd_window_median_ms, 3.0);
+  EXPECT_GT(s.rtt_sd_ms, 25.0);  // the pooled sd takes the burst in whole
+}
+
 TEST(Failovers, FromTheKilledLeaderToTheNextLeaderOfAHigherTerm) {
   auto events = Parse(
       R"({"wall_s":2,"event":"leader_elected","node":"a","term":"2","leader":"b"})"
