@@ -1,5 +1,5 @@
 // Sensor faults with the real programs on the real engine: a short kind plan trial (physics server
-// + one agent: take-off, hover, land) with `{at: 8s, duration: 3s, gps_dropout: scout_1}` and then
+// + one agent: take-off, a 20 s hover, land) with `{at: 8s, duration: 3s, gps_dropout: scout_1}` and then
 // `{at: 12s, duration: 2s, gps_degrade: {target: scout_1, h_acc_m: 5, v_acc_m: 8}}`. The runner
 // execs `swarmbox-physics --send-command scout_1 gps_dropout 3` (and `... gps_degrade 2 5 8`) in
 // the physics container; events.jsonl records each apply and removal with mechanism
@@ -37,7 +37,12 @@ TEST(SensorFaultE2e, GpsDropoutAndDegradationAreSentToThePhysicsServerAndRecorde
                             .World("worlds/open_field.yaml")
                             .Rtf(1.0)
                             .Drone("scout_1", "x500", {0, 0, 0})
-                            .Mission({dsl::MissionKind::kPlan, "takeoff:3,hover:10,land", 40})
+                            // Hover 20 s: the faults (8-11 s, 12-14 s, each applied an exec's
+                            // latency late: seconds on a loaded CI host) end well before the landing.
+                            // With hover 10 the landing began ~1 s after the degraded fix was due to
+                            // end, and a CI run's late commands had the drone land on a 5 m / 8 m fix:
+                            // event=crash.
+                            .Mission({dsl::MissionKind::kPlan, "takeoff:3,hover:20,land", 40})
                             .EndOn("event=plan_complete", dsl::Outcome::kSuccess, {}, "scout_1")
                             .EndOn("event=crash", dsl::Outcome::kFailure, "crash")
                             .Timeout(dsl::Duration::Seconds(60), dsl::Outcome::kTimeout, dsl::Duration::Seconds(240));
