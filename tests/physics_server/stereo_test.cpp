@@ -207,80 +207,6 @@ double PlainMarch(const StereoScene& s, const Vec3& centre, const Vec3& d) {
   return t_end;
 }
 
-// Rubble (heaps, chunks, columns) seen obliquely from 2.5 m above its highest cell, so that rays
-// graze heaps, pass over tiles of every pyramid level and leave the grid: every left pixel's
-// truth depth is the reference march's through the same ray (the renderer's ray set-up, repeated).
-TEST(StereoRenderer, TruthDepthIsTheReferenceMarchsToTheBit) {
-  StereoScene scene = MakeSurfaceScene(StereoSurface::kRubble, 12.0, 5);
-  AddBox(&scene, {1, -1, 0}, {0.5, 0.5, 0}, 3.0, 0.5);  // a column up past the camera's level
-  scene.UpdateHeightRange();
-  StereoSpec spec;
-  spec.enabled = true;
-  spec.width_px = 160;
-  spec.height_px = 100;
-  Pose body;
-  body.position_m = {0.5, -0.3, scene.max_height_m + 2.5};
-  const double roll = 0.5, yaw = 0.3;  // yaw about z, then roll about body x: a tilted view
-  body.attitude = {std::cos(yaw / 2) * std::cos(roll / 2), std::cos(yaw / 2) * std::sin(roll / 2),
-                   std::sin(yaw / 2) * std::sin(roll / 2), std::sin(yaw / 2) * std::cos(roll / 2)};
-  StereoRenderer renderer(&scene);
-  StereoFrame frame;
-  renderer.Render(body, spec, 1, &frame);
-  const Vec3 ex = Rotate(body.attitude, Vec3{0, -1, 0}), ey = Rotate(body.attitude, Vec3{-1, 0, 0}),
-             ez = Rotate(body.attitude, Vec3{0, 0, -1});
-  const Vec3 mid = body.position_m + Rotate(body.attitude, spec.offset_m);
-  const Vec3 left = mid - ex * (spec.baseline_m / 2);
-  const double f = spec.FocalPx(), cx = spec.width_px / 2.0, cy = spec.height_px / 2.0;
-  int compared = 0, differ = 0;
-  for (int v = 0; v < spec.height_px; ++v) {
-    for (int u = 0; u < spec.width_px; ++u) {
-      const double xn = (u + 0.5 - cx) / f, yn = (v + 0.5 - cy) / f;
-      const Vec3 d{ex.x * xn + ey.x * yn + ez.x, ex.y * xn + ey.y * yn + ez.y, ex.z * xn + ey.z * yn + ez.z};
-      if (d.z > -1e-6) continue;  // the renderer's sky
-      ++compared;
-      if (frame.depth_truth_m.at<float>(v, u) != static_cast<float>(PlainMarch(scene, left, d))) ++differ;
-    }
-  }
-  EXPECT_GT(compared, spec.width_px * spec.height_px / 2);
-  EXPECT_EQ(differ, 0) << "of " << compared << " pixels";
-}
-
-// A trial world's patch (MakeWorldScene) with obstacles far taller than the ground's relief, seen
-// from 15 m: most of each ray's march lies above its tile's highest cell (skipped samples), and
-// every left pixel's truth depth is still the reference march's.
-TEST(StereoRenderer, TruthDepthOverAWorldPatchIsTheReferenceMarchsToTheBit) {
-  WorldConfig world;
-  world.terrain = Terrain{TerrainKind::kRubble, 0.0};
-  world.obstacles.push_back({"wall", {0, 6, 4}, {20, 1, 8}, 0.2, ObstacleKind::kBox});
-  world.obstacles.push_back({"block", {-4, -3, 6}, {4, 4, 12}, 0.7, ObstacleKind::kBox});
-  const StereoScene scene = MakeWorldScene(world, 0, 0, 15, 3);
-  StereoSpec spec;
-  spec.enabled = true;
-  spec.width_px = 160;
-  spec.height_px = 100;
-  Pose body;
-  body.position_m = {1.0, 0.5, 15.0};
-  StereoRenderer renderer(&scene);
-  StereoFrame frame;
-  renderer.Render(body, spec, 1, &frame);
-  const Vec3 ex = Rotate(body.attitude, Vec3{0, -1, 0}), ey = Rotate(body.attitude, Vec3{-1, 0, 0}),
-             ez = Rotate(body.attitude, Vec3{0, 0, -1});
-  const Vec3 left = body.position_m + Rotate(body.attitude, spec.offset_m) - ex * (spec.baseline_m / 2);
-  const double f = spec.FocalPx(), cx = spec.width_px / 2.0, cy = spec.height_px / 2.0;
-  int differ = 0, on_obstacles = 0;
-  for (int v = 0; v < spec.height_px; ++v) {
-    for (int u = 0; u < spec.width_px; ++u) {
-      const double xn = (u + 0.5 - cx) / f, yn = (v + 0.5 - cy) / f;
-      const Vec3 d{ex.x * xn + ey.x * yn + ez.x, ex.y * xn + ey.y * yn + ez.y, ex.z * xn + ey.z * yn + ez.z};
-      const float depth = frame.depth_truth_m.at<float>(v, u);
-      if (depth != static_cast<float>(PlainMarch(scene, left, d))) ++differ;
-      if (depth < 12.0f) ++on_obstacles;  // the wall's or the block's top
-    }
-  }
-  EXPECT_EQ(differ, 0) << "of " << spec.width_px * spec.height_px << " pixels";
-  EXPECT_GT(on_obstacles, 100);
-}
-
 // Yaw about z, then roll about the body's x axis (a view tilted sideways by `roll_rad`).
 Quat YawThenRoll(double yaw_rad, double roll_rad) {
   return {std::cos(yaw_rad / 2) * std::cos(roll_rad / 2), std::cos(yaw_rad / 2) * std::sin(roll_rad / 2),
@@ -309,6 +235,52 @@ int DepthsOffTheReferenceMarch(const StereoScene& scene, const Pose& body, const
     }
   }
   return differ;
+}
+
+// Rubble (heaps, chunks, columns) seen obliquely from 2.5 m above its highest cell, so that rays
+// graze heaps, pass over tiles of every pyramid level and leave the grid: every left pixel's
+// truth depth is the reference march's through the same ray (the renderer's ray set-up, repeated).
+TEST(StereoRenderer, TruthDepthIsTheReferenceMarchsToTheBit) {
+  StereoScene scene = MakeSurfaceScene(StereoSurface::kRubble, 12.0, 5);
+  AddBox(&scene, {1, -1, 0}, {0.5, 0.5, 0}, 3.0, 0.5);  // a column up past the camera's level
+  scene.UpdateHeightRange();
+  StereoSpec spec;
+  spec.enabled = true;
+  spec.width_px = 160;
+  spec.height_px = 100;
+  Pose body;
+  body.position_m = {0.5, -0.3, scene.max_height_m + 2.5};
+  body.attitude = YawThenRoll(/*yaw_rad=*/0.3, /*roll_rad=*/0.5);  // a tilted view
+  int compared = 0;
+  const int differ = DepthsOffTheReferenceMarch(scene, body, spec, &compared);
+  EXPECT_GT(compared, spec.width_px * spec.height_px / 2);
+  EXPECT_EQ(differ, 0) << "of " << compared << " pixels";
+}
+
+// A trial world's patch (MakeWorldScene) with obstacles far taller than the ground's relief, seen
+// from 15 m: most of each ray's march lies above its tile's highest cell (skipped samples), and
+// every left pixel's truth depth is still the reference march's.
+TEST(StereoRenderer, TruthDepthOverAWorldPatchIsTheReferenceMarchsToTheBit) {
+  WorldConfig world;
+  world.terrain = Terrain{TerrainKind::kRubble, 0.0};
+  world.obstacles.push_back({"wall", {0, 6, 4}, {20, 1, 8}, 0.2, ObstacleKind::kBox});
+  world.obstacles.push_back({"block", {-4, -3, 6}, {4, 4, 12}, 0.7, ObstacleKind::kBox});
+  const StereoScene scene = MakeWorldScene(world, 0, 0, 15, 3);
+  StereoSpec spec;
+  spec.enabled = true;
+  spec.width_px = 160;
+  spec.height_px = 100;
+  Pose body;
+  body.position_m = {1.0, 0.5, 15.0};
+  int compared = 0;
+  const int differ = DepthsOffTheReferenceMarch(scene, body, spec, &compared);
+  EXPECT_EQ(compared, spec.width_px * spec.height_px);  // straight down: every ray meets the ground
+  StereoRenderer renderer(&scene);
+  StereoFrame frame;
+  renderer.Render(body, spec, 1, &frame);
+  const int on_obstacles = cv::countNonZero(frame.depth_truth_m < 12.0f);  // the wall's or the block's top
+  EXPECT_EQ(differ, 0) << "of " << spec.width_px * spec.height_px << " pixels";
+  EXPECT_GT(on_obstacles, 100);
 }
 
 // The march's empty-space jumps (over tiles whose highest cell is far below the ray) over tall
