@@ -10,6 +10,7 @@
 // figure):
 //   suite=swarm drones=100 agents=101 rtf=... cpu_per_drone=... mem_per_agent_mib=... mission_complete=0|1
 //   mission_s=... msgs_per_drone_s=... lost=0 start_s=... exit_s=... (then joined, physics_cpu,
+//   flying_cpu_per_drone, start_cpu_per_agent_s,
 //   mem_agent_max_mib, mem_total_mib, sim_s, wall_s, outcome, load1: the host's 1-minute load
 //   average before the trial, and the trial folder with --keep)
 // --quick: 3 scouts (and the lifter) for 10 simulated s (a ctest smoke test, label e2e: it needs Docker).

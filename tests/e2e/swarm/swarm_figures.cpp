@@ -24,6 +24,51 @@ std::string Fixed(std::optional<double> v, int decimals) {
   return buf;
 }
 
+// The largest simulated time of the lines logged by wall time `wall_s` (events.jsonl is in the
+// order the runner read the lines; a line's t is its component's simulated time).
+double SimTimeBy(const std::vector<std::string>& events, double wall_s) {
+  double t_max = 0;
+  for (const std::string& line : events) {
+    auto doc = yaml::Parse(line, "events.jsonl");
+    if (!doc || !doc->is_mapping()) continue;
+    const std::optional<double> wall = Number(doc->Find("wall_s"));
+    const std::optional<double> t = Number(doc->Find("t"));
+    if (wall && t && *wall <= wall_s) t_max = std::max(t_max, *t);
+  }
+  return t_max;
+}
+
+// The agents' summed CPU time at one sample; nullopt unless every drone is in it.
+std::optional<double> AgentCpuAt(const CgroupSnapshot& sample, const std::vector<std::string>& drones) {
+  double sum = 0;
+  for (const std::string& d : drones) {
+    auto it = sample.containers.find(d);
+    if (it == sample.containers.end()) return std::nullopt;
+    sum += it->second.cpu_s;
+  }
+  return sum;
+}
+
+// flying_cpu_per_drone and start_cpu_per_agent_s (swarm_figures.hpp): between the first sample at
+// or after `start_s` holding every drone and the last one before the first stop.
+void FlyingCpu(const std::vector<std::string>& events, const CgroupSamples& samples,
+               const std::vector<std::string>& drones, double start_s, std::optional<double> first_stop,
+               SwarmFigures* f) {
+  const CgroupSnapshot* first = nullptr;
+  const CgroupSnapshot* last = nullptr;
+  for (const CgroupSnapshot& s : samples) {
+    if (s.wall_s < start_s || (first_stop && s.wall_s > *first_stop) || !AgentCpuAt(s, drones)) continue;
+    if (first == nullptr) first = &s;
+    last = &s;
+  }
+  if (first == nullptr || drones.empty()) return;
+  const double cpu_first = *AgentCpuAt(*first, drones);
+  f->start_cpu_per_agent_s = cpu_first / static_cast<double>(drones.size());
+  const double sim_span_s = SimTimeBy(events, last->wall_s) - SimTimeBy(events, first->wall_s);
+  if (last == first || sim_span_s <= 0) return;
+  f->flying_cpu_per_drone = (*AgentCpuAt(*last, drones) - cpu_first) / (static_cast<double>(drones.size()) * sim_span_s);
+}
+
 }  // namespace
 
 TrialSummary ParseResultJson(std::string_view json) {
@@ -91,9 +136,9 @@ SwarmFigures ComputeSwarmFigures(const TrialSummary& result, const std::vector<s
 
   // CPU: each container's last cumulative figure; memory: each one's peak, and the largest total.
   std::map<std::string, CgroupSample> last;
-  for (const auto& sample : samples) {
+  for (const CgroupSnapshot& sample : samples) {
     double total = 0;
-    for (const auto& [name, s] : sample) {
+    for (const auto& [name, s] : sample.containers) {
       CgroupSample& l = last[name];
       l.cpu_s = std::max(l.cpu_s, s.cpu_s);
       l.mem_peak_mib = std::max({l.mem_peak_mib, s.mem_peak_mib, s.mem_mib});
@@ -116,6 +161,7 @@ SwarmFigures ComputeSwarmFigures(const TrialSummary& result, const std::vector<s
   }
   if (agents > 0) f.mem_per_agent_mib = agent_mem / agents;
   if (f.drones > 0 && result.sim_s > 0) f.cpu_per_drone = agent_cpu / (f.drones * result.sim_s);
+  if (f.start_s) FlyingCpu(events, samples, drones, *f.start_s, first_stop, &f);
   return f;
 }
 
@@ -132,6 +178,8 @@ std::string FormatSwarmLine(const SwarmFigures& f, int scouts) {
   line += " exit_s=" + Fixed(f.exit_s, 1);
   line += " joined=" + std::to_string(f.joined);
   line += " physics_cpu=" + Fixed(f.physics_cpu, 3);
+  line += " flying_cpu_per_drone=" + Fixed(f.flying_cpu_per_drone, 4);
+  line += " start_cpu_per_agent_s=" + Fixed(f.start_cpu_per_agent_s, 2);
   line += " mem_agent_max_mib=" + Fixed(f.mem_agent_max_mib, 1);
   line += " mem_total_mib=" + Fixed(f.mem_total_mib, 0);
   line += " sim_s=" + Fixed(f.sim_s, 1);

@@ -12,7 +12,15 @@
 //   cpu_per_drone       agent CPU per drone per simulated second [cores at real time]: the sum of
 //                       the agents' cgroup CPU time over (drones x simulated seconds); 0.035 means
 //                       a drone needs 3.5 % of a core to fly at rtf 1. physics_cpu is the physics
-//                       server's, on the same scale (cores at real time, the whole world).
+//                       server's, on the same scale (cores at real time, the whole world). It
+//                       counts each container's whole life: its start (loading, discovery, the
+//                       wait for the last drone to join, which grows with the fleet) and its exit.
+//   flying_cpu_per_drone the same between the first sample after simulated time moves (start_s)
+//                       and the last before the first stop, over the simulated time between them
+//                       (the largest t of events.jsonl's lines by then): what a drone costs per
+//                       simulated second in flight, the figure that shows whether per-drone work
+//                       grows with the fleet ("-" without two such samples)
+//   start_cpu_per_agent_s the mean agent's CPU time [s] before simulated time moved (that sample)
 //   mem_per_agent_mib   the mean over agents of each agent container's peak memory (cgroup v1
 //                       memory.max_usage_in_bytes: RSS and page cache) [MiB]; mem_agent_max_mib the
 //                       largest; mem_total_mib the largest sum over all containers at one sample
@@ -43,8 +51,15 @@ struct CgroupSample {
   double mem_peak_mib = 0;   // peak usage so far [MiB] (memory.max_usage_in_bytes)
 };
 
-// Samples over the trial: per sample, per component name ("physics", "scout_1", ...).
-using CgroupSamples = std::vector<std::map<std::string, CgroupSample>>;
+// One sample of every container, taken `wall_s` after the run's start (the clock of events.jsonl's
+// wall_s, within the sampler's period).
+struct CgroupSnapshot {
+  double wall_s = 0;
+  std::map<std::string, CgroupSample> containers;  // by component name ("physics", "scout_1", ...)
+};
+
+// Samples over the trial, in time order.
+using CgroupSamples = std::vector<CgroupSnapshot>;
 
 // What result.json says that the figures need.
 struct TrialSummary {
@@ -61,6 +76,8 @@ struct SwarmFigures {
   int drones = 0;  // agents: every drone of the trial
   std::optional<double> rtf;
   double cpu_per_drone = 0;
+  std::optional<double> flying_cpu_per_drone;
+  std::optional<double> start_cpu_per_agent_s;
   double physics_cpu = 0;
   double mem_per_agent_mib = 0;
   double mem_agent_max_mib = 0;

@@ -101,25 +101,29 @@ class CgroupSampler {
     std::unique_lock<std::mutex> lk(mu_);
     while (!stop_) {
       lk.unlock();
-      std::map<std::string, CgroupSample> sample;
+      CgroupSnapshot sample;
+      sample.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
       if (auto list = (*client)->ListContainers(run, /*all=*/false)) {
         for (const docker::ContainerSummary& c : *list) {
           auto name = c.labels.find(std::string(docker::kLabelComponent));
           if (name == c.labels.end()) continue;
           if (auto s = ReadCgroup(c.id)) {
-            sample[name->second] = *s;
+            sample.containers[name->second] = *s;
             read_.insert(name->second);
           }
         }
       }
       lk.lock();
-      if (!sample.empty()) samples_.push_back(std::move(sample));
+      if (!sample.containers.empty()) samples_.push_back(std::move(sample));
       cv_.wait_for(lk, every_, [this] { return stop_; });
     }
   }
 
   std::string run_id_;
   std::chrono::milliseconds every_;
+  // The samples' wall_s origin: made just before the runner's own start (events.jsonl's wall_s 0,
+  // which comes after the trial folder is prepared: tens of ms later, well within `every_`).
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
   std::mutex mu_;
   std::condition_variable cv_;
   bool stop_ = false;
