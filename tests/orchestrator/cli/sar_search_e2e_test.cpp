@@ -15,6 +15,7 @@
 
 #include <unistd.h>
 
+#include <deque>
 #include <filesystem>
 #include <iostream>
 #include <set>
@@ -58,8 +59,36 @@ class TrialRun : public ::testing::Test {
       run.equals[std::string(docker::kLabelRun)] = run_id_;
       (void)docker::RemoveLabelled(*api_, run, /*include_images=*/false);
     }
+    // A failed trial's folder stays for whoever reads the log (its path is printed); `swarmbox gc`
+    // does not own it, the next run of the test in the same process id replaces it.
+    if (HasFailure()) {
+      std::cout << "kept the failed trial's folder: " << dir_.string() << "\n";
+      return;
+    }
     fs::remove_all(dir_);
   }
+
+  // The last `n` lines of events.jsonl without the periodic ones (battery, link, flock_metrics:
+  // most of a long run's lines), all of them when fewer ("" when unreadable).
+  static std::string LastLines(const std::string& path, std::size_t n) {
+    std::istringstream in(ReadWholeFile(path));
+    std::deque<std::string> tail;
+    for (std::string line; std::getline(in, line);) {
+      if (line.find("\"event\":\"battery\"") != std::string::npos || line.find("\"event\":\"link\"") != std::string::npos ||
+          line.find("\"event\":\"flock_metrics\"") != std::string::npos) {
+        continue;
+      }
+      tail.push_back(line);
+      if (tail.size() > n) tail.pop_front();
+    }
+    std::string out;
+    for (const std::string& line : tail) out += line + "\n";
+    return out;
+  }
+
+  // On a failed outcome, enough of the run's events to see which step of the mission stalled
+  // (a flaky end-to-end run on a loaded CI host is otherwise gone with its folder).
+  static constexpr std::size_t kEventLinesOnFailure = 80;
 
   // Runs the trial to its end (a hang guard only) and checks the CLI contract: exit 0, outcome
   // success. Returns the trial folder.
@@ -76,7 +105,8 @@ class TrialRun : public ::testing::Test {
     EXPECT_TRUE(result) << result.error().ToString();
     if (result && result->Find("outcome") != nullptr) {
       EXPECT_EQ(result->Find("outcome")->scalar(), "success")
-          << ReadWholeFile((trial_dir / "result.json").string());
+          << ReadWholeFile((trial_dir / "result.json").string()) << "\nthe last lines of events.jsonl:\n"
+          << LastLines((trial_dir / "events.jsonl").string(), kEventLinesOnFailure);
     } else {
       ADD_FAILURE() << "no outcome in result.json";
     }
