@@ -40,6 +40,7 @@
 
 #include "swarmbox/bus/messages.hpp"
 #include "swarmbox/depth/ground_plane.hpp"
+#include "swarmbox/depth/stereo_matcher.hpp"
 
 namespace swarmbox::depth {
 
@@ -47,9 +48,7 @@ struct ClearanceConfig {
   // Horizontal distance from the camera's nadir [m]: the x500 (0.62 m across) plus its position
   // error and the flocking's sideways motion, and 1 s of cruise (5 m/s) ahead: 5 m.
   double radius_m = 5.0;
-  // Depth beyond this is ignored [m]: the OAK-D Pro's projector reaches 15 m, and SGBM's median
-  // error there is already 1.3 m (2.9 m at 20 m: BENCHMARKS.md "stereo").
-  double max_range_m = 15.0;
+  double max_range_m = kTrustedDepthRangeM;  // depth beyond this is ignored [m] (stereo_matcher.hpp)
   // Pixels inside the radius and the range for a valid answer: ~0.6 x 0.6 m seen at 15 m
   // (3.4 cm a pixel); fewer is SGBM's scattered false matches on ground beyond the range.
   int min_points = 400;

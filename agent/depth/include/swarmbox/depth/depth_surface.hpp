@@ -34,6 +34,7 @@
 
 #include "swarmbox/bus/messages.hpp"
 #include "swarmbox/depth/ground_plane.hpp"
+#include "swarmbox/depth/stereo_matcher.hpp"
 
 namespace swarmbox::depth {
 
@@ -41,9 +42,7 @@ struct DepthSurfaceConfig {
   // The grid's cell [m]: ~30 pixels at 8 m and ~8 at 15 m (f = 441 px); a person lying down covers
   // a few cells, so a height near them is theirs or the surface they lie on.
   double cell_m = 0.25;
-  // Depth beyond this is ignored [m]: the OAK-D Pro's projector reaches 15 m, and SGBM's median
-  // error there is already 1.3 m (2.9 m at 20 m: BENCHMARKS.md "stereo").
-  double max_range_m = 15.0;
+  double max_range_m = kTrustedDepthRangeM;  // depth beyond this is ignored [m] (stereo_matcher.hpp)
   // A cell's median counts with this many points (as ChooseDropSpot's and ClearanceBelow's).
   int min_cell_points = 4;
   // HeightNear answers with at least this many seen cells in its circle: one or two cells may be a

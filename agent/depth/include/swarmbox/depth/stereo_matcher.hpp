@@ -17,6 +17,11 @@
 
 namespace swarmbox::depth {
 
+// The depth range the agent trusts from the pair [m]: the OAK-D Pro's projector reaches 15 m, and
+// SGBM's median error there is already 1.3 m (2.9 m at 20 m: BENCHMARKS.md "stereo").
+// ClearanceConfig and DepthSurfaceConfig ignore depth beyond it.
+inline constexpr double kTrustedDepthRangeM = 15.0;
+
 // cv::StereoSGBM parameters (OpenCV's names). P1/P2 are 8 and 32 x block_size^2 (OpenCV's
 // suggested values for one channel).
 struct MatchConfig {
