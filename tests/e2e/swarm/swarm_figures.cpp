@@ -66,7 +66,8 @@ void FlyingCpu(const std::vector<std::string>& events, const CgroupSamples& samp
   f->start_cpu_per_agent_s = cpu_first / static_cast<double>(drones.size());
   const double sim_span_s = SimTimeBy(events, last->wall_s) - SimTimeBy(events, first->wall_s);
   if (last == first || sim_span_s <= 0) return;
-  f->flying_cpu_per_drone = (*AgentCpuAt(*last, drones) - cpu_first) / (static_cast<double>(drones.size()) * sim_span_s);
+  const double agents = static_cast<double>(drones.size());
+  f->flying_cpu_per_drone = (*AgentCpuAt(*last, drones) - cpu_first) / (agents * sim_span_s);
 }
 
 }  // namespace

@@ -34,10 +34,16 @@ TEST(SwarmFigures, EachFigureAsDefined) {
   r.rtf_achieved = 1.1;
   r.mission_time_s = 19.5;
   CgroupSamples samples = {
-      {3.0, {{"physics", {1.0, 50, 50}}, {"scout_1", {0.2, 8, 9}}, {"scout_2", {0.3, 9, 9}}, {"lifter", {0.1, 10, 10}}}},
-      {10.0, {{"physics", {2.0, 55, 60}}, {"scout_1", {0.4, 8, 10}}, {"scout_2", {0.5, 9, 9}}, {"lifter", {0.2, 10, 10}}}},
-      {20.0, {{"physics", {4.0, 60, 70}}, {"scout_1", {0.6, 9, 12}}, {"scout_2", {0.8, 10, 10}}, {"lifter", {0.4, 10, 11}},
-              {"scout_1-brain", {9.0, 99, 99}}}},
+      {3.0,
+       {{"physics", {1.0, 50, 50}}, {"scout_1", {0.2, 8, 9}}, {"scout_2", {0.3, 9, 9}}, {"lifter", {0.1, 10, 10}}}},
+      {10.0,
+       {{"physics", {2.0, 55, 60}}, {"scout_1", {0.4, 8, 10}}, {"scout_2", {0.5, 9, 9}}, {"lifter", {0.2, 10, 10}}}},
+      {20.0,
+       {{"physics", {4.0, 60, 70}},
+        {"scout_1", {0.6, 9, 12}},
+        {"scout_2", {0.8, 10, 10}},
+        {"lifter", {0.4, 10, 11}},
+        {"scout_1-brain", {9.0, 99, 99}}}},
   };
   const SwarmFigures f = ComputeSwarmFigures(r, kEvents, samples, kDrones);
   EXPECT_EQ(f.drones, 3);
@@ -61,7 +67,8 @@ TEST(SwarmFigures, EachFigureAsDefined) {
   EXPECT_EQ(FormatSwarmLine(f, 2),
             "drones=2 agents=3 rtf=1.10 cpu_per_drone=0.0300 mem_per_agent_mib=11.0 mission_complete=1 "
             "mission_s=19.5 msgs_per_drone_s=11.0 lost=1 start_s=5.5 exit_s=3.0 joined=3 physics_cpu=0.200 "
-            "flying_cpu_per_drone=0.0233 start_cpu_per_agent_s=0.37 mem_agent_max_mib=12.0 mem_total_mib=188 sim_s=20.0 wall_s=24.0 outcome=success");
+            "flying_cpu_per_drone=0.0233 start_cpu_per_agent_s=0.37 mem_agent_max_mib=12.0 mem_total_mib=188 "
+            "sim_s=20.0 wall_s=24.0 outcome=success");
 }
 
 TEST(SwarmFigures, NoFlyingFigureWithoutTwoSamplesOfEveryDroneInFlight) {
@@ -75,7 +82,8 @@ TEST(SwarmFigures, NoFlyingFigureWithoutTwoSamplesOfEveryDroneInFlight) {
   SwarmFigures f = ComputeSwarmFigures(r, kEvents, samples, kDrones);
   EXPECT_FALSE(f.flying_cpu_per_drone);
   EXPECT_FALSE(f.start_cpu_per_agent_s);
-  EXPECT_NE(FormatSwarmLine(f, 2).find(" flying_cpu_per_drone=- start_cpu_per_agent_s=- "), std::string::npos);
+  EXPECT_NE(FormatSwarmLine(f, 2).find(" flying_cpu_per_drone=- start_cpu_per_agent_s=- "),
+            std::string::npos);
   // One sample of every drone in flight: the start figure, no rate.
   samples.push_back({15.0, {{"scout_1", {0.6, 8, 9}}, {"scout_2", {0.7, 9, 9}}, {"lifter", {0.5, 10, 10}}}});
   f = ComputeSwarmFigures(r, kEvents, samples, kDrones);

@@ -74,10 +74,10 @@ class TrialRun : public ::testing::Test {
     std::istringstream in(ReadWholeFile(path));
     std::deque<std::string> tail;
     for (std::string line; std::getline(in, line);) {
-      if (line.find("\"event\":\"battery\"") != std::string::npos || line.find("\"event\":\"link\"") != std::string::npos ||
-          line.find("\"event\":\"flock_metrics\"") != std::string::npos) {
-        continue;
-      }
+      const bool periodic = line.find("\"event\":\"battery\"") != std::string::npos ||
+                            line.find("\"event\":\"link\"") != std::string::npos ||
+                            line.find("\"event\":\"flock_metrics\"") != std::string::npos;
+      if (periodic) continue;
       tail.push_back(line);
       if (tail.size() > n) tail.pop_front();
     }
