@@ -31,6 +31,8 @@
 // filters and the forest still allocate internal buffers per frame (allocation_test.cpp). Frames
 // come at 5 Hz, outside the control loop. A model with blob features adds them per candidate
 // (0.25 ms of CPU each measured at load ~9: BENCHMARKS.md "Blob features for the second stage").
+// A model with a CNN costs ~52 ms per frame at 30 m with 96 candidates on a quiet machine, 3.4
+// times the forest (BENCHMARKS.md "A CNN second stage"); cv::dnn allocates its buffers per forward.
 #pragma once
 
 #include <memory>
