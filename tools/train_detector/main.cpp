@@ -11,7 +11,10 @@
 //   --negatives-sets N (cones-and-rubble sets 7200001..7200000+N), --calibration-altitude M
 //   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there), --max-candidates N
 //   (the first stage's cap while calibrating and mining), --operating-precision P (probability 0.5
-//   where the calibration detections reach precision P)
+//   where the calibration detections reach precision P), --export-patches FILE (the CNN's patches,
+//   train_detector.hpp), --cnn SCRIPT (a CNN second stage trained by SCRIPT, train_cnn.py, with
+//   --python PY, its ONNX at --cnn-onnx FILE (default DIR/victim_detector_cnn.onnx; the patches
+//   beside it unless --export-patches), --cnn-epochs N, --cnn-seed N)
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -72,6 +75,12 @@ constexpr Flag kFlags[] = {
      [](const char* v, Args* a) { a->options.operating_precision = std::stod(v); return true; }},
     {"--calibration-altitude", true,
      [](const char* v, Args* a) { a->options.calibration_altitude_m = std::stod(v); return true; }},
+    {"--export-patches", true, [](const char* v, Args* a) { a->options.export_patches = v; return true; }},
+    {"--cnn", true, [](const char* v, Args* a) { a->options.cnn_script = v; return true; }},
+    {"--python", true, [](const char* v, Args* a) { a->options.python = v; return true; }},
+    {"--cnn-onnx", true, [](const char* v, Args* a) { a->options.cnn_onnx_out = v; return true; }},
+    {"--cnn-epochs", true, [](const char* v, Args* a) { a->options.cnn_epochs = std::stoi(v); return true; }},
+    {"--cnn-seed", true, [](const char* v, Args* a) { a->options.cnn_seed = std::stoi(v); return true; }},
 };
 
 // The flag named `a` when it is complete at argv[i] (its value, if it takes one, follows).
@@ -91,7 +100,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
                    "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] "
-                   "[--calibration-altitude M] [--max-candidates N] [--operating-precision P]\n");
+                   "[--calibration-altitude M] [--max-candidates N] [--operating-precision P] [--export-patches FILE] "
+                   "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N]]\n");
       return kUsageError;
     }
     const char* value = flag->takes_value ? argv[++i] : nullptr;
@@ -101,6 +111,7 @@ int ParseArgs(int argc, char** argv, Args* args) {
     std::fprintf(stderr, "swarmbox-train-detector: --out-dir is required\n");
     return kUsageError;
   }
+  if (args->options.cnn_onnx_out.empty()) args->options.cnn_onnx_out = args->out_dir + "/victim_detector_cnn.onnx";
   return kContinue;
 }
 

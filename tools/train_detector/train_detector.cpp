@@ -10,12 +10,22 @@
 #include <set>
 #include <sstream>
 
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <cstring>
+#include <fstream>
+
 #include <opencv2/core.hpp>
+#include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "swarmbox/swarm/blob_features.hpp"
+#include "swarmbox/swarm/candidate_patch.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
 #include "swarmbox/swarm/victim_detector.hpp"
+
+extern char** environ;
 
 namespace swarmbox::train_detector {
 namespace {
@@ -317,6 +327,7 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
+  if (!o.cnn_script.empty()) r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed;
   return r.str();
 }
 
@@ -560,11 +571,12 @@ namespace {
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
       o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
-      o.negatives_sets < 0 || o.calibration_altitude_m < 0) {
+      o.negatives_sets < 0 || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
+      (!o.cnn_script.empty() && o.cnn_onnx_out.empty())) {
     return Error(ErrorCode::kInvalidArgument,
                  "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
                  "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets and "
-                 "calibration_altitude_m >= 0");
+                 "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path");
   }
   const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
   for (const auto* list : {&o.training_seeds, &o.calibration_seeds, &negatives_seeds}) {
@@ -812,6 +824,147 @@ Status CheckFlattenedForest(const Training& t, Labelled& s2) {
   return Ok{};
 }
 
+// The patch file (train_detector.hpp, kPatchFileMagic): records streamed out, the count written
+// into the header by Close().
+class PatchWriter {
+ public:
+  Status Open(const std::string& path) {
+    path_ = path;
+    out_.open(path, std::ios::binary | std::ios::trunc);
+    if (!out_) return Error(ErrorCode::kIo, "train-detector: cannot write the patch file", path);
+    const std::uint32_t header[3] = {kPatchFileVersion, static_cast<std::uint32_t>(swarm::kCnnPatchPx), 3};
+    const auto px_per_m = static_cast<float>(swarm::kCnnPxPerM);
+    const std::uint64_t count = 0;  // Close() writes the count here
+    out_.write(kPatchFileMagic, sizeof(kPatchFileMagic));
+    out_.write(reinterpret_cast<const char*>(header), sizeof(header));
+    out_.write(reinterpret_cast<const char*>(&px_per_m), sizeof(px_per_m));
+    out_.write(reinterpret_cast<const char*>(&count), sizeof(count));
+    return Ok{};
+  }
+  void Add(const cv::Mat& patch, int label, PatchSplit split) {
+    SWARMBOX_CHECK(patch.type() == CV_8UC3 && patch.isContinuous() && patch.rows == swarm::kCnnPatchPx &&
+                   patch.cols == swarm::kCnnPatchPx);
+    const char record[2] = {static_cast<char>(label), static_cast<char>(split)};
+    out_.write(record, sizeof(record));
+    out_.write(reinterpret_cast<const char*>(patch.data), static_cast<std::streamsize>(patch.total() * patch.elemSize()));
+    ++count_;
+    ++(split == PatchSplit::kTraining ? training_ : calibration_)[label ? 1 : 0];
+  }
+  Status Close() {
+    constexpr std::streamoff kCountOffset = sizeof(kPatchFileMagic) + 4 * sizeof(std::uint32_t);
+    out_.seekp(kCountOffset);
+    out_.write(reinterpret_cast<const char*>(&count_), sizeof(count_));
+    out_.close();
+    if (!out_) return Error(ErrorCode::kIo, "train-detector: writing the patch file failed", path_);
+    std::fprintf(stderr, "train-detector: %llu patches: training %d persons, %d not; calibration %d persons, %d not\n",
+                 static_cast<unsigned long long>(count_), training_[1], training_[0], calibration_[1], calibration_[0]);
+    return Ok{};
+  }
+
+ private:
+  std::ofstream out_;
+  std::string path_;
+  std::uint64_t count_ = 0;
+  int training_[2] = {0, 0};  // [no person, person]
+  int calibration_[2] = {0, 0};
+};
+
+// One scene's patches: its first-stage local maxima (the best kStage2CandidatesPerScene, any score)
+// labelled as the forest's samples are, and on training frames each must-detect person's own centre
+// as a positive too (the first stage's centred positives).
+void AddScenePatches(swarm::VictimDetector& det, const Scene& s, PatchSplit split, PatchWriter* w) {
+  const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+  cv::Mat patch;
+  for (const auto& c : det.Candidates(BgrOf(s), ppm, kStage2CandidatesPerScene, -1e30)) {
+    const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_col,
+                                 swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_row);
+    const auto [dist, must] = NearestPerson(s, scale, centre);
+    const int label = dist <= kPositiveRadiusM && must ? 1 : dist >= kNegativeRadiusM ? 0 : -1;
+    if (label < 0) continue;
+    det.CnnPatch(c, &patch);
+    w->Add(patch, label, split);
+  }
+  if (split != PatchSplit::kTraining) return;
+  swarm::CandidatePatchSampler sampler;
+  sampler.SetFrame(BgrOf(s), ppm);
+  for (const SceneVictim& v : s.victims) {
+    const std::optional<Eigen::Vector2d> px =
+        swarm::ProjectToPixel(Eigen::Vector3d(v.position_m.x(), v.position_m.y(), 0.0), s.intrinsics, s.true_pose);
+    if (v.visible_fraction < kMustDetectFraction || !px) continue;
+    sampler.Extract(*px, &patch);
+    w->Add(patch, 1, split);
+  }
+}
+
+// The CNN's patches of the training and calibration frames into `path`, with the first stage of
+// t.model.
+Status ExportPatches(const Training& t, const std::vector<Scene>& train, const std::vector<Scene>& cal,
+                     const std::string& path) {
+  auto shared = std::make_shared<swarm::VictimDetectorModel>(t.model);
+  swarm::VictimDetector det(shared, {});
+  PatchWriter w;
+  SWARMBOX_TRY(w.Open(path));
+  for (const Scene& s : train) AddScenePatches(det, s, PatchSplit::kTraining, &w);
+  for (const Scene& s : cal) AddScenePatches(det, s, PatchSplit::kCalibration, &w);
+  SWARMBOX_TRY(w.Close());
+  std::fprintf(stderr, "train-detector: wrote %s (%.0f s)\n", path.c_str(), Seconds(t.t0));
+  return Ok{};
+}
+
+// Runs the CNN training script (argv, no shell) and waits for it.
+Status RunCnnScript(const TrainingOptions& o, const std::string& patches, const std::string& onnx) {
+  std::vector<std::string> args = {o.python, o.cnn_script, "--patches", patches, "--out", onnx,
+                                   "--seed", std::to_string(o.cnn_seed), "--epochs", std::to_string(o.cnn_epochs)};
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string install = " (python3-torch: scripts/setup_training.sh installs it)";
+  pid_t pid = 0;
+  if (const int rc = posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ); rc != 0) {
+    return Error(ErrorCode::kNotFound, "train-detector: cannot run " + o.python + ": " + std::strerror(rc) + install);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    return Error(ErrorCode::kInternal, "train-detector: " + o.cnn_script + " failed" + install);
+  }
+  return Ok{};
+}
+
+// The CNN second stage: patches exported, the script run, its ONNX into the model (checked to load
+// in cv::dnn); the forest dropped.
+Status TrainCnnStage(Training& t, const std::vector<Scene>& train, const std::vector<Scene>& cal) {
+  const std::string patches = t.o.export_patches.empty() ? t.o.cnn_onnx_out + ".patches" : t.o.export_patches;
+  SWARMBOX_TRY(ExportPatches(t, train, cal, patches));
+  SWARMBOX_TRY(RunCnnScript(t.o, patches, t.o.cnn_onnx_out));
+  std::ifstream in(t.o.cnn_onnx_out, std::ios::binary | std::ios::ate);
+  t.model.cnn_onnx.resize(in ? static_cast<std::size_t>(in.tellg()) : 0);
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(t.model.cnn_onnx.data()), static_cast<std::streamsize>(t.model.cnn_onnx.size()));
+  if (!in) t.model.cnn_onnx.clear();
+  if (t.model.cnn_onnx.empty()) return Error(ErrorCode::kIo, "train-detector: no ONNX from the script", t.o.cnn_onnx_out);
+  try {
+    if (cv::dnn::readNetFromONNX(t.o.cnn_onnx_out).empty()) throw cv::Exception();
+  } catch (const cv::Exception& e) {
+    return Error(ErrorCode::kInvalidArgument, std::string("train-detector: cv::dnn cannot read the CNN: ") + e.what(),
+                 t.o.cnn_onnx_out);
+  }
+  t.model.forest.release();
+  std::fprintf(stderr, "train-detector: CNN of %zu bytes (%.0f s)\n", t.model.cnn_onnx.size(), Seconds(t.t0));
+  return Ok{};
+}
+
+// The forest second stage (the shipped recipe): samples, forest, hard-negative rounds, check.
+Status TrainForestStage(Training& t, const std::vector<Scene>& train, Labelled& s2) {
+  SWARMBOX_TRY(CollectStage2(t, train, &s2));
+  SWARMBOX_TRY(TrainModelForest(t, s2));
+  // Hard negatives, hard_negative_rounds times, each followed by the forest trained again.
+  for (int round = 0; round < t.o.hard_negative_rounds; ++round) {
+    MineHardNegatives(t, train, round, &s2);
+    SWARMBOX_TRY(TrainModelForest(t, s2));
+  }
+  return CheckFlattenedForest(t, s2);
+}
+
 }  // namespace
 
 Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingReport* report) {
@@ -832,14 +985,12 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
                report->training_scenes, report->calibration_scenes, Seconds(t0));
   Training t{.o = o, .report = report, .t0 = t0};
   Labelled s2 = TrainStage1(t, *train);
-  SWARMBOX_TRY(CollectStage2(t, *train, &s2));
-  SWARMBOX_TRY(TrainModelForest(t, s2));
-  // Hard negatives, hard_negative_rounds times, each followed by the forest trained again.
-  for (int round = 0; round < o.hard_negative_rounds; ++round) {
-    MineHardNegatives(t, *train, round, &s2);
-    SWARMBOX_TRY(TrainModelForest(t, s2));
+  if (!o.cnn_script.empty()) {
+    SWARMBOX_TRY(TrainCnnStage(t, *train, *cal));
+  } else {
+    if (!o.export_patches.empty()) SWARMBOX_TRY(ExportPatches(t, *train, *cal, o.export_patches));
+    SWARMBOX_TRY(TrainForestStage(t, *train, s2));
   }
-  SWARMBOX_TRY(CheckFlattenedForest(t, s2));
   if (Status st = Calibrate(*cal, o, &t.model, report); !st) return st.error();
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t.model;
@@ -858,6 +1009,8 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
     << (model.blob_features > 0 ? " on the window, the first-stage score and " + std::to_string(model.blob_features) +
                                       " blob features (size, shape, parts, edge orientations; 16 px/m)"
                                 : std::string())
+    << (model.has_cnn() ? " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn (train_cnn.py)"
+                        : std::string())
     << ", Platt sigmoid\",\n";
   j << "  \"recipe\": \"" << model.recipe << "\",\n";
   j << "  \"training_seeds\": ";

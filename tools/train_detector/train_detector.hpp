@@ -69,7 +69,30 @@ struct TrainingOptions {
   // altitude, so that the sigmoid is fitted where the detector is used; 0: the training sets'
   // mixed altitudes (8-65 m, the shipped recipe).
   double calibration_altitude_m = 0;
+  // When not empty: the second stage's samples (candidates labelled as for the forest, and each
+  // must-detect person's own centre as a positive) and the calibration frames' candidates are
+  // written to this file as CNN patches (WritePatchFile format below).
+  std::string export_patches;
+  // When not empty: the second stage is a CNN trained by this script (train_cnn.py) on the exported
+  // patches (export_patches, or a file beside cnn_onnx_out), run as `python SCRIPT --patches F
+  // --out ONNX --seed cnn_seed --epochs cnn_epochs`; its ONNX goes into the model (format 3) and
+  // the sigmoid is fitted on its logits. Empty: the forest (the shipped recipe).
+  std::string cnn_script;
+  std::string python = "python3";  // the interpreter with torch (Debian: /usr/bin/python3)
+  std::string cnn_onnx_out;        // where the script writes the ONNX (default: beside the patches)
+  int cnn_epochs = 6;
+  int cnn_seed = 1;
 };
+
+// The patch file (--export-patches), little-endian:
+//   header  8 bytes "SWBPATCH", uint32 version (1), uint32 patch_px, uint32 channels (3),
+//           float32 px_per_m, uint64 count
+//   records count times: int8 label (1 person, 0 no person), uint8 split (0 training,
+//           1 calibration), then patch_px * patch_px * 3 uint8 (rows, columns, BGR)
+// The patches are swarm::CandidatePatchSampler's (candidate_patch.hpp), what the detector's CNN sees.
+inline constexpr char kPatchFileMagic[8] = {'S', 'W', 'B', 'P', 'A', 'T', 'C', 'H'};
+inline constexpr std::uint32_t kPatchFileVersion = 1;
+enum class PatchSplit : std::uint8_t { kTraining = 0, kCalibration = 1 };
 
 // The cones-and-rubble sets' seeds start above this (disjoint from training, calibration and
 // evaluation seeds).

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 
+#include <opencv2/dnn.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "swarmbox/common/result.hpp"
@@ -55,16 +56,29 @@ void LocalMaxima(const cv::Mat& valid, const cv::Mat& dilated, double threshold,
 // so that the trainer links the detector without a model).
 VictimDetector::VictimDetector(std::shared_ptr<const VictimDetectorModel> model, const VictimDetectorParams& params)
     : model_(std::move(model)), params_(params) {
-  SWARMBOX_CHECK(model_ && model_->forest && static_cast<int>(model_->kernels.size()) == kChannels);
+  SWARMBOX_CHECK(model_ && (model_->forest || model_->has_cnn()) && static_cast<int>(model_->kernels.size()) == kChannels);
   SWARMBOX_CHECK(params_.max_candidates > 0 && params_.nms_radius_m >= 0);
+  if (model_->has_cnn()) {
+    // The bytes were checked when the model was trained and loaded: a network that does not parse
+    // here is a broken build, not a runtime condition.
+    cnn_ = cv::dnn::readNetFromONNX(reinterpret_cast<const char*>(model_->cnn_onnx.data()), model_->cnn_onnx.size());
+    SWARMBOX_CHECK(!cnn_.empty());
+    cnn_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+    cnn_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+  }
   candidates_.reserve(static_cast<std::size_t>(params_.max_candidates) * 4);
   scratch_.reserve(static_cast<std::size_t>(params_.max_candidates));
+  kept_.reserve(static_cast<std::size_t>(params_.max_candidates));
+  scores_.reserve(static_cast<std::size_t>(params_.max_candidates));
 }
 
 const std::vector<VictimDetector::Candidate>& VictimDetector::Candidates(const cv::Mat& bgr, double pixels_per_m,
                                                                          int max_candidates, double threshold) {
   SWARMBOX_CHECK(bgr.type() == CV_8UC3 && pixels_per_m > 0);
   candidates_.clear();
+  frame_ = bgr;
+  frame_px_per_m_ = pixels_per_m;
+  patch_frame_set_ = false;
   scale_ = kCanonicalPxPerM / pixels_per_m;
   ComputeChannels(bgr, scale_, &maps_);
   if (model_->blob_features > 0) blob_.SetFrame(bgr, pixels_per_m);
@@ -97,6 +111,30 @@ void VictimDetector::ForestFeatures(const Candidate& c, float* out) {
   if (model_->blob_features > 0) blob_.Extract(CentrePx(c), out + kForestFeatures);
 }
 
+void VictimDetector::CnnPatch(const Candidate& c, cv::Mat* patch) {
+  SWARMBOX_CHECK(!frame_.empty());
+  if (!patch_frame_set_) {
+    patches_.SetFrame(frame_, frame_px_per_m_);
+    patch_frame_set_ = true;
+  }
+  patches_.Extract(CentrePx(c), patch);
+}
+
+void VictimDetector::CnnScores(const std::vector<Candidate>& cands, const std::vector<int>& kept,
+                               std::vector<double>* scores) {
+  patch_batch_.resize(kept.size());
+  for (std::size_t i = 0; i < kept.size(); ++i) CnnPatch(cands[static_cast<std::size_t>(kept[i])], &patch_batch_[i]);
+  // (pixel - kCnnInputMean) * kCnnInputScale, N x 3 x H x W, BGR as sampled (train_cnn.py reads the
+  // trainer's patches in the same order).
+  cv::dnn::blobFromImages(patch_batch_, cnn_input_, kCnnInputScale, cv::Size(kCnnPatchPx, kCnnPatchPx),
+                          cv::Scalar::all(kCnnInputMean), false, false, CV_32F);
+  cnn_.setInput(cnn_input_);
+  cnn_output_ = cnn_.forward();
+  SWARMBOX_CHECK(cnn_output_.total() == kept.size() && cnn_output_.type() == CV_32F);
+  const float* logits = cnn_output_.ptr<float>();
+  scores->assign(logits, logits + kept.size());
+}
+
 void VictimDetector::Detect(const cv::Mat& bgr, double pixels_per_m, std::vector<ImageBlob>* out) {
   DetectImpl(bgr, pixels_per_m, [](const Eigen::Vector2d&) { return true; }, out);
 }
@@ -120,6 +158,19 @@ void VictimDetector::Detect(const cv::Mat& bgr, const PinholeIntrinsics& k, cons
       [&](const Eigen::Vector2d& px) { return PixelToGround(px, k, pose, ground_z_m).has_value(); }, out);
 }
 
+void VictimDetector::SecondStageScores(const std::vector<Candidate>& cands) {
+  if (model_->has_cnn()) {
+    CnnScores(cands, kept_, &scores_);
+    return;
+  }
+  samples_.resize(static_cast<std::size_t>(model_->forest_inputs()));
+  scores_.clear();
+  for (int i : kept_) {
+    ForestFeatures(cands[static_cast<std::size_t>(i)], samples_.data());
+    scores_.push_back(model_->Votes(samples_.data()));
+  }
+}
+
 template <typename KeepFn>
 void VictimDetector::DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn keep, std::vector<ImageBlob>* out) {
   SWARMBOX_CHECK(bgr.type() == CV_8UC3);
@@ -127,20 +178,23 @@ void VictimDetector::DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn 
   out->clear();
   const std::vector<Candidate>& cands = Candidates(bgr, pixels_per_m, params_.max_candidates, model_->stage1_threshold);
   if (cands.empty()) return;
-  const int n = static_cast<int>(cands.size());
-  samples_.resize(static_cast<std::size_t>(model_->forest_inputs()));
+  kept_.clear();
+  for (std::size_t i = 0; i < cands.size(); ++i) {
+    const Eigen::Vector2d px = CentrePx(cands[i]);
+    if (px.x() < -0.5 || px.y() < -0.5 || px.x() > bgr.cols - 0.5 || px.y() > bgr.rows - 0.5) continue;  // off the image
+    if (keep(px)) kept_.push_back(static_cast<int>(i));
+  }
+  if (kept_.empty()) return;
+  SecondStageScores(cands);
   const double expected_area = params_.person_area_m2 * pixels_per_m * pixels_per_m;
   const double half_px = params_.partial_half_extent_m * pixels_per_m;
   scratch_.clear();
-  for (int i = 0; i < n; ++i) {
-    const Candidate& c = cands[static_cast<std::size_t>(i)];
+  for (std::size_t k = 0; k < kept_.size(); ++k) {
+    const Candidate& c = cands[static_cast<std::size_t>(kept_[k])];
     ImageBlob b;
     b.centroid_px = CentrePx(c);
     const double u = b.centroid_px.x(), v = b.centroid_px.y();
-    if (u < -0.5 || v < -0.5 || u > bgr.cols - 0.5 || v > bgr.rows - 0.5) continue;  // centre off the image
-    if (!keep(b.centroid_px)) continue;
-    ForestFeatures(c, samples_.data());
-    b.votes = model_->Votes(samples_.data());
+    b.votes = scores_[k];
     b.confidence = model_->Probability(b.votes);
     if (b.confidence < params_.min_confidence) continue;
     b.linear_score = c.score;

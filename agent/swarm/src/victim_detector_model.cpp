@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "swarmbox/swarm/blob_features.hpp"
+#include "swarmbox/swarm/candidate_patch.hpp"
 
 namespace swarmbox::swarm {
 namespace {
@@ -17,6 +18,8 @@ constexpr int kCellsPerWindow = kWindowCells * kWindowCells;
 // 2: the blob features after the window features and score (blob_features), and the recipe.
 constexpr int kFormatVersion = 2;
 constexpr int kWindowOnlyFormatVersion = 1;
+// 3: a convolutional second stage (cnn_onnx, its patch layout) in place of the forest.
+constexpr int kCnnFormatVersion = 3;
 
 }  // namespace
 
@@ -153,15 +156,34 @@ double VictimDetectorModel::Probability(double votes) const {
   return 1.0 / (1.0 + std::exp(platt_a * votes + platt_b));
 }
 
+namespace {
+
+// The second stage into fs: the forest, or the CNN's ONNX bytes and its patch layout.
+void WriteSecondStage(const VictimDetectorModel& model, cv::FileStorage& fs) {
+  if (model.has_cnn()) {
+    fs << "cnn_patch_px" << kCnnPatchPx << "cnn_patch_m" << kCnnPatchM << "cnn_input_mean" << kCnnInputMean
+       << "cnn_input_scale" << kCnnInputScale;
+    fs << "cnn_onnx" << cv::Mat(1, static_cast<int>(model.cnn_onnx.size()), CV_8U,
+                                const_cast<std::uint8_t*>(model.cnn_onnx.data()));
+    return;
+  }
+  fs << "forest" << "{";
+  model.forest->write(fs);
+  fs << "}";
+}
+
+}  // namespace
+
 Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& path) {
-  SWARMBOX_CHECK(model.forest && static_cast<int>(model.kernels.size()) == kChannels);
+  SWARMBOX_CHECK((model.forest || model.has_cnn()) && static_cast<int>(model.kernels.size()) == kChannels);
   try {
     cv::FileStorage fs(path, cv::FileStorage::WRITE);
     if (!fs.isOpened()) return Error(ErrorCode::kIo, "cannot write the detector model", path);
     // A window-only model keeps format 1's layout, so the default training step still writes the
     // shipped file (agent/swarm/models) as before the blob features.
-    const bool blob = model.blob_features != 0;
-    fs << "format_version" << (blob ? kFormatVersion : kWindowOnlyFormatVersion);
+    const bool blob = model.blob_features != 0 || model.has_cnn();
+    fs << "format_version"
+       << (model.has_cnn() ? kCnnFormatVersion : model.blob_features != 0 ? kFormatVersion : kWindowOnlyFormatVersion);
     fs << "canonical_px_per_m" << kCanonicalPxPerM << "shrink" << kShrink << "window_cells" << kWindowCells
        << "channels" << kChannels;
     fs << "bias" << model.bias << "stage1_threshold" << model.stage1_threshold;
@@ -173,9 +195,7 @@ Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& pa
     fs << "kernels" << "[";
     for (const cv::Mat& k : model.kernels) fs << k;
     fs << "]";
-    fs << "forest" << "{";
-    model.forest->write(fs);
-    fs << "}";
+    WriteSecondStage(model, fs);
   } catch (const cv::Exception& e) {
     return Error(ErrorCode::kIo, std::string("writing the detector model: ") + e.what(), path);
   }
@@ -188,7 +208,7 @@ namespace {
 // or the reason it is not this build's.
 Status ReadLayout(cv::FileStorage& fs, const std::string& where, VictimDetectorModel* m) {
   const int version = static_cast<int>(fs["format_version"]);
-  if ((version != kFormatVersion && version != kWindowOnlyFormatVersion) ||
+  if ((version != kFormatVersion && version != kWindowOnlyFormatVersion && version != kCnnFormatVersion) ||
       static_cast<double>(fs["canonical_px_per_m"]) != kCanonicalPxPerM ||
       static_cast<int>(fs["shrink"]) != kShrink || static_cast<int>(fs["window_cells"]) != kWindowCells ||
       static_cast<int>(fs["channels"]) != kChannels) {
@@ -196,7 +216,14 @@ Status ReadLayout(cv::FileStorage& fs, const std::string& where, VictimDetectorM
                  "detector model: another format or feature layout than this build (retrain: target train-detector)",
                  where);
   }
-  if (version == kFormatVersion) {
+  if (version == kCnnFormatVersion &&
+      (static_cast<int>(fs["cnn_patch_px"]) != kCnnPatchPx || static_cast<double>(fs["cnn_patch_m"]) != kCnnPatchM ||
+       static_cast<double>(fs["cnn_input_mean"]) != kCnnInputMean ||
+       static_cast<double>(fs["cnn_input_scale"]) != kCnnInputScale)) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "detector model: another CNN patch layout than this build (retrain: target train-detector)", where);
+  }
+  if (version == kFormatVersion || version == kCnnFormatVersion) {
     m->blob_features = static_cast<int>(fs["blob_features"]);
     m->recipe = static_cast<std::string>(fs["recipe"]);
   }
@@ -224,6 +251,26 @@ Status ReadKernels(cv::FileStorage& fs, const std::string& where, VictimDetector
   return Ok{};
 }
 
+// The forest (flattened), or the CNN's ONNX bytes when the file has them, into *m.
+Status ReadSecondStage(cv::FileStorage& fs, const std::string& where, VictimDetectorModel* m) {
+  if (!fs["cnn_onnx"].empty()) {
+    cv::Mat onnx;
+    fs["cnn_onnx"] >> onnx;
+    if (onnx.empty() || onnx.type() != CV_8U || !onnx.isContinuous()) {
+      return Error(ErrorCode::kInvalidArgument, "detector model: the CNN's ONNX bytes are not a byte row", where);
+    }
+    m->cnn_onnx.assign(onnx.ptr<std::uint8_t>(0), onnx.ptr<std::uint8_t>(0) + onnx.total());
+    return Ok{};
+  }
+  m->forest = cv::ml::RTrees::create();
+  m->forest->read(fs["forest"]);
+  if (!m->forest->isTrained() || m->forest->getVarCount() != m->forest_inputs()) {
+    return Error(ErrorCode::kInvalidArgument, "detector model: the forest is missing or has the wrong inputs", where);
+  }
+  m->FlattenForest();
+  return Ok{};
+}
+
 Result<std::shared_ptr<const VictimDetectorModel>> Read(cv::FileStorage& fs, const std::string& where) {
   auto m = std::make_shared<VictimDetectorModel>();
   SWARMBOX_TRY(ReadLayout(fs, where, m.get()));
@@ -237,12 +284,7 @@ Result<std::shared_ptr<const VictimDetectorModel>> Read(cv::FileStorage& fs, con
   for (double s : seeds) m->training_seeds.push_back(static_cast<std::uint64_t>(s));
   for (double s : cal) m->calibration_seeds.push_back(static_cast<std::uint64_t>(s));
   SWARMBOX_TRY(ReadKernels(fs, where, m.get()));
-  m->forest = cv::ml::RTrees::create();
-  m->forest->read(fs["forest"]);
-  if (!m->forest->isTrained() || m->forest->getVarCount() != m->forest_inputs()) {
-    return Error(ErrorCode::kInvalidArgument, "detector model: the forest is missing or has the wrong inputs", where);
-  }
-  m->FlattenForest();
+  SWARMBOX_TRY(ReadSecondStage(fs, where, m.get()));
   return std::shared_ptr<const VictimDetectorModel>(std::move(m));
 }
 

@@ -17,6 +17,9 @@
 //   4. second stage: a random forest (cv::ml::RTrees) on each candidate (its window features, its
 //      first-stage score and, when the model has them, its blob features: blob_features.hpp), its
 //      vote fraction mapped to a probability by the trained Platt sigmoid: the confidence, in [0, 1];
+//      or, with a model that carries a CNN (format 3), the network on every candidate's colour patch
+//      (candidate_patch.hpp; all of a frame's candidates in one batch, one cv::dnn forward), its
+//      logit mapped by the sigmoid;
 //   5. non-maximum suppression: of candidates closer than nms_radius_m, the most confident stays.
 // A detection whose person box (centre +- 1 m) leaves the image is a partial view, its confidence
 // capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
@@ -28,6 +31,8 @@
 // filters and the forest still allocate internal buffers per frame (allocation_test.cpp). Frames
 // come at 5 Hz, outside the control loop. A model with blob features adds them per candidate
 // (0.25 ms of CPU each measured at load ~9: BENCHMARKS.md "Blob features for the second stage").
+// A model with a CNN costs ~52 ms per frame at 30 m with 96 candidates on a quiet machine, 3.4
+// times the forest (BENCHMARKS.md "A CNN second stage"); cv::dnn allocates its buffers per forward.
 #pragma once
 
 #include <memory>
@@ -35,8 +40,10 @@
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
+#include <opencv2/dnn.hpp>
 
 #include "swarmbox/swarm/blob_features.hpp"
+#include "swarmbox/swarm/candidate_patch.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
 #include "swarmbox/swarm/victim_detector_model.hpp"
 
@@ -61,7 +68,8 @@ struct ImageBlob {
   double expected_area_px = 0;   // the same (kept for geolocation's consumers)
   bool partial = false;          // the person box leaves the image
   double linear_score = 0;       // first-stage score (margin of the linear stage)
-  double votes = 0;              // second-stage vote fraction for "person" [0, 1]
+  double votes = 0;              // second-stage score: the forest's vote fraction for "person"
+                                 // [0, 1], or the CNN's logit (has_cnn())
   double confidence = 0;         // calibrated probability [0, 1] (capped for partial views)
 };
 
@@ -101,8 +109,16 @@ class VictimDetector {
   void ForestFeatures(const Candidate& c, float* out);
   // A candidate's window centre in pixels of the frame of the last Candidates() call.
   Eigen::Vector2d CentrePx(const Candidate& c) const;
+  // The CNN's input patch of candidate `c` of the last Candidates() call (CandidatePatchSampler
+  // on that frame, which must still be alive, at CentrePx(c)): what a convolutional second stage
+  // sees, whatever the model's second stage.
+  void CnnPatch(const Candidate& c, cv::Mat* patch);
 
  private:
+  // The second stage's score (votes or logit) of each cands[kept_[i]] into scores_[i].
+  void SecondStageScores(const std::vector<Candidate>& cands);
+  // The CNN's logits for the candidates cands[kept[i]] into scores[i] (one batched forward).
+  void CnnScores(const std::vector<Candidate>& cands, const std::vector<int>& kept, std::vector<double>* scores);
   template <typename KeepFn>
   void DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn keep, std::vector<ImageBlob>* out);
 
@@ -110,6 +126,15 @@ class VictimDetector {
   VictimDetectorParams params_;
   ChannelMaps maps_;
   BlobFeatureExtractor blob_;
+  CandidatePatchSampler patches_;
+  cv::Mat frame_;              // the last Candidates() frame (a header, not a copy) and its scale
+  double frame_px_per_m_ = 0;
+  bool patch_frame_set_ = false;
+  cv::dnn::Net cnn_;           // from model().cnn_onnx, when it has one
+  std::vector<cv::Mat> patch_batch_;
+  cv::Mat cnn_input_, cnn_output_;
+  std::vector<int> kept_;
+  std::vector<double> scores_;
   double scale_ = 1;  // canonical pixels per frame pixel, of the last Candidates() call
   cv::Mat score_, filtered_, dilated_;
   std::vector<float> samples_;

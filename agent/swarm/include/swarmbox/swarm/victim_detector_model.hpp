@@ -19,9 +19,13 @@
 // format 2 with blob_features = kBlobFeatures, the candidate's blob features (blob_features.hpp:
 // size, shape, parts and edge orientations, independent of the person's heading), and a Platt
 // sigmoid that maps the forest's vote fraction to a probability (fitted on calibration scenes).
-// Format 1 models (window features and score only) still load and run.
+// Format 1 models (window features and score only) still load and run. A format-3 model carries a
+// small convolutional network instead of the forest (cnn_onnx: ONNX bytes, run with cv::dnn on each
+// candidate's colour patch, candidate_patch.hpp; trained by tools/train_detector/train_cnn.py), its
+// logit mapped to a probability by the Platt sigmoid.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -42,6 +46,9 @@ inline constexpr int kColourChannels = 3;
 inline constexpr int kChannels = kColourChannels + 1 + kOrientations;
 inline constexpr int kWindowFeatures = kChannels * kWindowCells * kWindowCells + kColourChannels;
 inline constexpr int kForestFeatures = kWindowFeatures + 1;  // + the first-stage score
+// The CNN's input normalisation (pixel - mean) * scale, the same in train_cnn.py.
+inline constexpr double kCnnInputMean = 127.5;
+inline constexpr double kCnnInputScale = 1.0 / 64.0;
 // (then the blob features when the model has them: VictimDetectorModel::forest_inputs())
 
 // Channel maps at cell resolution (CV_32F each), with scratch images kept between frames.
@@ -74,7 +81,11 @@ struct VictimDetectorModel {
   std::vector<cv::Mat> kernels;
   double bias = 0;
   double stage1_threshold = 0;
-  cv::Ptr<cv::ml::RTrees> forest;  // class 1 = person; forest_inputs() inputs
+  cv::Ptr<cv::ml::RTrees> forest;  // class 1 = person; forest_inputs() inputs (empty with a CNN)
+  // The convolutional second stage (format 3), when not empty: an ONNX network from a batch of
+  // kCnnPatchPx x kCnnPatchPx BGR patches (N x 3 x H x W, (pixel - kCnnInputMean) * kCnnInputScale)
+  // to one logit per patch (> 0: person). It replaces the forest; the sigmoid then maps the logit.
+  std::vector<std::uint8_t> cnn_onnx;
   int blob_features = 0;           // 0 (format 1) or kBlobFeatures, after the kForestFeatures
   double platt_a = -8.0;           // p = 1 / (1 + exp(platt_a * votes + platt_b))
   double platt_b = 4.0;
@@ -83,6 +94,7 @@ struct VictimDetectorModel {
   std::string recipe;  // the trainer's options, as its command line (the model's provenance)
 
   int forest_inputs() const { return kForestFeatures + blob_features; }
+  bool has_cnn() const { return !cnn_onnx.empty(); }
 
   // The forest flattened for prediction without allocation (FlattenForest(); the same decisions
   // as cv::ml::DTrees::predict for ordered variables: value <= threshold goes left, unless the split

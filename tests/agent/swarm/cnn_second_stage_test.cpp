@@ -1,0 +1,185 @@
+// The detector's convolutional second stage (victim_detector_model.hpp format 3): the candidate
+// patches (candidate_patch.hpp) are sampled at a fixed metric scale and are the same pixels
+// through the trainer's path (CandidatePatch, CandidatePatchSampler) and the detector's
+// (VictimDetector::CnnPatch); cv::dnn gives torch's logits for the fixture network; a model that
+// carries a CNN saves, loads and scores every candidate with it, batched as one patch at a time.
+//
+// The fixture data/patch_cnn_fixture.onnx (an untrained network of train_cnn.py's architecture with
+// seeded weights) and its .logits.txt (torch's logits for FixturePatches(4)) were written by
+//   /usr/bin/python3 tools/train_detector/train_cnn.py --test-fixture --seed 1
+//       --out tests/agent/swarm/data/patch_cnn_fixture.onnx   (one command line)
+// (no Python at test time).
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <opencv2/dnn.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "swarmbox/swarm/candidate_patch.hpp"
+#include "swarmbox/swarm/victim_detector.hpp"
+#include "swarmbox/swarm/victim_detector_model.hpp"
+
+#ifndef SWARMBOX_SWARM_TEST_DATA_DIR
+#error "SWARMBOX_SWARM_TEST_DATA_DIR must point at tests/agent/swarm/data"
+#endif
+
+namespace swarmbox::swarm {
+namespace {
+
+const std::string kFixture = std::string(SWARMBOX_SWARM_TEST_DATA_DIR) + "/patch_cnn_fixture.onnx";
+constexpr double kLogitTolerance = 1e-4;
+
+std::vector<std::uint8_t> ReadBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  std::vector<std::uint8_t> bytes(in ? static_cast<std::size_t>(in.tellg()) : 0);
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return bytes;
+}
+
+// train_cnn.py fixture_patches(): pixel (n, i, j, c) = (31 n + 7 i + 13 j + 29 c + i j) mod 256.
+std::vector<cv::Mat> FixturePatches(int count) {
+  std::vector<cv::Mat> patches;
+  for (int n = 0; n < count; ++n) {
+    cv::Mat p(kCnnPatchPx, kCnnPatchPx, CV_8UC3);
+    for (int i = 0; i < kCnnPatchPx; ++i) {
+      for (int j = 0; j < kCnnPatchPx; ++j) {
+        for (int c = 0; c < 3; ++c) p.at<cv::Vec3b>(i, j)[c] = static_cast<std::uint8_t>((31 * n + 7 * i + 13 * j + 29 * c + i * j) % 256);
+      }
+    }
+    patches.push_back(p);
+  }
+  return patches;
+}
+
+// The network's logits for `patches`, one forward, with the detector's input normalisation.
+std::vector<float> Logits(cv::dnn::Net& net, const std::vector<cv::Mat>& patches) {
+  cv::Mat blob = cv::dnn::blobFromImages(patches, kCnnInputScale, cv::Size(kCnnPatchPx, kCnnPatchPx),
+                                         cv::Scalar::all(kCnnInputMean), false, false, CV_32F);
+  net.setInput(blob);
+  cv::Mat out = net.forward();
+  return std::vector<float>(out.ptr<float>(), out.ptr<float>() + out.total());
+}
+
+// A seeded 320 x 240 frame: textured ground and a few coloured rectangles and discs.
+cv::Mat TestFrame() {
+  std::mt19937 rng(19);
+  cv::Mat frame(240, 320, CV_8UC3, cv::Scalar(70, 110, 95));
+  cv::Mat noise(frame.size(), CV_8UC3);
+  cv::randn(noise, cv::Scalar::all(0), cv::Scalar::all(12));
+  frame += noise;
+  std::uniform_int_distribution<int> x(20, 300), y(20, 220), colour(0, 255);
+  for (int k = 0; k < 8; ++k) {
+    const cv::Scalar c(colour(rng), colour(rng), colour(rng));
+    if (k % 2 == 0) {
+      cv::rectangle(frame, cv::Rect(x(rng), y(rng), 12 + k * 3, 8), c, cv::FILLED);
+    } else {
+      cv::circle(frame, cv::Point(x(rng), y(rng)), 4 + k, c, cv::FILLED);
+    }
+  }
+  return frame;
+}
+
+TEST(CandidatePatch, SamplesAThreeMetreSquareAtTheFixedScaleAroundTheCentre) {
+  // Given a 1 x 1 m red square on grey ground, centred on pixel (99.5, 79.5), at 20 px/m.
+  constexpr double kPxPerM = 20.0;
+  cv::Mat frame(200, 200, CV_8UC3, cv::Scalar(100, 100, 100));
+  cv::rectangle(frame, cv::Rect(90, 70, 20, 20), cv::Scalar(0, 0, 255), cv::FILLED);
+  // When its patch is taken at the square's centre.
+  cv::Mat patch;
+  CandidatePatch(frame, kPxPerM, {99.5, 79.5}, &patch);
+  // Then the patch is kCnnPatchPx square, red within 0.5 m of its centre and grey beyond.
+  ASSERT_EQ(patch.rows, kCnnPatchPx);
+  ASSERT_EQ(patch.cols, kCnnPatchPx);
+  ASSERT_EQ(patch.type(), CV_8UC3);
+  const int mid = kCnnPatchPx / 2;
+  const int inside = static_cast<int>(0.35 * kCnnPxPerM), outside = static_cast<int>(0.7 * kCnnPxPerM);
+  constexpr double kLevels = 2;  // rounding of the area average and the bilinear taps
+  auto off = [&](int r, int c, cv::Vec3b want) { return cv::norm(cv::Vec3d(patch.at<cv::Vec3b>(r, c)) - cv::Vec3d(want), cv::NORM_INF); };
+  for (int d : {-inside - 1, inside}) {
+    EXPECT_LE(off(mid + d, mid + d, {0, 0, 255}), kLevels) << d;
+  }
+  for (int d : {-outside - 1, outside}) {
+    EXPECT_LE(off(mid + d, mid, {100, 100, 100}), kLevels) << d;
+    EXPECT_LE(off(mid, mid + d, {100, 100, 100}), kLevels) << d;
+  }
+}
+
+TEST(CandidatePatch, IsDeterministicAndTheDetectorSeesTheTrainersPixels) {
+  const cv::Mat frame = TestFrame();
+  for (double px_per_m : {6.0, 15.5, 40.0}) {  // coarser than the patch, the 30 m scale, finer (shrunk)
+    VictimDetector det;
+    const auto& cands = det.Candidates(frame, px_per_m, 24, -1e30);
+    ASSERT_FALSE(cands.empty()) << px_per_m;
+    for (const VictimDetector::Candidate& c : cands) {
+      cv::Mat from_detector, from_trainer, again;
+      det.CnnPatch(c, &from_detector);
+      CandidatePatch(frame, px_per_m, det.CentrePx(c), &from_trainer);
+      CandidatePatch(frame, px_per_m, det.CentrePx(c), &again);
+      EXPECT_EQ(cv::norm(from_detector, from_trainer, cv::NORM_INF), 0.0) << px_per_m;
+      EXPECT_EQ(cv::norm(from_trainer, again, cv::NORM_INF), 0.0) << px_per_m;
+    }
+  }
+}
+
+TEST(CnnSecondStage, CvDnnGivesTorchsLogitsForTheFixtureNetwork) {
+  const std::vector<std::uint8_t> onnx = ReadBytes(kFixture);
+  ASSERT_FALSE(onnx.empty()) << kFixture;
+  cv::dnn::Net net = cv::dnn::readNetFromONNX(reinterpret_cast<const char*>(onnx.data()), onnx.size());
+  ASSERT_FALSE(net.empty());
+  std::ifstream expected_file(kFixture + ".logits.txt");
+  std::vector<float> expected(4);
+  for (float& v : expected) ASSERT_TRUE(expected_file >> v);
+  const std::vector<float> logits = Logits(net, FixturePatches(4));
+  ASSERT_EQ(logits.size(), expected.size());
+  for (std::size_t i = 0; i < logits.size(); ++i) EXPECT_NEAR(logits[i], expected[i], kLogitTolerance) << i;
+}
+
+TEST(CnnSecondStage, AModelWithACnnRoundTripsAndScoresEachCandidateByItsPatch) {
+  // Given the shipped first stage with the fixture network as its second stage, saved and loaded.
+  VictimDetectorModel with_cnn = *ShippedDetectorModel();
+  with_cnn.cnn_onnx = ReadBytes(kFixture);
+  ASSERT_FALSE(with_cnn.cnn_onnx.empty());
+  with_cnn.forest.release();
+  with_cnn.nodes.clear();
+  with_cnn.roots.clear();
+  const std::string path = ::testing::TempDir() + "/cnn_model.yml.gz";
+  ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
+  ASSERT_TRUE((*loaded)->has_cnn());
+  EXPECT_EQ((*loaded)->cnn_onnx, with_cnn.cnn_onnx);
+  EXPECT_TRUE((*loaded)->forest.empty());
+  EXPECT_EQ((*loaded)->stage1_threshold, with_cnn.stage1_threshold);
+  // When the detector runs it on a frame (every candidate kept: no threshold, suppression or cap).
+  VictimDetectorParams all;
+  all.min_confidence = 0.0;
+  all.nms_radius_m = 0.0;
+  all.partial_confidence_cap = 1.0;
+  VictimDetector det(*loaded, all);
+  const cv::Mat frame = TestFrame();
+  constexpr double kPxPerM = 15.5;
+  std::vector<ImageBlob> blobs;
+  det.Detect(frame, kPxPerM, &blobs);
+  ASSERT_FALSE(blobs.empty());
+  // Then each detection's score is the network's logit for its own patch alone, and its
+  // confidence the sigmoid of that.
+  cv::dnn::Net net = cv::dnn::readNetFromONNX(reinterpret_cast<const char*>(with_cnn.cnn_onnx.data()),
+                                              with_cnn.cnn_onnx.size());
+  for (const ImageBlob& b : blobs) {
+    cv::Mat patch;
+    CandidatePatch(frame, kPxPerM, b.centroid_px, &patch);
+    const std::vector<float> alone = Logits(net, {patch});
+    ASSERT_EQ(alone.size(), 1u);
+    EXPECT_NEAR(b.votes, alone[0], kLogitTolerance);
+    EXPECT_NEAR(b.confidence, with_cnn.Probability(b.votes), 1e-12);
+  }
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace swarmbox::swarm
