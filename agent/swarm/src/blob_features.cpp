@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "detail/shrink_to_scale.hpp"
 #include "swarmbox/common/result.hpp"
 
 namespace swarmbox::swarm {
@@ -66,17 +67,8 @@ BlobFeatureExtractor::BlobFeatureExtractor()
 void BlobFeatureExtractor::SetFrame(const cv::Mat& bgr, double pixels_per_m) {
   SWARMBOX_CHECK(bgr.type() == CV_8UC3 && !bgr.empty() && pixels_per_m > 0);
   pixels_per_m_ = pixels_per_m;
-  frame_to_lab_ = 1.0;
-  const cv::Mat* src = &bgr;
-  if (pixels_per_m > kBlobPxPerM) {  // finer than the patch: shrink once, averaging (no aliasing)
-    const double s = kBlobPxPerM / pixels_per_m;
-    const cv::Size size(std::max(1, static_cast<int>(std::lround(bgr.cols * s))),
-                        std::max(1, static_cast<int>(std::lround(bgr.rows * s))));
-    cv::resize(bgr, small_, size, 0, 0, cv::INTER_AREA);
-    frame_to_lab_ = static_cast<double>(size.width) / bgr.cols;
-    src = &small_;
-  }
-  cv::cvtColor(*src, lab_, cv::COLOR_BGR2Lab);
+  cv::cvtColor(detail::ShrinkToScale(bgr, pixels_per_m, kBlobPxPerM, &small_, &frame_to_lab_), lab_,
+               cv::COLOR_BGR2Lab);
 }
 
 // Bilinear samples of lab_ on the patch grid (kBlobPxPerM), the frame's border replicated.

@@ -5,24 +5,15 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "detail/shrink_to_scale.hpp"
 #include "swarmbox/common/result.hpp"
 
 namespace swarmbox::swarm {
 
 void CandidatePatchSampler::SetFrame(const cv::Mat& bgr, double pixels_per_m) {
   SWARMBOX_CHECK(bgr.type() == CV_8UC3 && !bgr.empty() && pixels_per_m > 0);
-  frame_px_per_m_ = pixels_per_m;
-  to_frame_ = 1.0;
-  frame_ = bgr;
-  if (pixels_per_m > kCnnPxPerM) {  // finer than the patch: shrink once, averaging (no aliasing)
-    const double s = kCnnPxPerM / pixels_per_m;
-    const cv::Size size(std::max(1, static_cast<int>(std::lround(bgr.cols * s))),
-                        std::max(1, static_cast<int>(std::lround(bgr.rows * s))));
-    cv::resize(bgr, small_, size, 0, 0, cv::INTER_AREA);
-    to_frame_ = static_cast<double>(size.width) / bgr.cols;
-    frame_px_per_m_ = pixels_per_m * to_frame_;
-    frame_ = small_;
-  }
+  frame_ = detail::ShrinkToScale(bgr, pixels_per_m, kCnnPxPerM, &small_, &to_frame_);
+  frame_px_per_m_ = pixels_per_m * to_frame_;
 }
 
 void CandidatePatchSampler::Extract(const Eigen::Vector2d& centre_px, cv::Mat* patch) const {
