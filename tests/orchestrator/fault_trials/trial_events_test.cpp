@@ -5,9 +5,29 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace swarmbox::fault_trials {
 namespace {
+
+// One event=link line (the agents' link probe) of `node` -> `peer` over one window: the loss is
+// 1 - received / sent, and the round trips (mean = median, sd) are there only when a pong came back.
+std::string LinkLine(double wall_s, const char* node, const char* peer, int sent, int received,
+                     double rtt_mean_ms = 0, double rtt_sd_ms = 0) {
+  char buf[320];
+  const double loss = 1.0 - static_cast<double>(received) / sent;
+  int n = std::snprintf(buf, sizeof buf,
+                        R"({"wall_s":%g,"event":"link","node":"%s","peer":"%s",)"
+                        R"("sent":"%d","received":"%d","loss":"%g")",
+                        wall_s, node, peer, sent, received, loss);
+  if (received > 0) {
+    n += std::snprintf(buf + n, sizeof buf - static_cast<std::size_t>(n),
+                       R"(,"rtt_ms_mean":"%g","rtt_ms_sd":"%g","rtt_ms_p50":"%g")", rtt_mean_ms, rtt_sd_ms,
+                       rtt_mean_ms);
+  }
+  return std::string(buf) + "}\n";
+}
 
 std::vector<TrialEvent> Parse(std::string_view text) {
   auto e = ParseEvents(text);
@@ -36,15 +56,8 @@ TEST(ParseEvents, ReadsScalarsTargetsAndRefusesNonObjects) {
 
 TEST(SummariseLinks, SkipsDiscoveryWindowsAndPoolsMoments) {
   // scout_1 -> scout_2: a discovery window (nothing back), then two windows of 2 and 4 pongs.
-  auto events = Parse(
-      R"({"wall_s":1,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"0","loss":"1"})"
-      "\n"
-      R"({"wall_s":3,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"2","loss":"0.6","rtt_ms_mean":"10","rtt_ms_sd":"0","rtt_ms_p50":"10"})"
-      "\n"
-      R"({"wall_s":5,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"4","loss":"0.2","rtt_ms_mean":"20","rtt_ms_sd":"2","rtt_ms_p50":"20"})"
-      "\n"
-      R"({"wall_s":7,"event":"link","node":"scout_1","peer":"scout_2","sent":"5","received":"5","loss":"0","rtt_ms_mean":"99","rtt_ms_sd":"0","rtt_ms_p50":"99"})"
-      "\n");
+  auto events = Parse(LinkLine(1, "scout_1", "scout_2", 5, 0) + LinkLine(3, "scout_1", "scout_2", 5, 2, 10, 0) +
+                      LinkLine(5, "scout_1", "scout_2", 5, 4, 20, 2) + LinkLine(7, "scout_1", "scout_2", 5, 5, 99, 0));
   // The first window with a pong straddles discovery too: [0, 6) holds only the 5 s window.
   LinkSummary s = SummariseLinks(events, 0.0, 6.0);
   EXPECT_EQ(s.windows, 1u);
@@ -65,19 +78,9 @@ TEST(SummariseLinks, SkipsDiscoveryWindowsAndPoolsMoments) {
 TEST(SummariseLinks, TheWindowMedianSdIgnoresABurstAndThinWindows) {
   // After discovery (the first window with a pong straddles it: skipped, as above), three
   // windows of 6 pongs (sd 50, a host's burst; 3; 2) and one of 3 pongs (sd 99: too few to count).
-  auto events = Parse(
-      R"({"wall_s":1,"event":"link","node":"a","peer":"b","sent":"5","received":"0","loss":"1"})"
-      "\n"
-      R"({"wall_s":3,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"1","rtt_ms_p50":"10"})"
-      "\n"
-      R"({"wall_s":5,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"50","rtt_ms_p50":"10"})"
-      "\n"
-      R"({"wall_s":7,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"3","rtt_ms_p50":"10"})"
-      "\n"
-      R"({"wall_s":9,"event":"link","node":"a","peer":"b","sent":"6","received":"3","loss":"0.5","rtt_ms_mean":"10","rtt_ms_sd":"99","rtt_ms_p50":"10"})"
-      "\n"
-      R"({"wall_s":11,"event":"link","node":"a","peer":"b","sent":"6","received":"6","loss":"0","rtt_ms_mean":"10","rtt_ms_sd":"2","rtt_ms_p50":"10"})"
-      "\n");
+  auto events = Parse(LinkLine(1, "a", "b", 5, 0) + LinkLine(3, "a", "b", 6, 6, 10, 1) +
+                      LinkLine(5, "a", "b", 6, 6, 10, 50) + LinkLine(7, "a", "b", 6, 6, 10, 3) +
+                      LinkLine(9, "a", "b", 6, 3, 10, 99) + LinkLine(11, "a", "b", 6, 6, 10, 2));
   const LinkSummary s = SummariseLinks(events, 0.0, 100.0);
   EXPECT_EQ(s.windows, 4u);
   EXPECT_EQ(s.sd_windows, 3u);
