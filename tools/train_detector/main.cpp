@@ -9,7 +9,9 @@
 //   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
 //   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features,
 //   --negatives-sets N (cones-and-rubble sets 7200001..7200000+N), --calibration-altitude M
-//   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there), --max-candidates N
+//   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there), --calibration-sets N
+//   (calibration seeds 7100001..7100000+N; default 2), --clean-calibration (no painted clutter on the
+//   calibration frames), --max-candidates N
 //   (the first stage's cap while calibrating and mining), --operating-precision P (probability 0.5
 //   where the calibration detections reach precision P), --export-patches FILE (the CNN's patches,
 //   train_detector.hpp), --cnn SCRIPT (a CNN second stage trained by SCRIPT, train_cnn.py, with
@@ -50,6 +52,17 @@ bool SetTrainingSets(const char* value, Args* args) {
   return true;
 }
 
+// --calibration-sets N: the calibration seeds 7100001..7100000+N.
+bool SetCalibrationSets(const char* value, Args* args) {
+  const int n = std::stoi(value);
+  if (n < 1 || n > 99) {
+    std::fprintf(stderr, "swarmbox-train-detector: --calibration-sets must be 1..99\n");
+    return false;
+  }
+  args->options.calibration_seeds = td::CalibrationSeeds(n);
+  return true;
+}
+
 // A flag: its name, whether a value follows it, and what it sets (false: a usage error, printed).
 struct Flag {
   std::string_view name;
@@ -75,6 +88,8 @@ constexpr Flag kFlags[] = {
      [](const char* v, Args* a) { a->options.operating_precision = std::stod(v); return true; }},
     {"--calibration-altitude", true,
      [](const char* v, Args* a) { a->options.calibration_altitude_m = std::stod(v); return true; }},
+    {"--calibration-sets", true, SetCalibrationSets},
+    {"--clean-calibration", false, [](const char*, Args* a) { a->options.clean_calibration = true; return true; }},
     {"--export-patches", true, [](const char* v, Args* a) { a->options.export_patches = v; return true; }},
     {"--cnn", true, [](const char* v, Args* a) { a->options.cnn_script = v; return true; }},
     {"--python", true, [](const char* v, Args* a) { a->options.python = v; return true; }},
@@ -100,7 +115,7 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
                    "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] "
-                   "[--calibration-altitude M] [--max-candidates N] [--operating-precision P] [--export-patches FILE] "
+                   "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] [--operating-precision P] [--export-patches FILE] "
                    "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N]]\n");
       return kUsageError;
     }

@@ -169,16 +169,18 @@ std::size_t NearestIndex(const Scene& s, double scale, const Eigen::Vector2d& ca
   return best;
 }
 
-// The scene sets of `seeds`, each made by set_params(seed, scenes); half of the frames get clutter.
+// The scene sets of `seeds`, each made by set_params(seed, scenes); half of the frames get clutter
+// unless `clutter` is false.
 template <typename SetParams>
-Result<std::vector<Scene>> RenderSets(const std::vector<std::uint64_t>& seeds, int scenes, SetParams set_params) {
+Result<std::vector<Scene>> RenderSets(const std::vector<std::uint64_t>& seeds, int scenes, SetParams set_params,
+                                      bool clutter = true) {
   std::vector<Scene> all;
   std::mt19937_64 rng(0xC1A77E5);
   for (std::uint64_t seed : seeds) {
     Result<std::vector<Scene>> s = perception_scenes::RenderScenes(set_params(seed, scenes));
     if (!s) return s.error().Context("rendering training scene set " + std::to_string(seed));
     for (Scene& x : *s) {
-      if (std::uniform_real_distribution<double>(0, 1)(rng) < 0.5) PaintClutter(x, PixelsPerMetre(x), rng);
+      if (clutter && std::uniform_real_distribution<double>(0, 1)(rng) < 0.5) PaintClutter(x, PixelsPerMetre(x), rng);
       all.push_back(std::move(x));
     }
   }
@@ -327,6 +329,8 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
+  if (o.calibration_seeds != CalibrationSeeds(2)) r << " --calibration-sets " << o.calibration_seeds.size();
+  if (o.clean_calibration) r << " --clean-calibration";
   if (!o.cnn_script.empty()) r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed;
   return r.str();
 }
@@ -334,8 +338,14 @@ std::string RecipeText(const TrainingOptions& o) {
 TrainingOptions DefaultTrainingOptions() {
   TrainingOptions o;
   for (std::uint64_t i = 1; i <= 8; ++i) o.training_seeds.push_back(7'000'000 + i);
-  for (std::uint64_t i = 1; i <= 2; ++i) o.calibration_seeds.push_back(7'100'000 + i);
+  o.calibration_seeds = CalibrationSeeds(2);
   return o;
+}
+
+std::vector<std::uint64_t> CalibrationSeeds(int sets) {
+  std::vector<std::uint64_t> seeds;
+  for (int k = 1; k <= sets; ++k) seeds.push_back(kCalibrationSeedBase + static_cast<std::uint64_t>(k));
+  return seeds;
 }
 
 perception_scenes::SceneSetParams TrainingSceneSet(std::uint64_t seed, int scenes) {
@@ -381,9 +391,10 @@ std::vector<std::uint64_t> NegativesSeeds(const TrainingOptions& o) {
 }
 
 Result<std::vector<Scene>> RenderCalibrationSets(const TrainingOptions& o) {
-  return RenderSets(o.calibration_seeds, o.scenes_per_set, [&o](std::uint64_t seed, int scenes) {
-    return CalibrationSceneSet(seed, scenes, o.calibration_altitude_m);
-  });
+  return RenderSets(
+      o.calibration_seeds, o.scenes_per_set,
+      [&o](std::uint64_t seed, int scenes) { return CalibrationSceneSet(seed, scenes, o.calibration_altitude_m); },
+      !o.clean_calibration);
 }
 
 }  // namespace
@@ -536,33 +547,47 @@ Status Calibrate(const std::vector<Scene>& calibration, const TrainingOptions& o
   return Ok{};
 }
 
+namespace {
+
+// The recalibration's options that the model's recipe does not name yet, appended to it (the
+// calibration's altitude band, the cap, new calibration sets, clean frames, the operating point).
+void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::string* recipe) {
+  auto add = [recipe](bool wanted, const std::string& flag, const std::string& value) {
+    if (wanted && recipe->find(flag) == std::string::npos) *recipe += " " + flag + (value.empty() ? "" : " " + value);
+  };
+  std::ostringstream altitude, precision;
+  altitude << o.calibration_altitude_m;
+  precision << o.operating_precision;
+  add(o.calibration_altitude_m > 0, "--calibration-altitude", altitude.str());
+  add(o.max_candidates != swarm::VictimDetectorParams{}.max_candidates, "--max-candidates",
+      std::to_string(o.max_candidates));
+  add(new_seeds, "--calibration-sets", std::to_string(o.calibration_seeds.size()));
+  add(o.clean_calibration, "--clean-calibration", "");
+  add(o.operating_precision > 0, "--operating-precision", precision.str());
+}
+
+}  // namespace
+
 Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const std::string& model_path,
                                                TrainingReport* report) {
   Result<std::shared_ptr<const swarm::VictimDetectorModel>> loaded = swarm::LoadDetectorModel(model_path);
   if (!loaded) return loaded.error();
   swarm::VictimDetectorModel model = **loaded;
-  if (model.calibration_seeds != o.calibration_seeds) {
-    return Error(ErrorCode::kInvalidArgument, "recalibrate: the model was calibrated on other seeds", model_path);
+  // Other calibration seeds (--calibration-sets) replace the model's; they must not be ones it was
+  // trained on.
+  for (std::uint64_t s : o.calibration_seeds) {
+    if (std::find(model.training_seeds.begin(), model.training_seeds.end(), s) != model.training_seeds.end()) {
+      return Error(ErrorCode::kInvalidArgument, "recalibrate: calibration seed " + std::to_string(s) +
+                                                    " is one the model was trained on", model_path);
+    }
   }
+  const bool new_seeds = model.calibration_seeds != o.calibration_seeds;
+  model.calibration_seeds = o.calibration_seeds;
   Result<std::vector<Scene>> cal = RenderCalibrationSets(o);
   if (!cal) return cal.error();
   report->calibration_scenes = static_cast<int>(cal->size());
   if (Status st = Calibrate(*cal, o, &model, report); !st) return st.error();
-  // The recipe names the calibration's altitude band when it is not the training mix's.
-  if (o.calibration_altitude_m > 0 && model.recipe.find("--calibration-altitude") == std::string::npos) {
-    std::ostringstream r;
-    r << model.recipe << " --calibration-altitude " << o.calibration_altitude_m;
-    model.recipe = r.str();
-  }
-  if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates &&
-      model.recipe.find("--max-candidates") == std::string::npos) {
-    model.recipe += " --max-candidates " + std::to_string(o.max_candidates);
-  }
-  if (o.operating_precision > 0 && model.recipe.find("--operating-precision") == std::string::npos) {
-    std::ostringstream r;
-    r << model.recipe << " --operating-precision " << o.operating_precision;
-    model.recipe = r.str();
-  }
+  AppendRecalibrationRecipe(o, new_seeds, &model.recipe);
   return model;
 }
 

@@ -69,6 +69,10 @@ struct TrainingOptions {
   // altitude, so that the sigmoid is fitted where the detector is used; 0: the training sets'
   // mixed altitudes (8-65 m, the shipped recipe).
   double calibration_altitude_m = 0;
+  // The calibration frames as the renderer draws them, without the painted clutter the training
+  // frames get (half of them): the sigmoid is then fitted on the world the detector meets, not on
+  // the augmentation; false: half the calibration frames painted too (the shipped recipe).
+  bool clean_calibration = false;
   // When not empty: the second stage's samples (candidates labelled as for the forest, and each
   // must-detect person's own centre as a positive) and the calibration frames' candidates are
   // written to this file as CNN patches (WritePatchFile format below).
@@ -97,6 +101,10 @@ enum class PatchSplit : std::uint8_t { kTraining = 0, kCalibration = 1 };
 // The cones-and-rubble sets' seeds start above this (disjoint from training, calibration and
 // evaluation seeds).
 inline constexpr std::uint64_t kNegativesSeedBase = 7'200'000;
+// The calibration sets' seeds start above this (CalibrationSeeds(n): 7100001..7100000+n).
+inline constexpr std::uint64_t kCalibrationSeedBase = 7'100'000;
+std::vector<std::uint64_t> CalibrationSeeds(int sets);
+
 // Half the width of the calibration altitude band [m].
 inline constexpr double kCalibrationAltitudeBandM = 3.0;
 

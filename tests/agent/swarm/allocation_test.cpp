@@ -77,8 +77,9 @@ TEST(SwarmAllocation, LatencyQueueDoesNotAllocateOncePopTargetHasCapacity) {
 // The detector reuses its scratch images and runs its forest flattened (no allocation); OpenCV's
 // resize, colour conversion, Sobel, cartToPolar, the eight per-channel correlations (filter2D
 // builds a filter engine per call) and the dilation allocate internal buffers per frame: measured
-// (377 at 320x240 with OpenCV 4.6 and the trained detector; 36 with the former colour threshold)
-// and bounded here, not claimed to be zero. Frames come at 5 Hz, outside the control loop.
+// (377 at 320x240 with OpenCV 4.6 and the forest second stage; 515 with the CNN's, which cv::dnn
+// runs with buffers of its own per forward pass; 36 with the former colour threshold) and bounded
+// here, not claimed to be zero. Frames come at 5 Hz, outside the control loop.
 TEST(SwarmAllocation, VictimDetectorAllocatesOnlyASmallBoundedAmountPerFrame) {
   cv::Mat img(240, 320, CV_8UC3, cv::Scalar(40, 110, 60));
   cv::ellipse(img, cv::RotatedRect({160, 120}, cv::Size2f(16, 5), 30), cv::Scalar(0, 120, 255), cv::FILLED);
@@ -94,7 +95,7 @@ TEST(SwarmAllocation, VictimDetectorAllocatesOnlyASmallBoundedAmountPerFrame) {
   }
   ASSERT_EQ(blobs.size(), 1u);
   RecordProperty("allocations_per_frame", std::to_string(allocations / 10));
-  EXPECT_LE(allocations / 10, 512);
+  EXPECT_LE(allocations / 10, 640);
 }
 
 }  // namespace

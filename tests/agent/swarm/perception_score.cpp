@@ -132,7 +132,9 @@ DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector&
   for (std::size_t i = 0; i < prec.size(); ++i) {
     curve.ap += (rec[i] - last_r) * prec[i];
     last_r = rec[i];
+    if (prec[i] >= 0.9) curve.recall_at_precision_90 = std::max(curve.recall_at_precision_90, rec[i]);
   }
+  curve.max_recall = last_r;
   curve.precision = curve.tp + curve.fp ? static_cast<double>(curve.tp) / (curve.tp + curve.fp) : 1.0;
   curve.recall = curve.persons ? static_cast<double>(curve.tp) / curve.persons : 1.0;
   curve.ms_per_frame = curve.scenes ? 1e3 * seconds / curve.scenes : 0.0;

@@ -56,6 +56,11 @@ struct DetectionCurve {
   double precision = 1.0;          // at the operating point
   double recall = 1.0;
   double ap = 0.0;                 // area under the interpolated precision-recall curve (VOC)
+  // Two more points of the curve, at any confidence: the highest recall at which the precision is
+  // still at least 0.9 (0 when it never is), and the recall of all the detections (the first
+  // stage's and the detector's floor together).
+  double recall_at_precision_90 = 0.0;
+  double max_recall = 0.0;
   double ms_per_frame = 0.0;       // Detect() wall time per frame (the caller sets the threads)
 };
 DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector,

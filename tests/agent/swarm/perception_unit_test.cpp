@@ -211,7 +211,9 @@ TEST(VictimDetector, FindsAPersonAtItsCentroidWithHighConfidence) {
     ASSERT_TRUE(px.has_value());
     const double ppm = s->intrinsics.fx_px / s->altitude_m;
     det.Detect(BgrOf(*s), ppm, &blobs);
-    ASSERT_EQ(blobs.size(), 1u) << "altitude " << altitude;
+    ASSERT_EQ(blobs.size(), 1u) << "altitude " << altitude << ", the second at "
+                                << (blobs.size() > 1 ? (blobs[1].centroid_px - *px).norm() / ppm : 0.0)
+                                << " m from the person with confidence " << (blobs.size() > 1 ? blobs[1].confidence : 0.0);
     // A window centre, refined between cells of 0.25 m: within 0.3 m of the person's centre.
     EXPECT_LT((blobs[0].centroid_px - *px).norm(), 0.3 * ppm + 1.0) << "altitude " << altitude;
     EXPECT_GE(blobs[0].confidence, 0.9) << "altitude " << altitude;
@@ -231,7 +233,12 @@ TEST(VictimDetector, RejectsBlobsOfTheWrongSizeAndNoise) {
   cv::rectangle(img, cv::Rect(200, 40, 30, 30), cv::Scalar(160, 155, 150), cv::FILLED);  // grey roof
   AddNoise(img, 8.0, 4);
   det.Detect(img, ppm, &blobs);
-  EXPECT_TRUE(blobs.empty()) << blobs.size() << " detections, the first at " << blobs[0].centroid_px.transpose();
+  // Nothing the perception reports (PerceptionParams::min_confidence): the detector's
+  // probabilities go down to 0.05 (for the curves), and the CNN gives a tarp's corner 0.07.
+  const double reported = PerceptionParams{}.min_confidence;
+  for (const ImageBlob& b : blobs) {
+    EXPECT_LT(b.confidence, reported) << "a detection at " << b.centroid_px.transpose();
+  }
   Result<testing::Scene> plain = View({}, {-40.0, 10.0}, 20.0, 12.0);
   ASSERT_TRUE(plain.ok());
   det.Detect(BgrOf(*plain), ppm, &blobs);

@@ -1,7 +1,7 @@
 // The shipped detector model (agent/swarm/models/, written by `cmake --build build --target
 // train-detector`): it loads, it was trained and calibrated on scene seeds the evaluation never
-// uses, the binary carries the same model as the committed file, and the flattened forest the
-// detector runs decides as OpenCV's RTrees.
+// uses, the binary carries the same model as the committed file; a forest, flattened as the
+// detector runs it, decides as OpenCV's RTrees (the shipped second stage is a CNN).
 #include <algorithm>
 #include <fstream>
 #include <random>
@@ -58,29 +58,51 @@ TEST(VictimDetectorModel, TheBinaryCarriesTheCommittedModel) {
   EXPECT_DOUBLE_EQ(shipped->stage1_threshold, (*file)->stage1_threshold);
   EXPECT_DOUBLE_EQ(shipped->platt_a, (*file)->platt_a);
   EXPECT_EQ(shipped->nodes.size(), (*file)->nodes.size());
+  EXPECT_EQ(shipped->cnn_onnx, (*file)->cnn_onnx);
   EXPECT_EQ(cv::norm(shipped->kernels[3], (*file)->kernels[3], cv::NORM_INF), 0.0);
 }
 
+// A forest as the trainer grows one (depth 14, sqrt(features) per split; fewer trees and samples),
+// written and loaded: the shipped model's second stage is a CNN, so the flattening is checked on
+// this one.
 TEST(VictimDetectorModel, TheFlattenedForestVotesAsRTrees) {
-  const std::shared_ptr<const VictimDetectorModel> m = ShippedDetectorModel();
+  VictimDetectorModel trained;
+  trained.SetLinear(std::vector<double>(kWindowFeatures, 0.01), -0.5);
+  cv::Mat x(600, kForestFeatures, CV_32F), y(600, 1, CV_32S);
+  cv::theRNG().state = 11;
+  cv::randu(x, 0.0, 1.0);
+  for (int i = 0; i < y.rows; ++i) y.at<int>(i) = x.at<float>(i, 0) + x.at<float>(i, 7) > 1.0f ? 1 : 0;
+  trained.forest = cv::ml::RTrees::create();
+  trained.forest->setMaxDepth(14);
+  trained.forest->setMinSampleCount(2);
+  trained.forest->setActiveVarCount(34);
+  trained.forest->setTermCriteria(cv::TermCriteria(cv::TermCriteria::MAX_ITER, 12, 0));
+  ASSERT_TRUE(trained.forest->train(cv::ml::TrainData::create(x, cv::ml::ROW_SAMPLE, y)));
+  trained.training_seeds = {7000001};
+  trained.calibration_seeds = {7100001};
+  const std::string path = ::testing::TempDir() + "/flattened_forest.yml";
+  ASSERT_TRUE(SaveDetectorModel(trained, path).ok());
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
+  const std::shared_ptr<const VictimDetectorModel> m = *loaded;
   std::mt19937_64 rng(3);
   // Feature values around the split thresholds: random draws from the thresholds themselves.
   std::vector<float> thresholds;
   for (const VictimDetectorModel::ForestNode& n : m->nodes) {
     if (n.var >= 0) thresholds.push_back(n.threshold);
   }
-  ASSERT_FALSE(thresholds.empty());
-  cv::Mat x(200, m->forest_inputs(), CV_32F);
+  ASSERT_GT(thresholds.size(), 100u);
+  cv::Mat probe(200, m->forest_inputs(), CV_32F);
   std::uniform_int_distribution<std::size_t> pick(0, thresholds.size() - 1);
-  for (int i = 0; i < x.rows; ++i) {
-    for (int j = 0; j < x.cols; ++j) x.at<float>(i, j) = thresholds[pick(rng)];
+  for (int i = 0; i < probe.rows; ++i) {
+    for (int j = 0; j < probe.cols; ++j) probe.at<float>(i, j) = thresholds[pick(rng)];
   }
   cv::Mat votes;
-  m->forest->getVotes(x, votes, 0);
+  m->forest->getVotes(probe, votes, 0);
   const int person_col = votes.at<int>(0, 0) == 1 ? 0 : 1;
-  for (int i = 0; i < x.rows; ++i) {
+  for (int i = 0; i < probe.rows; ++i) {
     const double trees = votes.at<int>(i + 1, 0) + votes.at<int>(i + 1, 1);
-    EXPECT_DOUBLE_EQ(m->Votes(x.ptr<float>(i)), votes.at<int>(i + 1, person_col) / trees) << "sample " << i;
+    EXPECT_DOUBLE_EQ(m->Votes(probe.ptr<float>(i)), votes.at<int>(i + 1, person_col) / trees) << "sample " << i;
   }
 }
 
@@ -88,7 +110,9 @@ TEST(VictimDetectorModel, ConfidenceIsACalibratedIncreasingProbability) {
   const std::shared_ptr<const VictimDetectorModel> m = ShippedDetectorModel();
   EXPECT_LT(m->platt_a, 0.0);  // more votes, more confidence
   double last = -1;
-  for (double v = 0; v <= 1.0; v += 0.05) {
+  // The second stage's score: the forest's vote fraction [0, 1], or the CNN's logit.
+  const double lo = m->has_cnn() ? -10.0 : 0.0, hi = m->has_cnn() ? 10.0 : 1.0;
+  for (double v = lo; v <= hi; v += (hi - lo) / 20) {
     const double p = m->Probability(v);
     EXPECT_GE(p, 0.0);
     EXPECT_LE(p, 1.0);

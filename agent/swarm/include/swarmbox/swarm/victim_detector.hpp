@@ -56,7 +56,12 @@ struct VictimDetectorParams {
   // 96. It stays 48 while the shipped model's sigmoid is the one fitted with 48 candidates (a model
   // calibrated with another cap is run with it: swarmbox-bench perception --max-candidates N).
   int max_candidates = 48;
-  double nms_radius_m = 1.0;          // detections closer than this on the ground are one
+  // Detections closer than this on the ground are one. 1.5 m: the training labels a candidate
+  // within 0.75 m of a person "person" and one 1.5 m or more from every person "none", so a
+  // candidate in between (the other end of a lying person: 1.7 m long) is never taught either
+  // way and can score high beside the person's own detection (a CNN did: a second detection
+  // 1.1 m from one person at 10 m); the bench matches detections to people within 1.5 m.
+  double nms_radius_m = 1.5;
   double min_confidence = 0.05;       // detections below are dropped
   double partial_half_extent_m = 1.0; // a detection this close to the border is a partial view
   double partial_confidence_cap = 0.8;
