@@ -148,7 +148,8 @@ void VaryPeople(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldCon
   }
 }
 
-// p.distractors of random kinds 2-9 m from each person (tarps often orange or red).
+// p.distractors of random kinds 2-9 m from each person (tarps and backpacks in the generated
+// worlds' colours).
 void AddDistractors(std::mt19937_64& rng, const SceneSetParams& p, physics::WorldConfig* w) {
   std::uniform_real_distribution<double> unit(0, 1);
   static constexpr physics::DistractorKind kKinds[] = {physics::DistractorKind::kTarp, physics::DistractorKind::kCone,
@@ -166,8 +167,9 @@ void AddDistractors(std::mt19937_64& rng, const SceneSetParams& p, physics::Worl
       d.heading_rad = 2 * std::numbers::pi * unit(rng);
       d.size_m = physics::DefaultSizeM(d.kind) * (0.7 + 0.6 * unit(rng));
       d.colour_bgr = physics::DefaultColour(d.kind);
-      if (d.kind == physics::DistractorKind::kTarp && unit(rng) < 0.5) {
-        d.colour_bgr = unit(rng) < 0.5 ? physics::Bgr{0, 110, 250} : physics::Bgr{30, 30, 190};
+      if (d.kind == physics::DistractorKind::kTarp) d.colour_bgr = kTarpColours[rng() % std::size(kTarpColours)];
+      if (d.kind == physics::DistractorKind::kBackpack) {
+        d.colour_bgr = kBackpackColours[rng() % std::size(kBackpackColours)];
       }
       d.colour_bgr = Jitter(rng, d.colour_bgr, 20);
       w->distractors.push_back(d);

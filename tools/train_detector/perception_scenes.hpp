@@ -57,6 +57,14 @@ struct Scene {
   std::vector<SceneVictim> victims;
 };
 
+// The colours generated worlds give tarps and backpacks (orchestrator/worlds generator.cpp
+// DistractorLook; tests/orchestrator/worlds checks that every one it writes is here): the varied
+// look draws from the same, so the detector is trained on what the mission meets. When the scenes
+// had only red backpacks, the CNN took orange ones ([30, 120, 240]) for people at 0.77-0.95 and
+// the mission confirmed two (rubble20-a-r1, 2026-11-27).
+inline constexpr physics::Bgr kTarpColours[] = {{20, 90, 230}, {30, 30, 200}, {170, 90, 30}, {50, 110, 60}};
+inline constexpr physics::Bgr kBackpackColours[] = {{40, 40, 200}, {30, 120, 240}, {60, 80, 70}, {120, 60, 30}};
+
 // Which distractor kinds a varied-look world gets (perception_scenes.cpp AddDistractors).
 enum class DistractorMix {
   kAllKinds,     // tarps, cones, backpacks, debris and rocks, equally often

@@ -4,10 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <set>
 #include <string>
 
+#include "perception_scenes.hpp"
 #include "swarmbox/physics/world_config.hpp"
 
 namespace swarmbox::worlds {
@@ -98,6 +101,32 @@ TEST(WorldGenerator, PosesAndClothesVaryAcrossVictims) {
   }
   EXPECT_EQ(poses.size(), 4u);
   EXPECT_GE(clothes.size(), 8u);
+}
+
+// The detector's training scenes (tools/train_detector perception_scenes.hpp) draw tarps and
+// backpacks from the palettes below; a generated world must hold no colour outside them.
+TEST(WorldGenerator, TarpsAndBackpacksComeInTheColoursTheDetectorIsTrainedOn) {
+  auto in = [](const physics::Bgr& c, const auto& palette) {
+    return std::find(std::begin(palette), std::end(palette), c) != std::end(palette);
+  };
+  std::set<physics::Bgr> seen;
+  for (WorldKind kind : {WorldKind::kRubbleField, WorldKind::kForestEdge, WorldKind::kOpenField}) {
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+      const physics::WorldConfig w =
+          Generated({.kind = kind, .size_m = {200, 200}, .victims = 4, .obstacles = 10, .distractors = 60}, seed);
+      for (const physics::Distractor& d : w.distractors) {
+        if (d.kind == physics::DistractorKind::kTarp) {
+          EXPECT_TRUE(in(d.colour_bgr, perception_scenes::kTarpColours)) << KindName(kind) << " seed " << seed;
+          seen.insert(d.colour_bgr);
+        }
+        if (d.kind == physics::DistractorKind::kBackpack) {
+          EXPECT_TRUE(in(d.colour_bgr, perception_scenes::kBackpackColours)) << KindName(kind) << " seed " << seed;
+          seen.insert(d.colour_bgr);
+        }
+      }
+    }
+  }
+  EXPECT_EQ(seen.size(), std::size(perception_scenes::kTarpColours) + std::size(perception_scenes::kBackpackColours));
 }
 
 TEST(WorldGenerator, AnAreaTooSmallForTheVictimsSaysSo) {
