@@ -14,25 +14,24 @@
 //      cells), windows of 3 x 3 m at a stride of one cell;
 //   3. first stage: a linear score for every window (one correlation per channel), its local
 //      maxima above the trained threshold, at most max_candidates of them;
-//   4. second stage: a random forest (cv::ml::RTrees) on each candidate (its window features, its
-//      first-stage score and, when the model has them, its blob features: blob_features.hpp), its
-//      vote fraction mapped to a probability by the trained Platt sigmoid: the confidence, in [0, 1];
-//      or, with a model that carries a CNN (format 3), the network on every candidate's colour patch
-//      (candidate_patch.hpp; all of a frame's candidates in one batch, one cv::dnn forward), its
-//      logit mapped by the sigmoid;
+//   4. second stage: with a model that carries a CNN (format 3, the shipped model), the network on
+//      every candidate's colour patch (candidate_patch.hpp; all of a frame's candidates in one
+//      batch, one cv::dnn forward), its logit mapped to a probability by the trained Platt
+//      sigmoid: the confidence, in [0, 1]; with a forest model (formats 1 and 2), a random forest
+//      (cv::ml::RTrees) on each candidate (its window features, its first-stage score and, when the
+//      model has them, its blob features: blob_features.hpp), its vote fraction mapped the same way;
 //   5. non-maximum suppression: of candidates closer than nms_radius_m, the most confident stays.
 // A detection whose person box (centre +- 1 m) leaves the image is a partial view, its confidence
 // capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
 // Detections under min_confidence are not reported.
 //
-// Cost: about 4-14 ms per 640 x 360 frame at 10-40 m on one core, ~39 ms at 60 m (wall time on a
-// loaded machine, BENCHMARKS.md "Perception"; the scale of step 1 makes low altitudes cheaper and
-// high ones dearer: at 60 m the frame is enlarged to keep 8 px/m). Scratch images are kept between frames; OpenCV's
-// filters and the forest still allocate internal buffers per frame (allocation_test.cpp). Frames
-// come at 5 Hz, outside the control loop. A model with blob features adds them per candidate
-// (0.25 ms of CPU each measured at load ~9: BENCHMARKS.md "Blob features for the second stage").
-// A model with a CNN costs ~52 ms per frame at 30 m with 96 candidates on a quiet machine, 3.4
-// times the forest (BENCHMARKS.md "A CNN second stage"); cv::dnn allocates its buffers per forward.
+// Cost with the shipped CNN: ~16-42 ms per 640 x 360 frame at 10-40 m on one core, ~45-61 ms at
+// 60 m (48 candidates; BENCHMARKS.md "Perception: the shipped detector"; the scale of step 1 makes
+// low altitudes cheaper and high ones dearer: at 60 m the frame is enlarged to keep 8 px/m); a
+// forest model ~4-14 ms. Scratch images are kept between frames; OpenCV's filters and cv::dnn still
+// allocate internal buffers per frame (allocation_test.cpp). Frames come at up to 5 Hz, outside
+// the control loop. A forest model with blob features adds them per candidate (0.25 ms of CPU each
+// measured at load ~9: BENCHMARKS.md "Blob features for the second stage").
 #pragma once
 
 #include <memory>
@@ -51,10 +50,10 @@ namespace swarmbox::swarm {
 
 struct VictimDetectorParams {
   double person_area_m2 = 0.59;       // plan-view area of a lying person [m^2] (expected_area_px)
-  // First-stage maxima passed to the forest, best first. At 48 the cap loses people: 3 of 30 at
-  // 30 m on held-out scenes (seed 7100003, neither trained, calibrated nor evaluated on), none at
-  // 96. It stays 48 while the shipped model's sigmoid is the one fitted with 48 candidates (a model
-  // calibrated with another cap is run with it: swarmbox-bench perception --max-candidates N).
+  // First-stage maxima passed to the second stage, best first. With the forest, 48 lost people
+  // (3 of 30 at 30 m on seed 7100003, none at 96); with the shipped CNN (calibrated at 96), 48 and
+  // 96 find 60 and 62 of 100 people on dev seeds 11-13 at 30 m, 96 at twice the second stage's
+  // cost (BENCHMARKS.md "Perception: the shipped detector"), so it stays 48.
   int max_candidates = 48;
   // Detections closer than this on the ground are one. 1.5 m: the training labels a candidate
   // within 0.75 m of a person "person" and one 1.5 m or more from every person "none", so a
