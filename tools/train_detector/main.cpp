@@ -115,7 +115,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
                    "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] "
-                   "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] [--operating-precision P] [--export-patches FILE] "
+                   "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
+                   "[--operating-precision P] [--export-patches FILE] "
                    "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N]]\n");
       return kUsageError;
     }

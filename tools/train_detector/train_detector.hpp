@@ -51,12 +51,12 @@ struct TrainingOptions {
   int hard_negative_rounds = 0;
   int max_hard_negatives = 20000;
   // The second stage also sees each candidate's blob features (swarm/blob_features.hpp: size,
-  // shape, parts, edge orientations, model format 2); false (the shipped model's recipe) trains the
-  // format-1 layout (window features and score).
+  // shape, parts, edge orientations, model format 2); false (the forest recipe shipped until 2026-11-27)
+  // trains the format-1 layout (window features and score).
   bool blob_features = false;
   // Extra training sets (seeds kNegativesSeedBase + 1..N) of the cones-and-rubble mix
   // (perception_scenes::DistractorMix::kConesRubble, 4 cones per person): more of the blob model's
-  // false alarms among the second stage's negatives. 0: none (the shipped recipe).
+  // false alarms among the second stage's negatives (the shipped recipe: 4). 0: none.
   int negatives_sets = 0;
   // The first stage's cap on candidates per frame while calibrating and mining hard negatives (the
   // detector's default, VictimDetectorParams::max_candidates, unless set: a blob model is run at 96).
@@ -67,11 +67,12 @@ struct TrainingOptions {
   double operating_precision = 0;
   // The calibration frames' altitude band [m]: centre +- kCalibrationAltitudeBandM, the search
   // altitude, so that the sigmoid is fitted where the detector is used; 0: the training sets'
-  // mixed altitudes (8-65 m, the shipped recipe).
+  // mixed altitudes (8-65 m, the forest recipes').
   double calibration_altitude_m = 0;
   // The calibration frames as the renderer draws them, without the painted clutter the training
   // frames get (half of them): the sigmoid is then fitted on the world the detector meets, not on
-  // the augmentation; false: half the calibration frames painted too (the shipped recipe).
+  // the augmentation (the shipped recipe); false: half the calibration frames painted too (the
+  // forest recipes').
   bool clean_calibration = false;
   // When not empty: the second stage's samples (candidates labelled as for the forest, and each
   // must-detect person's own centre as a positive) and the calibration frames' candidates are
@@ -80,7 +81,8 @@ struct TrainingOptions {
   // When not empty: the second stage is a CNN trained by this script (train_cnn.py) on the exported
   // patches (export_patches, or a file beside cnn_onnx_out), run as `python SCRIPT --patches F
   // --out ONNX --seed cnn_seed --epochs cnn_epochs`; its ONNX goes into the model (format 3) and
-  // the sigmoid is fitted on its logits. Empty: the forest (the shipped recipe).
+  // the sigmoid is fitted on its logits. Empty: the forest (the shipped
+  // model has a CNN: train-detector passes --cnn).
   std::string cnn_script;
   std::string python = "python3";  // the interpreter with torch (Debian: /usr/bin/python3)
   std::string cnn_onnx_out;        // where the script writes the ONNX (default: beside the patches)
@@ -111,7 +113,8 @@ inline constexpr double kCalibrationAltitudeBandM = 3.0;
 // The options as the trainer's command line (recorded in the model and its JSON report).
 std::string RecipeText(const TrainingOptions& options);
 
-// The recipe of the shipped model: 8 training sets (7000001-7000008), 2 calibration sets.
+// The trainer's defaults (the forest recipe shipped until 2026-11-27): 8 training sets
+// (7000001-7000008), 2 calibration sets. The shipped CNN's options: tools/train_detector/CMakeLists.txt.
 TrainingOptions DefaultTrainingOptions();
 
 // The scene mix of one training or calibration set: altitudes 8-65 m, noise 2-12 levels, 30 % of

@@ -9,9 +9,10 @@
 //   case=occlusion    occluded_fraction=0|0.5|1 at 30 m (share of the people under 20-80 % cover)
 //   case=distractors  distractors=0|2|6 per person at 30 m
 // with persons (at least half visible), tp, fp, precision and recall at confidence 0.5, ap (VOC,
-// all detections), recall_at_p90 (the highest recall at precision >= 0.9, any confidence: a point of
-// the curve, not an operating point), max_recall (all detections) and ms_per_frame (Detect() on one core: cv::setNumThreads(1)); then the pipeline
-// scenarios (latency queue, geolocation with estimated poses, tilted cameras) as before.
+// all detections), recall_at_p90 (the highest recall at precision >= 0.9, any confidence: a point
+// of the curve, not an operating point), max_recall (all detections) and ms_per_frame (Detect() on
+// one core: cv::setNumThreads(1)); then the pipeline scenarios (latency queue, geolocation with
+// estimated poses, tilted cameras) as before.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

@@ -211,9 +211,10 @@ TEST(VictimDetector, FindsAPersonAtItsCentroidWithHighConfidence) {
     ASSERT_TRUE(px.has_value());
     const double ppm = s->intrinsics.fx_px / s->altitude_m;
     det.Detect(BgrOf(*s), ppm, &blobs);
+    const bool second = blobs.size() > 1;
     ASSERT_EQ(blobs.size(), 1u) << "altitude " << altitude << ", the second at "
-                                << (blobs.size() > 1 ? (blobs[1].centroid_px - *px).norm() / ppm : 0.0)
-                                << " m from the person with confidence " << (blobs.size() > 1 ? blobs[1].confidence : 0.0);
+                                << (second ? (blobs[1].centroid_px - *px).norm() / ppm : 0.0)
+                                << " m from the person with confidence " << (second ? blobs[1].confidence : 0.0);
     // A window centre, refined between cells of 0.25 m: within 0.3 m of the person's centre.
     EXPECT_LT((blobs[0].centroid_px - *px).norm(), 0.3 * ppm + 1.0) << "altitude " << altitude;
     EXPECT_GE(blobs[0].confidence, 0.9) << "altitude " << altitude;
