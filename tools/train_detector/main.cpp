@@ -47,8 +47,7 @@ bool SetTrainingSets(const char* value, Args* args) {
     std::fprintf(stderr, "swarmbox-train-detector: --training-sets must be 1..99\n");
     return false;
   }
-  args->options.training_seeds.clear();
-  for (int k = 1; k <= n; ++k) args->options.training_seeds.push_back(7'000'000 + static_cast<std::uint64_t>(k));
+  args->options.training_seeds = td::SeedSets(td::kTrainingSeedBase, n);
   return true;
 }
 
@@ -59,7 +58,7 @@ bool SetCalibrationSets(const char* value, Args* args) {
     std::fprintf(stderr, "swarmbox-train-detector: --calibration-sets must be 1..99\n");
     return false;
   }
-  args->options.calibration_seeds = td::CalibrationSeeds(n);
+  args->options.calibration_seeds = td::SeedSets(td::kCalibrationSeedBase, n);
   return true;
 }
 

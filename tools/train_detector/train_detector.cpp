@@ -329,7 +329,7 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
-  if (o.calibration_seeds != CalibrationSeeds(2)) r << " --calibration-sets " << o.calibration_seeds.size();
+  if (o.calibration_seeds != SeedSets(kCalibrationSeedBase, 2)) r << " --calibration-sets " << o.calibration_seeds.size();
   if (o.clean_calibration) r << " --clean-calibration";
   if (!o.cnn_script.empty()) r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed;
   return r.str();
@@ -337,14 +337,14 @@ std::string RecipeText(const TrainingOptions& o) {
 
 TrainingOptions DefaultTrainingOptions() {
   TrainingOptions o;
-  for (std::uint64_t i = 1; i <= 8; ++i) o.training_seeds.push_back(7'000'000 + i);
-  o.calibration_seeds = CalibrationSeeds(2);
+  o.training_seeds = SeedSets(kTrainingSeedBase, 8);
+  o.calibration_seeds = SeedSets(kCalibrationSeedBase, 2);
   return o;
 }
 
-std::vector<std::uint64_t> CalibrationSeeds(int sets) {
+std::vector<std::uint64_t> SeedSets(std::uint64_t base, int sets) {
   std::vector<std::uint64_t> seeds;
-  for (int k = 1; k <= sets; ++k) seeds.push_back(kCalibrationSeedBase + static_cast<std::uint64_t>(k));
+  for (int k = 1; k <= sets; ++k) seeds.push_back(base + static_cast<std::uint64_t>(k));
   return seeds;
 }
 
@@ -385,9 +385,7 @@ namespace {
 
 // The seeds of the cones-and-rubble sets.
 std::vector<std::uint64_t> NegativesSeeds(const TrainingOptions& o) {
-  std::vector<std::uint64_t> seeds;
-  for (int k = 1; k <= o.negatives_sets; ++k) seeds.push_back(kNegativesSeedBase + static_cast<std::uint64_t>(k));
-  return seeds;
+  return SeedSets(kNegativesSeedBase, o.negatives_sets);
 }
 
 Result<std::vector<Scene>> RenderCalibrationSets(const TrainingOptions& o) {

@@ -103,9 +103,11 @@ enum class PatchSplit : std::uint8_t { kTraining = 0, kCalibration = 1 };
 // The cones-and-rubble sets' seeds start above this (disjoint from training, calibration and
 // evaluation seeds).
 inline constexpr std::uint64_t kNegativesSeedBase = 7'200'000;
-// The calibration sets' seeds start above this (CalibrationSeeds(n): 7100001..7100000+n).
+// The training and calibration sets' seeds start above these.
+inline constexpr std::uint64_t kTrainingSeedBase = 7'000'000;
 inline constexpr std::uint64_t kCalibrationSeedBase = 7'100'000;
-std::vector<std::uint64_t> CalibrationSeeds(int sets);
+// The seeds of `sets` scene sets: base + 1 .. base + sets.
+std::vector<std::uint64_t> SeedSets(std::uint64_t base, int sets);
 
 // Half the width of the calibration altitude band [m].
 inline constexpr double kCalibrationAltitudeBandM = 3.0;
