@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -9,6 +11,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "swarmbox/common/split.hpp"
 #include "swarmbox/physics/airframe.hpp"
 #include "swarmbox/physics/ground_renderer.hpp"
 #include "swarmbox/physics/world.hpp"
@@ -436,6 +439,88 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double di
     }
   }
   return scenes;
+}
+
+
+namespace {
+
+// truth.csv's columns the replay reads, by name (truth_log.cpp writes the header).
+struct TruthColumns {
+  static constexpr const char* kNames[] = {"t_s", "drone", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz",
+                                           "p_rad_s", "q_rad_s", "r_rad_s"};
+  std::size_t at[std::size(kNames)] = {};
+};
+
+Result<TruthColumns> ReadTruthHeader(const std::string& header, const std::string& path) {
+  TruthColumns c;
+  const std::vector<std::string_view> names = SplitOn(header, ',');
+  for (std::size_t k = 0; k < std::size(TruthColumns::kNames); ++k) {
+    const auto it = std::find(names.begin(), names.end(), TruthColumns::kNames[k]);
+    if (it == names.end()) {
+      return Error(ErrorCode::kInvalidArgument, std::string("truth.csv has no column ") + TruthColumns::kNames[k], path);
+    }
+    c.at[k] = static_cast<std::size_t>(it - names.begin());
+  }
+  return c;
+}
+
+// A camera drone's state in the replay: where its last frame was taken.
+struct ReplayCamera {
+  bool taken = false;
+  Vector2d last_xy = Vector2d::Zero();
+  double last_t_s = 0.0;
+  std::uint64_t frames = 0;
+};
+
+}  // namespace
+
+Status ReplayTrial(const ReplayParams& params,
+                   const std::function<void(const physics::WorldConfig&, const ReplayFrame&)>& on_frame) {
+  Result<physics::WorldConfig> world = physics::LoadWorld(params.trial_dir + "/world.yaml");
+  if (!world) return world.error().Context("replaying a trial (is it a generated world's trial folder?)");
+  Result<physics::Airframe> x500 = CameraAirframe();
+  if (!x500) return x500.error();
+  const std::string truth_path = params.trial_dir + "/truth.csv";
+  std::ifstream truth(truth_path);
+  if (!truth) return Error(ErrorCode::kNotFound, "cannot read the trial's truth.csv", truth_path);
+  std::string line;
+  std::getline(truth, line);
+  Result<TruthColumns> cols = ReadTruthHeader(line, truth_path);
+  if (!cols) return cols.error();
+  const physics::CameraSpec& camera = x500->camera;
+  physics::GroundRenderer renderer(*world);
+  std::map<std::string, ReplayCamera, std::less<>> cameras;
+  physics::CameraImage image;
+  std::vector<physics::VisiblePerson> people;
+  std::size_t row = 1;
+  while (std::getline(truth, line)) {
+    ++row;
+    const std::vector<std::string_view> cells = SplitOn(line, ',');
+    double v[std::size(TruthColumns::kNames)] = {};
+    for (std::size_t k = 0; k < std::size(v); ++k) {
+      if (cols->at[k] >= cells.size()) {
+        return Error(ErrorCode::kInvalidArgument, "truth.csv row " + std::to_string(row) + " is short", truth_path);
+      }
+      if (k != 1) v[k] = std::strtod(std::string(cells[cols->at[k]]).c_str(), nullptr);
+    }
+    const std::string_view drone = cells[cols->at[1]];
+    if (!drone.starts_with(params.drone_prefix) || v[4] < params.min_height_m || v[4] > params.max_height_m) continue;
+    ReplayCamera& cam = cameras[std::string(drone)];
+    const Vector2d xy(v[2], v[3]);
+    const bool due = !cam.taken ||
+                     (camera.trigger_distance_m > 0 ? (xy - cam.last_xy).norm() >= camera.trigger_distance_m
+                                                    : v[0] - cam.last_t_s >= 1.0 / camera.rate_hz);
+    if (!due) continue;
+    cam.taken = true;
+    cam.last_xy = xy;
+    cam.last_t_s = v[0];
+    const physics::Pose body{{v[2], v[3], v[4]}, {v[5], v[6], v[7], v[8]}};
+    const std::uint64_t noise_seed = std::hash<std::string_view>{}(drone) ^ (++cam.frames << 20);
+    renderer.Render(body, {v[9], v[10], v[11]}, camera, noise_seed, &image, &people);
+    ReplayFrame f{std::string(drone), v[0], WithTilt(SceneFromImage(image, *world, camera.noise_std, people))};
+    on_frame(*world, f);
+  }
+  return Ok{};
 }
 
 }  // namespace swarmbox::perception_scenes

@@ -25,6 +25,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
@@ -105,5 +107,32 @@ Result<Scene> RenderView(const physics::WorldConfig& world, const Eigen::Vector2
 // server's own attitude and camera mounting, not a pose made up here.
 Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& params, double differential,
                                               double burst_s);
+
+// A flown trial's camera frames, rendered again (`swarmbox-bench perception --replay RUN`): the
+// trial folder's world.yaml and truth.csv (every drone's pose and body rates over simulated time)
+// give each camera drone's frames as its camera took them in flight, through the same
+// GroundRenderer, with the renderer's truth: the detector's figures on the mission's own frames
+// (its altitudes, speeds, tilts, motion blur, light and ground), which tells a victim the mission
+// never saw from one it saw and failed to confirm. A frame is taken each time the drone has moved
+// the airframe camera's trigger_distance_m horizontally since the last (or 1 / rate_hz s of
+// truth without trigger_distance_m), while it is between min_height_m and max_height_m above the
+// ground; the truth rows are the physics server's (10 Hz by default), so a frame lands within one
+// row of where the camera's trigger fired. The pixel noise is seeded per frame, not the server's.
+struct ReplayParams {
+  std::string trial_dir;               // holds world.yaml and truth.csv
+  std::string drone_prefix = "scout";  // which drones carry the camera (name prefix)
+  double min_height_m = 10.0;
+  double max_height_m = 60.0;
+};
+struct ReplayFrame {
+  std::string drone;
+  double t_s = 0.0;
+  Scene scene;
+};
+// Calls on_frame for each frame in truth.csv's order (frames are not kept: a 15-minute mission is
+// thousands). kNotFound without world.yaml or truth.csv; kInvalidArgument for a truth.csv without
+// its columns or with a short row.
+Status ReplayTrial(const ReplayParams& params,
+                   const std::function<void(const physics::WorldConfig&, const ReplayFrame&)>& on_frame);
 
 }  // namespace swarmbox::perception_scenes

@@ -15,12 +15,15 @@
 // estimated poses, tilted cameras) as before.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <map>
 #include <cstdio>
 #include <memory>
 #include <numbers>
 #include <string>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "bench.hpp"
 #include "perception_score.hpp"
@@ -30,6 +33,8 @@ namespace {
 
 using namespace swarmbox::swarm;
 using namespace swarmbox::swarm::testing;
+using swarmbox::perception_scenes::ReplayFrame;
+using swarmbox::perception_scenes::ReplayTrial;
 
 struct Scenario {
   std::string name;
@@ -103,6 +108,156 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
   return 0;
 }
 
+// --replay RUN: the trial's own camera frames (perception_scenes.hpp ReplayTrial), one line for all
+// of them (persons at least half visible, tp, fp, precision and recall at 0.5, max_recall), one
+// line per victim (its look, the frames it was at least half visible in, the frames it was
+// detected in at >= 0.5, its highest confidence, the nearest the camera's nadir came to it) and
+// one per kind of thing the false alarms at >= 0.5 lay on (the nearest distractor within 1.5 m,
+// else an obstacle's footprint, else the ground). --crops DIR writes each victim's best view (the
+// frame where it was most visible, nearest the nadir) as DIR/<victim id>.png, 128 px around it.
+struct ReplayVictim {
+  int frames_half_visible = 0;
+  int frames_detected = 0;
+  double max_confidence = 0.0;
+  double nearest_nadir_m = 1e9;
+  double best_visible = -1.0;
+  double best_nadir_m = 1e9;
+  cv::Mat best_crop;
+};
+
+std::string LookOf(const swarmbox::physics::Victim& v) {
+  char look[96];
+  const auto c = v.clothing_bgr.value_or(swarmbox::physics::Bgr{0, 120, 255});
+  std::snprintf(look, sizeof look, "%s:%d:%d:%d:cover%.2f:h%.2f", swarmbox::physics::ToString(v.pose), c[0], c[1], c[2],
+                v.cover, v.height_m);
+  return look;
+}
+
+// What a false alarm at ground point g lay on.
+std::string FalseAlarmSite(const swarmbox::physics::WorldConfig& w, const Eigen::Vector2d& g) {
+  double best = 1.5;
+  std::string site;
+  for (const swarmbox::physics::Distractor& d : w.distractors) {
+    const double e = (Eigen::Vector2d(d.x_m, d.y_m) - g).norm();
+    if (e <= best) {
+      best = e;
+      char name[64];
+      std::snprintf(name, sizeof name, "%s:%d:%d:%d", swarmbox::physics::ToString(d.kind), d.colour_bgr[0],
+                    d.colour_bgr[1], d.colour_bgr[2]);
+      site = name;
+    }
+  }
+  if (!site.empty()) return site;
+  for (const swarmbox::physics::ObstacleBox& b : w.obstacles) {
+    if ((Eigen::Vector2d(b.center_m.x, b.center_m.y) - g).norm() <= 0.5 * std::hypot(b.size_m.x, b.size_m.y)) {
+      return "obstacle";
+    }
+  }
+  return "ground";
+}
+
+int RunReplay(const swarmbox::bench::Args& args, const std::shared_ptr<const VictimDetectorModel>& model) {
+  cv::setNumThreads(1);
+  VictimDetectorParams params;
+  params.max_candidates = static_cast<int>(args.GetInt("max-candidates", params.max_candidates));
+  VictimDetector detector(model, params);
+  const std::string crops = args.Get("crops", "");
+  std::vector<ReplayVictim> victims;
+  std::map<std::string, int> false_sites;
+  int frames = 0, persons = 0, tp = 0, fp = 0;
+  std::vector<ImageBlob> blobs;
+  const swarmbox::Status st = ReplayTrial(
+      {.trial_dir = args.Get("replay", ""), .drone_prefix = args.Get("drones", "scout")},
+      [&](const swarmbox::physics::WorldConfig& w, const ReplayFrame& f) {
+        const Scene& s = f.scene;
+        ++frames;
+        victims.resize(s.victims.size());
+        const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
+        detector.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs);
+        const Eigen::Vector2d nadir = s.true_pose.position_m.head<2>();
+        std::vector<bool> matched(s.victims.size(), false);
+        for (std::size_t i = 0; i < s.victims.size(); ++i) {
+          ReplayVictim& rv = victims[i];
+          const double off = (s.victims[i].position_m - nadir).norm();
+          rv.nearest_nadir_m = std::min(rv.nearest_nadir_m, off);
+          if (s.victims[i].visible_fraction >= 0.5) {
+            ++persons;
+            ++rv.frames_half_visible;
+          }
+          const double vis = s.victims[i].visible_fraction;
+          if (!crops.empty() && vis > 0 && (vis > rv.best_visible + 0.05 || (vis > rv.best_visible - 0.05 && off < rv.best_nadir_m))) {
+            const std::optional<Eigen::Vector2d> px =
+                ProjectToPixel(Eigen::Vector3d(s.victims[i].position_m.x(), s.victims[i].position_m.y(), 0.0),
+                               s.intrinsics, s.true_pose);
+            if (px) {
+              const cv::Rect r = cv::Rect(static_cast<int>(px->x()) - 64, static_cast<int>(px->y()) - 64, 128, 128) &
+                                 cv::Rect(0, 0, bgr.cols, bgr.rows);
+              if (r.area() > 0) {
+                rv.best_crop = bgr(r).clone();
+                rv.best_visible = vis;
+                rv.best_nadir_m = off;
+              }
+            }
+          }
+        }
+        for (const ImageBlob& b : blobs) {
+          const std::optional<Eigen::Vector3d> g = PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
+          if (!g) continue;
+          std::size_t best = s.victims.size();
+          double best_d = 1.5;
+          for (std::size_t i = 0; i < s.victims.size(); ++i) {
+            const double e = (s.victims[i].position_m - g->head<2>()).norm();
+            if (s.victims[i].visible_fraction > 0 && e <= best_d) {
+              best_d = e;
+              best = i;
+            }
+          }
+          if (best < s.victims.size()) {
+            ReplayVictim& rv = victims[best];
+            if (s.victims[best].visible_fraction >= 0.5) rv.max_confidence = std::max(rv.max_confidence, b.confidence);
+            if (b.confidence >= 0.5 && !matched[best]) {
+              matched[best] = true;
+              ++rv.frames_detected;
+              if (s.victims[best].visible_fraction >= 0.5) ++tp;
+            }
+          } else if (b.confidence >= 0.5) {
+            ++fp;
+            ++false_sites[FalseAlarmSite(w, g->head<2>())];
+          }
+        }
+      });
+  cv::setNumThreads(-1);
+  if (!st) {
+    std::fprintf(stderr, "perception bench: %s\n", st.error().ToString().c_str());
+    return 2;
+  }
+  swarmbox::Result<swarmbox::physics::WorldConfig> world =
+      swarmbox::physics::LoadWorld(args.Get("replay", "") + "/world.yaml");
+  if (!world) return 2;
+  std::puts(swarmbox::LogEvent(0.0, "bench", "bench_result")
+                .Add("suite", "perception").Add("case", "replay").Add("frames", frames).Add("persons", persons)
+                .Add("tp", tp).Add("fp", fp)
+                .Add("precision", tp + fp ? static_cast<double>(tp) / (tp + fp) : 1.0, 4)
+                .Add("recall", persons ? static_cast<double>(tp) / persons : 1.0, 4)
+                .str().c_str());
+  for (std::size_t i = 0; i < victims.size() && i < world->victims.size(); ++i) {
+    const ReplayVictim& rv = victims[i];
+    std::puts(swarmbox::LogEvent(0.0, "bench", "bench_result")
+                  .Add("suite", "perception").Add("case", "replay_victim").Add("victim", world->victims[i].id)
+                  .Add("look", LookOf(world->victims[i]))
+                  .Add("frames_half_visible", rv.frames_half_visible).Add("frames_detected", rv.frames_detected)
+                  .Add("max_confidence", rv.max_confidence, 3).Add("nearest_nadir_m", rv.nearest_nadir_m, 1)
+                  .str().c_str());
+    if (!crops.empty() && !rv.best_crop.empty()) cv::imwrite(crops + "/" + world->victims[i].id + ".png", rv.best_crop);
+  }
+  for (const auto& [site, n] : false_sites) {
+    std::puts(swarmbox::LogEvent(0.0, "bench", "bench_result")
+                  .Add("suite", "perception").Add("case", "replay_false_alarms").Add("site", site).Add("count", n)
+                  .str().c_str());
+  }
+  return 0;
+}
+
 int RunPerceptionBench(const swarmbox::bench::Args& args) {
   const auto seed = static_cast<std::uint64_t>(args.GetInt("seed", 20261121));
   std::shared_ptr<const VictimDetectorModel> model = ShippedDetectorModel();
@@ -122,6 +277,7 @@ int RunPerceptionBench(const swarmbox::bench::Args& args) {
       return 2;
     }
   }
+  if (args.options.count("replay") != 0) return RunReplay(args, model);
   if (int rc = RunCurves(args, seed, model); rc != 0) return rc;
   // The pipeline scenarios run the shipped model (VictimPerception): a --model file gets the curves.
   if (args.GetInt("curves_only", 0) != 0 || model_file != args.options.end()) return 0;
