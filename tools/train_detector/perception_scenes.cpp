@@ -391,6 +391,24 @@ Status FlyBurst(const TiltedDrones& tilted, double burst_s, physics::World& worl
 
 }  // namespace
 
+worlds::GenerateSpec SarRubbleSpec() {
+  return {.kind = worlds::WorldKind::kRubbleField, .size_m = {160, 160}, .victims = 4, .obstacles = 30, .distractors = 25};
+}
+
+namespace {
+
+// A generated world from `spec`, its seed drawn from rng (below 1e9, as a trial's world seed is).
+Result<physics::WorldConfig> GeneratedWorld(std::mt19937_64& rng, const worlds::GenerateSpec& spec) {
+  const std::uint64_t seed = rng() % 1'000'000'000ULL;
+  Result<std::string> text = worlds::GenerateWorld(spec, seed);
+  if (!text) return text.error().Context("generating a perception world");
+  Result<yaml::Node> root = yaml::Parse(*text, "generated world " + std::to_string(seed));
+  if (!root) return root.error();
+  return physics::ParseWorld(*root, "generated world " + std::to_string(seed));
+}
+
+}  // namespace
+
 Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
   Result<physics::Airframe> x500 = CameraAirframe();
   if (!x500) return x500.error();
@@ -399,7 +417,14 @@ Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
   scenes.reserve(static_cast<std::size_t>(p.scenes));
   int world_index = 0;
   while (static_cast<int>(scenes.size()) < p.scenes) {
-    const physics::WorldConfig config = MakeWorld(rng, world_index, p);
+    physics::WorldConfig config;
+    if (p.generated) {
+      Result<physics::WorldConfig> generated = GeneratedWorld(rng, *p.generated);
+      if (!generated) return generated.error();
+      config = std::move(*generated);
+    } else {
+      config = MakeWorld(rng, world_index, p);
+    }
     Result<std::unique_ptr<physics::World>> world = physics::World::Create(config, {.seed = rng()});
     if (!world) return world.error().Context("creating perception world");
     const int count = std::min(p.scenes_per_world, p.scenes - static_cast<int>(scenes.size()));

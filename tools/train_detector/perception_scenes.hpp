@@ -26,6 +26,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,7 @@
 #include "swarmbox/physics/camera_image.hpp"
 #include "swarmbox/physics/world_config.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
+#include "swarmbox/worlds/generator.hpp"
 
 namespace swarmbox::perception_scenes {
 
@@ -88,7 +90,18 @@ struct SceneSetParams {
   int distractors = 0;                 // distractors near each victim
   bool varied_look = false;            // terrain, light, poses, clothing, cover, distractor kinds
   DistractorMix distractor_mix = DistractorMix::kAllKinds;  // with varied_look only
+  // Set: the worlds are generated search areas (orchestrator/worlds GenerateWorld, as a trial's
+  // `world: {generate: ...}` makes them; the spec's seed is ignored, each world's is drawn from
+  // `seed`), with their own terrain, light, people, cover, obstacles and distractors:
+  // occluded_fraction, distractors, varied_look and distractor_mix are not used. The views are
+  // placed as above (near_victim_fraction of them near a person).
+  std::optional<worlds::GenerateSpec> generated{};
 };
+
+// The mission's search area (trials/sar_rubble.yaml's world: a 160 x 160 m rubble field, 4
+// people, 30 slabs and walls, 25 distractors): what the trainer's world sets and the bench's
+// world case generate.
+worlds::GenerateSpec SarRubbleSpec();
 
 // Scene-set seeds the perception tests and the bench evaluate on by default: never trained on.
 inline constexpr std::uint64_t kEvaluationSeeds[] = {20261121, 30, 40, 77, 78, 1, 2, 3, 4, 5};

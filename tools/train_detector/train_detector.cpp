@@ -326,6 +326,7 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.balance_classes) r << " --balance-classes";
   if (o.blob_features) r << " --blob-features";
   if (o.negatives_sets > 0) r << " --negatives-sets " << o.negatives_sets;
+  if (o.world_sets > 0) r << " --world-sets " << o.world_sets;
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
@@ -372,6 +373,14 @@ perception_scenes::SceneSetParams NegativesSceneSet(std::uint64_t seed, int scen
   return p;
 }
 
+perception_scenes::SceneSetParams WorldSceneSet(std::uint64_t seed, int scenes) {
+  perception_scenes::SceneSetParams p = TrainingSceneSet(seed, scenes);
+  p.min_altitude_m = 15.0;
+  p.max_altitude_m = 45.0;
+  p.generated = perception_scenes::SarRubbleSpec();
+  return p;
+}
+
 perception_scenes::SceneSetParams CalibrationSceneSet(std::uint64_t seed, int scenes, double calibration_altitude_m) {
   perception_scenes::SceneSetParams p = TrainingSceneSet(seed, scenes);
   if (calibration_altitude_m > 0) {
@@ -387,6 +396,8 @@ namespace {
 std::vector<std::uint64_t> NegativesSeeds(const TrainingOptions& o) {
   return SeedSets(kNegativesSeedBase, o.negatives_sets);
 }
+// The seeds of the generated rubble-field sets.
+std::vector<std::uint64_t> WorldSeeds(const TrainingOptions& o) { return SeedSets(kWorldsSeedBase, o.world_sets); }
 
 Result<std::vector<Scene>> RenderCalibrationSets(const TrainingOptions& o) {
   return RenderSets(
@@ -594,15 +605,16 @@ namespace {
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
       o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
-      o.negatives_sets < 0 || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
+      o.negatives_sets < 0 || o.world_sets < 0 || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty())) {
     return Error(ErrorCode::kInvalidArgument,
                  "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
-                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets and "
+                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, world_sets and "
                  "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path");
   }
   const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
-  for (const auto* list : {&o.training_seeds, &o.calibration_seeds, &negatives_seeds}) {
+  const std::vector<std::uint64_t> world_seeds = WorldSeeds(o);
+  for (const auto* list : {&o.training_seeds, &o.calibration_seeds, &negatives_seeds, &world_seeds}) {
     for (std::uint64_t s : *list) {
       for (std::uint64_t e : perception_scenes::kEvaluationSeeds) {
         if (s == e) return Error(ErrorCode::kInvalidArgument, "training seed " + std::to_string(s) + " is an evaluation seed");
@@ -723,6 +735,7 @@ Labelled Stage2Positives(const swarm::VictimDetectorModel& model, const Labelled
 Labelled TrainStage1(Training& t, const std::vector<Scene>& train) {
   t.model.training_seeds = t.o.training_seeds;
   for (std::uint64_t seed : NegativesSeeds(t.o)) t.model.training_seeds.push_back(seed);
+  for (std::uint64_t seed : WorldSeeds(t.o)) t.model.training_seeds.push_back(seed);
   t.model.calibration_seeds = t.o.calibration_seeds;
   t.model.SetLinear(std::vector<double>(swarm::kWindowFeatures, 0.0), 0.0);
   t.model.forest = cv::ml::RTrees::create();  // replaced below; the detector needs one to exist
@@ -997,6 +1010,11 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
   if (!train) return train.error();
   if (o.negatives_sets > 0) {
     Result<std::vector<Scene>> extra = RenderSets(NegativesSeeds(o), o.scenes_per_set, NegativesSceneSet);
+    if (!extra) return extra.error();
+    for (Scene& x : *extra) train->push_back(std::move(x));
+  }
+  if (o.world_sets > 0) {
+    Result<std::vector<Scene>> extra = RenderSets(WorldSeeds(o), o.scenes_per_set, WorldSceneSet);
     if (!extra) return extra.error();
     for (Scene& x : *extra) train->push_back(std::move(x));
   }

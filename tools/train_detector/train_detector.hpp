@@ -58,6 +58,11 @@ struct TrainingOptions {
   // (perception_scenes::DistractorMix::kConesRubble, 4 cones per person): more of the blob model's
   // false alarms among the second stage's negatives (the shipped recipe: 4). 0: none.
   int negatives_sets = 0;
+  // Extra training sets (seeds kWorldsSeedBase + 1..N) on the mission's generated rubble fields
+  // (perception_scenes::SarRubbleSpec, views at 15-45 m): the rubble ground, slabs, cover and
+  // distractors the mission meets, where stage 1 trained on the mixed terrains alone ranked half
+  // the people below its 48 candidates (`swarmbox-bench perception --only world:1`). 0: none.
+  int world_sets = 0;
   // The first stage's cap on candidates per frame while calibrating and mining hard negatives (the
   // detector's default, VictimDetectorParams::max_candidates, unless set: a blob model is run at 96).
   int max_candidates = swarm::VictimDetectorParams{}.max_candidates;
@@ -103,6 +108,8 @@ enum class PatchSplit : std::uint8_t { kTraining = 0, kCalibration = 1 };
 // The cones-and-rubble sets' seeds start above this (disjoint from training, calibration and
 // evaluation seeds).
 inline constexpr std::uint64_t kNegativesSeedBase = 7'200'000;
+// The generated rubble-field sets' seeds start above this.
+inline constexpr std::uint64_t kWorldsSeedBase = 7'300'000;
 // The training and calibration sets' seeds start above these.
 inline constexpr std::uint64_t kTrainingSeedBase = 7'000'000;
 inline constexpr std::uint64_t kCalibrationSeedBase = 7'100'000;
@@ -127,6 +134,10 @@ perception_scenes::SceneSetParams TrainingSceneSet(std::uint64_t seed, int scene
 // A cones-and-rubble set (TrainingOptions::negatives_sets): the training mix, every world in the
 // varied look on rubble terrain, 4 traffic cones per person.
 perception_scenes::SceneSetParams NegativesSceneSet(std::uint64_t seed, int scenes);
+
+// A generated rubble-field set (TrainingOptions::world_sets): worlds as sar_rubble.yaml generates
+// them, views at 15-45 m, 80 % of them near a person.
+perception_scenes::SceneSetParams WorldSceneSet(std::uint64_t seed, int scenes);
 
 // A calibration set: the training mix, at calibration_altitude_m +- kCalibrationAltitudeBandM when
 // that is not 0.

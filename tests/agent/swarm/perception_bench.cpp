@@ -8,6 +8,8 @@
 //   case=altitude     altitude_m=10|20|30|40|60 (30 % of the people partly covered, 2 distractors each)
 //   case=occlusion    occluded_fraction=0|0.5|1 at 30 m (share of the people under 20-80 % cover)
 //   case=distractors  distractors=0|2|6 per person at 30 m
+//   case=world        world=rubble_field at 30 m: the mission's generated fields (sar_rubble.yaml's
+//                     recipe, perception_scenes.hpp SarRubbleSpec; --only world:1)
 // with persons (at least half visible), tp, fp, precision and recall at confidence 0.5, ap (VOC,
 // all detections), recall_at_p90 (the highest recall at precision >= 0.9, any confidence: a point
 // of the curve, not an operating point), max_recall (all detections) and ms_per_frame (Detect() on
@@ -63,6 +65,9 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
   for (double a : {10.0, 20.0, 30.0, 40.0, 60.0}) cases.push_back({"altitude", "altitude_m", a, at(a, 0.3, 2)});
   for (double o : {0.0, 0.5, 1.0}) cases.push_back({"occlusion", "occluded_fraction", o, at(30, o, 2)});
   for (int d : {0, 2, 6}) cases.push_back({"distractors", "distractors", static_cast<double>(d), at(30, 0.3, d)});
+  SceneSetParams rubble = at(30, 0, 0);
+  rubble.generated = SarRubbleSpec();
+  cases.push_back({"world", "world_rubble_field", 1, rubble});
   if (args.quick) cases.resize(2);
   // --only KIND:VALUE (e.g. altitude:30, distractors:0): that case alone.
   if (const std::string only = args.Get("only", ""); !only.empty()) {
@@ -73,7 +78,7 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
     });
     if (cases.empty()) {
       std::fprintf(stderr, "perception bench: --only %s names no case (altitude:10|20|30|40|60, occlusion:0|0.5|1, "
-                   "distractors:0|2|6)\n", only.c_str());
+                   "distractors:0|2|6, world:1)\n", only.c_str());
       return 2;
     }
   }
@@ -90,7 +95,8 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
     const DetectionCurve d = ScoreDetections(*scenes, detector);
     swarmbox::LogEvent line(0.0, "bench", "bench_result");
     line.Add("suite", "perception").Add("case", c.kind).Add("seed", seed);
-    line.Add(c.key, c.value, c.key == "occluded_fraction" ? 1 : 0);
+    if (c.kind == "world") line.Add("world", "rubble_field");  // sar_rubble.yaml's generated fields
+    else line.Add(c.key, c.value, c.key == "occluded_fraction" ? 1 : 0);
     if (c.kind != "altitude") line.Add("altitude_m", 30);
     line.Add("scenes", d.scenes)
         .Add("persons", d.persons)

@@ -1,6 +1,7 @@
 // ReplayTrial (perception_scenes.hpp): a trial folder's camera frames rendered again from its
 // truth.csv. A synthetic folder: one victim at the origin, scout_1 flying a straight line over it
-// at 30 m and 5 m/s (10 Hz truth rows), the lifter below the height window.
+// at 30 m and 5 m/s (10 Hz truth rows), the lifter below the height window. And scene sets on
+// generated worlds, which the trainer and the bench also render.
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -85,6 +86,39 @@ TEST_F(ReplayFolder, RefusesAFolderWithoutTruthOrWithoutItsColumns) {
   EXPECT_EQ(columns.error().code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(columns.error().ToString().find("qw"), std::string::npos) << columns.error().ToString();
   EXPECT_EQ(frames, 0);
+}
+
+}  // namespace
+}  // namespace swarmbox::swarm
+
+namespace swarmbox::swarm {
+namespace {
+
+// Scene sets on generated search areas (SceneSetParams::generated): the mission's rubble fields,
+// four people each, seeded like any scene set.
+TEST(GeneratedScenes, ComeFromTheMissionsRubbleFieldsAndRepeatWithTheSeed) {
+  testing::SceneSetParams p{.seed = 5, .scenes = 4, .scenes_per_world = 2, .min_altitude_m = 30, .max_altitude_m = 30,
+                            .near_victim_fraction = 1.0, .near_victim_offset = 0.2};
+  p.generated = testing::SarRubbleSpec();
+  Result<std::vector<testing::Scene>> a = testing::RenderScenes(p);
+  ASSERT_TRUE(a.ok()) << a.error().ToString();
+  Result<std::vector<testing::Scene>> b = testing::RenderScenes(p);
+  ASSERT_TRUE(b.ok()) << b.error().ToString();
+  ASSERT_EQ(a->size(), 4u);
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    const testing::Scene& s = (*a)[i];
+    ASSERT_EQ(s.victims.size(), 4u);
+    double seen = 0;
+    for (const auto& v : s.victims) {
+      EXPECT_LE(std::abs(v.position_m.x()), 80.0);  // inside the 160 x 160 m field
+      EXPECT_LE(std::abs(v.position_m.y()), 80.0);
+      seen = std::max(seen, v.visible_fraction);
+    }
+    EXPECT_GT(seen, 0.0) << "scene " << i << " is centred near a person";
+    EXPECT_EQ(s.image.bgr, (*b)[i].image.bgr) << "scene " << i;
+  }
+  // Two worlds: the third scene's people are not the first's.
+  EXPECT_NE((*a)[0].victims[0].position_m, (*a)[2].victims[0].position_m);
 }
 
 }  // namespace

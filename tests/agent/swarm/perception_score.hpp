@@ -14,6 +14,7 @@ namespace swarmbox::swarm::testing {
 using perception_scenes::RenderScenes;
 using perception_scenes::RenderTiltedScenes;
 using perception_scenes::Scene;
+using perception_scenes::SarRubbleSpec;
 using perception_scenes::SceneSetParams;
 using perception_scenes::SceneVictim;
 using perception_scenes::Visibility;
