@@ -489,13 +489,52 @@ Result<TruthColumns> ReadTruthHeader(const std::string& header, const std::strin
   return c;
 }
 
+// One truth.csv row's values, in TruthColumns::kNames order (the drone's name aside).
+struct TruthRow {
+  std::string_view drone;
+  double v[std::size(TruthColumns::kNames)] = {};
+};
+
+Status ParseTruthRow(std::string_view line, const TruthColumns& cols, std::size_t row, const std::string& path,
+                     TruthRow* out) {
+  const std::vector<std::string_view> cells = SplitOn(line, ',');
+  for (std::size_t k = 0; k < std::size(out->v); ++k) {
+    if (cols.at[k] >= cells.size()) {
+      return Error(ErrorCode::kInvalidArgument, "truth.csv row " + std::to_string(row) + " is short", path);
+    }
+    if (k != 1) out->v[k] = std::strtod(std::string(cells[cols.at[k]]).c_str(), nullptr);
+  }
+  out->drone = cells[cols.at[1]];
+  return Ok{};
+}
+
 // A camera drone's state in the replay: where its last frame was taken.
 struct ReplayCamera {
   bool taken = false;
   Vector2d last_xy = Vector2d::Zero();
   double last_t_s = 0.0;
   std::uint64_t frames = 0;
+
+  // Whether the camera takes a frame at `xy` and `t_s` (its trigger distance, else its rate);
+  // when it does, it counts it.
+  bool Take(const Vector2d& xy, double t_s, const physics::CameraSpec& camera) {
+    const bool due = !taken || (camera.trigger_distance_m > 0 ? (xy - last_xy).norm() >= camera.trigger_distance_m
+                                                              : t_s - last_t_s >= 1.0 / camera.rate_hz);
+    if (!due) return false;
+    taken = true;
+    last_xy = xy;
+    last_t_s = t_s;
+    ++frames;
+    return true;
+  }
 };
+
+// A frame's pixel-noise seed: the drone's name (FNV-1a) and its frame count.
+std::uint64_t ReplayNoiseSeed(std::string_view drone, std::uint64_t frame) {
+  std::uint64_t h = 1469598103934665603ULL;
+  for (const char c : drone) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ULL;
+  return h ^ (frame << 20);
+}
 
 }  // namespace
 
@@ -518,31 +557,16 @@ Status ReplayTrial(const ReplayParams& params,
   physics::CameraImage image;
   std::vector<physics::VisiblePerson> people;
   std::size_t row = 1;
+  TruthRow r;
   while (std::getline(truth, line)) {
-    ++row;
-    const std::vector<std::string_view> cells = SplitOn(line, ',');
-    double v[std::size(TruthColumns::kNames)] = {};
-    for (std::size_t k = 0; k < std::size(v); ++k) {
-      if (cols->at[k] >= cells.size()) {
-        return Error(ErrorCode::kInvalidArgument, "truth.csv row " + std::to_string(row) + " is short", truth_path);
-      }
-      if (k != 1) v[k] = std::strtod(std::string(cells[cols->at[k]]).c_str(), nullptr);
-    }
-    const std::string_view drone = cells[cols->at[1]];
-    if (!drone.starts_with(params.drone_prefix) || v[4] < params.min_height_m || v[4] > params.max_height_m) continue;
-    ReplayCamera& cam = cameras[std::string(drone)];
-    const Vector2d xy(v[2], v[3]);
-    const bool due = !cam.taken ||
-                     (camera.trigger_distance_m > 0 ? (xy - cam.last_xy).norm() >= camera.trigger_distance_m
-                                                    : v[0] - cam.last_t_s >= 1.0 / camera.rate_hz);
-    if (!due) continue;
-    cam.taken = true;
-    cam.last_xy = xy;
-    cam.last_t_s = v[0];
+    SWARMBOX_TRY(ParseTruthRow(line, *cols, ++row, truth_path, &r));
+    const double* v = r.v;
+    if (!r.drone.starts_with(params.drone_prefix) || v[4] < params.min_height_m || v[4] > params.max_height_m) continue;
+    ReplayCamera& cam = cameras[std::string(r.drone)];
+    if (!cam.Take(Vector2d(v[2], v[3]), v[0], camera)) continue;
     const physics::Pose body{{v[2], v[3], v[4]}, {v[5], v[6], v[7], v[8]}};
-    const std::uint64_t noise_seed = std::hash<std::string_view>{}(drone) ^ (++cam.frames << 20);
-    renderer.Render(body, {v[9], v[10], v[11]}, camera, noise_seed, &image, &people);
-    ReplayFrame f{std::string(drone), v[0], WithTilt(SceneFromImage(image, *world, camera.noise_std, people))};
+    renderer.Render(body, {v[9], v[10], v[11]}, camera, ReplayNoiseSeed(r.drone, cam.frames), &image, &people);
+    ReplayFrame f{std::string(r.drone), v[0], WithTilt(SceneFromImage(image, *world, camera.noise_std, people))};
     on_frame(*world, f);
   }
   return Ok{};

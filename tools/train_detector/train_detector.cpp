@@ -37,6 +37,8 @@ constexpr double kMustDetectFraction = 0.5;   // "at least half visible"
 constexpr double kPositiveRadiusM = 0.75;
 constexpr double kNegativeRadiusM = 1.5;
 constexpr int kRandomNegativesPerScene = 40;
+// Stage 1's hard negatives per scene and bootstrapping round (AddStage1HardNegatives).
+constexpr int kStage1HardPerScene = 16;
 constexpr int kStage2CandidatesPerScene = 96;
 // A window one cell (0.25 m) off a person's centre is taught a lower score than the centred one, so
 // the first stage peaks on the person (geolocation) rather than anywhere on a plateau.
@@ -327,6 +329,7 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.blob_features) r << " --blob-features";
   if (o.negatives_sets > 0) r << " --negatives-sets " << o.negatives_sets;
   if (o.world_sets > 0) r << " --world-sets " << o.world_sets;
+  if (o.stage1_rounds > 0) r << " --stage1-rounds " << o.stage1_rounds;
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
@@ -605,11 +608,12 @@ namespace {
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
       o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
-      o.negatives_sets < 0 || o.world_sets < 0 || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
+      o.negatives_sets < 0 || o.world_sets < 0 || o.stage1_rounds < 0 ||
+      (o.stage1_rounds > 0 && o.blob_features) || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty())) {
     return Error(ErrorCode::kInvalidArgument,
                  "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
-                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, world_sets and "
+                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, world_sets, stage1_rounds (not with blob features) and "
                  "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path");
   }
   const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
@@ -696,6 +700,7 @@ void AddStage1Samples(const Scene& s, std::mt19937_64& rng, swarm::ChannelMaps& 
 // The ridge first stage on `s1`, its threshold at the stage1_percentile of the centred positives'
 // scores.
 void FitStage1(Training& t, const Labelled& s1, const std::vector<std::size_t>& centred) {
+  t.report->stage1_positives = t.report->stage1_negatives = 0;
   for (int y : s1.y) (y ? t.report->stage1_positives : t.report->stage1_negatives) += 1;
   std::fprintf(stderr, "train-detector: stage 1 on %d positives, %d negatives (%.0f s)\n",
                t.report->stage1_positives, t.report->stage1_negatives, Seconds(t.t0));
@@ -731,6 +736,33 @@ Labelled Stage2Positives(const swarm::VictimDetectorModel& model, const Labelled
   return s2;
 }
 
+// One round of stage 1's bootstrapping (Dollar et al., "Fast Feature Pyramids for Object
+// Detection", PAMI 2014, section 5: the ACF detector's rounds of hard negatives): the first stage
+// as fitted so far on every training scene, its kStage1HardPerScene best windows that lie
+// kNegativeRadiusM or more from every person join s1's negatives. Random windows alone teach the
+// ridge to tell people from average ground, not from the ground's few person-like spots (rubble
+// clumps, slab corners, debris), which are what fill the candidate list.
+void AddStage1HardNegatives(Training& t, const std::vector<Scene>& train, int round, Labelled* s1) {
+  auto shared = std::make_shared<swarm::VictimDetectorModel>(t.model);
+  swarm::VictimDetector det(shared, {});
+  int added = 0;
+  for (const Scene& s : train) {
+    const double ppm = PixelsPerMetre(s), scale = swarm::kCanonicalPxPerM / ppm;
+    const auto& cands = det.Candidates(BgrOf(s), ppm, kStage1HardPerScene, -1e30);
+    const swarm::ChannelMaps& maps = det.channels();
+    Stage1Sampler add{maps, nullptr, scale, maps.rows() - swarm::kWindowCells + 1,
+                      maps.cols() - swarm::kWindowCells + 1, s1};
+    for (const auto& c : cands) {
+      const Eigen::Vector2d centre(swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_col,
+                                   swarm::WindowCentreCanonical(0) + swarm::kShrink * c.sub_row);
+      if (NearestPerson(s, scale, centre).first < kNegativeRadiusM) continue;
+      added += add.Add(c.row, c.col, 0, -1.0f) ? 1 : 0;
+    }
+  }
+  std::fprintf(stderr, "train-detector: stage 1 round %d: %d hard negatives (%.0f s)\n", round + 1, added,
+               Seconds(t.t0));
+}
+
 // Stage 1 from the training scenes; returns stage 2's positives.
 Labelled TrainStage1(Training& t, const std::vector<Scene>& train) {
   t.model.training_seeds = t.o.training_seeds;
@@ -747,6 +779,10 @@ Labelled TrainStage1(Training& t, const std::vector<Scene>& train) {
   swarm::BlobFeatureExtractor blob;
   for (const Scene& s : train) AddStage1Samples(s, t.rng, maps, t.o.blob_features ? &blob : nullptr, &s1, &centred);
   FitStage1(t, s1, centred);
+  for (int round = 0; round < t.o.stage1_rounds; ++round) {
+    AddStage1HardNegatives(t, train, round, &s1);
+    FitStage1(t, s1, centred);
+  }
   return Stage2Positives(t.model, s1);
 }
 

@@ -63,6 +63,10 @@ struct TrainingOptions {
   // distractors the mission meets, where stage 1 trained on the mixed terrains alone ranked half
   // the people below its 48 candidates (`swarmbox-bench perception --only world:1`). 0: none.
   int world_sets = 0;
+  // Rounds of stage 1's bootstrapping (train_detector.cpp AddStage1HardNegatives: each adds the
+  // fitted stage's best windows away from every person, 16 a scene, to its negatives and fits it
+  // again). 0: random negatives only (the recipes until 2026-11-28). Not with blob_features.
+  int stage1_rounds = 0;
   // The first stage's cap on candidates per frame while calibrating and mining hard negatives (the
   // detector's default, VictimDetectorParams::max_candidates, unless set: a blob model is run at 96).
   int max_candidates = swarm::VictimDetectorParams{}.max_candidates;

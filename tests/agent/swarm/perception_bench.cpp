@@ -18,11 +18,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <cstdio>
+#include <map>
 #include <memory>
 #include <numbers>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -30,6 +32,7 @@
 #include "bench.hpp"
 #include "perception_score.hpp"
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/swarm/sighting_fusion.hpp"
 
 namespace {
 
@@ -115,21 +118,39 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
 }
 
 // --replay RUN: the trial's own camera frames (perception_scenes.hpp ReplayTrial), one line for all
-// of them (persons at least half visible, tp, fp, precision and recall at 0.5, max_recall), one
-// line per victim (its look, the frames it was at least half visible in, the frames it was
-// detected in at >= 0.5, its highest confidence, the nearest the camera's nadir came to it) and
-// one per kind of thing the false alarms at >= 0.5 lay on (the nearest distractor within 1.5 m,
-// else an obstacle's footprint, else the ground). --crops DIR writes each victim's best view (the
-// frame where it was most visible, nearest the nadir) as DIR/<victim id>.png, 128 px around it.
+// of them (persons at least half visible, tp, fp, precision and recall at 0.5), one line per
+// victim (its look, the frames it was at least half visible in, the frames it was detected in at
+// >= 0.5, its highest confidence, the most of it any frame saw, the nearest the camera's nadir
+// came to it), one per kind of thing the false alarms at >= 0.5 lay on (the nearest distractor
+// within 1.5 m, else an obstacle's footprint, else the ground), and the fusion's two likelihoods
+// as the mission meets them (sighting_fusion.hpp; frames from 10-40 m with the place within 5 m of
+// the nadir, FusionParams' in-view rule for a miss): detector_recall, the share of frames with a
+// person there (any part visible) that detect it at >= 0.5, and false_repeat, the share of frames
+// with a false alarm's place there (a place where one fired: false alarms within 1.5 m are one
+// place) that fire there again. --crops DIR writes each victim's best view (the frame where it was
+// most visible, nearest the nadir) as DIR/<victim id>.png, 128 px around it.
 struct ReplayVictim {
   int frames_half_visible = 0;
   int frames_detected = 0;
+  int frames_in_view = 0;           // within 5 m of the nadir, 10-40 m up, any part visible
+  int frames_in_view_detected = 0;
   double max_confidence = 0.0;
   double nearest_nadir_m = 1e9;
+  double max_visible = 0.0;
   double best_visible = -1.0;
   double best_nadir_m = 1e9;
   cv::Mat best_crop;
 };
+
+// A frame as the fusion's rules see it: where the camera was and where false alarms fired.
+struct ReplayView {
+  Eigen::Vector2d nadir;
+  double height_m;
+  std::vector<Eigen::Vector2d> false_alarms;
+};
+
+constexpr double kMissInViewM = FusionParams{}.miss_in_view_m;
+constexpr double kMatchM = 1.5;
 
 std::string LookOf(const swarmbox::physics::Victim& v) {
   char look[96];
@@ -141,7 +162,7 @@ std::string LookOf(const swarmbox::physics::Victim& v) {
 
 // What a false alarm at ground point g lay on.
 std::string FalseAlarmSite(const swarmbox::physics::WorldConfig& w, const Eigen::Vector2d& g) {
-  double best = 1.5;
+  double best = kMatchM;
   std::string site;
   for (const swarmbox::physics::Distractor& d : w.distractors) {
     const double e = (Eigen::Vector2d(d.x_m, d.y_m) - g).norm();
@@ -162,105 +183,172 @@ std::string FalseAlarmSite(const swarmbox::physics::WorldConfig& w, const Eigen:
   return "ground";
 }
 
+class ReplayScore {
+ public:
+  ReplayScore(VictimDetector& detector, std::string crops) : detector_(detector), crops_(std::move(crops)) {}
+
+  void OnFrame(const swarmbox::physics::WorldConfig& w, const ReplayFrame& f) {
+    const Scene& s = f.scene;
+    ++frames_;
+    victims_.resize(s.victims.size());
+    const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
+    detector_.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs_);
+    views_.push_back({s.true_pose.position_m.head<2>(), s.altitude_m, {}});
+    for (std::size_t i = 0; i < s.victims.size(); ++i) CountVictim(s, bgr, i);
+    std::vector<bool> matched(s.victims.size(), false);
+    for (const ImageBlob& b : blobs_) MatchBlob(w, s, b, &matched);
+    for (std::size_t i = 0; i < s.victims.size(); ++i) {
+      if (InView(views_.back(), s.victims[i].position_m) && s.victims[i].visible_fraction > 0) {
+        ++victims_[i].frames_in_view;
+        victims_[i].frames_in_view_detected += matched[i] ? 1 : 0;
+      }
+    }
+  }
+
+  void Print(const swarmbox::physics::WorldConfig& world) const {
+    std::puts(Line("replay").Add("frames", frames_).Add("persons", persons_).Add("tp", tp_).Add("fp", fp_)
+                  .Add("precision", tp_ + fp_ ? static_cast<double>(tp_) / (tp_ + fp_) : 1.0, 4)
+                  .Add("recall", persons_ ? static_cast<double>(tp_) / persons_ : 1.0, 4).str().c_str());
+    for (std::size_t i = 0; i < victims_.size() && i < world.victims.size(); ++i) {
+      const ReplayVictim& rv = victims_[i];
+      std::puts(Line("replay_victim").Add("victim", world.victims[i].id).Add("look", LookOf(world.victims[i]))
+                    .Add("frames_half_visible", rv.frames_half_visible).Add("frames_detected", rv.frames_detected)
+                    .Add("max_confidence", rv.max_confidence, 3).Add("max_visible", rv.max_visible, 2)
+                    .Add("nearest_nadir_m", rv.nearest_nadir_m, 1).str().c_str());
+      if (!crops_.empty() && !rv.best_crop.empty()) cv::imwrite(crops_ + "/" + world.victims[i].id + ".png", rv.best_crop);
+    }
+    for (const auto& [site, n] : false_sites_) {
+      std::puts(Line("replay_false_alarms").Add("site", site).Add("count", n).str().c_str());
+    }
+    PrintFusion();
+  }
+
+ private:
+  static swarmbox::LogEvent Line(const char* kind) {
+    swarmbox::LogEvent e(0.0, "bench", "bench_result");
+    e.Add("suite", "perception").Add("case", kind);
+    return e;
+  }
+  static bool InView(const ReplayView& v, const Eigen::Vector2d& p) {
+    const FusionParams fusion;
+    return (v.nadir - p).norm() <= kMissInViewM && v.height_m >= fusion.min_miss_height_m &&
+           v.height_m <= fusion.max_miss_height_m;
+  }
+
+  void CountVictim(const Scene& s, const cv::Mat& bgr, std::size_t i) {
+    ReplayVictim& rv = victims_[i];
+    const double off = (s.victims[i].position_m - s.true_pose.position_m.head<2>()).norm();
+    const double vis = s.victims[i].visible_fraction;
+    rv.nearest_nadir_m = std::min(rv.nearest_nadir_m, off);
+    rv.max_visible = std::max(rv.max_visible, vis);
+    if (vis >= 0.5) {
+      ++persons_;
+      ++rv.frames_half_visible;
+    }
+    if (crops_.empty() || vis <= 0 || !(vis > rv.best_visible + 0.05 || (vis > rv.best_visible - 0.05 && off < rv.best_nadir_m))) {
+      return;
+    }
+    const Eigen::Vector3d ground(s.victims[i].position_m.x(), s.victims[i].position_m.y(), 0.0);
+    const std::optional<Eigen::Vector2d> px = ProjectToPixel(ground, s.intrinsics, s.true_pose);
+    if (!px) return;
+    const cv::Rect r = cv::Rect(static_cast<int>(px->x()) - 64, static_cast<int>(px->y()) - 64, 128, 128) &
+                       cv::Rect(0, 0, bgr.cols, bgr.rows);
+    if (r.area() == 0) return;
+    rv.best_crop = bgr(r).clone();
+    rv.best_visible = vis;
+    rv.best_nadir_m = off;
+  }
+
+  void MatchBlob(const swarmbox::physics::WorldConfig& w, const Scene& s, const ImageBlob& b, std::vector<bool>* matched) {
+    const std::optional<Eigen::Vector3d> g = PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
+    if (!g) return;
+    std::size_t best = s.victims.size();
+    double best_d = kMatchM;
+    for (std::size_t i = 0; i < s.victims.size(); ++i) {
+      const double e = (s.victims[i].position_m - g->head<2>()).norm();
+      if (s.victims[i].visible_fraction > 0 && e <= best_d) {
+        best_d = e;
+        best = i;
+      }
+    }
+    if (best == s.victims.size()) {
+      if (b.confidence < 0.5) return;
+      ++fp_;
+      ++false_sites_[FalseAlarmSite(w, g->head<2>())];
+      views_.back().false_alarms.push_back(g->head<2>());
+      return;
+    }
+    ReplayVictim& rv = victims_[best];
+    const bool must = s.victims[best].visible_fraction >= 0.5;
+    if (must) rv.max_confidence = std::max(rv.max_confidence, b.confidence);
+    if (b.confidence < 0.5 || (*matched)[best]) return;
+    (*matched)[best] = true;
+    ++rv.frames_detected;
+    tp_ += must ? 1 : 0;
+  }
+
+  // detector_recall and false_repeat as the mission meets them (the comment above ReplayVictim).
+  void PrintFusion() const {
+    int person_views = 0, person_hits = 0;
+    for (const ReplayVictim& rv : victims_) {
+      person_views += rv.frames_in_view;
+      person_hits += rv.frames_in_view_detected;
+    }
+    std::vector<Eigen::Vector2d> places;
+    for (const ReplayView& v : views_) {
+      for (const Eigen::Vector2d& g : v.false_alarms) {
+        if (std::none_of(places.begin(), places.end(), [&](const Eigen::Vector2d& p) { return (p - g).norm() <= kMatchM; })) {
+          places.push_back(g);
+        }
+      }
+    }
+    int place_views = 0, place_hits = 0;
+    for (const Eigen::Vector2d& p : places) {
+      for (const ReplayView& v : views_) {
+        if (!InView(v, p)) continue;
+        ++place_views;
+        place_hits += std::any_of(v.false_alarms.begin(), v.false_alarms.end(),
+                                  [&](const Eigen::Vector2d& g) { return (p - g).norm() <= kMatchM; }) ? 1 : 0;
+      }
+    }
+    std::puts(Line("replay_fusion").Add("person_views", person_views).Add("person_detected", person_hits)
+                  .Add("detector_recall", person_views ? static_cast<double>(person_hits) / person_views : 0.0, 4)
+                  .Add("false_places", static_cast<std::int64_t>(places.size())).Add("false_place_views", place_views)
+                  .Add("false_place_fired", place_hits)
+                  .Add("false_repeat", place_views ? static_cast<double>(place_hits) / place_views : 0.0, 4)
+                  .str().c_str());
+  }
+
+  VictimDetector& detector_;
+  std::string crops_;
+  std::vector<ReplayVictim> victims_;
+  std::vector<ReplayView> views_;
+  std::map<std::string, int> false_sites_;
+  std::vector<ImageBlob> blobs_;
+  int frames_ = 0, persons_ = 0, tp_ = 0, fp_ = 0;
+};
+
 int RunReplay(const swarmbox::bench::Args& args, const std::shared_ptr<const VictimDetectorModel>& model) {
+  const std::string dir = args.Get("replay", "");
+  swarmbox::Result<swarmbox::physics::WorldConfig> world = swarmbox::physics::LoadWorld(dir + "/world.yaml");
+  if (!world) {
+    std::fprintf(stderr, "perception bench: %s\n", world.error().ToString().c_str());
+    return 2;
+  }
   cv::setNumThreads(1);
   VictimDetectorParams params;
   params.max_candidates = static_cast<int>(args.GetInt("max-candidates", params.max_candidates));
   VictimDetector detector(model, params);
-  const std::string crops = args.Get("crops", "");
-  std::vector<ReplayVictim> victims;
-  std::map<std::string, int> false_sites;
-  int frames = 0, persons = 0, tp = 0, fp = 0;
-  std::vector<ImageBlob> blobs;
-  const swarmbox::Status st = ReplayTrial(
-      {.trial_dir = args.Get("replay", ""), .drone_prefix = args.Get("drones", "scout")},
-      [&](const swarmbox::physics::WorldConfig& w, const ReplayFrame& f) {
-        const Scene& s = f.scene;
-        ++frames;
-        victims.resize(s.victims.size());
-        const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
-        detector.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs);
-        const Eigen::Vector2d nadir = s.true_pose.position_m.head<2>();
-        std::vector<bool> matched(s.victims.size(), false);
-        for (std::size_t i = 0; i < s.victims.size(); ++i) {
-          ReplayVictim& rv = victims[i];
-          const double off = (s.victims[i].position_m - nadir).norm();
-          rv.nearest_nadir_m = std::min(rv.nearest_nadir_m, off);
-          if (s.victims[i].visible_fraction >= 0.5) {
-            ++persons;
-            ++rv.frames_half_visible;
-          }
-          const double vis = s.victims[i].visible_fraction;
-          if (!crops.empty() && vis > 0 && (vis > rv.best_visible + 0.05 || (vis > rv.best_visible - 0.05 && off < rv.best_nadir_m))) {
-            const std::optional<Eigen::Vector2d> px =
-                ProjectToPixel(Eigen::Vector3d(s.victims[i].position_m.x(), s.victims[i].position_m.y(), 0.0),
-                               s.intrinsics, s.true_pose);
-            if (px) {
-              const cv::Rect r = cv::Rect(static_cast<int>(px->x()) - 64, static_cast<int>(px->y()) - 64, 128, 128) &
-                                 cv::Rect(0, 0, bgr.cols, bgr.rows);
-              if (r.area() > 0) {
-                rv.best_crop = bgr(r).clone();
-                rv.best_visible = vis;
-                rv.best_nadir_m = off;
-              }
-            }
-          }
-        }
-        for (const ImageBlob& b : blobs) {
-          const std::optional<Eigen::Vector3d> g = PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
-          if (!g) continue;
-          std::size_t best = s.victims.size();
-          double best_d = 1.5;
-          for (std::size_t i = 0; i < s.victims.size(); ++i) {
-            const double e = (s.victims[i].position_m - g->head<2>()).norm();
-            if (s.victims[i].visible_fraction > 0 && e <= best_d) {
-              best_d = e;
-              best = i;
-            }
-          }
-          if (best < s.victims.size()) {
-            ReplayVictim& rv = victims[best];
-            if (s.victims[best].visible_fraction >= 0.5) rv.max_confidence = std::max(rv.max_confidence, b.confidence);
-            if (b.confidence >= 0.5 && !matched[best]) {
-              matched[best] = true;
-              ++rv.frames_detected;
-              if (s.victims[best].visible_fraction >= 0.5) ++tp;
-            }
-          } else if (b.confidence >= 0.5) {
-            ++fp;
-            ++false_sites[FalseAlarmSite(w, g->head<2>())];
-          }
-        }
-      });
+  ReplayScore score(detector, args.Get("crops", ""));
+  const swarmbox::Status st =
+      ReplayTrial({.trial_dir = dir, .drone_prefix = args.Get("drones", "scout")},
+                  [&](const swarmbox::physics::WorldConfig& w, const ReplayFrame& f) { score.OnFrame(w, f); });
   cv::setNumThreads(-1);
   if (!st) {
     std::fprintf(stderr, "perception bench: %s\n", st.error().ToString().c_str());
     return 2;
   }
-  swarmbox::Result<swarmbox::physics::WorldConfig> world =
-      swarmbox::physics::LoadWorld(args.Get("replay", "") + "/world.yaml");
-  if (!world) return 2;
-  std::puts(swarmbox::LogEvent(0.0, "bench", "bench_result")
-                .Add("suite", "perception").Add("case", "replay").Add("frames", frames).Add("persons", persons)
-                .Add("tp", tp).Add("fp", fp)
-                .Add("precision", tp + fp ? static_cast<double>(tp) / (tp + fp) : 1.0, 4)
-                .Add("recall", persons ? static_cast<double>(tp) / persons : 1.0, 4)
-                .str().c_str());
-  for (std::size_t i = 0; i < victims.size() && i < world->victims.size(); ++i) {
-    const ReplayVictim& rv = victims[i];
-    std::puts(swarmbox::LogEvent(0.0, "bench", "bench_result")
-                  .Add("suite", "perception").Add("case", "replay_victim").Add("victim", world->victims[i].id)
-                  .Add("look", LookOf(world->victims[i]))
-                  .Add("frames_half_visible", rv.frames_half_visible).Add("frames_detected", rv.frames_detected)
-                  .Add("max_confidence", rv.max_confidence, 3).Add("nearest_nadir_m", rv.nearest_nadir_m, 1)
-                  .str().c_str());
-    if (!crops.empty() && !rv.best_crop.empty()) cv::imwrite(crops + "/" + world->victims[i].id + ".png", rv.best_crop);
-  }
-  for (const auto& [site, n] : false_sites) {
-    std::puts(swarmbox::LogEvent(0.0, "bench", "bench_result")
-                  .Add("suite", "perception").Add("case", "replay_false_alarms").Add("site", site).Add("count", n)
-                  .str().c_str());
-  }
+  score.Print(*world);
   return 0;
 }
 
