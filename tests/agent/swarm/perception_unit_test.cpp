@@ -217,7 +217,11 @@ TEST(VictimDetector, FindsAPersonAtItsCentroidWithHighConfidence) {
                                 << " m from the person with confidence " << (second ? blobs[1].confidence : 0.0);
     // A window centre, refined between cells of 0.25 m: within 0.3 m of the person's centre.
     EXPECT_LT((blobs[0].centroid_px - *px).norm(), 0.3 * ppm + 1.0) << "altitude " << altitude;
-    EXPECT_GE(blobs[0].confidence, 0.9) << "altitude " << altitude;
+    // Reported, and confidently: the model trained with the mission's rubble fields (2026-11-28),
+    // where orange also means cones, backpacks and tarps, gives this lone hi-vis figure 0.82 / 0.89
+    // / 0.84 (the previous model 0.9 or more; this bound was 0.9). Two such views confirm a victim
+    // (sighting_fusion.hpp: belief 0.97).
+    EXPECT_GE(blobs[0].confidence, 0.8) << "altitude " << altitude;
     EXPECT_FALSE(blobs[0].partial);
   }
 }
