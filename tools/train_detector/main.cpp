@@ -9,7 +9,8 @@
 //   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
 //   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features,
 //   --negatives-sets N (cones-and-rubble sets 7200001..7200000+N), --world-sets N (generated
-//   rubble fields 7300001..7300000+N), --stage1-rounds N (stage 1's hard negatives), --calibration-altitude M
+//   rubble fields 7300001..7300000+N), --world-distractors N (in each of those fields;
+//   default 25), --stage1-rounds N (stage 1's hard negatives), --calibration-altitude M
 //   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there), --calibration-sets N
 //   (calibration seeds 7100001..7100000+N; default 2), --clean-calibration (no painted clutter on the
 //   calibration frames), --max-candidates N
@@ -84,6 +85,8 @@ constexpr Flag kFlags[] = {
     {"--blob-features", false, [](const char*, Args* a) { a->options.blob_features = true; return true; }},
     {"--negatives-sets", true, [](const char* v, Args* a) { a->options.negatives_sets = std::stoi(v); return true; }},
     {"--stage1-rounds", true, [](const char* v, Args* a) { a->options.stage1_rounds = std::stoi(v); return true; }},
+    {"--world-distractors", true,
+     [](const char* v, Args* a) { a->options.world_distractors = std::stoi(v); return true; }},
     {"--world-sets", true, [](const char* v, Args* a) { a->options.world_sets = std::stoi(v); return true; }},
     {"--max-candidates", true, [](const char* v, Args* a) { a->options.max_candidates = std::stoi(v); return true; }},
     {"--operating-precision", true,
@@ -116,7 +119,7 @@ int ParseArgs(int argc, char** argv, Args* args) {
       std::fprintf(stderr,
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
-                   "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] [--world-sets N] [--stage1-rounds N] "
+                   "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] [--world-sets N] [--world-distractors N] [--stage1-rounds N] "
                    "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
                    "[--operating-precision P] [--export-patches FILE] "
                    "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N]]\n");

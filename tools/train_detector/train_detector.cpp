@@ -329,6 +329,7 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.blob_features) r << " --blob-features";
   if (o.negatives_sets > 0) r << " --negatives-sets " << o.negatives_sets;
   if (o.world_sets > 0) r << " --world-sets " << o.world_sets;
+  if (o.world_distractors != 25) r << " --world-distractors " << o.world_distractors;
   if (o.stage1_rounds > 0) r << " --stage1-rounds " << o.stage1_rounds;
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
@@ -376,11 +377,12 @@ perception_scenes::SceneSetParams NegativesSceneSet(std::uint64_t seed, int scen
   return p;
 }
 
-perception_scenes::SceneSetParams WorldSceneSet(std::uint64_t seed, int scenes) {
+perception_scenes::SceneSetParams WorldSceneSet(std::uint64_t seed, int scenes, int distractors) {
   perception_scenes::SceneSetParams p = TrainingSceneSet(seed, scenes);
   p.min_altitude_m = 15.0;
   p.max_altitude_m = 45.0;
   p.generated = perception_scenes::SarRubbleSpec();
+  p.generated->distractors = distractors;
   return p;
 }
 
@@ -608,7 +610,7 @@ namespace {
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
       o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
-      o.negatives_sets < 0 || o.world_sets < 0 || o.stage1_rounds < 0 ||
+      o.negatives_sets < 0 || o.world_sets < 0 || o.world_distractors < 0 || o.stage1_rounds < 0 ||
       (o.stage1_rounds > 0 && o.blob_features) || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty())) {
     return Error(ErrorCode::kInvalidArgument,
@@ -1050,7 +1052,9 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
     for (Scene& x : *extra) train->push_back(std::move(x));
   }
   if (o.world_sets > 0) {
-    Result<std::vector<Scene>> extra = RenderSets(WorldSeeds(o), o.scenes_per_set, WorldSceneSet);
+    Result<std::vector<Scene>> extra = RenderSets(WorldSeeds(o), o.scenes_per_set, [&o](std::uint64_t seed, int scenes) {
+      return WorldSceneSet(seed, scenes, o.world_distractors);
+    });
     if (!extra) return extra.error();
     for (Scene& x : *extra) train->push_back(std::move(x));
   }

@@ -63,6 +63,9 @@ struct TrainingOptions {
   // distractors the mission meets, where stage 1 trained on the mixed terrains alone ranked half
   // the people below its 48 candidates (`swarmbox-bench perception --only world:1`). 0: none.
   int world_sets = 0;
+  // Distractors in each generated field of the world sets (sar_rubble.yaml's 25 unless set): more
+  // tarps, cones, backpacks, debris and rocks among the same 4 people.
+  int world_distractors = 25;
   // Rounds of stage 1's bootstrapping (train_detector.cpp AddStage1HardNegatives: each adds the
   // fitted stage's best windows away from every person, 16 a scene, to its negatives and fits it
   // again). 0: random negatives only (the recipes until 2026-11-28). Not with blob_features.
@@ -141,7 +144,7 @@ perception_scenes::SceneSetParams NegativesSceneSet(std::uint64_t seed, int scen
 
 // A generated rubble-field set (TrainingOptions::world_sets): worlds as sar_rubble.yaml generates
 // them, views at 15-45 m, 80 % of them near a person.
-perception_scenes::SceneSetParams WorldSceneSet(std::uint64_t seed, int scenes);
+perception_scenes::SceneSetParams WorldSceneSet(std::uint64_t seed, int scenes, int distractors = 25);
 
 // A calibration set: the training mix, at calibration_altitude_m +- kCalibrationAltitudeBandM when
 // that is not 0.
