@@ -466,7 +466,6 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double di
   return scenes;
 }
 
-
 namespace {
 
 // truth.csv's columns the replay reads, by name (truth_log.cpp writes the header).

@@ -126,8 +126,9 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& params, doub
 // give each camera drone's frames as its camera took them in flight, through the same
 // GroundRenderer, with the renderer's truth: the detector's figures on the mission's own frames
 // (its altitudes, speeds, tilts, motion blur, light and ground), which tells a victim the mission
-// never saw from one it saw and failed to confirm. A frame is taken each time the drone has moved
-// the airframe camera's trigger_distance_m horizontally since the last (or 1 / rate_hz s of
+// never saw from one it saw and failed to confirm. The camera is the x500's (the scouts' airframe,
+// trials/airframes/x500.yaml). A frame is taken each time the drone has moved its
+// trigger_distance_m horizontally since the last (or 1 / rate_hz s of
 // truth without trigger_distance_m), while it is between min_height_m and max_height_m above the
 // ground; the truth rows are the physics server's (10 Hz by default), so a frame lands within one
 // row of where the camera's trigger fired. The pixel noise is seeded per frame, not the server's.

@@ -615,7 +615,8 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty())) {
     return Error(ErrorCode::kInvalidArgument,
                  "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
-                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, world_sets, stage1_rounds (not with blob features) and "
+                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, "
+                 "world_sets, world_distractors, stage1_rounds (not with blob features) and "
                  "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path");
   }
   const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
