@@ -60,8 +60,8 @@ struct TrainingOptions {
   int negatives_sets = 0;
   // Extra training sets (seeds kWorldsSeedBase + 1..N) on the mission's generated rubble fields
   // (perception_scenes::SarRubbleSpec, views at 15-45 m): the rubble ground, slabs, cover and
-  // distractors the mission meets, where stage 1 trained on the mixed terrains alone ranked half
-  // the people below its 48 candidates (`swarmbox-bench perception --only world:1`). 0: none.
+  // distractors the mission meets, where the detector trained on the mixed terrains alone gave
+  // half the people no detection at all (`swarmbox-bench perception --only world:1`). 0: none.
   int world_sets = 0;
   // Distractors in each generated field of the world sets (sar_rubble.yaml's 25 unless set): more
   // tarps, cones, backpacks, debris and rocks among the same 4 people.
