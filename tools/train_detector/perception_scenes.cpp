@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -11,11 +11,12 @@
 
 #include <opencv2/core.hpp>
 
-#include "swarmbox/common/split.hpp"
 #include "swarmbox/physics/airframe.hpp"
 #include "swarmbox/physics/ground_renderer.hpp"
 #include "swarmbox/physics/world.hpp"
 #include "swarmbox/physics/world_config.hpp"
+#include "swarmbox/report/trial_record.hpp"
+#include "swarmbox/report/trial_series.hpp"
 
 #ifndef SWARMBOX_TRIALS_DIR
 #error "SWARMBOX_TRIALS_DIR must point at the project's trials/ folder"
@@ -468,45 +469,6 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& p, double di
 
 namespace {
 
-// truth.csv's columns the replay reads, by name (truth_log.cpp writes the header).
-struct TruthColumns {
-  static constexpr const char* kNames[] = {"t_s", "drone", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz",
-                                           "p_rad_s", "q_rad_s", "r_rad_s"};
-  std::size_t at[std::size(kNames)] = {};
-};
-
-Result<TruthColumns> ReadTruthHeader(const std::string& header, const std::string& path) {
-  TruthColumns c;
-  const std::vector<std::string_view> names = SplitOn(header, ',');
-  for (std::size_t k = 0; k < std::size(TruthColumns::kNames); ++k) {
-    const auto it = std::find(names.begin(), names.end(), TruthColumns::kNames[k]);
-    if (it == names.end()) {
-      return Error(ErrorCode::kInvalidArgument, std::string("truth.csv has no column ") + TruthColumns::kNames[k], path);
-    }
-    c.at[k] = static_cast<std::size_t>(it - names.begin());
-  }
-  return c;
-}
-
-// One truth.csv row's values, in TruthColumns::kNames order (the drone's name aside).
-struct TruthRow {
-  std::string_view drone;
-  double v[std::size(TruthColumns::kNames)] = {};
-};
-
-Status ParseTruthRow(std::string_view line, const TruthColumns& cols, std::size_t row, const std::string& path,
-                     TruthRow* out) {
-  const std::vector<std::string_view> cells = SplitOn(line, ',');
-  for (std::size_t k = 0; k < std::size(out->v); ++k) {
-    if (cols.at[k] >= cells.size()) {
-      return Error(ErrorCode::kInvalidArgument, "truth.csv row " + std::to_string(row) + " is short", path);
-    }
-    if (k != 1) out->v[k] = std::strtod(std::string(cells[cols.at[k]]).c_str(), nullptr);
-  }
-  out->drone = cells[cols.at[1]];
-  return Ok{};
-}
-
 // A camera drone's state in the replay: where its last frame was taken.
 struct ReplayCamera {
   bool taken = false;
@@ -544,29 +506,35 @@ Status ReplayTrial(const ReplayParams& params,
   Result<physics::Airframe> x500 = CameraAirframe();
   if (!x500) return x500.error();
   const std::string truth_path = params.trial_dir + "/truth.csv";
-  std::ifstream truth(truth_path);
-  if (!truth) return Error(ErrorCode::kNotFound, "cannot read the trial's truth.csv", truth_path);
-  std::string line;
-  std::getline(truth, line);
-  Result<TruthColumns> cols = ReadTruthHeader(line, truth_path);
-  if (!cols) return cols.error();
+  if (!std::filesystem::is_regular_file(truth_path)) {
+    return Error(ErrorCode::kNotFound, "cannot read the trial's truth.csv", truth_path);
+  }
   const physics::CameraSpec& camera = x500->camera;
   physics::GroundRenderer renderer(*world);
   std::map<std::string, ReplayCamera, std::less<>> cameras;
   physics::CameraImage image;
   std::vector<physics::VisiblePerson> people;
-  std::size_t row = 1;
-  TruthRow r;
-  while (std::getline(truth, line)) {
-    SWARMBOX_TRY(ParseTruthRow(line, *cols, ++row, truth_path, &r));
-    const double* v = r.v;
-    if (!r.drone.starts_with(params.drone_prefix) || v[4] < params.min_height_m || v[4] > params.max_height_m) continue;
-    ReplayCamera& cam = cameras[std::string(r.drone)];
-    if (!cam.Take(Vector2d(v[2], v[3]), v[0], camera)) continue;
-    const physics::Pose body{{v[2], v[3], v[4]}, {v[5], v[6], v[7], v[8]}};
-    renderer.Render(body, {v[9], v[10], v[11]}, camera, ReplayNoiseSeed(r.drone, cam.frames), &image, &people);
-    ReplayFrame f{std::string(r.drone), v[0], WithTilt(SceneFromImage(image, *world, camera.noise_std, people))};
-    on_frame(*world, f);
+  bool attitude = true;
+  const bool read = report::ReadTruthCsv(truth_path, [&](const report::TruthRow& r) {
+    attitude = attitude && r.has_attitude;
+    if (!attitude || !r.drone.starts_with(params.drone_prefix) || r.z_m < params.min_height_m ||
+        r.z_m > params.max_height_m) {
+      return;
+    }
+    ReplayCamera& cam = cameras[r.drone];
+    if (!cam.Take(Vector2d(r.x_m, r.y_m), r.t_s, camera)) return;
+    const physics::Pose body{{r.x_m, r.y_m, r.z_m}, {r.qw, r.qx, r.qy, r.qz}};
+    renderer.Render(body, {r.p_rad_s, r.q_rad_s, r.r_rad_s}, camera, ReplayNoiseSeed(r.drone, cam.frames), &image,
+                    &people);
+    on_frame(*world, {r.drone, r.t_s, WithTilt(SceneFromImage(image, *world, camera.noise_std, people))});
+  });
+  if (!read) {
+    return Error(ErrorCode::kInvalidArgument, "truth.csv cannot be read or has no t_s, drone, x_m, y_m, z_m header",
+                 truth_path);
+  }
+  if (!attitude) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "truth.csv has no attitude and body rates (qw, qx, qy, qz, p_rad_s, q_rad_s, r_rad_s)", truth_path);
   }
   return Ok{};
 }

@@ -130,8 +130,9 @@ Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& params, doub
 // trials/airframes/x500.yaml). A frame is taken each time the drone has moved its
 // trigger_distance_m horizontally since the last (or 1 / rate_hz s of
 // truth without trigger_distance_m), while it is between min_height_m and max_height_m above the
-// ground; the truth rows are the physics server's (10 Hz by default), so a frame lands within one
-// row of where the camera's trigger fired. The pixel noise is seeded per frame, not the server's.
+// ground; truth.csv is read by report::ReadTruthCsv, its rows the physics server's (50 a second
+// per drone: 0.14 m apart at 7 m/s), so a frame lands within one row of where the trigger fired.
+// The pixel noise is seeded per frame, not the server's.
 struct ReplayParams {
   std::string trial_dir;               // holds world.yaml and truth.csv
   std::string drone_prefix = "scout";  // which drones carry the camera (name prefix)

@@ -1,6 +1,7 @@
 #include "swarmbox/report/trial_record.hpp"
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <fstream>
@@ -63,6 +64,9 @@ struct TruthColumns {
   bool velocity = false;
   std::size_t need = 0;    // a row needs more cells than this
   std::size_t need_v = 0;  // ... and more than this for its velocity
+  std::array<int, 7> attitude{-1, -1, -1, -1, -1, -1, -1};  // qw qx qy qz p q r
+  bool has_attitude = false;
+  std::size_t need_a = 0;  // ... and more than this for its attitude
 };
 
 // Splits `line` at every ',' into `cells` (views into line).
@@ -99,6 +103,10 @@ std::optional<TruthColumns> FindTruthColumns(const std::string& line) {
   c.velocity = c.vx >= 0 && c.vy >= 0 && c.vz >= 0;
   c.need = static_cast<std::size_t>(std::max({c.t, c.drone, c.x, c.y, c.z}));
   c.need_v = static_cast<std::size_t>(std::max({c.vx, c.vy, c.vz}));
+  constexpr std::string_view kAttitude[] = {"qw", "qx", "qy", "qz", "p_rad_s", "q_rad_s", "r_rad_s"};
+  for (std::size_t k = 0; k < c.attitude.size(); ++k) c.attitude[k] = col(kAttitude[k]);
+  c.has_attitude = *std::min_element(c.attitude.begin(), c.attitude.end()) >= 0;
+  c.need_a = static_cast<std::size_t>(*std::max_element(c.attitude.begin(), c.attitude.end()));
   return c;
 }
 
@@ -122,6 +130,16 @@ bool ParseTruthRow(const std::vector<std::string_view>& cells, const TruthColumn
       row.vy_m_s = *vy;
       row.vz_m_s = *vz;
       row.has_velocity = true;
+    }
+  }
+  row.has_attitude = false;
+  if (c.has_attitude && cells.size() > c.need_a) {
+    double* dst[] = {&row.qw, &row.qx, &row.qy, &row.qz, &row.p_rad_s, &row.q_rad_s, &row.r_rad_s};
+    row.has_attitude = true;
+    for (std::size_t k = 0; k < c.attitude.size(); ++k) {
+      const auto v = num(c.attitude[k]);
+      if (!v) row.has_attitude = false;
+      else *dst[k] = *v;
     }
   }
   return true;

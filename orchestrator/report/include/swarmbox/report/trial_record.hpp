@@ -59,7 +59,8 @@ struct TrialRecord {
 };
 
 // Calls `on_row` for every well-formed row of a truth.csv (columns t_s, drone, x_m, y_m, z_m by
-// the header; vx_m_s, vy_m_s, vz_m_s when it has them). Rows that do not parse are skipped. false
+// the header; vx_m_s, vy_m_s, vz_m_s and qw..qz, p_rad_s..r_rad_s when it has them). Rows that do
+// not parse are skipped. false
 // when the file cannot be read or its header lacks a column.
 bool ReadTruthCsv(const std::string& path, const std::function<void(const TruthRow&)>& on_row);
 

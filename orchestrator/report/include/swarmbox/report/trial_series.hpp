@@ -81,6 +81,11 @@ struct TruthRow {
   double x_m = 0, y_m = 0, z_m = 0;
   double vx_m_s = 0, vy_m_s = 0, vz_m_s = 0;
   bool has_velocity = true;  // false: the file has no velocity columns (no speed series)
+  // The attitude (world from body) and the body rates, when the file has them (the physics
+  // server's does): what a camera replay renders from (perception_scenes.hpp ReplayTrial).
+  bool has_attitude = false;
+  double qw = 1, qx = 0, qy = 0, qz = 0;
+  double p_rad_s = 0, q_rad_s = 0, r_rad_s = 0;
 };
 
 class TrialSeriesBuilder {
