@@ -189,7 +189,7 @@ class ReplayScore {
 
   void OnFrame(const swarmbox::physics::WorldConfig& w, const ReplayFrame& f) {
     const Scene& s = f.scene;
-    ++frames_;
+    if (frames_++ == 0) world_ = w;  // the trial's world, for the per-victim lines
     victims_.resize(s.victims.size());
     const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
     detector_.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs_);
@@ -205,7 +205,8 @@ class ReplayScore {
     }
   }
 
-  void Print(const swarmbox::physics::WorldConfig& world) const {
+  void Print() const {
+    const swarmbox::physics::WorldConfig& world = world_;
     std::puts(Line("replay").Add("frames", frames_).Add("persons", persons_).Add("tp", tp_).Add("fp", fp_)
                   .Add("precision", tp_ + fp_ ? static_cast<double>(tp_) / (tp_ + fp_) : 1.0, 4)
                   .Add("recall", persons_ ? static_cast<double>(tp_) / persons_ : 1.0, 4).str().c_str());
@@ -321,6 +322,7 @@ class ReplayScore {
 
   VictimDetector& detector_;
   std::string crops_;
+  swarmbox::physics::WorldConfig world_;
   std::vector<ReplayVictim> victims_;
   std::vector<ReplayView> views_;
   std::map<std::string, int> false_sites_;
@@ -330,11 +332,6 @@ class ReplayScore {
 
 int RunReplay(const swarmbox::bench::Args& args, const std::shared_ptr<const VictimDetectorModel>& model) {
   const std::string dir = args.Get("replay", "");
-  swarmbox::Result<swarmbox::physics::WorldConfig> world = swarmbox::physics::LoadWorld(dir + "/world.yaml");
-  if (!world) {
-    std::fprintf(stderr, "perception bench: %s\n", world.error().ToString().c_str());
-    return 2;
-  }
   cv::setNumThreads(1);
   VictimDetectorParams params;
   params.max_candidates = static_cast<int>(args.GetInt("max-candidates", params.max_candidates));
@@ -348,7 +345,7 @@ int RunReplay(const swarmbox::bench::Args& args, const std::shared_ptr<const Vic
     std::fprintf(stderr, "perception bench: %s\n", st.error().ToString().c_str());
     return 2;
   }
-  score.Print(*world);
+  score.Print();
   return 0;
 }
 
