@@ -88,6 +88,7 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
   cv::setNumThreads(1);
   VictimDetectorParams params;
   params.max_candidates = static_cast<int>(args.GetInt("max-candidates", params.max_candidates));
+  params.candidate_spacing_m = args.GetDouble("candidate-spacing", params.candidate_spacing_m);
   VictimDetector detector(model, params);
   for (const CurveCase& c : cases) {
     swarmbox::Result<std::vector<Scene>> scenes = RenderScenes(c.scenes);
@@ -335,6 +336,7 @@ int RunReplay(const swarmbox::bench::Args& args, const std::shared_ptr<const Vic
   cv::setNumThreads(1);
   VictimDetectorParams params;
   params.max_candidates = static_cast<int>(args.GetInt("max-candidates", params.max_candidates));
+  params.candidate_spacing_m = args.GetDouble("candidate-spacing", params.candidate_spacing_m);
   VictimDetector detector(model, params);
   ReplayScore score(detector, args.Get("crops", ""));
   const swarmbox::Status st =

@@ -55,6 +55,9 @@ struct VictimDetectorParams {
   // 96 find 60 and 62 of 100 people on dev seeds 11-13 at 30 m, 96 at twice the second stage's
   // cost (BENCHMARKS.md "Perception: the shipped detector"), so it stays 48.
   int max_candidates = 48;
+  // A first-stage candidate is the highest score within +- this on the ground (rounded to whole
+  // 0.25 m cells, at least one).
+  double candidate_spacing_m = 0.25;
   // Detections closer than this on the ground are one. 1.5 m: the training labels a candidate
   // within 0.75 m of a person "person" and one 1.5 m or more from every person "none", so a
   // candidate in between (the other end of a lying person: 1.7 m long) is never taught either
