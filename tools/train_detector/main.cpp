@@ -5,6 +5,8 @@
 //   swarmbox-train-detector --out-dir agent/swarm/models --recalibrate
 //   (steps 4-5 only, on the model in --out-dir: the sigmoid and the figures; the JSON keeps the
 //   training lines and gets "recalibrated": true)
+//   swarmbox-train-detector --out-dir DIR --recalibrate --replace-cnn FILE.onnx
+//   (the same with another CNN in place of the model's: train_cnn.py run again on its patches)
 //   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):
 //   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
 //   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features,
@@ -18,7 +20,8 @@
 //   where the calibration detections reach precision P), --export-patches FILE (the CNN's patches,
 //   train_detector.hpp), --cnn SCRIPT (a CNN second stage trained by SCRIPT, train_cnn.py, with
 //   --python PY, its ONNX at --cnn-onnx FILE (default DIR/victim_detector_cnn.onnx; the patches
-//   beside it unless --export-patches), --cnn-epochs N, --cnn-seed N)
+//   beside it unless --export-patches), --cnn-epochs N, --cnn-seed N, --cnn-widths A,B,C (its
+//   three blocks' channels), --cnn-negatives N (negatives drawn per epoch))
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -101,6 +104,10 @@ constexpr Flag kFlags[] = {
     {"--cnn-onnx", true, [](const char* v, Args* a) { a->options.cnn_onnx_out = v; return true; }},
     {"--cnn-epochs", true, [](const char* v, Args* a) { a->options.cnn_epochs = std::stoi(v); return true; }},
     {"--cnn-seed", true, [](const char* v, Args* a) { a->options.cnn_seed = std::stoi(v); return true; }},
+    {"--cnn-widths", true, [](const char* v, Args* a) { a->options.cnn_widths = v; return true; }},
+    {"--cnn-negatives", true,
+     [](const char* v, Args* a) { a->options.cnn_negatives_per_epoch = std::stoi(v); return true; }},
+    {"--replace-cnn", true, [](const char* v, Args* a) { a->options.replace_cnn = v; return true; }},
 };
 
 // The flag named `a` when it is complete at argv[i] (its value, if it takes one, follows).
@@ -122,7 +129,9 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] [--world-sets N] [--world-distractors N] [--stage1-rounds N] "
                    "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
                    "[--operating-precision P] [--export-patches FILE] "
-                   "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N]]\n");
+                   "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N] [--cnn-widths A,B,C] "
+                   "[--cnn-negatives N]] "
+                   "[--recalibrate --replace-cnn FILE]\n");
       return kUsageError;
     }
     const char* value = flag->takes_value ? argv[++i] : nullptr;
@@ -130,6 +139,10 @@ int ParseArgs(int argc, char** argv, Args* args) {
   }
   if (args->out_dir.empty()) {
     std::fprintf(stderr, "swarmbox-train-detector: --out-dir is required\n");
+    return kUsageError;
+  }
+  if (!args->options.replace_cnn.empty() && !args->recalibrate) {
+    std::fprintf(stderr, "swarmbox-train-detector: --replace-cnn goes with --recalibrate\n");
     return kUsageError;
   }
   if (args->options.cnn_onnx_out.empty()) args->options.cnn_onnx_out = args->out_dir + "/victim_detector_cnn.onnx";

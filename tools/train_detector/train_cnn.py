@@ -58,11 +58,11 @@ def read_patches(path):
 
 
 class PatchNet(nn.Module):
-    def __init__(self, px):
+    def __init__(self, px, widths=(16, 32, 64)):
         super().__init__()
         layers = []
         channels = 3
-        for width in (16, 32, 64):
+        for width in widths:
             layers += [nn.Conv2d(channels, width, 3, padding=1, bias=False), nn.BatchNorm2d(width),
                        nn.ReLU(inplace=True), nn.MaxPool2d(2)]
             channels = width
@@ -131,7 +131,7 @@ def train(args):
     per_epoch = min(len(neg_idx), args.negatives_per_epoch)
     pos_weight = torch.tensor([per_epoch / max(pos, 1.0)])
     loss_fn = nn.BCEWithLogitsLoss(pos_weight=pos_weight, reduction="sum")
-    net = PatchNet(patches.shape[1])
+    net = PatchNet(patches.shape[1], args.widths)
     opt = torch.optim.Adam(net.parameters(), lr=args.lr)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=args.epochs)
     gen = torch.Generator().manual_seed(args.seed)
@@ -184,7 +184,7 @@ def write_test_fixture(seed, px, onnx_path):
     and non-trivial batch-norm statistics, as ONNX, and beside it (.logits.txt) torch's logits for
     fixture_patches(4): cv::dnn must give the same."""
     torch.manual_seed(seed)
-    net = PatchNet(px)
+    net = PatchNet(px, (16, 32, 64))
     for m in net.modules():
         if isinstance(m, nn.BatchNorm2d):
             m.running_mean.uniform_(-0.5, 0.5)
@@ -213,12 +213,16 @@ def main():
     parser.add_argument("--lr", type=float, default=2e-3)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--negatives-per-epoch", type=int, default=24000)
+    parser.add_argument("--widths", type=lambda v: tuple(int(w) for w in v.split(",")), default=(16, 32, 64),
+                        help="the three blocks' channels (default 16,32,64)")
     args = parser.parse_args()
     if args.test_fixture:
         write_test_fixture(args.seed, 32, args.out)
         return
     if not args.patches:
         parser.error("--patches is required")
+    if len(args.widths) != 3 or min(args.widths) < 1:
+        parser.error("--widths takes three channel counts, e.g. 16,32,64")
     net, px = train(args)
     export(net, px, args.out)
     print(f"train_cnn: wrote {args.out}", flush=True)

@@ -336,7 +336,10 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
   if (o.calibration_seeds != SeedSets(kCalibrationSeedBase, 2)) r << " --calibration-sets " << o.calibration_seeds.size();
   if (o.clean_calibration) r << " --clean-calibration";
-  if (!o.cnn_script.empty()) r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed;
+  if (!o.cnn_script.empty()) {
+    r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed << " --cnn-widths "
+      << o.cnn_widths << " --cnn-negatives " << o.cnn_negatives_per_epoch;
+  }
   return r.str();
 }
 
@@ -578,6 +581,28 @@ void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::st
   add(new_seeds, "--calibration-sets", std::to_string(o.calibration_seeds.size()));
   add(o.clean_calibration, "--clean-calibration", "");
   add(o.operating_precision > 0, "--operating-precision", precision.str());
+  add(!o.replace_cnn.empty(), "--replace-cnn", o.replace_cnn.substr(o.replace_cnn.find_last_of('/') + 1));
+}
+
+}  // namespace
+
+namespace {
+
+// The ONNX at `path` into model->cnn_onnx, checked to load in cv::dnn.
+Status ReadCnn(const std::string& path, swarm::VictimDetectorModel* model) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  model->cnn_onnx.resize(in ? static_cast<std::size_t>(in.tellg()) : 0);
+  in.seekg(0);
+  in.read(reinterpret_cast<char*>(model->cnn_onnx.data()), static_cast<std::streamsize>(model->cnn_onnx.size()));
+  if (!in) model->cnn_onnx.clear();
+  if (model->cnn_onnx.empty()) return Error(ErrorCode::kIo, "train-detector: no ONNX", path);
+  try {
+    if (cv::dnn::readNetFromONNX(path).empty()) throw cv::Exception();
+  } catch (const cv::Exception& e) {
+    return Error(ErrorCode::kInvalidArgument, std::string("train-detector: cv::dnn cannot read the CNN: ") + e.what(),
+                 path);
+  }
+  return Ok{};
 }
 
 }  // namespace
@@ -594,6 +619,10 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
       return Error(ErrorCode::kInvalidArgument, "recalibrate: calibration seed " + std::to_string(s) +
                                                     " is one the model was trained on", model_path);
     }
+  }
+  if (!o.replace_cnn.empty()) {
+    if (!model.has_cnn()) return Error(ErrorCode::kInvalidArgument, "recalibrate: --replace-cnn needs a CNN model", model_path);
+    SWARMBOX_TRY(ReadCnn(o.replace_cnn, &model));
   }
   const bool new_seeds = model.calibration_seeds != o.calibration_seeds;
   model.calibration_seeds = o.calibration_seeds;
@@ -989,7 +1018,9 @@ Status ExportPatches(const Training& t, const std::vector<Scene>& train, const s
 // Runs the CNN training script (argv, no shell) and waits for it.
 Status RunCnnScript(const TrainingOptions& o, const std::string& patches, const std::string& onnx) {
   std::vector<std::string> args = {o.python, o.cnn_script, "--patches", patches, "--out", onnx,
-                                   "--seed", std::to_string(o.cnn_seed), "--epochs", std::to_string(o.cnn_epochs)};
+                                   "--seed", std::to_string(o.cnn_seed), "--epochs", std::to_string(o.cnn_epochs),
+                                   "--widths", o.cnn_widths, "--negatives-per-epoch",
+                                   std::to_string(o.cnn_negatives_per_epoch)};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -1011,18 +1042,7 @@ Status TrainCnnStage(Training& t, const std::vector<Scene>& train, const std::ve
   const std::string patches = t.o.export_patches.empty() ? t.o.cnn_onnx_out + ".patches" : t.o.export_patches;
   SWARMBOX_TRY(ExportPatches(t, train, cal, patches));
   SWARMBOX_TRY(RunCnnScript(t.o, patches, t.o.cnn_onnx_out));
-  std::ifstream in(t.o.cnn_onnx_out, std::ios::binary | std::ios::ate);
-  t.model.cnn_onnx.resize(in ? static_cast<std::size_t>(in.tellg()) : 0);
-  in.seekg(0);
-  in.read(reinterpret_cast<char*>(t.model.cnn_onnx.data()), static_cast<std::streamsize>(t.model.cnn_onnx.size()));
-  if (!in) t.model.cnn_onnx.clear();
-  if (t.model.cnn_onnx.empty()) return Error(ErrorCode::kIo, "train-detector: no ONNX from the script", t.o.cnn_onnx_out);
-  try {
-    if (cv::dnn::readNetFromONNX(t.o.cnn_onnx_out).empty()) throw cv::Exception();
-  } catch (const cv::Exception& e) {
-    return Error(ErrorCode::kInvalidArgument, std::string("train-detector: cv::dnn cannot read the CNN: ") + e.what(),
-                 t.o.cnn_onnx_out);
-  }
+  SWARMBOX_TRY(ReadCnn(t.o.cnn_onnx_out, &t.model));
   t.model.forest.release();
   std::fprintf(stderr, "train-detector: CNN of %zu bytes (%.0f s)\n", t.model.cnn_onnx.size(), Seconds(t.t0));
   return Ok{};
@@ -1091,7 +1111,8 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
     << (model.blob_features > 0 ? " on the window, the first-stage score and " + std::to_string(model.blob_features) +
                                       " blob features (size, shape, parts, edge orientations; 16 px/m)"
                                 : std::string())
-    << (model.has_cnn() ? " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn (train_cnn.py)"
+    << (model.has_cnn() ? " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn (train_cnn.py; the recipe's "
+                          "--cnn-widths: its blocks' channels)"
                         : std::string())
     << ", Platt sigmoid\",\n";
   j << "  \"recipe\": \"" << model.recipe << "\",\n";

@@ -98,8 +98,17 @@ struct TrainingOptions {
   std::string cnn_script;
   std::string python = "python3";  // the interpreter with torch (Debian: /usr/bin/python3)
   std::string cnn_onnx_out;        // where the script writes the ONNX (default: beside the patches)
-  int cnn_epochs = 6;
+  int cnn_epochs = 12;
   int cnn_seed = 1;
+  // The network's three blocks' channels (train_cnn.py --widths) and the negatives each epoch
+  // draws (--negatives-per-epoch). 24,48,96 over 16,32,64: on the generated rubble fields at 30 m
+  // (bench case=world, seed 1, 96 candidates) AP 0.84 against 0.79 with the same patches and
+  // epochs, at 2.25 times the network's cost (BENCHMARKS.md "Perception: the shipped detector").
+  std::string cnn_widths = "24,48,96";
+  int cnn_negatives_per_epoch = 48000;
+  // Recalibrate() only: when not empty, this ONNX (train_cnn.py's, e.g. run again on a model's
+  // exported patches with other settings) replaces the model's CNN before the sigmoid is refitted.
+  std::string replace_cnn;
 };
 
 // The patch file (--export-patches), little-endian:

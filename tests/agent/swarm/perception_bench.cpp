@@ -2,7 +2,10 @@
 // on physics-rendered scenes of seed N (never a training or calibration seed of the model: refused),
 // of the shipped model or of a model file train-detector wrote elsewhere (--model: the curves only,
 // to compare a recipe before shipping it; --only altitude:30 runs one case; --max-candidates N
-// the first stage's cap instead of VictimDetectorParams' default), in the
+// the first stage's cap instead of VictimDetectorParams' default, --candidate-spacing M its
+// VictimDetectorParams::candidate_spacing_m; --misses DIR writes each case's missed people, up to
+// 64, as one mosaic DIR/misses_<kind>_<value>.png: 128 px around each, with the best confidence
+// near it and how much of it was visible), in the
 // varied look (perception_scenes.hpp: terrains, light, poses, clothing, cover, distractors), one
 // logfmt line per case:
 //   case=altitude     altitude_m=10|20|30|40|60 (30 % of the people partly covered, 2 distractors each)
@@ -28,6 +31,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "bench.hpp"
 #include "perception_score.hpp"
@@ -54,6 +58,43 @@ struct CurveCase {
   std::string key;
   double value;
   SceneSetParams scenes;
+};
+
+// The people a case missed, 128 x 128 frame pixels around each (at most kMaxTiles, 8 a row), each
+// tile labelled with the best confidence near it and its visible fraction.
+class MissMosaic {
+ public:
+  static constexpr int kTile = 128, kColumns = 8, kMaxTiles = 64;
+  void Add(const Scene& s, const SceneVictim& v, double best_confidence) {
+    if (tiles_.size() >= kMaxTiles) return;
+    const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
+    const std::optional<Eigen::Vector2d> px =
+        ProjectToPixel(Eigen::Vector3d(v.position_m.x(), v.position_m.y(), 0.0), s.intrinsics, s.true_pose);
+    if (!px) return;
+    cv::Mat tile(kTile, kTile, CV_8UC3, cv::Scalar::all(0));
+    const cv::Rect want(static_cast<int>(px->x()) - kTile / 2, static_cast<int>(px->y()) - kTile / 2, kTile, kTile);
+    const cv::Rect r = want & cv::Rect(0, 0, bgr.cols, bgr.rows);
+    if (r.area() > 0) bgr(r).copyTo(tile(r - want.tl()));
+    char label[32];
+    std::snprintf(label, sizeof label, "%.2f v%.2f", best_confidence, v.visible_fraction);
+    cv::putText(tile, label, {2, kTile - 4}, cv::FONT_HERSHEY_PLAIN, 0.9, cv::Scalar(255, 255, 255), 1);
+    tiles_.push_back(tile);
+  }
+  // Writes the mosaic to `path` (nothing when no one was missed).
+  void Write(const std::string& path) const {
+    if (tiles_.empty()) return;
+    const int rows = (static_cast<int>(tiles_.size()) + kColumns - 1) / kColumns;
+    cv::Mat mosaic(rows * kTile, std::min<int>(kColumns, static_cast<int>(tiles_.size())) * kTile, CV_8UC3,
+                   cv::Scalar::all(0));
+    for (std::size_t i = 0; i < tiles_.size(); ++i) {
+      const int k = static_cast<int>(i);
+      tiles_[i].copyTo(mosaic(cv::Rect(k % kColumns * kTile, k / kColumns * kTile, kTile, kTile)));
+    }
+    if (!cv::imwrite(path, mosaic)) std::fprintf(stderr, "perception bench: cannot write %s\n", path.c_str());
+  }
+
+ private:
+  std::vector<cv::Mat> tiles_;
 };
 
 int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
@@ -90,13 +131,21 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
   params.max_candidates = static_cast<int>(args.GetInt("max-candidates", params.max_candidates));
   params.candidate_spacing_m = args.GetDouble("candidate-spacing", params.candidate_spacing_m);
   VictimDetector detector(model, params);
+  const std::string misses_dir = args.Get("misses", "");
   for (const CurveCase& c : cases) {
     swarmbox::Result<std::vector<Scene>> scenes = RenderScenes(c.scenes);
     if (!scenes) {
       std::fprintf(stderr, "perception bench: %s\n", scenes.error().ToString().c_str());
       return 1;
     }
-    const DetectionCurve d = ScoreDetections(*scenes, detector);
+    MissMosaic misses;
+    const DetectionCurve d = ScoreDetections(*scenes, detector, 0.5, 0.5, 1.5,
+                                             [&](const Scene& s, const SceneVictim& v, double best) {
+                                               if (!misses_dir.empty()) misses.Add(s, v, best);
+                                             });
+    char mosaic[96];
+    std::snprintf(mosaic, sizeof mosaic, "/misses_%s_%g.png", c.kind.c_str(), c.value);
+    if (!misses_dir.empty()) misses.Write(misses_dir + mosaic);
     swarmbox::LogEvent line(0.0, "bench", "bench_result");
     line.Add("suite", "perception").Add("case", c.kind).Add("seed", seed);
     if (c.kind == "world") line.Add("world", "rubble_field");  // sar_rubble.yaml's generated fields

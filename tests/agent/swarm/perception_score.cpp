@@ -81,7 +81,7 @@ PerceptionScore ScorePerception(const std::vector<Scene>& scenes, const Percepti
 }
 
 DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector, double operating_point,
-                               double must_fraction, double match_radius_m) {
+                               double must_fraction, double match_radius_m, const MissFn& on_miss) {
   DetectionCurve curve;
   std::vector<std::pair<double, int>> ranked;  // (confidence, 1 true / 0 false positive)
   std::vector<ImageBlob> blobs;
@@ -94,6 +94,7 @@ DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector&
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     for (const SceneVictim& v : s.victims) curve.persons += v.visible_fraction >= must_fraction ? 1 : 0;
     std::vector<bool> matched(s.victims.size(), false);
+    std::vector<double> best_confidence(s.victims.size(), 0.0);
     for (const ImageBlob& b : blobs) {  // most confident first (the detector's order)
       const std::optional<Vector3d> g = PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
       std::size_t best = s.victims.size();
@@ -111,7 +112,13 @@ DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector&
       if (best < s.victims.size() && s.victims[best].visible_fraction < must_fraction) continue;  // not scored
       const bool tp = best < s.victims.size() && !matched[best];
       if (tp) matched[best] = true;
+      if (best < s.victims.size()) best_confidence[best] = std::max(best_confidence[best], b.confidence);
       ranked.emplace_back(b.confidence, tp ? 1 : 0);
+    }
+    for (std::size_t i = 0; on_miss && i < s.victims.size(); ++i) {
+      if (s.victims[i].visible_fraction >= must_fraction && best_confidence[i] < operating_point) {
+        on_miss(s, s.victims[i], best_confidence[i]);
+      }
     }
   }
   std::stable_sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) { return a.first > b.first; });

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "perception_scenes.hpp"
@@ -64,8 +65,12 @@ struct DetectionCurve {
   double max_recall = 0.0;
   double ms_per_frame = 0.0;       // Detect() wall time per frame (the caller sets the threads)
 };
+// Called for each person at least must_fraction visible that no detection at or above the
+// operating point matched: its scene and the highest confidence of a detection within
+// match_radius_m of it (0 when none).
+using MissFn = std::function<void(const Scene& scene, const SceneVictim& person, double best_confidence)>;
 DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector,
                                double operating_point = 0.5, double must_fraction = 0.5,
-                               double match_radius_m = 1.5);
+                               double match_radius_m = 1.5, const MissFn& on_miss = {});
 
 }  // namespace swarmbox::swarm::testing

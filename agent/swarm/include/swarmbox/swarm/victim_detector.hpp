@@ -50,14 +50,17 @@ namespace swarmbox::swarm {
 
 struct VictimDetectorParams {
   double person_area_m2 = 0.59;       // plan-view area of a lying person [m^2] (expected_area_px)
-  // First-stage maxima passed to the second stage, best first. With the forest, 48 lost people
-  // (3 of 30 at 30 m on seed 7100003, none at 96); with the shipped CNN (calibrated at 96), 48 and
-  // 96 find 60 and 62 of 100 people on dev seeds 11-13 at 30 m, 96 at twice the second stage's
-  // cost (BENCHMARKS.md "Perception: the shipped detector"), so it stays 48.
-  int max_candidates = 48;
+  // First-stage maxima passed to the second stage, best first. 96: on the generated rubble fields
+  // at 30 m (bench case=world, seeds 1 and 20261121) 48 leave a third of the people without a
+  // candidate (max_recall 0.67 and 0.66 with the CNN of 2026-11-28); 96 cost the second stage twice
+  // (BENCHMARKS.md "Perception: the shipped detector").
+  int max_candidates = 96;
   // A first-stage candidate is the highest score within +- this on the ground (rounded to whole
-  // 0.25 m cells, at least one).
-  double candidate_spacing_m = 0.25;
+  // 0.25 m cells, at least one). 0.5 m: with one cell, a rubble field's clutter takes several
+  // candidates per block and the people go without; at 1 m a person 1 m from a tarp is suppressed
+  // by it (bench, seed 1, 96 candidates, the wider CNN: AP world 0.76 / 0.85 / 0.84 at 0.25 / 0.5 /
+  // 1 m, mixed scenes at 30 m 0.85 / 0.81 / 0.77). The trainer mines its patches with the same.
+  double candidate_spacing_m = 0.5;
   // Detections closer than this on the ground are one. 1.5 m: the training labels a candidate
   // within 0.75 m of a person "person" and one 1.5 m or more from every person "none", so a
   // candidate in between (the other end of a lying person: 1.7 m long) is never taught either
