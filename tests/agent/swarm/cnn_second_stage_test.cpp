@@ -10,6 +10,7 @@
 //       --out tests/agent/swarm/data/patch_cnn_fixture.onnx   (one command line)
 // (no Python at test time).
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <string>
@@ -122,6 +123,37 @@ TEST(CandidatePatch, IsDeterministicAndTheDetectorSeesTheTrainersPixels) {
       CandidatePatch(frame, px_per_m, det.CentrePx(c), &again);
       EXPECT_EQ(cv::norm(from_detector, from_trainer, cv::NORM_INF), 0.0) << px_per_m;
       EXPECT_EQ(cv::norm(from_trainer, again, cv::NORM_INF), 0.0) << px_per_m;
+    }
+  }
+}
+
+TEST(VictimDetectorCandidates, AreTheBestScoreWithinTheSpacingAndTheSpacingThinsThem) {
+  // Given one frame's candidates (every local maximum, any score) at one cell and at 1 m spacing.
+  const cv::Mat frame = TestFrame();
+  constexpr double kPxPerM = 15.5;
+  VictimDetectorParams fine, wide;
+  fine.candidate_spacing_m = 0.25;
+  wide.candidate_spacing_m = 1.0;
+  VictimDetector det_fine(ShippedDetectorModel(), fine), det_wide(ShippedDetectorModel(), wide);
+  const std::vector<VictimDetector::Candidate> all = det_fine.Candidates(frame, kPxPerM, 100000, -1e30);
+  const std::vector<VictimDetector::Candidate> thinned = det_wide.Candidates(frame, kPxPerM, 100000, -1e30);
+  // Then the wider spacing keeps fewer, each of them one of the fine ones, and no fine candidate
+  // within 1 m (4 cells either way) of a kept one scores higher than it.
+  ASSERT_FALSE(thinned.empty());
+  EXPECT_LT(thinned.size(), all.size());
+  for (const VictimDetector::Candidate& k : thinned) {
+    bool found = false;
+    for (const VictimDetector::Candidate& c : all) {
+      found = found || (c.row == k.row && c.col == k.col);
+      if (std::abs(c.row - k.row) <= 4 && std::abs(c.col - k.col) <= 4) EXPECT_LE(c.score, k.score);
+    }
+    EXPECT_TRUE(found) << k.row << "," << k.col;
+  }
+  // And two kept candidates are more than 4 cells apart unless they tie.
+  for (std::size_t i = 0; i < thinned.size(); ++i) {
+    for (std::size_t j = i + 1; j < thinned.size(); ++j) {
+      const bool near = std::abs(thinned[i].row - thinned[j].row) <= 4 && std::abs(thinned[i].col - thinned[j].col) <= 4;
+      if (near) EXPECT_EQ(thinned[i].score, thinned[j].score);
     }
   }
 }
