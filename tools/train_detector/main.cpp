@@ -129,8 +129,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] [--world-sets N] [--world-distractors N] [--stage1-rounds N] "
                    "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
                    "[--operating-precision P] [--export-patches FILE] "
-                   "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N] [--cnn-widths A,B,C] "
-                   "[--cnn-negatives N]] "
+                   "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N] "
+                   "[--cnn-widths A,B,C] [--cnn-negatives N]] "
                    "[--recalibrate --replace-cnn FILE]\n");
       return kUsageError;
     }

@@ -337,8 +337,8 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.calibration_seeds != SeedSets(kCalibrationSeedBase, 2)) r << " --calibration-sets " << o.calibration_seeds.size();
   if (o.clean_calibration) r << " --clean-calibration";
   if (!o.cnn_script.empty()) {
-    r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed << " --cnn-widths "
-      << o.cnn_widths << " --cnn-negatives " << o.cnn_negatives_per_epoch;
+    r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed
+      << " --cnn-widths " << o.cnn_widths << " --cnn-negatives " << o.cnn_negatives_per_epoch;
   }
   return r.str();
 }
@@ -593,14 +593,15 @@ Status ReadCnn(const std::string& path, swarm::VictimDetectorModel* model) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
   model->cnn_onnx.resize(in ? static_cast<std::size_t>(in.tellg()) : 0);
   in.seekg(0);
-  in.read(reinterpret_cast<char*>(model->cnn_onnx.data()), static_cast<std::streamsize>(model->cnn_onnx.size()));
+  in.read(reinterpret_cast<char*>(model->cnn_onnx.data()),
+          static_cast<std::streamsize>(model->cnn_onnx.size()));
   if (!in) model->cnn_onnx.clear();
   if (model->cnn_onnx.empty()) return Error(ErrorCode::kIo, "train-detector: no ONNX", path);
   try {
     if (cv::dnn::readNetFromONNX(path).empty()) throw cv::Exception();
   } catch (const cv::Exception& e) {
-    return Error(ErrorCode::kInvalidArgument, std::string("train-detector: cv::dnn cannot read the CNN: ") + e.what(),
-                 path);
+    return Error(ErrorCode::kInvalidArgument,
+                 std::string("train-detector: cv::dnn cannot read the CNN: ") + e.what(), path);
   }
   return Ok{};
 }
@@ -621,7 +622,8 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
     }
   }
   if (!o.replace_cnn.empty()) {
-    if (!model.has_cnn()) return Error(ErrorCode::kInvalidArgument, "recalibrate: --replace-cnn needs a CNN model", model_path);
+    if (!model.has_cnn())
+      return Error(ErrorCode::kInvalidArgument, "recalibrate: --replace-cnn needs a CNN model", model_path);
     SWARMBOX_TRY(ReadCnn(o.replace_cnn, &model));
   }
   const bool new_seeds = model.calibration_seeds != o.calibration_seeds;
@@ -1017,9 +1019,19 @@ Status ExportPatches(const Training& t, const std::vector<Scene>& train, const s
 
 // Runs the CNN training script (argv, no shell) and waits for it.
 Status RunCnnScript(const TrainingOptions& o, const std::string& patches, const std::string& onnx) {
-  std::vector<std::string> args = {o.python, o.cnn_script, "--patches", patches, "--out", onnx,
-                                   "--seed", std::to_string(o.cnn_seed), "--epochs", std::to_string(o.cnn_epochs),
-                                   "--widths", o.cnn_widths, "--negatives-per-epoch",
+  std::vector<std::string> args = {o.python,
+                                   o.cnn_script,
+                                   "--patches",
+                                   patches,
+                                   "--out",
+                                   onnx,
+                                   "--seed",
+                                   std::to_string(o.cnn_seed),
+                                   "--epochs",
+                                   std::to_string(o.cnn_epochs),
+                                   "--widths",
+                                   o.cnn_widths,
+                                   "--negatives-per-epoch",
                                    std::to_string(o.cnn_negatives_per_epoch)};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
@@ -1108,10 +1120,12 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
   j << "{\n  \"model\": \"victim_detector.yml.gz\",\n";
   j << "  \"method\": \"aggregated channel features (Luv, gradient magnitude, 4 orientations; 0.25 m cells, "
        "3 x 3 m windows at 8 px/m), ridge linear first stage, cv::ml::RTrees second stage"
-    << (model.blob_features > 0 ? " on the window, the first-stage score and " + std::to_string(model.blob_features) +
-                                      " blob features (size, shape, parts, edge orientations; 16 px/m)"
-                                : std::string())
-    << (model.has_cnn() ? " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn (train_cnn.py; the recipe's "
+    << (model.blob_features > 0
+            ? " on the window, the first-stage score and " + std::to_string(model.blob_features) +
+                  " blob features (size, shape, parts, edge orientations; 16 px/m)"
+            : std::string())
+    << (model.has_cnn() ? " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn "
+                          "(train_cnn.py; the recipe's "
                           "--cnn-widths: its blocks' channels)"
                         : std::string())
     << ", Platt sigmoid\",\n";

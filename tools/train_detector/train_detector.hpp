@@ -103,7 +103,7 @@ struct TrainingOptions {
   // The network's three blocks' channels (train_cnn.py --widths) and the negatives each epoch
   // draws (--negatives-per-epoch). 24,48,96 over 16,32,64: on the generated rubble fields at 30 m
   // (bench case=world, seed 1, 96 candidates) AP 0.84 against 0.79 with the same patches and
-  // epochs, at 2.25 times the network's cost (BENCHMARKS.md "Perception: the shipped detector").
+  // epochs, at 2.25 times the network's cost (BENCHMARKS.md "Perception: spread candidates and a wider CNN").
   std::string cnn_widths = "24,48,96";
   int cnn_negatives_per_epoch = 48000;
   // Recalibrate() only: when not empty, this ONNX (train_cnn.py's, e.g. run again on a model's

@@ -92,7 +92,8 @@ const std::vector<VictimDetector::Candidate>& VictimDetector::Candidates(const c
     score_ += filtered_;
   }
   const cv::Mat valid = score_(cv::Rect(0, 0, cols, rows));
-  const int reach = std::max(1, static_cast<int>(std::lround(params_.candidate_spacing_m * kCanonicalPxPerM / kShrink)));
+  const int reach =
+      std::max(1, static_cast<int>(std::lround(params_.candidate_spacing_m * kCanonicalPxPerM / kShrink)));
   const cv::Mat square = cv::Mat::ones(2 * reach + 1, 2 * reach + 1, CV_8U);
   cv::dilate(valid, dilated_, square, cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(-1e9));
   LocalMaxima(valid, dilated_, threshold, &candidates_);

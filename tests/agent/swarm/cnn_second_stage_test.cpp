@@ -145,15 +145,20 @@ TEST(VictimDetectorCandidates, AreTheBestScoreWithinTheSpacingAndTheSpacingThins
     bool found = false;
     for (const VictimDetector::Candidate& c : all) {
       found = found || (c.row == k.row && c.col == k.col);
-      if (std::abs(c.row - k.row) <= 4 && std::abs(c.col - k.col) <= 4) EXPECT_LE(c.score, k.score);
+      if (std::abs(c.row - k.row) <= 4 && std::abs(c.col - k.col) <= 4) {
+        EXPECT_LE(c.score, k.score);
+      }
     }
     EXPECT_TRUE(found) << k.row << "," << k.col;
   }
   // And two kept candidates are more than 4 cells apart unless they tie.
   for (std::size_t i = 0; i < thinned.size(); ++i) {
     for (std::size_t j = i + 1; j < thinned.size(); ++j) {
-      const bool near = std::abs(thinned[i].row - thinned[j].row) <= 4 && std::abs(thinned[i].col - thinned[j].col) <= 4;
-      if (near) EXPECT_EQ(thinned[i].score, thinned[j].score);
+      const bool near =
+          std::abs(thinned[i].row - thinned[j].row) <= 4 && std::abs(thinned[i].col - thinned[j].col) <= 4;
+      if (near) {
+        EXPECT_EQ(thinned[i].score, thinned[j].score);
+      }
     }
   }
 }

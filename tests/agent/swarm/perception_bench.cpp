@@ -67,12 +67,14 @@ class MissMosaic {
   static constexpr int kTile = 128, kColumns = 8, kMaxTiles = 64;
   void Add(const Scene& s, const SceneVictim& v, double best_confidence) {
     if (tiles_.size() >= kMaxTiles) return;
-    const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
+    const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3,
+                      const_cast<std::uint8_t*>(s.image.bgr.data()));
     const std::optional<Eigen::Vector2d> px =
         ProjectToPixel(Eigen::Vector3d(v.position_m.x(), v.position_m.y(), 0.0), s.intrinsics, s.true_pose);
     if (!px) return;
     cv::Mat tile(kTile, kTile, CV_8UC3, cv::Scalar::all(0));
-    const cv::Rect want(static_cast<int>(px->x()) - kTile / 2, static_cast<int>(px->y()) - kTile / 2, kTile, kTile);
+    const cv::Rect want(static_cast<int>(px->x()) - kTile / 2, static_cast<int>(px->y()) - kTile / 2, kTile,
+                        kTile);
     const cv::Rect r = want & cv::Rect(0, 0, bgr.cols, bgr.rows);
     if (r.area() > 0) bgr(r).copyTo(tile(r - want.tl()));
     char label[32];

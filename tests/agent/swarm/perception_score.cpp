@@ -80,8 +80,9 @@ PerceptionScore ScorePerception(const std::vector<Scene>& scenes, const Percepti
   return score;
 }
 
-DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector, double operating_point,
-                               double must_fraction, double match_radius_m, const MissFn& on_miss) {
+DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector,
+                               double operating_point, double must_fraction, double match_radius_m,
+                               const MissFn& on_miss) {
   DetectionCurve curve;
   std::vector<std::pair<double, int>> ranked;  // (confidence, 1 true / 0 false positive)
   std::vector<ImageBlob> blobs;

@@ -25,13 +25,14 @@
 // capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
 // Detections under min_confidence are not reported.
 //
-// Cost with the shipped CNN: ~16-42 ms per 640 x 360 frame at 10-40 m on one core, ~45-61 ms at
-// 60 m (48 candidates; BENCHMARKS.md "Perception: the shipped detector"; the scale of step 1 makes
-// low altitudes cheaper and high ones dearer: at 60 m the frame is enlarged to keep 8 px/m); a
-// forest model ~4-14 ms. Scratch images are kept between frames; OpenCV's filters and cv::dnn still
-// allocate internal buffers per frame (allocation_test.cpp). Frames come at up to 5 Hz, outside
-// the control loop. A forest model with blob features adds them per candidate (0.25 ms of CPU each
-// measured at load ~9: BENCHMARKS.md "Blob features for the second stage").
+// Cost with the shipped CNN (24, 48, 96 channels, up to 96 candidates): ~13 ms per 640 x 360 frame
+// at 10 m, ~31 ms at 30 m, ~48 ms at 60 m on one core (BENCHMARKS.md "Perception: spread candidates
+// and a wider CNN"; the scale of step 1 makes low altitudes cheaper and high ones dearer: at 60 m
+// the frame is enlarged to keep 8 px/m); a forest model ~4-14 ms. Scratch images are kept between
+// frames; OpenCV's filters and cv::dnn still allocate internal buffers per frame
+// (allocation_test.cpp). Frames come at up to 5 Hz, outside the control loop. A forest model with
+// blob features adds them per candidate (0.25 ms of CPU each measured at load ~9: BENCHMARKS.md
+// "Blob features for the second stage").
 #pragma once
 
 #include <memory>
@@ -53,7 +54,7 @@ struct VictimDetectorParams {
   // First-stage maxima passed to the second stage, best first. 96: on the generated rubble fields
   // at 30 m (bench case=world, seeds 1 and 20261121) 48 leave a third of the people without a
   // candidate (max_recall 0.67 and 0.66 with the CNN of 2026-11-28); 96 cost the second stage twice
-  // (BENCHMARKS.md "Perception: the shipped detector").
+  // (BENCHMARKS.md "Perception: spread candidates and a wider CNN").
   int max_candidates = 96;
   // A first-stage candidate is the highest score within +- this on the ground (rounded to whole
   // 0.25 m cells, at least one). 0.5 m: with one cell, a rubble field's clutter takes several
