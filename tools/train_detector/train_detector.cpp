@@ -596,7 +596,7 @@ Status ReadCnn(const std::string& path, swarm::VictimDetectorModel* model) {
   in.read(reinterpret_cast<char*>(model->cnn_onnx.data()),
           static_cast<std::streamsize>(model->cnn_onnx.size()));
   if (!in) model->cnn_onnx.clear();
-  if (model->cnn_onnx.empty()) return Error(ErrorCode::kIo, "train-detector: no ONNX", path);
+  if (model->cnn_onnx.empty()) return Error(ErrorCode::kIo, "train-detector: no ONNX there (missing or empty)", path);
   try {
     if (cv::dnn::readNetFromONNX(path).empty()) throw cv::Exception();
   } catch (const cv::Exception& e) {
@@ -1110,6 +1110,26 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
   return t.model;
 }
 
+namespace {
+
+// The report's one-line description of the model's method.
+std::string MethodText(const swarm::VictimDetectorModel& model) {
+  std::string text =
+      "aggregated channel features (Luv, gradient magnitude, 4 orientations; 0.25 m cells, 3 x 3 m windows at "
+      "8 px/m), ridge linear first stage, cv::ml::RTrees second stage";
+  if (model.blob_features > 0) {
+    text += " on the window, the first-stage score and " + std::to_string(model.blob_features) +
+            " blob features (size, shape, parts, edge orientations; 16 px/m)";
+  }
+  if (model.has_cnn()) {
+    text += " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn (train_cnn.py; the recipe's "
+            "--cnn-widths: its blocks' channels)";
+  }
+  return text + ", Platt sigmoid";
+}
+
+}  // namespace
+
 std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& o, const TrainingReport& r) {
   std::ostringstream j;
   auto list = [&](const std::vector<std::uint64_t>& v) {
@@ -1118,17 +1138,7 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
     j << "]";
   };
   j << "{\n  \"model\": \"victim_detector.yml.gz\",\n";
-  j << "  \"method\": \"aggregated channel features (Luv, gradient magnitude, 4 orientations; 0.25 m cells, "
-       "3 x 3 m windows at 8 px/m), ridge linear first stage, cv::ml::RTrees second stage"
-    << (model.blob_features > 0
-            ? " on the window, the first-stage score and " + std::to_string(model.blob_features) +
-                  " blob features (size, shape, parts, edge orientations; 16 px/m)"
-            : std::string())
-    << (model.has_cnn() ? " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn "
-                          "(train_cnn.py; the recipe's "
-                          "--cnn-widths: its blocks' channels)"
-                        : std::string())
-    << ", Platt sigmoid\",\n";
+  j << "  \"method\": \"" << MethodText(model) << "\",\n";
   j << "  \"recipe\": \"" << model.recipe << "\",\n";
   j << "  \"training_seeds\": ";
   list(model.training_seeds);
