@@ -596,7 +596,9 @@ Status ReadCnn(const std::string& path, swarm::VictimDetectorModel* model) {
   in.read(reinterpret_cast<char*>(model->cnn_onnx.data()),
           static_cast<std::streamsize>(model->cnn_onnx.size()));
   if (!in) model->cnn_onnx.clear();
-  if (model->cnn_onnx.empty()) return Error(ErrorCode::kIo, "train-detector: no ONNX there (missing or empty)", path);
+  if (model->cnn_onnx.empty()) {
+    return Error(ErrorCode::kIo, "train-detector: no ONNX there (missing or empty)", path);
+  }
   try {
     if (cv::dnn::readNetFromONNX(path).empty()) throw cv::Exception();
   } catch (const cv::Exception& e) {
