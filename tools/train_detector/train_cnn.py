@@ -2,6 +2,7 @@
 """Trains the victim detector's convolutional second stage on the trainer's patches.
 
     python3 train_cnn.py --patches FILE --out MODEL.onnx [--seed 1] [--epochs 6] [--threads 2]
+                         [--widths 16,32,64] [--negatives-per-epoch 24000]
     python3 train_cnn.py --test-fixture --out tests/agent/swarm/data/patch_cnn_fixture.onnx
 
 swarmbox-train-detector --cnn train_cnn.py runs this (argv, no shell) between its first stage and
@@ -13,7 +14,8 @@ output N x 1 logits > 0 for "person") that OpenCV 4.6's cv::dnn reads; the detec
 (pixel - 127.5) / 64 in BGR order (victim_detector_model.hpp kCnnInputMean, kCnnInputScale).
 
 The network: three blocks of 3 x 3 convolution, batch normalisation, ReLU and 2 x 2 max pooling
-(16, 32, 64 channels: 32 -> 16 -> 8 -> 4 px), then a 1024 -> 32 -> 1 classifier on the 4 x 4 map
+(--widths channels, default 16, 32, 64; the shipped recipe passes 24, 48, 96: 32 -> 16 -> 8 -> 4
+px), then a 16 C -> 32 -> 1 classifier on the 4 x 4 map
 (it keeps where things are relative to the candidate's centre, which a global pooling would lose).
 Training: Adam (cosine learning rate), each epoch on every positive and a fresh seeded draw of
 --negatives-per-epoch negatives, binary cross-entropy with the positives weighted by negatives /

@@ -640,6 +640,18 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
 
 namespace {
 
+// "A,B,C" with three positive integers (train_cnn.py --widths).
+bool ThreeWidths(const std::string& text) {
+  std::istringstream in(text);
+  int count = 0;
+  for (std::string part; std::getline(in, part, ',');) {
+    const bool digits = !part.empty() && part.size() <= 4 && part.find_first_not_of("0123456789") == std::string::npos;
+    if (!digits || std::stoi(part) < 1) return false;
+    ++count;
+  }
+  return count == 3;
+}
+
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
       o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
@@ -651,6 +663,10 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
                  "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, "
                  "world_sets, world_distractors, stage1_rounds (not with blob features) and "
                  "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path");
+  }
+  if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1)) {
+    return Error(ErrorCode::kInvalidArgument, "train-detector: --cnn-widths takes three positive channel counts "
+                                              "(e.g. 24,48,96) and --cnn-negatives a count >= 1");
   }
   const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
   const std::vector<std::uint64_t> world_seeds = WorldSeeds(o);
