@@ -60,6 +60,17 @@ struct CurveCase {
   SceneSetParams scenes;
 };
 
+// size x size pixels of `bgr` centred on px, black where they leave the frame; empty when none of
+// them is in it.
+cv::Mat CropAround(const cv::Mat& bgr, const Eigen::Vector2d& px, int size) {
+  const cv::Rect want(static_cast<int>(px.x()) - size / 2, static_cast<int>(px.y()) - size / 2, size, size);
+  const cv::Rect r = want & cv::Rect(0, 0, bgr.cols, bgr.rows);
+  if (r.area() == 0) return {};
+  cv::Mat crop(size, size, CV_8UC3, cv::Scalar::all(0));
+  bgr(r).copyTo(crop(r - want.tl()));
+  return crop;
+}
+
 // The people a case missed, 128 x 128 frame pixels around each (at most kMaxTiles, 8 a row), each
 // tile labelled with the best confidence near it and its visible fraction.
 class MissMosaic {
@@ -72,11 +83,8 @@ class MissMosaic {
     const std::optional<Eigen::Vector2d> px =
         ProjectToPixel(Eigen::Vector3d(v.position_m.x(), v.position_m.y(), 0.0), s.intrinsics, s.true_pose);
     if (!px) return;
-    cv::Mat tile(kTile, kTile, CV_8UC3, cv::Scalar::all(0));
-    const cv::Rect want(static_cast<int>(px->x()) - kTile / 2, static_cast<int>(px->y()) - kTile / 2, kTile,
-                        kTile);
-    const cv::Rect r = want & cv::Rect(0, 0, bgr.cols, bgr.rows);
-    if (r.area() > 0) bgr(r).copyTo(tile(r - want.tl()));
+    cv::Mat tile = CropAround(bgr, *px, kTile);
+    if (tile.empty()) return;
     char label[32];
     std::snprintf(label, sizeof label, "%.2f v%.2f", best_confidence, v.visible_fraction);
     cv::putText(tile, label, {2, kTile - 4}, cv::FONT_HERSHEY_PLAIN, 0.9, cv::Scalar(255, 255, 255), 1);
@@ -304,10 +312,9 @@ class ReplayScore {
     const Eigen::Vector3d ground(s.victims[i].position_m.x(), s.victims[i].position_m.y(), 0.0);
     const std::optional<Eigen::Vector2d> px = ProjectToPixel(ground, s.intrinsics, s.true_pose);
     if (!px) return;
-    const cv::Rect r = cv::Rect(static_cast<int>(px->x()) - 64, static_cast<int>(px->y()) - 64, 128, 128) &
-                       cv::Rect(0, 0, bgr.cols, bgr.rows);
-    if (r.area() == 0) return;
-    rv.best_crop = bgr(r).clone();
+    cv::Mat crop = CropAround(bgr, *px, 128);
+    if (crop.empty()) return;
+    rv.best_crop = crop;
     rv.best_visible = vis;
     rv.best_nadir_m = off;
   }
