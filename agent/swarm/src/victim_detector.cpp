@@ -25,7 +25,8 @@ void SuppressNonMaxima(std::vector<ImageBlob>* blobs, double radius_px, std::vec
   }
 }
 
-// The local maxima of `valid` (its 3 x 3 dilation `dilated`) at or above `threshold`, each peak
+// The local maxima of `valid` (its dilation `dilated`: over 3 x 3 cells or the wider square of
+// VictimDetectorParams::candidate_spacing_m) at or above `threshold`, each peak
 // refined to a fraction of a cell, appended to *out.
 void LocalMaxima(const cv::Mat& valid, const cv::Mat& dilated, double threshold,
                  std::vector<VictimDetector::Candidate>* out) {

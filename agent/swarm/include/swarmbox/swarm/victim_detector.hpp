@@ -13,7 +13,8 @@
 //   2. features: aggregated channel features (Luv, gradient magnitude, 4 orientations, 0.25 m
 //      cells), windows of 3 x 3 m at a stride of one cell;
 //   3. first stage: a linear score for every window (one correlation per channel), its local
-//      maxima above the trained threshold, at most max_candidates of them;
+//      maxima (the best within candidate_spacing_m) above the trained threshold, at most
+//      max_candidates of them;
 //   4. second stage: with a model that carries a CNN (format 3, the shipped model), the network on
 //      every candidate's colour patch (candidate_patch.hpp; all of a frame's candidates in one
 //      batch, one cv::dnn forward), its logit mapped to a probability by the trained Platt
