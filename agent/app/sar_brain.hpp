@@ -84,7 +84,13 @@ bool DecodeMissionMode(std::string_view text, swarm::Role* role, std::string* mo
 // agent/app/README.md for the figures); every value has a reason next to it in sar_brain.cpp.
 struct MissionTuning {
   double mission_dt_s = 0.1;            // behaviour tick [s]
-  double search_margin_m = 8.0;         // search area = geofence shrunk by this [m]
+  // Search area = geofence shrunk by this [m]. 0: the whole field. The lanes already end half a
+  // footprint in from the area's edge (search_pattern.hpp), so the drones stay >= 11 m inside the
+  // geofence at 30 m while the last frame of a lane reaches its edge; a margin of 8 m (until
+  // 2026-11-28) left people within 8-9 m of the field's edge in no frame or only at a frame's
+  // border (5 of the 12 people rubble20 missed that day: orchestrator/worlds places them up to
+  // 7 m from the edge).
+  double search_margin_m = 0.0;
   double scout_altitude_m = 30.0;       // above home [m]
   double scout_cruise_m_s = 7.0;
   double scout_takeoff_step_m = 3.0;    // flight-stack take-off height; then climb in position mode

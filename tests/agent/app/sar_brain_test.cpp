@@ -392,9 +392,9 @@ TEST(SarBrainScout, AloneAndLeadingItAssignsItselfTheWholeSearchAreaAndStarts) {
   const auto* assign = std::get_if<raft::AssignSectors>(&rig.proposals()[0]);
   ASSERT_NE(assign, nullptr);
   ASSERT_EQ(assign->sectors.size(), 1u);
-  // The 200 x 200 m geofence shrunk by the search margin (8 m).
-  EXPECT_DOUBLE_EQ(assign->sectors[0].x_min_m, -92.0);
-  EXPECT_DOUBLE_EQ(assign->sectors[0].y_max_m, 92.0);
+  // The 200 x 200 m geofence (the search margin is 0: the whole field).
+  EXPECT_DOUBLE_EQ(assign->sectors[0].x_min_m, -100.0);
+  EXPECT_DOUBLE_EQ(assign->sectors[0].y_max_m, 100.0);
   EXPECT_TRUE(std::holds_alternative<raft::StartSearch>(rig.proposals()[1]));
   // Committed: it flocks along its first lane (a velocity setpoint every mission tick).
   rig.Commit(rig.proposals()[0]);
