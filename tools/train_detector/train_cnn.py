@@ -111,6 +111,25 @@ def evaluate(net, x, y, loss_fn, batch):
     return loss, acc, logits
 
 
+def mine_hard_negatives(net, x_train, neg_idx, count, t0):
+    """The `count` training negatives the network scores highest (its false alarms and near
+    misses), by index into x_train: bootstrapping (Sung and Poggio 1998; Felzenszwalb et al.,
+    "Object detection with discriminatively trained part-based models", PAMI 2010, 'hard negative
+    mining'). Rare look-alikes (a backpack, a plank on rubble) are a small share of the random
+    negatives; drawn from this pool they weigh in every epoch."""
+    net.eval()
+    scores = []
+    with torch.no_grad():
+        for i in range(0, len(neg_idx), 2048):
+            scores.append(net(to_input(x_train[neg_idx[i:i + 2048]])).squeeze(1))
+    scores = torch.cat(scores)
+    top = torch.topk(scores, min(count, len(scores))).indices
+    print(f"train_cnn: mined the {len(top)} hardest of {len(neg_idx)} negatives (logit >= "
+          f"{float(scores[top[-1]]):.2f}, {int((scores > 0).sum())} above 0) ({time.monotonic() - t0:.0f} s)",
+          flush=True)
+    return neg_idx[top]
+
+
 def train(args):
     torch.manual_seed(args.seed)
     np.random.seed(args.seed)
@@ -138,9 +157,16 @@ def train(args):
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=args.epochs)
     gen = torch.Generator().manual_seed(args.seed)
     best = (float("inf"), None, -1)
+    hard_count = int(round(args.hard_fraction * per_epoch))
+    hard_pool = None  # the negatives the network scored highest at the last mining
     for epoch in range(args.epochs):
+        if hard_count > 0 and epoch >= args.mine_from and (epoch - args.mine_from) % args.mine_every == 0:
+            hard_pool = mine_hard_negatives(net, x_train, neg_idx, 2 * hard_count, t0)
         net.train()
         drawn = neg_idx[torch.randperm(len(neg_idx), generator=gen)[:per_epoch]]
+        if hard_pool is not None:  # part of the draw from the hardest: bootstrapping
+            hard = hard_pool[torch.randperm(len(hard_pool), generator=gen)[:hard_count]]
+            drawn = torch.cat([drawn[:per_epoch - len(hard)], hard])
         order = torch.cat([pos_idx, drawn])
         order = order[torch.randperm(len(order), generator=gen)]
         total, correct = 0.0, 0
@@ -215,6 +241,10 @@ def main():
     parser.add_argument("--lr", type=float, default=2e-3)
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--negatives-per-epoch", type=int, default=24000)
+    parser.add_argument("--hard-fraction", type=float, default=0.0,
+                        help="share of each epoch's negatives drawn from the hardest mined (default 0: none)")
+    parser.add_argument("--mine-from", type=int, default=3, help="first epoch (0-based) that mines (default 3)")
+    parser.add_argument("--mine-every", type=int, default=3, help="epochs between minings (default 3)")
     parser.add_argument("--widths", type=lambda v: tuple(int(w) for w in v.split(",")), default=(16, 32, 64),
                         help="the three blocks' channels (default 16,32,64)")
     args = parser.parse_args()
@@ -225,6 +255,8 @@ def main():
         parser.error("--patches is required")
     if len(args.widths) != 3 or min(args.widths) < 1:
         parser.error("--widths takes three channel counts, e.g. 16,32,64")
+    if not 0.0 <= args.hard_fraction < 1.0 or args.mine_from < 1 or args.mine_every < 1:
+        parser.error("--hard-fraction takes [0, 1), --mine-from and --mine-every >= 1")
     net, px = train(args)
     export(net, px, args.out)
     print(f"train_cnn: wrote {args.out}", flush=True)
