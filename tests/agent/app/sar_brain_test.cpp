@@ -164,6 +164,7 @@ TEST(SarBrainCreate, RejectsBadConfigurations) {
   EXPECT_NE(r.error().ToString().find("battery"), std::string::npos) << r.error().ToString();
   c = Scout("scout_1", {"scout_1"});
   c.geofence_size_x_m = 10.0;
+  c.tuning.search_margin_m = 5.0;  // nothing left to search
   r = SarBrain::Create(c);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.error().ToString().find("too small"), std::string::npos);
