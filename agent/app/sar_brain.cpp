@@ -271,6 +271,8 @@ Status ApplyTuningArgs(const brain::Context& ctx, MissionTuning* t) {
   }
   if (!(t->revisit_look_s >= 0))
     return Error(ErrorCode::kInvalidArgument, "sar brain: arg revisit_look_s must be >= 0");
+  if (!(t->search_margin_m >= 0))  // < 0 would send the lanes outside the geofence
+    return Error(ErrorCode::kInvalidArgument, "sar brain: arg search_margin_m must be >= 0");
   return Ok{};
 }
 
