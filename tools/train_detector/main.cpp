@@ -21,7 +21,8 @@
 //   train_detector.hpp), --cnn SCRIPT (a CNN second stage trained by SCRIPT, train_cnn.py, with
 //   --python PY, its ONNX at --cnn-onnx FILE (default DIR/victim_detector_cnn.onnx; the patches
 //   beside it unless --export-patches), --cnn-epochs N, --cnn-seed N, --cnn-widths A,B,C (its
-//   three blocks' channels), --cnn-negatives N (negatives drawn per epoch))
+//   three blocks' channels), --cnn-negatives N (negatives drawn per epoch), --cnn-hard-fraction F
+//   (the share of them drawn from the hardest the network scores))
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -107,6 +108,8 @@ constexpr Flag kFlags[] = {
     {"--cnn-widths", true, [](const char* v, Args* a) { a->options.cnn_widths = v; return true; }},
     {"--cnn-negatives", true,
      [](const char* v, Args* a) { a->options.cnn_negatives_per_epoch = std::stoi(v); return true; }},
+    {"--cnn-hard-fraction", true,
+     [](const char* v, Args* a) { a->options.cnn_hard_fraction = std::stod(v); return true; }},
     {"--replace-cnn", true, [](const char* v, Args* a) { a->options.replace_cnn = v; return true; }},
 };
 

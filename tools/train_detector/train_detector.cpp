@@ -338,7 +338,8 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.clean_calibration) r << " --clean-calibration";
   if (!o.cnn_script.empty()) {
     r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed
-      << " --cnn-widths " << o.cnn_widths << " --cnn-negatives " << o.cnn_negatives_per_epoch;
+      << " --cnn-widths " << o.cnn_widths << " --cnn-negatives " << o.cnn_negatives_per_epoch
+      << " --cnn-hard-fraction " << o.cnn_hard_fraction;
   }
   return r.str();
 }
@@ -664,9 +665,11 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
                  "world_sets, world_distractors, stage1_rounds (not with blob features) and "
                  "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path");
   }
-  if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1)) {
+  if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1 ||
+                                !(o.cnn_hard_fraction >= 0 && o.cnn_hard_fraction < 1))) {
     return Error(ErrorCode::kInvalidArgument, "train-detector: --cnn-widths takes three positive channel counts "
-                                              "(e.g. 24,48,96) and --cnn-negatives a count >= 1");
+                                              "(e.g. 24,48,96), --cnn-negatives a count >= 1 and "
+                                              "--cnn-hard-fraction a share in [0, 1)");
   }
   const std::vector<std::uint64_t> negatives_seeds = NegativesSeeds(o);
   const std::vector<std::uint64_t> world_seeds = WorldSeeds(o);
@@ -1050,7 +1053,9 @@ Status RunCnnScript(const TrainingOptions& o, const std::string& patches, const 
                                    "--widths",
                                    o.cnn_widths,
                                    "--negatives-per-epoch",
-                                   std::to_string(o.cnn_negatives_per_epoch)};
+                                   std::to_string(o.cnn_negatives_per_epoch),
+                                   "--hard-fraction",
+                                   std::to_string(o.cnn_hard_fraction)};
   std::vector<char*> argv;
   for (std::string& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -1141,7 +1146,8 @@ std::string MethodText(const swarm::VictimDetectorModel& model) {
   }
   if (model.has_cnn()) {
     text += " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn (train_cnn.py; the recipe's "
-            "--cnn-widths: its blocks' channels)";
+            "--cnn-widths: its blocks' channels; --cnn-hard-fraction: the share of each epoch's negatives from "
+            "the hardest mined)";
   }
   return text + ", Platt sigmoid";
 }
