@@ -3,6 +3,7 @@
 
     python3 train_cnn.py --patches FILE --out MODEL.onnx [--seed 1] [--epochs 6] [--threads 2]
                          [--widths 16,32,64] [--negatives-per-epoch 24000]
+                         [--hard-fraction 0] [--mine-from 3] [--mine-every 3]
     python3 train_cnn.py --test-fixture --out tests/agent/swarm/data/patch_cnn_fixture.onnx
 
 swarmbox-train-detector --cnn train_cnn.py runs this (argv, no shell) between its first stage and
@@ -18,7 +19,8 @@ The network: three blocks of 3 x 3 convolution, batch normalisation, ReLU and 2 
 px), then a 16 C -> 32 -> 1 classifier on the 4 x 4 map
 (it keeps where things are relative to the candidate's centre, which a global pooling would lose).
 Training: Adam (cosine learning rate), each epoch on every positive and a fresh seeded draw of
---negatives-per-epoch negatives, binary cross-entropy with the positives weighted by negatives /
+--negatives-per-epoch negatives (with --hard-fraction F, F of them from the 2 F x that many the
+network scored highest at the last mining: epochs --mine-from, then every --mine-every), binary cross-entropy with the positives weighted by negatives /
 positives of the epoch (the classes weigh the same), each batch's patches turned by a random multiple of 90 degrees and
 mirrored at random (people lie at any heading: the 8 symmetries of the square keep the pixel grid).
 Every draw is seeded; torch.use_deterministic_algorithms(True). The weights kept are those of the

@@ -60,11 +60,11 @@ struct FusionParams {
   // Measured on the mission's own frames (`swarmbox-bench perception --replay RUN`: frames with a
   // person within miss_in_view_m of the nadir at 10-40 m), sar_rubble seeds 42, 7, 8, 9: 0.74 (58
   // of 78 views) with the first detector of 2026-11-28, 0.83 (65 of 78) with the wider CNN shipped
-  // after it; 0.85 stays until more runs measure it.
+  // after it and again with its hard-negative retraining; 0.85 stays until more runs measure it.
   double detector_recall = 0.85;
   // Chance that a false alarm fires again from another view. The same replay measures 0.03 per
   // frame over the places where one fired (7 of 226 frames; 0.10, 18 of 188, with the wider CNN:
-  // debris), but the places that do fire again
+  // debris; 0.06, 6 of 98, with its hard-negative retraining), but the places that do fire again
   // fire on every pass (backpacks: every false victim of rubble20 on 2026-11-28), so the
   // assumption stays above the average: 0.3.
   double false_repeat = 0.3;
