@@ -326,6 +326,32 @@ TEST(ScoutRevisit, FliesOverTheCandidateLooksAndReportsAMissThenResumesItsSweep)
   EXPECT_EQ(s.lane_index(), lane);
 }
 
+// A candidate beyond where a drone can hover (2 m from the geofence: the wall repulsion keeps the
+// drone 4 m off) is looked at from the nearest point that can be reached, and the look ends.
+TEST(ScoutRevisit, ACandidateByTheFenceIsLookedAtFromTheNearestReachablePoint) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
+  m.Apply(raft::StartSearch{});
+  m.Apply(raft::ReportSighting{"scout_2", 1, 40, 78, 0.9, 40, 70, 30, 5.0});
+  m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .revisit_look_s = 2.0,
+                    .revisit_area = {-74, -74, 74, 74}});
+  MissionOutput out;
+  s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
+  s.Step(At(1.0, m.state, {0, 0, 30}), &out);
+  s.Step(At(21.0, m.state, {30, 50, 30}), &out);
+  ASSERT_EQ(out.mode, "revisiting");
+  EXPECT_TRUE(out.setpoint.target_m.isApprox(Vector3d(40, 74, 30)));
+  s.Step(At(30.0, m.state, {40, 73.5, 30}), &out);  // there (0.5 m), 4.5 m from the candidate
+  s.Step(At(32.0, m.state, {40, 73.6, 30}), &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  const auto& miss = std::get<raft::ReportMiss>(out.proposals[0]);
+  EXPECT_DOUBLE_EQ(miss.viewer_y_m, 73.6);
+  m.Apply(miss);
+  EXPECT_TRUE(m.state.FindCandidate(1)->revisit_drone.empty());  // the revisit is done ...
+  EXPECT_EQ(AssessCandidate(*m.state.FindCandidate(1), FusionParams{}).counted_misses, 1);  // ... and counts
+}
+
 TEST(ScoutRevisit, ADetectionThereIsTheRevisitsAnswer) {
   Mission m;
   m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});

@@ -119,6 +119,14 @@ struct ScoutConfig {
   // search altitude; look this long (10 frames at the x500's 5 Hz) before reporting a miss.
   double revisit_arrive_m = 2.0;
   double revisit_look_s = 2.0;
+  // Where a revisit can hover [m, ENU]: a candidate outside it (a detection near the geofence,
+  // where the flocking's wall repulsion keeps the drone out) is looked at from the nearest point
+  // inside, which still has it in the camera's footprint (41 x 23 m at 30 m); the miss carries
+  // that viewpoint and counts if it is within FusionParams::miss_in_view_m. Flying to the spot
+  // itself never arrived there: every revisit timed out and went to the next drone, for ever
+  // (rubble20 on 2026-11-28, a candidate 2.9 m from the fence). SarBrain sets it to the geofence
+  // shrunk by the wall stand-off and 2 m. Default: everywhere.
+  Rect revisit_area{-1e9, -1e9, 1e9, 1e9};
   double report_retry_s = 5.0;        // re-propose a report not yet in the committed state [s]
   int report_tries = 4;               // proposals of one report at most
   std::uint64_t first_sighting_seq = 1;  // after an agent restart: seed above any used (sim ms)
