@@ -65,6 +65,13 @@ double BrakingCurve(double r_m, double a_m_s2, double p_1_s) {
   return std::sqrt(2.0 * a_m_s2 * r_m - (a_m_s2 * a_m_s2) / (p_1_s * p_1_s));
 }
 
+double WallStandoffM(const FlockingParams& k) {
+  const double a = k.a_shill_m_s2, p = k.p_shill_1_s, v = k.v_shill_m_s;
+  // BrakingCurve inverted: linear up to a / p, then v^2 = 2 a r - a^2 / p^2.
+  const double r = v <= a / p ? v / p : (v * v + a * a / (p * p)) / (2 * a);
+  return k.r0_shill_m + r;
+}
+
 Flocking::Flocking(const FlockingParams& params, const Geofence& fence,
                    std::vector<ObstacleFootprint> obstacles)
     : params_(params), fence_(fence), obstacles_(std::move(obstacles)) {

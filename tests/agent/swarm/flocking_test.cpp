@@ -193,6 +193,25 @@ TEST(Flocking, ShillAgentsKeepADroneInsideTheGeofence) {
   EXPECT_GT(p.x(), fence.max_x_m - 2 * k.r0_shill_m - 5.0);  // but got close to it
 }
 
+// A drone at rest and on its goal is left alone just outside WallStandoffM and pushed in just
+// inside it (where a revisit can hover: scout_behaviour.hpp revisit_area).
+TEST(Flocking, TheWallStandoffIsWhereTheShillStartsPushingADroneAtRest) {
+  FlockingParams k;
+  const double standoff = WallStandoffM(k);
+  EXPECT_NEAR(standoff, 4.0 + (36.0 + 6.25) / 5.0, 1e-9);  // r0 4 m; v_shill 6, a 2.5, p 1
+  const Geofence fence = Geofence::Centered(100, 100);
+  for (const double clearance : {standoff + 0.05, standoff - 0.5}) {
+    Flocking f(k, fence);
+    const Vec3 p(0, fence.max_y_m - clearance, 20);
+    const Vec2 shill = f.Step({p, Vec3::Zero(), p, {}}, kDt).shill;
+    if (clearance > standoff) {
+      EXPECT_EQ(shill.norm(), 0.0) << clearance;
+    } else {
+      EXPECT_LT(shill.y(), -0.1) << clearance;  // pushed back inside
+    }
+  }
+}
+
 TEST(Flocking, ShillAgentsKeepADroneOutOfAnObstacle) {
   FlockingParams k;
   const ObstacleFootprint wall{Vec2(50, 0), Vec2(5, 20), 0.3};

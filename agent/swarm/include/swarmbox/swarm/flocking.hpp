@@ -145,6 +145,11 @@ struct FlockingOutput {
 // deceleration a, linear (gain p) near r = 0. Zero for r <= 0.
 double BrakingCurve(double r_m, double a_m_s2, double p_1_s);
 
+// The clearance from a geofence wall inside which its shill agent pushes a drone at rest inward:
+// r0_shill plus the distance over which BrakingCurve reaches v_shill (12.45 m with the defaults).
+// A drone cannot hold a spot closer to the fence than this [m].
+double WallStandoffM(const FlockingParams& k);
+
 class Flocking {
  public:
   // Aborts (SWARMBOX_CHECK) on a non-positive limit or timeout: that is a configuration bug.

@@ -124,8 +124,10 @@ struct ScoutConfig {
   // inside, which still has it in the camera's footprint (41 x 23 m at 30 m); the miss carries
   // that viewpoint and counts if it is within FusionParams::miss_in_view_m. Flying to the spot
   // itself never arrived there: every revisit timed out and went to the next drone, for ever
-  // (rubble20 on 2026-11-28, a candidate 2.9 m from the fence). SarBrain sets it to the geofence
-  // shrunk by the wall stand-off and 2 m. Default: everywhere.
+  // (rubble20 on 2026-11-28: 4 of 12 trials timed out so, candidates 3-6 m from the fence, the
+  // drones held ~10 m off). SarBrain sets it to the geofence shrunk by swarm::WallStandoffM.
+  // A spot more than miss_in_view_m from the candidate still ends the revisit; its miss does not
+  // count, so such a candidate is rejected undecided after max_revisits. Default: everywhere.
   Rect revisit_area{-1e9, -1e9, 1e9, 1e9};
   double report_retry_s = 5.0;        // re-propose a report not yet in the committed state [s]
   int report_tries = 4;               // proposals of one report at most
