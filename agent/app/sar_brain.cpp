@@ -506,6 +506,8 @@ swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, d
   s.dedupe_radius_m = t.sighting_dedupe_m;
   s.report_baseline_m = t.fusion.min_baseline_m;  // one view per counted baseline, no more
   s.revisit_look_s = t.revisit_look_s;
+  s.sighting_area = {-c.geofence_size_x_m / 2, -c.geofence_size_y_m / 2, c.geofence_size_x_m / 2,
+                     c.geofence_size_y_m / 2};
   // The wall repulsion keeps a drone at rest this far from the geofence (12.45 m with the defaults).
   const double in = swarm::WallStandoffM(FlockParams(t));
   s.revisit_area = {-c.geofence_size_x_m / 2 + in, -c.geofence_size_y_m / 2 + in, c.geofence_size_x_m / 2 - in,

@@ -104,6 +104,7 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
   for (const GroundDetection& d : in.detections) {
     if (d.confidence < config_.min_report_confidence) continue;
     const Eigen::Vector2d p = d.position_m.head<2>();
+    if (!config_.sighting_area.Contains(p)) continue;  // beyond the geofence: out of reach
     bool known = false;
     for (const raft::Victim& v : m.victims()) {
       known = known || (Eigen::Vector2d(v.x_m, v.y_m) - p).norm() <= config_.dedupe_radius_m;

@@ -352,6 +352,29 @@ TEST(ScoutRevisit, ACandidateByTheFenceIsLookedAtFromTheNearestReachablePoint) {
   EXPECT_EQ(AssessCandidate(*m.state.FindCandidate(1), FusionParams{}).counted_misses, 1);  // ... and counts
 }
 
+// A detection beyond the geofence (a frame at the field's edge sees past it) is not reported.
+TEST(ScoutRevisit, ADetectionBeyondTheSightingAreaIsNotReported) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .sighting_area = {-80, -80, 80, 80}});
+  MissionOutput out;
+  s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
+  s.Step(At(1.0, m.state, {0, 0, 30}), &out);
+  GroundDetection d;
+  d.confidence = 0.93;
+  d.capture_time_s = 4.0;
+  d.viewer_m = {40, 72, 30};
+  d.position_m = {40, 82.6, 0};
+  std::vector<GroundDetection> dets = {d};
+  s.Step(At(4.1, m.state, {40, 72, 30}, dets), &out);
+  EXPECT_TRUE(out.proposals.empty());
+  dets[0].position_m = {40, 79.0, 0};  // inside: reported
+  s.Step(At(4.2, m.state, {40, 72, 30}, dets), &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  EXPECT_DOUBLE_EQ(std::get<raft::ReportSighting>(out.proposals[0]).y_m, 79.0);
+}
+
 TEST(ScoutRevisit, ADetectionThereIsTheRevisitsAnswer) {
   Mission m;
   m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});

@@ -110,6 +110,10 @@ struct ScoutConfig {
   double approach_height_m = 0.0;
   // Sightings.
   double min_report_confidence = raft::MissionState::kMinConfidence;
+  // Detections outside this are not reported [m, ENU]: SarBrain passes the geofence, beyond which
+  // no drone may fly (nobody could be revisited or rescued there). A frame at the field's edge sees
+  // past it: rubble20 on 2026-11-28 revisited a false alarm 2.6 m outside the fence 14 times.
+  Rect sighting_area{-1e9, -1e9, 1e9, 1e9};
   double dedupe_radius_m = raft::MissionState::kConfirmRadiusM;
   double report_cooldown_s = 10.0;    // re-report the same place after this (a lost proposal) [s]
   // ... or sooner once this far from every own report of it: a second view for the fusion
