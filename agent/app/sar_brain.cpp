@@ -484,6 +484,12 @@ void SarBrain::SendStatus(const Now& now, brain::Output& out) {
 
 namespace {
 
+// The geofence (|x| <= size_x / 2, |y| <= size_y / 2) shrunk by `by_m` on every side.
+swarm::Rect GeofenceShrunk(const SarBrainConfig& c, double by_m) {
+  return {-c.geofence_size_x_m / 2 + by_m, -c.geofence_size_y_m / 2 + by_m, c.geofence_size_x_m / 2 - by_m,
+          c.geofence_size_y_m / 2 - by_m};
+}
+
 // The scout's behaviour for a mission started at t_s from home_m.
 swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, double t_s,
                                   bool lifter_present) {
@@ -506,12 +512,9 @@ swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, d
   s.dedupe_radius_m = t.sighting_dedupe_m;
   s.report_baseline_m = t.fusion.min_baseline_m;  // one view per counted baseline, no more
   s.revisit_look_s = t.revisit_look_s;
-  s.sighting_area = {-c.geofence_size_x_m / 2, -c.geofence_size_y_m / 2, c.geofence_size_x_m / 2,
-                     c.geofence_size_y_m / 2};
+  s.sighting_area = GeofenceShrunk(c, 0.0);
   // The wall repulsion keeps a drone at rest this far from the geofence (12.45 m with the defaults).
-  const double in = swarm::WallStandoffM(FlockParams(t));
-  s.revisit_area = {-c.geofence_size_x_m / 2 + in, -c.geofence_size_y_m / 2 + in, c.geofence_size_x_m / 2 - in,
-                    c.geofence_size_y_m / 2 - in};
+  s.revisit_area = GeofenceShrunk(c, swarm::WallStandoffM(FlockParams(t)));
   s.min_clearance_m = c.depth_camera ? t.scout_min_clearance_m : 0.0;  // no depth camera: nothing seen
   s.keep_searching_during_rescue = true;  // the lifter does the rescue; scouts finish the search
   s.return_when_swept = true;             // nothing left to see: land, do not loiter
@@ -557,9 +560,7 @@ swarm::LeaderConfig LeaderConfigFor(const SarBrainConfig& c) {
   const MissionTuning& t = c.tuning;
   swarm::LeaderConfig lc;
   lc.name = c.name;
-  const double m = t.search_margin_m;
-  lc.search_area = {-c.geofence_size_x_m / 2 + m, -c.geofence_size_y_m / 2 + m, c.geofence_size_x_m / 2 - m,
-                    c.geofence_size_y_m / 2 - m};
+  lc.search_area = GeofenceShrunk(c, t.search_margin_m);
   lc.retry_s = 2.0;
   lc.start_timeout_s = t.leader_start_timeout_s;
   lc.member_timeout_s = t.member_timeout_s;
