@@ -109,7 +109,7 @@ struct TrainingOptions {
   // The share of each epoch's negatives drawn from the hardest the network scores (train_cnn.py
   // --hard-fraction: mined at epochs 4, 7, 10). 0.5 over 0: on the rubble fields at 30 m (bench
   // case=world, the same patches) recall at precision 0.9 0.72 / 0.62 against 0.68 / 0.54 (seeds 1
-  // / 20261121; BENCHMARKS.md "Perception: hard negatives").
+  // / 20261121; BENCHMARKS.md "Perception: hard negatives for the CNN").
   double cnn_hard_fraction = 0.5;
   // Recalibrate() only: when not empty, this ONNX (train_cnn.py's, e.g. run again on a model's
   // exported patches with other settings) replaces the model's CNN before the sigmoid is refitted.

@@ -211,7 +211,8 @@ void ScoutBehaviour::RunRevisit(const MissionInput& in, MissionOutput* out) {
     return;
   }
   const Rect& area = config_.revisit_area;  // the nearest point a drone can hover over
-  const Eigen::Vector2d at(std::clamp(c->x_m, area.x_min_m, area.x_max_m), std::clamp(c->y_m, area.y_min_m, area.y_max_m));
+  const Eigen::Vector2d at(std::clamp(c->x_m, area.x_min_m, area.x_max_m),
+                           std::clamp(c->y_m, area.y_min_m, area.y_max_m));
   const double d = (p.head<2>() - at).norm();
   // Flock on the way (spacing from the others), a position hold over the spot.
   sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;

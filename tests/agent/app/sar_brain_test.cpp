@@ -139,7 +139,8 @@ TEST(SarBrainConfigFrom, NamesTheBadArgOrPayload) {
   ctx.args["search_margin_m"] = "-5";  // lanes outside the geofence
   c = SarBrainConfigFrom(ctx);
   ASSERT_FALSE(c.ok());
-  EXPECT_NE(c.error().ToString().find("search_margin_m must be >= 0"), std::string::npos) << c.error().ToString();
+  EXPECT_NE(c.error().ToString().find("search_margin_m must be >= 0"), std::string::npos)
+      << c.error().ToString();
   ctx = LifterContext();
   ctx.payload = "piano";
   c = SarBrainConfigFrom(ctx);

@@ -334,7 +334,9 @@ TEST(ScoutRevisit, ACandidateByTheFenceIsLookedAtFromTheNearestReachablePoint) {
   m.Apply(raft::StartSearch{});
   m.Apply(raft::ReportSighting{"scout_2", 1, 40, 78, 0.9, 40, 70, 30, 5.0});
   m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
-  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .revisit_look_s = 2.0,
+  ScoutBehaviour s({.name = "scout_1",
+                    .home_m = Vector3d(0, 0, 0),
+                    .revisit_look_s = 2.0,
                     .revisit_area = {-74, -74, 74, 74}});
   MissionOutput out;
   s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
