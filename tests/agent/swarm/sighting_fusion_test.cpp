@@ -289,10 +289,15 @@ MissionInput At(double t, const raft::MissionState& m, const Vector3d& p, std::s
   return in;
 }
 
+// A mission searching with scout_1 on sector (0, 0)-(60, 150).
+void StartSearching(Mission* m) {
+  m->Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
+  m->Apply(raft::StartSearch{});
+}
+
 TEST(ScoutRevisit, FliesOverTheCandidateLooksAndReportsAMissThenResumesItsSweep) {
   Mission m;
-  m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
-  m.Apply(raft::StartSearch{});
+  StartSearching(&m);
   m.Apply(raft::ReportSighting{"scout_2", 1, 100, 40, 0.9, 100, 30, 30, 5.0});
   ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .revisit_look_s = 2.0});
   MissionOutput out;
@@ -326,12 +331,12 @@ TEST(ScoutRevisit, FliesOverTheCandidateLooksAndReportsAMissThenResumesItsSweep)
   EXPECT_EQ(s.lane_index(), lane);
 }
 
-// A candidate beyond where a drone can hover (2 m from the geofence: the wall repulsion keeps the
-// drone 4 m off) is looked at from the nearest point that can be reached, and the look ends.
+// A candidate beyond where a drone can hover (by the geofence, whose wall repulsion holds a drone
+// WallStandoffM off: here the area ends at 74 m) is looked at from the nearest point that can be
+// reached, and the look ends.
 TEST(ScoutRevisit, ACandidateByTheFenceIsLookedAtFromTheNearestReachablePoint) {
   Mission m;
-  m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
-  m.Apply(raft::StartSearch{});
+  StartSearching(&m);
   m.Apply(raft::ReportSighting{"scout_2", 1, 40, 78, 0.9, 40, 70, 30, 5.0});
   m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
   ScoutBehaviour s({.name = "scout_1",
@@ -357,8 +362,7 @@ TEST(ScoutRevisit, ACandidateByTheFenceIsLookedAtFromTheNearestReachablePoint) {
 // A detection beyond the geofence (a frame at the field's edge sees past it) is not reported.
 TEST(ScoutRevisit, ADetectionBeyondTheSightingAreaIsNotReported) {
   Mission m;
-  m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
-  m.Apply(raft::StartSearch{});
+  StartSearching(&m);
   ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .sighting_area = {-80, -80, 80, 80}});
   MissionOutput out;
   s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
@@ -379,8 +383,7 @@ TEST(ScoutRevisit, ADetectionBeyondTheSightingAreaIsNotReported) {
 
 TEST(ScoutRevisit, ADetectionThereIsTheRevisitsAnswer) {
   Mission m;
-  m.Apply(raft::AssignSectors{{{"scout_1", 0, 0, 60, 150}}});
-  m.Apply(raft::StartSearch{});
+  StartSearching(&m);
   m.Apply(raft::ReportSighting{"scout_2", 1, 100, 40, 0.9, 100, 30, 30, 5.0});
   m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
   ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0)});
