@@ -7,6 +7,8 @@
 //   training lines and gets "recalibrated": true)
 //   swarmbox-train-detector --out-dir DIR --recalibrate --replace-cnn FILE.onnx
 //   (the same with another CNN in place of the model's: train_cnn.py run again on its patches)
+//   --model-name NAME: DIR/NAME.yml.gz and DIR/NAME.json (default victim_detector; the close-look
+//   model: victim_detector_close, trained with --view-altitudes 10,20 --cnn-patch-px 48)
 //   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):
 //   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
 //   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features,
@@ -22,7 +24,8 @@
 //   --python PY, its ONNX at --cnn-onnx FILE (default DIR/victim_detector_cnn.onnx; the patches
 //   beside it unless --export-patches), --cnn-epochs N, --cnn-seed N, --cnn-widths A,B,C (its
 //   three blocks' channels), --cnn-negatives N (negatives drawn per epoch), --cnn-hard-fraction F
-//   (the share of them drawn from the hardest the network scores))
+//   (the share of them drawn from the hardest the network scores), --cnn-patch-px N (its patch side
+//   over 3 m; default 32), --view-altitudes LO,HI (every training set's heights))
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -38,6 +41,7 @@ namespace td = swarmbox::train_detector;
 
 struct Args {
   std::string out_dir;
+  std::string model_name = "victim_detector";  // DIR/NAME.yml.gz and DIR/NAME.json
   bool recalibrate = false;
   td::TrainingOptions options = td::DefaultTrainingOptions();
 };
@@ -65,6 +69,19 @@ bool SetCalibrationSets(const char* value, Args* args) {
     return false;
   }
   args->options.calibration_seeds = td::SeedSets(td::kCalibrationSeedBase, n);
+  return true;
+}
+
+// --view-altitudes LO,HI: every training set's views between LO and HI metres.
+bool SetViewAltitudes(const char* value, Args* args) {
+  const std::string text = value;
+  const std::size_t comma = text.find(',');
+  if (comma == std::string::npos) {
+    std::fprintf(stderr, "swarmbox-train-detector: --view-altitudes takes LO,HI (metres)\n");
+    return false;
+  }
+  args->options.view_min_altitude_m = std::stod(text.substr(0, comma));
+  args->options.view_max_altitude_m = std::stod(text.substr(comma + 1));
   return true;
 }
 
@@ -110,6 +127,9 @@ constexpr Flag kFlags[] = {
      [](const char* v, Args* a) { a->options.cnn_negatives_per_epoch = std::stoi(v); return true; }},
     {"--cnn-hard-fraction", true,
      [](const char* v, Args* a) { a->options.cnn_hard_fraction = std::stod(v); return true; }},
+    {"--cnn-patch-px", true, [](const char* v, Args* a) { a->options.cnn_patch_px = std::stoi(v); return true; }},
+    {"--view-altitudes", true, SetViewAltitudes},
+    {"--model-name", true, [](const char* v, Args* a) { a->model_name = v; return true; }},
     {"--replace-cnn", true, [](const char* v, Args* a) { a->options.replace_cnn = v; return true; }},
 };
 
@@ -133,7 +153,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
                    "[--operating-precision P] [--export-patches FILE] "
                    "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N] "
-                   "[--cnn-widths A,B,C] [--cnn-negatives N]] "
+                   "[--cnn-widths A,B,C] [--cnn-negatives N] [--cnn-hard-fraction F] [--cnn-patch-px N]] "
+                   "[--view-altitudes LO,HI] [--model-name NAME] "
                    "[--recalibrate --replace-cnn FILE]\n");
       return kUsageError;
     }
@@ -148,7 +169,7 @@ int ParseArgs(int argc, char** argv, Args* args) {
     std::fprintf(stderr, "swarmbox-train-detector: --replace-cnn goes with --recalibrate\n");
     return kUsageError;
   }
-  if (args->options.cnn_onnx_out.empty()) args->options.cnn_onnx_out = args->out_dir + "/victim_detector_cnn.onnx";
+  if (args->options.cnn_onnx_out.empty()) args->options.cnn_onnx_out = args->out_dir + "/" + args->model_name + "_cnn.onnx";
   return kContinue;
 }
 
@@ -190,8 +211,8 @@ int main(int argc, char** argv) {
   if (int code = ParseArgs(argc, argv, &args); code != kContinue) return code;
   const td::TrainingOptions& options = args.options;
   td::TrainingReport report;
-  const std::string model_path = args.out_dir + "/victim_detector.yml.gz";
-  const std::string json_path = args.out_dir + "/victim_detector.json";
+  const std::string model_path = args.out_dir + "/" + args.model_name + ".yml.gz";
+  const std::string json_path = args.out_dir + "/" + args.model_name + ".json";
   const std::string old_json = args.recalibrate ? ReadText(json_path) : std::string();
   swarmbox::Result<swarmbox::swarm::VictimDetectorModel> model =
       args.recalibrate ? td::Recalibrate(options, model_path, &report) : td::Train(options, &report);
@@ -203,7 +224,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "swarmbox-train-detector: %s\n", s.error().ToString().c_str());
     return 1;
   }
-  std::string text = td::ReportJson(*model, options, report);
+  std::string text = td::ReportJson(*model, options, report, args.model_name + ".yml.gz");
   if (args.recalibrate) text = MergeRecalibratedReport(old_json, text);
   std::ofstream json(json_path);
   json << text;

@@ -336,6 +336,9 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
   if (o.calibration_seeds != SeedSets(kCalibrationSeedBase, 2)) r << " --calibration-sets " << o.calibration_seeds.size();
   if (o.clean_calibration) r << " --clean-calibration";
+  if (o.view_min_altitude_m > 0)
+    r << " --view-altitudes " << o.view_min_altitude_m << "," << o.view_max_altitude_m;
+  if (o.cnn_patch_px != swarm::kCnnPatchPx) r << " --cnn-patch-px " << o.cnn_patch_px;
   if (!o.cnn_script.empty()) {
     r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed
       << " --cnn-widths " << o.cnn_widths << " --cnn-negatives " << o.cnn_negatives_per_epoch
@@ -655,15 +658,20 @@ bool ThreeWidths(const std::string& text) {
 
 Status CheckTrainingOptions(const TrainingOptions& o) {
   if (!(o.stage1_percentile >= 0 && o.stage1_percentile < 100) || o.forest_trees < 1 || o.max_negatives < 1 ||
-      o.hard_negative_rounds < 0 || o.max_candidates < 1 || !(o.operating_precision >= 0 && o.operating_precision < 1) ||
-      o.negatives_sets < 0 || o.world_sets < 0 || o.world_distractors < 0 || o.stage1_rounds < 0 ||
+      o.hard_negative_rounds < 0 || o.max_candidates < 1 ||
+      !(o.operating_precision >= 0 && o.operating_precision < 1) || o.negatives_sets < 0 ||
+      o.world_sets < 0 || o.world_distractors < 0 || o.stage1_rounds < 0 ||
       (o.stage1_rounds > 0 && o.blob_features) || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
-      (!o.cnn_script.empty() && o.cnn_onnx_out.empty())) {
+      (!o.cnn_script.empty() && o.cnn_onnx_out.empty()) || !swarm::ValidCnnPatchPx(o.cnn_patch_px) ||
+      ((o.view_min_altitude_m != 0 || o.view_max_altitude_m != 0) &&
+       !(o.view_min_altitude_m >= 2 && o.view_max_altitude_m > o.view_min_altitude_m))) {
     return Error(ErrorCode::kInvalidArgument,
                  "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
                  "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, "
                  "world_sets, world_distractors, stage1_rounds (not with blob features) and "
-                 "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path");
+                 "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-patch-px is "
+                 "a multiple "
+                 "of 8 in [16, 128], --view-altitudes LO,HI has 2 <= LO < HI");
   }
   if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1 ||
                                 !(o.cnn_hard_fraction >= 0 && o.cnn_hard_fraction < 1))) {
@@ -955,12 +963,13 @@ Status CheckFlattenedForest(const Training& t, Labelled& s2) {
 // into the header by Close().
 class PatchWriter {
  public:
+  explicit PatchWriter(int patch_px) : patch_px_(patch_px) {}
   Status Open(const std::string& path) {
     path_ = path;
     out_.open(path, std::ios::binary | std::ios::trunc);
     if (!out_) return Error(ErrorCode::kIo, "train-detector: cannot write the patch file", path);
-    const std::uint32_t header[3] = {kPatchFileVersion, static_cast<std::uint32_t>(swarm::kCnnPatchPx), 3};
-    const auto px_per_m = static_cast<float>(swarm::kCnnPxPerM);
+    const std::uint32_t header[3] = {kPatchFileVersion, static_cast<std::uint32_t>(patch_px_), 3};
+    const auto px_per_m = static_cast<float>(patch_px_ / swarm::kCnnPatchM);
     const std::uint64_t count = 0;  // Close() writes the count here
     out_.write(kPatchFileMagic, sizeof(kPatchFileMagic));
     out_.write(reinterpret_cast<const char*>(header), sizeof(header));
@@ -969,8 +978,8 @@ class PatchWriter {
     return Ok{};
   }
   void Add(const cv::Mat& patch, int label, PatchSplit split) {
-    SWARMBOX_CHECK(patch.type() == CV_8UC3 && patch.isContinuous() && patch.rows == swarm::kCnnPatchPx &&
-                   patch.cols == swarm::kCnnPatchPx);
+    SWARMBOX_CHECK(patch.type() == CV_8UC3 && patch.isContinuous() && patch.rows == patch_px_ &&
+                   patch.cols == patch_px_);
     const char record[2] = {static_cast<char>(label), static_cast<char>(split)};
     out_.write(record, sizeof(record));
     out_.write(reinterpret_cast<const char*>(patch.data), static_cast<std::streamsize>(patch.total() * patch.elemSize()));
@@ -989,6 +998,7 @@ class PatchWriter {
   }
 
  private:
+  int patch_px_;
   std::ofstream out_;
   std::string path_;
   std::uint64_t count_ = 0;
@@ -1012,7 +1022,7 @@ void AddScenePatches(swarm::VictimDetector& det, const Scene& s, PatchSplit spli
     w->Add(patch, label, split);
   }
   if (split != PatchSplit::kTraining) return;
-  swarm::CandidatePatchSampler sampler;
+  swarm::CandidatePatchSampler sampler(det.model().cnn_patch_px);
   sampler.SetFrame(BgrOf(s), ppm);
   for (const SceneVictim& v : s.victims) {
     const std::optional<Eigen::Vector2d> px =
@@ -1028,8 +1038,9 @@ void AddScenePatches(swarm::VictimDetector& det, const Scene& s, PatchSplit spli
 Status ExportPatches(const Training& t, const std::vector<Scene>& train, const std::vector<Scene>& cal,
                      const std::string& path) {
   auto shared = std::make_shared<swarm::VictimDetectorModel>(t.model);
+  shared->cnn_patch_px = t.o.cnn_patch_px;
   swarm::VictimDetector det(shared, {});
-  PatchWriter w;
+  PatchWriter w(t.o.cnn_patch_px);
   SWARMBOX_TRY(w.Open(path));
   for (const Scene& s : train) AddScenePatches(det, s, PatchSplit::kTraining, &w);
   for (const Scene& s : cal) AddScenePatches(det, s, PatchSplit::kCalibration, &w);
@@ -1077,6 +1088,7 @@ Status TrainCnnStage(Training& t, const std::vector<Scene>& train, const std::ve
   const std::string patches = t.o.export_patches.empty() ? t.o.cnn_onnx_out + ".patches" : t.o.export_patches;
   SWARMBOX_TRY(ExportPatches(t, train, cal, patches));
   SWARMBOX_TRY(RunCnnScript(t.o, patches, t.o.cnn_onnx_out));
+  t.model.cnn_patch_px = t.o.cnn_patch_px;
   SWARMBOX_TRY(ReadCnn(t.o.cnn_onnx_out, &t.model));
   t.model.forest.release();
   std::fprintf(stderr, "train-detector: CNN of %zu bytes (%.0f s)\n", t.model.cnn_onnx.size(), Seconds(t.t0));
@@ -1097,23 +1109,43 @@ Status TrainForestStage(Training& t, const std::vector<Scene>& train, Labelled& 
 
 }  // namespace
 
+namespace {
+
+// Every training set (the mixed terrains, then the cones-and-rubble and the rubble-field sets),
+// each within --view-altitudes when given.
+Result<std::vector<Scene>> RenderTrainingSets(const TrainingOptions& o) {
+  auto band = [&o](perception_scenes::SceneSetParams p) {
+    if (o.view_min_altitude_m > 0) {
+      p.min_altitude_m = o.view_min_altitude_m;
+      p.max_altitude_m = o.view_max_altitude_m;
+    }
+    return p;
+  };
+  Result<std::vector<Scene>> train =
+      RenderSets(o.training_seeds, o.scenes_per_set,
+                 [&](std::uint64_t seed, int scenes) { return band(TrainingSceneSet(seed, scenes)); });
+  if (!train) return train.error();
+  auto add = [&](const std::vector<std::uint64_t>& seeds, auto set_params) -> Status {
+    Result<std::vector<Scene>> extra = RenderSets(seeds, o.scenes_per_set, set_params);
+    if (!extra) return extra.error();
+    for (Scene& x : *extra) train->push_back(std::move(x));
+    return Ok{};
+  };
+  SWARMBOX_TRY(add(NegativesSeeds(o),
+                   [&](std::uint64_t seed, int scenes) { return band(NegativesSceneSet(seed, scenes)); }));
+  SWARMBOX_TRY(add(WorldSeeds(o), [&](std::uint64_t seed, int scenes) {
+    return band(WorldSceneSet(seed, scenes, o.world_distractors));
+  }));
+  return train;
+}
+
+}  // namespace
+
 Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   SWARMBOX_TRY(CheckTrainingOptions(o));
-  Result<std::vector<Scene>> train = RenderSets(o.training_seeds, o.scenes_per_set, TrainingSceneSet);
+  Result<std::vector<Scene>> train = RenderTrainingSets(o);
   if (!train) return train.error();
-  if (o.negatives_sets > 0) {
-    Result<std::vector<Scene>> extra = RenderSets(NegativesSeeds(o), o.scenes_per_set, NegativesSceneSet);
-    if (!extra) return extra.error();
-    for (Scene& x : *extra) train->push_back(std::move(x));
-  }
-  if (o.world_sets > 0) {
-    Result<std::vector<Scene>> extra = RenderSets(WorldSeeds(o), o.scenes_per_set, [&o](std::uint64_t seed, int scenes) {
-      return WorldSceneSet(seed, scenes, o.world_distractors);
-    });
-    if (!extra) return extra.error();
-    for (Scene& x : *extra) train->push_back(std::move(x));
-  }
   Result<std::vector<Scene>> cal = RenderCalibrationSets(o);
   if (!cal) return cal.error();
   report->training_scenes = static_cast<int>(train->size());
@@ -1145,23 +1177,27 @@ std::string MethodText(const swarm::VictimDetectorModel& model) {
             " blob features (size, shape, parts, edge orientations; 16 px/m)";
   }
   if (model.has_cnn()) {
-    text += " replaced by a CNN on 32 x 32 colour patches (3 x 3 m) run by cv::dnn (train_cnn.py; the recipe's "
-            "--cnn-widths: its blocks' channels; --cnn-hard-fraction: the share of each epoch's negatives from "
-            "the hardest mined)";
+    const std::string px = std::to_string(model.cnn_patch_px);
+    text +=
+        " replaced by a CNN on " + px + " x " + px +
+        " colour patches (3 x 3 m) run by cv::dnn (train_cnn.py; the recipe's "
+        "--cnn-widths: its blocks' channels; --cnn-hard-fraction: the share of each epoch's negatives from "
+        "the hardest mined)";
   }
   return text + ", Platt sigmoid";
 }
 
 }  // namespace
 
-std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& o, const TrainingReport& r) {
+std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& o,
+                       const TrainingReport& r, const std::string& model_file) {
   std::ostringstream j;
   auto list = [&](const std::vector<std::uint64_t>& v) {
     j << "[";
     for (std::size_t i = 0; i < v.size(); ++i) j << (i ? ", " : "") << v[i];
     j << "]";
   };
-  j << "{\n  \"model\": \"victim_detector.yml.gz\",\n";
+  j << "{\n  \"model\": \"" << model_file << "\",\n";
   j << "  \"method\": \"" << MethodText(model) << "\",\n";
   j << "  \"recipe\": \"" << model.recipe << "\",\n";
   j << "  \"training_seeds\": ";

@@ -111,6 +111,14 @@ struct TrainingOptions {
   // case=world, the same patches) recall at precision 0.9 0.72 / 0.62 against 0.68 / 0.54 (seeds 1
   // / 20261121; BENCHMARKS.md "Perception: hard negatives for the CNN").
   double cnn_hard_fraction = 0.5;
+  // The CNN's patch side [px] over 3 m (swarm::ValidCnnPatchPx): 32 (10.7 px/m) for the search
+  // altitude; a close-look model (victim_detector_close) 48 (16 px/m), its frames from
+  // view_altitude_m's band.
+  int cnn_patch_px = swarm::kCnnPatchPx;
+  // When both > 0: every training set's views between these heights [m] (the defaults: 8-65 m for
+  // the mixed terrains, 15-45 m for the rubble fields); a close-look model's 10-20 m.
+  double view_min_altitude_m = 0;
+  double view_max_altitude_m = 0;
   // Recalibrate() only: when not empty, this ONNX (train_cnn.py's, e.g. run again on a model's
   // exported patches with other settings) replaces the model's CNN before the sigmoid is refitted.
   std::string replace_cnn;
@@ -192,6 +200,7 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& options, c
                                                TrainingReport* report);
 
 std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& options,
-                       const TrainingReport& report);
+                       const TrainingReport& report,
+                       const std::string& model_file = "victim_detector.yml.gz");
 
 }  // namespace swarmbox::train_detector

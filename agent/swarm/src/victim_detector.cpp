@@ -55,8 +55,9 @@ void LocalMaxima(const cv::Mat& valid, const cv::Mat& dilated, double threshold,
 
 // VictimDetector(params), with the shipped model, is defined in shipped_model.cpp (its own library,
 // so that the trainer links the detector without a model).
-VictimDetector::VictimDetector(std::shared_ptr<const VictimDetectorModel> model, const VictimDetectorParams& params)
-    : model_(std::move(model)), params_(params) {
+VictimDetector::VictimDetector(std::shared_ptr<const VictimDetectorModel> model,
+                               const VictimDetectorParams& params)
+    : model_(std::move(model)), params_(params), patches_(model_ ? model_->cnn_patch_px : kCnnPatchPx) {
   SWARMBOX_CHECK(model_ && (model_->forest || model_->has_cnn()) && static_cast<int>(model_->kernels.size()) == kChannels);
   SWARMBOX_CHECK(params_.max_candidates > 0 && params_.nms_radius_m >= 0);
   if (model_->has_cnn()) {
@@ -130,8 +131,9 @@ void VictimDetector::CnnScores(const std::vector<Candidate>& cands, const std::v
   for (std::size_t i = 0; i < kept.size(); ++i) CnnPatch(cands[static_cast<std::size_t>(kept[i])], &patch_batch_[i]);
   // (pixel - kCnnInputMean) * kCnnInputScale, N x 3 x H x W, BGR as sampled (train_cnn.py reads the
   // trainer's patches in the same order).
-  cv::dnn::blobFromImages(patch_batch_, cnn_input_, kCnnInputScale, cv::Size(kCnnPatchPx, kCnnPatchPx),
-                          cv::Scalar::all(kCnnInputMean), false, false, CV_32F);
+  cv::dnn::blobFromImages(patch_batch_, cnn_input_, kCnnInputScale,
+                          cv::Size(patches_.patch_px(), patches_.patch_px()), cv::Scalar::all(kCnnInputMean),
+                          false, false, CV_32F);
   cnn_.setInput(cnn_input_);
   cnn_output_ = cnn_.forward();
   SWARMBOX_CHECK(cnn_output_.total() == kept.size() && cnn_output_.type() == CV_32F);

@@ -161,8 +161,8 @@ namespace {
 // The second stage into fs: the forest, or the CNN's ONNX bytes and its patch layout.
 void WriteSecondStage(const VictimDetectorModel& model, cv::FileStorage& fs) {
   if (model.has_cnn()) {
-    fs << "cnn_patch_px" << kCnnPatchPx << "cnn_patch_m" << kCnnPatchM << "cnn_input_mean" << kCnnInputMean
-       << "cnn_input_scale" << kCnnInputScale;
+    fs << "cnn_patch_px" << model.cnn_patch_px << "cnn_patch_m" << kCnnPatchM << "cnn_input_mean"
+       << kCnnInputMean << "cnn_input_scale" << kCnnInputScale;
     fs << "cnn_onnx" << cv::Mat(1, static_cast<int>(model.cnn_onnx.size()), CV_8U,
                                 const_cast<std::uint8_t*>(model.cnn_onnx.data()));
     return;
@@ -216,13 +216,14 @@ Status ReadLayout(cv::FileStorage& fs, const std::string& where, VictimDetectorM
                  "detector model: another format or feature layout than this build (retrain: target train-detector)",
                  where);
   }
-  if (version == kCnnFormatVersion &&
-      (static_cast<int>(fs["cnn_patch_px"]) != kCnnPatchPx || static_cast<double>(fs["cnn_patch_m"]) != kCnnPatchM ||
-       static_cast<double>(fs["cnn_input_mean"]) != kCnnInputMean ||
-       static_cast<double>(fs["cnn_input_scale"]) != kCnnInputScale)) {
+  if (version == kCnnFormatVersion && (!ValidCnnPatchPx(static_cast<int>(fs["cnn_patch_px"])) ||
+                                       static_cast<double>(fs["cnn_patch_m"]) != kCnnPatchM ||
+                                       static_cast<double>(fs["cnn_input_mean"]) != kCnnInputMean ||
+                                       static_cast<double>(fs["cnn_input_scale"]) != kCnnInputScale)) {
     return Error(ErrorCode::kInvalidArgument,
                  "detector model: another CNN patch layout than this build (retrain: target train-detector)", where);
   }
+  if (version == kCnnFormatVersion) m->cnn_patch_px = static_cast<int>(fs["cnn_patch_px"]);
   if (version == kFormatVersion || version == kCnnFormatVersion) {
     m->blob_features = static_cast<int>(fs["blob_features"]);
     m->recipe = static_cast<std::string>(fs["recipe"]);

@@ -86,28 +86,38 @@ cv::Mat TestFrame() {
 }
 
 TEST(CandidatePatch, SamplesAThreeMetreSquareAtTheFixedScaleAroundTheCentre) {
-  // Given a 1 x 1 m red square on grey ground, centred on pixel (99.5, 79.5), at 20 px/m.
-  constexpr double kPxPerM = 20.0;
-  cv::Mat frame(200, 200, CV_8UC3, cv::Scalar(100, 100, 100));
-  cv::rectangle(frame, cv::Rect(90, 70, 20, 20), cv::Scalar(0, 0, 255), cv::FILLED);
-  // When its patch is taken at the square's centre.
-  cv::Mat patch;
-  CandidatePatch(frame, kPxPerM, {99.5, 79.5}, &patch);
-  // Then the patch is kCnnPatchPx square, red within 0.5 m of its centre and grey beyond.
-  ASSERT_EQ(patch.rows, kCnnPatchPx);
-  ASSERT_EQ(patch.cols, kCnnPatchPx);
-  ASSERT_EQ(patch.type(), CV_8UC3);
-  const int mid = kCnnPatchPx / 2;
-  const int inside = static_cast<int>(0.35 * kCnnPxPerM), outside = static_cast<int>(0.7 * kCnnPxPerM);
-  constexpr double kLevels = 2;  // rounding of the area average and the bilinear taps
-  auto off = [&](int r, int c, cv::Vec3b want) { return cv::norm(cv::Vec3d(patch.at<cv::Vec3b>(r, c)) - cv::Vec3d(want), cv::NORM_INF); };
-  for (int d : {-inside - 1, inside}) {
-    EXPECT_LE(off(mid + d, mid + d, {0, 0, 255}), kLevels) << d;
+  // The search model's 32 px (10.7 px/m) and the close-look model's 48 px (16 px/m).
+  for (const int px : {kCnnPatchPx, 48}) {
+    // Given a 1 x 1 m red square on grey ground, centred on pixel (99.5, 79.5), at 20 px/m.
+    constexpr double kPxPerM = 20.0;
+    cv::Mat frame(200, 200, CV_8UC3, cv::Scalar(100, 100, 100));
+    cv::rectangle(frame, cv::Rect(90, 70, 20, 20), cv::Scalar(0, 0, 255), cv::FILLED);
+    // When its patch is taken at the square's centre.
+    CandidatePatchSampler sampler(px);
+    sampler.SetFrame(frame, kPxPerM);
+    cv::Mat patch;
+    sampler.Extract({99.5, 79.5}, &patch);
+    // Then the patch is px square, red within 0.5 m of its centre and grey beyond.
+    ASSERT_EQ(patch.rows, px);
+    ASSERT_EQ(patch.cols, px);
+    ASSERT_EQ(patch.type(), CV_8UC3);
+    const double px_per_m = px / kCnnPatchM;
+    const int mid = px / 2;
+    const int inside = static_cast<int>(0.35 * px_per_m), outside = static_cast<int>(0.7 * px_per_m);
+    constexpr double kLevels = 2;  // rounding of the area average and the bilinear taps
+    auto off = [&](int r, int c, cv::Vec3b want) {
+      return cv::norm(cv::Vec3d(patch.at<cv::Vec3b>(r, c)) - cv::Vec3d(want), cv::NORM_INF);
+    };
+    for (int d : {-inside - 1, inside}) {
+      EXPECT_LE(off(mid + d, mid + d, {0, 0, 255}), kLevels) << px << " " << d;
+    }
+    for (int d : {-outside - 1, outside}) {
+      EXPECT_LE(off(mid + d, mid, {100, 100, 100}), kLevels) << px << " " << d;
+      EXPECT_LE(off(mid, mid + d, {100, 100, 100}), kLevels) << px << " " << d;
+    }
   }
-  for (int d : {-outside - 1, outside}) {
-    EXPECT_LE(off(mid + d, mid, {100, 100, 100}), kLevels) << d;
-    EXPECT_LE(off(mid, mid + d, {100, 100, 100}), kLevels) << d;
-  }
+  EXPECT_FALSE(ValidCnnPatchPx(36));
+  EXPECT_FALSE(ValidCnnPatchPx(8));
 }
 
 TEST(CandidatePatch, IsDeterministicAndTheDetectorSeesTheTrainersPixels) {

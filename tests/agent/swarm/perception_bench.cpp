@@ -12,7 +12,8 @@
 //   case=occlusion    occluded_fraction=0|0.5|1 at 30 m (share of the people under 20-80 % cover)
 //   case=distractors  distractors=0|2|6 per person at 30 m
 //   case=world        world=rubble_field at 30 m: the mission's generated fields (sar_rubble.yaml's
-//                     recipe, perception_scenes.hpp SarRubbleSpec; --only world:1)
+//                     recipe, perception_scenes.hpp SarRubbleSpec; --only world:1; --world-altitude M
+//                     from M metres instead: the revisit's close look, 15 m)
 // with persons (at least half visible), tp, fp, precision and recall at confidence 0.5, ap (VOC,
 // all detections), recall_at_p90 (the highest recall at precision >= 0.9, any confidence: a point
 // of the curve, not an operating point), max_recall (all detections) and ms_per_frame (Detect() on
@@ -119,7 +120,8 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
   for (double a : {10.0, 20.0, 30.0, 40.0, 60.0}) cases.push_back({"altitude", "altitude_m", a, at(a, 0.3, 2)});
   for (double o : {0.0, 0.5, 1.0}) cases.push_back({"occlusion", "occluded_fraction", o, at(30, o, 2)});
   for (int d : {0, 2, 6}) cases.push_back({"distractors", "distractors", static_cast<double>(d), at(30, 0.3, d)});
-  SceneSetParams rubble = at(30, 0, 0);
+  // --world-altitude M: the world case from M metres (a close-look model's 15 m) instead of 30.
+  SceneSetParams rubble = at(args.GetDouble("world-altitude", 30.0), 0, 0);
   rubble.generated = SarRubbleSpec();
   cases.push_back({"world", "world_rubble_field", 1, rubble});
   if (args.quick) cases.resize(2);
@@ -160,7 +162,7 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
     line.Add("suite", "perception").Add("case", c.kind).Add("seed", seed);
     if (c.kind == "world") line.Add("world", "rubble_field");  // sar_rubble.yaml's generated fields
     else line.Add(c.key, c.value, c.key == "occluded_fraction" ? 1 : 0);
-    if (c.kind != "altitude") line.Add("altitude_m", 30);
+    if (c.kind != "altitude") line.Add("altitude_m", c.scenes.min_altitude_m);
     line.Add("scenes", d.scenes)
         .Add("persons", d.persons)
         .Add("tp", d.tp)

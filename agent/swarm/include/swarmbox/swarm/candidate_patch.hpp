@@ -14,6 +14,8 @@
 // resolution at the 30 m search altitude (640 px over 1.204 rad: 15.5 px/m) and finer than it above 44 m.
 // Sampling: bilinear, the frame's border replicated; a frame finer than kCnnPxPerM is first shrunk
 // to it by area averaging (once per frame), so a patch never aliases.
+// A close-look model (VictimDetectorModel::cnn_patch_px, e.g. 48 px: 16 px/m, for frames from the
+// revisit's look altitude) samples the same 3 x 3 m at patch_px / kCnnPatchM px/m.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,11 +29,15 @@ inline constexpr double kCnnPxPerM = kCnnPatchPx / kCnnPatchM;
 
 class CandidatePatchSampler {
  public:
+  // patch_px: the patch's side [px], a multiple of 8 in [16, 128] (the network pools 3 times).
+  explicit CandidatePatchSampler(int patch_px = kCnnPatchPx);
+  int patch_px() const { return patch_px_; }
+  double px_per_m() const { return patch_px_ / kCnnPatchM; }
   // The frame (CV_8UC3 BGR, not copied: it must outlive the Extract() calls) and its ground scale
   // [px/m] > 0.
   void SetFrame(const cv::Mat& bgr, double pixels_per_m);
   // The patch centred on centre_px (a pixel of the frame, u right, v down; it may lie off the
-  // image) into *patch (kCnnPatchPx x kCnnPatchPx CV_8UC3, reallocated only when it is not that).
+  // image) into *patch (patch_px() x patch_px() CV_8UC3, reallocated only when it is not that).
   void Extract(const Eigen::Vector2d& centre_px, cv::Mat* patch) const;
 
  private:
@@ -39,7 +45,11 @@ class CandidatePatchSampler {
   cv::Mat small_;
   double frame_px_per_m_ = 0;  // of frame_
   double to_frame_ = 1;        // frame_ pixels per input pixel
+  int patch_px_ = kCnnPatchPx;
 };
+
+// Whether a patch side is one the sampler and train_cnn.py's network take.
+inline bool ValidCnnPatchPx(int px) { return px >= 16 && px <= 128 && px % 8 == 0; }
 
 // One patch of one frame (SetFrame then Extract): for tests and one-off use.
 void CandidatePatch(const cv::Mat& bgr, double pixels_per_m, const Eigen::Vector2d& centre_px, cv::Mat* patch);
