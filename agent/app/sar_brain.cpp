@@ -207,7 +207,13 @@ constexpr TuningArg kTuningArgs[] = {
     {"fusion_max_miss_height_m", nullptr, &swarm::FusionParams::max_miss_height_m},
     {"fusion_revisit_after_s", nullptr, &swarm::FusionParams::revisit_after_s},
     {"fusion_revisit_timeout_s", nullptr, &swarm::FusionParams::revisit_timeout_s},
+    {"fusion_close_look_height_m", nullptr, &swarm::FusionParams::close_look_height_m},
+    {"fusion_max_search_log_odds", nullptr, &swarm::FusionParams::max_search_log_odds},
+    {"fusion_max_close_view_confidence", nullptr, &swarm::FusionParams::max_close_view_confidence},
+    {"fusion_close_recall", nullptr, &swarm::FusionParams::close_recall},
+    {"fusion_close_false_repeat", nullptr, &swarm::FusionParams::close_false_repeat},
     {"revisit_look_s", &MissionTuning::revisit_look_s, nullptr},
+    {"revisit_look_altitude_m", &MissionTuning::revisit_look_altitude_m, nullptr},
 };
 // The fusion's counts, read after kTuningArgs as whole numbers.
 constexpr const char* kFusionConfirmViewsArg = "fusion_confirm_views";
@@ -271,6 +277,15 @@ Status ApplyTuningArgs(const brain::Context& ctx, MissionTuning* t) {
   }
   if (!(t->revisit_look_s >= 0))
     return Error(ErrorCode::kInvalidArgument, "sar brain: arg revisit_look_s must be >= 0");
+  // A close look must count as one: from the look altitude (+ the revisit's 2 m) the viewer is
+  // within fusion_close_look_height_m, and its miss within the fusion's miss heights.
+  if (t->revisit_look_altitude_m != 0 &&
+      !(t->revisit_look_altitude_m >= t->fusion.min_miss_height_m &&
+        t->revisit_look_altitude_m + 2.0 <= t->fusion.close_look_height_m)) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "sar brain: arg revisit_look_altitude_m must be 0 or at least fusion_min_miss_height_m and "
+                 "2 m below fusion_close_look_height_m");
+  }
   if (!(t->search_margin_m >= 0))  // < 0 would send the lanes outside the geofence
     return Error(ErrorCode::kInvalidArgument, "sar brain: arg search_margin_m must be >= 0");
   return Ok{};
@@ -512,6 +527,7 @@ swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, d
   s.dedupe_radius_m = t.sighting_dedupe_m;
   s.report_baseline_m = t.fusion.min_baseline_m;  // one view per counted baseline, no more
   s.revisit_look_s = t.revisit_look_s;
+  s.revisit_look_altitude_m = std::min(t.revisit_look_altitude_m, t.scout_altitude_m);
   s.sighting_area = GeofenceShrunk(c, 0.0);
   // The wall repulsion keeps a drone at rest this far from the geofence (12.45 m with the defaults).
   s.revisit_area = GeofenceShrunk(c, swarm::WallStandoffM(FlockParams(t)));

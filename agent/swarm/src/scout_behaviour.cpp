@@ -101,6 +101,7 @@ const raft::Victim* ScoutBehaviour::OrbitTarget(const MissionInput& in) const {
 void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out) {
   const raft::MissionState& m = *in.mission;
   const raft::Candidate* revisit = stage_ == Stage::kRevisiting ? m.FindCandidate(revisit_id_) : nullptr;
+  const double look_z = LookAltitude();
   for (const GroundDetection& d : in.detections) {
     if (d.confidence < config_.min_report_confidence) continue;
     const Eigen::Vector2d p = d.position_m.head<2>();
@@ -110,9 +111,14 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
       known = known || (Eigen::Vector2d(v.x_m, v.y_m) - p).norm() <= config_.dedupe_radius_m;
     }
     if (known) continue;
-    // The first sight of the candidate on a revisit always goes out: it is the revisit's answer.
-    const bool answer = revisit != nullptr && !revisit_seen_ &&
-                        (Eigen::Vector2d(revisit->x_m, revisit->y_m) - p).norm() <= config_.dedupe_radius_m;
+    // The first sight of the candidate on a revisit always goes out: it is the revisit's answer
+    // (with a close look: only from the look altitude; the descent's views of it are not sent).
+    const bool at_candidate =
+        revisit != nullptr &&
+        (Eigen::Vector2d(revisit->x_m, revisit->y_m) - p).norm() <= config_.dedupe_radius_m;
+    const bool from_look = config_.revisit_look_altitude_m <= 0 || d.viewer_m.z() <= look_z + 2.0;
+    if (at_candidate && !from_look) continue;
+    const bool answer = at_candidate && !revisit_seen_;
     for (const RecentReport& r : recent_) {
       known = known || ((r.position_m - p).norm() <= config_.dedupe_radius_m &&
                         in.t_s - r.t_s < config_.report_cooldown_s &&
@@ -214,11 +220,14 @@ void ScoutBehaviour::RunRevisit(const MissionInput& in, MissionOutput* out) {
   const Eigen::Vector2d at(std::clamp(c->x_m, area.x_min_m, area.x_max_m),
                            std::clamp(c->y_m, area.y_min_m, area.y_max_m));
   const double d = (p.head<2>() - at).norm();
-  // Flock on the way (spacing from the others), a position hold over the spot.
-  sp.kind = d > config_.home_approach_m ? SetpointKind::kFlock : SetpointKind::kPosition;
-  sp.target_m = {at.x(), at.y(), Raised(Altitude())};
+  // Flock on the way (spacing from the others) at the search altitude, a position hold over the
+  // spot at the look altitude.
+  const bool near = d <= config_.home_approach_m;
+  sp.kind = near ? SetpointKind::kPosition : SetpointKind::kFlock;
+  const double look_z = Raised(LookAltitude());
+  sp.target_m = {at.x(), at.y(), near ? look_z : Raised(Altitude())};
   sp.yaw_rad = in.yaw_rad;
-  const bool under = d <= config_.revisit_arrive_m && std::abs(p.z() - Raised(Altitude())) <= 2.0;
+  const bool under = d <= config_.revisit_arrive_m && std::abs(p.z() - look_z) <= 2.0;
   if (look_start_s_ < 0 && under) look_start_s_ = in.t_s;
   if (look_start_s_ < 0 || revisit_seen_ || !under) return;
   const bool first = miss_tries_ == 0 && in.t_s - look_start_s_ >= config_.revisit_look_s;

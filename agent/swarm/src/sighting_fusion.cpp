@@ -35,6 +35,17 @@ std::string FusionParamsProblem(const FusionParams& p) {
   if (!(p.miss_in_view_m > 0 && p.min_miss_height_m >= 0 && p.max_miss_height_m > p.min_miss_height_m)) {
     return "expected miss_in_view_m > 0 and 0 <= min_miss_height_m < max_miss_height_m";
   }
+  if (p.close_look_height_m < 0) return "close_look_height_m must be >= 0 (0: no close looks)";
+  if (p.close_look_height_m > 0) {
+    if (!(p.max_search_log_odds >= 0)) return "max_search_log_odds must be >= 0";
+    if (!(p.max_close_view_confidence > 0.5 && p.max_close_view_confidence < 1)) {
+      return "max_close_view_confidence must be in (0.5, 1)";
+    }
+    if (!(p.close_recall > 0 && p.close_recall < 1 && p.close_false_repeat >= 0 &&
+          p.close_false_repeat < p.close_recall)) {
+      return "expected 0 <= close_false_repeat < close_recall < 1";
+    }
+  }
   if (p.max_revisits < 1) return "max_revisits must be >= 1";
   if (!(p.revisit_after_s >= 0 && p.revisit_timeout_s > 0)) return "expected revisit_after_s >= 0, revisit_timeout_s > 0";
   return "";
@@ -48,8 +59,17 @@ void CheckFusionParams(const FusionParams& p) {
   }
 }
 
+bool CloseLook(const raft::SightingView& view, const FusionParams& p) {
+  return p.close_look_height_m > 0 && view.viewer_height_m <= p.close_look_height_m;
+}
+
 double ViewLogOdds(const raft::SightingView& view, const FusionParams& p) {
-  if (view.detected) return Logit(std::clamp(view.confidence, 1e-6, p.max_view_confidence));
+  const bool close = CloseLook(view, p);
+  if (view.detected) {
+    return Logit(
+        std::clamp(view.confidence, 1e-6, close ? p.max_close_view_confidence : p.max_view_confidence));
+  }
+  if (close) return std::log((1.0 - p.close_recall) / (1.0 - p.close_false_repeat));
   return std::log((1.0 - p.detector_recall) / (1.0 - p.false_repeat));
 }
 
@@ -59,9 +79,29 @@ bool MissInView(const raft::SightingView& view, double candidate_x_m, double can
          view.viewer_height_m <= p.max_miss_height_m;
 }
 
+namespace {
+
+// The decision on a candidate from its assessed evidence (the header's rules).
+void Decide(const raft::Candidate& c, const FusionParams& p, FusionAssessment* a) {
+  if (c.status == raft::CandidateStatus::kConfirmed) return;
+  const bool looked = p.close_look_height_m <= 0 || a->close_detections >= 1;
+  if (a->belief >= p.confirm_belief && a->counted_detections >= p.confirm_views && looked) {
+    a->decision = FusionDecision::kConfirm;
+  } else if (c.status == raft::CandidateStatus::kPending) {
+    if (a->belief <= p.reject_belief && a->counted_misses >= 1) {
+      a->decision = FusionDecision::kReject;
+    } else if (static_cast<int>(c.revisits) >= p.max_revisits && c.revisit_drone.empty()) {
+      a->decision = FusionDecision::kReject;
+      a->undecided = true;
+    }
+  }
+}
+
+}  // namespace
+
 FusionAssessment AssessCandidate(const raft::Candidate& c, const FusionParams& p) {
   FusionAssessment a;
-  a.log_odds = Logit(p.prior);
+  double search = 0, close = 0;  // the counted views' log-odds, from the search altitude and close looks
   std::vector<Viewpoint> counted;
   counted.reserve(c.views.size());
   for (const raft::SightingView& v : c.views) {
@@ -81,21 +121,15 @@ FusionAssessment AssessCandidate(const raft::Candidate& c, const FusionParams& p
     }
     if (!independent) continue;
     counted.push_back({v.viewer_x_m, v.viewer_y_m, v.viewer_height_m, v.t_s});
-    a.log_odds += ViewLogOdds(v, p);
+    const bool is_close = CloseLook(v, p);
+    (is_close ? close : search) += ViewLogOdds(v, p);
     (v.detected ? a.counted_detections : a.counted_misses) += 1;
+    if (v.detected && is_close) ++a.close_detections;
   }
+  if (p.close_look_height_m > 0) search = std::min(search, p.max_search_log_odds);
+  a.log_odds = Logit(p.prior) + search + close;
   a.belief = 1.0 / (1.0 + std::exp(-a.log_odds));
-  if (c.status == raft::CandidateStatus::kConfirmed) return a;
-  if (a.belief >= p.confirm_belief && a.counted_detections >= p.confirm_views) {
-    a.decision = FusionDecision::kConfirm;
-  } else if (c.status == raft::CandidateStatus::kPending) {
-    if (a.belief <= p.reject_belief && a.counted_misses >= 1) {
-      a.decision = FusionDecision::kReject;
-    } else if (static_cast<int>(c.revisits) >= p.max_revisits && c.revisit_drone.empty()) {
-      a.decision = FusionDecision::kReject;
-      a.undecided = true;
-    }
-  }
+  Decide(c, p, &a);
   return a;
 }
 
@@ -121,6 +155,7 @@ void AddEvidence(LogEvent& e, const raft::Candidate& c, const FusionAssessment& 
       .Add("counted", a.counted_detections)
       .Add("misses", a.misses)
       .Add("counted_misses", a.counted_misses)
+      .Add("close", a.close_detections)
       .Add("drones", drones)
       .Add("confidences", confidences)
       .Add("viewers", viewers)

@@ -124,6 +124,26 @@ TEST(SarBrainConfigFrom, ReadsTheFusionArgsAndRefusesOnesWhereOneViewWouldConfir
       << c.error().ToString();
 }
 
+// The close look: on by default (18 m, counted as close up to 21 m); a look altitude the fusion
+// would not count as a close look is refused; 0 turns it off with fusion_close_look_height_m 0.
+TEST(SarBrainConfigFrom, TheCloseLookMustCountAsOne) {
+  brain::Context ctx = LifterContext();
+  auto c = SarBrainConfigFrom(ctx);
+  ASSERT_TRUE(c.ok()) << c.error().ToString();
+  EXPECT_DOUBLE_EQ(c->tuning.revisit_look_altitude_m, 18.0);
+  EXPECT_DOUBLE_EQ(c->tuning.fusion.close_look_height_m, 21.0);
+  ctx.args["revisit_look_altitude_m"] = "20";
+  c = SarBrainConfigFrom(ctx);
+  ASSERT_FALSE(c.ok());
+  EXPECT_NE(c.error().ToString().find("revisit_look_altitude_m must be 0 or"), std::string::npos)
+      << c.error().ToString();
+  ctx.args["revisit_look_altitude_m"] = "0";
+  ctx.args["fusion_close_look_height_m"] = "0";
+  c = SarBrainConfigFrom(ctx);
+  ASSERT_TRUE(c.ok()) << c.error().ToString();
+  EXPECT_DOUBLE_EQ(c->tuning.fusion.close_look_height_m, 0.0);
+}
+
 TEST(SarBrainConfigFrom, NamesTheBadArgOrPayload) {
   brain::Context ctx = LifterContext();
   ctx.args["member_timeout_s"] = "six";

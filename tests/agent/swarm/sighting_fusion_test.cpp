@@ -135,6 +135,53 @@ TEST(SightingFusion, RevisitsRunOutOnAnUndecidedCandidate) {
   EXPECT_EQ(AssessCandidate(c, p).decision, FusionDecision::kNone);
 }
 
+// A close look by `who` from (vx, vy) at the revisit's 18 m, time t.
+SightingView CloseSeen(const std::string& who, double c, double vx, double vy, double t) {
+  return SightingView{who, 1, 0, 0, c, vx, vy, 18.0, t, true};
+}
+FusionParams WithCloseLooks() {
+  FusionParams p;
+  p.close_look_height_m = 21.0;
+  return p;
+}
+
+// Close looks: many confident views from the search altitude (a look-alike fires on each) raise
+// a candidate to 7:3 at most; only a view from the look altitude confirms.
+TEST(SightingFusion, WithCloseLooksOnlyACloseLookConfirms) {
+  const FusionParams p = WithCloseLooks();
+  std::vector<SightingView> v;
+  for (int i = 0; i < 5; ++i) v.push_back(Seen("scout_1", 0.9, 12.0 * i, 0, 10.0 + 15 * i));  // 5 passes
+  FusionAssessment a = AssessCandidate(With(v), p);
+  EXPECT_EQ(a.counted_detections, 5);
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds, 1e-9);
+  EXPECT_EQ(a.decision, FusionDecision::kNone);
+  EXPECT_EQ(AssessCandidate(With(v), FusionParams{}).decision,
+            FusionDecision::kConfirm);                  // without: confirmed
+  v.push_back(CloseSeen("scout_2", 0.9, 0.5, 0, 100));  // 7:3 and 9:1 fuse to 21:1
+  a = AssessCandidate(With(v), p);
+  EXPECT_EQ(a.close_detections, 1);
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + Logit(0.9), 1e-9);
+  EXPECT_EQ(a.decision, FusionDecision::kConfirm);
+  // A close look's confidence is capped at max_close_view_confidence, not the search views' cap.
+  v.back().confidence = 0.999;
+  EXPECT_NEAR(AssessCandidate(With(v), p).log_odds,
+              p.max_search_log_odds + Logit(p.max_close_view_confidence), 1e-9);
+}
+
+TEST(SightingFusion, ACloseLookThatSeesNothingRejectsWhatTheSearchViewsRaised) {
+  const FusionParams p = WithCloseLooks();
+  std::vector<SightingView> v;
+  for (int i = 0; i < 4; ++i) v.push_back(Seen("scout_1", 0.85, 12.0 * i, 0, 10.0 + 15 * i));
+  v.push_back(Missed("scout_2", 0.5, 0, 100, 18.0));
+  const FusionAssessment a = AssessCandidate(With(v), p);
+  EXPECT_EQ(a.counted_misses, 1);
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + std::log((1 - p.close_recall) / (1 - p.close_false_repeat)),
+              1e-9);
+  EXPECT_LT(a.belief, p.reject_belief);
+  EXPECT_EQ(a.decision, FusionDecision::kReject);
+  EXPECT_FALSE(a.undecided);
+}
+
 TEST(SightingFusion, ParametersThatWouldLetOneViewConfirmAreRefused) {
   FusionParams p;
   EXPECT_EQ(FusionParamsProblem(p), "");
@@ -379,6 +426,49 @@ TEST(ScoutRevisit, ADetectionBeyondTheSightingAreaIsNotReported) {
   s.Step(At(4.2, m.state, {40, 72, 30}, dets), &out);
   ASSERT_EQ(out.proposals.size(), 1u);
   EXPECT_DOUBLE_EQ(std::get<raft::ReportSighting>(out.proposals[0]).y_m, 79.0);
+}
+
+// With a look altitude the revisit flies out at the search altitude, descends over the spot, and
+// only a view from the look altitude answers (the descent's are views of the same object from the
+// search model's heights: not sent).
+TEST(ScoutRevisit, ACloseLookDescendsOverTheCandidateAndOnlyItsViewAnswers) {
+  Mission m;
+  StartSearching(&m);
+  m.Apply(raft::ReportSighting{"scout_2", 1, 100, 40, 0.9, 100, 30, 30, 5.0});
+  m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
+  ScoutBehaviour s({.name = "scout_1",
+                    .home_m = Vector3d(0, 0, 0),
+                    .revisit_look_s = 2.0,
+                    .revisit_look_altitude_m = 18.0});
+  MissionOutput out;
+  s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
+  s.Step(At(1.0, m.state, {0, 0, 30}), &out);
+  s.Step(At(21.0, m.state, {60, 40, 30}), &out);
+  ASSERT_EQ(out.mode, "revisiting");
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kFlock);
+  EXPECT_TRUE(out.setpoint.target_m.isApprox(Vector3d(100, 40, 30)));
+  s.Step(At(28.0, m.state, {95, 40, 30}), &out);
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kPosition);
+  EXPECT_TRUE(out.setpoint.target_m.isApprox(Vector3d(100, 40, 18)));
+  GroundDetection d;
+  d.position_m = {100.4, 39.8, 0};
+  d.confidence = 0.9;
+  d.capture_time_s = 29.0;
+  d.viewer_m = {99, 40, 26};
+  std::vector<GroundDetection> dets = {d};
+  s.Step(At(29.1, m.state, {99, 40, 26}, dets), &out);
+  EXPECT_TRUE(out.proposals.empty());
+  s.Step(At(33.0, m.state, {100, 40, 24}), &out);  // over it but not down yet: no look, no miss
+  EXPECT_TRUE(out.proposals.empty());
+  dets[0].viewer_m = {100, 40, 18.2};
+  dets[0].capture_time_s = 35.0;
+  s.Step(At(35.1, m.state, {100, 40, 18.2}, dets), &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  const auto& seen = std::get<raft::ReportSighting>(out.proposals[0]);
+  EXPECT_DOUBLE_EQ(seen.viewer_height_m, 18.2);
+  m.Apply(seen);
+  EXPECT_TRUE(m.state.FindCandidate(1)->revisit_drone.empty());
+  EXPECT_EQ(AssessCandidate(*m.state.FindCandidate(1), WithCloseLooks()).close_detections, 1);
 }
 
 TEST(ScoutRevisit, ADetectionThereIsTheRevisitsAnswer) {

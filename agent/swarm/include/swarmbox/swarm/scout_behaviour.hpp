@@ -18,7 +18,8 @@
 //    "swept" with no victim to orbit goes straight to "returning")
 //   any mission stage (and "returning"/"landed" when not for a low battery) --(a committed
 //       revisit of a pending candidate for this drone)--> kRevisiting "revisiting": fly over the
-//       candidate at search altitude, look revisit_look_s with it under the camera; a detection
+//       candidate at search altitude (descending to revisit_look_altitude_m over it, when set),
+//       look revisit_look_s with it under the camera; a detection
 //       there is reported as a sighting, nothing is reported as a raft ReportMiss (with where it
 //       looked from); back to what it did (the sweep resumes at its lane) once the committed
 //       state shows the revisit done, decided or given to another drone
@@ -123,6 +124,13 @@ struct ScoutConfig {
   // search altitude; look this long (10 frames at the x500's 5 Hz) before reporting a miss.
   double revisit_arrive_m = 2.0;
   double revisit_look_s = 2.0;
+  // > 0: the close look. A revisit flies out at the search altitude and, within home_approach_m
+  // of the spot, descends to this height above home to look (the agent's perception runs its
+  // close-look detector there, 16 px/m; FusionParams::close_look_height_m counts such views as
+  // close looks); only a detection from within 2 m of it answers the revisit (the descent's
+  // frames from higher up are not reported near the candidate). 0: look from the search altitude
+  // [m]. SarBrain: 18 m, 3 m over the generator's tallest tree (15 m).
+  double revisit_look_altitude_m = 0.0;
   // Where a revisit can hover [m, ENU]: a candidate outside it (a detection near the geofence,
   // where the flocking's wall repulsion keeps the drone out) is looked at from the nearest point
   // inside, which still has it in the camera's footprint (41 x 23 m at 30 m); the miss carries
@@ -210,6 +218,11 @@ class ScoutBehaviour {
   double Raised(double cruise_z_m) const { return std::max(cruise_z_m, clearance_floor_z_m_); }
   bool ClearanceRaised() const { return clearance_floor_z_m_ > -std::numeric_limits<double>::infinity(); }
   double Altitude() const { return config_.home_m.z() + config_.search_altitude_m; }
+  // Where a revisit looks from: the close look's altitude, or the search altitude.
+  double LookAltitude() const {
+    return config_.revisit_look_altitude_m > 0 ? config_.home_m.z() + config_.revisit_look_altitude_m
+                                               : Altitude();
+  }
 
   ScoutConfig config_;
   CameraFootprint footprint_;

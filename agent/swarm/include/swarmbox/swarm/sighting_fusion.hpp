@@ -22,9 +22,18 @@
 // A miss counts only if the place was in view at adequate altitude: the viewer within
 // miss_in_view_m horizontally of the candidate and between min/max_miss_height_m above ground.
 //
+// Close looks (close_look_height_m > 0: the mission's revisits descend to look, ScoutConfig::
+// revisit_look_altitude_m, and the agent runs the close-look detector there, victim_perception.hpp):
+// a view from at most close_look_height_m above ground is a close look, with its own cap
+// (max_close_view_confidence) and miss model (close_recall, close_false_repeat); the search
+// altitude's views together add at most max_search_log_odds (they are many views of one object
+// from nearly the same height and scale, and a look-alike fires on each: rubble20 on 2026-11-28
+// confirmed 31 false victims so), and only a close look can confirm.
+//
 // Decisions (Decide):
-//   kConfirm  belief >= confirm_belief AND at least confirm_views counted detections: a single
-//             view never confirms, however confident;
+//   kConfirm  belief >= confirm_belief AND at least confirm_views counted detections (with close
+//             looks: at least one of them a close look): a single view never confirms, however
+//             confident;
 //   kReject   pending, belief <= reject_belief and at least one counted miss; or pending with
 //             max_revisits revisits done and still undecided (logged as reason=undecided);
 //   kNone     otherwise (the leader sends a revisit when no new view came for revisit_after_s).
@@ -79,6 +88,18 @@ struct FusionParams {
   // 1.2 rad camera; below 10 m the footprint is smaller than the geolocation spread [m].
   double min_miss_height_m = 10.0;
   double max_miss_height_m = 40.0;
+  // Close looks (above); 0: off, every view alike (the fusion before 2026-11-28's close look).
+  double close_look_height_m = 0;
+  // logit(0.7): the search views raise a candidate to 7:3 at most, so that one close look that
+  // sees nothing rejects it (0.85 - 2.25: belief 0.197) and one close look at >= 0.89 confirms it.
+  double max_search_log_odds = 0.847;
+  double max_close_view_confidence = 0.99;
+  // The close-look detector's recall from the look altitude, per look (a look is 2 s, ~4 frames):
+  // 0.82 per frame at 18 m on the rubble fields (`swarmbox-bench perception --only world:1
+  // --world-altitude 18 --model agent/swarm/models/victim_detector_close.yml.gz`, seed 1).
+  double close_recall = 0.9;
+  // ... and its chance to fire on what the search model fired on: an assumption (not measured yet).
+  double close_false_repeat = 0.05;
   int max_revisits = 3;             // then an undecided candidate is rejected (reason=undecided)
   double revisit_after_s = 10.0;    // no new view this long after the last: send a revisit [s]
   double revisit_timeout_s = 60.0;  // a revisit not done by then goes to another drone [s]
@@ -93,6 +114,7 @@ struct FusionAssessment {
   int counted_detections = 0;     // ... that counted (independent)
   int misses = 0;                 // misses in the record
   int counted_misses = 0;         // ... that counted (in view, independent)
+  int close_detections = 0;       // counted detections that were close looks
   double last_view_s = 0.0;       // capture time of the latest evidence [s]
   FusionDecision decision = FusionDecision::kNone;
   bool undecided = false;         // kReject because max_revisits ran out
@@ -103,8 +125,11 @@ std::string FusionParamsProblem(const FusionParams& p);
 // Aborts when FusionParamsProblem is not empty (a broken invariant past start-up).
 void CheckFusionParams(const FusionParams& p);
 
-// The log-odds contribution of one piece of evidence (before the independence rule).
+// The log-odds contribution of one piece of evidence (before the independence rule and the cap on
+// the search altitude's views).
 double ViewLogOdds(const raft::SightingView& view, const FusionParams& p);
+// Whether a view is a close look (close_look_height_m > 0 and the viewer at most that high).
+bool CloseLook(const raft::SightingView& view, const FusionParams& p);
 // Whether a miss had the candidate's place in view at adequate altitude.
 bool MissInView(const raft::SightingView& view, double candidate_x_m, double candidate_y_m, const FusionParams& p);
 
