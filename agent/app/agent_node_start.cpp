@@ -133,9 +133,6 @@ Result<AgentNode::Startup> AgentNode::LoadStartup(const AgentOptions& o) {
     s.sar = std::move(*sar);
     s.perception.camera = s.sar->camera;
     s.perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
-    // Frames from a revisit's close look go to the close-look detector (the height the fusion
-    // counts as one).
-    s.perception.close_range_m = s.sar->tuning.fusion.close_look_height_m;
   }
   s.brain = o.brain.kind != BrainKind::kBuiltin;
   if (s.brain) {

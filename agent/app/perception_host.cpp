@@ -13,10 +13,9 @@ using flight::Vec3;
 
 constexpr std::size_t kHistory = 128;  // control steps of estimates kept (0.5 s at 250 Hz)
 
-swarm::PerceptionParams PerceptionFor(const PerceptionConfig& config) {
+swarm::PerceptionParams PerceptionFor(double latency_s) {
   swarm::PerceptionParams p;
-  p.latency_s = config.inference_latency_s;
-  p.close_range_m = config.close_range_m;
+  p.latency_s = latency_s;
   return p;
 }
 
@@ -54,8 +53,6 @@ Result<std::unique_ptr<PerceptionHost>> PerceptionHost::Create(const PerceptionC
   if (!(config.inference_latency_s >= 0)) {
     return Error(ErrorCode::kInvalidArgument, "perception: inference latency must be >= 0");
   }
-  if (!(config.close_range_m >= 0))
-    return Error(ErrorCode::kInvalidArgument, "perception: close_range_m must be >= 0");
   if (!(config.depth_max_age_s >= 0) || !(config.depth_height_radius_m > 0)) {
     return Error(ErrorCode::kInvalidArgument, "perception: depth_max_age_s must be >= 0 and depth_height_radius_m > 0");
   }
@@ -63,7 +60,7 @@ Result<std::unique_ptr<PerceptionHost>> PerceptionHost::Create(const PerceptionC
 }
 
 PerceptionHost::PerceptionHost(const PerceptionConfig& config)
-    : config_(config), perception_(PerceptionFor(config)), history_(kHistory) {}
+    : config_(config), perception_(PerceptionFor(config.inference_latency_s)), history_(kHistory) {}
 
 void PerceptionHost::RecordEstimate(double t_s, const flight::StateEstimate& est) {
   history_[history_next_] = {t_s, est.pos_m, est.att, est.rate_rad_s};

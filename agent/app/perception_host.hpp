@@ -57,9 +57,6 @@ struct PerceptionConfig {
   // The surface's height where a ray lands: the median of the depth's cells (0.25 m) within this
   // [m]: a person lying down (~1.7 x 0.5 m) and the surface they lie on.
   double depth_height_radius_m = 0.5;
-  // > 0: frames from at most this height above the ground go to the close-look detector
-  // (swarm::PerceptionParams::close_range_m; the SAR mission's fusion_close_look_height_m) [m].
-  double close_range_m = 0.0;
 };
 
 class DepthHeights;

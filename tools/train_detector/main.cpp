@@ -7,8 +7,8 @@
 //   training lines and gets "recalibrated": true)
 //   swarmbox-train-detector --out-dir DIR --recalibrate --replace-cnn FILE.onnx
 //   (the same with another CNN in place of the model's: train_cnn.py run again on its patches)
-//   --model-name NAME: DIR/NAME.yml.gz and DIR/NAME.json (default victim_detector; the close-look
-//   model: victim_detector_close, trained with --view-altitudes 10,20 --cnn-patch-px 48)
+//   --model-name NAME: DIR/NAME.yml.gz and DIR/NAME.json (default victim_detector; e.g.
+//   victim_detector_close for one trained with --view-altitudes 10,20 --cnn-patch-px 48)
 //   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):
 //   --training-sets N (seeds 7000001..7000000+N), --trees N, --max-negatives N,
 //   --stage1-percentile P, --balance-classes, --hard-negative-rounds N, --blob-features,

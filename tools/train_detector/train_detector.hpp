@@ -111,12 +111,12 @@ struct TrainingOptions {
   // case=world, the same patches) recall at precision 0.9 0.72 / 0.62 against 0.68 / 0.54 (seeds 1
   // / 20261121; BENCHMARKS.md "Perception: hard negatives for the CNN").
   double cnn_hard_fraction = 0.5;
-  // The CNN's patch side [px] over 3 m (swarm::ValidCnnPatchPx): 32 (10.7 px/m) for the search
-  // altitude; a close-look model (victim_detector_close) 48 (16 px/m), its frames from
-  // view_altitude_m's band.
+  // The CNN's patch side [px] over 3 m (swarm::ValidCnnPatchPx): 32 (10.7 px/m, the shipped
+  // model's); a model of low views 48 (16 px/m; BENCHMARKS.md "Perception: the close look":
+  // tried on views from 10-20 m, not shipped).
   int cnn_patch_px = swarm::kCnnPatchPx;
   // When both > 0: every training set's views between these heights [m] (the defaults: 8-65 m for
-  // the mixed terrains, 15-45 m for the rubble fields); a close-look model's 10-20 m.
+  // the mixed terrains, 15-45 m for the rubble fields); e.g. 10-20 m for a model of close looks.
   double view_min_altitude_m = 0;
   double view_max_altitude_m = 0;
   // Recalibrate() only: when not empty, this ONNX (train_cnn.py's, e.g. run again on a model's

@@ -7,8 +7,6 @@ namespace swarmbox::swarm {
 VictimPerception::VictimPerception(const PerceptionParams& params)
     : params_(params), detector_(params.detector), queue_(params.latency_s, params.queue_capacity) {
   blobs_.reserve(32);
-  SWARMBOX_CHECK(params_.close_range_m >= 0);
-  if (params_.close_range_m > 0) close_detector_.emplace(ShippedCloseDetectorModel(), params_.detector);
 }
 
 int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& k,
@@ -20,9 +18,7 @@ int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& 
     blobs_.clear();
     return 0;
   }
-  VictimDetector& detector =
-      close_detector_ && height <= params_.close_range_m ? *close_detector_ : detector_;
-  detector.Detect(bgr, k, camera_pose, params_.ground_z_m, &blobs_);
+  detector_.Detect(bgr, k, camera_pose, params_.ground_z_m, &blobs_);
   int queued = 0;
   for (const ImageBlob& b : blobs_) {
     if (b.confidence < params_.min_confidence) continue;

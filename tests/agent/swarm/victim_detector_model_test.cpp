@@ -62,32 +62,6 @@ TEST(VictimDetectorModel, TheBinaryCarriesTheCommittedModel) {
   EXPECT_EQ(cv::norm(shipped->kernels[3], (*file)->kernels[3], cv::NORM_INF), 0.0);
 }
 
-// The close-look model (victim_detector_close.yml.gz, the same trainer with --model-name
-// victim_detector_close): seeds disjoint from the evaluation's, 48 px patches (16 px/m), and the
-// binary carries it.
-TEST(VictimDetectorModel, TheCloseLookModelIsCommittedAndCompiledIn) {
-  Result<std::shared_ptr<const VictimDetectorModel>> file =
-      LoadDetectorModel(kModelDir + "/victim_detector_close.yml.gz");
-  ASSERT_TRUE(file.ok()) << file.error().ToString();
-  const VictimDetectorModel& model = **file;
-  ASSERT_TRUE(model.has_cnn());
-  EXPECT_EQ(model.cnn_patch_px, 48);
-  for (std::uint64_t e : perception_scenes::kEvaluationSeeds) {
-    EXPECT_EQ(std::count(model.training_seeds.begin(), model.training_seeds.end(), e), 0) << e;
-    EXPECT_EQ(std::count(model.calibration_seeds.begin(), model.calibration_seeds.end(), e), 0) << e;
-  }
-  EXPECT_NE(model.recipe.find("--view-altitudes 10,20"), std::string::npos) << model.recipe;
-  const std::shared_ptr<const VictimDetectorModel> shipped = ShippedCloseDetectorModel();
-  EXPECT_EQ(shipped->cnn_onnx, model.cnn_onnx);
-  EXPECT_EQ(shipped->cnn_patch_px, 48);
-  EXPECT_DOUBLE_EQ(shipped->platt_a, model.platt_a);
-  EXPECT_NE(shipped->cnn_onnx, ShippedDetectorModel()->cnn_onnx);
-  std::ifstream f(kModelDir + "/victim_detector_close.json");
-  std::stringstream json;
-  json << f.rdbuf();
-  EXPECT_NE(json.str().find("\"model\": \"victim_detector_close.yml.gz\""), std::string::npos);
-}
-
 // A forest as the trainer grows one (depth 14, sqrt(features) per split; fewer trees and samples),
 // written and loaded: the shipped model's second stage is a CNN, so the flattening is checked on
 // this one.

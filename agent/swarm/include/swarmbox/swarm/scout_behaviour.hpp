@@ -125,11 +125,11 @@ struct ScoutConfig {
   double revisit_arrive_m = 2.0;
   double revisit_look_s = 2.0;
   // > 0: the close look. A revisit flies out at the search altitude and, within home_approach_m
-  // of the spot, descends to this height above home to look (the agent's perception runs its
-  // close-look detector there, 16 px/m; FusionParams::close_look_height_m counts such views as
-  // close looks); only a detection from within 2 m of it answers the revisit (the descent's
-  // frames from higher up are not reported near the candidate). 0: look from the search altitude
-  // [m]. SarBrain: 18 m, 3 m over the generator's tallest tree (15 m).
+  // of the spot, descends to this height above home to look (at 18 m the x500's camera sees the
+  // spot at 26 px/m instead of 16; FusionParams::close_look_height_m counts such views as close
+  // looks); only a detection from within 2 m of it answers the revisit (the descent's frames
+  // from higher up are not reported near the candidate). 0: look from the search altitude [m].
+  // SarBrain: 18 m, 3 m over the generator's tallest tree (15 m).
   double revisit_look_altitude_m = 0.0;
   // Where a revisit can hover [m, ENU]: a candidate outside it (a detection near the geofence,
   // where the flocking's wall repulsion keeps the drone out) is looked at from the nearest point

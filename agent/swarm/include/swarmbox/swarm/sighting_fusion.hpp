@@ -22,8 +22,9 @@
 // A miss counts only if the place was in view at adequate altitude: the viewer within
 // miss_in_view_m horizontally of the candidate and between min/max_miss_height_m above ground.
 //
-// Close looks (close_look_height_m > 0: the mission's revisits descend to look, ScoutConfig::
-// revisit_look_altitude_m, and the agent runs the close-look detector there, victim_perception.hpp):
+// Close looks (close_look_height_m > 0: the mission's revisits descend to look from 18 m,
+// ScoutConfig::revisit_look_altitude_m, where the detector's precision is higher than at the 30 m
+// search altitude and the object is seen at another scale, against other pixels around it):
 // a view from at most close_look_height_m above ground is a close look, with its own cap
 // (max_close_view_confidence) and miss model (close_recall, close_false_repeat); the search
 // altitude's views together add at most max_search_log_odds (they are many views of one object
@@ -94,9 +95,9 @@ struct FusionParams {
   // sees nothing rejects it (0.85 - 2.25: belief 0.197) and one close look at >= 0.89 confirms it.
   double max_search_log_odds = 0.847;
   double max_close_view_confidence = 0.99;
-  // The close-look detector's recall from the look altitude, per look (a look is 2 s, ~4 frames):
-  // 0.82 per frame at 18 m on the rubble fields (`swarmbox-bench perception --only world:1
-  // --world-altitude 18 --model agent/swarm/models/victim_detector_close.yml.gz`, seed 1).
+  // The detector's recall from the look altitude, per look (a look is 2 s, ~4 frames): an
+  // assumption over the 0.74 per frame (precision 0.93) measured at 18 m on the rubble fields
+  // (`swarmbox-bench perception --seed 1 --only world:1 --world-altitude 18`).
   double close_recall = 0.9;
   // ... and its chance to fire on what the search model fired on: an assumption (not measured yet).
   double close_false_repeat = 0.05;

@@ -87,8 +87,9 @@ struct VictimDetectorModel {
   // kCnnPatchPx x kCnnPatchPx BGR patches (N x 3 x H x W, (pixel - kCnnInputMean) * kCnnInputScale)
   // to one logit per patch (> 0: person). It replaces the forest; the sigmoid then maps the logit.
   std::vector<std::uint8_t> cnn_onnx;
-  // Its patches' side [px] over kCnnPatchM (ValidCnnPatchPx): kCnnPatchPx (10.7 px/m) for the
-  // search altitude, more for a close-look model (victim_detector_close.yml.gz: 48, 16 px/m).
+  // Its patches' side [px] over kCnnPatchM (ValidCnnPatchPx): kCnnPatchPx (10.7 px/m), the
+  // shipped model's; a finer one (the trainer's --cnn-patch-px, e.g. 48: 16 px/m) for a model of
+  // low views (BENCHMARKS.md "Perception: the close look": tried, not shipped).
   int cnn_patch_px = kCnnPatchPx;
   int blob_features = 0;           // 0 (format 1) or kBlobFeatures, after the kForestFeatures
   double platt_a = -8.0;           // p = 1 / (1 + exp(platt_a * votes + platt_b))
@@ -134,9 +135,5 @@ Result<std::string> GunzipText(const unsigned char* data, std::size_t size);
 // aborts (SWARMBOX_CHECK) when the compiled-in bytes do not parse: a broken build, not a runtime
 // condition.
 std::shared_ptr<const VictimDetectorModel> ShippedDetectorModel();
-// The close-look model compiled in from agent/swarm/models/victim_detector_close.yml.gz (the same
-// trainer, views from 10-20 m, 48 px patches: 16 px/m; tools/train_detector target train-detector):
-// for frames from a revisit's look altitude (PerceptionParams::close_range_m).
-std::shared_ptr<const VictimDetectorModel> ShippedCloseDetectorModel();
 
 }  // namespace swarmbox::swarm

@@ -18,7 +18,6 @@
 // ("mono8" frames must be converted to BGR first; "rgb8" swapped: the detector thresholds colour.)
 #pragma once
 
-#include <optional>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -36,11 +35,6 @@ struct PerceptionParams {
   std::size_t queue_capacity = 64;
   double ground_z_m = 0.0;           // the ground plane (flat world) [m, ENU z]
   double min_confidence = 0.5;       // blobs below are not reported
-  // > 0: frames taken at most this high above the ground go to the close-look detector
-  // (ShippedCloseDetectorModel(): patches at 16 px/m, trained on views from 10-20 m) instead of the
-  // search altitude's: a revisit's look from low down (ScoutConfig::revisit_look_altitude_m), the
-  // place FusionParams::close_look_height_m counts as a close look [m]. 0: one detector.
-  double close_range_m = 0.0;
   // Uncertainty model for position_sigma_m of each detection.
   double position_sigma_m = 0.5;     // estimated camera position, horizontal 1-sigma [m]
   double attitude_sigma_rad = 0.01;  // estimated attitude 1-sigma [rad]
@@ -55,7 +49,6 @@ class VictimPerception {
   // Without `surface` each detection is where its pixel's ray meets the plane z = ground_z_m;
   // with one, where it meets the surface's heights (PixelToSurface: a person on a rubble slab seen
   // obliquely is not pushed height x tan(off-nadir angle) beyond it).
-  // (With close_range_m > 0, a frame from at most that height goes to the close-look detector.)
   int ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& k, const OpticalPose& camera_pose,
                    double capture_time_s, const GroundHeightSource* surface = nullptr);
   // Appends the detections that are visible at now_s (capture + latency <= now_s).
@@ -67,7 +60,6 @@ class VictimPerception {
  private:
   PerceptionParams params_;
   VictimDetector detector_;
-  std::optional<VictimDetector> close_detector_;  // with close_range_m > 0
   LatencyQueue queue_;
   std::vector<ImageBlob> blobs_;
 };
