@@ -531,6 +531,8 @@ swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, d
   s.sighting_area = GeofenceShrunk(c, 0.0);
   // The wall repulsion keeps a drone at rest this far from the geofence (12.45 m with the defaults).
   s.revisit_area = GeofenceShrunk(c, swarm::WallStandoffM(FlockParams(t)));
+  // ... and as far off an obstacle's face: the last stretch of a revisit is flown in position mode.
+  s.revisit_approach_m = swarm::WallStandoffM(FlockParams(t)) + 5.0;
   s.min_clearance_m = c.depth_camera ? t.scout_min_clearance_m : 0.0;  // no depth camera: nothing seen
   s.keep_searching_during_rescue = true;  // the lifter does the rescue; scouts finish the search
   s.return_when_swept = true;             // nothing left to see: land, do not loiter

@@ -222,7 +222,7 @@ void ScoutBehaviour::RunRevisit(const MissionInput& in, MissionOutput* out) {
   const double d = (p.head<2>() - at).norm();
   // Flock on the way (spacing from the others) at the search altitude, a position hold over the
   // spot at the look altitude.
-  const bool near = d <= config_.home_approach_m;
+  const bool near = d <= std::max(config_.home_approach_m, config_.revisit_approach_m);
   sp.kind = near ? SetpointKind::kPosition : SetpointKind::kFlock;
   const double look_z = Raised(LookAltitude());
   sp.target_m = {at.x(), at.y(), near ? look_z : Raised(Altitude())};

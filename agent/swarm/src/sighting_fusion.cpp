@@ -101,7 +101,10 @@ void Decide(const raft::Candidate& c, const FusionParams& p, FusionAssessment* a
 
 FusionAssessment AssessCandidate(const raft::Candidate& c, const FusionParams& p) {
   FusionAssessment a;
-  double search = 0, close = 0;  // the counted views' log-odds, from the search altitude and close looks
+  // The counted views' log-odds: from the search altitude (summed, then capped), close misses
+  // (summed) and the best close detection (close looks of one object by one detector at one
+  // scale are not independent either: the best counts, and outweighs the close misses).
+  double search = 0, close_misses = 0, best_close = -1.0;
   std::vector<Viewpoint> counted;
   counted.reserve(c.views.size());
   for (const raft::SightingView& v : c.views) {
@@ -121,12 +124,21 @@ FusionAssessment AssessCandidate(const raft::Candidate& c, const FusionParams& p
     }
     if (!independent) continue;
     counted.push_back({v.viewer_x_m, v.viewer_y_m, v.viewer_height_m, v.t_s});
-    const bool is_close = CloseLook(v, p);
-    (is_close ? close : search) += ViewLogOdds(v, p);
     (v.detected ? a.counted_detections : a.counted_misses) += 1;
-    if (v.detected && is_close) ++a.close_detections;
+    if (!CloseLook(v, p)) {
+      search += ViewLogOdds(v, p);
+    } else if (v.detected) {
+      ++a.close_detections;
+      best_close = std::max(best_close, v.confidence);
+    } else {
+      close_misses += ViewLogOdds(v, p);
+    }
   }
-  if (p.close_look_height_m > 0) search = std::min(search, p.max_search_log_odds);
+  double close = close_misses;
+  if (p.close_look_height_m > 0) {
+    search = std::min(search, p.max_search_log_odds);
+    if (a.close_detections > 0) close = Logit(std::clamp(best_close, 1e-6, p.max_close_view_confidence));
+  }
   a.log_odds = Logit(p.prior) + search + close;
   a.belief = 1.0 / (1.0 + std::exp(-a.log_odds));
   Decide(c, p, &a);

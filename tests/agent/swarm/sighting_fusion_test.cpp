@@ -157,7 +157,7 @@ TEST(SightingFusion, WithCloseLooksOnlyACloseLookConfirms) {
   EXPECT_EQ(a.decision, FusionDecision::kNone);
   EXPECT_EQ(AssessCandidate(With(v), FusionParams{}).decision,
             FusionDecision::kConfirm);                  // without: confirmed
-  v.push_back(CloseSeen("scout_2", 0.9, 0.5, 0, 100));  // 7:3 and 9:1 fuse to 21:1
+  v.push_back(CloseSeen("scout_2", 0.9, 0.5, 0, 100));  // 4:1 and 9:1 fuse to 36:1
   a = AssessCandidate(With(v), p);
   EXPECT_EQ(a.close_detections, 1);
   EXPECT_NEAR(a.log_odds, p.max_search_log_odds + Logit(0.9), 1e-9);
@@ -168,15 +168,37 @@ TEST(SightingFusion, WithCloseLooksOnlyACloseLookConfirms) {
               p.max_search_log_odds + Logit(p.max_close_view_confidence), 1e-9);
 }
 
-TEST(SightingFusion, ACloseLookThatSeesNothingRejectsWhatTheSearchViewsRaised) {
+// Weak close looks at a look-alike do not add up: the best close detection counts alone.
+TEST(SightingFusion, OnlyTheBestCloseLookCounts) {
   const FusionParams p = WithCloseLooks();
+  std::vector<SightingView> v = {Seen("scout_1", 0.8, 0, 0, 10), Seen("scout_1", 0.8, 12, 0, 25)};
+  for (int i = 0; i < 3; ++i) v.push_back(CloseSeen("scout_2", 0.7, 0.5, 0, 100.0 + 20 * i));
+  FusionAssessment a = AssessCandidate(With(v), p);
+  EXPECT_EQ(a.close_detections, 3);
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + Logit(0.7), 1e-9);
+  EXPECT_EQ(a.decision, FusionDecision::kNone);  // 0.90: undecided, rejected once revisits run out
+  // A person missed on the first close look and seen on the second: the detection counts, not the miss.
+  v.resize(2);
+  v.push_back(Missed("scout_2", 0.5, 0, 100, 18.0));
+  v.push_back(CloseSeen("scout_3", 0.9, 0.5, 0, 130));
+  a = AssessCandidate(With(v), p);
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + Logit(0.9), 1e-9);
+  EXPECT_EQ(a.decision, FusionDecision::kConfirm);
+}
+
+TEST(SightingFusion, TwoCloseLooksThatSeeNothingRejectWhatTheSearchViewsRaised) {
+  const FusionParams p = WithCloseLooks();
+  const double miss = std::log((1 - p.close_recall) / (1 - p.close_false_repeat));
   std::vector<SightingView> v;
   for (int i = 0; i < 4; ++i) v.push_back(Seen("scout_1", 0.85, 12.0 * i, 0, 10.0 + 15 * i));
   v.push_back(Missed("scout_2", 0.5, 0, 100, 18.0));
-  const FusionAssessment a = AssessCandidate(With(v), p);
+  FusionAssessment a = AssessCandidate(With(v), p);
   EXPECT_EQ(a.counted_misses, 1);
-  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + std::log((1 - p.close_recall) / (1 - p.close_false_repeat)),
-              1e-9);
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + miss, 1e-9);
+  EXPECT_EQ(a.decision, FusionDecision::kNone);  // 0.30: a person the first close look missed gets another
+  v.push_back(Missed("scout_3", 0.0, 0.5, 130, 18.0));
+  a = AssessCandidate(With(v), p);
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + 2 * miss, 1e-9);
   EXPECT_LT(a.belief, p.reject_belief);
   EXPECT_EQ(a.decision, FusionDecision::kReject);
   EXPECT_FALSE(a.undecided);
@@ -469,6 +491,28 @@ TEST(ScoutRevisit, ACloseLookDescendsOverTheCandidateAndOnlyItsViewAnswers) {
   m.Apply(seen);
   EXPECT_TRUE(m.state.FindCandidate(1)->revisit_drone.empty());
   EXPECT_EQ(AssessCandidate(*m.state.FindCandidate(1), WithCloseLooks()).close_detections, 1);
+}
+
+// The last revisit_approach_m to the spot are flown in position mode (the flocking's shill would
+// hold the drone WallStandoffM off a rubble heap beside the candidate).
+TEST(ScoutRevisit, TheLastStretchIsFlownInPositionModeFromTheApproachDistance) {
+  Mission m;
+  StartSearching(&m);
+  m.Apply(raft::ReportSighting{"scout_2", 1, 100, 40, 0.9, 100, 30, 30, 5.0});
+  m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
+  ScoutBehaviour s({.name = "scout_1",
+                    .home_m = Vector3d(0, 0, 0),
+                    .revisit_look_altitude_m = 18.0,
+                    .revisit_approach_m = 17.5});
+  MissionOutput out;
+  s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
+  s.Step(At(1.0, m.state, {0, 0, 30}), &out);
+  s.Step(At(21.0, m.state, {80, 40, 30}), &out);  // 20 m off: flocking at the search altitude
+  ASSERT_EQ(out.mode, "revisiting");
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kFlock);
+  s.Step(At(23.0, m.state, {84, 40, 30}), &out);  // 16 m off: straight there, down to look
+  EXPECT_EQ(out.setpoint.kind, SetpointKind::kPosition);
+  EXPECT_TRUE(out.setpoint.target_m.isApprox(Vector3d(100, 40, 18)));
 }
 
 TEST(ScoutRevisit, ADetectionThereIsTheRevisitsAnswer) {

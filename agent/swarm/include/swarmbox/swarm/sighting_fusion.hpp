@@ -29,7 +29,11 @@
 // (max_close_view_confidence) and miss model (close_recall, close_false_repeat); the search
 // altitude's views together add at most max_search_log_odds (they are many views of one object
 // from nearly the same height and scale, and a look-alike fires on each: rubble20 on 2026-11-28
-// confirmed 31 false victims so), and only a close look can confirm.
+// confirmed 31 false victims so); of the close looks, the best detection counts alone (several
+// weak close looks at a look-alike are no stronger than one), the close misses add up when no
+// close look detected anything; and only a close look can confirm:
+//   L = logit(prior) + min(sum of search views, max_search_log_odds)
+//       + (logit(best close detection) or, without one, the sum of the close misses).
 //
 // Decisions (Decide):
 //   kConfirm  belief >= confirm_belief AND at least confirm_views counted detections (with close
@@ -91,9 +95,12 @@ struct FusionParams {
   double max_miss_height_m = 40.0;
   // Close looks (above); 0: off, every view alike (the fusion before 2026-11-28's close look).
   double close_look_height_m = 0;
-  // logit(0.7): the search views raise a candidate to 7:3 at most, so that one close look that
-  // sees nothing rejects it (0.85 - 2.25: belief 0.197) and one close look at >= 0.89 confirms it.
-  double max_search_log_odds = 0.847;
+  // logit(0.8): the search views raise a candidate to 4:1 at most; one close look at >= 0.83
+  // confirms it; a close look that sees nothing leaves 0.30 (1.39 - 2.25), a second rejects it.
+  // Measured on rubble20 with the close look (2026-11-28, 5 trials, BENCHMARKS.md "Perception:
+  // the close look"): the best close look of the 13 people confirmed scored 0.87-0.997, of the 22
+  // false alarms nothing (17) or 0.54-0.75; 3 people were missed on the first close look.
+  double max_search_log_odds = 1.386;
   double max_close_view_confidence = 0.99;
   // The detector's recall from the look altitude, per look (a look is 2 s, ~4 frames): an
   // assumption over the 0.74 per frame (precision 0.93) measured at 18 m on the rubble fields
