@@ -506,6 +506,19 @@ swarm::Rect GeofenceShrunk(const SarBrainConfig& c, double by_m) {
 }
 
 // The scout's behaviour for a mission started at t_s from home_m.
+// A scout's revisits and sightings: where it may look from and report, from how low, how long.
+void SetRevisits(const SarBrainConfig& c, swarm::ScoutConfig* s) {
+  const MissionTuning& t = c.tuning;
+  s->revisit_look_s = t.revisit_look_s;
+  s->revisit_look_altitude_m = std::min(t.revisit_look_altitude_m, t.scout_altitude_m);
+  s->sighting_area = GeofenceShrunk(c, 0.0);
+  // The wall repulsion keeps a drone at rest this far from the geofence (12.45 m with the defaults).
+  const double standoff_m = swarm::WallStandoffM(FlockParams(t));
+  s->revisit_area = GeofenceShrunk(c, standoff_m);
+  // ... and as far off an obstacle's face: the last stretch of a revisit is flown in position mode.
+  s->revisit_approach_m = standoff_m + 5.0;
+}
+
 swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, double t_s,
                                   bool lifter_present) {
   const MissionTuning& t = c.tuning;
@@ -526,13 +539,7 @@ swarm::ScoutConfig ScoutConfigFor(const SarBrainConfig& c, const Vec3& home_m, d
   s.lifter_present = lifter_present;
   s.dedupe_radius_m = t.sighting_dedupe_m;
   s.report_baseline_m = t.fusion.min_baseline_m;  // one view per counted baseline, no more
-  s.revisit_look_s = t.revisit_look_s;
-  s.revisit_look_altitude_m = std::min(t.revisit_look_altitude_m, t.scout_altitude_m);
-  s.sighting_area = GeofenceShrunk(c, 0.0);
-  // The wall repulsion keeps a drone at rest this far from the geofence (12.45 m with the defaults).
-  s.revisit_area = GeofenceShrunk(c, swarm::WallStandoffM(FlockParams(t)));
-  // ... and as far off an obstacle's face: the last stretch of a revisit is flown in position mode.
-  s.revisit_approach_m = swarm::WallStandoffM(FlockParams(t)) + 5.0;
+  SetRevisits(c, &s);
   s.min_clearance_m = c.depth_camera ? t.scout_min_clearance_m : 0.0;  // no depth camera: nothing seen
   s.keep_searching_during_rescue = true;  // the lifter does the rescue; scouts finish the search
   s.return_when_swept = true;             // nothing left to see: land, do not loiter

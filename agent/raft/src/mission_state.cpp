@@ -311,6 +311,7 @@ ApplyResult MissionState::Handle(const RequestRevisit& c) {
   if (k == nullptr || k->status != CandidateStatus::kPending) {
     return Reject("no pending candidate " + std::to_string(c.candidate));
   }
+  if (!k->revisit_drone.empty()) ++k->revisits;  // the one under way is abandoned: it counts
   k->revisit_drone = c.drone;
   k->revisit_t_s = c.t_s;
   return Accepted();

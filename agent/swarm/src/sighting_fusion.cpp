@@ -81,6 +81,17 @@ bool MissInView(const raft::SightingView& view, double candidate_x_m, double can
 
 namespace {
 
+// Whether view v is at least min_baseline_m (3-D) or min_pass_interval_s from every view counted.
+bool Independent(const raft::SightingView& v, const std::vector<Viewpoint>& counted, const FusionParams& p) {
+  for (const Viewpoint& q : counted) {
+    const double baseline =
+        std::sqrt((v.viewer_x_m - q.x) * (v.viewer_x_m - q.x) + (v.viewer_y_m - q.y) * (v.viewer_y_m - q.y) +
+                  (v.viewer_height_m - q.h) * (v.viewer_height_m - q.h));
+    if (baseline < p.min_baseline_m && std::abs(v.t_s - q.t) < p.min_pass_interval_s) return false;
+  }
+  return true;
+}
+
 // The decision on a candidate from its assessed evidence (the header's rules).
 void Decide(const raft::Candidate& c, const FusionParams& p, FusionAssessment* a) {
   if (c.status == raft::CandidateStatus::kConfirmed) return;
@@ -115,14 +126,7 @@ FusionAssessment AssessCandidate(const raft::Candidate& c, const FusionParams& p
       ++a.misses;
       if (!MissInView(v, c.x_m, c.y_m, p)) continue;  // the place was not (well) in view: no evidence
     }
-    bool independent = true;
-    for (const Viewpoint& q : counted) {
-      const double baseline = std::sqrt((v.viewer_x_m - q.x) * (v.viewer_x_m - q.x) +
-                                        (v.viewer_y_m - q.y) * (v.viewer_y_m - q.y) +
-                                        (v.viewer_height_m - q.h) * (v.viewer_height_m - q.h));
-      independent = independent && (baseline >= p.min_baseline_m || std::abs(v.t_s - q.t) >= p.min_pass_interval_s);
-    }
-    if (!independent) continue;
+    if (!Independent(v, counted, p)) continue;
     counted.push_back({v.viewer_x_m, v.viewer_y_m, v.viewer_height_m, v.t_s});
     (v.detected ? a.counted_detections : a.counted_misses) += 1;
     if (!CloseLook(v, p)) {

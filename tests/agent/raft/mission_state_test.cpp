@@ -101,6 +101,20 @@ TEST_F(MissionStateTest, SightingsGatherIntoCandidatesAndNoneConfirmsByItself) {
   EXPECT_EQ(m_.victims()[0].confirmed_by.size(), 3u);
 }
 
+// A revisit handed to another drone (the first gone or too slow) counts the abandoned one, so a
+// spot nobody reaches runs out of revisits instead of being revisited for ever.
+TEST_F(MissionStateTest, ARevisitHandedToAnotherDroneCountsTheAbandonedOne) {
+  Do(StartSearch{});
+  Do(ReportSighting{"scout_1", 1, 10, 20, 0.9, 10, 10, 30, 5.0});
+  ASSERT_TRUE(Do(RequestRevisit{1, "scout_2", 20}).accepted);
+  EXPECT_EQ(m_.FindCandidate(1)->revisits, 0u);
+  ASSERT_TRUE(Do(RequestRevisit{1, "scout_3", 80}).accepted);
+  EXPECT_EQ(m_.FindCandidate(1)->revisit_drone, "scout_3");
+  EXPECT_EQ(m_.FindCandidate(1)->revisits, 1u);
+  ASSERT_TRUE(Do(ReportMiss{"scout_3", 1, 1, 10.5, 20, 30, 90.0}).accepted);
+  EXPECT_EQ(m_.FindCandidate(1)->revisits, 2u);
+}
+
 TEST_F(MissionStateTest, ARevisitIsDoneByItsDronesMissAndARejectedCandidateKeepsItsEvidence) {
   Do(StartSearch{});
   Do(ReportSighting{"scout_1", 1, 10, 20, 0.9, 10, 10, 30, 5.0});

@@ -20,7 +20,10 @@
 //     confidence-weighted mean of its detections; it keeps at most kMaxViews pieces of evidence;
 //   - ReportMiss: a revisit saw nothing where the candidate is (evidence against it);
 //   - RequestRevisit: the leader sends a drone to look again; the drone's next view or miss of
-//     that candidate completes the revisit (revisits counts them);
+//     that candidate completes the revisit (revisits counts them); a request that replaces one
+//     still under way (its drone gone or too slow) counts the abandoned one too, so a spot no
+//     drone can reach is given up after the fusion's max_revisits (rubble20 on 2026-11-28: a
+//     candidate revisited for ten minutes ran a trial out of time);
 //   - ConfirmSighting / RejectSighting: the leader's decision from the fused evidence
 //     (swarm/sighting_fusion.hpp weighs it; this state only records it, so that every drone and
 //     every later leader sees the same decisions). Confirming adds a Victim; a rejected candidate
