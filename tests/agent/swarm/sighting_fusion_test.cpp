@@ -146,7 +146,7 @@ FusionParams WithCloseLooks() {
 }
 
 // Close looks: many confident views from the search altitude (a look-alike fires on each) raise
-// a candidate to 7:3 at most; only a view from the look altitude confirms.
+// a candidate to 9:1 at most; only a view from the look altitude confirms.
 TEST(SightingFusion, WithCloseLooksOnlyACloseLookConfirms) {
   const FusionParams p = WithCloseLooks();
   std::vector<SightingView> v;
@@ -157,7 +157,7 @@ TEST(SightingFusion, WithCloseLooksOnlyACloseLookConfirms) {
   EXPECT_EQ(a.decision, FusionDecision::kNone);
   EXPECT_EQ(AssessCandidate(With(v), FusionParams{}).decision,
             FusionDecision::kConfirm);                  // without: confirmed
-  v.push_back(CloseSeen("scout_2", 0.9, 0.5, 0, 100));  // 4:1 and 9:1 fuse to 36:1
+  v.push_back(CloseSeen("scout_2", 0.9, 0.5, 0, 100));  // 9:1 and 9:1 fuse to 81:1
   a = AssessCandidate(With(v), p);
   EXPECT_EQ(a.close_detections, 1);
   EXPECT_NEAR(a.log_odds, p.max_search_log_odds + Logit(0.9), 1e-9);
@@ -172,11 +172,11 @@ TEST(SightingFusion, WithCloseLooksOnlyACloseLookConfirms) {
 TEST(SightingFusion, OnlyTheBestCloseLookCounts) {
   const FusionParams p = WithCloseLooks();
   std::vector<SightingView> v = {Seen("scout_1", 0.8, 0, 0, 10), Seen("scout_1", 0.8, 12, 0, 25)};
-  for (int i = 0; i < 3; ++i) v.push_back(CloseSeen("scout_2", 0.7, 0.5, 0, 100.0 + 20 * i));
+  for (int i = 0; i < 3; ++i) v.push_back(CloseSeen("scout_2", 0.6, 0.5, 0, 100.0 + 20 * i));
   FusionAssessment a = AssessCandidate(With(v), p);
   EXPECT_EQ(a.close_detections, 3);
-  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + Logit(0.7), 1e-9);
-  EXPECT_EQ(a.decision, FusionDecision::kNone);  // 0.90: undecided, rejected once revisits run out
+  EXPECT_NEAR(a.log_odds, p.max_search_log_odds + Logit(0.6), 1e-9);
+  EXPECT_EQ(a.decision, FusionDecision::kNone);  // 0.93: undecided, rejected once revisits run out
   // A person missed on the first close look and seen on the second: the detection counts, not the miss.
   v.resize(2);
   v.push_back(Missed("scout_2", 0.5, 0, 100, 18.0));
@@ -195,7 +195,7 @@ TEST(SightingFusion, TwoCloseLooksThatSeeNothingRejectWhatTheSearchViewsRaised) 
   FusionAssessment a = AssessCandidate(With(v), p);
   EXPECT_EQ(a.counted_misses, 1);
   EXPECT_NEAR(a.log_odds, p.max_search_log_odds + miss, 1e-9);
-  EXPECT_EQ(a.decision, FusionDecision::kNone);  // 0.30: a person the first close look missed gets another
+  EXPECT_EQ(a.decision, FusionDecision::kNone);  // 0.49: a person the first close look missed gets another
   v.push_back(Missed("scout_3", 0.0, 0.5, 130, 18.0));
   a = AssessCandidate(With(v), p);
   EXPECT_NEAR(a.log_odds, p.max_search_log_odds + 2 * miss, 1e-9);

@@ -95,12 +95,13 @@ struct FusionParams {
   double max_miss_height_m = 40.0;
   // Close looks (above); 0: off, every view alike (the fusion before 2026-11-28's close look).
   double close_look_height_m = 0;
-  // logit(0.8): the search views raise a candidate to 4:1 at most; one close look at >= 0.83
-  // confirms it; a close look that sees nothing leaves 0.30 (1.39 - 2.25), a second rejects it.
-  // Measured on rubble20 with the close look (2026-11-28, 5 trials, BENCHMARKS.md "Perception:
-  // the close look"): the best close look of the 13 people confirmed scored 0.87-0.997, of the 22
-  // false alarms nothing (17) or 0.54-0.75; 3 people were missed on the first close look.
-  double max_search_log_odds = 1.386;
+  // logit(0.9): the search views raise a candidate to 9:1 at most; one close look at >= 0.68
+  // confirms it; a close look that sees nothing leaves 0.49 (2.20 - 2.25), a second rejects it.
+  // Measured on rubble20 (2026-11-28, BENCHMARKS.md "Perception: the close look"): with logit(0.8)
+  // (a close look >= 0.83 confirms) 54 of 80 people were rescued and 9 false victims; the people
+  // rejected had close looks at 0.6-0.8, and on that run's decisions a close look >= 0.70 would
+  // have confirmed 47 of 51 real candidates and 11 of 75 false ones against 39 and 5.
+  double max_search_log_odds = 2.197;
   double max_close_view_confidence = 0.99;
   // The detector's recall from the look altitude, per look (a look is 2 s, ~4 frames): an
   // assumption over the 0.74 per frame (precision 0.93) measured at 18 m on the rubble fields
