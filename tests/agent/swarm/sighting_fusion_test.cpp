@@ -450,21 +450,30 @@ TEST(ScoutRevisit, ADetectionBeyondTheSightingAreaIsNotReported) {
   EXPECT_DOUBLE_EQ(std::get<raft::ReportSighting>(out.proposals[0]).y_m, 79.0);
 }
 
+// A candidate at (100, 40) that scout_2 saw, which the leader sent scout_1 to revisit at t = 20 s.
+void CandidateToRevisit(Mission* m) {
+  m->Apply(raft::ReportSighting{"scout_2", 1, 100, 40, 0.9, 100, 30, 30, 5.0});
+  m->Apply(raft::RequestRevisit{1, "scout_1", 20.0});
+}
+// The scout on the ground at t = 0 and at its 30 m search altitude at t = 1 s.
+void TakeOff(ScoutBehaviour& s, const Mission& m, MissionOutput* out) {
+  s.Step(At(0.0, m.state, {0, 0, 0.23}), out);
+  s.Step(At(1.0, m.state, {0, 0, 30}), out);
+}
+
 // With a look altitude the revisit flies out at the search altitude, descends over the spot, and
 // only a view from the look altitude answers (the descent's are views of the same object from the
 // search model's heights: not sent).
 TEST(ScoutRevisit, ACloseLookDescendsOverTheCandidateAndOnlyItsViewAnswers) {
   Mission m;
   StartSearching(&m);
-  m.Apply(raft::ReportSighting{"scout_2", 1, 100, 40, 0.9, 100, 30, 30, 5.0});
-  m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
+  CandidateToRevisit(&m);
   ScoutBehaviour s({.name = "scout_1",
                     .home_m = Vector3d(0, 0, 0),
                     .revisit_look_s = 2.0,
                     .revisit_look_altitude_m = 18.0});
   MissionOutput out;
-  s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
-  s.Step(At(1.0, m.state, {0, 0, 30}), &out);
+  TakeOff(s, m, &out);
   s.Step(At(21.0, m.state, {60, 40, 30}), &out);
   ASSERT_EQ(out.mode, "revisiting");
   EXPECT_EQ(out.setpoint.kind, SetpointKind::kFlock);
@@ -498,15 +507,13 @@ TEST(ScoutRevisit, ACloseLookDescendsOverTheCandidateAndOnlyItsViewAnswers) {
 TEST(ScoutRevisit, TheLastStretchIsFlownInPositionModeFromTheApproachDistance) {
   Mission m;
   StartSearching(&m);
-  m.Apply(raft::ReportSighting{"scout_2", 1, 100, 40, 0.9, 100, 30, 30, 5.0});
-  m.Apply(raft::RequestRevisit{1, "scout_1", 20.0});
+  CandidateToRevisit(&m);
   ScoutBehaviour s({.name = "scout_1",
                     .home_m = Vector3d(0, 0, 0),
                     .revisit_look_altitude_m = 18.0,
                     .revisit_approach_m = 17.5});
   MissionOutput out;
-  s.Step(At(0.0, m.state, {0, 0, 0.23}), &out);
-  s.Step(At(1.0, m.state, {0, 0, 30}), &out);
+  TakeOff(s, m, &out);
   s.Step(At(21.0, m.state, {80, 40, 30}), &out);  // 20 m off: flocking at the search altitude
   ASSERT_EQ(out.mode, "revisiting");
   EXPECT_EQ(out.setpoint.kind, SetpointKind::kFlock);
