@@ -281,7 +281,7 @@ Status ApplyTuningArgs(const brain::Context& ctx, MissionTuning* t) {
   // within fusion_close_look_height_m, and its miss within the fusion's miss heights.
   if (t->revisit_look_altitude_m != 0 &&
       !(t->revisit_look_altitude_m >= t->fusion.min_miss_height_m &&
-        t->revisit_look_altitude_m + 2.0 <= t->fusion.close_look_height_m)) {
+        t->revisit_look_altitude_m + swarm::kRevisitHeightToleranceM <= t->fusion.close_look_height_m)) {
     return Error(ErrorCode::kInvalidArgument,
                  "sar brain: arg revisit_look_altitude_m must be 0 or at least fusion_min_miss_height_m and "
                  "2 m below fusion_close_look_height_m");

@@ -116,7 +116,8 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
     const bool at_candidate =
         revisit != nullptr &&
         (Eigen::Vector2d(revisit->x_m, revisit->y_m) - p).norm() <= config_.dedupe_radius_m;
-    const bool from_look = config_.revisit_look_altitude_m <= 0 || d.viewer_m.z() <= look_z + 2.0;
+    const bool from_look =
+        config_.revisit_look_altitude_m <= 0 || d.viewer_m.z() <= look_z + kRevisitHeightToleranceM;
     if (at_candidate && !from_look) continue;
     const bool answer = at_candidate && !revisit_seen_;
     for (const RecentReport& r : recent_) {
@@ -227,7 +228,7 @@ void ScoutBehaviour::RunRevisit(const MissionInput& in, MissionOutput* out) {
   const double look_z = Raised(LookAltitude());
   sp.target_m = {at.x(), at.y(), near ? look_z : Raised(Altitude())};
   sp.yaw_rad = in.yaw_rad;
-  const bool under = d <= config_.revisit_arrive_m && std::abs(p.z() - look_z) <= 2.0;
+  const bool under = d <= config_.revisit_arrive_m && std::abs(p.z() - look_z) <= kRevisitHeightToleranceM;
   if (look_start_s_ < 0 && under) look_start_s_ = in.t_s;
   if (look_start_s_ < 0 || revisit_seen_ || !under) return;
   const bool first = miss_tries_ == 0 && in.t_s - look_start_s_ >= config_.revisit_look_s;

@@ -69,6 +69,10 @@
 
 namespace swarmbox::swarm {
 
+// A revisit's look counts from within this of its look altitude (the "under" check), and only a
+// detection from at most this above it answers the revisit [m].
+inline constexpr double kRevisitHeightToleranceM = 2.0;
+
 struct ScoutConfig {
   std::string name;
   Eigen::Vector3d home_m = Eigen::Vector3d::Zero();  // spawn point on the ground, world ENU [m]
