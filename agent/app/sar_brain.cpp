@@ -515,7 +515,7 @@ void SetRevisits(const SarBrainConfig& c, swarm::ScoutConfig* s) {
   // The wall repulsion keeps a drone at rest this far from the geofence (12.45 m with the defaults).
   const double standoff_m = swarm::WallStandoffM(FlockParams(t));
   s->revisit_area = GeofenceShrunk(c, standoff_m);
-  // ... and as far off an obstacle's face: the last stretch of a revisit is flown in position mode.
+  // The last stretch of a revisit is flown in position mode (scout_behaviour.hpp).
   s->revisit_approach_m = standoff_m + 5.0;
 }
 

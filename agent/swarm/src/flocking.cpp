@@ -118,6 +118,12 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
   if (in.migrate) out.migration = MigrationTerm(in, p);
   ScanNeighbours(in, p, &out);
   FollowNeighbours(in, p, v, &out);
+  // While migrating, cohesion weighs against the migration as it does at the cruise speed: scaled
+  // by the migration's speed over v_flock. Unscaled, at its cap (v_coh_max, 2 m/s) it balanced the
+  // braking migration 3.39 m short of the goal (BrakingCurve = 2 m/s there) and held a drone whose
+  // neighbours were far off there for good (rubble20, 2026-11-28: a revisit 3.4 m off its
+  // candidate for 40 s until it timed out, a returning scout 5 m off home).
+  if (in.migrate) out.cohesion *= std::min(1.0, out.migration.norm() / k.v_flock_m_s);
   out.shill = ShillTerm(p, v);
 
   const Vec2 v_xy = ClampNorm(out.migration + out.repulsion + out.friction + out.alignment +

@@ -176,6 +176,34 @@ TEST(Flocking, MigrationBrakesToStopAtTheGoal) {
   EXPECT_LT(v.norm(), 0.1);                          // [m/s]
 }
 
+// A drone flocking to a spot 36 m from its only neighbour reaches it: cohesion (at its cap, 2 m/s,
+// pulling back) is scaled by the migration's speed over v_flock. Unscaled, it balanced the braking
+// migration 3.39 m short of the spot (BrakingCurve(3.39 m) = 2 m/s) for good: a revisit on
+// rubble20 (2026-11-28) waited so for 40 s, 3.4 m off its candidate, until it timed out.
+TEST(Flocking, CohesionDoesNotHoldADroneFarFromItsNeighboursOffItsGoal) {
+  FlockingParams k;
+  EXPECT_NEAR(BrakingCurve((4.0 + 1.0 / 0.36) / 2.0, k.a_mig_m_s2, k.p_mig_1_s), k.v_coh_max_m_s, 1e-9);
+  Flocking f(k, Geofence{});
+  const std::vector<NeighbourState> behind{{Vec3(-20, 0, 20), Vec3::Zero(), 0.1}};
+  const Vec3 goal(20, 0, 20);
+  Vec3 p(0, 0, 20);
+  Vec3 v = Vec3::Zero();
+  double cohesion_at_start = 0.0;
+  for (int i = 0; i < 1200; ++i) {  // 60 s
+    const FlockingOutput out = f.Step({p, v, goal, behind}, kDt);
+    if (i == 0) cohesion_at_start = out.cohesion.norm();
+    v = out.velocity_m_s;
+    p += kDt * v;
+  }
+  EXPECT_NEAR(cohesion_at_start, 0.9, 1e-9);  // the neighbour does pull: p_coh x (20 m - r0_coh)
+  EXPECT_LT((goal - p).norm(), 0.2);
+  EXPECT_LT(v.norm(), 0.1);
+  // Holding (no migration), cohesion keeps its full weight.
+  Flocking hold(k, Geofence{});
+  EXPECT_NEAR(hold.Step({p, Vec3::Zero(), goal, behind, /*migrate=*/false}, kDt).cohesion.norm(),
+              k.v_coh_max_m_s, 1e-9);
+}
+
 // V18 shill agents: a drone migrating toward a goal outside the geofence stops before the wall.
 TEST(Flocking, ShillAgentsKeepADroneInsideTheGeofence) {
   FlockingParams k;

@@ -502,8 +502,8 @@ TEST(ScoutRevisit, ACloseLookDescendsOverTheCandidateAndOnlyItsViewAnswers) {
   EXPECT_EQ(AssessCandidate(*m.state.FindCandidate(1), WithCloseLooks()).close_detections, 1);
 }
 
-// The last revisit_approach_m to the spot are flown in position mode (the flocking's shill would
-// hold the drone WallStandoffM off a rubble heap beside the candidate).
+// The last revisit_approach_m to the spot are flown in position mode, descending to the look
+// altitude on the way.
 TEST(ScoutRevisit, TheLastStretchIsFlownInPositionModeFromTheApproachDistance) {
   Mission m;
   StartSearching(&m);

@@ -23,7 +23,8 @@
 //  - friction    velocity alignment with the V18 "smart" tolerance: only the part of the velocity
 //                difference above the braking curve is damped (V18 eq. 2-3);
 //  - alignment   Reynolds' linear alignment toward the neighbours' mean velocity (gain c_align);
-//  - cohesion    Reynolds' attraction to the neighbours' centroid beyond r0_coh;
+//  - cohesion    Reynolds' attraction to the neighbours' centroid beyond r0_coh (while migrating,
+//                scaled by the migration's speed over v_flock: it never holds a drone off its goal);
 //  - shill       V18 virtual agents on the geofence walls and on obstacle faces, moving inward /
 //                outward at v_shill; their velocity is imposed with the friction rule (V18 eq. 5)
 //                on the velocity component along the wall normal (so drones slide along walls);

@@ -136,10 +136,10 @@ struct ScoutConfig {
   // SarBrain: 18 m, 3 m over the generator's tallest tree (15 m).
   double revisit_look_altitude_m = 0.0;
   // A revisit flies the last this many metres to its spot in position mode, not flocking (at
-  // least home_approach_m): the flocking's shill holds a drone swarm::WallStandoffM (12.45 m) off
-  // an obstacle's face whatever their heights, so a candidate by a rubble heap was never reached
-  // (rubble20 on 2026-11-28: one candidate 3 m from a 1.3 m block revisited for 10 minutes).
-  // SarBrain: WallStandoffM + 5 m [m].
+  // least home_approach_m), and descends to the look altitude on the way. Added when a revisit on
+  // rubble20 (2026-11-28) waited 40 s 3.4 m off its candidate, each time, for 10 minutes: the
+  // flocking's cohesion toward the far-off others balanced its braking migration there (fixed in
+  // Flocking::Step since). SarBrain: swarm::WallStandoffM + 5 m (17.45 m) [m].
   double revisit_approach_m = 0.0;
   // Where a revisit can hover [m, ENU]: a candidate outside it (a detection near the geofence,
   // where the flocking's wall repulsion keeps the drone out) is looked at from the nearest point
