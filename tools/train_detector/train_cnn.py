@@ -100,6 +100,40 @@ def augment(x, generator):
     return out
 
 
+def shift(x, generator, max_px):
+    """Each patch moved by (dx, dy) px, both drawn in [-max_px, max_px], its border filled by
+    reflection: the first stage's candidate centres miss a person's by a few pixels."""
+    if max_px <= 0:
+        return x
+    n, side = x.shape[0], x.shape[2]
+    padded = nn.functional.pad(x, (max_px, max_px, max_px, max_px), mode="reflect")
+    dx = torch.randint(0, 2 * max_px + 1, (n,), generator=generator)
+    dy = torch.randint(0, 2 * max_px + 1, (n,), generator=generator)
+    out = torch.empty_like(x)
+    for oy in range(2 * max_px + 1):
+        for ox in range(2 * max_px + 1):
+            sel = (dx == ox) & (dy == oy)
+            if bool(sel.any()):
+                out[sel] = padded[sel, :, oy:oy + side, ox:ox + side]
+    return out
+
+
+def photometric(x, generator, amount):
+    """Each patch's exposure and white balance changed: pixel p -> clamp(g_c * p + o), the gain
+    g_c = (1 + u) (1 + v_c) with u in [-amount, amount] and v_c in [-amount / 2, amount / 2] per
+    channel, the offset o in [-32 amount, 32 amount] (pixel units). The world's time of day,
+    overcast and exposure vary what one person looks like more than the training draw covers."""
+    if amount <= 0:
+        return x
+    n = x.shape[0]
+    u = (torch.rand((n, 1, 1, 1), generator=generator) * 2 - 1) * amount
+    v = (torch.rand((n, 3, 1, 1), generator=generator) * 2 - 1) * (amount / 2)
+    o = (torch.rand((n, 1, 1, 1), generator=generator) * 2 - 1) * (32 * amount)
+    pixels = x / INPUT_SCALE + INPUT_MEAN
+    pixels = torch.clamp(pixels * (1 + u) * (1 + v) + o, 0, 255)
+    return (pixels - INPUT_MEAN) * INPUT_SCALE
+
+
 def evaluate(net, x, y, loss_fn, batch):
     """(mean loss, accuracy at logit 0, logits) on x (uint8 patches), y without augmentation."""
     net.eval()
@@ -175,6 +209,7 @@ def train(args):
         for i in range(0, len(order), args.batch):
             idx = order[i:i + args.batch]
             xb = augment(to_input(x_train[idx]), gen)
+            xb = photometric(shift(xb, gen, args.shift_px), gen, args.photometric)
             logits = net(xb).squeeze(1)
             loss = loss_fn(logits, y_train[idx])
             opt.zero_grad()
@@ -249,6 +284,10 @@ def main():
     parser.add_argument("--mine-every", type=int, default=3, help="epochs between minings (default 3)")
     parser.add_argument("--widths", type=lambda v: tuple(int(w) for w in v.split(",")), default=(16, 32, 64),
                         help="the three blocks' channels (default 16,32,64)")
+    parser.add_argument("--shift-px", type=int, default=0,
+                        help="move each training patch by up to this many pixels (default 0: not)")
+    parser.add_argument("--photometric", type=float, default=0.0,
+                        help="exposure and white-balance jitter, a share (default 0: none; 0.2 = +-20%%)")
     args = parser.parse_args()
     if args.test_fixture:
         write_test_fixture(args.seed, 32, args.out)
@@ -257,6 +296,8 @@ def main():
         parser.error("--patches is required")
     if len(args.widths) != 3 or min(args.widths) < 1:
         parser.error("--widths takes three channel counts, e.g. 16,32,64")
+    if not 0 <= args.shift_px <= 8 or not 0.0 <= args.photometric < 1.0:
+        parser.error("--shift-px takes 0-8, --photometric a share in [0, 1)")
     if not 0.0 <= args.hard_fraction < 1.0 or args.mine_from < 1 or args.mine_every < 1:
         parser.error("--hard-fraction takes [0, 1), --mine-from and --mine-every >= 1")
     net, px = train(args)
