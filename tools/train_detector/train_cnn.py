@@ -4,6 +4,7 @@
     python3 train_cnn.py --patches FILE --out MODEL.onnx [--seed 1] [--epochs 6] [--threads 2]
                          [--widths 16,32,64] [--negatives-per-epoch 24000]
                          [--hard-fraction 0] [--mine-from 3] [--mine-every 3]
+                         [--shift-px 0] [--photometric 0]
     python3 train_cnn.py --test-fixture --out tests/agent/swarm/data/patch_cnn_fixture.onnx
 
 swarmbox-train-detector --cnn train_cnn.py runs this (argv, no shell) between its first stage and
