@@ -165,9 +165,13 @@ TEST_F(NetnsPair, UserspacePlanDelaysJittersAndDropsAsSpecified) {
   // machine's scheduling latency.
   EXPECT_GT(s.Mean(), 50.0 - 0.95);
   EXPECT_LT(s.Mean(), 50.0 + 0.95 + 3.0);
-  // Spread: the sample sd of ~2,850 normal values has a relative standard error of 1.3%; allow 15%
-  // for the same scheduling noise.
-  EXPECT_NEAR(s.StdDev(), 10.0, 1.5);
+  // Spread: sigma from the interquartile range (1.349 sigma for a normal): a few datagrams the
+  // shared machine held up by tens of ms move the sample sd (CI on 2026-11-28: sd 13.1 ms, p99
+  // 104 ms) but not the quartiles. Its relative standard error over ~2,850 values is ~2.1%;
+  // allow 15% for the same scheduling noise.
+  const double sigma_iqr = (s.Quantile(0.75) - s.Quantile(0.25)) / 1.349;
+  RecordProperty("sigma_from_iqr_ms", std::to_string(sigma_iqr));
+  EXPECT_NEAR(sigma_iqr, 10.0, 1.5) << "sd " << s.StdDev();
 
   // Undo: chains, hooks and daemons gone, traffic back to a bare veth.
   Status undone_a = RunAllCommands(in_a, plan_a->undo);
