@@ -176,7 +176,7 @@ TEST(Flocking, MigrationBrakesToStopAtTheGoal) {
   EXPECT_LT(v.norm(), 0.1);                          // [m/s]
 }
 
-// A drone flocking to a spot 36 m from its only neighbour reaches it: cohesion (at its cap, 2 m/s,
+// A drone flocking to a spot 40 m from its only neighbour reaches it: cohesion (at its cap, 2 m/s,
 // pulling back) is scaled by the migration's speed over v_flock. Unscaled, it balanced the braking
 // migration 3.39 m short of the spot (BrakingCurve(3.39 m) = 2 m/s) for good: a revisit on
 // rubble20 (2026-11-28) waited so for 40 s, 3.4 m off its candidate, until it timed out.
