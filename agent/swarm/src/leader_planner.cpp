@@ -94,7 +94,10 @@ LogEvent DecisionEvent(double t_s, const std::string& leader, const raft::Candid
   if (confirmed) {
     e.Add("victim", static_cast<std::int64_t>(c.victim_id));
   } else {
-    e.Add("reason", a.undecided ? "undecided" : "belief");
+    // Why, from the decision's own belief: Decide rejects on belief only at <= reject_belief, so a
+    // rejection above it is one whose revisits ran out. (Assessing the candidate again cannot
+    // tell: Decide leaves a candidate no longer pending undecided = false.)
+    e.Add("reason", c.belief <= fusion.reject_belief ? "belief" : "undecided");
   }
   e.Add("decided_belief", c.belief, 3);
   AddEvidence(e, c, a);

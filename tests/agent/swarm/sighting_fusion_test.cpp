@@ -336,6 +336,27 @@ TEST_F(LeaderSightings, SendsTheNearestIdleScoutToRevisitThenRejectsAFalseAlarm)
   EXPECT_NE(Find<raft::ReturnHome>(StepAt(t + 12.0)), nullptr);
 }
 
+TEST_F(LeaderSightings, ACandidateWhoseRevisitsRanOutIsLoggedAsUndecided) {
+  // rubble20 on 2026-11-28 logged every such rejection reason=belief (with decided_belief up to 0.94).
+  leader.Track(0.0, m.state);
+  m.Apply(raft::ReportSighting{"scout_3", 1, 40, 10, 0.7, 30, 10, 30, 20.0});
+  // Each revisit sees something, too weakly to move the belief (a 0.5 view adds no log-odds).
+  double t = 40.0;
+  std::uint64_t seq = 1;
+  for (int look = 0; look < 3; ++look, t += 20.0) {
+    m.Apply(raft::RequestRevisit{1, "scout_2", t});
+    m.Apply(raft::ReportSighting{"scout_2", seq++, 40.2, 10, 0.5, 40, 10 + 12.0 * look, 30, t + 5});
+  }
+  MissionOutput out = StepAt(t);
+  const auto* reject = Find<raft::RejectSighting>(out);
+  ASSERT_NE(reject, nullptr);
+  EXPECT_NEAR(reject->belief, 0.7, 1e-9);
+  m.Apply(*reject);
+  out = StepAt(t + 1.0);
+  const std::string rejected = Line(out, "rejected");
+  EXPECT_NE(rejected.find("reason=undecided decided_belief=0.700"), std::string::npos) << rejected;
+}
+
 TEST_F(LeaderSightings, ARevisitWhoseDroneIsGoneGoesToAnother) {
   leader.Track(0.0, m.state);
   m.Apply(raft::ReportSighting{"scout_3", 1, 40, 10, 0.9, 30, 10, 30, 20.0});
