@@ -25,7 +25,9 @@
 //   beside it unless --export-patches), --cnn-epochs N, --cnn-seed N, --cnn-widths A,B,C (its
 //   three blocks' channels), --cnn-negatives N (negatives drawn per epoch), --cnn-hard-fraction F
 //   (the share of them drawn from the hardest the network scores), --cnn-patch-px N (its patch side
-//   over 3 m; default 32), --view-altitudes LO,HI (every training set's heights))
+//   over 3 m; default 32), --cnn-symmetries N (1, 4 or 8: each patch scored in that many of the
+//   square's symmetries, the logits averaged; with --recalibrate it replaces the model's),
+//   --view-altitudes LO,HI (every training set's heights))
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
@@ -128,6 +130,8 @@ constexpr Flag kFlags[] = {
     {"--cnn-hard-fraction", true,
      [](const char* v, Args* a) { a->options.cnn_hard_fraction = std::stod(v); return true; }},
     {"--cnn-patch-px", true, [](const char* v, Args* a) { a->options.cnn_patch_px = std::stoi(v); return true; }},
+    {"--cnn-symmetries", true,
+     [](const char* v, Args* a) { a->options.cnn_symmetries = std::stoi(v); return true; }},
     {"--view-altitudes", true, SetViewAltitudes},
     {"--model-name", true, [](const char* v, Args* a) { a->model_name = v; return true; }},
     {"--replace-cnn", true, [](const char* v, Args* a) { a->options.replace_cnn = v; return true; }},
@@ -153,7 +157,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
                    "[--operating-precision P] [--export-patches FILE] "
                    "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N] "
-                   "[--cnn-widths A,B,C] [--cnn-negatives N] [--cnn-hard-fraction F] [--cnn-patch-px N]] "
+                   "[--cnn-widths A,B,C] [--cnn-negatives N] [--cnn-hard-fraction F] [--cnn-patch-px N] "
+                   "[--cnn-symmetries 1|4|8]] "
                    "[--view-altitudes LO,HI] [--model-name NAME] "
                    "[--recalibrate --replace-cnn FILE]\n");
       return kUsageError;

@@ -339,6 +339,7 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.view_min_altitude_m > 0)
     r << " --view-altitudes " << o.view_min_altitude_m << "," << o.view_max_altitude_m;
   if (o.cnn_patch_px != swarm::kCnnPatchPx) r << " --cnn-patch-px " << o.cnn_patch_px;
+  if (o.cnn_symmetries > 1) r << " --cnn-symmetries " << o.cnn_symmetries;
   if (!o.cnn_script.empty()) {
     r << " --cnn train_cnn.py --cnn-epochs " << o.cnn_epochs << " --cnn-seed " << o.cnn_seed
       << " --cnn-widths " << o.cnn_widths << " --cnn-negatives " << o.cnn_negatives_per_epoch
@@ -586,6 +587,14 @@ void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::st
   add(o.clean_calibration, "--clean-calibration", "");
   add(o.operating_precision > 0, "--operating-precision", precision.str());
   add(!o.replace_cnn.empty(), "--replace-cnn", o.replace_cnn.substr(o.replace_cnn.find_last_of('/') + 1));
+  if (o.cnn_symmetries > 0) {  // the new count replaces one the recipe named
+    const std::string flag = " --cnn-symmetries ";
+    if (const std::size_t at = recipe->find(flag); at != std::string::npos) {
+      const std::size_t end = recipe->find(' ', at + flag.size());
+      recipe->erase(at, end == std::string::npos ? std::string::npos : end - at);
+    }
+    *recipe += flag + std::to_string(o.cnn_symmetries);
+  }
 }
 
 }  // namespace
@@ -632,6 +641,12 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
       return Error(ErrorCode::kInvalidArgument, "recalibrate: --replace-cnn needs a CNN model", model_path);
     SWARMBOX_TRY(ReadCnn(o.replace_cnn, &model));
   }
+  if (o.cnn_symmetries > 0) {
+    if (!model.has_cnn())
+      return Error(ErrorCode::kInvalidArgument, "recalibrate: --cnn-symmetries needs a CNN model",
+                   model_path);
+    model.cnn_symmetries = o.cnn_symmetries;
+  }
   const bool new_seeds = model.calibration_seeds != o.calibration_seeds;
   model.calibration_seeds = o.calibration_seeds;
   Result<std::vector<Scene>> cal = RenderCalibrationSets(o);
@@ -663,6 +678,7 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
       o.world_sets < 0 || o.world_distractors < 0 || o.stage1_rounds < 0 ||
       (o.stage1_rounds > 0 && o.blob_features) || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty()) || !swarm::ValidCnnPatchPx(o.cnn_patch_px) ||
+      (o.cnn_symmetries != 0 && !swarm::ValidCnnSymmetries(o.cnn_symmetries)) ||
       ((o.view_min_altitude_m != 0 || o.view_max_altitude_m != 0) &&
        !(o.view_min_altitude_m >= 2 && o.view_max_altitude_m > o.view_min_altitude_m))) {
     return Error(ErrorCode::kInvalidArgument,
@@ -671,7 +687,7 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
                  "world_sets, world_distractors, stage1_rounds (not with blob features) and "
                  "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-patch-px is "
                  "a multiple "
-                 "of 8 in [16, 128], --view-altitudes LO,HI has 2 <= LO < HI");
+                 "of 8 in [16, 128], --cnn-symmetries is 1, 4 or 8, --view-altitudes LO,HI has 2 <= LO < HI");
   }
   if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1 ||
                                 !(o.cnn_hard_fraction >= 0 && o.cnn_hard_fraction < 1))) {
@@ -1089,6 +1105,7 @@ Status TrainCnnStage(Training& t, const std::vector<Scene>& train, const std::ve
   SWARMBOX_TRY(ExportPatches(t, train, cal, patches));
   SWARMBOX_TRY(RunCnnScript(t.o, patches, t.o.cnn_onnx_out));
   t.model.cnn_patch_px = t.o.cnn_patch_px;
+  t.model.cnn_symmetries = t.o.cnn_symmetries > 0 ? t.o.cnn_symmetries : 1;
   SWARMBOX_TRY(ReadCnn(t.o.cnn_onnx_out, &t.model));
   t.model.forest.release();
   std::fprintf(stderr, "train-detector: CNN of %zu bytes (%.0f s)\n", t.model.cnn_onnx.size(), Seconds(t.t0));

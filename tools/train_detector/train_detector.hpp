@@ -115,6 +115,10 @@ struct TrainingOptions {
   // model's); a model of low views 48 (16 px/m; BENCHMARKS.md "Perception: the close look":
   // tried on views from 10-20 m, not shipped).
   int cnn_patch_px = swarm::kCnnPatchPx;
+  // The symmetries of each patch the CNN scores, logits averaged (swarm::VictimDetectorModel::
+  // cnn_symmetries: 1, 4 or 8), set before the sigmoid is fitted; 0: 1 when training, the model's
+  // own with --recalibrate.
+  int cnn_symmetries = 0;
   // When both > 0: every training set's views between these heights [m] (the defaults: 8-65 m for
   // the mixed terrains, 15-45 m for the rubble fields); e.g. 10-20 m for a model of close looks.
   double view_min_altitude_m = 0;

@@ -125,10 +125,34 @@ void VictimDetector::CnnPatch(const Candidate& c, cv::Mat* patch) {
   patches_.Extract(CentrePx(c), patch);
 }
 
+namespace {
+
+// Symmetry k (1-7) of the square applied to `patch`: turned k % 4 times by 90 degrees clockwise,
+// then mirrored left-right when k >= 4.
+void SquareSymmetry(const cv::Mat& patch, int k, cv::Mat* out) {
+  static constexpr cv::RotateFlags kTurns[] = {cv::ROTATE_90_CLOCKWISE, cv::ROTATE_180,
+                                               cv::ROTATE_90_COUNTERCLOCKWISE};
+  const int turns = k % 4;
+  if (turns == 0) {
+    cv::flip(patch, *out, 1);
+    return;
+  }
+  cv::rotate(patch, *out, kTurns[turns - 1]);
+  if (k >= 4) cv::flip(*out, *out, 1);
+}
+
+}  // namespace
+
 void VictimDetector::CnnScores(const std::vector<Candidate>& cands, const std::vector<int>& kept,
                                std::vector<double>* scores) {
-  patch_batch_.resize(kept.size());
-  for (std::size_t i = 0; i < kept.size(); ++i) CnnPatch(cands[static_cast<std::size_t>(kept[i])], &patch_batch_[i]);
+  // Each candidate's patch, then its other cnn_symmetries - 1 symmetries, in one batch.
+  const auto views = static_cast<std::size_t>(model_->cnn_symmetries);
+  patch_batch_.resize(kept.size() * views);
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    cv::Mat* first = &patch_batch_[i * views];
+    CnnPatch(cands[static_cast<std::size_t>(kept[i])], first);
+    for (std::size_t k = 1; k < views; ++k) SquareSymmetry(*first, static_cast<int>(k), first + k);
+  }
   // (pixel - kCnnInputMean) * kCnnInputScale, N x 3 x H x W, BGR as sampled (train_cnn.py reads the
   // trainer's patches in the same order).
   cv::dnn::blobFromImages(patch_batch_, cnn_input_, kCnnInputScale,
@@ -136,9 +160,14 @@ void VictimDetector::CnnScores(const std::vector<Candidate>& cands, const std::v
                           false, false, CV_32F);
   cnn_.setInput(cnn_input_);
   cnn_output_ = cnn_.forward();
-  SWARMBOX_CHECK(cnn_output_.total() == kept.size() && cnn_output_.type() == CV_32F);
+  SWARMBOX_CHECK(cnn_output_.total() == patch_batch_.size() && cnn_output_.type() == CV_32F);
   const float* logits = cnn_output_.ptr<float>();
-  scores->assign(logits, logits + kept.size());
+  scores->clear();
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    double sum = 0;
+    for (std::size_t k = 0; k < views; ++k) sum += logits[i * views + k];
+    scores->push_back(sum / static_cast<double>(views));
+  }
 }
 
 void VictimDetector::Detect(const cv::Mat& bgr, double pixels_per_m, std::vector<ImageBlob>* out) {

@@ -163,6 +163,7 @@ void WriteSecondStage(const VictimDetectorModel& model, cv::FileStorage& fs) {
   if (model.has_cnn()) {
     fs << "cnn_patch_px" << model.cnn_patch_px << "cnn_patch_m" << kCnnPatchM << "cnn_input_mean"
        << kCnnInputMean << "cnn_input_scale" << kCnnInputScale;
+    if (model.cnn_symmetries != 1) fs << "cnn_symmetries" << model.cnn_symmetries;
     fs << "cnn_onnx" << cv::Mat(1, static_cast<int>(model.cnn_onnx.size()), CV_8U,
                                 const_cast<std::uint8_t*>(model.cnn_onnx.data()));
     return;
@@ -223,7 +224,14 @@ Status ReadLayout(cv::FileStorage& fs, const std::string& where, VictimDetectorM
     return Error(ErrorCode::kInvalidArgument,
                  "detector model: another CNN patch layout than this build (retrain: target train-detector)", where);
   }
-  if (version == kCnnFormatVersion) m->cnn_patch_px = static_cast<int>(fs["cnn_patch_px"]);
+  if (version == kCnnFormatVersion) {
+    m->cnn_patch_px = static_cast<int>(fs["cnn_patch_px"]);
+    // Optional: a model written before test-time augmentation scores each patch once.
+    m->cnn_symmetries = fs["cnn_symmetries"].empty() ? 1 : static_cast<int>(fs["cnn_symmetries"]);
+    if (!ValidCnnSymmetries(m->cnn_symmetries)) {
+      return Error(ErrorCode::kInvalidArgument, "detector model: cnn_symmetries must be 1, 4 or 8", where);
+    }
+  }
   if (version == kFormatVersion || version == kCnnFormatVersion) {
     m->blob_features = static_cast<int>(fs["blob_features"]);
     m->recipe = static_cast<std::string>(fs["recipe"]);

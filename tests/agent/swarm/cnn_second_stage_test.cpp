@@ -225,6 +225,77 @@ TEST(CnnSecondStage, AModelWithACnnRoundTripsAndScoresEachCandidateByItsPatch) {
     EXPECT_NEAR(b.votes, alone[0], kLogitTolerance);
     EXPECT_NEAR(b.confidence, with_cnn.Probability(b.votes), 1e-12);
   }
+  EXPECT_EQ((*loaded)->cnn_symmetries, 1);  // a file without the field: the network once
+  std::remove(path.c_str());
+}
+
+// The patch turned by 90 degrees `turns` times (counter-clockwise), by transposes and flips.
+cv::Mat Turned(const cv::Mat& patch, int turns) {
+  cv::Mat out = patch.clone();
+  for (int k = 0; k < turns; ++k) {
+    cv::Mat t;
+    cv::transpose(out, t);
+    cv::flip(t, out, 0);
+  }
+  return out;
+}
+
+TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirrorImages) {
+  VictimDetectorModel with_cnn = *ShippedDetectorModel();
+  with_cnn.cnn_onnx = ReadBytes(kFixture);
+  ASSERT_FALSE(with_cnn.cnn_onnx.empty());
+  with_cnn.forest.release();
+  with_cnn.nodes.clear();
+  with_cnn.roots.clear();
+  cv::dnn::Net net = cv::dnn::readNetFromONNX(reinterpret_cast<const char*>(with_cnn.cnn_onnx.data()),
+                                              with_cnn.cnn_onnx.size());
+  const std::string path = ::testing::TempDir() + "/cnn_symmetries_model.yml.gz";
+  VictimDetectorParams all;
+  all.min_confidence = 0.0;
+  all.nms_radius_m = 0.0;
+  all.partial_confidence_cap = 1.0;
+  const cv::Mat frame = TestFrame();
+  constexpr double kPxPerM = 15.5;
+  for (const int symmetries : {4, 8}) {
+    // Given the fixture network scoring each patch in `symmetries` of the square's symmetries,
+    // saved and loaded.
+    with_cnn.cnn_symmetries = symmetries;
+    ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
+    Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
+    EXPECT_EQ((*loaded)->cnn_symmetries, symmetries);
+    // When the detector runs it on a frame.
+    VictimDetector det(*loaded, all);
+    std::vector<ImageBlob> blobs;
+    det.Detect(frame, kPxPerM, &blobs);
+    ASSERT_FALSE(blobs.empty());
+    // Then each score is the mean of the network's logits for its patch's four turns (and with 8,
+    // their mirror images too), which differs from the patch's own logit.
+    int differ = 0;
+    for (const ImageBlob& b : blobs) {
+      cv::Mat patch;
+      CandidatePatch(frame, kPxPerM, b.centroid_px, &patch);
+      std::vector<cv::Mat> views;
+      for (int turns = 0; turns < 4; ++turns) {
+        views.push_back(Turned(patch, turns));
+        if (symmetries == 8) {
+          cv::Mat mirrored;
+          cv::flip(views.back(), mirrored, 1);
+          views.push_back(mirrored);
+        }
+      }
+      const std::vector<float> logits = Logits(net, views);
+      double mean = 0;
+      for (float v : logits) mean += v / static_cast<double>(logits.size());
+      EXPECT_NEAR(b.votes, mean, kLogitTolerance) << symmetries;
+      differ += std::abs(b.votes - logits[0]) > 10 * kLogitTolerance ? 1 : 0;
+    }
+    EXPECT_GT(differ, 0) << symmetries;
+  }
+  // And a count the detector does not know is refused when the file is loaded.
+  with_cnn.cnn_symmetries = 3;
+  ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
+  EXPECT_FALSE(LoadDetectorModel(path).ok());
   std::remove(path.c_str());
 }
 

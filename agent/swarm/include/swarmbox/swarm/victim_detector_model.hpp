@@ -76,6 +76,8 @@ inline double InputToCanonical(double input_px, double scale) {
   return (input_px + 0.5) * scale + kPadCells * kShrink;
 }
 
+inline bool ValidCnnSymmetries(int n) { return n == 1 || n == 4 || n == 8; }
+
 struct VictimDetectorModel {
   // First stage: score(window) = bias + sum over channels of the correlation of the cell map with
   // kernels[c] (kWindowCells x kWindowCells, CV_32F); candidates score >= stage1_threshold.
@@ -91,6 +93,12 @@ struct VictimDetectorModel {
   // shipped model's; a finer one (the trainer's --cnn-patch-px, e.g. 48: 16 px/m) for a model of
   // low views (BENCHMARKS.md "Perception: the close look": tried, not shipped).
   int cnn_patch_px = kCnnPatchPx;
+  // Of the square's 8 symmetries (turns by 90 degrees, mirrored), how many of each patch the CNN
+  // scores, its logits averaged (test-time augmentation; ValidCnnSymmetries: 1, 4 or 8). The
+  // network was trained on all 8 (train_cnn.py: people lie at any heading), so each is a fair view
+  // and the mean is less noisy than one; the sigmoid is fitted to the mean (the trainer's
+  // --cnn-symmetries). 1: the network once, as before the field existed (files without it).
+  int cnn_symmetries = 1;
   int blob_features = 0;           // 0 (format 1) or kBlobFeatures, after the kForestFeatures
   double platt_a = -8.0;           // p = 1 / (1 + exp(platt_a * votes + platt_b))
   double platt_b = 4.0;
