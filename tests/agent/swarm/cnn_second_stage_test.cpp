@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -122,17 +123,29 @@ TEST(CandidatePatch, SamplesAThreeMetreSquareAtTheFixedScaleAroundTheCentre) {
 
 TEST(CandidatePatch, IsDeterministicAndTheDetectorSeesTheTrainersPixels) {
   const cv::Mat frame = TestFrame();
-  for (double px_per_m : {6.0, 15.5, 40.0}) {  // coarser than the patch, the 30 m scale, finer (shrunk)
-    VictimDetector det;
-    const auto& cands = det.Candidates(frame, px_per_m, 24, -1e30);
-    ASSERT_FALSE(cands.empty()) << px_per_m;
-    for (const VictimDetector::Candidate& c : cands) {
-      cv::Mat from_detector, from_trainer, again;
-      det.CnnPatch(c, &from_detector);
-      CandidatePatch(frame, px_per_m, det.CentrePx(c), &from_trainer);
-      CandidatePatch(frame, px_per_m, det.CentrePx(c), &again);
-      EXPECT_EQ(cv::norm(from_detector, from_trainer, cv::NORM_INF), 0.0) << px_per_m;
-      EXPECT_EQ(cv::norm(from_trainer, again, cv::NORM_INF), 0.0) << px_per_m;
+  // The 32 px patches of CandidatePatch() and 48 px ones (the trainer's --cnn-patch-px 48).
+  for (const int px : {kCnnPatchPx, 48}) {
+    auto model = std::make_shared<VictimDetectorModel>(*ShippedDetectorModel());
+    model->cnn_patch_px = px;
+    for (double px_per_m : {6.0, 15.5, 40.0}) {  // coarser than the patch, the 30 m scale, finer (shrunk)
+      VictimDetector det(model, {});
+      const auto& cands = det.Candidates(frame, px_per_m, 24, -1e30);
+      ASSERT_FALSE(cands.empty()) << px_per_m;
+      for (const VictimDetector::Candidate& c : cands) {
+        cv::Mat from_detector, from_trainer, again;
+        det.CnnPatch(c, &from_detector);
+        CandidatePatchSampler sampler(px);  // as the trainer exports them, a fresh frame each
+        sampler.SetFrame(frame, px_per_m);
+        sampler.Extract(det.CentrePx(c), &from_trainer);
+        if (px == kCnnPatchPx) {
+          CandidatePatch(frame, px_per_m, det.CentrePx(c), &again);
+        } else {
+          sampler.Extract(det.CentrePx(c), &again);
+        }
+        ASSERT_EQ(from_detector.rows, px);
+        EXPECT_EQ(cv::norm(from_detector, from_trainer, cv::NORM_INF), 0.0) << px << " " << px_per_m;
+        EXPECT_EQ(cv::norm(from_trainer, again, cv::NORM_INF), 0.0) << px << " " << px_per_m;
+      }
     }
   }
 }
@@ -190,6 +203,7 @@ TEST(CnnSecondStage, AModelWithACnnRoundTripsAndScoresEachCandidateByItsPatch) {
   // Given the shipped first stage with the fixture network as its second stage, saved and loaded.
   VictimDetectorModel with_cnn = *ShippedDetectorModel();
   with_cnn.cnn_onnx = ReadBytes(kFixture);
+  with_cnn.cnn_patch_px = kCnnPatchPx;  // the fixture network's, whatever the shipped model's
   ASSERT_FALSE(with_cnn.cnn_onnx.empty());
   with_cnn.forest.release();
   with_cnn.nodes.clear();
@@ -243,6 +257,7 @@ cv::Mat Turned(const cv::Mat& patch, int turns) {
 TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirrorImages) {
   VictimDetectorModel with_cnn = *ShippedDetectorModel();
   with_cnn.cnn_onnx = ReadBytes(kFixture);
+  with_cnn.cnn_patch_px = kCnnPatchPx;  // the fixture network's, whatever the shipped model's
   ASSERT_FALSE(with_cnn.cnn_onnx.empty());
   with_cnn.forest.release();
   with_cnn.nodes.clear();
