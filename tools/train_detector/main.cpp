@@ -15,7 +15,9 @@
 //   --negatives-sets N (cones-and-rubble sets 7200001..7200000+N), --world-sets N (generated
 //   rubble fields 7300001..7300000+N), --world-distractors N (in each of those fields;
 //   default 25), --stage1-rounds N (stage 1's hard negatives), --calibration-altitude M
-//   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there), --calibration-sets N
+//   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there),
+//   --close-calibration-altitude M (a second sigmoid, fitted at M +- 3 m, for finer frames: close
+//   looks), --calibration-sets N
 //   (calibration seeds 7100001..7100000+N; default 2), --clean-calibration (no painted clutter on the
 //   calibration frames), --max-candidates N
 //   (the first stage's cap while calibrating and mining), --operating-precision P (probability 0.5
@@ -130,6 +132,8 @@ constexpr Flag kFlags[] = {
     {"--cnn-hard-fraction", true,
      [](const char* v, Args* a) { a->options.cnn_hard_fraction = std::stod(v); return true; }},
     {"--cnn-patch-px", true, [](const char* v, Args* a) { a->options.cnn_patch_px = std::stoi(v); return true; }},
+    {"--close-calibration-altitude", true,
+     [](const char* v, Args* a) { a->options.close_calibration_altitude_m = std::stod(v); return true; }},
     {"--cnn-symmetries", true,
      [](const char* v, Args* a) { a->options.cnn_symmetries = std::stoi(v); return true; }},
     {"--view-altitudes", true, SetViewAltitudes},
@@ -154,7 +158,7 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "usage: swarmbox-train-detector --out-dir DIR [--recalibrate] [--scenes-per-set N] "
                    "[--training-sets N] [--trees N] [--max-negatives N] [--stage1-percentile P] "
                    "[--balance-classes] [--hard-negative-rounds N] [--blob-features] [--negatives-sets N] [--world-sets N] [--world-distractors N] [--stage1-rounds N] "
-                   "[--calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
+                   "[--calibration-altitude M] [--close-calibration-altitude M] [--calibration-sets N] [--clean-calibration] [--max-candidates N] "
                    "[--operating-precision P] [--export-patches FILE] "
                    "[--cnn train_cnn.py [--python PY] [--cnn-onnx FILE] [--cnn-epochs N] [--cnn-seed N] "
                    "[--cnn-widths A,B,C] [--cnn-negatives N] [--cnn-hard-fraction F] [--cnn-patch-px N] "

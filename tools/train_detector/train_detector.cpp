@@ -332,6 +332,8 @@ std::string RecipeText(const TrainingOptions& o) {
   if (o.world_distractors != 25) r << " --world-distractors " << o.world_distractors;
   if (o.stage1_rounds > 0) r << " --stage1-rounds " << o.stage1_rounds;
   if (o.calibration_altitude_m > 0) r << " --calibration-altitude " << o.calibration_altitude_m;
+  if (o.close_calibration_altitude_m > 0)
+    r << " --close-calibration-altitude " << o.close_calibration_altitude_m;
   if (o.max_candidates != swarm::VictimDetectorParams{}.max_candidates) r << " --max-candidates " << o.max_candidates;
   if (o.operating_precision > 0) r << " --operating-precision " << o.operating_precision;
   if (o.calibration_seeds != SeedSets(kCalibrationSeedBase, 2)) r << " --calibration-sets " << o.calibration_seeds.size();
@@ -581,6 +583,9 @@ void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::st
   altitude << o.calibration_altitude_m;
   precision << o.operating_precision;
   add(o.calibration_altitude_m > 0, "--calibration-altitude", altitude.str());
+  std::ostringstream close_altitude;
+  close_altitude << o.close_calibration_altitude_m;
+  add(o.close_calibration_altitude_m > 0, "--close-calibration-altitude", close_altitude.str());
   add(o.max_candidates != swarm::VictimDetectorParams{}.max_candidates, "--max-candidates",
       std::to_string(o.max_candidates));
   add(new_seeds, "--calibration-sets", std::to_string(o.calibration_seeds.size()));
@@ -623,6 +628,49 @@ Status ReadCnn(const std::string& path, swarm::VictimDetectorModel* model) {
 
 }  // namespace
 
+namespace {
+
+double MedianScale(const std::vector<Scene>& scenes) {
+  std::vector<double> scales;
+  for (const Scene& s : scenes) scales.push_back(PixelsPerMetre(s));
+  std::nth_element(scales.begin(), scales.begin() + static_cast<std::ptrdiff_t>(scales.size() / 2),
+                   scales.end());
+  return scales[scales.size() / 2];
+}
+
+// The close sigmoid (o.close_calibration_altitude_m > 0; TrainingOptions): fitted as Calibrate
+// fits the first, on the calibration seeds rendered at the close altitude.
+Status CalibrateClose(const std::vector<Scene>& search_calibration, const TrainingOptions& o,
+                      swarm::VictimDetectorModel* model) {
+  model->close_px_per_m = 0;
+  if (o.close_calibration_altitude_m <= 0) return Ok{};
+  if (!(o.calibration_altitude_m >= o.close_calibration_altitude_m + 2 * kCalibrationAltitudeBandM)) {
+    return Error(
+        ErrorCode::kInvalidArgument,
+        "train-detector: --close-calibration-altitude needs --calibration-altitude at least 6 m above it");
+  }
+  TrainingOptions at_close = o;
+  at_close.calibration_altitude_m = o.close_calibration_altitude_m;
+  at_close.operating_precision = 0;
+  Result<std::vector<Scene>> close = RenderCalibrationSets(at_close);
+  if (!close) return close.error();
+  swarm::VictimDetectorModel fitted = *model;
+  TrainingReport figures;
+  if (Status st = Calibrate(*close, at_close, &fitted, &figures); !st) return st.error();
+  model->close_platt_a = fitted.platt_a;
+  model->close_platt_b = fitted.platt_b;
+  model->close_px_per_m = std::sqrt(MedianScale(search_calibration) * MedianScale(*close));
+  std::fprintf(
+      stderr,
+      "train-detector: close sigmoid from %zu scenes at %.0f m (a %.4f, b %.4f) for frames of >= %.2f px/m: "
+      "precision %.4f recall %.4f at 0.5 there\n",
+      close->size(), o.close_calibration_altitude_m, fitted.platt_a, fitted.platt_b, model->close_px_per_m,
+      figures.precision, figures.recall);
+  return Ok{};
+}
+
+}  // namespace
+
 Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const std::string& model_path,
                                                TrainingReport* report) {
   Result<std::shared_ptr<const swarm::VictimDetectorModel>> loaded = swarm::LoadDetectorModel(model_path);
@@ -653,6 +701,7 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
   if (!cal) return cal.error();
   report->calibration_scenes = static_cast<int>(cal->size());
   if (Status st = Calibrate(*cal, o, &model, report); !st) return st.error();
+  SWARMBOX_TRY(CalibrateClose(*cal, o, &model));
   AppendRecalibrationRecipe(o, new_seeds, &model.recipe);
   return model;
 }
@@ -679,15 +728,21 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
       (o.stage1_rounds > 0 && o.blob_features) || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty()) || !swarm::ValidCnnPatchPx(o.cnn_patch_px) ||
       (o.cnn_symmetries != 0 && !swarm::ValidCnnSymmetries(o.cnn_symmetries)) ||
+      o.close_calibration_altitude_m < 0 ||
+      (o.close_calibration_altitude_m > 0 &&
+       !(o.close_calibration_altitude_m > kCalibrationAltitudeBandM &&
+         o.calibration_altitude_m >= o.close_calibration_altitude_m + 2 * kCalibrationAltitudeBandM)) ||
       ((o.view_min_altitude_m != 0 || o.view_max_altitude_m != 0) &&
        !(o.view_min_altitude_m >= 2 && o.view_max_altitude_m > o.view_min_altitude_m))) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
-                 "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, "
-                 "world_sets, world_distractors, stage1_rounds (not with blob features) and "
-                 "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-patch-px is "
-                 "a multiple "
-                 "of 8 in [16, 128], --cnn-symmetries is 1, 4 or 8, --view-altitudes LO,HI has 2 <= LO < HI");
+    return Error(
+        ErrorCode::kInvalidArgument,
+        "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
+        "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, "
+        "world_sets, world_distractors, stage1_rounds (not with blob features) and "
+        "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-patch-px is "
+        "a multiple "
+        "of 8 in [16, 128], --cnn-symmetries is 1, 4 or 8, --close-calibration-altitude is above 3 m and at "
+        "least 6 m under --calibration-altitude, --view-altitudes LO,HI has 2 <= LO < HI");
   }
   if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1 ||
                                 !(o.cnn_hard_fraction >= 0 && o.cnn_hard_fraction < 1))) {
@@ -1178,6 +1233,7 @@ Result<swarm::VictimDetectorModel> Train(const TrainingOptions& o, TrainingRepor
     SWARMBOX_TRY(TrainForestStage(t, *train, s2));
   }
   if (Status st = Calibrate(*cal, o, &t.model, report); !st) return st.error();
+  SWARMBOX_TRY(CalibrateClose(*cal, o, &t.model));
   report->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t.model;
 }

@@ -81,6 +81,11 @@ struct TrainingOptions {
   // altitude, so that the sigmoid is fitted where the detector is used; 0: the training sets'
   // mixed altitudes (8-65 m, the forest recipes').
   double calibration_altitude_m = 0;
+  // When > 0: a second sigmoid, fitted on the calibration seeds rendered again at this altitude
+  // +- kCalibrationAltitudeBandM, for frames finer than the geometric mean of the two sets'
+  // median scales (swarm::VictimDetectorModel::close_px_per_m): the mission's close looks from
+  // 18 m. Needs calibration_altitude_m at least 2 bands above it.
+  double close_calibration_altitude_m = 0;
   // The calibration frames as the renderer draws them, without the painted clutter the training
   // frames get (half of them): the sigmoid is then fitted on the world the detector meets, not on
   // the augmentation (the shipped recipe); false: half the calibration frames painted too (the

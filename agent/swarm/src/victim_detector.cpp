@@ -230,7 +230,7 @@ void VictimDetector::DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn 
     b.centroid_px = CentrePx(c);
     const double u = b.centroid_px.x(), v = b.centroid_px.y();
     b.votes = scores_[k];
-    b.confidence = model_->Probability(b.votes);
+    b.confidence = model_->Probability(b.votes, pixels_per_m);
     if (b.confidence < params_.min_confidence) continue;
     b.linear_score = c.score;
     b.expected_area_px = expected_area;

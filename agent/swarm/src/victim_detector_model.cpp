@@ -156,6 +156,13 @@ double VictimDetectorModel::Probability(double votes) const {
   return 1.0 / (1.0 + std::exp(platt_a * votes + platt_b));
 }
 
+double VictimDetectorModel::Probability(double votes, double pixels_per_m) const {
+  if (close_px_per_m > 0 && pixels_per_m >= close_px_per_m) {
+    return 1.0 / (1.0 + std::exp(close_platt_a * votes + close_platt_b));
+  }
+  return Probability(votes);
+}
+
 namespace {
 
 // The second stage into fs: the forest, or the CNN's ONNX bytes and its patch layout.
@@ -189,6 +196,10 @@ Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& pa
        << "channels" << kChannels;
     fs << "bias" << model.bias << "stage1_threshold" << model.stage1_threshold;
     fs << "platt_a" << model.platt_a << "platt_b" << model.platt_b;
+    if (model.close_px_per_m > 0) {
+      fs << "close_px_per_m" << model.close_px_per_m << "close_platt_a" << model.close_platt_a
+         << "close_platt_b" << model.close_platt_b;
+    }
     std::vector<double> seeds(model.training_seeds.begin(), model.training_seeds.end());
     std::vector<double> cal(model.calibration_seeds.begin(), model.calibration_seeds.end());
     fs << "training_seeds" << seeds << "calibration_seeds" << cal;
@@ -287,6 +298,11 @@ Result<std::shared_ptr<const VictimDetectorModel>> Read(cv::FileStorage& fs, con
   m->stage1_threshold = static_cast<double>(fs["stage1_threshold"]);
   m->platt_a = static_cast<double>(fs["platt_a"]);
   m->platt_b = static_cast<double>(fs["platt_b"]);
+  if (!fs["close_px_per_m"].empty()) {  // optional: a model with one sigmoid has none
+    m->close_px_per_m = static_cast<double>(fs["close_px_per_m"]);
+    m->close_platt_a = static_cast<double>(fs["close_platt_a"]);
+    m->close_platt_b = static_cast<double>(fs["close_platt_b"]);
+  }
   std::vector<double> seeds, cal;
   fs["training_seeds"] >> seeds;
   fs["calibration_seeds"] >> cal;

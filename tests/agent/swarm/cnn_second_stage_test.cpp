@@ -9,17 +9,18 @@
 //   /usr/bin/python3 tools/train_detector/train_cnn.py --test-fixture --seed 1
 //       --out tests/agent/swarm/data/patch_cnn_fixture.onnx   (one command line)
 // (no Python at test time).
+#include <gtest/gtest.h>
+
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <opencv2/dnn.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-#include <opencv2/dnn.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "swarmbox/swarm/candidate_patch.hpp"
 #include "swarmbox/swarm/victim_detector.hpp"
@@ -312,6 +313,49 @@ TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirr
   ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
   EXPECT_FALSE(LoadDetectorModel(path).ok());
   std::remove(path.c_str());
+}
+
+TEST(CnnSecondStage, ACloseSigmoidGivesTheConfidenceOnFramesAtLeastThatFine) {
+  // Given the fixture network with a second sigmoid for frames of >= 20 px/m, saved and loaded.
+  VictimDetectorModel with_cnn = *ShippedDetectorModel();
+  with_cnn.cnn_onnx = ReadBytes(kFixture);
+  with_cnn.cnn_patch_px = kCnnPatchPx;
+  ASSERT_FALSE(with_cnn.cnn_onnx.empty());
+  with_cnn.forest.release();
+  with_cnn.nodes.clear();
+  with_cnn.roots.clear();
+  EXPECT_DOUBLE_EQ(with_cnn.Probability(0.7, 100.0), with_cnn.Probability(0.7));  // none: one sigmoid
+  with_cnn.close_px_per_m = 20.0;
+  with_cnn.close_platt_a = -2.0;
+  with_cnn.close_platt_b = 0.5;
+  const std::string path = ::testing::TempDir() + "/cnn_close_model.yml.gz";
+  ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
+  std::remove(path.c_str());
+  EXPECT_EQ((*loaded)->close_px_per_m, 20.0);
+  EXPECT_EQ((*loaded)->close_platt_a, -2.0);
+  EXPECT_EQ((*loaded)->close_platt_b, 0.5);
+  VictimDetectorParams all;
+  all.min_confidence = 0.0;
+  all.nms_radius_m = 0.0;
+  all.partial_confidence_cap = 1.0;
+  VictimDetector det(*loaded, all);
+  const cv::Mat frame = TestFrame();
+  // When it runs on the frame at the search altitude's 15.5 px/m and at 25 px/m (a close look).
+  for (const double px_per_m : {15.5, 25.0}) {
+    std::vector<ImageBlob> blobs;
+    det.Detect(frame, px_per_m, &blobs);
+    ASSERT_FALSE(blobs.empty()) << px_per_m;
+    // Then the first sigmoid gives the confidences of the coarser frame, the close one those of
+    // the finer.
+    for (const ImageBlob& b : blobs) {
+      const double first = 1.0 / (1.0 + std::exp(with_cnn.platt_a * b.votes + with_cnn.platt_b));
+      const double close = 1.0 / (1.0 + std::exp(-2.0 * b.votes + 0.5));
+      EXPECT_NEAR(b.confidence, px_per_m < 20.0 ? first : close, 1e-12) << px_per_m;
+      EXPECT_GT(std::abs(first - close), 1e-6);
+    }
+  }
 }
 
 }  // namespace

@@ -102,6 +102,14 @@ struct VictimDetectorModel {
   int blob_features = 0;           // 0 (format 1) or kBlobFeatures, after the kForestFeatures
   double platt_a = -8.0;           // p = 1 / (1 + exp(platt_a * votes + platt_b))
   double platt_b = 4.0;
+  // A second sigmoid for frames at least close_px_per_m fine on the ground (0: none, one sigmoid
+  // for every frame): the mission's close looks (revisits from 18 m) see a candidate at another
+  // scale, against other pixels, and the network's scores there mean other odds than at the
+  // search altitude the first sigmoid was fitted at (the trainer's --close-calibration-altitude;
+  // optional in the file).
+  double close_px_per_m = 0;
+  double close_platt_a = 0;
+  double close_platt_b = 0;
   std::vector<std::uint64_t> training_seeds;     // scene-set seeds the forest was trained on
   std::vector<std::uint64_t> calibration_seeds;  // scene-set seeds the sigmoid was fitted on
   std::string recipe;  // the trainer's options, as its command line (the model's provenance)
@@ -131,6 +139,9 @@ struct VictimDetectorModel {
   // Linear weights over kWindowFeatures in feature order (for training: folded into kernels).
   void SetLinear(const std::vector<double>& weights, double bias);
   double Probability(double votes) const;
+  // The same for a detection on a frame of `pixels_per_m`: the close sigmoid when the model has one
+  // and the frame is at least close_px_per_m fine.
+  double Probability(double votes, double pixels_per_m) const;
 };
 
 Status SaveDetectorModel(const VictimDetectorModel& model, const std::string& path);
