@@ -630,6 +630,13 @@ Status ReadCnn(const std::string& path, swarm::VictimDetectorModel* model) {
 
 namespace {
 
+// No close sigmoid, or one whose calibration band lies wholly under the first's.
+bool CloseCalibrationOk(const TrainingOptions& o) {
+  return o.close_calibration_altitude_m == 0 ||
+         (o.close_calibration_altitude_m > kCalibrationAltitudeBandM &&
+          o.calibration_altitude_m >= o.close_calibration_altitude_m + 2 * kCalibrationAltitudeBandM);
+}
+
 double MedianScale(const std::vector<Scene>& scenes) {
   std::vector<double> scales;
   for (const Scene& s : scenes) scales.push_back(PixelsPerMetre(s));
@@ -644,10 +651,10 @@ Status CalibrateClose(const std::vector<Scene>& search_calibration, const Traini
                       swarm::VictimDetectorModel* model) {
   model->close_px_per_m = 0;
   if (o.close_calibration_altitude_m <= 0) return Ok{};
-  if (!(o.calibration_altitude_m >= o.close_calibration_altitude_m + 2 * kCalibrationAltitudeBandM)) {
-    return Error(
-        ErrorCode::kInvalidArgument,
-        "train-detector: --close-calibration-altitude needs --calibration-altitude at least 6 m above it");
+  if (!CloseCalibrationOk(o)) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "train-detector: --close-calibration-altitude must be above 3 m "
+                 "and at least 6 m under --calibration-altitude");
   }
   TrainingOptions at_close = o;
   at_close.calibration_altitude_m = o.close_calibration_altitude_m;
@@ -727,11 +734,7 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
       o.world_sets < 0 || o.world_distractors < 0 || o.stage1_rounds < 0 ||
       (o.stage1_rounds > 0 && o.blob_features) || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty()) || !swarm::ValidCnnPatchPx(o.cnn_patch_px) ||
-      (o.cnn_symmetries != 0 && !swarm::ValidCnnSymmetries(o.cnn_symmetries)) ||
-      o.close_calibration_altitude_m < 0 ||
-      (o.close_calibration_altitude_m > 0 &&
-       !(o.close_calibration_altitude_m > kCalibrationAltitudeBandM &&
-         o.calibration_altitude_m >= o.close_calibration_altitude_m + 2 * kCalibrationAltitudeBandM)) ||
+      (o.cnn_symmetries != 0 && !swarm::ValidCnnSymmetries(o.cnn_symmetries)) || !CloseCalibrationOk(o) ||
       ((o.view_min_altitude_m != 0 || o.view_max_altitude_m != 0) &&
        !(o.view_min_altitude_m >= 2 && o.view_max_altitude_m > o.view_min_altitude_m))) {
     return Error(

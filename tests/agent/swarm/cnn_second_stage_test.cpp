@@ -324,7 +324,8 @@ TEST(CnnSecondStage, ACloseSigmoidGivesTheConfidenceOnFramesAtLeastThatFine) {
   with_cnn.forest.release();
   with_cnn.nodes.clear();
   with_cnn.roots.clear();
-  EXPECT_DOUBLE_EQ(with_cnn.Probability(0.7, 100.0), with_cnn.Probability(0.7));  // none: one sigmoid
+  with_cnn.close_px_per_m = 0;  // none: one sigmoid for every frame
+  EXPECT_DOUBLE_EQ(with_cnn.Probability(0.7, 100.0), with_cnn.Probability(0.7));
   with_cnn.close_px_per_m = 20.0;
   with_cnn.close_platt_a = -2.0;
   with_cnn.close_platt_b = 0.5;
