@@ -1289,7 +1289,12 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
   j << "  \"stage2\": {\"positives\": " << r.stage2_positives << ", \"negatives\": " << r.stage2_negatives
     << ", \"balance_classes\": " << (o.balance_classes ? "true" : "false") << ", \"hard_negative_rounds\": "
     << o.hard_negative_rounds << ", \"hard_negatives\": " << r.stage2_hard_negatives << ", \"trees\": " << o.forest_trees << ", \"max_depth\": " << o.forest_depth << "},\n";
-  j << "  \"platt\": {\"a\": " << model.platt_a << ", \"b\": " << model.platt_b << "},\n";
+  j << "  \"platt\": {\"a\": " << model.platt_a << ", \"b\": " << model.platt_b;
+  if (model.close_px_per_m > 0) {  // on the same line: a recalibration's report takes it with the first
+    j << ", \"close\": {\"a\": " << model.close_platt_a << ", \"b\": " << model.close_platt_b
+      << ", \"from_px_per_m\": " << model.close_px_per_m << "}";
+  }
+  j << "},\n";
   j << "  \"calibration_figures\": {\"persons_at_least_half_visible\": " << r.calibration_persons
     << ", \"detections_labelled\": " << r.calibration_detections << ", \"tp_at_0.5\": " << r.calibration_tp
     << ", \"fp_at_0.5\": " << r.calibration_fp << ", \"precision_at_0.5\": " << r.precision
