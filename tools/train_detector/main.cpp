@@ -17,7 +17,7 @@
 //   default 25), --stage1-rounds N (stage 1's hard negatives), --calibration-altitude M
 //   (calibration frames at M +- 3 m; with --recalibrate: refit the sigmoid there),
 //   --close-calibration-altitude M (a second sigmoid, fitted at M +- 3 m, for finer frames: close
-//   looks), --calibration-sets N
+//   looks; --recalibrate without it drops a model's), --calibration-sets N
 //   (calibration seeds 7100001..7100000+N; default 2), --clean-calibration (no painted clutter on the
 //   calibration frames), --max-candidates N
 //   (the first stage's cap while calibrating and mining), --operating-precision P (probability 0.5

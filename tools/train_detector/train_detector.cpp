@@ -573,8 +573,17 @@ Status Calibrate(const std::vector<Scene>& calibration, const TrainingOptions& o
 
 namespace {
 
+// `flag` (" --name ") and its value out of the recipe, when it names them.
+void EraseFlag(const std::string& flag, std::string* recipe) {
+  if (const std::size_t at = recipe->find(flag); at != std::string::npos) {
+    const std::size_t end = recipe->find(' ', at + flag.size());
+    recipe->erase(at, end == std::string::npos ? std::string::npos : end - at);
+  }
+}
+
 // The recalibration's options that the model's recipe does not name yet, appended to it (the
-// calibration's altitude band, the cap, new calibration sets, clean frames, the operating point).
+// calibration's altitude band, the cap, new calibration sets, clean frames, the operating point);
+// the close sigmoid's and the symmetries' replace what it names.
 void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::string* recipe) {
   auto add = [recipe](bool wanted, const std::string& flag, const std::string& value) {
     if (wanted && recipe->find(flag) == std::string::npos) *recipe += " " + flag + (value.empty() ? "" : " " + value);
@@ -583,6 +592,7 @@ void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::st
   altitude << o.calibration_altitude_m;
   precision << o.operating_precision;
   add(o.calibration_altitude_m > 0, "--calibration-altitude", altitude.str());
+  EraseFlag(" --close-calibration-altitude ", recipe);  // refitted below, or dropped (CalibrateClose)
   std::ostringstream close_altitude;
   close_altitude << o.close_calibration_altitude_m;
   add(o.close_calibration_altitude_m > 0, "--close-calibration-altitude", close_altitude.str());
@@ -593,12 +603,8 @@ void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::st
   add(o.operating_precision > 0, "--operating-precision", precision.str());
   add(!o.replace_cnn.empty(), "--replace-cnn", o.replace_cnn.substr(o.replace_cnn.find_last_of('/') + 1));
   if (o.cnn_symmetries > 0) {  // the new count replaces one the recipe named
-    const std::string flag = " --cnn-symmetries ";
-    if (const std::size_t at = recipe->find(flag); at != std::string::npos) {
-      const std::size_t end = recipe->find(' ', at + flag.size());
-      recipe->erase(at, end == std::string::npos ? std::string::npos : end - at);
-    }
-    *recipe += flag + std::to_string(o.cnn_symmetries);
+    EraseFlag(" --cnn-symmetries ", recipe);
+    *recipe += " --cnn-symmetries " + std::to_string(o.cnn_symmetries);
   }
 }
 
@@ -646,7 +652,8 @@ double MedianScale(const std::vector<Scene>& scenes) {
 }
 
 // The close sigmoid (o.close_calibration_altitude_m > 0; TrainingOptions): fitted as Calibrate
-// fits the first, on the calibration seeds rendered at the close altitude.
+// fits the first, on the calibration seeds rendered at the close altitude. Without the option a
+// recalibrated model has none (one fitted to its scores before would not be refitted).
 Status CalibrateClose(const std::vector<Scene>& search_calibration, const TrainingOptions& o,
                       swarm::VictimDetectorModel* model) {
   model->close_px_per_m = 0;
@@ -742,10 +749,9 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
         "train-detector: stage1_percentile must be in [0, 100), trees and max_negatives >= 1, "
         "max_candidates >= 1, operating_precision in [0, 1), hard_negative_rounds, negatives_sets, "
         "world_sets, world_distractors, stage1_rounds (not with blob features) and "
-        "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-patch-px is "
-        "a multiple "
-        "of 8 in [16, 128], --cnn-symmetries is 1, 4 or 8, --close-calibration-altitude is above 3 m and at "
-        "least 6 m under --calibration-altitude, --view-altitudes LO,HI has 2 <= LO < HI");
+        "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-symmetries is 1, 4 "
+        "or 8, --close-calibration-altitude is above 3 m and at least 6 m under --calibration-altitude, "
+        "--cnn-patch-px is a multiple of 8 in [16, 128], --view-altitudes LO,HI has 2 <= LO < HI");
   }
   if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1 ||
                                 !(o.cnn_hard_fraction >= 0 && o.cnn_hard_fraction < 1))) {
