@@ -68,6 +68,27 @@ std::vector<float> Logits(cv::dnn::Net& net, const std::vector<cv::Mat>& patches
   return std::vector<float>(out.ptr<float>(), out.ptr<float>() + out.total());
 }
 
+// The shipped first stage with the fixture network as its second stage (its 32 px patches,
+// whatever the shipped model's); no cnn_onnx when the fixture file is missing.
+VictimDetectorModel FixtureModel() {
+  VictimDetectorModel m = *ShippedDetectorModel();
+  m.cnn_onnx = ReadBytes(kFixture);
+  m.cnn_patch_px = kCnnPatchPx;
+  m.forest.release();
+  m.nodes.clear();
+  m.roots.clear();
+  return m;
+}
+
+// Every candidate kept: no threshold, suppression or partial-view cap.
+VictimDetectorParams EveryCandidate() {
+  VictimDetectorParams all;
+  all.min_confidence = 0.0;
+  all.nms_radius_m = 0.0;
+  all.partial_confidence_cap = 1.0;
+  return all;
+}
+
 // A seeded 320 x 240 frame: textured ground and a few coloured rectangles and discs.
 cv::Mat TestFrame() {
   std::mt19937 rng(19);
@@ -202,13 +223,8 @@ TEST(CnnSecondStage, CvDnnGivesTorchsLogitsForTheFixtureNetwork) {
 
 TEST(CnnSecondStage, AModelWithACnnRoundTripsAndScoresEachCandidateByItsPatch) {
   // Given the shipped first stage with the fixture network as its second stage, saved and loaded.
-  VictimDetectorModel with_cnn = *ShippedDetectorModel();
-  with_cnn.cnn_onnx = ReadBytes(kFixture);
-  with_cnn.cnn_patch_px = kCnnPatchPx;  // the fixture network's, whatever the shipped model's
-  ASSERT_FALSE(with_cnn.cnn_onnx.empty());
-  with_cnn.forest.release();
-  with_cnn.nodes.clear();
-  with_cnn.roots.clear();
+  VictimDetectorModel with_cnn = FixtureModel();
+  ASSERT_FALSE(with_cnn.cnn_onnx.empty()) << kFixture;
   const std::string path = ::testing::TempDir() + "/cnn_model.yml.gz";
   ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
   Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
@@ -217,11 +233,8 @@ TEST(CnnSecondStage, AModelWithACnnRoundTripsAndScoresEachCandidateByItsPatch) {
   EXPECT_EQ((*loaded)->cnn_onnx, with_cnn.cnn_onnx);
   EXPECT_TRUE((*loaded)->forest.empty());
   EXPECT_EQ((*loaded)->stage1_threshold, with_cnn.stage1_threshold);
-  // When the detector runs it on a frame (every candidate kept: no threshold, suppression or cap).
-  VictimDetectorParams all;
-  all.min_confidence = 0.0;
-  all.nms_radius_m = 0.0;
-  all.partial_confidence_cap = 1.0;
+  // When the detector runs it on a frame (every candidate kept).
+  const VictimDetectorParams all = EveryCandidate();
   VictimDetector det(*loaded, all);
   const cv::Mat frame = TestFrame();
   constexpr double kPxPerM = 15.5;
@@ -256,20 +269,12 @@ cv::Mat Turned(const cv::Mat& patch, int turns) {
 }
 
 TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirrorImages) {
-  VictimDetectorModel with_cnn = *ShippedDetectorModel();
-  with_cnn.cnn_onnx = ReadBytes(kFixture);
-  with_cnn.cnn_patch_px = kCnnPatchPx;  // the fixture network's, whatever the shipped model's
-  ASSERT_FALSE(with_cnn.cnn_onnx.empty());
-  with_cnn.forest.release();
-  with_cnn.nodes.clear();
-  with_cnn.roots.clear();
+  VictimDetectorModel with_cnn = FixtureModel();
+  ASSERT_FALSE(with_cnn.cnn_onnx.empty()) << kFixture;
   cv::dnn::Net net = cv::dnn::readNetFromONNX(reinterpret_cast<const char*>(with_cnn.cnn_onnx.data()),
                                               with_cnn.cnn_onnx.size());
   const std::string path = ::testing::TempDir() + "/cnn_symmetries_model.yml.gz";
-  VictimDetectorParams all;
-  all.min_confidence = 0.0;
-  all.nms_radius_m = 0.0;
-  all.partial_confidence_cap = 1.0;
+  const VictimDetectorParams all = EveryCandidate();
   const cv::Mat frame = TestFrame();
   constexpr double kPxPerM = 15.5;
   for (const int symmetries : {4, 8}) {
@@ -317,13 +322,8 @@ TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirr
 
 TEST(CnnSecondStage, ACloseSigmoidGivesTheConfidenceOnFramesAtLeastThatFine) {
   // Given the fixture network with a second sigmoid for frames of >= 20 px/m, saved and loaded.
-  VictimDetectorModel with_cnn = *ShippedDetectorModel();
-  with_cnn.cnn_onnx = ReadBytes(kFixture);
-  with_cnn.cnn_patch_px = kCnnPatchPx;
-  ASSERT_FALSE(with_cnn.cnn_onnx.empty());
-  with_cnn.forest.release();
-  with_cnn.nodes.clear();
-  with_cnn.roots.clear();
+  VictimDetectorModel with_cnn = FixtureModel();
+  ASSERT_FALSE(with_cnn.cnn_onnx.empty()) << kFixture;
   with_cnn.close_px_per_m = 0;  // none: one sigmoid for every frame
   EXPECT_DOUBLE_EQ(with_cnn.Probability(0.7, 100.0), with_cnn.Probability(0.7));
   with_cnn.close_px_per_m = 20.0;
@@ -337,10 +337,7 @@ TEST(CnnSecondStage, ACloseSigmoidGivesTheConfidenceOnFramesAtLeastThatFine) {
   EXPECT_EQ((*loaded)->close_px_per_m, 20.0);
   EXPECT_EQ((*loaded)->close_platt_a, -2.0);
   EXPECT_EQ((*loaded)->close_platt_b, 0.5);
-  VictimDetectorParams all;
-  all.min_confidence = 0.0;
-  all.nms_radius_m = 0.0;
-  all.partial_confidence_cap = 1.0;
+  const VictimDetectorParams all = EveryCandidate();
   VictimDetector det(*loaded, all);
   const cv::Mat frame = TestFrame();
   // When it runs on the frame at the search altitude's 15.5 px/m and at 25 px/m (a close look).
