@@ -152,15 +152,18 @@ double VictimDetectorModel::Votes(const float* x) const {
   return person / static_cast<double>(roots.size());
 }
 
-double VictimDetectorModel::Probability(double votes) const {
-  return 1.0 / (1.0 + std::exp(platt_a * votes + platt_b));
-}
+namespace {
+
+// Platt's sigmoid: 1 / (1 + exp(a votes + b)).
+double Platt(double a, double b, double votes) { return 1.0 / (1.0 + std::exp(a * votes + b)); }
+
+}  // namespace
+
+double VictimDetectorModel::Probability(double votes) const { return Platt(platt_a, platt_b, votes); }
 
 double VictimDetectorModel::Probability(double votes, double pixels_per_m) const {
-  if (close_px_per_m > 0 && pixels_per_m >= close_px_per_m) {
-    return 1.0 / (1.0 + std::exp(close_platt_a * votes + close_platt_b));
-  }
-  return Probability(votes);
+  const bool close = close_px_per_m > 0 && pixels_per_m >= close_px_per_m;
+  return close ? Platt(close_platt_a, close_platt_b, votes) : Probability(votes);
 }
 
 namespace {
