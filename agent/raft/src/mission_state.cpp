@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "swarmbox/raft/detail/byte_io.hpp"
 #include "swarmbox/raft/detail/mission_io.hpp"
@@ -90,9 +91,17 @@ void MissionState::AddView(Candidate& c, SightingView v) {
     ++c.revisits;
   }
   c.views.push_back(std::move(v));
+  // The position comes from the closest looks only: a geolocation's error grows with the camera's
+  // height, and a detector that fires from 30 m on a heap beside the person would otherwise pull
+  // the drop point metres off (see kCloseLookBand).
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const SightingView& e : c.views) {
+    if (e.detected) lowest = std::min(lowest, e.viewer_height_m);
+  }
+  const double band = lowest + (kCloseLookBand - 1) * std::max(lowest, 0.0);
   double w = 0, x = 0, y = 0;
   for (const SightingView& e : c.views) {
-    if (!e.detected) continue;
+    if (!e.detected || e.viewer_height_m > band) continue;
     w += e.confidence;
     x += e.confidence * e.x_m;
     y += e.confidence * e.y_m;

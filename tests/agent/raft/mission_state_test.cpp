@@ -101,6 +101,27 @@ TEST_F(MissionStateTest, SightingsGatherIntoCandidatesAndNoneConfirmsByItself) {
   EXPECT_EQ(m_.victims()[0].confirmed_by.size(), 3u);
 }
 
+// A candidate's position comes from its closest looks: a 30 m detection of the heap beside the
+// person does not pull the drop point off once an 18 m look has found the person.
+TEST_F(MissionStateTest, ACandidatesPositionComesFromItsClosestLooks) {
+  Do(StartSearch{});
+  Do(ReportSighting{"scout_1", 1, 33.8, 15.0, 0.90, 30, 5, 30, 10.0});  // the heap, from 30 m
+  EXPECT_DOUBLE_EQ(m_.FindCandidate(1)->x_m, 33.8);
+  Do(ReportSighting{"scout_2", 1, 29.0, 15.2, 0.70, 29, 10, 18, 40.0});  // the person, from 18 m
+  EXPECT_DOUBLE_EQ(m_.FindCandidate(1)->x_m, 29.0);
+  EXPECT_DOUBLE_EQ(m_.FindCandidate(1)->y_m, 15.2);
+  // Later search views from 30 m join the evidence but not the position; looks within 1.25 x
+  // the lowest height (here 22.5 m) are averaged by confidence.
+  Do(ReportSighting{"scout_1", 2, 32.0, 15.0, 0.95, 30, 5, 30, 50.0});
+  EXPECT_DOUBLE_EQ(m_.FindCandidate(1)->x_m, 29.0);
+  Do(ReportSighting{"scout_3", 1, 30.0, 15.0, 0.80, 30, 10, 22, 60.0});
+  EXPECT_DOUBLE_EQ(m_.FindCandidate(1)->x_m, (0.7 * 29.0 + 0.8 * 30.0) / (0.7 + 0.8));
+  // A miss is evidence, not a place: it moves nothing.
+  Do(ReportMiss{"scout_2", 2, 1, 29, 10, 10, 70.0});
+  EXPECT_DOUBLE_EQ(m_.FindCandidate(1)->x_m, (0.7 * 29.0 + 0.8 * 30.0) / (0.7 + 0.8));
+  EXPECT_EQ(m_.FindCandidate(1)->views.size(), 5u);
+}
+
 // A revisit handed to another drone (the first gone or too slow) counts the abandoned one, so a
 // spot nobody reaches runs out of revisits instead of being revisited for ever.
 TEST_F(MissionStateTest, ARevisitHandedToAnotherDroneCountsTheAbandonedOne) {

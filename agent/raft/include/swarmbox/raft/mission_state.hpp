@@ -17,7 +17,8 @@
 //     confirmed victim is that victim (its reporter joins confirmed_by);
 //   - otherwise it is a view of the nearest candidate within kConfirmRadiusM (pending or
 //     rejected), or it opens a new candidate (ids count up from 1). A candidate's position is the
-//     confidence-weighted mean of its detections; it keeps at most kMaxViews pieces of evidence;
+//     confidence-weighted mean of its closest detections (those from a camera height within
+//     kCloseLookBand of the lowest); it keeps at most kMaxViews pieces of evidence;
 //   - ReportMiss: a revisit saw nothing where the candidate is (evidence against it);
 //   - RequestRevisit: the leader sends a drone to look again; the drone's next view or miss of
 //     that candidate completes the revisit (revisits counts them); a request that replaces one
@@ -114,6 +115,12 @@ class MissionState {
  public:
   static constexpr double kMinConfidence = 0.5;
   static constexpr double kConfirmRadiusM = 5.0;
+  // A candidate's position averages the detections from at most 1.25 x the lowest camera height
+  // among them: the scouts search from 30 m and the revisits look from 18 m (swarm/sar_brain.hpp),
+  // and a geolocation's error grows in proportion to the height (a pixel covers height / focal
+  // length on the ground; an attitude error a moves the point by height * tan a), so a look from
+  // 18 m places the person 0.6 as far off as one from 30 m.
+  static constexpr double kCloseLookBand = 1.25;
   static constexpr std::size_t kMaxCandidates = 64;
   static constexpr std::size_t kMaxViews = 24;  // evidence per candidate; more is rejected
   static constexpr std::uint8_t kSnapshotVersion = 2;
