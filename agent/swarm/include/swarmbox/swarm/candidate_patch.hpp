@@ -14,8 +14,10 @@
 // resolution at the 30 m search altitude (640 px over 1.204 rad: 15.5 px/m) and finer than it above 44 m.
 // Sampling: bilinear, the frame's border replicated; a frame finer than kCnnPxPerM is first shrunk
 // to it by area averaging (once per frame), so a patch never aliases.
-// A model with finer patches (VictimDetectorModel::cnn_patch_px, e.g. 48 px: 16 px/m, for frames
-// from low down) samples the same 3 x 3 m at patch_px / kCnnPatchM px/m.
+// A model with finer patches (VictimDetectorModel::cnn_patch_px) samples the same 3 x 3 m at
+// patch_px / kCnnPatchM px/m. The shipped model's are 48 px (16 px/m, the camera's own resolution
+// at 30 m: tools/train_detector README "Patches at the camera's resolution"); kCnnPatchPx is the
+// default of a model file without the field.
 #pragma once
 
 #include <Eigen/Core>

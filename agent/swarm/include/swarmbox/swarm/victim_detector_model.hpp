@@ -89,9 +89,9 @@ struct VictimDetectorModel {
   // kCnnPatchPx x kCnnPatchPx BGR patches (N x 3 x H x W, (pixel - kCnnInputMean) * kCnnInputScale)
   // to one logit per patch (> 0: person). It replaces the forest; the sigmoid then maps the logit.
   std::vector<std::uint8_t> cnn_onnx;
-  // Its patches' side [px] over kCnnPatchM (ValidCnnPatchPx): kCnnPatchPx (10.7 px/m), the
-  // shipped model's; a finer one (the trainer's --cnn-patch-px, e.g. 48: 16 px/m) for a model of
-  // low views (BENCHMARKS.md "Perception: the close look": tried, not shipped).
+  // Its patches' side [px] over kCnnPatchM (ValidCnnPatchPx; the trainer's --cnn-patch-px): the
+  // shipped model's 48 (16 px/m, the camera's resolution at the 30 m search altitude); kCnnPatchPx
+  // (10.7 px/m) in a file without the field.
   int cnn_patch_px = kCnnPatchPx;
   // Of the square's 8 symmetries (turns by 90 degrees, mirrored), how many of each patch the CNN
   // scores, its logits averaged (test-time augmentation; ValidCnnSymmetries: 1, 4 or 8). The
