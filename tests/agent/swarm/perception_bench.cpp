@@ -189,13 +189,16 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
 // the nadir, FusionParams' in-view rule for a miss): detector_recall, the share of frames with a
 // person there (any part visible) that detect it at >= 0.5, and false_repeat, the share of frames
 // with a false alarm's place there (a place where one fired: false alarms within 1.5 m are one
-// place) that fire there again. --crops DIR writes each victim's best view (the frame where it was
-// most visible, nearest the nadir) as DIR/<victim id>.png, 128 px around it.
+// place) that fire there again; and the same recall on the close looks' frames alone (at most
+// kCloseLookM up: close_recall, frames_close per victim). --crops DIR writes each victim's best view (the
+// frame where it was most visible, nearest the nadir) as DIR/<victim id>.png, 128 px around it.
 struct ReplayVictim {
   int frames_half_visible = 0;
   int frames_detected = 0;
   int frames_in_view = 0;           // within 5 m of the nadir, 10-40 m up, any part visible
   int frames_in_view_detected = 0;
+  int frames_close = 0;  // ... of those, from at most kCloseLookM up (a revisit's look)
+  int frames_close_detected = 0;
   double max_confidence = 0.0;
   double nearest_nadir_m = 1e9;
   double max_visible = 0.0;
@@ -213,6 +216,9 @@ struct ReplayView {
 
 constexpr double kMissInViewM = FusionParams{}.miss_in_view_m;
 constexpr double kMatchM = 1.5;
+// The SAR brain's close look (agent/app sar_brain.hpp: fusion close_look_height_m 21, a revisit
+// looks from 18 m): frames from at most this high count as close looks too.
+constexpr double kCloseLookM = 21.0;
 
 std::string LookOf(const swarmbox::physics::Victim& v) {
   char look[96];
@@ -263,6 +269,10 @@ class ReplayScore {
       if (InView(views_.back(), s.victims[i].position_m) && s.victims[i].visible_fraction > 0) {
         ++victims_[i].frames_in_view;
         victims_[i].frames_in_view_detected += matched[i] ? 1 : 0;
+        if (s.altitude_m <= kCloseLookM) {
+          ++victims_[i].frames_close;
+          victims_[i].frames_close_detected += matched[i] ? 1 : 0;
+        }
       }
     }
   }
@@ -274,10 +284,18 @@ class ReplayScore {
                   .Add("recall", persons_ ? static_cast<double>(tp_) / persons_ : 1.0, 4).str().c_str());
     for (std::size_t i = 0; i < victims_.size() && i < world.victims.size(); ++i) {
       const ReplayVictim& rv = victims_[i];
-      std::puts(Line("replay_victim").Add("victim", world.victims[i].id).Add("look", LookOf(world.victims[i]))
-                    .Add("frames_half_visible", rv.frames_half_visible).Add("frames_detected", rv.frames_detected)
-                    .Add("max_confidence", rv.max_confidence, 3).Add("max_visible", rv.max_visible, 2)
-                    .Add("nearest_nadir_m", rv.nearest_nadir_m, 1).str().c_str());
+      std::puts(Line("replay_victim")
+                    .Add("victim", world.victims[i].id)
+                    .Add("look", LookOf(world.victims[i]))
+                    .Add("frames_half_visible", rv.frames_half_visible)
+                    .Add("frames_detected", rv.frames_detected)
+                    .Add("frames_close", rv.frames_close)
+                    .Add("frames_close_detected", rv.frames_close_detected)
+                    .Add("max_confidence", rv.max_confidence, 3)
+                    .Add("max_visible", rv.max_visible, 2)
+                    .Add("nearest_nadir_m", rv.nearest_nadir_m, 1)
+                    .str()
+                    .c_str());
       if (!crops_.empty() && !rv.best_crop.empty()) cv::imwrite(crops_ + "/" + world.victims[i].id + ".png", rv.best_crop);
     }
     for (const auto& [site, n] : false_sites_) {
@@ -351,10 +369,12 @@ class ReplayScore {
 
   // detector_recall and false_repeat as the mission meets them (the comment above ReplayVictim).
   void PrintFusion() const {
-    int person_views = 0, person_hits = 0;
+    int person_views = 0, person_hits = 0, close_views = 0, close_hits = 0;
     for (const ReplayVictim& rv : victims_) {
       person_views += rv.frames_in_view;
       person_hits += rv.frames_in_view_detected;
+      close_views += rv.frames_close;
+      close_hits += rv.frames_close_detected;
     }
     std::vector<Eigen::Vector2d> places;
     for (const ReplayView& v : views_) {
@@ -373,12 +393,20 @@ class ReplayScore {
                                   [&](const Eigen::Vector2d& g) { return (p - g).norm() <= kMatchM; }) ? 1 : 0;
       }
     }
-    std::puts(Line("replay_fusion").Add("person_views", person_views).Add("person_detected", person_hits)
-                  .Add("detector_recall", person_views ? static_cast<double>(person_hits) / person_views : 0.0, 4)
-                  .Add("false_places", static_cast<std::int64_t>(places.size())).Add("false_place_views", place_views)
-                  .Add("false_place_fired", place_hits)
-                  .Add("false_repeat", place_views ? static_cast<double>(place_hits) / place_views : 0.0, 4)
-                  .str().c_str());
+    std::puts(
+        Line("replay_fusion")
+            .Add("person_views", person_views)
+            .Add("person_detected", person_hits)
+            .Add("detector_recall", person_views ? static_cast<double>(person_hits) / person_views : 0.0, 4)
+            .Add("close_views", close_views)
+            .Add("close_detected", close_hits)
+            .Add("close_recall", close_views ? static_cast<double>(close_hits) / close_views : 0.0, 4)
+            .Add("false_places", static_cast<std::int64_t>(places.size()))
+            .Add("false_place_views", place_views)
+            .Add("false_place_fired", place_hits)
+            .Add("false_repeat", place_views ? static_cast<double>(place_hits) / place_views : 0.0, 4)
+            .str()
+            .c_str());
   }
 
   VictimDetector& detector_;
