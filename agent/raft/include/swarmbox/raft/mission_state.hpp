@@ -116,7 +116,7 @@ class MissionState {
   static constexpr double kMinConfidence = 0.5;
   static constexpr double kConfirmRadiusM = 5.0;
   // A candidate's position averages the detections from at most 1.25 x the lowest camera height
-  // among them: the scouts search from 30 m and the revisits look from 18 m (swarm/sar_brain.hpp),
+  // among them: the scouts search from 30 m and the revisits look from 18 m (agent/app/sar_brain.hpp),
   // and a geolocation's error grows in proportion to the height (a pixel covers height / focal
   // length on the ground; an attitude error a moves the point by height * tan a), so a look from
   // 18 m places the person 0.6 as far off as one from 30 m.
