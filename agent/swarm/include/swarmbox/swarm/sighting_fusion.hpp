@@ -107,9 +107,9 @@ struct FusionParams {
   // The detector's recall from the look altitude, per look (a look is 2 s, ~4 frames): an
   // assumption over the 0.74 per frame (precision 0.93) measured at 18 m on the rubble fields
   // (`swarmbox-bench perception --seed 1 --only world:1 --world-altitude 18`); the 48 px model
-  // with its close sigmoid gives 0.81 there (precision 0.85), but on the mission's own close
-  // frames of four rubble20 trials with misses 25 of 49 (`--replay RUN`, close_recall): to be
-  // measured over all 20 and set from that (BENCHMARKS.md "Perception: the 48 px network ships").
+  // with its close sigmoid gives 0.81 there (precision 0.85), and on the mission's own close
+  // frames 0.66 (rubble20, 142 of 215: `--replay RUN`, close_recall); per look (correlated
+  // frames) it is higher, not measured yet (BENCHMARKS.md "Perception: the 48 px network ships").
   double close_recall = 0.9;
   // ... and its chance to fire on what the search model fired on: an assumption (not measured yet).
   double close_false_repeat = 0.05;
