@@ -643,6 +643,8 @@ bool CloseCalibrationOk(const TrainingOptions& o) {
           o.calibration_altitude_m >= o.close_calibration_altitude_m + 2 * kCalibrationAltitudeBandM);
 }
 
+Status CheckTrainingOptions(const TrainingOptions& o);  // below, with the training's other checks
+
 double MedianScale(const std::vector<Scene>& scenes) {
   std::vector<double> scales;
   for (const Scene& s : scenes) scales.push_back(PixelsPerMetre(s));
@@ -651,18 +653,14 @@ double MedianScale(const std::vector<Scene>& scenes) {
   return scales[scales.size() / 2];
 }
 
-// The close sigmoid (o.close_calibration_altitude_m > 0; TrainingOptions): fitted as Calibrate
-// fits the first, on the calibration seeds rendered at the close altitude. Without the option a
+// The close sigmoid (o.close_calibration_altitude_m > 0, CloseCalibrationOk checked by
+// CheckTrainingOptions; TrainingOptions): fitted as Calibrate fits the first, on the calibration
+// seeds rendered at the close altitude. Without the option a
 // recalibrated model has none (one fitted to its scores before would not be refitted).
 Status CalibrateClose(const std::vector<Scene>& search_calibration, const TrainingOptions& o,
                       swarm::VictimDetectorModel* model) {
   model->close_px_per_m = 0;
   if (o.close_calibration_altitude_m <= 0) return Ok{};
-  if (!CloseCalibrationOk(o)) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "train-detector: --close-calibration-altitude must be above 3 m "
-                 "and at least 6 m under --calibration-altitude");
-  }
   TrainingOptions at_close = o;
   at_close.calibration_altitude_m = o.close_calibration_altitude_m;
   at_close.operating_precision = 0;
@@ -687,6 +685,7 @@ Status CalibrateClose(const std::vector<Scene>& search_calibration, const Traini
 
 Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const std::string& model_path,
                                                TrainingReport* report) {
+  SWARMBOX_TRY(CheckTrainingOptions(o));  // before the model is read or a frame rendered
   Result<std::shared_ptr<const swarm::VictimDetectorModel>> loaded = swarm::LoadDetectorModel(model_path);
   if (!loaded) return loaded.error();
   swarm::VictimDetectorModel model = **loaded;

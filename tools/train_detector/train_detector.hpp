@@ -204,7 +204,8 @@ struct TrainingReport {
 Result<swarm::VictimDetectorModel> Train(const TrainingOptions& options, TrainingReport* report);
 
 // Steps 4-5 again on a trained model (its first stage and forest kept): for a calibration fix
-// without retraining. The model must name the same calibration seeds.
+// without retraining. The model must name the same calibration seeds. The options are checked as
+// Train checks them, before the model is read.
 Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& options, const std::string& model_path,
                                                TrainingReport* report);
 
