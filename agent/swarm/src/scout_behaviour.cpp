@@ -65,10 +65,24 @@ ScoutBehaviour::ScoutBehaviour(ScoutConfig config)
 
 void ScoutBehaviour::Enter(Stage stage, const MissionInput& in, MissionOutput* out) {
   if (stage == stage_) return;
+  // Taken off a lane (a revisit, an orbit): the search comes back to where it left the lane, the
+  // point on the lane nearest the drone, and flies the rest of it from there; the first such point
+  // stays until reached (another revisit on the way back does not move it on).
+  if (stage_ == Stage::kSearching && has_plan_ && lane_index_ % 2 == 1 && lane_index_ < lanes_.size() &&
+      !rejoin_m_) {
+    const Eigen::Vector2d a = lanes_[lane_index_ - 1].position_m.head<2>();
+    const Eigen::Vector2d b = lanes_[lane_index_].position_m.head<2>();
+    const double length2 = (b - a).squaredNorm();
+    const double along =
+        length2 > 0 ? std::clamp((in.position_m.head<2>() - a).dot(b - a) / length2, 0.0, 1.0) : 1.0;
+    rejoin_m_ = a + along * (b - a);
+  }
   stage_ = stage;
   LogEvent e(in.t_s, config_.name, "mission_stage");
   e.Add("role", "scout").Add("stage", StageName(stage));
   if (stage == Stage::kSearching && has_plan_) e.Add("lane", static_cast<std::int64_t>(lane_index_ / 2));
+  if (stage == Stage::kSearching && rejoin_m_)
+    e.Add("rejoin_x", rejoin_m_->x(), 2).Add("rejoin_y", rejoin_m_->y(), 2);
   if (stage == Stage::kOrbiting) e.Add("victim", static_cast<std::int64_t>(orbit_victim_));
   if (stage == Stage::kRevisiting) e.Add("candidate", static_cast<std::int64_t>(revisit_id_));
   out->events.push_back(std::move(e));
@@ -80,6 +94,7 @@ void ScoutBehaviour::PlanSector(const raft::Sector& sector, const Eigen::Vector3
   lanes_ = LawnmowerWaypoints(AsRect(sector), SweepSpacing(footprint_, config_.overlap), Altitude(),
                               footprint_, position_m.head<2>());
   lane_index_ = 0;
+  rejoin_m_.reset();
 }
 
 const raft::Sector* ScoutBehaviour::NextSector(const raft::MissionState& m) const {
@@ -423,6 +438,14 @@ void ScoutBehaviour::RunLanding(const MissionInput& in, MissionOutput* out) {
 
 void ScoutBehaviour::RunSearch(const MissionInput& in, MissionOutput* out) {
   const Eigen::Vector3d& p = in.position_m;
+  SetpointRequest& sp = out->setpoint;
+  if (rejoin_m_ && (*rejoin_m_ - p.head<2>()).norm() <= config_.waypoint_radius_m) rejoin_m_.reset();
+  if (rejoin_m_) {  // back to the lane first (Enter)
+    sp.kind = SetpointKind::kFlock;
+    sp.target_m = {rejoin_m_->x(), rejoin_m_->y(), Raised(lanes_[lane_index_].position_m.z())};
+    sp.yaw_rad = lanes_[lane_index_].yaw_rad;
+    return;
+  }
   if ((lanes_[lane_index_].position_m.head<2>() - p.head<2>()).norm() <= config_.waypoint_radius_m) {
     ++lane_index_;
     if (lane_index_ == lanes_.size()) {
@@ -438,7 +461,6 @@ void ScoutBehaviour::RunSearch(const MissionInput& in, MissionOutput* out) {
                                           .Add("lanes", static_cast<std::int64_t>(lanes_.size() / 2))));
     }
   }
-  SetpointRequest& sp = out->setpoint;
   sp.kind = SetpointKind::kFlock;
   sp.target_m = lanes_[lane_index_].position_m;
   sp.target_m.z() = Raised(sp.target_m.z());

@@ -243,8 +243,69 @@ TEST(ScoutBehaviour, OrbitsTheTargetVictimAndResumesItsLaneAfterTheRescue) {
   m.Apply(raft::MarkRescued{1});
   s.Step(Input(5.0, m, {85, 100, 30}), &out);
   EXPECT_EQ(out.mode, "searching");
-  EXPECT_EQ(s.lane_index(), 1u);  // where it left off
+  EXPECT_EQ(s.lane_index(), 1u);  // the lane it left ...
+  // ... from the lane's point nearest where it left it (it left from (10, 10), off the lane) ...
+  const Vector2d a = s.lanes()[0].position_m.head<2>();
+  const Vector2d b = s.lanes()[1].position_m.head<2>();
+  const Vector2d rejoin =
+      a + std::clamp((Vector2d(10, 10) - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0) * (b - a);
+  EXPECT_NEAR((out.setpoint.target_m.head<2>() - rejoin).norm(), 0.0, 1e-9);
+  // ... then on along the lane.
+  s.Step(Input(6.0, m, {rejoin.x(), rejoin.y(), 30}), &out);
   EXPECT_EQ(out.setpoint.target_m, s.lanes()[1].position_m);
+}
+
+// A revisit taken halfway along a lane: the sweep comes back to that point of the lane and flies
+// the rest of it, rather than cutting across to the lane's end (rubble20 on 2026-11-28: r14's
+// scout_1 lost two lanes so and never saw victim_3); a second revisit on the way back does not
+// move the point on.
+TEST(ScoutBehaviour, ARevisitMidLaneResumesTheSweepWhereItLeftTheLane) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0)});
+  MissionOutput out;
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  s.Step(Input(1.1, m, {0, 0, 30}), &out);
+  ASSERT_EQ(out.mode, "searching");
+  const Vector3d start = s.lanes()[0].position_m;
+  const Vector3d end = s.lanes()[1].position_m;
+  s.Step(Input(2.0, m, start), &out);
+  ASSERT_EQ(s.lane_index(), 1u);
+  const Vector3d halfway = 0.5 * (start + end);
+  ASSERT_GT((end - start).head<2>().norm(), 50.0);
+  // Candidate 1 far off the lane, its revisit given to this scout.
+  m.Apply(raft::ReportSighting{"scout_2", 1, 200, 200, 0.8});
+  m.Apply(raft::RequestRevisit{1, "scout_1"});
+  s.Step(Input(3.0, m, halfway), &out);
+  ASSERT_EQ(out.mode, "revisiting");
+  // The revisit is answered (a view from scout_1 commits and the leader clears the request): the
+  // sweep resumes, towards where it left the lane, not the lane's end.
+  m.Apply(raft::ReportSighting{"scout_1", 1, 200, 200, 0.9});
+  ASSERT_TRUE(m.state.FindCandidate(1)->revisit_drone.empty());
+  s.Step(Input(40.0, m, {200, 200, 30}), &out);
+  ASSERT_EQ(out.mode, "searching");
+  EXPECT_TRUE(HasEvent(out, "mission_stage"));
+  EXPECT_EQ(s.lane_index(), 1u);
+  EXPECT_NEAR((out.setpoint.target_m.head<2>() - halfway.head<2>()).norm(), 0.0, 1e-9);
+  // Another revisit on the way back, taken from off the lane: the rejoin point stays.
+  m.Apply(raft::ReportSighting{"scout_2", 2, -100, 200, 0.8});
+  m.Apply(raft::RequestRevisit{2, "scout_1"});
+  s.Step(Input(41.0, m, {150, 150, 30}), &out);
+  ASSERT_EQ(out.mode, "revisiting");
+  m.Apply(raft::ReportSighting{"scout_1", 2, -100, 200, 0.9});
+  s.Step(Input(80.0, m, {-100, 200, 30}), &out);
+  ASSERT_EQ(out.mode, "searching");
+  EXPECT_NEAR((out.setpoint.target_m.head<2>() - halfway.head<2>()).norm(), 0.0, 1e-9);
+  // Passing the lane's end on the way back does not count it as flown.
+  s.Step(Input(90.0, m, end), &out);
+  EXPECT_EQ(s.lane_index(), 1u);
+  // Back on the lane: on to its end.
+  s.Step(Input(100.0, m, halfway), &out);
+  EXPECT_EQ(out.setpoint.target_m, end);
+  s.Step(Input(110.0, m, end), &out);
+  EXPECT_EQ(s.lane_index(), 2u);
 }
 
 TEST(ScoutBehaviour, BatteryLowEmitsTheEventOnceThenReturnsAndLandsAtHome) {

@@ -21,8 +21,11 @@
 //       candidate at search altitude (descending to revisit_look_altitude_m over it, when set),
 //       look revisit_look_s with it under the camera; a detection
 //       there is reported as a sighting, nothing is reported as a raft ReportMiss (with where it
-//       looked from); back to what it did (the sweep resumes at its lane) once the committed
-//       state shows the revisit done, decided or given to another drone
+//       looked from); back to what it did once the committed state shows the revisit done,
+//       decided or given to another drone. The sweep resumes where it left its lane (a revisit or
+//       an orbit taken mid-lane: it flies back to the point of the lane it left from, then on
+//       along the lane; mission_stage stage=searching carries rejoin_x/rejoin_y), so a lane's
+//       unflown part is never cut short by a diagonal to the lane's end
 //   airborne --(phase RETURN/COMPLETE, or battery low: event=battery_low)--> kReturning
 //       "returning" --(over home)--> kLanding "landing" --(touch-down)--> kLanded "landed".
 // Detections (after the latency queue) become Raft ReportSighting proposals with their viewpoint
@@ -60,6 +63,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -242,6 +246,8 @@ class ScoutBehaviour {
   std::vector<raft::Sector> swept_;  // sectors this drone finished (a repeated hand-over is a no-op)
   std::vector<Waypoint> lanes_;
   std::size_t lane_index_ = 0;
+  // Where the sweep left its lane (Enter): searching flies back here before going on.
+  std::optional<Eigen::Vector2d> rejoin_m_;
   std::uint32_t orbit_victim_ = 0;
   double orbit_reached_s_ = -1.0;
   std::vector<Waypoint> orbit_;
