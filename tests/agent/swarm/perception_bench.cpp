@@ -18,25 +18,27 @@
 // all detections), recall_at_p90 (the highest recall at precision >= 0.9, any confidence: a point
 // of the curve, not an operating point), max_recall (all detections) and ms_per_frame (Detect() on
 // one core: cv::setNumThreads(1)); then the pipeline scenarios (latency queue, geolocation with
-// estimated poses, tilted cameras) as before.
+// estimated poses, tilted cameras) as before. --replay RUN and --looks DIR: see RunReplay and RunLooks.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <memory>
 #include <numbers>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "bench.hpp"
 #include "perception_score.hpp"
 #include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/common/yaml.hpp"
 #include "swarmbox/swarm/sighting_fusion.hpp"
 
 namespace {
@@ -439,7 +441,144 @@ int RunReplay(const swarmbox::bench::Args& args, const std::shared_ptr<const Vic
   return 0;
 }
 
+// --looks DIR: the close looks the mission's fusion met (perception_score.hpp TallyCloseLooks), for
+// the trial folder DIR or every trial folder in the experiment folder DIR (those with a world.yaml
+// and logs/, in name order), one line per trial and one over all of them:
+//   case=looks trial=... real_candidates false_candidates real_looks real_detected close_recall
+//              false_looks false_detected close_false_repeat real_conf false_conf
+// (the *_conf fields: close detections per confidence bin, "0.5:n,0.6:n,0.7:n,0.8:n,0.9:n"); then
+// the same candidates decided again on their own records (Redecide) by the fusion the SAR brain
+// runs (FusionParams with close_look_height_m kCloseLookM), with --fusion-close-recall,
+// --fusion-close-false-repeat and --fusion-max-revisits in place of its defaults:
+//   case=redecide close_recall close_false_repeat max_revisits real_confirmed real_rejected
+//                 real_open false_confirmed false_rejected false_open same (as logged)
+// No frame is rendered: the figures come from the leader's logged evidence and the world's victims.
+std::string Bins(const std::array<int, CloseLookTally::kBins>& bins) {
+  std::string out;
+  for (std::size_t i = 0; i < CloseLookTally::kBins; ++i) {
+    char piece[32];
+    std::snprintf(piece, sizeof piece, "%s0.%zu:%d", i ? "," : "", 5 + i, bins[i]);
+    out += piece;
+  }
+  return out;
+}
+
+swarmbox::LogEvent BenchLine(const char* kind) {
+  swarmbox::LogEvent e(0.0, "bench", "bench_result");
+  e.Add("suite", "perception").Add("case", kind);
+  return e;
+}
+
+swarmbox::LogEvent LooksLine(const std::string& trial, const CloseLookTally& t) {
+  swarmbox::LogEvent e = BenchLine("looks");
+  e.Add("trial", trial).Add("real_candidates", t.real_candidates).Add("false_candidates", t.false_candidates);
+  e.Add("real_looks", t.real_looks)
+      .Add("real_detected", t.real_detected)
+      .Add("close_recall", t.close_recall(), 4);
+  e.Add("false_looks", t.false_looks).Add("false_detected", t.false_detected);
+  e.Add("close_false_repeat", t.close_false_repeat(), 4);
+  e.Add("real_conf", Bins(t.real_bins)).Add("false_conf", Bins(t.false_bins));
+  return e;
+}
+
+// The world's victims (x, y) from a trial folder's world.yaml.
+swarmbox::Result<std::vector<Eigen::Vector2d>> WorldVictims(const std::filesystem::path& trial) {
+  swarmbox::Result<swarmbox::yaml::Node> world = swarmbox::yaml::ParseFile((trial / "world.yaml").string());
+  if (!world) return world.error();
+  std::vector<Eigen::Vector2d> victims;
+  if (const swarmbox::yaml::Node* list = world->Find("victims"); list != nullptr && list->is_sequence()) {
+    for (const swarmbox::yaml::Node& v : list->items()) {
+      double x = 0, y = 0;
+      const swarmbox::yaml::Node* xn = v.Find("x_m");
+      const swarmbox::yaml::Node* yn = v.Find("y_m");
+      if (xn != nullptr && yn != nullptr && swarmbox::yaml::Decode(*xn, &x) &&
+          swarmbox::yaml::Decode(*yn, &y)) {
+        victims.emplace_back(x, y);
+      }
+    }
+  }
+  return victims;
+}
+
+// The decision lines of a trial folder's logs/*.log.
+std::vector<swarmbox::LogfmtFields> DecisionLines(const std::filesystem::path& trial) {
+  std::vector<swarmbox::LogfmtFields> lines;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(trial / "logs", ec)) {
+    if (e.path().extension() != ".log") continue;
+    std::ifstream in(e.path());
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.find("event=confirmed") != std::string::npos ||
+          line.find("event=rejected") != std::string::npos) {
+        lines.push_back(swarmbox::ParseLogfmt(line));
+      }
+    }
+  }
+  return lines;
+}
+
+int RunLooks(const swarmbox::bench::Args& args) {
+  namespace fs = std::filesystem;
+  const fs::path dir = args.Get("looks", "");
+  FusionParams fusion{.close_look_height_m = kCloseLookM};
+  fusion.close_recall = args.GetDouble("fusion-close-recall", fusion.close_recall);
+  fusion.close_false_repeat = args.GetDouble("fusion-close-false-repeat", fusion.close_false_repeat);
+  fusion.max_revisits = static_cast<int>(args.GetInt("fusion-max-revisits", fusion.max_revisits));
+  if (const std::string why = FusionParamsProblem(fusion); !why.empty()) {
+    std::fprintf(stderr, "perception bench: --looks: %s\n", why.c_str());
+    return 2;
+  }
+  std::vector<fs::path> trials;
+  std::error_code ec;
+  if (fs::exists(dir / "world.yaml")) {
+    trials.push_back(dir);
+  } else {
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+      if (fs::exists(e.path() / "world.yaml") && fs::is_directory(e.path() / "logs"))
+        trials.push_back(e.path());
+    }
+  }
+  std::sort(trials.begin(), trials.end());
+  if (trials.empty()) {
+    std::fprintf(stderr, "perception bench: --looks %s: no trial folder there (a world.yaml and logs/)\n",
+                 dir.string().c_str());
+    return 2;
+  }
+  CloseLookTally all;
+  Redecision again;
+  for (const fs::path& trial : trials) {
+    swarmbox::Result<std::vector<Eigen::Vector2d>> victims = WorldVictims(trial);
+    if (!victims) {
+      std::fprintf(stderr, "perception bench: %s\n", victims.error().ToString().c_str());
+      return 2;
+    }
+    const std::vector<DecidedCandidate> decided =
+        DecidedCandidates(DecisionLines(trial), *victims, swarmbox::raft::MissionState::kConfirmRadiusM);
+    const CloseLookTally t = TallyCloseLooks(decided, kCloseLookM);
+    all.Add(t);
+    again.Add(Redecide(decided, fusion));
+    std::puts(LooksLine(trial.filename().string(), t).str().c_str());
+  }
+  std::puts(LooksLine("all", all).str().c_str());
+  std::puts(BenchLine("redecide")
+                .Add("close_recall", fusion.close_recall, 3)
+                .Add("close_false_repeat", fusion.close_false_repeat, 3)
+                .Add("max_revisits", fusion.max_revisits)
+                .Add("real_confirmed", again.real_confirmed)
+                .Add("real_rejected", again.real_rejected)
+                .Add("real_open", again.real_open)
+                .Add("false_confirmed", again.false_confirmed)
+                .Add("false_rejected", again.false_rejected)
+                .Add("false_open", again.false_open)
+                .Add("same", again.same)
+                .str()
+                .c_str());
+  return 0;
+}
+
 int RunPerceptionBench(const swarmbox::bench::Args& args) {
+  if (args.options.count("looks") != 0) return RunLooks(args);
   const auto seed = static_cast<std::uint64_t>(args.GetInt("seed", 20261121));
   std::shared_ptr<const VictimDetectorModel> model = ShippedDetectorModel();
   const auto model_file = args.options.find("model");

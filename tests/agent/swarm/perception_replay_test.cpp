@@ -2,13 +2,14 @@
 // truth.csv. A synthetic folder: one victim at the origin, scout_1 flying a straight line over it
 // at 30 m and 5 m/s (10 Hz truth rows), the lifter below the height window. And scene sets on
 // generated worlds, which the trainer and the bench also render.
+#include <gtest/gtest.h>
+
+#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
 
 #include "perception_score.hpp"
 
@@ -119,6 +120,84 @@ TEST(GeneratedScenes, ComeFromTheMissionsRubbleFieldsAndRepeatWithTheSeed) {
   }
   // Two worlds: the third scene's people are not the first's.
   EXPECT_NE((*a)[0].victims[0].position_m, (*a)[2].victims[0].position_m);
+}
+
+// The close looks of a trial's decided candidates (`swarmbox-bench perception --looks`): per look,
+// people's candidates apart from false ones, a candidate decided twice counted once; and the same
+// candidates decided again on their own records.
+std::vector<LogfmtFields> DecisionLines() {
+  return {
+      ParseLogfmt("t=5 node=scout_1 event=mission_stage stage=searching"),
+      // A person's candidate (2 m from victim (10, 10)): a 30 m view, a close miss, a close 0.93.
+      ParseLogfmt(
+          "t=60 node=scout_2 event=confirmed candidate=1 x=11.5 y=11.3 drones=scout_1,scout_2,scout_2 "
+          "confidences=0.900,0.000,0.930 viewers=0:0:30.0,11:11:18.0,11.2:11:19.5 view_t=10,30,50"),
+      // A false one far from both victims: close 0.55 and a miss; decided again by a later leader
+      // with one more close miss (the last record counts).
+      ParseLogfmt("t=70 node=scout_2 event=rejected candidate=2 x=50 y=50 drones=scout_1,scout_3,scout_3 "
+                  "confidences=0.700,0.550,0.000 viewers=40:40:30,50:50:18,50:50:18 view_t=12,40,60"),
+      ParseLogfmt(
+          "t=90 node=scout_3 event=rejected candidate=2 x=50 y=50 drones=scout_1,scout_3,scout_3,scout_1 "
+          "confidences=0.700,0.550,0.000,0.000 viewers=40:40:30,50:50:18,50:50:18,50:50:18 "
+          "view_t=12,40,60,80"),
+      // Search views only: a candidate, no close look.
+      ParseLogfmt("t=95 node=scout_3 event=rejected candidate=3 x=-30 y=0 drones=scout_3 confidences=0.600 "
+                  "viewers=-30:0:30 view_t=20"),
+      // Not an evidence record (the lists disagree): skipped.
+      ParseLogfmt("t=96 node=scout_3 event=rejected candidate=4 x=5 y=5 drones=scout_3 confidences=0.6,0.7 "
+                  "viewers=5:5:30 view_t=20"),
+  };
+}
+
+TEST(CloseLookTally, CountsThePeoplesAndTheFalseCandidatesCloseLooksFromTheDecisions) {
+  const std::vector<Eigen::Vector2d> victims = {{10, 10}, {-80, -80}};
+  const std::vector<testing::DecidedCandidate> decided =
+      testing::DecidedCandidates(DecisionLines(), victims, 5.0);
+  ASSERT_EQ(decided.size(), 3u);
+  EXPECT_EQ(decided[1].candidate.views.size(), 4u);  // the later leader's record
+  EXPECT_EQ(decided[0].candidate.views[2].viewer_height_m, 19.5);
+  EXPECT_FALSE(decided[0].candidate.views[1].detected);
+  const testing::CloseLookTally t = testing::TallyCloseLooks(decided, 21.0);
+  EXPECT_EQ(t.real_candidates, 1);
+  EXPECT_EQ(t.false_candidates, 2);
+  EXPECT_EQ(t.real_looks, 2);
+  EXPECT_EQ(t.real_detected, 1);
+  EXPECT_DOUBLE_EQ(t.close_recall(), 0.5);
+  EXPECT_EQ(t.false_looks, 3);
+  EXPECT_EQ(t.false_detected, 1);
+  EXPECT_DOUBLE_EQ(t.close_false_repeat(), 1.0 / 3.0);
+  EXPECT_EQ(t.real_bins, (std::array<int, 5>{0, 0, 0, 0, 1}));   // 0.93
+  EXPECT_EQ(t.false_bins, (std::array<int, 5>{1, 0, 0, 0, 0}));  // 0.55
+  testing::CloseLookTally sum = t;
+  sum.Add(t);
+  EXPECT_EQ(sum.real_looks, 4);
+  EXPECT_EQ(sum.false_bins[0], 2);
+}
+
+TEST(CloseLookTally, RedecidesEachCandidateOnItsOwnRecord) {
+  const std::vector<testing::DecidedCandidate> decided =
+      testing::DecidedCandidates(DecisionLines(), {{10, 10}}, 5.0);
+  FusionParams p{.close_look_height_m = 21.0};
+  // The person: 0.9 from 30 m (capped at 9:1), a close miss (-2.25: 0.46), then 0.93 close
+  // (2.2 + 2.59: 0.99) confirms. The false one: 0.7 from 30 m, 0.55 close (0.85 + 0.2: 0.74, no
+  // confirmation), then a miss: the best close detection still counts alone, the record ends open
+  // ... unless max_revisits ends it: 2 revisits done, undecided, rejected. The third: one view,
+  // undecided (no miss, no close look).
+  p.max_revisits = 3;
+  testing::Redecision r = testing::Redecide(decided, p);
+  EXPECT_EQ(r.real_confirmed, 1);
+  EXPECT_EQ(r.false_confirmed, 0);
+  EXPECT_EQ(r.false_rejected, 1);  // 3 close looks = 3 revisits: undecided, rejected
+  EXPECT_EQ(r.false_open, 1);
+  EXPECT_EQ(r.same, 2);
+  // A prior of 0.9 (9:1 before any view): the false one's 0.7 from 30 m and 0.55 close give
+  // 2.2 + 0.85 + 0.2 (0.96) and confirm it at its second view.
+  p.prior = 0.9;
+  r = testing::Redecide(decided, p);
+  EXPECT_EQ(r.real_confirmed, 1);
+  EXPECT_EQ(r.false_confirmed, 1);
+  EXPECT_EQ(r.false_open, 1);
+  EXPECT_EQ(r.same, 1);
 }
 
 }  // namespace

@@ -1,12 +1,16 @@
 #include "perception_score.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
+#include <map>
+#include <opencv2/core.hpp>
 #include <random>
+#include <string>
 #include <utility>
 
-#include <opencv2/core.hpp>
+#include "swarmbox/common/split.hpp"
+#include "swarmbox/common/yaml.hpp"
 
 namespace swarmbox::swarm::testing {
 
@@ -147,6 +151,136 @@ DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector&
   curve.recall = curve.persons ? static_cast<double>(curve.tp) / curve.persons : 1.0;
   curve.ms_per_frame = curve.scenes ? 1e3 * seconds / curve.scenes : 0.0;
   return curve;
+}
+
+void CloseLookTally::Add(const CloseLookTally& o) {
+  real_candidates += o.real_candidates;
+  false_candidates += o.false_candidates;
+  real_looks += o.real_looks;
+  real_detected += o.real_detected;
+  false_looks += o.false_looks;
+  false_detected += o.false_detected;
+  for (std::size_t i = 0; i < kBins; ++i) {
+    real_bins[i] += o.real_bins[i];
+    false_bins[i] += o.false_bins[i];
+  }
+}
+
+std::vector<DecidedCandidate> DecidedCandidates(const std::vector<LogfmtFields>& log_lines,
+                                                const std::vector<Vector2d>& victims, double real_radius_m) {
+  std::map<std::uint32_t, const LogfmtFields*> last;  // candidate id -> its last decision
+  for (const LogfmtFields& f : log_lines) {
+    const auto event = FindField(f, "event");
+    if (event != std::optional<std::string>("confirmed") && event != std::optional<std::string>("rejected"))
+      continue;
+    const auto id = yaml::ScalarAsDouble(FindField(f, "candidate").value_or(""));
+    if (id && *id >= 0) last[static_cast<std::uint32_t>(*id)] = &f;
+  }
+  std::vector<DecidedCandidate> out;
+  for (const auto& [id, f] : last) {
+    const auto x = yaml::ScalarAsDouble(FindField(*f, "x").value_or(""));
+    const auto y = yaml::ScalarAsDouble(FindField(*f, "y").value_or(""));
+    const std::string drone_list = FindField(*f, "drones").value_or("");
+    const std::string confidence_list = FindField(*f, "confidences").value_or("");
+    const std::string viewer_list = FindField(*f, "viewers").value_or("");
+    const std::string time_list = FindField(*f, "view_t").value_or("");
+    const std::vector<std::string_view> drones = SplitOn(drone_list, ',');
+    const std::vector<std::string_view> confidences = SplitOn(confidence_list, ',');
+    const std::vector<std::string_view> viewers = SplitOn(viewer_list, ',');
+    const std::vector<std::string_view> times = SplitOn(time_list, ',');
+    const std::size_t n = confidences.size();
+    if (!x || !y || viewers.size() != n || drones.size() != n || times.size() != n) continue;  // not evidence
+    DecidedCandidate d;
+    d.candidate.id = id;
+    d.candidate.x_m = *x;
+    d.candidate.y_m = *y;
+    d.confirmed = FindField(*f, "event") == std::optional<std::string>("confirmed");
+    d.real = std::any_of(victims.begin(), victims.end(),
+                         [&](const Vector2d& v) { return (v - Vector2d(*x, *y)).norm() <= real_radius_m; });
+    bool complete = true;
+    for (std::size_t i = 0; i < n && complete; ++i) {
+      const std::vector<std::string_view> xyh = SplitOn(viewers[i], ':');
+      const auto confidence = yaml::ScalarAsDouble(confidences[i]);
+      const auto t = yaml::ScalarAsDouble(times[i]);
+      std::optional<double> vx, vy, vh;
+      if (xyh.size() == 3) {
+        vx = yaml::ScalarAsDouble(xyh[0]);
+        vy = yaml::ScalarAsDouble(xyh[1]);
+        vh = yaml::ScalarAsDouble(xyh[2]);
+      }
+      complete = confidence && t && vx && vy && vh;
+      if (!complete) break;
+      raft::SightingView v;
+      v.reporter = std::string(drones[i]);
+      v.seq = i + 1;
+      v.x_m = *x;
+      v.y_m = *y;
+      v.detected = *confidence > 0;
+      v.confidence = *confidence;
+      v.viewer_x_m = *vx;
+      v.viewer_y_m = *vy;
+      v.viewer_height_m = *vh;
+      v.t_s = *t;
+      d.candidate.views.push_back(std::move(v));
+    }
+    if (complete) out.push_back(std::move(d));
+  }
+  return out;
+}
+
+CloseLookTally TallyCloseLooks(const std::vector<DecidedCandidate>& decided, double close_height_m) {
+  CloseLookTally t;
+  for (const DecidedCandidate& d : decided) {
+    (d.real ? t.real_candidates : t.false_candidates) += 1;
+    for (const raft::SightingView& v : d.candidate.views) {
+      if (v.viewer_height_m > close_height_m) continue;
+      (d.real ? t.real_looks : t.false_looks) += 1;
+      if (!v.detected) continue;
+      (d.real ? t.real_detected : t.false_detected) += 1;
+      const auto bin =
+          static_cast<std::size_t>(std::clamp(static_cast<int>(std::floor((v.confidence - 0.5) * 10)), 0,
+                                              static_cast<int>(CloseLookTally::kBins) - 1));
+      (d.real ? t.real_bins : t.false_bins)[bin] += 1;
+    }
+  }
+  return t;
+}
+
+void Redecision::Add(const Redecision& o) {
+  real_confirmed += o.real_confirmed;
+  real_rejected += o.real_rejected;
+  real_open += o.real_open;
+  false_confirmed += o.false_confirmed;
+  false_rejected += o.false_rejected;
+  false_open += o.false_open;
+  same += o.same;
+}
+
+Redecision Redecide(const std::vector<DecidedCandidate>& decided, const FusionParams& params) {
+  Redecision r;
+  for (const DecidedCandidate& d : decided) {
+    raft::Candidate c = d.candidate;
+    c.views.clear();
+    FusionDecision decision = FusionDecision::kNone;
+    std::uint32_t close_looks = 0;
+    for (const raft::SightingView& v : d.candidate.views) {
+      c.views.push_back(v);
+      close_looks += CloseLook(v, params) ? 1u : 0u;
+      c.revisits =
+          params.close_look_height_m > 0 ? close_looks : static_cast<std::uint32_t>(c.views.size() - 1);
+      decision = AssessCandidate(c, params).decision;
+      if (decision != FusionDecision::kNone) break;
+    }
+    const bool confirmed = decision == FusionDecision::kConfirm;
+    const bool rejected = decision == FusionDecision::kReject;
+    if (d.real) {
+      (confirmed ? r.real_confirmed : rejected ? r.real_rejected : r.real_open) += 1;
+    } else {
+      (confirmed ? r.false_confirmed : rejected ? r.false_rejected : r.false_open) += 1;
+    }
+    r.same += (confirmed && d.confirmed) || (rejected && !d.confirmed) ? 1 : 0;
+  }
+  return r;
 }
 
 }  // namespace swarmbox::swarm::testing

@@ -3,11 +3,16 @@
 // `swarmbox-bench perception`.
 #pragma once
 
+#include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
 
 #include "perception_scenes.hpp"
+#include "swarmbox/common/logfmt.hpp"
+#include "swarmbox/raft/mission_state.hpp"
+#include "swarmbox/swarm/sighting_fusion.hpp"
 #include "swarmbox/swarm/victim_perception.hpp"
 
 namespace swarmbox::swarm::testing {
@@ -72,5 +77,57 @@ using MissFn = std::function<void(const Scene& scene, const SceneVictim& person,
 DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector,
                                double operating_point = 0.5, double must_fraction = 0.5,
                                double match_radius_m = 1.5, const MissFn& on_miss = {});
+
+// A trial's decided candidates as the leader logged them (event=confirmed / event=rejected carry
+// every view: sighting_fusion.hpp AddEvidence's drones, confidences, 0 for a miss, viewers
+// "x:y:height" and view_t), rebuilt as raft::Candidates (each view's ground point is the
+// candidate's, which the fusion does not read); a candidate decided twice (a later leader) comes
+// once, with its last record. `real`: within real_radius_m of a victim of the world.
+struct DecidedCandidate {
+  raft::Candidate candidate;
+  bool real = false;
+  bool confirmed = false;  // the logged decision
+};
+// `log_lines`: every log line of the trial (others are skipped); `victims`: the world's (x, y).
+std::vector<DecidedCandidate> DecidedCandidates(const std::vector<LogfmtFields>& log_lines,
+                                                const std::vector<Eigen::Vector2d>& victims,
+                                                double real_radius_m);
+
+// The revisits' close looks as the mission's fusion met them (`swarmbox-bench perception --looks
+// RUN`), per look rather than per frame (a look's ~4 frames of one hover are nearly one image): a
+// close look is a view from at most close_height_m up. close_recall() and close_false_repeat() are
+// the figures FusionParams' close_recall and close_false_repeat stand for. The sample follows the
+// mission's policy (a person's candidate is looked at again until it is decided), so it is the
+// looks the fusion meets, not a uniform sample of the detector.
+struct CloseLookTally {
+  static constexpr std::size_t kBins = 5;  // detections by confidence: [0.5, 0.6) ... [0.9, 1]
+  int real_candidates = 0;
+  int false_candidates = 0;
+  int real_looks = 0;
+  int real_detected = 0;
+  int false_looks = 0;
+  int false_detected = 0;
+  std::array<int, kBins> real_bins{};
+  std::array<int, kBins> false_bins{};
+  void Add(const CloseLookTally& other);
+  double close_recall() const { return real_looks ? static_cast<double>(real_detected) / real_looks : 0.0; }
+  double close_false_repeat() const {
+    return false_looks ? static_cast<double>(false_detected) / false_looks : 0.0;
+  }
+};
+CloseLookTally TallyCloseLooks(const std::vector<DecidedCandidate>& decided, double close_height_m);
+
+// The same candidates decided again by `params` on their own records: the views in order, the
+// candidate assessed after each (AssessCandidate; revisits done = the close looks so far, or the
+// views after the first without close looks), the first decision taken; `open` when the record
+// ended undecided (the mission would have looked again: what that look sees is not in the logs).
+// With the params the mission ran, `same` counts the candidates decided as logged.
+struct Redecision {
+  int real_confirmed = 0, real_rejected = 0, real_open = 0;
+  int false_confirmed = 0, false_rejected = 0, false_open = 0;
+  int same = 0;
+  void Add(const Redecision& other);
+};
+Redecision Redecide(const std::vector<DecidedCandidate>& decided, const FusionParams& params);
 
 }  // namespace swarmbox::swarm::testing

@@ -104,14 +104,18 @@ struct FusionParams {
   // logit(0.9): 64 rescued, 26 false victims: a trade either way (the detector sets the limit).
   double max_search_log_odds = 2.197;
   double max_close_view_confidence = 0.99;
-  // The detector's recall from the look altitude, per look (a look is 2 s, ~4 frames): an
-  // assumption over the 0.74 per frame (precision 0.93) measured at 18 m on the rubble fields
-  // (`swarmbox-bench perception --seed 1 --only world:1 --world-altitude 18`); the 48 px model
-  // with its close sigmoid gives 0.81 there (precision 0.85), and on the mission's own close
-  // frames 0.66 (rubble20, 142 of 215: `--replay RUN`, close_recall); per look (correlated
-  // frames) it is higher, not measured yet (BENCHMARKS.md "Perception: the 48 px network ships").
+  // The detector's recall from the look altitude, per look (a look is 2 s, ~4 frames), and its
+  // chance to fire on what the search model fired on. Measured per look on the mission's own
+  // decided candidates (`swarmbox-bench perception --looks RUN`, rubble20 with the shipped 48 px
+  // model, BENCHMARKS.md "Perception: the close looks per look"): 0.83 (86 of 103 looks at people)
+  // and 0.41 (82 of 199 looks at false candidates, most of them at 0.5-0.7). The assumptions stay
+  // 0.9 and 0.05: in this rule a close miss weighs only while no close look detected anything
+  // (the best detection counts alone), and replaying that run's decisions with the measured pair
+  // (a miss ln(0.17 / 0.59) = -1.24 instead of -2.25, so a third look before a rejection)
+  // confirmed 2 more people and 5 more false candidates of 73 and 107: more trials fail. The
+  // limit is the detector's close look (confidences of people and of look-alikes overlap at
+  // 0.5-0.8), not these two numbers.
   double close_recall = 0.9;
-  // ... and its chance to fire on what the search model fired on: an assumption (not measured yet).
   double close_false_repeat = 0.05;
   int max_revisits = 3;             // then an undecided candidate is rejected (reason=undecided)
   double revisit_after_s = 10.0;    // no new view this long after the last: send a revisit [s]
