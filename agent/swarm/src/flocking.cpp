@@ -84,29 +84,50 @@ Flocking::Flocking(const FlockingParams& params, const Geofence& fence,
   nearest_.reserve(static_cast<std::size_t>(params_.max_neighbours) + 1);
 }
 
-Vec2 Flocking::ShillTerm(const Vec2& p, const Vec2& v) const {
-  const FlockingParams& k = params_;
-  Vec2 sum = Vec2::Zero();
-  // Only the velocity component along the wall normal is compared with the shill agent's (V18
-  // compares the full velocity, which also brakes motion along the wall and can stall a drone
-  // beside an obstacle while migration pulls it past): drones slide along walls.
-  auto add = [&](double clearance_m, const Vec2& away_normal) {
-    const Vec2 v_normal = v.dot(away_normal) * away_normal;
-    sum += FrictionRule(v_normal, k.v_shill_m_s * away_normal, clearance_m, k.r0_shill_m, 0.0,
-                        k.a_shill_m_s2, k.p_shill_1_s, k.c_shill);
-  };
+template <typename Fn>
+void Flocking::ForEachWall(const Vec2& p, Fn&& fn) const {
   // Geofence walls: shill agents at the foot of the perpendicular, moving inward.
-  add(p.x() - fence_.min_x_m, Vec2(1, 0));
-  add(fence_.max_x_m - p.x(), Vec2(-1, 0));
-  add(p.y() - fence_.min_y_m, Vec2(0, 1));
-  add(fence_.max_y_m - p.y(), Vec2(0, -1));
+  fn(p.x() - fence_.min_x_m, Vec2(1, 0));
+  fn(fence_.max_x_m - p.x(), Vec2(-1, 0));
+  fn(p.y() - fence_.min_y_m, Vec2(0, 1));
+  fn(fence_.max_y_m - p.y(), Vec2(0, -1));
   // Obstacles: a shill agent at the nearest point of the footprint, moving away from it.
   for (const ObstacleFootprint& o : obstacles_) {
     Vec2 n;
     const double clearance = ObstacleClearance(o, p, &n);
-    add(clearance, n);
+    fn(clearance, n);
   }
+}
+
+// The shill agents' push on a drone at rest (V18 eq. 5 with the drone's velocity taken as zero):
+// inward within WallStandoffM, from the position alone. The part of V18's rule that depends on the
+// drone's own velocity (braking it as it closes on a wall) is WallLimit below: fed back through
+// the flight stack's lag at the 10 Hz mission tick with gain c_shill it swung the x500's attitude
+// +-20-28 deg at ~1.4 Hz over the last 15 m of every lane toward a wall (2026-11-28,
+// tests/agent/flight flocking_closed_loop_test.cpp).
+Vec2 Flocking::ShillTerm(const Vec2& p) const {
+  const FlockingParams& k = params_;
+  Vec2 sum = Vec2::Zero();
+  ForEachWall(p, [&](double clearance_m, const Vec2& away_normal) {
+    sum += FrictionRule(Vec2::Zero(), k.v_shill_m_s * away_normal, clearance_m, k.r0_shill_m, 0.0,
+                        k.a_shill_m_s2, k.p_shill_1_s, k.c_shill);
+  });
   return sum;
+}
+
+// The commanded velocity's component toward each wall and obstacle face held to the speed that
+// can still brake before the shill's stand-off (BrakingCurve(clearance - r0_shill, a_shill,
+// p_shill); nothing toward it within r0_shill): a function of the position alone, so the braking
+// follows the curve smoothly instead of through a velocity feedback loop. Only the normal
+// component is cut: drones slide along walls.
+Vec2 Flocking::WallLimit(const Vec2& p, Vec2 v) const {
+  const FlockingParams& k = params_;
+  ForEachWall(p, [&](double clearance_m, const Vec2& away_normal) {
+    const double toward = -v.dot(away_normal);
+    const double allowed = BrakingCurve(clearance_m - k.r0_shill_m, k.a_shill_m_s2, k.p_shill_1_s);
+    if (toward > allowed) v += (toward - allowed) * away_normal;
+  });
+  return v;
 }
 
 FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
@@ -124,11 +145,11 @@ FlockingOutput Flocking::Step(const FlockingInput& in, double dt_s) {
   // neighbours were far off there for good (rubble20, 2026-11-28: a revisit 3.4 m off its
   // candidate for 40 s until it timed out, a returning scout 5 m off home).
   if (in.migrate) out.cohesion *= std::min(1.0, out.migration.norm() / k.v_flock_m_s);
-  out.shill = ShillTerm(p, v);
+  out.shill = ShillTerm(p);
 
-  const Vec2 v_xy = ClampNorm(out.migration + out.repulsion + out.friction + out.alignment +
-                                  out.cohesion + out.shill,
-                              k.v_max_m_s);
+  const Vec2 v_xy = WallLimit(
+      p, ClampNorm(out.migration + out.repulsion + out.friction + out.alignment + out.cohesion + out.shill,
+                   k.v_max_m_s));
   const double v_z =
       std::clamp(k.p_z_1_s * (in.goal_m.z() - in.position_m.z()), -k.v_z_max_m_s, k.v_z_max_m_s);
   Vec3 desired(v_xy.x(), v_xy.y(), v_z);

@@ -26,9 +26,13 @@
 //  - cohesion    Reynolds' attraction to the neighbours' centroid beyond r0_coh (while migrating,
 //                scaled by the migration's speed over v_flock: it never holds a drone off its goal);
 //  - shill       V18 virtual agents on the geofence walls and on obstacle faces, moving inward /
-//                outward at v_shill; their velocity is imposed with the friction rule (V18 eq. 5)
-//                on the velocity component along the wall normal (so drones slide along walls);
-//                near an obstacle the migration term turns along its face (no head-on stall);
+//                outward at v_shill: their push on a drone at rest (V18 eq. 5 with the drone's
+//                velocity zero) from within WallStandoffM; and the commanded velocity's component
+//                toward a wall or face held to the braking curve to r0_shill (the velocity part of
+//                V18 eq. 5 as a limit on the command, not a feedback on the measured velocity,
+//                which through the flight stack's lag swung the attitude: flocking.cpp ShillTerm);
+//                only the normal component (drones slide along walls); near an obstacle the
+//                migration term turns along its face (no head-on stall);
 //  - limits      |v_xy| <= v_max, |v_z| <= v_z_max, |dv/dt| <= a_max (across steps).
 //
 // Neighbours: the position is dead-reckoned by velocity * age. A neighbour older than
@@ -177,7 +181,11 @@ class Flocking {
   void ScanNeighbours(const FlockingInput& in, const Vec2& p, FlockingOutput* out);
   void FollowNeighbours(const FlockingInput& in, const Vec2& p, const Vec2& v,
                         FlockingOutput* out) const;
-  Vec2 ShillTerm(const Vec2& p, const Vec2& v) const;
+  Vec2 ShillTerm(const Vec2& p) const;
+  Vec2 WallLimit(const Vec2& p, Vec2 v) const;
+  // fn(clearance_m, away_normal) for each geofence wall and obstacle footprint.
+  template <typename Fn>
+  void ForEachWall(const Vec2& p, Fn&& fn) const;
 
   FlockingParams params_;
   Geofence fence_;
