@@ -444,8 +444,11 @@ int RunReplay(const swarmbox::bench::Args& args, const std::shared_ptr<const Vic
 // --looks DIR: the close looks the mission's fusion met (perception_score.hpp TallyCloseLooks), for
 // the trial folder DIR or every trial folder in the experiment folder DIR (those with a world.yaml
 // and logs/, in name order), one line per trial and one over all of them:
-//   case=looks trial=... real_candidates false_candidates real_looks real_detected close_recall
-//              false_looks false_detected close_false_repeat real_conf false_conf
+//   case=looks trial=... victims_inner inner_found victims_edge edge_found real_candidates
+//              false_candidates real_looks real_detected close_recall false_looks false_detected
+//              close_false_repeat real_conf false_conf
+// (victims_edge: within kEdgeBandM of the geofence, where the sweep's lanes end and turn; found: a
+// decided candidate within kConfirmRadiusM of the person)
 // (the *_conf fields: close detections per confidence bin, "0.5:n,0.6:n,0.7:n,0.8:n,0.9:n"); then
 // the same candidates decided again on their own records (Redecide) by the fusion the SAR brain
 // runs (FusionParams with close_look_height_m kCloseLookM), with --fusion-close-recall,
@@ -469,23 +472,27 @@ swarmbox::LogEvent BenchLine(const char* kind) {
   return e;
 }
 
-swarmbox::LogEvent LooksLine(const std::string& trial, const CloseLookTally& t) {
-  swarmbox::LogEvent e = BenchLine("looks");
-  e.Add("trial", trial).Add("real_candidates", t.real_candidates).Add("false_candidates", t.false_candidates);
-  e.Add("real_looks", t.real_looks)
-      .Add("real_detected", t.real_detected)
-      .Add("close_recall", t.close_recall(), 4);
-  e.Add("false_looks", t.false_looks).Add("false_detected", t.false_detected);
-  e.Add("close_false_repeat", t.close_false_repeat(), 4);
-  e.Add("real_conf", Bins(t.real_bins)).Add("false_conf", Bins(t.false_bins));
-  return e;
-}
+// A trial's world as --looks needs it: the victims (x, y) and the geofence's half sizes.
+struct LooksWorld {
+  std::vector<Eigen::Vector2d> victims;
+  double half_x_m = 0, half_y_m = 0;
+};
 
-// The world's victims (x, y) from a trial folder's world.yaml.
-swarmbox::Result<std::vector<Eigen::Vector2d>> WorldVictims(const std::filesystem::path& trial) {
+// From a trial folder's world.yaml.
+swarmbox::Result<LooksWorld> ReadLooksWorld(const std::filesystem::path& trial) {
   swarmbox::Result<swarmbox::yaml::Node> world = swarmbox::yaml::ParseFile((trial / "world.yaml").string());
   if (!world) return world.error();
-  std::vector<Eigen::Vector2d> victims;
+  LooksWorld out;
+  if (const swarmbox::yaml::Node* fence = world->Find("geofence"); fence != nullptr && fence->is_mapping()) {
+    const swarmbox::yaml::Node* sx = fence->Find("size_x_m");
+    const swarmbox::yaml::Node* sy = fence->Find("size_y_m");
+    if (sx != nullptr && sy != nullptr && swarmbox::yaml::Decode(*sx, &out.half_x_m) &&
+        swarmbox::yaml::Decode(*sy, &out.half_y_m)) {
+      out.half_x_m /= 2;
+      out.half_y_m /= 2;
+    }
+  }
+  std::vector<Eigen::Vector2d>& victims = out.victims;
   if (const swarmbox::yaml::Node* list = world->Find("victims"); list != nullptr && list->is_sequence()) {
     for (const swarmbox::yaml::Node& v : list->items()) {
       double x = 0, y = 0;
@@ -497,7 +504,49 @@ swarmbox::Result<std::vector<Eigen::Vector2d>> WorldVictims(const std::filesyste
       }
     }
   }
-  return victims;
+  return out;
+}
+
+// The world's victims near the geofence (within kEdgeBandM of it: the lanes' ends and the outer
+// lanes, where the sweep brakes and turns) and inside, and how many of each a decided candidate
+// lies within kConfirmRadiusM of (found: the swarm saw the person and decided on it).
+constexpr double kEdgeBandM = 20.0;
+struct FoundTally {
+  int edge = 0, edge_found = 0, inner = 0, inner_found = 0;
+  void Add(const FoundTally& o) {
+    edge += o.edge;
+    edge_found += o.edge_found;
+    inner += o.inner;
+    inner_found += o.inner_found;
+  }
+};
+FoundTally TallyFound(const LooksWorld& w, const std::vector<DecidedCandidate>& decided) {
+  FoundTally t;
+  for (const Eigen::Vector2d& v : w.victims) {
+    const bool edge = w.half_x_m > 0 && (w.half_x_m - std::abs(v.x()) < kEdgeBandM ||
+                                         w.half_y_m - std::abs(v.y()) < kEdgeBandM);
+    const bool found = std::any_of(decided.begin(), decided.end(), [&](const DecidedCandidate& d) {
+      return (Eigen::Vector2d(d.candidate.x_m, d.candidate.y_m) - v).norm() <=
+             swarmbox::raft::MissionState::kConfirmRadiusM;
+    });
+    (edge ? t.edge : t.inner) += 1;
+    (edge ? t.edge_found : t.inner_found) += found ? 1 : 0;
+  }
+  return t;
+}
+
+swarmbox::LogEvent LooksLine(const std::string& trial, const CloseLookTally& t, const FoundTally& found) {
+  swarmbox::LogEvent e = BenchLine("looks");
+  e.Add("trial", trial).Add("victims_inner", found.inner).Add("inner_found", found.inner_found);
+  e.Add("victims_edge", found.edge).Add("edge_found", found.edge_found);
+  e.Add("real_candidates", t.real_candidates).Add("false_candidates", t.false_candidates);
+  e.Add("real_looks", t.real_looks)
+      .Add("real_detected", t.real_detected)
+      .Add("close_recall", t.close_recall(), 4);
+  e.Add("false_looks", t.false_looks).Add("false_detected", t.false_detected);
+  e.Add("close_false_repeat", t.close_false_repeat(), 4);
+  e.Add("real_conf", Bins(t.real_bins)).Add("false_conf", Bins(t.false_bins));
+  return e;
 }
 
 // The decision lines of a trial folder's logs/*.log.
@@ -546,21 +595,24 @@ int RunLooks(const swarmbox::bench::Args& args) {
     return 2;
   }
   CloseLookTally all;
+  FoundTally all_found;
   Redecision again;
   for (const fs::path& trial : trials) {
-    swarmbox::Result<std::vector<Eigen::Vector2d>> victims = WorldVictims(trial);
-    if (!victims) {
-      std::fprintf(stderr, "perception bench: %s\n", victims.error().ToString().c_str());
+    swarmbox::Result<LooksWorld> world = ReadLooksWorld(trial);
+    if (!world) {
+      std::fprintf(stderr, "perception bench: %s\n", world.error().ToString().c_str());
       return 2;
     }
-    const std::vector<DecidedCandidate> decided =
-        DecidedCandidates(DecisionLines(trial), *victims, swarmbox::raft::MissionState::kConfirmRadiusM);
+    const std::vector<DecidedCandidate> decided = DecidedCandidates(
+        DecisionLines(trial), world->victims, swarmbox::raft::MissionState::kConfirmRadiusM);
     const CloseLookTally t = TallyCloseLooks(decided, kCloseLookM);
+    const FoundTally found = TallyFound(*world, decided);
     all.Add(t);
+    all_found.Add(found);
     again.Add(Redecide(decided, fusion));
-    std::puts(LooksLine(trial.filename().string(), t).str().c_str());
+    std::puts(LooksLine(trial.filename().string(), t, found).str().c_str());
   }
-  std::puts(LooksLine("all", all).str().c_str());
+  std::puts(LooksLine("all", all, all_found).str().c_str());
   std::puts(BenchLine("redecide")
                 .Add("close_recall", fusion.close_recall, 3)
                 .Add("close_false_repeat", fusion.close_false_repeat, 3)
