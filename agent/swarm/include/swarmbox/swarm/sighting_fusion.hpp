@@ -107,14 +107,14 @@ struct FusionParams {
   // The detector's recall from the look altitude, per look (a look is 2 s, ~4 frames), and its
   // chance to fire on what the search model fired on. Measured per look on the mission's own
   // decided candidates (`swarmbox-bench perception --looks RUN`, rubble20 with the shipped 48 px
-  // model, BENCHMARKS.md "Perception: the close looks per look"): 0.83 (86 of 103 looks at people)
-  // and 0.41 (82 of 199 looks at false candidates, most of them at 0.5-0.7). The assumptions stay
-  // 0.9 and 0.05: in this rule a close miss weighs only while no close look detected anything
-  // (the best detection counts alone), and replaying that run's decisions with the measured pair
-  // (a miss ln(0.17 / 0.59) = -1.24 instead of -2.25, so a third look before a rejection)
-  // confirmed 2 more people and 5 more false candidates of 73 and 107: more trials fail. The
-  // limit is the detector's close look (confidences of people and of look-alikes overlap at
-  // 0.5-0.8), not these two numbers.
+  // model; BENCHMARKS.md "The sweep's lane ends, rejoined lanes and the close looks per look"):
+  // 0.83 (84 of 101 looks at people) and 0.35-0.42 over three runs (82 of 197 on the first, most
+  // at 0.5-0.7). The assumptions stay 0.9 and 0.05: a close miss weighs only while no close look
+  // detected anything (the best detection counts alone), and deciding that run's candidates again
+  // with the measured pair (`--looks RUN --fusion-close-recall 0.83 --fusion-close-false-repeat
+  // 0.41`: a miss -1.24 instead of -2.25) leaves 65 of 93 rejected false candidates and 3 of 12
+  // rejected people open for another look, ~9 more false victims for ~2 more people at those
+  // rates. The limit is the detector's close look (people and look-alikes overlap at 0.5-0.8).
   double close_recall = 0.9;
   double close_false_repeat = 0.05;
   int max_revisits = 3;             // then an undecided candidate is rejected (reason=undecided)
