@@ -2,14 +2,14 @@
 // truth.csv. A synthetic folder: one victim at the origin, scout_1 flying a straight line over it
 // at 30 m and 5 m/s (10 Hz truth rows), the lifter below the height window. And scene sets on
 // generated worlds, which the trainer and the bench also render.
-#include <gtest/gtest.h>
-
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
+
+#include <gtest/gtest.h>
 
 #include "perception_score.hpp"
 

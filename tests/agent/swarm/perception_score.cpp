@@ -4,10 +4,11 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <opencv2/core.hpp>
 #include <random>
 #include <string>
 #include <utility>
+
+#include <opencv2/core.hpp>
 
 #include "swarmbox/common/split.hpp"
 #include "swarmbox/common/yaml.hpp"

@@ -3,11 +3,12 @@
 // `swarmbox-bench perception`.
 #pragma once
 
-#include <Eigen/Core>
 #include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "perception_scenes.hpp"
 #include "swarmbox/common/logfmt.hpp"
