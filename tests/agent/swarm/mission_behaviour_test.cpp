@@ -219,19 +219,25 @@ TEST(ScoutBehaviour, KeepSearchingDuringRescueOrbitsOnlyOnceSweptThenLeavesTheOr
   EXPECT_EQ(out.mode, "landing");
 }
 
+// From the ground at home to its sector's first lane (the mission has kSector and the search
+// started): taken off to 30 m, searching, at the lane's start (t 2 s), flying the lane.
+void OnItsFirstLane(const Mission& m, ScoutBehaviour& s, MissionOutput& out) {
+  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
+  s.Step(Input(1.0, m, {0, 0, 30}), &out);
+  s.Step(Input(1.1, m, {0, 0, 30}), &out);
+  ASSERT_EQ(out.mode, "searching");
+  s.Step(Input(2.0, m, s.lanes()[0].position_m), &out);
+  ASSERT_EQ(s.lane_index(), 1u);
+}
+
 TEST(ScoutBehaviour, OrbitsTheTargetVictimAndResumesItsLaneAfterTheRescue) {
   Mission m;
   m.Apply(raft::AssignSectors{{kSector}});
   m.Apply(raft::StartSearch{});
   ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0)});
   MissionOutput out;
-  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
-  s.Step(Input(1.0, m, {0, 0, 30}), &out);
-  s.Step(Input(1.1, m, {0, 0, 30}), &out);
-  ASSERT_EQ(out.mode, "searching");
+  ASSERT_NO_FATAL_FAILURE(OnItsFirstLane(m, s, out));
   ASSERT_GE(s.lanes().size(), 4u);
-  s.Step(Input(2.0, m, s.lanes()[0].position_m), &out);
-  ASSERT_EQ(s.lane_index(), 1u);
   m.Apply(raft::ConfirmVictim{"operator", 100, 100});
   m.Apply(raft::ConvergeOn{1});
   s.Step(Input(3.0, m, {10, 10, 30}), &out);
@@ -265,14 +271,9 @@ TEST(ScoutBehaviour, ARevisitMidLaneResumesTheSweepWhereItLeftTheLane) {
   m.Apply(raft::StartSearch{});
   ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0)});
   MissionOutput out;
-  s.Step(Input(0.0, m, {0, 0, 0.23}), &out);
-  s.Step(Input(1.0, m, {0, 0, 30}), &out);
-  s.Step(Input(1.1, m, {0, 0, 30}), &out);
-  ASSERT_EQ(out.mode, "searching");
+  ASSERT_NO_FATAL_FAILURE(OnItsFirstLane(m, s, out));
   const Vector3d start = s.lanes()[0].position_m;
   const Vector3d end = s.lanes()[1].position_m;
-  s.Step(Input(2.0, m, start), &out);
-  ASSERT_EQ(s.lane_index(), 1u);
   const Vector3d halfway = 0.5 * (start + end);
   ASSERT_GT((end - start).head<2>().norm(), 50.0);
   // Candidate 1 far off the lane, its revisit given to this scout.
