@@ -39,7 +39,7 @@
 #include "bench.hpp"
 #include "perception_score.hpp"
 #include "swarmbox/common/logfmt.hpp"
-#include "swarmbox/common/yaml.hpp"
+#include "swarmbox/physics/world_config.hpp"
 #include "swarmbox/swarm/sighting_fusion.hpp"
 
 namespace {
@@ -473,39 +473,11 @@ swarmbox::LogEvent BenchLine(const char* kind) {
   return e;
 }
 
-// A trial's world as --looks needs it: the victims (x, y) and the geofence's half sizes.
-struct LooksWorld {
-  std::vector<Eigen::Vector2d> victims;
-  double half_x_m = 0, half_y_m = 0;
-};
-
-// From a trial folder's world.yaml.
-swarmbox::Result<LooksWorld> ReadLooksWorld(const std::filesystem::path& trial) {
-  swarmbox::Result<swarmbox::yaml::Node> world = swarmbox::yaml::ParseFile((trial / "world.yaml").string());
-  if (!world) return world.error();
-  LooksWorld out;
-  if (const swarmbox::yaml::Node* fence = world->Find("geofence"); fence != nullptr && fence->is_mapping()) {
-    const swarmbox::yaml::Node* sx = fence->Find("size_x_m");
-    const swarmbox::yaml::Node* sy = fence->Find("size_y_m");
-    if (sx != nullptr && sy != nullptr && swarmbox::yaml::Decode(*sx, &out.half_x_m) &&
-        swarmbox::yaml::Decode(*sy, &out.half_y_m)) {
-      out.half_x_m /= 2;
-      out.half_y_m /= 2;
-    }
-  }
-  std::vector<Eigen::Vector2d>& victims = out.victims;
-  if (const swarmbox::yaml::Node* list = world->Find("victims"); list != nullptr && list->is_sequence()) {
-    for (const swarmbox::yaml::Node& v : list->items()) {
-      double x = 0, y = 0;
-      const swarmbox::yaml::Node* xn = v.Find("x_m");
-      const swarmbox::yaml::Node* yn = v.Find("y_m");
-      if (xn != nullptr && yn != nullptr && swarmbox::yaml::Decode(*xn, &x) &&
-          swarmbox::yaml::Decode(*yn, &y)) {
-        victims.emplace_back(x, y);
-      }
-    }
-  }
-  return out;
+// The world's victims' ground points.
+std::vector<Eigen::Vector2d> VictimPoints(const swarmbox::physics::WorldConfig& w) {
+  std::vector<Eigen::Vector2d> points;
+  for (const swarmbox::physics::Victim& v : w.victims) points.emplace_back(v.x_m, v.y_m);
+  return points;
 }
 
 // The world's victims near the geofence (within kEdgeBandM of it: the lanes' ends and the outer
@@ -521,11 +493,11 @@ struct FoundTally {
     inner_found += o.inner_found;
   }
 };
-FoundTally TallyFound(const LooksWorld& w, const std::vector<DecidedCandidate>& decided) {
+FoundTally TallyFound(const swarmbox::physics::WorldConfig& w, const std::vector<DecidedCandidate>& decided) {
   FoundTally t;
-  for (const Eigen::Vector2d& v : w.victims) {
-    const bool edge = w.half_x_m > 0 && (w.half_x_m - std::abs(v.x()) < kEdgeBandM ||
-                                         w.half_y_m - std::abs(v.y()) < kEdgeBandM);
+  for (const Eigen::Vector2d& v : VictimPoints(w)) {
+    const bool edge =
+        w.size_x_m / 2 - std::abs(v.x()) < kEdgeBandM || w.size_y_m / 2 - std::abs(v.y()) < kEdgeBandM;
     const bool found = std::any_of(decided.begin(), decided.end(), [&](const DecidedCandidate& d) {
       return (Eigen::Vector2d(d.candidate.x_m, d.candidate.y_m) - v).norm() <=
              swarmbox::raft::MissionState::kConfirmRadiusM;
@@ -599,13 +571,14 @@ int RunLooks(const swarmbox::bench::Args& args) {
   FoundTally all_found;
   Redecision again;
   for (const fs::path& trial : trials) {
-    swarmbox::Result<LooksWorld> world = ReadLooksWorld(trial);
+    swarmbox::Result<swarmbox::physics::WorldConfig> world =
+        swarmbox::physics::LoadWorld((trial / "world.yaml").string());
     if (!world) {
       std::fprintf(stderr, "perception bench: %s\n", world.error().ToString().c_str());
       return 2;
     }
     const std::vector<DecidedCandidate> decided = DecidedCandidates(
-        DecisionLines(trial), world->victims, swarmbox::raft::MissionState::kConfirmRadiusM);
+        DecisionLines(trial), VictimPoints(*world), swarmbox::raft::MissionState::kConfirmRadiusM);
     const CloseLookTally t = TallyCloseLooks(decided, kCloseLookM);
     const FoundTally found = TallyFound(*world, decided);
     all.Add(t);
