@@ -58,7 +58,7 @@ TEST(FlockingClosedLoop, BrakingAtALaneEndNearTheGeofenceKeepsTheCameraLevel) {
   const Vec3 goal(fence.max_x_m - 11.6, start.y(), start.z());
   flock.Reset(r.fc().estimate().vel_m_s);
   int step = 0;
-  double max_speed = 0, peak_tilt_cruise = 0, peak_tilt_braking = 0, max_x = -1e9;
+  double max_speed = 0, peak_tilt_approach = 0, peak_tilt_braking = 0, max_x = -1e9;
   int tilt_reversals = 0;
   double peak_pitch_rate = 0;
   double last_pitch_rate_sign = 0;
@@ -76,17 +76,17 @@ TEST(FlockingClosedLoop, BrakingAtALaneEndNearTheGeofenceKeepsTheCameraLevel) {
     const auto v = r.truth().velocity_m_s;
     max_x = std::max(max_x, p.x);
     max_speed = std::max(max_speed, std::hypot(v.x, v.y));
-    const double to_wall = fence.max_x_m - p.x;
-    const double tilt = TiltDeg(r);
     // Braking: from where the shill engages at the cruise speed (WallStandoffM and the braking
-    // curve put it ~30 m out at 5 m/s) to the end of the lane; before it, cruise.
-    (to_wall > 32.0 ? peak_tilt_cruise : peak_tilt_braking) =
-        std::max(to_wall > 32.0 ? peak_tilt_cruise : peak_tilt_braking, tilt);
+    // curve put it ~30 m out at 5 m/s) to the end of the lane; before it, the climb-out from the
+    // hover and the cruise.
+    const bool braking = fence.max_x_m - p.x <= 32.0;
+    double& peak_tilt = braking ? peak_tilt_braking : peak_tilt_approach;
+    peak_tilt = std::max(peak_tilt, TiltDeg(r));
     // Fast pitch-rate sign changes while braking (above 1 rad/s, beyond a hover's jitter): a
     // swinging attitude reverses every half period.
     const double q = r.truth().body_rates_rad_s.y;
-    if (to_wall <= 32.0) peak_pitch_rate = std::max(peak_pitch_rate, std::abs(q));
-    if (to_wall <= 32.0 && std::abs(q) > 1.0) {
+    if (braking) peak_pitch_rate = std::max(peak_pitch_rate, std::abs(q));
+    if (braking && std::abs(q) > 1.0) {
       const double sign = q > 0 ? 1.0 : -1.0;
       if (last_pitch_rate_sign != 0 && sign != last_pitch_rate_sign) ++tilt_reversals;
       last_pitch_rate_sign = sign;
@@ -94,9 +94,9 @@ TEST(FlockingClosedLoop, BrakingAtALaneEndNearTheGeofenceKeepsTheCameraLevel) {
   });
   const double end_gap = (goal.head<2>() - r.fc().estimate().pos_m.head<2>()).norm();
   std::printf(
-      "flocking_wall max_speed_m_s=%.2f peak_tilt_cruise_deg=%.1f peak_tilt_braking_deg=%.1f "
+      "flocking_wall max_speed_m_s=%.2f peak_tilt_approach_deg=%.1f peak_tilt_braking_deg=%.1f "
       "fast_pitch_reversals=%d peak_pitch_rate_rad_s=%.2f closest_to_wall_m=%.2f end_gap_m=%.2f\n",
-      max_speed, peak_tilt_cruise, peak_tilt_braking, tilt_reversals, peak_pitch_rate, fence.max_x_m - max_x,
+      max_speed, peak_tilt_approach, peak_tilt_braking, tilt_reversals, peak_pitch_rate, fence.max_x_m - max_x,
       end_gap);
   EXPECT_FALSE(r.crashed());
   EXPECT_GT(max_speed, 4.0);              // it cruised
