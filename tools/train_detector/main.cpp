@@ -7,6 +7,10 @@
 //   training lines and gets "recalibrated": true)
 //   swarmbox-train-detector --out-dir DIR --recalibrate --replace-cnn FILE.onnx
 //   (the same with another CNN in place of the model's: train_cnn.py run again on its patches)
+//   swarmbox-train-detector --out-dir DIR --recalibrate --close-cnn FILE.onnx --close-cnn-patch-px 64
+//     --close-calibration-altitude 18 ...
+//   (the same, and FILE.onnx becomes the model's close-look CNN, the close sigmoid fitted to it:
+//   the train-detector target's last step, with the CNN of the close-look model it trains)
 //   --model-name NAME: DIR/NAME.yml.gz and DIR/NAME.json (default victim_detector; e.g.
 //   victim_detector_close for one trained with --view-altitudes 10,20 --cnn-patch-px 48)
 //   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):
@@ -139,6 +143,9 @@ constexpr Flag kFlags[] = {
     {"--view-altitudes", true, SetViewAltitudes},
     {"--model-name", true, [](const char* v, Args* a) { a->model_name = v; return true; }},
     {"--replace-cnn", true, [](const char* v, Args* a) { a->options.replace_cnn = v; return true; }},
+    {"--close-cnn", true, [](const char* v, Args* a) { a->options.close_cnn = v; return true; }},
+    {"--close-cnn-patch-px", true,
+     [](const char* v, Args* a) { a->options.close_cnn_patch_px = std::stoi(v); return true; }},
 };
 
 // The flag named `a` when it is complete at argv[i] (its value, if it takes one, follows).
@@ -164,7 +171,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
                    "[--cnn-widths A,B,C] [--cnn-negatives N] [--cnn-hard-fraction F] [--cnn-patch-px N] "
                    "[--cnn-symmetries 1|4|8]] "
                    "[--view-altitudes LO,HI] [--model-name NAME] "
-                   "[--recalibrate --replace-cnn FILE]\n");
+                   "[--recalibrate --replace-cnn FILE] "
+                   "[--recalibrate --close-cnn FILE [--close-cnn-patch-px N] --close-calibration-altitude M]\n");
       return kUsageError;
     }
     const char* value = flag->takes_value ? argv[++i] : nullptr;
@@ -174,8 +182,8 @@ int ParseArgs(int argc, char** argv, Args* args) {
     std::fprintf(stderr, "swarmbox-train-detector: --out-dir is required\n");
     return kUsageError;
   }
-  if (!args->options.replace_cnn.empty() && !args->recalibrate) {
-    std::fprintf(stderr, "swarmbox-train-detector: --replace-cnn goes with --recalibrate\n");
+  if ((!args->options.replace_cnn.empty() || !args->options.close_cnn.empty()) && !args->recalibrate) {
+    std::fprintf(stderr, "swarmbox-train-detector: --replace-cnn and --close-cnn go with --recalibrate\n");
     return kUsageError;
   }
   if (args->options.cnn_onnx_out.empty()) args->options.cnn_onnx_out = args->out_dir + "/" + args->model_name + "_cnn.onnx";
@@ -204,7 +212,7 @@ std::string MergeRecalibratedReport(const std::string& old_json, const std::stri
     if (calibration_line(line)) fresh += line + "\n";
   }
   while (std::getline(old_lines, line)) {
-    if (calibration_line(line)) continue;
+    if (calibration_line(line) || line.find("\"recalibrated\"") != std::string::npos) continue;
     if (line.find("\"training_seconds\"") != std::string::npos) {
       merged += fresh + "  \"recalibrated\": true,\n";
     }

@@ -602,6 +602,12 @@ void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::st
   add(o.clean_calibration, "--clean-calibration", "");
   add(o.operating_precision > 0, "--operating-precision", precision.str());
   add(!o.replace_cnn.empty(), "--replace-cnn", o.replace_cnn.substr(o.replace_cnn.find_last_of('/') + 1));
+  if (!o.close_cnn.empty()) {  // a new close CNN replaces one the recipe named
+    EraseFlag(" --close-cnn ", recipe);
+    EraseFlag(" --close-cnn-patch-px ", recipe);
+    *recipe += " --close-cnn " + o.close_cnn.substr(o.close_cnn.find_last_of('/') + 1) +
+               " --close-cnn-patch-px " + std::to_string(o.close_cnn_patch_px);
+  }
   if (o.cnn_symmetries > 0) {  // the new count replaces one the recipe named
     EraseFlag(" --cnn-symmetries ", recipe);
     *recipe += " --cnn-symmetries " + std::to_string(o.cnn_symmetries);
@@ -612,15 +618,14 @@ void AppendRecalibrationRecipe(const TrainingOptions& o, bool new_seeds, std::st
 
 namespace {
 
-// The ONNX at `path` into model->cnn_onnx, checked to load in cv::dnn.
-Status ReadCnn(const std::string& path, swarm::VictimDetectorModel* model) {
+// The ONNX at `path` into *onnx (the model's cnn_onnx or close_cnn_onnx), checked to load in cv::dnn.
+Status ReadCnn(const std::string& path, std::vector<std::uint8_t>* onnx) {
   std::ifstream in(path, std::ios::binary | std::ios::ate);
-  model->cnn_onnx.resize(in ? static_cast<std::size_t>(in.tellg()) : 0);
+  onnx->resize(in ? static_cast<std::size_t>(in.tellg()) : 0);
   in.seekg(0);
-  in.read(reinterpret_cast<char*>(model->cnn_onnx.data()),
-          static_cast<std::streamsize>(model->cnn_onnx.size()));
-  if (!in) model->cnn_onnx.clear();
-  if (model->cnn_onnx.empty()) {
+  in.read(reinterpret_cast<char*>(onnx->data()), static_cast<std::streamsize>(onnx->size()));
+  if (!in) onnx->clear();
+  if (onnx->empty()) {
     return Error(ErrorCode::kIo, "train-detector: no ONNX there (missing or empty)", path);
   }
   try {
@@ -660,24 +665,30 @@ double MedianScale(const std::vector<Scene>& scenes) {
 Status CalibrateClose(const std::vector<Scene>& search_calibration, const TrainingOptions& o,
                       swarm::VictimDetectorModel* model) {
   model->close_px_per_m = 0;
-  if (o.close_calibration_altitude_m <= 0) return Ok{};
+  if (o.close_calibration_altitude_m <= 0) {
+    model->close_cnn_onnx.clear();  // a close CNN goes with the close sigmoid
+    model->close_cnn_patch_px = 0;
+    return Ok{};
+  }
   TrainingOptions at_close = o;
   at_close.calibration_altitude_m = o.close_calibration_altitude_m;
   at_close.operating_precision = 0;
   Result<std::vector<Scene>> close = RenderCalibrationSets(at_close);
   if (!close) return close.error();
-  swarm::VictimDetectorModel fitted = *model;
+  // With a close CNN the sigmoid is fitted to its logits: the model as close frames see it.
+  swarm::VictimDetectorModel fitted = model->has_close_cnn() ? model->CloseView() : *model;
   TrainingReport figures;
   if (Status st = Calibrate(*close, at_close, &fitted, &figures); !st) return st.error();
   model->close_platt_a = fitted.platt_a;
   model->close_platt_b = fitted.platt_b;
   model->close_px_per_m = std::sqrt(MedianScale(search_calibration) * MedianScale(*close));
-  std::fprintf(
-      stderr,
-      "train-detector: close sigmoid from %zu scenes at %.0f m (a %.4f, b %.4f) for frames of >= %.2f px/m: "
-      "precision %.4f recall %.4f at 0.5 there\n",
-      close->size(), o.close_calibration_altitude_m, fitted.platt_a, fitted.platt_b, model->close_px_per_m,
-      figures.precision, figures.recall);
+  std::fprintf(stderr,
+               "train-detector: close sigmoid%s from %zu scenes at %.0f m (a %.4f, b %.4f) for frames of >= "
+               "%.2f px/m: "
+               "precision %.4f recall %.4f at 0.5 there\n",
+               model->has_close_cnn() ? " (of the close CNN)" : "", close->size(),
+               o.close_calibration_altitude_m, fitted.platt_a, fitted.platt_b, model->close_px_per_m,
+               figures.precision, figures.recall);
   return Ok{};
 }
 
@@ -700,7 +711,14 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
   if (!o.replace_cnn.empty()) {
     if (!model.has_cnn())
       return Error(ErrorCode::kInvalidArgument, "recalibrate: --replace-cnn needs a CNN model", model_path);
-    SWARMBOX_TRY(ReadCnn(o.replace_cnn, &model));
+    SWARMBOX_TRY(ReadCnn(o.replace_cnn, &model.cnn_onnx));
+  }
+  if (!o.close_cnn.empty()) {
+    if (!model.has_cnn() || o.close_calibration_altitude_m <= 0)
+      return Error(ErrorCode::kInvalidArgument,
+                   "recalibrate: --close-cnn needs a CNN model and --close-calibration-altitude", model_path);
+    SWARMBOX_TRY(ReadCnn(o.close_cnn, &model.close_cnn_onnx));
+    model.close_cnn_patch_px = o.close_cnn_patch_px;
   }
   if (o.cnn_symmetries > 0) {
     if (!model.has_cnn())
@@ -740,6 +758,7 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
       o.world_sets < 0 || o.world_distractors < 0 || o.stage1_rounds < 0 ||
       (o.stage1_rounds > 0 && o.blob_features) || o.calibration_altitude_m < 0 || o.cnn_epochs < 1 ||
       (!o.cnn_script.empty() && o.cnn_onnx_out.empty()) || !swarm::ValidCnnPatchPx(o.cnn_patch_px) ||
+      !swarm::ValidCnnPatchPx(o.close_cnn_patch_px) ||
       (o.cnn_symmetries != 0 && !swarm::ValidCnnSymmetries(o.cnn_symmetries)) || !CloseCalibrationOk(o) ||
       ((o.view_min_altitude_m != 0 || o.view_max_altitude_m != 0) &&
        !(o.view_min_altitude_m >= 2 && o.view_max_altitude_m > o.view_min_altitude_m))) {
@@ -750,7 +769,9 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
         "world_sets, world_distractors, stage1_rounds (not with blob features) and "
         "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-symmetries is 1, 4 "
         "or 8, --close-calibration-altitude is above 3 m and at least 6 m under --calibration-altitude, "
-        "--cnn-patch-px is a multiple of 8 in [16, 128], --view-altitudes LO,HI has 2 <= LO < HI");
+        "--cnn-patch-px and --close-cnn-patch-px are multiples of 8 in [16, 128], --view-altitudes LO,HI has "
+        "2 <= LO < "
+        "HI");
   }
   if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1 ||
                                 !(o.cnn_hard_fraction >= 0 && o.cnn_hard_fraction < 1))) {
@@ -1169,7 +1190,7 @@ Status TrainCnnStage(Training& t, const std::vector<Scene>& train, const std::ve
   SWARMBOX_TRY(RunCnnScript(t.o, patches, t.o.cnn_onnx_out));
   t.model.cnn_patch_px = t.o.cnn_patch_px;
   t.model.cnn_symmetries = t.o.cnn_symmetries > 0 ? t.o.cnn_symmetries : 1;
-  SWARMBOX_TRY(ReadCnn(t.o.cnn_onnx_out, &t.model));
+  SWARMBOX_TRY(ReadCnn(t.o.cnn_onnx_out, &t.model.cnn_onnx));
   t.model.forest.release();
   std::fprintf(stderr, "train-detector: CNN of %zu bytes (%.0f s)\n", t.model.cnn_onnx.size(), Seconds(t.t0));
   return Ok{};
@@ -1297,7 +1318,12 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
   j << "  \"platt\": {\"a\": " << model.platt_a << ", \"b\": " << model.platt_b;
   if (model.close_px_per_m > 0) {  // on the same line: a recalibration's report takes it with the first
     j << ", \"close\": {\"a\": " << model.close_platt_a << ", \"b\": " << model.close_platt_b
-      << ", \"from_px_per_m\": " << model.close_px_per_m << "}";
+      << ", \"from_px_per_m\": " << model.close_px_per_m;
+    if (model.has_close_cnn()) {
+      j << ", \"close_cnn_patch_px\": " << model.close_cnn_patch_px
+        << ", \"close_cnn_bytes\": " << model.close_cnn_onnx.size();
+    }
+    j << "}";
   }
   j << "},\n";
   j << "  \"calibration_figures\": {\"persons_at_least_half_visible\": " << r.calibration_persons

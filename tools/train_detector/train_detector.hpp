@@ -131,6 +131,13 @@ struct TrainingOptions {
   // Recalibrate() only: when not empty, this ONNX (train_cnn.py's, e.g. run again on a model's
   // exported patches with other settings) replaces the model's CNN before the sigmoid is refitted.
   std::string replace_cnn;
+  // Recalibrate() only: when not empty, this ONNX becomes the model's close-look CNN
+  // (VictimDetectorModel::close_cnn_onnx: train_cnn.py's, on patches of close_cnn_patch_px from
+  // views near the close altitude, e.g. the CNN of the train-close-detector target's model), and
+  // the close sigmoid (close_calibration_altitude_m, which it needs) is fitted to its logits on the
+  // model's own candidates. Without it a recalibration keeps the model's close CNN, if any.
+  std::string close_cnn;
+  int close_cnn_patch_px = 64;
 };
 
 // The patch file (--export-patches), little-endian:

@@ -68,6 +68,11 @@ VictimDetector::VictimDetector(std::shared_ptr<const VictimDetectorModel> model,
     cnn_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
     cnn_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
   }
+  if (model_->has_close_cnn()) {
+    SWARMBOX_CHECK(model_->close_px_per_m > 0);
+    close_ =
+        std::make_unique<VictimDetector>(std::make_shared<VictimDetectorModel>(model_->CloseView()), params_);
+  }
   candidates_.reserve(static_cast<std::size_t>(params_.max_candidates) * 4);
   scratch_.reserve(static_cast<std::size_t>(params_.max_candidates));
   kept_.reserve(static_cast<std::size_t>(params_.max_candidates));
@@ -210,6 +215,10 @@ template <typename KeepFn>
 void VictimDetector::DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn keep, std::vector<ImageBlob>* out) {
   SWARMBOX_CHECK(bgr.type() == CV_8UC3);
   SWARMBOX_CHECK(pixels_per_m > 0);
+  if (close_ && pixels_per_m >= model_->close_px_per_m) {  // the close look's CNN and sigmoid
+    close_->DetectImpl(bgr, pixels_per_m, keep, out);
+    return;
+  }
   out->clear();
   const std::vector<Candidate>& cands = Candidates(bgr, pixels_per_m, params_.max_candidates, model_->stage1_threshold);
   if (cands.empty()) return;

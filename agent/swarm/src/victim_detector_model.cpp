@@ -161,6 +161,18 @@ double Platt(double a, double b, double votes) { return 1.0 / (1.0 + std::exp(a 
 
 double VictimDetectorModel::Probability(double votes) const { return Platt(platt_a, platt_b, votes); }
 
+VictimDetectorModel VictimDetectorModel::CloseView() const {
+  VictimDetectorModel close = *this;
+  close.cnn_onnx = close_cnn_onnx;
+  close.cnn_patch_px = close_cnn_patch_px;
+  close.platt_a = close_platt_a;
+  close.platt_b = close_platt_b;
+  close.close_px_per_m = 0;
+  close.close_cnn_onnx.clear();
+  close.close_cnn_patch_px = 0;
+  return close;
+}
+
 double VictimDetectorModel::Probability(double votes, double pixels_per_m) const {
   const bool close = close_px_per_m > 0 && pixels_per_m >= close_px_per_m;
   return close ? Platt(close_platt_a, close_platt_b, votes) : Probability(votes);
@@ -176,6 +188,12 @@ void WriteSecondStage(const VictimDetectorModel& model, cv::FileStorage& fs) {
     if (model.cnn_symmetries != 1) fs << "cnn_symmetries" << model.cnn_symmetries;
     fs << "cnn_onnx" << cv::Mat(1, static_cast<int>(model.cnn_onnx.size()), CV_8U,
                                 const_cast<std::uint8_t*>(model.cnn_onnx.data()));
+    if (model.has_close_cnn()) {
+      fs << "close_cnn_patch_px" << model.close_cnn_patch_px;
+      fs << "close_cnn_onnx"
+         << cv::Mat(1, static_cast<int>(model.close_cnn_onnx.size()), CV_8U,
+                    const_cast<std::uint8_t*>(model.close_cnn_onnx.data()));
+    }
     return;
   }
   fs << "forest" << "{";
@@ -274,16 +292,32 @@ Status ReadKernels(cv::FileStorage& fs, const std::string& where, VictimDetector
   return Ok{};
 }
 
-// The forest (flattened), or the CNN's ONNX bytes when the file has them, into *m.
+// The ONNX bytes under `key` into *bytes.
+Status ReadOnnx(cv::FileStorage& fs, const char* key, const std::string& where,
+                std::vector<std::uint8_t>* bytes) {
+  cv::Mat onnx;
+  fs[key] >> onnx;
+  if (onnx.empty() || onnx.type() != CV_8U || !onnx.isContinuous()) {
+    return Error(ErrorCode::kInvalidArgument, std::string("detector model: ") + key + " is not a byte row",
+                 where);
+  }
+  bytes->assign(onnx.ptr<std::uint8_t>(0), onnx.ptr<std::uint8_t>(0) + onnx.total());
+  return Ok{};
+}
+
+// The forest (flattened), or the CNN's ONNX bytes (and the close look's, optional) when the file
+// has them, into *m.
 Status ReadSecondStage(cv::FileStorage& fs, const std::string& where, VictimDetectorModel* m) {
   if (!fs["cnn_onnx"].empty()) {
-    cv::Mat onnx;
-    fs["cnn_onnx"] >> onnx;
-    if (onnx.empty() || onnx.type() != CV_8U || !onnx.isContinuous()) {
-      return Error(ErrorCode::kInvalidArgument, "detector model: the CNN's ONNX bytes are not a byte row", where);
+    SWARMBOX_TRY(ReadOnnx(fs, "cnn_onnx", where, &m->cnn_onnx));
+    if (fs["close_cnn_onnx"].empty()) return Ok{};
+    m->close_cnn_patch_px = static_cast<int>(fs["close_cnn_patch_px"]);
+    if (!ValidCnnPatchPx(m->close_cnn_patch_px) || m->close_px_per_m <= 0) {
+      return Error(ErrorCode::kInvalidArgument,
+                   "detector model: a close-look CNN needs a valid close_cnn_patch_px and close_px_per_m",
+                   where);
     }
-    m->cnn_onnx.assign(onnx.ptr<std::uint8_t>(0), onnx.ptr<std::uint8_t>(0) + onnx.total());
-    return Ok{};
+    return ReadOnnx(fs, "close_cnn_onnx", where, &m->close_cnn_onnx);
   }
   m->forest = cv::ml::RTrees::create();
   m->forest->read(fs["forest"]);

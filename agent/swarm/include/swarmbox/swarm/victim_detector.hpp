@@ -26,6 +26,11 @@
 // capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
 // Detections under min_confidence are not reported.
 //
+// A model with a close-look CNN (VictimDetectorModel::close_cnn_onnx, the shipped one): frames at
+// least close_px_per_m fine on the ground (the mission's close looks from 18 m: 25.8 px/m; the
+// switch is 20 px/m, 23 m for the x500's camera) get the same first stage, then that CNN on finer
+// patches (64 px over 3 m) and the close sigmoid (model.CloseView(), run by a second detector).
+//
 // Cost with the shipped CNN (24, 48, 96 channels, up to 96 candidates): ~13 ms per 640 x 360 frame
 // at 10 m, ~31 ms at 30 m, ~48 ms at 60 m on one core (BENCHMARKS.md "Perception: spread candidates
 // and a wider CNN"; the scale of step 1 makes low altitudes cheaper and high ones dearer: at 60 m
@@ -101,6 +106,8 @@ class VictimDetector {
 
   const VictimDetectorParams& params() const { return params_; }
   const VictimDetectorModel& model() const { return *model_; }
+  // The close-look CNN's detector (null: the model has none; model().CloseView()).
+  const VictimDetector* close() const { return close_.get(); }
   const ChannelMaps& channels() const { return maps_; }  // of the last frame (training, debugging)
 
   // Steps 1-3 on their own (training mines the forest's samples from these): the first-stage
@@ -135,6 +142,7 @@ class VictimDetector {
   void DetectImpl(const cv::Mat& bgr, double pixels_per_m, KeepFn keep, std::vector<ImageBlob>* out);
 
   std::shared_ptr<const VictimDetectorModel> model_;
+  std::unique_ptr<VictimDetector> close_;  // on model_->CloseView(), for close frames (Detect only)
   VictimDetectorParams params_;
   ChannelMaps maps_;
   BlobFeatureExtractor blob_;

@@ -110,12 +110,23 @@ struct VictimDetectorModel {
   double close_px_per_m = 0;
   double close_platt_a = 0;
   double close_platt_b = 0;
+  // A second CNN for those frames (optional, with close_px_per_m > 0; empty: the CNN above scores
+  // them too): trained on views from 15-21 m, on patches of close_cnn_patch_px over kCnnPatchM (64:
+  // 21.3 px/m, where the search CNN's 48 keep 16 of the camera's 25.8 px/m at 18 m), the close
+  // sigmoid fitted to its logits (tools/train_detector README, "A CNN for the close look").
+  std::vector<std::uint8_t> close_cnn_onnx;
+  int close_cnn_patch_px = 0;
   std::vector<std::uint64_t> training_seeds;     // scene-set seeds the forest was trained on
   std::vector<std::uint64_t> calibration_seeds;  // scene-set seeds the sigmoid was fitted on
   std::string recipe;  // the trainer's options, as its command line (the model's provenance)
 
   int forest_inputs() const { return kForestFeatures + blob_features; }
   bool has_cnn() const { return !cnn_onnx.empty(); }
+  bool has_close_cnn() const { return !close_cnn_onnx.empty(); }
+  // The model as the close frames see it: the same first stage, the close CNN and its patches, the
+  // close sigmoid as its only one (what VictimDetector runs on frames at least close_px_per_m fine,
+  // and what the trainer fits the close sigmoid on).
+  VictimDetectorModel CloseView() const;
 
   // The forest flattened for prediction without allocation (FlattenForest(); the same decisions
   // as cv::ml::DTrees::predict for ordered variables: value <= threshold goes left, unless the split
