@@ -694,6 +694,31 @@ Status CalibrateClose(const std::vector<Scene>& search_calibration, const Traini
 
 }  // namespace
 
+namespace {
+
+// A recalibration's changes to the model's networks: another CNN (--replace-cnn), a close-look CNN
+// (--close-cnn), the symmetries each patch is scored in (--cnn-symmetries).
+Status ApplyCnnOptions(const TrainingOptions& o, const std::string& model_path,
+                       swarm::VictimDetectorModel* model) {
+  if (!model->has_cnn() && (!o.replace_cnn.empty() || !o.close_cnn.empty() || o.cnn_symmetries > 0)) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "recalibrate: --replace-cnn, --close-cnn and --cnn-symmetries need a CNN model", model_path);
+  }
+  if (!o.replace_cnn.empty()) SWARMBOX_TRY(ReadCnn(o.replace_cnn, &model->cnn_onnx));
+  if (!o.close_cnn.empty()) {
+    if (o.close_calibration_altitude_m <= 0) {
+      return Error(ErrorCode::kInvalidArgument, "recalibrate: --close-cnn needs --close-calibration-altitude",
+                   model_path);
+    }
+    SWARMBOX_TRY(ReadCnn(o.close_cnn, &model->close_cnn_onnx));
+    model->close_cnn_patch_px = o.close_cnn_patch_px;
+  }
+  if (o.cnn_symmetries > 0) model->cnn_symmetries = o.cnn_symmetries;
+  return Ok{};
+}
+
+}  // namespace
+
 Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const std::string& model_path,
                                                TrainingReport* report) {
   SWARMBOX_TRY(CheckTrainingOptions(o));  // before the model is read or a frame rendered
@@ -708,24 +733,7 @@ Result<swarm::VictimDetectorModel> Recalibrate(const TrainingOptions& o, const s
                                                     " is one the model was trained on", model_path);
     }
   }
-  if (!o.replace_cnn.empty()) {
-    if (!model.has_cnn())
-      return Error(ErrorCode::kInvalidArgument, "recalibrate: --replace-cnn needs a CNN model", model_path);
-    SWARMBOX_TRY(ReadCnn(o.replace_cnn, &model.cnn_onnx));
-  }
-  if (!o.close_cnn.empty()) {
-    if (!model.has_cnn() || o.close_calibration_altitude_m <= 0)
-      return Error(ErrorCode::kInvalidArgument,
-                   "recalibrate: --close-cnn needs a CNN model and --close-calibration-altitude", model_path);
-    SWARMBOX_TRY(ReadCnn(o.close_cnn, &model.close_cnn_onnx));
-    model.close_cnn_patch_px = o.close_cnn_patch_px;
-  }
-  if (o.cnn_symmetries > 0) {
-    if (!model.has_cnn())
-      return Error(ErrorCode::kInvalidArgument, "recalibrate: --cnn-symmetries needs a CNN model",
-                   model_path);
-    model.cnn_symmetries = o.cnn_symmetries;
-  }
+  SWARMBOX_TRY(ApplyCnnOptions(o, model_path, &model));
   const bool new_seeds = model.calibration_seeds != o.calibration_seeds;
   model.calibration_seeds = o.calibration_seeds;
   Result<std::vector<Scene>> cal = RenderCalibrationSets(o);
@@ -1291,6 +1299,28 @@ std::string MethodText(const swarm::VictimDetectorModel& model) {
 
 }  // namespace
 
+namespace {
+
+// The sigmoids (and the close-look CNN's size) as one JSON object, on one line: a recalibration's
+// report takes it with the first sigmoid.
+std::string PlattJson(const swarm::VictimDetectorModel& model) {
+  std::ostringstream j;
+  j << "{\"a\": " << model.platt_a << ", \"b\": " << model.platt_b;
+  if (model.close_px_per_m > 0) {
+    j << ", \"close\": {\"a\": " << model.close_platt_a << ", \"b\": " << model.close_platt_b
+      << ", \"from_px_per_m\": " << model.close_px_per_m;
+    if (model.has_close_cnn()) {
+      j << ", \"close_cnn_patch_px\": " << model.close_cnn_patch_px
+        << ", \"close_cnn_bytes\": " << model.close_cnn_onnx.size();
+    }
+    j << "}";
+  }
+  j << "}";
+  return j.str();
+}
+
+}  // namespace
+
 std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOptions& o,
                        const TrainingReport& r, const std::string& model_file) {
   std::ostringstream j;
@@ -1315,17 +1345,7 @@ std::string ReportJson(const swarm::VictimDetectorModel& model, const TrainingOp
   j << "  \"stage2\": {\"positives\": " << r.stage2_positives << ", \"negatives\": " << r.stage2_negatives
     << ", \"balance_classes\": " << (o.balance_classes ? "true" : "false") << ", \"hard_negative_rounds\": "
     << o.hard_negative_rounds << ", \"hard_negatives\": " << r.stage2_hard_negatives << ", \"trees\": " << o.forest_trees << ", \"max_depth\": " << o.forest_depth << "},\n";
-  j << "  \"platt\": {\"a\": " << model.platt_a << ", \"b\": " << model.platt_b;
-  if (model.close_px_per_m > 0) {  // on the same line: a recalibration's report takes it with the first
-    j << ", \"close\": {\"a\": " << model.close_platt_a << ", \"b\": " << model.close_platt_b
-      << ", \"from_px_per_m\": " << model.close_px_per_m;
-    if (model.has_close_cnn()) {
-      j << ", \"close_cnn_patch_px\": " << model.close_cnn_patch_px
-        << ", \"close_cnn_bytes\": " << model.close_cnn_onnx.size();
-    }
-    j << "}";
-  }
-  j << "},\n";
+  j << "  \"platt\": " << PlattJson(model) << ",\n";
   j << "  \"calibration_figures\": {\"persons_at_least_half_visible\": " << r.calibration_persons
     << ", \"detections_labelled\": " << r.calibration_detections << ", \"tp_at_0.5\": " << r.calibration_tp
     << ", \"fp_at_0.5\": " << r.calibration_fp << ", \"precision_at_0.5\": " << r.precision

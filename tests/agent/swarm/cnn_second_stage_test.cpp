@@ -356,5 +356,66 @@ TEST(CnnSecondStage, ACloseSigmoidGivesTheConfidenceOnFramesAtLeastThatFine) {
   }
 }
 
+TEST(CnnSecondStage, ACloseLookCnnScoresTheFramesAtLeastThatFineOnTheSameCandidates) {
+  // Given the shipped model (its 48 px CNN) with the fixture network (32 px) as its close-look CNN
+  // from 20 px/m, saved and loaded.
+  VictimDetectorModel m = *ShippedDetectorModel();
+  m.close_cnn_onnx = ReadBytes(kFixture);
+  ASSERT_FALSE(m.close_cnn_onnx.empty()) << kFixture;
+  ASSERT_NE(m.cnn_patch_px, kCnnPatchPx);
+  m.close_cnn_patch_px = kCnnPatchPx;
+  m.close_px_per_m = 20.0;
+  m.close_platt_a = -2.0;
+  m.close_platt_b = 0.5;
+  const std::string path = ::testing::TempDir() + "/close_cnn_model.yml.gz";
+  ASSERT_TRUE(SaveDetectorModel(m, path).ok());
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
+  EXPECT_EQ((*loaded)->close_cnn_onnx, m.close_cnn_onnx);
+  EXPECT_EQ((*loaded)->close_cnn_patch_px, kCnnPatchPx);
+  // Its close view: the same first stage, the close CNN, its patches and the close sigmoid alone.
+  const VictimDetectorModel view = (*loaded)->CloseView();
+  EXPECT_EQ(view.cnn_onnx, m.close_cnn_onnx);
+  EXPECT_EQ(view.cnn_patch_px, kCnnPatchPx);
+  EXPECT_EQ(view.platt_a, -2.0);
+  EXPECT_EQ(view.close_px_per_m, 0.0);
+  EXPECT_FALSE(view.has_close_cnn());
+  EXPECT_EQ(view.stage1_threshold, m.stage1_threshold);
+  // When the detector runs on the frame as a search view (15.5 px/m) and a close look (25 px/m).
+  const VictimDetectorParams all = EveryCandidate();
+  VictimDetector det(*loaded, all), close(std::make_shared<VictimDetectorModel>(view), all);
+  VictimDetectorModel no_close_cnn = **loaded;
+  no_close_cnn.close_cnn_onnx.clear();
+  VictimDetector search(std::make_shared<VictimDetectorModel>(no_close_cnn), all);
+  ASSERT_NE(det.close(), nullptr);
+  EXPECT_EQ(search.close(), nullptr);
+  const cv::Mat frame = TestFrame();
+  for (const double px_per_m : {15.5, 25.0}) {
+    std::vector<ImageBlob> got, want, other;
+    det.Detect(frame, px_per_m, &got);
+    (px_per_m < 20.0 ? search : close).Detect(frame, px_per_m, &want);
+    search.Detect(frame, px_per_m, &other);
+    // Then the coarser frame is scored as without a close CNN, the finer by the close view: the
+    // same candidates, the fixture's logits through the close sigmoid, not the search CNN's.
+    ASSERT_FALSE(got.empty()) << px_per_m;
+    ASSERT_EQ(got.size(), want.size()) << px_per_m;
+    int other_score = 0;
+    for (std::size_t i = 0; i < got.size(); ++i) {
+      EXPECT_EQ(got[i].centroid_px, want[i].centroid_px) << px_per_m;
+      EXPECT_DOUBLE_EQ(got[i].votes, want[i].votes) << px_per_m;
+      EXPECT_DOUBLE_EQ(got[i].confidence, want[i].confidence) << px_per_m;
+      other_score += i < other.size() && other[i].votes != got[i].votes ? 1 : 0;
+    }
+    EXPECT_EQ(other_score > 0, px_per_m >= 20.0) << px_per_m;
+  }
+  // A close CNN without the scale it takes over from is refused with the reason.
+  m.close_px_per_m = 0;
+  ASSERT_TRUE(SaveDetectorModel(m, path).ok());
+  loaded = LoadDetectorModel(path);
+  std::remove(path.c_str());
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.error().ToString().find("close_px_per_m"), std::string::npos) << loaded.error().ToString();
+}
+
 }  // namespace
 }  // namespace swarmbox::swarm

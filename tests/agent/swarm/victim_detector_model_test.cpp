@@ -1,7 +1,6 @@
 // The shipped detector model (agent/swarm/models/, written by `cmake --build build --target
 // train-detector`): it loads, it was trained and calibrated on scene seeds the evaluation never
-// uses, the binary carries the same model as the committed file, the shipped detector runs the
-// close-look CNN on close frames; a forest, flattened as the
+// uses, the binary carries the same model as the committed file; a forest, flattened as the
 // detector runs it, decides as OpenCV's RTrees (the shipped second stage is a CNN).
 #include <algorithm>
 #include <fstream>
@@ -48,11 +47,6 @@ TEST(VictimDetectorModel, TheCommittedModelWasTrainedOnSeedsDisjointFromTheEvalu
   for (std::size_t i = 0; i < model.training_seeds.size(); ++i) seeds << (i ? ", " : "") << model.training_seeds[i];
   seeds << "]";
   EXPECT_NE(json.str().find(seeds.str()), std::string::npos) << seeds.str();
-  // The close-look CNN is the train-close-detector model's, trained on the same seeds (its recipe
-  // in the report names the CNN; tools/train_detector/CMakeLists.txt).
-  EXPECT_TRUE(model.has_close_cnn());
-  EXPECT_NE(json.str().find("--close-cnn victim_detector_close_cnn.onnx --close-cnn-patch-px 64"),
-            std::string::npos);
 }
 
 TEST(VictimDetectorModel, TheBinaryCarriesTheCommittedModel) {
@@ -69,75 +63,6 @@ TEST(VictimDetectorModel, TheBinaryCarriesTheCommittedModel) {
   EXPECT_EQ(shipped->close_cnn_onnx, (*file)->close_cnn_onnx);
   EXPECT_EQ(shipped->close_cnn_patch_px, (*file)->close_cnn_patch_px);
   EXPECT_EQ(cv::norm(shipped->kernels[3], (*file)->kernels[3], cv::NORM_INF), 0.0);
-}
-
-// The shipped detector scores frames at least close_px_per_m fine with the close-look CNN and the
-// close sigmoid (the model's CloseView(): the same first stage) and coarser ones with the search CNN.
-TEST(VictimDetectorModel, TheShippedDetectorRunsTheCloseLookCnnOnCloseFrames) {
-  const std::shared_ptr<const VictimDetectorModel> model = ShippedDetectorModel();
-  ASSERT_TRUE(model->has_close_cnn());
-  const double from = model->close_px_per_m;
-  EXPECT_GT(from, 15.5);  // the x500's camera at the 30 m search altitude: the search CNN's
-  EXPECT_LT(from, 25.8);  // at the 18 m close look: the close-look CNN's
-  const VictimDetectorModel close_view = model->CloseView();
-  EXPECT_EQ(close_view.cnn_onnx, model->close_cnn_onnx);
-  EXPECT_EQ(close_view.cnn_patch_px, model->close_cnn_patch_px);
-  EXPECT_DOUBLE_EQ(close_view.platt_a, model->close_platt_a);
-  EXPECT_FALSE(close_view.has_close_cnn());
-  VictimDetector shipped, close(std::make_shared<VictimDetectorModel>(close_view), {});
-  VictimDetectorModel search_only = *model;
-  search_only.close_cnn_onnx.clear();
-  search_only.close_px_per_m = 0;
-  VictimDetector search(std::make_shared<VictimDetectorModel>(search_only), {});
-  ASSERT_NE(shipped.close(), nullptr);
-  EXPECT_EQ(search.close(), nullptr);
-  const perception_scenes::SceneSetParams set{.seed = 20261121,
-                                              .scenes = 4,
-                                              .scenes_per_world = 4,
-                                              .min_altitude_m = 18,
-                                              .max_altitude_m = 18,
-                                              .near_victim_fraction = 1.0,
-                                              .varied_look = true};
-  Result<std::vector<perception_scenes::Scene>> scenes = perception_scenes::RenderScenes(set);
-  ASSERT_TRUE(scenes.ok()) << scenes.error().ToString();
-  int close_detections = 0, differ = 0;
-  for (const perception_scenes::Scene& s : *scenes) {
-    const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3,
-                      const_cast<std::uint8_t*>(s.image.bgr.data()));
-    for (const double ppm : {from * 1.3, from / 1.3}) {  // a close frame, then a search frame
-      std::vector<ImageBlob> got, want, other;
-      shipped.Detect(bgr, ppm, &got);
-      (ppm >= from ? close : search).Detect(bgr, ppm, &want);
-      ASSERT_EQ(got.size(), want.size()) << ppm;
-      for (std::size_t i = 0; i < got.size(); ++i) {
-        EXPECT_EQ(got[i].centroid_px, want[i].centroid_px);
-        EXPECT_DOUBLE_EQ(got[i].confidence, want[i].confidence);
-      }
-      if (ppm < from) continue;
-      close_detections += static_cast<int>(got.size());
-      search.Detect(bgr, ppm, &other);  // the search CNN on the same close frame scores otherwise
-      differ +=
-          other.size() != got.size() || (!got.empty() && other[0].confidence != got[0].confidence) ? 1 : 0;
-    }
-  }
-  EXPECT_GT(close_detections, 0);
-  EXPECT_GT(differ, 0);
-}
-
-TEST(VictimDetectorModel, ACloseLookCnnKeepsItsPatchSizeThroughTheFile) {
-  VictimDetectorModel m = *ShippedDetectorModel();
-  const std::string path = ::testing::TempDir() + "/close_cnn.yml.gz";
-  ASSERT_TRUE(SaveDetectorModel(m, path).ok());
-  Result<std::shared_ptr<const VictimDetectorModel>> back = LoadDetectorModel(path);
-  ASSERT_TRUE(back.ok()) << back.error().ToString();
-  EXPECT_EQ((*back)->close_cnn_onnx, m.close_cnn_onnx);
-  EXPECT_EQ((*back)->close_cnn_patch_px, m.close_cnn_patch_px);
-  // A close CNN without the scale it takes over from is refused with the reason.
-  m.close_px_per_m = 0;
-  ASSERT_TRUE(SaveDetectorModel(m, path).ok());
-  back = LoadDetectorModel(path);
-  ASSERT_FALSE(back.ok());
-  EXPECT_NE(back.error().ToString().find("close_px_per_m"), std::string::npos) << back.error().ToString();
 }
 
 // A forest as the trainer grows one (depth 14, sqrt(features) per split; fewer trees and samples),
