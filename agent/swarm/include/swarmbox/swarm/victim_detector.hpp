@@ -26,10 +26,11 @@
 // capped at partial_confidence_cap (it cannot confirm a victim alone: MissionState needs 0.9).
 // Detections under min_confidence are not reported.
 //
-// A model with a close-look CNN (VictimDetectorModel::close_cnn_onnx, the shipped one): frames at
-// least close_px_per_m fine on the ground (the mission's close looks from 18 m: 25.8 px/m; the
-// switch is 20 px/m, 23 m for the x500's camera) get the same first stage, then that CNN on finer
-// patches (64 px over 3 m) and the close sigmoid (model.CloseView(), run by a second detector).
+// A model with a close-look CNN (VictimDetectorModel::close_cnn_onnx; tried, not the shipped model:
+// tools/train_detector README "A CNN for the close look"): frames at least close_px_per_m fine on
+// the ground (the mission's close looks from 18 m: 25.8 px/m; the switch is 20 px/m, 23 m for the
+// x500's camera) get the same first stage, then that CNN on its own patches (64 px over 3 m in the
+// one tried) and the close sigmoid (model.CloseView(), run by a second detector).
 //
 // Cost with the shipped CNN (24, 48, 96 channels, up to 96 candidates): ~13 ms per 640 x 360 frame
 // at 10 m, ~31 ms at 30 m, ~48 ms at 60 m on one core (BENCHMARKS.md "Perception: spread candidates

@@ -110,10 +110,11 @@ struct VictimDetectorModel {
   double close_px_per_m = 0;
   double close_platt_a = 0;
   double close_platt_b = 0;
-  // A second CNN for those frames (optional, with close_px_per_m > 0; empty: the CNN above scores
-  // them too): trained on views from 15-21 m, on patches of close_cnn_patch_px over kCnnPatchM (64:
-  // 21.3 px/m, where the search CNN's 48 keep 16 of the camera's 25.8 px/m at 18 m), the close
-  // sigmoid fitted to its logits (tools/train_detector README, "A CNN for the close look").
+  // A second CNN for those frames (optional, with close_px_per_m > 0; empty, as in the shipped
+  // model: the CNN above scores them too), on patches of close_cnn_patch_px over kCnnPatchM, the
+  // close sigmoid fitted to its logits. The one tried (tools/train_detector README, "A CNN for the
+  // close look"; not shipped): trained on views from 15-21 m, 64 px (21.3 px/m, where the search
+  // CNN's 48 keep 16 of the camera's 25.8 px/m at 18 m).
   std::vector<std::uint8_t> close_cnn_onnx;
   int close_cnn_patch_px = 0;
   std::vector<std::uint64_t> training_seeds;     // scene-set seeds the forest was trained on
