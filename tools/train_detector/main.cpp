@@ -10,7 +10,7 @@
 //   swarmbox-train-detector --out-dir DIR --recalibrate --close-cnn FILE.onnx --close-cnn-patch-px 64
 //     --close-calibration-altitude 18 ...
 //   (the same, and FILE.onnx becomes the model's close-look CNN, the close sigmoid fitted to it:
-//   the train-detector target's last step, with the CNN of the close-look model it trains)
+//   the train-close-cnn target's last step, with the CNN of the close-view model it trains first)
 //   --model-name NAME: DIR/NAME.yml.gz and DIR/NAME.json (default victim_detector; e.g.
 //   victim_detector_close for one trained with --view-altitudes 10,20 --cnn-patch-px 48)
 //   Recipe options (the defaults are the shipped model's recipe; README.md "Another recipe"):

@@ -135,7 +135,8 @@ struct TrainingOptions {
   // (VictimDetectorModel::close_cnn_onnx: train_cnn.py's, on patches of close_cnn_patch_px from
   // views near the close altitude, e.g. the CNN of the train-close-detector target's model), and
   // the close sigmoid (close_calibration_altitude_m, which it needs) is fitted to its logits on the
-  // model's own candidates. Without it a recalibration keeps the model's close CNN, if any.
+  // model's own candidates. Without it a recalibration keeps the model's close CNN, if any, when
+  // close_calibration_altitude_m is set (the close sigmoid refitted to it), and drops it otherwise.
   std::string close_cnn;
   int close_cnn_patch_px = 64;
 };
