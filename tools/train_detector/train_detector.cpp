@@ -683,9 +683,8 @@ Status CalibrateClose(const std::vector<Scene>& search_calibration, const Traini
   model->close_platt_b = fitted.platt_b;
   model->close_px_per_m = std::sqrt(MedianScale(search_calibration) * MedianScale(*close));
   std::fprintf(stderr,
-               "train-detector: close sigmoid%s from %zu scenes at %.0f m (a %.4f, b %.4f) for frames of >= "
-               "%.2f px/m: "
-               "precision %.4f recall %.4f at 0.5 there\n",
+               "train-detector: close sigmoid%s from %zu scenes at %.0f m (a %.4f, b %.4f) "
+               "for frames of >= %.2f px/m: precision %.4f recall %.4f at 0.5 there\n",
                model->has_close_cnn() ? " (of the close CNN)" : "", close->size(),
                o.close_calibration_altitude_m, fitted.platt_a, fitted.platt_b, model->close_px_per_m,
                figures.precision, figures.recall);
@@ -777,9 +776,8 @@ Status CheckTrainingOptions(const TrainingOptions& o) {
         "world_sets, world_distractors, stage1_rounds (not with blob features) and "
         "calibration_altitude_m >= 0, cnn_epochs >= 1, a CNN needs its ONNX path, --cnn-symmetries is 1, 4 "
         "or 8, --close-calibration-altitude is above 3 m and at least 6 m under --calibration-altitude, "
-        "--cnn-patch-px and --close-cnn-patch-px are multiples of 8 in [16, 128], --view-altitudes LO,HI has "
-        "2 <= LO < "
-        "HI");
+        "--cnn-patch-px and --close-cnn-patch-px are multiples of 8 in [16, 128], "
+        "--view-altitudes LO,HI has 2 <= LO < HI");
   }
   if (!o.cnn_script.empty() && (!ThreeWidths(o.cnn_widths) || o.cnn_negatives_per_epoch < 1 ||
                                 !(o.cnn_hard_fraction >= 0 && o.cnn_hard_fraction < 1))) {

@@ -80,6 +80,16 @@ VictimDetectorModel FixtureModel() {
   return m;
 }
 
+// `m` written to a file in the test's temporary folder and read back (the file removed): what a
+// model file keeps of it, or why it cannot be read.
+Result<std::shared_ptr<const VictimDetectorModel>> ThroughTheFile(const VictimDetectorModel& m) {
+  const std::string path = ::testing::TempDir() + "/cnn_second_stage_model.yml.gz";
+  if (Status st = SaveDetectorModel(m, path); !st) return st.error();
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  std::remove(path.c_str());
+  return loaded;
+}
+
 // Every candidate kept: no threshold, suppression or partial-view cap.
 VictimDetectorParams EveryCandidate() {
   VictimDetectorParams all;
@@ -225,9 +235,7 @@ TEST(CnnSecondStage, AModelWithACnnRoundTripsAndScoresEachCandidateByItsPatch) {
   // Given the shipped first stage with the fixture network as its second stage, saved and loaded.
   VictimDetectorModel with_cnn = FixtureModel();
   ASSERT_FALSE(with_cnn.cnn_onnx.empty()) << kFixture;
-  const std::string path = ::testing::TempDir() + "/cnn_model.yml.gz";
-  ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
-  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = ThroughTheFile(with_cnn);
   ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
   ASSERT_TRUE((*loaded)->has_cnn());
   EXPECT_EQ((*loaded)->cnn_onnx, with_cnn.cnn_onnx);
@@ -254,7 +262,6 @@ TEST(CnnSecondStage, AModelWithACnnRoundTripsAndScoresEachCandidateByItsPatch) {
     EXPECT_NEAR(b.confidence, with_cnn.Probability(b.votes), 1e-12);
   }
   EXPECT_EQ((*loaded)->cnn_symmetries, 1);  // a file without the field: the network once
-  std::remove(path.c_str());
 }
 
 // The patch turned by 90 degrees `turns` times (counter-clockwise), by transposes and flips.
@@ -273,7 +280,6 @@ TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirr
   ASSERT_FALSE(with_cnn.cnn_onnx.empty()) << kFixture;
   cv::dnn::Net net = cv::dnn::readNetFromONNX(reinterpret_cast<const char*>(with_cnn.cnn_onnx.data()),
                                               with_cnn.cnn_onnx.size());
-  const std::string path = ::testing::TempDir() + "/cnn_symmetries_model.yml.gz";
   const VictimDetectorParams all = EveryCandidate();
   const cv::Mat frame = TestFrame();
   constexpr double kPxPerM = 15.5;
@@ -281,8 +287,7 @@ TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirr
     // Given the fixture network scoring each patch in `symmetries` of the square's symmetries,
     // saved and loaded.
     with_cnn.cnn_symmetries = symmetries;
-    ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
-    Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+    Result<std::shared_ptr<const VictimDetectorModel>> loaded = ThroughTheFile(with_cnn);
     ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
     EXPECT_EQ((*loaded)->cnn_symmetries, symmetries);
     // When the detector runs it on a frame.
@@ -315,9 +320,7 @@ TEST(CnnSecondStage, WithSymmetriesAScoreIsTheMeanLogitOverThePatchsTurnsAndMirr
   }
   // And a count the detector does not know is refused when the file is loaded.
   with_cnn.cnn_symmetries = 3;
-  ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
-  EXPECT_FALSE(LoadDetectorModel(path).ok());
-  std::remove(path.c_str());
+  EXPECT_FALSE(ThroughTheFile(with_cnn).ok());
 }
 
 TEST(CnnSecondStage, ACloseSigmoidGivesTheConfidenceOnFramesAtLeastThatFine) {
@@ -329,11 +332,8 @@ TEST(CnnSecondStage, ACloseSigmoidGivesTheConfidenceOnFramesAtLeastThatFine) {
   with_cnn.close_px_per_m = 20.0;
   with_cnn.close_platt_a = -2.0;
   with_cnn.close_platt_b = 0.5;
-  const std::string path = ::testing::TempDir() + "/cnn_close_model.yml.gz";
-  ASSERT_TRUE(SaveDetectorModel(with_cnn, path).ok());
-  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = ThroughTheFile(with_cnn);
   ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
-  std::remove(path.c_str());
   EXPECT_EQ((*loaded)->close_px_per_m, 20.0);
   EXPECT_EQ((*loaded)->close_platt_a, -2.0);
   EXPECT_EQ((*loaded)->close_platt_b, 0.5);
@@ -367,9 +367,7 @@ TEST(CnnSecondStage, ACloseLookCnnScoresTheFramesAtLeastThatFineOnTheSameCandida
   m.close_px_per_m = 20.0;
   m.close_platt_a = -2.0;
   m.close_platt_b = 0.5;
-  const std::string path = ::testing::TempDir() + "/close_cnn_model.yml.gz";
-  ASSERT_TRUE(SaveDetectorModel(m, path).ok());
-  Result<std::shared_ptr<const VictimDetectorModel>> loaded = LoadDetectorModel(path);
+  Result<std::shared_ptr<const VictimDetectorModel>> loaded = ThroughTheFile(m);
   ASSERT_TRUE(loaded.ok()) << loaded.error().ToString();
   EXPECT_EQ((*loaded)->close_cnn_onnx, m.close_cnn_onnx);
   EXPECT_EQ((*loaded)->close_cnn_patch_px, kCnnPatchPx);
@@ -410,9 +408,7 @@ TEST(CnnSecondStage, ACloseLookCnnScoresTheFramesAtLeastThatFineOnTheSameCandida
   }
   // A close CNN without the scale it takes over from is refused with the reason.
   m.close_px_per_m = 0;
-  ASSERT_TRUE(SaveDetectorModel(m, path).ok());
-  loaded = LoadDetectorModel(path);
-  std::remove(path.c_str());
+  loaded = ThroughTheFile(m);
   ASSERT_FALSE(loaded.ok());
   EXPECT_NE(loaded.error().ToString().find("close_px_per_m"), std::string::npos) << loaded.error().ToString();
 }
