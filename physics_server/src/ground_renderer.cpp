@@ -6,11 +6,13 @@
 #include <numbers>
 #include <vector>
 
-#include "detail/render_scene.hpp"
-
 #include <opencv2/imgproc.hpp>
 
+#include "detail/render_scene.hpp"
+#include "detail/scene_draw.hpp"
+
 namespace swarmbox::physics {
+namespace detail {
 namespace {
 
 // 3x3 rotation (row-major) from a unit quaternion (body -> world).
@@ -53,23 +55,6 @@ std::array<double, 9> Mul(const std::array<double, 9>& a, const std::array<doubl
       for (int k = 0; k < 3; ++k) c[static_cast<std::size_t>(i * 3 + j)] += a[static_cast<std::size_t>(i * 3 + k)] * b[static_cast<std::size_t>(k * 3 + j)];
   return c;
 }
-
-// Projects world points through the optical camera; returns false if any lies behind it.
-struct Projector {
-  std::array<double, 9> r_wc;  // optical -> world (columns: optical axes in world)
-  Vec3 c;                      // camera centre, world
-  CameraIntrinsics k;
-
-  bool Project(const Vec3& p, cv::Point2f* out) const {
-    const Vec3 d = p - c;
-    const double xc = r_wc[0] * d.x + r_wc[3] * d.y + r_wc[6] * d.z;
-    const double yc = r_wc[1] * d.x + r_wc[4] * d.y + r_wc[7] * d.z;
-    const double zc = r_wc[2] * d.x + r_wc[5] * d.y + r_wc[8] * d.z;
-    if (zc < 0.05) return false;
-    *out = cv::Point2f(static_cast<float>(k.fx_px * xc / zc + k.cx_px), static_cast<float>(k.fy_px * yc / zc + k.cy_px));
-    return true;
-  }
-};
 
 // Projects a convex 3D polygon to a fixed-point convex hull (kShift fractional bits); false when
 // any vertex lies behind the camera.
@@ -148,8 +133,7 @@ bool MayShow(const Projector& cam, const Vec3& centre, double radius_m, int w, i
   return q.x > -margin && q.y > -margin && q.x < w + margin && q.y < h + margin;
 }
 
-constexpr int kNoiseTilePx = 1024;
-constexpr double kNoiseScale = 16.0;  // tile std; frames rescale to their noise_std
+}  // namespace
 
 // The ground plane z = 0 through one homography texel -> pixel:
 // pixel ~ K * R_cw * [e1 e2 -C] * T * texel. A camera at or below the ground sees dark.
@@ -166,12 +150,12 @@ void DrawGround(const detail::RenderScene& scene, const Projector& cam, cv::Mat&
   if (C.z > 0.01) {
     cv::warpPerspective(scene.texture, img, cv::Mat(H), img.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT101);
   } else {
-    img.setTo(cv::Scalar(40, 60, 70));
+    img.setTo(scene.underground);
   }
 }
 
 // Sky: pixels whose ray has world z >= 0. ray_w.z = a*u + b*v + c, a half-plane of the image.
-void DrawSky(const Projector& cam, cv::Mat& img) {
+void DrawSky(const Projector& cam, const cv::Scalar& sky_colour, cv::Mat& img) {
   const auto& R = cam.r_wc;
   const CameraIntrinsics& k = cam.k;
   const int w = img.cols, h = img.rows;
@@ -191,14 +175,8 @@ void DrawSky(const Projector& cam, cv::Mat& img) {
       sky.emplace_back(cv::Point(static_cast<int>(std::lround(x.x)), static_cast<int>(std::lround(x.y))));
     }
   }
-  if (sky.size() >= 3) cv::fillConvexPoly(img, sky, cv::Scalar(235, 206, 135));
+  if (sky.size() >= 3) cv::fillConvexPoly(img, sky, sky_colour);
 }
-
-// A person in view: its figure and its unclipped box.
-struct InView {
-  const detail::Figure* figure;
-  cv::Rect box;
-};
 
 // Distractors, then people (with their cover), then obstacles and trees, lowest top first; each
 // person's label (index + 1) into `labels` (when set) under everything drawn over it. Appends the
@@ -227,7 +205,7 @@ void DrawScene(const detail::RenderScene& scene, const Projector& cam, cv::Mat& 
         FillProjected(img, cam, d.parts[0].pts, d.parts[0].colour, labels, 0);
         FillProjected(img, cam, d.parts[1].pts, d.parts[1].colour);
       } else {
-        FillProjected(img, cam, d.parts[0].pts, cv::Scalar(90, 95, 100), labels, 0);
+        FillProjected(img, cam, d.parts[0].pts, scene.box_below, labels, 0);
       }
       continue;
     }
@@ -250,6 +228,31 @@ void ListVisible(const WorldConfig& config, const cv::Mat& labels, const Project
     people->push_back({config.victims[p.figure->victim].id, clipped, std::min(1.0, seen / std::max(1.0, full))});
   }
 }
+
+Projector MakeProjector(const Pose& body_pose, const Pose& optical_pose, const CameraIntrinsics& k) {
+  return Projector{Mul(RotationOf(body_pose.attitude), kBodyFromOptical), optical_pose.position_m, k};
+}
+
+Pose OpticalPoseAt(const Pose& body, const Vec3& offset_m) {
+  Pose p;
+  p.position_m = body.position_m + Rotate(body.attitude, offset_m);
+  p.attitude = QuatOf(Mul(RotationOf(body.attitude), kBodyFromOptical));
+  return p;
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::DrawGround;
+using detail::DrawScene;
+using detail::DrawSky;
+using detail::InView;
+using detail::ListVisible;
+using detail::Projector;
+
+constexpr int kNoiseTilePx = 1024;
+constexpr double kNoiseScale = 16.0;  // tile std; frames rescale to their noise_std
 
 // Exposure: auto-exposure lengthens the exposure as the light falls (up to 8x), then raises the
 // analog gain (up to 4x); a frame's exposure misses its target by a seeded few per cent.
@@ -356,15 +359,16 @@ CameraIntrinsics IntrinsicsFor(const CameraSpec& spec) {
 }
 
 Pose OpticalPose(const Pose& body, const CameraSpec& spec) {
-  Pose p;
-  p.position_m = body.position_m + Rotate(body.attitude, spec.offset_m);
-  p.attitude = QuatOf(Mul(RotationOf(body.attitude), kBodyFromOptical));
-  return p;
+  return detail::OpticalPoseAt(body, spec.offset_m);
 }
 
 GroundRenderer::GroundRenderer(const WorldConfig& config)
     : config_(&config), scene_(std::make_unique<detail::RenderScene>(detail::BuildScene(config))) {
   texel_m_ = scene_->texel_m;
+  // The thermal scene's maps (ThermalSceneOf): not needed to draw colours.
+  scene_->vegetation.release();
+  scene_->wet.release();
+  scene_->shadow.release();
 }
 
 GroundRenderer::~GroundRenderer() = default;
@@ -385,10 +389,10 @@ void GroundRenderer::Render(const Pose& body_pose, const Vec3& body_rates_rad_s,
   out->camera_pose = OpticalPose(body_pose, spec);
   out->bgr.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * 3);
   cv::Mat img(h, w, CV_8UC3, out->bgr.data());
-  const Projector cam{Mul(RotationOf(body_pose.attitude), kBodyFromOptical), out->camera_pose.position_m, out->intrinsics};
+  const Projector cam = detail::MakeProjector(body_pose, out->camera_pose, out->intrinsics);
 
   DrawGround(scene, cam, img);
-  DrawSky(cam, img);
+  DrawSky(cam, scene.sky, img);
   cv::Mat* labels = nullptr;  // truth: each person's label (index + 1), 0 elsewhere
   if (people != nullptr) {
     labels_.create(h, w, CV_16U);

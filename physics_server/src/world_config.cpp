@@ -183,7 +183,9 @@ void ReadWorldLists(MapReader& r, WorldConfig* w) {
 void ReadWorldSections(MapReader& r, WorldConfig* w) {
   Nested(r, "lighting", "lighting", false, [w](MapReader& g, const Node&) {
     Lighting l;
-    g.Optional("time_of_day_h", &l.time_of_day_h).Optional("overcast", &l.overcast);
+    g.Optional("time_of_day_h", &l.time_of_day_h)
+        .Optional("overcast", &l.overcast)
+        .Optional("air_temperature_c", &l.air_temperature_c);
     w->lighting = l;
   });
   Nested(r, "terrain", "terrain", false, [w](MapReader& g, const Node&) {
@@ -211,6 +213,10 @@ Status CheckLook(const Node& root, WorldConfig* w) {
     }
     if (!(w->lighting->overcast >= 0 && w->lighting->overcast <= 1)) {
       return Error(ErrorCode::kInvalidArgument, "world: lighting overcast must be within 0..1", n.Where());
+    }
+    if (!(w->lighting->air_temperature_c >= -40 && w->lighting->air_temperature_c <= 50)) {
+      return Error(ErrorCode::kInvalidArgument, "world: lighting air_temperature_c must be within -40..50",
+                   n.Where());
     }
   }
   if (w->terrain) {

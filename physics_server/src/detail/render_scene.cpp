@@ -9,6 +9,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "detail/thermal_scene.hpp"
 #include "swarmbox/physics/ground_renderer.hpp"
 
 namespace swarmbox::physics::detail {
@@ -79,25 +80,35 @@ constexpr std::array<Bgr, 5> kSkin = {{{130, 160, 215}, {105, 140, 190}, {80, 11
 constexpr std::array<Bgr, 4> kHair = {{{20, 25, 30}, {30, 50, 80}, {70, 110, 150}, {40, 40, 45}}};
 constexpr std::array<Bgr, 5> kTrousers = {{{95, 65, 45}, {40, 50, 60}, {55, 55, 55}, {80, 100, 95}, {30, 35, 40}}};
 
+// A part's colour and how it warms.
+struct Paint {
+  cv::Scalar colour;
+  Heat heat = Heat::kSolid;
+};
+
 // Adds a figure's parts in the victim's frame `f`, at `s` times the size of a 1.75 m person.
 struct FigureBuilder {
   Frame2 f;
   double s;
   std::vector<Part>* parts;
-  void Limb(Vec3 p, Vec3 q, double r, const cv::Scalar& c) const {
-    parts->push_back({Capsule(f, {p.x * s, p.y * s, p.z * s}, {q.x * s, q.y * s, q.z * s}, r * s), c});
+  void Limb(Vec3 p, Vec3 q, double r, const Paint& c) const {
+    parts->push_back(
+        {Capsule(f, {p.x * s, p.y * s, p.z * s}, {q.x * s, q.y * s, q.z * s}, r * s), c.colour, c.heat});
   }
-  void Disc(double u, double w, double a, double b, double z, const cv::Scalar& c) const {
-    parts->push_back({Ring(f, u * s, w * s, a * s, b * s, z * s), c});
+  void Disc(double u, double w, double a, double b, double z, const Paint& c) const {
+    parts->push_back({Ring(f, u * s, w * s, a * s, b * s, z * s), c.colour, c.heat});
   }
   // An upright trunk: a ring at z0 under one at z1 (sitting and standing).
-  void Trunk(double u1, double a0, double b0, double z0, double a1, double b1, double z1, const cv::Scalar& c) const {
-    parts->push_back({Concat(Ring(f, 0, 0, a0 * s, b0 * s, z0 * s), Ring(f, u1 * s, 0, a1 * s, b1 * s, z1 * s)), c});
+  void Trunk(double u1, double a0, double b0, double z0, double a1, double b1, double z1,
+             const Paint& c) const {
+    parts->push_back(
+        {Concat(Ring(f, 0, 0, a0 * s, b0 * s, z0 * s), Ring(f, u1 * s, 0, a1 * s, b1 * s, z1 * s)), c.colour,
+         c.heat});
   }
 };
 
 struct FigureColours {
-  cv::Scalar cloth, legs, skin, hair;
+  Paint cloth, legs, skin, hair;
 };
 
 void PoseFigure(VictimPose pose, const FigureBuilder& b, const FigureColours& c, double arm_swing) {
@@ -144,15 +155,20 @@ std::vector<Part> FigureParts(const Victim& v) {
   const Frame2 f{v.x_m, v.y_m, std::cos(v.heading_rad), std::sin(v.heading_rad)};
   if (!v.clothing_bgr && v.pose == VictimPose::kLying) {
     // Today's figure: hi-vis orange body ellipse 1.44 x 0.48 m, amber head.
-    return {{Ring(f, -0.15, 0, 0.72, 0.24, 0.0, 20), cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2])},
-            {Ring(f, 0.7, 0, 0.13, 0.11, 0.0, 20), cv::Scalar(kVictimHeadBgr[0], kVictimHeadBgr[1], kVictimHeadBgr[2])}};
+    return {{Ring(f, -0.15, 0, 0.72, 0.24, 0.0, 20),
+             cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]), Heat::kClothing},
+            {Ring(f, 0.7, 0, 0.13, 0.11, 0.0, 20),
+             cv::Scalar(kVictimHeadBgr[0], kVictimHeadBgr[1], kVictimHeadBgr[2]), Heat::kSkin}};
   }
   const std::uint64_t h = HashOf(v.id);
   FigureColours c;
-  c.cloth = v.clothing_bgr ? S(*v.clothing_bgr) : cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]);
-  c.legs = ((h >> 8) % 4 == 0) ? Scale(c.cloth, 0.85) : S(kTrousers[(h >> 12) % kTrousers.size()]);
-  c.skin = S(kSkin[(h >> 16) % kSkin.size()]);
-  c.hair = S(kHair[(h >> 20) % kHair.size()]);
+  c.cloth = {v.clothing_bgr ? S(*v.clothing_bgr)
+                            : cv::Scalar(kVictimBodyBgr[0], kVictimBodyBgr[1], kVictimBodyBgr[2]),
+             Heat::kClothing};
+  c.legs = {((h >> 8) % 4 == 0) ? Scale(c.cloth.colour, 0.85) : S(kTrousers[(h >> 12) % kTrousers.size()]),
+            Heat::kClothing};
+  c.skin = {S(kSkin[(h >> 16) % kSkin.size()]), Heat::kSkin};
+  c.hair = {S(kHair[(h >> 20) % kHair.size()]), Heat::kHair};
   std::vector<Part> parts;
   const double arm_swing = ((h >> 24) % 3 == 0) ? 0.45 : 0.0;  // one arm above the head, sometimes
   PoseFigure(v.pose, FigureBuilder{f, v.height_m / 1.75, &parts}, c, arm_swing);
@@ -214,7 +230,7 @@ std::vector<Part> CoverParts(const Victim& v, const std::vector<Part>& figure, b
     const cv::Scalar colour = CoverColour(vegetation, rng);
     std::vector<Vec3> pts = Blob(world, x, y, r, top_z, 0.45, rng);
     raster.Fill(pts, hidden);
-    out.push_back({std::move(pts), colour});
+    out.push_back({std::move(pts), colour, vegetation ? Heat::kVegetation : Heat::kSolid});
   }
   return out;
 }
@@ -237,24 +253,31 @@ struct DistractorShape {
 
   void Tarp() const {
     const double a = s / 2, b = 0.375 * s;
-    out->parts.push_back({Quad(f, -a, -b, a, b, 0.02), c});
+    out->parts.push_back({Quad(f, -a, -b, a, b, 0.02), c, Heat::kSheet});
     const double fold = rng.uniform(-0.3, 0.3) * s;  // a fold: one side in its own shade
-    out->parts.push_back({{f(fold - 0.1 * s, -b, 0.03), f(a, -b, 0.03), f(a, b, 0.03), f(fold + 0.1 * s, b, 0.03)}, Scale(c, 0.8)});
+    out->parts.push_back(
+        {{f(fold - 0.1 * s, -b, 0.03), f(a, -b, 0.03), f(a, b, 0.03), f(fold + 0.1 * s, b, 0.03)},
+         Scale(c, 0.8),
+         Heat::kSheet});
     out->top_m = 0.05;
   }
   void Cone() const {
     const double r = s / 2, hgt = 1.4 * s;
-    out->parts.push_back({Concat(Ring(f, 0, 0, r, r, 0), {f(0, 0, hgt)}), c});
-    out->parts.push_back({Concat(Ring(f, 0, 0, 0.55 * r, 0.55 * r, 0.45 * hgt), Ring(f, 0, 0, 0.42 * r, 0.42 * r, 0.6 * hgt)),
-                          cv::Scalar(225, 230, 230)});
-    out->parts.push_back({Concat(Ring(f, 0, 0, 0.3 * r, 0.3 * r, 0.7 * hgt), {f(0, 0, hgt)}), c});
+    out->parts.push_back({Concat(Ring(f, 0, 0, r, r, 0), {f(0, 0, hgt)}), c, Heat::kSheet});
+    out->parts.push_back(
+        {Concat(Ring(f, 0, 0, 0.55 * r, 0.55 * r, 0.45 * hgt), Ring(f, 0, 0, 0.42 * r, 0.42 * r, 0.6 * hgt)),
+         cv::Scalar(225, 230, 230), Heat::kSheet});
+    out->parts.push_back(
+        {Concat(Ring(f, 0, 0, 0.3 * r, 0.3 * r, 0.7 * hgt), {f(0, 0, hgt)}), c, Heat::kSheet});
     out->top_m = hgt;
   }
   void Backpack() const {
     const double a = s / 2, b = 0.33 * s, hgt = 0.4 * s;
-    out->parts.push_back({Concat(Quad(f, -a, -b, a, b, 0), Quad(f, -a, -b, a, b, hgt)), Scale(c, 0.7)});
-    out->parts.push_back({Quad(f, -a * 0.95, -b * 0.95, a * 0.95, b * 0.95, hgt), c});
-    out->parts.push_back({Quad(f, a * 0.25, -b * 0.9, a * 0.95, b * 0.9, hgt + 0.01), Scale(c, 0.6)});  // the flap
+    out->parts.push_back(
+        {Concat(Quad(f, -a, -b, a, b, 0), Quad(f, -a, -b, a, b, hgt)), Scale(c, 0.7), Heat::kSheet});
+    out->parts.push_back({Quad(f, -a * 0.95, -b * 0.95, a * 0.95, b * 0.95, hgt), c, Heat::kSheet});
+    out->parts.push_back({Quad(f, a * 0.25, -b * 0.9, a * 0.95, b * 0.9, hgt + 0.01), Scale(c, 0.6),
+                          Heat::kSheet});  // the flap
     out->top_m = hgt;
   }
   void Debris() const {
@@ -263,7 +286,7 @@ struct DistractorShape {
       out->parts.push_back({Quad(f, -a, -b, a, b, 0.05), c});
       out->parts.push_back({Quad(f, -a, -b * 0.2, a, b * 0.2, 0.06), Scale(c, 0.75)});
     } else {  // a broken sheet
-      out->parts.push_back({Blob(f, 0, 0, s / 2, 0.05, 0.5, rng, 7), c});
+      out->parts.push_back({Blob(f, 0, 0, s / 2, 0.05, 0.5, rng, 7), c, Heat::kSheet});
     }
     out->top_m = 0.06;
   }
@@ -305,15 +328,17 @@ Drawable TreeDrawable(const ObstacleBox& b, std::uint64_t seed, const Light& lig
   out.radius_m = r;
   out.top_m = top;
   out.parts.push_back({Capsule(f, {0, 0, 0}, {0, 0, crown_bottom}, std::max(0.12, 0.08 * r)), cv::Scalar(35, 55, 75)});
-  out.parts.push_back({Concat(Blob(f, 0, 0, r * 0.85, crown_bottom, 0.15, rng, 12), Blob(f, 0, 0, r, top - 0.3 * (top - crown_bottom), 0.2, rng, 12)),
-                       Scale(leaf, 0.85)});
+  out.parts.push_back({Concat(Blob(f, 0, 0, r * 0.85, crown_bottom, 0.15, rng, 12),
+                              Blob(f, 0, 0, r, top - 0.3 * (top - crown_bottom), 0.2, rng, 12)),
+                       Scale(leaf, 0.85), Heat::kVegetation});
   // Clumps of foliage, lit on the sun's side.
   const double sun_u = light.enabled ? light.to_sun.x : 0, sun_v = light.enabled ? light.to_sun.y : 0;
   for (int k = 0; k < 5; ++k) {
     const double a = rng.uniform(0.0, 2 * kPi), d = rng.uniform(0.0, 0.55 * r);
     const double u = d * std::cos(a) + 0.2 * r * sun_u, v = d * std::sin(a) + 0.2 * r * sun_v;
-    out.parts.push_back({Blob(f, u, v, r * rng.uniform(0.3, 0.45), top - 0.1 * (top - crown_bottom), 0.3, rng, 8),
-                         Scale(leaf, rng.uniform(1.0, 1.3))});
+    out.parts.push_back(
+        {Blob(f, u, v, r * rng.uniform(0.3, 0.45), top - 0.1 * (top - crown_bottom), 0.3, rng, 8),
+         Scale(leaf, rng.uniform(1.0, 1.3)), Heat::kVegetation});
   }
   return out;
 }
@@ -354,7 +379,7 @@ cv::Mat Noise(cv::RNG& rng, cv::Size size, std::initializer_list<std::pair<int, 
 }
 
 // Today's look: grass with soil patches (the RNG sequence is the original one).
-void LegacyTexture(const WorldConfig& config, cv::Mat* texture) {
+void LegacyTexture(const WorldConfig& config, cv::Mat* texture, cv::Mat* vegetation) {
   const int rows = texture->rows, cols = texture->cols;
   cv::RNG rng(config.ground_texture_seed * 0x9E3779B97F4A7C15ULL + 1);
   cv::Mat acc(rows, cols, CV_32F, cv::Scalar(0));
@@ -379,9 +404,11 @@ void LegacyTexture(const WorldConfig& config, cv::Mat* texture) {
     const float* a = acc.ptr<float>(r);
     const float* s = soil.ptr<float>(r);
     auto* px = texture->ptr<cv::Vec3b>(r);
+    auto* veg = vegetation->ptr<std::uint8_t>(r);
     for (int c = 0; c < cols; ++c) {
       const float v = std::clamp(a[c], 0.0f, 1.2f);
       const float soil_mix = std::clamp((s[c] - 0.62f) * 4.0f, 0.0f, 1.0f);
+      veg[c] = cv::saturate_cast<std::uint8_t>(255 * (1 - soil_mix));
       const float gb = 30 + 40 * v, gg = 80 + 70 * v, gr = 40 + 50 * v;
       const float sb = 50 + 30 * v, sg = 70 + 30 * v, sr = 90 + 30 * v;
       px[c] = cv::Vec3b(cv::saturate_cast<std::uint8_t>(gb + (sb - gb) * soil_mix),
@@ -422,17 +449,21 @@ float WaterLevel(const WorldConfig& config, const Terrain& terrain, double texel
 }
 
 // One texel's ground colour for brightness noise `v` and the region noises `g`, `g2`; its speckle
-// in *grain_std.
-cv::Vec3f GroundColour(TerrainKind kind, float v, float g, float g2, float* grain_std) {
+// in *grain_std, its share of living vegetation in *veg (dry grass counts half: it transpires less).
+cv::Vec3f GroundColour(TerrainKind kind, float v, float g, float g2, float* grain_std, float* veg) {
   const float dry = std::clamp((g2 - 0.55f) * 5.0f, 0.0f, 1.0f);
   auto grass = [&] { return Lerp(kGrassP, v) * (1 - dry) + Lerp(kDryGrassP, v) * dry; };
+  const float grass_veg = 1 - 0.5f * dry;
+  *veg = 0;
   switch (kind) {
     case TerrainKind::kGrass:
       *grain_std = kGrassP.grain;
+      *veg = grass_veg;
       return grass();
     case TerrainKind::kSoil: {
       const float grassy = std::clamp((g - 0.7f) * 5.0f, 0.0f, 1.0f);
       *grain_std = kSoilP.grain;
+      *veg = grass_veg * grassy;
       return Lerp(kSoilP, v) * (1 - grassy) + grass() * grassy;
     }
     case TerrainKind::kGravel:
@@ -446,6 +477,7 @@ cv::Vec3f GroundColour(TerrainKind kind, float v, float g, float g2, float* grai
     case TerrainKind::kMixed:
       if (g < 0.45f) {
         *grain_std = kGrassP.grain;
+        *veg = grass_veg;
         return grass();
       }
       if (g < 0.62f) {
@@ -459,14 +491,18 @@ cv::Vec3f GroundColour(TerrainKind kind, float v, float g, float g2, float* grai
   return cv::Vec3f();
 }
 
-// Water below the level (deeper, darker), mud in a band above it; `col` elsewhere.
-cv::Vec3f WithWater(const cv::Vec3f& col, float w, float water_level, float n) {
+// Water below the level (deeper, darker), mud in a band above it; `col` elsewhere. *wet: 1 in
+// the water, falling from 0.5 at the waterline to 0 across the mud; 0 elsewhere.
+cv::Vec3f WithWater(const cv::Vec3f& col, float w, float water_level, float n, float* wet) {
+  *wet = 0;
   if (w < water_level) {
     const float depth = std::clamp((water_level - w) * 12.0f, 0.0f, 1.0f);
+    *wet = 1;
     return cv::Vec3f(70, 75, 50) * (1 - depth) + cv::Vec3f(85, 70, 35) * depth + cv::Vec3f(1, 1, 1) * (3 * n);
   }
   if (w < water_level + kWaterEdge) {
     const float t = (w - water_level) / kWaterEdge;  // mud at the waterline, drying outwards
+    *wet = 0.5f * (1 - t);
     return cv::Vec3f(40, 55, 65) * (1 - t) + col * t;
   }
   return col;
@@ -475,7 +511,7 @@ cv::Vec3f WithWater(const cv::Vec3f& col, float w, float water_level, float n) {
 // Chunks of concrete and brick scattered over the ground (rubble everywhere, gravel areas of
 // mixed), never in the water or its muddy band.
 void ScatterRubble(const Terrain& terrain, double texel_m, const cv::Mat& region, const cv::Mat& water,
-                   float water_level, cv::RNG& rng, cv::Mat* texture) {
+                   float water_level, cv::RNG& rng, cv::Mat* texture, cv::Mat* vegetation) {
   const cv::Size size = texture->size();
   const double area = (size.width * texel_m) * (size.height * texel_m);
   const int count = static_cast<int>(area * (terrain.kind == TerrainKind::kRubble ? 0.6 : 0.1));
@@ -498,11 +534,12 @@ void ScatterRubble(const Terrain& terrain, double texel_m, const cv::Mat& region
     std::vector<cv::Point> hull;
     cv::convexHull(pts, hull);
     cv::fillConvexPoly(*texture, hull, col, cv::LINE_8, 4);
+    cv::fillConvexPoly(*vegetation, hull, cv::Scalar(0), cv::LINE_8, 4);
   }
 }
 
-void TerrainTexture(const WorldConfig& config, const Terrain& terrain, double texel_m, double origin_x_m, double top_y_m,
-                    cv::Mat* texture) {
+void TerrainTexture(const WorldConfig& config, const Terrain& terrain, double texel_m, double origin_x_m,
+                    double top_y_m, cv::Mat* texture, cv::Mat* vegetation, cv::Mat* wet) {
   const cv::Size size = texture->size();
   cv::RNG rng(Mix(config.ground_texture_seed ^ 0x7E44A1ULL));
   const cv::Mat base = Noise(rng, size, {{8, 0.35f}, {24, 0.3f}, {96, 0.2f}, {400, 0.15f}});
@@ -519,26 +556,31 @@ void TerrainTexture(const WorldConfig& config, const Terrain& terrain, double te
     const float* w = water.ptr<float>(r);
     const float* n = grain.ptr<float>(r);
     auto* px = texture->ptr<cv::Vec3b>(r);
+    auto* veg_px = vegetation->ptr<std::uint8_t>(r);
+    auto* wet_px = wet->ptr<std::uint8_t>(r);
     for (int c = 0; c < size.width; ++c) {
       const float v = std::clamp(a[c], 0.0f, 1.2f) / 1.2f;
-      float grain_std = 0;
-      cv::Vec3f col = GroundColour(terrain.kind, v, g[c], g2[c], &grain_std);
+      float grain_std = 0, veg = 0, wetness = 0;
+      cv::Vec3f col = GroundColour(terrain.kind, v, g[c], g2[c], &grain_std, &veg);
       col += cv::Vec3f(1, 1, 1) * (grain_std * n[c]);
-      col = WithWater(col, w[c], water_level, n[c]);
+      col = WithWater(col, w[c], water_level, n[c], &wetness);
+      veg_px[c] = cv::saturate_cast<std::uint8_t>(255 * veg * (1 - std::min(1.0f, 2 * wetness)));
+      wet_px[c] = cv::saturate_cast<std::uint8_t>(255 * wetness);
       px[c] = cv::Vec3b(cv::saturate_cast<std::uint8_t>(col[0]), cv::saturate_cast<std::uint8_t>(col[1]),
                         cv::saturate_cast<std::uint8_t>(col[2]));
     }
   }
   if (terrain.kind == TerrainKind::kRubble || terrain.kind == TerrainKind::kMixed) {
-    ScatterRubble(terrain, texel_m, region, water, water_level, rng, texture);
+    ScatterRubble(terrain, texel_m, region, water, water_level, rng, texture, vegetation);
   }
 }
 
-// Darkens the texture where the parts' shadows fall (each part's points projected along the sun).
-void BakeShadows(const std::vector<const std::vector<Part>*>& casters, const Light& light, double texel_m, double origin_x_m,
-                 double top_y_m, cv::Mat* texture) {
+// Darkens the texture where the parts' shadows fall (each part's points projected along the sun);
+// *shadow (zeros, the texture's size) receives the mask, 255 in full shadow.
+void BakeShadows(const std::vector<const std::vector<Part>*>& casters, const Light& light, double texel_m,
+                 double origin_x_m, double top_y_m, cv::Mat* texture, cv::Mat* shadow) {
   if (!light.enabled || light.shadow_factor >= 0.99 || light.to_sun.z <= 0.05) return;
-  cv::Mat mask(texture->size(), CV_8U, cv::Scalar(0));
+  cv::Mat& mask = *shadow;
   const double kx = light.to_sun.x / light.to_sun.z, ky = light.to_sun.y / light.to_sun.z;
   for (const std::vector<Part>* parts : casters) {
     for (const Part& part : *parts) {
@@ -586,6 +628,8 @@ Light LightOf(const WorldConfig& config) {
   constexpr double kNoonClear = 0.3 + 0.8660254;  // ambient + direct at noon, clear sky
   l.level = (ambient + direct) / kNoonClear;
   l.shadow_factor = ambient / std::max(1e-6, ambient + direct);
+  l.direct = direct;
+  l.ambient = ambient;
   const double warm = (1.0 - std::clamp(sun / 0.5, 0.0, 1.0)) * (1.0 - in.overcast);  // low sun: warm light
   l.colour = cv::Scalar(1.0 - 0.22 * warm + 0.06 * in.overcast, 1.0 - 0.05 * warm, 1.0 + 0.18 * warm - 0.04 * in.overcast);
   return l;
@@ -605,6 +649,7 @@ void AddFigures(const WorldConfig& config, RenderScene* s) {
     f.cover = CoverParts(v, f.parts, vegetation, Mix(config.ground_texture_seed ^ HashOf(v.id)));
     f.centre_m = {v.x_m, v.y_m, 0};
     f.radius_m = 1.5 * v.height_m / 1.75 + 0.4;
+    f.clothing_pass = kClothingPass[(HashOf(v.id) >> 28) % kClothingPass.size()];
     s->figures.push_back(std::move(f));
   }
 }
@@ -645,15 +690,19 @@ RenderScene BuildScene(const WorldConfig& config) {
   s.origin_x_m = -config.size_x_m / 2 - kMarginM;
   s.top_y_m = config.size_y_m / 2 + kMarginM;
   s.texture.create(rows, cols, CV_8UC3);
+  s.vegetation = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  s.wet = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  s.shadow = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   if (config.terrain) {
-    TerrainTexture(config, *config.terrain, s.texel_m, s.origin_x_m, s.top_y_m, &s.texture);
+    TerrainTexture(config, *config.terrain, s.texel_m, s.origin_x_m, s.top_y_m, &s.texture, &s.vegetation,
+                   &s.wet);
   } else {
-    LegacyTexture(config, &s.texture);
+    LegacyTexture(config, &s.texture, &s.vegetation);
   }
   s.light = LightOf(config);
   AddFigures(config, &s);
   AddFlatsAndObstacles(config, &s);
-  BakeShadows(ShadowCasters(config, s), s.light, s.texel_m, s.origin_x_m, s.top_y_m, &s.texture);
+  BakeShadows(ShadowCasters(config, s), s.light, s.texel_m, s.origin_x_m, s.top_y_m, &s.texture, &s.shadow);
   return s;
 }
 

@@ -14,10 +14,17 @@
 
 namespace swarmbox::physics::detail {
 
+// How a part warms in the thermal camera (detail/thermal_scene.cpp): solids (ground, rock,
+// concrete, wood) and thin sheets (fabric, plastic: a tarp, a backpack, a cone) by the sunlight
+// they absorb, vegetation hardly (it transpires), a person's clothing, skin and hair also by the
+// body's heat from inside.
+enum class Heat : std::uint8_t { kSolid, kSheet, kVegetation, kClothing, kSkin, kHair };
+
 // A convex polygon (the convex hull of its points once projected) in world ENU [m].
 struct Part {
   std::vector<Vec3> pts;
   cv::Scalar colour;  // BGR
+  Heat heat = Heat::kSolid;
 };
 
 struct Figure {
@@ -26,6 +33,9 @@ struct Figure {
   std::vector<Part> cover;  // drawn over the figure; hides it
   double radius_m = 1.0;    // ground radius around (x, y) that holds the figure and its cover
   Vec3 centre_m;
+  // The share of the body's warmth over the air that the clothing's surface shows (thermal):
+  // one of the three measured layers (detail/thermal_scene.hpp, kClothingPass), by the victim.
+  double clothing_pass = 0.274;
 };
 
 struct Drawable {
@@ -46,6 +56,10 @@ struct Light {
   double level = 1.0;         // relative scene radiance (noon, clear = 1)
   cv::Scalar colour{1, 1, 1}; // white balance of the light (B, G, R gains)
   double shadow_factor = 1.0; // radiance in shadow / in sun
+  // The two terms of `level` (noon, clear = 0.866 + 0.3): the sun's on a horizontal surface and
+  // the sky's; the thermal camera's irradiance (detail/thermal_scene.cpp).
+  double direct = 0.0;
+  double ambient = 1.0;
 };
 
 Light LightOf(const WorldConfig& config);
@@ -54,7 +68,12 @@ struct RenderScene {
   double texel_m = 0.125;
   double origin_x_m = 0;   // world x of texel column 0's left edge
   double top_y_m = 0;      // world y of texel row 0's top edge
-  cv::Mat texture;         // CV_8UC3
+  cv::Mat texture;         // CV_8UC3 (a thermal scene: CV_32F, kelvin)
+  // Per texel, 0..255: the share of vegetation, of water (255) or mud, and of the sun's direct
+  // light withheld by a shadow: what the thermal scene needs of the ground (ThermalSceneOf).
+  cv::Mat vegetation, wet, shadow;
+  // Where no texture is drawn: the sky, a box from below, the view from under the ground.
+  cv::Scalar sky{235, 206, 135}, box_below{90, 95, 100}, underground{40, 60, 70};
   Light light;
   std::vector<Figure> figures;
   std::vector<Drawable> flats;      // distractors: drawn under people

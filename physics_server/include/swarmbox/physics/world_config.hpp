@@ -53,6 +53,9 @@ struct Victim {
 struct Lighting {
   double time_of_day_h = 12.0;  // local solar time [h], 0..24 (sun below the horizon: dusk light)
   double overcast = 0.0;        // [0, 1]: 0 clear (hard shadows), 1 fully overcast (no shadows)
+  // Air temperature [deg C], -40..50: what the thermal camera sees surfaces warm above or cool
+  // below (ThermalRenderer); the RGB camera ignores it.
+  double air_temperature_c = 20.0;
 };
 
 // Ground cover of the procedural texture. Absent: today's grass with soil patches.
