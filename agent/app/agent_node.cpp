@@ -394,6 +394,27 @@ void AgentNode::StepBrain(const bus::SensorSample& msg) {
   brain_host_->Step(msg.step, msg.sim_time_ns, v, &cmd_.world);
 }
 
+// A thermal frame to perception in kelvin: 16-bit little-endian counts of 0.01 K (bus/messages.hpp).
+void AgentNode::OnThermalImage(const bus::CameraImage& image) {
+  const int w = static_cast<int>(image.width_px), h = static_cast<int>(image.height_px);
+  if (w <= 0 || h <= 0 || image.row_stride_bytes < image.width_px * 2 ||
+      image.data.size() < static_cast<std::size_t>(h) * image.row_stride_bytes) {
+    return;
+  }
+  thermal_kelvin_.create(h, w, CV_32F);
+  for (int y = 0; y < h; ++y) {
+    const std::uint8_t* row = image.data.data() + static_cast<std::size_t>(y) * image.row_stride_bytes;
+    auto* out = thermal_kelvin_.ptr<float>(y);
+    for (int x = 0; x < w; ++x) {
+      const auto counts = static_cast<unsigned>(row[2 * x]) | (static_cast<unsigned>(row[2 * x + 1]) << 8);
+      out[x] = static_cast<float>(counts) * 0.01f;
+    }
+  }
+  const bus::CameraIntrinsics& k = image.intrinsics;
+  perception_->OnThermalFrame(thermal_kelvin_, {k.fx_px, k.fy_px, k.cx_px, k.cy_px},
+                              static_cast<double>(image.sim_time_ns) * 1e-9);
+}
+
 void AgentNode::StepMission(const bus::SensorSample& msg) {
   // Perception (scouts): this step's frames geolocated with the estimate of their capture step,
   // to the brain once the inference latency has passed.
@@ -402,6 +423,10 @@ void AgentNode::StepMission(const bus::SensorSample& msg) {
     perception_->RecordEstimate(t_s_, fc_.estimate());
     for (std::size_t i = 0; i < camera_frames_.count; ++i) {
       bus::CameraImage& image = camera_frames_.images[i];
+      if (image.encoding == bus::kThermalEncoding) {  // before its colour frame (frame_wait.hpp)
+        OnThermalImage(image);
+        continue;
+      }
       if (image.encoding != "bgr8" && image.encoding != "rgb8") continue;  // the detector needs colour
       if (image.data.size() < static_cast<std::size_t>(image.height_px) * image.row_stride_bytes) continue;
       cv::Mat bgr(static_cast<int>(image.height_px), static_cast<int>(image.width_px), CV_8UC3, image.data.data(),

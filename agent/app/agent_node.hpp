@@ -169,6 +169,7 @@ class AgentNode final : private FrameHandler {
   // --mission sar: perception (camera frames -> detections to the brain, also broadcast), netem's
   // wall clock for SarBrain's side channel, then StepBrain.
   void StepMission(const bus::SensorSample& msg);
+  void OnThermalImage(const bus::CameraImage& image);  // a thermal frame to perception, in kelvin
   // With a stereo depth camera: the step's pairs into the device (posed by this step's estimate),
   // the depth frames due released (event=stereo_missing for a flagged pair that did not come).
   // false: stop requested while waiting.
@@ -254,6 +255,7 @@ class AgentNode final : private FrameHandler {
   std::vector<brain::Detection> detections_;    // this step's
   std::unique_ptr<bus::Subscriber<bus::CameraImage>> camera_sub_;
   FrameBuffers camera_frames_;                // taken this step
+  cv::Mat thermal_kelvin_;                    // a thermal frame in kelvin (reused)
   std::unique_ptr<DepthHost> depth_;          // an airframe with a stereo depth camera
   std::int64_t drop_spot_frame_ns_ = -1;      // the depth frame the last drop-spot answer used
   // The lifter's own slung payload as its depth camera sees it (masked out of the drop-spot

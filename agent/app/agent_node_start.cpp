@@ -132,6 +132,7 @@ Result<AgentNode::Startup> AgentNode::LoadStartup(const AgentOptions& o) {
     if (!sar) return sar.error();
     s.sar = std::move(*sar);
     s.perception.camera = s.sar->camera;
+    s.perception.thermal = s.airframe.thermal;
     s.perception.inference_latency_s = o.mission.inference_latency_ms * 1e-3;
   }
   s.brain = o.brain.kind != BrainKind::kBuiltin;
@@ -363,6 +364,7 @@ Status AgentNode::StartPerception(const Startup& s) {
   bool perceive = sar_ != nullptr && sar_->role() == swarm::Role::kScout;
   if (s.brain && s.airframe.has_camera) {
     perception.camera = s.airframe.camera;
+    perception.thermal = s.airframe.thermal;
     perception.inference_latency_s = options_.mission.inference_latency_ms * 1e-3;
     perceive = true;
   }

@@ -15,7 +15,9 @@ FrameWait TakeStepFrames(bus::Subscriber<bus::CameraImage>& sub, std::int64_t si
     const bool took = wait ? sub.TakeFor(img, slice) : sub.Take(img);
     if (!took) return false;
     ++frames->count;
-    have_step = have_step || img.sim_time_ns == sim_time_ns;
+    // The step's own frame is its colour (or stereo) frame: a thermal frame goes out just before
+    // the colour frame it was taken with, so once that is here the thermal one is too.
+    have_step = have_step || (img.sim_time_ns == sim_time_ns && img.encoding != bus::kThermalEncoding);
     return true;
   };
   while (take(false, {})) {

@@ -34,7 +34,8 @@ enum class FrameWait {
 };
 
 // Takes every frame waiting on `sub` into `frames` (count reset first) and, when `due` and the
-// frame of `sim_time_ns` is not among them, waits up to `timeout` for it in 50 ms slices.
+// frame of `sim_time_ns` is not among them, waits up to `timeout` for it in 50 ms slices. A
+// thermal frame (bus::kThermalEncoding) is taken but is not the step's frame: it precedes it.
 FrameWait TakeStepFrames(bus::Subscriber<bus::CameraImage>& sub, std::int64_t sim_time_ns, bool due,
                          std::chrono::milliseconds timeout, const volatile std::sig_atomic_t* stop,
                          FrameBuffers* frames);

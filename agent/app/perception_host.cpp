@@ -13,9 +13,10 @@ using flight::Vec3;
 
 constexpr std::size_t kHistory = 128;  // control steps of estimates kept (0.5 s at 250 Hz)
 
-swarm::PerceptionParams PerceptionFor(double latency_s) {
+swarm::PerceptionParams PerceptionFor(const PerceptionConfig& config) {
   swarm::PerceptionParams p;
-  p.latency_s = latency_s;
+  p.latency_s = config.inference_latency_s;
+  p.thermal = config.thermal_evidence;
   return p;
 }
 
@@ -60,7 +61,7 @@ Result<std::unique_ptr<PerceptionHost>> PerceptionHost::Create(const PerceptionC
 }
 
 PerceptionHost::PerceptionHost(const PerceptionConfig& config)
-    : config_(config), perception_(PerceptionFor(config.inference_latency_s)), history_(kHistory) {}
+    : config_(config), perception_(PerceptionFor(config)), history_(kHistory) {}
 
 void PerceptionHost::RecordEstimate(double t_s, const flight::StateEstimate& est) {
   history_[history_next_] = {t_s, est.pos_m, est.att, est.rate_rad_s};
@@ -81,7 +82,23 @@ void PerceptionHost::OnCameraFrame(const cv::Mat& bgr, const swarm::PinholeIntri
   if (best->rate_rad_s.norm() > config_.max_rate_rad_s) return;
   const airframe::Vec3& offset = config_.camera.offset_m;
   const swarm::OpticalPose pose = swarm::OpticalPoseFromBody(best->pos_m, best->att, Vec3(offset.x, offset.y, offset.z));
-  (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s, SurfaceFor(capture_t_s));
+  // The thermal frame taken with this one (the same capture step), seen from the same estimate.
+  std::optional<swarm::ThermalView> thermal;
+  if (config_.thermal.enabled && thermal_t_s_ >= 0 && std::abs(thermal_t_s_ - capture_t_s) < 1e-6) {
+    const airframe::Vec3& t = config_.thermal.offset_m;
+    thermal = swarm::ThermalView{thermal_kelvin_, thermal_k_,
+                                 swarm::OpticalPoseFromBody(best->pos_m, best->att, Vec3(t.x, t.y, t.z))};
+  }
+  (void)perception_.ProcessFrame(bgr, k, pose, capture_t_s, SurfaceFor(capture_t_s),
+                                 thermal ? &*thermal : nullptr);
+}
+
+void PerceptionHost::OnThermalFrame(const cv::Mat& kelvin, const swarm::PinholeIntrinsics& k,
+                                    double capture_t_s) {
+  if (!config_.thermal.enabled || kelvin.type() != CV_32F) return;
+  kelvin.copyTo(thermal_kelvin_);
+  thermal_k_ = k;
+  thermal_t_s_ = capture_t_s;
 }
 
 void PerceptionHost::OnDepthFrame(const depth::DepthFrame& frame, const bus::Pose& camera_pose,

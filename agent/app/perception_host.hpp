@@ -7,6 +7,7 @@
 //   auto p = PerceptionHost::Create({.camera = airframe.camera, .inference_latency_s = 0.04});
 //   p->RecordEstimate(t_s, est);                       // every control step (capture-time lookup)
 //   p->OnDepthFrame(f.frame, f.camera_pose, f.intrinsics);  // each newly released depth frame
+//   p->OnThermalFrame(kelvin, k, capture_t_s);         // a thermal frame, before its colour frame
 //   p->OnCameraFrame(bgr, k, capture_t_s);             // each camera image of this step
 //   p->PopVisible(t_s, &detections);                   // capture + latency <= t_s: to the brain
 //
@@ -14,6 +15,12 @@
 // frames older than the history, ~0.5 s, are dropped), and only steady frames: a frame taken
 // more tilted than max_tilt_rad or turning faster than max_rate_rad_s is skipped (attitude errors
 // multiply on the ground). Time is simulated seconds, frames world ENU [m]. Not thread-safe.
+//
+// With a thermal camera (airframe `thermal:`; PerceptionConfig::thermal enabled), the thermal frame
+// taken with a colour frame (the same capture time; it arrives first) is the colour detector's
+// second opinion: each candidate's confidence takes the thermal evidence at its ground point
+// (swarm::ThermalEvidence, the shipped fit), seen from the same estimated pose through the thermal
+// camera's own offset and intrinsics (swarm::VictimPerception::ProcessFrame).
 //
 // Where the drone's stereo camera saw the ground (issue #23), detections are placed on the surface
 // it saw, not on the flat plane z = 0 (swarm::PixelToSurface): the newest depth frame (DepthHost's,
@@ -48,6 +55,8 @@ namespace swarmbox::agent {
 
 struct PerceptionConfig {
   airframe::CameraSpec camera;                 // the airframe's (offset_m: where the frames are taken from)
+  airframe::ThermalSpec thermal;               // the airframe's; disabled: thermal frames are not used
+  swarm::ThermalEvidence thermal_evidence = swarm::ShippedThermalEvidence();
   double inference_latency_s = 0.040;          // simulated detector latency [s], >= 0
   double max_tilt_rad = 0.2;                   // frames taken more tilted are not used
   double max_rate_rad_s = 0.5;                 // nor while turning faster
@@ -72,6 +81,9 @@ class PerceptionHost {
   // their capture step, tilted or turning are skipped.
   // With a depth frame captured within depth_max_age_s, on the surface it saw (see above).
   void OnCameraFrame(const cv::Mat& bgr, const swarm::PinholeIntrinsics& k, double capture_t_s);
+  // A thermal frame (CV_32F kelvin; copied), for the colour frame of the same capture time.
+  // Ignored without a thermal camera in the config.
+  void OnThermalFrame(const cv::Mat& kelvin, const swarm::PinholeIntrinsics& k, double capture_t_s);
   // The newest depth frame (its depth_m is shared, not copied: DepthCamera makes each frame's
   // anew); `camera_pose`: its left camera's optical frame at the exposure (LeftCameraPose).
   void OnDepthFrame(const depth::DepthFrame& frame, const bus::Pose& camera_pose,
@@ -101,6 +113,9 @@ class PerceptionHost {
   std::vector<Estimate> history_;  // ring, one entry per control step
   std::size_t history_next_ = 0;
   std::vector<swarm::GroundDetection> visible_;
+  cv::Mat thermal_kelvin_;  // the newest thermal frame
+  swarm::PinholeIntrinsics thermal_k_;
+  double thermal_t_s_ = -1.0;  // its capture time; < 0: none
 };
 
 }  // namespace swarmbox::agent

@@ -177,6 +177,18 @@ void ReadCamera(MapReader& parent, Airframe* af) {
   });
 }
 
+// `thermal:` (thermal_spec.cpp): absent or null leaves af->thermal disabled.
+void ReadThermal(MapReader& parent, Airframe* af) {
+  const Node* n = parent.Child("thermal", false);
+  if (n == nullptr) return;
+  auto spec = ParseThermalSpec(n);
+  if (!spec) {
+    parent.Fail(spec.error());
+    return;
+  }
+  af->thermal = *spec;
+}
+
 // `stereo:` (stereo_spec.cpp): absent or null leaves af->stereo disabled.
 void ReadStereo(MapReader& parent, Airframe* af) {
   const Node* n = parent.Child("stereo", false);
@@ -223,7 +235,8 @@ void ReadControl(MapReader& parent, Airframe* af) {
 // section: its reader here (a field of Airframe filled by a parse function in its own file).
 using SectionReader = void (*)(MapReader& parent, Airframe* af);
 constexpr SectionReader kSections[] = {
-    ReadCollision, ReadImpact, ReadMotor, ReadRotors, ReadSensors, ReadCamera, ReadStereo, ReadPayloads, ReadControl,
+    ReadCollision, ReadImpact, ReadMotor,   ReadRotors,   ReadSensors,
+    ReadCamera,    ReadStereo, ReadThermal, ReadPayloads, ReadControl,
 };
 
 // Checks across keys, once every section is read.

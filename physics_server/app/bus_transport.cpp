@@ -133,6 +133,33 @@ Status BusTransport::PublishCamera(std::size_t drone, const std::string& name, s
   return drones_.at(drone).camera->Publish(m);
 }
 
+Status BusTransport::PublishThermal(std::size_t drone, const std::string& name, std::uint64_t step,
+                                    const ThermalImage& img) {
+  bus::CameraImage& m = thermal_msg_;
+  m.drone = name;
+  m.step = step;
+  m.sim_time_ns = img.time_ns;
+  m.width_px = static_cast<std::uint32_t>(img.width_px);
+  m.height_px = static_cast<std::uint32_t>(img.height_px);
+  m.row_stride_bytes = static_cast<std::uint32_t>(img.width_px * 2);
+  m.encoding = std::string(bus::kThermalEncoding);
+  m.intrinsics.fx_px = img.intrinsics.fx_px;
+  m.intrinsics.fy_px = img.intrinsics.fy_px;
+  m.intrinsics.cx_px = img.intrinsics.cx_px;
+  m.intrinsics.cy_px = img.intrinsics.cy_px;
+  m.intrinsics.distortion = {};
+  m.camera_pose.position_enu_m = A(img.camera_pose.position_m);
+  const Quat& q = img.camera_pose.attitude;
+  m.camera_pose.orientation_wxyz = {q.w, q.x, q.y, q.z};
+  // Little-endian 16-bit counts (the bus's byte order for "16UC1" and "mono16").
+  m.data.resize(img.centikelvin.size() * 2);
+  for (std::size_t k = 0; k < img.centikelvin.size(); ++k) {
+    m.data[2 * k] = static_cast<std::uint8_t>(img.centikelvin[k] & 0xFF);
+    m.data[2 * k + 1] = static_cast<std::uint8_t>(img.centikelvin[k] >> 8);
+  }
+  return drones_.at(drone).camera->Publish(m);
+}
+
 Status BusTransport::PublishStereo(std::size_t drone, const bus::CameraImage& pair) {
   const DroneEndpoints& e = drones_.at(drone);
   if (!e.stereo) return Error(ErrorCode::kInternal, "drone '" + e.name + "' has no stereo pair publisher");

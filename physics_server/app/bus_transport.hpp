@@ -46,6 +46,8 @@ class BusTransport final : public SimTransport {
   Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) override;
   // kInternal for a drone created without a stereo publisher (a bug: SimServer sends none).
   Status PublishStereo(std::size_t drone, const bus::CameraImage& pair) override;
+  Status PublishThermal(std::size_t drone, const std::string& name, std::uint64_t step,
+                        const ThermalImage& image) override;
   Status PublishClock(std::uint64_t step, std::int64_t sim_time_ns, std::int64_t period_ns, double rtf) override;
   Status PublishStatus(const JoiningStatus& status, bool done) override;
   void WaitActuators(std::int64_t deadline_ns, std::size_t awaited, std::vector<ActuatorInput>* out) override;
@@ -84,6 +86,7 @@ class BusTransport final : public SimTransport {
   std::unordered_map<std::string, std::size_t, NameHash, std::equal_to<>> index_of_;  // set before the subscriber
   bus::SensorSample sample_msg_;
   bus::CameraImage camera_msg_;
+  bus::CameraImage thermal_msg_;
 
   mutable std::mutex mu_;
   std::condition_variable cv_;

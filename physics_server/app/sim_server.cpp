@@ -290,6 +290,11 @@ Status SimServer::PublishDrone(std::size_t i, bool with_camera) {
   Slot& slot = slots_[i];
   const std::string& name = world_.drone_name(i);
   if (with_camera && slot.camera_frame) {
+    // The thermal frame first: the agent waits for the step's colour frame (frame_wait.hpp), and
+    // one writer's samples arrive in order, so the thermal one is there with it.
+    if (slot.thermal_frame) {
+      if (auto s = transport_.PublishThermal(i, name, world_.step_count(), slot.thermal); !s) return s;
+    }
     if (auto s = transport_.PublishCamera(i, name, world_.step_count(), slot.image); !s) return s;
   }
   if (with_camera && slot.stereo_frame) {
@@ -469,6 +474,7 @@ bool SimServer::CaptureCamera(std::size_t i) {
   if (!trigger_.Due(i, world_.airframe(i).camera, world_.CameraDue(i), world_.time_ns(), position_m)) return false;
   trigger_.Captured(i, world_.time_ns(), position_m);
   world_.RenderCamera(i, &slot.image);
+  slot.thermal_frame = world_.airframe(i).thermal.enabled && world_.RenderThermal(i, &slot.thermal).ok();
   if (options_.observer != nullptr) options_.observer->OnCamera(i, slot.image);
   return true;
 }

@@ -49,12 +49,13 @@
 #include "joining.hpp"
 #include "radio_plan.hpp"
 #include "stereo_capture.hpp"
-#include "swarmbox/channel/channel.hpp"
 #include "swarmbox/bus/messages.hpp"
+#include "swarmbox/channel/channel.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/physics/camera_image.hpp"
 #include "swarmbox/physics/lockstep.hpp"
 #include "swarmbox/physics/sensor_sample.hpp"
+#include "swarmbox/physics/thermal_renderer.hpp"
 #include "swarmbox/physics/truth_log.hpp"
 #include "swarmbox/physics/world.hpp"
 
@@ -95,6 +96,11 @@ class SimTransport {
   virtual Status PublishSample(std::size_t drone, const std::string& name, const SensorSample& sample,
                                const SampleExtras& extras) = 0;
   virtual Status PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& image) = 0;
+  // A thermal frame (airframe `thermal:`), taken with the camera frame and published just before
+  // it on the same topic (bus/messages.hpp, CameraImage "mono16"); only for drones whose airframe
+  // has a thermal camera.
+  virtual Status PublishThermal(std::size_t drone, const std::string& name, std::uint64_t step,
+                                const ThermalImage& image) = 0;
   // A stereo pair, already in the bus layout (bus/messages.hpp, CameraImage); only for drones whose
   // airframe has stereo enabled.
   virtual Status PublishStereo(std::size_t drone, const bus::CameraImage& pair) = 0;
@@ -220,6 +226,8 @@ class SimServer {
   struct Slot {
     bool camera_frame = false;
     CameraImage image;                         // this step's frame, re-sent with a re-sent sample
+    bool thermal_frame = false;                // a thermal frame went with it (airframe `thermal:`)
+    ThermalImage thermal;
     bool stereo_frame = false;
     bus::CameraImage stereo;                   // this step's stereo pair, re-sent likewise
     std::vector<bus::RadioFrame> radio_in;

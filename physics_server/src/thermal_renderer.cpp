@@ -52,6 +52,13 @@ void ThermalRenderer::Render(const Pose& body_pose, const airframe::ThermalSpec&
   detail::DrawScene(scene, cam, img_, labels, people != nullptr, &in_view);
   if (people != nullptr) detail::ListVisible(*config_, labels_, cam, in_view, &scratch_, people);
 
+  out->centikelvin.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  cv::Mat dst(h, w, CV_16U, out->centikelvin.data());
+  ApplySensor(spec, noise_seed, &dst);
+}
+
+// The optics' blur, the frame's offset and the temporal noise, then 0.01 K counts into `dst`.
+void ThermalRenderer::ApplySensor(const airframe::ThermalSpec& spec, std::uint64_t noise_seed, cv::Mat* dst) {
   if (spec.psf_sigma_px > 0) {
     cv::GaussianBlur(img_, blurred_, cv::Size(), spec.psf_sigma_px, spec.psf_sigma_px, cv::BORDER_REFLECT101);
   } else {
@@ -60,15 +67,13 @@ void ThermalRenderer::Render(const Pose& body_pose, const airframe::ThermalSpec&
   cv::RNG rng(noise_seed);
   const double offset = spec.offset_std_k > 0 ? spec.offset_std_k * rng.gaussian(1.0) : 0.0;
   if (spec.netd_k > 0) {
-    noise_.create(h, w, CV_32F);
+    noise_.create(img_.rows, img_.cols, CV_32F);
     rng.fill(noise_, cv::RNG::NORMAL, offset, spec.netd_k);
     blurred_ += noise_;
   } else if (offset != 0) {
     blurred_ += cv::Scalar(offset);
   }
-  out->centikelvin.resize(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  cv::Mat dst(h, w, CV_16U, out->centikelvin.data());
-  blurred_.convertTo(dst, CV_16U, kThermalCountsPerK);
+  blurred_.convertTo(*dst, CV_16U, kThermalCountsPerK);
 }
 
 }  // namespace swarmbox::physics

@@ -5,15 +5,16 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <mutex>
 #include <numbers>
-#include <functional>
 #include <string>
 #include <string_view>
 #include <unordered_map>
 
-#include "swarmbox/physics/ground_renderer.hpp"
 #include "sensor_models.hpp"
+#include "swarmbox/physics/ground_renderer.hpp"
+#include "swarmbox/physics/thermal_renderer.hpp"
 
 namespace swarmbox::physics {
 namespace {
@@ -123,6 +124,7 @@ struct World::Impl {
   WindModel wind;
   Vec3 wind_now;
   std::unique_ptr<GroundRenderer> renderer;
+  std::unique_ptr<ThermalRenderer> thermal;  // built on the first thermal frame
   EventSink* sink = nullptr;
   std::array<PendingEvent, kMaxPendingEvents> pending{};
   std::size_t pending_count = 0;
@@ -806,6 +808,22 @@ void World::RenderCamera(std::size_t index, CameraImage* out, std::vector<Visibl
   w.renderer->Render(Pose{k.position_m, k.attitude}, k.body_rates_rad_s, d.af.camera,
                      MixSeed(w.options.seed, (static_cast<std::uint64_t>(index) << 40) ^ w.step), out, people);
   out->time_ns = w.time_ns;
+}
+
+Status World::RenderThermal(std::size_t index, ThermalImage* out, std::vector<VisiblePerson>* people) {
+  Impl& w = *impl_;
+  const Impl::Drone& d = *w.drones.at(index);
+  if (!d.af.thermal.enabled) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "drone " + std::to_string(index) + " carries no thermal camera");
+  }
+  if (!w.thermal) w.thermal = std::make_unique<ThermalRenderer>(w.config);
+  const TrueKinematics k = w.Kinematics(d);
+  w.thermal->Render(Pose{k.position_m, k.attitude}, d.af.thermal,
+                    MixSeed(w.options.seed ^ 0x7E4A11ULL, (static_cast<std::uint64_t>(index) << 40) ^ w.step),
+                    out, people);
+  out->time_ns = w.time_ns;
+  return Ok{};
 }
 
 bool World::CameraDue(std::size_t index) const {

@@ -51,6 +51,13 @@ class ScriptedAgents final : public SimTransport {
     EXPECT_EQ(img.bgr.size(), static_cast<std::size_t>(img.width_px) * static_cast<std::size_t>(img.height_px) * 3u);
     return Ok{};
   }
+  Status PublishThermal(std::size_t, const std::string& name, std::uint64_t step,
+                        const ThermalImage& img) override {
+    published.push_back("thermal " + name + " " + std::to_string(step));
+    EXPECT_EQ(img.centikelvin.size(),
+              static_cast<std::size_t>(img.width_px) * static_cast<std::size_t>(img.height_px));
+    return Ok{};
+  }
   Status PublishStereo(std::size_t, const bus::CameraImage& pair) override {
     published.push_back("stereo " + pair.drone + " " + std::to_string(pair.step));
     pairs[pair.drone].push_back(pair);

@@ -363,6 +363,25 @@ TEST_F(SimServerTest, CameraFrameGoesOutBeforeItsSampleWhichSaysSo) {
             4);
 }
 
+// The x500's thermal camera (airframe `thermal:`) is taken with each camera frame and goes out
+// just before it: the agent waits for the colour frame and finds the thermal one there already.
+TEST_F(SimServerTest, AThermalFrameGoesOutJustBeforeItsCameraFrame) {
+  SimServerOptions o = Options(0);
+  o.rtf = 0;
+  SimServer server(*world_, agents_, clock_, nullptr, o, out_);
+  for (int k = 0; k < 51; ++k) ASSERT_TRUE(server.RunStep(stop_).ok());
+  std::vector<std::string> thermal;
+  for (std::size_t n = 0; n < agents_.published.size(); ++n) {
+    const std::string& line = agents_.published[n];
+    if (line.rfind("thermal ", 0) != 0) continue;
+    thermal.push_back(line);
+    ASSERT_LT(n + 1, agents_.published.size());
+    EXPECT_EQ(agents_.published[n + 1], "camera " + line.substr(8));
+  }
+  EXPECT_EQ(thermal,
+            (std::vector<std::string>{"thermal a 0", "thermal b 0", "thermal a 50", "thermal b 50"}));
+}
+
 // The shipped x500 triggers its camera by distance (x500.yaml, camera_trigger.hpp): a drone holding
 // its position takes its first frame at once, then one per trigger_interval_max_s (0.5 s, on the
 // 5 Hz grid: 0.6 s), not 5 a second.

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,7 @@
 
 #include "detail/render_scene.hpp"
 #include "detail/thermal_scene.hpp"
+#include "swarmbox/airframe/airframe.hpp"
 #include "swarmbox/airframe/thermal_spec.hpp"
 #include "swarmbox/physics/thermal_renderer.hpp"
 #include "swarmbox/physics/world_config.hpp"
@@ -80,6 +83,29 @@ TEST(ThermalSpec, ReferenceFileIsTheBoson320) {
   EXPECT_DOUBLE_EQ(spec.netd_k, 0.05);
   // 12 um pixels behind a 4.3 mm lens: f = 4.3 / 0.012 = 358.3 px.
   EXPECT_NEAR(spec.FocalPx(), 4.3 / 0.012, 0.2);
+}
+
+// An airframe carries the camera under `thermal:` (airframe::ReadThermal): the x500 scouts do, the
+// x8_heavy lifter does not.
+TEST(ThermalSpec, TheScoutsAirframeCarriesItUnderThermal) {
+  auto x500 = airframe::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x500.yaml");
+  ASSERT_TRUE(x500.ok()) << x500.error().ToString();
+  EXPECT_TRUE(x500->thermal.enabled);
+  const ThermalSpec shipped = ShippedSpec();
+  EXPECT_EQ(x500->thermal.width_px, shipped.width_px);
+  EXPECT_EQ(x500->thermal.height_px, shipped.height_px);
+  EXPECT_DOUBLE_EQ(x500->thermal.hfov_rad, shipped.hfov_rad);
+  EXPECT_DOUBLE_EQ(x500->thermal.netd_k, shipped.netd_k);
+  auto lifter = airframe::LoadAirframe(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x8_heavy.yaml");
+  ASSERT_TRUE(lifter.ok()) << lifter.error().ToString();
+  EXPECT_FALSE(lifter->thermal.enabled);
+
+  std::ifstream in(std::string(SWARMBOX_TRIALS_DIR) + "/airframes/x8_heavy.yaml");
+  std::stringstream text;
+  text << in.rdbuf();
+  auto bad = yaml::Parse(text.str() + "thermal: {netd_k: 3}\n", "x8_thermal.yaml");
+  ASSERT_TRUE(bad.ok());
+  EXPECT_FALSE(airframe::ParseAirframe(*bad).ok());
 }
 
 TEST(ThermalSpec, UnknownKeysAndANoisyCoreAreErrors) {

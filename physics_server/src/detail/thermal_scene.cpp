@@ -87,28 +87,20 @@ double SurfaceK(Heat heat, const cv::Scalar& bgr, double sunlit, const ThermalEn
          env.cooling_w_m2 / h;
 }
 
-RenderScene ThermalSceneOf(const RenderScene& rgb, const WorldConfig& config) {
-  RenderScene s;
-  s.texel_m = rgb.texel_m;
-  s.origin_x_m = rgb.origin_x_m;
-  s.top_y_m = rgb.top_y_m;
-  s.light = rgb.light;
-  const ThermalEnv env = ThermalEnvOf(config, rgb.light);
-  s.sky = cv::Scalar(env.sky_k);
-  s.box_below = cv::Scalar(env.air_k);
-  s.underground = cv::Scalar(env.air_k);
+namespace {
 
-  // The ground: solid where bare, a leaf's temperature where vegetated, under the air in water.
-  // The texture's colours carry the baked shadows: undone here (the shadow map says how much)
-  // before the colour gives the absorptance.
+// The ground in kelvin: solid where bare, a leaf's temperature where vegetated, under the air in
+// water. The texture's colours carry the baked shadows: undone here (the shadow map says how
+// much) before the colour gives the absorptance.
+cv::Mat GroundKelvin(const RenderScene& rgb, const ThermalEnv& env) {
   const double dark = 1.0 - rgb.light.shadow_factor;
-  s.texture.create(rgb.texture.size(), CV_32F);
+  cv::Mat out(rgb.texture.size(), CV_32F);
   for (int r = 0; r < rgb.texture.rows; ++r) {
     const auto* px = rgb.texture.ptr<cv::Vec3b>(r);
     const auto* veg = rgb.vegetation.ptr<std::uint8_t>(r);
     const auto* wet = rgb.wet.ptr<std::uint8_t>(r);
     const auto* shade = rgb.shadow.ptr<std::uint8_t>(r);
-    auto* t = s.texture.ptr<float>(r);
+    auto* t = out.ptr<float>(r);
     for (int c = 0; c < rgb.texture.cols; ++c) {
       const double m = shade[c] / 255.0;
       const double unshade = 1.0 / std::max(0.05, 1.0 - dark * m);
@@ -121,22 +113,36 @@ RenderScene ThermalSceneOf(const RenderScene& rgb, const WorldConfig& config) {
       t[c] = static_cast<float>(k);
     }
   }
+  return out;
+}
+
+std::vector<Drawable> DrawablesInKelvin(const std::vector<Drawable>& in, const ThermalEnv& env) {
+  std::vector<Drawable> out = in;
+  for (Drawable& d : out) d.parts = InKelvin(d.parts, env, 0);
+  return out;
+}
+
+}  // namespace
+
+RenderScene ThermalSceneOf(const RenderScene& rgb, const WorldConfig& config) {
+  RenderScene s;
+  s.texel_m = rgb.texel_m;
+  s.origin_x_m = rgb.origin_x_m;
+  s.top_y_m = rgb.top_y_m;
+  s.light = rgb.light;
+  const ThermalEnv env = ThermalEnvOf(config, rgb.light);
+  s.sky = cv::Scalar(env.sky_k);
+  s.box_below = cv::Scalar(env.air_k);
+  s.underground = cv::Scalar(env.air_k);
+  s.texture = GroundKelvin(rgb, env);
   for (const Figure& f : rgb.figures) {
     Figure g = f;
     g.parts = InKelvin(f.parts, env, f.clothing_pass);
     g.cover = InKelvin(f.cover, env, 0);
     s.figures.push_back(std::move(g));
   }
-  for (const Drawable& d : rgb.flats) {
-    Drawable e = d;
-    e.parts = InKelvin(d.parts, env, 0);
-    s.flats.push_back(std::move(e));
-  }
-  for (const Drawable& d : rgb.obstacles) {
-    Drawable e = d;
-    e.parts = InKelvin(d.parts, env, 0);
-    s.obstacles.push_back(std::move(e));
-  }
+  s.flats = DrawablesInKelvin(rgb.flats, env);
+  s.obstacles = DrawablesInKelvin(rgb.obstacles, env);
   return s;
 }
 

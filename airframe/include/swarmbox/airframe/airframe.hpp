@@ -28,10 +28,11 @@
 #include <string_view>
 #include <vector>
 
+#include "swarmbox/airframe/stereo_spec.hpp"
+#include "swarmbox/airframe/thermal_spec.hpp"
+#include "swarmbox/airframe/vec3.hpp"
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/common/yaml.hpp"
-#include "swarmbox/airframe/stereo_spec.hpp"
-#include "swarmbox/airframe/vec3.hpp"
 
 namespace swarmbox::airframe {
 
@@ -161,6 +162,7 @@ struct Airframe {
   CameraSpec camera;
   bool has_camera = false;              // the file has a `camera:` mapping (else `camera` is the default)
   StereoSpec stereo;                    // `stereo:` (OAK-D Pro depth); absent: stereo.enabled == false
+  ThermalSpec thermal;                  // `thermal:` (FLIR Boson 320 LWIR); absent: thermal.enabled == false
   std::vector<PayloadSpec> payloads;    // what this airframe can carry (x8_heavy: the stretcher)
   yaml::Node control;                   // flight-stack gains, passed through untouched (may be null)
 

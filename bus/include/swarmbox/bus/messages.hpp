@@ -246,6 +246,13 @@ struct Pose {
   bool operator==(const Pose&) const = default;
 };
 
+// A thermal frame (airframe `thermal:`, physics ThermalRenderer) is one CameraImage on
+// CameraTopic(drone), published just before the colour frame it was taken with (same sim_time_ns
+// and step): encoding kThermalEncoding, each pixel the apparent temperature in hundredths of a
+// kelvin as an unsigned 16-bit little-endian count, row_stride_bytes = 2 width_px; intrinsics and
+// camera_pose the thermal camera's own.
+inline constexpr std::string_view kThermalEncoding = "mono16";
+
 // One camera frame. Physics server -> agent, on CameraTopic(drone) with Qos::kLockstep (5 Hz,
 // 320x240 mono8/bgr8, ~80 KB).
 //
@@ -267,7 +274,8 @@ struct CameraImage {
   std::uint32_t width_px = 0;
   std::uint32_t height_px = 0;
   std::uint32_t row_stride_bytes = 0;  // bytes from one row to the next in `data`
-  // "mono8", "bgr8", "rgb8" (OpenCV/ROS names) or "16UC1" (a depth image: DepthImageTopic)
+  // "mono8", "bgr8", "rgb8" (OpenCV/ROS names), "16UC1" (a depth image: DepthImageTopic) or
+  // kThermalEncoding (a thermal frame on CameraTopic)
   std::string encoding;
   CameraIntrinsics intrinsics;
   // Pose of the camera's optical frame (OpenCV convention: x right, y down, z along the optical

@@ -67,6 +67,8 @@ class ThermalRenderer {
   double air_k() const { return air_k_; }  // the world's air temperature [K]
 
  private:
+  void ApplySensor(const airframe::ThermalSpec& spec, std::uint64_t noise_seed, cv::Mat* dst);
+
   const WorldConfig* config_;
   std::unique_ptr<detail::RenderScene> scene_;  // in kelvin
   double air_k_ = 293.15;

@@ -42,6 +42,7 @@
 namespace swarmbox::physics {
 
 struct VisiblePerson;  // ground_renderer.hpp
+struct ThermalImage;   // thermal_renderer.hpp
 
 struct WorldOptions {
   std::uint64_t seed = 1;                        // drives every noise source and the wind
@@ -137,6 +138,10 @@ class World {
   void RenderCamera(std::size_t index, CameraImage* out, std::vector<VisiblePerson>* people = nullptr);
   // Whether a camera frame is due at the current step (camera.rate_hz of the airframe).
   bool CameraDue(std::size_t index) const;
+  // Renders the drone's thermal camera (airframe `thermal:`, ThermalRenderer) at its true pose now;
+  // the renderer is built on the first call (its scene costs as much as the RGB camera's).
+  // kInvalidArgument: the drone's airframe has no thermal camera.
+  Status RenderThermal(std::size_t index, ThermalImage* out, std::vector<VisiblePerson>* people = nullptr);
 
   // Not owned; nullptr drops events. Must outlive the World or be reset.
   void SetEventSink(EventSink* sink);

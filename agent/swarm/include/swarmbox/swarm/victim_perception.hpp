@@ -25,6 +25,7 @@
 #include "swarmbox/swarm/detection.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
 #include "swarmbox/swarm/latency_queue.hpp"
+#include "swarmbox/swarm/thermal_evidence.hpp"
 #include "swarmbox/swarm/victim_detector.hpp"
 
 namespace swarmbox::swarm {
@@ -39,6 +40,9 @@ struct PerceptionParams {
   double position_sigma_m = 0.5;     // estimated camera position, horizontal 1-sigma [m]
   double attitude_sigma_rad = 0.01;  // estimated attitude 1-sigma [rad]
   double pixel_sigma_px = 0.7;       // blob centroid 1-sigma [px]
+  // With a thermal frame (ProcessFrame's `thermal`): each candidate's confidence takes the
+  // thermal evidence at its ground point (thermal_evidence.hpp) before min_confidence applies.
+  ThermalEvidence thermal;
 };
 
 class VictimPerception {
@@ -49,8 +53,13 @@ class VictimPerception {
   // Without `surface` each detection is where its pixel's ray meets the plane z = ground_z_m;
   // with one, where it meets the surface's heights (PixelToSurface: a person on a rubble slab seen
   // obliquely is not pushed height x tan(off-nadir angle) beyond it).
+  // With `thermal` (a thermal frame taken with this one, its estimated pose), a candidate the
+  // thermal camera sees (its contrast defined: ThermalContrastAt) has its confidence moved by the
+  // thermal evidence: sigmoid(logit(confidence) + params.thermal.Llr(contrast)); one it does not
+  // see (the thermal camera's view is narrower) keeps the colour detector's.
   int ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& k, const OpticalPose& camera_pose,
-                   double capture_time_s, const GroundHeightSource* surface = nullptr);
+                   double capture_time_s, const GroundHeightSource* surface = nullptr,
+                   const ThermalView* thermal = nullptr);
   // Appends the detections that are visible at now_s (capture + latency <= now_s).
   void PopVisible(double now_s, std::vector<GroundDetection>* out) { queue_.PopVisible(now_s, out); }
 
