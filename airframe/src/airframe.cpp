@@ -186,6 +186,13 @@ void ReadThermal(MapReader& parent, Airframe* af) {
     parent.Fail(spec.error());
     return;
   }
+  // A thermal frame is taken with each camera frame (physics SimServer): the core must keep up.
+  if (spec->enabled && af->camera.rate_hz > spec->rate_hz) {
+    parent.Fail(InvalidAt(
+        *n, "rate_hz",
+        "thermal: rate_hz must be at least camera.rate_hz (a frame is taken with each camera frame)"));
+    return;
+  }
   af->thermal = *spec;
 }
 

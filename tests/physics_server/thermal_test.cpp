@@ -106,6 +106,13 @@ TEST(ThermalSpec, TheScoutsAirframeCarriesItUnderThermal) {
   auto bad = yaml::Parse(text.str() + "thermal: {netd_k: 3}\n", "x8_thermal.yaml");
   ASSERT_TRUE(bad.ok());
   EXPECT_FALSE(airframe::ParseAirframe(*bad).ok());
+  // A frame is taken with each camera frame: a core slower than the camera is refused.
+  auto slow = yaml::Parse(text.str() + "thermal: {rate_hz: 2}\n", "x8_thermal.yaml");
+  ASSERT_TRUE(slow.ok());
+  auto refused = airframe::ParseAirframe(*slow);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().ToString().find("camera.rate_hz"), std::string::npos)
+      << refused.error().ToString();
 }
 
 TEST(ThermalSpec, UnknownKeysAndANoisyCoreAreErrors) {

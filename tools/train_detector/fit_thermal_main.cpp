@@ -1,48 +1,105 @@
-// swarmbox-fit-thermal: fits the thermal evidence the agent adds to the colour detector's
-// candidates (agent/swarm thermal_evidence.hpp) on rendered training worlds, and writes it with its
-// provenance (the `fit-thermal` target: agent/swarm/models/thermal_evidence.yaml).
+// swarmbox-fit-thermal: fits how the agent takes the thermal camera's evidence into the colour
+// detector's confidence (agent/swarm thermal_evidence.hpp), on the shipped detector's own
+// candidates in rendered training worlds, and writes it with its provenance (the `fit-thermal`
+// target: agent/swarm/models/thermal_evidence.yaml).
 //
-//   swarmbox-fit-thermal --out FILE [--seed N (9001)] [--worlds N (40)] [--radius-m R (0.7)]
+//   swarmbox-fit-thermal --out FILE [--seed N (9001)] [--scenes N (2880)] [--radius-m R (0.7)]
 //
-// Worlds: rubble fields as trials/sar_rubble.yaml generates them (160 x 160 m, 4 people, 30
-// obstacles, 25 distractors, their own time of day and overcast), world seeds drawn from --seed;
-// the seeds of `swarmbox-bench thermal` (1-10) are refused. Each person at least half visible is
-// looked at straight down from 15-35 m (the close look's 18 m to above the search's 30 m), a few
-// metres off centre, by the thermal camera (trials/sensors/boson_320_thermal.yaml, the physics
-// server's ThermalRenderer); the point looked at is where they lie give or take the colour
-// detector's geolocation error (0.4 m, one sigma). Negatives: every distractor (tarps, cones,
-// backpacks, debris, rocks: what the colour detector fires on) and two ground points 3-12 m from
-// each person, looked at likewise. Each point's contrast is ThermalContrastAt's (the agent's own
-// code). The fit: a logistic regression of person-or-not on the contrast with the two classes
-// weighted equally, so that its logit is the log-likelihood ratio the agent adds to the colour
-// detector's logit: Llr(c) = slope (c - offset).
+// Scenes: nadir views from 15-35 m (the close look's 18 m to above the search's 30 m) of rubble
+// fields as trials/sar_rubble.yaml generates them (perception_scenes.hpp, SarRubbleSpec; 24 views
+// a world, most near a person), each with the x500's thermal frame (trials/airframes/x500.yaml
+// `thermal:`, the physics server's ThermalRenderer). The shipped detector runs on each colour frame;
+// each candidate is placed on the ground with the true pose and labelled a person when within
+// 1.5 m of one at least half visible (near one less visible: left out), else not; its contrast is
+// ThermalContrastAt's (the agent's own code), candidates the thermal frame does not see are left
+// out. The fit: a logistic regression of person-or-not on (logit of the detector's confidence,
+// contrast, 1) by Newton's method: the fused confidence is its probability. Refused seeds: the
+// perception bench's evaluation seeds and the shipped model's training and calibration seeds.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <numbers>
-#include <random>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
-#include "swarmbox/airframe/thermal_spec.hpp"
-#include "swarmbox/common/yaml.hpp"
+#include "perception_scenes.hpp"
 #include "swarmbox/physics/thermal_renderer.hpp"
-#include "swarmbox/physics/world_config.hpp"
+#include "swarmbox/swarm/geolocation.hpp"
 #include "swarmbox/swarm/thermal_evidence.hpp"
-#include "swarmbox/worlds/generator.hpp"
+#include "swarmbox/swarm/victim_detector.hpp"
+#include "swarmbox/swarm/victim_detector_model.hpp"
 
 namespace {
 
 using namespace swarmbox;
+using Eigen::Vector3d;
 
 struct Sample {
-  double contrast_k;
+  double logit;       // the colour detector's, clamped to +-12
+  double contrast_k;  // clamped as Fuse clamps it
   bool person;
 };
+
+// Logistic regression on the features `f(sample)` (the last one the intercept) by Newton's method.
+template <std::size_t N, typename F>
+std::array<double, N> Fit(const std::vector<Sample>& samples, F features) {
+  std::array<double, N> w{};
+  for (int it = 0; it < 100; ++it) {
+    std::array<double, N> g{};
+    std::array<std::array<double, N>, N> h{};
+    for (const Sample& s : samples) {
+      const std::array<double, N> x = features(s);
+      double z = 0;
+      for (std::size_t i = 0; i < N; ++i) z += w[i] * x[i];
+      const double p = 1.0 / (1.0 + std::exp(-z)), y = s.person ? 1.0 : 0.0;
+      for (std::size_t i = 0; i < N; ++i) {
+        g[i] += (p - y) * x[i];
+        for (std::size_t j = 0; j < N; ++j) h[i][j] += p * (1 - p) * x[i] * x[j] + (i == j ? 1e-9 : 0.0);
+      }
+    }
+    // Solve h d = g (Gaussian elimination, N <= 3).
+    std::array<std::array<double, N + 1>, N> m{};
+    for (std::size_t i = 0; i < N; ++i) {
+      for (std::size_t j = 0; j < N; ++j) m[i][j] = h[i][j];
+      m[i][N] = g[i];
+    }
+    for (std::size_t c = 0; c < N; ++c) {
+      for (std::size_t r = c + 1; r < N; ++r) {
+        const double k = m[r][c] / m[c][c];
+        for (std::size_t j = c; j <= N; ++j) m[r][j] -= k * m[c][j];
+      }
+    }
+    std::array<double, N> d{};
+    for (std::size_t c = N; c-- > 0;) {
+      double v = m[c][N];
+      for (std::size_t j = c + 1; j < N; ++j) v -= m[c][j] * d[j];
+      d[c] = v / m[c][c];
+    }
+    double step = 0;
+    for (std::size_t i = 0; i < N; ++i) w[i] -= d[i], step = std::max(step, std::abs(d[i]));
+    if (step < 1e-10) break;
+  }
+  return w;
+}
+
+template <std::size_t N, typename F>
+double LogLoss(const std::vector<Sample>& samples, const std::array<double, N>& w, F features) {
+  double loss = 0;
+  for (const Sample& s : samples) {
+    const std::array<double, N> x = features(s);
+    double z = 0;
+    for (std::size_t i = 0; i < N; ++i) z += w[i] * x[i];
+    const double p = std::clamp(1.0 / (1.0 + std::exp(-z)), 1e-12, 1 - 1e-12);
+    loss -= s.person ? std::log(p) : std::log(1 - p);
+  }
+  return loss / static_cast<double>(samples.size());
+}
 
 double Quantile(std::vector<double> v, double q) {
   if (v.empty()) return std::nan("");
@@ -50,192 +107,167 @@ double Quantile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
-// Weighted logistic regression on one feature by Newton's method: returns (w1, w0) of
-// logit = w1 c + w0, each class's weights summing to one half.
-std::pair<double, double> FitLogistic(const std::vector<Sample>& samples) {
-  double np = 0, nn = 0;
-  for (const Sample& s : samples) (s.person ? np : nn) += 1;
-  double w1 = 0, w0 = 0;
-  for (int it = 0; it < 50; ++it) {
-    double g1 = 0, g0 = 0, h11 = 0, h10 = 0, h00 = 0;
-    for (const Sample& s : samples) {
-      const double c = std::clamp(s.contrast_k, swarm::kMinContrastK, swarm::kMaxContrastK);
-      const double wt = s.person ? 0.5 / np : 0.5 / nn;
-      const double p = 1.0 / (1.0 + std::exp(-(w1 * c + w0)));
-      const double y = s.person ? 1.0 : 0.0;
-      g1 += wt * (p - y) * c, g0 += wt * (p - y);
-      const double v = wt * p * (1 - p);
-      h11 += v * c * c, h10 += v * c, h00 += v;
+swarm::ThermalView ViewOf(const physics::ThermalImage& t) {
+  cv::Mat kelvin;
+  cv::Mat(t.height_px, t.width_px, CV_16U, const_cast<std::uint16_t*>(t.centikelvin.data()))
+      .convertTo(kelvin, CV_32F, 1.0 / physics::kThermalCountsPerK);
+  return {kelvin,
+          {t.intrinsics.fx_px, t.intrinsics.fy_px, t.intrinsics.cx_px, t.intrinsics.cy_px},
+          {Vector3d(t.camera_pose.position_m.x, t.camera_pose.position_m.y, t.camera_pose.position_m.z),
+           Eigen::Quaterniond(t.camera_pose.attitude.w, t.camera_pose.attitude.x, t.camera_pose.attitude.y,
+                              t.camera_pose.attitude.z)}};
+}
+
+// The candidates of one scene as samples.
+void AddSamples(const perception_scenes::Scene& s, swarm::VictimDetector& detector, double radius_m,
+                std::vector<Sample>* out) {
+  const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3,
+                    const_cast<std::uint8_t*>(s.image.bgr.data()));
+  std::vector<swarm::ImageBlob> blobs;
+  detector.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs);
+  const swarm::ThermalView view = ViewOf(*s.thermal);
+  for (const swarm::ImageBlob& b : blobs) {
+    const std::optional<Vector3d> g = swarm::PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
+    if (!g) continue;
+    const perception_scenes::SceneVictim* near = nullptr;
+    for (const perception_scenes::SceneVictim& v : s.victims) {
+      if (v.visible_fraction > 0 && (v.position_m - g->head<2>()).norm() <= 1.5) near = &v;
     }
-    const double det = h11 * h00 - h10 * h10;
-    if (!(det > 1e-12)) break;
-    const double d1 = (h00 * g1 - h10 * g0) / det, d0 = (h11 * g0 - h10 * g1) / det;
-    w1 -= d1, w0 -= d0;
-    if (std::abs(d1) < 1e-9 && std::abs(d0) < 1e-9) break;
+    if (near != nullptr && near->visible_fraction < 0.5) continue;
+    const std::optional<double> c = swarm::ThermalContrastAt(view, *g, radius_m);
+    if (!c) continue;
+    const double p = std::clamp(b.confidence, 1e-6, 1 - 1e-6);
+    out->push_back({std::clamp(std::log(p / (1 - p)), -12.0, 12.0),
+                    std::clamp(*c, swarm::kMinContrastK, swarm::kMaxContrastK), near != nullptr});
   }
-  return {w1, w0};
-}
-
-double Auc(const std::vector<Sample>& samples) {
-  std::vector<double> p, n;
-  for (const Sample& s : samples) (s.person ? p : n).push_back(s.contrast_k);
-  double wins = 0;
-  for (double a : p) {
-    for (double b : n) wins += a > b ? 1.0 : a == b ? 0.5 : 0.0;
-  }
-  return wins / (static_cast<double>(p.size()) * static_cast<double>(n.size()));
-}
-
-cv::Mat Kelvin(const physics::ThermalImage& img) {
-  cv::Mat counts(img.height_px, img.width_px, CV_16U, const_cast<std::uint16_t*>(img.centikelvin.data())), k;
-  counts.convertTo(k, CV_32F, 1.0 / physics::kThermalCountsPerK);
-  return k;
 }
 
 int Usage() {
-  std::fprintf(stderr, "usage: swarmbox-fit-thermal --out FILE [--seed N] [--worlds N] [--radius-m R]\n");
+  std::fprintf(stderr, "usage: swarmbox-fit-thermal --out FILE [--seed N] [--scenes N] [--radius-m R]\n");
   return 2;
+}
+
+struct Args {
+  std::string out;
+  std::uint64_t seed = 9001;
+  int scenes = 2880;
+  double radius_m = 0.7;
+};
+
+std::optional<Args> ParseArgs(int argc, char** argv) {
+  Args args;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) return std::nullopt;
+    const std::string v = argv[++i];
+    if (a == "--out") {
+      args.out = v;
+    } else if (a == "--seed") {
+      args.seed = std::strtoull(v.c_str(), nullptr, 10);
+    } else if (a == "--scenes") {
+      args.scenes = std::atoi(v.c_str());
+    } else if (a == "--radius-m") {
+      args.radius_m = std::atof(v.c_str());
+    } else {
+      return std::nullopt;
+    }
+  }
+  if (args.out.empty() || args.scenes < 24 || !(args.radius_m > 0.1 && args.radius_m < 3))
+    return std::nullopt;
+  return args;
+}
+
+// The fit's file (thermal_evidence.hpp's mapping, with its provenance); false when it cannot be written.
+bool WriteFit(const Args& args, const std::array<double, 3>& w, std::size_t people, std::size_t others,
+              double loss, double loss_colour, const std::vector<double>& pc, const std::vector<double>& nc) {
+  std::ofstream f(args.out);
+  f << "# How the agent takes the thermal camera's evidence into the colour detector's confidence\n"
+    << "# (agent/swarm thermal_evidence.hpp): sigmoid(colour_weight logit(confidence) + slope_per_k c\n"
+    << "# + bias), c the contrast within radius_m of the candidate's ground point. Written by\n"
+    << "# swarmbox-fit-thermal (the fit-thermal target; tools/train_detector/fit_thermal_main.cpp has\n"
+    << "# the method): do not edit. fit: the candidates it was fitted on, and the log-loss with the\n"
+    << "# contrast and with the colour detector's confidence alone (refitted likewise).\n"
+    << "thermal_evidence:\n";
+  char line[768];
+  std::snprintf(line, sizeof line,
+                "  colour_weight: %.6f\n  slope_per_k: %.6f\n  bias: %.6f\n  radius_m: %.3f\n", w[0], w[1],
+                w[2], args.radius_m);
+  f << line;
+  std::snprintf(
+      line, sizeof line,
+      "  fit: {seed: %llu, scenes: %d, altitudes_m: [15, 35], people: %zu, others: %zu, log_loss: %.4f,\n"
+      "        log_loss_colour_alone: %.4f, person_contrast_p10_k: %.2f, person_contrast_p50_k: %.2f,\n"
+      "        other_contrast_p50_k: %.2f, other_contrast_p90_k: %.2f}\n",
+      static_cast<unsigned long long>(args.seed), args.scenes, people, others, loss, loss_colour,
+      Quantile(pc, 0.1), Quantile(pc, 0.5), Quantile(nc, 0.5), Quantile(nc, 0.9));
+  f << line;
+  return static_cast<bool>(f);
+}
+
+// The shipped detector's candidates on the rendered scenes (nullopt and a message on failure).
+std::optional<std::vector<Sample>> Candidates(const Args& args) {
+  const std::shared_ptr<const swarm::VictimDetectorModel> model = swarm::ShippedDetectorModel();
+  std::vector<std::uint64_t> refused(std::begin(perception_scenes::kEvaluationSeeds),
+                                     std::end(perception_scenes::kEvaluationSeeds));
+  refused.insert(refused.end(), model->training_seeds.begin(), model->training_seeds.end());
+  refused.insert(refused.end(), model->calibration_seeds.begin(), model->calibration_seeds.end());
+  if (std::find(refused.begin(), refused.end(), args.seed) != refused.end()) {
+    std::fprintf(
+        stderr,
+        "swarmbox-fit-thermal: seed %llu is an evaluation seed or the detector's own: fit on another\n",
+        static_cast<unsigned long long>(args.seed));
+    return std::nullopt;
+  }
+  perception_scenes::SceneSetParams params{.seed = args.seed,
+                                           .scenes = args.scenes,
+                                           .scenes_per_world = 24,
+                                           .min_altitude_m = 15,
+                                           .max_altitude_m = 35};
+  params.generated = perception_scenes::SarRubbleSpec();
+  params.thermal = true;
+  Result<std::vector<perception_scenes::Scene>> scenes = perception_scenes::RenderScenes(params);
+  if (!scenes) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", scenes.error().ToString().c_str());
+    return std::nullopt;
+  }
+  swarm::VictimDetector detector(model, swarm::VictimDetectorParams{});
+  std::vector<Sample> samples;
+  for (const perception_scenes::Scene& s : *scenes) AddSamples(s, detector, args.radius_m, &samples);
+  return samples;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string out;
-  std::uint64_t seed = 9001;
-  int worlds_n = 40;
-  double radius_m = 0.7;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) return Usage();
-    const std::string v = argv[++i];
-    if (a == "--out") {
-      out = v;
-    } else if (a == "--seed") {
-      seed = std::strtoull(v.c_str(), nullptr, 10);
-    } else if (a == "--worlds") {
-      worlds_n = std::atoi(v.c_str());
-    } else if (a == "--radius-m") {
-      radius_m = std::atof(v.c_str());
-    } else {
-      return Usage();
-    }
-  }
-  if (out.empty() || worlds_n < 1 || !(radius_m > 0.1 && radius_m < 3)) return Usage();
-  if (seed >= 1 && seed <= 10) {
-    std::fprintf(stderr,
-                 "swarmbox-fit-thermal: seed %llu is one of swarmbox-bench thermal's (1-10): fit on others\n",
-                 static_cast<unsigned long long>(seed));
-    return 2;
-  }
-  auto doc = yaml::ParseFile(std::string(SWARMBOX_TRIALS_DIR) + "/sensors/boson_320_thermal.yaml");
-  if (!doc) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", doc.error().ToString().c_str());
-    return 1;
-  }
-  auto spec = airframe::ParseThermalSpec(doc->Find("thermal"));
-  if (!spec) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", spec.error().ToString().c_str());
-    return 1;
-  }
-  const worlds::GenerateSpec gen{.kind = worlds::WorldKind::kRubbleField,
-                                 .size_m = {160, 160},
-                                 .victims = 4,
-                                 .obstacles = 30,
-                                 .distractors = 25};
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0, 1);
-  std::normal_distribution<double> jitter(0.0, 0.4);
-  std::vector<Sample> samples;
-  physics::ThermalImage img;
-  std::vector<physics::VisiblePerson> people;
-  // Looks at world point (x, y) from a random height and offset; the contrast there, if defined
-  // (and for a person, `id` at least half visible).
-  auto look = [&](physics::ThermalRenderer& renderer, double x, double y,
-                  const std::string& id) -> std::optional<double> {
-    const double alt = 15 + 20 * unit(rng), yaw = unit(rng) * 2 * std::numbers::pi;
-    const double cx = x + (unit(rng) - 0.5) * 0.3 * alt, cy = y + (unit(rng) - 0.5) * 0.3 * alt;
-    renderer.Render(
-        physics::Pose{physics::Vec3{cx, cy, alt}, physics::Quat{std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)}},
-        *spec, rng(), &img, id.empty() ? nullptr : &people);
-    if (!id.empty()) {
-      const auto it = std::find_if(people.begin(), people.end(),
-                                   [&](const physics::VisiblePerson& p) { return p.id == id; });
-      if (it == people.end() || it->visible_fraction < 0.5) return std::nullopt;
-    }
-    const physics::Pose& pose = img.camera_pose;
-    const swarm::ThermalView view{
-        Kelvin(img),
-        {img.intrinsics.fx_px, img.intrinsics.fy_px, img.intrinsics.cx_px, img.intrinsics.cy_px},
-        {Eigen::Vector3d(pose.position_m.x, pose.position_m.y, pose.position_m.z),
-         Eigen::Quaterniond(pose.attitude.w, pose.attitude.x, pose.attitude.y, pose.attitude.z)}};
-    return swarm::ThermalContrastAt(view, Eigen::Vector3d(x + jitter(rng), y + jitter(rng), 0.0), radius_m);
-  };
-  for (int w = 0; w < worlds_n; ++w) {
-    const std::uint64_t world_seed = rng() % 1'000'000'000ULL;
-    auto text = worlds::GenerateWorld(gen, world_seed);
-    if (!text) {
-      std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", text.error().ToString().c_str());
-      return 1;
-    }
-    auto root = yaml::Parse(*text, "generated world");
-    if (!root) return 1;
-    auto world = physics::ParseWorld(*root, "generated world " + std::to_string(world_seed));
-    if (!world) {
-      std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", world.error().ToString().c_str());
-      return 1;
-    }
-    physics::ThermalRenderer renderer(*world);
-    for (const physics::Victim& v : world->victims) {
-      if (auto c = look(renderer, v.x_m, v.y_m, v.id)) samples.push_back({*c, true});
-      for (int k = 0; k < 2; ++k) {
-        const double r = 3 + 9 * unit(rng), a = unit(rng) * 2 * std::numbers::pi;
-        if (auto c = look(renderer, v.x_m + r * std::cos(a), v.y_m + r * std::sin(a), ""))
-          samples.push_back({*c, false});
-      }
-    }
-    for (const physics::Distractor& d : world->distractors) {
-      if (auto c = look(renderer, d.x_m, d.y_m, "")) samples.push_back({*c, false});
-    }
-    std::fprintf(stderr, "swarmbox-fit-thermal: world %d/%d (seed %llu): %zu samples\n", w + 1, worlds_n,
-                 static_cast<unsigned long long>(world_seed), samples.size());
-  }
+  const std::optional<Args> args = ParseArgs(argc, argv);
+  if (!args) return Usage();
+  const std::optional<std::vector<Sample>> samples = Candidates(*args);
+  if (!samples) return 1;
   std::vector<double> pc, nc;
-  for (const Sample& s : samples) (s.person ? pc : nc).push_back(s.contrast_k);
-  if (pc.size() < 10 || nc.size() < 10) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: too few samples (%zu people, %zu negatives)\n", pc.size(),
+  for (const Sample& s : *samples) (s.person ? pc : nc).push_back(s.contrast_k);
+  if (pc.size() < 20 || nc.size() < 20) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: too few candidates (%zu people, %zu others)\n", pc.size(),
                  nc.size());
     return 1;
   }
-  const auto [w1, w0] = FitLogistic(samples);
-  if (!(w1 > 0)) {
-    std::fprintf(
-        stderr, "swarmbox-fit-thermal: the fit's slope is %g: warmer is not more likely a person here\n", w1);
+  auto both = [](const Sample& s) { return std::array<double, 3>{s.logit, s.contrast_k, 1.0}; };
+  auto colour = [](const Sample& s) { return std::array<double, 2>{s.logit, 1.0}; };
+  const std::array<double, 3> w = Fit<3>(*samples, both);
+  const std::array<double, 2> w_colour = Fit<2>(*samples, colour);
+  if (!(w[0] > 0 && w[1] > 0)) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: the fit's weights are %g, %g: not a usable fusion\n", w[0],
+                 w[1]);
     return 1;
   }
-  const double offset = -w0 / w1;
-  std::ofstream f(out);
-  f << "# Thermal evidence for the colour detector's candidates (agent/swarm thermal_evidence.hpp):\n"
-    << "# Llr(c) = slope_per_k (c - offset_k) added to the detector's logit, c the contrast within\n"
-    << "# radius_m of the candidate's ground point. Written by swarmbox-fit-thermal (the fit-thermal\n"
-    << "# target; tools/train_detector/fit_thermal_main.cpp has the method): do not edit.\n"
-    << "thermal_evidence:\n";
-  char line[512];
-  std::snprintf(line, sizeof line, "  slope_per_k: %.6f\n  offset_k: %.4f\n  radius_m: %.3f\n", w1, offset,
-                radius_m);
-  f << line;
-  std::snprintf(
-      line, sizeof line,
-      "  fit: {seed: %llu, worlds: %d, people: %zu, negatives: %zu, auc: %.4f, person_contrast_p10_k: %.2f,\n"
-      "        person_contrast_p50_k: %.2f, negative_contrast_p50_k: %.2f, negative_contrast_p90_k: %.2f}\n",
-      static_cast<unsigned long long>(seed), worlds_n, pc.size(), nc.size(), Auc(samples), Quantile(pc, 0.1),
-      Quantile(pc, 0.5), Quantile(nc, 0.5), Quantile(nc, 0.9));
-  f << line;
-  if (!f) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", out.c_str());
+  const double loss = LogLoss<3>(*samples, w, both), loss_colour = LogLoss<2>(*samples, w_colour, colour);
+  if (!WriteFit(*args, w, pc.size(), nc.size(), loss, loss_colour, pc, nc)) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", args->out.c_str());
     return 1;
   }
   std::printf(
-      "fit=thermal seed=%llu worlds=%d people=%zu negatives=%zu slope_per_k=%.4f offset_k=%.3f auc=%.4f\n",
-      static_cast<unsigned long long>(seed), worlds_n, pc.size(), nc.size(), w1, offset, Auc(samples));
+      "fit=thermal seed=%llu scenes=%d people=%zu others=%zu colour_weight=%.4f slope_per_k=%.4f bias=%.4f "
+      "log_loss=%.4f log_loss_colour_alone=%.4f\n",
+      static_cast<unsigned long long>(args->seed), args->scenes, pc.size(), nc.size(), w[0], w[1], w[2], loss,
+      loss_colour);
   return 0;
 }

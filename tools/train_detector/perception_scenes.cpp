@@ -339,6 +339,11 @@ Status RenderNadirViews(std::mt19937_64& rng, const SceneSetParams& p, const phy
     Result<std::size_t> d = world.AddDrone(spawn);
     if (!d) return d.error().Context("placing camera drone");
     scenes->push_back(SceneOfCamera(world, *d, config, noise_std));
+    if (p.thermal) {
+      scenes->back().thermal.emplace();
+      if (auto s = world.RenderThermal(*d, &*scenes->back().thermal); !s)
+        return s.error().Context("thermal camera");
+    }
   }
   return Ok{};
 }

@@ -34,6 +34,7 @@
 
 #include "swarmbox/common/result.hpp"
 #include "swarmbox/physics/camera_image.hpp"
+#include "swarmbox/physics/thermal_renderer.hpp"
 #include "swarmbox/physics/world_config.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
 #include "swarmbox/worlds/generator.hpp"
@@ -59,6 +60,8 @@ struct Scene {
   double noise_std = 0.0;     // pixel noise of this scene [8-bit levels]
   double tilt_rad = 0.0;      // angle between the optical axis and straight down
   std::vector<SceneVictim> victims;
+  // With SceneSetParams::thermal: the thermal camera's frame taken with it (the x500's `thermal:`).
+  std::optional<physics::ThermalImage> thermal;
 };
 
 // The colours generated worlds give tarps and backpacks (orchestrator/worlds generator.cpp
@@ -96,6 +99,9 @@ struct SceneSetParams {
   // occluded_fraction, distractors, varied_look and distractor_mix are not used. The views are
   // placed as above (near_victim_fraction of them near a person).
   std::optional<worlds::GenerateSpec> generated{};
+  // The x500's thermal camera too (Scene::thermal; nadir views only): what `swarmbox-bench
+  // perception --thermal 1` scores the colour detector with its thermal evidence on.
+  bool thermal = false;
 };
 
 // The mission's search area (trials/sar_rubble.yaml's world: a 160 x 160 m rubble field, 4

@@ -46,8 +46,11 @@ std::optional<double> ThermalContrastAt(const ThermalView& view, const Eigen::Ve
   return static_cast<double>(Quantile(disc, 0.98)) - static_cast<double>(Quantile(ring, 0.5));
 }
 
-double ThermalEvidence::Llr(double contrast_k) const {
-  return slope_per_k * (std::clamp(contrast_k, kMinContrastK, kMaxContrastK) - offset_k);
+double ThermalEvidence::Fuse(double confidence, double contrast_k) const {
+  const double p = std::clamp(confidence, 1e-6, 1 - 1e-6);
+  const double z = colour_weight * std::log(p / (1 - p)) +
+                   slope_per_k * std::clamp(contrast_k, kMinContrastK, kMaxContrastK) + bias;
+  return 1.0 / (1.0 + std::exp(-z));
 }
 
 Result<ThermalEvidence> ParseThermalEvidence(const yaml::Node& root) {
@@ -57,8 +60,9 @@ Result<ThermalEvidence> ParseThermalEvidence(const yaml::Node& root) {
                  root.Where());
   ThermalEvidence e;
   yaml::MapReader r(*n, "thermal_evidence");
-  r.Required("slope_per_k", &e.slope_per_k)
-      .Required("offset_k", &e.offset_k)
+  r.Required("colour_weight", &e.colour_weight)
+      .Required("slope_per_k", &e.slope_per_k)
+      .Required("bias", &e.bias)
       .Required("radius_m", &e.radius_m);
   (void)r.Child("fit");  // provenance: seeds, counts, figures (read past)
   if (auto s = r.Finish(); !s) return s.error();
@@ -69,8 +73,9 @@ Result<ThermalEvidence> ParseThermalEvidence(const yaml::Node& root) {
   if (!(e.radius_m > 0.1 && e.radius_m < 3)) {
     return Error(ErrorCode::kInvalidArgument, "thermal evidence: radius_m must be within 0.1..3", n->Where());
   }
-  if (!(e.offset_k > kMinContrastK && e.offset_k < kMaxContrastK)) {
-    return Error(ErrorCode::kInvalidArgument, "thermal evidence: offset_k out of range", n->Where());
+  if (!(e.colour_weight > 0 && e.colour_weight < 5) || !(std::abs(e.bias) < 20)) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "thermal evidence: colour_weight must be within 0..5 and |bias| below 20", n->Where());
   }
   return e;
 }

@@ -32,8 +32,7 @@ int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& 
     double confidence = b.confidence;
     if (thermal != nullptr) {
       if (const std::optional<double> c = ThermalContrastAt(*thermal, *p, params_.thermal.radius_m)) {
-        const double rgb = std::clamp(confidence, 1e-6, 1 - 1e-6);
-        confidence = 1.0 / (1.0 + std::exp(-(std::log(rgb / (1 - rgb)) + params_.thermal.Llr(*c))));
+        confidence = params_.thermal.Fuse(confidence, *c);
       }
       if (confidence < params_.min_confidence) continue;
     }

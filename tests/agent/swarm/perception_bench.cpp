@@ -5,7 +5,8 @@
 // the first stage's cap instead of VictimDetectorParams' default, --candidate-spacing M its
 // VictimDetectorParams::candidate_spacing_m; --misses DIR writes each case's missed people, up to
 // 64, as one mosaic DIR/misses_<kind>_<value>.png: 128 px around each, with the best confidence
-// near it and how much of it was visible), in the
+// near it and how much of it was visible; --thermal 1 renders the x500's thermal frames too and
+// moves each detection's confidence by the shipped thermal evidence, as the agent does), in the
 // varied look (perception_scenes.hpp: terrains, light, poses, clothing, cover, distractors), one
 // logfmt line per case:
 //   case=altitude     altitude_m=10|20|30|40|60 (30 % of the people partly covered, 2 distractors each)
@@ -114,10 +115,22 @@ class MissMosaic {
 int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
               const std::shared_ptr<const VictimDetectorModel>& model) {
   const int n = args.quick ? 12 : static_cast<int>(args.GetInt("scenes", 240));
+  // --thermal 1: the x500's thermal frames too, each detection's confidence moved by the shipped
+  // thermal evidence as the agent's perception does (thermal_evidence.hpp).
+  const bool thermal = args.GetInt("thermal", 0) != 0;
   auto at = [&](double altitude, double occluded, int distractors) {
-    return SceneSetParams{.seed = seed, .scenes = n, .scenes_per_world = 12, .min_altitude_m = altitude,
-                          .max_altitude_m = altitude, .near_victim_fraction = 0.85, .near_victim_offset = 1.0,
-                          .occluded_fraction = occluded, .distractors = distractors, .varied_look = true};
+    SceneSetParams p{.seed = seed,
+                     .scenes = n,
+                     .scenes_per_world = 12,
+                     .min_altitude_m = altitude,
+                     .max_altitude_m = altitude,
+                     .near_victim_fraction = 0.85,
+                     .near_victim_offset = 1.0,
+                     .occluded_fraction = occluded,
+                     .distractors = distractors,
+                     .varied_look = true};
+    p.thermal = thermal;
+    return p;
   };
   std::vector<CurveCase> cases;
   for (double a : {10.0, 20.0, 30.0, 40.0, 60.0}) cases.push_back({"altitude", "altitude_m", a, at(a, 0.3, 2)});
@@ -154,15 +167,17 @@ int RunCurves(const swarmbox::bench::Args& args, std::uint64_t seed,
       return 1;
     }
     MissMosaic misses;
-    const DetectionCurve d = ScoreDetections(*scenes, detector, 0.5, 0.5, 1.5,
-                                             [&](const Scene& s, const SceneVictim& v, double best) {
-                                               if (!misses_dir.empty()) misses.Add(s, v, best);
-                                             });
+    const DetectionCurve d = ScoreDetections(
+        *scenes, detector, 0.5, 0.5, 1.5,
+        [&](const Scene& s, const SceneVictim& v, double best) {
+          if (!misses_dir.empty()) misses.Add(s, v, best);
+        },
+        thermal ? &ShippedThermalEvidence() : nullptr);
     char mosaic[96];
     std::snprintf(mosaic, sizeof mosaic, "/misses_%s_%g.png", c.kind.c_str(), c.value);
     if (!misses_dir.empty()) misses.Write(misses_dir + mosaic);
     swarmbox::LogEvent line(0.0, "bench", "bench_result");
-    line.Add("suite", "perception").Add("case", c.kind).Add("seed", seed);
+    line.Add("suite", "perception").Add("case", c.kind).Add("seed", seed).Add("thermal", thermal ? 1 : 0);
     if (c.kind == "world") line.Add("world", "rubble_field");  // sar_rubble.yaml's generated fields
     else line.Add(c.key, c.value, c.key == "occluded_fraction" ? 1 : 0);
     if (c.kind != "altitude") line.Add("altitude_m", c.scenes.min_altitude_m);

@@ -85,9 +85,37 @@ PerceptionScore ScorePerception(const std::vector<Scene>& scenes, const Percepti
   return score;
 }
 
+namespace {
+
+// The blobs' confidences moved by the thermal evidence at their ground points (VictimPerception's
+// rule), most confident first again.
+void WithThermalEvidence(const Scene& s, const ThermalEvidence& evidence, std::vector<ImageBlob>* blobs) {
+  const physics::ThermalImage& t = *s.thermal;
+  cv::Mat kelvin;
+  cv::Mat(t.height_px, t.width_px, CV_16U, const_cast<std::uint16_t*>(t.centikelvin.data()))
+      .convertTo(kelvin, CV_32F, 1.0 / physics::kThermalCountsPerK);
+  const ThermalView view{
+      kelvin,
+      {t.intrinsics.fx_px, t.intrinsics.fy_px, t.intrinsics.cx_px, t.intrinsics.cy_px},
+      {Vector3d(t.camera_pose.position_m.x, t.camera_pose.position_m.y, t.camera_pose.position_m.z),
+       Eigen::Quaterniond(t.camera_pose.attitude.w, t.camera_pose.attitude.x, t.camera_pose.attitude.y,
+                          t.camera_pose.attitude.z)}};
+  for (ImageBlob& b : *blobs) {
+    const std::optional<Vector3d> g = PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
+    if (!g) continue;
+    const std::optional<double> c = ThermalContrastAt(view, *g, evidence.radius_m);
+    if (!c) continue;
+    b.confidence = evidence.Fuse(b.confidence, *c);
+  }
+  std::stable_sort(blobs->begin(), blobs->end(),
+                   [](const ImageBlob& a, const ImageBlob& b) { return a.confidence > b.confidence; });
+}
+
+}  // namespace
+
 DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector,
                                double operating_point, double must_fraction, double match_radius_m,
-                               const MissFn& on_miss) {
+                               const MissFn& on_miss, const ThermalEvidence* thermal) {
   DetectionCurve curve;
   std::vector<std::pair<double, int>> ranked;  // (confidence, 1 true / 0 false positive)
   std::vector<ImageBlob> blobs;
@@ -98,6 +126,7 @@ DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector&
     const auto t0 = std::chrono::steady_clock::now();
     detector.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (thermal != nullptr && s.thermal) WithThermalEvidence(s, *thermal, &blobs);
     for (const SceneVictim& v : s.victims) curve.persons += v.visible_fraction >= must_fraction ? 1 : 0;
     std::vector<bool> matched(s.victims.size(), false);
     std::vector<double> best_confidence(s.victims.size(), 0.0);

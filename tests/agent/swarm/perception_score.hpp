@@ -75,9 +75,13 @@ struct DetectionCurve {
 // operating point matched: its scene and the highest confidence of a detection within
 // match_radius_m of it (0 when none).
 using MissFn = std::function<void(const Scene& scene, const SceneVictim& person, double best_confidence)>;
+// With `thermal`, a scene's thermal frame (Scene::thermal; scenes without one are scored on colour
+// alone) moves each detection's confidence by the thermal evidence at its ground point, as the
+// agent's VictimPerception does, and the detections are ranked again.
 DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector& detector,
                                double operating_point = 0.5, double must_fraction = 0.5,
-                               double match_radius_m = 1.5, const MissFn& on_miss = {});
+                               double match_radius_m = 1.5, const MissFn& on_miss = {},
+                               const ThermalEvidence* thermal = nullptr);
 
 // A trial's decided candidates as the leader logged them (event=confirmed / event=rejected carry
 // every view: sighting_fusion.hpp AddEvidence's drones, confidences, 0 for a miss, viewers

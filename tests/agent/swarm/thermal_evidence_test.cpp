@@ -57,25 +57,27 @@ TEST(ThermalEvidence, TheContrastIsTheWarmSpotOverTheGroundAroundIt) {
   EXPECT_FALSE(ThermalContrastAt(v, person, 0.0).has_value());
 }
 
-TEST(ThermalEvidence, TheRatioIsLinearInTheContrastAndClamped) {
-  const ThermalEvidence e{0.5, 4.0, 0.7};
-  EXPECT_DOUBLE_EQ(e.Llr(4.0), 0.0);
-  EXPECT_DOUBLE_EQ(e.Llr(10.0), 3.0);
-  EXPECT_DOUBLE_EQ(e.Llr(-1.0), -2.5);
-  EXPECT_DOUBLE_EQ(e.Llr(1000.0), e.Llr(kMaxContrastK));
-  EXPECT_DOUBLE_EQ(e.Llr(-1000.0), e.Llr(kMinContrastK));
+TEST(ThermalEvidence, TheFusionIsALogisticOfBothAndClampsTheContrast) {
+  const ThermalEvidence e{0.8, 0.2, -1.0, 0.7};
+  auto logit = [](double p) { return std::log(p / (1 - p)); };
+  EXPECT_NEAR(logit(e.Fuse(0.9, 5.0)), 0.8 * logit(0.9) + 0.2 * 5.0 - 1.0, 1e-9);
+  EXPECT_GT(e.Fuse(0.6, 15.0), e.Fuse(0.6, 2.0));
+  EXPECT_GT(e.Fuse(0.9, 5.0), e.Fuse(0.6, 5.0));
+  EXPECT_DOUBLE_EQ(e.Fuse(0.7, 1000.0), e.Fuse(0.7, kMaxContrastK));
+  EXPECT_DOUBLE_EQ(e.Fuse(0.7, -1000.0), e.Fuse(0.7, kMinContrastK));
+  // The defaults leave a confidence as it was.
+  EXPECT_NEAR(ThermalEvidence{}.Fuse(0.73, 12.0), 0.73, 1e-12);
 }
 
-// The shipped fit (models/thermal_evidence.yaml): warmer is more likely a person, and a few kelvin
-// of contrast (a sun-warmed backpack's, the ground's ring) say little either way.
+// The shipped fit (models/thermal_evidence.yaml): warmer is more likely a person, and the colour
+// detector's confidence still counts.
 TEST(ThermalEvidence, TheShippedFitSaysWarmerIsMoreLikelyAPerson) {
   const ThermalEvidence& e = ShippedThermalEvidence();
-  EXPECT_GT(e.slope_per_k, 0.05);
-  EXPECT_GT(e.offset_k, 0.0);
-  EXPECT_LT(e.offset_k, 15.0);
+  EXPECT_GT(e.slope_per_k, 0.02);
+  EXPECT_GT(e.colour_weight, 0.3);
   EXPECT_GT(e.radius_m, 0.3);
-  EXPECT_LT(e.Llr(0.0), 0.0);
-  EXPECT_GT(e.Llr(15.0), 0.0);
+  EXPECT_GT(e.Fuse(0.7, 15.0), 0.7);
+  EXPECT_LT(e.Fuse(0.7, 0.0), 0.7);
 }
 
 TEST(ThermalEvidence, AFitWithoutItsFiguresIsRefused) {
@@ -84,17 +86,24 @@ TEST(ThermalEvidence, AFitWithoutItsFiguresIsRefused) {
     EXPECT_TRUE(root.ok());
     return ParseThermalEvidence(*root);
   };
-  EXPECT_TRUE(
-      parse("thermal_evidence: {slope_per_k: 0.3, offset_k: 5, radius_m: 0.7, fit: {seed: 1}}\n").ok());
-  EXPECT_FALSE(parse("thermal_evidence: {slope_per_k: 0.3, offset_k: 5}\n").ok());
-  EXPECT_FALSE(parse("thermal_evidence: {slope_per_k: -0.3, offset_k: 5, radius_m: 0.7}\n").ok());
-  EXPECT_FALSE(parse("thermal_evidence: {slope_per_k: 0.3, offset_k: 5, radius_m: 0.7, colour: red}\n").ok());
+  EXPECT_TRUE(parse("thermal_evidence: {colour_weight: 0.8, slope_per_k: 0.2, bias: -1, radius_m: 0.7, fit: "
+                    "{seed: 1}}\n")
+                  .ok());
+  EXPECT_FALSE(parse("thermal_evidence: {colour_weight: 0.8, slope_per_k: 0.2, radius_m: 0.7}\n").ok());
+  EXPECT_FALSE(
+      parse("thermal_evidence: {colour_weight: 0.8, slope_per_k: -0.2, bias: -1, radius_m: 0.7}\n").ok());
+  EXPECT_FALSE(
+      parse("thermal_evidence: {colour_weight: 0, slope_per_k: 0.2, bias: -1, radius_m: 0.7}\n").ok());
+  EXPECT_FALSE(
+      parse(
+          "thermal_evidence: {colour_weight: 0.8, slope_per_k: 0.2, bias: -1, radius_m: 0.7, colour: red}\n")
+          .ok());
   EXPECT_FALSE(parse("other: 1\n").ok());
 }
 
-// A rendered colour frame with one person, and thermal frames taken with it: warm where the
-// person lies raises the detector's confidence, a flat field lowers it, and a frame that does not
-// see the point leaves it as the colour detector gave it.
+// A rendered colour frame with one person, and thermal frames taken with it: each gives the fused
+// confidence of its contrast there (warm where the person lies, none on a flat field), and a frame
+// that does not see the point leaves it as the colour detector gave it.
 TEST(VictimPerception, AThermalFrameMovesTheColourDetectorsConfidence) {
   const Vector3d person(4.0, -3.0, 0.0);
   physics::WorldConfig w;
@@ -110,7 +119,7 @@ TEST(VictimPerception, AThermalFrameMovesTheColourDetectorsConfidence) {
   ASSERT_TRUE(s.ok()) << s.error().ToString();
   cv::Mat bgr(s->image.height_px, s->image.width_px, CV_8UC3, s->image.bgr.data());
   PerceptionParams params;
-  params.thermal = ThermalEvidence{0.35, 5.5, 0.7};
+  params.thermal = ThermalEvidence{0.8, 0.2, -1.0, 0.7};
   const Vector3d camera = s->true_pose.position_m;
 
   VictimPerception colour(params), warm(params), flat(params), elsewhere(params);
@@ -129,18 +138,16 @@ TEST(VictimPerception, AThermalFrameMovesTheColourDetectorsConfidence) {
   const double rgb = a[0].confidence;
   const std::optional<double> contrast = ThermalContrastAt(warm_view, b[0].position_m, 0.7);
   ASSERT_TRUE(contrast.has_value());
-  const double logit = std::log(rgb / (1 - rgb)) + params.thermal.Llr(*contrast);
-  EXPECT_NEAR(b[0].confidence, 1.0 / (1.0 + std::exp(-logit)), 1e-9);
-  EXPECT_GT(b[0].confidence, rgb);
+  EXPECT_NEAR(*contrast, 10.0, 1e-3);
+  EXPECT_NEAR(b[0].confidence, params.thermal.Fuse(rgb, *contrast), 1e-12);
   EXPECT_DOUBLE_EQ(c[0].confidence, rgb);
-  // Flat: no contrast, Llr(0) = -1.9: the confidence falls by that much in logit.
+  // Flat: no contrast: the confidence is what the colour detector's alone is worth to the fit.
   ASSERT_EQ(flat.ProcessFrame(bgr, s->intrinsics, s->true_pose, 5.0, nullptr, &flat_view), 1);
   std::vector<GroundDetection> d;
   flat.PopVisible(10.0, &d);
   ASSERT_EQ(d.size(), 1u);
-  EXPECT_LT(d[0].confidence, rgb);
-  EXPECT_NEAR(std::log(d[0].confidence / (1 - d[0].confidence)),
-              std::log(rgb / (1 - rgb)) + params.thermal.Llr(0.0), 1e-6);
+  EXPECT_NEAR(d[0].confidence, params.thermal.Fuse(rgb, 0.0), 1e-12);
+  EXPECT_GT(b[0].confidence, d[0].confidence);
 }
 
 }  // namespace

@@ -23,7 +23,9 @@ struct ThermalSpec {
   int width_px = 320;
   int height_px = 256;
   double hfov_rad = 0.8399;        // 48.1 deg: 320 x 12 um behind a 4.3 mm lens
-  double rate_hz = 8.6;            // frames per simulated second (the core's slow configuration)
+  // The core's frame rate (its slow configuration). A frame is taken with each camera frame, so
+  // an airframe's camera.rate_hz may not exceed it (ParseAirframe refuses that).
+  double rate_hz = 8.6;
   double netd_k = 0.05;            // temporal noise, one standard deviation [K]
   double offset_std_k = 1.0;       // a frame's radiometric offset, one standard deviation [K]
   double psf_sigma_px = 0.5;       // the optics' blur, a Gaussian's standard deviation [px]

@@ -1,18 +1,18 @@
 // Thermal evidence for a detection: how much warmer than its surroundings the thermal camera
 // (airframe `thermal:`, a FLIR Boson 320) saw the ground point the colour detector placed a person
-// at, and what that says about it: a log-likelihood ratio fitted on rendered training worlds
-// (`swarmbox-fit-thermal`, the `fit-thermal` target; models/thermal_evidence.yaml).
+// at, and the detector's confidence with it: a logistic calibration of both together, fitted on the
+// shipped detector's own candidates in rendered training worlds (`swarmbox-fit-thermal`, the
+// `fit-thermal` target; models/thermal_evidence.yaml).
 //
 //   ThermalView view{kelvin, k, pose};                     // one frame: CV_32F kelvin, its camera
 //   std::optional<double> c = ThermalContrastAt(view, point_m, evidence.radius_m);
-//   if (c) confidence = Sigmoid(Logit(confidence) + evidence.Llr(*c));
+//   if (c) confidence = evidence.Fuse(confidence, *c);
 //
 // The contrast: the 98th percentile of the temperatures within radius_m of the point minus the
 // median of the ring from 1.7 to 3.4 radius_m around it [K] (a person is a few warm pixels, the
-// head warmest; the ring is the ground they lie on). The ratio: Llr(c) = slope (c - offset),
-// c clamped to [kMinContrastK, kMaxContrastK]; with the colour detector's calibrated confidence
-// as the prior odds (the two cameras see different things of a person: their evidence is taken as
-// independent given person or not). Pure: frames and points in.
+// head warmest; the ring is the ground they lie on). The fusion: sigmoid(colour_weight x
+// logit(confidence) + slope_per_k x c + bias), c clamped to [kMinContrastK, kMaxContrastK].
+// Pure: frames and points in.
 #pragma once
 
 #include <optional>
@@ -44,14 +44,16 @@ std::optional<double> ThermalContrastAt(const ThermalView& view, const Eigen::Ve
                                         double radius_m);
 
 struct ThermalEvidence {
-  double slope_per_k = 0.0;  // the ratio's slope [1/K]
-  double offset_k = 0.0;     // the contrast at which it says nothing [K]
-  double radius_m = 0.7;     // the disc ThermalContrastAt looks in [m]
-  double Llr(double contrast_k) const;
+  double colour_weight = 1.0;  // on the colour detector's logit
+  double slope_per_k = 0.0;    // on the contrast [1/K]
+  double bias = 0.0;
+  double radius_m = 0.7;  // the disc ThermalContrastAt looks in [m]
+  // The confidence with the contrast; the defaults leave it as it was.
+  double Fuse(double confidence, double contrast_k) const;
 };
 
-// The `thermal_evidence:` mapping of a models/thermal_evidence.yaml ({slope_per_k, offset_k,
-// radius_m, and the fit's provenance, which is read past}). kInvalidArgument: missing or
+// The `thermal_evidence:` mapping of a models/thermal_evidence.yaml ({colour_weight, slope_per_k,
+// bias, radius_m, and the fit's provenance, which is read past}). kInvalidArgument: missing or
 // out-of-range figures.
 Result<ThermalEvidence> ParseThermalEvidence(const yaml::Node& root);
 // The fit that ships: agent/swarm/models/thermal_evidence.yaml, compiled in.
