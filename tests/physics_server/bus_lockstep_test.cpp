@@ -61,7 +61,8 @@ void RunLockstepOverBus(const std::string& backend) {
   bus::ActuatorCommand cmd;
   cmd.armed = true;
   cmd.motor_throttle.assign(4, u);
-  std::uint64_t a_answered = 0, images = 0, a_camera_flags = 0, b_heard = 0;
+  std::uint64_t a_answered = 0, images = 0, thermal_images = 0, a_camera_flags = 0, b_heard = 0;
+  std::int64_t last_thermal_ns = -1;  // the last thermal frame's time
   bool b_valid_gps = false;
   bus::RadioFrame frame;
   frame.from = "a";
@@ -106,10 +107,21 @@ void RunLockstepOverBus(const std::string& backend) {
     }
     bus::CameraImage img;
     while ((*cam_a)->Take(img)) {
+      // The x500's thermal frame (trials/airframes/x500.yaml `thermal:`) goes just before the
+      // colour frame it was taken with, on the same topic.
+      if (img.encoding == bus::kThermalEncoding) {
+        ++thermal_images;
+        EXPECT_EQ(img.width_px, 320u);
+        EXPECT_EQ(img.row_stride_bytes, 640u);
+        EXPECT_EQ(img.data.size(), 320u * 256u * 2u);
+        last_thermal_ns = img.sim_time_ns;
+        continue;
+      }
       ++images;
       EXPECT_EQ(img.width_px, 640u);  // the x500 camera (trials/airframes/x500.yaml)
       EXPECT_EQ(img.data.size(), 640u * 360u * 3u);
       EXPECT_EQ(img.encoding, "bgr8");
+      if (last_thermal_ns >= 0) EXPECT_EQ(img.sim_time_ns, last_thermal_ns);  // its thermal frame came first
     }
   }
   const Status result = server.Join();
@@ -117,6 +129,7 @@ void RunLockstepOverBus(const std::string& backend) {
   EXPECT_EQ(world->step_count(), 250u);
   EXPECT_GE(a_answered, 250u);
   EXPECT_GE(images, 4u);  // 5 frames in 1 s (the first may go before discovery completes)
+  EXPECT_GE(thermal_images, 4u);
   EXPECT_TRUE(b_valid_gps);
   EXPECT_GE(a_camera_flags, 5u);  // 5 frames in 1 s, each announced by its step's sample
   EXPECT_GE(b_heard, 40u);        // a's frames of steps 0..49 (b answers, and hears, until 50)
