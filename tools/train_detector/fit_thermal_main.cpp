@@ -107,17 +107,6 @@ double Quantile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
-swarm::ThermalView ViewOf(const physics::ThermalImage& t) {
-  cv::Mat kelvin;
-  cv::Mat(t.height_px, t.width_px, CV_16U, const_cast<std::uint16_t*>(t.centikelvin.data()))
-      .convertTo(kelvin, CV_32F, 1.0 / physics::kThermalCountsPerK);
-  return {kelvin,
-          {t.intrinsics.fx_px, t.intrinsics.fy_px, t.intrinsics.cx_px, t.intrinsics.cy_px},
-          {Vector3d(t.camera_pose.position_m.x, t.camera_pose.position_m.y, t.camera_pose.position_m.z),
-           Eigen::Quaterniond(t.camera_pose.attitude.w, t.camera_pose.attitude.x, t.camera_pose.attitude.y,
-                              t.camera_pose.attitude.z)}};
-}
-
 // The candidates of one scene as samples.
 void AddSamples(const perception_scenes::Scene& s, swarm::VictimDetector& detector, double radius_m,
                 std::vector<Sample>* out) {
@@ -125,7 +114,7 @@ void AddSamples(const perception_scenes::Scene& s, swarm::VictimDetector& detect
                     const_cast<std::uint8_t*>(s.image.bgr.data()));
   std::vector<swarm::ImageBlob> blobs;
   detector.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs);
-  const swarm::ThermalView view = ViewOf(*s.thermal);
+  const swarm::ThermalView view = perception_scenes::ThermalViewOf(*s.thermal);
   for (const swarm::ImageBlob& b : blobs) {
     const std::optional<Vector3d> g = swarm::PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
     if (!g) continue;

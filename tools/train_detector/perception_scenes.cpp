@@ -415,6 +415,17 @@ Result<physics::WorldConfig> GeneratedWorld(std::mt19937_64& rng, const worlds::
 
 }  // namespace
 
+swarm::ThermalView ThermalViewOf(const physics::ThermalImage& t) {
+  cv::Mat kelvin;
+  cv::Mat(t.height_px, t.width_px, CV_16U, const_cast<std::uint16_t*>(t.centikelvin.data()))
+      .convertTo(kelvin, CV_32F, 1.0 / physics::kThermalCountsPerK);
+  const physics::Pose& pose = t.camera_pose;
+  return {kelvin,
+          {t.intrinsics.fx_px, t.intrinsics.fy_px, t.intrinsics.cx_px, t.intrinsics.cy_px},
+          {Vector3d(pose.position_m.x, pose.position_m.y, pose.position_m.z),
+           Eigen::Quaterniond(pose.attitude.w, pose.attitude.x, pose.attitude.y, pose.attitude.z)}};
+}
+
 Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
   Result<physics::Airframe> x500 = CameraAirframe();
   if (!x500) return x500.error();

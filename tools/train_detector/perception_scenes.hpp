@@ -37,6 +37,7 @@
 #include "swarmbox/physics/thermal_renderer.hpp"
 #include "swarmbox/physics/world_config.hpp"
 #include "swarmbox/swarm/geolocation.hpp"
+#include "swarmbox/swarm/thermal_evidence.hpp"
 #include "swarmbox/worlds/generator.hpp"
 
 namespace swarmbox::perception_scenes {
@@ -114,6 +115,10 @@ inline constexpr std::uint64_t kEvaluationSeeds[] = {20261121, 30, 40, 77, 78, 1
 
 // Renders the scene set. Fails (kNotFound...) when the x500 airframe file cannot be read.
 Result<std::vector<Scene>> RenderScenes(const SceneSetParams& params);
+
+// A scene's thermal frame as the agent's perception takes it (swarm::ThermalView: kelvin, the
+// thermal camera's intrinsics and its true optical pose).
+swarm::ThermalView ThermalViewOf(const physics::ThermalImage& image);
 
 // One nadir view of `world` from a camera drone hovering at altitude_m over centre_m with the
 // given yaw and pixel noise (unit tests place a victim or draw a distractor and look).

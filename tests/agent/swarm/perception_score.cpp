@@ -90,16 +90,7 @@ namespace {
 // The blobs' confidences moved by the thermal evidence at their ground points (VictimPerception's
 // rule), most confident first again.
 void WithThermalEvidence(const Scene& s, const ThermalEvidence& evidence, std::vector<ImageBlob>* blobs) {
-  const physics::ThermalImage& t = *s.thermal;
-  cv::Mat kelvin;
-  cv::Mat(t.height_px, t.width_px, CV_16U, const_cast<std::uint16_t*>(t.centikelvin.data()))
-      .convertTo(kelvin, CV_32F, 1.0 / physics::kThermalCountsPerK);
-  const ThermalView view{
-      kelvin,
-      {t.intrinsics.fx_px, t.intrinsics.fy_px, t.intrinsics.cx_px, t.intrinsics.cy_px},
-      {Vector3d(t.camera_pose.position_m.x, t.camera_pose.position_m.y, t.camera_pose.position_m.z),
-       Eigen::Quaterniond(t.camera_pose.attitude.w, t.camera_pose.attitude.x, t.camera_pose.attitude.y,
-                          t.camera_pose.attitude.z)}};
+  const ThermalView view = perception_scenes::ThermalViewOf(*s.thermal);
   for (ImageBlob& b : *blobs) {
     const std::optional<Vector3d> g = PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
     if (!g) continue;
