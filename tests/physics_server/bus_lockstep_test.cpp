@@ -121,7 +121,9 @@ void RunLockstepOverBus(const std::string& backend) {
       EXPECT_EQ(img.width_px, 640u);  // the x500 camera (trials/airframes/x500.yaml)
       EXPECT_EQ(img.data.size(), 640u * 360u * 3u);
       EXPECT_EQ(img.encoding, "bgr8");
-      if (last_thermal_ns >= 0) EXPECT_EQ(img.sim_time_ns, last_thermal_ns);  // its thermal frame came first
+      if (last_thermal_ns >= 0) {
+        EXPECT_EQ(img.sim_time_ns, last_thermal_ns);  // its thermal frame came first
+      }
     }
   }
   const Status result = server.Join();
