@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <string>
+#include <string_view>
 
 namespace swarmbox::physics {
 namespace {
@@ -112,23 +114,35 @@ Status BusTransport::PublishSample(std::size_t drone, const std::string& name, c
   return drones_[drone].sensor->Publish(m);
 }
 
+namespace {
+
+// A camera message's header: who, when, the frame's size and encoding, the pinhole and the pose.
+void SetImageHeader(const std::string& name, std::uint64_t step, std::int64_t time_ns, int width_px,
+                    int height_px, std::uint32_t bytes_per_px, std::string_view encoding,
+                    const CameraIntrinsics& k, const Pose& pose, bus::CameraImage* m) {
+  m->drone = name;
+  m->step = step;
+  m->sim_time_ns = time_ns;
+  m->width_px = static_cast<std::uint32_t>(width_px);
+  m->height_px = static_cast<std::uint32_t>(height_px);
+  m->row_stride_bytes = static_cast<std::uint32_t>(width_px) * bytes_per_px;
+  m->encoding = std::string(encoding);
+  m->intrinsics.fx_px = k.fx_px;
+  m->intrinsics.fy_px = k.fy_px;
+  m->intrinsics.cx_px = k.cx_px;
+  m->intrinsics.cy_px = k.cy_px;
+  m->intrinsics.distortion = {};
+  m->camera_pose.position_enu_m = A(pose.position_m);
+  const Quat& q = pose.attitude;
+  m->camera_pose.orientation_wxyz = {q.w, q.x, q.y, q.z};
+}
+
+}  // namespace
+
 Status BusTransport::PublishCamera(std::size_t drone, const std::string& name, std::uint64_t step, const CameraImage& img) {
   bus::CameraImage& m = camera_msg_;
-  m.drone = name;
-  m.step = step;
-  m.sim_time_ns = img.time_ns;
-  m.width_px = static_cast<std::uint32_t>(img.width_px);
-  m.height_px = static_cast<std::uint32_t>(img.height_px);
-  m.row_stride_bytes = static_cast<std::uint32_t>(img.width_px * 3);
-  m.encoding = "bgr8";
-  m.intrinsics.fx_px = img.intrinsics.fx_px;
-  m.intrinsics.fy_px = img.intrinsics.fy_px;
-  m.intrinsics.cx_px = img.intrinsics.cx_px;
-  m.intrinsics.cy_px = img.intrinsics.cy_px;
-  m.intrinsics.distortion = {};
-  m.camera_pose.position_enu_m = A(img.camera_pose.position_m);
-  const Quat& q = img.camera_pose.attitude;
-  m.camera_pose.orientation_wxyz = {q.w, q.x, q.y, q.z};
+  SetImageHeader(name, step, img.time_ns, img.width_px, img.height_px, 3, "bgr8", img.intrinsics,
+                 img.camera_pose, &m);
   m.data.assign(img.bgr.begin(), img.bgr.end());
   return drones_.at(drone).camera->Publish(m);
 }
@@ -136,21 +150,8 @@ Status BusTransport::PublishCamera(std::size_t drone, const std::string& name, s
 Status BusTransport::PublishThermal(std::size_t drone, const std::string& name, std::uint64_t step,
                                     const ThermalImage& img) {
   bus::CameraImage& m = thermal_msg_;
-  m.drone = name;
-  m.step = step;
-  m.sim_time_ns = img.time_ns;
-  m.width_px = static_cast<std::uint32_t>(img.width_px);
-  m.height_px = static_cast<std::uint32_t>(img.height_px);
-  m.row_stride_bytes = static_cast<std::uint32_t>(img.width_px * 2);
-  m.encoding = std::string(bus::kThermalEncoding);
-  m.intrinsics.fx_px = img.intrinsics.fx_px;
-  m.intrinsics.fy_px = img.intrinsics.fy_px;
-  m.intrinsics.cx_px = img.intrinsics.cx_px;
-  m.intrinsics.cy_px = img.intrinsics.cy_px;
-  m.intrinsics.distortion = {};
-  m.camera_pose.position_enu_m = A(img.camera_pose.position_m);
-  const Quat& q = img.camera_pose.attitude;
-  m.camera_pose.orientation_wxyz = {q.w, q.x, q.y, q.z};
+  SetImageHeader(name, step, img.time_ns, img.width_px, img.height_px, 2, bus::kThermalEncoding,
+                 img.intrinsics, img.camera_pose, &m);
   // Little-endian 16-bit counts (the bus's byte order for "16UC1" and "mono16").
   m.data.resize(img.centikelvin.size() * 2);
   for (std::size_t k = 0; k < img.centikelvin.size(); ++k) {
