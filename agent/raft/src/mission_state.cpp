@@ -70,10 +70,10 @@ Candidate* MissionState::MutableCandidate(std::uint32_t id) {
   return nullptr;
 }
 
-Candidate* MissionState::NearCandidate(double x_m, double y_m) {
-  Candidate* best = nullptr;
+const Candidate* MissionState::CandidateAt(double x_m, double y_m) const {
+  const Candidate* best = nullptr;
   double best_d = kConfirmRadiusM;
-  for (Candidate& c : candidates_) {
+  for (const Candidate& c : candidates_) {
     if (c.status == CandidateStatus::kConfirmed) continue;  // its victim takes the sightings
     const double d = Distance(c.x_m, c.y_m, x_m, y_m);
     if (d <= best_d) {
@@ -381,7 +381,8 @@ ApplyResult MissionState::ApplySighting(const ReportSighting& c) {
   }
   SightingView view{c.reporter, c.seq, c.x_m, c.y_m, c.confidence, c.viewer_x_m, c.viewer_y_m,
                     c.viewer_height_m, c.t_s, true};
-  Candidate* k = NearCandidate(c.x_m, c.y_m);
+  const Candidate* near = CandidateAt(c.x_m, c.y_m);
+  Candidate* k = near != nullptr ? MutableCandidate(near->id) : nullptr;
   if (k != nullptr && k->views.size() >= kMaxViews) {
     return Reject("candidate " + std::to_string(k->id) + " holds " + std::to_string(kMaxViews) + " views");
   }

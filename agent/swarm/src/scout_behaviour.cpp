@@ -128,9 +128,12 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
     if (known) continue;
     // The first sight of the candidate on a revisit always goes out: it is the revisit's answer
     // (with a close look: only from the look altitude; the descent's views of it are not sent).
-    const bool at_candidate =
-        revisit != nullptr &&
-        (Eigen::Vector2d(revisit->x_m, revisit->y_m) - p).norm() <= config_.dedupe_radius_m;
+    // A sight is of the candidate when the mission state will file it there: a look-alike a few
+    // metres off is another candidate's view, and the revisit still waits for its answer (counting
+    // it as one left the scout hovering for the revisit's whole timeout with nothing reported:
+    // rubble20-a-r18 on 2026-11-29, a person 6 m from a backpack).
+    const raft::Candidate* filed = revisit != nullptr ? m.CandidateAt(p.x(), p.y()) : nullptr;
+    const bool at_candidate = filed != nullptr && filed->id == revisit->id;
     const bool from_look =
         config_.revisit_look_altitude_m <= 0 || d.viewer_m.z() <= look_z + kRevisitHeightToleranceM;
     if (at_candidate && !from_look) continue;

@@ -309,6 +309,51 @@ TEST(ScoutBehaviour, ARevisitMidLaneResumesTheSweepWhereItLeftTheLane) {
   EXPECT_EQ(s.lane_index(), 2u);
 }
 
+// A revisit's answer is a sight the mission state files under the revisited candidate: a
+// look-alike 6 m off (within the scout's 10 m victim dedupe radius, beyond the state's 5 m
+// association) is reported as the other candidate's view, and the revisit still ends with its own
+// answer, here a miss (rubble20-a-r18 on 2026-11-29: the scout took the backpack for its answer,
+// reported nothing of the person and hovered for the revisit's whole timeout).
+TEST(ScoutBehaviour, ALookAlikeBesideTheCandidateDoesNotAnswerItsRevisit) {
+  Mission m;
+  m.Apply(raft::AssignSectors{{kSector}});
+  m.Apply(raft::StartSearch{});
+  ScoutBehaviour s({.name = "scout_1", .home_m = Vector3d(0, 0, 0), .dedupe_radius_m = 10.0});
+  MissionOutput out;
+  ASSERT_NO_FATAL_FAILURE(OnItsFirstLane(m, s, out));
+  m.Apply(raft::ReportSighting{"scout_2", 1, 200, 200, 0.8});
+  m.Apply(raft::ReportSighting{"scout_2", 2, 206, 200, 0.8});
+  ASSERT_EQ(m.state.candidates().size(), 2u);
+  m.Apply(raft::RequestRevisit{1, "scout_1"});
+  const Vector3d over(200, 200, 30);
+  s.Step(Input(3.0, m, over), &out);
+  ASSERT_EQ(out.mode, "revisiting");
+  GroundDetection lookalike;
+  lookalike.position_m = {206, 200, 0};
+  lookalike.viewer_m = over;
+  lookalike.confidence = 0.8;
+  const std::vector<GroundDetection> dets = {lookalike};
+  MissionInput in = Input(3.2, m, over);
+  in.detections = dets;
+  s.Step(in, &out);
+  ASSERT_EQ(out.proposals.size(), 1u);
+  const auto* r = std::get_if<raft::ReportSighting>(&out.proposals[0]);
+  ASSERT_NE(r, nullptr);
+  EXPECT_DOUBLE_EQ(r->x_m, 206.0);
+  m.Apply(*r);
+  ASSERT_EQ(m.state.FindCandidate(2)->views.size(), 2u);  // filed under the look-alike's candidate
+  // Nothing at the candidate for revisit_look_s: the revisit's answer is a miss of candidate 1.
+  bool missed = false;
+  for (double t = 3.4; t < 6.0 && !missed; t += 0.2) {
+    s.Step(Input(t, m, over), &out);
+    for (const raft::MissionCommand& c : out.proposals) {
+      const auto* miss = std::get_if<raft::ReportMiss>(&c);
+      missed = missed || (miss != nullptr && miss->candidate == 1u);
+    }
+  }
+  EXPECT_TRUE(missed);
+}
+
 TEST(ScoutBehaviour, BatteryLowEmitsTheEventOnceThenReturnsAndLandsAtHome) {
   Mission m;
   m.Apply(raft::AssignSectors{{kSector}});

@@ -141,6 +141,9 @@ class MissionState {
   const std::vector<Sector>& sectors() const { return sectors_; }
   const std::vector<Candidate>& candidates() const { return candidates_; }
   const Candidate* FindCandidate(std::uint32_t id) const;
+  // The candidate a sighting at (x_m, y_m) away from every victim is a view of: the nearest one
+  // not confirmed within kConfirmRadiusM, or nullptr (the sighting opens a new one).
+  const Candidate* CandidateAt(double x_m, double y_m) const;
   const std::vector<Victim>& victims() const { return victims_; }
   const Victim* FindVictim(std::uint32_t id) const;
   // The sector assigned to `drone`, or nullptr.
@@ -174,7 +177,6 @@ class MissionState {
   ApplyResult ApplyMiss(const ReportMiss& c);
   // The reporter/seq rule shared by sightings and misses: empty when `seq` may be applied.
   std::string CheckSeq(const std::string& reporter, std::uint64_t seq) const;
-  Candidate* NearCandidate(double x_m, double y_m);
   // A new pending candidate at (x_m, y_m); at kMaxCandidates the oldest decided one (or else the
   // oldest) makes room.
   Candidate& NewCandidate(double x_m, double y_m);
