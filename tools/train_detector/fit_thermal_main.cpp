@@ -4,6 +4,7 @@
 // target: agent/swarm/models/thermal_evidence.yaml).
 //
 //   swarmbox-fit-thermal --out FILE [--seed N (9001)] [--scenes N (2880)] [--radius-m R (0.7)]
+//                        [--samples CSV (every candidate: logit, contrast_k, person, altitude_m, x_m, y_m)]
 //
 // Scenes: nadir views from 15-35 m (the close look's 18 m to above the search's 30 m) of rubble
 // fields as trials/sar_rubble.yaml generates them (perception_scenes.hpp, SarRubbleSpec; 24 views
@@ -20,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <optional>
@@ -44,6 +46,8 @@ struct Sample {
   double logit;       // the colour detector's, clamped to +-12
   double contrast_k;  // clamped as Fuse clamps it
   bool person;
+  double altitude_m;  // the scene's camera height
+  double x_m, y_m;    // where the candidate was placed on the ground
 };
 
 // Logistic regression on the features `f(sample)` (the last one the intercept) by Newton's method.
@@ -127,12 +131,15 @@ void AddSamples(const perception_scenes::Scene& s, swarm::VictimDetector& detect
     if (!c) continue;
     const double p = std::clamp(b.confidence, 1e-6, 1 - 1e-6);
     out->push_back({std::clamp(std::log(p / (1 - p)), -12.0, 12.0),
-                    std::clamp(*c, swarm::kMinContrastK, swarm::kMaxContrastK), near != nullptr});
+                    std::clamp(*c, swarm::kMinContrastK, swarm::kMaxContrastK), near != nullptr, s.altitude_m,
+                    g->x(), g->y()});
   }
 }
 
 int Usage() {
-  std::fprintf(stderr, "usage: swarmbox-fit-thermal --out FILE [--seed N] [--scenes N] [--radius-m R]\n");
+  std::fprintf(
+      stderr,
+      "usage: swarmbox-fit-thermal --out FILE [--seed N] [--scenes N] [--radius-m R] [--samples CSV]\n");
   return 2;
 }
 
@@ -141,6 +148,12 @@ struct Args {
   std::uint64_t seed = 9001;
   int scenes = 2880;
   double radius_m = 0.7;
+  double near_distractors = 0.8;  // SceneSetParams::near_distractor_fraction
+  double near_victims = 0.75;     // SceneSetParams::near_victim_fraction
+  double min_altitude_m = 15, max_altitude_m = 35;
+  std::string replay;  // --replay DIR: the flown trials' frames too (ReplaySamples)
+  std::string
+      samples;  // --samples FILE: every candidate as CSV (logit, contrast_k, person, altitude_m, x_m, y_m)
 };
 
 std::optional<Args> ParseArgs(int argc, char** argv) {
@@ -157,11 +170,25 @@ std::optional<Args> ParseArgs(int argc, char** argv) {
       args.scenes = std::atoi(v.c_str());
     } else if (a == "--radius-m") {
       args.radius_m = std::atof(v.c_str());
+    } else if (a == "--near-distractors") {
+      args.near_distractors = std::atof(v.c_str());
+    } else if (a == "--near-victims") {
+      args.near_victims = std::atof(v.c_str());
+    } else if (a == "--min-altitude") {
+      args.min_altitude_m = std::atof(v.c_str());
+    } else if (a == "--max-altitude") {
+      args.max_altitude_m = std::atof(v.c_str());
+    } else if (a == "--replay") {
+      args.replay = v;
+    } else if (a == "--samples") {
+      args.samples = v;
     } else {
       return std::nullopt;
     }
   }
-  if (args.out.empty() || args.scenes < 24 || !(args.radius_m > 0.1 && args.radius_m < 3))
+  if (args.out.empty() || (args.scenes < 24 && !(args.scenes == 0 && !args.replay.empty())) ||
+      !(args.radius_m > 0.1 && args.radius_m < 3) ||
+      !(args.near_distractors >= 0 && args.near_distractors <= 1))
     return std::nullopt;
   return args;
 }
@@ -193,6 +220,61 @@ bool WriteFit(const Args& args, const std::array<double, 3>& w, std::size_t peop
   return static_cast<bool>(f);
 }
 
+// The candidates as CSV, one a line; false when the file cannot be written.
+bool WriteSamples(const std::string& path, const std::vector<Sample>& samples) {
+  std::ofstream f(path);
+  f << "logit,contrast_k,person,altitude_m,x_m,y_m\n";
+  char line[160];
+  for (const Sample& s : samples) {
+    std::snprintf(line, sizeof line, "%.4f,%.3f,%d,%.2f,%.2f,%.2f\n", s.logit, s.contrast_k, s.person ? 1 : 0,
+                  s.altitude_m, s.x_m, s.y_m);
+    f << line;
+  }
+  return static_cast<bool>(f);
+}
+
+// The trial folders of `dir` (it or its subfolders with a world.yaml and a truth.csv), in name order.
+std::vector<std::filesystem::path> TrialFolders(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  const auto is_trial = [](const fs::path& p) {
+    return fs::exists(p / "world.yaml") && fs::exists(p / "truth.csv");
+  };
+  std::vector<fs::path> trials;
+  std::error_code ec;
+  if (is_trial(dir)) return {dir};
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    if (is_trial(e.path())) trials.push_back(e.path());
+  }
+  std::sort(trials.begin(), trials.end());
+  return trials;
+}
+
+// The candidates on the flown trials' own frames (perception_scenes::ReplayTrial: the scouts'
+// colour and thermal cameras along truth.csv), onto *out; false and a message on failure.
+bool ReplaySamples(const Args& args, swarm::VictimDetector& detector, std::vector<Sample>* out) {
+  const std::vector<std::filesystem::path> trials = TrialFolders(args.replay);
+  if (trials.empty()) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: --replay %s: no trial folder (world.yaml and truth.csv)\n",
+                 args.replay.c_str());
+    return false;
+  }
+  for (const std::filesystem::path& trial : trials) {
+    const std::size_t before = out->size();
+    const Status st = perception_scenes::ReplayTrial(
+        {.trial_dir = trial.string(), .thermal = true},
+        [&](const physics::WorldConfig&, const perception_scenes::ReplayFrame& f) {
+          AddSamples(f.scene, detector, args.radius_m, out);
+        });
+    if (!st) {
+      std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", st.error().ToString().c_str());
+      return false;
+    }
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s: %zu candidates\n", trial.filename().c_str(),
+                 out->size() - before);
+  }
+  return true;
+}
+
 // The shipped detector's candidates on the rendered scenes (nullopt and a message on failure).
 std::optional<std::vector<Sample>> Candidates(const Args& args) {
   const std::shared_ptr<const swarm::VictimDetectorModel> model = swarm::ShippedDetectorModel();
@@ -210,18 +292,23 @@ std::optional<std::vector<Sample>> Candidates(const Args& args) {
   perception_scenes::SceneSetParams params{.seed = args.seed,
                                            .scenes = args.scenes,
                                            .scenes_per_world = 24,
-                                           .min_altitude_m = 15,
-                                           .max_altitude_m = 35};
+                                           .min_altitude_m = args.min_altitude_m,
+                                           .max_altitude_m = args.max_altitude_m,
+                                           .near_victim_fraction = args.near_victims,
+                                           .near_distractor_fraction = args.near_distractors};
   params.generated = perception_scenes::SarRubbleSpec();
   params.thermal = true;
-  Result<std::vector<perception_scenes::Scene>> scenes = perception_scenes::RenderScenes(params);
-  if (!scenes) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", scenes.error().ToString().c_str());
-    return std::nullopt;
-  }
   swarm::VictimDetector detector(model, swarm::VictimDetectorParams{});
   std::vector<Sample> samples;
-  for (const perception_scenes::Scene& s : *scenes) AddSamples(s, detector, args.radius_m, &samples);
+  if (args.scenes > 0) {
+    Result<std::vector<perception_scenes::Scene>> scenes = perception_scenes::RenderScenes(params);
+    if (!scenes) {
+      std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", scenes.error().ToString().c_str());
+      return std::nullopt;
+    }
+    for (const perception_scenes::Scene& s : *scenes) AddSamples(s, detector, args.radius_m, &samples);
+  }
+  if (!args.replay.empty() && !ReplaySamples(args, detector, &samples)) return std::nullopt;
   return samples;
 }
 
@@ -232,6 +319,10 @@ int main(int argc, char** argv) {
   if (!args) return Usage();
   const std::optional<std::vector<Sample>> samples = Candidates(*args);
   if (!samples) return 1;
+  if (!args->samples.empty() && !WriteSamples(args->samples, *samples)) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", args->samples.c_str());
+    return 1;
+  }
   std::vector<double> pc, nc;
   for (const Sample& s : *samples) (s.person ? pc : nc).push_back(s.contrast_k);
   if (pc.size() < 20 || nc.size() < 20) {

@@ -13,6 +13,7 @@
 
 #include "swarmbox/physics/airframe.hpp"
 #include "swarmbox/physics/ground_renderer.hpp"
+#include "swarmbox/physics/thermal_renderer.hpp"
 #include "swarmbox/physics/world.hpp"
 #include "swarmbox/physics/world_config.hpp"
 #include "swarmbox/report/trial_record.hpp"
@@ -315,14 +316,25 @@ Scene SceneOfCamera(physics::World& world, std::size_t drone, const physics::Wor
 }
 
 // A nadir view's centre: mostly near a victim (up to near_victim_offset half footprints away),
-// else anywhere in the central 160 x 160 m.
+// else (near_distractor_fraction of the rest) near a distractor the same way, else anywhere in
+// the central 160 x 160 m.
 Vector2d ViewCentre(std::mt19937_64& rng, const SceneSetParams& p, const physics::WorldConfig& config, double half_w) {
   std::uniform_real_distribution<double> unit(0, 1);
+  double x_m = 0, y_m = 0;
   if (unit(rng) < p.near_victim_fraction) {
     const physics::Victim& v = config.victims[static_cast<std::size_t>(rng() % config.victims.size())];
-    return Vector2d(v.x_m, v.y_m) + p.near_victim_offset * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
+    x_m = v.x_m;
+    y_m = v.y_m;
+  } else if (p.near_distractor_fraction > 0 && !config.distractors.empty() &&
+             unit(rng) < p.near_distractor_fraction) {  // (no draw without it: older sets stay as they were)
+    const physics::Distractor& d =
+        config.distractors[static_cast<std::size_t>(rng() % config.distractors.size())];
+    x_m = d.x_m;
+    y_m = d.y_m;
+  } else {
+    return Vector2d(160 * unit(rng) - 80, 160 * unit(rng) - 80);
   }
-  return Vector2d(160 * unit(rng) - 80, 160 * unit(rng) - 80);
+  return Vector2d(x_m, y_m) + p.near_victim_offset * half_w * Vector2d(2 * unit(rng) - 1, 2 * unit(rng) - 1);
 }
 
 // `count` nadir views of one world from camera drones added to it, onto *scenes.
@@ -492,11 +504,18 @@ struct ReplayCamera {
   double last_t_s = 0.0;
   std::uint64_t frames = 0;
 
-  // Whether the camera takes a frame at `xy` and `t_s` (its trigger distance, else its rate);
-  // when it does, it counts it.
+  // Whether the camera takes a frame at `xy` and `t_s` (its trigger distance, or its
+  // trigger_interval_max_s while it does not move: a hover, a revisit's close look; else its
+  // rate), as the physics server's camera_trigger.hpp; when it does, it counts it. (Without the
+  // wait a replay had no frame of a close look at all.)
   bool Take(const Vector2d& xy, double t_s, const physics::CameraSpec& camera) {
-    const bool due = !taken || (camera.trigger_distance_m > 0 ? (xy - last_xy).norm() >= camera.trigger_distance_m
-                                                              : t_s - last_t_s >= 1.0 / camera.rate_hz);
+    const bool moved = (xy - last_xy).norm() >= camera.trigger_distance_m;
+    // (the server decides on its rate_hz grid: the wait ends at the first slot past the interval)
+    const double slots = std::floor((t_s - last_t_s) * camera.rate_hz + 1e-6);
+    const bool waited =
+        camera.trigger_interval_max_s > 0 && slots / camera.rate_hz >= camera.trigger_interval_max_s - 1e-9;
+    const bool due =
+        !taken || (camera.trigger_distance_m > 0 ? moved || waited : t_s - last_t_s >= 1.0 / camera.rate_hz);
     if (!due) return false;
     taken = true;
     last_xy = xy;
@@ -527,6 +546,12 @@ Status ReplayTrial(const ReplayParams& params,
   }
   const physics::CameraSpec& camera = x500->camera;
   physics::GroundRenderer renderer(*world);
+  std::unique_ptr<physics::ThermalRenderer> thermal;
+  if (params.thermal) {
+    if (!x500->thermal.enabled)
+      return Error(ErrorCode::kInvalidArgument, "the x500 carries no thermal camera");
+    thermal = std::make_unique<physics::ThermalRenderer>(*world);
+  }
   std::map<std::string, ReplayCamera, std::less<>> cameras;
   physics::CameraImage image;
   std::vector<physics::VisiblePerson> people;
@@ -542,7 +567,13 @@ Status ReplayTrial(const ReplayParams& params,
     const physics::Pose body{{r.x_m, r.y_m, r.z_m}, {r.qw, r.qx, r.qy, r.qz}};
     renderer.Render(body, {r.p_rad_s, r.q_rad_s, r.r_rad_s}, camera, ReplayNoiseSeed(r.drone, cam.frames), &image,
                     &people);
-    on_frame(*world, {r.drone, r.t_s, WithTilt(SceneFromImage(image, *world, camera.noise_std, people))});
+    ReplayFrame frame{r.drone, r.t_s, WithTilt(SceneFromImage(image, *world, camera.noise_std, people))};
+    if (thermal) {
+      frame.scene.thermal.emplace();
+      thermal->Render(body, x500->thermal, ReplayNoiseSeed(r.drone, cam.frames) ^ 0x7E4A11ULL,
+                      &*frame.scene.thermal);
+    }
+    on_frame(*world, frame);
   });
   if (!read) {
     return Error(ErrorCode::kInvalidArgument, "truth.csv cannot be read or has no t_s, drone, x_m, y_m, z_m header",

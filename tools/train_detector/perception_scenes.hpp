@@ -90,6 +90,9 @@ struct SceneSetParams {
   double max_noise_std = 10.0;
   double near_victim_fraction = 0.75;  // share of views centred near a victim
   double near_victim_offset = 1.2;     // view centre up to this * half the footprint width away
+  // Of the views not near a person, the share centred near a distractor likewise (the look-alikes
+  // a revisit's close look meets: swarmbox-fit-thermal).
+  double near_distractor_fraction = 0.0;
   double occluded_fraction = 0.0;      // share of victims partly covered by a low slab
   int distractors = 0;                 // distractors near each victim
   bool varied_look = false;            // terrain, light, poses, clothing, cover, distractor kinds
@@ -149,6 +152,7 @@ struct ReplayParams {
   std::string drone_prefix = "scout";  // which drones carry the camera (name prefix)
   double min_height_m = 10.0;
   double max_height_m = 60.0;
+  bool thermal = false;  // each frame's thermal one too (Scene::thermal; the x500's `thermal:`)
 };
 struct ReplayFrame {
   std::string drone;

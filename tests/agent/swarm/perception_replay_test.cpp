@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,37 @@ TEST_F(ReplayFolder, TakesAFrameEveryTriggerDistanceAndSeesTheVictimUnderTheCame
   EXPECT_GT(visible_at_nadir, 0.95);
   EXPECT_GE(half_visible, 6);
   EXPECT_LE(half_visible, 9);
+}
+
+// A revisit's close look: scout_1 hovers at 18 m over the victim for 2 s (10 Hz rows). The
+// camera takes a frame once trigger_interval_max_s (0.5 s) has passed without moving, on its
+// 5 Hz grid (every 0.6 s), as the physics server's trigger does; with `thermal` each carries its
+// thermal frame, in which the person is warmer than the rubble around it.
+TEST_F(ReplayFolder, AHoverTakesAFrameEveryIntervalWithItsThermalFrame) {
+  {
+    std::ofstream f(dir_ / "truth.csv");
+    f << kHeader << "\n";
+    for (int k = 0; k <= 20; ++k) {
+      char row[256];
+      std::snprintf(row, sizeof row, "%.3f,scout_1,0,0,18,0,0,0,1,0,0,0,0,0,0,0,0,0,0,0\n", 0.1 * k);
+      f << row;
+    }
+  }
+  std::vector<double> ts;
+  std::vector<double> contrasts;
+  const Status st = ReplayTrial(
+      {.trial_dir = dir_.string(), .thermal = true}, [&](const physics::WorldConfig&, const ReplayFrame& f) {
+        ts.push_back(f.t_s);
+        ASSERT_TRUE(f.scene.thermal.has_value());
+        const std::optional<double> c = ThermalContrastAt(perception_scenes::ThermalViewOf(*f.scene.thermal),
+                                                          Eigen::Vector3d::Zero(), 0.7);
+        ASSERT_TRUE(c.has_value());
+        contrasts.push_back(*c);
+      });
+  ASSERT_TRUE(st.ok()) << st.error().ToString();
+  ASSERT_EQ(ts.size(), 4u);  // t = 0, 0.6, 1.2, 1.8
+  for (std::size_t i = 0; i < ts.size(); ++i) EXPECT_NEAR(ts[i], 0.6 * static_cast<double>(i), 1e-6);
+  for (double c : contrasts) EXPECT_GT(c, 2.0);
 }
 
 TEST_F(ReplayFolder, RefusesAFolderWithoutTruthOrWithoutItsColumns) {
