@@ -3,8 +3,17 @@
 // candidates in rendered training worlds, and writes it with its provenance (the `fit-thermal`
 // target: agent/swarm/models/thermal_evidence.yaml).
 //
-//   swarmbox-fit-thermal --out FILE [--seed N (9001)] [--scenes N (2880)] [--radius-m R (0.7)]
+//   swarmbox-fit-thermal --out FILE [--seed N (9001)] [--scenes N (2880; 0 with --replay)]
+//                        [--radius-m R (0.7)] [--min-altitude M (15)] [--max-altitude M (35)]
+//                        [--near-victims F (0.75)] [--near-distractors F (0)] [--replay DIR]
 //                        [--samples CSV (every candidate: logit, contrast_k, person, altitude_m, x_m, y_m)]
+//
+// --replay DIR adds the candidates on flown trials' own frames (DIR: a trial folder or an
+// experiment's; perception_scenes::ReplayTrial renders each scout's colour and thermal frames
+// along truth.csv, the close looks' hover frames too): the mission's altitudes, tilts, motion
+// blur and the look-alikes its search flags (trials/experiments/rubble_cal.yaml flies fields
+// rubble20 never scores). --near-distractors F centres that share of the views not near a person
+// near a distractor instead (the look-alikes a close look meets).
 //
 // Scenes: nadir views from 15-35 m (the close look's 18 m to above the search's 30 m) of rubble
 // fields as trials/sar_rubble.yaml generates them (perception_scenes.hpp, SarRubbleSpec; 24 views
@@ -148,7 +157,7 @@ struct Args {
   std::uint64_t seed = 9001;
   int scenes = 2880;
   double radius_m = 0.7;
-  double near_distractors = 0.8;  // SceneSetParams::near_distractor_fraction
+  double near_distractors = 0.0;  // SceneSetParams::near_distractor_fraction
   double near_victims = 0.75;     // SceneSetParams::near_victim_fraction
   double min_altitude_m = 15, max_altitude_m = 35;
   std::string replay;  // --replay DIR: the flown trials' frames too (ReplaySamples)
@@ -217,6 +226,8 @@ bool WriteFit(const Args& args, const std::array<double, 3>& w, std::size_t peop
       static_cast<unsigned long long>(args.seed), args.scenes, people, others, loss, loss_colour,
       Quantile(pc, 0.1), Quantile(pc, 0.5), Quantile(nc, 0.5), Quantile(nc, 0.9));
   f << line;
+  if (!args.replay.empty())
+    f << "  # and the frames of the flown trials in " << args.replay << " (--replay)\n";
   return static_cast<bool>(f);
 }
 
