@@ -6,6 +6,7 @@
 //   swarmbox-fit-thermal --out FILE [--seed N (9001)] [--scenes N (2880; 0 with --replay)]
 //                        [--radius-m R (0.7)] [--min-altitude M (15)] [--max-altitude M (35)]
 //                        [--near-victims F (0.75)] [--near-distractors F (0)] [--replay DIR]
+//                        [--evaluate DIR (the AUCs on other flown trials' frames: Evaluate)]
 //                        [--samples CSV (every candidate: logit, contrast_k, person, altitude_m, x_m, y_m)]
 //
 // --replay DIR adds the candidates on flown trials' own frames (DIR: a trial folder or an
@@ -161,6 +162,7 @@ struct Args {
   double near_victims = 0.75;     // SceneSetParams::near_victim_fraction
   double min_altitude_m = 15, max_altitude_m = 35;
   std::string replay;  // --replay DIR: the flown trials' frames too (ReplaySamples)
+  std::string evaluate;  // --evaluate DIR: the AUCs of the shipped fusion and the fit on these trials' frames
   std::string
       samples;  // --samples FILE: every candidate as CSV (logit, contrast_k, person, altitude_m, x_m, y_m)
 };
@@ -187,6 +189,8 @@ std::optional<Args> ParseArgs(int argc, char** argv) {
       args.min_altitude_m = std::atof(v.c_str());
     } else if (a == "--max-altitude") {
       args.max_altitude_m = std::atof(v.c_str());
+    } else if (a == "--evaluate") {
+      args.evaluate = v;
     } else if (a == "--replay") {
       args.replay = v;
     } else if (a == "--samples") {
@@ -262,11 +266,12 @@ std::vector<std::filesystem::path> TrialFolders(const std::filesystem::path& dir
 
 // The candidates on the flown trials' own frames (perception_scenes::ReplayTrial: the scouts'
 // colour and thermal cameras along truth.csv), onto *out; false and a message on failure.
-bool ReplaySamples(const Args& args, swarm::VictimDetector& detector, std::vector<Sample>* out) {
-  const std::vector<std::filesystem::path> trials = TrialFolders(args.replay);
+bool ReplaySamples(const Args& args, const std::string& dir, swarm::VictimDetector& detector,
+                   std::vector<Sample>* out) {
+  const std::vector<std::filesystem::path> trials = TrialFolders(dir);
   if (trials.empty()) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: --replay %s: no trial folder (world.yaml and truth.csv)\n",
-                 args.replay.c_str());
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s: no trial folder (world.yaml and truth.csv)\n",
+                 dir.c_str());
     return false;
   }
   for (const std::filesystem::path& trial : trials) {
@@ -319,8 +324,68 @@ std::optional<std::vector<Sample>> Candidates(const Args& args) {
     }
     for (const perception_scenes::Scene& s : *scenes) AddSamples(s, detector, args.radius_m, &samples);
   }
-  if (!args.replay.empty() && !ReplaySamples(args, detector, &samples)) return std::nullopt;
+  if (!args.replay.empty() && !ReplaySamples(args, args.replay, detector, &samples)) return std::nullopt;
   return samples;
+}
+
+// The area under the ROC curve of `score` over the samples `keep` selects (ties count half).
+template <typename Score, typename Keep>
+double Auc(const std::vector<Sample>& samples, Score score, Keep keep) {
+  std::vector<std::pair<double, bool>> v;
+  for (const Sample& s : samples) {
+    if (keep(s)) v.emplace_back(score(s), s.person);
+  }
+  std::sort(v.begin(), v.end());
+  double pos = 0, neg = 0, rank_sum = 0;
+  for (std::size_t i = 0; i < v.size();) {
+    std::size_t j = i;
+    while (j < v.size() && v[j].first == v[i].first) ++j;
+    const double mid_rank = 0.5 * static_cast<double>(i + j + 1);  // 1-based ranks i+1..j
+    for (std::size_t k = i; k < j; ++k) {
+      if (v[k].second) rank_sum += mid_rank, pos += 1;
+    }
+    neg += static_cast<double>(j - i);
+    i = j;
+  }
+  neg -= pos;
+  if (pos == 0 || neg == 0) return std::nan("");
+  return (rank_sum - pos * (pos + 1) / 2) / (pos * neg);
+}
+
+// --evaluate DIR: how well each score ranks people over the other candidates on the flown trials'
+// own frames, at the search altitude (views from 24 m up) and in the close looks (below), one
+// line per band and score: the colour confidence alone, the contrast alone, the shipped fusion
+// and this fit.
+bool Evaluate(const Args& args, const std::array<double, 3>& w) {
+  swarm::VictimDetector detector(swarm::ShippedDetectorModel(), swarm::VictimDetectorParams{});
+  std::vector<Sample> samples;
+  if (!ReplaySamples(args, args.evaluate, detector, &samples)) return false;
+  // The shipped fit from the source tree (this tool builds before the agent embeds it).
+  Result<yaml::Node> doc = yaml::ParseFile(SWARMBOX_THERMAL_EVIDENCE_FILE);
+  Result<swarm::ThermalEvidence> shipped =
+      doc ? swarm::ParseThermalEvidence(*doc) : Result<swarm::ThermalEvidence>(doc.error());
+  if (!shipped) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: the shipped fit: %s\n", shipped.error().ToString().c_str());
+    return false;
+  }
+  const swarm::ThermalEvidence fit{w[0], w[1], w[2], args.radius_m};
+  const auto fused = [](const swarm::ThermalEvidence& e) {
+    return [e](const Sample& s) { return e.colour_weight * s.logit + e.slope_per_k * s.contrast_k + e.bias; };
+  };
+  const auto colour = [](const Sample& s) { return s.logit; };
+  const auto contrast = [](const Sample& s) { return s.contrast_k; };
+  for (const bool close : {false, true}) {
+    const auto keep = [close](const Sample& s) { return (s.altitude_m < 24.0) == close; };
+    const auto people =
+        std::count_if(samples.begin(), samples.end(), [&](const Sample& s) { return keep(s) && s.person; });
+    const auto all = std::count_if(samples.begin(), samples.end(), keep);
+    std::printf(
+        "evaluate=%s band=%s people=%td others=%td auc_colour=%.3f auc_contrast=%.3f auc_shipped=%.3f "
+        "auc_fit=%.3f\n",
+        args.evaluate.c_str(), close ? "close" : "search", people, all - people, Auc(samples, colour, keep),
+        Auc(samples, contrast, keep), Auc(samples, fused(*shipped), keep), Auc(samples, fused(fit), keep));
+  }
+  return true;
 }
 
 }  // namespace
@@ -360,5 +425,6 @@ int main(int argc, char** argv) {
       "log_loss=%.4f log_loss_colour_alone=%.4f\n",
       static_cast<unsigned long long>(args->seed), args->scenes, pc.size(), nc.size(), w[0], w[1], w[2], loss,
       loss_colour);
+  if (!args->evaluate.empty() && !Evaluate(*args, w)) return 1;
   return 0;
 }

@@ -532,6 +532,35 @@ std::uint64_t ReplayNoiseSeed(std::string_view drone, std::uint64_t frame) {
   return h ^ (frame << 20);
 }
 
+// Truth row r's frame: the colour camera's (and with `thermal` the thermal camera's) at its pose.
+ReplayFrame RenderReplayFrame(const report::TruthRow& r, std::uint64_t noise_seed,
+                              const physics::WorldConfig& world, const physics::Airframe& x500,
+                              physics::GroundRenderer& renderer, physics::ThermalRenderer* thermal,
+                              physics::CameraImage& image, std::vector<physics::VisiblePerson>& people) {
+  const physics::Pose body{{r.x_m, r.y_m, r.z_m}, {r.qw, r.qx, r.qy, r.qz}};
+  renderer.Render(body, {r.p_rad_s, r.q_rad_s, r.r_rad_s}, x500.camera, noise_seed, &image, &people);
+  ReplayFrame frame{r.drone, r.t_s, WithTilt(SceneFromImage(image, world, x500.camera.noise_std, people))};
+  if (thermal != nullptr) {
+    frame.scene.thermal.emplace();
+    thermal->Render(body, x500.thermal, noise_seed ^ 0x7E4A11ULL, &*frame.scene.thermal);
+  }
+  return frame;
+}
+
+// What reading truth.csv for a replay came to.
+Status TruthStatus(bool read, bool attitude, const std::string& truth_path) {
+  if (!read) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "truth.csv cannot be read or has no t_s, drone, x_m, y_m, z_m header", truth_path);
+  }
+  if (!attitude) {
+    return Error(ErrorCode::kInvalidArgument,
+                 "truth.csv has no attitude and body rates (qw, qx, qy, qz, p_rad_s, q_rad_s, r_rad_s)",
+                 truth_path);
+  }
+  return Ok{};
+}
+
 }  // namespace
 
 Status ReplayTrial(const ReplayParams& params,
@@ -564,26 +593,11 @@ Status ReplayTrial(const ReplayParams& params,
     }
     ReplayCamera& cam = cameras[r.drone];
     if (!cam.Take(Vector2d(r.x_m, r.y_m), r.t_s, camera)) return;
-    const physics::Pose body{{r.x_m, r.y_m, r.z_m}, {r.qw, r.qx, r.qy, r.qz}};
-    renderer.Render(body, {r.p_rad_s, r.q_rad_s, r.r_rad_s}, camera, ReplayNoiseSeed(r.drone, cam.frames), &image,
-                    &people);
-    ReplayFrame frame{r.drone, r.t_s, WithTilt(SceneFromImage(image, *world, camera.noise_std, people))};
-    if (thermal) {
-      frame.scene.thermal.emplace();
-      thermal->Render(body, x500->thermal, ReplayNoiseSeed(r.drone, cam.frames) ^ 0x7E4A11ULL,
-                      &*frame.scene.thermal);
-    }
+    const ReplayFrame frame = RenderReplayFrame(r, ReplayNoiseSeed(r.drone, cam.frames), *world, *x500,
+                                                renderer, thermal.get(), image, people);
     on_frame(*world, frame);
   });
-  if (!read) {
-    return Error(ErrorCode::kInvalidArgument, "truth.csv cannot be read or has no t_s, drone, x_m, y_m, z_m header",
-                 truth_path);
-  }
-  if (!attitude) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "truth.csv has no attitude and body rates (qw, qx, qy, qz, p_rad_s, q_rad_s, r_rad_s)", truth_path);
-  }
-  return Ok{};
+  return TruthStatus(read, attitude, truth_path);
 }
 
 }  // namespace swarmbox::perception_scenes

@@ -113,6 +113,17 @@ const raft::Victim* ScoutBehaviour::OrbitTarget(const MissionInput& in) const {
   return v;
 }
 
+// A sight at p is of candidate c when the mission state will file it there: a look-alike a few
+// metres off is another candidate's view, and c's revisit still waits for its answer (counting it
+// as one left the scout hovering for the revisit's whole timeout with nothing reported:
+// rubble20-a-r18 on 2026-11-29, a person 6 m from a backpack).
+bool ScoutBehaviour::OfCandidate(const raft::MissionState& m, const raft::Candidate* c,
+                                 const Eigen::Vector2d& p) {
+  if (c == nullptr) return false;
+  const raft::Candidate* filed = m.CandidateAt(p.x(), p.y());
+  return filed != nullptr && filed->id == c->id;
+}
+
 void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out) {
   const raft::MissionState& m = *in.mission;
   const raft::Candidate* revisit = stage_ == Stage::kRevisiting ? m.FindCandidate(revisit_id_) : nullptr;
@@ -128,12 +139,7 @@ void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out)
     if (known) continue;
     // The first sight of the candidate on a revisit always goes out: it is the revisit's answer
     // (with a close look: only from the look altitude; the descent's views of it are not sent).
-    // A sight is of the candidate when the mission state will file it there: a look-alike a few
-    // metres off is another candidate's view, and the revisit still waits for its answer (counting
-    // it as one left the scout hovering for the revisit's whole timeout with nothing reported:
-    // rubble20-a-r18 on 2026-11-29, a person 6 m from a backpack).
-    const raft::Candidate* filed = revisit != nullptr ? m.CandidateAt(p.x(), p.y()) : nullptr;
-    const bool at_candidate = filed != nullptr && filed->id == revisit->id;
+    const bool at_candidate = OfCandidate(m, revisit, p);
     const bool from_look =
         config_.revisit_look_altitude_m <= 0 || d.viewer_m.z() <= look_z + kRevisitHeightToleranceM;
     if (at_candidate && !from_look) continue;
