@@ -28,6 +28,7 @@
 // perception bench's evaluation seeds and the shipped model's training and calibration seeds.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -36,6 +37,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -265,28 +267,42 @@ std::vector<std::filesystem::path> TrialFolders(const std::filesystem::path& dir
 }
 
 // The candidates on the flown trials' own frames (perception_scenes::ReplayTrial: the scouts'
-// colour and thermal cameras along truth.csv), onto *out; false and a message on failure.
-bool ReplaySamples(const Args& args, const std::string& dir, swarm::VictimDetector& detector,
-                   std::vector<Sample>* out) {
+// colour and thermal frames along truth.csv), onto *out in trial order; the trials replayed on
+// every core, a detector each (a trial's candidates do not depend on which); false and a message
+// on failure.
+bool ReplaySamples(const Args& args, const std::string& dir, std::vector<Sample>* out) {
   const std::vector<std::filesystem::path> trials = TrialFolders(dir);
   if (trials.empty()) {
     std::fprintf(stderr, "swarmbox-fit-thermal: %s: no trial folder (world.yaml and truth.csv)\n",
                  dir.c_str());
     return false;
   }
-  for (const std::filesystem::path& trial : trials) {
-    const std::size_t before = out->size();
-    const Status st = perception_scenes::ReplayTrial(
-        {.trial_dir = trial.string(), .thermal = true},
-        [&](const physics::WorldConfig&, const perception_scenes::ReplayFrame& f) {
-          AddSamples(f.scene, detector, args.radius_m, out);
-        });
-    if (!st) {
-      std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", st.error().ToString().c_str());
+  std::vector<std::vector<Sample>> per_trial(trials.size());
+  std::vector<std::string> errors(trials.size());
+  std::atomic<std::size_t> next{0};
+  const auto work = [&] {
+    swarm::VictimDetector detector(swarm::ShippedDetectorModel(), swarm::VictimDetectorParams{});
+    for (std::size_t i = next++; i < trials.size(); i = next++) {
+      const Status st = perception_scenes::ReplayTrial(
+          {.trial_dir = trials[i].string(), .thermal = true},
+          [&](const physics::WorldConfig&, const perception_scenes::ReplayFrame& f) {
+            AddSamples(f.scene, detector, args.radius_m, &per_trial[i]);
+          });
+      if (!st) errors[i] = st.error().ToString();
+    }
+  };
+  std::vector<std::thread> pool(std::max(1U, std::thread::hardware_concurrency()) - 1);
+  for (std::thread& t : pool) t = std::thread(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  for (std::size_t i = 0; i < trials.size(); ++i) {
+    if (!errors[i].empty()) {
+      std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", errors[i].c_str());
       return false;
     }
-    std::fprintf(stderr, "swarmbox-fit-thermal: %s: %zu candidates\n", trial.filename().c_str(),
-                 out->size() - before);
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s: %zu candidates\n", trials[i].filename().c_str(),
+                 per_trial[i].size());
+    out->insert(out->end(), per_trial[i].begin(), per_trial[i].end());
   }
   return true;
 }
@@ -324,7 +340,7 @@ std::optional<std::vector<Sample>> Candidates(const Args& args) {
     }
     for (const perception_scenes::Scene& s : *scenes) AddSamples(s, detector, args.radius_m, &samples);
   }
-  if (!args.replay.empty() && !ReplaySamples(args, args.replay, detector, &samples)) return std::nullopt;
+  if (!args.replay.empty() && !ReplaySamples(args, args.replay, &samples)) return std::nullopt;
   return samples;
 }
 
@@ -357,9 +373,8 @@ double Auc(const std::vector<Sample>& samples, Score score, Keep keep) {
 // line per band and score: the colour confidence alone, the contrast alone, the shipped fusion
 // and this fit.
 bool Evaluate(const Args& args, const std::array<double, 3>& w) {
-  swarm::VictimDetector detector(swarm::ShippedDetectorModel(), swarm::VictimDetectorParams{});
   std::vector<Sample> samples;
-  if (!ReplaySamples(args, args.evaluate, detector, &samples)) return false;
+  if (!ReplaySamples(args, args.evaluate, &samples)) return false;
   // The shipped fit from the source tree (this tool builds before the agent embeds it).
   Result<yaml::Node> doc = yaml::ParseFile(SWARMBOX_THERMAL_EVIDENCE_FILE);
   Result<swarm::ThermalEvidence> shipped =
