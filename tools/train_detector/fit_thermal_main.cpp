@@ -151,7 +151,10 @@ void AddSamples(const perception_scenes::Scene& s, swarm::VictimDetector& detect
 int Usage() {
   std::fprintf(
       stderr,
-      "usage: swarmbox-fit-thermal --out FILE [--seed N] [--scenes N] [--radius-m R] [--samples CSV]\n");
+      "usage: swarmbox-fit-thermal --out FILE [--seed N] [--scenes N] [--radius-m R] [--min-altitude M]\n"
+      "         [--max-altitude M] [--near-victims F] [--near-distractors F] [--replay DIR] [--evaluate "
+      "DIR]\n"
+      "         [--samples CSV]\n");
   return 2;
 }
 
@@ -203,7 +206,9 @@ std::optional<Args> ParseArgs(int argc, char** argv) {
   }
   if (args.out.empty() || (args.scenes < 24 && !(args.scenes == 0 && !args.replay.empty())) ||
       !(args.radius_m > 0.1 && args.radius_m < 3) ||
-      !(args.near_distractors >= 0 && args.near_distractors <= 1))
+      !(args.near_distractors >= 0 && args.near_distractors <= 1) ||
+      !(args.near_victims >= 0 && args.near_victims <= 1) ||
+      !(args.min_altitude_m > 0 && args.min_altitude_m <= args.max_altitude_m))
     return std::nullopt;
   return args;
 }
@@ -385,7 +390,7 @@ bool Evaluate(const Args& args, const std::array<double, 3>& w) {
   }
   const swarm::ThermalEvidence fit{w[0], w[1], w[2], args.radius_m};
   const auto fused = [](const swarm::ThermalEvidence& e) {
-    return [e](const Sample& s) { return e.colour_weight * s.logit + e.slope_per_k * s.contrast_k + e.bias; };
+    return [e](const Sample& s) { return e.Fuse(1.0 / (1.0 + std::exp(-s.logit)), s.contrast_k); };
   };
   const auto colour = [](const Sample& s) { return s.logit; };
   const auto contrast = [](const Sample& s) { return s.contrast_k; };

@@ -113,16 +113,19 @@ const raft::Victim* ScoutBehaviour::OrbitTarget(const MissionInput& in) const {
   return v;
 }
 
+namespace {
+
 // A sight at p is of candidate c when the mission state will file it there: a look-alike a few
 // metres off is another candidate's view, and c's revisit still waits for its answer (counting it
 // as one left the scout hovering for the revisit's whole timeout with nothing reported:
 // rubble20-a-r18 on 2026-11-29, a person 6 m from a backpack).
-bool ScoutBehaviour::OfCandidate(const raft::MissionState& m, const raft::Candidate* c,
-                                 const Eigen::Vector2d& p) {
+bool OfCandidate(const raft::MissionState& m, const raft::Candidate* c, const Eigen::Vector2d& p) {
   if (c == nullptr) return false;
   const raft::Candidate* filed = m.CandidateAt(p.x(), p.y());
   return filed != nullptr && filed->id == c->id;
 }
+
+}  // namespace
 
 void ScoutBehaviour::ReportSightings(const MissionInput& in, MissionOutput* out) {
   const raft::MissionState& m = *in.mission;

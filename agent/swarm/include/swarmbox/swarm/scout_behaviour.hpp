@@ -214,8 +214,6 @@ class ScoutBehaviour {
   // Flocks toward `xy_m` at search altitude (waiting for a sector, or over the swept one).
   void FlockOver(const Eigen::Vector2d& xy_m, const MissionInput& in, MissionOutput* out) const;
   void ReportSightings(const MissionInput& in, MissionOutput* out);
-  // Whether a sight at p would be filed under candidate c (nullptr: none).
-  static bool OfCandidate(const raft::MissionState& m, const raft::Candidate* c, const Eigen::Vector2d& p);
   void RetrySightings(const MissionInput& in, MissionOutput* out);
   void Propose(const MissionInput& in, const GroundDetection& d, int tries, MissionOutput* out);
   // The pending candidate the committed state sends this drone to, or nullptr.
