@@ -8,6 +8,8 @@
 //                        [--near-victims F (0.75)] [--near-distractors F (0)] [--replay DIR]
 //                        [--evaluate DIR (the AUCs on other flown trials' frames: Evaluate)]
 //                        [--samples CSV (every candidate: logit, contrast_k, person, altitude_m, x_m, y_m)]
+//                        [--cnn train_thermal_cnn.py --cnn-work DIR [--cnn-epochs N (12)]
+//                         [--cnn-seed N (1)] [--python PATH (/usr/bin/python3)]]
 //
 // --replay DIR adds the candidates on flown trials' own frames (DIR: a trial folder or an
 // experiment's; perception_scenes::ReplayTrial renders each scout's colour and thermal frames
@@ -24,7 +26,15 @@
 // 1.5 m of one at least half visible (near one less visible: left out), else not; its contrast is
 // ThermalContrastAt's (the agent's own code), candidates the thermal frame does not see are left
 // out. The fit: a logistic regression of person-or-not on (logit of the detector's confidence,
-// contrast, 1) by Newton's method: the fused confidence is its probability. Refused seeds: the
+// contrast, 1) by Newton's method: the fused confidence is its probability.
+//
+// --cnn SCRIPT: the thermal classifier too (thermal_evidence.hpp ThermalClassifier). Each
+// candidate's thermal patch (ThermalPatchAt, the agent's own code) goes into DIR/thermal_patches.bin,
+// split by world or trial (every fourth one the calibration split, Calibration); the script
+// (train_thermal_cnn.py, torch) trains the network on the training split and writes it as
+// thermal_cnn.onnx beside --out; every candidate is scored by it through cv::dnn, and the fusion's
+// regression on (logit, contrast, the network's logit, 1) is fitted on the calibration split alone
+// (candidates the network never saw; without the contrast when its weight comes out <= 0). Refused seeds: the
 // perception bench's evaluation seeds and the shipped model's training and calibration seeds.
 #include <algorithm>
 #include <array>
@@ -32,6 +42,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -39,6 +50,9 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <spawn.h>
+#include <sys/wait.h>
 
 #include <opencv2/core.hpp>
 
@@ -48,6 +62,8 @@
 #include "swarmbox/swarm/thermal_evidence.hpp"
 #include "swarmbox/swarm/victim_detector.hpp"
 #include "swarmbox/swarm/victim_detector_model.hpp"
+
+extern char** environ;
 
 namespace {
 
@@ -60,7 +76,14 @@ struct Sample {
   bool person;
   double altitude_m;  // the scene's camera height
   double x_m, y_m;    // where the candidate was placed on the ground
+  int group = 0;      // its world (scenes) or trial (replays): the CNN's split (Calibration)
+  std::vector<float> patch;  // ThermalPatchAt's (empty: not in the frame)
+  double cnn_logit = 0.0;    // the thermal classifier's on it (0 without one, as the agent takes it)
 };
+
+// The calibration split: every fourth world or trial, never trained on by the thermal CNN; the
+// fusion with the CNN is fitted on it alone.
+bool Calibration(const Sample& s) { return s.group % 4 == 3; }
 
 // Logistic regression on the features `f(sample)` (the last one the intercept) by Newton's method.
 template <std::size_t N, typename F>
@@ -79,7 +102,7 @@ std::array<double, N> Fit(const std::vector<Sample>& samples, F features) {
         for (std::size_t j = 0; j < N; ++j) h[i][j] += p * (1 - p) * x[i] * x[j] + (i == j ? 1e-9 : 0.0);
       }
     }
-    // Solve h d = g (Gaussian elimination, N <= 3).
+    // Solve h d = g (Gaussian elimination, N <= 4).
     std::array<std::array<double, N + 1>, N> m{};
     for (std::size_t i = 0; i < N; ++i) {
       for (std::size_t j = 0; j < N; ++j) m[i][j] = h[i][j];
@@ -123,9 +146,9 @@ double Quantile(std::vector<double> v, double q) {
   return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
-// The candidates of one scene as samples.
+// The candidates of one scene as samples of `group`.
 void AddSamples(const perception_scenes::Scene& s, swarm::VictimDetector& detector, double radius_m,
-                std::vector<Sample>* out) {
+                int group, std::vector<Sample>* out) {
   const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3,
                     const_cast<std::uint8_t*>(s.image.bgr.data()));
   std::vector<swarm::ImageBlob> blobs;
@@ -142,9 +165,18 @@ void AddSamples(const perception_scenes::Scene& s, swarm::VictimDetector& detect
     const std::optional<double> c = swarm::ThermalContrastAt(view, *g, radius_m);
     if (!c) continue;
     const double p = std::clamp(b.confidence, 1e-6, 1 - 1e-6);
-    out->push_back({std::clamp(std::log(p / (1 - p)), -12.0, 12.0),
-                    std::clamp(*c, swarm::kMinContrastK, swarm::kMaxContrastK), near != nullptr, s.altitude_m,
-                    g->x(), g->y()});
+    Sample sample{std::clamp(std::log(p / (1 - p)), -12.0, 12.0),
+                  std::clamp(*c, swarm::kMinContrastK, swarm::kMaxContrastK),
+                  near != nullptr,
+                  s.altitude_m,
+                  g->x(),
+                  g->y(),
+                  group,
+                  {},
+                  0.0};
+    if (cv::Mat patch; swarm::ThermalPatchAt(view, *g, &patch))
+      sample.patch.assign(patch.begin<float>(), patch.end<float>());
+    out->push_back(std::move(sample));
   }
 }
 
@@ -154,7 +186,8 @@ int Usage() {
       "usage: swarmbox-fit-thermal --out FILE [--seed N] [--scenes N] [--radius-m R] [--min-altitude M]\n"
       "         [--max-altitude M] [--near-victims F] [--near-distractors F] [--replay DIR] [--evaluate "
       "DIR]\n"
-      "         [--samples CSV]\n");
+      "         [--samples CSV] [--cnn SCRIPT --cnn-work DIR [--cnn-epochs N] [--cnn-seed N] [--python "
+      "PATH]]\n");
   return 2;
 }
 
@@ -170,6 +203,11 @@ struct Args {
   std::string evaluate;  // --evaluate DIR: the AUCs of the shipped fusion and the fit on these trials' frames
   std::string
       samples;  // --samples FILE: every candidate as CSV (logit, contrast_k, person, altitude_m, x_m, y_m)
+  std::string cnn;       // --cnn SCRIPT: train_thermal_cnn.py, the thermal classifier (TrainCnn)
+  std::string cnn_work;  // --cnn-work DIR: its patch file
+  std::string python = "/usr/bin/python3";
+  int cnn_epochs = 12;
+  int cnn_seed = 1;
 };
 
 std::optional<Args> ParseArgs(int argc, char** argv) {
@@ -200,6 +238,16 @@ std::optional<Args> ParseArgs(int argc, char** argv) {
       args.replay = v;
     } else if (a == "--samples") {
       args.samples = v;
+    } else if (a == "--cnn") {
+      args.cnn = v;
+    } else if (a == "--cnn-work") {
+      args.cnn_work = v;
+    } else if (a == "--python") {
+      args.python = v;
+    } else if (a == "--cnn-epochs") {
+      args.cnn_epochs = std::atoi(v.c_str());
+    } else if (a == "--cnn-seed") {
+      args.cnn_seed = std::atoi(v.c_str());
     } else {
       return std::nullopt;
     }
@@ -208,37 +256,59 @@ std::optional<Args> ParseArgs(int argc, char** argv) {
       !(args.radius_m > 0.1 && args.radius_m < 3) ||
       !(args.near_distractors >= 0 && args.near_distractors <= 1) ||
       !(args.near_victims >= 0 && args.near_victims <= 1) ||
-      !(args.min_altitude_m > 0 && args.min_altitude_m <= args.max_altitude_m))
+      !(args.min_altitude_m > 0 && args.min_altitude_m <= args.max_altitude_m) ||
+      (!args.cnn.empty() && (args.cnn_work.empty() || args.cnn_epochs < 1)))
     return std::nullopt;
   return args;
 }
 
+// What was fitted: the evidence, the candidates it was fitted on and its log-loss on them, with and
+// without the thermal camera.
+struct Fitted {
+  swarm::ThermalEvidence evidence;
+  std::size_t people = 0, others = 0;
+  double loss = 0, loss_colour = 0;
+  std::vector<double> person_contrast, other_contrast;
+};
+
 // The fit's file (thermal_evidence.hpp's mapping, with its provenance); false when it cannot be written.
-bool WriteFit(const Args& args, const std::array<double, 3>& w, std::size_t people, std::size_t others,
-              double loss, double loss_colour, const std::vector<double>& pc, const std::vector<double>& nc) {
+bool WriteFit(const Args& args, const Fitted& fit) {
+  const swarm::ThermalEvidence& e = fit.evidence;
   std::ofstream f(args.out);
   f << "# How the agent takes the thermal camera's evidence into the colour detector's confidence\n"
     << "# (agent/swarm thermal_evidence.hpp): sigmoid(colour_weight logit(confidence) + slope_per_k c\n"
-    << "# + bias), c the contrast within radius_m of the candidate's ground point. Written by\n"
+    << "# + cnn_weight l + bias), c the contrast within radius_m of the candidate's ground point, l the\n"
+    << "# thermal classifier's logit on its patch (cnn_model, beside this file). Written by\n"
     << "# swarmbox-fit-thermal (the fit-thermal target; tools/train_detector/fit_thermal_main.cpp has\n"
-    << "# the method): do not edit. fit: the candidates it was fitted on, and the log-loss with the\n"
-    << "# contrast and with the colour detector's confidence alone (refitted likewise).\n"
+    << "# the method): do not edit. fit: the candidates it was fitted on (with a classifier: its\n"
+    << "# calibration split, never trained on), and the log-loss with the thermal camera and with the\n"
+    << "# colour detector's confidence alone (refitted likewise).\n"
     << "thermal_evidence:\n";
   char line[768];
   std::snprintf(line, sizeof line,
-                "  colour_weight: %.6f\n  slope_per_k: %.6f\n  bias: %.6f\n  radius_m: %.3f\n", w[0], w[1],
-                w[2], args.radius_m);
+                "  colour_weight: %.6f\n  slope_per_k: %.6f\n  bias: %.6f\n  radius_m: %.3f\n",
+                e.colour_weight, e.slope_per_k, e.bias, e.radius_m);
   f << line;
+  if (e.cnn_weight > 0) {
+    std::snprintf(line, sizeof line, "  cnn_weight: %.6f\n  cnn_model: %s\n", e.cnn_weight,
+                  e.cnn_model.c_str());
+    f << line;
+  }
   std::snprintf(
       line, sizeof line,
       "  fit: {seed: %llu, scenes: %d, altitudes_m: [15, 35], people: %zu, others: %zu, log_loss: %.4f,\n"
       "        log_loss_colour_alone: %.4f, person_contrast_p10_k: %.2f, person_contrast_p50_k: %.2f,\n"
       "        other_contrast_p50_k: %.2f, other_contrast_p90_k: %.2f}\n",
-      static_cast<unsigned long long>(args.seed), args.scenes, people, others, loss, loss_colour,
-      Quantile(pc, 0.1), Quantile(pc, 0.5), Quantile(nc, 0.5), Quantile(nc, 0.9));
+      static_cast<unsigned long long>(args.seed), args.scenes, fit.people, fit.others, fit.loss,
+      fit.loss_colour, Quantile(fit.person_contrast, 0.1), Quantile(fit.person_contrast, 0.5),
+      Quantile(fit.other_contrast, 0.5), Quantile(fit.other_contrast, 0.9));
   f << line;
   if (!args.replay.empty())
-    f << "  # and the frames of the flown trials in " << args.replay << " (--replay)\n";
+    f << "  # and the frames of the flown trials in "
+      << std::filesystem::path(args.replay).filename().string() << " (--replay)\n";
+  if (e.cnn_weight > 0)
+    f << "  # the classifier: " << std::filesystem::path(args.cnn).filename().string() << " --seed "
+      << args.cnn_seed << " --epochs " << args.cnn_epochs << " on the training split\n";
   return static_cast<bool>(f);
 }
 
@@ -254,6 +324,9 @@ bool WriteSamples(const std::string& path, const std::vector<Sample>& samples) {
   }
   return static_cast<bool>(f);
 }
+
+// Replayed trials' groups: kReplayGroup + the trial's index (scene worlds count from 0).
+constexpr int kReplayGroup = 1000000;
 
 // The trial folders of `dir` (it or its subfolders with a world.yaml and a truth.csv), in name order.
 std::vector<std::filesystem::path> TrialFolders(const std::filesystem::path& dir) {
@@ -291,7 +364,7 @@ bool ReplaySamples(const Args& args, const std::string& dir, std::vector<Sample>
       const Status st = perception_scenes::ReplayTrial(
           {.trial_dir = trials[i].string(), .thermal = true},
           [&](const physics::WorldConfig&, const perception_scenes::ReplayFrame& f) {
-            AddSamples(f.scene, detector, args.radius_m, &per_trial[i]);
+            AddSamples(f.scene, detector, args.radius_m, kReplayGroup + static_cast<int>(i), &per_trial[i]);
           });
       if (!st) errors[i] = st.error().ToString();
     }
@@ -343,18 +416,167 @@ std::optional<std::vector<Sample>> Candidates(const Args& args) {
       std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", scenes.error().ToString().c_str());
       return std::nullopt;
     }
-    for (const perception_scenes::Scene& s : *scenes) AddSamples(s, detector, args.radius_m, &samples);
+    for (std::size_t i = 0; i < scenes->size(); ++i) {
+      AddSamples((*scenes)[i], detector, args.radius_m, static_cast<int>(i / 24), &samples);
+    }
   }
   if (!args.replay.empty() && !ReplaySamples(args, args.replay, &samples)) return std::nullopt;
   return samples;
 }
 
-// The area under the ROC curve of `score` over the samples `keep` selects (ties count half).
-template <typename Score, typename Keep>
-double Auc(const std::vector<Sample>& samples, Score score, Keep keep) {
-  std::vector<std::pair<double, bool>> v;
+// --cnn: the patches as train_thermal_cnn.py reads them (its docstring: SWBTHERM version 1), those
+// of the calibration split marked so; false when the file cannot be written.
+bool WritePatches(const std::string& path, const std::vector<Sample>& samples) {
+  std::ofstream f(path, std::ios::binary);
+  const auto count = static_cast<std::uint64_t>(
+      std::count_if(samples.begin(), samples.end(), [](const Sample& s) { return !s.patch.empty(); }));
+  const std::uint32_t version = 1, px = swarm::kThermalPatchPx;
+  f.write("SWBTHERM", 8);
+  f.write(reinterpret_cast<const char*>(&version), sizeof version);
+  f.write(reinterpret_cast<const char*>(&px), sizeof px);
+  f.write(reinterpret_cast<const char*>(&count), sizeof count);
   for (const Sample& s : samples) {
-    if (keep(s)) v.emplace_back(score(s), s.person);
+    if (s.patch.empty()) continue;
+    const char label = s.person ? 1 : 0, split = Calibration(s) ? 1 : 0;
+    f.put(label).put(split);
+    f.write(reinterpret_cast<const char*>(s.patch.data()),
+            static_cast<std::streamsize>(s.patch.size() * sizeof(float)));
+  }
+  return static_cast<bool>(f);
+}
+
+// Runs the training script (argv, no shell) and waits for it; false and a message on failure.
+bool RunCnnScript(const Args& args, const std::string& patches, const std::string& onnx) {
+  std::vector<std::string> argv_s = {args.python, args.cnn,
+                                     "--patches", patches,
+                                     "--out",     onnx,
+                                     "--seed",    std::to_string(args.cnn_seed),
+                                     "--epochs",  std::to_string(args.cnn_epochs)};
+  std::vector<char*> argv;
+  for (std::string& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  int status = 0;
+  if (const int rc = posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ); rc != 0) {
+    std::fprintf(stderr,
+                 "swarmbox-fit-thermal: cannot run %s: %s (python3-torch: scripts/setup_training.sh)\n",
+                 args.python.c_str(), std::strerror(rc));
+    return false;
+  }
+  if (waitpid(pid, &status, 0) != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s failed (python3-torch: scripts/setup_training.sh)\n",
+                 args.cnn.c_str());
+    return false;
+  }
+  return true;
+}
+
+std::optional<std::string> ReadWhole(const std::string& path) {
+  std::ifstream f(path, std::ios::binary | std::ios::ate);
+  if (!f) return std::nullopt;
+  std::string bytes(static_cast<std::size_t>(f.tellg()), '\0');
+  f.seekg(0);
+  if (!f.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) return std::nullopt;
+  return bytes;
+}
+
+// Each sample's cnn_logit by the network `onnx` (the agent's ThermalClassifier; 0 without a patch,
+// as the agent takes it); false and a message when cv::dnn cannot run it.
+bool ScoreSamples(const std::string& onnx, std::vector<Sample>* samples) {
+  Result<std::unique_ptr<swarm::ThermalClassifier>> c = swarm::ThermalClassifier::FromOnnx(onnx);
+  if (!c) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", c.error().ToString().c_str());
+    return false;
+  }
+  for (Sample& s : *samples) {
+    if (s.patch.empty()) {
+      s.cnn_logit = 0.0;
+      continue;
+    }
+    const cv::Mat patch(swarm::kThermalPatchPx, swarm::kThermalPatchPx, CV_32F, s.patch.data());
+    s.cnn_logit = (*c)->Logit(patch);
+  }
+  return true;
+}
+
+// --cnn: trains the thermal classifier on the training split's patches (the script's ONNX next to
+// --out as thermal_cnn.onnx) and scores every sample with it: the ONNX, or nullopt and a message.
+std::optional<std::string> TrainCnn(const Args& args, std::vector<Sample>* samples) {
+  std::error_code ec;
+  std::filesystem::create_directories(args.cnn_work, ec);
+  const std::string patches = (std::filesystem::path(args.cnn_work) / "thermal_patches.bin").string();
+  const std::string onnx_path = (std::filesystem::path(args.out).parent_path() / "thermal_cnn.onnx").string();
+  if (!WritePatches(patches, *samples)) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", patches.c_str());
+    return std::nullopt;
+  }
+  if (!RunCnnScript(args, patches, onnx_path)) return std::nullopt;
+  std::optional<std::string> onnx = ReadWhole(onnx_path);
+  if (!onnx) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s wrote no %s\n", args.cnn.c_str(), onnx_path.c_str());
+    return std::nullopt;
+  }
+  if (!ScoreSamples(*onnx, samples)) return std::nullopt;
+  return onnx;
+}
+
+// The fusion fitted on `samples` (with `onnx`: the calibration split alone, with the classifier's
+// logit); nullopt and a message when a weight comes out unusable.
+std::optional<Fitted> FitEvidence(const Args& args, const std::vector<Sample>& all,
+                                  const std::optional<std::string>& onnx) {
+  std::vector<Sample> samples;
+  for (const Sample& s : all) {
+    if (!onnx || Calibration(s)) samples.push_back(s);
+  }
+  Fitted fit;
+  for (const Sample& s : samples)
+    (s.person ? fit.person_contrast : fit.other_contrast).push_back(s.contrast_k);
+  fit.people = fit.person_contrast.size(), fit.others = fit.other_contrast.size();
+  if (fit.people < 20 || fit.others < 20) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: too few candidates (%zu people, %zu others)\n", fit.people,
+                 fit.others);
+    return std::nullopt;
+  }
+  auto colour = [](const Sample& s) { return std::array<double, 2>{s.logit, 1.0}; };
+  fit.loss_colour = LogLoss<2>(samples, Fit<2>(samples, colour), colour);
+  swarm::ThermalEvidence& e = fit.evidence;
+  e.radius_m = args.radius_m;
+  if (onnx) {
+    auto all4 = [](const Sample& s) {
+      return std::array<double, 4>{s.logit, s.contrast_k, s.cnn_logit, 1.0};
+    };
+    const std::array<double, 4> w = Fit<4>(samples, all4);
+    fit.loss = LogLoss<4>(samples, w, all4);
+    e.colour_weight = w[0], e.slope_per_k = w[1], e.cnn_weight = w[2], e.bias = w[3];
+    if (!(w[1] > 0)) {  // the classifier holds all the contrast tells: without it
+      auto no_contrast = [](const Sample& s) { return std::array<double, 3>{s.logit, s.cnn_logit, 1.0}; };
+      const std::array<double, 3> v = Fit<3>(samples, no_contrast);
+      fit.loss = LogLoss<3>(samples, v, no_contrast);
+      e.colour_weight = v[0], e.slope_per_k = 0.0, e.cnn_weight = v[1], e.bias = v[2];
+    }
+    e.cnn_model = "thermal_cnn.onnx";
+    e.cnn_onnx = std::make_shared<const std::string>(*onnx);
+  } else {
+    auto both = [](const Sample& s) { return std::array<double, 3>{s.logit, s.contrast_k, 1.0}; };
+    const std::array<double, 3> w = Fit<3>(samples, both);
+    fit.loss = LogLoss<3>(samples, w, both);
+    e.colour_weight = w[0], e.slope_per_k = w[1], e.bias = w[2];
+  }
+  if (!(e.colour_weight > 0 && (e.slope_per_k > 0 || e.cnn_weight > 0))) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: the fit's weights are %g, %g, %g: not a usable fusion\n",
+                 e.colour_weight, e.slope_per_k, e.cnn_weight);
+    return std::nullopt;
+  }
+  return fit;
+}
+
+// The area under the ROC curve of `scores` (one a sample) over the samples `keep` selects (ties
+// count half).
+template <typename Keep>
+double Auc(const std::vector<Sample>& samples, const std::vector<double>& scores, Keep keep) {
+  std::vector<std::pair<double, bool>> v;
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (keep(samples[i])) v.emplace_back(scores[i], samples[i].person);
   }
   std::sort(v.begin(), v.end());
   double pos = 0, neg = 0, rank_sum = 0;
@@ -373,37 +595,67 @@ double Auc(const std::vector<Sample>& samples, Score score, Keep keep) {
   return (rank_sum - pos * (pos + 1) / 2) / (pos * neg);
 }
 
+// Each sample's fused confidence by `e` (its classifier's logits into the samples' cnn_logit);
+// nullopt when the classifier does not run.
+std::optional<std::vector<double>> FusedScores(const swarm::ThermalEvidence& e,
+                                               std::vector<Sample>* samples) {
+  if (e.cnn_weight > 0 && !ScoreSamples(*e.cnn_onnx, samples)) return std::nullopt;
+  std::vector<double> out;
+  for (const Sample& s : *samples) {
+    out.push_back(
+        e.Fuse(1.0 / (1.0 + std::exp(-s.logit)), s.contrast_k, e.cnn_weight > 0 ? s.cnn_logit : 0.0));
+  }
+  return out;
+}
+
+// The shipped thermal evidence from the source tree, its classifier beside it (this tool builds
+// before the agent embeds them).
+Result<swarm::ThermalEvidence> ShippedFromSource() {
+  Result<yaml::Node> doc = yaml::ParseFile(SWARMBOX_THERMAL_EVIDENCE_FILE);
+  if (!doc) return doc.error();
+  Result<swarm::ThermalEvidence> e = swarm::ParseThermalEvidence(*doc);
+  if (!e || e->cnn_weight == 0) return e;
+  const std::filesystem::path onnx =
+      std::filesystem::path(SWARMBOX_THERMAL_EVIDENCE_FILE).parent_path() / e->cnn_model;
+  std::optional<std::string> bytes = ReadWhole(onnx.string());
+  if (!bytes) return Error(ErrorCode::kNotFound, "cannot read " + onnx.string());
+  e->cnn_onnx = std::make_shared<const std::string>(std::move(*bytes));
+  return e;
+}
+
 // --evaluate DIR: how well each score ranks people over the other candidates on the flown trials'
 // own frames, at the search altitude (views from 24 m up) and in the close looks (below), one
-// line per band and score: the colour confidence alone, the contrast alone, the shipped fusion
-// and this fit.
-bool Evaluate(const Args& args, const std::array<double, 3>& w) {
+// line per band and score: the colour confidence alone, the contrast alone, this fit's thermal
+// classifier alone (without one: nan), the shipped fusion and this fit.
+bool Evaluate(const Args& args, const swarm::ThermalEvidence& fit) {
   std::vector<Sample> samples;
   if (!ReplaySamples(args, args.evaluate, &samples)) return false;
-  // The shipped fit from the source tree (this tool builds before the agent embeds it).
-  Result<yaml::Node> doc = yaml::ParseFile(SWARMBOX_THERMAL_EVIDENCE_FILE);
-  Result<swarm::ThermalEvidence> shipped =
-      doc ? swarm::ParseThermalEvidence(*doc) : Result<swarm::ThermalEvidence>(doc.error());
+  Result<swarm::ThermalEvidence> shipped = ShippedFromSource();
   if (!shipped) {
     std::fprintf(stderr, "swarmbox-fit-thermal: the shipped fit: %s\n", shipped.error().ToString().c_str());
     return false;
   }
-  const swarm::ThermalEvidence fit{w[0], w[1], w[2], args.radius_m};
-  const auto fused = [](const swarm::ThermalEvidence& e) {
-    return [e](const Sample& s) { return e.Fuse(1.0 / (1.0 + std::exp(-s.logit)), s.contrast_k); };
-  };
-  const auto colour = [](const Sample& s) { return s.logit; };
-  const auto contrast = [](const Sample& s) { return s.contrast_k; };
+  const std::optional<std::vector<double>> shipped_p = FusedScores(*shipped, &samples);
+  const std::optional<std::vector<double>> fit_p = FusedScores(fit, &samples);
+  if (!shipped_p || !fit_p) return false;
+  std::vector<double> colour, contrast, cnn;
+  for (const Sample& s : samples) {
+    colour.push_back(s.logit);
+    contrast.push_back(s.contrast_k);
+    cnn.push_back(fit.cnn_weight > 0 ? s.cnn_logit : std::nan(""));
+  }
   for (const bool close : {false, true}) {
     const auto keep = [close](const Sample& s) { return (s.altitude_m < 24.0) == close; };
     const auto people =
         std::count_if(samples.begin(), samples.end(), [&](const Sample& s) { return keep(s) && s.person; });
     const auto all = std::count_if(samples.begin(), samples.end(), keep);
     std::printf(
-        "evaluate=%s band=%s people=%td others=%td auc_colour=%.3f auc_contrast=%.3f auc_shipped=%.3f "
+        "evaluate=%s band=%s people=%td others=%td auc_colour=%.3f auc_contrast=%.3f auc_cnn=%.3f "
+        "auc_shipped=%.3f "
         "auc_fit=%.3f\n",
         args.evaluate.c_str(), close ? "close" : "search", people, all - people, Auc(samples, colour, keep),
-        Auc(samples, contrast, keep), Auc(samples, fused(*shipped), keep), Auc(samples, fused(fit), keep));
+        Auc(samples, contrast, keep), fit.cnn_weight > 0 ? Auc(samples, cnn, keep) : std::nan(""),
+        Auc(samples, *shipped_p, keep), Auc(samples, *fit_p, keep));
   }
   return true;
 }
@@ -413,38 +665,27 @@ bool Evaluate(const Args& args, const std::array<double, 3>& w) {
 int main(int argc, char** argv) {
   const std::optional<Args> args = ParseArgs(argc, argv);
   if (!args) return Usage();
-  const std::optional<std::vector<Sample>> samples = Candidates(*args);
+  std::optional<std::vector<Sample>> samples = Candidates(*args);
   if (!samples) return 1;
   if (!args->samples.empty() && !WriteSamples(args->samples, *samples)) {
     std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", args->samples.c_str());
     return 1;
   }
-  std::vector<double> pc, nc;
-  for (const Sample& s : *samples) (s.person ? pc : nc).push_back(s.contrast_k);
-  if (pc.size() < 20 || nc.size() < 20) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: too few candidates (%zu people, %zu others)\n", pc.size(),
-                 nc.size());
-    return 1;
-  }
-  auto both = [](const Sample& s) { return std::array<double, 3>{s.logit, s.contrast_k, 1.0}; };
-  auto colour = [](const Sample& s) { return std::array<double, 2>{s.logit, 1.0}; };
-  const std::array<double, 3> w = Fit<3>(*samples, both);
-  const std::array<double, 2> w_colour = Fit<2>(*samples, colour);
-  if (!(w[0] > 0 && w[1] > 0)) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: the fit's weights are %g, %g: not a usable fusion\n", w[0],
-                 w[1]);
-    return 1;
-  }
-  const double loss = LogLoss<3>(*samples, w, both), loss_colour = LogLoss<2>(*samples, w_colour, colour);
-  if (!WriteFit(*args, w, pc.size(), nc.size(), loss, loss_colour, pc, nc)) {
+  std::optional<std::string> onnx;
+  if (!args->cnn.empty() && !(onnx = TrainCnn(*args, &*samples))) return 1;
+  const std::optional<Fitted> fit = FitEvidence(*args, *samples, onnx);
+  if (!fit) return 1;
+  if (!WriteFit(*args, *fit)) {
     std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", args->out.c_str());
     return 1;
   }
+  const swarm::ThermalEvidence& e = fit->evidence;
   std::printf(
-      "fit=thermal seed=%llu scenes=%d people=%zu others=%zu colour_weight=%.4f slope_per_k=%.4f bias=%.4f "
-      "log_loss=%.4f log_loss_colour_alone=%.4f\n",
-      static_cast<unsigned long long>(args->seed), args->scenes, pc.size(), nc.size(), w[0], w[1], w[2], loss,
-      loss_colour);
-  if (!args->evaluate.empty() && !Evaluate(*args, w)) return 1;
+      "fit=thermal seed=%llu scenes=%d people=%zu others=%zu colour_weight=%.4f slope_per_k=%.4f "
+      "cnn_weight=%.4f "
+      "bias=%.4f log_loss=%.4f log_loss_colour_alone=%.4f\n",
+      static_cast<unsigned long long>(args->seed), args->scenes, fit->people, fit->others, e.colour_weight,
+      e.slope_per_k, e.cnn_weight, e.bias, fit->loss, fit->loss_colour);
+  if (!args->evaluate.empty() && !Evaluate(*args, e)) return 1;
   return 0;
 }

@@ -8,7 +8,10 @@
 namespace swarmbox::swarm {
 
 VictimPerception::VictimPerception(const PerceptionParams& params)
-    : params_(params), detector_(params.detector), queue_(params.latency_s, params.queue_capacity) {
+    : params_(params),
+      detector_(params.detector),
+      thermal_(params.thermal),
+      queue_(params.latency_s, params.queue_capacity) {
   blobs_.reserve(32);
 }
 
@@ -31,9 +34,7 @@ int VictimPerception::ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& 
     if (!p) continue;
     double confidence = b.confidence;
     if (thermal != nullptr) {
-      if (const std::optional<double> c = ThermalContrastAt(*thermal, *p, params_.thermal.radius_m)) {
-        confidence = params_.thermal.Fuse(confidence, *c);
-      }
+      confidence = thermal_.Apply(confidence, *thermal, *p);
       if (confidence < params_.min_confidence) continue;
     }
     GroundDetection d;

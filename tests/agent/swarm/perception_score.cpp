@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <utility>
@@ -88,15 +89,12 @@ PerceptionScore ScorePerception(const std::vector<Scene>& scenes, const Percepti
 namespace {
 
 // The blobs' confidences moved by the thermal evidence at their ground points (VictimPerception's
-// rule), most confident first again.
-void WithThermalEvidence(const Scene& s, const ThermalEvidence& evidence, std::vector<ImageBlob>* blobs) {
+// rule, ThermalFusion), most confident first again.
+void WithThermalEvidence(const Scene& s, ThermalFusion& fusion, std::vector<ImageBlob>* blobs) {
   const ThermalView view = perception_scenes::ThermalViewOf(*s.thermal);
   for (ImageBlob& b : *blobs) {
     const std::optional<Vector3d> g = PixelToGround(b.centroid_px, s.intrinsics, s.true_pose, 0.0);
-    if (!g) continue;
-    const std::optional<double> c = ThermalContrastAt(view, *g, evidence.radius_m);
-    if (!c) continue;
-    b.confidence = evidence.Fuse(b.confidence, *c);
+    if (g) b.confidence = fusion.Apply(b.confidence, view, *g);
   }
   std::stable_sort(blobs->begin(), blobs->end(),
                    [](const ImageBlob& a, const ImageBlob& b) { return a.confidence > b.confidence; });
@@ -111,13 +109,15 @@ DetectionCurve ScoreDetections(const std::vector<Scene>& scenes, VictimDetector&
   std::vector<std::pair<double, int>> ranked;  // (confidence, 1 true / 0 false positive)
   std::vector<ImageBlob> blobs;
   double seconds = 0;
+  std::optional<ThermalFusion> fusion;
+  if (thermal != nullptr) fusion.emplace(*thermal);
   for (const Scene& s : scenes) {
     ++curve.scenes;
     const cv::Mat bgr(s.image.height_px, s.image.width_px, CV_8UC3, const_cast<std::uint8_t*>(s.image.bgr.data()));
     const auto t0 = std::chrono::steady_clock::now();
     detector.Detect(bgr, s.intrinsics, s.true_pose, 0.0, &blobs);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (thermal != nullptr && s.thermal) WithThermalEvidence(s, *thermal, &blobs);
+    if (fusion && s.thermal) WithThermalEvidence(s, *fusion, &blobs);
     for (const SceneVictim& v : s.victims) curve.persons += v.visible_fraction >= must_fraction ? 1 : 0;
     std::vector<bool> matched(s.victims.size(), false);
     std::vector<double> best_confidence(s.victims.size(), 0.0);

@@ -54,9 +54,9 @@ class VictimPerception {
   // with one, where it meets the surface's heights (PixelToSurface: a person on a rubble slab seen
   // obliquely is not pushed height x tan(off-nadir angle) beyond it).
   // With `thermal` (a thermal frame taken with this one, its estimated pose), a candidate the
-  // thermal camera sees (its contrast defined: ThermalContrastAt) gets the confidence of both,
-  // params.thermal.Fuse(confidence, contrast); one it does not see (the thermal camera's view is
-  // narrower) keeps the colour detector's.
+  // thermal camera sees (its contrast defined: ThermalContrastAt) gets the confidence of both
+  // (ThermalFusion: the contrast and, with the evidence's classifier, its logit on the patch);
+  // one it does not see (the thermal camera's view is narrower) keeps the colour detector's.
   int ProcessFrame(const cv::Mat& bgr, const PinholeIntrinsics& k, const OpticalPose& camera_pose,
                    double capture_time_s, const GroundHeightSource* surface = nullptr,
                    const ThermalView* thermal = nullptr);
@@ -69,6 +69,7 @@ class VictimPerception {
  private:
   PerceptionParams params_;
   VictimDetector detector_;
+  ThermalFusion thermal_;
   LatencyQueue queue_;
   std::vector<ImageBlob> blobs_;
 };
