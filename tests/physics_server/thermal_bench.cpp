@@ -2,7 +2,8 @@
 // ThermalRenderer) tells apart on the mission's generated rubble fields, and what a frame costs.
 //   suite=thermal altitude_m=18 light=sun people=... lookalikes=... person_contrast_p10_k=...
 //     person_contrast_p50_k=... lookalike_contrast_p50_k=... lookalike_contrast_p90_k=...
-//     auc_people_vs_distractors=... auc_people_vs_lookalikes=... ms_per_frame=...
+//     auc_people_vs_distractors=... auc_people_vs_lookalikes=... auc_cnn_people_vs_lookalikes=...
+//     ms_per_frame=... ms_per_classification=...
 // Worlds: --worlds (20) rubble fields as trials/sar_rubble.yaml generates them (160 x 160 m, 4
 // people, 30 obstacles, 25 distractors; seeds from --seed, 1), with their own time of day and
 // overcast; light=sun: 9-15 h under less than half cloud, light=dim the rest. Each person and
@@ -13,10 +14,15 @@
 // Lookalikes: backpacks and debris, what the RGB detector's false victims were on rubble20
 // (BENCHMARKS.md, "Where the false victims are"). AUC: the share of (person, thing) pairs in
 // which the person has the larger contrast. A frame's cost is the process's CPU time.
+// The agent's thermal classifier (agent/swarm thermal_evidence.hpp, the shipped network) scores the
+// patch at each person's and thing's ground point in the same frames: auc_cnn_people_vs_lookalikes
+// and ms_per_classification (CPU time of one ThermalClassifier::Logit, the patch's resampling
+// included).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <memory>
 #include <numbers>
 #include <random>
 #include <string>
@@ -26,10 +32,12 @@
 #include <opencv2/imgproc.hpp>
 
 #include "bench.hpp"
+#include "perception_scenes.hpp"
 #include "swarmbox/airframe/thermal_spec.hpp"
 #include "swarmbox/common/yaml.hpp"
 #include "swarmbox/physics/thermal_renderer.hpp"
 #include "swarmbox/physics/world_config.hpp"
+#include "swarmbox/swarm/thermal_evidence.hpp"
 #include "swarmbox/worlds/generator.hpp"
 
 namespace {
@@ -84,9 +92,22 @@ double Auc(const std::vector<double>& people, const std::vector<double>& things)
 
 struct Tally {
   std::vector<double> people, lookalikes, distractors;
-  double render_s = 0;
-  int frames = 0;
+  std::vector<double> people_cnn, lookalikes_cnn;  // the classifier's logits
+  double render_s = 0, cnn_s = 0;
+  int frames = 0, classified = 0;
 };
+
+// The classifier's logit on the patch at ground point (x, y) of `view` into `out`, its cost into
+// the tally; nothing when the patch leaves the frame.
+void Classify(swarm::ThermalClassifier& classifier, const swarm::ThermalView& view, double x, double y,
+              Tally* t, std::vector<double>* out) {
+  const double t0 = CpuS();
+  cv::Mat patch;
+  if (!swarm::ThermalPatchAt(view, Eigen::Vector3d(x, y, 0), &patch)) return;
+  out->push_back(classifier.Logit(patch));
+  t->cnn_s += CpuS() - t0;
+  ++t->classified;
+}
 
 Pose NadirPose(double x, double y, double alt, double yaw) {
   return Pose{Vec3{x, y, alt}, Quat{std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)}};
@@ -101,6 +122,17 @@ int RunThermalBench(const bench::Args& args) {
   auto spec = airframe::ParseThermalSpec(doc->Find("thermal"));
   if (!spec) {
     std::fprintf(stderr, "thermal bench: %s\n", spec.error().ToString().c_str());
+    return 1;
+  }
+  const swarm::ThermalEvidence& evidence = swarm::ShippedThermalEvidence();
+  if (evidence.cnn_onnx == nullptr) {
+    std::fprintf(stderr, "thermal bench: the shipped thermal evidence has no classifier\n");
+    return 1;
+  }
+  Result<std::unique_ptr<swarm::ThermalClassifier>> classifier =
+      swarm::ThermalClassifier::FromOnnx(*evidence.cnn_onnx);
+  if (!classifier) {
+    std::fprintf(stderr, "thermal bench: %s\n", classifier.error().ToString().c_str());
     return 1;
   }
   const int worlds_n = static_cast<int>(args.GetInt("worlds", args.quick ? 2 : 20));
@@ -153,6 +185,7 @@ int RunThermalBench(const bench::Args& args) {
           if (p.id != v.id || p.visible_fraction < 0.5) continue;
           const double c = Contrast(img, p.box_px, std::max(6, p.box_px.width / 2));
           if (!std::isnan(c)) t.people.push_back(c);
+          Classify(**classifier, perception_scenes::ThermalViewOf(img), v.x_m, v.y_m, &t, &t.people_cnn);
         }
         if (!png.empty() && w < 2) {
           cv::Mat k(img.height_px, img.width_px, CV_16U, img.centikelvin.data()), view;
@@ -181,8 +214,10 @@ int RunThermalBench(const bench::Args& args) {
         const double c = Contrast(img, box, std::max(6, half));
         if (std::isnan(c)) continue;
         t.distractors.push_back(c);
-        if (d.kind == DistractorKind::kBackpack || d.kind == DistractorKind::kDebris)
+        if (d.kind == DistractorKind::kBackpack || d.kind == DistractorKind::kDebris) {
           t.lookalikes.push_back(c);
+          Classify(**classifier, perception_scenes::ThermalViewOf(img), d.x_m, d.y_m, &t, &t.lookalikes_cnn);
+        }
       }
     }
   }
@@ -194,11 +229,12 @@ int RunThermalBench(const bench::Args& args) {
           "suite=thermal altitude_m=%.0f light=%s worlds=%d people=%zu lookalikes=%zu distractors=%zu "
           "person_contrast_p10_k=%.2f person_contrast_p50_k=%.2f lookalike_contrast_p50_k=%.2f "
           "lookalike_contrast_p90_k=%.2f auc_people_vs_distractors=%.3f auc_people_vs_lookalikes=%.3f "
-          "ms_per_frame=%.2f build_ms=%.0f\n",
+          "auc_cnn_people_vs_lookalikes=%.3f ms_per_frame=%.2f ms_per_classification=%.2f build_ms=%.0f\n",
           altitudes[a], s ? "sun" : "dim", worlds_n, t.people.size(), t.lookalikes.size(),
           t.distractors.size(), Quantile(t.people, 0.1), Quantile(t.people, 0.5), Quantile(t.lookalikes, 0.5),
           Quantile(t.lookalikes, 0.9), Auc(t.people, t.distractors), Auc(t.people, t.lookalikes),
-          t.render_s / t.frames * 1e3, build_s / worlds_n * 1e3);
+          Auc(t.people_cnn, t.lookalikes_cnn), t.render_s / t.frames * 1e3,
+          t.classified ? t.cnn_s / t.classified * 1e3 : std::nan(""), build_s / worlds_n * 1e3);
     }
   }
   std::fflush(stdout);
