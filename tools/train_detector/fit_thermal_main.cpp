@@ -7,9 +7,10 @@
 //                        [--radius-m R (0.7)] [--min-altitude M (15)] [--max-altitude M (35)]
 //                        [--near-victims F (0.75)] [--near-distractors F (0)] [--replay DIR]
 //                        [--evaluate DIR (the AUCs on other flown trials' frames: Evaluate)]
-//                        [--samples CSV (every candidate: logit, contrast_k, person, altitude_m, x_m, y_m)]
+//                        [--samples CSV (every candidate: logit, contrast_k, person, altitude_m, x_m, y_m,
+//                         cnn_logit)]
 //                        [--cnn train_thermal_cnn.py --cnn-work DIR [--cnn-epochs N (12)]
-//                         [--cnn-seed N (1)] [--python PATH (/usr/bin/python3)]]
+//                         [--cnn-seed N (1)] [--python PATH (/usr/bin/python3)] [--thermal-views N (0)]]
 //
 // --replay DIR adds the candidates on flown trials' own frames (DIR: a trial folder or an
 // experiment's; perception_scenes::ReplayTrial renders each scout's colour and thermal frames
@@ -27,6 +28,11 @@
 // ThermalContrastAt's (the agent's own code), candidates the thermal frame does not see are left
 // out. The fit: a logistic regression of person-or-not on (logit of the detector's confidence,
 // contrast, 1) by Newton's method: the fused confidence is its probability.
+//
+// --thermal-views N (with --cnn): the classifier also trains on the patches of N thermal frames of
+// generated rubble fields at every person, distractor and some ground points in them
+// (perception_scenes::RenderThermalPatches: far more people and look-alikes, in more surroundings,
+// than the colour detector's candidates hold); the fusion is not fitted on them.
 //
 // --cnn SCRIPT: the thermal classifier too (thermal_evidence.hpp ThermalClassifier). Each
 // candidate's thermal patch (ThermalPatchAt, the agent's own code) goes into DIR/thermal_patches.bin,
@@ -81,6 +87,8 @@ struct Sample {
   int group = 0;      // its world (scenes) or trial (replays): the CNN's split (Calibration)
   std::vector<float> patch;  // ThermalPatchAt's (empty: not in the frame)
   double cnn_logit = 0.0;    // the thermal classifier's on it (0 without one, as the agent takes it)
+  bool thermal_only = false;  // --thermal-views: a patch of a thermal frame alone (no colour
+                              // candidate): the classifier trains on it, the fusion does not fit on it
 };
 
 // The calibration split: every fourth world or trial, never trained on by the thermal CNN; the
@@ -189,7 +197,8 @@ int Usage() {
       "         [--max-altitude M] [--near-victims F] [--near-distractors F] [--replay DIR] [--evaluate "
       "DIR]\n"
       "         [--samples CSV] [--cnn SCRIPT --cnn-work DIR [--cnn-epochs N] [--cnn-seed N] [--python "
-      "PATH]]\n");
+      "PATH]\n"
+      "         [--thermal-views N]]\n");
   return 2;
 }
 
@@ -210,6 +219,7 @@ struct Args {
   std::string python = "/usr/bin/python3";
   int cnn_epochs = 12;
   int cnn_seed = 1;
+  int thermal_views = 0;  // --thermal-views N: patches of N thermal frames too (ThermalViewSamples)
 };
 
 // One option's value into `args`; false for an unknown option.
@@ -233,6 +243,7 @@ bool SetOption(const std::string& a, const std::string& v, Args* args) {
       {"--python", [&] { args->python = v; }},
       {"--cnn-epochs", [&] { args->cnn_epochs = n(); }},
       {"--cnn-seed", [&] { args->cnn_seed = n(); }},
+      {"--thermal-views", [&] { args->thermal_views = n(); }},
   };
   for (const auto& [name, set] : options) {
     if (a == name) {
@@ -253,7 +264,8 @@ std::optional<Args> ParseArgs(int argc, char** argv) {
       !(args.near_distractors >= 0 && args.near_distractors <= 1) ||
       !(args.near_victims >= 0 && args.near_victims <= 1) ||
       !(args.min_altitude_m > 0 && args.min_altitude_m <= args.max_altitude_m) ||
-      (!args.cnn.empty() && (args.cnn_work.empty() || args.cnn_epochs < 1)))
+      (!args.cnn.empty() && (args.cnn_work.empty() || args.cnn_epochs < 1)) || args.thermal_views < 0 ||
+      (args.thermal_views > 0 && args.cnn.empty()))
     return std::nullopt;
   return args;
 }
@@ -305,19 +317,6 @@ bool WriteFit(const Args& args, const Fitted& fit) {
   if (e.cnn_weight > 0)
     f << "  # the classifier: " << std::filesystem::path(args.cnn).filename().string() << " --seed "
       << args.cnn_seed << " --epochs " << args.cnn_epochs << " on the training split\n";
-  return static_cast<bool>(f);
-}
-
-// The candidates as CSV, one a line; false when the file cannot be written.
-bool WriteSamples(const std::string& path, const std::vector<Sample>& samples) {
-  std::ofstream f(path);
-  f << "logit,contrast_k,person,altitude_m,x_m,y_m\n";
-  char line[160];
-  for (const Sample& s : samples) {
-    std::snprintf(line, sizeof line, "%.4f,%.3f,%d,%.2f,%.2f,%.2f\n", s.logit, s.contrast_k, s.person ? 1 : 0,
-                  s.altitude_m, s.x_m, s.y_m);
-    f << line;
-  }
   return static_cast<bool>(f);
 }
 
@@ -381,6 +380,28 @@ bool ReplaySamples(const Args& args, const std::string& dir, std::vector<Sample>
   return true;
 }
 
+// --thermal-views: the patches of perception_scenes::RenderThermalPatches (worlds from seed + 1,
+// views from 16-32 m) as thermal-only samples, their worlds' groups after kThermalGroup; false and
+// a message on failure.
+constexpr int kThermalGroup = 2000000;
+bool ThermalViewSamples(const Args& args, std::vector<Sample>* out) {
+  Result<std::vector<perception_scenes::ThermalPatch>> patches =
+      perception_scenes::RenderThermalPatches({.seed = args.seed + 1, .views = args.thermal_views});
+  if (!patches) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: %s\n", patches.error().ToString().c_str());
+    return false;
+  }
+  std::size_t people = 0;
+  for (perception_scenes::ThermalPatch& p : *patches) {
+    Sample s{0.0, 0.0, p.person, 0.0, 0.0, 0.0, kThermalGroup + p.world, std::move(p.patch), 0.0, true};
+    people += p.person ? 1 : 0;
+    out->push_back(std::move(s));
+  }
+  std::fprintf(stderr, "swarmbox-fit-thermal: %d thermal views: %zu patches (%zu people)\n",
+               args.thermal_views, patches->size(), people);
+  return true;
+}
+
 // The shipped detector's candidates on the rendered scenes (nullopt and a message on failure).
 std::optional<std::vector<Sample>> Candidates(const Args& args) {
   const std::shared_ptr<const swarm::VictimDetectorModel> model = swarm::ShippedDetectorModel();
@@ -417,6 +438,7 @@ std::optional<std::vector<Sample>> Candidates(const Args& args) {
     }
   }
   if (!args.replay.empty() && !ReplaySamples(args, args.replay, &samples)) return std::nullopt;
+  if (args.thermal_views > 0 && !ThermalViewSamples(args, &samples)) return std::nullopt;
   return samples;
 }
 
@@ -516,19 +538,24 @@ std::optional<std::string> TrainCnn(const Args& args, std::vector<Sample>* sampl
   return onnx;
 }
 
-// The fusion's weights on (logit, contrast, the classifier's logit, 1) into `e` and its log-loss;
-// without the contrast when its weight comes out <= 0 (the classifier holds all it tells).
+// The fusion's weights on (logit, contrast, the classifier's logit, 1) into `e` and its log-loss.
+// A term whose weight comes out <= 0 is dropped (its weight 0) and the rest refitted: the
+// classifier can hold all the colour confidence or the contrast tell about these candidates.
 double FitWithClassifier(const std::vector<Sample>& samples, swarm::ThermalEvidence* e) {
-  auto all4 = [](const Sample& s) { return std::array<double, 4>{s.logit, s.contrast_k, s.cnn_logit, 1.0}; };
-  const std::array<double, 4> w = Fit<4>(samples, all4);
-  if (w[1] > 0) {
-    e->colour_weight = w[0], e->slope_per_k = w[1], e->cnn_weight = w[2], e->bias = w[3];
-    return LogLoss<4>(samples, w, all4);
+  std::array<bool, 2> use{true, true};  // the colour logit, the contrast
+  for (;;) {
+    auto features = [&use](const Sample& s) {
+      return std::array<double, 4>{use[0] ? s.logit : 0.0, use[1] ? s.contrast_k : 0.0, s.cnn_logit, 1.0};
+    };
+    const std::array<double, 4> w = Fit<4>(samples, features);
+    const bool drop_colour = use[0] && !(w[0] > 0), drop_contrast = use[1] && !(w[1] > 0);
+    if (!drop_colour && !drop_contrast) {
+      e->colour_weight = use[0] ? w[0] : 0.0, e->slope_per_k = use[1] ? w[1] : 0.0;
+      e->cnn_weight = w[2], e->bias = w[3];
+      return LogLoss<4>(samples, w, features);
+    }
+    use[0] = use[0] && !drop_colour, use[1] = use[1] && !drop_contrast;
   }
-  auto no_contrast = [](const Sample& s) { return std::array<double, 3>{s.logit, s.cnn_logit, 1.0}; };
-  const std::array<double, 3> v = Fit<3>(samples, no_contrast);
-  e->colour_weight = v[0], e->slope_per_k = 0.0, e->cnn_weight = v[1], e->bias = v[2];
-  return LogLoss<3>(samples, v, no_contrast);
 }
 
 // The fusion fitted on `all` (with `onnx`: the calibration split alone, with the classifier's
@@ -537,7 +564,7 @@ std::optional<Fitted> FitEvidence(const Args& args, const std::vector<Sample>& a
                                   const std::optional<std::string>& onnx) {
   std::vector<Sample> samples;
   std::copy_if(all.begin(), all.end(), std::back_inserter(samples),
-               [&](const Sample& s) { return !onnx || Calibration(s); });
+               [&](const Sample& s) { return !s.thermal_only && (!onnx || Calibration(s)); });
   Fitted fit;
   for (const Sample& s : samples)
     (s.person ? fit.person_contrast : fit.other_contrast).push_back(s.contrast_k);
@@ -561,7 +588,7 @@ std::optional<Fitted> FitEvidence(const Args& args, const std::vector<Sample>& a
     fit.loss = LogLoss<3>(samples, w, both);
     e.colour_weight = w[0], e.slope_per_k = w[1], e.bias = w[2];
   }
-  if (!(e.colour_weight > 0 && (e.slope_per_k > 0 || e.cnn_weight > 0))) {
+  if (!(e.cnn_weight > 0 || (e.colour_weight > 0 && e.slope_per_k > 0))) {
     std::fprintf(stderr, "swarmbox-fit-thermal: the fit's weights are %g, %g, %g: not a usable fusion\n",
                  e.colour_weight, e.slope_per_k, e.cnn_weight);
     return std::nullopt;
@@ -659,6 +686,30 @@ bool Evaluate(const Args& args, const swarm::ThermalEvidence& fit) {
   return true;
 }
 
+// --samples: the candidates as CSV, one a line, with the classifier's logit (--cnn: the new
+// network's; else the shipped one's, when it has one); false and a message on failure.
+bool WriteSamples(const Args& args, std::vector<Sample>* all) {
+  if (args.cnn.empty()) {
+    Result<swarm::ThermalEvidence> shipped = ShippedFromSource();
+    if (!shipped) {
+      std::fprintf(stderr, "swarmbox-fit-thermal: the shipped fit: %s\n", shipped.error().ToString().c_str());
+      return false;
+    }
+    if (shipped->cnn_weight > 0 && !ScoreSamples(*shipped->cnn_onnx, all)) return false;
+  }
+  std::ofstream f(args.samples);
+  f << "logit,contrast_k,person,altitude_m,x_m,y_m,cnn_logit\n";
+  char line[192];
+  for (const Sample& s : *all) {
+    if (s.thermal_only) continue;
+    std::snprintf(line, sizeof line, "%.4f,%.3f,%d,%.2f,%.2f,%.2f,%.3f\n", s.logit, s.contrast_k,
+                  s.person ? 1 : 0, s.altitude_m, s.x_m, s.y_m, s.cnn_logit);
+    f << line;
+  }
+  if (!f) std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", args.samples.c_str());
+  return static_cast<bool>(f);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -666,12 +717,9 @@ int main(int argc, char** argv) {
   if (!args) return Usage();
   std::optional<std::vector<Sample>> samples = Candidates(*args);
   if (!samples) return 1;
-  if (!args->samples.empty() && !WriteSamples(args->samples, *samples)) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", args->samples.c_str());
-    return 1;
-  }
   std::optional<std::string> onnx;
   if (!args->cnn.empty() && !(onnx = TrainCnn(*args, &*samples))) return 1;
+  if (!args->samples.empty() && !WriteSamples(*args, &*samples)) return 1;
   const std::optional<Fitted> fit = FitEvidence(*args, *samples, onnx);
   if (!fit) return 1;
   if (!WriteFit(*args, *fit)) {

@@ -438,6 +438,102 @@ swarm::ThermalView ThermalViewOf(const physics::ThermalImage& t) {
            Eigen::Quaterniond(pose.attitude.w, pose.attitude.x, pose.attitude.y, pose.attitude.z)}};
 }
 
+namespace {
+
+// The patch at ground point (x, y) into *out when it lies in the frame.
+void AddThermalPatch(const swarm::ThermalView& view, double x, double y, bool person, int world,
+                     std::vector<ThermalPatch>* out) {
+  cv::Mat patch;
+  if (!swarm::ThermalPatchAt(view, Vector3d(x, y, 0.0), &patch)) return;
+  out->push_back({std::vector<float>(patch.begin<float>(), patch.end<float>()), person, world});
+}
+
+// A point just outside obstacle `b`'s footprint (along one of its sides, up to 1 m out).
+Vector2d BesideObstacle(std::mt19937_64& rng, const physics::ObstacleBox& b) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double side = std::floor(unit(rng) * 4), along = unit(rng) - 0.5, out = 0.5 + 0.5 * unit(rng);
+  const double hx = b.size_m.x / 2, hy = b.size_m.y / 2;
+  const Vector2d local = side < 1   ? Vector2d(hx + out, 2 * along * hy)
+                         : side < 2 ? Vector2d(-hx - out, 2 * along * hy)
+                         : side < 3 ? Vector2d(2 * along * hx, hy + out)
+                                    : Vector2d(2 * along * hx, -hy - out);
+  const double c = std::cos(b.yaw_rad), s = std::sin(b.yaw_rad);
+  return {b.center_m.x + c * local.x() - s * local.y(), b.center_m.y + s * local.x() + c * local.y()};
+}
+
+// Where a view of `w` is centred: near a person, a distractor, an obstacle's edge, or anywhere.
+Vector2d ViewCentre(std::mt19937_64& rng, const physics::WorldConfig& w) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0), near(-4.0, 4.0);
+  const double pick = unit(rng);
+  const auto any = [&](std::size_t n) {
+    return static_cast<std::size_t>(unit(rng) * static_cast<double>(n)) % n;
+  };
+  if (pick < 0.4 && !w.victims.empty()) {
+    const physics::Victim& v = w.victims[any(w.victims.size())];
+    return {v.x_m + near(rng), v.y_m + near(rng)};
+  }
+  if (pick < 0.7 && !w.distractors.empty()) {
+    const physics::Distractor& d = w.distractors[any(w.distractors.size())];
+    return {d.x_m + near(rng), d.y_m + near(rng)};
+  }
+  if (pick < 0.9 && !w.obstacles.empty()) return BesideObstacle(rng, w.obstacles[any(w.obstacles.size())]);
+  const double half = 0.5 * SarRubbleSpec().size_m[0] - 10.0;
+  return {(2 * unit(rng) - 1) * half, (2 * unit(rng) - 1) * half};
+}
+
+// One frame's patches (see RenderThermalPatches).
+void FramePatches(std::mt19937_64& rng, const physics::WorldConfig& w, const physics::ThermalImage& img,
+                  const std::vector<physics::VisiblePerson>& people, const ThermalPatchParams& p, int world,
+                  std::vector<ThermalPatch>* out) {
+  const swarm::ThermalView view = ThermalViewOf(img);
+  std::normal_distribution<double> error(0.0, p.geolocation_sigma_m);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const physics::VisiblePerson& seen : people) {
+    if (seen.visible_fraction < 0.5) continue;
+    for (const physics::Victim& v : w.victims) {
+      if (v.id == seen.id) AddThermalPatch(view, v.x_m + error(rng), v.y_m + error(rng), true, world, out);
+    }
+  }
+  for (const physics::Distractor& d : w.distractors) AddThermalPatch(view, d.x_m, d.y_m, false, world, out);
+  const Vector2d nadir(img.camera_pose.position_m.x, img.camera_pose.position_m.y);
+  const Vector2d ground = nadir + Vector2d((unit(rng) - 0.5) * 12.0, (unit(rng) - 0.5) * 10.0);
+  AddThermalPatch(view, ground.x(), ground.y(), false, world, out);
+  if (!w.obstacles.empty()) {
+    const auto i =
+        static_cast<std::size_t>(unit(rng) * static_cast<double>(w.obstacles.size())) % w.obstacles.size();
+    const Vector2d beside = BesideObstacle(rng, w.obstacles[i]);
+    AddThermalPatch(view, beside.x(), beside.y(), false, world, out);
+  }
+}
+
+}  // namespace
+
+Result<std::vector<ThermalPatch>> RenderThermalPatches(const ThermalPatchParams& p) {
+  Result<physics::Airframe> x500 = CameraAirframe();
+  if (!x500) return x500.error();
+  std::mt19937_64 rng(p.seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<ThermalPatch> out;
+  physics::ThermalImage img;
+  std::vector<physics::VisiblePerson> people;
+  for (int first = 0; first < p.views; first += p.views_per_world) {
+    Result<physics::WorldConfig> w = GeneratedWorld(rng, SarRubbleSpec());
+    if (!w) return w.error();
+    physics::ThermalRenderer renderer(*w);
+    const int world = first / p.views_per_world;
+    for (int i = first; i < std::min(p.views, first + p.views_per_world); ++i) {
+      const Vector2d c = ViewCentre(rng, *w);
+      const double alt = p.min_altitude_m + (p.max_altitude_m - p.min_altitude_m) * unit(rng);
+      const double yaw = 2 * std::numbers::pi * unit(rng);
+      const physics::Pose body{physics::Vec3{c.x(), c.y(), alt},
+                               physics::Quat{std::cos(yaw / 2), 0, 0, std::sin(yaw / 2)}};
+      renderer.Render(body, x500->thermal, rng(), &img, &people);
+      FramePatches(rng, *w, img, people, p, world, &out);
+    }
+  }
+  return out;
+}
+
 Result<std::vector<Scene>> RenderScenes(const SceneSetParams& p) {
   Result<physics::Airframe> x500 = CameraAirframe();
   if (!x500) return x500.error();

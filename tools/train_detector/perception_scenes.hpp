@@ -135,6 +135,29 @@ Result<Scene> RenderView(const physics::WorldConfig& world, const Eigen::Vector2
 Result<std::vector<Scene>> RenderTiltedScenes(const SceneSetParams& params, double differential,
                                               double burst_s);
 
+// Thermal patches for the thermal classifier (swarmbox-fit-thermal --thermal-views): nadir frames
+// of the x500's thermal camera (physics::ThermalRenderer, airframe `thermal:`) over generated rubble
+// fields (SarRubbleSpec, a new world every views_per_world frames, its seed drawn from `seed`), from
+// min_altitude_m to max_altitude_m at a random yaw, each centred within 4 m of a person (40 % of
+// the views), of a distractor (30 %), beside an obstacle (20 %) or anywhere (10 %). In each frame the patch
+// (swarm::ThermalPatchAt) at each person at least half visible (a positive; placed off the person
+// by a geolocation error of geolocation_sigma_m per axis), at each distractor, and at two ground
+// points, one beside an obstacle (negatives); patches leaving the frame are skipped. Many more
+// people and look-alikes, in more surroundings, than the colour detector's candidates hold.
+struct ThermalPatchParams {
+  std::uint64_t seed = 1;
+  int views = 4000;
+  int views_per_world = 40;
+  double min_altitude_m = 16.0, max_altitude_m = 32.0;
+  double geolocation_sigma_m = 0.4;
+};
+struct ThermalPatch {
+  std::vector<float> patch;  // kThermalPatchPx squared, ThermalPatchAt's
+  bool person = false;
+  int world = 0;  // the index of its world in the set
+};
+Result<std::vector<ThermalPatch>> RenderThermalPatches(const ThermalPatchParams& params);
+
 // A flown trial's camera frames, rendered again (`swarmbox-bench perception --replay RUN`): the
 // trial folder's world.yaml and truth.csv (every drone's pose and body rates over simulated time)
 // give each camera drone's frames as its camera took them in flight, through the same

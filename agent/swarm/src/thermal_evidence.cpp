@@ -170,9 +170,13 @@ Result<ThermalEvidence> ParseThermalEvidence(const yaml::Node& root) {
   if (!(e.radius_m > 0.1 && e.radius_m < 3)) {
     return Error(ErrorCode::kInvalidArgument, "thermal evidence: radius_m must be within 0.1..3", n->Where());
   }
-  if (!(e.colour_weight > 0 && e.colour_weight < 5) || !(std::abs(e.bias) < 20)) {
-    return Error(ErrorCode::kInvalidArgument,
-                 "thermal evidence: colour_weight must be within 0..5 and |bias| below 20", n->Where());
+  // With a classifier the colour confidence may add nothing (weight 0); without one it must count.
+  if (!(e.colour_weight >= 0 && e.colour_weight < 5) || !(e.colour_weight > 0 || e.cnn_weight > 0) ||
+      !(std::abs(e.bias) < 20)) {
+    return Error(
+        ErrorCode::kInvalidArgument,
+        "thermal evidence: colour_weight must be within 0..5 (0 only with a classifier) and |bias| below 20",
+        n->Where());
   }
   if (!(e.cnn_weight >= 0 && e.cnn_weight < 5) || (e.cnn_weight > 0) != !e.cnn_model.empty()) {
     return Error(ErrorCode::kInvalidArgument,
