@@ -4,6 +4,8 @@
 // the median geolocation error under 1 m at 30 m altitude.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "perception_score.hpp"
 
 namespace swarmbox::swarm {
@@ -107,6 +109,35 @@ TEST(PerceptionTilted, GeolocationMatchesTheRendererWhenTheCameraIsTilted) {
   ASSERT_GE(score.errors_m.size(), 30u);
   EXPECT_LT(score.median_error_m(), 0.3);  // [m] true pose: the pinhole model alone
   EXPECT_LT(score.p90_error_m(), 0.5);
+}
+
+// The thermal classifier's rendered patches (swarmbox-fit-thermal --thermal-views): people and
+// things in many worlds, each patch ThermalPatchAt's shape, a person's warmer than bare ground's
+// and the same seed giving the same set.
+TEST(PerceptionThermalPatches, PeopleAndThingsInEveryWorldTheSameForTheSameSeed) {
+  const perception_scenes::ThermalPatchParams params{.seed = 5, .views = 80, .views_per_world = 40};
+  Result<std::vector<perception_scenes::ThermalPatch>> a = perception_scenes::RenderThermalPatches(params);
+  ASSERT_TRUE(a.ok()) << a.error().ToString();
+  int people = 0, others = 0, second_world = 0;
+  double person_max = 0;
+  for (const perception_scenes::ThermalPatch& p : *a) {
+    ASSERT_EQ(p.patch.size(), static_cast<std::size_t>(kThermalPatchPx * kThermalPatchPx));
+    const double max = *std::max_element(p.patch.begin(), p.patch.end());
+    (p.person ? people : others) += 1;
+    if (p.person) person_max = std::max(person_max, max);
+    second_world += p.world == 1 ? 1 : 0;
+  }
+  EXPECT_GE(people, 10);
+  EXPECT_GE(others, 2 * people);
+  EXPECT_GT(second_world, 0);
+  EXPECT_GT(person_max, 0.3);  // a person 3 K or more over the ground around them
+  Result<std::vector<perception_scenes::ThermalPatch>> b = perception_scenes::RenderThermalPatches(params);
+  ASSERT_TRUE(b.ok());
+  ASSERT_EQ(a->size(), b->size());
+  for (std::size_t i = 0; i < a->size(); ++i) {
+    EXPECT_EQ((*a)[i].person, (*b)[i].person);
+    EXPECT_EQ((*a)[i].patch, (*b)[i].patch);
+  }
 }
 
 }  // namespace

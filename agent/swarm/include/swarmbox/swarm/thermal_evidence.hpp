@@ -105,7 +105,6 @@ class ThermalFusion {
   // Aborts when the evidence's classifier does not load (the shipped one is tested to).
   explicit ThermalFusion(const ThermalEvidence& evidence);
   double Apply(double confidence, const ThermalView& view, const Eigen::Vector3d& point_m);
-  const ThermalEvidence& evidence() const { return evidence_; }
 
  private:
   ThermalEvidence evidence_;
