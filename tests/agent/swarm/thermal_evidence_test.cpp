@@ -160,9 +160,8 @@ TEST(ThermalEvidence, TheFusionIsALogisticOfBothAndClampsTheContrast) {
 }
 
 // The shipped fit (models/thermal_evidence.yaml): a person's shape by the classifier is more likely
-// a person. Beside the classifier the colour confidence and the contrast fitted weights <= 0 on
-// the held-out candidates (tools/train_detector/README.md "A thermal classifier"), so they were
-// dropped: what the thermal frame shows decides a candidate it sees.
+// a person, and it weighs most (tools/train_detector/README.md "A thermal classifier"): what the
+// thermal frame shows decides a candidate it sees.
 TEST(ThermalEvidence, TheShippedFitSaysWhatLooksLikeAPersonInThermalIsMoreLikelyOne) {
   const ThermalEvidence& e = ShippedThermalEvidence();
   EXPECT_GE(e.slope_per_k, 0.0);
