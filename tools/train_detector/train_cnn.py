@@ -63,18 +63,23 @@ def read_patches(path):
 
 
 class PatchNet(nn.Module):
-    def __init__(self, px, widths=(16, 32, 64)):
+    """The blocks and the classifier above; in_channels 1 and dropout before the last layer for the
+    thermal classifier (train_thermal_cnn.py)."""
+
+    def __init__(self, px, widths=(16, 32, 64), in_channels=3, dropout=0.0):
         super().__init__()
         layers = []
-        channels = 3
+        channels = in_channels
         for width in widths:
             layers += [nn.Conv2d(channels, width, 3, padding=1, bias=False), nn.BatchNorm2d(width),
                        nn.ReLU(inplace=True), nn.MaxPool2d(2)]
             channels = width
         self.features = nn.Sequential(*layers)
         side = px // 8
-        self.classifier = nn.Sequential(nn.Flatten(), nn.Linear(channels * side * side, 32),
-                                        nn.ReLU(inplace=True), nn.Linear(32, 1))
+        head = [nn.Flatten(), nn.Linear(channels * side * side, 32), nn.ReLU(inplace=True)]
+        if dropout > 0:
+            head.append(nn.Dropout(dropout))
+        self.classifier = nn.Sequential(*head, nn.Linear(32, 1))
 
     def forward(self, x):
         return self.classifier(self.features(x))

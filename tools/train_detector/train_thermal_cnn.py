@@ -38,6 +38,8 @@ except ImportError:
                      "(apt-get install python3-torch) and use Debian's /usr/bin/python3\n")
     sys.exit(3)
 
+from train_cnn import PatchNet  # the same blocks (this script's folder is on sys.path)
+
 MAGIC = b"SWBTHERM"
 HEADER = struct.Struct("<8sIIQ")
 TRAINING, CALIBRATION = 0, 1
@@ -54,24 +56,6 @@ def read_patches(path):
     if len(data) != count:
         raise ValueError(f"{path}: {len(data)} records of {count}")
     return data["pixels"], data["label"], data["split"]
-
-
-class ThermalNet(nn.Module):
-    def __init__(self, px, widths=(16, 32, 64)):
-        super().__init__()
-        layers = []
-        channels = 1
-        for width in widths:
-            layers += [nn.Conv2d(channels, width, 3, padding=1, bias=False), nn.BatchNorm2d(width),
-                       nn.ReLU(inplace=True), nn.MaxPool2d(2)]
-            channels = width
-        self.features = nn.Sequential(*layers)
-        side = px // 8
-        self.classifier = nn.Sequential(nn.Flatten(), nn.Linear(channels * side * side, 32),
-                                        nn.ReLU(inplace=True), nn.Dropout(0.3), nn.Linear(32, 1))
-
-    def forward(self, x):
-        return self.classifier(self.features(x))
 
 
 def augment(x, generator, shift_px):
@@ -114,7 +98,7 @@ def train(args):
     print(f"train_thermal_cnn: {len(y[TRAINING])} training patches ({int(pos)} people), "
           f"{len(y[CALIBRATION])} calibration ({int(y[CALIBRATION].sum())} people)", flush=True)
     loss_fn = nn.BCEWithLogitsLoss(pos_weight=torch.tensor([neg / pos]), reduction="sum")
-    net = ThermalNet(px)
+    net = PatchNet(px, in_channels=1, dropout=0.3)
     opt = torch.optim.Adam(net.parameters(), lr=2e-3, weight_decay=1e-4)
     sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, T_max=args.epochs)
     gen = torch.Generator().manual_seed(args.seed)
