@@ -37,11 +37,12 @@
 // --cnn SCRIPT: the thermal classifier too (thermal_evidence.hpp ThermalClassifier). Each
 // candidate's thermal patch (ThermalPatchAt, the agent's own code) goes into DIR/thermal_patches.bin,
 // split by world or trial (every fourth one the calibration split, Calibration); the script
-// (train_thermal_cnn.py, torch) trains the network on the training split and writes it as
-// thermal_cnn.onnx beside --out; every candidate is scored by it through cv::dnn, and the fusion's
-// regression on (logit, contrast, the network's logit, 1) is fitted on the calibration split alone
-// (candidates the network never saw; without the contrast when its weight comes out <= 0). Refused seeds: the
-// perception bench's evaluation seeds and the shipped model's training and calibration seeds.
+// (train_thermal_cnn.py, torch) trains the network on the training split and writes it into DIR;
+// every candidate is scored by it through cv::dnn, and the fusion's regression on (logit,
+// contrast, the network's logit, 1) is fitted on the calibration split alone (candidates the
+// network never saw; a term whose weight fits <= 0 dropped); the network is copied beside --out as
+// thermal_cnn.onnx once the fit is usable. Refused seeds: the perception bench's evaluation seeds
+// and the shipped model's training and calibration seeds.
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -517,13 +518,13 @@ bool ScoreSamples(const std::string& onnx, std::vector<Sample>* samples) {
   return true;
 }
 
-// --cnn: trains the thermal classifier on the training split's patches (the script's ONNX next to
-// --out as thermal_cnn.onnx) and scores every sample with it: the ONNX, or nullopt and a message.
+// --cnn: trains the thermal classifier on the training split's patches (the script's ONNX into
+// --cnn-work) and scores every sample with it: the ONNX, or nullopt and a message.
 std::optional<std::string> TrainCnn(const Args& args, std::vector<Sample>* samples) {
   std::error_code ec;
   std::filesystem::create_directories(args.cnn_work, ec);
   const std::string patches = (std::filesystem::path(args.cnn_work) / "thermal_patches.bin").string();
-  const std::string onnx_path = (std::filesystem::path(args.out).parent_path() / "thermal_cnn.onnx").string();
+  const std::string onnx_path = (std::filesystem::path(args.cnn_work) / "thermal_cnn.onnx").string();
   if (!WritePatches(patches, *samples)) {
     std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", patches.c_str());
     return std::nullopt;
@@ -580,6 +581,12 @@ std::optional<Fitted> FitEvidence(const Args& args, const std::vector<Sample>& a
   e.radius_m = args.radius_m;
   if (onnx) {
     fit.loss = FitWithClassifier(samples, &e);
+    if (!(e.cnn_weight > 0)) {
+      std::fprintf(stderr,
+                   "swarmbox-fit-thermal: the classifier's weight fits %g: the network adds nothing\n",
+                   e.cnn_weight);
+      return std::nullopt;
+    }
     e.cnn_model = "thermal_cnn.onnx";
     e.cnn_onnx = std::make_shared<const std::string>(*onnx);
   } else {
@@ -722,8 +729,11 @@ int main(int argc, char** argv) {
   if (!args->samples.empty() && !WriteSamples(*args, &*samples)) return 1;
   const std::optional<Fitted> fit = FitEvidence(*args, *samples, onnx);
   if (!fit) return 1;
-  if (!WriteFit(*args, *fit)) {
-    std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s\n", args->out.c_str());
+  // The network beside the fit only once the fit is usable: the two ship as a pair.
+  const std::filesystem::path onnx_out = std::filesystem::path(args->out).parent_path() / "thermal_cnn.onnx";
+  if (!WriteFit(*args, *fit) || (onnx && !(std::ofstream(onnx_out, std::ios::binary) << *onnx))) {
+    std::fprintf(stderr, "swarmbox-fit-thermal: cannot write %s or %s\n", args->out.c_str(),
+                 onnx_out.c_str());
     return 1;
   }
   const swarm::ThermalEvidence& e = fit->evidence;
