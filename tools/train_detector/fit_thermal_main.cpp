@@ -539,10 +539,13 @@ std::optional<std::string> TrainCnn(const Args& args, std::vector<Sample>* sampl
   return onnx;
 }
 
-// The fusion's weights on (logit, contrast, the classifier's logit, 1) into `e` and its log-loss.
-// A term whose weight comes out <= 0 is dropped (its weight 0) and the rest refitted: the
-// classifier can hold all the colour confidence or the contrast tell about these candidates.
-double FitWithClassifier(const std::vector<Sample>& samples, swarm::ThermalEvidence* e) {
+// The fusion's weights on (logit, contrast, the classifier's logit, 1) into `e`, with the network
+// `onnx`, and its log-loss. A term whose weight comes out <= 0 is dropped (its weight 0) and the
+// rest refitted: the classifier can hold all the colour confidence or the contrast tell about
+// these candidates. The classifier's own weight <= 0 (a network that adds nothing) is said on
+// stderr; the caller refuses it.
+double FitWithClassifier(const std::vector<Sample>& samples, const std::string& onnx,
+                         swarm::ThermalEvidence* e) {
   std::array<bool, 2> use{true, true};  // the colour logit, the contrast
   for (;;) {
     auto features = [&use](const Sample& s) {
@@ -553,6 +556,12 @@ double FitWithClassifier(const std::vector<Sample>& samples, swarm::ThermalEvide
     if (!drop_colour && !drop_contrast) {
       e->colour_weight = use[0] ? w[0] : 0.0, e->slope_per_k = use[1] ? w[1] : 0.0;
       e->cnn_weight = w[2], e->bias = w[3];
+      e->cnn_model = "thermal_cnn.onnx";
+      e->cnn_onnx = std::make_shared<const std::string>(onnx);
+      if (!(w[2] > 0))
+        std::fprintf(stderr,
+                     "swarmbox-fit-thermal: the classifier's weight fits %g: the network adds nothing\n",
+                     w[2]);
       return LogLoss<4>(samples, w, features);
     }
     use[0] = use[0] && !drop_colour, use[1] = use[1] && !drop_contrast;
@@ -580,15 +589,8 @@ std::optional<Fitted> FitEvidence(const Args& args, const std::vector<Sample>& a
   swarm::ThermalEvidence& e = fit.evidence;
   e.radius_m = args.radius_m;
   if (onnx) {
-    fit.loss = FitWithClassifier(samples, &e);
-    if (!(e.cnn_weight > 0)) {
-      std::fprintf(stderr,
-                   "swarmbox-fit-thermal: the classifier's weight fits %g: the network adds nothing\n",
-                   e.cnn_weight);
-      return std::nullopt;
-    }
-    e.cnn_model = "thermal_cnn.onnx";
-    e.cnn_onnx = std::make_shared<const std::string>(*onnx);
+    fit.loss = FitWithClassifier(samples, *onnx, &e);
+    if (!(e.cnn_weight > 0)) return std::nullopt;
   } else {
     auto both = [](const Sample& s) { return std::array<double, 3>{s.logit, s.contrast_k, 1.0}; };
     const std::array<double, 3> w = Fit<3>(samples, both);
