@@ -42,6 +42,20 @@ function(swarmbox_target_defaults target)
   target_compile_options(${target} PRIVATE $<$<COMPILE_LANGUAGE:CXX>:${SWARMBOX_WARNINGS}>)
 endfunction()
 
+# swarmbox_embed_file(<input> <output.cpp> <symbol> <namespace> <comment>) generates output.cpp
+# at build time, defining `const unsigned char symbol[]` (input's bytes, plus a NUL) and
+# `const std::size_t symbolSize` in namespace (cmake/SwarmboxEmbed.cmake): a file compiled into a
+# library, regenerated whenever it changes.
+function(swarmbox_embed_file input output symbol namespace comment)
+  add_custom_command(
+    OUTPUT ${output}
+    COMMAND ${CMAKE_COMMAND} -DINPUT=${input} -DOUTPUT=${output} -DSYMBOL=${symbol} -DNAMESPACE=${namespace}
+            -P ${PROJECT_SOURCE_DIR}/cmake/SwarmboxEmbed.cmake
+    DEPENDS ${input} ${PROJECT_SOURCE_DIR}/cmake/SwarmboxEmbed.cmake
+    COMMENT "${comment}"
+    VERBATIM)
+endfunction()
+
 # swarmbox_add_library(<name> <add_library arguments>... [LINK <target_link_libraries arguments>...])
 # declares a component's library swarmbox_<name> and its alias swarmbox::<name>, with the
 # component's include/ folder as its public headers, its links and swarmbox_target_defaults().

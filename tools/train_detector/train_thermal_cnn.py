@@ -25,24 +25,16 @@ and trials than the training split's).
 """
 import argparse
 import struct
-import sys
 import time
 
 import numpy as np
 
-try:
-    import torch
-    from torch import nn
-except ImportError:
-    sys.stderr.write("train_thermal_cnn.py: torch is missing: run scripts/setup_training.sh "
-                     "(apt-get install python3-torch) and use Debian's /usr/bin/python3\n")
-    sys.exit(3)
-
-from train_cnn import PatchNet  # the same blocks (this script's folder is on sys.path)
+# The same blocks, torch (train_cnn.py says how to install it when it is missing) and the splits'
+# codes (this script's folder is on sys.path).
+from train_cnn import CALIBRATION, TRAINING, PatchNet, nn, torch
 
 MAGIC = b"SWBTHERM"
 HEADER = struct.Struct("<8sIIQ")
-TRAINING, CALIBRATION = 0, 1
 
 
 def read_patches(path):
